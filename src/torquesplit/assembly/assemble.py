@@ -1,0 +1,253 @@
+"""Model -> Structure: number the DOFs, build the diagonal mass and the element list.
+
+Element kinds produced here (DESIGN.md §4):
+
+==============  ==========================================  =========================
+element         deformation ``V . q``                         stiffness
+==============  ==========================================  =========================
+mesh            ``n.(u_d - u_n) + arm_d th_d - arm_n th_n``   k(phase) table [N/m]
+shaft           ``th_a - th_b``                               torsional [N m/rad]
+support         ``u_i`` (one translational DOF)               bearing [N/m], clearance
+spline radial   ``u_hub,i - u_float,i``                       contact [N/m], clearance
+==============  ==========================================  =========================
+
+Bodies joined by a rigid shaft share one rotational DOF.  A drive in ``speed`` mode
+prescribes its body's rotation: that DOF is removed.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ModelError
+from ..model.kinematics import Kinematics, solve_kinematics
+from ..model.schema import Model
+from . import excitation
+from .structure import MESH, SPRING, Structure, build_structure
+
+
+@dataclass(frozen=True)
+class DofMap:
+    """Where each body's coordinates live in the state vector."""
+
+    theta: dict[str, tuple[int, float]]
+    """body -> (DOF index or -1 if prescribed, sign relative to the DOF's axis)."""
+    translation: dict[str, dict[str, int]]
+    """body -> {'x': index, ...}."""
+    names: tuple[str, ...]
+
+
+def number_dofs(model: Model, kin: Kinematics) -> tuple[DofMap, np.ndarray]:
+    """DOF numbering and the diagonal mass (inverse mass returned)."""
+    names: list[str] = []
+    mass: list[float] = []
+    theta: dict[str, tuple[int, float]] = {}
+    trans: dict[str, dict[str, int]] = {}
+    prescribed = {kin.groups[d.body] for d in model.drives.values() if d.mode == "speed"}
+    group_index: dict[str, int] = {}
+    for body in model.body_names():
+        spec = model.gears.get(body) or model.bodies[body]
+        bk = kin.bodies[body]
+        rep = kin.groups[body]
+        sign = 1.0 if float(kin.bodies[rep].axis @ bk.axis) > 0 else -1.0
+        if "theta" in spec.dofs or rep != body:
+            if rep in prescribed:
+                theta[body] = (-1, sign)
+            else:
+                if rep not in group_index:
+                    group_index[rep] = len(names)
+                    names.append(f"{rep}.theta")
+                    mass.append(0.0)
+                idx = group_index[rep]
+                mass[idx] += bk.polar_inertia
+                theta[body] = (idx, sign)
+        trans[body] = {}
+        for d in ("x", "y", "z"):
+            if d in spec.dofs:
+                trans[body][d] = len(names)
+                names.append(f"{body}.{d}")
+                mass.append(bk.mass)
+    m = np.asarray(mass)
+    if np.any(m <= 0):
+        bad = [names[i] for i in np.flatnonzero(m <= 0)]
+        raise ModelError([("", f"DOFs {bad} have no mass or inertia; give 'mass'/'polar_inertia'")])
+    return DofMap(theta=theta, translation=trans, names=tuple(names)), 1.0 / m
+
+
+def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None = None,
+             options: dict | None = None) -> Structure:
+    """Assemble the equations of motion of ``model`` (see module docstring)."""
+    kin = kin or solve_kinematics(model)
+    n_table = n_table or model.analysis.table_points
+    dmap, inv_mass = number_dofs(model, kin)
+    n_dof = len(dmap.names)
+    elements: list[dict] = []
+    ext = np.zeros(n_dof)
+    ground = np.zeros(n_dof)
+    meta_meshes = {}
+
+    phases = excitation.mesh_phases(model, kin)
+
+    # ---- meshes
+    for name, mesh in model.meshes.items():
+        mk = kin.meshes[name]
+        dofs, coefs = [], []
+        for body, sgn, arm in ((mk.driver, 1.0, mk.arm_driver), (mk.driven, -1.0, mk.arm_driven)):
+            idx, s = dmap.theta.get(body, (-1, 1.0))
+            if idx >= 0:
+                dofs.append(idx)
+                coefs.append(sgn * arm * s)
+            for d, comp in zip("xyz", mk.line_of_action):
+                j = dmap.translation[body].get(d)
+                if j is not None and comp != 0.0:
+                    dofs.append(j)
+                    coefs.append(sgn * comp)
+        table = excitation.stiffness_table(model, kin, name, n_table)
+        k_mean = float(np.mean(table))
+        if mesh.damping is not None:
+            c = mesh.damping
+        elif mesh.damping_ratio is not None:
+            # c = 2 zeta sqrt(k m_eq), m_eq = J1 J2 / (J1 r2^2 + J2 r1^2) (seed 001 eq. 1, corrected)
+            c = 2 * mesh.damping_ratio * math.sqrt(k_mean * mk.equivalent_mass)
+        else:
+            c = 0.0
+        gaps = excitation.half_backlash_sequence(model, kin, name)
+        err_const, sines = excitation.mesh_errors(model, kin, name)
+        el = dict(
+            name=name, kind=MESH, dofs=dofs, coefs=coefs, stiffness=table,
+            frequency=mk.frequency, phase=phases[name], damping=c, gaps=gaps,
+            error_constant=err_const, errors=sines,
+        )
+        force = excitation.impact_force_table(model, kin, name, n_table)
+        if force is not None:
+            el["force"] = force
+        elements.append(el)
+        meta_meshes[name] = dict(stage=excitation.stage_label(model, name), path=mesh.path,
+                                 driver=mk.driver, driven=mk.driven,
+                                 static_force=mk.force, frequency=mk.frequency)
+
+    # ---- shafts
+    for name, shaft in model.shafts.items():
+        if shaft.rigid:
+            continue
+        a, b = shaft.connects
+        ia, sa = dmap.theta[a]
+        ib, sb = dmap.theta[b]
+        r = 1.0 if float(kin.bodies[a].axis @ kin.bodies[b].axis) > 0 else -1.0
+        dofs, coefs = [], []
+        if ia >= 0:
+            dofs.append(ia)
+            coefs.append(sa)
+        if ib >= 0:
+            dofs.append(ib)
+            coefs.append(-r * sb)
+        k = shaft.torsional_stiffness
+        if k is None:
+            # seed 001 eq. 3: k_T = G pi d^4 / (32 l) (hollow: d^4 - d_i^4)
+            k = shaft.shear_modulus * math.pi * (shaft.diameter**4 - shaft.inner_diameter**4) / (
+                32 * shaft.length)
+        ja, jb = kin.bodies[a].polar_inertia, kin.bodies[b].polar_inertia
+        if shaft.damping is not None:
+            c = shaft.damping
+        elif shaft.damping_ratio is not None:
+            c = 2 * shaft.damping_ratio * math.sqrt(k * ja * jb / (ja + jb))
+        else:
+            c = 0.0
+        if dofs:
+            elements.append(dict(name=name, kind=SPRING, dofs=dofs, coefs=coefs, stiffness=k,
+                                 damping=c))
+
+    # ---- supports
+    for body in model.body_names():
+        spec = model.gears.get(body) or model.bodies[body]
+        tr = dmap.translation[body]
+        if not tr:
+            continue
+        sup = spec.support
+        if sup is None:
+            raise ModelError([(f"{'gears' if body in model.gears else 'bodies'}.{body}.support",
+                               f"DOFs {sorted(tr)} have no support; add a support with a "
+                               f"stiffness, or remove them from 'dofs'")])
+        k_rad = support_stiffness(sup)
+        for d, j in tr.items():
+            k = k_rad if d != "z" else (sup.axial_stiffness or k_rad)
+            m = kin.bodies[body].mass
+            if sup.damping is not None:
+                c = sup.damping
+            elif sup.damping_ratio is not None:
+                c = 2 * sup.damping_ratio * math.sqrt(k * m)
+            else:
+                c = 0.0
+            elements.append(dict(name=f"{body}.support.{d}", kind=SPRING, dofs=[j], coefs=[1.0],
+                                 stiffness=k, damping=c, gaps=sup.clearance))
+
+    # ---- splines (torsion + radial clearance; friction: see docs/theory)
+    for name, sp in model.splines.items():
+        hub, flo = sp.connects
+        ih, sh = dmap.theta[hub]
+        if_, sf = dmap.theta[flo]
+        dofs, coefs = [], []
+        if ih >= 0:
+            dofs.append(ih)
+            coefs.append(sh)
+        if if_ >= 0:
+            dofs.append(if_)
+            coefs.append(-sf)
+        if dofs:
+            elements.append(dict(name=f"{name}.torsion", kind=SPRING, dofs=dofs, coefs=coefs,
+                                 stiffness=sp.torsional_stiffness))
+        for d in ("x", "y"):
+            jh = dmap.translation[hub].get(d)
+            jf = dmap.translation[flo].get(d)
+            if jh is None and jf is None:
+                continue
+            dofs, coefs = [], []
+            if jh is not None:
+                dofs.append(jh)
+                coefs.append(1.0)
+            if jf is not None:
+                dofs.append(jf)
+                coefs.append(-1.0)
+            elements.append(dict(name=f"{name}.radial.{d}", kind=SPRING, dofs=dofs, coefs=coefs,
+                                 stiffness=sp.stiffness, gaps=sp.radial_clearance))
+
+    # ---- drives and loads
+    for name, d in model.drives.items():
+        idx, s = dmap.theta[d.body]
+        if idx >= 0 and d.mode == "torque":
+            ext[idx] += s * math.copysign(kin.drive_torques[name], d.speed)
+    for name, ld in model.loads.items():
+        idx, s = dmap.theta[ld.body]
+        if idx >= 0:
+            w = kin.bodies[ld.body].speed
+            ext[idx] -= s * math.copysign(kin.load_torques[name], w)
+            ground[idx] += ld.speed_coefficient
+
+    meta = dict(
+        model_name=model.model.name,
+        meshes=meta_meshes,
+        dof_map=dmap,
+        mesh_names=list(model.meshes),
+    )
+    return build_structure(dmap.names, inv_mass, elements, external_force=ext,
+                           ground_damping=ground, n_table=n_table, metadata=meta)
+
+
+def support_stiffness(sup) -> float:
+    """Radial support stiffness, from the value or from shaft bending in series."""
+    if sup.stiffness is not None:
+        return sup.stiffness
+    sh = sup.shaft
+    a = sh.position
+    b = sh.span - a
+    inertia = math.pi * sh.diameter**4 / 64
+    # seed 001 eqs. 5-7: simply supported shaft, load at a from one bearing:
+    # deflection y = F a^2 b^2 / (3 E I l)  =>  k_S = 3 E I l / (a^2 b^2)
+    k_shaft = 3 * sh.youngs_modulus * inertia * sh.span / (a**2 * b**2)
+    if sh.bearing_stiffness is None:
+        return k_shaft
+    # seed 001 eq. 10: bearing in series with the shaft, k' = k_S k_C / (k_S + k_C)
+    return k_shaft * sh.bearing_stiffness / (k_shaft + sh.bearing_stiffness)

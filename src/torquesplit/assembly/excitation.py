@@ -1,0 +1,188 @@
+"""Periodic excitation tables of the meshes: stiffness, phasing, backlash, errors, impact.
+
+Each function turns the model's description of one mesh into the arrays the
+:class:`~torquesplit.assembly.structure.Structure` holds, by calling the physics in
+:mod:`torquesplit.gears`.  Phase 0 of a mesh cycle is when a new tooth pair enters
+contact.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..gears import line_of_action as loa
+from ..model.kinematics import Kinematics
+from ..model.schema import Model
+
+
+def stage_label(model: Model, mesh_name: str) -> str:
+    """The mesh's stage: the model's label, or the tooth-count pair of its gears."""
+    mesh = model.meshes[mesh_name]
+    if mesh.stage:
+        return mesh.stage
+    za, zb = sorted(model.gears[g].teeth for g in mesh.gears)
+    return f"{za}/{zb}"
+
+
+# --------------------------------------------------------------------------- stiffness
+def stiffness_table(model: Model, kin: Kinematics, mesh_name: str, n: int) -> np.ndarray:
+    """k(phase) sampled at ``n`` uniform mesh phases [N/m]."""
+    spec = model.meshes[mesh_name].stiffness
+    phase = np.arange(n) / n
+    mk = kin.meshes[mesh_name]
+    if spec.method == "constant":
+        if spec.peak_to_peak == 0:
+            return np.full(n, spec.value)
+        return contact_zone_wave(phase, spec.value, spec.peak_to_peak,
+                                 _profile_contact_ratio(mk))
+    if spec.method == "table":
+        src = np.asarray(spec.phase)
+        order = np.argsort(src)
+        return np.interp(phase, src[order], np.asarray(spec.values)[order], period=1.0)
+    if spec.method == "fourier":
+        k = np.full(n, spec.mean)
+        for i, a in enumerate(spec.cos, start=1):
+            k += a * np.cos(2 * np.pi * i * phase)
+        for i, b in enumerate(spec.sin, start=1):
+            k += b * np.sin(2 * np.pi * i * phase)
+        if np.any(k <= 0):
+            raise ValueError(f"meshes.{mesh_name}.stiffness: the Fourier series becomes negative; "
+                             f"check the coefficients against the mean")
+        return k
+    from ..gears import stiffness as gst
+
+    if mk.geometry is None:
+        raise ValueError(f"meshes.{mesh_name}.stiffness: method {spec.method!r} needs a "
+                         f"cylindrical pair; give a table or a constant for bevel/face meshes")
+    opts = {}
+    if spec.method == "potential_energy":
+        opts = dict(fillet_foundation=spec.fillet_foundation, slices=spec.slices)
+    ms = gst.mesh_stiffness(mk.geometry, spec.method, n=n, **opts)
+    return np.interp(phase, np.asarray(ms.phase), np.asarray(ms.stiffness), period=1.0)
+
+
+def _profile_contact_ratio(mk) -> float:
+    eps = mk.transverse_contact_ratio
+    return eps if math.isfinite(eps) else 1.5
+
+
+def contact_zone_wave(phase: np.ndarray, mean: float, peak_to_peak: float, contact_ratio: float):
+    """Rectangular single/double contact wave with the given mean and relative p-p.
+
+    Over one mesh cycle ``ceil(eps) `` pairs are in contact for the fraction
+    ``eps - floor(eps)`` of the cycle (starting at phase 0), ``floor(eps)`` pairs
+    for the rest; the stiffness steps by ``peak_to_peak * mean`` between the two.
+    """
+    frac = contact_ratio - math.floor(contact_ratio)
+    high = phase < frac
+    dk = peak_to_peak * mean
+    k_low = mean - dk * frac
+    return np.where(high, k_low + dk, k_low)
+
+
+# --------------------------------------------------------------------------- phasing
+def mesh_phases(model: Model, kin: Kinematics) -> dict[str, float]:
+    """Mesh phase at t = 0 [cycles] of every mesh: override, else clocking.
+
+    Two meshes on one gear g are offset by ``-z_g sgn(w_g) (theta_2 - theta_1) / 2 pi``
+    cycles, theta being the angular positions of their contact points about g's axis
+    (a tooth reaches the second contact that much later).  Meshes reached from no
+    fixed reference start at phase 0.
+    """
+    phases: dict[str, float] = {}
+    on_gear: dict[str, list[str]] = {g: [] for g in model.gears}
+    for name, m in model.meshes.items():
+        for g in m.gears:
+            on_gear[g].append(name)
+    angle = {}
+    for name, m in model.meshes.items():
+        mk = kin.meshes[name]
+        for g in m.gears:
+            axis = kin.bodies[g].axis
+            e1 = loa.reference_direction(axis, 0.0)
+            e2 = np.cross(axis, e1)
+            r = mk.contact_point - kin.bodies[g].position
+            r = r - axis * float(r @ axis)
+            angle[(name, g)] = math.atan2(float(r @ e2), float(r @ e1))
+    order = [n for n, m in model.meshes.items() if m.phase is not None] + list(model.meshes)
+    for start in order:
+        if start in phases:
+            continue
+        m0 = model.meshes[start]
+        phases[start] = (m0.phase or 0.0) % 1.0
+        stack = [start]
+        while stack:
+            cur = stack.pop()
+            for g in model.meshes[cur].gears:
+                z = model.gears[g].teeth
+                s = 1.0 if kin.bodies[g].speed > 0 else -1.0
+                for other in on_gear[g]:
+                    if other in phases:
+                        continue
+                    if model.meshes[other].phase is not None:
+                        phases[other] = model.meshes[other].phase % 1.0
+                    else:
+                        d = angle[(other, g)] - angle[(cur, g)]
+                        phases[other] = (phases[cur] - z * s * d / (2 * math.pi)) % 1.0
+                    stack.append(other)
+    return phases
+
+
+# --------------------------------------------------------------------------- backlash
+def half_backlash_sequence(model: Model, kin: Kinematics, mesh_name: str) -> np.ndarray:
+    """Half backlash per engagement [m]: constant, or random per seed 001 eq. 14."""
+    spec = model.meshes[mesh_name].backlash
+    if spec.distribution == "constant" or spec.tolerance == 0:
+        return np.array([spec.nominal / 2])
+    from ..gears import backlash as gbl
+
+    za, zb = (model.gears[g].teeth for g in model.meshes[mesh_name].gears)
+    seq = gbl.backlash_sequence(
+        nominal=spec.nominal, tolerance=spec.tolerance, distribution=spec.distribution,
+        teeth=(za, zb), seed=spec.seed)
+    return np.asarray(seq) / 2
+
+
+# --------------------------------------------------------------------------- errors
+def mesh_errors(model: Model, kin: Kinematics, mesh_name: str):
+    """Constant error and sinusoids (amplitude, omega, phase) along the line of action."""
+    mesh = model.meshes[mesh_name]
+    mk = kin.meshes[mesh_name]
+    te = mesh.transmission_error
+    const = te.constant
+    sines = []
+    if te.amplitude:
+        sines.append((te.amplitude, 2 * math.pi * mk.frequency, te.phase))
+    from ..gears import errors as gerr
+
+    for g in mesh.gears:
+        ge = model.gears[g].errors
+        if not any((ge.eccentricity, ge.installation, ge.tooth_thickness, ge.pitch,
+                    ge.bearing_runout)):
+            continue
+        sign = 1.0 if g == mk.driver else -1.0
+        contrib = gerr.gear_errors_on_line_of_action(
+            gear_errors=ge, speed=kin.bodies[g].speed, axis=kin.bodies[g].axis,
+            center=kin.bodies[g].position, line_of_action=mk.line_of_action,
+            contact_point=mk.contact_point, teeth=model.gears[g].teeth,
+            mesh_frequency=mk.frequency)
+        const += sign * contrib.constant
+        for a, w, p in zip(contrib.amplitudes, contrib.omegas, contrib.phases):
+            sines.append((sign * a, w, p))
+    return const, sines
+
+
+# --------------------------------------------------------------------------- impact
+def impact_force_table(model: Model, kin: Kinematics, mesh_name: str, n: int):
+    """Meshing-in impact force over one mesh cycle [N], or None (seed 000 eqs. 6-10)."""
+    mesh = model.meshes[mesh_name]
+    if not mesh.impact:
+        return None
+    from ..gears import impact as gim
+
+    mk = kin.meshes[mesh_name]
+    if mk.geometry is None:
+        raise ValueError(f"meshes.{mesh_name}.impact: meshing-in impact needs a cylindrical pair")
+    return gim.impact_force_table_for_pair(mk, model, mesh_name, n)

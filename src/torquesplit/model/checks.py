@@ -1,0 +1,168 @@
+"""Checks a validated schema cannot express: references, topology, physics consistency.
+
+Errors are collected (all of them, not only the first) and raised as one
+:class:`~torquesplit.errors.ModelError`.  Values that look wrong but can be right are
+reported as :class:`~torquesplit.errors.ModelWarning`.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+from ..errors import ModelError, ModelWarning
+from .schema import Model
+
+
+def check_model(model: Model, source: str | None = None) -> None:
+    """Raise ModelError listing every problem found; warn on suspicious values."""
+    issues = reference_issues(model)
+    if not issues:
+        issues = topology_issues(model)
+    if not issues:
+        issues = mesh_compatibility_issues(model)
+    if issues:
+        raise ModelError(issues, source)
+    # the kinematic pass finds loops that cannot turn and power that does not balance
+    from .kinematics import KinematicsError, solve_kinematics
+
+    try:
+        kin = solve_kinematics(model)
+    except KinematicsError as exc:
+        raise ModelError(exc.issues, source) from None
+    for loc, msg in plausibility_warnings(model, kin):
+        warnings.warn(f"{source + ': ' if source else ''}{loc}: {msg}", ModelWarning, stacklevel=3)
+
+
+def reference_issues(model: Model) -> list[tuple[str, str]]:
+    """Names that refer to bodies which do not exist, duplicated names."""
+    issues = []
+    bodies = set(model.body_names())
+    for name in set(model.gears) & set(model.bodies):
+        issues.append((f"bodies.{name}", f"name {name!r} is used by a gear too; rename one"))
+
+    def need(loc, name, what="body"):
+        if name not in bodies:
+            issues.append((loc, f"{what} {name!r} does not exist; known bodies: {sorted(bodies)}"))
+
+    for name, g in model.gears.items():
+        if g.place is not None:
+            if g.place.from_gear not in model.gears:
+                issues.append((f"gears.{name}.place.from_gear",
+                               f"gear {g.place.from_gear!r} does not exist"))
+    for name, s in model.shafts.items():
+        for b in s.connects:
+            need(f"shafts.{name}.connects", b)
+        if s.connects[0] == s.connects[1]:
+            issues.append((f"shafts.{name}.connects", "a shaft must join two different bodies"))
+    for name, s in model.splines.items():
+        for b in s.connects:
+            need(f"splines.{name}.connects", b)
+    for name, m in model.meshes.items():
+        for g in m.gears:
+            if g not in model.gears:
+                issues.append((f"meshes.{name}.gears",
+                               f"gear {g!r} does not exist; known gears: {sorted(model.gears)}"))
+    for name, d in model.drives.items():
+        need(f"drives.{name}.body", d.body)
+    for name, ld in model.loads.items():
+        need(f"loads.{name}.body", ld.body)
+    if not model.drives:
+        issues.append(("drives", "the model has no drive; add a [drives.NAME] section"))
+    if not model.loads:
+        issues.append(("loads", "the model has no load; add a [loads.NAME] section"))
+    return issues
+
+
+def topology_issues(model: Model) -> list[tuple[str, str]]:
+    """Every body must be connected to the drive train; a drive and a load per train."""
+    issues = []
+    names = model.body_names()
+    adj: dict[str, set[str]] = {n: set() for n in names}
+    for m in model.meshes.values():
+        a, b = m.gears
+        adj[a].add(b)
+        adj[b].add(a)
+    for s in list(model.shafts.values()) + list(model.splines.values()):
+        a, b = s.connects
+        adj[a].add(b)
+        adj[b].add(a)
+    for n in names:
+        if not adj[n]:
+            kind = "gears" if n in model.gears else "bodies"
+            issues.append((f"{kind}.{n}", "this body is connected to nothing; add a mesh or a "
+                           "shaft that joins it to the gearbox, or delete it"))
+    if issues:
+        return issues
+    # connected components: each needs a drive and a load
+    seen: set[str] = set()
+    for start in names:
+        if start in seen:
+            continue
+        comp = {start}
+        stack = [start]
+        while stack:
+            for nb in adj[stack.pop()]:
+                if nb not in comp:
+                    comp.add(nb)
+                    stack.append(nb)
+        seen |= comp
+        has_drive = any(d.body in comp for d in model.drives.values())
+        has_load = any(ld.body in comp for ld in model.loads.values())
+        if len(comp) < len(names) or not (has_drive and has_load):
+            if not has_drive or not has_load:
+                missing = "drive" if not has_drive else "load"
+                issues.append(("", f"bodies {sorted(comp)} form a separate gear train without a "
+                               f"{missing}; connect them to the rest or add a {missing}"))
+    return issues
+
+
+def mesh_compatibility_issues(model: Model) -> list[tuple[str, str]]:
+    """Meshing gears must share module, pressure angle and (opposite) helix."""
+    issues = []
+    for name, m in model.meshes.items():
+        a, b = (model.gears[g] for g in m.gears)
+        loc = f"meshes.{name}"
+        if not math.isclose(a.module, b.module, rel_tol=1e-6):
+            issues.append((loc, f"gears {m.gears[0]!r} and {m.gears[1]!r} cannot mesh: modules "
+                           f"{a.module * 1e3:g} mm and {b.module * 1e3:g} mm differ; make them equal"))
+        if not math.isclose(a.pressure_angle, b.pressure_angle, rel_tol=1e-6):
+            issues.append((loc, f"gears {m.gears[0]!r} and {m.gears[1]!r} cannot mesh: pressure "
+                           f"angles {math.degrees(a.pressure_angle):g} deg and "
+                           f"{math.degrees(b.pressure_angle):g} deg differ; make them equal"))
+        conical = {a.gear_type, b.gear_type} & {"bevel", "face"}
+        if not conical and not math.isclose(abs(a.helix_angle), abs(b.helix_angle), rel_tol=1e-6,
+                                            abs_tol=1e-9):
+            issues.append((loc, f"gears {m.gears[0]!r} and {m.gears[1]!r} cannot mesh: helix "
+                           f"angles {math.degrees(a.helix_angle):g} deg and "
+                           f"{math.degrees(b.helix_angle):g} deg differ"))
+        internal = [a.gear_type == "internal", b.gear_type == "internal"]
+        if all(internal):
+            issues.append((loc, "two internal gears cannot mesh; one must be external"))
+        elif (not conical and a.helix_angle != 0 and a.hand is not None and b.hand is not None
+              and not any(internal) and a.hand == b.hand
+              and "double_helical" not in (a.gear_type, b.gear_type)):
+            issues.append((loc, f"external helical gears {m.gears[0]!r} and {m.gears[1]!r} are both "
+                           f"{a.hand}-handed; meshing external helical gears need opposite hands"))
+    return issues
+
+
+def plausibility_warnings(model: Model, kin) -> list[tuple[str, str]]:
+    """Values that can be right but usually are not."""
+    out = []
+    for name, mk in kin.meshes.items():
+        m = model.meshes[name]
+        if m.damping_ratio is not None and m.damping_ratio > 1:
+            out.append((f"meshes.{name}.damping_ratio",
+                        f"{m.damping_ratio:g} is above critical damping (1); typical 0.02-0.1"))
+        if m.damping is not None and mk.critical_damping > 0 and m.damping > mk.critical_damping:
+            out.append((f"meshes.{name}.damping",
+                        f"{m.damping:g} N s/m is {m.damping / mk.critical_damping:.1f} times "
+                        f"critical for this mesh; typical mesh damping ratios are 0.02-0.1"))
+        iso = mk.iso_stiffness
+        spec = m.stiffness
+        if spec.method == "constant" and iso and not (0.2 < spec.value / iso < 5):
+            out.append((f"meshes.{name}.stiffness",
+                        f"{spec.value:.3g} N/m is {spec.value / iso:.2g} times the ISO 6336 estimate "
+                        f"c_gamma*b = {iso:.3g} N/m; check the value and its unit"))
+    return out

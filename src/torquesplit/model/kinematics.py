@@ -1,0 +1,484 @@
+"""Nominal kinematics and statics of a model: layout, speeds, power flow, torques, forces.
+
+This is the rigid-body solution about which the dynamic model vibrates:
+
+* layout: each gear's centre and axis (given, placed from a mating gear, or
+  inherited from the body it shares a shaft with);
+* per mesh: the contact frame (pitch point, radial and tangential unit vectors of each
+  gear), pitch and base radii, contact ratios, the line of action as a 3-D unit vector;
+* speeds propagated from the first drive through meshes and shafts; a power-split loop
+  whose paths give different speeds is an error (it could not turn);
+* power flow with an equal split at every branching (the nominal design split), from
+  which each mesh's driver, torque and tooth force follow.
+
+All values SI.  Angles of rotation are signed about each body's own axis.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..gears import line_of_action as loa
+from ..gears.geometry import GearGeometry, PairGeometry
+from .schema import Gear, Model
+
+
+class KinematicsError(ValueError):
+    """Raised with a list of (location, message) issues; turned into ModelError."""
+
+    def __init__(self, issues):
+        self.issues = issues
+        super().__init__("; ".join(f"{a}: {b}" for a, b in issues))
+
+
+@dataclass(frozen=True)
+class BodyKinematics:
+    """Nominal state of one body."""
+
+    name: str
+    position: np.ndarray
+    axis: np.ndarray
+    speed: float
+    """Signed angular speed about the body's axis [rad/s]."""
+    torque: float
+    """Torque magnitude carried through the body for the equal split [N m]."""
+    power: float
+    """Power through the body [W]."""
+    mass: float
+    polar_inertia: float
+    mass_computed: bool
+    inertia_computed: bool
+
+
+@dataclass(frozen=True)
+class MeshKinematics:
+    """Nominal geometry and loading of one mesh."""
+
+    name: str
+    driver: str
+    driven: str
+    frequency: float
+    """Mesh frequency [Hz]."""
+    contact_point: np.ndarray
+    line_of_action: np.ndarray
+    """Unit vector of the force the driver exerts on the driven gear."""
+    arm_driver: float
+    """(rho x n) . a of the driver [m]: torque per unit mesh force about its axis."""
+    arm_driven: float
+    pitch_radii: tuple[float, float]
+    base_radii: tuple[float, float]
+    transverse_contact_ratio: float
+    overlap_contact_ratio: float
+    total_contact_ratio: float
+    working_pressure_angle: float
+    center_distance: float
+    torque_driver: float
+    """Torque the mesh takes from the driver for the equal split [N m]."""
+    torque_driven: float
+    force: float
+    """Nominal normal tooth force along the line of action [N]."""
+    power: float
+    equivalent_mass: float
+    """J1 J2 / (J1 rb2^2 + J2 rb1^2) [kg], the mesh's torsional equivalent mass."""
+    critical_damping: float
+    """2 sqrt(k m_eq) with the mean mesh stiffness [N s/m]."""
+    iso_stiffness: float | None
+    """ISO 6336-1 estimate c_gamma * b [N/m] (cylindrical pairs only)."""
+    conical: bool
+    geometry: PairGeometry | None = field(default=None, repr=False, compare=False)
+
+
+@dataclass(frozen=True)
+class Kinematics:
+    """The rigid-body (nominal) solution of a model."""
+
+    bodies: dict[str, BodyKinematics]
+    meshes: dict[str, MeshKinematics]
+    input_power: float
+    output_power: float
+    load_torques: dict[str, float]
+    """Resisting torque magnitude of each load [N m]."""
+    drive_torques: dict[str, float]
+    groups: dict[str, str]
+    """Body -> representative of its rigid group (bodies joined by rigid shafts)."""
+    positions_computed: list[str]
+
+
+# --------------------------------------------------------------------------- helpers
+def gear_geometry(gear: Gear) -> GearGeometry:
+    """The involute geometry of a schema gear."""
+    return GearGeometry(
+        teeth=gear.teeth,
+        normal_module=gear.module,
+        normal_pressure_angle=gear.pressure_angle,
+        helix_angle=abs(gear.helix_angle),
+        face_width=gear.face_width,
+        profile_shift=gear.profile_shift,
+        internal=gear.gear_type == "internal",
+        double_helical=gear.gear_type == "double_helical",
+    )
+
+
+def _unit(v) -> np.ndarray:
+    v = np.asarray(v, dtype=float)
+    return v / np.linalg.norm(v)
+
+
+def _perp_unit(v: np.ndarray, axis: np.ndarray) -> np.ndarray:
+    """Component of v perpendicular to axis, normalised (any perpendicular if v || axis)."""
+    w = v - axis * (v @ axis)
+    n = np.linalg.norm(w)
+    if n < 1e-12:
+        trial = np.array([1.0, 0.0, 0.0]) if abs(axis[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+        w = trial - axis * (trial @ axis)
+        n = np.linalg.norm(w)
+    return w / n
+
+
+def gear_mass_properties(gear: Gear) -> tuple[float, float, bool, bool]:
+    """Mass and polar inertia, from the model or from a solid disc of the pitch diameter."""
+    geo = gear_geometry(gear)
+    d = 2 * geo.reference_radius
+    width = gear.face_width * (2 if gear.gear_type == "double_helical" else 1)
+    di = min(gear.bore_diameter, 0.9 * d)
+    m_geo = gear.density * math.pi * (d**2 - di**2) / 4 * width
+    j_geo = m_geo * (d**2 + di**2) / 8
+    mass = gear.mass if gear.mass is not None else m_geo
+    inertia = gear.polar_inertia if gear.polar_inertia is not None else j_geo
+    return mass, inertia, gear.mass is None, gear.polar_inertia is None
+
+
+# --------------------------------------------------------------------------- solver
+def solve_kinematics(model: Model) -> Kinematics:
+    """Layout, speeds, power flow, torques and forces of the nominal equal split."""
+    issues: list[tuple[str, str]] = []
+    groups = _rigid_groups(model)
+    positions, axes, computed = _layout(model, issues)
+    if issues:
+        raise KinematicsError(issues)
+
+    frames = {}
+    for name, mesh in model.meshes.items():
+        try:
+            frames[name] = loa.contact_frame(model, name, positions, axes)
+        except ValueError as exc:
+            issues.append((f"meshes.{name}", str(exc)))
+    if issues:
+        raise KinematicsError(issues)
+
+    speeds = _propagate_speeds(model, axes, frames, issues)
+    if issues:
+        raise KinematicsError(issues)
+
+    power, edge_power, drivers, drive_torques, load_torques, p_in, p_out = _power_flow(
+        model, speeds, groups, issues
+    )
+    if issues:
+        raise KinematicsError(issues)
+
+    bodies = {}
+    for name in model.body_names():
+        if name in model.gears:
+            mass, inertia, mc, ic = gear_mass_properties(model.gears[name])
+        else:
+            b = model.bodies[name]
+            mass, inertia, mc, ic = (b.mass or 0.0), b.polar_inertia, False, False
+        w = speeds[name]
+        p = power.get(name, 0.0)
+        bodies[name] = BodyKinematics(
+            name=name, position=positions[name], axis=axes[name], speed=w,
+            torque=p / abs(w), power=p, mass=mass, polar_inertia=inertia,
+            mass_computed=mc, inertia_computed=ic,
+        )
+
+    meshes = {}
+    for name, mesh in model.meshes.items():
+        driver, driven = drivers[name]
+        fr = frames[name]
+        n_vec, arm_d, arm_n = loa.line_of_action(model, name, fr, driver, speeds)
+        za = model.gears[driver].teeth
+        freq = abs(speeds[driver]) * za / (2 * math.pi)
+        p_mesh = edge_power[name]
+        t_drv = p_mesh / abs(speeds[driver])
+        t_dvn = p_mesh / abs(speeds[driven])
+        force = t_drv / abs(arm_d)
+        ja, jb = bodies[driver].polar_inertia, bodies[driven].polar_inertia
+        # equivalent mass of the mesh, m = J1 J2 / (J1 r2^2 + J2 r1^2), with the arms
+        # as the effective base radii (issue 2; seed 001 eq. 1 corrected)
+        m_eq = ja * jb / (ja * arm_n**2 + jb * arm_d**2)
+        spec = mesh.stiffness
+        k_mean = _mean_stiffness(spec)
+        crit = 2 * math.sqrt(k_mean * m_eq) if k_mean else 0.0
+        i0, i1 = (0, 1) if mesh.gears[0] == driver else (1, 0)
+        geo = fr.pair_geometry
+        iso = None
+        if geo is not None:
+            iso = _iso_estimate(geo)
+        meshes[name] = MeshKinematics(
+            name=name, driver=driver, driven=driven, frequency=freq,
+            contact_point=fr.contact_point, line_of_action=n_vec,
+            arm_driver=arm_d, arm_driven=arm_n,
+            pitch_radii=(fr.pitch_radii[i0], fr.pitch_radii[i1]),
+            base_radii=(fr.base_radii[i0], fr.base_radii[i1]),
+            transverse_contact_ratio=fr.transverse_contact_ratio,
+            overlap_contact_ratio=fr.overlap_contact_ratio,
+            total_contact_ratio=fr.transverse_contact_ratio + fr.overlap_contact_ratio,
+            working_pressure_angle=fr.working_pressure_angle,
+            center_distance=fr.center_distance,
+            torque_driver=t_drv, torque_driven=t_dvn, force=force, power=p_mesh,
+            equivalent_mass=m_eq, critical_damping=crit, iso_stiffness=iso,
+            conical=fr.conical, geometry=geo,
+        )
+    return Kinematics(
+        bodies=bodies, meshes=meshes, input_power=p_in, output_power=p_out,
+        load_torques=load_torques, drive_torques=drive_torques, groups=groups,
+        positions_computed=computed,
+    )
+
+
+def _iso_estimate(geo) -> float | None:
+    """ISO 6336-1 c_gamma * b of a cylindrical pair [N/m] (None if not applicable)."""
+    try:
+        from ..gears.stiffness import iso6336_mesh_stiffness_value
+    except ImportError:
+        return None
+    try:
+        return float(iso6336_mesh_stiffness_value(geo))
+    except ValueError:
+        return None
+
+
+def _mean_stiffness(spec) -> float | None:
+    if spec.method == "constant":
+        return spec.value
+    if spec.method == "table":
+        return float(np.mean(spec.values))
+    if spec.method == "fourier":
+        return spec.mean
+    return None
+
+
+def _rigid_groups(model: Model) -> dict[str, str]:
+    parent = {n: n for n in model.body_names()}
+
+    def find(a):
+        while parent[a] != a:
+            parent[a] = parent[parent[a]]
+            a = parent[a]
+        return a
+
+    for s in model.shafts.values():
+        if s.rigid:
+            a, b = (find(x) for x in s.connects)
+            if a != b:
+                parent[b] = a
+    return {n: find(n) for n in parent}
+
+
+def _layout(model: Model, issues) -> tuple[dict, dict, list[str]]:
+    """Centre and unit axis of every body."""
+    positions: dict[str, np.ndarray] = {}
+    axes: dict[str, np.ndarray] = {}
+    computed: list[str] = []
+    for name, b in model.bodies.items():
+        positions[name] = np.asarray(b.position, dtype=float)
+        axes[name] = _unit(b.axis)
+    for name, g in model.gears.items():
+        axes[name] = _unit(g.axis)
+        if g.position is not None:
+            positions[name] = np.asarray(g.position, dtype=float)
+    # place gears relative to mating gears / coaxial bodies until nothing changes
+    mates: dict[str, list[str]] = {n: [] for n in model.gears}
+    for m in model.meshes.values():
+        a, b = m.gears
+        mates[a].append(b)
+        mates[b].append(a)
+    coaxial: dict[str, list[str]] = {n: [] for n in model.body_names()}
+    for s in list(model.shafts.values()) + list(model.splines.values()):
+        a, b = s.connects
+        coaxial[a].append(b)
+        coaxial[b].append(a)
+    pending = [n for n in model.gears if n not in positions]
+    auto_count: dict[str, int] = {}
+    progress = True
+    while pending and progress:
+        progress = False
+        for name in list(pending):
+            g = model.gears[name]
+            if g.place is not None:
+                ref = g.place.from_gear
+                if ref in positions:
+                    positions[name] = loa.placed_position(
+                        model, name, ref, positions[ref], axes[ref], g.place.angle)
+                    pending.remove(name)
+                    progress = True
+                continue
+            co = [b for b in coaxial[name] if b in positions]
+            if co:
+                positions[name] = positions[co[0]].copy()
+                computed.append(name)
+                pending.remove(name)
+                progress = True
+                continue
+            mt = [b for b in mates[name] if b in positions]
+            if mt:
+                ref = mt[0]
+                k = auto_count.get(ref, 0)
+                auto_count[ref] = k + 1
+                positions[name] = loa.placed_position(
+                    model, name, ref, positions[ref], axes[ref], math.pi * k)
+                computed.append(name)
+                pending.remove(name)
+                progress = True
+        if pending and not progress:
+            # nothing anchored: put the first pending gear at the origin
+            first = pending.pop(0)
+            positions[first] = np.zeros(3)
+            computed.append(first)
+            progress = True
+    for name in model.bodies:
+        positions.setdefault(name, np.zeros(3))
+    return positions, axes, computed
+
+
+def _propagate_speeds(model: Model, axes, frames, issues) -> dict[str, float]:
+    """Signed speed of every body from the first drive; loops must be consistent."""
+    adj: dict[str, list[tuple[str, float, str]]] = {n: [] for n in model.body_names()}
+    for name, m in model.meshes.items():
+        a, b = m.gears
+        r = frames[name].speed_ratio  # omega_b = r * omega_a
+        adj[a].append((b, r, f"meshes.{name}"))
+        adj[b].append((a, 1.0 / r, f"meshes.{name}"))
+    for kind, items in (("shafts", model.shafts), ("splines", model.splines)):
+        for name, s in items.items():
+            a, b = s.connects
+            dot = float(axes[a] @ axes[b])
+            if abs(abs(dot) - 1) > 1e-6:
+                issues.append((f"{kind}.{name}", f"joins {a!r} and {b!r} whose axes are not "
+                               f"parallel; give both bodies the same 'axis'"))
+                continue
+            r = 1.0 if dot > 0 else -1.0
+            adj[a].append((b, r, f"{kind}.{name}"))
+            adj[b].append((a, r, f"{kind}.{name}"))
+    if issues:
+        return {}
+    first = next(iter(model.drives.values()))
+    speeds = {first.body: first.speed}
+    queue = deque([first.body])
+    while queue:
+        a = queue.popleft()
+        for b, r, via in adj[a]:
+            w = speeds[a] * r
+            if b not in speeds:
+                speeds[b] = w
+                queue.append(b)
+            elif not math.isclose(speeds[b], w, rel_tol=1e-9, abs_tol=1e-12):
+                issues.append((via, (
+                    f"the gears could not turn: body {b!r} would run at "
+                    f"{speeds[b] * 30 / math.pi:.6g} rpm by one path and {w * 30 / math.pi:.6g} rpm "
+                    f"by another; a power-split loop needs the same ratio on every path "
+                    f"(check tooth counts and axis directions)")))
+                return speeds
+    for name, d in model.drives.items():
+        w = speeds.get(d.body)
+        if w is not None and not math.isclose(w, d.speed, rel_tol=1e-6):
+            issues.append((f"drives.{name}.speed", (
+                f"{d.speed * 30 / math.pi:.6g} rpm contradicts the {w * 30 / math.pi:.6g} rpm that "
+                f"the gear ratios give from drive {next(iter(model.drives))!r}; "
+                f"make the drive speeds consistent (mind the sign, which follows the axis)")))
+    return speeds
+
+
+def _power_flow(model: Model, speeds, groups, issues):
+    """Equal-split power flow from the drives to the loads."""
+    # graph of rigid groups: edges are meshes and elastic shafts/splines
+    edges: list[tuple[str, str, str]] = []  # (name, body_a, body_b)
+    for name, m in model.meshes.items():
+        edges.append((name, *m.gears))
+    for name, s in list(model.shafts.items()) + list(model.splines.items()):
+        if not getattr(s, "rigid", False):
+            edges.append((name, *s.connects))
+    g_adj: dict[str, list[tuple[str, str]]] = {}
+    for name, a, b in edges:
+        ga, gb = groups[a], groups[b]
+        g_adj.setdefault(ga, []).append((name, gb))
+        g_adj.setdefault(gb, []).append((name, ga))
+    # distance of every group to the nearest load
+    dist: dict[str, int] = {}
+    queue = deque()
+    for ld in model.loads.values():
+        g = groups[ld.body]
+        if g not in dist:
+            dist[g] = 0
+            queue.append(g)
+    while queue:
+        g = queue.popleft()
+        for _, h in g_adj.get(g, []):
+            if h not in dist:
+                dist[h] = dist[g] + 1
+                queue.append(h)
+    # inputs
+    drive_torques = {}
+    group_power: dict[str, float] = {}
+    p_in = 0.0
+    for name, d in model.drives.items():
+        t = d.input_torque
+        p = t * abs(d.speed)
+        drive_torques[name] = t
+        p_in += p
+        g = groups[d.body]
+        group_power[g] = group_power.get(g, 0.0) + p
+    edge_power: dict[str, float] = {name: 0.0 for name, _, _ in edges}
+    edge_dir: dict[str, tuple[str, str]] = {}
+    order = sorted(dist, key=lambda g: -dist[g])
+    for g in order:
+        p = group_power.get(g, 0.0)
+        outs = [(name, h) for name, h in g_adj.get(g, []) if dist[h] < dist[g]]
+        if not outs:
+            continue
+        share = p / len(outs)
+        for name, h in outs:
+            edge_power[name] += share
+            edge_dir[name] = (g, h)
+            group_power[h] = group_power.get(h, 0.0) + share
+    # loads
+    load_torques = {}
+    balanced = [n for n, ld in model.loads.items() if ld.torque is None]
+    fixed = {n: ld.torque for n, ld in model.loads.items() if ld.torque is not None}
+    p_fixed = sum(t * abs(speeds[model.loads[n].body]) for n, t in fixed.items())
+    p_rest = p_in - p_fixed
+    for n, t in fixed.items():
+        load_torques[n] = t
+    if balanced:
+        if p_rest <= 0:
+            issues.append(("loads", f"the loads with a given torque take {p_fixed / 1e3:.6g} kW, "
+                           f"all of the {p_in / 1e3:.6g} kW input; nothing is left for "
+                           f"{balanced}; correct the torques"))
+        for n in balanced:
+            load_torques[n] = p_rest / len(balanced) / abs(speeds[model.loads[n].body])
+    elif not math.isclose(p_fixed, p_in, rel_tol=1e-3):
+        issues.append(("loads", (
+            f"power does not balance: the drives put in {p_in / 1e3:.6g} kW and the loads take "
+            f"{p_fixed / 1e3:.6g} kW; set a load's torque to \"balanced\" or correct the values")))
+    p_out = sum(load_torques[n] * abs(speeds[model.loads[n].body]) for n in model.loads)
+    # power through each body (groups share their power)
+    power = {b: group_power.get(groups[b], 0.0) for b in model.body_names()}
+    drivers = {}
+    for name, m in model.meshes.items():
+        a, b = m.gears
+        flow = edge_dir.get(name)
+        if flow is None:
+            # no power flows through the mesh in the nominal split (e.g. an idler loop)
+            drv = m.driver or a
+        else:
+            drv = a if groups[a] == flow[0] else b
+            if m.driver is not None and m.driver != drv:
+                issues.append((f"meshes.{name}.driver", (
+                    f"{m.driver!r} is given as driver but power flows from {drv!r} to it; "
+                    f"remove 'driver' or correct it")))
+        drivers[name] = (drv, b if drv == a else a)
+    return power, edge_power, drivers, drive_torques, load_torques, p_in, p_out

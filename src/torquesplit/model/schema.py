@@ -1,0 +1,461 @@
+"""The model-file schema: what a gearbox description may contain.
+
+A model file is TOML (or JSON) with the sections ``[model]``, ``[gears.NAME]``,
+``[bodies.NAME]``, ``[shafts.NAME]``, ``[meshes.NAME]``, ``[splines.NAME]``,
+``[drives.NAME]``, ``[loads.NAME]`` and ``[analysis]``.  Every physical quantity is
+read through :func:`torquesplit.model.units.parse_quantity`: a string with units
+(``"50 um"``) or a bare number in the field's SI unit.  After validation every value
+is SI float64.  Unknown fields are errors (a typo must not be silently ignored).
+
+``docs/model-file.md`` is generated from this module (``python -m
+torquesplit.model.docs``) and a test checks that it is up to date.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated, Literal
+
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, model_validator
+
+from .units import KINDS, parse_quantity
+
+
+class Unit:
+    """Annotation marker: the field is a physical quantity of this kind."""
+
+    def __init__(self, kind: str):
+        self.kind = kind
+        self.si = KINDS[kind][0]
+
+    def __repr__(self) -> str:  # pragma: no cover - debugging aid
+        return f"Unit({self.kind!r})"
+
+
+def Q(kind: str):
+    """A float field that accepts a quantity with units of ``kind`` (stored in SI)."""
+    return Annotated[float, BeforeValidator(lambda v: parse_quantity(v, kind)), Unit(kind)]
+
+
+Length = Q("length")
+Angle = Q("angle")
+Mass = Q("mass")
+Inertia = Q("inertia")
+Density = Q("density")
+Stiffness = Q("stiffness")
+TorsionalStiffness = Q("torsional_stiffness")
+Damping = Q("damping")
+TorsionalDamping = Q("torsional_damping")
+Pressure = Q("pressure")
+Speed = Q("speed")
+Power = Q("power")
+Torque = Q("torque")
+Time = Q("time")
+Viscosity = Q("viscosity")
+
+Dof = Literal["x", "y", "z", "theta"]
+
+
+class Strict(BaseModel):
+    """Base of every schema section: unknown fields are errors."""
+
+    model_config = ConfigDict(extra="forbid", validate_default=True, frozen=True)
+
+
+def _check_angle(v: float, name: str, upper_deg: float) -> float:
+    if not (-math.radians(upper_deg) <= v <= math.radians(upper_deg)):
+        raise ValueError(
+            f"{name} of {v:g} rad ({math.degrees(v):g} deg) is outside +/-{upper_deg:g} deg; "
+            f"write angles with their unit, e.g. '20 deg'"
+        )
+    return v
+
+
+# --------------------------------------------------------------------------- supports
+class ShaftBending(Strict):
+    """Lateral stiffness of a gear on a simply supported shaft (seed 001 eqs. 5-7, 10)."""
+
+    diameter: Length = Field(gt=0, description="Shaft diameter at the gear.")
+    span: Length = Field(gt=0, description="Distance between the two bearings.")
+    position: Length = Field(
+        gt=0, description="Distance from the first bearing to the gear (0 < position < span)."
+    )
+    youngs_modulus: Pressure = Field(206e9, gt=0, description="Young's modulus of the shaft.")
+    bearing_stiffness: Stiffness | None = Field(
+        None, gt=0, description="Radial stiffness of each bearing, in series with the shaft."
+    )
+
+    @model_validator(mode="after")
+    def _inside(self):
+        if self.position >= self.span:
+            raise ValueError(
+                f"position {self.position:g} m must lie between the bearings (span {self.span:g} m)"
+            )
+        return self
+
+
+class Support(Strict):
+    """Support of a body's translations to the housing: bearing or shaft bending."""
+
+    stiffness: Stiffness | None = Field(
+        None, gt=0, description="Radial stiffness (x and y) of the support."
+    )
+    axial_stiffness: Stiffness | None = Field(
+        None, gt=0, description="Axial stiffness (z); defaults to the radial stiffness."
+    )
+    shaft: ShaftBending | None = Field(
+        None, description="Compute the radial stiffness from the shaft instead (seed 001)."
+    )
+    damping: Damping | None = Field(None, ge=0, description="Viscous damping of the support.")
+    damping_ratio: float | None = Field(
+        None, ge=0, description="Damping as a fraction of critical, c = 2 zeta sqrt(k m)."
+    )
+    clearance: Length = Field(
+        0.0, ge=0, description="Radial clearance (dead zone, seed 002 eq. 7); 0 = none."
+    )
+
+    @model_validator(mode="after")
+    def _one_stiffness(self):
+        if self.stiffness is None and self.shaft is None:
+            raise ValueError("give either 'stiffness' or a [shaft] bending description")
+        if self.stiffness is not None and self.shaft is not None:
+            raise ValueError("give either 'stiffness' or 'shaft', not both")
+        if self.damping is not None and self.damping_ratio is not None:
+            raise ValueError("give either 'damping' or 'damping_ratio', not both")
+        return self
+
+
+# --------------------------------------------------------------------------- errors
+class GearErrors(Strict):
+    """Manufacturing and assembly errors of one gear (seed 000 eqs. 1-2, seed 002 eq. 11)."""
+
+    eccentricity: Length = Field(0.0, ge=0, description="Eccentricity amplitude (rotates with the gear).")
+    eccentricity_phase: Angle = Field(0.0, description="Angular position of the eccentricity at t = 0.")
+    installation: Length = Field(0.0, ge=0, description="Installation (mounting) error amplitude.")
+    installation_phase: Angle = Field(0.0, description="Direction of the installation error.")
+    tooth_thickness: Length = Field(0.0, description="Tooth thickness error (seed 004 §4).")
+    pitch: Length = Field(0.0, ge=0, description="Single pitch error amplitude (seed 004 §4).")
+    bearing_runout: Length = Field(0.0, ge=0, description="Bearing run-out amplitude (seed 004 §4).")
+    bearing_runout_phase: Angle = Field(0.0, description="Phase of the bearing run-out.")
+    grade: int | None = Field(
+        None, ge=1, le=12, description="ISO 1328-1 accuracy grade, used for tolerance sampling."
+    )
+
+
+# --------------------------------------------------------------------------- bodies
+class Placement(Strict):
+    """Place a gear at the operating centre distance from a mating gear."""
+
+    from_gear: str = Field(description="Name of the gear this one meshes with.")
+    angle: Angle = Field(
+        description="Direction of the centre line, measured in the mating gear's plane "
+        "from its x axis (counter-clockwise about the mating gear's axis)."
+    )
+
+
+class Gear(Strict):
+    """A gear: one rigid body with involute teeth."""
+
+    teeth: int = Field(gt=0, description="Number of teeth.")
+    module: Length = Field(gt=0, description="Normal module.")
+    pressure_angle: Angle = Field(math.radians(20.0), description="Normal pressure angle.")
+    helix_angle: Angle = Field(0.0, description="Helix angle (spiral angle for bevel gears).")
+    hand: Literal["right", "left"] | None = Field(
+        None, description="Hand of the helix or spiral; required when the helix angle is not 0."
+    )
+    kind: Literal["spur", "helical", "double_helical", "bevel", "face", "internal"] | None = Field(
+        None, description="Gear type; default spur, or helical when a helix angle is given."
+    )
+    face_width: Length = Field(gt=0, description="Face width (of one helix for double-helical).")
+    profile_shift: float = Field(0.0, description="Profile shift coefficient x.")
+    cone_angle: Angle | None = Field(
+        None, description="Pitch cone angle of a bevel gear (default from the shaft angle)."
+    )
+    mass: Mass | None = Field(None, gt=0, description="Mass; from geometry and density if omitted.")
+    polar_inertia: Inertia | None = Field(
+        None, gt=0, description="Polar moment of inertia; from geometry and density if omitted."
+    )
+    bore_diameter: Length = Field(0.0, ge=0, description="Bore diameter used for computed mass/inertia.")
+    density: Density = Field(7850.0, gt=0, description="Material density.")
+    youngs_modulus: Pressure = Field(206e9, gt=0, description="Young's modulus of the gear material.")
+    poisson_ratio: float = Field(0.3, gt=0, lt=0.5, description="Poisson's ratio.")
+    position: tuple[Length, Length, Length] | None = Field(
+        None, description="Centre coordinates [x, y, z]."
+    )
+    place: Placement | None = Field(None, description="Position from a mating gear and an angle.")
+    axis: tuple[float, float, float] = Field((0.0, 0.0, 1.0), description="Rotation axis direction.")
+    dofs: list[Dof] = Field(["theta"], description="Degrees of freedom of this body.")
+    support: Support | None = Field(None, description="Support of the translational DOFs.")
+    errors: GearErrors = Field(GearErrors(), description="Eccentricity, installation, ... errors.")
+
+    @model_validator(mode="after")
+    def _consistent(self):
+        _check_angle(self.pressure_angle, "pressure_angle", 45)
+        _check_angle(self.helix_angle, "helix_angle", 60)
+        if self.helix_angle != 0 and self.hand is None:
+            raise ValueError("a gear with a helix angle needs 'hand' ('right' or 'left')")
+        if self.position is not None and self.place is not None:
+            raise ValueError("give either 'position' or 'place', not both")
+        if math.hypot(*self.axis) == 0:
+            raise ValueError("'axis' must not be the zero vector")
+        _unique_dofs(self.dofs)
+        return self
+
+    @property
+    def gear_type(self) -> str:
+        if self.kind is not None:
+            return self.kind
+        return "helical" if self.helix_angle != 0 else "spur"
+
+
+class Body(Strict):
+    """A rigid body that is not a gear: prime mover, load inertia, carrier."""
+
+    polar_inertia: Inertia = Field(gt=0, description="Polar moment of inertia.")
+    mass: Mass | None = Field(None, gt=0, description="Mass (needed with translational DOFs).")
+    position: tuple[Length, Length, Length] = Field((0.0, 0.0, 0.0), description="Centre.")
+    axis: tuple[float, float, float] = Field((0.0, 0.0, 1.0), description="Rotation axis.")
+    dofs: list[Dof] = Field(["theta"], description="Degrees of freedom of this body.")
+    support: Support | None = Field(None, description="Support of the translational DOFs.")
+
+    @model_validator(mode="after")
+    def _consistent(self):
+        _unique_dofs(self.dofs)
+        if any(d != "theta" for d in self.dofs) and self.mass is None:
+            raise ValueError("a body with translational DOFs needs a 'mass'")
+        return self
+
+
+def _unique_dofs(dofs):
+    if len(set(dofs)) != len(dofs):
+        raise ValueError(f"'dofs' lists a DOF twice: {dofs}")
+
+
+# --------------------------------------------------------------------------- connections
+class Shaft(Strict):
+    """A torsional connection between two bodies on a common axis."""
+
+    connects: tuple[str, str] = Field(description="The two bodies the shaft joins.")
+    rigid: bool = Field(False, description="Join the bodies rigidly (one rotational DOF).")
+    torsional_stiffness: TorsionalStiffness | None = Field(
+        None, gt=0, description="Torsional stiffness; or give diameter and length."
+    )
+    diameter: Length | None = Field(None, gt=0, description="Outer diameter (seed 001 eq. 3).")
+    inner_diameter: Length = Field(0.0, ge=0, description="Bore of a hollow shaft.")
+    length: Length | None = Field(None, gt=0, description="Length between the two bodies.")
+    shear_modulus: Pressure = Field(79.3e9, gt=0, description="Shear modulus of the shaft.")
+    damping: TorsionalDamping | None = Field(None, ge=0, description="Torsional damping.")
+    damping_ratio: float | None = Field(
+        None, ge=0, description="Torsional damping as a fraction of critical."
+    )
+
+    @model_validator(mode="after")
+    def _stiffness(self):
+        if self.rigid:
+            return self
+        if self.torsional_stiffness is None and (self.diameter is None or self.length is None):
+            raise ValueError(
+                "give 'torsional_stiffness', or 'diameter' and 'length', or rigid = true"
+            )
+        if self.diameter is not None and self.inner_diameter >= self.diameter:
+            raise ValueError("'inner_diameter' must be smaller than 'diameter'")
+        if self.damping is not None and self.damping_ratio is not None:
+            raise ValueError("give either 'damping' or 'damping_ratio', not both")
+        return self
+
+
+class StiffnessSpec(Strict):
+    """Mesh stiffness: method and its parameters (see docs/theory)."""
+
+    method: Literal["constant", "iso6336", "potential_energy", "table", "fourier"] = Field(
+        "constant", description="How k(phase) is obtained."
+    )
+    value: Stiffness | None = Field(None, gt=0, description="Mean mesh stiffness (constant).")
+    peak_to_peak: float = Field(
+        0.0, ge=0, description="Constant method: relative peak-to-peak variation of a rectangular "
+        "single/double contact wave built from the contact ratio (0 = constant)."
+    )
+    phase: list[float] | None = Field(None, description="Table: mesh phases in [0, 1).")
+    values: list[Stiffness] | None = Field(None, description="Table: stiffness at each phase.")
+    mean: Stiffness | None = Field(None, gt=0, description="Fourier: mean stiffness.")
+    cos: list[Stiffness] = Field([], description="Fourier: cosine coefficients a_1..a_n.")
+    sin: list[Stiffness] = Field([], description="Fourier: sine coefficients b_1..b_n.")
+    fillet_foundation: bool = Field(True, description="Potential energy: include the fillet term.")
+    slices: int = Field(40, ge=1, description="Helical: number of slices across the face.")
+
+    @model_validator(mode="after")
+    def _complete(self):
+        m = self.method
+        if m == "constant" and self.value is None:
+            raise ValueError("method 'constant' needs 'value'")
+        if m == "table":
+            if not self.phase or not self.values or len(self.phase) != len(self.values):
+                raise ValueError("method 'table' needs 'phase' and 'values' of equal length")
+            if any(not 0 <= p < 1 for p in self.phase):
+                raise ValueError("table 'phase' values must lie in [0, 1)")
+            if any(v <= 0 for v in self.values):
+                raise ValueError("table stiffness 'values' must be positive")
+        if m == "fourier" and self.mean is None:
+            raise ValueError("method 'fourier' needs 'mean'")
+        return self
+
+
+class BacklashSpec(Strict):
+    """Backlash: constant, or random per engagement (seed 001 eq. 14)."""
+
+    nominal: Length = Field(ge=0, description="Total (circumferential-normal) backlash 2b.")
+    tolerance: Length = Field(0.0, ge=0, description="Half-width of the tolerance band.")
+    distribution: Literal["constant", "normal", "uniform"] = Field(
+        "constant", description="How each engagement's backlash is drawn."
+    )
+    seed: int = Field(0, description="Random seed for reproducible sequences.")
+
+
+class TransmissionError(Strict):
+    """An additional error along the line of action: constant plus mesh-frequency harmonic."""
+
+    constant: Length = Field(0.0, description="Constant error (installation along the LOA).")
+    amplitude: Length = Field(0.0, ge=0, description="Amplitude at mesh frequency.")
+    phase: Angle = Field(0.0, description="Phase of the mesh-frequency error.")
+
+
+def _stiffness_shorthand(v):
+    if isinstance(v, (dict, StiffnessSpec)):
+        return v
+    return {"method": "constant", "value": v}
+
+
+def _backlash_shorthand(v):
+    if isinstance(v, (dict, BacklashSpec)):
+        return v
+    return {"nominal": v}
+
+
+def _balanced_or_torque(v):
+    if v is None or v == "balanced":
+        return None
+    x = parse_quantity(v, "torque")
+    if x <= 0:
+        raise ValueError("the load torque must be positive (its direction follows the speed)")
+    return x
+
+
+class Mesh(Strict):
+    """A gear mesh between two gears."""
+
+    gears: tuple[str, str] = Field(description="The two gears in mesh.")
+    driver: str | None = Field(None, description="Which gear drives; from the power flow if omitted.")
+    stiffness: Annotated[StiffnessSpec, BeforeValidator(_stiffness_shorthand)] = Field(
+        description="Mean mesh stiffness (\"4.5e9 N/m\"), or a [stiffness] table with a method."
+    )
+    damping: Damping | None = Field(None, ge=0, description="Mesh damping.")
+    damping_ratio: float | None = Field(
+        None, ge=0, description="Mesh damping as a fraction of critical, with the equivalent mass "
+        "m = J1 J2 / (J1 r2^2 + J2 r1^2)."
+    )
+    backlash: Annotated[BacklashSpec, BeforeValidator(_backlash_shorthand)] = Field(
+        0.0, description="Total backlash (\"100 um\"; 0 = none), or a [backlash] table."
+    )
+    transmission_error: TransmissionError = Field(TransmissionError(), description="Extra LOA error.")
+    phase: float | None = Field(None, description="Mesh phase at t = 0 in cycles (overrides clocking).")
+    stage: str | None = Field(None, description="Stage label for load-sharing groups.")
+    path: str | None = Field(None, description="Input-path label (seed 000: left/right).")
+    shaft_angle: Angle | None = Field(None, description="Angle between the axes (bevel/face).")
+    impact: bool = Field(False, description="Add meshing-in impact (seed 000 eqs. 6-10).")
+    friction: bool = Field(False, description="Add EHL tooth friction (seed 003).")
+
+    @model_validator(mode="after")
+    def _consistent(self):
+        if self.gears[0] == self.gears[1]:
+            raise ValueError("a gear cannot mesh with itself")
+        if self.driver is not None and self.driver not in self.gears:
+            raise ValueError(f"driver {self.driver!r} is not one of the mesh's gears {list(self.gears)}")
+        if self.damping is not None and self.damping_ratio is not None:
+            raise ValueError("give either 'damping' or 'damping_ratio', not both")
+        return self
+
+
+class Spline(Strict):
+    """A member floating on a spline: radial clearance and friction (seed 002 eq. 6)."""
+
+    connects: tuple[str, str] = Field(description="The hub body and the floating body.")
+    radial_clearance: Length = Field(ge=0, description="Radial clearance of the spline.")
+    friction_coefficient: float = Field(0.1, ge=0, description="Coulomb friction coefficient.")
+    pitch_radius: Length = Field(gt=0, description="Spline pitch radius.")
+    stiffness: Stiffness = Field(gt=0, description="Radial contact stiffness once the clearance closes.")
+    torsional_stiffness: TorsionalStiffness = Field(gt=0, description="Torsional stiffness of the spline.")
+
+
+# --------------------------------------------------------------------------- drives
+class Drive(Strict):
+    """A power input: torque, power or prescribed speed at a body."""
+
+    body: str = Field(description="The driven body.")
+    speed: Speed = Field(description="Nominal speed, signed about the body's axis.")
+    power: Power | None = Field(None, gt=0, description="Input power (gives the torque).")
+    torque: Torque | None = Field(None, gt=0, description="Input torque magnitude.")
+    mode: Literal["torque", "speed"] = Field(
+        "torque", description="'torque': constant torque; 'speed': prescribed speed (DOF removed)."
+    )
+
+    @model_validator(mode="after")
+    def _one(self):
+        if (self.power is None) == (self.torque is None):
+            raise ValueError("give exactly one of 'power' and 'torque'")
+        if self.speed == 0:
+            raise ValueError("'speed' must not be zero")
+        return self
+
+    @property
+    def input_torque(self) -> float:
+        """Torque magnitude [N m]."""
+        return self.torque if self.torque is not None else self.power / abs(self.speed)
+
+
+class Load(Strict):
+    """A power output: a resisting torque at a body."""
+
+    body: str = Field(description="The loaded body.")
+    torque: Annotated[float | None, BeforeValidator(_balanced_or_torque)] = Field(
+        "balanced", description="Resisting torque magnitude, or 'balanced' to take all input power."
+    )
+    speed_coefficient: TorsionalDamping = Field(
+        0.0, ge=0, description="dT/d(speed) of the load characteristic (removes rigid-body drift)."
+    )
+
+
+class Analysis(Strict):
+    """Default settings of the analyses (the CLI can override them)."""
+
+    method: Literal["rk4", "dopri"] = Field("rk4", description="Time integrator.")
+    steps_per_period: int = Field(100, ge=10, description="RK4 steps per shortest mesh period.")
+    duration: Time | None = Field(None, gt=0, description="Simulated time.")
+    cycles: int | None = Field(None, gt=0, description="Simulated cycles of the slowest mesh.")
+    rtol: float = Field(1e-6, gt=0, lt=1, description="Relative tolerance (dopri).")
+    table_points: int = Field(256, ge=16, description="Samples per mesh period of excitation tables.")
+    load_sharing: Literal["cycle_peak", "engineering", "mean_force", "static_torque"] = Field(
+        "cycle_peak", description="Default load-sharing definition reported by 'run'."
+    )
+
+
+class ModelInfo(Strict):
+    name: str = Field(description="Short name of the model.")
+    description: str = Field("", description="One-line description.")
+    reference: str = Field("", description="Source of the data (paper, drawing).")
+
+
+class Model(Strict):
+    """A complete gearbox description (all values SI after validation)."""
+
+    model: ModelInfo
+    gears: dict[str, Gear] = Field(description="Gears by name.")
+    bodies: dict[str, Body] = Field({}, description="Other rigid bodies by name.")
+    shafts: dict[str, Shaft] = Field({}, description="Shafts by name.")
+    meshes: dict[str, Mesh] = Field(description="Gear meshes by name.")
+    splines: dict[str, Spline] = Field({}, description="Splines by name.")
+    drives: dict[str, Drive] = Field(description="Power inputs by name.")
+    loads: dict[str, Load] = Field(description="Power outputs by name.")
+    analysis: Analysis = Field(Analysis(), description="Analysis defaults.")
+
+    def body_names(self) -> list[str]:
+        return list(self.gears) + list(self.bodies)

@@ -1,0 +1,104 @@
+"""The kinematic and static summary printed by ``torquesplit check``."""
+
+from __future__ import annotations
+
+import math
+
+from .kinematics import solve_kinematics
+from .schema import Model
+
+RPM = 30 / math.pi
+
+
+def summary(model: Model) -> dict:
+    """A JSON-serialisable summary: speeds, torques, mesh frequencies, geometry, forces."""
+    from ..assembly.excitation import stage_label
+
+    kin = solve_kinematics(model)
+    bodies = {}
+    for name, b in kin.bodies.items():
+        bodies[name] = {
+            "speed_rpm": b.speed * RPM,
+            "torque_Nm": b.torque,
+            "power_kW": b.power / 1e3,
+            "mass_kg": b.mass,
+            "polar_inertia_kgm2": b.polar_inertia,
+            "mass_computed": b.mass_computed,
+            "inertia_computed": b.inertia_computed,
+            "position_mm": [1e3 * float(v) for v in b.position],
+            "position_computed": name in kin.positions_computed,
+        }
+    meshes = {}
+    for name, mk in kin.meshes.items():
+        meshes[name] = {
+            "driver": mk.driver,
+            "driven": mk.driven,
+            "stage": stage_label(model, name),
+            "frequency_Hz": mk.frequency,
+            "base_radii_mm": [1e3 * r for r in mk.base_radii],
+            "pitch_radii_mm": [1e3 * r for r in mk.pitch_radii],
+            "transverse_contact_ratio": _num(mk.transverse_contact_ratio),
+            "overlap_contact_ratio": _num(mk.overlap_contact_ratio),
+            "total_contact_ratio": _num(mk.total_contact_ratio),
+            "working_pressure_angle_deg": math.degrees(mk.working_pressure_angle),
+            "center_distance_mm": _num(1e3 * mk.center_distance),
+            "line_of_action": [float(v) for v in mk.line_of_action],
+            "torque_driver_Nm": mk.torque_driver,
+            "torque_driven_Nm": mk.torque_driven,
+            "tooth_force_N": mk.force,
+            "power_kW": mk.power / 1e3,
+            "equivalent_mass_kg": mk.equivalent_mass,
+            "critical_damping_Ns_per_m": mk.critical_damping,
+            "iso6336_stiffness_N_per_m": mk.iso_stiffness,
+        }
+    return {
+        "model": model.model.name,
+        "description": model.model.description,
+        "reference": model.model.reference,
+        "input_power_kW": kin.input_power / 1e3,
+        "output_power_kW": kin.output_power / 1e3,
+        "power_balance": (kin.input_power - kin.output_power) / kin.input_power,
+        "drive_torques_Nm": kin.drive_torques,
+        "load_torques_Nm": kin.load_torques,
+        "bodies": bodies,
+        "meshes": meshes,
+    }
+
+
+def _num(x):
+    return None if x is None or not math.isfinite(x) else float(x)
+
+
+def render_summary(s: dict, console) -> None:
+    """Print the summary as rich tables."""
+    from rich.table import Table
+
+    console.print(f"[bold]{s['model']}[/]  {s['description']}")
+    if s["reference"]:
+        console.print(f"[dim]{s['reference']}[/]")
+    console.print(
+        f"input {s['input_power_kW']:.6g} kW, output {s['output_power_kW']:.6g} kW, "
+        f"balance {s['power_balance']:.2e}")
+    t = Table(title="bodies")
+    for col in ("body", "speed [rpm]", "torque [N m]", "mass [kg]", "J [kg m^2]"):
+        t.add_column(col, justify="right" if col != "body" else "left")
+    for name, b in s["bodies"].items():
+        mark = lambda flag: " (computed)" if flag else ""  # noqa: E731
+        t.add_row(name, f"{b['speed_rpm']:.6g}", f"{b['torque_Nm']:.6g}",
+                  f"{b['mass_kg']:.5g}{mark(b['mass_computed'])}",
+                  f"{b['polar_inertia_kgm2']:.5g}{mark(b['inertia_computed'])}")
+    console.print(t)
+    t = Table(title="meshes")
+    for col in ("mesh", "driver->driven", "stage", "f_mesh [Hz]", "r_b [mm]", "eps_a", "eps_b",
+                "eps_g", "LOA n", "T_driver [N m]", "F_n [N]"):
+        t.add_column(col, justify="left" if col in ("mesh", "driver->driven", "stage", "LOA n")
+                     else "right")
+    for name, m in s["meshes"].items():
+        fmt = lambda x: "-" if x is None else f"{x:.4f}"  # noqa: E731
+        t.add_row(name, f"{m['driver']}->{m['driven']}", m["stage"], f"{m['frequency_Hz']:.6g}",
+                  "/".join(f"{r:.2f}" for r in m["base_radii_mm"]),
+                  fmt(m["transverse_contact_ratio"]), fmt(m["overlap_contact_ratio"]),
+                  fmt(m["total_contact_ratio"]),
+                  "(" + ", ".join(f"{v:+.3f}" for v in m["line_of_action"]) + ")",
+                  f"{m['torque_driver_Nm']:.6g}", f"{m['tooth_force_N']:.6g}")
+    console.print(t)

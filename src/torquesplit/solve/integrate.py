@@ -1,0 +1,709 @@
+"""Time integration of an assembled :class:`~torquesplit.assembly.structure.Structure`.
+
+:func:`integrate` is the readable entry point; the loops run in
+:mod:`torquesplit.solve._kernels`.  A run is split into chunks of about 1.5 % of its
+length; between chunks the optional ``progress`` callback is told the fraction done
+(no Python call happens per step).  Chunk boundaries depend only on the run length, so
+a run gives the same numbers with or without a progress callback.
+
+Post-processing streams while integrating, so memory does not grow with the run length
+except for the explicitly sized output arrays:
+
+* per-mesh-cycle max / min / mean / count of the force of tracked elements,
+* decimated histories (every ``record_every`` steps for RK4, uniform ``sample_interval``
+  for Dormand-Prince, interpolated by cubic Hermite) of chosen element forces and DOFs,
+* per-element counts of steps in separation and in back-side contact,
+* optionally the full state at every step (RK4) or sample time (Dormand-Prince).
+"""
+
+from __future__ import annotations
+
+import difflib
+import logging
+import math
+import time
+from dataclasses import dataclass
+from typing import Callable, Sequence
+
+import numpy as np
+
+from torquesplit.assembly.structure import Structure
+from torquesplit.errors import SolverError
+from torquesplit.solve import _kernels as kern
+from torquesplit.solve.reference import element_forces_numpy, rhs_numpy
+from torquesplit.solve.stability import check_step, stable_step, system_eigenvalues
+
+__all__ = ["Solution", "integrate", "rhs", "element_forces", "rhs_numpy",
+           "element_forces_numpy", "compile_kernels", "STATUS_MESSAGES"]
+
+log = logging.getLogger(__name__)
+
+STATUS_MESSAGES = {
+    kern.FINISHED: "finished",
+    kern.DIVERGED: "diverged",
+    kern.STEP_UNDERFLOW: "step size underflow",
+    kern.MAX_STEPS: "maximum number of steps reached",
+}
+
+_N_CHUNKS = 64  # progress granularity: about 1.5 % of the run per chunk
+_MIN_CHUNK_STEPS = 16 * kern.RESYNC
+_MEMORY_LIMIT = 2 * 1024**3  # bytes of output arrays before we refuse and explain
+_COMPILE_TIME: float | None = None
+
+
+# ===================================================================== result
+@dataclass(frozen=True)
+class Solution:
+    """Result of :func:`integrate`.  Arrays are owned by the solution (never views).
+
+    Cycle arrays have shape (n_cycles, n_tracked); row c is the c-th excitation cycle
+    of each tracked element counted from the cycle containing ``t_span[0]``; empty
+    cycles have count 0 and NaN statistics.  History arrays have one row per record.
+    """
+
+    status: int
+    """0 finished, 1 diverged, 2 step size underflow (dopri), 3 maximum steps reached."""
+    message: str
+    """Where and why the run stopped (scipy.integrate style)."""
+    success: bool
+    """``status == 0``."""
+    method: str
+    t_span: tuple[float, float]
+    t_final: float
+    """Time of ``y_final`` (where the run stopped)."""
+    y_final: np.ndarray
+    """State [q, v] at ``t_final`` (non-finite if the run diverged there)."""
+    n_steps: int
+    """Accepted steps."""
+    n_rejected: int
+    """Rejected steps (dopri)."""
+    n_rhs: int
+    """Right-hand-side evaluations of the integrator (not those made to record samples)."""
+    step: float | None
+    """RK4 step used [s]; None for dopri."""
+    step_min: float
+    """Smallest accepted step [s]."""
+    step_max: float
+    """Largest accepted step [s]."""
+    compile_time: float
+    """Seconds this process spent compiling (or loading from cache) the kernels."""
+    wall_time: float
+    """Seconds spent in this call, compile time excluded."""
+    dof_names: tuple[str, ...]
+    element_names: tuple[str, ...]
+    tracked_elements: tuple[int, ...]
+    cycle_start: np.ndarray
+    """(n_cycles, n_tracked) start time of each excitation cycle [s]."""
+    cycle_max: np.ndarray
+    """(n_cycles, n_tracked) largest element force in the cycle [N]."""
+    cycle_min: np.ndarray
+    """(n_cycles, n_tracked) smallest element force in the cycle [N]."""
+    cycle_mean: np.ndarray
+    """(n_cycles, n_tracked) mean of the force samples in the cycle [N]."""
+    cycle_count: np.ndarray
+    """(n_cycles, n_tracked) number of accepted states in the cycle."""
+    history_elements: tuple[int, ...]
+    history_dofs: tuple[int, ...]
+    history_t: np.ndarray
+    """(n_records,) [s]."""
+    history_forces: np.ndarray
+    """(n_records, n_history_elements) element forces [N]."""
+    history_q: np.ndarray
+    """(n_records, n_history_dofs) displacements [m, rad]."""
+    history_v: np.ndarray
+    """(n_records, n_history_dofs) velocities [m/s, rad/s]."""
+    full_t: np.ndarray | None
+    """Times of the full state records, or None if not asked."""
+    full_y: np.ndarray | None
+    """(n_records, 2 n_dof) full states, or None if not asked."""
+    n_samples: int
+    """Accepted states entered in the statistics and contact counters."""
+    separation_steps: np.ndarray
+    """(n_el,) accepted states with |delta| <= g (g > 0): contact lost."""
+    back_contact_steps: np.ndarray
+    """(n_el,) accepted states with delta < -g (back flank; mesh without backlash: delta < 0)."""
+
+    @property
+    def separation_fraction(self) -> np.ndarray:
+        """(n_el,) fraction of accepted states in separation."""
+        return self.separation_steps / max(self.n_samples, 1)
+
+    @property
+    def back_contact_fraction(self) -> np.ndarray:
+        """(n_el,) fraction of accepted states in back-side contact."""
+        return self.back_contact_steps / max(self.n_samples, 1)
+
+    def cycles(self, element: int | str) -> dict[str, np.ndarray]:
+        """Cycle statistics of one tracked element (by index or name) as a dict."""
+        e = _resolve(self.element_names, [element], "element")[0]
+        if e not in self.tracked_elements:
+            names = [self.element_names[i] for i in self.tracked_elements]
+            raise ValueError(f"element {self.element_names[e]!r} was not tracked; tracked "
+                             f"elements are {names}. Pass track_elements=[...] to integrate.")
+        j = self.tracked_elements.index(e)
+        return {"start": self.cycle_start[:, j], "max": self.cycle_max[:, j],
+                "min": self.cycle_min[:, j], "mean": self.cycle_mean[:, j],
+                "count": self.cycle_count[:, j]}
+
+
+# ============================================================== model arrays
+def _model_arrays(structure: Structure) -> tuple:
+    """The 22 MODEL arrays of the kernels: contiguous, writable, float64 / int64."""
+    s = structure
+    n_el = s.n_elements
+    if np.any(np.diff(s.gap_ptr) < 1):
+        bad = [s.element_names[e] for e in np.flatnonzero(np.diff(s.gap_ptr) < 1)]
+        raise SolverError(f"elements {bad} have no half-gap value; give gaps=0.0 for no "
+                          "dead zone when building the structure.")
+    if np.any(s.frequency < 0) or not np.all(np.isfinite(s.frequency)):
+        raise SolverError("excitation frequencies must be finite and >= 0 Hz; check the "
+                          "mesh frequencies of the structure.")
+    if s.n_table < 1:
+        raise SolverError("stiffness tables are empty; build the structure with n_table >= 1.")
+
+    def f8(a):
+        return np.array(a, dtype=np.float64, order="C", copy=True)
+
+    def i8(a):
+        return np.array(a, dtype=np.int64, order="C", copy=True)
+
+    varying = s.frequency > 0.0
+    sin_el = np.repeat(np.arange(n_el, dtype=np.int64), np.diff(s.error_ptr))
+    err_el = np.unique(sin_el)
+    return (
+        f8(s.inv_mass), f8(s.external_force), f8(s.ground_damping), i8(s.element_kind),
+        i8(s.v_ptr), i8(s.v_dof), f8(s.v_coef), f8(s.stiffness_table), f8(s.frequency),
+        f8(s.phase), f8(s.damping), i8(s.gap_ptr), f8(s.gap_values),
+        f8(s.error_constant), i8(s.error_ptr), f8(s.error_amplitude), f8(s.error_omega),
+        f8(s.error_phase), f8(s.force_table), i8(np.flatnonzero(varying)), i8(err_el),
+        i8(sin_el),
+    )
+
+
+def rhs(structure: Structure, t: float, y) -> np.ndarray:
+    """dy/dt at (t, y) evaluated by the compiled kernel (twin: :func:`rhs_numpy`)."""
+    dy, _, _ = _rhs_kernel(structure, t, y)
+    return dy
+
+
+def element_forces(structure: Structure, t: float, y):
+    """Element forces and deformations at (t, y) from the compiled kernel: ``(f, delta)``."""
+    _, force, defl = _rhs_kernel(structure, t, y)
+    return force, defl
+
+
+def _rhs_kernel(structure, t, y):
+    y = np.array(y, dtype=np.float64, order="C", copy=True)
+    if y.shape != (2 * structure.n_dof,):
+        raise ValueError(f"state must have shape ({2 * structure.n_dof},) = [q, v], "
+                         f"got {y.shape}.")
+    dy = np.empty_like(y)
+    force = np.empty(structure.n_elements)
+    defl = np.empty(structure.n_elements)
+    kern.rhs_at(float(t), y, *_model_arrays(structure), dy, force, defl)
+    return dy, force, defl
+
+
+# ============================================================== compilation
+def compile_kernels() -> float:
+    """Compile (or load from numba's cache) every kernel once per process.
+
+    Returns the seconds it took the first time (the same number afterwards).
+    """
+    global _COMPILE_TIME
+    if _COMPILE_TIME is None:
+        from torquesplit.assembly.structure import MESH, build_structure
+
+        _COMPILE_TIME = 0.0  # guard: the warm-up below calls integrate()
+        t_start = time.perf_counter()
+        s = build_structure(
+            ["a.theta", "b.theta"], [1.0, 1.0],
+            [dict(name="m", kind=MESH, dofs=[0, 1], coefs=[1.0, -1.0],
+                  stiffness=[1.0, 2.0], frequency=1.0, gaps=[0.0, 0.1], damping=0.01,
+                  errors=[(0.01, 1.0, 0.0)], force=[0.0, 0.1])],
+            n_table=4,
+        )
+        y0 = np.zeros(4)
+        integrate(s, y0, (0.0, 0.05), method="rk4", step=0.01, full_history=True)
+        integrate(s, y0, (0.0, 0.05), method="dopri", full_history=True)
+        rhs(s, 0.0, y0)
+        _COMPILE_TIME = time.perf_counter() - t_start
+    return _COMPILE_TIME
+
+
+# ================================================================= helpers
+def _resolve(names: Sequence[str], selection, what: str) -> list[int]:
+    out = []
+    for item in selection:
+        if isinstance(item, str):
+            if item not in names:
+                close = difflib.get_close_matches(item, names, n=3)
+                hint = f" Did you mean {close}?" if close else ""
+                raise ValueError(f"unknown {what} {item!r}.{hint} Use one of the names in "
+                                 f"structure.{what}_names or an index.")
+            out.append(names.index(item))
+        else:
+            i = int(item)
+            if not 0 <= i < len(names):
+                raise ValueError(f"{what} index {i} is out of range 0..{len(names) - 1}; "
+                                 f"use an index or a name from structure.{what}_names.")
+            out.append(i)
+    return out
+
+
+def _excitation_periods(structure: Structure) -> np.ndarray:
+    f = structure.frequency[structure.frequency > 0]
+    om = np.abs(structure.error_omega)
+    om = om[om > 0]
+    return np.concatenate([1.0 / f, 2 * math.pi / om])
+
+
+def _natural_period_min(structure: Structure) -> float:
+    lam = system_eigenvalues(structure)
+    w = float(np.max(np.abs(lam))) if lam.size else 0.0
+    return 2 * math.pi / w if w > 0 else math.inf
+
+
+def _default_atol(structure: Structure, rtol: float) -> np.ndarray:
+    """Absolute tolerance per state: rtol x a typical displacement / velocity of each DOF.
+
+    Typical element deformation = max(load / stiffness, half-gap, error amplitude), the
+    load being the largest external force or torque carried by any element; each DOF's
+    scale is the smallest deformation scale of its elements divided by its projection
+    coefficient.  Velocities scale with the highest excitation (or natural) frequency.
+    """
+    s = structure
+    n = s.n_dof
+    k_ref = s.stiffness_table.max(axis=1)
+    load = 0.0
+    for e in range(s.n_elements):
+        for j in range(s.v_ptr[e], s.v_ptr[e + 1]):
+            c = abs(s.v_coef[j])
+            if c > 0:
+                load = max(load, abs(s.external_force[s.v_dof[j]]) / c)
+    load = max(load, float(np.max(np.abs(s.force_table), initial=0.0)))
+    q_scale = np.full(n, np.inf)
+    for e in range(s.n_elements):
+        gaps = s.gap_values[s.gap_ptr[e]:s.gap_ptr[e + 1]]
+        amp = abs(s.error_constant[e]) + np.sum(np.abs(
+            s.error_amplitude[s.error_ptr[e]:s.error_ptr[e + 1]]))
+        d = max(load / k_ref[e] if k_ref[e] > 0 else 0.0, float(np.max(gaps)), amp)
+        if d <= 0:
+            continue
+        for j in range(s.v_ptr[e], s.v_ptr[e + 1]):
+            c = abs(s.v_coef[j])
+            if c > 0:
+                q_scale[s.v_dof[j]] = min(q_scale[s.v_dof[j]], d / c)
+    finite = np.isfinite(q_scale)
+    q_scale[~finite] = np.max(q_scale[finite]) if finite.any() else 1e-6
+    periods = _excitation_periods(s)
+    period = float(periods.min()) if periods.size else _natural_period_min(s)
+    omega = 2 * math.pi / period if math.isfinite(period) else 1.0
+    return rtol * np.concatenate([q_scale, q_scale * omega])
+
+
+# =================================================================== integrate
+def integrate(
+    structure: Structure,
+    y0,
+    t_span,
+    *,
+    method: str = "rk4",
+    step: float | None = None,
+    steps_per_period: int | None = None,
+    rtol: float | None = None,
+    atol=None,
+    max_step: float | None = None,
+    max_steps: int | None = None,
+    track_elements=None,
+    n_cycles_cap: int | None = None,
+    history_elements=None,
+    history_dofs=None,
+    record_every: int | None = None,
+    sample_interval: float | None = None,
+    full_history: bool = False,
+    check_stability: bool | None = None,
+    blowup: float = 1.0e3,
+    progress: Callable[[float], None] | None = None,
+) -> Solution:
+    """Integrate the equations of motion of ``structure`` from ``y0`` over ``t_span``.
+
+    Parameters
+    ----------
+    structure : Structure
+        Assembled system.
+    y0 : array_like
+        Initial state ``[q, v]`` (2 n_dof) or displacements ``q`` only (velocities 0).
+        Start from :func:`torquesplit.solve.static.static_equilibrium` to skip start-up
+        transients.
+    t_span : (float, float)
+        Start and end time [s].
+    method : {"rk4", "dopri"}
+        Classic fixed-step Runge-Kutta 4, or adaptive Dormand-Prince 5(4).
+    step : float, optional (rk4)
+        Time step [s].  Default: shortest excitation period / ``steps_per_period`` (or
+        shortest natural period / ``steps_per_period`` without excitation), refined to
+        a whole number of steps per period if that is unstable.  Reduced slightly if
+        needed so that a whole number of steps spans ``t_span`` (see ``Solution.step``).
+    steps_per_period : int, optional (rk4)
+        Default 100.
+    rtol : float, optional (dopri)
+        Relative tolerance, default 1e-6.
+    atol : float or array_like, optional (dopri)
+        Absolute tolerance, scalar or per state (2 n_dof).  Default: ``rtol`` x a
+        typical displacement of each DOF (load / stiffness, gaps, errors) and the
+        matching velocity.
+    max_step : float, optional (dopri)
+        Largest step [s].  Default: shortest excitation period / 20.
+    max_steps : int, optional
+        Stop with status 3 after this many accepted steps.  Default: no limit for rk4;
+        for dopri 10 x the steps at ``max_step`` (at least 100 000).
+    track_elements : sequence of int or str, optional
+        Elements whose force is summarised per excitation cycle (all must have an
+        excitation frequency > 0).  Default: every element with frequency > 0.
+    n_cycles_cap : int, optional
+        Rows of the cycle arrays.  Default: enough for the whole run.
+    history_elements, history_dofs : sequence of int or str, optional
+        Elements (forces) and DOFs (q and v) kept in the decimated history.
+        Default: all of them.  Pass ``()`` to keep none.
+    record_every : int, optional (rk4)
+        History every ``record_every`` steps, default 1.
+    sample_interval : float, optional
+        History sampling interval [s].  dopri: uniform times by cubic Hermite
+        interpolation, default ``max_step``; rk4: rounded to a whole number of steps.
+    full_history : bool
+        Also keep the full state at every step (rk4) or sample time (dopri).
+    check_stability : bool, optional (rk4)
+        Refuse an unstable step with :class:`~torquesplit.errors.StepTooLargeError`
+        (default True).
+    blowup : float
+        Stop with status 1 when any |q| exceeds this [m or rad].
+    progress : callable, optional
+        ``progress(fraction_done)``, called between chunks of the run.
+
+    Returns
+    -------
+    Solution
+        Never raises for a diverging run: status and message say where and why it
+        stopped, and everything recorded before stays valid.
+
+    Examples
+    --------
+    >>> from torquesplit.assembly.structure import MESH, build_structure
+    >>> s = build_structure(["g1.theta", "g2.theta"], [1 / 0.01, 1 / 0.04],
+    ...     [dict(name="mesh", kind=MESH, dofs=[0, 1], coefs=[0.05, -0.1],
+    ...           stiffness=2e8, frequency=1000.0)],
+    ...     external_force=[100.0, -200.0])
+    >>> sol = integrate(s, [0.0] * 4, (0.0, 0.01))
+    >>> sol.success, sol.n_steps
+    (True, 1000)
+    """
+    compile_time = compile_kernels()
+    t_call = time.perf_counter()
+
+    if method not in ("rk4", "dopri"):
+        raise ValueError(f"unknown method {method!r}; use method='rk4' (fixed step) or "
+                         "method='dopri' (adaptive Dormand-Prince 5(4)).")
+    rk4 = method == "rk4"
+    wrong = [name for name, val in (("step", step), ("steps_per_period", steps_per_period),
+                                    ("record_every", record_every),
+                                    ("check_stability", check_stability))
+             if val is not None and not rk4]
+    wrong += [name for name, val in (("rtol", rtol), ("atol", atol), ("max_step", max_step))
+              if val is not None and rk4]
+    if wrong:
+        raise ValueError(f"option(s) {wrong} do not apply to method={method!r}; remove them "
+                         f"or choose the other method.")
+    if record_every is not None and sample_interval is not None:
+        raise ValueError("give either record_every or sample_interval, not both.")
+    if progress is not None and not callable(progress):
+        raise TypeError("progress must be a callable taking the fraction done, e.g. "
+                        "progress=lambda f: print(f'{f:.0%}').")
+
+    s = structure
+    n = s.n_dof
+    n_el = s.n_elements
+    t0, t_end = (float(x) for x in t_span)
+    span = t_end - t0
+    if not (math.isfinite(span) and span > 0):
+        raise ValueError(f"t_span must be (start, end) with end > start, got {t_span!r}.")
+    y = np.array(y0, dtype=np.float64, order="C", copy=True).ravel()
+    if y.shape == (n,):
+        y = np.concatenate([y, np.zeros(n)])
+    if y.shape != (2 * n,):
+        raise ValueError(f"y0 must hold {2 * n} values [q, v] or {n} values q, got "
+                         f"{np.shape(y0)}.")
+    if not np.all(np.isfinite(y)):
+        raise ValueError("y0 contains NaN or inf; start from finite displacements and "
+                         "velocities, e.g. static_equilibrium(structure).q.")
+    model = _model_arrays(s)
+
+    # ------------------------------------------------------------ selections
+    if track_elements is None:
+        track = [e for e in range(n_el) if s.frequency[e] > 0]
+    else:
+        track = _resolve(s.element_names, track_elements, "element")
+        static_ones = [s.element_names[e] for e in track if not s.frequency[e] > 0]
+        if static_ones:
+            raise ValueError(f"elements {static_ones} have no excitation frequency, so they "
+                             "have no mesh cycles to track; leave them out of track_elements.")
+    hist_el = list(range(n_el)) if history_elements is None else _resolve(
+        s.element_names, history_elements, "element")
+    hist_dof = list(range(n)) if history_dofs is None else _resolve(
+        s.dof_names, history_dofs, "dof")
+    track_arr = np.array(track, dtype=np.int64)
+    track_base = np.array([math.floor(s.frequency[e] * t0 + s.phase[e]) for e in track],
+                          dtype=np.int64)
+    f_track = float(s.frequency[track_arr].max()) if track else 0.0
+    cap = (int(math.ceil(f_track * span)) + 2 if track else 0) if n_cycles_cap is None \
+        else int(n_cycles_cap)
+    if cap < 0:
+        raise ValueError("n_cycles_cap must be >= 0.")
+
+    periods = _excitation_periods(s)
+    t_exc = float(periods.min()) if periods.size else math.inf
+
+    # ------------------------------------------------------------ step plan
+    if rk4:
+        spp = 100 if steps_per_period is None else int(steps_per_period)
+        if spp < 1:
+            raise ValueError("steps_per_period must be >= 1.")
+        do_check = True if check_stability is None else bool(check_stability)
+        if step is None:
+            period = t_exc if math.isfinite(t_exc) else _natural_period_min(s)
+            if not math.isfinite(period):
+                period = span * spp / 1000.0
+            h = period / spp
+            if do_check:
+                safe = 0.8 * stable_step(s)
+                if h > safe:
+                    per = math.ceil(period / safe)
+                    log.info("default step %.3g s is unstable; using %d steps per period",
+                             h, per)
+                    h = period / per
+        else:
+            h = float(step)
+            if do_check:
+                check_step(s, h)
+            elif not (h > 0 and math.isfinite(h)):
+                raise ValueError(f"step must be a positive number of seconds, got {step!r}.")
+        n_total = span / h
+        n_steps_total = int(round(n_total))
+        if n_steps_total < 1 or abs(n_total - n_steps_total) > 1e-9 * n_total:
+            n_steps_total = max(1, int(math.ceil(n_total)))
+        h = span / n_steps_total if abs(n_steps_total * h - span) > 1e-12 * span else h
+        if sample_interval is not None:
+            every = max(1, int(round(float(sample_interval) / h)))
+        else:
+            every = 1 if record_every is None else int(record_every)
+        if every < 1:
+            raise ValueError("record_every must be >= 1.")
+        n_hist = n_steps_total // every + 1
+        n_full = n_steps_total + 1 if full_history else 0
+        limit_steps = n_steps_total if max_steps is None else min(n_steps_total, int(max_steps))
+    else:
+        rtol_ = 1e-6 if rtol is None else float(rtol)
+        if not rtol_ > 0:
+            raise ValueError("rtol must be > 0, e.g. rtol=1e-6.")
+        if atol is None:
+            atol_ = _default_atol(s, rtol_)
+        else:
+            atol_ = np.ascontiguousarray(np.broadcast_to(
+                np.asarray(atol, dtype=np.float64), (2 * n,))).copy()
+        if np.any(atol_ < 0) or (np.any(atol_ == 0) and not rtol_ > 0):
+            raise ValueError("atol must be >= 0.")
+        h_max = (t_exc / 20.0 if math.isfinite(t_exc) else span) if max_step is None \
+            else float(max_step)
+        if not h_max > 0:
+            raise ValueError("max_step must be > 0.")
+        dt_sample = (h_max if math.isfinite(t_exc) or max_step is not None
+                     else span / 1000.0) if sample_interval is None else float(sample_interval)
+        if not dt_sample > 0:
+            raise ValueError("sample_interval must be > 0.")
+        n_hist = int(math.floor(span / dt_sample * (1 + 1e-12))) + 1
+        n_full = n_hist if full_history else 0
+        limit_steps = (max(100_000, int(10 * span / h_max)) if max_steps is None
+                       else int(max_steps))
+        h = None
+    if not (hist_el or hist_dof) and (rk4 or not full_history):
+        n_hist = 0  # (dopri writes the full state at the history sample times)
+
+    # ------------------------------------------------------------ outputs
+    n_tr = len(track)
+    need = 8 * (n_hist * (1 + len(hist_el) + 2 * len(hist_dof)) + n_full * (1 + 2 * n)
+                + 4 * cap * n_tr)
+    if need > _MEMORY_LIMIT:
+        raise SolverError(
+            f"the requested outputs need {need / 1024**3:.1f} GiB; record less: raise "
+            "record_every / sample_interval, list fewer history_elements and "
+            "history_dofs, drop full_history, or lower n_cycles_cap.")
+    cyc_max = np.full((cap, n_tr), -np.inf)
+    cyc_min = np.full((cap, n_tr), np.inf)
+    cyc_sum = np.zeros((cap, n_tr))
+    cyc_cnt = np.zeros((cap, n_tr), dtype=np.int64)
+    sep_count = np.zeros(n_el, dtype=np.int64)
+    back_count = np.zeros(n_el, dtype=np.int64)
+    hist_el_a = np.array(hist_el, dtype=np.int64)
+    hist_dof_a = np.array(hist_dof, dtype=np.int64)
+    hist_t = np.zeros(n_hist)
+    hist_f = np.zeros((n_hist, len(hist_el)))
+    hist_q = np.zeros((n_hist, len(hist_dof)))
+    hist_v = np.zeros((n_hist, len(hist_dof)))
+    full_t = np.zeros(n_full)
+    full_y = np.zeros((n_full, 2 * n))
+    record = (track_arr, track_base, cyc_max, cyc_min, cyc_sum, cyc_cnt, sep_count,
+              back_count, hist_el_a, hist_dof_a, hist_t, hist_f, hist_q, hist_v,
+              full_t, full_y)
+    counters = np.zeros(kern.N_COUNTERS, dtype=np.int64)
+    clock = np.zeros(kern.N_CLOCK)
+    clock[kern.F_T] = t0
+    blowup = float(blowup)
+
+    # ------------------------------------------------------------ run
+    if rk4:
+        chunk = max(_MIN_CHUNK_STEPS,
+                    -(-math.ceil(limit_steps / _N_CHUNKS) // kern.RESYNC) * kern.RESYNC)
+        done = 0
+        while done < limit_steps:
+            m = min(chunk, limit_steps - done)
+            final = done + m == limit_steps
+            kern.rk4_run(y, t0, h, done, m, final, every, blowup, *model, *record,
+                         counters, clock)
+            done += m
+            if counters[kern.I_STATUS] != kern.FINISHED:
+                break
+            if progress is not None:
+                progress(done / n_steps_total)
+        if counters[kern.I_STATUS] == kern.FINISHED and limit_steps < n_steps_total:
+            counters[kern.I_STATUS] = kern.MAX_STEPS
+        step_min = step_max = h
+    else:
+        kfsal = np.zeros(2 * n)
+        clock[kern.F_H] = min(_initial_step(s, y, t0, t_end, rtol_, atol_, model), h_max)
+        clock[kern.F_FACOLD] = 1e-4
+        clock[kern.F_HMIN] = math.inf
+        clock[kern.F_HMAX] = 0.0
+        counters[kern.I_RHS] = 2  # the two evaluations of the initial step estimate
+        h_min = 1e-12 * span
+        for k in range(1, _N_CHUNKS + 1):
+            t_stop = t_end if k == _N_CHUNKS else t0 + span * k / _N_CHUNKS
+            if clock[kern.F_T] >= t_stop:
+                continue
+            kern.dopri_run(y, kfsal, t0, t_end, t_stop, rtol_, atol_, h_max, h_min,
+                           limit_steps, blowup, dt_sample, *model, *record, counters, clock)
+            if counters[kern.I_STATUS] != kern.FINISHED:
+                break
+            if progress is not None:
+                progress(min(1.0, (clock[kern.F_T] - t0) / span))
+        step_min = float(clock[kern.F_HMIN]) if counters[kern.I_STEPS] else math.nan
+        step_max = float(clock[kern.F_HMAX]) if counters[kern.I_STEPS] else math.nan
+
+    # ------------------------------------------------------------ results
+    status = int(counters[kern.I_STATUS])
+    t_final = float(clock[kern.F_T])
+    message = _message(status, s, y, t_final, t_end, counters, clock, blowup, limit_steps,
+                       method)
+    n_rec = int(counters[kern.I_HIST])
+    n_full_rec = int(counters[kern.I_FULL])
+    used = np.flatnonzero(cyc_cnt.sum(axis=1) > 0)
+    n_cyc = int(used[-1]) + 1 if used.size else 0
+    cnt = cyc_cnt[:n_cyc].copy()
+    with np.errstate(invalid="ignore", divide="ignore"):
+        mean = np.where(cnt > 0, cyc_sum[:n_cyc] / cnt, np.nan)
+    cmax = np.where(cnt > 0, cyc_max[:n_cyc], np.nan)
+    cmin = np.where(cnt > 0, cyc_min[:n_cyc], np.nan)
+    rows = np.arange(n_cyc)[:, None]
+    if n_tr:
+        start = (track_base[None, :] + rows - s.phase[track_arr][None, :]) \
+            / s.frequency[track_arr][None, :]
+    else:
+        start = np.zeros((n_cyc, 0))
+    return Solution(
+        status=status,
+        message=message,
+        success=status == kern.FINISHED,
+        method=method,
+        t_span=(t0, t_end),
+        t_final=t_final,
+        y_final=y.copy(),
+        n_steps=int(counters[kern.I_STEPS]),
+        n_rejected=int(counters[kern.I_REJECTED]),
+        n_rhs=int(counters[kern.I_RHS]),
+        step=h,
+        step_min=step_min,
+        step_max=step_max,
+        compile_time=compile_time,
+        wall_time=time.perf_counter() - t_call,
+        dof_names=tuple(s.dof_names),
+        element_names=tuple(s.element_names),
+        tracked_elements=tuple(track),
+        cycle_start=start,
+        cycle_max=cmax,
+        cycle_min=cmin,
+        cycle_mean=mean,
+        cycle_count=cnt,
+        history_elements=tuple(hist_el),
+        history_dofs=tuple(hist_dof),
+        history_t=hist_t[:n_rec].copy(),
+        history_forces=hist_f[:n_rec].copy(),
+        history_q=hist_q[:n_rec].copy(),
+        history_v=hist_v[:n_rec].copy(),
+        full_t=full_t[:n_full_rec].copy() if full_history else None,
+        full_y=full_y[:n_full_rec].copy() if full_history else None,
+        n_samples=int(counters[kern.I_SAMPLES]),
+        separation_steps=sep_count,
+        back_contact_steps=back_count,
+    )
+
+
+def _initial_step(s, y, t0, t_end, rtol, atol, model) -> float:
+    """Starting step of the adaptive method (Hairer, Norsett & Wanner, Solving ODE I,
+    II.4, 'starting step size')."""
+    n2 = y.shape[0]
+    sc = atol + rtol * np.abs(y)
+    sc = np.where(sc > 0, sc, 1e-300)
+    f0 = np.empty(n2)
+    scratch = np.empty(s.n_elements), np.empty(s.n_elements)
+    kern.rhs_at(t0, y, *model, f0, *scratch)
+    d0 = math.sqrt(np.mean((y / sc) ** 2))
+    d1 = math.sqrt(np.mean((f0 / sc) ** 2))
+    h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
+    h0 = min(h0, t_end - t0)
+    f1 = np.empty(n2)
+    kern.rhs_at(t0 + h0, y + h0 * f0, *model, f1, *scratch)
+    d2 = math.sqrt(np.mean(((f1 - f0) / sc) ** 2)) / h0
+    dmax = max(d1, d2)
+    h1 = max(1e-6, h0 * 1e-3) if dmax <= 1e-15 else (0.01 / dmax) ** (1.0 / 5.0)
+    return min(100 * h0, h1, t_end - t0)
+
+
+def _message(status, s, y, t_final, t_end, counters, clock, blowup, limit_steps,
+             method) -> str:
+    n = s.n_dof
+    n_steps = int(counters[kern.I_STEPS])
+    if status == kern.FINISHED:
+        return (f"The solver successfully reached the end of the integration interval "
+                f"(t = {t_final:.6g} s) in {n_steps} steps.")
+    if status == kern.DIVERGED:
+        i = int(counters[kern.I_BAD])
+        name = s.dof_names[i % n] + (" (velocity)" if i >= n else "")
+        if not math.isfinite(y[i]):
+            why = f"the state of DOF '{name}' is not finite ({y[i]})"
+        else:
+            why = f"|q| of DOF '{name}' = {abs(y[i]):.3g} exceeds blowup = {blowup:.3g}"
+        fix = ("Use a smaller step (see torquesplit.solve.check_step) or method='dopri', "
+               "check stiffness signs and units and that drive and load torques balance, "
+               "or raise blowup if such a displacement is real."
+               if method == "rk4" else
+               "Check stiffness signs and units and that the drive and load torques "
+               "balance, or raise blowup if such a displacement is real.")
+        return (f"Integration diverged at t = {t_final:.6g} s (step {n_steps}): {why}. "
+                f"Everything recorded before that time is valid. {fix}")
+    if status == kern.STEP_UNDERFLOW:
+        return (f"Required step size {clock[kern.F_H]:.3g} s fell below the minimum at "
+                f"t = {t_final:.6g} s (step {n_steps}); the response is too stiff or "
+                f"discontinuous there for method='dopri'. Loosen rtol/atol, or use "
+                f"method='rk4' with a step from check_step.")
+    return (f"Maximum number of steps ({limit_steps}) reached at t = {t_final:.6g} s before "
+            f"t_end = {t_end:.6g} s. Raise max_steps"
+            + (" or loosen rtol/atol." if method == "dopri" else "."))

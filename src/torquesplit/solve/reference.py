@@ -1,0 +1,243 @@
+"""Readable numpy twins of the compiled kernels in :mod:`torquesplit.solve._kernels`.
+
+These functions say in plain numpy what the kernels compute.  They are slow (a Python
+call per step) and exist for three uses: documentation, tests that compare kernel and
+twin, and baselines (e.g. ``scipy.integrate.solve_ivp(lambda t, y: rhs_numpy(s, t, y),
+...)``).  Symbols follow :mod:`torquesplit.assembly.structure`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from torquesplit.assembly.structure import MESH, Structure
+
+__all__ = [
+    "Excitation",
+    "excitation_numpy",
+    "element_forces_numpy",
+    "rhs_numpy",
+    "hermite_numpy",
+    "cycle_statistics_numpy",
+    "rk4_numpy",
+    "dopri_numpy",
+]
+
+
+@dataclass(frozen=True)
+class Excitation:
+    """Every element's time-dependent quantities at one instant (all shape (n_el,))."""
+
+    stiffness: np.ndarray
+    """k_e(t) [N/m]."""
+    force: np.ndarray
+    """Additive force p_e(t) [N]."""
+    half_gap: np.ndarray
+    """Half-gap g_e of the current excitation cycle [m]."""
+    error: np.ndarray
+    """e_e(t) [m]."""
+    error_rate: np.ndarray
+    """e_e'(t) [m/s]."""
+    cycle: np.ndarray
+    """Excitation cycle index floor(f t + phase) (int64; 0 for f == 0)."""
+
+
+def excitation_numpy(structure: Structure, t: float) -> Excitation:
+    """Excitation of every element at time ``t``.
+
+    Mesh phase s = f t + phase.  Stiffness and additive force are interpolated linearly
+    and periodically in their table at frac(s) * n_table (column 0 when f == 0); the
+    half-gap is entry floor(s) mod n_gaps of the element's per-cycle sequence; the error
+    is e = e_const + sum A sin(omega t + phi) and its rate sum A omega cos(omega t + phi).
+    Twin of ``_kernels.excite_exact`` (and ``init_slots``).
+    """
+    s = structure
+    n_el = s.n_elements
+    n_tab = s.n_table
+    rows = np.arange(n_el)
+    varying = s.frequency > 0.0
+    mesh_phase = np.where(varying, s.frequency * t + s.phase, 0.0)
+    cycle = np.floor(mesh_phase)
+    x = (mesh_phase - cycle) * n_tab
+    i0 = x.astype(np.int64)
+    w = x - i0
+    i0 = np.where(i0 >= n_tab, i0 - n_tab, i0)
+    i1 = (i0 + 1) % n_tab
+    k0 = s.stiffness_table[rows, i0]
+    p0 = s.force_table[rows, i0]
+    stiffness = k0 + w * (s.stiffness_table[rows, i1] - k0)
+    force = p0 + w * (s.force_table[rows, i1] - p0)
+    cycle = cycle.astype(np.int64)
+    n_gaps = np.diff(s.gap_ptr)
+    half_gap = s.gap_values[s.gap_ptr[:-1] + np.mod(cycle, n_gaps)]
+
+    owner = np.repeat(np.arange(n_el), np.diff(s.error_ptr))
+    arg = s.error_omega * t + s.error_phase
+    error = s.error_constant.astype(float).copy()
+    error_rate = np.zeros(n_el)
+    np.add.at(error, owner, s.error_amplitude * np.sin(arg))
+    np.add.at(error_rate, owner, s.error_amplitude * s.error_omega * np.cos(arg))
+    return Excitation(stiffness, force, half_gap, error, error_rate, cycle)
+
+
+def element_forces_numpy(structure: Structure, t: float, y: np.ndarray):
+    """Element forces f_e and deformations delta_e at (t, y); returns ``(force, delta)``.
+
+    delta = V.q - e, rate = V.v - e', h = dead zone of half-width g (h = delta when
+    g == 0), f = k h + c rate (in contact only) + p.
+    Twin of the element loop in ``_kernels.rhs_slot``.
+    """
+    n = structure.n_dof
+    y = np.asarray(y, dtype=float)
+    q, v = y[:n], y[n:]
+    ex = excitation_numpy(structure, t)
+    V = structure.projection_matrix()
+    delta = V @ q - ex.error
+    rate = V @ v - ex.error_rate
+    g = ex.half_gap
+    gapped = g > 0.0
+    h = np.where(delta > g, delta - g, np.where(delta < -g, delta + g, 0.0))
+    h = np.where(gapped, h, delta)
+    contact = ~gapped | (np.abs(delta) > g)
+    force = ex.stiffness * h + np.where(contact, structure.damping * rate, 0.0) + ex.force
+    return force, delta
+
+
+def rhs_numpy(structure: Structure, t: float, y: np.ndarray) -> np.ndarray:
+    """Right-hand side of the first-order system: dy/dt = [v, M^-1 (F - C_g v - V^T f)].
+
+    Twin of ``_kernels.rhs_slot`` / ``_kernels.rhs_at``.  Usable directly with
+    :func:`scipy.integrate.solve_ivp`.
+    """
+    n = structure.n_dof
+    y = np.asarray(y, dtype=float)
+    v = y[n:]
+    force, _ = element_forces_numpy(structure, t, y)
+    V = structure.projection_matrix()
+    accel = structure.inv_mass * (structure.external_force - structure.ground_damping * v
+                                  - V.T @ force)
+    return np.concatenate([v, accel])
+
+
+def hermite_numpy(theta, h, y0, f0, y1, f1):
+    """Cubic Hermite interpolant between (y0, f0) and (y1, f1) at t0 + theta h.
+
+    Twin of ``_kernels.hermite``.
+    """
+    h00 = 2 * theta**3 - 3 * theta**2 + 1
+    h10 = theta**3 - 2 * theta**2 + theta
+    h01 = -2 * theta**3 + 3 * theta**2
+    h11 = theta**3 - theta**2
+    return h00 * y0 + h10 * h * f0 + h01 * y1 + h11 * h * f1
+
+
+def cycle_statistics_numpy(times, forces, frequency, phase, t0, n_cycles_cap):
+    """Per-excitation-cycle max, min, sum and count of one element's force samples.
+
+    Cycle index of a sample at t is floor(f t + phase) - floor(f t0 + phase).
+    Returns four arrays of length ``n_cycles_cap`` (max -inf / min +inf where empty).
+    Twin of the cycle part of ``_kernels.record_statistics``.
+    """
+    times = np.asarray(times, dtype=float)
+    forces = np.asarray(forces, dtype=float)
+    idx = (np.floor(frequency * times + phase) - np.floor(frequency * t0 + phase)).astype(int)
+    cmax = np.full(n_cycles_cap, -np.inf)
+    cmin = np.full(n_cycles_cap, np.inf)
+    csum = np.zeros(n_cycles_cap)
+    ccnt = np.zeros(n_cycles_cap, dtype=np.int64)
+    ok = (idx >= 0) & (idx < n_cycles_cap)
+    np.maximum.at(cmax, idx[ok], forces[ok])
+    np.minimum.at(cmin, idx[ok], forces[ok])
+    np.add.at(csum, idx[ok], forces[ok])
+    np.add.at(ccnt, idx[ok], 1)
+    return cmax, cmin, csum, ccnt
+
+
+def rk4_numpy(structure: Structure, y0, t0: float, h: float, n_steps: int):
+    """Classic RK4 with a Python call per stage; returns ``(t, y)`` of all steps.
+
+    Twin of ``_kernels.rk4_run`` (which advances error sinusoids by phasor rotation, so
+    the two agree to round-off, not bit for bit).
+    """
+    y = np.array(y0, dtype=float)
+    ts = [t0]
+    ys = [y.copy()]
+    for i in range(n_steps):
+        t = t0 + i * h
+        k1 = rhs_numpy(structure, t, y)
+        k2 = rhs_numpy(structure, t0 + (i + 0.5) * h, y + 0.5 * h * k1)
+        k3 = rhs_numpy(structure, t0 + (i + 0.5) * h, y + 0.5 * h * k2)
+        k4 = rhs_numpy(structure, t0 + (i + 1) * h, y + h * k3)
+        y = y + h / 6.0 * (k1 + 2.0 * (k2 + k3) + k4)
+        ts.append(t0 + (i + 1) * h)
+        ys.append(y.copy())
+    return np.array(ts), np.array(ys)
+
+
+# Dormand & Prince 5(4) tableau (Hairer, Norsett & Wanner, Solving ODE I, table 5.2)
+_DP_C = np.array([0, 1 / 5, 3 / 10, 4 / 5, 8 / 9, 1, 1])
+_DP_A = [
+    [],
+    [1 / 5],
+    [3 / 40, 9 / 40],
+    [44 / 45, -56 / 15, 32 / 9],
+    [19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729],
+    [9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656],
+    [35 / 384, 0, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84],
+]
+_DP_E = np.array([71 / 57600, 0, -71 / 16695, 71 / 1920, -17253 / 339200, 22 / 525, -1 / 40])
+
+
+def dopri_numpy(structure: Structure, y0, t_span, *, rtol, atol, h0, h_max=np.inf,
+                max_steps=100_000):
+    """Adaptive Dormand-Prince 5(4) with PI step control; returns ``(t, y, n_rejected)``.
+
+    Error norm: RMS of err_i / (atol_i + rtol max(|y_i|, |y_new_i|)).  Step control:
+    h_new = h / clip(err^0.17 / err_old^0.04 / 0.9, 0.1, 5) after acceptance,
+    h / min(5, err^0.17 / 0.9) after rejection (no increase right after a rejection).
+    Twin of ``_kernels.dopri_run`` (same step sequence up to round-off).
+    """
+    t0, t_end = map(float, t_span)
+    y = np.array(y0, dtype=float)
+    atol = np.broadcast_to(np.asarray(atol, dtype=float), y.shape)
+    t, h, facold, last_rejected, n_rejected = t0, float(h0), 1e-4, False, 0
+    ts, ys = [t], [y.copy()]
+    f = rhs_numpy(structure, t, y)
+    while t < t_end and len(ts) <= max_steps:
+        hs = min(h, h_max)
+        last = False
+        if t + 1.01 * hs >= t_end:
+            if t_end - t <= h_max:
+                hs, last = t_end - t, True
+            else:
+                hs = 0.5 * (t_end - t)
+        k = [f]
+        for i in range(1, 7):
+            yi = y + hs * sum(a * kj for a, kj in zip(_DP_A[i], k))
+            ti = t_end if (last and i >= 5) else t + _DP_C[i] * hs
+            k.append(rhs_numpy(structure, ti, yi))
+            if i == 6:
+                y_new = yi
+        err = hs * sum(e * kj for e, kj in zip(_DP_E, k))
+        scale = atol + rtol * np.maximum(np.abs(y), np.abs(y_new))
+        enorm = np.sqrt(np.mean((err / scale) ** 2))
+        if not np.isfinite(enorm):
+            n_rejected, last_rejected, h = n_rejected + 1, True, hs * 0.2
+            continue
+        fac11 = enorm**0.17
+        if enorm <= 1.0:
+            t = t_end if last else t + hs
+            y, f = y_new, k[6]
+            ts.append(t)
+            ys.append(y.copy())
+            fac = np.clip(fac11 / facold**0.04 / 0.9, 0.1, 5.0)
+            h_new = hs / fac
+            if last_rejected:
+                h_new = min(h_new, hs)
+            h, facold, last_rejected = h_new, max(enorm, 1e-4), False
+        else:
+            n_rejected, last_rejected = n_rejected + 1, True
+            h = hs / min(5.0, fac11 / 0.9)
+    return np.array(ts), np.array(ys), n_rejected

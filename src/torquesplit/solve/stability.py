@@ -1,0 +1,130 @@
+"""Linear stability of the fixed-step RK4 integrator for an assembled structure.
+
+The check linearises the equations of motion with every element at the maximum of its
+stiffness table and every dead zone closed (the stiffest state the run can reach)::
+
+    A = [[0, I], [-M^-1 K_max, -M^-1 C]]
+
+and requires ``|R(h lambda)| <= 1`` for every eigenvalue ``lambda`` of ``A``, with the
+RK4 amplification factor ``R(z) = 1 + z + z^2/2 + z^3/6 + z^4/24``.  Zero (rigid-body)
+eigenvalues give ``R = 1`` and never limit the step; eigenvalues with a clearly positive
+real part (a physically unstable model, e.g. negative stiffness) are left out, since
+no step makes them decay.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from torquesplit.assembly.structure import Structure
+from torquesplit.errors import StepTooLargeError
+
+__all__ = [
+    "rk4_amplification",
+    "system_eigenvalues",
+    "highest_natural_frequency",
+    "stable_step",
+    "check_step",
+]
+
+SAFETY = 0.8
+"""Safe step = SAFETY x the largest stable step."""
+
+_REAL_TOL = 1e-8  # real parts below this x max|lambda| count as zero (round-off)
+_R_TOL = 1e-12  # |R| may exceed 1 by this much (round-off)
+
+
+def rk4_amplification(z):
+    """RK4 amplification factor R(z) = 1 + z + z^2/2 + z^3/6 + z^4/24."""
+    return 1.0 + z * (1.0 + z * (0.5 + z * (1.0 / 6.0 + z / 24.0)))
+
+
+def system_eigenvalues(structure: Structure) -> np.ndarray:
+    """Eigenvalues of the first-order system at maximum stiffness, all gaps closed [1/s].
+
+    Round-off positive real parts (below 1e-8 max|lambda|) are set to zero.
+    """
+    n = structure.n_dof
+    if n == 0:
+        return np.zeros(0, dtype=complex)
+    k_max = structure.stiffness_table.max(axis=1) if structure.n_table else np.zeros(0)
+    K = structure.stiffness_matrix(k_max)
+    C = structure.damping_matrix()
+    A = np.zeros((2 * n, 2 * n))
+    A[:n, n:] = np.eye(n)
+    A[n:, :n] = -structure.inv_mass[:, None] * K
+    A[n:, n:] = -structure.inv_mass[:, None] * C
+    lam = np.linalg.eigvals(A)
+    scale = np.max(np.abs(lam)) if lam.size else 0.0
+    tiny = (lam.real > 0) & (lam.real <= _REAL_TOL * scale)
+    return np.where(tiny, 1j * lam.imag, lam)
+
+
+def highest_natural_frequency(structure: Structure) -> float:
+    """Largest |lambda| / 2 pi of :func:`system_eigenvalues` [Hz] (0 without stiffness)."""
+    lam = system_eigenvalues(structure)
+    return float(np.max(np.abs(lam)) / (2 * math.pi)) if lam.size else 0.0
+
+
+def _limiting(lam: np.ndarray) -> np.ndarray:
+    """Eigenvalues that can limit the step (physically decaying or oscillating)."""
+    scale = np.max(np.abs(lam)) if lam.size else 0.0
+    return lam[(lam.real <= _REAL_TOL * scale) & (np.abs(lam) > 0.0)]
+
+
+def _is_stable(h: float, lam: np.ndarray) -> bool:
+    return bool(np.all(np.abs(rk4_amplification(h * lam)) <= 1.0 + _R_TOL))
+
+
+def stable_step(structure: Structure) -> float:
+    """Largest RK4 step [s] for which every mode stays bounded (``inf`` if none limits).
+
+    Found by bisection on |R(h lambda)| <= 1 (RK4's region lies within |z| < 3).
+    """
+    lam = _limiting(system_eigenvalues(structure))
+    if lam.size == 0:
+        return math.inf
+    lo, hi = 0.0, 4.0 / float(np.max(np.abs(lam)))
+    while _is_stable(hi, lam):  # not expected: the region lies inside |z| < 3
+        lo, hi = hi, 2.0 * hi
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if _is_stable(mid, lam):
+            lo = mid
+        else:
+            hi = mid
+        if hi - lo <= 1e-13 * hi:
+            break
+    return lo
+
+
+def check_step(structure: Structure, h: float) -> float:
+    """Raise :class:`StepTooLargeError` if RK4 with step ``h`` is unstable; else return
+    the safe step (0.8 x the largest stable step).
+
+    Examples
+    --------
+    >>> from torquesplit.assembly.structure import build_structure
+    >>> s = build_structure(["a.x"], [1.0], [dict(name="k", dofs=[0], coefs=[1.0],
+    ...                                           stiffness=1.0e6)])
+    >>> round(check_step(s, 1e-4), 6)
+    0.002263
+    """
+    h = float(h)
+    if not (h > 0.0 and math.isfinite(h)):
+        raise StepTooLargeError(f"RK4 step must be a positive finite number of seconds, "
+                                f"got {h!r}; give e.g. step=1e-6.")
+    lam = _limiting(system_eigenvalues(structure))
+    h_stable = stable_step(structure)
+    safe = SAFETY * h_stable
+    if lam.size and not _is_stable(h, lam):
+        f_max = float(np.max(np.abs(lam))) / (2 * math.pi)
+        raise StepTooLargeError(
+            f"RK4 step {h:.4g} s is unstable for this model: the highest natural "
+            f"frequency is {f_max:.6g} Hz (period {1.0 / f_max:.4g} s), so the largest "
+            f"stable step is {h_stable:.4g} s and a safe step is {safe:.4g} s. "
+            f"Use step <= {safe:.4g} s (or a larger steps_per_period), or method='dopri'."
+        )
+    return safe
