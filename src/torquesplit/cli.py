@@ -25,8 +25,8 @@ app = typer.Typer(
     no_args_is_help=True,
     help="Dynamic load-sharing analysis of power-split gear transmissions.",
 )
-console = Console()
-err_console = Console(stderr=True)
+console = Console(width=None if sys.stdout.isatty() else 160)
+err_console = Console(stderr=True, width=None if sys.stderr.isatty() else 160)
 
 _state = {"debug": False}
 
@@ -40,7 +40,8 @@ def _fail(exc: BaseException) -> None:
     if _state["debug"]:
         raise exc
     msg = str(exc).strip() or exc.__class__.__name__
-    err_console.print(f"[bold red]error:[/] {msg}", markup=True, highlight=False, soft_wrap=True)
+    err_console.print("[bold red]error:[/] ", end="")
+    err_console.print(msg, markup=False, highlight=False, soft_wrap=True)
     raise typer.Exit(2)
 
 
@@ -65,7 +66,8 @@ def _load(model: str):
         m = load_model(path)
     for w in caught:
         if issubclass(w.category, ModelWarning):
-            err_console.print(f"[yellow]warning:[/] {w.message}", highlight=False, soft_wrap=True)
+            err_console.print("[yellow]warning:[/] ", end="")
+            err_console.print(str(w.message), markup=False, highlight=False, soft_wrap=True)
     return m, path
 
 
@@ -90,6 +92,108 @@ def check(
     from .model.summary import render_summary
 
     render_summary(s, console)
+
+
+# --------------------------------------------------------------------------- run
+@app.command()
+def run(
+    model: str = typer.Argument(..., help="Model file (.toml/.json) or example name."),
+    duration: Optional[str] = typer.Option(None, "--duration", help="Simulated time, e.g. '0.5 s'."),
+    cycles: Optional[int] = typer.Option(None, "--cycles", help="Cycles of the slowest mesh."),
+    method: Optional[str] = typer.Option(None, "--method", help="rk4 (fixed step) or dopri."),
+    steps_per_period: Optional[int] = typer.Option(
+        None, "--steps-per-period", help="RK4 steps per shortest mesh period (default 100)."),
+    definition: Optional[str] = typer.Option(
+        None, "--definition",
+        help="Load-sharing definition: cycle_peak, instantaneous, engineering, mean_force."),
+    out: Optional[Path] = typer.Option(None, "--out", help="Write results to this NetCDF file."),
+    as_json: bool = typer.Option(False, "--json", help="Print metrics and statistics as JSON."),
+    quiet: bool = typer.Option(False, "--quiet", help="No progress bar."),
+):
+    """Static equilibrium, then the dynamic response: load sharing and dynamic factors."""
+    from .model.units import parse_quantity
+
+    try:
+        if method is not None and method not in ("rk4", "dopri"):
+            raise TorquesplitError(f"--method {method!r} is unknown; use rk4 or dopri")
+        dur = parse_quantity(duration, "time") if duration is not None else None
+        m, path = _load(model)
+        from .simulation import simulate
+
+        res = _with_progress(lambda cb: simulate(
+            m, duration=dur, cycles=cycles, method=method,
+            steps_per_period=steps_per_period, progress=cb), quiet or as_json)
+    except (TorquesplitError, ValueError) as exc:
+        _fail(exc)
+        return
+    saved = None
+    if out is not None:
+        saved = res.to_netcdf(out)
+    try:
+        met = res.metrics(definition)
+    except ValueError as exc:
+        _fail(exc)
+        return
+    if as_json:
+        print(json.dumps({"model": m.model.name, "success": res.success,
+                          "metrics": met.to_dict(), "statistics": res.statistics(),
+                          "results_file": str(saved) if saved else None},
+                         indent=2, default=_json_default))
+    else:
+        _render_run(res, met, saved)
+    if not res.success:
+        raise typer.Exit(1)
+
+
+def _json_default(x):
+    if isinstance(x, float) and not math.isfinite(x):
+        return None
+    try:
+        return float(x)
+    except Exception:
+        return str(x)
+
+
+def _with_progress(job, quiet: bool):
+    """Run job(callback) with a rich progress bar on stderr."""
+    if quiet:
+        return job(None)
+    from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+
+    with Progress(TextColumn("integrating"), BarColumn(), TextColumn("{task.percentage:>3.0f}%"),
+                  TimeRemainingColumn(), console=err_console, transient=True) as bar:
+        task = bar.add_task("run", total=1.0)
+        return job(lambda f: bar.update(task, completed=f))
+
+
+def _render_run(res, met, saved) -> None:
+    st = res.statistics()
+    console.print(f"[bold]{res.model.model.name}[/]: {res.message}")
+    console.print(
+        f"{st['steps']} steps ({st['method']}), {st['microseconds_per_step']:.3g} us/step, "
+        f"integration {st['wall_time_s']:.3g} s, compile/load {st['compile_time_s']:.3g} s; "
+        f"transient discarded: {met.settling.start_time:.4g} s"
+        + ("" if met.settling.settled else " (not settled: last half used)"))
+    t = Table(title=f"meshes (load sharing: {met.definition})")
+    for col in ("mesh", "group", "nominal F [N]", "static F [N]", "mean F [N]", "peak F [N]",
+                "DLF", "LSC", "contact loss"):
+        t.add_column(col, justify="left" if col in ("mesh", "group") else "right")
+    for r in met.rows:
+        t.add_row(r.mesh, r.group, f"{r.nominal_force:.6g}", f"{r.static_force:.6g}",
+                  f"{r.mean_force:.6g}", f"{r.peak_force:.6g}", f"{r.dynamic_factor:.5f}",
+                  f"{r.load_sharing:.5f}", f"{100 * r.contact_loss:.2f} %")
+    console.print(t)
+    g = Table(title="load-sharing groups")
+    for col in ("group", "meshes", "LSC", "DLF", "DLF (eng.)"):
+        g.add_column(col, justify="left" if col in ("group", "meshes") else "right")
+    for name, members in met.load_sharing.groups.items():
+        g.add_row(name, ", ".join(members), f"{met.load_sharing.per_group[name]:.5f}",
+                  f"{met.dynamic_factors.per_group_peak[name]:.5f}",
+                  f"{met.dynamic_factors.per_group_engineering[name]:.5f}")
+    console.print(g)
+    console.print(f"system load-sharing coefficient: [bold]{met.load_sharing.system:.5f}[/]")
+    if saved:
+        console.print(f"results written to {saved}")
 
 
 # --------------------------------------------------------------------------- examples

@@ -55,18 +55,18 @@ def parse_quantity(value, kind: str) -> float:
     """
     si_unit, example = KINDS[kind]
     if isinstance(value, bool):
-        raise ValueError(f"expected a {_label(kind)} such as '{example}', got {value!r}")
+        raise ValueError(f"expected {_label(kind)} such as '{example}', got {value!r}")
     if isinstance(value, (int, float)):
         x = float(value)
     elif isinstance(value, str):
         x = _parse_string(value, kind)
     else:
         raise ValueError(
-            f"expected a {_label(kind)} such as '{example}' (a number is read in {si_unit}), "
+            f"expected {_label(kind)} such as '{example}' (a number is read in {si_unit}), "
             f"got {value!r}"
         )
     if not math.isfinite(x):
-        raise ValueError(f"expected a finite {_label(kind)}, got {value!r}")
+        raise ValueError(f"expected a finite {_label(kind)[2:].strip()}, got {value!r}")
     return x
 
 
@@ -77,14 +77,14 @@ def _parse_string(text: str, kind: str) -> float:
         q = ureg.Quantity(text.strip())
     except Exception:
         raise ValueError(
-            f"cannot read {text!r} as a {_label(kind)}; write a number and a unit, e.g. '{example}'"
+            f"cannot read {text!r} as {_label(kind)}; write a number and a unit, e.g. '{example}'"
         ) from None
     ref = _reference(kind)
     if not isinstance(q, pint.Quantity):  # a bare number in a string
         return float(q)
     if q.dimensionality != ref.dimensionality:
         raise ValueError(
-            f"{text!r} is not a {_label(kind)} (its dimension is {_dimension_text(q)}); "
+            f"{text!r} is not {_label(kind)} (its dimension is {_dimension_text(q)}); "
             f"write it in {si_unit} or a compatible unit, e.g. '{example}'"
         )
     if kind == "angle" and not (q.unitless or _is_angle_unit(q)):
@@ -106,7 +106,9 @@ def _dimension_text(q) -> str:
 
 
 def _label(kind: str) -> str:
-    return kind.replace("_", " ")
+    """'angle' -> 'an angle', 'torque' -> 'a torque' (for messages)."""
+    word = kind.replace("_", " ")
+    return ("an " if word[0] in "aeiou" else "a ") + word
 
 
 def format_quantity(value: float, unit: str, digits: int = 6) -> str:

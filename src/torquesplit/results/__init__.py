@@ -1,0 +1,203 @@
+"""Results of a dynamic run: metrics on demand, xarray Dataset, NetCDF / CSV / MAT export.
+
+============  ==============================================================
+module        content
+============  ==============================================================
+``results``   :class:`Results` (this module): holds the pipeline's stages
+``dataset``   conversion to an :class:`xarray.Dataset` with units and long names
+============  ==============================================================
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from functools import cached_property
+from pathlib import Path
+
+import numpy as np
+
+from ..metrics import load_sharing as ls
+
+
+@dataclass(frozen=True)
+class MeshRow:
+    """One line of the summary table of a run."""
+
+    mesh: str
+    group: str
+    nominal_force: float
+    static_force: float
+    mean_force: float
+    peak_force: float
+    dynamic_factor: float
+    dynamic_factor_engineering: float
+    load_sharing: float
+    contact_loss: float
+
+
+@dataclass(frozen=True)
+class Metrics:
+    """Metrics of a run for one load-sharing definition."""
+
+    definition: str
+    settling: ls.Settling
+    load_sharing: ls.LoadSharing
+    dynamic_factors: ls.DynamicFactors
+    rows: list[MeshRow]
+
+    def to_dict(self) -> dict:
+        return {
+            "definition": self.definition,
+            "settle_time_s": self.settling.start_time,
+            "settled": self.settling.settled,
+            "system_load_sharing": self.load_sharing.system,
+            "groups": {g: {"meshes": self.load_sharing.groups[g],
+                           "load_sharing": self.load_sharing.per_group[g],
+                           "dynamic_factor": self.dynamic_factors.per_group_peak[g],
+                           "dynamic_factor_engineering":
+                               self.dynamic_factors.per_group_engineering[g]}
+                       for g in self.load_sharing.groups},
+            "meshes": {r.mesh: {k: v for k, v in r.__dict__.items() if k != "mesh"}
+                       for r in self.rows},
+        }
+
+
+class Results:
+    """A finished (or stopped) dynamic run and everything needed to interpret it."""
+
+    def __init__(self, *, model, kinematics, structure, static, solution):
+        self.model = model
+        self.kinematics = kinematics
+        self.structure = structure
+        self.static = static
+        self.solution = solution
+
+    # ------------------------------------------------------------------ status
+    @property
+    def success(self) -> bool:
+        return self.solution.success
+
+    @property
+    def message(self) -> str:
+        return self.solution.message
+
+    @property
+    def mesh_names(self) -> list[str]:
+        return list(self.model.meshes)
+
+    def statistics(self) -> dict:
+        """Integration statistics: steps, rhs evaluations, step size, times."""
+        s = self.solution
+        return {
+            "method": s.method, "status": s.status, "message": s.message,
+            "steps": s.n_steps, "rejected_steps": s.n_rejected, "rhs_evaluations": s.n_rhs,
+            "step_s": s.step, "step_min_s": s.step_min, "step_max_s": s.step_max,
+            "simulated_time_s": s.t_final - s.t_span[0],
+            "compile_time_s": s.compile_time, "wall_time_s": s.wall_time,
+            "microseconds_per_step": 1e6 * s.wall_time / max(s.n_steps, 1),
+        }
+
+    # ------------------------------------------------------------------ metrics
+    @cached_property
+    def _mesh_meta(self) -> dict:
+        return self.structure.metadata["meshes"]
+
+    @cached_property
+    def groups(self) -> dict[str, list[str]]:
+        return ls.group_meshes(self._mesh_meta)
+
+    def nominal_forces(self) -> dict[str, float]:
+        """Equal-split static tooth force of each mesh [N]."""
+        return {m: self.kinematics.meshes[m].force for m in self.mesh_names}
+
+    def static_forces(self) -> dict[str, float]:
+        """Mesh forces of the static equilibrium (the static load sharing) [N]."""
+        names = self.structure.element_names
+        return {m: float(self.static.element_forces[names.index(m)]) for m in self.mesh_names}
+
+    def metrics(self, definition: str | None = None, *, window: int = 20,
+                tolerance: float = 0.01) -> Metrics:
+        """Load sharing (by ``definition``, see :mod:`torquesplit.metrics.load_sharing`)
+        and dynamic load factors over the settled part of the run."""
+        definition = definition or self.model.analysis.load_sharing
+        if definition not in ls.DEFINITIONS:
+            raise ValueError(f"unknown load-sharing definition {definition!r}; choose one of "
+                             f"{', '.join(ls.DEFINITIONS)}")
+        s = self.solution
+        names = self.mesh_names
+        st = ls.settle(s.cycle_max, s.cycle_start, names, window, tolerance)
+        groups = self.groups
+        if definition == "cycle_peak":
+            lsc = ls.cycle_peak(s.cycle_max, names, groups, st.first_cycle)
+        elif definition == "mean_force":
+            lsc = ls.mean_force(s.cycle_mean, s.cycle_count, names, groups, st.first_cycle)
+        elif definition in ("instantaneous", "engineering"):
+            t, f = self.mesh_force_history()
+            freq = {g: self._mesh_meta[m[0]]["frequency"] for g, m in groups.items()}
+            lsc = ls.instantaneous(t, f, names, groups, st.start_time, freq, definition)
+        else:  # static_torque on a dynamic run: instantaneous on the history
+            t, f = self.mesh_force_history()
+            lsc = ls.instantaneous(t, f, names, groups, st.start_time, None, "instantaneous")
+            lsc = ls.LoadSharing("static_torque", lsc.per_mesh, lsc.per_group, lsc.system,
+                                 lsc.groups)
+        nominal = self.nominal_forces()
+        dyn = ls.dynamic_factors(s.cycle_max, names, groups, st.first_cycle, nominal)
+        static = self.static_forces()
+        group_of = {m: g for g, ms in groups.items() for m in ms}
+        el = self.structure.element_names
+        rows = []
+        for j, m in enumerate(names):
+            k0 = st.first_cycle[m]
+            c = s.cycle_count[k0:, j]
+            mean = float((np.nan_to_num(s.cycle_mean[k0:, j]) * c).sum() / max(c.sum(), 1))
+            peak = s.cycle_max[k0:, j]
+            peak = float(np.nanmax(peak)) if np.isfinite(peak).any() else math.nan
+            rows.append(MeshRow(
+                mesh=m, group=group_of[m], nominal_force=nominal[m], static_force=static[m],
+                mean_force=mean, peak_force=peak, dynamic_factor=dyn.peak[m],
+                dynamic_factor_engineering=dyn.engineering[m],
+                load_sharing=lsc.per_mesh[m],
+                contact_loss=float(s.separation_fraction[el.index(m)]),
+            ))
+        return Metrics(definition, st, lsc, dyn, rows)
+
+    def mesh_force_history(self) -> tuple[np.ndarray, np.ndarray]:
+        """Decimated time and mesh forces (n_samples, n_meshes) [s, N]."""
+        s = self.solution
+        el = self.structure.element_names
+        cols = [list(s.history_elements).index(el.index(m)) for m in self.mesh_names]
+        return s.history_t, s.history_forces[:, cols]
+
+    # ------------------------------------------------------------------ export
+    def to_dataset(self):
+        """The run as an :class:`xarray.Dataset` (units and long names on every variable)."""
+        from .dataset import results_to_dataset
+
+        return results_to_dataset(self)
+
+    def to_netcdf(self, path) -> Path:
+        """Save as NetCDF (h5netcdf); the model is embedded so the file can be re-run."""
+        path = Path(path)
+        self.to_dataset().to_netcdf(path, engine="h5netcdf")
+        return path
+
+    def model_json(self) -> str:
+        from ..model.io import model_to_json
+
+        return model_to_json(self.model)
+
+
+def open_results(path):
+    """Open a results file written by :meth:`Results.to_netcdf` as an xarray Dataset."""
+    import xarray as xr
+
+    return xr.open_dataset(path, engine="h5netcdf")
+
+
+def model_from_results(dataset):
+    """Re-create the model embedded in a results Dataset."""
+    from ..model.io import load_model
+
+    return load_model(json.loads(dataset.attrs["model_json"]))

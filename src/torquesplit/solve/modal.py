@@ -1,0 +1,114 @@
+"""Undamped modes of a structure linearised about a displacement state.
+
+Each element contributes its mean stiffness ``k_e V_e V_e^T`` if it is in contact at
+the linearisation state (no dead zone, or ``|V_e.q - e_e| > g_e`` with the constant
+error and the mean half-gap); separated elements contribute nothing.  The generalized
+eigenproblem ``K phi = omega^2 M phi`` is solved in the symmetric form
+``(M^-1/2 K M^-1/2) psi = omega^2 psi`` with ``phi = M^-1/2 psi`` (mass-normalised:
+``phi^T M phi = 1``).  Modes with ``omega^2`` below ``rigid_tolerance`` x the largest
+are rigid-body modes; they are reported apart and left out of the frequency list.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from torquesplit.assembly.structure import Structure
+
+__all__ = ["ModalSolution", "modal_analysis"]
+
+
+@dataclass(frozen=True)
+class ModalSolution:
+    """Natural frequencies and modes (SI; columns are modes, ascending frequency)."""
+
+    frequencies: np.ndarray
+    """(n_modes,) natural frequencies [Hz] of the elastic modes; a negative value marks
+    a statically unstable mode (negative stiffness), its magnitude sqrt(|lambda|)/2 pi."""
+    mode_shapes: np.ndarray
+    """(n_dof, n_modes) mass-normalised mode shapes [m or rad per sqrt(kg)]."""
+    strain_energy_fraction: np.ndarray
+    """(n_modes, n_el) share of each element in the mode's strain energy (rows sum to 1)."""
+    damping_ratios: np.ndarray
+    """(n_modes,) modal damping estimate phi^T C phi / (2 omega) (coupling ignored)."""
+    rigid_modes: np.ndarray
+    """(n_dof, n_rigid) mass-normalised rigid-body modes."""
+    active: np.ndarray
+    """(n_el,) bool: elements in contact at the linearisation state."""
+    dof_names: tuple[str, ...]
+    element_names: tuple[str, ...]
+
+    @property
+    def n_modes(self) -> int:
+        return int(self.frequencies.shape[0])
+
+    def dominant_elements(self, mode: int, n: int = 3) -> list[tuple[str, float]]:
+        """The ``n`` elements with the largest strain-energy share in ``mode``."""
+        frac = self.strain_energy_fraction[mode]
+        order = np.argsort(-frac)[:n]
+        return [(self.element_names[i], float(frac[i])) for i in order]
+
+
+def modal_analysis(structure: Structure, q=None, *, rigid_tolerance: float = 1e-10
+                   ) -> ModalSolution:
+    """Natural frequencies, mass-normalised modes and modal strain energy per element.
+
+    Parameters
+    ----------
+    structure : Structure
+    q : array_like, optional
+        Displacements (n_dof) to linearise about, typically
+        ``static_equilibrium(structure).q``.  None: every element in contact.
+    rigid_tolerance : float
+        Eigenvalues omega^2 below this fraction of the largest are rigid-body modes.
+
+    Examples
+    --------
+    >>> from torquesplit.assembly.structure import build_structure
+    >>> s = build_structure(["m.x"], [1.0], [dict(name="k", dofs=[0], coefs=[1.0],
+    ...                                           stiffness=(2 * 3.141592653589793)**2)])
+    >>> modal_analysis(s).frequencies
+    array([1.])
+    """
+    s = structure
+    V = s.projection_matrix()
+    k = s.mean_stiffness()
+    if q is None:
+        active = np.ones(s.n_elements, dtype=bool)
+    else:
+        q = np.asarray(q, dtype=float)
+        if q.shape != (s.n_dof,):
+            raise ValueError(f"q must hold {s.n_dof} displacements, got shape {q.shape}; "
+                             "pass e.g. static_equilibrium(structure).q.")
+        g = np.array([s.gap_values[s.gap_ptr[i]:s.gap_ptr[i + 1]].mean()
+                      for i in range(s.n_elements)])
+        delta = V @ q - s.error_constant
+        active = (g <= 0) | (np.abs(delta) > g)
+    k_act = np.where(active, k, 0.0)
+    K = V.T @ (k_act[:, None] * V)
+    d = np.sqrt(s.inv_mass)
+    A = d[:, None] * K * d[None, :]
+    A = 0.5 * (A + A.T)
+    lam, psi = np.linalg.eigh(A)
+    lam_max = float(np.max(np.abs(lam))) if lam.size else 0.0
+    rigid = np.abs(lam) <= rigid_tolerance * lam_max
+    phi = d[:, None] * psi
+    elastic = ~rigid
+    lam_e = lam[elastic]
+    phi_e = phi[:, elastic]
+    freqs = np.sign(lam_e) * np.sqrt(np.abs(lam_e)) / (2 * math.pi)
+    energy = k_act[None, :] * (V @ phi_e).T ** 2
+    total = energy.sum(axis=1, keepdims=True)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        fraction = np.where(total != 0, energy / total, 0.0)
+    C = V.T @ (np.where(active, s.damping, 0.0)[:, None] * V) + np.diag(s.ground_damping)
+    omega = np.sqrt(np.abs(lam_e))
+    zeta = np.einsum("im,ij,jm->m", phi_e, C, phi_e) / (2 * omega) if omega.size \
+        else np.zeros(0)
+    return ModalSolution(frequencies=freqs, mode_shapes=phi_e,
+                         strain_energy_fraction=fraction, damping_ratios=zeta,
+                         rigid_modes=phi[:, rigid], active=active,
+                         dof_names=tuple(s.dof_names), element_names=tuple(s.element_names))
