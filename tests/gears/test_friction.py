@@ -88,12 +88,14 @@ def test_unit_convention():
 
     Lubricated steel gears show mu ~ 0.02-0.08 (sliding regions).  Only the
     convention above puts the peak of mu along the path in that range; R in mm
-    gives ~1e-3 and P_h in MPa ~1e-50.
+    gives ~1e-3 everywhere, and P_h in MPa makes mu vanish (~1e-20 and below)
+    where sliding is largest, at the ends of the path.
     """
     chosen = path_mu(0.6e-6)
     assert 0.02 <= chosen.max() <= 0.08
     assert path_mu(0.6e-6, r_scale=1e3).max() < 0.005  # R in mm
-    assert path_mu(0.6e-6, p_scale=1e-6).max() < 1e-10  # P_h in MPa
+    mpa = path_mu(0.6e-6, p_scale=1e-6)  # P_h in MPa
+    assert mpa[0] < 1e-10 and mpa[-1] < 1e-10
     # the library function implements the chosen convention (SI inputs)
     s = np.linspace(S_START, S_END, 201)
     u1, u2 = rolling_velocities(s, LINE, OMEGA1, OMEGA1 * RB1 / RB2)
@@ -135,9 +137,10 @@ def test_friction_reverses_at_pitch_point():
     assert before.any() and after.any()
     assert np.all(force[before] < 0) and np.all(force[after] > 0)
     # the direction coefficient itself
-    s = np.array([S_START, tab.pitch_point, S_END])
+    s = np.array([S_START, tab.pitch_point - 1e-6, tab.pitch_point + 1e-6, S_END])
     u1, u2 = rolling_velocities(s, LINE, OMEGA1, OMEGA1 * RB1 / RB2)
-    np.testing.assert_array_equal(friction_direction(u1, u2), [-1.0, 0.0, 1.0])
+    np.testing.assert_array_equal(friction_direction(u1, u2), [-1.0, -1.0, 1.0, 1.0])
+    assert friction_direction(3.0, 3.0) == 0.0
     # the total spur friction force changes sign within a mesh period (seed 003 sec. 4.1)
     assert tab.friction_force.min() < 0 < tab.friction_force.max()
 

@@ -59,8 +59,9 @@ def _wrap(phase):
 class LineOfActionError:
     """e(t) = constant + sum_k amplitudes[k] * sin(omegas[k] t + phases[k])  [m].
 
-    Normalised on construction: omegas >= 0 and amplitudes >= 0 (signs moved into
-    the phases), phases wrapped to [-pi, pi).
+    Normalised on construction: omegas >= 0 and amplitudes > 0 (signs moved into
+    the phases), phases wrapped to [-pi, pi), zero-frequency terms folded into the
+    constant, zero-amplitude terms dropped.
 
     Examples
     --------
@@ -91,10 +92,10 @@ class LineOfActionError:
         neg_a = a < 0
         a[neg_a] = -a[neg_a]
         p[neg_a] = p[neg_a] + np.pi
-        # zero-frequency terms are constants
+        # zero-frequency terms are constants; zero-amplitude terms are dropped
         zero = w == 0.0
         const = float(self.constant) + float(np.sum(a[zero] * np.sin(p[zero])))
-        keep = ~zero
+        keep = ~zero & (a != 0.0)
         object.__setattr__(self, "constant", const)
         object.__setattr__(self, "amplitudes", a[keep])
         object.__setattr__(self, "omegas", w[keep])

@@ -295,6 +295,8 @@ def meshing_in_point(
     rg = d - og
     v_g = w_g * np.array([rg[1], -rg[0]])  # clockwise gear
     v_s = float(np.dot(v_p - v_g, normal))  # seed 000 eq. 9: v_s = v_np - v_ng
+    if advance == 0.0:
+        v_s = 0.0  # conjugate contact on the line of action: exactly zero (removes round-off)
 
     alpha_ag = math.acos(rbg / rag)
     gamma_g = alpha_ag - aw  # = pi/2 - alpha_t - angle(PEO_g) of seed 000 eq. 6

@@ -64,7 +64,7 @@ def fourier_stiffness(mean: float, cos=(), sin=(), n: int = 256) -> MeshStiffnes
     the dynamic model (§2.3).
 
     >>> k = fourier_stiffness(1e9, cos=[1e8], n=4)
-    >>> [round(v / 1e8, 6) for v in k.stiffness]
+    >>> [float(round(v / 1e8, 6)) for v in k.stiffness]
     [11.0, 10.0, 9.0, 10.0]
     """
     a = np.atleast_1d(np.asarray(cos, dtype=float))

@@ -1,0 +1,62 @@
+"""Figure of mesh stiffness against mesh phase (for ``torquesplit mesh``)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Sequence
+
+__all__ = ["plot_mesh_stiffness"]
+
+
+def plot_mesh_stiffness(comparison, path, *, cycles: int = 2, title: str | None = None) -> Path:
+    """Plot mesh-stiffness waveforms and save the figure to ``path``.
+
+    Parameters
+    ----------
+    comparison : MethodComparison, MeshStiffness or sequence of MeshStiffness
+        What to draw.  For a :class:`~torquesplit.gears.stiffness.MethodComparison`
+        the ISO 6336-1 mean mesh stiffness ``c_gamma b`` is drawn as a dashed line.
+    path : str or Path
+        Output file; the format follows the suffix (``.png``, ``.pdf``, ``.svg``).
+    cycles : int
+        Number of mesh cycles to draw (the waveform repeats).
+    title : str, optional
+        Figure title.
+
+    Returns
+    -------
+    Path
+        The written file.
+    """
+    import numpy as np
+    from matplotlib.figure import Figure  # no pyplot: no global backend or state
+
+    from torquesplit.gears.stiffness import MeshStiffness
+
+    if isinstance(comparison, MeshStiffness):
+        labels, results, iso = [comparison.method], [comparison], None
+    elif hasattr(comparison, "results") and hasattr(comparison, "labels"):
+        labels, results, iso = list(comparison.labels), list(comparison.results), comparison.iso_mesh_stiffness
+    else:
+        results = list(comparison)  # type: Sequence[MeshStiffness]
+        labels, iso = [r.method for r in results], None
+
+    fig = Figure(figsize=(7.5, 4.2), layout="constrained")
+    ax = fig.add_subplot()
+    for lab, r in zip(labels, results):
+        ph = np.concatenate([r.phase + c for c in range(cycles)] + [np.array([float(cycles)])])
+        k = np.concatenate([r.stiffness] * cycles + [r.stiffness[:1]])
+        ax.step(ph, k / 1e8, where="post", label=f"{lab} (mean {r.mean:.3e} N/m)")
+    if iso is not None:
+        ax.axhline(iso / 1e8, color="k", linestyle="--", linewidth=1.0,
+                   label=f"ISO 6336-1 $c_\\gamma b$ = {iso:.3e} N/m")
+    ax.set_xlabel("mesh phase [mesh cycles]")
+    ax.set_ylabel("mesh stiffness [$10^8$ N/m]")
+    ax.set_xlim(0, cycles)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize="small", loc="best")
+    if title:
+        ax.set_title(title)
+    path = Path(path)
+    fig.savefig(path, dpi=150)
+    return path

@@ -1,0 +1,139 @@
+"""Small model files as TOML text, shared by the tests."""
+
+from __future__ import annotations
+
+import math
+
+
+SPUR_PAIR = """
+[model]
+name = "spur pair"
+
+[gears.pinion]
+teeth = 20
+module = "2 mm"
+face_width = "20 mm"
+polar_inertia = "4e-5 kg m^2"
+position = ["0 mm", "0 mm", "0 mm"]
+
+[gears.wheel]
+teeth = 40
+module = "2 mm"
+face_width = "20 mm"
+polar_inertia = "6e-4 kg m^2"
+place = {from_gear = "pinion", angle = "0 deg"}
+
+[meshes.m]
+gears = ["pinion", "wheel"]
+stiffness = "4e8 N/m"
+damping_ratio = 0.05
+
+[drives.motor]
+body = "pinion"
+speed = "3000 rpm"
+torque = "100 N m"
+
+[loads.out]
+body = "wheel"
+"""
+
+
+def split_model(error_a: str = "0 um", extra: str = "") -> str:
+    """A torsional locked-train split: pinion -> A, B (40 t) -> A2, B2 (20 t) -> out (60 t).
+
+    The output gear sits on the y axis so that it meshes with both second-stage
+    pinions: its centre distance to each is 80 mm, they are 60 mm off the axis.
+    """
+    y_out = math.sqrt(80.0**2 - 60.0**2)
+    return f"""
+[model]
+name = "two-path split"
+
+[gears.pinion]
+teeth = 20
+module = "2 mm"
+face_width = "20 mm"
+polar_inertia = "4e-5 kg m^2"
+position = ["0 mm", "0 mm", "0 mm"]
+
+[gears.a]
+teeth = 40
+module = "2 mm"
+face_width = "20 mm"
+polar_inertia = "6e-4 kg m^2"
+place = {{from_gear = "pinion", angle = "180 deg"}}
+
+[gears.b]
+teeth = 40
+module = "2 mm"
+face_width = "20 mm"
+polar_inertia = "6e-4 kg m^2"
+place = {{from_gear = "pinion", angle = "0 deg"}}
+
+[gears.a2]
+teeth = 20
+module = "2 mm"
+face_width = "20 mm"
+polar_inertia = "4e-5 kg m^2"
+
+[gears.b2]
+teeth = 20
+module = "2 mm"
+face_width = "20 mm"
+polar_inertia = "4e-5 kg m^2"
+
+[gears.out]
+teeth = 60
+module = "2 mm"
+face_width = "20 mm"
+polar_inertia = "3e-3 kg m^2"
+position = ["0 mm", "{y_out!r} mm", "0 mm"]
+
+[shafts.sa]
+connects = ["a", "a2"]
+rigid = true
+
+[shafts.sb]
+connects = ["b", "b2"]
+rigid = true
+
+[meshes.a1]
+gears = ["pinion", "a"]
+stiffness = "4e8 N/m"
+damping_ratio = 0.05
+stage = "split"
+transmission_error = {{constant = "{error_a}"}}
+
+[meshes.b1]
+gears = ["pinion", "b"]
+stiffness = "4e8 N/m"
+damping_ratio = 0.05
+stage = "split"
+
+[meshes.a2]
+gears = ["a2", "out"]
+stiffness = "4e8 N/m"
+damping_ratio = 0.05
+stage = "combine"
+
+[meshes.b2]
+gears = ["b2", "out"]
+stiffness = "4e8 N/m"
+damping_ratio = 0.05
+stage = "combine"
+
+[drives.motor]
+body = "pinion"
+speed = "3000 rpm"
+torque = "100 N m"
+
+[loads.out]
+body = "out"
+{extra}
+"""
+
+
+def write_model(tmp_path, text: str, name: str = "model.toml"):
+    path = tmp_path / name
+    path.write_text(text, encoding="utf-8")
+    return path
