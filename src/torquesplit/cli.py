@@ -196,6 +196,108 @@ def _render_run(res, met, saved) -> None:
         console.print(f"results written to {saved}")
 
 
+# --------------------------------------------------------------------------- static
+@app.command()
+def static(
+    model: str = typer.Argument(..., help="Model file (.toml/.json) or example name."),
+    revolutions: float = typer.Option(1.0, "--revolutions", help="Revolutions of the slowest gear."),
+    points_per_cycle: int = typer.Option(8, "--points-per-cycle", help="Positions per mesh cycle."),
+    out: Optional[Path] = typer.Option(None, "--out", help="Write results to this NetCDF file."),
+    as_json: bool = typer.Option(False, "--json", help="Print the results as JSON."),
+):
+    """Quasi-static load sharing: equilibrium at each mesh position (seed 004)."""
+    try:
+        m, _ = _load(model)
+        from .quasistatic import quasi_static_load_sharing
+
+        res = quasi_static_load_sharing(m, revolutions=revolutions,
+                                        points_per_cycle=points_per_cycle)
+    except (TorquesplitError, ValueError) as exc:
+        _fail(exc)
+        return
+    met = res.metrics()
+    orbits = res.orbits()
+    saved = res.to_netcdf(out) if out is not None else None
+    forces = res.mesh_forces()
+    if as_json:
+        print(json.dumps({
+            "model": m.model.name, "positions": int(res.times.size),
+            "converged": bool(res.solution.converged.all()),
+            "load_sharing": {"per_mesh": met.per_mesh, "per_group": met.per_group,
+                             "system": met.system, "groups": met.groups},
+            "mesh_force_N": {name: {"min": float(forces[:, j].min()),
+                                    "mean": float(forces[:, j].mean()),
+                                    "max": float(forces[:, j].max())}
+                             for j, name in enumerate(res.mesh_names)},
+            "orbits_um": {b: {"x_range": [1e6 * float(o[:, 0].min()), 1e6 * float(o[:, 0].max())],
+                              "y_range": [1e6 * float(o[:, 1].min()), 1e6 * float(o[:, 1].max())]}
+                          for b, o in orbits.items()},
+            "results_file": str(saved) if saved else None,
+        }, indent=2, default=_json_default))
+        return
+    console.print(f"[bold]{m.model.name}[/]: {res.times.size} mesh positions, "
+                  f"{'all converged' if res.solution.converged.all() else 'NOT all converged'}")
+    t = Table(title="quasi-static load sharing (static torque ratio, largest over positions)")
+    for col in ("mesh", "min F [N]", "mean F [N]", "max F [N]", "LSC"):
+        t.add_column(col, justify="left" if col == "mesh" else "right")
+    for j, name in enumerate(res.mesh_names):
+        t.add_row(name, f"{forces[:, j].min():.6g}", f"{forces[:, j].mean():.6g}",
+                  f"{forces[:, j].max():.6g}", f"{met.per_mesh[name]:.5f}")
+    console.print(t)
+    for g, v in met.per_group.items():
+        console.print(f"group {g}: {v:.5f}")
+    console.print(f"system load-sharing coefficient: [bold]{met.system:.5f}[/]")
+    if orbits:
+        o = Table(title="floating orbits")
+        for col in ("body", "x range [um]", "y range [um]"):
+            o.add_column(col)
+        for b, xy in orbits.items():
+            o.add_row(b, f"{1e6 * xy[:, 0].min():.3f} .. {1e6 * xy[:, 0].max():.3f}",
+                      f"{1e6 * xy[:, 1].min():.3f} .. {1e6 * xy[:, 1].max():.3f}")
+        console.print(o)
+    if saved:
+        console.print(f"results written to {saved}")
+
+
+# --------------------------------------------------------------------------- modes
+@app.command()
+def modes(
+    model: str = typer.Argument(..., help="Model file (.toml/.json) or example name."),
+    count: int = typer.Option(20, "--count", help="Number of modes to list."),
+    as_json: bool = typer.Option(False, "--json", help="Print the modes as JSON."),
+):
+    """Natural frequencies about the static equilibrium, with the dominant elements."""
+    try:
+        m, _ = _load(model)
+        from .assembly.assemble import assemble
+        from .model.kinematics import solve_kinematics
+        from .solve.modal import modal_analysis
+        from .solve.static import static_equilibrium
+
+        kin = solve_kinematics(m)
+        st = assemble(m, kin)
+        sol = modal_analysis(st, static_equilibrium(st).q)
+    except (TorquesplitError, ValueError) as exc:
+        _fail(exc)
+        return
+    mesh_f = {n: mk.frequency for n, mk in kin.meshes.items()}
+    rows = [{"mode": i + 1, "frequency_Hz": float(sol.frequencies[i]),
+             "dominant": sol.dominant_elements(i, 3)} for i in range(min(count, sol.n_modes))]
+    if as_json:
+        print(json.dumps({"rigid_body_modes": int(sol.rigid_modes.shape[1]), "modes": rows,
+                          "mesh_frequencies_Hz": mesh_f}, indent=2, default=_json_default))
+        return
+    console.print(f"{sol.rigid_modes.shape[1]} rigid-body mode(s) left out; mesh frequencies: "
+                  + ", ".join(f"{k} {v:.5g} Hz" for k, v in mesh_f.items()))
+    t = Table(title="natural modes")
+    for col in ("mode", "f [Hz]", "strain energy (largest shares)"):
+        t.add_column(col)
+    for r in rows:
+        t.add_row(str(r["mode"]), f"{r['frequency_Hz']:.6g}",
+                  ", ".join(f"{n} {100 * v:.0f} %" for n, v in r["dominant"]))
+    console.print(t)
+
+
 # --------------------------------------------------------------------------- examples
 @app.command()
 def examples():
