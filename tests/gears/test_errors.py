@@ -41,7 +41,8 @@ def test_eccentricity_rotates_with_its_gear():
     """Signal at the gear's rotation frequency, phase from the offset direction
     relative to the line of action: -E cos(Omega t + phi - zeta) for gear 1."""
     ecc, phi, omega, zeta = 8e-6, 0.7, 798.6, math.radians(22.5) + 1.2
-    e = centre_errors_on_line(zeta, CentreError(eccentricity=ecc, eccentricity_phase=phi, omega=omega), CentreError())
+    gear = CentreError(eccentricity=ecc, eccentricity_phase=phi, omega=omega)
+    e = centre_errors_on_line(zeta, gear, CentreError())
     assert e.omegas.tolist() == [pytest.approx(omega)]
     assert e.amplitudes[0] == pytest.approx(ecc)
     # direct vector projection of the rotating offset
@@ -59,7 +60,8 @@ def test_eccentricity_rotates_with_its_gear():
 
 def test_common_offset_cancels_and_installation_is_constant():
     g = CentreError(installation=12e-6, installation_direction=0.4, omega=100.0)
-    e = centre_errors_on_line(1.1, g, CentreError(installation=12e-6, installation_direction=0.4, omega=-30.0))
+    mate = CentreError(installation=12e-6, installation_direction=0.4, omega=-30.0)
+    e = centre_errors_on_line(1.1, g, mate)
     assert e.omegas.size == 0 and e.constant == pytest.approx(0.0, abs=1e-20)
     only = centre_errors_on_line(1.1, g, CentreError(omega=-30.0))
     assert only.omegas.size == 0
@@ -146,7 +148,8 @@ def test_seed004_thickness_pitch_and_bearing_errors():
     alpha = math.radians(20)
     # thinner tooth opens the mesh by (|ds|/2) cos(alpha)
     assert tooth_thickness_error(-6e-6, alpha).constant == pytest.approx(3e-6 * math.cos(alpha))
-    assert tooth_thickness_error(-6e-6, alpha).angular(0.02).constant == pytest.approx(3e-6 * math.cos(alpha) / 0.02)
+    angular = tooth_thickness_error(-6e-6, alpha).angular(0.02)
+    assert angular.constant == pytest.approx(3e-6 * math.cos(alpha) / 0.02)
     cp = cumulative_pitch_error(6e-6, 0.0, 100.0, alpha)
     assert cp.amplitudes[0] == pytest.approx(3e-6 * math.cos(alpha)) and cp.omegas[0] == 100.0
     br = bearing_runout_error(6e-6, 0.0, 100.0, 0.0)

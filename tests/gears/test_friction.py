@@ -80,7 +80,10 @@ def path_mu(roughness, power=500e3, *, r_scale=1.0, p_scale=1e-9):
     nu = VISCOSITY * 1e3
     x = np.abs(sr) * ph * p_scale * np.log10(nu)
     f = b[0] + b[3] * x + b[4] * np.exp(-x) + b[8] * np.exp(roughness * 1e6)
-    return np.exp(f) * (ph * p_scale) ** b[1] * np.abs(sr) ** b[2] * ve ** b[5] * nu ** b[6] * (radius * r_scale) ** b[7]
+    return (
+        np.exp(f) * (ph * p_scale) ** b[1] * np.abs(sr) ** b[2]
+        * ve ** b[5] * nu ** b[6] * (radius * r_scale) ** b[7]
+    )
 
 
 def test_unit_convention():
@@ -101,14 +104,19 @@ def test_unit_convention():
     u1, u2 = rolling_velocities(s, LINE, OMEGA1, OMEGA1 * RB1 / RB2)
     radius = s * (LINE - s) / LINE
     ph = hertz_max_pressure(500e3 / OMEGA1 / RB1 / WIDTH, s, LINE - s)
-    lib = xu_friction_coefficient(slide_to_roll_ratio(u1, u2), ph, entrainment_velocity(u1, u2), VISCOSITY, radius, 0.6e-6)
+    lib = xu_friction_coefficient(
+        slide_to_roll_ratio(u1, u2), ph, entrainment_velocity(u1, u2), VISCOSITY, radius, 0.6e-6
+    )
     np.testing.assert_allclose(lib, chosen, rtol=1e-12)
 
 
 def test_exponents_are_b6_b7_b8():
     """Seed 003 eq. 6 prints V_e^b4 nu_0^b5 R^b6; the regression uses b6, b7, b8."""
     b = XU_COEFFICIENTS
-    base = dict(slide_to_roll=0.3, hertz_pressure=1e9, entrainment_velocity=10.0, viscosity=8e-3, radius=0.015, roughness=0.5e-6)
+    base = dict(
+        slide_to_roll=0.3, hertz_pressure=1e9, entrainment_velocity=10.0,
+        viscosity=8e-3, radius=0.015, roughness=0.5e-6,
+    )
     mu0 = xu_friction_coefficient(**base)
     assert xu_friction_coefficient(**{**base, "entrainment_velocity": 20.0}) / mu0 == pytest.approx(2 ** b[5])
     assert xu_friction_coefficient(**{**base, "radius": 0.030}) / mu0 == pytest.approx(2 ** b[7])
@@ -145,6 +153,17 @@ def test_friction_reverses_at_pitch_point():
     assert tab.friction_force.min() < 0 < tab.friction_force.max()
 
 
+def test_friction_larger_entering_than_leaving_mesh():
+    """Seed 003 section 4.1: the friction factor on entering the mesh exceeds that on
+    leaving it (larger slide-to-roll ratio on the pinion-root side)."""
+    tab = spur_table()
+    contact = tab.pair_load > 0
+    mu, pos = tab.friction_coefficient, tab.position
+    entering = mu[contact & (pos < S_START + 0.02 * PB)]
+    leaving = mu[contact & (pos > S_END - 0.02 * PB)]
+    assert entering.min() > leaving.max()
+
+
 def test_friction_rises_with_roughness():
     """Seed 003 section 4.1: friction increases with RMS roughness 0.3 -> 0.6 -> 0.9 um."""
     means = [np.abs(spur_table(s).friction_force).mean() for s in (0.3e-6, 0.6e-6, 0.9e-6)]
@@ -162,8 +181,9 @@ def test_friction_is_dissipative_and_arms_follow_contact():
     np.testing.assert_allclose(tab.arm_1[contact], tab.position[contact])
     np.testing.assert_allclose(tab.arm_1[contact] + tab.arm_2[contact], LINE)
     # friction moments are force times arm
-    np.testing.assert_allclose(tab.pair_moment_1[contact], -tab.pair_friction_force[contact] * tab.arm_1[contact])
-    np.testing.assert_allclose(tab.pair_moment_2[contact], tab.pair_friction_force[contact] * tab.arm_2[contact])
+    force = tab.pair_friction_force[contact]
+    np.testing.assert_allclose(tab.pair_moment_1[contact], -force * tab.arm_1[contact])
+    np.testing.assert_allclose(tab.pair_moment_2[contact], force * tab.arm_2[contact])
     # load is shared among the pairs in contact and sums to the mesh load
     np.testing.assert_allclose(tab.pair_load.sum(axis=1), tab.normal_load)
     np.testing.assert_allclose(tab.force_per_load * tab.normal_load, tab.friction_force)
@@ -183,7 +203,8 @@ def test_hertz_pressure_by_hand():
 def test_seed003_eq15_coefficients():
     """Kf = lambda mu k l and KTf = lambda mu k l R (seed 003 eq. 15)."""
     assert friction_stiffness(-1.0, 0.05, 1.5e10, 0.048) == pytest.approx(-0.05 * 1.5e10 * 0.048)
-    assert friction_torque_coefficient(1.0, 0.05, 1.5e10, 0.048, 0.02) == pytest.approx(0.05 * 1.5e10 * 0.048 * 0.02)
+    ktf = friction_torque_coefficient(1.0, 0.05, 1.5e10, 0.048, 0.02)
+    assert ktf == pytest.approx(0.05 * 1.5e10 * 0.048 * 0.02)
     s1, s2 = friction_arms(0.015, LINE)
     assert s1 == 0.015 and s2 == pytest.approx(LINE - 0.015)
 
@@ -231,3 +252,20 @@ def test_bad_input_is_named():
         spur_table(contact_end=None)
     with pytest.raises(ValueError, match="viscosity"):
         spur_table(viscosity=-1.0)
+
+
+def test_reverse_power_flow_and_custom_load_sharing():
+    """Gear 2 driving: contact runs from S_END to S_START; friction depends on position only."""
+    fwd = spur_table()
+    rev = spur_table(contact_start=S_END, contact_end=S_START)
+    assert rev.position[0, 0] == pytest.approx(S_END)
+    assert rev.pair_friction_force[0, 0] > 0  # recess side of the pitch point first
+    assert np.abs(rev.friction_force).max() == pytest.approx(np.abs(fwd.friction_force).max(), rel=0.05)
+    # load shared in proportion to a position-dependent stiffness
+    tab = spur_table(pair_stiffness=lambda s: 1.0 + 50.0 * np.nan_to_num(s))
+    np.testing.assert_allclose(tab.pair_load.sum(axis=1), tab.normal_load)
+    two = tab.pair_load[:, :2]
+    both = (two > 0).all(axis=1)
+    pos = tab.position[both][:, :2]
+    ratio = two[both][:, 0] / two[both][:, 1]
+    np.testing.assert_allclose(ratio, (1 + 50 * pos[:, 0]) / (1 + 50 * pos[:, 1]))

@@ -61,7 +61,8 @@ def test_grows_with_load():
     peaks = [impact(load=f).peak_force for f in (2e3, 5e3, 10e3, 20e3)]
     assert all(a < b for a, b in zip(peaks, peaks[1:]))
     # a base-pitch excess of the pinion acts like extra deflection
-    assert impact(load=5e3, base_pitch_difference=5e-6).peak_force == pytest.approx(impact(load=10e3).peak_force)
+    with_pitch = impact(load=5e3, base_pitch_difference=5e-6).peak_force
+    assert with_pitch == pytest.approx(impact(load=10e3).peak_force)
 
 
 @pytest.mark.parametrize("exponent", [1.0, 1.5])
@@ -98,7 +99,9 @@ def test_eq10_and_duration_against_impact_ode(exponent):
 
     leave.terminal, leave.direction = True, -1
     t_guess = 10 * impact_duration(m, v, k, exponent)
-    sol = solve_ivp(rhs, (0, t_guess), [1e-15, v], events=leave, rtol=1e-10, atol=1e-16, max_step=t_guess / 2000)
+    sol = solve_ivp(
+        rhs, (0, t_guess), [1e-15, v], events=leave, rtol=1e-10, atol=1e-16, max_step=t_guess / 2000
+    )
     x = sol.y[0]
     assert k * x.max() ** exponent == pytest.approx(impact_force(m, v, k, exponent), rel=1e-4)
     assert sol.t_events[0][0] == pytest.approx(impact_duration(m, v, k, exponent), rel=1e-3)

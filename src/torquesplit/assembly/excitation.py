@@ -132,57 +132,113 @@ def mesh_phases(model: Model, kin: Kinematics) -> dict[str, float]:
 
 # --------------------------------------------------------------------------- backlash
 def half_backlash_sequence(model: Model, kin: Kinematics, mesh_name: str) -> np.ndarray:
-    """Half backlash per engagement [m]: constant, or random per seed 001 eq. 14."""
+    """Half backlash per engagement [m]: constant, or random per seed 001 eq. 14.
+
+    The model gives the total backlash 2b; the dead zone of the mesh element has the
+    half-width b (seed 001 eq. 13, seed 002 eq. 7).  A random sequence is drawn per
+    engagement within ``nominal +/- tolerance`` and repeats after lcm(z1, z2) cycles.
+    """
     spec = model.meshes[mesh_name].backlash
     if spec.distribution == "constant" or spec.tolerance == 0:
         return np.array([spec.nominal / 2])
     from ..gears import backlash as gbl
 
     za, zb = (model.gears[g].teeth for g in model.meshes[mesh_name].gears)
-    seq = gbl.backlash_sequence(
-        nominal=spec.nominal, tolerance=spec.tolerance, distribution=spec.distribution,
-        teeth=(za, zb), seed=spec.seed)
+    lower = max(spec.nominal - spec.tolerance, 0.0)
+    upper = spec.nominal + spec.tolerance
+    period = 1.0 / kin.meshes[mesh_name].frequency
+    if spec.distribution == "normal":
+        seq = gbl.random_backlash(lower, upper, za, zb, period, spec.seed).values
+    else:
+        n = gbl.hunting_period_cycles(za, zb)
+        seq = np.random.default_rng(spec.seed).uniform(lower, upper, n)
     return np.asarray(seq) / 2
 
 
 # --------------------------------------------------------------------------- errors
 def mesh_errors(model: Model, kin: Kinematics, mesh_name: str):
-    """Constant error and sinusoids (amplitude, omega, phase) along the line of action."""
+    """Constant error and sinusoids (amplitude, omega, phase) along the line of action.
+
+    A positive error opens the mesh (delta = V q - e).  Centre offsets of the driver
+    (eccentricity, installation, bearing run-out) enter as ``-eps_d . n``, those of the
+    driven gear as ``+eps_n . n`` (seed 000 eqs. 1-2 and seed 002 eq. 11 in physical
+    form, see gears/errors.py); tooth thickness and pitch errors of either gear open
+    the mesh (seed 004 §4).  In-plane offsets are projected on the 3-D line of action
+    through its component in the gear's plane.
+    """
+    from ..gears import errors as gerr
+
     mesh = model.meshes[mesh_name]
     mk = kin.meshes[mesh_name]
     te = mesh.transmission_error
-    const = te.constant
-    sines = []
+    total = gerr.LineOfActionError(te.constant)
     if te.amplitude:
-        sines.append((te.amplitude, 2 * math.pi * mk.frequency, te.phase))
-    from ..gears import errors as gerr
-
+        total = total + gerr.LineOfActionError(0.0, [te.amplitude],
+                                               [2 * math.pi * mk.frequency], [te.phase])
+    n = mk.line_of_action
     for g in mesh.gears:
         ge = model.gears[g].errors
         if not any((ge.eccentricity, ge.installation, ge.tooth_thickness, ge.pitch,
                     ge.bearing_runout)):
             continue
-        sign = 1.0 if g == mk.driver else -1.0
-        contrib = gerr.gear_errors_on_line_of_action(
-            gear_errors=ge, speed=kin.bodies[g].speed, axis=kin.bodies[g].axis,
-            center=kin.bodies[g].position, line_of_action=mk.line_of_action,
-            contact_point=mk.contact_point, teeth=model.gears[g].teeth,
-            mesh_frequency=mk.frequency)
-        const += sign * contrib.constant
-        for a, w, p in zip(contrib.amplitudes, contrib.omegas, contrib.phases):
-            sines.append((sign * a, w, p))
-    return const, sines
+        body = kin.bodies[g]
+        axis = body.axis
+        e1 = loa.reference_direction(axis, 0.0)
+        e2 = np.cross(axis, e1)
+        n1, n2 = float(n @ e1), float(n @ e2)
+        scale = math.hypot(n1, n2)  # in-plane part of the line of action
+        zeta = math.atan2(n2, n1)
+        w = body.speed
+        centre = gerr.CentreError(
+            eccentricity=ge.eccentricity * scale, eccentricity_phase=ge.eccentricity_phase,
+            installation=ge.installation * scale, installation_direction=ge.installation_phase,
+            omega=w).on_line(zeta)
+        if ge.bearing_runout:
+            centre = centre + gerr.bearing_runout_error(ge.bearing_runout * scale,
+                                                        ge.bearing_runout_phase, w, zeta)
+        sign = -1.0 if g == mk.driver else 1.0
+        total = total + centre.scaled(sign)
+        alpha = mk.working_pressure_angle
+        if ge.tooth_thickness:
+            total = total + gerr.tooth_thickness_error(ge.tooth_thickness, alpha)
+        if ge.pitch:
+            total = total + gerr.cumulative_pitch_error(ge.pitch, 0.0, abs(w), alpha)
+    sines = [(float(a), float(om), float(ph))
+             for a, om, ph in zip(total.amplitudes, total.omegas, total.phases)]
+    return float(total.constant), sines
 
 
 # --------------------------------------------------------------------------- impact
 def impact_force_table(model: Model, kin: Kinematics, mesh_name: str, n: int):
-    """Meshing-in impact force over one mesh cycle [N], or None (seed 000 eqs. 6-10)."""
+    """Meshing-in impact force over one mesh cycle [N], or None (seed 000 eqs. 6-10).
+
+    Inputs the seed leaves open: the loaded stiffness is the mean mesh stiffness and
+    the single-pair stiffness at the engagement point is that mean divided by the
+    transverse contact ratio (linear contact law, n = 1); the pulse is a half sine
+    (see gears/impact.py).
+    """
     mesh = model.meshes[mesh_name]
     if not mesh.impact:
         return None
     from ..gears import impact as gim
 
     mk = kin.meshes[mesh_name]
-    if mk.geometry is None:
-        raise ValueError(f"meshes.{mesh_name}.impact: meshing-in impact needs a cylindrical pair")
-    return gim.impact_force_table_for_pair(mk, model, mesh_name, n)
+    geo = mk.geometry
+    if geo is None:
+        raise ValueError(f"meshes.{mesh_name}.impact: meshing-in impact needs a cylindrical "
+                         f"pair; set impact = false for bevel and face meshes")
+    k_mean = float(np.mean(stiffness_table(model, kin, mesh_name, n)))
+    driver_first = model.gears[mk.driver].gear_type != "internal" and (
+        geo.gear1.teeth == model.gears[mk.driver].teeth)
+    g_drv, g_dvn = (geo.gear1, geo.gear2) if driver_first else (geo.gear2, geo.gear1)
+    imp = gim.meshing_in_impact(
+        base_radius_driving=mk.base_radii[0], base_radius_driven=mk.base_radii[1],
+        tip_radius_driven=g_dvn.tip_radius, centre_distance=mk.center_distance,
+        base_pitch=geo.base_pitch, omega_driving=abs(kin.bodies[mk.driver].speed),
+        normal_load=mk.force, loaded_stiffness=k_mean,
+        inertia_driving=kin.bodies[mk.driver].polar_inertia,
+        inertia_driven=kin.bodies[mk.driven].polar_inertia,
+        impact_stiffness=k_mean / max(mk.transverse_contact_ratio, 1.0),
+    )
+    _, force = imp.table(n)
+    return np.asarray(force)

@@ -188,9 +188,11 @@ def xu_friction_coefficient(
     Unit convention of the regression (established in
     tests/gears/test_friction.py::test_unit_convention): P_h in GPa, V_e in m/s,
     nu_0 in cP (= mPa s), R in m, S in um.  With these, mu at seed 003's split-stage
-    operating point peaks at 0.015-0.045 towards the ends of the path of contact,
+    operating point (nu_0 = 5-20 mPa s, S = 0.3-0.9 um) peaks at 0.015-0.045
+    towards the ends of the path of contact,
     inside the 0.02-0.08 range reported for lubricated steel gears; R in mm gives
-    mu ~ 1e-3 and P_h in MPa gives mu ~ 1e-50, both unphysical.
+    mu ~ 1e-3 and P_h in MPa makes mu vanish (< 1e-40) where sliding is
+    largest, both unphysical.
 
     Seed 003 prints the exponents of V_e, nu_0 and R as b4, b5, b6; the
     regression uses b6, b7, b8 (b4 and b5 belong to f only).  mu -> 0 at the pitch
@@ -367,9 +369,10 @@ def mesh_friction_table(
         eqs. 17-18), shifted along the line of action by z tan(beta_b).
     n_phases : number of samples over one mesh period.
     pair_stiffness : optional callable k(s) giving the mesh stiffness per unit
-        contact length at position s [N/m^2]; the normal load is shared among
-        pairs and slices in proportion to k(s) * dl.  Default: uniform, i.e.
-        equal load per unit contact length.
+        contact length at position s [N/m^2] (vectorised; s is NaN for slices
+        out of contact, any value may be returned there); the normal load is
+        shared among pairs and slices in proportion to k(s) * dl.  Default:
+        uniform, i.e. equal load per unit contact length.
 
     Returns
     -------
@@ -507,7 +510,9 @@ def mesh_friction_table(
         pos_mean = np.nansum(np.where(in_contact, s * load, 0.0), axis=2) / safe
         arm1 = np.nansum(np.where(in_contact, rho1 * load, 0.0), axis=2) / safe
         arm2 = np.nansum(np.where(in_contact, rho2 * load, 0.0), axis=2) / safe
-        mu_mean = np.where(pair_load > 0, (mu * load).sum(axis=2) / np.where(pair_load > 0, pair_load, 1.0), 0.0)
+        mu_mean = np.where(
+            pair_load > 0, (mu * load).sum(axis=2) / np.where(pair_load > 0, pair_load, 1.0), 0.0
+        )
 
     total_force = pair_force.sum(axis=1)  # seed 003 eq. 16 (sum over pairs)
     total_m1 = pair_m1.sum(axis=1)

@@ -208,7 +208,9 @@ class FlankTolerances:
         )
 
 
-def flank_tolerances(grade: int, module: float, reference_diameter: float, face_width: float) -> FlankTolerances:
+def flank_tolerances(
+    grade: int, module: float, reference_diameter: float, face_width: float
+) -> FlankTolerances:
     """All flank tolerances of a gear (unrounded; call ``.rounded()`` for 5.2.3).
 
     Examples
@@ -248,7 +250,9 @@ def sample_within(tolerance: float, size, rng, distribution: str = "normal", *, 
     Reproducible from ``rng`` (numpy Generator or int seed).
     """
     if distribution not in _DISTRIBUTIONS:
-        raise ModelError(f"sample_within: distribution must be one of {_DISTRIBUTIONS}, got {distribution!r}.")
+        raise ModelError(
+            f"sample_within: distribution must be one of {_DISTRIBUTIONS}, got {distribution!r}."
+        )
     if tolerance < 0:
         raise ModelError("sample_within: tolerance must be >= 0 m.")
     gen = np.random.default_rng(rng)

@@ -33,7 +33,7 @@ from __future__ import annotations
 
 import math
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.optimize import brentq
@@ -218,7 +218,8 @@ def meshing_in_point(
     phi_k = Z / r_ag for the angle due to the deflection Z; a deflection along
     the line of action turns the gear by Z / r_bg, which we use (``lag_angle``).
     """
-    rbp, rbg, rag, a = (float(base_radius_driving), float(base_radius_driven), float(tip_radius_driven), float(centre_distance))
+    rbp, rbg = float(base_radius_driving), float(base_radius_driven)
+    rag, a = float(tip_radius_driven), float(centre_distance)
     if a <= rbp + rbg:
         raise ModelError("meshing_in_point: centre_distance must exceed r_bp + r_bg (metres).")
     if rag <= rbg:
@@ -438,7 +439,7 @@ def meshing_in_impact(
         omega_driving=omega_driving,
     )
     lead = (point.theoretical_start - point.pinion_flank_position) / base_pitch
-    point = MeshingInPoint(**{**point.__dict__, "phase_lead": lead})
+    point = replace(point, phase_lead=lead)
     m_e = equivalent_mass(inertia_driving, inertia_driven, base_radius_driving, base_radius_driven)
     v_s = max(point.normal_velocity, 0.0)
     peak = float(impact_force(m_e, v_s, impact_stiffness, exponent))

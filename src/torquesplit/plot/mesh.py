@@ -41,7 +41,7 @@ def plot_mesh_stiffness(comparison, path, *, cycles: int = 2, title: str | None 
         results = list(comparison)  # type: Sequence[MeshStiffness]
         labels, iso = [r.method for r in results], None
 
-    fig = Figure(figsize=(7.5, 4.2), layout="constrained")
+    fig = Figure(figsize=(7.5, 5.0), layout="constrained")
     ax = fig.add_subplot()
     for lab, r in zip(labels, results):
         ph = np.concatenate([r.phase + c for c in range(cycles)] + [np.array([float(cycles)])])
@@ -54,7 +54,7 @@ def plot_mesh_stiffness(comparison, path, *, cycles: int = 2, title: str | None 
     ax.set_ylabel("mesh stiffness [$10^8$ N/m]")
     ax.set_xlim(0, cycles)
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize="small", loc="best")
+    fig.legend(loc="outside lower center", ncols=2, fontsize="small")
     if title:
         ax.set_title(title)
     path = Path(path)

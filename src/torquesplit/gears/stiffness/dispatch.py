@@ -105,10 +105,10 @@ class MethodComparison:
 
     def table(self) -> str:
         """Plain-text table of :meth:`rows` (stiffness in N/m)."""
-        head = f"{'method':<34}{'mean':>12}{'min':>12}{'max':>12}{'peak-peak':>12}{'mean/ISO':>10}"
+        head = f"{'method':<42}{'mean':>12}{'min':>12}{'max':>12}{'peak-peak':>12}{'mean/ISO':>10}"
         lines = [head, "-" * len(head)]
         for r in self.rows():
-            lines.append(f"{r['method']:<34}{r['mean']:12.4e}{r['minimum']:12.4e}{r['maximum']:12.4e}"
+            lines.append(f"{r['method']:<42}{r['mean']:12.4e}{r['minimum']:12.4e}{r['maximum']:12.4e}"
                          f"{r['peak_to_peak']:12.4e}{r['mean_over_iso']:10.3f}")
         lines.append(f"ISO 6336-1: c' = {self.iso.c_prime_iso:.3f} N/(mm um), c_gamma = "
                      f"{self.iso.c_gamma_iso:.3f} N/(mm um), c_gamma b = {self.iso_mesh_stiffness:.4e} N/m "
@@ -125,17 +125,19 @@ def compare_methods(pair: PairGeometry, n: int = 256, *, young_modulus=206e9, po
                     extra: Mapping[str, MeshStiffness] | None = None) -> MethodComparison:
     """All applicable mesh-stiffness methods of ``pair`` side by side.
 
-    Computes ISO 6336-1 (default scale), ISO 6336-1 with the single-pair scale,
-    and -- for external pairs -- the potential-energy method with and without the
-    fillet-foundation term; ``extra`` adds user results (tables, LTCA) by label.
+    Computes ISO 6336-1 with its default scale first and then the other scale
+    (``single_pair`` / ``c_gamma``), and -- for external pairs -- the potential-energy
+    method with and without the fillet-foundation term; ``extra`` adds user results
+    (tables, LTCA) by label.
     """
     e = young_modulus
     labels, results = [], []
-    labels.append("iso6336")
-    results.append(iso6336_stiffness(pair, n, blank_factor=blank_factor, young_modulus=e))
-    labels.append("iso6336 (single pair c')")
-    results.append(iso6336_stiffness(pair, n, scale="single_pair", blank_factor=blank_factor,
-                                     young_modulus=e))
+    default = iso6336_stiffness(pair, n, blank_factor=blank_factor, young_modulus=e)
+    other = "c_gamma" if default.info["scale"] == "single_pair" else "single_pair"
+    labels.append(f"iso6336 ({default.info['scale']})")
+    results.append(default)
+    labels.append(f"iso6336 ({other})")
+    results.append(iso6336_stiffness(pair, n, scale=other, blank_factor=blank_factor, young_modulus=e))
     if not pair.is_internal:
         opts = dict(young_modulus=e, poisson_ratio=poisson_ratio, bore_radius=bore_radius,
                     slices=None if pair.gear1.beta == 0 else slices)

@@ -41,6 +41,7 @@ __all__ = [
     "basic_rack_factor",
     "blank_factor",
     "iso6336_values",
+    "iso6336_mesh_stiffness_value",
     "iso6336_stiffness",
 ]
 
@@ -210,6 +211,16 @@ def iso6336_values(pair: PairGeometry, *, blank_factor: float = 1.0, young_modul
         factor_cb=cb, factor_material=f_mat, factor_load=f_load,
         base_helix_angle=pair.base_helix_angle,
     )
+
+
+def iso6336_mesh_stiffness_value(pair: PairGeometry, **options) -> float:
+    """ISO 6336-1 mean mesh stiffness ``c_gamma b`` of the pair along the flank normal [N/m].
+
+    ``c_gamma b / cos^2(beta_b)`` (= ``c_gamma b`` for spur gears), the mean of
+    :func:`iso6336_stiffness` with ``scale="c_gamma"``; ``options`` as
+    :func:`iso6336_values`.
+    """
+    return iso6336_values(pair, **options).mesh_stiffness_normal
 
 
 def iso6336_stiffness(pair: PairGeometry, n: int = 256, *, scale: str | None = None,

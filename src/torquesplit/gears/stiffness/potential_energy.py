@@ -302,7 +302,8 @@ def potential_energy_stiffness(pair: PairGeometry, n: int = 256, *, young_modulu
         Bore / rim inner radius ``r_int`` of each gear [m] (fillet-foundation term);
         default half the root radius.
     slices : int, optional
-        Number of face slices of a helical pair (default 50; spur pairs use 1).
+        Number of face slices of a helical pair (default 50).  A spur pair's slices
+        are all in phase, so it is computed unsliced whatever the value.
     stagger : float
         Phase offset of the second helix of a double-helical pair [cycles].
     grid : int
@@ -331,8 +332,9 @@ def potential_energy_stiffness(pair: PairGeometry, n: int = 256, *, young_modulu
     phase = phase_grid(n)
     helical = pair.gear1.beta > 0
     if not helical:
-        if slices not in (None, 1):
-            raise ModelError([("slices", "a spur pair needs no slicing; leave slices unset")])
+        # all slices of a spur pair are in phase: the result does not depend on `slices`
+        if slices is not None and not (isinstance(slices, (int, np.integer)) and slices >= 1):
+            raise ModelError([("slices", f"must be a positive integer, got {slices!r}")])
         if stagger:
             raise ModelError([("stagger", "applies to double-helical pairs only")])
         s = pair_positions(pair, phase)                       # (n, K)
