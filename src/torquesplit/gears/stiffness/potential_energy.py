@@ -194,8 +194,6 @@ def tooth_compliance(gear: GearGeometry, roll, *, young_modulus: float, poisson_
     # straight part of base-circle thickness between root circle and base circle
     if rf < rb:
         h_b = rb * math.sin(psi)
-        if h_b >= rf:
-            raise ModelError([("dedendum", "root circle too small for the tooth thickness")])
         x_r, x_b = math.sqrt(rf * rf - h_b * h_b), rb * math.cos(psi)
         t2, w2 = _GAUSS_STRAIGHT
         xs = x_r + 0.5 * (x_b - x_r) * (t2 + 1.0)
