@@ -259,6 +259,62 @@ def static(
         console.print(f"results written to {saved}")
 
 
+# --------------------------------------------------------------------------- mesh
+@app.command()
+def mesh(
+    model: str = typer.Argument(..., help="Model file (.toml/.json) or example name."),
+    pair: str = typer.Option(..., "--pair", help="Name of the mesh to inspect."),
+    plot: Optional[Path] = typer.Option(None, "--plot", help="Save k(phase) of every method."),
+    points: int = typer.Option(256, "--points", help="Samples per mesh cycle."),
+    as_json: bool = typer.Option(False, "--json", help="Print the comparison as JSON."),
+):
+    """Mesh stiffness k(phase) of one mesh by every applicable method, with the ISO value."""
+    try:
+        m, _ = _load(model)
+        if pair not in m.meshes:
+            raise TorquesplitError(f"no mesh named {pair!r}; meshes are {', '.join(m.meshes)}")
+        from .assembly.excitation import stiffness_table
+        from .gears.stiffness import compare_methods
+        from .gears.stiffness.result import MeshStiffness
+        from .model.kinematics import solve_kinematics
+
+        kin = solve_kinematics(m)
+        mk = kin.meshes[pair]
+        if mk.geometry is None:
+            raise TorquesplitError(f"mesh {pair!r} is a bevel/face mesh; only its model-file "
+                                   f"stiffness applies (no involute stiffness methods)")
+        model_k = MeshStiffness.from_samples(stiffness_table(m, kin, pair, points),
+                                             method=f"model file ({m.meshes[pair].stiffness.method})")
+        g = m.gears[mk.driver]
+        cmp = compare_methods(mk.geometry, points, young_modulus=g.youngs_modulus,
+                              poisson_ratio=g.poisson_ratio, extra={"model file": model_k})
+    except (TorquesplitError, ValueError) as exc:
+        _fail(exc)
+        return
+    if plot is not None:
+        from .plot.mesh import plot_mesh_stiffness
+
+        plot_mesh_stiffness(cmp, plot, title=f"{m.model.name}: mesh {pair}")
+    if as_json:
+        print(json.dumps({"mesh": pair, "methods": cmp.rows(),
+                          "iso_c_prime_N_per_mm_um": cmp.iso.c_prime_iso,
+                          "iso_c_gamma_N_per_mm_um": cmp.iso.c_gamma_iso,
+                          "iso_mesh_stiffness_N_per_m": cmp.iso_mesh_stiffness,
+                          "plot": str(plot) if plot else None}, indent=2, default=_json_default))
+        return
+    t = Table(title=f"mesh stiffness of {pair} (N/m, along the line of action)")
+    for col in ("method", "mean", "min", "max", "peak-peak", "mean / ISO"):
+        t.add_column(col, justify="left" if col == "method" else "right")
+    for r in cmp.rows():
+        t.add_row(r["method"], f"{r['mean']:.4e}", f"{r['minimum']:.4e}", f"{r['maximum']:.4e}",
+                  f"{r['peak_to_peak']:.4e}", f"{r['mean_over_iso']:.3f}")
+    console.print(t)
+    console.print(f"ISO 6336-1: c' = {cmp.iso.c_prime_iso:.3f} N/(mm um), c_gamma = "
+                  f"{cmp.iso.c_gamma_iso:.3f} N/(mm um), c_gamma b = {cmp.iso_mesh_stiffness:.4e} N/m")
+    if plot is not None:
+        console.print(f"plot written to {plot}")
+
+
 # --------------------------------------------------------------------------- modes
 @app.command()
 def modes(
