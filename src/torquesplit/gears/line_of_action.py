@@ -22,8 +22,10 @@ tangent ``t_i = a_i x e_r,i``.  The force the driver exerts on the driven gear a
 Here ``e_t = s t`` is the direction in which the driver's contact point moves (s is the
 sign of the driver's speed about its axis), ``sep = +1`` for an external driver and -1
 for an internal one (the separating force pushes the driven gear away from the driver's
-flank), and ``h = +1`` for a right hand, -1 for a left hand (0 for spur and
-double-helical gears, whose axial components cancel).  The projection coefficient of a
+flank), and ``h = +1`` for a right hand, -1 for a left hand (0 for spur gears).  For a
+double-helical pair the axial components of the two helices cancel: n keeps only its
+transverse part and is not renormalised (``|n| = cos(beta_b)``), so that ``V . q`` is the
+normal flank deflection and the mesh force is the normal force of both helices.  The projection coefficient of a
 gear's rotation is its arm ``(rho x n) . a = r n . t``; for the driver this is
 ``s r_b cos(beta_b)`` for a cylindrical pair.
 
@@ -265,7 +267,11 @@ def line_of_action(model, mesh_name: str, frame: ContactFrame, driver: str, spee
         beta_b = frame.base_helix_angle
         n = (math.cos(beta_b) * (math.cos(alpha) * et + sep * math.sin(alpha) * er)
              - h * s * math.sin(beta_b) * a)
-    n = n / np.linalg.norm(n)
+    if gd.gear_type != "double_helical":
+        n = n / np.linalg.norm(n)
+    # double-helical: the axial components of the two helices cancel, so n keeps only its
+    # transverse part, |n| = cos(beta_b): V.q is then the normal deflection of the flanks
+    # and the force along n is the normal tooth force of both helices together.
     arm_d = frame.pitch_radii[i] * float(n @ frame.tangent[i])
     arm_n = frame.pitch_radii[j] * float(n @ frame.tangent[j])
     return n, arm_d, arm_n
