@@ -24,8 +24,12 @@ and likewise for the pinions around the ring.  The wheels are 20 teeth, the pini
 the sun is the smallest tooth count (>= 20) that fits, the ring 2 teeth more.
 
 All numbers are benchmark choices (not from a paper): mesh stiffness 4e8 N/m with a
-10 % peak-to-peak single/double contact wave, damping ratio 0.05, backlash 0.1 mm,
-supports 1e9 N/m, torsion shafts 2e5 N m/rad; 3000 rpm, 100 N m per branch.
+10 % peak-to-peak single/double contact wave, damping ratio 0.05, backlash 0.01 mm,
+supports 1e9 N/m, torsion shafts 2e5 N m/rad; 3000 rpm; input torque set for a 5 kN
+tangential tooth force per branch at the sun (13 um mesh deflection, more than the
+5 um half-backlash, so the static active-set iteration starts in contact: with a
+larger backlash ``static_equilibrium`` raises a false 'singular stiffness' error, see
+RESULTS.md).
 """
 
 from __future__ import annotations
@@ -37,6 +41,7 @@ MODULE_MM = 2.0
 Z_WHEEL = 20
 Z_PINION = 18
 CLEARANCE_MM = 2.0  # between adjacent tip circles
+TOOTH_FORCE_N = 5000.0  # nominal tangential force per branch mesh at the sun
 
 
 def branch_teeth(n_branches: int) -> tuple[int, int, int, int]:
@@ -61,7 +66,8 @@ def split_model_text(n_branches: int) -> str:
     n = int(n_branches)
     z_sun, z_wheel, z_pinion, z_ring = branch_teeth(n)
     a = MODULE_MM * (z_sun + z_wheel) / 2.0  # both stages [mm]
-    torque = 100.0 * n
+    r_sun_m = MODULE_MM * z_sun / 2.0 * 1e-3
+    torque = n * TOOTH_FORCE_N * r_sun_m  # the same tooth force in every model
     out = [f'''
 [model]
 name = "bench_split_{n}"
@@ -143,14 +149,14 @@ damping_ratio = 0.02
 gears = ["sun", "wheel{i}"]
 stiffness = {{ method = "constant", value = "4e8 N/m", peak_to_peak = 0.1 }}
 damping_ratio = 0.05
-backlash = "0.1 mm"
+backlash = "0.01 mm"
 stage = "split"
 
 [meshes.c{i}]
 gears = ["pinion{i}", "ring"]
 stiffness = {{ method = "constant", value = "4e8 N/m", peak_to_peak = 0.1 }}
 damping_ratio = 0.05
-backlash = "0.1 mm"
+backlash = "0.01 mm"
 stage = "combine"
 ''')
     return "".join(out)
