@@ -91,6 +91,17 @@ def _perp_unit(v: np.ndarray, axis: np.ndarray) -> np.ndarray:
     return w / n
 
 
+def _closest_point_on_line(p1, d1, p2, d2) -> np.ndarray:
+    """Point of line (p1, d1) closest to line (p2, d2) (the apex of crossed axes)."""
+    w = p1 - p2
+    b = float(d1 @ d2)
+    den = 1.0 - b * b
+    if den < 1e-12:
+        return p1.copy()
+    t = (b * float(d2 @ w) - float(d1 @ w)) / den
+    return p1 + t * d1
+
+
 def reference_direction(axis: np.ndarray, angle: float) -> np.ndarray:
     """Unit vector in the plane normal to ``axis`` at ``angle`` from its x reference.
 
@@ -118,7 +129,9 @@ def placed_position(model, name, ref, ref_position, ref_axis, angle) -> np.ndarr
     g, r = model.gears[name], model.gears[ref]
     direction = reference_direction(ref_axis, angle)
     if is_conical(g, r):
-        return ref_position + (r.teeth * r.module / 2) * direction
+        raise ValueError(
+            f"gear {name!r} meshes with {ref!r} on crossed axes: 'place' is for parallel axes; "
+            f"give the bevel or face gear an explicit 'position' and 'axis'")
     pair = cylindrical_pair(r, g)
     return ref_position + pair.operating_center_distance * direction
 
@@ -198,17 +211,43 @@ def _conical_frame(mesh, na, nb, ga, gb, aa, ab, positions) -> ContactFrame:
         gam_a = ga.cone_angle
     if gb.cone_angle is not None:
         gam_b = gb.cone_angle
-    e_perp = _perp_unit(ab, aa)
-    g_line = math.cos(gam_a) * aa + math.sin(gam_a) * e_perp
-    er_a = e_perp
-    er_b = _perp_unit(g_line, ab)
+    face = "face" in (ga.gear_type, gb.gear_type)
+    if face:
+        # face gear on a cylindrical pinion: pitch radii z m / 2 (their ratio is the
+        # speed ratio); the contact lies on the pinion's pitch cylinder on the side of
+        # the face gear, at the face gear's pitch radius from its axis (positions decide
+        # at which end of the pinion a face gear sits)
+        ip, jf = (0, 1) if gb.gear_type == "face" else (1, 0)
+        names, gears, axes_ = (na, nb), (ga, gb), (aa, ab)
+        cp, cf = positions[names[ip]], positions[names[jf]]
+        ap, af = axes_[ip], axes_[jf]
+        rp = gears[ip].teeth * gears[ip].module / 2
+        rf = gears[jf].teeth * gears[jf].module / 2
+        er_p = _perp_unit(cf - cp, ap)
+        apex = _closest_point_on_line(cp, ap, cf, af)
+        side = float((cp - apex) @ ap)
+        side = 1.0 if side >= 0 else -1.0
+        point = apex + side * rf * ap + rp * er_p
+        er_f = _perp_unit(point - cf, af)
+        radials = [None, None]
+        radials[ip], radials[jf] = er_p, er_f
+        radii = [0.0, 0.0]
+        radii[ip], radii[jf] = rp, rf
+        er_a, er_b = radials
+        ra, rb = radii
+    else:
+        e_perp = _perp_unit(ab, aa)
+        g_line = math.cos(gam_a) * aa + math.sin(gam_a) * e_perp
+        er_a = e_perp
+        er_b = _perp_unit(g_line, ab)
 
-    def mean_radius(g, gam):
-        r_outer = g.teeth * g.module / 2
-        return r_outer - 0.5 * g.face_width * math.sin(gam)
+        def mean_radius(g, gam):
+            # mean pitch radius at mid face width along the cone
+            r_outer = g.teeth * g.module / 2
+            return r_outer - 0.5 * g.face_width * math.sin(gam)
 
-    ra, rb = mean_radius(ga, gam_a), mean_radius(gb, gam_b)
-    point = positions[na] + ra * er_a
+        ra, rb = mean_radius(ga, gam_a), mean_radius(gb, gam_b)
+        point = positions[na] + ra * er_a
     ta, tb = np.cross(aa, er_a), np.cross(ab, er_b)
     ratio = (za / zb) * float(ta @ tb)
     # contact ratio from the virtual (Tredgold) spur/helical gears z_v = z / cos(gamma)

@@ -206,7 +206,9 @@ def solve_kinematics(model: Model) -> Kinematics:
         t_drv = p_mesh / abs(speeds[driver])
         t_dvn = p_mesh / abs(speeds[driven])
         force = t_drv / abs(arm_d)
-        ja, jb = bodies[driver].polar_inertia, bodies[driven].polar_inertia
+        # inertia of the rigid group each gear belongs to (compound gears)
+        ja, jb = (sum(bodies[b].polar_inertia for b in bodies if groups[b] == groups[g])
+                  for g in (driver, driven))
         # equivalent mass of the mesh, m = J1 J2 / (J1 r2^2 + J2 r1^2), with the arms
         # as the effective base radii (issue 2; seed 001 eq. 1 corrected)
         m_eq = ja * jb / (ja * arm_n**2 + jb * arm_d**2)
@@ -312,8 +314,12 @@ def _layout(model: Model, issues) -> tuple[dict, dict, list[str]]:
             if g.place is not None:
                 ref = g.place.from_gear
                 if ref in positions:
-                    positions[name] = loa.placed_position(
-                        model, name, ref, positions[ref], axes[ref], g.place.angle)
+                    try:
+                        positions[name] = loa.placed_position(
+                            model, name, ref, positions[ref], axes[ref], g.place.angle)
+                    except ValueError as exc:
+                        issues.append((f"gears.{name}.place", str(exc)))
+                        positions[name] = positions[ref].copy()
                     pending.remove(name)
                     progress = True
                 continue
@@ -329,8 +335,13 @@ def _layout(model: Model, issues) -> tuple[dict, dict, list[str]]:
                 ref = mt[0]
                 k = auto_count.get(ref, 0)
                 auto_count[ref] = k + 1
-                positions[name] = loa.placed_position(
-                    model, name, ref, positions[ref], axes[ref], math.pi * k)
+                try:
+                    positions[name] = loa.placed_position(
+                        model, name, ref, positions[ref], axes[ref], math.pi * k)
+                except ValueError:
+                    # crossed axes: a bevel gear's frame follows from the axes alone;
+                    # a face gear needs an explicit position (see gears/line_of_action.py)
+                    positions[name] = positions[ref].copy()
                 computed.append(name)
                 pending.remove(name)
                 progress = True

@@ -1,0 +1,738 @@
+"""Report figures of a dynamic run (:class:`~torquesplit.results.Results`) and of a
+quasi-static sweep (:class:`~torquesplit.quasistatic.QuasiStaticResults`).
+
+Every ``*_figure`` function takes results and returns a :class:`matplotlib.figure.Figure`
+drawn with the object-oriented API on an Agg canvas: no pyplot, no global state, nothing
+set at import.  :func:`write_figures` and :func:`write_static_figures` write every figure
+that applies to a run.
+
+Units on the axes: forces in kN (spectrum amplitudes in N), time in s or ms (ms when the
+run is shorter than one second), frequency in Hz or kHz, displacements in micrometres,
+mesh stiffness in N/um (1 N/um = 1e6 N/m).
+
+Examples
+--------
+>>> import torquesplit
+>>> from torquesplit.plot import figures
+>>> res = torquesplit.simulate(torquesplit.example_path("seed001_mill_drive"), cycles=20)
+>>> fig = figures.mesh_force_figure(res)
+>>> paths = figures.write_figures(res, "figures", formats=("png",))
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from pathlib import Path
+from typing import Iterable
+
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+
+from ..errors import TorquesplitError
+
+__all__ = [
+    "FigureNotApplicableError",
+    "mesh_force_figure", "cycle_peak_figure", "load_sharing_figure",
+    "support_spectrum_figure", "orbit_figure", "mesh_stiffness_figure",
+    "static_mesh_force_figure", "static_load_sharing_figure",
+    "write_figures", "write_static_figures",
+]
+
+log = logging.getLogger(__name__)
+
+#: font sizes [pt] of the figure title, panel titles, axis labels, ticks and legends
+FONT = {"suptitle": 13, "title": 11, "label": 10.5, "tick": 9.5, "legend": 9}
+#: width [in] of a one-column figure and height [in] of one row of panels
+WIDTH, ROW_HEIGHT = 9.0, 2.9
+#: colour of the nominal (equal-split static) force and of reported coefficients
+REFERENCE_COLOR = "0.15"
+
+_KN = 1e-3  # N -> kN
+_UM = 1e6  # m -> um
+_N_PER_UM = 1e-6  # N/m -> N/um
+
+_DEFINITION_TEXT = {
+    "cycle_peak": r"$N\,F_{\max,i}(k)\,/\,\sum_j F_{\max,j}(k)$ in each mesh cycle $k$",
+    "instantaneous": r"peak in each mesh cycle of $N\,F_i(t)\,/\,\sum_j F_j(t)$",
+    "engineering": r"peak in each mesh cycle of $N\,F_i(t)\,/\,\sum_j F_j(t)$",
+    "static_torque": r"peak in each mesh cycle of $N\,F_i(t)\,/\,\sum_j F_j(t)$",
+    "mean_force": r"$N\,\bar F_i(k)\,/\,\sum_j \bar F_j(k)$ in each mesh cycle $k$",
+}
+_REPORTED_TEXT = {
+    "cycle_peak": "largest over settled cycles",
+    "instantaneous": "largest over settled samples",
+    "engineering": "mean of settled cycle peaks",
+    "static_torque": "largest over settled samples",
+    "mean_force": "from settled mean forces",
+}
+
+
+class FigureNotApplicableError(TorquesplitError, ValueError):
+    """The results hold nothing this figure can show (no supports, no floating body...)."""
+
+
+# ============================================================ dynamic run figures
+def mesh_force_figure(results, *, last_cycles: float | None = None,
+                      max_points: int = 4000) -> Figure:
+    """Mesh force against time, one panel per load-sharing group, the paths overlaid.
+
+    Parameters
+    ----------
+    results : Results
+        A dynamic run.
+    last_cycles : float, optional
+        Show only the last ``last_cycles`` mesh cycles of each group (each panel has its
+        own time window).  Default: the whole run.
+    max_points : int
+        Longer histories are drawn as their min/max envelope on ``max_points`` points
+        per line (every peak and trough kept); shorter ones sample by sample.
+
+    Returns
+    -------
+    Figure
+        The nominal (equal-split) static force of each mesh is the dashed line.
+    """
+    t, forces = results.mesh_force_history()
+    forces = _finite(forces)
+    names, groups = results.mesh_names, results.groups
+    nominal = results.nominal_forces()
+    freq = _group_frequencies(results)
+    fig, axes = _panels(len(groups), sharex=last_cycles is None)
+    scale, unit = _time_unit(t)
+    for ax, (g, members) in zip(axes, groups.items()):
+        keep = np.ones(t.shape, bool)
+        if last_cycles is not None and t.size:
+            keep = t >= t[-1] - last_cycles / freq[g]
+        for i, m in enumerate(members):
+            tt, ff = _envelope(t[keep], forces[keep, names.index(m)], max_points)
+            ax.plot(tt * scale, ff * _KN, color=_color(i), lw=1.0, label=m)
+        _nominal_lines(ax, [nominal[m] for m in members])
+        window = f", last {last_cycles:g} mesh cycles" if last_cycles is not None else ""
+        ax.set_title(f"{_group_label(g, members)}, mesh frequency {_hz(freq[g])}{window}",
+                     fontsize=FONT["title"])
+        _label(ax, f"time [{unit}]", "mesh force [kN]")
+        _legend(ax)
+    what = "mesh force" if last_cycles is None else "mesh force, end of the run"
+    _suptitle(fig, results, what)
+    return fig
+
+
+def cycle_peak_figure(results, *, definition: str | None = None) -> Figure:
+    """Peak mesh force of every mesh cycle against the cycle's start time.
+
+    One panel per load-sharing group; the nominal static force is dashed, the start of
+    the settled part (by the settle criterion of ``results.metrics(definition)``) is the
+    dotted vertical line and the transient before it is shaded.
+    """
+    s = results.solution
+    names, groups = results.mesh_names, results.groups
+    nominal = results.nominal_forces()
+    settle = results.metrics(definition).settling.start_time
+    cols = _cycle_columns(results)
+    fig, axes = _panels(len(groups), sharex=True)
+    scale, unit = _time_unit(s.history_t if s.history_t.size else s.cycle_start.ravel())
+    for ax, (g, members) in zip(axes, groups.items()):
+        for i, m in enumerate(members):
+            start, peak = s.cycle_start[:, cols[m]], _finite(s.cycle_max[:, cols[m]])
+            ok = np.isfinite(peak)
+            ax.plot(start[ok] * scale, peak[ok] * _KN, color=_color(i), lw=1.0, label=m)
+        _nominal_lines(ax, [nominal[m] for m in members])
+        _mark_settled(ax, settle * scale, s.cycle_start[:, [cols[m] for m in members]] * scale,
+                      unit)
+        ax.set_title(_group_label(g, members), fontsize=FONT["title"])
+        _label(ax, f"cycle start time [{unit}]", "peak force in cycle [kN]")
+        _legend(ax)
+    _suptitle(fig, results, "peak mesh force of each mesh cycle")
+    return fig
+
+
+def load_sharing_figure(results, definition: str | None = None) -> Figure:
+    """Load-sharing coefficient of each mesh cycle against time, by ``definition``.
+
+    Parameters
+    ----------
+    results : Results
+        A dynamic run.
+    definition : str, optional
+        One of :data:`torquesplit.metrics.load_sharing.DEFINITIONS`; default the model's
+        ``[analysis] load_sharing``.  ``cycle_peak`` and ``mean_force`` use the per-cycle
+        peak or mean forces; the sample-based definitions (``instantaneous``,
+        ``engineering``, ``static_torque``) show the peak in each mesh cycle of the
+        instantaneous coefficient.
+
+    Returns
+    -------
+    Figure
+        One panel per group of two or more meshes.  The dashed line is the group's
+        reported coefficient (``results.metrics(definition).load_sharing.per_group``),
+        the dotted vertical line the start of the settled part.
+    """
+    met = results.metrics(definition)
+    definition = met.definition
+    groups = {g: ms for g, ms in results.groups.items() if len(ms) > 1}
+    if not groups:
+        raise FigureNotApplicableError(
+            "every load-sharing group has a single mesh, so every coefficient is 1; give "
+            "parallel meshes the same 'stage' (and 'path') label in the model file to group "
+            "them")
+    s = results.solution
+    settle = met.settling.start_time
+    cycle_t, coef = _cycle_coefficients(results, definition, groups)
+    fig, axes = _panels(len(groups), sharex=True)
+    scale, unit = _time_unit(s.history_t if s.history_t.size else s.cycle_start.ravel())
+    for ax, (g, members) in zip(axes, groups.items()):
+        for i, m in enumerate(members):
+            ax.plot(cycle_t[m] * scale, coef[m], color=_color(i), lw=1.0, label=m)
+        ax.axhline(1.0, color="0.6", lw=0.8)
+        ax.axhline(met.load_sharing.per_group[g], color=REFERENCE_COLOR, ls="--", lw=1.2,
+                   label=f"reported {met.load_sharing.per_group[g]:.4f}\n"
+                         f"({_REPORTED_TEXT[definition]})")
+        _mark_settled(ax, settle * scale, np.concatenate([cycle_t[m] for m in members]) * scale,
+                      unit)
+        ax.set_title(_group_label(g, members), fontsize=FONT["title"])
+        _label(ax, f"time [{unit}]", "load-sharing coefficient [-]")
+        _legend(ax)
+    _suptitle(fig, results, f"load-sharing coefficient, definition '{definition}'\n"
+                            f"{_DEFINITION_TEXT[definition]}")
+    return fig
+
+
+def support_spectrum_figure(results, *, start_time: float | None = None, orders: int = 4,
+                            max_frequency: float | None = None,
+                            bodies: Iterable[str] | None = None) -> Figure:
+    """Amplitude spectrum of each support (bearing) force history, mesh orders marked.
+
+    Parameters
+    ----------
+    results : Results
+        A dynamic run (support forces are recorded by :func:`torquesplit.simulate`).
+    start_time : float, optional
+        Analyse the history from this time [s]; default the settled start of
+        ``results.metrics()`` (the transient would smear the spectrum).
+    orders : int
+        Number of harmonics of each mesh frequency to mark (and, without
+        ``max_frequency``, the range shown: up to ``orders + 0.5`` times the highest mesh
+        frequency, at most the Nyquist frequency).
+    max_frequency : float, optional
+        Upper end of the frequency axis [Hz].
+    bodies : iterable of str, optional
+        Supported bodies to show (default all), one panel each.
+
+    Returns
+    -------
+    Figure
+        Single-sided amplitude spectrum [N] of the force minus its mean, Hann window
+        (amplitude-corrected, so a sinusoid of amplitude A shows a peak of about A); the
+        legend gives each direction's mean force.
+    """
+    s = results.solution
+    el = results.structure.element_names
+    supports: dict[str, list[tuple[str, int]]] = {}
+    for col, e in enumerate(s.history_elements):
+        if ".support." in el[e]:
+            body, direction = el[e].split(".support.", 1)
+            supports.setdefault(body, []).append((direction, col))
+    if bodies is not None:
+        wanted = list(bodies)
+        unknown = [b for b in wanted if b not in supports]
+        if unknown:
+            raise FigureNotApplicableError(
+                f"no support force history of {', '.join(unknown)}; choose among "
+                f"{', '.join(supports) or '(none)'}")
+        supports = {b: supports[b] for b in wanted}
+    if not supports:
+        raise FigureNotApplicableError(
+            "the run recorded no support force; give a gear a [gears.<name>.support] table "
+            "(with translational dofs) to get bearing forces")
+    t = s.history_t
+    t0 = results.metrics().settling.start_time if start_time is None else float(start_time)
+    keep = t >= t0
+    if keep.sum() < 16:
+        raise FigureNotApplicableError(
+            f"only {int(keep.sum())} history samples after t = {t0:.4g} s; simulate more "
+            f"cycles or give an earlier start_time")
+    tk = t[keep]
+    dt = float(np.median(np.diff(tk)))
+    uniform = np.allclose(np.diff(tk), dt, rtol=1e-6, atol=0.0)
+    grid = tk if uniform else tk[0] + dt * np.arange(int((tk[-1] - tk[0]) / dt) + 1)
+    freq = np.fft.rfftfreq(grid.size, dt)
+    window = np.hanning(grid.size)
+    mesh_f = _distinct_mesh_frequencies(results)
+    f_top = max_frequency or min(freq[-1], (orders + 0.5) * max(mesh_f))
+    fscale, funit = (1e-3, "kHz") if f_top >= 1e4 else (1.0, "Hz")
+    show = freq <= f_top
+    ncols = 1 if len(supports) <= 3 else 2
+    fig, axes = _panels(len(supports), ncols=ncols, sharex=True, row_height=2.5)
+    for ax, (body, dirs) in zip(axes, supports.items()):
+        for i, (direction, col) in enumerate(dirs):
+            x = _finite(s.history_forces[keep, col])
+            if not uniform:
+                x = np.interp(grid, tk, x)
+            mean = float(np.nanmean(x))
+            spec = np.fft.rfft(np.nan_to_num(x - mean) * window)
+            amp = 2.0 * np.abs(spec) / window.sum()
+            ax.plot(freq[show] * fscale, amp[show], color=_color(i), lw=1.0,
+                    label=f"{direction}  (mean {mean * _KN:.3g} kN)")
+        for j, (f, label) in enumerate(mesh_f.items()):
+            for k in range(1, orders + 1):
+                if k * f <= f_top:
+                    ax.axvline(k * f * fscale, color=_order_color(j), ls=":", lw=1.1,
+                               label=f"{label}: $f_m$ = {_hz(f)} x 1..{orders}"
+                               if k == 1 else None)
+        ax.set_xlim(0, f_top * fscale)
+        ax.set_ylim(bottom=0)
+        ax.set_title(f"support of {body}", fontsize=FONT["title"])
+        _label(ax, f"frequency [{funit}]", "force amplitude [N]")
+        _legend(ax)
+    span = tk[-1] - tk[0]
+    _suptitle(fig, results, f"support force spectrum, t >= {t0:.4g} s "
+                            f"({span:.4g} s, resolution {1 / span:.3g} Hz)")
+    return fig
+
+
+def orbit_figure(results, *, bodies: Iterable[str] | None = None) -> Figure:
+    """Floating orbit (x-y path of the centre) of every body with x and y DOFs [um].
+
+    Works on a :class:`~torquesplit.quasistatic.QuasiStaticResults` (its
+    :meth:`orbits`) and on a dynamic run whose ``history_dofs`` include ``<body>.x`` and
+    ``<body>.y``.  Equal aspect; ``+`` is the nominal centre, the circle the start.
+    """
+    orbits = _orbits(results)
+    if bodies is not None:
+        wanted = list(bodies)
+        unknown = [b for b in wanted if b not in orbits]
+        if unknown:
+            raise FigureNotApplicableError(
+                f"no x-y orbit of {', '.join(unknown)}; choose among "
+                f"{', '.join(orbits) or '(none)'}")
+        orbits = {b: orbits[b] for b in wanted}
+    if not orbits:
+        raise FigureNotApplicableError(
+            "no body has recorded x and y displacements; give floating members "
+            "dofs = [\"x\", \"y\", \"theta\"] and, for a dynamic run, "
+            "simulate(..., history_dofs=[\"<body>.x\", \"<body>.y\"])")
+    n = len(orbits)
+    ncols = min(n, 4)
+    nrows = math.ceil(n / ncols)
+    fig = _figure(width=min(WIDTH * 1.4, 3.3 * ncols + 0.6), height=3.3 * nrows + 0.6)
+    axes = fig.subplots(nrows, ncols, squeeze=False).ravel()
+    for ax in axes[n:]:
+        ax.set_visible(False)
+    for ax, (body, xy) in zip(axes, orbits.items()):
+        xy = _finite(xy) * _UM
+        ax.plot(xy[:, 0], xy[:, 1], color=_color(0), lw=1.0)
+        ax.plot(xy[:1, 0], xy[:1, 1], "o", color=_color(0), ms=5, mfc="none")
+        ax.plot([0.0], [0.0], "+", color=REFERENCE_COLOR, ms=9)
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.set_title(body, fontsize=FONT["title"])
+        _label(ax, "x [µm]", "y [µm]")
+    kind = "quasi-static" if hasattr(results, "orbits") else "dynamic"
+    _suptitle(fig, results, f"floating orbits ({kind}); + nominal centre, o start")
+    return fig
+
+
+def mesh_stiffness_figure(results, *, cycles: float = 2.0, points_per_cycle: int = 400
+                          ) -> Figure:
+    """Mesh stiffness k(t) over ``cycles`` mesh cycles, one panel per group.
+
+    The assembled stiffness tables are drawn as the integrator reads them (linear
+    periodic interpolation at the mesh phase ``f t + phase``), so the relative phasing
+    of parallel meshes shows.  Works on dynamic and quasi-static results.
+    """
+    st = results.structure
+    el = st.element_names
+    groups = _groups(results)
+    x = np.linspace(0.0, cycles, int(points_per_cycle * cycles) + 1)
+    fig, axes = _panels(len(groups), sharex=True, row_height=2.5)
+    for ax, (g, members) in zip(axes, groups.items()):
+        for i, m in enumerate(members):
+            e = el.index(m)
+            ax.plot(x, _stiffness_at_phase(st.stiffness_table[e], x + st.phase[e])
+                    * _N_PER_UM, color=_color(i), lw=1.2,
+                    label=f"{m} (mean {st.stiffness_table[e].mean() * _N_PER_UM:.4g} N/µm)")
+        ax.set_xlim(0, cycles)
+        ax.set_title(_group_label(g, members), fontsize=FONT["title"])
+        _label(ax, "time [mesh cycles]", "mesh stiffness [N/µm]")
+        _legend(ax)
+    _suptitle(fig, results, "mesh stiffness")
+    return fig
+
+
+# ============================================================ quasi-static figures
+def static_mesh_force_figure(results) -> Figure:
+    """Quasi-static mesh force against mesh position, one panel per group."""
+    angle, xlabel = _positions(results)
+    forces = _finite(_static_forces(results))
+    names, groups = results.mesh_names, _groups(results)
+    nominal = {m: results.kinematics.meshes[m].force for m in names}
+    fig, axes = _panels(len(groups), sharex=True)
+    for ax, (g, members) in zip(axes, groups.items()):
+        for i, m in enumerate(members):
+            ax.plot(angle, forces[:, names.index(m)] * _KN, color=_color(i), lw=1.2, label=m)
+        _nominal_lines(ax, [nominal[m] for m in members])
+        ax.set_xlim(angle[0], angle[-1])
+        ax.set_title(_group_label(g, members), fontsize=FONT["title"])
+        _label(ax, xlabel, "mesh force [kN]")
+        _legend(ax)
+    _suptitle(fig, results, f"quasi-static mesh force{_unconverged_note(results)}")
+    return fig
+
+
+def static_load_sharing_figure(results) -> Figure:
+    """Static torque ratio ``N F_i / sum_j F_j`` (seed 004 eq. 14) against position.
+
+    The dashed line is the group's reported value (largest over the positions,
+    seed 004 eq. 15: ``results.metrics().per_group``).
+    """
+    angle, xlabel = _positions(results)
+    forces = _finite(_static_forces(results))
+    names = results.mesh_names
+    groups = {g: ms for g, ms in _groups(results).items() if len(ms) > 1}
+    if not groups:
+        raise FigureNotApplicableError(
+            "every load-sharing group has a single mesh; give parallel meshes the same "
+            "'stage' (and 'path') label in the model file to group them")
+    met = results.metrics()
+    fig, axes = _panels(len(groups), sharex=True)
+    for ax, (g, members) in zip(axes, groups.items()):
+        ratio = _share_ratio(forces[:, [names.index(m) for m in members]])
+        for i, m in enumerate(members):
+            ax.plot(angle, ratio[:, i], color=_color(i), lw=1.2, label=m)
+        ax.axhline(1.0, color="0.6", lw=0.8)
+        ax.axhline(met.per_group[g], color=REFERENCE_COLOR, ls="--", lw=1.2,
+                   label=f"reported {met.per_group[g]:.4f}\n(largest over positions)")
+        ax.set_xlim(angle[0], angle[-1])
+        ax.set_title(_group_label(g, members), fontsize=FONT["title"])
+        _label(ax, xlabel, "static torque ratio [-]")
+        _legend(ax)
+    _suptitle(fig, results, "quasi-static load sharing, "
+                            r"$N\,F_i\,/\,\sum_j F_j$ at each position"
+                            f"{_unconverged_note(results)}")
+    return fig
+
+
+# ============================================================ writing
+def write_figures(results, directory, formats=("png", "svg"), *,
+                  definition: str | None = None, last_cycles: float = 5.0,
+                  prefix: str = "", dpi: int = 150) -> list[Path]:
+    """Write every figure that applies to a dynamic run; return the written paths.
+
+    Parameters
+    ----------
+    results : Results
+        A dynamic run (for a quasi-static sweep use :func:`write_static_figures`).
+    directory : str or Path
+        Output directory (created if missing).
+    formats : sequence of str
+        File formats (suffixes) to write each figure in, e.g. ``("png", "svg", "pdf")``.
+    definition : str, optional
+        Load-sharing definition of the coefficient figure (default: the model's).
+    last_cycles : float
+        Mesh cycles shown in the end-of-run mesh-force figure.
+    prefix : str
+        Put in front of every file name (e.g. the case name).
+    dpi : int
+        Resolution of raster formats.
+
+    Returns
+    -------
+    list of Path
+        ``mesh_force.*`` (whole run), ``mesh_force_end.*`` (last cycles),
+        ``cycle_peak_force.*``, ``load_sharing_<definition>.*`` (if a group has two or
+        more meshes), ``support_force_spectrum.*`` (if supports were recorded),
+        ``orbits.*`` (if x-y histories were recorded), ``mesh_stiffness.*`` (if a mesh
+        stiffness varies).
+    """
+    if hasattr(results, "orbits"):
+        raise TypeError("write_figures takes a dynamic run; for quasi-static results call "
+                        "write_static_figures(results, directory)")
+    definition = results.metrics(definition).definition
+    jobs = [
+        ("mesh_force", lambda: mesh_force_figure(results)),
+        ("mesh_force_end", lambda: mesh_force_figure(results, last_cycles=last_cycles)),
+        ("cycle_peak_force", lambda: cycle_peak_figure(results, definition=definition)),
+        (f"load_sharing_{definition}", lambda: load_sharing_figure(results, definition)),
+        ("support_force_spectrum", lambda: support_spectrum_figure(results)),
+        ("orbits", lambda: orbit_figure(results)),
+    ]
+    if _stiffness_varies(results):
+        jobs.append(("mesh_stiffness", lambda: mesh_stiffness_figure(results)))
+    return _write(jobs, directory, formats, prefix, dpi)
+
+
+def write_static_figures(results, directory, formats=("png", "svg"), *, prefix: str = "",
+                         dpi: int = 150) -> list[Path]:
+    """Write every figure of a quasi-static sweep; return the written paths.
+
+    ``static_mesh_force.*``, ``static_load_sharing.*`` (if a group has two or more
+    meshes), ``static_orbits.*`` (if a body floats), ``mesh_stiffness.*`` (if a mesh
+    stiffness varies).  Arguments as in :func:`write_figures`.
+    """
+    if not hasattr(results, "orbits"):
+        raise TypeError("write_static_figures takes quasi-static results; for a dynamic run "
+                        "call write_figures(results, directory)")
+    jobs = [
+        ("static_mesh_force", lambda: static_mesh_force_figure(results)),
+        ("static_load_sharing", lambda: static_load_sharing_figure(results)),
+        ("static_orbits", lambda: orbit_figure(results)),
+    ]
+    if _stiffness_varies(results):
+        jobs.append(("mesh_stiffness", lambda: mesh_stiffness_figure(results)))
+    return _write(jobs, directory, formats, prefix, dpi)
+
+
+def _write(jobs, directory, formats, prefix, dpi) -> list[Path]:
+    formats = (formats,) if isinstance(formats, str) else tuple(formats)
+    supported = FigureCanvasAgg.get_supported_filetypes()
+    bad = [f for f in formats if f.lower().lstrip(".") not in supported]
+    if bad or not formats:
+        raise ValueError(f"cannot write figures as {', '.join(bad) or 'no format'}; choose "
+                         f"formats among {', '.join(sorted(supported))}")
+    directory = Path(directory)
+    directory.mkdir(parents=True, exist_ok=True)
+    written = []
+    for name, make in jobs:
+        try:
+            fig = make()
+        except FigureNotApplicableError as exc:
+            log.info("figure %s skipped: %s", name, exc)
+            continue
+        for fmt in formats:
+            path = directory / f"{prefix}{name}.{fmt.lower().lstrip('.')}"
+            fig.savefig(path, dpi=dpi)
+            written.append(path)
+        log.debug("figure %s written", name)
+    return written
+
+
+# ============================================================ helpers: data
+def _finite(x: np.ndarray) -> np.ndarray:
+    """Copy with +-inf replaced by NaN (a diverged run), so lines just stop."""
+    x = np.asarray(x, dtype=float)
+    return np.where(np.isfinite(x), x, np.nan)
+
+
+def _share_ratio(x: np.ndarray) -> np.ndarray:
+    """N x_i / sum_j x_j along the last axis: the form of every definition of
+    :mod:`torquesplit.metrics.load_sharing` (seed 000 eq. 17, seed 001 eq. 18,
+    seed 002 eq. 12, seed 004 eq. 14)."""
+    total = x.sum(axis=-1, keepdims=True)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return x.shape[-1] * x / np.where(total != 0, total, np.nan)
+
+
+def _groups(results) -> dict[str, list[str]]:
+    from ..metrics.load_sharing import group_meshes
+
+    return group_meshes(results.structure.metadata["meshes"])
+
+
+def _group_frequencies(results) -> dict[str, float]:
+    meta = results.structure.metadata["meshes"]
+    return {g: float(meta[ms[0]]["frequency"]) for g, ms in _groups(results).items()}
+
+
+def _distinct_mesh_frequencies(results) -> dict[float, str]:
+    """Mesh frequency -> names of the groups meshing at it (equal to 1e-6 relative)."""
+    out: dict[float, list[str]] = {}
+    for g, f in _group_frequencies(results).items():
+        for known in out:
+            if math.isclose(known, f, rel_tol=1e-6):
+                out[known].append(g)
+                break
+        else:
+            out[f] = [g]
+    return {f: ", ".join(gs) for f, gs in sorted(out.items())}
+
+
+def _cycle_columns(results) -> dict[str, int]:
+    """Mesh -> column of the solution's cycle arrays."""
+    s = results.solution
+    el = results.structure.element_names
+    tracked = list(s.tracked_elements)
+    return {m: tracked.index(el.index(m)) for m in results.mesh_names}
+
+
+def _cycle_coefficients(results, definition, groups):
+    """Per-cycle coefficient of each mesh over the whole run, with its cycle start time."""
+    s = results.solution
+    cols = _cycle_columns(results)
+    times, coef = {}, {}
+    if definition in ("cycle_peak", "mean_force"):
+        per_cycle = s.cycle_max if definition == "cycle_peak" else s.cycle_mean
+        for members in groups.values():
+            x = per_cycle[:, [cols[m] for m in members]]
+            ok = np.all(np.isfinite(x), axis=-1)
+            r = _share_ratio(x[ok])
+            for i, m in enumerate(members):
+                times[m], coef[m] = s.cycle_start[ok, cols[m]], r[:, i]
+        return times, coef
+    # sample-based definitions: peak of the instantaneous coefficient in each complete
+    # mesh cycle of the mesh (cycles as counted by the integrator, cycle_start)
+    t, forces = results.mesh_force_history()
+    names = results.mesh_names
+    for members in groups.values():
+        r = _share_ratio(forces[:, [names.index(m) for m in members]])
+        for i, m in enumerate(members):
+            start = s.cycle_start[:, cols[m]]
+            complete = np.flatnonzero((start[:-1] >= t[0]) & (start[1:] <= t[-1])) \
+                if t.size else np.zeros(0, int)
+            k = np.searchsorted(start, t, side="right") - 1
+            peaks = np.full(start.size, np.nan)
+            ok = (k >= 0) & np.isfinite(r[:, i])
+            np.fmax.at(peaks, k[ok], r[ok, i])
+            times[m], coef[m] = start[complete], peaks[complete]
+    return times, coef
+
+
+def _envelope(t: np.ndarray, y: np.ndarray, max_points: int):
+    """Min/max decimation: at most ``max_points`` points keeping each bin's extremes in
+    time order, so that peaks survive; the input itself when it is short enough."""
+    n = t.size
+    if n <= max_points:
+        return t, y
+    n_bins = max(max_points // 2, 1)
+    edges = np.linspace(0, n, n_bins + 1).astype(np.int64)
+    idx = []
+    for a, b in zip(edges[:-1], edges[1:]):
+        seg = y[a:b]
+        if not np.isfinite(seg).any():
+            idx.append(a)
+            continue
+        i_min, i_max = a + int(np.nanargmin(seg)), a + int(np.nanargmax(seg))
+        idx.extend(sorted({i_min, i_max}))
+    idx = np.asarray(idx)
+    return t[idx], y[idx]
+
+
+def _stiffness_at_phase(table: np.ndarray, phase: np.ndarray) -> np.ndarray:
+    """The stiffness table read as the integrator reads it: linear, periodic, at
+    ``frac(phase) * n_table`` (:func:`torquesplit.solve._kernels.excite_tables`)."""
+    n = table.size
+    pos = np.mod(phase, 1.0) * n
+    return np.interp(pos, np.arange(n + 1), np.append(table, table[0]))
+
+
+def _stiffness_varies(results) -> bool:
+    st = results.structure
+    rows = st.stiffness_table[[st.element_names.index(m) for m in results.mesh_names]]
+    return bool(np.any(np.ptp(rows, axis=1) > 1e-9 * np.abs(rows).max(axis=1)))
+
+
+def _orbits(results) -> dict[str, np.ndarray]:
+    if hasattr(results, "orbits"):
+        return results.orbits()
+    s = results.solution
+    names = [s.dof_names[i] for i in s.history_dofs]
+    out = {}
+    for name in names:
+        body, _, axis = name.rpartition(".")
+        if axis == "x" and f"{body}.y" in names:
+            out[body] = s.history_q[:, [names.index(name), names.index(f"{body}.y")]]
+    return out
+
+
+def _static_forces(results) -> np.ndarray:
+    forces = np.array(results.mesh_forces(), dtype=float)
+    converged = np.asarray(getattr(results.solution, "converged", np.ones(len(forces), bool)))
+    forces[~converged.astype(bool)] = np.nan
+    return forces
+
+
+def _positions(results) -> tuple[np.ndarray, str]:
+    """Sweep positions as the rotation of the slowest gear [deg] (one revolution per
+    360 deg, as :func:`torquesplit.quasistatic.quasi_static_load_sharing` sweeps)."""
+    kin = results.kinematics
+    gear = min(results.model.gears, key=lambda g: abs(kin.bodies[g].speed))
+    angle = np.degrees(results.times * abs(kin.bodies[gear].speed))
+    return angle, f"rotation of {gear} [deg]"
+
+
+def _unconverged_note(results) -> str:
+    conv = np.asarray(getattr(results.solution, "converged", []), bool)
+    bad = int((~conv).sum())
+    return f"  ({bad} unconverged positions left out)" if bad else ""
+
+
+# ============================================================ helpers: drawing
+def _figure(width: float, height: float) -> Figure:
+    fig = Figure(figsize=(width, height), layout="constrained")
+    FigureCanvasAgg(fig)  # Agg canvas of this figure only; no pyplot, no global backend
+    return fig
+
+
+def _panels(n: int, *, ncols: int = 1, sharex: bool = False, row_height: float = ROW_HEIGHT):
+    nrows = math.ceil(n / ncols)
+    fig = _figure(WIDTH if ncols == 1 else WIDTH * 1.5, row_height * nrows + 0.8)
+    axes = fig.subplots(nrows, ncols, squeeze=False, sharex=sharex).ravel()
+    for ax in axes[n:]:
+        ax.set_visible(False)
+    if sharex and n < axes.size:  # the panel above an empty slot shows its x ticks
+        for ax in axes[max(n - ncols, 0):n]:
+            ax.xaxis.set_tick_params(labelbottom=True)
+    return fig, list(axes[:n])
+
+
+def _label(ax, xlabel: str, ylabel: str) -> None:
+    ax.set_xlabel(xlabel, fontsize=FONT["label"])
+    ax.set_ylabel(ylabel, fontsize=FONT["label"])
+    ax.tick_params(labelsize=FONT["tick"])
+    for axis in (ax.xaxis, ax.yaxis):
+        if axis.get_scale() == "linear":
+            axis.get_major_formatter().set_useOffset(False)
+    ax.grid(True, alpha=0.3)
+
+
+def _legend(ax) -> None:
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=FONT["legend"],
+              frameon=False, borderaxespad=0.0)
+
+
+def _suptitle(fig, results, what: str) -> None:
+    name = results.model.model.name
+    note = "" if getattr(results, "success", True) else \
+        f"\nrun stopped: {results.message}"
+    fig.suptitle(f"{name}: {what}{note}", fontsize=FONT["suptitle"])
+
+
+def _nominal_lines(ax, values) -> None:
+    """One dashed line per distinct nominal (equal-split static) force of the panel."""
+    drawn: list[float] = []
+    for v in values:
+        if any(math.isclose(v, d, rel_tol=1e-9) for d in drawn):
+            continue
+        drawn.append(v)
+        ax.axhline(v * _KN, color=REFERENCE_COLOR, ls="--", lw=1.2,
+                   label=f"nominal static\n{v * _KN:.4g} kN")
+
+
+def _mark_settled(ax, settle: float, times: np.ndarray, unit: str) -> None:
+    ax.axvline(settle, color="0.3", ls=":", lw=1.4, label=f"settled from\n{settle:.4g} {unit}")
+    start = np.nanmin(times) if np.isfinite(times).any() else settle
+    if settle > start:
+        ax.axvspan(start, settle, color="0.85", alpha=0.6, lw=0, label="transient")
+
+
+def _group_label(group: str, members) -> str:
+    n = len(members)
+    return f"group {group} ({n} mesh{'es' if n != 1 else ''})"
+
+
+def _time_unit(t: np.ndarray) -> tuple[float, str]:
+    """Milliseconds for runs shorter than one second, else seconds."""
+    end = float(np.nanmax(np.abs(t))) if np.size(t) else 0.0
+    return (1e3, "ms") if end < 1.0 else (1.0, "s")
+
+
+def _hz(f: float) -> str:
+    return f"{f / 1e3:.4g} kHz" if f >= 1e3 else f"{f:.4g} Hz"
+
+
+def _color(i: int) -> str:
+    return f"C{i % 10}"
+
+
+def _order_color(j: int) -> str:
+    return ("tab:red", "tab:purple", "tab:brown", "tab:olive", "tab:cyan")[j % 5]
