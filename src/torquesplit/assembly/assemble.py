@@ -161,12 +161,15 @@ def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None
                                  damping=c))
 
     # ---- supports
+    spline_members = {b for sp in model.splines.values() for b in sp.connects}
     for body in model.body_names():
         spec = model.gears.get(body) or model.bodies[body]
         tr = dmap.translation[body]
         if not tr:
             continue
         sup = spec.support
+        if sup is None and body in spline_members:
+            continue  # held radially by its spline (seed 002 floating pinion)
         if sup is None:
             raise ModelError([(f"{'gears' if body in model.gears else 'bodies'}.{body}.support",
                                f"DOFs {sorted(tr)} have no support; add a support with a "
