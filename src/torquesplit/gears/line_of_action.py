@@ -128,10 +128,14 @@ def placed_position(model, name, ref, ref_position, ref_axis, angle) -> np.ndarr
     """Centre of gear ``name`` placed from mating gear ``ref`` at a centre-line angle."""
     g, r = model.gears[name], model.gears[ref]
     direction = reference_direction(ref_axis, angle)
-    if is_conical(g, r):
+    if "face" in (g.gear_type, r.gear_type):
         raise ValueError(
-            f"gear {name!r} meshes with {ref!r} on crossed axes: 'place' is for parallel axes; "
-            f"give the bevel or face gear an explicit 'position' and 'axis'")
+            f"gear {name!r} meshes with {ref!r} as a face-gear pair: 'place' is for parallel "
+            f"axes; give the face gear and its pinion explicit 'position' and 'axis'")
+    if is_conical(g, r):
+        # a bevel pair's contact frame follows from the axes alone; the centre is put at
+        # the mating gear's pitch radius in the given direction (used for display only)
+        return ref_position + (r.teeth * r.module / 2) * direction
     pair = cylindrical_pair(r, g)
     return ref_position + pair.operating_center_distance * direction
 

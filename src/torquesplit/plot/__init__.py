@@ -41,10 +41,10 @@ rotation deg.  Coefficients are dimensionless ("[-]").
 
 Examples
 --------
->>> import torquesplit
+>>> import tempfile, torquesplit
 >>> from torquesplit.plot import write_figures
 >>> res = torquesplit.simulate(torquesplit.example_path("seed001_mill_drive"), cycles=20)
->>> paths = write_figures(res, "figures", formats=("png",))
+>>> paths = write_figures(res, tempfile.mkdtemp(), formats=("png", "svg"))
 """
 
 from __future__ import annotations

@@ -12,11 +12,15 @@ mesh stiffness in N/um (1 N/um = 1e6 N/m).
 
 Examples
 --------
->>> import torquesplit
+>>> import tempfile, torquesplit
 >>> from torquesplit.plot import figures
 >>> res = torquesplit.simulate(torquesplit.example_path("seed001_mill_drive"), cycles=20)
 >>> fig = figures.mesh_force_figure(res)
->>> paths = figures.write_figures(res, "figures", formats=("png",))
+>>> fig.axes[0].get_ylabel()
+'mesh force [kN]'
+>>> paths = figures.write_figures(res, tempfile.mkdtemp(), formats=("png",))
+>>> sorted(p.name for p in paths)[:2]
+['cycle_peak_force.png', 'load_sharing_engineering.png']
 """
 
 from __future__ import annotations
@@ -29,6 +33,7 @@ from typing import Iterable
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
+from matplotlib.ticker import NullFormatter
 
 from ..errors import TorquesplitError
 
@@ -54,11 +59,11 @@ _UM = 1e6  # m -> um
 _N_PER_UM = 1e-6  # N/m -> N/um
 
 _DEFINITION_TEXT = {
-    "cycle_peak": r"$N\,F_{\max,i}(k)\,/\,\sum_j F_{\max,j}(k)$ in each mesh cycle $k$",
-    "instantaneous": r"peak in each mesh cycle of $N\,F_i(t)\,/\,\sum_j F_j(t)$",
-    "engineering": r"peak in each mesh cycle of $N\,F_i(t)\,/\,\sum_j F_j(t)$",
-    "static_torque": r"peak in each mesh cycle of $N\,F_i(t)\,/\,\sum_j F_j(t)$",
-    "mean_force": r"$N\,\bar F_i(k)\,/\,\sum_j \bar F_j(k)$ in each mesh cycle $k$",
+    "cycle_peak": r"$N\,F_{\max,i}(k)\,/\,\Sigma_j F_{\max,j}(k)$ in each mesh cycle $k$",
+    "instantaneous": r"peak in each mesh cycle of $N\,F_i(t)\,/\,\Sigma_j F_j(t)$",
+    "engineering": r"peak in each mesh cycle of $N\,F_i(t)\,/\,\Sigma_j F_j(t)$",
+    "static_torque": r"peak in each mesh cycle of $N\,F_i(t)\,/\,\Sigma_j F_j(t)$",
+    "mean_force": r"$N\,\bar F_i(k)\,/\,\Sigma_j \bar F_j(k)$ in each mesh cycle $k$",
 }
 _REPORTED_TEXT = {
     "cycle_peak": "largest over settled cycles",
@@ -75,7 +80,7 @@ class FigureNotApplicableError(TorquesplitError, ValueError):
 
 # ============================================================ dynamic run figures
 def mesh_force_figure(results, *, last_cycles: float | None = None,
-                      max_points: int = 4000) -> Figure:
+                      band_above: float = 150.0, bins: int = 800) -> Figure:
     """Mesh force against time, one panel per load-sharing group, the paths overlaid.
 
     Parameters
@@ -85,9 +90,14 @@ def mesh_force_figure(results, *, last_cycles: float | None = None,
     last_cycles : float, optional
         Show only the last ``last_cycles`` mesh cycles of each group (each panel has its
         own time window).  Default: the whole run.
-    max_points : int
-        Longer histories are drawn as their min/max envelope on ``max_points`` points
-        per line (every peak and trough kept); shorter ones sample by sample.
+    band_above : float
+        A panel showing more than this many mesh cycles draws each mesh as the band
+        between its smallest and largest recorded force in each mesh cycle (or in runs of
+        whole cycles, at most ``bins`` per panel): every peak and trough of the history
+        is kept, and single cycles would not be visible anyway.  Fewer cycles are drawn
+        sample by sample.
+    bins : int
+        Largest number of time bins of a band.
 
     Returns
     -------
@@ -104,10 +114,30 @@ def mesh_force_figure(results, *, last_cycles: float | None = None,
     for ax, (g, members) in zip(axes, groups.items()):
         keep = np.ones(t.shape, bool)
         if last_cycles is not None and t.size:
-            keep = t >= t[-1] - last_cycles / freq[g]
+            # the end of the finite record (a diverged run stops being finite before t[-1])
+            finite = np.flatnonzero(np.isfinite(forces[:, [names.index(m) for m in members]])
+                                    .all(axis=1))
+            t_end = t[finite[-1]] if finite.size else t[-1]
+            keep = (t >= t_end - last_cycles / freq[g]) & (t <= t_end)
+        tk = t[keep]
+        n_cycles = (tk[-1] - tk[0]) * freq[g] if tk.size else 0.0
+        band = n_cycles > band_above
+        if band:  # bins of whole mesh cycles, so that each bin holds its cycle's peak
+            per_bin = math.ceil(n_cycles / bins)
+            # + 1e-6 cycle: a sample on a cycle boundary (t f integer up to rounding)
+            # always opens the new cycle, never sometimes closes the previous one
+            bin_index = np.floor((tk - tk[0]) * freq[g] / per_bin + 1e-6).astype(np.int64)
         for i, m in enumerate(members):
-            tt, ff = _envelope(t[keep], forces[keep, names.index(m)], max_points)
-            ax.plot(tt * scale, ff * _KN, color=_color(i), lw=1.0, label=m)
+            style = _line_style(i, len(members))
+            y = forces[keep, names.index(m)] * _KN
+            if band:
+                tb, lo, hi = _bin_extremes(tk, y, bin_index)
+                ax.fill_between(tb * scale, lo, hi, color=style["color"], alpha=0.2, lw=0,
+                                label=f"{m} (min-max band)")
+                ax.plot(tb * scale, hi, color=style["color"], lw=0.9)
+                ax.plot(tb * scale, lo, color=style["color"], lw=0.9)
+            else:
+                ax.plot(tk * scale, y, label=m, **style)
         _nominal_lines(ax, [nominal[m] for m in members])
         window = f", last {last_cycles:g} mesh cycles" if last_cycles is not None else ""
         ax.set_title(f"{_group_label(g, members)}, mesh frequency {_hz(freq[g])}{window}",
@@ -119,17 +149,17 @@ def mesh_force_figure(results, *, last_cycles: float | None = None,
     return fig
 
 
-def cycle_peak_figure(results, *, definition: str | None = None) -> Figure:
+def cycle_peak_figure(results) -> Figure:
     """Peak mesh force of every mesh cycle against the cycle's start time.
 
     One panel per load-sharing group; the nominal static force is dashed, the start of
-    the settled part (by the settle criterion of ``results.metrics(definition)``) is the
-    dotted vertical line and the transient before it is shaded.
+    the settled part (the settle criterion of :meth:`Results.metrics`, which works on
+    these peaks) is the dotted vertical line and the transient before it is shaded.
     """
     s = results.solution
     names, groups = results.mesh_names, results.groups
     nominal = results.nominal_forces()
-    settle = results.metrics(definition).settling.start_time
+    settle = results.metrics().settling.start_time
     cols = _cycle_columns(results)
     fig, axes = _panels(len(groups), sharex=True)
     scale, unit = _time_unit(s.history_t if s.history_t.size else s.cycle_start.ravel())
@@ -137,10 +167,9 @@ def cycle_peak_figure(results, *, definition: str | None = None) -> Figure:
         for i, m in enumerate(members):
             start, peak = s.cycle_start[:, cols[m]], _finite(s.cycle_max[:, cols[m]])
             ok = np.isfinite(peak)
-            ax.plot(start[ok] * scale, peak[ok] * _KN, color=_color(i), lw=1.0, label=m)
+            ax.plot(start[ok] * scale, peak[ok] * _KN, label=m, **_line_style(i, len(members)))
         _nominal_lines(ax, [nominal[m] for m in members])
-        _mark_settled(ax, settle * scale, s.cycle_start[:, [cols[m] for m in members]] * scale,
-                      unit)
+        _mark_settled(ax, settle * scale, s.t_span[0] * scale, unit)
         ax.set_title(_group_label(g, members), fontsize=FONT["title"])
         _label(ax, f"cycle start time [{unit}]", "peak force in cycle [kN]")
         _legend(ax)
@@ -184,13 +213,12 @@ def load_sharing_figure(results, definition: str | None = None) -> Figure:
     scale, unit = _time_unit(s.history_t if s.history_t.size else s.cycle_start.ravel())
     for ax, (g, members) in zip(axes, groups.items()):
         for i, m in enumerate(members):
-            ax.plot(cycle_t[m] * scale, coef[m], color=_color(i), lw=1.0, label=m)
+            ax.plot(cycle_t[m] * scale, coef[m], label=m, **_line_style(i, len(members)))
         ax.axhline(1.0, color="0.6", lw=0.8)
         ax.axhline(met.load_sharing.per_group[g], color=REFERENCE_COLOR, ls="--", lw=1.2,
-                   label=f"reported {met.load_sharing.per_group[g]:.4f}\n"
+                   label=f"reported {met.load_sharing.per_group[g]:.6g}\n"
                          f"({_REPORTED_TEXT[definition]})")
-        _mark_settled(ax, settle * scale, np.concatenate([cycle_t[m] for m in members]) * scale,
-                      unit)
+        _mark_settled(ax, settle * scale, s.t_span[0] * scale, unit)
         ax.set_title(_group_label(g, members), fontsize=FONT["title"])
         _label(ax, f"time [{unit}]", "load-sharing coefficient [-]")
         _legend(ax)
@@ -200,7 +228,8 @@ def load_sharing_figure(results, definition: str | None = None) -> Figure:
 
 
 def support_spectrum_figure(results, *, start_time: float | None = None, orders: int = 4,
-                            max_frequency: float | None = None,
+                            max_frequency: float | None = None, log: bool = True,
+                            dynamic_range: float = 1e-4,
                             bodies: Iterable[str] | None = None) -> Figure:
     """Amplitude spectrum of each support (bearing) force history, mesh orders marked.
 
@@ -217,6 +246,11 @@ def support_spectrum_figure(results, *, start_time: float | None = None, orders:
         frequency, at most the Nyquist frequency).
     max_frequency : float, optional
         Upper end of the frequency axis [Hz].
+    log : bool
+        Logarithmic amplitude axis spanning ``dynamic_range`` below the largest line
+        (mesh orders usually sit far below the shaft-rate lines of eccentricities).
+    dynamic_range : float
+        Smallest amplitude shown on a log axis, relative to the largest.
     bodies : iterable of str, optional
         Supported bodies to show (default all), one panel each.
 
@@ -225,7 +259,8 @@ def support_spectrum_figure(results, *, start_time: float | None = None, orders:
     Figure
         Single-sided amplitude spectrum [N] of the force minus its mean, Hann window
         (amplitude-corrected, so a sinusoid of amplitude A shows a peak of about A); the
-        legend gives each direction's mean force.
+        legend gives each direction's mean force and largest line.  Dotted: orders of
+        each mesh frequency; dash-dot grey: rotation frequency of the supported body.
     """
     s = results.solution
     el = results.structure.element_names
@@ -256,16 +291,27 @@ def support_spectrum_figure(results, *, start_time: float | None = None, orders:
     tk = t[keep]
     dt = float(np.median(np.diff(tk)))
     uniform = np.allclose(np.diff(tk), dt, rtol=1e-6, atol=0.0)
-    grid = tk if uniform else tk[0] + dt * np.arange(int((tk[-1] - tk[0]) / dt) + 1)
+    mesh_f = _distinct_mesh_frequencies(results)
+    # a whole number of periods of the slowest mesh: its orders fall on frequency bins
+    # (no scalloping loss of their amplitudes)
+    n = int((tk[-1] - tk[0]) / dt + 0.5) + 1
+    periods = math.floor((n * dt) * min(mesh_f) + 1e-6)
+    if periods >= 1:
+        n = min(n, max(16, int(round(periods / min(mesh_f) / dt))))
+    grid = tk[0] + dt * np.arange(n)
+    if uniform:
+        keep = np.flatnonzero(keep)[:n]
+        tk = t[keep]
     freq = np.fft.rfftfreq(grid.size, dt)
     window = np.hanning(grid.size)
-    mesh_f = _distinct_mesh_frequencies(results)
     f_top = max_frequency or min(freq[-1], (orders + 0.5) * max(mesh_f))
     fscale, funit = (1e-3, "kHz") if f_top >= 1e4 else (1.0, "Hz")
     show = freq <= f_top
     ncols = 1 if len(supports) <= 3 else 2
-    fig, axes = _panels(len(supports), ncols=ncols, sharex=True, row_height=2.5)
-    for ax, (body, dirs) in zip(axes, supports.items()):
+    fig, axes = _panels(len(supports), ncols=ncols, sharex=True, row_height=2.6)
+    for n_panel, (ax, (body, dirs)) in enumerate(zip(axes, supports.items())):
+        largest, size = 0.0, 0.0
+        lines = []
         for i, (direction, col) in enumerate(dirs):
             x = _finite(s.history_forces[keep, col])
             if not uniform:
@@ -273,22 +319,50 @@ def support_spectrum_figure(results, *, start_time: float | None = None, orders:
             mean = float(np.nanmean(x))
             spec = np.fft.rfft(np.nan_to_num(x - mean) * window)
             amp = 2.0 * np.abs(spec) / window.sum()
-            ax.plot(freq[show] * fscale, amp[show], color=_color(i), lw=1.0,
-                    label=f"{direction}  (mean {mean * _KN:.3g} kN)")
+            peak = int(np.argmax(np.where(show, amp, -1.0)))
+            lines.append((direction, mean, amp, peak))
+            largest = max(largest, float(amp[peak]))
+            size = max(size, float(np.nanmax(np.abs(x))))
+        quiet = largest <= 1e-9 * max(size, 1.0)  # rounding noise only
+        floor = largest * dynamic_range
+        for i, (direction, mean, amp, peak) in enumerate(lines):
+            y = np.maximum(amp[show], 0.1 * floor) if log and not quiet else amp[show]
+            style = _spike_style(i, len(dirs))
+            ax.plot(freq[show] * fscale, y, zorder=3, gid=f"{body}.support.{direction}",
+                    **style)
+            # the top of each strong line marked, so coinciding lines of x, y, z all show
+            tops = _spectral_lines(y, 0.01 * largest) if not quiet else np.zeros(0, int)
+            ax.plot(freq[show][tops] * fscale, y[tops], ls="none", marker=_MARKERS[i % 3],
+                    ms=5, mfc="none", mew=1.2, color=style["color"], zorder=4,
+                    label=f"{direction}: mean {_force_text(mean)},\n"
+                          f"largest {_force_text(amp[peak])} at {_hz(freq[peak])}")
         for j, (f, label) in enumerate(mesh_f.items()):
             for k in range(1, orders + 1):
                 if k * f <= f_top:
-                    ax.axvline(k * f * fscale, color=_order_color(j), ls=":", lw=1.1,
-                               label=f"{label}: $f_m$ = {_hz(f)} x 1..{orders}"
-                               if k == 1 else None)
+                    ax.axvline(k * f * fscale, color=_order_color(j), ls=":", lw=1.2, zorder=1,
+                               label=f"{label} mesh: {_hz(f)} x 1..{orders}"
+                               if k == 1 and n_panel == 0 else None)
+        f_rot = _rotation_frequency(results, body)
+        if f_rot is not None and 0 < f_rot <= f_top:
+            ax.axvline(f_rot * fscale, color="0.45", ls="-.", lw=1.0, zorder=1,
+                       label=f"rotation of {body}: {_hz(f_rot)}")
         ax.set_xlim(0, f_top * fscale)
-        ax.set_ylim(bottom=0)
+        if quiet:  # do not blow rounding noise up to full scale
+            ax.set_ylim(0, 1)
+            ax.text(0.5, 0.5, "no dynamic content (rounding noise only)", ha="center",
+                    va="center", transform=ax.transAxes, fontsize=FONT["label"])
+        elif log:
+            ax.set_yscale("log")
+            ax.set_ylim(floor, 2.0 * largest)
+            ax.yaxis.set_minor_formatter(NullFormatter())  # decades only: readable, fast
+        else:
+            ax.set_ylim(0, 1.08 * largest)
         ax.set_title(f"support of {body}", fontsize=FONT["title"])
         _label(ax, f"frequency [{funit}]", "force amplitude [N]")
         _legend(ax)
-    span = tk[-1] - tk[0]
-    _suptitle(fig, results, f"support force spectrum, t >= {t0:.4g} s "
-                            f"({span:.4g} s, resolution {1 / span:.3g} Hz)")
+    span = grid.size * dt
+    _suptitle(fig, results, f"support force spectrum, {grid[0]:.4g} s ≤ t < "
+                            f"{grid[0] + span:.4g} s (resolution {1 / span:.3g} Hz)")
     return fig
 
 
@@ -297,7 +371,9 @@ def orbit_figure(results, *, bodies: Iterable[str] | None = None) -> Figure:
 
     Works on a :class:`~torquesplit.quasistatic.QuasiStaticResults` (its
     :meth:`orbits`) and on a dynamic run whose ``history_dofs`` include ``<body>.x`` and
-    ``<body>.y``.  Equal aspect; ``+`` is the nominal centre, the circle the start.
+    ``<body>.y``.  Equal aspect, displacements from the nominal centre; each panel is
+    zoomed on its orbit: ``+`` marks the nominal centre when it is near the orbit, else the
+    panel title gives the mean offset from it.  The circle is the start.
     """
     orbits = _orbits(results)
     if bodies is not None:
@@ -316,7 +392,7 @@ def orbit_figure(results, *, bodies: Iterable[str] | None = None) -> Figure:
     n = len(orbits)
     ncols = min(n, 4)
     nrows = math.ceil(n / ncols)
-    fig = _figure(width=min(WIDTH * 1.4, 3.3 * ncols + 0.6), height=3.3 * nrows + 0.6)
+    fig = _figure(width=max(6.5, 3.4 * ncols + 0.4), height=3.5 * nrows + 0.7)
     axes = fig.subplots(nrows, ncols, squeeze=False).ravel()
     for ax in axes[n:]:
         ax.set_visible(False)
@@ -324,12 +400,20 @@ def orbit_figure(results, *, bodies: Iterable[str] | None = None) -> Figure:
         xy = _finite(xy) * _UM
         ax.plot(xy[:, 0], xy[:, 1], color=_color(0), lw=1.0)
         ax.plot(xy[:1, 0], xy[:1, 1], "o", color=_color(0), ms=5, mfc="none")
-        ax.plot([0.0], [0.0], "+", color=REFERENCE_COLOR, ms=9)
+        lo, hi = np.nanmin(xy, axis=0), np.nanmax(xy, axis=0)
+        reach = max(float(np.max(hi - lo)), 1e-12)
+        title = body
+        if np.all(lo - reach <= 0.0) and np.all(hi + reach >= 0.0):
+            ax.plot([0.0], [0.0], "+", color=REFERENCE_COLOR, ms=10, mew=1.5)
+        else:
+            mean = np.nanmean(xy, axis=0)
+            title += f"\nmean offset ({mean[0]:.3g}, {mean[1]:.3g}) µm"
         ax.set_aspect("equal", adjustable="datalim")
-        ax.set_title(body, fontsize=FONT["title"])
+        ax.set_title(title, fontsize=FONT["title"])
         _label(ax, "x [µm]", "y [µm]")
     kind = "quasi-static" if hasattr(results, "orbits") else "dynamic"
-    _suptitle(fig, results, f"floating orbits ({kind}); + nominal centre, o start")
+    _suptitle(fig, results, f"floating orbits ({kind})\n"
+                            "displacement from the nominal centre +, o start")
     return fig
 
 
@@ -350,8 +434,8 @@ def mesh_stiffness_figure(results, *, cycles: float = 2.0, points_per_cycle: int
         for i, m in enumerate(members):
             e = el.index(m)
             ax.plot(x, _stiffness_at_phase(st.stiffness_table[e], x + st.phase[e])
-                    * _N_PER_UM, color=_color(i), lw=1.2,
-                    label=f"{m} (mean {st.stiffness_table[e].mean() * _N_PER_UM:.4g} N/µm)")
+                    * _N_PER_UM, **_line_style(i, len(members)),
+                    label=f"{m} (mean {st.stiffness_table[e].mean() * _N_PER_UM:.5g} N/µm)")
         ax.set_xlim(0, cycles)
         ax.set_title(_group_label(g, members), fontsize=FONT["title"])
         _label(ax, "time [mesh cycles]", "mesh stiffness [N/µm]")
@@ -370,7 +454,8 @@ def static_mesh_force_figure(results) -> Figure:
     fig, axes = _panels(len(groups), sharex=True)
     for ax, (g, members) in zip(axes, groups.items()):
         for i, m in enumerate(members):
-            ax.plot(angle, forces[:, names.index(m)] * _KN, color=_color(i), lw=1.2, label=m)
+            ax.plot(angle, forces[:, names.index(m)] * _KN, label=m,
+                    **_line_style(i, len(members)))
         _nominal_lines(ax, [nominal[m] for m in members])
         ax.set_xlim(angle[0], angle[-1])
         ax.set_title(_group_label(g, members), fontsize=FONT["title"])
@@ -399,16 +484,16 @@ def static_load_sharing_figure(results) -> Figure:
     for ax, (g, members) in zip(axes, groups.items()):
         ratio = _share_ratio(forces[:, [names.index(m) for m in members]])
         for i, m in enumerate(members):
-            ax.plot(angle, ratio[:, i], color=_color(i), lw=1.2, label=m)
+            ax.plot(angle, ratio[:, i], label=m, **_line_style(i, len(members)))
         ax.axhline(1.0, color="0.6", lw=0.8)
         ax.axhline(met.per_group[g], color=REFERENCE_COLOR, ls="--", lw=1.2,
-                   label=f"reported {met.per_group[g]:.4f}\n(largest over positions)")
+                   label=f"reported {met.per_group[g]:.6g}\n(largest over positions)")
         ax.set_xlim(angle[0], angle[-1])
         ax.set_title(_group_label(g, members), fontsize=FONT["title"])
         _label(ax, xlabel, "static torque ratio [-]")
         _legend(ax)
     _suptitle(fig, results, "quasi-static load sharing, "
-                            r"$N\,F_i\,/\,\sum_j F_j$ at each position"
+                            r"$N\,F_i\,/\,\Sigma_j F_j$ at each position"
                             f"{_unconverged_note(results)}")
     return fig
 
@@ -452,7 +537,7 @@ def write_figures(results, directory, formats=("png", "svg"), *,
     jobs = [
         ("mesh_force", lambda: mesh_force_figure(results)),
         ("mesh_force_end", lambda: mesh_force_figure(results, last_cycles=last_cycles)),
-        ("cycle_peak_force", lambda: cycle_peak_figure(results, definition=definition)),
+        ("cycle_peak_force", lambda: cycle_peak_figure(results)),
         (f"load_sharing_{definition}", lambda: load_sharing_figure(results, definition)),
         ("support_force_spectrum", lambda: support_spectrum_figure(results)),
         ("orbits", lambda: orbit_figure(results)),
@@ -547,6 +632,18 @@ def _distinct_mesh_frequencies(results) -> dict[float, str]:
     return {f: ", ".join(gs) for f, gs in sorted(out.items())}
 
 
+def _spectral_lines(amp: np.ndarray, threshold: float) -> np.ndarray:
+    """Indices of local maxima of a spectrum above ``threshold``."""
+    inner = np.flatnonzero((amp[1:-1] >= amp[:-2]) & (amp[1:-1] > amp[2:])) + 1
+    return inner[amp[inner] > threshold]
+
+
+def _rotation_frequency(results, body: str) -> float | None:
+    """Rotation frequency [Hz] of a body, or None if the kinematics do not know it."""
+    info = getattr(results.kinematics, "bodies", {}).get(body)
+    return abs(info.speed) / (2 * math.pi) if info is not None else None
+
+
 def _cycle_columns(results) -> dict[str, int]:
     """Mesh -> column of the solution's cycle arrays."""
     s = results.solution
@@ -587,24 +684,18 @@ def _cycle_coefficients(results, definition, groups):
     return times, coef
 
 
-def _envelope(t: np.ndarray, y: np.ndarray, max_points: int):
-    """Min/max decimation: at most ``max_points`` points keeping each bin's extremes in
-    time order, so that peaks survive; the input itself when it is short enough."""
-    n = t.size
-    if n <= max_points:
-        return t, y
-    n_bins = max(max_points // 2, 1)
-    edges = np.linspace(0, n, n_bins + 1).astype(np.int64)
-    idx = []
-    for a, b in zip(edges[:-1], edges[1:]):
-        seg = y[a:b]
-        if not np.isfinite(seg).any():
-            idx.append(a)
-            continue
-        i_min, i_max = a + int(np.nanargmin(seg)), a + int(np.nanargmax(seg))
-        idx.extend(sorted({i_min, i_max}))
-    idx = np.asarray(idx)
-    return t[idx], y[idx]
+def _bin_extremes(t: np.ndarray, y: np.ndarray, bin_index: np.ndarray):
+    """Mid time, smallest and largest value of ``y`` in each run of equal, non-decreasing
+    ``bin_index``; a short (incomplete) last bin is left out."""
+    edges = np.flatnonzero(np.diff(bin_index, prepend=bin_index[0] - 1))
+    last = np.append(edges[1:], t.size) - 1
+    count = last - edges + 1
+    if count.size > 2 and count[-1] < 0.9 * np.median(count):
+        edges, last = edges[:-1], last[:-1]
+    with np.errstate(invalid="ignore"):
+        lo = np.fmin.reduceat(y[:last[-1] + 1], edges)
+        hi = np.fmax.reduceat(y[:last[-1] + 1], edges)
+    return 0.5 * (t[edges] + t[last]), lo, hi
 
 
 def _stiffness_at_phase(table: np.ndarray, phase: np.ndarray) -> np.ndarray:
@@ -669,9 +760,8 @@ def _panels(n: int, *, ncols: int = 1, sharex: bool = False, row_height: float =
     axes = fig.subplots(nrows, ncols, squeeze=False, sharex=sharex).ravel()
     for ax in axes[n:]:
         ax.set_visible(False)
-    if sharex and n < axes.size:  # the panel above an empty slot shows its x ticks
-        for ax in axes[max(n - ncols, 0):n]:
-            ax.xaxis.set_tick_params(labelbottom=True)
+    for ax in axes[:n]:  # every panel keeps its x tick labels (and unit label)
+        ax.xaxis.set_tick_params(labelbottom=True)
     return fig, list(axes[:n])
 
 
@@ -683,6 +773,12 @@ def _label(ax, xlabel: str, ylabel: str) -> None:
         if axis.get_scale() == "linear":
             axis.get_major_formatter().set_useOffset(False)
     ax.grid(True, alpha=0.3)
+    lo, hi = ax.dataLim.intervaly
+    size = max(abs(lo), abs(hi))
+    if np.isfinite(size) and hi - lo <= 1e-9 * size and ax.get_autoscaley_on():
+        # constant data: a +-2 % window instead of the 12th significant digit
+        pad = 0.02 * size if size > 0 else 1.0
+        ax.set_ylim(0.5 * (lo + hi) - pad, 0.5 * (lo + hi) + pad)
 
 
 def _legend(ax) -> None:
@@ -708,11 +804,31 @@ def _nominal_lines(ax, values) -> None:
                    label=f"nominal static\n{v * _KN:.4g} kN")
 
 
-def _mark_settled(ax, settle: float, times: np.ndarray, unit: str) -> None:
+def _mark_settled(ax, settle: float, start: float, unit: str) -> None:
+    """Dotted line at the settled start, the transient before it shaded."""
     ax.axvline(settle, color="0.3", ls=":", lw=1.4, label=f"settled from\n{settle:.4g} {unit}")
-    start = np.nanmin(times) if np.isfinite(times).any() else settle
     if settle > start:
         ax.axvspan(start, settle, color="0.85", alpha=0.6, lw=0, label="transient")
+
+
+_MARKERS = ("o", "s", "^")
+_DASHES = ("-", (0, (5, 2)), (0, (5, 2, 1, 2)), (0, (1.5, 1.5)))
+
+
+def _line_style(i: int, n: int) -> dict:
+    """Colour and dash of line i of n overlaid: a path lying on another (equal sharing)
+    still shows through the gaps of its dashes, and the paths stay apart in greyscale."""
+    return {"color": _color(i), "lw": 1.4, "ls": _DASHES[i % len(_DASHES)]}
+
+
+def _spike_style(i: int, n: int) -> dict:
+    """Colour and width of spectrum line i of n: earlier lines wider, so that coinciding
+    spectral lines show every colour."""
+    return {"color": _color(i), "lw": 0.9 + 0.9 * (n - 1 - i)}
+
+
+def _force_text(value: float) -> str:
+    return f"{value * _KN:.4g} kN" if abs(value) >= 1e3 else f"{value:.4g} N"
 
 
 def _group_label(group: str, members) -> str:

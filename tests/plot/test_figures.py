@@ -1,0 +1,329 @@
+"""Report figures: written, labelled with units, and drawing the run's own numbers."""
+
+from __future__ import annotations
+
+import dataclasses
+import re
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import torquesplit
+from torquesplit.plot import figures as F
+from torquesplit.quasistatic import quasi_static_load_sharing
+from torquesplit.results import Results
+from torquesplit.solve.reference import excitation_numpy
+
+from model_texts import split_model, write_model
+
+UNIT = re.compile(r"\[[^\]]+\]$")  # "force [kN]", "coefficient [-]"
+SPLIT_F = 1000.0  # mesh frequency of the split stage [Hz] (20 teeth at 3000 rpm)
+
+
+def _model_text() -> str:
+    """The two-path split with a floating, supported pinion, a time-varying stiffness on
+    the split stage and a 3 um error on mesh a1 (so the paths do not share equally)."""
+    text = split_model(error_a="3 um")
+    text = text.replace(
+        'position = ["0 mm", "0 mm", "0 mm"]\n',
+        'position = ["0 mm", "0 mm", "0 mm"]\ndofs = ["x", "y", "theta"]\n\n'
+        '[gears.pinion.support]\nstiffness = "2e8 N/m"\ndamping_ratio = 0.05\n', 1)
+    text = text.replace(
+        'stiffness = "4e8 N/m"\ndamping_ratio = 0.05\nstage = "split"',
+        'stiffness = {method = "constant", value = "4e8 N/m", peak_to_peak = 0.3}\n'
+        'damping_ratio = 0.05\nstage = "split"')
+    assert "[gears.pinion.support]" in text and "peak_to_peak" in text
+    return text
+
+
+@pytest.fixture(scope="module")
+def model(tmp_path_factory):
+    return torquesplit.load_model(write_model(tmp_path_factory.mktemp("plot"), _model_text()))
+
+
+@pytest.fixture(scope="module")
+def run(model):
+    res = torquesplit.simulate(model, cycles=40, history_dofs=["pinion.x", "pinion.y"])
+    assert res.success
+    return res
+
+
+@pytest.fixture(scope="module")
+def static(model):
+    return quasi_static_load_sharing(model)
+
+
+def _with_history(res, column_values: dict[str, np.ndarray]) -> Results:
+    """The same run with some element force histories replaced (by element name)."""
+    s = res.solution
+    forces = s.history_forces.copy()
+    names = [res.structure.element_names[e] for e in s.history_elements]
+    for name, values in column_values.items():
+        forces[:, names.index(name)] = values
+    return Results(model=res.model, kinematics=res.kinematics, structure=res.structure,
+                   static=res.static, solution=dataclasses.replace(s, history_forces=forces))
+
+
+def _panel(fig, title_start: str):
+    return next(ax for ax in fig.axes if ax.get_title().startswith(title_start))
+
+
+def _line(ax, label: str):
+    return next(ln for ln in ax.get_lines() if ln.get_label() == label)
+
+
+def _assert_labelled(fig, model_name: str):
+    visible = [ax for ax in fig.axes if ax.get_visible()]
+    assert visible
+    for ax in visible:
+        assert UNIT.search(ax.get_xlabel()), ax.get_xlabel()
+        assert UNIT.search(ax.get_ylabel()), ax.get_ylabel()
+        assert ax.get_title()
+    assert fig.get_suptitle().startswith(model_name)
+
+
+# ----------------------------------------------------------------------------- files
+def test_write_figures_writes_every_applicable_figure(run, tmp_path):
+    paths = F.write_figures(run, tmp_path / "out", formats=("png",), dpi=50,
+                            definition="cycle_peak", prefix="case1_")
+    names = sorted(p.name for p in paths)
+    assert names == sorted(f"case1_{n}.png" for n in (
+        "mesh_force", "mesh_force_end", "cycle_peak_force", "load_sharing_cycle_peak",
+        "support_force_spectrum", "orbits", "mesh_stiffness"))
+    for p in paths:
+        assert p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_write_static_figures_svg(static, tmp_path):
+    paths = F.write_static_figures(static, tmp_path, formats="svg")
+    assert sorted(p.name for p in paths) == [
+        "mesh_stiffness.svg", "static_load_sharing.svg", "static_mesh_force.svg",
+        "static_orbits.svg"]
+    for p in paths:
+        text = p.read_text(encoding="utf-8")
+        assert "<svg" in text and "two-path split" in text
+
+
+def test_writers_refuse_the_wrong_results_and_unknown_formats(run, static, tmp_path):
+    with pytest.raises(TypeError, match="write_static_figures"):
+        F.write_figures(static, tmp_path)
+    with pytest.raises(TypeError, match="write_figures"):
+        F.write_static_figures(run, tmp_path)
+    with pytest.raises(ValueError, match="choose formats among"):
+        F.write_figures(run, tmp_path, formats=("png", "docx"))
+    assert not list(tmp_path.iterdir())  # nothing written before the check
+
+
+def test_import_sets_no_backend_and_no_pyplot():
+    code = ("import sys, logging; "
+            "import torquesplit.plot.figures as f; "
+            "print('matplotlib.pyplot' in sys.modules, "
+            "bool(logging.getLogger('torquesplit.plot.figures').handlers))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True).stdout.split()
+    assert out == ["False", "False"]
+
+
+# ----------------------------------------------------------------------------- content
+def test_every_axis_has_a_unit_and_the_model_is_named(run, static):
+    name = run.model.model.name
+    figs = [F.mesh_force_figure(run), F.mesh_force_figure(run, last_cycles=3),
+            F.cycle_peak_figure(run), F.load_sharing_figure(run, "engineering"),
+            F.support_spectrum_figure(run), F.orbit_figure(run), F.mesh_stiffness_figure(run),
+            F.static_mesh_force_figure(static), F.static_load_sharing_figure(static),
+            F.orbit_figure(static)]
+    for fig in figs:
+        _assert_labelled(fig, name)
+        assert fig.get_layout_engine() is not None  # laid out, nothing clipped
+
+
+def test_mesh_force_lines_are_the_history(run):
+    fig = F.mesh_force_figure(run, last_cycles=3)
+    t, forces = run.mesh_force_history()
+    assert len(fig.axes) == len(run.groups) == 2
+    for g, members in run.groups.items():
+        ax = _panel(fig, f"group {g}")
+        assert ax.get_xlabel() == "time [ms]" and ax.get_ylabel() == "mesh force [kN]"
+        f_mesh = run.structure.metadata["meshes"][members[0]]["frequency"]
+        keep = t >= t[-1] - 3 / f_mesh
+        for m in members:
+            line = _line(ax, m)
+            np.testing.assert_allclose(line.get_xdata(), t[keep] * 1e3, rtol=1e-12)
+            np.testing.assert_allclose(line.get_ydata(),
+                                       forces[keep, run.mesh_names.index(m)] / 1e3, rtol=1e-12)
+        nominal = [ln for ln in ax.get_lines() if ln.get_label().startswith("nominal")]
+        assert len(nominal) == 1 and nominal[0].get_linestyle() == "--"
+        assert nominal[0].get_ydata()[0] == pytest.approx(run.nominal_forces()[members[0]] / 1e3)
+
+
+def test_long_histories_keep_every_peak_and_trough(run):
+    fig = F.mesh_force_figure(run, band_above=5.0)  # 40-80 cycles per panel: bands
+    t, forces = run.mesh_force_history()
+    for g, members in run.groups.items():
+        ax = _panel(fig, f"group {g}")
+        assert {f"{m} (min-max band)" for m in members} <= {
+            c.get_label() for c in ax.collections}
+        edges = [ln for ln in ax.get_lines() if not ln.get_label().startswith("nominal")]
+        assert len(edges) == 2 * len(members)
+        cols = [run.mesh_names.index(m) for m in members]
+        # the incomplete last mesh cycle is left out of the band
+        f_mesh = run.structure.metadata["meshes"][members[0]]["frequency"]
+        body = t <= t[-1] - 1.0 / f_mesh
+        # bands are whole mesh cycles: the incomplete last one is not a bin
+        assert max(ln.get_xdata()[-1] for ln in edges) <= (t[-1] - 0.5 / f_mesh) * 1e3 + 1e-9
+        top = max(ln.get_ydata().max() for ln in edges)
+        bottom = min(ln.get_ydata().min() for ln in edges)
+        assert top == pytest.approx(forces[body][:, cols].max() / 1e3, rel=1e-12)
+        assert bottom == pytest.approx(forces[body][:, cols].min() / 1e3, rel=1e-12)
+
+
+def test_constant_force_gets_a_readable_window(run):
+    t, forces = run.mesh_force_history()
+    nominal = run.nominal_forces()  # the symmetric split without error: force = nominal
+    flat = _with_history(run, {m: np.full(t.size, nominal[m]) for m in run.mesh_names})
+    ax = _panel(F.mesh_force_figure(flat), "group split")
+    lo, hi = ax.get_ylim()
+    assert hi - lo == pytest.approx(0.04 * nominal["a1"] / 1e3, rel=0.3)  # +-2 %, not 1e-12
+
+
+def test_cycle_peaks_against_cycle_start(run):
+    fig = F.cycle_peak_figure(run)
+    s = run.solution
+    settle = run.metrics().settling.start_time
+    for g, members in run.groups.items():
+        ax = _panel(fig, f"group {g}")
+        assert ax.get_xlabel() == "cycle start time [ms]"
+        for m in members:
+            j = run.mesh_names.index(m)
+            ok = np.isfinite(s.cycle_max[:, j])
+            line = _line(ax, m)
+            np.testing.assert_allclose(line.get_xdata(), s.cycle_start[ok, j] * 1e3)
+            np.testing.assert_allclose(line.get_ydata(), s.cycle_max[ok, j] / 1e3)
+        marker = next(ln for ln in ax.get_lines() if ln.get_label().startswith("settled"))
+        assert marker.get_xdata()[0] == pytest.approx(settle * 1e3)
+
+
+@pytest.mark.parametrize("definition", ["cycle_peak", "instantaneous", "mean_force"])
+def test_load_sharing_lines_reproduce_the_reported_coefficient(run, definition):
+    met = run.metrics(definition)
+    fig = F.load_sharing_figure(run, definition)
+    assert definition in fig.get_suptitle()
+    settle_ms = met.settling.start_time * 1e3
+    for g, members in run.groups.items():
+        ax = _panel(fig, f"group {g}")
+        lines = [_line(ax, m) for m in members]
+        # the coefficients of a group sum to its number of meshes in every cycle
+        if definition != "instantaneous":  # per-mesh cycle peaks need not coincide
+            total = sum(ln.get_ydata() for ln in lines)
+            np.testing.assert_allclose(total, len(members), rtol=1e-9)
+        reported = next(ln for ln in ax.get_lines() if ln.get_label().startswith("reported"))
+        assert reported.get_ydata()[0] == pytest.approx(met.load_sharing.per_group[g])
+        if definition in ("cycle_peak", "instantaneous"):  # reported = largest settled
+            for m, ln in zip(members, lines):
+                settled = ln.get_xdata() >= settle_ms
+                assert ln.get_ydata()[settled].max() == pytest.approx(
+                    met.load_sharing.per_mesh[m], rel=1e-6)
+    # the 3 um error on a1 moves load to b1
+    split = _panel(fig, "group split")
+    assert np.nanmean(_line(split, "b1").get_ydata()) > 1.0 > np.nanmean(
+        _line(split, "a1").get_ydata())
+
+
+def test_single_mesh_groups_have_no_coefficient_figure(run):
+    meta = {m: dict(v, stage=m) for m, v in run.structure.metadata["meshes"].items()}
+    lonely = Results(model=run.model, kinematics=run.kinematics, static=run.static,
+                     solution=run.solution,
+                     structure=dataclasses.replace(
+                         run.structure, metadata=dict(run.structure.metadata, meshes=meta)))
+    with pytest.raises(F.FigureNotApplicableError, match="same 'stage'"):
+        F.load_sharing_figure(lonely)
+
+
+def test_support_spectrum_finds_a_known_sinusoid(run):
+    t = run.solution.history_t
+    f0 = 2.0 * SPLIT_F  # second mesh order of the split stage
+    fake = _with_history(run, {"pinion.support.x": 500.0 + 123.0 * np.sin(2 * np.pi * f0 * t),
+                               "pinion.support.y": np.full(t.size, -40.0)})
+    fig = F.support_spectrum_figure(fake, start_time=0.0, log=False)
+    ax = _panel(fig, "support of pinion")
+    assert ax.get_xlabel() == "frequency [Hz]" and ax.get_ylabel() == "force amplitude [N]"
+    x = next(ln for ln in ax.get_lines() if ln.get_gid() == "pinion.support.x")
+    freq, amp = x.get_xdata(), x.get_ydata()
+    k = int(np.argmax(amp))
+    # the record is trimmed to whole periods of the slowest mesh (500 Hz): every mesh
+    # order lies on a frequency bin, so the Hann-windowed amplitude is the true one
+    periods = 500.0 / (freq[1] - freq[0])
+    assert periods == pytest.approx(round(periods), abs=1e-6) and periods >= 39
+    assert freq[k] == pytest.approx(f0, rel=1e-9)
+    assert amp[k] == pytest.approx(123.0, rel=1e-3)
+    legend = next(ln for ln in ax.get_lines() if ln.get_label().startswith("x:"))
+    assert "mean 500 N" in legend.get_label() and "largest 123 N at 2 kHz" in legend.get_label()
+    np.testing.assert_allclose(legend.get_xydata(), [[f0, amp[k]]])  # the one strong line
+    y = next(ln for ln in ax.get_lines() if ln.get_gid() == "pinion.support.y")
+    assert np.max(y.get_ydata()) < 1e-9  # a constant force has no spectrum
+    # mesh orders marked: 500 Hz (combine) and 1 kHz (split) and their harmonics
+    marks = {round(ln.get_xdata()[0], 6) for ln in ax.get_lines() if ln.get_linestyle() == ":"}
+    assert {500.0, 1000.0, 2000.0, 3000.0, 4000.0} <= marks
+
+
+def test_support_spectrum_without_supports_explains(run):
+    with pytest.raises(F.FigureNotApplicableError, match="choose among pinion"):
+        F.support_spectrum_figure(run, bodies=["out"])
+
+
+def test_orbit_in_micrometres_with_equal_aspect(run, static):
+    fig = F.orbit_figure(run)
+    ax = _panel(fig, "pinion")
+    assert (ax.get_xlabel(), ax.get_ylabel()) == ("x [µm]", "y [µm]")
+    assert ax.get_aspect() == 1.0
+    np.testing.assert_allclose(ax.get_lines()[0].get_xydata(),
+                               run.solution.history_q * 1e6, rtol=1e-12)
+    orbit = static.orbits()["pinion"] * 1e6
+    ax = _panel(F.orbit_figure(static), "pinion")
+    np.testing.assert_allclose(ax.get_lines()[0].get_xydata(), orbit, rtol=1e-12)
+
+
+def test_mesh_stiffness_is_the_assembled_table(run):
+    fig = F.mesh_stiffness_figure(run, cycles=2)
+    st = run.structure
+    ax = _panel(fig, "group split")
+    assert ax.get_ylabel() == "mesh stiffness [N/µm]"
+    for m in ("a1", "b1"):
+        e = st.element_names.index(m)
+        table = st.stiffness_table[e]
+        assert table.max() / table.min() > 1.2  # peak_to_peak 0.3: a real waveform
+        line = next(ln for ln in ax.get_lines() if ln.get_label().startswith(m))
+        x, y = line.get_xdata(), line.get_ydata()
+        assert x[0] == 0.0 and x[-1] == 2.0
+        # k(t) as the integrator's reference twin evaluates it, at t = x / f_mesh
+        expected = [excitation_numpy(st, xi / st.frequency[e]).stiffness[e] / 1e6
+                    for xi in x[::7]]
+        np.testing.assert_allclose(y[::7], expected, rtol=1e-9)
+
+
+def test_static_figures_follow_rotation_and_report(static):
+    names = static.mesh_names
+    forces = static.mesh_forces()
+    fig = F.static_mesh_force_figure(static)
+    ax = _panel(fig, "group split")
+    assert ax.get_xlabel() == "rotation of out [deg]"
+    line = _line(ax, "a1")
+    assert line.get_xdata()[0] == 0.0 and 300.0 < line.get_xdata()[-1] <= 360.0
+    np.testing.assert_allclose(line.get_ydata(), forces[:, names.index("a1")] / 1e3)
+    # positions without a converged equilibrium are left out, and the title says so
+    conv = static.solution.converged.copy()
+    conv[5] = False
+    broken = dataclasses.replace(static, solution=dataclasses.replace(static.solution,
+                                                                      converged=conv))
+    fig = F.static_mesh_force_figure(broken)
+    y = _line(_panel(fig, "group split"), "a1").get_ydata()
+    assert np.isnan(y[5]) and np.isfinite(np.delete(y, 5)).all()
+    assert "1 unconverged positions left out" in fig.get_suptitle()
+    met = static.metrics()
+    fig = F.static_load_sharing_figure(static)
+    for g, members in met.groups.items():
+        ax = _panel(fig, f"group {g}")
+        for m in members:
+            assert _line(ax, m).get_ydata().max() == pytest.approx(met.per_mesh[m], rel=1e-9)
