@@ -27,8 +27,9 @@ per-cycle peak / nominal force (seed 001 eq. 19, G_it).  The nominal static forc
 the equal-split tooth force of :mod:`torquesplit.model.kinematics`.
 
 The transient is excluded by a settle criterion: per-cycle peaks are averaged over
-windows of W cycles; the run is settled from the first window whose mean peak and
-largest peak both differ from the next window's by less than ``tolerance``.
+windows of W cycles (at least the longest excitation period); the run is settled from
+the earliest window after which every window's mean and largest peak stay within
+``tolerance`` of the last window's.
 """
 
 from __future__ import annotations
@@ -75,30 +76,47 @@ def group_meshes(mesh_meta: dict[str, dict]) -> dict[str, list[str]]:
     return groups
 
 
-def settle(cycle_max: np.ndarray, cycle_start: np.ndarray, names, window: int = 20,
+def settle(cycle_max: np.ndarray, cycle_start: np.ndarray, names, window=20,
            tolerance: float = 0.01) -> Settling:
-    """Find the first settled cycle of each mesh from its per-cycle peaks."""
+    """Find the first settled cycle of each mesh from its per-cycle peaks.
+
+    The peaks are averaged over consecutive windows of W cycles (``window``: one
+    value, or one per mesh; W should cover the longest excitation period, e.g. a
+    gear revolution when errors rotate with the gears).  The last window is the
+    reference; the run is settled from the earliest window after which every window's
+    mean and largest peak stay within ``tolerance`` of the reference (relative to the
+    reference's largest peak).  A slow drift that lasts until the end therefore leaves
+    only the last windows, and a run whose settled part is shorter than a quarter of
+    the run is reported as not settled.
+    """
     first = {}
     settled = True
     t0 = 0.0
     for j, name in enumerate(names):
         peaks = cycle_max[:, j]
         valid = np.isfinite(peaks)
-        peaks = peaks[valid]
         idx = np.flatnonzero(valid)
+        peaks = peaks[valid]
         n = peaks.size
-        k_set = None
-        w = max(2, min(window, n // 4))
-        for k in range(0, max(n - 2 * w + 1, 0), w):
-            a, b = peaks[k:k + w], peaks[k + w:k + 2 * w]
-            scale = max(abs(b).max(), 1e-300)
-            if (abs(a.mean() - b.mean()) <= tolerance * scale
-                    and abs(a.max() - b.max()) <= tolerance * scale):
-                k_set = k
-                break
-        if k_set is None:
+        w_req = int(window[j] if np.ndim(window) else window)
+        w = max(2, min(w_req, n // 4))
+        k_set = n // 2
+        ok = False
+        if n >= 2 * w:
+            n_win = n // w
+            start = n - n_win * w  # align the windows with the end of the run
+            blocks = peaks[start:].reshape(n_win, w)
+            ref_mean, ref_max = blocks[-1].mean(), blocks[-1].max()
+            scale = max(abs(ref_max), 1e-300)
+            good = ((np.abs(blocks.mean(axis=1) - ref_mean) <= tolerance * scale)
+                    & (np.abs(blocks.max(axis=1) - ref_max) <= tolerance * scale))
+            bad = np.flatnonzero(~good)
+            b0 = int(bad[-1]) + 1 if bad.size else 0
+            k_set = start + b0 * w if b0 else 0
+            ok = (n - k_set) >= n / 4
+        if not ok:
             settled = False
-            k_set = n // 2
+            k_set = min(k_set, n // 2)
         c = int(idx[k_set]) if n else 0
         first[name] = c
         if n:

@@ -127,7 +127,8 @@ class Results:
                              f"{', '.join(ls.DEFINITIONS)}")
         s = self.solution
         names = self.mesh_names
-        st = ls.settle(s.cycle_max, s.cycle_start, names, window, tolerance)
+        st = ls.settle(s.cycle_max, s.cycle_start, names, self.settle_windows(window),
+                       tolerance)
         groups = self.groups
         if definition == "cycle_peak":
             lsc = ls.cycle_peak(s.cycle_max, names, groups, st.first_cycle)
@@ -162,6 +163,22 @@ class Results:
                 contact_loss=float(s.separation_fraction[el.index(m)]),
             ))
         return Metrics(definition, st, lsc, dyn, rows)
+
+    def settle_windows(self, minimum: int = 20) -> list[int]:
+        """Cycles per settle window of each mesh: at least ``minimum`` and the longest
+        excitation period (slowest error sinusoid or backlash sequence) in its cycles."""
+        st = self.structure
+        slow = [w / (2 * math.pi) for w in np.abs(st.error_omega) if w > 0]
+        for e in range(st.n_elements):
+            n_gaps = st.gap_ptr[e + 1] - st.gap_ptr[e]
+            if n_gaps > 1 and st.frequency[e] > 0:
+                slow.append(st.frequency[e] / n_gaps)
+        f_slow = min(slow) if slow else None
+        out = []
+        for m in self.mesh_names:
+            f = self._mesh_meta[m]["frequency"]
+            out.append(max(minimum, int(math.ceil(f / f_slow))) if f_slow else minimum)
+        return out
 
     def mesh_force_history(self) -> tuple[np.ndarray, np.ndarray]:
         """Decimated time and mesh forces (n_samples, n_meshes) [s, N]."""
