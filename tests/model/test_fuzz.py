@@ -12,15 +12,24 @@ other exception is a bug: bad input must never end in a traceback.
 from __future__ import annotations
 
 import json
+
+import numpy as np
+import re
 import warnings
 
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, given, note, settings
 from hypothesis import strategies as st
 from model_fixtures import pair_dict, rich_dict
 
 import torquesplit
 from torquesplit.errors import ModelWarning
 from torquesplit.model.summary import summary
+
+#: words with which a message tells the user what to do
+_FIX_VERBS = re.compile(
+    r"\b(add|give|write|remove|correct|check|make|use|set|rename|delete|connect|fix|name|"
+    r"increase|reduce|list|put|change)\b"
+)
 
 #: units of every kind the schema knows, so that most picks have the wrong dimension
 WRONG_UNITS = [
@@ -29,9 +38,9 @@ WRONG_UNITS = [
     "1 m/s", "3 mm^2", "mm", "20", "",
 ]
 
-#: numbers at the edges: zero, negative, huge, tiny, beyond float range
-EDGE_NUMBERS = [0, 0.0, -1, -1.5, -1e-9, 1e300, -1e300, 10**30, 2**64, 10**400, -(10**400),
-                5e-324, 1e-300, 2**63 - 1]
+#: numbers at the edges: zero, negative, huge, tiny, beyond float range.
+EDGE_NUMBERS = [0, 0.0, -1, -1.5, -1e-9, 1e200, 1e300, -1e300, 10**30, 2**64, 10**400,
+                -(10**400), 1e-300, 5e-324, 2**63 - 1]
 
 #: names a mutation may rename a key to: other fields of the schema and typos
 FIELD_NAMES = [
@@ -59,7 +68,10 @@ junk = st.one_of(
 def _paths(obj, prefix=()):
     """Every path (tuple of keys/indices) to a value inside ``obj``."""
     out = []
-    items = obj.items() if isinstance(obj, dict) else enumerate(obj) if isinstance(obj, list) else ()
+    if isinstance(obj, dict):
+        items = obj.items()
+    else:
+        items = enumerate(obj) if isinstance(obj, list) else ()
     for key, value in items:
         out.append(prefix + (key,))
         out.extend(_paths(value, prefix + (key,)))
@@ -100,7 +112,11 @@ def _mutate(data, draw) -> str:
         value = json.loads(json.dumps(_parent(data, path)[path[-1]]))
         target = draw(st.sampled_from(["sibling", "gears", "bodies", "meshes", "drives", "loads"]))
         if target == "sibling":
-            _parent(data, path)[f"{path[-1]}_copy"] = value
+            parent = _parent(data, path)
+            if isinstance(parent, list):
+                parent.append(value)
+            else:
+                parent[f"{path[-1]}_copy"] = value
         else:
             data.setdefault(target, {})
             if isinstance(data[target], dict):
@@ -118,7 +134,7 @@ def test_mutated_model_is_valid_or_a_clean_model_error(seed, n_mutations, data):
         if not isinstance(model_dict, dict) or not _paths(model_dict):
             break
         steps.append(_mutate(model_dict, data.draw))
-    data.note(f"mutations: {steps}")
+    note(f"mutations: {steps}")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ModelWarning)
         warnings.simplefilter("ignore", RuntimeWarning)
@@ -129,13 +145,17 @@ def test_mutated_model_is_valid_or_a_clean_model_error(seed, n_mutations, data):
             for loc, msg in exc.issues:
                 assert isinstance(loc, str) and isinstance(msg, str) and msg.strip()
                 assert "Traceback" not in msg
+                # the message ends with what to do (names in it may contain ';' too)
+                assert ";" in msg and _FIX_VERBS.search(msg.split(";", 1)[1]), (loc, msg)
             return
-        # a valid model: the kinematics and the check summary must work too
+        # a valid model: the kinematics, the check summary and the assembly work too
         try:
             torquesplit.solve_kinematics(model)
             json.dumps(summary(model))
+            structure = torquesplit.assemble(model)
         except torquesplit.ModelError:
-            pass
+            return
+        assert np.all(np.isfinite(structure.inv_mass))
 
 
 def test_fixtures_are_valid():

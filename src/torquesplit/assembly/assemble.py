@@ -71,10 +71,12 @@ def number_dofs(model: Model, kin: Kinematics) -> tuple[DofMap, np.ndarray]:
                 names.append(f"{body}.{d}")
                 mass.append(bk.mass)
     m = np.asarray(mass)
-    if np.any(m <= 0):
+    with np.errstate(divide="ignore", over="ignore"):
+        inv = 1.0 / m
+    if np.any(m <= 0) or not np.all(np.isfinite(inv)):
         bad = [names[i] for i in np.flatnonzero(m <= 0)]
         raise ModelError([("", f"DOFs {bad} have no mass or inertia; give 'mass'/'polar_inertia'")])
-    return DofMap(theta=theta, translation=trans, names=tuple(names)), 1.0 / m
+    return DofMap(theta=theta, translation=trans, names=tuple(names)), inv
 
 
 def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None = None,

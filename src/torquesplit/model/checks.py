@@ -8,6 +8,7 @@ reported as :class:`~torquesplit.errors.ModelWarning`.
 from __future__ import annotations
 
 import math
+import re
 import warnings
 
 from ..errors import ModelError, ModelWarning
@@ -21,6 +22,8 @@ def check_model(model: Model, source: str | None = None) -> None:
         issues = topology_issues(model)
     if not issues:
         issues = mesh_compatibility_issues(model)
+    if not issues:
+        issues = geometry_issues(model) + support_issues(model)
     if issues:
         raise ModelError(issues, source)
     # the kinematic pass finds loops that cannot turn and power that does not balance
@@ -41,20 +44,29 @@ def reference_issues(model: Model) -> list[tuple[str, str]]:
     for name in set(model.gears) & set(model.bodies):
         issues.append((f"bodies.{name}", f"name {name!r} is used by a gear too; rename one"))
 
-    def need(loc, name, what="body"):
+    def need(loc, name):
         if name not in bodies:
-            issues.append((loc, f"{what} {name!r} does not exist; known bodies: {sorted(bodies)}"))
+            issues.append((loc, f"body {name!r} does not exist; {_one_of(bodies, 'bodies')}"))
 
+    mates: dict[str, set[str]] = {}
+    for m in model.meshes.values():
+        mates.setdefault(m.gears[0], set()).add(m.gears[1])
+        mates.setdefault(m.gears[1], set()).add(m.gears[0])
     for name, g in model.gears.items():
         if g.place is not None:
-            if g.place.from_gear not in model.gears:
-                issues.append((f"gears.{name}.place.from_gear",
-                               f"gear {g.place.from_gear!r} does not exist"))
+            ref, loc = g.place.from_gear, f"gears.{name}.place.from_gear"
+            if ref not in model.gears:
+                issues.append((loc, f"gear {ref!r} does not exist; {_one_of(model.gears, 'gears')}"))
+            elif ref not in mates.get(name, set()):
+                issues.append((loc, f"{name!r} is placed from {ref!r} but does not mesh with it; "
+                               f"name a gear it meshes with: {sorted(mates.get(name, set()))}, "
+                               f"or give 'position' instead"))
     for name, s in model.shafts.items():
         for b in s.connects:
             need(f"shafts.{name}.connects", b)
         if s.connects[0] == s.connects[1]:
-            issues.append((f"shafts.{name}.connects", "a shaft must join two different bodies"))
+            issues.append((f"shafts.{name}.connects", "a shaft must join two different "
+                           "bodies; name two different bodies in 'connects'"))
     for name, s in model.splines.items():
         for b in s.connects:
             need(f"splines.{name}.connects", b)
@@ -62,7 +74,7 @@ def reference_issues(model: Model) -> list[tuple[str, str]]:
         for g in m.gears:
             if g not in model.gears:
                 issues.append((f"meshes.{name}.gears",
-                               f"gear {g!r} does not exist; known gears: {sorted(model.gears)}"))
+                               f"gear {g!r} does not exist; {_one_of(model.gears, 'gears')}"))
     for name, d in model.drives.items():
         need(f"drives.{name}.body", d.body)
     for name, ld in model.loads.items():
@@ -72,6 +84,14 @@ def reference_issues(model: Model) -> list[tuple[str, str]]:
     if not model.loads:
         issues.append(("loads", "the model has no load; add a [loads.NAME] section"))
     return issues
+
+
+def _one_of(names, what: str) -> str:
+    """'use one of the gears [...]', or 'add a [gears.NAME] section first' if there is none."""
+    if names:
+        return f"use one of the {what} {sorted(names)}"
+    sections = "[gears.NAME] or [bodies.NAME]" if what == "bodies" else f"[{what}.NAME]"
+    return f"add a {sections} section first"
 
 
 def topology_issues(model: Model) -> list[tuple[str, str]]:
@@ -125,7 +145,8 @@ def mesh_compatibility_issues(model: Model) -> list[tuple[str, str]]:
         loc = f"meshes.{name}"
         if not math.isclose(a.module, b.module, rel_tol=1e-6):
             issues.append((loc, f"gears {m.gears[0]!r} and {m.gears[1]!r} cannot mesh: modules "
-                           f"{a.module * 1e3:g} mm and {b.module * 1e3:g} mm differ; make them equal"))
+                           f"{a.module * 1e3:g} mm and {b.module * 1e3:g} mm differ; "
+                           f"make them equal"))
         if not math.isclose(a.pressure_angle, b.pressure_angle, rel_tol=1e-6):
             issues.append((loc, f"gears {m.gears[0]!r} and {m.gears[1]!r} cannot mesh: pressure "
                            f"angles {math.degrees(a.pressure_angle):g} deg and "
@@ -135,34 +156,104 @@ def mesh_compatibility_issues(model: Model) -> list[tuple[str, str]]:
                                             abs_tol=1e-9):
             issues.append((loc, f"gears {m.gears[0]!r} and {m.gears[1]!r} cannot mesh: helix "
                            f"angles {math.degrees(a.helix_angle):g} deg and "
-                           f"{math.degrees(b.helix_angle):g} deg differ"))
+                           f"{math.degrees(b.helix_angle):g} deg differ in size; make them equal"))
         internal = [a.gear_type == "internal", b.gear_type == "internal"]
         if all(internal):
-            issues.append((loc, "two internal gears cannot mesh; one must be external"))
+            issues.append((loc, "two internal gears cannot mesh; make one of them external"))
         elif (not conical and a.helix_angle != 0 and a.hand is not None and b.hand is not None
               and not any(internal) and a.hand == b.hand
               and "double_helical" not in (a.gear_type, b.gear_type)):
             issues.append((loc, f"external helical gears {m.gears[0]!r} and {m.gears[1]!r} are both "
-                           f"{a.hand}-handed; meshing external helical gears need opposite hands"))
+                           f"{a.hand}-handed; meshing external helical gears need opposite hands: "
+                           f"change the 'hand' of one of them"))
+    return issues
+
+
+#: GearGeometry argument -> schema field of a gear
+_GEOMETRY_FIELDS = {
+    "teeth": "teeth", "normal_module": "module", "normal_pressure_angle": "pressure_angle",
+    "helix_angle": "helix_angle", "face_width": "face_width", "addendum": "profile_shift",
+    "double_helical": "kind", "internal": "kind",
+}
+
+
+def geometry_issues(model: Model) -> list[tuple[str, str]]:
+    """What the involute geometry refuses (too few teeth, interference...), by field.
+
+    Runs the geometry of :mod:`torquesplit.gears.geometry` on every gear and every
+    cylindrical pair before the kinematics, so that its errors name the model's fields.
+    """
+    from ..gears.line_of_action import cylindrical_pair, is_conical
+    from .kinematics import gear_geometry
+
+    issues = []
+    good = set()
+    for name, gear in model.gears.items():
+        try:
+            gear_geometry(gear)
+            good.add(name)
+        except ModelError as exc:
+            for loc, msg in exc.issues:
+                field = _GEOMETRY_FIELDS.get(loc.split(".")[-1])
+                issues.append((f"gears.{name}" + (f".{field}" if field else ""), _teach(msg)))
+    for name, mesh in model.meshes.items():
+        a, b = mesh.gears
+        ga, gb = model.gears[a], model.gears[b]
+        if not {a, b} <= good or is_conical(ga, gb):
+            continue
+        # the pair's messages say pinion (gear1) and wheel (gear2); an internal gear is
+        # put second: name the gears instead
+        role = {"pinion": b, "wheel": a} if ga.gear_type == "internal" else {"pinion": a, "wheel": b}
+        try:
+            cylindrical_pair(ga, gb).operating_center_distance  # noqa: B018 - validates
+        except ModelError as exc:
+            for _, msg in exc.issues:
+                msg = re.sub(r"\b(pinion|wheel)\b", lambda m: role[m.group()], msg)
+                issues.append((f"meshes.{name}", f"gears {a!r} and {b!r}: {_teach(msg)}"))
+    return issues
+
+
+def _teach(msg: str) -> str:
+    """A geometry message, ending with what to do if it does not already."""
+    return msg if ";" in msg else f"{msg}; correct the value"
+
+
+def support_issues(model: Model) -> list[tuple[str, str]]:
+    """Translational DOFs need a support to the housing (bearing or shaft bending)."""
+    issues = []
+    for kind, items in (("gears", model.gears), ("bodies", model.bodies)):
+        for name, body in items.items():
+            free = [d for d in body.dofs if d != "theta"]
+            if free and body.support is None:
+                issues.append((f"{kind}.{name}.support", (
+                    f"the translational DOFs {free} have no support; add one, e.g. "
+                    f"support = {{stiffness = '1e8 N/m'}}, or remove them from 'dofs'")))
     return issues
 
 
 def plausibility_warnings(model: Model, kin) -> list[tuple[str, str]]:
     """Values that can be right but usually are not."""
     out = []
+    ratios = [(f"shafts.{n}.damping_ratio", s.damping_ratio) for n, s in model.shafts.items()]
+    for kind, items in (("gears", model.gears), ("bodies", model.bodies)):
+        ratios += [(f"{kind}.{n}.support.damping_ratio", b.support.damping_ratio)
+                   for n, b in items.items() if b.support is not None]
+    ratios += [(f"meshes.{n}.damping_ratio", m.damping_ratio) for n, m in model.meshes.items()]
+    for loc, ratio in ratios:
+        if ratio is not None and ratio > 1:
+            out.append((loc, f"{ratio:g} is above critical damping (1); check the value "
+                             f"(typical 0.02-0.1)"))
     for name, mk in kin.meshes.items():
         m = model.meshes[name]
-        if m.damping_ratio is not None and m.damping_ratio > 1:
-            out.append((f"meshes.{name}.damping_ratio",
-                        f"{m.damping_ratio:g} is above critical damping (1); typical 0.02-0.1"))
         if m.damping is not None and mk.critical_damping > 0 and m.damping > mk.critical_damping:
             out.append((f"meshes.{name}.damping",
                         f"{m.damping:g} N s/m is {m.damping / mk.critical_damping:.1f} times "
-                        f"critical for this mesh; typical mesh damping ratios are 0.02-0.1"))
+                        f"critical for this mesh; check the value (typical mesh damping ratios "
+                        f"are 0.02-0.1)"))
         iso = mk.iso_stiffness
         spec = m.stiffness
         if spec.method == "constant" and iso and not (0.2 < spec.value / iso < 5):
             out.append((f"meshes.{name}.stiffness",
-                        f"{spec.value:.3g} N/m is {spec.value / iso:.2g} times the ISO 6336 estimate "
-                        f"c_gamma*b = {iso:.3g} N/m; check the value and its unit"))
+                        f"{spec.value:.3g} N/m is {spec.value / iso:.2g} times the ISO 6336 "
+                        f"estimate c_gamma*b = {iso:.3g} N/m; check the value and its unit"))
     return out

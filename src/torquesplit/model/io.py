@@ -2,8 +2,12 @@
 
 from __future__ import annotations
 
+import difflib
 import json
+import re
 import tomllib
+import types
+import typing
 import warnings
 from pathlib import Path
 from typing import Any
@@ -11,7 +15,8 @@ from typing import Any
 import pydantic
 
 from ..errors import ModelError
-from .schema import Model
+from .schema import FieldError, Model
+from .units import _short
 
 
 def load_model(source, *, check: bool = True) -> Model:
@@ -60,7 +65,8 @@ def read_file(path: Path) -> dict[str, Any]:
         raise ModelError([("", f"TOML syntax error: {exc}; fix the line it names")], str(path)) from None
     except json.JSONDecodeError as exc:
         raise ModelError(
-            [("", f"JSON syntax error at line {exc.lineno} column {exc.colno}: {exc.msg}")], str(path)
+            [("", f"JSON syntax error at line {exc.lineno} column {exc.colno}: {exc.msg}; "
+                  f"fix the file there")], str(path)
         ) from None
 
 
@@ -80,8 +86,12 @@ def _format_errors(exc: pydantic.ValidationError) -> list[tuple[str, str]]:
     out = []
     seen = set()
     for err in exc.errors(include_url=False):
-        loc = ".".join(str(p) for p in err["loc"] if not _is_internal_tag(p))
-        msg = _message(err)
+        parts = [str(p) for p in err["loc"] if not _is_internal_tag(p)]
+        error = (err.get("ctx") or {}).get("error")
+        if isinstance(error, FieldError):
+            parts.append(error.field)
+        loc = ".".join(parts)
+        msg = _message(err, parts)
         key = (loc, msg)
         if key not in seen:
             seen.add(key)
@@ -89,26 +99,111 @@ def _format_errors(exc: pydantic.ValidationError) -> list[tuple[str, str]]:
     return out
 
 
+#: a location part pydantic adds for a validator or a union member, not a field or key
+_INTERNAL_TAG = re.compile(r"^[a-z]+(-[a-z]+)*\[.*\]$")
+
+
 def _is_internal_tag(part) -> bool:
-    return isinstance(part, str) and ("[" in part or part.startswith("function-"))
+    return isinstance(part, str) and _INTERNAL_TAG.match(part) is not None
 
 
-def _message(err: dict) -> str:
+_SEE_DOCS = "see docs/model-file.md"
+
+_TABLE = ("must be a table of fields", f"write it as a [section] or {{key = value}} ({_SEE_DOCS})")
+
+#: pydantic error type -> (what the value must be, what to write instead)
+_TYPE_MESSAGES = {
+    "int": ("must be a whole number", "write an integer such as 20"),
+    "float": ("must be a number", "write a plain number such as 0.05"),
+    "finite_number": ("must be a finite number", "write a plain number such as 0.05"),
+    "string": ("must be text", 'write it in quotes, e.g. "pinion"'),
+    "bool": ("must be true or false", "write true or false"),
+    "dict": _TABLE,
+    "model": _TABLE,
+    "model_attributes": _TABLE,
+    "list": ("must be a list", "write it as [item, item, ...]"),
+    "tuple": ("must be a list", "write it as [item, item, ...]"),
+}
+
+
+def _message(err: dict, parts: list[str]) -> str:
     kind = err["type"]
-    value = err.get("input")
+    ctx = err.get("ctx") or {}
+    got = _short(err.get("input"))
     if kind == "extra_forbidden":
-        return f"unknown field (value {value!r}); check the spelling against docs/model-file.md"
+        name, section = (parts[-1], parts[:-1]) if parts else ("", [])
+        guess = difflib.get_close_matches(name, _fields_at(section), n=1, cutoff=0.6)
+        hint = f"did you mean {guess[0]!r}? " if guess else ""
+        return f"unknown field; {hint}check the spelling against docs/model-file.md"
     if kind == "missing":
-        return "required field is missing; add it"
+        if parts and parts[-1].isdigit():
+            return f"an item is missing (the list is too short); give all items ({_SEE_DOCS})"
+        return f"required field is missing; add it ({_SEE_DOCS})"
+    if kind in ("value_error", "assertion_error"):
+        msg = err["msg"]
+        for prefix in ("Value error, ", "Assertion failed, "):
+            if msg.startswith(prefix):
+                msg = msg[len(prefix):]
+        return msg
+    if kind == "greater_than":
+        fix = "give a positive value" if ctx.get("gt") == 0 else "correct the value"
+        return f"must be greater than {ctx.get('gt')}, got {got}; {fix}"
+    if kind == "greater_than_equal":
+        if ctx.get("ge") == 0:
+            return f"must not be negative, got {got}; give zero or a positive value"
+        return f"must be at least {ctx.get('ge')}, got {got}; correct the value"
+    if kind in ("less_than", "less_than_equal"):
+        bound = ctx.get("lt", ctx.get("le"))
+        word = "less than" if kind == "less_than" else "at most"
+        return f"must be {word} {bound}, got {got}; correct the value"
+    if kind == "literal_error":
+        return f"must be {ctx.get('expected')}, got {got}; use one of these"
+    if kind in ("too_long", "too_short"):
+        return f"{err['msg']}; give as many items as docs/model-file.md says"
+    # longest prefix first: 'model_attributes_type' before 'model_type'
+    for base in sorted(_TYPE_MESSAGES, key=len, reverse=True):
+        if kind.startswith(base):
+            what, fix = _TYPE_MESSAGES[base]
+            return f"{what}, got {got}; {fix}"
     msg = err["msg"]
-    for prefix in ("Value error, ", "Assertion failed, "):
-        if msg.startswith(prefix):
-            msg = msg[len(prefix):]
-    if kind in ("greater_than", "greater_than_equal", "less_than", "less_than_equal"):
-        return f"{msg}, got {value!r}; correct the value"
-    if kind.endswith("_parsing") or kind.endswith("_type") or kind == "literal_error":
-        return f"{msg}, got {value!r}"
-    return msg
+    if msg.startswith("Input should be "):
+        msg = "must be " + msg[len("Input should be "):]
+    return f"{msg}, got {got}; correct the value ({_SEE_DOCS})"
+
+
+def _fields_at(parts: list[str]) -> list[str]:
+    """Field names of the schema section at location ``parts`` ([] if there is none)."""
+    node = Model
+    for part in parts:
+        node = _strip(node)
+        if isinstance(node, type) and issubclass(node, pydantic.BaseModel):
+            field = node.model_fields.get(part)
+            if field is None:
+                return []
+            node = field.annotation
+        elif typing.get_origin(node) is dict:
+            node = typing.get_args(node)[1]
+        else:
+            return []
+    node = _strip(node)
+    if isinstance(node, type) and issubclass(node, pydantic.BaseModel):
+        return list(node.model_fields)
+    return []
+
+
+def _strip(tp):
+    """``X | None`` and ``Annotated[X, ...]`` -> ``X``."""
+    while True:
+        origin = typing.get_origin(tp)
+        if origin is typing.Annotated:
+            tp = typing.get_args(tp)[0]
+        elif origin in (typing.Union, types.UnionType):
+            args = [a for a in typing.get_args(tp) if a is not type(None)]
+            if len(args) != 1:
+                return tp
+            tp = args[0]
+        else:
+            return tp
 
 
 def model_to_dict(model: Model) -> dict[str, Any]:

@@ -211,7 +211,8 @@ def solve_kinematics(model: Model) -> Kinematics:
                   for g in (driver, driven))
         # equivalent mass of the mesh, m = J1 J2 / (J1 r2^2 + J2 r1^2), with the arms
         # as the effective base radii (issue 2; seed 001 eq. 1 corrected)
-        m_eq = ja * jb / (ja * arm_n**2 + jb * arm_d**2)
+        den = ja * arm_n**2 + jb * arm_d**2
+        m_eq = ja * jb / den if den > 0 else 0.0
         spec = mesh.stiffness
         k_mean = _mean_stiffness(spec)
         crit = 2 * math.sqrt(k_mean * m_eq) if k_mean else 0.0

@@ -22,7 +22,11 @@ from .units import KINDS, parse_quantity
 
 
 class Unit:
-    """Annotation marker: the field is a physical quantity of this kind."""
+    """Annotation marker: the field is a physical quantity of this kind.
+
+    On a table field (mesh ``stiffness``, ``backlash``) it marks the shorthand: a single
+    quantity of this kind stands for the table.
+    """
 
     def __init__(self, kind: str):
         self.kind = kind
@@ -57,17 +61,29 @@ Dof = Literal["x", "y", "z", "theta"]
 
 
 class Strict(BaseModel):
-    """Base of every schema section: unknown fields are errors."""
+    """Base of every schema section: unknown fields are errors, numbers must be finite."""
 
-    model_config = ConfigDict(extra="forbid", validate_default=True, frozen=True)
+    model_config = ConfigDict(extra="forbid", validate_default=True, frozen=True,
+                              allow_inf_nan=False)
+
+
+class FieldError(ValueError):
+    """A check across fields that failed on one of them.
+
+    Raised inside a section's validator; :mod:`torquesplit.model.io` appends ``field``
+    to the section's location, so that the message names ``gears.g1.hand``, not ``gears.g1``.
+    """
+
+    def __init__(self, field: str, message: str):
+        super().__init__(message)
+        self.field = field
 
 
 def _check_angle(v: float, name: str, upper_deg: float) -> float:
     if not (-math.radians(upper_deg) <= v <= math.radians(upper_deg)):
-        raise ValueError(
-            f"{name} of {v:g} rad ({math.degrees(v):g} deg) is outside +/-{upper_deg:g} deg; "
-            f"write angles with their unit, e.g. '20 deg'"
-        )
+        raise FieldError(name, (
+            f"{v:g} rad ({math.degrees(v):g} deg) is outside +/-{upper_deg:g} deg; a bare number "
+            f"is read in radians: if you meant {v:g} degrees, write '{v:g} deg'"))
     return v
 
 
@@ -88,9 +104,9 @@ class ShaftBending(Strict):
     @model_validator(mode="after")
     def _inside(self):
         if self.position >= self.span:
-            raise ValueError(
-                f"position {self.position:g} m must lie between the bearings (span {self.span:g} m)"
-            )
+            raise FieldError("position", (
+                f"{self.position:g} m must lie between the bearings (span {self.span:g} m); "
+                f"correct 'position' or 'span'"))
         return self
 
 
@@ -117,11 +133,12 @@ class Support(Strict):
     @model_validator(mode="after")
     def _one_stiffness(self):
         if self.stiffness is None and self.shaft is None:
-            raise ValueError("give either 'stiffness' or a [shaft] bending description")
+            raise ValueError("the support has no stiffness; give 'stiffness' (e.g. '1e8 N/m') "
+                             "or a 'shaft' bending description")
         if self.stiffness is not None and self.shaft is not None:
-            raise ValueError("give either 'stiffness' or 'shaft', not both")
+            raise ValueError("both 'stiffness' and 'shaft' are given; remove one of them")
         if self.damping is not None and self.damping_ratio is not None:
-            raise ValueError("give either 'damping' or 'damping_ratio', not both")
+            raise ValueError("both 'damping' and 'damping_ratio' are given; remove one of them")
         return self
 
 
@@ -156,7 +173,7 @@ class Placement(Strict):
 class Gear(Strict):
     """A gear: one rigid body with involute teeth."""
 
-    teeth: int = Field(gt=0, description="Number of teeth.")
+    teeth: int = Field(gt=0, le=10_000, description="Number of teeth.")
     module: Length = Field(gt=0, description="Normal module.")
     pressure_angle: Angle = Field(math.radians(20.0), description="Normal pressure angle.")
     helix_angle: Angle = Field(0.0, description="Helix angle (spiral angle for bevel gears).")
@@ -167,7 +184,7 @@ class Gear(Strict):
         None, description="Gear type; default spur, or helical when a helix angle is given."
     )
     face_width: Length = Field(gt=0, description="Face width (of one helix for double-helical).")
-    profile_shift: float = Field(0.0, description="Profile shift coefficient x.")
+    profile_shift: float = Field(0.0, ge=-5, le=5, description="Profile shift coefficient x.")
     cone_angle: Angle | None = Field(
         None, description="Pitch cone angle of a bevel gear (default from the shaft angle)."
     )
@@ -193,11 +210,11 @@ class Gear(Strict):
         _check_angle(self.pressure_angle, "pressure_angle", 45)
         _check_angle(self.helix_angle, "helix_angle", 60)
         if self.helix_angle != 0 and self.hand is None:
-            raise ValueError("a gear with a helix angle needs 'hand' ('right' or 'left')")
+            raise FieldError("hand", "a gear with a helix angle needs a hand; add "
+                             "hand = 'right' or hand = 'left'")
         if self.position is not None and self.place is not None:
-            raise ValueError("give either 'position' or 'place', not both")
-        if math.hypot(*self.axis) == 0:
-            raise ValueError("'axis' must not be the zero vector")
+            raise ValueError("both 'position' and 'place' are given; remove one of them")
+        _check_axis(self.axis)
         _unique_dofs(self.dofs)
         return self
 
@@ -220,15 +237,23 @@ class Body(Strict):
 
     @model_validator(mode="after")
     def _consistent(self):
+        _check_axis(self.axis)
         _unique_dofs(self.dofs)
         if any(d != "theta" for d in self.dofs) and self.mass is None:
-            raise ValueError("a body with translational DOFs needs a 'mass'")
+            raise FieldError("mass", "a body with translational DOFs needs a mass; add "
+                             "mass = '12.5 kg' (your value), or remove x, y, z from 'dofs'")
         return self
 
 
 def _unique_dofs(dofs):
     if len(set(dofs)) != len(dofs):
-        raise ValueError(f"'dofs' lists a DOF twice: {dofs}")
+        raise FieldError("dofs", f"{dofs} lists a DOF twice; list each DOF once")
+
+
+def _check_axis(axis):
+    if not math.hypot(*axis) > 0:
+        raise FieldError("axis", "the zero vector has no direction; give a direction such as "
+                         "[0, 0, 1]")
 
 
 # --------------------------------------------------------------------------- connections
@@ -255,12 +280,14 @@ class Shaft(Strict):
             return self
         if self.torsional_stiffness is None and (self.diameter is None or self.length is None):
             raise ValueError(
-                "give 'torsional_stiffness', or 'diameter' and 'length', or rigid = true"
+                "the shaft has no stiffness; give 'torsional_stiffness' (e.g. '2.5e6 N m/rad'), "
+                "or 'diameter' and 'length', or rigid = true"
             )
         if self.diameter is not None and self.inner_diameter >= self.diameter:
-            raise ValueError("'inner_diameter' must be smaller than 'diameter'")
+            raise FieldError("inner_diameter", "must be smaller than 'diameter'; correct one "
+                             "of them")
         if self.damping is not None and self.damping_ratio is not None:
-            raise ValueError("give either 'damping' or 'damping_ratio', not both")
+            raise ValueError("both 'damping' and 'damping_ratio' are given; remove one of them")
         return self
 
 
@@ -287,16 +314,21 @@ class StiffnessSpec(Strict):
     def _complete(self):
         m = self.method
         if m == "constant" and self.value is None:
-            raise ValueError("method 'constant' needs 'value'")
+            raise FieldError("value", "method 'constant' needs the mean stiffness; add "
+                             "value = '4e8 N/m' (your value)")
         if m == "table":
             if not self.phase or not self.values or len(self.phase) != len(self.values):
-                raise ValueError("method 'table' needs 'phase' and 'values' of equal length")
+                raise ValueError("method 'table' needs 'phase' and 'values' lists of equal "
+                                 "length; give one stiffness per phase")
             if any(not 0 <= p < 1 for p in self.phase):
-                raise ValueError("table 'phase' values must lie in [0, 1)")
+                raise FieldError("phase", f"{self.phase} has values outside [0, 1); give "
+                                 "phases as fractions of one mesh cycle")
             if any(v <= 0 for v in self.values):
-                raise ValueError("table stiffness 'values' must be positive")
+                raise FieldError("values", "table stiffness values must be positive; correct "
+                                 "them")
         if m == "fourier" and self.mean is None:
-            raise ValueError("method 'fourier' needs 'mean'")
+            raise FieldError("mean", "method 'fourier' needs the mean stiffness; add "
+                             "mean = '4e8 N/m' (your value)")
         return self
 
 
@@ -336,7 +368,8 @@ def _balanced_or_torque(v):
         return None
     x = parse_quantity(v, "torque")
     if x <= 0:
-        raise ValueError("the load torque must be positive (its direction follows the speed)")
+        raise ValueError("the load torque must be positive (its direction follows the speed); "
+                         "give its magnitude, or \"balanced\"")
     return x
 
 
@@ -345,7 +378,9 @@ class Mesh(Strict):
 
     gears: tuple[str, str] = Field(description="The two gears in mesh.")
     driver: str | None = Field(None, description="Which gear drives; from the power flow if omitted.")
-    stiffness: Annotated[StiffnessSpec, BeforeValidator(_stiffness_shorthand)] = Field(
+    stiffness: Annotated[
+        StiffnessSpec, BeforeValidator(_stiffness_shorthand), Unit("stiffness")
+    ] = Field(
         description="Mean mesh stiffness (\"4.5e9 N/m\"), or a [stiffness] table with a method."
     )
     damping: Damping | None = Field(None, ge=0, description="Mesh damping.")
@@ -353,7 +388,9 @@ class Mesh(Strict):
         None, ge=0, description="Mesh damping as a fraction of critical, with the equivalent mass "
         "m = J1 J2 / (J1 r2^2 + J2 r1^2)."
     )
-    backlash: Annotated[BacklashSpec, BeforeValidator(_backlash_shorthand)] = Field(
+    backlash: Annotated[
+        BacklashSpec, BeforeValidator(_backlash_shorthand), Unit("length")
+    ] = Field(
         0.0, description="Total backlash (\"100 um\"; 0 = none), or a [backlash] table."
     )
     transmission_error: TransmissionError = Field(TransmissionError(), description="Extra LOA error.")
@@ -367,11 +404,13 @@ class Mesh(Strict):
     @model_validator(mode="after")
     def _consistent(self):
         if self.gears[0] == self.gears[1]:
-            raise ValueError("a gear cannot mesh with itself")
+            raise FieldError("gears", f"{self.gears[0]!r} cannot mesh with itself; name two "
+                             "different gears")
         if self.driver is not None and self.driver not in self.gears:
-            raise ValueError(f"driver {self.driver!r} is not one of the mesh's gears {list(self.gears)}")
+            raise FieldError("driver", f"{self.driver!r} is not one of the mesh's gears "
+                             f"{list(self.gears)}; name one of them or remove 'driver'")
         if self.damping is not None and self.damping_ratio is not None:
-            raise ValueError("give either 'damping' or 'damping_ratio', not both")
+            raise ValueError("both 'damping' and 'damping_ratio' are given; remove one of them")
         return self
 
 
@@ -400,10 +439,14 @@ class Drive(Strict):
 
     @model_validator(mode="after")
     def _one(self):
-        if (self.power is None) == (self.torque is None):
-            raise ValueError("give exactly one of 'power' and 'torque'")
-        if self.speed == 0:
-            raise ValueError("'speed' must not be zero")
+        if self.power is not None and self.torque is not None:
+            raise ValueError("both 'power' and 'torque' are given; remove one of them")
+        if self.power is None and self.torque is None:
+            raise ValueError("the drive has neither 'power' nor 'torque'; add one of them, e.g. "
+                             "torque = '100 N m'")
+        if abs(self.speed) < 1e-6:
+            raise FieldError("speed", "must not be zero (below 1e-6 rad/s); give the nominal "
+                             "speed, e.g. '3000 rpm'")
         return self
 
     @property
@@ -416,7 +459,7 @@ class Load(Strict):
     """A power output: a resisting torque at a body."""
 
     body: str = Field(description="The loaded body.")
-    torque: Annotated[float | None, BeforeValidator(_balanced_or_torque)] = Field(
+    torque: Annotated[float | None, BeforeValidator(_balanced_or_torque), Unit("torque")] = Field(
         "balanced", description="Resisting torque magnitude, or 'balanced' to take all input power."
     )
     speed_coefficient: TorsionalDamping = Field(
@@ -439,6 +482,8 @@ class Analysis(Strict):
 
 
 class ModelInfo(Strict):
+    """Name and source of the model."""
+
     name: str = Field(description="Short name of the model.")
     description: str = Field("", description="One-line description.")
     reference: str = Field("", description="Source of the data (paper, drawing).")
@@ -447,7 +492,7 @@ class ModelInfo(Strict):
 class Model(Strict):
     """A complete gearbox description (all values SI after validation)."""
 
-    model: ModelInfo
+    model: ModelInfo = Field(description="Name, description and source of the model.")
     gears: dict[str, Gear] = Field(description="Gears by name.")
     bodies: dict[str, Body] = Field({}, description="Other rigid bodies by name.")
     shafts: dict[str, Shaft] = Field({}, description="Shafts by name.")

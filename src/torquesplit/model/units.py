@@ -9,6 +9,8 @@ number, which is read in the kind's SI unit (given in :data:`KINDS`).
 from __future__ import annotations
 
 import math
+import numbers
+import re
 from functools import lru_cache
 
 import pint
@@ -54,42 +56,66 @@ def parse_quantity(value, kind: str) -> float:
     Raises ``ValueError`` with a message that says what was expected.
     """
     si_unit, example = KINDS[kind]
-    if isinstance(value, bool):
-        raise ValueError(f"expected {_label(kind)} such as '{example}', got {value!r}")
-    if isinstance(value, (int, float)):
-        x = float(value)
-    elif isinstance(value, str):
+    hint = f"write {_label(kind)} such as '{example}' (a bare number is read in {si_unit})"
+    if isinstance(value, bool) or not isinstance(value, (numbers.Real, str)):
+        raise ValueError(f"got {_short(value)}; {hint}")
+    if isinstance(value, str):
         x = _parse_string(value, kind)
     else:
-        raise ValueError(
-            f"expected {_label(kind)} such as '{example}' (a number is read in {si_unit}), "
-            f"got {value!r}"
-        )
+        try:
+            x = float(value)
+        except OverflowError:
+            x = math.inf
     if not math.isfinite(x):
-        raise ValueError(f"expected a finite {_label(kind)[2:].strip()}, got {value!r}")
+        raise ValueError(f"got {_short(value)}, which is not a finite number; {hint}")
     return x
+
+
+#: a number literal; pint evaluates integer literals exactly, so that "10**10**10 mm"
+#: would not finish: they are read as floats instead (see _floats)
+_NUMBER = re.compile(r"(?<![\w.])(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?(?![\w.])")
+
+
+def _floats(text: str) -> str:
+    """``text`` with every integer literal written as a float ("10**3" -> "10.0**3.0")."""
+    return _NUMBER.sub(lambda m: m.group() + ".0" if m.group().isdigit() else m.group(), text)
 
 
 def _parse_string(text: str, kind: str) -> float:
     ureg = registry()
     si_unit, example = KINDS[kind]
     try:
-        q = ureg.Quantity(text.strip())
+        q = ureg.Quantity(_floats(text.strip()))
+        if not isinstance(q, pint.Quantity):  # pragma: no cover - older pint: a bare number
+            q = ureg.Quantity(float(q))
     except Exception:
         raise ValueError(
             f"cannot read {text!r} as {_label(kind)}; write a number and a unit, e.g. '{example}'"
         ) from None
     ref = _reference(kind)
-    if not isinstance(q, pint.Quantity):  # a bare number in a string
-        return float(q)
     if q.dimensionality != ref.dimensionality:
+        if _is_number(text):
+            fix = f"add the unit, e.g. '{text.strip()} {example.split(' ', 1)[1]}'"
+        else:
+            fix = f"write it in {si_unit} or a compatible unit, e.g. '{example}'"
         raise ValueError(
-            f"{text!r} is not {_label(kind)} (its dimension is {_dimension_text(q)}); "
-            f"write it in {si_unit} or a compatible unit, e.g. '{example}'"
+            f"{text!r} is not {_label(kind)} (its dimension is {_dimension_text(q)}); {fix}"
         )
     if kind == "angle" and not (q.unitless or _is_angle_unit(q)):
         raise ValueError(f"{text!r} is not an angle; write e.g. '{example}'")
-    return float(q.to(si_unit).magnitude)
+    try:
+        magnitude = q.to(si_unit).magnitude
+        return float(magnitude) if isinstance(magnitude, (int, float)) else math.nan
+    except (ArithmeticError, TypeError, ValueError):
+        return math.nan
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+        return True
+    except ValueError:
+        return False
 
 
 def _is_angle_unit(q) -> bool:
@@ -103,6 +129,12 @@ def _is_angle_unit(q) -> bool:
 def _dimension_text(q) -> str:
     dim = str(q.dimensionality)
     return "dimensionless" if dim == "dimensionless" else dim
+
+
+def _short(value, limit: int = 60) -> str:
+    """repr of a value for a message, shortened to ``limit`` characters."""
+    text = repr(value)
+    return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
 def _label(kind: str) -> str:
