@@ -178,7 +178,12 @@ def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None
                                f"stiffness, or remove them from 'dofs'")])
         k_rad = support_stiffness(sup)
         for d, j in tr.items():
-            k = k_rad if d != "z" else (sup.axial_stiffness or k_rad)
+            if d == "z":
+                k = sup.axial_stiffness or k_rad
+            elif d == "y" and sup.stiffness_y is not None:
+                k = sup.stiffness_y
+            else:
+                k = k_rad
             m = kin.bodies[body].mass
             if sup.damping is not None:
                 c = sup.damping

@@ -116,6 +116,9 @@ class Support(Strict):
     stiffness: Stiffness | None = Field(
         None, gt=0, description="Radial stiffness (x and y) of the support."
     )
+    stiffness_y: Stiffness | None = Field(
+        None, gt=0, description="Stiffness in y when it differs from x (defaults to 'stiffness')."
+    )
     axial_stiffness: Stiffness | None = Field(
         None, gt=0, description="Axial stiffness (z); defaults to the radial stiffness."
     )
@@ -248,6 +251,9 @@ class Body(Strict):
 def _unique_dofs(dofs):
     if len(set(dofs)) != len(dofs):
         raise FieldError("dofs", f"{dofs} lists a DOF twice; list each DOF once")
+    if "theta" not in dofs:
+        raise FieldError("dofs", f"{dofs} has no 'theta': every body turns about its axis; "
+                         f"add 'theta' to 'dofs'")
 
 
 def _check_axis(axis):
@@ -351,6 +357,27 @@ class TransmissionError(Strict):
     phase: Angle = Field(0.0, description="Phase of the mesh-frequency error.")
 
 
+class FrictionSpec(Strict):
+    """Sliding friction between the teeth (seed 003 eqs. 6, 14-18)."""
+
+    model: Literal["xu2007", "constant"] = Field(
+        "xu2007", description="Friction coefficient: EHL regression of Xu et al. (2007, seed 003 "
+        "eq. 6) or a constant.")
+    coefficient: float = Field(0.05, ge=0, le=1, description="Constant friction coefficient.")
+    roughness: Length = Field(0.3e-6, gt=0, description="Composite RMS surface roughness S.")
+    viscosity: Viscosity = Field(8e-3, gt=0, description="Dynamic viscosity of the oil at the "
+                                 "inlet temperature.")
+    slices: int = Field(20, ge=1, le=200, description="Slices across the face (helical pairs).")
+
+
+def _friction_shorthand(v):
+    if v is None or v is False:
+        return None
+    if v is True:
+        return {}
+    return v
+
+
 def _stiffness_shorthand(v):
     if isinstance(v, (dict, StiffnessSpec)):
         return v
@@ -396,10 +423,15 @@ class Mesh(Strict):
     transmission_error: TransmissionError = Field(TransmissionError(), description="Extra LOA error.")
     phase: float | None = Field(None, description="Mesh phase at t = 0 in cycles (overrides clocking).")
     stage: str | None = Field(None, description="Stage label for load-sharing groups.")
-    path: str | None = Field(None, description="Input-path label (seed 000: left/right).")
+    path: str | None = Field(
+        None, description="Input-path label: the power source a mesh belongs to (seed 000: "
+        "left/right engine).  Meshes of one stage share load within a path; do not use it to "
+        "name the parallel branches of a split.")
     shaft_angle: Angle | None = Field(None, description="Angle between the axes (bevel/face).")
     impact: bool = Field(False, description="Add meshing-in impact (seed 000 eqs. 6-10).")
-    friction: bool = Field(False, description="Add EHL tooth friction (seed 003).")
+    friction: Annotated[FrictionSpec | None, BeforeValidator(_friction_shorthand)] = Field(
+        None, description="Tooth friction (seed 003): true for the defaults, or a [friction] "
+        "table; omitted or false = none.")
 
     @model_validator(mode="after")
     def _consistent(self):
@@ -421,8 +453,19 @@ class Spline(Strict):
     radial_clearance: Length = Field(ge=0, description="Radial clearance of the spline.")
     friction_coefficient: float = Field(0.1, ge=0, description="Coulomb friction coefficient.")
     pitch_radius: Length = Field(gt=0, description="Spline pitch radius.")
-    stiffness: Stiffness = Field(gt=0, description="Radial contact stiffness once the clearance closes.")
+    stiffness: Stiffness = Field(gt=0, description="Radial stiffness k_w once the clearance "
+                                 "closes (and below the stick limit).")
+    damping: Damping = Field(0.0, ge=0, description="Radial damping c_w while in contact.")
+    stick_limit: Length = Field(0.0, ge=0, description="Radial displacement S_1 below which "
+                                "the spline sticks (seed 002 eq. 6; 0 = slides at once).")
     torsional_stiffness: TorsionalStiffness = Field(gt=0, description="Torsional stiffness of the spline.")
+
+    @model_validator(mode="after")
+    def _limits(self):
+        if self.stick_limit > self.radial_clearance:
+            raise FieldError("stick_limit", "must not exceed 'radial_clearance' (S_1 <= S_2); "
+                             "lower it or raise the clearance")
+        return self
 
 
 # --------------------------------------------------------------------------- drives
