@@ -107,6 +107,7 @@ def run(
         None, "--definition",
         help="Load-sharing definition: cycle_peak, instantaneous, engineering, mean_force."),
     out: Optional[Path] = typer.Option(None, "--out", help="Write results to this NetCDF file."),
+    plots: Optional[Path] = typer.Option(None, "--plots", help="Write report figures (PNG, SVG) here."),
     as_json: bool = typer.Option(False, "--json", help="Print metrics and statistics as JSON."),
     quiet: bool = typer.Option(False, "--quiet", help="No progress bar."),
 ):
@@ -134,13 +135,19 @@ def run(
     except ValueError as exc:
         _fail(exc)
         return
+    figures = []
+    if plots is not None:
+        figures = res.write_figures(plots, definition=met.definition)
     if as_json:
         print(json.dumps({"model": m.model.name, "success": res.success,
                           "metrics": met.to_dict(), "statistics": res.statistics(),
-                          "results_file": str(saved) if saved else None},
+                          "results_file": str(saved) if saved else None,
+                          "figures": [str(f) for f in figures]},
                          indent=2, default=_json_default))
     else:
         _render_run(res, met, saved)
+        if figures:
+            console.print(f"{len(figures)} figure files written to {plots}")
     if not res.success:
         raise typer.Exit(1)
 
@@ -203,6 +210,7 @@ def static(
     revolutions: float = typer.Option(1.0, "--revolutions", help="Revolutions of the slowest gear."),
     points_per_cycle: int = typer.Option(8, "--points-per-cycle", help="Positions per mesh cycle."),
     out: Optional[Path] = typer.Option(None, "--out", help="Write results to this NetCDF file."),
+    plots: Optional[Path] = typer.Option(None, "--plots", help="Write report figures (PNG, SVG) here."),
     as_json: bool = typer.Option(False, "--json", help="Print the results as JSON."),
 ):
     """Quasi-static load sharing: equilibrium at each mesh position (seed 004)."""
@@ -218,6 +226,10 @@ def static(
     met = res.metrics()
     orbits = res.orbits()
     saved = res.to_netcdf(out) if out is not None else None
+    if plots is not None:
+        from .plot import write_static_figures
+
+        write_static_figures(res, plots)
     forces = res.mesh_forces()
     if as_json:
         print(json.dumps({

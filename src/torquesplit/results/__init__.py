@@ -200,6 +200,12 @@ class Results:
         self.to_dataset().to_netcdf(path, engine="h5netcdf")
         return path
 
+    def write_figures(self, directory, formats=("png", "svg"), **kwargs):
+        """Write the report figures (see :func:`torquesplit.plot.write_figures`)."""
+        from ..plot import write_figures
+
+        return write_figures(self, directory, formats, **kwargs)
+
     def model_json(self) -> str:
         from ..model.io import model_to_json
 

@@ -1,7 +1,9 @@
 """Numerical core: time integration, static equilibrium and modes of a Structure.
 
 Every analysis here takes an assembled :class:`torquesplit.assembly.structure.Structure`
-(immutable flat arrays) and returns a frozen result object; nothing is modified.
+(immutable flat arrays) and returns a frozen result object with read-only arrays;
+nothing is modified.  Lifetime: compiled kernels are built once per process (and cached
+on disk by numba); a Structure once per model or study case; results once per call.
 
 ==================  ===================================================================
 Module              What it does
@@ -21,6 +23,7 @@ Module              What it does
 ``reference``       Readable numpy twins of the kernels (:func:`rhs_numpy`, ...), used by
                     tests and as the scipy baseline.
 ``_kernels``        Every numba ``@njit(cache=True)`` loop, each naming its twin.
+``_frozen``         Makes the arrays of the frozen result objects read-only.
 ==================  ===================================================================
 
 Conventions

@@ -17,14 +17,26 @@ S C      ``(n_slot, n_sin)``: sin and cos of every error sinusoid's argument
 tv_el    elements whose tables vary in time (frequency > 0)
 err_el   elements that own at least one error sinusoid
 sin_el   owning element of each error sinusoid
-genf     generalized force accumulator (n)
+gap_cyc  cycle whose half-gap is cached in gap_val (per element)
+has_force  elements with a non-zero additive force table
+watch_el elements whose contact state is counted (n_watch of them)
+vr_ptr vq_idx vv_idx  V by element (CSR), unsigned: row pointers, indices into y
+         of the q and of the v entries
+vt_*     V by DOF (CSR of V^T): generalized forces are gathered, not scattered
 defl     element deformation delta = V.q - e (ne)
-MODEL    the 22 model arrays, always passed in the order of :data:`MODEL_ARRAYS`
-RECORD   the 16 output arrays, always passed in the order of :data:`RECORD_ARRAYS`
+MODEL    the 28 model arrays, always passed in the order of :data:`MODEL_ARRAYS`
+RECORD   the 18 output arrays, always passed in the order of :data:`RECORD_ARRAYS`
 
 Time of step ``i`` is always computed as ``t0 + i * h`` (never accumulated), so a run
 split into chunks whose sizes are multiples of :data:`RESYNC` reproduces the unsplit run
 bit for bit.
+
+Compilation flags: ``error_model="numpy"`` only (no Python zero-division checks; the
+inputs are validated in Python).  No fastmath: besides keeping NaN/inf checks valid,
+even ``contract`` (FMA) would make the excitation phases ``f t + phase`` round
+differently from their numpy twins, and numba compiles a callee with the flags of its
+first caller, so flags cannot be confined to a few kernels.  Every kernel must
+therefore keep the same flags.
 """
 
 from __future__ import annotations
@@ -63,18 +75,22 @@ F_HMAX = 4  # dopri: largest accepted step
 N_CLOCK = 5
 
 MESH_KIND = 1
+_NO_CYCLE = -(2**62)
 RESYNC = 64
 """RK4 recomputes the error sinusoids exactly every RESYNC steps (phasor rotation between)."""
+# Slot indices are always passed as int64 variables (np.int64(k)), never as literal
+# constants: numba would compile one copy of the callee per literal value.
 
 MODEL_ARRAYS = (
     "inv_mass", "external_force", "ground_damping", "element_kind", "v_ptr", "v_dof",
     "v_coef", "stiffness_table", "frequency", "phase", "damping", "gap_ptr",
     "gap_values", "error_constant", "error_ptr", "error_amplitude", "error_omega",
-    "error_phase", "force_table", "tv_el", "err_el", "sin_el",
+    "error_phase", "force_table", "tv_el", "err_el", "sin_el", "vr_ptr", "vq_idx",
+    "vv_idx", "vt_ptr", "vt_el", "vt_coef",
 )
 RECORD_ARRAYS = (
     "track_el", "track_base", "cyc_max", "cyc_min", "cyc_sum", "cyc_cnt",
-    "sep_count", "back_count", "hist_el", "hist_dof", "hist_t", "hist_f",
+    "sep_count", "back_count", "sep_time", "back_time", "hist_el", "hist_dof", "hist_t", "hist_f",
     "hist_q", "hist_v", "full_t", "full_y",
 )
 
@@ -99,7 +115,7 @@ _EXPO1 = 0.2 - _BETA * 0.75
 
 
 # =================================================================== excitation
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def init_slots(stiffness_table, force_table, gap_ptr, gap_values, error_constant,
                K, P, G, E, ED, CY):
     """Fill every slot with the time-invariant values (table column 0, first gap).
@@ -116,13 +132,42 @@ def init_slots(stiffness_table, force_table, gap_ptr, gap_values, error_constant
             CY[s, e] = 0
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
+def scratch_flags(element_kind, gap_ptr, gap_values, force_table, has_force, watch_el):
+    """Per-element flags computed once per call: ``has_force[e]`` (a non-zero additive
+    force table) and the list ``watch_el`` of elements whose contact state is counted
+    (a dead zone somewhere in the gap sequence, or a mesh).  Returns len(watch_el).
+
+    Twin: ``np.any(force_table != 0, axis=1)`` and the masks of
+    :func:`record_statistics`.
+    """
+    n_watch = 0
+    for e in range(force_table.shape[0]):
+        has_force[e] = False
+        for i in range(force_table.shape[1]):
+            if force_table[e, i] != 0.0:
+                has_force[e] = True
+                break
+        watch = element_kind[e] == MESH_KIND
+        for j in range(gap_ptr[e], gap_ptr[e + 1]):
+            if gap_values[j] > 0.0:
+                watch = True
+        if watch:
+            watch_el[n_watch] = e
+            n_watch += 1
+    return n_watch
+
+
+@njit(cache=True, error_model="numpy")
 def excite_tables(t, slot, tv_el, frequency, phase, stiffness_table, force_table,
-                  gap_ptr, gap_values, K, P, G, CY):
+                  gap_ptr, gap_values, K, P, G, CY, gap_cyc, gap_val, has_force):
     """Stiffness, additive force, half-gap and cycle index of time-varying elements at t.
 
     Mesh phase s = f t + phase; tables are interpolated linearly and periodically at
-    frac(s) * n_table; the half-gap is the per-cycle sequence entry floor(s) mod n_gaps.
+    frac(s) * n_table; the half-gap is entry floor(s) mod n_gaps of the per-cycle
+    sequence (cached in ``gap_cyc``/``gap_val`` since the cycle changes rarely).  The
+    force table is read only where ``has_force`` (see :func:`scratch_flags`); elsewhere
+    P keeps its zero from :func:`init_slots`.
     Twin: :func:`torquesplit.solve.reference.excitation_numpy`.
     """
     n_tab = stiffness_table.shape[1]
@@ -140,18 +185,25 @@ def excite_tables(t, slot, tv_el, frequency, phase, stiffness_table, force_table
             i1 = 0
         k0 = stiffness_table[e, i0]
         K[slot, e] = k0 + w * (stiffness_table[e, i1] - k0)
-        p0 = force_table[e, i0]
-        P[slot, e] = p0 + w * (force_table[e, i1] - p0)
+        if has_force[e]:
+            p0 = force_table[e, i0]
+            P[slot, e] = p0 + w * (force_table[e, i1] - p0)
         c = np.int64(fl)
-        ng = gap_ptr[e + 1] - gap_ptr[e]
-        m = c % ng
-        if m < 0:
-            m += ng
-        G[slot, e] = gap_values[gap_ptr[e] + m]
         CY[slot, e] = c
+        ng = gap_ptr[e + 1] - gap_ptr[e]
+        if ng == 1:
+            G[slot, e] = gap_values[gap_ptr[e]]
+        else:
+            if c != gap_cyc[e]:
+                m = c % ng
+                if m < 0:
+                    m += ng
+                gap_cyc[e] = c
+                gap_val[e] = gap_values[gap_ptr[e] + m]
+            G[slot, e] = gap_val[e]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def phasors_exact(t, slot, error_omega, error_phase, S, C):
     """sin and cos of omega t + phi for every error sinusoid.
 
@@ -163,20 +215,33 @@ def phasors_exact(t, slot, error_omega, error_phase, S, C):
         C[slot, i] = math.cos(arg)
 
 
-@njit(cache=True)
-def phasors_rotate(src, dst, cos_rot, sin_rot, S, C):
-    """Advance every phasor by a fixed time (angle omega dt given as cos, sin).
+@njit(cache=True, error_model="numpy")
+def advance_errors(src, dst, cos_rot, sin_rot, err_el, error_constant, sin_el,
+                   error_amplitude, error_omega, S, C, E, ED):
+    """Rotate every phasor of slot ``src`` by a fixed time into slot ``dst`` (angle
+    omega dt given as cos, sin) and rebuild the errors of ``dst`` from them.
 
-    Twin: :func:`phasors_exact` at the later time (equal to round-off).
+    Twin: :func:`phasors_exact` + :func:`errors_from_phasors` at the later time (equal
+    to round-off), i.e. the error part of :func:`reference.excitation_numpy`.
     """
-    for i in range(S.shape[1]):
-        s = S[src, i]
-        c = C[src, i]
-        S[dst, i] = s * cos_rot[i] + c * sin_rot[i]
-        C[dst, i] = c * cos_rot[i] - s * sin_rot[i]
+    for j in range(err_el.shape[0]):
+        e = err_el[j]
+        E[dst, e] = error_constant[e]
+        ED[dst, e] = 0.0
+    for i in range(sin_el.shape[0]):
+        s0 = S[src, i]
+        c0 = C[src, i]
+        s1 = s0 * cos_rot[i] + c0 * sin_rot[i]
+        c1 = c0 * cos_rot[i] - s0 * sin_rot[i]
+        S[dst, i] = s1
+        C[dst, i] = c1
+        e = sin_el[i]
+        a = error_amplitude[i]
+        E[dst, e] += a * s1
+        ED[dst, e] += a * error_omega[i] * c1
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def errors_from_phasors(slot, err_el, error_constant, sin_el, error_amplitude,
                         error_omega, S, C, E, ED):
     """e = e_const + sum A sin(.), e' = sum A omega cos(.) from the phasors of a slot.
@@ -194,47 +259,45 @@ def errors_from_phasors(slot, err_el, error_constant, sin_el, error_amplitude,
         ED[slot, e] += a * error_omega[i] * C[slot, i]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def excite_exact(t, slot, frequency, phase, stiffness_table, force_table, gap_ptr,
                  gap_values, error_constant, error_amplitude, error_omega, error_phase,
-                 tv_el, err_el, sin_el, K, P, G, E, ED, CY, S, C):
+                 tv_el, err_el, sin_el, K, P, G, E, ED, CY, S, C, gap_cyc, gap_val,
+                 has_force):
     """Every time-dependent excitation at t, sinusoids evaluated exactly.
 
     Twin: :func:`torquesplit.solve.reference.excitation_numpy`.
     """
     excite_tables(t, slot, tv_el, frequency, phase, stiffness_table, force_table,
-                  gap_ptr, gap_values, K, P, G, CY)
+                  gap_ptr, gap_values, K, P, G, CY, gap_cyc, gap_val,
+                  has_force)
     phasors_exact(t, slot, error_omega, error_phase, S, C)
     errors_from_phasors(slot, err_el, error_constant, sin_el, error_amplitude,
                         error_omega, S, C, E, ED)
 
 
 # ======================================================================== rhs
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def rhs_slot(y, slot, K, P, G, E, ED, inv_mass, external_force, ground_damping,
-             v_ptr, v_dof, v_coef, damping, dy, force, defl, genf):
+             v_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
+             dy, force, defl):
     """dy = [v, a] with a = M^-1 (F_ext - C_g v - sum_e V_e f_e) for one excitation slot.
 
     delta = V.q - e, rate = V.v - e', h = dead zone of half-width g (g == 0: h = delta,
     always in contact), f = k h + c rate (only in contact) + p.  Also writes the
-    element forces ``force`` and deformations ``defl``.
+    element forces ``force`` and deformations ``defl``.  V is read row-wise (CSR,
+    unsigned indices into y for q and v) and, for the generalized forces, column-wise
+    (``vt_*``: a gather per DOF, no scatter).
     Twin: :func:`torquesplit.solve.reference.rhs_numpy`.
     """
     n = inv_mass.shape[0]
-    for i in range(n):
-        vi = y[n + i]
-        dy[i] = vi
-        genf[i] = external_force[i] - ground_damping[i] * vi
     for el in range(v_ptr.shape[0] - 1):
-        d = 0.0
-        r = 0.0
+        d = -E[slot, el]
+        r = -ED[slot, el]
         for j in range(v_ptr[el], v_ptr[el + 1]):
-            dof = v_dof[j]
             cf = v_coef[j]
-            d += cf * y[dof]
-            r += cf * y[n + dof]
-        d -= E[slot, el]
-        r -= ED[slot, el]
+            d += cf * y[vq_idx[j]]
+            r += cf * y[vv_idx[j]]
         g = G[slot, el]
         if g > 0.0:
             if d > g:
@@ -245,20 +308,23 @@ def rhs_slot(y, slot, K, P, G, E, ED, inv_mass, external_force, ground_damping,
                 fe = 0.0
         else:
             fe = K[slot, el] * d + damping[el] * r
-        fe += P[slot, el]
-        force[el] = fe
+        force[el] = fe + P[slot, el]
         defl[el] = d
-        for j in range(v_ptr[el], v_ptr[el + 1]):
-            genf[v_dof[j]] -= v_coef[j] * fe
     for i in range(n):
-        dy[n + i] = inv_mass[i] * genf[i]
+        vi = y[n + i]
+        acc = external_force[i] - ground_damping[i] * vi
+        for j in range(vt_ptr[i], vt_ptr[i + 1]):
+            acc -= vt_coef[j] * force[vt_el[j]]
+        dy[i] = vi
+        dy[n + i] = inv_mass[i] * acc
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def rhs_at(t, y, inv_mass, external_force, ground_damping, element_kind, v_ptr, v_dof,
            v_coef, stiffness_table, frequency, phase, damping, gap_ptr, gap_values,
            error_constant, error_ptr, error_amplitude, error_omega, error_phase,
-           force_table, tv_el, err_el, sin_el, dy, force, defl):
+           force_table, tv_el, err_el, sin_el, vr_ptr, vq_idx, vv_idx, vt_ptr, vt_el,
+           vt_coef, dy, force, defl):
     """One exact right-hand-side evaluation at (t, y) (allocates; not for loops).
 
     Twin: :func:`torquesplit.solve.reference.rhs_numpy` and
@@ -274,27 +340,36 @@ def rhs_at(t, y, inv_mass, external_force, ground_damping, element_kind, v_ptr, 
     CY = np.empty((1, ne), dtype=np.int64)
     S = np.empty((1, n_sin))
     C = np.empty((1, n_sin))
-    genf = np.empty(inv_mass.shape[0])
+    gap_cyc = np.full(ne, _NO_CYCLE, dtype=np.int64)
+    gap_val = np.zeros(ne)
+    has_force = np.zeros(ne, dtype=np.bool_)
+    scratch_flags(element_kind, gap_ptr, gap_values, force_table, has_force,
+                  np.empty(ne, dtype=np.int64))
+    s0 = np.int64(0)  # slots are passed as int64 variables, never literals
     init_slots(stiffness_table, force_table, gap_ptr, gap_values, error_constant,
                K, P, G, E, ED, CY)
-    excite_exact(t, 0, frequency, phase, stiffness_table, force_table, gap_ptr,
+    excite_exact(t, s0, frequency, phase, stiffness_table, force_table, gap_ptr,
                  gap_values, error_constant, error_amplitude, error_omega, error_phase,
-                 tv_el, err_el, sin_el, K, P, G, E, ED, CY, S, C)
-    rhs_slot(y, 0, K, P, G, E, ED, inv_mass, external_force, ground_damping,
-             v_ptr, v_dof, v_coef, damping, dy, force, defl, genf)
+                 tv_el, err_el, sin_el, K, P, G, E, ED, CY, S, C, gap_cyc, gap_val, has_force)
+    rhs_slot(y, s0, K, P, G, E, ED, inv_mass, external_force, ground_damping,
+             vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
+             dy, force, defl)
 
 
 # ================================================================== recording
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def record_statistics(slot, force, defl, G, CY, element_kind, track_el, track_base,
                       cyc_max, cyc_min, cyc_sum, cyc_cnt, sep_count, back_count,
-                      counters):
+                      sep_time, back_time, weight, counters, watch_el, n_watch):
     """Enter one accepted state in the per-cycle statistics and contact counters.
 
     Cycle index of tracked element j = CY - track_base[j]; cycles at or beyond the
     capacity (rows of ``cyc_max``) are ignored.  Separation: |delta| <= g with g > 0;
     back-side contact: delta < -g with g > 0, or delta < 0 for a mesh without backlash.
-    Twin: :func:`torquesplit.solve.reference.cycle_statistics_numpy`.
+    Only the ``n_watch`` elements of ``watch_el`` can be in either state.  ``weight``
+    is the time the sample stands for (added to ``sep_time`` / ``back_time``).
+    Twins: :func:`torquesplit.solve.reference.cycle_statistics_numpy` and
+    :func:`torquesplit.solve.reference.contact_state_numpy`.
     """
     cap = cyc_max.shape[0]
     for j in range(track_el.shape[0]):
@@ -308,20 +383,24 @@ def record_statistics(slot, force, defl, G, CY, element_kind, track_el, track_ba
                 cyc_min[c, j] = fe
             cyc_sum[c, j] += fe
             cyc_cnt[c, j] += 1
-    for el in range(force.shape[0]):
+    for j in range(n_watch):
+        el = watch_el[j]
         g = G[slot, el]
         d = defl[el]
         if g > 0.0:
             if d < -g:
                 back_count[el] += 1
+                back_time[el] += weight
             elif d <= g:
                 sep_count[el] += 1
+                sep_time[el] += weight
         elif element_kind[el] == MESH_KIND and d < 0.0:
             back_count[el] += 1
+            back_time[el] += weight
     counters[I_SAMPLES] += 1
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def store_history(row, t, y, force, hist_el, hist_dof, hist_t, hist_f, hist_q, hist_v):
     """Write one decimated history row: t, forces of history elements, q and v of DOFs.
 
@@ -337,32 +416,32 @@ def store_history(row, t, y, force, hist_el, hist_dof, hist_t, hist_f, hist_q, h
         hist_v[row, j] = y[n + d]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def bad_state(y, blowup):
     """Index of the first non-finite state or |q| > blowup, or -1 if all is well.
 
     Twin: ``np.flatnonzero(~np.isfinite(y) | (abs(q) > blowup))[:1]``.
     """
     n = y.shape[0] // 2
-    for i in range(y.shape[0]):
-        yi = y[i]
-        if not math.isfinite(yi):
+    for i in range(n):
+        if not abs(y[i]) <= blowup:  # also true for NaN
             return i
-        if i < n and abs(yi) > blowup:
+    for i in range(n, y.shape[0]):
+        if not math.isfinite(y[i]):
             return i
     return -1
 
 
 # ======================================================================== RK4
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def rk4_run(y, t0, h, n_first, n_steps, record_final, record_every, blowup,
             inv_mass, external_force, ground_damping, element_kind, v_ptr, v_dof,
             v_coef, stiffness_table, frequency, phase, damping, gap_ptr, gap_values,
             error_constant, error_ptr, error_amplitude, error_omega, error_phase,
-            force_table, tv_el, err_el, sin_el,
-            track_el, track_base, cyc_max, cyc_min, cyc_sum, cyc_cnt,
-            sep_count, back_count, hist_el, hist_dof, hist_t, hist_f, hist_q, hist_v,
-            full_t, full_y, counters, clock):
+            force_table, tv_el, err_el, sin_el, vr_ptr, vq_idx, vv_idx, vt_ptr, vt_el,
+            vt_coef, track_el, track_base, cyc_max, cyc_min, cyc_sum, cyc_cnt,
+            sep_count, back_count, sep_time, back_time, hist_el, hist_dof, hist_t,
+            hist_f, hist_q, hist_v, full_t, full_y, counters, clock):
     """Classic fixed-step RK4 over global steps n_first .. n_first + n_steps - 1.
 
     Step i runs from t0 + i h to t0 + (i + 1) h.  The state at the start of each step
@@ -396,15 +475,21 @@ def rk4_run(y, t0, h, n_first, n_steps, record_final, record_every, blowup,
     k3 = np.empty(n2)
     k4 = np.empty(n2)
     yt = np.empty(n2)
-    genf = np.empty(n)
+    gap_cyc = np.full(ne, _NO_CYCLE, dtype=np.int64)
+    gap_val = np.zeros(ne)
+    has_force = np.zeros(ne, dtype=np.bool_)
+    watch_el = np.empty(ne, dtype=np.int64)
+    n_watch = scratch_flags(element_kind, gap_ptr, gap_values, force_table, has_force,
+                            watch_el)
     force = np.empty(ne)
     defl = np.empty(ne)
     ftmp = np.empty(ne)
     dtmp = np.empty(ne)
     init_slots(stiffness_table, force_table, gap_ptr, gap_values, error_constant,
                K, P, G, E, ED, CY)
-    a = 0  # slot of t
-    b = 2  # slot of t + h ; slot 1 is t + h/2
+    a = np.int64(0)  # slot of t
+    b = np.int64(2)  # slot of t + h
+    s_half = np.int64(1)  # slot of t + h/2
     hh = 0.5 * h
     h6 = h / 6.0
     for it in range(n_steps):
@@ -412,17 +497,20 @@ def rk4_run(y, t0, h, n_first, n_steps, record_final, record_every, blowup,
         t = t0 + i * h
         if it == 0 or i % RESYNC == 0:
             excite_tables(t, a, tv_el, frequency, phase, stiffness_table, force_table,
-                          gap_ptr, gap_values, K, P, G, CY)
+                          gap_ptr, gap_values, K, P, G, CY, gap_cyc, gap_val,
+                          has_force)
             phasors_exact(t, a, error_omega, error_phase, S, C)
             errors_from_phasors(a, err_el, error_constant, sin_el, error_amplitude,
                                 error_omega, S, C, E, ED)
         # stage 1 at t: its forces are those of the accepted state y(t)
         rhs_slot(y, a, K, P, G, E, ED, inv_mass, external_force, ground_damping,
-                 v_ptr, v_dof, v_coef, damping, k1, force, defl, genf)
+                 vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
+                 k1, force, defl)
         record_statistics(a, force, defl, G, CY, element_kind, track_el, track_base,
                           cyc_max, cyc_min, cyc_sum, cyc_cnt, sep_count, back_count,
-                          counters)
-        if record_every > 0 and i % record_every == 0 and counters[I_HIST] < hist_t.shape[0]:
+                          sep_time, back_time, h, counters, watch_el, n_watch)
+        if (record_every > 0 and i % record_every == 0
+                and counters[I_HIST] < hist_t.shape[0]):
             store_history(counters[I_HIST], t, y, force, hist_el, hist_dof,
                           hist_t, hist_f, hist_q, hist_v)
             counters[I_HIST] += 1
@@ -433,30 +521,33 @@ def rk4_run(y, t0, h, n_first, n_steps, record_final, record_every, blowup,
             counters[I_FULL] += 1
         # stages 2 and 3 at t + h/2
         th = t0 + (i + 0.5) * h
-        excite_tables(th, 1, tv_el, frequency, phase, stiffness_table, force_table,
-                      gap_ptr, gap_values, K, P, G, CY)
-        phasors_rotate(a, 1, cos_rot, sin_rot, S, C)
-        errors_from_phasors(1, err_el, error_constant, sin_el, error_amplitude,
-                            error_omega, S, C, E, ED)
+        excite_tables(th, s_half, tv_el, frequency, phase, stiffness_table, force_table,
+                      gap_ptr, gap_values, K, P, G, CY, gap_cyc, gap_val,
+                      has_force)
+        advance_errors(a, s_half, cos_rot, sin_rot, err_el, error_constant, sin_el,
+                       error_amplitude, error_omega, S, C, E, ED)
         for m in range(n2):
             yt[m] = y[m] + hh * k1[m]
-        rhs_slot(yt, 1, K, P, G, E, ED, inv_mass, external_force, ground_damping,
-                 v_ptr, v_dof, v_coef, damping, k2, ftmp, dtmp, genf)
+        rhs_slot(yt, s_half, K, P, G, E, ED, inv_mass, external_force, ground_damping,
+                 vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
+                 k2, ftmp, dtmp)
         for m in range(n2):
             yt[m] = y[m] + hh * k2[m]
-        rhs_slot(yt, 1, K, P, G, E, ED, inv_mass, external_force, ground_damping,
-                 v_ptr, v_dof, v_coef, damping, k3, ftmp, dtmp, genf)
+        rhs_slot(yt, s_half, K, P, G, E, ED, inv_mass, external_force, ground_damping,
+                 vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
+                 k3, ftmp, dtmp)
         # stage 4 at t + h
         tb = t0 + (i + 1) * h
         excite_tables(tb, b, tv_el, frequency, phase, stiffness_table, force_table,
-                      gap_ptr, gap_values, K, P, G, CY)
-        phasors_rotate(1, b, cos_rot, sin_rot, S, C)
-        errors_from_phasors(b, err_el, error_constant, sin_el, error_amplitude,
-                            error_omega, S, C, E, ED)
+                      gap_ptr, gap_values, K, P, G, CY, gap_cyc, gap_val,
+                      has_force)
+        advance_errors(s_half, b, cos_rot, sin_rot, err_el, error_constant, sin_el,
+                       error_amplitude, error_omega, S, C, E, ED)
         for m in range(n2):
             yt[m] = y[m] + h * k3[m]
         rhs_slot(yt, b, K, P, G, E, ED, inv_mass, external_force, ground_damping,
-                 v_ptr, v_dof, v_coef, damping, k4, ftmp, dtmp, genf)
+                 vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
+                 k4, ftmp, dtmp)
         for m in range(n2):
             y[m] += h6 * (k1[m] + 2.0 * (k2[m] + k3[m]) + k4[m])
         counters[I_STEPS] += 1
@@ -472,11 +563,13 @@ def rk4_run(y, t0, h, n_first, n_steps, record_final, record_every, blowup,
         i = n_first + n_steps
         t = t0 + i * h
         rhs_slot(y, a, K, P, G, E, ED, inv_mass, external_force, ground_damping,
-                 v_ptr, v_dof, v_coef, damping, k1, force, defl, genf)
+                 vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
+                 k1, force, defl)
         record_statistics(a, force, defl, G, CY, element_kind, track_el, track_base,
                           cyc_max, cyc_min, cyc_sum, cyc_cnt, sep_count, back_count,
-                          counters)
-        if record_every > 0 and i % record_every == 0 and counters[I_HIST] < hist_t.shape[0]:
+                          sep_time, back_time, 0.0, counters, watch_el, n_watch)
+        if (record_every > 0 and i % record_every == 0
+                and counters[I_HIST] < hist_t.shape[0]):
             store_history(counters[I_HIST], t, y, force, hist_el, hist_dof,
                           hist_t, hist_f, hist_q, hist_v)
             counters[I_HIST] += 1
@@ -488,7 +581,7 @@ def rk4_run(y, t0, h, n_first, n_steps, record_final, record_every, blowup,
 
 
 # ============================================================== Dormand-Prince
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def hermite(theta, h, y0, f0, y1, f1, out):
     """Cubic Hermite interpolation of the state between two accepted steps.
 
@@ -504,16 +597,16 @@ def hermite(theta, h, y0, f0, y1, f1, out):
         out[m] = h00 * y0[m] + h10 * f0[m] + h01 * y1[m] + h11 * f1[m]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def dopri_run(y, kfsal, t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, blowup,
               dt_sample,
               inv_mass, external_force, ground_damping, element_kind, v_ptr, v_dof,
               v_coef, stiffness_table, frequency, phase, damping, gap_ptr, gap_values,
               error_constant, error_ptr, error_amplitude, error_omega, error_phase,
-              force_table, tv_el, err_el, sin_el,
-              track_el, track_base, cyc_max, cyc_min, cyc_sum, cyc_cnt,
-              sep_count, back_count, hist_el, hist_dof, hist_t, hist_f, hist_q, hist_v,
-              full_t, full_y, counters, clock):
+              force_table, tv_el, err_el, sin_el, vr_ptr, vq_idx, vv_idx, vt_ptr, vt_el,
+              vt_coef, track_el, track_base, cyc_max, cyc_min, cyc_sum, cyc_cnt,
+              sep_count, back_count, sep_time, back_time, hist_el, hist_dof, hist_t,
+              hist_f, hist_q, hist_v, full_t, full_y, counters, clock):
     """Adaptive Dormand-Prince 5(4) with FSAL and PI step-size control (Hairer's DOPRI5).
 
     Integrates from clock[F_T] until t >= t_stop (never past t_end; the last step is
@@ -548,13 +641,20 @@ def dopri_run(y, kfsal, t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, 
     ynew = np.empty(n2)
     ys = np.empty(n2)
     dys = np.empty(n2)
-    genf = np.empty(n)
+    gap_cyc = np.full(ne, _NO_CYCLE, dtype=np.int64)
+    gap_val = np.zeros(ne)
+    has_force = np.zeros(ne, dtype=np.bool_)
+    watch_el = np.empty(ne, dtype=np.int64)
+    n_watch = scratch_flags(element_kind, gap_ptr, gap_values, force_table, has_force,
+                            watch_el)
     force = np.empty(ne)
     defl = np.empty(ne)
     ftmp = np.empty(ne)
     dtmp = np.empty(ne)
     init_slots(stiffness_table, force_table, gap_ptr, gap_values, error_constant,
                K, P, G, E, ED, CY)
+    s0 = np.int64(0)  # slot of the stages (and of interpolated samples)
+    s1 = np.int64(1)  # slot of t + h: the candidate state, then the accepted one
     n_hist = hist_t.shape[0]
     t = clock[F_T]
     h = clock[F_H]
@@ -562,17 +662,20 @@ def dopri_run(y, kfsal, t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, 
     eps = 2.220446049250313e-16
     # current state: f(t, y) and, at the very start, its sample
     if counters[I_FSAL] == 0:
-        excite_exact(t, 1, frequency, phase, stiffness_table, force_table, gap_ptr,
+        excite_exact(t, s1, frequency, phase, stiffness_table, force_table, gap_ptr,
                      gap_values, error_constant, error_amplitude, error_omega,
-                     error_phase, tv_el, err_el, sin_el, K, P, G, E, ED, CY, S, C)
-        rhs_slot(y, 1, K, P, G, E, ED, inv_mass, external_force, ground_damping,
-                 v_ptr, v_dof, v_coef, damping, kfsal, force, defl, genf)
+                     error_phase, tv_el, err_el, sin_el, K, P, G, E, ED, CY, S, C,
+                     gap_cyc, gap_val, has_force)
+        rhs_slot(y, s1, K, P, G, E, ED, inv_mass, external_force, ground_damping,
+                 vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
+                 kfsal, force, defl)
         counters[I_RHS] += 1
         counters[I_FSAL] = 1
         if counters[I_SAMPLES] == 0:
-            record_statistics(1, force, defl, G, CY, element_kind, track_el,
+            record_statistics(s1, force, defl, G, CY, element_kind, track_el,
                               track_base, cyc_max, cyc_min, cyc_sum, cyc_cnt,
-                              sep_count, back_count, counters)
+                              sep_count, back_count, sep_time, back_time, 0.0,
+                              counters, watch_el, n_watch)
         while counters[I_NEXT] < n_hist and t0 + counters[I_NEXT] * dt_sample <= t:
             row = counters[I_NEXT]
             store_history(row, t, y, force, hist_el, hist_dof, hist_t, hist_f,
@@ -603,42 +706,52 @@ def dopri_run(y, kfsal, t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, 
         # stages 2..6 (slot 0), stage 7 at t + hs (slot 1)
         for m in range(n2):
             yt[m] = y[m] + hs * _A21 * kfsal[m]
-        excite_exact(t + _C2 * hs, 0, frequency, phase, stiffness_table, force_table,
+        excite_exact(t + _C2 * hs, s0, frequency, phase, stiffness_table, force_table,
                      gap_ptr, gap_values, error_constant, error_amplitude, error_omega,
-                     error_phase, tv_el, err_el, sin_el, K, P, G, E, ED, CY, S, C)
-        rhs_slot(yt, 0, K, P, G, E, ED, inv_mass, external_force, ground_damping,
-                 v_ptr, v_dof, v_coef, damping, k2, ftmp, dtmp, genf)
+                     error_phase, tv_el, err_el, sin_el, K, P, G, E, ED, CY, S, C,
+                     gap_cyc, gap_val, has_force)
+        rhs_slot(yt, s0, K, P, G, E, ED, inv_mass, external_force, ground_damping,
+                 vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
+                 k2, ftmp, dtmp)
         for m in range(n2):
             yt[m] = y[m] + hs * (_A31 * kfsal[m] + _A32 * k2[m])
-        excite_exact(t + _C3 * hs, 0, frequency, phase, stiffness_table, force_table,
+        excite_exact(t + _C3 * hs, s0, frequency, phase, stiffness_table, force_table,
                      gap_ptr, gap_values, error_constant, error_amplitude, error_omega,
-                     error_phase, tv_el, err_el, sin_el, K, P, G, E, ED, CY, S, C)
-        rhs_slot(yt, 0, K, P, G, E, ED, inv_mass, external_force, ground_damping,
-                 v_ptr, v_dof, v_coef, damping, k3, ftmp, dtmp, genf)
+                     error_phase, tv_el, err_el, sin_el, K, P, G, E, ED, CY, S, C,
+                     gap_cyc, gap_val, has_force)
+        rhs_slot(yt, s0, K, P, G, E, ED, inv_mass, external_force, ground_damping,
+                 vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
+                 k3, ftmp, dtmp)
         for m in range(n2):
             yt[m] = y[m] + hs * (_A41 * kfsal[m] + _A42 * k2[m] + _A43 * k3[m])
-        excite_exact(t + _C4 * hs, 0, frequency, phase, stiffness_table, force_table,
+        excite_exact(t + _C4 * hs, s0, frequency, phase, stiffness_table, force_table,
                      gap_ptr, gap_values, error_constant, error_amplitude, error_omega,
-                     error_phase, tv_el, err_el, sin_el, K, P, G, E, ED, CY, S, C)
-        rhs_slot(yt, 0, K, P, G, E, ED, inv_mass, external_force, ground_damping,
-                 v_ptr, v_dof, v_coef, damping, k4, ftmp, dtmp, genf)
+                     error_phase, tv_el, err_el, sin_el, K, P, G, E, ED, CY, S, C,
+                     gap_cyc, gap_val, has_force)
+        rhs_slot(yt, s0, K, P, G, E, ED, inv_mass, external_force, ground_damping,
+                 vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
+                 k4, ftmp, dtmp)
         for m in range(n2):
             yt[m] = y[m] + hs * (_A51 * kfsal[m] + _A52 * k2[m] + _A53 * k3[m]
                                  + _A54 * k4[m])
-        excite_exact(t + _C5 * hs, 0, frequency, phase, stiffness_table, force_table,
+        excite_exact(t + _C5 * hs, s0, frequency, phase, stiffness_table, force_table,
                      gap_ptr, gap_values, error_constant, error_amplitude, error_omega,
-                     error_phase, tv_el, err_el, sin_el, K, P, G, E, ED, CY, S, C)
-        rhs_slot(yt, 0, K, P, G, E, ED, inv_mass, external_force, ground_damping,
-                 v_ptr, v_dof, v_coef, damping, k5, ftmp, dtmp, genf)
+                     error_phase, tv_el, err_el, sin_el, K, P, G, E, ED, CY, S, C,
+                     gap_cyc, gap_val, has_force)
+        rhs_slot(yt, s0, K, P, G, E, ED, inv_mass, external_force, ground_damping,
+                 vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
+                 k5, ftmp, dtmp)
         for m in range(n2):
             yt[m] = y[m] + hs * (_A61 * kfsal[m] + _A62 * k2[m] + _A63 * k3[m]
                                  + _A64 * k4[m] + _A65 * k5[m])
         t_new = t_end if last else t + hs
-        excite_exact(t_new, 0, frequency, phase, stiffness_table, force_table,
+        excite_exact(t_new, s0, frequency, phase, stiffness_table, force_table,
                      gap_ptr, gap_values, error_constant, error_amplitude, error_omega,
-                     error_phase, tv_el, err_el, sin_el, K, P, G, E, ED, CY, S, C)
-        rhs_slot(yt, 0, K, P, G, E, ED, inv_mass, external_force, ground_damping,
-                 v_ptr, v_dof, v_coef, damping, k6, ftmp, dtmp, genf)
+                     error_phase, tv_el, err_el, sin_el, K, P, G, E, ED, CY, S, C,
+                     gap_cyc, gap_val, has_force)
+        rhs_slot(yt, s0, K, P, G, E, ED, inv_mass, external_force, ground_damping,
+                 vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
+                 k6, ftmp, dtmp)
         for m in range(n2):
             ynew[m] = y[m] + hs * (_B1 * kfsal[m] + _B3 * k3[m] + _B4 * k4[m]
                                    + _B5 * k5[m] + _B6 * k6[m])
@@ -650,8 +763,9 @@ def dopri_run(y, kfsal, t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, 
             E[1, el] = E[0, el]
             ED[1, el] = ED[0, el]
             CY[1, el] = CY[0, el]
-        rhs_slot(ynew, 1, K, P, G, E, ED, inv_mass, external_force, ground_damping,
-                 v_ptr, v_dof, v_coef, damping, k7, force, defl, genf)
+        rhs_slot(ynew, s1, K, P, G, E, ED, inv_mass, external_force, ground_damping,
+                 vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
+                 k7, force, defl)
         counters[I_RHS] += 6
         acc = 0.0
         for m in range(n2):
@@ -668,6 +782,15 @@ def dopri_run(y, kfsal, t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, 
         fac11 = enorm ** _EXPO1
         if enorm <= 1.0:
             # ------------------------------------------------ accepted
+            bad = bad_state(ynew, blowup)
+            if bad >= 0:  # stop before recording anything of this step
+                for m in range(n2):
+                    y[m] = ynew[m]
+                t = t_new
+                counters[I_STEPS] += 1
+                counters[I_STATUS] = DIVERGED
+                counters[I_BAD] = bad
+                break
             while (counters[I_NEXT] < n_hist
                    and t0 + counters[I_NEXT] * dt_sample <= t_new + 1e-9 * dt_sample):
                 row = counters[I_NEXT]
@@ -676,13 +799,13 @@ def dopri_run(y, kfsal, t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, 
                 if theta > 1.0:
                     theta = 1.0
                 hermite(theta, hs, y, kfsal, ynew, k7, ys)
-                excite_exact(ts, 0, frequency, phase, stiffness_table, force_table,
+                excite_exact(ts, s0, frequency, phase, stiffness_table, force_table,
                              gap_ptr, gap_values, error_constant, error_amplitude,
                              error_omega, error_phase, tv_el, err_el, sin_el,
-                             K, P, G, E, ED, CY, S, C)
-                rhs_slot(ys, 0, K, P, G, E, ED, inv_mass, external_force,
-                         ground_damping, v_ptr, v_dof, v_coef, damping, dys, ftmp,
-                         dtmp, genf)
+                             K, P, G, E, ED, CY, S, C, gap_cyc, gap_val, has_force)
+                rhs_slot(ys, s0, K, P, G, E, ED, inv_mass, external_force,
+                         ground_damping, vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el,
+                         vt_coef, damping, dys, ftmp, dtmp)
                 store_history(row, ts, ys, ftmp, hist_el, hist_dof, hist_t, hist_f,
                               hist_q, hist_v)
                 if row < full_t.shape[0]:
@@ -702,9 +825,10 @@ def dopri_run(y, kfsal, t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, 
                 clock[F_HMIN] = hs
             if hs > clock[F_HMAX]:
                 clock[F_HMAX] = hs
-            record_statistics(1, force, defl, G, CY, element_kind, track_el, track_base,
+            record_statistics(s1, force, defl, G, CY, element_kind, track_el, track_base,
                               cyc_max, cyc_min, cyc_sum, cyc_cnt, sep_count,
-                              back_count, counters)
+                              back_count, sep_time, back_time, hs, counters, watch_el,
+                              n_watch)
             fac = fac11 / facold ** _BETA
             fac = max(1.0 / _FAC_MAX, min(1.0 / _FAC_MIN, fac / _SAFE))
             h_new = hs / fac
@@ -713,11 +837,6 @@ def dopri_run(y, kfsal, t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, 
             h = h_new
             facold = max(enorm, 1.0e-4)
             counters[I_LAST_REJECTED] = 0
-            bad = bad_state(y, blowup)
-            if bad >= 0:
-                counters[I_STATUS] = DIVERGED
-                counters[I_BAD] = bad
-                break
         else:
             counters[I_REJECTED] += 1
             counters[I_LAST_REJECTED] = 1

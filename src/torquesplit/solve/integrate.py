@@ -12,7 +12,7 @@ except for the explicitly sized output arrays:
 * per-mesh-cycle max / min / mean / count of the force of tracked elements,
 * decimated histories (every ``record_every`` steps for RK4, uniform ``sample_interval``
   for Dormand-Prince, interpolated by cubic Hermite) of chosen element forces and DOFs,
-* per-element counts of steps in separation and in back-side contact,
+* per-element counts of steps (and time) in separation and in back-side contact,
 * optionally the full state at every step (RK4) or sample time (Dormand-Prince).
 """
 
@@ -30,6 +30,7 @@ import numpy as np
 from torquesplit.assembly.structure import Structure
 from torquesplit.errors import SolverError
 from torquesplit.solve import _kernels as kern
+from torquesplit.solve._frozen import freeze_arrays
 from torquesplit.solve.reference import element_forces_numpy, rhs_numpy
 from torquesplit.solve.stability import check_step, stable_step, system_eigenvalues
 
@@ -52,9 +53,9 @@ _COMPILE_TIME: float | None = None
 
 
 # ===================================================================== result
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Solution:
-    """Result of :func:`integrate`.  Arrays are owned by the solution (never views).
+    """Result of :func:`integrate`.  Arrays are owned by the solution and read-only.
 
     Cycle arrays have shape (n_cycles, n_tracked); row c is the c-th excitation cycle
     of each tracked element counted from the cycle containing ``t_span[0]``; empty
@@ -121,17 +122,28 @@ class Solution:
     separation_steps: np.ndarray
     """(n_el,) accepted states with |delta| <= g (g > 0): contact lost."""
     back_contact_steps: np.ndarray
-    """(n_el,) accepted states with delta < -g (back flank; mesh without backlash: delta < 0)."""
+    """(n_el,) accepted states with delta < -g (back flank; mesh without backlash:
+    delta < 0)."""
+    separation_time: np.ndarray
+    """(n_el,) time spent in separation [s]: each accepted state weighted by the step it
+    stands for (rk4: the step that starts there; dopri: the step that ends there).
+    Unlike ``separation_steps`` this is not biased by adaptive steps crowding at
+    contact events."""
+    back_contact_time: np.ndarray
+    """(n_el,) time spent in back-side contact [s], weighted like ``separation_time``."""
+
+    def __post_init__(self):
+        freeze_arrays(self)
 
     @property
     def separation_fraction(self) -> np.ndarray:
-        """(n_el,) fraction of accepted states in separation."""
-        return self.separation_steps / max(self.n_samples, 1)
+        """(n_el,) fraction of the integrated time spent in separation."""
+        return self.separation_time / max(self.t_final - self.t_span[0], 1e-300)
 
     @property
     def back_contact_fraction(self) -> np.ndarray:
-        """(n_el,) fraction of accepted states in back-side contact."""
-        return self.back_contact_steps / max(self.n_samples, 1)
+        """(n_el,) fraction of the integrated time spent in back-side contact."""
+        return self.back_contact_time / max(self.t_final - self.t_span[0], 1e-300)
 
     def cycles(self, element: int | str) -> dict[str, np.ndarray]:
         """Cycle statistics of one tracked element (by index or name) as a dict."""
@@ -148,7 +160,8 @@ class Solution:
 
 # ============================================================== model arrays
 def _model_arrays(structure: Structure) -> tuple:
-    """The 22 MODEL arrays of the kernels: contiguous, writable, float64 / int64."""
+    """The 28 MODEL arrays of the kernels (order: ``_kernels.MODEL_ARRAYS``):
+    contiguous, writable, float64 / int64 / uint64, derived index arrays included."""
     s = structure
     n_el = s.n_elements
     if np.any(np.diff(s.gap_ptr) < 1):
@@ -158,6 +171,18 @@ def _model_arrays(structure: Structure) -> tuple:
     if np.any(s.frequency < 0) or not np.all(np.isfinite(s.frequency)):
         raise SolverError("excitation frequencies must be finite and >= 0 Hz; check the "
                           "mesh frequencies of the structure.")
+    nnz = len(s.v_dof)
+    if (len(s.v_ptr) != n_el + 1 or s.v_ptr[0] != 0 or s.v_ptr[-1] != nnz
+            or np.any(np.diff(s.v_ptr) < 0) or len(s.v_coef) != nnz
+            or (nnz and (np.min(s.v_dof) < 0 or np.max(s.v_dof) >= s.n_dof))):
+        raise SolverError("the projection arrays (v_ptr, v_dof, v_coef) of the structure are "
+                          "inconsistent; rebuild it with build_structure.")
+    if (len(s.error_ptr) != n_el + 1 or s.error_ptr[-1] != len(s.error_amplitude)
+            or len(s.gap_ptr) != n_el + 1 or s.gap_ptr[-1] != len(s.gap_values)
+            or s.stiffness_table.shape != s.force_table.shape
+            or s.stiffness_table.shape[0] != n_el):
+        raise SolverError("the excitation arrays of the structure are inconsistent; "
+                          "rebuild it with build_structure.")
     if s.n_table < 1:
         raise SolverError("stiffness tables are empty; build the structure with n_table >= 1.")
 
@@ -167,16 +192,26 @@ def _model_arrays(structure: Structure) -> tuple:
     def i8(a):
         return np.array(a, dtype=np.int64, order="C", copy=True)
 
+    def u8(a):
+        return np.array(a, dtype=np.uint64, order="C", copy=True)
+
     varying = s.frequency > 0.0
     sin_el = np.repeat(np.arange(n_el, dtype=np.int64), np.diff(s.error_ptr))
     err_el = np.unique(sin_el)
+    # V by DOF (CSR of V^T) for gathering the generalized forces
+    owner = np.repeat(np.arange(n_el, dtype=np.int64), np.diff(s.v_ptr))
+    order = np.lexsort((owner, s.v_dof))
+    vt_ptr = np.zeros(s.n_dof + 1, dtype=np.int64)
+    np.add.at(vt_ptr, np.asarray(s.v_dof, dtype=np.int64) + 1, 1)
     return (
         f8(s.inv_mass), f8(s.external_force), f8(s.ground_damping), i8(s.element_kind),
         i8(s.v_ptr), i8(s.v_dof), f8(s.v_coef), f8(s.stiffness_table), f8(s.frequency),
         f8(s.phase), f8(s.damping), i8(s.gap_ptr), f8(s.gap_values),
         f8(s.error_constant), i8(s.error_ptr), f8(s.error_amplitude), f8(s.error_omega),
-        f8(s.error_phase), f8(s.force_table), i8(np.flatnonzero(varying)), i8(err_el),
-        i8(sin_el),
+        f8(s.error_phase), f8(s.force_table),
+        i8(np.flatnonzero(varying)), i8(err_el), i8(sin_el),
+        u8(s.v_ptr), u8(s.v_dof), u8(np.asarray(s.v_dof) + s.n_dof),
+        u8(np.cumsum(vt_ptr)), u8(owner[order]), f8(np.asarray(s.v_coef)[order]),
     )
 
 
@@ -385,7 +420,15 @@ def integrate(
     -------
     Solution
         Never raises for a diverging run: status and message say where and why it
-        stopped, and everything recorded before stays valid.
+        stopped, and everything recorded before stays valid.  Status 1: a state became
+        non-finite or |q| > ``blowup``; 2 (dopri): the step fell below
+        max(1e-12 x span, 10 eps |t|); 3: ``max_steps`` reached.
+
+    Notes
+    -----
+    Numbers in ``compile_time`` are per process: the first call compiles the kernels
+    (or loads them from numba's on-disk cache) through a tiny warm-up run, and every
+    later call reports the same figure; ``wall_time`` excludes it.
 
     Examples
     --------
@@ -400,227 +443,54 @@ def integrate(
     """
     compile_time = compile_kernels()
     t_call = time.perf_counter()
-
-    if method not in ("rk4", "dopri"):
-        raise ValueError(f"unknown method {method!r}; use method='rk4' (fixed step) or "
-                         "method='dopri' (adaptive Dormand-Prince 5(4)).")
-    rk4 = method == "rk4"
-    wrong = [name for name, val in (("step", step), ("steps_per_period", steps_per_period),
-                                    ("record_every", record_every),
-                                    ("check_stability", check_stability))
-             if val is not None and not rk4]
-    wrong += [name for name, val in (("rtol", rtol), ("atol", atol), ("max_step", max_step))
-              if val is not None and rk4]
-    if wrong:
-        raise ValueError(f"option(s) {wrong} do not apply to method={method!r}; remove them "
-                         f"or choose the other method.")
-    if record_every is not None and sample_interval is not None:
-        raise ValueError("give either record_every or sample_interval, not both.")
-    if progress is not None and not callable(progress):
-        raise TypeError("progress must be a callable taking the fraction done, e.g. "
-                        "progress=lambda f: print(f'{f:.0%}').")
-
+    rk4 = _check_options(method, progress, record_every, sample_interval,
+                         rk4_only=dict(step=step, steps_per_period=steps_per_period,
+                                       record_every=record_every,
+                                       check_stability=check_stability),
+                         dopri_only=dict(rtol=rtol, atol=atol, max_step=max_step))
     s = structure
-    n = s.n_dof
-    n_el = s.n_elements
     t0, t_end = (float(x) for x in t_span)
     span = t_end - t0
     if not (math.isfinite(span) and span > 0):
         raise ValueError(f"t_span must be (start, end) with end > start, got {t_span!r}.")
-    y = np.array(y0, dtype=np.float64, order="C", copy=True).ravel()
-    if y.shape == (n,):
-        y = np.concatenate([y, np.zeros(n)])
-    if y.shape != (2 * n,):
-        raise ValueError(f"y0 must hold {2 * n} values [q, v] or {n} values q, got "
-                         f"{np.shape(y0)}.")
-    if not np.all(np.isfinite(y)):
-        raise ValueError("y0 contains NaN or inf; start from finite displacements and "
-                         "velocities, e.g. static_equilibrium(structure).q.")
+    y = _initial_state(s, y0)
     model = _model_arrays(s)
-
-    # ------------------------------------------------------------ selections
-    if track_elements is None:
-        track = [e for e in range(n_el) if s.frequency[e] > 0]
-    else:
-        track = _resolve(s.element_names, track_elements, "element")
-        static_ones = [s.element_names[e] for e in track if not s.frequency[e] > 0]
-        if static_ones:
-            raise ValueError(f"elements {static_ones} have no excitation frequency, so they "
-                             "have no mesh cycles to track; leave them out of track_elements.")
-    hist_el = list(range(n_el)) if history_elements is None else _resolve(
-        s.element_names, history_elements, "element")
-    hist_dof = list(range(n)) if history_dofs is None else _resolve(
-        s.dof_names, history_dofs, "dof")
-    track_arr = np.array(track, dtype=np.int64)
-    track_base = np.array([math.floor(s.frequency[e] * t0 + s.phase[e]) for e in track],
-                          dtype=np.int64)
-    f_track = float(s.frequency[track_arr].max()) if track else 0.0
-    cap = (int(math.ceil(f_track * span)) + 2 if track else 0) if n_cycles_cap is None \
-        else int(n_cycles_cap)
-    if cap < 0:
-        raise ValueError("n_cycles_cap must be >= 0.")
-
-    periods = _excitation_periods(s)
-    t_exc = float(periods.min()) if periods.size else math.inf
-
-    # ------------------------------------------------------------ step plan
+    sel = _select(s, t0, span, track_elements, n_cycles_cap, history_elements, history_dofs)
     if rk4:
-        spp = 100 if steps_per_period is None else int(steps_per_period)
-        if spp < 1:
-            raise ValueError("steps_per_period must be >= 1.")
-        do_check = True if check_stability is None else bool(check_stability)
-        if step is None:
-            period = t_exc if math.isfinite(t_exc) else _natural_period_min(s)
-            if not math.isfinite(period):
-                period = span * spp / 1000.0
-            h = period / spp
-            if do_check:
-                safe = 0.8 * stable_step(s)
-                if h > safe:
-                    per = math.ceil(period / safe)
-                    log.info("default step %.3g s is unstable; using %d steps per period",
-                             h, per)
-                    h = period / per
-        else:
-            h = float(step)
-            if do_check:
-                check_step(s, h)
-            elif not (h > 0 and math.isfinite(h)):
-                raise ValueError(f"step must be a positive number of seconds, got {step!r}.")
-        n_total = span / h
-        n_steps_total = int(round(n_total))
-        if n_steps_total < 1 or abs(n_total - n_steps_total) > 1e-9 * n_total:
-            n_steps_total = max(1, int(math.ceil(n_total)))
-        h = span / n_steps_total if abs(n_steps_total * h - span) > 1e-12 * span else h
-        if sample_interval is not None:
-            every = max(1, int(round(float(sample_interval) / h)))
-        else:
-            every = 1 if record_every is None else int(record_every)
-        if every < 1:
-            raise ValueError("record_every must be >= 1.")
-        n_hist = n_steps_total // every + 1
-        n_full = n_steps_total + 1 if full_history else 0
-        limit_steps = n_steps_total if max_steps is None else min(n_steps_total, int(max_steps))
+        plan = _plan_rk4(s, span, step, steps_per_period, check_stability, record_every,
+                         sample_interval, full_history, max_steps)
     else:
-        rtol_ = 1e-6 if rtol is None else float(rtol)
-        if not rtol_ > 0:
-            raise ValueError("rtol must be > 0, e.g. rtol=1e-6.")
-        if atol is None:
-            atol_ = _default_atol(s, rtol_)
-        else:
-            atol_ = np.ascontiguousarray(np.broadcast_to(
-                np.asarray(atol, dtype=np.float64), (2 * n,))).copy()
-        if np.any(atol_ < 0) or (np.any(atol_ == 0) and not rtol_ > 0):
-            raise ValueError("atol must be >= 0.")
-        h_max = (t_exc / 20.0 if math.isfinite(t_exc) else span) if max_step is None \
-            else float(max_step)
-        if not h_max > 0:
-            raise ValueError("max_step must be > 0.")
-        dt_sample = (h_max if math.isfinite(t_exc) or max_step is not None
-                     else span / 1000.0) if sample_interval is None else float(sample_interval)
-        if not dt_sample > 0:
-            raise ValueError("sample_interval must be > 0.")
-        n_hist = int(math.floor(span / dt_sample * (1 + 1e-12))) + 1
-        n_full = n_hist if full_history else 0
-        limit_steps = (max(100_000, int(10 * span / h_max)) if max_steps is None
-                       else int(max_steps))
-        h = None
-    if not (hist_el or hist_dof) and (rk4 or not full_history):
-        n_hist = 0  # (dopri writes the full state at the history sample times)
-
-    # ------------------------------------------------------------ outputs
-    n_tr = len(track)
-    need = 8 * (n_hist * (1 + len(hist_el) + 2 * len(hist_dof)) + n_full * (1 + 2 * n)
-                + 4 * cap * n_tr)
-    if need > _MEMORY_LIMIT:
-        raise SolverError(
-            f"the requested outputs need {need / 1024**3:.1f} GiB; record less: raise "
-            "record_every / sample_interval, list fewer history_elements and "
-            "history_dofs, drop full_history, or lower n_cycles_cap.")
-    cyc_max = np.full((cap, n_tr), -np.inf)
-    cyc_min = np.full((cap, n_tr), np.inf)
-    cyc_sum = np.zeros((cap, n_tr))
-    cyc_cnt = np.zeros((cap, n_tr), dtype=np.int64)
-    sep_count = np.zeros(n_el, dtype=np.int64)
-    back_count = np.zeros(n_el, dtype=np.int64)
-    hist_el_a = np.array(hist_el, dtype=np.int64)
-    hist_dof_a = np.array(hist_dof, dtype=np.int64)
-    hist_t = np.zeros(n_hist)
-    hist_f = np.zeros((n_hist, len(hist_el)))
-    hist_q = np.zeros((n_hist, len(hist_dof)))
-    hist_v = np.zeros((n_hist, len(hist_dof)))
-    full_t = np.zeros(n_full)
-    full_y = np.zeros((n_full, 2 * n))
-    record = (track_arr, track_base, cyc_max, cyc_min, cyc_sum, cyc_cnt, sep_count,
-              back_count, hist_el_a, hist_dof_a, hist_t, hist_f, hist_q, hist_v,
-              full_t, full_y)
+        plan = _plan_dopri(s, span, rtol, atol, max_step, sample_interval, full_history,
+                           max_steps)
+    n_hist = plan.n_hist if (sel.hist_el or sel.hist_dof or (full_history and not rk4)) else 0
+    out = _Outputs.allocate(s, sel, n_hist, plan.n_full)
     counters = np.zeros(kern.N_COUNTERS, dtype=np.int64)
     clock = np.zeros(kern.N_CLOCK)
     clock[kern.F_T] = t0
     blowup = float(blowup)
 
-    # ------------------------------------------------------------ run
     if rk4:
-        chunk = max(_MIN_CHUNK_STEPS,
-                    -(-math.ceil(limit_steps / _N_CHUNKS) // kern.RESYNC) * kern.RESYNC)
-        done = 0
-        while done < limit_steps:
-            m = min(chunk, limit_steps - done)
-            final = done + m == limit_steps
-            kern.rk4_run(y, t0, h, done, m, final, every, blowup, *model, *record,
-                         counters, clock)
-            done += m
-            if counters[kern.I_STATUS] != kern.FINISHED:
-                break
-            if progress is not None:
-                progress(done / n_steps_total)
-        if counters[kern.I_STATUS] == kern.FINISHED and limit_steps < n_steps_total:
-            counters[kern.I_STATUS] = kern.MAX_STEPS
-        step_min = step_max = h
+        _run_rk4(y, t0, plan, blowup, model, out.record, counters, clock, progress)
+        step_min = step_max = plan.h
     else:
-        kfsal = np.zeros(2 * n)
-        clock[kern.F_H] = min(_initial_step(s, y, t0, t_end, rtol_, atol_, model), h_max)
-        clock[kern.F_FACOLD] = 1e-4
-        clock[kern.F_HMIN] = math.inf
-        clock[kern.F_HMAX] = 0.0
-        counters[kern.I_RHS] = 2  # the two evaluations of the initial step estimate
-        h_min = 1e-12 * span
-        for k in range(1, _N_CHUNKS + 1):
-            t_stop = t_end if k == _N_CHUNKS else t0 + span * k / _N_CHUNKS
-            if clock[kern.F_T] >= t_stop:
-                continue
-            kern.dopri_run(y, kfsal, t0, t_end, t_stop, rtol_, atol_, h_max, h_min,
-                           limit_steps, blowup, dt_sample, *model, *record, counters, clock)
-            if counters[kern.I_STATUS] != kern.FINISHED:
-                break
-            if progress is not None:
-                progress(min(1.0, (clock[kern.F_T] - t0) / span))
-        step_min = float(clock[kern.F_HMIN]) if counters[kern.I_STEPS] else math.nan
-        step_max = float(clock[kern.F_HMAX]) if counters[kern.I_STEPS] else math.nan
+        clock[kern.F_H] = min(_initial_step(s, y, t0, t_end, plan.rtol, plan.atol, model),
+                              plan.h_max)
+        counters[kern.I_RHS] = 2  # the two evaluations of the starting-step estimate
+        _run_dopri(y, t0, t_end, plan, blowup, model, out.record, counters, clock,
+                   progress)
+        accepted = counters[kern.I_STEPS] > 0
+        step_min = float(clock[kern.F_HMIN]) if accepted else math.nan
+        step_max = float(clock[kern.F_HMAX]) if accepted else math.nan
 
-    # ------------------------------------------------------------ results
     status = int(counters[kern.I_STATUS])
     t_final = float(clock[kern.F_T])
-    message = _message(status, s, y, t_final, t_end, counters, clock, blowup, limit_steps,
-                       method)
+    cycles = out.cycle_summary(s, sel)
     n_rec = int(counters[kern.I_HIST])
     n_full_rec = int(counters[kern.I_FULL])
-    used = np.flatnonzero(cyc_cnt.sum(axis=1) > 0)
-    n_cyc = int(used[-1]) + 1 if used.size else 0
-    cnt = cyc_cnt[:n_cyc].copy()
-    with np.errstate(invalid="ignore", divide="ignore"):
-        mean = np.where(cnt > 0, cyc_sum[:n_cyc] / cnt, np.nan)
-    cmax = np.where(cnt > 0, cyc_max[:n_cyc], np.nan)
-    cmin = np.where(cnt > 0, cyc_min[:n_cyc], np.nan)
-    rows = np.arange(n_cyc)[:, None]
-    if n_tr:
-        start = (track_base[None, :] + rows - s.phase[track_arr][None, :]) \
-            / s.frequency[track_arr][None, :]
-    else:
-        start = np.zeros((n_cyc, 0))
     return Solution(
         status=status,
-        message=message,
+        message=_message(status, s, y, t_final, t_end, counters, clock, blowup,
+                         plan.limit_steps, method),
         success=status == kern.FINISHED,
         method=method,
         t_span=(t0, t_end),
@@ -629,31 +499,292 @@ def integrate(
         n_steps=int(counters[kern.I_STEPS]),
         n_rejected=int(counters[kern.I_REJECTED]),
         n_rhs=int(counters[kern.I_RHS]),
-        step=h,
+        step=plan.h if rk4 else None,
         step_min=step_min,
         step_max=step_max,
         compile_time=compile_time,
         wall_time=time.perf_counter() - t_call,
         dof_names=tuple(s.dof_names),
         element_names=tuple(s.element_names),
-        tracked_elements=tuple(track),
-        cycle_start=start,
-        cycle_max=cmax,
-        cycle_min=cmin,
-        cycle_mean=mean,
-        cycle_count=cnt,
-        history_elements=tuple(hist_el),
-        history_dofs=tuple(hist_dof),
-        history_t=hist_t[:n_rec].copy(),
-        history_forces=hist_f[:n_rec].copy(),
-        history_q=hist_q[:n_rec].copy(),
-        history_v=hist_v[:n_rec].copy(),
-        full_t=full_t[:n_full_rec].copy() if full_history else None,
-        full_y=full_y[:n_full_rec].copy() if full_history else None,
+        tracked_elements=tuple(sel.track),
+        **cycles,
+        history_elements=tuple(sel.hist_el),
+        history_dofs=tuple(sel.hist_dof),
+        history_t=_rows(out.hist_t, n_rec),
+        history_forces=_rows(out.hist_f, n_rec),
+        history_q=_rows(out.hist_q, n_rec),
+        history_v=_rows(out.hist_v, n_rec),
+        full_t=_rows(out.full_t, n_full_rec) if full_history else None,
+        full_y=_rows(out.full_y, n_full_rec) if full_history else None,
         n_samples=int(counters[kern.I_SAMPLES]),
-        separation_steps=sep_count,
-        back_contact_steps=back_count,
+        separation_steps=out.sep_count,
+        back_contact_steps=out.back_count,
+        separation_time=out.sep_time,
+        back_contact_time=out.back_time,
     )
+
+
+# ============================================================ integrate: parts
+def _check_options(method, progress, record_every, sample_interval, *, rk4_only,
+                   dopri_only) -> bool:
+    """Refuse unknown methods and options that the chosen method would ignore."""
+    if method not in ("rk4", "dopri"):
+        raise ValueError(f"unknown method {method!r}; use method='rk4' (fixed step) or "
+                         "method='dopri' (adaptive Dormand-Prince 5(4)).")
+    rk4 = method == "rk4"
+    ignored = rk4_only if not rk4 else dopri_only
+    wrong = [name for name, val in ignored.items() if val is not None]
+    if wrong:
+        raise ValueError(f"option(s) {wrong} do not apply to method={method!r}; remove them "
+                         f"or choose the other method.")
+    if record_every is not None and sample_interval is not None:
+        raise ValueError("give either record_every or sample_interval, not both.")
+    if progress is not None and not callable(progress):
+        raise TypeError("progress must be a callable taking the fraction done, e.g. "
+                        "progress=lambda f: print(f'{f:.0%}').")
+    return rk4
+
+
+def _initial_state(s: Structure, y0) -> np.ndarray:
+    n = s.n_dof
+    y = np.array(y0, dtype=np.float64, order="C", copy=True).ravel()
+    if y.shape == (n,):
+        y = np.concatenate([y, np.zeros(n)])
+    if y.shape != (2 * n,):
+        raise ValueError(f"y0 must hold {2 * n} values [q, v] or {n} values q, got shape "
+                         f"{np.shape(y0)}.")
+    if not np.all(np.isfinite(y)):
+        raise ValueError("y0 contains NaN or inf; start from finite displacements and "
+                         "velocities, e.g. static_equilibrium(structure).y0.")
+    return y
+
+
+@dataclass(frozen=True)
+class _Selection:
+    track: list[int]
+    track_base: np.ndarray  # floor(f t0 + phase) of each tracked element
+    n_cycles_cap: int
+    hist_el: list[int]
+    hist_dof: list[int]
+
+
+def _select(s, t0, span, track_elements, n_cycles_cap, history_elements,
+            history_dofs) -> _Selection:
+    if track_elements is None:
+        track = [e for e in range(s.n_elements) if s.frequency[e] > 0]
+    else:
+        track = _resolve(s.element_names, track_elements, "element")
+        static_ones = [s.element_names[e] for e in track if not s.frequency[e] > 0]
+        if static_ones:
+            raise ValueError(f"elements {static_ones} have no excitation frequency, so they "
+                             "have no mesh cycles to track; leave them out of track_elements.")
+    # same floating-point expression as the kernel's cycle index at t0
+    base = np.array([math.floor(s.frequency[e] * t0 + s.phase[e]) for e in track],
+                    dtype=np.int64)
+    if n_cycles_cap is None:
+        f_max = max((float(s.frequency[e]) for e in track), default=0.0)
+        cap = int(math.ceil(f_max * span)) + 2 if track else 0
+    else:
+        cap = int(n_cycles_cap)
+        if cap < 0:
+            raise ValueError("n_cycles_cap must be >= 0.")
+    hist_el = list(range(s.n_elements)) if history_elements is None else _resolve(
+        s.element_names, history_elements, "element")
+    hist_dof = list(range(s.n_dof)) if history_dofs is None else _resolve(
+        s.dof_names, history_dofs, "dof")
+    return _Selection(track, base, cap, hist_el, hist_dof)
+
+
+@dataclass(frozen=True)
+class _Plan:
+    limit_steps: int  # accepted steps before status MAX_STEPS
+    n_hist: int  # rows of the history arrays
+    n_full: int  # rows of the full-state arrays
+    h: float = math.nan  # rk4 step
+    n_steps: int = 0  # rk4 steps spanning t_span
+    every: int = 1  # rk4 history decimation
+    rtol: float = math.nan  # dopri
+    atol: np.ndarray | None = None
+    h_max: float = math.nan
+    h_min: float = math.nan
+    dt_sample: float = math.nan
+
+
+def _plan_rk4(s, span, step, steps_per_period, check_stability, record_every,
+              sample_interval, full_history, max_steps) -> _Plan:
+    spp = 100 if steps_per_period is None else int(steps_per_period)
+    if spp < 1:
+        raise ValueError("steps_per_period must be >= 1.")
+    check = True if check_stability is None else bool(check_stability)
+    if step is None:
+        periods = _excitation_periods(s)
+        period = float(periods.min()) if periods.size else _natural_period_min(s)
+        if not math.isfinite(period):  # nothing oscillates: 1000 steps
+            period = span * spp / 1000.0
+        h = period / spp
+        if check:
+            safe = 0.8 * stable_step(s)
+            if h > safe:  # keep a whole number of steps per period
+                per = math.ceil(period / safe)
+                log.info("default step %.3g s is unstable; using %d steps per period", h, per)
+                h = period / per
+    else:
+        h = float(step)
+        if check:
+            check_step(s, h)
+        elif not (h > 0 and math.isfinite(h)):
+            raise ValueError(f"step must be a positive number of seconds, got {step!r}.")
+    # a whole number of steps spans t_span (h is kept when it already divides it)
+    n_float = span / h
+    n_steps = int(round(n_float))
+    if n_steps < 1 or abs(n_float - n_steps) > 1e-9 * n_float:
+        n_steps = max(1, int(math.ceil(n_float)))
+    if abs(n_steps * h - span) > 1e-12 * span:
+        h = span / n_steps
+    if sample_interval is not None:
+        every = max(1, int(round(float(sample_interval) / h)))
+    else:
+        every = 1 if record_every is None else int(record_every)
+        if every < 1:
+            raise ValueError("record_every must be >= 1.")
+    limit = n_steps if max_steps is None else min(n_steps, int(max_steps))
+    return _Plan(limit_steps=limit, n_hist=n_steps // every + 1,
+                 n_full=n_steps + 1 if full_history else 0, h=h, n_steps=n_steps,
+                 every=every)
+
+
+def _plan_dopri(s, span, rtol, atol, max_step, sample_interval, full_history,
+                max_steps) -> _Plan:
+    rtol = 1e-6 if rtol is None else float(rtol)
+    if not rtol > 0:
+        raise ValueError("rtol must be > 0, e.g. rtol=1e-6.")
+    if atol is None:
+        atol = _default_atol(s, rtol)
+    else:
+        atol = np.ascontiguousarray(np.broadcast_to(np.asarray(atol, dtype=np.float64),
+                                                    (2 * s.n_dof,))).copy()
+        if not np.all(atol > 0):
+            raise ValueError("atol must be > 0 (scalar or one value per state [q, v]).")
+    periods = _excitation_periods(s)
+    if max_step is None:
+        h_max = float(periods.min()) / 20.0 if periods.size else span
+    else:
+        h_max = float(max_step)
+        if not h_max > 0:
+            raise ValueError("max_step must be > 0.")
+    if sample_interval is None:
+        dt = h_max if (periods.size or max_step is not None) else span / 1000.0
+    else:
+        dt = float(sample_interval)
+        if not dt > 0:
+            raise ValueError("sample_interval must be > 0.")
+    n_hist = int(math.floor(span / dt * (1 + 1e-12))) + 1
+    limit = max(100_000, int(10 * span / h_max)) if max_steps is None else int(max_steps)
+    return _Plan(limit_steps=limit, n_hist=n_hist, n_full=n_hist if full_history else 0,
+                 rtol=rtol, atol=atol, h_max=h_max, h_min=1e-12 * span, dt_sample=dt)
+
+
+@dataclass(frozen=True)
+class _Outputs:
+    """The RECORD arrays the kernels fill (order: ``_kernels.RECORD_ARRAYS``)."""
+
+    record: tuple
+
+    def __getattr__(self, name):
+        try:
+            return self.record[kern.RECORD_ARRAYS.index(name)]
+        except ValueError:
+            raise AttributeError(name) from None
+
+    @classmethod
+    def allocate(cls, s: Structure, sel: _Selection, n_hist: int, n_full: int):
+        n, n_el, cap, n_tr = s.n_dof, s.n_elements, sel.n_cycles_cap, len(sel.track)
+        n_he, n_hd = len(sel.hist_el), len(sel.hist_dof)
+        need = 8 * (n_hist * (1 + n_he + 2 * n_hd) + n_full * (1 + 2 * n) + 4 * cap * n_tr)
+        if need > _MEMORY_LIMIT:
+            raise SolverError(
+                f"the requested outputs need {need / 1024**3:.1f} GiB; record less: raise "
+                "record_every / sample_interval, list fewer history_elements and "
+                "history_dofs, drop full_history, or lower n_cycles_cap.")
+        return cls((
+            np.array(sel.track, dtype=np.int64), sel.track_base,
+            np.full((cap, n_tr), -np.inf), np.full((cap, n_tr), np.inf),
+            np.zeros((cap, n_tr)), np.zeros((cap, n_tr), dtype=np.int64),
+            np.zeros(n_el, dtype=np.int64), np.zeros(n_el, dtype=np.int64),
+            np.zeros(n_el), np.zeros(n_el),
+            np.array(sel.hist_el, dtype=np.int64), np.array(sel.hist_dof, dtype=np.int64),
+            np.zeros(n_hist), np.zeros((n_hist, n_he)), np.zeros((n_hist, n_hd)),
+            np.zeros((n_hist, n_hd)), np.zeros(n_full), np.zeros((n_full, 2 * n)),
+        ))
+
+    def cycle_summary(self, s: Structure, sel: _Selection) -> dict:
+        """Cycle arrays trimmed to the cycles reached; NaN where a cycle has no sample.
+
+        Works in place on the kernel's buffers (the sums become means), so the summary
+        costs no second copy of them.
+        """
+        cnt_all = self.cyc_cnt
+        used = np.flatnonzero(cnt_all.any(axis=1))
+        n_cyc = int(used[-1]) + 1 if used.size else 0
+        empty = cnt_all == 0
+        for buf in (self.cyc_max, self.cyc_min, self.cyc_sum):
+            buf[empty] = np.nan
+        np.divide(self.cyc_sum, cnt_all, out=self.cyc_sum, where=~empty)
+        tr = np.array(sel.track, dtype=np.int64)
+        rows = np.arange(n_cyc)[:, None]
+        start = (sel.track_base[None, :] + rows - s.phase[tr][None, :]) \
+            / s.frequency[tr][None, :] if tr.size else np.zeros((n_cyc, 0))
+        return dict(cycle_start=start, cycle_max=_rows(self.cyc_max, n_cyc),
+                    cycle_min=_rows(self.cyc_min, n_cyc), cycle_mean=_rows(self.cyc_sum, n_cyc),
+                    cycle_count=_rows(cnt_all, n_cyc))
+
+
+def _rows(buf: np.ndarray, n: int) -> np.ndarray:
+    """The first n rows of an output buffer (the solution owns the buffer).
+
+    A view when nearly all of it is used (no second copy of a large output), else a
+    copy, so that a mostly unused buffer (a run that stopped early) is freed.
+    """
+    return buf[:n] if n >= 0.9 * buf.shape[0] else buf[:n].copy()
+
+
+def _run_rk4(y, t0, plan, blowup, model, record, counters, clock, progress):
+    """Run the RK4 kernel in chunks (multiples of RESYNC steps, about 1.5 % each)."""
+    per_chunk = math.ceil(plan.limit_steps / _N_CHUNKS)
+    chunk = max(_MIN_CHUNK_STEPS, -(-per_chunk // kern.RESYNC) * kern.RESYNC)
+    done = 0
+    while done < plan.limit_steps:
+        m = min(chunk, plan.limit_steps - done)
+        last = done + m == plan.limit_steps
+        kern.rk4_run(y, t0, plan.h, done, m, last, plan.every, blowup, *model, *record,
+                     counters, clock)
+        done += m
+        if counters[kern.I_STATUS] != kern.FINISHED:
+            return
+        if progress is not None:
+            progress(done / plan.n_steps)
+    if plan.limit_steps < plan.n_steps:
+        counters[kern.I_STATUS] = kern.MAX_STEPS
+
+
+def _run_dopri(y, t0, t_end, plan, blowup, model, record, counters, clock, progress):
+    """Run the Dormand-Prince kernel up to successive 1/64 fractions of the span."""
+    kfsal = np.zeros(y.shape[0])
+    clock[kern.F_FACOLD] = 1e-4
+    clock[kern.F_HMIN] = math.inf
+    clock[kern.F_HMAX] = 0.0
+    span = t_end - t0
+    for k in range(1, _N_CHUNKS + 1):
+        t_stop = t_end if k == _N_CHUNKS else t0 + span * k / _N_CHUNKS
+        if clock[kern.F_T] >= t_stop:
+            continue
+        kern.dopri_run(y, kfsal, t0, t_end, t_stop, plan.rtol, plan.atol, plan.h_max,
+                       plan.h_min, plan.limit_steps, blowup, plan.dt_sample, *model,
+                       *record, counters, clock)
+        if counters[kern.I_STATUS] != kern.FINISHED:
+            return
+        if progress is not None:
+            progress(min(1.0, (clock[kern.F_T] - t0) / span))
 
 
 def _initial_step(s, y, t0, t_end, rtol, atol, model) -> float:

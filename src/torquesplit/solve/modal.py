@@ -17,11 +17,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from torquesplit.assembly.structure import Structure
+from torquesplit.solve._frozen import freeze_arrays
 
 __all__ = ["ModalSolution", "modal_analysis"]
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class ModalSolution:
     """Natural frequencies and modes (SI; columns are modes, ascending frequency)."""
 
@@ -40,6 +41,9 @@ class ModalSolution:
     """(n_el,) bool: elements in contact at the linearisation state."""
     dof_names: tuple[str, ...]
     element_names: tuple[str, ...]
+
+    def __post_init__(self):
+        freeze_arrays(self)
 
     @property
     def n_modes(self) -> int:

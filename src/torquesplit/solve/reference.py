@@ -19,6 +19,7 @@ __all__ = [
     "excitation_numpy",
     "element_forces_numpy",
     "rhs_numpy",
+    "contact_state_numpy",
     "hermite_numpy",
     "cycle_statistics_numpy",
     "rk4_numpy",
@@ -121,6 +122,21 @@ def rhs_numpy(structure: Structure, t: float, y: np.ndarray) -> np.ndarray:
     return np.concatenate([v, accel])
 
 
+def contact_state_numpy(structure: Structure, t: float, y: np.ndarray):
+    """Which elements are separated and which touch on their back side at (t, y).
+
+    Separated: |delta| <= g with g > 0.  Back-side contact: delta < -g with g > 0, or
+    delta < 0 for a mesh without backlash.  Returns two boolean arrays (n_el,).
+    Twin of the contact counters in ``_kernels.record_statistics``.
+    """
+    _, delta = element_forces_numpy(structure, t, y)
+    g = excitation_numpy(structure, t).half_gap
+    gapped = g > 0
+    separated = gapped & (np.abs(delta) <= g)
+    back = np.where(gapped, delta < -g, (structure.element_kind == MESH) & (delta < 0))
+    return separated, back
+
+
 def hermite_numpy(theta, h, y0, f0, y1, f1):
     """Cubic Hermite interpolant between (y0, f0) and (y1, f1) at t0 + theta h.
 
@@ -215,12 +231,12 @@ def dopri_numpy(structure: Structure, y0, t_span, *, rtol, atol, h0, h_max=np.in
                 hs = 0.5 * (t_end - t)
         k = [f]
         for i in range(1, 7):
-            yi = y + hs * sum(a * kj for a, kj in zip(_DP_A[i], k))
+            yi = y + hs * sum(a * kj for a, kj in zip(_DP_A[i], k, strict=False))
             ti = t_end if (last and i >= 5) else t + _DP_C[i] * hs
             k.append(rhs_numpy(structure, ti, yi))
             if i == 6:
                 y_new = yi
-        err = hs * sum(e * kj for e, kj in zip(_DP_E, k))
+        err = hs * sum(e * kj for e, kj in zip(_DP_E, k, strict=True))
         scale = atol + rtol * np.maximum(np.abs(y), np.abs(y_new))
         enorm = np.sqrt(np.mean((err / scale) ** 2))
         if not np.isfinite(enorm):

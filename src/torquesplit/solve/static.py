@@ -5,9 +5,11 @@ Solves ``sum_e V_e f_e(q) = F_ext`` with ``f_e = k_e h(V_e.q - e_e; g_e) + p_e``
 the "Newton" iteration is an active-set iteration: with each element's contact state
 fixed (front contact, back contact, separated) the equations are linear; solve, update
 the states from the new deformations, repeat until no state changes.  Separated
-elements get a tiny regularising stiffness (``regularisation`` x k) so that a member
-left floating by them stays determined; they are reported in
-``StaticSolution.separated`` and their force is exactly zero.
+elements get a tiny regularising stiffness (``regularisation`` x k) during the
+iteration so that a member left floating by them stays determined; they are reported
+in ``StaticSolution.separated`` and their force is exactly zero.  Once the contact
+states have settled, the regularisation is dropped again if the elements in contact
+hold every DOF on their own, so the equilibrium is then exact.
 
 Rigid-body modes are the null space of the structure with every dead zone closed.  A
 gear train driven and loaded by torques has one (the whole train turning).  Each is
@@ -29,6 +31,7 @@ import numpy as np
 
 from torquesplit.assembly.structure import Structure
 from torquesplit.errors import SolverError
+from torquesplit.solve._frozen import freeze_arrays
 from torquesplit.solve.reference import excitation_numpy
 
 __all__ = ["StaticSolution", "QuasiStaticSolution", "static_equilibrium", "quasi_static",
@@ -37,7 +40,7 @@ __all__ = ["StaticSolution", "QuasiStaticSolution", "static_equilibrium", "quasi
 FRONT, SEPARATED, BACK = 1, 0, -1
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class StaticSolution:
     """Static equilibrium of a structure (SI units)."""
 
@@ -60,13 +63,16 @@ class StaticSolution:
     t: float | None
     """Time of the excitation used, None for mean values."""
 
+    def __post_init__(self):
+        freeze_arrays(self)
+
     @property
     def y0(self) -> np.ndarray:
         """``[q, 0]``: a state to start :func:`~torquesplit.solve.integrate.integrate` from."""
         return np.concatenate([self.q, np.zeros_like(self.q)])
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class QuasiStaticSolution:
     """Static equilibrium at a sequence of times (rows = times)."""
 
@@ -85,6 +91,9 @@ class QuasiStaticSolution:
     """(n_times,) int."""
     rigid_modes: np.ndarray
     """(n_dof, n_rigid) mass-normalised rigid-body modes."""
+
+    def __post_init__(self):
+        freeze_arrays(self)
 
 
 def rigid_body_modes(structure: Structure, active: np.ndarray | None = None,
@@ -154,8 +163,7 @@ class _StaticProblem:
                     f"{unit} referred to '{s.dof_names[j]}' "
                     f"({100 * abs(net) / scale:.3g} % of the applied load), so no static "
                     f"equilibrium exists. Make the drive and load torques consistent with "
-                    f"the gear ratios (output torque = input torque x ratio, minus losses), "
-                    f"or give the load a speed-dependent characteristic.")
+                    f"the gear ratios (output torque = input torque x ratio, minus losses).")
 
     def solve(self, t, states=None, max_iterations=50):
         s = self.s
@@ -176,19 +184,20 @@ class _StaticProblem:
         converged = False
         it = 0
         q = np.zeros(n)
-        for it in range(1, max_iterations + 1):
+
+        def linear_solve(k_eff, target):
+            A = np.zeros((n + r, n + r))
+            A[:n, :n] = V.T @ (k_eff[:, None] * V)
+            A[:n, n:] = B
+            A[n:, :n] = B.T
+            rhs = np.concatenate([f_eff + V.T @ (k_eff * target), np.zeros(r)])
+            return self._solve(A, rhs, k_eff)[:n]
+
+        for it in range(1, max_iterations + 1):  # noqa: B007 (returned)
             offset = np.where(gapped & ~first_linear, states * g, 0.0)
             on = stiff & ((states != SEPARATED) | first_linear)
             k_eff = np.where(on, k, self.reg * np.abs(k))
-            target = e + np.where(on, offset, 0.0)
-            K = V.T @ (k_eff[:, None] * V)
-            rhs = f_eff + V.T @ (k_eff * target)
-            A = np.zeros((n + r, n + r))
-            A[:n, :n] = K
-            A[:n, n:] = B
-            A[n:, :n] = B.T
-            sol = self._solve(A, np.concatenate([rhs, np.zeros(r)]), k_eff)
-            q = sol[:n]
+            q = linear_solve(k_eff, e + np.where(on, offset, 0.0))
             delta = V @ q - e
             new = np.where(delta > g, FRONT, np.where(delta < -g, BACK, SEPARATED))
             new = np.where(gapped, new, FRONT)
@@ -200,6 +209,16 @@ class _StaticProblem:
                 break  # cycling between contact states
             seen.add(key)
             states, first_linear = new, False
+        separated = stiff & (states == SEPARATED)
+        if converged and separated.any():
+            # drop the regularisation if the contact elements alone hold every DOF
+            on = stiff & ~separated
+            if rigid_body_modes(self.s, active=on).shape[1] == self.phi.shape[1]:
+                q_exact = linear_solve(np.where(on, k, 0.0), e + np.where(on, states * g, 0.0))
+                d_exact = V @ q_exact - e
+                check = np.where(d_exact > g, FRONT, np.where(d_exact < -g, BACK, SEPARATED))
+                if np.array_equal(np.where(gapped, check, FRONT), states):
+                    q = q_exact
         delta = V @ q - e
         h = np.where(gapped, np.where(delta > g, delta - g,
                                       np.where(delta < -g, delta + g, 0.0)), delta)

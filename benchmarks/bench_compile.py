@@ -1,0 +1,109 @@
+"""Compile time of the kernels, cold (empty numba cache) and cached, in fresh processes.
+
+:func:`measure` runs this file twice as a child process with ``NUMBA_CACHE_DIR`` set to
+one new temporary directory: the first child finds the cache empty and compiles every
+kernel (cold compile); the second loads them from that cache.  The project's own cache
+(``src/torquesplit/solve/__pycache__``) is neither used nor touched.
+
+Each child prints one JSON line with, in seconds:
+
+* ``import``  -- ``import torquesplit.solve.integrate`` (numpy, numba, the kernel module);
+* ``compile`` -- :func:`torquesplit.solve.integrate.compile_kernels` (every kernel:
+  RK4, Dormand-Prince and the single right-hand side), the number ``Solution.compile_time``
+  reports;
+* ``compile_cpu`` -- CPU seconds of that compilation (less than the wall time when other
+  processes load the machine);
+* ``kernels`` -- numba's own compile timers per kernel (inclusive of its callees);
+* ``first_run`` -- then assembling seed 001 and integrating 1000 RK4 steps;
+* ``total`` -- wall time from the start of the child to the end of that first run
+  (the interpreter start-up itself excluded).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+
+def _child() -> None:
+    t0 = time.perf_counter()
+    import warnings
+
+    from torquesplit.solve.integrate import compile_kernels, integrate
+
+    t1 = time.perf_counter()
+    c1 = time.process_time()
+    compile_time = compile_kernels()
+    t2 = time.perf_counter()
+    compile_cpu = time.process_time() - c1
+    import torquesplit
+    from torquesplit.solve.static import static_equilibrium
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", torquesplit.ModelWarning)
+        model = torquesplit.load_model(torquesplit.example_path("seed001_mill_drive"))
+    s = torquesplit.assemble(model)
+    st = static_equilibrium(s)
+    h = 1.0 / (100 * s.frequency.max())
+    integrate(s, st.y0, (0.0, 1000 * h), method="rk4", steps_per_period=100,
+                    record_every=100)
+    t3 = time.perf_counter()
+    from numba.core import config
+
+    print(json.dumps({"import_": t1 - t0, "compile": t2 - t1, "compile_cpu": compile_cpu,
+                          "compile_reported": compile_time, "first_run": t3 - t2, "total": t3 - t0,
+                          "cache_dir": config.CACHE_DIR, "kernels": _kernel_timers()}))
+
+
+def _kernel_timers() -> dict:
+    """Per kernel: numba's compile timers (inclusive of the kernels it calls), seconds.
+
+    ``compiler_lock`` is the whole compilation, ``llvm_lock`` its LLVM part; both are 0
+    for a kernel loaded from the cache.
+    """
+    from numba.core.registry import CPUDispatcher
+
+    from torquesplit.solve import _kernels
+
+    out = {}
+    for name, obj in vars(_kernels).items():
+        if isinstance(obj, CPUDispatcher):
+            tot = llvm = 0.0
+            for cres in obj.overloads.values():
+                timers = (cres.metadata or {}).get("timers", {})
+                tot += timers.get("compiler_lock", 0.0)
+                llvm += timers.get("llvm_lock", 0.0)
+            out[name] = {"n_signatures": len(obj.overloads), "compile": tot, "llvm": llvm}
+    return out
+
+
+def run_child(cache_dir: str) -> dict:
+    env = dict(os.environ, NUMBA_CACHE_DIR=cache_dir)
+    out = subprocess.run([sys.executable, str(Path(__file__).resolve()), "--child"],
+                         env=env, capture_output=True, text=True, check=False)
+    if out.returncode != 0:
+        raise RuntimeError(f"compile-time child failed:\n{out.stderr}")
+    data = json.loads(out.stdout.strip().splitlines()[-1])
+    data["import"] = data.pop("import_")
+    return data
+
+
+def measure() -> dict:
+    """{"cold": {...}, "cached": {...}} from two fresh processes sharing a new cache."""
+    with tempfile.TemporaryDirectory(prefix="torquesplit-numba-cache-") as tmp:
+        cold = run_child(tmp)
+        n_files = sum(1 for _ in Path(tmp).rglob("*.nbi"))
+        cached = run_child(tmp)
+    return {"cold": cold, "cached": cached, "cache_index_files": n_files}
+
+
+if __name__ == "__main__":
+    if "--child" in sys.argv:
+        _child()
+    else:
+        print(json.dumps(measure(), indent=2))

@@ -1,0 +1,423 @@
+"""Speed benchmark of the torquesplit engine; writes benchmarks/RESULTS.md.
+
+    python benchmarks/run.py            # full run (a few minutes on 2 cores)
+    python benchmarks/run.py --quick    # fewer steps, 1-million-step memory run
+
+Every comparison is a ratio against a baseline measured in the same run, never an
+absolute threshold; the issue's targets are printed beside the measured values.  See
+benchmarks/README.md for what each number means.  Not part of the test suite.
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime as _dt
+import math
+import os
+import platform
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+
+import bench_baseline
+import bench_compile
+import bench_engine
+import bench_memory
+
+TARGETS = {
+    "us_per_step": 1.0,  # seed 001, microseconds per RK4 step
+    "speedup": 1000.0,  # engine / scipy baseline, simulated seconds per wall second
+    "compile": 20.0,  # first (cold) compilation, seconds
+    "memory": 300.0,  # MB (MiB) for a 10-million-step run
+}
+SEED001 = "seed001_mill_drive"
+
+
+def _log(msg: str) -> None:
+    print(f"[{time.strftime('%H:%M:%S')}] {msg}", file=sys.stderr, flush=True)
+
+
+def _settings(quick: bool) -> dict:
+    if quick:
+        return {"engine_steps": 50_000, "memory_steps": 1_000_000, "scipy_periods": 5,
+                    "numpy_rk4_steps": 50, "scipy_budget": 20.0, "kernel_calls": 200_000}
+    return {"engine_steps": 200_000, "memory_steps": 10_000_000, "scipy_periods": 20,
+                "numpy_rk4_steps": 200, "scipy_budget": 25.0, "kernel_calls": 1_000_000}
+
+
+# ======================================================================== run
+def run(quick: bool, repeat: int, skip_compile: bool = False) -> dict:
+    cfg = _settings(quick)
+    t_start = time.perf_counter()
+    res = {"quick": quick, "repeat": repeat, "cfg": cfg, "machine": _machine(),
+               "load_start": _loadavg()}
+
+    from torquesplit.solve.integrate import compile_kernels
+
+    _log("loading kernels (numba cache)")
+    compile_kernels()
+
+    _log("assembling the shipped examples and the generated split models")
+    examples, res["skipped"] = bench_engine.example_cases()
+    for name, why in res["skipped"].items():
+        _log(f"  skipped {name}: {why}")
+    splits = bench_engine.split_cases((2, 4, 8, 16))
+    cases = examples + splits
+
+    _log(f"engine: {cfg['engine_steps']} RK4 steps per model, best of {repeat}")
+    res["engine"] = []
+    for c in cases:
+        r = bench_engine.time_rk4(c, cfg["engine_steps"], repeat)
+        _log(f"  {c.name}: {r['us_per_step']:.2f} us/step (cpu {r['cpu_us_per_step']:.2f})")
+        res["engine"].append(r)
+    eng = {r["model"]: r for r in res["engine"]}
+
+    _log("engine dopri (rtol 1e-6) over a tenth of that simulated time")
+    res["dopri"] = [bench_engine.time_dopri(c, 0.1 * eng[c.name]["simulated"], 1e-6, repeat)
+                    for c in cases]
+
+    _log(f"scipy RK45 baselines over {cfg['scipy_periods']} shortest mesh periods")
+    res["scipy"], res["scipy_cached"], res["numpy_rk4"], res["cached_check"] = [], [], [], []
+    for c in cases:
+        a = bench_baseline.time_scipy(c, cfg["scipy_periods"], budget=cfg["scipy_budget"])
+        b = bench_baseline.time_scipy(c, cfg["scipy_periods"], cached=True,
+                                      budget=cfg["scipy_budget"])
+        n = bench_baseline.time_numpy_rk4(c, eng[c.name]["step"], cfg["numpy_rk4_steps"])
+        res["scipy"].append(a)
+        res["scipy_cached"].append(b)
+        res["numpy_rk4"].append(n)
+        res["cached_check"].append(bench_baseline.check_cached_rhs(c))
+        _log(f"  {c.name}: scipy {a['sim_per_wall']:.3g} sim s/s ({a['n_rhs']} rhs), "
+             f"cached-V {b['sim_per_wall']:.3g}, numpy RK4 {n['us_per_step']:.0f} us/step")
+
+    _log("kernel building blocks (seed 001)")
+    import bench_kernel_parts
+
+    c001 = next(c for c in cases if c.name == SEED001)
+    res["parts"] = bench_kernel_parts.breakdown(c001, cfg["kernel_calls"],
+                                                cfg["engine_steps"])
+    if quick:
+        res["marginal"] = None
+    else:
+        _log("in-situ cost of rhs_slot (compiles a patched kernel copy, ~20-40 s)")
+        res["marginal"] = bench_kernel_parts.marginal_rhs_cost(c001, cfg["engine_steps"])
+
+    _log(f"memory: {cfg['memory_steps']:,} steps of seed 001 in a fresh process")
+    res["memory"] = bench_memory.measure(cfg["memory_steps"], 100)
+
+    if skip_compile:
+        res["compile"] = None
+    else:
+        _log("compile time: cold and cached, in fresh processes (takes ~20-60 s)")
+        res["compile"] = bench_compile.measure()
+
+    res["load_end"] = _loadavg()
+    res["elapsed"] = time.perf_counter() - t_start
+    return res
+
+
+# ===================================================================== report
+def _machine() -> dict:
+    import numba
+    import numpy
+    import scipy
+
+    import torquesplit
+
+    try:
+        commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=HERE,
+                                capture_output=True, text=True, check=False).stdout.strip()
+        dirty = subprocess.run(["git", "status", "--porcelain", "src"], cwd=HERE.parent,
+                               capture_output=True, text=True, check=False).stdout.strip()
+    except OSError:
+        commit, dirty = "?", ""
+    kern_file = HERE.parent / "src" / "torquesplit" / "solve" / "_kernels.py"
+    try:
+        import hashlib
+
+        kern_sha = hashlib.sha256(kern_file.read_bytes()).hexdigest()[:10]
+        kern_dirty = subprocess.run(["git", "diff", "--quiet", "HEAD", "--", str(kern_file)],
+                                    cwd=HERE.parent, check=False).returncode != 0
+    except OSError:
+        kern_sha, kern_dirty = "?", False
+    cpu = platform.processor() or ""
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    return {
+        "date": _dt.datetime.now().astimezone().strftime("%Y-%m-%d %H:%M %Z"),
+        "platform": platform.platform(), "cpu": cpu, "cpu_count": os.cpu_count(),
+        "python": platform.python_version(), "numba": numba.__version__,
+        "numpy": numpy.__version__, "scipy": scipy.__version__,
+        "torquesplit": torquesplit.__version__, "commit": commit,
+        "src_dirty": len(dirty.splitlines()) if dirty else 0,
+        "kernels_sha": kern_sha, "kernels_modified": kern_dirty,
+    }
+
+
+def _loadavg():
+    try:
+        return os.getloadavg()
+    except OSError:
+        return (math.nan,) * 3
+
+
+def _f(x, digits=3) -> str:
+    if x is None or (isinstance(x, float) and math.isnan(x)):
+        return "-"
+    if isinstance(x, int):
+        return f"{x:,}"
+    if x == 0:
+        return "0"
+    mag = abs(x)
+    if mag >= 1e5 or mag < 1e-3:
+        return f"{x:.{digits - 1}e}"
+    return f"{x:.{max(digits - 1 - math.floor(math.log10(mag)), 0)}f}"
+
+
+def _table(header, rows) -> str:
+    out = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    out += ["| " + " | ".join(str(c) for c in r) + " |" for r in rows]
+    return "\n".join(out)
+
+
+def _ok(passed: bool | None) -> str:
+    return "-" if passed is None else ("met" if passed else "**not met**")
+
+
+def report(res: dict) -> str:
+    m, cfg = res["machine"], res["cfg"]
+    eng = {r["model"]: r for r in res["engine"]}
+    dop = {r["model"]: r for r in res["dopri"]}
+    sci = {r["model"]: r for r in res["scipy"]}
+    scc = {r["model"]: r for r in res["scipy_cached"]}
+    nrk = {r["model"]: r for r in res["numpy_rk4"]}
+    mem, comp = res["memory"], res["compile"]
+    e001 = eng[SEED001]
+    speed001 = e001["sim_per_wall"] / sci[SEED001]["sim_per_wall"]
+    speed_min = min(eng[k]["sim_per_wall"] / sci[k]["sim_per_wall"] for k in eng)
+    mode = ("**--quick** (fewer steps; the memory run is 1 million steps, not 10 million)"
+            if res["quick"] else "full")
+    L = []
+    L.append("# torquesplit speed benchmark results\n")
+    L.append(f"Produced by `python benchmarks/run.py{' --quick' if res['quick'] else ''}` "
+             f"(mode: {mode}) in {res['elapsed'] / 60:.1f} min. Regenerate with the same "
+             "command; see `benchmarks/README.md` for what each number means.\n")
+    L.append(_table(["machine", ""], [
+        ["date", m["date"]], ["platform", m["platform"]], ["CPU", m["cpu"]],
+        ["cpu count", m["cpu_count"]], ["Python", m["python"]], ["numba", m["numba"]],
+        ["numpy", m["numpy"]], ["scipy", m["scipy"]],
+        ["torquesplit", f"{m['torquesplit']} (commit {m['commit']}"
+         + (f", {m['src_dirty']} uncommitted file(s) under src/)" if m["src_dirty"] else ")")],
+        ["solve/_kernels.py measured", f"sha256 {m['kernels_sha']}"
+         + (" (uncommitted changes against HEAD)" if m["kernels_modified"] else " (as in HEAD)")],
+        ["load average (1/5/15 min) at start", " / ".join(f"{x:.2f}" for x in res["load_start"])],
+        ["load average at end", " / ".join(f"{x:.2f}" for x in res["load_end"])],
+    ]))
+    L.append("\nWall-clock numbers are the best of "
+             f"{res['repeat']} runs. The CPU column is process CPU time (the kernels are "
+             "single-threaded): when other processes load the machine (load average above "
+             "the cpu count) it is the better estimate of an idle core.\n")
+
+    # ---------------------------------------------------------------- targets
+    L.append("## Targets from the issue\n")
+    rows = [
+        ["µs per RK4 step, seed 001", f"<= {TARGETS['us_per_step']:g}",
+         f"{_f(e001['us_per_step'])} (CPU {_f(e001['cpu_us_per_step'])})",
+         _ok(e001["us_per_step"] <= TARGETS["us_per_step"])],
+        ["speed-up over the scipy baseline (simulated s per wall s), seed 001",
+         f">= {TARGETS['speedup']:g}x", f"{_f(speed001)}x",
+         _ok(speed001 >= TARGETS["speedup"])],
+        ["speed-up over the scipy baseline, smallest over all models",
+         f">= {TARGETS['speedup']:g}x", f"{_f(speed_min)}x",
+         _ok(speed_min >= TARGETS["speedup"])],
+    ]
+    if comp:
+        rows.append(["first (cold) compilation", f"< {TARGETS['compile']:g} s",
+                     f"{_f(comp['cold']['compile'])} s (CPU {_f(comp['cold']['compile_cpu'])} s)",
+                     _ok(comp["cold"]["compile"] < TARGETS["compile"])])
+    n_mem = mem["n_steps"]
+    rows.append([f"peak memory, {n_mem:,}-step seed 001 run (peak RSS during the run)",
+                 f"< {TARGETS['memory']:g} MB"
+                 + ("" if n_mem >= 10_000_000 else " (for 10 million steps)"),
+                 (f"{_f(mem['rss_peak'])} MiB (run itself: +{_f(mem['rss_delta'])} MiB RSS, "
+                 f"tracemalloc peak {_f(mem['tracemalloc_peak'])} MiB)"),
+                 _ok(mem["rss_peak"] < TARGETS["memory"]) if n_mem >= 10_000_000 else
+                 "- (quick mode)"])
+    L.append(_table(["quantity", "target", "measured", "status"], rows))
+
+    # ---------------------------------------------------------------- engine
+    L.append("\n## Engine: `integrate(method='rk4')`\n")
+    L.append(f"{cfg['engine_steps']:,} RK4 steps per model from the static equilibrium, "
+             "100 steps per shortest mesh period (or the finer stable step `integrate` "
+             "chooses itself, see 'steps/period'), streaming outputs as in `simulate` "
+             "(cycle statistics of every mesh, history of every element and DOF every "
+             "100 steps).\n")
+    if res["skipped"]:
+        L.append("Shipped examples left out because they do not load in this checkout "
+                 "(src/ is edited concurrently):\n")
+        L.extend(f"* `{k}`: {v}" for k, v in res["skipped"].items())
+        L.append("")
+    rows = []
+    for r in res["engine"]:
+        rows.append([r["model"], r["n_dof"], r["n_elements"], _f(r["f_max"], 4),
+                     _f(r["steps_per_period"], 4), _f(r["step"]), f"{r['n_steps']:,}",
+                     f"**{_f(r['us_per_step'])}**", _f(r["cpu_us_per_step"]),
+                     _f(r["us_per_step"] * 1e3 / r["n_dof"]),
+                     _f(r["sim_per_wall"]),
+                     ("ok" if r["success"] else r["message"])
+                     + ("" if r["static_converged"] else
+                        " (static equilibrium did not converge: started from its last "
+                        "iterate)")])
+    L.append(_table(["model", "DOFs", "elements", "f_mesh max [Hz]", "steps/period",
+                     "step [s]", "steps", "µs/step", "CPU µs/step", "ns/step/DOF",
+                     "simulated s per wall s", "status"], rows))
+
+    # ---------------------------------------------------------------- scipy
+    L.append("\n## Engine against the scipy baseline (simulated seconds per wall second)\n")
+    L.append(f"Baseline: `scipy.integrate.solve_ivp(method='RK45', rtol=1e-6)` with "
+             f"`torquesplit.solve.reference.rhs_numpy` on the same assembled structure and "
+             f"initial state, over {cfg['scipy_periods']} shortest mesh periods (atol: the "
+             f"engine's own per-state default). 'cached V' is the same right-hand side with "
+             f"the projection matrix built once (`bench_baseline.cached_rhs`; it equals "
+             f"`rhs_numpy` to a relative "
+             f"{_f(max(res['cached_check']), 2)}). 'engine dopri' is `integrate(method="
+             f"'dopri', rtol=1e-6)` over a tenth of the engine RK4 run's simulated time: "
+             f"the same algorithm family as RK45 (*max steps*: it stopped at its step limit "
+             f"and is reported over the part it did). Ratio = engine / baseline.\n")
+    rows = []
+    for k in eng:
+        a, b, d = sci[k], scc[k], dop[k]
+        n_per = a["n_steps"] / cfg["scipy_periods"] if a["n_steps"] else None
+        rows.append([k, _f(a["sim_per_wall"]) + ("" if a["complete"] else " (partial)"),
+                     a["n_rhs"], _f(n_per), _f(a["rhs_us"], 3),
+                     _f(b["sim_per_wall"]), _f(eng[k]["sim_per_wall"]),
+                     f"**{_f(eng[k]['sim_per_wall'] / a['sim_per_wall'])}x**",
+                     f"{_f(eng[k]['sim_per_wall'] / b['sim_per_wall'])}x",
+                     _f(d["sim_per_wall"]) + ("" if d["success"] else " (max steps)"),
+                     f"{_f(d['sim_per_wall'] / a['sim_per_wall'])}x"])
+    L.append(_table(["model", "scipy sim s/wall s", "scipy rhs calls",
+                     "scipy steps/period", "µs per rhs_numpy call", "scipy cached-V sim s/wall s",
+                     "engine RK4 sim s/wall s", "RK4 / scipy", "RK4 / scipy cached-V",
+                     "engine dopri sim s/wall s", "dopri / scipy"], rows))
+
+    L.append("\n## Engine against a numpy RK4 loop (per step)\n")
+    L.append(f"Baseline: `torquesplit.solve.reference.rk4_numpy` (classic RK4, a Python "
+             f"call to `rhs_numpy` per stage), {cfg['numpy_rk4_steps']} steps of the same "
+             f"step size as the engine run.\n")
+    rows = [[k, _f(nrk[k]["us_per_step"]), _f(eng[k]["us_per_step"]),
+             f"**{_f(nrk[k]['us_per_step'] / eng[k]['us_per_step'])}x**"] for k in eng]
+    L.append(_table(["model", "numpy RK4 µs/step", "engine µs/step", "ratio"], rows))
+
+    # ---------------------------------------------------------------- kernel parts
+    p = res["parts"]
+    L.append(f"\n## Where a seed 001 RK4 step goes ({p['n_dof']} DOFs, {p['n_elements']} "
+             f"elements, {p['nnz']} projection entries, {p['n_time_varying']} meshes, "
+             f"{p['n_sinusoids']} error sinusoids)\n")
+    L.append("Each building block of `_kernels.rk4_run` called in a compiled loop, CPU time "
+             f"per call (best of 3); shares of a whole CPU step measured right after "
+             f"({_f(p['step_ns'] / 1e3)} µs, best of 3).\n")
+    rows = [[k, _f(v["ns_per_call"]), v["calls_per_step"], _f(v["ns_per_step"]),
+             f"{100 * v['share']:.0f} %"] for k, v in p["parts"].items()]
+    L.append(_table(["block", "ns/call", "calls/step", "ns/step", "share"], rows))
+    mg = res.get("marginal")
+    if mg and "rhs_ns" in mg:
+        L.append(f"\nIn situ, the isolated loops understate the cost: `rk4_run` with one "
+                 f"more `rhs_slot` call per step (a patched copy, "
+                 f"`bench_kernel_parts.marginal_rhs_cost`) takes "
+                 f"{_f(mg['step_plus_one_ns'])} ns per step against {_f(mg['step_ns'])} ns "
+                 f"as is: **{_f(mg['rhs_ns'])} ns per `rhs_slot` call**, so its "
+                 f"{mg['calls_per_step']} calls are "
+                 f"**{100 * mg['calls_per_step'] * mg['rhs_ns'] / mg['step_ns']:.0f} %** of "
+                 f"the step.")
+    elif mg:
+        L.append(f"\nIn-situ rhs_slot cost not measured: {mg['skipped']}")
+    if p["skipped"]:
+        L.append("\nNot timed (the kernels changed under this benchmark; see "
+                 "`bench_kernel_parts.py`): "
+                 + "; ".join(f"`{k}`: {v}" for k, v in p["skipped"].items()))
+
+    # ---------------------------------------------------------------- compile
+    if comp:
+        L.append("\n## Compile time (fresh processes, temporary `NUMBA_CACHE_DIR`)\n")
+        rows = []
+        for label, d in (("cold (empty cache)", comp["cold"]), ("cached", comp["cached"])):
+            rows.append([label, _f(d["import"]), f"**{_f(d['compile'])}**",
+                         _f(d["compile_cpu"]), _f(d["first_run"]), _f(d["total"])])
+        L.append(_table(["process", "import [s]", "compile_kernels() [s]", "its CPU [s]",
+                         "assemble + 1000 steps seed 001 [s]", "total [s]"], rows))
+        L.append("\nnumba's compile timers per kernel in the cold process (inclusive of the "
+                 "kernels each one calls, so they do not add up; 'signatures' is how many "
+                 "specialisations were compiled):\n")
+        rows = [[k, v["n_signatures"], _f(v["compile"]), _f(v["llvm"])]
+                for k, v in sorted(comp["cold"]["kernels"].items(),
+                                   key=lambda kv: -kv[1]["compile"])]
+        L.append(_table(["kernel", "signatures", "compile [s]", "of which LLVM [s]"], rows))
+
+    # ---------------------------------------------------------------- memory
+    L.append(f"\n## Memory: {mem['n_steps']:,}-step seed 001 run"
+             + ("" if mem["n_steps"] >= 10_000_000 else
+                " (quick mode: 1 million steps, not 10 million)") + "\n")
+    L.append(f"Fresh process, `integrate(method='rk4', record_every={mem['record_every']})`: "
+             f"{mem['n_records']:,} history records of every element and DOF, "
+             f"{mem['n_cycles']:,} mesh cycles of statistics, {_f(mem['simulated'])} s "
+             "simulated.\n")
+    L.append(_table(["quantity", "value"], [
+        ["wall time [s]", _f(mem["wall"])],
+        ["µs/step (CPU µs/step)", f"{_f(mem['us_per_step'])} ({_f(mem['cpu_us_per_step'])})"],
+        ["RSS before the run (interpreter, numpy, numba, kernels) [MiB]", _f(mem["rss_before"])],
+        ["peak RSS during the run [MiB]", f"**{_f(mem['rss_peak'])}**"],
+        ["peak RSS of the whole process (incl. loading the kernels) [MiB]",
+         _f(mem["process_maxrss"])],
+        ["peak RSS added by the run [MiB]", _f(mem["rss_delta"])],
+        ["tracemalloc peak during the run [MiB]", _f(mem["tracemalloc_peak"])],
+        ["arrays held by the returned Solution [MiB]", _f(mem["outputs"])],
+    ]))
+    return "\n".join(L) + "\n"
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--quick", action="store_true",
+                   help="fewer steps everywhere; 1 million steps for the memory run")
+    p.add_argument("--repeat", type=int, default=2, help="timed runs per case (best kept)")
+    p.add_argument("--skip-compile", action="store_true",
+                   help="skip the cold-compile measurement (about a minute)")
+    p.add_argument("--output", type=Path, default=HERE / "RESULTS.md",
+                   help="markdown file to write (default benchmarks/RESULTS.md)")
+    a = p.parse_args(argv)
+    res = run(a.quick, max(1, a.repeat), a.skip_compile)
+    text = report(res)
+    a.output.write_text(text, encoding="utf-8")
+    json_path = a.output.with_suffix(".json")
+    import json
+
+    json_path.write_text(json.dumps(res, indent=1, default=_jsonable), encoding="utf-8")
+    print(text)
+    _log(f"wrote {a.output} and {json_path.name} in {res['elapsed'] / 60:.1f} min")
+    return 0
+
+
+def _jsonable(x):
+    try:
+        import numpy as np
+
+        if isinstance(x, np.generic):
+            return x.item()
+        if isinstance(x, np.ndarray):
+            return x.tolist()
+    except ImportError:
+        pass
+    return str(x)
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

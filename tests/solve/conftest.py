@@ -1,0 +1,8 @@
+"""Make the shared tiny models (solve_models.py) importable from the solver tests."""
+
+import sys
+from pathlib import Path
+
+_HERE = str(Path(__file__).parent)
+if _HERE not in sys.path:
+    sys.path.insert(0, _HERE)

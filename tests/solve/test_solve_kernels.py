@@ -1,0 +1,149 @@
+"""Compiled kernels against their readable numpy twins (solve/reference.py)."""
+
+from __future__ import annotations
+
+import importlib
+
+import numpy as np
+import pytest
+from solve_models import random_structure, spur_pair
+
+from torquesplit.solve import element_forces, integrate, rhs
+from torquesplit.solve.reference import (
+    contact_state_numpy,
+    cycle_statistics_numpy,
+    dopri_numpy,
+    element_forces_numpy,
+    excitation_numpy,
+    hermite_numpy,
+    rhs_numpy,
+    rk4_numpy,
+)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_kernel_rhs_equals_numpy_twin(seed):
+    s = random_structure(seed)
+    rng = np.random.default_rng(100 + seed)
+    n = s.n_dof
+    branches = set()
+    for t in [0.0, 1.234e-3, 0.0371, 2.5, 17.3]:
+        for _ in range(20):
+            y = np.concatenate([rng.normal(scale=2e-6, size=n), rng.normal(scale=1e-3, size=n)])
+            dy_k = rhs(s, t, y)
+            dy_n = rhs_numpy(s, t, y)
+            np.testing.assert_array_equal(dy_k[:n], dy_n[:n])
+            scale = np.max(np.abs(dy_n[n:]))
+            assert np.max(np.abs(dy_k[n:] - dy_n[n:])) <= 1e-12 * scale
+            f_k, d_k = element_forces(s, t, y)
+            f_n, d_n = element_forces_numpy(s, t, y)
+            np.testing.assert_allclose(d_k, d_n, rtol=0, atol=1e-12 * np.max(np.abs(d_n)))
+            np.testing.assert_allclose(f_k, f_n, rtol=0, atol=1e-12 * np.max(np.abs(f_n)))
+            g = excitation_numpy(s, t).half_gap
+            branches.update(np.sign(np.where(g > 0, np.where(np.abs(d_n) <= g, 0,
+                                                              np.sign(d_n) * 2), 3)).tolist())
+    assert {-1.0, 0.0, 1.0} <= branches  # back contact, separation, front contact seen
+
+
+def test_excitation_tables_are_periodic_and_interpolated():
+    s = random_structure(0)
+    e = 1  # mesh1: three-entry half-gap sequence
+    f = s.frequency[e]
+    ex0 = excitation_numpy(s, 0.0)
+    ex3 = excitation_numpy(s, 3.0 / f)  # three cycles later: same table phase, same gap
+    assert ex0.stiffness[e] == pytest.approx(ex3.stiffness[e], rel=1e-12)
+    assert ex0.half_gap[e] == ex3.half_gap[e]
+    ex1 = excitation_numpy(s, 1.0 / f)
+    assert ex1.cycle[e] == ex0.cycle[e] + 1
+    assert ex1.half_gap[e] == s.gap_values[s.gap_ptr[e] + (ex1.cycle[e] % 3)]
+    # exactly at a table node the value is the table entry
+    n_tab = s.n_table
+    t_node = ((5 / n_tab) - s.phase[e]) / f + 2 / f
+    assert excitation_numpy(s, t_node).stiffness[e] == pytest.approx(
+        s.stiffness_table[e, 5], rel=1e-9)
+
+
+def test_rk4_kernel_matches_readable_rk4():
+    s = random_structure(3)
+    rng = np.random.default_rng(7)
+    y0 = np.concatenate([rng.normal(scale=1e-6, size=s.n_dof), np.zeros(s.n_dof)])
+    h = 2e-6
+    n_steps = 300
+    _, ys = rk4_numpy(s, y0, 0.0, h, n_steps)
+    sol = integrate(s, y0, (0.0, n_steps * h), step=h, full_history=True)
+    assert sol.n_steps == n_steps
+    scale = np.max(np.abs(ys), axis=0)
+    assert np.all(np.abs(sol.full_y - ys) <= 1e-10 * scale + 1e-300)
+
+
+def test_dopri_kernel_matches_readable_dopri():
+    # smooth problem: with tabulated (piecewise-linear) stiffness the accept / reject
+    # decisions hinge on round-off at the table kinks and the step sequences drift apart
+    s = spur_pair(damping=200.0, errors=[(1e-6, 2 * np.pi * 900, 0.3),
+                                         (3e-7, 2 * np.pi * 1700, 1.0)])
+    y0 = np.array([1e-4, -5e-5, 0.0, 0.0])
+    atol = np.array([1e-12, 1e-12, 1e-8, 1e-8])
+    sol = integrate(s, y0, (0.0, 0.01), method="dopri", rtol=1e-7, atol=atol,
+                    max_step=1e-4, full_history=True, history_elements=(), history_dofs=())
+    h0 = _first_step(s, y0, 1e-7, atol, 0.01)
+    t_ref, y_ref, n_rej = dopri_numpy(s, y0, (0.0, 0.01), rtol=1e-7, atol=atol, h0=h0,
+                                      h_max=1e-4)
+    assert sol.n_steps == len(t_ref) - 1
+    assert sol.n_rejected == n_rej
+    np.testing.assert_allclose(sol.y_final, y_ref[-1], rtol=1e-9,
+                               atol=1e-9 * np.abs(y_ref).max(axis=0).max())
+
+
+def _first_step(s, y0, rtol, atol, span):
+    """The starting step integrate() uses (the twin must start from the same one)."""
+    mod = importlib.import_module("torquesplit.solve.integrate")  # module, not function
+    return min(mod._initial_step(s, y0, 0.0, span, rtol, atol, mod._model_arrays(s)), 1e-4)
+
+
+def test_hermite_reproduces_cubic():
+    # a cubic polynomial is reproduced exactly from values and slopes at both ends
+    p = np.poly1d([2.0, -1.0, 0.5, 3.0])
+    dp = p.deriv()
+    t0, h = 0.3, 0.7
+    for theta in [0.0, 0.25, 0.5, 0.9, 1.0]:
+        val = hermite_numpy(theta, h, p(t0), dp(t0), p(t0 + h), dp(t0 + h))
+        assert val == pytest.approx(p(t0 + theta * h), rel=1e-13)
+
+
+def test_streaming_cycle_statistics_equal_post_processed_history():
+    # more steps than one chunk, so the statistics must continue across chunks
+    s = spur_pair(damping=100.0, frequency=1000.0, phase=0.37,
+                  stiffness=2e8 * (1 + 0.3 * np.sign(np.sin(2 * np.pi * np.arange(64) / 64))),
+                  errors=[(2e-6, 2 * np.pi * 60, 0.0)])
+    y0 = np.array([1e-4, -5e-5, 0.0, 0.0])
+    sol = integrate(s, y0, (0.0, 0.0377), steps_per_period=97)
+    assert sol.success and sol.n_steps > 3000
+    cmax, cmin, csum, ccnt = cycle_statistics_numpy(
+        sol.history_t, sol.history_forces[:, 0], 1000.0, 0.37, 0.0, 100)
+    n = sol.cycle_max.shape[0]
+    np.testing.assert_array_equal(sol.cycle_count[:, 0], ccnt[:n])
+    np.testing.assert_array_equal(sol.cycle_max[:, 0], cmax[:n])
+    np.testing.assert_array_equal(sol.cycle_min[:, 0], cmin[:n])
+    np.testing.assert_allclose(sol.cycle_mean[:, 0], csum[:n] / ccnt[:n], rtol=1e-13)
+    assert ccnt[n:].sum() == 0
+    # cycle start times: the mesh phase is an integer there
+    starts = sol.cycle_start[1:, 0]
+    np.testing.assert_allclose((1000.0 * starts + 0.37) % 1.0, 0.0, atol=1e-9)
+    assert sol.n_samples == sol.n_steps + 1 == len(sol.history_t)
+
+
+def test_contact_counters_equal_twin_over_the_full_history():
+    s = random_structure(4)
+    rng = np.random.default_rng(11)
+    y0 = np.concatenate([rng.normal(scale=3e-6, size=s.n_dof), np.zeros(s.n_dof)])
+    sol = integrate(s, y0, (0.0, 0.004), step=2e-6, full_history=True)
+    assert sol.success
+    sep = np.zeros(s.n_elements, dtype=int)
+    back = np.zeros(s.n_elements, dtype=int)
+    for t, y in zip(sol.full_t, sol.full_y, strict=True):
+        a, b = contact_state_numpy(s, t, y)
+        sep += a
+        back += b
+    np.testing.assert_array_equal(sol.separation_steps, sep)
+    np.testing.assert_array_equal(sol.back_contact_steps, back)
+    assert sep.sum() > 0 and back.sum() > 0
