@@ -57,13 +57,19 @@ def _resolve_model_path(model: str) -> Path:
     return p
 
 
-def _load(model: str):
-    from .model.io import load_model
+def _load(model: str, assignments: Optional[list[str]] = None):
+    from .model.io import load_model, model_from_dict
 
     path = _resolve_model_path(model)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", ModelWarning)
-        m = load_model(path)
+        if assignments:
+            from .model.overrides import apply_overrides, parse_assignment, read_raw
+
+            data = apply_overrides(read_raw(path), dict(parse_assignment(a) for a in assignments))
+            m = load_model(model_from_dict(data, source=str(path)))
+        else:
+            m = load_model(path)
     for w in caught:
         if issubclass(w.category, ModelWarning):
             err_console.print("[yellow]warning:[/] ", end="")
@@ -108,6 +114,8 @@ def run(
         help="Load-sharing definition: cycle_peak, instantaneous, engineering, mean_force."),
     out: Optional[Path] = typer.Option(None, "--out", help="Write results to this NetCDF file."),
     plots: Optional[Path] = typer.Option(None, "--plots", help="Write report figures (PNG, SVG) here."),
+    assign: Optional[list[str]] = typer.Option(
+        None, "--set", help="Override a model field: PATH=VALUE, e.g. shafts.s1.diameter='250 mm'."),
     as_json: bool = typer.Option(False, "--json", help="Print metrics and statistics as JSON."),
     quiet: bool = typer.Option(False, "--quiet", help="No progress bar."),
 ):
@@ -118,7 +126,7 @@ def run(
         if method is not None and method not in ("rk4", "dopri"):
             raise TorquesplitError(f"--method {method!r} is unknown; use rk4 or dopri")
         dur = parse_quantity(duration, "time") if duration is not None else None
-        m, path = _load(model)
+        m, path = _load(model, assign)
         from .simulation import simulate
 
         res = _with_progress(lambda cb: simulate(
