@@ -112,7 +112,8 @@ def run(
     definition: Optional[str] = typer.Option(
         None, "--definition",
         help="Load-sharing definition: cycle_peak, instantaneous, engineering, mean_force."),
-    out: Optional[Path] = typer.Option(None, "--out", help="Write results to this NetCDF file."),
+    out: Optional[Path] = typer.Option(
+        None, "--out", help="Write results: .nc (NetCDF), .mat (MATLAB) or .csv (spreadsheet)."),
     plots: Optional[Path] = typer.Option(None, "--plots", help="Write report figures (PNG, SVG) here."),
     assign: Optional[list[str]] = typer.Option(
         None, "--set", help="Override a model field: PATH=VALUE, e.g. shafts.s1.diameter='250 mm'."),
@@ -136,9 +137,9 @@ def run(
         _fail(exc)
         return
     saved = None
-    if out is not None:
-        saved = res.to_netcdf(out)
     try:
+        if out is not None:
+            saved = res.save(out)
         met = res.metrics(definition)
     except ValueError as exc:
         _fail(exc)

@@ -88,3 +88,23 @@ def test_two_runs_identical_and_netcdf_round_trip(split, tmp_path):
     np.testing.assert_allclose(again.solution.history_forces, r1.solution.history_forces,
                                rtol=1e-12)
     ds.close()
+
+
+def test_mat_and_csv_exports(split, tmp_path):
+    import csv
+
+    from scipy.io import loadmat
+
+    res = torquesplit.simulate(split, cycles=20)
+    mat = loadmat(res.save(tmp_path / "run.mat"))
+    np.testing.assert_allclose(mat["element_force"], res.solution.history_forces)
+    assert mat["static_force"].ravel() == pytest.approx(list(res.static_forces().values()))
+    res.save(tmp_path / "run.csv")
+    with open(tmp_path / "run.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert [r["mesh"] for r in rows] == res.mesh_names
+    assert float(rows[0]["peak_force_N"]) == pytest.approx(res.metrics().rows[0].peak_force)
+    hist = np.loadtxt(tmp_path / "run_history.csv", delimiter=",", skiprows=1)
+    np.testing.assert_allclose(hist[:, 0], res.solution.history_t)
+    with pytest.raises(ValueError, match=r"\.nc, \.mat or \.csv"):
+        res.save(tmp_path / "run.xlsx")

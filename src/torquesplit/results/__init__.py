@@ -200,6 +200,61 @@ class Results:
         self.to_dataset().to_netcdf(path, engine="h5netcdf")
         return path
 
+    def save(self, path) -> Path:
+        """Save by suffix: ``.nc`` NetCDF, ``.mat`` MATLAB, ``.csv`` spreadsheet tables."""
+        path = Path(path)
+        suffix = path.suffix.lower()
+        if suffix in (".nc", ".netcdf", ".h5"):
+            return self.to_netcdf(path)
+        if suffix == ".mat":
+            return self.to_mat(path)
+        if suffix == ".csv":
+            return self.to_csv(path)
+        raise ValueError(f"cannot save results as {path.name!r}; use a .nc, .mat or .csv file")
+
+    def to_mat(self, path) -> Path:
+        """Save for MATLAB (scipy.io.savemat): every variable of the Dataset, SI units."""
+        from scipy.io import savemat
+
+        ds = self.to_dataset()
+        data = {name: np.asarray(ds[name].values) for name in ds.data_vars}
+        for name in ds.coords:
+            values = ds[name].values
+            data[name] = (np.asarray(values, dtype=object) if values.dtype.kind in "UO"
+                          else np.asarray(values))
+        data["units"] = {name: ds[name].attrs.get("units", "") for name in ds.data_vars}
+        data["model_json"] = ds.attrs["model_json"]
+        data["metrics_json"] = ds.attrs.get("metrics_json", "")
+        path = Path(path)
+        savemat(path, data, long_field_names=True, do_compression=True)
+        return path
+
+    def to_csv(self, path) -> Path:
+        """Save spreadsheet tables: ``NAME.csv`` (per-mesh summary) and beside it
+        ``NAME_history.csv`` (decimated forces) and ``NAME_cycles.csv`` (cycle peaks)."""
+        path = Path(path)
+        met = self.metrics()
+        header = ["mesh", "group", "nominal_force_N", "static_force_N", "mean_force_N",
+                  "peak_force_N", "dynamic_factor", "dynamic_factor_engineering",
+                  f"load_sharing_{met.definition}", "contact_loss_fraction"]
+        rows = [[r.mesh, r.group, r.nominal_force, r.static_force, r.mean_force, r.peak_force,
+                 r.dynamic_factor, r.dynamic_factor_engineering, r.load_sharing,
+                 r.contact_loss] for r in met.rows]
+        _write_csv(path, header, rows)
+        s = self.solution
+        el = self.structure.element_names
+        names = [el[i] for i in s.history_elements]
+        _write_csv(path.with_name(path.stem + "_history.csv"),
+                   ["time_s"] + [f"{n}_N" for n in names],
+                   np.column_stack([s.history_t, s.history_forces]).tolist())
+        cols = [list(s.tracked_elements).index(el.index(m)) for m in self.mesh_names]
+        _write_csv(path.with_name(path.stem + "_cycles.csv"),
+                   ["cycle"] + [f"{m}_start_s" for m in self.mesh_names]
+                   + [f"{m}_peak_N" for m in self.mesh_names],
+                   np.column_stack([np.arange(s.cycle_max.shape[0]), s.cycle_start[:, cols],
+                                    s.cycle_max[:, cols]]).tolist())
+        return path
+
     def write_figures(self, directory, formats=("png", "svg"), **kwargs):
         """Write the report figures (see :func:`torquesplit.plot.write_figures`)."""
         from ..plot import write_figures
@@ -210,6 +265,15 @@ class Results:
         from ..model.io import model_to_json
 
         return model_to_json(self.model)
+
+
+def _write_csv(path: Path, header, rows) -> None:
+    import csv
+
+    with open(path, "w", newline="", encoding="utf-8") as fh:
+        w = csv.writer(fh)
+        w.writerow(header)
+        w.writerows(rows)
 
 
 def open_results(path):

@@ -1,0 +1,124 @@
+"""Run each seed paper's study on its example model and collect the numbers the paper
+reports, for docs/validation.md.
+
+    python scripts/validate.py [seed000 seed001 ...] [--quick]
+
+Writes docs/validation_results.json (one entry per seed) and prints a summary.  The
+settings are the papers' where they give them (see each example's [analysis] section
+and the comments in the model files); nothing is tuned to a published number.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+import warnings
+from pathlib import Path
+
+import torquesplit
+from torquesplit.errors import ModelWarning
+from torquesplit.model.io import model_from_dict
+from torquesplit.model.overrides import apply_overrides, read_raw
+from torquesplit.quasistatic import quasi_static_load_sharing
+
+OUT = Path(__file__).resolve().parents[1] / "docs" / "validation_results.json"
+
+
+def _model(name: str, overrides: dict | None = None):
+    data = read_raw(torquesplit.example_path(name))
+    if overrides:
+        data = apply_overrides(data, overrides)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ModelWarning)
+        return torquesplit.load_model(model_from_dict(data, source=name))
+
+
+def _run(model, **kwargs) -> dict:
+    t0 = time.perf_counter()
+    res = torquesplit.simulate(model, **kwargs)
+    wall = time.perf_counter() - t0
+    out = {"wall_time_s": wall, "statistics": res.statistics()}
+    for definition in ("cycle_peak", "engineering", "mean_force"):
+        met = res.metrics(definition)
+        out[definition] = met.to_dict()
+    return out
+
+
+def seed000(quick: bool) -> dict:
+    """Per-cycle peak LSC and DLF of the left path, with and without meshing-in impact."""
+    cycles = 200 if quick else None  # None: the example's [analysis] (2000 third-stage cycles)
+    names = [m for m in read_raw(torquesplit.example_path("seed000_split_torque"))["meshes"]]
+    results = {}
+    for label, impact in (("no_impact", False), ("impact", True)):
+        over = {f"meshes.{m}.impact": impact for m in names if not m.endswith("12")}
+        results[label] = _run(_model("seed000_split_torque", over), cycles=cycles)
+    return results
+
+
+def seed001(quick: bool) -> dict:
+    """g1t, g2t, G1t, G2t at drive-shaft diameters 200, 250 and 300 mm."""
+    out = {}
+    for d in ("200 mm", "250 mm", "300 mm"):
+        over = {"shafts.drive1.diameter": d, "shafts.drive2.diameter": d}
+        for g in ("z2", "z3", "z4", "z5"):
+            over[f"gears.{g}.support.shaft.diameter"] = d
+        kwargs = {"duration": 3.0} if quick else {}
+        out[d] = _run(_model("seed001_mill_drive", over), **kwargs)
+    return out
+
+
+def seed002(quick: bool) -> dict:
+    """Omega_I, Omega_II and every Omega_ij (mean-force definition, seed 002 eq. 12)."""
+    return {"baseline": _run(_model("seed002_face_gear"), cycles=100 if quick else None)}
+
+
+def seed003(quick: bool) -> dict:
+    """Mesh forces with tooth friction for RMS roughness 0.3, 0.6 and 0.9 um."""
+    data = read_raw(torquesplit.example_path("seed003_friction_split"))
+    out = {}
+    for s in ("0.3 um", "0.6 um", "0.9 um"):
+        over = {f"meshes.{m}.friction": {"roughness": s}
+                for m, v in data["meshes"].items() if v.get("friction")}
+        out[s] = _run(_model("seed003_friction_split", over), cycles=100 if quick else None)
+    return out
+
+
+def seed004(quick: bool) -> dict:
+    """Quasi-static star load-sharing coefficients and the suns' floating orbits."""
+    res = quasi_static_load_sharing(_model("seed004_star_reducer"),
+                                    points_per_cycle=2 if quick else 8)
+    met = res.metrics()
+    orbits = {b: {"x_um": [1e6 * float(o[:, 0].min()), 1e6 * float(o[:, 0].max())],
+                  "y_um": [1e6 * float(o[:, 1].min()), 1e6 * float(o[:, 1].max())]}
+              for b, o in res.orbits().items() if b in ("s1", "s2")}
+    return {"per_mesh": met.per_mesh, "per_group": met.per_group, "system": met.system,
+            "orbits": orbits, "positions": int(res.times.size),
+            "converged": bool(res.solution.converged.all())}
+
+
+STUDIES = {"seed000": seed000, "seed001": seed001, "seed002": seed002, "seed003": seed003,
+           "seed004": seed004}
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("seeds", nargs="*", default=list(STUDIES))
+    ap.add_argument("--quick", action="store_true", help="shorter runs (smoke test)")
+    args = ap.parse_args(argv)
+    old = json.loads(OUT.read_text()) if OUT.exists() else {}
+    for seed in args.seeds:
+        t0 = time.perf_counter()
+        try:
+            old[seed] = STUDIES[seed](args.quick)
+        except torquesplit.TorquesplitError as exc:
+            old[seed] = {"error": str(exc)}
+        old[seed + "_wall_time_s"] = time.perf_counter() - t0
+        print(f"{seed}: done in {time.perf_counter() - t0:.1f} s", flush=True)
+        OUT.write_text(json.dumps(old, indent=1, default=float))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
