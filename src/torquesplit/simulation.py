@@ -30,7 +30,7 @@ def simulate(
     method: str | None = None,
     steps_per_period: int | None = None,
     rtol: float | None = None,
-    samples_per_period: int = 10,
+    samples_per_period: int = 20,
     history_dofs=None,
     full_history: bool = False,
     progress: Callable[[float], None] | None = None,
