@@ -157,7 +157,7 @@ def cycle_peak_figure(results) -> Figure:
     these peaks) is the dotted vertical line and the transient before it is shaded.
     """
     s = results.solution
-    names, groups = results.mesh_names, results.groups
+    groups = results.groups
     nominal = results.nominal_forces()
     settle = results.metrics().settling.start_time
     cols = _cycle_columns(results)
