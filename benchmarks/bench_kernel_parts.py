@@ -16,6 +16,11 @@ the usual names (``y``, ``K``, ``force``, ...).  A block whose kernel is missing
 takes an argument this file does not know is reported as skipped, not fatal.  The
 ``slot`` argument is passed as a variable (as ``rk4_run`` does for its slots ``a`` and
 ``b``), so the drivers do not get literal-specialised copies.
+
+The kernels of tooth friction and splines (``excite_friction``, ``rhs_extra``) are
+called inside ``if`` blocks, only for models that have them, so the breakdown of a model
+without them leaves them out (as it leaves out the RESYNC and history branches); their
+scratch arrays are in the namespace all the same.
 """
 
 from __future__ import annotations
@@ -85,6 +90,7 @@ def _namespace(case) -> dict:
         K=np.empty((3, ne)), P=np.empty((3, ne)), G=np.empty((3, ne)),
         E=np.empty((3, ne)), ED=np.empty((3, ne)), CY=np.zeros((3, ne), np.int64),
         S=np.zeros((3, n_sin)), C=np.ones((3, n_sin)),
+        FR=np.zeros((3, ns["friction_table"].shape[0])),
         cos_rot=np.cos(ns["error_omega"] * h / 2), sin_rot=np.sin(ns["error_omega"] * h / 2),
         gap_cyc=np.full(ne, getattr(kern, "_NO_CYCLE", -(2**62)), np.int64),
         gap_val=np.zeros(ne),

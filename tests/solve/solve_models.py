@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-from torquesplit.assembly.structure import MESH, SPRING, build_structure
+from torquesplit.assembly.structure import MESH, SPLINE, SPRING, build_structure
 
 J1, J2 = 0.01, 0.04  # kg m^2
 R1, R2 = 0.05, 0.10  # m
@@ -63,3 +63,43 @@ def random_structure(seed: int = 0):
     return build_structure([f"b{i}.x" for i in range(n)], 1.0 / rng.uniform(0.5, 2.0, n),
                            els, external_force=rng.normal(size=n) * 10,
                            ground_damping=rng.random(n), n_table=32)
+
+
+def random_structure_extras(seed: int = 0):
+    """:func:`random_structure` plus tooth friction on its four meshes and two spline
+    radial elements (one with a stick limit and a clearance, one without clearance), so
+    that every branch of the spline law and of the friction scatter is reachable."""
+    base = random_structure(seed)
+    rng = np.random.default_rng(1000 + seed)
+    n = base.n_dof
+    ph = np.arange(32) / 32
+    els = []
+    for e, name in enumerate(base.element_names):
+        sl = slice(base.v_ptr[e], base.v_ptr[e + 1])
+        el = dict(name=name, kind=int(base.element_kind[e]), dofs=base.v_dof[sl].tolist(),
+                  coefs=base.v_coef[sl].tolist(), stiffness=base.stiffness_table[e],
+                  frequency=float(base.frequency[e]), phase=float(base.phase[e]),
+                  damping=float(base.damping[e]),
+                  gaps=base.gap_values[base.gap_ptr[e]:base.gap_ptr[e + 1]].tolist(),
+                  error_constant=float(base.error_constant[e]),
+                  errors=list(zip(base.error_amplitude[base.error_ptr[e]:base.error_ptr[e + 1]],
+                                  base.error_omega[base.error_ptr[e]:base.error_ptr[e + 1]],
+                                  base.error_phase[base.error_ptr[e]:base.error_ptr[e + 1]],
+                                  strict=True)),
+                  force=base.force_table[e])
+        if name.startswith("mesh"):
+            table = [0.05 * np.sign(np.sin(2 * np.pi * (ph - rng.random())))
+                     + 0.01 * rng.normal(size=32),
+                     0.002 * rng.normal(size=32), 0.003 * rng.normal(size=32)]
+            dofs = rng.choice(n, size=4, replace=False).tolist()
+            el["friction"] = dict(table=table, dofs=dofs, coefs=rng.normal(size=4).tolist(),
+                                  rows=[0, 1, 2, 0])
+        els.append(el)
+    els.append(dict(name="spA", kind=SPLINE, x=([0, 1], [1.0, -1.0]), y=([2], [-1.0]),
+                    stiffness=5e7, damping=20.0, stick_limit=1e-6, clearance=3e-6,
+                    friction_force=30.0, velocity_scale=1e-3))
+    els.append(dict(name="spB", kind=SPLINE, x=([3], [-1.0]), y=([4], [-1.0]),
+                    stiffness=2e7, damping=5.0, friction_force=10.0, velocity_scale=1e-3))
+    return build_structure(base.dof_names, base.inv_mass, els,
+                           external_force=base.external_force,
+                           ground_damping=base.ground_damping, n_table=32)

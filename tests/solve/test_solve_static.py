@@ -134,3 +134,77 @@ def test_member_held_only_by_an_open_clearance_is_regularised_and_reported():
     # the tiny regularising spring centres the free member in its clearance
     assert st.deformations[1] == pytest.approx(0.0, abs=1e-15)
     assert st.q[0] == pytest.approx(50.0 / 1e7, rel=1e-12)
+
+
+def _spline_mass(load, stick=2e-6, clearance=1e-5, k=1e8):
+    """A 2-D mass held only by a spline to ground, loaded by ``load`` (N, 2-vector)."""
+    from torquesplit.assembly.structure import SPLINE
+
+    els = [dict(name="sp", kind=SPLINE, x=([0], [-1.0]), y=([1], [-1.0]), stiffness=k,
+                damping=10.0, stick_limit=stick, clearance=clearance, friction_force=50.0)]
+    return build_structure(["m.x", "m.y"], [1.0, 1.0], els, external_force=load)
+
+
+@pytest.mark.parametrize("magnitude", [0.0, 50.0, 150.0, 3000.0])
+def test_static_spline_is_a_radial_dead_zone(magnitude):
+    k, s1, s2 = 1e8, 2e-6, 1e-5
+    direction = np.array([0.6, -0.8])
+    st = static_equilibrium(_spline_mass(magnitude * direction, s1, s2, k))
+    assert st.converged
+    rad = np.linalg.norm(st.q)
+    if magnitude == 0.0:
+        assert rad < 1e-15  # centred (stick zone around R = 0)
+        return
+    np.testing.assert_allclose(st.q / rad, direction, atol=1e-12)  # moves along the load
+    if magnitude < k * s1:  # sticks: F = k R
+        assert rad == pytest.approx(magnitude / k, rel=1e-12)
+    else:  # slides across the clearance (friction is zero at rest): F = k (R - S2)
+        assert rad == pytest.approx(s2 + magnitude / k, rel=1e-12)
+    assert st.in_contact.all() and st.separated == ()
+    np.testing.assert_allclose(st.element_forces, -magnitude * direction, rtol=1e-12)
+
+
+def test_static_floating_member_in_its_spline_clearance_is_reported():
+    # no stick limit: without load the member floats (regularised, centred)
+    st = static_equilibrium(_spline_mass([0.0, 0.0], stick=0.0))
+    assert st.converged and st.separated == ("sp.x", "sp.y")
+    np.testing.assert_array_equal(st.element_forces, 0.0)
+    assert np.linalg.norm(st.q) < 1e-15
+
+
+def test_static_friction_changes_the_load_only_through_its_mean_moments():
+    ph = np.arange(64) / 64
+    m1 = -4e-4 + 6e-4 * np.sign(np.sin(2 * np.pi * (ph - 0.3)))  # reverses at the pitch point
+    m2 = -9e-4 - 1.2e-3 * np.sign(np.sin(2 * np.pi * (ph - 0.3)))
+    mesh = dict(name="mesh", kind=MESH, dofs=[0, 1], coefs=[R1, -R2], stiffness=K_MESH,
+                frequency=500.0, friction=dict(table=[0 * ph, m1, m2], dofs=[0, 1],
+                                               coefs=[-1.0, -1.0], rows=[1, 2]))
+    m1_bar, m2_bar = m1.mean(), m2.mean()
+    f_lossy = T_IN / (R1 - m1_bar)  # driver: T_in = (r1 - m1) f
+    lossy = build_structure(["g1.theta", "g2.theta"], [1 / J1, 1 / J2], [mesh],
+                            external_force=[T_IN, -(R2 + m2_bar) * f_lossy])
+    st = static_equilibrium(lossy)
+    assert st.converged
+    assert st.element_forces[0] == pytest.approx(f_lossy, rel=1e-12)
+    assert abs(st.rigid_acceleration[0]) < 1e-12 * T_IN / np.sqrt(J1)
+    # lossless balance (as the kinematics gives it): friction decelerates the train;
+    # the d'Alembert force of that deceleration shifts the force, by the mean moments only
+    lossless = build_structure(["g1.theta", "g2.theta"], [1 / J1, 1 / J2], [mesh],
+                               external_force=[T_IN, -T_IN * R2 / R1])
+    st2 = static_equilibrium(lossless)
+    phi = st2.rigid_modes[:, 0]
+    a = st2.rigid_acceleration[0]
+    assert a * np.sign(phi[0]) < 0  # decelerates (phi along the rotation when phi[0] > 0)
+    # J1 (a phi1) = T_in - (r1 - m1) f  and  J2 (a phi2) = -T_in r2 / r1 + (r2 + m2) f
+    f = st2.element_forces[0]
+    assert J1 * a * phi[0] == pytest.approx(T_IN - (R1 - m1_bar) * f, rel=1e-9)
+    assert J2 * a * phi[1] == pytest.approx(-T_IN * R2 / R1 + (R2 + m2_bar) * f, rel=1e-9)
+    # a load torque wildly out of balance is still refused
+    wrong = build_structure(["g1.theta", "g2.theta"], [1 / J1, 1 / J2], [mesh],
+                            external_force=[T_IN, -0.5 * T_IN * R2 / R1])
+    with pytest.raises(SolverError, match="do not balance"):
+        static_equilibrium(wrong)
+    # quasi-statics use the friction moments at each mesh position
+    qs = quasi_static(lossy, [0.1 / 500.0, 0.7 / 500.0])
+    assert qs.converged.all()
+    assert qs.element_forces[0, 0] != pytest.approx(qs.element_forces[1, 0], rel=1e-3)

@@ -8,11 +8,23 @@ element         deformation ``V . q``                         stiffness
 mesh            ``n.(u_d - u_n) + arm_d th_d - arm_n th_n``   k(phase) table [N/m]
 shaft           ``th_a - th_b``                               torsional [N m/rad]
 support         ``u_i`` (one translational DOF)               bearing [N/m], clearance
-spline radial   ``u_hub,i - u_float,i``                       contact [N/m], clearance
+spline torsion  ``th_hub - th_float``                         torsional [N m/rad]
+spline radial   ``u_hub - u_float``, radial plane, 2-D        radial law, seed 002 eq. 6
 ==============  ==========================================  =========================
+
+A mesh with ``friction`` also gets its friction projection W (seed 003; forces only):
+``+t`` on the driver's and ``-t`` on the driven gear's translations times the friction
+force per unit load, and the friction moments per unit load on their rotations (see
+:func:`torquesplit.assembly.excitation.friction_table` for the signs).
 
 Bodies joined by a rigid shaft share one rotational DOF.  A drive in ``speed`` mode
 prescribes its body's rotation: that DOF is removed.
+
+Options (``assemble(..., options={...})``):
+
+``spline_velocity_scale``
+    Velocity scale v of the regularised Coulomb friction of the splines,
+    F_m tanh(Rdot / v) [m/s]; default :data:`SPLINE_VELOCITY_SCALE`.
 """
 
 from __future__ import annotations
@@ -23,10 +35,19 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ModelError
+from ..gears import line_of_action as loa
 from ..model.kinematics import Kinematics, solve_kinematics
 from ..model.schema import Model
 from . import excitation
-from .structure import MESH, SPRING, Structure, build_structure
+from .structure import MESH, SPLINE, SPRING, Structure, build_structure
+
+SPLINE_VELOCITY_SCALE = 1.0e-4
+"""Default velocity scale v of the spline friction F_m tanh(Rdot / v) [m/s]: below about v
+the friction is viscous (tangent F_m / v), above it Coulomb.  Small against the radial
+vibration velocities of a floating member (mm/s to m/s), so the friction is Coulomb in
+effect; the RK4 stability check accounts for the tangent F_m / v, which can shorten the
+step (see docs/theory/model.md)."""
+_OPTIONS = {"spline_velocity_scale"}
 
 
 @dataclass(frozen=True)
@@ -84,6 +105,13 @@ def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None
     """Assemble the equations of motion of ``model`` (see module docstring)."""
     kin = kin or solve_kinematics(model)
     n_table = n_table or model.analysis.table_points
+    options = dict(options or {})
+    unknown = sorted(set(options) - _OPTIONS)
+    if unknown:
+        raise ValueError(f"unknown assembly option(s) {unknown}; known: {sorted(_OPTIONS)}")
+    v_reg = float(options.get("spline_velocity_scale", SPLINE_VELOCITY_SCALE))
+    if not (v_reg > 0 and math.isfinite(v_reg)):
+        raise ValueError(f"spline_velocity_scale must be a positive speed in m/s, got {v_reg!r}")
     dmap, inv_mass = number_dofs(model, kin)
     n_dof = len(dmap.names)
     elements: list[dict] = []
@@ -126,6 +154,8 @@ def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None
         force = excitation.impact_force_table(model, kin, name, n_table)
         if force is not None:
             el["force"] = force
+        if mesh.friction is not None:
+            el["friction"] = _friction_projection(model, kin, dmap, name, n_table)
         elements.append(el)
         meta_meshes[name] = dict(stage=excitation.stage_label(model, name), path=mesh.path,
                                  driver=mk.driver, driven=mk.driven,
@@ -194,7 +224,7 @@ def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None
             elements.append(dict(name=f"{body}.support.{d}", kind=SPRING, dofs=[j], coefs=[1.0],
                                  stiffness=k, damping=c, gaps=sup.clearance))
 
-    # ---- splines (torsion + radial clearance; friction: see docs/theory)
+    # ---- splines: torsion spring + 2-D radial element (seed 002 eq. 6)
     for name, sp in model.splines.items():
         hub, flo = sp.connects
         ih, sh = dmap.theta[hub]
@@ -209,20 +239,31 @@ def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None
         if dofs:
             elements.append(dict(name=f"{name}.torsion", kind=SPRING, dofs=dofs, coefs=coefs,
                                  stiffness=sp.torsional_stiffness))
-        for d in ("x", "y"):
-            jh = dmap.translation[hub].get(d)
-            jf = dmap.translation[flo].get(d)
-            if jh is None and jf is None:
-                continue
-            dofs, coefs = [], []
-            if jh is not None:
-                dofs.append(jh)
-                coefs.append(1.0)
-            if jf is not None:
-                dofs.append(jf)
-                coefs.append(-1.0)
-            elements.append(dict(name=f"{name}.radial.{d}", kind=SPRING, dofs=dofs, coefs=coefs,
-                                 stiffness=sp.stiffness, gaps=sp.radial_clearance))
+        # the radial plane: normal to the floating member's axis (global x, y for an
+        # axis along z); the law is isotropic, so any orthonormal pair of directions does
+        axis = kin.bodies[flo].axis / np.linalg.norm(kin.bodies[flo].axis)
+        e1 = loa.reference_direction(axis, 0.0)
+        e2 = np.cross(axis, e1)
+        if e2[np.argmax(np.abs(e2))] < 0:
+            e2 = -e2
+        rows = {}
+        for comp, e in (("x", e1), ("y", e2)):
+            rdofs, rcoefs = [], []
+            for body, sgn in ((hub, 1.0), (flo, -1.0)):
+                for d, c in zip("xyz", e, strict=True):
+                    j = dmap.translation[body].get(d)
+                    if j is not None and abs(c) > 1e-15:
+                        rdofs.append(j)
+                        rcoefs.append(sgn * float(c))
+            rows[comp] = (rdofs, rcoefs)
+        if rows["x"][0] or rows["y"][0]:
+            # friction force F_m = mu T / r_p, T the nominal torque through the spline
+            # (carried by the floating member)
+            f_m = sp.friction_coefficient * kin.bodies[flo].torque / sp.pitch_radius
+            elements.append(dict(name=f"{name}.radial", kind=SPLINE, x=rows["x"], y=rows["y"],
+                                 stiffness=sp.stiffness, damping=sp.damping,
+                                 stick_limit=sp.stick_limit, clearance=sp.radial_clearance,
+                                 friction_force=f_m, velocity_scale=v_reg))
 
     # ---- drives and loads
     for name, d in model.drives.items():
@@ -241,9 +282,42 @@ def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None
         meshes=meta_meshes,
         dof_map=dmap,
         mesh_names=list(model.meshes),
+        friction_meshes=[n for n, m in model.meshes.items() if m.friction is not None],
+        splines=list(model.splines),
     )
     return build_structure(dmap.names, inv_mass, elements, external_force=ext,
                            ground_damping=ground, n_table=n_table, metadata=meta)
+
+
+def _friction_projection(model: Model, kin: Kinematics, dmap: DofMap, name: str,
+                         n_table: int) -> dict:
+    """Friction projection W of a mesh (build_structure's ``friction`` entry).
+
+    Table rows (per unit normal load, :func:`excitation.friction_table`): 0 the friction
+    force on the driven gear along the rolling direction t, 1 and 2 the friction moments
+    on driver and driven gear, positive in their direction of rotation.  The generalized
+    force is -W f: so W has +t on the driver's translations and -t on the driven gear's
+    (row 0), and -s sgn(w) on each gear's rotation (rows 1, 2), s the sign of the body's
+    axis against its DOF's axis and sgn(w) its sense of rotation.
+    """
+    mk = kin.meshes[name]
+    table = excitation.friction_table(model, kin, name, n_table)
+    t_dir = excitation.friction_direction(kin, name)
+    dofs, coefs, rows = [], [], []
+    for body, sgn, row in ((mk.driver, 1.0, 1), (mk.driven, -1.0, 2)):
+        idx, s = dmap.theta.get(body, (-1, 1.0))
+        if idx >= 0:
+            w = 1.0 if kin.bodies[body].speed > 0 else -1.0
+            dofs.append(idx)
+            coefs.append(-s * w)
+            rows.append(row)
+        for d, comp in zip("xyz", t_dir, strict=True):
+            j = dmap.translation[body].get(d)
+            if j is not None and comp != 0.0:
+                dofs.append(j)
+                coefs.append(sgn * float(comp))
+                rows.append(0)
+    return dict(table=table, dofs=dofs, coefs=coefs, rows=rows)
 
 
 def support_stiffness(sup) -> float:

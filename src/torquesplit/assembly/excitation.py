@@ -242,3 +242,121 @@ def impact_force_table(model: Model, kin: Kinematics, mesh_name: str, n: int):
     )
     _, force = imp.table(n)
     return np.asarray(force)
+
+
+# --------------------------------------------------------------------------- friction
+def friction_direction(kin: Kinematics, mesh_name: str) -> np.ndarray:
+    """Unit rolling direction t of a mesh [-] (global frame): perpendicular to the line of
+    action in the driver's transverse plane, pointing where the driver's surface moves at
+    the contact (the entrainment direction of both flanks).
+
+    Tooth friction on the driven gear is ``ff f t`` (ff > 0 after the pitch point, where
+    the driver's flank slides ahead of the driven one, i.e. along the driver's sliding
+    velocity), on the driver ``-ff f t`` (see :func:`friction_table`).
+    """
+    mk = kin.meshes[mesh_name]
+    drv = kin.bodies[mk.driver]
+    a = drv.axis / np.linalg.norm(drv.axis)
+    n = np.asarray(mk.line_of_action, dtype=float)
+    n_t = n - a * float(n @ a)
+    n_t = n_t / np.linalg.norm(n_t)
+    t = np.cross(a, n_t)
+    v = drv.speed * np.cross(a, mk.contact_point - drv.position)
+    if float(t @ v) < 0.0:
+        t = -t
+    t[np.abs(t) < 1e-15] = 0.0
+    return t
+
+
+def friction_table(model: Model, kin: Kinematics, mesh_name: str, n: int) -> np.ndarray:
+    """Tooth friction per unit normal mesh load over one mesh cycle (seed 003), (3, n).
+
+    Rows: the friction force on the driven gear along the rolling direction t of
+    :func:`friction_direction` [-] (the driver gets the opposite force), and the friction
+    moments on the driver and on the driven gear [m], each positive in that gear's own
+    direction of rotation.  Phase 0 is the instant a new tooth pair enters contact (as the
+    stiffness tables).
+
+    This is :func:`torquesplit.gears.friction.mesh_friction_table` with gear 1 = the
+    driver (its tangency point N1 is the origin of the contact positions, so contact
+    travels from ``contact_start`` to ``contact_end`` > ``contact_start``); its sign
+    conventions then read: force on gear 2 = sign(u1 - u2) mu F (negative in the approach,
+    before the pitch point, positive in the recess), moment_1 = -force rho1 (aids the
+    driver in the approach), moment_2 = +force rho2 (opposes the driven gear in the
+    approach); the friction power moment_1 |w1| + moment_2 |w2| = -mu F |u1 - u2| <= 0.
+    Model ``"constant"``: the same kinematics (pairs, slices, load shared in proportion to
+    the contact length) with a constant coefficient, reversing at the pitch point.
+    Double-helical pairs: one helix at half the load (the ratios per unit load are those
+    of the whole mesh).
+    """
+    from ..errors import ModelError
+    from ..gears import friction as gfr
+
+    spec = model.meshes[mesh_name].friction
+    mk = kin.meshes[mesh_name]
+    geo = mk.geometry
+    loc = f"meshes.{mesh_name}.friction"
+    if mk.conical or geo is None:
+        raise ModelError([(loc, "tooth friction is implemented for cylindrical (spur, helical, "
+                                "double-helical) pairs; remove 'friction' from this bevel/face "
+                                "mesh")])
+    if geo.is_internal:
+        raise ModelError([(loc, "tooth friction is implemented for external pairs; remove "
+                                "'friction' from this internal mesh")])
+    mesh = model.meshes[mesh_name]
+    p1, p2, _, _ = geo._tangent_lengths
+    if mk.driver == mesh.gears[0]:  # PairGeometry gear 1 (the pinion) drives
+        rb = (geo.gear1.base_radius, geo.gear2.base_radius)
+        start, end = p1 + geo.path_start, p1 + geo.path_end
+    else:  # the wheel drives: measure from its tangency point T2
+        rb = (geo.gear2.base_radius, geo.gear1.base_radius)
+        start, end = p2 - geo.path_end, p2 - geo.path_start
+    g_drv, g_dvn = model.gears[mk.driver], model.gears[mk.driven]
+    omega = abs(kin.bodies[mk.driver].speed)
+    load = mk.force / 2.0 if geo.double_helical else mk.force
+    common = dict(base_radius_1=rb[0], base_radius_2=rb[1],
+                  centre_distance=geo.operating_center_distance, contact_start=start,
+                  contact_end=end, base_pitch=geo.base_pitch,
+                  base_helix_angle=geo.base_helix_angle, face_width=geo.face_width)
+    if spec.model == "xu2007":
+        tab = gfr.mesh_friction_table(
+            omega_1=omega, normal_load=load, viscosity=spec.viscosity,
+            roughness=spec.roughness,
+            youngs_modulus=(g_drv.youngs_modulus, g_dvn.youngs_modulus),
+            poisson_ratio=(g_drv.poisson_ratio, g_dvn.poisson_ratio),
+            n_phases=n, n_slices=spec.slices, **common)
+        return np.vstack([tab.force_per_load, tab.moment_1_per_load, tab.moment_2_per_load])
+    return constant_friction_table(coefficient=spec.coefficient, n=n, n_slices=spec.slices,
+                                   **common)
+
+
+def constant_friction_table(*, coefficient, base_radius_1, base_radius_2, centre_distance,
+                            contact_start, contact_end, base_pitch, base_helix_angle,
+                            face_width, n, n_slices) -> np.ndarray:
+    """(3, n) friction force and moments per unit normal load with a constant coefficient.
+
+    Gear 1 drives; the kinematics are those of
+    :func:`torquesplit.gears.friction.mesh_friction_table` (tooth pairs one base pitch
+    apart, helical teeth cut into slices shifted by z tan(beta_b), load shared in
+    proportion to the contact length in contact), with mu constant and the direction
+    lambda = sign(u1 - u2) reversing at the pitch point.
+    """
+    line = float(np.sqrt(centre_distance**2 - (base_radius_1 + base_radius_2) ** 2))
+    path = contact_end - contact_start
+    helical = base_helix_angle != 0.0
+    m = n_slices if helical else 1
+    tan_bb = math.tan(abs(base_helix_angle))
+    n_pairs = int(np.ceil(path / base_pitch + face_width * tan_bb / base_pitch)) + 1
+    phase = np.arange(n) / n
+    z = (np.arange(m) + 0.5) * face_width / m
+    travel = ((phase[:, None, None] + np.arange(n_pairs)[None, :, None]) * base_pitch
+              - z[None, None, :] * tan_bb)
+    inside = (travel >= 0.0) & (travel <= path)
+    share = inside / inside.sum(axis=(1, 2), keepdims=True)
+    s = contact_start + travel
+    rho1, rho2 = s, line - s
+    omega_ratio = base_radius_1 / base_radius_2  # w2 / w1
+    lam = np.where(inside, np.sign(rho1 - omega_ratio * rho2), 0.0)
+    f = lam * coefficient * share
+    return np.vstack([f.sum(axis=(1, 2)), (-f * rho1).sum(axis=(1, 2)),
+                      (f * rho2).sum(axis=(1, 2))])

@@ -12,6 +12,25 @@ stiffness ``k_e(t)`` (one table row sampled over one excitation period), a dead 
 contact), an error ``e_e(t)`` made of a constant plus sinusoids, and an additive periodic
 force ``p_e(t)`` (meshing-in impact).  Damping acts only while the element is in contact.
 
+Two optional extensions, both empty (and free) when a model does not use them:
+
+* **Tooth friction** of a mesh element e (seed 003): a second, phase-dependent
+  projection ``W_e(s)`` used only to apply forces.  The generalized force of the mesh
+  becomes ``-V_e f_e - W_e(s) max(f_e, 0)``; the deformation still uses ``V_e`` only.
+  ``W_e`` is stored sparsely (``fr_*``): entry i contributes
+  ``fr_coef[i] * friction_table[fr_row[i], s]`` on DOF ``fr_dof[i]``, the table rows
+  being the friction force and the two friction moments per unit normal load over one
+  mesh cycle (see :mod:`torquesplit.assembly.excitation`).
+* **Spline radial elements** (seed 002 eq. 6): a 2-D radial law between a floating
+  member and its hub.  It is stored as two ordinary elements (kind SPLINE) whose
+  projection rows give the relative displacement components ``d = (dx, dy)`` (hub
+  minus floating member); ``sp_el`` pairs them and ``sp_par`` holds the law.  With
+  ``R = |d|`` and ``Rdot = d.d'/R`` the radial force is
+  ``F = k R + c Rdot`` (R < S1), ``F = F_m tanh(Rdot / v)`` (S1 <= R <= S2),
+  ``F = k (R - S2) + c Rdot + F_m tanh(Rdot / v)`` (R > S2), and the two component
+  elements carry ``f_x = F dx / R`` and ``f_y = F dy / R`` (0 at R = 0), so the usual
+  ``-V_e f_e`` applies it.
+
 All quantities are SI: metres, radians, newtons, newton-metres, kilograms, kg m^2,
 seconds.  Rotational DOFs are the vibratory angle about the body's own axis, measured
 from the nominal rigid rotation.
@@ -29,6 +48,21 @@ import numpy as np
 #: element kinds
 SPRING = 0
 MESH = 1
+SPLINE = 2
+"""Component (x or y) of a spline radial element; see ``sp_el`` / ``sp_par``."""
+
+#: rows of the friction table per friction mesh: force, moment on driver, on driven
+FRICTION_ROWS = 3
+#: columns of ``sp_par``
+SP_STIFFNESS, SP_DAMPING, SP_STICK, SP_CLEARANCE, SP_FRICTION, SP_VELOCITY = range(6)
+
+
+def _empty_int(*shape):
+    return np.zeros(shape or (0,), dtype=np.int64)
+
+
+def _empty_float(*shape):
+    return np.zeros(shape or (0,), dtype=np.float64)
 
 
 @dataclass(frozen=True)
@@ -46,7 +80,7 @@ class Structure:
 
     element_names: tuple[str, ...]
     element_kind: np.ndarray
-    """(n_el,) int64, SPRING or MESH."""
+    """(n_el,) int64, SPRING, MESH or SPLINE."""
     v_ptr: np.ndarray
     """(n_el + 1,) int64: entries of element e are v_dof[v_ptr[e]:v_ptr[e+1]]."""
     v_dof: np.ndarray
@@ -83,6 +117,27 @@ class Structure:
     force_table: np.ndarray
     """(n_el, n_table) additive periodic force along the element [N] (impact); zeros if none."""
 
+    fr_el: np.ndarray = field(default_factory=_empty_int)
+    """(n_fm,) int64 element index of each mesh with tooth friction."""
+    fr_ptr: np.ndarray = field(default_factory=lambda: _empty_int(1))
+    """(n_fm + 1,) int64: friction entries of friction mesh j are fr_*[fr_ptr[j]:fr_ptr[j+1]]."""
+    fr_dof: np.ndarray = field(default_factory=_empty_int)
+    """(n_fe,) int64 DOF of each friction entry."""
+    fr_coef: np.ndarray = field(default_factory=_empty_float)
+    """(n_fe,) float64 coefficient of each friction entry [-]: W_i(s) = coef * table[row, s]."""
+    fr_row: np.ndarray = field(default_factory=_empty_int)
+    """(n_fe,) int64 row of ``friction_table`` of each entry."""
+    friction_table: np.ndarray = field(default_factory=lambda: _empty_float(0, 1))
+    """(3 n_fm, n_table) per unit normal load over one mesh cycle: rows 3j, 3j+1, 3j+2 of
+    friction mesh j are the friction force [-], and the friction moments on the driver
+    and on the driven gear [m] (positive in each gear's direction of rotation)."""
+    sp_el: np.ndarray = field(default_factory=lambda: _empty_int(0, 2))
+    """(n_sp, 2) int64: the x and y component elements of each spline radial element."""
+    sp_par: np.ndarray = field(default_factory=lambda: _empty_float(0, 6))
+    """(n_sp, 6) float64: stiffness k [N/m], damping c [N s/m], stick limit S1 [m],
+    radial clearance S2 [m], friction force F_m [N], velocity scale v [m/s] of the
+    regularised Coulomb friction (columns SP_*)."""
+
     metadata: dict = field(default_factory=dict, compare=False)
     """Free-form information for post-processing (mesh names, stages, body map...)."""
 
@@ -107,6 +162,27 @@ class Structure:
             np.add.at(V[e], self.v_dof[sl], self.v_coef[sl])
         return V
 
+    @property
+    def n_friction(self) -> int:
+        """Number of meshes with tooth friction."""
+        return int(self.fr_el.shape[0])
+
+    @property
+    def n_splines(self) -> int:
+        """Number of spline radial elements (each is two component elements)."""
+        return int(self.sp_el.shape[0])
+
+    def friction_matrix(self, values: np.ndarray | None = None) -> np.ndarray:
+        """Dense (n_el, n_dof) friction projections W_e for friction-table values
+        ``values`` (one per row of ``friction_table``); the mean of each row if None.
+        Rows of elements without friction are zero."""
+        vals = self.friction_table.mean(axis=1) if values is None else np.asarray(values)
+        W = np.zeros((self.n_elements, self.n_dof))
+        for j, e in enumerate(self.fr_el):
+            sl = slice(self.fr_ptr[j], self.fr_ptr[j + 1])
+            np.add.at(W[e], self.fr_dof[sl], self.fr_coef[sl] * vals[self.fr_row[sl]])
+        return W
+
     def mean_stiffness(self) -> np.ndarray:
         """(n_el,) mean of each element's stiffness table [N/m]."""
         return self.stiffness_table.mean(axis=1)
@@ -118,9 +194,18 @@ class Structure:
         return V.T @ (k[:, None] * V)
 
     def damping_matrix(self) -> np.ndarray:
-        """Dense C = sum_e c_e V_e V_e^T + diag(ground damping)."""
+        """Dense C = sum_e c_e V_e V_e^T + diag(ground damping).
+
+        A spline component element adds the largest tangent of its regularised
+        friction, F_m / v, to its damping (the stiffest damping the run can meet; the
+        RK4 stability check uses this matrix)."""
         V = self.projection_matrix()
-        return V.T @ (self.damping[:, None] * V) + np.diag(self.ground_damping)
+        c = self.damping.astype(float).copy()
+        for j in range(self.n_splines):
+            par = self.sp_par[j]
+            if par[SP_FRICTION] > 0 and par[SP_VELOCITY] > 0:
+                c[self.sp_el[j]] += par[SP_FRICTION] / par[SP_VELOCITY]
+        return V.T @ (c[:, None] * V) + np.diag(self.ground_damping)
 
     def kernel_arrays(self) -> tuple:
         """The arrays in the order the compiled kernels take them."""
@@ -131,6 +216,8 @@ class Structure:
             self.gap_ptr, self.gap_values,
             self.error_constant, self.error_ptr, self.error_amplitude,
             self.error_omega, self.error_phase, self.force_table,
+            self.fr_el, self.fr_ptr, self.fr_dof, self.fr_coef, self.fr_row,
+            self.friction_table, self.sp_el, self.sp_par,
         )
 
 
@@ -146,15 +233,53 @@ def build_structure(
 ) -> Structure:
     """Pack a list of element descriptions into a :class:`Structure`.
 
-    Each element is a dict with keys ``name``, ``kind`` (SPRING or MESH), ``dofs``
-    (indices), ``coefs`` (projection coefficients) and optionally ``stiffness`` (a
-    scalar or an array sampled over one period, resampled to ``n_table``),
-    ``frequency`` [Hz], ``phase`` [cycles], ``damping``, ``gaps`` (scalar or per-cycle
-    sequence of half-gaps), ``error_constant``, ``errors`` (list of
+    Each element is a dict with keys ``name``, ``kind`` (SPRING, MESH or SPLINE),
+    ``dofs`` (indices), ``coefs`` (projection coefficients) and optionally
+    ``stiffness`` (a scalar or an array sampled over one period, resampled to
+    ``n_table``), ``frequency`` [Hz], ``phase`` [cycles], ``damping``, ``gaps`` (scalar
+    or per-cycle sequence of half-gaps), ``error_constant``, ``errors`` (list of
     ``(amplitude, omega, phase)``) and ``force`` (array over one period).
+
+    A MESH may carry ``friction``: a dict with ``table`` (3 arrays over one mesh cycle:
+    friction force, moment on the driver, moment on the driven gear, per unit normal
+    load; resampled to ``n_table``), ``dofs``, ``coefs`` and ``rows`` (0, 1 or 2: the
+    table row each entry scales).  See the module docstring.
+
+    A SPLINE describes a whole radial element and becomes two component elements named
+    ``<name>.x`` and ``<name>.y``: give ``x`` and ``y`` as ``(dofs, coefs)`` (the rows
+    of the relative displacement hub - floating member; either may be empty), and
+    ``stiffness``, ``damping``, ``stick_limit``, ``clearance``, ``friction_force`` and
+    ``velocity_scale`` (scalars, SI).
     """
     n_dof = len(dof_names)
     inv_mass = np.ascontiguousarray(inv_mass, dtype=np.float64)
+    expanded: list[dict] = []
+    splines: list[tuple[int, int, list[float]]] = []
+    for el in elements:
+        if el.get("kind", SPRING) != SPLINE:
+            expanded.append(el)
+            continue
+        k = float(el.get("stiffness", 0.0))
+        c = float(el.get("damping", 0.0))
+        idx = []
+        for comp in ("x", "y"):
+            dofs, coefs = el.get(comp, ((), ()))
+            idx.append(len(expanded))
+            expanded.append({"name": f"{el['name']}.{comp}", "kind": SPLINE,
+                             "dofs": list(dofs), "coefs": list(coefs), "stiffness": k,
+                             "damping": c})
+        s1 = float(el.get("stick_limit", 0.0))
+        s2 = float(el.get("clearance", 0.0))
+        if not 0.0 <= s1 <= s2:
+            raise ValueError(f"spline {el['name']!r}: need 0 <= stick_limit <= clearance, got "
+                             f"{s1!r} and {s2!r} m")
+        par = [k, c, s1, s2, float(el.get("friction_force", 0.0)),
+               float(el.get("velocity_scale", 1e-4))]
+        if par[SP_FRICTION] < 0 or not par[SP_VELOCITY] > 0:
+            raise ValueError(f"spline {el['name']!r}: friction_force must be >= 0 N and "
+                             f"velocity_scale > 0 m/s")
+        splines.append((idx[0], idx[1], par))
+    elements = expanded
     n_el = len(elements)
     kind = np.zeros(n_el, dtype=np.int64)
     v_ptr = np.zeros(n_el + 1, dtype=np.int64)
@@ -172,6 +297,12 @@ def build_structure(
     e_amp: list[float] = []
     e_om: list[float] = []
     e_ph: list[float] = []
+    fr_el: list[int] = []
+    fr_ptr = [0]
+    fr_dof: list[int] = []
+    fr_coef: list[float] = []
+    fr_row: list[int] = []
+    fr_tab: list[np.ndarray] = []
     grid = np.arange(n_table) / n_table
     for i, el in enumerate(elements):
         kind[i] = el.get("kind", SPRING)
@@ -193,6 +324,24 @@ def build_structure(
             e_om.append(om)
             e_ph.append(ph)
         e_ptr[i + 1] = len(e_amp)
+        fr = el.get("friction")
+        if fr is not None:
+            if kind[i] != MESH:
+                raise ValueError(f"element {el['name']!r}: only a MESH can have tooth friction")
+            table = fr["table"]
+            if len(table) != FRICTION_ROWS:
+                raise ValueError(f"element {el['name']!r}: the friction table needs 3 rows "
+                                 "(force, moment on driver, moment on driven gear)")
+            base = FRICTION_ROWS * len(fr_el)
+            fr_el.append(i)
+            fr_tab.extend(_resample_periodic(row, grid) for row in table)
+            for d, c, r in zip(fr["dofs"], fr["coefs"], fr["rows"], strict=True):
+                if not 0 <= int(r) < FRICTION_ROWS:
+                    raise ValueError(f"element {el['name']!r}: friction rows are 0, 1 or 2")
+                fr_dof.append(int(d))
+                fr_coef.append(float(c))
+                fr_row.append(base + int(r))
+            fr_ptr.append(len(fr_dof))
     return Structure(
         dof_names=tuple(dof_names),
         inv_mass=inv_mass,
@@ -215,6 +364,15 @@ def build_structure(
         error_omega=np.asarray(e_om, dtype=np.float64),
         error_phase=np.asarray(e_ph, dtype=np.float64),
         force_table=ftab,
+        fr_el=np.asarray(fr_el, dtype=np.int64),
+        fr_ptr=np.asarray(fr_ptr, dtype=np.int64),
+        fr_dof=np.asarray(fr_dof, dtype=np.int64),
+        fr_coef=np.asarray(fr_coef, dtype=np.float64),
+        fr_row=np.asarray(fr_row, dtype=np.int64),
+        friction_table=(np.asarray(fr_tab, dtype=np.float64) if fr_tab
+                        else np.zeros((0, n_table))),
+        sp_el=np.asarray([[a, b] for a, b, _ in splines], dtype=np.int64).reshape(-1, 2),
+        sp_par=np.asarray([p for _, _, p in splines], dtype=np.float64).reshape(-1, 6),
         metadata=dict(metadata or {}),
     )
 

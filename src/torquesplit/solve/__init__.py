@@ -15,9 +15,10 @@ Module              What it does
 ``stability``       :func:`check_step` / :func:`stable_step` - RK4 stability of a step
                     from the eigenvalues at maximum stiffness; the error explains the
                     highest natural frequency and a safe step.
-``static``          :func:`static_equilibrium`, :func:`quasi_static` - active-set solution
-                    with backlash / clearance dead zones; rigid-body modes removed by
-                    mass-weighted constraints; unbalanced torques reported.
+``static``          :func:`static_equilibrium`, :func:`quasi_static` - Newton with exact
+                    line search on the strain energy with backlash / clearance / spline
+                    dead zones, tooth friction iterated as a load; rigid-body modes
+                    removed by mass-weighted constraints; unbalanced torques reported.
 ``modal``           :func:`modal_analysis` - natural frequencies, mass-normalised modes,
                     modal strain energy per element, rigid-body modes apart.
 ``reference``       Readable numpy twins of the kernels (:func:`rhs_numpy`, ...), used by
@@ -35,9 +36,13 @@ Conventions
   are the vibratory angle measured from the nominal rigid rotation.
 * Element ``e``: deformation ``delta = V_e.q - e_e(t)``, force ``f_e = k_e(t) h(delta)
   + c_e rate + p_e(t)`` (positive = compression of the mesh / spring), generalized
-  force ``-V_e f_e``.  Element and DOF selections accept indices or names.
-* Excitation cycle ``c`` of an element: ``floor(f t + phase)`` minus its value at the
-  start of the run; per-cycle arrays have one row per cycle, one column per element.
+  force ``-V_e f_e``; a mesh with tooth friction adds ``-W_e(phase) max(f_e, 0)``; the
+  two component elements of a spline carry the x and y components of its radial force.
+  Element and DOF selections accept indices or names.
+* Excitation cycle ``c`` of an element: ``floor(f t + phase)`` (counted one up within
+  1e-9 below the next integer, so a sample on a cycle boundary belongs to the cycle it
+  starts) minus its value at the start of the run; per-cycle arrays have one row per
+  cycle, one column per element.
 * Solver status codes: 0 finished, 1 diverged, 2 step size underflow, 3 maximum
   steps reached.  A stopped run is a result, not an exception.
 """

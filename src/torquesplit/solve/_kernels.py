@@ -12,7 +12,8 @@ ne       number of elements
 K P G    excitation slots ``(n_slot, ne)``: stiffness [N/m], additive force [N],
          half-gap [m] of each element at one instant
 E ED     excitation slots ``(n_slot, ne)``: error [m] and error rate [m/s]
-CY       excitation slot ``(n_slot, ne)`` int64: excitation cycle index floor(f t + phase)
+CY       excitation slot ``(n_slot, ne)`` int64: statistics cycle index of s = f t + phase,
+         floor(s) counted one up within CYCLE_EPS below the next integer
 S C      ``(n_slot, n_sin)``: sin and cos of every error sinusoid's argument
 tv_el    elements whose tables vary in time (frequency > 0)
 err_el   elements that own at least one error sinusoid
@@ -24,12 +25,25 @@ vr_ptr vq_idx vv_idx  V by element (CSR), unsigned: row pointers, indices into y
          of the q and of the v entries
 vt_*     V by DOF (CSR of V^T): generalized forces are gathered, not scattered
 defl     element deformation delta = V.q - e (ne)
-MODEL    the 28 model arrays, always passed in the order of :data:`MODEL_ARRAYS`
+fr_*     tooth friction (seed 003): friction meshes fr_el, their sparse force projections
+         W (CSR over friction meshes: fr_ptr, fr_dof, fr_coef, fr_row) and the table
+         ``friction_table`` (3 rows per friction mesh); empty without friction
+FR       excitation slot ``(n_slot, 3 n_fm)``: friction-table values at one instant
+sp_el sp_par  spline radial elements (seed 002 eq. 6): the x / y component elements and
+         the law (k, c, S1, S2, F_m, v); empty without splines
+MODEL    the 36 model arrays, always passed in the order of :data:`MODEL_ARRAYS`
 RECORD   the 18 output arrays, always passed in the order of :data:`RECORD_ARRAYS`
 
 Time of step ``i`` is always computed as ``t0 + i * h`` (never accumulated), so a run
 split into chunks whose sizes are multiples of :data:`RESYNC` reproduces the unsplit run
 bit for bit.
+
+Tooth friction and splines are handled by two kernels of their own,
+:func:`excite_friction` and :func:`rhs_extra`, called after :func:`excite_tables` /
+:func:`rhs_slot` only when a model has them (``has_fr``, ``extra``); the kernels get zero
+stiffness and damping for the spline component elements, so rhs_slot's element loop and
+gather are unchanged.  A model without friction or splines runs exactly the arithmetic
+it ran before they existed (bit for bit), at the same cost per step.
 
 Compilation flags: ``error_model="numpy"`` only (no Python zero-division checks; the
 inputs are validated in Python).  No fastmath: besides keeping NaN/inf checks valid,
@@ -76,6 +90,11 @@ N_CLOCK = 5
 
 MESH_KIND = 1
 _NO_CYCLE = -(2**62)
+CYCLE_EPS = 1e-9
+"""Cycle index of the statistics: floor(s), plus one when frac(s) >= 1 - CYCLE_EPS, so a
+sample at a cycle boundary whose phase s = f t + phase rounds just below the integer
+(e.g. 31.99999999999999) counts in the cycle it starts.  Tables and the half-gap
+sequence still use floor(s)."""
 RESYNC = 64
 """RK4 recomputes the error sinusoids exactly every RESYNC steps (phasor rotation between)."""
 # Slot indices are always passed as int64 variables (np.int64(k)), never as literal
@@ -86,7 +105,8 @@ MODEL_ARRAYS = (
     "v_coef", "stiffness_table", "frequency", "phase", "damping", "gap_ptr",
     "gap_values", "error_constant", "error_ptr", "error_amplitude", "error_omega",
     "error_phase", "force_table", "tv_el", "err_el", "sin_el", "vr_ptr", "vq_idx",
-    "vv_idx", "vt_ptr", "vt_el", "vt_coef",
+    "vv_idx", "vt_ptr", "vt_el", "vt_coef", "fr_el", "fr_ptr", "fr_dof", "fr_coef",
+    "fr_row", "friction_table", "sp_el", "sp_par",
 )
 RECORD_ARRAYS = (
     "track_el", "track_base", "cyc_max", "cyc_min", "cyc_sum", "cyc_cnt",
@@ -167,7 +187,8 @@ def excite_tables(t, slot, tv_el, frequency, phase, stiffness_table, force_table
     frac(s) * n_table; the half-gap is entry floor(s) mod n_gaps of the per-cycle
     sequence (cached in ``gap_cyc``/``gap_val`` since the cycle changes rarely).  The
     force table is read only where ``has_force`` (see :func:`scratch_flags`); elsewhere
-    P keeps its zero from :func:`init_slots`.
+    P keeps its zero from :func:`init_slots`.  CY is the statistics cycle index (floor(s),
+    plus one within CYCLE_EPS below the next integer).
     Twin: :func:`torquesplit.solve.reference.excitation_numpy`.
     """
     n_tab = stiffness_table.shape[1]
@@ -189,7 +210,10 @@ def excite_tables(t, slot, tv_el, frequency, phase, stiffness_table, force_table
             p0 = force_table[e, i0]
             P[slot, e] = p0 + w * (force_table[e, i1] - p0)
         c = np.int64(fl)
-        CY[slot, e] = c
+        if s - fl >= 1.0 - CYCLE_EPS:
+            CY[slot, e] = c + 1
+        else:
+            CY[slot, e] = c
         ng = gap_ptr[e + 1] - gap_ptr[e]
         if ng == 1:
             G[slot, e] = gap_values[gap_ptr[e]]
@@ -201,6 +225,31 @@ def excite_tables(t, slot, tv_el, frequency, phase, stiffness_table, force_table
                 gap_cyc[e] = c
                 gap_val[e] = gap_values[gap_ptr[e] + m]
             G[slot, e] = gap_val[e]
+
+
+@njit(cache=True, error_model="numpy")
+def excite_friction(t, slot, frequency, phase, fr_el, friction_table, FR):
+    """Friction-table values of every friction mesh at t: rows 3 j .. 3 j + 2 of friction
+    mesh j, interpolated like the stiffness (periodically at frac(s) n_table, s = f t +
+    phase of its mesh element).  Called only for models with tooth friction.
+    Twin: the friction part of :func:`torquesplit.solve.reference.excitation_numpy`.
+    """
+    n_fr = friction_table.shape[1]
+    for j in range(fr_el.shape[0]):
+        e = fr_el[j]
+        s = frequency[e] * t + phase[e]
+        fl = math.floor(s)
+        x = (s - fl) * n_fr
+        i0 = int(x)
+        w = x - i0
+        if i0 >= n_fr:
+            i0 -= n_fr
+        i1 = i0 + 1
+        if i1 == n_fr:
+            i1 = 0
+        for r in range(3 * j, 3 * j + 3):
+            v0 = friction_table[r, i0]
+            FR[slot, r] = v0 + w * (friction_table[r, i1] - v0)
 
 
 @njit(cache=True, error_model="numpy")
@@ -287,8 +336,10 @@ def rhs_slot(y, slot, K, P, G, E, ED, inv_mass, external_force, ground_damping,
     always in contact), f = k h + c rate (only in contact) + p.  Also writes the
     element forces ``force`` and deformations ``defl``.  V is read row-wise (CSR,
     unsigned indices into y for q and v) and, for the generalized forces, column-wise
-    (``vt_*``: a gather per DOF, no scatter).
-    Twin: :func:`torquesplit.solve.reference.rhs_numpy`.
+    (``vt_*``: a gather per DOF, no scatter).  The kernels get zero stiffness and
+    damping for spline component elements (their force here is 0); :func:`rhs_extra`
+    adds splines and tooth friction.
+    Twin: :func:`torquesplit.solve.reference.rhs_numpy` (with :func:`rhs_extra`).
     """
     n = inv_mass.shape[0]
     for el in range(v_ptr.shape[0] - 1):
@@ -320,11 +371,85 @@ def rhs_slot(y, slot, K, P, G, E, ED, inv_mass, external_force, ground_damping,
 
 
 @njit(cache=True, error_model="numpy")
+def rhs_extra(y, slot, inv_mass, v_ptr, vq_idx, vv_idx, v_coef, fr_el, fr_ptr, fr_dof,
+              fr_coef, fr_row, FR, sp_el, sp_par, dy, force, defl):
+    """Spline radial elements and tooth friction, after :func:`rhs_slot` (only called
+    for models that have them, so others run exactly the arithmetic they always ran).
+
+    Each spline j gets its radial law (:func:`spline_force`), which overwrites the force
+    of its two component elements, and adds -M^-1 V_e f_e of both by a scatter (rhs_slot
+    saw them with zero stiffness).  Each friction mesh adds -M^-1 W_e(s) max(f_e, 0):
+    friction on the working flank only.
+    Twin: the spline and friction parts of :func:`torquesplit.solve.reference.rhs_numpy`.
+    """
+    n = inv_mass.shape[0]
+    for j in range(sp_el.shape[0]):
+        spline_force(j, y, sp_el, sp_par, v_ptr, vq_idx, vv_idx, v_coef, force, defl)
+        for c in range(2):
+            el = sp_el[j, c]
+            fe = force[el]
+            for i in range(v_ptr[el], v_ptr[el + 1]):
+                dy[vv_idx[i]] -= inv_mass[vq_idx[i]] * (v_coef[i] * fe)
+    for j in range(fr_el.shape[0]):
+        fe = force[fr_el[j]]
+        if fe > 0.0:
+            for i in range(fr_ptr[j], fr_ptr[j + 1]):
+                d = fr_dof[i]
+                dy[n + d] -= inv_mass[d] * (fr_coef[i] * FR[slot, fr_row[i]] * fe)
+
+
+@njit(cache=True, error_model="numpy")
+def spline_force(j, y, sp_el, sp_par, v_ptr, vq_idx, vv_idx, v_coef, force, defl):
+    """Radial law of spline j (seed 002 eq. 6, restoring, Coulomb friction regularised).
+
+    d = (dx, dy) from the projection rows of its two component elements, R = |d|,
+    Rdot = d.d'/R; F = k R + c Rdot (R < S1), F_m tanh(Rdot / v) (S1 <= R <= S2),
+    k (R - S2) + c Rdot + F_m tanh(Rdot / v) (R > S2); writes f_x = F dx / R,
+    f_y = F dy / R (0 at R = 0) and the deformations dx, dy.
+    Twin: the spline part of :func:`torquesplit.solve.reference.element_forces_numpy`.
+    """
+    ex = sp_el[j, 0]
+    ey = sp_el[j, 1]
+    dx = 0.0
+    rx = 0.0
+    for i in range(v_ptr[ex], v_ptr[ex + 1]):
+        dx += v_coef[i] * y[vq_idx[i]]
+        rx += v_coef[i] * y[vv_idx[i]]
+    dyy = 0.0
+    ry = 0.0
+    for i in range(v_ptr[ey], v_ptr[ey + 1]):
+        dyy += v_coef[i] * y[vq_idx[i]]
+        ry += v_coef[i] * y[vv_idx[i]]
+    defl[ex] = dx
+    defl[ey] = dyy
+    rad = math.sqrt(dx * dx + dyy * dyy)
+    if rad > 0.0:
+        rdot = (dx * rx + dyy * ry) / rad
+        k = sp_par[j, 0]
+        c = sp_par[j, 1]
+        s1 = sp_par[j, 2]
+        s2 = sp_par[j, 3]
+        fm = sp_par[j, 4]
+        if rad < s1:
+            f = k * rad + c * rdot
+        elif rad <= s2:
+            f = fm * math.tanh(rdot / sp_par[j, 5])
+        else:
+            f = k * (rad - s2) + c * rdot + fm * math.tanh(rdot / sp_par[j, 5])
+        force[ex] = f * dx / rad
+        force[ey] = f * dyy / rad
+    else:
+        force[ex] = 0.0
+        force[ey] = 0.0
+
+
+@njit(cache=True, error_model="numpy")
 def rhs_at(t, y, inv_mass, external_force, ground_damping, element_kind, v_ptr, v_dof,
            v_coef, stiffness_table, frequency, phase, damping, gap_ptr, gap_values,
            error_constant, error_ptr, error_amplitude, error_omega, error_phase,
            force_table, tv_el, err_el, sin_el, vr_ptr, vq_idx, vv_idx, vt_ptr, vt_el,
-           vt_coef, dy, force, defl):
+           vt_coef, fr_el, fr_ptr, fr_dof, fr_coef, fr_row, friction_table, sp_el,
+           sp_par, dy, force, defl):
     """One exact right-hand-side evaluation at (t, y) (allocates; not for loops).
 
     Twin: :func:`torquesplit.solve.reference.rhs_numpy` and
@@ -340,6 +465,9 @@ def rhs_at(t, y, inv_mass, external_force, ground_damping, element_kind, v_ptr, 
     CY = np.empty((1, ne), dtype=np.int64)
     S = np.empty((1, n_sin))
     C = np.empty((1, n_sin))
+    FR = np.empty((1, friction_table.shape[0]))
+    has_fr = fr_el.shape[0] > 0
+    extra = has_fr or sp_el.shape[0] > 0
     gap_cyc = np.full(ne, _NO_CYCLE, dtype=np.int64)
     gap_val = np.zeros(ne)
     has_force = np.zeros(ne, dtype=np.bool_)
@@ -351,9 +479,15 @@ def rhs_at(t, y, inv_mass, external_force, ground_damping, element_kind, v_ptr, 
     excite_exact(t, s0, frequency, phase, stiffness_table, force_table, gap_ptr,
                  gap_values, error_constant, error_amplitude, error_omega, error_phase,
                  tv_el, err_el, sin_el, K, P, G, E, ED, CY, S, C, gap_cyc, gap_val, has_force)
+    if has_fr:
+        excite_friction(t, s0, frequency, phase, fr_el, friction_table, FR)
     rhs_slot(y, s0, K, P, G, E, ED, inv_mass, external_force, ground_damping,
              vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
              dy, force, defl)
+    if extra:
+        rhs_extra(y, s0, inv_mass, vr_ptr, vq_idx, vv_idx, v_coef, fr_el,
+                  fr_ptr, fr_dof, fr_coef, fr_row, FR, sp_el, sp_par, dy, force,
+                  defl)
 
 
 # ================================================================== recording
@@ -439,7 +573,8 @@ def rk4_run(y, t0, h, n_first, n_steps, record_final, record_every, blowup,
             v_coef, stiffness_table, frequency, phase, damping, gap_ptr, gap_values,
             error_constant, error_ptr, error_amplitude, error_omega, error_phase,
             force_table, tv_el, err_el, sin_el, vr_ptr, vq_idx, vv_idx, vt_ptr, vt_el,
-            vt_coef, track_el, track_base, cyc_max, cyc_min, cyc_sum, cyc_cnt,
+            vt_coef, fr_el, fr_ptr, fr_dof, fr_coef, fr_row, friction_table,
+              sp_el, sp_par, track_el, track_base, cyc_max, cyc_min, cyc_sum, cyc_cnt,
             sep_count, back_count, sep_time, back_time, hist_el, hist_dof, hist_t,
             hist_f, hist_q, hist_v, full_t, full_y, counters, clock):
     """Classic fixed-step RK4 over global steps n_first .. n_first + n_steps - 1.
@@ -450,7 +585,9 @@ def rk4_run(y, t0, h, n_first, n_steps, record_final, record_every, blowup,
     advanced in place.  Excitation is evaluated once per distinct stage time (t,
     t + h/2, t + h) and the t + h values are reused by the next step; error sinusoids
     are advanced by phasor rotation and recomputed exactly every RESYNC steps.
-    Stops early (status DIVERGED) if the state is non-finite or |q| > blowup.
+    Stops early (status DIVERGED) if the state is non-finite or |q| > blowup.  Models
+    with tooth friction or splines also run :func:`excite_friction` after each
+    excitation and :func:`rhs_extra` after each right-hand side (``has_fr``, ``extra``).
     Twin: :func:`torquesplit.solve.reference.rk4_numpy`.
     """
     n = inv_mass.shape[0]
@@ -465,6 +602,9 @@ def rk4_run(y, t0, h, n_first, n_steps, record_final, record_every, blowup,
     CY = np.empty((3, ne), dtype=np.int64)
     S = np.empty((3, n_sin))
     C = np.empty((3, n_sin))
+    FR = np.empty((3, friction_table.shape[0]))
+    has_fr = fr_el.shape[0] > 0
+    extra = has_fr or sp_el.shape[0] > 0
     cos_rot = np.empty(n_sin)
     sin_rot = np.empty(n_sin)
     for i in range(n_sin):
@@ -499,6 +639,8 @@ def rk4_run(y, t0, h, n_first, n_steps, record_final, record_every, blowup,
             excite_tables(t, a, tv_el, frequency, phase, stiffness_table, force_table,
                           gap_ptr, gap_values, K, P, G, CY, gap_cyc, gap_val,
                           has_force)
+            if has_fr:
+                excite_friction(t, a, frequency, phase, fr_el, friction_table, FR)
             phasors_exact(t, a, error_omega, error_phase, S, C)
             errors_from_phasors(a, err_el, error_constant, sin_el, error_amplitude,
                                 error_omega, S, C, E, ED)
@@ -506,6 +648,10 @@ def rk4_run(y, t0, h, n_first, n_steps, record_final, record_every, blowup,
         rhs_slot(y, a, K, P, G, E, ED, inv_mass, external_force, ground_damping,
                  vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
                  k1, force, defl)
+        if extra:
+            rhs_extra(y, a, inv_mass, vr_ptr, vq_idx, vv_idx, v_coef, fr_el,
+                      fr_ptr, fr_dof, fr_coef, fr_row, FR, sp_el, sp_par, k1, force,
+                      defl)
         record_statistics(a, force, defl, G, CY, element_kind, track_el, track_base,
                           cyc_max, cyc_min, cyc_sum, cyc_cnt, sep_count, back_count,
                           sep_time, back_time, h, counters, watch_el, n_watch)
@@ -524,6 +670,8 @@ def rk4_run(y, t0, h, n_first, n_steps, record_final, record_every, blowup,
         excite_tables(th, s_half, tv_el, frequency, phase, stiffness_table, force_table,
                       gap_ptr, gap_values, K, P, G, CY, gap_cyc, gap_val,
                       has_force)
+        if has_fr:
+            excite_friction(th, s_half, frequency, phase, fr_el, friction_table, FR)
         advance_errors(a, s_half, cos_rot, sin_rot, err_el, error_constant, sin_el,
                        error_amplitude, error_omega, S, C, E, ED)
         for m in range(n2):
@@ -531,16 +679,26 @@ def rk4_run(y, t0, h, n_first, n_steps, record_final, record_every, blowup,
         rhs_slot(yt, s_half, K, P, G, E, ED, inv_mass, external_force, ground_damping,
                  vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
                  k2, ftmp, dtmp)
+        if extra:
+            rhs_extra(yt, s_half, inv_mass, vr_ptr, vq_idx, vv_idx, v_coef, fr_el,
+                      fr_ptr, fr_dof, fr_coef, fr_row, FR, sp_el, sp_par, k2, ftmp,
+                      dtmp)
         for m in range(n2):
             yt[m] = y[m] + hh * k2[m]
         rhs_slot(yt, s_half, K, P, G, E, ED, inv_mass, external_force, ground_damping,
                  vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
                  k3, ftmp, dtmp)
+        if extra:
+            rhs_extra(yt, s_half, inv_mass, vr_ptr, vq_idx, vv_idx, v_coef, fr_el,
+                      fr_ptr, fr_dof, fr_coef, fr_row, FR, sp_el, sp_par, k3, ftmp,
+                      dtmp)
         # stage 4 at t + h
         tb = t0 + (i + 1) * h
         excite_tables(tb, b, tv_el, frequency, phase, stiffness_table, force_table,
                       gap_ptr, gap_values, K, P, G, CY, gap_cyc, gap_val,
                       has_force)
+        if has_fr:
+            excite_friction(tb, b, frequency, phase, fr_el, friction_table, FR)
         advance_errors(s_half, b, cos_rot, sin_rot, err_el, error_constant, sin_el,
                        error_amplitude, error_omega, S, C, E, ED)
         for m in range(n2):
@@ -548,6 +706,10 @@ def rk4_run(y, t0, h, n_first, n_steps, record_final, record_every, blowup,
         rhs_slot(yt, b, K, P, G, E, ED, inv_mass, external_force, ground_damping,
                  vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
                  k4, ftmp, dtmp)
+        if extra:
+            rhs_extra(yt, b, inv_mass, vr_ptr, vq_idx, vv_idx, v_coef, fr_el,
+                      fr_ptr, fr_dof, fr_coef, fr_row, FR, sp_el, sp_par, k4, ftmp,
+                      dtmp)
         for m in range(n2):
             y[m] += h6 * (k1[m] + 2.0 * (k2[m] + k3[m]) + k4[m])
         counters[I_STEPS] += 1
@@ -565,6 +727,10 @@ def rk4_run(y, t0, h, n_first, n_steps, record_final, record_every, blowup,
         rhs_slot(y, a, K, P, G, E, ED, inv_mass, external_force, ground_damping,
                  vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
                  k1, force, defl)
+        if extra:
+            rhs_extra(y, a, inv_mass, vr_ptr, vq_idx, vv_idx, v_coef, fr_el,
+                      fr_ptr, fr_dof, fr_coef, fr_row, FR, sp_el, sp_par, k1, force,
+                      defl)
         record_statistics(a, force, defl, G, CY, element_kind, track_el, track_base,
                           cyc_max, cyc_min, cyc_sum, cyc_cnt, sep_count, back_count,
                           sep_time, back_time, 0.0, counters, watch_el, n_watch)
@@ -604,7 +770,8 @@ def dopri_run(y, kfsal, t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, 
               v_coef, stiffness_table, frequency, phase, damping, gap_ptr, gap_values,
               error_constant, error_ptr, error_amplitude, error_omega, error_phase,
               force_table, tv_el, err_el, sin_el, vr_ptr, vq_idx, vv_idx, vt_ptr, vt_el,
-              vt_coef, track_el, track_base, cyc_max, cyc_min, cyc_sum, cyc_cnt,
+              vt_coef, fr_el, fr_ptr, fr_dof, fr_coef, fr_row, friction_table,
+              sp_el, sp_par, track_el, track_base, cyc_max, cyc_min, cyc_sum, cyc_cnt,
               sep_count, back_count, sep_time, back_time, hist_el, hist_dof, hist_t,
               hist_f, hist_q, hist_v, full_t, full_y, counters, clock):
     """Adaptive Dormand-Prince 5(4) with FSAL and PI step-size control (Hairer's DOPRI5).
@@ -631,6 +798,9 @@ def dopri_run(y, kfsal, t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, 
     CY = np.empty((2, ne), dtype=np.int64)
     S = np.empty((2, n_sin))
     C = np.empty((2, n_sin))
+    FR = np.empty((2, friction_table.shape[0]))
+    has_fr = fr_el.shape[0] > 0
+    extra = has_fr or sp_el.shape[0] > 0
     k2 = np.empty(n2)
     k3 = np.empty(n2)
     k4 = np.empty(n2)
@@ -666,9 +836,15 @@ def dopri_run(y, kfsal, t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, 
                      gap_values, error_constant, error_amplitude, error_omega,
                      error_phase, tv_el, err_el, sin_el, K, P, G, E, ED, CY, S, C,
                      gap_cyc, gap_val, has_force)
+        if has_fr:
+            excite_friction(t, s1, frequency, phase, fr_el, friction_table, FR)
         rhs_slot(y, s1, K, P, G, E, ED, inv_mass, external_force, ground_damping,
                  vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
                  kfsal, force, defl)
+        if extra:
+            rhs_extra(y, s1, inv_mass, vr_ptr, vq_idx, vv_idx, v_coef, fr_el,
+                      fr_ptr, fr_dof, fr_coef, fr_row, FR, sp_el, sp_par, kfsal, force,
+                      defl)
         counters[I_RHS] += 1
         counters[I_FSAL] = 1
         if counters[I_SAMPLES] == 0:
@@ -710,27 +886,45 @@ def dopri_run(y, kfsal, t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, 
                      gap_ptr, gap_values, error_constant, error_amplitude, error_omega,
                      error_phase, tv_el, err_el, sin_el, K, P, G, E, ED, CY, S, C,
                      gap_cyc, gap_val, has_force)
+        if has_fr:
+            excite_friction(t + _C2 * hs, s0, frequency, phase, fr_el, friction_table, FR)
         rhs_slot(yt, s0, K, P, G, E, ED, inv_mass, external_force, ground_damping,
                  vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
                  k2, ftmp, dtmp)
+        if extra:
+            rhs_extra(yt, s0, inv_mass, vr_ptr, vq_idx, vv_idx, v_coef, fr_el,
+                      fr_ptr, fr_dof, fr_coef, fr_row, FR, sp_el, sp_par, k2, ftmp,
+                      dtmp)
         for m in range(n2):
             yt[m] = y[m] + hs * (_A31 * kfsal[m] + _A32 * k2[m])
         excite_exact(t + _C3 * hs, s0, frequency, phase, stiffness_table, force_table,
                      gap_ptr, gap_values, error_constant, error_amplitude, error_omega,
                      error_phase, tv_el, err_el, sin_el, K, P, G, E, ED, CY, S, C,
                      gap_cyc, gap_val, has_force)
+        if has_fr:
+            excite_friction(t + _C3 * hs, s0, frequency, phase, fr_el, friction_table, FR)
         rhs_slot(yt, s0, K, P, G, E, ED, inv_mass, external_force, ground_damping,
                  vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
                  k3, ftmp, dtmp)
+        if extra:
+            rhs_extra(yt, s0, inv_mass, vr_ptr, vq_idx, vv_idx, v_coef, fr_el,
+                      fr_ptr, fr_dof, fr_coef, fr_row, FR, sp_el, sp_par, k3, ftmp,
+                      dtmp)
         for m in range(n2):
             yt[m] = y[m] + hs * (_A41 * kfsal[m] + _A42 * k2[m] + _A43 * k3[m])
         excite_exact(t + _C4 * hs, s0, frequency, phase, stiffness_table, force_table,
                      gap_ptr, gap_values, error_constant, error_amplitude, error_omega,
                      error_phase, tv_el, err_el, sin_el, K, P, G, E, ED, CY, S, C,
                      gap_cyc, gap_val, has_force)
+        if has_fr:
+            excite_friction(t + _C4 * hs, s0, frequency, phase, fr_el, friction_table, FR)
         rhs_slot(yt, s0, K, P, G, E, ED, inv_mass, external_force, ground_damping,
                  vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
                  k4, ftmp, dtmp)
+        if extra:
+            rhs_extra(yt, s0, inv_mass, vr_ptr, vq_idx, vv_idx, v_coef, fr_el,
+                      fr_ptr, fr_dof, fr_coef, fr_row, FR, sp_el, sp_par, k4, ftmp,
+                      dtmp)
         for m in range(n2):
             yt[m] = y[m] + hs * (_A51 * kfsal[m] + _A52 * k2[m] + _A53 * k3[m]
                                  + _A54 * k4[m])
@@ -738,9 +932,15 @@ def dopri_run(y, kfsal, t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, 
                      gap_ptr, gap_values, error_constant, error_amplitude, error_omega,
                      error_phase, tv_el, err_el, sin_el, K, P, G, E, ED, CY, S, C,
                      gap_cyc, gap_val, has_force)
+        if has_fr:
+            excite_friction(t + _C5 * hs, s0, frequency, phase, fr_el, friction_table, FR)
         rhs_slot(yt, s0, K, P, G, E, ED, inv_mass, external_force, ground_damping,
                  vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
                  k5, ftmp, dtmp)
+        if extra:
+            rhs_extra(yt, s0, inv_mass, vr_ptr, vq_idx, vv_idx, v_coef, fr_el,
+                      fr_ptr, fr_dof, fr_coef, fr_row, FR, sp_el, sp_par, k5, ftmp,
+                      dtmp)
         for m in range(n2):
             yt[m] = y[m] + hs * (_A61 * kfsal[m] + _A62 * k2[m] + _A63 * k3[m]
                                  + _A64 * k4[m] + _A65 * k5[m])
@@ -749,9 +949,15 @@ def dopri_run(y, kfsal, t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, 
                      gap_ptr, gap_values, error_constant, error_amplitude, error_omega,
                      error_phase, tv_el, err_el, sin_el, K, P, G, E, ED, CY, S, C,
                      gap_cyc, gap_val, has_force)
+        if has_fr:
+            excite_friction(t_new, s0, frequency, phase, fr_el, friction_table, FR)
         rhs_slot(yt, s0, K, P, G, E, ED, inv_mass, external_force, ground_damping,
                  vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
                  k6, ftmp, dtmp)
+        if extra:
+            rhs_extra(yt, s0, inv_mass, vr_ptr, vq_idx, vv_idx, v_coef, fr_el,
+                      fr_ptr, fr_dof, fr_coef, fr_row, FR, sp_el, sp_par, k6, ftmp,
+                      dtmp)
         for m in range(n2):
             ynew[m] = y[m] + hs * (_B1 * kfsal[m] + _B3 * k3[m] + _B4 * k4[m]
                                    + _B5 * k5[m] + _B6 * k6[m])
@@ -763,9 +969,15 @@ def dopri_run(y, kfsal, t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, 
             E[1, el] = E[0, el]
             ED[1, el] = ED[0, el]
             CY[1, el] = CY[0, el]
+        for r in range(FR.shape[1]):
+            FR[1, r] = FR[0, r]
         rhs_slot(ynew, s1, K, P, G, E, ED, inv_mass, external_force, ground_damping,
                  vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
                  k7, force, defl)
+        if extra:
+            rhs_extra(ynew, s1, inv_mass, vr_ptr, vq_idx, vv_idx, v_coef, fr_el,
+                      fr_ptr, fr_dof, fr_coef, fr_row, FR, sp_el, sp_par, k7, force,
+                      defl)
         counters[I_RHS] += 6
         acc = 0.0
         for m in range(n2):
@@ -803,9 +1015,15 @@ def dopri_run(y, kfsal, t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, 
                              gap_ptr, gap_values, error_constant, error_amplitude,
                              error_omega, error_phase, tv_el, err_el, sin_el,
                              K, P, G, E, ED, CY, S, C, gap_cyc, gap_val, has_force)
+                if has_fr:
+                    excite_friction(ts, s0, frequency, phase, fr_el, friction_table, FR)
                 rhs_slot(ys, s0, K, P, G, E, ED, inv_mass, external_force,
                          ground_damping, vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el,
                          vt_coef, damping, dys, ftmp, dtmp)
+                if extra:
+                    rhs_extra(ys, s0, inv_mass, vr_ptr, vq_idx, vv_idx, v_coef, fr_el,
+                              fr_ptr, fr_dof, fr_coef, fr_row, FR, sp_el, sp_par, dys, ftmp,
+                              dtmp)
                 store_history(row, ts, ys, ftmp, hist_el, hist_dof, hist_t, hist_f,
                               hist_q, hist_v)
                 if row < full_t.shape[0]:

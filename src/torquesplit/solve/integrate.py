@@ -160,7 +160,7 @@ class Solution:
 
 # ============================================================== model arrays
 def _model_arrays(structure: Structure) -> tuple:
-    """The 28 MODEL arrays of the kernels (order: ``_kernels.MODEL_ARRAYS``):
+    """The 36 MODEL arrays of the kernels (order: ``_kernels.MODEL_ARRAYS``):
     contiguous, writable, float64 / int64 / uint64, derived index arrays included."""
     s = structure
     n_el = s.n_elements
@@ -185,6 +185,22 @@ def _model_arrays(structure: Structure) -> tuple:
                           "rebuild it with build_structure.")
     if s.n_table < 1:
         raise SolverError("stiffness tables are empty; build the structure with n_table >= 1.")
+    n_fm, n_fe = len(s.fr_el), len(s.fr_dof)
+    if (len(s.fr_ptr) != n_fm + 1 or s.fr_ptr[0] != 0 or s.fr_ptr[-1] != n_fe
+            or np.any(np.diff(s.fr_ptr) < 0) or len(s.fr_coef) != n_fe
+            or len(s.fr_row) != n_fe or s.friction_table.shape[0] != 3 * n_fm
+            or (n_fm and s.friction_table.shape[1] < 1)
+            or (n_fm and (np.min(s.fr_el) < 0 or np.max(s.fr_el) >= n_el))
+            or (n_fe and (np.min(s.fr_dof) < 0 or np.max(s.fr_dof) >= s.n_dof
+                          or np.min(s.fr_row) < 0 or np.max(s.fr_row) >= 3 * n_fm))):
+        raise SolverError("the tooth-friction arrays (fr_*, friction_table) of the structure "
+                          "are inconsistent; rebuild it with build_structure.")
+    n_sp = s.sp_el.shape[0] if s.sp_el.ndim == 2 else -1
+    if (s.sp_el.ndim != 2 or s.sp_el.shape[1] != 2 or s.sp_par.shape != (n_sp, 6)
+            or (n_sp and (np.min(s.sp_el) < 0 or np.max(s.sp_el) >= n_el))
+            or (n_sp and not np.all(s.sp_par[:, 5] > 0))):
+        raise SolverError("the spline arrays (sp_el, sp_par) of the structure are "
+                          "inconsistent; rebuild it with build_structure.")
 
     def f8(a):
         return np.array(a, dtype=np.float64, order="C", copy=True)
@@ -203,15 +219,24 @@ def _model_arrays(structure: Structure) -> tuple:
     order = np.lexsort((owner, s.v_dof))
     vt_ptr = np.zeros(s.n_dof + 1, dtype=np.int64)
     np.add.at(vt_ptr, np.asarray(s.v_dof, dtype=np.int64) + 1, 1)
+    # spline component elements: zero stiffness and damping in the element loop of the
+    # kernels (their force there is 0); _kernels.rhs_extra applies the radial law
+    ktab, damp = f8(s.stiffness_table), f8(s.damping)
+    comps = np.asarray(s.sp_el, dtype=np.int64).ravel()
+    ktab[comps] = 0.0
+    damp[comps] = 0.0
     return (
         f8(s.inv_mass), f8(s.external_force), f8(s.ground_damping), i8(s.element_kind),
-        i8(s.v_ptr), i8(s.v_dof), f8(s.v_coef), f8(s.stiffness_table), f8(s.frequency),
-        f8(s.phase), f8(s.damping), i8(s.gap_ptr), f8(s.gap_values),
+        i8(s.v_ptr), i8(s.v_dof), f8(s.v_coef), ktab, f8(s.frequency),
+        f8(s.phase), damp, i8(s.gap_ptr), f8(s.gap_values),
         f8(s.error_constant), i8(s.error_ptr), f8(s.error_amplitude), f8(s.error_omega),
         f8(s.error_phase), f8(s.force_table),
         i8(np.flatnonzero(varying)), i8(err_el), i8(sin_el),
         u8(s.v_ptr), u8(s.v_dof), u8(np.asarray(s.v_dof) + s.n_dof),
         u8(np.cumsum(vt_ptr)), u8(owner[order]), f8(np.asarray(s.v_coef)[order]),
+        i8(s.fr_el), i8(s.fr_ptr), i8(s.fr_dof), f8(s.fr_coef), i8(s.fr_row),
+        f8(s.friction_table).reshape(3 * n_fm, -1) if n_fm else np.zeros((0, 1)),
+        i8(s.sp_el).reshape(n_sp, 2), f8(s.sp_par).reshape(n_sp, 6),
     )
 
 
@@ -247,18 +272,23 @@ def compile_kernels() -> float:
     """
     global _COMPILE_TIME
     if _COMPILE_TIME is None:
-        from torquesplit.assembly.structure import MESH, build_structure
+        from torquesplit.assembly.structure import MESH, SPLINE, build_structure
 
         _COMPILE_TIME = 0.0  # guard: the warm-up below calls integrate()
         t_start = time.perf_counter()
         s = build_structure(
-            ["a.theta", "b.theta"], [1.0, 1.0],
-            [dict(name="m", kind=MESH, dofs=[0, 1], coefs=[1.0, -1.0],
+            ["a.theta", "b.theta", "b.x", "b.y"], [1.0, 1.0, 1.0, 1.0],
+            [dict(name="m", kind=MESH, dofs=[0, 1, 2], coefs=[1.0, -1.0, 0.1],
                   stiffness=[1.0, 2.0], frequency=1.0, gaps=[0.0, 0.1], damping=0.01,
-                  errors=[(0.01, 1.0, 0.0)], force=[0.0, 0.1])],
+                  errors=[(0.01, 1.0, 0.0)], force=[0.0, 0.1],
+                  friction=dict(table=[[0.1, -0.1], [0.01, 0.0], [0.0, -0.01]],
+                                dofs=[0, 1, 3], coefs=[-1.0, -1.0, 1.0], rows=[1, 2, 0])),
+             dict(name="sp", kind=SPLINE, x=([2], [-1.0]), y=([3], [-1.0]), stiffness=1.0,
+                  damping=0.01, stick_limit=0.001, clearance=0.01, friction_force=0.01,
+                  velocity_scale=0.1)],
             n_table=4,
         )
-        y0 = np.zeros(4)
+        y0 = np.zeros(8)
         integrate(s, y0, (0.0, 0.05), method="rk4", step=0.01, full_history=True)
         integrate(s, y0, (0.0, 0.05), method="dopri", full_history=True)
         rhs(s, 0.0, y0)
@@ -302,10 +332,10 @@ def _natural_period_min(structure: Structure) -> float:
 def _default_atol(structure: Structure, rtol: float) -> np.ndarray:
     """Absolute tolerance per state: rtol x a typical displacement / velocity of each DOF.
 
-    Typical element deformation = max(load / stiffness, half-gap, error amplitude), the
-    load being the largest external force or torque carried by any element; each DOF's
-    scale is the smallest deformation scale of its elements divided by its projection
-    coefficient.  Velocities scale with the highest excitation (or natural) frequency.
+    Typical element deformation = max(load / stiffness, half-gap or spline clearance,
+    error amplitude), the load being the largest external force or torque carried by any
+    element; each DOF's scale is the smallest deformation scale of its elements divided
+    by its projection coefficient.  Velocities scale with the highest excitation (or natural) frequency.
     """
     s = structure
     n = s.n_dof
@@ -318,8 +348,11 @@ def _default_atol(structure: Structure, rtol: float) -> np.ndarray:
                 load = max(load, abs(s.external_force[s.v_dof[j]]) / c)
     load = max(load, float(np.max(np.abs(s.force_table), initial=0.0)))
     q_scale = np.full(n, np.inf)
+    clearance = np.zeros(s.n_elements)  # spline components: their radial clearance
+    for (ex, ey), par in zip(s.sp_el, s.sp_par, strict=True):
+        clearance[[ex, ey]] = par[3]
     for e in range(s.n_elements):
-        gaps = s.gap_values[s.gap_ptr[e]:s.gap_ptr[e + 1]]
+        gaps = np.append(s.gap_values[s.gap_ptr[e]:s.gap_ptr[e + 1]], clearance[e])
         amp = abs(s.error_constant[e]) + np.sum(np.abs(
             s.error_amplitude[s.error_ptr[e]:s.error_ptr[e + 1]]))
         d = max(load / k_ref[e] if k_ref[e] > 0 else 0.0, float(np.max(gaps)), amp)
@@ -578,8 +611,8 @@ def _select(s, t0, span, track_elements, n_cycles_cap, history_elements,
         if static_ones:
             raise ValueError(f"elements {static_ones} have no excitation frequency, so they "
                              "have no mesh cycles to track; leave them out of track_elements.")
-    # same floating-point expression as the kernel's cycle index at t0
-    base = np.array([math.floor(s.frequency[e] * t0 + s.phase[e]) for e in track],
+    # same floating-point expressions as the kernel's cycle index at t0
+    base = np.array([_cycle_index(s.frequency[e] * t0 + s.phase[e]) for e in track],
                     dtype=np.int64)
     if n_cycles_cap is None:
         f_max = max((float(s.frequency[e]) for e in track), default=0.0)
@@ -737,6 +770,12 @@ class _Outputs:
         return dict(cycle_start=start, cycle_max=_rows(self.cyc_max, n_cyc),
                     cycle_min=_rows(self.cyc_min, n_cyc), cycle_mean=_rows(self.cyc_sum, n_cyc),
                     cycle_count=_rows(cnt_all, n_cyc))
+
+
+def _cycle_index(s: float) -> int:
+    """Statistics cycle index of mesh phase s (as ``_kernels.excite_tables``)."""
+    fl = math.floor(s)
+    return fl + 1 if s - fl >= 1.0 - kern.CYCLE_EPS else fl
 
 
 def _rows(buf: np.ndarray, n: int) -> np.ndarray:

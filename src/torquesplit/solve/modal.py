@@ -2,7 +2,13 @@
 
 Each element contributes its mean stiffness ``k_e V_e V_e^T`` if it is in contact at
 the linearisation state (no dead zone, or ``|V_e.q - e_e| > g_e`` with the constant
-error and the mean half-gap); separated elements contribute nothing.  The generalized
+error and the mean half-gap); separated elements contribute nothing.  A spline radial
+element contributes the tangent of its static law (:func:`static.spline_static_law`)
+in the plane of its two component rows: ``k`` in both directions when sticking (or
+without clearance), nothing while floating, and ``k`` radially, ``k (R - S2) / R``
+tangentially once its clearance has closed; half of its strain energy is assigned to
+each of its two component elements.  Tooth friction (non-conservative) and the spline
+friction are left out: these are the modes of the conservative system.  The generalized
 eigenproblem ``K phi = omega^2 M phi`` is solved in the symmetric form
 ``(M^-1/2 K M^-1/2) psi = omega^2 psi`` with ``phi = M^-1/2 psi`` (mass-normalised:
 ``phi^T M phi = 1``).  Modes with ``omega^2`` below ``rigid_tolerance`` x the largest
@@ -18,6 +24,7 @@ import numpy as np
 
 from torquesplit.assembly.structure import Structure
 from torquesplit.solve._frozen import freeze_arrays
+from torquesplit.solve.static import spline_static_law
 
 __all__ = ["ModalSolution", "modal_analysis"]
 
@@ -80,6 +87,7 @@ def modal_analysis(structure: Structure, q=None, *, rigid_tolerance: float = 1e-
     s = structure
     V = s.projection_matrix()
     k = s.mean_stiffness()
+    delta = None
     if q is None:
         active = np.ones(s.n_elements, dtype=bool)
     else:
@@ -92,7 +100,17 @@ def modal_analysis(structure: Structure, q=None, *, rigid_tolerance: float = 1e-
         delta = V @ q - s.error_constant
         active = (g <= 0) | (np.abs(delta) > g)
     k_act = np.where(active, k, 0.0)
+    sp_tangent = []  # (x element, y element, 2 x 2 tangent, their two rows of V)
+    for j in range(s.n_splines):
+        ex, ey = (int(i) for i in s.sp_el[j])
+        dx, dy = (0.0, 0.0) if delta is None else (delta[ex], delta[ey])
+        h2 = _spline_tangent(s.sp_par[j], dx, dy, closed=delta is None)
+        k_act[ex] = k_act[ey] = 0.0
+        active[ex] = active[ey] = bool(np.any(h2 != 0))
+        sp_tangent.append((ex, ey, h2, V[[ex, ey]]))
     K = V.T @ (k_act[:, None] * V)
+    for _, _, h2, rows in sp_tangent:
+        K = K + rows.T @ h2 @ rows
     d = np.sqrt(s.inv_mass)
     A = d[:, None] * K * d[None, :]
     A = 0.5 * (A + A.T)
@@ -105,6 +123,9 @@ def modal_analysis(structure: Structure, q=None, *, rigid_tolerance: float = 1e-
     phi_e = phi[:, elastic]
     freqs = np.sign(lam_e) * np.sqrt(np.abs(lam_e)) / (2 * math.pi)
     energy = k_act[None, :] * (V @ phi_e).T ** 2
+    for ex, ey, h2, rows in sp_tangent:  # half of the spline's energy on each component
+        u = rows @ phi_e  # (2, n_modes)
+        energy[:, ex] = energy[:, ey] = 0.5 * np.einsum("im,ij,jm->m", u, h2, u)
     total = energy.sum(axis=1, keepdims=True)
     with np.errstate(invalid="ignore", divide="ignore"):
         fraction = np.where(total != 0, energy / total, 0.0)
@@ -116,3 +137,17 @@ def modal_analysis(structure: Structure, q=None, *, rigid_tolerance: float = 1e-
                          strain_energy_fraction=fraction, damping_ratios=zeta,
                          rigid_modes=phi[:, rigid], active=active,
                          dof_names=tuple(s.dof_names), element_names=tuple(s.element_names))
+
+
+def _spline_tangent(par, dx: float, dy: float, closed: bool) -> np.ndarray:
+    """2 x 2 tangent stiffness of a spline's static radial law at (dx, dy)."""
+    k = float(par[0])
+    rad = float(np.hypot(dx, dy))
+    if closed:
+        return k * np.eye(2)
+    force, tangent, _ = (float(v) for v in spline_static_law(par, rad))
+    if rad == 0.0:
+        return (k if par[2] > 0 or par[3] == 0 else 0.0) * np.eye(2)
+    n = np.array([dx, dy]) / rad
+    nn = np.outer(n, n)
+    return tangent * nn + force / rad * (np.eye(2) - nn)

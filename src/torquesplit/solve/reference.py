@@ -12,13 +12,26 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from torquesplit.assembly.structure import MESH, Structure
+from torquesplit.assembly.structure import (
+    MESH,
+    SP_CLEARANCE,
+    SP_DAMPING,
+    SP_FRICTION,
+    SP_STICK,
+    SP_STIFFNESS,
+    SP_VELOCITY,
+    Structure,
+)
+from torquesplit.solve._kernels import CYCLE_EPS
 
 __all__ = [
     "Excitation",
     "excitation_numpy",
     "element_forces_numpy",
     "rhs_numpy",
+    "spline_law_numpy",
+    "friction_matrix_numpy",
+    "cycle_index_numpy",
     "contact_state_numpy",
     "hermite_numpy",
     "cycle_statistics_numpy",
@@ -42,7 +55,21 @@ class Excitation:
     error_rate: np.ndarray
     """e_e'(t) [m/s]."""
     cycle: np.ndarray
-    """Excitation cycle index floor(f t + phase) (int64; 0 for f == 0)."""
+    """Statistics cycle index of s = f t + phase (int64; 0 for f == 0): floor(s), plus one
+    within CYCLE_EPS below the next integer (see :func:`cycle_index_numpy`)."""
+    friction: np.ndarray
+    """(3 n_fm,) friction-table values: per unit normal load, the friction force and the
+    friction moments on driver and driven gear of each friction mesh."""
+
+
+def cycle_index_numpy(s):
+    """Statistics cycle index of mesh phases ``s``: floor(s), plus one when
+    frac(s) >= 1 - CYCLE_EPS (a sample at a cycle boundary counts in the cycle it starts,
+    even if s rounds to just below the integer).  Twin of the CY lines of
+    ``_kernels.excite_tables``."""
+    s = np.asarray(s, dtype=float)
+    fl = np.floor(s)
+    return (fl + (s - fl >= 1.0 - CYCLE_EPS)).astype(np.int64)
 
 
 def excitation_numpy(structure: Structure, t: float) -> Excitation:
@@ -52,7 +79,9 @@ def excitation_numpy(structure: Structure, t: float) -> Excitation:
     and periodically in their table at frac(s) * n_table (column 0 when f == 0); the
     half-gap is entry floor(s) mod n_gaps of the element's per-cycle sequence; the error
     is e = e_const + sum A sin(omega t + phi) and its rate sum A omega cos(omega t + phi).
-    Twin of ``_kernels.excite_exact`` (and ``init_slots``).
+    The friction rows of each friction mesh are interpolated like the tables, at the
+    phase of its mesh element.
+    Twin of ``_kernels.excite_exact`` (and ``init_slots``, ``excite_friction``).
     """
     s = structure
     n_el = s.n_elements
@@ -70,9 +99,9 @@ def excitation_numpy(structure: Structure, t: float) -> Excitation:
     p0 = s.force_table[rows, i0]
     stiffness = k0 + w * (s.stiffness_table[rows, i1] - k0)
     force = p0 + w * (s.force_table[rows, i1] - p0)
-    cycle = cycle.astype(np.int64)
     n_gaps = np.diff(s.gap_ptr)
-    half_gap = s.gap_values[s.gap_ptr[:-1] + np.mod(cycle, n_gaps)]
+    half_gap = s.gap_values[s.gap_ptr[:-1] + np.mod(cycle.astype(np.int64), n_gaps)]
+    stat_cycle = np.where(varying, cycle_index_numpy(mesh_phase), 0)
 
     owner = np.repeat(np.arange(n_el), np.diff(s.error_ptr))
     arg = s.error_omega * t + s.error_phase
@@ -80,15 +109,60 @@ def excitation_numpy(structure: Structure, t: float) -> Excitation:
     error_rate = np.zeros(n_el)
     np.add.at(error, owner, s.error_amplitude * np.sin(arg))
     np.add.at(error_rate, owner, s.error_amplitude * s.error_omega * np.cos(arg))
-    return Excitation(stiffness, force, half_gap, error, error_rate, cycle)
+
+    friction = np.zeros(s.friction_table.shape[0])
+    n_fr = s.friction_table.shape[1]
+    for j, e in enumerate(s.fr_el):
+        sp = s.frequency[e] * t + s.phase[e]
+        xf = (sp - np.floor(sp)) * n_fr
+        j0 = int(xf)
+        wf = xf - j0
+        j0 = j0 - n_fr if j0 >= n_fr else j0
+        j1 = (j0 + 1) % n_fr
+        rows = slice(3 * j, 3 * j + 3)
+        v0 = s.friction_table[rows, j0]
+        friction[rows] = v0 + wf * (s.friction_table[rows, j1] - v0)
+    return Excitation(stiffness, force, half_gap, error, error_rate, stat_cycle, friction)
+
+
+def spline_law_numpy(par, dx, dy, rx=0.0, ry=0.0):
+    """Radial force of a spline at relative displacement (dx, dy) and rate (rx, ry).
+
+    ``par`` is a row of ``structure.sp_par`` (k, c, S1, S2, F_m, v).  With R = |d| and
+    Rdot = d.d'/R: F = k R + c Rdot (R < S1); F_m tanh(Rdot / v) (S1 <= R <= S2);
+    k (R - S2) + c Rdot + F_m tanh(Rdot / v) (R > S2).  Returns the component forces
+    (F dx / R, F dy / R), (0, 0) at R = 0.  Twin of ``_kernels.spline_force``.
+    """
+    rad = float(np.hypot(dx, dy))
+    if rad == 0.0:
+        return 0.0, 0.0
+    rdot = (dx * rx + dy * ry) / rad
+    k, c, s1, s2 = par[SP_STIFFNESS], par[SP_DAMPING], par[SP_STICK], par[SP_CLEARANCE]
+    fric = par[SP_FRICTION] * np.tanh(rdot / par[SP_VELOCITY])
+    if rad < s1:
+        f = k * rad + c * rdot
+    elif rad <= s2:
+        f = fric
+    else:
+        f = k * (rad - s2) + c * rdot + fric
+    return f * dx / rad, f * dy / rad
+
+
+def friction_matrix_numpy(structure: Structure, t: float) -> np.ndarray:
+    """Dense (n_el, n_dof) friction projections W_e(s(t)) (zero rows without friction).
+
+    The generalized force of tooth friction is -W_e max(f_e, 0): friction acts on the
+    working flank only (see docs/theory/model.md)."""
+    return structure.friction_matrix(excitation_numpy(structure, t).friction)
 
 
 def element_forces_numpy(structure: Structure, t: float, y: np.ndarray):
     """Element forces f_e and deformations delta_e at (t, y); returns ``(force, delta)``.
 
     delta = V.q - e, rate = V.v - e', h = dead zone of half-width g (h = delta when
-    g == 0), f = k h + c rate (in contact only) + p.
-    Twin of the element loop in ``_kernels.rhs_slot``.
+    g == 0), f = k h + c rate (in contact only) + p; the two component elements of a
+    spline then get the radial law (:func:`spline_law_numpy`).
+    Twin of the element loop of ``_kernels.rhs_slot`` and ``_kernels.spline_force``.
     """
     n = structure.n_dof
     y = np.asarray(y, dtype=float)
@@ -103,22 +177,29 @@ def element_forces_numpy(structure: Structure, t: float, y: np.ndarray):
     h = np.where(gapped, h, delta)
     contact = ~gapped | (np.abs(delta) > g)
     force = ex.stiffness * h + np.where(contact, structure.damping * rate, 0.0) + ex.force
+    for (e_x, e_y), par in zip(structure.sp_el, structure.sp_par, strict=True):
+        force[e_x], force[e_y] = spline_law_numpy(par, delta[e_x], delta[e_y],
+                                                  rate[e_x], rate[e_y])
     return force, delta
 
 
 def rhs_numpy(structure: Structure, t: float, y: np.ndarray) -> np.ndarray:
-    """Right-hand side of the first-order system: dy/dt = [v, M^-1 (F - C_g v - V^T f)].
+    """Right-hand side of the first-order system:
+    dy/dt = [v, M^-1 (F - C_g v - V^T f - W(t)^T max(f, 0))].
 
-    Twin of ``_kernels.rhs_slot`` / ``_kernels.rhs_at``.  Usable directly with
-    :func:`scipy.integrate.solve_ivp`.
+    W(t) holds the tooth-friction projections (:func:`friction_matrix_numpy`); f includes
+    the spline forces.  Twin of ``_kernels.rhs_slot`` + ``_kernels.rhs_extra`` /
+    ``_kernels.rhs_at``.  Usable directly with :func:`scipy.integrate.solve_ivp`.
     """
     n = structure.n_dof
     y = np.asarray(y, dtype=float)
     v = y[n:]
     force, _ = element_forces_numpy(structure, t, y)
     V = structure.projection_matrix()
-    accel = structure.inv_mass * (structure.external_force - structure.ground_damping * v
-                                  - V.T @ force)
+    gen = structure.external_force - structure.ground_damping * v - V.T @ force
+    if structure.n_friction:
+        gen = gen - friction_matrix_numpy(structure, t).T @ np.maximum(force, 0.0)
+    accel = structure.inv_mass * gen
     return np.concatenate([v, accel])
 
 
@@ -152,13 +233,15 @@ def hermite_numpy(theta, h, y0, f0, y1, f1):
 def cycle_statistics_numpy(times, forces, frequency, phase, t0, n_cycles_cap):
     """Per-excitation-cycle max, min, sum and count of one element's force samples.
 
-    Cycle index of a sample at t is floor(f t + phase) - floor(f t0 + phase).
-    Returns four arrays of length ``n_cycles_cap`` (max -inf / min +inf where empty).
+    Cycle index of a sample at t is c(f t + phase) - c(f t0 + phase), c the statistics
+    cycle index (:func:`cycle_index_numpy`).  Returns four arrays of length
+    ``n_cycles_cap`` (max -inf / min +inf where empty).
     Twin of the cycle part of ``_kernels.record_statistics``.
     """
     times = np.asarray(times, dtype=float)
     forces = np.asarray(forces, dtype=float)
-    idx = (np.floor(frequency * times + phase) - np.floor(frequency * t0 + phase)).astype(int)
+    idx = (cycle_index_numpy(frequency * times + phase)
+           - cycle_index_numpy(frequency * t0 + phase)).astype(int)
     cmax = np.full(n_cycles_cap, -np.inf)
     cmin = np.full(n_cycles_cap, np.inf)
     csum = np.zeros(n_cycles_cap)

@@ -1,35 +1,61 @@
-"""Static and quasi-static equilibrium with dead zones and rigid-body modes.
+"""Static and quasi-static equilibrium with dead zones, splines, friction and rigid modes.
 
-Solves ``sum_e V_e f_e(q) = F_ext`` with ``f_e = k_e h(V_e.q - e_e; g_e) + p_e``
-(damping plays no part).  The dead zone ``h`` makes the problem piecewise linear, so
-the "Newton" iteration is an active-set iteration: with each element's contact state
-fixed (front contact, back contact, separated) the equations are linear; solve, update
-the states from the new deformations, repeat until no state changes.  Separated
-elements get a tiny regularising stiffness (``regularisation`` x k) during the
-iteration so that a member left floating by them stays determined; they are reported
-in ``StaticSolution.separated`` and their force is exactly zero.  Once the contact
-states have settled, the regularisation is dropped again if the elements in contact
-hold every DOF on their own, so the equilibrium is then exact.
+Solves ``sum_e V_e f_e(q) + sum_fr W_e max(f_e, 0) = F_ext`` with the static element
+laws (damping plays no part):
+
+* ordinary elements: ``f_e = k_e h(V_e.q - e_e; g_e) + p_e``, h the dead zone of
+  half-width g (backlash, support clearance);
+* spline radial elements (seed 002 eq. 6): radial force F(R) along d/R with
+  ``F = k R`` (R < S1), ``0`` (S1 <= R <= S2: floating; friction is zero at rest),
+  ``k (R - S2)`` (R > S2), i.e. a radial dead zone;
+* tooth friction: the projection W_e of the mean friction-table values (``t=None``) or
+  of their values at ``t``.
+
+Method.  Without friction the static problem is the minimum of the strain energy
+``U(q) - F_eff.q`` (F_eff = F_ext - V^T p), which is convex and piecewise quadratic
+for dead zones (and convex for the radial dead zone of a spline when S1 = 0).  It is
+minimised by Newton's method with an exact line search along the Newton direction (the
+directional derivative is monotone, so a bracketing root search finds the step), which
+cannot cycle between contact states the way full active-set steps can.  Elements inside
+their dead zone get a tiny regularising stiffness (``regularisation`` x k, centred, so a
+member left floating by them stays determined); they are reported in
+``StaticSolution.separated`` and their force is exactly zero.  Once the contact states
+have settled, the regularisation is dropped again if the elements in contact hold every
+DOF on their own, and Newton continues on the exact law, so the equilibrium is then
+exact.  Tooth friction is non-conservative; its generalized forces are iterated as
+loads (fixed point on the mesh forces, which converges at the rate of the friction
+moment per unit load over the mesh arm, about mu), each step solved as above.
 
 Rigid-body modes are the null space of the structure with every dead zone closed.  A
 gear train driven and loaded by torques has one (the whole train turning).  Each is
 removed by the constraint ``phi_r^T M q = 0`` (zero mass-weighted motion along the
-mode), imposed with Lagrange multipliers::
+mode), imposed with Lagrange multipliers in every Newton step::
 
-    [ K_s    M Phi ] [ q  ]   [ F_ext - V^T p + sum_active k_e V_e (e_e + s_e g_e) ]
-    [ Phi^T M   0  ] [ mu ] = [ 0                                                  ]
+    [ H        M Phi ] [ dq ]   [ -grad          ]
+    [ Phi^T M    0   ] [ mu ] = [ -Phi^T M q     ]
 
-The external forces must do no work along a rigid-body mode (the torques must
-balance); if they do, :class:`~torquesplit.errors.SolverError` says by how much.
+The external forces must do no work along a rigid-body mode (the torques must balance);
+if they do, :class:`~torquesplit.errors.SolverError` says by how much.  Friction losses
+also load the rigid mode: with the lossless balanced load torque a real train
+decelerates slowly, with a load torque that takes the losses off the external torques
+alone do not balance.  Both are accepted (the external imbalance may be up to twice the
+friction's load along the mode); the net load is carried by the constraint as the
+d'Alembert force of a uniform acceleration, reported as
+``StaticSolution.rigid_acceleration``.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
-from torquesplit.assembly.structure import Structure
+from torquesplit.assembly.structure import (
+    SP_CLEARANCE,
+    SP_STICK,
+    SP_STIFFNESS,
+    Structure,
+)
 from torquesplit.errors import SolverError
 from torquesplit.solve._frozen import freeze_arrays
 from torquesplit.solve.reference import excitation_numpy
@@ -38,6 +64,10 @@ __all__ = ["StaticSolution", "QuasiStaticSolution", "static_equilibrium", "quasi
            "rigid_body_modes"]
 
 FRONT, SEPARATED, BACK = 1, 0, -1
+STICK, FLOAT, CONTACT = 2, 3, 4  # spline radial states
+
+_FRICTION_TOL = 1e-13  # relative change of the mesh forces ending the friction iteration
+_STEP_TOL = 1e-10  # relative Newton step below which a nonlinear (spline) state has settled
 
 
 @dataclass(frozen=True, eq=False)
@@ -47,21 +77,28 @@ class StaticSolution:
     q: np.ndarray
     """(n_dof,) displacements [m, rad]; zero mass-weighted motion along rigid modes."""
     element_forces: np.ndarray
-    """(n_el,) element forces f_e [N] (0 for separated elements)."""
+    """(n_el,) element forces f_e [N] (0 for separated elements; for the two component
+    elements of a spline the x and y components of its radial force)."""
     deformations: np.ndarray
     """(n_el,) deformations delta_e = V_e.q - e_e [m]."""
     in_contact: np.ndarray
-    """(n_el,) bool: element carries load (|delta| > g, or no dead zone)."""
+    """(n_el,) bool: element carries load (|delta| > g, or no dead zone; a spline when
+    R < S1 or R > S2)."""
     iterations: int
-    """Active-set iterations (linear solves)."""
+    """Linear solves (Newton steps, including the first closed-gap solve)."""
     converged: bool
-    """False if the contact states kept changing (cycling) within ``max_iterations``."""
+    """False if the iteration did not settle within ``max_iterations`` linear solves."""
     rigid_modes: np.ndarray
     """(n_dof, n_rigid) mass-normalised rigid-body modes (dead zones closed)."""
     separated: tuple[str, ...]
-    """Names of elements in separation (regularised with a tiny stiffness)."""
+    """Names of elements in separation (regularised with a tiny stiffness); for a spline
+    floating in its clearance, its two component elements."""
     t: float | None
     """Time of the excitation used, None for mean values."""
+    rigid_acceleration: np.ndarray | None = field(default=None)
+    """(n_rigid,) acceleration along each mass-normalised rigid mode that the net load
+    along it would cause (phi_r^T of the residual force) [sqrt(kg) m/s^2]; zero up to
+    round-off unless tooth friction takes power out of a torque-balanced train."""
 
     def __post_init__(self):
         freeze_arrays(self)
@@ -117,6 +154,42 @@ def rigid_body_modes(structure: Structure, active: np.ndarray | None = None,
     return d[:, None] * vt[rank:].T
 
 
+def spline_static_law(par, radius, reg: float = 0.0):
+    """Static radial law of a spline: force F(R), tangent dF/dR and energy U(R).
+
+    ``par`` a row of ``structure.sp_par``.  F = k R (R < S1), 0 (S1 <= R <= S2),
+    k (R - S2) (R > S2), plus the regularisation reg k min(R, S2) (continuous; zero
+    for reg = 0).  Vectorised over ``radius``.
+    """
+    k, s1, s2 = par[SP_STIFFNESS], par[SP_STICK], par[SP_CLEARANCE]
+    r = np.asarray(radius, dtype=float)
+    stick = r < s1
+    over = np.maximum(r - s2, 0.0)
+    inner = np.minimum(r, s2)
+    force = np.where(stick, k * r, 0.0) + k * over + reg * k * inner
+    tangent = np.where(stick, k, 0.0) + np.where(r > s2, k, 0.0) + np.where(r < s2, reg * k, 0.0)
+    energy = (np.where(stick, 0.5 * k * r * r, 0.5 * k * s1 * s1) + 0.5 * k * over * over
+              + reg * k * (0.5 * inner * inner + s2 * over))
+    return force, tangent, energy
+
+
+def spline_states(par, radius) -> np.ndarray:
+    """STICK (R < S1), FLOAT (S1 <= R <= S2, S2 > 0) or CONTACT of a spline."""
+    s1, s2 = par[SP_STICK], par[SP_CLEARANCE]
+    r = np.asarray(radius, dtype=float)
+    return np.where(r < s1, STICK, np.where((r <= s2) & (s2 > 0), FLOAT, CONTACT))
+
+
+@dataclass
+class _Loads:
+    k: np.ndarray
+    p: np.ndarray
+    e: np.ndarray
+    g: np.ndarray
+    W: np.ndarray | None  # friction projections (n_el, n_dof), None without friction
+    f_eff: np.ndarray  # F_ext - V^T p
+
+
 class _StaticProblem:
     """What stays the same for every time of a quasi-static sweep."""
 
@@ -130,8 +203,17 @@ class _StaticProblem:
         self.B = self.mass[:, None] * self.phi
         self.reg = regularisation
         self.balance_tolerance = balance_tolerance
+        self.sp_x = s.sp_el[:, 0].astype(int)
+        self.sp_y = s.sp_el[:, 1].astype(int)
+        self.linear = np.ones(s.n_elements, dtype=bool)  # ordinary (1-D) elements
+        self.linear[self.sp_x] = False
+        self.linear[self.sp_y] = False
+        self.has_gaps = bool(np.any(s.gap_values > 0)
+                             or np.any(s.sp_par[:, SP_CLEARANCE] > 0)
+                             or np.any(s.sp_par[:, SP_STICK] > 0))
 
-    def loads(self, t):
+    # ------------------------------------------------------------------ loads
+    def loads(self, t) -> _Loads:
         s = self.s
         if t is None:
             k = s.stiffness_table.mean(axis=1)
@@ -139,20 +221,29 @@ class _StaticProblem:
             e = s.error_constant.astype(float)
             g = np.array([s.gap_values[s.gap_ptr[i]:s.gap_ptr[i + 1]].mean()
                           for i in range(s.n_elements)])
+            fr = None
         else:
             ex = excitation_numpy(s, float(t))
-            k, p, e, g = ex.stiffness, ex.force, ex.error, ex.half_gap
-        return k, p, e, g
+            k, p, e, g, fr = ex.stiffness, ex.force, ex.error, ex.half_gap, ex.friction
+        W = s.friction_matrix(fr) if s.n_friction else None
+        return _Loads(k, p, e, g, W, s.external_force - self.V.T @ p)
 
-    def check_balance(self, f_eff):
-        """Raise if the effective external forces do work along a rigid-body mode."""
+    def check_balance(self, f_eff, friction_load=None):
+        """Raise if the effective external forces do work along a rigid-body mode.
+
+        With tooth friction (``friction_load`` = the friction's generalized force
+        W^T max(f, 0) at the solution) the external forces may be out of balance by up to
+        twice the friction's share along the mode: a load torque may be the lossless
+        balance (friction then decelerates the train) or take the losses off.
+        """
         s = self.s
         for r in range(self.phi.shape[1]):
             phi = self.phi[:, r]
             work = phi * f_eff
             net = float(work.sum())
             scale = float(np.abs(work).sum())
-            if scale > 0 and abs(net) > self.balance_tolerance * scale:
+            allowance = 0.0 if friction_load is None else 2.0 * abs(float(phi @ friction_load))
+            if scale > 0 and abs(net) > self.balance_tolerance * scale + allowance:
                 j = int(np.argmax(np.abs(work)))
                 unit = "N m" if s.dof_names[j].endswith("theta") else "N"
                 moving = [s.dof_names[i] for i in np.argsort(-np.abs(phi * np.sqrt(
@@ -165,87 +256,241 @@ class _StaticProblem:
                     f"equilibrium exists. Make the drive and load torques consistent with "
                     f"the gear ratios (output torque = input torque x ratio, minus losses).")
 
-    def solve(self, t, states=None, max_iterations=50):
+    # ------------------------------------------------------------ element laws
+    def forces(self, q, L: _Loads, reg: float):
+        """Element forces (without p), tangents, energy and states at q."""
         s = self.s
-        V, B = self.V, self.B
-        n, r = s.n_dof, B.shape[1]
-        k, p, e, g = self.loads(t)
-        f_eff = s.external_force - V.T @ p
-        self.check_balance(f_eff)
-        stiff = k > 0
+        delta = self.V @ q - L.e
+        k, g = L.k, L.g
+        a = np.abs(delta)
+        over = np.maximum(a - g, 0.0)
         gapped = g > 0
-        if states is None:
-            states = np.full(s.n_elements, FRONT)
-            first_linear = True  # first pass: every dead zone ignored (h = delta)
-        else:
-            states = np.asarray(states).copy()
-            first_linear = False
-        seen = set()
-        converged = False
-        it = 0
-        q = np.zeros(n)
+        clip = np.clip(delta, -g, g)
+        f = np.where(gapped, np.sign(delta) * k * over + reg * k * clip, k * delta)
+        kt = np.where(gapped, np.where(a > g, k, 0.0) + np.where(a <= g, reg * k, 0.0), k)
+        u = np.where(gapped, 0.5 * k * over * over
+                     + reg * k * (0.5 * np.minimum(a, g) ** 2 + g * over), 0.5 * k * delta ** 2)
+        state = np.where(gapped, np.where(delta > g, FRONT, np.where(delta < -g, BACK,
+                                                                       SEPARATED)), FRONT)
+        state = state.astype(np.int64)
+        energy = float(np.sum(np.where(self.linear, u, 0.0)))
+        sp = []
+        for j in range(s.n_splines):
+            ex, ey = self.sp_x[j], self.sp_y[j]
+            dx, dy = delta[ex], delta[ey]
+            rad = float(np.hypot(dx, dy))
+            par = s.sp_par[j]
+            fr, tr, ur = (float(v) for v in spline_static_law(par, rad, reg))
+            energy += ur
+            if rad > 0:
+                nx, ny = dx / rad, dy / rad
+                f[ex], f[ey] = fr * nx, fr * ny
+                ratio = fr / rad
+                nn = np.array([[nx * nx, nx * ny], [nx * ny, ny * ny]])
+                h2 = tr * nn + ratio * (np.eye(2) - nn)
+            else:
+                f[ex] = f[ey] = 0.0
+                slope0 = float(spline_static_law(par, 0.0, reg)[1])
+                if par[SP_STICK] == 0 and par[SP_CLEARANCE] == 0:
+                    slope0 = float(par[SP_STIFFNESS])
+                h2 = slope0 * np.eye(2)
+            kt[ex] = kt[ey] = 0.0
+            st = int(spline_states(par, rad))
+            state[ex] = state[ey] = st
+            sp.append(h2)
+        return delta, f, kt, energy, state, sp
 
-        def linear_solve(k_eff, target):
-            A = np.zeros((n + r, n + r))
-            A[:n, :n] = V.T @ (k_eff[:, None] * V)
-            A[:n, n:] = B
-            A[n:, :n] = B.T
-            rhs = np.concatenate([f_eff + V.T @ (k_eff * target), np.zeros(r)])
-            return self._solve(A, rhs, k_eff)[:n]
+    def hessian(self, kt, sp):
+        """Tangent stiffness: sum_e kt_e V_e V_e^T plus each spline's 2 x 2 tangent."""
+        V = self.V
+        H = V.T @ (kt[:, None] * V)
+        for j, h2 in enumerate(sp):
+            rows = V[[self.sp_x[j], self.sp_y[j]]]
+            H += rows.T @ h2 @ rows
+        return H
 
-        for it in range(1, max_iterations + 1):  # noqa: B007 (returned)
-            offset = np.where(gapped & ~first_linear, states * g, 0.0)
-            on = stiff & ((states != SEPARATED) | first_linear)
-            k_eff = np.where(on, k, self.reg * np.abs(k))
-            q = linear_solve(k_eff, e + np.where(on, offset, 0.0))
-            delta = V @ q - e
-            new = np.where(delta > g, FRONT, np.where(delta < -g, BACK, SEPARATED))
-            new = np.where(gapped, new, FRONT)
-            if not first_linear and np.array_equal(new, states):
-                converged = True
-                break
-            key = new.tobytes()
-            if key in seen:
-                break  # cycling between contact states
-            seen.add(key)
-            states, first_linear = new, False
-        separated = stiff & (states == SEPARATED)
-        if converged and separated.any():
-            # drop the regularisation if the contact elements alone hold every DOF
-            on = stiff & ~separated
-            if rigid_body_modes(self.s, active=on).shape[1] == self.phi.shape[1]:
-                q_exact = linear_solve(np.where(on, k, 0.0), e + np.where(on, states * g, 0.0))
-                d_exact = V @ q_exact - e
-                check = np.where(d_exact > g, FRONT, np.where(d_exact < -g, BACK, SEPARATED))
-                if np.array_equal(np.where(gapped, check, FRONT), states):
-                    q = q_exact
-        delta = V @ q - e
-        h = np.where(gapped, np.where(delta > g, delta - g,
-                                      np.where(delta < -g, delta + g, 0.0)), delta)
-        forces = k * h + p
-        contact = ~gapped | (np.abs(delta) > g)
-        return q, forces, delta, contact, it, converged, states
-
-    def _solve(self, A, b, k_eff):
+    # ------------------------------------------------------------------ Newton
+    def _kkt(self, H, rhs_top, rhs_bottom, active):
+        """Solve the constrained Newton system.  Rows and columns are scaled by the square
+        root of the diagonal of H (and the constraint columns to unit size), since the
+        stiffnesses of one model span many decades (bearings 1e12 N/m, regularised
+        separated elements, N m/rad against N/m), and one step of iterative refinement
+        follows."""
+        n, r = self.s.n_dof, self.B.shape[1]
+        diag = np.abs(np.diag(H))
+        sc = np.where(diag > 0, 1.0 / np.sqrt(np.where(diag > 0, diag, 1.0)), 1.0)
+        Bs = sc[:, None] * self.B
+        cs = 1.0 / np.maximum(np.max(np.abs(Bs), axis=0, initial=0.0), 1e-300)
+        A = np.zeros((n + r, n + r))
+        A[:n, :n] = sc[:, None] * H * sc[None, :]
+        A[:n, n:] = Bs * cs[None, :]
+        A[n:, :n] = A[:n, n:].T
+        b = np.concatenate([sc * rhs_top, cs * rhs_bottom])
         try:
             x = np.linalg.solve(A, b)
-            ok = np.all(np.isfinite(x)) and np.allclose(A @ x, b, rtol=1e-6,
-                                                        atol=1e-9 * np.abs(b).max())
+            x = x + np.linalg.solve(A, b - A @ x)
+            # backward error: a step that follows a tiny (regularised) stiffness is
+            # legitimately huge, a singular system gives no finite or consistent one
+            ok = bool(np.all(np.isfinite(x)) and np.all(
+                np.abs(A @ x - b) <= 1e-9 * (np.abs(A) @ np.abs(x) + np.abs(b)) + 1e-300))
         except np.linalg.LinAlgError:
             ok = False
         if not ok:
             s = self.s
-            free = rigid_body_modes(s, active=k_eff > 0)
+            free = rigid_body_modes(s, active=active)
             extra = free.shape[1] - self.phi.shape[1]
             loose = sorted({s.dof_names[i] for c in range(free.shape[1])
                             for i in np.flatnonzero(np.abs(free[:, c]) > 1e-9
                                                     * np.abs(free[:, c]).max())})
             raise SolverError(
                 f"the static stiffness is singular beyond the {self.phi.shape[1]} "
-                f"rigid-body mode(s): {extra} more free motion(s) involving {loose}. "
-                f"Give every DOF a support (bearing, shaft or mesh with non-zero "
+                f"rigid-body mode(s): {max(extra, 1)} more free motion(s) involving "
+                f"{loose}. Give every DOF a support (bearing, shaft or mesh with non-zero "
                 f"stiffness).")
-        return x
+        return sc * x[:n]
+
+    def closed_solve(self, L: _Loads, load):
+        """Equilibrium with every dead zone closed and no clearance (a linear spring per
+        element): the starting point of the Newton iteration."""
+        kt = np.where(L.k > 0, L.k, 0.0)
+        H = self.V.T @ (kt[:, None] * self.V)
+        return self._kkt(H, load + self.V.T @ (kt * L.e), np.zeros(self.B.shape[1]), kt > 0)
+
+    def _directional(self, q, dq, L, load, reg):
+        """phi'(alpha) = grad(q + alpha dq) . dq along the Newton direction, and the size
+        of the terms it is made of (its round-off scale)."""
+        vdq = self.V @ dq
+        fdq = float(load @ dq)
+
+        def dphi(alpha):
+            _, f, _, _, _, _ = self.forces(q + alpha * dq, L, reg)
+            terms = f * vdq
+            return float(terms.sum()) - fdq, float(np.abs(terms).sum()) + abs(fdq)
+        return dphi, vdq
+
+    def newton(self, q, L: _Loads, load, reg, budget):
+        """Minimise U(q) - load.q on B^T M q = 0 from q; returns (q, solves, converged)."""
+        solves = 0
+        delta, f, kt, _, state, sp = self.forces(q, L, reg)
+        while solves < budget:
+            grad = self.V.T @ f - load
+            H = self.hessian(kt, sp)
+            active = kt > 0
+            for j, h2 in enumerate(sp):
+                active[[self.sp_x[j], self.sp_y[j]]] = bool(np.any(h2 != 0))
+            dq = self._kkt(H, -grad, -(self.B.T @ q), active)
+            solves += 1
+            dphi, vdq = self._directional(q, dq, L, load, reg)
+            d0 = float(grad @ dq)
+            scale = max(float(np.max(np.abs(delta), initial=0.0)),
+                        float(np.max(L.g, initial=0.0)),
+                        float(np.max(self.s.sp_par[:, SP_CLEARANCE], initial=0.0)), 1e-300)
+            step = float(np.max(np.abs(vdq), initial=0.0))
+            if step <= 1e-15 * scale or d0 >= 0.0:  # d0 = -dq^T H dq: only if dq ~ 0
+                return q + dq, solves, True
+            alpha = _line_search(dphi, d0)
+            q_new = q + alpha * dq
+            delta_n, f_n, kt_n, _, state_n, sp_n = self.forces(q_new, L, reg)
+            settled = alpha == 1.0 and np.array_equal(state_n, state)
+            if settled:
+                nonlinear = any(state_n[self.sp_x[j]] == CONTACT
+                                and self.s.sp_par[j, SP_CLEARANCE] > 0
+                                for j in range(self.s.n_splines))
+                if not nonlinear or step <= _STEP_TOL * scale:
+                    return q_new, solves, True
+            q, delta, f, kt, state, sp = q_new, delta_n, f_n, kt_n, state_n, sp_n
+        return q, solves, False
+
+    def equilibrium(self, q, L: _Loads, reg, budget):
+        """Newton, with the friction loads iterated around it; (q, solves, converged)."""
+        if L.W is None:
+            return self.newton(q, L, L.f_eff, reg, budget)
+        solves, ok = 0, False
+        f_old = None
+        while solves < budget:
+            _, f, _, _, _, _ = self.forces(q, L, reg)
+            fm = np.maximum(f + L.p, 0.0)
+            if f_old is not None:
+                change = float(np.max(np.abs(fm - f_old)))
+                if change <= _FRICTION_TOL * max(float(np.max(np.abs(fm))), 1e-300):
+                    ok = True
+                    break
+            f_old = fm
+            q, n_solves, ok_n = self.newton(q, L, L.f_eff - L.W.T @ fm, reg, budget - solves)
+            solves += n_solves
+            if not ok_n:
+                ok = False
+                break
+        return q, solves, ok
+
+    def solve(self, t, q0=None, max_iterations=200):
+        s = self.s
+        L = self.loads(t)
+        if L.W is None:
+            self.check_balance(L.f_eff)
+        solves = 0
+        if q0 is None:
+            q = self.closed_solve(L, L.f_eff)
+            solves = 1
+            if not self.has_gaps and L.W is None:
+                return self._result(q, L, solves, True)
+        else:
+            q = np.asarray(q0, dtype=float).copy()
+        q, n, ok = self.equilibrium(q, L, self.reg, max_iterations - solves)
+        solves += n
+        if ok and self.has_gaps and self.reg > 0:
+            # drop the regularisation if the elements in contact hold every DOF
+            _, _, _, _, state, _ = self.forces(q, L, 0.0)
+            on = (np.abs(L.k) > 0) & (state != SEPARATED) & (state != FLOAT)
+            on[self.sp_x] &= state[self.sp_x] != FLOAT
+            if rigid_body_modes(s, active=on).shape[1] == self.phi.shape[1]:
+                try:
+                    q2, n2, ok2 = self.equilibrium(q, L, 0.0, max_iterations - solves)
+                except SolverError:
+                    n2, ok2 = 1, False
+                solves += n2
+                if ok2:
+                    state2 = self.forces(q2, L, 0.0)[4]
+                    if np.array_equal(state2, state):
+                        q = q2
+        return self._result(q, L, solves, ok)
+
+    def _result(self, q, L: _Loads, solves, ok):
+        delta, f, _, _, state, _ = self.forces(q, L, 0.0)
+        forces = f + L.p
+        contact = (state != SEPARATED) & (state != FLOAT)
+        resid = L.f_eff - self.V.T @ f
+        if L.W is not None:
+            friction_load = L.W.T @ np.maximum(forces, 0.0)
+            self.check_balance(L.f_eff, friction_load)
+            resid = resid - friction_load
+        accel = self.phi.T @ resid
+        return dict(q=q, forces=forces, delta=delta, contact=contact, it=solves,
+                    converged=bool(ok), accel=accel)
+
+
+def _line_search(dphi, d0: float) -> float:
+    """Step along a descent direction: 1 if phi'(1) <= 0 (up to round-off), else the
+    root of the monotone phi' in (0, 1) (regula falsi, Illinois variant)."""
+    d1, size = dphi(1.0)
+    if d1 <= 1e-12 * size + 1e-10 * abs(d0):
+        return 1.0
+    a, da, b, db = 0.0, d0, 1.0, d1
+    c = 1.0
+    for _ in range(200):
+        c = b - db * (b - a) / (db - da)
+        if not a < c < b:
+            c = 0.5 * (a + b)
+        dc, size = dphi(c)
+        if abs(dc) <= 1e-12 * size + 1e-12 * abs(d0) or b - a <= 1e-15:
+            break
+        if dc > 0:
+            b, db = c, dc
+            da *= 0.5
+        else:
+            a, da = c, dc
+            db *= 0.5
+    return c
 
 
 def static_equilibrium(
@@ -254,7 +499,7 @@ def static_equilibrium(
     *,
     regularisation: float = 1e-9,
     balance_tolerance: float = 1e-8,
-    max_iterations: int = 50,
+    max_iterations: int = 200,
 ) -> StaticSolution:
     """Static equilibrium ``sum_e V_e f_e(q) = F_ext`` with dead zones and rigid modes.
 
@@ -262,15 +507,16 @@ def static_equilibrium(
     ----------
     structure : Structure
     t : float, optional
-        None: mean stiffness, constant error part, mean additive force and mean half-gap
-        of each element.  A time: the values of the excitation at ``t``.
+        None: mean stiffness, constant error part, mean additive force, mean half-gap and
+        mean friction table of each element.  A time: the values of the excitation at
+        ``t``.
     regularisation : float
         Stiffness of a separated element as a fraction of its own.
     balance_tolerance : float
         Largest net load along a rigid-body mode, as a fraction of the applied load,
         accepted as round-off.
     max_iterations : int
-        Active-set iterations before giving up (``converged=False``).
+        Linear solves (Newton steps) before giving up (``converged=False``).
 
     Raises
     ------
@@ -288,11 +534,13 @@ def static_equilibrium(
     (2000.0, 1e-05)
     """
     problem = _StaticProblem(structure, regularisation, balance_tolerance)
-    q, f, d, c, it, conv, _ = problem.solve(t, max_iterations=max_iterations)
-    names = tuple(structure.element_names[i] for i in np.flatnonzero(~c))
-    return StaticSolution(q=q, element_forces=f, deformations=d, in_contact=c,
-                          iterations=it, converged=conv, rigid_modes=problem.phi,
-                          separated=names, t=None if t is None else float(t))
+    r = problem.solve(t, max_iterations=max_iterations)
+    names = tuple(structure.element_names[i] for i in np.flatnonzero(~r["contact"]))
+    return StaticSolution(q=r["q"], element_forces=r["forces"], deformations=r["delta"],
+                          in_contact=r["contact"], iterations=r["it"],
+                          converged=r["converged"], rigid_modes=problem.phi,
+                          separated=names, t=None if t is None else float(t),
+                          rigid_acceleration=r["accel"])
 
 
 def quasi_static(
@@ -301,13 +549,13 @@ def quasi_static(
     *,
     regularisation: float = 1e-9,
     balance_tolerance: float = 1e-8,
-    max_iterations: int = 50,
+    max_iterations: int = 200,
 ) -> QuasiStaticSolution:
     """Static equilibrium at each time of ``times`` (mesh positions), e.g. for load
     sharing without dynamics.
 
     The projection matrix, rigid-body modes and their constraint are built once; each
-    time starts its active-set iteration from the previous time's contact states, so a
+    time starts its Newton iteration from the previous time's displacements, so a
     smooth sweep usually needs one or two linear solves per time.
     """
     times = np.atleast_1d(np.asarray(times, dtype=float))
@@ -319,10 +567,12 @@ def quasi_static(
     C = np.zeros((nt, n_el), dtype=bool)
     conv = np.zeros(nt, dtype=bool)
     its = np.zeros(nt, dtype=np.int64)
-    states = None
+    q = None
     for i, t in enumerate(times):
-        q, f, d, c, it, ok, states = problem.solve(t, states, max_iterations)
-        Q[i], F[i], D[i], C[i], conv[i], its[i] = q, f, d, c, ok, it
+        r = problem.solve(t, q, max_iterations)
+        q = r["q"] if r["converged"] else None
+        Q[i], F[i], D[i], C[i] = r["q"], r["forces"], r["delta"], r["contact"]
+        conv[i], its[i] = r["converged"], r["it"]
     return QuasiStaticSolution(times=times, q=Q, element_forces=F, deformations=D,
                                in_contact=C, converged=conv, iterations=its,
                                rigid_modes=problem.phi)
