@@ -24,7 +24,10 @@ Options (``assemble(..., options={...})``):
 
 ``spline_velocity_scale``
     Velocity scale v of the regularised Coulomb friction of the splines,
-    F_m tanh(Rdot / v) [m/s]; default :data:`SPLINE_VELOCITY_SCALE`.
+    F_m tanh(Rdot / v) [m/s]; default: the model's ``[analysis] spline_velocity_scale``
+    (1e-3 m/s).  Below about v the friction is viscous (tangent F_m / v), above it
+    Coulomb; the RK4 stability check accounts for the tangent F_m / v, which can shorten
+    the step (see docs/theory/model.md).
 """
 
 from __future__ import annotations
@@ -41,12 +44,6 @@ from ..model.schema import Model
 from . import excitation
 from .structure import MESH, SPLINE, SPRING, Structure, build_structure
 
-SPLINE_VELOCITY_SCALE = 1.0e-4
-"""Default velocity scale v of the spline friction F_m tanh(Rdot / v) [m/s]: below about v
-the friction is viscous (tangent F_m / v), above it Coulomb.  Small against the radial
-vibration velocities of a floating member (mm/s to m/s), so the friction is Coulomb in
-effect; the RK4 stability check accounts for the tangent F_m / v, which can shorten the
-step (see docs/theory/model.md)."""
 _OPTIONS = {"spline_velocity_scale"}
 
 
@@ -109,7 +106,7 @@ def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None
     unknown = sorted(set(options) - _OPTIONS)
     if unknown:
         raise ValueError(f"unknown assembly option(s) {unknown}; known: {sorted(_OPTIONS)}")
-    v_reg = float(options.get("spline_velocity_scale", SPLINE_VELOCITY_SCALE))
+    v_reg = float(options.get("spline_velocity_scale", model.analysis.spline_velocity_scale))
     if not (v_reg > 0 and math.isfinite(v_reg)):
         raise ValueError(f"spline_velocity_scale must be a positive speed in m/s, got {v_reg!r}")
     dmap, inv_mass = number_dofs(model, kin)

@@ -219,12 +219,14 @@ def _teach(msg: str) -> str:
 
 
 def support_issues(model: Model) -> list[tuple[str, str]]:
-    """Translational DOFs need a support to the housing (bearing or shaft bending)."""
+    """Translational DOFs need a support to the housing (bearing or shaft bending), or a
+    spline that holds the body radially (seed 002 floating pinion)."""
     issues = []
+    on_spline = {b for sp in model.splines.values() for b in sp.connects}
     for kind, items in (("gears", model.gears), ("bodies", model.bodies)):
         for name, body in items.items():
             free = [d for d in body.dofs if d != "theta"]
-            if free and body.support is None:
+            if free and body.support is None and name not in on_spline:
                 issues.append((f"{kind}.{name}.support", (
                     f"the translational DOFs {free} have no support; add one, e.g. "
                     f"support = {{stiffness = '1e8 N/m'}}, or remove them from 'dofs'")))

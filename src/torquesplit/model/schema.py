@@ -519,6 +519,9 @@ class Analysis(Strict):
     cycles: int | None = Field(None, gt=0, description="Simulated cycles of the slowest mesh.")
     rtol: float = Field(1e-6, gt=0, lt=1, description="Relative tolerance (dopri).")
     table_points: int = Field(256, ge=16, description="Samples per mesh period of excitation tables.")
+    spline_velocity_scale: float = Field(
+        1e-3, gt=0, description="Radial sliding speed [m/s] over which spline friction "
+        "reaches its Coulomb value (regularisation of sgn; smaller is stiffer to integrate).")
     load_sharing: Literal["cycle_peak", "engineering", "mean_force", "static_torque"] = Field(
         "cycle_peak", description="Default load-sharing definition reported by 'run'."
     )
