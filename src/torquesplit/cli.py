@@ -208,6 +208,15 @@ def _render_run(res, met, saved) -> None:
                   f"{met.dynamic_factors.per_group_engineering[name]:.5f}")
     console.print(g)
     console.print(f"system load-sharing coefficient: [bold]{met.load_sharing.system:.5f}[/]")
+    lost = [r for r in met.rows if r.contact_loss > 0]
+    if lost:
+        err_console.print("[yellow]warning:[/] ", end="")
+        err_console.print(
+            "contact loss in " + ", ".join(f"{r.mesh} ({100 * r.contact_loss:.1f} % of the time)"
+                                           for r in lost)
+            + ": the teeth separate (backlash larger than the dynamic deflection), so peak "
+            "forces are impacts and the load-sharing coefficients of those meshes are not "
+            "meaningful; check the backlash and the excitation", markup=False, highlight=False)
     if saved:
         console.print(f"results written to {saved}")
 
