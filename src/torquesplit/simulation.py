@@ -10,11 +10,12 @@ holds them and computes the metrics on demand.
 from __future__ import annotations
 
 import math
+import warnings
 from typing import Callable
 
 import numpy as np
 
-from .errors import SolverError
+from .errors import ModelWarning, SolverError
 from .model.io import load_model
 from .model.kinematics import solve_kinematics
 
@@ -80,10 +81,17 @@ def simulate(
     kin = solve_kinematics(model)
     structure = assemble(model, kin)
     static = static_equilibrium(structure)
-    if not static.converged:
+    if not np.all(np.isfinite(static.q)):
         raise SolverError(
-            "the static equilibrium did not converge; check the clearances and the supports "
+            "the static equilibrium failed; check the clearances and the supports "
             "(a body free to move inside its clearance needs a support or a spring)")
+    if not static.converged:
+        # e.g. a member floating inside its clearance with no net load: its position is
+        # not determined; the regularised solution is a valid starting state
+        warnings.warn(
+            "the static equilibrium did not converge exactly (members free inside their "
+            f"clearances: {', '.join(static.separated) or 'none reported'}); the dynamic run "
+            "starts from the regularised solution", ModelWarning, stacklevel=2)
     mesh_names = list(model.meshes)
     freqs = np.array([kin.meshes[m].frequency for m in mesh_names])
     f_min, f_max = float(freqs.min()), float(freqs.max())
