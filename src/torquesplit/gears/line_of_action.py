@@ -68,7 +68,8 @@ class ContactFrame:
     pair_geometry: PairGeometry | None
 
 
-def _geometry(gear, teeth=None) -> GearGeometry:
+def gear_geometry(gear, teeth=None) -> GearGeometry:
+    """Involute geometry of a schema gear (``teeth`` overrides, for virtual gears)."""
     return GearGeometry(
         teeth=teeth if teeth is not None else gear.teeth,
         normal_module=gear.module,
@@ -120,8 +121,8 @@ def is_conical(gear_a, gear_b) -> bool:
 def cylindrical_pair(gear_a, gear_b) -> PairGeometry:
     """PairGeometry of two cylindrical gears (an internal gear is always put second)."""
     if gear_a.gear_type == "internal":
-        return PairGeometry(_geometry(gear_b), _geometry(gear_a))
-    return PairGeometry(_geometry(gear_a), _geometry(gear_b))
+        return PairGeometry(gear_geometry(gear_b), gear_geometry(gear_a))
+    return PairGeometry(gear_geometry(gear_a), gear_geometry(gear_b))
 
 
 def placed_position(model, name, ref, ref_position, ref_axis, angle) -> np.ndarray:
@@ -259,7 +260,7 @@ def _conical_frame(mesh, na, nb, ga, gb, aa, ab, positions) -> ContactFrame:
     try:
         zva = max(int(round(za / max(math.cos(gam_a), 1e-3))), 5)
         zvb = max(int(round(zb / max(math.cos(gam_b), 1e-3))), 5)
-        pair = PairGeometry(_geometry(ga, zva), _geometry(gb, zvb))
+        pair = PairGeometry(gear_geometry(ga, zva), gear_geometry(gb, zvb))
         eps_a, eps_b = pair.transverse_contact_ratio, pair.overlap_contact_ratio
     except Exception:  # geometry of a virtual gear outside the involute model
         pair = None

@@ -111,32 +111,12 @@ class Kinematics:
 # --------------------------------------------------------------------------- helpers
 def gear_geometry(gear: Gear) -> GearGeometry:
     """The involute geometry of a schema gear."""
-    return GearGeometry(
-        teeth=gear.teeth,
-        normal_module=gear.module,
-        normal_pressure_angle=gear.pressure_angle,
-        helix_angle=abs(gear.helix_angle),
-        face_width=gear.face_width,
-        profile_shift=gear.profile_shift,
-        internal=gear.gear_type == "internal",
-        double_helical=gear.gear_type == "double_helical",
-    )
+    return loa.gear_geometry(gear)
 
 
 def _unit(v) -> np.ndarray:
     v = np.asarray(v, dtype=float)
     return v / np.linalg.norm(v)
-
-
-def _perp_unit(v: np.ndarray, axis: np.ndarray) -> np.ndarray:
-    """Component of v perpendicular to axis, normalised (any perpendicular if v || axis)."""
-    w = v - axis * (v @ axis)
-    n = np.linalg.norm(w)
-    if n < 1e-12:
-        trial = np.array([1.0, 0.0, 0.0]) if abs(axis[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
-        w = trial - axis * (trial @ axis)
-        n = np.linalg.norm(w)
-    return w / n
 
 
 def gear_mass_properties(gear: Gear) -> tuple[float, float, bool, bool]:
