@@ -1,0 +1,57 @@
+"""The command line: every sub-command on small models, exit codes and JSON output."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+from typer.testing import CliRunner
+
+from model_texts import SPUR_PAIR, split_model, write_model
+from torquesplit.cli import app
+
+runner = CliRunner()
+
+
+def _ok(args):
+    res = runner.invoke(app, args)
+    assert res.exit_code == 0, res.output
+    return res.output
+
+
+def test_examples_and_example(tmp_path):
+    out = _ok(["examples"])
+    for name in ("seed000_split_torque", "seed004_star_reducer"):
+        assert name in out
+    _ok(["example", "seed001_mill_drive", "--dir", str(tmp_path)])
+    assert (tmp_path / "seed001_mill_drive.toml").exists()
+    again = runner.invoke(app, ["example", "seed001_mill_drive", "--dir", str(tmp_path)])
+    assert again.exit_code == 2 and "--force" in again.output
+    bad = runner.invoke(app, ["example", "nope"])
+    assert bad.exit_code == 2 and "torquesplit examples" in bad.output
+
+
+def test_run_json_out_and_set(tmp_path):
+    path = write_model(tmp_path, split_model())
+    out = _ok(["run", str(path), "--cycles", "20", "--json", "--out", str(tmp_path / "r.nc"),
+               "--set", "meshes.a1.damping_ratio=0.07"])
+    data = json.loads(out)
+    assert data["success"] is True
+    assert data["metrics"]["system_load_sharing"] == pytest.approx(1.0, abs=1e-6)
+    assert data["statistics"]["steps"] > 0 and data["statistics"]["rhs_evaluations"] > 0
+    assert (tmp_path / "r.nc").exists()
+    bad = runner.invoke(app, ["run", str(path), "--set", "meshes.zz.damping_ratio=1"])
+    assert bad.exit_code == 2 and "meshes.zz" in bad.output
+
+
+def test_static_mesh_and_modes(tmp_path):
+    path = write_model(tmp_path, split_model())
+    data = json.loads(_ok(["static", str(path), "--json", "--points-per-cycle", "2"]))
+    assert data["converged"] and data["load_sharing"]["system"] == pytest.approx(1.0)
+    pair = write_model(tmp_path, SPUR_PAIR, "pair.toml")
+    mesh = json.loads(_ok(["mesh", str(pair), "--pair", "m", "--json",
+                           "--plot", str(tmp_path / "k.png")]))
+    assert {r["method"] for r in mesh["methods"]} >= {"potential_energy", "model file"}
+    assert (tmp_path / "k.png").stat().st_size > 0
+    modes = json.loads(_ok(["modes", str(path), "--json"]))
+    assert modes["rigid_body_modes"] == 1 and modes["modes"][0]["frequency_Hz"] > 0
