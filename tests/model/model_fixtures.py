@@ -5,7 +5,7 @@ from __future__ import annotations
 import copy
 import tomllib
 
-#: The tiny spur pair of /tmp/t/pair.toml (with the valid place.angle).
+#: A tiny spur pair (20/40 teeth, 2 mm) used by the fuzzing and bad-input tests.
 PAIR_TOML = """\
 [model]
 name = "spur pair"
