@@ -216,7 +216,7 @@ CASES = [
     ("DOF listed twice", setting("gears.pinion.dofs", ["theta", "theta"]),
      "gears.pinion.dofs", r"lists a DOF twice; list each DOF once"),
     ("unknown DOF", setting("gears.pinion.dofs", ["theta", "phi"]),
-     "gears.pinion.dofs.1", r"must be 'x', 'y', 'z' or 'theta', got 'phi'"),
+     "gears.pinion.dofs.1", r"must be 'x', 'y', 'z', 'loa' or 'theta', got 'phi'"),
     ("damping and damping ratio", setting("meshes.m.damping", "1000 N s/m"),
      "meshes.m", r"both 'damping' and 'damping_ratio' are given; remove one"),
     ("zero axis", setting("gears.pinion.axis", [0, 0, 0]),

@@ -54,8 +54,20 @@ class DofMap:
     theta: dict[str, tuple[int, float]]
     """body -> (DOF index or -1 if prescribed, sign relative to the DOF's axis)."""
     translation: dict[str, dict[str, int]]
-    """body -> {'x': index, ...}."""
+    """body -> {'x': index, ...} ('x', 'y', 'z', 'loa')."""
     names: tuple[str, ...]
+    axes: dict[str, dict[str, np.ndarray]]
+    """body -> {'x': unit direction, ...} of each translational DOF."""
+
+    def project(self, body: str, vec, sign: float = 1.0, tol: float = 0.0):
+        """(DOF index, sign * vec . direction) of each of ``body``'s translations whose
+        projection exceeds ``tol`` in magnitude (x, y, z give vec's components exactly)."""
+        out = []
+        for d, j in self.translation[body].items():
+            c = float(np.dot(vec, self.axes[body][d]))
+            if abs(c) > tol:
+                out.append((j, sign * c))
+        return out
 
 
 def number_dofs(model: Model, kin: Kinematics) -> tuple[DofMap, np.ndarray]:
@@ -83,7 +95,7 @@ def number_dofs(model: Model, kin: Kinematics) -> tuple[DofMap, np.ndarray]:
                 mass[idx] += bk.polar_inertia
                 theta[body] = (idx, sign)
         trans[body] = {}
-        for d in ("x", "y", "z"):
+        for d in ("x", "y", "z", "loa"):
             if d in spec.dofs:
                 trans[body][d] = len(names)
                 names.append(f"{body}.{d}")
@@ -94,7 +106,8 @@ def number_dofs(model: Model, kin: Kinematics) -> tuple[DofMap, np.ndarray]:
     if np.any(m <= 0) or not np.all(np.isfinite(inv)):
         bad = [names[i] for i in np.flatnonzero(m <= 0)]
         raise ModelError([("", f"DOFs {bad} have no mass or inertia; give 'mass'/'polar_inertia'")])
-    return DofMap(theta=theta, translation=trans, names=tuple(names)), inv
+    axes = {b: dict(kin.translation_axes.get(b, {})) for b in trans}
+    return DofMap(theta=theta, translation=trans, names=tuple(names), axes=axes), inv
 
 
 def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None = None,
@@ -127,11 +140,9 @@ def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None
             if idx >= 0:
                 dofs.append(idx)
                 coefs.append(sgn * arm * s)
-            for d, comp in zip("xyz", mk.line_of_action):
-                j = dmap.translation[body].get(d)
-                if j is not None and comp != 0.0:
-                    dofs.append(j)
-                    coefs.append(sgn * comp)
+            for j, c in dmap.project(body, mk.line_of_action, sgn):
+                dofs.append(j)
+                coefs.append(c)
         table = excitation.stiffness_table(model, kin, name, n_table)
         k_mean = float(np.mean(table))
         if mesh.damping is not None:
@@ -204,13 +215,11 @@ def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None
                                f"DOFs {sorted(tr)} have no support; add a support with a "
                                f"stiffness, or remove them from 'dofs'")])
         k_rad = support_stiffness(sup)
+        # diagonal support stiffness in the global axes, projected on each DOF's
+        # direction u: k = kx ux^2 + ky uy^2 + kz uz^2 (x, y, z: the value itself)
+        k_xyz = np.array([k_rad, sup.stiffness_y or k_rad, sup.axial_stiffness or k_rad])
         for d, j in tr.items():
-            if d == "z":
-                k = sup.axial_stiffness or k_rad
-            elif d == "y" and sup.stiffness_y is not None:
-                k = sup.stiffness_y
-            else:
-                k = k_rad
+            k = float(k_xyz @ dmap.axes[body][d] ** 2)
             m = kin.bodies[body].mass
             if sup.damping is not None:
                 c = sup.damping
@@ -247,11 +256,9 @@ def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None
         for comp, e in (("x", e1), ("y", e2)):
             rdofs, rcoefs = [], []
             for body, sgn in ((hub, 1.0), (flo, -1.0)):
-                for d, c in zip("xyz", e, strict=True):
-                    j = dmap.translation[body].get(d)
-                    if j is not None and abs(c) > 1e-15:
-                        rdofs.append(j)
-                        rcoefs.append(sgn * float(c))
+                for j, c in dmap.project(body, e, sgn, tol=1e-15):
+                    rdofs.append(j)
+                    rcoefs.append(c)
             rows[comp] = (rdofs, rcoefs)
         if rows["x"][0] or rows["y"][0]:
             # friction force F_m = mu T / r_p, T the nominal torque through the spline
@@ -308,12 +315,10 @@ def _friction_projection(model: Model, kin: Kinematics, dmap: DofMap, name: str,
             dofs.append(idx)
             coefs.append(-s * w)
             rows.append(row)
-        for d, comp in zip("xyz", t_dir, strict=True):
-            j = dmap.translation[body].get(d)
-            if j is not None and comp != 0.0:
-                dofs.append(j)
-                coefs.append(sgn * float(comp))
-                rows.append(0)
+        for j, c in dmap.project(body, t_dir, sgn):
+            dofs.append(j)
+            coefs.append(c)
+            rows.append(0)
     return dict(table=table, dofs=dofs, coefs=coefs, rows=rows)
 
 

@@ -106,6 +106,9 @@ class Kinematics:
     groups: dict[str, str]
     """Body -> representative of its rigid group (bodies joined by rigid shafts)."""
     positions_computed: list[str]
+    translation_axes: dict[str, dict[str, np.ndarray]] = field(default_factory=dict)
+    """Body -> {translational DOF: its unit direction}: the global axes for x, y, z and
+    the transverse line of action of the body's meshes for 'loa'."""
 
 
 # --------------------------------------------------------------------------- helpers
@@ -216,11 +219,74 @@ def solve_kinematics(model: Model) -> Kinematics:
             equivalent_mass=m_eq, critical_damping=crit, iso_stiffness=iso,
             conical=fr.conical, geometry=geo,
         )
+    trans_axes = _translation_axes(model, bodies, meshes, issues)
+    if issues:
+        raise KinematicsError(issues)
     return Kinematics(
         bodies=bodies, meshes=meshes, input_power=p_in, output_power=p_out,
         load_torques=load_torques, drive_torques=drive_torques, groups=groups,
-        positions_computed=computed,
+        positions_computed=computed, translation_axes=trans_axes,
     )
+
+
+LOA_PARALLEL_TOL = 1e-6
+"""Largest sine of the angle between the transverse lines of action of two meshes that
+share one 'loa' translation."""
+
+
+def _translation_axes(model: Model, bodies, meshes, issues) -> dict[str, dict[str, np.ndarray]]:
+    """Unit direction of every translational DOF of every body.
+
+    x, y, z are the global axes.  'loa' (seed 001 eq. 9: one translation X_i per gear
+    "along the tangent of the meshing pair") is the line of action of the gear's meshes
+    projected on its transverse plane; every mesh of the gear must have that direction
+    (up to sign: e.g. two branches at 180 deg about an input pinion), else the gear
+    needs x and y.
+    """
+    out: dict[str, dict[str, np.ndarray]] = {}
+    for body in model.body_names():
+        spec = model.gears.get(body) or model.bodies[body]
+        kind = "gears" if body in model.gears else "bodies"
+        dirs: dict[str, np.ndarray] = {}
+        for d in spec.dofs:
+            if d in ("x", "y", "z"):
+                dirs[d] = np.eye(3)["xyz".index(d)]
+            elif d == "loa":
+                u = _loa_direction(body, bodies[body].axis, meshes, f"{kind}.{body}.dofs", issues)
+                if u is not None:
+                    dirs[d] = u
+        out[body] = dirs
+    return out
+
+
+def _loa_direction(body, axis, meshes, loc, issues) -> np.ndarray | None:
+    a = _unit(axis)
+    mine = [m for m in meshes.values() if body in (m.driver, m.driven)]
+    if not mine:
+        issues.append((loc, "'loa' is a translation along the line of action of the body's "
+                            "meshes, and it has none; use 'x' and 'y' instead"))
+        return None
+    u = None
+    for m in mine:
+        n = m.line_of_action
+        t = n - (n @ a) * a
+        if np.linalg.norm(t) < 1e-9:
+            issues.append((loc, f"mesh {m.name!r} pushes {body!r} along its axis only; 'loa' "
+                                f"has no transverse direction to follow: use 'x' and 'y'"))
+            return None
+        t = t / np.linalg.norm(t)
+        if u is None:
+            u, first = t, m.name
+            continue
+        sine = float(np.linalg.norm(np.cross(u, t)))
+        if sine > LOA_PARALLEL_TOL:
+            angle = math.degrees(math.asin(min(1.0, sine)))
+            issues.append((loc, (
+                f"meshes {first!r} and {m.name!r} push {body!r} along lines of action "
+                f"{angle:.3g} deg apart; one 'loa' translation carries only parallel lines "
+                f"(e.g. branches at 180 deg): use 'x' and 'y' instead")))
+            return None
+    return u
 
 
 def _iso_estimate(geo) -> float | None:

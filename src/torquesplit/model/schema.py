@@ -57,7 +57,10 @@ Torque = Q("torque")
 Time = Q("time")
 Viscosity = Q("viscosity")
 
-Dof = Literal["x", "y", "z", "theta"]
+Dof = Literal["x", "y", "z", "loa", "theta"]
+"""Body DOFs: translations along the global x, y, z; 'loa' a single translation along
+the (transverse) line of action of the gear's meshes, as in lumped torsion-translation
+models (seed 001 eq. 9); 'theta' the rotation about the body's axis."""
 
 
 class Strict(BaseModel):
@@ -204,7 +207,10 @@ class Gear(Strict):
     )
     place: Placement | None = Field(None, description="Position from a mating gear and an angle.")
     axis: tuple[float, float, float] = Field((0.0, 0.0, 1.0), description="Rotation axis direction.")
-    dofs: list[Dof] = Field(["theta"], description="Degrees of freedom of this body.")
+    dofs: list[Dof] = Field(["theta"], description=(
+        "Degrees of freedom: 'theta' rotation; 'x', 'y', 'z' translations along the global "
+        "axes; or 'loa', one translation along the line of action of the gear's meshes "
+        "(seed 001 eq. 9; its meshes must push it along parallel lines)."))
     support: Support | None = Field(None, description="Support of the translational DOFs.")
     errors: GearErrors = Field(GearErrors(), description="Eccentricity, installation, ... errors.")
 
@@ -235,7 +241,10 @@ class Body(Strict):
     mass: Mass | None = Field(None, gt=0, description="Mass (needed with translational DOFs).")
     position: tuple[Length, Length, Length] = Field((0.0, 0.0, 0.0), description="Centre.")
     axis: tuple[float, float, float] = Field((0.0, 0.0, 1.0), description="Rotation axis.")
-    dofs: list[Dof] = Field(["theta"], description="Degrees of freedom of this body.")
+    dofs: list[Dof] = Field(["theta"], description=(
+        "Degrees of freedom: 'theta' rotation; 'x', 'y', 'z' translations along the global "
+        "axes; or 'loa', one translation along the line of action of the gear's meshes "
+        "(seed 001 eq. 9; its meshes must push it along parallel lines)."))
     support: Support | None = Field(None, description="Support of the translational DOFs.")
 
     @model_validator(mode="after")
@@ -244,13 +253,17 @@ class Body(Strict):
         _unique_dofs(self.dofs)
         if any(d != "theta" for d in self.dofs) and self.mass is None:
             raise FieldError("mass", "a body with translational DOFs needs a mass; add "
-                             "mass = '12.5 kg' (your value), or remove x, y, z from 'dofs'")
+                             "mass = '12.5 kg' (your value), or remove x, y, z, loa from 'dofs'")
         return self
 
 
 def _unique_dofs(dofs):
     if len(set(dofs)) != len(dofs):
         raise FieldError("dofs", f"{dofs} lists a DOF twice; list each DOF once")
+    if "loa" in dofs and ("x" in dofs or "y" in dofs):
+        raise FieldError("dofs", f"{dofs} combines 'loa' with 'x'/'y': 'loa' is the one "
+                         f"translation along the line of action, x and y are both in-plane "
+                         f"translations; keep either 'loa' or 'x' and 'y'")
     if "theta" not in dofs:
         raise FieldError("dofs", f"{dofs} has no 'theta': every body turns about its axis; "
                          f"add 'theta' to 'dofs'")
