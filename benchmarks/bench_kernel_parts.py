@@ -59,6 +59,9 @@ def step_blocks() -> list[tuple[str, int, bool]]:
 
     def visit(stmts):
         for st in stmts:
+            if isinstance(st, ast.If) and isinstance(st.test, ast.Name) and st.test.id == "gen":
+                visit(st.orelse)  # the general right-hand side (rhs_slot) of `if gen:`
+                continue
             if isinstance(st, ast.If):
                 continue
             if isinstance(st, ast.For):
@@ -168,7 +171,8 @@ def _best_cpu(fn, *args, repeat: int = 3) -> float:
 
 
 def _step_cpu_us(case, n_steps: int) -> float:
-    """CPU µs of one whole RK4 step (integrate, best of 3), measured right now."""
+    """CPU µs of one whole RK4 step with the general right-hand side (the blocks timed
+    here; integrate(rhs="general"), best of 3), measured right now."""
     from torquesplit.solve.integrate import integrate
 
     h = integrate(case.structure, case.y0, (0.0, 1.0 / case.f_max), method="rk4",
@@ -177,7 +181,7 @@ def _step_cpu_us(case, n_steps: int) -> float:
     for _ in range(3):
         c0 = time.process_time()
         sol = integrate(case.structure, case.y0, (0.0, n_steps * h), method="rk4",
-                        steps_per_period=100, record_every=100)
+                        steps_per_period=100, record_every=100, rhs="general")
         best = min(best, (time.process_time() - c0) / sol.n_steps)
     return best * 1e6
 
@@ -245,11 +249,15 @@ def marginal_rhs_cost(case, n_steps: int = 200_000, repeat: int = 5) -> dict:
     fn = next(n for n in tree.body if isinstance(n, ast.FunctionDef) and n.name == "rk4_run")
     loops = [n for n in fn.body if isinstance(n, ast.For)]
     loop = max(loops, key=lambda n: sum(isinstance(c, ast.Call) for c in ast.walk(n)))
-    stmt = next((st for st in loop.body if isinstance(st, ast.Expr)
-                 and isinstance(st.value, ast.Call) and isinstance(st.value.func, ast.Name)
-                 and st.value.func.id == "rhs_slot"), None)
+    # the first right-hand-side statement of the step loop: a bare rhs_slot call, or the
+    # `if gen: rhs_fn(...) else: rhs_slot(...)` block (duplicated whole)
+    stmt = next((st for st in loop.body if (
+        isinstance(st, ast.Expr) and isinstance(st.value, ast.Call)
+        and isinstance(st.value.func, ast.Name) and st.value.func.id == "rhs_slot") or (
+        isinstance(st, ast.If) and isinstance(st.test, ast.Name) and st.test.id == "gen")),
+        None)
     if stmt is None:
-        return {"skipped": "no unconditional rhs_slot statement in rk4_run's step loop"}
+        return {"skipped": "no right-hand-side statement in rk4_run's step loop"}
     lines = src.splitlines(keepends=True)
     dup = lines[stmt.lineno - 1:stmt.end_lineno]
     patched = "".join(lines[:stmt.end_lineno] + dup + lines[stmt.end_lineno:])

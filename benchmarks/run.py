@@ -76,6 +76,12 @@ def run(quick: bool, repeat: int, skip_compile: bool = False) -> dict:
         res["engine"].append(r)
     eng = {r["model"]: r for r in res["engine"]}
 
+    _log("engine against a specialised transcription of seed 001 (compiles ~10-20 s)")
+    import bench_specialised
+
+    res["specialised"] = bench_specialised.compare(
+        next(c for c in cases if c.name == SEED001), cfg["engine_steps"], max(3, repeat))
+
     _log("engine dopri (rtol 1e-6) over a tenth of that simulated time")
     res["dopri"] = [bench_engine.time_dopri(c, 0.1 * eng[c.name]["simulated"], 1e-6, repeat)
                     for c in cases]
@@ -252,6 +258,12 @@ def report(res: dict) -> str:
                  f"tracemalloc peak {_f(mem['tracemalloc_peak'])} MiB)"),
                  _ok(mem["rss_peak"] < TARGETS["memory"]) if n_mem >= 10_000_000 else
                  "- (quick mode)"])
+    sp = res.get("specialised") or {}
+    if "ratio" in sp:
+        rows.insert(1, ["engine / specialised transcription of the same model, seed 001 "
+                        "(CPU time per step, same run)", "<= 1.5",
+                        f"{_f(sp['ratio'])} ({_f(sp['engine_us'])} / "
+                        f"{_f(sp['specialised_us'])} µs)", _ok(sp["ratio"] <= 1.5)])
     L.append(_table(["quantity", "target", "measured", "status"], rows))
 
     # ---------------------------------------------------------------- engine
@@ -266,11 +278,18 @@ def report(res: dict) -> str:
                  "(src/ is edited concurrently):\n")
         L.extend(f"* `{k}`: {v}" for k, v in res["skipped"].items())
         L.append("")
+    L.append("The right-hand side is the model's generated code (`solve/codegen.py`, "
+             "the default; 'rhs' says which ran and its compile time); 'general µs/step' "
+             "is the same run with `rhs=\"general\"` (the kernel's element loop), "
+             "alternated with it.\n")
     rows = []
     for r in res["engine"]:
         rows.append([r["model"], r["n_dof"], r["n_elements"], _f(r["f_max"], 4),
                      _f(r["steps_per_period"], 4), _f(r["step"]), f"{r['n_steps']:,}",
                      f"**{_f(r['us_per_step'])}**", _f(r["cpu_us_per_step"]),
+                     f"{r['rhs']} ({1e3 * r['rhs_compile_s']:.0f} ms)",
+                     _f(r["general_us_per_step"]),
+                     f"{_f(r['general_us_per_step'] / r['us_per_step'])}x",
                      _f(r["us_per_step"] * 1e3 / r["n_dof"]),
                      _f(r["sim_per_wall"]),
                      ("ok" if r["success"] else r["message"])
@@ -278,7 +297,8 @@ def report(res: dict) -> str:
                         " (static equilibrium did not converge: started from its last "
                         "iterate)")])
     L.append(_table(["model", "DOFs", "elements", "f_mesh max [Hz]", "steps/period",
-                     "step [s]", "steps", "µs/step", "CPU µs/step", "ns/step/DOF",
+                     "step [s]", "steps", "µs/step", "CPU µs/step", "rhs",
+                     "general µs/step", "general / generated", "ns/step/DOF",
                      "simulated s per wall s", "status"], rows))
 
     # ---------------------------------------------------------------- scipy
@@ -308,6 +328,25 @@ def report(res: dict) -> str:
                      "scipy steps/period", "µs per rhs_numpy call", "scipy cached-V sim s/wall s",
                      "engine RK4 sim s/wall s", "RK4 / scipy", "RK4 / scipy cached-V",
                      "engine dopri sim s/wall s", "dopri / scipy"], rows))
+
+    if "ratio" in sp:
+        L.append("\n## Engine against a specialised transcription (seed 001)\n")
+        L.append("`bench_specialised.py` writes the seed 001 structure out as straight-line "
+                 "numba code: one statement per non-zero, every coefficient and index a "
+                 "literal, the same stiffness tables, dead zones, per-cycle statistics and "
+                 "history, no error sinusoids/friction/splines/contact counters/divergence "
+                 "checks. Both run the same steps from the same state, alternated, best CPU "
+                 "time of each.\n")
+        L.append(_table(["quantity", "value"], [
+            ["DOFs / elements", f"{sp['n_dof']} / {sp['n_elements']}"],
+            ["steps", f"{sp['steps']:,}"],
+            ["engine CPU µs/step", _f(sp["engine_us"])],
+            ["specialised CPU µs/step", _f(sp["specialised_us"])],
+            ["ratio engine / specialised", f"**{_f(sp['ratio'])}**"],
+            ["final states, largest relative difference", _f(sp["final_state_rel_diff"], 2)],
+            ["specialised code: lines / numba compile time",
+             f"{sp['source_lines']} / {_f(sp['compile_s'])} s"],
+        ]))
 
     L.append("\n## Engine against a numpy RK4 loop (per step)\n")
     L.append(f"Baseline: `torquesplit.solve.reference.rk4_numpy` (classic RK4, a Python "

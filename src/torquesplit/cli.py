@@ -187,7 +187,8 @@ def _render_run(res, met, saved) -> None:
     console.print(f"[bold]{res.model.model.name}[/]: {res.message}")
     console.print(
         f"{st['steps']} steps ({st['method']}), {st['microseconds_per_step']:.3g} us/step, "
-        f"integration {st['wall_time_s']:.3g} s, compile/load {st['compile_time_s']:.3g} s; "
+        f"integration {st['wall_time_s']:.3g} s, compile/load {st['compile_time_s']:.3g} s "
+        f"(+{st['rhs_compile_time_s']:.2g} s for the {st['rhs']} right-hand side); "
         f"transient discarded: {met.settling.start_time:.4g} s"
         + ("" if met.settling.settled else " (not settled: last half used)"))
     t = Table(title=f"meshes (load sharing: {met.definition})")

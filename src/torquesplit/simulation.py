@@ -35,6 +35,7 @@ def simulate(
     history_dofs=None,
     full_history: bool = False,
     progress: Callable[[float], None] | None = None,
+    rhs: str = "generated",
 ):
     """Dynamic response of a model, started from its static equilibrium.
 
@@ -58,6 +59,10 @@ def simulate(
         Keep every state (memory grows with the run length).
     progress : callable, optional
         Called with the completed fraction (0..1) during the integration.
+    rhs : {"generated", "general"}
+        Right-hand side of the kernels: the model's equations compiled as straight-line
+        code (default) or the general element loop; same results bit for bit (see
+        :func:`torquesplit.solve.integrate.integrate`).
 
     Returns
     -------
@@ -120,7 +125,7 @@ def simulate(
         sample_interval = duration / MAX_HISTORY_RECORDS
     kwargs = dict(
         method=method, track_elements=track, history_elements=hist_el,
-        history_dofs=hist_dofs, full_history=full_history, progress=progress,
+        history_dofs=hist_dofs, full_history=full_history, progress=progress, rhs=rhs,
     )
     if method == "rk4":
         step = 1.0 / (f_max * steps_per_period)

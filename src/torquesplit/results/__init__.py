@@ -97,6 +97,7 @@ class Results:
             "simulated_time_s": s.t_final - s.t_span[0],
             "compile_time_s": s.compile_time, "wall_time_s": s.wall_time,
             "microseconds_per_step": 1e6 * s.wall_time / max(s.n_steps, 1),
+            "rhs": s.rhs, "rhs_compile_time_s": s.rhs_compile_time,
         }
 
     # ------------------------------------------------------------------ metrics

@@ -38,6 +38,14 @@ Time of step ``i`` is always computed as ``t0 + i * h`` (never accumulated), so 
 split into chunks whose sizes are multiples of :data:`RESYNC` reproduces the unsplit run
 bit for bit.
 
+The right-hand side of a model is either :func:`rhs_slot` (the general element loop) or
+the same arithmetic generated for the model as straight-line code
+(:mod:`torquesplit.solve.codegen`), called through the first-class function ``rhs_fn``
+when its parameter vector ``rhs_par`` is not empty.  The call is written out at each call
+site (``if gen:``): passing a numba first-class function on to another compiled function
+costs about 150 ns per call (and an inlined helper with the 20 array arguments of the
+general path costs as much in reference counting), more than the generated code itself.
+
 Tooth friction and splines are handled by two kernels of their own,
 :func:`excite_friction` and :func:`rhs_extra`, called after :func:`excite_tables` /
 :func:`rhs_slot` only when a model has them (``has_fr``, ``extra``); the kernels get zero
@@ -576,7 +584,8 @@ def rk4_run(y, t0, h, n_first, n_steps, record_final, record_every, blowup,
             vt_coef, fr_el, fr_ptr, fr_dof, fr_coef, fr_row, friction_table,
               sp_el, sp_par, track_el, track_base, cyc_max, cyc_min, cyc_sum, cyc_cnt,
             sep_count, back_count, sep_time, back_time, hist_el, hist_dof, hist_t,
-            hist_f, hist_q, hist_v, full_t, full_y, counters, clock):
+            hist_f, hist_q, hist_v, full_t, full_y, rhs_fn, rhs_par, counters,
+              clock):
     """Classic fixed-step RK4 over global steps n_first .. n_first + n_steps - 1.
 
     Step i runs from t0 + i h to t0 + (i + 1) h.  The state at the start of each step
@@ -588,6 +597,8 @@ def rk4_run(y, t0, h, n_first, n_steps, record_final, record_every, blowup,
     Stops early (status DIVERGED) if the state is non-finite or |q| > blowup.  Models
     with tooth friction or splines also run :func:`excite_friction` after each
     excitation and :func:`rhs_extra` after each right-hand side (``has_fr``, ``extra``).
+    The right-hand side is :func:`rhs_slot`, or the model's generated code ``rhs_fn``
+    with parameters ``rhs_par`` when these are not empty (see the module docstring).
     Twin: :func:`torquesplit.solve.reference.rk4_numpy`.
     """
     n = inv_mass.shape[0]
@@ -603,6 +614,7 @@ def rk4_run(y, t0, h, n_first, n_steps, record_final, record_every, blowup,
     S = np.empty((3, n_sin))
     C = np.empty((3, n_sin))
     FR = np.empty((3, friction_table.shape[0]))
+    gen = rhs_par.shape[0] > 0  # a generated right-hand side was given
     has_fr = fr_el.shape[0] > 0
     extra = has_fr or sp_el.shape[0] > 0
     cos_rot = np.empty(n_sin)
@@ -645,9 +657,14 @@ def rk4_run(y, t0, h, n_first, n_steps, record_final, record_every, blowup,
             errors_from_phasors(a, err_el, error_constant, sin_el, error_amplitude,
                                 error_omega, S, C, E, ED)
         # stage 1 at t: its forces are those of the accepted state y(t)
-        rhs_slot(y, a, K, P, G, E, ED, inv_mass, external_force, ground_damping,
-                 vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
-                 k1, force, defl)
+        if gen:  # the model's generated code (codegen.py), else the general loop
+            rhs_fn(y.ctypes, k1.ctypes, force.ctypes, defl.ctypes, K[a].ctypes,
+                   G[a].ctypes, E[a].ctypes, ED[a].ctypes, P[a].ctypes,
+                   rhs_par.ctypes)
+        else:
+            rhs_slot(y, a, K, P, G, E, ED, inv_mass, external_force, ground_damping,
+                     vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
+                     k1, force, defl)
         if extra:
             rhs_extra(y, a, inv_mass, vr_ptr, vq_idx, vv_idx, v_coef, fr_el,
                       fr_ptr, fr_dof, fr_coef, fr_row, FR, sp_el, sp_par, k1, force,
@@ -676,18 +693,28 @@ def rk4_run(y, t0, h, n_first, n_steps, record_final, record_every, blowup,
                        error_amplitude, error_omega, S, C, E, ED)
         for m in range(n2):
             yt[m] = y[m] + hh * k1[m]
-        rhs_slot(yt, s_half, K, P, G, E, ED, inv_mass, external_force, ground_damping,
-                 vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
-                 k2, ftmp, dtmp)
+        if gen:  # the model's generated code (codegen.py), else the general loop
+            rhs_fn(yt.ctypes, k2.ctypes, ftmp.ctypes, dtmp.ctypes, K[s_half].ctypes,
+                   G[s_half].ctypes, E[s_half].ctypes, ED[s_half].ctypes, P[s_half].ctypes,
+                   rhs_par.ctypes)
+        else:
+            rhs_slot(yt, s_half, K, P, G, E, ED, inv_mass, external_force, ground_damping,
+                     vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
+                     k2, ftmp, dtmp)
         if extra:
             rhs_extra(yt, s_half, inv_mass, vr_ptr, vq_idx, vv_idx, v_coef, fr_el,
                       fr_ptr, fr_dof, fr_coef, fr_row, FR, sp_el, sp_par, k2, ftmp,
                       dtmp)
         for m in range(n2):
             yt[m] = y[m] + hh * k2[m]
-        rhs_slot(yt, s_half, K, P, G, E, ED, inv_mass, external_force, ground_damping,
-                 vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
-                 k3, ftmp, dtmp)
+        if gen:  # the model's generated code (codegen.py), else the general loop
+            rhs_fn(yt.ctypes, k3.ctypes, ftmp.ctypes, dtmp.ctypes, K[s_half].ctypes,
+                   G[s_half].ctypes, E[s_half].ctypes, ED[s_half].ctypes, P[s_half].ctypes,
+                   rhs_par.ctypes)
+        else:
+            rhs_slot(yt, s_half, K, P, G, E, ED, inv_mass, external_force, ground_damping,
+                     vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
+                     k3, ftmp, dtmp)
         if extra:
             rhs_extra(yt, s_half, inv_mass, vr_ptr, vq_idx, vv_idx, v_coef, fr_el,
                       fr_ptr, fr_dof, fr_coef, fr_row, FR, sp_el, sp_par, k3, ftmp,
@@ -703,9 +730,14 @@ def rk4_run(y, t0, h, n_first, n_steps, record_final, record_every, blowup,
                        error_amplitude, error_omega, S, C, E, ED)
         for m in range(n2):
             yt[m] = y[m] + h * k3[m]
-        rhs_slot(yt, b, K, P, G, E, ED, inv_mass, external_force, ground_damping,
-                 vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
-                 k4, ftmp, dtmp)
+        if gen:  # the model's generated code (codegen.py), else the general loop
+            rhs_fn(yt.ctypes, k4.ctypes, ftmp.ctypes, dtmp.ctypes, K[b].ctypes,
+                   G[b].ctypes, E[b].ctypes, ED[b].ctypes, P[b].ctypes,
+                   rhs_par.ctypes)
+        else:
+            rhs_slot(yt, b, K, P, G, E, ED, inv_mass, external_force, ground_damping,
+                     vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
+                     k4, ftmp, dtmp)
         if extra:
             rhs_extra(yt, b, inv_mass, vr_ptr, vq_idx, vv_idx, v_coef, fr_el,
                       fr_ptr, fr_dof, fr_coef, fr_row, FR, sp_el, sp_par, k4, ftmp,
@@ -724,9 +756,14 @@ def rk4_run(y, t0, h, n_first, n_steps, record_final, record_every, blowup,
     if record_final and n_steps > 0:
         i = n_first + n_steps
         t = t0 + i * h
-        rhs_slot(y, a, K, P, G, E, ED, inv_mass, external_force, ground_damping,
-                 vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
-                 k1, force, defl)
+        if gen:  # the model's generated code (codegen.py), else the general loop
+            rhs_fn(y.ctypes, k1.ctypes, force.ctypes, defl.ctypes, K[a].ctypes,
+                   G[a].ctypes, E[a].ctypes, ED[a].ctypes, P[a].ctypes,
+                   rhs_par.ctypes)
+        else:
+            rhs_slot(y, a, K, P, G, E, ED, inv_mass, external_force, ground_damping,
+                     vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
+                     k1, force, defl)
         if extra:
             rhs_extra(y, a, inv_mass, vr_ptr, vq_idx, vv_idx, v_coef, fr_el,
                       fr_ptr, fr_dof, fr_coef, fr_row, FR, sp_el, sp_par, k1, force,
@@ -773,7 +810,8 @@ def dopri_run(y, kfsal, t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, 
               vt_coef, fr_el, fr_ptr, fr_dof, fr_coef, fr_row, friction_table,
               sp_el, sp_par, track_el, track_base, cyc_max, cyc_min, cyc_sum, cyc_cnt,
               sep_count, back_count, sep_time, back_time, hist_el, hist_dof, hist_t,
-              hist_f, hist_q, hist_v, full_t, full_y, counters, clock):
+              hist_f, hist_q, hist_v, full_t, full_y, rhs_fn, rhs_par, counters,
+            clock):
     """Adaptive Dormand-Prince 5(4) with FSAL and PI step-size control (Hairer's DOPRI5).
 
     Integrates from clock[F_T] until t >= t_stop (never past t_end; the last step is
@@ -784,6 +822,7 @@ def dopri_run(y, kfsal, t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, 
     cubic Hermite interpolation between accepted steps.
     Status: DIVERGED (non-finite or |q| > blowup after an accepted step),
     STEP_UNDERFLOW (h < max(h_min, 10 eps |t|)), MAX_STEPS (accepted steps).
+    Right-hand side: as :func:`rk4_run` (``rhs_fn``, ``rhs_par``).
     Twin: :func:`torquesplit.solve.reference.dopri_numpy`.
     """
     n = inv_mass.shape[0]
@@ -799,6 +838,7 @@ def dopri_run(y, kfsal, t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, 
     S = np.empty((2, n_sin))
     C = np.empty((2, n_sin))
     FR = np.empty((2, friction_table.shape[0]))
+    gen = rhs_par.shape[0] > 0  # a generated right-hand side was given
     has_fr = fr_el.shape[0] > 0
     extra = has_fr or sp_el.shape[0] > 0
     k2 = np.empty(n2)
@@ -838,9 +878,14 @@ def dopri_run(y, kfsal, t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, 
                      gap_cyc, gap_val, has_force)
         if has_fr:
             excite_friction(t, s1, frequency, phase, fr_el, friction_table, FR)
-        rhs_slot(y, s1, K, P, G, E, ED, inv_mass, external_force, ground_damping,
-                 vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
-                 kfsal, force, defl)
+        if gen:  # the model's generated code (codegen.py), else the general loop
+            rhs_fn(y.ctypes, kfsal.ctypes, force.ctypes, defl.ctypes, K[s1].ctypes,
+                   G[s1].ctypes, E[s1].ctypes, ED[s1].ctypes, P[s1].ctypes,
+                   rhs_par.ctypes)
+        else:
+            rhs_slot(y, s1, K, P, G, E, ED, inv_mass, external_force, ground_damping,
+                     vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
+                     kfsal, force, defl)
         if extra:
             rhs_extra(y, s1, inv_mass, vr_ptr, vq_idx, vv_idx, v_coef, fr_el,
                       fr_ptr, fr_dof, fr_coef, fr_row, FR, sp_el, sp_par, kfsal, force,
@@ -888,9 +933,14 @@ def dopri_run(y, kfsal, t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, 
                      gap_cyc, gap_val, has_force)
         if has_fr:
             excite_friction(t + _C2 * hs, s0, frequency, phase, fr_el, friction_table, FR)
-        rhs_slot(yt, s0, K, P, G, E, ED, inv_mass, external_force, ground_damping,
-                 vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
-                 k2, ftmp, dtmp)
+        if gen:  # the model's generated code (codegen.py), else the general loop
+            rhs_fn(yt.ctypes, k2.ctypes, ftmp.ctypes, dtmp.ctypes, K[s0].ctypes,
+                   G[s0].ctypes, E[s0].ctypes, ED[s0].ctypes, P[s0].ctypes,
+                   rhs_par.ctypes)
+        else:
+            rhs_slot(yt, s0, K, P, G, E, ED, inv_mass, external_force, ground_damping,
+                     vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
+                     k2, ftmp, dtmp)
         if extra:
             rhs_extra(yt, s0, inv_mass, vr_ptr, vq_idx, vv_idx, v_coef, fr_el,
                       fr_ptr, fr_dof, fr_coef, fr_row, FR, sp_el, sp_par, k2, ftmp,
@@ -903,9 +953,14 @@ def dopri_run(y, kfsal, t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, 
                      gap_cyc, gap_val, has_force)
         if has_fr:
             excite_friction(t + _C3 * hs, s0, frequency, phase, fr_el, friction_table, FR)
-        rhs_slot(yt, s0, K, P, G, E, ED, inv_mass, external_force, ground_damping,
-                 vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
-                 k3, ftmp, dtmp)
+        if gen:  # the model's generated code (codegen.py), else the general loop
+            rhs_fn(yt.ctypes, k3.ctypes, ftmp.ctypes, dtmp.ctypes, K[s0].ctypes,
+                   G[s0].ctypes, E[s0].ctypes, ED[s0].ctypes, P[s0].ctypes,
+                   rhs_par.ctypes)
+        else:
+            rhs_slot(yt, s0, K, P, G, E, ED, inv_mass, external_force, ground_damping,
+                     vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
+                     k3, ftmp, dtmp)
         if extra:
             rhs_extra(yt, s0, inv_mass, vr_ptr, vq_idx, vv_idx, v_coef, fr_el,
                       fr_ptr, fr_dof, fr_coef, fr_row, FR, sp_el, sp_par, k3, ftmp,
@@ -918,9 +973,14 @@ def dopri_run(y, kfsal, t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, 
                      gap_cyc, gap_val, has_force)
         if has_fr:
             excite_friction(t + _C4 * hs, s0, frequency, phase, fr_el, friction_table, FR)
-        rhs_slot(yt, s0, K, P, G, E, ED, inv_mass, external_force, ground_damping,
-                 vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
-                 k4, ftmp, dtmp)
+        if gen:  # the model's generated code (codegen.py), else the general loop
+            rhs_fn(yt.ctypes, k4.ctypes, ftmp.ctypes, dtmp.ctypes, K[s0].ctypes,
+                   G[s0].ctypes, E[s0].ctypes, ED[s0].ctypes, P[s0].ctypes,
+                   rhs_par.ctypes)
+        else:
+            rhs_slot(yt, s0, K, P, G, E, ED, inv_mass, external_force, ground_damping,
+                     vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
+                     k4, ftmp, dtmp)
         if extra:
             rhs_extra(yt, s0, inv_mass, vr_ptr, vq_idx, vv_idx, v_coef, fr_el,
                       fr_ptr, fr_dof, fr_coef, fr_row, FR, sp_el, sp_par, k4, ftmp,
@@ -934,9 +994,14 @@ def dopri_run(y, kfsal, t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, 
                      gap_cyc, gap_val, has_force)
         if has_fr:
             excite_friction(t + _C5 * hs, s0, frequency, phase, fr_el, friction_table, FR)
-        rhs_slot(yt, s0, K, P, G, E, ED, inv_mass, external_force, ground_damping,
-                 vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
-                 k5, ftmp, dtmp)
+        if gen:  # the model's generated code (codegen.py), else the general loop
+            rhs_fn(yt.ctypes, k5.ctypes, ftmp.ctypes, dtmp.ctypes, K[s0].ctypes,
+                   G[s0].ctypes, E[s0].ctypes, ED[s0].ctypes, P[s0].ctypes,
+                   rhs_par.ctypes)
+        else:
+            rhs_slot(yt, s0, K, P, G, E, ED, inv_mass, external_force, ground_damping,
+                     vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
+                     k5, ftmp, dtmp)
         if extra:
             rhs_extra(yt, s0, inv_mass, vr_ptr, vq_idx, vv_idx, v_coef, fr_el,
                       fr_ptr, fr_dof, fr_coef, fr_row, FR, sp_el, sp_par, k5, ftmp,
@@ -951,9 +1016,14 @@ def dopri_run(y, kfsal, t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, 
                      gap_cyc, gap_val, has_force)
         if has_fr:
             excite_friction(t_new, s0, frequency, phase, fr_el, friction_table, FR)
-        rhs_slot(yt, s0, K, P, G, E, ED, inv_mass, external_force, ground_damping,
-                 vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
-                 k6, ftmp, dtmp)
+        if gen:  # the model's generated code (codegen.py), else the general loop
+            rhs_fn(yt.ctypes, k6.ctypes, ftmp.ctypes, dtmp.ctypes, K[s0].ctypes,
+                   G[s0].ctypes, E[s0].ctypes, ED[s0].ctypes, P[s0].ctypes,
+                   rhs_par.ctypes)
+        else:
+            rhs_slot(yt, s0, K, P, G, E, ED, inv_mass, external_force, ground_damping,
+                     vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
+                     k6, ftmp, dtmp)
         if extra:
             rhs_extra(yt, s0, inv_mass, vr_ptr, vq_idx, vv_idx, v_coef, fr_el,
                       fr_ptr, fr_dof, fr_coef, fr_row, FR, sp_el, sp_par, k6, ftmp,
@@ -971,9 +1041,14 @@ def dopri_run(y, kfsal, t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, 
             CY[1, el] = CY[0, el]
         for r in range(FR.shape[1]):
             FR[1, r] = FR[0, r]
-        rhs_slot(ynew, s1, K, P, G, E, ED, inv_mass, external_force, ground_damping,
-                 vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
-                 k7, force, defl)
+        if gen:  # the model's generated code (codegen.py), else the general loop
+            rhs_fn(ynew.ctypes, k7.ctypes, force.ctypes, defl.ctypes, K[s1].ctypes,
+                   G[s1].ctypes, E[s1].ctypes, ED[s1].ctypes, P[s1].ctypes,
+                   rhs_par.ctypes)
+        else:
+            rhs_slot(ynew, s1, K, P, G, E, ED, inv_mass, external_force, ground_damping,
+                     vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
+                     k7, force, defl)
         if extra:
             rhs_extra(ynew, s1, inv_mass, vr_ptr, vq_idx, vv_idx, v_coef, fr_el,
                       fr_ptr, fr_dof, fr_coef, fr_row, FR, sp_el, sp_par, k7, force,
@@ -1017,9 +1092,14 @@ def dopri_run(y, kfsal, t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, 
                              K, P, G, E, ED, CY, S, C, gap_cyc, gap_val, has_force)
                 if has_fr:
                     excite_friction(ts, s0, frequency, phase, fr_el, friction_table, FR)
-                rhs_slot(ys, s0, K, P, G, E, ED, inv_mass, external_force,
-                         ground_damping, vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el,
-                         vt_coef, damping, dys, ftmp, dtmp)
+                if gen:  # the model's generated code (codegen.py), else the general loop
+                    rhs_fn(ys.ctypes, dys.ctypes, ftmp.ctypes, dtmp.ctypes, K[s0].ctypes,
+                           G[s0].ctypes, E[s0].ctypes, ED[s0].ctypes, P[s0].ctypes,
+                           rhs_par.ctypes)
+                else:
+                    rhs_slot(ys, s0, K, P, G, E, ED, inv_mass, external_force, ground_damping,
+                             vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
+                             dys, ftmp, dtmp)
                 if extra:
                     rhs_extra(ys, s0, inv_mass, vr_ptr, vq_idx, vv_idx, v_coef, fr_el,
                               fr_ptr, fr_dof, fr_coef, fr_row, FR, sp_el, sp_par, dys, ftmp,

@@ -22,6 +22,7 @@ import difflib
 import logging
 import math
 import time
+import warnings
 from dataclasses import dataclass
 from typing import Callable, Sequence
 
@@ -30,6 +31,7 @@ import numpy as np
 from torquesplit.assembly.structure import Structure
 from torquesplit.errors import SolverError
 from torquesplit.solve import _kernels as kern
+from torquesplit.solve import codegen
 from torquesplit.solve._frozen import freeze_arrays
 from torquesplit.solve.reference import element_forces_numpy, rhs_numpy
 from torquesplit.solve.stability import check_step, stable_step, system_eigenvalues
@@ -50,6 +52,7 @@ _N_CHUNKS = 64  # progress granularity: about 1.5 % of the run per chunk
 _MIN_CHUNK_STEPS = 16 * kern.RESYNC
 _MEMORY_LIMIT = 2 * 1024**3  # bytes of output arrays before we refuse and explain
 _COMPILE_TIME: float | None = None
+_CODEGEN_WARNED = False
 
 
 # ===================================================================== result
@@ -90,6 +93,10 @@ class Solution:
     """Seconds this process spent compiling (or loading from cache) the kernels."""
     wall_time: float
     """Seconds spent in this call, compile time excluded."""
+    rhs: str
+    """Right-hand side the kernels called: "generated" or "general" (see integrate)."""
+    rhs_compile_time: float
+    """Seconds spent generating and compiling it in this call (0 when cached)."""
     dof_names: tuple[str, ...]
     element_names: tuple[str, ...]
     tracked_elements: tuple[int, ...]
@@ -393,6 +400,7 @@ def integrate(
     check_stability: bool | None = None,
     blowup: float = 1.0e3,
     progress: Callable[[float], None] | None = None,
+    rhs: str = "generated",
 ) -> Solution:
     """Integrate the equations of motion of ``structure`` from ``y0`` over ``t_span``.
 
@@ -448,6 +456,13 @@ def integrate(
         Stop with status 1 when any |q| exceeds this [m or rad].
     progress : callable, optional
         ``progress(fraction_done)``, called between chunks of the run.
+    rhs : {"generated", "general"}
+        Right-hand side the kernels call.  "generated": this structure's equations as
+        straight-line machine code (:mod:`torquesplit.solve.codegen`, compiled in
+        milliseconds, cached per sparsity pattern; bit for bit the general kernel's
+        results, 2-3 times faster).  "general": the kernel's element loop.  If the
+        code cannot be generated (e.g. an llvmlite without the new pass manager) the
+        run uses "general" with a warning; ``Solution.rhs`` says which one ran.
 
     Returns
     -------
@@ -488,6 +503,7 @@ def integrate(
         raise ValueError(f"t_span must be (start, end) with end > start, got {t_span!r}.")
     y = _initial_state(s, y0)
     model = _model_arrays(s)
+    rhs_code = _rhs_code(rhs, model)
     sel = _select(s, t0, span, track_elements, n_cycles_cap, history_elements, history_dofs)
     if rk4:
         plan = _plan_rk4(s, span, step, steps_per_period, check_stability, record_every,
@@ -503,14 +519,15 @@ def integrate(
     blowup = float(blowup)
 
     if rk4:
-        _run_rk4(y, t0, plan, blowup, model, out.record, counters, clock, progress)
+        _run_rk4(y, t0, plan, blowup, model, rhs_code, out.record, counters, clock,
+                 progress)
         step_min = step_max = plan.h
     else:
         clock[kern.F_H] = min(_initial_step(s, y, t0, t_end, plan.rtol, plan.atol, model),
                               plan.h_max)
         counters[kern.I_RHS] = 2  # the two evaluations of the starting-step estimate
-        _run_dopri(y, t0, t_end, plan, blowup, model, out.record, counters, clock,
-                   progress)
+        _run_dopri(y, t0, t_end, plan, blowup, model, rhs_code, out.record, counters,
+                   clock, progress)
         accepted = counters[kern.I_STEPS] > 0
         step_min = float(clock[kern.F_HMIN]) if accepted else math.nan
         step_max = float(clock[kern.F_HMAX]) if accepted else math.nan
@@ -537,6 +554,8 @@ def integrate(
         step_max=step_max,
         compile_time=compile_time,
         wall_time=time.perf_counter() - t_call,
+        rhs="generated" if rhs_code.generated else "general",
+        rhs_compile_time=rhs_code.compile_time,
         dof_names=tuple(s.dof_names),
         element_names=tuple(s.element_names),
         tracked_elements=tuple(sel.track),
@@ -787,7 +806,25 @@ def _rows(buf: np.ndarray, n: int) -> np.ndarray:
     return buf[:n] if n >= 0.9 * buf.shape[0] else buf[:n].copy()
 
 
-def _run_rk4(y, t0, plan, blowup, model, record, counters, clock, progress):
+def _rhs_code(kind: str, model) -> codegen.GeneratedRhs:
+    """The right-hand side the kernels call (see ``integrate(rhs=...)``)."""
+    if kind == "general":
+        return codegen.general_rhs()
+    if kind != "generated":
+        raise ValueError(f"rhs must be 'generated' or 'general', got {kind!r}.")
+    try:
+        return codegen.generated_rhs(model)
+    except Exception as exc:  # noqa: BLE001 - any failure falls back, with a warning
+        global _CODEGEN_WARNED
+        if not _CODEGEN_WARNED:
+            _CODEGEN_WARNED = True
+            warnings.warn(f"could not compile this model's right-hand side ({type(exc).__name__}: "
+                          f"{exc}); using the general kernel (same results, 2-3x slower).",
+                          RuntimeWarning, stacklevel=3)
+        return codegen.general_rhs()
+
+
+def _run_rk4(y, t0, plan, blowup, model, rhs_code, record, counters, clock, progress):
     """Run the RK4 kernel in chunks (multiples of RESYNC steps, about 1.5 % each)."""
     per_chunk = math.ceil(plan.limit_steps / _N_CHUNKS)
     chunk = max(_MIN_CHUNK_STEPS, -(-per_chunk // kern.RESYNC) * kern.RESYNC)
@@ -796,7 +833,7 @@ def _run_rk4(y, t0, plan, blowup, model, record, counters, clock, progress):
         m = min(chunk, plan.limit_steps - done)
         last = done + m == plan.limit_steps
         kern.rk4_run(y, t0, plan.h, done, m, last, plan.every, blowup, *model, *record,
-                     counters, clock)
+                     rhs_code.function, rhs_code.parameters, counters, clock)
         done += m
         if counters[kern.I_STATUS] != kern.FINISHED:
             return
@@ -806,7 +843,8 @@ def _run_rk4(y, t0, plan, blowup, model, record, counters, clock, progress):
         counters[kern.I_STATUS] = kern.MAX_STEPS
 
 
-def _run_dopri(y, t0, t_end, plan, blowup, model, record, counters, clock, progress):
+def _run_dopri(y, t0, t_end, plan, blowup, model, rhs_code, record, counters, clock,
+               progress):
     """Run the Dormand-Prince kernel up to successive 1/64 fractions of the span."""
     kfsal = np.zeros(y.shape[0])
     clock[kern.F_FACOLD] = 1e-4
@@ -819,7 +857,7 @@ def _run_dopri(y, t0, t_end, plan, blowup, model, record, counters, clock, progr
             continue
         kern.dopri_run(y, kfsal, t0, t_end, t_stop, plan.rtol, plan.atol, plan.h_max,
                        plan.h_min, plan.limit_steps, blowup, plan.dt_sample, *model,
-                       *record, counters, clock)
+                       *record, rhs_code.function, rhs_code.parameters, counters, clock)
         if counters[kern.I_STATUS] != kern.FINISHED:
             return
         if progress is not None:

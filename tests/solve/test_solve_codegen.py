@@ -1,0 +1,145 @@
+"""The generated right-hand side (solve/codegen.py) against the general kernel rhs_slot:
+bit for bit, in the kernels and through integrate."""
+
+from __future__ import annotations
+
+import sys
+
+import numpy as np
+import pytest
+from numba import njit
+from solve_models import random_structure, random_structure_extras, spur_pair
+
+import torquesplit
+from torquesplit.solve import _kernels as kern
+from torquesplit.solve import codegen, integrate
+from torquesplit.solve.integrate import _model_arrays
+
+integrate_module = sys.modules["torquesplit.solve.integrate"]
+
+
+def _slot_arrays(model, t):
+    """Excitation slot 0 of the kernels at time t (what rhs_at builds)."""
+    a = dict(zip(kern.MODEL_ARRAYS, model, strict=True))
+    ne = a["vr_ptr"].shape[0] - 1
+    n_sin = a["error_omega"].shape[0]
+    K, P, G, E, ED = (np.empty((1, ne)) for _ in range(5))
+    CY = np.empty((1, ne), dtype=np.int64)
+    S, C = np.empty((1, n_sin)), np.empty((1, n_sin))
+    has_force = np.zeros(ne, dtype=np.bool_)
+    kern.scratch_flags(a["element_kind"], a["gap_ptr"], a["gap_values"], a["force_table"],
+                       has_force, np.empty(ne, dtype=np.int64))
+    kern.init_slots(a["stiffness_table"], a["force_table"], a["gap_ptr"], a["gap_values"],
+                    a["error_constant"], K, P, G, E, ED, CY)
+    kern.excite_exact(t, np.int64(0), a["frequency"], a["phase"], a["stiffness_table"],
+                      a["force_table"], a["gap_ptr"], a["gap_values"], a["error_constant"],
+                      a["error_amplitude"], a["error_omega"], a["error_phase"], a["tv_el"],
+                      a["err_el"], a["sin_el"], K, P, G, E, ED, CY, S, C,
+                      np.full(ne, -(2**62), dtype=np.int64), np.zeros(ne), has_force)
+    return a, K, P, G, E, ED
+
+
+@njit(error_model="numpy")
+def _rhs_any(fn, par, y, slot, K, P, G, E, ED, inv_mass, external_force, ground_damping,
+             vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping, dy, force, defl):
+    """What the kernels' call sites do (``if gen: rhs_fn(...) else: rhs_slot(...)``)."""
+    if par.shape[0] > 0:
+        fn(y.ctypes, dy.ctypes, force.ctypes, defl.ctypes, K[slot].ctypes, G[slot].ctypes,
+           E[slot].ctypes, ED[slot].ctypes, P[slot].ctypes, par.ctypes)
+    else:
+        kern.rhs_slot(y, slot, K, P, G, E, ED, inv_mass, external_force, ground_damping,
+                      vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping, dy,
+                      force, defl)
+
+
+def _call(code, a, y, K, P, G, E, ED):
+    n, ne = a["inv_mass"].shape[0], a["vr_ptr"].shape[0] - 1
+    dy, force, defl = np.full(2 * n, np.nan), np.full(ne, np.nan), np.full(ne, np.nan)
+    _rhs_any(code.function, code.parameters, y, np.int64(0), K, P, G, E, ED,
+                 a["inv_mass"], a["external_force"], a["ground_damping"], a["vr_ptr"],
+                 a["vq_idx"], a["vv_idx"], a["v_coef"], a["vt_ptr"], a["vt_el"],
+                 a["vt_coef"], a["damping"], dy, force, defl)
+    return dy, force, defl
+
+
+@pytest.mark.parametrize("make, seed", [(random_structure, 0), (random_structure, 1),
+                                        (random_structure_extras, 2)])
+def test_generated_rhs_is_rhs_slot_bit_for_bit(make, seed):
+    """Every branch: elements inside and outside their dead zones (gaps 1-2 um against
+    deflections of a few um), errors, additive forces, spline components (zero
+    stiffness in this kernel), at several times."""
+    s = make(seed)
+    model = _model_arrays(s)
+    gen, general = codegen.generated_rhs(model), codegen.general_rhs()
+    assert gen.generated and not general.generated and gen.lines > 0
+    rng = np.random.default_rng(seed)
+    n = s.n_dof
+    in_zone = set()
+    for t in (0.0, 1.7e-3, 0.0413, 3.2):
+        a, K, P, G, E, ED = _slot_arrays(model, t)
+        for _ in range(25):
+            y = np.concatenate([rng.normal(scale=3e-6, size=n), rng.normal(scale=1e-3, size=n)])
+            dy_g, f_g, d_g = _call(gen, a, y, K, P, G, E, ED)
+            dy_s, f_s, d_s = _call(general, a, y, K, P, G, E, ED)
+            np.testing.assert_array_equal(dy_g, dy_s)
+            np.testing.assert_array_equal(f_g, f_s)
+            np.testing.assert_array_equal(d_g, d_s)
+            in_zone |= set(np.flatnonzero((np.abs(d_s) <= G[0]) & (G[0] > 0)).tolist())
+    assert in_zone, "no state fell inside a dead zone: the test would miss that branch"
+
+
+@pytest.mark.parametrize("method", ["rk4", "dopri"])
+def test_integrate_generated_equals_general(method):
+    s = random_structure_extras(3)
+    y0 = np.zeros(2 * s.n_dof)
+    kw = dict(method=method, full_history=True)
+    if method == "rk4":
+        kw["step"] = 2e-6
+    a = integrate(s, y0, (0.0, 0.004), rhs="generated", **kw)
+    b = integrate(s, y0, (0.0, 0.004), rhs="general", **kw)
+    assert (a.rhs, b.rhs) == ("generated", "general")
+    assert a.success and b.success and a.n_steps == b.n_steps > 100
+    for name in ("y_final", "cycle_max", "cycle_min", "cycle_mean", "history_forces",
+                 "history_q", "full_y", "separation_steps", "back_contact_steps"):
+        np.testing.assert_array_equal(getattr(a, name), getattr(b, name), err_msg=name)
+
+
+def test_seed001_example_runs_the_generated_code_with_the_same_results():
+    model = torquesplit.load_model(torquesplit.example_path("seed001_mill_drive"))
+    runs = [torquesplit.simulate(model, duration=0.05, rhs=kind) for kind in ("generated",
+                                                                             "general")]
+    a, b = (r.solution for r in runs)
+    assert (a.rhs, b.rhs) == ("generated", "general")
+    np.testing.assert_array_equal(a.y_final, b.y_final)
+    np.testing.assert_array_equal(a.cycle_max, b.cycle_max)
+
+
+def test_compiled_code_is_reused_for_the_same_pattern():
+    """Values differ (stiffness, torque), sparsity does not: one compilation."""
+    s1, s2 = spur_pair(stiffness=3.1e8, torque=71.0), spur_pair(stiffness=4.7e8, torque=13.0)
+    g1, g2 = (codegen.generated_rhs(_model_arrays(s)) for s in (s1, s2))
+    assert g2.compile_time == 0.0
+    assert g1.function.__wrapper_address__() == g2.function.__wrapper_address__()
+    assert not np.array_equal(g1.parameters, g2.parameters)
+    y0 = np.zeros(2 * s2.n_dof)
+    a = integrate(s2, y0, (0.0, 1e-3), rhs="generated")
+    b = integrate(s2, y0, (0.0, 1e-3), rhs="general")
+    np.testing.assert_array_equal(a.y_final, b.y_final)
+
+
+def test_bad_rhs_option_is_refused():
+    s = spur_pair()
+    with pytest.raises(ValueError, match="rhs must be 'generated' or 'general'"):
+        integrate(s, np.zeros(2 * s.n_dof), (0.0, 1e-3), rhs="fast")
+
+
+def test_generation_failure_falls_back_to_the_general_kernel(monkeypatch):
+    def broken(model):
+        raise RuntimeError("no compiler here")
+
+    monkeypatch.setattr(codegen, "generated_rhs", broken)
+    monkeypatch.setattr(integrate_module, "_CODEGEN_WARNED", False)
+    s = spur_pair()
+    with pytest.warns(RuntimeWarning, match="no compiler here.*general kernel"):
+        sol = integrate(s, np.zeros(2 * s.n_dof), (0.0, 1e-3))
+    assert sol.success and sol.rhs == "general"
