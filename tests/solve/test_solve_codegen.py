@@ -44,8 +44,9 @@ def _rhs_any(fn, par, y, slot, K, P, G, E, ED, inv_mass, external_force, ground_
              vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping, dy, force, defl):
     """What the kernels' call sites do (``if gen: rhs_fn(...) else: rhs_slot(...)``)."""
     if par.shape[0] > 0:
-        fn(y.ctypes, dy.ctypes, force.ctypes, defl.ctypes, K[slot].ctypes, G[slot].ctypes,
-           E[slot].ctypes, ED[slot].ctypes, P[slot].ctypes, par.ctypes)
+        fn(y.ctypes.data, dy.ctypes.data, force.ctypes.data, defl.ctypes.data,
+           K.ctypes.data, G.ctypes.data, E.ctypes.data, ED.ctypes.data, P.ctypes.data,
+           par.ctypes.data, slot * K.shape[1])
     else:
         kern.rhs_slot(y, slot, K, P, G, E, ED, inv_mass, external_force, ground_damping,
                       vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping, dy,

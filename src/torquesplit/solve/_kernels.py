@@ -639,6 +639,23 @@ def rk4_run(y, t0, h, n_first, n_steps, record_final, record_every, blowup,
     dtmp = np.empty(ne)
     init_slots(stiffness_table, force_table, gap_ptr, gap_values, error_constant,
                K, P, G, E, ED, CY)
+    # data addresses for the generated right-hand side (see the module docstring)
+    ad_y = y.ctypes.data
+    ad_k1 = k1.ctypes.data
+    ad_k2 = k2.ctypes.data
+    ad_k3 = k3.ctypes.data
+    ad_k4 = k4.ctypes.data
+    ad_yt = yt.ctypes.data
+    ad_force = force.ctypes.data
+    ad_defl = defl.ctypes.data
+    ad_ftmp = ftmp.ctypes.data
+    ad_dtmp = dtmp.ctypes.data
+    ad_K = K.ctypes.data
+    ad_G = G.ctypes.data
+    ad_E = E.ctypes.data
+    ad_ED = ED.ctypes.data
+    ad_P = P.ctypes.data
+    ad_par = rhs_par.ctypes.data
     a = np.int64(0)  # slot of t
     b = np.int64(2)  # slot of t + h
     s_half = np.int64(1)  # slot of t + h/2
@@ -658,9 +675,8 @@ def rk4_run(y, t0, h, n_first, n_steps, record_final, record_every, blowup,
                                 error_omega, S, C, E, ED)
         # stage 1 at t: its forces are those of the accepted state y(t)
         if gen:  # the model's generated code (codegen.py), else the general loop
-            rhs_fn(y.ctypes, k1.ctypes, force.ctypes, defl.ctypes, K[a].ctypes,
-                   G[a].ctypes, E[a].ctypes, ED[a].ctypes, P[a].ctypes,
-                   rhs_par.ctypes)
+            rhs_fn(ad_y, ad_k1, ad_force, ad_defl, ad_K, ad_G, ad_E, ad_ED, ad_P,
+                   ad_par, a * ne)
         else:
             rhs_slot(y, a, K, P, G, E, ED, inv_mass, external_force, ground_damping,
                      vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
@@ -694,9 +710,8 @@ def rk4_run(y, t0, h, n_first, n_steps, record_final, record_every, blowup,
         for m in range(n2):
             yt[m] = y[m] + hh * k1[m]
         if gen:  # the model's generated code (codegen.py), else the general loop
-            rhs_fn(yt.ctypes, k2.ctypes, ftmp.ctypes, dtmp.ctypes, K[s_half].ctypes,
-                   G[s_half].ctypes, E[s_half].ctypes, ED[s_half].ctypes, P[s_half].ctypes,
-                   rhs_par.ctypes)
+            rhs_fn(ad_yt, ad_k2, ad_ftmp, ad_dtmp, ad_K, ad_G, ad_E, ad_ED, ad_P,
+                   ad_par, s_half * ne)
         else:
             rhs_slot(yt, s_half, K, P, G, E, ED, inv_mass, external_force, ground_damping,
                      vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
@@ -708,9 +723,8 @@ def rk4_run(y, t0, h, n_first, n_steps, record_final, record_every, blowup,
         for m in range(n2):
             yt[m] = y[m] + hh * k2[m]
         if gen:  # the model's generated code (codegen.py), else the general loop
-            rhs_fn(yt.ctypes, k3.ctypes, ftmp.ctypes, dtmp.ctypes, K[s_half].ctypes,
-                   G[s_half].ctypes, E[s_half].ctypes, ED[s_half].ctypes, P[s_half].ctypes,
-                   rhs_par.ctypes)
+            rhs_fn(ad_yt, ad_k3, ad_ftmp, ad_dtmp, ad_K, ad_G, ad_E, ad_ED, ad_P,
+                   ad_par, s_half * ne)
         else:
             rhs_slot(yt, s_half, K, P, G, E, ED, inv_mass, external_force, ground_damping,
                      vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
@@ -731,9 +745,8 @@ def rk4_run(y, t0, h, n_first, n_steps, record_final, record_every, blowup,
         for m in range(n2):
             yt[m] = y[m] + h * k3[m]
         if gen:  # the model's generated code (codegen.py), else the general loop
-            rhs_fn(yt.ctypes, k4.ctypes, ftmp.ctypes, dtmp.ctypes, K[b].ctypes,
-                   G[b].ctypes, E[b].ctypes, ED[b].ctypes, P[b].ctypes,
-                   rhs_par.ctypes)
+            rhs_fn(ad_yt, ad_k4, ad_ftmp, ad_dtmp, ad_K, ad_G, ad_E, ad_ED, ad_P,
+                   ad_par, b * ne)
         else:
             rhs_slot(yt, b, K, P, G, E, ED, inv_mass, external_force, ground_damping,
                      vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
@@ -757,9 +770,8 @@ def rk4_run(y, t0, h, n_first, n_steps, record_final, record_every, blowup,
         i = n_first + n_steps
         t = t0 + i * h
         if gen:  # the model's generated code (codegen.py), else the general loop
-            rhs_fn(y.ctypes, k1.ctypes, force.ctypes, defl.ctypes, K[a].ctypes,
-                   G[a].ctypes, E[a].ctypes, ED[a].ctypes, P[a].ctypes,
-                   rhs_par.ctypes)
+            rhs_fn(ad_y, ad_k1, ad_force, ad_defl, ad_K, ad_G, ad_E, ad_ED, ad_P,
+                   ad_par, a * ne)
         else:
             rhs_slot(y, a, K, P, G, E, ED, inv_mass, external_force, ground_damping,
                      vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
@@ -870,6 +882,29 @@ def dopri_run(y, kfsal, t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, 
     h = clock[F_H]
     facold = clock[F_FACOLD]
     eps = 2.220446049250313e-16
+    # data addresses for the generated right-hand side (see the module docstring)
+    ad_y = y.ctypes.data
+    ad_kfsal = kfsal.ctypes.data
+    ad_k2 = k2.ctypes.data
+    ad_k3 = k3.ctypes.data
+    ad_k4 = k4.ctypes.data
+    ad_k5 = k5.ctypes.data
+    ad_k6 = k6.ctypes.data
+    ad_k7 = k7.ctypes.data
+    ad_yt = yt.ctypes.data
+    ad_ynew = ynew.ctypes.data
+    ad_ys = ys.ctypes.data
+    ad_dys = dys.ctypes.data
+    ad_force = force.ctypes.data
+    ad_defl = defl.ctypes.data
+    ad_ftmp = ftmp.ctypes.data
+    ad_dtmp = dtmp.ctypes.data
+    ad_K = K.ctypes.data
+    ad_G = G.ctypes.data
+    ad_E = E.ctypes.data
+    ad_ED = ED.ctypes.data
+    ad_P = P.ctypes.data
+    ad_par = rhs_par.ctypes.data
     # current state: f(t, y) and, at the very start, its sample
     if counters[I_FSAL] == 0:
         excite_exact(t, s1, frequency, phase, stiffness_table, force_table, gap_ptr,
@@ -879,9 +914,8 @@ def dopri_run(y, kfsal, t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, 
         if has_fr:
             excite_friction(t, s1, frequency, phase, fr_el, friction_table, FR)
         if gen:  # the model's generated code (codegen.py), else the general loop
-            rhs_fn(y.ctypes, kfsal.ctypes, force.ctypes, defl.ctypes, K[s1].ctypes,
-                   G[s1].ctypes, E[s1].ctypes, ED[s1].ctypes, P[s1].ctypes,
-                   rhs_par.ctypes)
+            rhs_fn(ad_y, ad_kfsal, ad_force, ad_defl, ad_K, ad_G, ad_E, ad_ED, ad_P,
+                   ad_par, s1 * ne)
         else:
             rhs_slot(y, s1, K, P, G, E, ED, inv_mass, external_force, ground_damping,
                      vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
@@ -934,9 +968,8 @@ def dopri_run(y, kfsal, t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, 
         if has_fr:
             excite_friction(t + _C2 * hs, s0, frequency, phase, fr_el, friction_table, FR)
         if gen:  # the model's generated code (codegen.py), else the general loop
-            rhs_fn(yt.ctypes, k2.ctypes, ftmp.ctypes, dtmp.ctypes, K[s0].ctypes,
-                   G[s0].ctypes, E[s0].ctypes, ED[s0].ctypes, P[s0].ctypes,
-                   rhs_par.ctypes)
+            rhs_fn(ad_yt, ad_k2, ad_ftmp, ad_dtmp, ad_K, ad_G, ad_E, ad_ED, ad_P,
+                   ad_par, s0 * ne)
         else:
             rhs_slot(yt, s0, K, P, G, E, ED, inv_mass, external_force, ground_damping,
                      vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
@@ -954,9 +987,8 @@ def dopri_run(y, kfsal, t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, 
         if has_fr:
             excite_friction(t + _C3 * hs, s0, frequency, phase, fr_el, friction_table, FR)
         if gen:  # the model's generated code (codegen.py), else the general loop
-            rhs_fn(yt.ctypes, k3.ctypes, ftmp.ctypes, dtmp.ctypes, K[s0].ctypes,
-                   G[s0].ctypes, E[s0].ctypes, ED[s0].ctypes, P[s0].ctypes,
-                   rhs_par.ctypes)
+            rhs_fn(ad_yt, ad_k3, ad_ftmp, ad_dtmp, ad_K, ad_G, ad_E, ad_ED, ad_P,
+                   ad_par, s0 * ne)
         else:
             rhs_slot(yt, s0, K, P, G, E, ED, inv_mass, external_force, ground_damping,
                      vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
@@ -974,9 +1006,8 @@ def dopri_run(y, kfsal, t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, 
         if has_fr:
             excite_friction(t + _C4 * hs, s0, frequency, phase, fr_el, friction_table, FR)
         if gen:  # the model's generated code (codegen.py), else the general loop
-            rhs_fn(yt.ctypes, k4.ctypes, ftmp.ctypes, dtmp.ctypes, K[s0].ctypes,
-                   G[s0].ctypes, E[s0].ctypes, ED[s0].ctypes, P[s0].ctypes,
-                   rhs_par.ctypes)
+            rhs_fn(ad_yt, ad_k4, ad_ftmp, ad_dtmp, ad_K, ad_G, ad_E, ad_ED, ad_P,
+                   ad_par, s0 * ne)
         else:
             rhs_slot(yt, s0, K, P, G, E, ED, inv_mass, external_force, ground_damping,
                      vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
@@ -995,9 +1026,8 @@ def dopri_run(y, kfsal, t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, 
         if has_fr:
             excite_friction(t + _C5 * hs, s0, frequency, phase, fr_el, friction_table, FR)
         if gen:  # the model's generated code (codegen.py), else the general loop
-            rhs_fn(yt.ctypes, k5.ctypes, ftmp.ctypes, dtmp.ctypes, K[s0].ctypes,
-                   G[s0].ctypes, E[s0].ctypes, ED[s0].ctypes, P[s0].ctypes,
-                   rhs_par.ctypes)
+            rhs_fn(ad_yt, ad_k5, ad_ftmp, ad_dtmp, ad_K, ad_G, ad_E, ad_ED, ad_P,
+                   ad_par, s0 * ne)
         else:
             rhs_slot(yt, s0, K, P, G, E, ED, inv_mass, external_force, ground_damping,
                      vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
@@ -1017,9 +1047,8 @@ def dopri_run(y, kfsal, t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, 
         if has_fr:
             excite_friction(t_new, s0, frequency, phase, fr_el, friction_table, FR)
         if gen:  # the model's generated code (codegen.py), else the general loop
-            rhs_fn(yt.ctypes, k6.ctypes, ftmp.ctypes, dtmp.ctypes, K[s0].ctypes,
-                   G[s0].ctypes, E[s0].ctypes, ED[s0].ctypes, P[s0].ctypes,
-                   rhs_par.ctypes)
+            rhs_fn(ad_yt, ad_k6, ad_ftmp, ad_dtmp, ad_K, ad_G, ad_E, ad_ED, ad_P,
+                   ad_par, s0 * ne)
         else:
             rhs_slot(yt, s0, K, P, G, E, ED, inv_mass, external_force, ground_damping,
                      vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
@@ -1042,9 +1071,8 @@ def dopri_run(y, kfsal, t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, 
         for r in range(FR.shape[1]):
             FR[1, r] = FR[0, r]
         if gen:  # the model's generated code (codegen.py), else the general loop
-            rhs_fn(ynew.ctypes, k7.ctypes, force.ctypes, defl.ctypes, K[s1].ctypes,
-                   G[s1].ctypes, E[s1].ctypes, ED[s1].ctypes, P[s1].ctypes,
-                   rhs_par.ctypes)
+            rhs_fn(ad_ynew, ad_k7, ad_force, ad_defl, ad_K, ad_G, ad_E, ad_ED, ad_P,
+                   ad_par, s1 * ne)
         else:
             rhs_slot(ynew, s1, K, P, G, E, ED, inv_mass, external_force, ground_damping,
                      vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
@@ -1093,9 +1121,8 @@ def dopri_run(y, kfsal, t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, 
                 if has_fr:
                     excite_friction(ts, s0, frequency, phase, fr_el, friction_table, FR)
                 if gen:  # the model's generated code (codegen.py), else the general loop
-                    rhs_fn(ys.ctypes, dys.ctypes, ftmp.ctypes, dtmp.ctypes, K[s0].ctypes,
-                           G[s0].ctypes, E[s0].ctypes, ED[s0].ctypes, P[s0].ctypes,
-                           rhs_par.ctypes)
+                    rhs_fn(ad_ys, ad_dys, ad_ftmp, ad_dtmp, ad_K, ad_G, ad_E, ad_ED, ad_P,
+                           ad_par, s0 * ne)
                 else:
                     rhs_slot(ys, s0, K, P, G, E, ED, inv_mass, external_force, ground_damping,
                              vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,

@@ -26,10 +26,13 @@ same pattern (a parameter sweep compiles once).
 
 Calling convention (C)::
 
-    void rhs(double* y, double* dy, double* force, double* defl, double* K,
-             double* G, double* E, double* ED, double* P, double* par)
+    void rhs(uint64 y, uint64 dy, uint64 force, uint64 defl, uint64 K, uint64 G,
+             uint64 E, uint64 ED, uint64 P, uint64 par, int64 off)
 
-K, G, E, ED, P point to one slot (row) of the kernels' excitation arrays.
+Every argument but ``off`` is the address of a float64 array's data (the kernels take
+them once per call, ``array.ctypes.data``).  K, G, E, ED, P are the kernels' whole
+(n_slot, ne) excitation arrays; the function reads the slot starting at flat index
+``off`` = slot * ne.
 """
 
 from __future__ import annotations
@@ -46,6 +49,8 @@ from . import _kernels as kern
 __all__ = ["GeneratedRhs", "generated_rhs", "general_rhs", "rhs_ir"]
 
 ARG_NAMES = ("y", "dy", "force", "defl", "K", "G", "E", "ED", "P", "par")
+SLOT_ARGS = ("K", "G", "E", "ED", "P")
+"""Excitation arrays (n_slot, ne), passed whole: the function reads row ``off / ne``."""
 _CACHE_SIZE = 32  # compiled patterns kept per process
 
 
@@ -92,6 +97,10 @@ def rhs_ir(model) -> tuple[str, list[tuple[str, int]]]:
 
     def load(ptr: str, i: int) -> str:
         p, v = new(), new()
+        if ptr in SLOT_ARGS:  # row `slot` of a (n_slot, ne) array: entry off + i
+            k = new()
+            body.append(f"  {k} = add i64 %off, {i}")
+            i = k
         body.append(f"  {p} = getelementptr inbounds double, double* %{ptr}, i64 {i}")
         body.append(f"  {v} = load double, double* {p}, align 8")
         return v
@@ -153,10 +162,24 @@ def rhs_ir(model) -> tuple[str, list[tuple[str, int]]]:
             acc = op("fsub", acc, op("fmul", param("vt_coef", j), force[int(vt_el[j])]))
         store("dy", i, v)
         store("dy", n + i, op("fmul", param("inv_mass", i), acc))
-    args = ", ".join(f"double* noalias nocapture %{x}" for x in ARG_NAMES)
-    ir = (f"define void @rhs({args}) nounwind {{\nentry:\n" + "\n".join(body)
-          + "\n  ret void\n}\n")
+    args = ", ".join(f"double* noalias nocapture %{x}" for x in ARG_NAMES) + ", i64 %off"
+    ir = (f"define internal void @rhs_body({args}) nounwind alwaysinline {{\nentry:\n"
+          + "\n".join(body) + "\n  ret void\n}\n\n" + _entry_point())
     return ir, layout
+
+
+def _entry_point() -> str:
+    """``rhs`` taking addresses (i64): the kernels pass ``array.ctypes.data`` computed
+    once per call, not ``array.ctypes`` per call (which costs a reference-count
+    increment and decrement, atomic, per array and call: more than the arithmetic).
+    It casts them and calls the body, whose noalias arguments LLVM keeps when it
+    inlines it."""
+    casts = "\n".join(f"  %p{i} = inttoptr i64 %{x} to double*"
+                      for i, x in enumerate(ARG_NAMES))
+    args = ", ".join(f"i64 %{x}" for x in ARG_NAMES) + ", i64 %off"
+    call = ", ".join(f"double* %p{i}" for i in range(len(ARG_NAMES))) + ", i64 %off"
+    return (f"define void @rhs({args}) nounwind {{\nentry:\n{casts}\n"
+            f"  call void @rhs_body({call})\n  ret void\n}}\n")
 
 
 def _pattern_key(model) -> str:
@@ -236,8 +259,7 @@ def _function(address: int, keep):
     from numba.core.types import WrapperAddressProtocol
 
     if _SIGNATURE is None:
-        ptr = types.CPointer(types.float64)
-        _SIGNATURE = types.void(*([ptr] * len(ARG_NAMES)))
+        _SIGNATURE = types.void(*([types.uintp] * len(ARG_NAMES)), types.int64)
 
     class _Rhs(WrapperAddressProtocol):
         def __wrapper_address__(self):
@@ -259,7 +281,7 @@ def general_rhs() -> GeneratedRhs:
     parameters; its function is a compiled no-op that is never called)."""
     global _GENERAL
     if _GENERAL is None:
-        args = ", ".join(f"double* %{x}" for x in ARG_NAMES)
+        args = ", ".join(f"i64 %{x}" for x in ARG_NAMES) + ", i64 %off"
         ir = f"define void @rhs({args}) nounwind {{\nentry:\n  ret void\n}}\n"
         engine, address = _COMPILER.compile("noop", ir)
         _GENERAL = GeneratedRhs(_function(address, engine), np.zeros(0), 0.0, 0)
