@@ -6,13 +6,16 @@ arithmetic can be written out once: one load, multiply and add per non-zero of t
 projection V, no index arrays and no loops.  This module writes that code as LLVM IR
 (text) from the kernels' own model arrays and compiles it with llvmlite, the compiler
 numba itself uses: tens of milliseconds for the seed examples, against seconds for the
-same code through numba.  The kernels call it through a function pointer
-(``_kernels.rhs_any``), so they are compiled and cached once for every model.
+same code through numba.  The kernels (``rk4_run``, ``dopri_run``) call it through a
+numba first-class function, so they are compiled and cached once for every model.
 
 It is the same computation as ``rhs_slot``, operation for operation and in the same
 order (no fused multiply-adds, no reassociation), so results are bit for bit the same
-(tested); it is 2-3 times faster because a hand-written transcription of a model's
-equations is.  What it computes, for one excitation slot::
+(tested).  A whole RK4 step is about twice as fast with it (seed 001: 0.42 against
+0.83 µs, benchmarks/RESULTS.md), within 1.2 times of a hand-written transcription of
+the model.  The kernels pass it data addresses taken once per call: ``array.ctypes``
+at every call would cost an atomic reference-count increment and decrement per array,
+more than the arithmetic.  What it computes, for one excitation slot::
 
     delta_e = -E_e + sum_j V_ej q_j          (CSR order of V)
     rate_e  = -ED_e + sum_j V_ej v_j

@@ -460,7 +460,7 @@ def integrate(
         Right-hand side the kernels call.  "generated": this structure's equations as
         straight-line machine code (:mod:`torquesplit.solve.codegen`, compiled in
         milliseconds, cached per sparsity pattern; bit for bit the general kernel's
-        results, 2-3 times faster).  "general": the kernel's element loop.  If the
+        results, about twice as fast per step).  "general": the kernel's element loop.  If the
         code cannot be generated (e.g. an llvmlite without the new pass manager) the
         run uses "general" with a warning; ``Solution.rhs`` says which one ran.
 
@@ -819,7 +819,7 @@ def _rhs_code(kind: str, model) -> codegen.GeneratedRhs:
         if not _CODEGEN_WARNED:
             _CODEGEN_WARNED = True
             warnings.warn(f"could not compile this model's right-hand side ({type(exc).__name__}: "
-                          f"{exc}); using the general kernel (same results, 2-3x slower).",
+                          f"{exc}); using the general kernel (same results, about half the speed).",
                           RuntimeWarning, stacklevel=3)
         return codegen.general_rhs()
 
