@@ -406,7 +406,9 @@ def rhs_extra(y, slot, inv_mass, v_ptr, vq_idx, vv_idx, v_coef, fr_el, fr_ptr, f
                 dy[n + d] -= inv_mass[d] * (fr_coef[i] * FR[slot, fr_row[i]] * fe)
 
 
-@njit(cache=True, error_model="numpy")
+# inlined (numba IR) into rhs_extra: as a call inside its loop it cost an atomic
+# reference-count increment and decrement per array argument (a third of a seed 002 step)
+@njit(cache=True, error_model="numpy", inline="always")
 def spline_force(j, y, sp_el, sp_par, v_ptr, vq_idx, vv_idx, v_coef, force, defl):
     """Radial law of spline j (seed 002 eq. 6, restoring, Coulomb friction regularised).
 
