@@ -61,6 +61,20 @@ body = "wheel"
 """
 
 
+# a body on the wheel's shaft that asks for 'loa' but has no mesh
+FLYWHEEL = """[bodies.flywheel]
+polar_inertia = "1 kg m^2"
+mass = "1 kg"
+dofs = ["theta", "loa"]
+support = {stiffness = "1e8 N/m"}
+
+[shafts.s]
+connects = ["wheel", "flywheel"]
+torsional_stiffness = "1e4 N m/rad"
+
+"""
+
+
 def load(text: str):
     return load_model(tomllib.loads(text))
 
@@ -124,11 +138,7 @@ def test_input_pinion_between_two_branches_at_180_deg_takes_one_loa_translation(
 
 @pytest.mark.parametrize("text, field, words", [
     (pair('["theta", "loa", "x"]'), "gears.pinion.dofs", "keep either 'loa' or 'x' and 'y'"),
-    (pair('["theta", "loa"]').replace('[gears.wheel]\n', '[bodies.flywheel]\npolar_inertia = '
-                                      '"1 kg m^2"\nmass = "1 kg"\ndofs = ["theta", "loa"]\n'
-                                      'support = {stiffness = "1e8 N/m"}\n\n[shafts.s]\nconnects = ["wheel", '
-                                      '"flywheel"]\ntorsional_stiffness = "1e4 N m/rad"\n\n'
-                                      '[gears.wheel]\n'),
+    (pair('["theta", "loa"]').replace('[gears.wheel]\n', FLYWHEEL + '[gears.wheel]\n'),
      "bodies.flywheel.dofs", "has none"),
 ])
 def test_bad_loa_dofs_are_named(text, field, words):

@@ -469,9 +469,9 @@ def integrate(
         Right-hand side the kernels call.  "generated": this structure's equations as
         straight-line machine code (:mod:`torquesplit.solve.codegen`, compiled in
         milliseconds, cached per sparsity pattern; bit for bit the general kernel's
-        results, about twice as fast per step).  "general": the kernel's element loop.  If the
-        code cannot be generated (e.g. an llvmlite without the new pass manager) the
-        run uses "general" with a warning; ``Solution.rhs`` says which one ran.
+        results, about twice as fast per step).  "general": the kernel's element loop.
+        If the code cannot be generated (e.g. an llvmlite without the new pass manager)
+        the run uses "general" with a warning; ``Solution.rhs`` says which one ran.
 
     Returns
     -------
