@@ -35,7 +35,7 @@ def simulate(
     history_dofs=None,
     full_history: bool = False,
     progress: Callable[[float], None] | None = None,
-    rhs: str = "generated",
+    rhs: str = "auto",
 ):
     """Dynamic response of a model, started from its static equilibrium.
 
@@ -59,9 +59,10 @@ def simulate(
         Keep every state (memory grows with the run length).
     progress : callable, optional
         Called with the completed fraction (0..1) during the integration.
-    rhs : {"generated", "general"}
+    rhs : {"auto", "generated", "general"}
         Right-hand side of the kernels: the model's equations compiled as straight-line
-        code (default) or the general element loop; same results bit for bit (see
+        code, or the general element loop, or (default) the first when the run is long
+        enough to repay its compilation; same results bit for bit (see
         :func:`torquesplit.solve.integrate.integrate`).
 
     Returns

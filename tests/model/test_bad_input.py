@@ -262,6 +262,21 @@ def test_bad_input(mutate, location, pattern):
     assert isinstance(exc, ValueError)  # ``except ValueError`` keeps working
 
 
+def test_shaft_bending_without_a_finite_stiffness_is_named_at_assembly():
+    """Found by the fuzz test: a gear 1e-300 m from a bearing passes the schema
+    (0 < position < span) but a^2 b^2 underflows to 0 in seed 001 eqs. 5-7."""
+    data = pair_dict()
+    data["gears"]["pinion"].update(
+        dofs=["x", "y", "theta"], mass="0.5 kg",
+        support={"shaft": {"diameter": "30 mm", "span": "100 mm", "position": "1e-300 m"}})
+    model = load(data)
+    with pytest.raises(torquesplit.ModelError) as info:
+        torquesplit.assemble(model)
+    locs = [loc for loc, _ in info.value.issues]
+    assert locs == ["gears.pinion.support.shaft"], info.value.issues
+    assert_teaches(info.value)
+
+
 def test_enough_distinct_cases():
     assert len(CASES) >= 25
     assert len({c[0] for c in CASES}) == len(CASES)

@@ -130,7 +130,7 @@ def test_compiled_code_is_reused_for_the_same_pattern():
 
 def test_bad_rhs_option_is_refused():
     s = spur_pair()
-    with pytest.raises(ValueError, match="rhs must be 'generated' or 'general'"):
+    with pytest.raises(ValueError, match="rhs must be 'auto', 'generated' or 'general'"):
         integrate(s, np.zeros(2 * s.n_dof), (0.0, 1e-3), rhs="fast")
 
 
@@ -142,5 +142,22 @@ def test_generation_failure_falls_back_to_the_general_kernel(monkeypatch):
     monkeypatch.setattr(integrate_module, "_CODEGEN_WARNED", False)
     s = spur_pair()
     with pytest.warns(RuntimeWarning, match="no compiler here.*general kernel"):
-        sol = integrate(s, np.zeros(2 * s.n_dof), (0.0, 1e-3))
+        sol = integrate(s, np.zeros(2 * s.n_dof), (0.0, 1e-3), rhs="generated")
     assert sol.success and sol.rhs == "general"
+
+
+def test_auto_generates_only_when_the_run_repays_the_compilation():
+    """A pattern no other test compiles: short runs keep the general kernel, long ones
+    generate, and once compiled the pattern is always used."""
+    s = random_structure(7)
+    model = _model_arrays(s)
+    assert not codegen.worth_generating(model, 1e3)
+    assert codegen.worth_generating(model, 1e9)
+    y0 = np.zeros(2 * s.n_dof)
+    short = integrate(s, y0, (0.0, 1e-4), step=1e-6)  # 100 steps
+    assert short.rhs == "general"
+    codegen.generated_rhs(model)
+    assert codegen.worth_generating(model, 1e3)
+    again = integrate(s, y0, (0.0, 1e-4), step=1e-6)
+    assert again.rhs == "generated"
+    np.testing.assert_array_equal(short.y_final, again.y_final)

@@ -214,7 +214,8 @@ def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None
             raise ModelError([(f"{'gears' if body in model.gears else 'bodies'}.{body}.support",
                                f"DOFs {sorted(tr)} have no support; add a support with a "
                                f"stiffness, or remove them from 'dofs'")])
-        k_rad = support_stiffness(sup)
+        k_rad = support_stiffness(
+            sup, f"{'gears' if body in model.gears else 'bodies'}.{body}.support")
         # diagonal support stiffness in the global axes, projected on each DOF's
         # direction u: k = kx ux^2 + ky uy^2 + kz uz^2 (x, y, z: the value itself)
         k_xyz = np.array([k_rad, sup.stiffness_y or k_rad, sup.axial_stiffness or k_rad])
@@ -322,8 +323,11 @@ def _friction_projection(model: Model, kin: Kinematics, dmap: DofMap, name: str,
     return dict(table=table, dofs=dofs, coefs=coefs, rows=rows)
 
 
-def support_stiffness(sup) -> float:
-    """Radial support stiffness, from the value or from shaft bending in series."""
+def support_stiffness(sup, where: str = "support") -> float:
+    """Radial support stiffness, from the value or from shaft bending in series.
+
+    ``where`` names the support in the error raised when the shaft's numbers give no
+    finite stiffness (e.g. a gear at 1e-300 m from a bearing)."""
     if sup.stiffness is not None:
         return sup.stiffness
     sh = sup.shaft
@@ -332,7 +336,14 @@ def support_stiffness(sup) -> float:
     inertia = math.pi * sh.diameter**4 / 64
     # seed 001 eqs. 5-7: simply supported shaft, load at a from one bearing:
     # deflection y = F a^2 b^2 / (3 E I l)  =>  k_S = 3 E I l / (a^2 b^2)
-    k_shaft = 3 * sh.youngs_modulus * inertia * sh.span / (a**2 * b**2)
+    den = a**2 * b**2
+    k_shaft = 3 * sh.youngs_modulus * inertia * sh.span / den if den > 0 else math.inf
+    if not (math.isfinite(k_shaft) and k_shaft > 0):
+        raise ModelError([(f"{where}.shaft", (
+            f"the shaft bending stiffness 3 E I l / (a^2 b^2) is not a finite positive "
+            f"number (gear {a:g} m and {b:g} m from the bearings, span {sh.span:g} m, "
+            f"diameter {sh.diameter:g} m); place the gear between the bearings, away from "
+            f"them, or give the support a 'stiffness'"))])
     if sh.bearing_stiffness is None:
         return k_shaft
     # seed 001 eq. 10: bearing in series with the shaft, k' = k_S k_C / (k_S + k_C)

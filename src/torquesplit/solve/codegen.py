@@ -49,7 +49,7 @@ import numpy as np
 
 from . import _kernels as kern
 
-__all__ = ["GeneratedRhs", "generated_rhs", "general_rhs", "rhs_ir"]
+__all__ = ["GeneratedRhs", "generated_rhs", "general_rhs", "rhs_ir", "worth_generating"]
 
 ARG_NAMES = ("y", "dy", "force", "defl", "K", "G", "E", "ED", "P", "par")
 SLOT_ARGS = ("K", "G", "E", "ED", "P")
@@ -230,6 +230,10 @@ class _Compiler:
         engine.finalize_object()
         return engine, engine.get_function_address("rhs")
 
+    def cached(self, model) -> bool:
+        with self._lock:
+            return _pattern_key(model) in self._cache
+
     def get(self, model):
         import time
 
@@ -289,6 +293,27 @@ def general_rhs() -> GeneratedRhs:
         engine, address = _COMPILER.compile("noop", ir)
         _GENERAL = GeneratedRhs(_function(address, engine), np.zeros(0), 0.0, 0)
     return _GENERAL
+
+
+# Cost model of "auto" (measured on the 2-core development machine, benchmarks/RESULTS.md):
+# compiling L lines of IR takes about 4e-5 L + 5e-9 L^2 s (0.05 s for seed 001's 974 lines,
+# 7 s for a 392-DOF model's 35 000), about 30 lines per non-zero of V; each right-hand-side
+# call saves about 5 ns per non-zero against the general kernel.
+_COMPILE_S_PER_LINE = 4e-5
+_COMPILE_S_PER_LINE2 = 5e-9
+_LINES_PER_NONZERO = 30.0
+_SAVING_S_PER_NONZERO = 5e-9
+
+
+def worth_generating(model, n_rhs: float) -> bool:
+    """Whether generating the right-hand side of the kernel model arrays ``model`` repays
+    its compilation over ``n_rhs`` evaluations (always, when the pattern is cached)."""
+    if _COMPILER.cached(model):
+        return True
+    nnz = float(_arrays(model)["v_coef"].shape[0]) + 1.0
+    lines = _LINES_PER_NONZERO * nnz
+    compile_s = _COMPILE_S_PER_LINE * lines + _COMPILE_S_PER_LINE2 * lines**2
+    return n_rhs * _SAVING_S_PER_NONZERO * nnz > compile_s
 
 
 def generated_rhs(model) -> GeneratedRhs:

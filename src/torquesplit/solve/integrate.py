@@ -409,7 +409,7 @@ def integrate(
     check_stability: bool | None = None,
     blowup: float = 1.0e3,
     progress: Callable[[float], None] | None = None,
-    rhs: str = "generated",
+    rhs: str = "auto",
 ) -> Solution:
     """Integrate the equations of motion of ``structure`` from ``y0`` over ``t_span``.
 
@@ -465,13 +465,16 @@ def integrate(
         Stop with status 1 when any |q| exceeds this [m or rad].
     progress : callable, optional
         ``progress(fraction_done)``, called between chunks of the run.
-    rhs : {"generated", "general"}
+    rhs : {"auto", "generated", "general"}
         Right-hand side the kernels call.  "generated": this structure's equations as
         straight-line machine code (:mod:`torquesplit.solve.codegen`, compiled in
-        milliseconds, cached per sparsity pattern; bit for bit the general kernel's
-        results, about twice as fast per step).  "general": the kernel's element loop.
-        If the code cannot be generated (e.g. an llvmlite without the new pass manager)
-        the run uses "general" with a warning; ``Solution.rhs`` says which one ran.
+        0.05 s for 14 DOFs to seconds for 400, cached per sparsity pattern; bit for bit
+        the general kernel's results, about twice as fast per step).  "general": the
+        kernel's element loop.  "auto" (default): generated when the run is long enough
+        to repay the compilation (:func:`codegen.worth_generating`) or the pattern is
+        already compiled.  If the code cannot be generated (e.g. an llvmlite without
+        the new pass manager) the run uses "general" with a warning; ``Solution.rhs``
+        says which one ran.
 
     Returns
     -------
@@ -513,7 +516,6 @@ def integrate(
         raise ValueError(f"t_span must be (start, end) with end > start, got {t_span!r}.")
     y = _initial_state(s, y0)
     model = _model_arrays(s)
-    rhs_code = _rhs_code(rhs, model)
     sel = _select(s, t0, span, track_elements, n_cycles_cap, history_elements, history_dofs)
     if rk4:
         plan = _plan_rk4(s, span, step, steps_per_period, check_stability, record_every,
@@ -521,6 +523,9 @@ def integrate(
     else:
         plan = _plan_dopri(s, span, rtol, atol, max_step, sample_interval, full_history,
                            max_steps)
+    # right-hand-side evaluations the run will need (dopri: at least 6 per largest step)
+    n_rhs_planned = 4 * min(plan.n_steps, plan.limit_steps) if rk4 else 6 * span / plan.h_max
+    rhs_code = _rhs_code(rhs, model, n_rhs_planned)
     n_hist = plan.n_hist if (sel.hist_el or sel.hist_dof or (full_history and not rk4)) else 0
     out = _Outputs.allocate(s, sel, n_hist, plan.n_full)
     counters = np.zeros(kern.N_COUNTERS, dtype=np.int64)
@@ -816,12 +821,12 @@ def _rows(buf: np.ndarray, n: int) -> np.ndarray:
     return buf[:n] if n >= 0.9 * buf.shape[0] else buf[:n].copy()
 
 
-def _rhs_code(kind: str, model) -> codegen.GeneratedRhs:
+def _rhs_code(kind: str, model, n_rhs: float) -> codegen.GeneratedRhs:
     """The right-hand side the kernels call (see ``integrate(rhs=...)``)."""
-    if kind == "general":
+    if kind not in ("auto", "generated", "general"):
+        raise ValueError(f"rhs must be 'auto', 'generated' or 'general', got {kind!r}.")
+    if kind == "general" or (kind == "auto" and not codegen.worth_generating(model, n_rhs)):
         return codegen.general_rhs()
-    if kind != "generated":
-        raise ValueError(f"rhs must be 'generated' or 'general', got {kind!r}.")
     try:
         return codegen.generated_rhs(model)
     except Exception as exc:  # noqa: BLE001 - any failure falls back, with a warning
@@ -829,8 +834,8 @@ def _rhs_code(kind: str, model) -> codegen.GeneratedRhs:
         if not _CODEGEN_WARNED:
             _CODEGEN_WARNED = True
             warnings.warn(f"could not compile this model's right-hand side ({type(exc).__name__}: "
-                          f"{exc}); using the general kernel (same results, about half the speed).",
-                          RuntimeWarning, stacklevel=3)
+                          f"{exc}); using the general kernel (same results, about half the "
+                          f"speed).", RuntimeWarning, stacklevel=3)
         return codegen.general_rhs()
 
 
