@@ -41,10 +41,12 @@ bit for bit.
 The right-hand side of a model is either :func:`rhs_slot` (the general element loop) or
 the same arithmetic generated for the model as straight-line code
 (:mod:`torquesplit.solve.codegen`), called through the first-class function ``rhs_fn``
-when its parameter vector ``rhs_par`` is not empty.  The call is written out at each call
-site (``if gen:``): passing a numba first-class function on to another compiled function
-costs about 150 ns per call (and an inlined helper with the 20 array arguments of the
-general path costs as much in reference counting), more than the generated code itself.
+when its parameter vector ``rhs_par`` is not empty, with the data addresses ``ad_*`` of
+the arrays taken once per kernel call.  Both choices are measured, not taste: the call
+is written out at each call site (``if gen:``) because passing a numba first-class
+function on to another compiled function costs about 150 ns per call, and
+``array.ctypes`` at each call costs an atomic reference-count increment and decrement
+per array (together more than the generated arithmetic; found with perf).
 
 Tooth friction and splines are handled by two kernels of their own,
 :func:`excite_friction` and :func:`rhs_extra`, called after :func:`excite_tables` /
