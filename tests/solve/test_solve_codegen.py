@@ -161,3 +161,21 @@ def test_auto_generates_only_when_the_run_repays_the_compilation():
     again = integrate(s, y0, (0.0, 1e-4), step=1e-6)
     assert again.rhs == "generated"
     np.testing.assert_array_equal(short.y_final, again.y_final)
+
+
+def test_threads_compiling_and_running_at_once_agree():
+    """Four threads generate (distinct patterns and one shared) and integrate at once:
+    the compiler is serialised and every result equals the general kernel's."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    structures = [random_structure(20 + k % 3) for k in range(4)]
+
+    def run(s):
+        y0 = np.zeros(2 * s.n_dof)
+        a = integrate(s, y0, (0.0, 2e-4), step=1e-6, rhs="generated")
+        b = integrate(s, y0, (0.0, 2e-4), step=1e-6, rhs="general")
+        return a.rhs, np.array_equal(a.y_final, b.y_final)
+
+    with ThreadPoolExecutor(4) as pool:
+        results = list(pool.map(run, structures))
+    assert results == [("generated", True)] * 4

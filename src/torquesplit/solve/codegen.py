@@ -42,7 +42,6 @@ from __future__ import annotations
 
 import hashlib
 import threading
-from collections import OrderedDict
 from dataclasses import dataclass
 
 import numpy as np
@@ -54,7 +53,6 @@ __all__ = ["GeneratedRhs", "generated_rhs", "general_rhs", "rhs_ir", "worth_gene
 ARG_NAMES = ("y", "dy", "force", "defl", "K", "G", "E", "ED", "P", "par")
 SLOT_ARGS = ("K", "G", "E", "ED", "P")
 """Excitation arrays (n_slot, ne), passed whole: the function reads row ``off / ne``."""
-_CACHE_SIZE = 32  # compiled patterns kept per process
 
 
 @dataclass(frozen=True)
@@ -200,35 +198,57 @@ def _pattern_key(model) -> str:
 
 
 class _Compiler:
-    """llvmlite target machine and a small cache of compiled patterns (thread-safe)."""
+    """One llvmlite MCJIT engine for every generated function, as numba keeps one for its
+    own code, and the cache of compiled patterns (thread-safe).
+
+    Every pattern is a module added to the same engine under its own function name; the
+    code is never freed (a process compiles few distinct patterns).  An engine per
+    pattern sharing one target machine crashed when threads compiled at once.
+    """
 
     def __init__(self):
         self._lock = threading.Lock()
-        self._cache: OrderedDict[str, tuple] = OrderedDict()
+        self._cache: dict[str, tuple] = {}
+        self._engine = None
         self._tm = None
 
-    def _target(self):
+    def _setup(self):
         import llvmlite.binding as llvm
 
-        if self._tm is None:
+        if self._engine is None:
             llvm.initialize_native_target()
             llvm.initialize_native_asmprinter()
             target = llvm.Target.from_default_triple()
-            self._tm = target.create_target_machine(
-                cpu=llvm.get_host_cpu_name(), features=llvm.get_host_cpu_features().flatten(),
-                opt=2)
-        return llvm, self._tm
 
-    def compile(self, key: str, ir: str):
-        llvm, tm = self._target()
-        mod = llvm.parse_assembly(ir)
-        mod.verify()
-        pto = llvm.create_pipeline_tuning_options(speed_level=2)
-        pb = llvm.create_pass_builder(tm, pto)
-        pb.getModulePassManager().run(mod, pb)
-        engine = llvm.create_mcjit_compiler(mod, tm)
-        engine.finalize_object()
-        return engine, engine.get_function_address("rhs")
+            def machine():
+                return target.create_target_machine(
+                    cpu=llvm.get_host_cpu_name(),
+                    features=llvm.get_host_cpu_features().flatten(), opt=2)
+
+            self._tm = machine()  # optimisation passes
+            empty = llvm.parse_assembly("")
+            empty.triple = target.triple
+            self._engine = llvm.create_mcjit_compiler(empty, machine())
+        return llvm
+
+    def compile(self, name: str, ir: str) -> int:
+        """Add the IR (whose entry point is ``@rhs``) as function ``name``; its address."""
+        # LLVM's global context is not thread-safe: hold numba's own compiler lock, so
+        # that threads (e.g. Dask workers) never compile at the same time as each other
+        # or as numba
+        from numba.core.compiler_lock import global_compiler_lock
+
+        ir = ir.replace("@rhs(", f"@{name}(").replace("@rhs_body(", f"@{name}_body(")
+        with global_compiler_lock:
+            llvm = self._setup()
+            mod = llvm.parse_assembly(ir)
+            mod.verify()
+            pto = llvm.create_pipeline_tuning_options(speed_level=2)
+            pb = llvm.create_pass_builder(self._tm, pto)
+            pb.getModulePassManager().run(mod, pb)
+            self._engine.add_module(mod)
+            self._engine.finalize_object()
+            return self._engine.get_function_address(name)
 
     def cached(self, model) -> bool:
         with self._lock:
@@ -240,17 +260,18 @@ class _Compiler:
         key = _pattern_key(model)
         with self._lock:
             hit = self._cache.get(key)
-            if hit is not None:
-                self._cache.move_to_end(key)
-                return hit, 0.0
+        if hit is not None:
+            return hit, 0.0
         t0 = time.perf_counter()
         ir, layout = rhs_ir(model)
-        engine, address = self.compile(key, ir)
-        entry = (engine, address, layout, ir.count("\n"))
+        with self._lock:  # another thread may have compiled it meanwhile
+            hit = self._cache.get(key)
+        if hit is not None:
+            return hit, 0.0
+        address = self.compile(f"rhs_{key[:24]}", ir)
+        entry = (address, layout, ir.count("\n"))
         with self._lock:
-            self._cache[key] = entry
-            while len(self._cache) > _CACHE_SIZE:
-                self._cache.popitem(last=False)
+            self._cache.setdefault(key, entry)
         return entry, time.perf_counter() - t0
 
 
@@ -258,7 +279,7 @@ _COMPILER = _Compiler()
 _SIGNATURE = None
 
 
-def _function(address: int, keep):
+def _function(address: int):
     """A numba first-class function of the rhs signature at ``address``."""
     global _SIGNATURE
     import numba.experimental.function_type  # noqa: F401 - registers typeof of the protocol
@@ -275,9 +296,7 @@ def _function(address: int, keep):
         def signature(self):
             return _SIGNATURE
 
-    fn = _Rhs()
-    fn._keep = keep  # the compiled code lives as long as the function object
-    return fn
+    return _Rhs()  # the code lives in the compiler's engine for the whole process
 
 
 _GENERAL = None
@@ -290,8 +309,8 @@ def general_rhs() -> GeneratedRhs:
     if _GENERAL is None:
         args = ", ".join(f"i64 %{x}" for x in ARG_NAMES) + ", i64 %off"
         ir = f"define void @rhs({args}) nounwind {{\nentry:\n  ret void\n}}\n"
-        engine, address = _COMPILER.compile("noop", ir)
-        _GENERAL = GeneratedRhs(_function(address, engine), np.zeros(0), 0.0, 0)
+        _GENERAL = GeneratedRhs(_function(_COMPILER.compile("rhs_noop", ir)), np.zeros(0),
+                                0.0, 0)
     return _GENERAL
 
 
@@ -320,7 +339,7 @@ def generated_rhs(model) -> GeneratedRhs:
     """The compiled right-hand side of the kernel model arrays ``model`` (the tuple
     ``integrate`` passes to the kernels), from the cache when its pattern was compiled
     before in this process."""
-    (engine, address, layout, lines), seconds = _COMPILER.get(model)
+    (address, layout, lines), seconds = _COMPILER.get(model)
     a = _arrays(model)
     par = np.array([a[name][i] for name, i in layout], dtype=np.float64)
-    return GeneratedRhs(_function(address, engine), par, seconds, lines)
+    return GeneratedRhs(_function(address), par, seconds, lines)
