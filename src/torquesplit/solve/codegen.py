@@ -5,15 +5,15 @@ and the DOFs of any structure through index arrays.  For a given structure the s
 arithmetic can be written out once: one load, multiply and add per non-zero of the
 projection V, no index arrays and no loops.  This module writes that code as LLVM IR
 (text) from the kernels' own model arrays and compiles it with llvmlite, the compiler
-numba itself uses: tens of milliseconds for the seed examples, against seconds for the
-same code through numba.  The kernels (``rk4_run``, ``dopri_run``) call it through a
+numba itself uses: 0.05-0.5 s for the seed examples, against 4-20 s for the same code
+written as Python and compiled by numba.  The kernels (``rk4_run``, ``dopri_run``) call it through a
 numba first-class function, so they are compiled and cached once for every model.
 
 It is the same computation as ``rhs_slot``, operation for operation and in the same
 order (no fused multiply-adds, no reassociation), so results are bit for bit the same
-(tested).  A whole RK4 step is about twice as fast with it (seed 001: 0.42 against
-0.83 µs, benchmarks/RESULTS.md), within 1.2 times of a hand-written transcription of
-the model.  The kernels pass it data addresses taken once per call: ``array.ctypes``
+(tested).  A whole RK4 step is about twice as fast with it (seed 001: 0.78 against
+1.51 µs in the same benchmark run, benchmarks/RESULTS.md), and within 1.0-1.2 times of a
+hand-written transcription of the model.  The kernels pass it data addresses taken once per call: ``array.ctypes``
 at every call would cost an atomic reference-count increment and decrement per array,
 more than the arithmetic.  What it computes, for one excitation slot::
 
