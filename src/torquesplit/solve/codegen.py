@@ -5,7 +5,7 @@ and the DOFs of any structure through index arrays.  For a given structure the s
 arithmetic can be written out once: one load, multiply and add per non-zero of the
 projection V, no index arrays and no loops.  This module writes that code as LLVM IR
 (text) from the kernels' own model arrays and compiles it with llvmlite, the compiler
-numba itself uses: 0.05-0.5 s for the seed examples, against 4-20 s for the same code
+numba itself uses: 0.05-0.5 s for the seed examples, against 4-22 s for the same code
 written as Python and compiled by numba.  The kernels (``rk4_run``, ``dopri_run``) call it through a
 numba first-class function, so they are compiled and cached once for every model.
 
