@@ -201,3 +201,13 @@ def test_comparison_detects_a_small_error(shipped):
     assert _scaled_difference(shipped.to_paper(shipped.static.q), q_wrong) > 100 * TOL
     f_right, f_wrong = tr.natural_frequencies(shipped.p), tr.natural_frequencies(wrong)
     assert np.max(np.abs(f_wrong - f_right) / f_right) > 100 * TOL
+
+
+def test_transcription_refuses_what_it_does_not_write_out():
+    """A model with a law eq. 9 has no term for (here a transmission error) is refused,
+    not silently transcribed without it."""
+    raw = read_raw(torquesplit.example_path(NAME))
+    model = torquesplit.load_model(apply_overrides(
+        raw, {"meshes.m12.transmission_error": {"amplitude": "5 um"}}))
+    with pytest.raises(ValueError, match="errors"):
+        tr.build(model)

@@ -318,12 +318,16 @@ def build(model) -> Seed001:
             raise ValueError(f"meshes.{name}.backlash: distribution {bl.distribution!r} is "
                              "not in the paper; use 'constant' or 'normal'")
 
-    # mesh phases at t = 0: two meshes on one gear with contact points at angles
-    # th_a, th_b about its axis are offset by -z sgn(w) (th_b - th_a) / 2 pi cycles.
-    # z1 meets z2 at angle 0 and z3 at 180 deg (z1 turns positively); z6 meets z4 at
-    # 0 and z5 at 180 deg (z6 turns positively).  The stages are not geared to each
-    # other (elastic drive shafts): each starts at phase 0 (the engine's convention).
-    phase = np.array([0.0, (-z["z1"] * 0.5) % 1.0, 0.0, (-z["z6"] * 0.5) % 1.0])
+    # mesh phases at t = 0 (the model's clocking rule): two meshes on one gear whose
+    # contact points lie at angles th_a, th_b about its axis are offset by
+    # -z sgn(w) (th_b - th_a) / 2 pi cycles (a tooth reaches the second contact that much
+    # later).  z1 and z6 both turn positively.  The stages are not geared to each other
+    # (elastic drive shafts): F11 and F12 start at phase 0 (the model's convention).
+    p4, p5, p6 = (np.array(g[n].position) for n in ("z4", "z5", "z6"))
+    d21 = g["z3"].place.angle - g["z2"].place.angle  # z3's contact after z2's, on z1
+    d22 = math.atan2((p5 - p6)[1], (p5 - p6)[0]) - math.atan2((p4 - p6)[1], (p4 - p6)[0])
+    phase = np.array([0.0, (-z["z1"] * d21 / (2 * math.pi)) % 1.0,
+                      0.0, (-z["z6"] * d22 / (2 * math.pi)) % 1.0])
 
     eom = Eom(*J, *m, *r, cb1, cb2, *arm, *kT, *cT, *kS, *cS, *cv, T1, T0)
     lengths = [len(s) for s in seqs]
@@ -338,7 +342,8 @@ def build(model) -> Seed001:
 
 
 def _check_layout(model):
-    """Refuse a model that is not the seed 001 topology this file transcribes."""
+    """Refuse a model that is not the seed 001 model this file transcribes (topology,
+    layout and the kinds of laws it writes out)."""
     want = dict(gears=set(GEARS), bodies={"motor", "mill"}, meshes=set(MESHES),
                 shafts=set(SHAFTS))
     for what, names in want.items():
@@ -355,6 +360,35 @@ def _check_layout(model):
             raise ValueError(f"meshes.{name} must join {a} and {b}")
     if model.drives["motor"].speed <= 0 or model.drives["motor"].mode != "torque":
         raise ValueError("the motor must be a torque drive turning positively about +z")
+    load = model.loads["mill"]
+    if load.torque is not None or load.speed_coefficient != 0:
+        raise ValueError("the mill's load must be the constant balanced torque of eq. 9")
+    # what eq. 9 has no term for (or this file computes differently) must be absent
+    for n in GEARS:
+        sup = model.gears[n].support
+        if (sup.stiffness is not None or sup.shaft is None or sup.damping is not None
+                or sup.clearance or sup.shaft.bearing_stiffness is None):
+            raise ValueError(f"gears.{n}.support: the transcription needs shaft bending + "
+                             "bearing (eqs. 6, 10), a damping ratio and no clearance")
+        ge = model.gears[n].errors
+        if any((ge.eccentricity, ge.installation, ge.tooth_thickness, ge.pitch,
+                ge.bearing_runout)):
+            raise ValueError(f"gears.{n}.errors: e_ij of eq. 12 is 0 in the transcription")
+    for name in MESHES:
+        mesh = model.meshes[name]
+        te = mesh.transmission_error
+        if (mesh.stiffness.method != "constant" or mesh.damping is not None
+                or mesh.phase is not None or mesh.impact or mesh.friction is not None
+                or te.constant or te.amplitude):
+            raise ValueError(f"meshes.{name}: the transcription has a constant-method "
+                             "stiffness wave, a damping ratio, no phase override, no "
+                             "errors, impact or friction")
+    for name in SHAFTS:
+        sh = model.shafts[name]
+        if sh.rigid or sh.torsional_stiffness is not None or sh.damping is not None or (
+                sh.inner_diameter):
+            raise ValueError(f"shafts.{name}: the transcription needs a solid elastic "
+                             "shaft (eq. 3) with a damping ratio (eq. 2)")
 
 
 def _directions(model) -> dict:
