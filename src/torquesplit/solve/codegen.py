@@ -17,7 +17,9 @@ linked into each generated module and inlined), so the generated code and
 around it (no fused multiply-adds, no reassociation): results are bit for bit the same
 (tested).  A whole RK4 step is about twice as fast with it (seed 001: 0.78 against
 1.51 µs in the same benchmark run, benchmarks/RESULTS.md), and within 1.0-1.2 times of a
-hand-written transcription of the model.  The kernels pass it data addresses taken once per call: ``array.ctypes``
+transcription generated from the assembled structure (benchmarks/bench_specialised.py:
+checks kernel overhead, not assembly; the seed 001 equations written by hand are timed
+in benchmarks/bench_transcription.py).  The kernels pass it data addresses taken once per call: ``array.ctypes``
 at every call would cost an atomic reference-count increment and decrement per array,
 more than the arithmetic.  What it computes, for one excitation slot::
 
