@@ -111,7 +111,8 @@ def run(
         None, "--steps-per-period", help="RK4 steps per shortest mesh period (default 100)."),
     definition: Optional[str] = typer.Option(
         None, "--definition",
-        help="Load-sharing definition: cycle_peak, instantaneous, engineering, mean_force."),
+        help="Load-sharing definition: cycle_peak, instantaneous, engineering, mean_force "
+             "(static_torque: use `torquesplit static`)."),
     out: Optional[Path] = typer.Option(
         None, "--out", help="Write results: .nc (NetCDF), .mat (MATLAB) or .csv (spreadsheet)."),
     plots: Optional[Path] = typer.Option(None, "--plots", help="Write report figures (PNG, SVG) here."),
@@ -191,24 +192,34 @@ def _render_run(res, met, saved) -> None:
         f"(+{st['rhs_compile_time_s']:.2g} s for the {st['rhs']} right-hand side); "
         f"transient discarded: {met.settling.start_time:.4g} s"
         + ("" if met.settling.settled else " (not settled: last half used)"))
+    from .metrics.load_sharing import DEFINITION_TEXT
+
     t = Table(title=f"meshes (load sharing: {met.definition})")
     for col in ("mesh", "group", "nominal F [N]", "static F [N]", "mean F [N]", "peak F [N]",
-                "DLF", "LSC", "contact loss"):
+                "dynamic factor", "peak/nominal", "LSC", "contact loss", "back flank"):
         t.add_column(col, justify="left" if col in ("mesh", "group") else "right")
     for r in met.rows:
         t.add_row(r.mesh, r.group, f"{r.nominal_force:.6g}", f"{r.static_force:.6g}",
                   f"{r.mean_force:.6g}", f"{r.peak_force:.6g}", f"{r.dynamic_factor:.5f}",
-                  f"{r.load_sharing:.5f}", f"{100 * r.contact_loss:.2f} %")
+                  f"{r.peak_to_nominal:.5f}", f"{r.load_sharing:.5f}",
+                  f"{100 * r.contact_loss:.2f} %", f"{100 * r.back_contact:.2f} %")
     console.print(t)
     g = Table(title="load-sharing groups")
-    for col in ("group", "meshes", "LSC", "DLF", "DLF (eng.)"):
+    for col in ("group", "meshes", "LSC", "dynamic factor", "peak/nominal",
+                "peak/nominal (eng.)"):
         g.add_column(col, justify="left" if col in ("group", "meshes") else "right")
+    d = met.dynamic_factors
     for name, members in met.load_sharing.groups.items():
         g.add_row(name, ", ".join(members), f"{met.load_sharing.per_group[name]:.5f}",
-                  f"{met.dynamic_factors.per_group_peak[name]:.5f}",
-                  f"{met.dynamic_factors.per_group_engineering[name]:.5f}")
+                  f"{d.per_group_dynamic_factor[name]:.5f}",
+                  f"{d.per_group_peak_to_nominal[name]:.5f}",
+                  f"{d.per_group_peak_to_nominal_engineering[name]:.5f}")
     console.print(g)
     console.print(f"system load-sharing coefficient: [bold]{met.load_sharing.system:.5f}[/]")
+    console.print(f"LSC ({met.definition}): {DEFINITION_TEXT[met.definition]}; dynamic "
+                  "factor = settled peak / the mesh's own static force; peak/nominal = "
+                  "settled peak / equal-split nominal force (Ji & Li eq. 19)",
+                  markup=False, highlight=False)
     lost = [r for r in met.rows if r.contact_loss > 0]
     if lost:
         err_console.print("[yellow]warning:[/] ", end="")

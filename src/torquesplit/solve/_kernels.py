@@ -56,8 +56,11 @@ from torquesplit.solve.kernel_data import (
     A_Y,
     F_MAIN,
     F_TMP,
+    SLOT_EVENT,
+    Y_ALT,
     Y_DSAMPLE,
     Y_K1,
+    Y_K1ALT,
     Y_KFSAL,
     Y_NEW,
     Y_SAMPLE,
@@ -83,7 +86,9 @@ I_NEXT = 7  # dopri: index of the next uniform sample time
 I_BAD = 8  # index into y of the state that diverged
 I_FSAL = 9  # dopri: 1 when Y_KFSAL holds f(t, y) of the current state
 I_LAST_REJECTED = 10  # dopri: the previous attempt was rejected
-N_COUNTERS = 11
+I_SAVED = 11  # rk4: the previous state and its k1 are saved in rows Y_ALT, Y_K1ALT
+I_EVENTS = 12  # corner events sampled (see record_extrema)
+N_COUNTERS = 13
 
 # ---------------------------------------------------- float64 clock (in/out)
 F_T = 0  # time of the current state
@@ -405,6 +410,134 @@ def record(slot, i_f, weight, m, w, r, counters):
 
 
 @_kernel
+def record_extrema(slot, i_f, w, r):
+    """Enter the forces of row ``i_f`` in the per-cycle max / min of the force and of the
+    instantaneous load-sharing ratio only (a corner event: an instant, not a sample of
+    the run, so no sums, counts or contact time).  Twin: the max / min part of
+    :func:`record`."""
+    force, CY = w.F, w.CY
+    track_el, track_base = r.track_el, r.track_base
+    cyc_max, cyc_min = r.cyc_max, r.cyc_min
+    grp_ptr, grp_col, rat_max, rat_min = r.grp_ptr, r.grp_col, r.rat_max, r.rat_min
+    cap = cyc_max.shape[0]
+    for j in range(track_el.shape[0]):
+        el = track_el[j]
+        c = CY[slot, el] - track_base[j]
+        if c >= 0 and c < cap:
+            fe = force[i_f, el]
+            if fe > cyc_max[c, j]:
+                cyc_max[c, j] = fe
+            if fe < cyc_min[c, j]:
+                cyc_min[c, j] = fe
+    for g in range(grp_ptr.shape[0] - 1):
+        total = 0.0
+        for k in range(grp_ptr[g], grp_ptr[g + 1]):
+            total += force[i_f, track_el[grp_col[k]]]
+        if total != 0.0:
+            nm = grp_ptr[g + 1] - grp_ptr[g]
+            for k in range(grp_ptr[g], grp_ptr[g + 1]):
+                j = grp_col[k]
+                el = track_el[j]
+                c = CY[slot, el] - track_base[j]
+                if c >= 0 and c < cap:
+                    ratio = nm * force[i_f, el] / total
+                    if ratio > rat_max[c, j]:
+                        rat_max[c, j] = ratio
+                    if ratio < rat_min[c, j]:
+                        rat_min[c, j] = ratio
+
+
+@_kernel
+def first_corners(t, m, w, r):
+    """Set ``w.next_node`` of every tracked element with corners to its first corner
+    node after time t (absolute node: cycle x n_table + node); returns the earliest
+    corner time."""
+    n_tab = m.stiffness_table.shape[1]
+    corner_ptr, corner_node, next_node = m.corner_ptr, m.corner_node, w.next_node
+    frequency, phase, track_el = m.frequency, m.phase, r.track_el
+    for j in range(track_el.shape[0]):
+        e = track_el[j]
+        c0 = corner_ptr[e]
+        c1 = corner_ptr[e + 1]
+        if c1 == c0:
+            continue
+        x = (frequency[e] * t + phase[e]) * n_tab
+        base = np.int64(math.floor(x / n_tab)) * n_tab
+        node = base + corner_node[c0]
+        k = c0
+        while node <= x:
+            k += 1
+            if k == c1:
+                k = c0
+                base += n_tab
+            node = base + corner_node[k]
+        next_node[e] = node
+    return next_corner_time(m, w, r)
+
+
+@_kernel
+def next_corner_time(m, w, r):
+    """Earliest time of the tracked elements' next corners (``w.next_node``); inf if
+    none."""
+    n_tab = m.stiffness_table.shape[1]
+    corner_ptr, next_node = m.corner_ptr, w.next_node
+    frequency, phase, track_el = m.frequency, m.phase, r.track_el
+    earliest = math.inf
+    for j in range(track_el.shape[0]):
+        e = track_el[j]
+        if corner_ptr[e + 1] > corner_ptr[e]:
+            tc = (next_node[e] / n_tab - phase[e]) / frequency[e]
+            if tc < earliest:
+                earliest = tc
+    return earliest
+
+
+@_kernel
+def corner_events(t_a, t_b, ya, fa, yb, fb, m, w, r, rhs_fn, gen, counters):
+    """Sample the statistics at every corner of a tracked element's force inside the
+    step (t_a, t_b) (see ``kernel_data.CORNER_TOL``): the state there by cubic Hermite
+    interpolation between rows (ya, fa) and (yb, fb) of w.Y (third order, as RK4's
+    error), the excitation exactly, the forces by the stage evaluation, then
+    :func:`record_extrema`.  The largest force and load-sharing ratio then converge like
+    h^2 instead of h when they sit at a corner of a piecewise-linear table.  Returns the
+    earliest next corner time (the callers skip the call until then)."""
+    n_tab = m.stiffness_table.shape[1]
+    corner_ptr, corner_node, next_node = m.corner_ptr, m.corner_node, w.next_node
+    frequency, phase, track_el = m.frequency, m.phase, r.track_el
+    extra = m.fr_el.shape[0] > 0 or m.sp_el.shape[0] > 0
+    h = t_b - t_a
+    slot = np.int64(SLOT_EVENT)
+    for j in range(track_el.shape[0]):
+        e = track_el[j]
+        c0 = corner_ptr[e]
+        c1 = corner_ptr[e + 1]
+        if c1 == c0:
+            continue
+        while True:
+            node = next_node[e]
+            tc = (node / n_tab - phase[e]) / frequency[e]
+            if tc >= t_b:
+                break
+            if tc > t_a:
+                hermite((tc - t_a) / h, h, ya, fa, yb, fb, Y_SAMPLE, w)
+                excite(tc, slot, np.int64(-1), m, w)
+                _stage(slot, Y_SAMPLE, Y_DSAMPLE, F_TMP, m, w, rhs_fn, gen, extra)
+                record_extrema(slot, F_TMP, w, r)
+                counters[I_EVENTS] += 1
+            # the element's next corner
+            base = (node // n_tab) * n_tab
+            p = node - base
+            k = c0
+            while k < c1 and corner_node[k] <= p:
+                k += 1
+            if k == c1:
+                next_node[e] = base + n_tab + corner_node[c0]
+            else:
+                next_node[e] = base + corner_node[k]
+    return next_corner_time(m, w, r)
+
+
+@_kernel
 def store_history(row, t, iy, i_f, w, r):
     """One decimated history row: t, forces of history elements, q and v of DOFs.
     Twin: plain indexing, ``hist_f[row] = force[hist_el]`` etc."""
@@ -453,11 +586,13 @@ def rk4_run(t0, h, n_first, n_steps, record_final, record_every, blowup, m, w, r
     Step i runs from t0 + i h to t0 + (i + 1) h; the state is row Y_STATE of w.Y,
     advanced in place.  The state at the start of each step is recorded (statistics;
     history when i % record_every == 0; full state while ``r.full_t`` has room); with
-    ``record_final`` the end state is recorded too.  Excitation is evaluated once per
-    distinct stage time (t, t + h/2, t + h) and the t + h values are reused by the next
-    step; error sinusoids are advanced by phasor rotation and recomputed exactly every
-    RESYNC steps.  Stops early (status DIVERGED) if the state is non-finite or
-    |q| > blowup.
+    ``record_final`` the end state is recorded too.  A step that contains a corner of a
+    tracked element's force keeps its start state and derivative (rows Y_ALT, Y_K1ALT)
+    so that the forces at the corner are sampled once the end state is known
+    (:func:`corner_events`).  Excitation is evaluated once per distinct stage time (t,
+    t + h/2, t + h) and the t + h values are reused by the next step; error sinusoids
+    are advanced by phasor rotation and recomputed exactly every RESYNC steps.  Stops
+    early (status DIVERGED) if the state is non-finite or |q| > blowup.
     Twin: :func:`torquesplit.solve.reference.rk4_numpy`.
     """
     Y, rot, error_omega = w.Y, w.rot, m.error_omega
@@ -477,6 +612,9 @@ def rk4_run(t0, h, n_first, n_steps, record_final, record_every, blowup, m, w, r
     s_half = np.int64(1)  # slot of t + h/2
     hh = 0.5 * h
     h6 = h / 6.0
+    t_corner = math.inf  # earliest corner still to be sampled
+    if m.corner_node.shape[0] > 0 and n_steps > 0:
+        t_corner = first_corners(t0 + max(n_first - 1, 0) * h, m, w, r)
     for it in range(n_steps):
         i = n_first + it
         t = t0 + i * h
@@ -485,6 +623,10 @@ def rk4_run(t0, h, n_first, n_steps, record_final, record_every, blowup, m, w, r
         # stage 1 at t: its forces are those of the accepted state y(t)
         _stage(a, Y_STATE, k1, F_MAIN, m, w, rhs_fn, gen, extra)
         record(a, F_MAIN, h, m, w, r, counters)
+        if counters[I_SAVED] == 1:  # corners inside the step that ended at t
+            counters[I_SAVED] = 0
+            t_corner = corner_events(t - h, t, Y_ALT, Y_K1ALT, Y_STATE, k1, m, w, r,
+                                     rhs_fn, gen, counters)
         if (record_every > 0 and i % record_every == 0
                 and counters[I_HIST] < n_hist):
             store_history(counters[I_HIST], t, Y_STATE, F_MAIN, w, r)
@@ -492,6 +634,12 @@ def rk4_run(t0, h, n_first, n_steps, record_final, record_every, blowup, m, w, r
         if counters[I_FULL] < n_full:
             store_full(counters[I_FULL], t, Y_STATE, w, r)
             counters[I_FULL] += 1
+        tb = t0 + (i + 1) * h
+        if t_corner < tb:  # a corner inside this step: keep its start
+            for k in range(n2):
+                Y[Y_ALT, k] = Y[Y_STATE, k]
+                Y[Y_K1ALT, k] = Y[k1, k]
+            counters[I_SAVED] = 1
         # stages 2 and 3 at t + h/2
         excite(t0 + (i + 0.5) * h, s_half, a, m, w)
         for k in range(n2):
@@ -501,7 +649,6 @@ def rk4_run(t0, h, n_first, n_steps, record_final, record_every, blowup, m, w, r
             Y[Y_TRIAL, k] = Y[Y_STATE, k] + hh * Y[k2, k]
         _stage(s_half, Y_TRIAL, k3, F_TMP, m, w, rhs_fn, gen, extra)
         # stage 4 at t + h
-        tb = t0 + (i + 1) * h
         excite(tb, b, s_half, m, w)
         for k in range(n2):
             Y[Y_TRIAL, k] = Y[Y_STATE, k] + h * Y[k3, k]
@@ -522,6 +669,10 @@ def rk4_run(t0, h, n_first, n_steps, record_final, record_every, blowup, m, w, r
         t = t0 + i * h
         _stage(a, Y_STATE, k1, F_MAIN, m, w, rhs_fn, gen, extra)
         record(a, F_MAIN, 0.0, m, w, r, counters)
+        if counters[I_SAVED] == 1:
+            counters[I_SAVED] = 0
+            corner_events(t - h, t, Y_ALT, Y_K1ALT, Y_STATE, k1, m, w, r, rhs_fn, gen,
+                          counters)
         if (record_every > 0 and i % record_every == 0
                 and counters[I_HIST] < n_hist):
             store_history(counters[I_HIST], t, Y_STATE, F_MAIN, w, r)
@@ -555,7 +706,8 @@ def dopri_run(t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, blowup, dt
     Integrates from clock[F_T] until t >= t_stop (never past t_end; the last step is
     shortened to land on t_end), advancing row Y_STATE in place; row Y_KFSAL carries
     f(t, y) between calls (counters[I_FSAL]).  Error norm: RMS of err_i / (atol_i +
-    rtol max(|y_i|, |y_new_i|)).  Every accepted state enters the statistics; the
+    rtol max(|y_i|, |y_new_i|)).  Every accepted state enters the statistics, and so do
+    the forces at the corners inside each accepted step (:func:`corner_events`); the
     decimated (and optional full) histories are written at the uniform times
     t0 + k dt_sample by cubic Hermite interpolation between accepted steps.
     Status: DIVERGED (non-finite or |q| > blowup after an accepted step),
@@ -566,6 +718,9 @@ def dopri_run(t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, blowup, dt
     n2 = Y.shape[1]
     n_full = r.full_t.shape[0]
     extra = m.fr_el.shape[0] > 0 or m.sp_el.shape[0] > 0
+    t_corner = math.inf  # earliest corner still to be sampled
+    if m.corner_node.shape[0] > 0:
+        t_corner = first_corners(clock[F_T], m, w, r)
     kf = Y_KFSAL
     k2 = kf + 1
     k3 = kf + 2
@@ -686,6 +841,9 @@ def dopri_run(t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, blowup, dt
                     counters[I_FULL] = row + 1
                 counters[I_NEXT] = row + 1
                 counters[I_HIST] = row + 1
+            if t_corner < t_new:
+                t_corner = corner_events(t, t_new, Y_STATE, kf, Y_NEW, k7, m, w, r, rhs_fn,
+                                         gen, counters)
             for k in range(n2):
                 Y[Y_STATE, k] = Y[Y_NEW, k]
                 Y[kf, k] = Y[k7, k]

@@ -37,7 +37,7 @@ from torquesplit.errors import SolverError
 
 __all__ = ["KernelModel", "Work", "Record", "kernel_model", "make_work", "make_record",
            "Y_STATE", "Y_TRIAL", "Y_K1", "Y_KFSAL", "Y_NEW", "Y_SAMPLE", "Y_DSAMPLE",
-           "F_MAIN", "F_TMP", "N_SLOT"]
+           "F_MAIN", "F_TMP", "N_SLOT", "SLOT_EVENT", "Y_ALT", "Y_K1ALT", "corner_nodes"]
 
 KernelModel = namedtuple("KernelModel", (
     "inv_mass", "external_force", "ground_damping", "element_kind", "v_ptr", "v_dof",
@@ -46,6 +46,7 @@ KernelModel = namedtuple("KernelModel", (
     "error_phase", "force_table", "tv_el", "err_el", "sin_el", "vr_ptr", "vq_idx",
     "vv_idx", "vt_ptr", "vt_el", "vt_coef", "fr_el", "fr_ptr", "fr_dof", "fr_coef",
     "fr_row", "friction_table", "sp_el", "sp_par", "gy_ptr", "gy_idx", "gy_coef",
+    "corner_ptr", "corner_node",
 ))
 """A :class:`~torquesplit.assembly.structure.Structure` in kernel form.
 
@@ -55,12 +56,14 @@ the owner of each sinusoid; ``vr_ptr vq_idx vv_idx`` V by element (unsigned; ind
 into the state of the q and of the v entries); ``vt_ptr vt_el vt_coef`` V by DOF (the
 generalized forces are gathered, not scattered); ``gy_ptr gy_idx gy_coef`` the
 gyroscopic matrix G by row (generalized force -G v); spline component elements get zero
-stiffness and damping in ``stiffness_table`` / ``damping`` (their law is applied apart).
+stiffness and damping in ``stiffness_table`` / ``damping`` (their law is applied apart);
+``corner_node[corner_ptr[e]:corner_ptr[e+1]]`` the table nodes where element e's force has
+a corner (:func:`corner_nodes`): the integrators also sample the statistics there.
 """
 
 Work = namedtuple("Work", (
     "Y", "F", "D", "K", "P", "G", "E", "ED", "CY", "S", "C", "FR", "gap_cyc", "gap_val",
-    "has_force", "watch_el", "rot", "addr", "par",
+    "has_force", "watch_el", "rot", "addr", "par", "next_node",
 ))
 """Scratch of one run.  ``Y`` (12, 2 n): state-sized rows (see the ``Y_*`` indices);
 ``F``/``D`` (2, n_el): element forces / deformations of the evaluation whose statistics
@@ -72,7 +75,9 @@ half-gap of each element's current cycle; ``has_force`` elements with a non-zero
 additive force table; ``watch_el`` elements whose contact state is counted; ``rot``
 (2, n_sin) cos and sin of the phasor rotation over half an RK4 step; ``addr`` data
 addresses for the generated right-hand side (``A_*``); ``par`` its parameter vector
-(empty for the general kernel), held here so that its address stays valid."""
+(empty for the general kernel), held here so that its address stays valid;
+``next_node`` the absolute table node (cycle x n_table + node) of each element's next
+corner."""
 
 Record = namedtuple("Record", (
     "track_el", "track_base", "cyc_max", "cyc_min", "cyc_sum", "cyc_cnt",
@@ -93,14 +98,25 @@ Y_TRIAL = 1  # stage argument
 Y_K1 = 2  # rk4: k1..k4 in rows 2..5
 Y_KFSAL = 2  # dopri: f(t, y) of the current state, k2..k7 in rows 3..8
 Y_NEW = 9  # dopri: candidate state
-Y_SAMPLE = 10  # dopri: interpolated sample state
-Y_DSAMPLE = 11  # dopri: its derivative
-N_ROWS = 12
+Y_SAMPLE = 10  # interpolated sample state (dopri history, corner events)
+Y_DSAMPLE = 11  # its derivative
+Y_ALT = 12  # rk4: the other state row (the previous state, kept for corner events)
+Y_K1ALT = 13  # rk4: its k1
+N_ROWS = 14
 # rows of Work.F / Work.D
 F_MAIN = 0
 F_TMP = 1
-#: excitation slots (rk4: t, t + h/2, t + h; dopri: stages, accepted state)
-N_SLOT = 3
+#: excitation slots (rk4: t, t + h/2, t + h; dopri: stages, accepted state; last: events)
+N_SLOT = 4
+SLOT_EVENT = 3
+CORNER_TOL = 1e-3
+"""A table node is a corner of an element's force when the table's second difference
+there exceeds CORNER_TOL x the table's range (a rectangular stiffness wave, the edge of
+a meshing-in impact), or when the half-gap changes from cycle to cycle (node 0).  The
+largest force, and the largest load-sharing ratio, of such an element can sit exactly at
+a corner: sampled at the steps only it converges like h, sampled at the corners as well
+like h^2 (the sampling error at a smooth corner below the tolerance is at most about
+CORNER_TOL x the table's range)."""
 # indices of Work.addr
 A_Y, A_F, A_D, A_K, A_G, A_E, A_ED, A_P, A_PAR = range(9)
 
@@ -208,8 +224,38 @@ def kernel_model(structure: Structure) -> KernelModel:
                         else np.zeros((0, 1))),
         sp_el=i8(s.sp_el).reshape(n_sp, 2), sp_par=f8(s.sp_par).reshape(n_sp, 6),
         gy_ptr=u8(_gy_ptr(s)), gy_idx=u8(np.asarray(s.gy_idx) + s.n_dof),
-        gy_coef=f8(s.gy_coef),
+        gy_coef=f8(s.gy_coef), **_corners(s),
     )
+
+
+def corner_nodes(table: np.ndarray, tolerance: float = CORNER_TOL) -> np.ndarray:
+    """Nodes of a periodic table (one period) where its second difference exceeds
+    ``tolerance`` x its range: the corners of its piecewise-linear interpolant."""
+    t = np.asarray(table, dtype=float)
+    span = float(t.max() - t.min()) if t.size else 0.0
+    if t.size < 3 or not span > 0:
+        return np.zeros(0, dtype=np.int64)
+    second = np.roll(t, -1) - 2.0 * t + np.roll(t, 1)
+    return np.flatnonzero(np.abs(second) > tolerance * span).astype(np.int64)
+
+
+def _corners(s: Structure) -> dict:
+    """CSR of the corner nodes of each time-varying element (see CORNER_TOL)."""
+    ptr = np.zeros(s.n_elements + 1, dtype=np.int64)
+    nodes: list[np.ndarray] = []
+    comps = set(np.asarray(s.sp_el, dtype=np.int64).ravel().tolist())
+    for e in range(s.n_elements):
+        if not s.frequency[e] > 0 or e in comps:
+            c = np.zeros(0, dtype=np.int64)
+        else:
+            c = np.union1d(corner_nodes(s.stiffness_table[e]), corner_nodes(s.force_table[e]))
+            gaps = s.gap_values[s.gap_ptr[e]:s.gap_ptr[e + 1]]
+            if np.ptp(gaps) > 0:  # the half-gap jumps at the start of a cycle
+                c = np.union1d(c, [0])
+        nodes.append(c.astype(np.int64))
+        ptr[e + 1] = ptr[e] + c.size
+    return dict(corner_ptr=ptr, corner_node=(np.concatenate(nodes) if nodes
+                                             else np.zeros(0, dtype=np.int64)))
 
 
 def make_work(m: KernelModel, rhs_parameters: np.ndarray | None = None) -> Work:
@@ -241,7 +287,7 @@ def make_work(m: KernelModel, rhs_parameters: np.ndarray | None = None) -> Work:
         FR=np.zeros((N_SLOT, m.friction_table.shape[0])),
         gap_cyc=np.full(ne, -(2**62), dtype=np.int64), gap_val=np.zeros(ne),
         has_force=has_force, watch_el=watch, rot=np.zeros((2, n_sin)),
-        addr=np.zeros(9, dtype=np.uint64), par=par,
+        addr=np.zeros(9, dtype=np.uint64), par=par, next_node=np.zeros(ne, dtype=np.int64),
     )
     for i, arr in ((A_Y, w.Y), (A_F, w.F), (A_D, w.D), (A_K, w.K), (A_G, w.G), (A_E, w.E),
                    (A_ED, w.ED), (A_P, w.P), (A_PAR, par)):

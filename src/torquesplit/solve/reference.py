@@ -17,16 +17,9 @@ import numpy as np
 
 from torquesplit.assembly.structure import (
     MESH,
-    SP_CLEARANCE,
-    SP_DAMPING,
-    SP_FRICTION,
-    SP_STICK,
-    SP_STIFFNESS,
-    SP_VELOCITY,
     Structure,
 )
 from torquesplit.solve import laws
-from torquesplit.solve.laws import CYCLE_EPS
 
 __all__ = [
     "Excitation",

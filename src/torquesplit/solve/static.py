@@ -59,7 +59,7 @@ from torquesplit.assembly.structure import (
 from torquesplit.errors import SolverError
 from torquesplit.solve import laws
 from torquesplit.solve._frozen import freeze_arrays
-from torquesplit.solve.laws import CONTACT, FLOAT, STICK
+from torquesplit.solve.laws import CONTACT, FLOAT
 from torquesplit.solve.reference import excitation_numpy
 
 __all__ = ["StaticSolution", "QuasiStaticSolution", "static_equilibrium", "quasi_static",
