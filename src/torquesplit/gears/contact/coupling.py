@@ -1,0 +1,246 @@
+"""LTCA of a mesh of a model: what the assembly needs (stiffness method ``"ltca"``).
+
+At model assembly a mesh with ``stiffness.method = "ltca"`` gets, at its operating
+load (the nominal normal force of the power flow, or ``stiffness.ltca.load``):
+
+* the mesh stiffness over one mesh cycle, and
+* the transmission-error excitation ``e(phase)`` of the mesh element
+  ``f = k(phase) h(V q - e) + ...`` (structure.py), such that at the operating load the
+  static mesh force equals the load at every position:
+
+  - ``excitation = "tangent"`` (default): ``k = dP/dZ`` (the LTCA tangent stiffness)
+    and ``e = Z - P / k``.  Small vibrations about the loaded state see the right
+    stiffness, and the loaded transmission error drives the mesh;
+  - ``excitation = "secant"``: ``k = P / Z`` (Liu et al. 2021 eq. 5, the paper's form)
+    and ``e = 0``;
+* with ``impact = true``, the meshing-in impact from the loaded geometry
+  (:mod:`torquesplit.gears.contact.impact`).
+
+The stiffness and impact force are tables over ``n`` uniform phases; the error is
+passed as its Fourier series in the mesh phase (sinusoids at multiples of the mesh
+frequency, with the mesh's phase), so that the kernel also gets its rate ``e'``.
+
+Not done here (the kernel's): a stiffness table over load interpolated by the
+instantaneous mesh force.
+
+The gear that drives is gear 1 of the pair analysed (phase 0: a new pair enters at
+the driver's start of active profile).  For an internal pair driven by its ring gear
+the positions are run backwards (the contact travels from the pinion's tip).
+
+Results are cached in memory and on disk (:mod:`~torquesplit.gears.contact.cache`) by a
+hash of every input.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from torquesplit.errors import ModelError
+from torquesplit.gears.contact import cache as _cache
+from torquesplit.gears.contact.impact import loaded_meshing_in
+from torquesplit.gears.contact.ltca import ContactModel, LtcaOptions
+from torquesplit.gears.contact.modifications import misalignment_from_spec, modification_from_spec
+from torquesplit.gears.geometry import PairGeometry
+from torquesplit.gears.stiffness.result import periodic_resample
+
+__all__ = ["MeshLtca", "pair_for_mesh", "contact_model_for_mesh", "mesh_ltca",
+           "error_harmonics", "MAX_ERROR_HARMONICS"]
+
+#: Fourier harmonics of the transmission-error excitation passed to the mesh element
+MAX_ERROR_HARMONICS = 24
+
+_MEMO: dict[str, "MeshLtca"] = {}
+
+
+@dataclass(frozen=True)
+class MeshLtca:
+    """LTCA excitation of one mesh at its operating load (SI).
+
+    Attributes
+    ----------
+    stiffness : (n,) mesh stiffness at phases k/n [N/m].
+    impact_force : (n,) meshing-in impact force [N], or None.
+    te : (M,) loaded transmission error at the LTCA positions [m] (normal).
+    error : (M,) transmission-error excitation e at the LTCA positions [m].
+    summary : dict of scalars (load, TE peak-to-peak, stiffness, impact, ...).
+    """
+
+    stiffness: np.ndarray
+    impact_force: np.ndarray | None
+    te: np.ndarray
+    error: np.ndarray
+    summary: dict
+
+
+def pair_for_mesh(model, kin, mesh_name: str) -> tuple[PairGeometry, tuple[str, str], bool]:
+    """The PairGeometry of a mesh with its driver first where possible.
+
+    Returns ``(pair, (gear 1 name, gear 2 name), reverse)``; ``reverse`` is True for an
+    internal pair driven by its ring gear (the ring must be gear 2).
+    """
+    from torquesplit.gears.line_of_action import gear_geometry, is_conical
+
+    mesh = model.meshes[mesh_name]
+    mk = kin.meshes[mesh_name]
+    a, b = mesh.gears
+    ga, gb = model.gears[a], model.gears[b]
+    if is_conical(ga, gb) or mk.geometry is None:
+        raise ModelError([(f"meshes.{mesh_name}.stiffness.method", (
+            "the LTCA is implemented for cylindrical pairs (spur, helical, double-helical, "
+            "internal); use a table or a constant for this bevel/face mesh"))])
+    driver, driven = mk.driver, mk.driven
+    reverse = False
+    if model.gears[driver].gear_type == "internal":
+        g1, g2, reverse = driven, driver, True
+    else:
+        g1, g2 = driver, driven
+    pair = PairGeometry(gear_geometry(model.gears[g1]), gear_geometry(model.gears[g2]))
+    return pair, (g1, g2), reverse
+
+
+def _options(spec) -> LtcaOptions:
+    lt = spec.ltca
+    return LtcaOptions(positions=int(lt.positions), slices=int(spec.slices),
+                       contact_model=lt.contact_model, coupling=bool(lt.coupling),
+                       stagger=float(lt.stagger), fillet_foundation=bool(spec.fillet_foundation))
+
+
+def contact_model_for_mesh(model, kin, mesh_name: str, *, options: LtcaOptions | None = None):
+    """The :class:`ContactModel` of a mesh and its operating normal load [N].
+
+    Returns ``(contact_model, load, (gear 1 name, gear 2 name), reverse)``.
+    """
+    spec = model.meshes[mesh_name].stiffness
+    pair, names, reverse = pair_for_mesh(model, kin, mesh_name)
+    mods = tuple(modification_from_spec(model.gears[g].modifications, pair.face_width,
+                                        f"gears.{g}.modifications") for g in names)
+    mis = misalignment_from_spec(model.meshes[mesh_name].misalignment)
+    opts = options or _options(spec)
+    gears = [model.gears[g] for g in names]
+    cm = ContactModel(pair, mods, mis, opts,
+                      young_modulus=tuple(g.youngs_modulus for g in gears),
+                      poisson_ratio=tuple(g.poisson_ratio for g in gears),
+                      where=(f"gears.{names[0]}.modifications", f"gears.{names[1]}.modifications",
+                             f"meshes.{mesh_name}.misalignment"))
+    load = spec.ltca.load if spec.ltca.load is not None else kin.meshes[mesh_name].force
+    return cm, float(load), names, reverse
+
+
+def _key_inputs(model, kin, mesh_name, n, pair, names, reverse, load) -> dict:
+    mesh = model.meshes[mesh_name]
+    spec = mesh.stiffness
+    gears = {}
+    for role, g in zip(("gear1", "gear2"), names):
+        gg = model.gears[g]
+        geo = pair.gear1 if role == "gear1" else pair.gear2
+        gears[role] = dict(
+            teeth=geo.teeth, module=geo.normal_module, alpha=geo.normal_pressure_angle,
+            beta=geo.helix_angle, b=geo.face_width, x=geo.profile_shift, ha=geo.addendum,
+            hf=geo.dedendum, internal=geo.internal, double=geo.double_helical,
+            rho=geo.tool_tip_radius, E=gg.youngs_modulus, nu=gg.poisson_ratio,
+            mods=None if gg.modifications is None else gg.modifications.model_dump(mode="json"))
+    inputs = dict(gears=gears, reverse=reverse, load=load, n=n,
+                  ltca={k: v for k, v in spec.ltca.model_dump(mode="json").items() if k != "cache"},
+                  slices=spec.slices, fillet=spec.fillet_foundation,
+                  misalignment=mesh.misalignment.model_dump(mode="json"), impact=bool(mesh.impact))
+    if mesh.impact:
+        mk = kin.meshes[mesh_name]
+        inputs["impact_inputs"] = dict(
+            omega=abs(kin.bodies[mk.driver].speed), j_driver=kin.bodies[mk.driver].polar_inertia,
+            j_driven=kin.bodies[mk.driven].polar_inertia)
+    return inputs
+
+
+def mesh_ltca(model, kin, mesh_name: str, n: int) -> MeshLtca:
+    """LTCA stiffness table, error excitation and impact of a mesh (cached).
+
+    Raises ModelError (naming the field) for unsupported meshes or bad modifications and
+    SolverError if the contact problem does not converge.
+    """
+    mesh = model.meshes[mesh_name]
+    spec = mesh.stiffness
+    pair, names, reverse = pair_for_mesh(model, kin, mesh_name)
+    mk = kin.meshes[mesh_name]
+    load = float(spec.ltca.load if spec.ltca.load is not None else mk.force)
+    if not (load > 0):
+        raise ModelError([(f"meshes.{mesh_name}.stiffness.ltca.load", (
+            "the mesh carries no load in the power flow; give the operating load, e.g. "
+            "load = '10 kN'"))])
+    key = _cache.cache_key(_key_inputs(model, kin, mesh_name, n, pair, names, reverse, load))
+    if key in _MEMO:
+        return _MEMO[key]
+    use_disk = bool(spec.ltca.cache)
+    hit = _cache.load(key) if use_disk else None
+    if hit is not None:
+        arrays, summary = hit
+        out = MeshLtca(stiffness=arrays["stiffness"], te=arrays["te"], error=arrays["error"],
+                       impact_force=arrays.get("impact_force"), summary=summary)
+        _MEMO[key] = out
+        return out
+    cm, load, names, reverse = contact_model_for_mesh(model, kin, mesh_name)
+    res = cm.solve(load).require_converged(f"meshes.{mesh_name}.stiffness")
+    phase = cm.phase if not reverse else np.mod(-cm.phase, 1.0)
+    if spec.ltca.excitation == "tangent":
+        k = res.stiffness_tangent
+        err = res.transmission_error - load / k
+    else:
+        k = res.stiffness_secant
+        err = np.zeros_like(k)
+    table = periodic_resample(phase, k, n)
+    summary = {k_: v for k_, v in res.summary().items()}
+    summary.update(excitation=spec.ltca.excitation, gears=list(names), reverse=reverse,
+                   error_peak_to_peak_m=float(np.ptp(err)))
+    impact = None
+    if mesh.impact:
+        if reverse:
+            raise ModelError([(f"meshes.{mesh_name}.impact", (
+                "meshing-in impact from the LTCA needs the pinion to drive an internal pair; "
+                "set impact = false"))])
+        drv, dvn = kin.bodies[mk.driver], kin.bodies[mk.driven]
+        mi = loaded_meshing_in(res, omega_driving=abs(drv.speed), inertia_driving=drv.polar_inertia,
+                               inertia_driven=dvn.polar_inertia)
+        impact = mi.force(np.arange(n) / n)
+        summary.update(impact_peak_force_N=mi.peak_force, impact_advance_m=mi.advance,
+                       impact_corner_separation_m=mi.corner_separation)
+    # sort the samples by phase (the reversed order of an internal pair driven by its ring)
+    order = np.argsort(phase, kind="stable")
+    out = MeshLtca(stiffness=table, impact_force=impact, te=res.transmission_error[order],
+                   error=err[order], summary=summary)
+    if use_disk:
+        arrays = dict(stiffness=out.stiffness, te=out.te, error=out.error)
+        if impact is not None:
+            arrays["impact_force"] = impact
+        _cache.store(key, arrays, summary)
+    _MEMO[key] = out
+    return out
+
+
+def error_harmonics(error, frequency: float, phase0: float,
+                    harmonics: int = MAX_ERROR_HARMONICS) -> tuple[float, list[tuple[float, float, float]]]:
+    """Constant and sinusoids ``(amplitude, omega, phase)`` of an error given at uniform
+    mesh phases, for a mesh of ``frequency`` [Hz] whose phase at t = 0 is ``phase0``:
+
+    ``e(t) = c + sum A_h sin(omega_h t + psi_h)``, ``omega_h = 2 pi h f``, the mesh phase
+    being ``f t + phase0`` (the convention of the assembled structure).
+    """
+    e = np.asarray(error, dtype=float)
+    m = e.size
+    c = np.fft.rfft(e) / m
+    const = float(c[0].real)
+    out = []
+    for h in range(1, min(harmonics, (m - 1) // 2) + 1):
+        a, b = 2.0 * c[h].real, -2.0 * c[h].imag   # e ~ a cos(2 pi h x) + b sin(2 pi h x)
+        amp = math.hypot(a, b)
+        if amp <= 1e-15:
+            continue
+        theta = math.atan2(a, b)                   # a cos u + b sin u = amp sin(u + theta)
+        out.append((amp, 2.0 * math.pi * h * frequency, 2.0 * math.pi * h * phase0 + theta))
+    return const, out
+
+
+def clear_memory_cache() -> None:
+    """Forget the in-memory results (the disk cache stays)."""
+    _MEMO.clear()
