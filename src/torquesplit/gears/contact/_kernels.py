@@ -52,12 +52,13 @@ __all__ = [
     "contact_deflection_twin",
     "ltca_solve",
     "ltca_solve_twin",
+    "position_system",
     "STATUS",
 ]
 
 #: status codes of :func:`ltca_solve` per position
 STATUS = {0: "converged", 1: "active set: iteration limit", 2: "Hertz loop: iteration limit",
-          3: "no contact point at this position"}
+          3: "no contact point at this position", 4: "compliance matrix not positive definite"}
 
 _LN_MIN = 0.5  # floor of ln(2 d / a): the formula holds for a << d (see contact_deflection)
 
@@ -263,14 +264,15 @@ def _gaps(nb, bptr, cptr, cflat, hs, w, p, Z, d):
 def _active_set(nb, bptr, cptr, cflat, hs, w, act, p, P, tol_d, maxit, amat, rhs1, rhs2, x1, x2,
                 work, u_all, v_all, p_hat, d):
     """Primal active-set method (Nocedal & Wright 2006, Algorithm 16.3) from a feasible
-    ``p`` with working set ``act``.  Returns (Z, iterations, ok)."""
+    ``p`` with working set ``act``.  Returns (Z, iterations, status) with status 0
+    (solved), 1 (iteration limit) or 4 (not positive definite)."""
     n = bptr[nb]
     Z = 0.0
     for it in range(maxit):
         Z, ok = _solve_working_set(nb, bptr, cptr, cflat, hs, w, act, P, amat, rhs1, rhs2,
                                    x1, x2, work, u_all, v_all, p_hat)
         if not ok:
-            return Z, it, False
+            return Z, it, 4
         # step towards p_hat, blocked by the first load that would turn negative
         alpha = 1.0
         block = -1
@@ -292,7 +294,7 @@ def _active_set(nb, bptr, cptr, cflat, hs, w, act, p, P, tol_d, maxit, amat, rhs
                     dmin = d[i]
                     jmin = i
             if jmin < 0:
-                return Z, it + 1, True
+                return Z, it + 1, 0
             act[jmin] = True
         else:
             for i in range(n):
@@ -302,7 +304,7 @@ def _active_set(nb, bptr, cptr, cflat, hs, w, act, p, P, tol_d, maxit, amat, rhs
                         p[i] = 0.0
             p[block] = 0.0
             act[block] = False  # the blocking load leaves the working set
-    return Z, maxit, False
+    return Z, maxit, 1
 
 
 @njit(cache=True)
@@ -465,11 +467,11 @@ def ltca_solve(zone, frac, kb1, kb2, g1, g2, loc, w, radius, depth1, depth2, db,
             for i in range(n):
                 p_old[i] = p[i]
             Z_old = Z
-            Z, it, ok = _active_set(nb, bptr, cptr, cflat, hs, wv, act, p, P, tol_d, maxit, amat,
-                                    rhs1, rhs2, x1, x2, work, u_all, v_all, p_hat, d)
+            Z, it, code = _active_set(nb, bptr, cptr, cflat, hs, wv, act, p, P, tol_d, maxit,
+                                      amat, rhs1, rhs2, x1, x2, work, u_all, v_all, p_hat, d)
             iters += it
-            if not ok:
-                status = 1
+            if code != 0:
+                status = code
                 break
             if model == 0:
                 status = 0
@@ -523,11 +525,48 @@ def _plate_compliance_twin(kb, g, frac, db, coupling):
     return np.linalg.inv(K)
 
 
+def position_system(zone, frac, kb1, kb2, g1, g2, loc, w, radius, depth1, depth2, db, length,
+                    coupling, m):
+    """The contact problem at position ``m`` as dense arrays (readable twin of the block
+    assembly inside :func:`ltca_solve`).
+
+    Returns ``(C, where, w, radius, depth1, depth2, line_length)``: the elastic
+    compliance (n x n, without the contact term), the ``(h, k, j)`` index of each point,
+    and per point the separation, contact geometry and contact-line length.
+    """
+    H, K = zone.shape[1], zone.shape[2]
+    blocks = []
+    for h in range(H):
+        for k in range(K):
+            js = np.flatnonzero(zone[m, h, k])
+            if js.size == 0:
+                continue
+            fr = frac[m, h, k]
+            c = (_plate_compliance_twin(kb1[m, h, k], g1[m, h, k], fr, db, coupling)
+                 + _plate_compliance_twin(kb2[m, h, k], g2[m, h, k], fr, db, coupling))
+            c = c[np.ix_(js, js)] + np.diag(loc[m, h, k, js] / (fr[js] * db))
+            blocks.append(((h, k, js), c))
+    n = sum(b[0][2].size for b in blocks)
+    C = np.zeros((n, n))
+    where = []
+    i0 = 0
+    for (h, k, js), c in blocks:
+        C[i0:i0 + js.size, i0:i0 + js.size] = c
+        where += [(h, k, int(j)) for j in js]
+        i0 += js.size
+
+    def pick(a):
+        return np.array([a[m][t] for t in where])
+
+    return (C, where, pick(w), pick(radius), pick(depth1), pick(depth2),
+            pick(frac) * length)
+
+
 def ltca_solve_twin(zone, frac, kb1, kb2, g1, g2, loc, w, radius, depth1, depth2, db, length,
                     c1, c2, nu1, nu2, model, lin, coupling, P, tol, maxit):
     """Readable twin of :func:`ltca_solve`: dense matrices, numpy solves, the same
     primal active-set method and Hertz fixed point, started from all points."""
-    M, H, K, N = zone.shape
+    M = zone.shape[0]
     p_out = np.zeros(zone.shape)
     Z_out = np.zeros(M)
     kt_out = np.zeros(M)
@@ -540,30 +579,9 @@ def ltca_solve_twin(zone, frac, kb1, kb2, g1, g2, loc, w, radius, depth1, depth2
         return float(contact_deflection_twin(q, R[i], D1[i], D2[i], c1, c2, nu1, nu2)) / p
 
     for m in range(M):
-        blocks = []
-        for h in range(H):
-            for k in range(K):
-                js = np.flatnonzero(zone[m, h, k])
-                if js.size == 0:
-                    continue
-                fr = frac[m, h, k]
-                c = (_plate_compliance_twin(kb1[m, h, k], g1[m, h, k], fr, db, coupling)
-                     + _plate_compliance_twin(kb2[m, h, k], g2[m, h, k], fr, db, coupling))
-                c = c[np.ix_(js, js)] + np.diag(loc[m, h, k, js] / (fr[js] * db))
-                blocks.append(((h, k, js), c))
-        n = sum(b[0][2].size for b in blocks)
-        C = np.zeros((n, n))
-        where = []
-        i0 = 0
-        for (h, k, js), c in blocks:
-            C[i0:i0 + js.size, i0:i0 + js.size] = c
-            where += [(h, k, j) for j in js]
-            i0 += js.size
-        wv = np.array([w[m][t] for t in where])
-        R = np.array([radius[m][t] for t in where])
-        D1 = np.array([depth1[m][t] for t in where])
-        D2 = np.array([depth2[m][t] for t in where])
-        Ln = np.array([frac[m][t] * length for t in where])
+        C, where, wv, R, D1, D2, Ln = position_system(zone, frac, kb1, kb2, g1, g2, loc, w, radius,
+                                                      depth1, depth2, db, length, coupling, m)
+        n = len(where)
         p_ref = P / n
         hs = np.array([secant(p_ref * Ln[i] / length, i) for i in range(n)])
         act = np.ones(n, bool)

@@ -36,7 +36,9 @@ Ring gears (internal pairs): ISO 6336-1 treats the teeth of an internal gear as 
 the basic rack (virtual tooth number infinite).  Their bending, shear, axial and fillet
 terms are here those of an external tooth of :data:`RACK_TEETH` teeth with the same
 module, pressure angle, addendum, dedendum and tool, loaded at the same height above its
-reference circle (an approximation, stated).
+reference circle (an approximation, stated), without the fillet-foundation term: the fit
+of Sainsot et al. is for external gears (it turns negative for the proxy's tiny root
+angle), and the foundation of a ring's teeth is its rim, which is not modelled.
 
 Normal direction: a transverse compliance ``c_t`` becomes ``cos^2(beta_b) c_t`` along the
 flank normal; a slice of axial width ``db`` has a contact line ``db / cos(beta_b)`` long
@@ -56,7 +58,6 @@ import numpy as np
 from torquesplit.errors import ModelError
 from torquesplit.gears.geometry import GearGeometry, PairGeometry
 from torquesplit.gears.stiffness.potential_energy import (
-    DEFAULT_BORE_RATIO,
     _two,
     _two_radii,
     tooth_compliance,
@@ -160,11 +161,18 @@ def slice_tables(pair: PairGeometry, *, young_modulus=206e9, poisson_ratio=0.3,
         eta = g2.reference_radius - r2            # height above the ring's reference circle
         r_proxy = proxy.reference_radius + eta
         roll2 = np.sqrt(np.maximum(r_proxy ** 2 / proxy.base_radius ** 2 - 1.0, 0.0))
-        b2p = b2 if b2 is not None else DEFAULT_BORE_RATIO * proxy.root_radius
-        bend2, loc2, lev2, dep2 = _tooth_table(proxy, roll2, e2, n2, fillet_foundation, b2p)
+        # no fillet foundation: Sainsot et al.'s fit is for external gears (it turns
+        # negative for the proxy's tiny root angle); a ring's foundation is its rim
+        bend2, loc2, lev2, dep2 = _tooth_table(proxy, roll2, e2, n2, False, None)
     else:
         bend2, loc2, lev2, dep2 = _tooth_table(g2, rho2 / g2.base_radius, e2, n2,
                                                fillet_foundation, b2)
+    for name, v in (("gear1", bend1), ("gear1", loc1), ("gear2", bend2), ("gear2", loc2)):
+        if not np.all(v > 0):
+            raise ModelError([("fillet_foundation", (
+                f"the tooth compliance of {name} is not positive on the path of contact (the "
+                "fillet-foundation fit of Sainsot et al. 2004 is outside its range for this "
+                "tooth); set fillet_foundation = false"))])
     r1n, r2n = pair.curvature_radii(s, normal=True)
     radius = r1n * r2n / (r1n + r2n)
     if np.any(radius <= 0):

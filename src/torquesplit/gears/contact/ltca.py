@@ -249,14 +249,7 @@ class ContactModel:
         if not (load > 0 and math.isfinite(load)):
             raise ModelError([("load", f"must be a positive normal force in N, got {load!r}; "
                                        "give the operating load")])
-        o = self.options
-        a = self._arrays
-        (e1, e2), (n1, n2) = self.young_modulus, self.poisson_ratio
-        args = (self.zone, self.fraction, a["kb1"], a["kb2"], a["g1"], a["g2"], a["loc"], self.separation,
-                a["radius"], a["depth1"], a["depth2"], self.slice_width, self.line_length,
-                (1 - n1 * n1) / e1, (1 - n2 * n2) / e2, n1, n2,
-                1 if o.contact_model == "weber" else 0, self.hertz_linear, bool(o.coupling),
-                float(load), float(o.tolerance), int(o.max_iterations))
+        args = self._kernel_args(load)
         if twin:
             p, Z, kt = _kernels.ltca_solve_twin(*args)
             it = np.zeros(Z.size, dtype=np.int64)
@@ -265,6 +258,16 @@ class ContactModel:
             p, Z, kt, it, st = _kernels.ltca_solve(*args)
         return LtcaResult(model=self, load=float(load), slice_load=p, transmission_error=Z,
                           stiffness_tangent=kt, iterations=it, status=st)
+
+    def _kernel_args(self, load: float) -> tuple:
+        o = self.options
+        a = self._arrays
+        (e1, e2), (n1, n2) = self.young_modulus, self.poisson_ratio
+        return (self.zone, self.fraction, a["kb1"], a["kb2"], a["g1"], a["g2"], a["loc"],
+                self.separation, a["radius"], a["depth1"], a["depth2"], self.slice_width,
+                self.line_length, (1 - n1 * n1) / e1, (1 - n2 * n2) / e2, n1, n2,
+                1 if o.contact_model == "weber" else 0, self.hertz_linear, bool(o.coupling),
+                float(load), float(o.tolerance), int(o.max_iterations))
 
     def harris_map(self, loads) -> "HarrisMap":
         """Transmission error peak-to-peak and mean stiffness at each load [N]."""
@@ -412,6 +415,28 @@ class LtcaResult:
     def unloaded_te(self) -> np.ndarray:
         """Transmission error at vanishing load (geometric, from the separations) [m]."""
         return self.model.unloaded_te
+
+    def gaps(self) -> np.ndarray:
+        """(M, H, K, N) separation left under load at every potential contact point [m]
+        (0 where loaded, >= 0 elsewhere; NaN off the active path): the contact condition,
+        evaluated independently of the solver from the compliance and the loads."""
+        cm = self.model
+        args = cm._kernel_args(self.load)
+        (zone, frac, kb1, kb2, g1, g2, loc, w, radius, d1, d2, db, length, c1, c2, nu1, nu2,
+         model, lin, coupling) = args[:20]
+        out = np.full(zone.shape, np.nan)
+        for m in range(zone.shape[0]):
+            C, where, wv, R, D1, D2, Ln = _kernels.position_system(
+                zone, frac, kb1, kb2, g1, g2, loc, w, radius, d1, d2, db, length, coupling, m)
+            p = np.array([self.slice_load[m][t] for t in where])
+            if model == 1:
+                delta = _kernels.contact_deflection_twin(p / Ln, R, D1, D2, c1, c2, nu1, nu2)
+            else:
+                delta = lin * p / Ln
+            gap = C @ p + delta + wv - self.transmission_error[m]
+            for i, t in enumerate(where):
+                out[m][t] = gap[i]
+        return out
 
     def summary(self) -> dict:
         """Scalars of the result (SI and arc seconds) for tables and JSON."""
