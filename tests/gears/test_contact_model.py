@@ -163,8 +163,10 @@ def test_assembled_mesh_reproduces_the_loaded_transmission_error():
         approach = sol.deformations[:, i] + e
         force = kin.meshes["m"].force
         np.testing.assert_allclose(sol.element_forces[:, i], force, rtol=1e-6)
-        # 32 positions: 16 harmonics, the error series passes through every sample
-        np.testing.assert_allclose(approach, tab.te, rtol=0, atol=1e-6 * tab.te.mean())
+        # the error series reproduces the samples to what the coupling reports (16
+        # harmonics of 32 samples: all of them here)
+        tol = tab.summary["error_series_residual_m"] + 1e-9 * tab.te.mean()
+        np.testing.assert_allclose(approach, tab.te, rtol=0, atol=tol)
         if form == "secant":
             assert hi == lo  # no error excitation
 

@@ -209,10 +209,11 @@ def mesh_errors(model: Model, kin: Kinematics, mesh_name: str):
             total = total + gerr.cumulative_pitch_error(ge.pitch, 0.0, abs(w), alpha)
     if mesh.stiffness.method == "ltca":
         # loaded transmission-error excitation of the LTCA (gears/contact/coupling.py)
-        from ..gears.contact.coupling import error_harmonics, mesh_ltca
+        from ..gears.contact.coupling import mesh_ltca, error_harmonics
 
         tab = mesh_ltca(model, kin, mesh_name, model.analysis.table_points)
-        c0, harm = error_harmonics(tab.error, mk.frequency, mesh_phases(model, kin)[mesh_name])
+        c0, harm = error_harmonics(tab.error, mk.frequency, mesh_phases(model, kin)[mesh_name],
+                                   int(tab.summary.get("error_harmonics", 16)))
         if harm:
             amp, om, ph = zip(*harm)
             total = total + gerr.LineOfActionError(c0, list(amp), list(om), list(ph))

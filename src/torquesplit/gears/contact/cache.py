@@ -21,7 +21,7 @@ import numpy as np
 __all__ = ["CACHE_VERSION", "cache_dir", "cache_key", "load", "store"]
 
 #: bump when the LTCA model changes
-CACHE_VERSION = 1
+CACHE_VERSION = 3
 
 
 def cache_dir() -> Path:

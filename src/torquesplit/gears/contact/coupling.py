@@ -18,7 +18,12 @@ load (the nominal normal force of the power flow, or ``stiffness.ltca.load``):
 
 The stiffness and impact force are tables over ``n`` uniform phases; the error is
 passed as its Fourier series in the mesh phase (sinusoids at multiples of the mesh
-frequency, with the mesh's phase), so that the kernel also gets its rate ``e'``.
+frequency, with the mesh's phase), so that the kernel also gets its rate ``e'``; the
+series keeps the fewest harmonics, up to mesh order 16, that reproduce the LTCA samples
+to 5 % of their peak-to-peak or 10 nm (each harmonic costs a sine per step); what the
+cut leaves out is ``summary["error_series_residual_m"]``.  The tangent stiffness changes
+in steps where a slice joins or leaves the contact, so ``e`` of a modified pair has
+content beyond order 16.
 
 Not done here (the kernel's): a stiffness table over load interpolated by the
 instantaneous mesh force.
@@ -49,10 +54,13 @@ from torquesplit.gears.stiffness.result import periodic_resample
 __all__ = ["MeshLtca", "pair_for_mesh", "contact_model_for_mesh", "mesh_ltca",
            "error_harmonics", "MAX_ERROR_HARMONICS"]
 
-#: Fourier harmonics of the transmission-error excitation passed to the mesh element (each
-#: costs one sine per mesh per right-hand-side evaluation); 32 reproduce the 64 default
-#: positions exactly
-MAX_ERROR_HARMONICS = 32
+#: Fourier harmonics of the transmission-error excitation passed to the mesh element at
+#: most: mesh orders 1..16 (each costs one sine per mesh per right-hand-side evaluation)
+MAX_ERROR_HARMONICS = 16
+#: the series is cut at the fewest harmonics that reproduce the LTCA samples to this
+#: fraction of their peak-to-peak, or to SERIES_FLOOR, whichever is larger
+SERIES_TOLERANCE = 0.05
+SERIES_FLOOR = 1e-8  # m
 
 _MEMO: dict[str, "MeshLtca"] = {}
 
@@ -193,9 +201,10 @@ def mesh_ltca(model, kin, mesh_name: str, n: int) -> MeshLtca:
         err = np.zeros_like(k)
     table = periodic_resample(phase, k, n)
     summary = {k_: v for k_, v in res.summary().items()}
+    n_harm = harmonics_needed(err)
     summary.update(excitation=spec.ltca.excitation, gears=list(names), reverse=reverse,
-                   error_peak_to_peak_m=float(np.ptp(err)),
-                   error_series_residual_m=series_residual(err))
+                   error_peak_to_peak_m=float(np.ptp(err)), error_harmonics=n_harm,
+                   error_series_residual_m=series_residual(err, n_harm))
     impact = None
     if mesh.impact:
         if reverse:
@@ -221,6 +230,19 @@ def mesh_ltca(model, kin, mesh_name: str, n: int) -> MeshLtca:
     return out
 
 
+def harmonics_needed(error, rel_tol: float = SERIES_TOLERANCE,
+                     harmonics: int = MAX_ERROR_HARMONICS, floor: float = SERIES_FLOOR) -> int:
+    """Fewest harmonics (at most ``harmonics``) whose series of :func:`error_harmonics`
+    reproduces the samples to ``rel_tol`` times their peak-to-peak or to ``floor`` [m]."""
+    e = np.asarray(error, dtype=float)
+    top = min(harmonics, e.size // 2)
+    limit = max(rel_tol * float(np.ptp(e)), floor)
+    for h in range(0, top + 1):
+        if series_residual(e, h) <= limit:
+            return h
+    return top
+
+
 def error_harmonics(error, frequency: float, phase0: float,
                     harmonics: int = MAX_ERROR_HARMONICS) -> tuple[float, list[tuple[float, float, float]]]:
     """Constant and sinusoids ``(amplitude, omega, phase)`` of an error given at ``M``
@@ -230,7 +252,7 @@ def error_harmonics(error, frequency: float, phase0: float,
 
     Harmonics 1 .. min(harmonics, M/2) (the Nyquist one of an even M included, with its
     single weight): with ``M / 2 <= harmonics`` the series passes exactly through the
-    samples.
+    samples.  :func:`harmonics_needed` gives the fewest that reproduce them to a tolerance.
     """
     e = np.asarray(error, dtype=float)
     m = e.size
