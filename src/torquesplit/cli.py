@@ -479,6 +479,61 @@ def _contact_load(text, model, kin, pair, names, on, cm, parse_quantity) -> floa
                            f"or '17500 N m'")
 
 
+# --------------------------------------------------------------------------- optimize
+@app.command()
+def optimize(
+    spec: str = typer.Argument(..., help="Optimisation file (.toml), or the name of a shipped "
+                               "one (seed000_dh_modification)."),
+    out: Optional[Path] = typer.Option(None, "--out", help="Folder for pareto.csv, pareto.png "
+                                       "and chosen.toml (default: next to the file)."),
+    workers: Optional[int] = typer.Option(None, "--workers", help="Processes (overrides the file)."),
+    generations: Optional[int] = typer.Option(None, "--generations", help="Generations."),
+    population: Optional[int] = typer.Option(None, "--population", help="Population size."),
+    seed: Optional[int] = typer.Option(None, "--seed", help="Random seed."),
+    as_json: bool = typer.Option(False, "--json", help="Print the Pareto front as JSON."),
+):
+    """Optimise model parameters (NSGA-II or any pymoo algorithm) on LTCA or dynamic outputs;
+    evaluations are stored as they finish, so an interrupted run resumes."""
+    from .optimize import optimize as run_optimization
+
+    path = Path(spec)
+    if not path.exists():
+        from importlib import resources
+
+        shipped = Path(str(resources.files("torquesplit.examples") / "optimize" / f"{spec}.toml"))
+        if shipped.exists():
+            path = shipped
+    try:
+        res = _with_progress(lambda cb: run_optimization(
+            path, workers=workers, generations=generations, population=population, seed=seed,
+            progress=None if cb is None else (lambda g, n: cb(g / max(n + 1, 1)))),
+            as_json)
+        target = out or (Path.cwd() / f"{path.stem}_results")
+        files = res.write(target)
+    except (TorquesplitError, ValueError) as exc:
+        _fail(exc)
+        return
+    names = [v.path for v in res.spec.variables]
+    objs = [o.output for o in res.spec.objectives]
+    if as_json:
+        print(json.dumps({"pareto": [{"x": dict(zip(names, map(float, x))),
+                                      "objectives": dict(zip(objs, map(float, f)))}
+                                     for x, f in zip(res.X, res.F)],
+                          "chosen": int(res.chosen), "baseline": res.baseline,
+                          "evaluations": res.evaluations, "computed": res.computed,
+                          "files": [str(f) for f in files]}, indent=2, default=_json_default))
+        return
+    t = Table(title=f"Pareto front ({res.spec.algorithm}, {res.evaluations} evaluations, "
+                    f"{res.computed} computed)")
+    for col in ("", *[n.split(".")[-1] for n in names], *objs):
+        t.add_column(col, justify="right")
+    for i, (x, f) in enumerate(zip(res.X, res.F)):
+        t.add_row("*" if i == res.chosen else "", *[f"{v:.4g}" for v in x], *[f"{v:.4g}" for v in f])
+    console.print(t)
+    console.print(f"chosen design (*) written to {target / 'chosen.toml'}; front in "
+                  f"{target / 'pareto.csv'}")
+
+
 # --------------------------------------------------------------------------- modes
 @app.command()
 def modes(

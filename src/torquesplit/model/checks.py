@@ -288,7 +288,7 @@ def plausibility_warnings(model: Model, kin) -> list[tuple[str, str]]:
                         "this gear uses it; set stiffness.method = 'ltca' on its meshes or remove "
                         "the modifications"))
     for name, m in model.meshes.items():
-        if m.stiffness.method != "ltca" and m.misalignment.model_fields_set:
+        if m.stiffness.method != "ltca" and m.misalignment != type(m.misalignment)():
             out.append((f"meshes.{name}.misalignment",
                         "only the stiffness method 'ltca' uses the misalignment; set "
                         "stiffness.method = 'ltca' or remove it"))

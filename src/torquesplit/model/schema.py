@@ -368,7 +368,7 @@ class StiffnessSpec(Strict):
         if m == "fourier" and self.mean is None:
             raise FieldError("mean", "method 'fourier' needs the mean stiffness; add "
                              "mean = '4e8 N/m' (your value)")
-        if m != "ltca" and "ltca" in self.model_fields_set:
+        if m != "ltca" and self.ltca != LtcaSpec():
             raise FieldError("ltca", f"applies to method 'ltca' only, the method is {m!r}; set "
                              "method = 'ltca' or remove the ltca table")
         return self

@@ -61,7 +61,7 @@ class ReliefSpec(Strict):
         if len(given) != 1:
             raise ValueError(f"give exactly one of length, start_diameter, start_roll_angle, "
                              f"height (got {', '.join(given) or 'none'}); remove the others")
-        if "exponent" in self.model_fields_set and self.shape != "power":
+        if self.exponent != 2.0 and self.shape != "power":
             raise FieldError("exponent", "applies to shape = 'power' only; set shape = 'power' "
                              "or remove 'exponent'")
         return self
@@ -77,7 +77,7 @@ class EndReliefSpec(Strict):
 
     @model_validator(mode="after")
     def _exponent(self):
-        if "exponent" in self.model_fields_set and self.shape != "power":
+        if self.exponent != 2.0 and self.shape != "power":
             raise FieldError("exponent", "applies to shape = 'power' only; set shape = 'power' "
                              "or remove 'exponent'")
         return self
