@@ -327,6 +327,23 @@ def markdown(res: dict) -> str:
                  f"{dyn['secant/unmodified']['groups']['left/spur_split']['dynamic_factor']:.1f} with "
                  "impact; docs/validation.md, seed 000) and barely changes.  Wall times: "
                  + ", ".join(f"{k} {v['wall_time_s']:.1f} s" for k, v in dyn.items()) + ".\n")
+    nsga = res.get("nsga")
+    if nsga:
+        f_paper = mo["te_peak_to_peak_arcsec"] / un["te_peak_to_peak_arcsec"]
+        L.append("## 5. NSGA-II on the paper's objective\n")
+        L.append("`torquesplit optimize seed000_dh_modification` (the shipped optimisation file: "
+                 "y1..y6 of the four pinions, eq. 23 objectives F1 = SLTE amplitude / unmodified, "
+                 "F2 = impact / unmodified, assumed bounds, population 40 x 50 generations, seed 1, "
+                 "our LTCA of mesh L68 at 64 x 40 x 2): "
+                 f"{nsga['computed']} designs in {nsga['nsga2_s']:.0f} s on 2 workers (from "
+                 "benchmarks/LTCA_RESULTS.json).  The paper's design, as our LTCA evaluates it: "
+                 f"F = ({f_paper:.2f}, {mo['impact_N'] / un['impact_N']:.2f}).  NSGA-II's chosen "
+                 f"design: F = ({nsga['best_F'][0]:.3f}, {nsga['best_F'][1]:.3f}) "
+                 f"({nsga['pareto_size']} design(s) on the front) -- at least as good on both "
+                 "objectives; in our model a modification can remove the impact and still lower "
+                 "the already small transmission-error amplitude.  Tested on a coarse grid in "
+                 "`tests/test_optimize.py` (dominates the paper's design, same result twice with "
+                 "one seed, resumes from its store).\n")
     L.append("## Not done\n")
     L.append("* A stiffness table over load interpolated by the instantaneous mesh force in the "
              "kernel (the numerical core's; the LTCA gives tables at the operating load).\n"
@@ -344,9 +361,16 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     if args.markdown_only:
         res = json.loads(JSON_OUT.read_text())
+        bench = ROOT / "benchmarks" / "LTCA_RESULTS.json"
+        if bench.exists() and "nsga" in json.loads(bench.read_text()):
+            res["nsga"] = json.loads(bench.read_text())["nsga"]
+            JSON_OUT.write_text(json.dumps(res, indent=1))
     else:
         t0 = time.perf_counter()
         res = {"light_load": light_load(), "liu2021": liu_static()}
+        bench = ROOT / "benchmarks" / "LTCA_RESULTS.json"
+        if bench.exists() and "nsga" in json.loads(bench.read_text()):
+            res["nsga"] = json.loads(bench.read_text())["nsga"]
         print(f"static part {time.perf_counter() - t0:.1f} s", file=sys.stderr)
         if not args.no_dynamics:
             res["dynamics"] = dynamics(args.cycles)

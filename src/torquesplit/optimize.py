@@ -5,9 +5,10 @@
 
 Self-contained: the evaluations run in a local process pool of this module, not through
 the study runner (which is being written apart); they are stored in a JSON-lines file
-as they finish, keyed by the variable values, so that an interrupted optimisation run
-again with the same file and seed recomputes nothing it has already evaluated (pymoo
-with a fixed seed proposes the same designs again).
+as they finish (``OPT.evaluations.jsonl`` in the current folder, or ``store = "..."``
+relative to the optimisation file), keyed by the variable values, so that an
+interrupted optimisation run again with the same file and seed recomputes nothing it has
+already evaluated (pymoo with a fixed seed proposes the same designs again).
 
 The optimisation file (TOML)::
 
@@ -19,6 +20,7 @@ The optimisation file (TOML)::
     seed = 1
     workers = 2                      # processes; 1 = in this process
     choose = "min_sum"               # design written back: least sum of the objectives
+    # store = "runs/evals.jsonl"     # where evaluations are kept (default: current folder)
 
     [set]                            # fixed overrides of the model (as --set PATH=VALUE)
     "meshes.L68.stiffness" = {method = "ltca"}
@@ -192,7 +194,7 @@ def read_spec(source) -> OptimizationSpec:
         issues.append(("optimization.population", "population >= 4, generations >= 1 and "
                                                   "workers >= 1 are needed; correct them"))
     if kw["choose"] not in ("min_sum", "knee"):
-        issues.append(("optimization.choose", "use 'min_sum' or 'knee'"))
+        issues.append(("optimization.choose", f"unknown choice {kw['choose']!r}; use 'min_sum' or 'knee'"))
     variables = []
     for i, v in enumerate(data.get("variables", [])):
         where = f"variables[{i}]"
@@ -226,9 +228,10 @@ def read_spec(source) -> OptimizationSpec:
                 issues.append((f"{where}.output", f"{o['output']!r} is not an output; write "
                                                   "ltca.MESH.KEY or dynamic.GROUP.KEY"))
             if o.get("relative_to") not in (None, "baseline"):
-                issues.append((f"{where}.relative_to", "use 'baseline' or leave it out"))
+                issues.append((f"{where}.relative_to", "must be 'baseline'; write relative_to = 'baseline' "
+                                                      "or remove it"))
             if o.get("sense", "min") not in ("min", "max"):
-                issues.append((f"{where}.sense", "use 'min' or 'max'"))
+                issues.append((f"{where}.sense", "must be 'min' or 'max'; use one of them"))
             out.append(Output(str(o["output"]), o.get("relative_to"), o.get("sense", "min"),
                               None if o.get("lower") is None else _si(o["lower"], f"{where}.lower"),
                               None if o.get("upper") is None else _si(o["upper"], f"{where}.upper")))
@@ -239,16 +242,20 @@ def read_spec(source) -> OptimizationSpec:
         issues.append(("objectives", "no objectives; add [[objectives]] with an output"))
     for i, c in enumerate(constraints):
         if c.lower is None and c.upper is None:
-            issues.append((f"constraints[{i}]", "needs lower or upper; add a bound"))
+            issues.append((f"constraints[{i}]", "has no bound; add lower or upper"))
     if issues:
         raise ModelError(issues, name)
     store = kw.pop("store")
-    if store is None and not isinstance(source, dict):
-        store = str(Path(source).with_suffix(".evaluations.jsonl").name)
+    if store is not None:
+        store_path = base / store          # relative to the optimisation file
+    elif not isinstance(source, dict):     # default: in the current folder
+        store_path = Path.cwd() / Path(source).with_suffix(".evaluations.jsonl").name
+    else:
+        store_path = None
     return OptimizationSpec(model_data=model_data, model_source=str(mpath),
                             fixed=dict(data.get("set", {})), variables=tuple(variables),
                             objectives=tuple(objectives), constraints=tuple(constraints),
-                            store=None if store is None else base / store, base_dir=base, **kw)
+                            store=store_path, base_dir=base, **kw)
 
 
 # ========================================================================= evaluation

@@ -603,7 +603,8 @@ def ltca_solve_twin(zone, frac, kb1, kb2, g1, g2, loc, w, radius, depth1, depth2
                     p = p_hat
                     d = Hm @ p + wv - Z
                     cand = np.flatnonzero(~act)
-                    if cand.size == 0 or d[cand].min() >= -1e-12 * (P * np.mean(np.diag(Hm)) + abs(wv.min())):
+                    tol_d = 1e-12 * (P * np.mean(np.diag(Hm)) + abs(wv.min()))
+                    if cand.size == 0 or d[cand].min() >= -tol_d:
                         break
                     act[cand[np.argmin(d[cand])]] = True
                 else:

@@ -421,18 +421,6 @@ def check_modification(mod: ToothModification, pair, gear: int, where: str) -> N
         lead_separation(flank, np.linspace(0, pair.face_width, 5), pair.face_width, loc)
 
 
-def with_amounts_scaled(mod: FlankModification, factor: float) -> FlankModification:
-    """The same modification with every amount multiplied by ``factor`` (for studies)."""
-    return replace(
-        mod,
-        tip_relief=None if mod.tip_relief is None else replace(mod.tip_relief, amount=mod.tip_relief.amount * factor),
-        root_relief=None if mod.root_relief is None else replace(mod.root_relief, amount=mod.root_relief.amount * factor),
-        crowning=mod.crowning * factor,
-        end_relief=None if mod.end_relief is None else replace(mod.end_relief, amount=mod.end_relief.amount * factor),
-        helix_slope=mod.helix_slope * factor,
-    )
-
-
 # ------------------------------------------------------------------ from the model file
 def _relief_from_spec(spec) -> Relief | None:
     if spec is None:
@@ -465,7 +453,8 @@ def flank_from_spec(spec, face_width: float, where: str = "modifications") -> Fl
     return mod
 
 
-def modification_from_spec(spec, face_width: float, where: str = "modifications") -> ToothModification | None:
+def modification_from_spec(spec, face_width: float,
+                           where: str = "modifications") -> ToothModification | None:
     """A :class:`ToothModification` from a gear's ``modifications`` section (or None)."""
     if spec is None:
         return None
