@@ -198,7 +198,7 @@ def run(
                 try:
                     dur = parse_quantity(duration, "time")
                 except ValueError as exc:
-                    raise OptionError(f"--duration {exc}") from None
+                    raise OptionError(f"--duration: {exc}") from None
                 _positive(dur, "--duration", "'0.5 s'")
             _at_least(cycles, 1, "--cycles", "200")
             _at_least(steps_per_period, 10, "--steps-per-period", "100")

@@ -77,11 +77,12 @@ def check_model(model: Model, source: str | None = None, *, deep: bool = False) 
         raise ModelError(exc.issues, source) from None
     issues = nominal_load_issues(model, kin) + balance_issues(model, kin)
     issues += stiffness_table_issues(model, kin)
+    notes = []
     if not issues and deep:
-        issues = readiness_issues(model, kin)
+        issues, notes = _readiness(model, kin)
     if issues:
         raise ModelError(issues, source)
-    for loc, msg in plausibility_warnings(model, kin):
+    for loc, msg in plausibility_warnings(model, kin) + notes:
         warnings.warn(f"{source + ': ' if source else ''}{loc}: {msg}", ModelWarning, stacklevel=3)
 
 
@@ -532,9 +533,16 @@ def readiness_issues(model: Model, kin=None) -> list[tuple[str, str]]:
     equations of motion (every stiffness table, support and spline) and the static
     equilibrium it starts from.  Their refusals come back as (location, message).
 
-    A model that passes is refused by ``run`` for a numerical reason only (the step,
-    the cost, a diverging integration), never for a modelling one.
+    A static deflection beyond what the integrator accepts (its ``blowup``) is refused
+    too: every run of such a model diverges at its first step.  A model that passes is
+    refused by ``run`` for a numerical reason only (the step, the cost, a diverging
+    integration), never for a modelling one.
     """
+    return _readiness(model, kin)[0]
+
+
+def _readiness(model: Model, kin=None) -> tuple[list, list]:
+    """(issues, warnings) of :func:`readiness_issues`."""
     from ..assembly.assemble import assemble
     from ..solve.static import static_equilibrium
     from .kinematics import solve_kinematics
@@ -544,23 +552,51 @@ def readiness_issues(model: Model, kin=None) -> list[tuple[str, str]]:
         with np.errstate(all="ignore"):
             structure = assemble(model, kin)
     except ModelError as exc:
-        return [(loc, _teach(msg)) for loc, msg in exc.issues] or [("", "cannot be assembled; "
-                                                                    "check the model")]
+        return [(loc, _teach(msg)) for loc, msg in exc.issues] or [
+            ("", "cannot be assembled; check the model")], []
     except (ValueError, ArithmeticError) as exc:
-        return [_located(str(exc), "the equations of motion cannot be assembled")]
+        return [_located(str(exc), "the equations of motion cannot be assembled")], []
     try:
         with np.errstate(all="ignore"):
             static = static_equilibrium(structure)
     except SolverError as exc:
         loc, msg = _located(str(exc), "the static equilibrium that starts every run fails")
-        return [(loc or "loads", msg)]
+        return [(loc or "loads", msg)], []
     except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:
-        return [_located(str(exc), "the static equilibrium that starts every run fails")]
-    if not np.all(np.isfinite(static.q)):
+        return [_located(str(exc), "the static equilibrium that starts every run fails")], []
+    q = np.asarray(static.q, dtype=float)
+    if not np.all(np.isfinite(q)):
         return [("", "the static equilibrium that starts every run has no finite solution; "
                      "check the clearances and the supports (a body free to move inside its "
-                     "clearance needs a support or a spring)")]
-    return []
+                     "clearance needs a support or a spring)")], []
+    if q.size == 0:
+        return [], []
+    names = structure.dof_names
+    j = int(np.argmax(np.abs(q)))
+    body, _, dof = names[j].rpartition(".")
+    loc = f"{'gears' if body in model.gears else 'bodies'}.{body}"
+    unit = "rad" if dof == "theta" else "m"
+    blowup = _integrator_blowup()
+    if abs(q[j]) > blowup:
+        return [(loc, f"the static equilibrium that starts every run displaces "
+                      f"'{names[j]}' by {abs(q[j]):.3g} {unit}, beyond what any run "
+                      f"accepts ({blowup:g}): a stiffness is far too small for the load; "
+                      f"check the stiffness values and their units (shafts, supports, "
+                      f"meshes)")], []
+    return [], []
+
+
+def _integrator_blowup() -> float:
+    """The displacement at which the integrator stops a run (its ``blowup`` default)."""
+    import inspect
+
+    from ..solve.integrate import integrate
+
+    default = inspect.signature(integrate).parameters.get("blowup")
+    try:
+        return float(default.default)
+    except (AttributeError, TypeError, ValueError):  # pragma: no cover - signature changed
+        return 1e3
 
 
 _LOCATED = re.compile(r"^((?:gears|bodies|shafts|meshes|splines|drives|loads|analysis)"

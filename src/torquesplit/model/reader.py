@@ -44,7 +44,8 @@ _BOMS = {
 }
 
 #: tokens that matter for nesting: brackets, string delimiters, comments, line ends
-_TOML_TOKENS = re.compile(r'"""|\'\'\'|["\'#\[\]{}\n\\]')
+_TOML_TOKENS = re.compile(r'"""|\'\'\'|["\'#\[\]{}\n\\.=,]')
+_QUOTES = ('"', "'", '"""', "'''")
 _JSON_TOKENS = re.compile(r'["\[\]{}\n\\]')
 
 
@@ -179,7 +180,9 @@ def check_nesting(text: str, fmt: str = "toml", source: str | None = None,
     """Refuse brackets (arrays, inline tables) nested more than ``limit`` deep.
 
     A linear scan that skips strings and comments, stopping at the first level too
-    deep, so it takes microseconds for a model file and cannot recurse.
+    deep, so it takes microseconds for a model file and cannot recurse.  TOML dotted
+    keys (``a.b.c = 1``, one table per part) with more than ``limit`` parts are refused
+    too: the parser takes seconds to build thousands of levels.
 
     Examples
     --------
@@ -189,19 +192,22 @@ def check_nesting(text: str, fmt: str = "toml", source: str | None = None,
     ...
     torquesplit.errors.ModelError: line 1: brackets are nested more than 2 deep; a model file needs a few levels: check for unclosed or repeated '[' and '{'
     """
-    if text.count("[") + text.count("{") <= limit:
+    if text.count("[") + text.count("{") <= limit and text.count(".") <= limit:
         return
     tokens = _JSON_TOKENS if fmt == "json" else _TOML_TOKENS
-    depth = 0
+    opened = []  # the brackets open at this point
     line = 1
     string = None  # the delimiter of the string we are in
     comment = False
     escaped_at = -1
+    in_key = True  # TOML: from the start of a line (or '{', ',' in a table) to '='
+    dots = 0  # dots of the current dotted key: each part is one more level of tables
     for m in tokens.finditer(text):
         tok = m.group()
         if tok == "\n":
             line += 1
             comment = False
+            in_key, dots = True, 0
             if string in ('"', "'"):
                 string = None  # single-line strings end at the line (the parser says more)
             continue
@@ -217,16 +223,27 @@ def check_nesting(text: str, fmt: str = "toml", source: str | None = None,
             continue
         if tok == "#":
             comment = True
-        elif tok in ('"', "'", '"""', "'''"):
+        elif tok in _QUOTES:
             string = tok
+        elif tok == "=":
+            in_key, dots = False, 0
+        elif tok == ",":
+            in_key, dots = bool(opened) and opened[-1] == "{", 0
+        elif tok == ".":
+            dots += in_key
+            if dots > limit:
+                raise ModelError([(f"line {line}", (
+                    f"a dotted key has more than {limit} parts; a model file needs a few "
+                    f"levels: check the key (section.name.field)"))], source)
         elif tok in "[{":
-            depth += 1
-            if depth > limit:
+            opened.append(tok)
+            in_key = in_key or tok == "{"
+            if len(opened) > limit:
                 raise ModelError([(f"line {line}", (
                     f"brackets are nested more than {limit} deep; a model file needs a few "
                     f"levels: check for unclosed or repeated '[' and '{{'"))], source)
-        elif tok in "]}":
-            depth = max(depth - 1, 0)
+        elif tok in "]}" and opened:
+            opened.pop()
 
 
 def check_data_depth(data, source: str | None = None, limit: int = MAX_DEPTH) -> None:

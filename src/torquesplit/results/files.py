@@ -135,6 +135,10 @@ def check_output(path, *, formats: dict[str, str] | None = None, overwrite: bool
     formats = RESULT_FORMATS if formats is None else formats
     path = Path(os.path.expanduser(str(path)))
     suffix = path.suffix.lower()
+    if path.is_dir():
+        example = path / ("results" + next(iter(formats)))
+        raise OutputError(f"{clip_text(str(path))} is a folder; give a file name in it, e.g. "
+                          f"{clip_text(str(example))}")
     if suffix not in formats:
         known = sorted(set(formats), key=list(formats).index)
         listed = (", ".join(known[:-1]) + " or " + known[-1]) if len(known) > 1 else known[0]
@@ -145,9 +149,6 @@ def check_output(path, *, formats: dict[str, str] | None = None, overwrite: bool
         raise OutputFormatError(f"cannot save {what} as {clip_text(path.name)!r}; use a "
                                 f"{listed} file")
     parent = path.parent
-    if path.is_dir():
-        raise OutputError(f"{clip_text(str(path))} is a folder; give a file name in it, e.g. "
-                          f"{clip_text(str(path / ('results' + suffix)))}")
     if not parent.exists():
         raise OutputError(f"cannot write {clip_text(str(path))}: the folder "
                           f"{clip_text(str(parent))} does not exist; create it first or "
