@@ -255,10 +255,13 @@ def _check_definition(definition: Optional[str]) -> None:
 def _likely_cause(res) -> Optional[str]:
     """Why a run that stopped early most likely stopped, from its static equilibrium.
 
-    A static deflection of radians or centimetres means a stiffness far too small for
-    the load (often a unit); the integrator's advice (a smaller step) does not help then.
+    A static deflection of a tenth of the integrator's limit (``blowup``, 1000 m or rad)
+    means a stiffness far too small for the load (often a unit): the vibration about it
+    crosses the limit, and the integrator's advice (a smaller step) does not help.
     """
     import numpy as np
+
+    from .model.checks import integrator_blowup
 
     q = np.asarray(res.static.q, dtype=float)
     names = list(res.structure.dof_names)
@@ -267,15 +270,12 @@ def _likely_cause(res) -> Optional[str]:
     if not np.all(np.isfinite(q)):
         return ("the static equilibrium is not finite: a stiffness or an inertia of extreme "
                 "size (see the warnings of 'torquesplit check'); check the values and units")
-    rot = [i for i, n in enumerate(names) if n.endswith(".theta")]
-    tra = [i for i, n in enumerate(names) if not n.endswith(".theta")]
-    for idx, limit, unit in ((rot, 1.0, "rad"), (tra, 0.01, "m")):
-        if idx:
-            j = max(idx, key=lambda i: abs(q[i]))
-            if abs(q[j]) > limit:
-                return (f"the static deflection of '{names[j]}' is {abs(q[j]):.3g} {unit}: a "
-                        f"stiffness is far too small for the load; check the stiffness values "
-                        f"and their units (shafts, supports, meshes), not the step")
+    j = int(np.argmax(np.abs(q)))
+    if abs(q[j]) >= 0.1 * integrator_blowup():
+        unit = "rad" if names[j].endswith(".theta") else "m"
+        return (f"the static deflection of '{names[j]}' is {abs(q[j]):.3g} {unit}: a "
+                f"stiffness is far too small for the load; check the stiffness values and "
+                f"their units (shafts, supports, meshes), not the step")
     return None
 
 

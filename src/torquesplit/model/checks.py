@@ -576,7 +576,7 @@ def _readiness(model: Model, kin=None) -> tuple[list, list]:
     body, _, dof = names[j].rpartition(".")
     loc = f"{'gears' if body in model.gears else 'bodies'}.{body}"
     unit = "rad" if dof == "theta" else "m"
-    blowup = _integrator_blowup()
+    blowup = integrator_blowup()
     if abs(q[j]) > blowup:
         return [(loc, f"the static equilibrium that starts every run displaces "
                       f"'{names[j]}' by {abs(q[j]):.3g} {unit}, beyond what any run "
@@ -586,8 +586,9 @@ def _readiness(model: Model, kin=None) -> tuple[list, list]:
     return [], []
 
 
-def _integrator_blowup() -> float:
-    """The displacement at which the integrator stops a run (its ``blowup`` default)."""
+def integrator_blowup() -> float:
+    """The displacement at which the integrator stops a run (its ``blowup`` default; also
+    used by the CLI to name the likely cause of a run that stopped)."""
     import inspect
 
     from ..solve.integrate import integrate
