@@ -8,8 +8,10 @@ Each mutant of ``tests/fuzz_corpus.py`` (deterministic: mutant i is always the s
 is written to a temporary file and checked by the real CLI (in-process, in a worker
 process with a memory limit).  A mutant that takes longer than ``--timeout`` seconds
 is a hang: its worker is killed and replaced.  With ``--run``, every accepted mutant
-is also run briefly (two periods of its fastest mesh), and any refusal other than a
-:class:`~torquesplit.errors.SolverError` is counted as a failure of ``check``.
+is also run briefly (two periods of its fastest mesh, ``--run-timeout`` seconds at
+most), and any refusal other than a :class:`~torquesplit.errors.SolverError` is counted
+as a failure of ``check``; a slow run is counted apart (its cost is the step the
+stability check chooses, not a failure of ``check``).
 
 Prints the counts by outcome (``ok``, ``error`` = clean one-line errors with exit 2,
 and every kind of failure) and the first examples of each failure; exits 1 if any
@@ -67,12 +69,16 @@ def _worker(memory_gib: float) -> None:  # pragma: no cover - runs in a subproce
         except MemoryError:
             verdict, stderr = "memory", "MemoryError"
         seconds = time.perf_counter() - t0
-        run = None
-        if do_run and verdict == "ok":
-            run = _short_run(path)
+        will_run = bool(do_run and verdict == "ok")
         out.write(json.dumps({"index": index, "desc": desc, "verdict": verdict,
-                              "stderr": stderr[:400], "seconds": seconds, "run": run}) + "\n")
+                              "stderr": stderr[:400], "seconds": seconds, "run": None,
+                              "more": will_run}) + "\n")
         out.flush()
+        if will_run:
+            t0 = time.perf_counter()
+            run = _short_run(path)
+            out.write(json.dumps({"run": run, "run_seconds": time.perf_counter() - t0}) + "\n")
+            out.flush()
 
 
 def _short_run(path: Path) -> str:  # pragma: no cover - runs in a subprocess
@@ -110,9 +116,11 @@ class _Worker:
             env=env, text=True, bufsize=1)
         self.index = None
         self.since = 0.0
+        self.pending = None  # the check result of a mutant whose short run is going on
 
     def send(self, index):
         self.index = index
+        self.pending = None
         self.since = time.monotonic()
         self.proc.stdin.write(json.dumps([index, self.args.seed, self.args.run]) + "\n")
         self.proc.stdin.flush()
@@ -131,6 +139,8 @@ def main(argv=None) -> int:
     p.add_argument("--timeout", type=float, default=10.0, help="seconds per mutant")
     p.add_argument("--memory", type=float, default=3.0, help="GiB per worker")
     p.add_argument("--run", action="store_true", help="also run the accepted mutants")
+    p.add_argument("--run-timeout", type=float, default=60.0,
+                   help="seconds per short run (a slow run is reported, not a failure)")
     p.add_argument("--show", action="store_true", help="print each mutant's file and result")
     p.add_argument("--json", type=Path, help="write counts and failures here")
     p.add_argument("--src", help="torquesplit sources to test (default: this checkout)")
@@ -170,11 +180,27 @@ def main(argv=None) -> int:
                 w.kill()
                 w.start()
                 continue
-            results.append(json.loads(line))
-            w.index = None
+            result = json.loads(line)
+            if w.pending is not None:  # the short run of an accepted mutant
+                w.pending.update(run=result["run"], run_seconds=result["run_seconds"])
+                results.append(w.pending)
+                w.index = w.pending = None
+            elif result.pop("more"):
+                w.pending = result
+                w.since = time.monotonic()
+                busy[fd] = w
+            else:
+                results.append(result)
+                w.index = None
         now = time.monotonic()
         for fd, w in list(busy.items()):
-            if now - w.since > args.timeout:
+            if w.pending is not None and now - w.since > args.run_timeout:
+                del busy[fd]
+                w.pending["run"] = f"slow: more than {args.run_timeout:g} s"
+                results.append(w.pending)
+                w.kill()
+                w.start()
+            elif w.pending is None and now - w.since > args.timeout:
                 del busy[fd]
                 results.append({"index": w.index, "desc": "", "verdict": "hang",
                                 "stderr": "", "seconds": now - w.since, "run": None})
