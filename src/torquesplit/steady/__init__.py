@@ -1,0 +1,1 @@
+"""Periodic steady state, speed sweeps and resonance maps (placeholder map, see below)."""
