@@ -110,12 +110,15 @@ class SteadyState:
             else int(n)
         if N == len(ps.t):
             return ps.t, ps.forces, ps.deformations
-        hb = HarmonicBalance(self.problem, ps.harmonics, N)
+        every = int(math.ceil((2 * ps.harmonics + 2) / N))  # enough samples for the series
+        hb = HarmonicBalance(self.problem, ps.harmonics, N * every)
         x = ps.coefficients
         q, v, _ = hb.waveforms(x, ps.speed)
         _, lam = hb.split(x)
         t = hb.times(ps.speed)
-        _, F, D = self.problem.accelerations(t, hb._states(q, v, lam), ps.speed)
+        Y = hb._states(q, v, lam)[::every]
+        t = t[::every]
+        _, F, D = self.problem.accelerations(t, Y, ps.speed)
         return t, F, D
 
     def to_results(self, periods: int | None = None):

@@ -139,9 +139,18 @@ def floquet_hill(hb: HarmonicBalance, x, speed=1.0, harmonics: int | None = None
     wgt = np.abs(vec.reshape(2 * Hh + 1, m, -1)) ** 2
     wgt = wgt.sum(axis=1)
     centre = (ks[:, None] * wgt).sum(axis=0) / wgt.sum(axis=0)
-    pick = np.argsort(np.abs(centre))[:m]
     period = 1.0 / (p.frequency * speed)
-    mu = np.exp(ev[pick] * period)
+    picked: list[complex] = []
+    # the most centred first; a copy shifted by i k omega (same multiplier) is skipped,
+    # which matters where exponents sit on the strip's edge (real negative multipliers)
+    for i in np.argsort(np.abs(centre)):
+        mu_i = np.exp(ev[i] * period)
+        if any(abs(mu_i - m0) <= 1e-7 * max(1.0, abs(m0)) for m0 in picked):
+            continue
+        picked.append(mu_i)
+        if len(picked) == m:
+            break
+    mu = np.array(picked)
     return mu[np.argsort(-np.abs(mu))]
 
 
@@ -172,6 +181,8 @@ def solve_shooting(p: PeriodicProblem, y0, steps: int, speed=1.0, tol=1e-9, max_
     while True:
         yT, Phi = p.integrate_variational(y, 0.0, T, steps, speed)
         d = Pr @ (yT - y)
+        dscale = max(float(np.max(np.abs(V @ y[:n]), initial=0.0)),
+                     float(np.max(np.abs(V @ yT[:n]), initial=0.0)), 1e-300)
         err = max(float(np.max(np.abs(V @ d[:n]), initial=0.0)),
                   float(np.max(np.abs(V @ d[n:]), initial=0.0)) / w) / dscale
         hist.append(err)

@@ -128,8 +128,15 @@ def excitation_sources(structure: Structure) -> list[ExcitationSource]:
 
 
 def _rational(x: float) -> Fraction | None:
-    fr = Fraction(x).limit_denominator(MAX_DENOMINATOR)
-    return fr if abs(float(fr) - x) <= RTOL * abs(x) else None
+    """The rational of smallest denominator (bounds 10, 100, ..., MAX_DENOMINATOR)
+    within RTOL of x, or None."""
+    bound = 10
+    while bound <= MAX_DENOMINATOR:
+        fr = Fraction(x).limit_denominator(bound)
+        if abs(float(fr) - x) <= RTOL * abs(x):
+            return fr
+        bound *= 10
+    return None
 
 
 def fundamental_period(structure: Structure, *, max_cycles: int | None = MAX_CYCLES

@@ -191,7 +191,7 @@ def periodic_solution(structure, period: Period, *, method: str = "hb", harmonic
         v = hb._states(q, v, lam)[:, p.n:]  # physical velocity (rigid speed offset included)
         if stability:
             m2 = 2 * p.n - (p.nr + int(np.sum(~p.rigid_damped)))
-            if stability == "hill" or (stability is True and m2 * (2 * H + 1) <= HILL_LIMIT):
+            if stability == "hill" or (stability is True and hill_applies(p, H, f)):
                 multipliers = floquet_hill(hb, x, speed, None if stability == "hill" else H)
                 stab_method = "hill"
         defect = math.nan
@@ -242,6 +242,17 @@ def periodic_solution(structure, period: Period, *, method: str = "hb", harmonic
         q=np.asarray(q), v=np.asarray(v), forces=np.asarray(F), deformations=np.asarray(D),
         rigid_load=np.asarray(lam, dtype=float), coefficients=coeffs,
         wall_time=time.perf_counter() - t_start)
+
+
+def hill_applies(p: PeriodicProblem, H: int, frequency: float) -> bool:
+    """Hill's method is used automatically when its matrix is small and its harmonics
+    reach beyond the highest natural frequency (else the truncation cannot hold the
+    fast modes and the monodromy is used)."""
+    from torquesplit.solve.stability import highest_mode
+
+    m2 = 2 * p.n - (p.nr + int(np.sum(~p.rigid_damped)))
+    f_hi, _ = highest_mode(p.structure)
+    return m2 * (2 * H + 1) <= HILL_LIMIT and H * frequency >= 1.5 * f_hi
 
 
 def _defect(p: PeriodicProblem, y0, yT) -> float:

@@ -29,7 +29,7 @@ import numpy as np
 from torquesplit.errors import SolverError
 from torquesplit.steady.harmonic import HarmonicBalance
 from torquesplit.steady.newton import floquet_hill, floquet_monodromy
-from torquesplit.steady.solution import HARMONICS_PER_CYCLE, HILL_LIMIT, _initial_hb
+from torquesplit.steady.solution import HARMONICS_PER_CYCLE, _initial_hb, hill_applies
 
 log = logging.getLogger(__name__)
 
@@ -155,8 +155,7 @@ class Continuation:
     def multipliers(self, x, s):
         hb = self.hb
         p = hb.p
-        m2 = 2 * p.n - (p.nr + int(np.sum(~p.rigid_damped)))
-        if m2 * (2 * hb.H + 1) <= HILL_LIMIT:
+        if hill_applies(p, hb.H, p.frequency * s):
             return floquet_hill(hb, x, s, hb.H)
         q, v, _ = hb.waveforms(x, s)
         _, lam = hb.split(x)
