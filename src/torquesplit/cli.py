@@ -718,11 +718,22 @@ def modes(
     model: str = typer.Argument(..., help="Model file (.toml/.json) or example name."),
     count: int = typer.Option(20, "--count", help="Number of modes to list."),
     as_json: bool = typer.Option(False, "--json", help="Print the modes as JSON."),
+    campbell: bool = typer.Option(False, "--campbell", help="Resonance map over --from..--to."),
+    start: Optional[str] = typer.Option(None, "--from", help="Campbell: first speed, e.g. '500 rpm'."),
+    stop: Optional[str] = typer.Option(None, "--to", help="Campbell: last speed."),
+    plot: Optional[Path] = typer.Option(None, "--plot", help="Campbell: write the diagram."),
 ):
     """Natural frequencies about the static equilibrium, with the dominant elements."""
     try:
         _at_least(count, 1, "--count", "20")
         m, _ = _load(model)
+        if campbell:
+            if start is None or stop is None:
+                raise TorquesplitError("--campbell needs a speed range: add --from '500 rpm' "
+                                       "--to '3000 rpm'")
+            from .steady.cli import campbell_command
+
+            return campbell_command(m, start, stop, plot, as_json, console, _json_default)
         from .assembly.assemble import assemble
         from .model.kinematics import solve_kinematics
         from .solve.modal import modal_analysis
@@ -796,6 +807,11 @@ def example(
         _fail(exc)
         return
     console.print(f"wrote {dst}")
+
+
+from .steady.cli import register as _register_steady  # noqa: E402
+
+_register_steady(app, lambda model: _load(model), _fail, console, err_console, _json_default)
 
 
 def main():  # pragma: no cover - console entry point
