@@ -139,7 +139,8 @@ class ShaftBending(Strict):
 
 
 class Support(Strict):
-    """Support of a body's translations to the housing: bearing or shaft bending."""
+    """Support of a body's translations: a bearing or shaft bending, to the housing or
+    (``on``) to another body (a planet on its carrier pin, a gear on a moving frame)."""
 
     stiffness: Stiffness | None = Field(
         None, gt=0, description="Radial stiffness (x and y) of the support."
@@ -159,6 +160,11 @@ class Support(Strict):
     )
     clearance: Length = Field(
         0.0, ge=0, description="Radial clearance (dead zone, seed 002 eq. 7); 0 = none."
+    )
+    on: str | None = Field(
+        None, description="Body the bearing sits on (its translations carry the bearing's "
+        "other end: a planet pin on its carrier, a moving housing); default: the fixed "
+        "housing."
     )
 
     @model_validator(mode="after")
