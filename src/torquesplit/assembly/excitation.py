@@ -192,7 +192,8 @@ def mesh_errors(model: Model, kin: Kinematics, mesh_name: str):
         n1, n2 = float(n @ e1), float(n @ e2)
         scale = math.hypot(n1, n2)  # in-plane part of the line of action
         zeta = math.atan2(n2, n1)
-        w = body.speed
+        # errors turn with the gear relative to the mesh's frame (a planet mesh's carrier)
+        w = mk.driver_speed if g == mk.driver else mk.driven_speed
         centre = gerr.CentreError(
             eccentricity=ge.eccentricity * scale, eccentricity_phase=ge.eccentricity_phase,
             installation=ge.installation * scale, installation_direction=ge.installation_phase,
@@ -255,7 +256,7 @@ def impact_force_table(model: Model, kin: Kinematics, mesh_name: str, n: int):
     imp = gim.meshing_in_impact(
         base_radius_driving=mk.base_radii[0], base_radius_driven=mk.base_radii[1],
         tip_radius_driven=g_dvn.tip_radius, centre_distance=mk.center_distance,
-        base_pitch=geo.base_pitch, omega_driving=abs(kin.bodies[mk.driver].speed),
+        base_pitch=geo.base_pitch, omega_driving=abs(mk.driver_speed),
         normal_load=mk.force, loaded_stiffness=k_mean,
         inertia_driving=kin.bodies[mk.driver].polar_inertia,
         inertia_driven=kin.bodies[mk.driven].polar_inertia,
@@ -282,7 +283,7 @@ def friction_direction(kin: Kinematics, mesh_name: str) -> np.ndarray:
     n_t = n - a * float(n @ a)
     n_t = n_t / np.linalg.norm(n_t)
     t = np.cross(a, n_t)
-    v = drv.speed * np.cross(a, mk.contact_point - drv.position)
+    v = mk.driver_speed * np.cross(a, mk.contact_point - drv.position)
     if float(t @ v) < 0.0:
         t = -t
     t[np.abs(t) < 1e-15] = 0.0
@@ -333,7 +334,7 @@ def friction_table(model: Model, kin: Kinematics, mesh_name: str, n: int) -> np.
         rb = (geo.gear2.base_radius, geo.gear1.base_radius)
         start, end = p2 - geo.path_end, p2 - geo.path_start
     g_drv, g_dvn = model.gears[mk.driver], model.gears[mk.driven]
-    omega = abs(kin.bodies[mk.driver].speed)
+    omega = abs(mk.driver_speed)
     load = mk.force / 2.0 if geo.double_helical else mk.force
     common = dict(base_radius_1=rb[0], base_radius_2=rb[1],
                   centre_distance=geo.operating_center_distance, contact_start=start,

@@ -156,6 +156,12 @@ def topology_issues(model: Model) -> list[tuple[str, str]]:
         a, b = s.connects
         adj[a].add(b)
         adj[b].add(a)
+    for n in names:  # a bearing on another body (a planet on its carrier) joins them
+        spec = model.gears.get(n) or model.bodies.get(n)
+        on = spec.support.on if spec is not None and spec.support is not None else None
+        if on in adj and on != n:
+            adj[n].add(on)
+            adj[on].add(n)
     for n in names:
         if not adj[n]:
             kind = "gears" if n in model.gears else "bodies"
