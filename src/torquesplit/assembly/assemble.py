@@ -144,7 +144,7 @@ def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None
     ground = np.zeros(n_dof)
     meta_meshes = {}
 
-    phases = excitation.mesh_phases(model, kin)
+    phases = excitation.mesh_phases(model, kin, strict=True)
 
     # ---- meshes
     for name, mesh in model.meshes.items():
