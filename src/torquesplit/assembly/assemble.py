@@ -112,6 +112,17 @@ def number_dofs(model: Model, kin: Kinematics) -> tuple[DofMap, np.ndarray]:
                 trans[body][d] = len(names)
                 names.append(f"{body}.{d}")
                 mass.append(bk.mass)
+    # a planet without translations sits rigidly on its pin: its mass moves with the
+    # carrier's translations and, at the pin radius R, with its rotation (m R^2)
+    for body, carrier in kin.planet_bodies.items():
+        if trans[body] or body not in kin.bodies:
+            continue
+        mp = kin.bodies[body].mass
+        for j in trans.get(carrier, {}).values():
+            mass[j] += mp
+        idx, _ = theta.get(carrier, (-1, 1.0))
+        if idx >= 0:
+            mass[idx] += mp * _orbit_radius(kin, body, carrier) ** 2
     m = np.asarray(mass)
     with np.errstate(divide="ignore", over="ignore"):
         inv = 1.0 / m
@@ -155,7 +166,7 @@ def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None
             if idx >= 0:
                 dofs.append(idx)
                 coefs.append(sgn * arm * s)
-            for j, c in dmap.project(body, mk.line_of_action, sgn):
+            for j, c in centre_projection(kin, dmap, body, mk.line_of_action, sgn):
                 dofs.append(j)
                 coefs.append(c)
         table = excitation.stiffness_table(model, kin, name, n_table)
@@ -395,6 +406,32 @@ def _bearing_seat(model: Model, dmap: DofMap, body: str, on: str | None,
     return on
 
 
+def _orbit_radius(kin: Kinematics, body: str, carrier: str) -> float:
+    c = kin.bodies[carrier]
+    a = c.axis / np.linalg.norm(c.axis)
+    r = kin.bodies[body].position - c.position
+    return float(np.linalg.norm(r - a * float(r @ a)))
+
+
+def centre_projection(kin: Kinematics, dmap: DofMap, body: str, vec, sign: float = 1.0):
+    """(DOF, coefficient) of the displacement of ``body``'s centre along ``vec``: its
+    own translations, or -- a planet without translations, rigid on its pin -- those of
+    its carrier and the carrier's rotation, ``theta_C (a_C x r) . vec``."""
+    if dmap.translation.get(body) or body not in kin.planet_bodies:
+        return dmap.project(body, vec, sign)
+    carrier = kin.planet_bodies[body]
+    c = kin.bodies[carrier]
+    a = c.axis / np.linalg.norm(c.axis)
+    r = kin.bodies[body].position - c.position
+    r = r - a * float(r @ a)
+    out = list(dmap.project(carrier, vec, sign))
+    idx, s_c = dmap.theta.get(carrier, (-1, 1.0))
+    arm = float(np.cross(a, r) @ np.asarray(vec, dtype=float))
+    if idx >= 0 and abs(arm) > 0.0:
+        out.append((idx, sign * s_c * arm))
+    return out
+
+
 def _seat_geometry(kin: Kinematics, body: str, on: str | None, sup, where: str):
     """(a_C x r, pin offset) of a bearing on the body ``on``: the displacement of the
     seat per unit rotation of ``on`` (r from its axis to the body's nominal centre) and
@@ -463,7 +500,7 @@ def _friction_projection(model: Model, kin: Kinematics, dmap: DofMap, name: str,
             dofs.append(idx)
             coefs.append(-s * w)
             rows.append(row)
-        for j, c in dmap.project(body, t_dir, sgn):
+        for j, c in centre_projection(kin, dmap, body, t_dir, sgn):
             dofs.append(j)
             coefs.append(c)
             rows.append(0)

@@ -19,7 +19,16 @@ Cooley & Parker 2012 eq. 1)::
   body, their projections the body's displacements along two orthonormal directions of
   the carrier's plane (``<body>.centripetal.1``, ``.2``);
 * centrifugal force ``m Omega^2 r0`` (outwards, constant in the carrier frame) on the
-  translations of a body off the axis (the planets), an external force.
+  translations of a body off the axis (the planets), an external force;
+* the geometric stiffness of that preload in the planet's pin, ``m Omega^2 R^2`` on the
+  carrier's rotation (R the pin radius): when the carrier turns by theta the pin, and
+  the preload with it, turns too.  With it the rigid rotation of carrier and planets
+  stays a zero-frequency mode in the turning frame (it is only a shift of the nominal
+  rotation); the lumped models in the literature omit it, and their examples hold every
+  member torsionally (Cooley & Parker 2012), where it is negligible.
+* A planet without translations sits rigidly on its pin: its mass is carried by the
+  carrier (translations and ``m R^2`` on its rotation, assembly/assemble.py) and so are
+  its rotating-frame terms and centrifugal force.
 
 The bodies' rotations need no term (planar model, all axes parallel to a).
 """
@@ -49,6 +58,11 @@ def rotating_frame_terms(kin, dmap, ext: np.ndarray):
     """
     elements: list[dict] = []
     gyro: list[tuple[int, int, float]] = []
+    # planets rigid on their pins (no translations) move with their carrier
+    rigid_pins: dict[str, list[str]] = {}
+    for p, c in kin.planet_bodies.items():
+        if not dmap.translation.get(p):
+            rigid_pins.setdefault(c, []).append(p)
     for body in dmap.translation:  # the model's order: a reproducible element list
         carrier = kin.frames.get(body)
         tr = dmap.translation[body]
@@ -60,6 +74,8 @@ def rotating_frame_terms(kin, dmap, ext: np.ndarray):
             continue
         a = cb.axis / np.linalg.norm(cb.axis)
         m = kin.bodies[body].mass
+        if body == carrier:
+            m += sum(kin.bodies[p].mass for p in rigid_pins.get(body, []))
         dirs = {d: dmap.axes[body][d] for d in tr}
         # Coriolis: G_ij = 2 m Omega u_i . (a x u_j)   (Lin & Parker 1999 G)
         for di, i in tr.items():
@@ -76,10 +92,26 @@ def rotating_frame_terms(kin, dmap, ext: np.ndarray):
             if dofs:
                 elements.append(dict(name=f"{body}.centripetal.{k}", kind=SPRING, dofs=dofs,
                                      coefs=coefs, stiffness=-m * omega**2, damping=0.0))
-        # centrifugal force of the nominal position, m Omega^2 r0 outwards
-        r = kin.bodies[body].position - cb.position
-        r0 = r - a * float(r @ a)
-        if float(np.linalg.norm(r0)) > 0.0:
-            for j, c in dmap.project(body, m * omega**2 * r0, 1.0, tol=0.0):
-                ext[j] += c
+        # centrifugal force of the nominal position, m Omega^2 r0 outwards (for a carrier,
+        # that of the planets rigid on its pins)
+        carried = [(body, m)] if body != carrier else \
+            [(p, kin.bodies[p].mass) for p in rigid_pins.get(body, [])]
+        for b, mb in carried:
+            r = kin.bodies[b].position - cb.position
+            r0 = r - a * float(r @ a)
+            if float(np.linalg.norm(r0)) > 0.0:
+                for j, c in dmap.project(body, mb * omega**2 * r0, 1.0, tol=0.0):
+                    ext[j] += c
+        # the planet's centrifugal preload in its pin turns with the carrier: geometric
+        # stiffness m Omega^2 R^2 on the carrier's rotation (without it the rigid rotation
+        # of carrier and planets would soften by -m Omega^2 R^2 per planet)
+        if body in kin.planet_bodies and body != carrier:
+            c_name = kin.planet_bodies[body]
+            idx, s_c = dmap.theta.get(c_name, (-1, 1.0))
+            r = kin.bodies[body].position - kin.bodies[c_name].position
+            big_r2 = float(r @ r) - float(r @ a) ** 2
+            if idx >= 0 and big_r2 > 0.0:
+                elements.append(dict(name=f"{body}.pin_preload", kind=SPRING, dofs=[idx],
+                                     coefs=[s_c], stiffness=m * omega**2 * big_r2,
+                                     damping=0.0))
     return elements, gyro

@@ -334,6 +334,26 @@ class _StaticProblem:
             s = self.s
             free = rigid_body_modes(s, active=active)
             extra = free.shape[1] - self.phi.shape[1]
+            if extra <= 0:
+                # no free motion by the topology: the system is singular to round-off
+                # only (a motion held by elements many decades softer than the rest,
+                # whose detection must not depend on the order of the DOFs); the least-
+                # squares solution is the equilibrium if it satisfies the equations
+                x, *_ = np.linalg.lstsq(A, b, rcond=None)
+                if np.all(np.isfinite(x)) and np.all(
+                        np.abs(A @ x - b) <= 1e-7 * (np.abs(A) @ np.abs(x) + np.abs(b))
+                        + 1e-300):
+                    return sc * x[:n]
+                lam, vec = np.linalg.eigh(0.5 * (A[:n, :n] + A[:n, :n].T))
+                weak = vec[:, 0]
+                names = [s.dof_names[i] for i in np.argsort(-np.abs(weak))[:4]
+                         if abs(weak[i]) > 1e-3 * np.abs(weak).max()]
+                raise SolverError(
+                    f"the static stiffness is singular to round-off: the motion of "
+                    f"{names} is held only by elements about {abs(lam[0]):.1e} times "
+                    f"softer than the others. Stiffen those elements (or remove the "
+                    f"DOFs they hold) so that every stiffness is within about 10 decades "
+                    f"of the largest.")
             loose = sorted({s.dof_names[i] for c in range(free.shape[1])
                             for i in np.flatnonzero(np.abs(free[:, c]) > 1e-9
                                                     * np.abs(free[:, c]).max())})
@@ -424,7 +444,9 @@ class _StaticProblem:
         if L.W is None:
             self.check_balance(L.f_eff)
         solves = 0
-        if q0 is None:
+        if q0 is None or (not self.has_gaps and L.W is None):
+            # a linear problem is one solve: from a previous time's q the Newton step
+            # would only lose digits (its gradient is a difference of large forces)
             q = self.closed_solve(L, L.f_eff)
             solves = 1
             if not self.has_gaps and L.W is None:
