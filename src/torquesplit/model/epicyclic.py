@@ -266,6 +266,10 @@ def solve_speeds(model: Model, axes, frames, groups, layout: EpicyclicLayout,
             f"torsional_support (e.g. the ring of a planetary, the carrier of a star stage) "
             f"or give a second drive")))
         return {}
+    # held members stand exactly still; round-off of the solve is cleared
+    w[np.abs(w) <= 1e-12 * max(float(np.max(np.abs(w))), 1e-300)] = 0.0
+    for h in layout.held:
+        w[col[groups[h]]] = 0.0
     return {b: _sign(axes, b, groups[b]) * float(w[col[groups[b]]]) for b in groups}
 
 
