@@ -353,7 +353,16 @@ def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None
     if rotating and kin.frames:
         from .rotating import rotating_frame_terms
 
-        frame_elements, gyroscopic = rotating_frame_terms(kin, dmap, ext)
+        def pin_stiffness(body, direction):
+            spec = model.gears.get(body) or model.bodies[body]
+            sup = spec.support
+            if sup is None or sup.on != kin.planet_bodies.get(body):
+                return None
+            k_rad = support_stiffness(sup)
+            k_xyz = np.array([k_rad, sup.stiffness_y or k_rad, sup.axial_stiffness or k_rad])
+            return float(k_xyz @ np.asarray(direction) ** 2)
+
+        frame_elements, gyroscopic = rotating_frame_terms(kin, dmap, ext, pin_stiffness)
         elements.extend(frame_elements)
 
     # ---- drives and loads

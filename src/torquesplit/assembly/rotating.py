@@ -20,12 +20,14 @@ Cooley & Parker 2012 eq. 1)::
   the carrier's plane (``<body>.centripetal.1``, ``.2``);
 * centrifugal force ``m Omega^2 r0`` (outwards, constant in the carrier frame) on the
   translations of a body off the axis (the planets), an external force;
-* the geometric stiffness of that preload in the planet's pin, ``m Omega^2 R^2`` on the
-  carrier's rotation (R the pin radius): when the carrier turns by theta the pin, and
-  the preload with it, turns too.  With it the rigid rotation of carrier and planets
-  stays a zero-frequency mode in the turning frame (it is only a shift of the nominal
-  rotation); the lumped models in the literature omit it, and their examples hold every
-  member torsionally (Cooley & Parker 2012), where it is negligible.
+* the geometric stiffness of that preload in the planet's pin, ``P R`` on the carrier's
+  rotation (R the pin radius, P = m Omega^2 R k_t / (k_t - m Omega^2) the static
+  centrifugal load of a bearing of stiffness k_t along the pin's tangent): when the
+  carrier turns by theta the pin, and the preload with it, turns too.  With it the rigid
+  rotation of carrier, sun and planets stays a zero-frequency mode in the turning frame
+  (it is only a shift of the nominal rotation).  The lumped models in the literature
+  omit it; their examples hold every member torsionally (Cooley & Parker 2012), where
+  it is a small correction.  The radial preload of the meshes is left out.
 * A planet without translations sits rigidly on its pin: its mass is carried by the
   carrier (translations and ``m R^2`` on its rotation, assembly/assemble.py) and so are
   its rotating-frame terms and centrifugal force.
@@ -37,6 +39,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import ModelError
 from ..gears import line_of_action as loa
 from .structure import SPRING
 
@@ -49,12 +52,13 @@ def in_plane_basis(axis) -> tuple[np.ndarray, np.ndarray]:
     return e1, np.cross(a, e1)
 
 
-def rotating_frame_terms(kin, dmap, ext: np.ndarray):
+def rotating_frame_terms(kin, dmap, ext: np.ndarray, pin_stiffness=None):
     """Elements (centripetal springs) and gyroscopic entries of every body measured in a
     turning carrier's frame; adds the centrifugal forces to ``ext`` in place.
 
-    Returns ``(elements, gyroscopic)`` for :func:`~torquesplit.assembly.structure.
-    build_structure`.
+    ``pin_stiffness(body, direction)`` gives the stiffness of a planet's bearing along
+    a unit direction (for the pin-preload term).  Returns ``(elements, gyroscopic)`` for
+    :func:`~torquesplit.assembly.structure.build_structure`.
     """
     elements: list[dict] = []
     gyro: list[tuple[int, int, float]] = []
@@ -102,16 +106,27 @@ def rotating_frame_terms(kin, dmap, ext: np.ndarray):
             if float(np.linalg.norm(r0)) > 0.0:
                 for j, c in dmap.project(body, mb * omega**2 * r0, 1.0, tol=0.0):
                     ext[j] += c
-        # the planet's centrifugal preload in its pin turns with the carrier: geometric
-        # stiffness m Omega^2 R^2 on the carrier's rotation (without it the rigid rotation
-        # of carrier and planets would soften by -m Omega^2 R^2 per planet)
-        if body in kin.planet_bodies and body != carrier:
+        # the planet's centrifugal preload P in its pin turns with the carrier: geometric
+        # stiffness P R on the carrier's rotation, P = m Omega^2 R k_t / (k_t - m Omega^2)
+        # the bearing's static share (k_t its stiffness along the pin's tangent); without
+        # it the rigid rotation of carrier and planets would soften
+        if body in kin.planet_bodies and body != carrier and pin_stiffness is not None:
             c_name = kin.planet_bodies[body]
             idx, s_c = dmap.theta.get(c_name, (-1, 1.0))
             r = kin.bodies[body].position - kin.bodies[c_name].position
-            big_r2 = float(r @ r) - float(r @ a) ** 2
-            if idx >= 0 and big_r2 > 0.0:
+            r0 = r - a * float(r @ a)
+            big_r = float(np.linalg.norm(r0))
+            k_t = pin_stiffness(body, np.cross(a, r0 / big_r)) if big_r > 0 else None
+            if idx >= 0 and k_t is not None:
+                soft = m * omega**2
+                if not k_t > soft:
+                    raise ModelError([(f"gears.{body}.support", (
+                        f"the planet's bearing ({k_t:.3g} N/m along its pin's tangent) is "
+                        f"softer than its centrifugal softening m Omega^2 = {soft:.3g} N/m at "
+                        f"the carrier's speed: it would fly off its pin; give a stiffer "
+                        f"bearing or a lower speed"))])
                 elements.append(dict(name=f"{body}.pin_preload", kind=SPRING, dofs=[idx],
-                                     coefs=[s_c], stiffness=m * omega**2 * big_r2,
+                                     coefs=[s_c],
+                                     stiffness=soft * big_r**2 * k_t / (k_t - soft),
                                      damping=0.0))
     return elements, gyro

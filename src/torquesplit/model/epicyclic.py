@@ -141,7 +141,8 @@ def find_layout(model: Model, positions, axes, groups, issues) -> EpicyclicLayou
         r_orbit = _off_axis(positions[planet], positions[c], ac)
         r_other = g_other.teeth * g_other.module / 2
         if g_other.gear_type != "internal" and r_other > r_orbit and \
-                g_planet.gear_type != "internal":
+                g_planet.gear_type != "internal" and \
+                not any(loc == f"gears.{other}.kind" for loc, _ in issues):
             issues.append((f"gears.{other}.kind", (
                 f"{other!r} meshes with planet {planet!r} around it (its pitch radius "
                 f"{r_other * 1e3:.4g} mm exceeds the planet circle {r_orbit * 1e3:.4g} mm) "

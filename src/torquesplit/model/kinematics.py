@@ -177,18 +177,20 @@ def solve_kinematics(model: Model) -> Kinematics:
     if issues:
         raise KinematicsError(issues)
 
+    from . import epicyclic as epi
+
+    # carriers and planets first: a ring of the wrong kind is named as such, not as a
+    # centre distance that does not fit
+    layout = epi.find_layout(model, positions, axes, groups, issues)
+    if issues:
+        raise KinematicsError(issues)
+
     frames = {}
     for name, mesh in model.meshes.items():
         try:
             frames[name] = loa.contact_frame(model, name, positions, axes)
         except ValueError as exc:
             issues.append((f"meshes.{name}", str(exc)))
-    if issues:
-        raise KinematicsError(issues)
-
-    from . import epicyclic as epi
-
-    layout = epi.find_layout(model, positions, axes, groups, issues)
     if issues:
         raise KinematicsError(issues)
     nominal = None
