@@ -260,6 +260,12 @@ def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None
             m = m * m_on / (m + m_on) if m_on > 0 else m
         seat_arm, pin_offset = _seat_geometry(kin, body, on, sup, where)
         ecc_const, ecc_sines = _eccentricity(model, kin, body)
+        if on is not None and not dmap.translation[on]:
+            # a seat body without translations (a carrier on rigid bearings): its
+            # eccentricity moves the pins it carries
+            seat_const, seat_sines = _eccentricity(model, kin, on)
+            pin_offset = pin_offset + seat_const
+            ecc_sines = ecc_sines + seat_sines
         for d, j in tr.items():
             u = dmap.axes[body][d]
             k = float(k_xyz @ u ** 2)
