@@ -370,3 +370,28 @@ def test_ring_of_the_wrong_kind_in_the_shorthand():
     with pytest.raises(ModelError, match="planetary.0.name: the stage would create "
                        "gears.stage_sun"):
         load(raw)
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_static_solve_and_modes_do_not_depend_on_the_order_of_lines(seed):
+    """The sections of the file in another order, and every mesh's gears the other way
+    round: the same static mesh forces and natural frequencies (issue 16)."""
+    import random
+
+    model = lp_model(4)
+    data = general_elements(model)
+    rnd = random.Random(seed)
+    for section in ("gears", "bodies", "meshes"):
+        items = list(data[section].items())
+        rnd.shuffle(items)
+        data[section] = dict(items)
+    for mesh in data["meshes"].values():
+        mesh["gears"] = mesh["gears"][::-1]
+    shuffled = load(data)
+    a, b = torquesplit.assemble(model), torquesplit.assemble(shuffled)
+    fa = dict(zip(a.element_names, static_equilibrium(a).element_forces))
+    fb = dict(zip(b.element_names, static_equilibrium(b).element_forces))
+    for name in model.meshes:
+        assert fb[name] == pytest.approx(fa[name], rel=1e-9)
+    np.testing.assert_allclose(modal_analysis(b).frequencies, modal_analysis(a).frequencies,
+                               rtol=1e-9)

@@ -21,7 +21,7 @@ Cooley & Parker 2012 eq. 1)::
 * centrifugal force ``m Omega^2 r0`` (outwards, constant in the carrier frame) on the
   translations of a body off the axis (the planets), an external force;
 * the geometric stiffness of that preload in the planet's pin, ``P R`` on the carrier's
-  rotation (R the pin radius, P = m Omega^2 R k_t / (k_t - m Omega^2) the static
+  rotation (one element ``<carrier>.pin_preload`` for all its planets) (R the pin radius, P = m Omega^2 R k_t / (k_t - m Omega^2) the static
   centrifugal load of a bearing of stiffness k_t along the pin's tangent): when the
   carrier turns by theta the pin, and the preload with it, turns too.  With it the rigid
   rotation of carrier, sun and planets stays a zero-frequency mode in the turning frame
@@ -63,6 +63,7 @@ def rotating_frame_terms(kin, dmap, ext: np.ndarray, pin_stiffness=None):
     elements: list[dict] = []
     gyro: list[tuple[int, int, float]] = []
     # planets rigid on their pins (no translations) move with their carrier
+    preload: dict[str, list] = {}  # carrier -> [its rotation DOF, sign, stiffness]
     rigid_pins: dict[str, list[str]] = {}
     for p, c in kin.planet_bodies.items():
         if not dmap.translation.get(p):
@@ -125,8 +126,10 @@ def rotating_frame_terms(kin, dmap, ext: np.ndarray, pin_stiffness=None):
                         f"softer than its centrifugal softening m Omega^2 = {soft:.3g} N/m at "
                         f"the carrier's speed: it would fly off its pin; give a stiffer "
                         f"bearing or a lower speed"))])
-                elements.append(dict(name=f"{body}.pin_preload", kind=SPRING, dofs=[idx],
-                                     coefs=[s_c],
-                                     stiffness=soft * big_r**2 * k_t / (k_t - soft),
-                                     damping=0.0))
+                preload.setdefault(c_name, [idx, s_c, 0.0])[2] += \
+                    soft * big_r**2 * k_t / (k_t - soft)
+    # one element per carrier carries the pin preloads of all its planets
+    for c_name, (idx, s_c, k) in preload.items():
+        elements.append(dict(name=f"{c_name}.pin_preload", kind=SPRING, dofs=[idx],
+                             coefs=[s_c], stiffness=k, damping=0.0))
     return elements, gyro
