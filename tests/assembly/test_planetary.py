@@ -326,6 +326,8 @@ def _general(**change):
     ({"gears.stage_planet2.place.angle": math.radians(91)}, "meshes.stage_",
      "tooth-count assembly condition"),
     ({"gears.stage_ring.kind": "spur"}, "gears.stage_ring.kind", "set kind = 'internal'"),
+    ({"gears.stage_planet2.place.angle": math.radians(60)}, "gears.stage_planet2",
+     "overlap"),
     ({"gears.stage_ring.support.stiffness_y": 2e8}, "gears.stage_ring.support.stiffness_y",
      "one radial stiffness"),
     ({"gears.stage_ring.torsional_support": None}, "drives", "not determined"),
@@ -395,3 +397,29 @@ def test_static_solve_and_modes_do_not_depend_on_the_order_of_lines(seed):
         assert fb[name] == pytest.approx(fa[name], rel=1e-9)
     np.testing.assert_allclose(modal_analysis(b).frequencies, modal_analysis(a).frequencies,
                                rtol=1e-9)
+
+
+def test_two_stage_train_from_the_same_elements():
+    """Two stages in series (the first carrier drives the second sun through a shaft):
+    the ratio is (1 + z_r / z_s)^2, each carrier has its own turning frame, and the
+    output torque is the input's times the ratio."""
+    raw = lp_raw(3)
+    first = raw["planetary"][0]
+    first["name"] = "s1"
+    second = copy.deepcopy(first)
+    second.update(name="s2", position=["0 mm", "0 mm", "-80 mm"], planets=4)
+    raw["planetary"] = [first, second]
+    raw["shafts"] = {"link": {"connects": ["s1_carrier", "s2_sun"],
+                              "torsional_stiffness": "1e6 N m/rad"}}
+    raw["drives"]["input"]["body"] = "s1_sun"
+    raw["loads"]["output"]["body"] = "s2_carrier"
+    model = load(raw)
+    kin = solve_kinematics(model)
+    ratio = (1 + ZR / ZS) ** 2
+    assert kin.bodies["s1_sun"].speed / kin.bodies["s2_carrier"].speed == pytest.approx(ratio)
+    assert kin.load_torques["output"] == pytest.approx(100.0 * ratio, rel=1e-9)
+    assert kin.frames["s2_planet1"] == "s2_carrier" and kin.frames["s1_sun"] == "s1_carrier"
+    s = torquesplit.assemble(model)
+    assert s.n_gyroscopic == 2 * (6 + 7)  # x-y pairs of every translating body
+    sol = modal_analysis(s, static_equilibrium(s).q)
+    assert sol.rigid_modes.shape[1] == 1 and np.all(sol.frequencies > 0)

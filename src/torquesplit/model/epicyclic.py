@@ -98,6 +98,17 @@ def find_layout(model: Model, positions, axes, groups, issues) -> EpicyclicLayou
                     f"its axis is not parallel to {c!r}'s; give both the same 'axis'")))
                 continue
             carriers.setdefault(c, []).append(name)
+    for c, planets in carriers.items():  # planets whose tips overlap cannot be assembled
+        gears = [p for p in planets if p in model.gears]
+        for i, p in enumerate(gears):
+            for q in gears[i + 1:]:
+                overlap = _tips_overlap(model, p, q, positions, axes[c])
+                if overlap is not None:
+                    issues.append((f"gears.{q}", (
+                        f"planets {p!r} and {q!r} overlap: their centres are "
+                        f"{overlap[0] * 1e3:.4f} mm apart, less than the sum of their tip "
+                        f"radii {overlap[1] * 1e3:.4f} mm; place them farther apart (another "
+                        f"angle), or in other planes")))
     planet_bodies: dict[str, str] = {}
     for c, planets in carriers.items():
         for p in planets:
@@ -166,6 +177,26 @@ def find_layout(model: Model, positions, axes, groups, issues) -> EpicyclicLayou
     return EpicyclicLayout(carriers={c: tuple(p) for c, p in carriers.items()},
                            planet_bodies=planet_bodies, mesh_carrier=mesh_carrier,
                            held=tuple(held))
+
+
+def _tips_overlap(model, p, q, positions, axis):
+    """(centre distance, sum of tip radii) of two planets in overlapping planes whose tip
+    circles intersect, else None."""
+    from ..gears import line_of_action as loa
+    from ..errors import ModelError
+
+    try:
+        rp = loa.gear_geometry(model.gears[p]).tip_radius
+        rq = loa.gear_geometry(model.gears[q]).tip_radius
+    except (ModelError, ValueError):  # reported by the geometry checks
+        return None
+    d = np.asarray(positions[q], float) - np.asarray(positions[p], float)
+    axial = abs(float(d @ axis))
+    width = 0.5 * (model.gears[p].face_width + model.gears[q].face_width)
+    radial = float(np.linalg.norm(d - axis * float(d @ axis)))
+    if axial < width and radial < rp + rq:
+        return radial, rp + rq
+    return None
 
 
 # --------------------------------------------------------------------------- speeds
