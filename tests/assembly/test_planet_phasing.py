@@ -192,7 +192,10 @@ def test_flank_not_determined_by_the_power_flow_warns():
 
     d = model_to_dict(model)
     d["gears"]["idle"] = dict(d["gears"]["stage_planet1"])
-    d["gears"]["idle"]["place"] = {"from_gear": "stage_sun", "angle": math.radians(60)}
+    d["gears"]["idle"].pop("place")  # in another plane, where it fits between the planets
+    a_w = 2.25e-3 * (42 + 48) / 2
+    d["gears"]["idle"]["position"] = [a_w * math.cos(math.pi / 3), a_w * math.sin(math.pi / 3),
+                                      0.05]
     d["meshes"]["idle_mesh"] = {"gears": ["stage_sun", "idle"], "stiffness": 5e8}
     m2 = torquesplit.load_model(model_from_dict(d), check=False)
     with pytest.warns(ModelWarning, match="meshes.idle_mesh: no power passes this mesh.*"

@@ -423,3 +423,31 @@ def test_two_stage_train_from_the_same_elements():
     assert s.n_gyroscopic == 2 * (6 + 7)  # x-y pairs of every translating body
     sol = modal_analysis(s, static_equilibrium(s).q)
     assert sol.rigid_modes.shape[1] == 1 and np.all(sol.frequencies > 0)
+
+
+def test_ring_floating_on_a_spline_in_the_turning_frame():
+    """The ring held by a spline to a held housing (radial clearance and friction): its
+    speed is zero, the spline's friction load is the ring's reaction, the static state
+    has no rigid drift (the turning frame's inertial terms do not hold the rigid rotation
+    in the static solve), and kernel and numpy twin agree there."""
+    from torquesplit.solve import rhs, rhs_numpy
+
+    raw = lp_raw(3)
+    ring = raw["planetary"][0]["ring"]
+    ring.pop("torsional_support")
+    ring.pop("support")
+    raw["bodies"] = {"housing": {"polar_inertia": 1.0, "torsional_support": {"rigid": True}}}
+    raw["splines"] = {"ring_spline": {
+        "connects": ["housing", "stage_ring"], "radial_clearance": "20 um",
+        "stiffness": "1e8 N/m", "pitch_radius": "160 mm",
+        "torsional_stiffness": "2e7 N m/rad", "friction_coefficient": 0.1}}
+    model = load(raw)
+    kin = solve_kinematics(model)
+    assert kin.bodies["stage_ring"].speed == 0.0
+    assert kin.bodies["stage_ring"].torque == pytest.approx(100.0 * ZR / ZS, rel=1e-9)
+    s = torquesplit.assemble(model)
+    st = static_equilibrium(s)
+    assert st.converged and st.rigid_modes.shape[1] == 1
+    assert np.max(np.abs(st.q)) < 1e-2
+    np.testing.assert_allclose(rhs(s, 1e-6, st.y0), rhs_numpy(s, 1e-6, st.y0),
+                               rtol=1e-7, atol=1e-6)

@@ -394,6 +394,8 @@ def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None
         planet_bodies=dict(kin.planet_bodies),
         frames=dict(kin.frames),
         rotating_frame=bool(rotating and gyroscopic),
+        inertial_elements=[el["name"] for el in elements if el["name"].endswith(
+            (".centripetal.1", ".centripetal.2", ".pin_preload"))],
     )
     return build_structure(dmap.names, inv_mass, elements, external_force=ext,
                            ground_damping=ground, gyroscopic=gyroscopic, n_table=n_table,

@@ -141,13 +141,22 @@ def rigid_body_modes(structure: Structure, active: np.ndarray | None = None,
     ``active`` (n_el bool) defaults to every element whose stiffness table is not all
     zero, dead zones closed.  Computed from the projection vectors alone (singular
     values of V M^-1/2 below ``tolerance`` x the largest), so stiffness magnitudes do
-    not affect it.
+    not affect it.  The inertial terms of a turning frame (centripetal softening, pin
+    preload: ``metadata['inertial_elements']``) are left out: the rigid rotation of a
+    planetary train is that of its kinematics, on which the nominal torques balance.
     """
     s = structure
     if active is None:
         active = np.abs(s.stiffness_table).max(axis=1) > 0
+    active = np.asarray(active, dtype=bool).copy()
+    # the terms of a turning frame (centripetal softening, pin preload) are inertial, not
+    # elastic: they do not hold the train's rigid rotation
+    inertial = s.metadata.get("inertial_elements", ())
+    if inertial:
+        names = {n: i for i, n in enumerate(s.element_names)}
+        active[[names[n] for n in inertial if n in names]] = False
     d = np.sqrt(s.inv_mass)
-    A = s.projection_matrix()[np.asarray(active, dtype=bool)] * d[None, :]
+    A = s.projection_matrix()[active] * d[None, :]
     if A.shape[0] == 0:
         return np.diag(d)
     _, sv, vt = np.linalg.svd(A, full_matrices=True)
