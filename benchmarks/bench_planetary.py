@@ -93,7 +93,7 @@ def main(argv=None) -> int:
              f" in {time.time() - t0:.0f} s; {n_steps:,} RK4 steps per case, 100 per mesh "
              f"period, best of {args.repeat}; load average {load0[0]:.2f} at start, "
              f"{load1[0]:.2f} at end (2 cores shared: the CPU columns are the steadier).",
-             f"torquesplit {torquesplit.__version__ if hasattr(torquesplit, '__version__') else ''}",
+             f"torquesplit {getattr(torquesplit, '__version__', '')}",
              "", "| model | DOFs | elements | gyroscopic entries | µs/step | CPU µs/step | "
              "ns/step/DOF (CPU) | general µs/step | rhs |",
              "|---|---|---|---|---|---|---|---|---|"]

@@ -20,7 +20,6 @@ sys.path.insert(0, str(ROOT / "tests" / "assembly"))
 
 
 def main() -> int:
-    import numpy as np
     from planetary_models import CP, cp_raw, load, lp_raw
     from test_lin_parker1999 import COOLEY_PARKER_2012, LIN_PARKER_1999
     from test_planet_load_sharing import _hand, _model, _sun_forces

@@ -24,7 +24,6 @@ Rigid-body modes are counted and left out, as in ``modal_analysis``.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
 import numpy as np

@@ -21,8 +21,9 @@ Cooley & Parker 2012 eq. 1)::
 * centrifugal force ``m Omega^2 r0`` (outwards, constant in the carrier frame) on the
   translations of a body off the axis (the planets), an external force;
 * the geometric stiffness of that preload in the planet's pin, ``P R`` on the carrier's
-  rotation (one element ``<carrier>.pin_preload`` for all its planets) (R the pin radius, P = m Omega^2 R k_t / (k_t - m Omega^2) the static
-  centrifugal load of a bearing of stiffness k_t along the pin's tangent): when the
+  rotation (one element ``<carrier>.pin_preload`` for all its planets; R the pin
+  radius, P = m Omega^2 R k_t / (k_t - m Omega^2) the static centrifugal load of a
+  bearing of stiffness k_t along the pin's tangent): when the
   carrier turns by theta the pin, and the preload with it, turns too.  With it the rigid
   rotation of carrier, sun and planets stays a zero-frequency mode in the turning frame
   (it is only a shift of the nominal rotation).  The lumped models in the literature

@@ -173,7 +173,7 @@ def find_layout(model: Model, positions, axes, groups, issues) -> EpicyclicLayou
                         f"drive/load")))
             if name in planet_bodies:
                 issues.append((f"{kind}.{name}.torsional_support", (
-                    f"a planet cannot be held against rotation on its pin; remove it")))
+                    "a planet cannot be held against rotation on its pin; remove it")))
     return EpicyclicLayout(carriers={c: tuple(p) for c, p in carriers.items()},
                            planet_bodies=planet_bodies, mesh_carrier=mesh_carrier,
                            held=tuple(held))
