@@ -10,10 +10,12 @@ The pipeline, one stage per subpackage (each stage returns a new object)::
 
 from __future__ import annotations
 
+from .assembly.assemble import assemble
 from .errors import ModelError, ModelWarning, SolverError, StepTooLargeError, TorquesplitError
 from .examples import example_names, example_path
 from .model.io import load_model
 from .model.kinematics import solve_kinematics
+from .simulation import simulate
 
 __version__ = "0.1.0"
 
@@ -21,17 +23,3 @@ __all__ = [
     "ModelError", "ModelWarning", "SolverError", "StepTooLargeError", "TorquesplitError",
     "example_names", "example_path", "load_model", "solve_kinematics", "assemble", "simulate",
 ]
-
-
-def assemble(model, **kwargs):
-    """Assemble a model into a :class:`~torquesplit.assembly.structure.Structure`."""
-    from .assembly.assemble import assemble as _assemble
-
-    return _assemble(model, **kwargs)
-
-
-def simulate(model, **kwargs):
-    """Static equilibrium then dynamic response; see :func:`torquesplit.simulation.simulate`."""
-    from .simulation import simulate as _simulate
-
-    return _simulate(model, **kwargs)

@@ -112,6 +112,15 @@ def simulate(
     freqs = np.array([kin.meshes[m].frequency for m in mesh_names])
     f_min, f_max = float(freqs.min()), float(freqs.max())
     method = method or an.method
+    # options that the chosen method would ignore are refused, not ignored
+    wrong = ([name for name, v in (("rtol", rtol),) if v is not None] if method == "rk4" else
+             [name for name, v in (("steps_per_period", steps_per_period),
+                                   ("max_steps", max_steps)) if v is not None])
+    if wrong:
+        from .errors import OptionError
+
+        raise OptionError(f"option(s) {wrong} do not apply to method={method!r}; remove "
+                          "them or choose the other method")
     steps_per_period = steps_per_period or an.steps_per_period
     if duration is None:
         if cycles is not None:

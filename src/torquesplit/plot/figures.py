@@ -35,7 +35,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.ticker import NullFormatter
 
-from ..errors import TorquesplitError
+from ..errors import FigureNotApplicableError, TorquesplitError  # noqa: F401 - re-exported
 
 __all__ = [
     "FigureNotApplicableError",
@@ -72,8 +72,6 @@ _REPORTED_TEXT = {
 }
 
 
-class FigureNotApplicableError(TorquesplitError, ValueError):
-    """The results hold nothing this figure can show (no supports, no floating body...)."""
 
 
 # ============================================================ dynamic run figures
