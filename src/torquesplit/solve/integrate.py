@@ -358,6 +358,7 @@ def integrate(
     blowup: float = 1.0e3,
     progress: Callable[[float], None] | None = None,
     rhs: str = "auto",
+    corners: bool = True,
 ) -> Solution:
     """Integrate the equations of motion of ``structure`` from ``y0`` over ``t_span``.
 
@@ -432,6 +433,14 @@ def integrate(
         the new pass manager) the run uses "general" with a warning; ``Solution.rhs``
         says which one ran.
 
+    corners : bool
+        Where a table (stiffness wave, impact force, per-cycle backlash) has a corner
+        (``kernel_data.CORNER_TOL``): RK4 steps through it in sub-steps that end on it,
+        so that no step straddles a kink of the right-hand side (which would cost RK4
+        its order), and both methods sample the forces there for the per-cycle
+        extremes.  False: plain fixed steps and step samples only (to compare with
+        another fixed-step RK4 code, step for step).
+
     Returns
     -------
     Solution
@@ -472,6 +481,9 @@ def integrate(
         raise ValueError(f"t_span must be (start, end) with end > start, got {t_span!r}.")
     y = _initial_state(s, y0)
     model = kd.kernel_model(s)
+    if not corners:
+        model = model._replace(corner_node=np.zeros(0, dtype=np.int64),
+                               corner_ptr=np.zeros_like(model.corner_ptr))
     sel = _select(s, t0, span, track_elements, n_cycles_cap, history_elements, history_dofs,
                   load_sharing_groups)
     if rk4:
