@@ -1,17 +1,22 @@
-"""Run each seed paper's study on its example model and collect the numbers the paper
+"""Run each paper's study on its example model and collect the numbers the paper
 reports, for docs/validation.md.
 
     python scripts/validate.py [seed000 seed001 ...] [--quick]
+    python scripts/render_docs.py      # then docs/validation.md from the numbers
 
-Writes docs/validation_results.json (one entry per seed) and prints a summary.  The
-settings are the papers' where they give them (see each example's [analysis] section
-and the comments in the model files); nothing is tuned to a published number.
+Writes docs/validation_results.json (one entry per paper, with the commit and the
+machine it ran on) and prints a summary.  The settings are the papers' where they give
+them (see each example's [analysis] section and the comments in the model files);
+nothing is tuned to a published number.  Every dynamic run is repeated with half the
+step: the largest change of any reported metric is stored beside it (``halved``), so a
+number is only published with the evidence that it does not move.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 import time
 import warnings
@@ -39,11 +44,43 @@ def _run(model, **kwargs) -> dict:
     t0 = time.perf_counter()
     res = torquesplit.simulate(model, **kwargs)
     wall = time.perf_counter() - t0
-    out = {"wall_time_s": wall, "statistics": res.statistics()}
+    values = res.metric_values()
+    out = {"wall_time_s": wall, "statistics": res.statistics(), "values": values,
+           "settled": bool(res.metrics().settling.settled)}
     for definition in ("cycle_peak", "engineering", "mean_force"):
-        met = res.metrics(definition)
-        out[definition] = met.to_dict()
+        out[definition] = res.metrics(definition).to_dict()
+    # the same run with half the step: how far every reported number moves
+    spp = 2 * (kwargs.pop("steps_per_period", None) or model.analysis.steps_per_period)
+    half = torquesplit.simulate(model, steps_per_period=spp, **kwargs).metric_values()
+    change = {k: abs(half[k] - v) for k, v in values.items()
+              if k in half and math.isfinite(v) and math.isfinite(half[k])
+              and k.startswith(("load_sharing", "dynamic_factor", "peak_to_nominal"))}
+    worst = max(change, key=change.get) if change else ""
+    out["halved"] = {"steps_per_period": spp, "max_change": change.get(worst, 0.0),
+                     "worst": worst}
     return out
+
+
+def _provenance() -> dict:
+    """Which code and machine produced the numbers."""
+    import platform
+    import subprocess
+
+    root = Path(__file__).resolve().parents[1]
+
+    def git(*args):
+        try:
+            return subprocess.run(["git", *args], cwd=root, capture_output=True, text=True,
+                                  check=True).stdout.strip()
+        except (OSError, subprocess.CalledProcessError):
+            return ""
+
+    dirty = bool(git("status", "--porcelain", "--untracked-files=no", "src"))
+    return {"commit": git("rev-parse", "--short", "HEAD") + (" (with uncommitted changes "
+                                                             "in src)" if dirty else ""),
+            "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
+            "torquesplit": torquesplit.__version__, "python": platform.python_version(),
+            "machine": platform.machine(), "cpu_count": __import__("os").cpu_count()}
 
 
 def seed000(quick: bool) -> dict:
@@ -108,6 +145,7 @@ def main(argv=None) -> int:
     ap.add_argument("--quick", action="store_true", help="shorter runs (smoke test)")
     args = ap.parse_args(argv)
     old = json.loads(OUT.read_text()) if OUT.exists() else {}
+    old["provenance"] = _provenance()
     for seed in args.seeds:
         t0 = time.perf_counter()
         try:
