@@ -423,6 +423,13 @@ def example(
     console.print(f"wrote {dst}")
 
 
+# --------------------------------------------------------------------------- studies
+from .study.cli import study as _study, sweep as _sweep  # noqa: E402  (typer signatures only)
+
+app.command("study")(_study)
+app.command("sweep")(_sweep)
+
+
 def main():  # pragma: no cover - console entry point
     app()
 
