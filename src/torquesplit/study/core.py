@@ -82,7 +82,7 @@ class Study:
 
     def __init__(self, source):
         self.spec, self.folder, self.text = read_study(source)
-        self.source = str(source) if isinstance(source, (str, Path)) else self.spec.study.name
+        self.source = str(source) if isinstance(source, (str, Path)) else None
         self._plan: Plan | None = None
 
     @classmethod

@@ -109,7 +109,7 @@ class Plan:
     """A study ready to run."""
 
     spec: StudySpec
-    source: str
+    source: str | None
     study_text: str
     model_source: str
     base_data: dict
@@ -128,7 +128,7 @@ class Plan:
 
 
 # ============================================================================ resolve
-def resolve(spec: StudySpec, folder: Path | None, text: str, source: str = "study") -> Plan:
+def resolve(spec: StudySpec, folder: Path | None, text: str, source: str | None = None) -> Plan:
     """Check a study against its model and compute every case's values (no case runs)."""
     try:
         return _resolve(spec, folder, text, source)
@@ -156,10 +156,10 @@ def _resolve(spec, folder, text, source) -> Plan:
         from .sensitivity import sensitivity_design
 
         design = sensitivity_design(spec.sensitivity, _sensitivity_parameters(spec, base))
-    # probe: the first (and last) case must give a valid model, or the study is refused
-    for i in sorted({0, design.n_cases - 1}):
-        _validated(apply_overrides(base, design.overrides(i)), model_source,
-                   f"{kind}.parameters", case=i, design=design)
+    # probe: a study whose first case gives an invalid model is refused (almost always a
+    # mistake in the file); an invalid later case is recorded as refused when it runs
+    _validated(apply_overrides(base, design.overrides(0)), model_source,
+               f"{kind}.parameters", case=0, design=design)
     canonical = spec.canonical()
     return Plan(spec=spec, source=source, study_text=text, model_source=model_source,
                 base_data=base, model=model, model_hash=model_hash, model_dict=canon,
@@ -257,6 +257,18 @@ def _outputs(spec: StudySpec, model, analysis: str) -> tuple[list[str], list[str
         if stop.output not in names:
             names.append(stop.output)
     return names, out_mod.definitions_needed(names)
+
+
+def _check_disjoint(params, where: str) -> None:
+    """Refuse two parameters that write the same field (the later would silently win)."""
+    owner: dict[str, int] = {}
+    for i, p in enumerate(params):
+        for f in p.fields:
+            if f.path in owner:
+                raise StudyError(f"{where}.{i}", f"{p.name!r} writes {f.path}, which parameter "
+                                                 f"{owner[f.path]} also writes; vary each field "
+                                                 f"in one parameter only")
+            owner[f.path] = i
 
 
 # ============================================================================ grid
@@ -366,6 +378,7 @@ def _grid(spec: StudySpec, raw: dict) -> Design:
     if len(set(names)) != len(names):
         raise StudyError("grid.parameters", f"two parameters are named {names}; give each a "
                                             f"different name")
+    _check_disjoint(params, "grid.parameters")
     shape = tuple(len(a) for a in axes)
     values = np.array(list(itertools.product(*axes)), dtype=float).reshape(-1, len(axes))
     return Design("grid", params, values, shape=shape, axes=axes)
@@ -409,6 +422,7 @@ def _monte_carlo(spec: StudySpec, raw: dict, model) -> Design:
     if dup:
         raise StudyError("monte_carlo.parameters", f"{sorted(dup)[0]!r} is varied twice; vary "
                                                    f"each field in one parameter only")
+    _check_disjoint(params, "monte_carlo.parameters")
     n = mc.samples if mc.samples is not None else mc.stop.max_samples
     u = uniform_points(mc.sampling, n, len(params), mc.seed)
     values = np.column_stack([transform(rv, u[:, j]) for j, rv in enumerate(rvs)])
@@ -545,4 +559,5 @@ def _sensitivity_parameters(spec: StudySpec, raw: dict):
     if len(set(names)) != len(names):
         raise StudyError("sensitivity.parameters", "two factors have the same name; give each "
                                                    "a different name")
+    _check_disjoint([p for p, *_ in out], "sensitivity.parameters")
     return out

@@ -118,8 +118,13 @@ def _unwrap(tp, meta):
 
 # ============================================================================ data
 def expand(path: str, raw: dict, where: str) -> list[str]:
-    """Concrete paths of ``path``: itself, or every field of the model data matching the
-    pattern.  Parents must exist in the data (as for ``--set``)."""
+    """Concrete paths of ``path``: itself, or every field matching the pattern.
+
+    Wildcards range over the entries and fields the model file writes; a literal segment
+    may also name a table the file leaves at its default (``errors``,
+    ``transmission_error``: written out empty) or a field left at its default.  Parents
+    must otherwise exist (as for ``--set``).
+    """
     parts = path.split(".")
     if not is_pattern(path):
         _parent(raw, parts, path, where)
@@ -130,21 +135,33 @@ def expand(path: str, raw: dict, where: str) -> list[str]:
         if i == len(parts):
             found.append(".".join(prefix))
             return
+        seg = parts[i]
         if isinstance(node, dict):
-            keys = [k for k in node if fnmatch.fnmatchcase(str(k), parts[i])]
+            if is_pattern(seg):
+                keys = [k for k in node if fnmatch.fnmatchcase(str(k), seg)]
+            elif seg in node or i == len(parts) - 1:
+                keys = [seg]
+            elif _is_section(prefix + [seg]):
+                node[seg] = {}
+                keys = [seg]
+            else:
+                keys = []
         elif isinstance(node, list):
-            keys = [str(k) for k in range(len(node)) if fnmatch.fnmatchcase(str(k), parts[i])]
+            keys = [str(k) for k in range(len(node)) if fnmatch.fnmatchcase(str(k), seg)]
         else:
             return
         for k in keys:
+            if i == len(parts) - 1:
+                found.append(".".join(prefix + [k]))
+                continue
             child = node[k] if isinstance(node, dict) else node[int(k)]
             walk(child, i + 1, prefix + [k])
 
     walk(raw, 0, [])
     if not found:
-        raise StudyError(where, f"pattern {path!r} matches no field of the model file; check "
-                                f"it against the model (a pattern only matches fields that "
-                                f"the file writes)")
+        raise StudyError(where, f"pattern {path!r} matches no field of the model; check it "
+                                f"against the model file (wildcards match the entries and "
+                                f"fields that the file writes)")
     return found
 
 
@@ -152,6 +169,8 @@ def _parent(raw, parts, path, where):
     node = raw
     for i, key in enumerate(parts[:-1]):
         here = ".".join(parts[: i + 1])
+        if isinstance(node, dict) and key not in node and _is_section(parts[: i + 1]):
+            node[key] = {}  # a table the file leaves out (defaults): write it out empty
         if isinstance(node, dict) and key in node:
             node = node[key]
         elif isinstance(node, list) and key.isdigit() and int(key) < len(node):
@@ -161,6 +180,28 @@ def _parent(raw, parts, path, where):
             raise StudyError(where, f"{path!r}: {here!r} does not exist in the model (known "
                                     f"here: {known}); check the path")
     return node
+
+
+def _is_section(parts: list[str]) -> bool:
+    """The schema has a table with a default value (not None, not a named entry) at
+    ``parts``: writing it out empty changes nothing."""
+    node: object = Model
+    field = None
+    for part in parts:
+        node, _ = _unwrap(node, [])
+        if isinstance(node, type) and issubclass(node, pydantic.BaseModel):
+            field = node.model_fields.get(part)
+            if field is None:
+                return False
+            node = field.annotation
+        elif typing.get_origin(node) is dict and part != parts[-1]:
+            node, field = typing.get_args(node)[1], None  # a named entry: it must exist
+        else:
+            return False
+    node, _ = _unwrap(node, [])
+    return (isinstance(node, type) and issubclass(node, pydantic.BaseModel)
+            and field is not None and field.default is not None
+            and not field.is_required())
 
 
 def current_value(raw: dict, path: str):
@@ -237,7 +278,11 @@ def check_unit(unit: str | None, kind: str | None, where: str) -> None:
         return
     if kind is None:
         raise StudyError(where, f"unit {unit!r} given for a plain-number field; remove 'unit'")
-    to_si(f"1 {unit}", kind, None, where)
+    try:
+        parse_quantity(f"1 {unit}", kind)
+    except ValueError:
+        raise StudyError(where, f"{unit!r} is not a unit of {kind.replace('_', ' ')}; write "
+                                f"e.g. unit = \"{KINDS[kind][1].split(' ', 1)[1]}\"") from None
 
 
 def si_unit(kind: str | None) -> str:
