@@ -35,10 +35,14 @@ def test_grid_equals_runs_one_by_one(split_file):
     assert np.ptp(ds["peak_force.a1"].values) > 1.0
 
 
-def test_one_and_two_workers_identical(split_file):
+def test_one_and_two_workers_identical(split_file, tmp_path):
+    from torquesplit.study.figures import write_study_figures
+
     study = Study(grid_study(split_file, [STIFFNESS, ERROR]))
     one = study.run(workers=1)
     two = study.run(workers=2)
+    maps = write_study_figures(one, tmp_path, formats=("png",))
+    assert [p.name for p in maps] == ["map_load_sharing.cycle_peak.png"]
     assert one["load_sharing.cycle_peak"].shape == (4, 2)
     xr.testing.assert_identical(one.drop_vars("case_wall_time"), two.drop_vars("case_wall_time"))
     assert np.ptp(one["load_sharing.cycle_peak"].values) > 0.01

@@ -88,10 +88,11 @@ def _run(source, *, workers, scheduler, out, resume, overwrite, figures, quiet, 
             out = Path(f"study_{_safe(name_hint or st.name)}")
         if workers is not None and workers < 1:
             raise ValueError(f"--workers {workers}: give at least 1")
-        ui.err_console.print(
-            f"[bold]{st.name}[/]: {plan.n_cases} cases ({plan.design.kind}, "
-            f"{plan.analysis['type']}), {len(plan.outputs)} outputs -> {out}",
-            highlight=False)
+        if not as_json:
+            ui.err_console.print(
+                f"[bold]{st.name}[/]: {plan.n_cases} cases ({plan.design.kind}, "
+                f"{plan.analysis['type']}), {len(plan.outputs)} outputs -> {out}",
+                highlight=False)
         ds = _with_bar(lambda cb: st.run(workers=workers, scheduler=scheduler, out=out,
                                          resume=resume, overwrite=overwrite, progress=cb,
                                          figures=figures), plan.n_cases, quiet or as_json)
