@@ -29,7 +29,7 @@ _PROCESS = {"compiled": False}
 
 def payload(index: int, plan, overrides: dict) -> dict:
     """The picklable description of case ``index`` of a plan."""
-    return {"index": int(index), "model": plan.base_data, "source": plan.model_source,
+    return {"index": int(index), "model": plan.case_data, "source": plan.model_source,
             "overrides": overrides, "analysis": plan.analysis, "outputs": plan.outputs,
             "definitions": plan.definitions}
 
@@ -113,7 +113,7 @@ def _dynamic(model, p, out) -> list[float]:
             return _finish(res, names, defs, out, output_values)
         vals = output_values(res, defs)
         current = [vals.get(n, math.nan) for n in names]
-        settled = res.metrics(defs[0] if defs else None).settling.settled
+        settled = res.metrics("cycle_peak").settling.settled  # the same for every definition
         if previous is not None and settled and _close(previous, current, settle["tolerance"]):
             break
         if length >= full:
@@ -168,7 +168,7 @@ def _finish(res, names, defs, out, output_values, vals=None) -> list[float]:
         return [math.nan] * len(names)
     if vals is None:
         vals = output_values(res, defs)
-    met = res.metrics(defs[0] if defs else None)
+    met = res.metrics("cycle_peak")  # settling and contact loss: the same for every definition
     out["settled"] = out["settled"] and met.settling.settled
     lost = [(r.mesh, r.contact_loss) for r in met.rows if r.contact_loss > 0]
     if lost:

@@ -113,6 +113,10 @@ class Plan:
     study_text: str
     model_source: str
     base_data: dict
+    """The model file's data with ``[set]`` applied, as written (units as strings)."""
+    case_data: dict
+    """The same model as SI numbers (validated once here): what each case starts from,
+    so that a case does not parse units again (the round trip is exact; tested)."""
     model: object
     model_hash: str
     model_dict: dict
@@ -162,7 +166,7 @@ def _resolve(spec, folder, text, source) -> Plan:
                f"{kind}.parameters", case=0, design=design)
     canonical = spec.canonical()
     return Plan(spec=spec, source=source, study_text=text, model_source=model_source,
-                base_data=base, model=model, model_hash=model_hash, model_dict=canon,
+                base_data=base, case_data=canon, model=model, model_hash=model_hash, model_dict=canon,
                 study_hash=_hash(canonical), outputs=outputs, definitions=definitions,
                 analysis=analysis, design=design)
 
