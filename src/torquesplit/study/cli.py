@@ -155,16 +155,20 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
     design = ds.attrs["design"]
     if design == "grid" and status.size <= 60 and len(out_vars) <= 8:
         t = Table(title=f"{ds.attrs['study_name']}")
+        from .figures import _coord
+
         dims = list(ds[out_vars[0]].dims)
+        shown = {}
         for d in dims:
-            unit = ds[d].attrs.get("units", "")
+            values, unit = _coord(ds, d)
+            shown[d] = dict(zip(ds[d].values.tolist(), values.tolist()))
             t.add_column(f"{d} [{unit}]", justify="right")
         for v in out_vars:
             t.add_column(v, justify="right")
         t.add_column("status")
         flat = ds.stack(case=dims)
         for k in range(flat.sizes["case"]):
-            row = [f"{float(flat[d].values[k]):.6g}" for d in dims]
+            row = [f"{shown[d][float(flat[d].values[k])]:.6g}" for d in dims]
             row += [f"{float(flat[v].values[k]):.6g}" for v in out_vars]
             row.append(str(flat["status"].values[k]))
             t.add_row(*row)

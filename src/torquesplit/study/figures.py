@@ -93,13 +93,11 @@ def curves_figure(ds, family: str, members: list[tuple[str, str]]) -> Figure:
                     ms=2.5, label=member)
     _mark_failed(ax, x, ds["status"].values)
     ax.set_xlabel(f"{_param_label(ds, pname)} [{xunit}]")
-    ax.set_ylabel(f"{out_mod.FAMILIES.get(family.split('.')[0], ('', family))[1]} [{unit}]"
-                  if not family.startswith("load_sharing") else
-                  f"load-sharing coefficient ({family.split('.', 1)[1]}) [{unit}]")
+    ax.set_ylabel(f"{family} [{unit}]")
     ax.grid(True, alpha=0.3)
     ax.yaxis.get_major_formatter().set_useOffset(False)
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False, fontsize=8)
-    fig.suptitle(f"{ds.attrs['study_name']}: {family}", fontsize=11)
+    fig.suptitle(f"{ds.attrs['study_name']}: {_family_text(family)}", fontsize=11)
     return fig
 
 
@@ -142,12 +140,14 @@ def maps_figure(ds, family: str, members: list[tuple[str, str]]) -> Figure:
         if bad.any():
             yy, xx = np.nonzero(bad)
             ax.plot(np.asarray(x)[xx], np.asarray(y)[yy], "rx", ms=6, label="not ok")
-        fig.colorbar(mesh, ax=ax, label=f"[{unit}]")
+        bar = fig.colorbar(mesh, ax=ax, label=f"[{unit}]")
+        bar.formatter.set_useOffset(False)
+        bar.update_ticks()
         ax.set_title(title, fontsize=9)
         ax.set_xlabel(f"{_param_label(ds, dims[0])} [{xunit}]", fontsize=8)
         ax.set_ylabel(f"{_param_label(ds, dims[1])} [{yunit}]", fontsize=8)
         ax.tick_params(labelsize=7)
-    fig.suptitle(f"{ds.attrs['study_name']}: {family}", fontsize=11)
+    fig.suptitle(f"{ds.attrs['study_name']}: {_family_text(family)}", fontsize=11)
     return fig
 
 
@@ -293,6 +293,15 @@ def _mark_failed(ax, x, status) -> None:
     if bad.any():
         ax.plot(np.asarray(x)[bad], np.zeros(bad.sum()), "rx", ms=7, clip_on=False,
                 transform=ax.get_xaxis_transform(), label="case not ok")
+
+
+def _family_text(family: str) -> str:
+    """ "load_sharing.engineering" -> "load-sharing coefficient (engineering)"."""
+    head = family.split(".")[0]
+    text = out_mod.FAMILIES.get(head, ("", family))[1]
+    if head == "load_sharing" and "." in family:
+        text += f" ({family.split('.', 1)[1]})"
+    return text
 
 
 def _safe(name: str) -> str:
