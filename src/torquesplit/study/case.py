@@ -174,5 +174,5 @@ def _finish(res, names, defs, out, output_values, vals=None) -> list[float]:
     if lost:
         out["status"] = "contact_lost"
         out["reason"] = "contact lost in " + ", ".join(
-            f"{m} ({100 * f:.1f} % of the time)" for m, f in lost)
+            f"{m} ({100 * f:.2g} % of the time)" for m, f in lost)
     return [vals.get(n, math.nan) for n in names]
