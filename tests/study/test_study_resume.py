@@ -121,3 +121,23 @@ def test_ctrl_c_stops_cleanly_and_resume_finishes(tmp_path, split_file):
     assert (ds["status"] == "ok").all() and ds.sizes[GRID[0]["path"]] == 10
     with sqlite3.connect(out / "study.sqlite") as db:
         assert [c for (c,) in db.execute("SELECT computed FROM runs ORDER BY run")] == [4, 6]
+
+
+def test_a_dead_worker_stops_the_study_without_losing_cases(tmp_path, split_file):
+    from concurrent.futures.process import BrokenProcessPool
+
+    def flaky(function, payloads):  # any callable is a runner
+        for i, p in enumerate(payloads):
+            if i == 3:
+                raise BrokenProcessPool("a worker process died")
+            yield function(p)
+
+    data = grid_study(split_file, GRID)
+    out = tmp_path / "out"
+    with pytest.raises(StudyError, match="stopped after 3 cases: BrokenProcessPool.*--resume"):
+        Study(data).run(runner=flaky, out=out)
+    ds = Study(data).run(workers=1, out=out, resume=True, figures=False)
+    assert (ds["status"] == "ok").all()
+    with sqlite3.connect(out / "study.sqlite") as db:
+        assert db.execute("SELECT state, computed FROM runs ORDER BY run").fetchall() == [
+            ("failed", 3), ("finished", 7)]

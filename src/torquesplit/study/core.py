@@ -316,6 +316,13 @@ class _Driver:
             state = "finished"
         except KeyboardInterrupt:
             raise StudyInterrupted(int(self.finished.sum()), self._target(), self.out) from None
+        except (OSError, RuntimeError) as exc:  # a worker process died, a cluster went away
+            state = "failed"
+            again = ("run it again with --resume" if self.out else
+                     "give an output folder to keep finished cases")
+            raise StudyError("", f"the study stopped after {int(self.finished.sum())} cases: "
+                                 f"{type(exc).__name__}: {exc}; every finished case is "
+                                 f"saved, {again}") from exc
         finally:
             close = getattr(results, "close", None)
             if close is not None:
