@@ -141,3 +141,18 @@ def test_a_dead_worker_stops_the_study_without_losing_cases(tmp_path, split_file
     with sqlite3.connect(out / "study.sqlite") as db:
         assert db.execute("SELECT state, computed FROM runs ORDER BY run").fetchall() == [
             ("failed", 3), ("finished", 7)]
+
+
+def test_one_run_at_a_time_per_folder(tmp_path, split_file):
+    from torquesplit.study.store import StoreLock
+
+    out = tmp_path / "out"
+    out.mkdir()
+    held = StoreLock(out)  # as if another process were running the study
+    try:
+        with pytest.raises(StudyError, match="in use by another run of a study"):
+            Study(grid_study(split_file, GRID)).run(workers=1, out=out)
+    finally:
+        held.release()
+    ds = Study(grid_study(split_file, GRID[:1])).run(workers=1, out=out, figures=False)
+    assert ds.sizes[GRID[0]["path"]] == 10

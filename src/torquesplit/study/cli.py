@@ -98,7 +98,9 @@ def _run(source, *, workers, scheduler, out, resume, overwrite, figures, quiet, 
                                          figures=figures), plan.n_cases, quiet or as_json)
     except StudyInterrupted as exc:
         ui.err_console.print("[yellow]stopped:[/] ", end="")
-        ui.err_console.print(str(exc), markup=False, highlight=False, soft_wrap=True)
+        ui.err_console.print(f"{exc.done} of {exc.total} cases done and saved in {out}; to "
+                             f"finish, run the same command with --resume", markup=False,
+                             highlight=False, soft_wrap=True)
         raise typer.Exit(130)
     except (TorquesplitError, ValueError) as exc:
         ui._fail(exc)

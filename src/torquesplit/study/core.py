@@ -31,7 +31,7 @@ from .design import Plan, resolve
 from .errors import StudyError, StudyInterrupted
 from .runners import make_runner
 from .spec import read_study
-from .store import STORE_NAME, Store
+from .store import STORE_NAME, Store, StoreLock
 
 log = logging.getLogger(__name__)
 
@@ -204,6 +204,22 @@ def _open_store(plan: Plan, out, resume: bool, overwrite: bool) -> Store:
         store.write_meta(_provenance(plan))
         return store
     out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    try:
+        lock = StoreLock(out)
+    except BlockingIOError as exc:
+        raise StudyError("--out", f"{out} is in use by another run of a study ({exc}); wait "
+                                  f"for it to finish or stop it, or choose another folder") from None
+    try:
+        store = _open_folder(plan, out, resume, overwrite)
+    except BaseException:
+        lock.release()
+        raise
+    store.lock = lock
+    return store
+
+
+def _open_folder(plan: Plan, out: Path, resume: bool, overwrite: bool) -> Store:
     path = out / STORE_NAME
     if path.exists() and overwrite:
         for suffix in ("", "-wal", "-shm"):
@@ -212,7 +228,6 @@ def _open_store(plan: Plan, out, resume: bool, overwrite: bool) -> Store:
     if exists and not resume:
         raise StudyError("--out", f"{out} already holds a study; add --resume to continue it, "
                                   f"--overwrite to start it again, or choose another folder")
-    out.mkdir(parents=True, exist_ok=True)
     store = Store(path)
     if store.is_new():
         store.write_meta(_provenance(plan))

@@ -26,6 +26,7 @@ Tables
 from __future__ import annotations
 
 import json
+import os
 import sqlite3
 import time
 from pathlib import Path
@@ -43,6 +44,36 @@ CREATE TABLE IF NOT EXISTS cases (
 """
 
 STORE_NAME = "study.sqlite"
+LOCK_NAME = "study.lock"
+
+
+class StoreLock:
+    """An exclusive lock on a study folder for the life of a run (``flock``: the OS drops
+    it when the process dies, SIGKILL included), so that two processes never run the
+    same study at once.  Where ``fcntl`` does not exist (Windows) it locks nothing."""
+
+    def __init__(self, folder: Path):
+        self.path = Path(folder) / LOCK_NAME
+        self.file = open(self.path, "a+")
+        try:
+            import fcntl
+        except ImportError:  # pragma: no cover - Windows
+            return
+        try:
+            fcntl.flock(self.file.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            self.file.seek(0)
+            holder = self.file.read().strip() or "another process"
+            self.file.close()
+            raise BlockingIOError(holder) from None
+        self.file.seek(0)
+        self.file.truncate()
+        self.file.write(f"pid {os.getpid()}")
+        self.file.flush()
+
+    def release(self) -> None:
+        if not self.file.closed:
+            self.file.close()
 
 
 class Store:
@@ -56,6 +87,7 @@ class Store:
         self.db.execute("PRAGMA synchronous=NORMAL")
         self.db.executescript(SCHEMA)
         self.run_id: int | None = None
+        self.lock: StoreLock | None = None
 
     # ------------------------------------------------------------------ meta
     def is_new(self) -> bool:
@@ -124,3 +156,5 @@ class Store:
 
     def close(self) -> None:
         self.db.close()
+        if self.lock is not None:
+            self.lock.release()
