@@ -102,7 +102,7 @@ def _run(source, *, workers, scheduler, out, resume, overwrite, figures, quiet, 
                              f"finish, run the same command with --resume", markup=False,
                              highlight=False, soft_wrap=True)
         raise typer.Exit(130)
-    except (TorquesplitError, ValueError) as exc:
+    except (TorquesplitError, ValueError, OSError) as exc:
         ui._fail(exc)
         return
     _summary(ds, Path(out), as_json, figures)

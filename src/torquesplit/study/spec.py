@@ -338,17 +338,24 @@ def read_study(source) -> tuple[StudySpec, Path | None, str]:
         return source, None, json.dumps(source.canonical())
     if isinstance(source, dict):
         return parse_study(source), None, json.dumps(source, default=str)
-    path = Path(source)
-    if not path.exists():
-        from .shipped import study_names, study_path
+    from .shipped import study_names, study_path
 
+    path = Path(source)
+    if not path.is_file():
         if str(source) in study_names():
             path = study_path(str(source))
+        elif path.is_dir():
+            raise StudyError("", "is a folder, not a study file; give the .toml file (to look "
+                                 "at finished results, open DIR/results.nc)", str(source))
         else:
-            raise StudyError("", f"no such study file (nor a shipped study of that name); "
-                                 f"check the path, or list shipped studies with "
-                                 f"'torquesplit study --list'", str(source))
-    text = path.read_text(encoding="utf-8")
+            raise StudyError("", "no such study file (nor a shipped study of that name); "
+                                 "check the path, or list shipped studies with "
+                                 "'torquesplit study --list'", str(source))
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise StudyError("", f"cannot read the file ({exc}); check it is a TOML text file",
+                         str(source)) from None
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
