@@ -115,6 +115,33 @@ def diameter() -> dict:
 
 
 # ============================================================================ Monte Carlo
+_PLAIN = r"""
+import sys, time, warnings, torquesplit
+warnings.simplefilter("ignore")
+m = torquesplit.load_model(torquesplit.example_path("seed002_face_gear"))
+torquesplit.simulate(m, duration=0.01)
+r = torquesplit.simulate(m, duration=0.3)
+print(r.statistics()["wall_time_s"])
+"""
+
+
+def parallel_capacity() -> dict:
+    """How much two plain ``simulate`` processes slow each other down on this machine
+    right now (1.0 on two idle cores, 2.0 when only one core is free): the baseline for
+    the worker speed-up, measured in the same run."""
+    env = dict(os.environ)
+
+    def start():
+        return subprocess.Popen([sys.executable, "-c", _PLAIN], env=env,
+                                stdout=subprocess.PIPE, text=True)
+
+    alone = float(start().communicate()[0])
+    a, b = start(), start()
+    pair = [float(a.communicate()[0]), float(b.communicate()[0])]
+    return {"alone_s": alone, "side_by_side_s": pair,
+            "slowdown": sum(pair) / 2 / alone, "free_cores_estimate": 2 * alone / max(pair)}
+
+
 def monte_carlo(n: int) -> dict:
     from torquesplit.study import Study
 
@@ -127,7 +154,7 @@ def monte_carlo(n: int) -> dict:
             {"paths": ["gears.*.errors.eccentricity_phase"], "distribution": "uniform",
              "low": "0 deg", "high": "360 deg"}]},
     }
-    out: dict = {}
+    out: dict = {"capacity_before": parallel_capacity()}
     for workers in (1, 2):
         with tempfile.TemporaryDirectory() as tmp:
             _log(f"Monte Carlo, seed 002 model: {n} cases on {workers} worker(s)")
@@ -136,6 +163,7 @@ def monte_carlo(n: int) -> dict:
             wall = time.perf_counter() - t0
             out[f"workers_{workers}"] = _overhead(_cases(Path(tmp)), wall, workers)
             _log(f"  {wall:.1f} s")
+    out["capacity_after"] = parallel_capacity()
     w1, w2 = out["workers_1"], out["workers_2"]
     out["speedup_1_to_2"] = w1["study_wall_s"] / w2["study_wall_s"]
     out["extrapolated_1000_cases_2_workers_s"] = 1000 * w2["study_wall_s"] / n
@@ -240,6 +268,14 @@ def report(res: dict) -> str:
                          f"{w['mean_case_wall_s']:.2f} | {w['mean_integration_s']:.2f} | "
                          f"{100 * w['overhead_in_worker_fraction']:.2f} % | "
                          f"{100 * w['overhead_seen_by_driver_fraction']:.1f} % |")
+        caps = [mc[k] for k in ("capacity_before", "capacity_after") if k in mc]
+        if caps:
+            lines += ["", "Baseline in the same run: two plain `torquesplit.simulate` processes "
+                      "side by side take " + " and ".join(
+                          f"{c['slowdown']:.2f}x" for c in caps) + " as long as one alone "
+                      "(before and after the study; 1.0 = two free cores, 2.0 = one): the "
+                      "most a 2-worker study can gain here is about " + " / ".join(
+                          f"{2 / c['slowdown']:.2f}x" for c in caps) + "."]
         lines += ["", f"Speed-up 1 -> 2 workers: **{mc['speedup_1_to_2']:.2f}x** (target "
                   f">= 1.8x).  1000 cases on 2 workers, extrapolated: "
                   f"**{mc['extrapolated_1000_cases_2_workers_s'] / 60:.0f} min** (target <= "
