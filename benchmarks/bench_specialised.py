@@ -1,13 +1,14 @@
-"""A specialised RK4 of one model: what a hand-written transcription of its equations does.
+"""A transcription generated from the assembled structure (checks kernel overhead, not
+assembly).
 
-The issue measures the general engine against "a numba transcription of the same
-model" (the speed target is within 1.5 times of it).  Rather than hand-copying the
-seed 001 equations, :func:`specialised_source` writes that transcription from an
-assembled structure: one straight-line Python statement per non-zero of the equations,
-every coefficient, stiffness, damping, mass and DOF index a literal, no index arrays, no
+:func:`specialised_source` writes a straight-line RK4 of one model *from the engine's
+own assembled structure*: one Python statement per non-zero of the equations, every
+coefficient, stiffness, damping, mass and DOF index a literal, no index arrays, no
 element loop, no generality.  It is compiled with numba (same flags as the engine) and
 timed in the same process as the engine, so the ratio does not depend on how loaded the
-machine is.
+machine is.  Because its equations come from the assembly, it measures the overhead of
+the kernels but cannot reveal an error of the assembly; the independent baseline, the
+seed 001 equations written by hand from the paper, is ``bench_transcription.py``.
 
 What the specialised code does per step, like the engine: classic RK4; mesh stiffness
 interpolated in the same periodic tables at each distinct stage time (t, t + h/2,

@@ -111,7 +111,8 @@ def run(
         None, "--steps-per-period", help="RK4 steps per shortest mesh period (default 100)."),
     definition: Optional[str] = typer.Option(
         None, "--definition",
-        help="Load-sharing definition: cycle_peak, instantaneous, engineering, mean_force."),
+        help="Load-sharing definition: cycle_peak, instantaneous, engineering, mean_force "
+             "(static_torque: use `torquesplit static`)."),
     out: Optional[Path] = typer.Option(
         None, "--out", help="Write results: .nc (NetCDF), .mat (MATLAB) or .csv (spreadsheet)."),
     plots: Optional[Path] = typer.Option(None, "--plots", help="Write report figures (PNG, SVG) here."),
@@ -191,24 +192,34 @@ def _render_run(res, met, saved) -> None:
         f"(+{st['rhs_compile_time_s']:.2g} s for the {st['rhs']} right-hand side); "
         f"transient discarded: {met.settling.start_time:.4g} s"
         + ("" if met.settling.settled else " (not settled: last half used)"))
+    from .metrics.load_sharing import DEFINITION_TEXT
+
     t = Table(title=f"meshes (load sharing: {met.definition})")
     for col in ("mesh", "group", "nominal F [N]", "static F [N]", "mean F [N]", "peak F [N]",
-                "DLF", "LSC", "contact loss"):
+                "dynamic factor", "peak/nominal", "LSC", "contact loss", "back flank"):
         t.add_column(col, justify="left" if col in ("mesh", "group") else "right")
     for r in met.rows:
         t.add_row(r.mesh, r.group, f"{r.nominal_force:.6g}", f"{r.static_force:.6g}",
                   f"{r.mean_force:.6g}", f"{r.peak_force:.6g}", f"{r.dynamic_factor:.5f}",
-                  f"{r.load_sharing:.5f}", f"{100 * r.contact_loss:.2f} %")
+                  f"{r.peak_to_nominal:.5f}", f"{r.load_sharing:.5f}",
+                  f"{100 * r.contact_loss:.2f} %", f"{100 * r.back_contact:.2f} %")
     console.print(t)
     g = Table(title="load-sharing groups")
-    for col in ("group", "meshes", "LSC", "DLF", "DLF (eng.)"):
+    for col in ("group", "meshes", "LSC", "dynamic factor", "peak/nominal",
+                "peak/nominal (eng.)"):
         g.add_column(col, justify="left" if col in ("group", "meshes") else "right")
+    d = met.dynamic_factors
     for name, members in met.load_sharing.groups.items():
         g.add_row(name, ", ".join(members), f"{met.load_sharing.per_group[name]:.5f}",
-                  f"{met.dynamic_factors.per_group_peak[name]:.5f}",
-                  f"{met.dynamic_factors.per_group_engineering[name]:.5f}")
+                  f"{d.per_group_dynamic_factor[name]:.5f}",
+                  f"{d.per_group_peak_to_nominal[name]:.5f}",
+                  f"{d.per_group_peak_to_nominal_engineering[name]:.5f}")
     console.print(g)
     console.print(f"system load-sharing coefficient: [bold]{met.load_sharing.system:.5f}[/]")
+    console.print(f"LSC ({met.definition}): {DEFINITION_TEXT[met.definition]}; dynamic "
+                  "factor = settled peak / the mesh's own static force; peak/nominal = "
+                  "settled peak / equal-split nominal force (Ji & Li eq. 19)",
+                  markup=False, highlight=False)
     lost = [r for r in met.rows if r.contact_loss > 0]
     if lost:
         err_console.print("[yellow]warning:[/] ", end="")
@@ -344,6 +355,194 @@ def mesh(
                   f"{cmp.iso.c_gamma_iso:.3f} N/(mm um), c_gamma b = {cmp.iso_mesh_stiffness:.4e} N/m")
     if plot is not None:
         console.print(f"plot written to {plot}")
+
+
+# --------------------------------------------------------------------------- contact
+@app.command()
+def contact(
+    model: str = typer.Argument(..., help="Model file (.toml/.json) or example name."),
+    pair: str = typer.Option(..., "--pair", help="Name of the mesh to analyse."),
+    load: Optional[list[str]] = typer.Option(
+        None, "--load", help="Load: a normal force ('40 kN') or a torque ('17500 N m', on the "
+        "gear named by --on); repeat for several.  Default: the operating load."),
+    on: Optional[str] = typer.Option(None, "--on", help="Gear a torque --load acts on "
+                                     "(default the driven gear)."),
+    plot: Optional[Path] = typer.Option(None, "--plot", help="Write the figures (PNG) to this folder."),
+    positions: Optional[int] = typer.Option(None, "--positions", help="Mesh positions per cycle."),
+    slices: Optional[int] = typer.Option(None, "--slices", help="Slices across the face."),
+    harris: int = typer.Option(10, "--harris", help="Loads of the Harris map (0.1 to 1.5 times "
+                               "the largest load); 0 for none."),
+    assign: Optional[list[str]] = typer.Option(
+        None, "--set", help="Override a model field: PATH=VALUE."),
+    as_json: bool = typer.Option(False, "--json", help="Print the results as JSON."),
+):
+    """Loaded tooth contact analysis of one mesh: transmission error, stiffness, load
+    distribution, contact pressure, Harris map, meshing-in impact."""
+    try:
+        m, _ = _load(model, assign)
+        if pair not in m.meshes:
+            raise TorquesplitError(f"no mesh named {pair!r}; name one of {', '.join(m.meshes)}")
+        from .gears.contact.coupling import contact_model_for_mesh, _options
+        from .gears.contact.impact import loaded_meshing_in
+        from .model.kinematics import solve_kinematics
+        from .model.units import parse_quantity
+
+        kin = solve_kinematics(m)
+        spec = m.meshes[pair].stiffness
+        opts = _options(spec)
+        if positions is not None or slices is not None:
+            from dataclasses import replace
+
+            opts = replace(opts, positions=positions or opts.positions,
+                           slices=slices or opts.slices)
+        cm, op_load, names, reverse = contact_model_for_mesh(m, kin, pair, options=opts)
+        loads = [_contact_load(text, m, kin, pair, names, on, cm, parse_quantity)
+                 for text in (load or [])] or [op_load]
+        results = [cm.solve(f).require_converged(f"meshes.{pair}") for f in loads]
+        top = max(loads)
+        import numpy as np
+
+        hm = cm.harris_map(np.linspace(0.1, 1.5, harris) * top) if harris > 0 else None
+        op = max(results, key=lambda r: r.load)
+        impact = None
+        if not cm.pair.is_internal and not reverse:
+            mk = kin.meshes[pair]
+            drv, dvn = kin.bodies[mk.driver], kin.bodies[mk.driven]
+            impact = loaded_meshing_in(op, omega_driving=abs(drv.speed),
+                                       inertia_driving=drv.polar_inertia,
+                                       inertia_driven=dvn.polar_inertia)
+    except (TorquesplitError, ValueError) as exc:
+        _fail(exc)
+        return
+    figures = []
+    if plot is not None:
+        from .plot.contact import write_contact_figures
+
+        if hm is None:
+            hm = cm.harris_map(loads)
+        figures = write_contact_figures(results, hm, plot, operating=op, operating_load=op_load,
+                                        title=f"{m.model.name} {pair}")
+    rows = [r.summary() for r in results]
+    if as_json:
+        print(json.dumps({
+            "mesh": pair, "gears": list(names), "operating_load_N": op_load,
+            "positions": int(cm.phase.size), "slices": int(cm.y.size), "loads": rows,
+            "harris": None if hm is None else {
+                "load_N": hm.loads.tolist(), "te_peak_to_peak_m": hm.te_peak_to_peak.tolist(),
+                "te_peak_to_peak_arcsec": hm.te_peak_to_peak_arcsec.tolist(),
+                "mean_stiffness_N_per_m": hm.mean_stiffness.tolist(),
+                "contact_ratio": hm.contact_ratio.tolist()},
+            "impact": None if impact is None else {
+                "peak_force_N": impact.peak_force, "advance_m": impact.advance,
+                "corner_separation_m": impact.corner_separation},
+            "figures": [str(f) for f in figures]}, indent=2, default=_json_default))
+        return
+    console.print(f"[bold]{m.model.name}[/]: LTCA of mesh {pair} ({names[0]} drives {names[1]}), "
+                  f"{cm.phase.size} positions x {cm.y.size} slices"
+                  + (" x 2 helices" if cm.helices == 2 else "")
+                  + f"; operating normal load {op_load / 1e3:.5g} kN")
+    t = Table(title="loaded tooth contact analysis (normal direction)")
+    for col in ("load [kN]", "TE mean [um]", "TE p-p [um]", "TE p-p [arc s]", "k secant [N/um]",
+                "k tangent [N/um]", "p_H max [MPa]", "contact ratio"):
+        t.add_column(col, justify="right")
+    for r, row in zip(results, rows):
+        t.add_row(f"{r.load / 1e3:.5g}", f"{row['te_mean_m'] * 1e6:.4g}",
+                  f"{row['te_peak_to_peak_m'] * 1e6:.4g}", f"{row['te_peak_to_peak_arcsec']:.4g}",
+                  f"{row['stiffness_secant_mean_N_per_m'] / 1e6:.5g}",
+                  f"{row['stiffness_tangent_mean_N_per_m'] / 1e6:.5g}",
+                  f"{row['max_hertz_pressure_Pa'] / 1e6:.5g}", f"{row['actual_contact_ratio']:.3f}")
+    console.print(t)
+    if hm is not None:
+        h = Table(title="Harris map")
+        for col in ("load [kN]", "TE p-p [um]", "TE p-p [arc s]", "contact ratio"):
+            h.add_column(col, justify="right")
+        for f, pp, pa, cr in zip(hm.loads, hm.te_peak_to_peak, hm.te_peak_to_peak_arcsec,
+                                 hm.contact_ratio):
+            h.add_row(f"{f / 1e3:.4g}", f"{pp * 1e6:.4g}", f"{pa:.4g}", f"{cr:.3f}")
+        console.print(h)
+    if impact is not None:
+        console.print(f"meshing-in impact at {op.load / 1e3:.5g} kN: {impact.peak_force:.5g} N "
+                      f"(premature approach {impact.advance * 1e6:.3g} um, corner relief "
+                      f"{impact.corner_separation * 1e6:.3g} um)")
+    if figures:
+        console.print(f"{len(figures)} figures written to {plot}")
+
+
+def _contact_load(text, model, kin, pair, names, on, cm, parse_quantity) -> float:
+    """A --load value as a normal force [N]: a force as given, a torque on a gear divided
+    by its base radius times cos(beta_b)."""
+    for kind in ("force", "torque"):
+        try:
+            value = parse_quantity(text, kind)
+        except ValueError:
+            continue
+        if not (value > 0):
+            raise TorquesplitError(f"--load {text!r} must be positive; give e.g. '40 kN'")
+        if kind == "force":
+            return value
+        gear = on or kin.meshes[pair].driven
+        if gear not in names:
+            raise TorquesplitError(f"--on {gear!r} is not a gear of mesh {pair!r}; name one of "
+                                   f"{', '.join(names)}")
+        g = cm.pair.gear1 if gear == names[0] else cm.pair.gear2
+        return value / (g.base_radius * cm.normal_factor)
+    raise TorquesplitError(f"--load {text!r} is neither a force nor a torque; write e.g. '40 kN' "
+                           f"or '17500 N m'")
+
+
+# --------------------------------------------------------------------------- optimize
+@app.command()
+def optimize(
+    spec: str = typer.Argument(..., help="Optimisation file (.toml), or the name of a shipped "
+                               "one (seed000_dh_modification)."),
+    out: Optional[Path] = typer.Option(None, "--out", help="Folder for pareto.csv, pareto.png "
+                                       "and chosen.toml (default: next to the file)."),
+    workers: Optional[int] = typer.Option(None, "--workers", help="Processes (overrides the file)."),
+    generations: Optional[int] = typer.Option(None, "--generations", help="Generations."),
+    population: Optional[int] = typer.Option(None, "--population", help="Population size."),
+    seed: Optional[int] = typer.Option(None, "--seed", help="Random seed."),
+    as_json: bool = typer.Option(False, "--json", help="Print the Pareto front as JSON."),
+):
+    """Optimise model parameters (NSGA-II or any pymoo algorithm) on LTCA or dynamic outputs;
+    evaluations are stored as they finish, so an interrupted run resumes."""
+    from .optimize import optimize as run_optimization
+
+    path = Path(spec)
+    if not path.exists():
+        from importlib import resources
+
+        shipped = Path(str(resources.files("torquesplit.examples") / "optimize" / f"{spec}.toml"))
+        if shipped.exists():
+            path = shipped
+    try:
+        res = _with_progress(lambda cb: run_optimization(
+            path, workers=workers, generations=generations, population=population, seed=seed,
+            progress=None if cb is None else (lambda g, n: cb(g / max(n + 1, 1)))),
+            as_json)
+        target = out or (Path.cwd() / f"{path.stem}_results")
+        files = res.write(target)
+    except (TorquesplitError, ValueError) as exc:
+        _fail(exc)
+        return
+    names = [v.path for v in res.spec.variables]
+    objs = [o.output for o in res.spec.objectives]
+    if as_json:
+        print(json.dumps({"pareto": [{"x": dict(zip(names, map(float, x))),
+                                      "objectives": dict(zip(objs, map(float, f)))}
+                                     for x, f in zip(res.X, res.F)],
+                          "chosen": int(res.chosen), "baseline": res.baseline,
+                          "evaluations": res.evaluations, "computed": res.computed,
+                          "files": [str(f) for f in files]}, indent=2, default=_json_default))
+        return
+    t = Table(title=f"Pareto front ({res.spec.algorithm}, {res.evaluations} evaluations, "
+                    f"{res.computed} computed)")
+    for col in ("", *[n.split(".")[-1] for n in names], *objs):
+        t.add_column(col, justify="right")
+    for i, (x, f) in enumerate(zip(res.X, res.F)):
+        t.add_row("*" if i == res.chosen else "", *[f"{v:.4g}" for v in x], *[f"{v:.4g}" for v in f])
+    console.print(t)
+    console.print(f"chosen design (*) written to {target / 'chosen.toml'}; front in "
+                  f"{target / 'pareto.csv'}")
 
 
 # --------------------------------------------------------------------------- modes

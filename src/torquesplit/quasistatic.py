@@ -46,9 +46,7 @@ class QuasiStaticResults:
     def metrics(self) -> ls.LoadSharing:
         """Static torque ratios per mesh, group and system (seed 004 eqs. 14-15)."""
         groups = ls.group_meshes(self.structure.metadata["meshes"])
-        res = ls.instantaneous(self.times, self.mesh_forces(), self.mesh_names, groups,
-                               start_time=-np.inf, definition="static_torque")
-        return res
+        return ls.static_torque(self.times, self.mesh_forces(), self.mesh_names, groups)
 
     def orbits(self) -> dict[str, np.ndarray]:
         """Floating orbit (n_times, 2) [m] of every body with x and y DOFs."""

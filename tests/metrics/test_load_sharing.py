@@ -1,6 +1,9 @@
-"""Load-sharing definitions on hand-made force records."""
+"""Load-sharing definitions, dynamic factors and the settle criterion on hand-made
+per-cycle records (values derived by hand in the comments)."""
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 import pytest
@@ -8,8 +11,12 @@ import pytest
 from torquesplit.metrics import load_sharing as ls
 
 
+def _starts(n, m=2, f=100.0):
+    return np.repeat((np.arange(n) / f)[:, None], m, axis=1)
+
+
 def test_seed002_omega_from_mean_torque():
-    """Seed 002 §6.1: 1129.33 N m on mesh 12 of an input of 2175.24 N m gives 1.0384.
+    """Dong et al. 2021 §6.1: 1129.33 N m on mesh 12 of an input of 2175.24 N m.
 
     Omega = mean torque / nominal torque (T_in / 2); with equal arms the mean-force
     definition N F_i / sum F_j is the same number, and Omega_12 + Omega_13 = 2.
@@ -19,43 +26,82 @@ def test_seed002_omega_from_mean_torque():
     means = np.array([[1129.33 / arm, (t_in - 1129.33) / arm]])
     counts = np.ones_like(means)
     groups = {"I": ["m12", "m13"]}
-    res = ls.mean_force(means, counts, ["m12", "m13"], groups, {"m12": 0, "m13": 0})
-    # exact ratio 1129.33 / 1087.62 = 1.038350: the paper prints 1.0383, issue 5 quotes
-    # 1.0384; both are roundings of it, hence the tolerance of one unit in the 4th decimal
+    res = ls.mean_force(means, counts, _starts(1), ["m12", "m13"], groups,
+                        {"m12": 0, "m13": 0})
+    # exact ratio 1129.33 / 1087.62 = 1.038350: the paper prints 1.0383
     assert res.per_mesh["m12"] == pytest.approx(1.0384, abs=1e-4)
     assert res.per_mesh["m12"] == pytest.approx(1129.33 / 1087.62, rel=1e-12)
     assert res.per_mesh["m12"] + res.per_mesh["m13"] == pytest.approx(2.0, abs=1e-12)
     assert res.system == res.per_mesh["m12"]
 
 
-def test_cycle_peak_is_the_largest_per_cycle_ratio():
-    # seed 000 eq. 17 on two meshes: cycle peaks 10/10, 12/8, 9/11
-    peaks = np.array([[10.0, 10.0], [12.0, 8.0], [9.0, 11.0]])
-    res = ls.cycle_peak(peaks, ["a", "b"], {"g": ["a", "b"]}, {"a": 0, "b": 0})
+def test_cycle_peak_is_the_largest_per_cycle_ratio_over_settled_cycles():
+    # Liu et al. 2021 eq. 17 on two meshes: cycle peaks 30/10 (transient), 10/10,
+    # 12/8, 9/11 -> ratios 1.5, 1, 1.2, 0.9; settled from cycle 1
+    peaks = np.array([[30.0, 10.0], [10.0, 10.0], [12.0, 8.0], [9.0, 11.0]])
+    res = ls.cycle_peak(peaks, _starts(4), ["a", "b"], {"g": ["a", "b"]}, {"a": 1, "b": 1})
     assert res.per_mesh["a"] == pytest.approx(2 * 12 / 20)
     assert res.per_mesh["b"] == pytest.approx(2 * 11 / 20)
     np.testing.assert_allclose(res.per_cycle["a"] + res.per_cycle["b"], 2.0)
+    assert res.per_cycle["a"][0] == pytest.approx(1.5)  # whole run kept for plots
     assert res.system == pytest.approx(1.2)
 
 
-def test_instantaneous_and_engineering():
-    # seed 001 eq. 18: g = 2 max(F1, F2) / (F1 + F2); engineering: mean of cycle peaks
-    t = np.arange(400) / 100.0  # 4 s sampled at 100 Hz, cycles of 1 Hz
-    f1 = 100 + 10 * np.sin(2 * np.pi * t)
-    f2 = 100 - 10 * np.sin(2 * np.pi * t)
-    res = ls.instantaneous(t, np.c_[f1, f2], ["a", "b"], {"g": ["a", "b"]}, 0.0)
-    assert res.per_mesh["a"] == pytest.approx(1.1, abs=1e-3)
-    eng = ls.instantaneous(t, np.c_[f1, f2], ["a", "b"], {"g": ["a", "b"]}, 0.0,
-                           {"g": 1.0}, "engineering")
-    assert eng.per_mesh["a"] == pytest.approx(1.1, abs=1e-3)
-    assert len(eng.per_cycle["a"]) == 2  # incomplete first and last cycles dropped
+def test_instantaneous_and_engineering_from_streamed_cycle_ratio_peaks():
+    # Ji & Li eq. 18: per-cycle peaks of 2 F_i / (F_1 + F_2) of 1.10, 1.12, 1.08 after a
+    # transient cycle of 1.4: g = 1.12 (largest), g_t = 1.10 (mean of the peaks)
+    ratio = np.array([[1.4, 1.0], [1.10, 0.95], [1.12, 0.97], [1.08, 0.96]])
+    first = {"a": 1, "b": 1}
+    inst = ls.instantaneous(ratio, _starts(4), ["a", "b"], {"g": ["a", "b"]}, first)
+    eng = ls.instantaneous(ratio, _starts(4), ["a", "b"], {"g": ["a", "b"]}, first,
+                           "engineering")
+    assert inst.per_mesh["a"] == pytest.approx(1.12)
+    assert eng.per_mesh["a"] == pytest.approx((1.10 + 1.12 + 1.08) / 3)
+    assert eng.per_group["g"] == pytest.approx(1.10)
+    with pytest.raises(ValueError, match="instantaneous"):
+        ls.instantaneous(ratio, _starts(4), ["a", "b"], {"g": ["a", "b"]}, first, "x")
 
 
-def test_dynamic_factor_peak_over_nominal():
-    peaks = np.array([[110.0], [130.0], [120.0]])
-    dyn = ls.dynamic_factors(peaks, ["a"], {"g": ["a"]}, {"a": 1}, {"a": 100.0})
-    assert dyn.peak["a"] == pytest.approx(1.3)
-    assert dyn.engineering["a"] == pytest.approx(1.25)
+def test_dynamic_factor_is_peak_over_own_static_force_and_peak_to_nominal_is_eq19():
+    """Mesh a is lightly loaded (static 86 N of a nominal 100 N), mesh b heavily (114 N):
+    peaks 93.2 and 123.6 N give dynamic factors 1.0837 and 1.0842 (>= 1, the K_v sense),
+    and peak/nominal 0.932 and 1.236 (Ji & Li eq. 19 per mesh: G = max F_i / F_0)."""
+    peaks = np.array([[500.0, 500.0], [93.2, 123.6], [90.0, 120.0]])
+    first = {"a": 1, "b": 1}
+    dyn = ls.dynamic_factors(peaks, ["a", "b"], {"g": ["a", "b"]}, first,
+                             {"a": 86.0, "b": 114.0}, {"a": 100.0, "b": 100.0})
+    assert dyn.dynamic_factor["a"] == pytest.approx(93.2 / 86.0)
+    assert dyn.dynamic_factor["b"] == pytest.approx(123.6 / 114.0)
+    assert dyn.dynamic_factor_engineering["a"] == pytest.approx((93.2 + 90.0) / 2 / 86.0)
+    assert dyn.peak_to_nominal["a"] == pytest.approx(0.932)
+    assert dyn.per_group_peak_to_nominal["g"] == pytest.approx(1.236)
+    # G_t: mean over cycles of max_i F_i / F_0 = (1.236 + 1.20) / 2
+    assert dyn.per_group_peak_to_nominal_engineering["g"] == pytest.approx(1.218)
+    assert dyn.per_group_dynamic_factor["g"] == pytest.approx(123.6 / 114.0)
+
+
+def test_peak_to_nominal_reproduces_ji_li_eq19_on_a_hand_case():
+    """Ji & Li eq. 19: G_1 = (F_11, F_21)_max / F_01.  Forces of the two branches over
+    three mesh cycles (hand values): peaks 1.05, 1.03 and 1.07 F_01 on branch 1 and
+    0.98, 1.08, 1.01 F_01 on branch 2; G_1 = 1.08 (largest instant), and the
+    engineering coefficient G_1t = mean of the per-cycle peaks of max(F_11, F_21) / F_01
+    = (1.05 + 1.08 + 1.07) / 3."""
+    f01 = 2.0e5
+    peaks = f01 * np.array([[1.05, 0.98], [1.03, 1.08], [1.07, 1.01]])
+    dyn = ls.dynamic_factors(peaks, ["m11", "m21"], {"s1": ["m11", "m21"]},
+                             {"m11": 0, "m21": 0}, {"m11": f01, "m21": f01},
+                             {"m11": f01, "m21": f01})
+    assert dyn.per_group_peak_to_nominal["s1"] == pytest.approx(1.08, rel=1e-12)
+    assert dyn.per_group_peak_to_nominal_engineering["s1"] == pytest.approx(3.2 / 3,
+                                                                            rel=1e-12)
+
+
+def test_unloaded_mesh_has_no_dynamic_factor():
+    peaks = np.array([[5.0], [6.0]])
+    dyn = ls.dynamic_factors(peaks, ["a"], {"g": ["a"]}, {"a": 0}, {"a": -3.0},
+                             {"a": 100.0})
+    assert math.isnan(dyn.dynamic_factor["a"])
+    assert dyn.peak_to_nominal["a"] == pytest.approx(0.06)
 
 
 def test_settle_skips_a_decaying_transient():
@@ -65,3 +111,45 @@ def test_settle_skips_a_decaying_transient():
     assert st.settled
     assert 40 <= st.first_cycle["a"] <= 140
     assert st.start_time == pytest.approx(st.first_cycle["a"] / 100.0)
+
+
+@pytest.mark.parametrize("k", [1, 3, 7, 19, 25])
+def test_settle_never_counts_a_transient_cycle_for_any_run_length(k):
+    """A transient of k cycles (peak 1.3) then steady cycles (peak 1.0, with a small
+    ripple): for every run length n, not only multiples of the window, the first settled
+    cycle is after the transient, so the largest settled peak is the steady one."""
+    for n in range(8 * 20, 8 * 20 + 41):
+        i = np.arange(n)
+        peaks = 1.0 + 0.001 * np.sin(0.7 * i)
+        peaks[:k] = 1.3
+        st = ls.settle(peaks[:, None], (i / 100.0)[:, None], ["a"], window=20,
+                       tolerance=0.01)
+        assert st.first_cycle["a"] >= k, (n, st.first_cycle)
+        assert peaks[st.first_cycle["a"]:].max() < 1.01
+
+
+def test_one_settle_time_per_group_used_by_every_member():
+    """Mesh a settles late (transient 60 cycles), mesh b at once: both members of the
+    group start at a's settle time, and so do the group's coefficients."""
+    n = 400
+    i = np.arange(n)
+    a = np.where(i < 60, 2.0, 1.0)
+    b = np.ones(n)
+    peaks = np.c_[a, b]
+    starts = _starts(n)
+    groups = {"g": ["a", "b"]}
+    st = ls.settle(peaks, starts, ["a", "b"], window=20, tolerance=0.01, groups=groups)
+    assert st.own_first_cycle["b"] < st.own_first_cycle["a"]
+    assert st.first_cycle["a"] == st.first_cycle["b"] >= 60
+    assert st.group_time["g"] == pytest.approx(starts[st.first_cycle["a"], 0])
+    res = ls.cycle_peak(peaks, starts, ["a", "b"], groups, st.first_cycle)
+    assert res.per_group["g"] == pytest.approx(1.0)
+
+
+def test_static_torque_is_largest_ratio_over_positions():
+    # Mo et al. 2017 eq. 14-15: three star gears, forces at two positions
+    f = np.array([[100.0, 100.0, 100.0], [110.0, 95.0, 95.0]])
+    res = ls.static_torque(np.array([0.0, 1.0]), f, ["p1", "p2", "p3"],
+                           {"s": ["p1", "p2", "p3"]})
+    assert res.per_mesh["p1"] == pytest.approx(3 * 110 / 300)
+    assert res.system == pytest.approx(1.1)

@@ -210,20 +210,23 @@ def test_load_sharing_lines_reproduce_the_reported_coefficient(run, definition):
     met = run.metrics(definition)
     fig = F.load_sharing_figure(run, definition)
     assert definition in fig.get_suptitle()
-    settle_ms = met.settling.start_time * 1e3
     for g, members in run.groups.items():
+        settle_ms = met.settling.group_time[g] * 1e3
         ax = _panel(fig, f"group {g}")
         lines = [_line(ax, m) for m in members]
-        # the coefficients of a group sum to its number of meshes in every cycle
+        # the coefficients of a group sum to its number of meshes in every cycle (a cycle
+        # without samples, the last one cut by the end of the run, is NaN)
         if definition != "instantaneous":  # per-mesh cycle peaks need not coincide
             total = sum(ln.get_ydata() for ln in lines)
+            total = total[np.isfinite(total)]
+            assert total.size > 10
             np.testing.assert_allclose(total, len(members), rtol=1e-9)
         reported = next(ln for ln in ax.get_lines() if ln.get_label().startswith("reported"))
         assert reported.get_ydata()[0] == pytest.approx(met.load_sharing.per_group[g])
         if definition in ("cycle_peak", "instantaneous"):  # reported = largest settled
             for m, ln in zip(members, lines):
                 settled = ln.get_xdata() >= settle_ms
-                assert ln.get_ydata()[settled].max() == pytest.approx(
+                assert np.nanmax(ln.get_ydata()[settled]) == pytest.approx(
                     met.load_sharing.per_mesh[m], rel=1e-6)
     # the 3 um error on a1 moves load to b1
     split = _panel(fig, "group split")

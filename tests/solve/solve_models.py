@@ -65,10 +65,11 @@ def random_structure(seed: int = 0):
                            ground_damping=rng.random(n), n_table=32)
 
 
-def random_structure_extras(seed: int = 0):
+def random_structure_extras(seed: int = 0, gyroscopic: bool = False):
     """:func:`random_structure` plus tooth friction on its four meshes and two spline
     radial elements (one with a stick limit and a clearance, one without clearance), so
-    that every branch of the spline law and of the friction scatter is reachable."""
+    that every branch of the spline law and of the friction scatter is reachable; with
+    ``gyroscopic`` also a gyroscopic coupling of DOFs 0 and 1 (and a diagonal entry)."""
     base = random_structure(seed)
     rng = np.random.default_rng(1000 + seed)
     n = base.n_dof
@@ -100,6 +101,9 @@ def random_structure_extras(seed: int = 0):
                     friction_force=30.0, velocity_scale=1e-3))
     els.append(dict(name="spB", kind=SPLINE, x=([3], [-1.0]), y=([4], [-1.0]),
                     stiffness=2e7, damping=5.0, friction_force=10.0, velocity_scale=1e-3))
+    # gyroscopic coupling of two translations (a body in a rotating frame), so that the
+    # velocity-coupling term of every right-hand side is exercised too
+    gyro = [(0, 1, -35.0), (1, 0, 35.0), (3, 3, 2.0)] if gyroscopic else []
     return build_structure(base.dof_names, base.inv_mass, els,
                            external_force=base.external_force,
-                           ground_damping=base.ground_damping, n_table=32)
+                           ground_damping=base.ground_damping, gyroscopic=gyro, n_table=32)

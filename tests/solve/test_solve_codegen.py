@@ -11,87 +11,51 @@ from numba import njit
 from solve_models import random_structure, random_structure_extras, spur_pair
 
 import torquesplit
-from torquesplit.solve import _kernels as kern
 from torquesplit.solve import codegen, integrate
-from torquesplit.solve.integrate import _model_arrays
+from torquesplit.solve.kernel_data import kernel_model
 
 integrate_module = sys.modules["torquesplit.solve.integrate"]
 
 
-def _slot_arrays(model, t):
-    """Excitation slot 0 of the kernels at time t (what rhs_at builds)."""
-    a = dict(zip(kern.MODEL_ARRAYS, model, strict=True))
-    ne = a["vr_ptr"].shape[0] - 1
-    n_sin = a["error_omega"].shape[0]
-    K, P, G, E, ED = (np.empty((1, ne)) for _ in range(5))
-    CY = np.empty((1, ne), dtype=np.int64)
-    S, C = np.empty((1, n_sin)), np.empty((1, n_sin))
-    has_force = np.zeros(ne, dtype=np.bool_)
-    kern.scratch_flags(a["element_kind"], a["gap_ptr"], a["gap_values"], a["force_table"],
-                       has_force, np.empty(ne, dtype=np.int64))
-    kern.init_slots(a["stiffness_table"], a["force_table"], a["gap_ptr"], a["gap_values"],
-                    a["error_constant"], K, P, G, E, ED, CY)
-    kern.excite_exact(t, np.int64(0), a["frequency"], a["phase"], a["stiffness_table"],
-                      a["force_table"], a["gap_ptr"], a["gap_values"], a["error_constant"],
-                      a["error_amplitude"], a["error_omega"], a["error_phase"], a["tv_el"],
-                      a["err_el"], a["sin_el"], K, P, G, E, ED, CY, S, C,
-                      np.full(ne, -(2**62), dtype=np.int64), np.zeros(ne), has_force)
-    return a, K, P, G, E, ED
+def _call(code, s, t, y):
+    """dy/dt, forces and deformations at (t, y) through the kernels' one stage
+    evaluation, with the generated code or the general kernel (``code``)."""
+    return integrate_module._evaluate(s, t, y, code=code)
 
 
-@njit(error_model="numpy")
-def _rhs_any(fn, par, y, slot, K, P, G, E, ED, inv_mass, external_force, ground_damping,
-             vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping, dy, force, defl):
-    """What the kernels' call sites do (``if gen: rhs_fn(...) else: rhs_slot(...)``)."""
-    if par.shape[0] > 0:
-        fn(y.ctypes.data, dy.ctypes.data, force.ctypes.data, defl.ctypes.data,
-           K.ctypes.data, G.ctypes.data, E.ctypes.data, ED.ctypes.data, P.ctypes.data,
-           par.ctypes.data, slot * K.shape[1])
-    else:
-        kern.rhs_slot(y, slot, K, P, G, E, ED, inv_mass, external_force, ground_damping,
-                      vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping, dy,
-                      force, defl)
-
-
-def _call(code, a, y, K, P, G, E, ED):
-    n, ne = a["inv_mass"].shape[0], a["vr_ptr"].shape[0] - 1
-    dy, force, defl = np.full(2 * n, np.nan), np.full(ne, np.nan), np.full(ne, np.nan)
-    _rhs_any(code.function, code.parameters, y, np.int64(0), K, P, G, E, ED,
-                 a["inv_mass"], a["external_force"], a["ground_damping"], a["vr_ptr"],
-                 a["vq_idx"], a["vv_idx"], a["v_coef"], a["vt_ptr"], a["vt_el"],
-                 a["vt_coef"], a["damping"], dy, force, defl)
-    return dy, force, defl
+def _extras_gyro(seed):
+    return random_structure_extras(seed, gyroscopic=True)
 
 
 @pytest.mark.parametrize("make, seed", [(random_structure, 0), (random_structure, 1),
-                                        (random_structure_extras, 2)])
+                                        (random_structure_extras, 2), (_extras_gyro, 4)])
 def test_generated_rhs_is_rhs_slot_bit_for_bit(make, seed):
     """Every branch: elements inside and outside their dead zones (gaps 1-2 um against
     deflections of a few um), errors, additive forces, spline components (zero
     stiffness in this kernel), at several times."""
     s = make(seed)
-    model = _model_arrays(s)
+    model = kernel_model(s)
     gen, general = codegen.generated_rhs(model), codegen.general_rhs()
     assert gen.generated and not general.generated and gen.lines > 0
     rng = np.random.default_rng(seed)
     n = s.n_dof
     in_zone = set()
     for t in (0.0, 1.7e-3, 0.0413, 3.2):
-        a, K, P, G, E, ED = _slot_arrays(model, t)
+        g = torquesplit.solve.excitation_numpy(s, t).half_gap
         for _ in range(25):
             y = np.concatenate([rng.normal(scale=3e-6, size=n), rng.normal(scale=1e-3, size=n)])
-            dy_g, f_g, d_g = _call(gen, a, y, K, P, G, E, ED)
-            dy_s, f_s, d_s = _call(general, a, y, K, P, G, E, ED)
+            dy_g, f_g, d_g = _call(gen, s, t, y)
+            dy_s, f_s, d_s = _call(general, s, t, y)
             np.testing.assert_array_equal(dy_g, dy_s)
             np.testing.assert_array_equal(f_g, f_s)
             np.testing.assert_array_equal(d_g, d_s)
-            in_zone |= set(np.flatnonzero((np.abs(d_s) <= G[0]) & (G[0] > 0)).tolist())
+            in_zone |= set(np.flatnonzero((np.abs(d_s) <= g) & (g > 0)).tolist())
     assert in_zone, "no state fell inside a dead zone: the test would miss that branch"
 
 
 @pytest.mark.parametrize("method", ["rk4", "dopri"])
 def test_integrate_generated_equals_general(method):
-    s = random_structure_extras(3)
+    s = random_structure_extras(3, gyroscopic=True)
     y0 = np.zeros(2 * s.n_dof)
     kw = dict(method=method, full_history=True)
     if method == "rk4":
@@ -118,7 +82,7 @@ def test_seed001_example_runs_the_generated_code_with_the_same_results():
 def test_compiled_code_is_reused_for_the_same_pattern():
     """Values differ (stiffness, torque), sparsity does not: one compilation."""
     s1, s2 = spur_pair(stiffness=3.1e8, torque=71.0), spur_pair(stiffness=4.7e8, torque=13.0)
-    g1, g2 = (codegen.generated_rhs(_model_arrays(s)) for s in (s1, s2))
+    g1, g2 = (codegen.generated_rhs(kernel_model(s)) for s in (s1, s2))
     assert g2.compile_time == 0.0
     assert g1.function.__wrapper_address__() == g2.function.__wrapper_address__()
     assert not np.array_equal(g1.parameters, g2.parameters)
@@ -150,7 +114,7 @@ def test_auto_generates_only_when_the_run_repays_the_compilation():
     """A pattern no other test compiles: short runs keep the general kernel, long ones
     generate, and once compiled the pattern is always used."""
     s = random_structure(7)
-    model = _model_arrays(s)
+    model = kernel_model(s)
     assert not codegen.worth_generating(model, 1e3)
     assert codegen.worth_generating(model, 1e9)
     y0 = np.zeros(2 * s.n_dof)

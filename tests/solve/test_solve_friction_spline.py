@@ -173,7 +173,7 @@ def test_dopri_kernel_matches_readable_dopri_with_friction():
     sol = integrate(s, y0, (0.0, 0.005), method="dopri", rtol=1e-7, atol=atol,
                     max_step=1e-4, full_history=True, history_elements=(), history_dofs=())
     mod = importlib.import_module("torquesplit.solve.integrate")
-    h0 = min(mod._initial_step(s, y0, 0.0, 0.005, 1e-7, atol, mod._model_arrays(s)), 1e-4)
+    h0 = min(mod._initial_step(s, y0, 0.0, 0.005, 1e-7, atol, None), 1e-4)
     _, y_ref, n_rej = dopri_numpy(s, y0, (0.0, 0.005), rtol=1e-7, atol=atol, h0=h0,
                                   h_max=1e-4)
     assert sol.n_steps == len(y_ref) - 1 and sol.n_rejected == n_rej

@@ -97,7 +97,7 @@ def test_dopri_kernel_matches_readable_dopri():
 def _first_step(s, y0, rtol, atol, span):
     """The starting step integrate() uses (the twin must start from the same one)."""
     mod = importlib.import_module("torquesplit.solve.integrate")  # module, not function
-    return min(mod._initial_step(s, y0, 0.0, span, rtol, atol, mod._model_arrays(s)), 1e-4)
+    return min(mod._initial_step(s, y0, 0.0, span, rtol, atol, None), 1e-4)
 
 
 def test_hermite_reproduces_cubic():
@@ -111,10 +111,14 @@ def test_hermite_reproduces_cubic():
 
 
 def test_streaming_cycle_statistics_equal_post_processed_history():
-    # more steps than one chunk, so the statistics must continue across chunks
-    s = spur_pair(damping=100.0, frequency=1000.0, phase=0.37,
-                  stiffness=2e8 * (1 + 0.3 * np.sign(np.sin(2 * np.pi * np.arange(64) / 64))),
+    # more steps than one chunk, so the statistics must continue across chunks; a smooth
+    # stiffness (no corner events: every statistic comes from the step samples)
+    from torquesplit.solve.kernel_data import corner_nodes
+
+    s = spur_pair(damping=100.0, frequency=1000.0, phase=0.37, n_table=256,
+                  stiffness=2e8 * (1 + 0.3 * np.sin(2 * np.pi * np.arange(256) / 256)),
                   errors=[(2e-6, 2 * np.pi * 60, 0.0)])
+    assert corner_nodes(s.stiffness_table[0]).size == 0
     y0 = np.array([1e-4, -5e-5, 0.0, 0.0])
     sol = integrate(s, y0, (0.0, 0.0377), steps_per_period=97)
     assert sol.success and sol.n_steps > 3000
@@ -130,6 +134,68 @@ def test_streaming_cycle_statistics_equal_post_processed_history():
     starts = sol.cycle_start[1:, 0]
     np.testing.assert_allclose((1000.0 * starts + 0.37) % 1.0, 0.0, atol=1e-9)
     assert sol.n_samples == sol.n_steps + 1 == len(sol.history_t)
+
+
+def _rectangular_pair():
+    """A spur pair with a rectangular stiffness wave (ramps of one table node): its
+    force has corners at the four ramp ends of every mesh cycle."""
+    return spur_pair(damping=100.0, frequency=1000.0, phase=0.37,
+                     stiffness=2e8 * (1 + 0.3 * np.sign(np.sin(2 * np.pi * (np.arange(64)
+                                                                         + 0.5) / 64))),
+                     errors=[(2e-6, 2 * np.pi * 60, 0.0)])
+
+
+def test_corner_events_sample_the_forces_at_the_table_corners():
+    """Cycle max / min = those of the step samples and of the forces at every corner
+    time, the state there by cubic Hermite interpolation of the steps (twin: numpy)."""
+    from torquesplit.solve.kernel_data import corner_nodes
+
+    s = _rectangular_pair()
+    y0 = np.array([1e-4, -5e-5, 0.0, 0.0])
+    sol = integrate(s, y0, (0.0, 0.0077), steps_per_period=97, full_history=True)
+    nodes = corner_nodes(s.stiffness_table[0])
+    assert nodes.size == 4
+    f, ph, n_tab = 1000.0, 0.37, s.n_table
+    t, forces = list(sol.full_t), list(element_forces_numpy(s, ti, yi)[0][0]
+                                       for ti, yi in zip(sol.full_t, sol.full_y))
+    ext_t = []
+    for c in range(int(f * sol.t_final) + 2):
+        for node in nodes:
+            tc = ((c + node / n_tab) - ph) / f
+            k = np.searchsorted(sol.full_t, tc) - 1
+            if 0 <= k < len(sol.full_t) - 1 and sol.full_t[k] < tc:
+                h = sol.full_t[k + 1] - sol.full_t[k]
+                ya, yb = sol.full_y[k], sol.full_y[k + 1]
+                yc = hermite_numpy((tc - sol.full_t[k]) / h, h, ya, rhs_numpy(s, sol.full_t[k], ya),
+                                   yb, rhs_numpy(s, sol.full_t[k + 1], yb))
+                t.append(tc)
+                forces.append(element_forces_numpy(s, tc, yc)[0][0])
+                ext_t.append(tc)
+    assert len(ext_t) > 20
+    cmax, cmin, _, _ = cycle_statistics_numpy(np.array(t), np.array(forces), f, ph, 0.0, 100)
+    n = sol.cycle_max.shape[0]
+    np.testing.assert_allclose(sol.cycle_max[:, 0], cmax[:n], rtol=1e-12)
+    np.testing.assert_allclose(sol.cycle_min[:, 0], cmin[:n], rtol=1e-12)
+    # the steps alone miss the corners: the events change the statistics
+    smax, _, _, _ = cycle_statistics_numpy(sol.full_t, np.array(forces[:len(sol.full_t)]),
+                                           f, ph, 0.0, 100)
+    assert np.any(cmax[:n] > smax[:n] * (1 + 1e-9))
+
+
+def test_peak_force_with_corners_converges_with_the_step():
+    """The largest force of the rectangular-stiffness pair moves by less than 1e-4 of
+    itself when the step is halved from 200 steps per mesh period on (what remains is
+    RK4's error across the table's corners, first order in h once a corner falls inside
+    a step)."""
+    s = _rectangular_pair()
+    y0 = np.array([1e-4, -5e-5, 0.0, 0.0])
+
+    def peak(spp):
+        sol = integrate(s, y0, (0.0, 0.02), steps_per_period=spp)
+        return np.nanmax(sol.cycle_max[5:15, 0])
+
+    peaks = [peak(spp) for spp in (200, 400, 800)]
+    assert np.max(np.abs(np.diff(peaks))) < 1e-4 * peaks[-1]
 
 
 def test_contact_counters_equal_twin_over_the_full_history():

@@ -51,6 +51,10 @@ def stiffness_table(model: Model, kin: Kinematics, mesh_name: str, n: int) -> np
             raise ValueError(f"meshes.{mesh_name}.stiffness: the Fourier series becomes negative; "
                              f"check the coefficients against the mean")
         return k
+    if spec.method == "ltca":
+        from ..gears.contact.coupling import mesh_ltca
+
+        return np.asarray(mesh_ltca(model, kin, mesh_name, n).stiffness)
     from ..gears import stiffness as gst
 
     if mk.geometry is None:
@@ -203,6 +207,18 @@ def mesh_errors(model: Model, kin: Kinematics, mesh_name: str):
             total = total + gerr.tooth_thickness_error(ge.tooth_thickness, alpha)
         if ge.pitch:
             total = total + gerr.cumulative_pitch_error(ge.pitch, 0.0, abs(w), alpha)
+    if mesh.stiffness.method == "ltca":
+        # loaded transmission-error excitation of the LTCA (gears/contact/coupling.py)
+        from ..gears.contact.coupling import mesh_ltca, error_harmonics
+
+        tab = mesh_ltca(model, kin, mesh_name, model.analysis.table_points)
+        c0, harm = error_harmonics(tab.error, mk.frequency, mesh_phases(model, kin)[mesh_name],
+                                   int(tab.summary.get("error_harmonics", 16)))
+        if harm:
+            amp, om, ph = zip(*harm)
+            total = total + gerr.LineOfActionError(c0, list(amp), list(om), list(ph))
+        else:
+            total = total + gerr.LineOfActionError(c0)
     sines = [(float(a), float(om), float(ph))
              for a, om, ph in zip(total.amplitudes, total.omegas, total.phases)]
     return float(total.constant), sines
@@ -220,6 +236,11 @@ def impact_force_table(model: Model, kin: Kinematics, mesh_name: str, n: int):
     mesh = model.meshes[mesh_name]
     if not mesh.impact:
         return None
+    if mesh.stiffness.method == "ltca":
+        # meshing-in impact from the loaded geometry (gears/contact/impact.py)
+        from ..gears.contact.coupling import mesh_ltca
+
+        return np.asarray(mesh_ltca(model, kin, mesh_name, n).impact_force)
     from ..gears import impact as gim
 
     mk = kin.meshes[mesh_name]

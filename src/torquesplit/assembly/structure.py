@@ -138,6 +138,15 @@ class Structure:
     radial clearance S2 [m], friction force F_m [N], velocity scale v [m/s] of the
     regularised Coulomb friction (columns SP_*)."""
 
+    gy_ptr: np.ndarray = field(default_factory=_empty_int)
+    """(n_dof + 1,) int64, or empty for none: the gyroscopic matrix G by row (CSR).  The
+    generalized force on DOF i is ``-sum_j G_ij v_j`` (Coriolis coupling of the
+    translations of a body in a rotating frame: skew-symmetric, does no work)."""
+    gy_idx: np.ndarray = field(default_factory=_empty_int)
+    """(n_gy,) int64 column (DOF) of each entry of G."""
+    gy_coef: np.ndarray = field(default_factory=_empty_float)
+    """(n_gy,) float64 value of each entry of G [N s/m, N m s/rad]."""
+
     metadata: dict = field(default_factory=dict, compare=False)
     """Free-form information for post-processing (mesh names, stages, body map...)."""
 
@@ -183,6 +192,19 @@ class Structure:
             np.add.at(W[e], self.fr_dof[sl], self.fr_coef[sl] * vals[self.fr_row[sl]])
         return W
 
+    @property
+    def n_gyroscopic(self) -> int:
+        """Number of non-zero entries of the gyroscopic matrix."""
+        return int(self.gy_idx.shape[0])
+
+    def gyroscopic_matrix(self) -> np.ndarray:
+        """Dense (n_dof, n_dof) gyroscopic matrix G (generalized force -G v)."""
+        Gm = np.zeros((self.n_dof, self.n_dof))
+        for i in range(self.n_dof if self.gy_ptr.size else 0):
+            sl = slice(self.gy_ptr[i], self.gy_ptr[i + 1])
+            np.add.at(Gm[i], self.gy_idx[sl], self.gy_coef[sl])
+        return Gm
+
     def mean_stiffness(self) -> np.ndarray:
         """(n_el,) mean of each element's stiffness table [N/m]."""
         return self.stiffness_table.mean(axis=1)
@@ -207,19 +229,6 @@ class Structure:
                 c[self.sp_el[j]] += par[SP_FRICTION] / par[SP_VELOCITY]
         return V.T @ (c[:, None] * V) + np.diag(self.ground_damping)
 
-    def kernel_arrays(self) -> tuple:
-        """The arrays in the order the compiled kernels take them."""
-        return (
-            self.inv_mass, self.external_force, self.ground_damping,
-            self.element_kind, self.v_ptr, self.v_dof, self.v_coef,
-            self.stiffness_table, self.frequency, self.phase, self.damping,
-            self.gap_ptr, self.gap_values,
-            self.error_constant, self.error_ptr, self.error_amplitude,
-            self.error_omega, self.error_phase, self.force_table,
-            self.fr_el, self.fr_ptr, self.fr_dof, self.fr_coef, self.fr_row,
-            self.friction_table, self.sp_el, self.sp_par,
-        )
-
 
 def build_structure(
     dof_names,
@@ -228,6 +237,7 @@ def build_structure(
     *,
     external_force=None,
     ground_damping=None,
+    gyroscopic=(),
     n_table: int = 256,
     metadata: dict | None = None,
 ) -> Structure:
@@ -250,6 +260,9 @@ def build_structure(
     of the relative displacement hub - floating member; either may be empty), and
     ``stiffness``, ``damping``, ``stick_limit``, ``clearance``, ``friction_force`` and
     ``velocity_scale`` (scalars, SI).
+
+    ``gyroscopic`` lists ``(i, j, g)`` entries of the gyroscopic matrix: the generalized
+    force on DOF i gets ``-g v_j`` (entries on one (i, j) add up).
     """
     n_dof = len(dof_names)
     inv_mass = np.ascontiguousarray(inv_mass, dtype=np.float64)
@@ -342,6 +355,14 @@ def build_structure(
                 fr_coef.append(float(c))
                 fr_row.append(base + int(r))
             fr_ptr.append(len(fr_dof))
+    gy = sorted((int(i), int(j), float(g)) for i, j, g in gyroscopic)
+    for i, j, g in gy:
+        if not (0 <= i < n_dof and 0 <= j < n_dof and np.isfinite(g)):
+            raise ValueError(f"gyroscopic entry ({i}, {j}, {g}) is out of range or not "
+                             f"finite; DOF indices are 0..{n_dof - 1}")
+    gy_ptr = np.zeros(n_dof + 1, dtype=np.int64)
+    for i, _, _ in gy:
+        gy_ptr[i + 1] += 1
     return Structure(
         dof_names=tuple(dof_names),
         inv_mass=inv_mass,
@@ -373,6 +394,9 @@ def build_structure(
                         else np.zeros((0, n_table))),
         sp_el=np.asarray([[a, b] for a, b, _ in splines], dtype=np.int64).reshape(-1, 2),
         sp_par=np.asarray([p for _, _, p in splines], dtype=np.float64).reshape(-1, 6),
+        gy_ptr=np.cumsum(gy_ptr),
+        gy_idx=np.asarray([j for _, j, _ in gy], dtype=np.int64),
+        gy_coef=np.asarray([g for _, _, g in gy], dtype=np.float64),
         metadata=dict(metadata or {}),
     )
 

@@ -1,35 +1,44 @@
-"""Load-sharing coefficients and dynamic load factors, by the seeds' definitions.
+"""Load-sharing coefficients and dynamic factors, by the papers' definitions.
 
 Meshes are grouped into *load-sharing groups*: meshes with the same ``path`` and
 ``stage`` labels (model file) carry parallel shares of one flow of power.  In a group
 of N meshes each definition forms ``N X_i / sum_j X_j`` of some per-mesh quantity X,
-so a perfect split gives 1 for every mesh and the coefficients of a group sum to N:
+so a perfect split gives 1 for every mesh and the coefficients of a group sum to N.
+Every definition is computed from quantities the integrator streams at every step (per
+mesh cycle: force max, min and mean, and the largest instantaneous ratio), never from
+the decimated history, so a coefficient does not depend on how often the history is
+sampled, and it converges with the step:
 
 ==================  =============================================================
 definition          X and reduction
 ==================  =============================================================
 ``cycle_peak``      X = peak force of each mesh in mesh cycle k; the coefficient
-                    is the largest over meshes and settled cycles
-                    (seed 000 eqs. 17-19)
-``instantaneous``   X = force at each instant; largest over the settled samples
-                    (seed 001 eq. 18, g_i)
+                    is the largest over meshes and settled cycles (Liu et al. 2021
+                    eqs. 17-19)
+``instantaneous``   X = force at each instant; the largest over the settled part
+                    (Ji & Li eq. 18, g_i)
 ``engineering``     mean over settled mesh cycles of the per-cycle peak of the
-                    instantaneous coefficient (seed 001, g_it: "average value of the
+                    instantaneous coefficient (Ji & Li, g_it: "average value of the
                     periodic peak")
-``mean_force``      X = mean force over the settled window (seed 002 eq. 12, Omega)
-``static_torque``   X = quasi-static force at each mesh position; largest over the
-                    positions (seed 004 eqs. 14-15)
+``mean_force``      X = mean force over the settled part (Dong et al. 2021 eq. 12)
+``static_torque``   X = quasi-static force at each mesh position; the largest over
+                    the positions (Mo et al. 2017 eqs. 14-15); quasi-static runs only
 ==================  =============================================================
 
-Dynamic load factors (per mesh): ``peak`` = largest settled force / nominal static
-force (ISO sense; seed 000 DLF); ``engineering`` = mean over settled cycles of the
-per-cycle peak / nominal force (seed 001 eq. 19, G_it).  The nominal static force is
-the equal-split tooth force of :mod:`torquesplit.model.kinematics`.
+Dynamic factors (per mesh, over the settled part), named for what they are:
 
-The transient is excluded by a settle criterion: per-cycle peaks are averaged over
-windows of W cycles (at least the longest excitation period); the run is settled from
-the earliest window after which every window's mean and largest peak stay within
-``tolerance`` of the last window's.
+* ``dynamic_factor`` = peak force / the mesh's own static force: the dynamic
+  amplification of the mesh's load in the K_v sense (ISO 6336-1), >= 1 for a mesh that
+  stays in contact; static maldistribution is not in it;
+* ``dynamic_factor_engineering`` = mean over cycles of the per-cycle peak / static force;
+* ``peak_to_nominal`` = peak force / the equal-split nominal force of
+  :mod:`torquesplit.model.kinematics`: load sharing and dynamics together (Ji & Li eq.
+  19, G_i: the largest over the group's meshes);
+* ``peak_to_nominal_engineering`` (per group) = mean over settled cycles of the
+  largest member's per-cycle peak / nominal force (Ji & Li, G_it).
+
+The transient is excluded by a settle criterion (:func:`settle`): one settle time per
+group, used by every metric of that group.
 """
 
 from __future__ import annotations
@@ -40,18 +49,38 @@ from dataclasses import dataclass, field
 import numpy as np
 
 DEFINITIONS = ("cycle_peak", "instantaneous", "engineering", "mean_force", "static_torque")
+DYNAMIC_DEFINITIONS = DEFINITIONS[:4]
+
+DEFINITION_TEXT = {
+    "cycle_peak": "ratio of the meshes' peak forces in each mesh cycle, largest over the "
+                  "settled cycles (Liu et al. 2021 eqs. 17-19)",
+    "instantaneous": "ratio of the meshes' forces at each instant, largest over the settled "
+                     "part (Ji & Li eq. 18)",
+    "engineering": "mean over settled mesh cycles of the per-cycle peak of the "
+                   "instantaneous ratio (Ji & Li, engineering coefficient)",
+    "mean_force": "ratio of the meshes' mean forces over the settled part (Dong et al. "
+                  "2021 eq. 12)",
+    "static_torque": "ratio of quasi-static mesh forces, largest over the mesh positions "
+                     "(Mo et al. 2017 eqs. 14-15)",
+}
+"""What each definition measures, in one line (tables, plots, docs)."""
 
 
 @dataclass(frozen=True)
 class Settling:
-    """Where the transient ends, per tracked mesh."""
+    """Where the transient ends: per mesh and, consistently, per load-sharing group."""
 
     start_time: float
-    """Earliest time from which every mesh is settled [s]."""
+    """Latest group settle time [s] (every group is settled from then on)."""
     settled: bool
     """False if some mesh never settled (then the last half of the run is used)."""
     first_cycle: dict[str, int]
-    """Mesh -> first settled cycle index."""
+    """Mesh -> first cycle used by every metric: the first cycle of the mesh that starts
+    at or after its group's settle time."""
+    group_time: dict[str, float] = field(default_factory=dict)
+    """Group -> settle time [s]: the latest of its meshes' own settle times."""
+    own_first_cycle: dict[str, int] = field(default_factory=dict)
+    """Mesh -> first settled cycle by its own peaks alone."""
 
 
 @dataclass(frozen=True)
@@ -64,7 +93,11 @@ class LoadSharing:
     system: float
     groups: dict[str, list[str]]
     per_cycle: dict[str, np.ndarray] = field(default_factory=dict, repr=False)
-    """Mesh -> coefficient in each settled cycle (cycle-based definitions)."""
+    """Mesh -> the definition's coefficient in every mesh cycle of the run (NaN where a
+    cycle has no sample): the cycle-peak ratio, the per-cycle peak of the instantaneous
+    ratio, or the ratio of the cycle means (``mean_force``)."""
+    cycle_time: dict[str, np.ndarray] = field(default_factory=dict, repr=False)
+    """Mesh -> start time of each of those cycles [s]."""
 
 
 def group_meshes(mesh_meta: dict[str, dict]) -> dict[str, list[str]]:
@@ -77,26 +110,28 @@ def group_meshes(mesh_meta: dict[str, dict]) -> dict[str, list[str]]:
 
 
 def settle(cycle_max: np.ndarray, cycle_start: np.ndarray, names, window=20,
-           tolerance: float = 0.01) -> Settling:
-    """Find the first settled cycle of each mesh from its per-cycle peaks.
+           tolerance: float = 0.01, groups: dict[str, list[str]] | None = None) -> Settling:
+    """Find where the transient ends, from the per-cycle peak forces.
 
-    The peaks are averaged over consecutive windows of W cycles (``window``: one
-    value, or one per mesh; W should cover the longest excitation period, e.g. a
-    gear revolution when errors rotate with the gears).  The last window is the
-    reference; the run is settled from the earliest window after which every window's
-    mean and largest peak stay within ``tolerance`` of the reference (relative to the
-    reference's largest peak).  A slow drift that lasts until the end therefore leaves
-    only the last windows, and a run whose settled part is shorter than a quarter of
-    the run is reported as not settled.
+    Per mesh, the peaks are averaged over consecutive windows of W cycles (``window``:
+    one value, or one per mesh; W should cover the longest excitation period, e.g. a
+    gear revolution when errors rotate with the gears) aligned with the end of the run.
+    The last window is the reference; the mesh is settled from the start of the window
+    after the last one whose mean or largest peak differs from the reference's by more
+    than ``tolerance`` x the reference's largest peak.  The cycles before the first
+    whole window (fewer than W) are never counted as settled: they were not checked.  A
+    drift that lasts until the end leaves only the last windows, and a mesh whose settled
+    part is shorter than a quarter of its cycles is reported as not settled (its last
+    half is used).  A group is settled from the latest settle time of its meshes, and
+    every metric of the group starts there.
     """
-    first = {}
+    own: dict[str, int] = {}
     settled = True
-    t0 = 0.0
+    t_own: dict[str, float] = {}
     for j, name in enumerate(names):
         peaks = cycle_max[:, j]
-        valid = np.isfinite(peaks)
-        idx = np.flatnonzero(valid)
-        peaks = peaks[valid]
+        idx = np.flatnonzero(np.isfinite(peaks))
+        peaks = peaks[idx]
         n = peaks.size
         w_req = int(window[j] if np.ndim(window) else window)
         w = max(2, min(w_req, n // 4))
@@ -104,7 +139,7 @@ def settle(cycle_max: np.ndarray, cycle_start: np.ndarray, names, window=20,
         ok = False
         if n >= 2 * w:
             n_win = n // w
-            start = n - n_win * w  # align the windows with the end of the run
+            start = n - n_win * w  # windows aligned with the end; cycles before: unchecked
             blocks = peaks[start:].reshape(n_win, w)
             ref_mean, ref_max = blocks[-1].mean(), blocks[-1].max()
             scale = max(abs(ref_max), 1e-300)
@@ -112,16 +147,28 @@ def settle(cycle_max: np.ndarray, cycle_start: np.ndarray, names, window=20,
                     & (np.abs(blocks.max(axis=1) - ref_max) <= tolerance * scale))
             bad = np.flatnonzero(~good)
             b0 = int(bad[-1]) + 1 if bad.size else 0
-            k_set = start + b0 * w if b0 else 0
+            k_set = start + b0 * w
             ok = (n - k_set) >= n / 4
         if not ok:
             settled = False
-            k_set = min(k_set, n // 2)
+            k_set = n // 2 if n else 0
         c = int(idx[k_set]) if n else 0
-        first[name] = c
-        if n:
-            t0 = max(t0, float(cycle_start[c, j]))
-    return Settling(start_time=t0, settled=settled, first_cycle=first)
+        own[name] = c
+        t_own[name] = float(cycle_start[c, j]) if n else -math.inf
+    groups = groups or {name: [name] for name in names}
+    col = {n: j for j, n in enumerate(names)}
+    group_time = {g: max(t_own[m] for m in ms) for g, ms in groups.items()}
+    first = {}
+    for g, ms in groups.items():
+        for m in ms:
+            starts = cycle_start[:, col[m]]
+            # first cycle starting at or after the group's settle time (round-off aside)
+            tol = 1e-9 * max(abs(group_time[g]), 1e-300)
+            k = int(np.searchsorted(starts, group_time[g] - tol, side="left"))
+            first[m] = min(max(k, own[m]), max(len(starts) - 1, 0))
+    start_time = max(group_time.values()) if group_time else 0.0
+    return Settling(start_time=start_time, settled=settled, first_cycle=first,
+                    group_time=group_time, own_first_cycle=own)
 
 
 def _ratio(x: np.ndarray) -> np.ndarray:
@@ -131,105 +178,140 @@ def _ratio(x: np.ndarray) -> np.ndarray:
         return x.shape[-1] * x / np.where(s != 0, s, np.nan)
 
 
-def cycle_peak(cycle_max, names, groups, first_cycle) -> LoadSharing:
-    """seed 000 eqs. 17-19: coefficients from per-cycle peak forces."""
+def _nanmax(x) -> float:
+    x = np.asarray(x, dtype=float)
+    return float(np.nanmax(x)) if np.isfinite(x).any() else math.nan
+
+
+def _nanmean(x) -> float:
+    x = np.asarray(x, dtype=float)
+    return float(np.nanmean(x)) if np.isfinite(x).any() else math.nan
+
+
+def cycle_peak(cycle_max, cycle_start, names, groups, first_cycle) -> LoadSharing:
+    """Liu et al. 2021 eqs. 17-19: coefficients from per-cycle peak forces."""
     col = {n: j for j, n in enumerate(names)}
-    per_mesh, per_group, per_cycle = {}, {}, {}
+    per_mesh, per_group, per_cycle, times = {}, {}, {}, {}
     for g, members in groups.items():
-        k0 = max(first_cycle[m] for m in members)
-        x = np.stack([cycle_max[k0:, col[m]] for m in members], axis=-1)
-        x = x[np.all(np.isfinite(x), axis=-1)]
-        r = _ratio(x)  # seed 000 eq. 17: LSC_i(k) = N F_max,i(k) / sum_j F_max,j(k)
+        x = np.stack([cycle_max[:, col[m]] for m in members], axis=-1)
+        r = _ratio(x)  # Liu et al. 2021 eq. 17: LSC_i(k) = N F_max,i(k) / sum_j F_max,j(k)
         for i, m in enumerate(members):
             per_cycle[m] = r[:, i]
-            per_mesh[m] = float(np.nanmax(r[:, i])) if r.size else math.nan
-        per_group[g] = max(per_mesh[m] for m in members)  # seed 000 eq. 18
-    system = max(per_group.values())  # seed 000 eq. 19
-    return LoadSharing("cycle_peak", per_mesh, per_group, system, groups, per_cycle)
+            times[m] = cycle_start[:, col[m]]
+            per_mesh[m] = _nanmax(r[first_cycle[m]:, i])
+        per_group[g] = max(per_mesh[m] for m in members)  # eq. 18
+    system = max(per_group.values())  # eq. 19
+    return LoadSharing("cycle_peak", per_mesh, per_group, system, groups, per_cycle, times)
 
 
-def mean_force(cycle_mean, cycle_count, names, groups, first_cycle) -> LoadSharing:
-    """seed 002 eq. 12: coefficients from mean forces (count-weighted cycle means)."""
+def mean_force(cycle_mean, cycle_count, cycle_start, names, groups,
+               first_cycle) -> LoadSharing:
+    """Dong et al. 2021 eq. 12: coefficients from mean forces (count-weighted cycle
+    means over the settled part)."""
     col = {n: j for j, n in enumerate(names)}
-    per_mesh, per_group = {}, {}
+    per_mesh, per_group, per_cycle, times = {}, {}, {}, {}
     for g, members in groups.items():
-        k0 = max(first_cycle[m] for m in members)
         means = []
         for m in members:
+            k0 = first_cycle[m]
             c = cycle_count[k0:, col[m]]
             v = np.nan_to_num(cycle_mean[k0:, col[m]])
             means.append(float((v * c).sum() / max(c.sum(), 1)))
         r = _ratio(np.asarray(means))
+        rc = _ratio(np.stack([cycle_mean[:, col[m]] for m in members], axis=-1))
         for i, m in enumerate(members):
             per_mesh[m] = float(r[i])
+            per_cycle[m] = rc[:, i]
+            times[m] = cycle_start[:, col[m]]
         per_group[g] = max(per_mesh[m] for m in members)
-    return LoadSharing("mean_force", per_mesh, per_group, max(per_group.values()), groups)
+    return LoadSharing("mean_force", per_mesh, per_group, max(per_group.values()), groups,
+                       per_cycle, times)
 
 
-def instantaneous(t, forces, names, groups, start_time, cycle_frequency=None,
+def instantaneous(cycle_ratio_max, cycle_start, names, groups, first_cycle,
                   definition="instantaneous") -> LoadSharing:
-    """seed 001 eq. 18 (and seed 004 eq. 14 on quasi-static forces).
-
-    ``forces`` (n_samples, n_meshes) sampled at ``t``.  With ``definition ==
-    'engineering'`` the per-cycle peaks of the coefficient (cycles of
-    ``cycle_frequency[group]`` Hz) are averaged instead of taking the largest.
-    """
+    """Ji & Li eq. 18 from the streamed per-cycle peaks of the instantaneous ratio
+    ``N F_i(t) / sum_j F_j(t)`` (``Solution.cycle_ratio_max``): the largest over the
+    settled cycles (``instantaneous``, g_i) or their mean (``engineering``, g_it)."""
+    if definition not in ("instantaneous", "engineering"):
+        raise ValueError(f"definition must be 'instantaneous' or 'engineering', got "
+                         f"{definition!r}")
     col = {n: j for j, n in enumerate(names)}
-    keep = t >= start_time
-    per_mesh, per_group, per_cycle = {}, {}, {}
+    reduce = _nanmax if definition == "instantaneous" else _nanmean
+    per_mesh, per_group, per_cycle, times = {}, {}, {}, {}
     for g, members in groups.items():
-        x = forces[keep][:, [col[m] for m in members]]
-        r = _ratio(x)  # seed 001 eq. 18: g = N F_i / sum_j F_j
-        if definition == "engineering":
-            f = cycle_frequency[g]
-            k = np.floor((t[keep] - t[keep][0]) * f).astype(np.int64) if x.size else np.zeros(0)
-            for i, m in enumerate(members):
-                peaks = _per_bin_max(k, r[:, i])
-                per_cycle[m] = peaks
-                per_mesh[m] = float(np.nanmean(peaks)) if peaks.size else math.nan
-        else:
-            for i, m in enumerate(members):
-                per_mesh[m] = float(np.nanmax(r[:, i])) if r.size else math.nan
+        for m in members:
+            peaks = cycle_ratio_max[:, col[m]]
+            per_cycle[m] = peaks
+            times[m] = cycle_start[:, col[m]]
+            per_mesh[m] = reduce(peaks[first_cycle[m]:])
         per_group[g] = max(per_mesh[m] for m in members)
     return LoadSharing(definition, per_mesh, per_group, max(per_group.values()), groups,
-                       per_cycle)
+                       per_cycle, times)
 
 
-def _per_bin_max(bins: np.ndarray, values: np.ndarray) -> np.ndarray:
-    if bins.size == 0:
-        return np.zeros(0)
-    out = np.full(int(bins.max()) + 1, np.nan)
-    np.fmax.at(out, bins, values)
-    # drop the incomplete first/last bins
-    return out[1:-1] if out.size > 2 else out
+def static_torque(times, forces, names, groups) -> LoadSharing:
+    """Mo et al. 2017 eqs. 14-15: ratios of the quasi-static mesh forces at every mesh
+    position (``forces`` (n_positions, n_meshes)), the largest over the positions."""
+    col = {n: j for j, n in enumerate(names)}
+    per_mesh, per_group, per_cycle, ts = {}, {}, {}, {}
+    for g, members in groups.items():
+        r = _ratio(forces[:, [col[m] for m in members]])  # Mo et al. 2017 eq. 14
+        for i, m in enumerate(members):
+            per_cycle[m] = r[:, i]
+            ts[m] = np.asarray(times, dtype=float)
+            per_mesh[m] = _nanmax(r[:, i])
+        per_group[g] = max(per_mesh[m] for m in members)  # eq. 15
+    return LoadSharing("static_torque", per_mesh, per_group, max(per_group.values()),
+                       groups, per_cycle, ts)
 
 
 @dataclass(frozen=True)
 class DynamicFactors:
-    """Dynamic load factors per mesh: peak and engineering (mean of cycle peaks)."""
+    """Dynamic factors per mesh and per group (see the module docstring)."""
 
-    peak: dict[str, float]
-    engineering: dict[str, float]
-    per_group_peak: dict[str, float]
-    per_group_engineering: dict[str, float]
+    dynamic_factor: dict[str, float]
+    """Mesh -> settled peak force / the mesh's own static force (K_v sense)."""
+    dynamic_factor_engineering: dict[str, float]
+    """Mesh -> mean over settled cycles of the per-cycle peak / static force."""
+    peak_to_nominal: dict[str, float]
+    """Mesh -> settled peak force / equal-split nominal force."""
+    per_group_dynamic_factor: dict[str, float]
+    """Group -> largest member dynamic factor."""
+    per_group_peak_to_nominal: dict[str, float]
+    """Group -> largest member peak / nominal (Ji & Li eq. 19, G_i)."""
+    per_group_peak_to_nominal_engineering: dict[str, float]
+    """Group -> mean over settled cycles of the largest member's per-cycle peak /
+    nominal force (Ji & Li, G_it)."""
 
 
-def dynamic_factors(cycle_max, names, groups, first_cycle, nominal_force) -> DynamicFactors:
-    """Peak dynamic force / nominal static force (ISO sense; seed 000 DLF; seed 001 eq. 19)."""
+def dynamic_factors(cycle_max, names, groups, first_cycle, static_force, nominal_force,
+                    min_static_fraction: float = 1e-3) -> DynamicFactors:
+    """Dynamic factors from the per-cycle peaks (see the module docstring).
+
+    A mesh whose static force is below ``min_static_fraction`` of its nominal force
+    (unloaded, or loaded on its back flank) has no dynamic factor (NaN): a ratio to a
+    vanishing load means nothing.
+    """
     col = {n: j for j, n in enumerate(names)}
-    peak, eng = {}, {}
+    dyn, dyn_eng, ptn = {}, {}, {}
     for m in names:
         p = cycle_max[first_cycle[m]:, col[m]]
         p = p[np.isfinite(p)]
-        f0 = nominal_force[m]
-        peak[m] = float(p.max() / f0) if p.size else math.nan
-        eng[m] = float(p.mean() / f0) if p.size else math.nan
-    gp, ge = {}, {}
+        f_s, f_0 = static_force[m], nominal_force[m]
+        peak = float(p.max()) if p.size else math.nan
+        mean_peak = float(p.mean()) if p.size else math.nan
+        loaded = f_s > min_static_fraction * abs(f_0)
+        dyn[m] = peak / f_s if loaded else math.nan
+        dyn_eng[m] = mean_peak / f_s if loaded else math.nan
+        ptn[m] = peak / f_0 if f_0 != 0 else math.nan
+    g_dyn, g_ptn, g_ptn_eng = {}, {}, {}
     for g, members in groups.items():
-        gp[g] = max(peak[m] for m in members)
-        # seed 001 eq. 19: G = max_i F_i / F_0, averaged over the periodic peaks
+        g_dyn[g] = _nanmax([dyn[m] for m in members])
+        g_ptn[g] = _nanmax([ptn[m] for m in members])
+        # Ji & Li eq. 19: G = max_i F_i / F_0, averaged over the periodic (cycle) peaks
         k0 = max(first_cycle[m] for m in members)
         x = np.stack([cycle_max[k0:, col[m]] / nominal_force[m] for m in members], axis=-1)
         x = x[np.all(np.isfinite(x), axis=-1)]
-        ge[g] = float(x.max(axis=-1).mean()) if x.size else math.nan
-    return DynamicFactors(peak, eng, gp, ge)
+        g_ptn_eng[g] = float(x.max(axis=-1).mean()) if x.size else math.nan
+    return DynamicFactors(dyn, dyn_eng, ptn, g_dyn, g_ptn, g_ptn_eng)

@@ -23,7 +23,7 @@ def check_model(model: Model, source: str | None = None) -> None:
     if not issues:
         issues = mesh_compatibility_issues(model)
     if not issues:
-        issues = geometry_issues(model) + support_issues(model)
+        issues = geometry_issues(model) + support_issues(model) + modification_issues(model)
     if issues:
         raise ModelError(issues, source)
     # the kinematic pass finds loops that cannot turn and power that does not balance
@@ -213,6 +213,41 @@ def geometry_issues(model: Model) -> list[tuple[str, str]]:
     return issues
 
 
+def modification_issues(model: Model) -> list[tuple[str, str]]:
+    """Tooth modifications that do not fit the active profile of a mating pair (a relief
+    longer than the active profile, tip and root relief overlapping, an end relief longer
+    than half the face), and the LTCA asked of a bevel or face mesh, named by field."""
+    from ..gears.contact.modifications import check_modification, modification_from_spec
+    from ..gears.line_of_action import cylindrical_pair, is_conical
+
+    issues: list[tuple[str, str]] = []
+    for name, mesh in model.meshes.items():
+        a, b = mesh.gears
+        ga, gb = model.gears[a], model.gears[b]
+        if mesh.stiffness.method == "ltca" and is_conical(ga, gb):
+            issues.append((f"meshes.{name}.stiffness.method", (
+                "the LTCA is implemented for cylindrical pairs (spur, helical, double-helical, "
+                "internal); use a table or a constant for this bevel/face mesh")))
+        if (ga.modifications is None and gb.modifications is None) or is_conical(ga, gb):
+            continue
+        try:
+            pair = cylindrical_pair(ga, gb)
+        except ModelError:
+            continue  # reported by geometry_issues
+        order = (b, a) if ga.gear_type == "internal" else (a, b)
+        for index, g in enumerate(order, start=1):
+            spec = model.gears[g].modifications
+            if spec is None:
+                continue
+            where = f"gears.{g}.modifications"
+            try:
+                check_modification(modification_from_spec(spec, pair.face_width, where), pair,
+                                   index, where)
+            except ModelError as exc:
+                issues += [i for i in exc.issues if i not in issues]
+    return issues
+
+
 def _teach(msg: str) -> str:
     """A geometry message, ending with what to do if it does not already."""
     return msg if ";" in msg else f"{msg}; correct the value"
@@ -245,6 +280,18 @@ def plausibility_warnings(model: Model, kin) -> list[tuple[str, str]]:
         if ratio is not None and ratio > 1:
             out.append((loc, f"{ratio:g} is above critical damping (1); check the value "
                              f"(typical 0.02-0.1)"))
+    ltca_gears = {g for m in model.meshes.values() if m.stiffness.method == "ltca" for g in m.gears}
+    for name, gear in model.gears.items():
+        if gear.modifications is not None and name not in ltca_gears:
+            out.append((f"gears.{name}.modifications",
+                        "only the stiffness method 'ltca' uses tooth modifications and no mesh of "
+                        "this gear uses it; set stiffness.method = 'ltca' on its meshes or remove "
+                        "the modifications"))
+    for name, m in model.meshes.items():
+        if m.stiffness.method != "ltca" and m.misalignment != type(m.misalignment)():
+            out.append((f"meshes.{name}.misalignment",
+                        "only the stiffness method 'ltca' uses the misalignment; set "
+                        "stiffness.method = 'ltca' or remove it"))
     for name, mk in kin.meshes.items():
         m = model.meshes[name]
         if m.damping is not None and mk.critical_damping > 0 and m.damping > mk.critical_damping:

@@ -90,6 +90,11 @@ def _check_angle(v: float, name: str, upper_deg: float) -> float:
     return v
 
 
+# tooth modifications, misalignment and LTCA options live in their own module; imported
+# here, after the base classes above, which it uses
+from .schema_modifications import LtcaSpec, MisalignmentSpec, ModificationsSpec  # noqa: E402
+
+
 # --------------------------------------------------------------------------- supports
 class ShaftBending(Strict):
     """Lateral stiffness of a gear on a simply supported shaft (seed 001 eqs. 5-7, 10)."""
@@ -213,9 +218,21 @@ class Gear(Strict):
         "(seed 001 eq. 9; its meshes must push it along parallel lines)."))
     support: Support | None = Field(None, description="Support of the translational DOFs.")
     errors: GearErrors = Field(GearErrors(), description="Eccentricity, installation, ... errors.")
+    modifications: ModificationsSpec | None = Field(
+        None, description="Tooth modification of the loaded flank (used by stiffness method "
+        "'ltca').")
 
     @model_validator(mode="after")
     def _consistent(self):
+        if self.modifications is not None:
+            if self.gear_type in ("bevel", "face"):
+                raise FieldError("modifications", (
+                    f"tooth modifications are analysed for cylindrical gears (spur, helical, "
+                    f"double-helical, internal), not for a {self.gear_type} gear; remove them"))
+            if self.modifications.second_helix is not None and self.gear_type != "double_helical":
+                raise FieldError("modifications.second_helix", (
+                    "a second helix exists on double-helical gears only; remove second_helix "
+                    "or set kind = 'double_helical'"))
         _check_angle(self.pressure_angle, "pressure_angle", 45)
         _check_angle(self.helix_angle, "helix_angle", 60)
         if self.helix_angle != 0 and self.hand is None:
@@ -313,8 +330,9 @@ class Shaft(Strict):
 class StiffnessSpec(Strict):
     """Mesh stiffness: method and its parameters (see docs/theory)."""
 
-    method: Literal["constant", "iso6336", "potential_energy", "table", "fourier"] = Field(
-        "constant", description="How k(phase) is obtained."
+    method: Literal["constant", "iso6336", "potential_energy", "table", "fourier", "ltca"] = Field(
+        "constant", description="How k(phase) is obtained ('ltca': loaded tooth contact analysis "
+        "with the gears' modifications at the operating load)."
     )
     value: Stiffness | None = Field(None, gt=0, description="Mean mesh stiffness (constant).")
     peak_to_peak: float = Field(
@@ -326,8 +344,10 @@ class StiffnessSpec(Strict):
     mean: Stiffness | None = Field(None, gt=0, description="Fourier: mean stiffness.")
     cos: list[Stiffness] = Field([], description="Fourier: cosine coefficients a_1..a_n.")
     sin: list[Stiffness] = Field([], description="Fourier: sine coefficients b_1..b_n.")
-    fillet_foundation: bool = Field(True, description="Potential energy: include the fillet term.")
-    slices: int = Field(40, ge=1, description="Helical: number of slices across the face.")
+    fillet_foundation: bool = Field(True, description="Potential energy and LTCA: include the "
+                                    "fillet term.")
+    slices: int = Field(40, ge=1, description="Helical (and LTCA): number of slices across the face.")
+    ltca: LtcaSpec = Field(LtcaSpec(), description="Options of method 'ltca'.")
 
     @model_validator(mode="after")
     def _complete(self):
@@ -348,6 +368,9 @@ class StiffnessSpec(Strict):
         if m == "fourier" and self.mean is None:
             raise FieldError("mean", "method 'fourier' needs the mean stiffness; add "
                              "mean = '4e8 N/m' (your value)")
+        if m != "ltca" and self.ltca != LtcaSpec():
+            raise FieldError("ltca", f"applies to method 'ltca' only, the method is {m!r}; set "
+                             "method = 'ltca' or remove the ltca table")
         return self
 
 
@@ -442,6 +465,8 @@ class Mesh(Strict):
         "name the parallel branches of a split.")
     shaft_angle: Angle | None = Field(None, description="Angle between the axes (bevel/face).")
     impact: bool = Field(False, description="Add meshing-in impact (seed 000 eqs. 6-10).")
+    misalignment: MisalignmentSpec = Field(MisalignmentSpec(), description="Misalignment and "
+                                           "base pitch deviation (stiffness method 'ltca').")
     friction: Annotated[FrictionSpec | None, BeforeValidator(_friction_shorthand)] = Field(
         None, description="Tooth friction (seed 003): true for the defaults, or a [friction] "
         "table; omitted or false = none.")

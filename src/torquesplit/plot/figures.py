@@ -62,14 +62,12 @@ _DEFINITION_TEXT = {
     "cycle_peak": r"$N\,F_{\max,i}(k)\,/\,\Sigma_j F_{\max,j}(k)$ in each mesh cycle $k$",
     "instantaneous": r"peak in each mesh cycle of $N\,F_i(t)\,/\,\Sigma_j F_j(t)$",
     "engineering": r"peak in each mesh cycle of $N\,F_i(t)\,/\,\Sigma_j F_j(t)$",
-    "static_torque": r"peak in each mesh cycle of $N\,F_i(t)\,/\,\Sigma_j F_j(t)$",
     "mean_force": r"$N\,\bar F_i(k)\,/\,\Sigma_j \bar F_j(k)$ in each mesh cycle $k$",
 }
 _REPORTED_TEXT = {
     "cycle_peak": "largest over settled cycles",
     "instantaneous": "largest over settled samples",
     "engineering": "mean of settled cycle peaks",
-    "static_torque": "largest over settled samples",
     "mean_force": "from settled mean forces",
 }
 
@@ -196,7 +194,7 @@ def load_sharing_figure(results, definition: str | None = None) -> Figure:
     Figure
         One panel per group of two or more meshes.  The dashed line is the group's
         reported coefficient (``results.metrics(definition).load_sharing.per_group``),
-        the dotted vertical line the start of the settled part.
+        the dotted vertical line the start of the group's settled part.
     """
     met = results.metrics(definition)
     definition = met.definition
@@ -208,7 +206,8 @@ def load_sharing_figure(results, definition: str | None = None) -> Figure:
             "them")
     s = results.solution
     settle = met.settling.start_time
-    cycle_t, coef = _cycle_coefficients(results, definition, groups)
+    # the metric's own per-cycle data: the figure shows what the number is made of
+    cycle_t, coef = met.load_sharing.cycle_time, met.load_sharing.per_cycle
     fig, axes = _panels(len(groups), sharex=True)
     scale, unit = _time_unit(s.history_t if s.history_t.size else s.cycle_start.ravel())
     for ax, (g, members) in zip(axes, groups.items()):
@@ -218,7 +217,9 @@ def load_sharing_figure(results, definition: str | None = None) -> Figure:
         ax.axhline(met.load_sharing.per_group[g], color=REFERENCE_COLOR, ls="--", lw=1.2,
                    label=f"reported {met.load_sharing.per_group[g]:.6g}\n"
                          f"({_REPORTED_TEXT[definition]})")
-        _mark_settled(ax, settle * scale, s.t_span[0] * scale, unit)
+        # the group's own settle time: its coefficients start there
+        _mark_settled(ax, met.settling.group_time.get(g, settle) * scale,
+                      s.t_span[0] * scale, unit)
         ax.set_title(_group_label(g, members), fontsize=FONT["title"])
         _label(ax, f"time [{unit}]", "load-sharing coefficient [-]")
         _legend(ax)
@@ -472,8 +473,6 @@ def static_load_sharing_figure(results) -> Figure:
     seed 004 eq. 15: ``results.metrics().per_group``).
     """
     angle, xlabel = _positions(results)
-    forces = _finite(_static_forces(results))
-    names = results.mesh_names
     groups = {g: ms for g, ms in _groups(results).items() if len(ms) > 1}
     if not groups:
         raise FigureNotApplicableError(
@@ -482,9 +481,8 @@ def static_load_sharing_figure(results) -> Figure:
     met = results.metrics()
     fig, axes = _panels(len(groups), sharex=True)
     for ax, (g, members) in zip(axes, groups.items()):
-        ratio = _share_ratio(forces[:, [names.index(m) for m in members]])
-        for i, m in enumerate(members):
-            ax.plot(angle, ratio[:, i], label=m, **_line_style(i, len(members)))
+        for i, m in enumerate(members):  # the metric's own per-position ratios
+            ax.plot(angle, _finite(met.per_cycle[m]), label=m, **_line_style(i, len(members)))
         ax.axhline(1.0, color="0.6", lw=0.8)
         ax.axhline(met.per_group[g], color=REFERENCE_COLOR, ls="--", lw=1.2,
                    label=f"reported {met.per_group[g]:.6g}\n(largest over positions)")
@@ -599,15 +597,6 @@ def _finite(x: np.ndarray) -> np.ndarray:
     return np.where(np.isfinite(x), x, np.nan)
 
 
-def _share_ratio(x: np.ndarray) -> np.ndarray:
-    """N x_i / sum_j x_j along the last axis: the form of every definition of
-    :mod:`torquesplit.metrics.load_sharing` (seed 000 eq. 17, seed 001 eq. 18,
-    seed 002 eq. 12, seed 004 eq. 14)."""
-    total = x.sum(axis=-1, keepdims=True)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return x.shape[-1] * x / np.where(total != 0, total, np.nan)
-
-
 def _groups(results) -> dict[str, list[str]]:
     from ..metrics.load_sharing import group_meshes
 
@@ -650,38 +639,6 @@ def _cycle_columns(results) -> dict[str, int]:
     el = results.structure.element_names
     tracked = list(s.tracked_elements)
     return {m: tracked.index(el.index(m)) for m in results.mesh_names}
-
-
-def _cycle_coefficients(results, definition, groups):
-    """Per-cycle coefficient of each mesh over the whole run, with its cycle start time."""
-    s = results.solution
-    cols = _cycle_columns(results)
-    times, coef = {}, {}
-    if definition in ("cycle_peak", "mean_force"):
-        per_cycle = s.cycle_max if definition == "cycle_peak" else s.cycle_mean
-        for members in groups.values():
-            x = per_cycle[:, [cols[m] for m in members]]
-            ok = np.all(np.isfinite(x), axis=-1)
-            r = _share_ratio(x[ok])
-            for i, m in enumerate(members):
-                times[m], coef[m] = s.cycle_start[ok, cols[m]], r[:, i]
-        return times, coef
-    # sample-based definitions: peak of the instantaneous coefficient in each complete
-    # mesh cycle of the mesh (cycles as counted by the integrator, cycle_start)
-    t, forces = results.mesh_force_history()
-    names = results.mesh_names
-    for members in groups.values():
-        r = _share_ratio(forces[:, [names.index(m) for m in members]])
-        for i, m in enumerate(members):
-            start = s.cycle_start[:, cols[m]]
-            complete = np.flatnonzero((start[:-1] >= t[0]) & (start[1:] <= t[-1])) \
-                if t.size else np.zeros(0, int)
-            k = np.searchsorted(start, t, side="right") - 1
-            peaks = np.full(start.size, np.nan)
-            ok = (k >= 0) & np.isfinite(r[:, i])
-            np.fmax.at(peaks, k[ok], r[ok, i])
-            times[m], coef[m] = start[complete], peaks[complete]
-    return times, coef
 
 
 def _bin_extremes(t: np.ndarray, y: np.ndarray, bin_index: np.ndarray):

@@ -18,23 +18,36 @@ from pathlib import Path
 
 import numpy as np
 
+from ..errors import SolverError
 from ..metrics import load_sharing as ls
 
 
 @dataclass(frozen=True)
 class MeshRow:
-    """One line of the summary table of a run."""
+    """One line of the summary table of a run (forces in N, the rest dimensionless)."""
 
     mesh: str
     group: str
     nominal_force: float
+    """Equal-split nominal tooth force."""
     static_force: float
+    """Force at the static equilibrium (static load sharing included)."""
     mean_force: float
     peak_force: float
+    min_force: float
     dynamic_factor: float
+    """Settled peak / static force (K_v sense; NaN for an unloaded mesh)."""
     dynamic_factor_engineering: float
+    """Mean of the settled per-cycle peaks / static force."""
+    peak_to_nominal: float
+    """Settled peak / nominal force (Ji & Li eq. 19 per mesh)."""
     load_sharing: float
+    """Coefficient of the metrics' definition."""
     contact_loss: float
+    """Fraction of the run with the mesh inside its backlash (drive flank separated)."""
+    back_contact: float
+    """Fraction of the run in back-flank contact (tensile force for a mesh without
+    backlash: double-flank contact)."""
 
 
 @dataclass(frozen=True)
@@ -48,20 +61,50 @@ class Metrics:
     rows: list[MeshRow]
 
     def to_dict(self) -> dict:
+        d = self.dynamic_factors
         return {
             "definition": self.definition,
+            "definition_text": ls.DEFINITION_TEXT[self.definition],
             "settle_time_s": self.settling.start_time,
             "settled": self.settling.settled,
             "system_load_sharing": self.load_sharing.system,
             "groups": {g: {"meshes": self.load_sharing.groups[g],
+                           "settle_time_s": self.settling.group_time.get(g, math.nan),
                            "load_sharing": self.load_sharing.per_group[g],
-                           "dynamic_factor": self.dynamic_factors.per_group_peak[g],
-                           "dynamic_factor_engineering":
-                               self.dynamic_factors.per_group_engineering[g]}
+                           "dynamic_factor": d.per_group_dynamic_factor[g],
+                           "peak_to_nominal": d.per_group_peak_to_nominal[g],
+                           "peak_to_nominal_engineering":
+                               d.per_group_peak_to_nominal_engineering[g]}
                        for g in self.load_sharing.groups},
             "meshes": {r.mesh: {k: v for k, v in r.__dict__.items() if k != "mesh"}
                        for r in self.rows},
         }
+
+    def values(self) -> dict[str, float]:
+        """Every number of these metrics by a flat name (what studies ask for):
+        ``load_sharing.<definition>`` (system) and ``.<group>`` / ``.<mesh>``;
+        ``dynamic_factor``, ``peak_to_nominal`` (system, ``.<group>``, ``.<mesh>``);
+        ``dynamic_factor_engineering.<mesh>``, ``peak_to_nominal_engineering.<group>``;
+        ``peak_force``, ``min_force``, ``mean_force``, ``static_force``,
+        ``nominal_force``, ``contact_loss``, ``back_contact`` ``.<mesh>``;
+        ``settle_time``."""
+        lsc, d = self.load_sharing, self.dynamic_factors
+        key = f"load_sharing.{self.definition}"
+        out = {key: lsc.system, "settle_time": self.settling.start_time}
+        out.update({f"{key}.{g}": v for g, v in lsc.per_group.items()})
+        out.update({f"{key}.{m}": v for m, v in lsc.per_mesh.items()})
+        out["dynamic_factor"] = ls._nanmax(list(d.per_group_dynamic_factor.values()))
+        out["peak_to_nominal"] = ls._nanmax(list(d.per_group_peak_to_nominal.values()))
+        for g in lsc.groups:
+            out[f"dynamic_factor.{g}"] = d.per_group_dynamic_factor[g]
+            out[f"peak_to_nominal.{g}"] = d.per_group_peak_to_nominal[g]
+            out[f"peak_to_nominal_engineering.{g}"] = d.per_group_peak_to_nominal_engineering[g]
+        for r in self.rows:
+            for name in ("dynamic_factor", "dynamic_factor_engineering", "peak_to_nominal",
+                         "peak_force", "min_force", "mean_force", "static_force",
+                         "nominal_force", "contact_loss", "back_contact"):
+                out[f"{name}.{r.mesh}"] = getattr(r, name)
+        return out
 
 
 class Results:
@@ -121,49 +164,73 @@ class Results:
     def metrics(self, definition: str | None = None, *, window: int = 20,
                 tolerance: float = 0.01) -> Metrics:
         """Load sharing (by ``definition``, see :mod:`torquesplit.metrics.load_sharing`)
-        and dynamic load factors over the settled part of the run."""
+        and dynamic factors over the settled part of the run.
+
+        Every number comes from the per-cycle statistics streamed by the integrator at
+        every step; the settle criterion (``window`` cycles at least, ``tolerance``) gives
+        one settle time per load-sharing group, used by all of its metrics."""
         definition = definition or self.model.analysis.load_sharing
+        if definition == "static_torque":
+            raise SolverError(
+                "'static_torque' is the load sharing of quasi-static equilibria (Mo et al. "
+                "2017 eqs. 14-15), not of a dynamic run; compute it with `torquesplit "
+                "static MODEL` (or torquesplit.quasistatic.quasi_static_load_sharing), or "
+                f"choose one of {', '.join(ls.DYNAMIC_DEFINITIONS)} for this run.")
         if definition not in ls.DEFINITIONS:
             raise ValueError(f"unknown load-sharing definition {definition!r}; choose one of "
-                             f"{', '.join(ls.DEFINITIONS)}")
+                             f"{', '.join(ls.DYNAMIC_DEFINITIONS)}")
         s = self.solution
         names = self.mesh_names
-        st = ls.settle(s.cycle_max, s.cycle_start, names, self.settle_windows(window),
-                       tolerance)
+        cols = self._mesh_columns
+        c_max, c_min = s.cycle_max[:, cols], s.cycle_min[:, cols]
+        c_mean, c_cnt = s.cycle_mean[:, cols], s.cycle_count[:, cols]
+        c_start, c_ratio = s.cycle_start[:, cols], s.cycle_ratio_max[:, cols]
         groups = self.groups
+        st = ls.settle(c_max, c_start, names, self.settle_windows(window), tolerance, groups)
         if definition == "cycle_peak":
-            lsc = ls.cycle_peak(s.cycle_max, names, groups, st.first_cycle)
+            lsc = ls.cycle_peak(c_max, c_start, names, groups, st.first_cycle)
         elif definition == "mean_force":
-            lsc = ls.mean_force(s.cycle_mean, s.cycle_count, names, groups, st.first_cycle)
-        elif definition in ("instantaneous", "engineering"):
-            t, f = self.mesh_force_history()
-            freq = {g: self._mesh_meta[m[0]]["frequency"] for g, m in groups.items()}
-            lsc = ls.instantaneous(t, f, names, groups, st.start_time, freq, definition)
-        else:  # static_torque on a dynamic run: instantaneous on the history
-            t, f = self.mesh_force_history()
-            lsc = ls.instantaneous(t, f, names, groups, st.start_time, None, "instantaneous")
-            lsc = ls.LoadSharing("static_torque", lsc.per_mesh, lsc.per_group, lsc.system,
-                                 lsc.groups)
+            lsc = ls.mean_force(c_mean, c_cnt, c_start, names, groups, st.first_cycle)
+        else:
+            lsc = ls.instantaneous(c_ratio, c_start, names, groups, st.first_cycle,
+                                   definition)
         nominal = self.nominal_forces()
-        dyn = ls.dynamic_factors(s.cycle_max, names, groups, st.first_cycle, nominal)
         static = self.static_forces()
+        dyn = ls.dynamic_factors(c_max, names, groups, st.first_cycle, static, nominal)
         group_of = {m: g for g, ms in groups.items() for m in ms}
         el = self.structure.element_names
         rows = []
         for j, m in enumerate(names):
             k0 = st.first_cycle[m]
-            c = s.cycle_count[k0:, j]
-            mean = float((np.nan_to_num(s.cycle_mean[k0:, j]) * c).sum() / max(c.sum(), 1))
-            peak = s.cycle_max[k0:, j]
-            peak = float(np.nanmax(peak)) if np.isfinite(peak).any() else math.nan
+            c = c_cnt[k0:, j]
+            mean = float((np.nan_to_num(c_mean[k0:, j]) * c).sum() / max(c.sum(), 1))
             rows.append(MeshRow(
                 mesh=m, group=group_of[m], nominal_force=nominal[m], static_force=static[m],
-                mean_force=mean, peak_force=peak, dynamic_factor=dyn.peak[m],
-                dynamic_factor_engineering=dyn.engineering[m],
-                load_sharing=lsc.per_mesh[m],
+                mean_force=mean, peak_force=ls._nanmax(c_max[k0:, j]),
+                min_force=-ls._nanmax(-c_min[k0:, j]),
+                dynamic_factor=dyn.dynamic_factor[m],
+                dynamic_factor_engineering=dyn.dynamic_factor_engineering[m],
+                peak_to_nominal=dyn.peak_to_nominal[m], load_sharing=lsc.per_mesh[m],
                 contact_loss=float(s.separation_fraction[el.index(m)]),
+                back_contact=float(s.back_contact_fraction[el.index(m)]),
             ))
         return Metrics(definition, st, lsc, dyn, rows)
+
+    def metric_values(self, definitions=None, *, window: int = 20,
+                      tolerance: float = 0.01) -> dict[str, float]:
+        """Every metric of the run by a flat name (:meth:`Metrics.values`), for every
+        dynamic load-sharing definition (or those given)."""
+        out: dict[str, float] = {}
+        for d in definitions or ls.DYNAMIC_DEFINITIONS:
+            out.update(self.metrics(d, window=window, tolerance=tolerance).values())
+        return out
+
+    @cached_property
+    def _mesh_columns(self) -> list[int]:
+        """Column of each mesh in the solution's cycle arrays."""
+        el = self.structure.element_names
+        tracked = list(self.solution.tracked_elements)
+        return [tracked.index(el.index(m)) for m in self.mesh_names]
 
     def settle_windows(self, minimum: int = 20) -> list[int]:
         """Cycles per settle window of each mesh: at least ``minimum`` and the longest
@@ -182,7 +249,8 @@ class Results:
         return out
 
     def mesh_force_history(self) -> tuple[np.ndarray, np.ndarray]:
-        """Decimated time and mesh forces (n_samples, n_meshes) [s, N]."""
+        """Decimated time and mesh forces (n_samples, n_meshes) [s, N], for plots and
+        exports (no metric is computed from it)."""
         s = self.solution
         el = self.structure.element_names
         cols = [list(s.history_elements).index(el.index(m)) for m in self.mesh_names]
@@ -236,11 +304,14 @@ class Results:
         path = Path(path)
         met = self.metrics()
         header = ["mesh", "group", "nominal_force_N", "static_force_N", "mean_force_N",
-                  "peak_force_N", "dynamic_factor", "dynamic_factor_engineering",
-                  f"load_sharing_{met.definition}", "contact_loss_fraction"]
+                  "peak_force_N", "min_force_N", "dynamic_factor",
+                  "dynamic_factor_engineering", "peak_to_nominal",
+                  f"load_sharing_{met.definition}", "contact_loss_fraction",
+                  "back_contact_fraction"]
         rows = [[r.mesh, r.group, r.nominal_force, r.static_force, r.mean_force, r.peak_force,
-                 r.dynamic_factor, r.dynamic_factor_engineering, r.load_sharing,
-                 r.contact_loss] for r in met.rows]
+                 r.min_force, r.dynamic_factor, r.dynamic_factor_engineering,
+                 r.peak_to_nominal, r.load_sharing, r.contact_loss, r.back_contact]
+                for r in met.rows]
         _write_csv(path, header, rows)
         s = self.solution
         el = self.structure.element_names

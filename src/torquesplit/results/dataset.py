@@ -43,7 +43,12 @@ def results_to_dataset(res) -> xr.Dataset:
                                         "static equilibrium displacement"),
             "contact_loss_fraction": _var(("element",),
                                           s.separation_fraction[list(s.history_elements)], "1",
-                                          "fraction of steps with the element out of contact"),
+                                          "fraction of the run with the element inside its "
+                                          "dead zone (drive flank separated)"),
+            "back_contact_fraction": _var(("element",),
+                                          s.back_contact_fraction[list(s.history_elements)],
+                                          "1", "fraction of the run in back-flank contact "
+                                          "(mesh without backlash: tensile force)"),
         },
         coords={
             "time": _var(("time",), s.history_t, "s", "time"),
@@ -64,8 +69,13 @@ def results_to_dataset(res) -> xr.Dataset:
         met = res.metrics()
         ds["load_sharing"] = _var(("mesh",), [met.load_sharing.per_mesh[m] for m in meshes],
                                   "1", f"load-sharing coefficient ({met.definition})")
-        ds["dynamic_factor"] = _var(("mesh",), [met.dynamic_factors.peak[m] for m in meshes],
-                                    "1", "dynamic load factor (peak / nominal static force)")
+        d = met.dynamic_factors
+        ds["dynamic_factor"] = _var(("mesh",), [d.dynamic_factor[m] for m in meshes], "1",
+                                    "dynamic factor: settled peak / the mesh's own static "
+                                    "force (K_v sense)")
+        ds["peak_to_nominal"] = _var(("mesh",), [d.peak_to_nominal[m] for m in meshes], "1",
+                                     "settled peak / equal-split nominal force (Ji & Li "
+                                     "eq. 19)")
         ds.attrs["metrics_json"] = json.dumps(met.to_dict(), default=float)
     except Exception as exc:  # metrics of a diverged run may be undefined; keep the data
         ds.attrs["metrics_error"] = str(exc)

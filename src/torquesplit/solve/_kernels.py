@@ -1,66 +1,39 @@
-"""Compiled kernels of the dynamic solver: every ``@njit(cache=True)`` function lives here.
+"""Compiled kernels of the dynamic solver: every ``@njit(cache=True)`` loop lives here.
 
 Each kernel's docstring names the readable Python twin it mirrors (in
-:mod:`torquesplit.solve.reference`); tests check that the two agree.  Nothing in this
-module allocates inside a step loop; scratch arrays are allocated once per call (one
-call = one chunk of a run, see :func:`torquesplit.solve.integrate.integrate`).
+:mod:`torquesplit.solve.reference`); tests check that the two agree.  Element force
+laws are not written here: they come from :mod:`torquesplit.solve.laws`, inlined.
+Nothing allocates inside a step loop; the scratch is one :class:`~.kernel_data.Work`
+bundle per run.
 
-Legend (short symbols are used only inside this module)
---------------------------------------------------------
-n        number of DOFs; the state is ``y = [q (n), v (n)]``
+Data (see :mod:`torquesplit.solve.kernel_data`): ``m`` the model
+(:class:`KernelModel`), ``w`` the scratch (:class:`Work`), ``r`` the outputs
+(:class:`Record`).  Legend of the short names used inside kernels:
+
+n        number of DOFs; a state row of ``w.Y`` is ``[q (n), v (n)]``
 ne       number of elements
-K P G    excitation slots ``(n_slot, ne)``: stiffness [N/m], additive force [N],
-         half-gap [m] of each element at one instant
-E ED     excitation slots ``(n_slot, ne)``: error [m] and error rate [m/s]
-CY       excitation slot ``(n_slot, ne)`` int64: statistics cycle index of s = f t + phase,
-         floor(s) counted one up within CYCLE_EPS below the next integer
-S C      ``(n_slot, n_sin)``: sin and cos of every error sinusoid's argument
-tv_el    elements whose tables vary in time (frequency > 0)
-err_el   elements that own at least one error sinusoid
-sin_el   owning element of each error sinusoid
-gap_cyc  cycle whose half-gap is cached in gap_val (per element)
-has_force  elements with a non-zero additive force table
-watch_el elements whose contact state is counted (n_watch of them)
-vr_ptr vq_idx vv_idx  V by element (CSR), unsigned: row pointers, indices into y
-         of the q and of the v entries
-vt_*     V by DOF (CSR of V^T): generalized forces are gathered, not scattered
-defl     element deformation delta = V.q - e (ne)
-fr_*     tooth friction (seed 003): friction meshes fr_el, their sparse force projections
-         W (CSR over friction meshes: fr_ptr, fr_dof, fr_coef, fr_row) and the table
-         ``friction_table`` (3 rows per friction mesh); empty without friction
-FR       excitation slot ``(n_slot, 3 n_fm)``: friction-table values at one instant
-sp_el sp_par  spline radial elements (seed 002 eq. 6): the x / y component elements and
-         the law (k, c, S1, S2, F_m, v); empty without splines
-MODEL    the 36 model arrays, always passed in the order of :data:`MODEL_ARRAYS`
-RECORD   the 18 output arrays, always passed in the order of :data:`RECORD_ARRAYS`
+slot     excitation slot (row of w.K, w.P, w.G, w.E, w.ED, w.CY, w.S, w.C, w.FR)
+iy idy   rows of w.Y: the state a right-hand side reads and where it writes dy/dt
+i_f      row of w.F / w.D where it writes the element forces and deformations
+gen      a generated right-hand side ``rhs_fn`` replaces :func:`rhs_slot`
 
 Time of step ``i`` is always computed as ``t0 + i * h`` (never accumulated), so a run
 split into chunks whose sizes are multiples of :data:`RESYNC` reproduces the unsplit run
 bit for bit.
 
-The right-hand side of a model is either :func:`rhs_slot` (the general element loop) or
-the same arithmetic generated for the model as straight-line code
-(:mod:`torquesplit.solve.codegen`), called through the first-class function ``rhs_fn``
-when its parameter vector ``rhs_par`` is not empty, with the data addresses ``ad_*`` of
-the arrays taken once per kernel call.  Both choices are measured, not taste: the call
-is written out at each call site (``if gen:``) because passing a numba first-class
-function on to another compiled function costs about 150 ns per call, and
-``array.ctypes`` at each call costs an atomic reference-count increment and decrement
-per array (together more than the generated arithmetic; found with perf).
-
-Tooth friction and splines are handled by two kernels of their own,
-:func:`excite_friction` and :func:`rhs_extra`, called after :func:`excite_tables` /
-:func:`rhs_slot` only when a model has them (``has_fr``, ``extra``); the kernels get zero
-stiffness and damping for the spline component elements, so rhs_slot's element loop and
-gather are unchanged.  A model without friction or splines runs exactly the arithmetic
-it ran before they existed (bit for bit), at the same cost per step.
+One stage evaluation, :func:`_stage`, serves both integrators: the model's generated
+straight-line code (:mod:`torquesplit.solve.codegen`, called through the first-class
+function ``rhs_fn`` with data addresses computed from ``w.addr``) or the general
+element loop :func:`rhs_slot`, then :func:`rhs_extra` for splines and tooth friction when
+the model has them.  ``_stage`` is inlined by numba (a first-class function passed on to
+a compiled callee costs about 150 ns per call; ``array.ctypes`` per call an atomic
+reference-count pair per array: both measured, hence the precomputed addresses).
 
 Compilation flags: ``error_model="numpy"`` only (no Python zero-division checks; the
 inputs are validated in Python).  No fastmath: besides keeping NaN/inf checks valid,
 even ``contract`` (FMA) would make the excitation phases ``f t + phase`` round
 differently from their numpy twins, and numba compiles a callee with the flags of its
-first caller, so flags cannot be confined to a few kernels.  Every kernel must
-therefore keep the same flags.
+first caller, so flags cannot be confined to a few kernels.
 """
 
 from __future__ import annotations
@@ -69,6 +42,31 @@ import math
 
 import numpy as np
 from numba import njit
+
+from torquesplit.solve import laws
+from torquesplit.solve.kernel_data import (
+    A_D,
+    A_E,
+    A_ED,
+    A_F,
+    A_G,
+    A_K,
+    A_P,
+    A_PAR,
+    A_Y,
+    F_MAIN,
+    F_TMP,
+    SLOT_EVENT,
+    Y_ALT,
+    Y_DSAMPLE,
+    Y_K1,
+    Y_K1ALT,
+    Y_KFSAL,
+    Y_NEW,
+    Y_SAMPLE,
+    Y_STATE,
+    Y_TRIAL,
+)
 
 # ----------------------------------------------------------------- status codes
 FINISHED = 0
@@ -86,9 +84,11 @@ I_HIST = 5  # rows written to the history arrays
 I_FULL = 6  # rows written to the full-state arrays
 I_NEXT = 7  # dopri: index of the next uniform sample time
 I_BAD = 8  # index into y of the state that diverged
-I_FSAL = 9  # dopri: 1 when kfsal holds f(t, y) of the current state
+I_FSAL = 9  # dopri: 1 when Y_KFSAL holds f(t, y) of the current state
 I_LAST_REJECTED = 10  # dopri: the previous attempt was rejected
-N_COUNTERS = 11
+I_SAVED = 11  # rk4: the previous state and its k1 are saved in rows Y_ALT, Y_K1ALT
+I_EVENTS = 12  # corner events sampled (see record_extrema)
+N_COUNTERS = 13
 
 # ---------------------------------------------------- float64 clock (in/out)
 F_T = 0  # time of the current state
@@ -99,30 +99,11 @@ F_HMAX = 4  # dopri: largest accepted step
 N_CLOCK = 5
 
 MESH_KIND = 1
-_NO_CYCLE = -(2**62)
-CYCLE_EPS = 1e-9
-"""Cycle index of the statistics: floor(s), plus one when frac(s) >= 1 - CYCLE_EPS, so a
-sample at a cycle boundary whose phase s = f t + phase rounds just below the integer
-(e.g. 31.99999999999999) counts in the cycle it starts.  Tables and the half-gap
-sequence still use floor(s)."""
+CYCLE_EPS = laws.CYCLE_EPS
 RESYNC = 64
 """RK4 recomputes the error sinusoids exactly every RESYNC steps (phasor rotation between)."""
-# Slot indices are always passed as int64 variables (np.int64(k)), never as literal
-# constants: numba would compile one copy of the callee per literal value.
-
-MODEL_ARRAYS = (
-    "inv_mass", "external_force", "ground_damping", "element_kind", "v_ptr", "v_dof",
-    "v_coef", "stiffness_table", "frequency", "phase", "damping", "gap_ptr",
-    "gap_values", "error_constant", "error_ptr", "error_amplitude", "error_omega",
-    "error_phase", "force_table", "tv_el", "err_el", "sin_el", "vr_ptr", "vq_idx",
-    "vv_idx", "vt_ptr", "vt_el", "vt_coef", "fr_el", "fr_ptr", "fr_dof", "fr_coef",
-    "fr_row", "friction_table", "sp_el", "sp_par",
-)
-RECORD_ARRAYS = (
-    "track_el", "track_base", "cyc_max", "cyc_min", "cyc_sum", "cyc_cnt",
-    "sep_count", "back_count", "sep_time", "back_time", "hist_el", "hist_dof", "hist_t", "hist_f",
-    "hist_q", "hist_v", "full_t", "full_y",
-)
+# Slot and row indices are passed as int64 variables (np.int64(k)) where a callee is not
+# inlined: numba would compile one copy of the callee per literal value.
 
 # Dormand & Prince 5(4) (Hairer, Norsett & Wanner, Solving ODE I, table 5.2)
 _C2, _C3, _C4, _C5 = 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0
@@ -143,396 +124,278 @@ _FAC_MAX = 10.0  # largest increase: h_new <= 10 h
 _BETA = 0.04
 _EXPO1 = 0.2 - _BETA * 0.75
 
+_kernel = njit(cache=True, error_model="numpy", _nrt=False)
+
 
 # =================================================================== excitation
-@njit(cache=True, error_model="numpy")
-def init_slots(stiffness_table, force_table, gap_ptr, gap_values, error_constant,
-               K, P, G, E, ED, CY):
-    """Fill every slot with the time-invariant values (table column 0, first gap).
+@_kernel
+def excite(t, slot, src, m, w):
+    """Every time-dependent excitation at t into ``slot``.
 
-    Twin: :func:`torquesplit.solve.reference.excitation_numpy` for elements with f == 0.
-    """
-    for s in range(K.shape[0]):
-        for e in range(K.shape[1]):
-            K[s, e] = stiffness_table[e, 0]
-            P[s, e] = force_table[e, 0]
-            G[s, e] = gap_values[gap_ptr[e]]
-            E[s, e] = error_constant[e]
-            ED[s, e] = 0.0
-            CY[s, e] = 0
-
-
-@njit(cache=True, error_model="numpy")
-def scratch_flags(element_kind, gap_ptr, gap_values, force_table, has_force, watch_el):
-    """Per-element flags computed once per call: ``has_force[e]`` (a non-zero additive
-    force table) and the list ``watch_el`` of elements whose contact state is counted
-    (a dead zone somewhere in the gap sequence, or a mesh).  Returns len(watch_el).
-
-    Twin: ``np.any(force_table != 0, axis=1)`` and the masks of
-    :func:`record_statistics`.
-    """
-    n_watch = 0
-    for e in range(force_table.shape[0]):
-        has_force[e] = False
-        for i in range(force_table.shape[1]):
-            if force_table[e, i] != 0.0:
-                has_force[e] = True
-                break
-        watch = element_kind[e] == MESH_KIND
-        for j in range(gap_ptr[e], gap_ptr[e + 1]):
-            if gap_values[j] > 0.0:
-                watch = True
-        if watch:
-            watch_el[n_watch] = e
-            n_watch += 1
-    return n_watch
-
-
-@njit(cache=True, error_model="numpy")
-def excite_tables(t, slot, tv_el, frequency, phase, stiffness_table, force_table,
-                  gap_ptr, gap_values, K, P, G, CY, gap_cyc, gap_val, has_force):
-    """Stiffness, additive force, half-gap and cycle index of time-varying elements at t.
-
-    Mesh phase s = f t + phase; tables are interpolated linearly and periodically at
-    frac(s) * n_table; the half-gap is entry floor(s) mod n_gaps of the per-cycle
-    sequence (cached in ``gap_cyc``/``gap_val`` since the cycle changes rarely).  The
-    force table is read only where ``has_force`` (see :func:`scratch_flags`); elsewhere
-    P keeps its zero from :func:`init_slots`.  CY is the statistics cycle index (floor(s),
-    plus one within CYCLE_EPS below the next integer).
+    Time-varying tables (stiffness, additive force, friction) are interpolated at the
+    mesh phase s = f t + phase (:func:`laws.table_phase`); the half-gap is entry
+    floor(s) mod n_gaps of the element's per-cycle sequence (cached in ``w.gap_cyc`` /
+    ``w.gap_val``); CY is the statistics cycle index (:func:`laws.stat_cycle`).  Error
+    sinusoids are evaluated exactly when ``src < 0``, else advanced from slot ``src``
+    by the phasor rotation ``w.rot`` (cos, sin of omega dt).
     Twin: :func:`torquesplit.solve.reference.excitation_numpy`.
     """
-    n_tab = stiffness_table.shape[1]
+    # every array is taken out of its bundle once, before the loops: an attribute of a
+    # bundle read inside a loop costs an atomic reference-count pair per read (measured:
+    # five times slower steps)
+    K, P, G, CY, FR = w.K, w.P, w.G, w.CY, w.FR
+    E, ED, S, C, rot = w.E, w.ED, w.S, w.C, w.rot
+    gap_cyc, gap_val, has_force = w.gap_cyc, w.gap_val, w.has_force
+    tv_el, frequency, phase = m.tv_el, m.frequency, m.phase
+    ktab, ftab, frtab = m.stiffness_table, m.force_table, m.friction_table
+    gap_ptr, gap_values, fr_el = m.gap_ptr, m.gap_values, m.fr_el
+    err_el, error_constant, sin_el = m.err_el, m.error_constant, m.sin_el
+    error_omega, error_phase, error_amplitude = m.error_omega, m.error_phase, m.error_amplitude
+    n_tab = ktab.shape[1]
     for j in range(tv_el.shape[0]):
         e = tv_el[j]
         s = frequency[e] * t + phase[e]
-        fl = math.floor(s)
-        x = (s - fl) * n_tab
-        i0 = int(x)
-        w = x - i0
-        if i0 >= n_tab:  # s - fl rounded up to 1.0
-            i0 -= n_tab
-        i1 = i0 + 1
-        if i1 == n_tab:
-            i1 = 0
-        k0 = stiffness_table[e, i0]
-        K[slot, e] = k0 + w * (stiffness_table[e, i1] - k0)
+        i0, i1, wt, fl = laws.table_phase(s, n_tab)
+        K[slot, e] = laws.lerp(ktab[e, i0], ktab[e, i1], wt)
         if has_force[e]:
-            p0 = force_table[e, i0]
-            P[slot, e] = p0 + w * (force_table[e, i1] - p0)
-        c = np.int64(fl)
-        if s - fl >= 1.0 - CYCLE_EPS:
-            CY[slot, e] = c + 1
-        else:
-            CY[slot, e] = c
-        ng = gap_ptr[e + 1] - gap_ptr[e]
+            P[slot, e] = laws.lerp(ftab[e, i0], ftab[e, i1], wt)
+        CY[slot, e] = laws.stat_cycle(s, fl)
+        g0 = gap_ptr[e]
+        ng = gap_ptr[e + 1] - g0
         if ng == 1:
-            G[slot, e] = gap_values[gap_ptr[e]]
+            G[slot, e] = gap_values[g0]
         else:
+            c = np.int64(fl)
             if c != gap_cyc[e]:
-                m = c % ng
-                if m < 0:
-                    m += ng
+                k = c % ng
+                if k < 0:
+                    k += ng
                 gap_cyc[e] = c
-                gap_val[e] = gap_values[gap_ptr[e] + m]
+                gap_val[e] = gap_values[g0 + k]
             G[slot, e] = gap_val[e]
-
-
-@njit(cache=True, error_model="numpy")
-def excite_friction(t, slot, frequency, phase, fr_el, friction_table, FR):
-    """Friction-table values of every friction mesh at t: rows 3 j .. 3 j + 2 of friction
-    mesh j, interpolated like the stiffness (periodically at frac(s) n_table, s = f t +
-    phase of its mesh element).  Called only for models with tooth friction.
-    Twin: the friction part of :func:`torquesplit.solve.reference.excitation_numpy`.
-    """
-    n_fr = friction_table.shape[1]
+    n_fr = frtab.shape[1]
     for j in range(fr_el.shape[0]):
         e = fr_el[j]
         s = frequency[e] * t + phase[e]
-        fl = math.floor(s)
-        x = (s - fl) * n_fr
-        i0 = int(x)
-        w = x - i0
-        if i0 >= n_fr:
-            i0 -= n_fr
-        i1 = i0 + 1
-        if i1 == n_fr:
-            i1 = 0
-        for r in range(3 * j, 3 * j + 3):
-            v0 = friction_table[r, i0]
-            FR[slot, r] = v0 + w * (friction_table[r, i1] - v0)
-
-
-@njit(cache=True, error_model="numpy")
-def phasors_exact(t, slot, error_omega, error_phase, S, C):
-    """sin and cos of omega t + phi for every error sinusoid.
-
-    Twin: the ``np.sin``/``np.cos`` lines of :func:`reference.excitation_numpy`.
-    """
-    for i in range(error_omega.shape[0]):
-        arg = error_omega[i] * t + error_phase[i]
-        S[slot, i] = math.sin(arg)
-        C[slot, i] = math.cos(arg)
-
-
-@njit(cache=True, error_model="numpy")
-def advance_errors(src, dst, cos_rot, sin_rot, err_el, error_constant, sin_el,
-                   error_amplitude, error_omega, S, C, E, ED):
-    """Rotate every phasor of slot ``src`` by a fixed time into slot ``dst`` (angle
-    omega dt given as cos, sin) and rebuild the errors of ``dst`` from them.
-
-    Twin: :func:`phasors_exact` + :func:`errors_from_phasors` at the later time (equal
-    to round-off), i.e. the error part of :func:`reference.excitation_numpy`.
-    """
-    for j in range(err_el.shape[0]):
-        e = err_el[j]
-        E[dst, e] = error_constant[e]
-        ED[dst, e] = 0.0
-    for i in range(sin_el.shape[0]):
-        s0 = S[src, i]
-        c0 = C[src, i]
-        s1 = s0 * cos_rot[i] + c0 * sin_rot[i]
-        c1 = c0 * cos_rot[i] - s0 * sin_rot[i]
-        S[dst, i] = s1
-        C[dst, i] = c1
-        e = sin_el[i]
-        a = error_amplitude[i]
-        E[dst, e] += a * s1
-        ED[dst, e] += a * error_omega[i] * c1
-
-
-@njit(cache=True, error_model="numpy")
-def errors_from_phasors(slot, err_el, error_constant, sin_el, error_amplitude,
-                        error_omega, S, C, E, ED):
-    """e = e_const + sum A sin(.), e' = sum A omega cos(.) from the phasors of a slot.
-
-    Twin: the error part of :func:`torquesplit.solve.reference.excitation_numpy`.
-    """
+        i0, i1, wt, _ = laws.table_phase(s, n_fr)
+        for row in range(3 * j, 3 * j + 3):
+            FR[slot, row] = laws.lerp(frtab[row, i0], frtab[row, i1], wt)
     for j in range(err_el.shape[0]):
         e = err_el[j]
         E[slot, e] = error_constant[e]
         ED[slot, e] = 0.0
     for i in range(sin_el.shape[0]):
+        if src < 0:
+            arg = error_omega[i] * t + error_phase[i]
+            s1 = math.sin(arg)
+            c1 = math.cos(arg)
+        else:
+            s0 = S[src, i]
+            c0 = C[src, i]
+            s1 = s0 * rot[0, i] + c0 * rot[1, i]
+            c1 = c0 * rot[0, i] - s0 * rot[1, i]
+        S[slot, i] = s1
+        C[slot, i] = c1
         e = sin_el[i]
         a = error_amplitude[i]
-        E[slot, e] += a * S[slot, i]
-        ED[slot, e] += a * error_omega[i] * C[slot, i]
+        E[slot, e] += a * s1
+        ED[slot, e] += a * error_omega[i] * c1
 
 
-@njit(cache=True, error_model="numpy")
-def excite_exact(t, slot, frequency, phase, stiffness_table, force_table, gap_ptr,
-                 gap_values, error_constant, error_amplitude, error_omega, error_phase,
-                 tv_el, err_el, sin_el, K, P, G, E, ED, CY, S, C, gap_cyc, gap_val,
-                 has_force):
-    """Every time-dependent excitation at t, sinusoids evaluated exactly.
-
-    Twin: :func:`torquesplit.solve.reference.excitation_numpy`.
-    """
-    excite_tables(t, slot, tv_el, frequency, phase, stiffness_table, force_table,
-                  gap_ptr, gap_values, K, P, G, CY, gap_cyc, gap_val,
-                  has_force)
-    phasors_exact(t, slot, error_omega, error_phase, S, C)
-    errors_from_phasors(slot, err_el, error_constant, sin_el, error_amplitude,
-                        error_omega, S, C, E, ED)
+@_kernel
+def copy_slot(src, dst, w):
+    """Copy the excitation of slot ``src`` into slot ``dst`` (same time)."""
+    K, P, G, E, ED, CY, FR, S, C = w.K, w.P, w.G, w.E, w.ED, w.CY, w.FR, w.S, w.C
+    for e in range(K.shape[1]):
+        K[dst, e] = K[src, e]
+        P[dst, e] = P[src, e]
+        G[dst, e] = G[src, e]
+        E[dst, e] = E[src, e]
+        ED[dst, e] = ED[src, e]
+        CY[dst, e] = CY[src, e]
+    for row in range(FR.shape[1]):
+        FR[dst, row] = FR[src, row]
+    for i in range(S.shape[1]):
+        S[dst, i] = S[src, i]
+        C[dst, i] = C[src, i]
 
 
 # ======================================================================== rhs
-@njit(cache=True, error_model="numpy")
-def rhs_slot(y, slot, K, P, G, E, ED, inv_mass, external_force, ground_damping,
-             v_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
-             dy, force, defl):
-    """dy = [v, a] with a = M^-1 (F_ext - C_g v - sum_e V_e f_e) for one excitation slot.
+@_kernel
+def rhs_slot(slot, iy, idy, i_f, m, w):
+    """Row ``idy`` of w.Y = dy/dt = [v, a] at state row ``iy`` for excitation ``slot``.
 
-    delta = V.q - e, rate = V.v - e', h = dead zone of half-width g (g == 0: h = delta,
-    always in contact), f = k h + c rate (only in contact) + p.  Also writes the
-    element forces ``force`` and deformations ``defl``.  V is read row-wise (CSR,
-    unsigned indices into y for q and v) and, for the generalized forces, column-wise
-    (``vt_*``: a gather per DOF, no scatter).  The kernels get zero stiffness and
-    damping for spline component elements (their force here is 0); :func:`rhs_extra`
-    adds splines and tooth friction.
+    a = M^-1 (F_ext - C_g v - sum_e V_e f_e - G v); element e: delta = V.q - e,
+    rate = V.v - e', force :func:`laws.spring_force` (k, c, delta, rate, half-gap) plus
+    the additive force p.  Writes the forces and deformations into row ``i_f`` of w.F /
+    w.D.  V is read by element (CSR, unsigned indices into the state) and, for the
+    generalized forces, by DOF (a gather per DOF, no scatter).  Spline component
+    elements have zero stiffness and damping here (force 0); :func:`rhs_extra` adds
+    splines and tooth friction.
     Twin: :func:`torquesplit.solve.reference.rhs_numpy` (with :func:`rhs_extra`).
     """
+    Y, force, defl = w.Y, w.F, w.D
+    K, P, G, E, ED = w.K, w.P, w.G, w.E, w.ED
+    v_coef, vq_idx, vv_idx, vr_ptr = m.v_coef, m.vq_idx, m.vv_idx, m.vr_ptr
+    damping, inv_mass = m.damping, m.inv_mass
+    external_force, ground_damping = m.external_force, m.ground_damping
+    vt_ptr, vt_el, vt_coef = m.vt_ptr, m.vt_el, m.vt_coef
+    gy_ptr, gy_idx, gy_coef = m.gy_ptr, m.gy_idx, m.gy_coef
     n = inv_mass.shape[0]
-    for el in range(v_ptr.shape[0] - 1):
+    for el in range(vr_ptr.shape[0] - 1):
         d = -E[slot, el]
         r = -ED[slot, el]
-        for j in range(v_ptr[el], v_ptr[el + 1]):
+        for j in range(vr_ptr[el], vr_ptr[el + 1]):
             cf = v_coef[j]
-            d += cf * y[vq_idx[j]]
-            r += cf * y[vv_idx[j]]
-        g = G[slot, el]
-        if g > 0.0:
-            if d > g:
-                fe = K[slot, el] * (d - g) + damping[el] * r
-            elif d < -g:
-                fe = K[slot, el] * (d + g) + damping[el] * r
-            else:
-                fe = 0.0
-        else:
-            fe = K[slot, el] * d + damping[el] * r
-        force[el] = fe + P[slot, el]
-        defl[el] = d
+            d += cf * Y[iy, vq_idx[j]]
+            r += cf * Y[iy, vv_idx[j]]
+        fe, _, _ = laws.spring_force(K[slot, el], damping[el], d, r, G[slot, el])
+        force[i_f, el] = fe + P[slot, el]
+        defl[i_f, el] = d
     for i in range(n):
-        vi = y[n + i]
+        vi = Y[iy, n + i]
         acc = external_force[i] - ground_damping[i] * vi
         for j in range(vt_ptr[i], vt_ptr[i + 1]):
-            acc -= vt_coef[j] * force[vt_el[j]]
-        dy[i] = vi
-        dy[n + i] = inv_mass[i] * acc
+            acc -= vt_coef[j] * force[i_f, vt_el[j]]
+        for j in range(gy_ptr[i], gy_ptr[i + 1]):
+            acc -= gy_coef[j] * Y[iy, gy_idx[j]]
+        Y[idy, i] = vi
+        Y[idy, n + i] = inv_mass[i] * acc
 
 
-@njit(cache=True, error_model="numpy")
-def rhs_extra(y, slot, inv_mass, v_ptr, vq_idx, vv_idx, v_coef, fr_el, fr_ptr, fr_dof,
-              fr_coef, fr_row, FR, sp_el, sp_par, dy, force, defl):
-    """Spline radial elements and tooth friction, after :func:`rhs_slot` (only called
-    for models that have them, so others run exactly the arithmetic they always ran).
+@_kernel
+def rhs_extra(slot, iy, idy, i_f, m, w):
+    """Spline radial elements and tooth friction, after :func:`rhs_slot` (called only for
+    models that have them, so others run exactly the arithmetic they always ran).
 
-    Each spline j gets its radial law (:func:`spline_force`), which overwrites the force
-    of its two component elements, and adds -M^-1 V_e f_e of both by a scatter (rhs_slot
-    saw them with zero stiffness).  Each friction mesh adds -M^-1 W_e(s) max(f_e, 0):
-    friction on the working flank only.
+    Each spline gets its radial law (:func:`laws.spline_force` on the relative
+    displacement given by the projection rows of its two component elements), which
+    overwrites their forces and deformations, and adds -M^-1 V_e f_e of both (rhs_slot
+    saw them with zero stiffness).  Each friction mesh adds -M^-1 W_e(s) max(f_e, 0)
+    (:func:`laws.positive_part`: friction on the working flank only).
     Twin: the spline and friction parts of :func:`torquesplit.solve.reference.rhs_numpy`.
     """
+    Y, force, defl = w.Y, w.F, w.D
+    v_ptr, vq_idx, vv_idx, v_coef = m.vr_ptr, m.vq_idx, m.vv_idx, m.v_coef
+    inv_mass, sp_el, sp_par, FR = m.inv_mass, m.sp_el, m.sp_par, w.FR
+    fr_el, fr_ptr, fr_dof, fr_coef, fr_row = m.fr_el, m.fr_ptr, m.fr_dof, m.fr_coef, m.fr_row
     n = inv_mass.shape[0]
     for j in range(sp_el.shape[0]):
-        spline_force(j, y, sp_el, sp_par, v_ptr, vq_idx, vv_idx, v_coef, force, defl)
-        for c in range(2):
-            el = sp_el[j, c]
-            fe = force[el]
+        ex = sp_el[j, 0]
+        ey = sp_el[j, 1]
+        dx = 0.0
+        rx = 0.0
+        for i in range(v_ptr[ex], v_ptr[ex + 1]):
+            dx += v_coef[i] * Y[iy, vq_idx[i]]
+            rx += v_coef[i] * Y[iy, vv_idx[i]]
+        dyy = 0.0
+        ry = 0.0
+        for i in range(v_ptr[ey], v_ptr[ey + 1]):
+            dyy += v_coef[i] * Y[iy, vq_idx[i]]
+            ry += v_coef[i] * Y[iy, vv_idx[i]]
+        fx, fy = laws.spline_force(dx, dyy, rx, ry, sp_par[j, 0], sp_par[j, 1], sp_par[j, 2],
+                                   sp_par[j, 3], sp_par[j, 4], sp_par[j, 5])
+        defl[i_f, ex] = dx
+        defl[i_f, ey] = dyy
+        force[i_f, ex] = fx
+        force[i_f, ey] = fy
+        for el in (ex, ey):
+            fe = force[i_f, el]
             for i in range(v_ptr[el], v_ptr[el + 1]):
-                dy[vv_idx[i]] -= inv_mass[vq_idx[i]] * (v_coef[i] * fe)
+                Y[idy, vv_idx[i]] -= inv_mass[vq_idx[i]] * (v_coef[i] * fe)
     for j in range(fr_el.shape[0]):
-        fe = force[fr_el[j]]
-        if fe > 0.0:
+        fp, _ = laws.positive_part(force[i_f, fr_el[j]])
+        if fp > 0.0:
             for i in range(fr_ptr[j], fr_ptr[j + 1]):
                 d = fr_dof[i]
-                dy[n + d] -= inv_mass[d] * (fr_coef[i] * FR[slot, fr_row[i]] * fe)
+                Y[idy, n + d] -= inv_mass[d] * (fr_coef[i] * FR[slot, fr_row[i]] * fp)
 
 
-# inlined (numba IR) into rhs_extra: as a call inside its loop it cost an atomic
-# reference-count increment and decrement per array argument (a third of a seed 002 step)
-@njit(cache=True, error_model="numpy", inline="always")
-def spline_force(j, y, sp_el, sp_par, v_ptr, vq_idx, vv_idx, v_coef, force, defl):
-    """Radial law of spline j (seed 002 eq. 6, restoring, Coulomb friction regularised).
-
-    d = (dx, dy) from the projection rows of its two component elements, R = |d|,
-    Rdot = d.d'/R; F = k R + c Rdot (R < S1), F_m tanh(Rdot / v) (S1 <= R <= S2),
-    k (R - S2) + c Rdot + F_m tanh(Rdot / v) (R > S2); writes f_x = F dx / R,
-    f_y = F dy / R (0 at R = 0) and the deformations dx, dy.
-    Twin: the spline part of :func:`torquesplit.solve.reference.element_forces_numpy`.
-    """
-    ex = sp_el[j, 0]
-    ey = sp_el[j, 1]
-    dx = 0.0
-    rx = 0.0
-    for i in range(v_ptr[ex], v_ptr[ex + 1]):
-        dx += v_coef[i] * y[vq_idx[i]]
-        rx += v_coef[i] * y[vv_idx[i]]
-    dyy = 0.0
-    ry = 0.0
-    for i in range(v_ptr[ey], v_ptr[ey + 1]):
-        dyy += v_coef[i] * y[vq_idx[i]]
-        ry += v_coef[i] * y[vv_idx[i]]
-    defl[ex] = dx
-    defl[ey] = dyy
-    rad = math.sqrt(dx * dx + dyy * dyy)
-    if rad > 0.0:
-        rdot = (dx * rx + dyy * ry) / rad
-        k = sp_par[j, 0]
-        c = sp_par[j, 1]
-        s1 = sp_par[j, 2]
-        s2 = sp_par[j, 3]
-        fm = sp_par[j, 4]
-        if rad < s1:
-            f = k * rad + c * rdot
-        elif rad <= s2:
-            f = fm * math.tanh(rdot / sp_par[j, 5])
-        else:
-            f = k * (rad - s2) + c * rdot + fm * math.tanh(rdot / sp_par[j, 5])
-        force[ex] = f * dx / rad
-        force[ey] = f * dyy / rad
+@njit(inline="always", error_model="numpy")
+def _stage(slot, iy, idy, i_f, m, w, rhs_fn, gen, extra):
+    """One right-hand-side evaluation (the only one both integrators use): the
+    generated code ``rhs_fn`` if ``gen`` else :func:`rhs_slot`, then :func:`rhs_extra`
+    if the model has splines or tooth friction."""
+    if gen:
+        a = w.addr
+        row = np.uint64(8 * w.Y.shape[1])
+        el = np.uint64(8 * w.F.shape[1])
+        rhs_fn(a[A_Y] + row * np.uint64(iy), a[A_Y] + row * np.uint64(idy),
+               a[A_F] + el * np.uint64(i_f), a[A_D] + el * np.uint64(i_f), a[A_K], a[A_G],
+               a[A_E], a[A_ED], a[A_P], a[A_PAR], np.int64(slot * w.F.shape[1]))
     else:
-        force[ex] = 0.0
-        force[ey] = 0.0
+        rhs_slot(slot, iy, idy, i_f, m, w)
+    if extra:
+        rhs_extra(slot, iy, idy, i_f, m, w)
 
 
-@njit(cache=True, error_model="numpy")
-def rhs_at(t, y, inv_mass, external_force, ground_damping, element_kind, v_ptr, v_dof,
-           v_coef, stiffness_table, frequency, phase, damping, gap_ptr, gap_values,
-           error_constant, error_ptr, error_amplitude, error_omega, error_phase,
-           force_table, tv_el, err_el, sin_el, vr_ptr, vq_idx, vv_idx, vt_ptr, vt_el,
-           vt_coef, fr_el, fr_ptr, fr_dof, fr_coef, fr_row, friction_table, sp_el,
-           sp_par, dy, force, defl):
-    """One exact right-hand-side evaluation at (t, y) (allocates; not for loops).
-
+@_kernel
+def evaluate(t, m, w, rhs_fn, gen):
+    """One exact evaluation at time t of the state in row Y_STATE: dy/dt into row Y_K1,
+    element forces and deformations into row F_MAIN (slot 0; the generated code if
+    ``gen``, else the general kernel).
     Twin: :func:`torquesplit.solve.reference.rhs_numpy` and
     :func:`torquesplit.solve.reference.element_forces_numpy`.
     """
-    ne = v_ptr.shape[0] - 1
-    n_sin = error_omega.shape[0]
-    K = np.empty((1, ne))
-    P = np.empty((1, ne))
-    G = np.empty((1, ne))
-    E = np.empty((1, ne))
-    ED = np.empty((1, ne))
-    CY = np.empty((1, ne), dtype=np.int64)
-    S = np.empty((1, n_sin))
-    C = np.empty((1, n_sin))
-    FR = np.empty((1, friction_table.shape[0]))
-    has_fr = fr_el.shape[0] > 0
-    extra = has_fr or sp_el.shape[0] > 0
-    gap_cyc = np.full(ne, _NO_CYCLE, dtype=np.int64)
-    gap_val = np.zeros(ne)
-    has_force = np.zeros(ne, dtype=np.bool_)
-    scratch_flags(element_kind, gap_ptr, gap_values, force_table, has_force,
-                  np.empty(ne, dtype=np.int64))
-    s0 = np.int64(0)  # slots are passed as int64 variables, never literals
-    init_slots(stiffness_table, force_table, gap_ptr, gap_values, error_constant,
-               K, P, G, E, ED, CY)
-    excite_exact(t, s0, frequency, phase, stiffness_table, force_table, gap_ptr,
-                 gap_values, error_constant, error_amplitude, error_omega, error_phase,
-                 tv_el, err_el, sin_el, K, P, G, E, ED, CY, S, C, gap_cyc, gap_val, has_force)
-    if has_fr:
-        excite_friction(t, s0, frequency, phase, fr_el, friction_table, FR)
-    rhs_slot(y, s0, K, P, G, E, ED, inv_mass, external_force, ground_damping,
-             vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
-             dy, force, defl)
-    if extra:
-        rhs_extra(y, s0, inv_mass, vr_ptr, vq_idx, vv_idx, v_coef, fr_el,
-                  fr_ptr, fr_dof, fr_coef, fr_row, FR, sp_el, sp_par, dy, force,
-                  defl)
+    s0 = np.int64(0)
+    excite(t, s0, np.int64(-1), m, w)
+    extra = m.fr_el.shape[0] > 0 or m.sp_el.shape[0] > 0
+    _stage(s0, Y_STATE, Y_K1, F_MAIN, m, w, rhs_fn, gen, extra)
 
 
 # ================================================================== recording
-@njit(cache=True, error_model="numpy")
-def record_statistics(slot, force, defl, G, CY, element_kind, track_el, track_base,
-                      cyc_max, cyc_min, cyc_sum, cyc_cnt, sep_count, back_count,
-                      sep_time, back_time, weight, counters, watch_el, n_watch):
-    """Enter one accepted state in the per-cycle statistics and contact counters.
+@_kernel
+def record(slot, i_f, weight, m, w, r, counters):
+    """Enter one accepted state (forces in row ``i_f``) in the statistics.
 
-    Cycle index of tracked element j = CY - track_base[j]; cycles at or beyond the
-    capacity (rows of ``cyc_max``) are ignored.  Separation: |delta| <= g with g > 0;
-    back-side contact: delta < -g with g > 0, or delta < 0 for a mesh without backlash.
-    Only the ``n_watch`` elements of ``watch_el`` can be in either state.  ``weight``
-    is the time the sample stands for (added to ``sep_time`` / ``back_time``).
-    Twins: :func:`torquesplit.solve.reference.cycle_statistics_numpy` and
+    Per tracked element j: cycle c = CY - track_base[j] (cycles at or beyond the
+    capacity are ignored); force max, min, sum and count of the cycle; per load-sharing
+    group the instantaneous ratio N f_i / sum_j f_j of each member (Ji & Li eq. 18) and
+    its max and min in the member's cycle.  Contact counters: separation |delta| <= g
+    with g > 0; back-side contact delta < -g with g > 0, or delta < 0 for a mesh
+    without backlash; ``weight`` is the time the sample stands for.
+    Twins: :func:`torquesplit.solve.reference.cycle_statistics_numpy`,
     :func:`torquesplit.solve.reference.contact_state_numpy`.
     """
+    force, defl, CY, G, watch_el = w.F, w.D, w.CY, w.G, w.watch_el
+    track_el, track_base = r.track_el, r.track_base
+    cyc_max, cyc_min, cyc_sum, cyc_cnt = r.cyc_max, r.cyc_min, r.cyc_sum, r.cyc_cnt
+    grp_ptr, grp_col, rat_max, rat_min = r.grp_ptr, r.grp_col, r.rat_max, r.rat_min
+    sep_count, sep_time, back_count, back_time = (r.sep_count, r.sep_time, r.back_count,
+                                                  r.back_time)
+    element_kind = m.element_kind
     cap = cyc_max.shape[0]
     for j in range(track_el.shape[0]):
         el = track_el[j]
         c = CY[slot, el] - track_base[j]
         if c >= 0 and c < cap:
-            fe = force[el]
+            fe = force[i_f, el]
             if fe > cyc_max[c, j]:
                 cyc_max[c, j] = fe
             if fe < cyc_min[c, j]:
                 cyc_min[c, j] = fe
             cyc_sum[c, j] += fe
             cyc_cnt[c, j] += 1
-    for j in range(n_watch):
+    for g in range(grp_ptr.shape[0] - 1):
+        total = 0.0
+        for k in range(grp_ptr[g], grp_ptr[g + 1]):
+            total += force[i_f, track_el[grp_col[k]]]
+        if total != 0.0:
+            nm = grp_ptr[g + 1] - grp_ptr[g]
+            for k in range(grp_ptr[g], grp_ptr[g + 1]):
+                j = grp_col[k]
+                el = track_el[j]
+                c = CY[slot, el] - track_base[j]
+                if c >= 0 and c < cap:
+                    ratio = nm * force[i_f, el] / total
+                    if ratio > rat_max[c, j]:
+                        rat_max[c, j] = ratio
+                    if ratio < rat_min[c, j]:
+                        rat_min[c, j] = ratio
+    for j in range(watch_el.shape[0]):
         el = watch_el[j]
         g = G[slot, el]
-        d = defl[el]
+        d = defl[i_f, el]
         if g > 0.0:
             if d < -g:
                 back_count[el] += 1
@@ -546,225 +409,256 @@ def record_statistics(slot, force, defl, G, CY, element_kind, track_el, track_ba
     counters[I_SAMPLES] += 1
 
 
-@njit(cache=True, error_model="numpy")
-def store_history(row, t, y, force, hist_el, hist_dof, hist_t, hist_f, hist_q, hist_v):
-    """Write one decimated history row: t, forces of history elements, q and v of DOFs.
+@_kernel
+def record_extrema(slot, i_f, w, r):
+    """Enter the forces of row ``i_f`` in the per-cycle max / min of the force and of the
+    instantaneous load-sharing ratio only (a corner event: an instant, not a sample of
+    the run, so no sums, counts or contact time).  Twin: the max / min part of
+    :func:`record`."""
+    force, CY = w.F, w.CY
+    track_el, track_base = r.track_el, r.track_base
+    cyc_max, cyc_min = r.cyc_max, r.cyc_min
+    grp_ptr, grp_col, rat_max, rat_min = r.grp_ptr, r.grp_col, r.rat_max, r.rat_min
+    cap = cyc_max.shape[0]
+    for j in range(track_el.shape[0]):
+        el = track_el[j]
+        c = CY[slot, el] - track_base[j]
+        if c >= 0 and c < cap:
+            fe = force[i_f, el]
+            if fe > cyc_max[c, j]:
+                cyc_max[c, j] = fe
+            if fe < cyc_min[c, j]:
+                cyc_min[c, j] = fe
+    for g in range(grp_ptr.shape[0] - 1):
+        total = 0.0
+        for k in range(grp_ptr[g], grp_ptr[g + 1]):
+            total += force[i_f, track_el[grp_col[k]]]
+        if total != 0.0:
+            nm = grp_ptr[g + 1] - grp_ptr[g]
+            for k in range(grp_ptr[g], grp_ptr[g + 1]):
+                j = grp_col[k]
+                el = track_el[j]
+                c = CY[slot, el] - track_base[j]
+                if c >= 0 and c < cap:
+                    ratio = nm * force[i_f, el] / total
+                    if ratio > rat_max[c, j]:
+                        rat_max[c, j] = ratio
+                    if ratio < rat_min[c, j]:
+                        rat_min[c, j] = ratio
 
-    Twin: plain indexing, ``hist_f[row] = force[hist_el]`` etc.
-    """
-    n = y.shape[0] // 2
-    hist_t[row] = t
+
+@_kernel
+def first_corners(t, m, w, r):
+    """Set ``w.next_node`` of every tracked element with corners to its first corner
+    node after time t (absolute node: cycle x n_table + node); returns the earliest
+    corner time."""
+    n_tab = m.stiffness_table.shape[1]
+    corner_ptr, corner_node, next_node = m.corner_ptr, m.corner_node, w.next_node
+    frequency, phase, track_el = m.frequency, m.phase, r.track_el
+    for j in range(track_el.shape[0]):
+        e = track_el[j]
+        c0 = corner_ptr[e]
+        c1 = corner_ptr[e + 1]
+        if c1 == c0:
+            continue
+        x = (frequency[e] * t + phase[e]) * n_tab
+        base = np.int64(math.floor(x / n_tab)) * n_tab
+        node = base + corner_node[c0]
+        k = c0
+        while node <= x:
+            k += 1
+            if k == c1:
+                k = c0
+                base += n_tab
+            node = base + corner_node[k]
+        next_node[e] = node
+    return next_corner_time(m, w, r)
+
+
+@_kernel
+def next_corner_time(m, w, r):
+    """Earliest time of the tracked elements' next corners (``w.next_node``); inf if
+    none."""
+    n_tab = m.stiffness_table.shape[1]
+    corner_ptr, next_node = m.corner_ptr, w.next_node
+    frequency, phase, track_el = m.frequency, m.phase, r.track_el
+    earliest = math.inf
+    for j in range(track_el.shape[0]):
+        e = track_el[j]
+        if corner_ptr[e + 1] > corner_ptr[e]:
+            tc = (next_node[e] / n_tab - phase[e]) / frequency[e]
+            if tc < earliest:
+                earliest = tc
+    return earliest
+
+
+@_kernel
+def corner_events(t_a, t_b, ya, fa, yb, fb, m, w, r, rhs_fn, gen, counters):
+    """Sample the statistics at every corner of a tracked element's force inside the
+    step (t_a, t_b) (see ``kernel_data.CORNER_TOL``): the state there by cubic Hermite
+    interpolation between rows (ya, fa) and (yb, fb) of w.Y (third order, as RK4's
+    error), the excitation exactly, the forces by the stage evaluation, then
+    :func:`record_extrema`.  The largest force and load-sharing ratio then converge like
+    h^2 instead of h when they sit at a corner of a piecewise-linear table.  Returns the
+    earliest next corner time (the callers skip the call until then)."""
+    n_tab = m.stiffness_table.shape[1]
+    corner_ptr, corner_node, next_node = m.corner_ptr, m.corner_node, w.next_node
+    frequency, phase, track_el = m.frequency, m.phase, r.track_el
+    extra = m.fr_el.shape[0] > 0 or m.sp_el.shape[0] > 0
+    h = t_b - t_a
+    slot = np.int64(SLOT_EVENT)
+    for j in range(track_el.shape[0]):
+        e = track_el[j]
+        c0 = corner_ptr[e]
+        c1 = corner_ptr[e + 1]
+        if c1 == c0:
+            continue
+        while True:
+            node = next_node[e]
+            tc = (node / n_tab - phase[e]) / frequency[e]
+            if tc >= t_b:
+                break
+            if tc > t_a:
+                hermite((tc - t_a) / h, h, ya, fa, yb, fb, Y_SAMPLE, w)
+                excite(tc, slot, np.int64(-1), m, w)
+                _stage(slot, Y_SAMPLE, Y_DSAMPLE, F_TMP, m, w, rhs_fn, gen, extra)
+                record_extrema(slot, F_TMP, w, r)
+                counters[I_EVENTS] += 1
+            # the element's next corner
+            base = (node // n_tab) * n_tab
+            p = node - base
+            k = c0
+            while k < c1 and corner_node[k] <= p:
+                k += 1
+            if k == c1:
+                next_node[e] = base + n_tab + corner_node[c0]
+            else:
+                next_node[e] = base + corner_node[k]
+    return next_corner_time(m, w, r)
+
+
+@_kernel
+def store_history(row, t, iy, i_f, w, r):
+    """One decimated history row: t, forces of history elements, q and v of DOFs.
+    Twin: plain indexing, ``hist_f[row] = force[hist_el]`` etc."""
+    Y, F, hist_el, hist_dof = w.Y, w.F, r.hist_el, r.hist_dof
+    hist_f, hist_q, hist_v = r.hist_f, r.hist_q, r.hist_v
+    n = Y.shape[1] // 2
+    r.hist_t[row] = t
     for j in range(hist_el.shape[0]):
-        hist_f[row, j] = force[hist_el[j]]
+        hist_f[row, j] = F[i_f, hist_el[j]]
     for j in range(hist_dof.shape[0]):
         d = hist_dof[j]
-        hist_q[row, j] = y[d]
-        hist_v[row, j] = y[n + d]
+        hist_q[row, j] = Y[iy, d]
+        hist_v[row, j] = Y[iy, n + d]
 
 
-@njit(cache=True, error_model="numpy")
-def bad_state(y, blowup):
-    """Index of the first non-finite state or |q| > blowup, or -1 if all is well.
+@_kernel
+def store_full(row, t, iy, w, r):
+    """One full-state row (when ``full_t`` has room)."""
+    Y, full_y = w.Y, r.full_y
+    r.full_t[row] = t
+    for k in range(Y.shape[1]):
+        full_y[row, k] = Y[iy, k]
 
-    Twin: ``np.flatnonzero(~np.isfinite(y) | (abs(q) > blowup))[:1]``.
-    """
-    n = y.shape[0] // 2
+
+@_kernel
+def bad_state(iy, blowup, w):
+    """Index of the first non-finite entry of state row ``iy`` or |q| > blowup, or -1.
+    Twin: ``np.flatnonzero(~np.isfinite(y) | (abs(q) > blowup))[:1]``."""
+    y = w.Y
+    n = y.shape[1] // 2
     for i in range(n):
-        if not abs(y[i]) <= blowup:  # also true for NaN
+        if not abs(y[iy, i]) <= blowup:  # also true for NaN
             return i
-    for i in range(n, y.shape[0]):
-        if not math.isfinite(y[i]):
+    for i in range(n, y.shape[1]):
+        if not math.isfinite(y[iy, i]):
             return i
     return -1
 
 
 # ======================================================================== RK4
-@njit(cache=True, error_model="numpy")
-def rk4_run(y, t0, h, n_first, n_steps, record_final, record_every, blowup,
-            inv_mass, external_force, ground_damping, element_kind, v_ptr, v_dof,
-            v_coef, stiffness_table, frequency, phase, damping, gap_ptr, gap_values,
-            error_constant, error_ptr, error_amplitude, error_omega, error_phase,
-            force_table, tv_el, err_el, sin_el, vr_ptr, vq_idx, vv_idx, vt_ptr, vt_el,
-            vt_coef, fr_el, fr_ptr, fr_dof, fr_coef, fr_row, friction_table,
-              sp_el, sp_par, track_el, track_base, cyc_max, cyc_min, cyc_sum, cyc_cnt,
-            sep_count, back_count, sep_time, back_time, hist_el, hist_dof, hist_t,
-            hist_f, hist_q, hist_v, full_t, full_y, rhs_fn, rhs_par, counters,
-              clock):
+@_kernel
+def rk4_run(t0, h, n_first, n_steps, record_final, record_every, blowup, m, w, r,
+            rhs_fn, gen, counters, clock):
     """Classic fixed-step RK4 over global steps n_first .. n_first + n_steps - 1.
 
-    Step i runs from t0 + i h to t0 + (i + 1) h.  The state at the start of each step
-    is recorded (statistics; history when i % record_every == 0; full state when
-    ``full_t`` has room); with ``record_final`` the end state is recorded too.  ``y`` is
-    advanced in place.  Excitation is evaluated once per distinct stage time (t,
+    Step i runs from t0 + i h to t0 + (i + 1) h; the state is row Y_STATE of w.Y,
+    advanced in place.  The state at the start of each step is recorded (statistics;
+    history when i % record_every == 0; full state while ``r.full_t`` has room); with
+    ``record_final`` the end state is recorded too.  A step that contains a corner of a
+    tracked element's force keeps its start state and derivative (rows Y_ALT, Y_K1ALT)
+    so that the forces at the corner are sampled once the end state is known
+    (:func:`corner_events`).  Excitation is evaluated once per distinct stage time (t,
     t + h/2, t + h) and the t + h values are reused by the next step; error sinusoids
-    are advanced by phasor rotation and recomputed exactly every RESYNC steps.
-    Stops early (status DIVERGED) if the state is non-finite or |q| > blowup.  Models
-    with tooth friction or splines also run :func:`excite_friction` after each
-    excitation and :func:`rhs_extra` after each right-hand side (``has_fr``, ``extra``).
-    The right-hand side is :func:`rhs_slot`, or the model's generated code ``rhs_fn``
-    with parameters ``rhs_par`` when these are not empty (see the module docstring).
+    are advanced by phasor rotation and recomputed exactly every RESYNC steps.  Stops
+    early (status DIVERGED) if the state is non-finite or |q| > blowup.
     Twin: :func:`torquesplit.solve.reference.rk4_numpy`.
     """
-    n = inv_mass.shape[0]
-    n2 = 2 * n
-    ne = v_ptr.shape[0] - 1
-    n_sin = error_omega.shape[0]
-    K = np.empty((3, ne))
-    P = np.empty((3, ne))
-    G = np.empty((3, ne))
-    E = np.empty((3, ne))
-    ED = np.empty((3, ne))
-    CY = np.empty((3, ne), dtype=np.int64)
-    S = np.empty((3, n_sin))
-    C = np.empty((3, n_sin))
-    FR = np.empty((3, friction_table.shape[0]))
-    gen = rhs_par.shape[0] > 0  # a generated right-hand side was given
-    has_fr = fr_el.shape[0] > 0
-    extra = has_fr or sp_el.shape[0] > 0
-    cos_rot = np.empty(n_sin)
-    sin_rot = np.empty(n_sin)
-    for i in range(n_sin):
-        cos_rot[i] = math.cos(error_omega[i] * 0.5 * h)
-        sin_rot[i] = math.sin(error_omega[i] * 0.5 * h)
-    k1 = np.empty(n2)
-    k2 = np.empty(n2)
-    k3 = np.empty(n2)
-    k4 = np.empty(n2)
-    yt = np.empty(n2)
-    gap_cyc = np.full(ne, _NO_CYCLE, dtype=np.int64)
-    gap_val = np.zeros(ne)
-    has_force = np.zeros(ne, dtype=np.bool_)
-    watch_el = np.empty(ne, dtype=np.int64)
-    n_watch = scratch_flags(element_kind, gap_ptr, gap_values, force_table, has_force,
-                            watch_el)
-    force = np.empty(ne)
-    defl = np.empty(ne)
-    ftmp = np.empty(ne)
-    dtmp = np.empty(ne)
-    init_slots(stiffness_table, force_table, gap_ptr, gap_values, error_constant,
-               K, P, G, E, ED, CY)
-    # data addresses for the generated right-hand side (see the module docstring)
-    ad_y = y.ctypes.data
-    ad_k1 = k1.ctypes.data
-    ad_k2 = k2.ctypes.data
-    ad_k3 = k3.ctypes.data
-    ad_k4 = k4.ctypes.data
-    ad_yt = yt.ctypes.data
-    ad_force = force.ctypes.data
-    ad_defl = defl.ctypes.data
-    ad_ftmp = ftmp.ctypes.data
-    ad_dtmp = dtmp.ctypes.data
-    ad_K = K.ctypes.data
-    ad_G = G.ctypes.data
-    ad_E = E.ctypes.data
-    ad_ED = ED.ctypes.data
-    ad_P = P.ctypes.data
-    ad_par = rhs_par.ctypes.data
+    Y, rot, error_omega = w.Y, w.rot, m.error_omega
+    n2 = Y.shape[1]
+    n_hist = r.hist_t.shape[0]
+    n_full = r.full_t.shape[0]
+    extra = m.fr_el.shape[0] > 0 or m.sp_el.shape[0] > 0
+    for i in range(error_omega.shape[0]):
+        rot[0, i] = math.cos(error_omega[i] * 0.5 * h)
+        rot[1, i] = math.sin(error_omega[i] * 0.5 * h)
+    k1 = Y_K1
+    k2 = Y_K1 + 1
+    k3 = Y_K1 + 2
+    k4 = Y_K1 + 3
     a = np.int64(0)  # slot of t
     b = np.int64(2)  # slot of t + h
     s_half = np.int64(1)  # slot of t + h/2
     hh = 0.5 * h
     h6 = h / 6.0
+    t_corner = math.inf  # earliest corner still to be sampled
+    if m.corner_node.shape[0] > 0 and n_steps > 0:
+        t_corner = first_corners(t0 + max(n_first - 1, 0) * h, m, w, r)
     for it in range(n_steps):
         i = n_first + it
         t = t0 + i * h
         if it == 0 or i % RESYNC == 0:
-            excite_tables(t, a, tv_el, frequency, phase, stiffness_table, force_table,
-                          gap_ptr, gap_values, K, P, G, CY, gap_cyc, gap_val,
-                          has_force)
-            if has_fr:
-                excite_friction(t, a, frequency, phase, fr_el, friction_table, FR)
-            phasors_exact(t, a, error_omega, error_phase, S, C)
-            errors_from_phasors(a, err_el, error_constant, sin_el, error_amplitude,
-                                error_omega, S, C, E, ED)
+            excite(t, a, np.int64(-1), m, w)
         # stage 1 at t: its forces are those of the accepted state y(t)
-        if gen:  # the model's generated code (codegen.py), else the general loop
-            rhs_fn(ad_y, ad_k1, ad_force, ad_defl, ad_K, ad_G, ad_E, ad_ED, ad_P,
-                   ad_par, a * ne)
-        else:
-            rhs_slot(y, a, K, P, G, E, ED, inv_mass, external_force, ground_damping,
-                     vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
-                     k1, force, defl)
-        if extra:
-            rhs_extra(y, a, inv_mass, vr_ptr, vq_idx, vv_idx, v_coef, fr_el,
-                      fr_ptr, fr_dof, fr_coef, fr_row, FR, sp_el, sp_par, k1, force,
-                      defl)
-        record_statistics(a, force, defl, G, CY, element_kind, track_el, track_base,
-                          cyc_max, cyc_min, cyc_sum, cyc_cnt, sep_count, back_count,
-                          sep_time, back_time, h, counters, watch_el, n_watch)
+        _stage(a, Y_STATE, k1, F_MAIN, m, w, rhs_fn, gen, extra)
+        record(a, F_MAIN, h, m, w, r, counters)
+        if counters[I_SAVED] == 1:  # corners inside the step that ended at t
+            counters[I_SAVED] = 0
+            t_corner = corner_events(t - h, t, Y_ALT, Y_K1ALT, Y_STATE, k1, m, w, r,
+                                     rhs_fn, gen, counters)
         if (record_every > 0 and i % record_every == 0
-                and counters[I_HIST] < hist_t.shape[0]):
-            store_history(counters[I_HIST], t, y, force, hist_el, hist_dof,
-                          hist_t, hist_f, hist_q, hist_v)
+                and counters[I_HIST] < n_hist):
+            store_history(counters[I_HIST], t, Y_STATE, F_MAIN, w, r)
             counters[I_HIST] += 1
-        if counters[I_FULL] < full_t.shape[0]:
-            full_t[counters[I_FULL]] = t
-            for m in range(n2):
-                full_y[counters[I_FULL], m] = y[m]
+        if counters[I_FULL] < n_full:
+            store_full(counters[I_FULL], t, Y_STATE, w, r)
             counters[I_FULL] += 1
-        # stages 2 and 3 at t + h/2
-        th = t0 + (i + 0.5) * h
-        excite_tables(th, s_half, tv_el, frequency, phase, stiffness_table, force_table,
-                      gap_ptr, gap_values, K, P, G, CY, gap_cyc, gap_val,
-                      has_force)
-        if has_fr:
-            excite_friction(th, s_half, frequency, phase, fr_el, friction_table, FR)
-        advance_errors(a, s_half, cos_rot, sin_rot, err_el, error_constant, sin_el,
-                       error_amplitude, error_omega, S, C, E, ED)
-        for m in range(n2):
-            yt[m] = y[m] + hh * k1[m]
-        if gen:  # the model's generated code (codegen.py), else the general loop
-            rhs_fn(ad_yt, ad_k2, ad_ftmp, ad_dtmp, ad_K, ad_G, ad_E, ad_ED, ad_P,
-                   ad_par, s_half * ne)
-        else:
-            rhs_slot(yt, s_half, K, P, G, E, ED, inv_mass, external_force, ground_damping,
-                     vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
-                     k2, ftmp, dtmp)
-        if extra:
-            rhs_extra(yt, s_half, inv_mass, vr_ptr, vq_idx, vv_idx, v_coef, fr_el,
-                      fr_ptr, fr_dof, fr_coef, fr_row, FR, sp_el, sp_par, k2, ftmp,
-                      dtmp)
-        for m in range(n2):
-            yt[m] = y[m] + hh * k2[m]
-        if gen:  # the model's generated code (codegen.py), else the general loop
-            rhs_fn(ad_yt, ad_k3, ad_ftmp, ad_dtmp, ad_K, ad_G, ad_E, ad_ED, ad_P,
-                   ad_par, s_half * ne)
-        else:
-            rhs_slot(yt, s_half, K, P, G, E, ED, inv_mass, external_force, ground_damping,
-                     vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
-                     k3, ftmp, dtmp)
-        if extra:
-            rhs_extra(yt, s_half, inv_mass, vr_ptr, vq_idx, vv_idx, v_coef, fr_el,
-                      fr_ptr, fr_dof, fr_coef, fr_row, FR, sp_el, sp_par, k3, ftmp,
-                      dtmp)
-        # stage 4 at t + h
         tb = t0 + (i + 1) * h
-        excite_tables(tb, b, tv_el, frequency, phase, stiffness_table, force_table,
-                      gap_ptr, gap_values, K, P, G, CY, gap_cyc, gap_val,
-                      has_force)
-        if has_fr:
-            excite_friction(tb, b, frequency, phase, fr_el, friction_table, FR)
-        advance_errors(s_half, b, cos_rot, sin_rot, err_el, error_constant, sin_el,
-                       error_amplitude, error_omega, S, C, E, ED)
-        for m in range(n2):
-            yt[m] = y[m] + h * k3[m]
-        if gen:  # the model's generated code (codegen.py), else the general loop
-            rhs_fn(ad_yt, ad_k4, ad_ftmp, ad_dtmp, ad_K, ad_G, ad_E, ad_ED, ad_P,
-                   ad_par, b * ne)
-        else:
-            rhs_slot(yt, b, K, P, G, E, ED, inv_mass, external_force, ground_damping,
-                     vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
-                     k4, ftmp, dtmp)
-        if extra:
-            rhs_extra(yt, b, inv_mass, vr_ptr, vq_idx, vv_idx, v_coef, fr_el,
-                      fr_ptr, fr_dof, fr_coef, fr_row, FR, sp_el, sp_par, k4, ftmp,
-                      dtmp)
-        for m in range(n2):
-            y[m] += h6 * (k1[m] + 2.0 * (k2[m] + k3[m]) + k4[m])
+        if t_corner < tb:  # a corner inside this step: keep its start
+            for k in range(n2):
+                Y[Y_ALT, k] = Y[Y_STATE, k]
+                Y[Y_K1ALT, k] = Y[k1, k]
+            counters[I_SAVED] = 1
+        # stages 2 and 3 at t + h/2
+        excite(t0 + (i + 0.5) * h, s_half, a, m, w)
+        for k in range(n2):
+            Y[Y_TRIAL, k] = Y[Y_STATE, k] + hh * Y[k1, k]
+        _stage(s_half, Y_TRIAL, k2, F_TMP, m, w, rhs_fn, gen, extra)
+        for k in range(n2):
+            Y[Y_TRIAL, k] = Y[Y_STATE, k] + hh * Y[k2, k]
+        _stage(s_half, Y_TRIAL, k3, F_TMP, m, w, rhs_fn, gen, extra)
+        # stage 4 at t + h
+        excite(tb, b, s_half, m, w)
+        for k in range(n2):
+            Y[Y_TRIAL, k] = Y[Y_STATE, k] + h * Y[k3, k]
+        _stage(b, Y_TRIAL, k4, F_TMP, m, w, rhs_fn, gen, extra)
+        for k in range(n2):
+            Y[Y_STATE, k] += h6 * (Y[k1, k] + 2.0 * (Y[k2, k] + Y[k3, k]) + Y[k4, k])
         counters[I_STEPS] += 1
         counters[I_RHS] += 4
         clock[F_T] = tb
-        bad = bad_state(y, blowup)
+        bad = bad_state(Y_STATE, blowup, w)
         if bad >= 0:
             counters[I_STATUS] = DIVERGED
             counters[I_BAD] = bad
@@ -773,176 +667,87 @@ def rk4_run(y, t0, h, n_first, n_steps, record_final, record_every, blowup,
     if record_final and n_steps > 0:
         i = n_first + n_steps
         t = t0 + i * h
-        if gen:  # the model's generated code (codegen.py), else the general loop
-            rhs_fn(ad_y, ad_k1, ad_force, ad_defl, ad_K, ad_G, ad_E, ad_ED, ad_P,
-                   ad_par, a * ne)
-        else:
-            rhs_slot(y, a, K, P, G, E, ED, inv_mass, external_force, ground_damping,
-                     vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
-                     k1, force, defl)
-        if extra:
-            rhs_extra(y, a, inv_mass, vr_ptr, vq_idx, vv_idx, v_coef, fr_el,
-                      fr_ptr, fr_dof, fr_coef, fr_row, FR, sp_el, sp_par, k1, force,
-                      defl)
-        record_statistics(a, force, defl, G, CY, element_kind, track_el, track_base,
-                          cyc_max, cyc_min, cyc_sum, cyc_cnt, sep_count, back_count,
-                          sep_time, back_time, 0.0, counters, watch_el, n_watch)
+        _stage(a, Y_STATE, k1, F_MAIN, m, w, rhs_fn, gen, extra)
+        record(a, F_MAIN, 0.0, m, w, r, counters)
+        if counters[I_SAVED] == 1:
+            counters[I_SAVED] = 0
+            corner_events(t - h, t, Y_ALT, Y_K1ALT, Y_STATE, k1, m, w, r, rhs_fn, gen,
+                          counters)
         if (record_every > 0 and i % record_every == 0
-                and counters[I_HIST] < hist_t.shape[0]):
-            store_history(counters[I_HIST], t, y, force, hist_el, hist_dof,
-                          hist_t, hist_f, hist_q, hist_v)
+                and counters[I_HIST] < n_hist):
+            store_history(counters[I_HIST], t, Y_STATE, F_MAIN, w, r)
             counters[I_HIST] += 1
-        if counters[I_FULL] < full_t.shape[0]:
-            full_t[counters[I_FULL]] = t
-            for m in range(n2):
-                full_y[counters[I_FULL], m] = y[m]
+        if counters[I_FULL] < n_full:
+            store_full(counters[I_FULL], t, Y_STATE, w, r)
             counters[I_FULL] += 1
 
 
 # ============================================================== Dormand-Prince
-@njit(cache=True, error_model="numpy")
-def hermite(theta, h, y0, f0, y1, f1, out):
-    """Cubic Hermite interpolation of the state between two accepted steps.
-
-    Twin: :func:`torquesplit.solve.reference.hermite_numpy`.
-    """
+@_kernel
+def hermite(theta, h, i0, if0, i1, if1, iout, w):
+    """Cubic Hermite interpolation between rows (y0, f0) and (y1, f1) of w.Y into row
+    ``iout``.  Twin: :func:`torquesplit.solve.reference.hermite_numpy`."""
+    Y = w.Y
     t2 = theta * theta
     t3 = t2 * theta
     h00 = 2.0 * t3 - 3.0 * t2 + 1.0
     h10 = (t3 - 2.0 * t2 + theta) * h
     h01 = 3.0 * t2 - 2.0 * t3
     h11 = (t3 - t2) * h
-    for m in range(out.shape[0]):
-        out[m] = h00 * y0[m] + h10 * f0[m] + h01 * y1[m] + h11 * f1[m]
+    for k in range(Y.shape[1]):
+        Y[iout, k] = h00 * Y[i0, k] + h10 * Y[if0, k] + h01 * Y[i1, k] + h11 * Y[if1, k]
 
 
-@njit(cache=True, error_model="numpy")
-def dopri_run(y, kfsal, t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, blowup,
-              dt_sample,
-              inv_mass, external_force, ground_damping, element_kind, v_ptr, v_dof,
-              v_coef, stiffness_table, frequency, phase, damping, gap_ptr, gap_values,
-              error_constant, error_ptr, error_amplitude, error_omega, error_phase,
-              force_table, tv_el, err_el, sin_el, vr_ptr, vq_idx, vv_idx, vt_ptr, vt_el,
-              vt_coef, fr_el, fr_ptr, fr_dof, fr_coef, fr_row, friction_table,
-              sp_el, sp_par, track_el, track_base, cyc_max, cyc_min, cyc_sum, cyc_cnt,
-              sep_count, back_count, sep_time, back_time, hist_el, hist_dof, hist_t,
-              hist_f, hist_q, hist_v, full_t, full_y, rhs_fn, rhs_par, counters,
-            clock):
+@_kernel
+def dopri_run(t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, blowup, dt_sample,
+              m, w, r, rhs_fn, gen, counters, clock):
     """Adaptive Dormand-Prince 5(4) with FSAL and PI step-size control (Hairer's DOPRI5).
 
     Integrates from clock[F_T] until t >= t_stop (never past t_end; the last step is
-    shortened to land on t_end), advancing ``y`` in place.  ``kfsal`` carries f(t, y)
-    between calls (counters[I_FSAL]).  Error norm: RMS of err_i / (atol_i + rtol
-    max(|y_i|, |y_new_i|)).  Every accepted state enters the statistics; the decimated
-    (and optional full) histories are written at the uniform times t0 + k dt_sample by
-    cubic Hermite interpolation between accepted steps.
+    shortened to land on t_end), advancing row Y_STATE in place; row Y_KFSAL carries
+    f(t, y) between calls (counters[I_FSAL]).  Error norm: RMS of err_i / (atol_i +
+    rtol max(|y_i|, |y_new_i|)).  Every accepted state enters the statistics, and so do
+    the forces at the corners inside each accepted step (:func:`corner_events`); the
+    decimated (and optional full) histories are written at the uniform times
+    t0 + k dt_sample by cubic Hermite interpolation between accepted steps.
     Status: DIVERGED (non-finite or |q| > blowup after an accepted step),
     STEP_UNDERFLOW (h < max(h_min, 10 eps |t|)), MAX_STEPS (accepted steps).
-    Right-hand side: as :func:`rk4_run` (``rhs_fn``, ``rhs_par``).
     Twin: :func:`torquesplit.solve.reference.dopri_numpy`.
     """
-    n = inv_mass.shape[0]
-    n2 = 2 * n
-    ne = v_ptr.shape[0] - 1
-    n_sin = error_omega.shape[0]
-    K = np.empty((2, ne))
-    P = np.empty((2, ne))
-    G = np.empty((2, ne))
-    E = np.empty((2, ne))
-    ED = np.empty((2, ne))
-    CY = np.empty((2, ne), dtype=np.int64)
-    S = np.empty((2, n_sin))
-    C = np.empty((2, n_sin))
-    FR = np.empty((2, friction_table.shape[0]))
-    gen = rhs_par.shape[0] > 0  # a generated right-hand side was given
-    has_fr = fr_el.shape[0] > 0
-    extra = has_fr or sp_el.shape[0] > 0
-    k2 = np.empty(n2)
-    k3 = np.empty(n2)
-    k4 = np.empty(n2)
-    k5 = np.empty(n2)
-    k6 = np.empty(n2)
-    k7 = np.empty(n2)
-    yt = np.empty(n2)
-    ynew = np.empty(n2)
-    ys = np.empty(n2)
-    dys = np.empty(n2)
-    gap_cyc = np.full(ne, _NO_CYCLE, dtype=np.int64)
-    gap_val = np.zeros(ne)
-    has_force = np.zeros(ne, dtype=np.bool_)
-    watch_el = np.empty(ne, dtype=np.int64)
-    n_watch = scratch_flags(element_kind, gap_ptr, gap_values, force_table, has_force,
-                            watch_el)
-    force = np.empty(ne)
-    defl = np.empty(ne)
-    ftmp = np.empty(ne)
-    dtmp = np.empty(ne)
-    init_slots(stiffness_table, force_table, gap_ptr, gap_values, error_constant,
-               K, P, G, E, ED, CY)
+    Y = w.Y
+    n2 = Y.shape[1]
+    n_full = r.full_t.shape[0]
+    extra = m.fr_el.shape[0] > 0 or m.sp_el.shape[0] > 0
+    t_corner = math.inf  # earliest corner still to be sampled
+    if m.corner_node.shape[0] > 0:
+        t_corner = first_corners(clock[F_T], m, w, r)
+    kf = Y_KFSAL
+    k2 = kf + 1
+    k3 = kf + 2
+    k4 = kf + 3
+    k5 = kf + 4
+    k6 = kf + 5
+    k7 = kf + 6
     s0 = np.int64(0)  # slot of the stages (and of interpolated samples)
     s1 = np.int64(1)  # slot of t + h: the candidate state, then the accepted one
-    n_hist = hist_t.shape[0]
+    n_hist = r.hist_t.shape[0]
     t = clock[F_T]
     h = clock[F_H]
     facold = clock[F_FACOLD]
     eps = 2.220446049250313e-16
-    # data addresses for the generated right-hand side (see the module docstring)
-    ad_y = y.ctypes.data
-    ad_kfsal = kfsal.ctypes.data
-    ad_k2 = k2.ctypes.data
-    ad_k3 = k3.ctypes.data
-    ad_k4 = k4.ctypes.data
-    ad_k5 = k5.ctypes.data
-    ad_k6 = k6.ctypes.data
-    ad_k7 = k7.ctypes.data
-    ad_yt = yt.ctypes.data
-    ad_ynew = ynew.ctypes.data
-    ad_ys = ys.ctypes.data
-    ad_dys = dys.ctypes.data
-    ad_force = force.ctypes.data
-    ad_defl = defl.ctypes.data
-    ad_ftmp = ftmp.ctypes.data
-    ad_dtmp = dtmp.ctypes.data
-    ad_K = K.ctypes.data
-    ad_G = G.ctypes.data
-    ad_E = E.ctypes.data
-    ad_ED = ED.ctypes.data
-    ad_P = P.ctypes.data
-    ad_par = rhs_par.ctypes.data
     # current state: f(t, y) and, at the very start, its sample
     if counters[I_FSAL] == 0:
-        excite_exact(t, s1, frequency, phase, stiffness_table, force_table, gap_ptr,
-                     gap_values, error_constant, error_amplitude, error_omega,
-                     error_phase, tv_el, err_el, sin_el, K, P, G, E, ED, CY, S, C,
-                     gap_cyc, gap_val, has_force)
-        if has_fr:
-            excite_friction(t, s1, frequency, phase, fr_el, friction_table, FR)
-        if gen:  # the model's generated code (codegen.py), else the general loop
-            rhs_fn(ad_y, ad_kfsal, ad_force, ad_defl, ad_K, ad_G, ad_E, ad_ED, ad_P,
-                   ad_par, s1 * ne)
-        else:
-            rhs_slot(y, s1, K, P, G, E, ED, inv_mass, external_force, ground_damping,
-                     vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
-                     kfsal, force, defl)
-        if extra:
-            rhs_extra(y, s1, inv_mass, vr_ptr, vq_idx, vv_idx, v_coef, fr_el,
-                      fr_ptr, fr_dof, fr_coef, fr_row, FR, sp_el, sp_par, kfsal, force,
-                      defl)
+        excite(t, s1, np.int64(-1), m, w)
+        _stage(s1, Y_STATE, kf, F_MAIN, m, w, rhs_fn, gen, extra)
         counters[I_RHS] += 1
         counters[I_FSAL] = 1
         if counters[I_SAMPLES] == 0:
-            record_statistics(s1, force, defl, G, CY, element_kind, track_el,
-                              track_base, cyc_max, cyc_min, cyc_sum, cyc_cnt,
-                              sep_count, back_count, sep_time, back_time, 0.0,
-                              counters, watch_el, n_watch)
+            record(s1, F_MAIN, 0.0, m, w, r, counters)
         while counters[I_NEXT] < n_hist and t0 + counters[I_NEXT] * dt_sample <= t:
             row = counters[I_NEXT]
-            store_history(row, t, y, force, hist_el, hist_dof, hist_t, hist_f,
-                          hist_q, hist_v)
-            if row < full_t.shape[0]:
-                full_t[row] = t
-                for m in range(n2):
-                    full_y[row, m] = y[m]
+            store_history(row, t, Y_STATE, F_MAIN, w, r)
+            if row < n_full:
+                store_full(row, t, Y_STATE, w, r)
                 counters[I_FULL] = row + 1
             counters[I_NEXT] = row + 1
             counters[I_HIST] = row + 1
@@ -963,134 +768,44 @@ def dopri_run(y, kfsal, t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, 
             clock[F_H] = hs
             break
         # stages 2..6 (slot 0), stage 7 at t + hs (slot 1)
-        for m in range(n2):
-            yt[m] = y[m] + hs * _A21 * kfsal[m]
-        excite_exact(t + _C2 * hs, s0, frequency, phase, stiffness_table, force_table,
-                     gap_ptr, gap_values, error_constant, error_amplitude, error_omega,
-                     error_phase, tv_el, err_el, sin_el, K, P, G, E, ED, CY, S, C,
-                     gap_cyc, gap_val, has_force)
-        if has_fr:
-            excite_friction(t + _C2 * hs, s0, frequency, phase, fr_el, friction_table, FR)
-        if gen:  # the model's generated code (codegen.py), else the general loop
-            rhs_fn(ad_yt, ad_k2, ad_ftmp, ad_dtmp, ad_K, ad_G, ad_E, ad_ED, ad_P,
-                   ad_par, s0 * ne)
-        else:
-            rhs_slot(yt, s0, K, P, G, E, ED, inv_mass, external_force, ground_damping,
-                     vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
-                     k2, ftmp, dtmp)
-        if extra:
-            rhs_extra(yt, s0, inv_mass, vr_ptr, vq_idx, vv_idx, v_coef, fr_el,
-                      fr_ptr, fr_dof, fr_coef, fr_row, FR, sp_el, sp_par, k2, ftmp,
-                      dtmp)
-        for m in range(n2):
-            yt[m] = y[m] + hs * (_A31 * kfsal[m] + _A32 * k2[m])
-        excite_exact(t + _C3 * hs, s0, frequency, phase, stiffness_table, force_table,
-                     gap_ptr, gap_values, error_constant, error_amplitude, error_omega,
-                     error_phase, tv_el, err_el, sin_el, K, P, G, E, ED, CY, S, C,
-                     gap_cyc, gap_val, has_force)
-        if has_fr:
-            excite_friction(t + _C3 * hs, s0, frequency, phase, fr_el, friction_table, FR)
-        if gen:  # the model's generated code (codegen.py), else the general loop
-            rhs_fn(ad_yt, ad_k3, ad_ftmp, ad_dtmp, ad_K, ad_G, ad_E, ad_ED, ad_P,
-                   ad_par, s0 * ne)
-        else:
-            rhs_slot(yt, s0, K, P, G, E, ED, inv_mass, external_force, ground_damping,
-                     vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
-                     k3, ftmp, dtmp)
-        if extra:
-            rhs_extra(yt, s0, inv_mass, vr_ptr, vq_idx, vv_idx, v_coef, fr_el,
-                      fr_ptr, fr_dof, fr_coef, fr_row, FR, sp_el, sp_par, k3, ftmp,
-                      dtmp)
-        for m in range(n2):
-            yt[m] = y[m] + hs * (_A41 * kfsal[m] + _A42 * k2[m] + _A43 * k3[m])
-        excite_exact(t + _C4 * hs, s0, frequency, phase, stiffness_table, force_table,
-                     gap_ptr, gap_values, error_constant, error_amplitude, error_omega,
-                     error_phase, tv_el, err_el, sin_el, K, P, G, E, ED, CY, S, C,
-                     gap_cyc, gap_val, has_force)
-        if has_fr:
-            excite_friction(t + _C4 * hs, s0, frequency, phase, fr_el, friction_table, FR)
-        if gen:  # the model's generated code (codegen.py), else the general loop
-            rhs_fn(ad_yt, ad_k4, ad_ftmp, ad_dtmp, ad_K, ad_G, ad_E, ad_ED, ad_P,
-                   ad_par, s0 * ne)
-        else:
-            rhs_slot(yt, s0, K, P, G, E, ED, inv_mass, external_force, ground_damping,
-                     vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
-                     k4, ftmp, dtmp)
-        if extra:
-            rhs_extra(yt, s0, inv_mass, vr_ptr, vq_idx, vv_idx, v_coef, fr_el,
-                      fr_ptr, fr_dof, fr_coef, fr_row, FR, sp_el, sp_par, k4, ftmp,
-                      dtmp)
-        for m in range(n2):
-            yt[m] = y[m] + hs * (_A51 * kfsal[m] + _A52 * k2[m] + _A53 * k3[m]
-                                 + _A54 * k4[m])
-        excite_exact(t + _C5 * hs, s0, frequency, phase, stiffness_table, force_table,
-                     gap_ptr, gap_values, error_constant, error_amplitude, error_omega,
-                     error_phase, tv_el, err_el, sin_el, K, P, G, E, ED, CY, S, C,
-                     gap_cyc, gap_val, has_force)
-        if has_fr:
-            excite_friction(t + _C5 * hs, s0, frequency, phase, fr_el, friction_table, FR)
-        if gen:  # the model's generated code (codegen.py), else the general loop
-            rhs_fn(ad_yt, ad_k5, ad_ftmp, ad_dtmp, ad_K, ad_G, ad_E, ad_ED, ad_P,
-                   ad_par, s0 * ne)
-        else:
-            rhs_slot(yt, s0, K, P, G, E, ED, inv_mass, external_force, ground_damping,
-                     vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
-                     k5, ftmp, dtmp)
-        if extra:
-            rhs_extra(yt, s0, inv_mass, vr_ptr, vq_idx, vv_idx, v_coef, fr_el,
-                      fr_ptr, fr_dof, fr_coef, fr_row, FR, sp_el, sp_par, k5, ftmp,
-                      dtmp)
-        for m in range(n2):
-            yt[m] = y[m] + hs * (_A61 * kfsal[m] + _A62 * k2[m] + _A63 * k3[m]
-                                 + _A64 * k4[m] + _A65 * k5[m])
+        for k in range(n2):
+            Y[Y_TRIAL, k] = Y[Y_STATE, k] + hs * _A21 * Y[kf, k]
+        excite(t + _C2 * hs, s0, np.int64(-1), m, w)
+        _stage(s0, Y_TRIAL, k2, F_TMP, m, w, rhs_fn, gen, extra)
+        for k in range(n2):
+            Y[Y_TRIAL, k] = Y[Y_STATE, k] + hs * (_A31 * Y[kf, k] + _A32 * Y[k2, k])
+        excite(t + _C3 * hs, s0, np.int64(-1), m, w)
+        _stage(s0, Y_TRIAL, k3, F_TMP, m, w, rhs_fn, gen, extra)
+        for k in range(n2):
+            Y[Y_TRIAL, k] = Y[Y_STATE, k] + hs * (_A41 * Y[kf, k] + _A42 * Y[k2, k]
+                                                 + _A43 * Y[k3, k])
+        excite(t + _C4 * hs, s0, np.int64(-1), m, w)
+        _stage(s0, Y_TRIAL, k4, F_TMP, m, w, rhs_fn, gen, extra)
+        for k in range(n2):
+            Y[Y_TRIAL, k] = Y[Y_STATE, k] + hs * (_A51 * Y[kf, k] + _A52 * Y[k2, k]
+                                                 + _A53 * Y[k3, k] + _A54 * Y[k4, k])
+        excite(t + _C5 * hs, s0, np.int64(-1), m, w)
+        _stage(s0, Y_TRIAL, k5, F_TMP, m, w, rhs_fn, gen, extra)
+        for k in range(n2):
+            Y[Y_TRIAL, k] = Y[Y_STATE, k] + hs * (_A61 * Y[kf, k] + _A62 * Y[k2, k]
+                                                 + _A63 * Y[k3, k] + _A64 * Y[k4, k]
+                                                 + _A65 * Y[k5, k])
         t_new = t_end if last else t + hs
-        excite_exact(t_new, s0, frequency, phase, stiffness_table, force_table,
-                     gap_ptr, gap_values, error_constant, error_amplitude, error_omega,
-                     error_phase, tv_el, err_el, sin_el, K, P, G, E, ED, CY, S, C,
-                     gap_cyc, gap_val, has_force)
-        if has_fr:
-            excite_friction(t_new, s0, frequency, phase, fr_el, friction_table, FR)
-        if gen:  # the model's generated code (codegen.py), else the general loop
-            rhs_fn(ad_yt, ad_k6, ad_ftmp, ad_dtmp, ad_K, ad_G, ad_E, ad_ED, ad_P,
-                   ad_par, s0 * ne)
-        else:
-            rhs_slot(yt, s0, K, P, G, E, ED, inv_mass, external_force, ground_damping,
-                     vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
-                     k6, ftmp, dtmp)
-        if extra:
-            rhs_extra(yt, s0, inv_mass, vr_ptr, vq_idx, vv_idx, v_coef, fr_el,
-                      fr_ptr, fr_dof, fr_coef, fr_row, FR, sp_el, sp_par, k6, ftmp,
-                      dtmp)
-        for m in range(n2):
-            ynew[m] = y[m] + hs * (_B1 * kfsal[m] + _B3 * k3[m] + _B4 * k4[m]
-                                   + _B5 * k5[m] + _B6 * k6[m])
+        excite(t_new, s0, np.int64(-1), m, w)
+        _stage(s0, Y_TRIAL, k6, F_TMP, m, w, rhs_fn, gen, extra)
+        for k in range(n2):
+            Y[Y_NEW, k] = Y[Y_STATE, k] + hs * (_B1 * Y[kf, k] + _B3 * Y[k3, k]
+                                               + _B4 * Y[k4, k] + _B5 * Y[k5, k]
+                                               + _B6 * Y[k6, k])
         # stage 7 (FSAL): same time as stage 6, so the excitation is copied
-        for el in range(ne):
-            K[1, el] = K[0, el]
-            P[1, el] = P[0, el]
-            G[1, el] = G[0, el]
-            E[1, el] = E[0, el]
-            ED[1, el] = ED[0, el]
-            CY[1, el] = CY[0, el]
-        for r in range(FR.shape[1]):
-            FR[1, r] = FR[0, r]
-        if gen:  # the model's generated code (codegen.py), else the general loop
-            rhs_fn(ad_ynew, ad_k7, ad_force, ad_defl, ad_K, ad_G, ad_E, ad_ED, ad_P,
-                   ad_par, s1 * ne)
-        else:
-            rhs_slot(ynew, s1, K, P, G, E, ED, inv_mass, external_force, ground_damping,
-                     vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
-                     k7, force, defl)
-        if extra:
-            rhs_extra(ynew, s1, inv_mass, vr_ptr, vq_idx, vv_idx, v_coef, fr_el,
-                      fr_ptr, fr_dof, fr_coef, fr_row, FR, sp_el, sp_par, k7, force,
-                      defl)
+        copy_slot(s0, s1, w)
+        _stage(s1, Y_NEW, k7, F_MAIN, m, w, rhs_fn, gen, extra)
         counters[I_RHS] += 6
         acc = 0.0
-        for m in range(n2):
-            err = hs * (_E1 * kfsal[m] + _E3 * k3[m] + _E4 * k4[m] + _E5 * k5[m]
-                        + _E6 * k6[m] + _E7 * k7[m])
-            sc = atol[m] + rtol * max(abs(y[m]), abs(ynew[m]))
+        for k in range(n2):
+            err = hs * (_E1 * Y[kf, k] + _E3 * Y[k3, k] + _E4 * Y[k4, k] + _E5 * Y[k5, k]
+                        + _E6 * Y[k6, k] + _E7 * Y[k7, k])
+            sc = atol[k] + rtol * max(abs(Y[Y_STATE, k]), abs(Y[Y_NEW, k]))
             acc += (err / sc) ** 2
         enorm = math.sqrt(acc / n2)
         if not math.isfinite(enorm):
@@ -1101,10 +816,10 @@ def dopri_run(y, kfsal, t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, 
         fac11 = enorm ** _EXPO1
         if enorm <= 1.0:
             # ------------------------------------------------ accepted
-            bad = bad_state(ynew, blowup)
+            bad = bad_state(Y_NEW, blowup, w)
             if bad >= 0:  # stop before recording anything of this step
-                for m in range(n2):
-                    y[m] = ynew[m]
+                for k in range(n2):
+                    Y[Y_STATE, k] = Y[Y_NEW, k]
                 t = t_new
                 counters[I_STEPS] += 1
                 counters[I_STATUS] = DIVERGED
@@ -1117,36 +832,21 @@ def dopri_run(y, kfsal, t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, 
                 theta = (ts - t) / hs
                 if theta > 1.0:
                     theta = 1.0
-                hermite(theta, hs, y, kfsal, ynew, k7, ys)
-                excite_exact(ts, s0, frequency, phase, stiffness_table, force_table,
-                             gap_ptr, gap_values, error_constant, error_amplitude,
-                             error_omega, error_phase, tv_el, err_el, sin_el,
-                             K, P, G, E, ED, CY, S, C, gap_cyc, gap_val, has_force)
-                if has_fr:
-                    excite_friction(ts, s0, frequency, phase, fr_el, friction_table, FR)
-                if gen:  # the model's generated code (codegen.py), else the general loop
-                    rhs_fn(ad_ys, ad_dys, ad_ftmp, ad_dtmp, ad_K, ad_G, ad_E, ad_ED, ad_P,
-                           ad_par, s0 * ne)
-                else:
-                    rhs_slot(ys, s0, K, P, G, E, ED, inv_mass, external_force, ground_damping,
-                             vr_ptr, vq_idx, vv_idx, v_coef, vt_ptr, vt_el, vt_coef, damping,
-                             dys, ftmp, dtmp)
-                if extra:
-                    rhs_extra(ys, s0, inv_mass, vr_ptr, vq_idx, vv_idx, v_coef, fr_el,
-                              fr_ptr, fr_dof, fr_coef, fr_row, FR, sp_el, sp_par, dys, ftmp,
-                              dtmp)
-                store_history(row, ts, ys, ftmp, hist_el, hist_dof, hist_t, hist_f,
-                              hist_q, hist_v)
-                if row < full_t.shape[0]:
-                    full_t[row] = ts
-                    for m in range(n2):
-                        full_y[row, m] = ys[m]
+                hermite(theta, hs, Y_STATE, kf, Y_NEW, k7, Y_SAMPLE, w)
+                excite(ts, s0, np.int64(-1), m, w)
+                _stage(s0, Y_SAMPLE, Y_DSAMPLE, F_TMP, m, w, rhs_fn, gen, extra)
+                store_history(row, ts, Y_SAMPLE, F_TMP, w, r)
+                if row < n_full:
+                    store_full(row, ts, Y_SAMPLE, w, r)
                     counters[I_FULL] = row + 1
                 counters[I_NEXT] = row + 1
                 counters[I_HIST] = row + 1
-            for m in range(n2):
-                y[m] = ynew[m]
-                kfsal[m] = k7[m]
+            if t_corner < t_new:
+                t_corner = corner_events(t, t_new, Y_STATE, kf, Y_NEW, k7, m, w, r, rhs_fn,
+                                         gen, counters)
+            for k in range(n2):
+                Y[Y_STATE, k] = Y[Y_NEW, k]
+                Y[kf, k] = Y[k7, k]
             t = t_new
             clock[F_T] = t
             counters[I_STEPS] += 1
@@ -1154,10 +854,7 @@ def dopri_run(y, kfsal, t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, 
                 clock[F_HMIN] = hs
             if hs > clock[F_HMAX]:
                 clock[F_HMAX] = hs
-            record_statistics(s1, force, defl, G, CY, element_kind, track_el, track_base,
-                              cyc_max, cyc_min, cyc_sum, cyc_cnt, sep_count,
-                              back_count, sep_time, back_time, hs, counters, watch_el,
-                              n_watch)
+            record(s1, F_MAIN, hs, m, w, r, counters)
             fac = fac11 / facold ** _BETA
             fac = max(1.0 / _FAC_MAX, min(1.0 / _FAC_MIN, fac / _SAFE))
             h_new = hs / fac

@@ -9,20 +9,26 @@ numba itself uses: 0.05-0.5 s for the seed examples, against 4-22 s for the same
 written as Python and compiled by numba.  The kernels (``rk4_run``, ``dopri_run``) call it through a
 numba first-class function, so they are compiled and cached once for every model.
 
-It is the same computation as ``rhs_slot``, operation for operation and in the same
-order (no fused multiply-adds, no reassociation), so results are bit for bit the same
+The element force law is not written here: each element's force is a call to the
+law's own compiled code, :func:`torquesplit.solve.laws.spring_force_c` (numba compiles
+:func:`~torquesplit.solve.laws.spring_force` with a C signature; its LLVM module is
+linked into each generated module and inlined), so the generated code and
+``rhs_slot`` run the same instructions for the law, and the same sums in the same order
+around it (no fused multiply-adds, no reassociation): results are bit for bit the same
 (tested).  A whole RK4 step is about twice as fast with it (seed 001: 0.78 against
 1.51 µs in the same benchmark run, benchmarks/RESULTS.md), and within 1.0-1.2 times of a
-hand-written transcription of the model.  The kernels pass it data addresses taken once per call: ``array.ctypes``
+transcription generated from the assembled structure (benchmarks/bench_specialised.py:
+checks kernel overhead, not assembly; the seed 001 equations written by hand are timed
+in benchmarks/bench_transcription.py).  The kernels pass it data addresses taken once per call: ``array.ctypes``
 at every call would cost an atomic reference-count increment and decrement per array,
 more than the arithmetic.  What it computes, for one excitation slot::
 
     delta_e = -E_e + sum_j V_ej q_j          (CSR order of V)
     rate_e  = -ED_e + sum_j V_ej v_j
-    f_e     = dead zone of half-width G_e as in rhs_slot, + P_e
-    dy      = [v, M^-1 (F_ext - C_g v - sum_e V_e f_e)]   (CSR order of V^T)
+    f_e     = spring_force(K_e, c_e, delta_e, rate_e, G_e) + P_e     (the law)
+    dy      = [v, M^-1 (F_ext - C_g v - sum_e V_e f_e - G v)]  (CSR order of V^T, of G)
 
-The code depends only on the sparsity of V and on which elements have a dead zone; the
+The code depends only on the sparsity of V and G and on which elements have a dead zone; the
 values (coefficients, damping, masses, forces) are read from a parameter vector at fixed
 offsets.  Compiled code is therefore kept per pattern and reused by every model with the
 same pattern (a parameter sweep compiles once).
@@ -32,8 +38,8 @@ Calling convention (C)::
     void rhs(uint64 y, uint64 dy, uint64 force, uint64 defl, uint64 K, uint64 G,
              uint64 E, uint64 ED, uint64 P, uint64 par, int64 off)
 
-Every argument but ``off`` is the address of a float64 array's data (the kernels take
-them once per call, ``array.ctypes.data``).  K, G, E, ED, P are the kernels' whole
+Every argument but ``off`` is the address of a float64 array's data (``Work.addr``:
+taken once per run; a state row's address is base + row x stride).  K, G, E, ED, P are the kernels' whole
 (n_slot, ne) excitation arrays; the function reads the slot starting at flat index
 ``off`` = slot * ne.
 """
@@ -46,7 +52,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import _kernels as kern
+from . import laws
 
 __all__ = ["GeneratedRhs", "generated_rhs", "general_rhs", "rhs_ir", "worth_generating"]
 
@@ -74,19 +80,41 @@ class GeneratedRhs:
 
 
 def _arrays(model) -> dict:
-    return dict(zip(kern.MODEL_ARRAYS, model, strict=True))
+    return model._asdict()
+
+
+_LAW = None
+
+
+def _law_ir() -> tuple[str, str]:
+    """LLVM IR of the compiled element law and the name of its function (numba calling
+    convention: ``i32 (ptr retptr, ptr excinfo, double k, c, d, r, g)``, the force
+    stored at retptr)."""
+    global _LAW
+    if _LAW is None:
+        cf = laws.spring_force_c()
+        name = cf.native_name
+        ir = cf.inspect_llvm()
+        inner = name[len("cfunc."):]
+        if not name.startswith("cfunc.") or f"@{inner}(" not in ir:
+            raise RuntimeError(f"the compiled law {name!r} has no LLVM function to link")
+        _LAW = (ir, inner)
+    return _LAW
 
 
 def rhs_ir(model) -> tuple[str, list[tuple[str, int]]]:
-    """LLVM IR of the right-hand side of the kernel model arrays ``model`` (the tuple of
-    :data:`torquesplit.solve._kernels.MODEL_ARRAYS`) and the parameter layout: entry i of
-    ``par`` is ``model_array[name][index]`` for the i-th ``(name, index)``."""
+    """LLVM IR of the right-hand side of a kernel model ``model``
+    (:class:`~torquesplit.solve.kernel_data.KernelModel`) and the parameter layout: entry
+    i of ``par`` is ``model.<name>[index]`` for the i-th ``(name, index)``.  The IR calls
+    the element law by name (:func:`_law_ir`); :func:`_Compiler.compile` links it in."""
     a = _arrays(model)
     n = a["inv_mass"].shape[0]
     ne = a["vr_ptr"].shape[0] - 1
     vr_ptr, vq_idx = a["vr_ptr"].astype(np.int64), a["vq_idx"].astype(np.int64)
     vt_ptr, vt_el = a["vt_ptr"].astype(np.int64), a["vt_el"].astype(np.int64)
+    gy_ptr, gy_idx = a["gy_ptr"].astype(np.int64), a["gy_idx"].astype(np.int64)
     gap_ptr, gap_values = a["gap_ptr"], a["gap_values"]
+    _, law = _law_ir()
     layout: list[tuple[str, int]] = []
     body: list[str] = []
     count = 0
@@ -102,14 +130,14 @@ def rhs_ir(model) -> tuple[str, list[tuple[str, int]]]:
             k = new()
             body.append(f"  {k} = add i64 %off, {i}")
             i = k
-        body.append(f"  {p} = getelementptr inbounds double, double* %{ptr}, i64 {i}")
-        body.append(f"  {v} = load double, double* {p}, align 8")
+        body.append(f"  {p} = getelementptr inbounds double, ptr %{ptr}, i64 {i}")
+        body.append(f"  {v} = load double, ptr {p}, align 8")
         return v
 
     def store(ptr: str, i: int, value: str) -> None:
         p = new()
-        body.append(f"  {p} = getelementptr inbounds double, double* %{ptr}, i64 {i}")
-        body.append(f"  store double {value}, double* {p}, align 8")
+        body.append(f"  {p} = getelementptr inbounds double, ptr %{ptr}, i64 {i}")
+        body.append(f"  store double {value}, ptr {p}, align 8")
 
     def op(opcode: str, x: str, y: str) -> str:
         v = new()
@@ -134,24 +162,14 @@ def rhs_ir(model) -> tuple[str, list[tuple[str, int]]]:
             d = op("fadd", d, op("fmul", c, load("y", vq_idx[j])))
             r = op("fadd", r, op("fmul", c, load("y", n + vq_idx[j])))
         k = load("K", e)
-        cr = op("fmul", param("damping", e), r)
-        if np.any(gap_values[gap_ptr[e]:gap_ptr[e + 1]] > 0.0):
-            # rhs_slot: g > 0: K (d - g) + c r above g, K (d + g) + c r below -g, else 0;
-            # g <= 0: K d + c r
-            g = load("G", e)
-            has_gap, above, below = new(), new(), new()
-            body.append(f"  {has_gap} = fcmp ogt double {g}, 0.0")
-            body.append(f"  {above} = fcmp ogt double {d}, {g}")
-            body.append(f"  {below} = fcmp olt double {d}, {neg(g)}")
-            f_above = op("fadd", op("fmul", k, op("fsub", d, g)), cr)
-            f_below = op("fadd", op("fmul", k, op("fadd", d, g)), cr)
-            f_plain = op("fadd", op("fmul", k, d), cr)
-            lo, gapped, fe = new(), new(), new()
-            body.append(f"  {lo} = select i1 {below}, double {f_below}, double 0.0")
-            body.append(f"  {gapped} = select i1 {above}, double {f_above}, double {lo}")
-            body.append(f"  {fe} = select i1 {has_gap}, double {gapped}, double {f_plain}")
-        else:
-            fe = op("fadd", op("fmul", k, d), cr)
+        c = param("damping", e)
+        # the law (laws.spring_force) on this element: its own compiled code, inlined
+        gapped = bool(np.any(gap_values[gap_ptr[e]:gap_ptr[e + 1]] > 0.0))
+        g = load("G", e) if gapped else "0.0"
+        st, fe = new(), new()
+        body.append(f"  {st} = call i32 @{law}(ptr %ret, ptr %exc, double {k}, double {c}, "
+                    f"double {d}, double {r}, double {g}) #0")
+        body.append(f"  {fe} = load double, ptr %ret, align 8")
         f = op("fadd", fe, load("P", e))
         store("force", e, f)
         store("defl", e, d)
@@ -161,24 +179,29 @@ def rhs_ir(model) -> tuple[str, list[tuple[str, int]]]:
         acc = op("fsub", param("external_force", i), op("fmul", param("ground_damping", i), v))
         for j in range(vt_ptr[i], vt_ptr[i + 1]):
             acc = op("fsub", acc, op("fmul", param("vt_coef", j), force[int(vt_el[j])]))
+        for j in range(gy_ptr[i], gy_ptr[i + 1]):
+            acc = op("fsub", acc, op("fmul", param("gy_coef", j), load("y", gy_idx[j])))
         store("dy", i, v)
         store("dy", n + i, op("fmul", param("inv_mass", i), acc))
-    args = ", ".join(f"double* noalias nocapture %{x}" for x in ARG_NAMES) + ", i64 %off"
+    args = ", ".join(f"ptr noalias nocapture %{x}" for x in ARG_NAMES) + ", i64 %off"
     ir = (f"define internal void @rhs_body({args}) nounwind alwaysinline {{\nentry:\n"
-          + "\n".join(body) + "\n  ret void\n}\n\n" + _entry_point())
+          "  %ret = alloca double, align 8\n  %exc = alloca ptr, align 8\n"
+          + "\n".join(body) + "\n  ret void\n}\n\n"
+          + f"declare i32 @{law}(ptr, ptr, double, double, double, double, double)\n\n"
+          + _entry_point() + "\nattributes #0 = { alwaysinline }\n")
     return ir, layout
 
 
 def _entry_point() -> str:
-    """``rhs`` taking addresses (i64): the kernels pass ``array.ctypes.data`` computed
-    once per call, not ``array.ctypes`` per call (which costs a reference-count
+    """``rhs`` taking addresses (i64): the kernels pass addresses computed once per run
+    (``Work.addr``), not ``array.ctypes`` per call (which costs a reference-count
     increment and decrement, atomic, per array and call: more than the arithmetic).
     It casts them and calls the body, whose noalias arguments LLVM keeps when it
     inlines it."""
-    casts = "\n".join(f"  %p{i} = inttoptr i64 %{x} to double*"
+    casts = "\n".join(f"  %p{i} = inttoptr i64 %{x} to ptr"
                       for i, x in enumerate(ARG_NAMES))
     args = ", ".join(f"i64 %{x}" for x in ARG_NAMES) + ", i64 %off"
-    call = ", ".join(f"double* %p{i}" for i in range(len(ARG_NAMES))) + ", i64 %off"
+    call = ", ".join(f"ptr %p{i}" for i in range(len(ARG_NAMES))) + ", i64 %off"
     return (f"define void @rhs({args}) nounwind {{\nentry:\n{casts}\n"
             f"  call void @rhs_body({call})\n  ret void\n}}\n")
 
@@ -190,7 +213,7 @@ def _pattern_key(model) -> str:
     gapped = np.array([np.any(gv[gp[e]:gp[e + 1]] > 0.0) for e in range(gp.shape[0] - 1)])
     h = hashlib.sha256()
     for x in (np.int64(a["inv_mass"].shape[0]), a["vr_ptr"], a["vq_idx"], a["vt_ptr"],
-              a["vt_el"], gapped):
+              a["vt_el"], a["gy_ptr"], a["gy_idx"], gapped):
         arr = np.ascontiguousarray(x)
         h.update(str((arr.dtype, arr.shape)).encode())
         h.update(arr.tobytes())
@@ -239,13 +262,19 @@ class _Compiler:
         from numba.core.compiler_lock import global_compiler_lock
 
         ir = ir.replace("@rhs(", f"@{name}(").replace("@rhs_body(", f"@{name}_body(")
+        law_ir, _ = _law_ir()
         with global_compiler_lock:
             llvm = self._setup()
             mod = llvm.parse_assembly(ir)
+            own = {f.name for f in mod.functions if not f.is_declaration}
+            mod.link_in(llvm.parse_assembly(law_ir))
+            for sym in list(mod.functions) + list(mod.global_variables):
+                # the law's symbols are private to this module (each pattern links its
+                # own copy into the one engine): only the entry point is exported
+                if not sym.is_declaration and sym.name not in own | {name}:
+                    sym.linkage = "internal"
             mod.verify()
-            pto = llvm.create_pipeline_tuning_options(speed_level=2)
-            pb = llvm.create_pass_builder(self._tm, pto)
-            pb.getModulePassManager().run(mod, pb)
+            _optimise(llvm, mod, self._tm)
             self._engine.add_module(mod)
             self._engine.finalize_object()
             return self._engine.get_function_address(name)
@@ -273,6 +302,22 @@ class _Compiler:
         with self._lock:
             self._cache.setdefault(key, entry)
         return entry, time.perf_counter() - t0
+
+
+def _optimise(llvm, mod, tm) -> None:
+    """O2 with the new pass manager (llvmlite >= 0.44) or the legacy one (older)."""
+    if hasattr(llvm, "create_pass_builder"):
+        pto = llvm.create_pipeline_tuning_options(speed_level=2)
+        pb = llvm.create_pass_builder(tm, pto)
+        pb.getModulePassManager().run(mod, pb)
+        return
+    pmb = llvm.create_pass_manager_builder()
+    pmb.opt_level = 2
+    pmb.inlining_threshold = 275
+    pm = llvm.create_module_pass_manager()
+    tm.add_analysis_passes(pm)
+    pmb.populate(pm)
+    pm.run(mod)
 
 
 _COMPILER = _Compiler()
@@ -303,15 +348,21 @@ _GENERAL = None
 
 
 def general_rhs() -> GeneratedRhs:
-    """The placeholder that makes the kernels use the general ``rhs_slot`` (empty
-    parameters; its function is a compiled no-op that is never called)."""
+    """The placeholder that makes the kernels use the general ``rhs_slot``: empty
+    parameters and a no-op of the rhs signature that is never called, compiled by numba
+    itself (so the general path needs nothing of llvmlite beyond what numba uses)."""
     global _GENERAL
     if _GENERAL is None:
-        args = ", ".join(f"i64 %{x}" for x in ARG_NAMES) + ", i64 %off"
-        ir = f"define void @rhs({args}) nounwind {{\nentry:\n  ret void\n}}\n"
-        _GENERAL = GeneratedRhs(_function(_COMPILER.compile("rhs_noop", ir)), np.zeros(0),
-                                0.0, 0)
+        from numba import cfunc, types
+
+        sig = types.void(*([types.uintp] * len(ARG_NAMES)), types.int64)
+        _GENERAL = GeneratedRhs(cfunc(sig, cache=True)(_noop), np.zeros(0), 0.0, 0)
     return _GENERAL
+
+
+def _noop(y, dy, force, defl, K, G, E, ED, P, par, off):  # noqa: N803 - kernel names
+    """Body of the general placeholder (never called: the kernels test ``gen`` first)."""
+    return
 
 
 # Cost model of "auto" (measured on the 2-core development machine, benchmarks/RESULTS.md):

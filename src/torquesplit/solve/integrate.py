@@ -29,12 +29,19 @@ from typing import Callable, Sequence
 import numpy as np
 
 from torquesplit.assembly.structure import Structure
-from torquesplit.errors import SolverError
+from torquesplit.errors import ModelWarning, SolverError
 from torquesplit.solve import _kernels as kern
 from torquesplit.solve import codegen
+from torquesplit.solve import kernel_data as kd
 from torquesplit.solve._frozen import freeze_arrays
 from torquesplit.solve.reference import element_forces_numpy, rhs_numpy
-from torquesplit.solve.stability import check_step, stable_step, system_eigenvalues
+from torquesplit.solve.stability import (
+    SAFETY,
+    check_step,
+    highest_mode,
+    stable_step,
+    system_eigenvalues,
+)
 
 __all__ = ["Solution", "integrate", "rhs", "element_forces", "rhs_numpy",
            "element_forces_numpy", "compile_kernels", "STATUS_MESSAGES"]
@@ -52,6 +59,14 @@ _N_CHUNKS = 64  # progress granularity: about 1.5 % of the run per chunk
 _MIN_CHUNK_STEPS = 16 * kern.RESYNC
 _MEMORY_LIMIT = 2 * 1024**3  # bytes of output arrays before we refuse and explain
 _COMPILE_TIMES: dict[str, float] = {}  # method -> seconds of its first warm-up
+ACCURACY = 1.0
+"""Default RK4 step: at most ACCURACY / omega_max, omega_max the highest natural angular
+frequency at maximum stiffness, so that the highest mode is resolved (6.3 steps per its
+period; RK4's amplitude error per step (omega h)^6 / 144 < 0.7 %) and not only stable
+(omega h <= 2.2 with the 0.8 safety).  Measured on the Ji & Li drive: at the stability
+limit (109 steps per mesh period) its load-sharing coefficient moved by 1.7e-3 when the
+step was halved, at this limit (about 240) by less than 1e-4."""
+_STEP_WARN_FACTOR = 10.0  # warn when the step is this many times the requested one
 _CODEGEN_WARNED = False
 
 
@@ -85,6 +100,9 @@ class Solution:
     """Right-hand-side evaluations of the integrator (not those made to record samples)."""
     step: float | None
     """RK4 step used [s]; None for dopri."""
+    step_limited_by: str
+    """What set the RK4 step: the excitation period (``steps_per_period``), the highest
+    mode (named, with its element), or a given step; empty for dopri."""
     step_min: float
     """Smallest accepted step [s]."""
     step_max: float
@@ -110,6 +128,13 @@ class Solution:
     """(n_cycles, n_tracked) mean of the force samples in the cycle [N]."""
     cycle_count: np.ndarray
     """(n_cycles, n_tracked) number of accepted states in the cycle."""
+    load_sharing_groups: tuple[tuple[int, ...], ...]
+    """Element indices of each load-sharing group (see ``integrate``)."""
+    cycle_ratio_max: np.ndarray
+    """(n_cycles, n_tracked) largest instantaneous load-sharing ratio N f_i / sum_j f_j
+    of the element's group in the cycle (NaN outside groups or without samples)."""
+    cycle_ratio_min: np.ndarray
+    """(n_cycles, n_tracked) smallest instantaneous ratio in the cycle."""
     history_elements: tuple[int, ...]
     history_dofs: tuple[int, ...]
     history_t: np.ndarray
@@ -165,110 +190,32 @@ class Solution:
                 "count": self.cycle_count[:, j]}
 
 
-# ============================================================== model arrays
-def _model_arrays(structure: Structure) -> tuple:
-    """The 36 MODEL arrays of the kernels (order: ``_kernels.MODEL_ARRAYS``):
-    contiguous, writable, float64 / int64 / uint64, derived index arrays included."""
-    s = structure
-    n_el = s.n_elements
-    if np.any(np.diff(s.gap_ptr) < 1):
-        bad = [s.element_names[e] for e in np.flatnonzero(np.diff(s.gap_ptr) < 1)]
-        raise SolverError(f"elements {bad} have no half-gap value; give gaps=0.0 for no "
-                          "dead zone when building the structure.")
-    if np.any(s.frequency < 0) or not np.all(np.isfinite(s.frequency)):
-        raise SolverError("excitation frequencies must be finite and >= 0 Hz; check the "
-                          "mesh frequencies of the structure.")
-    nnz = len(s.v_dof)
-    if (len(s.v_ptr) != n_el + 1 or s.v_ptr[0] != 0 or s.v_ptr[-1] != nnz
-            or np.any(np.diff(s.v_ptr) < 0) or len(s.v_coef) != nnz
-            or (nnz and (np.min(s.v_dof) < 0 or np.max(s.v_dof) >= s.n_dof))):
-        raise SolverError("the projection arrays (v_ptr, v_dof, v_coef) of the structure are "
-                          "inconsistent; rebuild it with build_structure.")
-    if (len(s.error_ptr) != n_el + 1 or s.error_ptr[-1] != len(s.error_amplitude)
-            or len(s.gap_ptr) != n_el + 1 or s.gap_ptr[-1] != len(s.gap_values)
-            or s.stiffness_table.shape != s.force_table.shape
-            or s.stiffness_table.shape[0] != n_el):
-        raise SolverError("the excitation arrays of the structure are inconsistent; "
-                          "rebuild it with build_structure.")
-    if s.n_table < 1:
-        raise SolverError("stiffness tables are empty; build the structure with n_table >= 1.")
-    n_fm, n_fe = len(s.fr_el), len(s.fr_dof)
-    if (len(s.fr_ptr) != n_fm + 1 or s.fr_ptr[0] != 0 or s.fr_ptr[-1] != n_fe
-            or np.any(np.diff(s.fr_ptr) < 0) or len(s.fr_coef) != n_fe
-            or len(s.fr_row) != n_fe or s.friction_table.shape[0] != 3 * n_fm
-            or (n_fm and s.friction_table.shape[1] < 1)
-            or (n_fm and (np.min(s.fr_el) < 0 or np.max(s.fr_el) >= n_el))
-            or (n_fe and (np.min(s.fr_dof) < 0 or np.max(s.fr_dof) >= s.n_dof
-                          or np.min(s.fr_row) < 0 or np.max(s.fr_row) >= 3 * n_fm))):
-        raise SolverError("the tooth-friction arrays (fr_*, friction_table) of the structure "
-                          "are inconsistent; rebuild it with build_structure.")
-    n_sp = s.sp_el.shape[0] if s.sp_el.ndim == 2 else -1
-    if (s.sp_el.ndim != 2 or s.sp_el.shape[1] != 2 or s.sp_par.shape != (n_sp, 6)
-            or (n_sp and (np.min(s.sp_el) < 0 or np.max(s.sp_el) >= n_el))
-            or (n_sp and not np.all(s.sp_par[:, 5] > 0))):
-        raise SolverError("the spline arrays (sp_el, sp_par) of the structure are "
-                          "inconsistent; rebuild it with build_structure.")
-
-    def f8(a):
-        return np.array(a, dtype=np.float64, order="C", copy=True)
-
-    def i8(a):
-        return np.array(a, dtype=np.int64, order="C", copy=True)
-
-    def u8(a):
-        return np.array(a, dtype=np.uint64, order="C", copy=True)
-
-    varying = s.frequency > 0.0
-    sin_el = np.repeat(np.arange(n_el, dtype=np.int64), np.diff(s.error_ptr))
-    err_el = np.unique(sin_el)
-    # V by DOF (CSR of V^T) for gathering the generalized forces
-    owner = np.repeat(np.arange(n_el, dtype=np.int64), np.diff(s.v_ptr))
-    order = np.lexsort((owner, s.v_dof))
-    vt_ptr = np.zeros(s.n_dof + 1, dtype=np.int64)
-    np.add.at(vt_ptr, np.asarray(s.v_dof, dtype=np.int64) + 1, 1)
-    # spline component elements: zero stiffness and damping in the element loop of the
-    # kernels (their force there is 0); _kernels.rhs_extra applies the radial law
-    ktab, damp = f8(s.stiffness_table), f8(s.damping)
-    comps = np.asarray(s.sp_el, dtype=np.int64).ravel()
-    ktab[comps] = 0.0
-    damp[comps] = 0.0
-    return (
-        f8(s.inv_mass), f8(s.external_force), f8(s.ground_damping), i8(s.element_kind),
-        i8(s.v_ptr), i8(s.v_dof), f8(s.v_coef), ktab, f8(s.frequency),
-        f8(s.phase), damp, i8(s.gap_ptr), f8(s.gap_values),
-        f8(s.error_constant), i8(s.error_ptr), f8(s.error_amplitude), f8(s.error_omega),
-        f8(s.error_phase), f8(s.force_table),
-        i8(np.flatnonzero(varying)), i8(err_el), i8(sin_el),
-        u8(s.v_ptr), u8(s.v_dof), u8(np.asarray(s.v_dof) + s.n_dof),
-        u8(np.cumsum(vt_ptr)), u8(owner[order]), f8(np.asarray(s.v_coef)[order]),
-        i8(s.fr_el), i8(s.fr_ptr), i8(s.fr_dof), f8(s.fr_coef), i8(s.fr_row),
-        f8(s.friction_table).reshape(3 * n_fm, -1) if n_fm else np.zeros((0, 1)),
-        i8(s.sp_el).reshape(n_sp, 2), f8(s.sp_par).reshape(n_sp, 6),
-    )
-
-
+# ============================================================ one evaluation
 def rhs(structure: Structure, t: float, y) -> np.ndarray:
     """dy/dt at (t, y) evaluated by the compiled kernel (twin: :func:`rhs_numpy`)."""
-    dy, _, _ = _rhs_kernel(structure, t, y)
+    dy, _, _ = _evaluate(structure, t, y)
     return dy
 
 
 def element_forces(structure: Structure, t: float, y):
     """Element forces and deformations at (t, y) from the compiled kernel: ``(f, delta)``."""
-    _, force, defl = _rhs_kernel(structure, t, y)
+    _, force, defl = _evaluate(structure, t, y)
     return force, defl
 
 
-def _rhs_kernel(structure, t, y):
+def _evaluate(structure, t, y, model=None, code=None):
+    """(dy/dt, element forces, deformations) at (t, y) from the compiled kernel: the
+    general one, or ``code`` (a :class:`codegen.GeneratedRhs`)."""
     y = np.array(y, dtype=np.float64, order="C", copy=True)
     if y.shape != (2 * structure.n_dof,):
         raise ValueError(f"state must have shape ({2 * structure.n_dof},) = [q, v], "
                          f"got {y.shape}.")
-    dy = np.empty_like(y)
-    force = np.empty(structure.n_elements)
-    defl = np.empty(structure.n_elements)
-    kern.rhs_at(float(t), y, *_model_arrays(structure), dy, force, defl)
-    return dy, force, defl
+    m = kd.kernel_model(structure) if model is None else model
+    code = codegen.general_rhs() if code is None else code
+    w = kd.make_work(m, code.parameters)
+    w.Y[kd.Y_STATE] = y
+    kern.evaluate(float(t), m, w, code.function, code.generated)
+    return (w.Y[kd.Y_K1].copy(), w.F[kd.F_MAIN].copy(), w.D[kd.F_MAIN].copy())
 
 
 # ============================================================== compilation
@@ -278,7 +225,7 @@ def compile_kernels(methods: Sequence[str] = ("rk4", "dopri")) -> float:
     Each method's kernels are warmed up on first need, so a first RK4 run (the default)
     does not wait for the Dormand-Prince kernel too.  Returns the seconds the first
     warm-up of these methods took (the same numbers afterwards).  The "dopri" warm-up
-    also compiles ``rhs_at`` (its starting step, :func:`rhs`, :func:`element_forces`).
+    also compiles ``evaluate`` (its starting step, :func:`rhs`, :func:`element_forces`).
     """
     unknown = sorted(set(methods) - {"rk4", "dopri"})
     if unknown:
@@ -400,6 +347,7 @@ def integrate(
     max_step: float | None = None,
     max_steps: int | None = None,
     track_elements=None,
+    load_sharing_groups=None,
     n_cycles_cap: int | None = None,
     history_elements=None,
     history_dofs=None,
@@ -428,7 +376,10 @@ def integrate(
     step : float, optional (rk4)
         Time step [s].  Default: shortest excitation period / ``steps_per_period`` (or
         shortest natural period / ``steps_per_period`` without excitation), refined to
-        a whole number of steps per period if that is unstable.  Reduced slightly if
+        a whole number of steps per period where the highest mode needs it (see
+        :data:`ACCURACY`: resolved, and stable with a 0.8 margin); ``Solution.
+        step_limited_by`` says which, and a step more than 10 times shorter than asked
+        is warned about with the element that causes it.  Reduced slightly if
         needed so that a whole number of steps spans ``t_span`` (see ``Solution.step``).
     steps_per_period : int, optional (rk4)
         Default 100.
@@ -446,6 +397,11 @@ def integrate(
     track_elements : sequence of int or str, optional
         Elements whose force is summarised per excitation cycle (all must have an
         excitation frequency > 0).  Default: every element with frequency > 0.
+    load_sharing_groups : sequence of sequences of int or str, optional
+        Groups of tracked elements that share one flow of power: the instantaneous
+        ratio N f_i / sum_j f_j of each member (Ji & Li eq. 18) is formed at every step
+        and its per-cycle largest and smallest values streamed
+        (``Solution.cycle_ratio_max`` / ``cycle_ratio_min``).  Default: none.
     n_cycles_cap : int, optional
         Rows of the cycle arrays.  Default: enough for the whole run.
     history_elements, history_dofs : sequence of int or str, optional
@@ -515,8 +471,9 @@ def integrate(
     if not (math.isfinite(span) and span > 0):
         raise ValueError(f"t_span must be (start, end) with end > start, got {t_span!r}.")
     y = _initial_state(s, y0)
-    model = _model_arrays(s)
-    sel = _select(s, t0, span, track_elements, n_cycles_cap, history_elements, history_dofs)
+    model = kd.kernel_model(s)
+    sel = _select(s, t0, span, track_elements, n_cycles_cap, history_elements, history_dofs,
+                  load_sharing_groups)
     if rk4:
         plan = _plan_rk4(s, span, step, steps_per_period, check_stability, record_every,
                          sample_interval, full_history, max_steps)
@@ -527,29 +484,40 @@ def integrate(
     n_rhs_planned = 4 * min(plan.n_steps, plan.limit_steps) if rk4 else 6 * span / plan.h_max
     rhs_code = _rhs_code(rhs, model, n_rhs_planned)
     n_hist = plan.n_hist if (sel.hist_el or sel.hist_dof or (full_history and not rk4)) else 0
-    out = _Outputs.allocate(s, sel, n_hist, plan.n_full)
+    need = kd.record_bytes(sel.n_cycles_cap, len(sel.track), n_hist, len(sel.hist_el),
+                           len(sel.hist_dof), plan.n_full, s.n_dof)
+    if need > _MEMORY_LIMIT:
+        raise SolverError(
+            f"the requested outputs need {need / 1024**3:.1f} GiB; record less: raise "
+            "record_every / sample_interval, list fewer history_elements and "
+            "history_dofs, drop full_history, or lower n_cycles_cap.")
+    rec = kd.make_record(sel.track, sel.track_base, sel.n_cycles_cap, sel.groups,
+                         s.n_elements, sel.hist_el, sel.hist_dof, n_hist, plan.n_full,
+                         s.n_dof)
+    work = kd.make_work(model, rhs_code.parameters)
+    work.Y[kd.Y_STATE] = y
     counters = np.zeros(kern.N_COUNTERS, dtype=np.int64)
     clock = np.zeros(kern.N_CLOCK)
     clock[kern.F_T] = t0
     blowup = float(blowup)
 
     if rk4:
-        _run_rk4(y, t0, plan, blowup, model, rhs_code, out.record, counters, clock,
-                 progress)
+        _run_rk4(t0, plan, blowup, model, work, rec, rhs_code, counters, clock, progress)
         step_min = step_max = plan.h
     else:
         clock[kern.F_H] = min(_initial_step(s, y, t0, t_end, plan.rtol, plan.atol, model),
                               plan.h_max)
         counters[kern.I_RHS] = 2  # the two evaluations of the starting-step estimate
-        _run_dopri(y, t0, t_end, plan, blowup, model, rhs_code, out.record, counters,
-                   clock, progress)
+        _run_dopri(t0, t_end, plan, blowup, model, work, rec, rhs_code, counters, clock,
+                   progress)
         accepted = counters[kern.I_STEPS] > 0
         step_min = float(clock[kern.F_HMIN]) if accepted else math.nan
         step_max = float(clock[kern.F_HMAX]) if accepted else math.nan
+    y = work.Y[kd.Y_STATE].copy()
 
     status = int(counters[kern.I_STATUS])
     t_final = float(clock[kern.F_T])
-    cycles = out.cycle_summary(s, sel)
+    cycles = _cycle_summary(rec, s, sel)
     n_rec = int(counters[kern.I_HIST])
     n_full_rec = int(counters[kern.I_FULL])
     return Solution(
@@ -560,11 +528,12 @@ def integrate(
         method=method,
         t_span=(t0, t_end),
         t_final=t_final,
-        y_final=y.copy(),
+        y_final=y,
         n_steps=int(counters[kern.I_STEPS]),
         n_rejected=int(counters[kern.I_REJECTED]),
         n_rhs=int(counters[kern.I_RHS]),
         step=plan.h if rk4 else None,
+        step_limited_by=plan.limited_by,
         step_min=step_min,
         step_max=step_max,
         compile_time=compile_time,
@@ -574,20 +543,21 @@ def integrate(
         dof_names=tuple(s.dof_names),
         element_names=tuple(s.element_names),
         tracked_elements=tuple(sel.track),
+        load_sharing_groups=tuple(tuple(sel.track[c] for c in g) for g in sel.groups),
         **cycles,
         history_elements=tuple(sel.hist_el),
         history_dofs=tuple(sel.hist_dof),
-        history_t=_rows(out.hist_t, n_rec),
-        history_forces=_rows(out.hist_f, n_rec),
-        history_q=_rows(out.hist_q, n_rec),
-        history_v=_rows(out.hist_v, n_rec),
-        full_t=_rows(out.full_t, n_full_rec) if full_history else None,
-        full_y=_rows(out.full_y, n_full_rec) if full_history else None,
+        history_t=_rows(rec.hist_t, n_rec),
+        history_forces=_rows(rec.hist_f, n_rec),
+        history_q=_rows(rec.hist_q, n_rec),
+        history_v=_rows(rec.hist_v, n_rec),
+        full_t=_rows(rec.full_t, n_full_rec) if full_history else None,
+        full_y=_rows(rec.full_y, n_full_rec) if full_history else None,
         n_samples=int(counters[kern.I_SAMPLES]),
-        separation_steps=out.sep_count,
-        back_contact_steps=out.back_count,
-        separation_time=out.sep_time,
-        back_contact_time=out.back_time,
+        separation_steps=rec.sep_count,
+        back_contact_steps=rec.back_count,
+        separation_time=rec.sep_time,
+        back_contact_time=rec.back_time,
     )
 
 
@@ -633,10 +603,11 @@ class _Selection:
     n_cycles_cap: int
     hist_el: list[int]
     hist_dof: list[int]
+    groups: list[list[int]]  # load-sharing groups as lists of tracked columns
 
 
 def _select(s, t0, span, track_elements, n_cycles_cap, history_elements,
-            history_dofs) -> _Selection:
+            history_dofs, load_sharing_groups) -> _Selection:
     if track_elements is None:
         track = [e for e in range(s.n_elements) if s.frequency[e] > 0]
     else:
@@ -659,7 +630,16 @@ def _select(s, t0, span, track_elements, n_cycles_cap, history_elements,
         s.element_names, history_elements, "element")
     hist_dof = list(range(s.n_dof)) if history_dofs is None else _resolve(
         s.dof_names, history_dofs, "dof")
-    return _Selection(track, base, cap, hist_el, hist_dof)
+    groups = []
+    for members in load_sharing_groups or ():
+        idx = _resolve(s.element_names, members, "element")
+        loose = [s.element_names[e] for e in idx if e not in track]
+        if loose or len(set(idx)) != len(idx) or not idx:
+            raise ValueError(f"load-sharing group {list(members)!r} must list distinct "
+                             f"tracked elements; not tracked: {loose}. Track them "
+                             f"(track_elements) or leave them out of the group.")
+        groups.append([track.index(e) for e in idx])
+    return _Selection(track, base, cap, hist_el, hist_dof, groups)
 
 
 @dataclass(frozen=True)
@@ -675,6 +655,7 @@ class _Plan:
     h_max: float = math.nan
     h_min: float = math.nan
     dt_sample: float = math.nan
+    limited_by: str = ""  # rk4: what set the step
 
 
 def _plan_rk4(s, span, step, steps_per_period, check_stability, record_every,
@@ -683,18 +664,31 @@ def _plan_rk4(s, span, step, steps_per_period, check_stability, record_every,
     if spp < 1:
         raise ValueError("steps_per_period must be >= 1.")
     check = True if check_stability is None else bool(check_stability)
+    limited_by = "excitation period"
     if step is None:
         periods = _excitation_periods(s)
         period = float(periods.min()) if periods.size else _natural_period_min(s)
         if not math.isfinite(period):  # nothing oscillates: 1000 steps
             period = span * spp / 1000.0
         h = period / spp
+        f_hi, element = highest_mode(s)
+        h_lim = ACCURACY / (2 * math.pi * f_hi) if f_hi > 0 else math.inf
         if check:
-            safe = 0.8 * stable_step(s)
-            if h > safe:  # keep a whole number of steps per period
-                per = math.ceil(period / safe)
-                log.info("default step %.3g s is unstable; using %d steps per period", h, per)
-                h = period / per
+            h_lim = min(h_lim, SAFETY * stable_step(s))
+        if h > h_lim:  # keep a whole number of steps per period
+            per = math.ceil(period / h_lim)
+            limited_by = (f"highest mode {f_hi:.6g} Hz (mostly element '{element}'): "
+                          f"{per} steps per excitation period instead of {spp}")
+            log.info("RK4 step limited by the %s", limited_by)
+            if per > _STEP_WARN_FACTOR * spp:
+                warnings.warn(
+                    f"the RK4 step is {per / spp:.3g} times shorter than {spp} steps per "
+                    f"excitation period, because element '{element}' gives a mode at "
+                    f"{f_hi:.4g} Hz that the step must resolve (omega h <= {ACCURACY:g}) "
+                    f"and keep stable; the run takes {math.ceil(span / (period / per)):,} "
+                    f"steps. Check that element's stiffness and unit, or use "
+                    f"method='dopri'.", ModelWarning, stacklevel=4)
+            h = period / per
     else:
         h = float(step)
         if check:
@@ -717,7 +711,7 @@ def _plan_rk4(s, span, step, steps_per_period, check_stability, record_every,
     limit = n_steps if max_steps is None else min(n_steps, int(max_steps))
     return _Plan(limit_steps=limit, n_hist=n_steps // every + 1,
                  n_full=n_steps + 1 if full_history else 0, h=h, n_steps=n_steps,
-                 every=every)
+                 every=every, limited_by=limited_by if step is None else "given step")
 
 
 def _plan_dopri(s, span, rtol, atol, max_step, sample_interval, full_history,
@@ -751,59 +745,30 @@ def _plan_dopri(s, span, rtol, atol, max_step, sample_interval, full_history,
                  rtol=rtol, atol=atol, h_max=h_max, h_min=1e-12 * span, dt_sample=dt)
 
 
-@dataclass(frozen=True)
-class _Outputs:
-    """The RECORD arrays the kernels fill (order: ``_kernels.RECORD_ARRAYS``)."""
+def _cycle_summary(rec: kd.Record, s: Structure, sel: _Selection) -> dict:
+    """Cycle arrays trimmed to the cycles reached; NaN where a cycle has no sample.
 
-    record: tuple
-
-    def __getattr__(self, name):
-        try:
-            return self.record[kern.RECORD_ARRAYS.index(name)]
-        except ValueError:
-            raise AttributeError(name) from None
-
-    @classmethod
-    def allocate(cls, s: Structure, sel: _Selection, n_hist: int, n_full: int):
-        n, n_el, cap, n_tr = s.n_dof, s.n_elements, sel.n_cycles_cap, len(sel.track)
-        n_he, n_hd = len(sel.hist_el), len(sel.hist_dof)
-        need = 8 * (n_hist * (1 + n_he + 2 * n_hd) + n_full * (1 + 2 * n) + 4 * cap * n_tr)
-        if need > _MEMORY_LIMIT:
-            raise SolverError(
-                f"the requested outputs need {need / 1024**3:.1f} GiB; record less: raise "
-                "record_every / sample_interval, list fewer history_elements and "
-                "history_dofs, drop full_history, or lower n_cycles_cap.")
-        return cls((
-            np.array(sel.track, dtype=np.int64), sel.track_base,
-            np.full((cap, n_tr), -np.inf), np.full((cap, n_tr), np.inf),
-            np.zeros((cap, n_tr)), np.zeros((cap, n_tr), dtype=np.int64),
-            np.zeros(n_el, dtype=np.int64), np.zeros(n_el, dtype=np.int64),
-            np.zeros(n_el), np.zeros(n_el),
-            np.array(sel.hist_el, dtype=np.int64), np.array(sel.hist_dof, dtype=np.int64),
-            np.zeros(n_hist), np.zeros((n_hist, n_he)), np.zeros((n_hist, n_hd)),
-            np.zeros((n_hist, n_hd)), np.zeros(n_full), np.zeros((n_full, 2 * n)),
-        ))
-
-    def cycle_summary(self, s: Structure, sel: _Selection) -> dict:
-        """Cycle arrays trimmed to the cycles reached; NaN where a cycle has no sample.
-
-        Works in place on the kernel's buffers (the sums become means), so the summary
-        costs no second copy of them.
-        """
-        cnt_all = self.cyc_cnt
-        used = np.flatnonzero(cnt_all.any(axis=1))
-        n_cyc = int(used[-1]) + 1 if used.size else 0
-        empty = cnt_all == 0
-        for buf in (self.cyc_max, self.cyc_min, self.cyc_sum):
-            buf[empty] = np.nan
-        np.divide(self.cyc_sum, cnt_all, out=self.cyc_sum, where=~empty)
-        tr = np.array(sel.track, dtype=np.int64)
-        rows = np.arange(n_cyc)[:, None]
-        start = (sel.track_base[None, :] + rows - s.phase[tr][None, :]) \
-            / s.frequency[tr][None, :] if tr.size else np.zeros((n_cyc, 0))
-        return dict(cycle_start=start, cycle_max=_rows(self.cyc_max, n_cyc),
-                    cycle_min=_rows(self.cyc_min, n_cyc), cycle_mean=_rows(self.cyc_sum, n_cyc),
-                    cycle_count=_rows(cnt_all, n_cyc))
+    Works in place on the kernel's buffers (the sums become means), so the summary
+    costs no second copy of them.
+    """
+    cnt_all = rec.cyc_cnt
+    used = np.flatnonzero(cnt_all.any(axis=1))
+    n_cyc = int(used[-1]) + 1 if used.size else 0
+    empty = cnt_all == 0
+    for buf in (rec.cyc_max, rec.cyc_min, rec.cyc_sum):
+        buf[empty] = np.nan
+    for buf in (rec.rat_max, rec.rat_min):
+        buf[~np.isfinite(buf)] = np.nan
+    np.divide(rec.cyc_sum, cnt_all, out=rec.cyc_sum, where=~empty)
+    tr = np.array(sel.track, dtype=np.int64)
+    rows = np.arange(n_cyc)[:, None]
+    start = (sel.track_base[None, :] + rows - s.phase[tr][None, :]) \
+        / s.frequency[tr][None, :] if tr.size else np.zeros((n_cyc, 0))
+    return dict(cycle_start=start, cycle_max=_rows(rec.cyc_max, n_cyc),
+                cycle_min=_rows(rec.cyc_min, n_cyc), cycle_mean=_rows(rec.cyc_sum, n_cyc),
+                cycle_count=_rows(cnt_all, n_cyc),
+                cycle_ratio_max=_rows(rec.rat_max, n_cyc),
+                cycle_ratio_min=_rows(rec.rat_min, n_cyc))
 
 
 def _cycle_index(s: float) -> int:
@@ -839,7 +804,7 @@ def _rhs_code(kind: str, model, n_rhs: float) -> codegen.GeneratedRhs:
         return codegen.general_rhs()
 
 
-def _run_rk4(y, t0, plan, blowup, model, rhs_code, record, counters, clock, progress):
+def _run_rk4(t0, plan, blowup, model, work, rec, rhs_code, counters, clock, progress):
     """Run the RK4 kernel in chunks (multiples of RESYNC steps, about 1.5 % each)."""
     per_chunk = math.ceil(plan.limit_steps / _N_CHUNKS)
     chunk = max(_MIN_CHUNK_STEPS, -(-per_chunk // kern.RESYNC) * kern.RESYNC)
@@ -847,8 +812,8 @@ def _run_rk4(y, t0, plan, blowup, model, rhs_code, record, counters, clock, prog
     while done < plan.limit_steps:
         m = min(chunk, plan.limit_steps - done)
         last = done + m == plan.limit_steps
-        kern.rk4_run(y, t0, plan.h, done, m, last, plan.every, blowup, *model, *record,
-                     rhs_code.function, rhs_code.parameters, counters, clock)
+        kern.rk4_run(t0, plan.h, done, m, last, plan.every, blowup, model, work, rec,
+                     rhs_code.function, rhs_code.generated, counters, clock)
         done += m
         if counters[kern.I_STATUS] != kern.FINISHED:
             return
@@ -858,10 +823,9 @@ def _run_rk4(y, t0, plan, blowup, model, rhs_code, record, counters, clock, prog
         counters[kern.I_STATUS] = kern.MAX_STEPS
 
 
-def _run_dopri(y, t0, t_end, plan, blowup, model, rhs_code, record, counters, clock,
+def _run_dopri(t0, t_end, plan, blowup, model, work, rec, rhs_code, counters, clock,
                progress):
     """Run the Dormand-Prince kernel up to successive 1/64 fractions of the span."""
-    kfsal = np.zeros(y.shape[0])
     clock[kern.F_FACOLD] = 1e-4
     clock[kern.F_HMIN] = math.inf
     clock[kern.F_HMAX] = 0.0
@@ -870,9 +834,9 @@ def _run_dopri(y, t0, t_end, plan, blowup, model, rhs_code, record, counters, cl
         t_stop = t_end if k == _N_CHUNKS else t0 + span * k / _N_CHUNKS
         if clock[kern.F_T] >= t_stop:
             continue
-        kern.dopri_run(y, kfsal, t0, t_end, t_stop, plan.rtol, plan.atol, plan.h_max,
-                       plan.h_min, plan.limit_steps, blowup, plan.dt_sample, *model,
-                       *record, rhs_code.function, rhs_code.parameters, counters, clock)
+        kern.dopri_run(t0, t_end, t_stop, plan.rtol, plan.atol, plan.h_max, plan.h_min,
+                       plan.limit_steps, blowup, plan.dt_sample, model, work, rec,
+                       rhs_code.function, rhs_code.generated, counters, clock)
         if counters[kern.I_STATUS] != kern.FINISHED:
             return
         if progress is not None:
@@ -882,18 +846,14 @@ def _run_dopri(y, t0, t_end, plan, blowup, model, rhs_code, record, counters, cl
 def _initial_step(s, y, t0, t_end, rtol, atol, model) -> float:
     """Starting step of the adaptive method (Hairer, Norsett & Wanner, Solving ODE I,
     II.4, 'starting step size')."""
-    n2 = y.shape[0]
     sc = atol + rtol * np.abs(y)
     sc = np.where(sc > 0, sc, 1e-300)
-    f0 = np.empty(n2)
-    scratch = np.empty(s.n_elements), np.empty(s.n_elements)
-    kern.rhs_at(t0, y, *model, f0, *scratch)
+    f0, _, _ = _evaluate(s, t0, y, model)
     d0 = math.sqrt(np.mean((y / sc) ** 2))
     d1 = math.sqrt(np.mean((f0 / sc) ** 2))
     h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
     h0 = min(h0, t_end - t0)
-    f1 = np.empty(n2)
-    kern.rhs_at(t0 + h0, y + h0 * f0, *model, f1, *scratch)
+    f1, _, _ = _evaluate(s, t0 + h0, y + h0 * f0, model)
     d2 = math.sqrt(np.mean(((f1 - f0) / sc) ** 2)) / h0
     dmax = max(d1, d2)
     h1 = max(1e-6, h0 * 1e-3) if dmax <= 1e-15 else (0.01 / dmax) ** (1.0 / 5.0)

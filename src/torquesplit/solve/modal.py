@@ -1,13 +1,17 @@
 """Undamped modes of a structure linearised about a displacement state.
 
-Each element contributes its mean stiffness ``k_e V_e V_e^T`` if it is in contact at
-the linearisation state (no dead zone, or ``|V_e.q - e_e| > g_e`` with the constant
-error and the mean half-gap); separated elements contribute nothing.  A spline radial
-element contributes the tangent of its static law (:func:`static.spline_static_law`)
-in the plane of its two component rows: ``k`` in both directions when sticking (or
-without clearance), nothing while floating, and ``k`` radially, ``k (R - S2) / R``
-tangentially once its clearance has closed; half of its strain energy is assigned to
-each of its two component elements.  Tooth friction (non-conservative) and the spline
+The linearisation is the derivative of the element laws (:mod:`torquesplit.solve.laws`)
+at the linearisation state: each element contributes ``k_e dh/dd V_e V_e^T`` with its
+mean stiffness and the slope of :func:`~torquesplit.solve.laws.dead_zone` at
+``V_e.q - e_e`` (constant error, mean half-gap): 1 in contact, 0 when separated.  A
+spline radial element contributes the Jacobian of
+:func:`~torquesplit.solve.laws.spline_tangent` at rest in the plane of its two
+component rows: ``k`` in both directions when sticking (or without clearance), nothing
+while floating, and ``k`` radially, ``k (R - S2) / R`` tangentially once its clearance
+has closed; half of its strain energy is assigned to each of its two component elements.
+A structure with a gyroscopic matrix G (bodies in a rotating frame) has the quadratic
+eigenproblem ``(K + i omega G - omega^2 M) phi = 0``: it is solved in first-order form and
+its modes are complex (forward and backward whirl split by G).  Tooth friction (non-conservative) and the spline
 friction are left out: these are the modes of the conservative system.  The generalized
 eigenproblem ``K phi = omega^2 M phi`` is solved in the symmetric form
 ``(M^-1/2 K M^-1/2) psi = omega^2 psi`` with ``phi = M^-1/2 psi`` (mass-normalised:
@@ -23,8 +27,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from torquesplit.assembly.structure import Structure
+from torquesplit.solve import laws
 from torquesplit.solve._frozen import freeze_arrays
-from torquesplit.solve.static import spline_static_law
 
 __all__ = ["ModalSolution", "modal_analysis"]
 
@@ -37,7 +41,8 @@ class ModalSolution:
     """(n_modes,) natural frequencies [Hz] of the elastic modes; a negative value marks
     a statically unstable mode (negative stiffness), its magnitude sqrt(|lambda|)/2 pi."""
     mode_shapes: np.ndarray
-    """(n_dof, n_modes) mass-normalised mode shapes [m or rad per sqrt(kg)]."""
+    """(n_dof, n_modes) mass-normalised mode shapes [m or rad per sqrt(kg)] (complex
+    with a gyroscopic matrix: phi^H M phi = 1)."""
     strain_energy_fraction: np.ndarray
     """(n_modes, n_el) share of each element in the mode's strain energy (rows sum to 1)."""
     damping_ratios: np.ndarray
@@ -87,19 +92,21 @@ def modal_analysis(structure: Structure, q=None, *, rigid_tolerance: float = 1e-
     s = structure
     V = s.projection_matrix()
     k = s.mean_stiffness()
-    delta = None
-    if q is None:
-        active = np.ones(s.n_elements, dtype=bool)
+    g = np.array([s.gap_values[s.gap_ptr[i]:s.gap_ptr[i + 1]].mean()
+                  for i in range(s.n_elements)])
+    if q is None:  # every element in contact: the slope of the law beyond its dead zone
+        delta = None
+        slope = np.ones(s.n_elements)
     else:
         q = np.asarray(q, dtype=float)
         if q.shape != (s.n_dof,):
             raise ValueError(f"q must hold {s.n_dof} displacements, got shape {q.shape}; "
                              "pass e.g. static_equilibrium(structure).q.")
-        g = np.array([s.gap_values[s.gap_ptr[i]:s.gap_ptr[i + 1]].mean()
-                      for i in range(s.n_elements)])
         delta = V @ q - s.error_constant
-        active = (g <= 0) | (np.abs(delta) > g)
-    k_act = np.where(active, k, 0.0)
+        h, slope, u = (np.empty(s.n_elements) for _ in range(3))
+        laws.dead_zones(delta, g, h, slope, u)
+    k_act = k * slope
+    active = slope > 0
     sp_tangent = []  # (x element, y element, 2 x 2 tangent, their two rows of V)
     for j in range(s.n_splines):
         ex, ey = (int(i) for i in s.sp_el[j])
@@ -111,43 +118,71 @@ def modal_analysis(structure: Structure, q=None, *, rigid_tolerance: float = 1e-
     K = V.T @ (k_act[:, None] * V)
     for _, _, h2, rows in sp_tangent:
         K = K + rows.T @ h2 @ rows
-    d = np.sqrt(s.inv_mass)
-    A = d[:, None] * K * d[None, :]
-    A = 0.5 * (A + A.T)
-    lam, psi = np.linalg.eigh(A)
-    lam_max = float(np.max(np.abs(lam))) if lam.size else 0.0
-    rigid = np.abs(lam) <= rigid_tolerance * lam_max
-    phi = d[:, None] * psi
-    elastic = ~rigid
-    lam_e = lam[elastic]
-    phi_e = phi[:, elastic]
-    freqs = np.sign(lam_e) * np.sqrt(np.abs(lam_e)) / (2 * math.pi)
-    energy = k_act[None, :] * (V @ phi_e).T ** 2
+    C = V.T @ (np.where(active, s.damping, 0.0)[:, None] * V) + np.diag(s.ground_damping)
+    if s.n_gyroscopic:
+        freqs, phi_e, phi_r, lam_e = _gyroscopic_modes(K, s.gyroscopic_matrix(), s.inv_mass,
+                                                       rigid_tolerance)
+    else:
+        d = np.sqrt(s.inv_mass)
+        A = d[:, None] * K * d[None, :]
+        A = 0.5 * (A + A.T)
+        lam, psi = np.linalg.eigh(A)
+        lam_max = float(np.max(np.abs(lam))) if lam.size else 0.0
+        rigid = np.abs(lam) <= rigid_tolerance * lam_max
+        phi = d[:, None] * psi
+        lam_e = lam[~rigid]
+        phi_e = phi[:, ~rigid]
+        phi_r = phi[:, rigid]
+        freqs = np.sign(lam_e) * np.sqrt(np.abs(lam_e)) / (2 * math.pi)
+    energy = k_act[None, :] * np.abs(V @ phi_e).T ** 2
     for ex, ey, h2, rows in sp_tangent:  # half of the spline's energy on each component
         u = rows @ phi_e  # (2, n_modes)
-        energy[:, ex] = energy[:, ey] = 0.5 * np.einsum("im,ij,jm->m", u, h2, u)
+        energy[:, ex] = energy[:, ey] = 0.5 * np.real(np.einsum("im,ij,jm->m", u.conj(),
+                                                               h2, u))
     total = energy.sum(axis=1, keepdims=True)
     with np.errstate(invalid="ignore", divide="ignore"):
         fraction = np.where(total != 0, energy / total, 0.0)
-    C = V.T @ (np.where(active, s.damping, 0.0)[:, None] * V) + np.diag(s.ground_damping)
     omega = np.sqrt(np.abs(lam_e))
-    zeta = np.einsum("im,ij,jm->m", phi_e, C, phi_e) / (2 * omega) if omega.size \
-        else np.zeros(0)
+    zeta = (np.real(np.einsum("im,ij,jm->m", phi_e.conj(), C, phi_e)) / (2 * omega)
+            if omega.size else np.zeros(0))
     return ModalSolution(frequencies=freqs, mode_shapes=phi_e,
                          strain_energy_fraction=fraction, damping_ratios=zeta,
-                         rigid_modes=phi[:, rigid], active=active,
+                         rigid_modes=phi_r, active=active,
                          dof_names=tuple(s.dof_names), element_names=tuple(s.element_names))
 
 
+def _gyroscopic_modes(K, Gm, inv_mass, rigid_tolerance):
+    """Modes of M q'' + G q' + K q = 0 (G skew-symmetric): first-order eigenproblem.
+
+    Returns frequencies [Hz] (ascending, one per conjugate pair), complex mode shapes
+    normalised to phi^H M phi = 1, the rigid modes and omega^2 of each mode."""
+    n = K.shape[0]
+    A = np.zeros((2 * n, 2 * n))
+    A[:n, n:] = np.eye(n)
+    A[n:, :n] = -inv_mass[:, None] * K
+    A[n:, n:] = -inv_mass[:, None] * Gm
+    lam, vec = np.linalg.eig(A)
+    scale = float(np.max(np.abs(lam))) if lam.size else 0.0
+    rigid = np.abs(lam) ** 2 <= rigid_tolerance * scale**2
+    keep = ~rigid & (lam.imag > 0)
+    order = np.argsort(lam.imag[keep])
+    w = lam.imag[keep][order]
+    phi = vec[:n][:, keep][:, order]
+    mass = 1.0 / inv_mass
+    norm = np.sqrt(np.real(np.einsum("im,i,im->m", phi.conj(), mass, phi)))
+    phi = phi / norm[None, :]
+    # rigid modes: the null space of K (real), mass-normalised
+    d = np.sqrt(inv_mass)
+    lk, psi = np.linalg.eigh(0.5 * (d[:, None] * K * d[None, :] + (d[:, None] * K * d[None, :]).T))
+    lk_max = float(np.max(np.abs(lk))) if lk.size else 0.0
+    phi_r = d[:, None] * psi[:, np.abs(lk) <= rigid_tolerance * lk_max]
+    return w / (2 * math.pi), phi, phi_r, w**2
+
+
 def _spline_tangent(par, dx: float, dy: float, closed: bool) -> np.ndarray:
-    """2 x 2 tangent stiffness of a spline's static radial law at (dx, dy)."""
-    k = float(par[0])
-    rad = float(np.hypot(dx, dy))
+    """2 x 2 tangent stiffness of a spline's law at rest at (dx, dy)
+    (:func:`laws.spline_tangent`); ``closed``: as in contact at its clearance."""
     if closed:
-        return k * np.eye(2)
-    force, tangent, _ = (float(v) for v in spline_static_law(par, rad))
-    if rad == 0.0:
-        return (k if par[2] > 0 or par[3] == 0 else 0.0) * np.eye(2)
-    n = np.array([dx, dy]) / rad
-    nn = np.outer(n, n)
-    return tangent * nn + force / rad * (np.eye(2) - nn)
+        return float(par[0]) * np.eye(2)
+    t = laws.spline_tangent(float(dx), float(dy), 0.0, 0.0, *map(float, par))
+    return np.array([[t[0], t[1]], [t[2], t[3]]])

@@ -3,7 +3,10 @@
 These functions say in plain numpy what the kernels compute.  They are slow (a Python
 call per step) and exist for three uses: documentation, tests that compare kernel and
 twin, and baselines (e.g. ``scipy.integrate.solve_ivp(lambda t, y: rhs_numpy(s, t, y),
-...)``).  Symbols follow :mod:`torquesplit.assembly.structure`.
+...)``).  Symbols follow :mod:`torquesplit.assembly.structure`.  The element laws and
+the table interpolation are not re-typed here: they are the functions of
+:mod:`torquesplit.solve.laws` (through its batch evaluators), so a twin checks the
+kernels' loops, gathers and bookkeeping against plain numpy linear algebra.
 """
 
 from __future__ import annotations
@@ -14,15 +17,9 @@ import numpy as np
 
 from torquesplit.assembly.structure import (
     MESH,
-    SP_CLEARANCE,
-    SP_DAMPING,
-    SP_FRICTION,
-    SP_STICK,
-    SP_STIFFNESS,
-    SP_VELOCITY,
     Structure,
 )
-from torquesplit.solve._kernels import CYCLE_EPS
+from torquesplit.solve import laws
 
 __all__ = [
     "Excitation",
@@ -68,8 +65,9 @@ def cycle_index_numpy(s):
     even if s rounds to just below the integer).  Twin of the CY lines of
     ``_kernels.excite_tables``."""
     s = np.asarray(s, dtype=float)
-    fl = np.floor(s)
-    return (fl + (s - fl >= 1.0 - CYCLE_EPS)).astype(np.int64)
+    out = np.array([laws.stat_cycle(float(x), float(np.floor(x))) for x in s.ravel()],
+                   dtype=np.int64)
+    return out.reshape(s.shape)
 
 
 def excitation_numpy(structure: Structure, t: float) -> Excitation:
@@ -85,20 +83,13 @@ def excitation_numpy(structure: Structure, t: float) -> Excitation:
     """
     s = structure
     n_el = s.n_elements
-    n_tab = s.n_table
-    rows = np.arange(n_el)
     varying = s.frequency > 0.0
     mesh_phase = np.where(varying, s.frequency * t + s.phase, 0.0)
     cycle = np.floor(mesh_phase)
-    x = (mesh_phase - cycle) * n_tab
-    i0 = x.astype(np.int64)
-    w = x - i0
-    i0 = np.where(i0 >= n_tab, i0 - n_tab, i0)
-    i1 = (i0 + 1) % n_tab
-    k0 = s.stiffness_table[rows, i0]
-    p0 = s.force_table[rows, i0]
-    stiffness = k0 + w * (s.stiffness_table[rows, i1] - k0)
-    force = p0 + w * (s.force_table[rows, i1] - p0)
+    stiffness = np.empty(n_el)
+    force = np.empty(n_el)
+    laws.periodic_values(np.ascontiguousarray(s.stiffness_table), mesh_phase, stiffness)
+    laws.periodic_values(np.ascontiguousarray(s.force_table), mesh_phase, force)
     n_gaps = np.diff(s.gap_ptr)
     half_gap = s.gap_values[s.gap_ptr[:-1] + np.mod(cycle.astype(np.int64), n_gaps)]
     stat_cycle = np.where(varying, cycle_index_numpy(mesh_phase), 0)
@@ -111,41 +102,18 @@ def excitation_numpy(structure: Structure, t: float) -> Excitation:
     np.add.at(error_rate, owner, s.error_amplitude * s.error_omega * np.cos(arg))
 
     friction = np.zeros(s.friction_table.shape[0])
-    n_fr = s.friction_table.shape[1]
-    for j, e in enumerate(s.fr_el):
-        sp = s.frequency[e] * t + s.phase[e]
-        xf = (sp - np.floor(sp)) * n_fr
-        j0 = int(xf)
-        wf = xf - j0
-        j0 = j0 - n_fr if j0 >= n_fr else j0
-        j1 = (j0 + 1) % n_fr
-        rows = slice(3 * j, 3 * j + 3)
-        v0 = s.friction_table[rows, j0]
-        friction[rows] = v0 + wf * (s.friction_table[rows, j1] - v0)
+    if s.n_friction:
+        rows = np.repeat(np.asarray(s.fr_el), 3)
+        laws.periodic_values(np.ascontiguousarray(s.friction_table),
+                             s.frequency[rows] * t + s.phase[rows], friction)
     return Excitation(stiffness, force, half_gap, error, error_rate, stat_cycle, friction)
 
 
 def spline_law_numpy(par, dx, dy, rx=0.0, ry=0.0):
-    """Radial force of a spline at relative displacement (dx, dy) and rate (rx, ry).
-
-    ``par`` is a row of ``structure.sp_par`` (k, c, S1, S2, F_m, v).  With R = |d| and
-    Rdot = d.d'/R: F = k R + c Rdot (R < S1); F_m tanh(Rdot / v) (S1 <= R <= S2);
-    k (R - S2) + c Rdot + F_m tanh(Rdot / v) (R > S2).  Returns the component forces
-    (F dx / R, F dy / R), (0, 0) at R = 0.  Twin of ``_kernels.spline_force``.
-    """
-    rad = float(np.hypot(dx, dy))
-    if rad == 0.0:
-        return 0.0, 0.0
-    rdot = (dx * rx + dy * ry) / rad
-    k, c, s1, s2 = par[SP_STIFFNESS], par[SP_DAMPING], par[SP_STICK], par[SP_CLEARANCE]
-    fric = par[SP_FRICTION] * np.tanh(rdot / par[SP_VELOCITY])
-    if rad < s1:
-        f = k * rad + c * rdot
-    elif rad <= s2:
-        f = fric
-    else:
-        f = k * (rad - s2) + c * rdot + fric
-    return f * dx / rad, f * dy / rad
+    """Radial force of a spline at relative displacement (dx, dy) and rate (rx, ry):
+    :func:`torquesplit.solve.laws.spline_force` for a row ``par`` of
+    ``structure.sp_par`` (k, c, S1, S2, F_m, v).  Returns (f_x, f_y)."""
+    return laws.spline_force(float(dx), float(dy), float(rx), float(ry), *map(float, par))
 
 
 def friction_matrix_numpy(structure: Structure, t: float) -> np.ndarray:
@@ -162,7 +130,8 @@ def element_forces_numpy(structure: Structure, t: float, y: np.ndarray):
     delta = V.q - e, rate = V.v - e', h = dead zone of half-width g (h = delta when
     g == 0), f = k h + c rate (in contact only) + p; the two component elements of a
     spline then get the radial law (:func:`spline_law_numpy`).
-    Twin of the element loop of ``_kernels.rhs_slot`` and ``_kernels.spline_force``.
+    Twin of the element loop of ``_kernels.rhs_slot`` and of the splines in
+    ``_kernels.rhs_extra`` (the laws are :mod:`torquesplit.solve.laws`).
     """
     n = structure.n_dof
     y = np.asarray(y, dtype=float)
@@ -171,12 +140,10 @@ def element_forces_numpy(structure: Structure, t: float, y: np.ndarray):
     V = structure.projection_matrix()
     delta = V @ q - ex.error
     rate = V @ v - ex.error_rate
-    g = ex.half_gap
-    gapped = g > 0.0
-    h = np.where(delta > g, delta - g, np.where(delta < -g, delta + g, 0.0))
-    h = np.where(gapped, h, delta)
-    contact = ~gapped | (np.abs(delta) > g)
-    force = ex.stiffness * h + np.where(contact, structure.damping * rate, 0.0) + ex.force
+    f = np.empty(structure.n_elements)
+    laws.spring_forces(ex.stiffness, np.asarray(structure.damping, dtype=float), delta, rate,
+                       ex.half_gap, f, np.empty_like(f), np.empty_like(f))
+    force = f + ex.force
     for (e_x, e_y), par in zip(structure.sp_el, structure.sp_par, strict=True):
         force[e_x], force[e_y] = spline_law_numpy(par, delta[e_x], delta[e_y],
                                                   rate[e_x], rate[e_y])
@@ -185,11 +152,11 @@ def element_forces_numpy(structure: Structure, t: float, y: np.ndarray):
 
 def rhs_numpy(structure: Structure, t: float, y: np.ndarray) -> np.ndarray:
     """Right-hand side of the first-order system:
-    dy/dt = [v, M^-1 (F - C_g v - V^T f - W(t)^T max(f, 0))].
+    dy/dt = [v, M^-1 (F - C_g v - V^T f - W(t)^T max(f, 0) - G v)].
 
     W(t) holds the tooth-friction projections (:func:`friction_matrix_numpy`); f includes
-    the spline forces.  Twin of ``_kernels.rhs_slot`` + ``_kernels.rhs_extra`` /
-    ``_kernels.rhs_at``.  Usable directly with :func:`scipy.integrate.solve_ivp`.
+    the spline forces; G is the gyroscopic matrix.  Twin of ``_kernels.rhs_slot`` +
+    ``_kernels.rhs_extra`` / ``_kernels.evaluate``.  Usable directly with :func:`scipy.integrate.solve_ivp`.
     """
     n = structure.n_dof
     y = np.asarray(y, dtype=float)
@@ -197,6 +164,8 @@ def rhs_numpy(structure: Structure, t: float, y: np.ndarray) -> np.ndarray:
     force, _ = element_forces_numpy(structure, t, y)
     V = structure.projection_matrix()
     gen = structure.external_force - structure.ground_damping * v - V.T @ force
+    if structure.n_gyroscopic:
+        gen = gen - structure.gyroscopic_matrix() @ v
     if structure.n_friction:
         gen = gen - friction_matrix_numpy(structure, t).T @ np.maximum(force, 0.0)
     accel = structure.inv_mass * gen
@@ -208,7 +177,7 @@ def contact_state_numpy(structure: Structure, t: float, y: np.ndarray):
 
     Separated: |delta| <= g with g > 0.  Back-side contact: delta < -g with g > 0, or
     delta < 0 for a mesh without backlash.  Returns two boolean arrays (n_el,).
-    Twin of the contact counters in ``_kernels.record_statistics``.
+    Twin of the contact counters in ``_kernels.record``.
     """
     _, delta = element_forces_numpy(structure, t, y)
     g = excitation_numpy(structure, t).half_gap
@@ -236,7 +205,7 @@ def cycle_statistics_numpy(times, forces, frequency, phase, t0, n_cycles_cap):
     Cycle index of a sample at t is c(f t + phase) - c(f t0 + phase), c the statistics
     cycle index (:func:`cycle_index_numpy`).  Returns four arrays of length
     ``n_cycles_cap`` (max -inf / min +inf where empty).
-    Twin of the cycle part of ``_kernels.record_statistics``.
+    Twin of the cycle part of ``_kernels.record``.
     """
     times = np.asarray(times, dtype=float)
     forces = np.asarray(forces, dtype=float)

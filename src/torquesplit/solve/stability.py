@@ -3,7 +3,7 @@
 The check linearises the equations of motion with every element at the maximum of its
 stiffness table and every dead zone closed (the stiffest state the run can reach)::
 
-    A = [[0, I], [-M^-1 K_max, -M^-1 C]]
+    A = [[0, I], [-M^-1 K_max, -M^-1 (C + G)]]
 
 and requires ``|R(h lambda)| <= 1`` for every eigenvalue ``lambda`` of ``A``, with the
 RK4 amplification factor ``R(z) = 1 + z + z^2/2 + z^3/6 + z^4/24``.  Zero (rigid-body)
@@ -27,6 +27,7 @@ __all__ = [
     "highest_natural_frequency",
     "stable_step",
     "check_step",
+    "highest_mode",
 ]
 
 SAFETY = 0.8
@@ -55,7 +56,7 @@ def system_eigenvalues(structure: Structure) -> np.ndarray:
     A = np.zeros((2 * n, 2 * n))
     A[:n, n:] = np.eye(n)
     A[n:, :n] = -structure.inv_mass[:, None] * K
-    A[n:, n:] = -structure.inv_mass[:, None] * C
+    A[n:, n:] = -structure.inv_mass[:, None] * (C + structure.gyroscopic_matrix())
     lam = np.linalg.eigvals(A)
     scale = np.max(np.abs(lam)) if lam.size else 0.0
     tiny = (lam.real > 0) & (lam.real <= _REAL_TOL * scale)
@@ -66,6 +67,23 @@ def highest_natural_frequency(structure: Structure) -> float:
     """Largest |lambda| / 2 pi of :func:`system_eigenvalues` [Hz] (0 without stiffness)."""
     lam = system_eigenvalues(structure)
     return float(np.max(np.abs(lam)) / (2 * math.pi)) if lam.size else 0.0
+
+
+def highest_mode(structure: Structure) -> tuple[float, str]:
+    """Highest natural frequency at maximum stiffness [Hz] and the element holding the
+    largest share of that mode's strain energy (the one that sets the step)."""
+    n = structure.n_dof
+    if n == 0:
+        return 0.0, ""
+    k_max = structure.stiffness_table.max(axis=1)
+    V = structure.projection_matrix()
+    K = V.T @ (k_max[:, None] * V)
+    d = np.sqrt(structure.inv_mass)
+    lam, psi = np.linalg.eigh(0.5 * (d[:, None] * K * d[None, :] + (d[:, None] * K * d[None, :]).T))
+    phi = d * psi[:, -1]
+    energy = k_max * (V @ phi) ** 2
+    name = structure.element_names[int(np.argmax(energy))] if energy.size else ""
+    return float(np.sqrt(max(lam[-1], 0.0)) / (2 * math.pi)), name
 
 
 def _limiting(lam: np.ndarray) -> np.ndarray:

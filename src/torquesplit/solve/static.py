@@ -57,14 +57,15 @@ from torquesplit.assembly.structure import (
     Structure,
 )
 from torquesplit.errors import SolverError
+from torquesplit.solve import laws
 from torquesplit.solve._frozen import freeze_arrays
+from torquesplit.solve.laws import CONTACT, FLOAT
 from torquesplit.solve.reference import excitation_numpy
 
 __all__ = ["StaticSolution", "QuasiStaticSolution", "static_equilibrium", "quasi_static",
            "rigid_body_modes"]
 
-FRONT, SEPARATED, BACK = 1, 0, -1
-STICK, FLOAT, CONTACT = 2, 3, 4  # spline radial states
+FRONT, SEPARATED, BACK = 1, 0, -1  # contact states of a dead zone; splines: laws.STICK...
 
 _FRICTION_TOL = 1e-13  # relative change of the mesh forces ending the friction iteration
 _STEP_TOL = 1e-10  # relative Newton step below which a nonlinear (spline) state has settled
@@ -154,30 +155,20 @@ def rigid_body_modes(structure: Structure, active: np.ndarray | None = None,
     return d[:, None] * vt[rank:].T
 
 
-def spline_static_law(par, radius, reg: float = 0.0):
-    """Static radial law of a spline: force F(R), tangent dF/dR and energy U(R).
-
-    ``par`` a row of ``structure.sp_par``.  F = k R (R < S1), 0 (S1 <= R <= S2),
-    k (R - S2) (R > S2), plus the regularisation reg k min(R, S2) (continuous; zero
-    for reg = 0).  Vectorised over ``radius``.
-    """
-    k, s1, s2 = par[SP_STIFFNESS], par[SP_STICK], par[SP_CLEARANCE]
-    r = np.asarray(radius, dtype=float)
-    stick = r < s1
-    over = np.maximum(r - s2, 0.0)
-    inner = np.minimum(r, s2)
-    force = np.where(stick, k * r, 0.0) + k * over + reg * k * inner
-    tangent = np.where(stick, k, 0.0) + np.where(r > s2, k, 0.0) + np.where(r < s2, reg * k, 0.0)
-    energy = (np.where(stick, 0.5 * k * r * r, 0.5 * k * s1 * s1) + 0.5 * k * over * over
-              + reg * k * (0.5 * inner * inner + s2 * over))
-    return force, tangent, energy
-
-
-def spline_states(par, radius) -> np.ndarray:
-    """STICK (R < S1), FLOAT (S1 <= R <= S2, S2 > 0) or CONTACT of a spline."""
-    s1, s2 = par[SP_STICK], par[SP_CLEARANCE]
-    r = np.asarray(radius, dtype=float)
-    return np.where(r < s1, STICK, np.where((r <= s2) & (s2 > 0), FLOAT, CONTACT))
+def regularisation(delta, half_gap, stiffness, reg: float):
+    """The static solver's regularisation of dead zones: a spring of ``reg x k`` inside
+    the dead zone (clipped to it, so that it adds a constant ``reg k g`` outside), which
+    keeps a member floating in its clearance determined.  Returns force, tangent and
+    energy (arrays), zero where there is no dead zone (``g <= 0``).  Not a physical law:
+    the solution is recomputed without it once the contact states settle."""
+    g = np.asarray(half_gap, dtype=float)
+    d = np.asarray(delta, dtype=float)
+    a = np.abs(d)
+    gapped = g > 0
+    rk = np.where(gapped, reg * np.asarray(stiffness, dtype=float), 0.0)
+    inside = np.minimum(a, g)
+    return (rk * np.clip(d, -g, g), np.where(a <= g, rk, 0.0),
+            rk * (0.5 * inside * inside + g * np.maximum(a - g, 0.0)))
 
 
 @dataclass
@@ -258,45 +249,49 @@ class _StaticProblem:
 
     # ------------------------------------------------------------ element laws
     def forces(self, q, L: _Loads, reg: float):
-        """Element forces (without p), tangents, energy and states at q."""
+        """Element forces (without p), tangents, energy and states at q: the static laws
+        (:func:`laws.dead_zone`, :func:`laws.spline_force` / :func:`laws.spline_tangent`
+        at rest) plus the :func:`regularisation` ``reg``."""
         s = self.s
         delta = self.V @ q - L.e
         k, g = L.k, L.g
-        a = np.abs(delta)
-        over = np.maximum(a - g, 0.0)
-        gapped = g > 0
-        clip = np.clip(delta, -g, g)
-        f = np.where(gapped, np.sign(delta) * k * over + reg * k * clip, k * delta)
-        kt = np.where(gapped, np.where(a > g, k, 0.0) + np.where(a <= g, reg * k, 0.0), k)
-        u = np.where(gapped, 0.5 * k * over * over
-                     + reg * k * (0.5 * np.minimum(a, g) ** 2 + g * over), 0.5 * k * delta ** 2)
-        state = np.where(gapped, np.where(delta > g, FRONT, np.where(delta < -g, BACK,
-                                                                       SEPARATED)), FRONT)
+        h, dh, u = (np.empty_like(delta) for _ in range(3))
+        laws.dead_zones(delta, np.asarray(g, dtype=float), h, dh, u)
+        fr, kr, ur = regularisation(delta, g, k, reg)
+        f = k * h + fr
+        kt = k * dh + kr
+        state = np.where(g > 0, np.where(delta > g, FRONT, np.where(delta < -g, BACK,
+                                                                      SEPARATED)), FRONT)
         state = state.astype(np.int64)
-        energy = float(np.sum(np.where(self.linear, u, 0.0)))
+        energy = float(np.sum(np.where(self.linear, k * u + ur, 0.0)))
         sp = []
+        if s.n_splines:
+            dx, dy = delta[self.sp_x], delta[self.sp_y]
+            zero = np.zeros_like(dx)
+            out = np.empty((s.n_splines, 12))
+            laws.spline_forces(dx, dy, zero, zero, np.ascontiguousarray(s.sp_par), out)
         for j in range(s.n_splines):
             ex, ey = self.sp_x[j], self.sp_y[j]
-            dx, dy = delta[ex], delta[ey]
-            rad = float(np.hypot(dx, dy))
             par = s.sp_par[j]
-            fr, tr, ur = (float(v) for v in spline_static_law(par, rad, reg))
-            energy += ur
+            rad = float(np.hypot(dx[j], dy[j]))
+            # the regularisation of the radial dead zone: reg k min(R, S2) along d / R
+            rk = reg * par[SP_STIFFNESS]
+            s2 = par[SP_CLEARANCE]
+            f_reg = rk * min(rad, s2)
+            f[ex], f[ey] = out[j, 0], out[j, 1]
+            h2 = out[j, 2:6].reshape(2, 2).copy()
             if rad > 0:
-                nx, ny = dx / rad, dy / rad
-                f[ex], f[ey] = fr * nx, fr * ny
-                ratio = fr / rad
+                nx, ny = dx[j] / rad, dy[j] / rad
+                f[ex] += f_reg * nx
+                f[ey] += f_reg * ny
                 nn = np.array([[nx * nx, nx * ny], [nx * ny, ny * ny]])
-                h2 = tr * nn + ratio * (np.eye(2) - nn)
-            else:
-                f[ex] = f[ey] = 0.0
-                slope0 = float(spline_static_law(par, 0.0, reg)[1])
-                if par[SP_STICK] == 0 and par[SP_CLEARANCE] == 0:
-                    slope0 = float(par[SP_STIFFNESS])
-                h2 = slope0 * np.eye(2)
+                h2 += (rk if rad < s2 else 0.0) * nn + f_reg / rad * (np.eye(2) - nn)
+            elif s2 > 0:
+                h2 += rk * np.eye(2)
+            inner = min(rad, s2)
+            energy += out[j, 10] + rk * (0.5 * inner * inner + s2 * max(rad - s2, 0.0))
             kt[ex] = kt[ey] = 0.0
-            st = int(spline_states(par, rad))
-            state[ex] = state[ey] = st
+            state[ex] = state[ey] = int(out[j, 11])
             sp.append(h2)
         return delta, f, kt, energy, state, sp
 

@@ -28,6 +28,21 @@ def _no_pair(func: Callable[..., MeshStiffness]) -> Callable[..., MeshStiffness]
     return call
 
 
+def _ltca(pair, n=256, **options):
+    # imported on use: the contact package builds on this one
+    from torquesplit.gears.contact.ltca import ltca_stiffness
+
+    return ltca_stiffness(pair, n, **options)
+
+
+def _ltca_options():
+    from torquesplit.gears.contact.ltca import ltca_stiffness
+
+    return ltca_stiffness
+
+
+_ltca.__wrapped_lazy__ = _ltca_options
+
 #: method name -> callable(pair, n, **options).  Methods that need no geometry ignore the pair.
 METHODS: dict[str, Callable[..., MeshStiffness]] = {
     "constant": _no_pair(constant_stiffness),
@@ -36,11 +51,13 @@ METHODS: dict[str, Callable[..., MeshStiffness]] = {
     "table": _no_pair(table_stiffness),
     "fourier": _no_pair(fourier_stiffness),
     "load_table": _no_pair(load_table_stiffness),
+    "ltca": _ltca,
 }
 
 
 def _option_names(func) -> list[str]:
-    target = getattr(func, "__wrapped__", func)
+    lazy = getattr(func, "__wrapped_lazy__", None)
+    target = lazy() if lazy is not None else getattr(func, "__wrapped__", func)
     return [p for p in inspect.signature(target).parameters if p not in ("pair", "n")]
 
 
@@ -55,7 +72,9 @@ def mesh_stiffness(pair: PairGeometry | None, method: str, n: int = 256, **optio
     method : str
         ``"constant"`` (``mean=``), ``"iso6336"``, ``"potential_energy"``,
         ``"table"`` (``phase=, stiffness=``), ``"fourier"`` (``mean=, cos=, sin=``),
-        ``"load_table"`` (``loads=, phase=, stiffness=, load=``).
+        ``"load_table"`` (``loads=, phase=, stiffness=, load=``), ``"ltca"``
+        (``load=`` and the options of
+        :func:`~torquesplit.gears.contact.ltca.ltca_stiffness`).
     n : int
         Number of uniform mesh-phase samples.
     **options
@@ -76,7 +95,7 @@ def mesh_stiffness(pair: PairGeometry | None, method: str, n: int = 256, **optio
     if unknown:
         raise TypeError(f"mesh_stiffness(method={method!r}) got unknown option(s) {unknown}; "
                         f"it accepts {allowed}")
-    if pair is None and method in ("iso6336", "potential_energy"):
+    if pair is None and method in ("iso6336", "potential_energy", "ltca"):
         raise ModelError([("pair", f"method {method!r} needs the pair geometry")])
     return func(pair, n, **options)
 

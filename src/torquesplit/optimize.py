@@ -1,0 +1,543 @@
+"""Multi-objective optimisation of model parameters with pymoo (NSGA-II by default).
+
+    torquesplit optimize OPT.toml [--workers 2] [--out DIR]
+    torquesplit.optimize("OPT.toml")
+
+Self-contained: the evaluations run in a local process pool of this module, not through
+the study runner (which is being written apart); they are stored in a JSON-lines file
+as they finish (``OPT.evaluations.jsonl`` in the current folder, or ``store = "..."``
+relative to the optimisation file), keyed by the variable values, so that an
+interrupted optimisation run again with the same file and seed recomputes nothing it has
+already evaluated (pymoo with a fixed seed proposes the same designs again).
+
+The optimisation file (TOML)::
+
+    [optimization]
+    model = "seed000_split_torque"   # example name, or a model file relative to this file
+    algorithm = "nsga2"              # any pymoo algorithm by name (see ALGORITHMS)
+    population = 40
+    generations = 50
+    seed = 1
+    workers = 2                      # processes; 1 = in this process
+    choose = "min_sum"               # design written back: least sum of the objectives
+    # store = "runs/evals.jsonl"     # where evaluations are kept (default: current folder)
+
+    [set]                            # fixed overrides of the model (as --set PATH=VALUE)
+    "meshes.L68.stiffness" = {method = "ltca"}
+
+    [[variables]]                    # any model path; tables on the way are created
+    path = "gears.L6.modifications.topological.y1"
+    lower = "0 mm"                   # quantities with units, or SI numbers
+    upper = "0.06 mm"
+    also = ["gears.L7.modifications.topological.y1"]   # set to the same value
+
+    [[objectives]]
+    output = "ltca.L68.te_peak_to_peak_arcsec"   # or dynamic.GROUP.dynamic_factor ...
+    relative_to = "baseline"         # divide by the value of the model without variables
+    sense = "min"                    # or "max"
+
+    [[constraints]]
+    output = "ltca.L68.max_hertz_pressure_Pa"
+    upper = "1500 MPa"
+
+Outputs: ``ltca.MESH.KEY`` -- any key of the LTCA summary of a mesh with
+``stiffness.method = "ltca"`` at its operating load (``te_peak_to_peak_arcsec``,
+``te_peak_to_peak_m``, ``impact_peak_force_N`` (needs ``impact = true``),
+``stiffness_secant_mean_N_per_m``, ``max_hertz_pressure_Pa``, ``actual_contact_ratio``...);
+``dynamic.GROUP.dynamic_factor``, ``dynamic.GROUP.load_sharing``,
+``dynamic.MESH.dynamic_factor``, ``dynamic.system_load_sharing`` -- from a dynamic run
+(:func:`torquesplit.simulate`, per-cycle peak definitions; slow).
+
+Results: the Pareto front (table ``pareto.csv`` and figure ``pareto.png``) and the chosen
+design written back as a model file (``chosen.toml``).
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import tomllib
+import warnings
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+from .errors import ModelError, ModelWarning, TorquesplitError
+
+__all__ = ["ALGORITHMS", "OptimizationSpec", "OptimizationResult", "read_spec", "optimize",
+           "evaluate_design"]
+
+#: pymoo algorithms by name (module, class); any of them takes ``pop_size``
+ALGORITHMS = {
+    "nsga2": ("pymoo.algorithms.moo.nsga2", "NSGA2"),
+    "rnsga2": ("pymoo.algorithms.moo.rnsga2", "RNSGA2"),
+    "nsga3": ("pymoo.algorithms.moo.nsga3", "NSGA3"),
+    "unsga3": ("pymoo.algorithms.moo.unsga3", "UNSGA3"),
+    "agemoea": ("pymoo.algorithms.moo.age", "AGEMOEA"),
+    "smsemoa": ("pymoo.algorithms.moo.sms", "SMSEMOA"),
+    "ga": ("pymoo.algorithms.soo.nonconvex.ga", "GA"),
+    "de": ("pymoo.algorithms.soo.nonconvex.de", "DE"),
+    "pso": ("pymoo.algorithms.soo.nonconvex.pso", "PSO"),
+}
+
+PENALTY = 1e12  # objective value of a design that could not be evaluated
+
+
+# =============================================================================== spec
+@dataclass(frozen=True)
+class Variable:
+    path: str
+    lower: float
+    upper: float
+    also: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class Output:
+    output: str
+    relative_to: str | None = None
+    sense: str = "min"
+    lower: float | None = None
+    upper: float | None = None
+
+
+@dataclass(frozen=True)
+class OptimizationSpec:
+    """A validated optimisation file (SI values)."""
+
+    model_data: dict
+    model_source: str
+    fixed: dict
+    variables: tuple[Variable, ...]
+    objectives: tuple[Output, ...]
+    constraints: tuple[Output, ...] = ()
+    algorithm: str = "nsga2"
+    population: int = 40
+    generations: int = 50
+    seed: int = 1
+    workers: int = 1
+    choose: str = "min_sum"
+    store: Path | None = None
+    base_dir: Path = field(default_factory=Path.cwd)
+
+
+def _si(value, where: str) -> float:
+    if isinstance(value, bool):
+        raise ModelError([(where, f"must be a number or a quantity, got {value!r}; write e.g. "
+                                  "'0.05 mm'")])
+    if isinstance(value, (int, float)):
+        return float(value)
+    from .model.units import registry
+
+    try:
+        q = registry().Quantity(str(value))
+        return float(q.to_base_units().magnitude)
+    except Exception:
+        raise ModelError([(where, f"{value!r} is not a quantity; write e.g. '0.05 mm' or a "
+                                  "number in SI units")]) from None
+
+
+def read_spec(source) -> OptimizationSpec:
+    """Read and check an optimisation file (path or dict)."""
+    from .model.overrides import read_raw
+
+    if isinstance(source, dict):
+        data, base, name = source, Path.cwd(), "<dict>"
+    else:
+        path = Path(source)
+        if not path.exists():
+            raise ModelError([("", f"no such file; check the path (current folder: {Path.cwd()})")],
+                             str(path))
+        try:
+            data = tomllib.loads(path.read_text(encoding="utf-8"))
+        except tomllib.TOMLDecodeError as exc:
+            raise ModelError([("", f"TOML syntax error: {exc}; fix the line it names")], str(path)) from None
+        base, name = path.resolve().parent, str(path)
+    known = {"optimization", "set", "variables", "objectives", "constraints"}
+    extra = sorted(set(data) - known)
+    if extra:
+        raise ModelError([(extra[0], f"unknown section; use {', '.join(sorted(known))}")], name)
+    opt = dict(data.get("optimization", {}))
+    issues = []
+    model_ref = opt.pop("model", None)
+    if not isinstance(model_ref, str):
+        raise ModelError([("optimization.model", "required: an example name or a model file; "
+                                                 "add model = \"seed000_split_torque\"")], name)
+    mpath = (base / model_ref) if not Path(model_ref).is_absolute() else Path(model_ref)
+    if not mpath.exists():
+        from .examples import example_names, example_path
+
+        if model_ref in example_names():
+            mpath = example_path(model_ref)
+        else:
+            raise ModelError([("optimization.model", f"{model_ref!r} is neither a file nor an "
+                                                     "example; give a model file path")], name)
+    model_data = read_raw(mpath)
+    kw = {}
+    for key, typ, default in (("algorithm", str, "nsga2"), ("population", int, 40),
+                              ("generations", int, 50), ("seed", int, 1), ("workers", int, 1),
+                              ("choose", str, "min_sum"), ("store", str, None)):
+        v = opt.pop(key, default)
+        if v is not None and not isinstance(v, typ):
+            issues.append((f"optimization.{key}", f"must be a {typ.__name__}, got {v!r}; correct it"))
+        kw[key] = v
+    if opt:
+        issues.append((f"optimization.{sorted(opt)[0]}", "unknown field; check the spelling "
+                                                          "against torquesplit/optimize.py"))
+    if kw["algorithm"] not in ALGORITHMS:
+        issues.append(("optimization.algorithm", f"unknown algorithm {kw['algorithm']!r}; use one "
+                                                 f"of {', '.join(ALGORITHMS)}"))
+    if kw["population"] < 4 or kw["generations"] < 1 or kw["workers"] < 1:
+        issues.append(("optimization.population", "population >= 4, generations >= 1 and "
+                                                  "workers >= 1 are needed; correct them"))
+    if kw["choose"] not in ("min_sum", "knee"):
+        issues.append(("optimization.choose", f"unknown choice {kw['choose']!r}; use 'min_sum' or 'knee'"))
+    variables = []
+    for i, v in enumerate(data.get("variables", [])):
+        where = f"variables[{i}]"
+        if not isinstance(v, dict) or "path" not in v or "lower" not in v or "upper" not in v:
+            issues.append((where, "needs path, lower and upper; add them"))
+            continue
+        lo, hi = _si(v["lower"], f"{where}.lower"), _si(v["upper"], f"{where}.upper")
+        if not lo < hi:
+            issues.append((f"{where}.upper", f"must exceed lower ({lo:g}); correct the bounds"))
+        unknown = sorted(set(v) - {"path", "lower", "upper", "also"})
+        if unknown:
+            issues.append((f"{where}.{unknown[0]}", "unknown field; use path, lower, upper, also"))
+        variables.append(Variable(str(v["path"]), lo, hi, tuple(v.get("also", ()))))
+    if not variables:
+        issues.append(("variables", "no variables; add [[variables]] with path, lower, upper"))
+
+    def outputs(key):
+        out = []
+        for i, o in enumerate(data.get(key, [])):
+            where = f"{key}[{i}]"
+            if not isinstance(o, dict) or "output" not in o:
+                issues.append((where, "needs an output, e.g. output = \"ltca.m.te_peak_to_peak_m\"; "
+                                      "add it"))
+                continue
+            unknown = sorted(set(o) - {"output", "relative_to", "sense", "lower", "upper", "name"})
+            if unknown:
+                issues.append((f"{where}.{unknown[0]}", "unknown field; use output, relative_to, "
+                                                         "sense, lower, upper"))
+            parts = str(o["output"]).split(".")
+            if parts[0] not in ("ltca", "dynamic") or (parts[0] == "ltca" and len(parts) != 3):
+                issues.append((f"{where}.output", f"{o['output']!r} is not an output; write "
+                                                  "ltca.MESH.KEY or dynamic.GROUP.KEY"))
+            if o.get("relative_to") not in (None, "baseline"):
+                issues.append((f"{where}.relative_to", "must be 'baseline'; write relative_to = 'baseline' "
+                                                      "or remove it"))
+            if o.get("sense", "min") not in ("min", "max"):
+                issues.append((f"{where}.sense", "must be 'min' or 'max'; use one of them"))
+            out.append(Output(str(o["output"]), o.get("relative_to"), o.get("sense", "min"),
+                              None if o.get("lower") is None else _si(o["lower"], f"{where}.lower"),
+                              None if o.get("upper") is None else _si(o["upper"], f"{where}.upper")))
+        return out
+
+    objectives, constraints = outputs("objectives"), outputs("constraints")
+    if not objectives:
+        issues.append(("objectives", "no objectives; add [[objectives]] with an output"))
+    for i, c in enumerate(constraints):
+        if c.lower is None and c.upper is None:
+            issues.append((f"constraints[{i}]", "has no bound; add lower or upper"))
+    if issues:
+        raise ModelError(issues, name)
+    store = kw.pop("store")
+    if store is not None:
+        store_path = base / store          # relative to the optimisation file
+    elif not isinstance(source, dict):     # default: in the current folder
+        store_path = Path.cwd() / Path(source).with_suffix(".evaluations.jsonl").name
+    else:
+        store_path = None
+    return OptimizationSpec(model_data=model_data, model_source=str(mpath),
+                            fixed=dict(data.get("set", {})), variables=tuple(variables),
+                            objectives=tuple(objectives), constraints=tuple(constraints),
+                            store=store_path, base_dir=base, **kw)
+
+
+# ========================================================================= evaluation
+def _set_deep(data: dict, path: str, value) -> dict:
+    """Set a dotted path, creating missing tables (a variable may add a modification)."""
+    from .model.overrides import set_parameter
+
+    parts = path.split(".")
+    node = data
+    for key in parts[:-1]:
+        if isinstance(node, dict) and key not in node:
+            node[key] = {}
+        node = node[key] if isinstance(node, dict) else node
+    return set_parameter(data, path, value)
+
+
+def _model_data(spec: OptimizationSpec, x) -> dict:
+    import copy
+
+    from .model.overrides import apply_overrides
+
+    data = apply_overrides(copy.deepcopy(spec.model_data), spec.fixed)
+    for var, value in zip(spec.variables, [] if x is None else x):
+        for p in (var.path, *var.also):
+            data = _set_deep(data, p, float(value))
+    # the optimiser's designs are not kept in the LTCA disk cache
+    for name in _ltca_meshes(spec):
+        data = _set_deep(data, f"meshes.{name}.stiffness.ltca.cache", False)
+    return data
+
+
+def _ltca_meshes(spec) -> set[str]:
+    return {o.output.split(".")[1] for o in (*spec.objectives, *spec.constraints)
+            if o.output.startswith("ltca.")}
+
+
+def evaluate_design(spec: OptimizationSpec, x) -> dict[str, float]:
+    """Every output the objectives and constraints name, for variables ``x`` (SI), or for
+    the baseline model (``x = None``)."""
+    from .model.io import model_from_dict
+
+    data = _model_data(spec, x)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ModelWarning)
+        import torquesplit
+
+        model = torquesplit.load_model(model_from_dict(data, source=spec.model_source))
+        out: dict[str, float] = {}
+        wanted = [o.output for o in (*spec.objectives, *spec.constraints)]
+        if any(w.startswith("ltca.") for w in wanted):
+            from .gears.contact.coupling import mesh_ltca
+            from .model.kinematics import solve_kinematics
+
+            kin = solve_kinematics(model)
+            for mesh in sorted(_ltca_meshes(spec)):
+                if mesh not in model.meshes:
+                    raise ModelError([("objectives", f"no mesh named {mesh!r}; name a mesh of the "
+                                                     "model")])
+                if model.meshes[mesh].stiffness.method != "ltca":
+                    raise ModelError([(f"meshes.{mesh}.stiffness.method", (
+                        "an ltca output needs stiffness.method = 'ltca'; set it in [set]"))])
+                summary = mesh_ltca(model, kin, mesh, model.analysis.table_points).summary
+                for k, v in summary.items():
+                    if isinstance(v, (int, float)) and not isinstance(v, bool):
+                        out[f"ltca.{mesh}.{k}"] = float(v)
+                if model.meshes[mesh].impact and "impact_peak_force_N" not in summary:
+                    out[f"ltca.{mesh}.impact_peak_force_N"] = 0.0
+        if any(w.startswith("dynamic.") for w in wanted):
+            res = torquesplit.simulate(model)
+            met = res.metrics("cycle_peak").to_dict()
+            out["dynamic.system_load_sharing"] = float(met["system_load_sharing"])
+            for g, v in met["groups"].items():
+                out[f"dynamic.{g}.dynamic_factor"] = float(v["dynamic_factor"])
+                out[f"dynamic.{g}.load_sharing"] = float(v["load_sharing"])
+            for mname, v in met["meshes"].items():
+                out[f"dynamic.{mname}.dynamic_factor"] = float(v["dynamic_factor"])
+                out[f"dynamic.{mname}.load_sharing"] = float(v["load_sharing"])
+    missing = [w for w in wanted if w not in out]
+    if missing:
+        raise ModelError([("objectives", f"output {missing[0]!r} is not produced; use one of "
+                                         f"{', '.join(sorted(out)[:12])} ...")])
+    return out
+
+
+def _evaluate_job(spec: OptimizationSpec, x: tuple[float, ...]) -> dict:
+    try:
+        return {"x": list(x), "outputs": evaluate_design(spec, x), "error": None}
+    except (TorquesplitError, ValueError) as exc:
+        return {"x": list(x), "outputs": None, "error": str(exc).splitlines()[0]}
+
+
+class _Store:
+    """Evaluations by variable values, appended to a JSON-lines file as they finish."""
+
+    def __init__(self, path: Path | None):
+        self.path = path
+        self.records: dict[tuple, dict] = {}
+        if path is not None and path.exists():
+            for line in path.read_text().splitlines():
+                try:
+                    rec = json.loads(line)
+                    self.records[tuple(rec["x"])] = rec
+                except (ValueError, KeyError):
+                    continue  # a line cut by an interruption
+
+    def __contains__(self, x) -> bool:
+        return tuple(x) in self.records
+
+    def get(self, x) -> dict:
+        return self.records[tuple(x)]
+
+    def add(self, rec: dict) -> None:
+        self.records[tuple(rec["x"])] = rec
+        if self.path is not None:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            with self.path.open("a") as fh:
+                fh.write(json.dumps(rec) + "\n")
+
+
+# ============================================================================= result
+@dataclass(frozen=True)
+class OptimizationResult:
+    """Pareto front and the chosen design."""
+
+    spec: OptimizationSpec
+    X: np.ndarray
+    """(n, n_var) Pareto-optimal variable values (SI)."""
+    F: np.ndarray
+    """(n, n_obj) their objective values (as minimised: 'max' objectives negated)."""
+    outputs: tuple[dict, ...]
+    baseline: dict
+    chosen: int
+    evaluations: int
+    computed: int
+
+    @property
+    def chosen_x(self) -> np.ndarray:
+        return self.X[self.chosen]
+
+    def chosen_model_data(self) -> dict:
+        """The model file data of the chosen design (fixed overrides and variables set)."""
+        data = _model_data(self.spec, self.chosen_x)
+        for name in _ltca_meshes(self.spec):  # keep the user's cache setting
+            data["meshes"][name]["stiffness"]["ltca"].pop("cache", None)
+        return data
+
+    def write(self, directory) -> list[Path]:
+        """pareto.csv, pareto.png and chosen.toml in ``directory``."""
+        import tomli_w
+
+        d = Path(directory)
+        d.mkdir(parents=True, exist_ok=True)
+        names = [v.path for v in self.spec.variables]
+        objs = [o.output + (" / baseline" if o.relative_to else "") for o in self.spec.objectives]
+        paths = [d / "pareto.csv", d / "chosen.toml"]
+        with paths[0].open("w", newline="") as fh:
+            w = csv.writer(fh)
+            w.writerow(["chosen", *names, *objs])
+            for i, (x, f) in enumerate(zip(self.X, self.F)):
+                sign = [(-1 if o.sense == "max" else 1) for o in self.spec.objectives]
+                w.writerow([int(i == self.chosen), *map(float, x), *(s * v for s, v in zip(sign, f))])
+        paths[1].write_text("# chosen by torquesplit optimize (" + self.spec.choose + ")\n"
+                            + tomli_w.dumps(self.chosen_model_data()))
+        if self.F.shape[1] >= 2:
+            from matplotlib.figure import Figure
+
+            fig = Figure(figsize=(6.5, 5.0), layout="constrained")
+            ax = fig.add_subplot()
+            ax.scatter(self.F[:, 0], self.F[:, 1], label="Pareto front")
+            ax.scatter(self.F[self.chosen, 0], self.F[self.chosen, 1], marker="*", s=200,
+                       color="tab:red", label="chosen")
+            ax.set_xlabel(objs[0] + " [-]" if self.spec.objectives[0].relative_to else objs[0])
+            ax.set_ylabel(objs[1] + " [-]" if self.spec.objectives[1].relative_to else objs[1])
+            ax.grid(True, alpha=0.3)
+            ax.legend()
+            ax.set_title(f"{self.spec.algorithm}: {len(self.F)} Pareto designs, "
+                         f"{self.evaluations} evaluations")
+            p = d / "pareto.png"
+            fig.savefig(p, dpi=120)
+            paths.append(p)
+        return paths
+
+
+# ============================================================================= driver
+def optimize(source, *, workers: int | None = None, generations: int | None = None,
+             population: int | None = None, seed: int | None = None,
+             progress: Callable[[int, int], None] | None = None) -> OptimizationResult:
+    """Run the optimisation of an optimisation file (path, dict or OptimizationSpec).
+
+    Keyword arguments override the file's settings.  ``progress(generation, total)`` is
+    called after each generation.
+    """
+    import importlib
+
+    from pymoo.core.problem import Problem
+    from pymoo.optimize import minimize
+
+    spec = source if isinstance(source, OptimizationSpec) else read_spec(source)
+    over = {k: v for k, v in dict(workers=workers, generations=generations,
+                                  population=population, seed=seed).items() if v is not None}
+    if over:
+        from dataclasses import replace
+
+        spec = replace(spec, **over)
+    store = _Store(spec.store)
+    baseline = evaluate_design(spec, None)
+    for o in (*spec.objectives,):
+        if o.relative_to and not baseline[o.output]:
+            raise ModelError([("objectives", f"the baseline value of {o.output!r} is 0; it cannot "
+                                             "be a reference: remove relative_to")])
+    counters = {"computed": 0, "evaluations": 0, "generation": 0}
+    pool = ProcessPoolExecutor(max_workers=spec.workers) if spec.workers > 1 else None
+
+    def objectives_of(rec):
+        if rec["outputs"] is None:
+            return [PENALTY] * len(spec.objectives), [1.0] * max(len(spec.constraints), 1)
+        f = []
+        for o in spec.objectives:
+            v = rec["outputs"][o.output]
+            if o.relative_to:
+                v = v / baseline[o.output]   # Liu et al. 2021 eq. 23: f / f0
+            f.append(-v if o.sense == "max" else v)
+        g = []
+        for c in spec.constraints:
+            v = rec["outputs"][c.output]
+            if c.upper is not None:
+                g.append(v - c.upper)
+            if c.lower is not None:
+                g.append(c.lower - v)
+        return f, g or [-1.0]
+
+    class _Problem(Problem):
+        def __init__(self):
+            super().__init__(n_var=len(spec.variables), n_obj=len(spec.objectives),
+                             n_ieq_constr=max(sum((c.lower is not None) + (c.upper is not None)
+                                                  for c in spec.constraints), 1),
+                             xl=np.array([v.lower for v in spec.variables]),
+                             xu=np.array([v.upper for v in spec.variables]))
+
+        def _evaluate(self, X, out, *args, **kwargs):
+            keys = [tuple(float(v) for v in x) for x in X]
+            todo = sorted({k for k in keys if k not in store})
+            if pool is None:
+                for k in todo:
+                    store.add(_evaluate_job(spec, k))
+                    counters["computed"] += 1
+            else:
+                futures = [pool.submit(_evaluate_job, spec, k) for k in todo]
+                for fut in as_completed(futures):
+                    store.add(fut.result())    # stored as it finishes
+                    counters["computed"] += 1
+            counters["evaluations"] += len(keys)
+            F, G = zip(*(objectives_of(store.get(k)) for k in keys))
+            out["F"] = np.array(F)
+            out["G"] = np.array(G)
+            counters["generation"] += 1
+            if progress is not None:
+                progress(counters["generation"], spec.generations)
+
+    mod, cls = ALGORITHMS[spec.algorithm]
+    algorithm = getattr(importlib.import_module(mod), cls)(pop_size=spec.population)
+    try:
+        res = minimize(_Problem(), algorithm, ("n_gen", spec.generations), seed=spec.seed,
+                       verbose=False)
+    finally:
+        if pool is not None:
+            pool.shutdown()
+    if res.X is None:
+        raise TorquesplitError("no feasible design found; widen the bounds or relax the "
+                               "constraints")
+    X = np.atleast_2d(res.X)
+    F = np.atleast_2d(res.F)
+    order = np.lexsort(F.T[::-1])
+    X, F = X[order], F[order]
+    outputs = tuple(store.get(tuple(float(v) for v in x))["outputs"] for x in X)
+    if spec.choose == "knee" and F.shape[1] >= 2 and len(F) > 2:
+        span = np.ptp(F, axis=0)
+        span[span == 0] = 1.0
+        Fn = (F - F.min(axis=0)) / span
+        chosen = int(np.argmin(np.linalg.norm(Fn, axis=1)))
+    else:
+        chosen = int(np.argmin(F.sum(axis=1)))
+    return OptimizationResult(spec=spec, X=X, F=F, outputs=outputs, baseline=baseline,
+                              chosen=chosen, evaluations=counters["evaluations"],
+                              computed=counters["computed"])

@@ -1,0 +1,329 @@
+"""The compiled kernels' data: three bundles of arrays instead of 70 arguments.
+
+A kernel call takes three named tuples of contiguous arrays (numba types a named tuple
+of arrays as one value; passing it costs nothing more than passing its arrays, measured):
+
+=================  ====================================================  ==============
+bundle             what it holds                                         lifetime
+=================  ====================================================  ==============
+:class:`KernelModel`  the structure's arrays in kernel form (SI), with    one per model
+                   the index arrays derived for speed (CSR of V by
+                   element and by DOF, time-varying elements, ...)
+:class:`Work`      scratch: state rows, element forces, excitation       one per run
+                   slots, error phasors, gap cache, data addresses for
+                   the generated right-hand side
+:class:`Record`    what a run keeps: per-cycle statistics of the force   one per run
+                   and of the load-sharing ratio, contact counters,
+                   decimated and full histories
+=================  ====================================================  ==============
+
+Named tuples rather than a numba structref or one packed buffer: they are plain
+Python objects on this side (readable, picklable, each array keeps its dtype and
+shape), numba caches kernels that take them, and adding a field touches this module,
+the kernel that uses it and nothing else.  Rows of :attr:`Work.Y` hold every state-
+sized vector of the integrators (the state, the trial state and the stages), so one
+stage evaluation (``_kernels._stage``) serves RK4 and Dormand-Prince alike, and the
+generated right-hand side gets a row's address as base + row * stride.
+"""
+
+from __future__ import annotations
+
+from collections import namedtuple
+
+import numpy as np
+
+from torquesplit.assembly.structure import Structure
+from torquesplit.errors import SolverError
+
+__all__ = ["KernelModel", "Work", "Record", "kernel_model", "make_work", "make_record",
+           "Y_STATE", "Y_TRIAL", "Y_K1", "Y_KFSAL", "Y_NEW", "Y_SAMPLE", "Y_DSAMPLE",
+           "F_MAIN", "F_TMP", "N_SLOT", "SLOT_EVENT", "Y_ALT", "Y_K1ALT", "corner_nodes"]
+
+KernelModel = namedtuple("KernelModel", (
+    "inv_mass", "external_force", "ground_damping", "element_kind", "v_ptr", "v_dof",
+    "v_coef", "stiffness_table", "frequency", "phase", "damping", "gap_ptr",
+    "gap_values", "error_constant", "error_ptr", "error_amplitude", "error_omega",
+    "error_phase", "force_table", "tv_el", "err_el", "sin_el", "vr_ptr", "vq_idx",
+    "vv_idx", "vt_ptr", "vt_el", "vt_coef", "fr_el", "fr_ptr", "fr_dof", "fr_coef",
+    "fr_row", "friction_table", "sp_el", "sp_par", "gy_ptr", "gy_idx", "gy_coef",
+    "corner_ptr", "corner_node",
+))
+"""A :class:`~torquesplit.assembly.structure.Structure` in kernel form.
+
+Besides the structure's own arrays (see its docstring): ``tv_el`` elements with a
+time-varying table (f > 0); ``err_el`` elements owning an error sinusoid and ``sin_el``
+the owner of each sinusoid; ``vr_ptr vq_idx vv_idx`` V by element (unsigned; indices
+into the state of the q and of the v entries); ``vt_ptr vt_el vt_coef`` V by DOF (the
+generalized forces are gathered, not scattered); ``gy_ptr gy_idx gy_coef`` the
+gyroscopic matrix G by row (generalized force -G v); spline component elements get zero
+stiffness and damping in ``stiffness_table`` / ``damping`` (their law is applied apart);
+``corner_node[corner_ptr[e]:corner_ptr[e+1]]`` the table nodes where element e's force has
+a corner (:func:`corner_nodes`): the integrators also sample the statistics there.
+"""
+
+Work = namedtuple("Work", (
+    "Y", "F", "D", "K", "P", "G", "E", "ED", "CY", "S", "C", "FR", "gap_cyc", "gap_val",
+    "has_force", "watch_el", "rot", "addr", "par", "next_node",
+))
+"""Scratch of one run.  ``Y`` (12, 2 n): state-sized rows (see the ``Y_*`` indices);
+``F``/``D`` (2, n_el): element forces / deformations of the evaluation whose statistics
+are recorded (row F_MAIN) and of the other stages (F_TMP); ``K P G E ED CY`` (N_SLOT,
+n_el) excitation slots: stiffness, additive force, half-gap, error, error rate,
+statistics cycle index; ``S C`` (N_SLOT, n_sin) sin and cos of every error sinusoid;
+``FR`` (N_SLOT, 3 n_fm) friction-table values; ``gap_cyc``/``gap_val`` the cached
+half-gap of each element's current cycle; ``has_force`` elements with a non-zero
+additive force table; ``watch_el`` elements whose contact state is counted; ``rot``
+(2, n_sin) cos and sin of the phasor rotation over half an RK4 step; ``addr`` data
+addresses for the generated right-hand side (``A_*``); ``par`` its parameter vector
+(empty for the general kernel), held here so that its address stays valid;
+``next_node`` the absolute table node (cycle x n_table + node) of each element's next
+corner."""
+
+Record = namedtuple("Record", (
+    "track_el", "track_base", "cyc_max", "cyc_min", "cyc_sum", "cyc_cnt",
+    "grp_ptr", "grp_col", "rat_max", "rat_min",
+    "sep_count", "back_count", "sep_time", "back_time",
+    "hist_el", "hist_dof", "hist_t", "hist_f", "hist_q", "hist_v", "full_t", "full_y",
+))
+"""Outputs of a run.  Per tracked element (columns) and cycle (rows, counted from the
+cycle containing the start time): force max, min, sum and sample count; per
+load-sharing group (``grp_col[grp_ptr[g]:grp_ptr[g+1]]`` its tracked columns) the
+largest and smallest instantaneous ratio ``N f_i / sum_j f_j`` of each member in each of
+its cycles (``rat_max``, ``rat_min``); per element the samples and time in separation
+and in back-side contact; the decimated history and the optional full state."""
+
+# rows of Work.Y
+Y_STATE = 0  # the state (copied in and out of the caller's y)
+Y_TRIAL = 1  # stage argument
+Y_K1 = 2  # rk4: k1..k4 in rows 2..5
+Y_KFSAL = 2  # dopri: f(t, y) of the current state, k2..k7 in rows 3..8
+Y_NEW = 9  # dopri: candidate state
+Y_SAMPLE = 10  # interpolated sample state (dopri history, corner events)
+Y_DSAMPLE = 11  # its derivative
+Y_ALT = 12  # rk4: the other state row (the previous state, kept for corner events)
+Y_K1ALT = 13  # rk4: its k1
+N_ROWS = 14
+# rows of Work.F / Work.D
+F_MAIN = 0
+F_TMP = 1
+#: excitation slots (rk4: t, t + h/2, t + h; dopri: stages, accepted state; last: events)
+N_SLOT = 4
+SLOT_EVENT = 3
+CORNER_TOL = 1e-3
+"""A table node is a corner of an element's force when the table's second difference
+there exceeds CORNER_TOL x the table's range (a rectangular stiffness wave, the edge of
+a meshing-in impact), or when the half-gap changes from cycle to cycle (node 0).  The
+largest force, and the largest load-sharing ratio, of such an element can sit exactly at
+a corner: sampled at the steps only it converges like h, sampled at the corners as well
+like h^2 (the sampling error at a smooth corner below the tolerance is at most about
+CORNER_TOL x the table's range)."""
+# indices of Work.addr
+A_Y, A_F, A_D, A_K, A_G, A_E, A_ED, A_P, A_PAR = range(9)
+
+
+def _check(s: Structure) -> None:
+    n_el = s.n_elements
+    if np.any(np.diff(s.gap_ptr) < 1):
+        bad = [s.element_names[e] for e in np.flatnonzero(np.diff(s.gap_ptr) < 1)]
+        raise SolverError(f"elements {bad} have no half-gap value; give gaps=0.0 for no "
+                          "dead zone when building the structure.")
+    if np.any(s.frequency < 0) or not np.all(np.isfinite(s.frequency)):
+        raise SolverError("excitation frequencies must be finite and >= 0 Hz; check the "
+                          "mesh frequencies of the structure.")
+    nnz = len(s.v_dof)
+    if (len(s.v_ptr) != n_el + 1 or s.v_ptr[0] != 0 or s.v_ptr[-1] != nnz
+            or np.any(np.diff(s.v_ptr) < 0) or len(s.v_coef) != nnz
+            or (nnz and (np.min(s.v_dof) < 0 or np.max(s.v_dof) >= s.n_dof))):
+        raise SolverError("the projection arrays (v_ptr, v_dof, v_coef) of the structure are "
+                          "inconsistent; rebuild it with build_structure.")
+    if (len(s.error_ptr) != n_el + 1 or s.error_ptr[-1] != len(s.error_amplitude)
+            or len(s.gap_ptr) != n_el + 1 or s.gap_ptr[-1] != len(s.gap_values)
+            or s.stiffness_table.shape != s.force_table.shape
+            or s.stiffness_table.shape[0] != n_el):
+        raise SolverError("the excitation arrays of the structure are inconsistent; "
+                          "rebuild it with build_structure.")
+    if s.n_table < 1:
+        raise SolverError("stiffness tables are empty; build the structure with n_table >= 1.")
+    n_fm, n_fe = len(s.fr_el), len(s.fr_dof)
+    if (len(s.fr_ptr) != n_fm + 1 or s.fr_ptr[0] != 0 or s.fr_ptr[-1] != n_fe
+            or np.any(np.diff(s.fr_ptr) < 0) or len(s.fr_coef) != n_fe
+            or len(s.fr_row) != n_fe or s.friction_table.shape[0] != 3 * n_fm
+            or (n_fm and s.friction_table.shape[1] < 1)
+            or (n_fm and (np.min(s.fr_el) < 0 or np.max(s.fr_el) >= n_el))
+            or (n_fe and (np.min(s.fr_dof) < 0 or np.max(s.fr_dof) >= s.n_dof
+                          or np.min(s.fr_row) < 0 or np.max(s.fr_row) >= 3 * n_fm))):
+        raise SolverError("the tooth-friction arrays (fr_*, friction_table) of the structure "
+                          "are inconsistent; rebuild it with build_structure.")
+    n_sp = s.sp_el.shape[0] if s.sp_el.ndim == 2 else -1
+    if (s.sp_el.ndim != 2 or s.sp_el.shape[1] != 2 or s.sp_par.shape != (n_sp, 6)
+            or (n_sp and (np.min(s.sp_el) < 0 or np.max(s.sp_el) >= n_el))
+            or (n_sp and not np.all(s.sp_par[:, 5] > 0))):
+        raise SolverError("the spline arrays (sp_el, sp_par) of the structure are "
+                          "inconsistent; rebuild it with build_structure.")
+    n_gy = len(s.gy_idx)
+    gy_ptr = _gy_ptr(s)
+    if (len(gy_ptr) != s.n_dof + 1 or gy_ptr[0] != 0 or gy_ptr[-1] != n_gy
+            or np.any(np.diff(gy_ptr) < 0) or len(s.gy_coef) != n_gy
+            or (n_gy and (np.min(s.gy_idx) < 0 or np.max(s.gy_idx) >= s.n_dof))):
+        raise SolverError("the gyroscopic arrays (gy_ptr, gy_idx, gy_coef) of the structure "
+                          "are inconsistent; rebuild it with build_structure.")
+
+
+def _gy_ptr(s: Structure) -> np.ndarray:
+    """Row pointer of the gyroscopic matrix (an empty one means no entries)."""
+    return s.gy_ptr if len(s.gy_ptr) else np.zeros(s.n_dof + 1, dtype=np.int64)
+
+
+def kernel_model(structure: Structure) -> KernelModel:
+    """The structure's arrays in kernel form (contiguous, writable copies, derived index
+    arrays included); raises :class:`~torquesplit.errors.SolverError` if inconsistent."""
+    s = structure
+    _check(s)
+    n_el = s.n_elements
+
+    def f8(a):
+        return np.array(a, dtype=np.float64, order="C", copy=True)
+
+    def i8(a):
+        return np.array(a, dtype=np.int64, order="C", copy=True)
+
+    def u8(a):
+        return np.array(a, dtype=np.uint64, order="C", copy=True)
+
+    varying = s.frequency > 0.0
+    sin_el = np.repeat(np.arange(n_el, dtype=np.int64), np.diff(s.error_ptr))
+    err_el = np.unique(sin_el)
+    # V by DOF (CSR of V^T) for gathering the generalized forces
+    owner = np.repeat(np.arange(n_el, dtype=np.int64), np.diff(s.v_ptr))
+    order = np.lexsort((owner, s.v_dof))
+    vt_ptr = np.zeros(s.n_dof + 1, dtype=np.int64)
+    np.add.at(vt_ptr, np.asarray(s.v_dof, dtype=np.int64) + 1, 1)
+    # spline component elements: zero stiffness and damping in the element loop (their
+    # force there is 0); the kernels' rhs_extra applies the radial law
+    ktab, damp = f8(s.stiffness_table), f8(s.damping)
+    comps = np.asarray(s.sp_el, dtype=np.int64).ravel()
+    ktab[comps] = 0.0
+    damp[comps] = 0.0
+    n_fm = len(s.fr_el)
+    n_sp = s.sp_el.shape[0]
+    return KernelModel(
+        inv_mass=f8(s.inv_mass), external_force=f8(s.external_force),
+        ground_damping=f8(s.ground_damping), element_kind=i8(s.element_kind),
+        v_ptr=i8(s.v_ptr), v_dof=i8(s.v_dof), v_coef=f8(s.v_coef), stiffness_table=ktab,
+        frequency=f8(s.frequency), phase=f8(s.phase), damping=damp, gap_ptr=i8(s.gap_ptr),
+        gap_values=f8(s.gap_values), error_constant=f8(s.error_constant),
+        error_ptr=i8(s.error_ptr), error_amplitude=f8(s.error_amplitude),
+        error_omega=f8(s.error_omega), error_phase=f8(s.error_phase),
+        force_table=f8(s.force_table), tv_el=i8(np.flatnonzero(varying)), err_el=i8(err_el),
+        sin_el=i8(sin_el), vr_ptr=u8(s.v_ptr), vq_idx=u8(s.v_dof),
+        vv_idx=u8(np.asarray(s.v_dof) + s.n_dof), vt_ptr=u8(np.cumsum(vt_ptr)),
+        vt_el=u8(owner[order]), vt_coef=f8(np.asarray(s.v_coef)[order]),
+        fr_el=i8(s.fr_el), fr_ptr=i8(s.fr_ptr), fr_dof=i8(s.fr_dof), fr_coef=f8(s.fr_coef),
+        fr_row=i8(s.fr_row),
+        friction_table=(f8(s.friction_table).reshape(3 * n_fm, -1) if n_fm
+                        else np.zeros((0, 1))),
+        sp_el=i8(s.sp_el).reshape(n_sp, 2), sp_par=f8(s.sp_par).reshape(n_sp, 6),
+        gy_ptr=u8(_gy_ptr(s)), gy_idx=u8(np.asarray(s.gy_idx) + s.n_dof),
+        gy_coef=f8(s.gy_coef), **_corners(s),
+    )
+
+
+def corner_nodes(table: np.ndarray, tolerance: float = CORNER_TOL) -> np.ndarray:
+    """Nodes of a periodic table (one period) where its second difference exceeds
+    ``tolerance`` x its range: the corners of its piecewise-linear interpolant."""
+    t = np.asarray(table, dtype=float)
+    span = float(t.max() - t.min()) if t.size else 0.0
+    if t.size < 3 or not span > 0:
+        return np.zeros(0, dtype=np.int64)
+    second = np.roll(t, -1) - 2.0 * t + np.roll(t, 1)
+    return np.flatnonzero(np.abs(second) > tolerance * span).astype(np.int64)
+
+
+def _corners(s: Structure) -> dict:
+    """CSR of the corner nodes of each time-varying element (see CORNER_TOL)."""
+    ptr = np.zeros(s.n_elements + 1, dtype=np.int64)
+    nodes: list[np.ndarray] = []
+    comps = set(np.asarray(s.sp_el, dtype=np.int64).ravel().tolist())
+    for e in range(s.n_elements):
+        if not s.frequency[e] > 0 or e in comps:
+            c = np.zeros(0, dtype=np.int64)
+        else:
+            c = np.union1d(corner_nodes(s.stiffness_table[e]), corner_nodes(s.force_table[e]))
+            gaps = s.gap_values[s.gap_ptr[e]:s.gap_ptr[e + 1]]
+            if np.ptp(gaps) > 0:  # the half-gap jumps at the start of a cycle
+                c = np.union1d(c, [0])
+        nodes.append(c.astype(np.int64))
+        ptr[e + 1] = ptr[e] + c.size
+    return dict(corner_ptr=ptr, corner_node=(np.concatenate(nodes) if nodes
+                                             else np.zeros(0, dtype=np.int64)))
+
+
+def make_work(m: KernelModel, rhs_parameters: np.ndarray | None = None) -> Work:
+    """Scratch for one run of model ``m``, with the time-invariant excitation values in
+    every slot (stiffness and force table column 0, first half-gap, constant error) and
+    the data addresses of the generated right-hand side's parameters ``rhs_parameters``
+    (kept alive by the returned bundle)."""
+    n = m.inv_mass.shape[0]
+    ne = m.damping.shape[0]
+    n_sin = m.error_omega.shape[0]
+    par = (np.zeros(0) if rhs_parameters is None
+           else np.ascontiguousarray(rhs_parameters, dtype=np.float64))
+
+    def slots(values, dtype=np.float64):
+        return np.ascontiguousarray(np.broadcast_to(np.asarray(values, dtype=dtype),
+                                                    (N_SLOT, ne)))
+
+    first_gap = m.gap_values[m.gap_ptr[:-1]] if ne else np.zeros(0)
+    has_force = np.any(m.force_table != 0.0, axis=1)
+    gapped = np.array([np.any(m.gap_values[m.gap_ptr[e]:m.gap_ptr[e + 1]] > 0.0)
+                       for e in range(ne)], dtype=bool)
+    watch = np.flatnonzero(gapped | (m.element_kind == 1)).astype(np.int64)
+    w = Work(
+        Y=np.zeros((N_ROWS, 2 * n)), F=np.zeros((2, ne)), D=np.zeros((2, ne)),
+        K=slots(m.stiffness_table[:, 0] if ne else 0.0),
+        P=slots(m.force_table[:, 0] if ne else 0.0), G=slots(first_gap),
+        E=slots(m.error_constant), ED=slots(0.0), CY=slots(0, np.int64),
+        S=np.zeros((N_SLOT, n_sin)), C=np.zeros((N_SLOT, n_sin)),
+        FR=np.zeros((N_SLOT, m.friction_table.shape[0])),
+        gap_cyc=np.full(ne, -(2**62), dtype=np.int64), gap_val=np.zeros(ne),
+        has_force=has_force, watch_el=watch, rot=np.zeros((2, n_sin)),
+        addr=np.zeros(9, dtype=np.uint64), par=par, next_node=np.zeros(ne, dtype=np.int64),
+    )
+    for i, arr in ((A_Y, w.Y), (A_F, w.F), (A_D, w.D), (A_K, w.K), (A_G, w.G), (A_E, w.E),
+                   (A_ED, w.ED), (A_P, w.P), (A_PAR, par)):
+        w.addr[i] = arr.ctypes.data
+    return w
+
+
+def make_record(track_el, track_base, n_cycles_cap: int, groups, n_el: int, hist_el,
+                hist_dof, n_hist: int, n_full: int, n_dof: int) -> Record:
+    """Output arrays of a run.  ``groups``: lists of tracked columns, one per
+    load-sharing group (the ratio statistics)."""
+    n_tr = len(track_el)
+    cap = int(n_cycles_cap)
+    grp_ptr = np.zeros(len(groups) + 1, dtype=np.int64)
+    grp_ptr[1:] = np.cumsum([len(g) for g in groups])
+    grp_col = np.array([c for g in groups for c in g], dtype=np.int64)
+    n_he, n_hd = len(hist_el), len(hist_dof)
+    return Record(
+        track_el=np.asarray(track_el, dtype=np.int64),
+        track_base=np.asarray(track_base, dtype=np.int64),
+        cyc_max=np.full((cap, n_tr), -np.inf), cyc_min=np.full((cap, n_tr), np.inf),
+        cyc_sum=np.zeros((cap, n_tr)), cyc_cnt=np.zeros((cap, n_tr), dtype=np.int64),
+        grp_ptr=grp_ptr, grp_col=grp_col,
+        rat_max=np.full((cap, n_tr), -np.inf), rat_min=np.full((cap, n_tr), np.inf),
+        sep_count=np.zeros(n_el, dtype=np.int64), back_count=np.zeros(n_el, dtype=np.int64),
+        sep_time=np.zeros(n_el), back_time=np.zeros(n_el),
+        hist_el=np.asarray(hist_el, dtype=np.int64),
+        hist_dof=np.asarray(hist_dof, dtype=np.int64),
+        hist_t=np.zeros(n_hist), hist_f=np.zeros((n_hist, n_he)),
+        hist_q=np.zeros((n_hist, n_hd)), hist_v=np.zeros((n_hist, n_hd)),
+        full_t=np.zeros(n_full), full_y=np.zeros((n_full, 2 * n_dof)),
+    )
+
+
+def record_bytes(n_cycles_cap: int, n_tracked: int, n_hist: int, n_hist_el: int,
+                 n_hist_dof: int, n_full: int, n_dof: int) -> int:
+    """Bytes of the output arrays :func:`make_record` would allocate."""
+    return 8 * (n_hist * (1 + n_hist_el + 2 * n_hist_dof) + n_full * (1 + 2 * n_dof)
+                + 6 * n_cycles_cap * n_tracked)

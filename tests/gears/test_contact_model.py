@@ -1,0 +1,227 @@
+"""LTCA in the model file: modifications and options, bad input, assembly, cache, CLI."""
+
+from __future__ import annotations
+
+import json
+import re
+import tomllib
+import warnings
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+import torquesplit
+from torquesplit.assembly.assemble import assemble
+from torquesplit.cli import app
+from torquesplit.errors import ModelWarning
+from torquesplit.gears.contact import coupling
+from torquesplit.model.kinematics import solve_kinematics
+from torquesplit.solve.static import quasi_static
+
+SPUR = """\
+[model]
+name = "relieved spur pair"
+
+[gears.pinion]
+teeth = 25
+module = "3 mm"
+face_width = "30 mm"
+position = ["0 mm", "0 mm", "0 mm"]
+[gears.pinion.modifications]
+tip_relief = {amount = "15 um", length = "5 mm"}
+crowning = "5 um"
+
+[gears.wheel]
+teeth = 50
+module = "3 mm"
+face_width = "30 mm"
+place = {from_gear = "pinion", angle = "0 deg"}
+[gears.wheel.modifications]
+tip_relief = {amount = "15 um", length = "5 mm", shape = "parabolic"}
+
+[meshes.m]
+gears = ["pinion", "wheel"]
+stiffness = {method = "ltca", slices = 6, ltca = {positions = 32}}
+damping_ratio = 0.05
+
+[drives.motor]
+body = "pinion"
+speed = "3000 rpm"
+torque = "150 N m"
+
+[loads.out]
+body = "wheel"
+"""
+
+_FIX_VERBS = re.compile(r"\b(add|give|write|remove|correct|check|make|use|set|reduce|shorten|"
+                        r"increase|change)\b")
+
+
+@pytest.fixture(autouse=True)
+def _private_cache(tmp_path, monkeypatch):
+    monkeypatch.setenv("TORQUESPLIT_CACHE_DIR", str(tmp_path / "cache"))
+    coupling.clear_memory_cache()
+    yield
+    coupling.clear_memory_cache()
+
+
+def data(text=SPUR):
+    return tomllib.loads(text)
+
+
+def load(d):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ModelWarning)
+        return torquesplit.load_model(d)
+
+
+# ---------------------------------------------------------------------------- bad input
+def _set(d, path, value):
+    node = d
+    parts = path.split(".")
+    for p in parts[:-1]:
+        node = node.setdefault(p, {})
+    node[parts[-1]] = value
+    return d
+
+
+@pytest.mark.parametrize("path, value, location", [
+    ("gears.pinion.modifications.tip_relief", {"amount": "15 um", "length": "40 mm"},
+     "gears.pinion.modifications.tip_relief.length"),
+    ("gears.pinion.modifications.tip_relief", {"amount": "-15 um", "length": "4 mm"},
+     "gears.pinion.modifications.tip_relief.amount"),
+    ("gears.pinion.modifications.root_relief", {"amount": "5 um", "height": "3.5 mm",
+                                                "length": "2 mm"},
+     "gears.pinion.modifications.root_relief"),
+    ("gears.pinion.modifications.tip_relief", {"amount": "5 um", "height": "1 mm", "exponent": 3},
+     "gears.pinion.modifications.tip_relief.exponent"),
+    ("gears.pinion.modifications.topological", {"y1": "1 um", "y2": "1 um", "y3": "1 mm",
+                                                "y4": "1 mm", "y5": "1 um", "y6": "5 mm"},
+     "gears.pinion.modifications.topological"),
+    ("gears.pinion.modifications.second_helix", {"crowning": "2 um"},
+     "gears.pinion.modifications.second_helix"),
+    ("gears.pinion.modifications.end_relief", {"amount": "5 um", "length": "20 mm"},
+     "gears.pinion.modifications.end_relief.length"),
+    ("meshes.m.stiffness", {"method": "constant", "value": "4e8 N/m", "ltca": {"positions": 16}},
+     "meshes.m.stiffness.ltca"),
+    ("meshes.m.stiffness.ltca.contact_model", "hertz", "meshes.m.stiffness.ltca.contact_model"),
+])
+def test_bad_modifications_and_options_give_one_line_errors_naming_the_field(path, value, location):
+    d = _set(data(), path, value)
+    with pytest.raises(torquesplit.ModelError) as exc:
+        load(d)
+    locs = [loc for loc, _ in exc.value.issues]
+    assert location in locs, exc.value.issues
+    for loc, msg in exc.value.issues:
+        assert "\n" not in msg and ";" in msg
+        assert _FIX_VERBS.search(msg.rsplit(";", 1)[1]), msg
+
+
+def test_modifications_on_a_bevel_gear_are_refused():
+    d = data()
+    d["gears"]["pinion"]["kind"] = "bevel"
+    with pytest.raises(torquesplit.ModelError) as exc:
+        load(d)
+    assert any(loc == "gears.pinion.modifications" and "bevel" in msg
+               for loc, msg in exc.value.issues)
+
+
+def test_unused_modifications_and_misalignment_warn():
+    d = data()
+    d["meshes"]["m"]["stiffness"] = "4e8 N/m"
+    d["meshes"]["m"]["misalignment"] = {"lead_mismatch": "5 um"}
+    with pytest.warns(ModelWarning) as rec:
+        torquesplit.load_model(d)
+    text = " ".join(str(w.message) for w in rec)
+    assert "gears.pinion.modifications" in text and "meshes.m.misalignment" in text
+
+
+# ---------------------------------------------------------------- assembly and dynamics
+def test_assembled_mesh_reproduces_the_loaded_transmission_error():
+    # Quasi-static equilibrium of the assembled structure at the LTCA positions: the
+    # approach V.q = delta + e must equal the LTCA's loaded transmission error Z (the
+    # stiffness table and the error harmonics with the mesh phase are consistent), for
+    # both excitation forms.
+    for form in ("tangent", "secant"):
+        d = data()
+        d["meshes"]["m"]["stiffness"]["ltca"]["excitation"] = form
+        m = load(d)
+        kin = solve_kinematics(m)
+        st = assemble(m, kin)
+        i = st.element_names.index("m")
+        tab = coupling.mesh_ltca(m, kin, "m", m.analysis.table_points)
+        M = tab.te.size
+        f, ph0 = st.frequency[i], st.phase[i]
+        phases = np.arange(M) / M
+        times = (phases - ph0 + 1.0) / f
+        sol = quasi_static(st, times)
+        lo, hi = st.error_ptr[i], st.error_ptr[i + 1]
+        e = st.error_constant[i] + np.array([
+            np.sum(st.error_amplitude[lo:hi] * np.sin(st.error_omega[lo:hi] * t + st.error_phase[lo:hi]))
+            for t in times])
+        approach = sol.deformations[:, i] + e
+        force = kin.meshes["m"].force
+        np.testing.assert_allclose(sol.element_forces[:, i], force, rtol=1e-6)
+        # the error series reproduces the samples to what the coupling reports (16
+        # harmonics of 32 samples: all of them here)
+        tol = tab.summary["error_series_residual_m"] + 1e-9 * tab.te.mean()
+        np.testing.assert_allclose(approach, tab.te, rtol=0, atol=tol)
+        if form == "secant":
+            assert hi == lo  # no error excitation
+
+
+def test_ltca_tables_are_cached_on_disk_by_their_inputs(tmp_path, monkeypatch):
+    m = load(data())
+    kin = solve_kinematics(m)
+    first = coupling.mesh_ltca(m, kin, "m", 64)
+    files = list((tmp_path / "cache" / "ltca").glob("*.npz"))
+    assert len(files) == 1
+    coupling.clear_memory_cache()
+
+    def boom(*a, **k):
+        raise AssertionError("recomputed instead of read from the cache")
+
+    monkeypatch.setattr(coupling.ContactModel, "solve", boom)
+    again = coupling.mesh_ltca(m, kin, "m", 64)
+    np.testing.assert_array_equal(first.stiffness, again.stiffness)
+    assert again.summary["te_peak_to_peak_m"] == first.summary["te_peak_to_peak_m"]
+    monkeypatch.undo()
+    monkeypatch.setenv("TORQUESPLIT_CACHE_DIR", str(tmp_path / "cache"))
+    d = data()
+    d["gears"]["pinion"]["modifications"]["tip_relief"]["amount"] = "16 um"
+    other = coupling.mesh_ltca(load(d), kin, "m", 64)
+    assert len(list((tmp_path / "cache" / "ltca").glob("*.npz"))) == 2
+    assert not np.array_equal(other.stiffness, first.stiffness)
+
+
+# --------------------------------------------------------------------------------- CLI
+def test_contact_command_prints_json_and_writes_figures(tmp_path):
+    model = tmp_path / "spur.toml"
+    model.write_text(SPUR)
+    out = tmp_path / "figs"
+    r = CliRunner().invoke(app, ["contact", str(model), "--pair", "m", "--load", "4 kN",
+                                 "--load", "200 N m", "--harris", "4", "--plot", str(out), "--json"])
+    assert r.exit_code == 0, r.output
+    res = json.loads(r.output)
+    assert [row["load_N"] for row in res["loads"]] == pytest.approx(
+        [4000.0, 200.0 / (0.075 * np.cos(np.radians(20)))], rel=1e-9)
+    assert len(res["harris"]["load_N"]) == 4
+    assert {p.name for p in out.iterdir()} == {f"contact_{n}.png" for n in (
+        "te", "harris", "load_distribution", "stiffness", "pressure")}
+    bad = CliRunner().invoke(app, ["contact", str(model), "--pair", "m", "--load", "3 kg"])
+    assert bad.exit_code == 2 and "--load" in bad.output
+
+
+def test_ltca_of_a_bevel_mesh_is_refused_at_load():
+    d = data()
+    for g in ("pinion", "wheel"):
+        d["gears"][g].pop("modifications")
+        d["gears"][g]["kind"] = "bevel"
+    d["gears"]["wheel"].pop("place")
+    d["gears"]["wheel"]["position"] = ["0 mm", "0 mm", "0 mm"]
+    d["gears"]["wheel"]["axis"] = [1.0, 0.0, 0.0]
+    d["meshes"]["m"]["shaft_angle"] = "90 deg"
+    with pytest.raises(torquesplit.ModelError) as exc:
+        load(d)
+    assert ("meshes.m.stiffness.method" in [loc for loc, _ in exc.value.issues]), exc.value.issues
