@@ -34,17 +34,18 @@ def test_dynamic_names_and_values_come_from_the_metrics(run):
     met = run.metrics("cycle_peak")
     rows = {r.mesh: r for r in met.rows}
     for m in run.mesh_names:
-        assert vals[f"peak_force.{m}"] == rows[m].peak_force
-        assert vals[f"static_force.{m}"] == rows[m].static_force
-        assert vals[f"nominal_force.{m}"] == rows[m].nominal_force
-        assert vals[f"peak_to_nominal.{m}"] == met.dynamic_factors.peak[m]
-        assert vals[f"dynamic_factor.{m}"] == pytest.approx(
-            rows[m].peak_force / rows[m].static_force, rel=1e-15)
+        for name in ("peak_force", "min_force", "mean_force", "static_force",
+                     "nominal_force", "dynamic_factor", "dynamic_factor_engineering",
+                     "peak_to_nominal", "contact_loss", "back_contact"):
+            assert vals[f"{name}.{m}"] == getattr(rows[m], name), (name, m)
         lo, mean, hi = (vals[f"{k}.{m}"] for k in ("min_force", "mean_force", "peak_force"))
         assert lo <= mean * (1 + 1e-12) and mean <= hi * (1 + 1e-12) and lo < hi
+    d = met.dynamic_factors
     for g in groups:
         assert vals[f"peak_to_nominal_engineering.{g}"] == \
-            met.dynamic_factors.per_group_engineering[g]
+            d.per_group_peak_to_nominal_engineering[g]
+        assert vals[f"dynamic_factor.{g}"] == d.per_group_dynamic_factor[g]
+    assert vals["dynamic_factor"] == max(d.per_group_dynamic_factor.values())
     assert vals["settle_time"] == met.settling.start_time
     assert vals["load_sharing.cycle_peak"] > 1.01  # the 5 um error is felt
 

@@ -1,9 +1,11 @@
 """Study outputs: every metric of a run as a flat ``{name: float}`` dict.
 
-:func:`output_values` is the ONE place where the study layer reads metrics: it flattens a
-dynamic :class:`~torquesplit.results.Results` (through ``Results.metrics(definition)``)
-or a :class:`~torquesplit.quasistatic.QuasiStaticResults` (through its ``metrics()``).
-Figures, tables and the store consume these numbers; none recomputes a metric.
+:func:`output_values` is the ONE place where the study layer reads metrics: it takes a
+dynamic :class:`~torquesplit.results.Results` through ``Results.metric_values()`` (the
+core's flat names, :meth:`torquesplit.results.Metrics.values`) or a
+:class:`~torquesplit.quasistatic.QuasiStaticResults` through its ``metrics()`` and
+``mesh_forces()``.  Figures, tables and the store consume these numbers; none
+recomputes a metric.
 
 Names (``<group>`` is a load-sharing group key of
 :func:`torquesplit.metrics.load_sharing.group_meshes`, ``<mesh>`` a mesh name):
@@ -17,38 +19,30 @@ name                                        value
                                             ``engineering``, ``mean_force`` (dynamic),
                                             ``static_torque`` (quasi-static)
 ``dynamic_factor[.<group|mesh>]``           settled peak force / the mesh's own static
-                                            force (system: largest group) [provisional]
+                                            force (system: largest group)
 ``dynamic_factor_engineering.<mesh>``       mean settled cycle peak / own static force
-                                            [provisional]
-``peak_to_nominal.<group|mesh>``            settled peak / equal-split nominal force
-``peak_to_nominal_engineering.<group>``     seed 001 eq. 19 G_it: mean over settled
-                                            cycles of the group's largest peak / nominal
-``peak_to_nominal_engineering.<mesh>``      mean settled cycle peak / nominal
+``peak_to_nominal[.<group|mesh>]``          settled peak / equal-split nominal force
+``peak_to_nominal_engineering.<group>``     Ji & Li eq. 19 G_it: mean over settled cycles
+                                            of the group's largest peak / nominal force
 ``peak_force.<mesh>``, ``min_force.<mesh>``,
 ``mean_force.<mesh>``                       settled peak, trough, mean force [N]
 ``static_force.<mesh>``                     static-equilibrium force [N]
 ``nominal_force.<mesh>``                    equal-split nominal force [N]
 ``contact_loss.<mesh>``                     fraction of the run with the teeth apart
+``back_contact.<mesh>``                     fraction of the run in back-flank contact
 ``settle_time``                             start of the settled part of the run [s]
 ==========================================  ==============================================
 
 Quasi-static results give ``load_sharing.static_torque[.<group|mesh>]`` and
 ``peak_force``/``min_force``/``mean_force.<mesh>`` over the mesh positions.
-
-TODO(core): the core is introducing these names in ``Metrics`` itself.  Until then the
-entries marked [provisional] are formed here from the metric's per-mesh rows (peak and
-static force, both computed by :mod:`torquesplit.metrics`), ``min_force`` from the
-settled cycle minima of the solution, and ``dynamic_factor_engineering.<group>`` is not
-available.  When ``Metrics`` carries them, read them from there and delete the
-provisional lines (search for ``TODO(core)``).
+``dynamic_factor_engineering.<group>`` is not defined by the core (a group's engineering
+factor is ``peak_to_nominal_engineering.<group>``, Ji & Li's G_it).
 """
 
 from __future__ import annotations
 
 import fnmatch
 import math
-
-import numpy as np
 
 #: load-sharing definitions of dynamic runs, in the order they are reported
 DYNAMIC_DEFINITIONS = ("cycle_peak", "instantaneous", "engineering", "mean_force")
@@ -69,6 +63,7 @@ FAMILIES: dict[str, tuple[str, str]] = {
     "static_force": ("N", "static mesh force"),
     "nominal_force": ("N", "nominal (equal-split) mesh force"),
     "contact_loss": ("1", "fraction of time with contact lost"),
+    "back_contact": ("1", "fraction of time in back-flank contact"),
     "settle_time": ("s", "start of the settled part of the run"),
 }
 
@@ -107,44 +102,8 @@ def output_values(result, definitions=None) -> dict[str, float]:
     if unknown:
         raise ValueError(f"unknown load-sharing definition(s) {unknown} for a dynamic run; "
                          f"use {', '.join(DYNAMIC_DEFINITIONS)}")
-    out: dict[str, float] = {}
-    met = None
-    for d in defs:
-        m = result.metrics(d)
-        _put_load_sharing(out, d, m.load_sharing)
-        met = met or m
-    if met is None:
-        met = result.metrics(DYNAMIC_DEFINITIONS[0])
-    dyn = met.dynamic_factors
-    groups = met.load_sharing.groups
-    rows = {r.mesh: r for r in met.rows}
-    for g in groups:
-        out[f"peak_to_nominal.{g}"] = _f(dyn.per_group_peak[g])
-        out[f"peak_to_nominal_engineering.{g}"] = _f(dyn.per_group_engineering[g])
-    for m, r in rows.items():
-        out[f"peak_to_nominal.{m}"] = _f(dyn.peak[m])
-        out[f"peak_to_nominal_engineering.{m}"] = _f(dyn.engineering[m])
-        out[f"peak_force.{m}"] = _f(r.peak_force)
-        out[f"mean_force.{m}"] = _f(r.mean_force)
-        out[f"static_force.{m}"] = _f(r.static_force)
-        out[f"nominal_force.{m}"] = _f(r.nominal_force)
-        out[f"contact_loss.{m}"] = _f(r.contact_loss)
-        # TODO(core): provisional, from the metric's own rows until Metrics has them
-        out[f"dynamic_factor.{m}"] = _ratio(r.peak_force, r.static_force)
-        out[f"dynamic_factor_engineering.{m}"] = _ratio(
-            r.dynamic_factor_engineering * r.nominal_force, r.static_force)
-    for g, members in groups.items():
-        out[f"dynamic_factor.{g}"] = _max(out[f"dynamic_factor.{m}"] for m in members)
-    out["dynamic_factor"] = _max(out[f"dynamic_factor.{g}"] for g in groups)
-    # TODO(core): min_force from the settled cycle minima until Metrics reports it
-    s = result.solution
-    for j, m in enumerate(result.mesh_names):
-        col = list(s.tracked_elements).index(result.structure.element_names.index(m))
-        lows = s.cycle_min[met.settling.first_cycle[m]:, col]
-        lows = lows[np.isfinite(lows)]
-        out[f"min_force.{m}"] = float(lows.min()) if lows.size else math.nan
-    out["settle_time"] = _f(met.settling.start_time)
-    return out
+    # no load sharing asked for: one (cheap) definition still gives the other metrics
+    return {k: float(v) for k, v in result.metric_values(defs or ["cycle_peak"]).items()}
 
 
 def _quasi_static_values(result) -> dict[str, float]:
@@ -175,15 +134,6 @@ def _f(x) -> float:
     return float(x) if x is not None else math.nan
 
 
-def _ratio(a, b) -> float:
-    return float(a) / float(b) if b else math.nan
-
-
-def _max(values) -> float:
-    vals = [v for v in values if not math.isnan(v)]
-    return max(vals) if vals else math.nan
-
-
 # ========================================================================= catalogue
 def available_outputs(mesh_names, groups: dict[str, list[str]], analysis: str) -> list[str]:
     """Every output name a run of this model gives (``analysis``: "run" or "static").
@@ -201,13 +151,13 @@ def available_outputs(mesh_names, groups: dict[str, list[str]], analysis: str) -
         for fam in ("peak_force", "min_force", "mean_force"):
             names += [f"{fam}.{m}" for m in mesh_names]
         return names
-    names.append("dynamic_factor")
+    names += ["dynamic_factor", "peak_to_nominal"]
     names += [f"dynamic_factor.{x}" for x in (*groups, *mesh_names)]
     names += [f"dynamic_factor_engineering.{m}" for m in mesh_names]
     names += [f"peak_to_nominal.{x}" for x in (*groups, *mesh_names)]
-    names += [f"peak_to_nominal_engineering.{x}" for x in (*groups, *mesh_names)]
+    names += [f"peak_to_nominal_engineering.{g}" for g in groups]
     for fam in ("peak_force", "min_force", "mean_force", "static_force", "nominal_force",
-                "contact_loss"):
+                "contact_loss", "back_contact"):
         names += [f"{fam}.{m}" for m in mesh_names]
     names.append("settle_time")
     return names
