@@ -210,7 +210,7 @@ def output_long_name(name: str) -> str:
     stage1"."""
     parts = name.split(".")
     unit_text = FAMILIES.get(parts[0], ("1", parts[0]))[1]
-    head, member = family(name)
+    _, member = family(name)
     if parts[0] == "load_sharing" and len(parts) > 1:
         unit_text += f" ({parts[1]})"
     return unit_text + ("" if member == "system" else f", {member}")
