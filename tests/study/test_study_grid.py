@@ -118,3 +118,19 @@ def test_two_parameters_writing_one_field_refused(split_file):
     b = {"name": "all", "scale": "meshes.*.stiffness", "values": [1.0]}
     with pytest.raises(StudyError, match="grid.parameters.1: 'all' writes meshes.a1.stiffness"):
         Study(grid_study(split_file, [a, b])).plan()
+
+
+@pytest.mark.parametrize("name", torquesplit.example_names())
+def test_cases_start_from_an_exact_si_copy_of_the_model(name):
+    """Cases start from the validated model written as SI numbers (no unit parsing per
+    case): that copy must give the very same model."""
+    import warnings
+
+    from torquesplit.model.io import model_to_dict
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        model = load_model(torquesplit.example_path(name))
+        again = load_model(model_from_dict(model_to_dict(model)))
+    assert again == model
+    assert model_to_dict(again) == model_to_dict(model)
