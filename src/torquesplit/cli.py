@@ -1,14 +1,19 @@
 """The ``torquesplit`` command line: one entry point, one sub-command per job.
 
-Bad input prints one line naming the file, the field and the fix, and exits with
-status 2; ``--debug`` shows the traceback instead.
+Bad input prints one line per problem, ``error: FILE: FIELD: what is wrong; what to
+do``, and exits with status 2; ``--debug`` shows the traceback instead.  Everything that
+can be checked before a computation is: the model (``check`` runs every check ``run``
+would), the numeric options, and the output path -- its folder, suffix, an existing file
+(kept unless ``--force``) and another run writing it (see
+:mod:`torquesplit.results.files`), so that no run computes for minutes and then cannot
+save.
 """
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
-import shutil
 import sys
 import warnings
 from pathlib import Path
@@ -18,7 +23,7 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
-from .errors import ModelWarning, TorquesplitError
+from .errors import ModelWarning, OptionError, TorquesplitError, clip_message
 
 app = typer.Typer(
     add_completion=False,
@@ -37,12 +42,51 @@ def _main(debug: bool = typer.Option(False, "--debug", help="Show tracebacks on 
 
 
 def _fail(exc: BaseException) -> None:
+    """Print ``exc`` as one ``error:`` line per problem and exit with status 2."""
     if _state["debug"]:
         raise exc
     msg = str(exc).strip() or exc.__class__.__name__
-    err_console.print("[bold red]error:[/] ", end="")
-    err_console.print(msg, markup=False, highlight=False, soft_wrap=True)
+    if isinstance(exc, OSError) and not isinstance(exc, TorquesplitError):
+        where = f"{exc.filename}: " if exc.filename else ""
+        msg = f"{where}{exc.strerror or msg}; check the path and its permissions"
+    msg = clip_message(msg)
+    for line in msg.splitlines() or [msg]:
+        err_console.print("[bold red]error:[/] ", end="")
+        err_console.print(line, markup=False, highlight=False, soft_wrap=True)
     raise typer.Exit(2)
+
+
+#: what the commands catch and print as one-line errors (anything else is a bug and
+#: keeps its traceback)
+_EXPECTED = (TorquesplitError, ValueError, OSError)
+
+
+def _at_least(value, minimum, option: str, example: str) -> None:
+    """Refuse a count below ``minimum`` (``--count -1``) before any computation."""
+    if value is not None and value < minimum:
+        raise OptionError(f"{option} must be a whole number of at least {minimum}, got "
+                          f"{value}; give e.g. {option} {example}")
+
+
+def _positive(value, option: str, example: str) -> None:
+    if value is not None and not (value > 0 and math.isfinite(value)):
+        raise OptionError(f"{option} must be a positive finite number, got {value}; give "
+                          f"e.g. {option} {example}")
+
+
+def _check_plots_folder(plots: Optional[Path]) -> None:
+    """A figures folder must be a folder (or creatable), checked before computing."""
+    if plots is None:
+        return
+    if plots.exists() and not plots.is_dir():
+        raise OptionError(f"--plots {plots} is a file, not a folder; give a folder for the "
+                          f"figures")
+    parent = plots if plots.exists() else plots.parent
+    while not parent.exists() and parent != parent.parent:
+        parent = parent.parent
+    if not parent.is_dir():
+        raise OptionError(f"--plots {plots} cannot be created: {parent} is not a folder; "
+                          f"give a folder for the figures")
 
 
 def _resolve_model_path(model: str) -> Path:
@@ -57,23 +101,33 @@ def _resolve_model_path(model: str) -> Path:
     return p
 
 
-def _load(model: str, assignments: Optional[list[str]] = None):
+def _load(model: str, assignments: Optional[list[str]] = None, *, deep: bool = False):
+    """Read, validate and check a model; ``--set`` overrides are applied to the file's
+    data first, and their errors are reported against the ``--set`` argument."""
+    from .model.checks import check_model
     from .model.io import load_model, model_from_dict
 
     path = _resolve_model_path(model)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", ModelWarning)
         if assignments:
-            from .model.overrides import apply_overrides, parse_assignment, read_raw
+            from .errors import ModelError
+            from .model.overrides import apply_assignments, attribute_errors, read_raw
 
-            data = apply_overrides(read_raw(path), dict(parse_assignment(a) for a in assignments))
-            m = load_model(model_from_dict(data, source=str(path)))
+            data, where = apply_assignments(read_raw(path), assignments)
+            try:
+                m = model_from_dict(data, source=str(path))
+                check_model(m, source=str(path), deep=deep)
+            except ModelError as exc:
+                raise attribute_errors(exc, where, str(path)) from None
         else:
-            m = load_model(path)
+            m = load_model(path, check=False)
+            check_model(m, source=str(path), deep=deep)
     for w in caught:
         if issubclass(w.category, ModelWarning):
             err_console.print("[yellow]warning:[/] ", end="")
-            err_console.print(str(w.message), markup=False, highlight=False, soft_wrap=True)
+            err_console.print(clip_message(str(w.message)), markup=False, highlight=False,
+                              soft_wrap=True)
     return m, path
 
 
@@ -83,13 +137,18 @@ def check(
     model: str = typer.Argument(..., help="Model file (.toml/.json) or example name."),
     as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
 ):
-    """Validate a model and print its kinematic and static summary."""
+    """Validate a model and print its kinematic and static summary.
+
+    Runs every check ``run`` performs before it integrates (the assembly and the static
+    equilibrium included), so a model that passes is refused by ``run`` only for a
+    numerical reason.
+    """
     try:
         from .model.summary import summary
 
-        m, path = _load(model)
+        m, path = _load(model, deep=True)
         s = summary(m)
-    except TorquesplitError as exc:
+    except _EXPECTED as exc:
         _fail(exc)
         return
     if as_json:
@@ -109,42 +168,70 @@ def run(
     method: Optional[str] = typer.Option(None, "--method", help="rk4 (fixed step) or dopri."),
     steps_per_period: Optional[int] = typer.Option(
         None, "--steps-per-period", help="RK4 steps per shortest mesh period (default 100)."),
+    max_steps: Optional[int] = typer.Option(
+        None, "--max-steps", help="Refuse an RK4 run needing more steps (default 2e8)."),
     definition: Optional[str] = typer.Option(
         None, "--definition",
         help="Load-sharing definition: cycle_peak, instantaneous, engineering, mean_force "
              "(static_torque: use `torquesplit static`)."),
     out: Optional[Path] = typer.Option(
         None, "--out", help="Write results: .nc (NetCDF), .mat (MATLAB) or .csv (spreadsheet)."),
+    force: bool = typer.Option(False, "--force", help="Replace existing results files."),
     plots: Optional[Path] = typer.Option(None, "--plots", help="Write report figures (PNG, SVG) here."),
     assign: Optional[list[str]] = typer.Option(
         None, "--set", help="Override a model field: PATH=VALUE, e.g. shafts.s1.diameter='250 mm'."),
     as_json: bool = typer.Option(False, "--json", help="Print metrics and statistics as JSON."),
     quiet: bool = typer.Option(False, "--quiet", help="No progress bar."),
 ):
-    """Static equilibrium, then the dynamic response: load sharing and dynamic factors."""
+    """Static equilibrium, then the dynamic response: load sharing and dynamic factors.
+
+    The options and the output path are checked before anything is computed; the
+    output is claimed for this run at once (a second run on the same path is refused)
+    and written atomically at the end.
+    """
     from .model.units import parse_quantity
+    from .results import files
 
-    try:
-        if method is not None and method not in ("rk4", "dopri"):
-            raise TorquesplitError(f"--method {method!r} is unknown; use rk4 or dopri")
-        dur = parse_quantity(duration, "time") if duration is not None else None
-        m, path = _load(model, assign)
-        from .simulation import simulate
+    with contextlib.ExitStack() as stack:
+        try:
+            if method is not None and method not in ("rk4", "dopri"):
+                raise OptionError(f"--method {method!r} is unknown; use rk4 or dopri")
+            dur = None
+            if duration is not None:
+                try:
+                    dur = parse_quantity(duration, "time")
+                except ValueError as exc:
+                    raise OptionError(f"--duration: {exc}") from None
+                _positive(dur, "--duration", "'0.5 s'")
+            _at_least(cycles, 1, "--cycles", "200")
+            _at_least(steps_per_period, 10, "--steps-per-period", "100")
+            _at_least(max_steps, 1, "--max-steps", "200000000")
+            _check_definition(definition)
+            _check_plots_folder(plots)
+            if out is not None:
+                plan = files.check_output(out, overwrite=force)
+                stack.enter_context(files.claim_output(plan))
+            m, path = _load(model, assign)
+            from .simulation import simulate
 
-        res = _with_progress(lambda cb: simulate(
-            m, duration=dur, cycles=cycles, method=method,
-            steps_per_period=steps_per_period, progress=cb), quiet or as_json)
-    except (TorquesplitError, ValueError) as exc:
-        _fail(exc)
-        return
-    saved = None
-    try:
-        if out is not None:
-            saved = res.save(out)
-        met = res.metrics(definition)
-    except ValueError as exc:
-        _fail(exc)
-        return
+            res = _with_progress(lambda cb: simulate(
+                m, duration=dur, cycles=cycles, method=method,
+                steps_per_period=steps_per_period, max_steps=max_steps, progress=cb),
+                quiet or as_json)
+        except _EXPECTED as exc:
+            _fail(exc)
+            return
+        saved = None
+        try:
+            if out is not None:
+                saved = res.save(out, overwrite=force)
+            met = res.metrics(definition) if res.success else None
+        except _EXPECTED as exc:
+            _fail(exc)
+            return
+    if met is None:
+        _render_stopped(res, saved, as_json)
+        raise typer.Exit(1)
     figures = []
     if plots is not None:
         figures = res.write_figures(plots, definition=met.definition)
@@ -158,8 +245,72 @@ def run(
         _render_run(res, met, saved)
         if figures:
             console.print(f"{len(figures)} figure files written to {plots}")
-    if not res.success:
-        raise typer.Exit(1)
+
+
+def _check_definition(definition: Optional[str]) -> None:
+    if definition is None:
+        return
+    from .metrics.load_sharing import DYNAMIC_DEFINITIONS
+
+    if definition in ("static", "static_torque"):
+        raise OptionError("--definition static_torque is the load sharing of quasi-static "
+                          "equilibria (Mo et al. 2017); run `torquesplit static MODEL` for it")
+    if definition not in DYNAMIC_DEFINITIONS:
+        raise OptionError(f"--definition {definition!r} is unknown; use one of "
+                          f"{', '.join(DYNAMIC_DEFINITIONS)}")
+
+
+def _likely_cause(res) -> Optional[str]:
+    """Why a run that stopped early most likely stopped, from its static equilibrium.
+
+    A static deflection of a tenth of the integrator's limit (``blowup``, 1000 m or rad)
+    means a stiffness far too small for the load (often a unit): the vibration about it
+    crosses the limit, and the integrator's advice (a smaller step) does not help.
+    """
+    import numpy as np
+
+    from .model.checks import integrator_blowup
+
+    q = np.asarray(res.static.q, dtype=float)
+    names = list(res.structure.dof_names)
+    if q.size == 0:
+        return None
+    if not np.all(np.isfinite(q)):
+        return ("the static equilibrium is not finite: a stiffness or an inertia of extreme "
+                "size (see the warnings of 'torquesplit check'); check the values and units")
+    j = int(np.argmax(np.abs(q)))
+    if abs(q[j]) >= 0.1 * integrator_blowup():
+        unit = "rad" if names[j].endswith(".theta") else "m"
+        return (f"the static deflection of '{names[j]}' is {abs(q[j]):.3g} {unit}: a "
+                f"stiffness is far too small for the load; check the stiffness values and "
+                f"their units (shafts, supports, meshes), not the step")
+    return None
+
+
+def _render_stopped(res, saved, as_json: bool) -> None:
+    """A run that did not finish: its status and the likely cause, never coefficients of
+    a partial run (they would read as results)."""
+    cause = _likely_cause(res)
+    st = res.statistics()
+    if as_json:
+        print(json.dumps({"model": res.model.model.name, "success": False,
+                          "status": st["status"], "message": res.message,
+                          "likely_cause": cause, "metrics": None, "statistics": st,
+                          "results_file": str(saved) if saved else None, "figures": []},
+                         indent=2, default=_json_default))
+        return
+    console.print(f"[bold]{res.model.model.name}[/]: [bold red]stopped[/]: {res.message}",
+                  highlight=False)
+    requested = res.solution.t_span[1] - res.solution.t_span[0]
+    console.print(f"{st['steps']} steps ({st['method']}); simulated "
+                  f"{st['simulated_time_s']:.4g} s of {requested:.4g} s", highlight=False)
+    if cause:
+        console.print(f"likely cause: {cause}", highlight=False)
+    console.print("no load-sharing or dynamic-factor table: the run did not finish, and "
+                  "coefficients of a partial run are not results"
+                  + (f"; the partial results (with their status) are in {saved}" if saved
+                     else "; save the partial results with --out to inspect them"),
+                  highlight=False)
 
 
 def _json_default(x):
@@ -240,22 +391,32 @@ def static(
     revolutions: float = typer.Option(1.0, "--revolutions", help="Revolutions of the slowest gear."),
     points_per_cycle: int = typer.Option(8, "--points-per-cycle", help="Positions per mesh cycle."),
     out: Optional[Path] = typer.Option(None, "--out", help="Write results to this NetCDF file."),
+    force: bool = typer.Option(False, "--force", help="Replace an existing results file."),
     plots: Optional[Path] = typer.Option(None, "--plots", help="Write report figures (PNG, SVG) here."),
     as_json: bool = typer.Option(False, "--json", help="Print the results as JSON."),
 ):
     """Quasi-static load sharing: equilibrium at each mesh position (seed 004)."""
-    try:
-        m, _ = _load(model)
-        from .quasistatic import quasi_static_load_sharing
+    from .results import files
 
-        res = quasi_static_load_sharing(m, revolutions=revolutions,
-                                        points_per_cycle=points_per_cycle)
-    except (TorquesplitError, ValueError) as exc:
-        _fail(exc)
-        return
+    with contextlib.ExitStack() as stack:
+        try:
+            _positive(revolutions, "--revolutions", "1")
+            _at_least(points_per_cycle, 1, "--points-per-cycle", "8")
+            _check_plots_folder(plots)
+            if out is not None:
+                plan = files.check_output(out, formats=files.NETCDF_FORMATS, overwrite=force)
+                stack.enter_context(files.claim_output(plan))
+            m, _ = _load(model)
+            from .quasistatic import quasi_static_load_sharing
+
+            res = quasi_static_load_sharing(m, revolutions=revolutions,
+                                            points_per_cycle=points_per_cycle)
+            saved = res.to_netcdf(out, overwrite=force) if out is not None else None
+        except _EXPECTED as exc:
+            _fail(exc)
+            return
     met = res.metrics()
     orbits = res.orbits()
-    saved = res.to_netcdf(out) if out is not None else None
     if plots is not None:
         from .plot import write_static_figures
 
@@ -312,9 +473,14 @@ def mesh(
 ):
     """Mesh stiffness k(phase) of one mesh by every applicable method, with the ISO value."""
     try:
+        _at_least(points, 16, "--points", "256")
+        if plot is not None and not plot.parent.is_dir():
+            raise OptionError(f"--plot {plot}: the folder {plot.parent} does not exist; create "
+                              f"it first or choose another folder")
         m, _ = _load(model)
         if pair not in m.meshes:
-            raise TorquesplitError(f"no mesh named {pair!r}; meshes are {', '.join(m.meshes)}")
+            raise OptionError(f"--pair: no mesh named {pair!r}; use one of "
+                              f"{', '.join(m.meshes)}")
         from .assembly.excitation import stiffness_table
         from .gears.stiffness import compare_methods
         from .gears.stiffness.result import MeshStiffness
@@ -323,14 +489,15 @@ def mesh(
         kin = solve_kinematics(m)
         mk = kin.meshes[pair]
         if mk.geometry is None:
-            raise TorquesplitError(f"mesh {pair!r} is a bevel/face mesh; only its model-file "
-                                   f"stiffness applies (no involute stiffness methods)")
+            raise OptionError(f"mesh {pair!r} is a bevel/face mesh: only its model-file "
+                              f"stiffness applies (no involute stiffness methods); choose a "
+                              f"cylindrical mesh")
         model_k = MeshStiffness.from_samples(stiffness_table(m, kin, pair, points),
                                              method=f"model file ({m.meshes[pair].stiffness.method})")
         g = m.gears[mk.driver]
         cmp = compare_methods(mk.geometry, points, young_modulus=g.youngs_modulus,
                               poisson_ratio=g.poisson_ratio, extra={"model file": model_k})
-    except (TorquesplitError, ValueError) as exc:
+    except _EXPECTED as exc:
         _fail(exc)
         return
     if plot is not None:
@@ -551,10 +718,22 @@ def modes(
     model: str = typer.Argument(..., help="Model file (.toml/.json) or example name."),
     count: int = typer.Option(20, "--count", help="Number of modes to list."),
     as_json: bool = typer.Option(False, "--json", help="Print the modes as JSON."),
+    campbell: bool = typer.Option(False, "--campbell", help="Resonance map over --from..--to."),
+    start: Optional[str] = typer.Option(None, "--from", help="Campbell: first speed, e.g. '500 rpm'."),
+    stop: Optional[str] = typer.Option(None, "--to", help="Campbell: last speed."),
+    plot: Optional[Path] = typer.Option(None, "--plot", help="Campbell: write the diagram."),
 ):
     """Natural frequencies about the static equilibrium, with the dominant elements."""
     try:
+        _at_least(count, 1, "--count", "20")
         m, _ = _load(model)
+        if campbell:
+            if start is None or stop is None:
+                raise TorquesplitError("--campbell needs a speed range: add --from '500 rpm' "
+                                       "--to '3000 rpm'")
+            from .steady.cli import campbell_command
+
+            return campbell_command(m, start, stop, plot, as_json, console, _json_default)
         from .assembly.assemble import assemble
         from .model.kinematics import solve_kinematics
         from .solve.modal import modal_analysis
@@ -563,7 +742,7 @@ def modes(
         kin = solve_kinematics(m)
         st = assemble(m, kin)
         sol = modal_analysis(st, static_equilibrium(st).q)
-    except (TorquesplitError, ValueError) as exc:
+    except _EXPECTED as exc:
         _fail(exc)
         return
     mesh_f = {n: mk.frequency for n, mk in kin.meshes.items()}
@@ -606,21 +785,33 @@ def example(
     directory: Path = typer.Option(Path("."), "--dir", help="Folder to write the file to."),
     force: bool = typer.Option(False, "--force", help="Overwrite an existing file."),
 ):
-    """Write an example model file to the current folder."""
-    from .examples import example_path
+    """Write an example model file to the current folder (or --dir)."""
+    from .examples import example_names, example_path
+    from .results import files
 
     try:
+        if name.removesuffix(".toml") not in example_names():
+            raise OptionError(f"no example named {name!r}; run 'torquesplit examples' to list "
+                              f"them ({', '.join(example_names())})")
         src = example_path(name)
-    except FileNotFoundError as exc:
-        _fail(TorquesplitError(f"{exc}; run 'torquesplit examples' to list them"))
+        if directory.exists() and not directory.is_dir():
+            raise OptionError(f"--dir {directory} is a file, not a folder; give a folder")
+        try:
+            directory.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise OptionError(f"--dir {directory} cannot be created ({exc.strerror}); give a "
+                              f"folder you can write to") from None
+        dst = files.write_atomically(directory / src.name, src.read_bytes(), overwrite=force,
+                                     formats={".toml": "toml"}, what="the example")
+    except _EXPECTED as exc:
+        _fail(exc)
         return
-    dst = directory / src.name
-    if dst.exists() and not force:
-        _fail(TorquesplitError(f"{dst} exists; use --force to overwrite it"))
-    directory.mkdir(parents=True, exist_ok=True)
-    shutil.copyfile(src, dst)
     console.print(f"wrote {dst}")
 
+
+from .steady.cli import register as _register_steady  # noqa: E402
+
+_register_steady(app, lambda model: _load(model), _fail, console, err_console, _json_default)
 
 # --------------------------------------------------------------------------- studies
 from .study.cli import study as _study, sweep as _sweep  # noqa: E402  (typer signatures only)

@@ -1,11 +1,60 @@
 """Exceptions of torquesplit.
 
 One base class; each subclass also derives from the matching built-in so that
-``except ValueError`` keeps working.  Every message ends with what to do.
-The CLI prints the message on one line and exits with status 2.
+``except ValueError`` (or ``except OSError`` for files) keeps working.  Every message
+ends with what to do.  The CLI prints each line of the message as ``error: ...`` and
+exits with status 2; ``--debug`` shows the traceback instead.
+
+Messages quote values from the user's files, which can be anything: they quote at most
+:data:`QUOTE_LIMIT` characters of a value, and :func:`clip_message` cuts whatever long
+text still reaches a message, so that an error never echoes a 100 KB string whole.
 """
 
 from __future__ import annotations
+
+import re
+
+#: longest quoted value (in characters) a message repeats from the input
+QUOTE_LIMIT = 80
+
+#: longest message line; longer lines keep their start and their end (the fix)
+LINE_LIMIT = 1000
+
+_LONG_WORD = re.compile(r"\S{%d,}" % (2 * QUOTE_LIMIT + 1))
+
+
+def clip_text(text: str, limit: int = QUOTE_LIMIT) -> str:
+    """``text`` shortened to ``limit`` characters, the cut marked with ``...``.
+
+    Examples
+    --------
+    >>> clip_text("x" * 100, 10)
+    'xxxxxxx...'
+    """
+    return text if len(text) <= limit else text[: max(limit - 3, 0)] + "..."
+
+
+def clip_message(message: str) -> str:
+    """A message with every unbroken run of text over twice :data:`QUOTE_LIMIT`
+    characters cut to that limit (its length noted), and each line at most
+    :data:`LINE_LIMIT` characters long (its end, which says what to do, is kept).
+
+    The code that quotes a value shortens it first (``units._short``); this is the
+    safety net for values that reach a message some other way (a 100 KB name).
+
+    Examples
+    --------
+    >>> clip_message("cannot read " + "1" * 10_000 + " as a length; write a number")[-60:]
+    '1111111111... (10000 characters) as a length; write a number'
+    """
+    lines = []
+    for line in message.split("\n"):
+        line = _LONG_WORD.sub(lambda m: clip_text(m.group(), QUOTE_LIMIT)
+                              + f" ({len(m.group())} characters)", line)
+        if len(line) > LINE_LIMIT:
+            line = line[: LINE_LIMIT // 2] + " ... " + line[-(LINE_LIMIT // 2 - 5):]
+        lines.append(line)
+    return "\n".join(lines)
 
 
 class TorquesplitError(Exception):
@@ -16,20 +65,43 @@ class ModelError(TorquesplitError, ValueError):
     """A model file or model object is invalid.
 
     ``issues`` holds one entry per problem: ``(location, message)``, where location
-    is the field path in the file (``meshes.m1.backlash``).
+    is the field path in the file (``meshes.m1.backlash``).  ``source`` names where the
+    model came from: the file, or a ``--set`` argument.  Quoted values are shortened
+    (:func:`clip_message`).
     """
 
     def __init__(self, issues, source: str | None = None):
         if isinstance(issues, str):
             issues = [("", issues)]
-        self.issues = list(issues)
+        self.issues = [(clip_text(str(loc), 2 * QUOTE_LIMIT), clip_message(str(msg)))
+                       for loc, msg in issues]
         self.source = source
         lines = []
         for loc, msg in self.issues:
-            where = f"{source}: " if source else ""
+            where = f"{clip_text(source, 2 * QUOTE_LIMIT)}: " if source else ""
             where += f"{loc}: " if loc else ""
             lines.append(where + msg)
         super().__init__("\n".join(lines))
+
+
+class OptionError(TorquesplitError, ValueError):
+    """A command-line option or function argument out of its range (``--count -1``)."""
+
+
+class OutputError(TorquesplitError, OSError):
+    """Results cannot be written where asked: no such folder, a folder, a file that
+    exists (and overwriting was not asked for), another run writing it, a full disk."""
+
+    def __str__(self) -> str:  # OSError would print "[Errno ...]" for two arguments
+        return str(self.args[0]) if self.args else ""
+
+
+class OutputFormatError(OutputError, ValueError):
+    """The output file's suffix names no format torquesplit writes (``.xlsx``)."""
+
+
+class OutputBusyError(OutputError):
+    """Another run holds the output path: exactly one of two writers may write it."""
 
 
 class SolverError(TorquesplitError, RuntimeError):

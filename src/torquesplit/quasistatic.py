@@ -87,12 +87,17 @@ class QuasiStaticResults:
         )
         return ds
 
-    def to_netcdf(self, path):
-        from pathlib import Path
+    def to_netcdf(self, path, *, overwrite: bool = False):
+        """Save as NetCDF, atomically, keeping an existing file unless ``overwrite``; the
+        attributes say which run wrote it (see :mod:`torquesplit.results.files`)."""
+        from .results import files
 
-        path = Path(path)
-        self.to_dataset().to_netcdf(path, engine="h5netcdf")
-        return path
+        plan = files.check_output(path, formats=files.NETCDF_FORMATS, overwrite=overwrite)
+        with files.claim_output(plan) as claim:
+            ds = self.to_dataset()
+            ds.attrs.update(files.provenance(claim.run_id))
+            claim.write({plan.path: files.netcdf_bytes(ds)})
+        return plan.path
 
 
 def quasi_static_load_sharing(model, *, revolutions: float = 1.0, points_per_cycle: int = 8,

@@ -21,6 +21,10 @@ from .model.kinematics import solve_kinematics
 
 #: largest number of decimated history records kept by default
 MAX_HISTORY_RECORDS = 200_000
+#: default step budget of a run (about 1-5 minutes of integration on one core)
+MAX_STEPS = 200_000_000
+#: runs longer than this many steps are announced with a warning (cost estimate)
+ANNOUNCE_STEPS = 20_000_000
 
 
 def simulate(
@@ -36,6 +40,7 @@ def simulate(
     full_history: bool = False,
     progress: Callable[[float], None] | None = None,
     rhs: str = "auto",
+    max_steps: int | None = None,
 ):
     """Dynamic response of a model, started from its static equilibrium.
 
@@ -60,6 +65,10 @@ def simulate(
         Keep every state (memory grows with the run length).
     progress : callable, optional
         Called with the completed fraction (0..1) during the integration.
+    max_steps : int, optional
+        Refuse (before integrating) an RK4 run that needs more steps than this, with the
+        reason (usually one stiff element or a tiny inertia setting the step); default
+        :data:`MAX_STEPS`.  Runs above :data:`ANNOUNCE_STEPS` steps get a cost warning.
     rhs : {"auto", "generated", "general"}
         Right-hand side of the kernels: the model's equations compiled as straight-line
         code, or the general element loop, or (default) the first when the run is long
@@ -138,8 +147,32 @@ def simulate(
     )
     if method == "rk4":
         kwargs["steps_per_period"] = steps_per_period
+        _check_cost(structure, duration, steps_per_period,
+                    MAX_STEPS if max_steps is None else int(max_steps))
     else:
         kwargs["rtol"] = rtol or an.rtol
     solution = integrate(structure, y0, (0.0, duration), **kwargs)
     return Results(model=model, kinematics=kin, structure=structure, static=static,
                    solution=solution)
+
+
+def _check_cost(structure, duration: float, steps_per_period: int, max_steps: int) -> None:
+    """Refuse an RK4 run beyond the step budget, announce a long one (the cost known
+    before integrating: the step is fixed)."""
+    from .solve.integrate import planned_step
+
+    if max_steps < 1:
+        raise SolverError(f"max_steps must be >= 1, got {max_steps}")
+    h, why = planned_step(structure, steps_per_period, duration)
+    n_steps = math.ceil(duration / h)
+    # about 60 ns per DOF and step with the generated right-hand side (benchmarks/)
+    seconds = n_steps * 6e-8 * max(structure.n_dof, 1)
+    if n_steps > max_steps:
+        raise SolverError(
+            f"this run needs {n_steps:,} RK4 steps of {h:.3g} s ({why}), more than "
+            f"max_steps = {max_steps:,} (about {seconds / 60:.3g} min); check the stiffness "
+            "and inertias named there and their units, shorten the duration, or raise "
+            "max_steps (--max-steps)")
+    if n_steps > ANNOUNCE_STEPS:
+        warnings.warn(f"this run takes {n_steps:,} RK4 steps of {h:.3g} s ({why}): about "
+                      f"{seconds / 60:.2g} min of integration", ModelWarning, stacklevel=3)

@@ -165,9 +165,16 @@ def _compare_runs(c: Case, y0_engine, rhs: str, p=None):
     scale = c.to_paper(np.abs(history).max(axis=0))
     state = _scaled_difference(c.to_paper(sol.y_final), run.y_final, np.abs(scale))
     assert np.array_equal(run.cycle_count, sol.cycle_count)
-    forces = max(float(np.nanmax(np.abs(a - b) / p.static_force)) for a, b in (
-        (run.cycle_max, sol.cycle_max), (run.cycle_min, sol.cycle_min),
-        (run.cycle_mean, sol.cycle_mean)))
+    # the engine also samples the forces at the corners of the stiffness tables (corner
+    # events, kernel_data.CORNER_TOL), which the step samples of the transcription miss:
+    # its cycle max / min can only be further out, the means (step samples) are equal
+    forces = float(np.nanmax(np.abs(run.cycle_mean - sol.cycle_mean) / p.static_force))
+    ok = np.isfinite(run.cycle_max) & np.isfinite(sol.cycle_max)
+    outward = (np.all((sol.cycle_max >= run.cycle_max - TOL * p.static_force)[ok])
+               and np.all((sol.cycle_min <= run.cycle_min + TOL * p.static_force)[ok]))
+    if not outward:
+        forces = max(forces, float(np.nanmax(np.abs(run.cycle_max - sol.cycle_max)
+                                             / p.static_force)))
     f_end, _ = element_forces(c.structure, sol.t_final, sol.y_final)
     final = float(np.max(np.abs(run.forces_final - f_end[:4]) / p.static_force))
     return state, max(forces, final), sol

@@ -7,7 +7,8 @@ element         deformation ``V . q``                         stiffness
 ==============  ==========================================  =========================
 mesh            ``n.(u_d - u_n) + arm_d th_d - arm_n th_n``   k(phase) table [N/m]
 shaft           ``th_a - th_b``                               torsional [N m/rad]
-support         ``u_i`` (one translational DOF)               bearing [N/m], clearance
+support         ``u_i`` (one translational DOF; ``- u_seat``  bearing [N/m], clearance
+                for a bearing on another body, ``on``)
 spline torsion  ``th_hub - th_float``                         torsional [N m/rad]
 spline radial   ``u_hub - u_float``, radial plane, 2-D        radial law, seed 002 eq. 6
 ==============  ==========================================  =========================
@@ -219,17 +220,30 @@ def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None
         # diagonal support stiffness in the global axes, projected on each DOF's
         # direction u: k = kx ux^2 + ky uy^2 + kz uz^2 (x, y, z: the value itself)
         k_xyz = np.array([k_rad, sup.stiffness_y or k_rad, sup.axial_stiffness or k_rad])
+        where = f"{'gears' if body in model.gears else 'bodies'}.{body}.support"
+        on = _bearing_seat(model, dmap, body, sup.on, where)
+        m = kin.bodies[body].mass
+        if on is not None:  # equivalent mass of the two bodies for the damping ratio
+            m_on = kin.bodies[on].mass
+            m = m * m_on / (m + m_on) if m_on > 0 else m
         for d, j in tr.items():
-            k = float(k_xyz @ dmap.axes[body][d] ** 2)
-            m = kin.bodies[body].mass
+            u = dmap.axes[body][d]
+            k = float(k_xyz @ u ** 2)
             if sup.damping is not None:
                 c = sup.damping
             elif sup.damping_ratio is not None:
                 c = 2 * sup.damping_ratio * math.sqrt(k * m)
             else:
                 c = 0.0
-            elements.append(dict(name=f"{body}.support.{d}", kind=SPRING, dofs=[j], coefs=[1.0],
-                                 stiffness=k, damping=c, gaps=sup.clearance))
+            # deformation: the body's displacement along u, less that of the seat (a
+            # bearing between two bodies: the same law, its other end on the seat)
+            dofs, coefs = [j], [1.0]
+            if on is not None:
+                for jj, cc in dmap.project(on, u, -1.0, tol=1e-15):
+                    dofs.append(jj)
+                    coefs.append(cc)
+            elements.append(dict(name=f"{body}.support.{d}", kind=SPRING, dofs=dofs,
+                                 coefs=coefs, stiffness=k, damping=c, gaps=sup.clearance))
 
     # ---- splines: torsion spring + 2-D radial element (seed 002 eq. 6)
     for name, sp in model.splines.items():
@@ -292,6 +306,25 @@ def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None
     )
     return build_structure(dmap.names, inv_mass, elements, external_force=ext,
                            ground_damping=ground, n_table=n_table, metadata=meta)
+
+
+def _bearing_seat(model: Model, dmap: DofMap, body: str, on: str | None,
+                  where: str) -> str | None:
+    """The body a bearing sits on (None: the housing), checked."""
+    if on is None:
+        return None
+    if on == body:
+        raise ModelError([(f"{where}.on", f"a bearing cannot sit on its own body {body!r}; "
+                           "name another body (e.g. the carrier) or leave 'on' out for the "
+                           "housing")])
+    if on not in dmap.translation:
+        raise ModelError([(f"{where}.on", f"unknown body {on!r}; use one of "
+                           f"{sorted(dmap.translation)}")])
+    if not dmap.translation[on]:
+        raise ModelError([(f"{where}.on", f"body {on!r} has no translational DOFs, so a "
+                           "bearing on it is a bearing on the housing; give it x/y DOFs or "
+                           "leave 'on' out")])
+    return on
 
 
 def _friction_projection(model: Model, kin: Kinematics, dmap: DofMap, name: str,

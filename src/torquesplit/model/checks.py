@@ -3,6 +3,30 @@
 Errors are collected (all of them, not only the first) and raised as one
 :class:`~torquesplit.errors.ModelError`.  Values that look wrong but can be right are
 reported as :class:`~torquesplit.errors.ModelWarning`.
+
+``torquesplit check`` and ``torquesplit run`` share these checks, so that a model that
+passes ``check`` is never refused by ``run`` for a modelling reason:
+
+==============================  ========================================================
+check                           what it refuses
+==============================  ========================================================
+:func:`reference_issues`        names of bodies, gears that do not exist
+:func:`topology_issues`         bodies connected to nothing, trains without drive/load
+:func:`mesh_compatibility_...`  modules, pressure angles, helices that cannot mesh
+:func:`geometry_issues`         involute geometry (interference, centre distance)
+kinematics                      loops that cannot turn, power that does not balance
+:func:`nominal_load_issues`     meshes that carry no load (no power passes them)
+:func:`balance_issues`          torques out of balance by more than
+                                :data:`BALANCE_TOLERANCE` (what the static solution of
+                                every run refuses)
+:func:`stiffness_table_issues`  mesh stiffness tables that are not positive everywhere
+:func:`readiness_issues`        (``deep``) the stages every run performs before it
+                                integrates: assembly and the static equilibrium
+==============================  ========================================================
+
+:func:`plausibility_warnings` flag magnitudes that are possible but usually a wrong
+unit: lengths against the size of the gears, inertias and masses against the gear's
+geometry, stiffness against ISO 6336, speeds and tooth loads against what gears carry.
 """
 
 from __future__ import annotations
@@ -11,12 +35,30 @@ import math
 import re
 import warnings
 
-from ..errors import ModelError, ModelWarning
+import numpy as np
+
+from ..errors import ModelError, ModelWarning, SolverError
 from .schema import Model
 
+#: largest net power along the train's rigid rotation, as a fraction of the input plus
+#: output power, that counts as round-off; the static equilibrium of every run refuses
+#: more (``torquesplit.solve.static.static_equilibrium(balance_tolerance=1e-8)``)
+BALANCE_TOLERANCE = 1e-8
 
-def check_model(model: Model, source: str | None = None) -> None:
-    """Raise ModelError listing every problem found; warn on suspicious values."""
+
+def check_model(model: Model, source: str | None = None, *, deep: bool = False) -> None:
+    """Raise ModelError listing every problem found; warn on suspicious values.
+
+    Parameters
+    ----------
+    model : Model
+    source : str, optional
+        Where the model came from (named in the messages).
+    deep : bool
+        Also run what every dynamic run does before it integrates -- the assembly of the
+        equations of motion and the static equilibrium -- and report their refusals as
+        model errors (:func:`readiness_issues`; ``torquesplit check`` does).
+    """
     issues = reference_issues(model)
     if not issues:
         issues = topology_issues(model)
@@ -33,7 +75,14 @@ def check_model(model: Model, source: str | None = None) -> None:
         kin = solve_kinematics(model)
     except KinematicsError as exc:
         raise ModelError(exc.issues, source) from None
-    for loc, msg in plausibility_warnings(model, kin):
+    issues = nominal_load_issues(model, kin) + balance_issues(model, kin)
+    issues += stiffness_table_issues(model, kin)
+    notes = []
+    if not issues and deep:
+        issues, notes = _readiness(model, kin)
+    if issues:
+        raise ModelError(issues, source)
+    for loc, msg in plausibility_warnings(model, kin) + notes:
         warnings.warn(f"{source + ': ' if source else ''}{loc}: {msg}", ModelWarning, stacklevel=3)
 
 
@@ -249,7 +298,7 @@ def modification_issues(model: Model) -> list[tuple[str, str]]:
 
 
 def _teach(msg: str) -> str:
-    """A geometry message, ending with what to do if it does not already."""
+    """A message, ending with what to do if it does not already."""
     return msg if ";" in msg else f"{msg}; correct the value"
 
 
@@ -305,4 +354,308 @@ def plausibility_warnings(model: Model, kin) -> list[tuple[str, str]]:
             out.append((f"meshes.{name}.stiffness",
                         f"{spec.value:.3g} N/m is {spec.value / iso:.2g} times the ISO 6336 "
                         f"estimate c_gamma*b = {iso:.3g} N/m; check the value and its unit"))
+    return out + magnitude_warnings(model, kin)
+
+
+#: a length more than this many times the largest gear (or less than its inverse) is
+#: flagged as a probable unit mistake
+SIZE_RATIO = 100.0
+#: a given mass or polar inertia outside [1/r, r] times the gear's solid-disc value (an
+#: inertia may include the gear's shaft: seed 002's pinion has 22 times its disc's)
+INERTIA_RATIO = 100.0
+#: pitch-line speed beyond which gears do not run [m/s] (turbine gears reach ~200)
+MAX_PITCH_SPEED = 500.0
+#: tooth load per face width beyond what steel teeth carry [N/m] (10 kN/mm)
+MAX_LOAD_PER_WIDTH = 1e7
+
+
+def magnitude_warnings(model: Model, kin) -> list[tuple[str, str]]:
+    """Sizes that are possible but usually a unit mistake ("560 parsec" for a shaft).
+
+    Lengths are compared with the gears' size (the largest pitch diameter ``D``), errors
+    and clearances with the module, a given mass or inertia with the gear's solid-disc
+    value, speeds and tooth loads with what gears carry.  Each names the field.
+    """
+    from .kinematics import gear_geometry
+
+    out = []
+    diameters = {}
+    for name, g in model.gears.items():
+        try:
+            diameters[name] = 2 * gear_geometry(g).reference_radius
+        except (ModelError, ValueError, ArithmeticError):  # pragma: no cover - checked before
+            continue
+    if not diameters:
+        return out
+    size = max(diameters.values())
+    size_text = f"the largest gear's pitch diameter ({size * 1e3:.4g} mm)"
+
+    def against_size(loc, value, small=True):
+        if value is None or value == 0 or not math.isfinite(value):
+            return
+        ratio = abs(value) / size
+        if ratio > SIZE_RATIO or (small and ratio < 1 / (100 * SIZE_RATIO)):
+            out.append((loc, f"{abs(value):.4g} m is {ratio:.3g} times {size_text}; check the "
+                             f"value and its unit"))
+
+    def against_module(loc, value, module, what):
+        if value and math.isfinite(value) and abs(value) > module:
+            out.append((loc, f"{abs(value) * 1e6:.4g} um is larger than the module "
+                             f"({module * 1e3:.4g} mm); {what} are microns: check the value "
+                             f"and its unit"))
+
+    for name, g in model.gears.items():
+        loc = f"gears.{name}"
+        if g.module > 0.1 or g.module < 5e-5:
+            out.append((f"{loc}.module", f"{g.module * 1e3:.4g} mm is outside the modules "
+                                         f"gears are made with (0.05-100 mm); check the value "
+                                         f"and its unit"))
+        d = diameters.get(name)
+        if d and g.face_width > 10 * d:
+            out.append((f"{loc}.face_width", f"{g.face_width * 1e3:.4g} mm is "
+                                             f"{g.face_width / d:.3g} times the pitch diameter "
+                                             f"({d * 1e3:.4g} mm); check the value and its unit"))
+        if g.position is not None:
+            for axis, v in zip("xyz", g.position):
+                against_size(f"{loc}.position", v, small=False)
+        e = g.errors
+        for field in ("eccentricity", "installation", "tooth_thickness", "pitch",
+                      "bearing_runout"):
+            against_module(f"{loc}.errors.{field}", getattr(e, field), g.module,
+                           "manufacturing and assembly errors")
+        if g.support is not None:
+            against_module(f"{loc}.support.clearance", g.support.clearance, g.module,
+                           "bearing clearances")
+            if g.support.shaft is not None:
+                for field in ("diameter", "span", "position"):
+                    against_size(f"{loc}.support.shaft.{field}",
+                                 getattr(g.support.shaft, field))
+        body = kin.bodies.get(name)
+        if body is not None and d:
+            m_geo, j_geo = _disc_mass_inertia(g, d)
+            translates = any(dof != "theta" for dof in g.dofs)
+            for field, given, ref, unit in (("mass", g.mass, m_geo, "kg"),
+                                            ("polar_inertia", g.polar_inertia, j_geo, "kg m^2")):
+                if given is None or not ref > 0 or (field == "mass" and not translates):
+                    continue  # a mass without translations is a placeholder: not used
+                ratio = given / ref
+                if not 1 / INERTIA_RATIO <= ratio <= INERTIA_RATIO:
+                    out.append((f"{loc}.{field}", (
+                        f"{given:.4g} {unit} is {ratio:.3g} times that of a solid steel disc "
+                        f"of the gear's pitch diameter and face width ({ref:.4g} {unit}); "
+                        f"check the value and its unit")))
+            w = abs(body.speed)
+            if w * d / 2 > MAX_PITCH_SPEED:
+                out.append((loc, f"runs at a pitch-line speed of {w * d / 2:.4g} m/s (the "
+                                 f"fastest gears run about 200 m/s); check the drive's "
+                                 f"speed and its unit"))
+    for name, b in model.bodies.items():
+        against_size(f"bodies.{name}.position", max(abs(v) for v in b.position), small=False)
+    for name, sh in model.shafts.items():
+        for field in ("diameter", "length"):
+            against_size(f"shafts.{name}.{field}", getattr(sh, field))
+    for name, m in model.meshes.items():
+        module = min(model.gears[x].module for x in m.gears)
+        bl = m.backlash
+        against_module(f"meshes.{name}.backlash", bl.nominal + bl.tolerance, module,
+                       "backlashes")
+        te = m.transmission_error
+        against_module(f"meshes.{name}.transmission_error", abs(te.constant) + te.amplitude,
+                       module, "transmission errors")
+        mk = kin.meshes.get(name)
+        if mk is not None and mk.force > 0:
+            width = min(model.gears[x].face_width for x in m.gears)
+            if mk.force / width > MAX_LOAD_PER_WIDTH:
+                out.append((f"meshes.{name}", (
+                    f"carries {mk.force / width / 1e3:.4g} N/mm of face width (steel teeth "
+                    f"carry up to about 2000 N/mm); check the drive's torque or power and "
+                    f"its unit")))
+    for name, sp in model.splines.items():
+        against_size(f"splines.{name}.pitch_radius", sp.pitch_radius)
+        if sp.radial_clearance > sp.pitch_radius:
+            out.append((f"splines.{name}.radial_clearance", (
+                f"{sp.radial_clearance * 1e3:.4g} mm is larger than the pitch radius "
+                f"({sp.pitch_radius * 1e3:.4g} mm); check the value and its unit")))
     return out
+
+
+def _disc_mass_inertia(gear, d: float) -> tuple[float, float]:
+    """Mass and polar inertia of a solid steel disc of pitch diameter ``d`` and the
+    gear's face width (both helices of a double-helical gear), less its bore."""
+    width = gear.face_width * (2 if gear.gear_type == "double_helical" else 1)
+    di = min(gear.bore_diameter, 0.9 * d)
+    mass = 7850.0 * math.pi * (d**2 - di**2) / 4 * width
+    return mass, mass * (d**2 + di**2) / 8
+
+
+# --------------------------------------------------------------------------- what run needs
+def nominal_load_issues(model: Model, kin) -> list[tuple[str, str]]:
+    """Every mesh must carry a nominal load: its load-sharing coefficient and dynamic
+    factor are ratios to it.  A mesh carries none when no power passes it on its way
+    from a drive to a load (a load on the drive's own body, say)."""
+    issues = []
+    same = sorted({d.body for d in model.drives.values()}
+                  & {ld.body for ld in model.loads.values()})
+    for name, mk in kin.meshes.items():
+        if mk.force > 0 and math.isfinite(mk.force):
+            continue
+        why = (f"the load acts on the driven body {same[0]!r} itself, so no power passes the "
+               f"gears" if same else "no power passes it on its way from a drive to a load")
+        issues.append((f"meshes.{name}", (
+            f"carries no nominal load ({why}); its load sharing and dynamic factor would "
+            f"divide by zero: put the loads where the power must pass the meshes, or "
+            f"remove the mesh")))
+    return issues
+
+
+def balance_issues(model: Model, kin) -> list[tuple[str, str]]:
+    """Drive and load torques must balance to :data:`BALANCE_TOLERANCE`, the tolerance
+    of the static equilibrium that starts every run.
+
+    Applies to torque-driven models without tooth friction (with friction the loads may
+    take the losses off; a prescribed speed takes any torque): those are checked by the
+    static equilibrium itself (:func:`readiness_issues`).
+    """
+    if any(m.friction is not None for m in model.meshes.values()):
+        return []
+    if any(d.mode != "torque" for d in model.drives.values()):
+        return []
+    p_in, p_out = kin.input_power, kin.output_power
+    total = abs(p_in) + abs(p_out)
+    if total > 0 and abs(p_in - p_out) > BALANCE_TOLERANCE * total:
+        return [("loads", (
+            f"power does not balance to within {100 * BALANCE_TOLERANCE:g} % (the tolerance "
+            f"of the static equilibrium that starts every run): the drives put in "
+            f"{p_in:.10g} W and the loads take {p_out:.10g} W "
+            f"({100 * abs(p_in - p_out) / total:.3g} % of the power through the train); set a "
+            f"load's torque to \"balanced\" or correct the torques"))]
+    return []
+
+
+#: stiffness methods whose table is cheap to evaluate here (the others are evaluated by
+#: the assembly, in :func:`readiness_issues`)
+_CHEAP_STIFFNESS = ("constant", "table", "fourier")
+
+
+def stiffness_table_issues(model: Model, kin) -> list[tuple[str, str]]:
+    """Each mesh's stiffness table, sampled as every run samples it
+    (``[analysis] table_points`` phases), must be positive and finite everywhere."""
+    from ..assembly.excitation import stiffness_table
+
+    issues = []
+    n = model.analysis.table_points
+    for name, mesh in model.meshes.items():
+        if mesh.stiffness.method not in _CHEAP_STIFFNESS:
+            continue
+        loc = f"meshes.{name}.stiffness"
+        try:
+            with np.errstate(all="ignore"):
+                k = np.asarray(stiffness_table(model, kin, name, n), dtype=float)
+        except ValueError:  # the Fourier series becomes negative: said below
+            k = None
+        if k is not None and np.all(np.isfinite(k)) and np.all(k > 0):
+            continue
+        spec = mesh.stiffness
+        if spec.method == "fourier":
+            fix = ("make 'mean' larger than the sum of the coefficients' sizes, or correct "
+                   "the coefficients")
+        elif spec.method == "constant":
+            fix = ("the step between single and double contact is too large: give a smaller "
+                   "'peak_to_peak' (typical 0.2-0.5)")
+        else:
+            fix = "correct the values"
+        if k is None:
+            kmin = "it goes to zero or below"
+        elif np.isfinite(k).any():
+            kmin = f"its smallest value is {np.nanmin(k):.4g} N/m"
+        else:
+            kmin = "it is not a finite number"
+        issues.append((loc, f"the stiffness over the mesh cycle must be positive, but "
+                            f"{kmin} (at {n} phases, as a run samples it); {fix}"))
+    return issues
+
+
+def readiness_issues(model: Model, kin=None) -> list[tuple[str, str]]:
+    """What every dynamic run does before it integrates, run here: the assembly of the
+    equations of motion (every stiffness table, support and spline) and the static
+    equilibrium it starts from.  Their refusals come back as (location, message).
+
+    A static deflection beyond what the integrator accepts (its ``blowup``) is refused
+    too: every run of such a model diverges at its first step.  A model that passes is
+    refused by ``run`` for a numerical reason only (the step, the cost, a diverging
+    integration), never for a modelling one.
+    """
+    return _readiness(model, kin)[0]
+
+
+def _readiness(model: Model, kin=None) -> tuple[list, list]:
+    """(issues, warnings) of :func:`readiness_issues`."""
+    from ..assembly.assemble import assemble
+    from ..solve.static import static_equilibrium
+    from .kinematics import solve_kinematics
+
+    kin = kin or solve_kinematics(model)
+    try:
+        with np.errstate(all="ignore"):
+            structure = assemble(model, kin)
+    except ModelError as exc:
+        return [(loc, _teach(msg)) for loc, msg in exc.issues] or [
+            ("", "cannot be assembled; check the model")], []
+    except (ValueError, ArithmeticError) as exc:
+        return [_located(str(exc), "the equations of motion cannot be assembled")], []
+    try:
+        with np.errstate(all="ignore"):
+            static = static_equilibrium(structure)
+    except SolverError as exc:
+        loc, msg = _located(str(exc), "the static equilibrium that starts every run fails")
+        return [(loc or "loads", msg)], []
+    except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:
+        return [_located(str(exc), "the static equilibrium that starts every run fails")], []
+    q = np.asarray(static.q, dtype=float)
+    if not np.all(np.isfinite(q)):
+        return [("", "the static equilibrium that starts every run has no finite solution; "
+                     "check the clearances and the supports (a body free to move inside its "
+                     "clearance needs a support or a spring)")], []
+    if q.size == 0:
+        return [], []
+    names = structure.dof_names
+    j = int(np.argmax(np.abs(q)))
+    body, _, dof = names[j].rpartition(".")
+    loc = f"{'gears' if body in model.gears else 'bodies'}.{body}"
+    unit = "rad" if dof == "theta" else "m"
+    blowup = integrator_blowup()
+    if abs(q[j]) > blowup:
+        return [(loc, f"the static equilibrium that starts every run displaces "
+                      f"'{names[j]}' by {abs(q[j]):.3g} {unit}, beyond what any run "
+                      f"accepts ({blowup:g}): a stiffness is far too small for the load; "
+                      f"check the stiffness values and their units (shafts, supports, "
+                      f"meshes)")], []
+    return [], []
+
+
+def integrator_blowup() -> float:
+    """The displacement at which the integrator stops a run (its ``blowup`` default; also
+    used by the CLI to name the likely cause of a run that stopped)."""
+    import inspect
+
+    from ..solve.integrate import integrate
+
+    default = inspect.signature(integrate).parameters.get("blowup")
+    try:
+        return float(default.default)
+    except (AttributeError, TypeError, ValueError):  # pragma: no cover - signature changed
+        return 1e3
+
+
+_LOCATED = re.compile(r"^((?:gears|bodies|shafts|meshes|splines|drives|loads|analysis)"
+                      r"\.[^:\s]+): (.*)$", re.S)
+
+
+def _located(text: str, what: str) -> tuple[str, str]:
+    """(location, message) from an exception text that may start with 'meshes.m1...: '."""
+    m = _LOCATED.match(text.strip())
+    loc, msg = (m.group(1), m.group(2)) if m else ("", f"{what}: {text.strip()}")
+    msg = msg.rstrip(".")
+    if ";" not in msg:
+        msg = re.sub(r"\. ([A-Z])", lambda m: "; " + m.group(1).lower(), msg, count=1)
+    return loc, _teach(msg)

@@ -74,7 +74,12 @@ with the same structure is accepted too.  Check a file with
 
 which prints every problem with the field it is in and what to do, or the speeds,
 torques and mesh frequencies if the model is valid.  Unknown fields are errors: a typo
-is never silently ignored.
+is never silently ignored.  `check` runs every check `run` performs before it
+integrates, so a model that passes is refused by `run` only for a numerical reason.
+
+The file is UTF-8 (a byte-order mark is accepted), at most 4 MiB, nested at most 32
+levels deep (brackets, inline tables, dotted keys).  `true` and `false` are not numbers,
+and numbers are not `true` or `false`.
 
 ## Units
 
@@ -85,6 +90,9 @@ Every physical quantity is written either
   converted; or
 * as a **bare number**, which is read in the SI unit of the field (m, N/m, rad/s,
   rad ...).  `module = 0.002` is 2 mm.
+
+A unit alone (`"mm"`) is refused: it is not 1 mm.  A quantity string is at most 100
+characters.
 
 Angles are the usual trap: a bare number is in **radians**, so write
 `pressure_angle = "20 deg"`, not `20` (a pressure or helix angle of 20 rad is refused

@@ -5,7 +5,6 @@ from __future__ import annotations
 import difflib
 import json
 import re
-import tomllib
 import types
 import typing
 import warnings
@@ -50,24 +49,11 @@ def load_model(source, *, check: bool = True) -> Model:
 
 
 def read_file(path: Path) -> dict[str, Any]:
-    """Parse a TOML or JSON file into a dict; syntax errors become ModelError."""
-    if not path.exists():
-        raise ModelError(
-            [("", f"no such file; check the path (current folder: {Path.cwd()})")], str(path)
-        )
-    text = path.read_text(encoding="utf-8")
-    suffix = path.suffix.lower()
-    try:
-        if suffix == ".json":
-            return json.loads(text)
-        return tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ModelError([("", f"TOML syntax error: {exc}; fix the line it names")], str(path)) from None
-    except json.JSONDecodeError as exc:
-        raise ModelError(
-            [("", f"JSON syntax error at line {exc.lineno} column {exc.colno}: {exc.msg}; "
-                  f"fix the file there")], str(path)
-        ) from None
+    """Parse a TOML or JSON file into a dict through the guarded reader
+    (:func:`torquesplit.model.reader.read_model_file`); every problem is a ModelError."""
+    from .reader import read_model_file
+
+    return read_model_file(path)
 
 
 def model_from_dict(data: dict[str, Any], source: str | None = None) -> Model:

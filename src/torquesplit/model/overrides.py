@@ -2,7 +2,9 @@
 
 Used by ``torquesplit run --set PATH=VALUE`` and by studies: the raw model data is
 edited before validation, so every override goes through the same units and checks
-as the file itself.
+as the file itself.  An error in an overridden field is reported against the ``--set``
+argument, not against the model file (:func:`apply_assignments`,
+:func:`attribute_errors`).
 """
 
 from __future__ import annotations
@@ -12,7 +14,7 @@ import tomllib
 from pathlib import Path
 from typing import Any, Mapping
 
-from ..errors import ModelError
+from ..errors import ModelError, clip_text
 
 
 def set_parameter(data: dict, path: str, value: Any) -> dict:
@@ -52,12 +54,86 @@ def parse_assignment(text: str) -> tuple[str, Any]:
     if "=" not in text:
         raise ModelError([("--set", f"{text!r} is not PATH=VALUE; write e.g. "
                                     f"--set shafts.drive1.diameter='250 mm'")])
+    from .reader import check_nesting
+
     path, raw = (s.strip() for s in text.split("=", 1))
+    if not path:
+        raise ModelError([("--set", f"{clip_text(text)!r} has no PATH before '='; write e.g. "
+                                    f"--set shafts.drive1.diameter='250 mm'")])
+    check_nesting(raw, "toml", f"--set {clip_text(text)}")
     try:
         value = tomllib.loads(f"v = {raw}")["v"]
     except tomllib.TOMLDecodeError:
         value = raw
+    except ValueError:  # an integer of more than 4300 digits
+        raise ModelError([("", "has an integer of more than 4300 digits; write numbers of "
+                               "ordinary size, e.g. 1e30")], f"--set {clip_text(text)}") from None
     return path, value
+
+
+def apply_assignments(data: dict, assignments) -> tuple[dict, dict[str, str]]:
+    """Apply ``--set PATH=VALUE`` arguments to raw model data.
+
+    Returns
+    -------
+    data : dict
+        A copy of ``data`` with the overrides applied.
+    where : dict
+        ``{path: argument}``, for :func:`attribute_errors`.
+
+    Raises
+    ------
+    ModelError
+        An argument that is not PATH=VALUE or names no field, reported against the
+        argument (``--set meshes.zz.damping=1: ...``).
+
+    Examples
+    --------
+    >>> data, where = apply_assignments({"meshes": {"m": {}}}, ["meshes.m.damping_ratio=0.07"])
+    >>> data, where
+    ({'meshes': {'m': {'damping_ratio': 0.07}}}, {'meshes.m.damping_ratio': 'meshes.m.damping_ratio=0.07'})
+    """
+    where: dict[str, str] = {}
+    for text in assignments:
+        source = f"--set {clip_text(text)}"
+        try:
+            path, value = parse_assignment(text)
+            data = set_parameter(data, path, value)
+        except ModelError as exc:
+            issues = [("" if loc in ("--set", path_of(text)) else loc, msg)
+                      for loc, msg in exc.issues]
+            raise ModelError(issues, exc.source or source) from None
+        where[path] = text
+    return data, where
+
+
+def path_of(text: str) -> str:
+    """The PATH of a ``PATH=VALUE`` argument."""
+    return text.split("=", 1)[0].strip()
+
+
+def attribute_errors(exc: ModelError, where: Mapping[str, str], source: str) -> ModelError:
+    """``exc`` with each issue reported against what caused it.
+
+    An issue inside an overridden field (``meshes.m.stiffness.value`` for ``--set
+    meshes.m.stiffness=...``) is reported against the ``--set`` argument; one in a
+    section that an override changed (``meshes.m`` for ``--set meshes.m.damping=...``)
+    against the file *with* that argument; any other against the file (``source``).
+    """
+    def cause(loc: str) -> str:
+        for path, text in where.items():
+            if loc == path or loc.startswith(path + "."):
+                return f"--set {clip_text(text)}"
+        for path, text in where.items():
+            if loc and path.startswith(loc + "."):
+                return f"{source} with --set {clip_text(text)}"
+        return source
+
+    causes = [cause(loc) for loc, _ in exc.issues]
+    if len(set(causes)) == 1:
+        return ModelError(exc.issues, causes[0])
+    return ModelError([(f"{c}: {loc}" if loc else c, msg)
+                       for c, (loc, msg) in zip(causes, exc.issues)])
 
 
 def read_raw(source) -> dict:

@@ -17,6 +17,7 @@ import math
 from typing import Annotated, Literal
 
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, model_validator
+from pydantic import Strict as StrictType
 
 from .units import KINDS, parse_quantity
 
@@ -40,6 +41,25 @@ def Q(kind: str):
     """A float field that accepts a quantity with units of ``kind`` (stored in SI)."""
     return Annotated[float, BeforeValidator(lambda v: parse_quantity(v, kind)), Unit(kind)]
 
+
+def _not_a_bool(what: str, example: str):
+    """A validator refusing true/false where a number is meant (pydantic reads true as 1)."""
+
+    def check(v):
+        if isinstance(v, bool):
+            raise ValueError(f"must be {what}, got {str(v).lower()} (true/false is not a "
+                             f"number); write {example}")
+        return v
+
+    return BeforeValidator(check)
+
+
+Number = Annotated[float, _not_a_bool("a number", "a plain number such as 0.05")]
+"""A plain (dimensionless) number; true/false are refused."""
+Count = Annotated[int, _not_a_bool("a whole number", "an integer such as 20")]
+"""A whole number; true/false are refused."""
+Flag = Annotated[bool, StrictType()]
+"""true or false only (not 0/1, not "yes")."""
 
 Length = Q("length")
 Angle = Q("angle")
@@ -119,7 +139,8 @@ class ShaftBending(Strict):
 
 
 class Support(Strict):
-    """Support of a body's translations to the housing: bearing or shaft bending."""
+    """Support of a body's translations: a bearing or shaft bending, to the housing or
+    (``on``) to another body (a planet on its carrier pin, a gear on a moving frame)."""
 
     stiffness: Stiffness | None = Field(
         None, gt=0, description="Radial stiffness (x and y) of the support."
@@ -134,11 +155,16 @@ class Support(Strict):
         None, description="Compute the radial stiffness from the shaft instead (seed 001)."
     )
     damping: Damping | None = Field(None, ge=0, description="Viscous damping of the support.")
-    damping_ratio: float | None = Field(
+    damping_ratio: Number | None = Field(
         None, ge=0, description="Damping as a fraction of critical, c = 2 zeta sqrt(k m)."
     )
     clearance: Length = Field(
         0.0, ge=0, description="Radial clearance (dead zone, seed 002 eq. 7); 0 = none."
+    )
+    on: str | None = Field(
+        None, description="Body the bearing sits on (its translations carry the bearing's "
+        "other end: a planet pin on its carrier, a moving housing); default: the fixed "
+        "housing."
     )
 
     @model_validator(mode="after")
@@ -165,7 +191,7 @@ class GearErrors(Strict):
     pitch: Length = Field(0.0, ge=0, description="Single pitch error amplitude (seed 004 §4).")
     bearing_runout: Length = Field(0.0, ge=0, description="Bearing run-out amplitude (seed 004 §4).")
     bearing_runout_phase: Angle = Field(0.0, description="Phase of the bearing run-out.")
-    grade: int | None = Field(
+    grade: Count | None = Field(
         None, ge=1, le=12, description="ISO 1328-1 accuracy grade, used for tolerance sampling."
     )
 
@@ -184,7 +210,7 @@ class Placement(Strict):
 class Gear(Strict):
     """A gear: one rigid body with involute teeth."""
 
-    teeth: int = Field(gt=0, le=10_000, description="Number of teeth.")
+    teeth: Count = Field(gt=0, le=10_000, description="Number of teeth.")
     module: Length = Field(gt=0, description="Normal module.")
     pressure_angle: Angle = Field(math.radians(20.0), description="Normal pressure angle.")
     helix_angle: Angle = Field(0.0, description="Helix angle (spiral angle for bevel gears).")
@@ -195,7 +221,7 @@ class Gear(Strict):
         None, description="Gear type; default spur, or helical when a helix angle is given."
     )
     face_width: Length = Field(gt=0, description="Face width (of one helix for double-helical).")
-    profile_shift: float = Field(0.0, ge=-5, le=5, description="Profile shift coefficient x.")
+    profile_shift: Number = Field(0.0, ge=-5, le=5, description="Profile shift coefficient x.")
     cone_angle: Angle | None = Field(
         None, description="Pitch cone angle of a bevel gear (default from the shaft angle)."
     )
@@ -206,12 +232,13 @@ class Gear(Strict):
     bore_diameter: Length = Field(0.0, ge=0, description="Bore diameter used for computed mass/inertia.")
     density: Density = Field(7850.0, gt=0, description="Material density.")
     youngs_modulus: Pressure = Field(206e9, gt=0, description="Young's modulus of the gear material.")
-    poisson_ratio: float = Field(0.3, gt=0, lt=0.5, description="Poisson's ratio.")
+    poisson_ratio: Number = Field(0.3, gt=0, lt=0.5, description="Poisson's ratio.")
     position: tuple[Length, Length, Length] | None = Field(
         None, description="Centre coordinates [x, y, z]."
     )
     place: Placement | None = Field(None, description="Position from a mating gear and an angle.")
-    axis: tuple[float, float, float] = Field((0.0, 0.0, 1.0), description="Rotation axis direction.")
+    axis: tuple[Number, Number, Number] = Field(
+        (0.0, 0.0, 1.0), description="Rotation axis direction.")
     dofs: list[Dof] = Field(["theta"], description=(
         "Degrees of freedom: 'theta' rotation; 'x', 'y', 'z' translations along the global "
         "axes; or 'loa', one translation along the line of action of the gear's meshes "
@@ -257,7 +284,7 @@ class Body(Strict):
     polar_inertia: Inertia = Field(gt=0, description="Polar moment of inertia.")
     mass: Mass | None = Field(None, gt=0, description="Mass (needed with translational DOFs).")
     position: tuple[Length, Length, Length] = Field((0.0, 0.0, 0.0), description="Centre.")
-    axis: tuple[float, float, float] = Field((0.0, 0.0, 1.0), description="Rotation axis.")
+    axis: tuple[Number, Number, Number] = Field((0.0, 0.0, 1.0), description="Rotation axis.")
     dofs: list[Dof] = Field(["theta"], description=(
         "Degrees of freedom: 'theta' rotation; 'x', 'y', 'z' translations along the global "
         "axes; or 'loa', one translation along the line of action of the gear's meshes "
@@ -297,7 +324,7 @@ class Shaft(Strict):
     """A torsional connection between two bodies on a common axis."""
 
     connects: tuple[str, str] = Field(description="The two bodies the shaft joins.")
-    rigid: bool = Field(False, description="Join the bodies rigidly (one rotational DOF).")
+    rigid: Flag = Field(False, description="Join the bodies rigidly (one rotational DOF).")
     torsional_stiffness: TorsionalStiffness | None = Field(
         None, gt=0, description="Torsional stiffness; or give diameter and length."
     )
@@ -306,7 +333,7 @@ class Shaft(Strict):
     length: Length | None = Field(None, gt=0, description="Length between the two bodies.")
     shear_modulus: Pressure = Field(79.3e9, gt=0, description="Shear modulus of the shaft.")
     damping: TorsionalDamping | None = Field(None, ge=0, description="Torsional damping.")
-    damping_ratio: float | None = Field(
+    damping_ratio: Number | None = Field(
         None, ge=0, description="Torsional damping as a fraction of critical."
     )
 
@@ -335,18 +362,19 @@ class StiffnessSpec(Strict):
         "with the gears' modifications at the operating load)."
     )
     value: Stiffness | None = Field(None, gt=0, description="Mean mesh stiffness (constant).")
-    peak_to_peak: float = Field(
+    peak_to_peak: Number = Field(
         0.0, ge=0, description="Constant method: relative peak-to-peak variation of a rectangular "
         "single/double contact wave built from the contact ratio (0 = constant)."
     )
-    phase: list[float] | None = Field(None, description="Table: mesh phases in [0, 1).")
+    phase: list[Number] | None = Field(None, description="Table: mesh phases in [0, 1).")
     values: list[Stiffness] | None = Field(None, description="Table: stiffness at each phase.")
     mean: Stiffness | None = Field(None, gt=0, description="Fourier: mean stiffness.")
     cos: list[Stiffness] = Field([], description="Fourier: cosine coefficients a_1..a_n.")
     sin: list[Stiffness] = Field([], description="Fourier: sine coefficients b_1..b_n.")
-    fillet_foundation: bool = Field(True, description="Potential energy and LTCA: include the "
+    fillet_foundation: Flag = Field(True, description="Potential energy and LTCA: include the "
                                     "fillet term.")
-    slices: int = Field(40, ge=1, description="Helical (and LTCA): number of slices across the face.")
+    slices: Count = Field(40, ge=1, description="Helical (and LTCA): number of slices across the "
+                          "face.")
     ltca: LtcaSpec = Field(LtcaSpec(), description="Options of method 'ltca'.")
 
     @model_validator(mode="after")
@@ -382,7 +410,7 @@ class BacklashSpec(Strict):
     distribution: Literal["constant", "normal", "uniform"] = Field(
         "constant", description="How each engagement's backlash is drawn."
     )
-    seed: int = Field(0, description="Random seed for reproducible sequences.")
+    seed: Count = Field(0, description="Random seed for reproducible sequences.")
 
 
 class TransmissionError(Strict):
@@ -399,11 +427,11 @@ class FrictionSpec(Strict):
     model: Literal["xu2007", "constant"] = Field(
         "xu2007", description="Friction coefficient: EHL regression of Xu et al. (2007, seed 003 "
         "eq. 6) or a constant.")
-    coefficient: float = Field(0.05, ge=0, le=1, description="Constant friction coefficient.")
+    coefficient: Number = Field(0.05, ge=0, le=1, description="Constant friction coefficient.")
     roughness: Length = Field(0.3e-6, gt=0, description="Composite RMS surface roughness S.")
     viscosity: Viscosity = Field(8e-3, gt=0, description="Dynamic viscosity of the oil at the "
                                  "inlet temperature.")
-    slices: int = Field(20, ge=1, le=200, description="Slices across the face (helical pairs).")
+    slices: Count = Field(20, ge=1, le=200, description="Slices across the face (helical pairs).")
 
 
 def _friction_shorthand(v):
@@ -447,7 +475,7 @@ class Mesh(Strict):
         description="Mean mesh stiffness (\"4.5e9 N/m\"), or a [stiffness] table with a method."
     )
     damping: Damping | None = Field(None, ge=0, description="Mesh damping.")
-    damping_ratio: float | None = Field(
+    damping_ratio: Number | None = Field(
         None, ge=0, description="Mesh damping as a fraction of critical, with the equivalent mass "
         "m = J1 J2 / (J1 r2^2 + J2 r1^2)."
     )
@@ -457,14 +485,14 @@ class Mesh(Strict):
         0.0, description="Total backlash (\"100 um\"; 0 = none), or a [backlash] table."
     )
     transmission_error: TransmissionError = Field(TransmissionError(), description="Extra LOA error.")
-    phase: float | None = Field(None, description="Mesh phase at t = 0 in cycles (overrides clocking).")
+    phase: Number | None = Field(None, description="Mesh phase at t = 0 in cycles (overrides clocking).")
     stage: str | None = Field(None, description="Stage label for load-sharing groups.")
     path: str | None = Field(
         None, description="Input-path label: the power source a mesh belongs to (seed 000: "
         "left/right engine).  Meshes of one stage share load within a path; do not use it to "
         "name the parallel branches of a split.")
     shaft_angle: Angle | None = Field(None, description="Angle between the axes (bevel/face).")
-    impact: bool = Field(False, description="Add meshing-in impact (seed 000 eqs. 6-10).")
+    impact: Flag = Field(False, description="Add meshing-in impact (seed 000 eqs. 6-10).")
     misalignment: MisalignmentSpec = Field(MisalignmentSpec(), description="Misalignment and "
                                            "base pitch deviation (stiffness method 'ltca').")
     friction: Annotated[FrictionSpec | None, BeforeValidator(_friction_shorthand)] = Field(
@@ -489,7 +517,7 @@ class Spline(Strict):
 
     connects: tuple[str, str] = Field(description="The hub body and the floating body.")
     radial_clearance: Length = Field(ge=0, description="Radial clearance of the spline.")
-    friction_coefficient: float = Field(0.1, ge=0, description="Coulomb friction coefficient.")
+    friction_coefficient: Number = Field(0.1, ge=0, description="Coulomb friction coefficient.")
     pitch_radius: Length = Field(gt=0, description="Spline pitch radius.")
     stiffness: Stiffness = Field(gt=0, description="Radial stiffness k_w once the clearance "
                                  "closes (and below the stick limit).")
@@ -552,12 +580,12 @@ class Analysis(Strict):
     """Default settings of the analyses (the CLI can override them)."""
 
     method: Literal["rk4", "dopri"] = Field("rk4", description="Time integrator.")
-    steps_per_period: int = Field(100, ge=10, description="RK4 steps per shortest mesh period.")
+    steps_per_period: Count = Field(100, ge=10, description="RK4 steps per shortest mesh period.")
     duration: Time | None = Field(None, gt=0, description="Simulated time.")
-    cycles: int | None = Field(None, gt=0, description="Simulated cycles of the slowest mesh.")
-    rtol: float = Field(1e-6, gt=0, lt=1, description="Relative tolerance (dopri).")
-    table_points: int = Field(256, ge=16, description="Samples per mesh period of excitation tables.")
-    spline_velocity_scale: float = Field(
+    cycles: Count | None = Field(None, gt=0, description="Simulated cycles of the slowest mesh.")
+    rtol: Number = Field(1e-6, gt=0, lt=1, description="Relative tolerance (dopri).")
+    table_points: Count = Field(256, ge=16, description="Samples per mesh period of excitation tables.")
+    spline_velocity_scale: Number = Field(
         1e-3, gt=0, description="Radial sliding speed [m/s] over which spline friction "
         "reaches its Coulomb value (regularisation of sgn; smaller is stiffer to integrate).")
     load_sharing: Literal["cycle_peak", "engineering", "mean_force", "static_torque"] = Field(

@@ -25,7 +25,7 @@ from pydantic import Field, model_validator
 
 # schema.py imports this module after defining its base classes (the package import
 # torquesplit -> model.io -> schema always comes first)
-from .schema import Angle, FieldError, Length, Q, Strict
+from .schema import Angle, Count, FieldError, Flag, Length, Number, Q, Strict
 
 Force = Q("force")
 
@@ -52,7 +52,7 @@ class ReliefSpec(Strict):
                                   "the tip (tip relief) or from the start of active profile "
                                   "(root relief), as y3, y4 of Liu et al. 2021.")
     shape: Literal["linear", "parabolic", "power"] = Field("linear", description=_SHAPE_DOC)
-    exponent: float = Field(2.0, gt=0, le=10, description="Exponent c of a 'power' relief curve.")
+    exponent: Number = Field(2.0, gt=0, le=10, description="Exponent c of a 'power' relief curve.")
 
     @model_validator(mode="after")
     def _one_start(self):
@@ -73,7 +73,7 @@ class EndReliefSpec(Strict):
     amount: Length = Field(ge=0, description="Material removed at each face end.")
     length: Length = Field(gt=0, description="Length of the relief zone at each end, along the face.")
     shape: Literal["linear", "parabolic", "power"] = Field("linear", description=_SHAPE_DOC)
-    exponent: float = Field(2.0, gt=0, le=10, description="Exponent c of a 'power' curve.")
+    exponent: Number = Field(2.0, gt=0, le=10, description="Exponent c of a 'power' curve.")
 
     @model_validator(mode="after")
     def _exponent(self):
@@ -93,7 +93,7 @@ class TopologicalSpec(Strict):
     y4: Length = Field(gt=0, description="Tip relief height below the tip.")
     y5: Length = Field(ge=0, description="End relief amount at both face ends.")
     y6: Length = Field(gt=0, description="Unmodified length in the middle of the face (of one helix).")
-    exponent: float = Field(2.0, gt=0, le=10, description="Index c of the modification curve "
+    exponent: Number = Field(2.0, gt=0, le=10, description="Index c of the modification curve "
                             "(eq. 20); 2 for the paper's quadratic parabolas.")
 
 
@@ -145,11 +145,11 @@ class MisalignmentSpec(Strict):
 class LtcaSpec(Strict):
     """Options of the loaded tooth contact analysis of a mesh (stiffness method 'ltca')."""
 
-    positions: int = Field(64, ge=8, le=4096, description="Mesh positions over one mesh cycle.")
+    positions: Count = Field(64, ge=8, le=4096, description="Mesh positions over one mesh cycle.")
     contact_model: Literal["weber", "linear"] = Field(
         "weber", description="Hertzian contact of a slice: load dependent (Weber 1949 / Johnson "
         "1985) or linear (Yang & Lin 1987, as the potential-energy method).")
-    coupling: bool = Field(True, description="Couple neighbouring slices of a tooth (Pasternak "
+    coupling: Flag = Field(True, description="Couple neighbouring slices of a tooth (Pasternak "
                            "strip); false gives independent slices.")
     excitation: Literal["tangent", "secant"] = Field(
         "tangent", description="'tangent': stiffness dP/dZ at the operating load plus the "
@@ -157,6 +157,6 @@ class LtcaSpec(Strict):
         "'secant': stiffness P/Z (Liu et al. 2021 eq. 5) and no error excitation.")
     load: Force | None = Field(None, gt=0, description="Operating normal load of the analysis; "
                                "default the mesh's nominal normal force from the power flow.")
-    stagger: float = Field(0.0, ge=0, lt=1, description="Phase offset of the second helix of a "
+    stagger: Number = Field(0.0, ge=0, lt=1, description="Phase offset of the second helix of a "
                            "double-helical pair [mesh cycles].")
-    cache: bool = Field(True, description="Keep results on disk, keyed by a hash of the inputs.")
+    cache: Flag = Field(True, description="Keep results on disk, keyed by a hash of the inputs.")

@@ -4,6 +4,11 @@ Inside torquesplit every number is SI float64.  This module is the only place th
 knows about pint.  A field declares its *kind* (``"length"``, ``"stiffness"``...);
 a value may be written as a string with units (``"0.85e6 N/mm"``), or as a bare
 number, which is read in the kind's SI unit (given in :data:`KINDS`).
+
+What reaches pint is guarded: a string longer than :data:`MAX_QUANTITY_CHARS` is
+refused before pint's preprocessing (its time grows with the square of the length), a
+unit without a number (``"mm"``, which pint reads as 1 mm) is refused, booleans are
+not numbers, and messages quote at most ~80 characters of a value.
 """
 
 from __future__ import annotations
@@ -14,6 +19,11 @@ import re
 from functools import lru_cache
 
 import pint
+
+from ..errors import QUOTE_LIMIT
+
+#: longest quantity string handed to pint; "0.85e6 N/mm" is 11 characters
+MAX_QUANTITY_CHARS = 100
 
 #: kind -> (SI unit as written in docs, example for messages)
 KINDS: dict[str, tuple[str, str]] = {
@@ -60,6 +70,10 @@ def parse_quantity(value, kind: str) -> float:
     if isinstance(value, bool) or not isinstance(value, (numbers.Real, str)):
         raise ValueError(f"got {_short(value)}; {hint}")
     if isinstance(value, str):
+        if len(value) > MAX_QUANTITY_CHARS:
+            raise ValueError(
+                f"is {len(value)} characters long ({_short(value)}); a quantity is a number "
+                f"and a unit of at most {MAX_QUANTITY_CHARS} characters: {hint}")
         x = _parse_string(value, kind)
     else:
         try:
@@ -81,6 +95,11 @@ def _floats(text: str) -> str:
     return _NUMBER.sub(lambda m: m.group() + ".0" if m.group().isdigit() else m.group(), text)
 
 
+#: a quantity string must contain a number: a digit, or inf/nan (refused later as not
+#: finite); pint reads a bare unit such as "mm" as 1 mm
+_HAS_NUMBER = re.compile(r"\d|\b(inf|infinity|nan|pi)\b", re.IGNORECASE)
+
+
 def _parse_string(text: str, kind: str) -> float:
     ureg = registry()
     si_unit, example = KINDS[kind]
@@ -90,19 +109,25 @@ def _parse_string(text: str, kind: str) -> float:
             q = ureg.Quantity(float(q))
     except Exception:
         raise ValueError(
-            f"cannot read {text!r} as {_label(kind)}; write a number and a unit, e.g. '{example}'"
+            f"cannot read {_short(text)} as {_label(kind)}; write a number and a unit, "
+            f"e.g. '{example}'"
         ) from None
+    if not _HAS_NUMBER.search(text):
+        raise ValueError(
+            f"{_short(text)} has no number (pint would read a unit alone as 1 of it); write "
+            f"the value and the unit, e.g. '{example}'")
     ref = _reference(kind)
     if q.dimensionality != ref.dimensionality:
-        if _is_number(text):
+        if _is_number(text):  # (text is at most MAX_QUANTITY_CHARS long)
             fix = f"add the unit, e.g. '{text.strip()} {example.split(' ', 1)[1]}'"
         else:
             fix = f"write it in {si_unit} or a compatible unit, e.g. '{example}'"
         raise ValueError(
-            f"{text!r} is not {_label(kind)} (its dimension is {_dimension_text(q)}); {fix}"
+            f"{_short(text)} is not {_label(kind)} (its dimension is {_dimension_text(q)}); "
+            f"{fix}"
         )
     if kind == "angle" and not (q.unitless or _is_angle_unit(q)):
-        raise ValueError(f"{text!r} is not an angle; write e.g. '{example}'")
+        raise ValueError(f"{_short(text)} is not an angle; write e.g. '{example}'")
     try:
         magnitude = q.to(si_unit).magnitude
         return float(magnitude) if isinstance(magnitude, (int, float)) else math.nan
@@ -131,7 +156,7 @@ def _dimension_text(q) -> str:
     return "dimensionless" if dim == "dimensionless" else dim
 
 
-def _short(value, limit: int = 60) -> str:
+def _short(value, limit: int = QUOTE_LIMIT) -> str:
     """repr of a value for a message, shortened to ``limit`` characters."""
     text = repr(value)
     return text if len(text) <= limit else text[: limit - 3] + "..."

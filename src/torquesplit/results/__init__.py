@@ -5,6 +5,7 @@ module        content
 ============  ==============================================================
 ``results``   :class:`Results` (this module): holds the pipeline's stages
 ``dataset``   conversion to an :class:`xarray.Dataset` with units and long names
+``files``     checked, claimed, atomic writing of results files with provenance
 ============  ==============================================================
 """
 
@@ -263,68 +264,109 @@ class Results:
 
         return results_to_dataset(self)
 
-    def to_netcdf(self, path) -> Path:
-        """Save as NetCDF (h5netcdf); the model is embedded so the file can be re-run."""
-        path = Path(path)
-        self.to_dataset().to_netcdf(path, engine="h5netcdf")
-        return path
+    def to_netcdf(self, path, *, overwrite: bool = False) -> Path:
+        """Save as NetCDF (h5netcdf); the model is embedded so the file can be re-run.
 
-    def save(self, path) -> Path:
-        """Save by suffix: ``.nc`` NetCDF, ``.mat`` MATLAB, ``.csv`` spreadsheet tables."""
-        path = Path(path)
-        suffix = path.suffix.lower()
-        if suffix in (".nc", ".netcdf", ".h5"):
-            return self.to_netcdf(path)
-        if suffix == ".mat":
-            return self.to_mat(path)
-        if suffix == ".csv":
-            return self.to_csv(path)
-        raise ValueError(f"cannot save results as {path.name!r}; use a .nc, .mat or .csv file")
+        The file is written atomically (:mod:`torquesplit.results.files`): complete or
+        absent, never replacing an existing file unless ``overwrite``; its attributes
+        ``run_id``, ``created_utc``, ``software`` and ``command`` say which run wrote it.
 
-    def to_mat(self, path) -> Path:
-        """Save for MATLAB (scipy.io.savemat): every variable of the Dataset, SI units."""
-        from scipy.io import savemat
+        Raises
+        ------
+        OutputError
+            The path's folder is missing, the file exists (without ``overwrite``) or
+            another run is writing it.
+        """
+        from . import files
 
-        ds = self.to_dataset()
-        data = {name: np.asarray(ds[name].values) for name in ds.data_vars}
-        for name in ds.coords:
-            values = ds[name].values
-            data[name] = (np.asarray(values, dtype=object) if values.dtype.kind in "UO"
-                          else np.asarray(values))
-        data["units"] = {name: ds[name].attrs.get("units", "") for name in ds.data_vars}
-        data["model_json"] = ds.attrs["model_json"]
-        data["metrics_json"] = ds.attrs.get("metrics_json", "")
-        path = Path(path)
-        savemat(path, data, long_field_names=True, do_compression=True)
-        return path
+        plan = files.check_output(path, formats=files.NETCDF_FORMATS, overwrite=overwrite)
+        with files.claim_output(plan) as claim:
+            ds = self.to_dataset()
+            ds.attrs.update(files.provenance(claim.run_id))
+            claim.write({plan.path: files.netcdf_bytes(ds)})
+        return plan.path
 
-    def to_csv(self, path) -> Path:
+    def save(self, path, *, overwrite: bool = False) -> Path:
+        """Save by suffix: ``.nc`` NetCDF, ``.mat`` MATLAB, ``.csv`` spreadsheet tables.
+
+        Every file is written atomically and an existing one is kept unless
+        ``overwrite`` (see :meth:`to_netcdf`).
+        """
+        from . import files
+
+        plan = files.check_output(path, overwrite=overwrite)
+        writer = {"netcdf": self.to_netcdf, "mat": self.to_mat, "csv": self.to_csv}[plan.format]
+        return writer(plan.path, overwrite=overwrite)
+
+    def to_mat(self, path, *, overwrite: bool = False) -> Path:
+        """Save for MATLAB (scipy.io.savemat): every variable of the Dataset, SI units,
+        and a ``provenance`` struct naming the run; written atomically."""
+        from . import files
+
+        plan = files.check_output(path, formats={".mat": "mat"}, overwrite=overwrite)
+        with files.claim_output(plan) as claim:
+            ds = self.to_dataset()
+            data = {name: np.asarray(ds[name].values) for name in ds.data_vars}
+            for name in ds.coords:
+                values = ds[name].values
+                data[name] = (np.asarray(values, dtype=object) if values.dtype.kind in "UO"
+                              else np.asarray(values))
+            data["units"] = {name: ds[name].attrs.get("units", "") for name in ds.data_vars}
+            data["model_json"] = ds.attrs["model_json"]
+            data["metrics_json"] = ds.attrs.get("metrics_json", "")
+            data["provenance"] = files.provenance(claim.run_id)
+            claim.write({plan.path: files.mat_bytes(data)})
+        return plan.path
+
+    def to_csv(self, path, *, overwrite: bool = False) -> Path:
         """Save spreadsheet tables: ``NAME.csv`` (per-mesh summary) and beside it
-        ``NAME_history.csv`` (decimated forces) and ``NAME_cycles.csv`` (cycle peaks)."""
-        path = Path(path)
-        met = self.metrics()
+        ``NAME_history.csv`` (decimated forces) and ``NAME_cycles.csv`` (cycle peaks).
+
+        All three are written atomically, and none replaces an existing file unless
+        ``overwrite``.  A run that did not finish has no metrics: its summary lists the
+        meshes with empty metric columns and its status.
+        """
+        from . import files
+
+        plan = files.check_output(path, formats={".csv": "csv"}, overwrite=overwrite)
+        path = plan.path
         header = ["mesh", "group", "nominal_force_N", "static_force_N", "mean_force_N",
                   "peak_force_N", "min_force_N", "dynamic_factor",
-                  "dynamic_factor_engineering", "peak_to_nominal",
-                  f"load_sharing_{met.definition}", "contact_loss_fraction",
-                  "back_contact_fraction"]
-        rows = [[r.mesh, r.group, r.nominal_force, r.static_force, r.mean_force, r.peak_force,
-                 r.min_force, r.dynamic_factor, r.dynamic_factor_engineering,
-                 r.peak_to_nominal, r.load_sharing, r.contact_loss, r.back_contact]
-                for r in met.rows]
-        _write_csv(path, header, rows)
+                  "dynamic_factor_engineering", "peak_to_nominal", "load_sharing",
+                  "contact_loss_fraction", "back_contact_fraction"]
+        try:
+            met = self.metrics() if self.success else None
+        except (ValueError, ArithmeticError):
+            met = None
+        if met is not None:
+            header[10] = f"load_sharing_{met.definition}"
+            rows = [[r.mesh, r.group, r.nominal_force, r.static_force, r.mean_force,
+                     r.peak_force, r.min_force, r.dynamic_factor,
+                     r.dynamic_factor_engineering, r.peak_to_nominal, r.load_sharing,
+                     r.contact_loss, r.back_contact] for r in met.rows]
+        else:
+            header.append("status")
+            group_of = {m: g for g, ms in self.groups.items() for m in ms}
+            nominal, static = self.nominal_forces(), self.static_forces()
+            rows = [[m, group_of.get(m, ""), nominal[m], static[m]] + [""] * 9
+                    + [self.message] for m in self.mesh_names]
         s = self.solution
         el = self.structure.element_names
         names = [el[i] for i in s.history_elements]
-        _write_csv(path.with_name(path.stem + "_history.csv"),
-                   ["time_s"] + [f"{n}_N" for n in names],
-                   np.column_stack([s.history_t, s.history_forces]).tolist())
         cols = [list(s.tracked_elements).index(el.index(m)) for m in self.mesh_names]
-        _write_csv(path.with_name(path.stem + "_cycles.csv"),
-                   ["cycle"] + [f"{m}_start_s" for m in self.mesh_names]
-                   + [f"{m}_peak_N" for m in self.mesh_names],
-                   np.column_stack([np.arange(s.cycle_max.shape[0]), s.cycle_start[:, cols],
-                                    s.cycle_max[:, cols]]).tolist())
+        history, cycles, summary = plan.files[1], plan.files[2], plan.files[0]
+        contents = {
+            history: files.csv_bytes(["time_s"] + [f"{n}_N" for n in names],
+                                     np.column_stack([s.history_t, s.history_forces]).tolist()),
+            cycles: files.csv_bytes(["cycle"] + [f"{m}_start_s" for m in self.mesh_names]
+                                    + [f"{m}_peak_N" for m in self.mesh_names],
+                                    np.column_stack([np.arange(s.cycle_max.shape[0]),
+                                                     s.cycle_start[:, cols],
+                                                     s.cycle_max[:, cols]]).tolist()),
+            summary: files.csv_bytes(header, rows),  # last: its presence marks the set
+        }
+        with files.claim_output(plan) as claim:
+            claim.write(contents)
         return path
 
     def write_figures(self, directory, formats=("png", "svg"), **kwargs):
@@ -337,15 +379,6 @@ class Results:
         from ..model.io import model_to_json
 
         return model_to_json(self.model)
-
-
-def _write_csv(path: Path, header, rows) -> None:
-    import csv
-
-    with open(path, "w", newline="", encoding="utf-8") as fh:
-        w = csv.writer(fh)
-        w.writerow(header)
-        w.writerows(rows)
 
 
 def open_results(path):

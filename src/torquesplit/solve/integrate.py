@@ -43,7 +43,7 @@ from torquesplit.solve.stability import (
     system_eigenvalues,
 )
 
-__all__ = ["Solution", "integrate", "rhs", "element_forces", "rhs_numpy",
+__all__ = ["Solution", "integrate", "planned_step", "rhs", "element_forces", "rhs_numpy",
            "element_forces_numpy", "compile_kernels", "STATUS_MESSAGES"]
 
 log = logging.getLogger(__name__)
@@ -658,6 +658,35 @@ class _Plan:
     limited_by: str = ""  # rk4: what set the step
 
 
+def _default_step(s: Structure, span: float, spp: int, check: bool):
+    """Default RK4 step: (h, what limited it, steps per excitation period)."""
+    periods = _excitation_periods(s)
+    period = float(periods.min()) if periods.size else _natural_period_min(s)
+    if not math.isfinite(period):  # nothing oscillates: 1000 steps
+        period = span * spp / 1000.0
+    h = period / spp
+    f_hi, element = highest_mode(s)
+    h_lim = ACCURACY / (2 * math.pi * f_hi) if f_hi > 0 else math.inf
+    if check:
+        h_lim = min(h_lim, SAFETY * stable_step(s))
+    if h <= h_lim:
+        return h, "excitation period", spp
+    per = math.ceil(period / h_lim)  # a whole number of steps per period
+    why = (f"the highest mode, {f_hi:.6g} Hz (mostly element '{element}'), needs "
+           f"{per} steps per excitation period instead of {spp}")
+    log.info("RK4 step limited: %s", why)
+    return period / per, why, per
+
+
+def planned_step(structure: Structure, steps_per_period: int | None = None,
+                 span: float = 1.0) -> tuple[float, str]:
+    """The RK4 step :func:`integrate` would take by default and what sets it (the
+    excitation period or the highest mode), without integrating: for cost estimates."""
+    spp = 100 if steps_per_period is None else int(steps_per_period)
+    h, why, _ = _default_step(structure, float(span), spp, True)
+    return h, why
+
+
 def _plan_rk4(s, span, step, steps_per_period, check_stability, record_every,
               sample_interval, full_history, max_steps) -> _Plan:
     spp = 100 if steps_per_period is None else int(steps_per_period)
@@ -666,29 +695,14 @@ def _plan_rk4(s, span, step, steps_per_period, check_stability, record_every,
     check = True if check_stability is None else bool(check_stability)
     limited_by = "excitation period"
     if step is None:
-        periods = _excitation_periods(s)
-        period = float(periods.min()) if periods.size else _natural_period_min(s)
-        if not math.isfinite(period):  # nothing oscillates: 1000 steps
-            period = span * spp / 1000.0
-        h = period / spp
-        f_hi, element = highest_mode(s)
-        h_lim = ACCURACY / (2 * math.pi * f_hi) if f_hi > 0 else math.inf
-        if check:
-            h_lim = min(h_lim, SAFETY * stable_step(s))
-        if h > h_lim:  # keep a whole number of steps per period
-            per = math.ceil(period / h_lim)
-            limited_by = (f"highest mode {f_hi:.6g} Hz (mostly element '{element}'): "
-                          f"{per} steps per excitation period instead of {spp}")
-            log.info("RK4 step limited by the %s", limited_by)
-            if per > _STEP_WARN_FACTOR * spp:
-                warnings.warn(
-                    f"the RK4 step is {per / spp:.3g} times shorter than {spp} steps per "
-                    f"excitation period, because element '{element}' gives a mode at "
-                    f"{f_hi:.4g} Hz that the step must resolve (omega h <= {ACCURACY:g}) "
-                    f"and keep stable; the run takes {math.ceil(span / (period / per)):,} "
-                    f"steps. Check that element's stiffness and unit, or use "
-                    f"method='dopri'.", ModelWarning, stacklevel=4)
-            h = period / per
+        h, limited_by, per = _default_step(s, span, spp, check)
+        if per > _STEP_WARN_FACTOR * spp:
+            warnings.warn(
+                f"the RK4 step is {per / spp:.3g} times shorter than {spp} steps per "
+                f"excitation period: {limited_by}; the run takes "
+                f"{math.ceil(span / h):,} steps. Check that element's stiffness and unit "
+                f"(and the inertias it joins), or use method='dopri'.", ModelWarning,
+                stacklevel=4)
     else:
         h = float(step)
         if check:

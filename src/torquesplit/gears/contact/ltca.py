@@ -38,13 +38,12 @@ from torquesplit.gears.contact.compliance import (
 )
 from torquesplit.gears.contact.modifications import (
     Misalignment,
-    ToothModification,
     flank_coordinates,
     lead_separation,
     profile_separation,
 )
 from torquesplit.gears.geometry import PairGeometry
-from torquesplit.gears.stiffness.phasing import pair_count, pair_positions, require_contact
+from torquesplit.gears.stiffness.phasing import pair_positions, require_contact
 from torquesplit.gears.stiffness.potential_energy import _two, hertz_compliance
 
 __all__ = ["LtcaOptions", "ContactModel", "LtcaResult", "HarrisMap", "ARCSEC_PER_RAD", "ltca_stiffness"]

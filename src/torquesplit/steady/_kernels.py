@@ -1,0 +1,322 @@
+"""Compiled kernels of the periodic steady-state solvers (every ``@njit`` loop here).
+
+Nothing here writes a force law: each kernel calls the integrators' own excitation
+(:func:`torquesplit.solve._kernels.excite`), their one right-hand-side evaluation
+(:func:`torquesplit.solve._kernels._stage`, inlined) and the element laws with their
+derivatives from :mod:`torquesplit.solve.laws` (``spring_force`` -> (f, df/dd, df/dr),
+``spline_tangent``, ``positive_part``).  The linearisation of one state is kept as
+per-element slopes, so a Jacobian-vector product costs one pass over the projections.
+
+=====================  ==============================================================
+kernel                 what it computes
+=====================  ==============================================================
+:func:`sample_rhs`     acceleration, element forces and deformations at many (t, y)
+                       (the alternating frequency-time evaluation of harmonic balance)
+:func:`sample_linearise`  the element slopes at many (t, y): df/dd, df/dr of every
+                       element, the 2-D tangents of splines, the friction-table values
+                       and the slope of max(f, 0) of friction meshes
+:func:`sample_jvp`     d(acceleration) = A_q dq + A_v dv at every sample, for a batch of
+                       directions (the Jacobian of harmonic balance, matrix-free)
+:func:`rk4_variational`  classic RK4 of the state together with its variational
+                       equations dPhi/dt = A(t, y) Phi (the monodromy for shooting
+                       and Floquet multipliers); the state steps are those of
+                       ``_kernels.rk4_run`` with exact excitation at every stage
+=====================  ==============================================================
+
+Twin: :func:`torquesplit.solve.reference.rhs_numpy` (tests compare the acceleration and
+finite differences of it with the slopes).
+
+Legend: ``n`` DOFs, ``ne`` elements, ``ns`` splines, ``nf`` friction meshes; a sample's
+linearisation is ``KD[j, e]`` (df/dd), ``CR[j, e]`` (df/dr), ``SPT[j, k, 0:8]``
+(jxx jxy jyx jyy cxx cxy cyx cyy of spline k), ``FRV[j, r]`` (friction-table row r) and
+``FPS[j, i]`` (d max(f, 0)/df of friction mesh i).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from torquesplit.solve import laws
+from torquesplit.solve._kernels import _stage, excite
+from torquesplit.solve.kernel_data import F_MAIN, Y_K1, Y_STATE, Y_TRIAL
+
+_kernel = njit(cache=True, error_model="numpy", _nrt=False)
+_inline = njit(inline="always", error_model="numpy")
+
+
+@_kernel
+def sample_rhs(ts, Y, m, w, rhs_fn, gen, A, F, D):
+    """At each sample j: state ``Y[j]`` = [q, v] at time ``ts[j]`` -> acceleration
+    ``A[j]`` (n), element forces ``F[j]`` and deformations ``D[j]`` (ne).  Exact
+    excitation at every sample (slot 0)."""
+    n = A.shape[1]
+    ne = F.shape[1]
+    extra = m.fr_el.shape[0] > 0 or m.sp_el.shape[0] > 0
+    s0 = np.int64(0)
+    WY, WF, WD = w.Y, w.F, w.D
+    for j in range(ts.shape[0]):
+        excite(ts[j], s0, np.int64(-1), m, w)
+        for k in range(2 * n):
+            WY[Y_STATE, k] = Y[j, k]
+        _stage(s0, Y_STATE, Y_K1, F_MAIN, m, w, rhs_fn, gen, extra)
+        for i in range(n):
+            A[j, i] = WY[Y_K1, n + i]
+        for e in range(ne):
+            F[j, e] = WF[F_MAIN, e]
+            D[j, e] = WD[F_MAIN, e]
+
+
+@_inline
+def _linearise(slot, iy, m, w, force, kd, cr, spt, frv, fps):
+    """Slopes of every element law at state row ``iy`` of w.Y with the excitation of
+    ``slot`` (already computed) into the 1-D outputs; ``force`` gets the forces (the
+    friction slope needs them).  Deformation and rate are the projections V.q - e,
+    V.v - e'; the laws give the rest."""
+    Y = w.Y
+    K, P, G, E, ED, FR = w.K, w.P, w.G, w.E, w.ED, w.FR
+    v_ptr, v_dof, v_coef, damping = m.v_ptr, m.v_dof, m.v_coef, m.damping
+    sp_el, sp_par, fr_el = m.sp_el, m.sp_par, m.fr_el
+    n = m.inv_mass.shape[0]
+    for el in range(v_ptr.shape[0] - 1):
+        d = -E[slot, el]
+        r = -ED[slot, el]
+        for j in range(v_ptr[el], v_ptr[el + 1]):
+            d += v_coef[j] * Y[iy, v_dof[j]]
+            r += v_coef[j] * Y[iy, n + v_dof[j]]
+        f, fd, fr = laws.spring_force(K[slot, el], damping[el], d, r, G[slot, el])
+        kd[el] = fd
+        cr[el] = fr
+        force[el] = f + P[slot, el]
+    for k in range(sp_el.shape[0]):
+        ex = sp_el[k, 0]
+        ey = sp_el[k, 1]
+        dx = 0.0
+        rx = 0.0
+        for j in range(v_ptr[ex], v_ptr[ex + 1]):
+            dx += v_coef[j] * Y[iy, v_dof[j]]
+            rx += v_coef[j] * Y[iy, n + v_dof[j]]
+        dy = 0.0
+        ry = 0.0
+        for j in range(v_ptr[ey], v_ptr[ey + 1]):
+            dy += v_coef[j] * Y[iy, v_dof[j]]
+            ry += v_coef[j] * Y[iy, n + v_dof[j]]
+        (spt[k, 0], spt[k, 1], spt[k, 2], spt[k, 3], spt[k, 4], spt[k, 5], spt[k, 6],
+         spt[k, 7], _, _) = laws.spline_tangent(dx, dy, rx, ry, sp_par[k, 0], sp_par[k, 1],
+                                                sp_par[k, 2], sp_par[k, 3], sp_par[k, 4],
+                                                sp_par[k, 5])
+        fx, fy = laws.spline_force(dx, dy, rx, ry, sp_par[k, 0], sp_par[k, 1], sp_par[k, 2],
+                                   sp_par[k, 3], sp_par[k, 4], sp_par[k, 5])
+        force[ex] = fx
+        force[ey] = fy
+        kd[ex] = 0.0
+        kd[ey] = 0.0
+        cr[ex] = 0.0
+        cr[ey] = 0.0
+    for r in range(FR.shape[1]):
+        frv[r] = FR[slot, r]
+    for i in range(fr_el.shape[0]):
+        _, slope = laws.positive_part(force[fr_el[i]])
+        fps[i] = slope
+
+
+@_inline
+def _jvp(m, kd, cr, spt, frv, fps, dq, dv, out, df):
+    """out = A_q dq + A_v dv for one linearisation (1-D arrays of n; ``df`` scratch of
+    ne): -M^-1 [sum_e V_e (kd_e V_e.dq + cr_e V_e.dv) + splines + friction slopes
+    + C_g dv + G dv]."""
+    v_ptr, v_dof, v_coef = m.v_ptr, m.v_dof, m.v_coef
+    inv_mass, ground = m.inv_mass, m.ground_damping
+    sp_el, fr_el, fr_ptr, fr_dof, fr_coef, fr_row = (m.sp_el, m.fr_el, m.fr_ptr, m.fr_dof,
+                                                     m.fr_coef, m.fr_row)
+    gy_ptr, gy_idx, gy_coef = m.gy_ptr, m.gy_idx, m.gy_coef
+    n = inv_mass.shape[0]
+    ne = v_ptr.shape[0] - 1
+    for i in range(n):
+        out[i] = -ground[i] * dv[i]
+        for j in range(gy_ptr[i], gy_ptr[i + 1]):
+            out[i] -= gy_coef[j] * dv[np.int64(gy_idx[j]) - n]
+    for el in range(ne):
+        a = 0.0
+        b = 0.0
+        for j in range(v_ptr[el], v_ptr[el + 1]):
+            a += v_coef[j] * dq[v_dof[j]]
+            b += v_coef[j] * dv[v_dof[j]]
+        df[el] = kd[el] * a + cr[el] * b
+    for k in range(sp_el.shape[0]):
+        ex = sp_el[k, 0]
+        ey = sp_el[k, 1]
+        ax = 0.0
+        bx = 0.0
+        for j in range(v_ptr[ex], v_ptr[ex + 1]):
+            ax += v_coef[j] * dq[v_dof[j]]
+            bx += v_coef[j] * dv[v_dof[j]]
+        ay = 0.0
+        by = 0.0
+        for j in range(v_ptr[ey], v_ptr[ey + 1]):
+            ay += v_coef[j] * dq[v_dof[j]]
+            by += v_coef[j] * dv[v_dof[j]]
+        df[ex] = spt[k, 0] * ax + spt[k, 1] * ay + spt[k, 4] * bx + spt[k, 5] * by
+        df[ey] = spt[k, 2] * ax + spt[k, 3] * ay + spt[k, 6] * bx + spt[k, 7] * by
+    for el in range(ne):
+        x = df[el]
+        if x != 0.0:
+            for j in range(v_ptr[el], v_ptr[el + 1]):
+                out[v_dof[j]] -= v_coef[j] * x
+    for i in range(fr_el.shape[0]):
+        x = fps[i] * df[fr_el[i]]
+        if x != 0.0:
+            for j in range(fr_ptr[i], fr_ptr[i + 1]):
+                out[fr_dof[j]] -= fr_coef[j] * frv[fr_row[j]] * x
+    for i in range(n):
+        out[i] *= inv_mass[i]
+
+
+@_kernel
+def sample_linearise(ts, Y, m, w, F, KD, CR, SPT, FRV, FPS):
+    """The slopes of every element law at each sample (see the module legend); ``F``
+    gets the element forces."""
+    s0 = np.int64(0)
+    n2 = Y.shape[1]
+    WY = w.Y
+    for j in range(ts.shape[0]):
+        excite(ts[j], s0, np.int64(-1), m, w)
+        for k in range(n2):
+            WY[Y_STATE, k] = Y[j, k]
+        _linearise(s0, Y_STATE, m, w, F[j], KD[j], CR[j], SPT[j], FRV[j], FPS[j])
+
+
+@_kernel
+def sample_jvp(m, KD, CR, SPT, FRV, FPS, dQ, dV, out, df):
+    """``out[c, j] = A_q(t_j) dQ[c, j] + A_v(t_j) dV[c, j]`` for every direction c and
+    sample j (arrays (n_dir, n_samples, n)); ``df`` scratch (ne,)."""
+    for c in range(dQ.shape[0]):
+        for j in range(dQ.shape[1]):
+            _jvp(m, KD[j], CR[j], SPT[j], FRV[j], FPS[j], dQ[c, j], dV[c, j], out[c, j], df)
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _var_stage(slot, iy, idy, m, w, rhs_fn, gen, extra, Pin, Pout, force, kd, cr, spt,
+               frv, fps, df, tmp):
+    """One stage of the state (row idy of w.Y) and of its variations:
+    Pout[:, c] = A(t, y) Pin[:, c] for every column c (first-order form)."""
+    _stage(slot, iy, idy, F_MAIN, m, w, rhs_fn, gen, extra)
+    _linearise(slot, iy, m, w, force, kd, cr, spt, frv, fps)
+    n = m.inv_mass.shape[0]
+    for c in range(Pin.shape[1]):
+        for i in range(n):
+            Pout[i, c] = Pin[n + i, c]
+        _jvp(m, kd, cr, spt, frv, fps, Pin[:n, c], Pin[n:, c], tmp, df)
+        for i in range(n):
+            Pout[n + i, c] = tmp[i]
+
+
+@_kernel
+def rk4_variational(t0, h, n_steps, m, w, rhs_fn, gen, Phi, S, force, kd, cr, spt, frv,
+                    fps, df, tmp):
+    """Classic RK4 from state row Y_STATE of w.Y and variations ``Phi`` (2n, n_col) over
+    ``n_steps`` steps of ``h`` from ``t0``, both advanced in place: the variations obey
+    the RK4 discretisation of dPhi/dt = A(t, y(t)) Phi (so Phi is the exact derivative of
+    the discrete step map).  ``S`` scratch (5, 2n, n_col).  Returns 0, or 1 if the state
+    became non-finite."""
+    Y = w.Y
+    n2 = Y.shape[1]
+    nc = Phi.shape[1]
+    extra = m.fr_el.shape[0] > 0 or m.sp_el.shape[0] > 0
+    s0 = np.int64(0)
+    s1 = np.int64(1)
+    s2 = np.int64(2)
+    k1 = Y_K1
+    k2 = Y_K1 + 1
+    k3 = Y_K1 + 2
+    k4 = Y_K1 + 3
+    hh = 0.5 * h
+    h6 = h / 6.0
+    K1, K2, K3, K4, PT = S[0], S[1], S[2], S[3], S[4]
+    for it in range(n_steps):
+        t = t0 + it * h
+        excite(t, s0, np.int64(-1), m, w)
+        _var_stage(s0, Y_STATE, k1, m, w, rhs_fn, gen, extra, Phi, K1, force, kd, cr,
+                   spt, frv, fps, df, tmp)
+        excite(t + hh, s1, np.int64(-1), m, w)
+        for k in range(n2):
+            Y[Y_TRIAL, k] = Y[Y_STATE, k] + hh * Y[k1, k]
+            for c in range(nc):
+                PT[k, c] = Phi[k, c] + hh * K1[k, c]
+        _var_stage(s1, Y_TRIAL, k2, m, w, rhs_fn, gen, extra, PT, K2, force, kd, cr,
+                   spt, frv, fps, df, tmp)
+        for k in range(n2):
+            Y[Y_TRIAL, k] = Y[Y_STATE, k] + hh * Y[k2, k]
+            for c in range(nc):
+                PT[k, c] = Phi[k, c] + hh * K2[k, c]
+        _var_stage(s1, Y_TRIAL, k3, m, w, rhs_fn, gen, extra, PT, K3, force, kd, cr,
+                   spt, frv, fps, df, tmp)
+        excite(t0 + (it + 1) * h, s2, np.int64(-1), m, w)
+        for k in range(n2):
+            Y[Y_TRIAL, k] = Y[Y_STATE, k] + h * Y[k3, k]
+            for c in range(nc):
+                PT[k, c] = Phi[k, c] + h * K3[k, c]
+        _var_stage(s2, Y_TRIAL, k4, m, w, rhs_fn, gen, extra, PT, K4, force, kd, cr,
+                   spt, frv, fps, df, tmp)
+        bad = False
+        for k in range(n2):
+            Y[Y_STATE, k] += h6 * (Y[k1, k] + 2.0 * (Y[k2, k] + Y[k3, k]) + Y[k4, k])
+            if not np.isfinite(Y[Y_STATE, k]):
+                bad = True
+            for c in range(nc):
+                Phi[k, c] += h6 * (K1[k, c] + 2.0 * (K2[k, c] + K3[k, c]) + K4[k, c])
+        if bad:
+            return 1
+    return 0
+
+
+@_kernel
+def rk4_samples(t0, h, n_steps, every, m, w, rhs_fn, gen, out_t, out_y, out_f):
+    """Classic RK4 (exact excitation at each stage) from state row Y_STATE over
+    ``n_steps``; every ``every`` steps (and at the start) the time, state and element
+    forces are stored in ``out_*`` while they have rows.  Returns the rows written, or
+    -1 if the state became non-finite."""
+    Y = w.Y
+    n2 = Y.shape[1]
+    ne = out_f.shape[1]
+    extra = m.fr_el.shape[0] > 0 or m.sp_el.shape[0] > 0
+    s0 = np.int64(0)
+    s1 = np.int64(1)
+    s2 = np.int64(2)
+    k1 = Y_K1
+    k2 = Y_K1 + 1
+    k3 = Y_K1 + 2
+    k4 = Y_K1 + 3
+    hh = 0.5 * h
+    h6 = h / 6.0
+    row = 0
+    WF = w.F
+    for it in range(n_steps + 1):
+        t = t0 + it * h
+        excite(t, s0, np.int64(-1), m, w)
+        _stage(s0, Y_STATE, k1, F_MAIN, m, w, rhs_fn, gen, extra)
+        if it % every == 0 and row < out_t.shape[0]:
+            out_t[row] = t
+            for k in range(n2):
+                out_y[row, k] = Y[Y_STATE, k]
+            for e in range(ne):
+                out_f[row, e] = WF[F_MAIN, e]
+            row += 1
+        if it == n_steps:
+            break
+        excite(t + hh, s1, np.int64(-1), m, w)
+        for k in range(n2):
+            Y[Y_TRIAL, k] = Y[Y_STATE, k] + hh * Y[k1, k]
+        _stage(s1, Y_TRIAL, k2, np.int64(1), m, w, rhs_fn, gen, extra)
+        for k in range(n2):
+            Y[Y_TRIAL, k] = Y[Y_STATE, k] + hh * Y[k2, k]
+        _stage(s1, Y_TRIAL, k3, np.int64(1), m, w, rhs_fn, gen, extra)
+        excite(t0 + (it + 1) * h, s2, np.int64(-1), m, w)
+        for k in range(n2):
+            Y[Y_TRIAL, k] = Y[Y_STATE, k] + h * Y[k3, k]
+        _stage(s2, Y_TRIAL, k4, np.int64(1), m, w, rhs_fn, gen, extra)
+        for k in range(n2):
+            Y[Y_STATE, k] += h6 * (Y[k1, k] + 2.0 * (Y[k2, k] + Y[k3, k]) + Y[k4, k])
+            if not np.isfinite(Y[Y_STATE, k]):
+                return -1
+    return row

@@ -1,0 +1,335 @@
+"""Model-level periodic steady state: :func:`steady_state` and :class:`SteadyState`.
+
+The pipeline is that of :func:`torquesplit.simulate` with the time integration replaced
+by a periodic solver: model -> kinematics -> structure -> static equilibrium ->
+fundamental period (or the kept excitations) -> periodic state.  The periodic state
+converts to a :class:`torquesplit.results.Results` (:meth:`SteadyState.to_results`)
+whose "run" is the periodic state repeated over a few periods, so every metric, plot
+and export of a dynamic run works on it unchanged.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from torquesplit.errors import SolverError
+from torquesplit.steady.period import (
+    MAX_CYCLES,
+    base_frequency,
+    fundamental_period,
+    keep_excitations,
+    scale_speed,
+)
+from torquesplit.steady.problem import PeriodicProblem
+from torquesplit.steady.solution import PeriodicSolution, periodic_solution
+
+__all__ = ["steady_state", "SteadyState", "MeshSteady", "speed_factor", "reference_speed"]
+
+
+@dataclass(frozen=True)
+class MeshSteady:
+    """One line of the per-mesh table of a periodic state (forces in N)."""
+
+    mesh: str
+    group: str
+    nominal_force: float
+    """Equal-split static tooth force (kinematics)."""
+    static_force: float
+    """The mesh's own static force (static equilibrium)."""
+    mean_force: float
+    min_force: float
+    peak_force: float
+    dynamic_factor: float
+    """peak / the mesh's own static force."""
+    peak_to_nominal: float
+    """peak / the equal-split nominal force."""
+    load_sharing: float
+    rms_transmission_error: float
+    """RMS of the mesh deformation about its mean [m] (dynamic transmission error
+    along the line of action)."""
+    contact_loss: float
+    """Fraction of the period with the teeth apart."""
+
+
+def reference_speed(model) -> float:
+    """|speed| of the model's first drive [rad/s]: the speed factor 1."""
+    drives = list(model.drives.values())
+    if not drives:
+        raise SolverError("the model has no drive, so it has no speed; add a [drives] entry.")
+    return abs(float(drives[0].speed))
+
+
+def speed_factor(model, speed) -> float:
+    """Speed factor of an input speed [rad/s] (None: 1)."""
+    if speed is None:
+        return 1.0
+    s = abs(float(speed)) / reference_speed(model)
+    if not (s > 0 and math.isfinite(s)):
+        raise SolverError(f"speed {speed!r} rad/s is not a positive finite speed; give e.g. "
+                          f"speed=300.0 (rad/s) or '3000 rpm' on the command line.")
+    return s
+
+
+class SteadyState:
+    """A periodic steady state of a model and everything needed to interpret it."""
+
+    def __init__(self, *, model, kinematics, structure, static, period, solution,
+                 dropped, problem):
+        self.model = model
+        self.kinematics = kinematics
+        self.structure = structure
+        self.static = static
+        self.period = period
+        self.solution: PeriodicSolution = solution
+        self.dropped = dropped
+        self.problem: PeriodicProblem = problem
+
+    @property
+    def success(self) -> bool:
+        return self.solution.converged
+
+    @property
+    def mesh_names(self) -> list[str]:
+        return list(self.model.meshes)
+
+    def samples(self, per_cycle: int = 64, n: int | None = None):
+        """(t, forces, deformations) over one period: HB at ``n`` equally spaced times
+        (default: at least ``per_cycle`` per cycle of the fastest excitation; q and v by
+        trigonometric interpolation, the forces from the model's laws at those times);
+        shooting at its RK4 steps."""
+        ps = self.solution
+        if ps.method != "hb":
+            return ps.t, ps.forces, ps.deformations
+        from torquesplit.steady.harmonic import HarmonicBalance
+
+        n_need = per_cycle * max(self.period.max_order, 1)
+        N = max(len(ps.t), 1 << int(math.ceil(math.log2(max(n_need, 2))))) if n is None \
+            else int(n)
+        if N == len(ps.t):
+            return ps.t, ps.forces, ps.deformations
+        every = int(math.ceil((2 * ps.harmonics + 2) / N))  # enough samples for the series
+        hb = HarmonicBalance(self.problem, ps.harmonics, N * every)
+        x = ps.coefficients
+        q, v, _ = hb.waveforms(x, ps.speed)
+        _, lam = hb.split(x)
+        t = hb.times(ps.speed)
+        Y = hb._states(q, v, lam)[::every]
+        t = t[::every]
+        _, F, D = self.problem.accelerations(t, Y, ps.speed)
+        return t, F, D
+
+    def to_results(self, periods: int | None = None):
+        """The periodic state as :class:`~torquesplit.results.Results` (the state
+        repeated over ``periods`` periods: default enough for 4 settle windows)."""
+        from torquesplit.results import Results
+
+        shell = Results(model=self.model, kinematics=self.kinematics,
+                        structure=self.structure, static=self.static, solution=None)
+        sol = _as_solution(self, shell, periods)
+        return Results(model=self.model, kinematics=self.kinematics, structure=self.structure,
+                       static=self.static, solution=sol)
+
+    def mesh_table(self, definition: str | None = None) -> list[MeshSteady]:
+        """Per-mesh static, mean, min and peak force, dynamic factors, load sharing
+        (``definition``: the model's by default), RMS transmission error, contact loss."""
+        res = self.to_results()
+        met = res.metrics(definition)
+        names = self.structure.element_names
+        _, F, D = self.samples()
+        out = []
+        for r in met.rows:
+            e = names.index(r.mesh)
+            d = D[:, e]
+            out.append(MeshSteady(
+                mesh=r.mesh, group=r.group, nominal_force=r.nominal_force,
+                static_force=r.static_force, mean_force=float(F[:, e].mean()),
+                min_force=float(F[:, e].min()), peak_force=float(F[:, e].max()),
+                dynamic_factor=float(F[:, e].max()) / r.static_force,
+                peak_to_nominal=float(F[:, e].max()) / r.nominal_force,
+                load_sharing=r.load_sharing,
+                rms_transmission_error=float(np.sqrt(np.mean((d - d.mean()) ** 2))),
+                contact_loss=r.contact_loss))
+        return out
+
+
+def steady_state(model, *, method: str = "hb", harmonics: int | None = None,
+                 samples: int | None = None, keep=None, speed: float | None = None,
+                 max_cycles: int | None = MAX_CYCLES, stability: bool | str = True,
+                 adaptive: bool = False, energy_tol: float = 1e-6,
+                 tol: float | None = None, steps_per_cycle: int | None = None,
+                 check: bool = True, initial=None) -> SteadyState:
+    """Periodic steady state of a model at one speed.
+
+    Parameters
+    ----------
+    model : Model, str or Path
+    method : {"hb", "shooting"}
+        Harmonic balance with alternating frequency-time evaluation (default), or
+        shooting (Newton on the period map; robust for contact loss and impacts).
+    harmonics : int, optional
+        HB harmonics of the fundamental frequency; default 8 per cycle of the fastest
+        excitation.  With ``adaptive`` it is doubled until the highest quarter of the
+        harmonics holds less than ``energy_tol`` of the velocity energy.
+    samples : int, optional
+        HB time samples per period (default: a power of two >= 4 H + 2).
+    keep : str or float, optional
+        Keep only the excitations periodic with this base (a stage label, a mesh or body
+        name, or a frequency in Hz); the others are replaced by their means and listed
+        in ``SteadyState.dropped``.  Default: every excitation, over their least common
+        period (refused when longer than ``max_cycles`` cycles of the fastest one).
+    speed : float, optional
+        Input speed of the first drive [rad/s] (default the model's).  Torques are kept
+        (a speed change at constant load); excitation tables are functions of the mesh
+        phase and stay.
+    stability : bool or "hill" or "monodromy"
+        Floquet multipliers (Hill's method for small HB systems, else the monodromy).
+    tol : float, optional
+        Newton tolerance (HB: 1e-10 of the largest acceleration; shooting: 1e-9 of the
+        largest deformation).
+    steps_per_cycle : int, optional
+        RK4 steps per cycle of the fastest excitation for shooting and the checks
+        (default 100, refined for the highest mode).
+    check : bool
+        HB: integrate one period from the solution and report the periodicity defect.
+
+    Returns
+    -------
+    SteadyState
+    """
+    from torquesplit.assembly.assemble import assemble
+    from torquesplit.model.io import load_model
+    from torquesplit.model.kinematics import solve_kinematics
+    from torquesplit.solve.static import static_equilibrium
+
+    if not hasattr(model, "meshes"):
+        model = load_model(model)
+    kin = solve_kinematics(model)
+    full = assemble(model, kin)
+    dropped = []
+    structure = full
+    if keep is not None:
+        structure, dropped = keep_excitations(full, base_frequency(full, keep, kin))
+    per = fundamental_period(structure, max_cycles=max_cycles)
+    if keep is not None:
+        base = base_frequency(full, keep, kin)
+        per = _at_base(per, base)
+    static = static_equilibrium(structure)
+    if not np.all(np.isfinite(static.q)):
+        raise SolverError("the static equilibrium failed, so the periodic state has no start; "
+                          "check the clearances and supports (see the run command).")
+    factor = speed_factor(model, speed)
+    problem = PeriodicProblem(structure, per.frequency)
+    sol = periodic_solution(structure, per, method=method, harmonics=harmonics,
+                            samples=samples, speed=factor, q_static=static.q, initial=initial,
+                            tol=tol, adaptive=adaptive, energy_tol=energy_tol,
+                            stability=stability, steps_per_cycle=steps_per_cycle,
+                            check=check, problem=problem)
+    return SteadyState(model=model, kinematics=kin, structure=structure, static=static,
+                       period=per, solution=sol, dropped=dropped, problem=problem)
+
+
+def _at_base(per, base):
+    """The period of kept excitations, stated over the base (1 / base)."""
+    from torquesplit.steady.period import Period
+
+    if per.frequency <= 0:
+        return Period(base, (), ())
+    k = per.frequency / base
+    if abs(k - round(k)) > 1e-9 * k or round(k) < 1:
+        raise SolverError(f"the kept excitations are not periodic with {base:.6g} Hz; "
+                          f"choose another base (keep=...).")
+    return Period(base, per.sources, tuple(int(o * round(k)) for o in per.orders))
+
+
+# --------------------------------------------------------------------------- Results
+def _as_solution(st: SteadyState, shell, periods):
+    """An integrate.Solution made of the periodic state repeated over a few periods."""
+    from torquesplit.solve.integrate import Solution
+
+    s = st.structure
+    ps = st.solution
+    t1, F1, D1 = st.samples()
+    T = ps.period
+    names = list(s.element_names)
+    mesh_names = st.mesh_names
+    track = [names.index(m) for m in mesh_names]
+    supports = [i for i, n in enumerate(names) if ".support." in n]
+    hist = track + supports
+    if periods is None:
+        win = max(shell.settle_windows(20))
+        per_period = min(float(s.frequency[e]) * T for e in track) if track else 1.0
+        periods = max(2, int(math.ceil(4 * (win + 2) / max(per_period, 1e-300))))
+    N = len(t1)
+    t = (t1[None, :] + T * np.arange(periods)[:, None]).ravel()
+    F = np.tile(F1, (periods, 1))
+    D = np.tile(D1, (periods, 1))
+    n_tr = len(track)
+    stats = {}
+    cyc_n = []
+    per_el = []
+    for e in track:
+        sph = s.frequency[e] * t + s.phase[e]
+        fl = np.floor(sph)
+        c = fl + (sph - fl >= 1 - 1e-9)
+        base = c[0]
+        idx = (c - base).astype(np.int64)
+        per_el.append((idx, base))
+        cyc_n.append(int(idx.max()) + 1)
+    nc = max(cyc_n) if cyc_n else 0
+    cmax = np.full((nc, n_tr), np.nan)
+    cmin = np.full((nc, n_tr), np.nan)
+    csum = np.zeros((nc, n_tr))
+    ccnt = np.zeros((nc, n_tr), dtype=np.int64)
+    cstart = np.zeros((nc, n_tr))
+    for j, e in enumerate(track):
+        idx, base = per_el[j]
+        f = F[:, e]
+        mx = np.full(nc, -np.inf)
+        mn = np.full(nc, np.inf)
+        np.maximum.at(mx, idx, f)
+        np.minimum.at(mn, idx, f)
+        sm = np.zeros(nc)
+        np.add.at(sm, idx, f)
+        cnt = np.bincount(idx, minlength=nc)
+        # the first and last cycles are partial (phase offsets): left out
+        cnt[0] = 0
+        cnt[cyc_n[j] - 1:] = 0
+        ok = cnt > 0
+        cmax[ok, j] = mx[ok]
+        cmin[ok, j] = mn[ok]
+        csum[ok, j] = sm[ok] / np.bincount(idx, minlength=nc)[ok]
+        ccnt[:, j] = cnt
+        cstart[:, j] = (base + np.arange(nc) - s.phase[e]) / s.frequency[e]
+    # contact loss over the period
+    sep = np.zeros(s.n_elements)
+    back = np.zeros(s.n_elements)
+    for e in range(s.n_elements):
+        gaps = s.gap_values[s.gap_ptr[e]:s.gap_ptr[e + 1]]
+        if gaps.size == 1:
+            g = np.full(N, gaps[0])
+        else:
+            cyc = np.floor(s.frequency[e] * t1 + s.phase[e]).astype(np.int64) % gaps.size
+            g = gaps[cyc]
+        d = D1[:, e]
+        sep[e] = np.mean((g > 0) & (np.abs(d) <= g))
+        back[e] = np.mean(np.where(g > 0, d < -g, (s.element_kind[e] == 1) & (d < 0)))
+    span = periods * T
+    return Solution(
+        status=0 if ps.converged else 1, message=ps.message, success=ps.converged,
+        method=ps.method, t_span=(0.0, span), t_final=span,
+        y_final=np.concatenate([ps.q[0], ps.v[0]]), n_steps=len(t), n_rejected=0,
+        n_rhs=0, step=None, step_limited_by="", step_min=math.nan, step_max=math.nan,
+        compile_time=0.0, wall_time=ps.wall_time, rhs="general", rhs_compile_time=0.0,
+        dof_names=tuple(s.dof_names), element_names=tuple(s.element_names),
+        tracked_elements=tuple(track), cycle_start=cstart, cycle_max=cmax, cycle_min=cmin,
+        cycle_mean=csum, cycle_count=ccnt, load_sharing_groups=(),
+        cycle_ratio_max=np.full((nc, n_tr), np.nan), cycle_ratio_min=np.full((nc, n_tr), np.nan),
+        history_elements=tuple(hist), history_dofs=(), history_t=t,
+        history_forces=F[:, hist], history_q=np.zeros((len(t), 0)),
+        history_v=np.zeros((len(t), 0)), full_t=None, full_y=None, n_samples=len(t),
+        separation_steps=np.round(sep * len(t)).astype(np.int64),
+        back_contact_steps=np.round(back * len(t)).astype(np.int64),
+        separation_time=sep * span, back_contact_time=back * span)

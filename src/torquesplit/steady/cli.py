@@ -1,0 +1,226 @@
+"""The ``steady`` and ``sweep-speed`` commands, and the Campbell part of ``modes``.
+
+Registered on the main typer app by :mod:`torquesplit.cli` (:func:`register`).  Errors
+print one line and exit with status 2 (the main CLI's ``_fail``).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import Optional
+
+import typer
+from rich.table import Table
+
+RPM = 60.0 / (2 * math.pi)
+
+
+def _speed(text, what):
+    from torquesplit.model.units import parse_quantity
+
+    if text is None:
+        return None
+    return float(parse_quantity(text, "speed"))
+
+
+def _keep(keep):
+    if keep is None:
+        return None
+    try:
+        return float(keep)
+    except ValueError:
+        return keep
+
+
+def register(app, load, fail, console, err_console, json_default):
+    """Add the commands to ``app`` (helpers of :mod:`torquesplit.cli` passed in)."""
+    from torquesplit.errors import TorquesplitError
+
+    @app.command()
+    def steady(
+        model: str = typer.Argument(..., help="Model file (.toml/.json) or example name."),
+        method: str = typer.Option("hb", "--method", help="hb (harmonic balance) or shooting."),
+        harmonics: Optional[int] = typer.Option(
+            None, "--harmonics", help="HB harmonics of the fundamental (default 8 per cycle "
+            "of the fastest excitation)."),
+        adaptive: bool = typer.Option(False, "--adaptive",
+                                      help="Double the harmonics until the top quarter holds "
+                                      "< 1e-6 of the energy."),
+        keep: Optional[str] = typer.Option(
+            None, "--keep", help="Keep only the excitations periodic with this stage, mesh, "
+            "body or frequency [Hz]; the others by their means."),
+        speed: Optional[str] = typer.Option(None, "--speed",
+                                            help="Input speed, e.g. '1200 rpm' (default the model's)."),
+        max_cycles: int = typer.Option(1000, "--max-cycles",
+                                       help="Longest period accepted, in cycles of the fastest excitation."),
+        out: Optional[Path] = typer.Option(None, "--out", help="Write results (.nc, .mat, .csv)."),
+        as_json: bool = typer.Option(False, "--json", help="Print the results as JSON."),
+    ):
+        """Periodic steady state at one speed: per-mesh table, residual, harmonics, stability."""
+        try:
+            if method not in ("hb", "shooting"):
+                raise TorquesplitError(f"--method {method!r} is unknown; use hb or shooting")
+            from torquesplit.steady.api import steady_state
+
+            m, _ = load(model)
+            st = steady_state(m, method=method, harmonics=harmonics, adaptive=adaptive,
+                              keep=_keep(keep), speed=_speed(speed, "speed"),
+                              max_cycles=max_cycles)
+            rows = st.mesh_table()
+            saved = st.to_results().save(out) if out is not None else None
+        except (TorquesplitError, ValueError) as exc:
+            fail(exc)
+            return
+        ps = st.solution
+        mu = ps.multipliers
+        info = {
+            "model": m.model.name, "method": ps.method, "converged": ps.converged,
+            "message": ps.message, "period_s": ps.period, "fundamental_Hz": ps.frequency,
+            "period": st.period.describe(), "harmonics": ps.harmonics,
+            "residual": ps.residual, "time_residual": ps.time_residual,
+            "periodicity_defect": ps.periodicity_defect,
+            "top_harmonic_energy": ps.top_harmonic_energy,
+            "stable": ps.stable, "stability_method": ps.stability_method,
+            "largest_multiplier": float(abs(mu[0])) if mu is not None and mu.size else None,
+            "dropped_excitations": [d.describe() for d in st.dropped],
+            "meshes": {r.mesh: {k: v for k, v in r.__dict__.items() if k != "mesh"}
+                       for r in rows},
+            "results_file": str(saved) if saved else None,
+        }
+        if as_json:
+            print(json.dumps(info, indent=2, default=json_default))
+        else:
+            console.print(f"[bold]{m.model.name}[/]: {ps.message}")
+            console.print(f"{st.period.describe()}")
+            if st.dropped:
+                console.print("kept excitations periodic with the base; replaced by their "
+                              "means: " + "; ".join(d.describe() for d in st.dropped))
+            console.print(
+                f"residual {ps.residual:.2e}, time-domain: midpoint residual "
+                f"{ps.time_residual:.2e}, one-period integration defect "
+                f"{ps.periodicity_defect:.2e}; harmonics {ps.harmonics}"
+                + (f" (top-quarter energy {ps.top_harmonic_energy:.1e})"
+                   if ps.harmonics else ""))
+            if mu is not None:
+                console.print(f"stability ({ps.stability_method}): "
+                              f"{'stable' if ps.stable else 'UNSTABLE'}, largest Floquet "
+                              f"multiplier |mu| = {abs(mu[0]):.6f}")
+            t = Table(title="meshes (periodic steady state)")
+            for col in ("mesh", "group", "static F [N]", "mean F [N]", "peak F [N]",
+                        "DF (peak/static)", "peak/nominal", "LSC", "RMS TE [um]",
+                        "contact loss"):
+                t.add_column(col, justify="left" if col in ("mesh", "group") else "right")
+            for r in rows:
+                t.add_row(r.mesh, r.group, f"{r.static_force:.6g}", f"{r.mean_force:.6g}",
+                          f"{r.peak_force:.6g}", f"{r.dynamic_factor:.5f}",
+                          f"{r.peak_to_nominal:.5f}", f"{r.load_sharing:.5f}",
+                          f"{1e6 * r.rms_transmission_error:.4g}",
+                          f"{100 * r.contact_loss:.2f} %")
+            console.print(t)
+            if saved:
+                console.print(f"results written to {saved}")
+        if not ps.converged:
+            raise typer.Exit(1)
+
+    @app.command("sweep-speed")
+    def sweep_speed_cmd(
+        model: str = typer.Argument(..., help="Model file (.toml/.json) or example name."),
+        start: str = typer.Option(..., "--from", help="First speed, e.g. '500 rpm'."),
+        stop: str = typer.Option(..., "--to", help="Last speed, e.g. '3000 rpm'."),
+        points: int = typer.Option(50, "--points", help="Initial steps over the range."),
+        harmonics: Optional[int] = typer.Option(None, "--harmonics", help="HB harmonics."),
+        keep: Optional[str] = typer.Option(None, "--keep", help="As for 'steady'."),
+        max_cycles: int = typer.Option(1000, "--max-cycles", help="As for 'steady'."),
+        no_stability: bool = typer.Option(False, "--no-stability",
+                                          help="Skip the Floquet multipliers."),
+        cross_check: bool = typer.Option(False, "--cross-check",
+                                         help="Also run-up and run-down time integrations."),
+        out: Optional[Path] = typer.Option(None, "--out", help="Write the Dataset (.nc)."),
+        plot: Optional[Path] = typer.Option(None, "--plot", help="Write the figure (.png/.svg)."),
+        as_json: bool = typer.Option(False, "--json", help="Print a summary as JSON."),
+    ):
+        """Speed response by continuation: dynamic factor, load sharing, RMS TE vs speed."""
+        try:
+            from torquesplit.steady.maps import sweep_speed
+
+            m, _ = load(model)
+            ds = sweep_speed(m, _speed(start, "--from"), _speed(stop, "--to"), points=points,
+                             harmonics=harmonics, keep=_keep(keep), max_cycles=max_cycles,
+                             stability=not no_stability, cross_check=cross_check)
+        except (TorquesplitError, ValueError) as exc:
+            fail(exc)
+            return
+        if out is not None:
+            _to_netcdf(ds, out)
+        if plot is not None:
+            from torquesplit.steady.plot import save, sweep_figure
+
+            save(sweep_figure(ds), plot)
+        summary = {
+            "model": ds.attrs["model"], "points": int(ds.sizes["point"]),
+            "complete": bool(ds.attrs["complete"]), "message": ds.attrs["message"],
+            "fold_speeds_rpm": ds.attrs["fold_speeds_rpm"],
+            "critical_speeds_rpm": ds.attrs["critical_speeds_rpm"],
+            "max_dynamic_factor": {str(k): float(ds["dynamic_factor"].sel(mesh=k).max())
+                                   for k in ds["mesh"].values},
+            "unstable_points": int((~ds["stable"].values).sum()),
+            "wall_time_s": ds.attrs["wall_time_s"],
+        }
+        if as_json:
+            print(json.dumps(summary, indent=2, default=json_default))
+        else:
+            console.print(f"[bold]{summary['model']}[/]: {summary['points']} points, "
+                          f"{ds.attrs['message']} ({summary['wall_time_s']:.3g} s)")
+            if summary["fold_speeds_rpm"]:
+                console.print("turning points (jump speeds): " + ", ".join(
+                    f"{f:.5g} rpm ({k})" for f, k in zip(summary["fold_speeds_rpm"],
+                                                        ds.attrs["fold_kinds"], strict=True)))
+            t = Table(title="largest dynamic factor over the sweep")
+            for col in ("mesh", "DF (peak/static)", "at [rpm]"):
+                t.add_column(col)
+            for k in ds["mesh"].values:
+                df = ds["dynamic_factor"].sel(mesh=k).values
+                i = int(np.nanargmax(df))
+                t.add_row(str(k), f"{df[i]:.5f}", f"{ds['speed_rpm'].values[i]:.6g}")
+            console.print(t)
+            console.print(f"unstable points: {summary['unstable_points']}")
+        if not ds.attrs["complete"]:
+            err_console.print(f"[yellow]warning:[/] {ds.attrs['message']}")
+            raise typer.Exit(1)
+
+
+import numpy as np  # noqa: E402  (used by the commands above)
+
+
+def _to_netcdf(ds, path):
+    ds = ds.copy()
+    for k, v in list(ds.attrs.items()):
+        if isinstance(v, list):
+            ds.attrs[k] = json.dumps(v)
+    ds.to_netcdf(path, engine="h5netcdf")
+
+
+def campbell_command(m, start, stop, plot, as_json, console, json_default):
+    """``modes --campbell``: the resonance map and the critical speeds."""
+    from torquesplit.steady.maps import campbell
+
+    ds, crossings = campbell(m, _speed(start, "--from"), _speed(stop, "--to"))
+    if plot is not None:
+        from torquesplit.steady.plot import campbell_figure, save
+
+        save(campbell_figure(ds), plot)
+    if as_json:
+        print(json.dumps({"critical_speeds": crossings,
+                          "natural_frequencies_Hz": ds["natural_frequency"].values[0].tolist()},
+                         indent=2, default=json_default))
+        return
+    t = Table(title=f"critical speeds between {start} and {stop}")
+    for col in ("speed [rpm]", "mode", "f [Hz]", "excitation", "strain energy (largest shares)"):
+        t.add_column(col)
+    for c in crossings:
+        t.add_row(f"{c['speed_rpm']:.6g}", str(c["mode"]), f"{c['frequency_Hz']:.6g}",
+                  f"{c['order']} x {c['source']}",
+                  ", ".join(f"{n} {100 * v:.0f} %" for n, v in c["energy"]))
+    console.print(t)

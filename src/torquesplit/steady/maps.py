@@ -1,0 +1,280 @@
+"""Model-level speed sweep (:func:`sweep_speed`) and resonance map (:func:`campbell`).
+
+Both return :class:`xarray.Dataset` objects with units and long names; speeds are the
+first drive's speed [rpm in the coordinates, rad/s in ``speed``], frequencies in Hz.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+from torquesplit.errors import SolverError
+from torquesplit.steady.api import reference_speed
+from torquesplit.steady.period import (
+    MAX_CYCLES,
+    base_frequency,
+    fundamental_period,
+    keep_excitations,
+)
+from torquesplit.steady.problem import PeriodicProblem
+from torquesplit.steady.sweep import continue_in_speed, point_metrics, stepped_sweep
+
+RPM = 60.0 / (2 * math.pi)
+
+__all__ = ["sweep_speed", "campbell"]
+
+
+def _prepare(model, keep, max_cycles):
+    from torquesplit.assembly.assemble import assemble
+    from torquesplit.model.io import load_model
+    from torquesplit.model.kinematics import solve_kinematics
+    from torquesplit.solve.static import static_equilibrium
+
+    if not hasattr(model, "meshes"):
+        model = load_model(model)
+    kin = solve_kinematics(model)
+    full = assemble(model, kin)
+    structure, dropped = full, []
+    if keep is not None:
+        base = base_frequency(full, keep, kin)
+        structure, dropped = keep_excitations(full, base)
+    per = fundamental_period(structure, max_cycles=max_cycles)
+    if keep is not None:
+        from torquesplit.steady.api import _at_base
+
+        per = _at_base(per, base)
+    static = static_equilibrium(structure)
+    return model, kin, structure, dropped, per, static
+
+
+def sweep_speed(model, start: float, stop: float, *, points: int = 50,
+                harmonics: int | None = None, samples: int | None = None, keep=None,
+                max_cycles: int | None = MAX_CYCLES, stability: bool = True,
+                max_step: float | None = None, cross_check: bool = False,
+                settle_periods: int = 200, progress=None):
+    """Frequency (speed) response of the periodic state by pseudo-arclength continuation.
+
+    Parameters
+    ----------
+    model : Model, str or Path
+    start, stop : float
+        Speeds of the first drive [rad/s]; the sweep runs from ``start`` to ``stop``.
+    points : int
+        Initial number of steps over the range (the step adapts; folds add points).
+    harmonics, samples, keep, max_cycles
+        As :func:`torquesplit.steady.steady_state`.
+    stability : bool
+        Floquet multipliers at every point (Hill's method for small systems, else the
+        monodromy); unstable points are dashed in the plot.
+    cross_check : bool
+        Also run-up and run-down time integrations at ``points`` speeds (each from the
+        previous end state, ``settle_periods`` periods per speed) for the same plot.
+
+    Returns
+    -------
+    xarray.Dataset
+        dims ``point`` and ``mesh``: speed, mesh frequency, dynamic factor (peak / the
+        mesh's static force), peak-to-nominal, load-sharing coefficient (largest
+        instantaneous ratio in its group over the period), RMS transmission error, peak
+        force, stability and largest Floquet multiplier; attributes: turning points
+        (jump speeds), natural frequencies and their mesh-order crossings, status
+        message.  A continuation that fails keeps the points computed so far
+        (``attrs['complete'] == 0`` and the reason in ``attrs['message']``).
+    """
+    import xarray as xr
+
+    from torquesplit.metrics.load_sharing import group_meshes
+
+    t_start = time.perf_counter()
+    model, kin, s, dropped, per, static = _prepare(model, keep, max_cycles)
+    w_ref = reference_speed(model)
+    s0, s1 = float(start) / w_ref, float(stop) / w_ref
+    if per.frequency <= 0:
+        raise SolverError("the model has no time-varying excitation: its response does not "
+                          "change with speed; nothing to sweep.")
+    problem = PeriodicProblem(s, per.frequency)
+    hb, pts, folds, msg, complete, _ = continue_in_speed(
+        problem, per, static.q, s0, s1, points=points, harmonics=harmonics, samples=samples,
+        stability=stability, max_step=None if max_step is None else max_step / w_ref,
+        progress=progress)
+    mesh_names = list(model.meshes)
+    names = list(s.element_names)
+    track = [names.index(m) for m in mesh_names]
+    meta = s.metadata["meshes"]
+    groups = group_meshes({m: meta[m] for m in mesh_names})
+    gcols = [[mesh_names.index(m) for m in g] for g in groups.values()]
+    static_f = np.array([static.element_forces[e] for e in track])
+    nominal = np.array([kin.meshes[m].force for m in mesh_names])
+    rows = [point_metrics(hb, p.x, p.speed, track, gcols, static_f, nominal,
+                          order=per.max_order) for p in pts]
+    sp = np.array([p.speed for p in pts])
+
+    def stack(key):
+        return np.array([r[key] for r in rows]) if rows else np.zeros((0, len(track)))
+
+    f_mesh = np.array([[meta[m]["frequency"] for m in mesh_names]]) * sp[:, None]
+    ds = xr.Dataset(
+        {
+            "speed": ("point", sp * w_ref, {"units": "rad/s", "long_name": "input speed"}),
+            "mesh_frequency": (("point", "mesh"), f_mesh, {"units": "Hz"}),
+            "dynamic_factor": (("point", "mesh"), stack("dynamic_factor"),
+                               {"units": "1", "long_name": "peak / the mesh's static force"}),
+            "peak_to_nominal": (("point", "mesh"), stack("peak_to_nominal"),
+                                {"units": "1", "long_name": "peak / equal-split nominal force"}),
+            "load_sharing": (("point", "mesh"), stack("load_sharing"),
+                             {"units": "1", "long_name": "largest instantaneous N F_i / sum F_j"}),
+            "rms_transmission_error": (("point", "mesh"), stack("rms_transmission_error"),
+                                       {"units": "m"}),
+            "peak_force": (("point", "mesh"), stack("peak_force"), {"units": "N"}),
+            "stable": ("point", np.array([bool(p.stable) if p.stable is not None else True
+                                          for p in pts], dtype=bool)),
+            "max_multiplier": ("point", np.array([p.max_multiplier for p in pts]),
+                               {"units": "1", "long_name": "largest |Floquet multiplier|"}),
+        },
+        coords={"speed_rpm": ("point", sp * w_ref * RPM, {"units": "rpm"}),
+                "mesh": mesh_names},
+    )
+    crit = critical_speeds(s, static.q, kin, model, min(s0, s1) * w_ref, max(s0, s1) * w_ref)
+    ds.attrs.update(
+        model=model.model.name, method="harmonic balance, pseudo-arclength continuation",
+        harmonics=hb.H, samples=hb.N, fundamental_frequency_at_model_speed_Hz=per.frequency,
+        complete=int(complete), message=msg,
+        fold_speeds_rpm=[f * w_ref * RPM for f, _ in folds],
+        fold_kinds=[k for _, k in folds],
+        kept_excitations="all" if keep is None else str(keep),
+        dropped_excitations=[x.describe() for x in dropped],
+        natural_frequencies_Hz=list(crit["natural_frequencies"]),
+        critical_speeds_rpm=[c["speed_rpm"] for c in crit["crossings"]],
+        critical_speed_labels=[f"mode {c['mode']} x {c['order']} {c['source']}"
+                               for c in crit["crossings"]],
+        loads="torques held at the model's values",
+        wall_time_s=time.perf_counter() - t_start,
+    )
+    if cross_check:
+        grid = np.linspace(min(s0, s1), max(s0, s1), points)
+        up, up_rms = stepped_sweep(problem, per, static.q, grid, settle_periods=settle_periods,
+                                   track=track)
+        down, dn_rms = stepped_sweep(problem, per, static.q, grid[::-1],
+                                     settle_periods=settle_periods, track=track)
+        ds = ds.assign_coords(check_speed_rpm=("check", grid * w_ref * RPM))
+        ds["run_up_dynamic_factor"] = (("check", "mesh"), up / static_f)
+        ds["run_down_dynamic_factor"] = (("check", "mesh"), down[::-1] / static_f)
+        ds["run_up_rms_transmission_error"] = (("check", "mesh"), up_rms)
+        ds["run_down_rms_transmission_error"] = (("check", "mesh"), dn_rms[::-1])
+    return ds
+
+
+def critical_speeds(structure, q, kin, model, w_lo, w_hi, orders=3):
+    """Natural frequencies about ``q`` and their crossings with the mesh-frequency
+    harmonics (orders 1..``orders``) of every mesh and the rotation of every gear,
+    between input speeds ``w_lo`` and ``w_hi`` [rad/s].  The natural frequencies of
+    the model do not depend on speed unless it has speed-dependent (gyroscopic) terms;
+    then they are recomputed per speed by :func:`campbell`."""
+    from torquesplit.solve.modal import modal_analysis
+
+    sol = modal_analysis(structure, q)
+    w_ref = reference_speed(model)
+    lines = _order_lines(kin, model, orders)
+    out = []
+    for i, fn in enumerate(sol.frequencies):
+        if fn <= 0:
+            continue
+        for label, order, per_rad in lines:  # f = order * per_rad * w_input
+            w = fn / (order * per_rad)
+            if w_lo <= w <= w_hi:
+                out.append(dict(mode=i + 1, frequency_Hz=float(fn), order=order,
+                                source=label, speed_rpm=float(w * RPM),
+                                energy=sol.dominant_elements(i, 4)))
+    out.sort(key=lambda c: c["speed_rpm"])
+    return dict(natural_frequencies=sol.frequencies, crossings=out, modal=sol,
+                lines=lines, reference_speed=w_ref)
+
+
+def _order_lines(kin, model, orders):
+    """(label, order, Hz per rad/s of input speed) of every excitation line."""
+    w_ref = reference_speed(model)
+    lines = []
+    seen = set()
+    for name, mk in kin.meshes.items():
+        key = round(mk.frequency, 9)
+        if key in seen:
+            continue
+        seen.add(key)
+        for h in range(1, orders + 1):
+            lines.append((f"mesh {name}", h, mk.frequency / w_ref))
+    shafts = set()
+    for b, bk in kin.bodies.items():
+        key = round(abs(bk.speed), 9)
+        if key in shafts or bk.speed == 0:
+            continue
+        shafts.add(key)
+        lines.append((f"rotation of {b}", 1, abs(bk.speed) / (2 * math.pi) / w_ref))
+    return lines
+
+
+def campbell(model, start: float, stop: float, *, points: int = 41, orders: int = 3,
+             count: int | None = None):
+    """Resonance (Campbell) map: natural frequencies against input speed [rad/s] with the
+    mesh-frequency harmonics of every stage and the shaft orders, and every crossing in
+    the range as a critical speed with the mode's strain-energy shares.
+
+    Natural frequencies are those of the model linearised about its static equilibrium
+    (mean mesh stiffness); a model with speed-dependent terms (a gyroscopic matrix from
+    a rotating frame) is re-assembled at each speed.  Returns an :class:`xarray.Dataset`
+    (dims ``speed``, ``mode``, ``line``) with ``attrs['critical_speeds']`` a list of
+    dicts (mode, frequency, order, source, speed, strain-energy shares).
+    """
+    import xarray as xr
+
+    from torquesplit.solve.modal import modal_analysis
+
+    model, kin, s, _, _, static = _prepare(model, None, None)
+    w_ref = reference_speed(model)
+    lo, hi = float(start), float(stop)
+    if not (lo > 0 and hi > lo and math.isfinite(hi)):
+        raise SolverError(f"the speed range {lo:g}..{hi:g} rad/s must be increasing and "
+                          f"positive; e.g. --from '1000 rpm' --to '3000 rpm'.")
+    speeds = np.linspace(lo, hi, points)
+    if s.n_gyroscopic:
+        freqs = []
+        for w in speeds:
+            st = _structure_at(model, w / w_ref)
+            freqs.append(modal_analysis(st, static.q).frequencies)
+        nf = min(len(f) for f in freqs)
+        F = np.array([f[:nf] for f in freqs])
+    else:
+        f = modal_analysis(s, static.q).frequencies
+        F = np.tile(f, (points, 1))
+    if count is not None:
+        F = F[:, :count]
+    crit = critical_speeds(s, static.q, kin, model, lo, hi, orders)
+    lines = crit["lines"]
+    L = np.array([[o * per * w for (_, o, per) in lines] for w in speeds])
+    crossings = [c for c in crit["crossings"] if count is None or c["mode"] <= count]
+    ds = xr.Dataset(
+        {"natural_frequency": (("speed", "mode"), F, {"units": "Hz"}),
+         "excitation_frequency": (("speed", "line"), L, {"units": "Hz"})},
+        coords={"speed": ("speed", speeds, {"units": "rad/s"}),
+                "speed_rpm": ("speed", speeds * RPM, {"units": "rpm"}),
+                "mode": np.arange(1, F.shape[1] + 1),
+                "line": [f"{o} x {lab}" for lab, o, _ in lines]})
+    ds.attrs["model"] = model.model.name
+    ds.attrs["critical_speeds_rpm"] = [c["speed_rpm"] for c in crossings]
+    ds.attrs["critical_speed_labels"] = [f"mode {c['mode']} ({c['frequency_Hz']:.5g} Hz) x "
+                                         f"{c['order']} {c['source']}" for c in crossings]
+    return ds, crossings
+
+
+def _structure_at(model, factor):  # pragma: no cover - no shipped model has a rotating frame
+    from torquesplit.assembly.assemble import assemble
+    from torquesplit.model.io import model_from_dict, model_to_json
+    import json
+
+    data = json.loads(model_to_json(model))
+    for d in data.get("drives", {}).values():
+        d["speed"] = float(d["speed"]) * factor if isinstance(d["speed"], (int, float)) \
+            else d["speed"]
+    return assemble(model_from_dict(data))

@@ -1,0 +1,200 @@
+"""Newton's method for harmonic balance and shooting, and Floquet multipliers.
+
+* :func:`solve_hb` - damped Newton on the HB equations (:mod:`.harmonic`).
+* :func:`solve_shooting` - Newton on the period map y0 -> y(T) (Keller 1968; Seydel,
+  Practical Bifurcation and Stability Analysis, 3rd ed., 2010, section 7.1), the
+  monodromy matrix dy(T)/dy0 from the variational equations integrated with the state
+  by the compiled RK4 (:func:`._kernels.rk4_variational`).
+* :func:`floquet_monodromy` - Floquet multipliers: eigenvalues of the monodromy matrix
+  (Seydel 2010, section 7.3) on the quotient by the rigid-body subspace.
+* :func:`floquet_hill` - Hill's method on the HB solution (Lazarus & Thomas 2010,
+  C. R. Mecanique 338, the eigenvectors most centred in the harmonics select the
+  Floquet exponents).
+
+Rigid-body modes: the subspace R spanned by [phi_r, 0] (and [0, phi_r] when no load
+characteristic damps the mode) is invariant under the flow and carries no deformation;
+residuals, Newton steps and multipliers are taken on the quotient by R (see
+:mod:`.problem`).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from torquesplit.errors import SolverError
+from torquesplit.steady.harmonic import HarmonicBalance
+from torquesplit.steady.problem import PeriodicProblem
+
+log = logging.getLogger(__name__)
+
+
+@dataclass
+class NewtonInfo:
+    converged: bool
+    iterations: int
+    residual: float
+    """Final relative residual."""
+    history: list
+
+
+def solve_hb(hb: HarmonicBalance, x0, speed=1.0, tol=1e-10, max_iter=25) -> tuple:
+    """Damped Newton on the HB equations from ``x0``; returns (x, NewtonInfo).
+
+    Converged when the largest residual harmonic is below ``tol`` times the largest
+    sampled acceleration.  A step that does not lower the residual is halved (up to 12
+    times)."""
+    x = np.array(x0, dtype=float)
+    R, scale = hb.residual(x, speed, linearise=True)
+    err = float(np.max(np.abs(R))) / scale
+    hist = [err]
+    it = 0
+    while err > tol and it < max_iter:
+        it += 1
+        dx = hb.solve_linear(-R, speed)
+        alpha = 1.0
+        for _ in range(13):
+            xt = x + alpha * dx
+            Rt, st = hb.residual(xt, speed, linearise=True)
+            et = float(np.max(np.abs(Rt))) / st
+            if np.isfinite(et) and et < err * (1 - 1e-4 * alpha) or alpha < 1e-3:
+                break
+            alpha *= 0.5
+        if not np.isfinite(et):
+            break
+        x, R, scale, err = xt, Rt, st, et
+        hist.append(err)
+        log.debug("HB Newton %d: residual %.3e (step %.3g)", it, err, alpha)
+    return x, NewtonInfo(err <= tol, it, err, hist)
+
+
+# ------------------------------------------------------------------------ rigid subspace
+def rigid_subspace(p: PeriodicProblem) -> np.ndarray:
+    """Orthonormal (2n, k) basis of the invariant rigid subspace R."""
+    n = p.n
+    cols = []
+    for r in range(p.nr):
+        z = np.zeros(2 * n)
+        z[:n] = p.rigid[:, r]
+        cols.append(z)
+        if not p.rigid_damped[r]:
+            z = np.zeros(2 * n)
+            z[n:] = p.rigid[:, r]
+            cols.append(z)
+    if not cols:
+        return np.zeros((2 * n, 0))
+    q, _ = np.linalg.qr(np.array(cols).T)
+    return q
+
+
+def complement(p: PeriodicProblem) -> np.ndarray:
+    """Orthonormal (2n, 2n - k) basis of the complement of R."""
+    R = rigid_subspace(p)
+    if R.shape[1] == 0:
+        return np.eye(2 * p.n)
+    q, _ = np.linalg.qr(np.hstack([R, np.eye(2 * p.n)]))
+    return q[:, R.shape[1]:2 * p.n]
+
+
+def floquet_monodromy(p: PeriodicProblem, Phi) -> np.ndarray:
+    """Floquet multipliers of the monodromy ``Phi`` without the rigid-body ones, sorted
+    by decreasing modulus."""
+    Q = complement(p)
+    mu = np.linalg.eigvals(Q.T @ Phi @ Q)
+    return mu[np.argsort(-np.abs(mu))]
+
+
+def floquet_hill(hb: HarmonicBalance, x, speed=1.0, harmonics: int | None = None
+                 ) -> np.ndarray:
+    """Floquet multipliers of the HB solution ``x`` by Hill's method with ``harmonics``
+    (default min(H, 10)) Hill harmonics; rigid-body multipliers left out."""
+    p = hb.p
+    Hh = min(hb.H, 10) if harmonics is None else int(harmonics)
+    q, v, _ = hb.waveforms(x, speed)
+    _, lam = hb.split(x)
+    t = hb.times(speed)
+    lin = p.linearise(t, hb._states(q, v, lam), speed)
+    Q = complement(p)
+    m = Q.shape[1]
+    A = np.empty((hb.N, m, m))
+    for j in range(hb.N):
+        A[j] = Q.T @ p.state_matrix(lin, j, speed) @ Q
+    Ahat = np.fft.fft(A, axis=0) / hb.N  # Ahat[k] multiplies exp(i k w t)
+    w = hb.omega(speed)
+    ks = np.arange(-Hh, Hh + 1)
+    big = np.zeros(((2 * Hh + 1) * m, (2 * Hh + 1) * m), dtype=complex)
+    for a, k in enumerate(ks):
+        for b, l in enumerate(ks):
+            d = k - l
+            if abs(d) >= hb.N // 2:
+                continue
+            blk = Ahat[d % hb.N].copy()
+            if k == l:
+                blk -= 1j * k * w * np.eye(m)
+            big[a * m:(a + 1) * m, b * m:(b + 1) * m] = blk
+    ev, vec = np.linalg.eig(big)
+    wgt = np.abs(vec.reshape(2 * Hh + 1, m, -1)) ** 2
+    wgt = wgt.sum(axis=1)
+    centre = (ks[:, None] * wgt).sum(axis=0) / wgt.sum(axis=0)
+    period = 1.0 / (p.frequency * speed)
+    picked: list[complex] = []
+    # the most centred first; a copy shifted by i k omega (same multiplier) is skipped,
+    # which matters where exponents sit on the strip's edge (real negative multipliers)
+    for i in np.argsort(np.abs(centre)):
+        mu_i = np.exp(ev[i] * period)
+        if any(abs(mu_i - m0) <= 1e-7 * max(1.0, abs(m0)) for m0 in picked):
+            continue
+        picked.append(mu_i)
+        if len(picked) == m:
+            break
+    mu = np.array(picked)
+    return mu[np.argsort(-np.abs(mu))]
+
+
+# ------------------------------------------------------------------------ shooting
+def _deformation_scale(p: PeriodicProblem, y):
+    V = p.structure.projection_matrix()
+    n = p.n
+    return V, max(float(np.max(np.abs(V @ y[:n]), initial=0.0)), 1e-300)
+
+
+def solve_shooting(p: PeriodicProblem, y0, steps: int, speed=1.0, tol=1e-9, max_iter=25):
+    """Newton on the period map: returns (y0, monodromy, NewtonInfo).
+
+    Converged when one period returns to the start within ``tol`` of the largest
+    element deformation (velocities: divided by omega)."""
+    n = p.n
+    T = 1.0 / (p.frequency * speed)
+    w = 2 * math.pi / T
+    R = rigid_subspace(p)
+    Pr = np.eye(2 * n) - R @ R.T  # orthogonal projector on the complement
+    y = np.array(y0, dtype=float)
+    y = Pr @ y
+    V, dscale = _deformation_scale(p, y)
+    hist = []
+    Phi = None
+    it = 0
+    err = math.inf
+    while True:
+        yT, Phi = p.integrate_variational(y, 0.0, T, steps, speed)
+        d = Pr @ (yT - y)
+        dscale = max(float(np.max(np.abs(V @ y[:n]), initial=0.0)),
+                     float(np.max(np.abs(V @ yT[:n]), initial=0.0)), 1e-300)
+        err = max(float(np.max(np.abs(V @ d[:n]), initial=0.0)),
+                  float(np.max(np.abs(V @ d[n:]), initial=0.0)) / w) / dscale
+        hist.append(err)
+        log.debug("shooting Newton %d: defect %.3e", it, err)
+        if err <= tol or it >= max_iter:
+            break
+        it += 1
+        A = np.vstack([Pr @ (Phi - np.eye(2 * n)), R.T])
+        b = -np.concatenate([d, R.T @ y])
+        dy = np.linalg.lstsq(A, b, rcond=None)[0]
+        y = y + dy
+        if not np.all(np.isfinite(y)):
+            raise SolverError("the shooting iteration diverged; start from a better guess "
+                              "(the harmonic-balance solution or a converged neighbour).")
+    return y, Phi, NewtonInfo(err <= tol, it, err, hist)

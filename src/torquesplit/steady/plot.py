@@ -1,0 +1,89 @@
+"""Figures of a speed sweep and of a Campbell diagram (matplotlib OO API, Agg, no pyplot).
+
+The figures consume the Datasets of :mod:`.maps` and recompute nothing.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+
+def _figure(w, h):
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(w, h), layout="constrained")
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def sweep_figure(ds, variable: str = "dynamic_factor"):
+    """``variable`` per mesh against speed: stable solid, unstable dashed, turning points
+    (jump speeds) and critical speeds (natural frequency x mesh order) marked, run-up /
+    run-down time integrations as markers when present."""
+    fig = _figure(8, 4.5)
+    ax = fig.add_subplot()
+    rpm = ds["speed_rpm"].values
+    stable = ds["stable"].values
+    colors = {}
+    for j, mesh in enumerate(ds["mesh"].values):
+        y = ds[variable].values[:, j]
+        line = None
+        for k in range(len(rpm) - 1):
+            st = stable[k] and stable[k + 1]
+            (line,) = ax.plot(rpm[k:k + 2], y[k:k + 2], "-" if st else "--",
+                              color=None if line is None else line.get_color(),
+                              label=str(mesh) if k == 0 else None, lw=1.3)
+        colors[mesh] = line.get_color() if line is not None else None
+        check = f"run_up_{variable}"
+        if check in ds:
+            ax.plot(ds["check_speed_rpm"].values, ds[check].values[:, j], "^", ms=4,
+                    color=colors[mesh], alpha=0.7,
+                    label="run-up (time integration)" if j == 0 else None)
+            ax.plot(ds["check_speed_rpm"].values, ds[f"run_down_{variable}"].values[:, j],
+                    "v", ms=4, color=colors[mesh], alpha=0.7,
+                    label="run-down (time integration)" if j == 0 else None)
+    for f in ds.attrs.get("fold_speeds_rpm", []):
+        ax.axvline(f, color="k", lw=0.8, ls=":")
+    lo, hi = float(np.nanmin(rpm)), float(np.nanmax(rpm))
+    for c, lab in zip(ds.attrs.get("critical_speeds_rpm", []),
+                      ds.attrs.get("critical_speed_labels", []), strict=False):
+        if lo <= c <= hi:
+            ax.axvline(c, color="0.6", lw=0.6)
+            ax.text(c, 1.0, lab, rotation=90, fontsize=6, va="top", ha="right",
+                    transform=ax.get_xaxis_transform(), color="0.4")
+    ax.set_xlabel("input speed [rpm]")
+    ax.set_ylabel(ds[variable].attrs.get("long_name", variable))
+    ax.set_title(f"{ds.attrs.get('model', '')}: {variable.replace('_', ' ')} "
+                 f"(solid stable, dashed unstable, dotted: turning points)", fontsize=9)
+    ax.legend(fontsize=7, ncol=2)
+    return fig
+
+
+def campbell_figure(ds):
+    """Natural frequencies and excitation lines against speed; crossings marked."""
+    fig = _figure(8, 5)
+    ax = fig.add_subplot()
+    rpm = ds["speed_rpm"].values
+    for m in range(ds.sizes["mode"]):
+        ax.plot(rpm, ds["natural_frequency"].values[:, m], color="k", lw=0.8)
+    for j, lab in enumerate(ds["line"].values):
+        ax.plot(rpm, ds["excitation_frequency"].values[:, j], lw=0.8, ls="--", label=str(lab))
+    fmax = float(np.nanmax(ds["excitation_frequency"].values))
+    for c in ds.attrs.get("critical_speeds_rpm", []):
+        ax.axvline(c, color="r", lw=0.5, alpha=0.5)
+    ax.set_ylim(0, fmax * 1.05)
+    ax.set_xlabel("input speed [rpm]")
+    ax.set_ylabel("frequency [Hz]")
+    ax.set_title(f"{ds.attrs.get('model', '')}: Campbell diagram", fontsize=9)
+    ax.legend(fontsize=6, ncol=2)
+    return fig
+
+
+def save(fig, path) -> Path:
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=150)
+    return path

@@ -1,0 +1,184 @@
+"""A structure prepared for periodic solutions: kernel bundles, rigid modes, speed.
+
+Shared by harmonic balance and shooting.  The equations are those the integrators
+solve, ``y' = [v, a(t, q, v)]`` with ``a`` the compiled right-hand side, plus the
+treatment of the torsional rigid-body modes that a periodic state needs:
+
+* the mean position along each mass-normalised rigid mode phi_r is fixed,
+  ``phi_r^T M q_0 = 0`` (the static solver's constraint);
+* if nothing damps a rigid mode, a mean load along it (tooth-friction losses of a
+  torque-balanced train) is carried as the d'Alembert force of a uniform acceleration
+  lambda (``q'' = a - phi_r lambda``), as in the static solution;
+* if the load has a speed characteristic (ground damping on the mode), the train turns
+  at a steady speed offset lambda instead (``v -> v + phi_r lambda`` in ``a``).
+
+Neither changes an element deformation (V phi_r = 0), so forces are those of the model.
+The speed of the model is scaled by ``speed`` (1 = the model's speed): every excitation
+frequency and error angular frequency scales with it, the tables (functions of the mesh
+phase) do not.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from torquesplit.assembly.structure import Structure
+from torquesplit.errors import SolverError
+from torquesplit.solve import codegen
+from torquesplit.solve import kernel_data as kd
+from torquesplit.solve.static import rigid_body_modes
+from torquesplit.steady import _kernels as sk
+
+
+class PeriodicProblem:
+    """``structure`` with fundamental frequency ``frequency`` [Hz] at speed factor 1."""
+
+    def __init__(self, structure: Structure, frequency: float):
+        if not (frequency > 0 and math.isfinite(frequency)):
+            raise SolverError(f"the fundamental frequency must be a positive number of Hz, "
+                              f"got {frequency!r}; see steady.fundamental_period.")
+        self.structure = structure
+        self.frequency = float(frequency)
+        self.model = kd.kernel_model(structure)
+        self.code = codegen.general_rhs()
+        self.work = kd.make_work(self.model, self.code.parameters)
+        s = structure
+        self.n = s.n_dof
+        self.ne = s.n_elements
+        self.ns = s.n_splines
+        self.nf = s.n_friction
+        self.mass = 1.0 / s.inv_mass
+        phi = rigid_body_modes(s)
+        self.rigid = np.ascontiguousarray(phi)
+        c = np.einsum("ir,i,ir->r", phi, s.ground_damping, phi) if phi.size else np.zeros(0)
+        self.rigid_damped = c > 1e-12 * max(float(np.max(s.ground_damping, initial=0.0)), 1e-300)
+        self._models: dict[float, kd.KernelModel] = {}
+
+    @property
+    def nr(self) -> int:
+        return int(self.rigid.shape[1])
+
+    def model_at(self, speed: float) -> kd.KernelModel:
+        """Kernel model at ``speed`` times the model's speed."""
+        key = float(speed)
+        m = self._models.get(key)
+        if m is None:
+            if len(self._models) > 8:
+                self._models.clear()
+            m = self.model._replace(frequency=self.model.frequency * key,
+                                    error_omega=self.model.error_omega * key)
+            self._models[key] = m
+        return m
+
+    # ---------------------------------------------------------------- evaluation
+    def accelerations(self, t, Y, speed=1.0):
+        """(acceleration (N, n), element forces (N, ne), deformations (N, ne)) at the
+        states ``Y`` (N, 2n) and times ``t`` (N,)."""
+        t = np.ascontiguousarray(t, dtype=np.float64)
+        Y = np.ascontiguousarray(Y, dtype=np.float64)
+        N = t.shape[0]
+        A = np.empty((N, self.n))
+        F = np.empty((N, self.ne))
+        D = np.empty((N, self.ne))
+        sk.sample_rhs(t, Y, self.model_at(speed), self.work, self.code.function,
+                      self.code.generated, A, F, D)
+        return A, F, D
+
+    def linearise(self, t, Y, speed=1.0):
+        """Slopes of every element law at the samples (see :mod:`._kernels`)."""
+        t = np.ascontiguousarray(t, dtype=np.float64)
+        Y = np.ascontiguousarray(Y, dtype=np.float64)
+        N = t.shape[0]
+        lin = (np.empty((N, self.ne)), np.empty((N, self.ne)), np.empty((N, self.ne)),
+               np.zeros((N, max(self.ns, 1), 8)), np.zeros((N, max(3 * self.nf, 1))),
+               np.zeros((N, max(self.nf, 1))))
+        sk.sample_linearise(t, Y, self.model_at(speed), self.work, *lin)
+        return lin[1:]
+
+    def jvp(self, lin, dQ, dV, speed=1.0):
+        """A_q dQ + A_v dV at every sample for directions (n_dir, N, n)."""
+        dQ = np.ascontiguousarray(dQ, dtype=np.float64)
+        dV = np.ascontiguousarray(dV, dtype=np.float64)
+        out = np.empty_like(dQ)
+        sk.sample_jvp(self.model_at(speed), *lin, dQ, dV, out, np.empty(self.ne))
+        return out
+
+    def mean_jacobian(self, lin, speed=1.0, max_samples=1024):
+        """Time-averaged (A_q, A_v), each (n, n), over at most ``max_samples`` samples."""
+        N = lin[0].shape[0]
+        stride = max(1, N // max_samples)
+        sub = tuple(np.ascontiguousarray(a[::stride]) for a in lin)
+        Ns = sub[0].shape[0]
+        eye = np.broadcast_to(np.eye(self.n)[:, None, :], (self.n, Ns, self.n))
+        zero = np.zeros((self.n, Ns, self.n))
+        aq = self.jvp(sub, eye, zero, speed).mean(axis=1).T
+        av = self.jvp(sub, zero, eye, speed).mean(axis=1).T
+        return aq, av
+
+    def state_matrix(self, lin, j, speed=1.0):
+        """First-order A(t_j) = [[0, I], [A_q, A_v]] of sample j (2n, 2n)."""
+        n = self.n
+        one = tuple(np.ascontiguousarray(a[j:j + 1]) for a in lin)
+        eye = np.eye(n)[:, None, :]
+        zero = np.zeros((n, 1, n))
+        aq = self.jvp(one, eye, zero, speed)[:, 0, :].T
+        av = self.jvp(one, zero, eye, speed)[:, 0, :].T
+        A = np.zeros((2 * n, 2 * n))
+        A[:n, n:] = np.eye(n)
+        A[n:, :n] = aq
+        A[n:, n:] = av
+        return A
+
+    # ---------------------------------------------------------------- integration
+    def integrate_variational(self, y0, t0, period, steps, speed=1.0, columns=None):
+        """RK4 over one ``period`` in ``steps`` steps from ``y0`` at ``t0`` with the
+        variational equations: returns (y(T), Phi) with Phi = dy(T)/dy0 applied to
+        ``columns`` (2n, k; identity by default).  Raises SolverError if it diverged."""
+        n2 = 2 * self.n
+        Phi = np.ascontiguousarray(np.eye(n2) if columns is None else columns, dtype=float)
+        nc = Phi.shape[1]
+        w = self.work
+        w.Y[kd.Y_STATE] = y0
+        S = np.empty((5, n2, nc))
+        status = sk.rk4_variational(
+            float(t0), float(period) / steps, int(steps), self.model_at(speed), w,
+            self.code.function, self.code.generated, Phi, S, np.empty(self.ne),
+            np.empty(self.ne), np.empty(self.ne), np.zeros((max(self.ns, 1), 8)),
+            np.zeros(max(3 * self.nf, 1)), np.zeros(max(self.nf, 1)), np.empty(self.ne),
+            np.empty(self.n))
+        if status != 0:
+            raise SolverError("the state became non-finite while integrating one period; "
+                              "the periodic state is far from the guess or the model "
+                              "diverges: start from a converged neighbour or check the model.")
+        return w.Y[kd.Y_STATE].copy(), Phi
+
+    def integrate(self, y0, t0, duration, steps, every=1, speed=1.0, max_rows=None):
+        """Plain RK4 (exact excitation per stage) from ``y0``: returns (t, Y, F) every
+        ``every`` steps."""
+        rows = steps // every + 1 if max_rows is None else int(max_rows)
+        out_t = np.empty(rows)
+        out_y = np.empty((rows, 2 * self.n))
+        out_f = np.empty((rows, self.ne))
+        self.work.Y[kd.Y_STATE] = y0
+        got = sk.rk4_samples(float(t0), float(duration) / steps, int(steps), int(every),
+                             self.model_at(speed), self.work, self.code.function,
+                             self.code.generated, out_t, out_y, out_f)
+        if got < 0:
+            raise SolverError("the time integration diverged (non-finite state); use more "
+                              "steps per period or check the model.")
+        return out_t[:got], out_y[:got], out_f[:got], self.work.Y[kd.Y_STATE].copy()
+
+    def rk4_steps(self, period, steps_per_cycle=None, max_order=1):
+        """RK4 steps for one period: ``steps_per_cycle`` per cycle of the fastest
+        excitation (default 100, refined so that omega_max h <= 1 for the highest mode,
+        as the integrator's default)."""
+        from torquesplit.solve.stability import highest_mode
+
+        spc = 100 if steps_per_cycle is None else int(steps_per_cycle)
+        n = spc * max(1, int(max_order))
+        f_hi, _ = highest_mode(self.structure)
+        if f_hi > 0:
+            n = max(n, int(math.ceil(2 * math.pi * f_hi * period)))
+        return n

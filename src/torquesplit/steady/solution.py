@@ -1,0 +1,267 @@
+"""Periodic steady state at one operating point: :func:`periodic_solution`.
+
+Works on an assembled :class:`~torquesplit.assembly.structure.Structure`; the model
+pipeline (model -> kinematics -> structure -> static -> periodic state -> Results) is
+:func:`torquesplit.steady.steady_state`.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from torquesplit.errors import SolverError
+from torquesplit.solve._frozen import freeze_arrays
+from torquesplit.steady.harmonic import HarmonicBalance, default_samples
+from torquesplit.steady.newton import (
+    floquet_hill,
+    floquet_monodromy,
+    solve_hb,
+    solve_shooting,
+)
+from torquesplit.steady.period import Period
+from torquesplit.steady.problem import PeriodicProblem
+
+log = logging.getLogger(__name__)
+
+STABILITY_TOL = 1e-6
+"""A periodic state is stable when every Floquet multiplier has |mu| <= 1 + this."""
+HARMONICS_PER_CYCLE = 8
+"""Default harmonics per cycle of the fastest excitation."""
+HILL_LIMIT = 800
+"""Largest Hill matrix (complex, square) for Hill's method; larger: the monodromy."""
+
+
+@dataclass(frozen=True, eq=False)
+class PeriodicSolution:
+    """A periodic steady state over one period (SI; samples at ``t``)."""
+
+    method: str
+    """'hb' (harmonic balance) or 'shooting'."""
+    converged: bool
+    message: str
+    speed: float
+    """Speed factor (1 = the model's speed)."""
+    frequency: float
+    """Fundamental frequency at this speed [Hz]."""
+    harmonics: int | None
+    """Harmonics of the fundamental (HB)."""
+    iterations: int
+    residual: float
+    """Final Newton residual: HB, largest residual harmonic over the largest
+    acceleration; shooting, the periodicity defect over the largest deformation."""
+    time_residual: float
+    """Time-domain check: RMS of the equation residual q'' - a(t, q, q') midway between
+    the HB samples over the largest acceleration (large where a table steps: the series
+    cannot follow a jump of the acceleration); shooting: the same as ``residual``."""
+    periodicity_defect: float
+    """One period integrated by RK4 from the solution's state at t = 0 returns within
+    this (largest element deformation mismatch over the largest deformation); NaN when
+    not checked."""
+    top_harmonic_energy: float
+    """Share of the velocity energy sum m (k w)^2 |c_k|^2 in the highest quarter of the
+    retained harmonics (HB; NaN for shooting)."""
+    multipliers: np.ndarray | None
+    """Floquet multipliers (rigid-body ones left out), by decreasing modulus."""
+    stability_method: str
+    """'monodromy', 'hill' or '' (not computed)."""
+    t: np.ndarray
+    """(N,) sample times over one period [s]."""
+    q: np.ndarray
+    """(N, n) displacements [m, rad]."""
+    v: np.ndarray
+    """(N, n) velocities."""
+    forces: np.ndarray
+    """(N, n_el) element forces [N]."""
+    deformations: np.ndarray
+    """(N, n_el) element deformations V q - e [m]."""
+    rigid_load: np.ndarray
+    """Per rigid mode: uniform acceleration carried (undamped mode) or steady speed
+    offset (mode damped by a load characteristic)."""
+    coefficients: np.ndarray | None = field(default=None)
+    """HB unknowns (a_0, a_1, b_1, ... per DOF, then the rigid terms)."""
+    wall_time: float = 0.0
+
+    def __post_init__(self):
+        freeze_arrays(self)
+
+    @property
+    def period(self) -> float:
+        return 1.0 / self.frequency
+
+    @property
+    def stable(self) -> bool | None:
+        if self.multipliers is None:
+            return None
+        return bool(np.max(np.abs(self.multipliers), initial=0.0) <= 1 + STABILITY_TOL)
+
+    @property
+    def y0(self) -> np.ndarray:
+        return np.concatenate([self.q[0], self.v[0]])
+
+
+def _initial_hb(hb: HarmonicBalance, q_static, initial):
+    x = np.zeros(hb.size)
+    u, _ = hb.split(x)
+    if initial is not None:
+        init = np.asarray(initial, dtype=float)
+        if init.ndim == 1 and init.size == 2 * hb.p.n:  # a state: mean from it
+            u[0] = init[:hb.p.n]
+        else:  # coefficients of another H
+            return pad_coefficients(init, hb)
+    elif q_static is not None:
+        u[0] = q_static
+    p = hb.p
+    if p.nr:
+        u[0] -= p.rigid @ (p.rigid.T @ (p.mass * u[0]))
+    return x
+
+
+def pad_coefficients(x_old, hb: HarmonicBalance, n_rigid: int | None = None):
+    """HB unknowns of another harmonic count, truncated or padded with zeros."""
+    n = hb.p.n
+    nr = hb.p.nr if n_rigid is None else n_rigid
+    m = (len(x_old) - nr) // n
+    old = x_old[:m * n].reshape(m, n)
+    x = np.zeros(hb.size)
+    u, lam = hb.split(x)
+    k = min(m, u.shape[0])
+    u[:k] = old[:k]
+    lam[:] = x_old[m * n:]
+    return x
+
+
+def top_energy(hb: HarmonicBalance, x, speed=1.0) -> float:
+    """Share of the velocity energy in the highest quarter of the harmonics."""
+    u, _ = hb.split(x)
+    k = np.arange(1, hb.H + 1)
+    e = ((u[1::2] ** 2 + u[2::2] ** 2) * hb.p.mass[None, :]).sum(axis=1) * k**2
+    tot = float(e.sum())
+    if tot <= 0:
+        return 0.0
+    return float(e[k > 0.75 * hb.H].sum() / tot)
+
+
+def periodic_solution(structure, period: Period, *, method: str = "hb", harmonics=None,
+                      samples=None, speed: float = 1.0, q_static=None, initial=None,
+                      tol: float | None = None, adaptive: bool = False,
+                      energy_tol: float = 1e-6, max_harmonics: int = 2**15,
+                      stability: bool | str = True, steps_per_cycle: int | None = None,
+                      check: bool = True, problem: PeriodicProblem | None = None
+                      ) -> PeriodicSolution:
+    """Periodic steady state of ``structure`` over ``period`` (see :func:`steady_state`
+    for the parameters).  ``q_static`` starts the iteration (HB: as the mean)."""
+    t_start = time.perf_counter()
+    if method not in ("hb", "shooting"):
+        raise SolverError(f"unknown method {method!r}; use method='hb' (harmonic balance) "
+                          "or method='shooting'.")
+    if period.frequency <= 0:
+        raise SolverError("the structure has no time-varying excitation, so its steady state "
+                          "is the static equilibrium; use static_equilibrium instead.")
+    p = problem or PeriodicProblem(structure, period.frequency)
+    order = max(period.max_order, 1)
+    f = period.frequency * speed
+    T = 1.0 / f
+    steps = p.rk4_steps(T, steps_per_cycle, order)
+    multipliers = None
+    stab_method = ""
+    if method == "hb":
+        H = int(harmonics) if harmonics is not None else HARMONICS_PER_CYCLE * order
+        tol = 1e-10 if tol is None else tol
+        while True:
+            hb = HarmonicBalance(p, H, samples)
+            x0 = _initial_hb(hb, q_static, initial)
+            x, info = solve_hb(hb, x0, speed, tol)
+            energy = top_energy(hb, x, speed)
+            if not adaptive or energy <= energy_tol or 2 * H > max_harmonics or not info.converged:
+                break
+            log.info("HB with %d harmonics: top-band energy %.2e > %.1e, doubling", H, energy,
+                     energy_tol)
+            initial = x
+            H *= 2
+        r, a, F, D, q, v = hb.residual_samples(x, speed)
+        rm = hb.residual_samples(x, speed, shift=0.5)[0]
+        t_res = float(np.sqrt(np.mean(rm**2))) / max(float(np.max(np.abs(a))), 1e-300)
+        t = hb.times(speed)
+        _, lam = hb.split(x)
+        v = hb._states(q, v, lam)[:, p.n:]  # physical velocity (rigid speed offset included)
+        if stability:
+            m2 = 2 * p.n - (p.nr + int(np.sum(~p.rigid_damped)))
+            if stability == "hill" or (stability is True and hill_applies(p, H, f)):
+                multipliers = floquet_hill(hb, x, speed, None if stability == "hill" else H)
+                stab_method = "hill"
+        defect = math.nan
+        if check or (stability and multipliers is None):
+            y0 = np.concatenate([q[0], v[0]])
+            yT, Phi = p.integrate_variational(y0, 0.0, T, steps, speed,
+                                              columns=None if (stability and multipliers is None)
+                                              else np.zeros((2 * p.n, 0)))
+            defect = _defect(p, y0, yT)
+            if stability and multipliers is None:
+                multipliers = floquet_monodromy(p, Phi)
+                stab_method = "monodromy"
+        msg = (f"harmonic balance, {H} harmonics of {f:.6g} Hz, {hb.N} samples: "
+               + ("converged" if info.converged else "did NOT converge")
+               + f" in {info.iterations} Newton steps (residual {info.residual:.2e})")
+        coeffs = x
+    else:
+        tol = 1e-9 if tol is None else tol
+        if initial is not None and np.size(initial) == 2 * p.n:
+            y0 = np.asarray(initial, dtype=float)
+        else:
+            y0 = np.concatenate([q_static if q_static is not None else np.zeros(p.n),
+                                 np.zeros(p.n)])
+            # a few periods of transient first: closer to the attracting orbit
+            _, _, _, y0 = p.integrate(y0, 0.0, 5 * T, 5 * steps, every=5 * steps, speed=speed)
+        y0, Phi, info = solve_shooting(p, y0, steps, speed, tol)
+        tt, Y, F, _ = p.integrate(y0, 0.0, T, steps, 1, speed)
+        t, q, v = tt[:-1], Y[:-1, :p.n], Y[:-1, p.n:]
+        _, _, D = p.accelerations(t, Y[:-1], speed)
+        F = F[:-1]
+        t_res = info.residual
+        defect = info.residual
+        energy = math.nan
+        H = None
+        lam = np.zeros(p.nr)
+        if stability:
+            multipliers = floquet_monodromy(p, Phi)
+            stab_method = "monodromy"
+        msg = (f"shooting, {steps} RK4 steps per period of {T:.6g} s: "
+               + ("converged" if info.converged else "did NOT converge")
+               + f" in {info.iterations} Newton steps (defect {info.residual:.2e})")
+        coeffs = None
+    return PeriodicSolution(
+        method=method, converged=info.converged, message=msg, speed=float(speed),
+        frequency=f, harmonics=H, iterations=info.iterations, residual=info.residual,
+        time_residual=t_res, periodicity_defect=defect, top_harmonic_energy=energy,
+        multipliers=multipliers, stability_method=stab_method, t=np.asarray(t),
+        q=np.asarray(q), v=np.asarray(v), forces=np.asarray(F), deformations=np.asarray(D),
+        rigid_load=np.asarray(lam, dtype=float), coefficients=coeffs,
+        wall_time=time.perf_counter() - t_start)
+
+
+def hill_applies(p: PeriodicProblem, H: int, frequency: float) -> bool:
+    """Hill's method is used automatically when its matrix is small and its harmonics
+    reach beyond the highest natural frequency (else the truncation cannot hold the
+    fast modes and the monodromy is used)."""
+    from torquesplit.solve.stability import highest_mode
+
+    m2 = 2 * p.n - (p.nr + int(np.sum(~p.rigid_damped)))
+    f_hi, _ = highest_mode(p.structure)
+    return m2 * (2 * H + 1) <= HILL_LIMIT and H * frequency >= 1.5 * f_hi
+
+
+def _defect(p: PeriodicProblem, y0, yT) -> float:
+    from torquesplit.steady.newton import rigid_subspace
+
+    R = rigid_subspace(p)
+    d = yT - y0
+    d = d - R @ (R.T @ d)
+    V = p.structure.projection_matrix()
+    n = p.n
+    scale = max(float(np.max(np.abs(V @ y0[:n]), initial=0.0)), 1e-300)
+    return float(np.max(np.abs(V @ d[:n]), initial=0.0)) / scale

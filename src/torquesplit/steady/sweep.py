@@ -1,0 +1,318 @@
+"""Speed sweeps: pseudo-arclength continuation of the periodic state in speed.
+
+The harmonic-balance equations R(x, s) = 0 (:mod:`.harmonic`) are followed in the
+speed factor s by pseudo-arclength continuation (Keller 1977; Seydel, Practical
+Bifurcation and Stability Analysis, 2010, section 4.5): tangent predictor, corrector on
+``[R(x, s); t.(z - z_pred)] = 0`` with the bordered Jacobian (dR/ds by a finite
+difference), step length adapted to the Newton iterations.  The branch may turn back
+(fold of a softening backlash response); folds are found where ds/d(arclength)
+changes sign and reported as jump speeds.  Each point gets its Floquet multipliers
+(unstable where one leaves the unit circle).  Torques are held at the model's values;
+the excitation tables, functions of the mesh phase, stay.
+
+A failed corrector halves the step; below the smallest step the sweep stops and the
+curve computed so far is returned with the reason (``SpeedSweep.message``).
+:func:`stepped_sweep` is the time-integration cross-check: constant-speed RK4 runs at
+increasing (run-up) or decreasing (run-down) speeds, each started from the previous
+end state.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from torquesplit.errors import SolverError
+from torquesplit.steady.harmonic import HarmonicBalance
+from torquesplit.steady.newton import floquet_hill, floquet_monodromy
+from torquesplit.steady.solution import HARMONICS_PER_CYCLE, _initial_hb, hill_applies
+
+log = logging.getLogger(__name__)
+
+
+@dataclass
+class SweepPoint:
+    speed: float
+    """Speed factor."""
+    x: np.ndarray
+    stable: bool | None
+    max_multiplier: float
+    iterations: int
+
+
+@dataclass
+class SpeedSweep:
+    """A continuation curve (points in arclength order) and what was found on it."""
+
+    points: list
+    folds: list
+    """Speed factors of the turning points, with the direction the branch took there."""
+    message: str
+    complete: bool
+    reference_speed: float
+    """Speed of the first drive at factor 1 [rad/s]."""
+    wall_time: float = 0.0
+    metrics: dict = field(default_factory=dict)
+
+
+class Continuation:
+    """Pseudo-arclength continuation of ``hb`` (a :class:`HarmonicBalance`) in speed."""
+
+    def __init__(self, hb: HarmonicBalance, tol=1e-9, stability=True, steps_per_period=None):
+        self.hb = hb
+        self.tol = tol
+        self.stability = stability
+        self.steps = steps_per_period
+        self.eps = 1e-6
+
+    def _R(self, x, s, lin=False):
+        return self.hb.residual(x, s, linearise=lin)
+
+    def _Rs(self, x, s, R0):
+        R1, _ = self.hb.residual(x, s + self.eps)
+        return (R1 - R0) / self.eps
+
+    def _solve_bordered(self, s, Rs, tw, rhs):
+        """[[J, Rs], [tw^T]] dz = rhs at the last linearised point."""
+        hb = self.hb
+        n = hb.size
+        if n <= 1500:
+            J = hb.dense_jacobian(s)
+            B = np.zeros((n + 1, n + 1))
+            B[:n, :n] = J
+            B[:n, n] = Rs
+            B[n] = tw
+            try:
+                return np.linalg.solve(B, rhs)
+            except np.linalg.LinAlgError:
+                return np.linalg.lstsq(B, rhs, rcond=None)[0]
+        from torquesplit.steady.harmonic import gmres
+
+        P = hb.preconditioner(s)
+
+        def mv(z):
+            return np.concatenate([hb.jvp(z[:n], s)[0] + Rs * z[n], [tw @ z]])
+
+        def pc(z):
+            return np.concatenate([P(z[:n]), [z[n]]])
+
+        sol, res = gmres(mv, rhs, pc, 1e-8, 80)
+        if res > 1e-4:
+            raise SolverError(f"bordered solve did not converge ({res:.1e})")
+        return sol
+
+    def _weights(self, x):
+        return 1.0 / max(float(np.linalg.norm(x)), 1e-300)
+
+    def tangent(self, x, s, prev=None):
+        R0, _ = self._R(x, s, lin=True)
+        Rs = self._Rs(x, s, R0)
+        n = self.hb.size
+        tw = np.zeros(n + 1)
+        if prev is None:
+            tw[n] = 1.0
+        else:
+            tw[:] = prev
+        rhs = np.zeros(n + 1)
+        rhs[n] = 1.0
+        t = self._solve_bordered(s, Rs, tw, rhs)
+        w = self._weights(x)
+        nrm = math.sqrt((w * np.linalg.norm(t[:n])) ** 2 + t[n] ** 2)
+        t = t / nrm
+        if prev is not None and (w * w * (t[:n] @ prev[:n]) + t[n] * prev[n]) < 0:
+            t = -t
+        return t
+
+    def correct(self, z_pred, t, max_iter=10):
+        hb = self.hb
+        n = hb.size
+        z = z_pred.copy()
+        w = self._weights(z[:n])
+        tw = np.concatenate([t[:n] * w * w, [t[n]]])
+        err = math.inf
+        for it in range(1, max_iter + 1):
+            x, s = z[:n], z[n]
+            if not s > 0:
+                return None, it
+            R, scale = self._R(x, s, lin=True)
+            err = float(np.max(np.abs(R))) / scale
+            arc = tw @ (z - z_pred)
+            if err <= self.tol and abs(arc) < 1e-9:
+                return z, it
+            Rs = self._Rs(x, s, R)
+            dz = self._solve_bordered(s, Rs, tw, -np.concatenate([R, [arc]]))
+            z = z + dz
+            if not np.all(np.isfinite(z)):
+                return None, it
+        R, scale = self._R(z[:n], z[n], lin=True)
+        err = float(np.max(np.abs(R))) / scale
+        return (z if err <= 10 * self.tol else None), max_iter
+
+    def multipliers(self, x, s):
+        hb = self.hb
+        p = hb.p
+        if hill_applies(p, hb.H, p.frequency * s):
+            return floquet_hill(hb, x, s, hb.H)
+        q, v, _ = hb.waveforms(x, s)
+        _, lam = hb.split(x)
+        y0 = hb._states(q, v, lam)[0]
+        T = 1.0 / (p.frequency * s)
+        steps = p.rk4_steps(T, self.steps, 1) if self.steps else p.rk4_steps(T)
+        _, Phi = p.integrate_variational(y0, 0.0, T, steps, s)
+        return floquet_monodromy(p, Phi)
+
+    def run(self, x0, s0, s1, step, max_step, min_step, max_points=2000, progress=None):
+        hb = self.hb
+        n = hb.size
+        direction = 1.0 if s1 > s0 else -1.0
+        from torquesplit.steady.newton import solve_hb
+
+        x, info = solve_hb(hb, x0, s0, self.tol)
+        if not info.converged:
+            raise SolverError(f"no periodic state at the start of the sweep (speed factor "
+                              f"{s0:.4g}, residual {info.residual:.1e}); start the sweep "
+                              f"elsewhere, use more harmonics, or keep fewer excitations.")
+        pts = []
+        folds = []
+        z = np.concatenate([x, [s0]])
+        t = self.tangent(x, s0)
+        if t[n] * direction < 0:
+            t = -t
+        message = "complete"
+        complete = True
+        h = step
+        while len(pts) < max_points:
+            mu = self.multipliers(z[:n], z[n]) if self.stability else None
+            m = float(np.max(np.abs(mu))) if mu is not None and mu.size else math.nan
+            pts.append(SweepPoint(float(z[n]), z[:n].copy(),
+                                  None if mu is None else bool(m <= 1 + 1e-6), m, 0))
+            if progress is not None:
+                progress(min(1.0, abs(z[n] - s0) / abs(s1 - s0)))
+            if (z[n] - s1) * direction >= 0:
+                break
+            while True:
+                z_pred = z + h * t
+                try:
+                    zc, its = self.correct(z_pred, t)
+                except SolverError as exc:
+                    zc, its = None, 99
+                    log.info("corrector failed: %s", exc)
+                if zc is not None:
+                    break
+                h *= 0.5
+                if h < min_step:
+                    message = (f"continuation failed at speed factor {z[n]:.6g}: the "
+                               f"corrector did not converge down to the smallest step "
+                               f"{min_step:.3g}; the curve up to there is kept. Use more "
+                               f"harmonics, a smaller --max-step, or method='shooting' at "
+                               f"single speeds there.")
+                    complete = False
+                    break
+            if zc is None:
+                break
+            try:
+                t_new = self.tangent(zc[:n], zc[n], np.concatenate(
+                    [t[:n] * self._weights(zc[:n]) ** 2, [t[n]]]))
+            except SolverError as exc:
+                message = f"tangent failed at speed factor {zc[n]:.6g} ({exc}); curve kept."
+                complete = False
+                break
+            if t_new[n] * t[n] < 0:  # fold: ds/darc changed sign
+                a = t[n] / (t[n] - t_new[n])
+                s_f = z[n] + a * (zc[n] - z[n])
+                folds.append((float(s_f), "turns back" if t[n] * direction > 0 else "turns on"))
+            z, t = zc, t_new
+            h = min(max_step, h * (1.5 if its <= 3 else (1.0 if its <= 5 else 0.6)))
+            if zc[n] < min(s0, s1) - 0.5 * abs(s1 - s0):
+                message = "the branch left the speed range backwards; curve kept."
+                complete = False
+                break
+        else:
+            message = f"stopped after {max_points} points; curve kept."
+            complete = False
+        return pts, folds, message, complete
+
+
+def continue_in_speed(problem, period, q_static, s0, s1, *, points=50, harmonics=None,
+                      samples=None, stability=True, max_step=None, tol=1e-9,
+                      progress=None, initial=None):
+    """Continuation of the HB state of ``problem`` from speed factor s0 to s1."""
+    t0 = time.perf_counter()
+    if not (s0 > 0 and s1 > 0 and math.isfinite(s0) and math.isfinite(s1)) or s0 == s1:
+        raise SolverError(f"the speed range {s0:.4g}..{s1:.4g} (times the model's speed) "
+                          f"must be two different positive speeds; e.g. --from '1000 rpm' "
+                          f"--to '3000 rpm'.")
+    order = max(period.max_order, 1)
+    H = int(harmonics) if harmonics is not None else HARMONICS_PER_CYCLE * order
+    hb = HarmonicBalance(problem, H, samples)
+    x0 = _initial_hb(hb, q_static, initial)
+    step = abs(s1 - s0) / max(points - 1, 1)
+    max_step = step * 2 if max_step is None else max_step
+    cont = Continuation(hb, tol, stability)
+    pts, folds, msg, complete = cont.run(x0, s0, s1, step, max_step, step * 1e-3,
+                                         progress=progress)
+    return hb, pts, folds, msg, complete, time.perf_counter() - t0
+
+
+def point_metrics(hb: HarmonicBalance, x, s, track, groups, static_forces, nominal,
+                  per_cycle=32, order=1):
+    """Per-mesh peak force, dynamic factors, load sharing (instantaneous ratio, largest
+    over the period) and RMS transmission error of one HB point."""
+    from torquesplit.steady.harmonic import default_samples
+
+    N = max(hb.N, per_cycle * order)
+    if N != hb.N:
+        hb2 = HarmonicBalance(hb.p, hb.H, max(N, default_samples(hb.H)))
+        from torquesplit.steady.solution import pad_coefficients
+        x2 = pad_coefficients(x, hb2)
+    else:
+        hb2, x2 = hb, x
+    _, _, F, D, _, _ = hb2.residual_samples(x2, s)
+    f = F[:, track]
+    d = D[:, track]
+    peak = f.max(axis=0)
+    lsc = np.full(len(track), np.nan)
+    for cols in groups:
+        sub = f[:, cols]
+        tot = sub.sum(axis=1, keepdims=True)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            r = len(cols) * sub / np.where(tot != 0, tot, np.nan)  # Ji & Li eq. 18
+        lsc[cols] = np.nanmax(r, axis=0)
+    rms = np.sqrt(np.mean((d - d.mean(axis=0)) ** 2, axis=0))
+    return dict(peak_force=peak, dynamic_factor=peak / static_forces,
+                peak_to_nominal=peak / nominal, load_sharing=lsc,
+                rms_transmission_error=rms, mean_force=f.mean(axis=0))
+
+
+def stepped_sweep(problem, period, q_static, speeds, *, settle_periods=200,
+                  record_periods=1, steps_per_cycle=None, track=(), progress=None):
+    """Time-integration cross-check: RK4 at each speed factor of ``speeds`` in order,
+    ``settle_periods`` periods from the previous end state (the first from the static
+    state), then ``record_periods`` recorded.  Returns the per-mesh peak forces
+    (n_speeds, n_track) and the RMS transmission errors."""
+    p = problem
+    y = np.concatenate([q_static, np.zeros(p.n)])
+    peaks = np.full((len(speeds), len(track)), np.nan)
+    rms = np.full((len(speeds), len(track)), np.nan)
+    order = max(period.max_order, 1)
+    for i, s in enumerate(speeds):
+        T = 1.0 / (period.frequency * s)
+        steps = p.rk4_steps(T, steps_per_cycle, order)
+        try:
+            _, _, _, y = p.integrate(y, 0.0, settle_periods * T, settle_periods * steps,
+                                     every=settle_periods * steps, speed=s)
+            tt, Y, F, y = p.integrate(y, 0.0, record_periods * T, record_periods * steps, 1,
+                                      speed=s)
+        except SolverError:
+            break
+        _, _, D = p.accelerations(tt, Y, s)
+        peaks[i] = F[:, list(track)].max(axis=0)
+        d = D[:, list(track)]
+        rms[i] = np.sqrt(np.mean((d - d.mean(axis=0)) ** 2, axis=0))
+        if progress is not None:
+            progress((i + 1) / len(speeds))
+    return peaks, rms

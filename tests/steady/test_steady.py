@@ -1,0 +1,272 @@
+"""Periodic steady state: harmonic balance, shooting, Floquet, period, continuation.
+
+Reference values are independent of the code under test: closed-form frequency
+responses and eigenvalues, hand-computed speeds, and time integrations by the
+project's integrator (``torquesplit.solve.integrate``).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from oscillators import backlash_oscillator
+from torquesplit.assembly.structure import MESH, SPRING, build_structure
+from torquesplit.errors import SolverError
+from torquesplit.solve.integrate import integrate
+from torquesplit.steady.harmonic import HarmonicBalance
+from torquesplit.steady.newton import (
+    floquet_hill,
+    floquet_monodromy,
+    solve_hb,
+    solve_shooting,
+)
+from torquesplit.steady.period import (
+    LongPeriodError,
+    PeriodError,
+    fundamental_period,
+    keep_excitations,
+)
+from torquesplit.steady.problem import PeriodicProblem
+from torquesplit.steady.sweep import continue_in_speed, stepped_sweep
+
+M1, M2, K1, K2, C1, C2 = 2.0, 1.0, 1e4, 2e4, 3.0, 1.0
+F0 = 7.0
+A1, A2 = 1e-3, 3e-4
+
+
+def _lti():
+    om = 2 * math.pi * F0
+    return build_structure(["a.x", "b.x"], [1 / M1, 1 / M2], [
+        dict(name="k1", kind=SPRING, dofs=[0], coefs=[1.0], stiffness=K1, damping=C1,
+             errors=[(A1, om, 0.3)]),
+        dict(name="k2", kind=MESH, dofs=[0, 1], coefs=[1.0, -1.0], stiffness=K2, damping=C2,
+             frequency=F0, errors=[(A2, 3 * om, 0.0)])],
+        external_force=[5.0, -2.0], n_table=8)
+
+
+def _matrices():
+    M = np.diag([M1, M2])
+    V1, V2 = np.array([1.0, 0.0]), np.array([1.0, -1.0])
+    K = K1 * np.outer(V1, V1) + K2 * np.outer(V2, V2)
+    C = C1 * np.outer(V1, V1) + C2 * np.outer(V2, V2)
+    return M, K, C, V1, V2
+
+
+def test_lti_harmonic_balance_equals_the_analytic_frequency_response():
+    s = _lti()
+    per = fundamental_period(s)
+    assert per.frequency == pytest.approx(F0, rel=1e-12) and per.orders == (1, 3)
+    p = PeriodicProblem(s, per.frequency)
+    hb = HarmonicBalance(p, 4)
+    x, info = solve_hb(hb, np.zeros(hb.size))
+    assert info.converged
+    u, _ = hb.split(x)
+    M, K, C, V1, V2 = _matrices()
+    q0 = np.linalg.solve(K, [5.0, -2.0])
+    assert np.max(np.abs(u[0] - q0)) <= 1e-9 * np.max(np.abs(q0))
+    om = 2 * math.pi * F0
+    for k, (A, ph, V, kk, cc) in ((1, (A1, 0.3, V1, K1, C1)), (3, (A2, 0.0, V2, K2, C2))):
+        w = k * om
+        # element force k (V.q - e) + c (V.q' - e'), e = A sin(w t + ph) = Re(E e^{iwt})
+        E = -1j * A * np.exp(1j * ph)
+        Q = np.linalg.solve(K - w * w * M + 1j * w * C, V * (kk + 1j * w * cc) * E)
+        got = u[2 * k - 1] - 1j * u[2 * k]
+        assert np.max(np.abs(got - Q)) <= 1e-9 * np.max(np.abs(Q))
+    for k in (2, 4):  # nothing excites these harmonics
+        assert np.max(np.abs(u[2 * k - 1:2 * k + 1])) <= 1e-12 * np.max(np.abs(q0))
+
+
+def test_shooting_and_floquet_of_the_lti_case():
+    s = _lti()
+    p = PeriodicProblem(s, F0)
+    hb = HarmonicBalance(p, 4)
+    x, _ = solve_hb(hb, np.zeros(hb.size))
+    q, _, _ = hb.waveforms(x)
+    y, Phi, info = solve_shooting(p, np.zeros(4), 800)
+    assert info.converged
+    amp = np.ptp(q, axis=0).max()
+    assert np.max(np.abs(y[:2] - q[0])) <= 1e-6 * amp  # RK4, 800 steps per period
+    M, K, C, _, _ = _matrices()
+    A = np.block([[np.zeros((2, 2)), np.eye(2)],
+                  [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
+    exact = np.exp(np.linalg.eigvals(A) / F0)
+    for got in (floquet_monodromy(p, Phi), floquet_hill(hb, x)):
+        assert len(got) == 4
+        assert max(np.min(np.abs(got - e)) for e in exact) < 1e-6
+
+
+def _mathieu(alpha, zeta=0.01):
+    """x'' + 2 zeta x' + (1 + alpha cos W t) x = 0.1: the principal instability tongue of
+    the Mathieu equation lies around W = 2 (width about alpha at zeta -> 0; Nayfeh &
+    Mook, Nonlinear Oscillations, 1979, section 5.4)."""
+    return backlash_oscillator(zeta=zeta, f_alt=0.0, alpha=alpha, half_gap=0.0)
+
+
+@pytest.mark.parametrize("speed, unstable", [(2.0, True), (1.3, False), (2.6, False)])
+def test_parametric_instability_tongue(speed, unstable):
+    s = _mathieu(0.3)
+    per = fundamental_period(s)
+    p = PeriodicProblem(s, per.frequency)
+    hb = HarmonicBalance(p, 12)
+    x0 = np.zeros(hb.size)
+    x0[0] = 0.1
+    x, info = solve_hb(hb, x0, speed)
+    assert info.converged
+    hill = floquet_hill(hb, x, speed)
+    _, Phi = p.integrate_variational(np.concatenate([hb.waveforms(x, speed)[0][0],
+                                                     hb.waveforms(x, speed)[1][0]]),
+                                     0.0, 1 / (per.frequency * speed), 2000, speed)
+    mono = floquet_monodromy(p, Phi)
+    assert (abs(mono[0]) > 1) == unstable
+    assert (abs(hill[0]) > 1) == unstable
+    assert abs(abs(hill[0]) - abs(mono[0])) < 1e-4
+    if unstable:  # the principal tongue: a real multiplier through -1 (period doubling)
+        assert mono[0].real < -1 and abs(mono[0].imag) < 1e-9
+
+
+def test_period_of_tooth_counts_long_periods_and_impossible_ones():
+    f1 = 235.0 + 11 / 12  # 168 and 17 cycles of f0 = f1 / 168
+    f2 = f1 * 17 / 168
+    el = [dict(name="a", kind=MESH, dofs=[0], coefs=[1.0], stiffness=[1.0, 2.0], frequency=f1),
+          dict(name="b", kind=MESH, dofs=[0], coefs=[1.0], stiffness=[1.0, 3.0], frequency=f2)]
+    s = build_structure(["x"], [1.0], el, n_table=4)
+    per = fundamental_period(s)
+    assert per.frequency == pytest.approx(f1 / 168, rel=1e-12)
+    assert sorted(per.orders) == [17, 168]
+    with pytest.raises(LongPeriodError, match="keep="):
+        fundamental_period(s, max_cycles=100)
+    kept, dropped = keep_excitations(s, f1)
+    assert [d.element for d in dropped] == ["b"]
+    assert fundamental_period(kept).frequency == pytest.approx(f1)
+    assert np.ptp(kept.stiffness_table[1]) == 0 and kept.stiffness_table[1, 0] == 2.0
+    el[1]["frequency"] = f1 / 1000000.5  # no ratio with a denominator up to 1e6
+    with pytest.raises(PeriodError, match="no rational ratio"):
+        fundamental_period(build_structure(["x"], [1.0], el, n_table=4))
+
+
+def continuation_multipliers(hb, point):
+    return floquet_hill(hb, point.x, point.speed, hb.H)
+
+
+def _contact_loss_onset(zeta, f_mean, f_alt):
+    """Speed where the linear (always in contact) response first reaches the backlash:
+    amplitude F_a W^2 / |1 - W^2 + 2 i zeta W| = F_m (the mean deflection beyond the gap)
+    (Kahraman & Singh 1990: the single-sided impact region begins there)."""
+    from scipy.optimize import brentq
+
+    def g(w):
+        return f_alt * w * w / abs(1 - w * w + 2j * zeta * w) - f_mean
+    return brentq(g, 0.3, 0.999)
+
+
+def test_backlash_benchmark_jump_impacts_and_time_integration():
+    zeta, fm, fa = 0.05, 0.1, 0.05
+    s = backlash_oscillator(zeta, fm, fa)
+    per = fundamental_period(s)
+    p = PeriodicProblem(s, per.frequency)
+    hb, pts, folds, msg, complete, _ = continue_in_speed(p, per, np.array([1.1]), 0.5, 1.5,
+                                                          points=60, harmonics=16)
+    assert complete, msg
+    sp = np.array([q.speed for q in pts])
+    # softening: the branch turns back (jump down when sweeping up) and on again
+    kinds = [k for _, k in folds]
+    assert "turns back" in kinds and "turns on" in kinds
+    up = max(f for f, k in folds if k == "turns back")
+    down = min(f for f, k in folds if k == "turns on")
+    assert 0.7 < down < up < 1.0
+    # multipliers cross +1 at the turning points: stable on the outer branches,
+    # unstable between; the largest multiplier next to a fold is close to +1
+    stab = np.array([q.stable for q in pts])
+    assert stab[0] and stab[-1] and not stab.all()
+    changes = int(np.sum(stab[1:] != stab[:-1]))
+    assert changes == len(folds)  # stability changes exactly at the turning points
+    i = int(np.flatnonzero(~stab)[0])  # first unstable point: a real multiplier beyond +1
+    mu = continuation_multipliers(hb, pts[i])
+    assert mu[0].real > 1 and abs(mu[0].imag) < 1e-6
+    # single-sided impacts begin where the linear response reaches the gap (hand formula)
+    w_c = _contact_loss_onset(zeta, fm, fa)
+    lost = []
+    for q in pts[:20]:
+        d = hb.residual_samples(q.x, q.speed)[3][:, 0]
+        lost.append(d.min() < 1.0 - 1e-9)
+    first = sp[:20][np.argmax(lost)]
+    assert abs(first - w_c) < 0.03
+    # run-up / run-down time integrations land on the lower / upper branch in between
+    w_mid = 0.5 * (up + down)
+    grid = np.array([0.6, 0.7, w_mid])
+    peaks_up, _ = stepped_sweep(p, per, np.array([1.1]), grid, settle_periods=150,
+                                steps_per_cycle=400, track=[0])
+    peaks_dn, _ = stepped_sweep(p, per, np.array([1.1]), np.array([1.0, 0.9, w_mid]),
+                                settle_periods=150, steps_per_cycle=400, track=[0])
+    near = [q for q in pts if abs(q.speed - w_mid) < 0.02]
+    peaks_hb = sorted(hb.residual_samples(q.x, q.speed)[2][:, 0].max() for q in near
+                      if q.stable)
+    assert len(peaks_hb) >= 2
+    assert peaks_up[-1, 0] == pytest.approx(peaks_hb[0], rel=0.03)
+    assert peaks_dn[-1, 0] == pytest.approx(peaks_hb[-1], rel=0.03)
+    assert peaks_dn[-1, 0] > 1.5 * peaks_up[-1, 0]
+
+
+def test_hb_and_shooting_agree_with_long_time_integration_on_a_geared_model():
+    """Two meshes with stepped stiffness and backlash never opened, 3 DOFs."""
+    f = 50.0
+    tab = np.where(np.arange(64) < 40, 1.1e6, 0.9e6)
+    s = build_structure(["a", "b", "c"], [1 / 0.02, 1 / 0.05, 1 / 0.03], [
+        dict(name="m1", kind=MESH, dofs=[0, 1], coefs=[1.0, -1.0], stiffness=tab,
+             frequency=f, damping=15.0, gaps=1e-3),
+        dict(name="m2", kind=MESH, dofs=[1, 2], coefs=[1.0, -1.0], stiffness=tab[::-1],
+             frequency=f, phase=0.3, damping=15.0),
+        dict(name="g", kind=SPRING, dofs=[2], coefs=[1.0], stiffness=3e5, damping=20.0)],
+        external_force=[200.0, 0.0, 0.0], n_table=64)
+    per = fundamental_period(s)
+    p = PeriodicProblem(s, per.frequency)
+    from torquesplit.steady.solution import periodic_solution
+    from torquesplit.solve.static import static_equilibrium
+
+    qs = static_equilibrium(s).q
+    hb = periodic_solution(s, per, harmonics=256, q_static=qs, steps_per_cycle=2048)
+    sh = periodic_solution(s, per, method="shooting", q_static=qs, steps_per_cycle=2048)
+    assert hb.converged and sh.converged and hb.stable and sh.stable
+    T = 1 / f
+    a = integrate(s, np.concatenate([qs, 0 * qs]), (0, 60 * T), step=T / 2048,
+                  history_elements=(), history_dofs=())
+    b = integrate(s, a.y_final, (60 * T, 61 * T), step=T / 2048, history_elements=[0, 1],
+                  history_dofs=())
+    t = b.history_t - 60 * T
+    for e in (0, 1):
+        ref = b.history_forces[:, e]
+        amp = np.ptp(ref)
+        assert np.max(np.abs(np.interp(t, sh.t, sh.forces[:, e], period=T) - ref)) < 1e-3 * amp
+        from torquesplit.steady.harmonic import HarmonicBalance as HB
+        hb2 = HB(p, 256, 2048)
+        from torquesplit.steady.solution import pad_coefficients
+        F = hb2.residual_samples(pad_coefficients(hb.coefficients, hb2))[2][:, e]
+        assert np.max(np.abs(F - ref[:-1])) < 1e-3 * amp
+
+
+def test_continuation_failure_keeps_the_partial_curve(monkeypatch):
+    from torquesplit.steady import sweep as sw
+
+    s = backlash_oscillator()
+    per = fundamental_period(s)
+    p = PeriodicProblem(s, per.frequency)
+    calls = {"n": 0}
+    orig = sw.Continuation.correct
+
+    def flaky(self, z_pred, t, max_iter=10):
+        calls["n"] += 1
+        if calls["n"] > 5:
+            return None, max_iter
+        return orig(self, z_pred, t, max_iter)
+
+    monkeypatch.setattr(sw.Continuation, "correct", flaky)
+    hb, pts, folds, msg, complete, _ = continue_in_speed(p, per, np.array([1.1]), 0.5, 1.5,
+                                                          points=20, harmonics=8,
+                                                          stability=False)
+    assert not complete and 3 <= len(pts) <= 6
+    assert "continuation failed at speed factor" in msg and "kept" in msg
+    with pytest.raises(SolverError, match="two different positive speeds"):
+        continue_in_speed(p, per, np.array([1.1]), -1.0, 1.5)

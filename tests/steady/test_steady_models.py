@@ -1,0 +1,88 @@
+"""Model-level steady state, Campbell map and the CLI commands on a shipped example."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from torquesplit.cli import app
+from torquesplit.examples import example_path
+from torquesplit.model.io import load_model
+from torquesplit.steady import campbell, steady_state
+from torquesplit.steady.period import LongPeriodError
+
+EXAMPLE = "seed001_mill_drive"
+
+
+def test_steady_state_of_one_stage_and_its_results():
+    st = steady_state(example_path(EXAMPLE), keep="stage1", harmonics=16)
+    ps = st.solution
+    assert ps.converged and ps.stable and ps.periodicity_defect < 1e-3
+    assert [d.element for d in st.dropped] == ["m12", "m22"]
+    rows = {r.mesh: r for r in st.mesh_table()}
+    for r in rows.values():
+        assert r.dynamic_factor == pytest.approx(r.peak_force / r.static_force)
+        assert r.peak_to_nominal == pytest.approx(r.peak_force / r.nominal_force)
+        assert r.min_force <= r.mean_force <= r.peak_force
+    res = st.to_results()  # every metric of a dynamic run works on it
+    met = res.metrics("cycle_peak")
+    assert met.settling.settled
+    assert met.rows[0].peak_force == pytest.approx(rows["m11"].peak_force, rel=1e-2)
+
+
+def test_long_period_is_refused_with_the_fix():
+    with pytest.raises(LongPeriodError, match="keep="):
+        steady_state(example_path(EXAMPLE), max_cycles=100)
+
+
+def test_campbell_crossings_at_hand_computed_speeds():
+    """Two-stage drive: stage 1 meshes z1 (motor shaft) at f = z1 n1, so a mode at f_n
+    is crossed by harmonic h of that mesh at n1 = f_n / (h z1) rev/s."""
+    m = load_model(example_path(EXAMPLE))
+    z1 = m.gears["z1"].teeth
+    w_model = abs(m.drives["motor"].speed)
+    ds, crossings = campbell(m, 0.5 * w_model, 1.5 * w_model, orders=2)
+    fn = ds["natural_frequency"].values[0]
+    hand = []
+    for i, f in enumerate(fn):
+        for h in (1, 2):
+            w = 2 * math.pi * f / (h * z1)
+            if 0.5 * w_model <= w <= 1.5 * w_model:
+                hand.append((i + 1, h, w * 60 / (2 * math.pi)))
+    got = [(c["mode"], c["order"], c["speed_rpm"]) for c in crossings
+           if c["source"] in ("mesh m11", "mesh m21")]
+    assert len(got) == len(hand) > 0
+    for (mo, h, rpm), (mo2, h2, rpm2) in zip(sorted(hand), sorted(got), strict=True):
+        assert (mo, h) == (mo2, h2) and rpm2 == pytest.approx(rpm, rel=1e-9)
+    assert all(abs(sum(v for _, v in c["energy"])) <= 1 + 1e-9 for c in crossings)
+
+
+def test_cli_steady_sweep_and_campbell(tmp_path):
+    r = CliRunner().invoke(app, ["steady", EXAMPLE, "--keep", "stage1", "--harmonics", "16",
+                                 "--json"])
+    assert r.exit_code == 0, r.output
+    out = json.loads(r.output)
+    assert out["converged"] and out["harmonics"] == 16 and out["stable"]
+    assert set(out["meshes"]) == {"m11", "m21", "m12", "m22"}
+    r = CliRunner().invoke(app, ["sweep-speed", EXAMPLE, "--keep", "stage1", "--from",
+                                 "700 rpm", "--to", "790 rpm", "--points", "4",
+                                 "--harmonics", "8", "--no-stability", "--plot",
+                                 str(tmp_path / "s.png"), "--out", str(tmp_path / "s.nc"),
+                                 "--json"])
+    assert r.exit_code == 0, r.output
+    out = json.loads(r.output)
+    assert out["complete"] and out["points"] >= 4 and (tmp_path / "s.png").exists()
+    r = CliRunner().invoke(app, ["sweep-speed", EXAMPLE, "--keep", "stage1", "--from",
+                                 "-700 rpm", "--to", "-700 rpm"])
+    assert r.exit_code == 2 and "positive speeds" in r.output
+    r = CliRunner().invoke(app, ["modes", EXAMPLE, "--campbell", "--from", "300 rpm",
+                                 "--to", "1200 rpm", "--json"])
+    assert r.exit_code == 0, r.output
+    assert json.loads(r.output)["critical_speeds"]
+    r = CliRunner().invoke(app, ["steady", EXAMPLE, "--max-cycles", "10"])
+    assert r.exit_code == 2 and "keep" in r.output
+    assert np.isfinite(1.0)
