@@ -6,6 +6,7 @@ The pipeline, one stage per subpackage (each stage returns a new object)::
     solve_kinematics(model)     -> Kinematics  (model/: speeds, torques, line of action)
     assemble(model)             -> Structure   (assembly/: DOFs, mass, element arrays)
     simulate(model, ...)        -> Results     (solve/ + metrics/ + results/)
+    run_study(study_file)       -> Dataset     (study/: grids, Monte Carlo, sensitivity)
 """
 
 from __future__ import annotations
@@ -22,4 +23,14 @@ __version__ = "0.1.0"
 __all__ = [
     "ModelError", "ModelWarning", "SolverError", "StepTooLargeError", "TorquesplitError",
     "example_names", "example_path", "load_model", "solve_kinematics", "assemble", "simulate",
+    "Study", "run_study",
 ]
+
+
+def __getattr__(name):
+    # the study layer (and xarray, scipy.stats) load only when asked for
+    if name in ("Study", "run_study"):
+        from . import study
+
+        return getattr(study, name)
+    raise AttributeError(f"module 'torquesplit' has no attribute {name!r}")
