@@ -358,6 +358,7 @@ def record(slot, i_f, weight, m, w, r, counters):
     track_el, track_base = r.track_el, r.track_base
     cyc_max, cyc_min, cyc_sum, cyc_cnt = r.cyc_max, r.cyc_min, r.cyc_sum, r.cyc_cnt
     grp_ptr, grp_col, rat_max, rat_min = r.grp_ptr, r.grp_col, r.rat_max, r.rat_min
+    grp_min = r.grp_min
     sep_count, sep_time, back_count, back_time = (r.sep_count, r.sep_time, r.back_count,
                                                   r.back_time)
     element_kind = m.element_kind
@@ -377,7 +378,7 @@ def record(slot, i_f, weight, m, w, r, counters):
         total = 0.0
         for k in range(grp_ptr[g], grp_ptr[g + 1]):
             total += force[i_f, track_el[grp_col[k]]]
-        if total != 0.0:
+        if total > grp_min[g]:
             nm = grp_ptr[g + 1] - grp_ptr[g]
             for k in range(grp_ptr[g], grp_ptr[g + 1]):
                 j = grp_col[k]
@@ -416,6 +417,7 @@ def record_extrema(slot, i_f, w, r):
     track_el, track_base = r.track_el, r.track_base
     cyc_max, cyc_min = r.cyc_max, r.cyc_min
     grp_ptr, grp_col, rat_max, rat_min = r.grp_ptr, r.grp_col, r.rat_max, r.rat_min
+    grp_min = r.grp_min
     cap = cyc_max.shape[0]
     for j in range(track_el.shape[0]):
         el = track_el[j]
@@ -430,7 +432,7 @@ def record_extrema(slot, i_f, w, r):
         total = 0.0
         for k in range(grp_ptr[g], grp_ptr[g + 1]):
             total += force[i_f, track_el[grp_col[k]]]
-        if total != 0.0:
+        if total > grp_min[g]:
             nm = grp_ptr[g + 1] - grp_ptr[g]
             for k in range(grp_ptr[g], grp_ptr[g + 1]):
                 j = grp_col[k]
