@@ -122,10 +122,11 @@ _BETA = 0.04
 _EXPO1 = 0.2 - _BETA * 0.75
 
 _kernel = njit(cache=True, error_model="numpy", _nrt=False)
+_inline = njit(inline="always", error_model="numpy", _nrt=False)
 
 
 # =================================================================== excitation
-@_kernel
+@_inline
 def excite(t, slot, src, m, w):
     """Every time-dependent excitation at t into ``slot``.
 
@@ -159,9 +160,7 @@ def excite(t, slot, src, m, w):
         CY[slot, e] = laws.stat_cycle(s, fl)
         g0 = gap_ptr[e]
         ng = gap_ptr[e + 1] - g0
-        if ng == 1:
-            G[slot, e] = gap_values[g0]
-        else:
+        if ng > 1:  # one half-gap: constant, set in every slot by make_work
             c = np.int64(fl)
             if c != gap_cyc[e]:
                 k = c % ng
@@ -341,7 +340,7 @@ def evaluate(t, m, w, rhs_fn, gen):
 
 
 # ================================================================== recording
-@_kernel
+@_inline
 def record(slot, i_f, weight, m, w, r, counters):
     """Enter one accepted state (forces in row ``i_f``) in the statistics.
 
@@ -592,7 +591,7 @@ def store_full(row, t, iy, w, r):
         full_y[row, k] = Y[iy, k]
 
 
-@_kernel
+@_inline
 def bad_state(iy, blowup, w):
     """Index of the first non-finite entry of state row ``iy`` or |q| > blowup, or -1.
     Twin: ``np.flatnonzero(~np.isfinite(y) | (abs(q) > blowup))[:1]``."""
