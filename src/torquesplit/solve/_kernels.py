@@ -704,18 +704,26 @@ def rk4_run(t0, h, n_first, n_steps, record_final, record_every, blowup, m, w, r
     t_corner = math.inf  # earliest corner still ahead
     if m.corner_node.shape[0] > 0 and n_steps > 0:
         t_corner = first_corners(t0 + n_first * h, m, w, r)
+    # the next step indices that are multiples of RESYNC and of record_every (counted, not
+    # found by an integer division per step)
+    next_sync = (n_first // RESYNC + 1) * RESYNC
+    every = record_every if record_every > 0 else n_first + n_steps + 1
+    next_rec = -(-n_first // every) * every
     for it in range(n_steps):
         i = n_first + it
         t = t0 + i * h
-        if it == 0 or i % RESYNC == 0:
+        if it == 0 or i == next_sync:
             excite(t, a, np.int64(-1), m, w)
+            if i == next_sync:
+                next_sync += RESYNC
         # stage 1 at t: its forces are those of the accepted state y(t)
         _stage(a, Y_STATE, Y_K1, F_MAIN, m, w, rhs_fn, gen, extra)
         record(a, F_MAIN, h, m, w, r, counters)
-        if (record_every > 0 and i % record_every == 0
-                and counters[I_HIST] < n_hist):
-            store_history(counters[I_HIST], t, Y_STATE, F_MAIN, w, r)
-            counters[I_HIST] += 1
+        if i == next_rec:
+            next_rec += every
+            if record_every > 0 and counters[I_HIST] < n_hist:
+                store_history(counters[I_HIST], t, Y_STATE, F_MAIN, w, r)
+                counters[I_HIST] += 1
         if counters[I_FULL] < n_full:
             store_full(counters[I_FULL], t, Y_STATE, w, r)
             counters[I_FULL] += 1
