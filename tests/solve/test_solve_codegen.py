@@ -7,7 +7,6 @@ import sys
 
 import numpy as np
 import pytest
-from numba import njit
 from solve_models import random_structure, random_structure_extras, spur_pair
 
 import torquesplit

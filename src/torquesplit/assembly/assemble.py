@@ -355,7 +355,7 @@ def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None
                              coefs=[s_t], stiffness=k, damping=c))
 
     # ---- rotating frames: Coriolis, centripetal softening, centrifugal force
-    gyroscopic = []
+    gyroscopic, frame_stiffness = [], []
     if rotating and kin.frames:
         from .rotating import rotating_frame_terms
 
@@ -368,8 +368,7 @@ def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None
             k_xyz = np.array([k_rad, sup.stiffness_y or k_rad, sup.axial_stiffness or k_rad])
             return float(k_xyz @ np.asarray(direction) ** 2)
 
-        frame_elements, gyroscopic = rotating_frame_terms(kin, dmap, ext, pin_stiffness)
-        elements.extend(frame_elements)
+        frame_stiffness, gyroscopic = rotating_frame_terms(kin, dmap, ext, pin_stiffness)
 
     # ---- drives and loads
     for name, d in model.drives.items():
@@ -394,12 +393,10 @@ def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None
         planet_bodies=dict(kin.planet_bodies),
         frames=dict(kin.frames),
         rotating_frame=bool(rotating and gyroscopic),
-        inertial_elements=[el["name"] for el in elements if el["name"].endswith(
-            (".centripetal.1", ".centripetal.2", ".pin_preload"))],
     )
     return build_structure(dmap.names, inv_mass, elements, external_force=ext,
-                           ground_damping=ground, gyroscopic=gyroscopic, n_table=n_table,
-                           metadata=meta)
+                           ground_damping=ground, gyroscopic=gyroscopic,
+                           frame_stiffness=frame_stiffness, n_table=n_table, metadata=meta)
 
 
 def _bearing_seat(model: Model, dmap: DofMap, body: str, on: str | None,

@@ -26,7 +26,8 @@ more than the arithmetic.  What it computes, for one excitation slot::
     delta_e = -E_e + sum_j V_ej q_j          (CSR order of V)
     rate_e  = -ED_e + sum_j V_ej v_j
     f_e     = spring_force(K_e, c_e, delta_e, rate_e, G_e) + P_e     (the law)
-    dy      = [v, M^-1 (F_ext - C_g v - sum_e V_e f_e - G v)]  (CSR order of V^T, of G)
+    dy      = [v, M^-1 (F_ext - C_g v - sum_e V_e f_e - G v - K_f q)]  (CSR order of
+              V^T, of G, of K_f)
 
 The code depends only on the sparsity of V and G and on which elements have a dead zone; the
 values (coefficients, damping, masses, forces) are read from a parameter vector at fixed
@@ -113,6 +114,7 @@ def rhs_ir(model) -> tuple[str, list[tuple[str, int]]]:
     vr_ptr, vq_idx = a["vr_ptr"].astype(np.int64), a["vq_idx"].astype(np.int64)
     vt_ptr, vt_el = a["vt_ptr"].astype(np.int64), a["vt_el"].astype(np.int64)
     gy_ptr, gy_idx = a["gy_ptr"].astype(np.int64), a["gy_idx"].astype(np.int64)
+    fs_ptr, fs_idx = a["fs_ptr"].astype(np.int64), a["fs_idx"].astype(np.int64)
     gap_ptr, gap_values = a["gap_ptr"], a["gap_values"]
     has_error, has_force = _error_and_force_flags(a)
     _, law = _law_ir()
@@ -190,6 +192,8 @@ def rhs_ir(model) -> tuple[str, list[tuple[str, int]]]:
             acc = op("fsub", acc, op("fmul", param("vt_coef", j), force[int(vt_el[j])]))
         for j in range(gy_ptr[i], gy_ptr[i + 1]):
             acc = op("fsub", acc, op("fmul", param("gy_coef", j), load("y", gy_idx[j])))
+        for j in range(fs_ptr[i], fs_ptr[i + 1]):
+            acc = op("fsub", acc, op("fmul", param("fs_coef", j), load("y", fs_idx[j])))
         store("dy", i, v)
         store("dy", n + i, op("fmul", param("inv_mass", i), acc))
     args = ", ".join(f"ptr noalias nocapture %{x}" for x in ARG_NAMES) + ", i64 %off"
@@ -234,7 +238,8 @@ def _pattern_key(model) -> str:
     has_error, has_force = _error_and_force_flags(a)
     h = hashlib.sha256()
     for x in (np.int64(a["inv_mass"].shape[0]), a["vr_ptr"], a["vq_idx"], a["vt_ptr"],
-              a["vt_el"], a["gy_ptr"], a["gy_idx"], gapped, has_error, has_force):
+              a["vt_el"], a["gy_ptr"], a["gy_idx"], a["fs_ptr"], a["fs_idx"], gapped,
+              has_error, has_force):
         arr = np.ascontiguousarray(x)
         h.update(str((arr.dtype, arr.shape)).encode())
         h.update(arr.tobytes())
