@@ -220,10 +220,17 @@ class Results:
     def metric_values(self, definitions=None, *, window: int = 20,
                       tolerance: float = 0.01) -> dict[str, float]:
         """Every metric of the run by a flat name (:meth:`Metrics.values`), for every
-        dynamic load-sharing definition (or those given)."""
+        dynamic load-sharing definition (or those given), with the planet load-sharing
+        factor ``planet_load_sharing.<definition>[.<carrier>|.<planet>]`` of planetary
+        stages."""
+        from ..metrics.planetary import planet_load_sharing
+
         out: dict[str, float] = {}
         for d in definitions or ls.DYNAMIC_DEFINITIONS:
-            out.update(self.metrics(d, window=window, tolerance=tolerance).values())
+            met = self.metrics(d, window=window, tolerance=tolerance)
+            out.update(met.values())
+            # the planet load-sharing factor K_gamma of every planetary stage (if any)
+            out.update(planet_load_sharing(met.load_sharing, self.kinematics).values())
         return out
 
     @cached_property
