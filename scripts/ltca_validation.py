@@ -7,7 +7,7 @@ Writes docs/ltca_validation_results.json (every number) and docs/ltca_validation
 (tables generated from it, with the explanations).  Nothing is tuned to a published
 number: the double-helical pair is the one of Liu, Fang, Jia et al. 2021 (Table 1) with
 its printed modification (§5), every other input is the example model's
-(seed000_split_torque) or the LTCA's defaults.
+(liu2021_split_torque_helicopter) or the LTCA's defaults.
 """
 
 from __future__ import annotations
@@ -117,10 +117,10 @@ def liu_static() -> dict:
 
 
 def _seed000(overrides: dict):
-    data = apply_overrides(read_raw(torquesplit.example_path("seed000_split_torque")), overrides)
+    data = apply_overrides(read_raw(torquesplit.example_path("liu2021_split_torque_helicopter")), overrides)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ModelWarning)
-        return torquesplit.load_model(model_from_dict(data, source="seed000_split_torque"))
+        return torquesplit.load_model(model_from_dict(data, source="liu2021_split_torque_helicopter"))
 
 
 def dynamics(cycles: int | None) -> dict:
@@ -286,7 +286,7 @@ def markdown(res: dict) -> str:
     dyn = res.get("dynamics")
     if dyn:
         L.append("## 4. Dynamics of the split-torque reducer before and after the modification\n")
-        L.append("The seed000_split_torque example (all its assumptions: masses, bearings, damping, "
+        L.append("The liu2021_split_torque_helicopter example (all its assumptions: masses, bearings, damping, "
                  "errors, see the model file), its four double-helical meshes switched to "
                  "`stiffness.method = \"ltca\"` at their nominal load, meshing-in impact on, "
                  "the paper's modification on the four double-helical pinions or not.  Left input "
@@ -331,7 +331,7 @@ def markdown(res: dict) -> str:
     if nsga:
         f_paper = mo["te_peak_to_peak_arcsec"] / un["te_peak_to_peak_arcsec"]
         L.append("## 5. NSGA-II on the paper's objective\n")
-        L.append("`torquesplit optimize seed000_dh_modification` (the shipped optimisation file: "
+        L.append("`torquesplit optimize liu2021_dh_modification` (the shipped optimisation file: "
                  "y1..y6 of the four pinions, eq. 23 objectives F1 = SLTE amplitude / unmodified, "
                  "F2 = impact / unmodified, assumed bounds, population 40 x 50 generations, seed 1, "
                  "our LTCA of mesh L68 at 64 x 40 x 2): "

@@ -14,7 +14,7 @@ Conventions
   parallel, each with the full transverse and overlap ratio of its own half), and
   the total active face width is ``2 * face_width``.  This is the convention that
   reproduces the total contact ratio 3.42 quoted for the double-helical pair of
-  seed 000 (Table 1: z = 23/215, m_n = 3.965 mm, b = 50 mm, beta = 30 deg gives
+  Liu et al. 2021 (Table 1: z = 23/215, m_n = 3.965 mm, b = 50 mm, beta = 30 deg gives
   eps_alpha = 1.4145, eps_beta = 2.0070, eps_gamma = 3.4215; with b = 25 mm per
   helix it would be 2.42, and reading 3.965 mm as a transverse module gives 3.73).
 * **Internal gears** (ring gears): give a *positive* tooth count and ``internal=True``

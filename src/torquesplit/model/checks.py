@@ -304,7 +304,7 @@ def _teach(msg: str) -> str:
 
 def support_issues(model: Model) -> list[tuple[str, str]]:
     """Translational DOFs need a support to the housing (bearing or shaft bending), or a
-    spline that holds the body radially (seed 002 floating pinion)."""
+    spline that holds the body radially (Dong et al. 2021 floating pinion)."""
     issues = []
     on_spline = {b for sp in model.splines.values() for b in sp.connects}
     for kind, items in (("gears", model.gears), ("bodies", model.bodies)):
@@ -361,7 +361,7 @@ def plausibility_warnings(model: Model, kin) -> list[tuple[str, str]]:
 #: flagged as a probable unit mistake
 SIZE_RATIO = 100.0
 #: a given mass or polar inertia outside [1/r, r] times the gear's solid-disc value (an
-#: inertia may include the gear's shaft: seed 002's pinion has 22 times its disc's)
+#: inertia may include the gear's shaft: Dong et al. 2021's pinion has 22 times its disc's)
 INERTIA_RATIO = 100.0
 #: pitch-line speed beyond which gears do not run [m/s] (turbine gears reach ~200)
 MAX_PITCH_SPEED = 500.0
