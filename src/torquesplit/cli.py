@@ -1000,6 +1000,11 @@ from .steady.cli import register as _register_steady  # noqa: E402
 
 _register_steady(app, lambda model: _load(model), _fail, console, err_console, _json_default)
 
+# --------------------------------------------------------------------------- report, draw
+from .report.cli import register as _register_report  # noqa: E402
+
+_register_report(app, sys.modules[__name__])
+
 
 def main():  # pragma: no cover - console entry point
     app()

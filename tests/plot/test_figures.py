@@ -91,7 +91,7 @@ def test_write_figures_writes_every_applicable_figure(run, tmp_path):
     names = sorted(p.name for p in paths)
     assert names == sorted(f"case1_{n}.png" for n in (
         "mesh_force", "mesh_force_end", "cycle_peak_force", "load_sharing_cycle_peak",
-        "support_force_spectrum", "orbits", "mesh_stiffness"))
+        "dynamic_factors", "support_force_spectrum", "orbits", "mesh_stiffness"))
     for p in paths:
         assert p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
@@ -131,6 +131,7 @@ def test_every_axis_has_a_unit_and_the_model_is_named(run, static):
     name = run.model.model.name
     figs = [F.mesh_force_figure(run), F.mesh_force_figure(run, last_cycles=3),
             F.cycle_peak_figure(run), F.load_sharing_figure(run, "engineering"),
+            F.dynamic_factor_figure(run),
             F.support_spectrum_figure(run), F.orbit_figure(run), F.mesh_stiffness_figure(run),
             F.static_mesh_force_figure(static), F.static_load_sharing_figure(static),
             F.orbit_figure(static)]
@@ -336,3 +337,14 @@ def test_static_figures_follow_rotation_and_report(static):
         ax = _panel(fig, f"group {g}")
         for m in members:
             assert _line(ax, m).get_ydata().max() == pytest.approx(met.per_mesh[m], rel=1e-9)
+
+
+def test_dynamic_factor_bars_are_the_metrics(run):
+    met = run.metrics("cycle_peak")
+    fig = F.dynamic_factor_figure(run, "cycle_peak")
+    ax = fig.axes[0]
+    bars = [p.get_height() for p in ax.patches]
+    order = [r for g in met.load_sharing.groups for r in met.rows if r.group == g]
+    n = len(order)
+    np.testing.assert_allclose(bars[:n], [r.dynamic_factor for r in order], rtol=1e-12)
+    np.testing.assert_allclose(bars[n:2 * n], [r.peak_to_nominal for r in order], rtol=1e-12)

@@ -367,6 +367,7 @@ def _layout(model: Model, issues) -> tuple[dict, dict, list[str]]:
                     except ValueError as exc:
                         issues.append((f"gears.{name}.place", str(exc)))
                         positions[name] = positions[ref].copy()
+                    computed.append(name)  # placed: computed from the mating gear
                     pending.remove(name)
                     progress = True
                 continue

@@ -34,13 +34,13 @@ from typing import Callable, Iterable
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
-from matplotlib.ticker import NullFormatter
+from matplotlib.ticker import NullLocator
 
 from ..errors import TorquesplitError
 
 __all__ = [
     "FigureNotApplicableError", "figure_jobs", "write_jobs", "figure_svg",
-    "mesh_force_figure", "cycle_peak_figure", "load_sharing_figure",
+    "mesh_force_figure", "cycle_peak_figure", "load_sharing_figure", "dynamic_factor_figure",
     "support_spectrum_figure", "orbit_figure", "mesh_stiffness_figure",
     "static_mesh_force_figure", "static_load_sharing_figure",
     "write_figures", "write_static_figures",
@@ -83,7 +83,7 @@ class FigureNotApplicableError(TorquesplitError, ValueError):
 
 # ============================================================ dynamic run figures
 def mesh_force_figure(results, *, last_cycles: float | None = None,
-                      band_above: float = 150.0, bins: int = 800) -> Figure:
+                      band_above: float = 150.0, bins: int = 400) -> Figure:
     """Mesh force against time, one panel per load-sharing group, the paths overlaid.
 
     Parameters
@@ -239,13 +239,14 @@ def load_sharing_figure(results, definition: str | None = None, *,
     scale, unit = _time_unit(s.history_t if s.history_t.size else s.cycle_start.ravel())
     for ax, zoom, (g, members) in zip(axes, zooms, groups.items()):
         reported = met.load_sharing.per_group[g]
+        per = 1
         for i, m in enumerate(members):
             style = _line_style(i, len(members))
             ok = np.isfinite(coef[m])
             if zoom is None:
                 ax.plot(cycle_t[m] * scale, coef[m], label=m, **style)
                 continue
-            _dense_line(ax, cycle_t[m][ok] * scale, coef[m][ok], m, style, 0)
+            per = _dense_line(ax, cycle_t[m][ok] * scale, coef[m][ok], m, style, 0)
             last = np.flatnonzero(ok)[-zoom_cycles:]
             zoom.plot(cycle_t[m][last] * scale, coef[m][last], label=m, marker=".",
                       ms=4, **style)
@@ -256,7 +257,9 @@ def load_sharing_figure(results, definition: str | None = None, *,
         # the group's own settle time: its coefficients start there
         _mark_settled(ax, met.settling.group_time.get(g, settle) * scale,
                       s.t_span[0] * scale, unit)
-        ax.set_title(_group_label(g, members) + (", whole run" if zoom is not None else ""),
+        whole = (f", whole run: mean of {per} cycles, band their range" if per > 1
+                 else ", whole run")
+        ax.set_title(_group_label(g, members) + (whole if zoom is not None else ""),
                      fontsize=FONT["title"])
         _label(ax, f"time [{unit}]", "load-sharing coefficient [-]")
         if zoom is None:
@@ -271,11 +274,52 @@ def load_sharing_figure(results, definition: str | None = None, *,
     return fig
 
 
+def dynamic_factor_figure(results, definition: str | None = None, *,
+                          resonance: float | None = None) -> Figure:
+    """Dynamic factor and peak / nominal force of every mesh, as bars by group.
+
+    The dynamic factor (settled peak / the mesh's own static force, the K_v sense) and
+    peak / nominal (settled peak / equal-split nominal force: load sharing and dynamics
+    together, Ji & Li eq. 19) come from ``results.metrics(definition).rows``; the grey
+    line is 1, the red dotted line the factor above which a run is reported as near a
+    resonance (:data:`torquesplit.results.plausibility.RESONANCE_FACTOR`).
+    """
+    from ..results.plausibility import RESONANCE_FACTOR
+
+    met = results.metrics(definition)
+    limit = RESONANCE_FACTOR if resonance is None else resonance
+    rows = met.rows
+    order = [r for g in met.load_sharing.groups for r in rows if r.group == g]
+    fig = _figure(WIDTH, 3.4 + 0.12 * len(order))
+    ax = fig.add_subplot()
+    x = np.arange(len(order))
+    dyn = np.array([r.dynamic_factor for r in order], float)
+    ptn = np.array([r.peak_to_nominal for r in order], float)
+    ax.bar(x - 0.2, np.nan_to_num(dyn), 0.4, color=_color(0),
+           label="dynamic factor\n(peak / own static force)")
+    ax.bar(x + 0.2, np.nan_to_num(ptn), 0.4, color=_color(1),
+           label="peak / nominal\n(peak / equal-split force)")
+    ax.axhline(1.0, color="0.5", lw=0.9)
+    top = float(np.nanmax(np.concatenate([dyn, ptn, [1.0]])))
+    if top > 0.6 * limit:
+        ax.axhline(limit, color="tab:red", ls=":", lw=1.3,
+                   label=f"{limit:g}: near a resonance\n(see torquesplit modes)")
+    ax.set_xticks(x, [f"{r.mesh}\n{r.group}" for r in order], rotation=0 if len(order) <= 6
+                  else 60, ha="center" if len(order) <= 6 else "right")
+    ax.set_xlim(-0.6, len(order) - 0.4)
+    ax.set_ylim(0, max(1.15 * top, 1.2))
+    ax.set_title("per mesh, over the settled part", fontsize=FONT["title"])
+    _label(ax, "mesh and group [-]", "factor [-]")
+    _legend(ax)
+    _suptitle(fig, results, "dynamic factors")
+    return fig
+
+
 def support_spectrum_figure(results, *, start_time: float | None = None, orders: int = 4,
                             max_frequency: float | None = None, log: bool = True,
                             dynamic_range: float = 1e-4,
-                            bodies: Iterable[str] | None = None, max_panels: int = 6,
-                            content_range: float = 1e-3, max_points: int = 3000) -> Figure:
+                            bodies: Iterable[str] | None = None, max_panels: int = 4,
+                            content_range: float = 1e-2, max_points: int = 3000) -> Figure:
     """Amplitude spectrum of the support (bearing) force histories, mesh orders marked.
 
     Parameters
@@ -396,7 +440,7 @@ def support_spectrum_figure(results, *, start_time: float | None = None, orders:
         shown = [b for b in supports if b in shown]  # model order
     fscale, funit = (1e-3, "kHz") if f_top >= 1e4 else (1.0, "Hz")
     show = freq <= f_top
-    ncols = 1 if len(shown) <= 3 else 2
+    ncols = 1 if len(shown) <= max(4, max_panels) else 2
     fig, axes = _panels(len(shown), ncols=ncols, sharex=True, row_height=2.6)
     for n_panel, (ax, body) in enumerate(zip(axes, shown)):
         lines = spectra[body]
@@ -433,7 +477,7 @@ def support_spectrum_figure(results, *, start_time: float | None = None, orders:
         elif log:
             ax.set_yscale("log")
             ax.set_ylim(floor, 2.0 * largest)
-            ax.yaxis.set_minor_formatter(NullFormatter())  # decades only: readable, fast
+            ax.yaxis.set_minor_locator(NullLocator())  # decades only: readable, fast
         else:
             ax.set_ylim(0, 1.08 * largest)
         ax.set_title(f"support of {body}", fontsize=FONT["title"])
@@ -442,8 +486,8 @@ def support_spectrum_figure(results, *, start_time: float | None = None, orders:
     span = grid.size * dt
     more = (f"\n{len(hidden)} weaker supports not drawn: {', '.join(hidden)}"
             if hidden else "")
-    _suptitle(fig, results, f"support force spectrum, {grid[0]:.4g} s ≤ t < "
-                            f"{grid[0] + span:.4g} s (resolution {1 / span:.3g} Hz){more}")
+    _suptitle(fig, results, f"support force spectrum\n{grid[0]:.4g} s ≤ t < "
+                            f"{grid[0] + span:.4g} s, resolution {1 / span:.3g} Hz{more}")
     return fig
 
 
@@ -617,7 +661,7 @@ def write_figures(results, directory, formats=("png", "svg"), *,
     list of Path
         ``mesh_force.*`` (whole run), ``mesh_force_end.*`` (last cycles),
         ``cycle_peak_force.*``, ``load_sharing_<definition>.*`` (if a group has two or
-        more meshes), ``support_force_spectrum.*`` (if supports were recorded),
+        more meshes), ``dynamic_factors.*``, ``support_force_spectrum.*`` (if supports were recorded),
         ``orbits.*`` (if x-y histories were recorded), ``mesh_stiffness.*`` (if a mesh
         stiffness varies).
     """
@@ -639,6 +683,7 @@ def figure_jobs(results, *, definition: str | None = None,
         ("mesh_force_end", lambda: mesh_force_figure(results, last_cycles=last_cycles)),
         ("cycle_peak_force", lambda: cycle_peak_figure(results)),
         (f"load_sharing_{definition}", lambda: load_sharing_figure(results, definition)),
+        ("dynamic_factors", lambda: dynamic_factor_figure(results, definition)),
         ("support_force_spectrum", lambda: support_spectrum_figure(results)),
         ("orbits", lambda: orbit_figure(results)),
     ]
@@ -707,14 +752,33 @@ def write_jobs(jobs, directory, formats=("png", "svg"), *, prefix: str = "", dpi
         except FigureNotApplicableError as exc:
             log.info("figure %s skipped: %s", name, exc)
             continue
-        for fmt in formats:
-            path = directory / f"{prefix}{name}.{fmt.lower().lstrip('.')}"
-            fig.savefig(path, dpi=dpi, bbox_inches="tight", pad_inches=0.1)
-            written.append(path)
+        written += save_figure(fig, [directory / f"{prefix}{name}.{fmt.lower().lstrip('.')}"
+                                     for fmt in formats], dpi=dpi)
         log.debug("figure %s written", name)
     if progress is not None:
         progress(len(jobs), len(jobs), "done")
     return written
+
+
+def save_figure(fig: Figure, paths, *, dpi: int = 150) -> list[Path]:
+    """Save ``fig`` to each path (format by suffix), cropped to its content so that no
+    legend or title is clipped.  The layout and the crop are computed once for all the
+    formats; SVG keeps its text as text (smaller, faster, searchable)."""
+    import matplotlib
+
+    fig.draw_without_rendering()  # the layout, once
+    bbox = fig.get_tightbbox().padded(0.1)
+    engine = fig.get_layout_engine()
+    fig.set_layout_engine("none")  # keep it: every save would lay the figure out again
+    out = []
+    with matplotlib.rc_context({"svg.fonttype": "none"}):
+        for path in paths:
+            path = Path(path)
+            fig.savefig(path, dpi=dpi, bbox_inches=bbox,
+                        metadata={"Date": None} if path.suffix.lower() == ".svg" else None)
+            out.append(path)
+    fig.set_layout_engine(engine)
+    return out
 
 
 def figure_svg(fig: Figure, salt: str) -> str:
@@ -800,14 +864,14 @@ def _bin_extremes(t: np.ndarray, y: np.ndarray, bin_index: np.ndarray):
 
 
 def _dense_line(ax, x: np.ndarray, y: np.ndarray, label: str, style: dict,
-                dense_above: int, bins: int = DENSE_BINS) -> None:
+                dense_above: int, bins: int = DENSE_BINS) -> int:
     """Draw ``y(x)`` as a line; beyond ``dense_above`` points, as the range of ``y`` over
     runs of consecutive points (light band, every extreme kept) with the run means as
     the line, so that thousands of cycles of several meshes stay readable."""
     x, y = np.asarray(x, float), np.asarray(y, float)
     if x.size <= dense_above or x.size < 2 * bins:
         ax.plot(x, y, label=label, **style)
-        return
+        return 1
     per = math.ceil(x.size / bins)
     n = math.ceil(x.size / per) * per
     pad = n - x.size
@@ -819,6 +883,7 @@ def _dense_line(ax, x: np.ndarray, y: np.ndarray, label: str, style: dict,
                             np.nanmax(yb, axis=1), np.nanmean(yb, axis=1))
     ax.fill_between(xm, lo, hi, color=style["color"], alpha=0.15, lw=0)
     ax.plot(xm, mean, label=f"{label} (mean of {per} cycles;\nband: their range)", **style)
+    return per
 
 
 def _stiffness_at_phase(table: np.ndarray, phase: np.ndarray) -> np.ndarray:
@@ -893,8 +958,9 @@ def _label(ax, xlabel: str, ylabel: str) -> None:
     ax.set_ylabel(ylabel, fontsize=FONT["label"])
     ax.tick_params(labelsize=FONT["tick"])
     for axis in (ax.xaxis, ax.yaxis):
-        if axis.get_scale() == "linear":
-            axis.get_major_formatter().set_useOffset(False)
+        formatter = axis.get_major_formatter()
+        if axis.get_scale() == "linear" and hasattr(formatter, "set_useOffset"):
+            formatter.set_useOffset(False)
     ax.grid(True, alpha=0.3)
     lo, hi = ax.dataLim.intervaly
     size = max(abs(lo), abs(hi))

@@ -75,17 +75,21 @@ def back_flank(results, metrics) -> list[tuple[str, str]]:
         if r.back_contact <= FRACTION_FLOOR:
             continue
         largest = r.back_flank_force
+        if r.min_force >= 0:  # none in the settled part
+            when = " (in the start-up transient only: the settled part has none)"
+        else:
+            when = ""
         if r.double_flank:
             out.append((f"meshes.{r.mesh}", (
                 f"double-flank contact {_pct(r.back_contact)} of the time, back-flank force "
-                f"up to {_kn(largest)}: the mesh has no backlash, so the model lets it carry "
+                f"up to {_kn(largest)}{when}: the mesh has no backlash, so the model lets it carry "
                 f"tension, which a real pair with backlash cannot; give "
                 f"meshes.{r.mesh}.backlash its real value (e.g. '100 um') or read its peak "
                 f"and load sharing as those of a double-flank (anti-backlash) mesh")))
         else:
             out.append((f"meshes.{r.mesh}", (
                 f"back-flank contact {_pct(r.back_contact)} of the time, back-flank force up "
-                f"to {_kn(largest)}: the teeth rattle through the backlash; peak forces are "
+                f"to {_kn(largest)}{when}: the teeth rattle through the backlash; peak forces are "
                 f"impacts and the load sharing is not meaningful; check the excitation "
                 f"and meshes.{r.mesh}.backlash")))
     return out
