@@ -325,7 +325,7 @@ def markdown(res: dict) -> str:
                  "The spur stage is dominated by its own resonance with the example's assumed "
                  "supports (its dynamic factor of "
                  f"{dyn['secant/unmodified']['groups']['left/spur_split']['dynamic_factor']:.1f} with "
-                 "impact; docs/validation.md, seed 000) and barely changes.  Wall times: "
+                 "impact; docs/validation.md, Liu et al. 2021) and barely changes.  Wall times: "
                  + ", ".join(f"{k} {v['wall_time_s']:.1f} s" for k, v in dyn.items()) + ".\n")
     nsga = res.get("nsga")
     if nsga:

@@ -27,7 +27,37 @@ from . import cli_support as ux
 from .cli_support import header as _h
 from .errors import ModelWarning, OptionError, TorquesplitError, clip_message
 
+class _Command(typer.core.TyperCommand):
+    """A command listed in --help without type noise: no ``<bool>`` on flags, no
+    ``<str>`` beside an argument that already has a name (MODEL)."""
+
+    def get_help_option(self, ctx):
+        option = super().get_help_option(ctx)
+        if option is not None and getattr(option, "metavar", "") is None:
+            option.metavar = ""
+        return option
+
+    def get_params(self, ctx):
+        params = super().get_params(ctx)
+        for p in params:
+            if isinstance(p, typer.core.TyperArgument) and p.metavar:
+                p.display_type_rich = lambda ctx: None  # the metavar says it
+        return params
+
+
+class _Group(typer.core.TyperGroup):
+    """The app's group, its --help listed like the commands'."""
+
+    def get_help_option(self, ctx):
+        option = super().get_help_option(ctx)
+        if option is not None and getattr(option, "metavar", "") is None:
+            option.metavar = ""
+        return option
+
+
 app = typer.Typer(
+    cls=_Group,
+    rich_markup_mode="markdown",
     add_completion=False,
     no_args_is_help=True,
     help="Dynamic load-sharing analysis of power-split gear transmissions.  Start with "
@@ -458,8 +488,9 @@ def _render_run(res, met, saved) -> None:
         f"{DEFINITION_USE[met.definition]}.  Dynamic factor = settled peak / the mesh's own "
         f"static force (K_v sense, >= 1 in contact); peak/nominal = settled peak / "
         f"equal-split nominal force (Ji & Li eq. 19) = load sharing and dynamics together.  "
-        f"Contact loss: drive flanks apart; back flank: time in back-flank contact and its "
-        f"largest force (double-flank: the mesh has no backlash).",
+        f"Contact loss: drive flanks apart (a mesh with no backlash cannot lose contact: it "
+        f"is in double-flank contact); back flank: time in back-flank contact and its "
+        f"largest force.",
         markup=False, highlight=False)
     if saved:
         console.print("results written to " + ", ".join(str(f) for f in saved),
@@ -469,28 +500,27 @@ def _render_run(res, met, saved) -> None:
 def run_table(met) -> Table:
     """The per-mesh table of a run (forces in kN)."""
     t = Table(title=f"meshes (load sharing: {met.definition})")
-    cols = ("mesh", "group", "nominal F [kN]", "static F [kN]", "mean F [kN]", "peak F [kN]",
-            "dynamic factor", "peak/nominal", f"LSC ({met.definition})", "contact loss",
-            "back flank")
+    cols = ("mesh", "group", "nominal F\n[kN]", "static F\n[kN]", "mean F\n[kN]",
+            "peak F\n[kN]", "dynamic\nfactor", "peak/\nnominal", f"LSC\n({met.definition})",
+            "contact\nloss", "back flank\n(time, force)")
     for col in cols:
         t.add_column(_h(col), justify="left" if col in ("mesh", "group") else "right")
     for r in met.rows:
         back = f"{100 * r.back_contact:.2f} %"
         if r.back_contact > 0:
             back += f", {r.back_flank_force / 1e3:.4g} kN"
-        if r.double_flank:
-            back += " (double-flank)"
+        loss = "no backlash" if r.double_flank else f"{100 * r.contact_loss:.2f} %"
         t.add_row(r.mesh, r.group, f"{r.nominal_force / 1e3:.5g}", f"{r.static_force / 1e3:.5g}",
                   f"{r.mean_force / 1e3:.5g}", f"{r.peak_force / 1e3:.5g}",
                   f"{r.dynamic_factor:.4f}", f"{r.peak_to_nominal:.4f}",
-                  f"{r.load_sharing:.4f}", f"{100 * r.contact_loss:.2f} %", back)
+                  f"{r.load_sharing:.4f}", loss, back)
     return t
 
 
 def group_table(met) -> Table:
     g = Table(title="load-sharing groups")
-    for col in ("group", "meshes", f"LSC ({met.definition})", "dynamic factor",
-                "peak/nominal", "peak/nominal (eng.)"):
+    for col in ("group", "meshes", f"LSC\n({met.definition})", "dynamic\nfactor",
+                "peak/\nnominal", "peak/nominal\n(eng.)"):
         g.add_column(_h(col), justify="left" if col in ("group", "meshes") else "right")
     d = met.dynamic_factors
     for name, members in met.load_sharing.groups.items():
@@ -1004,6 +1034,10 @@ _register_steady(app, lambda model: _load(model), _fail, console, err_console, _
 from .report.cli import register as _register_report  # noqa: E402
 
 _register_report(app, sys.modules[__name__])
+
+for _info in app.registered_commands:  # every command's --help without a type
+    if _info.cls in (None, typer.core.TyperCommand):
+        _info.cls = _Command
 
 
 def main():  # pragma: no cover - console entry point

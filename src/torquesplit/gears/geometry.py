@@ -186,8 +186,10 @@ class GearGeometry:
         if not (self.normal_module > 0 and math.isfinite(self.normal_module)):
             issues.append(("normal_module", f"must be a positive length in metres, got {self.normal_module!r}"))
         elif self.normal_module > 0.1:
-            issues.append(("normal_module", f"{self.normal_module} m is implausibly large; "
-                                            "lengths are in metres (3.5 mm = 3.5e-3)"))
+            issues.append(("normal_module", f"{self.normal_module:g} m is implausibly large; "
+                                            f"a bare number is read in metres: write "
+                                            f"'{self.normal_module:g} mm' (or "
+                                            f"{self.normal_module:g}e-3)"))
         if not (0 < self.normal_pressure_angle < math.radians(45)):
             issues.append(("normal_pressure_angle", f"must lie in (0, 45 deg) and is in radians, "
                                                     f"got {self.normal_pressure_angle!r}"))

@@ -210,12 +210,11 @@ def _run_section(res, met) -> str:
         back = f"{100 * r.back_contact:.2f} %"
         if r.back_contact > 0:
             back += f", up to {r.back_flank_force / 1e3:.4g} kN"
-        if r.double_flank:
-            back += " (double-flank)"
         rows.append([r.mesh, r.group, _g(r.nominal_force / 1e3), _g(r.static_force / 1e3),
                      _g(r.mean_force / 1e3), _g(r.peak_force / 1e3), f"{r.dynamic_factor:.4f}",
                      f"{r.peak_to_nominal:.4f}", f"{r.load_sharing:.4f}",
-                     f"{100 * r.contact_loss:.2f} %", back])
+                     "no backlash (double-flank)" if r.double_flank
+                     else f"{100 * r.contact_loss:.2f} %", back])
     per_mesh = _table(["mesh", "group", "nominal F [kN]", "static F [kN]", "mean F [kN]",
                        "peak F [kN]", "dynamic factor", "peak/nominal",
                        f"LSC ({met.definition})", "contact loss", "back flank"], rows, left=2)
