@@ -175,7 +175,7 @@ def markdown(res: dict) -> str:
         L.append(f"| {r['pair']} | {pe:.5g} | {r['ltca_independent']:.5g} "
                  f"({100 * (r['ltca_independent'] / pe - 1):+.2f} %) | {r['ltca_coupled']:.5g} "
                  f"({100 * (r['ltca_coupled'] / pe - 1):+.2f} %) |")
-    L.append("\nAcceptance (issue 11): within 5 %. Tested in `test_contact.py`.\n")
+    L.append("\nAcceptance: within 5 %. Tested in `test_contact.py`.\n")
     L.append("## 2. Hertzian contact of one slice\n")
     L.append("A single-slice spur pair in single-tooth contact: the difference of the loaded "
              "transmission error with the load-dependent contact (Weber 1949; Johnson 1985 §5.6) "

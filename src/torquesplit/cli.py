@@ -14,6 +14,7 @@ from __future__ import annotations
 import contextlib
 import json
 import math
+import os
 import sys
 import warnings
 from pathlib import Path
@@ -64,8 +65,18 @@ app = typer.Typer(
          "'torquesplit examples', then 'torquesplit check ji_li_mill_drive' and "
          "'torquesplit run ji_li_mill_drive'; docs/tutorial.md builds a model from scratch.",
 )
-console = Console(width=None if sys.stdout.isatty() else 160)
-err_console = Console(stderr=True, width=None if sys.stderr.isatty() else 160)
+def _width(stream) -> int | None:
+    """Terminal width: the terminal's, else $COLUMNS, else 160 (pipes, files)."""
+    if stream.isatty():
+        return None
+    try:
+        return max(40, int(os.environ.get("COLUMNS", "")))
+    except ValueError:
+        return 160
+
+
+console = Console(width=_width(sys.stdout))
+err_console = Console(stderr=True, width=_width(sys.stderr))
 
 _state = {"debug": False}
 

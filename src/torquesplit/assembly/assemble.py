@@ -1,6 +1,6 @@
 """Model -> Structure: number the DOFs, build the diagonal mass and the element list.
 
-Element kinds produced here (DESIGN.md §4):
+Element kinds produced here (docs/theory/model.md):
 
 ==============  ==========================================  =========================
 element         deformation ``V . q``                         stiffness

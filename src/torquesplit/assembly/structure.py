@@ -1,6 +1,6 @@
 """The assembled equations of motion as flat arrays for the compiled kernels.
 
-Every layout reduces to the same form (DESIGN.md §4)::
+Every layout reduces to the same form (docs/theory/model.md)::
 
     M q'' = F_ext - C_g q' - sum_e V_e f_e
     delta_e  = V_e . q  - e_e(t)            deformation of element e

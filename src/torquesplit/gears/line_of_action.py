@@ -1,6 +1,6 @@
 """Contact frame and line of action of a mesh, from the layout and the power flow.
 
-One formulation for every pair (DESIGN.md §4).  At the mean contact point P each gear
+One formulation for every pair (docs/theory/model.md).  At the mean contact point P each gear
 ``i`` has its axis ``a_i``, the radial unit vector ``e_r,i`` from its axis to P and the
 tangent ``t_i = a_i x e_r,i``.  The force the driver exerts on the driven gear acts along
 

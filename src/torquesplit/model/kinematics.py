@@ -193,7 +193,7 @@ def solve_kinematics(model: Model) -> Kinematics:
         ja, jb = (sum(bodies[b].polar_inertia for b in bodies if groups[b] == groups[g])
                   for g in (driver, driven))
         # equivalent mass of the mesh, m = J1 J2 / (J1 r2^2 + J2 r1^2), with the arms
-        # as the effective base radii (issue 2; Ji & Li eq. 1 corrected)
+        # as the effective base radii (Ji & Li eq. 1 corrected)
         den = ja * arm_n**2 + jb * arm_d**2
         m_eq = ja * jb / den if den > 0 else 0.0
         spec = mesh.stiffness
