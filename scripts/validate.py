@@ -1,17 +1,22 @@
-"""Run each seed paper's study on its example model and collect the numbers the paper
+"""Run each paper's study on its example model and collect the numbers the paper
 reports, for docs/validation.md.
 
     python scripts/validate.py [seed000 seed001 ...] [--quick]
+    python scripts/render_docs.py      # then docs/validation.md from the numbers
 
-Writes docs/validation_results.json (one entry per seed) and prints a summary.  The
-settings are the papers' where they give them (see each example's [analysis] section
-and the comments in the model files); nothing is tuned to a published number.
+Writes docs/validation_results.json (one entry per paper, with the commit and the
+machine it ran on) and prints a summary.  The settings are the papers' where they give
+them (see each example's [analysis] section and the comments in the model files);
+nothing is tuned to a published number.  Every dynamic run is repeated with half the
+step: the largest change of any reported metric is stored beside it (``halved``), so a
+number is only published with the evidence that it does not move.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 import time
 import warnings
@@ -39,11 +44,43 @@ def _run(model, **kwargs) -> dict:
     t0 = time.perf_counter()
     res = torquesplit.simulate(model, **kwargs)
     wall = time.perf_counter() - t0
-    out = {"wall_time_s": wall, "statistics": res.statistics()}
+    values = res.metric_values()
+    out = {"wall_time_s": wall, "statistics": res.statistics(), "values": values,
+           "settled": bool(res.metrics().settling.settled)}
     for definition in ("cycle_peak", "engineering", "mean_force"):
-        met = res.metrics(definition)
-        out[definition] = met.to_dict()
+        out[definition] = res.metrics(definition).to_dict()
+    # the same run with half the step: how far every reported number moves
+    spp = 2 * (kwargs.pop("steps_per_period", None) or model.analysis.steps_per_period)
+    half = torquesplit.simulate(model, steps_per_period=spp, **kwargs).metric_values()
+    change = {k: abs(half[k] - v) for k, v in values.items()
+              if k in half and math.isfinite(v) and math.isfinite(half[k])
+              and k.startswith(("load_sharing", "dynamic_factor", "peak_to_nominal"))}
+    worst = max(change, key=change.get) if change else ""
+    out["halved"] = {"steps_per_period": spp, "max_change": change.get(worst, 0.0),
+                     "worst": worst, "change": change}
     return out
+
+
+def _provenance() -> dict:
+    """Which code and machine produced the numbers."""
+    import platform
+    import subprocess
+
+    root = Path(__file__).resolve().parents[1]
+
+    def git(*args):
+        try:
+            return subprocess.run(["git", *args], cwd=root, capture_output=True, text=True,
+                                  check=True).stdout.strip()
+        except (OSError, subprocess.CalledProcessError):
+            return ""
+
+    dirty = bool(git("status", "--porcelain", "--untracked-files=no", "src"))
+    return {"commit": git("rev-parse", "--short", "HEAD") + (" (with uncommitted changes "
+                                                             "in src)" if dirty else ""),
+            "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
+            "torquesplit": torquesplit.__version__, "python": platform.python_version(),
+            "machine": platform.machine(), "cpu_count": __import__("os").cpu_count()}
 
 
 def seed000(quick: bool) -> dict:
@@ -77,11 +114,20 @@ def seed002(quick: bool) -> dict:
 def seed003(quick: bool) -> dict:
     """Mesh forces with tooth friction for RMS roughness 0.3, 0.6 and 0.9 um."""
     data = read_raw(torquesplit.example_path("jin2019_friction_split"))
+    from torquesplit.assembly.excitation import friction_table
+
     out = {}
     for s in ("0.3 um", "0.6 um", "0.9 um"):
         over = {f"meshes.{m}.friction": {"roughness": s}
                 for m, v in data["meshes"].items() if v.get("friction")}
-        out[s] = _run(_model("jin2019_friction_split", over), cycles=100 if quick else None)
+        model = _model("jin2019_friction_split", over)
+        out[s] = _run(model, cycles=100 if quick else None)
+        # friction force over one mesh cycle at the nominal load (the tables the
+        # dynamic model uses), a spur split mesh and a herringbone mesh of the right path
+        kin = torquesplit.solve_kinematics(model)
+        for mesh in ("Rp1s", "RB1h"):
+            force = friction_table(model, kin, mesh, 256)[0] * kin.meshes[mesh].force
+            out[s][f"friction_{mesh}_N"] = [float(force.min()), float(force.max())]
     return out
 
 
@@ -98,7 +144,33 @@ def seed004(quick: bool) -> dict:
             "converged": bool(res.solution.converged.all())}
 
 
-STUDIES = {"seed000": seed000, "seed001": seed001, "seed002": seed002, "seed003": seed003,
+def kinematics(quick: bool) -> dict:
+    """The exact (non-dynamic) quantities each paper prints: contact ratio, speeds,
+    torques, mesh frequencies, from the shipped models' kinematics."""
+    rpm = 3.141592653589793 / 30
+
+    def kin(name):
+        return torquesplit.solve_kinematics(_model(name))
+
+    k0, k1, k2, k4 = (kin(n) for n in ("liu2021_split_torque_helicopter", "ji_li_mill_drive",
+                                       "dong2021_face_gear", "mo2017_star_reducer"))
+    return {
+        "seed000": {"contact_ratio_dh": k0.meshes["L78"].total_contact_ratio,
+                    "speed_spur_pinion_rpm": abs(k0.bodies["L3"].speed) / rpm,
+                    "speed_dh_pinion_rpm": abs(k0.bodies["L7"].speed) / rpm,
+                    "design_load_Nm": k0.meshes["L78"].torque_driven},
+        "seed001": {"f_mesh1_Hz": k1.meshes["m11"].frequency,
+                    "f_mesh2_Hz": k1.meshes["m12"].frequency},
+        "seed002": {"input_torque_Nm": k2.drive_torques["engine"],
+                    "idler_torque_Nm": k2.bodies["O6"].torque},
+        "seed004": {"input_torque_Nm": k4.drive_torques["turbine"],
+                    "path_torque_Nm": k4.meshes["s1p11"].torque_driver,
+                    "star_shaft_torque_Nm": k4.bodies["p11"].torque,
+                    "output_torque_Nm": k4.load_torques["output"]},
+    }
+
+
+STUDIES = {"kinematics": kinematics, "seed000": seed000, "seed001": seed001, "seed002": seed002, "seed003": seed003,
            "seed004": seed004}
 
 
@@ -108,6 +180,7 @@ def main(argv=None) -> int:
     ap.add_argument("--quick", action="store_true", help="shorter runs (smoke test)")
     args = ap.parse_args(argv)
     old = json.loads(OUT.read_text()) if OUT.exists() else {}
+    old["provenance"] = _provenance()
     for seed in args.seeds:
         t0 = time.perf_counter()
         try:

@@ -2,10 +2,20 @@
 
 from __future__ import annotations
 
+import os
+
 import pytest
+from hypothesis import settings
 
 import torquesplit
 from model_texts import SPUR_PAIR, split_model, write_model
+
+# property-based tests draw the same examples on every run (a CI failure reproduces);
+# HYPOTHESIS_PROFILE=explore searches afresh
+settings.register_profile("ci", derandomize=True, database=None, deadline=None,
+                          print_blob=True)
+settings.register_profile("explore", deadline=None)
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
 
 
 @pytest.fixture

@@ -6,32 +6,31 @@ The pipeline, one stage per subpackage (each stage returns a new object)::
     solve_kinematics(model)     -> Kinematics  (model/: speeds, torques, line of action)
     assemble(model)             -> Structure   (assembly/: DOFs, mass, element arrays)
     simulate(model, ...)        -> Results     (solve/ + metrics/ + results/)
+    run_study(study_file)       -> Dataset     (study/: grids, Monte Carlo, sensitivity)
 """
 
 from __future__ import annotations
 
+from .assembly.assemble import assemble
 from .errors import ModelError, ModelWarning, SolverError, StepTooLargeError, TorquesplitError
 from .examples import example_names, example_path
 from .model.io import load_model
 from .model.kinematics import solve_kinematics
+from .simulation import simulate
 
 __version__ = "0.1.0"
 
 __all__ = [
     "ModelError", "ModelWarning", "SolverError", "StepTooLargeError", "TorquesplitError",
     "example_names", "example_path", "load_model", "solve_kinematics", "assemble", "simulate",
+    "Study", "run_study",
 ]
 
 
-def assemble(model, **kwargs):
-    """Assemble a model into a :class:`~torquesplit.assembly.structure.Structure`."""
-    from .assembly.assemble import assemble as _assemble
+def __getattr__(name):
+    # the study layer (and xarray, scipy.stats) load only when asked for
+    if name in ("Study", "run_study"):
+        from . import study
 
-    return _assemble(model, **kwargs)
-
-
-def simulate(model, **kwargs):
-    """Static equilibrium then dynamic response; see :func:`torquesplit.simulation.simulate`."""
-    from .simulation import simulate as _simulate
-
-    return _simulate(model, **kwargs)
+        return getattr(study, name)
+    raise AttributeError(f"module 'torquesplit' has no attribute {name!r}")

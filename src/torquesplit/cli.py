@@ -1041,6 +1041,12 @@ from .steady.cli import register as _register_steady  # noqa: E402
 
 _register_steady(app, lambda model: _load(model), _fail, console, err_console, _json_default)
 
+# --------------------------------------------------------------------------- studies
+from .study.cli import study as _study, sweep as _sweep  # noqa: E402  (typer signatures only)
+
+app.command("study")(_study)
+app.command("sweep")(_sweep)
+
 # --------------------------------------------------------------------------- report, draw
 from .report.cli import register as _register_report  # noqa: E402
 

@@ -112,5 +112,39 @@ class StepTooLargeError(SolverError, ValueError):
     """The requested time step lies outside the integrator's stability region."""
 
 
+class PeriodError(SolverError):
+    """No common period of the excitations can be formed (frequencies without a rational
+    ratio): a periodic steady state does not exist as asked."""
+
+
+class LongPeriodError(PeriodError):
+    """The common period holds too many cycles of the fastest excitation."""
+
+
+class FieldError(TorquesplitError, ValueError):
+    """A check across fields of a model-file section that failed on one field.
+
+    Raised inside a section's validator; :mod:`torquesplit.model.io` appends ``field``
+    to the section's location, so that the message names ``gears.g1.hand``, not
+    ``gears.g1`` (a ValueError, as pydantic validators require)."""
+
+    def __init__(self, field: str, message: str):
+        super().__init__(message)
+        self.field = field
+
+
+class KinematicsError(TorquesplitError, ValueError):
+    """The layout or the power flow cannot be solved; carries ``issues``, a list of
+    ``(location, message)``, which the model loader turns into a :class:`ModelError`."""
+
+    def __init__(self, issues):
+        self.issues = issues
+        super().__init__("; ".join(f"{a}: {b}" for a, b in issues))
+
+
+class FigureNotApplicableError(TorquesplitError, ValueError):
+    """The results hold nothing this figure can show (no supports, no floating body...)."""
+
+
 class ModelWarning(UserWarning):
     """A value that looks wrong but can be right (damping above critical, ...)."""

@@ -25,6 +25,9 @@ MAX_HISTORY_RECORDS = 200_000
 MAX_STEPS = 200_000_000
 #: runs longer than this many steps are announced with a warning (cost estimate)
 ANNOUNCE_STEPS = 20_000_000
+#: fraction of a group's nominal load below which no instantaneous load-sharing ratio is
+#: formed (an instant when every mesh of the group is nearly unloaded)
+GROUP_MIN_LOAD = 0.01
 
 
 def simulate(
@@ -137,6 +140,15 @@ def _simulate(model, *, duration, cycles, method, steps_per_period, rtol,
     freqs = np.array([kin.meshes[m].frequency for m in mesh_names])
     f_min, f_max = float(freqs.min()), float(freqs.max())
     method = method or an.method
+    # options that the chosen method would ignore are refused, not ignored
+    wrong = ([name for name, v in (("rtol", rtol),) if v is not None] if method == "rk4" else
+             [name for name, v in (("steps_per_period", steps_per_period),
+                                   ("max_steps", max_steps)) if v is not None])
+    if wrong:
+        from .errors import OptionError
+
+        raise OptionError(f"option(s) {wrong} do not apply to method={method!r}; remove "
+                          "them or choose the other method")
     steps_per_period = steps_per_period or an.steps_per_period
     if duration is None:
         if cycles is not None:
@@ -161,10 +173,14 @@ def _simulate(model, *, duration, cycles, method, steps_per_period, rtol,
         sample_interval = duration / MAX_HISTORY_RECORDS
     from .metrics.load_sharing import group_meshes
 
-    groups = [[names.index(m) for m in ms]
-              for ms in group_meshes(structure.metadata["meshes"]).values()]
+    mesh_groups = list(group_meshes(structure.metadata["meshes"]).values())
+    groups = [[names.index(m) for m in ms] for ms in mesh_groups]
+    # no load-sharing ratio while a group carries less than 1 % of its nominal load
+    min_total = [GROUP_MIN_LOAD * sum(abs(kin.meshes[m].force) for m in ms)
+                 for ms in mesh_groups]
     kwargs = dict(
         method=method, track_elements=track, load_sharing_groups=groups,
+        load_sharing_min_total=min_total,
         history_elements=hist_el, history_dofs=hist_dofs, full_history=full_history,
         progress=progress, rhs=rhs,
         # the history is sampled in time, so its size never depends on the step

@@ -7,8 +7,8 @@ import pytest
 
 from torquesplit.errors import ModelError
 from torquesplit.gears.errors import (
-    CentreError,
-    LineOfActionError,
+    CentreDeviation,
+    LineOfActionDeviation,
     bearing_runout_error,
     centre_errors_on_line,
     cumulative_pitch_error,
@@ -23,7 +23,7 @@ T = np.linspace(0.0, 0.05, 301)
 
 
 def test_signal_normalisation_and_rate():
-    e = LineOfActionError(1e-6, [-2e-6, 3e-6, 4e-6], [-50.0, 80.0, 0.0], [0.3, -1.0, 0.5])
+    e = LineOfActionDeviation(1e-6, [-2e-6, 3e-6, 4e-6], [-50.0, 80.0, 0.0], [0.3, -1.0, 0.5])
     assert np.all(e.omegas >= 0) and np.all(e.amplitudes >= 0)
     assert e.omegas.size == 2  # the zero-frequency term became part of the constant
     direct = 1e-6 - 2e-6 * np.sin(-50.0 * T + 0.3) + 3e-6 * np.sin(80.0 * T - 1.0) + 4e-6 * math.sin(0.5)
@@ -41,8 +41,8 @@ def test_eccentricity_rotates_with_its_gear():
     """Signal at the gear's rotation frequency, phase from the offset direction
     relative to the line of action: -E cos(Omega t + phi - zeta) for gear 1."""
     ecc, phi, omega, zeta = 8e-6, 0.7, 798.6, math.radians(22.5) + 1.2
-    gear = CentreError(eccentricity=ecc, eccentricity_phase=phi, omega=omega)
-    e = centre_errors_on_line(zeta, gear, CentreError())
+    gear = CentreDeviation(eccentricity=ecc, eccentricity_phase=phi, omega=omega)
+    e = centre_errors_on_line(zeta, gear, CentreDeviation())
     assert e.omegas.tolist() == [pytest.approx(omega)]
     assert e.amplitudes[0] == pytest.approx(ecc)
     # direct vector projection of the rotating offset
@@ -59,11 +59,11 @@ def test_eccentricity_rotates_with_its_gear():
 
 
 def test_common_offset_cancels_and_installation_is_constant():
-    g = CentreError(installation=12e-6, installation_direction=0.4, omega=100.0)
-    mate = CentreError(installation=12e-6, installation_direction=0.4, omega=-30.0)
+    g = CentreDeviation(installation=12e-6, installation_direction=0.4, omega=100.0)
+    mate = CentreDeviation(installation=12e-6, installation_direction=0.4, omega=-30.0)
     e = centre_errors_on_line(1.1, g, mate)
     assert e.omegas.size == 0 and e.constant == pytest.approx(0.0, abs=1e-20)
-    only = centre_errors_on_line(1.1, g, CentreError(omega=-30.0))
+    only = centre_errors_on_line(1.1, g, CentreDeviation(omega=-30.0))
     assert only.omegas.size == 0
     assert only.constant == pytest.approx(-12e-6 * math.cos(0.4 - 1.1))
 
@@ -108,8 +108,8 @@ def test_seed002_equals_physical_projection_with_its_conventions():
         line_angle=a,
     )
     seed = eccentricity_installation_error_difference_form(**kw)
-    gi = CentreError(50e-6, math.pi / 2 - 0.2, 50e-6, math.pi / 2 - 0.5, 120.0)
-    gj = CentreError(30e-6, math.pi / 2 + 1.0, 20e-6, math.pi / 2 - 2.0, 40.0)
+    gi = CentreDeviation(50e-6, math.pi / 2 - 0.2, 50e-6, math.pi / 2 - 0.5, 120.0)
+    gj = CentreDeviation(30e-6, math.pi / 2 + 1.0, 20e-6, math.pi / 2 - 2.0, 40.0)
     physical = centre_errors_on_line(a, gi, gj)
     np.testing.assert_allclose(seed.evaluate(T), -physical.evaluate(T), atol=1e-18)
 
@@ -172,6 +172,6 @@ def test_pitch_deviations_reproduced_at_each_tooth(z):
 
 def test_bad_input_is_named():
     with pytest.raises(ModelError, match="equal"):
-        LineOfActionError(0.0, [1.0, 2.0], [1.0], [0.0])
+        LineOfActionDeviation(0.0, [1.0, 2.0], [1.0], [0.0])
     with pytest.raises(ValueError, match="one cumulative deviation per tooth"):
         pitch_error_from_deviations([1e-6] * 5, 10.0, 0.3, tooth_number=6)

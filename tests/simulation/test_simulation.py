@@ -71,7 +71,7 @@ def test_power_balance_and_no_drift(tmp_path):
     w_out = 500 * math.pi / 30 + (q[-1, 1] - q[k0, 1]) / (t[-1] - t[k0])
     p_in, p_out = 100.0 * w_in, 600.0 * w_out
     # constant torques: the mean dissipated power is the difference, bounded by 1e-3 P
-    assert 0 <= p_in - p_out < 1e-3 * p_in
+    assert -1e-12 * p_in <= p_in - p_out < 1e-3 * p_in  # >= 0 to round-off
     # the rigid-body rotation does not drift: the vibratory angles stay bounded
     assert np.ptp(q[k0:, 0]) < 1e-3
 

@@ -143,3 +143,22 @@ def test_threads_compiling_and_running_at_once_agree():
     with ThreadPoolExecutor(4) as pool:
         results = list(pool.map(run, structures))
     assert results == [("generated", True)] * 4
+
+
+def test_without_llvmlite_compilation_runs_fall_back_to_the_general_kernel(monkeypatch):
+    """An llvmlite that cannot compile the generated code (e.g. without the new pass
+    manager): the general kernel needs nothing of it, so every run still works, with one
+    warning, and gives the same numbers."""
+    def no_compiler(*args, **kwargs):
+        raise AttributeError("module 'llvmlite.binding' has no attribute 'create_pass_builder'")
+
+    monkeypatch.setattr(codegen._COMPILER, "compile", no_compiler)
+    monkeypatch.setattr(codegen._COMPILER, "_cache", {})
+    monkeypatch.setattr(integrate_module, "_CODEGEN_WARNED", False)
+    s = random_structure(31)
+    y0 = np.zeros(2 * s.n_dof)
+    with pytest.warns(RuntimeWarning, match="create_pass_builder.*general kernel"):
+        sol = integrate(s, y0, (0.0, 2e-4), step=1e-6, rhs="generated")
+    assert sol.success and sol.rhs == "general"
+    ref = integrate(s, y0, (0.0, 2e-4), step=1e-6, rhs="general")
+    np.testing.assert_array_equal(sol.y_final, ref.y_final)

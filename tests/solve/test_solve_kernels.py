@@ -70,10 +70,35 @@ def test_rk4_kernel_matches_readable_rk4():
     h = 2e-6
     n_steps = 300
     _, ys = rk4_numpy(s, y0, 0.0, h, n_steps)
-    sol = integrate(s, y0, (0.0, n_steps * h), step=h, full_history=True)
+    sol = integrate(s, y0, (0.0, n_steps * h), step=h, full_history=True, corners=False)
     assert sol.n_steps == n_steps
     scale = np.max(np.abs(ys), axis=0)
     assert np.all(np.abs(sol.full_y - ys) <= 1e-10 * scale + 1e-300)
+
+
+def test_rk4_steps_through_table_corners_like_the_readable_rk4_on_that_grid():
+    """With corners (default) the kernel's steps end on every table corner inside a
+    step: the same as the readable RK4 on the step grid with the corner times inserted."""
+    from torquesplit.solve.reference import corner_times_numpy
+
+    s = random_structure(3)
+    rng = np.random.default_rng(7)
+    y0 = np.concatenate([rng.normal(scale=1e-6, size=s.n_dof), np.zeros(s.n_dof)])
+    h, n_steps = 2e-6, 300
+    steps = h * np.arange(n_steps + 1)
+    corners = corner_times_numpy(s, 0.0, n_steps * h)
+    assert corners.size > 20
+    # a corner within 1e-6 h of a step time is taken as on it (as the kernel does)
+    near = np.min(np.abs(corners[:, None] - steps[None, :]), axis=1) <= 1e-6 * h
+    grid = np.union1d(steps, corners[~near])
+    t, ys = rk4_numpy(s, y0, 0.0, h, n_steps, times=grid)
+    sol = integrate(s, y0, (0.0, n_steps * h), step=h, full_history=True)
+    assert sol.n_steps == n_steps and sol.n_rhs > 4 * n_steps
+    on_steps = np.isin(t, steps)
+    scale = np.max(np.abs(ys), axis=0)
+    assert np.all(np.abs(sol.full_y - ys[on_steps]) <= 1e-10 * scale + 1e-300)
+    plain = integrate(s, y0, (0.0, n_steps * h), step=h, corners=False)
+    assert not np.allclose(plain.y_final, sol.y_final, rtol=1e-10, atol=0)
 
 
 def test_dopri_kernel_matches_readable_dopri():
@@ -145,40 +170,28 @@ def _rectangular_pair():
                      errors=[(2e-6, 2 * np.pi * 60, 0.0)])
 
 
-def test_corner_events_sample_the_forces_at_the_table_corners():
-    """Cycle max / min = those of the step samples and of the forces at every corner
-    time, the state there by cubic Hermite interpolation of the steps (twin: numpy)."""
-    from torquesplit.solve.kernel_data import corner_nodes
+def test_cycle_extremes_include_the_forces_at_the_table_corners():
+    """Cycle max / min = those of the forces at the step times and at every corner time,
+    from the readable RK4 on the grid with the corners inserted."""
+    from torquesplit.solve.reference import corner_times_numpy
 
     s = _rectangular_pair()
     y0 = np.array([1e-4, -5e-5, 0.0, 0.0])
-    sol = integrate(s, y0, (0.0, 0.0077), steps_per_period=97, full_history=True)
-    nodes = corner_nodes(s.stiffness_table[0])
-    assert nodes.size == 4
-    f, ph, n_tab = 1000.0, 0.37, s.n_table
-    t, forces = list(sol.full_t), list(element_forces_numpy(s, ti, yi)[0][0]
-                                       for ti, yi in zip(sol.full_t, sol.full_y))
-    ext_t = []
-    for c in range(int(f * sol.t_final) + 2):
-        for node in nodes:
-            tc = ((c + node / n_tab) - ph) / f
-            k = np.searchsorted(sol.full_t, tc) - 1
-            if 0 <= k < len(sol.full_t) - 1 and sol.full_t[k] < tc:
-                h = sol.full_t[k + 1] - sol.full_t[k]
-                ya, yb = sol.full_y[k], sol.full_y[k + 1]
-                yc = hermite_numpy((tc - sol.full_t[k]) / h, h, ya, rhs_numpy(s, sol.full_t[k], ya),
-                                   yb, rhs_numpy(s, sol.full_t[k + 1], yb))
-                t.append(tc)
-                forces.append(element_forces_numpy(s, tc, yc)[0][0])
-                ext_t.append(tc)
-    assert len(ext_t) > 20
-    cmax, cmin, _, _ = cycle_statistics_numpy(np.array(t), np.array(forces), f, ph, 0.0, 100)
+    h = 1.0 / (97 * 1000.0)
+    n_steps = 747
+    sol = integrate(s, y0, (0.0, n_steps * h), step=h)
+    steps = h * np.arange(n_steps + 1)
+    corners = corner_times_numpy(s, 0.0, n_steps * h)
+    near = np.min(np.abs(corners[:, None] - steps[None, :]), axis=1) <= 1e-6 * h
+    t, ys = rk4_numpy(s, y0, 0.0, h, n_steps, times=np.union1d(steps, corners[~near]))
+    forces = np.array([element_forces_numpy(s, ti, yi)[0][0] for ti, yi in zip(t, ys)])
+    cmax, cmin, _, _ = cycle_statistics_numpy(t, forces, 1000.0, 0.37, 0.0, 100)
     n = sol.cycle_max.shape[0]
-    np.testing.assert_allclose(sol.cycle_max[:, 0], cmax[:n], rtol=1e-12)
-    np.testing.assert_allclose(sol.cycle_min[:, 0], cmin[:n], rtol=1e-12)
-    # the steps alone miss the corners: the events change the statistics
-    smax, _, _, _ = cycle_statistics_numpy(sol.full_t, np.array(forces[:len(sol.full_t)]),
-                                           f, ph, 0.0, 100)
+    np.testing.assert_allclose(sol.cycle_max[:, 0], cmax[:n], rtol=1e-10)
+    np.testing.assert_allclose(sol.cycle_min[:, 0], cmin[:n], rtol=1e-10)
+    # the step samples alone miss the corners
+    on = np.isin(t, steps)
+    smax, _, _, _ = cycle_statistics_numpy(t[on], forces[on], 1000.0, 0.37, 0.0, 100)
     assert np.any(cmax[:n] > smax[:n] * (1 + 1e-9))
 
 

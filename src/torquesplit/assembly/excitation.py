@@ -175,9 +175,9 @@ def mesh_errors(model: Model, kin: Kinematics, mesh_name: str):
     mesh = model.meshes[mesh_name]
     mk = kin.meshes[mesh_name]
     te = mesh.transmission_error
-    total = gerr.LineOfActionError(te.constant)
+    total = gerr.LineOfActionDeviation(te.constant)
     if te.amplitude:
-        total = total + gerr.LineOfActionError(0.0, [te.amplitude],
+        total = total + gerr.LineOfActionDeviation(0.0, [te.amplitude],
                                                [2 * math.pi * mk.frequency], [te.phase])
     n = mk.line_of_action
     for g in mesh.gears:
@@ -193,7 +193,7 @@ def mesh_errors(model: Model, kin: Kinematics, mesh_name: str):
         scale = math.hypot(n1, n2)  # in-plane part of the line of action
         zeta = math.atan2(n2, n1)
         w = body.speed
-        centre = gerr.CentreError(
+        centre = gerr.CentreDeviation(
             eccentricity=ge.eccentricity * scale, eccentricity_phase=ge.eccentricity_phase,
             installation=ge.installation * scale, installation_direction=ge.installation_phase,
             omega=w).on_line(zeta)
@@ -216,9 +216,9 @@ def mesh_errors(model: Model, kin: Kinematics, mesh_name: str):
                                    int(tab.summary.get("error_harmonics", 16)))
         if harm:
             amp, om, ph = zip(*harm)
-            total = total + gerr.LineOfActionError(c0, list(amp), list(om), list(ph))
+            total = total + gerr.LineOfActionDeviation(c0, list(amp), list(om), list(ph))
         else:
-            total = total + gerr.LineOfActionError(c0)
+            total = total + gerr.LineOfActionDeviation(c0)
     sines = [(float(a), float(om), float(ph))
              for a, om, ph in zip(total.amplitudes, total.omegas, total.phases)]
     return float(total.constant), sines

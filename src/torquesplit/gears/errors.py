@@ -1,6 +1,6 @@
 """Gear and assembly errors as displacement excitations along the line of action.
 
-Every error of a mesh is returned as a :class:`LineOfActionError`: a constant plus a
+Every error of a mesh is returned as a :class:`LineOfActionDeviation`: a constant plus a
 sum of sinusoids ``a_k sin(omega_k t + phi_k)`` (amplitudes in m, angular
 frequencies in rad/s >= 0, phases in rad).  The assembler adds them per mesh and
 uses ``evaluate`` and ``rate`` (e(t), de/dt) in the element deformation
@@ -42,8 +42,8 @@ import numpy as np
 from torquesplit.errors import ModelError
 
 __all__ = [
-    "LineOfActionError",
-    "CentreError",
+    "LineOfActionDeviation",
+    "CentreDeviation",
     "rotating_offset_on_line",
     "fixed_offset_on_line",
     "centre_errors_on_line",
@@ -61,7 +61,7 @@ def _wrap(phase):
 
 
 @dataclass(frozen=True)
-class LineOfActionError:
+class LineOfActionDeviation:
     """e(t) = constant + sum_k amplitudes[k] * sin(omegas[k] t + phases[k])  [m].
 
     Normalised on construction: omegas >= 0 and amplitudes > 0 (signs moved into
@@ -70,7 +70,7 @@ class LineOfActionError:
 
     Examples
     --------
-    >>> e = LineOfActionError(1e-6, [2e-6], [10.0], [0.0])
+    >>> e = LineOfActionDeviation(1e-6, [2e-6], [10.0], [0.0])
     >>> round(float(e.evaluate(0.0)), 12), round(float(e.rate(0.0)), 12)
     (1e-06, 2e-05)
     """
@@ -86,7 +86,7 @@ class LineOfActionError:
         p = np.atleast_1d(np.asarray(self.phases, dtype=float)).copy()
         if not (a.shape == w.shape == p.shape) or a.ndim != 1:
             raise ModelError(
-                "LineOfActionError: amplitudes, omegas and phases must be 1-D and of equal "
+                "LineOfActionDeviation: amplitudes, omegas and phases must be 1-D and of equal "
                 f"length (got {a.shape}, {w.shape}, {p.shape})."
             )
         # a sin(-|w| t + p) = a sin(|w| t - p + pi)
@@ -120,30 +120,30 @@ class LineOfActionError:
         return np.sum(self.amplitudes * self.omegas * np.cos(arg), axis=-1)
 
     # --- algebra --------------------------------------------------------
-    def __add__(self, other: "LineOfActionError") -> "LineOfActionError":
-        if not isinstance(other, LineOfActionError):
+    def __add__(self, other: "LineOfActionDeviation") -> "LineOfActionDeviation":
+        if not isinstance(other, LineOfActionDeviation):
             return NotImplemented
-        return LineOfActionError(
+        return LineOfActionDeviation(
             self.constant + other.constant,
             np.concatenate([self.amplitudes, other.amplitudes]),
             np.concatenate([self.omegas, other.omegas]),
             np.concatenate([self.phases, other.phases]),
         )
 
-    def __neg__(self) -> "LineOfActionError":
+    def __neg__(self) -> "LineOfActionDeviation":
         return self.scaled(-1.0)
 
-    def scaled(self, factor: float) -> "LineOfActionError":
+    def scaled(self, factor: float) -> "LineOfActionDeviation":
         """factor * e(t)."""
-        return LineOfActionError(self.constant * factor, self.amplitudes * factor, self.omegas, self.phases)
+        return LineOfActionDeviation(self.constant * factor, self.amplitudes * factor, self.omegas, self.phases)
 
-    def angular(self, base_radius: float) -> "LineOfActionError":
+    def angular(self, base_radius: float) -> "LineOfActionDeviation":
         """Equivalent angular meshing error e / r_b [rad] (Mo et al. 2017 section 4.1)."""
         if base_radius <= 0:
-            raise ModelError("LineOfActionError.angular: base_radius must be positive (m).")
+            raise ModelError("LineOfActionDeviation.angular: base_radius must be positive (m).")
         return self.scaled(1.0 / base_radius)
 
-    def combined(self, rtol: float = 1e-12) -> "LineOfActionError":
+    def combined(self, rtol: float = 1e-12) -> "LineOfActionDeviation":
         """Merge terms of equal frequency into one (phasor sum); drop zero amplitudes."""
         if self.omegas.size == 0:
             return self
@@ -159,7 +159,7 @@ class LineOfActionError:
                 out_z.append(z)
         out_z = np.array(out_z)
         keep = np.abs(out_z) > 0.0
-        return LineOfActionError(
+        return LineOfActionDeviation(
             self.constant, np.abs(out_z)[keep], np.array(out_w)[keep], np.angle(out_z)[keep]
         )
 
@@ -167,7 +167,7 @@ class LineOfActionError:
 # --------------------------------------------------------------------------- #
 # physical projections
 # --------------------------------------------------------------------------- #
-def rotating_offset_on_line(amplitude, phase, omega, line_angle) -> LineOfActionError:
+def rotating_offset_on_line(amplitude, phase, omega, line_angle) -> LineOfActionDeviation:
     """Projection on the line of action of an offset that rotates with its gear.
 
     The offset vector E (cos(Omega t + phi), sin(Omega t + phi)) projected on
@@ -179,16 +179,16 @@ def rotating_offset_on_line(amplitude, phase, omega, line_angle) -> LineOfAction
     angle of n.  This is the signed displacement along n, not yet the mesh error;
     see :func:`centre_errors_on_line` for the sign of e.
     """
-    return LineOfActionError(0.0, [amplitude], [omega], [phase - line_angle + np.pi / 2])
+    return LineOfActionDeviation(0.0, [amplitude], [omega], [phase - line_angle + np.pi / 2])
 
 
-def fixed_offset_on_line(amplitude, direction, line_angle) -> LineOfActionError:
+def fixed_offset_on_line(amplitude, direction, line_angle) -> LineOfActionDeviation:
     """Projection A cos(gamma - zeta) of a fixed (installation) offset on n."""
-    return LineOfActionError(float(amplitude * math.cos(direction - line_angle)))
+    return LineOfActionDeviation(float(amplitude * math.cos(direction - line_angle)))
 
 
 @dataclass(frozen=True)
-class CentreError:
+class CentreDeviation:
     """Tooth-ring centre errors of one gear, SI.
 
     eccentricity : E [m], offset of the tooth ring from the rotation axis; it
@@ -206,14 +206,14 @@ class CentreError:
     installation_direction: float = 0.0
     omega: float = 0.0
 
-    def on_line(self, line_angle: float) -> LineOfActionError:
+    def on_line(self, line_angle: float) -> LineOfActionDeviation:
         """Displacement of this gear's teeth along n (before the mesh sign)."""
         return rotating_offset_on_line(
             self.eccentricity, self.eccentricity_phase, self.omega, line_angle
         ) + fixed_offset_on_line(self.installation, self.installation_direction, line_angle)
 
 
-def centre_errors_on_line(line_angle: float, gear_1: CentreError, gear_2: CentreError) -> LineOfActionError:
+def centre_errors_on_line(line_angle: float, gear_1: CentreDeviation, gear_2: CentreDeviation) -> LineOfActionDeviation:
     """Mesh error from eccentricity and installation errors of both gears.
 
     e(t) = -(eps_1(t) - eps_2(t)) . n, n at polar angle ``line_angle`` (force of
@@ -223,8 +223,8 @@ def centre_errors_on_line(line_angle: float, gear_1: CentreError, gear_2: Centre
 
     Examples
     --------
-    >>> g1 = CentreError(eccentricity=8e-6, omega=800.0)
-    >>> g2 = CentreError(eccentricity=12e-6, omega=-254.0)
+    >>> g1 = CentreDeviation(eccentricity=8e-6, omega=800.0)
+    >>> g2 = CentreDeviation(eccentricity=12e-6, omega=-254.0)
     >>> e = centre_errors_on_line(0.3, g1, g2)
     >>> sorted(e.omegas.round(1).tolist())
     [254.0, 800.0]
@@ -249,7 +249,7 @@ def eccentricity_installation_error_sum_form(
     installation_phase_j: float,
     line_offset: float,
     sign: float = 1.0,
-) -> LineOfActionError:
+) -> LineOfActionDeviation:
     """Mesh error of eccentricity and installation errors with both gears' terms added:
     Liu, Fang, Jia et al. 2021 eqs. 1-2 exactly as printed.
 
@@ -271,7 +271,7 @@ def eccentricity_installation_error_sum_form(
     - The installation terms are constant: installation errors do not rotate.
     """
     c = line_offset
-    terms = LineOfActionError(
+    terms = LineOfActionDeviation(
         installation_i * math.sin(-installation_phase_i + c)
         + installation_j * math.sin(-installation_phase_j + c),  # Liu et al. 2021 eq. 1 A terms
         [eccentricity_i, eccentricity_j],
@@ -295,7 +295,7 @@ def eccentricity_installation_error_difference_form(
     installation_phase_j: float,
     line_angle: float,
     sign: float = 1.0,
-) -> LineOfActionError:
+) -> LineOfActionDeviation:
     """Mesh error of eccentricity and installation errors with the gears' terms
     subtracted: Dong, Zhang, Zhao & Duan 2021 eq. 11 exactly as printed.
 
@@ -315,7 +315,7 @@ def eccentricity_installation_error_difference_form(
     opposite senses (pass w_j < 0 to correct this).  Installation terms are constant.
     """
     a = line_angle
-    terms = LineOfActionError(
+    terms = LineOfActionDeviation(
         installation_i * math.sin(installation_phase_i + a)
         - installation_j * math.sin(installation_phase_j + a),  # Dong et al. 2021 eq. 11 A terms
         [eccentricity_i, -eccentricity_j],
@@ -325,7 +325,7 @@ def eccentricity_installation_error_difference_form(
     return terms.scaled(sign)
 
 
-def seed000_mesh_error(**kwargs) -> LineOfActionError:
+def seed000_mesh_error(**kwargs) -> LineOfActionDeviation:
     """Deprecated name of :func:`eccentricity_installation_error_sum_form`."""
     import warnings
 
@@ -334,7 +334,7 @@ def seed000_mesh_error(**kwargs) -> LineOfActionError:
     return eccentricity_installation_error_sum_form(**kwargs)
 
 
-def seed002_mesh_error(**kwargs) -> LineOfActionError:
+def seed002_mesh_error(**kwargs) -> LineOfActionDeviation:
     """Deprecated name of :func:`eccentricity_installation_error_difference_form`."""
     import warnings
 
@@ -347,7 +347,7 @@ def seed002_mesh_error(**kwargs) -> LineOfActionError:
 # --------------------------------------------------------------------------- #
 # Mo et al. 2017: tooth thickness, pitch and bearing errors
 # --------------------------------------------------------------------------- #
-def tooth_thickness_error(thickness_deviation: float, pressure_angle: float) -> LineOfActionError:
+def tooth_thickness_error(thickness_deviation: float, pressure_angle: float) -> LineOfActionDeviation:
     """Constant mesh error of a tooth thickness deviation (Mo et al. 2017 section 4.1).
 
     A deviation Delta s of the circular tooth thickness, measured on a circle of
@@ -357,12 +357,12 @@ def tooth_thickness_error(thickness_deviation: float, pressure_angle: float) -> 
     (Delta s < 0) opens the mesh:  e = -(Delta s / 2) cos alpha.  Angular equivalent
     (Mo et al. 2017): e / r_b.
     """
-    return LineOfActionError(-0.5 * thickness_deviation * math.cos(pressure_angle))
+    return LineOfActionDeviation(-0.5 * thickness_deviation * math.cos(pressure_angle))
 
 
 def cumulative_pitch_error(
     total_cumulative_deviation: float, phase: float, omega: float, pressure_angle: float
-) -> LineOfActionError:
+) -> LineOfActionDeviation:
     """First-harmonic model of the cumulative pitch deviation (Mo et al. 2017 section 4.1).
 
     A total cumulative pitch deviation F_p (peak-to-peak over one revolution,
@@ -370,14 +370,14 @@ def cumulative_pitch_error(
     harmonic (F_p / 2) sin(Omega t + phi); along the line of action it is scaled
     by cos(alpha).  Positive = the working flank lags (mesh opens).
     """
-    return LineOfActionError(
+    return LineOfActionDeviation(
         0.0, [0.5 * total_cumulative_deviation * math.cos(pressure_angle)], [omega], [phase]
     )
 
 
 def pitch_error_from_deviations(
     cumulative_deviations, omega: float, pressure_angle: float, *, tooth_number: int | None = None
-) -> LineOfActionError:
+) -> LineOfActionDeviation:
     """Tooth-by-tooth cumulative pitch deviations as a periodic line-of-action error.
 
     ``cumulative_deviations[k]`` [m] is the cumulative pitch deviation of tooth k
@@ -412,10 +412,10 @@ def pitch_error_from_deviations(
         amps.append(amp)
         omegas.append(h * w)
         phases.append(phase)
-    return LineOfActionError(float(coeffs[0].real), amps, omegas, phases)
+    return LineOfActionDeviation(float(coeffs[0].real), amps, omegas, phases)
 
 
-def bearing_runout_error(runout: float, phase: float, omega: float, line_angle: float) -> LineOfActionError:
+def bearing_runout_error(runout: float, phase: float, omega: float, line_angle: float) -> LineOfActionDeviation:
     """Displacement along n from the radial runout of a bearing ring that rotates
     with the shaft (inner ring), Mo et al. 2017 section 4.1 "bearing manufacturing error".
 
@@ -423,6 +423,6 @@ def bearing_runout_error(runout: float, phase: float, omega: float, line_angle: 
     the centre offset is runout / 2 and rotates with the shaft:
     (runout / 2) cos(Omega t + phi - zeta).  A stationary (outer) ring's runout is
     a fixed offset: use :func:`fixed_offset_on_line`.  Combine into a mesh error
-    like an eccentricity (:class:`CentreError` or minus/plus this signal).
+    like an eccentricity (:class:`CentreDeviation` or minus/plus this signal).
     """
     return rotating_offset_on_line(0.5 * runout, phase, omega, line_angle)

@@ -24,15 +24,10 @@ import numpy as np
 
 from ..gears import line_of_action as loa
 from ..gears.geometry import GearGeometry, PairGeometry
+from ..errors import KinematicsError  # noqa: F401 - re-exported
 from .schema import Gear, Model
 
 
-class KinematicsError(ValueError):
-    """Raised with a list of (location, message) issues; turned into ModelError."""
-
-    def __init__(self, issues):
-        self.issues = issues
-        super().__init__("; ".join(f"{a}: {b}" for a, b in issues))
 
 
 @dataclass(frozen=True)

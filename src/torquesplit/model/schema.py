@@ -19,6 +19,7 @@ from typing import Annotated, Literal
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, model_validator
 from pydantic import Strict as StrictType
 
+from ..errors import FieldError  # noqa: F401 - used by validators here and re-exported
 from .units import KINDS, parse_quantity
 
 
@@ -90,16 +91,6 @@ class Strict(BaseModel):
                               allow_inf_nan=False)
 
 
-class FieldError(ValueError):
-    """A check across fields that failed on one of them.
-
-    Raised inside a section's validator; :mod:`torquesplit.model.io` appends ``field``
-    to the section's location, so that the message names ``gears.g1.hand``, not ``gears.g1``.
-    """
-
-    def __init__(self, field: str, message: str):
-        super().__init__(message)
-        self.field = field
 
 
 def _check_angle(v: float, name: str, upper_deg: float) -> float:
@@ -413,7 +404,7 @@ class BacklashSpec(Strict):
     seed: Count = Field(0, description="Random seed for reproducible sequences.")
 
 
-class TransmissionError(Strict):
+class TransmissionErrorSpec(Strict):
     """An additional error along the line of action: constant plus mesh-frequency harmonic."""
 
     constant: Length = Field(0.0, description="Constant error (installation along the LOA).")
@@ -484,7 +475,7 @@ class Mesh(Strict):
     ] = Field(
         0.0, description="Total backlash (\"100 um\"; 0 = none), or a [backlash] table."
     )
-    transmission_error: TransmissionError = Field(TransmissionError(), description="Extra LOA error.")
+    transmission_error: TransmissionErrorSpec = Field(TransmissionErrorSpec(), description="Extra LOA error.")
     phase: Number | None = Field(None, description="Mesh phase at t = 0 in cycles (overrides clocking).")
     stage: str | None = Field(None, description="Stage label for load-sharing groups.")
     path: str | None = Field(

@@ -36,7 +36,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.ticker import NullLocator
 
-from ..errors import TorquesplitError
+from ..errors import FigureNotApplicableError, TorquesplitError  # noqa: F401 - re-exported
 
 __all__ = [
     "FigureNotApplicableError", "figure_jobs", "write_jobs", "figure_svg",
@@ -77,8 +77,6 @@ _REPORTED_TEXT = {
 }
 
 
-class FigureNotApplicableError(TorquesplitError, ValueError):
-    """The results hold nothing this figure can show (no supports, no floating body...)."""
 
 
 # ============================================================ dynamic run figures

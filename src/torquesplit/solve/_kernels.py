@@ -57,10 +57,8 @@ from torquesplit.solve.kernel_data import (
     F_MAIN,
     F_TMP,
     SLOT_EVENT,
-    Y_ALT,
     Y_DSAMPLE,
     Y_K1,
-    Y_K1ALT,
     Y_KFSAL,
     Y_NEW,
     Y_SAMPLE,
@@ -86,9 +84,8 @@ I_NEXT = 7  # dopri: index of the next uniform sample time
 I_BAD = 8  # index into y of the state that diverged
 I_FSAL = 9  # dopri: 1 when Y_KFSAL holds f(t, y) of the current state
 I_LAST_REJECTED = 10  # dopri: the previous attempt was rejected
-I_SAVED = 11  # rk4: the previous state and its k1 are saved in rows Y_ALT, Y_K1ALT
-I_EVENTS = 12  # corner events sampled (see record_extrema)
-N_COUNTERS = 13
+I_EVENTS = 11  # corners sampled (see record_extrema)
+N_COUNTERS = 12
 
 # ---------------------------------------------------- float64 clock (in/out)
 F_T = 0  # time of the current state
@@ -125,10 +122,11 @@ _BETA = 0.04
 _EXPO1 = 0.2 - _BETA * 0.75
 
 _kernel = njit(cache=True, error_model="numpy", _nrt=False)
+_inline = njit(inline="always", error_model="numpy", _nrt=False)
 
 
 # =================================================================== excitation
-@_kernel
+@_inline
 def excite(t, slot, src, m, w):
     """Every time-dependent excitation at t into ``slot``.
 
@@ -162,9 +160,7 @@ def excite(t, slot, src, m, w):
         CY[slot, e] = laws.stat_cycle(s, fl)
         g0 = gap_ptr[e]
         ng = gap_ptr[e + 1] - g0
-        if ng == 1:
-            G[slot, e] = gap_values[g0]
-        else:
+        if ng > 1:  # one half-gap: constant, set in every slot by make_work
             c = np.int64(fl)
             if c != gap_cyc[e]:
                 k = c % ng
@@ -344,7 +340,7 @@ def evaluate(t, m, w, rhs_fn, gen):
 
 
 # ================================================================== recording
-@_kernel
+@_inline
 def record(slot, i_f, weight, m, w, r, counters):
     """Enter one accepted state (forces in row ``i_f``) in the statistics.
 
@@ -361,6 +357,7 @@ def record(slot, i_f, weight, m, w, r, counters):
     track_el, track_base = r.track_el, r.track_base
     cyc_max, cyc_min, cyc_sum, cyc_cnt = r.cyc_max, r.cyc_min, r.cyc_sum, r.cyc_cnt
     grp_ptr, grp_col, rat_max, rat_min = r.grp_ptr, r.grp_col, r.rat_max, r.rat_min
+    grp_min = r.grp_min
     sep_count, sep_time, back_count, back_time = (r.sep_count, r.sep_time, r.back_count,
                                                   r.back_time)
     element_kind = m.element_kind
@@ -380,7 +377,7 @@ def record(slot, i_f, weight, m, w, r, counters):
         total = 0.0
         for k in range(grp_ptr[g], grp_ptr[g + 1]):
             total += force[i_f, track_el[grp_col[k]]]
-        if total != 0.0:
+        if total > grp_min[g]:
             nm = grp_ptr[g + 1] - grp_ptr[g]
             for k in range(grp_ptr[g], grp_ptr[g + 1]):
                 j = grp_col[k]
@@ -419,6 +416,7 @@ def record_extrema(slot, i_f, w, r):
     track_el, track_base = r.track_el, r.track_base
     cyc_max, cyc_min = r.cyc_max, r.cyc_min
     grp_ptr, grp_col, rat_max, rat_min = r.grp_ptr, r.grp_col, r.rat_max, r.rat_min
+    grp_min = r.grp_min
     cap = cyc_max.shape[0]
     for j in range(track_el.shape[0]):
         el = track_el[j]
@@ -433,7 +431,7 @@ def record_extrema(slot, i_f, w, r):
         total = 0.0
         for k in range(grp_ptr[g], grp_ptr[g + 1]):
             total += force[i_f, track_el[grp_col[k]]]
-        if total != 0.0:
+        if total > grp_min[g]:
             nm = grp_ptr[g + 1] - grp_ptr[g]
             for k in range(grp_ptr[g], grp_ptr[g + 1]):
                 j = grp_col[k]
@@ -449,12 +447,11 @@ def record_extrema(slot, i_f, w, r):
 
 @_kernel
 def first_corners(t, m, w, r):
-    """Set ``w.next_node`` of every tracked element with corners to its first corner
-    node after time t (absolute node: cycle x n_table + node); returns the earliest
-    corner time."""
+    """Set ``w.next_node`` of every element with corners to its first corner node after
+    time t (absolute node: cycle x n_table + node); returns the earliest corner time."""
     n_tab = m.stiffness_table.shape[1]
     corner_ptr, corner_node, next_node = m.corner_ptr, m.corner_node, w.next_node
-    frequency, phase, track_el = m.frequency, m.phase, r.track_el
+    frequency, phase, track_el = m.frequency, m.phase, m.tv_el
     for j in range(track_el.shape[0]):
         e = track_el[j]
         c0 = corner_ptr[e]
@@ -477,11 +474,10 @@ def first_corners(t, m, w, r):
 
 @_kernel
 def next_corner_time(m, w, r):
-    """Earliest time of the tracked elements' next corners (``w.next_node``); inf if
-    none."""
+    """Earliest time of the elements' next corners (``w.next_node``); inf if none."""
     n_tab = m.stiffness_table.shape[1]
     corner_ptr, next_node = m.corner_ptr, w.next_node
-    frequency, phase, track_el = m.frequency, m.phase, r.track_el
+    frequency, phase, track_el = m.frequency, m.phase, m.tv_el
     earliest = math.inf
     for j in range(track_el.shape[0]):
         e = track_el[j]
@@ -493,17 +489,50 @@ def next_corner_time(m, w, r):
 
 
 @_kernel
+def advance_corners(t, m, w):
+    """Move every element whose next corner is at or before t to its following corner;
+    returns the earliest next corner time."""
+    n_tab = m.stiffness_table.shape[1]
+    corner_ptr, corner_node, next_node = m.corner_ptr, m.corner_node, w.next_node
+    frequency, phase, tv_el = m.frequency, m.phase, m.tv_el
+    earliest = math.inf
+    for j in range(tv_el.shape[0]):
+        e = tv_el[j]
+        c0 = corner_ptr[e]
+        c1 = corner_ptr[e + 1]
+        if c1 == c0:
+            continue
+        while True:
+            node = next_node[e]
+            tc = (node / n_tab - phase[e]) / frequency[e]
+            if tc > t:
+                break
+            base = (node // n_tab) * n_tab
+            p = node - base
+            k = c0
+            while k < c1 and corner_node[k] <= p:
+                k += 1
+            if k == c1:
+                next_node[e] = base + n_tab + corner_node[c0]
+            else:
+                next_node[e] = base + corner_node[k]
+        if tc < earliest:
+            earliest = tc
+    return earliest
+
+
+@_kernel
 def corner_events(t_a, t_b, ya, fa, yb, fb, m, w, r, rhs_fn, gen, counters):
-    """Sample the statistics at every corner of a tracked element's force inside the
-    step (t_a, t_b) (see ``kernel_data.CORNER_TOL``): the state there by cubic Hermite
-    interpolation between rows (ya, fa) and (yb, fb) of w.Y (third order, as RK4's
-    error), the excitation exactly, the forces by the stage evaluation, then
-    :func:`record_extrema`.  The largest force and load-sharing ratio then converge like
-    h^2 instead of h when they sit at a corner of a piecewise-linear table.  Returns the
+    """Sample the statistics at every corner of an element's force inside the step
+    (t_a, t_b) (see ``kernel_data.CORNER_TOL``): the state there by cubic Hermite
+    interpolation between rows (ya, fa) and (yb, fb) of w.Y, the excitation exactly, the
+    forces by the stage evaluation, then :func:`record_extrema` (Dormand-Prince; RK4
+    steps through the corners instead, :func:`rk4_through_corners`).  The largest force
+    and load-sharing ratio then do not depend on where the steps fall.  Returns the
     earliest next corner time (the callers skip the call until then)."""
     n_tab = m.stiffness_table.shape[1]
     corner_ptr, corner_node, next_node = m.corner_ptr, m.corner_node, w.next_node
-    frequency, phase, track_el = m.frequency, m.phase, r.track_el
+    frequency, phase, track_el = m.frequency, m.phase, m.tv_el
     extra = m.fr_el.shape[0] > 0 or m.sp_el.shape[0] > 0
     h = t_b - t_a
     slot = np.int64(SLOT_EVENT)
@@ -562,7 +591,7 @@ def store_full(row, t, iy, w, r):
         full_y[row, k] = Y[iy, k]
 
 
-@_kernel
+@_inline
 def bad_state(iy, blowup, w):
     """Index of the first non-finite entry of state row ``iy`` or |q| > blowup, or -1.
     Twin: ``np.flatnonzero(~np.isfinite(y) | (abs(q) > blowup))[:1]``."""
@@ -578,6 +607,73 @@ def bad_state(iy, blowup, w):
 
 
 # ======================================================================== RK4
+@njit(inline="always", error_model="numpy")
+def _rk4_step(t_mid, t_end, hs, s_half, sb, src_half, src_end, m, w, rhs_fn, gen, extra):
+    """One classic RK4 step of length hs, the state in row Y_STATE and its derivative
+    already in row Y_K1: excitation of the midpoint t_mid into s_half and of t_end into
+    sb (phasors rotated from src_half / src_end, or exact when those are -1), stages 2-4,
+    the state advanced in place.  The times are passed, not summed, so that step i always
+    sees t0 + (i + 1/2) h and t0 + (i + 1) h exactly."""
+    Y = w.Y
+    n2 = Y.shape[1]
+    k1 = Y_K1
+    k2 = Y_K1 + 1
+    k3 = Y_K1 + 2
+    k4 = Y_K1 + 3
+    hh = 0.5 * hs
+    excite(t_mid, s_half, src_half, m, w)
+    for k in range(n2):
+        Y[Y_TRIAL, k] = Y[Y_STATE, k] + hh * Y[k1, k]
+    _stage(s_half, Y_TRIAL, k2, F_TMP, m, w, rhs_fn, gen, extra)
+    for k in range(n2):
+        Y[Y_TRIAL, k] = Y[Y_STATE, k] + hh * Y[k2, k]
+    _stage(s_half, Y_TRIAL, k3, F_TMP, m, w, rhs_fn, gen, extra)
+    excite(t_end, sb, src_end, m, w)
+    for k in range(n2):
+        Y[Y_TRIAL, k] = Y[Y_STATE, k] + hs * Y[k3, k]
+    _stage(sb, Y_TRIAL, k4, F_TMP, m, w, rhs_fn, gen, extra)
+    h6 = hs / 6.0
+    for k in range(n2):
+        Y[Y_STATE, k] += h6 * (Y[k1, k] + 2.0 * (Y[k2, k] + Y[k3, k]) + Y[k4, k])
+
+
+@_kernel
+def rk4_through_corners(t, tb, t_corner, sa, sb, m, w, r, rhs_fn, gen, counters):
+    """The RK4 step from t to tb when corners of the tables fall inside it: sub-steps
+    that end exactly on each corner (``kernel_data.CORNER_TOL``), so that no RK4 step
+    straddles a kink of the right-hand side (which would cost RK4 its order: the error
+    of a step across a corner is first order in the step), and the forces at every
+    corner enter the per-cycle extremes (:func:`record_extrema`) from the exact state.
+    Excitation exactly at every sub-step time (no phasor rotation).  Returns the slot
+    that holds the excitation at tb and the next corner time."""
+    extra = m.fr_el.shape[0] > 0 or m.sp_el.shape[0] > 0
+    s_half = np.int64(1)
+    minus = np.int64(-1)
+    h = tb - t
+    ts = t
+    first = True
+    while True:
+        te = t_corner if t_corner < tb - 1e-6 * h else tb
+        if not first:  # the corner: its exact forces, and k1 of the next sub-step
+            _stage(sa, Y_STATE, Y_K1, F_MAIN, m, w, rhs_fn, gen, extra)
+            record_extrema(sa, F_MAIN, w, r)
+            counters[I_RHS] += 1
+            counters[I_EVENTS] += 1
+        if te - ts > 1e-6 * h:
+            _rk4_step(ts + 0.5 * (te - ts), te, te - ts, s_half, sb, minus, minus, m, w,
+                      rhs_fn, gen, extra)
+            counters[I_RHS] += 3
+            sa, sb = sb, sa
+            ts = te
+            first = False
+        if te >= tb:
+            break
+        t_corner = advance_corners(te, m, w)
+    if ts < tb:  # the last corner fell within 1e-6 h of tb: nothing left to step
+        excite(tb, sa, minus, m, w)
+    return sa, advance_corners(tb, m, w)
+
+
 @_kernel
 def rk4_run(t0, h, n_first, n_steps, record_final, record_every, blowup, m, w, r,
             rhs_fn, gen, counters, clock):
@@ -586,93 +682,74 @@ def rk4_run(t0, h, n_first, n_steps, record_final, record_every, blowup, m, w, r
     Step i runs from t0 + i h to t0 + (i + 1) h; the state is row Y_STATE of w.Y,
     advanced in place.  The state at the start of each step is recorded (statistics;
     history when i % record_every == 0; full state while ``r.full_t`` has room); with
-    ``record_final`` the end state is recorded too.  A step that contains a corner of a
-    tracked element's force keeps its start state and derivative (rows Y_ALT, Y_K1ALT)
-    so that the forces at the corner are sampled once the end state is known
-    (:func:`corner_events`).  Excitation is evaluated once per distinct stage time (t,
-    t + h/2, t + h) and the t + h values are reused by the next step; error sinusoids
-    are advanced by phasor rotation and recomputed exactly every RESYNC steps.  Stops
-    early (status DIVERGED) if the state is non-finite or |q| > blowup.
+    ``record_final`` the end state is recorded too.  A step that contains corners of the
+    tables (stiffness waves, impact-force edges, backlash changing at a cycle) is taken
+    in sub-steps that end on them (:func:`rk4_through_corners`).  Excitation is
+    evaluated once per distinct stage time (t, t + h/2, t + h) and the t + h values are
+    reused by the next step; error sinusoids are advanced by phasor rotation and
+    recomputed exactly every RESYNC steps (and at sub-steps).  Stops early (status
+    DIVERGED) if the state is non-finite or |q| > blowup.
     Twin: :func:`torquesplit.solve.reference.rk4_numpy`.
     """
-    Y, rot, error_omega = w.Y, w.rot, m.error_omega
-    n2 = Y.shape[1]
+    rot, error_omega = w.rot, m.error_omega
     n_hist = r.hist_t.shape[0]
     n_full = r.full_t.shape[0]
     extra = m.fr_el.shape[0] > 0 or m.sp_el.shape[0] > 0
     for i in range(error_omega.shape[0]):
         rot[0, i] = math.cos(error_omega[i] * 0.5 * h)
         rot[1, i] = math.sin(error_omega[i] * 0.5 * h)
-    k1 = Y_K1
-    k2 = Y_K1 + 1
-    k3 = Y_K1 + 2
-    k4 = Y_K1 + 3
     a = np.int64(0)  # slot of t
     b = np.int64(2)  # slot of t + h
     s_half = np.int64(1)  # slot of t + h/2
-    hh = 0.5 * h
-    h6 = h / 6.0
-    t_corner = math.inf  # earliest corner still to be sampled
+    t_corner = math.inf  # earliest corner still ahead
     if m.corner_node.shape[0] > 0 and n_steps > 0:
-        t_corner = first_corners(t0 + max(n_first - 1, 0) * h, m, w, r)
+        t_corner = first_corners(t0 + n_first * h, m, w, r)
+    # the next step indices that are multiples of RESYNC and of record_every (counted, not
+    # found by an integer division per step)
+    next_sync = (n_first // RESYNC + 1) * RESYNC
+    every = record_every if record_every > 0 else n_first + n_steps + 1
+    next_rec = -(-n_first // every) * every
     for it in range(n_steps):
         i = n_first + it
         t = t0 + i * h
-        if it == 0 or i % RESYNC == 0:
+        if it == 0 or i == next_sync:
             excite(t, a, np.int64(-1), m, w)
+            if i == next_sync:
+                next_sync += RESYNC
         # stage 1 at t: its forces are those of the accepted state y(t)
-        _stage(a, Y_STATE, k1, F_MAIN, m, w, rhs_fn, gen, extra)
+        _stage(a, Y_STATE, Y_K1, F_MAIN, m, w, rhs_fn, gen, extra)
         record(a, F_MAIN, h, m, w, r, counters)
-        if counters[I_SAVED] == 1:  # corners inside the step that ended at t
-            counters[I_SAVED] = 0
-            t_corner = corner_events(t - h, t, Y_ALT, Y_K1ALT, Y_STATE, k1, m, w, r,
-                                     rhs_fn, gen, counters)
-        if (record_every > 0 and i % record_every == 0
-                and counters[I_HIST] < n_hist):
-            store_history(counters[I_HIST], t, Y_STATE, F_MAIN, w, r)
-            counters[I_HIST] += 1
+        if i == next_rec:
+            next_rec += every
+            if record_every > 0 and counters[I_HIST] < n_hist:
+                store_history(counters[I_HIST], t, Y_STATE, F_MAIN, w, r)
+                counters[I_HIST] += 1
         if counters[I_FULL] < n_full:
             store_full(counters[I_FULL], t, Y_STATE, w, r)
             counters[I_FULL] += 1
         tb = t0 + (i + 1) * h
-        if t_corner < tb:  # a corner inside this step: keep its start
-            for k in range(n2):
-                Y[Y_ALT, k] = Y[Y_STATE, k]
-                Y[Y_K1ALT, k] = Y[k1, k]
-            counters[I_SAVED] = 1
-        # stages 2 and 3 at t + h/2
-        excite(t0 + (i + 0.5) * h, s_half, a, m, w)
-        for k in range(n2):
-            Y[Y_TRIAL, k] = Y[Y_STATE, k] + hh * Y[k1, k]
-        _stage(s_half, Y_TRIAL, k2, F_TMP, m, w, rhs_fn, gen, extra)
-        for k in range(n2):
-            Y[Y_TRIAL, k] = Y[Y_STATE, k] + hh * Y[k2, k]
-        _stage(s_half, Y_TRIAL, k3, F_TMP, m, w, rhs_fn, gen, extra)
-        # stage 4 at t + h
-        excite(tb, b, s_half, m, w)
-        for k in range(n2):
-            Y[Y_TRIAL, k] = Y[Y_STATE, k] + h * Y[k3, k]
-        _stage(b, Y_TRIAL, k4, F_TMP, m, w, rhs_fn, gen, extra)
-        for k in range(n2):
-            Y[Y_STATE, k] += h6 * (Y[k1, k] + 2.0 * (Y[k2, k] + Y[k3, k]) + Y[k4, k])
+        if t_corner < tb:
+            a, t_corner = rk4_through_corners(t, tb, t_corner, a, b, m, w, r, rhs_fn, gen,
+                                              counters)
+            b = np.int64(2) - a
+            counters[I_RHS] += 1
+        else:
+            _rk4_step(t0 + (i + 0.5) * h, tb, h, s_half, b, a, s_half, m, w, rhs_fn, gen,
+                      extra)
+            a, b = b, a
+            counters[I_RHS] += 4
         counters[I_STEPS] += 1
-        counters[I_RHS] += 4
         clock[F_T] = tb
         bad = bad_state(Y_STATE, blowup, w)
         if bad >= 0:
             counters[I_STATUS] = DIVERGED
             counters[I_BAD] = bad
             return
-        a, b = b, a
     if record_final and n_steps > 0:
         i = n_first + n_steps
         t = t0 + i * h
-        _stage(a, Y_STATE, k1, F_MAIN, m, w, rhs_fn, gen, extra)
+        _stage(a, Y_STATE, Y_K1, F_MAIN, m, w, rhs_fn, gen, extra)
         record(a, F_MAIN, 0.0, m, w, r, counters)
-        if counters[I_SAVED] == 1:
-            counters[I_SAVED] = 0
-            corner_events(t - h, t, Y_ALT, Y_K1ALT, Y_STATE, k1, m, w, r, rhs_fn, gen,
-                          counters)
         if (record_every > 0 and i % record_every == 0
                 and counters[I_HIST] < n_hist):
             store_history(counters[I_HIST], t, Y_STATE, F_MAIN, w, r)

@@ -33,6 +33,7 @@ __all__ = [
     "hermite_numpy",
     "cycle_statistics_numpy",
     "rk4_numpy",
+    "corner_times_numpy",
     "dopri_numpy",
 ]
 
@@ -223,25 +224,47 @@ def cycle_statistics_numpy(times, forces, frequency, phase, t0, n_cycles_cap):
     return cmax, cmin, csum, ccnt
 
 
-def rk4_numpy(structure: Structure, y0, t0: float, h: float, n_steps: int):
+def rk4_numpy(structure: Structure, y0, t0: float, h: float, n_steps: int, times=None):
     """Classic RK4 with a Python call per stage; returns ``(t, y)`` of all steps.
 
+    ``times``: an explicit, increasing time grid instead of ``t0 + i h`` (e.g. the steps
+    with the table corners inserted, as the kernel takes them with ``corners=True``).
     Twin of ``_kernels.rk4_run`` (which advances error sinusoids by phasor rotation, so
     the two agree to round-off, not bit for bit).
     """
+    grid = (np.asarray(times, dtype=float) if times is not None
+            else t0 + h * np.arange(n_steps + 1))
     y = np.array(y0, dtype=float)
-    ts = [t0]
     ys = [y.copy()]
-    for i in range(n_steps):
-        t = t0 + i * h
-        k1 = rhs_numpy(structure, t, y)
-        k2 = rhs_numpy(structure, t0 + (i + 0.5) * h, y + 0.5 * h * k1)
-        k3 = rhs_numpy(structure, t0 + (i + 0.5) * h, y + 0.5 * h * k2)
-        k4 = rhs_numpy(structure, t0 + (i + 1) * h, y + h * k3)
-        y = y + h / 6.0 * (k1 + 2.0 * (k2 + k3) + k4)
-        ts.append(t0 + (i + 1) * h)
+    for ta, tb in zip(grid[:-1], grid[1:]):
+        hs = tb - ta
+        k1 = rhs_numpy(structure, ta, y)
+        k2 = rhs_numpy(structure, ta + 0.5 * hs, y + 0.5 * hs * k1)
+        k3 = rhs_numpy(structure, ta + 0.5 * hs, y + 0.5 * hs * k2)
+        k4 = rhs_numpy(structure, tb, y + hs * k3)
+        y = y + hs / 6.0 * (k1 + 2.0 * (k2 + k3) + k4)
         ys.append(y.copy())
-    return np.array(ts), np.array(ys)
+    return grid, np.array(ys)
+
+
+def corner_times_numpy(structure: Structure, t0: float, t1: float) -> np.ndarray:
+    """Times in (t0, t1) at the corners of every element's tables
+    (:func:`torquesplit.solve.kernel_data.corner_nodes`; node 0 where the half-gap
+    changes from cycle to cycle).  Twin of the corner bookkeeping of the kernels."""
+    from torquesplit.solve.kernel_data import kernel_model
+
+    m = kernel_model(structure)
+    n_tab = structure.n_table
+    out = []
+    for e in np.flatnonzero(structure.frequency > 0):
+        nodes = m.corner_node[m.corner_ptr[e]:m.corner_ptr[e + 1]]
+        f, ph = structure.frequency[e], structure.phase[e]
+        for c in range(int(np.floor(f * t0 + ph)) - 1, int(np.ceil(f * t1 + ph)) + 1):
+            for node in nodes:
+                tc = ((c * n_tab + node) / n_tab - ph) / f
+                if t0 < tc < t1:
+                    out.append(tc)
+    return np.unique(out)
 
 
 # Dormand & Prince 5(4) tableau (Hairer, Norsett & Wanner, Solving ODE I, table 5.2)

@@ -21,7 +21,6 @@ from torquesplit.steady.period import (
     base_frequency,
     fundamental_period,
     keep_excitations,
-    scale_speed,
 )
 from torquesplit.steady.problem import PeriodicProblem
 from torquesplit.steady.solution import PeriodicSolution, periodic_solution
@@ -265,9 +264,7 @@ def _as_solution(st: SteadyState, shell, periods):
     N = len(t1)
     t = (t1[None, :] + T * np.arange(periods)[:, None]).ravel()
     F = np.tile(F1, (periods, 1))
-    D = np.tile(D1, (periods, 1))
     n_tr = len(track)
-    stats = {}
     cyc_n = []
     per_el = []
     for e in track:
@@ -303,6 +300,33 @@ def _as_solution(st: SteadyState, shell, periods):
         csum[ok, j] = sm[ok] / np.bincount(idx, minlength=nc)[ok]
         ccnt[:, j] = cnt
         cstart[:, j] = (base + np.arange(nc) - s.phase[e]) / s.frequency[e]
+    # per-cycle extremes of the instantaneous load-sharing ratio N f_i / sum_j f_j of each
+    # group (Ji & Li eq. 18), from the same samples (what the integrator streams)
+    from torquesplit.metrics.load_sharing import group_meshes
+
+    rmax = np.full((nc, n_tr), np.nan)
+    rmin = np.full((nc, n_tr), np.nan)
+    groups = []
+    for members in group_meshes(s.metadata["meshes"]).values():
+        cols = [mesh_names.index(m) for m in members]
+        groups.append(tuple(track[c] for c in cols))
+        x = F[:, [track[c] for c in cols]]
+        total = x.sum(axis=1, keepdims=True)
+        from torquesplit.simulation import GROUP_MIN_LOAD
+
+        least = GROUP_MIN_LOAD * sum(abs(st.kinematics.meshes[m].force) for m in members)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            ratio = len(cols) * x / np.where(total > least, total, np.nan)
+        for i, c in enumerate(cols):
+            idx, _ = per_el[c]
+            mx = np.full(nc, -np.inf)
+            mn = np.full(nc, np.inf)
+            ok_s = np.isfinite(ratio[:, i])
+            np.maximum.at(mx, idx[ok_s], ratio[ok_s, i])
+            np.minimum.at(mn, idx[ok_s], ratio[ok_s, i])
+            ok = ccnt[:, c] > 0
+            rmax[ok, c] = mx[ok]
+            rmin[ok, c] = mn[ok]
     # contact loss over the period
     sep = np.zeros(s.n_elements)
     back = np.zeros(s.n_elements)
@@ -325,8 +349,8 @@ def _as_solution(st: SteadyState, shell, periods):
         compile_time=0.0, wall_time=ps.wall_time, rhs="general", rhs_compile_time=0.0,
         dof_names=tuple(s.dof_names), element_names=tuple(s.element_names),
         tracked_elements=tuple(track), cycle_start=cstart, cycle_max=cmax, cycle_min=cmin,
-        cycle_mean=csum, cycle_count=ccnt, load_sharing_groups=(),
-        cycle_ratio_max=np.full((nc, n_tr), np.nan), cycle_ratio_min=np.full((nc, n_tr), np.nan),
+        cycle_mean=csum, cycle_count=ccnt, load_sharing_groups=tuple(groups),
+        cycle_ratio_max=rmax, cycle_ratio_min=rmin,
         history_elements=tuple(hist), history_dofs=(), history_t=t,
         history_forces=F[:, hist], history_q=np.zeros((len(t), 0)),
         history_v=np.zeros((len(t), 0)), full_t=None, full_y=None, n_samples=len(t),

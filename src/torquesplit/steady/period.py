@@ -25,7 +25,7 @@ from fractions import Fraction
 import numpy as np
 
 from torquesplit.assembly.structure import Structure
-from torquesplit.errors import SolverError
+from torquesplit.errors import LongPeriodError, PeriodError, SolverError  # noqa: F401 - re-exported
 
 __all__ = ["ExcitationSource", "Period", "PeriodError", "LongPeriodError",
            "excitation_sources", "fundamental_period", "keep_excitations", "scale_speed",
@@ -38,14 +38,6 @@ RTOL = 1e-9
 """Relative mismatch below which a frequency ratio equals its rational approximation."""
 MAX_CYCLES = 1000
 """Default largest number of cycles of the fastest excitation in one period."""
-
-
-class PeriodError(SolverError):
-    """No common period can be formed (frequencies without a rational ratio)."""
-
-
-class LongPeriodError(PeriodError):
-    """The common period holds too many cycles of the fastest excitation."""
 
 
 @dataclass(frozen=True)

@@ -16,7 +16,7 @@ import numpy as np
 
 from torquesplit.errors import SolverError
 from torquesplit.solve._frozen import freeze_arrays
-from torquesplit.steady.harmonic import HarmonicBalance, default_samples
+from torquesplit.steady.harmonic import HarmonicBalance
 from torquesplit.steady.newton import (
     floquet_hill,
     floquet_monodromy,
@@ -190,7 +190,6 @@ def periodic_solution(structure, period: Period, *, method: str = "hb", harmonic
         _, lam = hb.split(x)
         v = hb._states(q, v, lam)[:, p.n:]  # physical velocity (rigid speed offset included)
         if stability:
-            m2 = 2 * p.n - (p.nr + int(np.sum(~p.rigid_damped)))
             if stability == "hill" or (stability is True and hill_applies(p, H, f)):
                 multipliers = floquet_hill(hb, x, speed, None if stability == "hill" else H)
                 stab_method = "hill"

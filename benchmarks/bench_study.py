@@ -1,0 +1,315 @@
+"""Speed of the study layer; writes benchmarks/STUDY_RESULTS.md and STUDY_RESULTS.json.
+
+    python benchmarks/bench_study.py              # everything, about 10 minutes on 2 cores
+    python benchmarks/bench_study.py --quick      # fewer Monte Carlo cases
+    python benchmarks/bench_study.py diameter     # one part: diameter, monte_carlo, memory
+
+Not part of the test suite; nothing here asserts a threshold.  The issue's targets are
+printed beside the measured values.
+
+diameter     Ji & Li's drive-shaft diameter study (28 diameters, the shipped
+             ``ji_li_diameter`` study) on 2 workers: with the stop-when-settled rule
+             (as shipped) and at the paper's fixed 30 s; wall time of the whole
+             ``Study.run`` (pool start, kernel loading, every case), the simulated time
+             the rule chose, and how far its outputs are from the 30 s runs.
+monte_carlo  Dong et al. 2021's model at its validation settings (1.21 s simulated,
+             RK4 100 steps per face-gear mesh period) with ISO 1328 eccentricities and
+             random phases on every gear: N cases on 1 and on 2 workers; speed-up,
+             per-case time, extrapolation to 1000 cases; per-case overhead.
+memory       peak RSS of the driver process for 200 and 2000 cases of a small model.
+
+Per-case overhead = everything but integration, measured in the worker: model
+validation, kinematics, assembly, static equilibrium, metrics, pickling, minus nothing
+else (``wall_time - integration_time - compile_time`` of each case, from the store),
+and, seen from the driver, the study's wall time times the workers minus the cases'
+integration time, per case (pool start, kernel loading, idle workers at the end,
+store commits).
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime as _dt
+import json
+import os
+import platform
+import sqlite3
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+OUT_MD = HERE / "STUDY_RESULTS.md"
+OUT_JSON = HERE / "STUDY_RESULTS.json"
+
+
+def _log(msg: str) -> None:
+    print(f"[{time.strftime('%H:%M:%S')}] {msg}", file=sys.stderr, flush=True)
+
+
+def _cases(folder: Path) -> list[dict]:
+    with sqlite3.connect(folder / "study.sqlite") as db:
+        cols = ("idx", "status", "wall_time", "integration_time", "compile_time",
+                "simulated_time", "runs", "worker")
+        return [dict(zip(cols, r)) for r in
+                db.execute(f"SELECT {', '.join(cols)} FROM cases ORDER BY idx")]
+
+
+def _overhead(cases: list[dict], wall: float, workers: int) -> dict:
+    n = len(cases)
+    case_wall = sum(c["wall_time"] for c in cases)
+    integ = sum(c["integration_time"] for c in cases)
+    comp = sum(c["compile_time"] for c in cases)
+    in_worker = case_wall - integ - comp
+    return {
+        "cases": n, "study_wall_s": wall, "workers": workers,
+        "mean_case_wall_s": case_wall / n, "mean_integration_s": integ / n,
+        "compile_s_total": comp,
+        "overhead_in_worker_s_per_case": in_worker / n,
+        "overhead_in_worker_fraction": in_worker / case_wall,
+        "overhead_seen_by_driver_s_per_case": (wall * workers - integ) / n,
+        "overhead_seen_by_driver_fraction": (wall * workers - integ) / (wall * workers),
+        "distinct_workers": len({c["worker"] for c in cases}),
+    }
+
+
+# ============================================================================ diameter
+def diameter() -> dict:
+    import numpy as np
+
+    from torquesplit.study import Study
+    from torquesplit.study.shipped import study_path
+
+    text = study_path("ji_li_diameter").read_text()
+    out: dict = {}
+    for label, body in (("settle", text),
+                        ("fixed_30s", text.replace("[analysis.settle]\ntolerance = 0.002\n"
+                                                   "start = \"1 s\"\n", ""))):
+        with tempfile.TemporaryDirectory() as tmp:
+            path = Path(tmp) / "s.toml"
+            path.write_text(body)
+            st = Study(path)
+            assert (label == "settle") == ("settle" in st.plan().analysis), label
+            _log(f"diameter study, {label}: {st.n_cases} cases on 2 workers")
+            t0 = time.perf_counter()
+            ds = st.run(workers=2, out=Path(tmp) / "out", figures=False)
+            wall = time.perf_counter() - t0
+            cases = _cases(Path(tmp) / "out")
+            res = _overhead(cases, wall, 2)
+            res["simulated_time_s"] = [c["simulated_time"] for c in cases]
+            res["runs_per_case"] = [c["runs"] for c in cases]
+            res["status"] = sorted(set(ds["status"].values.tolist()))
+            res["outputs"] = {v: ds[v].values.tolist() for v in ds.data_vars
+                              if "output" in ds[v].attrs}
+            res["diameter_m"] = ds["drive_shaft_diameter"].values.tolist()
+            out[label] = res
+            _log(f"  {wall:.1f} s")
+    diffs = {}
+    for name, a in out["settle"]["outputs"].items():
+        b = np.asarray(out["fixed_30s"]["outputs"][name])
+        diffs[name] = float(np.max(np.abs(np.asarray(a) - b)))
+    out["max_abs_difference_settle_vs_30s"] = diffs
+    return out
+
+
+# ============================================================================ Monte Carlo
+_PLAIN = r"""
+import sys, time, warnings, torquesplit
+warnings.simplefilter("ignore")
+m = torquesplit.load_model(torquesplit.example_path("dong2021_face_gear"))
+torquesplit.simulate(m, duration=0.01)
+r = torquesplit.simulate(m, duration=0.3)
+print(r.statistics()["wall_time_s"])
+"""
+
+
+def parallel_capacity() -> dict:
+    """How much two plain ``simulate`` processes slow each other down on this machine
+    right now (1.0 on two idle cores, 2.0 when only one core is free): the baseline for
+    the worker speed-up, measured in the same run."""
+    env = dict(os.environ)
+
+    def start():
+        return subprocess.Popen([sys.executable, "-c", _PLAIN], env=env,
+                                stdout=subprocess.PIPE, text=True)
+
+    alone = float(start().communicate()[0])
+    a, b = start(), start()
+    pair = [float(a.communicate()[0]), float(b.communicate()[0])]
+    return {"alone_s": alone, "side_by_side_s": pair,
+            "slowdown": sum(pair) / 2 / alone, "free_cores_estimate": 2 * alone / max(pair)}
+
+
+def monte_carlo(n: int) -> dict:
+    from torquesplit.study import Study
+
+    study = {
+        "study": {"name": "bench_mc", "model": "dong2021_face_gear",
+                  "outputs": ["load_sharing.mean_force", "load_sharing.mean_force.I"]},
+        "monte_carlo": {"sampling": "random", "seed": 1, "samples": n, "parameters": [
+            {"paths": ["gears.*.errors.eccentricity"], "distribution": "iso1328",
+             "grade": 6},
+            {"paths": ["gears.*.errors.eccentricity_phase"], "distribution": "uniform",
+             "low": "0 deg", "high": "360 deg"}]},
+    }
+    out: dict = {"capacity_before": parallel_capacity()}
+    for workers in (1, 2):
+        with tempfile.TemporaryDirectory() as tmp:
+            _log(f"Monte Carlo, seed 002 model: {n} cases on {workers} worker(s)")
+            t0 = time.perf_counter()
+            Study(study).run(workers=workers, out=Path(tmp), figures=False)
+            wall = time.perf_counter() - t0
+            out[f"workers_{workers}"] = _overhead(_cases(Path(tmp)), wall, workers)
+            _log(f"  {wall:.1f} s")
+    out["capacity_after"] = parallel_capacity()
+    w1, w2 = out["workers_1"], out["workers_2"]
+    out["speedup_1_to_2"] = w1["study_wall_s"] / w2["study_wall_s"]
+    out["extrapolated_1000_cases_2_workers_s"] = 1000 * w2["study_wall_s"] / n
+    return out
+
+
+# ============================================================================ memory
+_MEMORY_CHILD = r"""
+import json, resource, sys, tempfile
+sys.path[:0] = sys.argv[3:]
+from model_texts import split_model, write_model
+from torquesplit.study import Study
+n = int(sys.argv[1])
+tmp = tempfile.mkdtemp()
+model = write_model(__import__('pathlib').Path(tmp), split_model())
+study = {"study": {"name": "mem", "model": str(model), "outputs": ["load_sharing.cycle_peak*"]},
+         "analysis": {"cycles": 20},
+         "monte_carlo": {"seed": 1, "samples": n, "parameters": [
+             {"path": "meshes.a1.transmission_error.constant", "distribution": "uniform",
+              "low": "0 um", "high": "5 um"}]}}
+def rss():
+    for line in open('/proc/self/status'):
+        if line.startswith('VmRSS'):
+            return int(line.split()[1]) / 1024
+st = Study(study); st.plan()
+before = rss()
+st.run(workers=2, out=sys.argv[2], figures=False)
+peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+print(json.dumps({"cases": n, "rss_before_MiB": before, "rss_after_MiB": rss(),
+                  "peak_rss_MiB": peak}))
+"""
+
+
+def memory() -> dict:
+    repo = HERE.parent
+    paths = [str(repo / "tests"), str(repo / "src")]
+    out = {}
+    for n in (200, 2000):
+        _log(f"driver memory: {n} cases")
+        with tempfile.TemporaryDirectory() as tmp:
+            res = subprocess.run([sys.executable, "-c", _MEMORY_CHILD, str(n), tmp, *paths],
+                                 capture_output=True, text=True, check=True)
+        out[str(n)] = json.loads(res.stdout.strip().splitlines()[-1])
+    return out
+
+
+# ============================================================================ report
+def _machine() -> dict:
+    import numba
+    import numpy
+
+    import torquesplit
+
+    try:
+        commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=HERE,
+                                capture_output=True, text=True).stdout.strip()
+    except OSError:
+        commit = "?"
+    return {"date": _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
+            "platform": platform.platform(), "cpu_count": os.cpu_count(),
+            "python": platform.python_version(), "numba": numba.__version__,
+            "numpy": numpy.__version__, "torquesplit": torquesplit.__version__,
+            "commit": commit, "load_average": os.getloadavg()}
+
+
+def report(res: dict) -> str:
+    m = res["machine"]
+    lines = ["# Study layer speed (benchmarks/bench_study.py)", "",
+             f"{m['date']}, {m['platform']}, {m['cpu_count']} cpus, Python {m['python']}, "
+             f"numba {m['numba']}, torquesplit {m['torquesplit']} (commit {m['commit']}); "
+             f"load average at start {m['load_average'][0]:.2f}.  The numba cache was warm "
+             "(kernels compiled before); each worker process still loads them and "
+             "compiles the generated right-hand side once.", ""]
+    if "diameter" in res:
+        d = res["diameter"]
+        s, f = d["settle"], d["fixed_30s"]
+        lines += ["## Ji & Li drive-shaft diameter study (28 diameters, 2 workers)", "",
+                  "| run length | study wall [s] | target | simulated per case [s] | "
+                  "integration per case [s] | overhead in worker | status |",
+                  "|---|---|---|---|---|---|---|",
+                  f"| settle rule (0.2 %, 1 s, x2, cap 30 s) | **{s['study_wall_s']:.1f}** | "
+                  f"<= 20 | {min(s['simulated_time_s']):.0f}-{max(s['simulated_time_s']):.0f} | "
+                  f"{s['mean_integration_s']:.3f} | "
+                  f"{100 * s['overhead_in_worker_fraction']:.1f} % | {', '.join(s['status'])} |",
+                  f"| fixed 30 s (the paper's) | **{f['study_wall_s']:.1f}** | - | 30 | "
+                  f"{f['mean_integration_s']:.3f} | "
+                  f"{100 * f['overhead_in_worker_fraction']:.1f} % | {', '.join(f['status'])} |",
+                  "", "Largest difference between the settle-rule and the 30 s outputs "
+                  "over the 28 diameters:", ""]
+        for k, v in d["max_abs_difference_settle_vs_30s"].items():
+            lines.append(f"- `{k}`: {v:.2e}")
+        lines.append("")
+    if "monte_carlo" in res:
+        mc = res["monte_carlo"]
+        w1, w2 = mc["workers_1"], mc["workers_2"]
+        lines += [f"## Monte Carlo, Dong et al. 2021 model at its validation settings "
+                  f"({w1['cases']} cases)", "",
+                  "| workers | study wall [s] | per case [s] | integration per case [s] | "
+                  "overhead in worker | overhead seen by driver |", "|---|---|---|---|---|---|"]
+        for w in (w1, w2):
+            lines.append(f"| {w['workers']} | {w['study_wall_s']:.1f} | "
+                         f"{w['mean_case_wall_s']:.2f} | {w['mean_integration_s']:.2f} | "
+                         f"{100 * w['overhead_in_worker_fraction']:.2f} % | "
+                         f"{100 * w['overhead_seen_by_driver_fraction']:.1f} % |")
+        caps = [mc[k] for k in ("capacity_before", "capacity_after") if k in mc]
+        if caps:
+            lines += ["", "Baseline in the same run: two plain `torquesplit.simulate` processes "
+                      "side by side take " + " and ".join(
+                          f"{c['slowdown']:.2f}x" for c in caps) + " as long as one alone "
+                      "(before and after the study; 1.0 = two free cores, 2.0 = one): the "
+                      "most a 2-worker study can gain here is about " + " / ".join(
+                          f"{2 / c['slowdown']:.2f}x" for c in caps) + "."]
+        lines += ["", f"Speed-up 1 -> 2 workers: **{mc['speedup_1_to_2']:.2f}x** (target "
+                  f">= 1.8x).  1000 cases on 2 workers, extrapolated: "
+                  f"**{mc['extrapolated_1000_cases_2_workers_s'] / 60:.0f} min** (target <= "
+                  f"5 min).", ""]
+    if "memory" in res:
+        lines += ["## Driver memory", "", "| cases | RSS before [MiB] | peak RSS [MiB] |",
+                  "|---|---|---|"]
+        for k, v in res["memory"].items():
+            lines.append(f"| {k} | {v['rss_before_MiB']:.0f} | {v['peak_rss_MiB']:.0f} |")
+        lines.append("")
+    return "\n".join(lines)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("parts", nargs="*", default=["diameter", "monte_carlo", "memory"])
+    ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--mc-cases", type=int, default=None)
+    args = ap.parse_args(argv)
+    sys.path.insert(0, str(HERE.parent / "src"))
+    res = json.loads(OUT_JSON.read_text()) if OUT_JSON.exists() else {}
+    res["machine"] = _machine()
+    if "diameter" in args.parts:
+        res["diameter"] = diameter()
+    if "monte_carlo" in args.parts:
+        res["monte_carlo"] = monte_carlo(args.mc_cases or (6 if args.quick else 16))
+    if "memory" in args.parts:
+        res["memory"] = memory()
+    OUT_JSON.write_text(json.dumps(res, indent=1))
+    OUT_MD.write_text(report(res) + "\n")
+    print(report(res))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,178 @@
+"""One case of a study: the function every worker runs.
+
+:func:`run_case` takes a plain, picklable payload (base model data, the case's
+overrides, analysis settings, output names) and returns a plain dict: it can run in this
+process, in a process pool or on a Dask worker, unchanged.  It never raises for a bad
+case: a model the overrides make invalid is *refused*, a run that blows up *diverged*,
+a run whose teeth separate *contact_lost* (outputs kept); anything unexpected is an
+*error* with the exception's text.  Only Ctrl-C (KeyboardInterrupt) passes through.
+
+Kernel reuse: a worker process compiles (or loads from numba's on-disk cache) the
+integrator kernels once, on its first case, and the generated right-hand side once per
+sparsity pattern (:mod:`torquesplit.solve.codegen` keeps them per process); every later
+case of the same pattern reuses both.  ``compile_time`` in the result says what a case
+paid for that (the first case of a worker only).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import time
+import warnings
+
+STATUSES = ("ok", "contact_lost", "diverged", "refused", "error")
+"""Case statuses, from best to worst."""
+
+_PROCESS = {"compiled": False}
+
+
+def payload(index: int, plan, overrides: dict) -> dict:
+    """The picklable description of case ``index`` of a plan."""
+    return {"index": int(index), "model": plan.case_data, "source": plan.model_source,
+            "overrides": overrides, "analysis": plan.analysis, "outputs": plan.outputs,
+            "definitions": plan.definitions}
+
+
+def run_case(p: dict) -> dict:
+    """Run one case; returns ``{index, status, reason, values, wall_time,
+    integration_time, compile_time, simulated_time, runs, settled, worker, warnings}``."""
+    from ..errors import SolverError, TorquesplitError
+    from ..model.io import load_model, model_from_dict
+    from ..model.overrides import apply_overrides
+
+    t0 = time.perf_counter()
+    out = {"index": p["index"], "status": "ok", "reason": "", "values": None,
+           "wall_time": 0.0, "integration_time": 0.0, "compile_time": 0.0,
+           "simulated_time": math.nan, "runs": 0, "settled": True,
+           "worker": f"{os.uname().nodename}:{os.getpid()}", "warnings": []}
+    nan = [math.nan] * len(p["outputs"])
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            data = apply_overrides(p["model"], p["overrides"])
+            model = load_model(model_from_dict(data, source=p["source"]))
+            if p["analysis"]["type"] == "static":
+                values = _static(model, p, out)
+            else:
+                values = _dynamic(model, p, out)
+            out["values"] = values
+        except (TorquesplitError, SolverError, ValueError) as exc:
+            out.update(status="refused", reason=_one_line(exc), values=nan)
+        except Exception as exc:  # a bug, a memory error...: record it, keep the study going
+            out.update(status="error", reason=f"{type(exc).__name__}: {_one_line(exc)}",
+                       values=nan)
+    out["warnings"] = sorted({_one_line(w.message) for w in caught})
+    out["wall_time"] = time.perf_counter() - t0
+    return out
+
+
+def _one_line(exc) -> str:
+    return " | ".join(s.strip() for s in str(exc).splitlines() if s.strip())
+
+
+def _static(model, p, out) -> list[float]:
+    from ..quasistatic import quasi_static_load_sharing
+    from .outputs import output_values
+
+    a = p["analysis"]
+    t = time.perf_counter()
+    res = quasi_static_load_sharing(model, revolutions=a["revolutions"],
+                                    points_per_cycle=a["points_per_cycle"])
+    out["integration_time"] = time.perf_counter() - t
+    out["runs"] = 1
+    conv = res.solution.converged
+    if not conv.all():
+        out["status"] = "diverged"
+        out["reason"] = (f"the quasi-static equilibrium did not converge at "
+                         f"{int((~conv).sum())} of {conv.size} mesh positions")
+    vals = output_values(res)
+    return [vals.get(n, math.nan) for n in p["outputs"]]
+
+
+def _dynamic(model, p, out) -> list[float]:
+    from ..simulation import simulate
+    from .outputs import output_values
+
+    a = p["analysis"]
+    names, defs = p["outputs"], p["definitions"]
+    kw = {k: a[k] for k in ("method", "steps_per_period", "rtol") if a.get(k) is not None}
+    settle = a.get("settle")
+    if settle is None:
+        res = simulate(model, duration=a.get("duration"), cycles=a.get("cycles"), **kw)
+        _account(res, out)
+        return _finish(res, names, defs, out, output_values)
+    # stop-when-settled: lengths T, gT, g^2 T ... until two successive runs agree
+    full, f_min = _full_duration(model, a)
+    length = min(settle["start"] or 50.0 / f_min, full)
+    previous = None
+    while True:
+        res = simulate(model, duration=length, **kw)
+        _account(res, out)
+        if not res.success:
+            return _finish(res, names, defs, out, output_values)
+        vals = output_values(res, defs)
+        current = [vals.get(n, math.nan) for n in names]
+        settled = res.metrics("cycle_peak").settling.settled  # the same for every definition
+        if previous is not None and settled and _close(previous, current, settle["tolerance"]):
+            break
+        if length >= full:
+            out["settled"] = False
+            break
+        previous = current
+        length = min(length * settle["growth"], full)
+    return _finish(res, names, defs, out, output_values, vals)
+
+
+def _full_duration(model, a) -> tuple[float, float]:
+    """The run length without the settle rule (cap of the rule) and the slowest mesh
+    frequency, as :func:`torquesplit.simulate` chooses them."""
+    from ..model.kinematics import solve_kinematics
+
+    kin = solve_kinematics(model)
+    f_min = min(kin.meshes[m].frequency for m in model.meshes)
+    if a.get("duration") is not None:
+        return a["duration"], f_min
+    if a.get("cycles") is not None:
+        return a["cycles"] / f_min, f_min
+    an = model.analysis
+    if an.duration is not None:
+        return an.duration, f_min
+    return (an.cycles or 200) / f_min, f_min
+
+
+def _close(a, b, tol) -> bool:
+    for x, y in zip(a, b, strict=True):
+        if math.isnan(x) and math.isnan(y):
+            continue
+        if not abs(x - y) <= tol * max(abs(x), abs(y)):
+            return False
+    return True
+
+
+def _account(res, out) -> None:
+    st = res.statistics()
+    out["integration_time"] += st["wall_time_s"]
+    out["compile_time"] += st["rhs_compile_time_s"]
+    if not _PROCESS["compiled"]:
+        _PROCESS["compiled"] = True
+        out["compile_time"] += st["compile_time_s"]
+    out["simulated_time"] = st["simulated_time_s"]
+    out["runs"] += 1
+
+
+def _finish(res, names, defs, out, output_values, vals=None) -> list[float]:
+    if not res.success:
+        out["status"] = "diverged"
+        out["reason"] = _one_line(res.message)
+        return [math.nan] * len(names)
+    if vals is None:
+        vals = output_values(res, defs)
+    met = res.metrics("cycle_peak")  # settling and contact loss: the same for every definition
+    out["settled"] = out["settled"] and met.settling.settled
+    lost = [(r.mesh, r.contact_loss) for r in met.rows if r.contact_loss > 0]
+    if lost:
+        out["status"] = "contact_lost"
+        out["reason"] = "contact lost in " + ", ".join(
+            f"{m} ({100 * f:.2g} % of the time)" for m, f in lost)
+    return [vals.get(n, math.nan) for n in names]

@@ -1,0 +1,323 @@
+"""``torquesplit study`` and ``torquesplit sweep``: run a study from the command line.
+
+Registered on the main ``torquesplit`` app by :mod:`torquesplit.cli`.  Progress is a rich
+bar on stderr (cases done, failed, elapsed, remaining); the summary table goes to
+stdout.  Bad input: one line naming the field, exit status 2, before any case runs.
+Ctrl-C: every finished case is already saved; one line says how to resume; status 130.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+from pathlib import Path
+from typing import Optional
+
+import typer
+
+
+def _ui():
+    from .. import cli
+
+    return cli
+
+
+# --------------------------------------------------------------------------- study
+def study(
+    study_file: Optional[str] = typer.Argument(
+        None, help="Study file (.toml) or the name of a shipped study (see --list)."),
+    workers: Optional[int] = typer.Option(
+        None, "--workers", help="Local worker processes (default: all cores; 1 = this process)."),
+    scheduler: Optional[str] = typer.Option(
+        None, "--scheduler", help="Run on a Dask cluster: the scheduler address, e.g. "
+                                  "tcp://10.0.0.5:8786."),
+    out: Optional[Path] = typer.Option(
+        None, "--out", help="Output folder: store, results.nc, figures "
+                            "(default: ./study_NAME)."),
+    resume: bool = typer.Option(False, "--resume", help="Continue the study stored in --out."),
+    overwrite: bool = typer.Option(False, "--overwrite",
+                                   help="Start again, deleting the study stored in --out."),
+    list_studies: bool = typer.Option(False, "--list", help="List the shipped studies."),
+    no_figures: bool = typer.Option(False, "--no-figures", help="Do not write figures."),
+    quiet: bool = typer.Option(False, "--quiet", help="No progress bar."),
+    as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
+):
+    """Run a study: a grid, a Monte Carlo or a sensitivity ranking of a model."""
+    ui = _ui()
+    if list_studies:
+        _list()
+        return
+    if study_file is None:
+        ui._fail(ValueError("give a study file or a shipped study name; list them with "
+                            "'torquesplit study --list'"))
+        return
+    _run(study_file, workers=workers, scheduler=scheduler, out=out, resume=resume,
+         overwrite=overwrite, figures=not no_figures, quiet=quiet, as_json=as_json)
+
+
+def _list() -> None:
+    from rich.table import Table
+
+    from .shipped import study_info, study_names
+
+    ui = _ui()
+    t = Table(title="shipped studies (torquesplit study NAME)")
+    t.add_column("name", style="bold")
+    t.add_column("model")
+    t.add_column("description")
+    t.add_column("reference")
+    for name in study_names():
+        info = study_info(name)
+        t.add_row(name, info.get("model", ""), info.get("description", ""),
+                  info.get("reference", ""))
+    ui.console.print(t)
+
+
+def _run(source, *, workers, scheduler, out, resume, overwrite, figures, quiet, as_json,
+         name_hint: str | None = None):
+    from ..errors import TorquesplitError
+    from .core import Study
+    from .errors import StudyInterrupted
+
+    ui = _ui()
+    try:
+        st = Study(source)
+        plan = st.plan()
+        if out is None:
+            out = Path(f"study_{_safe(name_hint or st.name)}")
+        if workers is not None and workers < 1:
+            raise ValueError(f"--workers {workers}: give at least 1")
+        if not as_json:
+            ui.err_console.print(
+                f"[bold]{st.name}[/]: {plan.n_cases} cases ({plan.design.kind}, "
+                f"{plan.analysis['type']}), {len(plan.outputs)} outputs -> {out}",
+                highlight=False)
+        ds = _with_bar(lambda cb: st.run(workers=workers, scheduler=scheduler, out=out,
+                                         resume=resume, overwrite=overwrite, progress=cb,
+                                         figures=figures), plan.n_cases, quiet or as_json)
+    except StudyInterrupted as exc:
+        ui.err_console.print("[yellow]stopped:[/] ", end="")
+        ui.err_console.print(f"{exc.done} of {exc.total} cases done and saved in {out}; to "
+                             f"finish, run the same command with --resume", markup=False,
+                             highlight=False, soft_wrap=True)
+        raise typer.Exit(130)
+    except (TorquesplitError, ValueError, OSError) as exc:
+        ui._fail(exc)
+        return
+    _summary(ds, Path(out), as_json, figures)
+
+
+def _with_bar(job, total: int, quiet: bool):
+    if quiet:
+        return job(None)
+    from rich.progress import (BarColumn, MofNCompleteColumn, Progress, TextColumn,
+                               TimeElapsedColumn, TimeRemainingColumn)
+
+    ui = _ui()
+    with Progress(TextColumn("cases"), BarColumn(), MofNCompleteColumn(),
+                  TextColumn("[red]{task.fields[failed]} failed"), TimeElapsedColumn(),
+                  TextColumn("ETA"), TimeRemainingColumn(), console=ui.err_console,
+                  transient=False) as bar:
+        task = bar.add_task("study", total=total, failed=0)
+
+        def cb(p):
+            bar.update(task, completed=p.done, total=p.total, failed=p.failed)
+
+        return job(cb)
+
+
+def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
+    import numpy as np
+
+    from .dataset import ranking
+
+    ui = _ui()
+    status = ds["status"].values.ravel()
+    counts = {s: int((status == s).sum()) for s in sorted(set(status.tolist()))}
+    out_vars = [v for v in ds.data_vars if "output" in ds[v].attrs]
+    figs = sorted(str(p) for p in (out / "figures").glob("*.png")) if figures else []
+    if as_json:
+        data = {"study": ds.attrs["study_name"], "design": ds.attrs["design"],
+                "cases": int(status.size), "status": counts,
+                "results_file": str(out / "results.nc"), "figures": figs,
+                "coordinates": {c: [float(x) for x in np.ravel(ds[c].values)]
+                                for c in ds.coords if c not in ("output", "factor")
+                                and ds[c].dtype.kind == "f"},
+                "outputs": {ds[v].attrs["output"]: [_num(x) for x in ds[v].values.ravel()]
+                            for v in out_vars},
+                "reasons": sorted({r for r in ds["reason"].values.ravel().tolist() if r})}
+        if ds.attrs["design"] == "sensitivity":
+            data["ranking"] = {ds[v].attrs["output"]: ranking(ds, ds[v].attrs["output"])
+                               for v in out_vars}
+        print(json.dumps(data, indent=2))
+        return
+    from rich.table import Table
+
+    design = ds.attrs["design"]
+    if design == "grid" and status.size <= 60 and len(out_vars) <= 8:
+        t = Table(title=f"{ds.attrs['study_name']}")
+        from .figures import _coord
+
+        dims = list(ds[out_vars[0]].dims)
+        shown = {}
+        for d in dims:
+            values, unit = _coord(ds, d)
+            shown[d] = dict(zip(ds[d].values.tolist(), values.tolist()))
+            t.add_column(f"{d} [{unit}]", justify="right")
+        for v in out_vars:
+            t.add_column(v, justify="right")
+        t.add_column("status")
+        flat = ds.stack(case=dims)
+        for k in range(flat.sizes["case"]):
+            row = [f"{shown[d][float(flat[d].values[k])]:.6g}" for d in dims]
+            row += [f"{float(flat[v].values[k]):.6g}" for v in out_vars]
+            row.append(str(flat["status"].values[k]))
+            t.add_row(*row)
+        ui.console.print(t)
+    elif design == "sensitivity":
+        t = Table(title=f"{ds.attrs['study_name']}: factors ranked by "
+                        f"{ds.attrs['ranking']} (most important first)")
+        t.add_column("output")
+        t.add_column("ranking")
+        for v in out_vars:
+            rank = ranking(ds, ds[v].attrs["output"])
+            t.add_row(v, ", ".join(f"{f} {x:.3g}" for f, x in rank))
+        ui.console.print(t)
+    else:
+        t = Table(title=f"{ds.attrs['study_name']}: {status.size} cases")
+        for col in ("output", "mean", "std", "min", "p5", "p95", "max"):
+            t.add_column(col, justify="left" if col == "output" else "right")
+        for v in out_vars:
+            x = ds[v].values.ravel()
+            x = x[np.isfinite(x)]
+            if not x.size:
+                t.add_row(v, *["-"] * 6)
+                continue
+            t.add_row(v, *[f"{s:.6g}" for s in (x.mean(), x.std(ddof=1) if x.size > 1 else
+                                                0.0, x.min(), np.quantile(x, 0.05),
+                                                np.quantile(x, 0.95), x.max())])
+        ui.console.print(t)
+    ui.console.print("cases: " + ", ".join(f"{n} {s}" for s, n in counts.items()))
+    reasons = sorted({r for r, s in zip(ds["reason"].values.ravel().tolist(), status)
+                      if s != "ok"})
+    for r in reasons[:5]:
+        ui.console.print(f"  not ok: {r}", markup=False, highlight=False)
+    ui.console.print(f"results: {out / 'results.nc'}; store: {out / 'study.sqlite'}"
+                     + (f"; {len(figs)} figures in {out / 'figures'}" if figs else ""))
+
+
+def _num(x):
+    x = float(x)
+    return x if math.isfinite(x) else None
+
+
+def _safe(name: str) -> str:
+    return re.sub(r"[^A-Za-z0-9_.-]+", "_", name).strip("_") or "study"
+
+
+# --------------------------------------------------------------------------- sweep
+_RANGE = re.compile(r"^\s*(?P<start>[^:]+?)\s*:\s*(?P<stop>[^:]+?)\s*:\s*(?P<num>\d+)\s*"
+                    r"(?P<unit>[^\d\s].*?)?\s*$")
+
+
+def parse_vary(text: str) -> dict:
+    """``PATH[,PATH]=START:STOP:NUM[unit]`` -> a grid parameter table."""
+    if "=" not in text:
+        raise ValueError(f"--vary {text!r} is not PATH=START:STOP:NUM[unit]; write e.g. "
+                         f"--vary shafts.drive1.diameter=130:400:28mm")
+    paths_text, spec = (s.strip() for s in text.split("=", 1))
+    m = _RANGE.match(spec)
+    if not m:
+        raise ValueError(f"--vary {text!r}: {spec!r} is not START:STOP:NUM[unit]; write e.g. "
+                         f"130:400:28mm or '2e8 N/m:6e8 N/m:9'")
+    paths = [p.strip() for p in paths_text.split(",") if p.strip()]
+    table: dict = {}
+    if len(paths) == 1:
+        table["path"] = paths[0]
+    else:
+        table["paths"] = paths
+        table["name"] = paths[0].split(".")[-1]
+    table.update(start=_number(m["start"]), stop=_number(m["stop"]), num=int(m["num"]))
+    if m["unit"]:
+        table["unit"] = m["unit"].strip()
+    return table
+
+
+def _number(text: str):
+    try:
+        return float(text)
+    except ValueError:
+        return text.strip()
+
+
+def sweep(
+    model: str = typer.Argument(..., help="Model file (.toml/.json) or example name."),
+    vary: str = typer.Option(
+        ..., "--vary", help="PATH=START:STOP:NUM[unit], e.g. shafts.drive1.diameter="
+                            "130:400:28mm; several paths set together: P1,P2=..."),
+    output: Optional[list[str]] = typer.Option(
+        None, "--output", help="Output name or pattern (repeatable); default: the model's "
+                               "load-sharing definition, every group."),
+    log_spacing: bool = typer.Option(False, "--log", help="Logarithmic spacing."),
+    static: bool = typer.Option(False, "--static", help="Quasi-static analysis instead of a run."),
+    duration: Optional[str] = typer.Option(None, "--duration", help="Simulated time per case."),
+    cycles: Optional[int] = typer.Option(None, "--cycles", help="Cycles of the slowest mesh."),
+    settle: Optional[float] = typer.Option(
+        None, "--settle", help="Stop each run once its outputs change by less than this "
+                               "relative tolerance between run lengths (e.g. 0.002)."),
+    assign: Optional[list[str]] = typer.Option(
+        None, "--set", help="Fixed model change for every case: PATH=VALUE."),
+    workers: Optional[int] = typer.Option(None, "--workers", help="Local worker processes."),
+    scheduler: Optional[str] = typer.Option(None, "--scheduler", help="Dask scheduler address."),
+    out: Optional[Path] = typer.Option(None, "--out", help="Output folder (default "
+                                                           "./study_sweep_PATH)."),
+    resume: bool = typer.Option(False, "--resume", help="Continue the sweep stored in --out."),
+    overwrite: bool = typer.Option(False, "--overwrite", help="Start again in --out."),
+    no_figures: bool = typer.Option(False, "--no-figures", help="Do not write figures."),
+    quiet: bool = typer.Option(False, "--quiet", help="No progress bar."),
+    as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
+):
+    """One-parameter grid in one line: an output against a model parameter."""
+    from ..errors import TorquesplitError
+
+    ui = _ui()
+    try:
+        from ..model.overrides import parse_assignment
+
+        param = parse_vary(vary)
+        if log_spacing:
+            param["spacing"] = "log"
+        path = ui._resolve_model_path(model)
+        model_ref = str(path.resolve()) if path.exists() else model
+        if output:
+            outputs = list(output)
+        elif static:
+            outputs = ["load_sharing.static_torque.*"]
+        else:
+            from ..model.io import load_model
+
+            outputs = [f"load_sharing.{_default_definition(load_model, path)}.*"]
+        analysis: dict = {"type": "static" if static else "run"}
+        if duration is not None:
+            analysis["duration"] = duration
+        if cycles is not None:
+            analysis["cycles"] = cycles
+        if settle is not None:
+            analysis["settle"] = {"tolerance": settle}
+        first = (param.get("path") or param["paths"][0])
+        name = f"sweep_{first}"
+        data = {"study": {"name": name, "model": model_ref, "outputs": outputs},
+                "analysis": analysis, "grid": {"parameters": [param]},
+                "set": dict(parse_assignment(a) for a in (assign or []))}
+    except (TorquesplitError, ValueError) as exc:
+        ui._fail(exc)
+        return
+    _run(data, workers=workers, scheduler=scheduler, out=out, resume=resume,
+         overwrite=overwrite, figures=not no_figures, quiet=quiet, as_json=as_json,
+         name_hint=name)
+
+
+def _default_definition(load_model, path) -> str:
+    d = load_model(path).analysis.load_sharing
+    return d if d != "static_torque" else "cycle_peak"

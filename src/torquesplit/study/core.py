@@ -1,0 +1,433 @@
+"""``Study`` and ``run_study``: check a study, run its cases, return an xarray Dataset.
+
+The driver loop is the same whatever runs the cases (this process, a local process
+pool, a Dask cluster; see :mod:`torquesplit.study.runners`):
+
+1. resolve the study against its model (:func:`torquesplit.study.design.resolve`):
+   every check happens here, before any case runs;
+2. open the store in the output folder; on resume, refuse a changed study or model and
+   skip every finished case;
+3. stream the remaining cases to the runner; commit each result as it arrives; report
+   progress through the callback; for a Monte Carlo stopping rule, stop submitting once
+   the first n samples (n a checkpoint) give a narrow enough interval;
+4. build the Dataset from the store (ordered by case index, so it does not depend on
+   which worker finished first), write ``results.nc`` and the figures.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import math
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+from .case import payload, run_case
+from .design import Plan, resolve
+from .errors import StudyError, StudyInterrupted
+from .runners import make_runner
+from .spec import read_study
+from .store import STORE_NAME, Store, StoreLock
+
+log = logging.getLogger(__name__)
+
+RESULTS_NAME = "results.nc"
+
+
+@dataclass(frozen=True)
+class Progress:
+    """What the progress callback is told after each finished case."""
+
+    done: int
+    """Cases finished (this run and earlier runs of the same study)."""
+    failed: int
+    """Of which not ok (contact lost, diverged, refused, error)."""
+    total: int
+    """Cases in the study (Monte Carlo with a stopping rule: the current target)."""
+    computed: int
+    """Cases computed by this run."""
+    elapsed: float
+    """Seconds since this run started."""
+    last: dict | None
+    """The case that just finished (index, status, reason, values...)."""
+
+
+class Study:
+    """A study read from a file, a dict or a :class:`~torquesplit.study.spec.StudySpec`.
+
+    Parameters
+    ----------
+    source : str, Path, dict or StudySpec
+        A study file (``.toml``), the name of a shipped study, or its data.
+
+    Examples
+    --------
+    >>> import torquesplit
+    >>> study = torquesplit.Study({
+    ...     "study": {"name": "k", "model": "ji_li_mill_drive",
+    ...               "outputs": ["load_sharing.engineering"]},
+    ...     "analysis": {"cycles": 20},
+    ...     "grid": {"parameters": [{"path": "meshes.m11.damping_ratio",
+    ...                              "values": [0.05, 0.1]}]}})
+    >>> study.n_cases
+    2
+    >>> ds = study.run(workers=1)
+    >>> ds["load_sharing.engineering"].dims
+    ('meshes.m11.damping_ratio',)
+    """
+
+    def __init__(self, source):
+        self.spec, self.folder, self.text = read_study(source)
+        self.source = str(source) if isinstance(source, (str, Path)) else None
+        self._plan: Plan | None = None
+
+    @classmethod
+    def from_file(cls, path) -> "Study":
+        return cls(path)
+
+    @property
+    def name(self) -> str:
+        return self.spec.study.name
+
+    def plan(self) -> Plan:
+        """The study checked against its model, with every case's values (cached)."""
+        if self._plan is None:
+            self._plan = resolve(self.spec, self.folder, self.text, self.source)
+        return self._plan
+
+    @property
+    def n_cases(self) -> int:
+        """Number of cases (Monte Carlo with a stopping rule: the most it may run)."""
+        return self.plan().n_cases
+
+    @property
+    def outputs(self) -> list[str]:
+        """The output names the study records (patterns expanded)."""
+        return self.plan().outputs
+
+    def run(self, *, workers: int | None = None, client=None, scheduler: str | None = None,
+            runner=None, out=None, resume: bool = False, overwrite: bool = False,
+            progress: Callable[[Progress], None] | None = None, figures: bool = True):
+        """Run the study and return its results as an :class:`xarray.Dataset`.
+
+        Parameters
+        ----------
+        workers : int, optional
+            Local worker processes (default: all cores; 1 runs in this process).
+        client : dask.distributed.Client, optional
+            Run on this Dask cluster instead.
+        scheduler : str, optional
+            Or the address of a Dask scheduler (``"tcp://host:8786"``).
+        runner : callable, optional
+            Or any runner ``runner(function, payloads) -> iterator of results``.
+        out : str or Path, optional
+            Output folder: the store ``study.sqlite`` (every finished case, committed as
+            it completes), ``results.nc`` and the figures.  Without it nothing is written
+            and the study cannot be resumed.
+        resume : bool
+            Continue the study stored in ``out``: finished cases are not computed again.
+        overwrite : bool
+            Delete a study stored in ``out`` and start again.
+        progress : callable, optional
+            Called with a :class:`Progress` after each finished case.
+        figures : bool
+            Write the figures (PNG and SVG) into ``out``.
+
+        Raises
+        ------
+        StudyError
+            Bad study file, or ``out`` holds another study (the message says what
+            changed) - before any case runs.
+        StudyInterrupted
+            On Ctrl-C, after committing every finished case.
+        """
+        plan = self.plan()
+        store = _open_store(plan, out, resume, overwrite)
+        try:
+            run = _Driver(plan, store, make_runner(workers, client=client,
+                                                   scheduler=scheduler, runner=runner),
+                          progress, out)
+            run.execute()
+            ds = dataset_from_store(plan, store, run.n_used)
+        finally:
+            store.close()
+        if out is not None:
+            from .dataset import write_dataset
+
+            write_dataset(ds, Path(out) / RESULTS_NAME)
+            if figures:
+                from .figures import write_study_figures
+
+                write_study_figures(ds, Path(out) / "figures")
+        return ds
+
+
+def run_study(spec, **kwargs):
+    """Run a study (file, name of a shipped study, dict or spec) and return its Dataset;
+    keyword arguments as :meth:`Study.run`."""
+    return Study(spec).run(**kwargs)
+
+
+def load_results(out):
+    """The results Dataset of a finished study folder (``results.nc``)."""
+    import xarray as xr
+
+    return xr.open_dataset(Path(out) / RESULTS_NAME, engine="h5netcdf")
+
+
+# ============================================================================ store
+def _provenance(plan: Plan) -> dict:
+    from .. import __version__
+
+    d = plan.design
+    return {
+        "format": 1, "study_name": plan.spec.study.name, "study_source": plan.source,
+        "study_text": plan.study_text, "study": plan.spec.canonical(),
+        "study_hash": plan.study_hash, "model_source": plan.model_source,
+        "model": plan.model_dict, "model_hash": plan.model_hash,
+        "torquesplit_version": __version__, "design": d.kind, "n_cases": d.n_cases,
+        "outputs": plan.outputs, "parameters": [p.name for p in d.parameters],
+        "created": time.time(),
+    }
+
+
+def _open_store(plan: Plan, out, resume: bool, overwrite: bool) -> Store:
+    if out is None:
+        if resume:
+            raise StudyError("--out", "resume needs the output folder of the earlier run; "
+                                      "give out=DIR")
+        store = Store(":memory:")
+        store.write_meta(_provenance(plan))
+        return store
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    try:
+        lock = StoreLock(out)
+    except BlockingIOError as exc:
+        raise StudyError("--out", f"{out} is in use by another run of a study ({exc}); wait "
+                                  f"for it to finish or stop it, or choose another folder") from None
+    try:
+        store = _open_folder(plan, out, resume, overwrite)
+    except BaseException:
+        lock.release()
+        raise
+    store.lock = lock
+    return store
+
+
+def _open_folder(plan: Plan, out: Path, resume: bool, overwrite: bool) -> Store:
+    path = out / STORE_NAME
+    if path.exists() and overwrite:
+        for suffix in ("", "-wal", "-shm"):
+            Path(str(path) + suffix).unlink(missing_ok=True)
+    exists = path.exists()
+    if exists and not resume:
+        raise StudyError("--out", f"{out} already holds a study; add --resume to continue it, "
+                                  f"--overwrite to start it again, or choose another folder")
+    store = Store(path)
+    if store.is_new():
+        store.write_meta(_provenance(plan))
+        return store
+    try:
+        _check_same(plan, store.meta(), out)
+    except StudyError:
+        store.close()
+        raise
+    return store
+
+
+def _check_same(plan: Plan, meta: dict, out: Path) -> None:
+    from .. import __version__
+
+    if meta.get("study_hash") != plan.study_hash:
+        changes = _diff(meta.get("study", {}), plan.spec.canonical())
+        raise StudyError("--resume", f"the study file changed since {out} was started "
+                                     f"({changes}); undo the change, or start a new study "
+                                     f"with another --out or --overwrite")
+    if meta.get("model_hash") != plan.model_hash:
+        changes = _diff(meta.get("model", {}), plan.model_dict)
+        raise StudyError("--resume", f"the model changed since {out} was started "
+                                     f"({changes}); undo the change, or start a new study "
+                                     f"with another --out or --overwrite")
+    if meta.get("torquesplit_version") != __version__:
+        raise StudyError("--resume", f"{out} was computed with torquesplit "
+                                     f"{meta.get('torquesplit_version')}, this is {__version__}; "
+                                     f"finish it with that version or start a new study")
+
+
+def _diff(old, new, prefix: str = "", limit: int = 3) -> str:
+    found: list[str] = []
+
+    def walk(a, b, path):
+        if len(found) > limit:
+            return
+        if isinstance(a, dict) and isinstance(b, dict):
+            for k in sorted(set(a) | set(b), key=str):
+                walk(a.get(k, "<absent>"), b.get(k, "<absent>"), f"{path}.{k}" if path else k)
+        elif isinstance(a, list) and isinstance(b, list) and len(a) == len(b):
+            for i, (x, y) in enumerate(zip(a, b)):
+                walk(x, y, f"{path}.{i}")
+        elif a != b:
+            found.append(f"{path}: {_short(a)} -> {_short(b)}")
+
+    walk(old, new, prefix)
+    more = " ..." if len(found) > limit else ""
+    return "; ".join(found[:limit]) + more if found else "details differ"
+
+
+def _short(x) -> str:
+    text = json.dumps(x) if not isinstance(x, str) else repr(x)
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
+# ============================================================================ driver
+class _Driver:
+    def __init__(self, plan: Plan, store: Store, runner, progress, out):
+        self.plan = plan
+        self.store = store
+        self.runner = runner
+        self.progress = progress
+        self.out = None if out is None else str(out)
+        d = plan.design
+        self.total = d.n_cases
+        self.n_used = d.n_cases
+        stop = plan.spec.monte_carlo.stop if plan.spec.monte_carlo is not None else None
+        self.stop = stop
+        self.stop_at: int | None = None
+        self._checked: int | None = None
+        self.watch = np.full(d.n_cases, np.nan) if stop else None
+        self.finished = np.zeros(d.n_cases, dtype=bool)
+        self.failed = 0
+        self.computed = 0
+
+    def execute(self) -> None:
+        plan, store = self.plan, self.store
+        for r in store.cases():
+            self._note(r)
+        if self.stop is not None:
+            self._check_stop()
+        n_done = int(self.finished.sum())
+        log.info("study %s: %d cases, %d already finished", plan.spec.study.name,
+                 self.total, n_done)
+        store.start_run(repr(self.runner), int(getattr(self.runner, "workers", 0) or 0))
+        t0 = time.perf_counter()
+        results = self.runner(run_case, self._payloads())
+        state = "interrupted"
+        try:
+            for r in results:
+                store.put(r)
+                self.computed += 1
+                self._note(r)
+                if self.stop is not None:
+                    self._check_stop()
+                if self.progress is not None:
+                    self.progress(Progress(int(self.finished[: self._target()].sum()),
+                                           self.failed, self._target(), self.computed,
+                                           time.perf_counter() - t0, r))
+            state = "finished"
+        except KeyboardInterrupt:
+            raise StudyInterrupted(int(self.finished.sum()), self._target(), self.out) from None
+        except (OSError, RuntimeError) as exc:  # a worker process died, a cluster went away
+            state = "failed"
+            again = ("run it again with --resume" if self.out else
+                     "give an output folder to keep finished cases")
+            raise StudyError("", f"the study stopped after {int(self.finished.sum())} cases: "
+                                 f"{type(exc).__name__}: {exc}; every finished case is "
+                                 f"saved, {again}") from exc
+        finally:
+            close = getattr(results, "close", None)
+            if close is not None:
+                close()
+            store.end_run(state)
+        if self.stop is not None:
+            self.n_used = self.stop_at if self.stop_at is not None else self.total
+        missing = int((~self.finished[: self.n_used]).sum())
+        if missing:  # a runner that dropped cases (should not happen)
+            log.warning("%d cases of the study have no result", missing)
+
+    def _target(self) -> int:
+        return self.stop_at if self.stop_at is not None else self.total
+
+    def _payloads(self):
+        d = self.plan.design
+        for i in range(d.n_cases):
+            if self.stop_at is not None and i >= self.stop_at:
+                return
+            if not self.finished[i]:
+                yield payload(i, self.plan, d.overrides(i))
+
+    def _note(self, r: dict) -> None:
+        i = int(r["index"])
+        if i >= self.finished.size:
+            return
+        self.finished[i] = True
+        if r["status"] != "ok":
+            self.failed += 1
+        if self.watch is not None:
+            j = self.plan.outputs.index(self.stop.output)
+            self.watch[i] = r["values"][j]
+
+    # -------------------------------------------------------------- stopping rule
+    def _check_stop(self) -> None:
+        """Decide at checkpoints n = min_samples + k batch, once samples 0..n-1 are all
+        finished: the decision depends only on those n values (not on timing)."""
+        s = self.stop
+        while self.stop_at is None:
+            n = self._next_checkpoint()
+            if n is None or not self.finished[:n].all():
+                return
+            half, stat = confidence_half_width(self.watch[:n], s.statistic, s.confidence)
+            target = s.half_width * (abs(stat) if s.relative else 1.0)
+            log.info("stopping rule at n = %d: %s = %.6g +/- %.3g (target %.3g)", n,
+                     s.statistic, stat, half, target)
+            if half <= target or n >= s.max_samples:
+                self.stop_at = n
+                return
+            self._checked = n
+
+    def _next_checkpoint(self) -> int | None:
+        s = self.stop
+        last = self._checked
+        n = s.min_samples if last is None else last + s.batch
+        if last is not None and last >= s.max_samples:
+            return None
+        return min(n, s.max_samples)
+
+
+def confidence_half_width(values, statistic: str, confidence: float) -> tuple[float, float]:
+    """Half-width of the confidence interval of the mean (Student t) or of the 95th
+    percentile (distribution-free, from binomial order statistics), and the statistic,
+    over the finite ``values``."""
+    from scipy import stats
+
+    x = np.sort(np.asarray(values, dtype=float))
+    x = x[np.isfinite(x)]
+    n = x.size
+    if n < 2:
+        return math.inf, math.nan
+    if statistic == "mean":
+        m = float(x.mean())
+        t = stats.t.ppf(0.5 + confidence / 2, n - 1)
+        return float(t * x.std(ddof=1) / math.sqrt(n)), m
+    q = 0.95
+    est = float(np.quantile(x, q))
+    alpha = 1 - confidence
+    lo = int(stats.binom.ppf(alpha / 2, n, q))  # order-statistic ranks (0-based)
+    hi = int(stats.binom.ppf(1 - alpha / 2, n, q))
+    if lo < 0 or hi >= n:
+        return math.inf, est
+    return float((x[hi] - x[lo]) / 2), est
+
+
+# ============================================================================ dataset
+def dataset_from_store(plan: Plan, store: Store, n_used: int | None = None):
+    """The study's Dataset from the finished cases in ``store`` (see
+    :func:`torquesplit.study.dataset.build_dataset`)."""
+    from .dataset import build_dataset
+
+    n = plan.n_cases if n_used is None else n_used
+    return build_dataset(plan, store.cases(below=n), n, store.meta())

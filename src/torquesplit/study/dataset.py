@@ -1,0 +1,171 @@
+"""A study's results as an :class:`xarray.Dataset`.
+
+=====================  ==================================================================
+dimensions             grid: one per parameter, in the study's order, coordinates = the
+                       values (SI, ``units`` attribute; ``display_units`` = the unit the
+                       study file used); Monte Carlo and sensitivity: ``sample``, with
+                       each parameter as a coordinate along it
+output variables       one per requested output, named as the output
+                       (``load_sharing.engineering.stage1``; a ``/`` of a group key is
+                       written ``|``, as NetCDF forbids ``/``); ``units``, ``long_name``
+                       and the exact ``output`` name as attributes; NaN where a case
+                       failed
+``status``             ok / contact_lost / diverged / refused / error (/ missing)
+``reason``             why a case is not ok ("" when it is)
+``settled``            the metrics found a settled part (and the settle rule converged)
+``simulated_time``     simulated time of the (last) run of each case [s]
+``case_wall_time``     seconds each case took on its worker (the only variable that
+                       differs between two runs of the same study)
+sensitivity            variables over (``output``, ``factor``): ``mu_star``, ``mu``,
+                       ``sigma``, ``mu_star_conf`` (Morris) or ``S1``, ``ST``,
+                       ``S1_conf``, ``ST_conf`` (Sobol)
+attributes             study name, description, reference, design, the study file's
+                       text, the model (JSON, SI) and both hashes, torquesplit version
+=====================  ==================================================================
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+
+from . import outputs as out_mod
+
+
+def variable_name(output: str) -> str:
+    """Dataset variable of an output name (NetCDF forbids ``/`` in names)."""
+    return output.replace("/", "|")
+
+
+def build_dataset(plan, rows, n: int, meta: dict):
+    """Dataset of the first ``n`` cases of ``plan`` from the finished ``rows``."""
+    import xarray as xr
+
+    names = plan.outputs
+    d = plan.design
+    values = np.full((n, len(names)), np.nan)
+    status = np.full(n, "missing", dtype=object)
+    reason = np.full(n, "not computed", dtype=object)
+    settled = np.zeros(n, dtype=bool)
+    sim_time = np.full(n, np.nan)
+    wall = np.full(n, np.nan)
+    for r in rows:
+        i = r["index"]
+        values[i] = [math.nan if v is None else v for v in r["values"]]
+        status[i] = r["status"]
+        reason[i] = r["reason"]
+        settled[i] = r["settled"]
+        sim_time[i] = np.nan if r["simulated_time"] is None else r["simulated_time"]
+        wall[i] = r["wall_time"]
+    if d.kind == "grid":
+        dims = tuple(p.name for p in d.parameters)
+        shape = d.shape
+        coords = {p.name: (p.name, axis, _param_attrs(p))
+                  for p, axis in zip(d.parameters, d.axes, strict=True)}
+    else:
+        dims = ("sample",)
+        shape = (n,)
+        coords = {"sample": ("sample", np.arange(n), {"long_name": "case index"})}
+        for j, p in enumerate(d.parameters):
+            coords[p.name] = ("sample", d.values[:n, j].copy(), _param_attrs(p))
+
+    def var(a, attrs):
+        return (dims, np.asarray(a).reshape(shape), attrs)
+
+    data = {}
+    for j, name in enumerate(names):
+        data[variable_name(name)] = var(values[:, j], {
+            "units": out_mod.output_unit(name), "long_name": out_mod.output_long_name(name),
+            "output": name})
+    data["status"] = var(status.astype(str), {
+        "long_name": "case status", "flag_meanings": "ok contact_lost diverged refused error "
+                                                     "missing"})
+    data["reason"] = var(reason.astype(str), {"long_name": "why the case is not ok"})
+    data["settled"] = var(settled.astype(np.int8), {
+        "units": "1", "long_name": "settled part found (1) or not (0)"})
+    data["simulated_time"] = var(sim_time, {"units": "s", "long_name": "simulated time of "
+                                                                       "the case's run"})
+    data["case_wall_time"] = var(wall, {"units": "s", "long_name": "wall time of the case "
+                                                                   "on its worker"})
+    attrs = {
+        "title": f"torquesplit study: {plan.spec.study.name}",
+        "study_name": plan.spec.study.name,
+        "description": plan.spec.study.description,
+        "reference": plan.spec.study.reference,
+        "design": d.kind,
+        "analysis": plan.analysis["type"],
+        "outputs": json.dumps(names),
+        "study_hash": plan.study_hash,
+        "model_hash": plan.model_hash,
+        "model_source": plan.model_source,
+        "torquesplit_version": str(meta.get("torquesplit_version", "")),
+        "study_toml": plan.study_text,
+        "model_json": json.dumps(plan.model_dict),
+        "cases": int(n),
+    }
+    if d.kind == "monte_carlo":
+        mc = plan.spec.monte_carlo
+        attrs.update(sampling=mc.sampling, seed=mc.seed)
+        if mc.stop is not None:
+            attrs["stopping_rule"] = json.dumps(mc.stop.model_dump())
+            attrs["stopped_at"] = int(n)
+    ds = xr.Dataset(data, coords=coords, attrs=attrs)
+    if d.kind == "sensitivity":
+        ds = _add_indices(ds, plan, values[:n])
+    return ds
+
+
+def _param_attrs(p) -> dict:
+    return {"units": p.unit, "long_name": p.describe(),
+            "display_units": p.display_unit or p.unit, "paths": json.dumps(p.paths),
+            "mode": p.mode}
+
+
+def _add_indices(ds, plan, values):
+    from .sensitivity import indices, ranking_key
+
+    d = plan.design
+    names = plan.outputs
+    results = [indices(d, values[:, j]) for j in range(len(names))]
+    keys = [k for k in results[0] if np.ndim(results[0][k]) == 1]
+    factors = [p.name for p in d.parameters]
+    for k in keys:
+        ds[k] = (("output", "factor"), np.array([r[k] for r in results]),
+                 {"units": "1", "long_name": _INDEX_NAMES.get(k, k)})
+    ds = ds.assign_coords(output=("output", [variable_name(n) for n in names]),
+                          factor=("factor", factors))
+    ds.attrs.update(sensitivity_method=d.extra["method"], ranking=ranking_key(d),
+                    seed=plan.spec.sensitivity.seed)
+    return ds
+
+
+_INDEX_NAMES = {
+    "mu_star": "Morris mu*: mean |elementary effect| (output change over the factor's range)",
+    "mu": "Morris mu: mean elementary effect",
+    "sigma": "Morris sigma: standard deviation of the elementary effects",
+    "mu_star_conf": "half-width of the 95 % bootstrap interval of mu*",
+    "S1": "first-order Sobol index", "ST": "total Sobol index",
+    "S1_conf": "half-width of the 95 % bootstrap interval of S1",
+    "ST_conf": "half-width of the 95 % bootstrap interval of ST",
+}
+
+
+def write_dataset(ds, path) -> Path:
+    """Save a study Dataset as NetCDF (h5netcdf)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_suffix(".nc.tmp")
+    ds.to_netcdf(tmp, engine="h5netcdf")
+    tmp.replace(path)
+    return path
+
+
+def ranking(ds, output: str) -> list[tuple[str, float]]:
+    """Factors of a sensitivity Dataset ranked by importance for one output."""
+    key = ds.attrs["ranking"]
+    row = ds[key].sel(output=variable_name(output)).values
+    order = np.argsort(-np.nan_to_num(row, nan=-np.inf))
+    return [(str(ds["factor"].values[i]), float(row[i])) for i in order]

@@ -1,0 +1,574 @@
+"""A study's design resolved against its model: parameters in SI and the value of every case.
+
+:func:`resolve` turns a :class:`~torquesplit.study.spec.StudySpec` into a :class:`Plan`:
+the base model data (model file + ``[set]``), the validated base model and its hash, the
+requested output names, the analysis settings in SI, and a :class:`Design` that knows
+every case's parameter values.  Everything that can be wrong with a study file is found
+here, before any case runs.
+
+Case ``i`` depends only on the study file and ``i`` (never on the number of workers or
+the order in which cases finish): grid cases are the C-order product of the axes;
+Monte Carlo draws all ``n`` points of the sampler at once from the seed (a prefix of a
+longer draw for random and Sobol sampling, so a stopping rule can extend it); Morris
+trajectories and Sobol (Saltelli) matrices likewise.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import inspect
+import itertools
+import json
+import math
+import re
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import TorquesplitError
+from ..model.io import load_model, model_from_dict, model_to_dict
+from ..model.overrides import apply_overrides, read_raw
+from . import outputs as out_mod
+from . import paths as P
+from .errors import StudyError
+from .spec import StudySpec
+
+
+# ============================================================================ parameters
+@dataclass(frozen=True)
+class Parameter:
+    """One varied quantity and the model fields it writes."""
+
+    name: str
+    fields: tuple[P.Field, ...]
+    mode: str
+    """"set": every field takes the value; "scale": each field's model value x the value."""
+    base: tuple[float, ...] = ()
+    """Model values of the fields (SI), for "scale"."""
+    display_unit: str | None = None
+    """Unit the study file wrote its values in (for plots and tables)."""
+
+    @property
+    def kind(self) -> str | None:
+        return None if self.mode == "scale" else self.fields[0].kind
+
+    @property
+    def unit(self) -> str:
+        """SI unit of the parameter's values ("1" for factors and plain numbers)."""
+        return P.si_unit(self.kind)
+
+    @property
+    def paths(self) -> list[str]:
+        return [f.path for f in self.fields]
+
+    def overrides(self, value: float) -> dict:
+        """``{path: value}`` for the model data (SI numbers)."""
+        out = {}
+        for i, f in enumerate(self.fields):
+            v = value * self.base[i] if self.mode == "scale" else value
+            out[f.path] = int(round(v)) if f.integer else float(v)
+        return out
+
+    def describe(self) -> str:
+        what = "scales" if self.mode == "scale" else "sets"
+        paths = self.paths
+        shown = ", ".join(paths[:4]) + (f" and {len(paths) - 4} more" if len(paths) > 4 else "")
+        return f"{self.name} {what} {shown}"
+
+
+@dataclass
+class Design:
+    """Every case of a study: ``values[i]`` are the parameter values of case ``i``."""
+
+    kind: str
+    parameters: list[Parameter]
+    values: np.ndarray
+    """(n_cases, n_parameters) SI values (factors for scales)."""
+    shape: tuple[int, ...] = ()
+    """Grid: the number of values of each axis."""
+    axes: list[np.ndarray] = field(default_factory=list)
+    """Grid: the values of each axis."""
+    extra: dict = field(default_factory=dict)
+    """Sensitivity: the sampling scheme (see :mod:`torquesplit.study.sensitivity`)."""
+
+    @property
+    def n_cases(self) -> int:
+        return int(self.values.shape[0])
+
+    def overrides(self, i: int) -> dict:
+        out = {}
+        for p, v in zip(self.parameters, self.values[i], strict=True):
+            out.update(p.overrides(float(v)))
+        return out
+
+
+@dataclass
+class Plan:
+    """A study ready to run."""
+
+    spec: StudySpec
+    source: str | None
+    study_text: str
+    model_source: str
+    base_data: dict
+    """The model file's data with ``[set]`` applied, as written (units as strings)."""
+    case_data: dict
+    """The same model as SI numbers (validated once here): what each case starts from,
+    so that a case does not parse units again (the round trip is exact; tested)."""
+    model: object
+    model_hash: str
+    model_dict: dict
+    study_hash: str
+    outputs: list[str]
+    definitions: list[str]
+    analysis: dict
+    design: Design
+
+    @property
+    def n_cases(self) -> int:
+        return self.design.n_cases
+
+
+# ============================================================================ resolve
+def resolve(spec: StudySpec, folder: Path | None, text: str, source: str | None = None) -> Plan:
+    """Check a study against its model and compute every case's values (no case runs)."""
+    try:
+        return _resolve(spec, folder, text, source)
+    except StudyError as exc:
+        raise exc.with_source(source) from None
+
+
+def _resolve(spec, folder, text, source) -> Plan:
+    model_source, raw = _model_data(spec.study.model, folder)
+    try:
+        base = apply_overrides(raw, spec.set)
+    except TorquesplitError as exc:
+        raise StudyError("set", _one_line(exc)) from None
+    model = _validated(base, model_source, "set" if spec.set else "study.model")
+    canon = model_to_dict(model)
+    model_hash = _hash(canon)
+    analysis = _analysis(spec)
+    outputs, definitions = _outputs(spec, model, analysis["type"])
+    kind = spec.design
+    if kind == "grid":
+        design = _grid(spec, base)
+    elif kind == "monte_carlo":
+        design = _monte_carlo(spec, base, model)
+    else:
+        from .sensitivity import sensitivity_design
+
+        design = sensitivity_design(spec.sensitivity, _sensitivity_parameters(spec, base))
+    # probe: a study whose first case gives an invalid model is refused (almost always a
+    # mistake in the file); an invalid later case is recorded as refused when it runs
+    _validated(apply_overrides(base, design.overrides(0)), model_source,
+               f"{kind}.parameters", case=0, design=design)
+    canonical = spec.canonical()
+    return Plan(spec=spec, source=source, study_text=text, model_source=model_source,
+                base_data=base, case_data=canon, model=model, model_hash=model_hash, model_dict=canon,
+                study_hash=_hash(canonical), outputs=outputs, definitions=definitions,
+                analysis=analysis, design=design)
+
+
+def _model_data(name: str, folder: Path | None) -> tuple[str, dict]:
+    from ..examples import example_names, example_path
+
+    path = Path(name)
+    if not path.is_absolute() and folder is not None:
+        path = folder / path
+    if path.exists():
+        try:
+            return str(path), read_raw(path)
+        except TorquesplitError as exc:
+            raise StudyError("study.model", _one_line(exc)) from None
+    from ..examples import current_name
+
+    stem, note = current_name(name)
+    if stem in example_names():
+        if note:
+            warnings.warn(note, FutureWarning, stacklevel=2)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", FutureWarning)
+            return stem, read_raw(example_path(stem))
+    raise StudyError("study.model", f"{name!r} is neither a model file (looked in "
+                                    f"{path.parent}) nor a shipped example; give the path of "
+                                    f"the model file, relative to the study file")
+
+
+def _validated(data: dict, model_source: str, where: str, case=None, design=None):
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            return load_model(model_from_dict(data, source=model_source))
+    except TorquesplitError as exc:
+        what = "the model with the study's changes is invalid"
+        if case is not None:
+            vals = ", ".join(f"{p.name} = {v:g}" for p, v in
+                             zip(design.parameters, design.values[case], strict=True))
+            what = f"case {case} ({vals}) gives an invalid model"
+        raise StudyError(where, f"{what}: {_one_line(exc)}") from None
+
+
+def _one_line(exc: BaseException) -> str:
+    return " | ".join(s.strip() for s in str(exc).splitlines() if s.strip())
+
+
+def _hash(data) -> str:
+    text = json.dumps(data, sort_keys=True, separators=(",", ":"), default=str)
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def _analysis(spec: StudySpec) -> dict:
+    a = spec.analysis
+    out = {"type": a.type}
+    if a.type == "static":
+        out["revolutions"] = 1.0 if a.revolutions is None else float(a.revolutions)
+        out["points_per_cycle"] = 8 if a.points_per_cycle is None else int(a.points_per_cycle)
+        return out
+    out["duration"] = (None if a.duration is None
+                       else P.to_si(a.duration, "time", None, "analysis.duration"))
+    if out["duration"] is not None and out["duration"] <= 0:
+        raise StudyError("analysis.duration", "must be positive; give e.g. '2 s'")
+    out.update(cycles=a.cycles, method=a.method, steps_per_period=a.steps_per_period,
+               rtol=a.rtol)
+    if a.settle is not None:
+        start = (None if a.settle.start is None
+                 else P.to_si(a.settle.start, "time", None, "analysis.settle.start"))
+        if start is not None and start <= 0:
+            raise StudyError("analysis.settle.start", "must be positive; give e.g. '1 s'")
+        out["settle"] = {"tolerance": a.settle.tolerance, "start": start,
+                         "growth": a.settle.growth}
+    return out
+
+
+def _outputs(spec: StudySpec, model, analysis: str) -> tuple[list[str], list[str]]:
+    from ..assembly.excitation import stage_label
+    from ..metrics.load_sharing import group_meshes
+
+    meta = {m: {"stage": stage_label(model, m), "path": model.meshes[m].path}
+            for m in model.meshes}
+    available = out_mod.available_outputs(list(model.meshes), group_meshes(meta), analysis)
+    names, unmatched = out_mod.select_outputs(spec.study.outputs, available)
+    if unmatched:
+        p = unmatched[0]
+        import difflib
+
+        close = difflib.get_close_matches(p, available, n=3)
+        hint = f"close: {', '.join(close)}; " if close else ""
+        raise StudyError("study.outputs", f"{p!r} matches no output of a {analysis!r} analysis "
+                                          f"of this model; {hint}see docs/studies.md for the "
+                                          f"names")
+    stop = spec.monte_carlo.stop if spec.monte_carlo is not None else None
+    if stop is not None:
+        if stop.output not in available:
+            raise StudyError("monte_carlo.stop.output", f"{stop.output!r} is not an output of "
+                                                        f"this study; give one exact name, e.g. "
+                                                        f"{names[0]!r}")
+        if stop.output not in names:
+            names.append(stop.output)
+    return names, out_mod.definitions_needed(names)
+
+
+def _check_disjoint(params, where: str) -> None:
+    """Refuse two parameters that write the same field (the later would silently win)."""
+    owner: dict[str, int] = {}
+    for i, p in enumerate(params):
+        for f in p.fields:
+            if f.path in owner:
+                raise StudyError(f"{where}.{i}", f"{p.name!r} writes {f.path}, which parameter "
+                                                 f"{owner[f.path]} also writes; vary each field "
+                                                 f"in one parameter only")
+            owner[f.path] = i
+
+
+# ============================================================================ grid
+def _target_fields(t, raw: dict, where: str) -> list[P.Field]:
+    """Fields of a parameter table's path / paths (patterns expanded)."""
+    given = [t.path] if t.path is not None else list(t.paths)
+    key = "path" if t.path is not None else "paths"
+    fields: list[P.Field] = []
+    for j, path in enumerate(given):
+        w = f"{where}.{key}" + ("" if key == "path" else f".{j}")
+        schema = P.schema_field(path, w) if not P.is_pattern(path) else None
+        for concrete in P.expand(path, raw, w):
+            f = schema or P.schema_field(concrete, w)
+            f = P.Field(concrete, f.kind, f.integer, f.nonnegative)
+            P.check_settable(raw, f, w)
+            if all(f.path != g.path for g in fields):
+                fields.append(f)
+    kinds = {f.kind for f in fields}
+    if len(kinds) > 1:
+        shown = ", ".join(str(k or "plain number") for k in sorted(kinds, key=str))
+        raise StudyError(f"{where}.{key}", f"the fields are of different kinds ({shown}); one "
+                                           f"parameter sets one kind of quantity: split it")
+    return fields
+
+
+def _scale_fields(pattern: str, raw: dict, where: str) -> tuple[list[P.Field], list[float]]:
+    fields, base = [], []
+    for concrete in P.expand(pattern, raw, where):
+        f = P.schema_field(concrete, where)
+        fields.append(f)
+        base.append(P.base_value(raw, f, where))
+    return fields, base
+
+
+def _parameter(t, raw: dict, where: str, name_default: str | None = None) -> Parameter:
+    """A parameter table (grid / sensitivity) -> Parameter."""
+    if getattr(t, "scale", None) is not None:
+        fields, base = _scale_fields(t.scale, raw, f"{where}.scale")
+        name = t.name or name_default
+        if name is None:
+            raise StudyError(f"{where}.name", "a scaled parameter needs a name; add e.g. "
+                                              "name = \"support_stiffness_factor\"")
+        return Parameter(name, tuple(fields), "scale", tuple(base), None)
+    fields = _target_fields(t, raw, where)
+    if t.name is None and (t.paths is not None or len(fields) > 1):
+        raise StudyError(f"{where}.name", "a parameter that sets several fields needs a name; "
+                                          "add e.g. name = \"diameter\"")
+    name = t.name or fields[0].path
+    P.check_unit(t.unit, fields[0].kind, f"{where}.unit")
+    return Parameter(name, tuple(fields), "set", (), None)
+
+
+_UNIT_OF = re.compile(r"^\s*[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?\s*(.+?)\s*$")
+
+
+def _display_unit(values, unit: str | None) -> str | None:
+    if unit:
+        return unit
+    for v in values:
+        if isinstance(v, str):
+            m = _UNIT_OF.match(v)
+            if m:
+                return m.group(1)
+    return None
+
+
+def _value(v, p: Parameter, unit, where) -> float:
+    x = P.to_si(v, p.kind, unit, where)
+    if p.mode == "set" and p.fields[0].integer and x != round(x):
+        raise StudyError(where, f"{v!r}: {p.fields[0].path} takes whole numbers; give integers")
+    return x
+
+
+def _grid(spec: StudySpec, raw: dict) -> Design:
+    params: list[Parameter] = []
+    axes: list[np.ndarray] = []
+    for i, t in enumerate(spec.grid.parameters):
+        where = f"grid.parameters.{i}"
+        p = _parameter(t, raw, where)
+        if t.values is not None:
+            vals = np.array([_value(v, p, t.unit, f"{where}.values.{j}")
+                             for j, v in enumerate(t.values)], dtype=float)
+            shown = t.values
+        else:
+            a = _value(t.start, p, t.unit, f"{where}.start")
+            b = _value(t.stop, p, t.unit, f"{where}.stop")
+            if t.num > 1 and a == b:
+                raise StudyError(f"{where}.stop", "equals 'start': the range is empty; give a "
+                                                  "different stop, or 'values'")
+            if t.spacing == "log":
+                if a <= 0 or b <= 0:
+                    raise StudyError(f"{where}.start", "a log range needs positive start and "
+                                                       "stop; use spacing = \"linear\"")
+                vals = np.geomspace(a, b, t.num)
+            else:
+                vals = np.linspace(a, b, t.num)
+            if p.mode == "set" and p.fields[0].integer:
+                vals = np.round(vals)
+            shown = [t.start, t.stop]
+        if len(np.unique(vals)) != len(vals):
+            raise StudyError(f"{where}.values", "repeats a value; give each value once")
+        p = Parameter(p.name, p.fields, p.mode, p.base,
+                      None if p.mode == "scale" else _display_unit(shown, t.unit))
+        params.append(p)
+        axes.append(vals)
+    names = [p.name for p in params]
+    if len(set(names)) != len(names):
+        raise StudyError("grid.parameters", f"two parameters are named {names}; give each a "
+                                            f"different name")
+    _check_disjoint(params, "grid.parameters")
+    shape = tuple(len(a) for a in axes)
+    values = np.array(list(itertools.product(*axes)), dtype=float).reshape(-1, len(axes))
+    return Design("grid", params, values, shape=shape, axes=axes)
+
+
+# ============================================================================ Monte Carlo
+_ISO_DEFAULTS = {"eccentricity": ("runout", 0.5), "bearing_runout": ("runout", 1.0),
+                 "pitch": ("single_pitch", 1.0)}
+
+
+@dataclass(frozen=True)
+class RandomVariable:
+    """How a uniform number u in (0, 1) becomes a parameter value."""
+
+    distribution: str
+    args: tuple
+
+
+def _monte_carlo(spec: StudySpec, raw: dict, model) -> Design:
+    mc = spec.monte_carlo
+    params: list[Parameter] = []
+    rvs: list[RandomVariable] = []
+    for i, t in enumerate(mc.parameters):
+        where = f"monte_carlo.parameters.{i}"
+        fields = _target_fields(t, raw, where)
+        P.check_unit(t.unit, fields[0].kind, f"{where}.unit")
+        groups = [fields] if (t.shared or len(fields) == 1) else [[f] for f in fields]
+        for g in groups:
+            if t.name and len(groups) == 1:
+                name = t.name
+            elif t.name:
+                name = f"{t.name}.{g[0].path}"
+            else:
+                name = g[0].path
+            shown = [v for v in (t.mean, t.low, t.high) if v is not None]
+            p = Parameter(name, tuple(g), "set", (), _display_unit(shown, t.unit))
+            params.append(p)
+            rvs.append(_random_variable(t, p, model, where))
+    names = [p.name for p in params]
+    dup = {n for n in names if names.count(n) > 1}
+    if dup:
+        raise StudyError("monte_carlo.parameters", f"{sorted(dup)[0]!r} is varied twice; vary "
+                                                   f"each field in one parameter only")
+    _check_disjoint(params, "monte_carlo.parameters")
+    n = mc.samples if mc.samples is not None else mc.stop.max_samples
+    u = uniform_points(mc.sampling, n, len(params), mc.seed)
+    values = np.column_stack([transform(rv, u[:, j]) for j, rv in enumerate(rvs)])
+    return Design("monte_carlo", params, values, extra={"random_variables": rvs})
+
+
+def _random_variable(t, p: Parameter, model, where) -> RandomVariable:
+    kind = p.kind
+    d = t.distribution
+    if d == "iso1328":
+        return _iso_variable(t, p, model, where)
+
+    def si(name):
+        return P.to_si(getattr(t, name), kind, t.unit, f"{where}.{name}")
+
+    if d == "normal":
+        mean, std = si("mean"), si("std")
+        if std <= 0:
+            raise StudyError(f"{where}.std", "must be positive; give the standard deviation")
+        return RandomVariable("normal", (mean, std))
+    if d == "uniform":
+        low, high = si("low"), si("high")
+        if not high > low:
+            raise StudyError(f"{where}.high", "must exceed 'low'; correct the bounds")
+        return RandomVariable("uniform", (low, high))
+    mean, std, low, high = si("mean"), si("std"), si("low"), si("high")
+    if std <= 0:
+        raise StudyError(f"{where}.std", "must be positive; give the standard deviation")
+    if not high > low:
+        raise StudyError(f"{where}.high", "must exceed 'low'; correct the bounds")
+    return RandomVariable("truncated_normal", (mean, std, low, high))
+
+
+def _iso_variable(t, p: Parameter, model, where) -> RandomVariable:
+    from ..gears import grades
+
+    f0 = p.fields[0]
+    if p.kind != "length":
+        raise StudyError(f"{where}.distribution", f"an ISO 1328 grade gives length tolerances, "
+                                                  f"but {f0.path} is not a length; use another "
+                                                  f"distribution")
+    parts = f0.path.split(".")
+    gear = t.gear or (parts[1] if parts[0] == "gears" else None)
+    if gear is None or gear not in model.gears:
+        raise StudyError(f"{where}.gear", "name the gear whose size sets the tolerance; add "
+                                          "gear = \"NAME\"")
+    g = model.gears[gear]
+    grade = t.grade if t.grade is not None else g.errors.grade
+    if grade is None:
+        raise StudyError(f"{where}.grade", f"gear {gear!r} has no errors.grade in the model; "
+                                           f"add grade = N (ISO 1328-1 grade 1-11)")
+    tol_name, factor = (t.tolerance, 1.0) if t.tolerance else _ISO_DEFAULTS.get(parts[-1],
+                                                                                (None, 1.0))
+    if tol_name is None:
+        raise StudyError(f"{where}.tolerance", f"say which ISO 1328 tolerance bounds "
+                                               f"{parts[-1]!r}: tolerance = \"runout\", "
+                                               f"\"single_pitch\", ...")
+    d = g.teeth * g.module / math.cos(g.helix_angle)
+    try:
+        tol = grades.flank_tolerances(grade, g.module, d, g.face_width)
+    except TorquesplitError as exc:
+        raise StudyError(f"{where}.grade", _one_line(exc)) from None
+    value = getattr(tol, tol_name) * factor
+    signed = not all(f.nonnegative for f in p.fields)
+    return RandomVariable("iso1328", (value, t.shape, signed))
+
+
+def uniform_points(sampling: str, n: int, d: int, seed: int) -> np.ndarray:
+    """(n, d) points in [0, 1): random, scrambled Sobol or Latin hypercube, from ``seed``.
+    For "random" and "sobol" the first m rows do not depend on n."""
+    from scipy.stats import qmc
+
+    if sampling == "random":
+        return np.random.default_rng(seed).random((n, d))
+    cls = qmc.Sobol if sampling == "sobol" else qmc.LatinHypercube
+    key = "rng" if "rng" in inspect.signature(cls.__init__).parameters else "seed"
+    engine = cls(d, scramble=True, **{key: np.random.default_rng(seed)})
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # Sobol: "balance properties" for n not 2^m
+        return engine.random(n)
+
+
+def transform(rv: RandomVariable, u: np.ndarray) -> np.ndarray:
+    """Values of a random variable at uniform points ``u`` (inverse CDF)."""
+    from scipy.stats import norm, truncnorm
+
+    if rv.distribution == "uniform":
+        low, high = rv.args
+        return low + u * (high - low)
+    if rv.distribution == "normal":
+        mean, std = rv.args
+        return norm.ppf(np.clip(u, 1e-12, 1 - 1e-12), loc=mean, scale=std)
+    if rv.distribution == "truncated_normal":
+        mean, std, low, high = rv.args
+        return truncnorm.ppf(u, (low - mean) / std, (high - mean) / std, loc=mean, scale=std)
+    tol, shape, signed = rv.args
+    return iso_band(u, tol, shape, signed)
+
+
+def iso_band(u: np.ndarray, tolerance: float, shape: str, signed: bool) -> np.ndarray:
+    """Deviation inside an ISO 1328 tolerance band from uniform ``u``: the convention of
+    :func:`torquesplit.gears.grades.sample_within` (normal: +/-3 sigma = tolerance,
+    truncated; magnitudes in [0, T]); a test checks that both agree."""
+    from scipy.stats import truncnorm
+
+    u = np.asarray(u, dtype=float)
+    if tolerance == 0:
+        return np.zeros_like(u)
+    if shape == "uniform":
+        return (2.0 * u - 1.0) * tolerance if signed else u * tolerance
+    sigma = tolerance / 3.0
+    if signed:
+        return truncnorm.ppf(u, -3.0, 3.0, loc=0.0, scale=sigma)
+    return truncnorm.ppf(u, 0.0, 3.0, loc=0.0, scale=sigma)
+
+
+# ============================================================================ sensitivity
+def _sensitivity_parameters(spec: StudySpec, raw: dict):
+    out = []
+    for i, t in enumerate(spec.sensitivity.parameters):
+        where = f"sensitivity.parameters.{i}"
+        p = _parameter(t, raw, where)
+        low = _value(t.low, p, t.unit, f"{where}.low")
+        high = _value(t.high, p, t.unit, f"{where}.high")
+        if not high > low:
+            raise StudyError(f"{where}.high", "must exceed 'low'; give the range low < high")
+        if t.spacing == "log" and low <= 0:
+            raise StudyError(f"{where}.low", "a log range needs low > 0; use spacing = "
+                                             "\"linear\"")
+        p = Parameter(p.name, p.fields, p.mode, p.base,
+                      None if p.mode == "scale" else _display_unit([t.low, t.high], t.unit))
+        out.append((p, low, high, t.spacing))
+    names = [p.name for p, *_ in out]
+    if len(set(names)) != len(names):
+        raise StudyError("sensitivity.parameters", "two factors have the same name; give each "
+                                                   "a different name")
+    _check_disjoint([p for p, *_ in out], "sensitivity.parameters")
+    return out

@@ -1,0 +1,308 @@
+"""Figures of a study, drawn from its Dataset only (no metric is recomputed here).
+
+Matplotlib's object-oriented API on Agg canvases, no pyplot and no global state, as in
+:mod:`torquesplit.plot`.
+
+==========================  ==============================================================
+design                      figures (one file per output family, PNG and SVG)
+==========================  ==============================================================
+grid, 1 parameter           output against the parameter, one curve per load-sharing group
+                            or mesh (the papers' convention), the system value bold;
+                            failed cases marked with a red x on the axis
+grid, 2 parameters          one colour map per output (panels: members of a family)
+grid, 3 parameters          maps over the first two, one panel per value of the third
+monte_carlo                 per output: histogram; empirical CDF with its 95 % band
+                            (Dvoretzky-Kiefer-Wolfowitz); running mean with its 95 %
+                            interval and running 95th percentile against sample count
+sensitivity                 tornado chart per output: factors ranked by Morris mu* or
+                            Sobol ST, with bootstrap intervals (and S1 for Sobol)
+==========================  ==============================================================
+
+Axes carry units: parameters in the unit the study file wrote them in, forces in kN.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import math
+from pathlib import Path
+
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+
+from . import outputs as out_mod
+
+log = logging.getLogger(__name__)
+
+WIDTH = 7.5
+MAX_MEMBERS = 12
+"""Curves (or map panels) per figure; further members are left out (and logged)."""
+MAX_FIGURES = 40
+
+
+def write_study_figures(ds, directory, formats=("png", "svg"), dpi: int = 130) -> list[Path]:
+    """Write every figure that applies to the study Dataset ``ds``; returns the paths."""
+    directory = Path(directory)
+    directory.mkdir(parents=True, exist_ok=True)
+    design = ds.attrs["design"]
+    jobs = []
+    if design == "grid":
+        params = [d for d in ds[_output_vars(ds)[0]].dims]
+        fams = _families(ds)
+        for fam, members in fams.items():
+            if len(params) == 1:
+                jobs.append((_safe(fam), lambda f=fam, m=members: curves_figure(ds, f, m)))
+            else:
+                jobs.append((f"map_{_safe(fam)}", lambda f=fam, m=members: maps_figure(ds, f, m)))
+    elif design == "monte_carlo":
+        for var in _output_vars(ds):
+            jobs.append((f"mc_{_safe(var)}", lambda v=var: monte_carlo_figure(ds, v)))
+    elif design == "sensitivity":
+        for var in _output_vars(ds):
+            jobs.append((f"tornado_{_safe(var)}", lambda v=var: tornado_figure(ds, v)))
+    if len(jobs) > MAX_FIGURES:
+        log.info("%d figures apply; writing the first %d", len(jobs), MAX_FIGURES)
+        jobs = jobs[:MAX_FIGURES]
+    written = []
+    for name, make in jobs:
+        fig = make()
+        for fmt in formats:
+            path = directory / f"{name}.{fmt}"
+            fig.savefig(path, dpi=dpi)
+            written.append(path)
+    return written
+
+
+# ============================================================================ grid
+def curves_figure(ds, family: str, members: list[tuple[str, str]]) -> Figure:
+    """A 1-parameter grid: the outputs of one family against the parameter."""
+    var0 = members[0][1]
+    pname = ds[var0].dims[0]
+    x, xunit = _coord(ds, pname)
+    fig = _figure(WIDTH, 4.2)
+    ax = fig.add_subplot()
+    unit, scale = _out_unit(var0)
+    for i, (member, var) in enumerate(members[:MAX_MEMBERS]):
+        y = ds[var].values * scale
+        if member == "system":
+            ax.plot(x, y, color="k", lw=2.4, marker="o", ms=3, label="system", zorder=5)
+        else:
+            ax.plot(x, y, color=_color(i), lw=1.4, ls=_DASHES[i % len(_DASHES)], marker="o",
+                    ms=2.5, label=member)
+    _mark_failed(ax, x, ds["status"].values)
+    ax.set_xlabel(f"{_param_label(ds, pname)} [{xunit}]")
+    ax.set_ylabel(f"{family} [{unit}]")
+    ax.grid(True, alpha=0.3)
+    ax.yaxis.get_major_formatter().set_useOffset(False)
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False, fontsize=8)
+    fig.suptitle(f"{ds.attrs['study_name']}: {_family_text(family)}", fontsize=11)
+    return fig
+
+
+def maps_figure(ds, family: str, members: list[tuple[str, str]]) -> Figure:
+    """A 2- or 3-parameter grid: colour maps of one family over the first two parameters
+    (a panel per member of the family; with 3 parameters, a row per value of the third
+    and at most 4 members)."""
+    dims = ds[members[0][1]].dims
+    third = dims[2] if len(dims) == 3 else None
+    if third:
+        members = members[:4]
+        panels = [(m, r) for r in range(min(ds.sizes[third], 6)) for m in members]
+        ncols = len(members)
+    else:
+        members = members[:MAX_MEMBERS]
+        panels = [(m, 0) for m in members]
+        ncols = min(3, len(members))
+    nrows = math.ceil(len(panels) / ncols)
+    fig = _figure(max(WIDTH, 3.6 * ncols), 3.0 * nrows + 0.8)
+    axes = fig.subplots(nrows, ncols, squeeze=False).ravel()
+    for ax in axes[len(panels):]:
+        ax.set_visible(False)
+    x, xunit = _coord(ds, dims[0])
+    y, yunit = _coord(ds, dims[1])
+    unit, scale = _out_unit(members[0][1])
+    for ax, ((member, var), r) in zip(axes, panels):
+        data = ds[var]
+        status = ds["status"]
+        title = member
+        if third:
+            data = data.isel({third: r})
+            status = status.isel({third: r})
+            tv, tu = _coord(ds, third)
+            title += f", {third} = {tv[r]:.4g} {tu}"
+        z = data.transpose(dims[1], dims[0]).values * scale
+        mesh = ax.pcolormesh(x, y, np.ma.masked_invalid(z), shading="nearest", cmap="viridis")
+        if np.isfinite(z).all() and len(x) > 1 and len(y) > 1 and np.nanstd(z) > 0:
+            ax.contour(x, y, z, colors="w", linewidths=0.6, alpha=0.7)
+        bad = status.transpose(dims[1], dims[0]).values != "ok"
+        if bad.any():
+            yy, xx = np.nonzero(bad)
+            ax.plot(np.asarray(x)[xx], np.asarray(y)[yy], "rx", ms=6, label="not ok")
+        bar = fig.colorbar(mesh, ax=ax, label=f"[{unit}]")
+        bar.formatter.set_useOffset(False)
+        bar.update_ticks()
+        ax.set_title(title, fontsize=9)
+        ax.set_xlabel(f"{_param_label(ds, dims[0])} [{xunit}]", fontsize=8)
+        ax.set_ylabel(f"{_param_label(ds, dims[1])} [{yunit}]", fontsize=8)
+        ax.tick_params(labelsize=7)
+    fig.suptitle(f"{ds.attrs['study_name']}: {_family_text(family)}", fontsize=11)
+    return fig
+
+
+# ============================================================================ Monte Carlo
+def monte_carlo_figure(ds, var: str, confidence: float = 0.95) -> Figure:
+    """Histogram, ECDF with a DKW band, and convergence of the mean and 95th percentile."""
+    unit, scale = _out_unit(var)
+    y = ds[var].values * scale
+    ok = np.isfinite(y)
+    fig = _figure(WIDTH * 1.6, 3.8)
+    ax_h, ax_c, ax_v = fig.subplots(1, 3)
+    label = f"{ds[var].attrs.get('output', var)} [{unit}]"
+    v = np.sort(y[ok])
+    n = v.size
+    if n:
+        ax_h.hist(v, bins=max(5, min(40, int(math.sqrt(n)) + 1)), color=_color(0), alpha=0.8)
+        ecdf = np.arange(1, n + 1) / n
+        eps = math.sqrt(math.log(2 / (1 - confidence)) / (2 * n))  # Dvoretzky-Kiefer-Wolfowitz
+        ax_c.step(v, ecdf, where="post", color=_color(0), label="empirical CDF")
+        ax_c.fill_between(v, np.clip(ecdf - eps, 0, 1), np.clip(ecdf + eps, 0, 1),
+                          step="post", color=_color(0), alpha=0.25,
+                          label=f"{confidence:.0%} band (DKW)")
+        seq = y[ok]  # in sample order: the convergence a stopping rule sees
+        k = np.arange(1, seq.size + 1)
+        mean = np.cumsum(seq) / k
+        if seq.size > 1:
+            from scipy import stats
+
+            csum2 = np.cumsum(seq ** 2)
+            var_run = np.maximum(csum2 / k - mean ** 2, 0) * k / np.maximum(k - 1, 1)
+            t = stats.t.ppf(0.5 + confidence / 2, np.maximum(k - 1, 1))
+            half = t * np.sqrt(var_run / k)
+            half[0] = np.nan
+            ax_v.fill_between(k, mean - half, mean + half, color=_color(0), alpha=0.25,
+                              label=f"{confidence:.0%} interval of the mean")
+        ax_v.plot(k, mean, color=_color(0), label="running mean")
+        p95 = [np.quantile(seq[:j], 0.95) for j in range(1, seq.size + 1)]
+        ax_v.plot(k, p95, color=_color(1), ls="--", label="running 95th percentile")
+    ax_h.set_xlabel(label, fontsize=8)
+    ax_h.set_ylabel("cases")
+    ax_c.set_xlabel(label, fontsize=8)
+    ax_c.set_ylabel("cumulative probability [1]")
+    ax_v.set_xlabel("samples")
+    ax_v.set_ylabel(f"[{unit}]")
+    for ax in (ax_h, ax_c, ax_v):
+        ax.grid(True, alpha=0.3)
+    ax_c.legend(fontsize=7, loc="lower right")
+    ax_v.legend(fontsize=7)
+    failed = int((ds["status"].values != "ok").sum())
+    note = f" ({failed} of {y.size} cases not ok)" if failed else ""
+    fig.suptitle(f"{ds.attrs['study_name']}: {n} samples{note}", fontsize=11)
+    return fig
+
+
+# ============================================================================ sensitivity
+def tornado_figure(ds, var: str) -> Figure:
+    """Factors ranked by importance for one output (Morris mu* or Sobol ST)."""
+    key = ds.attrs["ranking"]
+    row = ds[key].sel(output=var).values
+    conf = ds[f"{key}_conf"].sel(output=var).values
+    factors = [str(f) for f in ds["factor"].values]
+    order = np.argsort(np.nan_to_num(row, nan=-np.inf))  # largest at the top
+    fig = _figure(WIDTH, 0.45 * len(factors) + 1.6)
+    ax = fig.add_subplot()
+    pos = np.arange(len(factors))
+    ax.barh(pos, row[order], xerr=conf[order], color=_color(0), alpha=0.85,
+            label="mu* (Morris)" if key == "mu_star" else "ST (total)")
+    if key == "ST":
+        s1 = ds["S1"].sel(output=var).values
+        ax.barh(pos, s1[order], height=0.4, color=_color(1), label="S1 (first order)")
+    ax.set_yticks(pos, [factors[i] for i in order], fontsize=8)
+    unit, _ = _out_unit(var)
+    ax.set_xlabel("mu*: mean |output change| over each factor's range [" + unit + "]"
+                  if key == "mu_star" else "Sobol index [1]")
+    ax.grid(True, axis="x", alpha=0.3)
+    ax.legend(fontsize=8, loc="lower right")
+    fig.suptitle(f"{ds.attrs['study_name']}: {ds[var].attrs.get('output', var)}", fontsize=11)
+    return fig
+
+
+# ============================================================================ helpers
+_DASHES = ("-", (0, (5, 2)), (0, (5, 2, 1, 2)), (0, (1.5, 1.5)))
+
+
+def _figure(width, height) -> Figure:
+    fig = Figure(figsize=(width, height), layout="constrained")
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def _color(i: int) -> str:
+    return f"C{i % 10}"
+
+
+def _output_vars(ds) -> list[str]:
+    return [v for v in ds.data_vars if "output" in ds[v].attrs]
+
+
+def _families(ds) -> dict[str, list[tuple[str, str]]]:
+    fams: dict[str, list[tuple[str, str]]] = {}
+    for var in _output_vars(ds):
+        fam, member = out_mod.family(ds[var].attrs["output"])
+        fams.setdefault(fam, []).append((member, var))
+    for fam, members in fams.items():  # the system value first
+        members.sort(key=lambda m: m[0] != "system")
+        if len(members) > MAX_MEMBERS:
+            log.info("family %s: %d members, showing %d", fam, len(members), MAX_MEMBERS)
+    return fams
+
+
+def _out_unit(var_or_name: str) -> tuple[str, float]:
+    unit = out_mod.output_unit(var_or_name)
+    if unit == "N":
+        return "kN", 1e-3
+    return ("-" if unit == "1" else unit), 1.0
+
+
+def _coord(ds, name) -> tuple[np.ndarray, str]:
+    """Coordinate values in the study's display unit."""
+    c = ds[name]
+    si = c.attrs.get("units", "1")
+    disp = c.attrs.get("display_units", si)
+    values = np.asarray(c.values, dtype=float)
+    if disp != si and si != "1":
+        from ..model.units import convert
+
+        try:
+            return np.array([convert(v, si, disp) for v in values]), disp
+        except Exception:  # an unknown display unit: show SI
+            return values, si
+    return values, ("-" if si == "1" else si)
+
+
+def _param_label(ds, name) -> str:
+    paths = json.loads(ds[name].attrs.get("paths", "[]"))
+    if ds[name].attrs.get("mode") == "scale":
+        return f"{name} (factor)"
+    return name if len(paths) != 1 or paths[0] == name else f"{name} ({paths[0]})"
+
+
+def _mark_failed(ax, x, status) -> None:
+    bad = np.asarray(status) != "ok"
+    if bad.any():
+        ax.plot(np.asarray(x)[bad], np.zeros(bad.sum()), "rx", ms=7, clip_on=False,
+                transform=ax.get_xaxis_transform(), label="case not ok")
+
+
+def _family_text(family: str) -> str:
+    """ "load_sharing.engineering" -> "load-sharing coefficient (engineering)"."""
+    head = family.split(".")[0]
+    text = out_mod.FAMILIES.get(head, ("", family))[1]
+    if head == "load_sharing" and "." in family:
+        text += f" ({family.split('.', 1)[1]})"
+    return text
+
+
+def _safe(name: str) -> str:
+    return name.replace("/", "_").replace("|", "_").replace(" ", "_")

@@ -1,0 +1,141 @@
+"""Grids: the same numbers as runs done one by one, any number of workers, failed cases."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import xarray as xr
+
+import torquesplit
+from study_helpers import CYCLES, grid_study
+from torquesplit.model.io import load_model, model_from_dict
+from torquesplit.model.overrides import read_raw, set_parameter
+from torquesplit.study import Study, output_values, run_study
+
+STIFFNESS = {"path": "meshes.a1.stiffness", "start": "2e8 N/m", "stop": "6e8 N/m", "num": 4}
+ERROR = {"path": "meshes.b1.transmission_error.constant", "values": ["0 um", "8 um"]}
+
+
+def test_grid_equals_runs_one_by_one(split_file):
+    ds = run_study(grid_study(split_file, [STIFFNESS], outputs=["load_sharing.*",
+                                                                  "peak_force.*"]),
+                   workers=1)
+    names = [ds[v].attrs["output"] for v in ds.data_vars if "output" in ds[v].attrs]
+    k = ds["meshes.a1.stiffness"]
+    assert k.attrs["units"] == "N/m" and k.values.tolist() == [2e8, 2e8 + 4e8 / 3,
+                                                               2e8 + 8e8 / 3, 6e8]
+    raw = read_raw(split_file)
+    for i, value in enumerate(np.linspace(2e8, 6e8, 4)):
+        model = load_model(model_from_dict(set_parameter(raw, "meshes.a1.stiffness", value)))
+        expected = output_values(torquesplit.simulate(model, cycles=CYCLES))
+        for name in names:
+            got = float(ds[name].values[i])
+            assert got == expected[name] or (np.isnan(got) and np.isnan(expected[name])), name
+    # the grid does change the answer (a test that could fail)
+    assert np.ptp(ds["peak_force.a1"].values) > 1.0
+
+
+def test_one_and_two_workers_identical(split_file, tmp_path):
+    from torquesplit.study.figures import write_study_figures
+
+    study = Study(grid_study(split_file, [STIFFNESS, ERROR]))
+    one = study.run(workers=1)
+    two = study.run(workers=2)
+    maps = write_study_figures(one, tmp_path, formats=("png",))
+    assert [p.name for p in maps] == ["map_load_sharing.cycle_peak.png"]
+    assert one["load_sharing.cycle_peak"].shape == (4, 2)
+    xr.testing.assert_identical(one.drop_vars("case_wall_time"), two.drop_vars("case_wall_time"))
+    assert np.ptp(one["load_sharing.cycle_peak"].values) > 0.01
+
+
+def test_failing_cases_recorded_and_others_complete(split_file):
+    # 1e10 N m deflects the train by ~6e4 rad at once: the run blows up (diverged); a
+    # negative torque is refused by the model check; the other cases run
+    data = grid_study(split_file, [{"path": "drives.motor.torque",
+                                    "values": ["100 N m", "1e10 N m", "-5 N m", "120 N m"]}])
+    ds = run_study(data, workers=1)
+    status = ds["status"].values.tolist()
+    assert status == ["ok", "diverged", "refused", "ok"]
+    reason = ds["reason"].values
+    assert "diverged" in reason[1] and "blowup" in reason[1]
+    assert "drives.motor.torque" in reason[2] and "greater than 0" in reason[2]
+    lsc = ds["load_sharing.cycle_peak"].values
+    assert np.isfinite(lsc[[0, 3]]).all() and np.isnan(lsc[[1, 2]]).all()
+    # a stiffness variation that makes the stiffness negative is refused too
+    text = split_file.read_text().replace(
+        '[meshes.a1]\ngears = ["pinion", "a"]\nstiffness = "4e8 N/m"',
+        '[meshes.a1]\ngears = ["pinion", "a"]\nstiffness = {method = "constant", '
+        'value = "4e8 N/m", peak_to_peak = 0.1}')
+    split_file.write_text(text)
+    ds = run_study(grid_study(split_file, [{"path": "meshes.a1.stiffness.peak_to_peak",
+                                            "values": [0.1, 2.5]}]), workers=1)
+    assert ds["status"].values.tolist() == ["ok", "refused"]
+    assert "peak_to_peak" in ds["reason"].values[1]
+
+
+def test_linked_paths_and_scale_by_pattern(split_file):
+    linked = {"name": "stage_stiffness", "paths": ["meshes.a2.stiffness", "meshes.b2.stiffness"],
+              "values": [3e8, 5e8]}
+    scale = {"name": "split_meshes", "scale": "meshes.*1.stiffness", "values": [0.5, 1.0]}
+    ds = run_study(grid_study(split_file, [linked, scale], outputs=["static_force.*"]),
+                   workers=1)
+    assert ds["split_meshes"].attrs["units"] == "1"
+    assert "meshes.b1.stiffness" in ds["split_meshes"].attrs["paths"]
+    # equal stiffness on both paths: equal static split whatever the values
+    np.testing.assert_allclose(ds["static_force.a2"].values, ds["static_force.b2"].values,
+                               rtol=1e-9)
+    raw = read_raw(split_file)
+    for path in ("meshes.a1.stiffness", "meshes.b1.stiffness"):
+        raw = set_parameter(raw, path, 0.5 * 4e8)
+    for path in ("meshes.a2.stiffness", "meshes.b2.stiffness"):
+        raw = set_parameter(raw, path, 5e8)
+    res = torquesplit.simulate(load_model(model_from_dict(raw)), cycles=CYCLES)
+    assert ds["static_force.a1"].sel(stage_stiffness=5e8, split_meshes=0.5).item() == \
+        output_values(res)["static_force.a1"]
+
+
+def test_log_range_and_display_units(split_file):
+    ds = run_study(grid_study(split_file, [{"path": "meshes.a1.transmission_error.constant",
+                                            "start": 1, "stop": 100, "num": 3, "unit": "um",
+                                            "spacing": "log"}]), workers=1)
+    c = ds["meshes.a1.transmission_error.constant"]
+    np.testing.assert_allclose(c.values, [1e-6, 1e-5, 1e-4], rtol=1e-12)
+    assert c.attrs["display_units"] == "um" and c.attrs["units"] == "m"
+    lsc = ds["load_sharing.cycle_peak"].values
+    assert lsc[0] < lsc[1] < lsc[2]
+
+
+@pytest.mark.parametrize("spacing", ["linear", "log"])
+def test_integer_field_takes_whole_numbers(split_file, spacing):
+    data = grid_study(split_file, [{"path": "meshes.a1.transmission_error.constant",
+                                    "values": [0.0]}, {"path": "analysis.table_points",
+                                                       "start": 16, "stop": 64, "num": 3,
+                                                       "spacing": spacing}])
+    plan = Study(data).plan()
+    assert all(float(v).is_integer() for v in plan.design.values[:, 1])
+    assert isinstance(plan.design.overrides(1)["analysis.table_points"], int)
+
+
+def test_two_parameters_writing_one_field_refused(split_file):
+    from torquesplit.study import StudyError
+
+    a = {"path": "meshes.a1.stiffness", "values": [3e8]}
+    b = {"name": "all", "scale": "meshes.*.stiffness", "values": [1.0]}
+    with pytest.raises(StudyError, match="grid.parameters.1: 'all' writes meshes.a1.stiffness"):
+        Study(grid_study(split_file, [a, b])).plan()
+
+
+@pytest.mark.parametrize("name", torquesplit.example_names())
+def test_cases_start_from_an_exact_si_copy_of_the_model(name):
+    """Cases start from the validated model written as SI numbers (no unit parsing per
+    case): that copy must give the very same model."""
+    import warnings
+
+    from torquesplit.model.io import model_to_dict
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        model = load_model(torquesplit.example_path(name))
+        again = load_model(model_from_dict(model_to_dict(model)))
+    assert again == model
+    assert model_to_dict(again) == model_to_dict(model)

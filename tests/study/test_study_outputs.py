@@ -1,0 +1,81 @@
+"""output_values: every name the catalogue promises, read from the metrics themselves."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+import torquesplit
+from torquesplit.quasistatic import quasi_static_load_sharing
+from torquesplit.study.outputs import (available_outputs, definitions_needed, family,
+                                       output_values, select_outputs)
+
+
+@pytest.fixture(scope="module")
+def run(tmp_path_factory):
+    from model_texts import split_model, write_model
+
+    path = write_model(tmp_path_factory.mktemp("m"), split_model(error_a="5 um"))
+    return torquesplit.simulate(path, cycles=40)
+
+
+def test_dynamic_names_and_values_come_from_the_metrics(run):
+    vals = output_values(run)
+    groups = run.groups
+    assert set(vals) == set(available_outputs(run.mesh_names, groups, "run"))
+    for d in ("cycle_peak", "instantaneous", "engineering", "mean_force"):
+        met = run.metrics(d)
+        assert vals[f"load_sharing.{d}"] == met.load_sharing.system
+        for g in groups:
+            assert vals[f"load_sharing.{d}.{g}"] == met.load_sharing.per_group[g]
+        for m in run.mesh_names:
+            assert vals[f"load_sharing.{d}.{m}"] == met.load_sharing.per_mesh[m]
+    met = run.metrics("cycle_peak")
+    rows = {r.mesh: r for r in met.rows}
+    for m in run.mesh_names:
+        for name in ("peak_force", "min_force", "mean_force", "static_force",
+                     "nominal_force", "dynamic_factor", "dynamic_factor_engineering",
+                     "peak_to_nominal", "contact_loss", "back_contact"):
+            assert vals[f"{name}.{m}"] == getattr(rows[m], name), (name, m)
+        lo, mean, hi = (vals[f"{k}.{m}"] for k in ("min_force", "mean_force", "peak_force"))
+        assert lo <= mean * (1 + 1e-12) and mean <= hi * (1 + 1e-12) and lo < hi
+    d = met.dynamic_factors
+    for g in groups:
+        assert vals[f"peak_to_nominal_engineering.{g}"] == \
+            d.per_group_peak_to_nominal_engineering[g]
+        assert vals[f"dynamic_factor.{g}"] == d.per_group_dynamic_factor[g]
+    assert vals["dynamic_factor"] == max(d.per_group_dynamic_factor.values())
+    assert vals["settle_time"] == met.settling.start_time
+    assert vals["load_sharing.cycle_peak"] > 1.01  # the 5 um error is felt
+
+
+def test_only_the_definitions_asked_for(run):
+    vals = output_values(run, ["engineering"])
+    assert "load_sharing.engineering" in vals and "load_sharing.cycle_peak" not in vals
+    with pytest.raises(ValueError, match="unknown load-sharing definition"):
+        output_values(run, ["static_torque"])
+
+
+def test_quasi_static_names(tmp_path):
+    from model_texts import split_model, write_model
+
+    res = quasi_static_load_sharing(write_model(tmp_path, split_model(error_a="5 um")),
+                                    points_per_cycle=2)
+    vals = output_values(res)
+    met = res.metrics()
+    assert vals["load_sharing.static_torque"] == met.system
+    groups = met.groups
+    assert set(vals) == set(available_outputs(res.mesh_names, groups, "static"))
+    assert all(math.isfinite(v) for v in vals.values())
+
+
+def test_patterns_and_families():
+    names = available_outputs(["m1", "m2"], {"s": ["m1", "m2"]}, "run")
+    chosen, missing = select_outputs(["load_sharing.engineering.*", "nope.*"], names)
+    assert chosen == ["load_sharing.engineering.s", "load_sharing.engineering.m1",
+                      "load_sharing.engineering.m2"]
+    assert missing == ["nope.*"]
+    assert definitions_needed(chosen + ["peak_force.m1"]) == ["engineering"]
+    assert family("load_sharing.mean_force.O2/II") == ("load_sharing.mean_force", "O2/II")
+    assert family("dynamic_factor") == ("dynamic_factor", "system")

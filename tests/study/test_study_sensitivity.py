@@ -1,0 +1,92 @@
+"""Sensitivity: the estimators on functions with known indices, and a model where one
+factor dominates and one has no effect by construction."""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from study_helpers import CYCLES
+from torquesplit.study import run_study
+from torquesplit.study.dataset import ranking
+from torquesplit.study.design import Parameter
+from torquesplit.study.paths import Field
+from torquesplit.study.sensitivity import indices, sensitivity_design
+
+
+def _design(method, k, **kw):
+    spec = SimpleNamespace(method=method, seed=5, trajectories=kw.get("trajectories"),
+                           levels=kw.get("levels"), samples=kw.get("samples"))
+    factors = [(Parameter(f"x{i}", (Field(f"p{i}", None, False),), "set"), 0.0, 1.0, "linear")
+               for i in range(k)]
+    return sensitivity_design(spec, factors)
+
+
+def test_morris_on_a_linear_function_gives_its_coefficients():
+    d = _design("morris", 3, trajectories=12, levels=4)
+    x = d.values
+    y = 4.0 * x[:, 0] - 2.0 * x[:, 1] + 0.0 * x[:, 2]
+    res = indices(d, y)
+    np.testing.assert_allclose(res["mu_star"], [4.0, 2.0, 0.0], atol=1e-12)
+    np.testing.assert_allclose(res["mu"], [4.0, -2.0, 0.0], atol=1e-12)
+    np.testing.assert_allclose(res["sigma"], 0.0, atol=1e-12)
+    assert d.n_cases == 12 * 4
+    # every step changes exactly one factor by Delta = p / (2 (p - 1)) = 2/3
+    steps = np.diff(x.reshape(12, 4, 3), axis=1)
+    assert ((np.abs(steps) > 0).sum(axis=2) == 1).all()
+    np.testing.assert_allclose(np.abs(steps).sum(axis=2), 2 / 3)
+
+
+def test_sobol_indices_of_the_ishigami_function():
+    d = _design("sobol", 3, samples=2048)
+    x = -np.pi + 2 * np.pi * d.values  # Ishigami and Homma (1990), a = 7, b = 0.1
+    y = np.sin(x[:, 0]) + 7 * np.sin(x[:, 1]) ** 2 + 0.1 * x[:, 2] ** 4 * np.sin(x[:, 0])
+    res = indices(d, y)
+    np.testing.assert_allclose(res["S1"], [0.3139, 0.4424, 0.0], atol=0.04)
+    np.testing.assert_allclose(res["ST"], [0.5576, 0.4424, 0.2437], atol=0.04)
+    assert (res["ST_conf"] > 0).all() and (res["ST_conf"] < 0.1).all()
+
+
+def test_failed_cases_drop_their_trajectory():
+    d = _design("morris", 2, trajectories=5)
+    y = 3.0 * d.values[:, 0] + d.values[:, 1]
+    y[4] = np.nan  # a failed case in trajectory 1
+    res = indices(d, y)
+    assert int(res["trajectories_used"]) == 4
+    np.testing.assert_allclose(res["mu_star"], [3.0, 1.0], atol=1e-12)
+
+
+def _study(model, method, **kw):
+    factors = [
+        # no effect: the pinion's density only sets a mass it does not have (theta only)
+        {"path": "gears.pinion.density", "low": "7000 kg/m^3", "high": "8000 kg/m^3"},
+        # small effect: a second-stage stiffness (both paths change the static split a bit)
+        {"path": "meshes.b2.stiffness", "low": "3.5e8 N/m", "high": "4.5e8 N/m"},
+        # dominant: an error in one path
+        {"path": "meshes.a1.transmission_error.constant", "low": "0 um", "high": "10 um"},
+    ]
+    return {"study": {"name": "ranking", "model": str(model),
+                      "outputs": ["load_sharing.cycle_peak", "static_force.a1"]},
+            "analysis": {"cycles": CYCLES},
+            "sensitivity": {"method": method, "seed": 2, "parameters": factors, **kw}}
+
+
+@pytest.mark.parametrize("method,kw", [("morris", {"trajectories": 4}),
+                                       ("sobol", {"samples": 16})])
+def test_ranking_of_a_constructed_model(split_file, tmp_path, method, kw):
+    from torquesplit.study.figures import write_study_figures
+
+    ds = run_study(_study(split_file, method, **kw), workers=1)
+    files = write_study_figures(ds, tmp_path, formats=("png",))
+    assert {p.name for p in files} == {"tornado_load_sharing.cycle_peak.png",
+                                       "tornado_static_force.a1.png"}
+    for out in ("load_sharing.cycle_peak", "static_force.a1"):
+        order = [name for name, _ in ranking(ds, out)]
+        assert order == ["meshes.a1.transmission_error.constant", "meshes.b2.stiffness",
+                         "gears.pinion.density"], (out, ranking(ds, out))
+        key = ds.attrs["ranking"]
+        none = ds[key].sel(output=out, factor="gears.pinion.density").item()
+        assert none == 0.0
+    assert ds.sizes["sample"] == (4 * 4 if method == "morris" else 16 * 5)

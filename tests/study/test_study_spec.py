@@ -1,0 +1,106 @@
+"""Bad study files are refused with one line naming the field, before any case runs."""
+
+from __future__ import annotations
+
+import pytest
+import tomli_w
+from typer.testing import CliRunner
+
+from study_helpers import grid_study, mc_study
+from torquesplit.cli import app
+from torquesplit.errors import TorquesplitError
+from torquesplit.study import Study, StudyError
+
+K = {"path": "meshes.a1.stiffness", "start": "2e8 N/m", "stop": "6e8 N/m", "num": 3}
+
+
+def _bad_cases(model):
+    two = grid_study(model, [K])
+    two["monte_carlo"] = mc_study(model)["monte_carlo"]
+    negative = mc_study(model)
+    negative["monte_carlo"]["samples"] = -3
+    typo = grid_study(model, [K])
+    typo["study"]["outputz"] = ["x"]
+    return {
+        "unknown path": (grid_study(model, [dict(K, path="meshes.zz.stiffness")]),
+                         "grid.parameters.0.path", "'meshes.zz' does not exist"),
+        "unknown field": (grid_study(model, [dict(K, path="meshes.a1.stifness")]),
+                          "grid.parameters.0.path", "did you mean 'stiffness'"),
+        "wrong dimension": (grid_study(model, [dict(K, start="2e8 kg")]),
+                            "grid.parameters.0.start", "is not a stiffness"),
+        "wrong unit option": (grid_study(model, [dict(K, start=2, stop=6, unit="mm")]),
+                              "grid.parameters.0.unit", "not a unit of stiffness"),
+        "empty range": (grid_study(model, [dict(K, num=0)]), "grid.parameters.0.num",
+                        "the range is empty"),
+        "start equals stop": (grid_study(model, [dict(K, stop="2e8 N/m")]),
+                              "grid.parameters.0.stop", "the range is empty"),
+        "negative samples": (negative, "monte_carlo.samples", "must be at least 1"),
+        "two designs": (two, "monte_carlo", "one design"),
+        "unknown output": (grid_study(model, [K], outputs=["load_sharing.engneering.*"]),
+                           "study.outputs", "matches no output"),
+        "unknown key": (typo, "study.outputz", "unknown field"),
+        "four axes": (grid_study(model, [dict(K, path=f"meshes.{m}.stiffness")
+                                         for m in ("a1", "b1", "a2", "b2")]),
+                      "grid.parameters", "at most 3"),
+        "plain number with unit": (grid_study(model, [{"path": "meshes.a1.damping_ratio",
+                                                       "values": ["5 %"]}]),
+                                   "grid.parameters.0.values.0", "plain number"),
+        "invalid first case": (grid_study(model, [{"path": "meshes.a1.damping_ratio",
+                                                   "values": [-0.1, 0.1]}]),
+                               "grid.parameters", "case 0"),
+    }
+
+
+@pytest.mark.parametrize("case", list(_bad_cases("m.toml")))
+def test_bad_study_refused_with_one_line(case, split_file):
+    data, field, words = _bad_cases(split_file)[case]
+    with pytest.raises(StudyError) as info:
+        Study(data).plan()
+    msg = str(info.value)
+    assert "\n" not in msg
+    assert f"{field}:" in msg, msg
+    assert words in msg, msg
+    assert isinstance(info.value, (TorquesplitError, ValueError))
+
+
+def test_cli_refuses_bad_file_before_any_case(tmp_path, split_file):
+    data = grid_study(split_file, [dict(K, start="2e8 kg")])
+    path = tmp_path / "bad.toml"
+    path.write_text(tomli_w.dumps(data))
+    out = tmp_path / "out"
+    res = CliRunner().invoke(app, ["study", str(path), "--out", str(out), "--quiet"])
+    assert res.exit_code == 2
+    lines = [line for line in res.output.splitlines() if line.strip()]
+    assert len(lines) == 1 and "grid.parameters.0.start" in lines[0] and "bad.toml" in lines[0]
+    assert not (out / "study.sqlite").exists()
+
+
+def test_toml_syntax_error_names_the_file(tmp_path):
+    path = tmp_path / "broken.toml"
+    path.write_text("[study\nname = 1\n")
+    with pytest.raises(StudyError, match="broken.toml: TOML syntax error"):
+        Study(path)
+
+
+def test_model_path_relative_to_study_file(tmp_path, split_file):
+    data = grid_study("split.toml", [K])
+    path = tmp_path / "s.toml"
+    path.write_text(tomli_w.dumps(data))
+    study = Study(path)
+    assert study.n_cases == 3
+    assert study.outputs[0] == "load_sharing.cycle_peak"
+
+
+def test_table_field_must_be_addressed_inside(tmp_path):
+    from study_helpers import model_file
+
+    model = model_file(tmp_path / "", extra="")
+    text = model.read_text().replace(
+        '[meshes.a1]\ngears = ["pinion", "a"]\nstiffness = "4e8 N/m"',
+        '[meshes.a1]\ngears = ["pinion", "a"]\nstiffness = {method = "constant", '
+        'value = "4e8 N/m", peak_to_peak = 0.1}')
+    model.write_text(text)
+    with pytest.raises(StudyError, match="a table in the model.*meshes.a1.stiffness.value"):
+        Study(grid_study(model, [K])).plan()
+    ok = Study(grid_study(model, [dict(K, path="meshes.a1.stiffness.value")]))
+    assert ok.n_cases == 3
