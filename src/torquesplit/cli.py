@@ -759,11 +759,12 @@ def contact(
         cm, op_load, names, reverse = contact_model_for_mesh(m, kin, pair, options=opts)
         loads = [_contact_load(text, m, kin, pair, names, on, cm, parse_quantity)
                  for text in (load or [])] or [op_load]
-        results = [cm.solve(f).require_converged(f"meshes.{pair}") for f in loads]
-        top = max(loads)
         import numpy as np
 
-        hm = cm.harris_map(np.linspace(0.1, 1.5, harris) * top) if harris > 0 else None
+        with ux.progress("loaded tooth contact analysis", as_json, total=None):
+            results = [cm.solve(f).require_converged(f"meshes.{pair}") for f in loads]
+            top = max(loads)
+            hm = cm.harris_map(np.linspace(0.1, 1.5, harris) * top) if harris > 0 else None
         op = max(results, key=lambda r: r.load)
         impact = None
         if not cm.pair.is_internal and not reverse:

@@ -359,7 +359,11 @@ def plausibility_warnings(model: Model, kin) -> list[tuple[str, str]]:
             out.append((f"meshes.{name}.stiffness",
                         f"{spec.value:.3g} N/m is {spec.value / iso:.2g} times the ISO 6336 "
                         f"estimate c_gamma*b = {iso:.3g} N/m; check the value and its unit"))
-    return out + magnitude_warnings(model, kin) + tolerance_warnings(model, kin)
+    rigid = [(loc, msg.replace("a shaft joins bodies on one axis", "a rigid join locks "
+                               "their rotations but not the motion of one about the other's "
+                               "centre"))
+             for loc, msg in shaft_axis_issues(model, kin, rigid=True)]
+    return out + rigid + magnitude_warnings(model, kin) + tolerance_warnings(model, kin)
 
 
 #: a shaft's two bodies may be this far off their common axis [m] (plus SHAFT_AXIS_RELATIVE
@@ -369,12 +373,18 @@ SHAFT_AXIS_RELATIVE = 1e-3
 SHAFT_AXIS_ANGLE = 1e-3
 
 
-def shaft_axis_issues(model: Model, kin) -> list[tuple[str, str]]:
-    """A shaft transmits torque about one axis: the bodies it joins must turn about
-    parallel axes and sit on that common axis.  A body whose position the file leaves
-    out (a motor or a load inertia) is taken to be on the axis."""
+def shaft_axis_issues(model: Model, kin, *, rigid: bool = False) -> list[tuple[str, str]]:
+    """An elastic shaft transmits torque about one axis: the bodies it joins must turn
+    about parallel axes and sit on that common axis.  A body whose position the file
+    leaves out (a motor or a load inertia) is taken to be on the axis.
+
+    ``rigid=True`` checks the rigid joins instead (``rigid = true``: the bodies turn as
+    one, as a gear bolted to a carrier may), which :func:`plausibility_warnings` reports
+    as warnings."""
     issues = []
     for name, s in model.shafts.items():
+        if bool(s.rigid) != rigid:
+            continue
         a, b = s.connects
         if a not in kin.bodies or b not in kin.bodies:
             continue

@@ -85,9 +85,12 @@ def register(app, load, fail, console, err_console, json_default):
 
             _check_out(out)
             m, _ = load(model)
-            st = steady_state(m, method=method, harmonics=harmonics, adaptive=adaptive,
-                              keep=_keep(keep), speed=_speed(speed, "speed"),
-                              max_cycles=max_cycles)
+            from torquesplit.cli_support import progress
+
+            with progress("periodic steady state", as_json, total=None):
+                st = steady_state(m, method=method, harmonics=harmonics, adaptive=adaptive,
+                                  keep=_keep(keep), speed=_speed(speed, "--speed"),
+                                  max_cycles=max_cycles)
             rows = st.mesh_table()
             saved = st.to_results().save(out) if out is not None else None
         except (TorquesplitError, ValueError, OSError) as exc:
@@ -170,9 +173,13 @@ def register(app, load, fail, console, err_console, json_default):
             if plot is not None:
                 _check_out(plot, {".png": "png", ".svg": "svg", ".pdf": "pdf"})
             m, _ = load(model)
-            ds = sweep_speed(m, _speed(start, "--from"), _speed(stop, "--to"), points=points,
-                             harmonics=harmonics, keep=_keep(keep), max_cycles=max_cycles,
-                             stability=not no_stability, cross_check=cross_check)
+            from torquesplit.cli_support import progress
+
+            with progress("speed sweep", as_json, total=None):
+                ds = sweep_speed(m, _speed(start, "--from"), _speed(stop, "--to"),
+                                 points=points, harmonics=harmonics, keep=_keep(keep),
+                                 max_cycles=max_cycles, stability=not no_stability,
+                                 cross_check=cross_check)
         except (TorquesplitError, ValueError, OSError) as exc:
             fail(exc)
             return
