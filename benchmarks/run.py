@@ -36,7 +36,7 @@ TARGETS = {
     "hand_ratio": 1.2,  # engine / hand transcription of seed 001, CPU time per step
     "hand_ratio_general": 1.5,  # the same with rhs="general"
 }
-SEED001 = "ji_li_mill_drive"
+SEED001 = "seed001_mill_drive"
 
 
 def _log(msg: str) -> None:

@@ -19,8 +19,8 @@ Examples
 >>> fig.axes[0].get_ylabel()
 'mesh force [kN]'
 >>> paths = figures.write_figures(res, tempfile.mkdtemp(), formats=("png",))
->>> sorted(p.name for p in paths)[:2]
-['cycle_peak_force.png', 'load_sharing_engineering.png']
+>>> sorted(p.name for p in paths)[:3]
+['cycle_peak_force.png', 'dynamic_factors.png', 'load_sharing_engineering.png']
 """
 
 from __future__ import annotations
