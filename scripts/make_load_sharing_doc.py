@@ -26,7 +26,7 @@ DOC = ROOT / "docs" / "load-sharing.md"
 #: examples run for the table (small ones: the script runs in about a minute)
 EXAMPLES = ("ji_li_mill_drive", "dong2021_face_gear")
 
-HEAD = f"""\
+HEAD = """\
 # Load sharing: which number to report
 
 A power-split gearbox divides its torque between parallel paths; the load-sharing

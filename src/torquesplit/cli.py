@@ -12,7 +12,6 @@ save.
 from __future__ import annotations
 
 import contextlib
-import json
 import math
 import os
 import sys

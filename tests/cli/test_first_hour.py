@@ -409,8 +409,8 @@ def test_a_long_run_is_announced_before_it_starts(tmp_path, monkeypatch):
 
     monkeypatch.setattr(integrate, "integrate", interrupted)
     model = write_model(tmp_path, SPUR_PAIR)
-    res = runner.invoke(app, ["run", str(model), "--duration", "1 h", "--max-steps", "1e10"
-                              .replace("1e10", "10000000000")])
+    res = runner.invoke(app, ["run", str(model), "--duration", "1 h", "--max-steps",
+                              "10000000000"])
     assert res.exit_code == 130
     said = " ".join(warnings_of(res))
     assert re.search(r"this run takes [\d,]+ RK4 steps", said)
@@ -418,7 +418,7 @@ def test_a_long_run_is_announced_before_it_starts(tmp_path, monkeypatch):
 
 
 def test_figures_say_what_they_are_doing():
-    import dataclasses  # noqa: F401  (keeps the figure helpers' import cost in one test)
+    import tempfile
 
     from torquesplit.plot.figures import write_jobs
 
@@ -427,8 +427,6 @@ def test_figures_say_what_they_are_doing():
 
     def job(name):
         return name, lambda: made.append(name) or _tiny_figure()
-
-    import tempfile
 
     write_jobs([job("a"), job("b")], tempfile.mkdtemp(), ("svg",),
                progress=lambda i, n, what: seen.append((i, n, what)))

@@ -79,6 +79,13 @@ def back_flank(results, metrics) -> list[tuple[str, str]]:
             when = " (in the start-up transient only: the settled part has none)"
         else:
             when = ""
+        if largest <= 0:  # deflection reversed, force still compressive (damping)
+            out.append((f"meshes.{r.mesh}", (
+                f"the mesh deflection is reversed {_pct(r.back_contact)} of the time{when}, "
+                f"the force staying compressive only through the damping: a real pair "
+                f"{'with backlash ' if r.double_flank else ''}would be about to lose contact "
+                f"there; check meshes.{r.mesh}.backlash and the excitation")))
+            continue
         if r.double_flank:
             out.append((f"meshes.{r.mesh}", (
                 f"double-flank contact {_pct(r.back_contact)} of the time, back-flank force "
