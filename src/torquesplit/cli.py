@@ -922,8 +922,19 @@ def optimize(
 @app.command()
 def modes(
     model: str = typer.Argument(..., help=_MODEL_HELP, metavar="MODEL"),
-    count: int = typer.Option(20, "--count", help="Number of modes to list.", metavar="N"),
-    as_json: bool = _flag("--json", "Print the modes as JSON."),
+    count: Optional[int] = typer.Option(None, "--count", help="List at most this many modes "
+                                        "(default: all; a degenerate group is kept whole).",
+                                        metavar="N"),
+    below: Optional[str] = typer.Option(None, "--below", help="List the modes below this "
+                                        "frequency, e.g. '5 kHz' (a bare number is Hz).",
+                                        metavar="FREQUENCY"),
+    rotating_frame: bool = typer.Option(True, "--rotating-frame/--no-rotating-frame",
+                                        help="Include the Coriolis and centripetal terms of "
+                                        "a turning carrier (off: stationary carrier)."),
+    as_json: bool = _flag("--json", "Print the modes, with their shapes, as JSON."),
+    out: Optional[Path] = typer.Option(None, "--out", help="Write the modes and shapes to "
+                                       "this NetCDF file.", metavar="FILE"),
+    force: bool = _flag("--force", "Replace an existing output file."),
     campbell: bool = _flag("--campbell", "Resonance map over --from..--to."),
     start: Optional[str] = typer.Option(None, "--from", help="Campbell: first speed, e.g. "
                                         "'500 rpm' (a bare number is rad/s).", metavar="SPEED"),
@@ -931,52 +942,70 @@ def modes(
                                        metavar="SPEED"),
     plot: Optional[Path] = typer.Option(None, "--plot", help="Campbell: write the diagram "
                                         "(.png, .svg or .pdf).", metavar="FILE"),
-    assign: Optional[list[str]] = typer.Option(None, "--set", help=_SET_HELP,
-                                               metavar="PATH=VALUE"),
     quiet: bool = _flag("--quiet", "No progress display."),
 ):
-    """Natural frequencies about the static equilibrium, with the elements that carry their
-    strain energy (a run near one of them shows a large dynamic factor)."""
-    with ux.interruptible():
-        try:
-            _at_least(count, 1, "--count", "20")
-            _check_figure_file(plot, "--plot")
-            m, _ = _load(model, assign)
-            if campbell:
-                if start is None or stop is None:
-                    raise OptionError("--campbell needs a speed range: add --from '500 rpm' "
-                                      "--to '3000 rpm'")
-                from .steady.cli import campbell_command
+    """Natural modes about the static equilibrium: every mode (or those asked for), its
+    multiplicity, type (rotational, translational, planet for a planetary stage) and the
+    strain-energy shares of its group."""
+    from .results import files
 
-                return campbell_command(m, start, stop, plot, as_json, console, _json_default)
-            from .assembly.assemble import assemble
-            from .model.kinematics import solve_kinematics
-            from .solve.modal import modal_analysis
-            from .solve.static import static_equilibrium
+    try:
+        _at_least(count, 1, "--count", "20")
+        _check_figure_file(plot, "--plot")
+        limit = ux.quantity(below, "frequency", "--below")
+        _positive(limit, "--below", "'5 kHz'")
+        if out is not None:
+            files.check_output(out, formats=files.NETCDF_FORMATS, overwrite=force)
+        m, _ = _load(model)
+        if campbell:
+            if start is None or stop is None:
+                raise TorquesplitError("--campbell needs a speed range: add --from '500 rpm' "
+                                       "--to '3000 rpm'")
+            from .steady.cli import campbell_command
 
-            with ux.progress("natural modes", quiet or as_json, total=None):
-                kin = solve_kinematics(m)
-                st = assemble(m, kin)
-                sol = modal_analysis(st, static_equilibrium(st).q)
-        except _EXPECTED as exc:
-            _fail(exc)
-            return
-    mesh_f = {n: mk.frequency for n, mk in kin.meshes.items()}
-    rows = [{"mode": i + 1, "frequency_Hz": float(sol.frequencies[i]),
-             "dominant": sol.dominant_elements(i, 3)} for i in range(min(count, sol.n_modes))]
-    if as_json:
-        ux.emit_json({"rigid_body_modes": int(sol.rigid_modes.shape[1]), "modes": rows,
-                      "mesh_frequencies_Hz": mesh_f}, _json_default)
+            return campbell_command(m, start, stop, plot, as_json, console, _json_default)
+        plan = None
+        if out is not None:
+            plan = files.check_output(out, formats=files.NETCDF_FORMATS, overwrite=force)
+        from .model.kinematics import solve_kinematics
+        from .modes import model_modes
+
+        with ux.interruptible(), ux.progress("natural modes", quiet or as_json, total=None):
+            kin = solve_kinematics(m)
+            rep = model_modes(m, rotating_frame=rotating_frame, below=limit, count=count)
+        saved = None
+        if plan is not None:
+            with files.claim_output(plan) as claim:
+                ds = rep.to_dataset()
+                ds.attrs.update(files.provenance(claim.run_id))
+                ds.attrs["model"] = m.model.name
+                claim.write({plan.path: files.netcdf_bytes(ds)})
+            saved = plan.path
+    except _EXPECTED as exc:
+        _fail(exc)
         return
-    console.print(f"{sol.rigid_modes.shape[1]} rigid-body mode(s) left out; mesh frequencies: "
+    mesh_f = {n: mk.frequency for n, mk in kin.meshes.items()}
+    if as_json:
+        data = rep.to_dict(shapes=True)
+        data.update(mesh_frequencies_Hz=mesh_f, results_file=str(saved) if saved else None)
+        ux.emit_json(data, _json_default)
+        return
+    frame = (" (turning carrier frame)" if rep.rotating_frame else "")
+    console.print(f"{rep.rigid_modes} rigid-body mode(s) left out{frame}; mesh frequencies: "
                   + ", ".join(f"{k} {v:.5g} Hz" for k, v in mesh_f.items()), highlight=False)
+    typed = any(r.type for r in rep.rows)
     t = Table(title="natural modes")
-    for col in ("mode", "f [Hz]", "strain energy (largest shares)"):
+    cols = ["mode", "f [Hz]", "mult."] + (["type"] if typed else []) + \
+        ["strain energy of the group (largest shares)"]
+    for col in cols:
         t.add_column(_h(col))
-    for r in rows:
-        t.add_row(str(r["mode"]), f"{r['frequency_Hz']:.6g}",
-                  ", ".join(f"{n} {100 * v:.0f} %" for n, v in r["dominant"]))
+    for r in rep.rows:
+        energy = ", ".join(f"{n} {100 * v:.0f} %" for n, v in list(r.strain_energy.items())[:3])
+        t.add_row(str(r.mode), f"{r.frequency:.6g}", str(r.multiplicity),
+                  *([r.type or ""] if typed else []), energy)
     console.print(t)
+    if saved:
+        console.print(f"modes written to {saved}")
 
 
 # --------------------------------------------------------------------------- examples
