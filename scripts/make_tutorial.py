@@ -324,7 +324,8 @@ def _numbers(work: Path) -> dict[str, str]:
     meshes = set(met["meshes"])
     f_split = modes["mesh_frequencies_Hz"]["in1"]
     mesh_modes = [m["frequency_Hz"] for m in modes["modes"]
-                  if m["dominant"] and m["dominant"][0][0] in meshes]
+                  if m["strain_energy"] and max(m["strain_energy"],
+                                                key=m["strain_energy"].get) in meshes]
     import torquesplit
     from torquesplit.assembly.excitation import stiffness_table
     from torquesplit.model.kinematics import solve_kinematics

@@ -264,24 +264,28 @@ def _figures(res, definition: str) -> str:
 
 
 def _modes(res) -> str:
-    from ..solve.modal import modal_analysis
+    from ..modes import model_modes
 
     try:
-        sol = modal_analysis(res.structure, res.static.q)
+        rep = model_modes(res.model, count=MODES_LISTED)
     except Exception as exc:  # noqa: BLE001 - the report goes on without its modes
         return f'<p class="note">Natural modes not computed: {_e(exc)}</p>'
     mesh_f = {n: mk.frequency for n, mk in res.kinematics.meshes.items()}
+    typed = any(r.type for r in rep.rows)
     rows = []
-    for i in range(min(MODES_LISTED, sol.n_modes)):
-        f = float(sol.frequencies[i])
+    for r in rep.rows:
+        f = float(r.frequency)
         near = [f"{k}×{name}" for name, fm in mesh_f.items() for k in (1, 2, 3)
                 if abs(f - k * fm) <= NEAR_FRACTION * k * fm]
-        rows.append([str(i + 1), _g(f, 6),
-                     ", ".join(f"{n} {100 * v:.0f} %" for n, v in sol.dominant_elements(i, 3)),
-                     ", ".join(sorted(set(near))) or "-"])
-    return (_table(["mode", "f [Hz]", "strain energy (largest shares)",
-                    f"within {NEAR_FRACTION:.0%} of a mesh order"], rows, left=1)
-            + f'<p class="note">{sol.rigid_modes.shape[1]} rigid-body mode(s) left out. Mesh '
+        energy = ", ".join(f"{n} {100 * v:.0f} %" for n, v in list(r.strain_energy.items())[:3])
+        rows.append([str(r.mode), _g(f, 6), str(r.multiplicity)]
+                    + ([r.type or ""] if typed else [])
+                    + [energy, ", ".join(sorted(set(near))) or "-"])
+    header = (["mode", "f [Hz]", "mult."] + (["type"] if typed else [])
+              + ["strain energy of the group (largest shares)",
+                 f"within {NEAR_FRACTION:.0%} of a mesh order"])
+    return (_table(header, rows, left=1)
+            + f'<p class="note">{rep.rigid_modes} rigid-body mode(s) left out. Mesh '
               "frequencies: " + _e(", ".join(f"{k} {v:.5g} Hz" for k, v in mesh_f.items()))
             + ".</p>")
 
