@@ -930,7 +930,8 @@ def modes(
                                         metavar="FREQUENCY"),
     rotating_frame: bool = typer.Option(True, "--rotating-frame/--no-rotating-frame",
                                         help="Include the Coriolis and centripetal terms of "
-                                        "a turning carrier (off: stationary carrier)."),
+                                        "a turning carrier (off: stationary carrier).",
+                                        metavar=""),
     as_json: bool = _flag("--json", "Print the modes, with their shapes, as JSON."),
     out: Optional[Path] = typer.Option(None, "--out", help="Write the modes and shapes to "
                                        "this NetCDF file.", metavar="FILE"),

@@ -1,4 +1,4 @@
-"""The shipped example gearboxes as model files (package data), one per paper.
+"""The shipped example gearboxes as model files (package data), most from one paper each.
 
 =================================  =====================================================
 name                               system (paper)
@@ -15,6 +15,11 @@ name                               system (paper)
                                    tooth friction (Jin, Yang, Lu & Zhu 2019)
 ``liu2021_split_torque_helicopter``  two-input two-path split-torque helicopter reducer,
                                    49 DOF (Liu, Fang, Jia et al. 2021)
+``lin_parker1999_planetary``       planetary stage, ring fixed, 4 planets: the modal
+                                   benchmark of Lin & Parker 1999
+``lin_parker1999_star``            the same gears as a star stage (carrier held)
+``split_path_planetary_``          two-path split drive recombining in a planetary
+``differential``                   differential (sun and ring driven, carrier output)
 =================================  =====================================================
 
 ``optimize/liu2021_dh_modification`` is an optimisation file (``torquesplit optimize``).

@@ -210,10 +210,20 @@ def layout_figure(model, kin=None, *, width: float = 10.0) -> Figure:
                                                         ("bodies", model.bodies))
                  for name, body in items.items()
                  if body.support is not None and any(d != "theta" for d in body.dofs)]
+    grounded = [name for _, name, body in supported if not getattr(body.support, "on", None)]
     texts = {name: _support_text(body.support) for _, name, body in supported}
-    same = len(set(texts.values())) == 1 and len(texts) > 3
+    same = len({texts[n] for n in grounded}) == 1 and len(grounded) > 3
     for kind, name, body in supported:
         c = proj(centre[name])
+        seat = getattr(body.support, "on", None)
+        if seat and seat in centre:  # a bearing on another body (a planet on its pin)
+            s = proj(centre[seat])
+            ax.plot([c[0], s[0]], [c[1], s[1]], color=COLORS["support"], lw=0.9, ls=":",
+                    zorder=1)
+            ax.annotate(f"bearing on {seat}", c, xytext=(-10, -14), textcoords="offset points",
+                        fontsize=fs - 1.0, color=COLORS["support"], zorder=6,
+                        gid=f"support:{name}")
+            continue
         drop = 0.18 * size * 1e3 + (radius.get(name, 0.0) * 1e3 if kind == "gears" else 0)
         g0 = c - np.array([0.0, drop])
         ax.plot([c[0], g0[0]], [c[1], g0[1]], color=COLORS["support"], lw=1.0, zorder=1)
@@ -257,7 +267,7 @@ def layout_figure(model, kin=None, *, width: float = 10.0) -> Figure:
         ax.plot([], [], color=COLORS["spline"], lw=2, ls="--", label="spline")
     if supported:
         ax.plot([], [], color=COLORS["support"], lw=1.6,
-                label="support to the housing" + (f": {next(iter(texts.values()))} each"
+                label="support to the housing" + (f": {texts[grounded[0]]} each"
                                                   if same else ""))
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=fs, frameon=False)
     ax.set_title(f"{model.model.name}: layout, {len(model.gears)} gears, "
