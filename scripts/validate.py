@@ -86,11 +86,11 @@ def _provenance() -> dict:
 def seed000(quick: bool) -> dict:
     """Per-cycle peak LSC and DLF of the left path, with and without meshing-in impact."""
     cycles = 200 if quick else None  # None: the example's [analysis] (2000 third-stage cycles)
-    names = [m for m in read_raw(torquesplit.example_path("seed000_split_torque"))["meshes"]]
+    names = [m for m in read_raw(torquesplit.example_path("liu2021_split_torque_helicopter"))["meshes"]]
     results = {}
     for label, impact in (("no_impact", False), ("impact", True)):
         over = {f"meshes.{m}.impact": impact for m in names if not m.endswith("12")}
-        results[label] = _run(_model("seed000_split_torque", over), cycles=cycles)
+        results[label] = _run(_model("liu2021_split_torque_helicopter", over), cycles=cycles)
     return results
 
 
@@ -102,25 +102,25 @@ def seed001(quick: bool) -> dict:
         for g in ("z2", "z3", "z4", "z5"):
             over[f"gears.{g}.support.shaft.diameter"] = d
         kwargs = {"duration": 3.0} if quick else {}
-        out[d] = _run(_model("seed001_mill_drive", over), **kwargs)
+        out[d] = _run(_model("ji_li_mill_drive", over), **kwargs)
     return out
 
 
 def seed002(quick: bool) -> dict:
     """Omega_I, Omega_II and every Omega_ij (mean-force definition, seed 002 eq. 12)."""
-    return {"baseline": _run(_model("seed002_face_gear"), cycles=100 if quick else None)}
+    return {"baseline": _run(_model("dong2021_face_gear"), cycles=100 if quick else None)}
 
 
 def seed003(quick: bool) -> dict:
     """Mesh forces with tooth friction for RMS roughness 0.3, 0.6 and 0.9 um."""
-    data = read_raw(torquesplit.example_path("seed003_friction_split"))
+    data = read_raw(torquesplit.example_path("jin2019_friction_split"))
     from torquesplit.assembly.excitation import friction_table
 
     out = {}
     for s in ("0.3 um", "0.6 um", "0.9 um"):
         over = {f"meshes.{m}.friction": {"roughness": s}
                 for m, v in data["meshes"].items() if v.get("friction")}
-        model = _model("seed003_friction_split", over)
+        model = _model("jin2019_friction_split", over)
         out[s] = _run(model, cycles=100 if quick else None)
         # friction force over one mesh cycle at the nominal load (the tables the
         # dynamic model uses), a spur split mesh and a herringbone mesh of the right path
@@ -133,7 +133,7 @@ def seed003(quick: bool) -> dict:
 
 def seed004(quick: bool) -> dict:
     """Quasi-static star load-sharing coefficients and the suns' floating orbits."""
-    res = quasi_static_load_sharing(_model("seed004_star_reducer"),
+    res = quasi_static_load_sharing(_model("mo2017_star_reducer"),
                                     points_per_cycle=2 if quick else 8)
     met = res.metrics()
     orbits = {b: {"x_um": [1e6 * float(o[:, 0].min()), 1e6 * float(o[:, 0].max())],
@@ -152,8 +152,8 @@ def kinematics(quick: bool) -> dict:
     def kin(name):
         return torquesplit.solve_kinematics(_model(name))
 
-    k0, k1, k2, k4 = (kin(n) for n in ("seed000_split_torque", "seed001_mill_drive",
-                                       "seed002_face_gear", "seed004_star_reducer"))
+    k0, k1, k2, k4 = (kin(n) for n in ("liu2021_split_torque_helicopter", "ji_li_mill_drive",
+                                       "dong2021_face_gear", "mo2017_star_reducer"))
     return {
         "seed000": {"contact_ratio_dh": k0.meshes["L78"].total_contact_ratio,
                     "speed_spur_pinion_rpm": abs(k0.bodies["L3"].speed) / rpm,

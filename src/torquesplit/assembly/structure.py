@@ -1,6 +1,6 @@
 """The assembled equations of motion as flat arrays for the compiled kernels.
 
-Every layout reduces to the same form (DESIGN.md §4)::
+Every layout reduces to the same form (docs/theory/model.md)::
 
     M q'' = F_ext - C_g q' - G q' - K_f q - sum_e V_e f_e
     delta_e  = V_e . q  - e_e(t)            deformation of element e
@@ -14,14 +14,14 @@ force ``p_e(t)`` (meshing-in impact).  Damping acts only while the element is in
 
 Two optional extensions, both empty (and free) when a model does not use them:
 
-* **Tooth friction** of a mesh element e (seed 003): a second, phase-dependent
+* **Tooth friction** of a mesh element e (Jin et al. 2019): a second, phase-dependent
   projection ``W_e(s)`` used only to apply forces.  The generalized force of the mesh
   becomes ``-V_e f_e - W_e(s) max(f_e, 0)``; the deformation still uses ``V_e`` only.
   ``W_e`` is stored sparsely (``fr_*``): entry i contributes
   ``fr_coef[i] * friction_table[fr_row[i], s]`` on DOF ``fr_dof[i]``, the table rows
   being the friction force and the two friction moments per unit normal load over one
   mesh cycle (see :mod:`torquesplit.assembly.excitation`).
-* **Spline radial elements** (seed 002 eq. 6): a 2-D radial law between a floating
+* **Spline radial elements** (Dong et al. 2021 eq. 6): a 2-D radial law between a floating
   member and its hub.  It is stored as two ordinary elements (kind SPLINE) whose
   projection rows give the relative displacement components ``d = (dx, dy)`` (hub
   minus floating member); ``sp_el`` pairs them and ``sp_par`` holds the law.  With

@@ -15,10 +15,10 @@ law's own compiled code, :func:`torquesplit.solve.laws.spring_force_c` (numba co
 linked into each generated module and inlined), so the generated code and
 ``rhs_slot`` run the same instructions for the law, and the same sums in the same order
 around it (no fused multiply-adds, no reassociation): results are bit for bit the same
-(tested).  A whole RK4 step is about twice as fast with it (seed 001: 0.78 against
+(tested).  A whole RK4 step is about twice as fast with it (Ji & Li: 0.78 against
 1.51 µs in the same benchmark run, benchmarks/RESULTS.md), and within 1.0-1.2 times of a
 transcription generated from the assembled structure (benchmarks/bench_specialised.py:
-checks kernel overhead, not assembly; the seed 001 equations written by hand are timed
+checks kernel overhead, not assembly; the Ji & Li equations written by hand are timed
 in benchmarks/bench_transcription.py).  The kernels pass it data addresses taken once per call: ``array.ctypes``
 at every call would cost an atomic reference-count increment and decrement per array,
 more than the arithmetic.  What it computes, for one excitation slot::
@@ -392,7 +392,7 @@ def _noop(y, dy, force, defl, K, G, E, ED, P, par, off):  # noqa: N803 - kernel 
 
 
 # Cost model of "auto" (measured on the 2-core development machine, benchmarks/RESULTS.md):
-# compiling L lines of IR takes about 4e-5 L + 5e-9 L^2 s (0.05 s for seed 001's 974 lines,
+# compiling L lines of IR takes about 4e-5 L + 5e-9 L^2 s (0.05 s for Ji & Li's 974 lines,
 # 7 s for a 392-DOF model's 35 000), about 30 lines per non-zero of V; each right-hand-side
 # call saves about 5 ns per non-zero against the general kernel.
 _COMPILE_S_PER_LINE = 4e-5

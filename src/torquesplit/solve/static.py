@@ -5,7 +5,7 @@ laws (damping plays no part):
 
 * ordinary elements: ``f_e = k_e h(V_e.q - e_e; g_e) + p_e``, h the dead zone of
   half-width g (backlash, support clearance);
-* spline radial elements (seed 002 eq. 6): radial force F(R) along d/R with
+* spline radial elements (Dong et al. 2021 eq. 6): radial force F(R) along d/R with
   ``F = k R`` (R < S1), ``0`` (S1 <= R <= S2: floating; friction is zero at rest),
   ``k (R - S2)`` (R > S2), i.e. a radial dead zone;
 * tooth friction: the projection W_e of the mean friction-table values (``t=None``) or
@@ -574,13 +574,15 @@ def quasi_static(
     regularisation: float = 1e-9,
     balance_tolerance: float = 1e-8,
     max_iterations: int = 200,
+    progress=None,
 ) -> QuasiStaticSolution:
     """Static equilibrium at each time of ``times`` (mesh positions), e.g. for load
     sharing without dynamics.
 
     The projection matrix, rigid-body modes and their constraint are built once; each
     time starts its Newton iteration from the previous time's displacements, so a
-    smooth sweep usually needs one or two linear solves per time.
+    smooth sweep usually needs one or two linear solves per time.  ``progress``, if
+    given, is called with the fraction of times done (about a hundred times).
     """
     times = np.atleast_1d(np.asarray(times, dtype=float))
     problem = _StaticProblem(structure, regularisation, balance_tolerance)
@@ -592,7 +594,10 @@ def quasi_static(
     conv = np.zeros(nt, dtype=bool)
     its = np.zeros(nt, dtype=np.int64)
     q = None
+    every = max(1, nt // 100)
     for i, t in enumerate(times):
+        if progress is not None and i % every == 0:
+            progress(i / nt)
         r = problem.solve(t, q, max_iterations)
         q = r["q"] if r["converged"] else None
         Q[i], F[i], D[i], C[i] = r["q"], r["forces"], r["delta"], r["contact"]
