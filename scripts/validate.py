@@ -1,7 +1,7 @@
 """Run each paper's study on its example model and collect the numbers the paper
 reports, for docs/validation.md.
 
-    python scripts/validate.py [seed000 seed001 ...] [--quick]
+    python scripts/validate.py [liu2021 ji_li ...] [--quick]
     python scripts/render_docs.py      # then docs/validation.md from the numbers
 
 Writes docs/validation_results.json (one entry per paper, with the commit and the
@@ -83,7 +83,7 @@ def _provenance() -> dict:
             "machine": platform.machine(), "cpu_count": __import__("os").cpu_count()}
 
 
-def seed000(quick: bool) -> dict:
+def liu2021(quick: bool) -> dict:
     """Per-cycle peak LSC and DLF of the left path, with and without meshing-in impact."""
     cycles = 200 if quick else None  # None: the example's [analysis] (2000 third-stage cycles)
     names = [m for m in read_raw(torquesplit.example_path("liu2021_split_torque_helicopter"))["meshes"]]
@@ -94,7 +94,7 @@ def seed000(quick: bool) -> dict:
     return results
 
 
-def seed001(quick: bool) -> dict:
+def ji_li(quick: bool) -> dict:
     """g1t, g2t, G1t, G2t at drive-shaft diameters 200, 250 and 300 mm."""
     out = {}
     for d in ("200 mm", "250 mm", "300 mm"):
@@ -106,12 +106,12 @@ def seed001(quick: bool) -> dict:
     return out
 
 
-def seed002(quick: bool) -> dict:
-    """Omega_I, Omega_II and every Omega_ij (mean-force definition, seed 002 eq. 12)."""
+def dong2021(quick: bool) -> dict:
+    """Omega_I, Omega_II and every Omega_ij (mean-force definition, Dong et al. 2021 eq. 12)."""
     return {"baseline": _run(_model("dong2021_face_gear"), cycles=100 if quick else None)}
 
 
-def seed003(quick: bool) -> dict:
+def jin2019(quick: bool) -> dict:
     """Mesh forces with tooth friction for RMS roughness 0.3, 0.6 and 0.9 um."""
     data = read_raw(torquesplit.example_path("jin2019_friction_split"))
     from torquesplit.assembly.excitation import friction_table
@@ -131,7 +131,7 @@ def seed003(quick: bool) -> dict:
     return out
 
 
-def seed004(quick: bool) -> dict:
+def mo2017(quick: bool) -> dict:
     """Quasi-static star load-sharing coefficients and the suns' floating orbits."""
     res = quasi_static_load_sharing(_model("mo2017_star_reducer"),
                                     points_per_cycle=2 if quick else 8)
@@ -155,33 +155,33 @@ def kinematics(quick: bool) -> dict:
     k0, k1, k2, k4 = (kin(n) for n in ("liu2021_split_torque_helicopter", "ji_li_mill_drive",
                                        "dong2021_face_gear", "mo2017_star_reducer"))
     return {
-        "seed000": {"contact_ratio_dh": k0.meshes["L78"].total_contact_ratio,
+        "liu2021": {"contact_ratio_dh": k0.meshes["L78"].total_contact_ratio,
                     "speed_spur_pinion_rpm": abs(k0.bodies["L3"].speed) / rpm,
                     "speed_dh_pinion_rpm": abs(k0.bodies["L7"].speed) / rpm,
                     "design_load_Nm": k0.meshes["L78"].torque_driven},
-        "seed001": {"f_mesh1_Hz": k1.meshes["m11"].frequency,
+        "ji_li": {"f_mesh1_Hz": k1.meshes["m11"].frequency,
                     "f_mesh2_Hz": k1.meshes["m12"].frequency},
-        "seed002": {"input_torque_Nm": k2.drive_torques["engine"],
+        "dong2021": {"input_torque_Nm": k2.drive_torques["engine"],
                     "idler_torque_Nm": k2.bodies["O6"].torque},
-        "seed004": {"input_torque_Nm": k4.drive_torques["turbine"],
+        "mo2017": {"input_torque_Nm": k4.drive_torques["turbine"],
                     "path_torque_Nm": k4.meshes["s1p11"].torque_driver,
                     "star_shaft_torque_Nm": k4.bodies["p11"].torque,
                     "output_torque_Nm": k4.load_torques["output"]},
     }
 
 
-STUDIES = {"kinematics": kinematics, "seed000": seed000, "seed001": seed001, "seed002": seed002, "seed003": seed003,
-           "seed004": seed004}
+STUDIES = {"kinematics": kinematics, "liu2021": liu2021, "ji_li": ji_li, "dong2021": dong2021, "jin2019": jin2019,
+           "mo2017": mo2017}
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("seeds", nargs="*", default=list(STUDIES))
+    ap.add_argument("papers", nargs="*", default=list(STUDIES))
     ap.add_argument("--quick", action="store_true", help="shorter runs (smoke test)")
     args = ap.parse_args(argv)
     old = json.loads(OUT.read_text()) if OUT.exists() else {}
     old["provenance"] = _provenance()
-    for seed in args.seeds:
+    for seed in args.papers:
         t0 = time.perf_counter()
         try:
             old[seed] = STUDIES[seed](args.quick)
