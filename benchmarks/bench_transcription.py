@@ -1,6 +1,6 @@
 """The engine against the hand transcription of Ji & Li's equations of motion (seed 001).
 
-``tests/validation/transcription_seed001.py`` writes the paper's 14-DOF eq. 9 by hand
+``tests/validation/transcription_ji_li.py`` writes the paper's 14-DOF eq. 9 by hand
 as numba code from the model's physical parameters, without the assembler (the test
 beside it shows that it agrees with the engine to 1e-9).  Here it is the speed
 baseline: the issue asks for the engine within 1.2 times of it per RK4 step (generated
@@ -36,7 +36,7 @@ MODEL = "ji_li_mill_drive"
 def _case():
     import torquesplit
     from torquesplit.solve import static_equilibrium
-    from validation import transcription_seed001 as tr
+    from validation import transcription_ji_li as tr
 
     model = torquesplit.load_model(torquesplit.example_path(MODEL))
     s = torquesplit.assemble(model)

@@ -36,7 +36,7 @@ TARGETS = {
     "hand_ratio": 1.2,  # engine / hand transcription of seed 001, CPU time per step
     "hand_ratio_general": 1.5,  # the same with rhs="general"
 }
-SEED001 = "seed001_mill_drive"
+SEED001 = "ji_li_mill_drive"
 
 
 def _log(msg: str) -> None:
@@ -111,17 +111,10 @@ def run(quick: bool, repeat: int, skip_compile: bool = False) -> dict:
         _log(f"  {c.name}: scipy {a['sim_per_wall']:.3g} sim s/s ({a['n_rhs']} rhs), "
              f"cached-V {b['sim_per_wall']:.3g}, numpy RK4 {n['us_per_step']:.0f} us/step")
 
-    _log("kernel building blocks (seed 001)")
+    _log("where a step goes (Ji & Li): parts removed one by one, fresh processes")
     import bench_kernel_parts
 
-    c001 = next(c for c in cases if c.name == SEED001)
-    res["parts"] = bench_kernel_parts.breakdown(c001, cfg["kernel_calls"],
-                                                cfg["engine_steps"])
-    if quick:
-        res["marginal"] = None
-    else:
-        _log("in-situ cost of rhs_slot (compiles a patched kernel copy, ~20-40 s)")
-        res["marginal"] = bench_kernel_parts.marginal_rhs_cost(c001, cfg["engine_steps"])
+    res["parts"] = bench_kernel_parts.breakdown(cfg["engine_steps"], 2 if quick else 3)
 
     _log(f"memory: {cfg['memory_steps']:,} steps of seed 001 in a fresh process")
     res["memory"] = bench_memory.measure(cfg["memory_steps"], 100)
@@ -358,9 +351,9 @@ def report(res: dict) -> str:
     if "ratio" in ht:
         L.append("\n## Engine against the hand transcription of Ji & Li's equations "
                  "(seed 001)\n")
-        L.append("`tests/validation/transcription_seed001.py` writes the paper's 14-DOF "
+        L.append("`tests/validation/transcription_ji_li.py` writes the paper's 14-DOF "
                  "eq. 9 by hand as numba code from the model's physical parameters, without "
-                 "the assembler (`tests/validation/test_seed001_transcription.py`: it agrees "
+                 "the assembler (`tests/validation/test_ji_li_transcription.py`: it agrees "
                  "with the engine to 1e-9). `bench_transcription.py` runs it and the engine "
                  "(generated and general right-hand side) over the same steps from the same "
                  "state, each streaming the per-cycle statistics of the four mesh forces "
@@ -410,31 +403,16 @@ def report(res: dict) -> str:
 
     # ---------------------------------------------------------------- kernel parts
     p = res["parts"]
-    L.append(f"\n## Where a seed 001 RK4 step goes ({p['n_dof']} DOFs, {p['n_elements']} "
-             f"elements, {p['nnz']} projection entries, {p['n_time_varying']} meshes, "
-             f"{p['n_sinusoids']} error sinusoids)\n")
-    L.append("Each building block of `_kernels.rk4_run` called in a compiled loop, CPU time "
-             f"per call (best of 3); shares of a whole CPU step measured right after "
-             f"({_f(p['step_ns'] / 1e3)} µs, best of 3).\n")
-    rows = [[k, _f(v["ns_per_call"]), v["calls_per_step"], _f(v["ns_per_step"]),
-             f"{100 * v['share']:.0f} %"] for k, v in p["parts"].items()]
-    L.append(_table(["block", "ns/call", "calls/step", "ns/step", "share"], rows))
-    mg = res.get("marginal")
-    if mg and "rhs_ns" in mg:
-        L.append(f"\nIn situ, the isolated loops understate the cost: `rk4_run` with one "
-                 f"more `rhs_slot` call per step (a patched copy, "
-                 f"`bench_kernel_parts.marginal_rhs_cost`) takes "
-                 f"{_f(mg['step_plus_one_ns'])} ns per step against {_f(mg['step_ns'])} ns "
-                 f"as is: **{_f(mg['rhs_ns'])} ns per `rhs_slot` call**, so its "
-                 f"{mg['calls_per_step']} calls are "
-                 f"**{100 * mg['calls_per_step'] * mg['rhs_ns'] / mg['step_ns']:.0f} %** of "
-                 f"the step.")
-    elif mg:
-        L.append(f"\nIn-situ rhs_slot cost not measured: {mg['skipped']}")
+    L.append(f"\n## Where a Ji & Li RK4 step goes ({p['n_dof']} DOFs, {p['n_elements']} "
+             f"elements, {_f(p['step_ns'] / 1e3)} µs per step)\n")
+    L.append("Marginal cost of each part: the step timed with that part removed from a copy "
+             "of `_kernels.py` (fresh process, generated right-hand side, plain steps, best "
+             "of 3 CPU times), against the unpatched copy (`bench_kernel_parts.py`).\n")
+    rows = [[k, _f(v["ns_per_step"]), f"{100 * v['share']:.0f} %"]
+            for k, v in p["parts"].items()]
+    L.append(_table(["part", "ns/step", "share"], rows))
     if p["skipped"]:
-        L.append("\nNot timed (the kernels changed under this benchmark; see "
-                 "`bench_kernel_parts.py`): "
-                 + "; ".join(f"`{k}`: {v}" for k, v in p["skipped"].items()))
+        L.append("\nNot measured: " + "; ".join(f"{k} ({v})" for k, v in p["skipped"].items()))
 
     # ---------------------------------------------------------------- compile
     if comp:

@@ -2,12 +2,12 @@
 
 Paper: Zhao Ji & Xia Li, bend-torsion model of a two-stage helical split-torque
 grinding-mill drive (printed title "Study on the vibration coupling mechanism of a power
-transmission system with misaligned couplings"), eqs. 1-17.  ``transcription_seed001``
+transmission system with misaligned couplings"), eqs. 1-17.  ``transcription_ji_li``
 writes its eq. 9 out by hand from the model's physical parameters, without
 :mod:`torquesplit.assembly`; here the engine (assembled Structure, static Newton, modal
 analysis, RK4 kernels) must agree with it to 1e-9.
 
-State mapping (``transcription_seed001.engine_state_signs``): the engine orders its DOFs
+State mapping (``transcription_ji_li.engine_state_signs``): the engine orders its DOFs
 by ``structure.dof_names`` (z1.theta, z1.loa, ..., motor.theta, mill.theta); the paper
 by eq. 15 (th0 motor, th1..th6 z1..z6, th7 mill, X1..X6).  Paper th_i = s_i x engine
 theta of the body, s_i its sense of rotation about +z (z1, z6, motor, mill +1; z2..z5
@@ -34,7 +34,7 @@ import pytest
 import torquesplit
 from torquesplit.model.overrides import apply_overrides, read_raw
 from torquesplit.solve import element_forces, integrate, modal_analysis, static_equilibrium
-from validation import transcription_seed001 as tr
+from validation import transcription_ji_li as tr
 
 NAME = "ji_li_mill_drive"
 TOL = 1e-9
