@@ -123,10 +123,14 @@ _EXPO1 = 0.2 - _BETA * 0.75
 
 _kernel = njit(cache=True, error_model="numpy", _nrt=False)
 _inline = njit(inline="always", error_model="numpy", _nrt=False)
+# An ordinary compiled callee (LLVM may still inline it): excite is large and is called
+# from four places, and inlining it in numba's IR cost 8 s of cold compile for no
+# measurable speed (benchmarks/bench_compile.py, bench_engine.py).
+_callee = njit(error_model="numpy", _nrt=False)
 
 
 # =================================================================== excitation
-@_inline
+@_callee
 def excite(t, slot, src, m, w):
     """Every time-dependent excitation at t into ``slot``.
 
