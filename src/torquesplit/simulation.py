@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
@@ -86,9 +87,58 @@ def simulate(
     >>> res.success
     True
     """
-    from .assembly.assemble import assemble
     from .results import Results
     from .solve.integrate import integrate
+
+    run = prepare_run(model, duration=duration, cycles=cycles, method=method,
+                      steps_per_period=steps_per_period, rtol=rtol,
+                      samples_per_period=samples_per_period, history_dofs=history_dofs,
+                      full_history=full_history, progress=progress, rhs=rhs,
+                      max_steps=max_steps)
+    solution = integrate(run.structure, run.y0, (0.0, run.duration), **run.integrate_kwargs)
+    return Results(model=run.model, kinematics=run.kinematics, structure=run.structure,
+                   static=run.static, solution=solution)
+
+
+@dataclass(frozen=True)
+class PreparedRun:
+    """Everything :func:`simulate` sets up before integrating: the stages up to the
+    static equilibrium and the arguments of
+    :func:`~torquesplit.solve.integrate.integrate`.  Other executors of the same run (the
+    GPU ensemble backend, :mod:`torquesplit.gpu`) start from it, so that a run means the
+    same thing whichever engine integrates it."""
+
+    model: object
+    kinematics: object
+    structure: object
+    static: object
+    y0: np.ndarray
+    """Initial state [q, v]: the static equilibrium at rest."""
+    duration: float
+    """Simulated time [s] (the run spans (0, duration))."""
+    integrate_kwargs: dict
+    """Keyword arguments of ``integrate`` (method, tracked elements, groups, ...)."""
+
+
+def prepare_run(
+    model,
+    *,
+    duration: float | None = None,
+    cycles: int | None = None,
+    method: str | None = None,
+    steps_per_period: int | None = None,
+    rtol: float | None = None,
+    samples_per_period: int = 20,
+    history_dofs=None,
+    full_history: bool = False,
+    progress: Callable[[float], None] | None = None,
+    rhs: str = "auto",
+    max_steps: int | None = None,
+) -> PreparedRun:
+    """The set-up of :func:`simulate` (same parameters) without the integration: model,
+    kinematics, structure, static equilibrium, initial state, run length and the
+    arguments of ``integrate``; refuses what ``simulate`` refuses, warns as it warns."""
+    from .assembly.assemble import assemble
     from .solve.static import static_equilibrium
 
     if not hasattr(model, "meshes"):
@@ -107,7 +157,7 @@ def simulate(
         warnings.warn(
             "the static equilibrium did not converge exactly (members free inside their "
             f"clearances: {', '.join(static.separated) or 'none reported'}); the dynamic run "
-            "starts from the regularised solution", ModelWarning, stacklevel=2)
+            "starts from the regularised solution", ModelWarning, stacklevel=3)
     mesh_names = list(model.meshes)
     freqs = np.array([kin.meshes[m].frequency for m in mesh_names])
     f_min, f_max = float(freqs.min()), float(freqs.max())
@@ -160,9 +210,8 @@ def simulate(
                     MAX_STEPS if max_steps is None else int(max_steps))
     else:
         kwargs["rtol"] = rtol or an.rtol
-    solution = integrate(structure, y0, (0.0, duration), **kwargs)
-    return Results(model=model, kinematics=kin, structure=structure, static=static,
-                   solution=solution)
+    return PreparedRun(model=model, kinematics=kin, structure=structure, static=static,
+                       y0=y0, duration=float(duration), integrate_kwargs=kwargs)
 
 
 def _check_cost(structure, duration: float, steps_per_period: int, max_steps: int) -> None:
@@ -184,4 +233,4 @@ def _check_cost(structure, duration: float, steps_per_period: int, max_steps: in
             "max_steps (--max-steps)")
     if n_steps > ANNOUNCE_STEPS:
         warnings.warn(f"this run takes {n_steps:,} RK4 steps of {h:.3g} s ({why}): about "
-                      f"{seconds / 60:.2g} min of integration", ModelWarning, stacklevel=3)
+                      f"{seconds / 60:.2g} min of integration", ModelWarning, stacklevel=4)

@@ -526,7 +526,22 @@ def integrate(
         step_min = float(clock[kern.F_HMIN]) if accepted else math.nan
         step_max = float(clock[kern.F_HMAX]) if accepted else math.nan
     y = work.Y[kd.Y_STATE].copy()
+    return _solution(s, sel, plan, rec, counters, clock, y, method=method, t_span=(t0, t_end),
+                     blowup=blowup, step_min=step_min, step_max=step_max,
+                     compile_time=compile_time, wall_time=time.perf_counter() - t_call,
+                     rhs_name="generated" if rhs_code.generated else "general",
+                     rhs_compile_time=rhs_code.compile_time, full_history=full_history)
 
+
+def _solution(s, sel, plan, rec, counters, clock, y, *, method, t_span, blowup, step_min,
+              step_max, compile_time, wall_time, rhs_name, rhs_compile_time,
+              full_history) -> Solution:
+    """The :class:`Solution` of a finished run from its output arrays (``rec``, a
+    :class:`~.kernel_data.Record`), counters, clock and end state ``y``: the one place
+    that turns a run's raw outputs into a Solution (the GPU ensemble backend,
+    :mod:`torquesplit.gpu`, hands its per-case outputs to it too)."""
+    t0, t_end = t_span
+    rk4 = method == "rk4"
     status = int(counters[kern.I_STATUS])
     t_final = float(clock[kern.F_T])
     cycles = _cycle_summary(rec, s, sel)
@@ -549,9 +564,9 @@ def integrate(
         step_min=step_min,
         step_max=step_max,
         compile_time=compile_time,
-        wall_time=time.perf_counter() - t_call,
-        rhs="generated" if rhs_code.generated else "general",
-        rhs_compile_time=rhs_code.compile_time,
+        wall_time=wall_time,
+        rhs=rhs_name,
+        rhs_compile_time=rhs_compile_time,
         dof_names=tuple(s.dof_names),
         element_names=tuple(s.element_names),
         tracked_elements=tuple(sel.track),

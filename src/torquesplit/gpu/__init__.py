@@ -1,0 +1,1 @@
+"""GPU ensembles (package map written below)."""

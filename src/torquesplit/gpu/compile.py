@@ -1,0 +1,163 @@
+"""Compile a generated ensemble kernel for the CPU (numba) or for CUDA (numba.cuda).
+
+The source of :mod:`torquesplit.gpu.source` is executed in a fresh namespace; each of
+its functions is then replaced by its compiled form, ``numba.njit`` for the CPU or a
+``numba.cuda.jit`` device function for CUDA, and they find each other (and the laws of
+:mod:`torquesplit.solve.laws`) by global name when numba compiles them.  A short driver
+is added per target: for the CPU a loop over the cases in one compiled function
+(:func:`cpu_driver`), for CUDA a kernel with one case per thread whose scratch arrays are
+thread-local (``cuda.local.array``, indexed by constants: registers).
+
+Compiled kernels are kept per process by the hash of their source (a study that runs
+batch after batch of one pattern compiles once).  Under ``NUMBA_ENABLE_CUDASIM=1`` the
+CUDA path runs in numba's simulator (the tests without a GPU).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+import threading
+
+import numpy as np
+
+from torquesplit.solve import laws
+
+from .source import KernelSource
+
+__all__ = ["cpu_driver", "cuda_kernel", "cuda_available", "cuda_simulated", "ptx"]
+
+_LOCK = threading.Lock()
+_CACHE: dict[tuple, object] = {}
+
+_CPU_DRIVER = """
+def run_all(n_cases, P, PT, PI, Y0, TK, TF, TFR, GS, CN, OF, OI):
+    W = np.empty({n_w}, DT)
+    X = np.empty({n_x})
+    WI = np.empty({n_wi}, np.int64)
+    for c in range(n_cases):
+        run_case(c, P, PT, PI, Y0, TK, TF, TFR, GS, CN, OF, OI, W, X, WI)
+    return 0
+"""
+
+_CUDA_KERNEL = """
+def kernel(n_cases, P, PT, PI, Y0, TK, TF, TFR, GS, CN, OF, OI):
+    c = cuda.grid(1)
+    if c < n_cases:
+        W = cuda.local.array({n_w}, DT_NB)
+        X = cuda.local.array({n_x}, float64)
+        WI = cuda.local.array({n_wi}, int64)
+        run_case(c, P, PT, PI, Y0, TK, TF, TFR, GS, CN, OF, OI, W, X, WI)
+"""
+
+_FUNCTIONS = ("excite", "copy_slot", "rhs", "flush", "new_cycle", "record",
+              "record_extrema", "first_corners", "next_corner_time", "advance_corners",
+              "rk4_step", "bad_state", "through_corners", "run_case")
+
+
+def _namespace(src: KernelSource) -> dict:
+    import numba
+
+    fp32 = src.precision == "fp32"
+    ns = {"math": math, "np": np, "laws": laws,
+          "DT": np.float32 if fp32 else np.float64,
+          "DT_NB": numba.float32 if fp32 else numba.float64,
+          "float64": numba.float64, "int64": numba.int64}
+    exec(compile(src.text, f"<torquesplit.gpu kernel {_digest(src)[:12]}>", "exec"), ns)
+    return ns
+
+
+def _digest(src: KernelSource) -> str:
+    return hashlib.sha256((src.precision + src.text).encode()).hexdigest()
+
+
+def cpu_driver(src: KernelSource):
+    """The generated code compiled with numba for the CPU: ``run_all(n_cases, P, PT, PI,
+    Y0, TK, TF, TFR, GS, CN, OF, OI)`` runs every case in turn (the reference the CUDA
+    kernel is tested against; not a fast path)."""
+    from numba import njit
+
+    key = ("cpu", _digest(src))
+    with _LOCK:
+        hit = _CACHE.get(key)
+    if hit is not None:
+        return hit
+    ns = _namespace(src)
+    jit = njit(error_model="numpy")
+    for name in _FUNCTIONS:
+        ns[name] = jit(ns[name])
+    exec(_CPU_DRIVER.format(n_w=src.n_w, n_x=src.n_x, n_wi=src.n_wi), ns)
+    fn = jit(ns["run_all"])
+    with _LOCK:
+        _CACHE.setdefault(key, fn)
+    return fn
+
+
+def cuda_kernel(src: KernelSource):
+    """The generated code as a CUDA kernel ``kernel[blocks, threads](n_cases, P, PT, PI,
+    Y0, TK, TF, TFR, GS, CN, OF, OI)``: one case per thread (compiled on first launch;
+    numba's simulator under ``NUMBA_ENABLE_CUDASIM=1``)."""
+    from numba import cuda
+
+    key = ("cuda", _digest(src), cuda_simulated())
+    with _LOCK:
+        hit = _CACHE.get(key)
+    if hit is not None:
+        return hit
+    ns = _namespace(src)
+    ns["cuda"] = cuda
+    for name in _FUNCTIONS:
+        ns[name] = cuda.jit(device=True)(ns[name])
+    exec(_CUDA_KERNEL.format(n_w=src.n_w, n_x=src.n_x, n_wi=src.n_wi), ns)
+    kern = cuda.jit(ns["kernel"])
+    with _LOCK:
+        _CACHE.setdefault(key, kern)
+    return kern
+
+
+def ptx(src: KernelSource, cc: tuple[int, int] = (9, 0)) -> str:
+    """PTX of the CUDA kernel for compute capability ``cc``, compiled without a device
+    (needs NVIDIA's libNVVM, e.g. a CUDA toolkit; numba finds it through ``CUDA_HOME``):
+    a check that the laws and the generated code compile for the GPU."""
+    from numba import cuda, float64, int64
+
+    ns = _namespace(src)
+    ns["cuda"] = cuda
+    for name in _FUNCTIONS:
+        ns[name] = cuda.jit(device=True)(ns[name])
+    exec(_CUDA_KERNEL.format(n_w=src.n_w, n_x=src.n_x, n_wi=src.n_wi), ns)
+    dt = float64 if src.precision == "fp64" else __import__("numba").float32
+    sig = (int64, dt[:, ::1], float64[:, ::1], int64[:, ::1], float64[:, ::1],
+           float64[:, :, ::1], float64[:, :, ::1], float64[:, :, ::1], float64[:, ::1],
+           int64[::1], float64[:, ::1], int64[:, ::1])
+    text, _ = cuda.compile_ptx(ns["kernel"], sig, cc=cc)
+    return text
+
+
+def cuda_simulated() -> bool:
+    """Whether numba runs CUDA code in its simulator (``NUMBA_ENABLE_CUDASIM=1``)."""
+    from numba import config
+
+    return bool(config.ENABLE_CUDASIM)
+
+
+def cuda_available() -> tuple[bool, str]:
+    """Whether a CUDA device (or numba's simulator) can run the kernels, and if not why."""
+    try:
+        from numba import cuda
+    except Exception as exc:  # noqa: BLE001 - a broken CUDA installation
+        return False, f"numba.cuda cannot be imported ({type(exc).__name__}: {exc})"
+    if cuda_simulated():
+        return True, "numba's CUDA simulator (NUMBA_ENABLE_CUDASIM=1)"
+    try:
+        ok = cuda.is_available()
+    except Exception as exc:  # noqa: BLE001 - driver errors
+        return False, f"the CUDA driver failed ({type(exc).__name__}: {exc})"
+    if not ok:
+        return False, "no CUDA device or driver found"
+    try:
+        dev = cuda.get_current_device()
+        name = dev.name.decode() if isinstance(dev.name, bytes) else str(dev.name)
+    except Exception as exc:  # noqa: BLE001
+        return False, f"the CUDA device cannot be opened ({type(exc).__name__}: {exc})"
+    return True, name
