@@ -50,25 +50,64 @@ def kernel(n_cases, P, PT, PI, Y0, TK, TF, TFR, GS, CN, OF, OI):
         run_case(c, P, PT, PI, Y0, TK, TF, TFR, GS, CN, OF, OI, W, X, WI)
 """
 
-_FUNCTIONS = ("excite", "copy_slot", "rhs", "flush", "new_cycle", "record",
-              "record_extrema", "first_corners", "next_corner_time", "advance_corners",
-              "rk4_step", "bad_state", "through_corners", "run_case")
+
+#: the element laws the generated code calls (by these names)
+LAWS = ("spring_force", "spline_force", "positive_part", "table_phase", "lerp", "stat_cycle")
+_LAW_DISPATCHERS: dict = {}
 
 
-def _namespace(src: KernelSource) -> dict:
+def law_functions() -> dict:
+    """The laws of :mod:`torquesplit.solve.laws` as the generated code calls them: each
+    law's own Python function compiled by numba as an ordinary (not IR-inlined)
+    function, with the laws' flags.  ``inline="always"`` (how the engine's kernels take
+    them) would re-type a law at each of its hundreds of call sites in straight-line
+    code (minutes of compilation); as a callee it is typed once per signature, and LLVM
+    (NVVM on a GPU) still inlines it.  The arithmetic is the same instructions."""
+    from numba import njit
+
+    with _LOCK:
+        if not _LAW_DISPATCHERS:
+            for name in LAWS:
+                _LAW_DISPATCHERS[name] = njit(error_model="numpy")(
+                    getattr(laws, name).py_func)
+        return dict(_LAW_DISPATCHERS)
+
+
+def _namespace(src: KernelSource, literal_calls: bool = False) -> dict:
     import numba
 
     fp32 = src.precision == "fp32"
-    ns = {"math": math, "np": np, "laws": laws,
+    const = (lambda k: k) if literal_calls else np.int64
+    ns = {"math": math, "np": np, **law_functions(),
           "DT": np.float32 if fp32 else np.float64,
           "DT_NB": numba.float32 if fp32 else numba.float64,
-          "float64": numba.float64, "int64": numba.int64}
+          "float64": numba.float64, "int64": numba.int64, "IM1": const(-1),
+          **{f"I{k}": const(k) for k in src.call_constants}}
     exec(compile(src.text, f"<torquesplit.gpu kernel {_digest(src)[:12]}>", "exec"), ns)
     return ns
 
 
 def _digest(src: KernelSource) -> str:
     return hashlib.sha256((src.precision + src.text).encode()).hexdigest()
+
+
+def _functions(ns: dict) -> list[str]:
+    """Names of the generated functions (every ``def`` of the source)."""
+    import types as _t
+
+    return [k for k, v in ns.items() if isinstance(v, _t.FunctionType)
+            and v.__code__.co_filename.startswith("<torquesplit.gpu kernel")]
+
+
+def _cuda_namespace(src: KernelSource) -> dict:
+    from numba import cuda
+
+    ns = _namespace(src, literal_calls=True)
+    ns["cuda"] = cuda
+    for name in _functions(ns):
+        ns[name] = cuda.jit(device=True)(ns[name])
+    exec(_CUDA_KERNEL.format(n_w=src.n_w, n_x=src.n_x, n_wi=src.n_wi), ns)
+    return ns
 
 
 def cpu_driver(src: KernelSource):
@@ -84,7 +123,7 @@ def cpu_driver(src: KernelSource):
         return hit
     ns = _namespace(src)
     jit = njit(error_model="numpy")
-    for name in _FUNCTIONS:
+    for name in _functions(ns):
         ns[name] = jit(ns[name])
     exec(_CPU_DRIVER.format(n_w=src.n_w, n_x=src.n_x, n_wi=src.n_wi), ns)
     fn = jit(ns["run_all"])
@@ -104,11 +143,7 @@ def cuda_kernel(src: KernelSource):
         hit = _CACHE.get(key)
     if hit is not None:
         return hit
-    ns = _namespace(src)
-    ns["cuda"] = cuda
-    for name in _FUNCTIONS:
-        ns[name] = cuda.jit(device=True)(ns[name])
-    exec(_CUDA_KERNEL.format(n_w=src.n_w, n_x=src.n_x, n_wi=src.n_wi), ns)
+    ns = _cuda_namespace(src)
     kern = cuda.jit(ns["kernel"])
     with _LOCK:
         _CACHE.setdefault(key, kern)
@@ -121,11 +156,7 @@ def ptx(src: KernelSource, cc: tuple[int, int] = (9, 0)) -> str:
     a check that the laws and the generated code compile for the GPU."""
     from numba import cuda, float64, int64
 
-    ns = _namespace(src)
-    ns["cuda"] = cuda
-    for name in _FUNCTIONS:
-        ns[name] = cuda.jit(device=True)(ns[name])
-    exec(_CUDA_KERNEL.format(n_w=src.n_w, n_x=src.n_x, n_wi=src.n_wi), ns)
+    ns = _cuda_namespace(src)
     dt = float64 if src.precision == "fp64" else __import__("numba").float32
     sig = (int64, dt[:, ::1], float64[:, ::1], int64[:, ::1], float64[:, ::1],
            float64[:, :, ::1], float64[:, :, ::1], float64[:, :, ::1], float64[:, ::1],

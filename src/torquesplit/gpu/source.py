@@ -74,6 +74,11 @@ class KernelSource:
     oi_counters: int
     n_watch: int
     n_lines: int
+    call_constants: tuple = ()
+    """Integers passed at call sites by name (``I<k>``, ``IM1`` = -1): the compiler binds
+    them as plain int64 values for the CPU (one compiled copy of each callee) and as
+    literals for CUDA (a copy per slot and offset: constant indices into the thread's
+    scratch, which then stays in registers)."""
 
 
 def _flt(v: float) -> str:
@@ -223,12 +228,12 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
         for e in tv:
             j = tv_pos[e]
             w(f"s = {par(('f', e))} * t + {par(('ph', e))}")
-            w(f"i0, i1, wt, fl = laws.table_phase(s, {L.n_table})")
-            w(f"X[b + {xk(('K', e))}] = laws.lerp(TK[ts, {j}, i0], TK[ts, {j}, i1], wt)")
+            w(f"i0, i1, wt, fl = table_phase(s, {L.n_table})")
+            w(f"X[b + {xk(('K', e))}] = lerp(TK[ts, {j}, i0], TK[ts, {j}, i1], wt)")
             if e in fpos:
                 jf = fpos[e]
-                w(f"X[b + {xk(('P', e))}] = laws.lerp(TF[ts, {jf}, i0], TF[ts, {jf}, i1], wt)")
-            w(f"WI[bi + {j}] = laws.stat_cycle(s, fl)")
+                w(f"X[b + {xk(('P', e))}] = lerp(TF[ts, {jf}, i0], TF[ts, {jf}, i1], wt)")
+            w(f"WI[bi + {j}] = stat_cycle(s, fl)")
             if e in gstart:
                 ng = int(L.n_gaps[e])
                 w("cy = np.int64(fl)")
@@ -239,9 +244,9 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
         for jj in range(n_fm):
             e = int(L.fr_el[jj])
             w(f"s = {par(('f', e))} * t + {par(('ph', e))}")
-            w(f"i0, i1, wt, _fl = laws.table_phase(s, {L.n_fr})")
+            w(f"i0, i1, wt, _fl = table_phase(s, {L.n_fr})")
             for row in range(3 * jj, 3 * jj + 3):
-                w(f"X[b + {xk(('FR', row))}] = laws.lerp(TFR[ts, {row}, i0], "
+                w(f"X[b + {xk(('FR', row))}] = lerp(TFR[ts, {row}, i0], "
                   f"TFR[ts, {row}, i1], wt)")
         for e in err_el:
             w(f"X[b + {xk(('E', e))}] = {par(('E0', e))}")
@@ -266,10 +271,10 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
 
     # ================================================================ copy B -> A
     with w.block("def copy_slot(X, WI):"):
-        for k in range(len(k_off)):
-            w(f"X[{k}] = X[{2 * nxs + k}]")
-        for j in range(len(tv)):
-            w(f"WI[{j}] = WI[{2 * n_tv + j}]")
+        with w.block(f"for k in range({len(k_off)}):"):
+            w(f"X[k] = X[{2 * nxs} + k]")
+        with w.block(f"for k in range({len(tv)}):"):
+            w(f"WI[k] = WI[{2 * n_tv} + k]")
         w("return 0")
     w()
 
@@ -284,7 +289,7 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
                 q = int(v_dof[j])
                 w(f"d += {par(('v', j))} * W[yo + {q}]")
                 w(f"r += {par(('v', j))} * W[yo + {n + q}]")
-            w(f"fe = laws.spring_force({k_of(e)}, {par(('damp', e))}, d, r, {g_of(e)})[0]")
+            w(f"fe = spring_force({k_of(e)}, {par(('damp', e))}, d, r, {g_of(e)})[0]")
             w(f"f{e} = {cast('fe + ' + p_of(e))}")
             w(f"W[{W_F + e}] = f{e}")
             w(f"W[{W_D + e}] = d")
@@ -309,7 +314,7 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
                     w(f"{var} += {par(('v', i))} * W[yo + {q}]")
                     w(f"{rv} += {par(('v', i))} * W[yo + {n + q}]")
             sp = ", ".join(par(("sp", j, k)) for k in range(6))
-            w(f"fx, fy = laws.spline_force(dx, dyy, rx, ry, {sp})")
+            w(f"fx, fy = spline_force(dx, dyy, rx, ry, {sp})")
             w(f"W[{W_D + ex}] = dx")
             w(f"W[{W_D + ey}] = dyy")
             w(f"W[{W_F + ex}] = {cast('fx')}")
@@ -322,7 +327,7 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
         # tooth friction (rhs_extra): on the loaded flank only
         for jj in range(n_fm):
             e = int(L.fr_el[jj])
-            w(f"fp = laws.positive_part(W[{W_F + e}])[0]")
+            w(f"fp = positive_part(W[{W_F + e}])[0]")
             with w.block("if fp > 0.0:"):
                 for i in range(L.fr_ptr[jj], L.fr_ptr[jj + 1]):
                     d = int(L.fr_dof[i])
@@ -334,43 +339,38 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
     w()
 
     # ================================================================ statistics
+    # per tracked element j (passed as I<j>: a literal on CUDA, so constant indices)
     with w.block("def flush(j, X, WI, OF, OI, c, cap):"):
+        w(f"st = {X_ST} + {N_STAT} * j")
         w(f"cur = WI[{WI_SC} + 2 * j]")
         with w.block("if cur >= 0 and cur < cap:"):
             w(f"o = (cur * {n_tr} + j) * {N_STAT}")
-            w(f"s = {X_ST} + {N_STAT} * j")
-            with w.block("if X[s] > OF[o, c]:"):
-                w("OF[o, c] = X[s]")
-            with w.block("if X[s + 1] < OF[o + 1, c]:"):
-                w("OF[o + 1, c] = X[s + 1]")
-            w("OF[o + 2, c] += X[s + 2]")
-            with w.block("if X[s + 3] > OF[o + 3, c]:"):
-                w("OF[o + 3, c] = X[s + 3]")
-            with w.block("if X[s + 4] < OF[o + 4, c]:"):
-                w("OF[o + 4, c] = X[s + 4]")
+            for q, op in enumerate((">", "<", None, ">", "<")):
+                if op is None:
+                    w(f"OF[o + {q}, c] += X[st + {q}]")
+                    continue
+                with w.block(f"if X[st + {q}] {op} OF[o + {q}, c]:"):
+                    w(f"OF[o + {q}, c] = X[st + {q}]")
             w(f"OI[cur * {n_tr} + j, c] += WI[{WI_SC} + 2 * j + 1]")
         w("return 0")
     w()
     with w.block("def new_cycle(j, cy, X, WI, OF, OI, c, cap):"):
         w("flush(j, X, WI, OF, OI, c, cap)")
-        w(f"s = {X_ST} + {N_STAT} * j")
-        w("X[s] = -math.inf")
-        w("X[s + 1] = math.inf")
-        w("X[s + 2] = 0.0")
-        w("X[s + 3] = -math.inf")
-        w("X[s + 4] = math.inf")
+        w(f"st = {X_ST} + {N_STAT} * j")
+        for q, v in enumerate(("-math.inf", "math.inf", "0.0", "-math.inf", "math.inf")):
+            w(f"X[st + {q}] = {v}")
         w(f"WI[{WI_SC} + 2 * j] = cy")
         w(f"WI[{WI_SC} + 2 * j + 1] = 0")
         w("return 0")
     w()
 
     def record_body(full: bool):
-        w(f"bi = xs * {n_tv}")
+        w("bi = 0  # slot A")
         w(f"cap = {par(('cap',))}")
         for j, el in enumerate(L.track):
             w(f"cy{j} = WI[bi + {tv_pos[el]}] - {par(('base', j))}")
             with w.block(f"if cy{j} != WI[{WI_SC + 2 * j}]:"):
-                w(f"new_cycle({j}, cy{j}, X, WI, OF, OI, c, cap)")
+                w(f"new_cycle(I{j}, cy{j}, X, WI, OF, OI, c, cap)")
             w(f"fe = W[{W_F + el}]")
             s = X_ST + N_STAT * j
             with w.block(f"if fe > X[{s}]:"):
@@ -394,7 +394,7 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
                         w(f"X[{s + 4}] = ratio")
         if not full:
             return
-        w(f"b = xs * {nxs}")
+        w("b = 0  # slot A")
         for k, el in enumerate(watch):
             w(f"g = {g_of(el)}")
             w(f"d = W[{W_D + el}]")
@@ -411,11 +411,11 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
                     w(f"X[{X_CT + 2 * k + 1}] += weight")
         w(f"WI[{WI_CNT + _I.I_SAMPLES}] += 1")
 
-    with w.block("def record(xs, weight, X, WI, W, OF, OI, P, PT, PI, c):"):
+    with w.block("def record(weight, X, WI, W, OF, OI, P, PT, PI, c):"):
         record_body(True)
         w("return 0")
     w()
-    with w.block("def record_extrema(xs, X, WI, W, OF, OI, P, PT, PI, c):"):
+    with w.block("def record_extrema(X, WI, W, OF, OI, P, PT, PI, c):"):
         record_body(False)
         w("return 0")
     w()
@@ -475,30 +475,30 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
                  "c, TK, TF, TFR, GS):"):
         w(f"hh = {cast('0.5 * hs')}")
         w(f"hsd = {cast('hs')}")
-        w("excite(t_mid, 1, src_half, X, WI, P, PT, PI, c, TK, TF, TFR, GS)")
-        for k in range(n2):
-            w(f"W[{W_YT + k}] = W[{W_Y + k}] + hh * W[{W_K1 + k}]")
-        w(f"rhs(1, {W_YT}, {W_K1 + n2}, X, W, P, PT, PI, c)")
-        for k in range(n2):
-            w(f"W[{W_YT + k}] = W[{W_Y + k}] + hh * W[{W_K1 + n2 + k}]")
-        w(f"rhs(1, {W_YT}, {W_K1 + 2 * n2}, X, W, P, PT, PI, c)")
-        w("excite(t_end, 2, src_end, X, WI, P, PT, PI, c, TK, TF, TFR, GS)")
-        for k in range(n2):
-            w(f"W[{W_YT + k}] = W[{W_Y + k}] + hsd * W[{W_K1 + 2 * n2 + k}]")
-        w(f"rhs(2, {W_YT}, {W_K1 + 3 * n2}, X, W, P, PT, PI, c)")
+        w("excite(t_mid, I1, src_half, X, WI, P, PT, PI, c, TK, TF, TFR, GS)")
+        with w.block(f"for k in range({n2}):"):
+            w(f"W[{W_YT} + k] = W[{W_Y} + k] + hh * W[{W_K1} + k]")
+        w(f"rhs(I1, I{W_YT}, I{W_K1 + n2}, X, W, P, PT, PI, c)")
+        with w.block(f"for k in range({n2}):"):
+            w(f"W[{W_YT} + k] = W[{W_Y} + k] + hh * W[{W_K1 + n2} + k]")
+        w(f"rhs(I1, I{W_YT}, I{W_K1 + 2 * n2}, X, W, P, PT, PI, c)")
+        w("excite(t_end, I2, src_end, X, WI, P, PT, PI, c, TK, TF, TFR, GS)")
+        with w.block(f"for k in range({n2}):"):
+            w(f"W[{W_YT} + k] = W[{W_Y} + k] + hsd * W[{W_K1 + 2 * n2} + k]")
+        w(f"rhs(I2, I{W_YT}, I{W_K1 + 3 * n2}, X, W, P, PT, PI, c)")
         w(f"h6 = {cast('hs / 6.0')}")
-        for k in range(n2):
-            w(f"W[{W_Y + k}] += h6 * (W[{W_K1 + k}] + {two} * (W[{W_K1 + n2 + k}] + "
-              f"W[{W_K1 + 2 * n2 + k}]) + W[{W_K1 + 3 * n2 + k}])")
+        with w.block(f"for k in range({n2}):"):
+            w(f"W[{W_Y} + k] += h6 * (W[{W_K1} + k] + {two} * (W[{W_K1 + n2} + k] + "
+              f"W[{W_K1 + 2 * n2} + k]) + W[{W_K1 + 3 * n2} + k])")
         w("return 0")
     w()
     with w.block("def bad_state(W):"):
-        for i in range(n):
-            with w.block(f"if not abs(W[{W_Y + i}]) <= {_flt(L.blowup)}:"):
-                w(f"return {i}")
-        for i in range(n, n2):
-            with w.block(f"if not math.isfinite(W[{W_Y + i}]):"):
-                w(f"return {i}")
+        with w.block(f"for i in range({n}):"):
+            with w.block(f"if not abs(W[{W_Y} + i]) <= {_flt(L.blowup)}:"):
+                w("return i")
+        with w.block(f"for i in range({n}, {n2}):"):
+            with w.block(f"if not math.isfinite(W[{W_Y} + i]):"):
+                w("return i")
         w("return -1")
     w()
     with w.block("def through_corners(t, tb, t_corner, X, WI, W, OF, OI, P, PT, PI, c, TK, "
@@ -509,12 +509,12 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
         with w.block("while True:"):
             w("te = t_corner if t_corner < tb - 1e-6 * h else tb")
             with w.block("if not first:"):
-                w(f"rhs(0, {W_Y}, {W_K1}, X, W, P, PT, PI, c)")
-                w("record_extrema(0, X, WI, W, OF, OI, P, PT, PI, c)")
+                w(f"rhs(I0, I{W_Y}, I{W_K1}, X, W, P, PT, PI, c)")
+                w("record_extrema(X, WI, W, OF, OI, P, PT, PI, c)")
                 w(f"WI[{WI_CNT + _I.I_RHS}] += 1")
                 w(f"WI[{WI_CNT + _I.I_EVENTS}] += 1")
             with w.block("if te - ts > 1e-6 * h:"):
-                w("rk4_step(ts + 0.5 * (te - ts), te, te - ts, -1, -1, X, WI, W, P, PT, PI, "
+                w("rk4_step(ts + 0.5 * (te - ts), te, te - ts, IM1, IM1, X, WI, W, P, PT, PI, "
                   "c, TK, TF, TFR, GS)")
                 w("copy_slot(X, WI)")
                 w(f"WI[{WI_CNT + _I.I_RHS}] += 3")
@@ -524,7 +524,7 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
                 w("break")
             w("t_corner = advance_corners(te, WI, PT, c, CN)")
         with w.block("if ts < tb:"):
-            w("excite(tb, 0, -1, X, WI, P, PT, PI, c, TK, TF, TFR, GS)")
+            w("excite(tb, I0, IM1, X, WI, P, PT, PI, c, TK, TF, TFR, GS)")
         w("return advance_corners(tb, WI, PT, c, CN)")
     w()
 
@@ -544,16 +544,16 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
                 w("OF[o + 3, c] = -math.inf")
                 w("OF[o + 4, c] = math.inf")
                 w(f"OI[row * {n_tr} + {j}, c] = 0")
-        for k in range(n2):
-            w(f"W[{W_Y + k}] = {cast(f'Y0[{k}, c]')}")
+        with w.block(f"for k in range({n2}):"):
+            w(f"W[{W_Y} + k] = {cast('Y0[k, c]')}")
         for j in range(n_tr):
             w(f"WI[{WI_SC + 2 * j}] = -4611686018427387904")  # no cycle yet (-2**62)
             w(f"WI[{WI_SC + 2 * j + 1}] = 0")
-        for k in range(2 * len(watch)):
-            w(f"X[{X_CT + k}] = 0.0")
-            w(f"WI[{WI_CC + k}] = 0")
-        for k in range(kern.N_COUNTERS):
-            w(f"WI[{WI_CNT + k}] = 0")
+        with w.block(f"for k in range({2 * len(watch)}):"):
+            w(f"X[{X_CT} + k] = 0.0")
+            w(f"WI[{WI_CC} + k] = 0")
+        with w.block(f"for k in range({kern.N_COUNTERS}):"):
+            w(f"WI[{WI_CNT} + k] = 0")
         for i in range(n_sin):
             w(f"X[{X_RT + 2 * i}] = math.cos({par(('ew', i))} * 0.5 * h)")
             w(f"X[{X_RT + 2 * i + 1}] = math.sin({par(('ew', i))} * 0.5 * h)")
@@ -565,16 +565,16 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
         with w.block("for i in range(n_steps):"):
             w("t = t0 + i * h")
             with w.block(f"if i == 0 or i % {kern.RESYNC} == 0:"):
-                w("excite(t, 0, -1, X, WI, P, PT, PI, c, TK, TF, TFR, GS)")
-            w(f"rhs(0, {W_Y}, {W_K1}, X, W, P, PT, PI, c)")
-            w("record(0, h, X, WI, W, OF, OI, P, PT, PI, c)")
+                w("excite(t, I0, IM1, X, WI, P, PT, PI, c, TK, TF, TFR, GS)")
+            w(f"rhs(I0, I{W_Y}, I{W_K1}, X, W, P, PT, PI, c)")
+            w("record(h, X, WI, W, OF, OI, P, PT, PI, c)")
             w("tb = t0 + (i + 1) * h")
             with w.block("if t_corner < tb:"):
                 w("t_corner = through_corners(t, tb, t_corner, X, WI, W, OF, OI, P, PT, PI, "
                   "c, TK, TF, TFR, GS, CN)")
                 w(f"WI[{WI_CNT + _I.I_RHS}] += 1")
             with w.block("else:"):
-                w("rk4_step(t0 + (i + 0.5) * h, tb, h, 0, 1, X, WI, W, P, PT, PI, c, TK, TF, "
+                w("rk4_step(t0 + (i + 0.5) * h, tb, h, I0, I1, X, WI, W, P, PT, PI, c, TK, TF, "
                   "TFR, GS)")
                 w("copy_slot(X, WI)")
                 w(f"WI[{WI_CNT + _I.I_RHS}] += 4")
@@ -586,22 +586,25 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
                 w(f"WI[{WI_CNT + _I.I_BAD}] = bad")
                 w("break")
         with w.block(f"if WI[{WI_CNT + _I.I_STATUS}] == 0 and n_steps > 0:"):
-            w(f"rhs(0, {W_Y}, {W_K1}, X, W, P, PT, PI, c)")
-            w("record(0, 0.0, X, WI, W, OF, OI, P, PT, PI, c)")
+            w(f"rhs(I0, I{W_Y}, I{W_K1}, X, W, P, PT, PI, c)")
+            w("record(0.0, X, WI, W, OF, OI, P, PT, PI, c)")
         for j in range(n_tr):
-            w(f"flush({j}, X, WI, OF, OI, c, cap)")
-        for k in range(2 * len(watch)):
-            w(f"OF[{of_contact + k}, c] = X[{X_CT + k}]")
-            w(f"OI[{oi_contact + k}, c] = WI[{WI_CC + k}]")
-        for k in range(n2):
-            w(f"OF[{of_y + k}, c] = W[{W_Y + k}]")
+            w(f"flush(I{j}, X, WI, OF, OI, c, cap)")
+        with w.block(f"for k in range({2 * len(watch)}):"):
+            w(f"OF[{of_contact} + k, c] = X[{X_CT} + k]")
+            w(f"OI[{oi_contact} + k, c] = WI[{WI_CC} + k]")
+        with w.block(f"for k in range({n2}):"):
+            w(f"OF[{of_y} + k, c] = W[{W_Y} + k]")
         w(f"OF[{of_t}, c] = t_final")
-        for k in range(kern.N_COUNTERS):
-            w(f"OI[{oi_counters + k}, c] = WI[{WI_CNT + k}]")
+        with w.block(f"for k in range({kern.N_COUNTERS}):"):
+            w(f"OI[{oi_counters} + k, c] = WI[{WI_CNT} + k]")
         w("return 0")
     w()
     text = "\n".join(w.lines) + "\n"
+    import re
+
+    consts = tuple(sorted({int(x) for x in re.findall(r"\bI(\d+)\b", text)}))
     return KernelSource(text=text, precision=precision, n_w=n_w, n_x=n_x, n_wi=n_wi,
                         n_of=n_of, n_oi=n_oi, of_contact=of_contact, of_y=of_y, of_t=of_t,
                         oi_contact=oi_contact, oi_counters=oi_counters, n_watch=len(watch),
-                        n_lines=len(w.lines))
+                        n_lines=len(w.lines), call_constants=consts)
