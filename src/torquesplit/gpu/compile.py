@@ -152,16 +152,31 @@ def cuda_kernel(src: KernelSource):
 
 def ptx(src: KernelSource, cc: tuple[int, int] = (9, 0)) -> str:
     """PTX of the CUDA kernel for compute capability ``cc``, compiled without a device
-    (needs NVIDIA's libNVVM, e.g. a CUDA toolkit; numba finds it through ``CUDA_HOME``):
-    a check that the laws and the generated code compile for the GPU."""
-    from numba import cuda, float64, int64
+    (needs NVIDIA's libNVVM, e.g. a CUDA toolkit, which numba finds itself or through
+    ``CUDA_HOME``): a check that the laws and the generated code compile for the GPU.
 
-    ns = _cuda_namespace(src)
-    dt = float64 if src.precision == "fp64" else __import__("numba").float32
+    The generated functions are bound as plain numba functions here (CUDA device
+    functions need a device to compile; numba compiles the same Python for the CUDA
+    target when a kernel calls a plain numba function; numba asks the current device for
+    its compute capability then, so a stand-in answering ``cc`` is put in its place for
+    the call), with the call-site literals of :func:`cuda_kernel`."""
+    from types import SimpleNamespace
+    from unittest import mock
+
+    from numba import cuda, float32, float64, int64, njit
+
+    ns = _namespace(src, literal_calls=True)
+    ns["cuda"] = cuda
+    for name in _functions(ns):
+        ns[name] = njit(ns[name])
+    exec(_CUDA_KERNEL.format(n_w=src.n_w, n_x=src.n_x, n_wi=src.n_wi), ns)
+    dt = float64 if src.precision == "fp64" else float32
     sig = (int64, dt[:, ::1], float64[:, ::1], int64[:, ::1], float64[:, ::1],
            float64[:, :, ::1], float64[:, :, ::1], float64[:, :, ::1], float64[:, ::1],
            int64[::1], float64[:, ::1], int64[:, ::1])
-    text, _ = cuda.compile_ptx(ns["kernel"], sig, cc=cc)
+    stand_in = SimpleNamespace(compute_capability=tuple(cc))
+    with mock.patch("numba.cuda.dispatcher.get_current_device", lambda: stand_in):
+        text, _ = cuda.compile_ptx(ns["kernel"], sig, cc=cc)
     return text
 
 

@@ -192,6 +192,11 @@ class Group:
         return len(self.cases)
 
 
+PER_CASE = ("t0", "h", "n_steps", "cap", "base")
+"""Parameters never made literals: the run plan.  A settle rule's rounds (another run
+length each) and batches of another length then reuse the compiled kernel."""
+
+
 def _scalars(L: Layout, c: CaseArrays) -> list[tuple[tuple, str, float]]:
     """Every scalar parameter of one case: (name, kind, value), in a fixed order."""
     m = c.model
@@ -276,7 +281,7 @@ def build_group(cases: list[CaseArrays], indices: list[int], precision) -> Group
     for k, (name, kind) in enumerate(zip(names, kinds, strict=True)):
         dtype = np.int64 if kind == _I else np.float64
         col = np.array([row[k][2] for row in per_case], dtype=dtype)
-        if _same(col):
+        if _same(col) and name[0] not in PER_CASE:
             g.columns[name] = ("lit", col[0].item())
             continue
         target = {_D: rows_d, _T: rows_t, _I: rows_i}[kind]
