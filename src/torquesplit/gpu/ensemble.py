@@ -72,7 +72,7 @@ class EnsembleResult:
     post_time: float
     """Outputs -> Solutions [s]."""
     sample_steps: int
-    """Sum over the cases of their RK4 steps."""
+    """Sum over the cases of the RK4 steps they took."""
     lines: list[int] = field(default_factory=list)
     """Lines of generated source per pattern."""
 
@@ -165,7 +165,7 @@ def run_ensemble(runs, *, target: str = "cuda", precision: str = "fp64",
     out = EnsembleResult(solutions=[None] * len(planned), target=target,
                          precision=precision, device=device, patterns=0, compile_time=0.0,
                          kernel_time=0.0, setup_time=setup, post_time=0.0,
-                         sample_steps=int(sum(p.case.n_steps for p in planned)))
+                         sample_steps=0)
     cases = [p.case for p in planned]
     dtype = np.float32 if precision == "fp32" else np.float64
     for indices in group_cases(cases).values():
@@ -196,6 +196,7 @@ def run_ensemble(runs, *, target: str = "cuda", precision: str = "fp64",
                                              precision, target, share)
             out.post_time += time.perf_counter() - t
         out.patterns += 1
+    out.sample_steps = int(sum(s.n_steps for s in out.solutions))
     return out
 
 
