@@ -92,7 +92,7 @@ def check_supported(run) -> None:
 
 def case_arrays(run) -> _Planned:
     """Plan one prepared run as the CPU engine would (same step, same tracked cycles)."""
-    from torquesplit.solve.integrate import _plan_rk4, _select
+    from torquesplit.solve.integrate import _plan_rk4, _select, rk4_chunk
 
     check_supported(run)
     s = run.structure
@@ -106,7 +106,8 @@ def case_arrays(run) -> _Planned:
     if y.shape != (2 * s.n_dof,):
         y = np.concatenate([y, np.zeros(s.n_dof)])
     case = CaseArrays(model=kd.kernel_model(s), y0=y, t0=t0, h=float(plan.h),
-                      n_steps=int(plan.limit_steps), track=list(sel.track),
+                      n_steps=int(plan.limit_steps), chunk=rk4_chunk(plan.limit_steps),
+                      track=list(sel.track),
                       track_base=np.asarray(sel.track_base, dtype=np.int64),
                       cap=int(sel.n_cycles_cap), groups=[list(g) for g in sel.groups],
                       blowup=BLOWUP)

@@ -40,6 +40,9 @@ class CaseArrays:
     t0: float
     h: float
     n_steps: int
+    chunk: int
+    """Steps per call of the engine's RK4 kernel: corners are found afresh at each
+    multiple (``integrate.rk4_chunk``)."""
     track: list[int]
     track_base: np.ndarray
     cap: int
@@ -192,7 +195,7 @@ class Group:
         return len(self.cases)
 
 
-PER_CASE = ("t0", "h", "n_steps", "cap", "base")
+PER_CASE = ("t0", "h", "n_steps", "chunk", "cap", "base")
 """Parameters never made literals: the run plan.  A settle rule's rounds (another run
 length each) and batches of another length then reuse the compiled kernel."""
 
@@ -237,6 +240,7 @@ def _scalars(L: Layout, c: CaseArrays) -> list[tuple[tuple, str, float]]:
     add((("t0",), _T, c.t0))
     add((("h",), _T, c.h))
     add((("n_steps",), _I, c.n_steps))
+    add((("chunk",), _I, c.chunk))
     add((("cap",), _I, c.cap))
     for j in range(len(c.track)):
         add((("base", j), _I, c.track_base[j]))

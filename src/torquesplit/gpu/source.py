@@ -533,6 +533,7 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
         w(f"t0 = {par(('t0',))}")
         w(f"h = {par(('h',))}")
         w(f"n_steps = {par(('n_steps',))}")
+        w(f"chunk = {par(('chunk',))}")
         w(f"cap = {par(('cap',))}")
         # outputs: every row as the CPU's make_record
         with w.block("for row in range(cap):"):
@@ -566,6 +567,9 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
             w("t = t0 + i * h")
             with w.block(f"if i == 0 or i % {kern.RESYNC} == 0:"):
                 w("excite(t, I0, IM1, X, WI, P, PT, PI, c, TK, TF, TFR, GS)")
+            if corner_el:  # the engine's chunks find the corners afresh (rk4_chunk)
+                with w.block("if i > 0 and i % chunk == 0:"):
+                    w("t_corner = first_corners(t, WI, PT, c, CN)")
             w(f"rhs(I0, I{W_Y}, I{W_K1}, X, W, P, PT, PI, c)")
             w("record(h, X, WI, W, OF, OI, P, PT, PI, c)")
             w("tb = t0 + (i + 1) * h")

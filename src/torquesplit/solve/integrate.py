@@ -845,10 +845,18 @@ def _rhs_code(kind: str, model, n_rhs: float) -> codegen.GeneratedRhs:
         return codegen.general_rhs()
 
 
+def rk4_chunk(limit_steps: int) -> int:
+    """Steps per call of the RK4 kernel (a multiple of RESYNC, about 1.5 % of the run).
+    A chunk starts with the exact excitation and the table corners found afresh from its
+    start time (``first_corners``); the GPU ensemble kernel (:mod:`torquesplit.gpu`)
+    does the same at the same steps, so that both take the same sub-steps."""
+    per_chunk = math.ceil(limit_steps / _N_CHUNKS)
+    return max(_MIN_CHUNK_STEPS, -(-per_chunk // kern.RESYNC) * kern.RESYNC)
+
+
 def _run_rk4(t0, plan, blowup, model, work, rec, rhs_code, counters, clock, progress):
     """Run the RK4 kernel in chunks (multiples of RESYNC steps, about 1.5 % each)."""
-    per_chunk = math.ceil(plan.limit_steps / _N_CHUNKS)
-    chunk = max(_MIN_CHUNK_STEPS, -(-per_chunk // kern.RESYNC) * kern.RESYNC)
+    chunk = rk4_chunk(plan.limit_steps)
     done = 0
     while done < plan.limit_steps:
         m = min(chunk, plan.limit_steps - done)

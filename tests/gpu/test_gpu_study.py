@@ -1,0 +1,111 @@
+"""The GPU backend as a study runner: same store, same Dataset, same values.
+
+The runner is :class:`torquesplit.gpu.backend.GpuRunner` with ``target="cpu"`` (the
+generated CUDA source compiled for the CPU), so that these tests need no device; the
+CUDA path itself is tested in the simulator and on a device (test_gpu_simulator.py,
+test_gpu_device.py)."""
+
+from __future__ import annotations
+
+import json
+import warnings
+
+import numpy as np
+import pytest
+
+import torquesplit
+from torquesplit.errors import GpuFallbackWarning, GpuUnsupportedError
+from torquesplit.gpu.backend import GpuRunner, check_plan
+from torquesplit.gpu.compile import cuda_available
+from torquesplit.study.errors import StudyError
+
+GRID = {"study": {"name": "gpu_grid", "model": "seed001_mill_drive",
+                  "outputs": ["load_sharing.*", "dynamic_factor*", "peak_force.*",
+                              "contact_loss.*", "settle_time"]},
+        "analysis": {"duration": "0.12 s"},
+        "grid": {"parameters": [
+            {"path": "meshes.m11.damping_ratio", "values": [0.05, 0.12]},
+            {"path": "meshes.m12.backlash", "values": ["0.3 mm", "0.9 mm"]}]}}
+
+TIMING = ("case_wall_time", "case_integration_time", "case_compile_time")
+
+
+def _same(ds_a, ds_b):
+    for v in ds_a.data_vars:
+        if v in TIMING:
+            continue
+        a, b = ds_a[v].values, ds_b[v].values
+        if a.dtype.kind == "f":
+            assert np.array_equal(a, b, equal_nan=True), v
+        else:
+            assert np.array_equal(a, b), v
+
+
+def test_gpu_runner_gives_the_cpu_runners_dataset(tmp_path):
+    ds_cpu = torquesplit.run_study(GRID, workers=1)
+    runner = GpuRunner(target="cpu", batch=3)  # two batches: 3 + 1 cases
+    ds_gpu = torquesplit.Study(GRID).run(runner=runner, out=tmp_path / "g", figures=False)
+    _same(ds_cpu, ds_gpu)
+    assert set(ds_gpu["status"].values.ravel()) == {"ok"}
+    report = json.loads(ds_gpu.attrs["gpu_backend"])
+    assert report["cases"] == 4 and report["ensembles"] == 2
+    assert report["sample_steps"] > 0 and report["precision"] == "fp64"
+    # the store is the CPU runner's: resume finds every case finished
+    again = torquesplit.Study(GRID).run(runner=GpuRunner(target="cpu"), out=tmp_path / "g",
+                                        resume=True, figures=False)
+    _same(ds_cpu, again)
+
+
+def test_settle_rule_runs_in_rounds_as_the_cpu_runner():
+    spec = {**GRID, "analysis": {"duration": "0.3 s",
+                                 "settle": {"tolerance": 0.2, "start": "0.08 s"}}}
+    spec["grid"] = {"parameters": [{"path": "meshes.m11.damping_ratio",
+                                    "values": [0.05, 0.12]}]}
+    ds_cpu = torquesplit.run_study(spec, workers=1)
+    ds_gpu = torquesplit.Study(spec).run(runner=GpuRunner(target="cpu"))
+    _same(ds_cpu, ds_gpu)
+    assert (ds_gpu["case_runs"].values >= 2).all()  # at least two run lengths each
+
+
+def test_fp32_reports_its_error_per_output():
+    spec = {**GRID, "grid": {"parameters": [{"path": "meshes.m11.damping_ratio",
+                                             "values": [0.05, 0.12]}]}}
+    runner = GpuRunner(target="cpu", precision="fp32", check_cases=2)
+    ds = torquesplit.Study(spec).run(runner=runner)
+    err = json.loads(ds.attrs["gpu_backend"])["fp32_error"]
+    assert set(err) <= set(ds.attrs["outputs"] and json.loads(ds.attrs["outputs"]))
+    assert "load_sharing.engineering" in err and len(err) > 10
+    worst = max(e["rel"] for e in err.values())
+    assert 0.0 < worst < 1e-2
+
+
+def test_refused_by_name_before_any_case_runs():
+    static = {"study": {"name": "s", "model": "seed004_star_reducer",
+                        "outputs": ["load_sharing.static_torque"]},
+              "analysis": {"type": "static", "points_per_cycle": 2},
+              "grid": {"parameters": [{"path": "gears.s1.errors.eccentricity",
+                                       "values": ["1 um", "2 um"]}]}}
+    with pytest.raises(GpuUnsupportedError, match="quasi-static"):
+        torquesplit.Study(static).run(backend="gpu")
+    dopri = {**GRID, "analysis": {"duration": "0.05 s", "method": "dopri"}}
+    with pytest.raises(GpuUnsupportedError, match="adaptive time stepping"):
+        check_plan(torquesplit.Study(dopri).plan())
+    with pytest.raises(StudyError, match="GPU backend only"):
+        torquesplit.Study(GRID).run(precision="fp32")
+    with pytest.raises(StudyError, match="unknown backend"):
+        torquesplit.Study(GRID).run(backend="tpu")
+    with pytest.raises(StudyError, match="scheduler"):
+        torquesplit.Study(GRID).run(backend="gpu", scheduler="tcp://127.0.0.1:1")
+
+
+@pytest.mark.skipif(cuda_available()[0], reason="a CUDA device is present")
+def test_without_a_device_the_cpu_runner_runs_it_with_a_warning():
+    spec = {**GRID, "analysis": {"duration": "0.03 s"},
+            "grid": {"parameters": [{"path": "meshes.m11.damping_ratio", "values": [0.1]}]}}
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        ds = torquesplit.Study(spec).run(backend="gpu", workers=1)
+    msgs = [str(w.message) for w in caught if issubclass(w.category, GpuFallbackWarning)]
+    assert msgs and "CPU runner" in msgs[0] and "no CUDA device" in msgs[0]
+    assert "gpu_backend" not in ds.attrs
+    _same(torquesplit.run_study(spec, workers=1), ds)
