@@ -62,9 +62,12 @@ def test_settle_rule_runs_in_rounds_as_the_cpu_runner():
     spec["grid"] = {"parameters": [{"path": "meshes.m11.damping_ratio",
                                     "values": [0.05, 0.12]}]}
     ds_cpu = torquesplit.run_study(spec, workers=1)
-    ds_gpu = torquesplit.Study(spec).run(runner=GpuRunner(target="cpu"))
+    runner = GpuRunner(target="cpu")
+    ds_gpu = torquesplit.Study(spec).run(runner=runner)
     _same(ds_cpu, ds_gpu)
-    assert (ds_gpu["case_runs"].values >= 2).all()  # at least two run lengths each
+    # rounds: 0.08 s, 0.16 s, then the cap 0.3 s, every case in each round's ensemble
+    assert runner.report["ensembles"] == 3 and runner.report["cases"] == 6
+    assert (ds_gpu["simulated_time"].values == 0.3).all()
 
 
 def test_fp32_reports_its_error_per_output():
