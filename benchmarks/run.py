@@ -486,7 +486,16 @@ def main(argv=None) -> int:
                    help="skip the cold-compile measurement (about a minute)")
     p.add_argument("--output", type=Path, default=HERE / "RESULTS.md",
                    help="markdown file to write (default benchmarks/RESULTS.md)")
+    p.add_argument("--render", action="store_true",
+                   help="measure nothing: re-render the markdown from its RESULTS.json")
     a = p.parse_args(argv)
+    if a.render:
+        import json
+
+        res = json.loads(a.output.with_suffix(".json").read_text(encoding="utf-8"))
+        a.output.write_text(report(res), encoding="utf-8")
+        _log(f"rendered {a.output} from {a.output.with_suffix('.json').name}")
+        return 0
     res = run(a.quick, max(1, a.repeat), a.skip_compile)
     text = report(res)
     a.output.write_text(text, encoding="utf-8")

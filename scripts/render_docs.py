@@ -8,7 +8,7 @@ hand) and ``docs/validation_results.json`` (every number, written by
 ``scripts/validate.py``).  A placeholder ``{{path/to/value:fmt}}`` is replaced by the
 value at that path of the JSON (keys separated by ``/``; a key may hold spaces and
 dots) formatted with the Python format spec ``fmt``; ``{{=expression:fmt}}`` evaluates a
-small arithmetic expression over ``$path`` references (for ranges and ratios).
+small arithmetic expression over ``$[path]`` references (for ranges and ratios).
 ``benchmarks/RESULTS.md`` is rendered by ``benchmarks/run.py`` from
 ``benchmarks/RESULTS.json`` (``run.py --render`` re-renders it without measuring); both
 renderings are checked by ``tests/test_docs_data.py``.
@@ -27,7 +27,7 @@ VALIDATION = (ROOT / "docs" / "validation.md.in", ROOT / "docs" / "validation_re
               ROOT / "docs" / "validation.md")
 
 _FIELD = re.compile(r"\{\{(=?)([^{}]+?)(?::([^{}:]*))?\}\}")
-_REF = re.compile(r"\$([A-Za-z0-9_./ \-]+?)(?=\s*[-+*/()]|\s*$)")
+_REF = re.compile(r"\$\[([^\]]+)\]")
 
 
 def lookup(data, path: str):
@@ -64,7 +64,8 @@ def _value(data, expression: str, is_expr: bool):
 
     code = _REF.sub(sub, expression)
     if not re.fullmatch(r"[\s_v0-9.+\-*/()e]*", code):
-        raise ValueError(f"expression {expression!r} may only hold $paths, numbers and + - * /")
+        raise ValueError(f"expression {expression!r} may only hold $[paths], numbers and "
+                         "+ - * /")
     return eval(code, {"__builtins__": {}}, refs)  # noqa: S307 - checked above
 
 

@@ -57,7 +57,7 @@ def _run(model, **kwargs) -> dict:
               and k.startswith(("load_sharing", "dynamic_factor", "peak_to_nominal"))}
     worst = max(change, key=change.get) if change else ""
     out["halved"] = {"steps_per_period": spp, "max_change": change.get(worst, 0.0),
-                     "worst": worst}
+                     "worst": worst, "change": change}
     return out
 
 
@@ -114,11 +114,20 @@ def seed002(quick: bool) -> dict:
 def seed003(quick: bool) -> dict:
     """Mesh forces with tooth friction for RMS roughness 0.3, 0.6 and 0.9 um."""
     data = read_raw(torquesplit.example_path("seed003_friction_split"))
+    from torquesplit.assembly.excitation import friction_table
+
     out = {}
     for s in ("0.3 um", "0.6 um", "0.9 um"):
         over = {f"meshes.{m}.friction": {"roughness": s}
                 for m, v in data["meshes"].items() if v.get("friction")}
-        out[s] = _run(_model("seed003_friction_split", over), cycles=100 if quick else None)
+        model = _model("seed003_friction_split", over)
+        out[s] = _run(model, cycles=100 if quick else None)
+        # friction force over one mesh cycle at the nominal load (the tables the
+        # dynamic model uses), a spur split mesh and a herringbone mesh of the right path
+        kin = torquesplit.solve_kinematics(model)
+        for mesh in ("Rp1s", "RB1h"):
+            force = friction_table(model, kin, mesh, 256)[0] * kin.meshes[mesh].force
+            out[s][f"friction_{mesh}_N"] = [float(force.min()), float(force.max())]
     return out
 
 
@@ -135,7 +144,33 @@ def seed004(quick: bool) -> dict:
             "converged": bool(res.solution.converged.all())}
 
 
-STUDIES = {"seed000": seed000, "seed001": seed001, "seed002": seed002, "seed003": seed003,
+def kinematics(quick: bool) -> dict:
+    """The exact (non-dynamic) quantities each paper prints: contact ratio, speeds,
+    torques, mesh frequencies, from the shipped models' kinematics."""
+    rpm = 3.141592653589793 / 30
+
+    def kin(name):
+        return torquesplit.solve_kinematics(_model(name))
+
+    k0, k1, k2, k4 = (kin(n) for n in ("seed000_split_torque", "seed001_mill_drive",
+                                       "seed002_face_gear", "seed004_star_reducer"))
+    return {
+        "seed000": {"contact_ratio_dh": k0.meshes["L78"].total_contact_ratio,
+                    "speed_spur_pinion_rpm": abs(k0.bodies["L3"].speed) / rpm,
+                    "speed_dh_pinion_rpm": abs(k0.bodies["L7"].speed) / rpm,
+                    "design_load_Nm": k0.meshes["L78"].torque_driven},
+        "seed001": {"f_mesh1_Hz": k1.meshes["m11"].frequency,
+                    "f_mesh2_Hz": k1.meshes["m12"].frequency},
+        "seed002": {"input_torque_Nm": k2.drive_torques["engine"],
+                    "idler_torque_Nm": k2.bodies["O6"].torque},
+        "seed004": {"input_torque_Nm": k4.drive_torques["turbine"],
+                    "path_torque_Nm": k4.meshes["s1p11"].torque_driver,
+                    "star_shaft_torque_Nm": k4.bodies["p11"].torque,
+                    "output_torque_Nm": k4.load_torques["output"]},
+    }
+
+
+STUDIES = {"kinematics": kinematics, "seed000": seed000, "seed001": seed001, "seed002": seed002, "seed003": seed003,
            "seed004": seed004}
 
 

@@ -716,16 +716,39 @@ def optimize(
 @app.command()
 def modes(
     model: str = typer.Argument(..., help="Model file (.toml/.json) or example name."),
-    count: int = typer.Option(20, "--count", help="Number of modes to list."),
-    as_json: bool = typer.Option(False, "--json", help="Print the modes as JSON."),
+    count: Optional[int] = typer.Option(None, "--count", help="List at most this many modes "
+                                        "(default: all; a degenerate group is kept whole)."),
+    below: Optional[str] = typer.Option(None, "--below", help="List the modes below this "
+                                        "frequency, e.g. '5 kHz'."),
+    rotating_frame: bool = typer.Option(True, "--rotating-frame/--no-rotating-frame",
+                                        help="Include the Coriolis and centripetal terms of "
+                                        "a turning carrier (off: stationary carrier)."),
+    as_json: bool = typer.Option(False, "--json", help="Print the modes, with their shapes, "
+                                 "as JSON."),
+    out: Optional[Path] = typer.Option(None, "--out", help="Write the modes and shapes to "
+                                       "this NetCDF file."),
+    force: bool = typer.Option(False, "--force", help="Replace an existing output file."),
     campbell: bool = typer.Option(False, "--campbell", help="Resonance map over --from..--to."),
     start: Optional[str] = typer.Option(None, "--from", help="Campbell: first speed, e.g. '500 rpm'."),
     stop: Optional[str] = typer.Option(None, "--to", help="Campbell: last speed."),
     plot: Optional[Path] = typer.Option(None, "--plot", help="Campbell: write the diagram."),
 ):
-    """Natural frequencies about the static equilibrium, with the dominant elements."""
+    """Natural modes about the static equilibrium: every mode (or those asked for), its
+    multiplicity, type (rotational, translational, planet for a planetary stage) and the
+    strain-energy shares of its group."""
+    from .results import files
+
     try:
         _at_least(count, 1, "--count", "20")
+        limit = None
+        if below is not None:
+            from .model.units import parse_quantity
+
+            try:
+                limit = parse_quantity(below, "frequency")
+            except ValueError as exc:
+                raise OptionError(f"--below {below!r}: {exc}") from None
+            _positive(limit, "--below", "'5 kHz'")
         m, _ = _load(model)
         if campbell:
             if start is None or stop is None:
@@ -734,33 +757,47 @@ def modes(
             from .steady.cli import campbell_command
 
             return campbell_command(m, start, stop, plot, as_json, console, _json_default)
-        from .assembly.assemble import assemble
+        plan = None
+        if out is not None:
+            plan = files.check_output(out, formats=files.NETCDF_FORMATS, overwrite=force)
         from .model.kinematics import solve_kinematics
-        from .solve.modal import modal_analysis
-        from .solve.static import static_equilibrium
+        from .modes import model_modes
 
         kin = solve_kinematics(m)
-        st = assemble(m, kin)
-        sol = modal_analysis(st, static_equilibrium(st).q)
+        rep = model_modes(m, rotating_frame=rotating_frame, below=limit, count=count)
+        saved = None
+        if plan is not None:
+            with files.claim_output(plan) as claim:
+                ds = rep.to_dataset()
+                ds.attrs.update(files.provenance(claim.run_id))
+                ds.attrs["model"] = m.model.name
+                claim.write({plan.path: files.netcdf_bytes(ds)})
+            saved = plan.path
     except _EXPECTED as exc:
         _fail(exc)
         return
     mesh_f = {n: mk.frequency for n, mk in kin.meshes.items()}
-    rows = [{"mode": i + 1, "frequency_Hz": float(sol.frequencies[i]),
-             "dominant": sol.dominant_elements(i, 3)} for i in range(min(count, sol.n_modes))]
     if as_json:
-        print(json.dumps({"rigid_body_modes": int(sol.rigid_modes.shape[1]), "modes": rows,
-                          "mesh_frequencies_Hz": mesh_f}, indent=2, default=_json_default))
+        data = rep.to_dict(shapes=True)
+        data.update(mesh_frequencies_Hz=mesh_f, results_file=str(saved) if saved else None)
+        print(json.dumps(data, indent=2, default=_json_default))
         return
-    console.print(f"{sol.rigid_modes.shape[1]} rigid-body mode(s) left out; mesh frequencies: "
+    frame = (" (turning carrier frame)" if rep.rotating_frame else "")
+    console.print(f"{rep.rigid_modes} rigid-body mode(s) left out{frame}; mesh frequencies: "
                   + ", ".join(f"{k} {v:.5g} Hz" for k, v in mesh_f.items()))
+    typed = any(r.type for r in rep.rows)
     t = Table(title="natural modes")
-    for col in ("mode", "f [Hz]", "strain energy (largest shares)"):
+    cols = ["mode", "f [Hz]", "mult."] + (["type"] if typed else []) + \
+        ["strain energy of the group (largest shares)"]
+    for col in cols:
         t.add_column(col)
-    for r in rows:
-        t.add_row(str(r["mode"]), f"{r['frequency_Hz']:.6g}",
-                  ", ".join(f"{n} {100 * v:.0f} %" for n, v in r["dominant"]))
+    for r in rep.rows:
+        energy = ", ".join(f"{n} {100 * v:.0f} %" for n, v in list(r.strain_energy.items())[:3])
+        t.add_row(str(r.mode), f"{r.frequency:.6g}", str(r.multiplicity),
+                  *([r.type or ""] if typed else []), energy)
     console.print(t)
+    if saved:
+        console.print(f"modes written to {saved}")
 
 
 # --------------------------------------------------------------------------- examples

@@ -102,8 +102,9 @@ class QuasiStaticResults:
 
 def quasi_static_load_sharing(model, *, revolutions: float = 1.0, points_per_cycle: int = 8,
                               max_points: int = 20000) -> QuasiStaticResults:
-    """Equilibria over ``revolutions`` of the slowest gear, ``points_per_cycle`` per
-    cycle of the fastest mesh (capped at ``max_points``)."""
+    """Equilibria over ``revolutions`` of the slowest gear (in its mesh's frame: relative
+    to the carrier for a planet mesh), ``points_per_cycle`` per cycle of the fastest mesh
+    (capped at ``max_points``)."""
     from .assembly.assemble import assemble
     from .solve.static import quasi_static
 
@@ -111,7 +112,10 @@ def quasi_static_load_sharing(model, *, revolutions: float = 1.0, points_per_cyc
         model = load_model(model)
     kin = solve_kinematics(model)
     structure = assemble(model, kin)
-    speeds = [abs(kin.bodies[g].speed) for g in model.gears]
+    # the slowest turning of a gear in its mesh's frame (a planet mesh: its carrier's;
+    # a held ring stands still in the housing but turns in the carrier's frame)
+    speeds = [abs(v) for mk in kin.meshes.values() for v in (mk.driver_speed, mk.driven_speed)
+              if v != 0]
     period = revolutions * 2 * math.pi / min(speeds)
     f_max = max(mk.frequency for mk in kin.meshes.values())
     n = int(min(max_points, max(16, math.ceil(period * f_max * points_per_cycle))))

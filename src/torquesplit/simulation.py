@@ -26,6 +26,9 @@ MAX_HISTORY_RECORDS = 200_000
 MAX_STEPS = 200_000_000
 #: runs longer than this many steps are announced with a warning (cost estimate)
 ANNOUNCE_STEPS = 20_000_000
+#: fraction of a group's nominal load below which no instantaneous load-sharing ratio is
+#: formed (an instant when every mesh of the group is nearly unloaded)
+GROUP_MIN_LOAD = 0.01
 
 
 def simulate(
@@ -195,10 +198,14 @@ def prepare_run(
         sample_interval = duration / MAX_HISTORY_RECORDS
     from .metrics.load_sharing import group_meshes
 
-    groups = [[names.index(m) for m in ms]
-              for ms in group_meshes(structure.metadata["meshes"]).values()]
+    mesh_groups = list(group_meshes(structure.metadata["meshes"]).values())
+    groups = [[names.index(m) for m in ms] for ms in mesh_groups]
+    # no load-sharing ratio while a group carries less than 1 % of its nominal load
+    min_total = [GROUP_MIN_LOAD * sum(abs(kin.meshes[m].force) for m in ms)
+                 for ms in mesh_groups]
     kwargs = dict(
         method=method, track_elements=track, load_sharing_groups=groups,
+        load_sharing_min_total=min_total,
         history_elements=hist_el, history_dofs=hist_dofs, full_history=full_history,
         progress=progress, rhs=rhs,
         # the history is sampled in time, so its size never depends on the step

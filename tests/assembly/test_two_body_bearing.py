@@ -1,5 +1,7 @@
 """A bearing between two bodies (``support.on``): a wheel whose bearing sits on a
-carrier that has its own support, the element kind planetary stages need."""
+moving housing (a body on the wheel's axis with its own support), the element kind
+planetary stages need.  (A seat body whose axis is not the wheel's would carry the wheel
+round as a planet: its pin follows the seat's rotation, tests/assembly/test_planetary.py.)"""
 
 from __future__ import annotations
 
@@ -39,7 +41,7 @@ support = {stiffness = "3e8 N/m", on = "carrier"}
 dofs = ["theta", "x", "y"]
 mass = "5 kg"
 polar_inertia = "1e-9 kg m^2"
-position = ["40 mm", "0 mm", "0 mm"]
+position = ["60 mm", "0 mm", "0 mm"]   # on the wheel's axis: a moving housing, not a carrier
 support = {stiffness = "5e8 N/m"}
 
 [shafts.pin]

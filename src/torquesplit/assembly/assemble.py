@@ -29,6 +29,12 @@ Options (``assemble(..., options={...})``):
     (1e-3 m/s).  Below about v the friction is viscous (tangent F_m / v), above it
     Coulomb; the RK4 stability check accounts for the tangent F_m / v, which can shorten
     the step (see docs/theory/model.md).
+
+``rotating_frame``
+    True (default): bodies whose translations are measured in a turning carrier's frame
+    get the Coriolis (gyroscopic) and centripetal terms and the centrifugal force
+    (:mod:`torquesplit.assembly.rotating`).  False leaves them out: the stationary-
+    carrier model of Lin & Parker 1999's natural frequencies.
 """
 
 from __future__ import annotations
@@ -45,7 +51,7 @@ from ..model.schema import Model
 from . import excitation
 from .structure import MESH, SPLINE, SPRING, Structure, build_structure
 
-_OPTIONS = {"spline_velocity_scale"}
+_OPTIONS = {"spline_velocity_scale", "rotating_frame"}
 
 
 @dataclass(frozen=True)
@@ -78,6 +84,11 @@ def number_dofs(model: Model, kin: Kinematics) -> tuple[DofMap, np.ndarray]:
     theta: dict[str, tuple[int, float]] = {}
     trans: dict[str, dict[str, int]] = {}
     prescribed = {kin.groups[d.body] for d in model.drives.values() if d.mode == "speed"}
+    # a member held rigidly (torsional_support.rigid) loses its rotation like a speed drive
+    for body in kin.held:
+        spec = model.gears.get(body) or model.bodies[body]
+        if spec.torsional_support.rigid:
+            prescribed.add(kin.groups[body])
     group_index: dict[str, int] = {}
     for body in model.body_names():
         spec = model.gears.get(body) or model.bodies[body]
@@ -101,6 +112,17 @@ def number_dofs(model: Model, kin: Kinematics) -> tuple[DofMap, np.ndarray]:
                 trans[body][d] = len(names)
                 names.append(f"{body}.{d}")
                 mass.append(bk.mass)
+    # a planet without translations sits rigidly on its pin: its mass moves with the
+    # carrier's translations and, at the pin radius R, with its rotation (m R^2)
+    for body, carrier in kin.planet_bodies.items():
+        if trans[body] or body not in kin.bodies:
+            continue
+        mp = kin.bodies[body].mass
+        for j in trans.get(carrier, {}).values():
+            mass[j] += mp
+        idx, _ = theta.get(carrier, (-1, 1.0))
+        if idx >= 0:
+            mass[idx] += mp * _orbit_radius(kin, body, carrier) ** 2
     m = np.asarray(mass)
     with np.errstate(divide="ignore", over="ignore"):
         inv = 1.0 / m
@@ -121,6 +143,9 @@ def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None
     if unknown:
         raise ValueError(f"unknown assembly option(s) {unknown}; known: {sorted(_OPTIONS)}")
     v_reg = float(options.get("spline_velocity_scale", model.analysis.spline_velocity_scale))
+    rotating = options.get("rotating_frame", True)
+    if not isinstance(rotating, bool):
+        raise ValueError(f"rotating_frame must be true or false, got {rotating!r}")
     if not (v_reg > 0 and math.isfinite(v_reg)):
         raise ValueError(f"spline_velocity_scale must be a positive speed in m/s, got {v_reg!r}")
     dmap, inv_mass = number_dofs(model, kin)
@@ -130,7 +155,7 @@ def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None
     ground = np.zeros(n_dof)
     meta_meshes = {}
 
-    phases = excitation.mesh_phases(model, kin)
+    phases = excitation.mesh_phases(model, kin, strict=True)
 
     # ---- meshes
     for name, mesh in model.meshes.items():
@@ -141,7 +166,7 @@ def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None
             if idx >= 0:
                 dofs.append(idx)
                 coefs.append(sgn * arm * s)
-            for j, c in dmap.project(body, mk.line_of_action, sgn):
+            for j, c in centre_projection(kin, dmap, body, mk.line_of_action, sgn):
                 dofs.append(j)
                 coefs.append(c)
         table = excitation.stiffness_table(model, kin, name, n_table)
@@ -221,11 +246,26 @@ def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None
         # direction u: k = kx ux^2 + ky uy^2 + kz uz^2 (x, y, z: the value itself)
         k_xyz = np.array([k_rad, sup.stiffness_y or k_rad, sup.axial_stiffness or k_rad])
         where = f"{'gears' if body in model.gears else 'bodies'}.{body}.support"
-        on = _bearing_seat(model, dmap, body, sup.on, where)
+        on = _bearing_seat(model, dmap, body, sup.on, where,
+                           orbits=body in kin.planet_bodies)
+        if on is None and kin.frame_speed(body) != 0.0 and sup.stiffness_y is not None \
+                and sup.stiffness is not None and sup.stiffness_y != sup.stiffness:
+            raise ModelError([(f"{where}.stiffness_y", (
+                f"{body!r} is measured in the frame of the turning carrier "
+                f"{kin.frames[body]!r}, where a bearing to the housing with different x and "
+                f"y stiffness turns; give it one radial stiffness (remove 'stiffness_y')"))])
         m = kin.bodies[body].mass
         if on is not None:  # equivalent mass of the two bodies for the damping ratio
             m_on = kin.bodies[on].mass
             m = m * m_on / (m + m_on) if m_on > 0 else m
+        seat_arm, pin_offset = _seat_geometry(kin, body, on, sup, where)
+        ecc_const, ecc_sines = _eccentricity(model, kin, body)
+        if on is not None and not dmap.translation[on]:
+            # a seat body without translations (a carrier on rigid bearings): its
+            # eccentricity moves the pins it carries
+            seat_const, seat_sines = _eccentricity(model, kin, on)
+            pin_offset = pin_offset + seat_const
+            ecc_sines = ecc_sines + seat_sines
         for d, j in tr.items():
             u = dmap.axes[body][d]
             k = float(k_xyz @ u ** 2)
@@ -236,14 +276,27 @@ def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None
             else:
                 c = 0.0
             # deformation: the body's displacement along u, less that of the seat (a
-            # bearing between two bodies: the same law, its other end on the seat)
+            # bearing between two bodies: the same law, its other end on the seat,
+            # which moves with the seat body's translations and, for a pin off its
+            # axis, its rotation: theta_C (a_C x r) . u)
             dofs, coefs = [j], [1.0]
             if on is not None:
                 for jj, cc in dmap.project(on, u, -1.0, tol=1e-15):
                     dofs.append(jj)
                     coefs.append(cc)
+                idx_on, s_on = dmap.theta.get(on, (-1, 1.0))
+                arm = float(seat_arm @ u)
+                if idx_on >= 0 and abs(arm) > 1e-15:
+                    dofs.append(idx_on)
+                    coefs.append(-s_on * arm)
+            # the seat's position error (pin error) and the body's eccentricity: the
+            # bearing is unloaded when the body is displaced by them
+            err = float(pin_offset @ u) + float(ecc_const @ u)
+            sines = [(float(a @ u), om, ph) for a, om, ph in ecc_sines
+                     if abs(float(a @ u)) > 0.0]
             elements.append(dict(name=f"{body}.support.{d}", kind=SPRING, dofs=dofs,
-                                 coefs=coefs, stiffness=k, damping=c, gaps=sup.clearance))
+                                 coefs=coefs, stiffness=k, damping=c, gaps=sup.clearance,
+                                 error_constant=err, errors=sines))
 
     # ---- splines: torsion spring + 2-D radial element (seed 002 eq. 6)
     for name, sp in model.splines.items():
@@ -284,6 +337,40 @@ def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None
                                  stick_limit=sp.stick_limit, clearance=sp.radial_clearance,
                                  friction_force=f_m, velocity_scale=v_reg))
 
+    # ---- torsional supports to the housing (held members: a fixed ring, a star carrier)
+    for body in kin.held:
+        spec = model.gears.get(body) or model.bodies[body]
+        ts = spec.torsional_support
+        idx, s_t = dmap.theta[body]
+        if ts.rigid or idx < 0:
+            continue
+        k = ts.stiffness
+        if ts.damping is not None:
+            c = ts.damping
+        elif ts.damping_ratio is not None:
+            c = 2 * ts.damping_ratio * math.sqrt(k / inv_mass[idx])
+        else:
+            c = 0.0
+        elements.append(dict(name=f"{body}.torsional_support", kind=SPRING, dofs=[idx],
+                             coefs=[s_t], stiffness=k, damping=c))
+
+    # ---- rotating frames: Coriolis, centripetal softening, centrifugal force
+    gyroscopic = []
+    if rotating and kin.frames:
+        from .rotating import rotating_frame_terms
+
+        def pin_stiffness(body, direction):
+            spec = model.gears.get(body) or model.bodies[body]
+            sup = spec.support
+            if sup is None or sup.on != kin.planet_bodies.get(body):
+                return None
+            k_rad = support_stiffness(sup)
+            k_xyz = np.array([k_rad, sup.stiffness_y or k_rad, sup.axial_stiffness or k_rad])
+            return float(k_xyz @ np.asarray(direction) ** 2)
+
+        frame_elements, gyroscopic = rotating_frame_terms(kin, dmap, ext, pin_stiffness)
+        elements.extend(frame_elements)
+
     # ---- drives and loads
     for name, d in model.drives.items():
         idx, s = dmap.theta[d.body]
@@ -303,14 +390,23 @@ def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None
         mesh_names=list(model.meshes),
         friction_meshes=[n for n, m in model.meshes.items() if m.friction is not None],
         splines=list(model.splines),
+        carriers={c: list(p) for c, p in kin.carriers.items()},
+        planet_bodies=dict(kin.planet_bodies),
+        frames=dict(kin.frames),
+        rotating_frame=bool(rotating and gyroscopic),
+        inertial_elements=[el["name"] for el in elements if el["name"].endswith(
+            (".centripetal.1", ".centripetal.2", ".pin_preload"))],
     )
     return build_structure(dmap.names, inv_mass, elements, external_force=ext,
-                           ground_damping=ground, n_table=n_table, metadata=meta)
+                           ground_damping=ground, gyroscopic=gyroscopic, n_table=n_table,
+                           metadata=meta)
 
 
 def _bearing_seat(model: Model, dmap: DofMap, body: str, on: str | None,
-                  where: str) -> str | None:
-    """The body a bearing sits on (None: the housing), checked."""
+                  where: str, orbits: bool = False) -> str | None:
+    """The body a bearing sits on (None: the housing), checked.  A planet (``orbits``)
+    may sit on a carrier without translations: its pin moves with the carrier's
+    rotation."""
     if on is None:
         return None
     if on == body:
@@ -320,11 +416,81 @@ def _bearing_seat(model: Model, dmap: DofMap, body: str, on: str | None,
     if on not in dmap.translation:
         raise ModelError([(f"{where}.on", f"unknown body {on!r}; use one of "
                            f"{sorted(dmap.translation)}")])
-    if not dmap.translation[on]:
+    if not dmap.translation[on] and not orbits:
         raise ModelError([(f"{where}.on", f"body {on!r} has no translational DOFs, so a "
                            "bearing on it is a bearing on the housing; give it x/y DOFs or "
                            "leave 'on' out")])
     return on
+
+
+def _orbit_radius(kin: Kinematics, body: str, carrier: str) -> float:
+    c = kin.bodies[carrier]
+    a = c.axis / np.linalg.norm(c.axis)
+    r = kin.bodies[body].position - c.position
+    return float(np.linalg.norm(r - a * float(r @ a)))
+
+
+def centre_projection(kin: Kinematics, dmap: DofMap, body: str, vec, sign: float = 1.0):
+    """(DOF, coefficient) of the displacement of ``body``'s centre along ``vec``: its
+    own translations, or -- a planet without translations, rigid on its pin -- those of
+    its carrier and the carrier's rotation, ``theta_C (a_C x r) . vec``."""
+    if dmap.translation.get(body) or body not in kin.planet_bodies:
+        return dmap.project(body, vec, sign)
+    carrier = kin.planet_bodies[body]
+    c = kin.bodies[carrier]
+    a = c.axis / np.linalg.norm(c.axis)
+    r = kin.bodies[body].position - c.position
+    r = r - a * float(r @ a)
+    out = list(dmap.project(carrier, vec, sign))
+    idx, s_c = dmap.theta.get(carrier, (-1, 1.0))
+    arm = float(np.cross(a, r) @ np.asarray(vec, dtype=float))
+    if idx >= 0 and abs(arm) > 0.0:
+        out.append((idx, sign * s_c * arm))
+    return out
+
+
+def _seat_geometry(kin: Kinematics, body: str, on: str | None, sup, where: str):
+    """(a_C x r, pin offset) of a bearing on the body ``on``: the displacement of the
+    seat per unit rotation of ``on`` (r from its axis to the body's nominal centre) and
+    the seat's position error (radial along r, tangential along a_C x r / |r|)."""
+    zero = np.zeros(3)
+    if on is None:
+        return zero, zero
+    c = kin.bodies[on]
+    a = c.axis / np.linalg.norm(c.axis)
+    r = kin.bodies[body].position - c.position
+    r = r - a * float(r @ a)
+    arm = np.cross(a, r)
+    pe = sup.pin_error
+    if pe.is_zero:
+        return arm, zero
+    rn = float(np.linalg.norm(r))
+    if rn <= 0.0:  # pragma: no cover - refused by the kinematics (find_layout)
+        raise ModelError([(f"{where}.pin_error", "the body sits on the seat body's axis: "
+                           "its pin has no radial direction; remove 'pin_error'")])
+    e_r = r / rn
+    return arm, pe.radial * e_r + pe.tangential * np.cross(a, e_r)
+
+
+def _eccentricity(model: Model, kin: Kinematics, body: str):
+    """A body's eccentricity (carrier eccentricity) as the offset of its centre from its
+    bearing axis: (constant vector, [(vector amplitude, omega, phase), ...]) with the
+    offset ``const + sum amp sin(omega t + phase)`` in the frame of the body's
+    translations (constant for a carrier measured in its own frame)."""
+    spec = model.bodies.get(body)
+    zero = np.zeros(3)
+    if spec is None or spec.eccentricity == 0.0:
+        return zero, []
+    bk = kin.bodies[body]
+    from .rotating import in_plane_basis
+
+    e1, e2 = in_plane_basis(bk.axis)
+    eps, phi = spec.eccentricity, spec.eccentricity_phase
+    w = kin.relative_speed(body, kin.frames.get(body))
+    if w == 0.0:
+        return eps * (math.cos(phi) * e1 + math.sin(phi) * e2), []
+    # eps (cos(phi + w t) e1 + sin(phi + w t) e2), cos x = sin(x + pi/2)
+    return zero, [(eps * e1, w, phi + math.pi / 2), (eps * e2, w, phi)]
 
 
 def _friction_projection(model: Model, kin: Kinematics, dmap: DofMap, name: str,
@@ -345,11 +511,13 @@ def _friction_projection(model: Model, kin: Kinematics, dmap: DofMap, name: str,
     for body, sgn, row in ((mk.driver, 1.0, 1), (mk.driven, -1.0, 2)):
         idx, s = dmap.theta.get(body, (-1, 1.0))
         if idx >= 0:
-            w = 1.0 if kin.bodies[body].speed > 0 else -1.0
+            # sense of rotation in the mesh's frame (the carrier's for a planet mesh)
+            speed = mk.driver_speed if body == mk.driver else mk.driven_speed
+            w = 1.0 if speed > 0 else -1.0
             dofs.append(idx)
             coefs.append(-s * w)
             rows.append(row)
-        for j, c in dmap.project(body, t_dir, sgn):
+        for j, c in centre_projection(kin, dmap, body, t_dir, sgn):
             dofs.append(j)
             coefs.append(c)
             rows.append(0)

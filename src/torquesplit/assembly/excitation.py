@@ -87,29 +87,53 @@ def contact_zone_wave(phase: np.ndarray, mean: float, peak_to_peak: float, conta
 
 
 # --------------------------------------------------------------------------- phasing
-def mesh_phases(model: Model, kin: Kinematics) -> dict[str, float]:
-    """Mesh phase at t = 0 [cycles] of every mesh: override, else clocking.
+def mesh_phases(model: Model, kin: Kinematics, *, strict: bool = False) -> dict[str, float]:
+    """Mesh phase at t = 0 [cycles] of every mesh: override, else from the involute
+    geometry (docs/theory/planetary.md, "Mesh phasing").
 
-    Two meshes on one gear g are offset by ``-z_g sgn(w_g) (theta_2 - theta_1) / 2 pi``
-    cycles, theta being the angular positions of their contact points about g's axis
-    (a tooth reaches the second contact that much later).  Meshes reached from no
-    fixed reference start at phase 0.
+    Phase 0 of a mesh cycle is the instant a new tooth pair enters contact at the
+    start of active contact (where the driven gear's tip cuts the line of action, the
+    driver's tip for an internal driver).  On a gear g (z teeth, base radius r_b, base
+    pitch p_b = 2 pi r_b / z) a mesh X has, at t = 0::
+
+        s_X = frac( -sigma z (tau_X - gamma) / 2 pi + eps_X (h - rho_X) / p_b )
+
+    with tau_X the angle (about g's axis) of the point where X's line of action touches
+    g's base circle, rho_X the distance from there to X's start of active contact,
+    sigma the sign of g's speed in X's frame (its carrier's for a planet mesh), eps_X =
+    +1 if X's contact moves away from that tangency point (g drives an external pair or
+    is driven as a ring), -1 otherwise -- which also says which flank X loads -- and h
+    half of g's base tooth thickness (+ external, - internal tooth: the flank's base
+    point lies h from the tooth centre line, itself at the angle gamma).  Two meshes on
+    the same flank of one gear (same eps) with congruent geometry differ by
+    ``-sigma z (tau_2 - tau_1) / 2 pi`` (the rule of split-torque clocking); the sun and
+    ring meshes of a planet are on opposite flanks and differ also by the tooth
+    thickness and their own starts of contact.  The first mesh reached on each gear
+    fixes its tooth angle gamma.  Bevel and face meshes (no involute pair) use the
+    angle of the contact point and no flank term.
+
+    A loop of meshes through a planet must close (the tooth-count assembly condition);
+    with ``strict`` a loop that does not raises :class:`~torquesplit.errors.ModelError`.
+    Meshes reached from no fixed reference start at phase 0.
     """
-    phases: dict[str, float] = {}
     on_gear: dict[str, list[str]] = {g: [] for g in model.gears}
     for name, m in model.meshes.items():
         for g in m.gears:
             on_gear[g].append(name)
-    angle = {}
-    for name, m in model.meshes.items():
-        mk = kin.meshes[name]
-        for g in m.gears:
-            axis = kin.bodies[g].axis
-            e1 = loa.reference_direction(axis, 0.0)
-            e2 = np.cross(axis, e1)
-            r = mk.contact_point - kin.bodies[g].position
-            r = r - axis * float(r @ axis)
-            angle[(name, g)] = math.atan2(float(r @ e2), float(r @ e1))
+    terms = {(name, g): _phase_terms(model, kin, name, g)
+             for name, m in model.meshes.items() for g in m.gears}
+
+    def phase(mesh, g, gamma):
+        z, sigma, tau, c = terms[(mesh, g)]
+        return (-sigma * z * (tau - gamma) / (2 * math.pi) + c) % 1.0
+
+    def tooth_angle(mesh, g, s):
+        z, sigma, tau, c = terms[(mesh, g)]
+        return tau + 2 * math.pi * (s - c) / (sigma * z)
+
+    phases: dict[str, float] = {}
+    gamma: dict[str, float] = {}
+    misfits: list[tuple[str, str, float]] = []
     order = [n for n, m in model.meshes.items() if m.phase is not None] + list(model.meshes)
     for start in order:
         if start in phases:
@@ -120,18 +144,93 @@ def mesh_phases(model: Model, kin: Kinematics) -> dict[str, float]:
         while stack:
             cur = stack.pop()
             for g in model.meshes[cur].gears:
-                z = model.gears[g].teeth
-                s = 1.0 if kin.bodies[g].speed > 0 else -1.0
+                if g not in gamma:
+                    gamma[g] = tooth_angle(cur, g, phases[cur])
+                elif model.meshes[cur].phase is None:
+                    d = (phase(cur, g, gamma[g]) - phases[cur] + 0.5) % 1.0 - 0.5
+                    if abs(d) > 1e-6:
+                        misfits.append((cur, g, d))
                 for other in on_gear[g]:
                     if other in phases:
                         continue
                     if model.meshes[other].phase is not None:
                         phases[other] = model.meshes[other].phase % 1.0
                     else:
-                        d = angle[(other, g)] - angle[(cur, g)]
-                        phases[other] = (phases[cur] - z * s * d / (2 * math.pi)) % 1.0
+                        phases[other] = phase(other, g, gamma[g])
                     stack.append(other)
+    if strict:
+        issues = []
+        for mesh, g, d in misfits:
+            if kin.meshes[mesh].carrier is None:
+                continue  # a fixed-axis loop: the user clocks the gears (seed 000)
+            planet = next((b for b in model.meshes[mesh].gears if b in kin.planet_bodies),
+                          g)
+            issues.append((f"meshes.{mesh}", (
+                f"the teeth of planet {planet!r} cannot mesh here: around the loop of "
+                f"meshes through it the tooth positions miss by {d:+.4f} of a mesh cycle "
+                f"(the tooth-count assembly condition: a planet fits sun and ring only at "
+                f"angles that are whole multiples of 360 deg / (z_s + z_r) from another "
+                f"planet); move the planet to such an angle, change the tooth counts, or "
+                f"give the meshes' 'phase'")))
+        if issues:
+            from ..errors import ModelError
+
+            raise ModelError(issues[:1] if len(issues) > 3 else issues)
     return phases
+
+
+def _phase_terms(model: Model, kin: Kinematics, mesh_name: str, gear: str):
+    """(z, sigma, tau, c) of gear ``gear`` in mesh ``mesh_name`` for :func:`mesh_phases`:
+    c = eps (h - rho_start) / p_b [cycles]."""
+    mk = kin.meshes[mesh_name]
+    body = kin.bodies[gear]
+    axis = body.axis / np.linalg.norm(body.axis)
+    e1 = loa.reference_direction(axis, 0.0)
+    e2 = np.cross(axis, e1)
+    z = model.gears[gear].teeth
+    w = mk.driver_speed if gear == mk.driver else mk.driven_speed
+    sigma = 1.0 if w > 0 else -1.0
+
+    def angle(v):
+        v = v - axis * float(v @ axis)
+        return math.atan2(float(v @ e2), float(v @ e1))
+
+    geo = mk.geometry
+    if geo is None:  # bevel / face: the contact point's angle, no flank term
+        return z, sigma, angle(mk.contact_point - body.position), 0.0
+    n = np.asarray(mk.line_of_action, dtype=float)
+    n_t = n - axis * float(n @ axis)
+    n_t = n_t / np.linalg.norm(n_t)
+    rel = mk.contact_point - body.position
+    rel = rel - axis * float(rel @ axis)
+    tangency = rel - float(rel @ n_t) * n_t  # foot of the perpendicular from the centre
+    tau = angle(tangency)
+    ga = model.gears[model.meshes[mesh_name].gears[0]]
+    pair_first = model.meshes[mesh_name].gears[0 if ga.gear_type != "internal" else 1]
+    index = 1 if gear == pair_first else 2  # gear 1 of the PairGeometry is the pinion
+    gg = geo.gear1 if index == 1 else geo.gear2
+    p1, p2, _, _ = geo._tangent_lengths
+    first_drives = mk.driver == pair_first
+    s_start = geo.path_start if first_drives else geo.path_end
+    s_dot = 1.0 if first_drives else -1.0  # direction of travel along s
+    if index == 1:
+        rho, d_rho = p1 + s_start, 1.0
+    elif geo.is_internal:
+        rho, d_rho = p2 + s_start, 1.0
+    else:
+        rho, d_rho = p2 - s_start, -1.0
+    eps = s_dot * d_rho
+    if gg.internal:
+        # half base thickness of an internal tooth: (pi/2 - 2 x tan(alpha_n)) / z at the
+        # reference circle, thinner by inv(alpha_t) at the base circle
+        alpha_t = gg.transverse_pressure_angle
+        psi = ((math.pi / 2 - 2.0 * gg.profile_shift * math.tan(gg.normal_pressure_angle))
+               / gg.teeth - (math.tan(alpha_t) - alpha_t))
+        h = -gg.base_radius * psi
+    else:
+        h = gg.base_radius * gg.base_half_angle
+    p_b = 2 * math.pi * gg.base_radius / gg.teeth
+    return z, sigma, tau, eps * (h - rho) / p_b
 
 
 # --------------------------------------------------------------------------- backlash
@@ -192,7 +291,8 @@ def mesh_errors(model: Model, kin: Kinematics, mesh_name: str):
         n1, n2 = float(n @ e1), float(n @ e2)
         scale = math.hypot(n1, n2)  # in-plane part of the line of action
         zeta = math.atan2(n2, n1)
-        w = body.speed
+        # errors turn with the gear relative to the mesh's frame (a planet mesh's carrier)
+        w = mk.driver_speed if g == mk.driver else mk.driven_speed
         centre = gerr.CentreDeviation(
             eccentricity=ge.eccentricity * scale, eccentricity_phase=ge.eccentricity_phase,
             installation=ge.installation * scale, installation_direction=ge.installation_phase,
@@ -255,7 +355,7 @@ def impact_force_table(model: Model, kin: Kinematics, mesh_name: str, n: int):
     imp = gim.meshing_in_impact(
         base_radius_driving=mk.base_radii[0], base_radius_driven=mk.base_radii[1],
         tip_radius_driven=g_dvn.tip_radius, centre_distance=mk.center_distance,
-        base_pitch=geo.base_pitch, omega_driving=abs(kin.bodies[mk.driver].speed),
+        base_pitch=geo.base_pitch, omega_driving=abs(mk.driver_speed),
         normal_load=mk.force, loaded_stiffness=k_mean,
         inertia_driving=kin.bodies[mk.driver].polar_inertia,
         inertia_driven=kin.bodies[mk.driven].polar_inertia,
@@ -282,7 +382,7 @@ def friction_direction(kin: Kinematics, mesh_name: str) -> np.ndarray:
     n_t = n - a * float(n @ a)
     n_t = n_t / np.linalg.norm(n_t)
     t = np.cross(a, n_t)
-    v = drv.speed * np.cross(a, mk.contact_point - drv.position)
+    v = mk.driver_speed * np.cross(a, mk.contact_point - drv.position)
     if float(t @ v) < 0.0:
         t = -t
     t[np.abs(t) < 1e-15] = 0.0
@@ -333,7 +433,7 @@ def friction_table(model: Model, kin: Kinematics, mesh_name: str, n: int) -> np.
         rb = (geo.gear2.base_radius, geo.gear1.base_radius)
         start, end = p2 - geo.path_end, p2 - geo.path_start
     g_drv, g_dvn = model.gears[mk.driver], model.gears[mk.driven]
-    omega = abs(kin.bodies[mk.driver].speed)
+    omega = abs(mk.driver_speed)
     load = mk.force / 2.0 if geo.double_helical else mk.force
     common = dict(base_radius_1=rb[0], base_radius_2=rb[1],
                   centre_distance=geo.operating_center_distance, contact_start=start,

@@ -3,5 +3,6 @@
 ``load_sharing`` holds every definition the seed papers use, selectable by name
 (``cycle_peak``, ``instantaneous``, ``engineering``, ``mean_force``,
 ``static_torque``), the settle criterion that excludes the transient, and the dynamic
-load factors.
+load factors.  ``planetary`` gives the mesh-load factor K_gamma of every planetary
+stage (largest planet load over the mean) from any of those definitions.
 """

@@ -14,12 +14,15 @@ check                           what it refuses
 :func:`topology_issues`         bodies connected to nothing, trains without drive/load
 :func:`mesh_compatibility_...`  modules, pressure angles, helices that cannot mesh
 :func:`geometry_issues`         involute geometry (interference, centre distance)
-kinematics                      loops that cannot turn, power that does not balance
+kinematics                      loops that cannot turn, power that does not balance,
+                                carriers and planets (model/epicyclic.py)
 :func:`nominal_load_issues`     meshes that carry no load (no power passes them)
 :func:`balance_issues`          torques out of balance by more than
                                 :data:`BALANCE_TOLERANCE` (what the static solution of
                                 every run refuses)
 :func:`stiffness_table_issues`  mesh stiffness tables that are not positive everywhere
+:func:`planet_fit_issues`       planets whose teeth cannot mesh with sun and ring at
+                                their angles (the tooth-count assembly condition)
 :func:`readiness_issues`        (``deep``) the stages every run performs before it
                                 integrates: assembly and the static equilibrium
 ==============================  ========================================================
@@ -76,7 +79,7 @@ def check_model(model: Model, source: str | None = None, *, deep: bool = False) 
     except KinematicsError as exc:
         raise ModelError(exc.issues, source) from None
     issues = nominal_load_issues(model, kin) + balance_issues(model, kin)
-    issues += stiffness_table_issues(model, kin)
+    issues += stiffness_table_issues(model, kin) + planet_fit_issues(model, kin)
     notes = []
     if not issues and deep:
         issues, notes = _readiness(model, kin)
@@ -156,6 +159,12 @@ def topology_issues(model: Model) -> list[tuple[str, str]]:
         a, b = s.connects
         adj[a].add(b)
         adj[b].add(a)
+    for n in names:  # a bearing on another body (a planet on its carrier) joins them
+        spec = model.gears.get(n) or model.bodies.get(n)
+        on = spec.support.on if spec is not None and spec.support is not None else None
+        if on in adj and on != n:
+            adj[n].add(on)
+            adj[on].add(n)
     for n in names:
         if not adj[n]:
             kind = "gears" if n in model.gears else "bodies"
@@ -529,6 +538,21 @@ def balance_issues(model: Model, kin) -> list[tuple[str, str]]:
             f"{p_in:.10g} W and the loads take {p_out:.10g} W "
             f"({100 * abs(p_in - p_out) / total:.3g} % of the power through the train); set a "
             f"load's torque to \"balanced\" or correct the torques"))]
+    return []
+
+
+def planet_fit_issues(model: Model, kin) -> list[tuple[str, str]]:
+    """Planets whose teeth cannot mesh with their sun and ring at their angles (the
+    tooth-count assembly condition, checked as the closure of the mesh phases around
+    every loop through a planet: :func:`torquesplit.assembly.excitation.mesh_phases`)."""
+    if not kin.carriers:
+        return []
+    from ..assembly.excitation import mesh_phases
+
+    try:
+        mesh_phases(model, kin, strict=True)
+    except ModelError as exc:
+        return list(exc.issues)
     return []
 
 

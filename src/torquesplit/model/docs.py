@@ -130,14 +130,17 @@ def render() -> str:
     for name, field in Model.model_fields.items():
         cls = _section_class(field.annotation)
         if cls is not None:
-            out.extend(_section(_header(name, field.annotation).strip("[]"), cls, paths))
+            out.extend(_section(_header(name, field.annotation).strip("[]"), cls, paths,
+                                double=_header(name, field.annotation).startswith("[[")))
     return "\n".join(out).rstrip("\n") + "\n"
 
 
-def _section(path: str, cls: type[BaseModel], paths: dict[type, str]) -> list[str]:
-    """The table of one section, followed by its nested sections seen for the first time."""
+def _section(path: str, cls: type[BaseModel], paths: dict[type, str],
+             double: bool = False) -> list[str]:
+    """The table of one section, followed by its nested sections seen for the first time
+    (``double``: an array of tables, ``[[path]]``)."""
     paths[cls] = path
-    lines = [f"### `[{path}]`\n"]
+    lines = [f"### `[[{path}]]`\n" if double else f"### `[{path}]`\n"]
     doc = (cls.__doc__ or "").strip().split("\n\n")[0]
     if doc:
         lines.append(" ".join(doc.split()) + "\n")
@@ -178,6 +181,8 @@ def _section_class(tp) -> type[BaseModel] | None:
     tp = _strip_optional(tp)
     if typing.get_origin(tp) is dict:
         tp = typing.get_args(tp)[1]
+    elif typing.get_origin(tp) is list and _is_table(typing.get_args(tp)[0]):
+        tp = typing.get_args(tp)[0]
     if typing.get_origin(tp) is typing.Annotated:
         tp = typing.get_args(tp)[0]
     if isinstance(tp, type) and issubclass(tp, Strict):
@@ -185,8 +190,17 @@ def _section_class(tp) -> type[BaseModel] | None:
     return None
 
 
+def _is_table(tp) -> bool:
+    return isinstance(tp, type) and issubclass(tp, Strict)
+
+
 def _header(name: str, tp) -> str:
-    return f"[{name}.NAME]" if typing.get_origin(_strip_optional(tp)) is dict else f"[{name}]"
+    tp = _strip_optional(tp)
+    if typing.get_origin(tp) is dict:
+        return f"[{name}.NAME]"
+    if typing.get_origin(tp) is list and _is_table(typing.get_args(tp)[0]):
+        return f"[[{name}]]"
+    return f"[{name}]"
 
 
 def _unit(tp, metadata=()) -> Unit | None:

@@ -194,7 +194,10 @@ def _strip(tp):
 
 def model_to_dict(model: Model) -> dict[str, Any]:
     """The model as a plain dict of SI numbers (can be re-read by :func:`load_model`)."""
-    return _drop_none(model.model_dump(mode="json"))
+    data = _drop_none(model.model_dump(mode="json"))
+    if not data.get("planetary"):  # expanded on reading: the general sections hold it
+        data.pop("planetary", None)
+    return data
 
 
 def model_to_json(model: Model) -> str:

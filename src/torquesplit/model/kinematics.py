@@ -17,11 +17,13 @@ All values SI.  Angles of rotation are signed about each body's own axis.
 from __future__ import annotations
 
 import math
+import warnings
 from collections import deque
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..errors import ModelWarning
 from ..gears import line_of_action as loa
 from ..gears.geometry import GearGeometry, PairGeometry
 from ..errors import KinematicsError  # noqa: F401 - re-exported
@@ -85,6 +87,12 @@ class MeshKinematics:
     """ISO 6336-1 estimate c_gamma * b [N/m] (cylindrical pairs only)."""
     conical: bool
     geometry: PairGeometry | None = field(default=None, repr=False, compare=False)
+    carrier: str | None = None
+    """The carrier in whose (rotating) frame the mesh is analysed; None: the housing."""
+    driver_speed: float = math.nan
+    """Signed speed of the driver about its axis in the mesh's frame [rad/s]."""
+    driven_speed: float = math.nan
+    """Signed speed of the driven gear about its axis in the mesh's frame [rad/s]."""
 
 
 @dataclass(frozen=True)
@@ -104,6 +112,31 @@ class Kinematics:
     translation_axes: dict[str, dict[str, np.ndarray]] = field(default_factory=dict)
     """Body -> {translational DOF: its unit direction}: the global axes for x, y, z and
     the transverse line of action of the body's meshes for 'loa'."""
+    carriers: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    """Carrier body -> its planets (bodies whose bearing sits on it, off its axis)."""
+    planet_bodies: dict[str, str] = field(default_factory=dict)
+    """Body turning with a planet (the planet and the gears on its shaft) -> carrier."""
+    frames: dict[str, str] = field(default_factory=dict)
+    """Body -> carrier whose rotating frame its translations are measured in (bodies not
+    listed: the housing's frame)."""
+    held: tuple[str, ...] = ()
+    """Bodies held against rotation by a torsional support (nominal speed zero)."""
+    reactions: dict[str, float] = field(default_factory=dict)
+    """Held body -> reaction torque of its torsional support about its axis [N m]."""
+
+    def frame_speed(self, body: str) -> float:
+        """Speed of the frame ``body``'s translations are measured in [rad/s] (signed
+        about the carrier's axis; 0 for the housing)."""
+        c = self.frames.get(body)
+        return 0.0 if c is None else self.bodies[c].speed
+
+    def relative_speed(self, body: str, carrier: str | None) -> float:
+        """Speed of ``body`` about its own axis relative to ``carrier``'s frame."""
+        w = self.bodies[body].speed
+        if carrier is None:
+            return w
+        c = self.bodies[carrier]
+        return w - float(self.bodies[body].axis @ c.axis) * c.speed
 
 
 # --------------------------------------------------------------------------- helpers
@@ -139,6 +172,14 @@ def solve_kinematics(model: Model) -> Kinematics:
     if issues:
         raise KinematicsError(issues)
 
+    from . import epicyclic as epi
+
+    # carriers and planets first: a ring of the wrong kind is named as such, not as a
+    # centre distance that does not fit
+    layout = epi.find_layout(model, positions, axes, groups, issues)
+    if issues:
+        raise KinematicsError(issues)
+
     frames = {}
     for name, mesh in model.meshes.items():
         try:
@@ -147,16 +188,35 @@ def solve_kinematics(model: Model) -> Kinematics:
             issues.append((f"meshes.{name}", str(exc)))
     if issues:
         raise KinematicsError(issues)
+    nominal = None
+    trans_frames: dict[str, str] = {}
+    if layout.active:
+        # carriers, planets or held members: speeds and torques from the linear
+        # equations of model/epicyclic.py (Willis in every carrier's frame)
+        speeds = epi.solve_speeds(model, axes, frames, groups, layout, issues)
+        if issues:
+            raise KinematicsError(issues)
+        nominal = epi.solve_torques(model, axes, frames, groups, speeds, layout, issues)
+        if issues or nominal is None:
+            raise KinematicsError(issues)
+        trans_frames = epi.translation_frames(model, layout, positions, axes, speeds, issues)
+        if issues:
+            raise KinematicsError(issues)
+        drivers, edge_power = nominal.drivers, nominal.mesh_power
+        drive_torques, load_torques = nominal.drive_torques, nominal.load_torques
+        power = {b: nominal.body_torque[b] * abs(speeds[b]) for b in model.body_names()}
+        p_in = sum(drive_torques[n] * abs(d.speed) for n, d in model.drives.items())
+        p_out = sum(load_torques[n] * abs(speeds[ld.body]) for n, ld in model.loads.items())
+    else:
+        speeds = _propagate_speeds(model, axes, frames, issues)
+        if issues:
+            raise KinematicsError(issues)
 
-    speeds = _propagate_speeds(model, axes, frames, issues)
-    if issues:
-        raise KinematicsError(issues)
-
-    power, edge_power, drivers, drive_torques, load_torques, p_in, p_out = _power_flow(
-        model, speeds, groups, issues
-    )
-    if issues:
-        raise KinematicsError(issues)
+        power, edge_power, drivers, drive_torques, load_torques, p_in, p_out = _power_flow(
+            model, speeds, groups, issues
+        )
+        if issues:
+            raise KinematicsError(issues)
 
     bodies = {}
     for name in model.body_names():
@@ -167,9 +227,10 @@ def solve_kinematics(model: Model) -> Kinematics:
             mass, inertia, mc, ic = (b.mass or 0.0), b.polar_inertia, False, False
         w = speeds[name]
         p = power.get(name, 0.0)
+        torque = nominal.body_torque[name] if nominal is not None else p / abs(w)
         bodies[name] = BodyKinematics(
             name=name, position=positions[name], axis=axes[name], speed=w,
-            torque=p / abs(w), power=p, mass=mass, polar_inertia=inertia,
+            torque=torque, power=p, mass=mass, polar_inertia=inertia,
             mass_computed=mc, inertia_computed=ic,
         )
 
@@ -177,12 +238,27 @@ def solve_kinematics(model: Model) -> Kinematics:
     for name, mesh in model.meshes.items():
         driver, driven = drivers[name]
         fr = frames[name]
-        n_vec, arm_d, arm_n = loa.line_of_action(model, name, fr, driver, speeds)
+        carrier = layout.mesh_carrier.get(name)
+        # speeds in the mesh's frame (its carrier's; the housing's for fixed axes)
+        rel = {g: epi.relative_speed(g, carrier, speeds, axes) for g in (driver, driven)}
+        n_vec, arm_d, arm_n = loa.line_of_action(model, name, fr, driver, rel)
         za = model.gears[driver].teeth
-        freq = abs(speeds[driver]) * za / (2 * math.pi)
+        freq = abs(rel[driver]) * za / (2 * math.pi)
+        if not freq > 0:
+            issues.append((f"meshes.{name}", (
+                f"the gears of this mesh do not turn against each other (speed "
+                f"{rel[driver] * 30 / math.pi:.6g} rpm in its frame), so it has no mesh "
+                f"cycle; check which members are held and driven")))
+            continue
         p_mesh = edge_power[name]
-        t_drv = p_mesh / abs(speeds[driver])
-        t_dvn = p_mesh / abs(speeds[driven])
+        if nominal is not None:
+            first = model.meshes[name].gears[0]
+            t_first, t_second = nominal.mesh_torque[name], nominal.mesh_torque_second[name]
+            t_drv, t_dvn = (abs(t_first), abs(t_second)) if driver == first else \
+                (abs(t_second), abs(t_first))
+        else:
+            t_drv = p_mesh / abs(speeds[driver])
+            t_dvn = p_mesh / abs(speeds[driven])
         force = t_drv / abs(arm_d)
         # inertia of the rigid group each gear belongs to (compound gears)
         ja, jb = (sum(bodies[b].polar_inertia for b in bodies if groups[b] == groups[g])
@@ -212,8 +288,11 @@ def solve_kinematics(model: Model) -> Kinematics:
             center_distance=fr.center_distance,
             torque_driver=t_drv, torque_driven=t_dvn, force=force, power=p_mesh,
             equivalent_mass=m_eq, critical_damping=crit, iso_stiffness=iso,
-            conical=fr.conical, geometry=geo,
+            conical=fr.conical, geometry=geo, carrier=carrier,
+            driver_speed=rel[driver], driven_speed=rel[driven],
         )
+    if issues:
+        raise KinematicsError(issues)
     trans_axes = _translation_axes(model, bodies, meshes, issues)
     if issues:
         raise KinematicsError(issues)
@@ -221,6 +300,9 @@ def solve_kinematics(model: Model) -> Kinematics:
         bodies=bodies, meshes=meshes, input_power=p_in, output_power=p_out,
         load_torques=load_torques, drive_torques=drive_torques, groups=groups,
         positions_computed=computed, translation_axes=trans_axes,
+        carriers=dict(layout.carriers), planet_bodies=dict(layout.planet_bodies),
+        frames=trans_frames, held=layout.held,
+        reactions=dict(nominal.reactions) if nominal is not None else {},
     )
 
 
@@ -527,6 +609,11 @@ def _power_flow(model: Model, speeds, groups, issues):
         if flow is None:
             # no power flows through the mesh in the nominal split (e.g. an idler loop)
             drv = m.driver or a
+            if m.driver is None:
+                warnings.warn(
+                    f"meshes.{name}: no power passes this mesh in the nominal split, so its "
+                    f"loaded flank is not determined; {a!r} (listed first) is taken as the "
+                    f"driver: give 'driver' to choose the flank", ModelWarning, stacklevel=4)
         else:
             drv = a if groups[a] == flow[0] else b
             if m.driver is not None and m.driver != drv:

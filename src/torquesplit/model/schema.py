@@ -129,6 +129,50 @@ class ShaftBending(Strict):
         return self
 
 
+class PinError(Strict):
+    """Position error of a bearing seat on the body that carries it (a planet pin on its
+    carrier; Bodas & Kahraman 2004, Ligata et al. 2008)."""
+
+    radial: Length = Field(0.0, description="Along the line from the seat body's axis to "
+                           "the nominal pin centre, positive outwards.")
+    tangential: Length = Field(0.0, description="Perpendicular to it in the seat body's "
+                               "plane, positive in the seat body's positive sense of "
+                               "rotation (counter-clockwise about its axis).")
+
+    @property
+    def is_zero(self) -> bool:
+        return self.radial == 0.0 and self.tangential == 0.0
+
+
+class TorsionalSupport(Strict):
+    """Holds a member against rotation (a fixed ring gear, the fixed carrier of a star
+    stage): its nominal speed is zero and the support takes the reaction torque, through
+    a torsional spring to the housing (Lin & Parker 1999 k_ru) or rigidly."""
+
+    stiffness: TorsionalStiffness | None = Field(
+        None, gt=0, description="Torsional stiffness to the housing (e.g. '6e6 N m/rad')."
+    )
+    damping: TorsionalDamping | None = Field(None, ge=0, description="Torsional damping.")
+    damping_ratio: Number | None = Field(
+        None, ge=0, description="Damping as a fraction of critical, c = 2 zeta sqrt(k J).")
+    rigid: Flag = Field(False, description="Hold the member rigidly (its rotation is "
+                        "removed from the DOFs) instead of through a spring.")
+
+    @model_validator(mode="after")
+    def _one(self):
+        if self.rigid and self.stiffness is not None:
+            raise ValueError("both 'rigid' and 'stiffness' are given; remove one of them")
+        if not self.rigid and self.stiffness is None:
+            raise ValueError("the torsional support has no stiffness; give 'stiffness' "
+                             "(e.g. '6e6 N m/rad') or rigid = true")
+        if self.rigid and (self.damping is not None or self.damping_ratio is not None):
+            raise ValueError("a rigid torsional support has no damping; remove 'damping' "
+                             "and 'damping_ratio' or give a 'stiffness' instead of rigid")
+        if self.damping is not None and self.damping_ratio is not None:
+            raise ValueError("both 'damping' and 'damping_ratio' are given; remove one of them")
+        return self
+
+
 class Support(Strict):
     """Support of a body's translations: a bearing or shaft bending, to the housing or
     (``on``) to another body (a planet on its carrier pin, a gear on a moving frame)."""
@@ -157,6 +201,9 @@ class Support(Strict):
         "other end: a planet pin on its carrier, a moving housing); default: the fixed "
         "housing."
     )
+    pin_error: PinError = Field(
+        PinError(), description="Position error of the seat (planet pin) on the body "
+        "named by 'on' (radial, tangential); requires 'on'.")
 
     @model_validator(mode="after")
     def _one_stiffness(self):
@@ -167,6 +214,11 @@ class Support(Strict):
             raise ValueError("both 'stiffness' and 'shaft' are given; remove one of them")
         if self.damping is not None and self.damping_ratio is not None:
             raise ValueError("both 'damping' and 'damping_ratio' are given; remove one of them")
+        if self.on is None and not self.pin_error.is_zero:
+            raise FieldError("pin_error", (
+                "a pin position error is the error of the seat on the body named by 'on' "
+                "(a planet pin on its carrier); add on = \"carrier\" (your carrier's name), "
+                "or give an offset of a housing bore as the gear's errors.installation"))
         return self
 
 
@@ -235,6 +287,9 @@ class Gear(Strict):
         "axes; or 'loa', one translation along the line of action of the gear's meshes "
         "(seed 001 eq. 9; its meshes must push it along parallel lines)."))
     support: Support | None = Field(None, description="Support of the translational DOFs.")
+    torsional_support: TorsionalSupport | None = Field(
+        None, description="Holds the gear against rotation (a fixed ring or sun gear): "
+        "its nominal speed is zero.")
     errors: GearErrors = Field(GearErrors(), description="Eccentricity, installation, ... errors.")
     modifications: ModificationsSpec | None = Field(
         None, description="Tooth modification of the loaded flank (used by stiffness method "
@@ -281,6 +336,14 @@ class Body(Strict):
         "axes; or 'loa', one translation along the line of action of the gear's meshes "
         "(seed 001 eq. 9; its meshes must push it along parallel lines)."))
     support: Support | None = Field(None, description="Support of the translational DOFs.")
+    torsional_support: TorsionalSupport | None = Field(
+        None, description="Holds the body against rotation (the fixed carrier of a star "
+        "stage): its nominal speed is zero.")
+    eccentricity: Length = Field(
+        0.0, ge=0, description="Offset of the body's centre (its planet pins) from its "
+        "bearing axis, turning with the body (carrier eccentricity).")
+    eccentricity_phase: Angle = Field(0.0, description="Direction of the eccentricity at "
+                                      "t = 0, from the x axis about the body's axis.")
 
     @model_validator(mode="after")
     def _consistent(self):
@@ -592,18 +655,55 @@ class ModelInfo(Strict):
     reference: str = Field("", description="Source of the data (paper, drawing).")
 
 
+# the [[planetary]] shorthand builds on the sections above
+from .planetary import Planetary  # noqa: E402
+
+
 class Model(Strict):
     """A complete gearbox description (all values SI after validation)."""
 
     model: ModelInfo = Field(description="Name, description and source of the model.")
-    gears: dict[str, Gear] = Field(description="Gears by name.")
+    gears: dict[str, Gear] = Field({}, description="Gears by name (required unless a "
+                                   "[[planetary]] stage gives them).")
     bodies: dict[str, Body] = Field({}, description="Other rigid bodies by name.")
     shafts: dict[str, Shaft] = Field({}, description="Shafts by name.")
-    meshes: dict[str, Mesh] = Field(description="Gear meshes by name.")
+    meshes: dict[str, Mesh] = Field({}, description="Gear meshes by name (required unless a "
+                                    "[[planetary]] stage gives them).")
     splines: dict[str, Spline] = Field({}, description="Splines by name.")
     drives: dict[str, Drive] = Field(description="Power inputs by name.")
     loads: dict[str, Load] = Field(description="Power outputs by name.")
     analysis: Analysis = Field(Analysis(), description="Analysis defaults.")
+    planetary: list[Planetary] = Field(
+        [], description="Planetary stages in one table each ([[planetary]]); expanded to "
+        "the general sections (gears, bodies, meshes) on reading.")
+
+    @model_validator(mode="after")
+    def _expand_planetary(self):
+        """Replace each [[planetary]] table by its general elements (model/planetary.py)."""
+        if not self.planetary:
+            for section in ("gears", "meshes"):
+                if not getattr(self, section):
+                    raise FieldError(section, (
+                        f"the model has no {section}; add [{section}.NAME] sections (see "
+                        f"docs/model-file.md) or a [[planetary]] stage"))
+            return self
+        gears, bodies, meshes = dict(self.gears), dict(self.bodies), dict(self.meshes)
+        for k, stage in enumerate(self.planetary):
+            g, b, m = stage.expand()
+            for section, new, have in (("gears", g, gears), ("bodies", b, bodies),
+                                       ("meshes", m, meshes)):
+                for name, spec in new.items():
+                    if name in have or name in gears or name in bodies:
+                        raise FieldError(f"planetary.{k}.name", (
+                            f"the stage would create {section}.{name}, which exists already; "
+                            f"give the stage another 'name'"))
+                    cls = {"gears": Gear, "bodies": Body, "meshes": Mesh}[section]
+                    have[name] = cls.model_validate(spec)
+        object.__setattr__(self, "gears", gears)
+        object.__setattr__(self, "bodies", bodies)
+        object.__setattr__(self, "meshes", meshes)
+        object.__setattr__(self, "planetary", [])
+        return self
 
     def body_names(self) -> list[str]:
         return list(self.gears) + list(self.bodies)

@@ -654,11 +654,16 @@ def _bin_extremes(t: np.ndarray, y: np.ndarray, bin_index: np.ndarray):
 
 
 def _stiffness_at_phase(table: np.ndarray, phase: np.ndarray) -> np.ndarray:
-    """The stiffness table read as the integrator reads it: linear, periodic, at
-    ``frac(phase) * n_table`` (:func:`torquesplit.solve._kernels.excite_tables`)."""
-    n = table.size
-    pos = np.mod(phase, 1.0) * n
-    return np.interp(pos, np.arange(n + 1), np.append(table, table[0]))
+    """The stiffness table read as the integrator reads it: the same law,
+    :func:`torquesplit.solve.laws.periodic_values` (linear, periodic)."""
+    from ..solve.laws import periodic_values
+
+    phase = np.asarray(phase, dtype=float).ravel()
+    rows = np.ascontiguousarray(np.broadcast_to(np.asarray(table, dtype=float),
+                                                (phase.size, np.size(table))))
+    out = np.empty(phase.size)
+    periodic_values(rows, phase, out)
+    return out
 
 
 def _stiffness_varies(results) -> bool:

@@ -122,10 +122,11 @@ _BETA = 0.04
 _EXPO1 = 0.2 - _BETA * 0.75
 
 _kernel = njit(cache=True, error_model="numpy", _nrt=False)
+_inline = njit(inline="always", error_model="numpy", _nrt=False)
 
 
 # =================================================================== excitation
-@_kernel
+@_inline
 def excite(t, slot, src, m, w):
     """Every time-dependent excitation at t into ``slot``.
 
@@ -159,9 +160,7 @@ def excite(t, slot, src, m, w):
         CY[slot, e] = laws.stat_cycle(s, fl)
         g0 = gap_ptr[e]
         ng = gap_ptr[e + 1] - g0
-        if ng == 1:
-            G[slot, e] = gap_values[g0]
-        else:
+        if ng > 1:  # one half-gap: constant, set in every slot by make_work
             c = np.int64(fl)
             if c != gap_cyc[e]:
                 k = c % ng
@@ -341,7 +340,7 @@ def evaluate(t, m, w, rhs_fn, gen):
 
 
 # ================================================================== recording
-@_kernel
+@_inline
 def record(slot, i_f, weight, m, w, r, counters):
     """Enter one accepted state (forces in row ``i_f``) in the statistics.
 
@@ -358,6 +357,7 @@ def record(slot, i_f, weight, m, w, r, counters):
     track_el, track_base = r.track_el, r.track_base
     cyc_max, cyc_min, cyc_sum, cyc_cnt = r.cyc_max, r.cyc_min, r.cyc_sum, r.cyc_cnt
     grp_ptr, grp_col, rat_max, rat_min = r.grp_ptr, r.grp_col, r.rat_max, r.rat_min
+    grp_min = r.grp_min
     sep_count, sep_time, back_count, back_time = (r.sep_count, r.sep_time, r.back_count,
                                                   r.back_time)
     element_kind = m.element_kind
@@ -377,7 +377,7 @@ def record(slot, i_f, weight, m, w, r, counters):
         total = 0.0
         for k in range(grp_ptr[g], grp_ptr[g + 1]):
             total += force[i_f, track_el[grp_col[k]]]
-        if total != 0.0:
+        if total > grp_min[g]:
             nm = grp_ptr[g + 1] - grp_ptr[g]
             for k in range(grp_ptr[g], grp_ptr[g + 1]):
                 j = grp_col[k]
@@ -416,6 +416,7 @@ def record_extrema(slot, i_f, w, r):
     track_el, track_base = r.track_el, r.track_base
     cyc_max, cyc_min = r.cyc_max, r.cyc_min
     grp_ptr, grp_col, rat_max, rat_min = r.grp_ptr, r.grp_col, r.rat_max, r.rat_min
+    grp_min = r.grp_min
     cap = cyc_max.shape[0]
     for j in range(track_el.shape[0]):
         el = track_el[j]
@@ -430,7 +431,7 @@ def record_extrema(slot, i_f, w, r):
         total = 0.0
         for k in range(grp_ptr[g], grp_ptr[g + 1]):
             total += force[i_f, track_el[grp_col[k]]]
-        if total != 0.0:
+        if total > grp_min[g]:
             nm = grp_ptr[g + 1] - grp_ptr[g]
             for k in range(grp_ptr[g], grp_ptr[g + 1]):
                 j = grp_col[k]
@@ -590,7 +591,7 @@ def store_full(row, t, iy, w, r):
         full_y[row, k] = Y[iy, k]
 
 
-@_kernel
+@_inline
 def bad_state(iy, blowup, w):
     """Index of the first non-finite entry of state row ``iy`` or |q| > blowup, or -1.
     Twin: ``np.flatnonzero(~np.isfinite(y) | (abs(q) > blowup))[:1]``."""
@@ -703,18 +704,26 @@ def rk4_run(t0, h, n_first, n_steps, record_final, record_every, blowup, m, w, r
     t_corner = math.inf  # earliest corner still ahead
     if m.corner_node.shape[0] > 0 and n_steps > 0:
         t_corner = first_corners(t0 + n_first * h, m, w, r)
+    # the next step indices that are multiples of RESYNC and of record_every (counted, not
+    # found by an integer division per step)
+    next_sync = (n_first // RESYNC + 1) * RESYNC
+    every = record_every if record_every > 0 else n_first + n_steps + 1
+    next_rec = -(-n_first // every) * every
     for it in range(n_steps):
         i = n_first + it
         t = t0 + i * h
-        if it == 0 or i % RESYNC == 0:
+        if it == 0 or i == next_sync:
             excite(t, a, np.int64(-1), m, w)
+            if i == next_sync:
+                next_sync += RESYNC
         # stage 1 at t: its forces are those of the accepted state y(t)
         _stage(a, Y_STATE, Y_K1, F_MAIN, m, w, rhs_fn, gen, extra)
         record(a, F_MAIN, h, m, w, r, counters)
-        if (record_every > 0 and i % record_every == 0
-                and counters[I_HIST] < n_hist):
-            store_history(counters[I_HIST], t, Y_STATE, F_MAIN, w, r)
-            counters[I_HIST] += 1
+        if i == next_rec:
+            next_rec += every
+            if record_every > 0 and counters[I_HIST] < n_hist:
+                store_history(counters[I_HIST], t, Y_STATE, F_MAIN, w, r)
+                counters[I_HIST] += 1
         if counters[I_FULL] < n_full:
             store_full(counters[I_FULL], t, Y_STATE, w, r)
             counters[I_FULL] += 1

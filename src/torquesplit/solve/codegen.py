@@ -114,6 +114,7 @@ def rhs_ir(model) -> tuple[str, list[tuple[str, int]]]:
     vt_ptr, vt_el = a["vt_ptr"].astype(np.int64), a["vt_el"].astype(np.int64)
     gy_ptr, gy_idx = a["gy_ptr"].astype(np.int64), a["gy_idx"].astype(np.int64)
     gap_ptr, gap_values = a["gap_ptr"], a["gap_values"]
+    has_error, has_force = _error_and_force_flags(a)
     _, law = _law_ir()
     layout: list[tuple[str, int]] = []
     body: list[str] = []
@@ -155,12 +156,19 @@ def rhs_ir(model) -> tuple[str, list[tuple[str, int]]]:
 
     force = {}
     for e in range(ne):
-        d = neg(load("E", e))
-        r = neg(load("ED", e))
+        # an element without error: its E and E' are 0, and -0 + x == x for every x, so
+        # the sums start at their first product (same result as rhs_slot, fewer loads)
+        errs = bool(has_error[e])
+        d = neg(load("E", e)) if errs else None
+        r = neg(load("ED", e)) if errs else None
         for j in range(vr_ptr[e], vr_ptr[e + 1]):
             c = param("v_coef", j)
-            d = op("fadd", d, op("fmul", c, load("y", vq_idx[j])))
-            r = op("fadd", r, op("fmul", c, load("y", n + vq_idx[j])))
+            pd = op("fmul", c, load("y", vq_idx[j]))
+            pr = op("fmul", c, load("y", n + vq_idx[j]))
+            d = pd if d is None else op("fadd", d, pd)
+            r = pr if r is None else op("fadd", r, pr)
+        if d is None:  # an element without projection entries
+            d, r = "0.0", "0.0"
         k = load("K", e)
         c = param("damping", e)
         # the law (laws.spring_force) on this element: its own compiled code, inlined
@@ -170,7 +178,8 @@ def rhs_ir(model) -> tuple[str, list[tuple[str, int]]]:
         body.append(f"  {st} = call i32 @{law}(ptr %ret, ptr %exc, double {k}, double {c}, "
                     f"double {d}, double {r}, double {g}) #0")
         body.append(f"  {fe} = load double, ptr %ret, align 8")
-        f = op("fadd", fe, load("P", e))
+        # without an additive force table P is 0: f + 0 == f (but for the sign of a zero)
+        f = op("fadd", fe, load("P", e)) if has_force[e] else fe
         store("force", e, f)
         store("defl", e, d)
         force[e] = f
@@ -206,14 +215,26 @@ def _entry_point() -> str:
             f"  call void @rhs_body({call})\n  ret void\n}}\n")
 
 
+def _error_and_force_flags(a: dict):
+    """Per element: does it own an error (constant or sinusoid), an additive force table."""
+    ne = a["vr_ptr"].shape[0] - 1
+    has_error = np.zeros(ne, dtype=bool)
+    has_error[np.asarray(a["err_el"], dtype=np.int64)] = True
+    has_error |= a["error_constant"] != 0.0
+    has_force = np.any(a["force_table"] != 0.0, axis=1) if ne else np.zeros(0, dtype=bool)
+    return has_error, has_force
+
+
 def _pattern_key(model) -> str:
-    """What the generated code depends on: sparsity of V and V^T, dead-zone elements."""
+    """What the generated code depends on: sparsity of V, V^T and G, which elements have
+    a dead zone, an error, an additive force."""
     a = _arrays(model)
     gp, gv = a["gap_ptr"], a["gap_values"]
     gapped = np.array([np.any(gv[gp[e]:gp[e + 1]] > 0.0) for e in range(gp.shape[0] - 1)])
+    has_error, has_force = _error_and_force_flags(a)
     h = hashlib.sha256()
     for x in (np.int64(a["inv_mass"].shape[0]), a["vr_ptr"], a["vq_idx"], a["vt_ptr"],
-              a["vt_el"], a["gy_ptr"], a["gy_idx"], gapped):
+              a["vt_el"], a["gy_ptr"], a["gy_idx"], gapped, has_error, has_force):
         arr = np.ascontiguousarray(x)
         h.update(str((arr.dtype, arr.shape)).encode())
         h.update(arr.tobytes())

@@ -348,6 +348,7 @@ def integrate(
     max_steps: int | None = None,
     track_elements=None,
     load_sharing_groups=None,
+    load_sharing_min_total=None,
     n_cycles_cap: int | None = None,
     history_elements=None,
     history_dofs=None,
@@ -403,6 +404,10 @@ def integrate(
         ratio N f_i / sum_j f_j of each member (Ji & Li eq. 18) is formed at every step
         and its per-cycle largest and smallest values streamed
         (``Solution.cycle_ratio_max`` / ``cycle_ratio_min``).  Default: none.
+    load_sharing_min_total : sequence of float, optional
+        Per group, the total force [N] below which no ratio is formed (an instant when the
+        group carries almost nothing, e.g. every mesh of it out of contact: the ratio of
+        nearly nothing is not load sharing).  Default: any positive total.
     n_cycles_cap : int, optional
         Rows of the cycle arrays.  Default: enough for the whole run.
     history_elements, history_dofs : sequence of int or str, optional
@@ -503,9 +508,11 @@ def integrate(
             f"the requested outputs need {need / 1024**3:.1f} GiB; record less: raise "
             "record_every / sample_interval, list fewer history_elements and "
             "history_dofs, drop full_history, or lower n_cycles_cap.")
+    if load_sharing_min_total is not None and len(load_sharing_min_total) != len(sel.groups):
+        raise ValueError("load_sharing_min_total needs one value per load-sharing group.")
     rec = kd.make_record(sel.track, sel.track_base, sel.n_cycles_cap, sel.groups,
                          s.n_elements, sel.hist_el, sel.hist_dof, n_hist, plan.n_full,
-                         s.n_dof)
+                         s.n_dof, load_sharing_min_total)
     work = kd.make_work(model, rhs_code.parameters)
     work.Y[kd.Y_STATE] = y
     counters = np.zeros(kern.N_COUNTERS, dtype=np.int64)

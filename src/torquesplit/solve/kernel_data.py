@@ -81,7 +81,7 @@ corner."""
 
 Record = namedtuple("Record", (
     "track_el", "track_base", "cyc_max", "cyc_min", "cyc_sum", "cyc_cnt",
-    "grp_ptr", "grp_col", "rat_max", "rat_min",
+    "grp_ptr", "grp_col", "grp_min", "rat_max", "rat_min",
     "sep_count", "back_count", "sep_time", "back_time",
     "hist_el", "hist_dof", "hist_t", "hist_f", "hist_q", "hist_v", "full_t", "full_y",
 ))
@@ -89,7 +89,8 @@ Record = namedtuple("Record", (
 cycle containing the start time): force max, min, sum and sample count; per
 load-sharing group (``grp_col[grp_ptr[g]:grp_ptr[g+1]]`` its tracked columns) the
 largest and smallest instantaneous ratio ``N f_i / sum_j f_j`` of each member in each of
-its cycles (``rat_max``, ``rat_min``); per element the samples and time in separation
+its cycles (``rat_max``, ``rat_min``), formed only while the group's total force exceeds
+``grp_min[g]`` (the ratio of nearly nothing is not load sharing); per element the samples and time in separation
 and in back-side contact; the decimated history and the optional full state."""
 
 # rows of Work.Y
@@ -301,9 +302,10 @@ def make_work(m: KernelModel, rhs_parameters: np.ndarray | None = None) -> Work:
 
 
 def make_record(track_el, track_base, n_cycles_cap: int, groups, n_el: int, hist_el,
-                hist_dof, n_hist: int, n_full: int, n_dof: int) -> Record:
+                hist_dof, n_hist: int, n_full: int, n_dof: int, group_min=None) -> Record:
     """Output arrays of a run.  ``groups``: lists of tracked columns, one per
-    load-sharing group (the ratio statistics)."""
+    load-sharing group (the ratio statistics); ``group_min``: the group total force below
+    which no ratio is formed [N] (default 0: any positive total)."""
     n_tr = len(track_el)
     cap = int(n_cycles_cap)
     grp_ptr = np.zeros(len(groups) + 1, dtype=np.int64)
@@ -316,6 +318,8 @@ def make_record(track_el, track_base, n_cycles_cap: int, groups, n_el: int, hist
         cyc_max=np.full((cap, n_tr), -np.inf), cyc_min=np.full((cap, n_tr), np.inf),
         cyc_sum=np.zeros((cap, n_tr)), cyc_cnt=np.zeros((cap, n_tr), dtype=np.int64),
         grp_ptr=grp_ptr, grp_col=grp_col,
+        grp_min=(np.zeros(len(groups)) if group_min is None
+                 else np.asarray(group_min, dtype=np.float64).reshape(len(groups))),
         rat_max=np.full((cap, n_tr), -np.inf), rat_min=np.full((cap, n_tr), np.inf),
         sep_count=np.zeros(n_el, dtype=np.int64), back_count=np.zeros(n_el, dtype=np.int64),
         sep_time=np.zeros(n_el), back_time=np.zeros(n_el),

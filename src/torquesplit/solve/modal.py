@@ -164,9 +164,15 @@ def _gyroscopic_modes(K, Gm, inv_mass, rigid_tolerance):
     lam, vec = np.linalg.eig(A)
     scale = float(np.max(np.abs(lam))) if lam.size else 0.0
     rigid = np.abs(lam) ** 2 <= rigid_tolerance * scale**2
-    keep = ~rigid & (lam.imag > 0)
-    order = np.argsort(lam.imag[keep])
-    w = lam.imag[keep][order]
+    real = np.abs(lam.imag) <= 1e-9 * scale
+    # oscillatory modes: one per conjugate pair; a real pair +-s (a statically unstable
+    # mode, e.g. divergence of a fast-turning carrier) is kept once, as frequency -s/2pi
+    osc = ~rigid & ~real & (lam.imag > 0)
+    div = ~rigid & real & (lam.real > 0)
+    w_all = np.where(osc, lam.imag, -lam.real)
+    keep = osc | div
+    order = np.argsort(w_all[keep])
+    w = w_all[keep][order]
     phi = vec[:n][:, keep][:, order]
     mass = 1.0 / inv_mass
     norm = np.sqrt(np.real(np.einsum("im,i,im->m", phi.conj(), mass, phi)))
@@ -176,7 +182,7 @@ def _gyroscopic_modes(K, Gm, inv_mass, rigid_tolerance):
     lk, psi = np.linalg.eigh(0.5 * (d[:, None] * K * d[None, :] + (d[:, None] * K * d[None, :]).T))
     lk_max = float(np.max(np.abs(lk))) if lk.size else 0.0
     phi_r = d[:, None] * psi[:, np.abs(lk) <= rigid_tolerance * lk_max]
-    return w / (2 * math.pi), phi, phi_r, w**2
+    return w / (2 * math.pi), phi, phi_r, np.sign(w) * w**2
 
 
 def _spline_tangent(par, dx: float, dy: float, closed: bool) -> np.ndarray:

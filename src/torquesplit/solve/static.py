@@ -141,13 +141,22 @@ def rigid_body_modes(structure: Structure, active: np.ndarray | None = None,
     ``active`` (n_el bool) defaults to every element whose stiffness table is not all
     zero, dead zones closed.  Computed from the projection vectors alone (singular
     values of V M^-1/2 below ``tolerance`` x the largest), so stiffness magnitudes do
-    not affect it.
+    not affect it.  The inertial terms of a turning frame (centripetal softening, pin
+    preload: ``metadata['inertial_elements']``) are left out: the rigid rotation of a
+    planetary train is that of its kinematics, on which the nominal torques balance.
     """
     s = structure
     if active is None:
         active = np.abs(s.stiffness_table).max(axis=1) > 0
+    active = np.asarray(active, dtype=bool).copy()
+    # the terms of a turning frame (centripetal softening, pin preload) are inertial, not
+    # elastic: they do not hold the train's rigid rotation
+    inertial = s.metadata.get("inertial_elements", ())
+    if inertial:
+        names = {n: i for i, n in enumerate(s.element_names)}
+        active[[names[n] for n in inertial if n in names]] = False
     d = np.sqrt(s.inv_mass)
-    A = s.projection_matrix()[np.asarray(active, dtype=bool)] * d[None, :]
+    A = s.projection_matrix()[active] * d[None, :]
     if A.shape[0] == 0:
         return np.diag(d)
     _, sv, vt = np.linalg.svd(A, full_matrices=True)
@@ -334,6 +343,26 @@ class _StaticProblem:
             s = self.s
             free = rigid_body_modes(s, active=active)
             extra = free.shape[1] - self.phi.shape[1]
+            if extra <= 0:
+                # no free motion by the topology: the system is singular to round-off
+                # only (a motion held by elements many decades softer than the rest,
+                # whose detection must not depend on the order of the DOFs); the least-
+                # squares solution is the equilibrium if it satisfies the equations
+                x, *_ = np.linalg.lstsq(A, b, rcond=None)
+                if np.all(np.isfinite(x)) and np.all(
+                        np.abs(A @ x - b) <= 1e-7 * (np.abs(A) @ np.abs(x) + np.abs(b))
+                        + 1e-300):
+                    return sc * x[:n]
+                lam, vec = np.linalg.eigh(0.5 * (A[:n, :n] + A[:n, :n].T))
+                weak = vec[:, 0]
+                names = [s.dof_names[i] for i in np.argsort(-np.abs(weak))[:4]
+                         if abs(weak[i]) > 1e-3 * np.abs(weak).max()]
+                raise SolverError(
+                    f"the static stiffness is singular to round-off: the motion of "
+                    f"{names} is held only by elements about {abs(lam[0]):.1e} times "
+                    f"softer than the others. Stiffen those elements (or remove the "
+                    f"DOFs they hold) so that every stiffness is within about 10 decades "
+                    f"of the largest.")
             loose = sorted({s.dof_names[i] for c in range(free.shape[1])
                             for i in np.flatnonzero(np.abs(free[:, c]) > 1e-9
                                                     * np.abs(free[:, c]).max())})
@@ -424,7 +453,9 @@ class _StaticProblem:
         if L.W is None:
             self.check_balance(L.f_eff)
         solves = 0
-        if q0 is None:
+        if q0 is None or (not self.has_gaps and L.W is None):
+            # a linear problem is one solve: from a previous time's q the Newton step
+            # would only lose digits (its gradient is a difference of large forces)
             q = self.closed_solve(L, L.f_eff)
             solves = 1
             if not self.has_gaps and L.W is None:

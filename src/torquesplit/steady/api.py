@@ -312,8 +312,11 @@ def _as_solution(st: SteadyState, shell, periods):
         groups.append(tuple(track[c] for c in cols))
         x = F[:, [track[c] for c in cols]]
         total = x.sum(axis=1, keepdims=True)
+        from torquesplit.simulation import GROUP_MIN_LOAD
+
+        least = GROUP_MIN_LOAD * sum(abs(st.kinematics.meshes[m].force) for m in members)
         with np.errstate(invalid="ignore", divide="ignore"):
-            ratio = len(cols) * x / np.where(total != 0, total, np.nan)
+            ratio = len(cols) * x / np.where(total > least, total, np.nan)
         for i, c in enumerate(cols):
             idx, _ = per_el[c]
             mx = np.full(nc, -np.inf)

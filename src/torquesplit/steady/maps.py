@@ -268,7 +268,7 @@ def campbell(model, start: float, stop: float, *, points: int = 41, orders: int 
     return ds, crossings
 
 
-def _structure_at(model, factor):  # pragma: no cover - no shipped model has a rotating frame
+def _structure_at(model, factor):  # the model at another speed (a turning carrier)
     from torquesplit.assembly.assemble import assemble
     from torquesplit.model.io import model_from_dict, model_to_json
     import json

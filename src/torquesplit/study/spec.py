@@ -39,18 +39,15 @@ from typing import Any, Literal, Union
 import pydantic
 from pydantic import BaseModel, ConfigDict, Field, StrictFloat, StrictInt, model_validator
 
+from ..errors import FieldError
 from .errors import StudyError
 
 Value = Union[StrictInt, StrictFloat, str]
 """A number (read in the field's SI unit, or in ``unit``) or a string with units."""
 
 
-class _Problem(ValueError):
-    """Raised by a validator for one field of its section (the location gets ``field``)."""
-
-    def __init__(self, field: str, message: str):
-        super().__init__(message)
-        self.field = field
+# raised by a validator for one field of its section (the location gets ``field``)
+_Problem = FieldError
 
 
 class _Strict(BaseModel):

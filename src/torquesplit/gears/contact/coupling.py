@@ -159,7 +159,7 @@ def _key_inputs(model, kin, mesh_name, n, pair, names, reverse, load) -> dict:
     if mesh.impact:
         mk = kin.meshes[mesh_name]
         inputs["impact_inputs"] = dict(
-            omega=abs(kin.bodies[mk.driver].speed), j_driver=kin.bodies[mk.driver].polar_inertia,
+            omega=abs(mk.driver_speed), j_driver=kin.bodies[mk.driver].polar_inertia,
             j_driven=kin.bodies[mk.driven].polar_inertia)
     return inputs
 
@@ -212,7 +212,8 @@ def mesh_ltca(model, kin, mesh_name: str, n: int) -> MeshLtca:
                 "meshing-in impact from the LTCA needs the pinion to drive an internal pair; "
                 "set impact = false"))])
         drv, dvn = kin.bodies[mk.driver], kin.bodies[mk.driven]
-        mi = loaded_meshing_in(res, omega_driving=abs(drv.speed), inertia_driving=drv.polar_inertia,
+        mi = loaded_meshing_in(res, omega_driving=abs(mk.driver_speed),
+                               inertia_driving=drv.polar_inertia,
                                inertia_driven=dvn.polar_inertia)
         impact = mi.force(np.arange(n) / n)
         summary.update(impact_peak_force_N=mi.peak_force, impact_advance_m=mi.advance,

@@ -1,0 +1,136 @@
+"""Rotating-frame terms of the bodies whose translations are measured in a carrier's frame.
+
+With the carrier turning at the constant speed Omega about its unit axis a, a body of
+mass m whose translations u are measured in the carrier's frame has the absolute
+acceleration ``u'' + 2 Omega a x u' + Omega a x (Omega a x (r0 + u))`` (r0 its nominal
+position from the axis).  Moved to the right-hand side, the equations of motion of the
+lumped planetary models in the literature follow (Lin & Parker 1999 eq. 1 with Omega_c;
+Cooley & Parker 2012 eq. 1)::
+
+    M q'' + Omega G q' + (K_b + K_m - Omega^2 K_Omega) q = T
+
+* Coriolis (gyroscopic) term, generalized force ``-G v`` with
+  ``G_ij = 2 m Omega u_i . (a x u_j)`` over the body's translational DOF directions
+  u_i, u_j (skew-symmetric, it does no work): for x, y DOFs about z,
+  ``G_xy = -2 m Omega``, ``G_yx = +2 m Omega`` (Lin & Parker 1999, the 2 m Omega blocks
+  of G);
+* centripetal softening ``-m Omega^2`` on every in-plane translation (Lin & Parker 1999
+  K_Omega = diag(m, m, 0) per body): two SPRING elements of negative stiffness per
+  body, their projections the body's displacements along two orthonormal directions of
+  the carrier's plane (``<body>.centripetal.1``, ``.2``);
+* centrifugal force ``m Omega^2 r0`` (outwards, constant in the carrier frame) on the
+  translations of a body off the axis (the planets), an external force;
+* the geometric stiffness of that preload in the planet's pin, ``P R`` on the carrier's
+  rotation (one element ``<carrier>.pin_preload`` for all its planets; R the pin
+  radius, P = m Omega^2 R k_t / (k_t - m Omega^2) the static centrifugal load of a
+  bearing of stiffness k_t along the pin's tangent): when the
+  carrier turns by theta the pin, and the preload with it, turns too.  With it the rigid
+  rotation of carrier, sun and planets stays a zero-frequency mode in the turning frame
+  (it is only a shift of the nominal rotation).  The lumped models in the literature
+  omit it; their examples hold every member torsionally (Cooley & Parker 2012), where
+  it is a small correction.  The radial preload of the meshes is left out.
+* A planet without translations sits rigidly on its pin: its mass is carried by the
+  carrier (translations and ``m R^2`` on its rotation, assembly/assemble.py) and so are
+  its rotating-frame terms and centrifugal force.
+
+The bodies' rotations need no term (planar model, all axes parallel to a).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import ModelError
+from ..gears import line_of_action as loa
+from .structure import SPRING
+
+
+def in_plane_basis(axis) -> tuple[np.ndarray, np.ndarray]:
+    """Two orthonormal directions of the plane normal to ``axis`` (x, y for the z axis)."""
+    a = np.asarray(axis, dtype=float)
+    a = a / np.linalg.norm(a)
+    e1 = loa.reference_direction(a, 0.0)
+    return e1, np.cross(a, e1)
+
+
+def rotating_frame_terms(kin, dmap, ext: np.ndarray, pin_stiffness=None):
+    """Elements (centripetal springs) and gyroscopic entries of every body measured in a
+    turning carrier's frame; adds the centrifugal forces to ``ext`` in place.
+
+    ``pin_stiffness(body, direction)`` gives the stiffness of a planet's bearing along
+    a unit direction (for the pin-preload term).  Returns ``(elements, gyroscopic)`` for
+    :func:`~torquesplit.assembly.structure.build_structure`.
+    """
+    elements: list[dict] = []
+    gyro: list[tuple[int, int, float]] = []
+    # planets rigid on their pins (no translations) move with their carrier
+    preload: dict[str, list] = {}  # carrier -> [its rotation DOF, sign, stiffness]
+    rigid_pins: dict[str, list[str]] = {}
+    for p, c in kin.planet_bodies.items():
+        if not dmap.translation.get(p):
+            rigid_pins.setdefault(c, []).append(p)
+    for body in dmap.translation:  # the model's order: a reproducible element list
+        carrier = kin.frames.get(body)
+        tr = dmap.translation[body]
+        if carrier is None or not tr:
+            continue
+        cb = kin.bodies[carrier]
+        omega = float(cb.speed)
+        if omega == 0.0:
+            continue
+        a = cb.axis / np.linalg.norm(cb.axis)
+        m = kin.bodies[body].mass
+        if body == carrier:
+            m += sum(kin.bodies[p].mass for p in rigid_pins.get(body, []))
+        dirs = {d: dmap.axes[body][d] for d in tr}
+        # Coriolis: G_ij = 2 m Omega u_i . (a x u_j)   (Lin & Parker 1999 G)
+        for di, i in tr.items():
+            for dj, j in tr.items():
+                g = 2.0 * m * omega * float(dirs[di] @ np.cross(a, dirs[dj]))
+                if abs(g) > 1e-14 * 2.0 * m * abs(omega):
+                    gyro.append((i, j, g))
+        # centripetal softening -m Omega^2 in the carrier's plane (Lin & Parker 1999 K_Omega)
+        for k, e in enumerate(in_plane_basis(a), start=1):
+            dofs, coefs = [], []
+            for j, c in dmap.project(body, e, 1.0, tol=1e-15):
+                dofs.append(j)
+                coefs.append(c)
+            if dofs:
+                elements.append(dict(name=f"{body}.centripetal.{k}", kind=SPRING, dofs=dofs,
+                                     coefs=coefs, stiffness=-m * omega**2, damping=0.0))
+        # centrifugal force of the nominal position, m Omega^2 r0 outwards (for a carrier,
+        # that of the planets rigid on its pins)
+        carried = [(body, m)] if body != carrier else \
+            [(p, kin.bodies[p].mass) for p in rigid_pins.get(body, [])]
+        for b, mb in carried:
+            r = kin.bodies[b].position - cb.position
+            r0 = r - a * float(r @ a)
+            if float(np.linalg.norm(r0)) > 0.0:
+                for j, c in dmap.project(body, mb * omega**2 * r0, 1.0, tol=0.0):
+                    ext[j] += c
+        # the planet's centrifugal preload P in its pin turns with the carrier: geometric
+        # stiffness P R on the carrier's rotation, P = m Omega^2 R k_t / (k_t - m Omega^2)
+        # the bearing's static share (k_t its stiffness along the pin's tangent); without
+        # it the rigid rotation of carrier and planets would soften
+        if body in kin.planet_bodies and body != carrier and pin_stiffness is not None:
+            c_name = kin.planet_bodies[body]
+            idx, s_c = dmap.theta.get(c_name, (-1, 1.0))
+            r = kin.bodies[body].position - kin.bodies[c_name].position
+            r0 = r - a * float(r @ a)
+            big_r = float(np.linalg.norm(r0))
+            k_t = pin_stiffness(body, np.cross(a, r0 / big_r)) if big_r > 0 else None
+            if idx >= 0 and k_t is not None:
+                soft = m * omega**2
+                if not k_t > soft:
+                    raise ModelError([(f"gears.{body}.support", (
+                        f"the planet's bearing ({k_t:.3g} N/m along its pin's tangent) is "
+                        f"softer than its centrifugal softening m Omega^2 = {soft:.3g} N/m at "
+                        f"the carrier's speed: it would fly off its pin; give a stiffer "
+                        f"bearing or a lower speed"))])
+                preload.setdefault(c_name, [idx, s_c, 0.0])[2] += \
+                    soft * big_r**2 * k_t / (k_t - soft)
+    # one element per carrier carries the pin preloads of all its planets
+    for c_name, (idx, s_c, k) in preload.items():
+        elements.append(dict(name=f"{c_name}.pin_preload", kind=SPRING, dofs=[idx],
+                             coefs=[s_c], stiffness=k, damping=0.0))
+    return elements, gyro

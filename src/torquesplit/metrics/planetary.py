@@ -1,0 +1,84 @@
+"""Planet load sharing: the mesh-load factor K_gamma of each planetary stage.
+
+The planetary gear standards rate the unequal sharing of a stage's planets by the
+mesh-load factor K_gamma = the load of the most heavily loaded planet over the mean
+planet load (AGMA 6123-B06 §5; ISO 6336-1 K_gamma).  It is the load-sharing coefficient
+of :mod:`torquesplit.metrics.load_sharing` restricted to the planet meshes: a planet's
+sun meshes form one load-sharing group, its ring meshes another (the stage labels of
+``[[planetary]]``, ``<name>-sun`` and ``<name>-ring``, or the tooth-count labels of
+general elements), and each group's coefficient is max_i N X_i / sum_j X_j = largest
+over mean.  So every definition gives its K_gamma:
+
+* quasi-static (``static_torque``, Mo et al. 2017 eqs. 14-15 generalised to planets):
+  the largest ratio over the mesh positions of a quasi-static sweep -- the standards'
+  K_gamma, with pin position errors, carrier eccentricity and floating members;
+* dynamic (``cycle_peak``, ``mean_force``, ``instantaneous``, ``engineering``): the
+  same ratio of the dynamic forces.
+
+``K_gamma`` of a stage is the largest over its sun and ring groups; per planet the
+largest coefficient of its meshes.  Names for studies: ``planet_load_sharing.<def>``
+(the largest stage), ``.<carrier>`` and ``.<planet>``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+__all__ = ["PlanetLoadSharing", "planet_load_sharing"]
+
+
+@dataclass(frozen=True)
+class PlanetLoadSharing:
+    """K_gamma per planetary stage (carrier) and per planet, for one definition."""
+
+    definition: str
+    per_stage: dict[str, float]
+    """Carrier -> K_gamma (largest planet load over the mean)."""
+    per_planet: dict[str, float]
+    """Planet -> the largest load-sharing coefficient of its meshes."""
+    groups: dict[str, list[str]]
+    """Carrier -> the load-sharing groups of its planet meshes."""
+
+    def values(self) -> dict[str, float]:
+        key = f"planet_load_sharing.{self.definition}"
+        out = {key: max(self.per_stage.values())} if self.per_stage else {}
+        out.update({f"{key}.{c}": v for c, v in self.per_stage.items()})
+        out.update({f"{key}.{p}": v for p, v in self.per_planet.items()})
+        return out
+
+
+def planet_load_sharing(load_sharing, kinematics) -> PlanetLoadSharing:
+    """K_gamma of every planetary stage from a :class:`~torquesplit.metrics.load_sharing.
+    LoadSharing` (any definition) and the model's kinematics.
+
+    Examples
+    --------
+    >>> import torquesplit
+    >>> from torquesplit.quasistatic import quasi_static_load_sharing
+    >>> qs = quasi_static_load_sharing(torquesplit.example_path("lin_parker1999_planetary"),
+    ...                                revolutions=0.05)
+    >>> k = planet_load_sharing(qs.metrics(), qs.kinematics)
+    >>> round(k.per_stage["stage_carrier"], 9)
+    1.0
+    """
+    ls = load_sharing
+    per_stage: dict[str, float] = {}
+    per_planet: dict[str, float] = {}
+    groups: dict[str, list[str]] = {}
+    group_of = {m: g for g, ms in ls.groups.items() for m in ms}
+    for carrier in kinematics.carriers:
+        planet_meshes = {n: mk for n, mk in kinematics.meshes.items()
+                         if mk.carrier == carrier and n in group_of}
+        gs = sorted({group_of[n] for n in planet_meshes})
+        if not gs:
+            continue
+        groups[carrier] = gs
+        per_stage[carrier] = max(ls.per_group[g] for g in gs)
+        for planet, c in kinematics.planet_bodies.items():
+            if c != carrier:
+                continue
+            mine = [ls.per_mesh[n] for n, mk in planet_meshes.items()
+                    if planet in (mk.driver, mk.driven)]
+            if mine:
+                per_planet[planet] = max(mine)
+    return PlanetLoadSharing(ls.definition, per_stage, per_planet, groups)

@@ -1,0 +1,360 @@
+"""The ``[[planetary]]`` shorthand: one table that expands to a planetary stage.
+
+A planetary (epicyclic) stage is made of the general elements of the model file --
+gears, a carrier body, planet bearings on the carrier (``support.on``), meshes and
+torsional supports -- and can be written with them alone (docs/theory/planetary.md).
+This shorthand writes them for you::
+
+    [[planetary]]
+    name = "stage"              # prefix of the generated names
+    planets = 4
+    module = "2.25 mm"
+    pressure_angle = "24.6 deg"
+    face_width = "30 mm"
+    sun = {teeth = 42}
+    planet = {teeth = 48, mass = "0.66 kg"}
+    ring = {teeth = 138, torsional_support = {stiffness = "2.1e7 N m/rad"}}
+    carrier = {polar_inertia = "0.064 kg m^2"}
+    planet_bearing = {stiffness = "1e8 N/m"}
+    sun_mesh = {stiffness = "5e8 N/m"}
+    ring_mesh = {stiffness = "5e8 N/m"}
+
+expands to ``stage_sun``, ``stage_ring`` (internal), ``stage_planet1`` ...
+(placed from the sun at the planet angles), the body ``stage_carrier`` holding the
+planet bearings (``support.on = "stage_carrier"``, with the pin errors), and the meshes
+``stage_sun_planet1`` ..., ``stage_ring_planet1`` ... with the stage labels
+``stage-sun`` and ``stage-ring`` (their load-sharing groups).  Drives and loads name the
+generated bodies.  What is checked here, with the field named: the planets fit (the
+tooth-count assembly condition ``(z_s + z_r) psi / 360 deg`` whole for every planet
+angle psi), they do not overlap, sun-planet and planet-ring centre distances agree, the
+ring is internal, the pins sit on the planet circle.
+
+After validation the model holds the general elements only (a model written back to a
+file has no ``[[planetary]]`` table).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated, Literal
+
+from pydantic import BeforeValidator, Field, model_validator
+
+from .schema import (
+    Angle,
+    BacklashSpec,
+    Count,
+    Damping,
+    Dof,
+    FieldError,
+    GearErrors,
+    Inertia,
+    Length,
+    Mass,
+    Number,
+    PinError,
+    StiffnessSpec,
+    Strict,
+    Support,
+    TorsionalSupport,
+    Unit,
+    _backlash_shorthand,
+    _check_angle,
+    _stiffness_shorthand,
+    _unique_dofs,
+)
+
+#: relative tolerance of the assembly condition (a whole number of teeth)
+FIT_TOLERANCE = 1e-6
+
+
+class PlanetaryGear(Strict):
+    """The sun, the planets or the ring of a ``[[planetary]]`` stage (the module, pressure
+    and helix angle are the stage's)."""
+
+    teeth: Count = Field(gt=0, le=10_000, description="Number of teeth.")
+    kind: Literal["spur", "helical", "double_helical", "internal"] | None = Field(
+        None, description="Gear type; default from the stage (the ring is internal).")
+    profile_shift: Number = Field(0.0, ge=-5, le=5, description="Profile shift coefficient x.")
+    face_width: Length | None = Field(None, gt=0, description="Face width; default the "
+                                      "stage's.")
+    mass: Mass | None = Field(None, gt=0, description="Mass; from geometry if omitted.")
+    polar_inertia: Inertia | None = Field(None, gt=0, description="Polar moment of inertia; "
+                                          "from geometry if omitted.")
+    bore_diameter: Length = Field(0.0, ge=0, description="Bore diameter used for computed "
+                                  "mass and inertia.")
+    dofs: list[Dof] | None = Field(None, description="Degrees of freedom; default "
+                                   "['theta', 'x', 'y'] for the planets, ['theta'] else.")
+    support: Support | None = Field(None, description="Support of the translational DOFs "
+                                    "(sun and ring; the planets sit on 'planet_bearing').")
+    torsional_support: TorsionalSupport | None = Field(
+        None, description="Holds the member against rotation (a fixed ring).")
+    errors: GearErrors = Field(GearErrors(), description="Manufacturing and assembly errors "
+                               "(every planet gets these).")
+
+    @model_validator(mode="after")
+    def _dofs(self):
+        if self.dofs is not None:
+            _unique_dofs(self.dofs)
+        return self
+
+
+class PlanetaryCarrier(Strict):
+    """The carrier of a ``[[planetary]]`` stage (a body on the stage axis)."""
+
+    polar_inertia: Inertia = Field(gt=0, description="Polar moment of inertia (with the "
+                                   "pins, without the planets).")
+    mass: Mass | None = Field(None, gt=0, description="Mass (needed with translational DOFs).")
+    dofs: list[Dof] = Field(["theta"], description="Degrees of freedom.")
+    support: Support | None = Field(None, description="Support of the translational DOFs.")
+    torsional_support: TorsionalSupport | None = Field(
+        None, description="Holds the carrier against rotation (a star stage).")
+    eccentricity: Length = Field(0.0, ge=0, description="Carrier eccentricity (turns with "
+                                 "the carrier).")
+    eccentricity_phase: Angle = Field(0.0, description="Direction of the eccentricity at "
+                                      "t = 0.")
+
+    @model_validator(mode="after")
+    def _dofs(self):
+        _unique_dofs(self.dofs)
+        return self
+
+
+class PlanetaryMesh(Strict):
+    """The sun-planet or the ring-planet meshes of a ``[[planetary]]`` stage (every planet
+    the same)."""
+
+    stiffness: Annotated[
+        StiffnessSpec, BeforeValidator(_stiffness_shorthand), Unit("stiffness")
+    ] = Field(description="Mean mesh stiffness (\"5e8 N/m\"), or a [stiffness] table.")
+    damping: Damping | None = Field(None, ge=0, description="Mesh damping.")
+    damping_ratio: Number | None = Field(None, ge=0, description="Mesh damping as a "
+                                         "fraction of critical.")
+    backlash: Annotated[
+        BacklashSpec, BeforeValidator(_backlash_shorthand), Unit("length")
+    ] = Field(0.0, description="Total backlash (\"100 um\"; 0 = none), or a [backlash] table.")
+
+    @model_validator(mode="after")
+    def _one(self):
+        if self.damping is not None and self.damping_ratio is not None:
+            raise ValueError("both 'damping' and 'damping_ratio' are given; remove one of them")
+        return self
+
+
+class Planetary(Strict):
+    """A planetary (epicyclic) stage in one table: expands to the sun, planets, ring and
+    carrier, the planet bearings on the carrier and the meshes (see
+    docs/theory/planetary.md).  Any member may be held by a ``torsional_support`` (ring:
+    planetary; carrier: star) or driven and loaded through ``[drives]``/``[loads]`` on
+    the generated names (``<name>_sun``, ``<name>_ring``, ``<name>_carrier``)."""
+
+    name: str = Field("planetary", pattern=r"^[A-Za-z][A-Za-z0-9_]*$", max_length=40,
+                      description="Prefix of the generated names (letters, digits, _).")
+    planets: Count = Field(ge=1, le=32, description="Number of planets.")
+    angles: list[Angle] | None = Field(
+        None, description="Planet angles about the stage axis from the x axis (default "
+        "equally spaced from 0); one per planet.")
+    module: Length = Field(gt=0, description="Normal module of all three gears.")
+    pressure_angle: Angle = Field(math.radians(20.0), description="Normal pressure angle.")
+    helix_angle: Angle = Field(0.0, description="Helix angle.")
+    hand: Literal["right", "left"] | None = Field(
+        None, description="Hand of the sun's helix (planets opposite, ring as the planets).")
+    face_width: Length = Field(gt=0, description="Face width (of one helix for "
+                               "double-helical gears).")
+    position: tuple[Length, Length, Length] = Field((0.0, 0.0, 0.0),
+                                                    description="Centre of the stage.")
+    axis: tuple[Number, Number, Number] = Field((0.0, 0.0, 1.0), description="Stage axis.")
+    pin_radius: Length | None = Field(
+        None, gt=0, description="Radius of the planet pins; must equal the sun-planet "
+        "centre distance (checked); default that distance.")
+    sun: PlanetaryGear = Field(description="The sun gear.")
+    planet: PlanetaryGear = Field(description="Every planet gear.")
+    ring: PlanetaryGear = Field(description="The ring gear (internal).")
+    carrier: PlanetaryCarrier = Field(description="The carrier.")
+    planet_bearing: Support = Field(description="Bearing of each planet on its carrier pin "
+                                    "(its other end is on the carrier: leave 'on' out).")
+    pin_errors: list[PinError] | None = Field(
+        None, description="Pin position error of each planet (radial, tangential).")
+    sun_mesh: PlanetaryMesh = Field(description="The sun-planet meshes.")
+    ring_mesh: PlanetaryMesh = Field(description="The ring-planet meshes.")
+
+    @model_validator(mode="after")
+    def _consistent(self):
+        _check_angle(self.pressure_angle, "pressure_angle", 45)
+        _check_angle(self.helix_angle, "helix_angle", 60)
+        if self.helix_angle != 0 and self.hand is None:
+            raise FieldError("hand", "a helical stage needs the sun's hand; add "
+                             "hand = 'right' or hand = 'left'")
+        if not math.hypot(*self.axis) > 0:
+            raise FieldError("axis", "the zero vector has no direction; give e.g. [0, 0, 1]")
+        n = self.planets
+        if self.angles is not None and len(self.angles) != n:
+            raise FieldError("angles", f"gives {len(self.angles)} angles for {n} planets; "
+                             f"give one angle per planet")
+        if self.pin_errors is not None and len(self.pin_errors) != n:
+            raise FieldError("pin_errors", f"gives {len(self.pin_errors)} errors for {n} "
+                             f"planets; give one {{radial, tangential}} per planet")
+        if self.planet_bearing.on is not None:
+            raise FieldError("planet_bearing.on", "the planet bearings sit on the stage's "
+                             "carrier; remove 'on'")
+        if self.ring.kind not in (None, "internal"):
+            raise FieldError("ring.kind", f"the ring of a planetary stage is an internal "
+                             f"gear, not {self.ring.kind!r}; remove 'kind' or write "
+                             f"kind = 'internal'")
+        for member in ("sun", "planet"):
+            if getattr(self, member).kind == "internal":
+                raise FieldError(f"{member}.kind", f"the {member} meshes outside the planets"
+                                 f"' teeth and cannot be internal; remove 'kind'")
+        self._check_fit()
+        return self
+
+    # ------------------------------------------------------------------ layout
+    def planet_angles(self) -> list[float]:
+        """Planet angles [rad] (given, or equally spaced from 0)."""
+        if self.angles is not None:
+            return list(self.angles)
+        return [2 * math.pi * i / self.planets for i in range(self.planets)]
+
+    def _kind(self, member: PlanetaryGear) -> str:
+        if member.kind is not None:
+            return member.kind
+        return "helical" if self.helix_angle != 0 else "spur"
+
+    def _geometry(self, member: PlanetaryGear, internal: bool = False):
+        from ..gears.geometry import GearGeometry
+
+        kind = "internal" if internal else self._kind(member)
+        return GearGeometry(
+            teeth=member.teeth, normal_module=self.module,
+            normal_pressure_angle=self.pressure_angle, helix_angle=abs(self.helix_angle),
+            face_width=member.face_width or self.face_width,
+            profile_shift=member.profile_shift, internal=kind == "internal",
+            double_helical=kind == "double_helical")
+
+    def _check_fit(self) -> None:
+        """Planets that do not fit: the assembly condition, overlapping planets, unequal
+        centre distances, pins off the planet circle."""
+        from ..errors import ModelError
+        from ..gears.geometry import PairGeometry
+
+        try:
+            sun, planet = self._geometry(self.sun), self._geometry(self.planet)
+            ring = self._geometry(self.ring, internal=True)
+            a_sp = PairGeometry(sun, planet).operating_center_distance
+            a_rp = PairGeometry(planet, ring).operating_center_distance
+        except ModelError as exc:
+            loc, msg = exc.issues[0]
+            raise FieldError("ring.teeth" if "internal" in msg else "planet.teeth",
+                             msg if ";" in msg else f"{msg}; correct the tooth counts") from None
+        zs, zp, zr = self.sun.teeth, self.planet.teeth, self.ring.teeth
+        if abs(a_sp - a_rp) > 1e-6 * a_sp:
+            raise FieldError("ring.teeth", (
+                f"the planets cannot mesh with sun and ring at once: the sun-planet centre "
+                f"distance is {a_sp * 1e3:.4f} mm, the planet-ring one {a_rp * 1e3:.4f} mm; "
+                f"without profile shifts the ring needs z_s + 2 z_p = {zs + 2 * zp} teeth: "
+                f"correct the tooth counts or the profile shifts"))
+        if self.pin_radius is not None and abs(self.pin_radius - a_sp) > 1e-6 * a_sp:
+            raise FieldError("pin_radius", (
+                f"pins at {self.pin_radius * 1e3:.4f} mm from the axis put the planets "
+                f"outside the mesh circle (the sun-planet centre distance is "
+                f"{a_sp * 1e3:.4f} mm); remove 'pin_radius' or correct it"))
+        angles = self.planet_angles()
+        where = "angles" if self.angles is not None else "planets"
+        period = 2 * math.pi / (zs + zr)
+        for i, psi in enumerate(angles[1:], start=2):
+            # tooth-count assembly condition: a planet fits sun and ring at once only at
+            # angles that are multiples of 360 deg / (z_s + z_r) from the first
+            # (e.g. Parker & Lin 2004; Mueller, Epicyclic drive trains)
+            steps = (psi - angles[0]) / period
+            if abs(steps - round(steps)) > FIT_TOLERANCE * max(1.0, abs(steps)):
+                hint = (f"with {self.planets} equally spaced planets (z_s + z_r) / N = "
+                        f"{(zs + zr) / self.planets:.6g} must be a whole number: choose tooth "
+                        f"counts with z_s + z_r divisible by {self.planets}, or give 'angles'"
+                        if self.angles is None else
+                        f"give angles that are multiples of 360 deg / (z_s + z_r) = "
+                        f"{math.degrees(period):.6g} deg from the first planet")
+                raise FieldError(where, (
+                    f"planet {i} does not fit: at {math.degrees(psi - angles[0]):.6g} deg from "
+                    f"planet 1 it is {steps:.6g} tooth periods of sun and ring away "
+                    f"(the tooth-count assembly condition); {hint}"))
+        order = sorted(a % (2 * math.pi) for a in angles)
+        tip = planet.tip_radius
+        for k in range(len(order)):
+            gap = (order[(k + 1) % len(order)] - order[k]) % (2 * math.pi)
+            if len(order) == 1:
+                break
+            chord = 2 * a_sp * math.sin(min(gap, 2 * math.pi) / 2)
+            if chord <= 2 * tip:
+                raise FieldError(where, (
+                    f"planets overlap: two planets {math.degrees(gap):.4g} deg apart are "
+                    f"{chord * 1e3:.4f} mm apart, less than the planet tip diameter "
+                    f"{2 * tip * 1e3:.4f} mm; use fewer planets, smaller planets or wider "
+                    f"angles"))
+
+    # ------------------------------------------------------------------ expansion
+    def names(self) -> dict[str, object]:
+        """Generated names: sun, ring, carrier, planets, sun meshes, ring meshes."""
+        n = self.name
+        planets = [f"{n}_planet{i + 1}" for i in range(self.planets)]
+        return dict(sun=f"{n}_sun", ring=f"{n}_ring", carrier=f"{n}_carrier",
+                    planets=planets, sun_meshes=[f"{n}_sun_planet{i + 1}" for i in
+                                                 range(self.planets)],
+                    ring_meshes=[f"{n}_ring_planet{i + 1}" for i in range(self.planets)])
+
+    def expand(self) -> tuple[dict, dict, dict]:
+        """(gears, bodies, meshes) as dicts of SI values and schema objects, ready for
+        the general schema sections."""
+        names = self.names()
+        hand_sun = self.hand
+        other = {"right": "left", "left": "right", None: None}[hand_sun]
+
+        def gear(member: PlanetaryGear, kind: str, hand, dofs, **extra) -> dict:
+            d = dict(teeth=member.teeth, module=self.module,
+                     pressure_angle=self.pressure_angle, helix_angle=self.helix_angle,
+                     hand=hand if self.helix_angle != 0 else None, kind=kind,
+                     face_width=member.face_width or self.face_width,
+                     profile_shift=member.profile_shift, bore_diameter=member.bore_diameter,
+                     axis=self.axis, dofs=member.dofs or dofs, errors=member.errors,
+                     torsional_support=member.torsional_support)
+            if member.mass is not None:
+                d["mass"] = member.mass
+            if member.polar_inertia is not None:
+                d["polar_inertia"] = member.polar_inertia
+            d.update(extra)
+            return {k: v for k, v in d.items() if v is not None}
+
+        gears = {
+            names["sun"]: gear(self.sun, self._kind(self.sun), hand_sun, ["theta"],
+                               position=self.position, support=self.sun.support),
+            names["ring"]: gear(self.ring, "internal", other, ["theta"],
+                                position=self.position, support=self.ring.support),
+        }
+        pins = self.pin_errors or [PinError()] * self.planets
+        for i, (pname, psi) in enumerate(zip(names["planets"], self.planet_angles())):
+            bearing = self.planet_bearing.model_copy(update={"on": names["carrier"],
+                                                             "pin_error": pins[i]})
+            if self.planet.support is not None:
+                raise FieldError("planet.support", "the planets sit on 'planet_bearing'; "
+                                 "remove planet.support")
+            gears[pname] = gear(self.planet, self._kind(self.planet), other,
+                                ["theta", "x", "y"],
+                                place={"from_gear": names["sun"], "angle": psi},
+                                support=bearing)
+        c = self.carrier
+        bodies = {names["carrier"]: {k: v for k, v in dict(
+            polar_inertia=c.polar_inertia, mass=c.mass, position=self.position,
+            axis=self.axis, dofs=c.dofs, support=c.support,
+            torsional_support=c.torsional_support, eccentricity=c.eccentricity,
+            eccentricity_phase=c.eccentricity_phase).items() if v is not None}}
+        meshes = {}
+        for member, spec, mnames in (("sun", self.sun_mesh, names["sun_meshes"]),
+                                     ("ring", self.ring_mesh, names["ring_meshes"])):
+            for mname, pname in zip(mnames, names["planets"]):
+                d = dict(gears=(names[member], pname), stiffness=spec.stiffness,
+                         backlash=spec.backlash, stage=f"{self.name}-{member}")
+                if spec.damping is not None:
+                    d["damping"] = spec.damping
+                if spec.damping_ratio is not None:
+                    d["damping_ratio"] = spec.damping_ratio
+                meshes[mname] = d
+        return gears, bodies, meshes

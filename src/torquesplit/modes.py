@@ -1,0 +1,235 @@
+"""Model-level modal analysis: every mode, its multiplicity, type and shape.
+
+:func:`model_modes` linearises a model about its static equilibrium
+(:func:`torquesplit.solve.modal.modal_analysis`) and groups and labels the modes the way
+an epicyclic analyst reads them (Lin & Parker 1999; Cooley & Parker 2012 with a turning
+carrier):
+
+* **multiplicity** -- modes whose frequencies agree to ``rtol`` form one group (the
+  degenerate pairs of the translational modes, the N - 3 planet modes);
+* **type** (models with planets) -- from the share of the mass-weighted motion
+  ``m_i |phi_i|^2`` (summed over the group, so it does not depend on the basis the
+  eigensolver picked) on the DOFs of the members that are not planets ("central"):
+  ``rotational`` when the central members do not translate, ``translational`` when they
+  do not rotate, ``planet`` when they do not move at all, ``mixed`` otherwise (each
+  below ``tol`` of the mode's motion);
+* **strain energy per element of a group** -- the sum over the group's mass-normalised
+  modes of each element's strain energy over the group's total: the trace of the
+  element's stiffness over the group's subspace, the same in any basis of a degenerate
+  pair (the per-mode shares of :class:`~torquesplit.solve.modal.ModalSolution` depend on
+  the basis the solver happened to return).
+
+Rigid-body modes are counted and left out, as in ``modal_analysis``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+__all__ = ["ModeRow", "ModalReport", "classify", "model_modes", "MODE_TYPES"]
+
+MODE_TYPES = ("rotational", "translational", "planet", "mixed")
+
+
+@dataclass(frozen=True)
+class ModeRow:
+    """One natural mode, with the properties of its degenerate group."""
+
+    mode: int
+    """1-based index in ascending frequency."""
+    frequency: float
+    """Natural frequency [Hz] (negative: statically unstable)."""
+    group: int
+    """1-based index of its group of equal frequencies."""
+    multiplicity: int
+    """Number of modes in the group."""
+    type: str | None
+    """rotational, translational, planet or mixed (None for a model without planets)."""
+    strain_energy: dict[str, float]
+    """Element -> share of the group's strain energy (basis-independent), largest first."""
+    motion: dict[str, float] = field(default_factory=dict)
+    """Share of the group's mass-weighted motion: central rotation, central translation,
+    planets."""
+
+
+@dataclass(frozen=True)
+class ModalReport:
+    """Modes of a model, grouped and classified."""
+
+    solution: object
+    """The :class:`~torquesplit.solve.modal.ModalSolution`."""
+    rows: list[ModeRow]
+    rigid_modes: int
+    dof_names: tuple[str, ...]
+    rotating_frame: bool
+    """True if the modes include the carrier-frame Coriolis and centripetal terms."""
+
+    def shape(self, mode: int) -> dict[str, complex]:
+        """Mass-normalised shape of ``mode`` (1-based) by DOF name."""
+        phi = self.solution.mode_shapes[:, mode - 1]
+        return {n: complex(v) for n, v in zip(self.dof_names, phi)}
+
+    def to_dict(self, shapes: bool = True) -> dict:
+        """JSON-serialisable summary (shapes as real numbers, or [re, im] pairs for the
+        complex modes of a rotating frame)."""
+        out = []
+        for r in self.rows:
+            d = dict(mode=r.mode, frequency_Hz=r.frequency, group=r.group,
+                     multiplicity=r.multiplicity, type=r.type,
+                     strain_energy={k: v for k, v in list(r.strain_energy.items())[:6]},
+                     motion=r.motion)
+            if shapes:
+                sh = self.solution.mode_shapes[:, r.mode - 1]
+                if np.iscomplexobj(sh):
+                    d["shape"] = {n: [float(v.real), float(v.imag)]
+                                  for n, v in zip(self.dof_names, sh)}
+                else:
+                    d["shape"] = {n: float(v) for n, v in zip(self.dof_names, sh)}
+            out.append(d)
+        return dict(rigid_body_modes=self.rigid_modes, rotating_frame=self.rotating_frame,
+                    modes=out)
+
+    def to_dataset(self):
+        """The modes as an xarray Dataset (frequencies, multiplicity, type, group
+        strain-energy shares, shapes: real and imaginary parts)."""
+        import xarray as xr
+
+        sol = self.solution
+        phi = np.asarray(sol.mode_shapes)
+        mode = [r.mode for r in self.rows]
+        elements = list(sol.element_names)
+        energy = np.array([[r.strain_energy.get(e, 0.0) for e in elements]
+                           for r in self.rows]).reshape(len(self.rows), len(elements))
+        return xr.Dataset(
+            {"frequency": (("mode",), [r.frequency for r in self.rows],
+                           {"units": "Hz", "long_name": "natural frequency"}),
+             "multiplicity": (("mode",), [r.multiplicity for r in self.rows],
+                              {"units": "1", "long_name": "modes of equal frequency"}),
+             "group": (("mode",), [r.group for r in self.rows],
+                       {"units": "1", "long_name": "group of equal frequencies"}),
+             "type": (("mode",), [r.type or "" for r in self.rows],
+                      {"long_name": "mode type (rotational, translational, planet, mixed)"}),
+             "strain_energy": (("mode", "element"), energy,
+                               {"units": "1", "long_name": "share of the group's strain "
+                                "energy (basis-independent)"}),
+             "shape_real": (("dof", "mode"), np.real(phi),
+                            {"units": "m or rad per sqrt(kg)",
+                             "long_name": "mass-normalised mode shape, real part"}),
+             "shape_imag": (("dof", "mode"), np.imag(phi) if np.iscomplexobj(phi)
+                            else np.zeros_like(phi),
+                            {"units": "m or rad per sqrt(kg)",
+                             "long_name": "mass-normalised mode shape, imaginary part"})},
+            coords={"mode": mode, "dof": list(self.dof_names), "element": elements},
+            attrs={"rigid_body_modes": self.rigid_modes,
+                   "rotating_frame": int(self.rotating_frame)})
+
+
+def _groups(freqs: np.ndarray, rtol: float) -> list[list[int]]:
+    groups: list[list[int]] = []
+    for i, f in enumerate(freqs):
+        if groups and abs(f - freqs[groups[-1][0]]) <= rtol * max(abs(f), 1e-300):
+            groups[-1].append(i)
+        else:
+            groups.append([i])
+    return groups
+
+
+def classify(structure, sol, *, rtol: float = 1e-6, tol: float = 1e-6) -> list[ModeRow]:
+    """Group and label the modes of ``sol`` (a ModalSolution of ``structure``)."""
+    meta = structure.metadata
+    planets = set(meta.get("planet_bodies", {}))
+    names = list(structure.dof_names)
+    mass = 1.0 / np.asarray(structure.inv_mass)
+    body = [n.rpartition(".")[0] for n in names]
+    is_rot = np.array([n.endswith(".theta") for n in names])
+    is_planet = np.array([b in planets for b in body])
+    # a rigid shaft joins rotations into one DOF named after the group's representative
+    groups_of = meta.get("dof_map").theta if meta.get("dof_map") is not None else {}
+    for b, (idx, _) in groups_of.items():
+        if idx >= 0 and b in planets:
+            is_planet[idx] = True
+    phi = np.asarray(sol.mode_shapes)
+    freqs = np.asarray(sol.frequencies)
+    frac = np.asarray(sol.strain_energy_fraction)
+    rows: list[ModeRow] = []
+    for gi, members in enumerate(_groups(freqs, rtol), start=1):
+        w = mass[:, None] * np.abs(phi[:, members]) ** 2
+        motion = w.sum(axis=1)
+        total = float(motion.sum()) or 1.0
+        c_rot = float(motion[is_rot & ~is_planet].sum()) / total
+        c_tr = float(motion[~is_rot & ~is_planet].sum()) / total
+        p = float(motion[is_planet].sum()) / total
+        kind = None
+        if planets:
+            if c_rot + c_tr < tol:
+                kind = "planet"
+            elif c_tr < tol:
+                kind = "rotational"
+            elif c_rot < tol:
+                kind = "translational"
+            else:
+                kind = "mixed"
+        # the group's strain energy per element: sum over its modes, weighted by each
+        # mode's strain energy omega^2 / 2 (mass-normalised modes)
+        e = (freqs[members] ** 2)[:, None] * frac[members]
+        share = e.sum(axis=0) / max(float(e.sum()), 1e-300)
+        order = np.argsort(-share)
+        energy = {structure.element_names[k]: float(share[k]) for k in order
+                  if share[k] > 1e-12}
+        for k in members:
+            rows.append(ModeRow(mode=k + 1, frequency=float(freqs[k]), group=gi,
+                                multiplicity=len(members), type=kind,
+                                strain_energy=energy,
+                                motion={"central_rotation": c_rot,
+                                        "central_translation": c_tr, "planets": p}))
+    return rows
+
+
+def model_modes(model, *, rotating_frame: bool = True, below: float | None = None,
+                count: int | None = None, rtol: float = 1e-6) -> ModalReport:
+    """Modes of a model about its static equilibrium, grouped and classified.
+
+    Parameters
+    ----------
+    model : Model, str or Path
+    rotating_frame : bool
+        Include the Coriolis and centripetal terms of the bodies in a turning carrier's
+        frame (False: the stationary-carrier modes of Lin & Parker 1999).
+    below : float, optional
+        Keep the modes below this frequency [Hz] (whole degenerate groups).
+    count : int, optional
+        Keep at most this many modes (a degenerate group is not cut: the last group is
+        kept whole).
+    rtol : float
+        Relative difference of frequencies that are one group.
+
+    Examples
+    --------
+    >>> import torquesplit
+    >>> rep = model_modes(torquesplit.example_path("lin_parker1999_planetary"),
+    ...                   rotating_frame=False)
+    >>> [(r.type, r.multiplicity) for r in rep.rows[:3]]
+    [('translational', 2), ('translational', 2), ('translational', 2)]
+    """
+    from .assembly.assemble import assemble
+    from .model.io import load_model
+    from .model.kinematics import solve_kinematics
+    from .solve.modal import modal_analysis
+    from .solve.static import static_equilibrium
+
+    if not hasattr(model, "meshes"):
+        model = load_model(model)
+    kin = solve_kinematics(model)
+    st = assemble(model, kin, options={"rotating_frame": rotating_frame})
+    sol = modal_analysis(st, static_equilibrium(st).q)
+    rows = classify(st, sol, rtol=rtol)
+    if below is not None:
+        rows = [r for r in rows if r.frequency < below]
+    if count is not None and len(rows) > count:
+        last = rows[count - 1].group
+        rows = [r for r in rows if r.mode <= count or r.group == last]
+    return ModalReport(solution=sol, rows=rows, rigid_modes=int(sol.rigid_modes.shape[1]),
+                       dof_names=tuple(st.dof_names),
+                       rotating_frame=bool(st.metadata.get("rotating_frame", False)))

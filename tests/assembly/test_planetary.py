@@ -1,0 +1,453 @@
+"""Planetary stages from the general elements: the [[planetary]] shorthand, epicyclic
+kinematics (Willis), planet bearings on the carrier, held members, pin errors, carrier
+eccentricity and the rotating frame (Coriolis, centripetal, centrifugal)."""
+
+from __future__ import annotations
+
+import copy
+import math
+
+import numpy as np
+import pytest
+from planetary_models import LP, general_elements, load, lp_model, lp_raw
+
+import torquesplit
+from torquesplit.assembly.assemble import assemble
+from torquesplit.errors import ModelError
+from torquesplit.model.kinematics import solve_kinematics
+from torquesplit.solve import modal_analysis, static_equilibrium
+
+ZS, ZP, ZR = 42, 48, 138  # the example's tooth counts
+A_W = 2.25e-3 * (ZS + ZP) / 2  # centre distance = pin radius [m]
+RB_S = 2.25e-3 * ZS / 2 * math.cos(math.radians(24.6))
+
+
+def _row(structure, element):
+    """Projection row of an element by DOF name."""
+    e = structure.element_names.index(element)
+    sl = slice(structure.v_ptr[e], structure.v_ptr[e + 1])
+    return {structure.dof_names[d]: c for d, c in zip(structure.v_dof[sl], structure.v_coef[sl])}
+
+
+def test_shorthand_is_the_general_elements():
+    """The [[planetary]] table is sugar: the model it expands to, written out as general
+    sections and read again, assembles to the same equations."""
+    model = lp_model(4)
+    data = general_elements(model)
+    assert "planetary" not in data and "stage_carrier" in data["bodies"]
+    a, b = torquesplit.assemble(model), torquesplit.assemble(load(data))
+    assert a.dof_names == b.dof_names and a.element_names == b.element_names
+    np.testing.assert_array_equal(a.stiffness_matrix(), b.stiffness_matrix())
+    np.testing.assert_array_equal(a.gyroscopic_matrix(), b.gyroscopic_matrix())
+    np.testing.assert_array_equal(a.external_force, b.external_force)
+
+
+def test_willis_speeds_torques_and_drivers():
+    """Ring held: w_c = w_s z_s / (z_s + z_r), the planet turns at w_c - (w_s - w_c) z_s /
+    z_p; the ring reacts T z_r / z_s, the carrier takes T (1 + z_r / z_s); each sun mesh
+    carries T / (N r_bs) at the mesh frequency z_s (w_s - w_c) / 2 pi (by hand)."""
+    kin = solve_kinematics(lp_model(4))
+    ws = kin.bodies["stage_sun"].speed
+    wc = kin.bodies["stage_carrier"].speed
+    assert wc == pytest.approx(ws * ZS / (ZS + ZR), rel=1e-12)
+    assert kin.bodies["stage_planet3"].speed == pytest.approx(wc - (ws - wc) * ZS / ZP, rel=1e-12)
+    assert kin.bodies["stage_ring"].speed == 0.0
+    assert abs(kin.reactions["stage_ring"]) == pytest.approx(100.0 * ZR / ZS, rel=1e-9)
+    assert kin.load_torques["output"] == pytest.approx(100.0 * (1 + ZR / ZS), rel=1e-9)
+    for i in range(1, 5):
+        sun, ring = kin.meshes[f"stage_sun_planet{i}"], kin.meshes[f"stage_ring_planet{i}"]
+        assert (sun.driver, ring.driver) == ("stage_sun", f"stage_planet{i}")
+        assert sun.force == pytest.approx(100.0 / (4 * RB_S), rel=1e-9)
+        assert ring.force == pytest.approx(sun.force, rel=1e-9)
+        assert sun.frequency == pytest.approx(ZS * (ws - wc) / (2 * math.pi), rel=1e-12)
+        assert sun.carrier == "stage_carrier"
+    assert kin.input_power == pytest.approx(kin.output_power, rel=1e-9)
+
+
+def test_star_and_differential_speeds():
+    """Carrier held (star): the ring turns at -w_s z_s / z_r.  Nothing held, sun and
+    ring driven through two paths (the differential example): w_c = (z_s w_s + z_r w_r) /
+    (z_s + z_r) and the ring takes z_r / z_s times the sun's torque."""
+    star = solve_kinematics(torquesplit.load_model(torquesplit.example_path(
+        "lin_parker1999_star")))
+    ws = star.bodies["stage_sun"].speed
+    assert star.bodies["stage_carrier"].speed == 0.0
+    assert star.bodies["stage_ring"].speed == pytest.approx(-ws * ZS / ZR, rel=1e-12)
+    diff = solve_kinematics(torquesplit.load_model(torquesplit.example_path(
+        "split_path_planetary_differential")))
+    w = {b: diff.bodies[b].speed for b in ("stage_sun", "stage_ring", "stage_carrier")}
+    assert w["stage_carrier"] == pytest.approx((30 * w["stage_sun"] + 90 * w["stage_ring"])
+                                               / 120, rel=1e-12)
+    t_sun = diff.bodies["stage_sun"].torque
+    assert diff.bodies["stage_ring"].torque == pytest.approx(3 * t_sun, rel=1e-9)
+    p_a = diff.meshes["path_a"].power
+    assert p_a / diff.input_power == pytest.approx(
+        t_sun * abs(w["stage_sun"]) / diff.input_power, rel=1e-9)
+
+
+def test_ring_mesh_listing_order_does_not_matter():
+    """The driving flank follows from the torques, not from the order the gears are
+    listed in (issue 16: listing a ring mesh the other way round moved modes by 8 %)."""
+    model = lp_model(4)
+    data = general_elements(model)
+    for name, mesh in data["meshes"].items():
+        if "ring" in name:
+            mesh["gears"] = mesh["gears"][::-1]
+    other = load(data)
+    for a, b in ((model, other),):
+        ka, kb = solve_kinematics(a), solve_kinematics(b)
+        assert {n: m.driver for n, m in ka.meshes.items()} == \
+            {n: m.driver for n, m in kb.meshes.items()}
+    fa = modal_analysis(torquesplit.assemble(model)).frequencies
+    fb = modal_analysis(torquesplit.assemble(other)).frequencies
+    np.testing.assert_allclose(fa, fb, rtol=1e-10)
+
+
+def test_planet_bearing_follows_the_carrier_rotation():
+    """A planet pin at radius R moves with the carrier's rotation: the bearing's
+    deformation along y of planet 1 (on the x axis) is y_p - y_c - R theta_c (Lin & Parker
+    1999: -x_c sin(psi) + y_c cos(psi) + u_c - eta)."""
+    s = torquesplit.assemble(lp_model(4))
+    row = _row(s, "stage_planet1.support.y")
+    assert row == pytest.approx({"stage_planet1.y": 1.0, "stage_carrier.y": -1.0,
+                                 "stage_carrier.theta": -A_W}, rel=1e-12)
+    row = _row(s, "stage_planet2.support.x")  # planet 2 at 90 deg: tangential is -x
+    assert row["stage_carrier.theta"] == pytest.approx(A_W, rel=1e-12)
+    assert "stage_planet1.theta" not in _row(s, "stage_planet1.support.x")
+
+
+def test_pin_errors_and_carrier_eccentricity_offset_the_bearings():
+    """A pin error (radial e_r, tangential e_t) of planet 2 at 90 deg is the offset
+    (-e_t, e_r) of its bearing; the carrier's eccentricity, fixed in its own frame, a
+    constant offset of its support."""
+    raw = lp_raw(4, pin_errors=[{}, {"radial": "20 um", "tangential": "-7 um"}, {}, {}])
+    raw["planetary"][0]["carrier"].update(eccentricity="10 um", eccentricity_phase="30 deg")
+    s = torquesplit.assemble(load(raw))
+    err = dict(zip(s.element_names, s.error_constant))
+    assert err["stage_planet2.support.x"] == pytest.approx(7e-6, rel=1e-12)
+    assert err["stage_planet2.support.y"] == pytest.approx(20e-6, rel=1e-12)
+    assert err["stage_planet1.support.x"] == 0.0
+    assert err["stage_carrier.support.x"] == pytest.approx(10e-6 * math.cos(math.pi / 6))
+    assert err["stage_carrier.support.y"] == pytest.approx(10e-6 * math.sin(math.pi / 6))
+    assert s.error_amplitude.size == 0  # nothing turns in the carrier's frame
+
+
+def test_rotating_frame_terms():
+    """In the turning carrier's frame every translating body gets G_xy = -2 m Omega,
+    G_yx = +2 m Omega, a centripetal spring -m Omega^2 on x and y, and a planet the
+    centrifugal force m Omega^2 R (Lin & Parker 1999 eq. 1 with Omega_c)."""
+    model = lp_model(4)
+    kin = solve_kinematics(model)
+    om = kin.bodies["stage_carrier"].speed
+    s = assemble(model, kin)
+    G = s.gyroscopic_matrix()
+    np.testing.assert_allclose(G, -G.T, atol=0)
+    idx = {n: i for i, n in enumerate(s.dof_names)}
+    for body, m in (("stage_sun", LP["m_s"]), ("stage_ring", LP["m_r"]),
+                    ("stage_carrier", LP["m_c"]), ("stage_planet3", LP["m_p"])):
+        assert G[idx[f"{body}.x"], idx[f"{body}.y"]] == pytest.approx(-2 * m * om, rel=1e-12)
+        k = dict(zip(s.element_names, s.stiffness_table[:, 0]))
+        assert k[f"{body}.centripetal.1"] == pytest.approx(-m * om**2, rel=1e-12)
+    assert s.external_force[idx["stage_planet1.x"]] == pytest.approx(
+        LP["m_p"] * om**2 * A_W, rel=1e-12)
+    still = assemble(model, kin, options={"rotating_frame": False})
+    assert still.n_gyroscopic == 0
+    assert not any("centripetal" in n for n in still.element_names)
+    with pytest.raises(ValueError, match="rotating_frame must be true or false"):
+        assemble(model, kin, options={"rotating_frame": "yes"})
+
+
+def _lin_parker_first_order(planets, omega, alpha, without_rigid_carrier=False):
+    """Lin & Parker 1999 eq. 1 written out from the paper's deflections (independent of
+    the assembly): M q'' + Omega G q' + (K_b + K_m - Omega^2 K_Omega) q = 0 in the
+    coordinates (x, y, u) of carrier, ring, sun and (zeta, eta, u) of each planet."""
+    n = 3 * (3 + planets)
+    K, M, G, KO = (np.zeros((n, n)) for _ in range(4))
+    c, r, s = 0, 3, 6
+    masses = ((c, LP["m_c"], LP["i_c"]), (r, LP["m_r"], LP["i_r"]), (s, LP["m_s"], LP["i_s"]))
+    for b, m, i in masses + tuple((9 + 3 * k, LP["m_p"], LP["i_p"]) for k in range(planets)):
+        M[b, b] = M[b + 1, b + 1] = m
+        M[b + 2, b + 2] = i
+        G[b, b + 1], G[b + 1, b] = -2 * m, 2 * m
+        KO[b, b] = KO[b + 1, b + 1] = m
+    kb, km = LP["k_bearing"], LP["k_mesh"]
+    for b in (c, r, s):
+        K[b, b] += kb
+        K[b + 1, b + 1] += kb
+    K[r + 2, r + 2] += LP["k_ru"]
+
+    def spring(v, k):
+        K[:] += k * np.outer(v, v)
+
+    for k in range(planets):
+        psi = 2 * math.pi * k / planets
+        p = 9 + 3 * k
+        v = np.zeros(n)  # sun-planet deflection
+        v[[s, s + 1, s + 2, p, p + 1, p + 2]] = (-math.sin(psi - alpha), math.cos(psi - alpha),
+                                                1.0, -math.sin(alpha), -math.cos(alpha), 1.0)
+        spring(v, km)
+        v = np.zeros(n)  # ring-planet deflection
+        v[[r, r + 1, r + 2, p, p + 1, p + 2]] = (-math.sin(psi + alpha), math.cos(psi + alpha),
+                                                1.0, math.sin(alpha), -math.cos(alpha), -1.0)
+        spring(v, km)
+        v = np.zeros(n)  # planet bearing, radial
+        v[[c, c + 1, p]] = (math.cos(psi), math.sin(psi), -1.0)
+        spring(v, kb)
+        v = np.zeros(n)  # planet bearing, tangential
+        v[[c, c + 1, c + 2, p + 1]] = (-math.sin(psi), math.cos(psi), 1.0, -1.0)
+        spring(v, kb)
+    Kt = K - omega**2 * KO
+    A = np.block([[np.zeros((n, n)), np.eye(n)],
+                  [-np.linalg.solve(M, Kt), -np.linalg.solve(M, omega * G)]])
+    return np.linalg.eigvals(A)
+
+
+def _first_order(structure, drop=()):
+    keep = [i for i, nm in enumerate(structure.element_names) if not any(d in nm for d in drop)]
+    V = structure.projection_matrix()[keep]
+    K = V.T @ (structure.mean_stiffness()[keep][:, None] * V)
+    n = structure.n_dof
+    inv_m = structure.inv_mass
+    A = np.block([[np.zeros((n, n)), np.eye(n)],
+                  [-inv_m[:, None] * K, -inv_m[:, None] * structure.gyroscopic_matrix()]])
+    return np.linalg.eigvals(A)
+
+
+def _sorted(lam):
+    lam = lam[np.abs(lam) > 1e-3]
+    return lam[np.lexsort((np.round(lam.real, 3), np.round(lam.imag, 3)))]
+
+
+@pytest.mark.parametrize("planets", [3, 4])
+def test_turning_frame_equals_the_published_equations(planets):
+    """At a carrier speed of 6500 rpm (sun 34 000 rpm) the assembled equations have
+    the eigenvalues of Lin & Parker 1999 eq. 1 with Omega_c = the carrier speed, written
+    out in the paper's coordinates (independent of the assembly), to 1e-8 -- once the
+    pin-preload stiffness, which the paper omits, is taken out."""
+    raw = lp_raw(planets)
+    raw["drives"]["input"]["speed"] = "34000 rpm"
+    model = load(raw)
+    om = solve_kinematics(model).bodies["stage_carrier"].speed
+    assert om > 600  # the Coriolis terms are not small
+    ours = _sorted(_first_order(torquesplit.assemble(model), drop=("pin_preload",)))
+    paper = _sorted(_lin_parker_first_order(planets, om, LP["alpha"]))
+    assert ours.size == paper.size
+    np.testing.assert_allclose(ours, paper, rtol=1e-8, atol=1e-6 * np.abs(paper).max())
+
+
+def test_rigid_rotation_stays_rigid_in_the_turning_frame():
+    """With the pin-preload stiffness the rotation of carrier, sun and planets together
+    (ring held) is still a zero-frequency mode at speed (the stiffness matrix has it in
+    its null space to round-off); without it it would diverge."""
+    raw = lp_raw(4)
+    raw["drives"]["input"]["speed"] = "34000 rpm"
+    s = torquesplit.assemble(load(raw))
+    sol = modal_analysis(s, static_equilibrium(s).q)
+    assert sol.rigid_modes.shape[1] == 1 and np.all(sol.frequencies > 0)
+    d = np.sqrt(s.inv_mass)
+    lam = np.linalg.eigvalsh(d[:, None] * s.stiffness_matrix() * d[None, :])
+    assert abs(lam[0]) < 1e-12 * lam[-1] and lam[1] > 1e-4 * lam[-1]
+    lam = _first_order(s, drop=("pin_preload",))
+    assert np.max(lam.real) > 1.0  # the spurious divergence the preload term removes
+
+
+def test_star_is_the_planetary_with_the_carrier_held():
+    """The star example (carrier held rigidly, ring free) assembles to the planetary
+    example's stationary-carrier equations with the carrier's rotation removed and the
+    ring's torsional spring dropped; and the sun torque gives the same mesh forces."""
+    planetary = torquesplit.assemble(lp_model(4), options={"rotating_frame": False})
+    star = torquesplit.assemble(torquesplit.load_model(
+        torquesplit.example_path("lin_parker1999_star")))
+    keep_el = [i for i, n in enumerate(planetary.element_names)
+               if n != "stage_ring.torsional_support"]
+    keep_dof = [i for i, n in enumerate(planetary.dof_names) if n != "stage_carrier.theta"]
+    V = planetary.projection_matrix()[keep_el][:, keep_dof]
+    K = V.T @ (planetary.mean_stiffness()[keep_el][:, None] * V)
+    d = np.sqrt(planetary.inv_mass[keep_dof])
+    lam = np.linalg.eigvalsh(d[:, None] * K * d[None, :])
+    expected = np.sqrt(lam[lam > 1e-9 * lam.max()]) / (2 * math.pi)
+    assert [n for n in planetary.dof_names if n != "stage_carrier.theta"] == \
+        [n for n in star.dof_names]
+    np.testing.assert_allclose(modal_analysis(star).frequencies, expected, rtol=1e-9)
+    fp = static_equilibrium(planetary).element_forces[:8]
+    fs = static_equilibrium(star).element_forces[:8]
+    np.testing.assert_allclose(fs, fp, rtol=1e-9)
+
+
+def test_torsional_support_elastic_and_rigid():
+    raw = lp_raw(4)
+    s = torquesplit.assemble(load(raw))
+    k = dict(zip(s.element_names, s.stiffness_table[:, 0]))
+    rbr = 2.25e-3 * ZR / 2 * math.cos(LP["alpha"])
+    assert k["stage_ring.torsional_support"] == pytest.approx(1e9 * 0.1411589**2, rel=1e-9)
+    assert rbr == pytest.approx(0.1411589, rel=1e-6)
+    raw["planetary"][0]["ring"]["torsional_support"] = {"rigid": True}
+    rigid = torquesplit.assemble(load(raw))
+    assert "stage_ring.theta" not in rigid.dof_names
+    assert rigid.n_dof == s.n_dof - 1
+
+
+def test_planets_rigid_on_their_pins():
+    """A planet without translations rides its pin: its mass moves with the carrier
+    (m R^2 on its rotation) and its meshes with the pin.  The modes of the rotational
+    model equal those of planets on bearings a million times stiffer."""
+    def model(rigid):
+        raw = lp_raw(3)
+        st = raw["planetary"][0]
+        for member in ("sun", "ring", "carrier"):
+            st[member]["dofs"] = ["theta"]
+            st[member].pop("support", None)
+        if rigid:
+            st["planet"]["dofs"] = ["theta"]
+        else:
+            st["planet_bearing"] = {"stiffness": "1e14 N/m"}
+        return torquesplit.assemble(load(raw), options={"rotating_frame": False})
+
+    r, b = model(True), model(False)
+    assert r.n_dof == 6  # sun, ring, carrier and three planet rotations
+    f_r = modal_analysis(r).frequencies
+    f_b = modal_analysis(b).frequencies
+    np.testing.assert_allclose(f_r, f_b[:f_r.size], rtol=1e-5)
+
+
+# --------------------------------------------------------------------------- bad input
+def _general(**change):
+    data = general_elements(lp_model(4))
+    for path, value in change.items():
+        node = data
+        keys = path.split(".")
+        for k in keys[:-1]:
+            node = node[k]
+        node[keys[-1]] = value
+    return data
+
+
+@pytest.mark.parametrize("change, where, text", [
+    ({"gears.stage_planet2.place.angle": math.radians(91)}, "meshes.stage_",
+     "tooth-count assembly condition"),
+    ({"gears.stage_ring.kind": "spur"}, "gears.stage_ring.kind", "set kind = 'internal'"),
+    ({"gears.stage_planet2.place.angle": math.radians(60)}, "gears.stage_planet2",
+     "overlap"),
+    ({"gears.stage_ring.support.stiffness_y": 2e8}, "gears.stage_ring.support.stiffness_y",
+     "one radial stiffness"),
+    ({"gears.stage_ring.torsional_support": None}, "drives", "not determined"),
+    ({"loads.output.body": "stage_ring"}, "torsional_support", "is driven or loaded"),
+    ({"gears.stage_planet1.support.pin_error": {"radial": 1e-5}, "gears.stage_planet1.support.on":
+      None}, "gears.stage_planet1.support.pin_error", "requires|add on"),
+])
+def test_bad_planetary_input_names_the_field(change, where, text):
+    data = _general(**change)
+    data = {k: v for k, v in data.items()}
+    if "gears.stage_ring.torsional_support" in change:
+        data["gears"]["stage_ring"].pop("torsional_support")
+    with pytest.raises(ModelError) as exc:
+        model = load(data)
+        torquesplit.assemble(model)
+    msg = str(exc.value)
+    assert where in msg and any(t in msg for t in text.split("|")), msg
+    assert len(msg.splitlines()) <= 2
+
+
+@pytest.mark.parametrize("stage, where, text", [
+    ({"planets": 7}, "planetary.0.planets", "assembly condition"),
+    ({"planets": 6}, "planetary.0.planets", "planets overlap"),
+    ({"pin_radius": "110 mm"}, "planetary.0.pin_radius", "outside the mesh circle"),
+    ({"angles": ["0 deg", "90 deg"]}, "planetary.0.angles", "one angle per planet"),
+])
+def test_bad_shorthand_names_the_field(stage, where, text):
+    raw = lp_raw(4)
+    raw["planetary"][0].update(stage)
+    with pytest.raises(ModelError, match=f"{where}: .*{text}"):
+        load(raw)
+
+
+def test_ring_of_the_wrong_kind_in_the_shorthand():
+    raw = lp_raw(4)
+    raw["planetary"][0]["ring"]["kind"] = "spur"
+    with pytest.raises(ModelError, match="planetary.0.ring.kind: the ring of a planetary stage "
+                       "is an internal gear"):
+        load(raw)
+    raw = copy.deepcopy(lp_raw(4))
+    raw["gears"] = {"stage_sun": {"teeth": 20, "module": "2 mm", "face_width": "10 mm"}}
+    with pytest.raises(ModelError, match="planetary.0.name: the stage would create "
+                       "gears.stage_sun"):
+        load(raw)
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_static_solve_and_modes_do_not_depend_on_the_order_of_lines(seed):
+    """The sections of the file in another order, and every mesh's gears the other way
+    round: the same static mesh forces and natural frequencies (issue 16)."""
+    import random
+
+    model = lp_model(4)
+    data = general_elements(model)
+    rnd = random.Random(seed)
+    for section in ("gears", "bodies", "meshes"):
+        items = list(data[section].items())
+        rnd.shuffle(items)
+        data[section] = dict(items)
+    for mesh in data["meshes"].values():
+        mesh["gears"] = mesh["gears"][::-1]
+    shuffled = load(data)
+    a, b = torquesplit.assemble(model), torquesplit.assemble(shuffled)
+    fa = dict(zip(a.element_names, static_equilibrium(a).element_forces))
+    fb = dict(zip(b.element_names, static_equilibrium(b).element_forces))
+    for name in model.meshes:
+        assert fb[name] == pytest.approx(fa[name], rel=1e-9)
+    np.testing.assert_allclose(modal_analysis(b).frequencies, modal_analysis(a).frequencies,
+                               rtol=1e-9)
+
+
+def test_two_stage_train_from_the_same_elements():
+    """Two stages in series (the first carrier drives the second sun through a shaft):
+    the ratio is (1 + z_r / z_s)^2, each carrier has its own turning frame, and the
+    output torque is the input's times the ratio."""
+    raw = lp_raw(3)
+    first = raw["planetary"][0]
+    first["name"] = "s1"
+    second = copy.deepcopy(first)
+    second.update(name="s2", position=["0 mm", "0 mm", "-80 mm"], planets=4)
+    raw["planetary"] = [first, second]
+    raw["shafts"] = {"link": {"connects": ["s1_carrier", "s2_sun"],
+                              "torsional_stiffness": "1e6 N m/rad"}}
+    raw["drives"]["input"]["body"] = "s1_sun"
+    raw["loads"]["output"]["body"] = "s2_carrier"
+    model = load(raw)
+    kin = solve_kinematics(model)
+    ratio = (1 + ZR / ZS) ** 2
+    assert kin.bodies["s1_sun"].speed / kin.bodies["s2_carrier"].speed == pytest.approx(ratio)
+    assert kin.load_torques["output"] == pytest.approx(100.0 * ratio, rel=1e-9)
+    assert kin.frames["s2_planet1"] == "s2_carrier" and kin.frames["s1_sun"] == "s1_carrier"
+    s = torquesplit.assemble(model)
+    assert s.n_gyroscopic == 2 * (6 + 7)  # x-y pairs of every translating body
+    sol = modal_analysis(s, static_equilibrium(s).q)
+    assert sol.rigid_modes.shape[1] == 1 and np.all(sol.frequencies > 0)
+
+
+def test_ring_floating_on_a_spline_in_the_turning_frame():
+    """The ring held by a spline to a held housing (radial clearance and friction): its
+    speed is zero, the spline's friction load is the ring's reaction, the static state
+    has no rigid drift (the turning frame's inertial terms do not hold the rigid rotation
+    in the static solve), and kernel and numpy twin agree there."""
+    from torquesplit.solve import rhs, rhs_numpy
+
+    raw = lp_raw(3)
+    ring = raw["planetary"][0]["ring"]
+    ring.pop("torsional_support")
+    ring.pop("support")
+    raw["bodies"] = {"housing": {"polar_inertia": 1.0, "torsional_support": {"rigid": True}}}
+    raw["splines"] = {"ring_spline": {
+        "connects": ["housing", "stage_ring"], "radial_clearance": "20 um",
+        "stiffness": "1e8 N/m", "pitch_radius": "160 mm",
+        "torsional_stiffness": "2e7 N m/rad", "friction_coefficient": 0.1}}
+    model = load(raw)
+    kin = solve_kinematics(model)
+    assert kin.bodies["stage_ring"].speed == 0.0
+    assert kin.bodies["stage_ring"].torque == pytest.approx(100.0 * ZR / ZS, rel=1e-9)
+    s = torquesplit.assemble(model)
+    st = static_equilibrium(s)
+    assert st.converged and st.rigid_modes.shape[1] == 1
+    assert np.max(np.abs(st.q)) < 1e-2
+    np.testing.assert_allclose(rhs(s, 1e-6, st.y0), rhs_numpy(s, 1e-6, st.y0),
+                               rtol=1e-7, atol=1e-6)

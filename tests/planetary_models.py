@@ -1,0 +1,90 @@
+"""Planetary test models: the Lin & Parker 1999 example and its variants, as data."""
+
+from __future__ import annotations
+
+import copy
+import math
+import warnings
+
+import torquesplit
+from torquesplit.model.io import model_from_dict, model_to_dict
+from torquesplit.model.reader import read_model_file
+
+#: Lin & Parker 1999 Table 1 (the example system), SI
+LP = dict(m_s=0.4, m_r=2.35, m_c=5.43, m_p=0.66, i_s=0.39, i_r=3.00, i_c=6.29, i_p=0.61,
+          k_mesh=5e8, k_bearing=1e8, k_ru=1e9, alpha=math.radians(24.6))
+
+
+def lp_raw(planets: int = 4, **stage) -> dict:
+    """The raw data of the shipped Lin & Parker example, ``planets`` planets, with
+    ``stage`` overriding fields of its [[planetary]] table."""
+    data = read_model_file(torquesplit.example_path("lin_parker1999_planetary"))
+    data = copy.deepcopy(data)
+    data["planetary"][0]["planets"] = planets
+    data["planetary"][0].update(stage)
+    return data
+
+
+def load(data: dict, check: bool = True):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        model = model_from_dict(data)
+        return torquesplit.load_model(model, check=check)
+
+
+def lp_model(planets: int = 4, **stage):
+    return load(lp_raw(planets, **stage))
+
+
+def general_elements(model) -> dict:
+    """The model written with the general sections only (no [[planetary]] table)."""
+    return model_to_dict(model)
+
+
+#: Cooley & Parker 2012 Table 1 (the example of the rotating-carrier analysis), SI; the
+#: torsional stiffnesses act on u = r theta.  Tooth counts and module are ours (not in
+#: the paper; the lumped model does not depend on them): 36 / 24 / 84, 2 mm, 20 deg.
+CP = dict(m_s=3.0, m_r=7.64, m_c=12.0, m_p=1.86, i_s=1.75, i_r=8.09, i_c=6.80, i_p=1.25,
+          k_mesh=100e6, k_s=20e6, k_r=100e6, k_c=50e6, k_p=10e6, k_su=20e6, k_ru=100e6,
+          k_cu=100e6, alpha=math.radians(20.0), teeth=(36, 24, 84), module=2e-3)
+
+
+def cp_raw(planets: int = 4, sun_speed: str = "100 rpm") -> dict:
+    """Cooley & Parker 2012's example as a model: the sun's torsional stiffness k_su is a
+    shaft to an input held at its speed (a speed drive removes its rotation), the
+    carrier's k_cu a shaft to an output inertia of 1e6 kg m^2 (ground for the stage's
+    modes: it adds one mode near 0.1 Hz), the ring held by k_ru."""
+    zs, zp, zr = CP["teeth"]
+    m, a = CP["module"], CP["alpha"]
+
+    def rb(z):
+        return m * z / 2 * math.cos(a)
+
+    ac = m * (zs + zp) / 2
+    p = CP
+    return {
+        "model": {"name": "cooley_parker2012"},
+        "planetary": [{
+            "name": "st", "planets": planets, "module": m, "pressure_angle": "20 deg",
+            "face_width": "20 mm",
+            "sun": {"teeth": zs, "mass": p["m_s"], "polar_inertia": p["i_s"] * rb(zs) ** 2,
+                    "dofs": ["theta", "x", "y"], "support": {"stiffness": p["k_s"]}},
+            "planet": {"teeth": zp, "mass": p["m_p"], "polar_inertia": p["i_p"] * rb(zp) ** 2},
+            "ring": {"teeth": zr, "mass": p["m_r"], "polar_inertia": p["i_r"] * rb(zr) ** 2,
+                     "dofs": ["theta", "x", "y"], "support": {"stiffness": p["k_r"]},
+                     "torsional_support": {"stiffness": p["k_ru"] * rb(zr) ** 2}},
+            "carrier": {"mass": p["m_c"], "polar_inertia": p["i_c"] * ac**2,
+                        "dofs": ["theta", "x", "y"], "support": {"stiffness": p["k_c"]}},
+            "planet_bearing": {"stiffness": p["k_p"]},
+            "sun_mesh": {"stiffness": p["k_mesh"]}, "ring_mesh": {"stiffness": p["k_mesh"]},
+        }],
+        "bodies": {"input": {"polar_inertia": 1.0}, "output": {"polar_inertia": 1e6}},
+        "shafts": {
+            "sun_shaft": {"connects": ["input", "st_sun"],
+                          "torsional_stiffness": p["k_su"] * rb(zs) ** 2},
+            "carrier_shaft": {"connects": ["st_carrier", "output"],
+                              "torsional_stiffness": p["k_cu"] * ac**2}},
+        "drives": {"in": {"body": "input", "speed": sun_speed, "torque": "10 N m",
+                          "mode": "speed"}},
+        "loads": {"out": {"body": "output"}},
+    }
