@@ -110,8 +110,18 @@ def case_arrays(run) -> _Planned:
                       track=list(sel.track),
                       track_base=np.asarray(sel.track_base, dtype=np.int64),
                       cap=int(sel.n_cycles_cap), groups=[list(g) for g in sel.groups],
-                      blowup=BLOWUP)
+                      blowup=BLOWUP, group_min=_group_min(kw, len(sel.groups)))
     return _Planned(case, sel, plan)
+
+
+def _group_min(kw: dict, n_groups: int) -> np.ndarray:
+    """``integrate``'s ``load_sharing_min_total`` (0 for each group when not given)."""
+    g = kw.get("load_sharing_min_total")
+    if g is None:
+        return np.zeros(n_groups)
+    if len(g) != n_groups:
+        raise ValueError("load_sharing_min_total needs one value per load-sharing group.")
+    return np.asarray(g, dtype=np.float64).reshape(n_groups)
 
 
 def run_ensemble(runs, *, target: str = "cuda", precision: str = "fp64",
@@ -229,7 +239,7 @@ def _solution(p: _Planned, run, g, src, of, oi, precision, target, share):
     n_tr = len(sel.track)
     cap = c.cap
     rec = kd.make_record(sel.track, sel.track_base, cap, sel.groups, s.n_elements, [], [],
-                         0, 0, s.n_dof)
+                         0, 0, s.n_dof, c.group_min)
     st = of[:cap * n_tr * N_STAT].reshape(cap, n_tr, N_STAT)
     rec.cyc_max[:] = st[:, :, 0]
     rec.cyc_min[:] = st[:, :, 1]

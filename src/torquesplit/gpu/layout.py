@@ -48,6 +48,9 @@ class CaseArrays:
     cap: int
     groups: list[list[int]]
     blowup: float
+    group_min: np.ndarray | None = None
+    """Per group, the total force below which no ratio is formed (``make_record``'s
+    ``group_min``; 0: any positive total)."""
 
 
 def _gapped(m) -> np.ndarray:
@@ -244,6 +247,9 @@ def _scalars(L: Layout, c: CaseArrays) -> list[tuple[tuple, str, float]]:
     add((("cap",), _I, c.cap))
     for j in range(len(c.track)):
         add((("base", j), _I, c.track_base[j]))
+    gmin = np.zeros(len(c.groups)) if c.group_min is None else c.group_min
+    for k in range(len(c.groups)):
+        add((("gmin", k), _T, gmin[k]))
     return out
 
 

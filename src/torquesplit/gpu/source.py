@@ -182,7 +182,7 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
             if isinstance(x, int):
                 return str(x)
             text = _flt(x)
-            kind_t = name[0] in ("f", "ph", "ew", "ep", "t0", "h")
+            kind_t = name[0] in ("f", "ph", "ew", "ep", "t0", "h", "gmin")
             return f"DT({text})" if (fp32 and not kind_t) else text
         return f"{where}[{x}, c]"
 
@@ -380,11 +380,11 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
             if full:
                 w(f"X[{s + 2}] += fe")
                 w(f"WI[{WI_SC + 2 * j + 1}] += 1")
-        for grp in L.groups:
+        for kg, grp in enumerate(L.groups):
             w("total = 0.0")
             for j in grp:
                 w(f"total += W[{W_F + L.track[j]}]")
-            with w.block("if total != 0.0:"):
+            with w.block(f"if total > {par(('gmin', kg))}:"):
                 for j in grp:
                     s = X_ST + N_STAT * j
                     w(f"ratio = {len(grp)} * W[{W_F + L.track[j]}] / total")
