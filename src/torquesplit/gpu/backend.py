@@ -91,7 +91,8 @@ class GpuRunner:
         self.report: dict = {"backend": "gpu", "target": target, "precision": precision,
                              "cases": 0, "ensembles": 0, "kernel_time_s": 0.0,
                              "compile_time_s": 0.0, "setup_time_s": 0.0, "post_time_s": 0.0,
-                             "prepare_time_s": 0.0, "sample_steps": 0}
+                             "prepare_time_s": 0.0, "metrics_time_s": 0.0,
+                             "sample_steps": 0}
 
     def __repr__(self) -> str:
         return f"GpuRunner(target={self.target!r}, precision={self.precision!r})"
@@ -146,10 +147,12 @@ class GpuRunner:
         if self.precision == "fp32" and r.get("fp32_checked", 0) < self.check_cases:
             k = min(len(runs), self.check_cases - r.get("fp32_checked", 0))
             fp64 = run_ensemble(runs[:k], target=self.target, precision="fp64").solutions
+        t = time.perf_counter()
         for i, (job, sol) in enumerate(zip(jobs, res.solutions, strict=True)):
             job.take(sol, res.kernel_time / len(runs), res.compile_time / len(runs))
             if fp64 is not None and i < len(fp64):
                 self._fp32_error(job, sol, fp64[i])
+        r["metrics_time_s"] = r.get("metrics_time_s", 0.0) + time.perf_counter() - t
 
     def _fp32_error(self, job, sol32, sol64) -> None:
         """Largest absolute and relative difference of every output, FP32 against FP64."""
