@@ -112,3 +112,28 @@ def test_without_a_device_the_cpu_runner_runs_it_with_a_warning():
     assert msgs and "CPU runner" in msgs[0] and "no CUDA device" in msgs[0]
     assert "gpu_backend" not in ds.attrs
     _same(torquesplit.run_study(spec, workers=1), ds)
+
+
+def test_cli_refuses_and_falls_back_in_one_line(tmp_path):
+    from typer.testing import CliRunner
+
+    from torquesplit.cli import app
+
+    cli = CliRunner()
+    res = cli.invoke(app, ["sweep", "seed004_star_reducer", "--static", "--vary",
+                           "gears.s1.errors.eccentricity=1:2:2um", "--backend", "gpu",
+                           "--quiet", "--no-figures", "--out", str(tmp_path / "s")])
+    assert res.exit_code == 2
+    assert "does not support quasi-static" in res.output
+    res = cli.invoke(app, ["sweep", "seed001_mill_drive", "--vary",
+                           "meshes.m11.damping_ratio=0.05:0.1:2", "--duration", "0.01 s",
+                           "--precision", "fp32", "--quiet", "--no-figures", "--out",
+                           str(tmp_path / "p")])
+    assert res.exit_code == 2 and "GPU backend only" in res.output
+    if not cuda_available()[0]:
+        res = cli.invoke(app, ["sweep", "seed001_mill_drive", "--vary",
+                               "meshes.m11.damping_ratio=0.05:0.1:2", "--duration", "0.01 s",
+                               "--backend", "gpu", "--workers", "1", "--quiet",
+                               "--no-figures", "--out", str(tmp_path / "f")])
+        assert res.exit_code == 0, res.output
+        assert res.output.count("running on the CPU runner") == 1

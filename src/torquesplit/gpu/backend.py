@@ -325,7 +325,7 @@ def make_gpu_runner(*, precision: str = "fp64", batch: int = BATCH):
         msg = (f"--backend gpu: {why}; the study runs on the CPU runner instead (same "
                "results, CPU speed). Run it on a machine with an NVIDIA GPU for the GPU "
                "backend.")
-        log.warning(msg)
+        log.info(msg)
         warnings.warn(msg, GpuFallbackWarning, stacklevel=3)
         return None
     return GpuRunner(precision=precision, target="cuda", batch=batch)

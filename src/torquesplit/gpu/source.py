@@ -198,7 +198,7 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
     def p_of(e) -> str:
         return cast(f"X[b + {xk(('P', e))}]") if ("P", e) in k_off else par(("P0", e))
 
-    def g_of(e, dyn=True) -> str:
+    def g_of(e) -> str:
         if ("G", e) in k_off:
             return cast(f"X[b + {xk(('G', e))}]")
         return par(("G0", e))

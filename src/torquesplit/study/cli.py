@@ -11,6 +11,7 @@ from __future__ import annotations
 import json
 import math
 import re
+import warnings
 from pathlib import Path
 from typing import Optional
 
@@ -101,11 +102,22 @@ def _run(source, *, workers, scheduler, out, resume, overwrite, figures, quiet, 
                 f"[bold]{st.name}[/]: {plan.n_cases} cases ({plan.design.kind}, "
                 f"{plan.analysis['type']}), {len(plan.outputs)} outputs -> {out}",
                 highlight=False)
-        ds = _with_bar(lambda cb: st.run(workers=workers, scheduler=scheduler, out=out,
-                                         resume=resume, overwrite=overwrite, progress=cb,
-                                         figures=figures, backend=backend,
-                                         precision=precision),
-                       plan.n_cases, quiet or as_json)
+        with warnings.catch_warnings():
+            if backend == "gpu":  # no device: say so in one line, not as a Python warning
+                from ..errors import GpuFallbackWarning
+                from ..gpu.compile import cuda_available
+
+                ok, why = cuda_available()
+                if not ok:
+                    ui.err_console.print(
+                        f"[yellow]--backend gpu:[/] {why}; running on the CPU runner "
+                        "(same results, CPU speed)", highlight=False)
+                warnings.simplefilter("ignore", GpuFallbackWarning)
+            ds = _with_bar(lambda cb: st.run(workers=workers, scheduler=scheduler, out=out,
+                                             resume=resume, overwrite=overwrite, progress=cb,
+                                             figures=figures, backend=backend,
+                                             precision=precision),
+                           plan.n_cases, quiet or as_json)
     except StudyInterrupted as exc:
         ui.err_console.print("[yellow]stopped:[/] ", end="")
         ui.err_console.print(f"{exc.done} of {exc.total} cases done and saved in {out}; to "
