@@ -14,6 +14,7 @@ import math
 import numpy as np
 import pytest
 
+import torquesplit
 from gpu_cases import compare, engine, example_run, feature_runs
 from torquesplit.errors import GpuUnavailableError, GpuUnsupportedError
 from torquesplit.gpu.compile import cuda_available
@@ -21,13 +22,15 @@ from torquesplit.gpu.ensemble import run_ensemble
 from torquesplit.results import Results
 from torquesplit.study.outputs import output_values
 
-EXAMPLES = {  # run lengths: a few hundred steps, table corners included
+_LENGTHS = {  # run lengths: about a hundred to a few hundred steps, table corners included
     "seed000_split_torque": 6e-4,
     "seed001_mill_drive": 2e-3,
     "seed002_face_gear": 1e-3,
     "seed003_friction_split": 6e-4,
     "seed004_star_reducer": 2e-3,
 }
+#: every shipped example (a new one is covered without editing this file)
+EXAMPLES = {name: _LENGTHS.get(name, 1e-3) for name in torquesplit.example_names()}
 
 
 def test_every_feature_equals_the_engine():
