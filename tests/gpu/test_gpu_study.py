@@ -137,3 +137,16 @@ def test_cli_refuses_and_falls_back_in_one_line(tmp_path):
                                "--no-figures", "--out", str(tmp_path / "f")])
         assert res.exit_code == 0, res.output
         assert res.output.count("running on the CPU runner") == 1
+
+
+def test_a_case_the_study_makes_invalid_is_refused_as_on_the_cpu():
+    spec = {"study": {"name": "bad", "model": "seed001_mill_drive",
+                      "outputs": ["load_sharing.engineering"]},
+            "analysis": {"duration": "0.01 s"},
+            "grid": {"parameters": [{"path": "meshes.m11.damping_ratio",
+                                     "values": [0.1, -0.5]}]}}
+    ds_cpu = torquesplit.run_study(spec, workers=1)
+    ds_gpu = torquesplit.Study(spec).run(runner=GpuRunner(target="cpu"))
+    assert list(ds_gpu["status"].values) == ["ok", "refused"]
+    assert "must not be negative" in str(ds_gpu["reason"].values[1])
+    _same(ds_cpu, ds_gpu)
