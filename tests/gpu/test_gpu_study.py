@@ -150,3 +150,14 @@ def test_a_case_the_study_makes_invalid_is_refused_as_on_the_cpu():
     assert list(ds_gpu["status"].values) == ["ok", "refused"]
     assert "must not be negative" in str(ds_gpu["reason"].values[1])
     _same(ds_cpu, ds_gpu)
+
+
+def test_cases_set_up_in_worker_processes_give_the_same_dataset():
+    spec = {**GRID, "analysis": {"duration": "0.02 s"}}
+    ds_one = torquesplit.Study(spec).run(runner=GpuRunner(target="cpu"))
+    runner = GpuRunner(target="cpu", workers=2)
+    ds_two = torquesplit.Study(spec).run(runner=runner)
+    _same(ds_one, ds_two)
+    assert runner._pool is None  # shut down when the study ends
+    with pytest.raises(ValueError, match="workers"):
+        GpuRunner(workers=0)

@@ -68,12 +68,14 @@ class GpuRunner:
         Cases per ensemble.
     check_cases : int
         FP32 only: cases also run in FP64 to report the FP32 error.
+    workers : int
+        Processes that set the cases up on the CPU (model, assembly, static
+        equilibrium: about 10-20 ms a case, the host's share of a GPU study); 1: this
+        process.
     """
 
-    workers = 1
-
     def __init__(self, *, precision: str = "fp64", target: str = "cuda", batch: int = BATCH,
-                 check_cases: int = 16):
+                 check_cases: int = 16, workers: int = 1):
         from .ensemble import PRECISIONS, TARGETS
 
         if precision not in PRECISIONS:
@@ -87,6 +89,10 @@ class GpuRunner:
         self.target = target
         self.batch = int(batch)
         self.check_cases = int(check_cases)
+        if int(workers) < 1:
+            raise ValueError(f"workers must be >= 1, got {workers}; give e.g. workers=4")
+        self.workers = int(workers)
+        self._pool = None
         self.device = ""
         self.report: dict = {"backend": "gpu", "target": target, "precision": precision,
                              "cases": 0, "ensembles": 0, "kernel_time_s": 0.0,
@@ -100,28 +106,50 @@ class GpuRunner:
     # ----------------------------------------------------------------- runner protocol
     def __call__(self, function, payloads):
         batch: list[dict] = []
-        for p in payloads:
-            batch.append(p)
-            if len(batch) >= self.batch:
+        try:
+            for p in payloads:
+                batch.append(p)
+                if len(batch) >= self.batch:
+                    yield from self._run_batch(batch)
+                    batch = []
+            if batch:
                 yield from self._run_batch(batch)
-                batch = []
-        if batch:
-            yield from self._run_batch(batch)
+        finally:
+            if self._pool is not None:
+                self._pool.shutdown(wait=False, cancel_futures=True)
+                self._pool = None
+
+    def _prepare(self, jobs: list["_Job"], first: bool) -> None:
+        """Set the jobs' next runs up, in a process pool when ``workers`` > 1."""
+        args = [(j.p, None if first else j.length) for j in jobs]
+        if self.workers > 1 and len(jobs) > 1:
+            if self._pool is None:
+                import multiprocessing
+                from concurrent.futures import ProcessPoolExecutor
+
+                from ..study.runners import _ignore_sigint
+
+                self._pool = ProcessPoolExecutor(
+                    self.workers, mp_context=multiprocessing.get_context("spawn"),
+                    initializer=_ignore_sigint)
+            chunk = max(1, len(jobs) // (4 * self.workers))
+            results = list(self._pool.map(prepare_case, *zip(*args), chunksize=chunk))
+        else:
+            results = [prepare_case(p, length) for p, length in args]
+        for job, res in zip(jobs, results, strict=True):
+            job.apply_prepared(res)
 
     # ----------------------------------------------------------------------- batches
     def _run_batch(self, payloads: list[dict]):
-        t0 = time.perf_counter()
         jobs = [_Job(p, self._worker()) for p in payloads]
-        for job in jobs:
-            job.load()
-        self.report["prepare_time_s"] += time.perf_counter() - t0
-        active = [j for j in jobs if j.status == "ok" and j.model is not None]
+        active = jobs
+        first = True
         while active:
             t = time.perf_counter()
-            for job in active:
-                job.prepare()
+            self._prepare(active, first)
+            first = False
             self.report["prepare_time_s"] += time.perf_counter() - t
-            ready = [j for j in active if j.run is not None]
+            ready = [j for j in active if j.run is not None and not j.finished]
             if ready:
                 self._integrate(ready)
             active = [j for j in active if not j.finished]
@@ -182,16 +210,54 @@ class GpuRunner:
         return f"{os.uname().nodename}:{os.getpid()}:{where}"
 
 
+def prepare_case(p: dict, length: float | None = None) -> dict:
+    """Set up one case as :func:`torquesplit.study.case.run_case` sets it up (the study's
+    overrides, validation, :func:`torquesplit.simulation.prepare_run`), in this process or
+    in a pool worker: ``{run, status, reason, warnings, full, length}``.  With a settle
+    rule, ``length`` is the run length of this round (None: the first, which is computed
+    here, with ``full``, the cap of the rule); errors become statuses, as in run_case."""
+    from ..errors import SolverError, TorquesplitError
+    from ..model.io import load_model, model_from_dict
+    from ..model.overrides import apply_overrides
+    from ..simulation import prepare_run
+    from ..study.case import _full_duration, _one_line
+
+    out = {"run": None, "status": "ok", "reason": "", "warnings": [], "full": None,
+           "length": length}
+    a = p["analysis"]
+    kw = {k: a[k] for k in ("method", "steps_per_period", "rtol") if a.get(k) is not None}
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            data = apply_overrides(p["model"], p["overrides"])
+            model = load_model(model_from_dict(data, source=p["source"]))
+            settle = a.get("settle")
+            if settle is None:
+                out["run"] = prepare_run(model, duration=a.get("duration"),
+                                         cycles=a.get("cycles"), **kw)
+            else:
+                if length is None:
+                    full, f_min = _full_duration(model, a)
+                    out["full"] = full
+                    out["length"] = length = min(settle["start"] or 50.0 / f_min, full)
+                out["run"] = prepare_run(model, duration=length, **kw)
+        except (TorquesplitError, SolverError, ValueError) as exc:
+            out.update(status="refused", reason=_one_line(exc))
+        except Exception as exc:  # noqa: BLE001 - recorded, the study goes on
+            out.update(status="error", reason=f"{type(exc).__name__}: {_one_line(exc)}")
+    out["warnings"] = [_one_line(w.message) for w in caught]
+    return out
+
+
 class _Job:
     """One case through the rounds of a batch: load, (prepare, integrate)+, result."""
 
     def __init__(self, p: dict, worker: str):
         self.p = p
-        self.model = None
         self.run = None
         self.finished = False
         self.status = "ok"
-        self.caught: list = []
+        self.notes: list[str] = []  # warnings, one line each
         self.t0 = time.perf_counter()
         a = p["analysis"]
         self.settle = a.get("settle")
@@ -218,7 +284,7 @@ class _Job:
             except Exception as exc:  # noqa: BLE001 - recorded, the study goes on
                 self._fail("error", f"{type(exc).__name__}: {_one_line(exc)}")
             finally:
-                self.caught.extend(caught)
+                self.notes.extend(_one_line(w.message) for w in caught)
         return None
 
     def _fail(self, status: str, reason: str) -> None:
@@ -227,36 +293,16 @@ class _Job:
         self.status = status
         self.finished = True
 
-    def load(self) -> None:
-        from ..model.io import load_model, model_from_dict
-        from ..model.overrides import apply_overrides
-
-        def go():
-            data = apply_overrides(self.p["model"], self.p["overrides"])
-            self.model = load_model(model_from_dict(data, source=self.p["source"]))
-            if self.settle is not None:
-                from ..study.case import _full_duration
-
-                self.full, f_min = _full_duration(self.model, self.p["analysis"])
-                self.length = min(self.settle["start"] or 50.0 / f_min, self.full)
-
-        self._guard(go)
-
-    def prepare(self) -> None:
-        from ..simulation import prepare_run
-
-        a = self.p["analysis"]
-        kw = {k: a[k] for k in ("method", "steps_per_period", "rtol")
-              if a.get(k) is not None}
-        self.run = None
-
-        def go():
-            if self.settle is None:
-                return prepare_run(self.model, duration=a.get("duration"),
-                                   cycles=a.get("cycles"), **kw)
-            return prepare_run(self.model, duration=self.length, **kw)
-
-        self.run = self._guard(go)
+    def apply_prepared(self, res: dict) -> None:
+        """The outcome of :func:`prepare_case` for this case's next run."""
+        self.notes.extend(res["warnings"])
+        self.run = res["run"]
+        if res["status"] != "ok":
+            self._fail(res["status"], res["reason"])
+            return
+        if res["full"] is not None:
+            self.full = res["full"]
+        self.length = res["length"]
 
     def take(self, solution, kernel_share: float, compile_share: float) -> None:
         """A finished integration of this case (as case._dynamic after simulate)."""
@@ -303,18 +349,17 @@ class _Job:
         self.finished = True
 
     def result(self) -> dict:
-        from ..study.case import _one_line
-
         out = self.out
         if out["values"] is None:  # never integrated (cannot happen; be explicit)
             out.update(status="error", reason="the case was not integrated",
                        values=[math.nan] * len(self.p["outputs"]))
-        out["warnings"] = sorted({_one_line(w.message) for w in self.caught})
+        out["warnings"] = sorted(set(self.notes))
         out["wall_time"] = time.perf_counter() - self.t0
         return out
 
 
-def make_gpu_runner(*, precision: str = "fp64", batch: int = BATCH):
+def make_gpu_runner(*, precision: str = "fp64", batch: int = BATCH,
+                    workers: int | None = None):
     """A :class:`GpuRunner` on the CUDA device, or — with a warning that says why — the
     CPU runner when there is none (``None``: the caller makes its usual CPU runner)."""
     from ..errors import GpuFallbackWarning
@@ -328,7 +373,8 @@ def make_gpu_runner(*, precision: str = "fp64", batch: int = BATCH):
         log.info(msg)
         warnings.warn(msg, GpuFallbackWarning, stacklevel=3)
         return None
-    return GpuRunner(precision=precision, target="cuda", batch=batch)
+    return GpuRunner(precision=precision, target="cuda", batch=batch,
+                     workers=int(workers or os.cpu_count() or 1))
 
 
 __all__ = ["GpuRunner", "check_plan", "make_gpu_runner", "BATCH"]

@@ -142,7 +142,8 @@ class Study:
             thread (:mod:`torquesplit.gpu`; same store and Dataset, FP64 results equal to
             the CPU engine's).  Without a device: a warning, and the CPU runner.  What the
             GPU kernel does not do (quasi-static analyses, ``method = "dopri"``) is
-            refused by name before any case runs.
+            refused by name before any case runs.  ``workers`` are then the processes
+            that set the cases up on the CPU (default: all cores).
         precision : {"fp64", "fp32"}, optional
             GPU backend only: arithmetic of the dynamics (default "fp64").  "fp32" also
             runs the first cases in FP64 and reports the largest difference of each
@@ -157,7 +158,8 @@ class Study:
             On Ctrl-C, after committing every finished case.
         """
         plan = self.plan()
-        chosen = _backend_runner(plan, backend, precision, client, scheduler, runner)
+        chosen = _backend_runner(plan, backend, precision, client, scheduler, runner,
+                                 workers)
         store = _open_store(plan, out, resume, overwrite)
         try:
             run = _Driver(plan, store, chosen or make_runner(workers, client=client,
@@ -182,7 +184,8 @@ class Study:
         return ds
 
 
-def _backend_runner(plan: Plan, backend: str, precision, client, scheduler, runner):
+def _backend_runner(plan: Plan, backend: str, precision, client, scheduler, runner,
+                    workers=None):
     """The GPU runner for ``backend="gpu"`` (None: use the CPU runners), after refusing
     options that do not go together and, by name, what the GPU kernel does not do."""
     if backend not in ("cpu", "gpu"):
@@ -201,7 +204,7 @@ def _backend_runner(plan: Plan, backend: str, precision, client, scheduler, runn
     from ..gpu.backend import check_plan, make_gpu_runner
 
     check_plan(plan)
-    return make_gpu_runner(precision=precision or "fp64")
+    return make_gpu_runner(precision=precision or "fp64", workers=workers)
 
 
 def run_study(spec, **kwargs):
