@@ -49,7 +49,7 @@ def _child() -> None:
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", torquesplit.ModelWarning)
-        model = torquesplit.load_model(torquesplit.example_path("seed001_mill_drive"))
+        model = torquesplit.load_model(torquesplit.example_path("ji_li_mill_drive"))
     s = torquesplit.assemble(model)
     st = static_equilibrium(s)
     h = 1.0 / (100 * s.frequency.max())

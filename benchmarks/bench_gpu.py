@@ -42,8 +42,8 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 OUT_JSON = HERE / "GPU_RESULTS.json"
 OUT_MD = HERE / "GPU_RESULTS.md"
-EXAMPLES = ("seed001_mill_drive", "seed004_star_reducer", "seed002_face_gear",
-            "seed000_split_torque", "seed003_friction_split")
+EXAMPLES = ("ji_li_mill_drive", "mo2017_star_reducer", "dong2021_face_gear",
+            "liu2021_split_torque_helicopter", "jin2019_friction_split")
 
 
 def _log(msg: str) -> None:
@@ -115,7 +115,7 @@ def layout() -> dict:
 
 # -------------------------------------------------------------------- studies
 MC_SPEC = {
-    "study": {"name": "gpu_bench_ji_li_mc", "model": "seed001_mill_drive",
+    "study": {"name": "gpu_bench_ji_li_mc", "model": "ji_li_mill_drive",
               "outputs": ["load_sharing.engineering*", "peak_to_nominal_engineering.*",
                           "dynamic_factor", "contact_loss.*"]},
     "analysis": {"duration": "10 s"},
@@ -187,7 +187,7 @@ def seed000(quick: bool) -> dict:
     if not ok:
         return {"run": False, "reason": why}
     n = 100 if quick else 1000
-    spec = {"study": {"name": "gpu_bench_liu", "model": "seed000_split_torque",
+    spec = {"study": {"name": "gpu_bench_liu", "model": "liu2021_split_torque_helicopter",
                       "outputs": ["load_sharing.cycle_peak*", "dynamic_factor"]},
             "analysis": {"type": "run"},
             "monte_carlo": {"samples": n, "seed": 2, "sampling": "random",

@@ -96,7 +96,7 @@ def run_nsga(workers: int) -> dict:
     from dataclasses import replace
 
     path = Path(str(resources.files("torquesplit.examples") / "optimize"
-                    / "seed000_dh_modification.toml"))
+                    / "liu2021_dh_modification.toml"))
     with tempfile.TemporaryDirectory() as tmp:
         spec = replace(read_spec(path), store=Path(tmp) / "evals.jsonl", workers=workers)
         t0 = time.perf_counter()
@@ -121,7 +121,7 @@ def markdown(res: dict) -> str:
     lines.append("")
     if res.get("nsga"):
         n = res["nsga"]
-        lines.append(f"NSGA-II of the shipped example (seed000_dh_modification.toml: population 40, "
+        lines.append(f"NSGA-II of the shipped example (liu2021_dh_modification.toml: population 40, "
                      f"50 generations, LTCA 64 x 40 x 2 helices per evaluation): "
                      f"{n['nsga2_s']:.0f} s with {n['workers']} workers (target < "
                      f"{TARGETS['nsga2_s']:.0f} s), {n['computed']} designs computed of "

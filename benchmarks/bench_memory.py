@@ -81,7 +81,7 @@ def _child(n_steps: int, record_every: int) -> None:
     compile_kernels()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", torquesplit.ModelWarning)
-        model = torquesplit.load_model(torquesplit.example_path("seed001_mill_drive"))
+        model = torquesplit.load_model(torquesplit.example_path("ji_li_mill_drive"))
     s = torquesplit.assemble(model)
     st = static_equilibrium(s)
     # the step integrate really takes over one mesh period (it refines 1/(100 f) to

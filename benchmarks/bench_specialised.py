@@ -240,7 +240,7 @@ if __name__ == "__main__":
 
     from bench_engine import example_cases
 
-    names = sys.argv[1:] or ["seed001_mill_drive"]
+    names = sys.argv[1:] or ["ji_li_mill_drive"]
     cases, skipped = example_cases(names)
     for c in cases:
         print(compare(c, 200_000))

@@ -42,13 +42,13 @@ def main():
     args = ap.parse_args()
     warnings.simplefilter("ignore")
     r = {}
-    s1 = example_path("seed001_mill_drive")
+    s1 = example_path("ji_li_mill_drive")
     steady_state(s1, keep="stage1", harmonics=8)  # compile
     for label, kw in (("seed001_full_period", {}), ("seed001_stage1", {"keep": "stage1"})):
         st, t = best(lambda kw=kw: steady_state(s1, stability=False, check=False, **kw))
         r[label] = dict(seconds=t, solver_seconds=st.solution.wall_time,
                         harmonics=st.solution.harmonics, converged=st.solution.converged)
-    s0 = example_path("seed000_split_torque")
+    s0 = example_path("liu2021_split_torque_helicopter")
     st, t = best(lambda: steady_state(s0, keep="spur_split", stability=False, check=False), 1)
     r["seed000_spur_split"] = dict(seconds=t, solver_seconds=st.solution.wall_time,
                                    harmonics=st.solution.harmonics,

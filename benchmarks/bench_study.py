@@ -118,7 +118,7 @@ def diameter() -> dict:
 _PLAIN = r"""
 import sys, time, warnings, torquesplit
 warnings.simplefilter("ignore")
-m = torquesplit.load_model(torquesplit.example_path("seed002_face_gear"))
+m = torquesplit.load_model(torquesplit.example_path("dong2021_face_gear"))
 torquesplit.simulate(m, duration=0.01)
 r = torquesplit.simulate(m, duration=0.3)
 print(r.statistics()["wall_time_s"])
@@ -146,7 +146,7 @@ def monte_carlo(n: int) -> dict:
     from torquesplit.study import Study
 
     study = {
-        "study": {"name": "bench_mc", "model": "seed002_face_gear",
+        "study": {"name": "bench_mc", "model": "dong2021_face_gear",
                   "outputs": ["load_sharing.mean_force", "load_sharing.mean_force.I"]},
         "monte_carlo": {"sampling": "random", "seed": 1, "samples": n, "parameters": [
             {"paths": ["gears.*.errors.eccentricity"], "distribution": "iso1328",

@@ -30,7 +30,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "tests"))
 
-MODEL = "seed001_mill_drive"
+MODEL = "ji_li_mill_drive"
 
 
 def _case():

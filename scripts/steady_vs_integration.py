@@ -24,10 +24,10 @@ from torquesplit.solve.integrate import integrate
 from torquesplit.steady.api import steady_state
 
 KEEP = {  # one stage's excitations: a period of one mesh cycle (the full periods are long)
-    "seed000_split_torque": "spur_split",
-    "seed001_mill_drive": "stage1",
-    "seed002_face_gear": "I",
-    "seed003_friction_split": "confluence",
+    "liu2021_split_torque_helicopter": "spur_split",
+    "ji_li_mill_drive": "stage1",
+    "dong2021_face_gear": "I",
+    "jin2019_friction_split": "confluence",
 }
 
 

@@ -1,7 +1,7 @@
 """Run each paper's study on its example model and collect the numbers the paper
 reports, for docs/validation.md.
 
-    python scripts/validate.py [seed000 seed001 ...] [--quick]
+    python scripts/validate.py [liu2021 ji_li ...] [--quick]
     python scripts/render_docs.py      # then docs/validation.md from the numbers
 
 Writes docs/validation_results.json (one entry per paper, with the commit and the
@@ -83,18 +83,18 @@ def _provenance() -> dict:
             "machine": platform.machine(), "cpu_count": __import__("os").cpu_count()}
 
 
-def seed000(quick: bool) -> dict:
+def liu2021(quick: bool) -> dict:
     """Per-cycle peak LSC and DLF of the left path, with and without meshing-in impact."""
     cycles = 200 if quick else None  # None: the example's [analysis] (2000 third-stage cycles)
-    names = [m for m in read_raw(torquesplit.example_path("seed000_split_torque"))["meshes"]]
+    names = [m for m in read_raw(torquesplit.example_path("liu2021_split_torque_helicopter"))["meshes"]]
     results = {}
     for label, impact in (("no_impact", False), ("impact", True)):
         over = {f"meshes.{m}.impact": impact for m in names if not m.endswith("12")}
-        results[label] = _run(_model("seed000_split_torque", over), cycles=cycles)
+        results[label] = _run(_model("liu2021_split_torque_helicopter", over), cycles=cycles)
     return results
 
 
-def seed001(quick: bool) -> dict:
+def ji_li(quick: bool) -> dict:
     """g1t, g2t, G1t, G2t at drive-shaft diameters 200, 250 and 300 mm."""
     out = {}
     for d in ("200 mm", "250 mm", "300 mm"):
@@ -102,25 +102,25 @@ def seed001(quick: bool) -> dict:
         for g in ("z2", "z3", "z4", "z5"):
             over[f"gears.{g}.support.shaft.diameter"] = d
         kwargs = {"duration": 3.0} if quick else {}
-        out[d] = _run(_model("seed001_mill_drive", over), **kwargs)
+        out[d] = _run(_model("ji_li_mill_drive", over), **kwargs)
     return out
 
 
-def seed002(quick: bool) -> dict:
-    """Omega_I, Omega_II and every Omega_ij (mean-force definition, seed 002 eq. 12)."""
-    return {"baseline": _run(_model("seed002_face_gear"), cycles=100 if quick else None)}
+def dong2021(quick: bool) -> dict:
+    """Omega_I, Omega_II and every Omega_ij (mean-force definition, Dong et al. 2021 eq. 12)."""
+    return {"baseline": _run(_model("dong2021_face_gear"), cycles=100 if quick else None)}
 
 
-def seed003(quick: bool) -> dict:
+def jin2019(quick: bool) -> dict:
     """Mesh forces with tooth friction for RMS roughness 0.3, 0.6 and 0.9 um."""
-    data = read_raw(torquesplit.example_path("seed003_friction_split"))
+    data = read_raw(torquesplit.example_path("jin2019_friction_split"))
     from torquesplit.assembly.excitation import friction_table
 
     out = {}
     for s in ("0.3 um", "0.6 um", "0.9 um"):
         over = {f"meshes.{m}.friction": {"roughness": s}
                 for m, v in data["meshes"].items() if v.get("friction")}
-        model = _model("seed003_friction_split", over)
+        model = _model("jin2019_friction_split", over)
         out[s] = _run(model, cycles=100 if quick else None)
         # friction force over one mesh cycle at the nominal load (the tables the
         # dynamic model uses), a spur split mesh and a herringbone mesh of the right path
@@ -131,9 +131,9 @@ def seed003(quick: bool) -> dict:
     return out
 
 
-def seed004(quick: bool) -> dict:
+def mo2017(quick: bool) -> dict:
     """Quasi-static star load-sharing coefficients and the suns' floating orbits."""
-    res = quasi_static_load_sharing(_model("seed004_star_reducer"),
+    res = quasi_static_load_sharing(_model("mo2017_star_reducer"),
                                     points_per_cycle=2 if quick else 8)
     met = res.metrics()
     orbits = {b: {"x_um": [1e6 * float(o[:, 0].min()), 1e6 * float(o[:, 0].max())],
@@ -152,36 +152,36 @@ def kinematics(quick: bool) -> dict:
     def kin(name):
         return torquesplit.solve_kinematics(_model(name))
 
-    k0, k1, k2, k4 = (kin(n) for n in ("seed000_split_torque", "seed001_mill_drive",
-                                       "seed002_face_gear", "seed004_star_reducer"))
+    k0, k1, k2, k4 = (kin(n) for n in ("liu2021_split_torque_helicopter", "ji_li_mill_drive",
+                                       "dong2021_face_gear", "mo2017_star_reducer"))
     return {
-        "seed000": {"contact_ratio_dh": k0.meshes["L78"].total_contact_ratio,
+        "liu2021": {"contact_ratio_dh": k0.meshes["L78"].total_contact_ratio,
                     "speed_spur_pinion_rpm": abs(k0.bodies["L3"].speed) / rpm,
                     "speed_dh_pinion_rpm": abs(k0.bodies["L7"].speed) / rpm,
                     "design_load_Nm": k0.meshes["L78"].torque_driven},
-        "seed001": {"f_mesh1_Hz": k1.meshes["m11"].frequency,
+        "ji_li": {"f_mesh1_Hz": k1.meshes["m11"].frequency,
                     "f_mesh2_Hz": k1.meshes["m12"].frequency},
-        "seed002": {"input_torque_Nm": k2.drive_torques["engine"],
+        "dong2021": {"input_torque_Nm": k2.drive_torques["engine"],
                     "idler_torque_Nm": k2.bodies["O6"].torque},
-        "seed004": {"input_torque_Nm": k4.drive_torques["turbine"],
+        "mo2017": {"input_torque_Nm": k4.drive_torques["turbine"],
                     "path_torque_Nm": k4.meshes["s1p11"].torque_driver,
                     "star_shaft_torque_Nm": k4.bodies["p11"].torque,
                     "output_torque_Nm": k4.load_torques["output"]},
     }
 
 
-STUDIES = {"kinematics": kinematics, "seed000": seed000, "seed001": seed001, "seed002": seed002, "seed003": seed003,
-           "seed004": seed004}
+STUDIES = {"kinematics": kinematics, "liu2021": liu2021, "ji_li": ji_li, "dong2021": dong2021, "jin2019": jin2019,
+           "mo2017": mo2017}
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("seeds", nargs="*", default=list(STUDIES))
+    ap.add_argument("papers", nargs="*", default=list(STUDIES))
     ap.add_argument("--quick", action="store_true", help="shorter runs (smoke test)")
     args = ap.parse_args(argv)
     old = json.loads(OUT.read_text()) if OUT.exists() else {}
     old["provenance"] = _provenance()
-    for seed in args.seeds:
+    for seed in args.papers:
         t0 = time.perf_counter()
         try:
             old[seed] = STUDIES[seed](args.quick)

@@ -21,7 +21,7 @@ PAPER = (0.023e-3, 0.035e-3, 2.30e-3, 2.01e-3, 0.013e-3, 8.19e-3)   # Liu et al.
 
 
 def spec_dict(**opt):
-    o = dict(model="seed000_split_torque", population=10, generations=4, seed=3, workers=1)
+    o = dict(model="liu2021_split_torque_helicopter", population=10, generations=4, seed=3, workers=1)
     o.update(opt)
     return {
         "optimization": o,
@@ -58,7 +58,7 @@ def test_interrupted_optimisation_resumes_from_its_store(tmp_path):
 
 
 @pytest.mark.parametrize("change, location", [
-    ({"optimization": {"model": "seed000_split_torque", "algorithm": "simplex"}}, "optimization.algorithm"),
+    ({"optimization": {"model": "liu2021_split_torque_helicopter", "algorithm": "simplex"}}, "optimization.algorithm"),
     ({"objectives": [{"output": "ltca.L68"}]}, "objectives[0].output"),
     ({"variables": [{"path": "gears.L6.modifications.topological.y1", "lower": "1 mm",
                      "upper": "0 mm"}]}, "variables[0].upper"),

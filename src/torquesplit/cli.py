@@ -12,8 +12,8 @@ save.
 from __future__ import annotations
 
 import contextlib
-import json
 import math
+import os
 import sys
 import warnings
 from pathlib import Path
@@ -23,22 +23,83 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
+from . import cli_support as ux
+from .cli_support import header as _h
 from .errors import ModelWarning, OptionError, TorquesplitError, clip_message
 
+class _Command(typer.core.TyperCommand):
+    """A command listed in --help without type noise: no ``<bool>`` on flags, no
+    ``<str>`` beside an argument that already has a name (MODEL)."""
+
+    def get_help_option(self, ctx):
+        option = super().get_help_option(ctx)
+        if option is not None and getattr(option, "metavar", "") is None:
+            option.metavar = ""
+        return option
+
+    def get_params(self, ctx):
+        params = super().get_params(ctx)
+        for p in params:
+            if isinstance(p, typer.core.TyperArgument) and p.metavar:
+                p.display_type_rich = lambda ctx: None  # the metavar says it
+        return params
+
+
+class _Group(typer.core.TyperGroup):
+    """The app's group, its --help listed like the commands'."""
+
+    def get_help_option(self, ctx):
+        option = super().get_help_option(ctx)
+        if option is not None and getattr(option, "metavar", "") is None:
+            option.metavar = ""
+        return option
+
+
 app = typer.Typer(
+    cls=_Group,
+    rich_markup_mode="markdown",
     add_completion=False,
     no_args_is_help=True,
-    help="Dynamic load-sharing analysis of power-split gear transmissions.",
+    help="Dynamic load-sharing analysis of power-split gear transmissions.  Start with "
+         "'torquesplit examples', then 'torquesplit check ji_li_mill_drive' and "
+         "'torquesplit run ji_li_mill_drive'; docs/tutorial.md builds a model from scratch.",
 )
-console = Console(width=None if sys.stdout.isatty() else 160)
-err_console = Console(stderr=True, width=None if sys.stderr.isatty() else 160)
+def _width(stream) -> int | None:
+    """Terminal width: the terminal's, else $COLUMNS, else 160 (pipes, files)."""
+    if stream.isatty():
+        return None
+    try:
+        return max(40, int(os.environ.get("COLUMNS", "")))
+    except ValueError:
+        return 160
+
+
+console = Console(width=_width(sys.stdout))
+err_console = Console(stderr=True, width=_width(sys.stderr))
 
 _state = {"debug": False}
 
 
+def _version(value: bool) -> None:
+    if value:
+        from . import __version__
+
+        print(f"torquesplit {__version__}")
+        raise typer.Exit()
+
+
 @app.callback()
-def _main(debug: bool = typer.Option(False, "--debug", help="Show tracebacks on errors.")):
+def _main(debug: bool = typer.Option(False, "--debug", help="Show tracebacks on errors.",
+                                     metavar=""),
+          version: bool = typer.Option(False, "--version", callback=_version, is_eager=True,
+                                       help="Print the version and exit.", metavar="")):
     _state["debug"] = debug
+    ux.reset(console, err_console, debug)
+
+
+def _flag(option: str, help: str):
+    """An on/off option shown without a type in --help."""
+    return typer.Option(False, option, help=help, metavar="")
 
 
 def _fail(exc: BaseException) -> None:
@@ -74,36 +135,60 @@ def _positive(value, option: str, example: str) -> None:
                           f"e.g. {option} {example}")
 
 
-def _check_plots_folder(plots: Optional[Path]) -> None:
+def _check_plots_folder(plots: Optional[Path], option: str = "--plots") -> None:
     """A figures folder must be a folder (or creatable), checked before computing."""
     if plots is None:
         return
     if plots.exists() and not plots.is_dir():
-        raise OptionError(f"--plots {plots} is a file, not a folder; give a folder for the "
+        raise OptionError(f"{option} {plots} is a file, not a folder; give a folder for the "
                           f"figures")
     parent = plots if plots.exists() else plots.parent
     while not parent.exists() and parent != parent.parent:
         parent = parent.parent
     if not parent.is_dir():
-        raise OptionError(f"--plots {plots} cannot be created: {parent} is not a folder; "
+        raise OptionError(f"{option} {plots} cannot be created: {parent} is not a folder; "
                           f"give a folder for the figures")
 
 
+def _check_figure_file(path: Optional[Path], option: str, force: bool = True) -> None:
+    """A single figure file (``mesh --plot k.png``): a format matplotlib writes, in an
+    existing folder, checked before computing."""
+    if path is None:
+        return
+    from .results import files
+
+    formats = {f".{s}": s for s in ("png", "svg", "pdf", "jpg", "jpeg", "eps", "ps", "tif",
+                                    "tiff", "webp")}
+    try:
+        files.check_output(path, formats=formats, overwrite=force, what="the figure")
+    except OSError as exc:
+        raise OptionError(f"{option}: {exc}") from None
+
+
 def _resolve_model_path(model: str) -> Path:
-    """A file path, or the name of a shipped example."""
+    """A file path, or the name of a shipped example (an old example name gives the new
+    one, with a note)."""
     p = Path(model)
     if p.exists() or p.suffix in (".toml", ".json"):
         return p
-    from .examples import example_names, example_path
+    from .examples import current_name, example_names, example_path
 
-    if model in example_names():
-        return example_path(model)
+    name, note = current_name(model)
+    if name in example_names():
+        if note:
+            ux.warn(note, label="note")
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", FutureWarning)
+            return example_path(name)
     return p
 
 
 def _load(model: str, assignments: Optional[list[str]] = None, *, deep: bool = False):
     """Read, validate and check a model; ``--set`` overrides are applied to the file's
-    data first, and their errors are reported against the ``--set`` argument."""
+    data first, and their errors are reported against the ``--set`` argument.
+
+    The model's warnings are printed at once and kept for ``--json``
+    (:mod:`torquesplit.cli_support`)."""
     from .model.checks import check_model
     from .model.io import load_model, model_from_dict
 
@@ -125,34 +210,49 @@ def _load(model: str, assignments: Optional[list[str]] = None, *, deep: bool = F
             check_model(m, source=str(path), deep=deep)
     for w in caught:
         if issubclass(w.category, ModelWarning):
-            err_console.print("[yellow]warning:[/] ", end="")
-            err_console.print(clip_message(str(w.message)), markup=False, highlight=False,
-                              soft_wrap=True)
+            ux.warn(str(w.message))
     return m, path
 
 
+def _model_warnings() -> list[str]:
+    """The warnings printed so far by this command (the model's, at load)."""
+    return list(ux.session().warnings)
+
+
 # --------------------------------------------------------------------------- check
+_MODEL_HELP = ("Model file (.toml/.json) or example name (see 'torquesplit examples').")
+_SET_HELP = ("Override a model field for this command: PATH=VALUE, e.g. "
+             "shafts.s1.diameter='250 mm' (repeat for several).")
+
+
 @app.command()
 def check(
-    model: str = typer.Argument(..., help="Model file (.toml/.json) or example name."),
-    as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
+    model: str = typer.Argument(..., help=_MODEL_HELP, metavar="MODEL"),
+    assign: Optional[list[str]] = typer.Option(None, "--set", help=_SET_HELP,
+                                               metavar="PATH=VALUE"),
+    as_json: bool = _flag("--json", "Print the summary as JSON."),
+    quiet: bool = _flag("--quiet", "No progress display."),
 ):
     """Validate a model and print its kinematic and static summary.
 
-    Runs every check ``run`` performs before it integrates (the assembly and the static
-    equilibrium included), so a model that passes is refused by ``run`` only for a
-    numerical reason.
+    Runs every check 'run' performs before it integrates (the assembly and the static
+    equilibrium included), so a model that passes is refused by 'run' only for a
+    numerical reason.  Values that are possible but look wrong (a unit mistake, an error
+    beyond the coarsest ISO 1328 grade) are warnings naming the field.
     """
-    try:
-        from .model.summary import summary
+    with ux.interruptible():
+        try:
+            from .model.summary import summary
 
-        m, path = _load(model, deep=True)
-        s = summary(m)
-    except _EXPECTED as exc:
-        _fail(exc)
-        return
+            with ux.progress("checking the model (assembly, static equilibrium)", quiet or
+                             as_json, total=None):
+                m, path = _load(model, assign, deep=True)
+                s = summary(m)
+        except _EXPECTED as exc:
+            _fail(exc)
+            return
     if as_json:
-        print(json.dumps(s, indent=2))
+        ux.emit_json(s, _json_default)
         return
     from .model.summary import render_summary
 
@@ -160,91 +260,143 @@ def check(
 
 
 # --------------------------------------------------------------------------- run
+def _definition_help() -> str:
+    from .metrics.load_sharing import DYNAMIC_DEFINITIONS, DEFINITION_TEXT, DEFINITION_USE
+
+    parts = [f"'{d}': {DEFINITION_TEXT[d]}; {DEFINITION_USE[d]}." for d in DYNAMIC_DEFINITIONS]
+    return ("Load-sharing definition to report (default: the model's [analysis] "
+            "load_sharing, 'mean_force' for a new model).  " + "  ".join(parts)
+            + "  'static' / 'static_torque': quasi-static, run 'torquesplit static'.")
+
+
 @app.command()
 def run(
-    model: str = typer.Argument(..., help="Model file (.toml/.json) or example name."),
-    duration: Optional[str] = typer.Option(None, "--duration", help="Simulated time, e.g. '0.5 s'."),
-    cycles: Optional[int] = typer.Option(None, "--cycles", help="Cycles of the slowest mesh."),
-    method: Optional[str] = typer.Option(None, "--method", help="rk4 (fixed step) or dopri."),
+    model: str = typer.Argument(..., help=_MODEL_HELP, metavar="MODEL"),
+    duration: Optional[str] = typer.Option(
+        None, "--duration", help="Simulated time, e.g. '0.5 s' (a bare number is seconds).",
+        metavar="TIME"),
+    cycles: Optional[int] = typer.Option(None, "--cycles", help="Cycles of the slowest mesh.",
+                                         metavar="N"),
+    method: Optional[str] = typer.Option(None, "--method", help="rk4 (fixed step) or dopri.",
+                                         metavar="rk4|dopri"),
     steps_per_period: Optional[int] = typer.Option(
-        None, "--steps-per-period", help="RK4 steps per shortest mesh period (default 100)."),
+        None, "--steps-per-period", help="RK4 steps per shortest mesh period (default 100).",
+        metavar="N"),
     max_steps: Optional[int] = typer.Option(
-        None, "--max-steps", help="Refuse an RK4 run needing more steps (default 2e8)."),
-    definition: Optional[str] = typer.Option(
-        None, "--definition",
-        help="Load-sharing definition: cycle_peak, instantaneous, engineering, mean_force "
-             "(static_torque: use `torquesplit static`)."),
+        None, "--max-steps", help="Refuse an RK4 run needing more steps (default 2e8).",
+        metavar="N"),
+    definition: Optional[str] = typer.Option(None, "--definition", help=_definition_help(),
+                                             metavar="NAME"),
     out: Optional[Path] = typer.Option(
-        None, "--out", help="Write results: .nc (NetCDF), .mat (MATLAB) or .csv (spreadsheet)."),
-    force: bool = typer.Option(False, "--force", help="Replace existing results files."),
-    plots: Optional[Path] = typer.Option(None, "--plots", help="Write report figures (PNG, SVG) here."),
-    assign: Optional[list[str]] = typer.Option(
-        None, "--set", help="Override a model field: PATH=VALUE, e.g. shafts.s1.diameter='250 mm'."),
-    as_json: bool = typer.Option(False, "--json", help="Print metrics and statistics as JSON."),
-    quiet: bool = typer.Option(False, "--quiet", help="No progress bar."),
+        None, "--out", help="Write results: .nc (NetCDF), .mat (MATLAB) or .csv (three "
+        "spreadsheet files: NAME.csv, NAME_history.csv, NAME_cycles.csv).", metavar="FILE"),
+    force: bool = _flag("--force", "Replace existing results files."),
+    plots: Optional[Path] = typer.Option(None, "--plots", help="Write report figures (PNG, "
+                                         "SVG) into this folder.", metavar="DIR"),
+    assign: Optional[list[str]] = typer.Option(None, "--set", help=_SET_HELP,
+                                               metavar="PATH=VALUE"),
+    as_json: bool = _flag("--json", "Print metrics, statistics and warnings as JSON."),
+    quiet: bool = _flag("--quiet", "No progress bar."),
 ):
     """Static equilibrium, then the dynamic response: load sharing and dynamic factors.
 
     The options and the output path are checked before anything is computed; the
     output is claimed for this run at once (a second run on the same path is refused)
-    and written atomically at the end.
+    and written atomically at the end.  Ctrl-C stops the run and says what was kept.
     """
-    from .model.units import parse_quantity
     from .results import files
 
-    with contextlib.ExitStack() as stack:
+    state = {"saved": [], "figures": None}
+
+    def kept() -> str:
+        if state["saved"]:
+            done = ", ".join(str(f) for f in state["saved"])
+            return f"results kept in {done}" + (
+                "; figures incomplete" if state["figures"] is not None else "")
+        return "nothing written"
+
+    with contextlib.ExitStack() as stack, ux.interruptible(kept):
         try:
             if method is not None and method not in ("rk4", "dopri"):
                 raise OptionError(f"--method {method!r} is unknown; use rk4 or dopri")
-            dur = None
-            if duration is not None:
-                try:
-                    dur = parse_quantity(duration, "time")
-                except ValueError as exc:
-                    raise OptionError(f"--duration: {exc}") from None
-                _positive(dur, "--duration", "'0.5 s'")
+            dur = ux.quantity(duration, "time", "--duration")
+            _positive(dur, "--duration", "'0.5 s'")
             _at_least(cycles, 1, "--cycles", "200")
             _at_least(steps_per_period, 10, "--steps-per-period", "100")
             _at_least(max_steps, 1, "--max-steps", "200000000")
             _check_definition(definition)
             _check_plots_folder(plots)
+            plan = None
             if out is not None:
                 plan = files.check_output(out, overwrite=force)
                 stack.enter_context(files.claim_output(plan))
             m, path = _load(model, assign)
+            chosen = _run_definition(m, definition)
             from .simulation import simulate
 
-            res = _with_progress(lambda cb: simulate(
-                m, duration=dur, cycles=cycles, method=method,
-                steps_per_period=steps_per_period, max_steps=max_steps, progress=cb),
-                quiet or as_json)
-        except _EXPECTED as exc:
-            _fail(exc)
-            return
-        saved = None
-        try:
+            with ux.collect_warnings(), ux.progress("integrating", quiet or as_json) as cb:
+                res = simulate(m, duration=dur, cycles=cycles, method=method,
+                               steps_per_period=steps_per_period, max_steps=max_steps,
+                               progress=cb)
+            res.model_warnings = [w for w in _model_warnings() if w not in res.run_warnings]
+            met = None
+            if res.success:
+                met = res.metrics(chosen)
+                from .results.plausibility import result_warnings
+
+                for loc, msg in result_warnings(res, met):
+                    ux.warn(f"{loc}: {msg}")
             if out is not None:
-                saved = res.save(out, overwrite=force)
-            met = res.metrics(definition) if res.success else None
+                res.save(out, overwrite=force, definition=chosen)
+                state["saved"] = list(plan.files)
         except _EXPECTED as exc:
             _fail(exc)
             return
-    if met is None:
-        _render_stopped(res, saved, as_json)
-        raise typer.Exit(1)
-    figures = []
-    if plots is not None:
-        figures = res.write_figures(plots, definition=met.definition)
+        saved = state["saved"]
+        if met is None:
+            _render_stopped(res, saved, as_json)
+            raise typer.Exit(1)
+        figures = []
+        if plots is not None:
+            state["figures"] = []
+            figures = _write_run_figures(res, plots, met.definition, quiet or as_json)
+            state["figures"] = None
     if as_json:
-        print(json.dumps({"model": m.model.name, "success": res.success,
-                          "metrics": met.to_dict(), "statistics": res.statistics(),
-                          "results_file": str(saved) if saved else None,
-                          "figures": [str(f) for f in figures]},
-                         indent=2, default=_json_default))
+        ux.emit_json({"model": m.model.name, "success": res.success,
+                      "metrics": met.to_dict(), "statistics": res.statistics(),
+                      "results_file": str(saved[0]) if saved else None,
+                      "results_files": [str(f) for f in saved],
+                      "figures": [str(f) for f in figures]}, _json_default)
     else:
         _render_run(res, met, saved)
         if figures:
             console.print(f"{len(figures)} figure files written to {plots}")
+
+
+def _run_definition(model, definition: Optional[str]) -> str:
+    """The definition a run reports: the option, else the model's, else (for a model
+    whose definition is the quasi-static 'static_torque') the standard one, with a note."""
+    from .metrics.load_sharing import STANDARD_DEFINITION
+
+    if definition:
+        return definition
+    chosen = model.analysis.load_sharing
+    if chosen in ("static", "static_torque"):
+        ux.warn(f"the model's load_sharing is '{chosen}', the quasi-static definition of "
+                f"'torquesplit static'; this dynamic run reports '{STANDARD_DEFINITION}' "
+                f"(choose another with --definition)", label="note")
+        return STANDARD_DEFINITION
+    return chosen
+
+
+def _write_run_figures(res, plots: Path, definition: str, quiet: bool) -> list:
+    """Write the run's figures with a progress display naming each one."""
+    from .plot.figures import figure_jobs, write_jobs
+
+    jobs = figure_jobs(res, definition=definition)
+    with ux.progress("writing figures", quiet) as cb:
+        return write_jobs(jobs, plots, ("png", "svg"),
+                          progress=lambda i, n, name: cb(i / n, name))
 
 
 def _check_definition(definition: Optional[str]) -> None:
@@ -253,11 +405,13 @@ def _check_definition(definition: Optional[str]) -> None:
     from .metrics.load_sharing import DYNAMIC_DEFINITIONS
 
     if definition in ("static", "static_torque"):
-        raise OptionError("--definition static_torque is the load sharing of quasi-static "
-                          "equilibria (Mo et al. 2017); run `torquesplit static MODEL` for it")
+        raise OptionError("--definition static (static_torque) is the load sharing of "
+                          "quasi-static equilibria (Mo et al. 2017), not of a dynamic run; "
+                          "run `torquesplit static MODEL` for it")
     if definition not in DYNAMIC_DEFINITIONS:
         raise OptionError(f"--definition {definition!r} is unknown; use one of "
-                          f"{', '.join(DYNAMIC_DEFINITIONS)}")
+                          f"{', '.join(DYNAMIC_DEFINITIONS)} (or `torquesplit static` for "
+                          f"static_torque)")
 
 
 def _likely_cause(res) -> Optional[str]:
@@ -293,11 +447,12 @@ def _render_stopped(res, saved, as_json: bool) -> None:
     cause = _likely_cause(res)
     st = res.statistics()
     if as_json:
-        print(json.dumps({"model": res.model.model.name, "success": False,
-                          "status": st["status"], "message": res.message,
-                          "likely_cause": cause, "metrics": None, "statistics": st,
-                          "results_file": str(saved) if saved else None, "figures": []},
-                         indent=2, default=_json_default))
+        ux.emit_json({"model": res.model.model.name, "success": False,
+                      "status": st["status"], "message": res.message,
+                      "likely_cause": cause, "metrics": None, "statistics": st,
+                      "results_file": str(saved[0]) if saved else None,
+                      "results_files": [str(f) for f in saved], "figures": []},
+                     _json_default)
         return
     console.print(f"[bold]{res.model.model.name}[/]: [bold red]stopped[/]: {res.message}",
                   highlight=False)
@@ -308,97 +463,110 @@ def _render_stopped(res, saved, as_json: bool) -> None:
         console.print(f"likely cause: {cause}", highlight=False)
     console.print("no load-sharing or dynamic-factor table: the run did not finish, and "
                   "coefficients of a partial run are not results"
-                  + (f"; the partial results (with their status) are in {saved}" if saved
+                  + (f"; the partial results (with their status) are in "
+                     f"{', '.join(str(f) for f in saved)}" if saved
                      else "; save the partial results with --out to inspect them"),
                   highlight=False)
 
 
-def _json_default(x):
-    if isinstance(x, float) and not math.isfinite(x):
-        return None
-    try:
-        return float(x)
-    except Exception:
-        return str(x)
+_json_default = ux.json_default
 
 
-def _with_progress(job, quiet: bool):
-    """Run job(callback) with a rich progress bar on stderr."""
-    if quiet:
-        return job(None)
-    from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
-
-    with Progress(TextColumn("integrating"), BarColumn(), TextColumn("{task.percentage:>3.0f}%"),
-                  TimeRemainingColumn(), console=err_console, transient=True) as bar:
-        task = bar.add_task("run", total=1.0)
-        return job(lambda f: bar.update(task, completed=f))
+def _with_progress(job, quiet: bool, label: str = "working"):
+    """Run job(callback) with a progress bar on stderr (callback: fraction done)."""
+    with ux.progress(label, quiet) as cb:
+        return job(None if quiet else (lambda f: cb(f)))
 
 
 def _render_run(res, met, saved) -> None:
+    from .metrics.load_sharing import DEFINITION_TEXT, DEFINITION_USE
+
     st = res.statistics()
-    console.print(f"[bold]{res.model.model.name}[/]: {res.message}")
+    console.print(f"[bold]{res.model.model.name}[/]: {res.message}", highlight=False)
     console.print(
-        f"{st['steps']} steps ({st['method']}), {st['microseconds_per_step']:.3g} us/step, "
+        f"{st['steps']:,} steps ({st['method']}), {st['microseconds_per_step']:.3g} µs/step, "
         f"integration {st['wall_time_s']:.3g} s, compile/load {st['compile_time_s']:.3g} s "
         f"(+{st['rhs_compile_time_s']:.2g} s for the {st['rhs']} right-hand side); "
         f"transient discarded: {met.settling.start_time:.4g} s"
-        + ("" if met.settling.settled else " (not settled: last half used)"))
-    from .metrics.load_sharing import DEFINITION_TEXT
+        + ("" if met.settling.settled else " (not settled: last half used)"), highlight=False)
+    console.print(run_table(met))
+    console.print(group_table(met))
+    console.print(f"system load-sharing coefficient ({met.definition}): "
+                  f"[bold]{met.load_sharing.system:.5f}[/]", highlight=False)
+    console.print(
+        f"LSC ({met.definition}): {DEFINITION_TEXT[met.definition]}; "
+        f"{DEFINITION_USE[met.definition]}.  Dynamic factor = settled peak / the mesh's own "
+        f"static force (K_v sense, >= 1 in contact); peak/nominal = settled peak / "
+        f"equal-split nominal force (Ji & Li eq. 19) = load sharing and dynamics together.  "
+        f"Contact loss: drive flanks apart (a mesh with no backlash cannot lose contact: it "
+        f"is in double-flank contact); back flank: time in back-flank contact and its "
+        f"largest force.",
+        markup=False, highlight=False)
+    if saved:
+        console.print("results written to " + ", ".join(str(f) for f in saved),
+                      highlight=False)
 
+
+def run_table(met) -> Table:
+    """The per-mesh table of a run (forces in kN)."""
     t = Table(title=f"meshes (load sharing: {met.definition})")
-    for col in ("mesh", "group", "nominal F [N]", "static F [N]", "mean F [N]", "peak F [N]",
-                "dynamic factor", "peak/nominal", "LSC", "contact loss", "back flank"):
-        t.add_column(col, justify="left" if col in ("mesh", "group") else "right")
+    cols = ("mesh", "group", "nominal F\n[kN]", "static F\n[kN]", "mean F\n[kN]",
+            "peak F\n[kN]", "dynamic\nfactor", "peak/\nnominal", f"LSC\n({met.definition})",
+            "contact\nloss", "back flank\n(time, force)")
+    for col in cols:
+        t.add_column(_h(col), justify="left" if col in ("mesh", "group") else "right")
     for r in met.rows:
-        t.add_row(r.mesh, r.group, f"{r.nominal_force:.6g}", f"{r.static_force:.6g}",
-                  f"{r.mean_force:.6g}", f"{r.peak_force:.6g}", f"{r.dynamic_factor:.5f}",
-                  f"{r.peak_to_nominal:.5f}", f"{r.load_sharing:.5f}",
-                  f"{100 * r.contact_loss:.2f} %", f"{100 * r.back_contact:.2f} %")
-    console.print(t)
+        back = f"{100 * r.back_contact:.2f} %"
+        if r.back_contact > 0:
+            back += f", {r.back_flank_force / 1e3:.4g} kN"
+        loss = "no backlash" if r.double_flank else f"{100 * r.contact_loss:.2f} %"
+        t.add_row(r.mesh, r.group, f"{r.nominal_force / 1e3:.5g}", f"{r.static_force / 1e3:.5g}",
+                  f"{r.mean_force / 1e3:.5g}", f"{r.peak_force / 1e3:.5g}",
+                  f"{r.dynamic_factor:.4f}", f"{r.peak_to_nominal:.4f}",
+                  f"{r.load_sharing:.4f}", loss, back)
+    return t
+
+
+def group_table(met) -> Table:
     g = Table(title="load-sharing groups")
-    for col in ("group", "meshes", "LSC", "dynamic factor", "peak/nominal",
-                "peak/nominal (eng.)"):
-        g.add_column(col, justify="left" if col in ("group", "meshes") else "right")
+    for col in ("group", "meshes", f"LSC\n({met.definition})", "dynamic\nfactor",
+                "peak/\nnominal", "peak/nominal\n(eng.)"):
+        g.add_column(_h(col), justify="left" if col in ("group", "meshes") else "right")
     d = met.dynamic_factors
     for name, members in met.load_sharing.groups.items():
-        g.add_row(name, ", ".join(members), f"{met.load_sharing.per_group[name]:.5f}",
-                  f"{d.per_group_dynamic_factor[name]:.5f}",
-                  f"{d.per_group_peak_to_nominal[name]:.5f}",
-                  f"{d.per_group_peak_to_nominal_engineering[name]:.5f}")
-    console.print(g)
-    console.print(f"system load-sharing coefficient: [bold]{met.load_sharing.system:.5f}[/]")
-    console.print(f"LSC ({met.definition}): {DEFINITION_TEXT[met.definition]}; dynamic "
-                  "factor = settled peak / the mesh's own static force; peak/nominal = "
-                  "settled peak / equal-split nominal force (Ji & Li eq. 19)",
-                  markup=False, highlight=False)
-    lost = [r for r in met.rows if r.contact_loss > 0]
-    if lost:
-        err_console.print("[yellow]warning:[/] ", end="")
-        err_console.print(
-            "contact loss in " + ", ".join(f"{r.mesh} ({100 * r.contact_loss:.1f} % of the time)"
-                                           for r in lost)
-            + ": the teeth separate (backlash larger than the dynamic deflection), so peak "
-            "forces are impacts and the load-sharing coefficients of those meshes are not "
-            "meaningful; check the backlash and the excitation", markup=False, highlight=False)
-    if saved:
-        console.print(f"results written to {saved}")
+        g.add_row(name, ", ".join(members), f"{met.load_sharing.per_group[name]:.4f}",
+                  f"{d.per_group_dynamic_factor[name]:.4f}",
+                  f"{d.per_group_peak_to_nominal[name]:.4f}",
+                  f"{d.per_group_peak_to_nominal_engineering[name]:.4f}")
+    return g
 
 
 # --------------------------------------------------------------------------- static
 @app.command()
 def static(
-    model: str = typer.Argument(..., help="Model file (.toml/.json) or example name."),
-    revolutions: float = typer.Option(1.0, "--revolutions", help="Revolutions of the slowest gear."),
-    points_per_cycle: int = typer.Option(8, "--points-per-cycle", help="Positions per mesh cycle."),
-    out: Optional[Path] = typer.Option(None, "--out", help="Write results to this NetCDF file."),
-    force: bool = typer.Option(False, "--force", help="Replace an existing results file."),
-    plots: Optional[Path] = typer.Option(None, "--plots", help="Write report figures (PNG, SVG) here."),
-    as_json: bool = typer.Option(False, "--json", help="Print the results as JSON."),
+    model: str = typer.Argument(..., help=_MODEL_HELP, metavar="MODEL"),
+    revolutions: float = typer.Option(1.0, "--revolutions",
+                                      help="Revolutions of the slowest gear.", metavar="N"),
+    points_per_cycle: int = typer.Option(8, "--points-per-cycle",
+                                         help="Positions per cycle of the fastest mesh.",
+                                         metavar="N"),
+    out: Optional[Path] = typer.Option(None, "--out", help="Write results to this NetCDF "
+                                       "file (.nc).", metavar="FILE"),
+    force: bool = _flag("--force", "Replace an existing results file."),
+    plots: Optional[Path] = typer.Option(None, "--plots", help="Write report figures (PNG, "
+                                         "SVG) into this folder.", metavar="DIR"),
+    assign: Optional[list[str]] = typer.Option(None, "--set", help=_SET_HELP,
+                                               metavar="PATH=VALUE"),
+    as_json: bool = _flag("--json", "Print the results and warnings as JSON."),
+    quiet: bool = _flag("--quiet", "No progress bar."),
 ):
-    """Quasi-static load sharing: equilibrium at each mesh position (seed 004)."""
+    """Quasi-static load sharing: the equilibrium at each mesh position, with the errors
+    and clearances at that position (Mo et al. 2017); floating orbits in µm."""
     from .results import files
 
-    with contextlib.ExitStack() as stack:
+    state = {"saved": None}
+    with contextlib.ExitStack() as stack, ux.interruptible(
+            lambda: f"results kept in {state['saved']}" if state["saved"] else ""):
         try:
             _positive(revolutions, "--revolutions", "1")
             _at_least(points_per_cycle, 1, "--points-per-cycle", "8")
@@ -406,28 +574,38 @@ def static(
             if out is not None:
                 plan = files.check_output(out, formats=files.NETCDF_FORMATS, overwrite=force)
                 stack.enter_context(files.claim_output(plan))
-            m, _ = _load(model)
+            m, _ = _load(model, assign)
             from .quasistatic import quasi_static_load_sharing
+            from .results.plausibility import static_warnings
 
-            res = quasi_static_load_sharing(m, revolutions=revolutions,
-                                            points_per_cycle=points_per_cycle)
-            saved = res.to_netcdf(out, overwrite=force) if out is not None else None
+            with ux.progress("quasi-static equilibria", quiet or as_json) as cb:
+                res = quasi_static_load_sharing(m, revolutions=revolutions,
+                                                points_per_cycle=points_per_cycle,
+                                                progress=cb)
+            for loc, msg in static_warnings(res):
+                ux.warn(f"{loc}: {msg}")
+            res.warnings = list(ux.session().warnings)
+            state["saved"] = res.to_netcdf(out, overwrite=force) if out is not None else None
         except _EXPECTED as exc:
             _fail(exc)
             return
-    met = res.metrics()
-    orbits = res.orbits()
-    if plots is not None:
-        from .plot import write_static_figures
+        saved = state["saved"]
+        met = res.metrics()
+        orbits = res.orbits()
+        figures = []
+        if plots is not None:
+            from .plot import write_static_figures
 
-        write_static_figures(res, plots)
+            with ux.progress("writing figures", quiet or as_json, total=None):
+                figures = write_static_figures(res, plots)
     forces = res.mesh_forces()
     if as_json:
-        print(json.dumps({
+        ux.emit_json({
             "model": m.model.name, "positions": int(res.times.size),
             "converged": bool(res.solution.converged.all()),
-            "load_sharing": {"per_mesh": met.per_mesh, "per_group": met.per_group,
-                             "system": met.system, "groups": met.groups},
+            "load_sharing": {"definition": "static_torque", "per_mesh": met.per_mesh,
+                             "per_group": met.per_group, "system": met.system,
+                             "groups": met.groups},
             "mesh_force_N": {name: {"min": float(forces[:, j].min()),
                                     "mean": float(forces[:, j].mean()),
                                     "max": float(forces[:, j].max())}
@@ -436,47 +614,51 @@ def static(
                               "y_range": [1e6 * float(o[:, 1].min()), 1e6 * float(o[:, 1].max())]}
                           for b, o in orbits.items()},
             "results_file": str(saved) if saved else None,
-        }, indent=2, default=_json_default))
+            "figures": [str(f) for f in figures],
+        }, _json_default)
         return
     console.print(f"[bold]{m.model.name}[/]: {res.times.size} mesh positions, "
-                  f"{'all converged' if res.solution.converged.all() else 'NOT all converged'}")
+                  f"{'all converged' if res.solution.converged.all() else 'NOT all converged'}",
+                  highlight=False)
     t = Table(title="quasi-static load sharing (static torque ratio, largest over positions)")
-    for col in ("mesh", "min F [N]", "mean F [N]", "max F [N]", "LSC"):
-        t.add_column(col, justify="left" if col == "mesh" else "right")
+    for col in ("mesh", "min F [kN]", "mean F [kN]", "max F [kN]", "LSC (static_torque)"):
+        t.add_column(_h(col), justify="left" if col == "mesh" else "right")
     for j, name in enumerate(res.mesh_names):
-        t.add_row(name, f"{forces[:, j].min():.6g}", f"{forces[:, j].mean():.6g}",
-                  f"{forces[:, j].max():.6g}", f"{met.per_mesh[name]:.5f}")
+        t.add_row(name, f"{forces[:, j].min() / 1e3:.5g}", f"{forces[:, j].mean() / 1e3:.5g}",
+                  f"{forces[:, j].max() / 1e3:.5g}", f"{met.per_mesh[name]:.5f}")
     console.print(t)
     for g, v in met.per_group.items():
-        console.print(f"group {g}: {v:.5f}")
-    console.print(f"system load-sharing coefficient: [bold]{met.system:.5f}[/]")
+        console.print(f"group {g}: {v:.5f}", highlight=False)
+    console.print(f"system load-sharing coefficient (static_torque): [bold]{met.system:.5f}[/]")
     if orbits:
-        o = Table(title="floating orbits")
-        for col in ("body", "x range [um]", "y range [um]"):
-            o.add_column(col)
+        o = Table(title="floating orbits (centre displacement from its nominal position)")
+        for col in ("body", "x range [µm]", "y range [µm]"):
+            o.add_column(_h(col))
         for b, xy in orbits.items():
             o.add_row(b, f"{1e6 * xy[:, 0].min():.3f} .. {1e6 * xy[:, 0].max():.3f}",
                       f"{1e6 * xy[:, 1].min():.3f} .. {1e6 * xy[:, 1].max():.3f}")
         console.print(o)
     if saved:
-        console.print(f"results written to {saved}")
+        console.print(f"results written to {saved}", highlight=False)
+    if figures:
+        console.print(f"{len(figures)} figure files written to {plots}", highlight=False)
 
 
 # --------------------------------------------------------------------------- mesh
 @app.command()
 def mesh(
-    model: str = typer.Argument(..., help="Model file (.toml/.json) or example name."),
-    pair: str = typer.Option(..., "--pair", help="Name of the mesh to inspect."),
-    plot: Optional[Path] = typer.Option(None, "--plot", help="Save k(phase) of every method."),
-    points: int = typer.Option(256, "--points", help="Samples per mesh cycle."),
-    as_json: bool = typer.Option(False, "--json", help="Print the comparison as JSON."),
+    model: str = typer.Argument(..., help=_MODEL_HELP, metavar="MODEL"),
+    pair: str = typer.Option(..., "--pair", help="Name of the mesh to inspect.", metavar="MESH"),
+    plot: Optional[Path] = typer.Option(None, "--plot", help="Save k(phase) of every method "
+                                        "(.png, .svg or .pdf).", metavar="FILE"),
+    points: int = typer.Option(256, "--points", help="Samples per mesh cycle.", metavar="N"),
+    as_json: bool = _flag("--json", "Print the comparison as JSON."),
 ):
-    """Mesh stiffness k(phase) of one mesh by every applicable method, with the ISO value."""
+    """Mesh stiffness k(phase) of one mesh by every applicable method, with the ISO value
+    (N/µm along the line of action, as in the figures)."""
     try:
         _at_least(points, 16, "--points", "256")
-        if plot is not None and not plot.parent.is_dir():
-            raise OptionError(f"--plot {plot}: the folder {plot.parent} does not exist; create "
-                              f"it first or choose another folder")
+        _check_figure_file(plot, "--plot")
         m, _ = _load(model)
         if pair not in m.meshes:
             raise OptionError(f"--pair: no mesh named {pair!r}; use one of "
@@ -505,21 +687,25 @@ def mesh(
 
         plot_mesh_stiffness(cmp, plot, title=f"{m.model.name}: mesh {pair}")
     if as_json:
-        print(json.dumps({"mesh": pair, "methods": cmp.rows(),
-                          "iso_c_prime_N_per_mm_um": cmp.iso.c_prime_iso,
-                          "iso_c_gamma_N_per_mm_um": cmp.iso.c_gamma_iso,
-                          "iso_mesh_stiffness_N_per_m": cmp.iso_mesh_stiffness,
-                          "plot": str(plot) if plot else None}, indent=2, default=_json_default))
+        ux.emit_json({"mesh": pair, "methods": cmp.rows(), "units": "N/m",
+                      "iso_c_prime_N_per_mm_um": cmp.iso.c_prime_iso,
+                      "iso_c_gamma_N_per_mm_um": cmp.iso.c_gamma_iso,
+                      "iso_mesh_stiffness_N_per_m": cmp.iso_mesh_stiffness,
+                      "plot": str(plot) if plot else None}, _json_default)
         return
-    t = Table(title=f"mesh stiffness of {pair} (N/m, along the line of action)")
-    for col in ("method", "mean", "min", "max", "peak-peak", "mean / ISO"):
-        t.add_column(col, justify="left" if col == "method" else "right")
+    t = Table(title=f"mesh stiffness of {pair} along the line of action")
+    for col in ("method", "mean [N/µm]", "min [N/µm]", "max [N/µm]", "peak-peak [N/µm]",
+                "mean / ISO"):
+        t.add_column(_h(col), justify="left" if col == "method" else "right")
     for r in cmp.rows():
-        t.add_row(r["method"], f"{r['mean']:.4e}", f"{r['minimum']:.4e}", f"{r['maximum']:.4e}",
-                  f"{r['peak_to_peak']:.4e}", f"{r['mean_over_iso']:.3f}")
+        t.add_row(r["method"], f"{r['mean'] / 1e6:.5g}", f"{r['minimum'] / 1e6:.5g}",
+                  f"{r['maximum'] / 1e6:.5g}", f"{r['peak_to_peak'] / 1e6:.5g}",
+                  f"{r['mean_over_iso']:.3f}")
     console.print(t)
-    console.print(f"ISO 6336-1: c' = {cmp.iso.c_prime_iso:.3f} N/(mm um), c_gamma = "
-                  f"{cmp.iso.c_gamma_iso:.3f} N/(mm um), c_gamma b = {cmp.iso_mesh_stiffness:.4e} N/m")
+    console.print(f"ISO 6336-1: c' = {cmp.iso.c_prime_iso:.3f} N/(mm µm), c_gamma = "
+                  f"{cmp.iso.c_gamma_iso:.3f} N/(mm µm), c_gamma b = "
+                  f"{cmp.iso_mesh_stiffness / 1e6:.5g} N/µm (1 N/µm = 1e6 N/m = 1 N/(mm µm) "
+                  f"per mm of face)", highlight=False)
     if plot is not None:
         console.print(f"plot written to {plot}")
 
@@ -527,25 +713,32 @@ def mesh(
 # --------------------------------------------------------------------------- contact
 @app.command()
 def contact(
-    model: str = typer.Argument(..., help="Model file (.toml/.json) or example name."),
-    pair: str = typer.Option(..., "--pair", help="Name of the mesh to analyse."),
+    model: str = typer.Argument(..., help=_MODEL_HELP, metavar="MODEL"),
+    pair: str = typer.Option(..., "--pair", help="Name of the mesh to analyse.", metavar="MESH"),
     load: Optional[list[str]] = typer.Option(
         None, "--load", help="Load: a normal force ('40 kN') or a torque ('17500 N m', on the "
         "gear named by --on); repeat for several.  Default: the operating load."),
     on: Optional[str] = typer.Option(None, "--on", help="Gear a torque --load acts on "
                                      "(default the driven gear)."),
-    plot: Optional[Path] = typer.Option(None, "--plot", help="Write the figures (PNG) to this folder."),
-    positions: Optional[int] = typer.Option(None, "--positions", help="Mesh positions per cycle."),
-    slices: Optional[int] = typer.Option(None, "--slices", help="Slices across the face."),
+    plot: Optional[Path] = typer.Option(None, "--plot", help="Write the figures (PNG) into "
+                                        "this folder.", metavar="DIR"),
+    positions: Optional[int] = typer.Option(None, "--positions", help="Mesh positions per cycle.",
+                                            metavar="N"),
+    slices: Optional[int] = typer.Option(None, "--slices", help="Slices across the face.",
+                                         metavar="N"),
     harris: int = typer.Option(10, "--harris", help="Loads of the Harris map (0.1 to 1.5 times "
-                               "the largest load); 0 for none."),
-    assign: Optional[list[str]] = typer.Option(
-        None, "--set", help="Override a model field: PATH=VALUE."),
-    as_json: bool = typer.Option(False, "--json", help="Print the results as JSON."),
+                               "the largest load); 0 for none.", metavar="N"),
+    assign: Optional[list[str]] = typer.Option(None, "--set", help=_SET_HELP,
+                                               metavar="PATH=VALUE"),
+    as_json: bool = _flag("--json", "Print the results as JSON."),
 ):
     """Loaded tooth contact analysis of one mesh: transmission error, stiffness, load
     distribution, contact pressure, Harris map, meshing-in impact."""
     try:
+        _check_plots_folder(plot, "--plot")
+        _at_least(positions, 4, "--positions", "64")
+        _at_least(slices, 2, "--slices", "40")
+        _at_least(harris, 0, "--harris", "10")
         m, _ = _load(model, assign)
         if pair not in m.meshes:
             raise TorquesplitError(f"no mesh named {pair!r}; name one of {', '.join(m.meshes)}")
@@ -565,11 +758,12 @@ def contact(
         cm, op_load, names, reverse = contact_model_for_mesh(m, kin, pair, options=opts)
         loads = [_contact_load(text, m, kin, pair, names, on, cm, parse_quantity)
                  for text in (load or [])] or [op_load]
-        results = [cm.solve(f).require_converged(f"meshes.{pair}") for f in loads]
-        top = max(loads)
         import numpy as np
 
-        hm = cm.harris_map(np.linspace(0.1, 1.5, harris) * top) if harris > 0 else None
+        with ux.progress("loaded tooth contact analysis", as_json, total=None):
+            results = [cm.solve(f).require_converged(f"meshes.{pair}") for f in loads]
+            top = max(loads)
+            hm = cm.harris_map(np.linspace(0.1, 1.5, harris) * top) if harris > 0 else None
         op = max(results, key=lambda r: r.load)
         impact = None
         if not cm.pair.is_internal and not reverse:
@@ -591,7 +785,7 @@ def contact(
                                         title=f"{m.model.name} {pair}")
     rows = [r.summary() for r in results]
     if as_json:
-        print(json.dumps({
+        ux.emit_json({
             "mesh": pair, "gears": list(names), "operating_load_N": op_load,
             "positions": int(cm.phase.size), "slices": int(cm.y.size), "loads": rows,
             "harris": None if hm is None else {
@@ -602,16 +796,16 @@ def contact(
             "impact": None if impact is None else {
                 "peak_force_N": impact.peak_force, "advance_m": impact.advance,
                 "corner_separation_m": impact.corner_separation},
-            "figures": [str(f) for f in figures]}, indent=2, default=_json_default))
+            "figures": [str(f) for f in figures]}, _json_default)
         return
     console.print(f"[bold]{m.model.name}[/]: LTCA of mesh {pair} ({names[0]} drives {names[1]}), "
                   f"{cm.phase.size} positions x {cm.y.size} slices"
                   + (" x 2 helices" if cm.helices == 2 else "")
                   + f"; operating normal load {op_load / 1e3:.5g} kN")
     t = Table(title="loaded tooth contact analysis (normal direction)")
-    for col in ("load [kN]", "TE mean [um]", "TE p-p [um]", "TE p-p [arc s]", "k secant [N/um]",
-                "k tangent [N/um]", "p_H max [MPa]", "contact ratio"):
-        t.add_column(col, justify="right")
+    for col in ("load [kN]", "TE mean [µm]", "TE p-p [µm]", "TE p-p [arc s]", "k secant [N/µm]",
+                "k tangent [N/µm]", "p_H max [MPa]", "contact ratio"):
+        t.add_column(_h(col), justify="right")
     for r, row in zip(results, rows):
         t.add_row(f"{r.load / 1e3:.5g}", f"{row['te_mean_m'] * 1e6:.4g}",
                   f"{row['te_peak_to_peak_m'] * 1e6:.4g}", f"{row['te_peak_to_peak_arcsec']:.4g}",
@@ -621,16 +815,16 @@ def contact(
     console.print(t)
     if hm is not None:
         h = Table(title="Harris map")
-        for col in ("load [kN]", "TE p-p [um]", "TE p-p [arc s]", "contact ratio"):
-            h.add_column(col, justify="right")
+        for col in ("load [kN]", "TE p-p [µm]", "TE p-p [arc s]", "contact ratio"):
+            h.add_column(_h(col), justify="right")
         for f, pp, pa, cr in zip(hm.loads, hm.te_peak_to_peak, hm.te_peak_to_peak_arcsec,
                                  hm.contact_ratio):
             h.add_row(f"{f / 1e3:.4g}", f"{pp * 1e6:.4g}", f"{pa:.4g}", f"{cr:.3f}")
         console.print(h)
     if impact is not None:
         console.print(f"meshing-in impact at {op.load / 1e3:.5g} kN: {impact.peak_force:.5g} N "
-                      f"(premature approach {impact.advance * 1e6:.3g} um, corner relief "
-                      f"{impact.corner_separation * 1e6:.3g} um)")
+                      f"(premature approach {impact.advance * 1e6:.3g} µm, corner relief "
+                      f"{impact.corner_separation * 1e6:.3g} µm)", highlight=False)
     if figures:
         console.print(f"{len(figures)} figures written to {plot}")
 
@@ -661,14 +855,18 @@ def _contact_load(text, model, kin, pair, names, on, cm, parse_quantity) -> floa
 @app.command()
 def optimize(
     spec: str = typer.Argument(..., help="Optimisation file (.toml), or the name of a shipped "
-                               "one (seed000_dh_modification)."),
+                               "one (liu2021_dh_modification).", metavar="SPEC"),
     out: Optional[Path] = typer.Option(None, "--out", help="Folder for pareto.csv, pareto.png "
-                                       "and chosen.toml (default: next to the file)."),
-    workers: Optional[int] = typer.Option(None, "--workers", help="Processes (overrides the file)."),
-    generations: Optional[int] = typer.Option(None, "--generations", help="Generations."),
-    population: Optional[int] = typer.Option(None, "--population", help="Population size."),
-    seed: Optional[int] = typer.Option(None, "--seed", help="Random seed."),
-    as_json: bool = typer.Option(False, "--json", help="Print the Pareto front as JSON."),
+                                       "and chosen.toml (default: SPEC_results in the current "
+                                       "folder).", metavar="DIR"),
+    workers: Optional[int] = typer.Option(None, "--workers", help="Processes (overrides the "
+                                          "file).", metavar="N"),
+    generations: Optional[int] = typer.Option(None, "--generations", help="Generations.",
+                                              metavar="N"),
+    population: Optional[int] = typer.Option(None, "--population", help="Population size.",
+                                             metavar="N"),
+    seed: Optional[int] = typer.Option(None, "--seed", help="Random seed.", metavar="N"),
+    as_json: bool = _flag("--json", "Print the Pareto front as JSON."),
 ):
     """Optimise model parameters (NSGA-II or any pymoo algorithm) on LTCA or dynamic outputs;
     evaluations are stored as they finish, so an interrupted run resumes."""
@@ -676,30 +874,38 @@ def optimize(
 
     path = Path(spec)
     if not path.exists():
-        from importlib import resources
+        from .examples import current_name, optimization_path
 
-        shipped = Path(str(resources.files("torquesplit.examples") / "optimize" / f"{spec}.toml"))
-        if shipped.exists():
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", FutureWarning)
+            shipped = optimization_path(spec)
+        if shipped is not None:
+            note = current_name(spec, {"seed000_dh_modification": "liu2021_dh_modification"})[1]
+            if note:
+                ux.warn(note, label="note")
             path = shipped
-    try:
-        res = _with_progress(lambda cb: run_optimization(
-            path, workers=workers, generations=generations, population=population, seed=seed,
-            progress=None if cb is None else (lambda g, n: cb(g / max(n + 1, 1)))),
-            as_json)
-        target = out or (Path.cwd() / f"{path.stem}_results")
-        files = res.write(target)
-    except (TorquesplitError, ValueError) as exc:
-        _fail(exc)
-        return
+    target = out or (Path.cwd() / f"{path.stem}_results")
+    with ux.interruptible(lambda: "evaluations done so far are kept in the store: run the "
+                          "same command again to resume"):
+        try:
+            _check_plots_folder(target, "--out")
+            res = _with_progress(lambda cb: run_optimization(
+                path, workers=workers, generations=generations, population=population,
+                seed=seed, progress=None if cb is None else (lambda g, n: cb(g / max(n + 1, 1)))),
+                as_json, "optimising")
+            files = res.write(target)
+        except _EXPECTED as exc:
+            _fail(exc)
+            return
     names = [v.path for v in res.spec.variables]
     objs = [o.output for o in res.spec.objectives]
     if as_json:
-        print(json.dumps({"pareto": [{"x": dict(zip(names, map(float, x))),
-                                      "objectives": dict(zip(objs, map(float, f)))}
-                                     for x, f in zip(res.X, res.F)],
-                          "chosen": int(res.chosen), "baseline": res.baseline,
-                          "evaluations": res.evaluations, "computed": res.computed,
-                          "files": [str(f) for f in files]}, indent=2, default=_json_default))
+        ux.emit_json({"pareto": [{"x": dict(zip(names, map(float, x))),
+                                  "objectives": dict(zip(objs, map(float, f)))}
+                                 for x, f in zip(res.X, res.F)],
+                      "chosen": int(res.chosen), "baseline": res.baseline,
+                      "evaluations": res.evaluations, "computed": res.computed,
+                      "files": [str(f) for f in files]}, _json_default)
         return
     t = Table(title=f"Pareto front ({res.spec.algorithm}, {res.evaluations} evaluations, "
                     f"{res.computed} computed)")
@@ -715,23 +921,29 @@ def optimize(
 # --------------------------------------------------------------------------- modes
 @app.command()
 def modes(
-    model: str = typer.Argument(..., help="Model file (.toml/.json) or example name."),
+    model: str = typer.Argument(..., help=_MODEL_HELP, metavar="MODEL"),
     count: Optional[int] = typer.Option(None, "--count", help="List at most this many modes "
-                                        "(default: all; a degenerate group is kept whole)."),
+                                        "(default: all; a degenerate group is kept whole).",
+                                        metavar="N"),
     below: Optional[str] = typer.Option(None, "--below", help="List the modes below this "
-                                        "frequency, e.g. '5 kHz'."),
+                                        "frequency, e.g. '5 kHz' (a bare number is Hz).",
+                                        metavar="FREQUENCY"),
     rotating_frame: bool = typer.Option(True, "--rotating-frame/--no-rotating-frame",
                                         help="Include the Coriolis and centripetal terms of "
-                                        "a turning carrier (off: stationary carrier)."),
-    as_json: bool = typer.Option(False, "--json", help="Print the modes, with their shapes, "
-                                 "as JSON."),
+                                        "a turning carrier (off: stationary carrier).",
+                                        metavar=""),
+    as_json: bool = _flag("--json", "Print the modes, with their shapes, as JSON."),
     out: Optional[Path] = typer.Option(None, "--out", help="Write the modes and shapes to "
-                                       "this NetCDF file."),
-    force: bool = typer.Option(False, "--force", help="Replace an existing output file."),
-    campbell: bool = typer.Option(False, "--campbell", help="Resonance map over --from..--to."),
-    start: Optional[str] = typer.Option(None, "--from", help="Campbell: first speed, e.g. '500 rpm'."),
-    stop: Optional[str] = typer.Option(None, "--to", help="Campbell: last speed."),
-    plot: Optional[Path] = typer.Option(None, "--plot", help="Campbell: write the diagram."),
+                                       "this NetCDF file.", metavar="FILE"),
+    force: bool = _flag("--force", "Replace an existing output file."),
+    campbell: bool = _flag("--campbell", "Resonance map over --from..--to."),
+    start: Optional[str] = typer.Option(None, "--from", help="Campbell: first speed, e.g. "
+                                        "'500 rpm' (a bare number is rad/s).", metavar="SPEED"),
+    stop: Optional[str] = typer.Option(None, "--to", help="Campbell: last speed.",
+                                       metavar="SPEED"),
+    plot: Optional[Path] = typer.Option(None, "--plot", help="Campbell: write the diagram "
+                                        "(.png, .svg or .pdf).", metavar="FILE"),
+    quiet: bool = _flag("--quiet", "No progress display."),
 ):
     """Natural modes about the static equilibrium: every mode (or those asked for), its
     multiplicity, type (rotational, translational, planet for a planetary stage) and the
@@ -740,15 +952,11 @@ def modes(
 
     try:
         _at_least(count, 1, "--count", "20")
-        limit = None
-        if below is not None:
-            from .model.units import parse_quantity
-
-            try:
-                limit = parse_quantity(below, "frequency")
-            except ValueError as exc:
-                raise OptionError(f"--below {below!r}: {exc}") from None
-            _positive(limit, "--below", "'5 kHz'")
+        _check_figure_file(plot, "--plot")
+        limit = ux.quantity(below, "frequency", "--below")
+        _positive(limit, "--below", "'5 kHz'")
+        if out is not None:
+            files.check_output(out, formats=files.NETCDF_FORMATS, overwrite=force)
         m, _ = _load(model)
         if campbell:
             if start is None or stop is None:
@@ -763,8 +971,9 @@ def modes(
         from .model.kinematics import solve_kinematics
         from .modes import model_modes
 
-        kin = solve_kinematics(m)
-        rep = model_modes(m, rotating_frame=rotating_frame, below=limit, count=count)
+        with ux.interruptible(), ux.progress("natural modes", quiet or as_json, total=None):
+            kin = solve_kinematics(m)
+            rep = model_modes(m, rotating_frame=rotating_frame, below=limit, count=count)
         saved = None
         if plan is not None:
             with files.claim_output(plan) as claim:
@@ -780,17 +989,17 @@ def modes(
     if as_json:
         data = rep.to_dict(shapes=True)
         data.update(mesh_frequencies_Hz=mesh_f, results_file=str(saved) if saved else None)
-        print(json.dumps(data, indent=2, default=_json_default))
+        ux.emit_json(data, _json_default)
         return
     frame = (" (turning carrier frame)" if rep.rotating_frame else "")
     console.print(f"{rep.rigid_modes} rigid-body mode(s) left out{frame}; mesh frequencies: "
-                  + ", ".join(f"{k} {v:.5g} Hz" for k, v in mesh_f.items()))
+                  + ", ".join(f"{k} {v:.5g} Hz" for k, v in mesh_f.items()), highlight=False)
     typed = any(r.type for r in rep.rows)
     t = Table(title="natural modes")
     cols = ["mode", "f [Hz]", "mult."] + (["type"] if typed else []) + \
         ["strain energy of the group (largest shares)"]
     for col in cols:
-        t.add_column(col)
+        t.add_column(_h(col))
     for r in rep.rows:
         energy = ", ".join(f"{n} {100 * v:.0f} %" for n, v in list(r.strain_energy.items())[:3])
         t.add_row(str(r.mode), f"{r.frequency:.6g}", str(r.multiplicity),
@@ -804,33 +1013,45 @@ def modes(
 @app.command()
 def examples():
     """List the shipped example models and the papers they come from."""
-    from .examples import example_info, example_names
+    from .examples import FIRST_EXAMPLE, RENAMED, example_info, example_names
 
-    t = Table(title="torquesplit examples")
+    t = Table(title="torquesplit examples (copy one with 'torquesplit example NAME')")
     t.add_column("name", style="bold")
     t.add_column("description")
     t.add_column("reference")
-    for name in example_names():
+    order = [FIRST_EXAMPLE] + [n for n in example_names() if n != FIRST_EXAMPLE]
+    for name in order:
         info = example_info(name)
-        t.add_row(name, info.get("description", ""), info.get("reference", ""))
+        label = name + ("\n(start here)" if name == FIRST_EXAMPLE else "")
+        t.add_row(label, info.get("description", ""), info.get("reference", ""))
     console.print(t)
+    console.print("The names used before version 0.2 still work for a while: "
+                  + ", ".join(f"{old} -> {new}" for old, new in RENAMED.items()),
+                  highlight=False)
 
 
 @app.command()
 def example(
-    name: str = typer.Argument(..., help="Example name (see 'torquesplit examples')."),
-    directory: Path = typer.Option(Path("."), "--dir", help="Folder to write the file to."),
-    force: bool = typer.Option(False, "--force", help="Overwrite an existing file."),
+    name: str = typer.Argument(..., help="Example name (see 'torquesplit examples').",
+                               metavar="NAME"),
+    directory: Path = typer.Option(Path("."), "--dir", help="Folder to write the file to.",
+                                   metavar="DIR"),
+    force: bool = _flag("--force", "Overwrite an existing file."),
 ):
     """Write an example model file to the current folder (or --dir)."""
-    from .examples import example_names, example_path
+    from .examples import current_name, example_names, example_path
     from .results import files
 
     try:
-        if name.removesuffix(".toml") not in example_names():
+        stem, note = current_name(name)
+        if stem not in example_names():
             raise OptionError(f"no example named {name!r}; run 'torquesplit examples' to list "
                               f"them ({', '.join(example_names())})")
-        src = example_path(name)
+        if note:
+            ux.warn(note, label="note")
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", FutureWarning)
+            src = example_path(stem)
         if directory.exists() and not directory.is_dir():
             raise OptionError(f"--dir {directory} is a file, not a folder; give a folder")
         try:
@@ -843,7 +1064,7 @@ def example(
     except _EXPECTED as exc:
         _fail(exc)
         return
-    console.print(f"wrote {dst}")
+    console.print(f"wrote {dst}", highlight=False)
 
 
 from .steady.cli import register as _register_steady  # noqa: E402
@@ -855,6 +1076,15 @@ from .study.cli import study as _study, sweep as _sweep  # noqa: E402  (typer si
 
 app.command("study")(_study)
 app.command("sweep")(_sweep)
+
+# --------------------------------------------------------------------------- report, draw
+from .report.cli import register as _register_report  # noqa: E402
+
+_register_report(app, sys.modules[__name__])
+
+for _info in app.registered_commands:  # every command's --help without a type
+    if _info.cls in (None, typer.core.TyperCommand):
+        _info.cls = _Command
 
 
 def main():  # pragma: no cover - console entry point

@@ -13,7 +13,7 @@ already evaluated (pymoo with a fixed seed proposes the same designs again).
 The optimisation file (TOML)::
 
     [optimization]
-    model = "seed000_split_torque"   # example name, or a model file relative to this file
+    model = "liu2021_split_torque_helicopter"   # example name, or a model file relative to this file
     algorithm = "nsga2"              # any pymoo algorithm by name (see ALGORITHMS)
     population = 40
     generations = 50
@@ -165,7 +165,7 @@ def read_spec(source) -> OptimizationSpec:
     model_ref = opt.pop("model", None)
     if not isinstance(model_ref, str):
         raise ModelError([("optimization.model", "required: an example name or a model file; "
-                                                 "add model = \"seed000_split_torque\"")], name)
+                                                 "add model = \"liu2021_split_torque_helicopter\"")], name)
     mpath = (base / model_ref) if not Path(model_ref).is_absolute() else Path(model_ref)
     if not mpath.exists():
         from .examples import example_names, example_path

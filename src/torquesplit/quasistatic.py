@@ -1,10 +1,10 @@
-"""Quasi-static load sharing: equilibrium at each mesh position (seed 004).
+"""Quasi-static load sharing: equilibrium at each mesh position (Mo et al. 2017).
 
 At every time of a sweep over one revolution of the slowest gear (or more), the
 static equilibrium of the assembled system is solved with the mesh stiffness, the
 errors (eccentricity, run-out... as functions of rotation) and the clearances at that
 position: displacement compatibility with floating members and loss of contact.  The
-result gives the static torque ratios of seed 004 eqs. 14-15 and the floating orbits of
+result gives the static torque ratios of Mo et al. 2017 eqs. 14-15 and the floating orbits of
 the members with translational DOFs.
 """
 
@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -29,6 +29,17 @@ class QuasiStaticResults:
     kinematics: object
     structure: object
     solution: object
+    warnings: list = field(default_factory=list)
+    """Warnings of the sweep as text (the command line puts the model's in too); empty:
+    :func:`torquesplit.results.plausibility.static_warnings` on demand."""
+
+    def all_warnings(self) -> list[str]:
+        """The warnings kept with the sweep, else those of its results."""
+        if self.warnings:
+            return list(self.warnings)
+        from .results.plausibility import static_warnings
+
+        return [f"{loc}: {msg}" for loc, msg in static_warnings(self)]
 
     @property
     def mesh_names(self) -> list[str]:
@@ -44,7 +55,7 @@ class QuasiStaticResults:
         return self.solution.element_forces[:, [el.index(m) for m in self.mesh_names]]
 
     def metrics(self) -> ls.LoadSharing:
-        """Static torque ratios per mesh, group and system (seed 004 eqs. 14-15)."""
+        """Static torque ratios per mesh, group and system (Mo et al. 2017 eqs. 14-15)."""
         groups = ls.group_meshes(self.structure.metadata["meshes"])
         return ls.static_torque(self.times, self.mesh_forces(), self.mesh_names, groups)
 
@@ -80,6 +91,9 @@ class QuasiStaticResults:
                     "mesh": ("mesh", self.mesh_names),
                     "dof": ("dof", list(self.structure.dof_names))},
             attrs={"title": f"torquesplit quasi-static: {self.model.model.name}",
+                   "warnings": "\n".join(self.all_warnings()),
+                   "warnings_json": json.dumps(self.all_warnings()),
+                   "load_sharing_definition": "static_torque",
                    "model_json": model_to_json(self.model),
                    "metrics_json": json.dumps({"per_mesh": met.per_mesh,
                                                "per_group": met.per_group,
@@ -101,10 +115,12 @@ class QuasiStaticResults:
 
 
 def quasi_static_load_sharing(model, *, revolutions: float = 1.0, points_per_cycle: int = 8,
-                              max_points: int = 20000) -> QuasiStaticResults:
+                              max_points: int = 20000, progress=None) -> QuasiStaticResults:
     """Equilibria over ``revolutions`` of the slowest gear (in its mesh's frame: relative
     to the carrier for a planet mesh), ``points_per_cycle`` per cycle of the fastest mesh
-    (capped at ``max_points``)."""
+    (capped at ``max_points``).
+
+    ``progress``, if given, is called with the fraction of positions done."""
     from .assembly.assemble import assemble
     from .solve.static import quasi_static
 
@@ -120,5 +136,5 @@ def quasi_static_load_sharing(model, *, revolutions: float = 1.0, points_per_cyc
     f_max = max(mk.frequency for mk in kin.meshes.values())
     n = int(min(max_points, max(16, math.ceil(period * f_max * points_per_cycle))))
     times = np.arange(n) * (period / n)
-    sol = quasi_static(structure, times)
+    sol = quasi_static(structure, times, progress=progress)
     return QuasiStaticResults(model=model, kinematics=kin, structure=structure, solution=sol)

@@ -59,7 +59,7 @@ def simulate(
     method : {"rk4", "dopri"}, optional
         Integrator; default from ``[analysis]``.
     steps_per_period : int, optional
-        RK4 steps per shortest mesh period (default 100, as in the seeds).
+        RK4 steps per shortest mesh period (default 100, as in the papers).
     samples_per_period : int
         Decimated history samples per shortest mesh period (plots and exports only: every
         metric is computed from statistics streamed at every step).
@@ -86,10 +86,37 @@ def simulate(
     Examples
     --------
     >>> import torquesplit
-    >>> res = torquesplit.simulate(torquesplit.example_path("seed001_mill_drive"), cycles=20)
+    >>> res = torquesplit.simulate(torquesplit.example_path("ji_li_mill_drive"), cycles=20)
     >>> res.success
     True
     """
+    if not hasattr(model, "meshes"):
+        model = load_model(model)
+    notes: list[str] = []
+    with warnings.catch_warnings():
+        # every ModelWarning of the run is shown (unless the caller's filters say
+        # otherwise) and kept with the results, so that files and reports carry it
+        warnings.simplefilter("always", ModelWarning, append=True)
+        shown = warnings.showwarning
+
+        def keep(message, category, filename, lineno, file=None, line=None):
+            if issubclass(category, ModelWarning):
+                notes.append(str(message))
+            shown(message, category, filename, lineno, file, line)
+
+        warnings.showwarning = keep
+        res = _simulate(model, duration=duration, cycles=cycles, method=method,
+                        steps_per_period=steps_per_period, rtol=rtol,
+                        samples_per_period=samples_per_period, history_dofs=history_dofs,
+                        full_history=full_history, progress=progress, rhs=rhs,
+                        max_steps=max_steps)
+    res.run_warnings = notes
+    return res
+
+
+def _simulate(model, *, duration, cycles, method, steps_per_period, rtol,
+              samples_per_period, history_dofs, full_history, progress, rhs, max_steps):
+    """:func:`simulate` on a loaded model, its warnings not yet collected."""
     from .results import Results
     from .solve.integrate import integrate
 
@@ -144,8 +171,6 @@ def prepare_run(
     from .assembly.assemble import assemble
     from .solve.static import static_equilibrium
 
-    if not hasattr(model, "meshes"):
-        model = load_model(model)
     an = model.analysis
     kin = solve_kinematics(model)
     structure = assemble(model, kin)
@@ -214,16 +239,24 @@ def prepare_run(
     if method == "rk4":
         kwargs["steps_per_period"] = steps_per_period
         _check_cost(structure, duration, steps_per_period,
-                    MAX_STEPS if max_steps is None else int(max_steps))
+                    MAX_STEPS if max_steps is None else int(max_steps),
+                    n_meshes=len(mesh_names), f_max=f_max, n_history=len(hist_el))
     else:
         kwargs["rtol"] = rtol or an.rtol
     return PreparedRun(model=model, kinematics=kin, structure=structure, static=static,
                        y0=y0, duration=float(duration), integrate_kwargs=kwargs)
 
 
-def _check_cost(structure, duration: float, steps_per_period: int, max_steps: int) -> None:
+#: runs estimated to take longer than this [s] or to keep more than ANNOUNCE_BYTES of
+#: results are announced with a warning before they start
+ANNOUNCE_SECONDS = 20.0
+ANNOUNCE_BYTES = 500 * 1024**2
+
+
+def _check_cost(structure, duration: float, steps_per_period: int, max_steps: int, *,
+                n_meshes: int = 0, f_max: float = 0.0, n_history: int = 0) -> None:
     """Refuse an RK4 run beyond the step budget, announce a long one (the cost known
-    before integrating: the step is fixed)."""
+    before integrating: the step is fixed) with its time and memory."""
     from .solve.integrate import planned_step
 
     if max_steps < 1:
@@ -238,6 +271,12 @@ def _check_cost(structure, duration: float, steps_per_period: int, max_steps: in
             f"max_steps = {max_steps:,} (about {seconds / 60:.3g} min); check the stiffness "
             "and inertias named there and their units, shorten the duration, or raise "
             "max_steps (--max-steps)")
-    if n_steps > ANNOUNCE_STEPS:
+    # per-cycle statistics (6 arrays per tracked mesh) and the decimated history
+    memory = 8 * (6 * (f_max * duration + 2) * n_meshes
+                  + MAX_HISTORY_RECORDS * (1 + n_history))
+    if n_steps > ANNOUNCE_STEPS or seconds > ANNOUNCE_SECONDS or memory > ANNOUNCE_BYTES:
+        took = f"{seconds / 60:.2g} min" if seconds >= 60 else f"{seconds:.2g} s"
         warnings.warn(f"this run takes {n_steps:,} RK4 steps of {h:.3g} s ({why}): about "
-                      f"{seconds / 60:.2g} min of integration", ModelWarning, stacklevel=4)
+                      f"{took} of integration and {memory / 1024**2:,.0f} MB of results; "
+                      f"shorten --duration/--cycles for a quicker look", ModelWarning,
+                      stacklevel=4)

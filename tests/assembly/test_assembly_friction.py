@@ -206,7 +206,7 @@ def test_friction_on_bevel_or_internal_meshes_is_refused():
     model = torquesplit.load_model(tomllib.loads(text))
     with pytest.raises(ModelError, match="meshes.m.friction: .*external pairs"):
         assemble(model)
-    seed000 = model_to_dict(torquesplit.load_model(torquesplit.example_path("seed000_split_torque")))
+    seed000 = model_to_dict(torquesplit.load_model(torquesplit.example_path("liu2021_split_torque_helicopter")))
     seed000["meshes"]["L12"]["friction"] = True  # a spiral bevel mesh
     with pytest.raises(ModelError, match="meshes.L12.friction: .*cylindrical"):
         assemble(model_from_dict(seed000))

@@ -204,7 +204,7 @@ def test_static_spline_contact_and_modes_of_the_floating_pinion():
 def test_seed002_static_equilibrium_converges():
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", torquesplit.ModelWarning)
-        model = torquesplit.load_model(torquesplit.example_path("seed002_face_gear"))
+        model = torquesplit.load_model(torquesplit.example_path("dong2021_face_gear"))
     s = assemble(model)
     assert s.n_splines == 2 and np.all(s.sp_par[:, SP_FRICTION] > 0)
     for t in (None, 0.0, 3.3e-4):

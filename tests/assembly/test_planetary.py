@@ -134,8 +134,8 @@ def test_pin_errors_and_carrier_eccentricity_offset_the_bearings():
 
 def test_rotating_frame_terms():
     """In the turning carrier's frame every translating body gets G_xy = -2 m Omega,
-    G_yx = +2 m Omega, a centripetal spring -m Omega^2 on x and y, and a planet the
-    centrifugal force m Omega^2 R (Lin & Parker 1999 eq. 1 with Omega_c)."""
+    G_yx = +2 m Omega, a centripetal frame stiffness -m Omega^2 on x and y, and a planet
+    the centrifugal force m Omega^2 R (Lin & Parker 1999 eq. 1 with Omega_c)."""
     model = lp_model(4)
     kin = solve_kinematics(model)
     om = kin.bodies["stage_carrier"].speed
@@ -143,16 +143,18 @@ def test_rotating_frame_terms():
     G = s.gyroscopic_matrix()
     np.testing.assert_allclose(G, -G.T, atol=0)
     idx = {n: i for i, n in enumerate(s.dof_names)}
+    Kf = s.frame_stiffness_matrix()
     for body, m in (("stage_sun", LP["m_s"]), ("stage_ring", LP["m_r"]),
                     ("stage_carrier", LP["m_c"]), ("stage_planet3", LP["m_p"])):
         assert G[idx[f"{body}.x"], idx[f"{body}.y"]] == pytest.approx(-2 * m * om, rel=1e-12)
-        k = dict(zip(s.element_names, s.stiffness_table[:, 0]))
-        assert k[f"{body}.centripetal.1"] == pytest.approx(-m * om**2, rel=1e-12)
+        for d in ("x", "y"):
+            assert Kf[idx[f"{body}.{d}"], idx[f"{body}.{d}"]] == pytest.approx(-m * om**2,
+                                                                              rel=1e-12)
+        assert Kf[idx[f"{body}.x"], idx[f"{body}.y"]] == pytest.approx(0.0, abs=1e-9 * m * om**2)
     assert s.external_force[idx["stage_planet1.x"]] == pytest.approx(
         LP["m_p"] * om**2 * A_W, rel=1e-12)
     still = assemble(model, kin, options={"rotating_frame": False})
-    assert still.n_gyroscopic == 0
-    assert not any("centripetal" in n for n in still.element_names)
+    assert still.n_gyroscopic == 0 and still.n_frame_stiffness == 0
     with pytest.raises(ValueError, match="rotating_frame must be true or false"):
         assemble(model, kin, options={"rotating_frame": "yes"})
 
@@ -203,9 +205,16 @@ def _lin_parker_first_order(planets, omega, alpha, without_rigid_carrier=False):
 
 
 def _first_order(structure, drop=()):
+    """Eigenvalues of the first-order system; ``drop=("pin_preload",)`` leaves out the
+    pin-preload stiffness (the frame-stiffness entries on rotations: the centripetal
+    ones act on translations only)."""
     keep = [i for i, nm in enumerate(structure.element_names) if not any(d in nm for d in drop)]
     V = structure.projection_matrix()[keep]
-    K = V.T @ (structure.mean_stiffness()[keep][:, None] * V)
+    Kf = structure.frame_stiffness_matrix()
+    if "pin_preload" in drop:
+        rot = [i for i, nm in enumerate(structure.dof_names) if nm.endswith(".theta")]
+        Kf[np.ix_(rot, rot)] = 0.0
+    K = V.T @ (structure.mean_stiffness()[keep][:, None] * V) + Kf
     n = structure.n_dof
     inv_m = structure.inv_mass
     A = np.block([[np.zeros((n, n)), np.eye(n)],

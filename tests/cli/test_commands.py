@@ -21,11 +21,11 @@ def _ok(args):
 
 def test_examples_and_example(tmp_path):
     out = _ok(["examples"])
-    for name in ("seed000_split_torque", "seed004_star_reducer"):
+    for name in ("liu2021_split_torque_helicopter", "mo2017_star_reducer"):
         assert name in out
-    _ok(["example", "seed001_mill_drive", "--dir", str(tmp_path)])
-    assert (tmp_path / "seed001_mill_drive.toml").exists()
-    again = runner.invoke(app, ["example", "seed001_mill_drive", "--dir", str(tmp_path)])
+    _ok(["example", "ji_li_mill_drive", "--dir", str(tmp_path)])
+    assert (tmp_path / "ji_li_mill_drive.toml").exists()
+    again = runner.invoke(app, ["example", "ji_li_mill_drive", "--dir", str(tmp_path)])
     assert again.exit_code == 2 and "--force" in again.output
     bad = runner.invoke(app, ["example", "nope"])
     assert bad.exit_code == 2 and "torquesplit examples" in bad.output

@@ -212,13 +212,13 @@ def test_example_copies_only_shipped_examples(tmp_path):
     res = runner.invoke(app, ["example", str(other), "--dir", str(tmp_path / "out")])
     one_line_error(res, "no example named", "torquesplit examples")
     assert not (tmp_path / "out" / "mine.toml").exists()
-    res = runner.invoke(app, ["example", "../examples/seed001_mill_drive"])
+    res = runner.invoke(app, ["example", "../examples/ji_li_mill_drive"])
     one_line_error(res, "no example named")
-    res = runner.invoke(app, ["example", "seed001_mill_drive", "--dir", str(other)])
+    res = runner.invoke(app, ["example", "ji_li_mill_drive", "--dir", str(other)])
     one_line_error(res, "is a file, not a folder; give a folder")
-    ok = runner.invoke(app, ["example", "seed001_mill_drive.toml", "--dir", str(tmp_path / "d")])
-    assert ok.exit_code == 0 and (tmp_path / "d" / "seed001_mill_drive.toml").exists()
-    one_line_error(runner.invoke(app, ["example", "seed001_mill_drive", "--dir",
+    ok = runner.invoke(app, ["example", "ji_li_mill_drive.toml", "--dir", str(tmp_path / "d")])
+    assert ok.exit_code == 0 and (tmp_path / "d" / "ji_li_mill_drive.toml").exists()
+    one_line_error(runner.invoke(app, ["example", "ji_li_mill_drive", "--dir",
                                        str(tmp_path / "d")]), "exists; use --force")
 
 

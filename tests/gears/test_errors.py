@@ -14,8 +14,8 @@ from torquesplit.gears.errors import (
     cumulative_pitch_error,
     pitch_error_from_deviations,
     rotating_offset_on_line,
-    seed000_mesh_error,
-    seed002_mesh_error,
+    eccentricity_installation_error_sum_form,
+    eccentricity_installation_error_difference_form,
     tooth_thickness_error,
 )
 
@@ -87,10 +87,10 @@ def test_seed002_eq11_hand_computed():
         installation_phase_j=-math.pi / 6,
         line_angle=math.pi / 6,
     )
-    e = seed002_mesh_error(**kw)
+    e = eccentricity_installation_error_difference_form(**kw)
     assert e.evaluate(0.0) == pytest.approx(55e-6)
     assert e.evaluate(math.pi / 200) == pytest.approx(6.69873e-6, rel=1e-5)
-    e13 = seed002_mesh_error(**kw, sign=-1.0)
+    e13 = eccentricity_installation_error_difference_form(**kw, sign=-1.0)
     np.testing.assert_allclose(e13.evaluate(T), -e.evaluate(T), atol=1e-18)
     # installation terms are constant, eccentricity at the shaft frequency
     assert e.constant == pytest.approx(50e-6 * 1.0 - 30e-6 * 0.0)
@@ -107,7 +107,7 @@ def test_seed002_equals_physical_projection_with_its_conventions():
         eccentricity_j=30e-6, phase_j=-1.0, omega_j=40.0, installation_j=20e-6, installation_phase_j=2.0,
         line_angle=a,
     )
-    seed = seed002_mesh_error(**kw)
+    seed = eccentricity_installation_error_difference_form(**kw)
     gi = CentreDeviation(50e-6, math.pi / 2 - 0.2, 50e-6, math.pi / 2 - 0.5, 120.0)
     gj = CentreDeviation(30e-6, math.pi / 2 + 1.0, 20e-6, math.pi / 2 - 2.0, 40.0)
     physical = centre_errors_on_line(a, gi, gj)
@@ -120,7 +120,7 @@ def test_seed000_eq1_transcription_and_its_same_sign_remark():
         eccentricity_j=12e-6, phase_j=-0.4, omega_j=253.8, installation_j=12e-6, installation_phase_j=0.2,
     )
     c = 0.7 + math.radians(22.5)  # gamma_34 + alpha_ts
-    e = seed000_mesh_error(**kw, line_offset=c)
+    e = eccentricity_installation_error_sum_form(**kw, line_offset=c)
     t = T
     direct = (
         8e-6 * np.sin(-798.6 * t - 0.3 + c)
@@ -130,14 +130,14 @@ def test_seed000_eq1_transcription_and_its_same_sign_remark():
     )
     np.testing.assert_allclose(e.evaluate(t), direct, atol=1e-18)
     # eq. 2 for the double-helical pairs: overall minus sign and gamma - alpha_th
-    e68 = seed000_mesh_error(**kw, line_offset=0.7 - math.radians(20), sign=-1.0)
+    e68 = eccentricity_installation_error_sum_form(**kw, line_offset=0.7 - math.radians(20), sign=-1.0)
     assert e68.evaluate(0.0) == pytest.approx(
         -(8e-6 * math.sin(-0.3 + 0.7 - math.radians(20)) + 8e-6 * math.sin(-1.0 + 0.7 - math.radians(20))
           + 12e-6 * math.sin(0.4 + 0.7 - math.radians(20)) + 12e-6 * math.sin(-0.2 + 0.7 - math.radians(20)))
     )
     # both gears enter with the same sign: the same installation offset on both
     # gears does not cancel (it would in the physical form)
-    same = seed000_mesh_error(
+    same = eccentricity_installation_error_sum_form(
         eccentricity_i=0, phase_i=0, omega_i=1, installation_i=10e-6, installation_phase_i=0.3,
         eccentricity_j=0, phase_j=0, omega_j=1, installation_j=10e-6, installation_phase_j=0.3, line_offset=c,
     )

@@ -25,7 +25,7 @@ def main() -> None:
     runs = feature_runs()
     for r in runs:  # a few hundred steps each: the simulator runs Python per thread
         object.__setattr__(r, "duration", 0.0015)
-    runs.append(example_run("seed001_mill_drive", 1.0e-3))
+    runs.append(example_run("ji_li_mill_drive", 1.0e-3))
     res = run_ensemble(runs, target="cuda", threads_per_block=2)
     out = []
     for i, (r, sol) in enumerate(zip(runs, res.solutions, strict=True)):

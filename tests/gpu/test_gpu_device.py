@@ -43,7 +43,7 @@ def test_kernel_compiles_to_ptx_without_a_device():
 @pytest.mark.gpu
 @needs_device
 def test_gpu_equals_the_engine_to_1e_9():
-    runs = feature_runs() + [example_run("seed001_mill_drive", 5e-3)]
+    runs = feature_runs() + [example_run("ji_li_mill_drive", 5e-3)]
     res = run_ensemble(runs, target="cuda")
     for run, sol in zip(runs, res.solutions, strict=True):
         ref = engine(run)

@@ -19,7 +19,7 @@ from torquesplit.gpu.backend import GpuRunner, check_plan
 from torquesplit.gpu.compile import cuda_available
 from torquesplit.study.errors import StudyError
 
-GRID = {"study": {"name": "gpu_grid", "model": "seed001_mill_drive",
+GRID = {"study": {"name": "gpu_grid", "model": "ji_li_mill_drive",
                   "outputs": ["load_sharing.*", "dynamic_factor*", "peak_force.*",
                               "contact_loss.*", "settle_time"]},
         "analysis": {"duration": "0.12 s"},
@@ -83,7 +83,7 @@ def test_fp32_reports_its_error_per_output():
 
 
 def test_refused_by_name_before_any_case_runs():
-    static = {"study": {"name": "s", "model": "seed004_star_reducer",
+    static = {"study": {"name": "s", "model": "mo2017_star_reducer",
                         "outputs": ["load_sharing.static_torque"]},
               "analysis": {"type": "static", "points_per_cycle": 2},
               "grid": {"parameters": [{"path": "gears.s1.errors.eccentricity",
@@ -120,18 +120,18 @@ def test_cli_refuses_and_falls_back_in_one_line(tmp_path):
     from torquesplit.cli import app
 
     cli = CliRunner()
-    res = cli.invoke(app, ["sweep", "seed004_star_reducer", "--static", "--vary",
+    res = cli.invoke(app, ["sweep", "mo2017_star_reducer", "--static", "--vary",
                            "gears.s1.errors.eccentricity=1:2:2um", "--backend", "gpu",
                            "--quiet", "--no-figures", "--out", str(tmp_path / "s")])
     assert res.exit_code == 2
     assert "does not support quasi-static" in res.output
-    res = cli.invoke(app, ["sweep", "seed001_mill_drive", "--vary",
+    res = cli.invoke(app, ["sweep", "ji_li_mill_drive", "--vary",
                            "meshes.m11.damping_ratio=0.05:0.1:2", "--duration", "0.01 s",
                            "--precision", "fp32", "--quiet", "--no-figures", "--out",
                            str(tmp_path / "p")])
     assert res.exit_code == 2 and "GPU backend only" in res.output
     if not cuda_available()[0]:
-        res = cli.invoke(app, ["sweep", "seed001_mill_drive", "--vary",
+        res = cli.invoke(app, ["sweep", "ji_li_mill_drive", "--vary",
                                "meshes.m11.damping_ratio=0.05:0.1:2", "--duration", "0.01 s",
                                "--backend", "gpu", "--workers", "1", "--quiet",
                                "--no-figures", "--out", str(tmp_path / "f")])
@@ -140,7 +140,7 @@ def test_cli_refuses_and_falls_back_in_one_line(tmp_path):
 
 
 def test_a_case_the_study_makes_invalid_is_refused_as_on_the_cpu():
-    spec = {"study": {"name": "bad", "model": "seed001_mill_drive",
+    spec = {"study": {"name": "bad", "model": "ji_li_mill_drive",
                       "outputs": ["load_sharing.engineering"]},
             "analysis": {"duration": "0.01 s"},
             "grid": {"parameters": [{"path": "meshes.m11.damping_ratio",

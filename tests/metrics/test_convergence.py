@@ -50,7 +50,7 @@ def _check(model, duration, spp):
 
 
 def test_ji_li_mill_drive_metrics_converge():
-    model = torquesplit.load_model(torquesplit.example_path("seed001_mill_drive"))
+    model = torquesplit.load_model(torquesplit.example_path("ji_li_mill_drive"))
     base = _check(model, 1.0, model.analysis.steps_per_period)
     # not a trivial case: stage 1 shares unevenly at its peaks
     assert base["load_sharing.engineering.stage1"] > 1.03

@@ -69,7 +69,8 @@ def random_structure_extras(seed: int = 0, gyroscopic: bool = False):
     """:func:`random_structure` plus tooth friction on its four meshes and two spline
     radial elements (one with a stick limit and a clearance, one without clearance), so
     that every branch of the spline law and of the friction scatter is reachable; with
-    ``gyroscopic`` also a gyroscopic coupling of DOFs 0 and 1 (and a diagonal entry)."""
+    ``gyroscopic`` also a gyroscopic coupling of DOFs 0 and 1 (and a diagonal entry) and
+    a frame stiffness on them."""
     base = random_structure(seed)
     rng = np.random.default_rng(1000 + seed)
     n = base.n_dof
@@ -104,6 +105,9 @@ def random_structure_extras(seed: int = 0, gyroscopic: bool = False):
     # gyroscopic coupling of two translations (a body in a rotating frame), so that the
     # velocity-coupling term of every right-hand side is exercised too
     gyro = [(0, 1, -35.0), (1, 0, 35.0), (3, 3, 2.0)] if gyroscopic else []
+    # and a frame stiffness (centripetal softening of a body in a turning frame)
+    frame = [(0, 0, -4e4), (1, 1, -4e4), (0, 1, 900.0), (1, 0, 900.0)] if gyroscopic else []
     return build_structure(base.dof_names, base.inv_mass, els,
                            external_force=base.external_force,
-                           ground_damping=base.ground_damping, gyroscopic=gyro, n_table=32)
+                           ground_damping=base.ground_damping, gyroscopic=gyro,
+                           frame_stiffness=frame, n_table=32)

@@ -70,3 +70,24 @@ def test_bad_gyroscopic_entry_is_refused():
     with pytest.raises(ValueError, match="out of range"):
         build_structure(["a.x"], [1.0], [dict(name="k", dofs=[0], coefs=[1.0],
                                               stiffness=1.0)], gyroscopic=[(0, 3, 1.0)])
+
+
+def test_frame_stiffness_term_in_every_consumer():
+    """K_f (the centripetal softening as a frame stiffness, not an element): kernel and
+    twin agree, the modes are those of K + K_f, and the static solve carries -K_f q."""
+    from torquesplit.solve import static_equilibrium
+
+    k = K
+    s = build_structure(["b.x", "b.y"], [1 / M, 1 / M],
+                        [dict(name="bx", dofs=[0], coefs=[1.0], stiffness=k),
+                         dict(name="by", dofs=[1], coefs=[1.0], stiffness=k)],
+                        external_force=[10.0, -4.0],
+                        frame_stiffness=[(0, 0, -M * OMEGA**2), (1, 1, -M * OMEGA**2)])
+    y = np.array([1e-5, -2e-5, 0.3, 0.1])
+    np.testing.assert_allclose(rhs(s, 0.0, y), rhs_numpy(s, 0.0, y), rtol=1e-14)
+    w = math.sqrt((k - M * OMEGA**2) / M)
+    np.testing.assert_allclose(modal_analysis(s).frequencies, [w / (2 * math.pi)] * 2,
+                               rtol=1e-12)
+    st = static_equilibrium(s)
+    np.testing.assert_allclose(st.q, [10.0 / (k - M * OMEGA**2), -4.0 / (k - M * OMEGA**2)],
+                               rtol=1e-12)

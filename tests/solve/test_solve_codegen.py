@@ -7,7 +7,6 @@ import sys
 
 import numpy as np
 import pytest
-from numba import njit
 from solve_models import random_structure, random_structure_extras, spur_pair
 
 import torquesplit
@@ -70,7 +69,7 @@ def test_integrate_generated_equals_general(method):
 
 
 def test_seed001_example_runs_the_generated_code_with_the_same_results():
-    model = torquesplit.load_model(torquesplit.example_path("seed001_mill_drive"))
+    model = torquesplit.load_model(torquesplit.example_path("ji_li_mill_drive"))
     runs = [torquesplit.simulate(model, duration=0.05, rhs=kind) for kind in ("generated",
                                                                              "general")]
     a, b = (r.solution for r in runs)

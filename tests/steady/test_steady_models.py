@@ -15,7 +15,7 @@ from torquesplit.model.io import load_model
 from torquesplit.steady import campbell, steady_state
 from torquesplit.steady.period import LongPeriodError
 
-EXAMPLE = "seed001_mill_drive"
+EXAMPLE = "ji_li_mill_drive"
 
 
 def test_steady_state_of_one_stage_and_its_results():

@@ -34,7 +34,7 @@ LOAD = DESIGN_TORQUE / (PAIR.gear2.base_radius * math.cos(PAIR.base_helix_angle)
 # §5: y1..y6 of the pinion's optimised modification
 MOD = ToothModification(liu2021_topological(23e-6, 35e-6, 2.30e-3, 2.01e-3, 13e-6, 8.19e-3,
                                             PAIR.face_width))
-# not in the paper: the inertias and speed of the seed000_split_torque example model
+# not in the paper: the inertias and speed of the liu2021_split_torque_helicopter example model
 IMPACT = dict(omega_driving=2423.11 * math.pi / 30, inertia_driving=0.009476, inertia_driven=23.2)
 
 

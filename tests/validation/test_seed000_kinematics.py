@@ -19,7 +19,7 @@ RPM = 2 * math.pi / 60  # rad/s per rpm
 
 @pytest.fixture(scope="module")
 def model():
-    return torquesplit.load_model(torquesplit.example_path("seed000_split_torque"))
+    return torquesplit.load_model(torquesplit.example_path("liu2021_split_torque_helicopter"))
 
 
 @pytest.fixture(scope="module")

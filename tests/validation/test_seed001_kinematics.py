@@ -19,7 +19,7 @@ import pytest
 import torquesplit
 from torquesplit.model.io import model_from_dict
 
-NAME = "seed001_mill_drive"
+NAME = "ji_li_mill_drive"
 RPM = math.pi / 30
 
 # Table 1 of the paper: member -> (teeth, helix angle deg, mass kg, J kg m^2, base radius m)

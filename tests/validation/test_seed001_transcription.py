@@ -36,7 +36,7 @@ from torquesplit.model.overrides import apply_overrides, read_raw
 from torquesplit.solve import element_forces, integrate, modal_analysis, static_equilibrium
 from validation import transcription_seed001 as tr
 
-NAME = "seed001_mill_drive"
+NAME = "ji_li_mill_drive"
 TOL = 1e-9
 N_STEPS = 8000  # 20 stage-1 mesh periods at the model's 400 steps per period
 

@@ -33,7 +33,7 @@ IDLER_MESHES = ("m610", "m710", "m810", "m910")
 
 @pytest.fixture(scope="module")
 def model():
-    return torquesplit.load_model(torquesplit.example_path("seed002_face_gear"))
+    return torquesplit.load_model(torquesplit.example_path("dong2021_face_gear"))
 
 
 @pytest.fixture(scope="module")

@@ -22,7 +22,7 @@ BRANCHES = ("R", "L")
 
 @pytest.fixture(scope="module")
 def model():
-    return torquesplit.load_model(torquesplit.example_path("seed003_friction_split"))
+    return torquesplit.load_model(torquesplit.example_path("jin2019_friction_split"))
 
 
 @pytest.fixture(scope="module")

@@ -20,7 +20,7 @@ import pytest
 import torquesplit
 from torquesplit.model.io import model_from_dict
 
-NAME = "seed004_star_reducer"
+NAME = "mo2017_star_reducer"
 RPM = math.pi / 30
 PATHS = (1, 2, 3)
 

@@ -25,7 +25,7 @@ from torquesplit.quasistatic import quasi_static_load_sharing
 
 
 def _model(with_errors: bool):
-    data = tomllib.loads(torquesplit.example_path("seed004_star_reducer").read_text())
+    data = tomllib.loads(torquesplit.example_path("mo2017_star_reducer").read_text())
     if not with_errors:
         for g in data["gears"].values():
             g.pop("errors", None)

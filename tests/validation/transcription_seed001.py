@@ -8,7 +8,7 @@ printed), cited below as "Ji & Li, eq. N".
 What this is for
 ----------------
 An *independent* transcription of the equations of motion of the shipped model
-``seed001_mill_drive``: every coefficient of the paper's eq. 9 is computed here from the
+``ji_li_mill_drive``: every coefficient of the paper's eq. 9 is computed here from the
 model's physical parameters (masses, inertias, tooth counts, modules, angles, shaft
 geometry, bearing stiffnesses, damping ratios, backlash, mesh stiffness) with the
 paper's eqs. 1-13, and eq. 9 is typed in as straight-line numba code in the paper's
@@ -237,7 +237,7 @@ def _geometry(gear) -> GearGeometry:
 def build(model) -> Seed001:
     """The transcription's coefficients for a model of the seed 001 topology (SI).
 
-    The model must be the shipped ``seed001_mill_drive`` or a variant of it (other
+    The model must be the shipped ``ji_li_mill_drive`` or a variant of it (other
     values, same bodies, shafts, meshes and layout); anything else is refused.
     """
     g = model.gears

@@ -1,6 +1,6 @@
 """Model -> Structure: number the DOFs, build the diagonal mass and the element list.
 
-Element kinds produced here (DESIGN.md §4):
+Element kinds produced here (docs/theory/model.md):
 
 ==============  ==========================================  =========================
 element         deformation ``V . q``                         stiffness
@@ -10,10 +10,10 @@ shaft           ``th_a - th_b``                               torsional [N m/rad
 support         ``u_i`` (one translational DOF; ``- u_seat``  bearing [N/m], clearance
                 for a bearing on another body, ``on``)
 spline torsion  ``th_hub - th_float``                         torsional [N m/rad]
-spline radial   ``u_hub - u_float``, radial plane, 2-D        radial law, seed 002 eq. 6
+spline radial   ``u_hub - u_float``, radial plane, 2-D        radial law, Dong et al. 2021 eq. 6
 ==============  ==========================================  =========================
 
-A mesh with ``friction`` also gets its friction projection W (seed 003; forces only):
+A mesh with ``friction`` also gets its friction projection W (Jin et al. 2019; forces only):
 ``+t`` on the driver's and ``-t`` on the driven gear's translations times the friction
 force per unit load, and the friction moments per unit load on their rotations (see
 :func:`torquesplit.assembly.excitation.friction_table` for the signs).
@@ -174,7 +174,7 @@ def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None
         if mesh.damping is not None:
             c = mesh.damping
         elif mesh.damping_ratio is not None:
-            # c = 2 zeta sqrt(k m_eq), m_eq = J1 J2 / (J1 r2^2 + J2 r1^2) (seed 001 eq. 1, corrected)
+            # c = 2 zeta sqrt(k m_eq), m_eq = J1 J2 / (J1 r2^2 + J2 r1^2) (Ji & Li eq. 1, corrected)
             c = 2 * mesh.damping_ratio * math.sqrt(k_mean * mk.equivalent_mass)
         else:
             c = 0.0
@@ -212,7 +212,7 @@ def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None
             coefs.append(-r * sb)
         k = shaft.torsional_stiffness
         if k is None:
-            # seed 001 eq. 3: k_T = G pi d^4 / (32 l) (hollow: d^4 - d_i^4)
+            # Ji & Li eq. 3: k_T = G pi d^4 / (32 l) (hollow: d^4 - d_i^4)
             k = shaft.shear_modulus * math.pi * (shaft.diameter**4 - shaft.inner_diameter**4) / (
                 32 * shaft.length)
         ja, jb = kin.bodies[a].polar_inertia, kin.bodies[b].polar_inertia
@@ -235,7 +235,7 @@ def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None
             continue
         sup = spec.support
         if sup is None and body in spline_members:
-            continue  # held radially by its spline (seed 002 floating pinion)
+            continue  # held radially by its spline (Dong et al. 2021 floating pinion)
         if sup is None:
             raise ModelError([(f"{'gears' if body in model.gears else 'bodies'}.{body}.support",
                                f"DOFs {sorted(tr)} have no support; add a support with a "
@@ -298,7 +298,7 @@ def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None
                                  coefs=coefs, stiffness=k, damping=c, gaps=sup.clearance,
                                  error_constant=err, errors=sines))
 
-    # ---- splines: torsion spring + 2-D radial element (seed 002 eq. 6)
+    # ---- splines: torsion spring + 2-D radial element (Dong et al. 2021 eq. 6)
     for name, sp in model.splines.items():
         hub, flo = sp.connects
         ih, sh = dmap.theta[hub]
@@ -355,7 +355,7 @@ def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None
                              coefs=[s_t], stiffness=k, damping=c))
 
     # ---- rotating frames: Coriolis, centripetal softening, centrifugal force
-    gyroscopic = []
+    gyroscopic, frame_stiffness = [], []
     if rotating and kin.frames:
         from .rotating import rotating_frame_terms
 
@@ -368,8 +368,7 @@ def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None
             k_xyz = np.array([k_rad, sup.stiffness_y or k_rad, sup.axial_stiffness or k_rad])
             return float(k_xyz @ np.asarray(direction) ** 2)
 
-        frame_elements, gyroscopic = rotating_frame_terms(kin, dmap, ext, pin_stiffness)
-        elements.extend(frame_elements)
+        frame_stiffness, gyroscopic = rotating_frame_terms(kin, dmap, ext, pin_stiffness)
 
     # ---- drives and loads
     for name, d in model.drives.items():
@@ -394,12 +393,10 @@ def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None
         planet_bodies=dict(kin.planet_bodies),
         frames=dict(kin.frames),
         rotating_frame=bool(rotating and gyroscopic),
-        inertial_elements=[el["name"] for el in elements if el["name"].endswith(
-            (".centripetal.1", ".centripetal.2", ".pin_preload"))],
     )
     return build_structure(dmap.names, inv_mass, elements, external_force=ext,
-                           ground_damping=ground, gyroscopic=gyroscopic, n_table=n_table,
-                           metadata=meta)
+                           ground_damping=ground, gyroscopic=gyroscopic,
+                           frame_stiffness=frame_stiffness, n_table=n_table, metadata=meta)
 
 
 def _bearing_seat(model: Model, dmap: DofMap, body: str, on: str | None,
@@ -535,7 +532,7 @@ def support_stiffness(sup, where: str = "support") -> float:
     a = sh.position
     b = sh.span - a
     inertia = math.pi * sh.diameter**4 / 64
-    # seed 001 eqs. 5-7: simply supported shaft, load at a from one bearing:
+    # Ji & Li eqs. 5-7: simply supported shaft, load at a from one bearing:
     # deflection y = F a^2 b^2 / (3 E I l)  =>  k_S = 3 E I l / (a^2 b^2)
     den = a**2 * b**2
     k_shaft = 3 * sh.youngs_modulus * inertia * sh.span / den if den > 0 else math.inf
@@ -547,5 +544,5 @@ def support_stiffness(sup, where: str = "support") -> float:
             f"them, or give the support a 'stiffness'"))])
     if sh.bearing_stiffness is None:
         return k_shaft
-    # seed 001 eq. 10: bearing in series with the shaft, k' = k_S k_C / (k_S + k_C)
+    # Ji & Li eq. 10: bearing in series with the shaft, k' = k_S k_C / (k_S + k_C)
     return k_shaft * sh.bearing_stiffness / (k_shaft + sh.bearing_stiffness)

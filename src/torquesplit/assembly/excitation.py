@@ -235,10 +235,10 @@ def _phase_terms(model: Model, kin: Kinematics, mesh_name: str, gear: str):
 
 # --------------------------------------------------------------------------- backlash
 def half_backlash_sequence(model: Model, kin: Kinematics, mesh_name: str) -> np.ndarray:
-    """Half backlash per engagement [m]: constant, or random per seed 001 eq. 14.
+    """Half backlash per engagement [m]: constant, or random per Ji & Li eq. 14.
 
     The model gives the total backlash 2b; the dead zone of the mesh element has the
-    half-width b (seed 001 eq. 13, seed 002 eq. 7).  A random sequence is drawn per
+    half-width b (Ji & Li eq. 13, Dong et al. 2021 eq. 7).  A random sequence is drawn per
     engagement within ``nominal +/- tolerance`` and repeats after lcm(z1, z2) cycles.
     """
     spec = model.meshes[mesh_name].backlash
@@ -264,9 +264,9 @@ def mesh_errors(model: Model, kin: Kinematics, mesh_name: str):
 
     A positive error opens the mesh (delta = V q - e).  Centre offsets of the driver
     (eccentricity, installation, bearing run-out) enter as ``-eps_d . n``, those of the
-    driven gear as ``+eps_n . n`` (seed 000 eqs. 1-2 and seed 002 eq. 11 in physical
+    driven gear as ``+eps_n . n`` (Liu et al. 2021 eqs. 1-2 and Dong et al. 2021 eq. 11 in physical
     form, see gears/errors.py); tooth thickness and pitch errors of either gear open
-    the mesh (seed 004 §4).  In-plane offsets are projected on the 3-D line of action
+    the mesh (Mo et al. 2017 §4).  In-plane offsets are projected on the 3-D line of action
     through its component in the gear's plane.
     """
     from ..gears import errors as gerr
@@ -326,7 +326,7 @@ def mesh_errors(model: Model, kin: Kinematics, mesh_name: str):
 
 # --------------------------------------------------------------------------- impact
 def impact_force_table(model: Model, kin: Kinematics, mesh_name: str, n: int):
-    """Meshing-in impact force over one mesh cycle [N], or None (seed 000 eqs. 6-10).
+    """Meshing-in impact force over one mesh cycle [N], or None (Liu et al. 2021 eqs. 6-10).
 
     Inputs the seed leaves open: the loaded stiffness is the mean mesh stiffness and
     the single-pair stiffness at the engagement point is that mean divided by the
@@ -390,7 +390,7 @@ def friction_direction(kin: Kinematics, mesh_name: str) -> np.ndarray:
 
 
 def friction_table(model: Model, kin: Kinematics, mesh_name: str, n: int) -> np.ndarray:
-    """Tooth friction per unit normal mesh load over one mesh cycle (seed 003), (3, n).
+    """Tooth friction per unit normal mesh load over one mesh cycle (Jin et al. 2019), (3, n).
 
     Rows: the friction force on the driven gear along the rolling direction t of
     :func:`friction_direction` [-] (the driver gets the opposite force), and the friction

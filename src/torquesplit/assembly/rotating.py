@@ -15,13 +15,13 @@ Cooley & Parker 2012 eq. 1)::
   ``G_xy = -2 m Omega``, ``G_yx = +2 m Omega`` (Lin & Parker 1999, the 2 m Omega blocks
   of G);
 * centripetal softening ``-m Omega^2`` on every in-plane translation (Lin & Parker 1999
-  K_Omega = diag(m, m, 0) per body): two SPRING elements of negative stiffness per
-  body, their projections the body's displacements along two orthonormal directions of
-  the carrier's plane (``<body>.centripetal.1``, ``.2``);
+  K_Omega = diag(m, m, 0) per body): entries ``-m Omega^2 V_k V_k^T`` of the frame
+  stiffness matrix K_f (generalized force -K_f q), V_k the body's displacement along
+  two orthonormal directions of the carrier's plane;
 * centrifugal force ``m Omega^2 r0`` (outwards, constant in the carrier frame) on the
   translations of a body off the axis (the planets), an external force;
 * the geometric stiffness of that preload in the planet's pin, ``P R`` on the carrier's
-  rotation (one element ``<carrier>.pin_preload`` for all its planets; R the pin
+  rotation (one K_f entry on the carrier's rotation for all its planets; R the pin
   radius, P = m Omega^2 R k_t / (k_t - m Omega^2) the static centrifugal load of a
   bearing of stiffness k_t along the pin's tangent): when the
   carrier turns by theta the pin, and the preload with it, turns too.  With it the rigid
@@ -42,7 +42,6 @@ import numpy as np
 
 from ..errors import ModelError
 from ..gears import line_of_action as loa
-from .structure import SPRING
 
 
 def in_plane_basis(axis) -> tuple[np.ndarray, np.ndarray]:
@@ -54,14 +53,16 @@ def in_plane_basis(axis) -> tuple[np.ndarray, np.ndarray]:
 
 
 def rotating_frame_terms(kin, dmap, ext: np.ndarray, pin_stiffness=None):
-    """Elements (centripetal springs) and gyroscopic entries of every body measured in a
-    turning carrier's frame; adds the centrifugal forces to ``ext`` in place.
+    """Frame-stiffness and gyroscopic entries of every body measured in a turning
+    carrier's frame; adds the centrifugal forces to ``ext`` in place.
 
     ``pin_stiffness(body, direction)`` gives the stiffness of a planet's bearing along
-    a unit direction (for the pin-preload term).  Returns ``(elements, gyroscopic)`` for
-    :func:`~torquesplit.assembly.structure.build_structure`.
+    a unit direction (for the pin-preload term).  Returns ``(frame_stiffness,
+    gyroscopic)``, lists of ``(i, j, value)`` for
+    :func:`~torquesplit.assembly.structure.build_structure`: the inertial terms are not
+    elements (they carry no force of their own), so they cost one multiply-add per entry.
     """
-    elements: list[dict] = []
+    frame: list[tuple[int, int, float]] = []
     gyro: list[tuple[int, int, float]] = []
     # planets rigid on their pins (no translations) move with their carrier
     preload: dict[str, list] = {}  # carrier -> [its rotation DOF, sign, stiffness]
@@ -89,15 +90,13 @@ def rotating_frame_terms(kin, dmap, ext: np.ndarray, pin_stiffness=None):
                 g = 2.0 * m * omega * float(dirs[di] @ np.cross(a, dirs[dj]))
                 if abs(g) > 1e-14 * 2.0 * m * abs(omega):
                     gyro.append((i, j, g))
-        # centripetal softening -m Omega^2 in the carrier's plane (Lin & Parker 1999 K_Omega)
-        for k, e in enumerate(in_plane_basis(a), start=1):
-            dofs, coefs = [], []
-            for j, c in dmap.project(body, e, 1.0, tol=1e-15):
-                dofs.append(j)
-                coefs.append(c)
-            if dofs:
-                elements.append(dict(name=f"{body}.centripetal.{k}", kind=SPRING, dofs=dofs,
-                                     coefs=coefs, stiffness=-m * omega**2, damping=0.0))
+        # centripetal softening -m Omega^2 in the carrier's plane (Lin & Parker 1999
+        # K_Omega): -m Omega^2 (V_k V_k^T) for the projection V_k of each in-plane direction
+        for e in in_plane_basis(a):
+            rows = dmap.project(body, e, 1.0, tol=1e-15)
+            for i, ci in rows:
+                for j, cj in rows:
+                    frame.append((i, j, -m * omega**2 * ci * cj))
         # centrifugal force of the nominal position, m Omega^2 r0 outwards (for a carrier,
         # that of the planets rigid on its pins)
         carried = [(body, m)] if body != carrier else \
@@ -129,8 +128,7 @@ def rotating_frame_terms(kin, dmap, ext: np.ndarray, pin_stiffness=None):
                         f"bearing or a lower speed"))])
                 preload.setdefault(c_name, [idx, s_c, 0.0])[2] += \
                     soft * big_r**2 * k_t / (k_t - soft)
-    # one element per carrier carries the pin preloads of all its planets
+    # the pin preloads of all the planets of a carrier, on its rotation
     for c_name, (idx, s_c, k) in preload.items():
-        elements.append(dict(name=f"{c_name}.pin_preload", kind=SPRING, dofs=[idx],
-                             coefs=[s_c], stiffness=k, damping=0.0))
-    return elements, gyro
+        frame.append((idx, idx, k * s_c * s_c))
+    return frame, gyro

@@ -1,8 +1,8 @@
 """The assembled equations of motion as flat arrays for the compiled kernels.
 
-Every layout reduces to the same form (DESIGN.md §4)::
+Every layout reduces to the same form (docs/theory/model.md)::
 
-    M q'' = F_ext - C_g q' - sum_e V_e f_e
+    M q'' = F_ext - C_g q' - G q' - K_f q - sum_e V_e f_e
     delta_e  = V_e . q  - e_e(t)            deformation of element e
     f_e      = k_e(t) h(delta_e; g_e) + c_e (V_e . q' - e_e'(t)) + p_e(t)
 
@@ -14,14 +14,14 @@ force ``p_e(t)`` (meshing-in impact).  Damping acts only while the element is in
 
 Two optional extensions, both empty (and free) when a model does not use them:
 
-* **Tooth friction** of a mesh element e (seed 003): a second, phase-dependent
+* **Tooth friction** of a mesh element e (Jin et al. 2019): a second, phase-dependent
   projection ``W_e(s)`` used only to apply forces.  The generalized force of the mesh
   becomes ``-V_e f_e - W_e(s) max(f_e, 0)``; the deformation still uses ``V_e`` only.
   ``W_e`` is stored sparsely (``fr_*``): entry i contributes
   ``fr_coef[i] * friction_table[fr_row[i], s]`` on DOF ``fr_dof[i]``, the table rows
   being the friction force and the two friction moments per unit normal load over one
   mesh cycle (see :mod:`torquesplit.assembly.excitation`).
-* **Spline radial elements** (seed 002 eq. 6): a 2-D radial law between a floating
+* **Spline radial elements** (Dong et al. 2021 eq. 6): a 2-D radial law between a floating
   member and its hub.  It is stored as two ordinary elements (kind SPLINE) whose
   projection rows give the relative displacement components ``d = (dx, dy)`` (hub
   minus floating member); ``sp_el`` pairs them and ``sp_par`` holds the law.  With
@@ -147,6 +147,17 @@ class Structure:
     gy_coef: np.ndarray = field(default_factory=_empty_float)
     """(n_gy,) float64 value of each entry of G [N s/m, N m s/rad]."""
 
+    fs_ptr: np.ndarray = field(default_factory=_empty_int)
+    """(n_dof + 1,) int64, or empty for none: the frame stiffness matrix K_f by row (CSR).
+    The generalized force on DOF i is ``-sum_j K_f,ij q_j``: the inertial stiffness of a
+    turning frame (centripetal softening -m Omega^2 of a body's in-plane translations,
+    the geometric stiffness of a planet's centrifugal pin preload).  Not an element: it
+    holds nothing and carries no force of its own."""
+    fs_idx: np.ndarray = field(default_factory=_empty_int)
+    """(n_fs,) int64 column (DOF) of each entry of K_f."""
+    fs_coef: np.ndarray = field(default_factory=_empty_float)
+    """(n_fs,) float64 value of each entry of K_f [N/m, N m/rad]."""
+
     metadata: dict = field(default_factory=dict, compare=False)
     """Free-form information for post-processing (mesh names, stages, body map...)."""
 
@@ -205,15 +216,28 @@ class Structure:
             np.add.at(Gm[i], self.gy_idx[sl], self.gy_coef[sl])
         return Gm
 
+    @property
+    def n_frame_stiffness(self) -> int:
+        """Number of non-zero entries of the frame stiffness matrix."""
+        return int(self.fs_idx.shape[0])
+
+    def frame_stiffness_matrix(self) -> np.ndarray:
+        """Dense (n_dof, n_dof) frame stiffness K_f (generalized force -K_f q)."""
+        Km = np.zeros((self.n_dof, self.n_dof))
+        for i in range(self.n_dof if self.fs_ptr.size else 0):
+            sl = slice(self.fs_ptr[i], self.fs_ptr[i + 1])
+            np.add.at(Km[i], self.fs_idx[sl], self.fs_coef[sl])
+        return Km
+
     def mean_stiffness(self) -> np.ndarray:
         """(n_el,) mean of each element's stiffness table [N/m]."""
         return self.stiffness_table.mean(axis=1)
 
     def stiffness_matrix(self, element_stiffness: np.ndarray | None = None) -> np.ndarray:
-        """Dense K = sum_e k_e V_e V_e^T, with the mean stiffness unless given."""
+        """Dense K = sum_e k_e V_e V_e^T + K_f, with the mean stiffness unless given."""
         k = self.mean_stiffness() if element_stiffness is None else element_stiffness
         V = self.projection_matrix()
-        return V.T @ (k[:, None] * V)
+        return V.T @ (k[:, None] * V) + self.frame_stiffness_matrix()
 
     def damping_matrix(self) -> np.ndarray:
         """Dense C = sum_e c_e V_e V_e^T + diag(ground damping).
@@ -238,6 +262,7 @@ def build_structure(
     external_force=None,
     ground_damping=None,
     gyroscopic=(),
+    frame_stiffness=(),
     n_table: int = 256,
     metadata: dict | None = None,
 ) -> Structure:
@@ -262,7 +287,8 @@ def build_structure(
     ``velocity_scale`` (scalars, SI).
 
     ``gyroscopic`` lists ``(i, j, g)`` entries of the gyroscopic matrix: the generalized
-    force on DOF i gets ``-g v_j`` (entries on one (i, j) add up).
+    force on DOF i gets ``-g v_j`` (entries on one (i, j) add up); ``frame_stiffness``
+    lists ``(i, j, k)`` entries of the frame stiffness matrix: DOF i gets ``-k q_j``.
     """
     n_dof = len(dof_names)
     inv_mass = np.ascontiguousarray(inv_mass, dtype=np.float64)
@@ -363,6 +389,14 @@ def build_structure(
     gy_ptr = np.zeros(n_dof + 1, dtype=np.int64)
     for i, _, _ in gy:
         gy_ptr[i + 1] += 1
+    fs = sorted((int(i), int(j), float(k)) for i, j, k in frame_stiffness)
+    for i, j, k in fs:
+        if not (0 <= i < n_dof and 0 <= j < n_dof and np.isfinite(k)):
+            raise ValueError(f"frame stiffness entry ({i}, {j}, {k}) is out of range or not "
+                             f"finite; DOF indices are 0..{n_dof - 1}")
+    fs_ptr = np.zeros(n_dof + 1, dtype=np.int64)
+    for i, _, _ in fs:
+        fs_ptr[i + 1] += 1
     return Structure(
         dof_names=tuple(dof_names),
         inv_mass=inv_mass,
@@ -397,6 +431,9 @@ def build_structure(
         gy_ptr=np.cumsum(gy_ptr),
         gy_idx=np.asarray([j for _, j, _ in gy], dtype=np.int64),
         gy_coef=np.asarray([g for _, _, g in gy], dtype=np.float64),
+        fs_ptr=np.cumsum(fs_ptr),
+        fs_idx=np.asarray([j for _, j, _ in fs], dtype=np.int64),
+        fs_coef=np.asarray([k for _, _, k in fs], dtype=np.float64),
         metadata=dict(metadata or {}),
     )
 

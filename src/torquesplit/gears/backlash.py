@@ -1,19 +1,19 @@
-"""Backlash sequences per engagement (seed 001 eqs. 13-14) and contact-loss check.
+"""Backlash sequences per engagement (Ji & Li eqs. 13-14) and contact-loss check.
 
 A :class:`BacklashSequence` holds one backlash value per mesh cycle ("engagement")
 over one hunting period and repeats it, so b(t) is piecewise constant and periodic:
 
-    b(t) = values[k mod N],  k = floor(t / T_mesh),  N = lcm(z1, z2)   # seed 001 eq. 14
+    b(t) = values[k mod N],  k = floor(t / T_mesh),  N = lcm(z1, z2)   # Ji & Li eq. 14
 
 N = lcm(z1, z2) mesh cycles is the hunting period after which the same pinion
 tooth meets the same gear tooth again.  All values are SI (m, s).
 
 What "backlash" means here
 --------------------------
-Seed 001 uses the symmetric dead zone of eq. 13, f(Y) = Y - b for Y > b, 0 for
+Ji & Li uses the symmetric dead zone of eq. 13, f(Y) = Y - b for Y > b, 0 for
 |Y| <= b, Y + b for Y < -b, with b = *half* the circumferential clearance along
 the line of action.  Changing b from one engagement to the next moves the
-working (drive-side) flank by the change in b.  Seed 001 draws b per engagement from
+working (drive-side) flank by the change in b.  Ji & Li draws b per engagement from
 a normal distribution inside 0.522-0.851 mm (first stage) with a mesh stiffness of
 4.5e9 N/m: consecutive values differ by ~0.1 mm while the static deflection is
 F/k ~ 10-100 um, so every upward jump larger than F/k opens the mesh (contact loss
@@ -22,7 +22,7 @@ meant to be a variation of the clearance only (tooth thickness), the drive flank
 should stay put and only the coast-side clearance vary; then no loss of contact
 follows from the sequence (see docs/theory/excitations.md).
 
-Misprints in seed 001 around eq. 14: t_h = 0.042388 s is ten mesh periods
+Misprints in Ji & Li around eq. 14: t_h = 0.042388 s is ten mesh periods
 (the first-stage mesh frequency is 235.91667 Hz, T = 4.2388 ms); 3192 = lcm(19,
 168) is right for the first stage but the second stage (17/91 teeth) has lcm =
 1547, not 1530; the first value printed, 0.513 mm, lies outside the stated band
@@ -63,9 +63,9 @@ class BacklashSequence:
     """Backlash per engagement over one hunting period, repeated periodically.
 
     values : backlash b_k [m] of engagement k = 0 .. N-1 (same meaning as b in the
-        dead zone of seed 001 eq. 13, i.e. half the clearance if the dead zone is
+        dead zone of Ji & Li eq. 13, i.e. half the clearance if the dead zone is
         symmetric).
-    mesh_period : duration of one engagement T_mesh [s] (t_h of seed 001 eq. 14).
+    mesh_period : duration of one engagement T_mesh [s] (t_h of Ji & Li eq. 14).
     """
 
     values: np.ndarray
@@ -88,7 +88,7 @@ class BacklashSequence:
 
     @property
     def period(self) -> float:
-        """Repetition period N * T_mesh [s] (T of seed 001 eq. 14)."""
+        """Repetition period N * T_mesh [s] (T of Ji & Li eq. 14)."""
         return self.values.size * self.mesh_period
 
     def engagement_index(self, t):
@@ -97,7 +97,7 @@ class BacklashSequence:
         return np.mod(k, self.values.size)
 
     def at(self, t):
-        """b(t) [m], piecewise constant and periodic (seed 001 eq. 14)."""
+        """b(t) [m], piecewise constant and periodic (Ji & Li eq. 14)."""
         return self.values[self.engagement_index(t)]
 
     def jumps(self) -> np.ndarray:
@@ -124,7 +124,7 @@ def random_backlash(
 ) -> BacklashSequence:
     """One backlash per engagement drawn from a normal law truncated to [lower, upper].
 
-    Seed 001 (text above eq. 14): "randomly selected according to the normal
+    Ji & Li (text above eq. 14): "randomly selected according to the normal
     distribution between 0.522 mm ~ 0.851 mm".  The seed gives neither mean nor
     standard deviation; defaults: mean = band centre, std = band width / 6 (the
     band is +/- 3 sigma).  Values are drawn by inverse CDF, so the result depends
@@ -213,7 +213,7 @@ class ContactLossReport:
 def contact_loss(sequence: BacklashSequence, force, mesh_stiffness) -> ContactLossReport:
     """Detect loss of contact caused by backlash jumps in the symmetric dead zone.
 
-    With seed 001 eq. 13 the relative displacement during engagement k under the
+    With Ji & Li eq. 13 the relative displacement during engagement k under the
     mesh force F is Y = b_k + F / k_m.  At the switch to engagement k+1 the
     displacement is continuous, so the deflection becomes
     F / k_m - (b_{k+1} - b_k); the mesh opens when b_{k+1} - b_k > F / k_m.

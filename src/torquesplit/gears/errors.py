@@ -16,15 +16,20 @@ hence ``e = -(eps_1 - eps_2) . n``.  Directions are polar angles from the global
 +x axis, counter-clockwise positive; a gear's signed angular velocity is positive
 counter-clockwise.
 
-Seed transcriptions
--------------------
-:func:`seed000_mesh_error` and :func:`seed002_mesh_error` reproduce seed 000 eqs.
-1-2 and seed 002 eq. 11 literally, for comparison and for the example models.
-Their differences from the physical form are listed in their docstrings and in
-docs/theory/excitations.md.
+The papers' printed forms
+-------------------------
+:func:`eccentricity_installation_error_sum_form` (both gears' terms added: Liu, Fang,
+Jia et al. 2021 eqs. 1-2) and :func:`eccentricity_installation_error_difference_form`
+(the gears' terms subtracted: Dong, Zhang, Zhao & Duan 2021 eq. 11) reproduce the
+papers' expressions literally, for comparison and for the example models.  Their
+differences from the physical form are listed in their docstrings and in
+docs/theory/excitations.md.  (Before version 0.2 they were called
+``seed000_mesh_error`` and ``seed002_mesh_error``; those names still work, with a
+FutureWarning.)
 
-Sources: seed 000 eqs. 1-2; seed 002 eq. 11; seed 004 section 4 (tooth thickness,
-pitch, bearing errors as equivalent linear/angular meshing errors).
+Sources: Liu et al. 2021 eqs. 1-2; Dong et al. 2021 eq. 11; Mo, Ma, Jin et al. 2017
+section 4 (tooth thickness, pitch, bearing errors as equivalent linear/angular meshing
+errors).
 """
 
 from __future__ import annotations
@@ -42,8 +47,8 @@ __all__ = [
     "rotating_offset_on_line",
     "fixed_offset_on_line",
     "centre_errors_on_line",
-    "seed000_mesh_error",
-    "seed002_mesh_error",
+    "eccentricity_installation_error_sum_form",
+    "eccentricity_installation_error_difference_form",
     "tooth_thickness_error",
     "cumulative_pitch_error",
     "pitch_error_from_deviations",
@@ -133,7 +138,7 @@ class LineOfActionDeviation:
         return LineOfActionDeviation(self.constant * factor, self.amplitudes * factor, self.omegas, self.phases)
 
     def angular(self, base_radius: float) -> "LineOfActionDeviation":
-        """Equivalent angular meshing error e / r_b [rad] (seed 004 section 4.1)."""
+        """Equivalent angular meshing error e / r_b [rad] (Mo et al. 2017 section 4.1)."""
         if base_radius <= 0:
             raise ModelError("LineOfActionDeviation.angular: base_radius must be positive (m).")
         return self.scaled(1.0 / base_radius)
@@ -167,7 +172,7 @@ def rotating_offset_on_line(amplitude, phase, omega, line_angle) -> LineOfAction
 
     The offset vector E (cos(Omega t + phi), sin(Omega t + phi)) projected on
     n = (cos zeta, sin zeta) is E cos(Omega t + phi - zeta)
-    = E sin(Omega t + phi - zeta + pi/2).       # seed 000 eqs. 1-2, seed 002 eq. 11
+    = E sin(Omega t + phi - zeta + pi/2).       # Liu et al. 2021 eqs. 1-2, Dong et al. 2021 eq. 11
 
     ``phase`` phi is the offset direction at t = 0 (polar angle), ``omega`` Omega
     the gear's signed angular velocity (CCW > 0), ``line_angle`` zeta the polar
@@ -213,7 +218,7 @@ def centre_errors_on_line(line_angle: float, gear_1: CentreDeviation, gear_2: Ce
 
     e(t) = -(eps_1(t) - eps_2(t)) . n, n at polar angle ``line_angle`` (force of
     gear 1 on gear 2).  Eccentricity terms vary at each gear's rotation frequency,
-    installation terms are constant (as in seed 000 eqs. 1-2 and seed 002 eq. 11).
+    installation terms are constant (as in Liu et al. 2021 eqs. 1-2 and Dong et al. 2021 eq. 11).
     A common offset of both gears cancels, as it must.
 
     Examples
@@ -228,9 +233,9 @@ def centre_errors_on_line(line_angle: float, gear_1: CentreDeviation, gear_2: Ce
 
 
 # --------------------------------------------------------------------------- #
-# literal seed transcriptions
+# the papers' printed forms
 # --------------------------------------------------------------------------- #
-def seed000_mesh_error(
+def eccentricity_installation_error_sum_form(
     *,
     eccentricity_i: float,
     phase_i: float,
@@ -245,7 +250,8 @@ def seed000_mesh_error(
     line_offset: float,
     sign: float = 1.0,
 ) -> LineOfActionDeviation:
-    """Seed 000 eqs. 1-2 exactly as printed.
+    """Mesh error of eccentricity and installation errors with both gears' terms added:
+    Liu, Fang, Jia et al. 2021 eqs. 1-2 exactly as printed.
 
     e = sign * [ E_i sin(-w_i t - lambda_i + c) + A_i sin(-mu_i + c)
                + E_j sin(-w_j t - lambda_j + c) + A_j sin(-mu_j + c) ]
@@ -267,15 +273,15 @@ def seed000_mesh_error(
     c = line_offset
     terms = LineOfActionDeviation(
         installation_i * math.sin(-installation_phase_i + c)
-        + installation_j * math.sin(-installation_phase_j + c),  # seed 000 eq. 1 A terms
+        + installation_j * math.sin(-installation_phase_j + c),  # Liu et al. 2021 eq. 1 A terms
         [eccentricity_i, eccentricity_j],
         [-omega_i, -omega_j],
-        [-phase_i + c, -phase_j + c],  # seed 000 eq. 1 E terms
+        [-phase_i + c, -phase_j + c],  # Liu et al. 2021 eq. 1 E terms
     )
     return terms.scaled(sign)
 
 
-def seed002_mesh_error(
+def eccentricity_installation_error_difference_form(
     *,
     eccentricity_i: float,
     phase_i: float,
@@ -290,16 +296,17 @@ def seed002_mesh_error(
     line_angle: float,
     sign: float = 1.0,
 ) -> LineOfActionDeviation:
-    """Seed 002 eq. 11 exactly as printed.
+    """Mesh error of eccentricity and installation errors with the gears' terms
+    subtracted: Dong, Zhang, Zhao & Duan 2021 eq. 11 exactly as printed.
 
     e = sign * [ E_i sin(-w_i t + eta_i + a_ij) - E_j sin(-w_j t + eta_j + a_ij)
                + A_i sin(delta_i + a_ij) - A_j sin(delta_j + a_ij) ]
 
     sign = +1 for pairs 12, 46, 58, 610, 810 and -1 for 13, 47, 59, 710, 910;
-    a_ij = ``line_angle`` is the angle alpha_Iij or alpha_IIij of seed 002 eq. 10
+    a_ij = ``line_angle`` is the angle alpha_Iij or alpha_IIij of Dong et al. 2021 eq. 10
     (e.g. pi/2 - alpha_n + gamma_IIij).
 
-    Interpretation: with n = (cos a, sin a) as in seed 002 eq. 10, E sin(psi + a)
+    Interpretation: with n = (cos a, sin a) as in Dong et al. 2021 eq. 10, E sin(psi + a)
     is the projection on n of an offset (E sin psi, E cos psi), i.e. with psi
     measured from the +y axis towards +x; psi = -w t + eta rotates
     counter-clockwise.  The two gears enter with opposite signs (a difference of
@@ -310,26 +317,45 @@ def seed002_mesh_error(
     a = line_angle
     terms = LineOfActionDeviation(
         installation_i * math.sin(installation_phase_i + a)
-        - installation_j * math.sin(installation_phase_j + a),  # seed 002 eq. 11 A terms
+        - installation_j * math.sin(installation_phase_j + a),  # Dong et al. 2021 eq. 11 A terms
         [eccentricity_i, -eccentricity_j],
         [-omega_i, -omega_j],
-        [phase_i + a, phase_j + a],  # seed 002 eq. 11 E terms
+        [phase_i + a, phase_j + a],  # Dong et al. 2021 eq. 11 E terms
     )
     return terms.scaled(sign)
 
 
+def seed000_mesh_error(**kwargs) -> LineOfActionDeviation:
+    """Deprecated name of :func:`eccentricity_installation_error_sum_form`."""
+    import warnings
+
+    warnings.warn("seed000_mesh_error is deprecated; use "
+                  "eccentricity_installation_error_sum_form", FutureWarning, stacklevel=2)
+    return eccentricity_installation_error_sum_form(**kwargs)
+
+
+def seed002_mesh_error(**kwargs) -> LineOfActionDeviation:
+    """Deprecated name of :func:`eccentricity_installation_error_difference_form`."""
+    import warnings
+
+    warnings.warn("seed002_mesh_error is deprecated; use "
+                  "eccentricity_installation_error_difference_form", FutureWarning,
+                  stacklevel=2)
+    return eccentricity_installation_error_difference_form(**kwargs)
+
+
 # --------------------------------------------------------------------------- #
-# seed 004: tooth thickness, pitch and bearing errors
+# Mo et al. 2017: tooth thickness, pitch and bearing errors
 # --------------------------------------------------------------------------- #
 def tooth_thickness_error(thickness_deviation: float, pressure_angle: float) -> LineOfActionDeviation:
-    """Constant mesh error of a tooth thickness deviation (seed 004 section 4.1).
+    """Constant mesh error of a tooth thickness deviation (Mo et al. 2017 section 4.1).
 
     A deviation Delta s of the circular tooth thickness, measured on a circle of
     pressure angle alpha (the reference circle: alpha_t), moves each flank by
     Delta s / 2 along that circle, i.e. turns it by Delta s / (2 r); along the line
     of action this is r_b Delta s / (2 r) = (Delta s / 2) cos alpha.  A thinner tooth
     (Delta s < 0) opens the mesh:  e = -(Delta s / 2) cos alpha.  Angular equivalent
-    (seed 004): e / r_b.
+    (Mo et al. 2017): e / r_b.
     """
     return LineOfActionDeviation(-0.5 * thickness_deviation * math.cos(pressure_angle))
 
@@ -337,7 +363,7 @@ def tooth_thickness_error(thickness_deviation: float, pressure_angle: float) -> 
 def cumulative_pitch_error(
     total_cumulative_deviation: float, phase: float, omega: float, pressure_angle: float
 ) -> LineOfActionDeviation:
-    """First-harmonic model of the cumulative pitch deviation (seed 004 section 4.1).
+    """First-harmonic model of the cumulative pitch deviation (Mo et al. 2017 section 4.1).
 
     A total cumulative pitch deviation F_p (peak-to-peak over one revolution,
     measured along the reference circle) is modelled by its once-per-revolution
@@ -359,7 +385,7 @@ def pitch_error_from_deviations(
     circle.  Tooth k meshes during [k T_z, (k+1) T_z) with T_z = 2 pi / (z |Omega|);
     the returned signal is the trigonometric interpolation of the sequence, sampled
     at the middle of each tooth's mesh interval: harmonics 1 .. z/2 of the gear
-    rotation frequency, multiplied by cos(alpha) (seed 004 section 4.1).  Its mean
+    rotation frequency, multiplied by cos(alpha) (Mo et al. 2017 section 4.1).  Its mean
     over a revolution is the constant.
     """
     dev = np.asarray(cumulative_deviations, dtype=float) * math.cos(pressure_angle)
@@ -391,7 +417,7 @@ def pitch_error_from_deviations(
 
 def bearing_runout_error(runout: float, phase: float, omega: float, line_angle: float) -> LineOfActionDeviation:
     """Displacement along n from the radial runout of a bearing ring that rotates
-    with the shaft (inner ring), seed 004 section 4.1 "bearing manufacturing error".
+    with the shaft (inner ring), Mo et al. 2017 section 4.1 "bearing manufacturing error".
 
     The runout (total indicator reading) is twice the eccentricity of the ring, so
     the centre offset is runout / 2 and rotates with the shaft:

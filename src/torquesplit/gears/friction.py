@@ -30,8 +30,8 @@ Sources
 -------
 - Xu H., Kahraman A., Anderson N.E., Maddock D.G., "A model to predict friction
   coefficients and mechanical efficiency of spur and helical gears",
-  J. Mech. Des. 129 (2007) 58-68 ("Xu et al. 2007"); as used in seed 003 eq. 6.
-- seed 003 eqs. 14-18: friction stiffness and friction torque coefficient, spur
+  J. Mech. Des. 129 (2007) 58-68 ("Xu et al. 2007"); as used in Jin et al. 2019 eq. 6.
+- Jin et al. 2019 eqs. 14-18: friction stiffness and friction torque coefficient, spur
   and helical (slices).
 - Hertz line contact: Johnson, Contact Mechanics (1985), eq. 4.45.
 """
@@ -63,7 +63,7 @@ __all__ = [
     "mesh_friction_table",
 ]
 
-# Xu et al. 2007, Table 3 (full precision).  Seed 003 Table 1 prints them
+# Xu et al. 2007, Table 3 (full precision).  Jin et al. 2019 Table 1 prints them
 # truncated to 4 decimals (e.g. b1 = -8.9164 instead of -8.916465).
 XU_COEFFICIENTS = (
     -8.916465,  # b1
@@ -170,7 +170,7 @@ def xu_friction_coefficient(
     radius,
     roughness,
 ):
-    """EHL friction coefficient of Xu et al. 2007 (seed 003 eq. 6).
+    """EHL friction coefficient of Xu et al. 2007 (Jin et al. 2019 eq. 6).
 
     mu = exp(f) * P_h^b2 * |SR|^b3 * V_e^b6 * nu_0^b7 * R^b8
     f  = b1 + b4 |SR| P_h log10(nu_0) + b5 exp(-|SR| P_h log10(nu_0)) + b9 exp(S)
@@ -187,14 +187,14 @@ def xu_friction_coefficient(
 
     Unit convention of the regression (established in
     tests/gears/test_friction.py::test_unit_convention): P_h in GPa, V_e in m/s,
-    nu_0 in cP (= mPa s), R in m, S in um.  With these, mu at seed 003's split-stage
+    nu_0 in cP (= mPa s), R in m, S in um.  With these, mu at Jin et al. 2019's split-stage
     operating point (nu_0 = 5-20 mPa s, S = 0.3-0.9 um) peaks at 0.015-0.045
     towards the ends of the path of contact,
     inside the 0.02-0.08 range reported for lubricated steel gears; R in mm gives
     mu ~ 1e-3 and P_h in MPa makes mu vanish (< 1e-40) where sliding is
     largest, both unphysical.
 
-    Seed 003 prints the exponents of V_e, nu_0 and R as b4, b5, b6; the
+    Jin et al. 2019 prints the exponents of V_e, nu_0 and R as b4, b5, b6; the
     regression uses b6, b7, b8 (b4 and b5 belong to f only).  mu -> 0 at the pitch
     point (SR = 0), a property of the regression.
 
@@ -217,16 +217,16 @@ def xu_friction_coefficient(
             "must be positive; check the lubricant viscosity (Pa s) and the gear speeds."
         )
     x = sr * ph * np.log10(nu0)
-    f = b1 + b4 * x + b5 * np.exp(-x) + b9 * np.exp(s_um)  # Xu et al. 2007; seed 003 eq. 6
+    f = b1 + b4 * x + b5 * np.exp(-x) + b9 * np.exp(s_um)  # Xu et al. 2007; Jin et al. 2019 eq. 6
     with np.errstate(divide="ignore"):
         mu = (
             np.exp(f) * ph**b2 * sr**b3 * ve**b6 * nu0**b7 * r**b8
-        )  # Xu et al. 2007 (exponents b6, b7, b8; seed 003 eq. 6 misprints b4, b5, b6)
+        )  # Xu et al. 2007 (exponents b6, b7, b8; Jin et al. 2019 eq. 6 misprints b4, b5, b6)
     return mu
 
 
 def friction_direction(u1, u2):
-    """Friction direction coefficient lambda = sign(u1 - u2) (seed 003 eq. 14).
+    """Friction direction coefficient lambda = sign(u1 - u2) (Jin et al. 2019 eq. 14).
 
     It is the sign of the friction force on gear 2 along ``t``; it changes at the
     pitch point where u1 = u2.
@@ -240,7 +240,7 @@ def friction_arms(position, line_length):
     The friction force lies along the common tangent, perpendicular to the line
     of action, so its arm about gear i's centre is the distance from N_i to the
     contact point along the line of action: R1 = s, R2 = |N1N2| - s.
-    Seed 003 eqs. 15 and 17 use these arms (R_1i, R_2i) without printing them.
+    Jin et al. 2019 eqs. 15 and 17 use these arms (R_1i, R_2i) without printing them.
     """
     s = np.asarray(position, dtype=float)
     return s, line_length - s
@@ -249,7 +249,7 @@ def friction_arms(position, line_length):
 def friction_stiffness(direction, mu, stiffness_per_length, contact_length):
     """Friction stiffness of one tooth pair or slice, Kf = lambda mu k0 l [N/m].
 
-    # seed 003 eq. 15 (spur: l = contact length) and eq. 17 (slice: l = dl);
+    # Jin et al. 2019 eq. 15 (spur: l = contact length) and eq. 17 (slice: l = dl);
     # summed over tooth pairs (eq. 16) and slices (eq. 18) by the caller.
     """
     return direction * mu * stiffness_per_length * contact_length
@@ -258,7 +258,7 @@ def friction_stiffness(direction, mu, stiffness_per_length, contact_length):
 def friction_torque_coefficient(direction, mu, stiffness_per_length, contact_length, arm):
     """Friction torque coefficient KTf = lambda mu k0 l R [N] of one pair or slice.
 
-    # seed 003 eqs. 15 and 17.  Seed 003 eq. 14 writes a single direction
+    # Jin et al. 2019 eqs. 15 and 17.  Jin et al. 2019 eq. 14 writes a single direction
     # coefficient lambda_Kf for force and torque; eq. 15 uses separate
     # lambda_1i, lambda_2i for the two gears.  With our sign convention the
     # torque on gear 1 is -lambda mu k l R1 and on gear 2 +lambda mu k l R2.
@@ -365,7 +365,7 @@ def mesh_friction_table(
     roughness : composite RMS roughness of the flanks [m].
     youngs_modulus, poisson_ratio : of gear 1 and gear 2.
     base_helix_angle : [rad]; 0 for spur teeth.  Helical teeth are cut into
-        ``n_slices`` transverse slices, each treated as a spur contact (seed 003
+        ``n_slices`` transverse slices, each treated as a spur contact (Jin et al. 2019
         eqs. 17-18), shifted along the line of action by z tan(beta_b).
     n_phases : number of samples over one mesh period.
     pair_stiffness : optional callable k(s) giving the mesh stiffness per unit
@@ -496,12 +496,12 @@ def mesh_friction_table(
             ),
             0.0,
         )
-    lam = np.where(in_contact, friction_direction(u1, u2), 0.0)  # seed 003 eq. 14 lambda
-    f = lam * mu * load  # seed 003 eq. 5 f = mu F, with direction lambda
-    m1 = np.where(in_contact, -f * rho1, 0.0)  # seed 003 eq. 8 friction torque terms
+    lam = np.where(in_contact, friction_direction(u1, u2), 0.0)  # Jin et al. 2019 eq. 14 lambda
+    f = lam * mu * load  # Jin et al. 2019 eq. 5 f = mu F, with direction lambda
+    m1 = np.where(in_contact, -f * rho1, 0.0)  # Jin et al. 2019 eq. 8 friction torque terms
     m2 = np.where(in_contact, f * rho2, 0.0)
 
-    pair_load = load.sum(axis=2)  # seed 003 eq. 18 (sum over slices)
+    pair_load = load.sum(axis=2)  # Jin et al. 2019 eq. 18 (sum over slices)
     pair_force = f.sum(axis=2)
     pair_m1 = m1.sum(axis=2)
     pair_m2 = m2.sum(axis=2)
@@ -514,7 +514,7 @@ def mesh_friction_table(
             pair_load > 0, (mu * load).sum(axis=2) / np.where(pair_load > 0, pair_load, 1.0), 0.0
         )
 
-    total_force = pair_force.sum(axis=1)  # seed 003 eq. 16 (sum over pairs)
+    total_force = pair_force.sum(axis=1)  # Jin et al. 2019 eq. 16 (sum over pairs)
     total_m1 = pair_m1.sum(axis=1)
     total_m2 = pair_m2.sum(axis=1)
 

@@ -14,7 +14,7 @@ Conventions
   parallel, each with the full transverse and overlap ratio of its own half), and
   the total active face width is ``2 * face_width``.  This is the convention that
   reproduces the total contact ratio 3.42 quoted for the double-helical pair of
-  seed 000 (Table 1: z = 23/215, m_n = 3.965 mm, b = 50 mm, beta = 30 deg gives
+  Liu et al. 2021 (Table 1: z = 23/215, m_n = 3.965 mm, b = 50 mm, beta = 30 deg gives
   eps_alpha = 1.4145, eps_beta = 2.0070, eps_gamma = 3.4215; with b = 25 mm per
   helix it would be 2.42, and reading 3.965 mm as a transverse module gives 3.73).
 * **Internal gears** (ring gears): give a *positive* tooth count and ``internal=True``
@@ -186,8 +186,10 @@ class GearGeometry:
         if not (self.normal_module > 0 and math.isfinite(self.normal_module)):
             issues.append(("normal_module", f"must be a positive length in metres, got {self.normal_module!r}"))
         elif self.normal_module > 0.1:
-            issues.append(("normal_module", f"{self.normal_module} m is implausibly large; "
-                                            "lengths are in metres (3.5 mm = 3.5e-3)"))
+            issues.append(("normal_module", f"{self.normal_module:g} m is implausibly large; "
+                                            f"a bare number is read in metres: write "
+                                            f"'{self.normal_module:g} mm' (or "
+                                            f"{self.normal_module:g}e-3)"))
         if not (0 < self.normal_pressure_angle < math.radians(45)):
             issues.append(("normal_pressure_angle", f"must lie in (0, 45 deg) and is in radians, "
                                                     f"got {self.normal_pressure_angle!r}"))

@@ -26,7 +26,7 @@ Rounding (5.2.3, optional here): > 10 um to 1 um, 5-10 um to 0.5 um, < 5 um to
 The runout formula and its placement in the standard should be checked against
 the document; the equation numbers (5)-(12) are those of ISO 1328-1:2013.
 
-Seed 000 Table 2 ("grade 5", eccentricity = installation error): 8 um for the
+Liu et al. 2021 Table 2 ("grade 5", eccentricity = installation error): 8 um for the
 34-tooth spur pinion (d = 119 mm), 12 um for the 107-tooth gear (d = 374.5 mm),
 8 um for the 23-tooth double-helical pinion (d = 105.3 mm).  These are close to
 half the grade-5 runout tolerance F_rT / 2 = 9.3, 11.6, 9.3 um (an eccentricity

@@ -1,4 +1,4 @@
-"""Meshing-in impact of standard involute teeth under load (seed 000 eqs. 6-10).
+"""Meshing-in impact of standard involute teeth under load (Liu et al. 2021 eqs. 6-10).
 
 Under load the tooth pairs already in contact deflect by ``delta`` along the
 line of action, so the driven gear lags its rigid position by ``delta / r_bg``.
@@ -6,7 +6,7 @@ The next tooth pair therefore meets early, off the theoretical line of action:
 the tip corner of the driven gear's tooth hits the driving pinion's flank at a
 point D before the theoretical start of contact E (corner contact).  Because D is
 off the line of action the two surfaces have a relative normal velocity v_s there,
-and the impact force follows from an impact-energy balance (seed 000 eq. 10).
+and the impact force follows from an impact-energy balance (Liu et al. 2021 eq. 10).
 
 All inputs and outputs are SI (m, rad, rad/s, N, kg m^2, N/m^n).
 
@@ -25,7 +25,7 @@ difference, exactly, since both lie on involutes of the same base circle.
 
 Sources
 -------
-- seed 000 eqs. 6-10 (reversal method after Zhou, Tang, Zhong, Chin. J. Mech. Eng.
+- Liu et al. 2021 eqs. 6-10 (reversal method after Zhou, Tang, Zhong, Chin. J. Mech. Eng.
   44(3) 2008; impact force after Mu, Fang, Li, Proc IMechE K 233(3) 2019).
 """
 
@@ -65,26 +65,26 @@ def loaded_deflection(normal_load: float, loaded_stiffness: float) -> float:
     """Deflection along the line of action of the loaded tooth pair(s), delta = F / k [m].
 
     ``loaded_stiffness`` is the stiffness of the pairs carrying the load just before
-    the next pair engages (single-pair stiffness for 1 < eps_alpha < 2).  In seed 000
+    the next pair engages (single-pair stiffness for 1 < eps_alpha < 2).  In Liu et al. 2021
     this is the normal deformation Z of the loaded tooth contact analysis (eq. 5:
     k = F_n / Z).
     """
     if loaded_stiffness <= 0:
         raise ModelError("loaded_deflection: loaded_stiffness must be positive (N/m).")
-    return max(float(normal_load), 0.0) / float(loaded_stiffness)  # seed 000 eq. 5
+    return max(float(normal_load), 0.0) / float(loaded_stiffness)  # Liu et al. 2021 eq. 5
 
 
 def equivalent_mass(inertia_driving, inertia_driven, base_radius_driving, base_radius_driven):
     """Equivalent mass of the pair along the line of action [kg].
 
-    m_e = J_p J_g / (J_p r_bg^2 + J_g r_bp^2)      # seed 000 eq. 10
+    m_e = J_p J_g / (J_p r_bg^2 + J_g r_bp^2)      # Liu et al. 2021 eq. 10
     """
     jp, jg = float(inertia_driving), float(inertia_driven)
     return jp * jg / (jp * base_radius_driven**2 + jg * base_radius_driving**2)
 
 
 def impact_force(effective_mass, normal_velocity, impact_stiffness, exponent=1.0):
-    """Maximum meshing-in impact force [N], seed 000 eq. 10.
+    """Maximum meshing-in impact force [N], Liu et al. 2021 eq. 10.
 
     F_s = ((n+1)/2 * m_e * v_s^2 * k_s^(1/n))^(n/(n+1))
 
@@ -102,7 +102,7 @@ def impact_force(effective_mass, normal_velocity, impact_stiffness, exponent=1.0
     n = float(exponent)
     v = np.abs(np.asarray(normal_velocity, dtype=float))
     energy_term = (n + 1.0) / 2.0 * effective_mass * v**2 * impact_stiffness ** (1.0 / n)
-    return energy_term ** (n / (n + 1.0))  # seed 000 eq. 10
+    return energy_term ** (n / (n + 1.0))  # Liu et al. 2021 eq. 10
 
 
 def impact_duration(effective_mass, normal_velocity, impact_stiffness, exponent=1.0):
@@ -125,7 +125,7 @@ def impact_duration(effective_mass, normal_velocity, impact_stiffness, exponent=
 
 
 def meshing_in_radius(tip_radius_driven, pitch_radius_driving, pitch_radius_driven, angle):
-    """Radius r_OpD of the meshing-in point on the driving pinion [m], seed 000 eq. 6.
+    """Radius r_OpD of the meshing-in point on the driving pinion [m], Liu et al. 2021 eq. 6.
 
     r_OpD = sqrt(r_ag^2 + (r_p + r_g)^2 - 2 r_ag (r_p + r_g) cos(gamma_g + phi_k + dphi_kg))
 
@@ -136,7 +136,7 @@ def meshing_in_radius(tip_radius_driven, pitch_radius_driving, pitch_radius_driv
     a = pitch_radius_driving + pitch_radius_driven
     return np.sqrt(
         tip_radius_driven**2 + a**2 - 2.0 * tip_radius_driven * a * np.cos(angle)
-    )  # seed 000 eq. 6
+    )  # Liu et al. 2021 eq. 6
 
 
 @dataclass(frozen=True)
@@ -146,21 +146,21 @@ class MeshingInPoint:
     Attributes
     ----------
     point : (x, y) of D in the frame of :mod:`this module <torquesplit.gears.impact>` [m].
-    radius_on_driving : |O_p D| [m] (seed 000 eq. 6 r_OpD).
+    radius_on_driving : |O_p D| [m] (Liu et al. 2021 eq. 6 r_OpD).
     theoretical_start : position of E, the rigid start of contact, along the line
         of action from N_p [m].
     pinion_flank_position : where the engaging pinion flank crosses the line of
         action at the instant of meshing-in [m] (< theoretical_start when loaded).
     offset_from_line : distance of D from the theoretical line of action [m].
     gear_angle : angle at O_g between the centre line and O_g D [rad]
-        (= gamma_g + phi_k + dphi_kg of seed 000 eq. 6).
+        (= gamma_g + phi_k + dphi_kg of Liu et al. 2021 eq. 6).
     gamma_g : angle at O_g between the centre line and O_g E [rad]
-        (seed 000: gamma_g = pi/2 - alpha_t - angle(PEO_g)).
+        (Liu et al. 2021: gamma_g = pi/2 - alpha_t - angle(PEO_g)).
     lag_angle : rotation lag of the driven gear from the deflection, advance / r_bg [rad].
     reverse_angle : total angle by which the driven gear meets the pinion early,
-        gear_angle - gamma_g [rad] (phi_k + dphi_kg of seed 000).
+        gear_angle - gamma_g [rad] (phi_k + dphi_kg of Liu et al. 2021).
     normal_velocity : relative normal velocity v_s = v_np - v_ng at D [m/s]
-        (seed 000 eq. 9), positive = approaching.
+        (Liu et al. 2021 eq. 9), positive = approaching.
     phase_lead : how much earlier than the theoretical start the contact occurs,
         in mesh periods (pinion travel / base pitch) [-]; filled by
         :func:`meshing_in_impact`, NaN otherwise.
@@ -210,7 +210,7 @@ def meshing_in_point(
 
     Notes
     -----
-    Seed 000 finds D by the reversal method (rotate the driven gear back by the
+    Liu et al. 2021 finds D by the reversal method (rotate the driven gear back by the
     reverse angle, eq. 6) and then the velocities (eq. 9).  Here the same point is
     found directly: the pinion flank position s_p is moved back from the rigid
     start E until the driven gear's tip corner, placed ``advance`` behind the
@@ -295,12 +295,12 @@ def meshing_in_point(
     v_p = w_p * np.array([-d[1], d[0]])  # counter-clockwise pinion
     rg = d - og
     v_g = w_g * np.array([rg[1], -rg[0]])  # clockwise gear
-    v_s = float(np.dot(v_p - v_g, normal))  # seed 000 eq. 9: v_s = v_np - v_ng
+    v_s = float(np.dot(v_p - v_g, normal))  # Liu et al. 2021 eq. 9: v_s = v_np - v_ng
     if advance == 0.0:
         v_s = 0.0  # conjugate contact on the line of action: exactly zero (removes round-off)
 
     alpha_ag = math.acos(rbg / rag)
-    gamma_g = alpha_ag - aw  # = pi/2 - alpha_t - angle(PEO_g) of seed 000 eq. 6
+    gamma_g = alpha_ag - aw  # = pi/2 - alpha_t - angle(PEO_g) of Liu et al. 2021 eq. 6
     gear_angle = float(math.atan2(-rg[1], -rg[0]))  # angle from O_g->O_p to O_g->D
     gear_angle = abs(gear_angle)
     return MeshingInPoint(
@@ -352,7 +352,7 @@ class MeshingInImpact:
         """Impact force [N] at mesh ``phase`` (any real, periodic with period 1).
 
         ``remove_mean=True`` subtracts :attr:`mean_force`: the seed adds the pulse
-        to the mesh force (seed 000 eqs. 14-16), which also adds a mean force and
+        to the mesh force (Liu et al. 2021 eqs. 14-16), which also adds a mean force and
         therefore a mean torque; removing it keeps the transmitted torque unchanged.
         """
         phase = np.asarray(phase, dtype=float)
@@ -400,7 +400,7 @@ def meshing_in_impact(
     exponent: float = 1.0,
     base_pitch_difference: float = 0.0,
 ) -> MeshingInImpact:
-    """Meshing-in impact of a standard involute pair (seed 000 eqs. 5-10).
+    """Meshing-in impact of a standard involute pair (Liu et al. 2021 eqs. 5-10).
 
     Steps: deflection delta = F / k (eq. 5) -> advance = delta + (p_bp - p_bg)
     -> meshing-in point D off the line of action (eqs. 6-8, reversal method)

@@ -1,6 +1,6 @@
 """Contact frame and line of action of a mesh, from the layout and the power flow.
 
-One formulation for every pair (DESIGN.md §4).  At the mean contact point P each gear
+One formulation for every pair (docs/theory/model.md).  At the mean contact point P each gear
 ``i`` has its axis ``a_i``, the radial unit vector ``e_r,i`` from its axis to P and the
 tangent ``t_i = a_i x e_r,i``.  The force the driver exerts on the driven gear acts along
 
@@ -16,8 +16,8 @@ tangent ``t_i = a_i x e_r,i``.  The force the driver exerts on the driven gear a
 
   with ``m = cos(gamma) e_r - sin(gamma) a`` the outward normal of the pitch cone and
   ``g = sin(gamma) e_r + cos(gamma) a`` the cone element (apex to heel).  For gamma = 0
-  and psi = beta this is the cylindrical form written with normal angles; seed 003 eq. 4
-  and seed 002 eq. 2 are special cases of it.
+  and psi = beta this is the cylindrical form written with normal angles; Jin et al. 2019 eq. 4
+  and Dong et al. 2021 eq. 2 are special cases of it.
 
 Here ``e_t = s t`` is the direction in which the driver's contact point moves (s is the
 sign of the driver's speed about its axis), ``sep = +1`` for an external driver and -1
@@ -303,7 +303,7 @@ def line_of_action(model, mesh_name: str, frame: ContactFrame, driver: str, spee
         gam = frame.cone_angles[i]
         m = math.cos(gam) * er - math.sin(gam) * a
         g = math.sin(gam) * er + math.cos(gam) * a
-        # conical line of action (seed 003 eq. 4 / seed 002 eq. 2 in vector form)
+        # conical line of action (Jin et al. 2019 eq. 4 / Dong et al. 2021 eq. 2 in vector form)
         n = (math.cos(alpha_n) * math.cos(psi) * et + sep * math.sin(alpha_n) * m
              - h * s * math.cos(alpha_n) * math.sin(psi) * g)
     else:

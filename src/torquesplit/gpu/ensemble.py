@@ -31,7 +31,7 @@ from torquesplit.solve import _kernels as kern
 from torquesplit.solve import kernel_data as kd
 
 from .compile import cpu_driver, cuda_available, cuda_kernel
-from .layout import CaseArrays, build_group, group_cases
+from .layout import CaseArrays, build_group, group_cases, unknown_fields
 from .source import N_STAT, kernel_source
 
 __all__ = ["EnsembleResult", "case_arrays", "run_ensemble", "TARGETS", "PRECISIONS",
@@ -97,6 +97,13 @@ def case_arrays(run) -> _Planned:
     check_supported(run)
     s = run.structure
     kw = run.integrate_kwargs
+    model = kd.kernel_model(s)
+    unknown = unknown_fields(model)
+    if unknown:
+        raise GpuUnsupportedError(
+            f"the engine's kernel arrays {unknown} (a term added to the engine after the "
+            f"GPU kernel generator)", "use the CPU backend until torquesplit.gpu.source "
+            "generates it")
     t0, span = 0.0, float(run.duration)
     sel = _select(s, t0, span, kw.get("track_elements"), None, [], [],
                   kw.get("load_sharing_groups"))
@@ -105,7 +112,7 @@ def case_arrays(run) -> _Planned:
     y = np.array(run.y0, dtype=np.float64).ravel()
     if y.shape != (2 * s.n_dof,):
         y = np.concatenate([y, np.zeros(s.n_dof)])
-    case = CaseArrays(model=kd.kernel_model(s), y0=y, t0=t0, h=float(plan.h),
+    case = CaseArrays(model=model, y0=y, t0=t0, h=float(plan.h),
                       n_steps=int(plan.limit_steps), chunk=rk4_chunk(plan.limit_steps),
                       track=list(sel.track),
                       track_base=np.asarray(sel.track_base, dtype=np.int64),

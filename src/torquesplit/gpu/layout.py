@@ -53,6 +53,26 @@ class CaseArrays:
     ``group_min``; 0: any positive total)."""
 
 
+KNOWN_FIELDS = (
+    "inv_mass", "external_force", "ground_damping", "element_kind", "v_ptr", "v_dof",
+    "v_coef", "stiffness_table", "frequency", "phase", "damping", "gap_ptr",
+    "gap_values", "error_constant", "error_ptr", "error_amplitude", "error_omega",
+    "error_phase", "force_table", "tv_el", "err_el", "sin_el", "vr_ptr", "vq_idx",
+    "vv_idx", "vt_ptr", "vt_el", "vt_coef", "fr_el", "fr_ptr", "fr_dof", "fr_coef",
+    "fr_row", "friction_table", "sp_el", "sp_par", "gy_ptr", "gy_idx", "gy_coef",
+    "corner_ptr", "corner_node", "fs_ptr", "fs_idx", "fs_coef",
+)
+"""The kernel arrays (:class:`~torquesplit.solve.kernel_data.KernelModel` fields) the
+generated code reproduces.  A field the engine gains later is a term the GPU kernel
+would miss: :func:`unknown_fields` names it and the run is refused (tested: the test
+fails when the engine's bundle and this list part)."""
+
+
+def unknown_fields(model) -> list[str]:
+    """Fields of a kernel model that the generated code does not know (see above)."""
+    return [f for f in model._fields if f not in KNOWN_FIELDS]
+
+
 def _gapped(m) -> np.ndarray:
     gp, gv = m.gap_ptr, m.gap_values
     return np.array([bool(np.any(gv[gp[e]:gp[e + 1]] > 0.0)) for e in range(len(gp) - 1)],
@@ -66,7 +86,7 @@ def pattern_key(case: CaseArrays) -> str:
     ne = m.damping.shape[0]
     parts = [
         np.int64(m.inv_mass.shape[0]), np.int64(ne), m.element_kind, m.vr_ptr, m.vq_idx,
-        m.vt_ptr, m.vt_el, m.gy_ptr, m.gy_idx, m.frequency > 0.0,
+        m.vt_ptr, m.vt_el, m.gy_ptr, m.gy_idx, m.fs_ptr, m.fs_idx, m.frequency > 0.0,
         np.any(m.force_table != 0.0, axis=1), _gapped(m), np.diff(m.gap_ptr), m.error_ptr,
         m.fr_el, m.fr_ptr, m.fr_dof, m.fr_row, m.sp_el, m.corner_ptr, m.corner_node,
         np.int64(m.stiffness_table.shape[1]), np.int64(m.friction_table.shape[1]),
@@ -107,6 +127,9 @@ class Layout:
     gy_ptr: np.ndarray
     gy_col: np.ndarray
     """Gyroscopic column as a velocity index (0..n-1)."""
+    fs_ptr: np.ndarray
+    fs_col: np.ndarray
+    """Frame stiffness K_f by row: its columns (displacement indices)."""
     tv: np.ndarray
     """Time-varying elements (frequency > 0), in index order."""
     has_force: np.ndarray
@@ -150,6 +173,8 @@ class Layout:
             vt_el=np.asarray(m.vt_el, dtype=np.int64),
             gy_ptr=np.asarray(m.gy_ptr, dtype=np.int64),
             gy_col=np.asarray(m.gy_idx, dtype=np.int64) - n,
+            fs_ptr=np.asarray(m.fs_ptr, dtype=np.int64),
+            fs_col=np.asarray(m.fs_idx, dtype=np.int64),
             tv=np.flatnonzero(m.frequency > 0.0),
             has_force=np.any(m.force_table != 0.0, axis=1), gapped=gapped,
             n_gaps=np.diff(m.gap_ptr), error_ptr=np.asarray(m.error_ptr),
@@ -235,6 +260,8 @@ def _scalars(L: Layout, c: CaseArrays) -> list[tuple[tuple, str, float]]:
         add((("cg", i), _D, m.ground_damping[i]))
     for j in range(len(m.gy_coef)):
         add((("gy", j), _D, m.gy_coef[j]))
+    for j in range(len(m.fs_coef)):
+        add((("fs", j), _D, m.fs_coef[j]))
     for j in range(len(m.fr_coef)):
         add((("frc", j), _D, m.fr_coef[j]))
     for j in range(m.sp_par.shape[0]):

@@ -300,6 +300,8 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
                 w(f"acc -= {par(('vt', j))} * f{int(L.vt_el[j])}")
             for j in range(L.gy_ptr[i], L.gy_ptr[i + 1]):
                 w(f"acc -= {par(('gy', j))} * W[yo + {n + int(L.gy_col[j])}]")
+            for j in range(L.fs_ptr[i], L.fs_ptr[i + 1]):  # frame stiffness: -K_f q
+                w(f"acc -= {par(('fs', j))} * W[yo + {int(L.fs_col[j])}]")
             w(f"W[dyo + {i}] = vi")
             w(f"W[dyo + {n + i}] = {par(('im', i))} * acc")
         # splines (rhs_extra): the radial law on the two component elements

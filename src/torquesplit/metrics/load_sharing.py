@@ -65,6 +65,28 @@ DEFINITION_TEXT = {
 }
 """What each definition measures, in one line (tables, plots, docs)."""
 
+DEFINITION_USE = {
+    "mean_force": "report it as the mesh load factor K_gamma of ISO 6336-1 / AGMA 6123 "
+                  "(the default): the share of the mean load a path carries, without the "
+                  "dynamic increment, which the dynamic factor gives (K_v sense)",
+    "cycle_peak": "report it to compare with Liu et al. 2021, or when the worst cycle's "
+                  "peak sharing matters; it contains the dynamics (do not multiply it by a "
+                  "dynamic factor)",
+    "engineering": "report it to compare with Ji & Li: a repeatable peak-sharing number, "
+                   "less sensitive to single cycles than 'instantaneous'",
+    "instantaneous": "an upper bound: meshes out of phase give spikes even when they share "
+                     "equally; use it to look for extreme instants, not as a design value",
+    "static_torque": "the sharing set by errors and compliances alone, without dynamics "
+                     "(compare with Mo et al. 2017); `torquesplit static` computes it",
+}
+"""When to report each definition, in one line (``run --help``, the table's footnote,
+docs/load-sharing.md)."""
+
+#: the definition of a new model: the mean-force ratio is the mesh load factor K_gamma
+#: of the design standards (ISO 6336-1, AGMA 6123), which combines with the dynamic
+#: factor K_v (``dynamic_factor``) as the standards multiply them
+STANDARD_DEFINITION = "mean_force"
+
 
 @dataclass(frozen=True)
 class Settling:

@@ -16,6 +16,7 @@ check                           what it refuses
 :func:`geometry_issues`         involute geometry (interference, centre distance)
 kinematics                      loops that cannot turn, power that does not balance,
                                 carriers and planets (model/epicyclic.py)
+:func:`shaft_axis_issues`       shafts joining bodies that are not on a common axis
 :func:`nominal_load_issues`     meshes that carry no load (no power passes them)
 :func:`balance_issues`          torques out of balance by more than
                                 :data:`BALANCE_TOLERANCE` (what the static solution of
@@ -29,7 +30,10 @@ kinematics                      loops that cannot turn, power that does not bala
 
 :func:`plausibility_warnings` flag magnitudes that are possible but usually a wrong
 unit: lengths against the size of the gears, inertias and masses against the gear's
-geometry, stiffness against ISO 6336, speeds and tooth loads against what gears carry.
+geometry, stiffness against ISO 6336, speeds and tooth loads against what gears carry;
+:func:`tolerance_warnings` errors, clearances and backlash against the ISO 1328-1
+tolerances of the gear (the coarsest grade, 11, and the grade the file states) and the
+backlash range of ISO/TR 10064-2.
 """
 
 from __future__ import annotations
@@ -78,7 +82,8 @@ def check_model(model: Model, source: str | None = None, *, deep: bool = False) 
         kin = solve_kinematics(model)
     except KinematicsError as exc:
         raise ModelError(exc.issues, source) from None
-    issues = nominal_load_issues(model, kin) + balance_issues(model, kin)
+    issues = shaft_axis_issues(model, kin)
+    issues += nominal_load_issues(model, kin) + balance_issues(model, kin)
     issues += stiffness_table_issues(model, kin) + planet_fit_issues(model, kin)
     notes = []
     if not issues and deep:
@@ -313,7 +318,7 @@ def _teach(msg: str) -> str:
 
 def support_issues(model: Model) -> list[tuple[str, str]]:
     """Translational DOFs need a support to the housing (bearing or shaft bending), or a
-    spline that holds the body radially (seed 002 floating pinion)."""
+    spline that holds the body radially (Dong et al. 2021 floating pinion)."""
     issues = []
     on_spline = {b for sp in model.splines.values() for b in sp.connects}
     for kind, items in (("gears", model.gears), ("bodies", model.bodies)):
@@ -363,14 +368,156 @@ def plausibility_warnings(model: Model, kin) -> list[tuple[str, str]]:
             out.append((f"meshes.{name}.stiffness",
                         f"{spec.value:.3g} N/m is {spec.value / iso:.2g} times the ISO 6336 "
                         f"estimate c_gamma*b = {iso:.3g} N/m; check the value and its unit"))
-    return out + magnitude_warnings(model, kin)
+    rigid = [(loc, msg.replace("a shaft joins bodies on one axis", "a rigid join locks "
+                               "their rotations but not the motion of one about the other's "
+                               "centre"))
+             for loc, msg in shaft_axis_issues(model, kin, rigid=True)]
+    return out + rigid + magnitude_warnings(model, kin) + tolerance_warnings(model, kin)
+
+
+#: a shaft's two bodies may be this far off their common axis [m] (plus SHAFT_AXIS_RELATIVE
+#: of their distance) and their axes this far from parallel [rad]
+SHAFT_AXIS_OFFSET = 1e-4
+SHAFT_AXIS_RELATIVE = 1e-3
+SHAFT_AXIS_ANGLE = 1e-3
+
+
+def shaft_axis_issues(model: Model, kin, *, rigid: bool = False) -> list[tuple[str, str]]:
+    """An elastic shaft transmits torque about one axis: the bodies it joins must turn
+    about parallel axes and sit on that common axis.  A body whose position the file
+    leaves out (a motor or a load inertia) is taken to be on the axis.
+
+    ``rigid=True`` checks the rigid joins instead (``rigid = true``: the bodies turn as
+    one, as a gear bolted to a carrier may), which :func:`plausibility_warnings` reports
+    as warnings."""
+    issues = []
+    for name, s in model.shafts.items():
+        if bool(s.rigid) != rigid:
+            continue
+        a, b = s.connects
+        if a not in kin.bodies or b not in kin.bodies:
+            continue
+        ba, bb = kin.bodies[a], kin.bodies[b]
+        ua, ub = np.asarray(ba.axis, float), np.asarray(bb.axis, float)
+        angle = math.acos(min(1.0, abs(float(np.dot(ua, ub)))))
+        if angle > SHAFT_AXIS_ANGLE:
+            issues.append((f"shafts.{name}", (
+                f"joins {a!r} and {b!r}, whose axes are {math.degrees(angle):.3g} deg apart; "
+                f"a shaft turns both bodies about one axis: give them the same 'axis', or "
+                f"connect them by a mesh (bevel gears) instead")))
+            continue
+        if not (_position_given(model, a) and _position_given(model, b)):
+            continue
+        d = np.asarray(bb.position, float) - np.asarray(ba.position, float)
+        off = float(np.linalg.norm(d - np.dot(d, ua) * ua))
+        if off > SHAFT_AXIS_OFFSET + SHAFT_AXIS_RELATIVE * float(np.linalg.norm(d)):
+            issues.append((f"shafts.{name}", (
+                f"joins {a!r} at {_mm(ba.position)} and {b!r} at {_mm(bb.position)}, "
+                f"{off * 1e3:.4g} mm off their common axis; a shaft joins bodies on one "
+                f"axis: correct the positions (or 'place'), or connect them otherwise")))
+    return issues
+
+
+def _mm(p) -> str:
+    return "(" + ", ".join(f"{1e3 * float(v):.4g}" for v in p) + ") mm"
+
+
+def _position_given(model: Model, name: str) -> bool:
+    """The position of a body is known: a gear always (given, placed or computed from
+    its mates), another body when its file gives 'position'."""
+    if name in model.gears:
+        return True
+    return "position" in model.bodies[name].model_fields_set
+
+
+#: errors beyond the tolerance of the grade a gear states, by more than this factor
+#: (one grade step of ISO 1328-1), are flagged
+GRADE_MARGIN = math.sqrt(2.0)
+#: backlash above this many times the ISO/TR 10064-2 minimum is flagged
+BACKLASH_RATIO = 10.0
+#: a support clearance above this fraction of the gear's pitch diameter is flagged
+#: (rolling-bearing radial clearances are a few thousandths of the bore at most)
+CLEARANCE_FRACTION = 5e-3
+
+
+def tolerance_warnings(model: Model, kin) -> list[tuple[str, str]]:
+    """Errors, clearances and backlash against the gear's size and ISO tolerances.
+
+    * eccentricity (a runout of twice its size), installation error and bearing runout
+      against the ISO 1328-1 runout tolerance F_rT of the gear at grade 11, the coarsest,
+      and at the grade the file states (``errors.grade``, one grade step of margin);
+    * single pitch error against f_pT the same way;
+    * backlash against ten times the minimum of ISO/TR 10064-2,
+      j_bn,min = 2/3 (0.06 + 0.0005 a + 0.03 m_n) mm;
+    * support clearance against half a percent of the pitch diameter.
+    """
+    from ..gears import grades
+    from .kinematics import gear_geometry
+
+    out = []
+    for name, g in model.gears.items():
+        try:
+            d = 2 * gear_geometry(g).reference_radius
+        except (ModelError, ValueError, ArithmeticError):  # pragma: no cover
+            continue
+        e = g.errors
+        loc = f"gears.{name}"
+        stated = e.grade if e.grade is not None and 1 <= e.grade <= 11 else None
+        for field, value, kind, what in (
+                ("eccentricity", 2 * e.eccentricity, "runout", "a runout of"),
+                ("installation", 2 * e.installation, "runout", "as a runout:"),
+                ("bearing_runout", e.bearing_runout, "runout", ""),
+                ("pitch", e.pitch, "pitch", "")):
+            if not value > 0:
+                continue
+            try:
+                tol = (grades.runout_tolerance if kind == "runout"
+                       else grades.single_pitch_tolerance)
+                coarsest = tol(11, g.module, d)
+                own = tol(stated, g.module, d) if stated else None
+            except ModelError:
+                continue  # outside the standard's scope: the size checks apply
+            name_tol = "runout tolerance F_rT" if kind == "runout" else                 "single pitch tolerance f_pT"
+            size = (f"{_length_text(value / 2)} ({what} {_length_text(value)})" if what
+                    else _length_text(value))
+            where = f"d = {d * 1e3:.4g} mm, m_n = {g.module * 1e3:.4g} mm"
+            if value > coarsest:
+                out.append((f"{loc}.errors.{field}", (
+                    f"{size} is beyond the ISO 1328-1 {name_tol} of the coarsest grade, "
+                    f"11 ({coarsest * 1e6:.4g} um for {where}); errors are microns: check "
+                    f"the value and its unit (a bare number is read in m)")))
+            elif own is not None and value > GRADE_MARGIN * own:
+                out.append((f"{loc}.errors.{field}", (
+                    f"{size} is more than one grade beyond the ISO 1328-1 {name_tol} of "
+                    f"grade {stated}, which errors.grade states ({own * 1e6:.4g} um for "
+                    f"{where}); correct the value or the grade")))
+        if g.support is not None and g.support.clearance > CLEARANCE_FRACTION * d:
+            out.append((f"{loc}.support.clearance", (
+                f"{g.support.clearance * 1e6:.4g} um is {g.support.clearance / d * 100:.2g} % "
+                f"of the pitch diameter ({d * 1e3:.4g} mm); bearing clearances are a few "
+                f"thousandths of the bore at most: check the value and its unit")))
+    for name, m in model.meshes.items():
+        mk = kin.meshes.get(name)
+        bl = m.backlash.nominal + m.backlash.tolerance
+        if mk is None or not bl > 0 or not (mk.center_distance and
+                                             math.isfinite(mk.center_distance)):
+            continue
+        mn = min(model.gears[x].module for x in m.gears)
+        j_min = 2 / 3 * (0.06 + 0.0005 * mk.center_distance * 1e3 + 0.03 * mn * 1e3) * 1e-3
+        if bl > BACKLASH_RATIO * j_min:
+            out.append((f"meshes.{name}.backlash", (
+                f"{bl * 1e6:.4g} um is {bl / j_min:.3g} times the minimum backlash of ISO/TR "
+                f"10064-2 for this mesh ({j_min * 1e6:.3g} um at a = "
+                f"{mk.center_distance * 1e3:.4g} mm, m_n = {mn * 1e3:.4g} mm); backlash is "
+                f"tens to hundreds of microns: check the value and its unit")))
+    return out
 
 
 #: a length more than this many times the largest gear (or less than its inverse) is
 #: flagged as a probable unit mistake
 SIZE_RATIO = 100.0
 #: a given mass or polar inertia outside [1/r, r] times the gear's solid-disc value (an
-#: inertia may include the gear's shaft: seed 002's pinion has 22 times its disc's)
+#: inertia may include the gear's shaft: Dong et al. 2021's pinion has 22 times its disc's)
 INERTIA_RATIO = 100.0
 #: pitch-line speed beyond which gears do not run [m/s] (turbine gears reach ~200)
 MAX_PITCH_SPEED = 500.0
@@ -405,20 +552,21 @@ def magnitude_warnings(model: Model, kin) -> list[tuple[str, str]]:
         ratio = abs(value) / size
         if ratio > SIZE_RATIO or (small and ratio < 1 / (100 * SIZE_RATIO)):
             out.append((loc, f"{abs(value):.4g} m is {ratio:.3g} times {size_text}; check the "
-                             f"value and its unit"))
+                             f"value and its unit (a bare number is read in m)"))
 
     def against_module(loc, value, module, what):
         if value and math.isfinite(value) and abs(value) > module:
-            out.append((loc, f"{abs(value) * 1e6:.4g} um is larger than the module "
+            out.append((loc, f"{_length_text(abs(value))} is larger than the module "
                              f"({module * 1e3:.4g} mm); {what} are microns: check the value "
-                             f"and its unit"))
+                             f"and its unit (a bare number is read in m: write '20 um')"))
 
     for name, g in model.gears.items():
         loc = f"gears.{name}"
         if g.module > 0.1 or g.module < 5e-5:
             out.append((f"{loc}.module", f"{g.module * 1e3:.4g} mm is outside the modules "
                                          f"gears are made with (0.05-100 mm); check the value "
-                                         f"and its unit"))
+                                         f"and its unit (a bare number is read in m: "
+                                         f"module = 3 means 3 m; write '3 mm')"))
         d = diameters.get(name)
         if d and g.face_width > 10 * d:
             out.append((f"{loc}.face_width", f"{g.face_width * 1e3:.4g} mm is "
@@ -486,6 +634,15 @@ def magnitude_warnings(model: Model, kin) -> list[tuple[str, str]]:
                 f"{sp.radial_clearance * 1e3:.4g} mm is larger than the pitch radius "
                 f"({sp.pitch_radius * 1e3:.4g} mm); check the value and its unit")))
     return out
+
+
+def _length_text(value: float) -> str:
+    """A length for a message in the unit that reads best (um, mm or m)."""
+    if value >= 1.0:
+        return f"{value:.4g} m"
+    if value >= 1e-3:
+        return f"{value * 1e3:.4g} mm"
+    return f"{value * 1e6:.4g} um"
 
 
 def _disc_mass_inertia(gear, d: float) -> tuple[float, float]:

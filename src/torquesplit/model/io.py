@@ -28,7 +28,7 @@ def load_model(source, *, check: bool = True) -> Model:
     Examples
     --------
     >>> import torquesplit
-    >>> m = torquesplit.load_model(torquesplit.example_path("seed001_mill_drive"))
+    >>> m = torquesplit.load_model(torquesplit.example_path("ji_li_mill_drive"))
     >>> m.gears["z1"].teeth
     19
     """

@@ -264,7 +264,7 @@ def solve_kinematics(model: Model) -> Kinematics:
         ja, jb = (sum(bodies[b].polar_inertia for b in bodies if groups[b] == groups[g])
                   for g in (driver, driven))
         # equivalent mass of the mesh, m = J1 J2 / (J1 r2^2 + J2 r1^2), with the arms
-        # as the effective base radii (issue 2; seed 001 eq. 1 corrected)
+        # as the effective base radii (Ji & Li eq. 1 corrected)
         den = ja * arm_n**2 + jb * arm_d**2
         m_eq = ja * jb / den if den > 0 else 0.0
         spec = mesh.stiffness
@@ -314,7 +314,7 @@ share one 'loa' translation."""
 def _translation_axes(model: Model, bodies, meshes, issues) -> dict[str, dict[str, np.ndarray]]:
     """Unit direction of every translational DOF of every body.
 
-    x, y, z are the global axes.  'loa' (seed 001 eq. 9: one translation X_i per gear
+    x, y, z are the global axes.  'loa' (Ji & Li eq. 9: one translation X_i per gear
     "along the tangent of the meshing pair") is the line of action of the gear's meshes
     projected on its transverse plane; every mesh of the gear must have that direction
     (up to sign: e.g. two branches at 180 deg about an input pinion), else the gear
@@ -444,6 +444,7 @@ def _layout(model: Model, issues) -> tuple[dict, dict, list[str]]:
                     except ValueError as exc:
                         issues.append((f"gears.{name}.place", str(exc)))
                         positions[name] = positions[ref].copy()
+                    computed.append(name)  # placed: computed from the mating gear
                     pending.remove(name)
                     progress = True
                 continue

@@ -73,7 +73,7 @@ def read_model_file(path) -> dict[str, Any]:
     --------
     >>> import torquesplit
     >>> from torquesplit.model.reader import read_model_file
-    >>> data = read_model_file(torquesplit.example_path("seed001_mill_drive"))
+    >>> data = read_model_file(torquesplit.example_path("ji_li_mill_drive"))
     >>> sorted(data)[:3]
     ['analysis', 'bodies', 'drives']
     """

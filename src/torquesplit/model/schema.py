@@ -81,7 +81,7 @@ Viscosity = Q("viscosity")
 Dof = Literal["x", "y", "z", "loa", "theta"]
 """Body DOFs: translations along the global x, y, z; 'loa' a single translation along
 the (transverse) line of action of the gear's meshes, as in lumped torsion-translation
-models (seed 001 eq. 9); 'theta' the rotation about the body's axis."""
+models (Ji & Li eq. 9); 'theta' the rotation about the body's axis."""
 
 
 class Strict(BaseModel):
@@ -108,7 +108,7 @@ from .schema_modifications import LtcaSpec, MisalignmentSpec, ModificationsSpec 
 
 # --------------------------------------------------------------------------- supports
 class ShaftBending(Strict):
-    """Lateral stiffness of a gear on a simply supported shaft (seed 001 eqs. 5-7, 10)."""
+    """Lateral stiffness of a gear on a simply supported shaft (Ji & Li eqs. 5-7, 10)."""
 
     diameter: Length = Field(gt=0, description="Shaft diameter at the gear.")
     span: Length = Field(gt=0, description="Distance between the two bearings.")
@@ -187,14 +187,14 @@ class Support(Strict):
         None, gt=0, description="Axial stiffness (z); defaults to the radial stiffness."
     )
     shaft: ShaftBending | None = Field(
-        None, description="Compute the radial stiffness from the shaft instead (seed 001)."
+        None, description="Compute the radial stiffness from the shaft instead (Ji & Li)."
     )
     damping: Damping | None = Field(None, ge=0, description="Viscous damping of the support.")
     damping_ratio: Number | None = Field(
         None, ge=0, description="Damping as a fraction of critical, c = 2 zeta sqrt(k m)."
     )
     clearance: Length = Field(
-        0.0, ge=0, description="Radial clearance (dead zone, seed 002 eq. 7); 0 = none."
+        0.0, ge=0, description="Radial clearance (dead zone, Dong et al. 2021 eq. 7); 0 = none."
     )
     on: str | None = Field(
         None, description="Body the bearing sits on (its translations carry the bearing's "
@@ -224,15 +224,15 @@ class Support(Strict):
 
 # --------------------------------------------------------------------------- errors
 class GearErrors(Strict):
-    """Manufacturing and assembly errors of one gear (seed 000 eqs. 1-2, seed 002 eq. 11)."""
+    """Manufacturing and assembly errors of one gear (Liu et al. 2021 eqs. 1-2, Dong et al. 2021 eq. 11)."""
 
     eccentricity: Length = Field(0.0, ge=0, description="Eccentricity amplitude (rotates with the gear).")
     eccentricity_phase: Angle = Field(0.0, description="Angular position of the eccentricity at t = 0.")
     installation: Length = Field(0.0, ge=0, description="Installation (mounting) error amplitude.")
     installation_phase: Angle = Field(0.0, description="Direction of the installation error.")
-    tooth_thickness: Length = Field(0.0, description="Tooth thickness error (seed 004 §4).")
-    pitch: Length = Field(0.0, ge=0, description="Single pitch error amplitude (seed 004 §4).")
-    bearing_runout: Length = Field(0.0, ge=0, description="Bearing run-out amplitude (seed 004 §4).")
+    tooth_thickness: Length = Field(0.0, description="Tooth thickness error (Mo et al. 2017 §4).")
+    pitch: Length = Field(0.0, ge=0, description="Single pitch error amplitude (Mo et al. 2017 §4).")
+    bearing_runout: Length = Field(0.0, ge=0, description="Bearing run-out amplitude (Mo et al. 2017 §4).")
     bearing_runout_phase: Angle = Field(0.0, description="Phase of the bearing run-out.")
     grade: Count | None = Field(
         None, ge=1, le=12, description="ISO 1328-1 accuracy grade, used for tolerance sampling."
@@ -285,7 +285,7 @@ class Gear(Strict):
     dofs: list[Dof] = Field(["theta"], description=(
         "Degrees of freedom: 'theta' rotation; 'x', 'y', 'z' translations along the global "
         "axes; or 'loa', one translation along the line of action of the gear's meshes "
-        "(seed 001 eq. 9; its meshes must push it along parallel lines)."))
+        "(Ji & Li eq. 9; its meshes must push it along parallel lines)."))
     support: Support | None = Field(None, description="Support of the translational DOFs.")
     torsional_support: TorsionalSupport | None = Field(
         None, description="Holds the gear against rotation (a fixed ring or sun gear): "
@@ -334,7 +334,7 @@ class Body(Strict):
     dofs: list[Dof] = Field(["theta"], description=(
         "Degrees of freedom: 'theta' rotation; 'x', 'y', 'z' translations along the global "
         "axes; or 'loa', one translation along the line of action of the gear's meshes "
-        "(seed 001 eq. 9; its meshes must push it along parallel lines)."))
+        "(Ji & Li eq. 9; its meshes must push it along parallel lines)."))
     support: Support | None = Field(None, description="Support of the translational DOFs.")
     torsional_support: TorsionalSupport | None = Field(
         None, description="Holds the body against rotation (the fixed carrier of a star "
@@ -382,7 +382,7 @@ class Shaft(Strict):
     torsional_stiffness: TorsionalStiffness | None = Field(
         None, gt=0, description="Torsional stiffness; or give diameter and length."
     )
-    diameter: Length | None = Field(None, gt=0, description="Outer diameter (seed 001 eq. 3).")
+    diameter: Length | None = Field(None, gt=0, description="Outer diameter (Ji & Li eq. 3).")
     inner_diameter: Length = Field(0.0, ge=0, description="Bore of a hollow shaft.")
     length: Length | None = Field(None, gt=0, description="Length between the two bodies.")
     shear_modulus: Pressure = Field(79.3e9, gt=0, description="Shear modulus of the shaft.")
@@ -457,7 +457,7 @@ class StiffnessSpec(Strict):
 
 
 class BacklashSpec(Strict):
-    """Backlash: constant, or random per engagement (seed 001 eq. 14)."""
+    """Backlash: constant, or random per engagement (Ji & Li eq. 14)."""
 
     nominal: Length = Field(ge=0, description="Total (circumferential-normal) backlash 2b.")
     tolerance: Length = Field(0.0, ge=0, description="Half-width of the tolerance band.")
@@ -476,10 +476,10 @@ class TransmissionErrorSpec(Strict):
 
 
 class FrictionSpec(Strict):
-    """Sliding friction between the teeth (seed 003 eqs. 6, 14-18)."""
+    """Sliding friction between the teeth (Jin et al. 2019 eqs. 6, 14-18)."""
 
     model: Literal["xu2007", "constant"] = Field(
-        "xu2007", description="Friction coefficient: EHL regression of Xu et al. (2007, seed 003 "
+        "xu2007", description="Friction coefficient: EHL regression of Xu et al. (2007, Jin et al. 2019 "
         "eq. 6) or a constant.")
     coefficient: Number = Field(0.05, ge=0, le=1, description="Constant friction coefficient.")
     roughness: Length = Field(0.3e-6, gt=0, description="Composite RMS surface roughness S.")
@@ -542,15 +542,15 @@ class Mesh(Strict):
     phase: Number | None = Field(None, description="Mesh phase at t = 0 in cycles (overrides clocking).")
     stage: str | None = Field(None, description="Stage label for load-sharing groups.")
     path: str | None = Field(
-        None, description="Input-path label: the power source a mesh belongs to (seed 000: "
+        None, description="Input-path label: the power source a mesh belongs to (Liu et al. 2021: "
         "left/right engine).  Meshes of one stage share load within a path; do not use it to "
         "name the parallel branches of a split.")
     shaft_angle: Angle | None = Field(None, description="Angle between the axes (bevel/face).")
-    impact: Flag = Field(False, description="Add meshing-in impact (seed 000 eqs. 6-10).")
+    impact: Flag = Field(False, description="Add meshing-in impact (Liu et al. 2021 eqs. 6-10).")
     misalignment: MisalignmentSpec = Field(MisalignmentSpec(), description="Misalignment and "
                                            "base pitch deviation (stiffness method 'ltca').")
     friction: Annotated[FrictionSpec | None, BeforeValidator(_friction_shorthand)] = Field(
-        None, description="Tooth friction (seed 003): true for the defaults, or a [friction] "
+        None, description="Tooth friction (Jin et al. 2019): true for the defaults, or a [friction] "
         "table; omitted or false = none.")
 
     @model_validator(mode="after")
@@ -567,7 +567,7 @@ class Mesh(Strict):
 
 
 class Spline(Strict):
-    """A member floating on a spline: radial clearance and friction (seed 002 eq. 6)."""
+    """A member floating on a spline: radial clearance and friction (Dong et al. 2021 eq. 6)."""
 
     connects: tuple[str, str] = Field(description="The hub body and the floating body.")
     radial_clearance: Length = Field(ge=0, description="Radial clearance of the spline.")
@@ -577,7 +577,7 @@ class Spline(Strict):
                                  "closes (and below the stick limit).")
     damping: Damping = Field(0.0, ge=0, description="Radial damping c_w while in contact.")
     stick_limit: Length = Field(0.0, ge=0, description="Radial displacement S_1 below which "
-                                "the spline sticks (seed 002 eq. 6; 0 = slides at once).")
+                                "the spline sticks (Dong et al. 2021 eq. 6; 0 = slides at once).")
     torsional_stiffness: TorsionalStiffness = Field(gt=0, description="Torsional stiffness of the spline.")
 
     @model_validator(mode="after")
@@ -642,8 +642,13 @@ class Analysis(Strict):
     spline_velocity_scale: Number = Field(
         1e-3, gt=0, description="Radial sliding speed [m/s] over which spline friction "
         "reaches its Coulomb value (regularisation of sgn; smaller is stiffer to integrate).")
-    load_sharing: Literal["cycle_peak", "engineering", "mean_force", "static_torque"] = Field(
-        "cycle_peak", description="Default load-sharing definition reported by 'run'."
+    load_sharing: Literal["mean_force", "cycle_peak", "engineering", "instantaneous",
+                          "static_torque"] = Field(
+        "mean_force", description="Load-sharing definition 'run' reports: 'mean_force' "
+        "(ratio of mean forces, the mesh load factor K_gamma of ISO 6336-1 and AGMA 6123; "
+        "the default), 'cycle_peak' (Liu et al. 2021), 'engineering' or 'instantaneous' "
+        "(Ji & Li), 'static_torque' (quasi-static, Mo et al. 2017: 'torquesplit static'; "
+        "'run' then reports 'mean_force')."
     )
 
 

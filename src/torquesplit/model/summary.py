@@ -70,29 +70,35 @@ def _num(x):
 
 
 def render_summary(s: dict, console) -> None:
-    """Print the summary as rich tables."""
+    """Print the summary as rich tables (units in every header)."""
+    from rich.markup import escape
     from rich.table import Table
 
-    console.print(f"[bold]{s['model']}[/]  {s['description']}")
+    console.print(f"[bold]{escape(s['model'])}[/]  {escape(s['description'])}")
     if s["reference"]:
-        console.print(f"[dim]{s['reference']}[/]")
+        console.print(f"[dim]{escape(s['reference'])}[/]")
     console.print(
         f"input {s['input_power_kW']:.6g} kW, output {s['output_power_kW']:.6g} kW, "
-        f"balance {s['power_balance']:.2e}")
-    t = Table(title="bodies")
-    for col in ("body", "speed [rpm]", "torque [N m]", "mass [kg]", "J [kg m^2]"):
-        t.add_column(col, justify="right" if col != "body" else "left")
+        f"balance {s['power_balance']:.2e}", highlight=False)
+    t = Table(title="bodies ((computed): from the gear's geometry; (placed): from its mates)")
+    for col in ("body", "speed [rpm]", "torque [N m]", "mass [kg]", "J [kg m²]",
+                "position [mm]"):
+        t.add_column(escape(col), justify="right" if col not in ("body", "position [mm]")
+                     else "left")
     for name, b in s["bodies"].items():
         mark = lambda flag: " (computed)" if flag else ""  # noqa: E731
+        pos = "(" + ", ".join(f"{round(v, 4) + 0.0:.6g}" for v in b["position_mm"]) + ")"
         t.add_row(name, f"{b['speed_rpm']:.6g}", f"{b['torque_Nm']:.6g}",
                   f"{b['mass_kg']:.5g}{mark(b['mass_computed'])}",
-                  f"{b['polar_inertia_kgm2']:.5g}{mark(b['inertia_computed'])}")
+                  f"{b['polar_inertia_kgm2']:.5g}{mark(b['inertia_computed'])}",
+                  pos + (" (placed)" if b["position_computed"] else ""))
     console.print(t)
-    t = Table(title="meshes")
+    t = Table(title="meshes (eps: transverse, overlap and total contact ratios; LOA n: unit "
+                    "line of action)")
     for col in ("mesh", "driver->driven", "stage", "f_mesh [Hz]", "r_b [mm]", "eps_a", "eps_b",
-                "eps_g", "LOA n", "T_driver [N m]", "F_n [N]"):
-        t.add_column(col, justify="left" if col in ("mesh", "driver->driven", "stage", "LOA n")
-                     else "right")
+                "eps_g", "LOA n", "T_driver [N m]", "F_n [kN]"):
+        t.add_column(escape(col), justify="left" if col in ("mesh", "driver->driven", "stage",
+                                                            "LOA n") else "right")
     for name, m in s["meshes"].items():
         fmt = lambda x: "-" if x is None else f"{x:.4f}"  # noqa: E731
         t.add_row(name, f"{m['driver']}->{m['driven']}", m["stage"], f"{m['frequency_Hz']:.6g}",
@@ -100,5 +106,5 @@ def render_summary(s: dict, console) -> None:
                   fmt(m["transverse_contact_ratio"]), fmt(m["overlap_contact_ratio"]),
                   fmt(m["total_contact_ratio"]),
                   "(" + ", ".join(f"{v:+.3f}" for v in m["line_of_action"]) + ")",
-                  f"{m['torque_driver_Nm']:.6g}", f"{m['tooth_force_N']:.6g}")
+                  f"{m['torque_driver_Nm']:.6g}", f"{m['tooth_force_N'] / 1e3:.5g}")
     console.print(t)

@@ -32,7 +32,7 @@ function                        shows                                           
 ``orbit_figure``                x-y orbit of floating bodies, equal aspect       both
 ``mesh_stiffness_figure``       mesh stiffness over two mesh cycles, phasing     both
 ``static_mesh_force_figure``    quasi-static mesh force vs rotation              static
-``static_load_sharing_figure``  static torque ratio vs rotation (seed 004)       static
+``static_load_sharing_figure``  static torque ratio vs rotation (Mo et al. 2017)       static
 ==============================  ===============================================  ==========
 
 Units on the axes: forces kN (spectrum amplitudes N), time s or ms (runs shorter than
@@ -43,7 +43,7 @@ Examples
 --------
 >>> import tempfile, torquesplit
 >>> from torquesplit.plot import write_figures
->>> res = torquesplit.simulate(torquesplit.example_path("seed001_mill_drive"), cycles=20)
+>>> res = torquesplit.simulate(torquesplit.example_path("ji_li_mill_drive"), cycles=20)
 >>> paths = write_figures(res, tempfile.mkdtemp(), formats=("png", "svg"))
 """
 

@@ -14,32 +14,33 @@ Examples
 --------
 >>> import tempfile, torquesplit
 >>> from torquesplit.plot import figures
->>> res = torquesplit.simulate(torquesplit.example_path("seed001_mill_drive"), cycles=20)
+>>> res = torquesplit.simulate(torquesplit.example_path("ji_li_mill_drive"), cycles=20)
 >>> fig = figures.mesh_force_figure(res)
 >>> fig.axes[0].get_ylabel()
 'mesh force [kN]'
 >>> paths = figures.write_figures(res, tempfile.mkdtemp(), formats=("png",))
->>> sorted(p.name for p in paths)[:2]
-['cycle_peak_force.png', 'load_sharing_engineering.png']
+>>> sorted(p.name for p in paths)[:3]
+['cycle_peak_force.png', 'dynamic_factors.png', 'load_sharing_engineering.png']
 """
 
 from __future__ import annotations
 
 import logging
 import math
+import warnings
 from pathlib import Path
-from typing import Iterable
+from typing import Callable, Iterable
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
-from matplotlib.ticker import NullFormatter
+from matplotlib.ticker import NullLocator
 
 from ..errors import FigureNotApplicableError, TorquesplitError  # noqa: F401 - re-exported
 
 __all__ = [
-    "FigureNotApplicableError",
-    "mesh_force_figure", "cycle_peak_figure", "load_sharing_figure",
+    "FigureNotApplicableError", "figure_jobs", "write_jobs", "figure_svg",
+    "mesh_force_figure", "cycle_peak_figure", "load_sharing_figure", "dynamic_factor_figure",
     "support_spectrum_figure", "orbit_figure", "mesh_stiffness_figure",
     "static_mesh_force_figure", "static_load_sharing_figure",
     "write_figures", "write_static_figures",
@@ -53,6 +54,10 @@ FONT = {"suptitle": 13, "title": 11, "label": 10.5, "tick": 9.5, "legend": 9}
 WIDTH, ROW_HEIGHT = 9.0, 2.9
 #: colour of the nominal (equal-split static) force and of reported coefficients
 REFERENCE_COLOR = "0.15"
+#: a per-cycle series longer than this is drawn as ranges over runs of cycles
+DENSE_CYCLES = 400
+#: number of runs of cycles (bins) of a dense series
+DENSE_BINS = 300
 
 _KN = 1e-3  # N -> kN
 _UM = 1e6  # m -> um
@@ -76,7 +81,7 @@ _REPORTED_TEXT = {
 
 # ============================================================ dynamic run figures
 def mesh_force_figure(results, *, last_cycles: float | None = None,
-                      band_above: float = 150.0, bins: int = 800) -> Figure:
+                      band_above: float = 150.0, bins: int = 400) -> Figure:
     """Mesh force against time, one panel per load-sharing group, the paths overlaid.
 
     Parameters
@@ -128,10 +133,11 @@ def mesh_force_figure(results, *, last_cycles: float | None = None,
             y = forces[keep, names.index(m)] * _KN
             if band:
                 tb, lo, hi = _bin_extremes(tk, y, bin_index)
-                ax.fill_between(tb * scale, lo, hi, color=style["color"], alpha=0.2, lw=0,
+                # light fill, edges in the mesh's own dash: overlapping bands stay apart
+                ax.fill_between(tb * scale, lo, hi, color=style["color"], alpha=0.12, lw=0,
                                 label=f"{m} (min-max band)")
-                ax.plot(tb * scale, hi, color=style["color"], lw=0.9)
-                ax.plot(tb * scale, lo, color=style["color"], lw=0.9)
+                ax.plot(tb * scale, hi, color=style["color"], lw=1.1, ls=style["ls"])
+                ax.plot(tb * scale, lo, color=style["color"], lw=1.1, ls=style["ls"])
             else:
                 ax.plot(tk * scale, y, label=m, **style)
         _nominal_lines(ax, [nominal[m] for m in members])
@@ -145,25 +151,31 @@ def mesh_force_figure(results, *, last_cycles: float | None = None,
     return fig
 
 
-def cycle_peak_figure(results) -> Figure:
-    """Peak mesh force of every mesh cycle against the cycle's start time.
+def cycle_peak_figure(results, *, dense_above: int = DENSE_CYCLES) -> Figure:
+    """Peak mesh force of every complete mesh cycle against the cycle's start time.
 
     One panel per load-sharing group; the nominal static force is dashed, the start of
     the settled part (the settle criterion of :meth:`Results.metrics`, which works on
-    these peaks) is the dotted vertical line and the transient before it is shaded.
+    these peaks) is the dotted vertical line and the transient before it is shaded.  The
+    cycle cut off by the end of the run is not drawn (its peak is that of part of a
+    cycle).  More than ``dense_above`` cycles are drawn as the range of the peaks over
+    runs of cycles with their mean (:func:`_dense_line`).
     """
     s = results.solution
     groups = results.groups
     nominal = results.nominal_forces()
     settle = results.metrics().settling.start_time
+    peaks = results.complete_cycle_statistics()[0]
+    col = {m: j for j, m in enumerate(results.mesh_names)}
     cols = _cycle_columns(results)
     fig, axes = _panels(len(groups), sharex=True)
     scale, unit = _time_unit(s.history_t if s.history_t.size else s.cycle_start.ravel())
     for ax, (g, members) in zip(axes, groups.items()):
         for i, m in enumerate(members):
-            start, peak = s.cycle_start[:, cols[m]], _finite(s.cycle_max[:, cols[m]])
+            start, peak = s.cycle_start[:, cols[m]], _finite(peaks[:, col[m]])
             ok = np.isfinite(peak)
-            ax.plot(start[ok] * scale, peak[ok] * _KN, label=m, **_line_style(i, len(members)))
+            _dense_line(ax, start[ok] * scale, peak[ok] * _KN, m,
+                        _line_style(i, len(members)), dense_above)
         _nominal_lines(ax, [nominal[m] for m in members])
         _mark_settled(ax, settle * scale, s.t_span[0] * scale, unit)
         ax.set_title(_group_label(g, members), fontsize=FONT["title"])
@@ -173,7 +185,8 @@ def cycle_peak_figure(results) -> Figure:
     return fig
 
 
-def load_sharing_figure(results, definition: str | None = None) -> Figure:
+def load_sharing_figure(results, definition: str | None = None, *,
+                        dense_above: int = DENSE_CYCLES, zoom_cycles: int = 40) -> Figure:
     """Load-sharing coefficient of each mesh cycle against time, by ``definition``.
 
     Parameters
@@ -186,6 +199,11 @@ def load_sharing_figure(results, definition: str | None = None) -> Figure:
         peak or mean forces; the sample-based definitions (``instantaneous``,
         ``engineering``, ``static_torque``) show the peak in each mesh cycle of the
         instantaneous coefficient.
+
+    dense_above : int
+        A run of more cycles than this is drawn in two columns: the whole run as the
+        range of the coefficient over runs of cycles with its mean, and the last
+        ``zoom_cycles`` cycles one by one.
 
     Returns
     -------
@@ -206,31 +224,101 @@ def load_sharing_figure(results, definition: str | None = None) -> Figure:
     settle = met.settling.start_time
     # the metric's own per-cycle data: the figure shows what the number is made of
     cycle_t, coef = met.load_sharing.cycle_time, met.load_sharing.per_cycle
-    fig, axes = _panels(len(groups), sharex=True)
+    dense = any(np.isfinite(coef[m]).sum() > dense_above for ms in groups.values()
+                for m in ms)
+    if dense:  # whole run as ranges (left), the last cycles one by one (right)
+        fig = _figure(WIDTH * 1.45, ROW_HEIGHT * len(groups) + 0.9)
+        grid = fig.subplots(len(groups), 2, squeeze=False,
+                            gridspec_kw={"width_ratios": [2.2, 1.0]})
+        axes, zooms = list(grid[:, 0]), list(grid[:, 1])
+    else:
+        fig, axes = _panels(len(groups), sharex=True)
+        zooms = [None] * len(groups)
     scale, unit = _time_unit(s.history_t if s.history_t.size else s.cycle_start.ravel())
-    for ax, (g, members) in zip(axes, groups.items()):
+    for ax, zoom, (g, members) in zip(axes, zooms, groups.items()):
+        reported = met.load_sharing.per_group[g]
+        per = 1
         for i, m in enumerate(members):
-            ax.plot(cycle_t[m] * scale, coef[m], label=m, **_line_style(i, len(members)))
-        ax.axhline(1.0, color="0.6", lw=0.8)
-        ax.axhline(met.load_sharing.per_group[g], color=REFERENCE_COLOR, ls="--", lw=1.2,
-                   label=f"reported {met.load_sharing.per_group[g]:.6g}\n"
-                         f"({_REPORTED_TEXT[definition]})")
+            style = _line_style(i, len(members))
+            ok = np.isfinite(coef[m])
+            if zoom is None:
+                ax.plot(cycle_t[m] * scale, coef[m], label=m, **style)
+                continue
+            per = _dense_line(ax, cycle_t[m][ok] * scale, coef[m][ok], m, style, 0)
+            last = np.flatnonzero(ok)[-zoom_cycles:]
+            zoom.plot(cycle_t[m][last] * scale, coef[m][last], label=m, marker=".",
+                      ms=4, **style)
+        for a in (ax, zoom) if zoom is not None else (ax,):
+            a.axhline(1.0, color="0.6", lw=0.8)
+            a.axhline(reported, color=REFERENCE_COLOR, ls="--", lw=1.2,
+                      label=f"reported {reported:.6g}\n({_REPORTED_TEXT[definition]})")
         # the group's own settle time: its coefficients start there
         _mark_settled(ax, met.settling.group_time.get(g, settle) * scale,
                       s.t_span[0] * scale, unit)
-        ax.set_title(_group_label(g, members), fontsize=FONT["title"])
+        whole = (f", whole run: mean of {per} cycles, band their range" if per > 1
+                 else ", whole run")
+        ax.set_title(_group_label(g, members) + (whole if zoom is not None else ""),
+                     fontsize=FONT["title"])
         _label(ax, f"time [{unit}]", "load-sharing coefficient [-]")
-        _legend(ax)
+        if zoom is None:
+            _legend(ax)
+            continue
+        zoom.set_title(f"last {zoom_cycles} cycles, one by one", fontsize=FONT["title"])
+        _label(zoom, f"time [{unit}]", "load-sharing coefficient [-]")
+        zoom.set_ylim(ax.get_ylim())
+        _legend(zoom)
     _suptitle(fig, results, f"load-sharing coefficient, definition '{definition}'\n"
                             f"{_DEFINITION_TEXT[definition]}")
+    return fig
+
+
+def dynamic_factor_figure(results, definition: str | None = None, *,
+                          resonance: float | None = None) -> Figure:
+    """Dynamic factor and peak / nominal force of every mesh, as bars by group.
+
+    The dynamic factor (settled peak / the mesh's own static force, the K_v sense) and
+    peak / nominal (settled peak / equal-split nominal force: load sharing and dynamics
+    together, Ji & Li eq. 19) come from ``results.metrics(definition).rows``; the grey
+    line is 1, the red dotted line the factor above which a run is reported as near a
+    resonance (:data:`torquesplit.results.plausibility.RESONANCE_FACTOR`).
+    """
+    from ..results.plausibility import RESONANCE_FACTOR
+
+    met = results.metrics(definition)
+    limit = RESONANCE_FACTOR if resonance is None else resonance
+    rows = met.rows
+    order = [r for g in met.load_sharing.groups for r in rows if r.group == g]
+    fig = _figure(WIDTH, 3.4 + 0.12 * len(order))
+    ax = fig.add_subplot()
+    x = np.arange(len(order))
+    dyn = np.array([r.dynamic_factor for r in order], float)
+    ptn = np.array([r.peak_to_nominal for r in order], float)
+    ax.bar(x - 0.2, np.nan_to_num(dyn), 0.4, color=_color(0),
+           label="dynamic factor\n(peak / own static force)")
+    ax.bar(x + 0.2, np.nan_to_num(ptn), 0.4, color=_color(1),
+           label="peak / nominal\n(peak / equal-split force)")
+    ax.axhline(1.0, color="0.5", lw=0.9)
+    top = float(np.nanmax(np.concatenate([dyn, ptn, [1.0]])))
+    if top > 0.6 * limit:
+        ax.axhline(limit, color="tab:red", ls=":", lw=1.3,
+                   label=f"{limit:g}: near a resonance\n(see torquesplit modes)")
+    ax.set_xticks(x, [f"{r.mesh}\n{r.group}" for r in order], rotation=0 if len(order) <= 6
+                  else 60, ha="center" if len(order) <= 6 else "right")
+    ax.set_xlim(-0.6, len(order) - 0.4)
+    ax.set_ylim(0, max(1.15 * top, 1.2))
+    ax.set_title("per mesh, over the settled part", fontsize=FONT["title"])
+    _label(ax, "mesh and group [-]", "factor [-]")
+    _legend(ax)
+    _suptitle(fig, results, "dynamic factors")
     return fig
 
 
 def support_spectrum_figure(results, *, start_time: float | None = None, orders: int = 4,
                             max_frequency: float | None = None, log: bool = True,
                             dynamic_range: float = 1e-4,
-                            bodies: Iterable[str] | None = None) -> Figure:
-    """Amplitude spectrum of each support (bearing) force history, mesh orders marked.
+                            bodies: Iterable[str] | None = None, max_panels: int = 4,
+                            content_range: float = 1e-2, max_points: int = 3000) -> Figure:
+    """Amplitude spectrum of the support (bearing) force histories, mesh orders marked.
 
     Parameters
     ----------
@@ -240,18 +328,28 @@ def support_spectrum_figure(results, *, start_time: float | None = None, orders:
         Analyse the history from this time [s]; default the settled start of
         ``results.metrics()`` (the transient would smear the spectrum).
     orders : int
-        Number of harmonics of each mesh frequency to mark (and, without
-        ``max_frequency``, the range shown: up to ``orders + 0.5`` times the highest mesh
-        frequency, at most the Nyquist frequency).
+        Number of harmonics of each mesh frequency to mark.
     max_frequency : float, optional
-        Upper end of the frequency axis [Hz].
+        Upper end of the frequency axis [Hz].  Default: the band that holds the content,
+        up to a little above the highest line stronger than ``content_range`` times the
+        largest (at most ``orders + 0.5`` times the highest mesh frequency and the Nyquist
+        frequency).
     log : bool
         Logarithmic amplitude axis spanning ``dynamic_range`` below the largest line
         (mesh orders usually sit far below the shaft-rate lines of eccentricities).
     dynamic_range : float
         Smallest amplitude shown on a log axis, relative to the largest.
     bodies : iterable of str, optional
-        Supported bodies to show (default all), one panel each.
+        Supported bodies to show, one panel each.  Default: the ``max_panels`` bodies
+        with the strongest dynamic support force; the title names how many more there
+        are (``bodies=`` shows any of them).
+    max_panels : int
+        Largest number of panels drawn by default.
+    content_range : float
+        Lines weaker than this fraction of the largest do not widen the band shown.
+    max_points : int
+        A panel's spectrum is reduced to about this many points by keeping the largest
+        amplitude of each run of frequency bins (every line keeps its height).
 
     Returns
     -------
@@ -268,7 +366,8 @@ def support_spectrum_figure(results, *, start_time: float | None = None, orders:
         if ".support." in el[e]:
             body, direction = el[e].split(".support.", 1)
             supports.setdefault(body, []).append((direction, col))
-    if bodies is not None:
+    chosen = bodies is not None
+    if chosen:
         wanted = list(bodies)
         unknown = [b for b in wanted if b not in supports]
         if unknown:
@@ -303,38 +402,61 @@ def support_spectrum_figure(results, *, start_time: float | None = None, orders:
         tk = t[keep]
     freq = np.fft.rfftfreq(grid.size, dt)
     window = np.hanning(grid.size)
-    f_top = max_frequency or min(freq[-1], (orders + 0.5) * max(mesh_f))
-    fscale, funit = (1e-3, "kHz") if f_top >= 1e4 else (1.0, "Hz")
-    show = freq <= f_top
-    ncols = 1 if len(supports) <= 3 else 2
-    fig, axes = _panels(len(supports), ncols=ncols, sharex=True, row_height=2.6)
-    for n_panel, (ax, (body, dirs)) in enumerate(zip(axes, supports.items())):
-        largest, size = 0.0, 0.0
-        lines = []
-        for i, (direction, col) in enumerate(dirs):
+    # every spectrum first: the band shown and the bodies drawn depend on all of them
+    spectra: dict[str, list] = {}
+    strength: dict[str, float] = {}
+    for body, dirs in supports.items():
+        lines, size = [], 0.0
+        for direction, col in dirs:
             x = _finite(s.history_forces[keep, col])
             if not uniform:
                 x = np.interp(grid, tk, x)
             mean = float(np.nanmean(x))
-            spec = np.fft.rfft(np.nan_to_num(x - mean) * window)
-            amp = 2.0 * np.abs(spec) / window.sum()
-            peak = int(np.argmax(np.where(show, amp, -1.0)))
-            lines.append((direction, mean, amp, peak))
-            largest = max(largest, float(amp[peak]))
+            amp = 2.0 * np.abs(np.fft.rfft(np.nan_to_num(x - mean) * window)) / window.sum()
+            amp[0] = 0.0
+            lines.append((direction, mean, amp))
             size = max(size, float(np.nanmax(np.abs(x))))
-        quiet = largest <= 1e-9 * max(size, 1.0)  # rounding noise only
+        spectra[body] = lines
+        strength[body] = max(float(a.max()) for _, _, a in lines)
+        if strength[body] <= 1e-9 * max(size, 1.0):
+            strength[body] = 0.0  # rounding noise only
+    f_cap = min(freq[-1], (orders + 0.5) * max(mesh_f))
+    if max_frequency:
+        f_top = min(float(max_frequency), freq[-1])
+    else:
+        largest = max(strength.values())
+        tops = [freq[np.flatnonzero(a > content_range * largest)[-1]]
+                for lines in spectra.values() for _, _, a in lines
+                if largest > 0 and (a > content_range * largest).any()]
+        content = max(tops) if tops else f_cap
+        f_top = min(f_cap, max(1.25 * content, 1.5 * min(mesh_f)))
+    shown = list(supports)
+    hidden: list[str] = []
+    if not chosen and len(shown) > max_panels:
+        shown = sorted(shown, key=lambda b: -strength[b])[:max_panels]
+        hidden = [b for b in supports if b not in shown]
+        shown = [b for b in supports if b in shown]  # model order
+    fscale, funit = (1e-3, "kHz") if f_top >= 1e4 else (1.0, "Hz")
+    show = freq <= f_top
+    ncols = 1 if len(shown) <= max(4, max_panels) else 2
+    fig, axes = _panels(len(shown), ncols=ncols, sharex=True, row_height=2.6)
+    for n_panel, (ax, body) in enumerate(zip(axes, shown)):
+        lines = spectra[body]
+        largest = max(float(a[show].max()) for _, _, a in lines)
+        quiet = strength[body] == 0.0
         floor = largest * dynamic_range
-        for i, (direction, mean, amp, peak) in enumerate(lines):
-            y = np.maximum(amp[show], 0.1 * floor) if log and not quiet else amp[show]
-            style = _spike_style(i, len(dirs))
-            ax.plot(freq[show] * fscale, y, zorder=3, gid=f"{body}.support.{direction}",
-                    **style)
+        for i, (direction, mean, amp) in enumerate(lines):
+            f_show, a_show = _peak_pool(freq[show], amp[show], max_points)
+            y = np.maximum(a_show, 0.1 * floor) if log and not quiet else a_show
+            style = _spike_style(i, len(lines))
+            ax.plot(f_show * fscale, y, zorder=3, gid=f"{body}.support.{direction}", **style)
+            peak = int(np.argmax(a_show))
             # the top of each strong line marked, so coinciding lines of x, y, z all show
             tops = _spectral_lines(y, 0.01 * largest) if not quiet else np.zeros(0, int)
-            ax.plot(freq[show][tops] * fscale, y[tops], ls="none", marker=_MARKERS[i % 3],
+            ax.plot(f_show[tops] * fscale, y[tops], ls="none", marker=_MARKERS[i % 3],
                     ms=5, mfc="none", mew=1.2, color=style["color"], zorder=4,
                     label=f"{direction}: mean {_force_text(mean)},\n"
-                          f"largest {_force_text(amp[peak])} at {_hz(freq[peak])}")
+                          f"largest {_force_text(a_show[peak])} at {_hz(f_show[peak])}")
         for j, (f, label) in enumerate(mesh_f.items()):
             for k in range(1, orders + 1):
                 if k * f <= f_top:
@@ -353,16 +475,31 @@ def support_spectrum_figure(results, *, start_time: float | None = None, orders:
         elif log:
             ax.set_yscale("log")
             ax.set_ylim(floor, 2.0 * largest)
-            ax.yaxis.set_minor_formatter(NullFormatter())  # decades only: readable, fast
+            ax.yaxis.set_minor_locator(NullLocator())  # decades only: readable, fast
         else:
             ax.set_ylim(0, 1.08 * largest)
         ax.set_title(f"support of {body}", fontsize=FONT["title"])
         _label(ax, f"frequency [{funit}]", "force amplitude [N]")
         _legend(ax)
     span = grid.size * dt
-    _suptitle(fig, results, f"support force spectrum, {grid[0]:.4g} s ≤ t < "
-                            f"{grid[0] + span:.4g} s (resolution {1 / span:.3g} Hz)")
+    more = (f"\n{len(hidden)} weaker supports not drawn: {', '.join(hidden)}"
+            if hidden else "")
+    _suptitle(fig, results, f"support force spectrum\n{grid[0]:.4g} s ≤ t < "
+                            f"{grid[0] + span:.4g} s, resolution {1 / span:.3g} Hz{more}")
     return fig
+
+
+def _peak_pool(freq: np.ndarray, amp: np.ndarray, max_points: int):
+    """At most about ``max_points`` points: the largest amplitude of each run of bins
+    (with its frequency), so that every spectral line keeps its height."""
+    if freq.size <= max_points:
+        return freq, amp
+    step = math.ceil(freq.size / max_points)
+    n = freq.size // step * step
+    blocks = amp[:n].reshape(-1, step)
+    k = blocks.argmax(axis=1) + np.arange(blocks.shape[0]) * step
+    k = np.append(k, np.arange(n, freq.size))
+    return freq[k], amp[k]
 
 
 def orbit_figure(results, *, bodies: Iterable[str] | None = None) -> Figure:
@@ -465,10 +602,10 @@ def static_mesh_force_figure(results) -> Figure:
 
 
 def static_load_sharing_figure(results) -> Figure:
-    """Static torque ratio ``N F_i / sum_j F_j`` (seed 004 eq. 14) against position.
+    """Static torque ratio ``N F_i / sum_j F_j`` (Mo et al. 2017 eq. 14) against position.
 
     The dashed line is the group's reported value (largest over the positions,
-    seed 004 eq. 15: ``results.metrics().per_group``).
+    Mo et al. 2017 eq. 15: ``results.metrics().per_group``).
     """
     angle, xlabel = _positions(results)
     groups = {g: ms for g, ms in _groups(results).items() if len(ms) > 1}
@@ -522,25 +659,35 @@ def write_figures(results, directory, formats=("png", "svg"), *,
     list of Path
         ``mesh_force.*`` (whole run), ``mesh_force_end.*`` (last cycles),
         ``cycle_peak_force.*``, ``load_sharing_<definition>.*`` (if a group has two or
-        more meshes), ``support_force_spectrum.*`` (if supports were recorded),
+        more meshes), ``dynamic_factors.*``, ``support_force_spectrum.*`` (if supports were recorded),
         ``orbits.*`` (if x-y histories were recorded), ``mesh_stiffness.*`` (if a mesh
         stiffness varies).
     """
     if hasattr(results, "orbits"):
         raise TypeError("write_figures takes a dynamic run; for quasi-static results call "
                         "write_static_figures(results, directory)")
+    _check_formats(formats)
+    jobs = figure_jobs(results, definition=definition, last_cycles=last_cycles)
+    return write_jobs(jobs, directory, formats, prefix=prefix, dpi=dpi)
+
+
+def figure_jobs(results, *, definition: str | None = None,
+                last_cycles: float = 5.0) -> list[tuple[str, Callable[[], Figure]]]:
+    """``(file name, make figure)`` of every figure :func:`write_figures` writes for a
+    dynamic run, in order (what :func:`write_jobs` and the HTML report draw)."""
     definition = results.metrics(definition).definition
     jobs = [
         ("mesh_force", lambda: mesh_force_figure(results)),
         ("mesh_force_end", lambda: mesh_force_figure(results, last_cycles=last_cycles)),
         ("cycle_peak_force", lambda: cycle_peak_figure(results)),
         (f"load_sharing_{definition}", lambda: load_sharing_figure(results, definition)),
+        ("dynamic_factors", lambda: dynamic_factor_figure(results, definition)),
         ("support_force_spectrum", lambda: support_spectrum_figure(results)),
         ("orbits", lambda: orbit_figure(results)),
     ]
     if _stiffness_varies(results):
         jobs.append(("mesh_stiffness", lambda: mesh_stiffness_figure(results)))
-    return _write(jobs, directory, formats, prefix, dpi)
+    return jobs
 
 
 def write_static_figures(results, directory, formats=("png", "svg"), *, prefix: str = "",
@@ -554,6 +701,11 @@ def write_static_figures(results, directory, formats=("png", "svg"), *, prefix: 
     if not hasattr(results, "orbits"):
         raise TypeError("write_static_figures takes quasi-static results; for a dynamic run "
                         "call write_figures(results, directory)")
+    return _write(static_figure_jobs(results), directory, formats, prefix, dpi)
+
+
+def static_figure_jobs(results) -> list[tuple[str, Callable[[], Figure]]]:
+    """``(file name, make figure)`` of every figure of a quasi-static sweep."""
     jobs = [
         ("static_mesh_force", lambda: static_mesh_force_figure(results)),
         ("static_load_sharing", lambda: static_load_sharing_figure(results)),
@@ -561,31 +713,87 @@ def write_static_figures(results, directory, formats=("png", "svg"), *, prefix: 
     ]
     if _stiffness_varies(results):
         jobs.append(("mesh_stiffness", lambda: mesh_stiffness_figure(results)))
-    return _write(jobs, directory, formats, prefix, dpi)
+    return jobs
 
 
-def _write(jobs, directory, formats, prefix, dpi) -> list[Path]:
+def _check_formats(formats) -> tuple[str, ...]:
     formats = (formats,) if isinstance(formats, str) else tuple(formats)
     supported = FigureCanvasAgg.get_supported_filetypes()
     bad = [f for f in formats if f.lower().lstrip(".") not in supported]
     if bad or not formats:
         raise ValueError(f"cannot write figures as {', '.join(bad) or 'no format'}; choose "
                          f"formats among {', '.join(sorted(supported))}")
+    return formats
+
+
+def _write(jobs, directory, formats, prefix, dpi) -> list[Path]:
+    return write_jobs(jobs, directory, formats, prefix=prefix, dpi=dpi)
+
+
+def write_jobs(jobs, directory, formats=("png", "svg"), *, prefix: str = "", dpi: int = 150,
+               progress: Callable[[int, int, str], None] | None = None) -> list[Path]:
+    """Make each ``(name, make figure)`` of ``jobs`` and write it in every format.
+
+    Figures that do not apply (:class:`FigureNotApplicableError`) are skipped.  Files are
+    cropped to their content (``bbox_inches="tight"``): no legend or title is clipped.
+    ``progress(i, n, name)`` is called before each figure.
+    """
+    formats = _check_formats(formats)
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
     written = []
-    for name, make in jobs:
+    for i, (name, make) in enumerate(jobs):
+        if progress is not None:
+            progress(i, len(jobs), name.replace("_", " "))
         try:
             fig = make()
         except FigureNotApplicableError as exc:
             log.info("figure %s skipped: %s", name, exc)
             continue
-        for fmt in formats:
-            path = directory / f"{prefix}{name}.{fmt.lower().lstrip('.')}"
-            fig.savefig(path, dpi=dpi)
-            written.append(path)
+        written += save_figure(fig, [directory / f"{prefix}{name}.{fmt.lower().lstrip('.')}"
+                                     for fmt in formats], dpi=dpi)
         log.debug("figure %s written", name)
+    if progress is not None:
+        progress(len(jobs), len(jobs), "done")
     return written
+
+
+def save_figure(fig: Figure, paths, *, dpi: int = 150) -> list[Path]:
+    """Save ``fig`` to each path (format by suffix), cropped to its content so that no
+    legend or title is clipped.  The layout and the crop are computed once for all the
+    formats; SVG keeps its text as text (smaller, faster, searchable)."""
+    import matplotlib
+
+    fig.draw_without_rendering()  # the layout, once
+    bbox = fig.get_tightbbox().padded(0.1)
+    engine = fig.get_layout_engine()
+    fig.set_layout_engine("none")  # keep it: every save would lay the figure out again
+    out = []
+    with matplotlib.rc_context({"svg.fonttype": "none"}):
+        for path in paths:
+            path = Path(path)
+            fig.savefig(path, dpi=dpi, bbox_inches=bbox,
+                        metadata={"Date": None} if path.suffix.lower() == ".svg" else None)
+            out.append(path)
+    fig.set_layout_engine(engine)
+    return out
+
+
+def figure_svg(fig: Figure, salt: str) -> str:
+    """``fig`` as SVG text for inlining in HTML: text kept as text, ids made unique by
+    ``salt`` (several figures in one page must not share clip-path or marker ids), no
+    XML prologue, cropped to the content."""
+    import io
+
+    import matplotlib
+
+    buffer = io.StringIO()
+    with matplotlib.rc_context({"svg.fonttype": "none", "svg.hashsalt": salt}):
+        fig.savefig(buffer, format="svg", bbox_inches="tight", pad_inches=0.1,
+                    metadata={"Date": None})
+    text = buffer.getvalue()
+    start = text.find("<svg")
+    return text[start:] if start >= 0 else text
 
 
 # ============================================================ helpers: data
@@ -651,6 +859,29 @@ def _bin_extremes(t: np.ndarray, y: np.ndarray, bin_index: np.ndarray):
         lo = np.fmin.reduceat(y[:last[-1] + 1], edges)
         hi = np.fmax.reduceat(y[:last[-1] + 1], edges)
     return 0.5 * (t[edges] + t[last]), lo, hi
+
+
+def _dense_line(ax, x: np.ndarray, y: np.ndarray, label: str, style: dict,
+                dense_above: int, bins: int = DENSE_BINS) -> int:
+    """Draw ``y(x)`` as a line; beyond ``dense_above`` points, as the range of ``y`` over
+    runs of consecutive points (light band, every extreme kept) with the run means as
+    the line, so that thousands of cycles of several meshes stay readable."""
+    x, y = np.asarray(x, float), np.asarray(y, float)
+    if x.size <= dense_above or x.size < 2 * bins:
+        ax.plot(x, y, label=label, **style)
+        return 1
+    per = math.ceil(x.size / bins)
+    n = math.ceil(x.size / per) * per
+    pad = n - x.size
+    xb = np.append(x, np.full(pad, np.nan)).reshape(-1, per)
+    yb = np.append(y, np.full(pad, np.nan)).reshape(-1, per)
+    with np.errstate(invalid="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        xm, lo, hi, mean = (np.nanmean(xb, axis=1), np.nanmin(yb, axis=1),
+                            np.nanmax(yb, axis=1), np.nanmean(yb, axis=1))
+    ax.fill_between(xm, lo, hi, color=style["color"], alpha=0.15, lw=0)
+    ax.plot(xm, mean, label=f"{label} (mean of {per} cycles;\nband: their range)", **style)
+    return per
 
 
 def _stiffness_at_phase(table: np.ndarray, phase: np.ndarray) -> np.ndarray:
@@ -730,8 +961,9 @@ def _label(ax, xlabel: str, ylabel: str) -> None:
     ax.set_ylabel(ylabel, fontsize=FONT["label"])
     ax.tick_params(labelsize=FONT["tick"])
     for axis in (ax.xaxis, ax.yaxis):
-        if axis.get_scale() == "linear":
-            axis.get_major_formatter().set_useOffset(False)
+        formatter = axis.get_major_formatter()
+        if axis.get_scale() == "linear" and hasattr(formatter, "set_useOffset"):
+            formatter.set_useOffset(False)
     ax.grid(True, alpha=0.3)
     lo, hi = ax.dataLim.intervaly
     size = max(abs(lo), abs(hi))

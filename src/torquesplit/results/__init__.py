@@ -22,6 +22,10 @@ import numpy as np
 from ..errors import SolverError
 from ..metrics import load_sharing as ls
 
+#: the load-sharing definition of a new model: the mean-force ratio, the mesh load factor
+#: K_gamma of the design standards (see docs/load-sharing.md)
+STANDARD_DEFINITION = ls.STANDARD_DEFINITION
+
 
 @dataclass(frozen=True)
 class MeshRow:
@@ -49,6 +53,12 @@ class MeshRow:
     back_contact: float
     """Fraction of the run in back-flank contact (tensile force for a mesh without
     backlash: double-flank contact)."""
+    back_flank_force: float = 0.0
+    """Largest back-flank force over the run (complete cycles, transient included, like
+    ``back_contact``) [N], >= 0: minus the smallest force when that is negative."""
+    double_flank: bool = False
+    """The mesh has no backlash: its back flank is always in reach (double-flank
+    contact), so it can carry tension."""
 
 
 @dataclass(frozen=True)
@@ -87,7 +97,8 @@ class Metrics:
         ``dynamic_factor``, ``peak_to_nominal`` (system, ``.<group>``, ``.<mesh>``);
         ``dynamic_factor_engineering.<mesh>``, ``peak_to_nominal_engineering.<group>``;
         ``peak_force``, ``min_force``, ``mean_force``, ``static_force``,
-        ``nominal_force``, ``contact_loss``, ``back_contact`` ``.<mesh>``;
+        ``nominal_force``, ``contact_loss``, ``back_contact``, ``back_flank_force``
+        ``.<mesh>``;
         ``settle_time``."""
         lsc, d = self.load_sharing, self.dynamic_factors
         key = f"load_sharing.{self.definition}"
@@ -103,7 +114,8 @@ class Metrics:
         for r in self.rows:
             for name in ("dynamic_factor", "dynamic_factor_engineering", "peak_to_nominal",
                          "peak_force", "min_force", "mean_force", "static_force",
-                         "nominal_force", "contact_loss", "back_contact"):
+                         "nominal_force", "contact_loss", "back_contact",
+                         "back_flank_force"):
                 out[f"{name}.{r.mesh}"] = getattr(r, name)
         return out
 
@@ -111,12 +123,52 @@ class Metrics:
 class Results:
     """A finished (or stopped) dynamic run and everything needed to interpret it."""
 
-    def __init__(self, *, model, kinematics, structure, static, solution):
+    def __init__(self, *, model, kinematics, structure, static, solution,
+                 run_warnings=(), model_warnings=None):
         self.model = model
         self.kinematics = kinematics
         self.structure = structure
         self.static = static
         self.solution = solution
+        self.run_warnings: list[str] = list(run_warnings)
+        """Warnings of the run itself (cost, step, static equilibrium), as text."""
+        self.model_warnings: list[str] | None = (None if model_warnings is None
+                                                 else list(model_warnings))
+        """Warnings of the model's checks, as text; None: computed on demand from the
+        model (:func:`torquesplit.model.checks.plausibility_warnings`)."""
+
+    def warnings(self, definition: str | None = None) -> list[str]:
+        """Every warning of this run, each ``"location: message"``: the model's
+        plausibility checks, the run's own (cost, step, static equilibrium) and the
+        plausibility of its results (:mod:`torquesplit.results.plausibility`: back-flank
+        and double-flank contact, contact loss, negative static force, a dynamic factor
+        near a resonance, a transient that did not settle).
+
+        The command line prints them, lists them in ``--json`` and the results files
+        carry them (attribute ``warnings``).
+        """
+        from .plausibility import result_warnings
+
+        out = list(self.model_warnings) if self.model_warnings is not None else [
+            f"{loc}: {msg}" for loc, msg in self._model_plausibility()]
+        out += self.run_warnings
+        if self.success:
+            try:
+                met = self.metrics(definition)
+            except (ValueError, ArithmeticError):  # pragma: no cover - reported elsewhere
+                met = None
+            if met is not None:
+                out += [f"{loc}: {msg}" for loc, msg in result_warnings(self, met)]
+        seen: set[str] = set()
+        return [w for w in out if not (w in seen or seen.add(w))]
+
+    def _model_plausibility(self) -> list[tuple[str, str]]:
+        from ..model.checks import plausibility_warnings
+
+        try:
+            return plausibility_warnings(self.model, self.kinematics)
+        except (ValueError, ArithmeticError, KeyError):  # pragma: no cover - checked before
+            return []
 
     # ------------------------------------------------------------------ status
     @property
@@ -170,8 +222,8 @@ class Results:
         Every number comes from the per-cycle statistics streamed by the integrator at
         every step; the settle criterion (``window`` cycles at least, ``tolerance``) gives
         one settle time per load-sharing group, used by all of its metrics."""
-        definition = definition or self.model.analysis.load_sharing
-        if definition == "static_torque":
+        definition = definition or self.default_definition
+        if definition in ("static", "static_torque"):
             raise SolverError(
                 "'static_torque' is the load sharing of quasi-static equilibria (Mo et al. "
                 "2017 eqs. 14-15), not of a dynamic run; compute it with `torquesplit "
@@ -182,10 +234,8 @@ class Results:
                              f"{', '.join(ls.DYNAMIC_DEFINITIONS)}")
         s = self.solution
         names = self.mesh_names
-        cols = self._mesh_columns
-        c_max, c_min = s.cycle_max[:, cols], s.cycle_min[:, cols]
-        c_mean, c_cnt = s.cycle_mean[:, cols], s.cycle_count[:, cols]
-        c_start, c_ratio = s.cycle_start[:, cols], s.cycle_ratio_max[:, cols]
+        c_max, c_min, c_mean, c_cnt, c_ratio = self.complete_cycle_statistics()
+        c_start = s.cycle_start[:, self._mesh_columns]
         groups = self.groups
         st = ls.settle(c_max, c_start, names, self.settle_windows(window), tolerance, groups)
         if definition == "cycle_peak":
@@ -214,16 +264,61 @@ class Results:
                 peak_to_nominal=dyn.peak_to_nominal[m], load_sharing=lsc.per_mesh[m],
                 contact_loss=float(s.separation_fraction[el.index(m)]),
                 back_contact=float(s.back_contact_fraction[el.index(m)]),
+                back_flank_force=_back_flank_force(c_min[:, j]),
+                double_flank=not (self.model.meshes[m].backlash.nominal > 0),
             ))
         return Metrics(definition, st, lsc, dyn, rows)
+
+    @property
+    def default_definition(self) -> str:
+        """The load-sharing definition :meth:`metrics` reports when none is given: the
+        model's ``[analysis] load_sharing``, or :data:`STANDARD_DEFINITION` when that is
+        the quasi-static ``static_torque`` (which needs ``torquesplit static``)."""
+        chosen = self.model.analysis.load_sharing
+        return STANDARD_DEFINITION if chosen in ("static", "static_torque") else chosen
+
+    @cached_property
+    def complete_cycles(self) -> np.ndarray:
+        """(n_cycles, n_meshes) True where a mesh cycle lies wholly inside the simulated
+        span.  The cycle cut off by the end of the run (and the one cut by its start)
+        has a peak, a mean and a ratio of part of a cycle only: no metric, table or
+        figure uses it."""
+        s = self.solution
+        start = s.cycle_start[:, self._mesh_columns]
+        f = np.array([float(self._mesh_meta[m]["frequency"]) for m in self.mesh_names])
+        if start.size == 0 or not np.all(f > 0):
+            return np.ones(start.shape, bool)
+        tol = 1e-6 / f
+        return (start >= s.t_span[0] - tol) & (start + 1.0 / f <= s.t_final + tol)
+
+    def complete_cycle_statistics(self):
+        """Per-cycle (max, min, mean, count, largest instantaneous ratio) of every mesh,
+        (n_cycles, n_meshes) each, with the incomplete cycles (:attr:`complete_cycles`)
+        emptied: NaN statistics and count 0."""
+        s = self.solution
+        cols = self._mesh_columns
+        partial = ~self.complete_cycles
+        out = []
+        for a in (s.cycle_max, s.cycle_min, s.cycle_mean, s.cycle_count, s.cycle_ratio_max):
+            a = np.array(a[:, cols])
+            a[partial] = 0 if a.dtype.kind in "iu" else np.nan
+            out.append(a)
+        return tuple(out)
 
     def metric_values(self, definitions=None, *, window: int = 20,
                       tolerance: float = 0.01) -> dict[str, float]:
         """Every metric of the run by a flat name (:meth:`Metrics.values`), for every
-        dynamic load-sharing definition (or those given)."""
+        dynamic load-sharing definition (or those given), with the planet load-sharing
+        factor ``planet_load_sharing.<definition>[.<carrier>|.<planet>]`` of planetary
+        stages."""
+        from ..metrics.planetary import planet_load_sharing
+
         out: dict[str, float] = {}
         for d in definitions or ls.DYNAMIC_DEFINITIONS:
-            out.update(self.metrics(d, window=window, tolerance=tolerance).values())
+            met = self.metrics(d, window=window, tolerance=tolerance)
+            out.update(met.values())
+            # the planet load-sharing factor K_gamma of every planetary stage (if any)
+            out.update(planet_load_sharing(met.load_sharing, self.kinematics).values())
         return out
 
     @cached_property
@@ -258,13 +353,15 @@ class Results:
         return s.history_t, s.history_forces[:, cols]
 
     # ------------------------------------------------------------------ export
-    def to_dataset(self):
-        """The run as an :class:`xarray.Dataset` (units and long names on every variable)."""
+    def to_dataset(self, definition: str | None = None):
+        """The run as an :class:`xarray.Dataset` (units and long names on every variable;
+        metrics of ``definition``, default the model's; warnings in its attributes)."""
         from .dataset import results_to_dataset
 
-        return results_to_dataset(self)
+        return results_to_dataset(self, definition)
 
-    def to_netcdf(self, path, *, overwrite: bool = False) -> Path:
+    def to_netcdf(self, path, *, overwrite: bool = False,
+                  definition: str | None = None) -> Path:
         """Save as NetCDF (h5netcdf); the model is embedded so the file can be re-run.
 
         The file is written atomically (:mod:`torquesplit.results.files`): complete or
@@ -281,12 +378,12 @@ class Results:
 
         plan = files.check_output(path, formats=files.NETCDF_FORMATS, overwrite=overwrite)
         with files.claim_output(plan) as claim:
-            ds = self.to_dataset()
+            ds = self.to_dataset(definition)
             ds.attrs.update(files.provenance(claim.run_id))
             claim.write({plan.path: files.netcdf_bytes(ds)})
         return plan.path
 
-    def save(self, path, *, overwrite: bool = False) -> Path:
+    def save(self, path, *, overwrite: bool = False, definition: str | None = None) -> Path:
         """Save by suffix: ``.nc`` NetCDF, ``.mat`` MATLAB, ``.csv`` spreadsheet tables.
 
         Every file is written atomically and an existing one is kept unless
@@ -296,16 +393,16 @@ class Results:
 
         plan = files.check_output(path, overwrite=overwrite)
         writer = {"netcdf": self.to_netcdf, "mat": self.to_mat, "csv": self.to_csv}[plan.format]
-        return writer(plan.path, overwrite=overwrite)
+        return writer(plan.path, overwrite=overwrite, definition=definition)
 
-    def to_mat(self, path, *, overwrite: bool = False) -> Path:
+    def to_mat(self, path, *, overwrite: bool = False, definition: str | None = None) -> Path:
         """Save for MATLAB (scipy.io.savemat): every variable of the Dataset, SI units,
         and a ``provenance`` struct naming the run; written atomically."""
         from . import files
 
         plan = files.check_output(path, formats={".mat": "mat"}, overwrite=overwrite)
         with files.claim_output(plan) as claim:
-            ds = self.to_dataset()
+            ds = self.to_dataset(definition)
             data = {name: np.asarray(ds[name].values) for name in ds.data_vars}
             for name in ds.coords:
                 values = ds[name].values
@@ -314,11 +411,12 @@ class Results:
             data["units"] = {name: ds[name].attrs.get("units", "") for name in ds.data_vars}
             data["model_json"] = ds.attrs["model_json"]
             data["metrics_json"] = ds.attrs.get("metrics_json", "")
+            data["warnings"] = np.asarray(self.warnings(definition) or [""], dtype=object)
             data["provenance"] = files.provenance(claim.run_id)
             claim.write({plan.path: files.mat_bytes(data)})
         return plan.path
 
-    def to_csv(self, path, *, overwrite: bool = False) -> Path:
+    def to_csv(self, path, *, overwrite: bool = False, definition: str | None = None) -> Path:
         """Save spreadsheet tables: ``NAME.csv`` (per-mesh summary) and beside it
         ``NAME_history.csv`` (decimated forces) and ``NAME_cycles.csv`` (cycle peaks).
 
@@ -333,9 +431,9 @@ class Results:
         header = ["mesh", "group", "nominal_force_N", "static_force_N", "mean_force_N",
                   "peak_force_N", "min_force_N", "dynamic_factor",
                   "dynamic_factor_engineering", "peak_to_nominal", "load_sharing",
-                  "contact_loss_fraction", "back_contact_fraction"]
+                  "contact_loss_fraction", "back_contact_fraction", "back_flank_force_N"]
         try:
-            met = self.metrics() if self.success else None
+            met = self.metrics(definition) if self.success else None
         except (ValueError, ArithmeticError):
             met = None
         if met is not None:
@@ -343,12 +441,12 @@ class Results:
             rows = [[r.mesh, r.group, r.nominal_force, r.static_force, r.mean_force,
                      r.peak_force, r.min_force, r.dynamic_factor,
                      r.dynamic_factor_engineering, r.peak_to_nominal, r.load_sharing,
-                     r.contact_loss, r.back_contact] for r in met.rows]
+                     r.contact_loss, r.back_contact, r.back_flank_force] for r in met.rows]
         else:
             header.append("status")
             group_of = {m: g for g, ms in self.groups.items() for m in ms}
             nominal, static = self.nominal_forces(), self.static_forces()
-            rows = [[m, group_of.get(m, ""), nominal[m], static[m]] + [""] * 9
+            rows = [[m, group_of.get(m, ""), nominal[m], static[m]] + [""] * 10
                     + [self.message] for m in self.mesh_names]
         s = self.solution
         el = self.structure.element_names
@@ -381,11 +479,28 @@ class Results:
         return model_to_json(self.model)
 
 
+def _back_flank_force(cycle_min: np.ndarray) -> float:
+    """Largest back-flank (tensile) force [N] from the per-cycle smallest forces."""
+    smallest = -ls._nanmax(-np.asarray(cycle_min, dtype=float))
+    return max(0.0, -smallest) if math.isfinite(smallest) else 0.0
+
+
 def open_results(path):
     """Open a results file written by :meth:`Results.to_netcdf` as an xarray Dataset."""
     import xarray as xr
 
     return xr.open_dataset(path, engine="h5netcdf")
+
+
+def load_results(path):
+    """A :class:`Results` from a results file written by :meth:`Results.to_netcdf`
+    (``torquesplit run --out F.nc``): the embedded model, the run's statistics and
+    histories (see :func:`torquesplit.results.dataset.results_from_dataset`)."""
+    from .dataset import results_from_dataset
+
+    with open_results(path) as ds:
+        ds.load()
+        return results_from_dataset(ds)
 
 
 def model_from_results(dataset):

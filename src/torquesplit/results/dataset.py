@@ -12,8 +12,13 @@ def _var(dims, data, units, long_name):
     return xr.Variable(dims, np.asarray(data), attrs={"units": units, "long_name": long_name})
 
 
-def results_to_dataset(res) -> xr.Dataset:
-    """Histories, per-cycle statistics, static and nominal forces, metrics, run info."""
+def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
+    """Histories, per-cycle statistics, static and nominal forces, metrics (of
+    ``definition``, default the model's), warnings, run info.
+
+    The file holds everything :func:`results_from_dataset` needs to give back a
+    :class:`~torquesplit.results.Results` with the same metrics (``torquesplit report
+    RESULTS.nc``)."""
     s = res.solution
     st = res.structure
     meshes = res.mesh_names
@@ -33,6 +38,14 @@ def results_to_dataset(res) -> xr.Dataset:
                                     "smallest mesh force in each mesh cycle"),
             "cycle_mean_force": _var(("cycle", "mesh"), s.cycle_mean[:, mesh_cols], "N",
                                      "mean mesh force in each mesh cycle"),
+            "cycle_count": _var(("cycle", "mesh"), s.cycle_count[:, mesh_cols], "1",
+                                "integration states in each mesh cycle"),
+            "cycle_ratio_max": _var(("cycle", "mesh"), s.cycle_ratio_max[:, mesh_cols], "1",
+                                    "largest instantaneous load-sharing ratio in each mesh "
+                                    "cycle"),
+            "cycle_ratio_min": _var(("cycle", "mesh"), s.cycle_ratio_min[:, mesh_cols], "1",
+                                    "smallest instantaneous load-sharing ratio in each mesh "
+                                    "cycle"),
             "nominal_force": _var(("mesh",), [res.kinematics.meshes[m].force for m in meshes],
                                   "N", "equal-split nominal tooth force"),
             "static_force": _var(("mesh",), list(res.static_forces().values()), "N",
@@ -66,7 +79,7 @@ def results_to_dataset(res) -> xr.Dataset:
         ds["velocity"] = _var(("time", "history_dof"), s.history_v, "m/s or rad/s",
                               "vibratory velocity")
     try:
-        met = res.metrics()
+        met = res.metrics(definition)
         ds["load_sharing"] = _var(("mesh",), [met.load_sharing.per_mesh[m] for m in meshes],
                                   "1", f"load-sharing coefficient ({met.definition})")
         d = met.dynamic_factors
@@ -76,10 +89,22 @@ def results_to_dataset(res) -> xr.Dataset:
         ds["peak_to_nominal"] = _var(("mesh",), [d.peak_to_nominal[m] for m in meshes], "1",
                                      "settled peak / equal-split nominal force (Ji & Li "
                                      "eq. 19)")
+        ds["back_flank_force"] = _var(("mesh",), [r.back_flank_force for r in met.rows], "N",
+                                      "largest back-flank (tensile) force over the settled "
+                                      "part")
+        ds["double_flank"] = _var(("mesh",), [int(r.double_flank) for r in met.rows], "1",
+                                  "1: the mesh has no backlash (double-flank contact)")
+        ds.attrs["load_sharing_definition"] = met.definition
         ds.attrs["metrics_json"] = json.dumps(met.to_dict(), default=float)
     except Exception as exc:  # metrics of a diverged run may be undefined; keep the data
         ds.attrs["metrics_error"] = str(exc)
+    notes = res.warnings(definition) if hasattr(res, "warnings") else []
     ds.attrs.update({
+        "warnings": "\n".join(notes),
+        "warnings_json": json.dumps(notes),
+        "t_start": float(s.t_span[0]),
+        "t_end": float(s.t_span[1]),
+        "t_final": float(s.t_final),
         "title": f"torquesplit results: {res.model.model.name}",
         "model_name": res.model.model.name,
         "model_json": res.model_json(),
@@ -89,3 +114,100 @@ def results_to_dataset(res) -> xr.Dataset:
         "software": "torquesplit",
     })
     return ds
+
+
+def results_from_dataset(ds: xr.Dataset):
+    """A :class:`~torquesplit.results.Results` rebuilt from a results Dataset written by
+    :func:`results_to_dataset` (a ``.nc`` file of ``torquesplit run --out``).
+
+    The model is the one embedded in the file; its kinematics, assembly and static
+    equilibrium are recomputed (deterministic), the integration's per-cycle statistics
+    and histories are the file's, so every metric equals the run's.  Files written before
+    the per-cycle ratios were stored give NaN instantaneous coefficients.
+
+    Raises
+    ------
+    ValueError
+        The Dataset is not a torquesplit dynamic-run file.
+    """
+    import math
+
+    from ..assembly.assemble import assemble
+    from ..metrics.load_sharing import group_meshes
+    from ..model.io import load_model
+    from ..model.kinematics import solve_kinematics
+    from ..solve.integrate import Solution
+    from ..solve.static import static_equilibrium
+    from . import Results
+
+    if "model_json" not in ds.attrs or "cycle_max_force" not in ds:
+        raise ValueError("not a torquesplit results file of a dynamic run (no embedded model "
+                         "or cycle statistics); give a file written by 'torquesplit run "
+                         "--out F.nc'")
+    model = load_model(json.loads(ds.attrs["model_json"]))
+    kin = solve_kinematics(model)
+    structure = assemble(model, kin)
+    static = static_equilibrium(structure)
+    names = list(structure.element_names)
+    meshes = [str(m) for m in ds["mesh"].values]
+    track = tuple(names.index(m) for m in meshes)
+    hist_el = tuple(names.index(str(e)) for e in ds["element"].values)
+    dofs = list(structure.dof_names)
+    hist_dof = (tuple(dofs.index(str(d)) for d in ds["history_dof"].values)
+                if "history_dof" in ds.coords else ())
+    stats = json.loads(ds.attrs.get("statistics_json", "{}"))
+    span_s = float(stats.get("simulated_time_s", math.nan))
+    t0 = float(ds.attrs.get("t_start", 0.0))
+    t_end = float(ds.attrs.get("t_end", t0 + span_s))
+    t_final = float(ds.attrs.get("t_final", t0 + span_s))
+    span = max(t_final - t0, 1e-300)
+
+    def cyc(name, fill=math.nan):
+        if name in ds:
+            return np.asarray(ds[name].values, dtype=float)
+        return np.full(ds["cycle_max_force"].shape, fill)
+
+    c_max = cyc("cycle_max_force")
+    count = (np.asarray(ds["cycle_count"].values, dtype=np.int64) if "cycle_count" in ds
+             else np.isfinite(c_max).astype(np.int64))
+    sep_t = np.zeros(len(names))
+    back_t = np.zeros(len(names))
+    sep_t[list(hist_el)] = np.asarray(ds["contact_loss_fraction"].values) * span
+    back_t[list(hist_el)] = np.asarray(ds["back_contact_fraction"].values) * span
+    groups = tuple(tuple(names.index(m) for m in ms)
+                   for ms in group_meshes(structure.metadata["meshes"]).values())
+    n_hist = ds.sizes.get("time", 0)
+    empty = np.zeros((n_hist, 0))
+
+    def stat(key, default=math.nan):
+        v = stats.get(key, default)
+        return default if v is None else v
+
+    solution = Solution(
+        status=int(ds.attrs.get("status", 0)), message=str(ds.attrs.get("message", "")),
+        success=int(ds.attrs.get("status", 0)) == 0, method=str(stat("method", "rk4")),
+        t_span=(t0, t_end), t_final=t_final,
+        y_final=np.full(2 * len(dofs), math.nan), n_steps=int(stat("steps", 0)),
+        n_rejected=int(stat("rejected_steps", 0)), n_rhs=int(stat("rhs_evaluations", 0)),
+        step=stats.get("step_s"), step_limited_by="", step_min=float(stat("step_min_s")),
+        step_max=float(stat("step_max_s")), compile_time=float(stat("compile_time_s", 0.0)),
+        wall_time=float(stat("wall_time_s", 0.0)), rhs=str(stat("rhs", "general")),
+        rhs_compile_time=float(stat("rhs_compile_time_s", 0.0)),
+        dof_names=tuple(dofs), element_names=tuple(names), tracked_elements=track,
+        cycle_start=cyc("cycle_start"), cycle_max=c_max, cycle_min=cyc("cycle_min_force"),
+        cycle_mean=cyc("cycle_mean_force"), cycle_count=count, load_sharing_groups=groups,
+        cycle_ratio_max=cyc("cycle_ratio_max"), cycle_ratio_min=cyc("cycle_ratio_min"),
+        history_elements=hist_el, history_dofs=hist_dof,
+        history_t=np.asarray(ds["time"].values, dtype=float),
+        history_forces=np.asarray(ds["element_force"].values, dtype=float),
+        history_q=(np.asarray(ds["displacement"].values, dtype=float) if hist_dof else empty),
+        history_v=(np.asarray(ds["velocity"].values, dtype=float) if hist_dof else empty),
+        full_t=None, full_y=None, n_samples=int(count.sum()),
+        separation_steps=np.zeros(len(names), np.int64),
+        back_contact_steps=np.zeros(len(names), np.int64),
+        separation_time=sep_t, back_contact_time=back_t)
+    notes = json.loads(ds.attrs.get("warnings_json", "[]"))
+    res = Results(model=model, kinematics=kin, structure=structure, static=static,
+                  solution=solution, model_warnings=notes)
+    res.saved_definition = ds.attrs.get("load_sharing_definition")
+    return res

@@ -221,7 +221,7 @@ def copy_slot(src, dst, w):
 def rhs_slot(slot, iy, idy, i_f, m, w):
     """Row ``idy`` of w.Y = dy/dt = [v, a] at state row ``iy`` for excitation ``slot``.
 
-    a = M^-1 (F_ext - C_g v - sum_e V_e f_e - G v); element e: delta = V.q - e,
+    a = M^-1 (F_ext - C_g v - sum_e V_e f_e - G v - K_f q); element e: delta = V.q - e,
     rate = V.v - e', force :func:`laws.spring_force` (k, c, delta, rate, half-gap) plus
     the additive force p.  Writes the forces and deformations into row ``i_f`` of w.F /
     w.D.  V is read by element (CSR, unsigned indices into the state) and, for the
@@ -237,6 +237,7 @@ def rhs_slot(slot, iy, idy, i_f, m, w):
     external_force, ground_damping = m.external_force, m.ground_damping
     vt_ptr, vt_el, vt_coef = m.vt_ptr, m.vt_el, m.vt_coef
     gy_ptr, gy_idx, gy_coef = m.gy_ptr, m.gy_idx, m.gy_coef
+    fs_ptr, fs_idx, fs_coef = m.fs_ptr, m.fs_idx, m.fs_coef
     n = inv_mass.shape[0]
     for el in range(vr_ptr.shape[0] - 1):
         d = -E[slot, el]
@@ -255,6 +256,8 @@ def rhs_slot(slot, iy, idy, i_f, m, w):
             acc -= vt_coef[j] * force[i_f, vt_el[j]]
         for j in range(gy_ptr[i], gy_ptr[i + 1]):
             acc -= gy_coef[j] * Y[iy, gy_idx[j]]
+        for j in range(fs_ptr[i], fs_ptr[i + 1]):
+            acc -= fs_coef[j] * Y[iy, fs_idx[j]]
         Y[idy, i] = vi
         Y[idy, n + i] = inv_mass[i] * acc
 

@@ -15,10 +15,10 @@ law's own compiled code, :func:`torquesplit.solve.laws.spring_force_c` (numba co
 linked into each generated module and inlined), so the generated code and
 ``rhs_slot`` run the same instructions for the law, and the same sums in the same order
 around it (no fused multiply-adds, no reassociation): results are bit for bit the same
-(tested).  A whole RK4 step is about twice as fast with it (seed 001: 0.78 against
+(tested).  A whole RK4 step is about twice as fast with it (Ji & Li: 0.78 against
 1.51 µs in the same benchmark run, benchmarks/RESULTS.md), and within 1.0-1.2 times of a
 transcription generated from the assembled structure (benchmarks/bench_specialised.py:
-checks kernel overhead, not assembly; the seed 001 equations written by hand are timed
+checks kernel overhead, not assembly; the Ji & Li equations written by hand are timed
 in benchmarks/bench_transcription.py).  The kernels pass it data addresses taken once per call: ``array.ctypes``
 at every call would cost an atomic reference-count increment and decrement per array,
 more than the arithmetic.  What it computes, for one excitation slot::
@@ -26,7 +26,8 @@ more than the arithmetic.  What it computes, for one excitation slot::
     delta_e = -E_e + sum_j V_ej q_j          (CSR order of V)
     rate_e  = -ED_e + sum_j V_ej v_j
     f_e     = spring_force(K_e, c_e, delta_e, rate_e, G_e) + P_e     (the law)
-    dy      = [v, M^-1 (F_ext - C_g v - sum_e V_e f_e - G v)]  (CSR order of V^T, of G)
+    dy      = [v, M^-1 (F_ext - C_g v - sum_e V_e f_e - G v - K_f q)]  (CSR order of
+              V^T, of G, of K_f)
 
 The code depends only on the sparsity of V and G and on which elements have a dead zone; the
 values (coefficients, damping, masses, forces) are read from a parameter vector at fixed
@@ -113,6 +114,7 @@ def rhs_ir(model) -> tuple[str, list[tuple[str, int]]]:
     vr_ptr, vq_idx = a["vr_ptr"].astype(np.int64), a["vq_idx"].astype(np.int64)
     vt_ptr, vt_el = a["vt_ptr"].astype(np.int64), a["vt_el"].astype(np.int64)
     gy_ptr, gy_idx = a["gy_ptr"].astype(np.int64), a["gy_idx"].astype(np.int64)
+    fs_ptr, fs_idx = a["fs_ptr"].astype(np.int64), a["fs_idx"].astype(np.int64)
     gap_ptr, gap_values = a["gap_ptr"], a["gap_values"]
     has_error, has_force = _error_and_force_flags(a)
     _, law = _law_ir()
@@ -190,6 +192,8 @@ def rhs_ir(model) -> tuple[str, list[tuple[str, int]]]:
             acc = op("fsub", acc, op("fmul", param("vt_coef", j), force[int(vt_el[j])]))
         for j in range(gy_ptr[i], gy_ptr[i + 1]):
             acc = op("fsub", acc, op("fmul", param("gy_coef", j), load("y", gy_idx[j])))
+        for j in range(fs_ptr[i], fs_ptr[i + 1]):
+            acc = op("fsub", acc, op("fmul", param("fs_coef", j), load("y", fs_idx[j])))
         store("dy", i, v)
         store("dy", n + i, op("fmul", param("inv_mass", i), acc))
     args = ", ".join(f"ptr noalias nocapture %{x}" for x in ARG_NAMES) + ", i64 %off"
@@ -234,7 +238,8 @@ def _pattern_key(model) -> str:
     has_error, has_force = _error_and_force_flags(a)
     h = hashlib.sha256()
     for x in (np.int64(a["inv_mass"].shape[0]), a["vr_ptr"], a["vq_idx"], a["vt_ptr"],
-              a["vt_el"], a["gy_ptr"], a["gy_idx"], gapped, has_error, has_force):
+              a["vt_el"], a["gy_ptr"], a["gy_idx"], a["fs_ptr"], a["fs_idx"], gapped,
+              has_error, has_force):
         arr = np.ascontiguousarray(x)
         h.update(str((arr.dtype, arr.shape)).encode())
         h.update(arr.tobytes())
@@ -387,7 +392,7 @@ def _noop(y, dy, force, defl, K, G, E, ED, P, par, off):  # noqa: N803 - kernel 
 
 
 # Cost model of "auto" (measured on the 2-core development machine, benchmarks/RESULTS.md):
-# compiling L lines of IR takes about 4e-5 L + 5e-9 L^2 s (0.05 s for seed 001's 974 lines,
+# compiling L lines of IR takes about 4e-5 L + 5e-9 L^2 s (0.05 s for Ji & Li's 974 lines,
 # 7 s for a 392-DOF model's 35 000), about 30 lines per non-zero of V; each right-hand-side
 # call saves about 5 ns per non-zero against the general kernel.
 _COMPILE_S_PER_LINE = 4e-5

@@ -46,7 +46,7 @@ KernelModel = namedtuple("KernelModel", (
     "error_phase", "force_table", "tv_el", "err_el", "sin_el", "vr_ptr", "vq_idx",
     "vv_idx", "vt_ptr", "vt_el", "vt_coef", "fr_el", "fr_ptr", "fr_dof", "fr_coef",
     "fr_row", "friction_table", "sp_el", "sp_par", "gy_ptr", "gy_idx", "gy_coef",
-    "corner_ptr", "corner_node",
+    "corner_ptr", "corner_node", "fs_ptr", "fs_idx", "fs_coef",
 ))
 """A :class:`~torquesplit.assembly.structure.Structure` in kernel form.
 
@@ -58,7 +58,8 @@ generalized forces are gathered, not scattered); ``gy_ptr gy_idx gy_coef`` the
 gyroscopic matrix G by row (generalized force -G v); spline component elements get zero
 stiffness and damping in ``stiffness_table`` / ``damping`` (their law is applied apart);
 ``corner_node[corner_ptr[e]:corner_ptr[e+1]]`` the table nodes where element e's force has
-a corner (:func:`corner_nodes`): the integrators also sample the statistics there.
+a corner (:func:`corner_nodes`): the integrators also sample the statistics there;
+``fs_ptr fs_idx fs_coef`` the frame stiffness K_f by row (generalized force -K_f q).
 """
 
 Work = namedtuple("Work", (
@@ -173,11 +174,23 @@ def _check(s: Structure) -> None:
             or (n_gy and (np.min(s.gy_idx) < 0 or np.max(s.gy_idx) >= s.n_dof))):
         raise SolverError("the gyroscopic arrays (gy_ptr, gy_idx, gy_coef) of the structure "
                           "are inconsistent; rebuild it with build_structure.")
+    n_fs = len(s.fs_idx)
+    fs_ptr = _fs_ptr(s)
+    if (len(fs_ptr) != s.n_dof + 1 or fs_ptr[0] != 0 or fs_ptr[-1] != n_fs
+            or np.any(np.diff(fs_ptr) < 0) or len(s.fs_coef) != n_fs
+            or (n_fs and (np.min(s.fs_idx) < 0 or np.max(s.fs_idx) >= s.n_dof))):
+        raise SolverError("the frame stiffness arrays (fs_ptr, fs_idx, fs_coef) of the "
+                          "structure are inconsistent; rebuild it with build_structure.")
 
 
 def _gy_ptr(s: Structure) -> np.ndarray:
     """Row pointer of the gyroscopic matrix (an empty one means no entries)."""
     return s.gy_ptr if len(s.gy_ptr) else np.zeros(s.n_dof + 1, dtype=np.int64)
+
+
+def _fs_ptr(s: Structure) -> np.ndarray:
+    """Row pointer of the frame stiffness matrix (an empty one means no entries)."""
+    return s.fs_ptr if len(s.fs_ptr) else np.zeros(s.n_dof + 1, dtype=np.int64)
 
 
 def kernel_model(structure: Structure) -> KernelModel:
@@ -230,7 +243,8 @@ def kernel_model(structure: Structure) -> KernelModel:
                         else np.zeros((0, 1))),
         sp_el=i8(s.sp_el).reshape(n_sp, 2), sp_par=f8(s.sp_par).reshape(n_sp, 6),
         gy_ptr=u8(_gy_ptr(s)), gy_idx=u8(np.asarray(s.gy_idx) + s.n_dof),
-        gy_coef=f8(s.gy_coef), **_corners(s),
+        gy_coef=f8(s.gy_coef), **_corners(s), fs_ptr=u8(_fs_ptr(s)), fs_idx=u8(s.fs_idx),
+        fs_coef=f8(s.fs_coef),
     )
 
 

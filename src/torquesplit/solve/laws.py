@@ -94,7 +94,7 @@ def spring_force(k, c, d, r, g):
     """Force of a mesh, shaft or support element and its derivatives.
 
     ``f = k h(d; g) + c r`` with ``h`` the :func:`dead_zone`; the damping acts only
-    while the element is in contact (DESIGN.md §4).  ``k`` stiffness [N/m], ``c``
+    while the element is in contact (docs/theory/model.md).  ``k`` stiffness [N/m], ``c``
     damping [N s/m], ``d`` deformation [m], ``r`` its rate [m/s], ``g`` half-gap [m].
     Returns ``(f, df/dd, df/dr)``.  The additive impact force of a mesh is added by the
     caller.

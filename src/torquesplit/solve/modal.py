@@ -115,7 +115,7 @@ def modal_analysis(structure: Structure, q=None, *, rigid_tolerance: float = 1e-
         k_act[ex] = k_act[ey] = 0.0
         active[ex] = active[ey] = bool(np.any(h2 != 0))
         sp_tangent.append((ex, ey, h2, V[[ex, ey]]))
-    K = V.T @ (k_act[:, None] * V)
+    K = V.T @ (k_act[:, None] * V) + s.frame_stiffness_matrix()
     for _, _, h2, rows in sp_tangent:
         K = K + rows.T @ h2 @ rows
     C = V.T @ (np.where(active, s.damping, 0.0)[:, None] * V) + np.diag(s.ground_damping)

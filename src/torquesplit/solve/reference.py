@@ -153,7 +153,7 @@ def element_forces_numpy(structure: Structure, t: float, y: np.ndarray):
 
 def rhs_numpy(structure: Structure, t: float, y: np.ndarray) -> np.ndarray:
     """Right-hand side of the first-order system:
-    dy/dt = [v, M^-1 (F - C_g v - V^T f - W(t)^T max(f, 0) - G v)].
+    dy/dt = [v, M^-1 (F - C_g v - V^T f - W(t)^T max(f, 0) - G v - K_f q)].
 
     W(t) holds the tooth-friction projections (:func:`friction_matrix_numpy`); f includes
     the spline forces; G is the gyroscopic matrix.  Twin of ``_kernels.rhs_slot`` +
@@ -167,6 +167,8 @@ def rhs_numpy(structure: Structure, t: float, y: np.ndarray) -> np.ndarray:
     gen = structure.external_force - structure.ground_damping * v - V.T @ force
     if structure.n_gyroscopic:
         gen = gen - structure.gyroscopic_matrix() @ v
+    if structure.n_frame_stiffness:
+        gen = gen - structure.frame_stiffness_matrix() @ y[:n]
     if structure.n_friction:
         gen = gen - friction_matrix_numpy(structure, t).T @ np.maximum(force, 0.0)
     accel = structure.inv_mass * gen

@@ -5,7 +5,7 @@ laws (damping plays no part):
 
 * ordinary elements: ``f_e = k_e h(V_e.q - e_e; g_e) + p_e``, h the dead zone of
   half-width g (backlash, support clearance);
-* spline radial elements (seed 002 eq. 6): radial force F(R) along d/R with
+* spline radial elements (Dong et al. 2021 eq. 6): radial force F(R) along d/R with
   ``F = k R`` (R < S1), ``0`` (S1 <= R <= S2: floating; friction is zero at rest),
   ``k (R - S2)`` (R > S2), i.e. a radial dead zone;
 * tooth friction: the projection W_e of the mean friction-table values (``t=None``) or
@@ -141,20 +141,15 @@ def rigid_body_modes(structure: Structure, active: np.ndarray | None = None,
     ``active`` (n_el bool) defaults to every element whose stiffness table is not all
     zero, dead zones closed.  Computed from the projection vectors alone (singular
     values of V M^-1/2 below ``tolerance`` x the largest), so stiffness magnitudes do
-    not affect it.  The inertial terms of a turning frame (centripetal softening, pin
-    preload: ``metadata['inertial_elements']``) are left out: the rigid rotation of a
-    planetary train is that of its kinematics, on which the nominal torques balance.
+    not affect it.  The inertial stiffness of a turning frame (centripetal softening,
+    pin preload: ``Structure.fs_*``) is not an element and does not hold a rigid motion:
+    the rigid rotation of a planetary train is that of its kinematics, on which the
+    nominal torques balance.
     """
     s = structure
     if active is None:
         active = np.abs(s.stiffness_table).max(axis=1) > 0
     active = np.asarray(active, dtype=bool).copy()
-    # the terms of a turning frame (centripetal softening, pin preload) are inertial, not
-    # elastic: they do not hold the train's rigid rotation
-    inertial = s.metadata.get("inertial_elements", ())
-    if inertial:
-        names = {n: i for i, n in enumerate(s.element_names)}
-        active[[names[n] for n in inertial if n in names]] = False
     d = np.sqrt(s.inv_mass)
     A = s.projection_matrix()[active] * d[None, :]
     if A.shape[0] == 0:
@@ -198,6 +193,7 @@ class _StaticProblem:
         s = structure
         self.s = s
         self.V = s.projection_matrix()
+        self.Kf = s.frame_stiffness_matrix()  # inertial stiffness of turning frames
         self.mass = 1.0 / s.inv_mass
         self.phi = rigid_body_modes(s)
         self.B = self.mass[:, None] * self.phi
@@ -305,9 +301,10 @@ class _StaticProblem:
         return delta, f, kt, energy, state, sp
 
     def hessian(self, kt, sp):
-        """Tangent stiffness: sum_e kt_e V_e V_e^T plus each spline's 2 x 2 tangent."""
+        """Tangent stiffness: sum_e kt_e V_e V_e^T plus each spline's 2 x 2 tangent and
+        the frame stiffness K_f."""
         V = self.V
-        H = V.T @ (kt[:, None] * V)
+        H = V.T @ (kt[:, None] * V) + self.Kf
         for j, h2 in enumerate(sp):
             rows = V[[self.sp_x[j], self.sp_y[j]]]
             H += rows.T @ h2 @ rows
@@ -377,7 +374,7 @@ class _StaticProblem:
         """Equilibrium with every dead zone closed and no clearance (a linear spring per
         element): the starting point of the Newton iteration."""
         kt = np.where(L.k > 0, L.k, 0.0)
-        H = self.V.T @ (kt[:, None] * self.V)
+        H = self.V.T @ (kt[:, None] * self.V) + self.Kf
         return self._kkt(H, load + self.V.T @ (kt * L.e), np.zeros(self.B.shape[1]), kt > 0)
 
     def _directional(self, q, dq, L, load, reg):
@@ -385,10 +382,11 @@ class _StaticProblem:
         of the terms it is made of (its round-off scale)."""
         vdq = self.V @ dq
         fdq = float(load @ dq)
+        kq, kdq = self.Kf @ q, self.Kf @ dq  # the frame stiffness (linear in q)
 
         def dphi(alpha):
             _, f, _, _, _, _ = self.forces(q + alpha * dq, L, reg)
-            terms = f * vdq
+            terms = np.concatenate([f * vdq, (kq + alpha * kdq) * dq])
             return float(terms.sum()) - fdq, float(np.abs(terms).sum()) + abs(fdq)
         return dphi, vdq
 
@@ -397,7 +395,7 @@ class _StaticProblem:
         solves = 0
         delta, f, kt, _, state, sp = self.forces(q, L, reg)
         while solves < budget:
-            grad = self.V.T @ f - load
+            grad = self.V.T @ f + self.Kf @ q - load
             H = self.hessian(kt, sp)
             active = kt > 0
             for j, h2 in enumerate(sp):
@@ -485,7 +483,7 @@ class _StaticProblem:
         delta, f, _, _, state, _ = self.forces(q, L, 0.0)
         forces = f + L.p
         contact = (state != SEPARATED) & (state != FLOAT)
-        resid = L.f_eff - self.V.T @ f
+        resid = L.f_eff - self.V.T @ f - self.Kf @ q
         if L.W is not None:
             friction_load = L.W.T @ np.maximum(forces, 0.0)
             self.check_balance(L.f_eff, friction_load)
@@ -576,13 +574,15 @@ def quasi_static(
     regularisation: float = 1e-9,
     balance_tolerance: float = 1e-8,
     max_iterations: int = 200,
+    progress=None,
 ) -> QuasiStaticSolution:
     """Static equilibrium at each time of ``times`` (mesh positions), e.g. for load
     sharing without dynamics.
 
     The projection matrix, rigid-body modes and their constraint are built once; each
     time starts its Newton iteration from the previous time's displacements, so a
-    smooth sweep usually needs one or two linear solves per time.
+    smooth sweep usually needs one or two linear solves per time.  ``progress``, if
+    given, is called with the fraction of times done (about a hundred times).
     """
     times = np.atleast_1d(np.asarray(times, dtype=float))
     problem = _StaticProblem(structure, regularisation, balance_tolerance)
@@ -594,7 +594,10 @@ def quasi_static(
     conv = np.zeros(nt, dtype=bool)
     its = np.zeros(nt, dtype=np.int64)
     q = None
+    every = max(1, nt // 100)
     for i, t in enumerate(times):
+        if progress is not None and i % every == 0:
+            progress(i / nt)
         r = problem.solve(t, q, max_iterations)
         q = r["q"] if r["converged"] else None
         Q[i], F[i], D[i], C[i] = r["q"], r["forces"], r["delta"], r["contact"]

@@ -124,18 +124,21 @@ def _linearise(slot, iy, m, w, force, kd, cr, spt, frv, fps):
 def _jvp(m, kd, cr, spt, frv, fps, dq, dv, out, df):
     """out = A_q dq + A_v dv for one linearisation (1-D arrays of n; ``df`` scratch of
     ne): -M^-1 [sum_e V_e (kd_e V_e.dq + cr_e V_e.dv) + splines + friction slopes
-    + C_g dv + G dv]."""
+    + C_g dv + G dv + K_f dq]."""
     v_ptr, v_dof, v_coef = m.v_ptr, m.v_dof, m.v_coef
     inv_mass, ground = m.inv_mass, m.ground_damping
     sp_el, fr_el, fr_ptr, fr_dof, fr_coef, fr_row = (m.sp_el, m.fr_el, m.fr_ptr, m.fr_dof,
                                                      m.fr_coef, m.fr_row)
     gy_ptr, gy_idx, gy_coef = m.gy_ptr, m.gy_idx, m.gy_coef
+    fs_ptr, fs_idx, fs_coef = m.fs_ptr, m.fs_idx, m.fs_coef
     n = inv_mass.shape[0]
     ne = v_ptr.shape[0] - 1
     for i in range(n):
         out[i] = -ground[i] * dv[i]
         for j in range(gy_ptr[i], gy_ptr[i + 1]):
             out[i] -= gy_coef[j] * dv[np.int64(gy_idx[j]) - n]
+        for j in range(fs_ptr[i], fs_ptr[i + 1]):
+            out[i] -= fs_coef[j] * dq[np.int64(fs_idx[j])]
     for el in range(ne):
         a = 0.0
         b = 0.0

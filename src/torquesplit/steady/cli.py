@@ -18,11 +18,30 @@ RPM = 60.0 / (2 * math.pi)
 
 
 def _speed(text, what):
-    from torquesplit.model.units import parse_quantity
+    """A speed option: '1200 rpm'; a bare number is rad/s (SI, as in model files)."""
+    from torquesplit.cli_support import quantity
 
-    if text is None:
-        return None
-    return float(parse_quantity(text, "speed"))
+    return quantity(text, "speed", what)
+
+
+def _check_out(path, formats=None):
+    """Check an output path before computing (folder, suffix, an existing file)."""
+    from torquesplit.results import files
+
+    if path is not None:
+        files.check_output(path, formats=formats, overwrite=True)
+
+
+def _emit(data, json_default):
+    from torquesplit.cli_support import emit_json
+
+    emit_json(data, json_default)
+
+
+def _h(text):
+    from torquesplit.cli_support import header
+
+    return header(text)
 
 
 def _keep(keep):
@@ -64,13 +83,17 @@ def register(app, load, fail, console, err_console, json_default):
                 raise TorquesplitError(f"--method {method!r} is unknown; use hb or shooting")
             from torquesplit.steady.api import steady_state
 
+            _check_out(out)
             m, _ = load(model)
-            st = steady_state(m, method=method, harmonics=harmonics, adaptive=adaptive,
-                              keep=_keep(keep), speed=_speed(speed, "speed"),
-                              max_cycles=max_cycles)
+            from torquesplit.cli_support import progress
+
+            with progress("periodic steady state", as_json, total=None):
+                st = steady_state(m, method=method, harmonics=harmonics, adaptive=adaptive,
+                                  keep=_keep(keep), speed=_speed(speed, "--speed"),
+                                  max_cycles=max_cycles)
             rows = st.mesh_table()
             saved = st.to_results().save(out) if out is not None else None
-        except (TorquesplitError, ValueError) as exc:
+        except (TorquesplitError, ValueError, OSError) as exc:
             fail(exc)
             return
         ps = st.solution
@@ -90,7 +113,7 @@ def register(app, load, fail, console, err_console, json_default):
             "results_file": str(saved) if saved else None,
         }
         if as_json:
-            print(json.dumps(info, indent=2, default=json_default))
+            _emit(info, json_default)
         else:
             console.print(f"[bold]{m.model.name}[/]: {ps.message}")
             console.print(f"{st.period.describe()}")
@@ -109,9 +132,9 @@ def register(app, load, fail, console, err_console, json_default):
                               f"multiplier |mu| = {abs(mu[0]):.6f}")
             t = Table(title="meshes (periodic steady state)")
             for col in ("mesh", "group", "static F [N]", "mean F [N]", "peak F [N]",
-                        "DF (peak/static)", "peak/nominal", "LSC", "RMS TE [um]",
+                        "DF (peak/static)", "peak/nominal", "LSC", "RMS TE [µm]",
                         "contact loss"):
-                t.add_column(col, justify="left" if col in ("mesh", "group") else "right")
+                t.add_column(_h(col), justify="left" if col in ("mesh", "group") else "right")
             for r in rows:
                 t.add_row(r.mesh, r.group, f"{r.static_force:.6g}", f"{r.mean_force:.6g}",
                           f"{r.peak_force:.6g}", f"{r.dynamic_factor:.5f}",
@@ -143,13 +166,21 @@ def register(app, load, fail, console, err_console, json_default):
     ):
         """Speed response by continuation: dynamic factor, load sharing, RMS TE vs speed."""
         try:
+            from torquesplit.results.files import NETCDF_FORMATS
             from torquesplit.steady.maps import sweep_speed
 
+            _check_out(out, NETCDF_FORMATS)
+            if plot is not None:
+                _check_out(plot, {".png": "png", ".svg": "svg", ".pdf": "pdf"})
             m, _ = load(model)
-            ds = sweep_speed(m, _speed(start, "--from"), _speed(stop, "--to"), points=points,
-                             harmonics=harmonics, keep=_keep(keep), max_cycles=max_cycles,
-                             stability=not no_stability, cross_check=cross_check)
-        except (TorquesplitError, ValueError) as exc:
+            from torquesplit.cli_support import progress
+
+            with progress("speed sweep", as_json, total=None):
+                ds = sweep_speed(m, _speed(start, "--from"), _speed(stop, "--to"),
+                                 points=points, harmonics=harmonics, keep=_keep(keep),
+                                 max_cycles=max_cycles, stability=not no_stability,
+                                 cross_check=cross_check)
+        except (TorquesplitError, ValueError, OSError) as exc:
             fail(exc)
             return
         if out is not None:
@@ -169,7 +200,7 @@ def register(app, load, fail, console, err_console, json_default):
             "wall_time_s": ds.attrs["wall_time_s"],
         }
         if as_json:
-            print(json.dumps(summary, indent=2, default=json_default))
+            _emit(summary, json_default)
         else:
             console.print(f"[bold]{summary['model']}[/]: {summary['points']} points, "
                           f"{ds.attrs['message']} ({summary['wall_time_s']:.3g} s)")
@@ -179,7 +210,7 @@ def register(app, load, fail, console, err_console, json_default):
                                                         ds.attrs["fold_kinds"], strict=True)))
             t = Table(title="largest dynamic factor over the sweep")
             for col in ("mesh", "DF (peak/static)", "at [rpm]"):
-                t.add_column(col)
+                t.add_column(_h(col))
             for k in ds["mesh"].values:
                 df = ds["dynamic_factor"].sel(mesh=k).values
                 i = int(np.nanargmax(df))
@@ -195,11 +226,15 @@ import numpy as np  # noqa: E402  (used by the commands above)
 
 
 def _to_netcdf(ds, path):
+    """Write atomically (complete or absent; see torquesplit.results.files)."""
+    from torquesplit.results import files
+
     ds = ds.copy()
     for k, v in list(ds.attrs.items()):
         if isinstance(v, list):
             ds.attrs[k] = json.dumps(v)
-    ds.to_netcdf(path, engine="h5netcdf")
+    files.write_atomically(path, files.netcdf_bytes(ds), overwrite=True,
+                           formats=files.NETCDF_FORMATS)
 
 
 def campbell_command(m, start, stop, plot, as_json, console, json_default):
@@ -212,13 +247,13 @@ def campbell_command(m, start, stop, plot, as_json, console, json_default):
 
         save(campbell_figure(ds), plot)
     if as_json:
-        print(json.dumps({"critical_speeds": crossings,
-                          "natural_frequencies_Hz": ds["natural_frequency"].values[0].tolist()},
-                         indent=2, default=json_default))
+        _emit({"critical_speeds": crossings,
+               "natural_frequencies_Hz": ds["natural_frequency"].values[0].tolist()},
+              json_default)
         return
     t = Table(title=f"critical speeds between {start} and {stop}")
     for col in ("speed [rpm]", "mode", "f [Hz]", "excitation", "strain energy (largest shares)"):
-        t.add_column(col)
+        t.add_column(_h(col))
     for c in crossings:
         t.add_row(f"{c['speed_rpm']:.6g}", str(c["mode"]), f"{c['frequency_Hz']:.6g}",
                   f"{c['order']} x {c['source']}",

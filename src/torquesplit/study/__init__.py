@@ -34,7 +34,7 @@ Examples
 --------
 >>> import torquesplit
 >>> ds = torquesplit.run_study({
-...     "study": {"name": "damping", "model": "seed001_mill_drive",
+...     "study": {"name": "damping", "model": "ji_li_mill_drive",
 ...               "outputs": ["load_sharing.engineering.*"]},
 ...     "analysis": {"cycles": 20},
 ...     "grid": {"parameters": [{"path": "meshes.m11.damping_ratio",

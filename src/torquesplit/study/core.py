@@ -68,7 +68,7 @@ class Study:
     --------
     >>> import torquesplit
     >>> study = torquesplit.Study({
-    ...     "study": {"name": "k", "model": "seed001_mill_drive",
+    ...     "study": {"name": "k", "model": "ji_li_mill_drive",
     ...               "outputs": ["load_sharing.engineering"]},
     ...     "analysis": {"cycles": 20},
     ...     "grid": {"parameters": [{"path": "meshes.m11.damping_ratio",

@@ -182,8 +182,15 @@ def _model_data(name: str, folder: Path | None) -> tuple[str, dict]:
             return str(path), read_raw(path)
         except TorquesplitError as exc:
             raise StudyError("study.model", _one_line(exc)) from None
-    if name in example_names():
-        return name, read_raw(example_path(name))
+    from ..examples import current_name
+
+    stem, note = current_name(name)
+    if stem in example_names():
+        if note:
+            warnings.warn(note, FutureWarning, stacklevel=2)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", FutureWarning)
+            return stem, read_raw(example_path(stem))
     raise StudyError("study.model", f"{name!r} is neither a model file (looked in "
                                     f"{path.parent}) nor a shipped example; give the path of "
                                     f"the model file, relative to the study file")

@@ -30,6 +30,7 @@ name                                        value
 ``nominal_force.<mesh>``                    equal-split nominal force [N]
 ``contact_loss.<mesh>``                     fraction of the run with the teeth apart
 ``back_contact.<mesh>``                     fraction of the run in back-flank contact
+``back_flank_force.<mesh>``                 largest back-flank (tensile) force [N]
 ``settle_time``                             start of the settled part of the run [s]
 ==========================================  ==============================================
 
@@ -64,6 +65,7 @@ FAMILIES: dict[str, tuple[str, str]] = {
     "nominal_force": ("N", "nominal (equal-split) mesh force"),
     "contact_loss": ("1", "fraction of time with contact lost"),
     "back_contact": ("1", "fraction of time in back-flank contact"),
+    "back_flank_force": ("N", "largest back-flank (tensile) force"),
     "settle_time": ("s", "start of the settled part of the run"),
 }
 
@@ -90,7 +92,7 @@ def output_values(result, definitions=None) -> dict[str, float]:
     --------
     >>> import torquesplit
     >>> from torquesplit.study.outputs import output_values
-    >>> res = torquesplit.simulate(torquesplit.example_path("seed001_mill_drive"), cycles=20)
+    >>> res = torquesplit.simulate(torquesplit.example_path("ji_li_mill_drive"), cycles=20)
     >>> v = output_values(res, ["engineering"])
     >>> 1.0 <= v["load_sharing.engineering"] < 2.0
     True
@@ -157,7 +159,7 @@ def available_outputs(mesh_names, groups: dict[str, list[str]], analysis: str) -
     names += [f"peak_to_nominal.{x}" for x in (*groups, *mesh_names)]
     names += [f"peak_to_nominal_engineering.{g}" for g in groups]
     for fam in ("peak_force", "min_force", "mean_force", "static_force", "nominal_force",
-                "contact_loss", "back_contact"):
+                "contact_loss", "back_contact", "back_flank_force"):
         names += [f"{fam}.{m}" for m in mesh_names]
     names.append("settle_time")
     return names

@@ -4,7 +4,7 @@ A study file is TOML::
 
     [study]
     name = "diameter"
-    model = "seed001_mill_drive"        # a model file (relative to this file) or an example
+    model = "ji_li_mill_drive"        # a model file (relative to this file) or an example
     outputs = ["load_sharing.engineering.*"]
 
     [set]                                # optional: fixed changes to the model, as --set

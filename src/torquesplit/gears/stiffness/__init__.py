@@ -14,7 +14,7 @@ module                 what it does
                        for helical and double-helical pairs
 ``tables``             constant, table against phase, Fourier series, tables at
                        several loads interpolated in load
-``load_fit``           seed 002 eqs. 17-18: fit of loaded transmission error against
+``load_fit``           Dong et al. 2021 eqs. 17-18: fit of loaded transmission error against
                        torque and the resulting stiffness
 ``dispatch``           :func:`mesh_stiffness` (method by name) and
                        :func:`compare_methods`

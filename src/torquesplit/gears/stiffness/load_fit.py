@@ -1,16 +1,16 @@
 """Load-dependent mesh stiffness from three loaded transmission-error levels
-(seed 002 §5, eqs. 17-18).
+(Dong et al. 2021 §5, eqs. 17-18).
 
-Seed 002 splits the loaded angular transmission error of a pair at each mesh
+Dong et al. 2021 splits the loaded angular transmission error of a pair at each mesh
 position into a geometric part (constant), a bending part (linear in torque) and a
 Hertzian contact part (torque to the power 2/3)::
 
-    dphi(T) = sign(T) (a + b |T| + c |T|^(2/3))                      (seed 002 eq. 17)
+    dphi(T) = sign(T) (a + b |T| + c |T|^(2/3))                      (Dong et al. 2021 eq. 17)
 
 fits ``a, b, c`` from LTCA results at 0.1, 0.5 and 0.9 of the nominal torque, and
 turns it into a mesh stiffness::
 
-    k(T) = T / (r_b^2 cos(alpha_n) cos(beta)) / dphi(T)                (seed 002 eq. 18)
+    k(T) = T / (r_b^2 cos(alpha_n) cos(beta)) / dphi(T)                (Dong et al. 2021 eq. 18)
 
 Note on eq. 17: the paper prints ``(T/|T|)(a + b T + c T^(2/3))``; for a negative
 torque that changes the sign of the bending term only.  The physically consistent
@@ -35,7 +35,7 @@ __all__ = ["LoadDeflectionFit", "fit_load_deflection", "load_fit_stiffness"]
 
 @dataclass(frozen=True)
 class LoadDeflectionFit:
-    """Coefficients of seed 002 eq. 17, one set per mesh position (or a single set).
+    """Coefficients of Dong et al. 2021 eq. 17, one set per mesh position (or a single set).
 
     ``a`` [rad], ``b`` [rad/(N m)], ``c`` [rad/(N m)^(2/3)]; arrays of shape (p,) for
     p mesh positions uniformly spread over one mesh cycle, or scalars.
@@ -46,31 +46,31 @@ class LoadDeflectionFit:
     c: np.ndarray
 
     def angular_deflection(self, torque: float) -> np.ndarray:
-        """``dphi(T) = sign(T)(a + b|T| + c|T|^(2/3))`` [rad] (seed 002 eq. 17)."""
+        """``dphi(T) = sign(T)(a + b|T| + c|T|^(2/3))`` [rad] (Dong et al. 2021 eq. 17)."""
         t = abs(float(torque))
-        # seed 002 eq. 17 (odd-symmetric form, see module docstring)
+        # Dong et al. 2021 eq. 17 (odd-symmetric form, see module docstring)
         return np.sign(torque) * (self.a + self.b * t + self.c * t ** (2.0 / 3.0))
 
     def stiffness(self, torque: float, base_radius: float, normal_pressure_angle: float,
                   helix_angle: float = 0.0) -> np.ndarray:
-        """Mesh stiffness at torque ``T`` [N/m] (seed 002 eq. 18).
+        """Mesh stiffness at torque ``T`` [N/m] (Dong et al. 2021 eq. 18).
 
         ``k = T / (r_b^2 cos(alpha_n) cos(beta)) / dphi(T)`` with ``r_b`` the base
         radius of the gear to which ``T`` and ``dphi`` refer.
         """
         if torque == 0:
-            raise ModelError([("torque", "the secant stiffness of seed 002 eq. 18 needs a non-zero torque")])
+            raise ModelError([("torque", "the secant stiffness of Dong et al. 2021 eq. 18 needs a non-zero torque")])
         dphi = self.angular_deflection(torque)
         if np.any(dphi * np.sign(torque) <= 0):
             raise ModelError([("torque", "the fitted deflection is not positive at this torque; "
                                          "evaluate within the fitted load range")])
-        # seed 002 eq. 18
+        # Dong et al. 2021 eq. 18
         return (torque / (base_radius ** 2 * np.cos(normal_pressure_angle) * np.cos(helix_angle))
                 / dphi)
 
 
 def fit_load_deflection(torques, deflections) -> LoadDeflectionFit:
-    """Fit ``a, b, c`` of seed 002 eq. 17 to loaded transmission errors.
+    """Fit ``a, b, c`` of Dong et al. 2021 eq. 17 to loaded transmission errors.
 
     Parameters
     ----------
@@ -100,7 +100,7 @@ def fit_load_deflection(torques, deflections) -> LoadDeflectionFit:
 def load_fit_stiffness(fit: LoadDeflectionFit, torque: float, base_radius: float,
                        normal_pressure_angle: float, helix_angle: float = 0.0,
                        n: int = 256) -> MeshStiffness:
-    """Mesh stiffness over one mesh cycle at ``torque`` from a per-position fit (seed 002
+    """Mesh stiffness over one mesh cycle at ``torque`` from a per-position fit (Dong et al. 2021
     eqs. 17-18), resampled periodically onto ``n`` phases [N/m].
 
     The ``p`` positions of the fit are taken as uniformly spaced over one mesh cycle,

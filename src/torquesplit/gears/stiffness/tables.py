@@ -1,7 +1,7 @@
 """User-supplied mesh stiffness: a constant, a table against mesh phase, a Fourier
 series, or tables at several load levels interpolated in load.
 
-Typical sources: an LTCA or FE program (seed 000 §2.3, seed 002 §5), a test rig, or
+Typical sources: an LTCA or FE program (Liu et al. 2021 §2.3, Dong et al. 2021 §5), a test rig, or
 a paper's figure.  Phases are in cycles of the tooth-mesh period (0..1, taken modulo
 1); stiffness in N/m along the normal to the flanks (the convention of
 :class:`~torquesplit.gears.stiffness.result.MeshStiffness`).
@@ -60,7 +60,7 @@ def fourier_stiffness(mean: float, cos=(), sin=(), n: int = 256) -> MeshStiffnes
 
     ``k(phi) = mean + sum_k a_k cos(2 pi k phi) + b_k sin(2 pi k phi)``, k = 1, 2, ...;
     ``cos`` holds ``a_k``, ``sin`` holds ``b_k`` (either may be shorter; missing
-    terms are 0).  This is the form in which seed 000 passes its LTCA stiffness to
+    terms are 0).  This is the form in which Liu et al. 2021 passes its LTCA stiffness to
     the dynamic model (§2.3).
 
     >>> k = fourier_stiffness(1e9, cos=[1e8], n=4)

@@ -1,0 +1,200 @@
+"""What every command of :mod:`torquesplit.cli` shows the user besides its result.
+
+==========================  ==============================================================
+helper                      what it does
+==========================  ==============================================================
+:class:`Session`            the warnings of one command, in the order they were printed
+:func:`warn`                print one ``warning:`` line on stderr and keep it for ``--json``
+:func:`collect_warnings`    route Python warnings raised inside (the model's checks, the
+                            run's cost estimate, deprecated names) to :func:`warn`
+:func:`emit_json`           print a command's JSON with its ``warnings`` list
+:func:`progress`            a progress bar (or a spinner for work of unknown length) on a
+                            terminal, nothing elsewhere; its callback takes the fraction
+                            done and, optionally, what is being done
+:func:`interruptible`       Ctrl-C prints "interrupted; ..." with what was kept, exit 130
+:func:`quantity`            an option value with units; a bare number is SI (``--duration
+                            3`` is 3 s), as in model files
+:func:`header`              a table header with its unit in brackets, safe from rich markup
+                            (``"speed [rpm]"`` would otherwise lose ``[rpm]``)
+==========================  ==============================================================
+
+No state survives a command: :func:`reset` starts each one (the app's callback calls it).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import math
+import sys
+import warnings
+from dataclasses import dataclass, field
+from typing import Callable, Iterator, Optional
+
+from rich.markup import escape
+
+from .errors import ModelWarning, OptionError, clip_message
+
+
+@dataclass
+class Session:
+    """Warnings printed by the current command."""
+
+    warnings: list[str] = field(default_factory=list)
+    console: object = None
+    err_console: object = None
+    debug: bool = False
+
+
+_session = Session()
+
+
+def session() -> Session:
+    return _session
+
+
+def reset(console, err_console, debug: bool = False) -> None:
+    """Start a command: no warnings yet."""
+    global _session
+    _session = Session(console=console, err_console=err_console, debug=debug)
+
+
+def warn(text: str, *, label: str = "warning") -> None:
+    """Print ``warning: text`` on stderr (once per command) and keep it for ``--json``."""
+    text = clip_message(str(text).strip())
+    if not text or text in _session.warnings:
+        return
+    _session.warnings.append(text)
+    con = _session.err_console
+    if con is None:  # pragma: no cover - outside a command
+        print(f"{label}: {text}", file=sys.stderr)
+        return
+    con.print(f"[yellow]{label}:[/] ", end="")
+    con.print(text, markup=False, highlight=False, soft_wrap=True)
+
+
+@contextlib.contextmanager
+def collect_warnings() -> Iterator[None]:
+    """Show every :class:`~torquesplit.errors.ModelWarning` (and deprecation notes) raised
+    inside as a ``warning:`` line the moment it is raised, and keep it for ``--json``.
+
+    Other Python warnings (numerical noise of a library) are shown the same way with
+    ``--debug`` only.
+    """
+    with warnings.catch_warnings():
+        warnings.simplefilter("always", ModelWarning)
+        warnings.simplefilter("always", FutureWarning)
+
+        def show(message, category, filename, lineno, file=None, line=None):
+            if issubclass(category, ModelWarning):
+                warn(str(message))
+            elif issubclass(category, FutureWarning):
+                warn(str(message), label="note")
+            elif _session.debug:
+                warn(f"{message} ({category.__name__} at {filename}:{lineno})")
+
+        warnings.showwarning = show
+        yield
+
+
+def emit_json(data: dict, default: Callable | None = None) -> None:
+    """Print ``data`` as JSON with the command's ``warnings`` list added."""
+    data = dict(data)
+    data["warnings"] = list(_session.warnings)
+    print(json.dumps(data, indent=2, default=default or json_default))
+
+
+def json_default(x):
+    if isinstance(x, float) and not math.isfinite(x):
+        return None
+    try:
+        return float(x)
+    except Exception:
+        return str(x)
+
+
+@contextlib.contextmanager
+def progress(label: str, quiet: bool = False, *, total: Optional[float] = 1.0):
+    """A transient progress bar on stderr while the block runs (a terminal only).
+
+    Yields a callback ``update(fraction, what=None)``; with ``total=None`` the bar is a
+    spinner (work of unknown length) and ``fraction`` is ignored.  ``quiet`` or a
+    non-terminal stderr: the callback does nothing.
+    """
+    con = _session.err_console
+    if quiet or con is None or not getattr(con, "is_terminal", False):
+        yield lambda fraction=None, what=None: None
+        return
+    from rich.progress import (BarColumn, Progress, SpinnerColumn, TextColumn,
+                               TimeElapsedColumn, TimeRemainingColumn)
+
+    columns = ([SpinnerColumn(), TextColumn("{task.description}"), TimeElapsedColumn()]
+               if total is None else
+               [TextColumn("{task.description}"), BarColumn(),
+                TextColumn("{task.percentage:>3.0f}%"), TimeRemainingColumn()])
+    with Progress(*columns, console=con, transient=True) as bar:
+        task = bar.add_task(label, total=total)
+
+        def update(fraction=None, what=None):
+            kwargs = {}
+            if fraction is not None and total is not None:
+                kwargs["completed"] = fraction * total
+            if what:
+                kwargs["description"] = f"{label}: {what}"
+            bar.update(task, **kwargs)
+
+        yield update
+
+
+class Interrupted(Exception):
+    """Raised by :func:`interruptible` after it has said what was kept."""
+
+
+@contextlib.contextmanager
+def interruptible(kept: Callable[[], str] | None = None) -> Iterator[None]:
+    """Turn Ctrl-C into one line, ``interrupted; <what was kept>``, and exit status 130.
+
+    ``kept()`` says what is on disk ("nothing written" when it returns an empty text).
+    """
+    import typer
+
+    try:
+        yield
+    except KeyboardInterrupt:
+        what = ""
+        try:
+            what = kept() if kept is not None else ""
+        except Exception:  # pragma: no cover - never hide the interrupt
+            what = ""
+        con = _session.err_console
+        text = f"interrupted; {what or 'nothing written'}"
+        if con is None:  # pragma: no cover
+            print(text, file=sys.stderr)
+        else:
+            con.print(text, markup=False, highlight=False)
+        raise typer.Exit(130) from None
+
+
+def quantity(text: Optional[str], kind: str, option: str) -> Optional[float]:
+    """An option value in SI: ``"0.5 s"``, ``"3000 rpm"``; a bare number is already SI
+    (``--duration 3`` is 3 s), as in model files."""
+    from .model.units import KINDS, parse_quantity
+
+    if text is None:
+        return None
+    try:
+        value = float(text)
+    except ValueError:
+        try:
+            return parse_quantity(text, kind)
+        except ValueError as exc:
+            raise OptionError(f"{option}: {exc}") from None
+    if not math.isfinite(value):
+        raise OptionError(f"{option} {text!r} is not a finite number; give e.g. {option} "
+                          f"'{KINDS[kind][1]}'")
+    return value
+
+
+def header(text: str) -> str:
+    """A table header safe from rich markup (``[rpm]`` is not a style tag)."""
+    return escape(text)

@@ -1,0 +1,317 @@
+"""The gearbox as an engineer sketches it: ``torquesplit draw MODEL``.
+
+One oblique (cabinet) view of the whole train, so that a user sees that the model is the
+gearbox they meant before running it:
+
+==================  ======================================================================
+element             drawn as
+==================  ======================================================================
+gear                its pitch circle at its position, in the plane normal to its axis
+                    (inclined circles for bevel and face gears); name and teeth
+mesh                red arrow: the line of action through the pitch point, pointing along
+                    the force the driver exerts on the driven gear; blue arrow: the power
+                    flow, driver towards driven; mesh name, backlash if any
+shaft               thick grey line between the centres of the bodies it joins (rigid:
+                    solid, elastic: with a spring zig-zag); name
+spline              dashed line; name and radial clearance
+support             ground hatch below the body; stiffness, clearance if any
+other body          square (motor, load inertia, carrier); name
+drive, load         green / purple label at the body: speed and torque or power
+==================  ======================================================================
+
+The view: the train's main axis (the axis most gears turn about) points out of the page,
+the other two global axes lie in it, and depth along the main axis is drawn half-size
+along the 45 deg diagonal (cabinet projection).  Pitch circles of gears on the main axis
+stay circles; coaxial bodies at different depths separate along the diagonal.  Lengths in
+mm on the axes.
+
+Examples
+--------
+>>> import torquesplit
+>>> from torquesplit.plot.layout import layout_figure
+>>> fig = layout_figure(torquesplit.load_model(torquesplit.example_path("ji_li_mill_drive")))
+>>> fig.axes[0].get_xlabel()
+'x [mm]'
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+
+__all__ = ["layout_figure", "layout_svg"]
+
+#: colours of the sketch
+COLORS = {"gear": "0.15", "loa": "tab:red", "power": "tab:blue", "shaft": "0.55",
+          "spline": "tab:orange", "support": "0.35", "drive": "tab:green", "load": "tab:purple",
+          "body": "0.3"}
+#: depth drawn along the diagonal, per unit of depth (cabinet projection)
+DEPTH_SCALE = 0.5
+DEPTH_ANGLE = math.radians(45.0)
+
+
+def _frame(main: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, str, str]:
+    """In-plane unit vectors (e1, e2), the depth direction and the axis labels for a main
+    axis along a global axis (the nearest one)."""
+    k = int(np.argmax(np.abs(main)))
+    names = "xyz"
+    e = np.eye(3)
+    i, j = [n for n in range(3) if n != k]
+    depth = e[k] * (1.0 if main[k] >= 0 else -1.0)
+    return e[i], e[j], depth, names[i], names[j]
+
+
+class _Projection:
+    """Affine cabinet projection of global coordinates [m] to the page [mm]."""
+
+    def __init__(self, main_axis):
+        self.e1, self.e2, self.depth, self.xlabel, self.ylabel = _frame(
+            np.asarray(main_axis, float))
+        self.dx = DEPTH_SCALE * math.cos(DEPTH_ANGLE)
+        self.dy = DEPTH_SCALE * math.sin(DEPTH_ANGLE)
+
+    def __call__(self, p) -> np.ndarray:
+        p = np.asarray(p, float)
+        d = p @ self.depth
+        return 1e3 * np.stack([p @ self.e1 + self.dx * d, p @ self.e2 + self.dy * d], axis=-1)
+
+    def vector(self, v) -> np.ndarray:
+        """Projection of a direction (no translation)."""
+        return self(np.asarray(v, float)) - self(np.zeros(3))
+
+
+def _main_axis(model, kin) -> np.ndarray:
+    """The axis most gears turn about (sign-insensitive)."""
+    counts: list[tuple[np.ndarray, int]] = []
+    for name in model.gears:
+        a = np.asarray(kin.bodies[name].axis, float)
+        for i, (ref, n) in enumerate(counts):
+            if abs(float(np.dot(ref, a))) > 1 - 1e-6:
+                counts[i] = (ref, n + 1)
+                break
+        else:
+            counts.append((a, 1))
+    return max(counts, key=lambda c: c[1])[0] if counts else np.array([0.0, 0.0, 1.0])
+
+
+def _circle(centre, axis, radius, n=96) -> np.ndarray:
+    """Points of a circle in 3-D: centre, unit normal ``axis``, radius."""
+    a = np.asarray(axis, float)
+    a = a / np.linalg.norm(a)
+    ref = np.eye(3)[int(np.argmin(np.abs(a)))]
+    u = np.cross(a, ref)
+    u /= np.linalg.norm(u)
+    w = np.cross(a, u)
+    t = np.linspace(0, 2 * math.pi, n)
+    return np.asarray(centre, float) + radius * (np.outer(np.cos(t), u) + np.outer(np.sin(t), w))
+
+
+def _si(value: float, unit: str = "um", digits: int = 3) -> str:
+    """A small length [m] in µm, or in mm from 1 mm on."""
+    if abs(value) >= 1e-3:
+        return f"{value * 1e3:.{digits}g} mm"
+    return f"{value * 1e6:.{digits}g} µm"
+
+
+def layout_figure(model, kin=None, *, width: float = 10.0) -> Figure:
+    """The sketch of ``model`` (see the module docstring); every gear, mesh, shaft,
+    spline and support carries its name as text.
+
+    Parameters
+    ----------
+    model : Model
+        A loaded model (checked).
+    kin : Kinematics, optional
+        Its kinematics (computed if not given).
+    width : float
+        Figure width [in].
+    """
+    from ..model.kinematics import gear_geometry, solve_kinematics
+
+    kin = kin or solve_kinematics(model)
+    proj = _Projection(_main_axis(model, kin))
+    fig = Figure(figsize=(width, width * 0.8), layout="constrained")
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot()
+    ax.set_aspect("equal", adjustable="datalim")
+    radius = {}
+    for name, g in model.gears.items():
+        try:
+            radius[name] = gear_geometry(g).reference_radius
+        except Exception:  # noqa: BLE001 - a conical gear: its pitch radius from the mesh
+            radius[name] = g.teeth * g.module / 2
+    for mk in kin.meshes.values():  # operating pitch radii where the kinematics know them
+        for gname, r in zip((mk.driver, mk.driven), mk.pitch_radii):
+            if r and math.isfinite(r):
+                radius[gname] = r
+    size = max(radius.values()) if radius else 0.1
+    fs = 8.0 if len(model.gears) <= 8 else 7.0
+    centre = _drawing_centres(model, kin, proj)
+    # ---- gears
+    for name, g in model.gears.items():
+        pts = proj(_circle(centre[name], kin.bodies[name].axis, radius[name]))
+        ax.plot(pts[:, 0], pts[:, 1], color=COLORS["gear"], lw=1.4, zorder=3)
+        c = proj(centre[name])
+        ax.plot(*c, marker="+", color=COLORS["gear"], ms=7, zorder=3)
+        kind = g.gear_type if g.gear_type not in (None, "spur") else ""
+        ax.annotate(f"{name}\n{g.teeth} T" + (f", {kind}" if kind else ""), c,
+                    xytext=(4, 4), textcoords="offset points", fontsize=fs, zorder=6,
+                    color=COLORS["gear"], gid=f"gear:{name}")
+    # ---- other bodies
+    for name, b in model.bodies.items():
+        c = proj(centre[name])
+        ax.plot(*c, marker="s", ms=9, mfc="white", mec=COLORS["body"], mew=1.4, zorder=4)
+        ax.annotate(name, c, xytext=(6, -10), textcoords="offset points", fontsize=fs,
+                    color=COLORS["body"], zorder=6, gid=f"body:{name}")
+    # ---- meshes: line of action and power flow
+    arrow = 0.35 * size * 1e3
+    for name, mk in kin.meshes.items():
+        p = proj(mk.contact_point)
+        n = proj.vector(mk.line_of_action)
+        norm = float(np.hypot(*n))
+        if norm > 1e-12:
+            n = n / norm * arrow
+            ax.annotate("", xy=p + n / 2, xytext=p - n / 2, zorder=5,
+                        arrowprops={"arrowstyle": "-|>", "color": COLORS["loa"], "lw": 1.6})
+        flow = proj(centre[mk.driven]) - proj(centre[mk.driver])
+        fn = float(np.hypot(*flow))
+        if fn > 1e-9:
+            flow = flow / fn * 0.6 * arrow
+            ax.annotate("", xy=p + flow / 2, xytext=p - flow / 2, zorder=5,
+                        arrowprops={"arrowstyle": "->", "color": COLORS["power"], "lw": 1.2,
+                                    "ls": "-"})
+        mesh = model.meshes[name]
+        extra = (f"\nbacklash {_si(mesh.backlash.nominal, 'um')}"
+                 if mesh.backlash.nominal > 0 else "")
+        ax.annotate(f"{name}{extra}", p, xytext=(5, -12), textcoords="offset points",
+                    fontsize=fs, color=COLORS["loa"], zorder=6, gid=f"mesh:{name}")
+    # ---- shafts and splines
+    for name, s in model.shafts.items():
+        a, b = (proj(centre[x]) for x in s.connects)
+        style = "-" if s.rigid else (0, (6, 2))
+        ax.plot([a[0], b[0]], [a[1], b[1]], color=COLORS["shaft"], lw=4.0, ls=style,
+                solid_capstyle="round", zorder=2, alpha=0.8)
+        m = (a + b) / 2
+        what = "rigid" if s.rigid else "elastic"
+        ax.annotate(f"shaft {name} ({what})", m, xytext=(6, 2), textcoords="offset points",
+                    fontsize=fs - 0.5, color=COLORS["shaft"], zorder=6, gid=f"shaft:{name}")
+    for name, s in model.splines.items():
+        a, b = (proj(centre[x]) for x in s.connects)
+        ax.plot([a[0], b[0]], [a[1], b[1]], color=COLORS["spline"], lw=2.0, ls="--", zorder=2)
+        m = (a + b) / 2
+        ax.annotate(f"spline {name}\nclearance {_si(s.radial_clearance, 'um')}", m,
+                    xytext=(6, -16), textcoords="offset points", fontsize=fs - 0.5,
+                    color=COLORS["spline"], zorder=6, gid=f"spline:{name}")
+    # ---- supports (the values once in the key when every support has the same)
+    supported = [(kind, name, body) for kind, items in (("gears", model.gears),
+                                                        ("bodies", model.bodies))
+                 for name, body in items.items()
+                 if body.support is not None and any(d != "theta" for d in body.dofs)]
+    grounded = [name for _, name, body in supported if not getattr(body.support, "on", None)]
+    texts = {name: _support_text(body.support) for _, name, body in supported}
+    same = len({texts[n] for n in grounded}) == 1 and len(grounded) > 3
+    for kind, name, body in supported:
+        c = proj(centre[name])
+        seat = getattr(body.support, "on", None)
+        if seat and seat in centre:  # a bearing on another body (a planet on its pin)
+            s = proj(centre[seat])
+            ax.plot([c[0], s[0]], [c[1], s[1]], color=COLORS["support"], lw=0.9, ls=":",
+                    zorder=1)
+            ax.annotate(f"bearing on {seat}", c, xytext=(-10, -14), textcoords="offset points",
+                        fontsize=fs - 1.0, color=COLORS["support"], zorder=6,
+                        gid=f"support:{name}")
+            continue
+        drop = 0.18 * size * 1e3 + (radius.get(name, 0.0) * 1e3 if kind == "gears" else 0)
+        g0 = c - np.array([0.0, drop])
+        ax.plot([c[0], g0[0]], [c[1], g0[1]], color=COLORS["support"], lw=1.0, zorder=1)
+        half = 0.06 * size * 1e3
+        ax.plot([g0[0] - half, g0[0] + half], [g0[1], g0[1]], color=COLORS["support"],
+                lw=1.6, zorder=1)
+        for k in range(5):
+            x0 = g0[0] - half + k * half / 2
+            ax.plot([x0, x0 - half / 3], [g0[1], g0[1] - half / 3],
+                    color=COLORS["support"], lw=0.8, zorder=1)
+        label = "support" if same else f"support {name}\n{texts[name]}"
+        ax.annotate(label, g0, xytext=(-10, -12 if same else -20),
+                    textcoords="offset points", fontsize=fs - 1.0,
+                    color=COLORS["support"], zorder=6, gid=f"support:{name}")
+    # ---- drives and loads
+    for name, d in model.drives.items():
+        c = proj(centre[d.body])
+        what = (f"{abs(d.speed) * 30 / math.pi:.5g} rpm" + (
+            f", {d.power / 1e3:.4g} kW" if d.power else
+            f", {d.torque:.4g} N m" if d.torque else ""))
+        ax.annotate(f"drive {name}: {what}", c, xytext=(-10, 14), textcoords="offset points",
+                    fontsize=fs, color=COLORS["drive"], fontweight="bold", zorder=7,
+                    gid=f"drive:{name}")
+    for name, ld in model.loads.items():
+        c = proj(centre[ld.body])
+        torque = kin.load_torques.get(name) if hasattr(kin, "load_torques") else None
+        what = f": {torque:.5g} N m" if isinstance(torque, (int, float)) else ""
+        ax.annotate(f"load {name}{what}", c, xytext=(-10, 24), textcoords="offset points",
+                    fontsize=fs, color=COLORS["load"], fontweight="bold", zorder=7,
+                    gid=f"load:{name}")
+    # ---- frame, key
+    ax.set_xlabel(f"{proj.xlabel} [mm]")
+    ax.set_ylabel(f"{proj.ylabel} [mm]")
+    ax.grid(True, alpha=0.2)
+    depth = "xyz"[int(np.argmax(np.abs(proj.depth)))]
+    ax.plot([], [], color=COLORS["loa"], lw=1.6, label="line of action (force on the driven "
+            "gear)")
+    ax.plot([], [], color=COLORS["power"], lw=1.2, label="power flow (driver to driven)")
+    ax.plot([], [], color=COLORS["shaft"], lw=4, label="shaft (dashed: elastic)")
+    if model.splines:
+        ax.plot([], [], color=COLORS["spline"], lw=2, ls="--", label="spline")
+    if supported:
+        ax.plot([], [], color=COLORS["support"], lw=1.6,
+                label="support to the housing" + (f": {texts[grounded[0]]} each"
+                                                  if same else ""))
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=fs, frameon=False)
+    ax.set_title(f"{model.model.name}: layout, {len(model.gears)} gears, "
+                 f"{len(model.meshes)} meshes\nviewed along {depth} (depth along the "
+                 f"diagonal at half scale); pitch circles", fontsize=11)
+    ax.margins(0.12)
+    return fig
+
+
+def _support_text(sup) -> str:
+    bits = []
+    if sup.stiffness:
+        bits.append(f"{sup.stiffness / 1e6:.3g} N/µm")
+    elif sup.shaft is not None:
+        bits.append("shaft bending")
+    if sup.clearance > 0:
+        bits.append(f"clearance {_si(sup.clearance, 'um')}")
+    return ", ".join(bits)
+
+
+def _drawing_centres(model, kin, proj) -> dict[str, np.ndarray]:
+    """Body centres for the sketch: the model's, except that bodies joined by a shaft or
+    spline at the very same point (a compound gear given one position) are spread along
+    their axis by their face widths, so that both show."""
+    centre = {n: np.asarray(b.position, float) for n, b in kin.bodies.items()}
+    links = [s.connects for s in list(model.shafts.values()) + list(model.splines.values())]
+    for a, b in links:
+        if np.linalg.norm(centre[a] - centre[b]) > 1e-9:
+            continue
+        axis = np.asarray(kin.bodies[b].axis, float)
+        width = sum(model.gears[x].face_width * (2 if model.gears[x].gear_type ==
+                                                 "double_helical" else 1)
+                    for x in (a, b) if x in model.gears) or 0.05
+        step = 1.5 * width * (1 if float(np.dot(axis, proj.depth)) >= 0 else -1)
+        shift = axis * step
+        taken = [centre[n] for n in centre if n != b]
+        while any(np.linalg.norm(centre[b] + shift - c) < 1e-9 for c in taken):
+            shift = shift * 2
+        centre[b] = centre[b] + shift
+    return centre
+
+
+def layout_svg(model, kin=None, *, salt: str = "layout") -> str:
+    """The sketch as SVG text (text kept as text: every name is searchable)."""
+    from .figures import figure_svg
+
+    return figure_svg(layout_figure(model, kin), salt)

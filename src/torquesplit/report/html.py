@@ -1,0 +1,423 @@
+"""The HTML report of a run: one self-contained file to hand on.
+
+:func:`build_report` takes a finished run (:class:`~torquesplit.results.Results`, from
+:func:`torquesplit.simulate` or a results file) and returns the page as text.  Sections:
+
+1. provenance: torquesplit version and commit, model file and its SHA-256, date, the
+   results file's run id when the run comes from one;
+2. warnings (the model's, the run's and the results');
+3. the model: bodies, meshes, supports, shafts and splines, with units;
+4. the layout drawing (:mod:`torquesplit.plot.layout`);
+5. the run's settings and the per-mesh and per-group tables, with what the load-sharing
+   definition measures and when to report it;
+6. figures: load sharing, dynamic factors, cycle peaks, mesh force at the end of the run,
+   support-force spectrum (whatever applies);
+7. natural modes, those near a mesh frequency or its harmonics marked;
+8. the quasi-static load sharing for a model whose definition is ``static_torque``;
+9. for the shipped examples, the comparison with the paper's published numbers.
+
+Every figure is inline SVG (text as text, ids unique per figure); the page loads nothing
+and runs no script, so it opens offline and prints as it shows.
+"""
+
+from __future__ import annotations
+
+import datetime
+import hashlib
+import html
+import math
+import subprocess
+from pathlib import Path
+
+import numpy as np
+
+#: natural modes listed
+MODES_LISTED = 12
+#: a mode within this fraction of a mesh frequency (or of its 2nd or 3rd harmonic) is
+#: marked as a possible resonance
+NEAR_FRACTION = 0.1
+
+_CSS = """
+body{font-family:system-ui,-apple-system,"Segoe UI",Roboto,Helvetica,Arial,sans-serif;
+margin:2em auto;max-width:1150px;color:#222;line-height:1.4;padding:0 1em}
+h1{font-size:1.6em;margin-bottom:.2em}h2{border-bottom:1px solid #ccc;padding-bottom:.2em;
+margin-top:1.8em}table{border-collapse:collapse;margin:.6em 0;font-size:.9em}
+th,td{border:1px solid #ccc;padding:.25em .5em;text-align:right}
+th{background:#f3f3f3}td.l,th.l{text-align:left}.warn{background:#fff6e0;
+border-left:4px solid #e0a000;padding:.5em 1em}.warn li{margin:.3em 0}
+figure{margin:1em 0;page-break-inside:avoid}figure svg{max-width:100%;height:auto}
+figcaption{font-size:.9em;color:#555}.note{color:#555;font-size:.9em}
+.bad{color:#b00000;font-weight:bold}code{background:#f3f3f3;padding:0 .2em}
+"""
+
+
+def _e(text) -> str:
+    return html.escape(str(text), quote=True)
+
+
+def _table(header: list[str], rows: list[list], left: int = 1) -> str:
+    """An HTML table; the first ``left`` columns are text (left-aligned)."""
+    th = "".join(f'<th class="{"l" if i < left else ""}">{_e(h)}</th>'
+                 for i, h in enumerate(header))
+    body = []
+    for row in rows:
+        cells = "".join(f'<td class="{"l" if i < left else ""}">{_e(c)}</td>'
+                        for i, c in enumerate(row))
+        body.append(f"<tr>{cells}</tr>")
+    return f"<table><thead><tr>{th}</tr></thead><tbody>{''.join(body)}</tbody></table>"
+
+
+def _g(x, digits: int = 5) -> str:
+    if x is None or (isinstance(x, float) and not math.isfinite(x)):
+        return "-"
+    return f"{x:.{digits}g}"
+
+
+def _commit() -> str:
+    """The git commit of the installed torquesplit, or how it was installed."""
+    here = Path(__file__).resolve().parent
+    try:
+        out = subprocess.run(["git", "-C", str(here), "rev-parse", "--short", "HEAD"],
+                             capture_output=True, text=True, timeout=3)
+        dirty = subprocess.run(["git", "-C", str(here), "status", "--porcelain", "--",
+                                str(here.parent)], capture_output=True, text=True, timeout=3)
+    except (OSError, subprocess.SubprocessError):
+        return "not a git checkout"
+    if out.returncode != 0 or not out.stdout.strip():
+        return "not a git checkout"
+    return out.stdout.strip() + (" (with local changes)" if dirty.stdout.strip() else "")
+
+
+def model_hash(source: Path | None, model_json: str) -> tuple[str, str]:
+    """(what was hashed, SHA-256): the model file's bytes, else the model's JSON."""
+    if source is not None and source.is_file() and source.suffix.lower() in (".toml", ".json"):
+        return str(source), hashlib.sha256(source.read_bytes()).hexdigest()
+    return "the model embedded in the results (JSON)", hashlib.sha256(
+        model_json.encode("utf-8")).hexdigest()
+
+
+# --------------------------------------------------------------------------- sections
+def _provenance(res, source: Path | None, results_attrs: dict | None) -> str:
+    from .. import __version__
+
+    what, digest = model_hash(source, res.model_json())
+    rows = [["torquesplit", f"{__version__}, commit {_commit()}"],
+            ["model", res.model.model.name],
+            ["model file", what], ["model SHA-256", digest],
+            ["report written (UTC)", datetime.datetime.now(datetime.timezone.utc)
+             .isoformat(timespec="seconds")]]
+    if results_attrs:
+        for key in ("run_id", "created_utc", "command", "software"):
+            if results_attrs.get(key):
+                rows.append([f"results file: {key}", results_attrs[key]])
+    info = res.model.model
+    head = f"<p>{_e(info.description)}</p>" if info.description else ""
+    if info.reference:
+        head += f'<p class="note">Reference: {_e(info.reference)}</p>'
+    return head + _table(["", "value"], rows, left=2)
+
+
+def _warnings(notes: list[str]) -> str:
+    if not notes:
+        return '<p class="note">No warnings: every check of the model and of the results ' \
+               "passed.</p>"
+    items = "".join(f"<li>{_e(w)}</li>" for w in notes)
+    return f'<div class="warn"><ul>{items}</ul></div>'
+
+
+def _model_tables(res) -> str:
+    from ..model.summary import summary
+
+    m = res.model
+    s = summary(m)
+    out = []
+    rows = []
+    for name, b in s["bodies"].items():
+        rows.append([name, "gear" if name in m.gears else "body", _g(b["speed_rpm"], 6),
+                     _g(b["torque_Nm"], 6), _g(b["mass_kg"]) + (" *" if b["mass_computed"]
+                                                                 else ""),
+                     _g(b["polar_inertia_kgm2"]) + (" *" if b["inertia_computed"] else ""),
+                     "(" + ", ".join(f"{round(v, 3) + 0.0:.5g}" for v in b["position_mm"])
+                     + ")"])
+    out.append("<h3>Bodies</h3>" + _table(
+        ["body", "kind", "speed [rpm]", "torque [N m]", "mass [kg]", "J [kg m²]",
+         "position [mm]"], rows, left=2)
+        + '<p class="note">* computed from the gear\'s geometry (solid steel disc of the '
+          "pitch diameter).</p>")
+    st = res.structure
+    rows = []
+    for name, mk in s["meshes"].items():
+        mesh = m.meshes[name]
+        e = st.element_names.index(name)
+        k = float(np.mean(st.stiffness_table[e])) if st.stiffness_table.shape[1] else math.nan
+        rows.append([name, f"{mk['driver']} → {mk['driven']}", mk["stage"],
+                     _g(mk["frequency_Hz"], 6),
+                     "/".join(f"{r:.2f}" for r in mk["pitch_radii_mm"]),
+                     _g(mk["total_contact_ratio"], 4), mesh.stiffness.method,
+                     _g(k / 1e6), _g(mesh.backlash.nominal * 1e6, 4),
+                     _g(mk["tooth_force_N"] / 1e3, 5)])
+    out.append("<h3>Meshes</h3>" + _table(
+        ["mesh", "driver → driven", "stage", "f_mesh [Hz]", "pitch radii [mm]",
+         "contact ratio", "stiffness method", "mean stiffness [N/µm]", "backlash [µm]",
+         "nominal F_n [kN]"], rows, left=3))
+    rows = []
+    for kind, items in (("gear", m.gears), ("body", m.bodies)):
+        for name, body in items.items():
+            sup = body.support
+            if sup is None:
+                continue
+            k = (f"{sup.stiffness / 1e6:.4g}" if sup.stiffness else
+                 "shaft bending" if sup.shaft is not None else "-")
+            rows.append([name, kind, ", ".join(d for d in body.dofs if d != "theta") or "-",
+                         k, _g(sup.damping_ratio, 3) if sup.damping_ratio is not None else "-",
+                         _g(sup.clearance * 1e6, 4)])
+    if rows:
+        out.append("<h3>Supports</h3>" + _table(
+            ["body", "kind", "translations", "stiffness [N/µm]", "damping ratio",
+             "clearance [µm]"], rows, left=3))
+    rows = []
+    for name, sh in m.shafts.items():
+        rows.append([name, " – ".join(sh.connects), "rigid" if sh.rigid else
+                     _g(sh.torsional_stiffness, 5) if sh.torsional_stiffness else
+                     f"d = {_g((sh.diameter or 0) * 1e3)} mm, l = {_g((sh.length or 0) * 1e3)} mm"])
+    if rows:
+        out.append("<h3>Shafts</h3>" + _table(
+            ["shaft", "joins", "torsional stiffness [N m/rad] (or its geometry)"], rows,
+            left=3))
+    rows = [[name, " – ".join(sp.connects), _g(sp.radial_clearance * 1e6, 4),
+             _g(sp.pitch_radius * 1e3, 4), _g(sp.friction_coefficient, 3)]
+            for name, sp in m.splines.items()]
+    if rows:
+        out.append("<h3>Splines</h3>" + _table(
+            ["spline", "joins (hub – floating)", "radial clearance [µm]", "pitch radius [mm]",
+             "friction coefficient"], rows, left=2))
+    return "".join(out)
+
+
+def _run_section(res, met) -> str:
+    from ..metrics.load_sharing import DEFINITION_TEXT, DEFINITION_USE
+
+    st = res.statistics()
+    settings = [["method", st["method"]], ["simulated time [s]", _g(st["simulated_time_s"], 6)],
+                ["steps", f"{st['steps']:,}"],
+                ["step [s]", _g(st["step_s"], 4) if st["step_s"] else "adaptive"],
+                ["transient discarded [s]", _g(met.settling.start_time, 5)
+                 + ("" if met.settling.settled else " (not settled: last half used)")],
+                ["load-sharing definition", met.definition],
+                ["status", res.message]]
+    rows = []
+    for r in met.rows:
+        back = f"{100 * r.back_contact:.2f} %"
+        if r.back_contact > 0:
+            back += f", up to {r.back_flank_force / 1e3:.4g} kN"
+        rows.append([r.mesh, r.group, _g(r.nominal_force / 1e3), _g(r.static_force / 1e3),
+                     _g(r.mean_force / 1e3), _g(r.peak_force / 1e3), f"{r.dynamic_factor:.4f}",
+                     f"{r.peak_to_nominal:.4f}", f"{r.load_sharing:.4f}",
+                     "no backlash (double-flank)" if r.double_flank
+                     else f"{100 * r.contact_loss:.2f} %", back])
+    per_mesh = _table(["mesh", "group", "nominal F [kN]", "static F [kN]", "mean F [kN]",
+                       "peak F [kN]", "dynamic factor", "peak/nominal",
+                       f"LSC ({met.definition})", "contact loss", "back flank"], rows, left=2)
+    d = met.dynamic_factors
+    groups = _table(
+        ["group", "meshes", f"LSC ({met.definition})", "dynamic factor", "peak/nominal"],
+        [[g, ", ".join(ms), f"{met.load_sharing.per_group[g]:.4f}",
+          f"{d.per_group_dynamic_factor[g]:.4f}", f"{d.per_group_peak_to_nominal[g]:.4f}"]
+         for g, ms in met.load_sharing.groups.items()], left=2)
+    what = (f"<p><b>Load sharing ({_e(met.definition)})</b>: "
+            f"{_e(DEFINITION_TEXT[met.definition])}; {_e(DEFINITION_USE[met.definition])}. "
+            "<b>Dynamic factor</b>: settled peak / the mesh's own static force (K_v sense, "
+            "&ge; 1 in contact). <b>Peak/nominal</b>: settled peak / equal-split nominal "
+            "force (Ji &amp; Li eq. 19), load sharing and dynamics together. "
+            f"System load-sharing coefficient: <b>{met.load_sharing.system:.5f}</b>.</p>")
+    return (_table(["setting", "value"], settings, left=2) + what + "<h3>Per mesh</h3>"
+            + per_mesh + "<h3>Per load-sharing group</h3>" + groups)
+
+
+def _figure(fig_svg: str, caption: str) -> str:
+    return f"<figure>{fig_svg}<figcaption>{_e(caption)}</figcaption></figure>"
+
+
+def _figures(res, definition: str) -> str:
+    from ..plot import figures as F
+
+    jobs = [
+        ("load_sharing", lambda: F.load_sharing_figure(res, definition),
+         "Load-sharing coefficient of each mesh cycle; dashed: the reported value."),
+        ("dynamic_factors", lambda: F.dynamic_factor_figure(res, definition),
+         "Dynamic factor (peak / own static force) and peak / nominal force of every mesh."),
+        ("cycle_peaks", lambda: F.cycle_peak_figure(res),
+         "Peak mesh force of each mesh cycle; shaded: the transient left out."),
+        ("mesh_force_end", lambda: F.mesh_force_figure(res, last_cycles=5),
+         "Mesh force over the last five mesh cycles of each group."),
+        ("support_spectrum", lambda: F.support_spectrum_figure(res),
+         "Support-force spectrum of the strongest supports; dotted: mesh orders."),
+    ]
+    out = []
+    for salt, make, caption in jobs:
+        try:
+            fig = make()
+        except F.FigureNotApplicableError:
+            continue
+        out.append(_figure(F.figure_svg(fig, salt), caption))
+    return "".join(out)
+
+
+def _modes(res) -> str:
+    from ..modes import model_modes
+
+    try:
+        rep = model_modes(res.model, count=MODES_LISTED)
+    except Exception as exc:  # noqa: BLE001 - the report goes on without its modes
+        return f'<p class="note">Natural modes not computed: {_e(exc)}</p>'
+    mesh_f = {n: mk.frequency for n, mk in res.kinematics.meshes.items()}
+    typed = any(r.type for r in rep.rows)
+    rows = []
+    for r in rep.rows:
+        f = float(r.frequency)
+        near = [f"{k}×{name}" for name, fm in mesh_f.items() for k in (1, 2, 3)
+                if abs(f - k * fm) <= NEAR_FRACTION * k * fm]
+        energy = ", ".join(f"{n} {100 * v:.0f} %" for n, v in list(r.strain_energy.items())[:3])
+        rows.append([str(r.mode), _g(f, 6), str(r.multiplicity)]
+                    + ([r.type or ""] if typed else [])
+                    + [energy, ", ".join(sorted(set(near))) or "-"])
+    header = (["mode", "f [Hz]", "mult."] + (["type"] if typed else [])
+              + ["strain energy of the group (largest shares)",
+                 f"within {NEAR_FRACTION:.0%} of a mesh order"])
+    return (_table(header, rows, left=1)
+            + f'<p class="note">{rep.rigid_modes} rigid-body mode(s) left out. Mesh '
+              "frequencies: " + _e(", ".join(f"{k} {v:.5g} Hz" for k, v in mesh_f.items()))
+            + ".</p>")
+
+
+def _static_section(quasi) -> str:
+    from ..plot import figures as F
+
+    met = quasi.metrics()
+    forces = quasi.mesh_forces()
+    rows = [[m, _g(forces[:, j].min() / 1e3), _g(forces[:, j].mean() / 1e3),
+             _g(forces[:, j].max() / 1e3), f"{met.per_mesh[m]:.5f}"]
+            for j, m in enumerate(quasi.mesh_names)]
+    out = (f"<p>{quasi.times.size} mesh positions; system coefficient "
+           f"<b>{met.system:.5f}</b> (static torque ratio, largest over the positions, Mo "
+           f"et al. 2017 eqs. 14-15).</p>"
+           + _table(["mesh", "min F [kN]", "mean F [kN]", "max F [kN]", "LSC (static_torque)"],
+                    rows))
+    try:
+        out += _figure(F.figure_svg(F.static_load_sharing_figure(quasi), "static_ls"),
+                       "Quasi-static load sharing over one revolution of the slowest gear.")
+    except F.FigureNotApplicableError:
+        pass
+    return out
+
+
+def _comparison(res, quasi) -> str:
+    from ..examples.published import published_for
+
+    entry = published_for(res.model.model.name)
+    if entry is None:
+        return ""
+    note, items = entry
+    if not items:
+        return f"<h2>Comparison with the paper</h2><p>{_e(note)}</p>"
+    values: dict[str, float] = {}
+    defs = sorted({k.split(".")[1] for p in items for k in p.keys
+                   if k.startswith("load_sharing.") and p.analysis == "dynamic"})
+    try:
+        values.update(res.metric_values(defs or None))
+    except (ValueError, ArithmeticError):
+        pass
+    if quasi is not None:
+        met = quasi.metrics()
+        values["load_sharing.static_torque"] = met.system
+        values.update({f"load_sharing.static_torque.{g}": v for g, v in met.per_group.items()})
+        values.update({f"load_sharing.static_torque.{m}": v for m, v in met.per_mesh.items()})
+    rows = []
+    for p in items:
+        ours = [values[k] for k in p.keys if k in values and math.isfinite(values[k])]
+        if not ours:
+            rows.append([p.quantity, p.where, _g(p.paper, 6), "not computed", "-"])
+            continue
+        v = max(ours)
+        rows.append([p.quantity, p.where, _g(p.paper, 6), _g(v, 6),
+                     f"{100 * (v - p.paper) / p.paper:+.1f} %"])
+    return ("<h2>Comparison with the paper</h2>" + f"<p>{_e(note)}</p>"
+            + _table(["quantity", "where", "paper", "this run", "difference"], rows, left=2)
+            + '<p class="note">The papers leave out inputs their dynamic results depend on '
+              "(masses, bearing stiffnesses, damping, error phases); the example model states "
+              "the values it assumes, and its comments say why the numbers differ.</p>")
+
+
+# --------------------------------------------------------------------------- page
+def build_report(res, *, definition: str | None = None, source: Path | None = None,
+                 results_attrs: dict | None = None, quasi=None,
+                 progress=None) -> str:
+    """The report of a finished run as one self-contained HTML page.
+
+    Parameters
+    ----------
+    res : Results
+        A finished dynamic run.
+    definition : str, optional
+        Load-sharing definition (default: the run's).
+    source : Path, optional
+        The model file (its SHA-256 goes in the provenance).
+    results_attrs : dict, optional
+        Attributes of the results file the run was read from (run id, time, command).
+    quasi : QuasiStaticResults, optional
+        A quasi-static sweep of the same model, reported in its own section.
+    progress : callable, optional
+        Called with ``(fraction, what)`` as the sections are built.
+    """
+    from ..plot.layout import layout_svg
+
+    def step(fraction, what):
+        if progress is not None:
+            progress(fraction, what)
+
+    met = res.metrics(definition)
+    name = res.model.model.name
+    parts = [f"<h1>{_e(name)}: dynamic load sharing</h1>",
+             _provenance(res, source, results_attrs)]
+    step(0.05, "warnings")
+    parts += ["<h2>Warnings</h2>", _warnings(res.warnings(met.definition))]
+    step(0.1, "model")
+    parts += ["<h2>Model</h2>", _model_tables(res)]
+    step(0.2, "layout")
+    parts += ["<h2>Layout</h2>", _figure(layout_svg(res.model, res.kinematics, salt="layout"),
+                                         "Pitch circles at their positions; red: lines of "
+                                         "action, blue: power flow.")]
+    step(0.3, "results")
+    parts += ["<h2>Run and results</h2>", _run_section(res, met)]
+    step(0.35, "figures")
+    parts += ["<h2>Figures</h2>", _figures(res, met.definition)]
+    step(0.8, "natural modes")
+    parts += ["<h2>Natural modes</h2>", _modes(res)]
+    if quasi is not None:
+        step(0.85, "quasi-static load sharing")
+        parts += ["<h2>Quasi-static load sharing</h2>", _static_section(quasi)]
+    step(0.9, "comparison with the paper")
+    parts.append(_comparison(res, quasi))
+    body = "\n".join(parts)
+    return ("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
+            f"<title>{_e(name)}: torquesplit report</title>"
+            "<meta name=\"generator\" content=\"torquesplit\">"
+            f"<style>{_CSS}</style></head><body>\n{body}\n"
+            "<p class=\"note\">Written by torquesplit. Figures are inline SVG; this page "
+            "loads nothing from the network.</p></body></html>\n")
+
+
+def results_attributes(ds) -> dict:
+    """The provenance attributes of a results Dataset (for :func:`build_report`)."""
+    return {k: ds.attrs.get(k) for k in ("run_id", "created_utc", "command", "software")
+            if ds.attrs.get(k)}
+
+
+def report_json_summary(res, definition: str | None = None) -> dict:
+    """A small JSON summary of what the report shows (``report --json``)."""
+    met = res.metrics(definition)
+    return {"model": res.model.model.name, "definition": met.definition,
+            "system_load_sharing": met.load_sharing.system}
+
+
+__all__ = ["build_report", "model_hash", "results_attributes", "report_json_summary"]

@@ -1,0 +1,163 @@
+"""Plausibility of computed results: numbers that are possible but need a word.
+
+A run can finish cleanly and still print numbers an engineer cannot put in a report:
+a mesh loaded on its back flank at rest, tensile tooth forces in a mesh modelled without
+backlash, a dynamic factor of 5.  Each check here returns ``(location, message)`` pairs
+naming the model field to look at; :meth:`torquesplit.results.Results.warnings` collects
+them with the model's own warnings and the run's, and the command line prints them, puts
+them in ``--json`` (``warnings``) and in the results file's attributes.
+
+=========================  ===========================================================
+check                      says
+=========================  ===========================================================
+:func:`static_force`       a mesh whose static force is negative (loaded on its back
+                           flank at rest: an error or a sign against the power flow)
+:func:`contact_loss`       drive flank separated (the teeth move inside the backlash)
+:func:`back_flank`         back-flank contact; without backlash: double-flank contact,
+                           tensile tooth force no real pair with backlash carries
+:func:`resonance`          dynamic factor above :data:`RESONANCE_FACTOR`: the run is near
+                           a resonance (``torquesplit modes``)
+:func:`settling`           the transient did not die out: the last half was used
+=========================  ===========================================================
+"""
+
+from __future__ import annotations
+
+import math
+
+#: a dynamic factor (settled peak / the mesh's own static force) above this is reported
+#: as "near a resonance"; gear standards' K_v rarely exceeds 2
+RESONANCE_FACTOR = 3.0
+#: time fractions below this (of the run) are rounding: not reported
+FRACTION_FLOOR = 1e-4
+
+
+def _kn(force: float) -> str:
+    return f"{force / 1e3:.4g} kN" if abs(force) >= 1e3 else f"{force:.4g} N"
+
+
+def _pct(fraction: float) -> str:
+    return f"{100 * fraction:.3g} %"
+
+
+def static_force(results, metrics) -> list[tuple[str, str]]:
+    """Meshes whose force at the static equilibrium is negative (or zero)."""
+    out = []
+    for r in metrics.rows:
+        if r.static_force < 0:
+            out.append((f"meshes.{r.mesh}", (
+                f"the static force is {_kn(r.static_force)} (nominal {_kn(r.nominal_force)}): "
+                f"at rest the mesh is loaded on its back flank, against the power flow, so "
+                f"its load sharing and dynamic factor are not meaningful; check the errors "
+                f"and backlash of this mesh and of its gears and their units (a '20 mm' for "
+                f"'20 um' does this)")))
+    return out
+
+
+def contact_loss(results, metrics) -> list[tuple[str, str]]:
+    """Meshes whose drive flanks separate (inside the backlash) during the run."""
+    out = []
+    for r in metrics.rows:
+        if r.contact_loss > FRACTION_FLOOR:
+            out.append((f"meshes.{r.mesh}", (
+                f"contact loss {_pct(r.contact_loss)} of the time: the teeth separate "
+                f"(backlash larger than the dynamic deflection), so peak forces are impacts "
+                f"and its load-sharing coefficient is not meaningful; check "
+                f"meshes.{r.mesh}.backlash and the excitation")))
+    return out
+
+
+def back_flank(results, metrics) -> list[tuple[str, str]]:
+    """Back-flank contact: with backlash the teeth rattle through it; without backlash the
+    mesh is in double-flank contact and carries tensile force."""
+    out = []
+    for r in metrics.rows:
+        if r.back_contact <= FRACTION_FLOOR:
+            continue
+        largest = r.back_flank_force
+        if r.min_force >= 0:  # none in the settled part
+            when = " (in the start-up transient only: the settled part has none)"
+        else:
+            when = ""
+        if largest <= 0:  # deflection reversed, force still compressive (damping)
+            out.append((f"meshes.{r.mesh}", (
+                f"the mesh deflection is reversed {_pct(r.back_contact)} of the time{when}, "
+                f"the force staying compressive only through the damping: a real pair "
+                f"{'with backlash ' if r.double_flank else ''}would be about to lose contact "
+                f"there; check meshes.{r.mesh}.backlash and the excitation")))
+            continue
+        if r.double_flank:
+            out.append((f"meshes.{r.mesh}", (
+                f"double-flank contact {_pct(r.back_contact)} of the time, back-flank force "
+                f"up to {_kn(largest)}{when}: the mesh has no backlash, so the model lets it carry "
+                f"tension, which a real pair with backlash cannot; give "
+                f"meshes.{r.mesh}.backlash its real value (e.g. '100 um') or read its peak "
+                f"and load sharing as those of a double-flank (anti-backlash) mesh")))
+        else:
+            out.append((f"meshes.{r.mesh}", (
+                f"back-flank contact {_pct(r.back_contact)} of the time, back-flank force up "
+                f"to {_kn(largest)}{when}: the teeth rattle through the backlash; peak forces are "
+                f"impacts and the load sharing is not meaningful; check the excitation "
+                f"and meshes.{r.mesh}.backlash")))
+    return out
+
+
+def resonance(results, metrics) -> list[tuple[str, str]]:
+    """Meshes whose dynamic factor exceeds :data:`RESONANCE_FACTOR`."""
+    out = []
+    kin = results.kinematics
+    for r in metrics.rows:
+        if math.isfinite(r.dynamic_factor) and r.dynamic_factor > RESONANCE_FACTOR:
+            f = kin.meshes[r.mesh].frequency
+            out.append((f"meshes.{r.mesh}", (
+                f"dynamic factor {r.dynamic_factor:.3g} (settled peak {_kn(r.peak_force)} / "
+                f"static {_kn(r.static_force)}): the run is near a resonance (mesh "
+                f"frequency {f:.5g} Hz); see `torquesplit modes` for the natural "
+                f"frequencies and the elements that carry them, and check the stiffnesses "
+                f"and inertias of those elements")))
+    return out
+
+
+def settling(results, metrics) -> list[tuple[str, str]]:
+    """A transient that did not settle by the end of the run."""
+    if metrics.settling.settled:
+        return []
+    return [("analysis", (
+        "the transient did not die out within the run (the peaks still drift), so the last "
+        "half of the run was used for the metrics; simulate longer (--cycles or --duration) "
+        "or add damping"))]
+
+
+#: every check, in the order the messages are listed
+CHECKS = (static_force, contact_loss, back_flank, resonance, settling)
+
+
+def result_warnings(results, metrics) -> list[tuple[str, str]]:
+    """Every plausibility warning of a finished run, as ``(location, message)``."""
+    out: list[tuple[str, str]] = []
+    for check in CHECKS:
+        out += check(results, metrics)
+    return out
+
+
+def static_warnings(results) -> list[tuple[str, str]]:
+    """Warnings of a quasi-static sweep: positions that did not converge, meshes loaded
+    on their back flank."""
+    import numpy as np
+
+    out = []
+    conv = np.asarray(results.solution.converged, bool)
+    if conv.size and not conv.all():
+        out.append(("analysis", (
+            f"{int((~conv).sum())} of {conv.size} positions did not converge and are left "
+            f"out of the load sharing; check the clearances and supports (a member free "
+            f"inside its clearance needs a support or a spring)")))
+    forces = results.mesh_forces()
+    for j, m in enumerate(results.mesh_names):
+        fmin = float(np.nanmin(forces[conv, j])) if conv.any() else math.nan
+        if fmin < 0:
+            out.append((f"meshes.{m}", (
+                f"the quasi-static force reaches {_kn(fmin)}: the mesh is loaded on its back "
+                f"flank at some positions, against the power flow; check the errors and "
+                f"backlash of this mesh and their units")))
+    return out

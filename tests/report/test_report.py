@@ -1,0 +1,184 @@
+"""The HTML report and the layout drawing (issue 13, items 8 and 9).
+
+The report is opened in a real headless Chromium over the DevTools protocol
+(``browser.py``): no console error, no exception, nothing loaded from the network, every
+figure an inline SVG that renders at a readable size, and a screenshot that is a page
+(not blank).  Skipped, with the reason, where Chromium is not installed.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+import torquesplit
+from model_texts import split_model, write_model
+from torquesplit.cli import app
+
+runner = CliRunner()
+HERE = Path(__file__).parent
+
+#: the two-path split with a floating, supported pinion and an error on mesh a1, so that
+#: the report has every figure (supports, load sharing) and a warning-free model
+MODEL = split_model(error_a="3 um").replace(
+    'position = ["0 mm", "0 mm", "0 mm"]\n',
+    'position = ["0 mm", "0 mm", "0 mm"]\ndofs = ["x", "y", "theta"]\n\n'
+    '[gears.pinion.support]\nstiffness = "2e8 N/m"\ndamping_ratio = 0.05\n', 1)
+
+
+@pytest.fixture(scope="module")
+def made(tmp_path_factory):
+    """A model run to a results file, and reports of the model and of the file."""
+    d = tmp_path_factory.mktemp("report")
+    model = write_model(d, MODEL)
+    run = runner.invoke(app, ["run", str(model), "--cycles", "40", "--out", str(d / "r.nc"),
+                              "--quiet"])
+    assert run.exit_code == 0, run.output
+    from_model = runner.invoke(app, ["report", str(model), "--cycles", "40", "--out",
+                                     str(d / "model.html"), "--quiet"])
+    assert from_model.exit_code == 0, from_model.output
+    from_file = runner.invoke(app, ["report", str(d / "r.nc"), "--out", str(d / "file.html"),
+                                    "--quiet"])
+    assert from_file.exit_code == 0, from_file.output
+    return d, model
+
+
+def test_report_is_self_contained_with_every_section(made):
+    d, model = made
+    page = (d / "model.html").read_text(encoding="utf-8")
+    for section in ("Warnings", "Model", "Bodies", "Meshes", "Supports", "Layout",
+                    "Run and results", "Per mesh", "Figures", "Natural modes"):
+        assert f">{section}</h" in page, section
+    assert not re.search(r"""(src|href)\s*=\s*["']?(https?:)?//""", page)  # no network
+    assert "<script" not in page and "<img" not in page
+    assert page.count("<svg") == page.count("<figure>") >= 6  # layout + figures inline
+    for unit in ("speed [rpm]", "mass [kg]", "J [kg m²]", "mean stiffness [N/µm]",
+                 "nominal F [kN]"):
+        assert unit in page, unit
+    import hashlib
+
+    assert hashlib.sha256(model.read_bytes()).hexdigest() in page  # provenance
+    assert torquesplit.__version__ in page
+
+
+def test_report_of_a_results_file_gives_the_same_numbers(made):
+    """The figures and tables of a saved run equal those of the run (same statistics)."""
+    d, _ = made
+    page = (d / "file.html").read_text(encoding="utf-8")
+    from torquesplit.results import load_results
+
+    res = load_results(d / "r.nc")
+    run = torquesplit.simulate(torquesplit.load_model(d / "model.toml"), cycles=40)
+    for definition in ("mean_force", "cycle_peak", "instantaneous"):
+        a, b = res.metrics(definition), run.metrics(definition)
+        assert a.load_sharing.per_mesh == pytest.approx(b.load_sharing.per_mesh, rel=1e-12)
+        assert a.dynamic_factors.dynamic_factor == pytest.approx(
+            b.dynamic_factors.dynamic_factor, rel=1e-12)
+    assert "results file: run_id" in page
+    assert f"{res.metrics().load_sharing.system:.5f}" in page
+
+
+def test_report_in_headless_chromium(made, tmp_path):
+    from browser import find_chromium, load_page
+
+    chromium = find_chromium()
+    if chromium is None:
+        pytest.skip("Chromium is not installed (Debian: apt-get install chromium); "
+                    "the report's browser test needs a real browser")
+    d, _ = made
+    page = load_page(d / "model.html", chromium)
+    assert page["console_errors"] == [] and page["exceptions"] == []
+    assert page["failed_loads"] == [] and page["network_requests"] == []
+    html_text = (d / "model.html").read_text(encoding="utf-8")
+    figures = page["figures"]
+    assert len(figures) == html_text.count("<figure>") >= 6
+    for fig in figures:  # every figure loaded and rendered at a readable size
+        assert fig["svg"] and fig["width"] > 300 and fig["height"] > 150, fig
+        assert fig["elements"] > 50 and fig["text"] > 5, fig
+    # the screenshot is a page: a tall image, neither blank nor solid
+    from matplotlib.image import imread
+
+    shot = tmp_path / "report.png"
+    shot.write_bytes(page["screenshot"])
+    img = imread(shot)
+    assert img.shape[0] > 2000 and img.shape[1] >= 1000
+    ink = float(np.mean(img[..., :3].mean(axis=-1) < 0.9))
+    assert 0.01 < ink < 0.6, ink
+
+
+def test_the_browser_check_can_fail(tmp_path):
+    """The harness sees a console error, a missing image and an unrendered figure."""
+    from browser import find_chromium, load_page
+
+    chromium = find_chromium()
+    if chromium is None:
+        pytest.skip("Chromium is not installed (Debian: apt-get install chromium)")
+    bad = tmp_path / "bad.html"
+    bad.write_text("<!DOCTYPE html><html><body><figure><svg width='0' height='0'></svg>"
+                   "</figure><img src='missing.png'><script>console.error('broken')"
+                   "</script></body></html>")
+    page = load_page(bad, chromium)
+    assert any("broken" in json.dumps(e) for e in page["console_errors"])
+    assert page["failed_loads"]
+    assert page["figures"][0]["width"] == 0
+
+
+def test_report_refuses_before_computing(tmp_path):
+    model = write_model(tmp_path, MODEL)
+    (tmp_path / "r.html").write_text("earlier")
+    res = runner.invoke(app, ["report", str(model), "--out", str(tmp_path / "r.html")])
+    assert res.exit_code == 2 and "exists; use --force" in res.stderr
+    res = runner.invoke(app, ["report", str(model), "--pdf"])
+    assert res.exit_code == 2 and "print it to PDF" in res.stderr
+    res = runner.invoke(app, ["report", str(tmp_path / "none.nc")])
+    assert res.exit_code == 2 and "no such results file" in res.stderr
+
+
+def test_report_of_a_shipped_example_compares_with_the_paper(tmp_path):
+    out = tmp_path / "mo.html"
+    res = runner.invoke(app, ["report", "mo2017_star_reducer", "--cycles", "30", "--out",
+                              str(out), "--quiet"])
+    assert res.exit_code == 0, res.output
+    page = out.read_text(encoding="utf-8")
+    assert ">Comparison with the paper</h2>" in page and "1.0619" in page
+    assert ">Quasi-static load sharing</h2>" in page
+
+
+# --------------------------------------------------------------------------- draw
+def _examples():
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return {n: torquesplit.load_model(torquesplit.example_path(n))
+                for n in torquesplit.example_names()}
+
+
+@pytest.mark.parametrize("name", torquesplit.example_names())
+def test_draw_labels_every_gear_and_mesh(name, tmp_path):
+    out = tmp_path / "layout.svg"
+    res = runner.invoke(app, ["draw", name, "--out", str(out)])
+    assert res.exit_code == 0, res.output
+    svg = out.read_text(encoding="utf-8")
+    model = _examples()[name]
+    for kind, names in (("gear", model.gears), ("mesh", model.meshes),
+                        ("shaft", model.shafts), ("spline", model.splines)):
+        for n in names:
+            group = re.search(rf'<g id="{kind}:{re.escape(n)}">(.*?)</g>', svg, re.S)
+            assert group, (kind, n)
+            assert re.search(rf">[^<]*\b{re.escape(n)}\b", group.group(1)), (kind, n)
+
+
+def test_draw_defaults_to_the_model_name_and_refuses_to_overwrite(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    model = write_model(tmp_path, MODEL)
+    assert runner.invoke(app, ["draw", str(model)]).exit_code == 0
+    assert (tmp_path / "two-path_split_layout.svg").exists()
+    res = runner.invoke(app, ["draw", str(model)])
+    assert res.exit_code == 2 and "exists; use --force" in res.stderr
+    res = runner.invoke(app, ["draw", str(model), "--out", str(tmp_path / "l.png")])
+    assert res.exit_code == 0 and (tmp_path / "l.png").read_bytes()[:4] == b"\x89PNG"
