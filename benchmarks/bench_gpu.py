@@ -2,7 +2,7 @@
 
     python benchmarks/bench_gpu.py              # everything that this machine can run
     python benchmarks/bench_gpu.py --quick      # 1,000-case Monte Carlo, 100 seed 000 cases
-    python benchmarks/bench_gpu.py layout       # one part: layout, monte_carlo, seed000
+    python benchmarks/bench_gpu.py layout       # one part: layout, monte_carlo, liu2021
 
 Not part of the test suite; nothing here asserts a threshold.  The issue's targets are
 printed beside the measured values.  Parts that need a CUDA device are recorded as not
@@ -19,7 +19,7 @@ monte_carlo  Device: Ji & Li's drive (14 DOF), a Monte Carlo over the backlash o
              metrics, store), the kernel time alone, sample-steps per second, the FP32
              run with its error; the CPU study runner on 2 workers on a subsample of the
              same study, extrapolated per case, for the ratio.
-seed000      Device: Liu et al. 2021's reducer (49 DOF) at the paper's resolution, random
+liu2021      Device: Liu et al. 2021's reducer (49 DOF) at the paper's resolution, random
              eccentricity phases on every gear, 1,000 cases (--quick 100).
 """
 
@@ -182,7 +182,7 @@ def monte_carlo(quick: bool) -> dict:
     return {"run": True, **_study_part(_mc_spec(1000 if quick else 10000), 10 if quick else 20)}
 
 
-def seed000(quick: bool) -> dict:
+def liu2021(quick: bool) -> dict:
     ok, why = _device()
     if not ok:
         return {"run": False, "reason": why}
@@ -201,7 +201,7 @@ def seed000(quick: bool) -> dict:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("parts", nargs="*", default=["layout", "monte_carlo", "seed000"])
+    ap.add_argument("parts", nargs="*", default=["layout", "monte_carlo", "liu2021"])
     ap.add_argument("--quick", action="store_true")
     args = ap.parse_args(argv)
     ok, why = _device()
@@ -215,8 +215,8 @@ def main(argv=None) -> int:
             result["layout"] = layout()
         elif part == "monte_carlo":
             result["monte_carlo"] = monte_carlo(args.quick)
-        elif part == "seed000":
-            result["seed000"] = seed000(args.quick)
+        elif part == "liu2021":
+            result["liu2021"] = liu2021(args.quick)
         else:
             ap.error(f"unknown part {part!r}")
     OUT_JSON.write_text(json.dumps(result, indent=1, default=str) + "\n")
@@ -241,7 +241,7 @@ def _markdown(r: dict) -> str:
         lines.append("")
     for part, target in (("monte_carlo", "issue target: 10,000 cases <= 2 s end to end, "
                                          "kernel <= 0.6 s, >= 300x the 2-core CPU runner"),
-                         ("seed000", "issue target: 1,000 cases <= 60 s")):
+                         ("liu2021", "issue target: 1,000 cases <= 60 s")):
         if part not in r:
             continue
         v = r[part]
