@@ -171,6 +171,8 @@ def prepare_run(
     from .assembly.assemble import assemble
     from .solve.static import static_equilibrium
 
+    if not hasattr(model, "meshes"):
+        model = load_model(model)
     an = model.analysis
     kin = solve_kinematics(model)
     structure = assemble(model, kin)
