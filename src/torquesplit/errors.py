@@ -182,5 +182,30 @@ class FigureNotApplicableError(TorquesplitError, ValueError):
     """The results hold nothing this figure can show (no supports, no floating body...)."""
 
 
+class GpuUnsupportedError(TorquesplitError, ValueError):
+    """The GPU ensemble backend (:mod:`torquesplit.gpu`) does not do something a run
+    needs: refused by name rather than computed differently from the CPU engine.
+    ``feature`` names it."""
+
+    def __init__(self, feature: str, fix: str):
+        self.feature = feature
+        super().__init__(f"the GPU backend does not support {feature} yet; {fix}")
+
+
+class GpuUnavailableError(TorquesplitError, RuntimeError):
+    """No CUDA device can run the GPU ensemble backend (``reason`` says why)."""
+
+    def __init__(self, reason: str):
+        self.reason = reason
+        super().__init__(f"no CUDA device to run on: {reason}; run on a machine with an "
+                         "NVIDIA GPU and its driver, or use the CPU backend "
+                         "(backend='cpu', the default)")
+
+
+class GpuFallbackWarning(UserWarning):
+    """``backend="gpu"`` was asked for but no CUDA device is present: the study runs on
+    the CPU runner instead (same results, CPU speed)."""
+
+
 class ModelWarning(UserWarning):
     """A value that looks wrong but can be right (damping above critical, ...)."""

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
@@ -116,11 +117,62 @@ def simulate(
 def _simulate(model, *, duration, cycles, method, steps_per_period, rtol,
               samples_per_period, history_dofs, full_history, progress, rhs, max_steps):
     """:func:`simulate` on a loaded model, its warnings not yet collected."""
-    from .assembly.assemble import assemble
     from .results import Results
     from .solve.integrate import integrate
+
+    run = prepare_run(model, duration=duration, cycles=cycles, method=method,
+                      steps_per_period=steps_per_period, rtol=rtol,
+                      samples_per_period=samples_per_period, history_dofs=history_dofs,
+                      full_history=full_history, progress=progress, rhs=rhs,
+                      max_steps=max_steps)
+    solution = integrate(run.structure, run.y0, (0.0, run.duration), **run.integrate_kwargs)
+    return Results(model=run.model, kinematics=run.kinematics, structure=run.structure,
+                   static=run.static, solution=solution)
+
+
+@dataclass(frozen=True)
+class PreparedRun:
+    """Everything :func:`simulate` sets up before integrating: the stages up to the
+    static equilibrium and the arguments of
+    :func:`~torquesplit.solve.integrate.integrate`.  Other executors of the same run (the
+    GPU ensemble backend, :mod:`torquesplit.gpu`) start from it, so that a run means the
+    same thing whichever engine integrates it."""
+
+    model: object
+    kinematics: object
+    structure: object
+    static: object
+    y0: np.ndarray
+    """Initial state [q, v]: the static equilibrium at rest."""
+    duration: float
+    """Simulated time [s] (the run spans (0, duration))."""
+    integrate_kwargs: dict
+    """Keyword arguments of ``integrate`` (method, tracked elements, groups, ...)."""
+
+
+def prepare_run(
+    model,
+    *,
+    duration: float | None = None,
+    cycles: int | None = None,
+    method: str | None = None,
+    steps_per_period: int | None = None,
+    rtol: float | None = None,
+    samples_per_period: int = 20,
+    history_dofs=None,
+    full_history: bool = False,
+    progress: Callable[[float], None] | None = None,
+    rhs: str = "auto",
+    max_steps: int | None = None,
+) -> PreparedRun:
+    """The set-up of :func:`simulate` (same parameters) without the integration: model,
+    kinematics, structure, static equilibrium, initial state, run length and the
+    arguments of ``integrate``; refuses what ``simulate`` refuses, warns as it warns."""
+    from .assembly.assemble import assemble
     from .solve.static import static_equilibrium
 
+    if not hasattr(model, "meshes"):
+        model = load_model(model)
     an = model.analysis
     kin = solve_kinematics(model)
     structure = assemble(model, kin)
@@ -193,9 +245,8 @@ def _simulate(model, *, duration, cycles, method, steps_per_period, rtol,
                     n_meshes=len(mesh_names), f_max=f_max, n_history=len(hist_el))
     else:
         kwargs["rtol"] = rtol or an.rtol
-    solution = integrate(structure, y0, (0.0, duration), **kwargs)
-    return Results(model=model, kinematics=kin, structure=structure, static=static,
-                   solution=solution)
+    return PreparedRun(model=model, kinematics=kin, structure=structure, static=static,
+                       y0=y0, duration=float(duration), integrate_kwargs=kwargs)
 
 
 #: runs estimated to take longer than this [s] or to keep more than ANNOUNCE_BYTES of

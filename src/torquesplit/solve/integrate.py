@@ -533,7 +533,22 @@ def integrate(
         step_min = float(clock[kern.F_HMIN]) if accepted else math.nan
         step_max = float(clock[kern.F_HMAX]) if accepted else math.nan
     y = work.Y[kd.Y_STATE].copy()
+    return _solution(s, sel, plan, rec, counters, clock, y, method=method, t_span=(t0, t_end),
+                     blowup=blowup, step_min=step_min, step_max=step_max,
+                     compile_time=compile_time, wall_time=time.perf_counter() - t_call,
+                     rhs_name="generated" if rhs_code.generated else "general",
+                     rhs_compile_time=rhs_code.compile_time, full_history=full_history)
 
+
+def _solution(s, sel, plan, rec, counters, clock, y, *, method, t_span, blowup, step_min,
+              step_max, compile_time, wall_time, rhs_name, rhs_compile_time,
+              full_history) -> Solution:
+    """The :class:`Solution` of a finished run from its output arrays (``rec``, a
+    :class:`~.kernel_data.Record`), counters, clock and end state ``y``: the one place
+    that turns a run's raw outputs into a Solution (the GPU ensemble backend,
+    :mod:`torquesplit.gpu`, hands its per-case outputs to it too)."""
+    t0, t_end = t_span
+    rk4 = method == "rk4"
     status = int(counters[kern.I_STATUS])
     t_final = float(clock[kern.F_T])
     cycles = _cycle_summary(rec, s, sel)
@@ -556,9 +571,9 @@ def integrate(
         step_min=step_min,
         step_max=step_max,
         compile_time=compile_time,
-        wall_time=time.perf_counter() - t_call,
-        rhs="generated" if rhs_code.generated else "general",
-        rhs_compile_time=rhs_code.compile_time,
+        wall_time=wall_time,
+        rhs=rhs_name,
+        rhs_compile_time=rhs_compile_time,
         dof_names=tuple(s.dof_names),
         element_names=tuple(s.element_names),
         tracked_elements=tuple(sel.track),
@@ -837,10 +852,18 @@ def _rhs_code(kind: str, model, n_rhs: float) -> codegen.GeneratedRhs:
         return codegen.general_rhs()
 
 
+def rk4_chunk(limit_steps: int) -> int:
+    """Steps per call of the RK4 kernel (a multiple of RESYNC, about 1.5 % of the run).
+    A chunk starts with the exact excitation and the table corners found afresh from its
+    start time (``first_corners``); the GPU ensemble kernel (:mod:`torquesplit.gpu`)
+    does the same at the same steps, so that both take the same sub-steps."""
+    per_chunk = math.ceil(limit_steps / _N_CHUNKS)
+    return max(_MIN_CHUNK_STEPS, -(-per_chunk // kern.RESYNC) * kern.RESYNC)
+
+
 def _run_rk4(t0, plan, blowup, model, work, rec, rhs_code, counters, clock, progress):
     """Run the RK4 kernel in chunks (multiples of RESYNC steps, about 1.5 % each)."""
-    per_chunk = math.ceil(plan.limit_steps / _N_CHUNKS)
-    chunk = max(_MIN_CHUNK_STEPS, -(-per_chunk // kern.RESYNC) * kern.RESYNC)
+    chunk = rk4_chunk(plan.limit_steps)
     done = 0
     while done < plan.limit_steps:
         m = min(chunk, plan.limit_steps - done)

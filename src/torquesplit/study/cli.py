@@ -11,6 +11,7 @@ from __future__ import annotations
 import json
 import math
 import re
+import warnings
 from pathlib import Path
 from typing import Optional
 
@@ -39,6 +40,13 @@ def study(
     overwrite: bool = typer.Option(False, "--overwrite",
                                    help="Start again, deleting the study stored in --out."),
     list_studies: bool = typer.Option(False, "--list", help="List the shipped studies."),
+    backend: str = typer.Option(
+        "cpu", "--backend", help="cpu (default) or gpu: integrate the cases as ensembles on "
+                                 "a CUDA GPU, one case per thread (falls back to the CPU "
+                                 "with a warning when there is none)."),
+    precision: Optional[str] = typer.Option(
+        None, "--precision", help="GPU backend: fp64 (default, equal to the CPU engine) or "
+                                  "fp32 (its error against fp64 is reported)."),
     no_figures: bool = typer.Option(False, "--no-figures", help="Do not write figures."),
     quiet: bool = typer.Option(False, "--quiet", help="No progress bar."),
     as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
@@ -53,7 +61,8 @@ def study(
                             "'torquesplit study --list'"))
         return
     _run(study_file, workers=workers, scheduler=scheduler, out=out, resume=resume,
-         overwrite=overwrite, figures=not no_figures, quiet=quiet, as_json=as_json)
+         overwrite=overwrite, figures=not no_figures, quiet=quiet, as_json=as_json,
+         backend=backend, precision=precision)
 
 
 def _list() -> None:
@@ -75,7 +84,7 @@ def _list() -> None:
 
 
 def _run(source, *, workers, scheduler, out, resume, overwrite, figures, quiet, as_json,
-         name_hint: str | None = None):
+         name_hint: str | None = None, backend: str = "cpu", precision: str | None = None):
     from ..errors import TorquesplitError
     from .core import Study
     from .errors import StudyInterrupted
@@ -93,9 +102,22 @@ def _run(source, *, workers, scheduler, out, resume, overwrite, figures, quiet, 
                 f"[bold]{st.name}[/]: {plan.n_cases} cases ({plan.design.kind}, "
                 f"{plan.analysis['type']}), {len(plan.outputs)} outputs -> {out}",
                 highlight=False)
-        ds = _with_bar(lambda cb: st.run(workers=workers, scheduler=scheduler, out=out,
-                                         resume=resume, overwrite=overwrite, progress=cb,
-                                         figures=figures), plan.n_cases, quiet or as_json)
+        with warnings.catch_warnings():
+            if backend == "gpu":  # no device: say so in one line, not as a Python warning
+                from ..errors import GpuFallbackWarning
+                from ..gpu.compile import cuda_available
+
+                ok, why = cuda_available()
+                if not ok:
+                    ui.err_console.print(
+                        f"[yellow]--backend gpu:[/] {why}; running on the CPU runner "
+                        "(same results, CPU speed)", highlight=False)
+                warnings.simplefilter("ignore", GpuFallbackWarning)
+            ds = _with_bar(lambda cb: st.run(workers=workers, scheduler=scheduler, out=out,
+                                             resume=resume, overwrite=overwrite, progress=cb,
+                                             figures=figures, backend=backend,
+                                             precision=precision),
+                           plan.n_cases, quiet or as_json)
     except StudyInterrupted as exc:
         ui.err_console.print("[yellow]stopped:[/] ", end="")
         ui.err_console.print(f"{exc.done} of {exc.total} cases done and saved in {out}; to "
@@ -274,6 +296,13 @@ def sweep(
                                                            "./study_sweep_PATH)."),
     resume: bool = typer.Option(False, "--resume", help="Continue the sweep stored in --out."),
     overwrite: bool = typer.Option(False, "--overwrite", help="Start again in --out."),
+    backend: str = typer.Option(
+        "cpu", "--backend", help="cpu (default) or gpu: integrate the cases as ensembles on "
+                                 "a CUDA GPU, one case per thread (falls back to the CPU "
+                                 "with a warning when there is none)."),
+    precision: Optional[str] = typer.Option(
+        None, "--precision", help="GPU backend: fp64 (default, equal to the CPU engine) or "
+                                  "fp32 (its error against fp64 is reported)."),
     no_figures: bool = typer.Option(False, "--no-figures", help="Do not write figures."),
     quiet: bool = typer.Option(False, "--quiet", help="No progress bar."),
     as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
@@ -315,7 +344,7 @@ def sweep(
         return
     _run(data, workers=workers, scheduler=scheduler, out=out, resume=resume,
          overwrite=overwrite, figures=not no_figures, quiet=quiet, as_json=as_json,
-         name_hint=name)
+         name_hint=name, backend=backend, precision=precision)
 
 
 def _default_definition(load_model, path) -> str:

@@ -111,7 +111,8 @@ class Study:
 
     def run(self, *, workers: int | None = None, client=None, scheduler: str | None = None,
             runner=None, out=None, resume: bool = False, overwrite: bool = False,
-            progress: Callable[[Progress], None] | None = None, figures: bool = True):
+            progress: Callable[[Progress], None] | None = None, figures: bool = True,
+            backend: str = "cpu", precision: str | None = None):
         """Run the study and return its results as an :class:`xarray.Dataset`.
 
         Parameters
@@ -136,6 +137,17 @@ class Study:
             Called with a :class:`Progress` after each finished case.
         figures : bool
             Write the figures (PNG and SVG) into ``out``.
+        backend : {"cpu", "gpu"}
+            ``"gpu"``: integrate the cases as ensembles on a CUDA device, one case per
+            thread (:mod:`torquesplit.gpu`; same store and Dataset, FP64 results equal to
+            the CPU engine's).  Without a device: a warning, and the CPU runner.  What the
+            GPU kernel does not do (quasi-static analyses, ``method = "dopri"``) is
+            refused by name before any case runs.  ``workers`` are then the processes
+            that set the cases up on the CPU (default: all cores).
+        precision : {"fp64", "fp32"}, optional
+            GPU backend only: arithmetic of the dynamics (default "fp64").  "fp32" also
+            runs the first cases in FP64 and reports the largest difference of each
+            output (the Dataset's ``gpu_backend`` attribute).
 
         Raises
         ------
@@ -146,12 +158,18 @@ class Study:
             On Ctrl-C, after committing every finished case.
         """
         plan = self.plan()
+        chosen = _backend_runner(plan, backend, precision, client, scheduler, runner,
+                                 workers)
         store = _open_store(plan, out, resume, overwrite)
         try:
-            run = _Driver(plan, store, make_runner(workers, client=client,
-                                                   scheduler=scheduler, runner=runner),
+            run = _Driver(plan, store, chosen or make_runner(workers, client=client,
+                                                             scheduler=scheduler,
+                                                             runner=runner),
                           progress, out)
             run.execute()
+            report = getattr(run.runner, "report", None)
+            if report is not None:
+                store.write_meta({"gpu_backend": report})
             ds = dataset_from_store(plan, store, run.n_used)
         finally:
             store.close()
@@ -164,6 +182,29 @@ class Study:
 
                 write_study_figures(ds, Path(out) / "figures")
         return ds
+
+
+def _backend_runner(plan: Plan, backend: str, precision, client, scheduler, runner,
+                    workers=None):
+    """The GPU runner for ``backend="gpu"`` (None: use the CPU runners), after refusing
+    options that do not go together and, by name, what the GPU kernel does not do."""
+    if backend not in ("cpu", "gpu"):
+        raise StudyError("--backend", f"unknown backend {backend!r}; use 'cpu' or 'gpu'")
+    if backend == "cpu":
+        if precision is not None:
+            raise StudyError("--precision", "applies to the GPU backend only; add "
+                                            "--backend gpu or leave --precision out")
+        return None
+    if precision not in (None, "fp64", "fp32"):
+        raise StudyError("--precision", f"unknown precision {precision!r}; use 'fp64' or "
+                                        f"'fp32'")
+    if client is not None or scheduler is not None or runner is not None:
+        raise StudyError("--backend", "the GPU backend runs the cases on this machine's GPU; "
+                                      "leave out --scheduler (or client / runner)")
+    from ..gpu.backend import check_plan, make_gpu_runner
+
+    check_plan(plan)
+    return make_gpu_runner(precision=precision or "fp64", workers=workers)
 
 
 def run_study(spec, **kwargs):

@@ -112,6 +112,8 @@ def build_dataset(plan, rows, n: int, meta: dict):
         if mc.stop is not None:
             attrs["stopping_rule"] = json.dumps(mc.stop.model_dump())
             attrs["stopped_at"] = int(n)
+    if "gpu_backend" in meta:  # the GPU runs' device, times and FP32 error (torquesplit.gpu)
+        attrs["gpu_backend"] = json.dumps(meta["gpu_backend"])
     ds = xr.Dataset(data, coords=coords, attrs=attrs)
     if d.kind == "sensitivity":
         ds = _add_indices(ds, plan, values[:n])

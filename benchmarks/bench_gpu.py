@@ -1,0 +1,257 @@
+"""The GPU ensemble backend (torquesplit.gpu); writes benchmarks/GPU_RESULTS.json / .md.
+
+    python benchmarks/bench_gpu.py              # everything that this machine can run
+    python benchmarks/bench_gpu.py --quick      # 1,000-case Monte Carlo, 100 seed 000 cases
+    python benchmarks/bench_gpu.py layout       # one part: layout, monte_carlo, liu2021
+
+Not part of the test suite; nothing here asserts a threshold.  The issue's targets are
+printed beside the measured values.  Parts that need a CUDA device are recorded as not
+run, with the reason, where there is none (never estimated).
+
+layout       Needs no device, only NVIDIA's compilers (libNVVM, ptxas): for every shipped
+             example, FP64 and FP32, the kernel's PTX compile time and what ptxas
+             allocates for one thread (registers, spill stores/loads, stack): how far
+             one-case-per-thread stays in registers as the DOF count grows.
+monte_carlo  Device: Ji & Li's drive (14 DOF), a Monte Carlo over the backlash of its
+             four meshes and their damping ratios, 10 s simulated per case (the
+             issue's 10,000-case study; --quick 1,000), ``Study.run(backend="gpu")`` end
+             to end (CPU set-up of every case incl. its static equilibrium, kernel,
+             metrics, store), the kernel time alone, sample-steps per second, the FP32
+             run with its error; the CPU study runner on 2 workers on a subsample of the
+             same study, extrapolated per case, for the ratio.
+liu2021      Device: Liu et al. 2021's reducer (49 DOF) at the paper's resolution, random
+             eccentricity phases on every gear, 1,000 cases (--quick 100).
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime as _dt
+import json
+import os
+import platform
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+import warnings
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+OUT_JSON = HERE / "GPU_RESULTS.json"
+OUT_MD = HERE / "GPU_RESULTS.md"
+EXAMPLES = ("ji_li_mill_drive", "mo2017_star_reducer", "dong2021_face_gear",
+            "liu2021_split_torque_helicopter", "jin2019_friction_split")
+
+
+def _log(msg: str) -> None:
+    print(f"[{time.strftime('%H:%M:%S')}] {msg}", file=sys.stderr, flush=True)
+
+
+def _device() -> tuple[bool, str]:
+    from torquesplit.gpu.compile import cuda_available, cuda_simulated
+
+    ok, why = cuda_available()
+    if ok and cuda_simulated():
+        return False, "numba's CUDA simulator is on (NUMBA_ENABLE_CUDASIM=1): no timings"
+    return ok, why
+
+
+# ------------------------------------------------------------------------- layout
+def layout() -> dict:
+    import numpy as np
+
+    import torquesplit
+    from torquesplit.gpu.compile import ptx
+    from torquesplit.gpu.ensemble import case_arrays
+    from torquesplit.gpu.layout import build_group
+    from torquesplit.gpu.source import kernel_source
+    from torquesplit.simulation import prepare_run
+
+    ptxas = shutil.which("ptxas")
+    out = {}
+    for name in EXAMPLES:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            run = prepare_run(torquesplit.example_path(name), duration=1e-3)
+        p = case_arrays(run)
+        for prec in ("fp64", "fp32"):
+            g = build_group([p.case], [0], np.float32 if prec == "fp32" else np.float64)
+            src = kernel_source(g, prec)
+            row = {"dof": run.structure.n_dof, "elements": run.structure.n_elements,
+                   "source_lines": src.n_lines}
+            t = time.perf_counter()
+            try:
+                text = ptx(src)
+            except Exception as exc:  # noqa: BLE001 - no libNVVM here
+                row["ptx"] = f"not compiled: {type(exc).__name__}: {exc}"[:300]
+                out[f"{name}/{prec}"] = row
+                continue
+            row["ptx_compile_s"] = round(time.perf_counter() - t, 2)
+            row["ptx_local_accesses"] = len(re.findall(r"\b(?:ld|st)\.local", text))
+            if ptxas:
+                with tempfile.TemporaryDirectory() as tmp:
+                    f = Path(tmp) / "k.ptx"
+                    f.write_text(text)
+                    r = subprocess.run([ptxas, "-arch=sm_90", "-v", str(f), "-o",
+                                        str(Path(tmp) / "k.cubin")], capture_output=True,
+                                       text=True)
+                info = r.stderr
+                m = re.search(r"Used (\d+) registers", info)
+                s = re.search(r"(\d+) bytes spill stores, (\d+) bytes spill loads", info)
+                k = re.search(r"(\d+) bytes stack frame", info)
+                row.update(registers=int(m.group(1)) if m else None,
+                           spill_store_bytes=int(s.group(1)) if s else None,
+                           spill_load_bytes=int(s.group(2)) if s else None,
+                           stack_bytes=int(k.group(1)) if k else None)
+            else:
+                row["ptxas"] = "ptxas not found: no register counts"
+            out[f"{name}/{prec}"] = row
+            _log(f"layout {name} {prec}: {row}")
+    return out
+
+
+# -------------------------------------------------------------------- studies
+MC_SPEC = {
+    "study": {"name": "gpu_bench_ji_li_mc", "model": "ji_li_mill_drive",
+              "outputs": ["load_sharing.engineering*", "peak_to_nominal_engineering.*",
+                          "dynamic_factor", "contact_loss.*"]},
+    "analysis": {"duration": "10 s"},
+    "monte_carlo": {"samples": 10000, "seed": 1, "sampling": "random"},
+}
+
+
+def _mc_spec(n: int) -> dict:
+    spec = json.loads(json.dumps(MC_SPEC))
+    spec["monte_carlo"]["samples"] = n
+    spec["monte_carlo"]["parameters"] = [
+        {"paths": ["meshes.*.backlash"], "distribution": "uniform", "low": "1.044 mm",
+         "high": "1.702 mm"},
+        {"paths": ["meshes.*.damping_ratio"], "distribution": "uniform", "low": 0.05,
+         "high": 0.15}]
+    return spec
+
+
+def _timed_study(spec, **kw) -> tuple[float, object]:
+    import torquesplit
+
+    t = time.perf_counter()
+    with tempfile.TemporaryDirectory() as tmp:
+        ds = torquesplit.Study(spec).run(out=Path(tmp) / "s", figures=False, **kw)
+    return time.perf_counter() - t, ds
+
+
+def _study_part(spec, cpu_cases: int) -> dict:
+    import numpy as np
+
+    n = spec["monte_carlo"]["samples"]
+    res = {"cases": n}
+    wall, ds = _timed_study(spec, backend="gpu")
+    rep = json.loads(ds.attrs["gpu_backend"])
+    res["gpu_fp64"] = {"end_to_end_s": wall, **rep,
+                       "sample_steps_per_s_kernel": rep["sample_steps"] / rep["kernel_time_s"]}
+    wall32, ds32 = _timed_study(spec, backend="gpu", precision="fp32")
+    rep32 = json.loads(ds32.attrs["gpu_backend"])
+    res["gpu_fp32"] = {"end_to_end_s": wall32, **rep32}
+    sub = json.loads(json.dumps(spec))
+    sub["monte_carlo"]["samples"] = cpu_cases
+    cwall, cds = _timed_study(sub, workers=2)
+    res["cpu_2_workers"] = {"cases": cpu_cases, "wall_s": cwall,
+                            "per_case_s": cwall / cpu_cases}
+    # same cases, same values: the CPU subsample against the GPU's first cases
+    diffs = []
+    for v in cds.data_vars:
+        if v.startswith(("load_sharing", "peak_to", "dynamic", "contact")):
+            a = np.asarray(cds[v].values, float)
+            b = np.asarray(ds[v].values[:cpu_cases], float)
+            ok = np.isfinite(a) & np.isfinite(b)
+            if ok.any():
+                diffs.append(float(np.max(np.abs(a[ok] - b[ok]) / np.maximum(np.abs(a[ok]),
+                                                                             1e-300))))
+    res["fp64_max_rel_difference_to_cpu"] = max(diffs) if diffs else None
+    res["ratio_to_cpu_runner_end_to_end"] = (res["cpu_2_workers"]["per_case_s"] * n) / wall
+    return res
+
+
+def monte_carlo(quick: bool) -> dict:
+    ok, why = _device()
+    if not ok:
+        return {"run": False, "reason": why}
+    return {"run": True, **_study_part(_mc_spec(1000 if quick else 10000), 10 if quick else 20)}
+
+
+def liu2021(quick: bool) -> dict:
+    ok, why = _device()
+    if not ok:
+        return {"run": False, "reason": why}
+    n = 100 if quick else 1000
+    spec = {"study": {"name": "gpu_bench_liu", "model": "liu2021_split_torque_helicopter",
+                      "outputs": ["load_sharing.cycle_peak*", "dynamic_factor"]},
+            "analysis": {"type": "run"},
+            "monte_carlo": {"samples": n, "seed": 2, "sampling": "random",
+                            "parameters": [{"paths": ["gears.*.errors.eccentricity_phase"],
+                                            "distribution": "uniform", "low": "0 deg",
+                                            "high": "360 deg"}]}}
+    return {"run": True, **_study_part(spec, 4)}
+
+
+# --------------------------------------------------------------------------- main
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("parts", nargs="*", default=["layout", "monte_carlo", "liu2021"])
+    ap.add_argument("--quick", action="store_true")
+    args = ap.parse_args(argv)
+    ok, why = _device()
+    result = {"date": _dt.datetime.now().isoformat(timespec="seconds"),
+              "host": platform.node(), "cpus": os.cpu_count(),
+              "load_average": os.getloadavg(), "device": why if ok else None,
+              "device_missing_reason": None if ok else why, "quick": args.quick}
+    for part in args.parts:
+        _log(f"{part} ...")
+        if part == "layout":
+            result["layout"] = layout()
+        elif part == "monte_carlo":
+            result["monte_carlo"] = monte_carlo(args.quick)
+        elif part == "liu2021":
+            result["liu2021"] = liu2021(args.quick)
+        else:
+            ap.error(f"unknown part {part!r}")
+    OUT_JSON.write_text(json.dumps(result, indent=1, default=str) + "\n")
+    OUT_MD.write_text(_markdown(result))
+    print(_markdown(result))
+    return 0
+
+
+def _markdown(r: dict) -> str:
+    lines = ["# GPU ensemble backend: measurements", "",
+             f"{r['date']} on {r['host']} ({r['cpus']} CPUs, load {r['load_average']}).",
+             f"Device: {r['device'] or 'none (' + str(r['device_missing_reason']) + ')'}.", ""]
+    if "layout" in r:
+        lines += ["## One case per thread: what ptxas allocates (sm_90, no device needed)", "",
+                  "| model/precision | DOF | source lines | PTX compile s | registers | "
+                  "spill stores B | spill loads B | stack B |", "|---|---|---|---|---|---|---|---|"]
+        for k, v in r["layout"].items():
+            lines.append(f"| {k} | {v.get('dof')} | {v.get('source_lines')} | "
+                         f"{v.get('ptx_compile_s', v.get('ptx', ''))} | {v.get('registers')} | "
+                         f"{v.get('spill_store_bytes')} | {v.get('spill_load_bytes')} | "
+                         f"{v.get('stack_bytes')} |")
+        lines.append("")
+    for part, target in (("monte_carlo", "issue target: 10,000 cases <= 2 s end to end, "
+                                         "kernel <= 0.6 s, >= 300x the 2-core CPU runner"),
+                         ("liu2021", "issue target: 1,000 cases <= 60 s")):
+        if part not in r:
+            continue
+        v = r[part]
+        lines += [f"## {part}", "", f"({target})", ""]
+        if not v.get("run"):
+            lines += [f"Not run: {v.get('reason')}.", ""]
+            continue
+        lines += ["```json", json.dumps(v, indent=1, default=str), "```", ""]
+    return "\n".join(lines) + "\n"
+
+
+if __name__ == "__main__":
+    sys.exit(main())

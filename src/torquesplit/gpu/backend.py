@@ -1,0 +1,380 @@
+"""The GPU backend of the study runner: ``Study.run(backend="gpu")``, ``--backend gpu``.
+
+A runner of :mod:`torquesplit.study.runners` is a callable ``runner(function, payloads)``
+that yields one result dict per case.  :class:`GpuRunner` is one: it takes the payloads
+in batches, sets every case up on the CPU exactly as a CPU worker would (the study's
+overrides, :func:`torquesplit.simulation.prepare_run`: structure, static equilibrium as
+initial state, step), integrates the batch as one ensemble
+(:func:`torquesplit.gpu.ensemble.run_ensemble`), and turns each case's Solution into the
+same result dict as :func:`torquesplit.study.case.run_case` through the study's own
+functions (``output_values``, the status and contact-loss rules of
+:mod:`torquesplit.study.case`).  The driver, the store and the dataset are the CPU
+runner's: nothing else changes.
+
+The settle rule of a study (``[analysis.settle]``: run lengths T, gT, g^2 T ... until two
+successive runs agree) is run in rounds: every unsettled case of the batch runs the next
+length in one ensemble, exactly as :func:`torquesplit.study.case._dynamic` runs them one
+after the other.
+
+``precision="fp32"``: the first ``check_cases`` cases of the study also run in FP64, and
+the largest difference of every output between the two is reported (``report``, written
+to the store's metadata and the dataset's attributes by :meth:`Study.run`).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import os
+import time
+import warnings
+
+log = logging.getLogger(__name__)
+
+BATCH = 1024
+"""Cases set up and integrated together (the store still gets them one by one)."""
+
+
+def check_plan(plan) -> None:
+    """Refuse, by name and before any case runs, a study the GPU backend cannot run."""
+    from ..errors import GpuUnsupportedError
+
+    a = plan.analysis
+    if a["type"] == "static":
+        raise GpuUnsupportedError(
+            "quasi-static analyses ([analysis] type = \"static\")",
+            "run this study with the CPU backend (leave out --backend gpu)")
+    if a.get("method") not in (None, "rk4"):
+        raise GpuUnsupportedError(
+            f"adaptive time stepping (method = {a['method']!r})",
+            "set [analysis] method = \"rk4\", or use the CPU backend")
+    if plan.model.analysis.method != "rk4" and a.get("method") is None:
+        raise GpuUnsupportedError(
+            f"adaptive time stepping (the model's [analysis] method = "
+            f"{plan.model.analysis.method!r})",
+            "set [analysis] method = \"rk4\" in the study, or use the CPU backend")
+
+
+class GpuRunner:
+    """Run a study's cases as GPU ensembles (see the module docstring).
+
+    Parameters
+    ----------
+    precision : {"fp64", "fp32"}
+        Arithmetic of the dynamics; FP64 equals the CPU engine.
+    target : {"cuda", "cpu"}
+        ``"cpu"`` runs the same generated code on the CPU (tests, no device needed).
+    batch : int
+        Cases per ensemble.
+    check_cases : int
+        FP32 only: cases also run in FP64 to report the FP32 error.
+    workers : int
+        Processes that set the cases up on the CPU (model, assembly, static
+        equilibrium: about 10-20 ms a case, the host's share of a GPU study); 1: this
+        process.
+    """
+
+    def __init__(self, *, precision: str = "fp64", target: str = "cuda", batch: int = BATCH,
+                 check_cases: int = 16, workers: int = 1):
+        from .ensemble import PRECISIONS, TARGETS
+
+        if precision not in PRECISIONS:
+            raise ValueError(f"precision must be one of {PRECISIONS}, got {precision!r}; "
+                             "use 'fp64' or 'fp32'")
+        if target not in TARGETS:
+            raise ValueError(f"target must be one of {TARGETS}, got {target!r}")
+        if batch < 1:
+            raise ValueError(f"batch must be >= 1, got {batch}; give e.g. batch=1024")
+        self.precision = precision
+        self.target = target
+        self.batch = int(batch)
+        self.check_cases = int(check_cases)
+        if int(workers) < 1:
+            raise ValueError(f"workers must be >= 1, got {workers}; give e.g. workers=4")
+        self.workers = int(workers)
+        self._pool = None
+        self.device = ""
+        self.report: dict = {"backend": "gpu", "target": target, "precision": precision,
+                             "cases": 0, "ensembles": 0, "kernel_time_s": 0.0,
+                             "compile_time_s": 0.0, "setup_time_s": 0.0, "post_time_s": 0.0,
+                             "prepare_time_s": 0.0, "metrics_time_s": 0.0,
+                             "sample_steps": 0}
+
+    def __repr__(self) -> str:
+        return f"GpuRunner(target={self.target!r}, precision={self.precision!r})"
+
+    # ----------------------------------------------------------------- runner protocol
+    def __call__(self, function, payloads):
+        batch: list[dict] = []
+        try:
+            for p in payloads:
+                batch.append(p)
+                if len(batch) >= self.batch:
+                    yield from self._run_batch(batch)
+                    batch = []
+            if batch:
+                yield from self._run_batch(batch)
+        finally:
+            if self._pool is not None:
+                self._pool.shutdown(wait=False, cancel_futures=True)
+                self._pool = None
+
+    def _prepare(self, jobs: list["_Job"], first: bool) -> None:
+        """Set the jobs' next runs up, in a process pool when ``workers`` > 1."""
+        args = [(j.p, None if first else j.length) for j in jobs]
+        if self.workers > 1 and len(jobs) > 1:
+            if self._pool is None:
+                import multiprocessing
+                from concurrent.futures import ProcessPoolExecutor
+
+                from ..study.runners import _ignore_sigint
+
+                self._pool = ProcessPoolExecutor(
+                    self.workers, mp_context=multiprocessing.get_context("spawn"),
+                    initializer=_ignore_sigint)
+            chunk = max(1, len(jobs) // (4 * self.workers))
+            results = list(self._pool.map(prepare_case, *zip(*args), chunksize=chunk))
+        else:
+            results = [prepare_case(p, length) for p, length in args]
+        for job, res in zip(jobs, results, strict=True):
+            job.apply_prepared(res)
+
+    # ----------------------------------------------------------------------- batches
+    def _run_batch(self, payloads: list[dict]):
+        jobs = [_Job(p, self._worker()) for p in payloads]
+        active = jobs
+        first = True
+        while active:
+            t = time.perf_counter()
+            self._prepare(active, first)
+            first = False
+            self.report["prepare_time_s"] += time.perf_counter() - t
+            ready = [j for j in active if j.run is not None and not j.finished]
+            if ready:
+                self._integrate(ready)
+            active = [j for j in active if not j.finished]
+        for job in jobs:
+            yield job.result()
+
+    def _integrate(self, jobs: list["_Job"]) -> None:
+        from .ensemble import run_ensemble
+
+        runs = [j.run for j in jobs]
+        res = run_ensemble(runs, target=self.target, precision=self.precision)
+        self.device = res.device
+        r = self.report
+        r["device"] = res.device
+        r["ensembles"] += 1
+        r["cases"] += len(runs)
+        r["kernel_time_s"] += res.kernel_time
+        r["compile_time_s"] += res.compile_time
+        r["setup_time_s"] += res.setup_time
+        r["post_time_s"] += res.post_time
+        r["sample_steps"] += res.sample_steps
+        fp64 = None
+        if self.precision == "fp32" and r.get("fp32_checked", 0) < self.check_cases:
+            k = min(len(runs), self.check_cases - r.get("fp32_checked", 0))
+            fp64 = run_ensemble(runs[:k], target=self.target, precision="fp64").solutions
+        t = time.perf_counter()
+        for i, (job, sol) in enumerate(zip(jobs, res.solutions, strict=True)):
+            job.take(sol, res.kernel_time / len(runs), res.compile_time / len(runs))
+            if fp64 is not None and i < len(fp64):
+                self._fp32_error(job, sol, fp64[i])
+        r["metrics_time_s"] = r.get("metrics_time_s", 0.0) + time.perf_counter() - t
+
+    def _fp32_error(self, job, sol32, sol64) -> None:
+        """Largest absolute and relative difference of every output, FP32 against FP64."""
+        from ..results import Results
+        from ..study.outputs import output_values
+
+        def values(sol):
+            res = Results(model=job.run.model, kinematics=job.run.kinematics,
+                          structure=job.run.structure, static=job.run.static, solution=sol)
+            if not res.success:
+                return {}
+            return output_values(res, job.p["definitions"])
+
+        a, b = values(sol32), values(sol64)
+        err = self.report.setdefault("fp32_error", {})
+        for name in job.p["outputs"]:
+            x, y = a.get(name, math.nan), b.get(name, math.nan)
+            if not (math.isfinite(x) and math.isfinite(y)):
+                continue
+            e = err.setdefault(name, {"abs": 0.0, "rel": 0.0})
+            e["abs"] = max(e["abs"], abs(x - y))
+            e["rel"] = max(e["rel"], abs(x - y) / max(abs(y), 1e-300))
+        self.report["fp32_checked"] = self.report.get("fp32_checked", 0) + 1
+
+    def _worker(self) -> str:
+        where = "gpu" if self.target == "cuda" else "ensemble-cpu"
+        return f"{os.uname().nodename}:{os.getpid()}:{where}"
+
+
+def prepare_case(p: dict, length: float | None = None) -> dict:
+    """Set up one case as :func:`torquesplit.study.case.run_case` sets it up (the study's
+    overrides, validation, :func:`torquesplit.simulation.prepare_run`), in this process or
+    in a pool worker: ``{run, status, reason, warnings, full, length}``.  With a settle
+    rule, ``length`` is the run length of this round (None: the first, which is computed
+    here, with ``full``, the cap of the rule); errors become statuses, as in run_case."""
+    from ..errors import SolverError, TorquesplitError
+    from ..model.io import load_model, model_from_dict
+    from ..model.overrides import apply_overrides
+    from ..simulation import prepare_run
+    from ..study.case import _full_duration, _one_line
+
+    out = {"run": None, "status": "ok", "reason": "", "warnings": [], "full": None,
+           "length": length}
+    a = p["analysis"]
+    kw = {k: a[k] for k in ("method", "steps_per_period", "rtol") if a.get(k) is not None}
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            data = apply_overrides(p["model"], p["overrides"])
+            model = load_model(model_from_dict(data, source=p["source"]))
+            settle = a.get("settle")
+            if settle is None:
+                out["run"] = prepare_run(model, duration=a.get("duration"),
+                                         cycles=a.get("cycles"), **kw)
+            else:
+                if length is None:
+                    full, f_min = _full_duration(model, a)
+                    out["full"] = full
+                    out["length"] = length = min(settle["start"] or 50.0 / f_min, full)
+                out["run"] = prepare_run(model, duration=length, **kw)
+        except (TorquesplitError, SolverError, ValueError) as exc:
+            out.update(status="refused", reason=_one_line(exc))
+        except Exception as exc:  # noqa: BLE001 - recorded, the study goes on
+            out.update(status="error", reason=f"{type(exc).__name__}: {_one_line(exc)}")
+    out["warnings"] = [_one_line(w.message) for w in caught]
+    return out
+
+
+class _Job:
+    """One case through the rounds of a batch: load, (prepare, integrate)+, result."""
+
+    def __init__(self, p: dict, worker: str):
+        self.p = p
+        self.run = None
+        self.finished = False
+        self.status = "ok"
+        self.notes: list[str] = []  # warnings, one line each
+        self.t0 = time.perf_counter()
+        a = p["analysis"]
+        self.settle = a.get("settle")
+        self.length = None
+        self.full = None
+        self.previous = None
+        self.vals = None
+        self.out = {"index": p["index"], "status": "ok", "reason": "", "values": None,
+                    "wall_time": 0.0, "integration_time": 0.0, "compile_time": 0.0,
+                    "simulated_time": math.nan, "runs": 0, "settled": True,
+                    "worker": worker, "warnings": []}
+
+    def _guard(self, fn):
+        """Run ``fn`` as run_case runs a case: warnings recorded, errors -> status."""
+        from ..errors import SolverError, TorquesplitError
+        from ..study.case import _one_line
+
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            try:
+                return fn()
+            except (TorquesplitError, SolverError, ValueError) as exc:
+                self._fail("refused", _one_line(exc))
+            except Exception as exc:  # noqa: BLE001 - recorded, the study goes on
+                self._fail("error", f"{type(exc).__name__}: {_one_line(exc)}")
+            finally:
+                self.notes.extend(_one_line(w.message) for w in caught)
+        return None
+
+    def _fail(self, status: str, reason: str) -> None:
+        self.out.update(status=status, reason=reason,
+                        values=[math.nan] * len(self.p["outputs"]))
+        self.status = status
+        self.finished = True
+
+    def apply_prepared(self, res: dict) -> None:
+        """The outcome of :func:`prepare_case` for this case's next run."""
+        self.notes.extend(res["warnings"])
+        self.run = res["run"]
+        if res["status"] != "ok":
+            self._fail(res["status"], res["reason"])
+            return
+        if res["full"] is not None:
+            self.full = res["full"]
+        self.length = res["length"]
+
+    def take(self, solution, kernel_share: float, compile_share: float) -> None:
+        """A finished integration of this case (as case._dynamic after simulate)."""
+        self._guard(lambda: self._take(solution, kernel_share, compile_share))
+
+    def _take(self, solution, kernel_share, compile_share) -> None:
+        from ..results import Results
+        from ..study.case import _close
+        from ..study.outputs import output_values
+
+        run = self.run
+        res = Results(model=run.model, kinematics=run.kinematics, structure=run.structure,
+                      static=run.static, solution=solution)
+        out = self.out
+        out["integration_time"] += kernel_share
+        out["compile_time"] += compile_share
+        out["simulated_time"] = solution.t_final - solution.t_span[0]
+        out["runs"] += 1
+        names, defs = self.p["outputs"], self.p["definitions"]
+        if self.settle is None or not res.success:
+            self._finish(res)
+            return
+        vals = output_values(res, defs)
+        current = [vals.get(n, math.nan) for n in names]
+        settled = res.metrics("cycle_peak").settling.settled
+        if (self.previous is not None and settled
+                and _close(self.previous, current, self.settle["tolerance"])):
+            self._finish(res, vals)
+            return
+        if self.length >= self.full:
+            out["settled"] = False
+            self._finish(res, vals)
+            return
+        self.previous = current
+        self.length = min(self.length * self.settle["growth"], self.full)
+
+    def _finish(self, res, vals=None) -> None:
+        from ..study.case import _finish
+        from ..study.outputs import output_values
+
+        self.out["values"] = _finish(res, self.p["outputs"], self.p["definitions"], self.out,
+                                     output_values, vals)
+        self.status = self.out["status"]
+        self.finished = True
+
+    def result(self) -> dict:
+        out = self.out
+        if out["values"] is None:  # never integrated (cannot happen; be explicit)
+            out.update(status="error", reason="the case was not integrated",
+                       values=[math.nan] * len(self.p["outputs"]))
+        out["warnings"] = sorted(set(self.notes))
+        out["wall_time"] = time.perf_counter() - self.t0
+        return out
+
+
+def make_gpu_runner(*, precision: str = "fp64", batch: int = BATCH,
+                    workers: int | None = None):
+    """A :class:`GpuRunner` on the CUDA device, or — with a warning that says why — the
+    CPU runner when there is none (``None``: the caller makes its usual CPU runner)."""
+    from ..errors import GpuFallbackWarning
+    from .compile import cuda_available
+
+    ok, why = cuda_available()
+    if not ok:
+        msg = (f"--backend gpu: {why}; the study runs on the CPU runner instead (same "
+               "results, CPU speed). Run it on a machine with an NVIDIA GPU for the GPU "
+               "backend.")
+        log.info(msg)
+        warnings.warn(msg, GpuFallbackWarning, stacklevel=3)
+        return None
+    return GpuRunner(precision=precision, target="cuda", batch=batch,
+                     workers=int(workers or os.cpu_count() or 1))
+
+
+__all__ = ["GpuRunner", "check_plan", "make_gpu_runner", "BATCH"]

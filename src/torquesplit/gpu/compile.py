@@ -1,0 +1,209 @@
+"""Compile a generated ensemble kernel for the CPU (numba) or for CUDA (numba.cuda).
+
+The source of :mod:`torquesplit.gpu.source` is executed in a fresh namespace; each of
+its functions is then replaced by its compiled form, ``numba.njit`` for the CPU or a
+``numba.cuda.jit`` device function for CUDA, and they find each other (and the laws of
+:mod:`torquesplit.solve.laws`) by global name when numba compiles them.  A short driver
+is added per target: for the CPU a loop over the cases in one compiled function
+(:func:`cpu_driver`), for CUDA a kernel with one case per thread whose scratch arrays are
+thread-local (``cuda.local.array``, indexed by constants: registers).
+
+Compiled kernels are kept per process by the hash of their source (a study that runs
+batch after batch of one pattern compiles once).  Under ``NUMBA_ENABLE_CUDASIM=1`` the
+CUDA path runs in numba's simulator (the tests without a GPU).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+import threading
+
+import numpy as np
+
+from torquesplit.solve import laws
+
+from .source import KernelSource
+
+__all__ = ["cpu_driver", "cuda_kernel", "cuda_available", "cuda_simulated", "ptx"]
+
+_LOCK = threading.Lock()
+_CACHE: dict[tuple, object] = {}
+
+_CPU_DRIVER = """
+def run_all(n_cases, P, PT, PI, Y0, TK, TF, TFR, GS, CN, OF, OI):
+    W = np.empty({n_w}, DT)
+    X = np.empty({n_x})
+    WI = np.empty({n_wi}, np.int64)
+    for c in range(n_cases):
+        run_case(c, P, PT, PI, Y0, TK, TF, TFR, GS, CN, OF, OI, W, X, WI)
+    return 0
+"""
+
+_CUDA_KERNEL = """
+def kernel(n_cases, P, PT, PI, Y0, TK, TF, TFR, GS, CN, OF, OI):
+    c = cuda.grid(1)
+    if c < n_cases:
+        W = cuda.local.array({n_w}, DT_NB)
+        X = cuda.local.array({n_x}, float64)
+        WI = cuda.local.array({n_wi}, int64)
+        run_case(c, P, PT, PI, Y0, TK, TF, TFR, GS, CN, OF, OI, W, X, WI)
+"""
+
+
+#: the element laws the generated code calls (by these names)
+LAWS = ("spring_force", "spline_force", "positive_part", "table_phase", "lerp", "stat_cycle")
+_LAW_DISPATCHERS: dict = {}
+
+
+def law_functions() -> dict:
+    """The laws of :mod:`torquesplit.solve.laws` as the generated code calls them: each
+    law's own Python function compiled by numba as an ordinary (not IR-inlined)
+    function, with the laws' flags.  ``inline="always"`` (how the engine's kernels take
+    them) would re-type a law at each of its hundreds of call sites in straight-line
+    code (minutes of compilation); as a callee it is typed once per signature, and LLVM
+    (NVVM on a GPU) still inlines it.  The arithmetic is the same instructions."""
+    from numba import njit
+
+    with _LOCK:
+        if not _LAW_DISPATCHERS:
+            for name in LAWS:
+                _LAW_DISPATCHERS[name] = njit(error_model="numpy")(
+                    getattr(laws, name).py_func)
+        return dict(_LAW_DISPATCHERS)
+
+
+def _namespace(src: KernelSource, literal_calls: bool = False) -> dict:
+    import numba
+
+    fp32 = src.precision == "fp32"
+    const = (lambda k: k) if literal_calls else np.int64
+    ns = {"math": math, "np": np, **law_functions(),
+          "DT": np.float32 if fp32 else np.float64,
+          "DT_NB": numba.float32 if fp32 else numba.float64,
+          "float64": numba.float64, "int64": numba.int64, "IM1": const(-1),
+          **{f"I{k}": const(k) for k in src.call_constants}}
+    exec(compile(src.text, f"<torquesplit.gpu kernel {_digest(src)[:12]}>", "exec"), ns)
+    return ns
+
+
+def _digest(src: KernelSource) -> str:
+    return hashlib.sha256((src.precision + src.text).encode()).hexdigest()
+
+
+def _functions(ns: dict) -> list[str]:
+    """Names of the generated functions (every ``def`` of the source)."""
+    import types as _t
+
+    return [k for k, v in ns.items() if isinstance(v, _t.FunctionType)
+            and v.__code__.co_filename.startswith("<torquesplit.gpu kernel")]
+
+
+def _cuda_namespace(src: KernelSource) -> dict:
+    from numba import cuda
+
+    ns = _namespace(src, literal_calls=True)
+    ns["cuda"] = cuda
+    for name in _functions(ns):
+        ns[name] = cuda.jit(device=True)(ns[name])
+    exec(_CUDA_KERNEL.format(n_w=src.n_w, n_x=src.n_x, n_wi=src.n_wi), ns)
+    return ns
+
+
+def cpu_driver(src: KernelSource):
+    """The generated code compiled with numba for the CPU: ``run_all(n_cases, P, PT, PI,
+    Y0, TK, TF, TFR, GS, CN, OF, OI)`` runs every case in turn (the reference the CUDA
+    kernel is tested against; not a fast path)."""
+    from numba import njit
+
+    key = ("cpu", _digest(src))
+    with _LOCK:
+        hit = _CACHE.get(key)
+    if hit is not None:
+        return hit
+    ns = _namespace(src)
+    jit = njit(error_model="numpy")
+    for name in _functions(ns):
+        ns[name] = jit(ns[name])
+    exec(_CPU_DRIVER.format(n_w=src.n_w, n_x=src.n_x, n_wi=src.n_wi), ns)
+    fn = jit(ns["run_all"])
+    with _LOCK:
+        _CACHE.setdefault(key, fn)
+    return fn
+
+
+def cuda_kernel(src: KernelSource):
+    """The generated code as a CUDA kernel ``kernel[blocks, threads](n_cases, P, PT, PI,
+    Y0, TK, TF, TFR, GS, CN, OF, OI)``: one case per thread (compiled on first launch;
+    numba's simulator under ``NUMBA_ENABLE_CUDASIM=1``)."""
+    from numba import cuda
+
+    key = ("cuda", _digest(src), cuda_simulated())
+    with _LOCK:
+        hit = _CACHE.get(key)
+    if hit is not None:
+        return hit
+    ns = _cuda_namespace(src)
+    kern = cuda.jit(ns["kernel"])
+    with _LOCK:
+        _CACHE.setdefault(key, kern)
+    return kern
+
+
+def ptx(src: KernelSource, cc: tuple[int, int] = (9, 0)) -> str:
+    """PTX of the CUDA kernel for compute capability ``cc``, compiled without a device
+    (needs NVIDIA's libNVVM, e.g. a CUDA toolkit, which numba finds itself or through
+    ``CUDA_HOME``): a check that the laws and the generated code compile for the GPU.
+
+    The generated functions are bound as plain numba functions here (CUDA device
+    functions need a device to compile; numba compiles the same Python for the CUDA
+    target when a kernel calls a plain numba function; numba asks the current device for
+    its compute capability then, so a stand-in answering ``cc`` is put in its place for
+    the call), with the call-site literals of :func:`cuda_kernel`."""
+    from types import SimpleNamespace
+    from unittest import mock
+
+    from numba import cuda, float32, float64, int64, njit
+
+    ns = _namespace(src, literal_calls=True)
+    ns["cuda"] = cuda
+    for name in _functions(ns):
+        ns[name] = njit(ns[name])
+    exec(_CUDA_KERNEL.format(n_w=src.n_w, n_x=src.n_x, n_wi=src.n_wi), ns)
+    dt = float64 if src.precision == "fp64" else float32
+    sig = (int64, dt[:, ::1], float64[:, ::1], int64[:, ::1], float64[:, ::1],
+           float64[:, :, ::1], float64[:, :, ::1], float64[:, :, ::1], float64[:, ::1],
+           int64[::1], float64[:, ::1], int64[:, ::1])
+    stand_in = SimpleNamespace(compute_capability=tuple(cc))
+    with mock.patch("numba.cuda.dispatcher.get_current_device", lambda: stand_in):
+        text, _ = cuda.compile_ptx(ns["kernel"], sig, cc=cc)
+    return text
+
+
+def cuda_simulated() -> bool:
+    """Whether numba runs CUDA code in its simulator (``NUMBA_ENABLE_CUDASIM=1``)."""
+    from numba import config
+
+    return bool(config.ENABLE_CUDASIM)
+
+
+def cuda_available() -> tuple[bool, str]:
+    """Whether a CUDA device (or numba's simulator) can run the kernels, and if not why."""
+    try:
+        from numba import cuda
+    except Exception as exc:  # noqa: BLE001 - a broken CUDA installation
+        return False, f"numba.cuda cannot be imported ({type(exc).__name__}: {exc})"
+    if cuda_simulated():
+        return True, "numba's CUDA simulator (NUMBA_ENABLE_CUDASIM=1)"
+    try:
+        ok = cuda.is_available()
+    except Exception as exc:  # noqa: BLE001 - driver errors
+        return False, f"the CUDA driver failed ({type(exc).__name__}: {exc})"
+    if not ok:
+        return False, "no CUDA device or driver found"
+    try:
+        dev = cuda.get_current_device()
+        name = dev.name.decode() if isinstance(dev.name, bytes) else str(dev.name)
+    except Exception as exc:  # noqa: BLE001
+        return False, f"the CUDA device cannot be opened ({type(exc).__name__}: {exc})"
+    return True, name

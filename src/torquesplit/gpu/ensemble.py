@@ -1,0 +1,277 @@
+"""Run many prepared dynamic runs as one ensemble: one generated kernel per pattern.
+
+:func:`run_ensemble` takes runs set up by :func:`torquesplit.simulation.prepare_run`
+(model, structure, static equilibrium as initial state, integrate arguments), plans each
+one's RK4 step and tracked cycles with the CPU engine's own planning
+(``integrate._plan_rk4``, ``integrate._select``), groups the runs by pattern
+(:mod:`torquesplit.gpu.layout`), generates and compiles each pattern's kernel
+(:mod:`torquesplit.gpu.source`, :mod:`torquesplit.gpu.compile`), runs it on the target
+(``"cuda"``: one case per thread on a CUDA device or numba's simulator; ``"cpu"``: the
+same source compiled with numba, case after case) and turns each case's outputs into the
+engine's :class:`~torquesplit.solve.integrate.Solution` with the engine's own
+``integrate._solution``.  Metrics are then computed from those Solutions by the one
+metrics code (:class:`torquesplit.results.Results`), never here.
+
+What the generated code does not do is refused up front, by name
+(:class:`~torquesplit.errors.GpuUnsupportedError`): adaptive time stepping
+(``method = "dopri"``), full state histories.  Decimated histories are not produced (no
+study output reads them): a GPU run's Solution has empty ``history_*`` arrays.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from torquesplit.errors import GpuUnsupportedError
+from torquesplit.solve import _kernels as kern
+from torquesplit.solve import kernel_data as kd
+
+from .compile import cpu_driver, cuda_available, cuda_kernel
+from .layout import CaseArrays, build_group, group_cases, unknown_fields
+from .source import N_STAT, kernel_source
+
+__all__ = ["EnsembleResult", "case_arrays", "run_ensemble", "TARGETS", "PRECISIONS",
+           "BLOWUP"]
+
+TARGETS = ("cuda", "cpu")
+PRECISIONS = ("fp64", "fp32")
+BLOWUP = 1.0e3
+"""|q| that stops a run (the default of ``integrate``, which ``simulate`` uses)."""
+THREADS_PER_BLOCK = 64
+MAX_OUTPUT_BYTES = 2 * 1024**3
+"""Output arrays of one launch at most (cases are launched in batches below it)."""
+
+
+@dataclass
+class _Planned:
+    case: CaseArrays
+    sel: object
+    plan: object
+
+
+@dataclass
+class EnsembleResult:
+    """Solutions of an ensemble, in the order of the runs, and where the time went."""
+
+    solutions: list
+    target: str
+    precision: str
+    device: str
+    patterns: int
+    """Distinct generated kernels."""
+    compile_time: float
+    """Generating and compiling the kernels [s] (a cached pattern costs nothing)."""
+    kernel_time: float
+    """Running the kernels, transfers included [s]."""
+    setup_time: float
+    """Planning, grouping and parameter arrays [s]."""
+    post_time: float
+    """Outputs -> Solutions [s]."""
+    sample_steps: int
+    """Sum over the cases of the RK4 steps they took."""
+    lines: list[int] = field(default_factory=list)
+    """Lines of generated source per pattern."""
+
+
+def check_supported(run) -> None:
+    """Refuse, by name, what the generated kernel does not do (before anything runs)."""
+    kw = run.integrate_kwargs
+    method = kw.get("method", "rk4")
+    if method != "rk4":
+        raise GpuUnsupportedError(
+            f"adaptive time stepping (method = {method!r})",
+            "set [analysis] method = \"rk4\" in the study, or run it with the CPU backend")
+    if kw.get("full_history"):
+        raise GpuUnsupportedError("full state histories (full_history)",
+                                  "leave full_history off, or use the CPU backend")
+
+
+def case_arrays(run) -> _Planned:
+    """Plan one prepared run as the CPU engine would (same step, same tracked cycles)."""
+    from torquesplit.solve.integrate import _plan_rk4, _select, rk4_chunk
+
+    check_supported(run)
+    s = run.structure
+    kw = run.integrate_kwargs
+    model = kd.kernel_model(s)
+    unknown = unknown_fields(model)
+    if unknown:
+        raise GpuUnsupportedError(
+            f"the engine's kernel arrays {unknown} (a term added to the engine after the "
+            f"GPU kernel generator)", "use the CPU backend until torquesplit.gpu.source "
+            "generates it")
+    t0, span = 0.0, float(run.duration)
+    sel = _select(s, t0, span, kw.get("track_elements"), None, [], [],
+                  kw.get("load_sharing_groups"))
+    plan = _plan_rk4(s, span, None, kw.get("steps_per_period"), None, None,
+                     kw.get("sample_interval"), False, None)
+    y = np.array(run.y0, dtype=np.float64).ravel()
+    if y.shape != (2 * s.n_dof,):
+        y = np.concatenate([y, np.zeros(s.n_dof)])
+    case = CaseArrays(model=model, y0=y, t0=t0, h=float(plan.h),
+                      n_steps=int(plan.limit_steps), chunk=rk4_chunk(plan.limit_steps),
+                      track=list(sel.track),
+                      track_base=np.asarray(sel.track_base, dtype=np.int64),
+                      cap=int(sel.n_cycles_cap), groups=[list(g) for g in sel.groups],
+                      blowup=BLOWUP, group_min=_group_min(kw, len(sel.groups)))
+    return _Planned(case, sel, plan)
+
+
+def _group_min(kw: dict, n_groups: int) -> np.ndarray:
+    """``integrate``'s ``load_sharing_min_total`` (0 for each group when not given)."""
+    g = kw.get("load_sharing_min_total")
+    if g is None:
+        return np.zeros(n_groups)
+    if len(g) != n_groups:
+        raise ValueError("load_sharing_min_total needs one value per load-sharing group.")
+    return np.asarray(g, dtype=np.float64).reshape(n_groups)
+
+
+def run_ensemble(runs, *, target: str = "cuda", precision: str = "fp64",
+                 threads_per_block: int = THREADS_PER_BLOCK,
+                 max_output_bytes: int = MAX_OUTPUT_BYTES) -> EnsembleResult:
+    """Integrate prepared runs (:class:`~torquesplit.simulation.PreparedRun`) together.
+
+    Parameters
+    ----------
+    runs : sequence of PreparedRun
+        Each from :func:`torquesplit.simulation.prepare_run` (RK4).
+    target : {"cuda", "cpu"}
+        ``"cuda"``: one case per GPU thread (a CUDA device, or numba's simulator under
+        ``NUMBA_ENABLE_CUDASIM=1``); ``"cpu"``: the same generated source compiled for
+        the CPU, one case after the other (the reference of the tests).
+    precision : {"fp64", "fp32"}
+        Arithmetic of the dynamics (state, stages, element forces).  Times, mesh phases,
+        error sinusoids and the statistics are float64 in both.
+    threads_per_block : int
+        CUDA block size.
+    max_output_bytes : int
+        Cases are launched in batches whose output arrays stay below this.
+
+    Returns
+    -------
+    EnsembleResult
+        ``solutions[i]`` is run i's :class:`~torquesplit.solve.integrate.Solution`.
+
+    Raises
+    ------
+    GpuUnsupportedError
+        A run needs something the generated kernel does not do (named).
+    GpuUnavailableError
+        ``target="cuda"`` without a CUDA device.
+    """
+    from torquesplit.errors import GpuUnavailableError
+
+    if target not in TARGETS:
+        raise ValueError(f"target must be one of {TARGETS}, got {target!r}; use 'cuda' "
+                         f"or 'cpu'")
+    if precision not in PRECISIONS:
+        raise ValueError(f"precision must be one of {PRECISIONS}, got {precision!r}; use "
+                         f"'fp64' (default) or 'fp32'")
+    device = "cpu (generated source, numba)"
+    if target == "cuda":
+        ok, device = cuda_available()
+        if not ok:
+            raise GpuUnavailableError(device)
+    t_setup = time.perf_counter()
+    planned = [case_arrays(r) for r in runs]
+    setup = time.perf_counter() - t_setup
+    out = EnsembleResult(solutions=[None] * len(planned), target=target,
+                         precision=precision, device=device, patterns=0, compile_time=0.0,
+                         kernel_time=0.0, setup_time=setup, post_time=0.0,
+                         sample_steps=0)
+    cases = [p.case for p in planned]
+    dtype = np.float32 if precision == "fp32" else np.float64
+    for indices in group_cases(cases).values():
+        t = time.perf_counter()
+        probe = build_group(cases, indices[:1], dtype)
+        probe.cap_max = max(cases[i].cap for i in indices)
+        sizes = kernel_source(probe, precision)
+        per_case = 8 * (sizes.n_of + sizes.n_oi)
+        out.setup_time += time.perf_counter() - t
+        batch = max(1, min(len(indices), int(max_output_bytes // max(per_case, 1))))
+        for start in range(0, len(indices), batch):
+            part = indices[start:start + batch]
+            t = time.perf_counter()
+            g = build_group(cases, part, dtype)
+            src = kernel_source(g, precision)
+            out.setup_time += time.perf_counter() - t
+            t = time.perf_counter()
+            fn = cuda_kernel(src) if target == "cuda" else cpu_driver(src)
+            out.compile_time += time.perf_counter() - t
+            out.lines.append(src.n_lines)
+            t = time.perf_counter()
+            OF, OI = _launch(fn, target, g, src, threads_per_block)
+            out.kernel_time += time.perf_counter() - t
+            t = time.perf_counter()
+            share = (out.kernel_time / max(len(part), 1))
+            for k, i in enumerate(part):
+                out.solutions[i] = _solution(planned[i], runs[i], g, src, OF[:, k], OI[:, k],
+                                             precision, target, share)
+            out.post_time += time.perf_counter() - t
+        out.patterns += 1
+    out.sample_steps = int(sum(s.n_steps for s in out.solutions))
+    return out
+
+
+def _launch(fn, target, g, src, threads_per_block):
+    n_c = g.n_cases
+    args = (g.P, g.PT, g.PI, g.Y0, g.TK, g.TF, g.TFR, g.GS, g.CN)
+    if target == "cpu":
+        OF = np.empty((src.n_of, n_c))
+        OI = np.empty((src.n_oi, n_c), dtype=np.int64)
+        fn(n_c, *args, OF, OI)
+        return OF, OI
+    from numba import cuda
+
+    d_args = [cuda.to_device(np.ascontiguousarray(a)) for a in args]
+    d_of = cuda.device_array((src.n_of, n_c), dtype=np.float64)
+    d_oi = cuda.device_array((src.n_oi, n_c), dtype=np.int64)
+    blocks = (n_c + threads_per_block - 1) // threads_per_block
+    fn[blocks, threads_per_block](n_c, *d_args, d_of, d_oi)
+    cuda.synchronize()
+    return d_of.copy_to_host(), d_oi.copy_to_host()
+
+
+def _solution(p: _Planned, run, g, src, of, oi, precision, target, share):
+    """A case's outputs as the engine's Solution (``integrate._solution``)."""
+    from torquesplit.solve.integrate import _solution as make_solution
+
+    c, sel, plan = p.case, p.sel, p.plan
+    s = run.structure
+    n_tr = len(sel.track)
+    cap = c.cap
+    rec = kd.make_record(sel.track, sel.track_base, cap, sel.groups, s.n_elements, [], [],
+                         0, 0, s.n_dof, c.group_min)
+    st = of[:cap * n_tr * N_STAT].reshape(cap, n_tr, N_STAT)
+    rec.cyc_max[:] = st[:, :, 0]
+    rec.cyc_min[:] = st[:, :, 1]
+    rec.cyc_sum[:] = st[:, :, 2]
+    rec.rat_max[:] = st[:, :, 3]
+    rec.rat_min[:] = st[:, :, 4]
+    rec.cyc_cnt[:] = oi[:cap * n_tr].reshape(cap, n_tr)
+    for k, el in enumerate(g.layout.watch):
+        rec.sep_time[el] = of[src.of_contact + 2 * k]
+        rec.back_time[el] = of[src.of_contact + 2 * k + 1]
+        rec.sep_count[el] = oi[src.oi_contact + 2 * k]
+        rec.back_count[el] = oi[src.oi_contact + 2 * k + 1]
+    counters = np.array(oi[src.oi_counters:src.oi_counters + kern.N_COUNTERS], dtype=np.int64)
+    clock = np.zeros(kern.N_CLOCK)
+    clock[kern.F_T] = of[src.of_t]
+    y = np.array(of[src.of_y:src.of_y + 2 * s.n_dof], dtype=np.float64)
+    label = ("gpu" if target == "cuda" else "ensemble-cpu") + (
+        "-fp32" if precision == "fp32" else "")
+    return make_solution(s, sel, plan, rec, counters, clock, y, method="rk4",
+                         t_span=(c.t0, c.t0 + run.duration), blowup=c.blowup,
+                         step_min=plan.h, step_max=plan.h, compile_time=0.0,
+                         wall_time=share, rhs_name=label, rhs_compile_time=0.0,
+                         full_history=False)
+
+
+def sample_steps_per_second(result: EnsembleResult) -> float:
+    """RK4 sample-steps per second of kernel time (cases x steps / kernel seconds)."""
+    return result.sample_steps / result.kernel_time if result.kernel_time > 0 else math.nan

@@ -1,0 +1,119 @@
+"""The generated ensemble kernel compiled for the CPU equals the CPU engine.
+
+The same source is what CUDA compiles (test_gpu_simulator.py runs it as CUDA in the
+simulator; test_gpu_device.py on a device).  FP64 results are bit-identical to
+:func:`torquesplit.solve.integrate.integrate`: every per-cycle statistic, contact
+counter, the end state, step counts, status and message; and every study output of
+every shipped example.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import torquesplit
+from gpu_cases import compare, engine, example_run, feature_runs
+from torquesplit.errors import GpuUnavailableError, GpuUnsupportedError
+from torquesplit.gpu.compile import cuda_available
+from torquesplit.gpu.ensemble import run_ensemble
+from torquesplit.results import Results
+from torquesplit.study.outputs import output_values
+
+_LENGTHS = {  # run lengths: about a hundred to a few hundred steps, table corners included
+    "liu2021_split_torque_helicopter": 6e-4,
+    "ji_li_mill_drive": 2e-3,
+    "dong2021_face_gear": 1e-3,
+    "jin2019_friction_split": 6e-4,
+    "mo2017_star_reducer": 2e-3,
+}
+#: every shipped example (a new one is covered without editing this file)
+EXAMPLES = {name: _LENGTHS.get(name, 1e-3) for name in torquesplit.example_names()}
+
+
+def test_every_feature_equals_the_engine():
+    runs = feature_runs()
+    res = run_ensemble(runs, target="cpu")
+    assert res.patterns == 2 and len(res.solutions) == 4
+    for i, (run, sol) in enumerate(zip(runs, res.solutions, strict=True)):
+        ref = engine(run)
+        assert compare(sol, ref) == [], f"case {i}"
+        assert sol.n_steps > (0 if i != 2 else -1)
+    assert [s.status for s in res.solutions] == [0, 0, 1, 0]
+    assert "diverged" in res.solutions[2].message
+    # the two cases of one pattern really differ (per-case parameters, table sets)
+    assert not np.array_equal(res.solutions[0].cycle_max, res.solutions[1].cycle_max,
+                              equal_nan=True)
+    assert res.sample_steps == sum(s.n_steps for s in res.solutions)
+
+
+@pytest.mark.parametrize("name", sorted(EXAMPLES))
+def test_shipped_example_equals_the_engine(name):
+    run = example_run(name, EXAMPLES[name])
+    sol = run_ensemble([run], target="cpu").solutions[0]
+    ref = engine(dict_free(run))
+    assert compare(sol, ref) == []
+    assert ref.n_steps > 50 and (ref.cycle_count > 0).any()
+
+    def values(s):
+        return output_values(Results(model=run.model, kinematics=run.kinematics,
+                                     structure=run.structure, static=run.static,
+                                     solution=s))
+
+    a, b = values(sol), values(ref)
+    assert a.keys() == b.keys() and len(a) > 50
+    for k in a:
+        assert a[k] == b[k] or (math.isnan(a[k]) and math.isnan(b[k])), k
+
+
+def dict_free(run):
+    """The engine runs the same prepared run (histories are not compared)."""
+    return run
+
+
+def test_refuses_what_it_does_not_do():
+    run = example_run("ji_li_mill_drive", 1e-3)
+    from dataclasses import replace
+
+    dopri = replace(run, integrate_kwargs={**run.integrate_kwargs, "method": "dopri"})
+    with pytest.raises(GpuUnsupportedError, match="adaptive time stepping") as info:
+        run_ensemble([dopri], target="cpu")
+    assert "rk4" in str(info.value) and info.value.feature.startswith("adaptive")
+    full = replace(run, integrate_kwargs={**run.integrate_kwargs, "full_history": True})
+    with pytest.raises(GpuUnsupportedError, match="full state histories"):
+        run_ensemble([full], target="cpu")
+    with pytest.raises(ValueError, match="precision"):
+        run_ensemble([run], target="cpu", precision="fp16")
+    with pytest.raises(ValueError, match="target"):
+        run_ensemble([run], target="tpu")
+
+
+@pytest.mark.skipif(cuda_available()[0], reason="a CUDA device is present")
+def test_no_device_is_said_clearly():
+    run = example_run("ji_li_mill_drive", 1e-3)
+    with pytest.raises(GpuUnavailableError, match="CPU backend") as info:
+        run_ensemble([run], target="cuda")
+    assert info.value.reason
+
+
+def test_fp32_is_close_to_fp64_and_not_equal():
+    run = example_run("ji_li_mill_drive", 2e-3)
+    s64 = engine(run)
+    s32 = run_ensemble([run], target="cpu", precision="fp32").solutions[0]
+    assert s32.status == 0 and s32.n_steps == s64.n_steps
+    m64, m32 = s64.cycle_max, s32.cycle_max
+    ok = np.isfinite(m64)
+    rel = np.abs(m32[ok] - m64[ok]) / np.abs(m64[ok])
+    assert rel.max() < 1e-3  # single precision of the dynamics (measured ~1e-6)
+    assert rel.max() > 0.0  # it really ran in single precision
+
+
+def test_generator_knows_every_kernel_array_of_the_engine():
+    """A field the engine's KernelModel gains is a term the generated code would miss:
+    runs are refused until the generator makes it (this test fails to say so)."""
+    from torquesplit.gpu.layout import KNOWN_FIELDS
+    from torquesplit.solve.kernel_data import KernelModel
+
+    assert tuple(KernelModel._fields) == KNOWN_FIELDS

@@ -1,0 +1,163 @@
+"""The GPU backend as a study runner: same store, same Dataset, same values.
+
+The runner is :class:`torquesplit.gpu.backend.GpuRunner` with ``target="cpu"`` (the
+generated CUDA source compiled for the CPU), so that these tests need no device; the
+CUDA path itself is tested in the simulator and on a device (test_gpu_simulator.py,
+test_gpu_device.py)."""
+
+from __future__ import annotations
+
+import json
+import warnings
+
+import numpy as np
+import pytest
+
+import torquesplit
+from torquesplit.errors import GpuFallbackWarning, GpuUnsupportedError
+from torquesplit.gpu.backend import GpuRunner, check_plan
+from torquesplit.gpu.compile import cuda_available
+from torquesplit.study.errors import StudyError
+
+GRID = {"study": {"name": "gpu_grid", "model": "ji_li_mill_drive",
+                  "outputs": ["load_sharing.*", "dynamic_factor*", "peak_force.*",
+                              "contact_loss.*", "settle_time"]},
+        "analysis": {"duration": "0.12 s"},
+        "grid": {"parameters": [
+            {"path": "meshes.m11.damping_ratio", "values": [0.05, 0.12]},
+            {"path": "meshes.m12.backlash", "values": ["0.3 mm", "0.9 mm"]}]}}
+
+TIMING = ("case_wall_time", "case_integration_time", "case_compile_time")
+
+
+def _same(ds_a, ds_b):
+    for v in ds_a.data_vars:
+        if v in TIMING:
+            continue
+        a, b = ds_a[v].values, ds_b[v].values
+        if a.dtype.kind == "f":
+            assert np.array_equal(a, b, equal_nan=True), v
+        else:
+            assert np.array_equal(a, b), v
+
+
+def test_gpu_runner_gives_the_cpu_runners_dataset(tmp_path):
+    ds_cpu = torquesplit.run_study(GRID, workers=1)
+    runner = GpuRunner(target="cpu", batch=3)  # two batches: 3 + 1 cases
+    ds_gpu = torquesplit.Study(GRID).run(runner=runner, out=tmp_path / "g", figures=False)
+    _same(ds_cpu, ds_gpu)
+    assert set(ds_gpu["status"].values.ravel()) == {"ok"}
+    report = json.loads(ds_gpu.attrs["gpu_backend"])
+    assert report["cases"] == 4 and report["ensembles"] == 2
+    assert report["sample_steps"] > 0 and report["precision"] == "fp64"
+    # the store is the CPU runner's: resume finds every case finished
+    again = torquesplit.Study(GRID).run(runner=GpuRunner(target="cpu"), out=tmp_path / "g",
+                                        resume=True, figures=False)
+    _same(ds_cpu, again)
+
+
+def test_settle_rule_runs_in_rounds_as_the_cpu_runner():
+    spec = {**GRID, "analysis": {"duration": "0.3 s",
+                                 "settle": {"tolerance": 0.2, "start": "0.08 s"}}}
+    spec["grid"] = {"parameters": [{"path": "meshes.m11.damping_ratio",
+                                    "values": [0.05, 0.12]}]}
+    ds_cpu = torquesplit.run_study(spec, workers=1)
+    runner = GpuRunner(target="cpu")
+    ds_gpu = torquesplit.Study(spec).run(runner=runner)
+    _same(ds_cpu, ds_gpu)
+    # rounds: 0.08 s, 0.16 s, then the cap 0.3 s, every case in each round's ensemble
+    assert runner.report["ensembles"] == 3 and runner.report["cases"] == 6
+    assert (ds_gpu["simulated_time"].values == 0.3).all()
+
+
+def test_fp32_reports_its_error_per_output():
+    spec = {**GRID, "grid": {"parameters": [{"path": "meshes.m11.damping_ratio",
+                                             "values": [0.05, 0.12]}]}}
+    runner = GpuRunner(target="cpu", precision="fp32", check_cases=2)
+    ds = torquesplit.Study(spec).run(runner=runner)
+    err = json.loads(ds.attrs["gpu_backend"])["fp32_error"]
+    assert set(err) <= set(ds.attrs["outputs"] and json.loads(ds.attrs["outputs"]))
+    assert "load_sharing.engineering" in err and len(err) > 10
+    worst = max(e["rel"] for e in err.values())
+    assert 0.0 < worst < 1e-2
+
+
+def test_refused_by_name_before_any_case_runs():
+    static = {"study": {"name": "s", "model": "mo2017_star_reducer",
+                        "outputs": ["load_sharing.static_torque"]},
+              "analysis": {"type": "static", "points_per_cycle": 2},
+              "grid": {"parameters": [{"path": "gears.s1.errors.eccentricity",
+                                       "values": ["1 um", "2 um"]}]}}
+    with pytest.raises(GpuUnsupportedError, match="quasi-static"):
+        torquesplit.Study(static).run(backend="gpu")
+    dopri = {**GRID, "analysis": {"duration": "0.05 s", "method": "dopri"}}
+    with pytest.raises(GpuUnsupportedError, match="adaptive time stepping"):
+        check_plan(torquesplit.Study(dopri).plan())
+    with pytest.raises(StudyError, match="GPU backend only"):
+        torquesplit.Study(GRID).run(precision="fp32")
+    with pytest.raises(StudyError, match="unknown backend"):
+        torquesplit.Study(GRID).run(backend="tpu")
+    with pytest.raises(StudyError, match="scheduler"):
+        torquesplit.Study(GRID).run(backend="gpu", scheduler="tcp://127.0.0.1:1")
+
+
+@pytest.mark.skipif(cuda_available()[0], reason="a CUDA device is present")
+def test_without_a_device_the_cpu_runner_runs_it_with_a_warning():
+    spec = {**GRID, "analysis": {"duration": "0.03 s"},
+            "grid": {"parameters": [{"path": "meshes.m11.damping_ratio", "values": [0.1]}]}}
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        ds = torquesplit.Study(spec).run(backend="gpu", workers=1)
+    msgs = [str(w.message) for w in caught if issubclass(w.category, GpuFallbackWarning)]
+    assert msgs and "CPU runner" in msgs[0] and "no CUDA device" in msgs[0]
+    assert "gpu_backend" not in ds.attrs
+    _same(torquesplit.run_study(spec, workers=1), ds)
+
+
+def test_cli_refuses_and_falls_back_in_one_line(tmp_path):
+    from typer.testing import CliRunner
+
+    from torquesplit.cli import app
+
+    cli = CliRunner()
+    res = cli.invoke(app, ["sweep", "mo2017_star_reducer", "--static", "--vary",
+                           "gears.s1.errors.eccentricity=1:2:2um", "--backend", "gpu",
+                           "--quiet", "--no-figures", "--out", str(tmp_path / "s")])
+    assert res.exit_code == 2
+    assert "does not support quasi-static" in res.output
+    res = cli.invoke(app, ["sweep", "ji_li_mill_drive", "--vary",
+                           "meshes.m11.damping_ratio=0.05:0.1:2", "--duration", "0.01 s",
+                           "--precision", "fp32", "--quiet", "--no-figures", "--out",
+                           str(tmp_path / "p")])
+    assert res.exit_code == 2 and "GPU backend only" in res.output
+    if not cuda_available()[0]:
+        res = cli.invoke(app, ["sweep", "ji_li_mill_drive", "--vary",
+                               "meshes.m11.damping_ratio=0.05:0.1:2", "--duration", "0.01 s",
+                               "--backend", "gpu", "--workers", "1", "--quiet",
+                               "--no-figures", "--out", str(tmp_path / "f")])
+        assert res.exit_code == 0, res.output
+        assert res.output.count("running on the CPU runner") == 1
+
+
+def test_a_case_the_study_makes_invalid_is_refused_as_on_the_cpu():
+    spec = {"study": {"name": "bad", "model": "ji_li_mill_drive",
+                      "outputs": ["load_sharing.engineering"]},
+            "analysis": {"duration": "0.01 s"},
+            "grid": {"parameters": [{"path": "meshes.m11.damping_ratio",
+                                     "values": [0.1, -0.5]}]}}
+    ds_cpu = torquesplit.run_study(spec, workers=1)
+    ds_gpu = torquesplit.Study(spec).run(runner=GpuRunner(target="cpu"))
+    assert list(ds_gpu["status"].values) == ["ok", "refused"]
+    assert "must not be negative" in str(ds_gpu["reason"].values[1])
+    _same(ds_cpu, ds_gpu)
+
+
+def test_cases_set_up_in_worker_processes_give_the_same_dataset():
+    spec = {**GRID, "analysis": {"duration": "0.02 s"}}
+    ds_one = torquesplit.Study(spec).run(runner=GpuRunner(target="cpu"))
+    runner = GpuRunner(target="cpu", workers=2)
+    ds_two = torquesplit.Study(spec).run(runner=runner)
+    _same(ds_one, ds_two)
+    assert runner._pool is None  # shut down when the study ends
+    with pytest.raises(ValueError, match="workers"):
+        GpuRunner(workers=0)
