@@ -278,6 +278,28 @@ def test_support_spectrum_finds_a_known_sinusoid(run):
     assert ax.get_xlim()[1] == pytest.approx(2500.0, rel=0.02)  # (+ the Hann window's spread)
 
 
+def test_support_spectrum_panels_share_one_amplitude_axis(tmp_path):
+    """Two bearings, one ten times stronger: one axis for both by default (so they can be
+    compared), each its own with common_scale=False."""
+    text = _model_text()
+    out_block = text.index("[gears.out]")
+    end = text.index("\n\n", out_block)
+    text = (text[:end] + '\ndofs = ["x", "y", "theta"]\n\n[gears.out.support]\n'
+            'stiffness = "5e8 N/m"\ndamping_ratio = 0.05' + text[end:])
+    res = torquesplit.simulate(torquesplit.load_model(write_model(tmp_path, text)), cycles=20)
+    t = res.solution.history_t
+    f0 = 2.0 * SPLIT_F
+    fake = _with_history(res, {"pinion.support.x": 1000.0 * np.sin(2 * np.pi * f0 * t),
+                               "out.support.x": 100.0 * np.sin(2 * np.pi * f0 * t)})
+    for common in (True, False):
+        fig = F.support_spectrum_figure(fake, start_time=0.0, log=True, common_scale=common)
+        tops = [_panel(fig, f"support of {b}").get_ylim()[1] for b in ("pinion", "out")]
+        if common:
+            assert tops[0] == tops[1]
+        else:
+            assert tops[0] == pytest.approx(10.0 * tops[1], rel=0.05)
+
+
 def test_support_spectrum_without_supports_explains(run):
     with pytest.raises(F.FigureNotApplicableError, match="choose among pinion"):
         F.support_spectrum_figure(run, bodies=["out"])

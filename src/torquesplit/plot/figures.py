@@ -317,7 +317,8 @@ def support_spectrum_figure(results, *, start_time: float | None = None, orders:
                             max_frequency: float | None = None, log: bool = True,
                             dynamic_range: float = 1e-4,
                             bodies: Iterable[str] | None = None, max_panels: int = 4,
-                            content_range: float = 1e-2, max_points: int = 3000) -> Figure:
+                            content_range: float = 1e-2, max_points: int = 3000,
+                            common_scale: bool = True) -> Figure:
     """Amplitude spectrum of the support (bearing) force histories, mesh orders marked.
 
     Parameters
@@ -350,6 +351,9 @@ def support_spectrum_figure(results, *, start_time: float | None = None, orders:
     max_points : int
         A panel's spectrum is reduced to about this many points by keeping the largest
         amplitude of each run of frequency bins (every line keeps its height).
+    common_scale : bool
+        One amplitude axis for all panels (default), so that the bearings can be compared
+        at a glance; ``False`` scales each panel to its own largest line.
 
     Returns
     -------
@@ -440,9 +444,12 @@ def support_spectrum_figure(results, *, start_time: float | None = None, orders:
     show = freq <= f_top
     ncols = 1 if len(shown) <= max(4, max_panels) else 2
     fig, axes = _panels(len(shown), ncols=ncols, sharex=True, row_height=2.6)
+    overall = max((float(a[show].max()) for b in shown if strength[b] > 0.0
+                   for _, _, a in spectra[b]), default=0.0)
     for n_panel, (ax, body) in enumerate(zip(axes, shown)):
         lines = spectra[body]
-        largest = max(float(a[show].max()) for _, _, a in lines)
+        own = max(float(a[show].max()) for _, _, a in lines)
+        largest = overall if common_scale and overall > 0.0 else own
         quiet = strength[body] == 0.0
         floor = largest * dynamic_range
         for i, (direction, mean, amp) in enumerate(lines):
@@ -452,7 +459,7 @@ def support_spectrum_figure(results, *, start_time: float | None = None, orders:
             ax.plot(f_show * fscale, y, zorder=3, gid=f"{body}.support.{direction}", **style)
             peak = int(np.argmax(a_show))
             # the top of each strong line marked, so coinciding lines of x, y, z all show
-            tops = _spectral_lines(y, 0.01 * largest) if not quiet else np.zeros(0, int)
+            tops = _spectral_lines(y, 0.01 * own) if not quiet else np.zeros(0, int)
             ax.plot(f_show[tops] * fscale, y[tops], ls="none", marker=_MARKERS[i % 3],
                     ms=5, mfc="none", mew=1.2, color=style["color"], zorder=4,
                     label=f"{direction}: mean {_force_text(mean)},\n"
