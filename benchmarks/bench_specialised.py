@@ -59,8 +59,8 @@ def specialised_source(s, name: str = "specialised_rk4") -> str:
     lines = [
         f"def {name}(y, t0, h, n_steps, tab, freq, phase, cyc_max, cyc_min, cyc_sum,",
         "        cyc_cnt, record_every, hist_t, hist_f, hist_y):",
-        f"    n_tab = tab.shape[1]",
-        f"    cap = cyc_max.shape[0]",
+        "    n_tab = tab.shape[1]",
+        "    cap = cyc_max.shape[0]",
         f"    ka = np.empty({len(tv)})",
         f"    kh = np.empty({len(tv)})",
         f"    kb = np.empty({len(tv)})",

@@ -328,10 +328,10 @@ def report(res: dict) -> str:
              + ", ".join(f"{r['model']} {_f(c, 2)}" for r, c in zip(res["engine"],
                                                                   res["cached_check"])
                          if c >= 1e-9)
-             + f"). 'engine dopri' is `integrate(method="
-             f"'dopri', rtol=1e-6)` over a tenth of the engine RK4 run's simulated time: "
-             f"the same algorithm family as RK45 (*max steps*: it stopped at its step limit "
-             f"and is reported over the part it did). Ratio = engine / baseline.\n")
+             + "). 'engine dopri' is `integrate(method="
+             "'dopri', rtol=1e-6)` over a tenth of the engine RK4 run's simulated time: "
+             "the same algorithm family as RK45 (*max steps*: it stopped at its step limit "
+             "and is reported over the part it did). Ratio = engine / baseline.\n")
     rows = []
     for k in eng:
         a, b, d = sci[k], scc[k], dop[k]

@@ -423,7 +423,7 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
     w()
 
     # ================================================================ corners
-    cptr, cnode = L.corner_ptr, L.corner_node
+    cptr = L.corner_ptr
     with w.block("def first_corners(t, WI, PT, c, CN):"):
         for k, e in enumerate(corner_el):
             c0, c1 = int(cptr[e]), int(cptr[e + 1])
