@@ -44,6 +44,17 @@ def test_benchmark_results_are_their_data():
         encoding="utf-8"), "benchmarks/RESULTS.md drifted: run python benchmarks/run.py --render"
 
 
+@pytest.mark.parametrize("script, stem", [("bench_steady.py", "STEADY_RESULTS"),
+                                           ("bench_study.py", "STUDY_RESULTS")])
+def test_study_and_steady_benchmark_pages_are_their_data(script, stem):
+    bench = _load(ROOT / "benchmarks" / script, stem.lower())
+    res = json.loads((ROOT / "benchmarks" / f"{stem}.json").read_text(encoding="utf-8"))
+    text = (ROOT / "benchmarks" / f"{stem}.md").read_text(encoding="utf-8")
+    assert bench.report(res).rstrip("\n") == text.rstrip("\n"), (
+        f"benchmarks/{stem}.md drifted: run python benchmarks/{script} (--render for the "
+        "steady one)")
+
+
 def test_renderer_fails_loudly_on_a_missing_number():
     render = _load(ROOT / "scripts" / "render_docs.py", "render_docs")
     assert render.render("a {{x/y:.2f}} b {{=$[x/y] * 2:.1f}}", {"x": {"y": 1.234}}) \

@@ -34,6 +34,23 @@ def test_steady_state_of_one_stage_and_its_results():
     assert met.rows[0].peak_force == pytest.approx(rows["m11"].peak_force, rel=1e-2)
 
 
+def test_default_harmonics_converge_the_dynamic_factor_to_shooting():
+    """The stepped stiffness of a contact-ratio change needs many harmonics: without a
+    number asked for, HB doubles them until converged and agrees with shooting (RK4, 400
+    steps per cycle); a fixed 8 per cycle (the first guess) does not."""
+    def factors(**kw):
+        st = steady_state(example_path(EXAMPLE), keep="stage1", stability=False,
+                          check=False, **kw)
+        return st, np.array([r.dynamic_factor for r in st.mesh_table()])
+
+    _, ref = factors(method="shooting", steps_per_cycle=400)
+    st, hb = factors()
+    assert st.solution.harmonics >= 64
+    np.testing.assert_allclose(hb, ref, rtol=1e-4)
+    _, coarse = factors(harmonics=8)
+    assert np.max(np.abs(coarse / ref - 1.0)) > 1e-2
+
+
 def test_long_period_is_refused_with_the_fix():
     with pytest.raises(LongPeriodError, match="keep="):
         steady_state(example_path(EXAMPLE), max_cycles=100)

@@ -62,11 +62,11 @@ def register(app, load, fail, console, err_console, json_default):
         model: str = typer.Argument(..., help="Model file (.toml/.json) or example name."),
         method: str = typer.Option("hb", "--method", help="hb (harmonic balance) or shooting."),
         harmonics: Optional[int] = typer.Option(
-            None, "--harmonics", help="HB harmonics of the fundamental (default 8 per cycle "
-            "of the fastest excitation)."),
-        adaptive: bool = typer.Option(False, "--adaptive",
-                                      help="Double the harmonics until the top quarter holds "
-                                      "< 1e-6 of the energy."),
+            None, "--harmonics", help="HB harmonics of the fundamental (default: 8 per cycle "
+            "of the fastest excitation, doubled until converged)."),
+        adaptive: Optional[bool] = typer.Option(
+            None, "--adaptive/--fixed", help="Double the harmonics until the top quarter holds "
+            "< 1e-7 of the velocity energy (default unless --harmonics is given)."),
         keep: Optional[str] = typer.Option(
             None, "--keep", help="Keep only the excitations periodic with this stage, mesh, "
             "body or frequency [Hz]; the others by their means."),
@@ -153,7 +153,9 @@ def register(app, load, fail, console, err_console, json_default):
         start: str = typer.Option(..., "--from", help="First speed, e.g. '500 rpm'."),
         stop: str = typer.Option(..., "--to", help="Last speed, e.g. '3000 rpm'."),
         points: int = typer.Option(50, "--points", help="Initial steps over the range."),
-        harmonics: Optional[int] = typer.Option(None, "--harmonics", help="HB harmonics."),
+        harmonics: Optional[int] = typer.Option(
+            None, "--harmonics", help="HB harmonics (default: as 'steady' chooses them at the "
+            "first speed, then kept along the curve)."),
         keep: Optional[str] = typer.Option(None, "--keep", help="As for 'steady'."),
         max_cycles: int = typer.Option(1000, "--max-cycles", help="As for 'steady'."),
         no_stability: bool = typer.Option(False, "--no-stability",

@@ -31,7 +31,12 @@ log = logging.getLogger(__name__)
 STABILITY_TOL = 1e-6
 """A periodic state is stable when every Floquet multiplier has |mu| <= 1 + this."""
 HARMONICS_PER_CYCLE = 8
-"""Default harmonics per cycle of the fastest excitation."""
+"""Harmonics per cycle of the fastest excitation to start from (doubled until converged)."""
+ENERGY_TOL = 1e-7
+"""Adaptive HB stops when the highest quarter of the harmonics holds at most this share of
+the velocity energy.  1e-6 left Liu et al. 2021's spur-split dynamic factors 0.4 % from
+shooting (32 harmonics); 1e-7 brings them to 3e-4 (64) and Ji & Li's to 1e-5 (256)
+(benchmarks/STEADY_RESULTS.md)."""
 HILL_LIMIT = 800
 """Largest Hill matrix (complex, square) for Hill's method; larger: the monodromy."""
 
@@ -146,10 +151,28 @@ def top_energy(hb: HarmonicBalance, x, speed=1.0) -> float:
     return float(e[k > 0.75 * hb.H].sum() / tot)
 
 
+def converged_hb(p, H, samples, speed, q_static, initial, tol, *, adaptive=True,
+                 energy_tol=ENERGY_TOL, max_harmonics=2**15):
+    """HB solution with H harmonics; with ``adaptive``, H doubled (each solve started from
+    the last) until the top quarter of the harmonics holds at most ``energy_tol`` of the
+    velocity energy.  Returns (HarmonicBalance, coefficients, Newton info, top energy)."""
+    while True:
+        hb = HarmonicBalance(p, H, samples)
+        x0 = _initial_hb(hb, q_static, initial)
+        x, info = solve_hb(hb, x0, speed, tol)
+        energy = top_energy(hb, x, speed)
+        if not adaptive or energy <= energy_tol or 2 * H > max_harmonics or not info.converged:
+            return hb, x, info, energy
+        log.info("HB with %d harmonics: top-band energy %.2e > %.1e, doubling", H, energy,
+                 energy_tol)
+        initial = x
+        H *= 2
+
+
 def periodic_solution(structure, period: Period, *, method: str = "hb", harmonics=None,
                       samples=None, speed: float = 1.0, q_static=None, initial=None,
                       tol: float | None = None, adaptive: bool = False,
-                      energy_tol: float = 1e-6, max_harmonics: int = 2**15,
+                      energy_tol: float = ENERGY_TOL, max_harmonics: int = 2**15,
                       stability: bool | str = True, steps_per_cycle: int | None = None,
                       check: bool = True, problem: PeriodicProblem | None = None
                       ) -> PeriodicSolution:
@@ -172,17 +195,10 @@ def periodic_solution(structure, period: Period, *, method: str = "hb", harmonic
     if method == "hb":
         H = int(harmonics) if harmonics is not None else HARMONICS_PER_CYCLE * order
         tol = 1e-10 if tol is None else tol
-        while True:
-            hb = HarmonicBalance(p, H, samples)
-            x0 = _initial_hb(hb, q_static, initial)
-            x, info = solve_hb(hb, x0, speed, tol)
-            energy = top_energy(hb, x, speed)
-            if not adaptive or energy <= energy_tol or 2 * H > max_harmonics or not info.converged:
-                break
-            log.info("HB with %d harmonics: top-band energy %.2e > %.1e, doubling", H, energy,
-                     energy_tol)
-            initial = x
-            H *= 2
+        hb, x, info, energy = converged_hb(p, H, samples, speed, q_static, initial, tol,
+                                           adaptive=adaptive, energy_tol=energy_tol,
+                                           max_harmonics=max_harmonics)
+        H = hb.H
         r, a, F, D, q, v = hb.residual_samples(x, speed)
         rm = hb.residual_samples(x, speed, shift=0.5)[0]
         t_res = float(np.sqrt(np.mean(rm**2))) / max(float(np.max(np.abs(a))), 1e-300)

@@ -29,7 +29,12 @@ import numpy as np
 from torquesplit.errors import SolverError
 from torquesplit.steady.harmonic import HarmonicBalance
 from torquesplit.steady.newton import floquet_hill, floquet_monodromy
-from torquesplit.steady.solution import HARMONICS_PER_CYCLE, _initial_hb, hill_applies
+from torquesplit.steady.solution import (
+    HARMONICS_PER_CYCLE,
+    _initial_hb,
+    converged_hb,
+    hill_applies,
+)
 
 log = logging.getLogger(__name__)
 
@@ -247,9 +252,14 @@ def continue_in_speed(problem, period, q_static, s0, s1, *, points=50, harmonics
                           f"must be two different positive speeds; e.g. --from '1000 rpm' "
                           f"--to '3000 rpm'.")
     order = max(period.max_order, 1)
-    H = int(harmonics) if harmonics is not None else HARMONICS_PER_CYCLE * order
-    hb = HarmonicBalance(problem, H, samples)
-    x0 = _initial_hb(hb, q_static, initial)
+    if harmonics is None:  # as steady_state chooses them at the first speed, then kept
+        hb, x0, info, _ = converged_hb(problem, HARMONICS_PER_CYCLE * order, samples, s0,
+                                       q_static, initial, tol)
+        if not info.converged:  # let the continuation's corrector report the failure
+            x0 = _initial_hb(hb, q_static, initial)
+    else:
+        hb = HarmonicBalance(problem, int(harmonics), samples)
+        x0 = _initial_hb(hb, q_static, initial)
     step = abs(s1 - s0) / max(points - 1, 1)
     max_step = step * 2 if max_step is None else max_step
     cont = Continuation(hb, tol, stability)
