@@ -327,9 +327,9 @@ def _stage(slot, iy, idy, i_f, m, w, rhs_fn, gen, extra):
                a[A_F] + el * np.uint64(i_f), a[A_D] + el * np.uint64(i_f), a[A_K], a[A_G],
                a[A_E], a[A_ED], a[A_P], a[A_PAR], np.int64(slot * w.F.shape[1]))
     else:
-        rhs_slot(slot, iy, idy, i_f, m, w)
+        rhs_slot(slot, np.int64(iy), np.int64(idy), np.int64(i_f), m, w)
     if extra:
-        rhs_extra(slot, iy, idy, i_f, m, w)
+        rhs_extra(slot, np.int64(iy), np.int64(idy), np.int64(i_f), m, w)
 
 
 @_kernel
@@ -558,7 +558,7 @@ def corner_events(t_a, t_b, ya, fa, yb, fb, m, w, r, rhs_fn, gen, counters):
                 hermite((tc - t_a) / h, h, ya, fa, yb, fb, Y_SAMPLE, w)
                 excite(tc, slot, np.int64(-1), m, w)
                 _stage(slot, Y_SAMPLE, Y_DSAMPLE, F_TMP, m, w, rhs_fn, gen, extra)
-                record_extrema(slot, F_TMP, w, r)
+                record_extrema(slot, np.int64(F_TMP), w, r)
                 counters[I_EVENTS] += 1
             # the element's next corner
             base = (node // n_tab) * n_tab
@@ -663,7 +663,7 @@ def rk4_through_corners(t, tb, t_corner, sa, sb, m, w, r, rhs_fn, gen, counters)
         te = t_corner if t_corner < tb - 1e-6 * h else tb
         if not first:  # the corner: its exact forces, and k1 of the next sub-step
             _stage(sa, Y_STATE, Y_K1, F_MAIN, m, w, rhs_fn, gen, extra)
-            record_extrema(sa, F_MAIN, w, r)
+            record_extrema(sa, np.int64(F_MAIN), w, r)
             counters[I_RHS] += 1
             counters[I_EVENTS] += 1
         if te - ts > 1e-6 * h:
@@ -729,10 +729,10 @@ def rk4_run(t0, h, n_first, n_steps, record_final, record_every, blowup, m, w, r
         if i == next_rec:
             next_rec += every
             if record_every > 0 and counters[I_HIST] < n_hist:
-                store_history(counters[I_HIST], t, Y_STATE, F_MAIN, w, r)
+                store_history(counters[I_HIST], t, np.int64(Y_STATE), np.int64(F_MAIN), w, r)
                 counters[I_HIST] += 1
         if counters[I_FULL] < n_full:
-            store_full(counters[I_FULL], t, Y_STATE, w, r)
+            store_full(counters[I_FULL], t, np.int64(Y_STATE), w, r)
             counters[I_FULL] += 1
         tb = t0 + (i + 1) * h
         if t_corner < tb:
@@ -759,10 +759,10 @@ def rk4_run(t0, h, n_first, n_steps, record_final, record_every, blowup, m, w, r
         record(a, F_MAIN, 0.0, m, w, r, counters)
         if (record_every > 0 and i % record_every == 0
                 and counters[I_HIST] < n_hist):
-            store_history(counters[I_HIST], t, Y_STATE, F_MAIN, w, r)
+            store_history(counters[I_HIST], t, np.int64(Y_STATE), np.int64(F_MAIN), w, r)
             counters[I_HIST] += 1
         if counters[I_FULL] < n_full:
-            store_full(counters[I_FULL], t, Y_STATE, w, r)
+            store_full(counters[I_FULL], t, np.int64(Y_STATE), w, r)
             counters[I_FULL] += 1
 
 
@@ -829,9 +829,9 @@ def dopri_run(t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, blowup, dt
             record(s1, F_MAIN, 0.0, m, w, r, counters)
         while counters[I_NEXT] < n_hist and t0 + counters[I_NEXT] * dt_sample <= t:
             row = counters[I_NEXT]
-            store_history(row, t, Y_STATE, F_MAIN, w, r)
+            store_history(row, t, np.int64(Y_STATE), np.int64(F_MAIN), w, r)
             if row < n_full:
-                store_full(row, t, Y_STATE, w, r)
+                store_full(row, t, np.int64(Y_STATE), w, r)
                 counters[I_FULL] = row + 1
             counters[I_NEXT] = row + 1
             counters[I_HIST] = row + 1
@@ -919,9 +919,9 @@ def dopri_run(t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, blowup, dt
                 hermite(theta, hs, Y_STATE, kf, Y_NEW, k7, Y_SAMPLE, w)
                 excite(ts, s0, np.int64(-1), m, w)
                 _stage(s0, Y_SAMPLE, Y_DSAMPLE, F_TMP, m, w, rhs_fn, gen, extra)
-                store_history(row, ts, Y_SAMPLE, F_TMP, w, r)
+                store_history(row, ts, np.int64(Y_SAMPLE), np.int64(F_TMP), w, r)
                 if row < n_full:
-                    store_full(row, ts, Y_SAMPLE, w, r)
+                    store_full(row, ts, np.int64(Y_SAMPLE), w, r)
                     counters[I_FULL] = row + 1
                 counters[I_NEXT] = row + 1
                 counters[I_HIST] = row + 1
