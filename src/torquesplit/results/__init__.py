@@ -332,7 +332,10 @@ class Results:
         """Cycles per settle window of each mesh: at least ``minimum`` and the longest
         excitation period (slowest error sinusoid or backlash sequence) in its cycles."""
         st = self.structure
-        slow = [w / (2 * math.pi) for w in np.abs(st.error_omega) if w > 0]
+        # sinusoids of zero amplitude (an excitation left out, e.g. by a steady state's
+        # keep=) excite nothing and do not lengthen the window
+        slow = [w / (2 * math.pi) for w, a in zip(np.abs(st.error_omega), st.error_amplitude)
+                if w > 0 and a != 0]
         for e in range(st.n_elements):
             n_gaps = st.gap_ptr[e + 1] - st.gap_ptr[e]
             if n_gaps > 1 and st.frequency[e] > 0:

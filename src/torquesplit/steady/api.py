@@ -225,6 +225,11 @@ def steady_state(model, *, method: str = "hb", harmonics: int | None = None,
     if not np.all(np.isfinite(static.q)):
         raise SolverError("the static equilibrium failed, so the periodic state has no start; "
                           "check the clearances and supports (see the run command).")
+    if per.frequency <= 0:
+        raise SolverError("the model has no time-varying excitation (constant mesh stiffness, "
+                          "no errors or tables), so its steady state is the static "
+                          "equilibrium: run `torquesplit static` (or static_equilibrium) "
+                          "instead, or give a mesh a stiffness variation or an error.")
     factor = speed_factor(model, speed)
     if adaptive is None:
         adaptive = harmonics is None
@@ -252,13 +257,17 @@ def _at_base(per, base):
 
 
 # --------------------------------------------------------------------------- Results
+RESULT_ROWS = 1 << 18
+"""Largest number of time samples of a steady state's Results record (its per-cycle
+statistics and history), before the samples per period are reduced."""
+
+
 def _as_solution(st: SteadyState, shell, periods):
     """An integrate.Solution made of the periodic state repeated over a few periods."""
     from torquesplit.solve.integrate import Solution
 
     s = st.structure
     ps = st.solution
-    t1, F1, D1 = st.samples()
     T = ps.period
     names = list(s.element_names)
     mesh_names = st.mesh_names
@@ -269,6 +278,15 @@ def _as_solution(st: SteadyState, shell, periods):
         win = max(shell.settle_windows(20))
         per_period = min(float(s.frequency[e]) * T for e in track) if track else 1.0
         periods = max(2, int(math.ceil(4 * (win + 2) / max(per_period, 1e-300))))
+    # samples per period: the solution's own (or 64 per cycle of the fastest excitation),
+    # fewer when the repeated record would pass RESULT_ROWS (a slow mesh left unexcited by
+    # keep= needs many periods for its cycles); exact values at those times either way
+    t1, F1, D1 = st.samples()
+    if periods * len(t1) > RESULT_ROWS:
+        n = max(64 * max(st.period.max_order, 1),
+                1 << int(math.floor(math.log2(max(RESULT_ROWS // periods, 2)))))
+        if n < len(t1):
+            t1, F1, D1 = st.samples(n=n)
     N = len(t1)
     t = (t1[None, :] + T * np.arange(periods)[:, None]).ravel()
     F = np.tile(F1, (periods, 1))

@@ -155,16 +155,29 @@ def converged_hb(p, H, samples, speed, q_static, initial, tol, *, adaptive=True,
                  energy_tol=ENERGY_TOL, max_harmonics=2**15):
     """HB solution with H harmonics; with ``adaptive``, H doubled (each solve started from
     the last) until the top quarter of the harmonics holds at most ``energy_tol`` of the
-    velocity energy.  Returns (HarmonicBalance, coefficients, Newton info, top energy)."""
+    velocity energy.  A doubled solve whose Newton stalls (a residual just above ``tol`` is
+    the usual case on larger models) is doubled once more; after two such in a row the
+    last converged solution is returned.  Returns (HarmonicBalance, coefficients, Newton
+    info, top energy)."""
+    best, stalled = None, 0
     while True:
         hb = HarmonicBalance(p, H, samples)
         x0 = _initial_hb(hb, q_static, initial)
         x, info = solve_hb(hb, x0, speed, tol)
         energy = top_energy(hb, x, speed)
-        if not adaptive or energy <= energy_tol or 2 * H > max_harmonics or not info.converged:
-            return hb, x, info, energy
-        log.info("HB with %d harmonics: top-band energy %.2e > %.1e, doubling", H, energy,
-                 energy_tol)
+        if info.converged:
+            best, stalled = (hb, x, info, energy), 0
+        else:
+            stalled += 1
+        if not adaptive or 2 * H > max_harmonics or stalled >= 2 or (
+                info.converged and energy <= energy_tol):
+            return best if best is not None and not info.converged else (hb, x, info, energy)
+        if info.converged:
+            log.info("HB with %d harmonics: top-band energy %.2e > %.1e, doubling", H,
+                     energy, energy_tol)
+        else:
+            log.info("HB with %d harmonics: Newton stalled at %.2e, doubling", H,
+                     info.residual)
         initial = x
         H *= 2
 
