@@ -152,14 +152,19 @@ def top_energy(hb: HarmonicBalance, x, speed=1.0) -> float:
 
 
 def converged_hb(p, H, samples, speed, q_static, initial, tol, *, adaptive=True,
-                 energy_tol=ENERGY_TOL, max_harmonics=2**15):
-    """HB solution with H harmonics; with ``adaptive``, H doubled (each solve started from
+                 energy_tol=ENERGY_TOL, max_harmonics=2**15, smallest=False):
+    """HB solution with H harmonics; with ``adaptive``, H raised (each solve started from
     the last) until the top quarter of the harmonics holds at most ``energy_tol`` of the
-    velocity energy.  A doubled solve whose Newton stalls (a residual just above ``tol`` is
-    the usual case on larger models) is doubled once more; after two such in a row the
-    last converged solution is returned.  Returns (HarmonicBalance, coefficients, Newton
+    velocity energy.  H is doubled, or after two converged solves multiplied by the power
+    of two that the energy's decay so far says is needed (at most 8x a step): the series
+    of a stepped stiffness converges slowly and every intermediate solve costs.  A solve
+    whose Newton stalls (a residual just above ``tol`` is the usual case on larger models)
+    is followed by a doubled one; after two stalls in a row the last converged solution is
+    returned.  ``smallest``: after a jump of more than one doubling, half the harmonics
+    are tried too and kept if they pass (worth one solve when the solution is used many
+    times, as along a continuation).  Returns (HarmonicBalance, coefficients, Newton
     info, top energy)."""
-    best, stalled = None, 0
+    best, last, stalled, jumped = None, None, 0, False
     while True:
         hb = HarmonicBalance(p, H, samples)
         x0 = _initial_hb(hb, q_static, initial)
@@ -171,15 +176,28 @@ def converged_hb(p, H, samples, speed, q_static, initial, tol, *, adaptive=True,
             stalled += 1
         if not adaptive or 2 * H > max_harmonics or stalled >= 2 or (
                 info.converged and energy <= energy_tol):
+            if smallest and jumped and info.converged:
+                fewer = converged_hb(p, H // 2, samples, speed, q_static, x, tol,
+                                     adaptive=False)
+                if fewer[2].converged and fewer[3] <= energy_tol:
+                    return fewer
             return best if best is not None and not info.converged else (hb, x, info, energy)
+        doublings = 1
+        if info.converged and last is not None and 0 < energy < last[1]:
+            per_doubling = (last[1] / energy) ** (1.0 / math.log2(H / last[0]))
+            if per_doubling > 1.5:
+                need = math.log(energy / energy_tol) / math.log(per_doubling)
+                doublings = min(3, max(1, math.ceil(need - 1e-9)))
+        while doublings > 1 and H * 2**doublings > max_harmonics:
+            doublings -= 1
+        log.info("HB with %d harmonics: %s, to %d", H,
+                 f"top-band energy {energy:.2e} > {energy_tol:.1e}" if info.converged
+                 else f"Newton stalled at {info.residual:.2e}", H * 2**doublings)
         if info.converged:
-            log.info("HB with %d harmonics: top-band energy %.2e > %.1e, doubling", H,
-                     energy, energy_tol)
-        else:
-            log.info("HB with %d harmonics: Newton stalled at %.2e, doubling", H,
-                     info.residual)
+            last = (H, energy)
         initial = x
-        H *= 2
+        jumped = doublings > 1
+        H *= 2**doublings
 
 
 def periodic_solution(structure, period: Period, *, method: str = "hb", harmonics=None,

@@ -64,6 +64,10 @@ class SpeedSweep:
     metrics: dict = field(default_factory=dict)
 
 
+PRECONDITIONER_REUSE = 0.01
+"""Relative speed change after which a continuation rebuilds its GMRES preconditioner."""
+
+
 class Continuation:
     """Pseudo-arclength continuation of ``hb`` (a :class:`HarmonicBalance`) in speed."""
 
@@ -73,6 +77,7 @@ class Continuation:
         self.stability = stability
         self.steps = steps_per_period
         self.eps = 1e-6
+        self._pc = None  # (speed it was built at, preconditioner)
 
     def _R(self, x, s, lin=False):
         return self.hb.residual(x, s, linearise=lin)
@@ -97,15 +102,21 @@ class Continuation:
                 return np.linalg.lstsq(B, rhs, rcond=None)[0]
         from torquesplit.steady.harmonic import gmres
 
-        P = hb.preconditioner(s)
-
         def mv(z):
             return np.concatenate([hb.jvp(z[:n], s)[0] + Rs * z[n], [tw @ z]])
 
-        def pc(z):
-            return np.concatenate([P(z[:n]), [z[n]]])
-
-        sol, res = gmres(mv, rhs, pc, 1e-8, 80)
+        # the preconditioner (the time-averaged system inverted harmonic by harmonic) is
+        # kept while the speed moves by less than PRECONDITIONER_REUSE: a slightly stale
+        # one costs GMRES a few iterations, not accuracy (the residual is the true one)
+        fresh = self._pc is None or abs(s - self._pc[0]) > PRECONDITIONER_REUSE * self._pc[0]
+        while True:
+            if fresh:
+                self._pc = (s, hb.preconditioner(s))
+            P = self._pc[1]
+            sol, res = gmres(mv, rhs, lambda z: np.concatenate([P(z[:n]), [z[n]]]), 1e-8, 80)
+            if res <= 1e-4 or fresh:
+                break
+            fresh = True
         if res > 1e-4:
             raise SolverError(f"bordered solve did not converge ({res:.1e})")
         return sol
@@ -254,7 +265,7 @@ def continue_in_speed(problem, period, q_static, s0, s1, *, points=50, harmonics
     order = max(period.max_order, 1)
     if harmonics is None:  # as steady_state chooses them at the first speed, then kept
         hb, x0, info, _ = converged_hb(problem, HARMONICS_PER_CYCLE * order, samples, s0,
-                                       q_static, initial, tol)
+                                       q_static, initial, tol, smallest=True)
         if not info.converged:  # let the continuation's corrector report the failure
             x0 = _initial_hb(hb, q_static, initial)
     else:
