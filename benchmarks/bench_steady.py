@@ -9,6 +9,7 @@ and STEADY_RESULTS.json.
   1's excitations kept; Liu et al. 2021 with the spur-split stage kept (its full period
   holds 7918 cycles of the fastest mesh and is refused).  Wall time of ``steady_state``
   from the model file, after a warm-up call (compilation), best of 2.
+* a 200-point speed sweep of Liu et al. 2021 (spur split kept, Floquet stability on);
 * a speed sweep of Ji & Li's drive (stage 1 kept, +-20 % speed, ``--points`` points) by
   harmonic-balance continuation against stepping RK4 from the static state to a settled
   state (2000 periods) at ``--check`` of those speeds, extrapolated to all points.  The
@@ -125,6 +126,22 @@ def sweep(points: int, check: int, harmonics: int) -> dict:
     return out
 
 
+def liu_sweep(points: int) -> dict:
+    """Liu et al. 2021 (spur split kept), +-20 % speed, with Floquet stability (default)."""
+    from torquesplit.examples import example_path
+    from torquesplit.model.io import load_model
+    from torquesplit.steady import sweep_speed
+
+    m = load_model(example_path("liu2021_split_torque_helicopter"))
+    w = abs(next(iter(m.drives.values())).speed)
+    sweep_speed(m, 0.8 * w, 1.2 * w, points=5, keep="spur_split")  # compile
+    ds, t = best(lambda: sweep_speed(m, 0.8 * w, 1.2 * w, points=points, keep="spur_split",
+                                     max_step=0.4 * w / (points - 1)), 1)
+    return dict(points=int(ds.sizes["point"]), harmonics=int(ds.attrs["harmonics"]),
+                seconds=t, complete=bool(ds.attrs["complete"]),
+                unstable_points=int((~ds["stable"].values).sum()))
+
+
 def _machine() -> dict:
     sys.path.insert(0, str(HERE))
     from bench_study import _machine as machine
@@ -181,6 +198,13 @@ def report(res: dict) -> str:
         lines += ["", "Refining the stepping does not bring it closer to the continuation "
                   "than doubling the harmonics moves the continuation: compare at equal "
                   "accuracy before quoting the speed-up.", ""]
+    if "liu2021_sweep" in res:
+        lw = res["liu2021_sweep"]
+        ok = "ok" if lw["seconds"] < 120 and lw["complete"] else "**not met**"
+        lines += [f"Liu et al. 2021, spur split kept, +-20 % speed, {lw['points']} points, "
+                  f"{lw['harmonics']} harmonics, Floquet stability at every point: "
+                  f"**{lw['seconds']:.1f} s** (target < 120 s on 2 cores: {ok}; "
+                  f"{lw['unstable_points']} unstable points).", ""]
     return "\n".join(lines)
 
 
@@ -199,7 +223,8 @@ def main(argv=None) -> int:
         return 0
     warnings.simplefilter("ignore")
     res = {"machine": _machine(), "one_speed": one_speed(),
-           "sweep": sweep(args.points, args.check, args.harmonics)}
+           "sweep": sweep(args.points, args.check, args.harmonics),
+           "liu2021_sweep": liu_sweep(args.points)}
     OUT_JSON.write_text(json.dumps(res, indent=1) + "\n")
     OUT_MD.write_text(report(res))
     print(report(res))
