@@ -170,13 +170,13 @@ def steady_state(model, *, method: str = "hb", harmonics: int | None = None,
         shooting (Newton on the period map; robust for contact loss and impacts).
     harmonics : int, optional
         HB harmonics of the fundamental frequency.  Default: 8 per cycle of the fastest
-        excitation to start with, doubled (``adaptive``) until the highest quarter of the
-        harmonics holds less than ``energy_tol`` of the velocity energy.  The stepped
-        stiffness of a contact-ratio change needs many: on Ji & Li's drive 8 per cycle
-        leave the dynamic factor 0.03 low, the adaptive rule stops at 256 (within 1e-4 of
-        shooting).
+        excitation to start with, raised (``adaptive``) until the highest quarter of the
+        harmonics holds less than ``energy_tol`` of the velocity energy
+        (:func:`~torquesplit.steady.solution.converged_hb`).  The stepped stiffness of a
+        contact-ratio change needs many: on Ji & Li's drive 8 per cycle leave the dynamic
+        factor 0.03 low; the adaptive rule stops at 512, within 1e-4 of shooting.
     adaptive : bool, optional
-        Double the harmonics until converged as above; default True when ``harmonics``
+        Raise the harmonics until converged as above; default True when ``harmonics``
         is not given, False when it is (a fixed number asked for).
     samples : int, optional
         HB time samples per period (default: a power of two >= 4 H + 2).

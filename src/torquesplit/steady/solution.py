@@ -31,11 +31,11 @@ log = logging.getLogger(__name__)
 STABILITY_TOL = 1e-6
 """A periodic state is stable when every Floquet multiplier has |mu| <= 1 + this."""
 HARMONICS_PER_CYCLE = 8
-"""Harmonics per cycle of the fastest excitation to start from (doubled until converged)."""
+"""Harmonics per cycle of the fastest excitation to start from (raised until converged)."""
 ENERGY_TOL = 1e-7
 """Adaptive HB stops when the highest quarter of the harmonics holds at most this share of
 the velocity energy.  1e-6 left Liu et al. 2021's spur-split dynamic factors 0.4 % from
-shooting (32 harmonics); 1e-7 brings them to 3e-4 (64) and Ji & Li's to 1e-5 (256)
+shooting (at 32 harmonics); 1e-7 brings them within 4e-4 and Ji & Li's within 6e-5
 (benchmarks/STEADY_RESULTS.md)."""
 HILL_LIMIT = 800
 """Largest Hill matrix (complex, square) for Hill's method; larger: the monodromy."""
