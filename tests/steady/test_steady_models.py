@@ -118,4 +118,16 @@ def test_cli_steady_sweep_and_campbell(tmp_path):
     assert json.loads(r.output)["critical_speeds"]
     r = CliRunner().invoke(app, ["steady", EXAMPLE, "--max-cycles", "10"])
     assert r.exit_code == 2 and "keep" in r.output
-    assert np.isfinite(1.0)
+
+
+def test_cli_steady_converges_its_harmonics_unless_told_not_to():
+    harmonics = {}
+    for flags in ([], ["--fixed"]):
+        r = CliRunner().invoke(app, ["steady", EXAMPLE, "--keep", "stage1", "--json", *flags])
+        assert r.exit_code == 0, r.output
+        harmonics[tuple(flags)] = json.loads(r.output)["harmonics"]
+    assert harmonics[()] >= 64 and harmonics[("--fixed",)] == 8
+    # nothing varies in time: the steady state is the static one, and the message says so
+    r = CliRunner().invoke(app, ["steady", "lin_parker1999_star"])
+    assert r.exit_code == 2 and "torquesplit static" in r.output
+    assert "Traceback" not in r.output
