@@ -67,6 +67,18 @@ def test_results_of_a_kept_stage_stay_bounded():
     assert all(np.isfinite(r.load_sharing) for r in rows)
 
 
+def test_speed_sweep_starts_and_ends_at_the_speeds_asked_for():
+    from torquesplit.steady import sweep_speed
+
+    m = load_model(example_path(EXAMPLE))
+    w = abs(m.drives["motor"].speed)
+    for a, b in ((0.8 * w, 1.2 * w), (1.2 * w, 0.8 * w)):
+        sp = sweep_speed(m, a, b, points=10, keep="stage1", harmonics=16,
+                         stability=False)["speed"].values
+        assert sp[0] == pytest.approx(a, rel=1e-12) and sp[-1] == pytest.approx(b, rel=1e-12)
+        assert np.all(np.diff(sp) * np.sign(b - a) > 0)
+
+
 def test_long_period_is_refused_with_the_fix():
     with pytest.raises(LongPeriodError, match="keep="):
         steady_state(example_path(EXAMPLE), max_cycles=100)

@@ -209,6 +209,14 @@ class Continuation:
             if progress is not None:
                 progress(min(1.0, abs(z[n] - s0) / abs(s1 - s0)))
             if (z[n] - s1) * direction >= 0:
+                if z[n] != s1 and len(pts) > 1:  # past the end: the state at the end itself
+                    x_end, info_end = solve_hb(hb, z[:n].copy(), s1, self.tol)
+                    if info_end.converged:
+                        mu = self.multipliers(x_end, s1) if self.stability else None
+                        m = float(np.max(np.abs(mu))) if mu is not None and mu.size \
+                            else math.nan
+                        pts[-1] = SweepPoint(float(s1), x_end.copy(), None if mu is None
+                                             else bool(m <= 1 + 1e-6), m, 0)
                 break
             while True:
                 z_pred = z + h * t
