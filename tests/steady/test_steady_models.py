@@ -79,6 +79,20 @@ def test_speed_sweep_starts_and_ends_at_the_speeds_asked_for():
         assert np.all(np.diff(sp) * np.sign(b - a) > 0)
 
 
+def test_harmonics_short_of_convergence_are_said():
+    """Ji & Li over the full 168-cycle period reaches the harmonic limit before the energy
+    criterion: a warning says so and what to do; a converged stage says nothing."""
+    import warnings
+
+    from torquesplit.errors import ModelWarning
+
+    with pytest.warns(ModelWarning, match="harmonic balance stopped at .*--method shooting"):
+        steady_state(example_path(EXAMPLE), stability=False, check=False)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ModelWarning)
+        steady_state(example_path(EXAMPLE), keep="stage1", stability=False, check=False)
+
+
 def test_long_period_is_refused_with_the_fix():
     with pytest.raises(LongPeriodError, match="keep="):
         steady_state(example_path(EXAMPLE), max_cycles=100)

@@ -85,9 +85,9 @@ def register(app, load, fail, console, err_console, json_default):
 
             _check_out(out)
             m, _ = load(model)
-            from torquesplit.cli_support import progress
+            from torquesplit.cli_support import collect_warnings, progress
 
-            with progress("periodic steady state", as_json, total=None):
+            with collect_warnings(), progress("periodic steady state", as_json, total=None):
                 st = steady_state(m, method=method, harmonics=harmonics, adaptive=adaptive,
                                   keep=_keep(keep), speed=_speed(speed, "--speed"),
                                   max_cycles=max_cycles)
@@ -175,9 +175,9 @@ def register(app, load, fail, console, err_console, json_default):
             if plot is not None:
                 _check_out(plot, {".png": "png", ".svg": "svg", ".pdf": "pdf"})
             m, _ = load(model)
-            from torquesplit.cli_support import progress
+            from torquesplit.cli_support import collect_warnings, progress
 
-            with progress("speed sweep", as_json, total=None):
+            with collect_warnings(), progress("speed sweep", as_json, total=None):
                 ds = sweep_speed(m, _speed(start, "--from"), _speed(stop, "--to"),
                                  points=points, harmonics=harmonics, keep=_keep(keep),
                                  max_cycles=max_cycles, stability=not no_stability,

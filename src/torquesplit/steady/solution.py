@@ -10,11 +10,12 @@ from __future__ import annotations
 import logging
 import math
 import time
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from torquesplit.errors import SolverError
+from torquesplit.errors import ModelWarning, SolverError
 from torquesplit.solve._frozen import freeze_arrays
 from torquesplit.steady.harmonic import HarmonicBalance
 from torquesplit.steady.newton import (
@@ -230,6 +231,13 @@ def periodic_solution(structure, period: Period, *, method: str = "hb", harmonic
                                            adaptive=adaptive, energy_tol=energy_tol,
                                            max_harmonics=max_harmonics)
         H = hb.H
+        if adaptive and info.converged and energy > energy_tol:
+            warnings.warn(
+                f"harmonic balance stopped at {H} harmonics (the limit is {max_harmonics}) "
+                f"with {energy:.1e} of the velocity energy in the top quarter, above "
+                f"{energy_tol:.0e}: peak forces may be off in the last digits; use "
+                f"method='shooting' (--method shooting), or keep one stage's excitations "
+                f"(keep=, --keep) for a shorter period", ModelWarning, stacklevel=3)
         r, a, F, D, q, v = hb.residual_samples(x, speed)
         rm = hb.residual_samples(x, speed, shift=0.5)[0]
         t_res = float(np.sqrt(np.mean(rm**2))) / max(float(np.max(np.abs(a))), 1e-300)

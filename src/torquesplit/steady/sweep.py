@@ -22,14 +22,16 @@ from __future__ import annotations
 import logging
 import math
 import time
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from torquesplit.errors import SolverError
+from torquesplit.errors import ModelWarning, SolverError
 from torquesplit.steady.harmonic import HarmonicBalance
 from torquesplit.steady.newton import floquet_hill, floquet_monodromy
 from torquesplit.steady.solution import (
+    ENERGY_TOL,
     HARMONICS_PER_CYCLE,
     _initial_hb,
     converged_hb,
@@ -272,10 +274,17 @@ def continue_in_speed(problem, period, q_static, s0, s1, *, points=50, harmonics
                           f"--to '3000 rpm'.")
     order = max(period.max_order, 1)
     if harmonics is None:  # as steady_state chooses them at the first speed, then kept
-        hb, x0, info, _ = converged_hb(problem, HARMONICS_PER_CYCLE * order, samples, s0,
-                                       q_static, initial, tol, smallest=True)
+        hb, x0, info, energy = converged_hb(problem, HARMONICS_PER_CYCLE * order, samples,
+                                            s0, q_static, initial, tol, smallest=True)
         if not info.converged:  # let the continuation's corrector report the failure
             x0 = _initial_hb(hb, q_static, initial)
+        elif energy > ENERGY_TOL:
+            warnings.warn(
+                f"the sweep keeps {hb.H} harmonics, the most it could converge at its first "
+                f"speed, with {energy:.1e} of the velocity energy in the top quarter (above "
+                f"{ENERGY_TOL:.0e}): peak forces may be off in the last digits; keep one "
+                f"stage's excitations (--keep) for a shorter period", ModelWarning,
+                stacklevel=2)
     else:
         hb = HarmonicBalance(problem, int(harmonics), samples)
         x0 = _initial_hb(hb, q_static, initial)
