@@ -152,6 +152,9 @@ body = "output"
 torque = "balanced"                  # takes whatever the drive puts in
 '''
 
+SPEED_SWEEP = ('torquesplit sweep-speed three_branch.toml --keep split --from "2400 rpm" '
+               '--to "3600 rpm" --plot speed_response.svg')
+
 SWEEP = ('torquesplit sweep three_branch.toml --vary '
          '"shafts.s1.diameter,shafts.s2.diameter,shafts.s3.diameter=25:40:4mm" '
          '--output load_sharing.mean_force')
@@ -162,9 +165,9 @@ TUTORIAL = f'''\
 
 This tutorial builds a gearbox that splits its power into three branches and joins it
 again, checks it, draws it, runs it, reads the table, changes a parameter, runs a small
-sweep and writes a report to hand on.  Every output below was produced by the command
-above it (`python scripts/make_tutorial.py` writes this page); your numbers should be the
-same to the digits shown.
+sweep, looks for resonances over a speed range and writes a report to hand on.  Every
+output below was produced by the command above it (`python scripts/make_tutorial.py`
+writes this page); your numbers should be the same to the digits shown.
 
 You need torquesplit installed (`pip install .` in the source folder) and a terminal.  All
 quantities in a model file carry their units (`"3 mm"`, `"3000 rpm"`); a bare number is
@@ -267,7 +270,31 @@ Thicker shafts share worse: the usual trade-off of a locked train, where the com
 of the branches is what evens out the errors.  Grids of several parameters, tolerance
 Monte Carlo and sensitivity ranking are `torquesplit study` files: [studies.md](studies.md).
 
-## 8. Hand it on
+## 8. Over the speed range
+
+Where are the resonances between 2400 and 3600 rpm, and how large is the dynamic factor
+there?  `sweep-speed` follows the periodic steady state along the speed range by
+continuation (harmonic balance, its harmonics converged at the first speed), instead of
+integrating from rest at every speed.  `--keep split` keeps the excitations of the split
+stage (the combine stage's stiffness variation is replaced by its mean; `torquesplit
+steady three_branch.toml --keep split` lists what is dropped), so that one period is one
+split-stage mesh cycle:
+
+$ {SPEED_SWEEP}
+
+The table gives each mesh's largest dynamic factor over the range and the speed where it
+occurs.  The figure draws the dynamic factor of every mesh against speed (dashed where the
+periodic state is unstable) and marks the critical speeds, where a natural frequency
+crosses a harmonic of a mesh frequency (`torquesplit modes three_branch.toml --campbell
+--from "2400 rpm" --to "3600 rpm"` lists them with the elements that carry each mode):
+
+![dynamic factor against speed](tutorial/speed_response.svg)
+
+`torquesplit steady` gives the full per-mesh table at one speed; `--cross-check` adds
+run-up and run-down time integrations to the sweep, to see the jumps a backlash
+nonlinearity can make.
+
+## 9. Hand it on
 
 $ torquesplit report three_branch.toml --out three_branch_report.html
 
@@ -360,6 +387,7 @@ def main() -> None:
                 out.append(line)
         FIGURES.mkdir(parents=True, exist_ok=True)
         shutil.copyfile(work / "three_branch_layout.svg", FIGURES / "three_branch_layout.svg")
+        shutil.copyfile(work / "speed_response.svg", FIGURES / "speed_response.svg")
         text = "\n".join(out) + "\n"
         text = re.sub(r"\n{3,}", "\n\n", text)
         DOC.write_text(text, encoding="utf-8")

@@ -157,3 +157,26 @@ def test_cli_steady_converges_its_harmonics_unless_told_not_to():
     r = CliRunner().invoke(app, ["steady", "lin_parker1999_star"])
     assert r.exit_code == 2 and "torquesplit static" in r.output
     assert "Traceback" not in r.output
+
+
+def test_coinciding_critical_speeds_share_one_line_in_the_sweep_figure():
+    """A degenerate pair of modes crosses a mesh order at one speed: one line, both
+    labels in one block (they were printed over each other)."""
+    import xarray as xr
+
+    from torquesplit.steady.plot import critical_speed_groups, sweep_figure
+
+    rpm = np.linspace(2400.0, 3600.0, 5)
+    ds = xr.Dataset(
+        {"speed_rpm": ("point", rpm), "stable": ("point", np.ones(5, bool)),
+         "dynamic_factor": (("point", "mesh"), np.ones((5, 1)))},
+        coords={"mesh": ["m1"]},
+        attrs={"model": "t", "critical_speeds_rpm": [2640.0, 2641.0, 3430.0, 5000.0],
+               "critical_speed_labels": ["mode 2 x 2 m1", "mode 3 x 2 m1", "mode 4 x 1 m1",
+                                         "outside"]})
+    groups = critical_speed_groups(ds, 2400.0, 3600.0)
+    assert [labs for _, labs in groups] == [["mode 2 x 2 m1", "mode 3 x 2 m1"],
+                                            ["mode 4 x 1 m1"]]
+    assert groups[0][0] == pytest.approx(2640.5)
+    ax = sweep_figure(ds).axes[0]
+    assert len([t for t in ax.texts if "mode" in t.get_text()]) == 2

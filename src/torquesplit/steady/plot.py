@@ -48,18 +48,34 @@ def sweep_figure(ds, variable: str = "dynamic_factor"):
     for f in ds.attrs.get("fold_speeds_rpm", []):
         ax.axvline(f, color="k", lw=0.8, ls=":")
     lo, hi = float(np.nanmin(rpm)), float(np.nanmax(rpm))
-    for c, lab in zip(ds.attrs.get("critical_speeds_rpm", []),
-                      ds.attrs.get("critical_speed_labels", []), strict=False):
-        if lo <= c <= hi:
-            ax.axvline(c, color="0.6", lw=0.6)
-            ax.text(c, 1.0, lab, rotation=90, fontsize=6, va="top", ha="right",
-                    transform=ax.get_xaxis_transform(), color="0.4")
+    for c, labels in critical_speed_groups(ds, lo, hi):
+        ax.axvline(c, color="0.6", lw=0.6)
+        ax.text(c, 1.0, "\n".join(labels), rotation=90, fontsize=6, va="top", ha="right",
+                transform=ax.get_xaxis_transform(), color="0.4")
     ax.set_xlabel("input speed [rpm]")
     ax.set_ylabel(ds[variable].attrs.get("long_name", variable))
     ax.set_title(f"{ds.attrs.get('model', '')}: {variable.replace('_', ' ')} "
                  f"(solid stable, dashed unstable, dotted: turning points)", fontsize=9)
     ax.legend(fontsize=7, ncol=2)
     return fig
+
+
+def critical_speed_groups(ds, lo: float, hi: float, merge: float = 0.005):
+    """Critical speeds of ``ds`` inside [lo, hi] rpm as (speed, labels): crossings closer
+    than ``merge`` of the range (a degenerate pair of modes, two orders meeting) share one
+    line and one label block instead of printing over each other."""
+    crit = sorted((float(c), str(lab)) for c, lab in zip(
+        ds.attrs.get("critical_speeds_rpm", []), ds.attrs.get("critical_speed_labels", []),
+        strict=False) if lo <= c <= hi)
+    groups: list[tuple[list[float], list[str]]] = []
+    for c, lab in crit:
+        if groups and c - groups[-1][0][-1] <= merge * max(hi - lo, 1e-12):
+            groups[-1][0].append(c)
+            if lab not in groups[-1][1]:
+                groups[-1][1].append(lab)
+        else:
+            groups.append(([c], [lab]))
+    return [(float(np.mean(cs)), labs) for cs, labs in groups]
 
 
 def campbell_figure(ds):
