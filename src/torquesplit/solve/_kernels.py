@@ -495,6 +495,21 @@ def next_corner_time(m, w, r):
     return earliest
 
 
+@_inline
+def _following_corner(node, c0, c1, n_tab, corner_node):
+    """The absolute table node (cycle x n_tab + node) of the element's corner after
+    ``node``: the next of its corners ``corner_node[c0:c1]`` in the same table cycle, else
+    the first of the next cycle."""
+    base = (node // n_tab) * n_tab
+    p = node - base
+    k = c0
+    while k < c1 and corner_node[k] <= p:
+        k += 1
+    if k == c1:
+        return base + n_tab + corner_node[c0]
+    return base + corner_node[k]
+
+
 @_kernel
 def advance_corners(t, m, w):
     """Move every element whose next corner is at or before t to its following corner;
@@ -514,15 +529,7 @@ def advance_corners(t, m, w):
             tc = (node / n_tab - phase[e]) / frequency[e]
             if tc > t:
                 break
-            base = (node // n_tab) * n_tab
-            p = node - base
-            k = c0
-            while k < c1 and corner_node[k] <= p:
-                k += 1
-            if k == c1:
-                next_node[e] = base + n_tab + corner_node[c0]
-            else:
-                next_node[e] = base + corner_node[k]
+            next_node[e] = _following_corner(node, c0, c1, n_tab, corner_node)
         if tc < earliest:
             earliest = tc
     return earliest
@@ -560,16 +567,7 @@ def corner_events(t_a, t_b, ya, fa, yb, fb, m, w, r, rhs_fn, gen, counters):
                 _stage(slot, Y_SAMPLE, Y_DSAMPLE, F_TMP, m, w, rhs_fn, gen, extra)
                 record_extrema(slot, np.int64(F_TMP), w, r)
                 counters[I_EVENTS] += 1
-            # the element's next corner
-            base = (node // n_tab) * n_tab
-            p = node - base
-            k = c0
-            while k < c1 and corner_node[k] <= p:
-                k += 1
-            if k == c1:
-                next_node[e] = base + n_tab + corner_node[c0]
-            else:
-                next_node[e] = base + corner_node[k]
+            next_node[e] = _following_corner(node, c0, c1, n_tab, corner_node)
     return next_corner_time(m, w, r)
 
 

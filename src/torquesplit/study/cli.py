@@ -17,6 +17,11 @@ from typing import Optional
 
 import typer
 
+BACKEND_HELP = ("cpu (default) or gpu: integrate the cases as ensembles on a CUDA GPU, one "
+                "case per thread (falls back to the CPU with a warning when there is none).")
+PRECISION_HELP = ("GPU backend: fp64 (default, equal to the CPU engine) or fp32 (its error "
+                  "against fp64 is reported).")
+
 
 def _ui():
     from .. import cli
@@ -40,13 +45,8 @@ def study(
     overwrite: bool = typer.Option(False, "--overwrite",
                                    help="Start again, deleting the study stored in --out."),
     list_studies: bool = typer.Option(False, "--list", help="List the shipped studies."),
-    backend: str = typer.Option(
-        "cpu", "--backend", help="cpu (default) or gpu: integrate the cases as ensembles on "
-                                 "a CUDA GPU, one case per thread (falls back to the CPU "
-                                 "with a warning when there is none)."),
-    precision: Optional[str] = typer.Option(
-        None, "--precision", help="GPU backend: fp64 (default, equal to the CPU engine) or "
-                                  "fp32 (its error against fp64 is reported)."),
+    backend: str = typer.Option("cpu", "--backend", help=BACKEND_HELP),
+    precision: Optional[str] = typer.Option(None, "--precision", help=PRECISION_HELP),
     no_figures: bool = typer.Option(False, "--no-figures", help="Do not write figures."),
     quiet: bool = typer.Option(False, "--quiet", help="No progress bar."),
     as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
@@ -296,13 +296,8 @@ def sweep(
                                                            "./study_sweep_PATH)."),
     resume: bool = typer.Option(False, "--resume", help="Continue the sweep stored in --out."),
     overwrite: bool = typer.Option(False, "--overwrite", help="Start again in --out."),
-    backend: str = typer.Option(
-        "cpu", "--backend", help="cpu (default) or gpu: integrate the cases as ensembles on "
-                                 "a CUDA GPU, one case per thread (falls back to the CPU "
-                                 "with a warning when there is none)."),
-    precision: Optional[str] = typer.Option(
-        None, "--precision", help="GPU backend: fp64 (default, equal to the CPU engine) or "
-                                  "fp32 (its error against fp64 is reported)."),
+    backend: str = typer.Option("cpu", "--backend", help=BACKEND_HELP),
+    precision: Optional[str] = typer.Option(None, "--precision", help=PRECISION_HELP),
     no_figures: bool = typer.Option(False, "--no-figures", help="Do not write figures."),
     quiet: bool = typer.Option(False, "--quiet", help="No progress bar."),
     as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
