@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import math
 import warnings
+import weakref
 from collections import deque
 from dataclasses import dataclass, field
 
@@ -164,8 +165,29 @@ def gear_mass_properties(gear: Gear) -> tuple[float, float, bool, bool]:
 
 
 # --------------------------------------------------------------------------- solver
+_LAST: tuple = (None, None, [])
+"""(weak reference to the model, its kinematics, their warnings) of the last call."""
+
+
 def solve_kinematics(model: Model) -> Kinematics:
-    """Layout, speeds, power flow, torques and forces of the nominal equal split."""
+    """Layout, speeds, power flow, torques and forces of the nominal equal split.
+
+    The result for the last model is kept (models and kinematics are frozen): loading a
+    model checks it through its kinematics, and the run set up next needs them again --
+    a study case would otherwise solve them twice."""
+    global _LAST
+    ref, kin, said = _LAST
+    if ref is None or ref() is not model:
+        with warnings.catch_warnings(record=True) as said:
+            warnings.simplefilter("always")
+            kin = _solve_kinematics(model)
+        _LAST = (weakref.ref(model), kin, said)
+    for w in said:  # its warnings, every time, as if solved again
+        warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    return kin
+
+
+def _solve_kinematics(model: Model) -> Kinematics:
     issues: list[tuple[str, str]] = []
     groups = _rigid_groups(model)
     positions, axes, computed = _layout(model, issues)

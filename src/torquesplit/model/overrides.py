@@ -9,7 +9,6 @@ argument, not against the model file (:func:`apply_assignments`,
 
 from __future__ import annotations
 
-import copy
 import tomllib
 from pathlib import Path
 from typing import Any, Mapping
@@ -22,12 +21,17 @@ def set_parameter(data: dict, path: str, value: Any) -> dict:
 
     The parent table must exist; the field itself may be new (it is then checked by the
     schema like any other field).  List items are addressed by index (``axis.2``).
+    Only the tables and lists on the path are copied; the rest is shared with ``data``
+    (neither is ever changed in place: a study sets a dozen parameters of a large model
+    per case, and copying the whole model for each cost milliseconds).
     """
-    out = copy.deepcopy(data)
     parts = path.split(".")
+    out = _copy_node(data)
     node = out
     for i, key in enumerate(parts[:-1]):
-        node = _child(node, key, ".".join(parts[: i + 1]), path)
+        child = _copy_node(_child(node, key, ".".join(parts[: i + 1]), path))
+        node[_index(key, node, path) if isinstance(node, list) else key] = child
+        node = child
     last = parts[-1]
     if isinstance(node, list):
         idx = _index(last, node, path)
@@ -41,10 +45,19 @@ def set_parameter(data: dict, path: str, value: Any) -> dict:
 
 
 def apply_overrides(data: dict, overrides: Mapping[str, Any]) -> dict:
-    """Apply several ``{path: value}`` overrides in order."""
+    """Apply several ``{path: value}`` overrides in order (``data`` is not changed)."""
     for path, value in overrides.items():
         data = set_parameter(data, path, value)
     return data
+
+
+def _copy_node(node):
+    """A shallow copy of a table or list (a value is returned as it is)."""
+    if isinstance(node, dict):
+        return dict(node)
+    if isinstance(node, list):
+        return list(node)
+    return node
 
 
 def parse_assignment(text: str) -> tuple[str, Any]:

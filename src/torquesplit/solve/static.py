@@ -257,7 +257,6 @@ class _StaticProblem:
         """Element forces (without p), tangents, energy and states at q: the static laws
         (:func:`laws.dead_zone`, :func:`laws.spline_force` / :func:`laws.spline_tangent`
         at rest) plus the :func:`regularisation` ``reg``."""
-        s = self.s
         delta = self.V @ q - L.e
         k, g = L.k, L.g
         h, dh, u = (np.empty_like(delta) for _ in range(3))
@@ -269,36 +268,58 @@ class _StaticProblem:
                                                                       SEPARATED)), FRONT)
         state = state.astype(np.int64)
         energy = float(np.sum(np.where(self.linear, k * u + ur, 0.0)))
-        sp = []
-        if s.n_splines:
-            dx, dy = delta[self.sp_x], delta[self.sp_y]
-            zero = np.zeros_like(dx)
-            out = np.empty((s.n_splines, 12))
-            laws.spline_forces(dx, dy, zero, zero, np.ascontiguousarray(s.sp_par), out)
-        for j in range(s.n_splines):
-            ex, ey = self.sp_x[j], self.sp_y[j]
-            par = s.sp_par[j]
-            rad = float(np.hypot(dx[j], dy[j]))
-            # the regularisation of the radial dead zone: reg k min(R, S2) along d / R
-            rk = reg * par[SP_STIFFNESS]
-            s2 = par[SP_CLEARANCE]
-            f_reg = rk * min(rad, s2)
-            f[ex], f[ey] = out[j, 0], out[j, 1]
-            h2 = out[j, 2:6].reshape(2, 2).copy()
-            if rad > 0:
-                nx, ny = dx[j] / rad, dy[j] / rad
-                f[ex] += f_reg * nx
-                f[ey] += f_reg * ny
-                nn = np.array([[nx * nx, nx * ny], [nx * ny, ny * ny]])
-                h2 += (rk if rad < s2 else 0.0) * nn + f_reg / rad * (np.eye(2) - nn)
-            elif s2 > 0:
-                h2 += rk * np.eye(2)
-            inner = min(rad, s2)
-            energy += out[j, 10] + rk * (0.5 * inner * inner + s2 * max(rad - s2, 0.0))
+        sp = np.empty((0, 2, 2))
+        if self.s.n_splines:
+            ex, ey = self.sp_x, self.sp_y
+            f[ex], f[ey], sp, e_sp, state_sp = self._splines(delta, reg, tangent=True)
+            energy += e_sp
             kt[ex] = kt[ey] = 0.0
-            state[ex] = state[ey] = int(out[j, 11])
-            sp.append(h2)
+            state[ex] = state[ey] = state_sp
         return delta, f, kt, energy, state, sp
+
+    def force(self, q, L: _Loads, reg: float):
+        """The element forces of :meth:`forces` alone (the line search needs no more)."""
+        delta = self.V @ q - L.e
+        k, g = L.k, L.g
+        h, dh, u = (np.empty_like(delta) for _ in range(3))
+        laws.dead_zones(delta, np.asarray(g, dtype=float), h, dh, u)
+        rk = np.where(g > 0, reg * k, 0.0)  # the force of :func:`regularisation`
+        f = k * h + rk * np.clip(delta, -g, g)
+        if self.s.n_splines:
+            f[self.sp_x], f[self.sp_y] = self._splines(delta, reg, tangent=False)
+        return f
+
+    def _splines(self, delta, reg, tangent: bool):
+        """Forces (fx, fy) of the splines at rest plus the regularisation of their radial
+        dead zone, reg k min(R, S2) along d / R; with ``tangent`` also their 2 x 2
+        tangents, energy and regions."""
+        s = self.s
+        dx, dy = delta[self.sp_x], delta[self.sp_y]
+        zero = np.zeros_like(dx)
+        out = np.empty((s.n_splines, 12))
+        laws.spline_forces(dx, dy, zero, zero, np.ascontiguousarray(s.sp_par), out)
+        rad = np.hypot(dx, dy)
+        rk = reg * s.sp_par[:, SP_STIFFNESS]
+        s2 = s.sp_par[:, SP_CLEARANCE]
+        inner = np.minimum(rad, s2)
+        f_reg = rk * inner
+        moved = rad > 0
+        safe = np.where(moved, rad, 1.0)
+        nx, ny = np.where(moved, dx / safe, 0.0), np.where(moved, dy / safe, 0.0)
+        fx, fy = out[:, 0] + f_reg * nx, out[:, 1] + f_reg * ny
+        if not tangent:
+            return fx, fy
+        nn = np.stack([np.stack([nx * nx, nx * ny], -1), np.stack([nx * ny, ny * ny], -1)], -2)
+        radial = np.where(moved & (rad < s2), rk, 0.0)
+        tangential = np.where(moved, f_reg / safe, 0.0)
+        eye = np.eye(2)[None]
+        sp = (out[:, 2:6].reshape(-1, 2, 2) + radial[:, None, None] * nn
+              + tangential[:, None, None] * (eye - nn))
+        at_rest = ~moved & (s2 > 0)
+        sp[at_rest] += rk[at_rest, None, None] * eye
+        energy = float(np.sum(out[:, 10] + rk * (0.5 * inner * inner
+                                                 + s2 * np.maximum(rad - s2, 0.0))))
+        return fx, fy, sp, energy, out[:, 11].astype(np.int64)
 
     def hessian(self, kt, sp):
         """Tangent stiffness: sum_e kt_e V_e V_e^T plus each spline's 2 x 2 tangent and
@@ -385,10 +406,32 @@ class _StaticProblem:
         kq, kdq = self.Kf @ q, self.Kf @ dq  # the frame stiffness (linear in q)
 
         def dphi(alpha):
-            _, f, _, _, _, _ = self.forces(q + alpha * dq, L, reg)
+            f = self.force(q + alpha * dq, L, reg)
             terms = np.concatenate([f * vdq, (kq + alpha * kdq) * dq])
             return float(terms.sum()) - fdq, float(np.abs(terms).sum()) + abs(fdq)
         return dphi, vdq
+
+    def _kinks(self, delta, vdq, g):
+        """Step lengths alpha at which phi' has a kink along delta + alpha V dq: a 1-D
+        element's deformation crossing an edge of its dead zone (+-g), a spline's radial
+        displacement |(dx, dy) + alpha (vx, vy)| crossing its stick limit or clearance
+        (roots of a quadratic)."""
+        on = self.linear & (np.asarray(g) > 0) & (vdq != 0)
+        d, v, gg = delta[on], vdq[on], np.asarray(g, dtype=float)[on]
+        out = [(gg - d) / v, (-gg - d) / v]
+        if self.s.n_splines:
+            x, y = self.sp_x, self.sp_y
+            a = vdq[x] ** 2 + vdq[y] ** 2
+            b = 2.0 * (delta[x] * vdq[x] + delta[y] * vdq[y])
+            r2 = delta[x] ** 2 + delta[y] ** 2
+            for edge in (self.s.sp_par[:, SP_STICK], self.s.sp_par[:, SP_CLEARANCE]):
+                c = r2 - edge * edge
+                disc = b * b - 4.0 * a * c
+                ok = (edge > 0) & (a > 0) & (disc >= 0)
+                root = np.sqrt(np.where(ok, disc, 0.0))
+                den = np.where(ok, 2.0 * a, 1.0)
+                out += [((-b - root) / den)[ok], ((-b + root) / den)[ok]]
+        return np.concatenate(out)
 
     def newton(self, q, L: _Loads, load, reg, budget):
         """Minimise U(q) - load.q on B^T M q = 0 from q; returns (q, solves, converged)."""
@@ -410,7 +453,7 @@ class _StaticProblem:
             step = float(np.max(np.abs(vdq), initial=0.0))
             if step <= 1e-15 * scale or d0 >= 0.0:  # d0 = -dq^T H dq: only if dq ~ 0
                 return q + dq, solves, True
-            alpha = _line_search(dphi, d0)
+            alpha = _line_search(dphi, d0, self._kinks(delta, vdq, L.g))
             q_new = q + alpha * dq
             delta_n, f_n, kt_n, _, state_n, sp_n = self.forces(q_new, L, reg)
             settled = alpha == 1.0 and np.array_equal(state_n, state)
@@ -493,13 +536,30 @@ class _StaticProblem:
                     converged=bool(ok), accel=accel)
 
 
-def _line_search(dphi, d0: float) -> float:
+def _line_search(dphi, d0: float, kinks=()) -> float:
     """Step along a descent direction: 1 if phi'(1) <= 0 (up to round-off), else the
-    root of the monotone phi' in (0, 1) (regula falsi, Illinois variant)."""
+    root of the monotone phi' in (0, 1).  The bracket is first narrowed, by bisection over
+    the sorted ``kinks`` (where phi' changes slope: dead-zone edges), to one smooth piece
+    of phi'; the root inside it by regula falsi (Illinois variant), which on a linear piece
+    lands on it at the first step.  A root at a kink is found at that kink: regula falsi
+    across a kink only converges linearly (20-odd evaluations of phi' per step)."""
     d1, size = dphi(1.0)
     if d1 <= 1e-12 * size + 1e-10 * abs(d0):
         return 1.0
     a, da, b, db = 0.0, d0, 1.0, d1
+    ks = np.unique(np.asarray(kinks, dtype=float))
+    ks = ks[(ks > 0.0) & (ks < 1.0)]
+    lo, hi = 0, ks.size
+    while lo < hi:
+        mid = (lo + hi) // 2
+        c = float(ks[mid])
+        dc, size = dphi(c)
+        if abs(dc) <= 1e-12 * size + 1e-12 * abs(d0):
+            return c
+        if dc > 0:
+            b, db, hi = c, dc, mid
+        else:
+            a, da, lo = c, dc, mid + 1
     c = 1.0
     for _ in range(200):
         c = b - db * (b - a) / (db - da)
