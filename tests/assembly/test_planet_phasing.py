@@ -200,7 +200,10 @@ def test_flank_not_determined_by_the_power_flow_warns():
     m2 = torquesplit.load_model(model_from_dict(d), check=False)
     with pytest.warns(ModelWarning, match="meshes.idle_mesh: no power passes this mesh.*"
                       "give 'driver'"):
-        solve_kinematics(m2)
+        kin = solve_kinematics(m2)
+    # the last model's kinematics are kept, and their warning is given again
+    with pytest.warns(ModelWarning, match="meshes.idle_mesh: no power passes this mesh"):
+        assert solve_kinematics(m2) is kin
     d["meshes"]["idle_mesh"]["driver"] = "stage_sun"
     m3 = torquesplit.load_model(model_from_dict(d), check=False)
     with warnings.catch_warnings():

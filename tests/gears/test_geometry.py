@@ -199,3 +199,14 @@ def test_bad_input_is_refused_with_a_message_naming_the_field():
     # ModelError is a ValueError
     with pytest.raises(ValueError):
         GearGeometry(2, 2e-3, A20)
+
+
+def test_fast_cross_equals_numpy_bit_for_bit():
+    from torquesplit.gears.vectors import cross
+
+    rng = np.random.default_rng(3)
+    for _ in range(200):
+        a, b = rng.normal(size=3) * 10.0 ** rng.integers(-6, 6), rng.normal(size=3)
+        assert np.array_equal(cross(a, b), np.cross(a, b))
+    many = rng.normal(size=(5, 3))
+    assert np.array_equal(cross(many, many[::-1]), np.cross(many, many[::-1]))

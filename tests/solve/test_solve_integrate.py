@@ -282,3 +282,22 @@ def test_selections_by_name_and_q_only_start():
     np.testing.assert_allclose(sol.history_t, np.arange(21) * 1e-4, atol=1e-15)
     c = sol.cycles("mesh")
     assert c["count"][0] == 100 and np.isfinite(c["mean"][0])
+
+
+def test_planned_step_is_kept_per_live_structure_only():
+    """The default step of a structure is computed once while it lives, then forgotten."""
+    import gc
+    import importlib
+
+    integ = importlib.import_module("torquesplit.solve.integrate")
+    from torquesplit.solve.integrate import planned_step
+
+    s = spur_pair()
+    first = planned_step(s, 100, 0.1)
+    assert id(s) in integ._STEPS
+    assert planned_step(s, 100, 0.1) == first
+    assert planned_step(s, 50, 0.1) != first  # other arguments: computed again
+    key = id(s)
+    del s
+    gc.collect()
+    assert key not in integ._STEPS

@@ -208,3 +208,41 @@ def test_static_friction_changes_the_load_only_through_its_mean_moments():
     qs = quasi_static(lossy, [0.1 / 500.0, 0.7 / 500.0])
     assert qs.converged.all()
     assert qs.element_forces[0, 0] != pytest.approx(qs.element_forces[1, 0], rel=1e-3)
+
+
+def test_line_search_lands_on_a_kink_at_the_root():
+    """phi' with a kink at its root: bisection over the kinks finds it in a few
+    evaluations (regula falsi alone converges linearly there, ~20 evaluations)."""
+    from torquesplit.solve.static import _line_search
+
+    root = 0.3
+    calls = []
+
+    def dphi(a):
+        calls.append(a)
+        d = (2.0 if a < root else 10.0) * (a - root)
+        return d, abs(d) + 1.0
+
+    kinks = np.array([-0.5, 0.1, root, 0.7, 2.0])  # some outside (0, 1)
+    assert _line_search(dphi, dphi(0.0)[0], kinks) == root
+    assert len(calls) <= 4
+    calls.clear()
+    alpha = _line_search(dphi, dphi(0.0)[0])  # without the kinks: the same root, slowly
+    assert alpha == pytest.approx(root, abs=1e-9)
+    assert len(calls) > 10
+
+
+def test_line_search_kinks_of_a_spline_are_its_radii():
+    """The kinks along a line are where |d + alpha v| reaches the spline's clearance."""
+    from torquesplit.solve.static import _StaticProblem
+
+    from torquesplit.assembly.structure import SPLINE
+
+    s = build_structure(["a.x", "a.y"], [1.0, 1.0], [dict(
+        name="sp", kind=SPLINE, x=([0], [1.0]), y=([1], [1.0]), stiffness=1e8,
+        clearance=1e-4, stick_limit=2e-5)])
+    p = _StaticProblem(s, 1e-9, 1e-8)
+    delta = np.array([0.0, 0.0])
+    vdq = np.array([3e-4, 4e-4])  # |v| = 5e-4: radius 1e-4 at 0.2, 2e-5 at 0.04
+    kinks = np.sort(p._kinks(delta, vdq, np.zeros(2)))
+    np.testing.assert_allclose(kinks[kinks > 0], [0.04, 0.2], rtol=1e-12)

@@ -46,6 +46,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..gears import line_of_action as loa
+from ..gears.vectors import cross
 from ..model.kinematics import Kinematics, solve_kinematics
 from ..model.schema import Model
 from . import excitation
@@ -317,7 +318,7 @@ def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None
         # axis along z); the law is isotropic, so any orthonormal pair of directions does
         axis = kin.bodies[flo].axis / np.linalg.norm(kin.bodies[flo].axis)
         e1 = loa.reference_direction(axis, 0.0)
-        e2 = np.cross(axis, e1)
+        e2 = cross(axis, e1)
         if e2[np.argmax(np.abs(e2))] < 0:
             e2 = -e2
         rows = {}
@@ -440,7 +441,7 @@ def centre_projection(kin: Kinematics, dmap: DofMap, body: str, vec, sign: float
     r = r - a * float(r @ a)
     out = list(dmap.project(carrier, vec, sign))
     idx, s_c = dmap.theta.get(carrier, (-1, 1.0))
-    arm = float(np.cross(a, r) @ np.asarray(vec, dtype=float))
+    arm = float(cross(a, r) @ np.asarray(vec, dtype=float))
     if idx >= 0 and abs(arm) > 0.0:
         out.append((idx, sign * s_c * arm))
     return out
@@ -457,7 +458,7 @@ def _seat_geometry(kin: Kinematics, body: str, on: str | None, sup, where: str):
     a = c.axis / np.linalg.norm(c.axis)
     r = kin.bodies[body].position - c.position
     r = r - a * float(r @ a)
-    arm = np.cross(a, r)
+    arm = cross(a, r)
     pe = sup.pin_error
     if pe.is_zero:
         return arm, zero
@@ -466,7 +467,7 @@ def _seat_geometry(kin: Kinematics, body: str, on: str | None, sup, where: str):
         raise ModelError([(f"{where}.pin_error", "the body sits on the seat body's axis: "
                            "its pin has no radial direction; remove 'pin_error'")])
     e_r = r / rn
-    return arm, pe.radial * e_r + pe.tangential * np.cross(a, e_r)
+    return arm, pe.radial * e_r + pe.tangential * cross(a, e_r)
 
 
 def _eccentricity(model: Model, kin: Kinematics, body: str):

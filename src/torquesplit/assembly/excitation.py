@@ -13,6 +13,7 @@ import math
 import numpy as np
 
 from ..gears import line_of_action as loa
+from ..gears.vectors import cross
 from ..model.kinematics import Kinematics
 from ..model.schema import Model
 
@@ -186,7 +187,7 @@ def _phase_terms(model: Model, kin: Kinematics, mesh_name: str, gear: str):
     body = kin.bodies[gear]
     axis = body.axis / np.linalg.norm(body.axis)
     e1 = loa.reference_direction(axis, 0.0)
-    e2 = np.cross(axis, e1)
+    e2 = cross(axis, e1)
     z = model.gears[gear].teeth
     w = mk.driver_speed if gear == mk.driver else mk.driven_speed
     sigma = 1.0 if w > 0 else -1.0
@@ -287,7 +288,7 @@ def mesh_errors(model: Model, kin: Kinematics, mesh_name: str):
         body = kin.bodies[g]
         axis = body.axis
         e1 = loa.reference_direction(axis, 0.0)
-        e2 = np.cross(axis, e1)
+        e2 = cross(axis, e1)
         n1, n2 = float(n @ e1), float(n @ e2)
         scale = math.hypot(n1, n2)  # in-plane part of the line of action
         zeta = math.atan2(n2, n1)
@@ -381,8 +382,8 @@ def friction_direction(kin: Kinematics, mesh_name: str) -> np.ndarray:
     n = np.asarray(mk.line_of_action, dtype=float)
     n_t = n - a * float(n @ a)
     n_t = n_t / np.linalg.norm(n_t)
-    t = np.cross(a, n_t)
-    v = mk.driver_speed * np.cross(a, mk.contact_point - drv.position)
+    t = cross(a, n_t)
+    v = mk.driver_speed * cross(a, mk.contact_point - drv.position)
     if float(t @ v) < 0.0:
         t = -t
     t[np.abs(t) < 1e-15] = 0.0

@@ -42,6 +42,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..gears import line_of_action as loa
+from ..gears.vectors import cross
 
 
 def in_plane_basis(axis) -> tuple[np.ndarray, np.ndarray]:
@@ -49,7 +50,7 @@ def in_plane_basis(axis) -> tuple[np.ndarray, np.ndarray]:
     a = np.asarray(axis, dtype=float)
     a = a / np.linalg.norm(a)
     e1 = loa.reference_direction(a, 0.0)
-    return e1, np.cross(a, e1)
+    return e1, cross(a, e1)
 
 
 def rotating_frame_terms(kin, dmap, ext: np.ndarray, pin_stiffness=None):
@@ -87,7 +88,7 @@ def rotating_frame_terms(kin, dmap, ext: np.ndarray, pin_stiffness=None):
         # Coriolis: G_ij = 2 m Omega u_i . (a x u_j)   (Lin & Parker 1999 G)
         for di, i in tr.items():
             for dj, j in tr.items():
-                g = 2.0 * m * omega * float(dirs[di] @ np.cross(a, dirs[dj]))
+                g = 2.0 * m * omega * float(dirs[di] @ cross(a, dirs[dj]))
                 if abs(g) > 1e-14 * 2.0 * m * abs(omega):
                     gyro.append((i, j, g))
         # centripetal softening -m Omega^2 in the carrier's plane (Lin & Parker 1999
@@ -117,7 +118,7 @@ def rotating_frame_terms(kin, dmap, ext: np.ndarray, pin_stiffness=None):
             r = kin.bodies[body].position - kin.bodies[c_name].position
             r0 = r - a * float(r @ a)
             big_r = float(np.linalg.norm(r0))
-            k_t = pin_stiffness(body, np.cross(a, r0 / big_r)) if big_r > 0 else None
+            k_t = pin_stiffness(body, cross(a, r0 / big_r)) if big_r > 0 else None
             if idx >= 0 and k_t is not None:
                 soft = m * omega**2
                 if not k_t > soft:

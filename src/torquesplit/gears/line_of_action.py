@@ -43,6 +43,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .geometry import GearGeometry, PairGeometry
+from .vectors import cross
 
 
 @dataclass(frozen=True)
@@ -110,7 +111,7 @@ def reference_direction(axis: np.ndarray, angle: float) -> np.ndarray:
     along x); angles are counter-clockwise about ``axis``.
     """
     e1 = _perp_unit(np.array([1.0, 0.0, 0.0]), axis)
-    e2 = np.cross(axis, e1)
+    e2 = cross(axis, e1)
     return math.cos(angle) * e1 + math.sin(angle) * e2
 
 
@@ -179,7 +180,7 @@ def contact_frame(model, mesh_name: str, positions: dict, axes: dict) -> Contact
     else:
         point = positions[na] + ra * u
         er_a, er_b = u, -u
-    ta, tb = np.cross(aa, er_a), np.cross(ab, er_b)
+    ta, tb = cross(aa, er_a), cross(ab, er_b)
     ratio = (ga.teeth / gb.teeth) * float(ta @ tb)
     return ContactFrame(
         gears=(na, nb), contact_point=point, radial=(er_a, er_b), tangent=(ta, tb),
@@ -253,7 +254,7 @@ def _conical_frame(mesh, na, nb, ga, gb, aa, ab, positions) -> ContactFrame:
 
         ra, rb = mean_radius(ga, gam_a), mean_radius(gb, gam_b)
         point = positions[na] + ra * er_a
-    ta, tb = np.cross(aa, er_a), np.cross(ab, er_b)
+    ta, tb = cross(aa, er_a), cross(ab, er_b)
     ratio = (za / zb) * float(ta @ tb)
     # contact ratio from the virtual (Tredgold) spur/helical gears z_v = z / cos(gamma)
     eps_a, eps_b, pair = float("nan"), float("nan"), None

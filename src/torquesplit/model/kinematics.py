@@ -26,6 +26,7 @@ import numpy as np
 
 from ..errors import ModelWarning
 from ..gears import line_of_action as loa
+from ..gears.vectors import cross
 from ..gears.geometry import GearGeometry, PairGeometry
 from ..errors import KinematicsError  # noqa: F401 - re-exported
 from .schema import Gear, Model
@@ -377,7 +378,7 @@ def _loa_direction(body, axis, meshes, loc, issues) -> np.ndarray | None:
         if u is None:
             u, first = t, m.name
             continue
-        sine = float(np.linalg.norm(np.cross(u, t)))
+        sine = float(np.linalg.norm(cross(u, t)))
         if sine > LOA_PARALLEL_TOL:
             angle = math.degrees(math.asin(min(1.0, sine)))
             issues.append((loc, (

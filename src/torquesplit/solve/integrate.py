@@ -23,6 +23,7 @@ import logging
 import math
 import time
 import warnings
+import weakref
 from dataclasses import dataclass
 from typing import Callable, Sequence
 
@@ -692,8 +693,28 @@ class _Plan:
     limited_by: str = ""  # rk4: what set the step
 
 
+_STEPS: dict = {}
+"""id(structure) -> (weak reference, arguments, result) of :func:`_default_step`, for the
+structures alive (an entry leaves with its structure)."""
+
+
 def _default_step(s: Structure, span: float, spp: int, check: bool):
-    """Default RK4 step: (h, what limited it, steps per excitation period)."""
+    """Default RK4 step: (h, what limited it, steps per excitation period).
+
+    Kept per live structure (a Structure is frozen): a run's set-up estimates its cost
+    with it and the integrator plans with it, and each costs two eigenvalue problems."""
+    key = id(s)
+    ref, args, result = _STEPS.get(key, (None, None, None))
+    if ref is not None and ref() is s and args == (span, spp, check):
+        return result
+    result = _step_for(s, span, spp, check)
+    if ref is None or ref() is not s:
+        weakref.finalize(s, _STEPS.pop, key, None)
+    _STEPS[key] = (weakref.ref(s), (span, spp, check), result)
+    return result
+
+
+def _step_for(s: Structure, span: float, spp: int, check: bool):
     periods = _excitation_periods(s)
     period = float(periods.min()) if periods.size else _natural_period_min(s)
     if not math.isfinite(period):  # nothing oscillates: 1000 steps
