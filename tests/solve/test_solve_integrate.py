@@ -301,3 +301,24 @@ def test_planned_step_is_kept_per_live_structure_only():
     del s
     gc.collect()
     assert key not in integ._STEPS
+
+
+def test_a_step_set_by_stability_names_the_damping_that_sets_it():
+    """A stiff friction regularisation (F_m / v of a spline) limits RK4 by stability, not
+    by the highest oscillation: the reason says so and names the spline."""
+    from torquesplit.assembly.structure import MESH, SPLINE, build_structure
+    from torquesplit.solve.integrate import planned_step
+
+    def pair(velocity):
+        return build_structure(
+            ["g1.theta", "g2.theta", "g2.x", "g2.y"], [1 / J1, 1 / J2, 0.1, 0.1],
+            [dict(name="m", kind=MESH, dofs=[0, 1], coefs=[R1, 0.05], stiffness=2e8,
+                  frequency=500.0),
+             dict(name="sp", kind=SPLINE, x=([2], [1.0]), y=([3], [1.0]), stiffness=1e8,
+                  clearance=5e-5, friction_force=1e4, velocity_scale=velocity)])
+
+    h, why = planned_step(pair(1e-4), 100, 0.1)
+    assert why.startswith("RK4 stability: a heavily damped motion")
+    assert "'sp." in why and "spline_velocity_scale" in why
+    h_soft, why_soft = planned_step(pair(1.0), 100, 0.1)
+    assert why_soft == "excitation period" and h_soft > 10 * h

@@ -40,6 +40,7 @@ from torquesplit.solve.stability import (
     SAFETY,
     check_step,
     highest_mode,
+    stability_cause,
     stable_step,
     system_eigenvalues,
 )
@@ -722,13 +723,17 @@ def _step_for(s: Structure, span: float, spp: int, check: bool):
     h = period / spp
     f_hi, element = highest_mode(s)
     h_lim = ACCURACY / (2 * math.pi * f_hi) if f_hi > 0 else math.inf
-    if check:
-        h_lim = min(h_lim, SAFETY * stable_step(s))
-    if h <= h_lim:
+    h_stable = SAFETY * stable_step(s) if check else math.inf
+    if h <= min(h_lim, h_stable):
         return h, "excitation period", spp
-    per = math.ceil(period / h_lim)  # a whole number of steps per period
-    why = (f"the highest mode, {f_hi:.6g} Hz (mostly element '{element}'), needs "
-           f"{per} steps per excitation period instead of {spp}")
+    per = math.ceil(period / min(h_lim, h_stable))  # a whole number of steps per period
+    if h_lim <= h_stable:
+        why = (f"the highest mode, {f_hi:.6g} Hz (mostly element '{element}'), needs "
+               f"{per} steps per excitation period instead of {spp}")
+    else:  # stability, not accuracy: often a stiff damping (a spline's friction)
+        why = (f"RK4 stability: {stability_cause(s)}, needs {per} steps per excitation "
+               f"period instead of {spp}")
+    h_lim = min(h_lim, h_stable)
     log.info("RK4 step limited: %s", why)
     return period / per, why, per
 

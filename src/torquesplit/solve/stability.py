@@ -28,6 +28,7 @@ __all__ = [
     "stable_step",
     "check_step",
     "highest_mode",
+    "stability_cause",
 ]
 
 SAFETY = 0.8
@@ -84,6 +85,47 @@ def highest_mode(structure: Structure) -> tuple[float, str]:
     energy = k_max * (V @ phi) ** 2
     name = structure.element_names[int(np.argmax(energy))] if energy.size else ""
     return float(np.sqrt(max(lam[-1], 0.0)) / (2 * math.pi)), name
+
+
+def stability_cause(structure: Structure) -> str:
+    """What sets :func:`stable_step`, in words: the eigenvalue of largest modulus (the
+    first to leave RK4's region), whether it is an oscillation or a heavily damped motion,
+    and the element with the largest share of its stiffness or damping forces
+    ``|k_e + lambda c_e| |V_e phi|^2`` (a spline's damping includes its regularised
+    friction, see :meth:`Structure.damping_matrix`)."""
+    from torquesplit.assembly.structure import SP_FRICTION, SP_VELOCITY
+
+    n = structure.n_dof
+    if n == 0:
+        return ""
+    k_max = structure.stiffness_table.max(axis=1) if structure.n_table else np.zeros(0)
+    c = structure.damping.astype(float).copy()
+    for j in range(structure.n_splines):
+        par = structure.sp_par[j]
+        if par[SP_FRICTION] > 0 and par[SP_VELOCITY] > 0:
+            c[structure.sp_el[j]] += par[SP_FRICTION] / par[SP_VELOCITY]
+    A = np.zeros((2 * n, 2 * n))
+    A[:n, n:] = np.eye(n)
+    A[n:, :n] = -structure.inv_mass[:, None] * structure.stiffness_matrix(k_max)
+    A[n:, n:] = -structure.inv_mass[:, None] * (structure.damping_matrix()
+                                                + structure.gyroscopic_matrix())
+    lam, vec = np.linalg.eig(A)
+    i = int(np.argmax(np.abs(lam)))
+    phi = vec[:n, i]
+    share = np.abs(k_max + lam[i] * c) * np.abs(structure.projection_matrix() @ phi) ** 2
+    if not share.size:
+        return ""
+    e = int(np.argmax(share))
+    lam_i = lam[i]
+    if abs(lam_i.imag) < abs(lam_i.real):
+        what = f"a heavily damped motion (decay rate {-lam_i.real:.3g} 1/s)"
+    else:
+        what = f"a mode at {abs(lam_i) / (2 * math.pi):.6g} Hz"
+    what += f", mostly element '{structure.element_names[e]}'"
+    if c[e] > structure.damping[e] and abs(lam_i * (c[e] - structure.damping[e])) > k_max[e]:
+        what += (" (its regularised spline friction F_m / v: a larger [analysis] "
+                 "spline_velocity_scale v makes it softer)")
+    return what
 
 
 def _limiting(lam: np.ndarray) -> np.ndarray:
