@@ -39,7 +39,6 @@ import math
 from dataclasses import dataclass, fields
 
 import numpy as np
-from scipy.stats import truncnorm
 
 from torquesplit.errors import ModelError
 
@@ -261,6 +260,8 @@ def sample_within(tolerance: float, size, rng, distribution: str = "normal", *, 
         return np.zeros_like(u)
     if distribution == "uniform":
         return (2.0 * u - 1.0) * tolerance if signed else u * tolerance
+    from scipy.stats import truncnorm  # here: importing scipy.stats takes about 0.5 s
+
     sigma = tolerance / 3.0
     if signed:
         return truncnorm.ppf(u, -3.0, 3.0, loc=0.0, scale=sigma)

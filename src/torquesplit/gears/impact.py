@@ -36,8 +36,6 @@ import warnings
 from dataclasses import dataclass, replace
 
 import numpy as np
-from scipy.optimize import brentq
-from scipy.special import gamma as gamma_function
 
 from torquesplit.errors import ModelError, ModelWarning
 
@@ -118,6 +116,8 @@ def impact_duration(effective_mass, normal_velocity, impact_stiffness, exponent=
     v = abs(float(normal_velocity))
     if v == 0.0:
         return 0.0
+    from scipy.special import gamma as gamma_function
+
     p = n + 1.0
     delta_max = (p * effective_mass * v**2 / (2.0 * impact_stiffness)) ** (1.0 / p)
     integral = math.sqrt(math.pi) * gamma_function(1.0 + 1.0 / p) / gamma_function(0.5 + 1.0 / p)
@@ -270,6 +270,8 @@ def meshing_in_point(
                     "meshing_in_point: no corner contact found; the advance "
                     f"{advance:.3g} m is too large for this tooth geometry."
                 )
+        from scipy.optimize import brentq  # here: importing scipy.optimize takes 0.4 s
+
         s_p = brentq(gap, lo, hi, xtol=1e-15, rtol=1e-14)
     d = corner(s_p)
     r_d = float(math.hypot(d[0], d[1]))
