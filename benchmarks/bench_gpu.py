@@ -21,6 +21,11 @@ monte_carlo  Device: Ji & Li's drive (14 DOF), a Monte Carlo over the backlash o
              same study, extrapolated per case, for the ratio.
 liu2021      Device: Liu et al. 2021's reducer (49 DOF) at the paper's resolution, random
              eccentricity phases on every gear, 1,000 cases (--quick 100).
+setup        Needs no device: the host's share of a GPU study, per case, on one core --
+             the cases of the monte_carlo and liu2021 studies set up as the GPU runner
+             sets them up (overrides, model validation and checks, kinematics, assembly,
+             static equilibrium: ``gpu.backend.prepare_case``; then the engine's step and
+             cycle planning: ``gpu.ensemble.case_arrays``), 64 cases each.
 """
 
 from __future__ import annotations
@@ -197,18 +202,53 @@ def liu2021(quick: bool) -> dict:
     return {"run": True, **_study_part(spec, 4)}
 
 
+def setup() -> dict:
+    """Host set-up per case (no device needed), one core."""
+    import torquesplit
+    from torquesplit.gpu.backend import prepare_case
+    from torquesplit.gpu.ensemble import case_arrays
+    from torquesplit.study.case import payload
+
+    liu = {"study": {"name": "gpu_bench_liu", "model": "liu2021_split_torque_helicopter",
+                     "outputs": ["load_sharing.cycle_peak*", "dynamic_factor"]},
+           "analysis": {"type": "run"},
+           "monte_carlo": {"samples": 64, "seed": 2, "sampling": "random",
+                           "parameters": [{"paths": ["gears.*.errors.eccentricity_phase"],
+                                           "distribution": "uniform", "low": "0 deg",
+                                           "high": "360 deg"}]}}
+    out = {}
+    for name, spec in (("ji_li_monte_carlo", _mc_spec(64)), ("liu2021", liu)):
+        plan = torquesplit.Study(spec).plan()
+        ps = [payload(i, plan, plan.design.overrides(i)) for i in range(64)]
+        prepare_case(ps[0])  # warm: imports, kernels
+        t = time.perf_counter()
+        runs = [prepare_case(p)["run"] for p in ps]
+        t_prep = (time.perf_counter() - t) / len(ps)
+        t = time.perf_counter()
+        for r in runs:
+            case_arrays(r)
+        t_plan = (time.perf_counter() - t) / len(ps)
+        out[name] = {"cases": len(ps), "prepare_ms": 1e3 * t_prep, "plan_ms": 1e3 * t_plan,
+                     "dof": runs[0].structure.n_dof}
+        _log(f"  {name}: {1e3 * (t_prep + t_plan):.1f} ms a case")
+    return out
+
+
 # --------------------------------------------------------------------------- main
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("parts", nargs="*", default=["layout", "monte_carlo", "liu2021"])
+    ap.add_argument("parts", nargs="*",
+                    default=["layout", "setup", "monte_carlo", "liu2021"])
     ap.add_argument("--quick", action="store_true")
     args = ap.parse_args(argv)
     ok, why = _device()
-    result = {"date": _dt.datetime.now().isoformat(timespec="seconds"),
-              "host": platform.node(), "cpus": os.cpu_count(),
-              "load_average": os.getloadavg(), "device": why if ok else None,
-              "device_missing_reason": None if ok else why, "quick": args.quick}
+    # parts not run this time keep their last results (``part_dates`` says when each ran)
+    result = json.loads(OUT_JSON.read_text()) if OUT_JSON.exists() else {}
+    result.update({"date": _dt.datetime.now().isoformat(timespec="seconds"),
+                   "host": platform.node(), "cpus": os.cpu_count(),
+                   "load_average": os.getloadavg(), "device": why if ok else None,
+                   "device_missing_reason": None if ok else why, "quick": args.quick})
     for part in args.parts:
         _log(f"{part} ...")
         if part == "layout":
@@ -217,8 +257,12 @@ def main(argv=None) -> int:
             result["monte_carlo"] = monte_carlo(args.quick)
         elif part == "liu2021":
             result["liu2021"] = liu2021(args.quick)
+        elif part == "setup":
+            result["setup"] = setup()
         else:
             ap.error(f"unknown part {part!r}")
+        result.setdefault("part_dates", {})[part] = _dt.datetime.now().isoformat(
+            timespec="seconds")
     OUT_JSON.write_text(json.dumps(result, indent=1, default=str) + "\n")
     OUT_MD.write_text(_markdown(result))
     print(_markdown(result))
@@ -229,6 +273,9 @@ def _markdown(r: dict) -> str:
     lines = ["# GPU ensemble backend: measurements", "",
              f"{r['date']} on {r['host']} ({r['cpus']} CPUs, load {r['load_average']}).",
              f"Device: {r['device'] or 'none (' + str(r['device_missing_reason']) + ')'}.", ""]
+    if r.get("part_dates"):
+        lines += ["Parts last run: " + ", ".join(f"{k} {v}" for k, v in
+                                                 r["part_dates"].items()) + ".", ""]
     if "layout" in r:
         lines += ["## One case per thread: what ptxas allocates (sm_90, no device needed)", "",
                   "| model/precision | DOF | source lines | PTX compile s | registers | "
@@ -238,6 +285,17 @@ def _markdown(r: dict) -> str:
                          f"{v.get('ptx_compile_s', v.get('ptx', ''))} | {v.get('registers')} | "
                          f"{v.get('spill_store_bytes')} | {v.get('spill_load_bytes')} | "
                          f"{v.get('stack_bytes')} |")
+        lines.append("")
+    if "setup" in r:
+        lines += ["## Host set-up per case (one CPU core, no device needed)", "",
+                  "What the GPU runner does on the CPU before the kernel, per case: "
+                  "overrides, model validation and checks, kinematics, assembly, static "
+                  "equilibrium (prepare), then the engine's step and cycle planning (plan).",
+                  "", "| study | DOF | cases | prepare [ms] | plan [ms] | total [ms] |",
+                  "|---|---|---|---|---|---|"]
+        for k, v in r["setup"].items():
+            lines.append(f"| {k} | {v['dof']} | {v['cases']} | {v['prepare_ms']:.1f} | "
+                         f"{v['plan_ms']:.1f} | {v['prepare_ms'] + v['plan_ms']:.1f} |")
         lines.append("")
     for part, target in (("monte_carlo", "issue target: 10,000 cases <= 2 s end to end, "
                                          "kernel <= 0.6 s, >= 300x the 2-core CPU runner"),

@@ -16,6 +16,7 @@ from typing import Callable
 
 import numpy as np
 
+from ._memo import remember_last
 from .errors import ModelWarning, SolverError
 from .model.io import load_model
 from .model.kinematics import solve_kinematics
@@ -150,6 +151,18 @@ class PreparedRun:
     """Keyword arguments of ``integrate`` (method, tracked elements, groups, ...)."""
 
 
+@remember_last
+def _set_up(model):
+    """Kinematics, structure and static equilibrium of a model (kept for the last model:
+    a study case run until settled sets the same model up for each run length)."""
+    from .assembly.assemble import assemble
+    from .solve.static import static_equilibrium
+
+    kin = solve_kinematics(model)
+    structure = assemble(model, kin)
+    return kin, structure, static_equilibrium(structure)
+
+
 def prepare_run(
     model,
     *,
@@ -168,15 +181,10 @@ def prepare_run(
     """The set-up of :func:`simulate` (same parameters) without the integration: model,
     kinematics, structure, static equilibrium, initial state, run length and the
     arguments of ``integrate``; refuses what ``simulate`` refuses, warns as it warns."""
-    from .assembly.assemble import assemble
-    from .solve.static import static_equilibrium
-
     if not hasattr(model, "meshes"):
         model = load_model(model)
     an = model.analysis
-    kin = solve_kinematics(model)
-    structure = assemble(model, kin)
-    static = static_equilibrium(structure)
+    kin, structure, static = _set_up(model)
     if not np.all(np.isfinite(static.q)):
         raise SolverError(
             "the static equilibrium failed; check the clearances and the supports "

@@ -18,12 +18,12 @@ from __future__ import annotations
 
 import math
 import warnings
-import weakref
 from collections import deque
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._memo import remember_last
 from ..errors import ModelWarning
 from ..gears import line_of_action as loa
 from ..gears.vectors import cross
@@ -166,26 +166,13 @@ def gear_mass_properties(gear: Gear) -> tuple[float, float, bool, bool]:
 
 
 # --------------------------------------------------------------------------- solver
-_LAST: tuple = (None, None, [])
-"""(weak reference to the model, its kinematics, their warnings) of the last call."""
-
-
+@remember_last
 def solve_kinematics(model: Model) -> Kinematics:
     """Layout, speeds, power flow, torques and forces of the nominal equal split.
 
     The result for the last model is kept (models and kinematics are frozen): loading a
-    model checks it through its kinematics, and the run set up next needs them again --
-    a study case would otherwise solve them twice."""
-    global _LAST
-    ref, kin, said = _LAST
-    if ref is None or ref() is not model:
-        with warnings.catch_warnings(record=True) as said:
-            warnings.simplefilter("always")
-            kin = _solve_kinematics(model)
-        _LAST = (weakref.ref(model), kin, said)
-    for w in said:  # its warnings, every time, as if solved again
-        warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
-    return kin
+    model checks it through its kinematics, and the run set up next needs them again."""
+    return _solve_kinematics(model)
 
 
 def _solve_kinematics(model: Model) -> Kinematics:
