@@ -239,18 +239,22 @@ class Structure:
         V = self.projection_matrix()
         return V.T @ (k[:, None] * V) + self.frame_stiffness_matrix()
 
-    def damping_matrix(self) -> np.ndarray:
-        """Dense C = sum_e c_e V_e V_e^T + diag(ground damping).
-
-        A spline component element adds the largest tangent of its regularised
-        friction, F_m / v, to its damping (the stiffest damping the run can meet; the
-        RK4 stability check uses this matrix)."""
-        V = self.projection_matrix()
+    def element_damping(self) -> np.ndarray:
+        """Damping c_e of every element, a spline component's with the largest tangent of
+        its regularised friction, F_m / v, added (the stiffest damping the run can meet;
+        the RK4 stability check uses it)."""
         c = self.damping.astype(float).copy()
         for j in range(self.n_splines):
             par = self.sp_par[j]
             if par[SP_FRICTION] > 0 and par[SP_VELOCITY] > 0:
                 c[self.sp_el[j]] += par[SP_FRICTION] / par[SP_VELOCITY]
+        return c
+
+    def damping_matrix(self) -> np.ndarray:
+        """Dense C = sum_e c_e V_e V_e^T + diag(ground damping), c_e from
+        :meth:`element_damping`."""
+        V = self.projection_matrix()
+        c = self.element_damping()
         return V.T @ (c[:, None] * V) + np.diag(self.ground_damping)
 
 

@@ -26,8 +26,8 @@ import numpy as np
 from .._memo import remember_last
 from ..errors import ModelWarning
 from ..gears import line_of_action as loa
-from ..gears.vectors import cross
 from ..gears.geometry import GearGeometry, PairGeometry
+from ..gears.vectors import cross
 from ..errors import KinematicsError  # noqa: F401 - re-exported
 from .schema import Gear, Model
 

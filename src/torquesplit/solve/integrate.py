@@ -733,7 +733,6 @@ def _step_for(s: Structure, span: float, spp: int, check: bool):
     else:  # stability, not accuracy: often a stiff damping (a spline's friction)
         why = (f"RK4 stability: {stability_cause(s)}, needs {per} steps per excitation "
                f"period instead of {spp}")
-    h_lim = min(h_lim, h_stable)
     log.info("RK4 step limited: %s", why)
     return period / per, why, per
 

@@ -88,33 +88,30 @@ def highest_mode(structure: Structure) -> tuple[float, str]:
 
 
 def stability_cause(structure: Structure) -> str:
-    """What sets :func:`stable_step`, in words: the eigenvalue of largest modulus (the
-    first to leave RK4's region), whether it is an oscillation or a heavily damped motion,
-    and the element with the largest share of its stiffness or damping forces
-    ``|k_e + lambda c_e| |V_e phi|^2`` (a spline's damping includes its regularised
-    friction, see :meth:`Structure.damping_matrix`)."""
-    from torquesplit.assembly.structure import SP_FRICTION, SP_VELOCITY
-
+    """What sets :func:`stable_step`, in words: the step-limiting eigenvalue of largest
+    modulus (RK4's region reaches about as far along the real as along the imaginary
+    axis, so it leaves the region first), whether it is an oscillation or a heavily damped
+    motion, and the element with the largest share of its forces
+    ``|k_e + lambda c_e| |V_e phi|^2`` (c_e from :meth:`Structure.element_damping`, a
+    spline's regularised friction included)."""
     n = structure.n_dof
     if n == 0:
         return ""
     k_max = structure.stiffness_table.max(axis=1) if structure.n_table else np.zeros(0)
-    c = structure.damping.astype(float).copy()
-    for j in range(structure.n_splines):
-        par = structure.sp_par[j]
-        if par[SP_FRICTION] > 0 and par[SP_VELOCITY] > 0:
-            c[structure.sp_el[j]] += par[SP_FRICTION] / par[SP_VELOCITY]
+    c = structure.element_damping()
     A = np.zeros((2 * n, 2 * n))
     A[:n, n:] = np.eye(n)
     A[n:, :n] = -structure.inv_mass[:, None] * structure.stiffness_matrix(k_max)
     A[n:, n:] = -structure.inv_mass[:, None] * (structure.damping_matrix()
                                                 + structure.gyroscopic_matrix())
     lam, vec = np.linalg.eig(A)
-    i = int(np.argmax(np.abs(lam)))
+    size = np.abs(lam)
+    limiting = (lam.real <= _REAL_TOL * size.max()) & (size > 0.0)  # as _limiting
+    if not limiting.any() or not k_max.size:
+        return ""
+    i = int(np.argmax(np.where(limiting, size, -1.0)))
     phi = vec[:n, i]
     share = np.abs(k_max + lam[i] * c) * np.abs(structure.projection_matrix() @ phi) ** 2
-    if not share.size:
-        return ""
     e = int(np.argmax(share))
     lam_i = lam[i]
     if abs(lam_i.imag) < abs(lam_i.real):
@@ -122,7 +119,8 @@ def stability_cause(structure: Structure) -> str:
     else:
         what = f"a mode at {abs(lam_i) / (2 * math.pi):.6g} Hz"
     what += f", mostly element '{structure.element_names[e]}'"
-    if c[e] > structure.damping[e] and abs(lam_i * (c[e] - structure.damping[e])) > k_max[e]:
+    friction = c[e] - structure.damping[e]  # the spline friction's share of c_e
+    if friction > 0 and abs(lam_i) * friction > k_max[e]:
         what += (" (its regularised spline friction F_m / v: a larger [analysis] "
                  "spline_velocity_scale v makes it softer)")
     return what

@@ -539,9 +539,9 @@ class _StaticProblem:
 def _line_search(dphi, d0: float, kinks=()) -> float:
     """Step along a descent direction: 1 if phi'(1) <= 0 (up to round-off), else the
     root of the monotone phi' in (0, 1).  The bracket is first narrowed, by bisection over
-    the sorted ``kinks`` (where phi' changes slope: dead-zone edges), to one smooth piece
-    of phi'; the root inside it by regula falsi (Illinois variant), which on a linear piece
-    lands on it at the first step.  A root at a kink is found at that kink: regula falsi
+    the sorted ``kinks`` (where phi' changes slope: dead-zone edges, spline radii), to one
+    smooth piece of phi'; the root inside it by regula falsi (Illinois variant), which on
+    a linear piece lands on it at the first step.  A root at a kink is found at that kink: regula falsi
     across a kink only converges linearly (20-odd evaluations of phi' per step)."""
     d1, size = dphi(1.0)
     if d1 <= 1e-12 * size + 1e-10 * abs(d0):
