@@ -175,3 +175,16 @@ def test_bad_input_is_named():
         LineOfActionDeviation(0.0, [1.0, 2.0], [1.0], [0.0])
     with pytest.raises(ValueError, match="one cumulative deviation per tooth"):
         pitch_error_from_deviations([1e-6] * 5, 10.0, 0.3, tooth_number=6)
+
+
+def test_a_constant_deviation_is_normalised_as_a_general_one():
+    """The constant-only fast path gives what the general path gives (-0.0 -> 0.0 too)."""
+    from torquesplit.gears.errors import LineOfActionDeviation
+
+    for c in (0.0, -0.0, 2.5e-6, -1e-5):
+        fast = LineOfActionDeviation(c)
+        general = LineOfActionDeviation(c, [0.0], [1.0], [0.3])  # a dropped zero term
+        assert repr(fast.constant) == repr(general.constant)
+        for name in ("amplitudes", "omegas", "phases"):
+            assert getattr(fast, name).shape == (0,) == getattr(general, name).shape
+            assert getattr(fast, name).dtype == np.float64

@@ -81,6 +81,12 @@ class LineOfActionDeviation:
     phases: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     def __post_init__(self):
+        if np.size(self.amplitudes) == 0 and np.size(self.omegas) == 0 \
+                and np.size(self.phases) == 0:  # a constant (most terms of a model)
+            object.__setattr__(self, "constant", float(self.constant) + 0.0)  # as below
+            for name in ("amplitudes", "omegas", "phases"):
+                object.__setattr__(self, name, np.zeros(0))
+            return
         a = np.atleast_1d(np.asarray(self.amplitudes, dtype=float)).copy()
         w = np.atleast_1d(np.asarray(self.omegas, dtype=float)).copy()
         p = np.atleast_1d(np.asarray(self.phases, dtype=float)).copy()
