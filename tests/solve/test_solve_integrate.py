@@ -322,3 +322,30 @@ def test_a_step_set_by_stability_names_the_damping_that_sets_it():
     assert "'sp." in why and "spline_velocity_scale" in why
     h_soft, why_soft = planned_step(pair(1.0), 100, 0.1)
     assert why_soft == "excitation period" and h_soft > 10 * h
+
+
+def test_chunks_after_the_first_call_the_compiled_kernel_directly(monkeypatch):
+    """After the first chunk the RK4 kernel is called without numba's argument typing;
+    the run is the same bit for bit as with the dispatcher for every chunk."""
+    import importlib
+
+    integ = importlib.import_module("torquesplit.solve.integrate")
+    from torquesplit.solve import _kernels as kern
+
+    s = spur_pair(gaps=5e-6)
+    st = static_equilibrium(s)
+    y0 = np.concatenate([st.q, np.zeros_like(st.q)])
+    found = []
+    real = integ._compiled
+
+    def spy(dispatcher, args):
+        fn = real(dispatcher, args)
+        found.append(fn is not dispatcher)
+        return fn
+
+    monkeypatch.setattr(integ, "_compiled", spy)
+    a = integrate(s, y0, (0.0, 0.05), method="rk4")
+    assert found and all(found) and a.n_steps > integ.rk4_chunk(a.n_steps)  # several chunks
+    monkeypatch.setattr(integ, "_compiled", lambda dispatcher, args: kern.rk4_run)
+    b = integrate(s, y0, (0.0, 0.05), method="rk4")
+    assert np.array_equal(a.y_final, b.y_final) and a.n_steps == b.n_steps
