@@ -489,6 +489,10 @@ def _render_run(res, met, saved) -> None:
         f"(+{st['rhs_compile_time_s']:.2g} s for the {st['rhs']} right-hand side); "
         f"transient discarded: {met.settling.start_time:.4g} s"
         + ("" if met.settling.settled else " (not settled: last half used)"), highlight=False)
+    why = st.get("step_limited_by") or ""
+    if why and why != "excitation period":  # a finer step than asked: say what set it
+        console.print(f"step {st['step_s']:.3g} s, set by {why}", highlight=False,
+                      markup=False)
     console.print(run_table(met))
     console.print(group_table(met))
     console.print(f"system load-sharing coefficient ({met.definition}): "

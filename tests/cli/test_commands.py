@@ -55,3 +55,17 @@ def test_static_mesh_and_modes(tmp_path):
     assert (tmp_path / "k.png").stat().st_size > 0
     modes = json.loads(_ok(["modes", str(path), "--json"]))
     assert modes["rigid_body_modes"] == 1 and modes["modes"][0]["frequency_Hz"] > 0
+
+
+def test_run_says_what_set_a_finer_step(tmp_path):
+    """A step finer than asked (a stiff mesh) is explained on the terminal and in the
+    JSON statistics; at the asked step nothing is said."""
+    pair = write_model(tmp_path, SPUR_PAIR, "pair.toml")
+    stiff = _ok(["run", str(pair), "--cycles", "10", "--set", "meshes.m.stiffness='4e10 N/m'"])
+    assert "set by the highest mode" in stiff and "mostly element 'm'" in stiff
+    normal = _ok(["run", str(pair), "--cycles", "10"])
+    assert "set by" not in normal
+    out = _ok(["run", str(pair), "--cycles", "10", "--json",
+               "--set", "meshes.m.stiffness='4e10 N/m'"])
+    data = json.loads(out[out.index("{"):])  # after the plausibility warning (stderr)
+    assert data["statistics"]["step_limited_by"].startswith("the highest mode")

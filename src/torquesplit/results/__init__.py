@@ -190,6 +190,7 @@ class Results:
             "method": s.method, "status": s.status, "message": s.message,
             "steps": s.n_steps, "rejected_steps": s.n_rejected, "rhs_evaluations": s.n_rhs,
             "step_s": s.step, "step_min_s": s.step_min, "step_max_s": s.step_max,
+            "step_limited_by": s.step_limited_by,
             "simulated_time_s": s.t_final - s.t_span[0],
             "compile_time_s": s.compile_time, "wall_time_s": s.wall_time,
             "microseconds_per_step": 1e6 * s.wall_time / max(s.n_steps, 1),
