@@ -29,8 +29,10 @@ def test_the_last_result_is_kept_and_its_warnings_repeat():
     with pytest.warns(UserWarning, match="note 1"):
         assert work(a, 1) is first
     assert calls == [1]
-    work(a, 2)  # other arguments
-    work(b, 2)  # another object
+    with pytest.warns(UserWarning, match="note 2"):
+        work(a, 2)  # other arguments
+    with pytest.warns(UserWarning, match="note 2"):
+        work(b, 2)  # another object
     assert calls == [1, 2, 2]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
