@@ -1,10 +1,12 @@
-"""Remember the last result of a function of a frozen object.
+"""Remember the last result of a function for each live frozen object.
 
 Loading a model checks it through its kinematics, and the run set up next needs them
-again; a study case that runs until settled sets the same model up for each run length.
-:func:`remember_last` keeps the result for the last object (held by a weak reference, so
-nothing is kept alive) and replays the warnings the first call gave, so that every
-caller sees what an uncached call would have shown.
+again; a study case that runs until settled sets the same model up for each run length;
+a run's cost check and its integrator both plan the same RK4 step.
+:func:`remember_last` keeps, for each object still alive (held by a weak reference, so
+nothing is kept alive and an entry leaves with its object), the result of the last
+arguments it was called with, and replays the warnings the first call gave, so that
+every caller sees what an uncached call would have shown.
 """
 
 from __future__ import annotations
@@ -15,20 +17,26 @@ import weakref
 
 
 def remember_last(fn):
-    """Decorator: ``fn(obj, *args)`` computed once while ``obj`` (frozen) and ``args``
-    stay the same; its warnings are given again on every call."""
-    last: list = [None, None, None, None]  # weak ref, args, result, warnings
+    """Decorator: ``fn(obj, *args)`` computed once while ``obj`` (frozen) lives and
+    ``args`` stay the same; its warnings are given again on every call.  The table
+    (``id(obj) -> (weak ref, args, result, warnings)``) is ``wrapper.cache``."""
+    cache: dict = {}
 
     @functools.wraps(fn)
     def wrapper(obj, *args):
-        ref, key, result, said = last
-        if ref is None or ref() is not obj or key != args:
+        key = id(obj)
+        ref, last_args, result, said = cache.get(key, (None, None, None, None))
+        alive = ref is not None and ref() is obj
+        if not alive or last_args != args:
             with warnings.catch_warnings(record=True) as said:
                 warnings.simplefilter("always")
                 result = fn(obj, *args)
-            last[:] = [weakref.ref(obj), args, result, said]
+            if not alive:
+                weakref.finalize(obj, cache.pop, key, None)
+            cache[key] = (weakref.ref(obj), args, result, said)
         for w in said:
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
         return result
 
+    wrapper.cache = cache
     return wrapper

@@ -153,8 +153,8 @@ class PreparedRun:
 
 @remember_last
 def _set_up(model):
-    """Kinematics, structure and static equilibrium of a model (kept for the last model:
-    a study case run until settled sets the same model up for each run length)."""
+    """Kinematics, structure and static equilibrium of a model (kept while the model
+    lives: a study case run until settled sets the same model up for each run length)."""
     from .assembly.assemble import assemble
     from .solve.static import static_equilibrium
 

@@ -170,8 +170,8 @@ def gear_mass_properties(gear: Gear) -> tuple[float, float, bool, bool]:
 def solve_kinematics(model: Model) -> Kinematics:
     """Layout, speeds, power flow, torques and forces of the nominal equal split.
 
-    The result for the last model is kept (models and kinematics are frozen): loading a
-    model checks it through its kinematics, and the run set up next needs them again."""
+    The result is kept while the model lives (models and kinematics are frozen): loading
+    a model checks it through its kinematics, and the run set up next needs them again."""
     return _solve_kinematics(model)
 
 

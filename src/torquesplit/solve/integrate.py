@@ -23,12 +23,12 @@ import logging
 import math
 import time
 import warnings
-import weakref
 from dataclasses import dataclass
 from typing import Callable, Sequence
 
 import numpy as np
 
+from torquesplit._memo import remember_last
 from torquesplit.assembly.structure import Structure
 from torquesplit.errors import ModelWarning, SolverError
 from torquesplit.solve import _kernels as kern
@@ -694,25 +694,16 @@ class _Plan:
     limited_by: str = ""  # rk4: what set the step
 
 
-_STEPS: dict = {}
-"""id(structure) -> (weak reference, arguments, result) of :func:`_default_step`, for the
-structures alive (an entry leaves with its structure)."""
-
-
+@remember_last
 def _default_step(s: Structure, span: float, spp: int, check: bool):
     """Default RK4 step: (h, what limited it, steps per excitation period).
 
     Kept per live structure (a Structure is frozen): a run's set-up estimates its cost
     with it and the integrator plans with it, and each costs two eigenvalue problems."""
-    key = id(s)
-    ref, args, result = _STEPS.get(key, (None, None, None))
-    if ref is not None and ref() is s and args == (span, spp, check):
-        return result
-    result = _step_for(s, span, spp, check)
-    if ref is None or ref() is not s:
-        weakref.finalize(s, _STEPS.pop, key, None)
-    _STEPS[key] = (weakref.ref(s), (span, spp, check), result)
-    return result
+    return _step_for(s, span, spp, check)
+
+
+_STEPS = _default_step.cache  # id(structure) -> its last step (entries leave with it)
 
 
 def _step_for(s: Structure, span: float, spp: int, check: bool):

@@ -43,21 +43,26 @@ def rk4_amplification(z):
     return 1.0 + z * (1.0 + z * (0.5 + z * (1.0 / 6.0 + z / 24.0)))
 
 
+def _system_matrix(structure: Structure) -> tuple[np.ndarray, np.ndarray]:
+    """``A`` of the module docstring (maximum stiffness, gaps closed) and ``k_max``."""
+    n = structure.n_dof
+    k_max = structure.stiffness_table.max(axis=1) if structure.n_table else np.zeros(0)
+    A = np.zeros((2 * n, 2 * n))
+    A[:n, n:] = np.eye(n)
+    A[n:, :n] = -structure.inv_mass[:, None] * structure.stiffness_matrix(k_max)
+    A[n:, n:] = -structure.inv_mass[:, None] * (structure.damping_matrix()
+                                                + structure.gyroscopic_matrix())
+    return A, k_max
+
+
 def system_eigenvalues(structure: Structure) -> np.ndarray:
     """Eigenvalues of the first-order system at maximum stiffness, all gaps closed [1/s].
 
     Round-off positive real parts (below 1e-8 max|lambda|) are set to zero.
     """
-    n = structure.n_dof
-    if n == 0:
+    if structure.n_dof == 0:
         return np.zeros(0, dtype=complex)
-    k_max = structure.stiffness_table.max(axis=1) if structure.n_table else np.zeros(0)
-    K = structure.stiffness_matrix(k_max)
-    C = structure.damping_matrix()
-    A = np.zeros((2 * n, 2 * n))
-    A[:n, n:] = np.eye(n)
-    A[n:, :n] = -structure.inv_mass[:, None] * K
-    A[n:, n:] = -structure.inv_mass[:, None] * (C + structure.gyroscopic_matrix())
+    A, _ = _system_matrix(structure)
     lam = np.linalg.eigvals(A)
     scale = np.max(np.abs(lam)) if lam.size else 0.0
     tiny = (lam.real > 0) & (lam.real <= _REAL_TOL * scale)
@@ -97,18 +102,13 @@ def stability_cause(structure: Structure) -> str:
     n = structure.n_dof
     if n == 0:
         return ""
-    k_max = structure.stiffness_table.max(axis=1) if structure.n_table else np.zeros(0)
+    A, k_max = _system_matrix(structure)
     c = structure.element_damping()
-    A = np.zeros((2 * n, 2 * n))
-    A[:n, n:] = np.eye(n)
-    A[n:, :n] = -structure.inv_mass[:, None] * structure.stiffness_matrix(k_max)
-    A[n:, n:] = -structure.inv_mass[:, None] * (structure.damping_matrix()
-                                                + structure.gyroscopic_matrix())
     lam, vec = np.linalg.eig(A)
-    size = np.abs(lam)
-    limiting = (lam.real <= _REAL_TOL * size.max()) & (size > 0.0)  # as _limiting
+    limiting = _limiting_mask(lam)
     if not limiting.any() or not k_max.size:
         return ""
+    size = np.abs(lam)
     i = int(np.argmax(np.where(limiting, size, -1.0)))
     phi = vec[:n, i]
     share = np.abs(k_max + lam[i] * c) * np.abs(structure.projection_matrix() @ phi) ** 2
@@ -126,10 +126,15 @@ def stability_cause(structure: Structure) -> str:
     return what
 
 
-def _limiting(lam: np.ndarray) -> np.ndarray:
-    """Eigenvalues that can limit the step (physically decaying or oscillating)."""
+def _limiting_mask(lam: np.ndarray) -> np.ndarray:
+    """Which eigenvalues can limit the step (physically decaying or oscillating)."""
     scale = np.max(np.abs(lam)) if lam.size else 0.0
-    return lam[(lam.real <= _REAL_TOL * scale) & (np.abs(lam) > 0.0)]
+    return (lam.real <= _REAL_TOL * scale) & (np.abs(lam) > 0.0)
+
+
+def _limiting(lam: np.ndarray) -> np.ndarray:
+    """The eigenvalues of :func:`_limiting_mask`."""
+    return lam[_limiting_mask(lam)]
 
 
 def _is_stable(h: float, lam: np.ndarray) -> bool:

@@ -168,11 +168,18 @@ def regularisation(delta, half_gap, stiffness, reg: float):
     g = np.asarray(half_gap, dtype=float)
     d = np.asarray(delta, dtype=float)
     a = np.abs(d)
-    gapped = g > 0
-    rk = np.where(gapped, reg * np.asarray(stiffness, dtype=float), 0.0)
+    rk, force = regularisation_force(d, g, stiffness, reg)
     inside = np.minimum(a, g)
-    return (rk * np.clip(d, -g, g), np.where(a <= g, rk, 0.0),
+    return (force, np.where(a <= g, rk, 0.0),
             rk * (0.5 * inside * inside + g * np.maximum(a - g, 0.0)))
+
+
+def regularisation_force(delta, half_gap, stiffness, reg: float):
+    """The spring ``reg x k`` of :func:`regularisation` and its force alone (what the
+    line search needs)."""
+    g = np.asarray(half_gap, dtype=float)
+    rk = np.where(g > 0, reg * np.asarray(stiffness, dtype=float), 0.0)
+    return rk, rk * np.clip(np.asarray(delta, dtype=float), -g, g)
 
 
 @dataclass
@@ -283,8 +290,7 @@ class _StaticProblem:
         k, g = L.k, L.g
         h, dh, u = (np.empty_like(delta) for _ in range(3))
         laws.dead_zones(delta, np.asarray(g, dtype=float), h, dh, u)
-        rk = np.where(g > 0, reg * k, 0.0)  # the force of :func:`regularisation`
-        f = k * h + rk * np.clip(delta, -g, g)
+        f = k * h + regularisation_force(delta, g, k, reg)[1]
         if self.s.n_splines:
             f[self.sp_x], f[self.sp_y] = self._splines(delta, reg, tangent=False)
         return f
