@@ -79,6 +79,21 @@ def test_lti_harmonic_balance_equals_the_analytic_frequency_response():
         assert np.max(np.abs(u[2 * k - 1:2 * k + 1])) <= 1e-12 * np.max(np.abs(q0))
 
 
+def test_matrix_free_shooting_reaches_the_monodromy_s_state():
+    """Newton-Krylov shooting (finite-difference products of the period map, GMRES) and
+    Newton with the formed monodromy reach the same periodic state; on this linear case
+    GMRES needs at most the 4 state dimensions per Newton step, and a second step removes
+    what the differences' rounding left (the formed monodromy needs one)."""
+    p = PeriodicProblem(_lti(), F0)
+    y0 = np.array([1e-3, -2e-3, 0.1, 0.0])
+    y_d, Phi, info_d = solve_shooting(p, y0, 800, krylov=False)
+    y_k, none, info_k = solve_shooting(p, y0, 800, krylov=True)
+    assert info_d.converged and info_k.converged and none is None and Phi is not None
+    assert info_d.iterations == 1 and info_d.products == 0
+    assert info_k.iterations <= 2 and 0 < info_k.products <= 4 * info_k.iterations
+    assert np.max(np.abs(y_k - y_d)) <= 1e-8 * np.max(np.abs(y_d))
+
+
 def test_shooting_and_floquet_of_the_lti_case():
     s = _lti()
     p = PeriodicProblem(s, F0)

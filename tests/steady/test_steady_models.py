@@ -87,10 +87,28 @@ def test_harmonics_short_of_convergence_are_said():
     from torquesplit.errors import ModelWarning
 
     with pytest.warns(ModelWarning, match="harmonic balance stopped at .*--method shooting"):
-        steady_state(example_path(EXAMPLE), stability=False, check=False)
+        steady_state(example_path(EXAMPLE), method="hb", stability=False, check=False)
     with warnings.catch_warnings():
         warnings.simplefilter("error", ModelWarning)
         steady_state(example_path(EXAMPLE), keep="stage1", stability=False, check=False)
+
+
+def test_a_long_period_is_shot_matrix_free():
+    """Ji & Li's full period holds 168 stage-1 mesh cycles: the default method shoots,
+    Newton-Krylov (a few products of the period map, no monodromy), and the state it
+    returns is periodic when integrated again, independently of the solver's check."""
+    st = steady_state(example_path(EXAMPLE), stability=False, check=False)
+    ps = st.solution
+    assert ps.method == "shooting" and ps.converged and "168 cycles" in ps.message
+    assert "matrix-free" in ps.message
+    p = st.problem
+    y0 = np.concatenate([ps.q[0], ps.v[0]])
+    steps = ps.t.size
+    yT = p.integrate(y0, 0.0, ps.period, steps, every=steps, max_rows=1)[3]
+    V = st.structure.projection_matrix()
+    drift = np.max(np.abs(V @ (yT - y0)[:p.n])) / np.max(np.abs(V @ y0[:p.n]))
+    assert drift <= 1e-9
+    assert all(1.07 < r.dynamic_factor < 1.09 for r in st.mesh_table())
 
 
 def test_long_period_is_refused_with_the_fix():

@@ -204,6 +204,8 @@ def _var_stage(slot, iy, idy, m, w, rhs_fn, gen, extra, Pin, Pout, force, kd, cr
     """One stage of the state (row idy of w.Y) and of its variations:
     Pout[:, c] = A(t, y) Pin[:, c] for every column c (first-order form)."""
     _stage(slot, iy, idy, F_MAIN, m, w, rhs_fn, gen, extra)
+    if Pin.shape[1] == 0:  # the state alone
+        return
     _linearise(slot, iy, m, w, force, kd, cr, spt, frv, fps)
     n = m.inv_mass.shape[0]
     for c in range(Pin.shape[1]):

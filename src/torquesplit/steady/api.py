@@ -154,7 +154,7 @@ class SteadyState:
         return out
 
 
-def steady_state(model, *, method: str = "hb", harmonics: int | None = None,
+def steady_state(model, *, method: str = "auto", harmonics: int | None = None,
                  samples: int | None = None, keep=None, speed: float | None = None,
                  max_cycles: int | None = MAX_CYCLES, stability: bool | str = True,
                  adaptive: bool | None = None, energy_tol: float = ENERGY_TOL,
@@ -165,9 +165,12 @@ def steady_state(model, *, method: str = "hb", harmonics: int | None = None,
     Parameters
     ----------
     model : Model, str or Path
-    method : {"hb", "shooting"}
-        Harmonic balance with alternating frequency-time evaluation (default), or
-        shooting (Newton on the period map; robust for contact loss and impacts).
+    method : {"auto", "hb", "shooting"}
+        Harmonic balance with alternating frequency-time evaluation, or shooting (Newton
+        on the period map; robust for contact loss and impacts; matrix-free on long
+        periods).  ``"auto"`` (default): harmonic balance unless the period holds 8 or
+        more cycles of the fastest excitation (then shooting, faster and closer to the
+        step-converged peaks there), or ``harmonics`` or Hill's stability is asked for.
     harmonics : int, optional
         HB harmonics of the fundamental frequency.  Default: 8 per cycle of the fastest
         excitation to start with, raised (``adaptive``) until the highest quarter of the

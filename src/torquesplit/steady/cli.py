@@ -60,7 +60,9 @@ def register(app, load, fail, console, err_console, json_default):
     @app.command()
     def steady(
         model: str = typer.Argument(..., help="Model file (.toml/.json) or example name."),
-        method: str = typer.Option("hb", "--method", help="hb (harmonic balance) or shooting."),
+        method: str = typer.Option(
+            "auto", "--method", help="hb (harmonic balance), shooting, or auto: hb unless the "
+            "period holds 8 or more cycles of the fastest excitation."),
         harmonics: Optional[int] = typer.Option(
             None, "--harmonics", help="HB harmonics of the fundamental (default: 8 per cycle "
             "of the fastest excitation, doubled until converged)."),
@@ -79,8 +81,9 @@ def register(app, load, fail, console, err_console, json_default):
     ):
         """Periodic steady state at one speed: per-mesh table, residual, harmonics, stability."""
         try:
-            if method not in ("hb", "shooting"):
-                raise TorquesplitError(f"--method {method!r} is unknown; use hb or shooting")
+            if method not in ("auto", "hb", "shooting"):
+                raise TorquesplitError(f"--method {method!r} is unknown; use auto, hb or "
+                                       "shooting")
             from torquesplit.steady.api import steady_state
 
             _check_out(out)
@@ -123,9 +126,9 @@ def register(app, load, fail, console, err_console, json_default):
             console.print(
                 f"residual {ps.residual:.2e}, time-domain: midpoint residual "
                 f"{ps.time_residual:.2e}, one-period integration defect "
-                f"{ps.periodicity_defect:.2e}; harmonics {ps.harmonics}"
-                + (f" (top-quarter energy {ps.top_harmonic_energy:.1e})"
-                   if ps.harmonics else ""))
+                f"{ps.periodicity_defect:.2e}"
+                + (f"; harmonics {ps.harmonics} (top-quarter energy "
+                   f"{ps.top_harmonic_energy:.1e})" if ps.harmonics else ""))
             if mu is not None:
                 console.print(f"stability ({ps.stability_method}): "
                               f"{'stable' if ps.stable else 'UNSTABLE'}, largest Floquet "

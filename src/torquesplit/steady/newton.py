@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from torquesplit.errors import SolverError
-from torquesplit.steady.harmonic import HarmonicBalance
+from torquesplit.steady.harmonic import HarmonicBalance, gmres
 from torquesplit.steady.problem import PeriodicProblem
 
 log = logging.getLogger(__name__)
@@ -39,6 +39,8 @@ class NewtonInfo:
     residual: float
     """Final relative residual."""
     history: list
+    products: int = 0
+    """Shooting, matrix-free: variational products Phi v taken (0: monodromy formed)."""
 
 
 def solve_hb(hb: HarmonicBalance, x0, speed=1.0, tol=1e-10, max_iter=25) -> tuple:
@@ -161,16 +163,41 @@ def _deformation_scale(p: PeriodicProblem, y):
     return V, max(float(np.max(np.abs(V @ y[:n]), initial=0.0)), 1e-300)
 
 
-def solve_shooting(p: PeriodicProblem, y0, steps: int, speed=1.0, tol=1e-9, max_iter=25):
-    """Newton on the period map: returns (y0, monodromy, NewtonInfo).
+KRYLOV_WORK = 200_000
+"""Above this many RK4 column-steps per monodromy (steps per period x columns), shooting
+solves its Newton steps matrix-free (:func:`solve_shooting`)."""
+KRYLOV_RTOL = 1e-4
+"""GMRES tolerance of a matrix-free Newton step (an inexact Newton step: the defect
+still has to fall below the shooting tolerance)."""
+
+
+def solve_shooting(p: PeriodicProblem, y0, steps: int, speed=1.0, tol=1e-9, max_iter=25,
+                   krylov: bool | None = None):
+    """Newton on the period map: returns (y0, monodromy or None, NewtonInfo).
 
     Converged when one period returns to the start within ``tol`` of the largest
-    element deformation (velocities: divided by omega)."""
+    element deformation (velocities: divided by omega).
+
+    ``krylov``: solve each Newton step (Phi - I) dy = -d by GMRES on the complement of
+    the rigid subspace with the products Phi v as finite differences of the period map
+    (Jacobian-free Newton-Krylov; Kelley, Solving Nonlinear Equations with Newton's
+    Method, SIAM 2003, sections 3.2 and 3.2.1), one state integration each, instead of
+    forming the monodromy (2n variational columns).  On a long period most multipliers are
+    tiny (every mode decays many times over it), so GMRES needs a few products; where it
+    has not converged after about the work of one monodromy, the step is taken with the
+    full monodromy, and so are the following.  Default: on when the monodromy would cost
+    more than ``KRYLOV_WORK`` column-steps.  The monodromy is returned only when it was
+    formed at the returned state (None otherwise)."""
     n = p.n
     T = 1.0 / (p.frequency * speed)
     w = 2 * math.pi / T
     R = rigid_subspace(p)
     Pr = np.eye(2 * n) - R @ R.T  # orthogonal projector on the complement
+    Q = complement(p)
+    m = Q.shape[1]
+    if krylov is None:
+        krylov = steps * 2 * n > KRYLOV_WORK
+    cap = min(m, max(4, (2 + 2 * n) // 3))  # products that cost about one monodromy
     y = np.array(y0, dtype=float)
     y = Pr @ y
     V, dscale = _deformation_scale(p, y)
@@ -178,8 +205,16 @@ def solve_shooting(p: PeriodicProblem, y0, steps: int, speed=1.0, tol=1e-9, max_
     Phi = None
     it = 0
     err = math.inf
+    products = [0]
+
+    def period_map(y):
+        return p.integrate(y, 0.0, T, steps, every=steps, speed=speed, max_rows=1)[3]
+
     while True:
-        yT, Phi = p.integrate_variational(y, 0.0, T, steps, speed)
+        if krylov:
+            yT = period_map(y)
+        else:
+            yT, Phi = p.integrate_variational(y, 0.0, T, steps, speed)
         d = Pr @ (yT - y)
         dscale = max(float(np.max(np.abs(V @ y[:n]), initial=0.0)),
                      float(np.max(np.abs(V @ yT[:n]), initial=0.0)), 1e-300)
@@ -190,11 +225,35 @@ def solve_shooting(p: PeriodicProblem, y0, steps: int, speed=1.0, tol=1e-9, max_
         if err <= tol or it >= max_iter:
             break
         it += 1
-        A = np.vstack([Pr @ (Phi - np.eye(2 * n)), R.T])
-        b = -np.concatenate([d, R.T @ y])
-        dy = np.linalg.lstsq(A, b, rcond=None)[0]
+        dy = None
+        if krylov:
+            # forcing term: aim at the tolerance in one step (Kelley 2003, eq. 3.6 ff.)
+            rtol = min(KRYLOV_RTOL, max(0.1 * tol / err, 1e-10))
+            size = float(np.linalg.norm(y))
+
+            def product(z, y=y, yT=yT, size=size):
+                products[0] += 1
+                # Kelley 2003, eq. 3.8 with the map's relative error: rounding over the
+                # steps of one period, at worst eps per step (sqrt(eps) alone leaves
+                # the differences in the rounding noise of a long period)
+                step = math.sqrt(np.finfo(float).eps * steps) * max(size, 1e-30) / max(
+                    float(np.linalg.norm(z)), 1e-300)
+                return Q.T @ (period_map(y + step * (Q @ z)) - yT) / step - z
+
+            dz, res = gmres(product, -(Q.T @ d), lambda v: v, rtol, cap)
+            if res <= max(rtol, KRYLOV_RTOL):
+                dy = Q @ dz
+            else:
+                log.info("Newton-Krylov shooting: GMRES at %.1e after %d products; the "
+                         "full monodromy from here on", res, cap)
+                krylov = False
+                _, Phi = p.integrate_variational(y, 0.0, T, steps, speed)
+        if dy is None:
+            A = np.vstack([Pr @ (Phi - np.eye(2 * n)), R.T])
+            b = -np.concatenate([d, R.T @ y])
+            dy = np.linalg.lstsq(A, b, rcond=None)[0]
         y = y + dy
         if not np.all(np.isfinite(y)):
             raise SolverError("the shooting iteration diverged; start from a better guess "
                               "(the harmonic-balance solution or a converged neighbour).")
-    return y, Phi, NewtonInfo(err <= tol, it, err, hist)
+    return y, (None if krylov else Phi), NewtonInfo(err <= tol, it, err, hist, products[0])

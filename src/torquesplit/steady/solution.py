@@ -40,6 +40,12 @@ shooting (at 32 harmonics); 1e-7 brings them within 4e-4 and Ji & Li's within 6e
 (benchmarks/STEADY_RESULTS.md)."""
 HILL_LIMIT = 800
 """Largest Hill matrix (complex, square) for Hill's method; larger: the monodromy."""
+AUTO_SHOOTING_CYCLES = 8
+"""``method='auto'`` shoots when the period holds at least this many cycles of the
+fastest excitation, else it balances harmonics.  A long period needs harmonics in
+proportion to its cycles while shooting's Newton steps grow cheap (matrix-free: every mode
+decays over the period); on Ji & Li's full 168-cycle period shooting is the faster and the
+closer to the step-converged dynamic factors (benchmarks/STEADY_RESULTS.md)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -201,7 +207,7 @@ def converged_hb(p, H, samples, speed, q_static, initial, tol, *, adaptive=True,
         H *= 2**doublings
 
 
-def periodic_solution(structure, period: Period, *, method: str = "hb", harmonics=None,
+def periodic_solution(structure, period: Period, *, method: str = "auto", harmonics=None,
                       samples=None, speed: float = 1.0, q_static=None, initial=None,
                       tol: float | None = None, adaptive: bool = False,
                       energy_tol: float = ENERGY_TOL, max_harmonics: int = 2**15,
@@ -211,9 +217,9 @@ def periodic_solution(structure, period: Period, *, method: str = "hb", harmonic
     """Periodic steady state of ``structure`` over ``period`` (see :func:`steady_state`
     for the parameters).  ``q_static`` starts the iteration (HB: as the mean)."""
     t_start = time.perf_counter()
-    if method not in ("hb", "shooting"):
-        raise SolverError(f"unknown method {method!r}; use method='hb' (harmonic balance) "
-                          "or method='shooting'.")
+    if method not in ("auto", "hb", "shooting"):
+        raise SolverError(f"unknown method {method!r}; use method='hb' (harmonic balance), "
+                          "method='shooting' or method='auto' (chosen by the period).")
     if period.frequency <= 0:
         raise SolverError("the structure has no time-varying excitation, so its steady state "
                           "is the static equilibrium; use static_equilibrium instead.")
@@ -222,6 +228,13 @@ def periodic_solution(structure, period: Period, *, method: str = "hb", harmonic
     f = period.frequency * speed
     T = 1.0 / f
     steps = p.rk4_steps(T, steps_per_cycle, order)
+    chosen = ""
+    if method == "auto":
+        method = ("hb" if harmonics is not None or stability == "hill"
+                  or order < AUTO_SHOOTING_CYCLES else "shooting")
+        if method == "shooting":
+            chosen = (f" (chosen: the period holds {order} cycles of the fastest "
+                      f"excitation)")
     multipliers = None
     stab_method = ""
     if method == "hb":
@@ -269,8 +282,10 @@ def periodic_solution(structure, period: Period, *, method: str = "hb", harmonic
         else:
             y0 = np.concatenate([q_static if q_static is not None else np.zeros(p.n),
                                  np.zeros(p.n)])
-            # a few periods of transient first: closer to the attracting orbit
-            _, _, _, y0 = p.integrate(y0, 0.0, 5 * T, 5 * steps, every=5 * steps, speed=speed)
+            # some transient first: closer to the attracting orbit (a few periods; one
+            # where the period holds many cycles, as long as several short ones)
+            k = 5 if order < 8 else 1
+            _, _, _, y0 = p.integrate(y0, 0.0, k * T, k * steps, every=k * steps, speed=speed)
         y0, Phi, info = solve_shooting(p, y0, steps, speed, tol)
         tt, Y, F, _ = p.integrate(y0, 0.0, T, steps, 1, speed)
         t, q, v = tt[:-1], Y[:-1, :p.n], Y[:-1, p.n:]
@@ -282,11 +297,15 @@ def periodic_solution(structure, period: Period, *, method: str = "hb", harmonic
         H = None
         lam = np.zeros(p.nr)
         if stability:
+            if Phi is None:  # matrix-free Newton: the monodromy at the solution
+                _, Phi = p.integrate_variational(y0, 0.0, T, steps, speed)
             multipliers = floquet_monodromy(p, Phi)
             stab_method = "monodromy"
         msg = (f"shooting, {steps} RK4 steps per period of {T:.6g} s: "
                + ("converged" if info.converged else "did NOT converge")
-               + f" in {info.iterations} Newton steps (defect {info.residual:.2e})")
+               + f" in {info.iterations} Newton steps (defect {info.residual:.2e}"
+               + (f", {info.products} matrix-free monodromy products)" if info.products
+                  else ")") + chosen)
         coeffs = None
     return PeriodicSolution(
         method=method, converged=info.converged, message=msg, speed=float(speed),
