@@ -116,6 +116,18 @@ def test_long_period_is_refused_with_the_fix():
         steady_state(example_path(EXAMPLE), max_cycles=100)
 
 
+def test_shooting_accepts_longer_periods_than_harmonic_balance():
+    """Liu et al. 2021 repeats after 3638 cycles of its fastest mesh: too long for
+    harmonic balance by default (refused before any solve, with the fix), within
+    shooting's default limit (its solve is benchmarked, not run here)."""
+    from torquesplit.steady.period import default_max_cycles
+
+    with pytest.raises(LongPeriodError, match=r"3638 cycles.*keep=.*max_cycles=3638"):
+        steady_state(example_path("liu2021_split_torque_helicopter"), method="hb")
+    assert default_max_cycles("hb") < 3638 < default_max_cycles("auto")
+    assert default_max_cycles("shooting") == default_max_cycles("auto")
+
+
 def test_campbell_crossings_at_hand_computed_speeds():
     """Two-stage drive: stage 1 meshes z1 (motor shaft) at f = z1 n1, so a mode at f_n
     is crossed by harmonic h of that mesh at n1 = f_n / (h z1) rev/s."""

@@ -17,8 +17,8 @@ import numpy as np
 
 from torquesplit.errors import SolverError
 from torquesplit.steady.period import (
-    MAX_CYCLES,
     base_frequency,
+    default_max_cycles,
     fundamental_period,
     keep_excitations,
 )
@@ -156,7 +156,7 @@ class SteadyState:
 
 def steady_state(model, *, method: str = "auto", harmonics: int | None = None,
                  samples: int | None = None, keep=None, speed: float | None = None,
-                 max_cycles: int | None = MAX_CYCLES, stability: bool | str = True,
+                 max_cycles: int | None | str = "auto", stability: bool | str = True,
                  adaptive: bool | None = None, energy_tol: float = ENERGY_TOL,
                  tol: float | None = None, steps_per_cycle: int | None = None,
                  check: bool = True, initial=None) -> SteadyState:
@@ -188,6 +188,10 @@ def steady_state(model, *, method: str = "auto", harmonics: int | None = None,
         name, or a frequency in Hz); the others are replaced by their means and listed
         in ``SteadyState.dropped``.  Default: every excitation, over their least common
         period (refused when longer than ``max_cycles`` cycles of the fastest one).
+    max_cycles : int, None or "auto"
+        Longest period accepted, in cycles of the fastest excitation; None: no limit;
+        "auto" (default): 1000 for harmonic balance, 10,000 for shooting and "auto"
+        (:func:`~torquesplit.steady.period.default_max_cycles`).
     speed : float, optional
         Input speed of the first drive [rad/s] (default the model's).  Torques are kept
         (a speed change at constant load); excitation tables are functions of the mesh
@@ -220,6 +224,8 @@ def steady_state(model, *, method: str = "auto", harmonics: int | None = None,
     structure = full
     if keep is not None:
         structure, dropped = keep_excitations(full, base_frequency(full, keep, kin))
+    if max_cycles == "auto":
+        max_cycles = default_max_cycles(method)
     per = fundamental_period(structure, max_cycles=max_cycles)
     if keep is not None:
         base = base_frequency(full, keep, kin)

@@ -74,8 +74,9 @@ def register(app, load, fail, console, err_console, json_default):
             "body or frequency [Hz]; the others by their means."),
         speed: Optional[str] = typer.Option(None, "--speed",
                                             help="Input speed, e.g. '1200 rpm' (default the model's)."),
-        max_cycles: int = typer.Option(1000, "--max-cycles",
-                                       help="Longest period accepted, in cycles of the fastest excitation."),
+        max_cycles: Optional[int] = typer.Option(
+            None, "--max-cycles", help="Longest period accepted, in cycles of the fastest "
+            "excitation (default 1000 for hb, 10000 for shooting and auto)."),
         out: Optional[Path] = typer.Option(None, "--out", help="Write results (.nc, .mat, .csv)."),
         as_json: bool = typer.Option(False, "--json", help="Print the results as JSON."),
     ):
@@ -93,7 +94,7 @@ def register(app, load, fail, console, err_console, json_default):
             with collect_warnings(), progress("periodic steady state", as_json, total=None):
                 st = steady_state(m, method=method, harmonics=harmonics, adaptive=adaptive,
                                   keep=_keep(keep), speed=_speed(speed, "--speed"),
-                                  max_cycles=max_cycles)
+                                  max_cycles="auto" if max_cycles is None else max_cycles)
             rows = st.mesh_table()
             saved = st.to_results().save(out) if out is not None else None
         except (TorquesplitError, ValueError, OSError) as exc:

@@ -28,7 +28,7 @@ from torquesplit.assembly.structure import Structure
 from torquesplit.errors import LongPeriodError, PeriodError, SolverError  # noqa: F401 - re-exported
 
 __all__ = ["ExcitationSource", "Period", "PeriodError", "LongPeriodError",
-           "excitation_sources", "fundamental_period", "keep_excitations", "scale_speed",
+           "default_max_cycles", "excitation_sources", "fundamental_period", "keep_excitations", "scale_speed",
            "base_frequency"]
 
 MAX_DENOMINATOR = 10**6
@@ -37,7 +37,18 @@ of real trains are far below)."""
 RTOL = 1e-9
 """Relative mismatch below which a frequency ratio equals its rational approximation."""
 MAX_CYCLES = 1000
-"""Default largest number of cycles of the fastest excitation in one period."""
+"""Default largest number of cycles of the fastest excitation in one period (harmonic
+balance: its harmonics grow with the cycles)."""
+MAX_CYCLES_SHOOTING = 10_000
+"""The same for shooting (its cost grows with the RK4 steps of one period: on a 2-core
+machine Liu et al. 2021's full period, 3638 cycles, takes about 10 s, Jin et al. 2019's,
+7252 cycles with tooth friction, about 20 s)."""
+
+
+def default_max_cycles(method: str) -> int:
+    """The longest period accepted by default for ``method`` ('hb', 'shooting' or 'auto',
+    which shoots on long periods)."""
+    return MAX_CYCLES if method == "hb" else MAX_CYCLES_SHOOTING
 
 
 @dataclass(frozen=True)
