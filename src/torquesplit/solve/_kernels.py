@@ -453,7 +453,7 @@ def record_extrema(slot, i_f, w, r):
 
 
 @_kernel
-def first_corners(t, m, w, r):
+def first_corners(t, m, w):
     """Set ``w.next_node`` of every element with corners to its first corner node after
     time t (absolute node: cycle x n_table + node); returns the earliest corner time."""
     n_tab = m.stiffness_table.shape[1]
@@ -476,11 +476,11 @@ def first_corners(t, m, w, r):
                 base += n_tab
             node = base + corner_node[k]
         next_node[e] = node
-    return next_corner_time(m, w, r)
+    return next_corner_time(m, w)
 
 
 @_kernel
-def next_corner_time(m, w, r):
+def next_corner_time(m, w):
     """Earliest time of the elements' next corners (``w.next_node``); inf if none."""
     n_tab = m.stiffness_table.shape[1]
     corner_ptr, next_node = m.corner_ptr, w.next_node
@@ -568,7 +568,7 @@ def corner_events(t_a, t_b, ya, fa, yb, fb, m, w, r, rhs_fn, gen, counters):
                 record_extrema(slot, np.int64(F_TMP), w, r)
                 counters[I_EVENTS] += 1
             next_node[e] = _following_corner(node, c0, c1, n_tab, corner_node)
-    return next_corner_time(m, w, r)
+    return next_corner_time(m, w)
 
 
 @_kernel
@@ -708,7 +708,7 @@ def rk4_run(t0, h, n_first, n_steps, record_final, record_every, blowup, m, w, r
     s_half = np.int64(1)  # slot of t + h/2
     t_corner = math.inf  # earliest corner still ahead
     if m.corner_node.shape[0] > 0 and n_steps > 0:
-        t_corner = first_corners(t0 + n_first * h, m, w, r)
+        t_corner = first_corners(t0 + n_first * h, m, w)
     # the next step indices that are multiples of RESYNC and of record_every (counted, not
     # found by an integer division per step)
     next_sync = (n_first // RESYNC + 1) * RESYNC
@@ -802,7 +802,7 @@ def dopri_run(t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, blowup, dt
     extra = m.fr_el.shape[0] > 0 or m.sp_el.shape[0] > 0
     t_corner = math.inf  # earliest corner still to be sampled
     if m.corner_node.shape[0] > 0:
-        t_corner = first_corners(clock[F_T], m, w, r)
+        t_corner = first_corners(clock[F_T], m, w)
     kf = Y_KFSAL
     k2 = kf + 1
     k3 = kf + 2

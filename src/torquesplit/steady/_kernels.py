@@ -19,8 +19,9 @@ kernel                 what it computes
                        directions (the Jacobian of harmonic balance, matrix-free)
 :func:`rk4_variational`  classic RK4 of the state together with its variational
                        equations dPhi/dt = A(t, y) Phi (the monodromy for shooting
-                       and Floquet multipliers); the state steps are those of
-                       ``_kernels.rk4_run`` with exact excitation at every stage
+                       and Floquet multipliers), exact excitation at every stage
+:func:`rk4_samples`    RK4 of the state alone, stepping through the tables' corners as
+                       ``_kernels.rk4_run`` does, with samples and corner instants
 =====================  ==============================================================
 
 Twin: :func:`torquesplit.solve.reference.rhs_numpy` (tests compare the acceleration and
@@ -34,11 +35,19 @@ linearisation is ``KD[j, e]`` (df/dd), ``CR[j, e]`` (df/dr), ``SPT[j, k, 0:8]``
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numba import njit
 
 from torquesplit.solve import laws
-from torquesplit.solve._kernels import _stage, excite
+from torquesplit.solve._kernels import (
+    _rk4_step,
+    _stage,
+    advance_corners,
+    excite,
+    first_corners,
+)
 from torquesplit.solve.kernel_data import F_MAIN, Y_K1, Y_STATE, Y_TRIAL
 
 _kernel = njit(cache=True, error_model="numpy", _nrt=False)
@@ -276,30 +285,34 @@ def rk4_variational(t0, h, n_steps, m, w, rhs_fn, gen, Phi, S, force, kd, cr, sp
 
 
 @_kernel
-def rk4_samples(t0, h, n_steps, every, m, w, rhs_fn, gen, out_t, out_y, out_f):
-    """Classic RK4 (exact excitation at each stage) from state row Y_STATE over
-    ``n_steps``; every ``every`` steps (and at the start) the time, state and element
-    forces are stored in ``out_*`` while they have rows.  Returns the rows written, or
-    -1 if the state became non-finite."""
+def rk4_samples(t0, h, n_steps, every, m, w, rhs_fn, gen, out_t, out_y, out_f, c_t, c_y,
+                c_f):
+    """Classic RK4 from state row Y_STATE over ``n_steps`` steps of ``h`` from ``t0``, as
+    ``_kernels.rk4_run`` steps: the excitation exact at each distinct stage time, and a
+    step that holds corners of the tables taken in sub-steps that end on them (so that no
+    step straddles a kink of the right-hand side, which would cost RK4 its order).
+    Every ``every`` steps (and at the start) the time, state and element forces are
+    stored in ``out_*`` while they have rows; the time, state and forces at every corner
+    in ``c_*`` while they have rows.  Returns (rows, corner rows), rows -1 if the state
+    became non-finite."""
     Y = w.Y
     n2 = Y.shape[1]
     ne = out_f.shape[1]
     extra = m.fr_el.shape[0] > 0 or m.sp_el.shape[0] > 0
-    s0 = np.int64(0)
-    s1 = np.int64(1)
-    s2 = np.int64(2)
-    k1 = Y_K1
-    k2 = Y_K1 + 1
-    k3 = Y_K1 + 2
-    k4 = Y_K1 + 3
-    hh = 0.5 * h
-    h6 = h / 6.0
+    minus = np.int64(-1)
+    s_half = np.int64(1)
+    a = np.int64(0)  # slot of the excitation at the current time
+    b = np.int64(2)
     row = 0
+    crow = 0
     WF = w.F
+    t_corner = math.inf
+    if m.corner_node.shape[0] > 0 and n_steps > 0:
+        t_corner = first_corners(t0, m, w)
+    excite(t0, a, minus, m, w)
     for it in range(n_steps + 1):
         t = t0 + it * h
-        excite(t, s0, np.int64(-1), m, w)
-        _stage(s0, Y_STATE, k1, F_MAIN, m, w, rhs_fn, gen, extra)
+        _stage(a, Y_STATE, Y_K1, F_MAIN, m, w, rhs_fn, gen, extra)
         if it % every == 0 and row < out_t.shape[0]:
             out_t[row] = t
             for k in range(n2):
@@ -309,19 +322,38 @@ def rk4_samples(t0, h, n_steps, every, m, w, rhs_fn, gen, out_t, out_y, out_f):
             row += 1
         if it == n_steps:
             break
-        excite(t + hh, s1, np.int64(-1), m, w)
+        tb = t0 + (it + 1) * h
+        if t_corner < tb:
+            ts = t
+            first = True
+            while True:
+                te = t_corner if t_corner < tb - 1e-6 * h else tb
+                if not first:  # at a corner: its forces, and k1 of the next sub-step
+                    _stage(a, Y_STATE, Y_K1, F_MAIN, m, w, rhs_fn, gen, extra)
+                    if crow < c_t.shape[0]:
+                        c_t[crow] = ts
+                        for k in range(n2):
+                            c_y[crow, k] = Y[Y_STATE, k]
+                        for e in range(ne):
+                            c_f[crow, e] = WF[F_MAIN, e]
+                        crow += 1
+                if te - ts > 1e-6 * h:
+                    _rk4_step(ts + 0.5 * (te - ts), te, te - ts, s_half, b, minus, minus, m,
+                              w, rhs_fn, gen, extra)
+                    a, b = b, a
+                    ts = te
+                    first = False
+                if te >= tb:
+                    break
+                t_corner = advance_corners(te, m, w)
+            if ts < tb:  # the last corner fell within 1e-6 h of tb
+                excite(tb, a, minus, m, w)
+            t_corner = advance_corners(tb, m, w)
+        else:
+            _rk4_step(t + 0.5 * h, tb, h, s_half, b, minus, minus, m, w, rhs_fn, gen,
+                      extra)
+            a, b = b, a
         for k in range(n2):
-            Y[Y_TRIAL, k] = Y[Y_STATE, k] + hh * Y[k1, k]
-        _stage(s1, Y_TRIAL, k2, np.int64(1), m, w, rhs_fn, gen, extra)
-        for k in range(n2):
-            Y[Y_TRIAL, k] = Y[Y_STATE, k] + hh * Y[k2, k]
-        _stage(s1, Y_TRIAL, k3, np.int64(1), m, w, rhs_fn, gen, extra)
-        excite(t0 + (it + 1) * h, s2, np.int64(-1), m, w)
-        for k in range(n2):
-            Y[Y_TRIAL, k] = Y[Y_STATE, k] + h * Y[k3, k]
-        _stage(s2, Y_TRIAL, k4, np.int64(1), m, w, rhs_fn, gen, extra)
-        for k in range(n2):
-            Y[Y_STATE, k] += h6 * (Y[k1, k] + 2.0 * (Y[k2, k] + Y[k3, k]) + Y[k4, k])
             if not np.isfinite(Y[Y_STATE, k]):
-                return -1
-    return row
+                return -1, crow
+    return row, crow

@@ -138,16 +138,21 @@ class SteadyState:
         met = res.metrics(definition)
         names = self.structure.element_names
         _, F, D = self.samples()
+        Fc = self.solution.corner_forces  # instants at table corners (shooting)
+        if Fc.shape[0] == 0:
+            Fc = np.zeros((0, F.shape[1]))
         out = []
         for r in met.rows:
             e = names.index(r.mesh)
             d = D[:, e]
+            peak = float(max(F[:, e].max(), Fc[:, e].max(initial=-np.inf)))
+            least = float(min(F[:, e].min(), Fc[:, e].min(initial=np.inf)))
             out.append(MeshSteady(
                 mesh=r.mesh, group=r.group, nominal_force=r.nominal_force,
                 static_force=r.static_force, mean_force=float(F[:, e].mean()),
-                min_force=float(F[:, e].min()), peak_force=float(F[:, e].max()),
-                dynamic_factor=float(F[:, e].max()) / r.static_force,
-                peak_to_nominal=float(F[:, e].max()) / r.nominal_force,
+                min_force=least, peak_force=peak,
+                dynamic_factor=peak / r.static_force,
+                peak_to_nominal=peak / r.nominal_force,
                 load_sharing=r.load_sharing,
                 rms_transmission_error=float(np.sqrt(np.mean((d - d.mean()) ** 2))),
                 contact_loss=r.contact_loss))
@@ -299,17 +304,29 @@ def _as_solution(st: SteadyState, shell, periods):
     N = len(t1)
     t = (t1[None, :] + T * np.arange(periods)[:, None]).ravel()
     F = np.tile(F1, (periods, 1))
+    # instants at table corners (shooting): in the per-cycle extremes, as the integrator's
+    # corner events, not in sums, counts or contact time
+    tc = (ps.corner_t[None, :] + T * np.arange(periods)[:, None]).ravel()
+    Fc = np.tile(ps.corner_forces, (periods, 1)) if tc.size else np.zeros((0, F.shape[1]))
     n_tr = len(track)
     cyc_n = []
     per_el = []
-    for e in track:
-        sph = s.frequency[e] * t + s.phase[e]
+    corner_idx = []
+
+    def cycle_of(e, times):
+        sph = s.frequency[e] * times + s.phase[e]
         fl = np.floor(sph)
-        c = fl + (sph - fl >= 1 - 1e-9)
+        return fl + (sph - fl >= 1 - 1e-9)
+
+    for e in track:
+        c = cycle_of(e, t)
         base = c[0]
         idx = (c - base).astype(np.int64)
         per_el.append((idx, base))
         cyc_n.append(int(idx.max()) + 1)
+        ic = (cycle_of(e, tc) - base).astype(np.int64)
+        keep = (ic >= 0) & (ic <= idx.max())
+        corner_idx.append((ic[keep], keep))
     nc = max(cyc_n) if cyc_n else 0
     cmax = np.full((nc, n_tr), np.nan)
     cmin = np.full((nc, n_tr), np.nan)
@@ -323,6 +340,9 @@ def _as_solution(st: SteadyState, shell, periods):
         mn = np.full(nc, np.inf)
         np.maximum.at(mx, idx, f)
         np.minimum.at(mn, idx, f)
+        ic, keep = corner_idx[j]
+        np.maximum.at(mx, ic, Fc[keep, e])
+        np.minimum.at(mn, ic, Fc[keep, e])
         sm = np.zeros(nc)
         np.add.at(sm, idx, f)
         cnt = np.bincount(idx, minlength=nc)
@@ -345,20 +365,26 @@ def _as_solution(st: SteadyState, shell, periods):
     for members in group_meshes(s.metadata["meshes"]).values():
         cols = [mesh_names.index(m) for m in members]
         groups.append(tuple(track[c] for c in cols))
-        x = F[:, [track[c] for c in cols]]
-        total = x.sum(axis=1, keepdims=True)
         from torquesplit.simulation import GROUP_MIN_LOAD
 
         least = GROUP_MIN_LOAD * sum(abs(st.kinematics.meshes[m].force) for m in members)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            ratio = len(cols) * x / np.where(total > least, total, np.nan)
+
+        def ratios(forces, least=least, cols=cols):
+            x = forces[:, [track[c] for c in cols]]
+            total = x.sum(axis=1, keepdims=True)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                return len(cols) * x / np.where(total > least, total, np.nan)
+
+        ratio, ratio_c = ratios(F), ratios(Fc)
         for i, c in enumerate(cols):
             idx, _ = per_el[c]
             mx = np.full(nc, -np.inf)
             mn = np.full(nc, np.inf)
-            ok_s = np.isfinite(ratio[:, i])
-            np.maximum.at(mx, idx[ok_s], ratio[ok_s, i])
-            np.minimum.at(mn, idx[ok_s], ratio[ok_s, i])
+            for ix, rt in ((idx, ratio[:, i]),
+                           (corner_idx[c][0], ratio_c[corner_idx[c][1], i])):
+                ok_s = np.isfinite(rt)
+                np.maximum.at(mx, ix[ok_s], rt[ok_s])
+                np.minimum.at(mn, ix[ok_s], rt[ok_s])
             ok = ccnt[:, c] > 0
             rmax[ok, c] = mx[ok]
             rmin[ok, c] = mn[ok]

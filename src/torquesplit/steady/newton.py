@@ -208,13 +208,15 @@ def solve_shooting(p: PeriodicProblem, y0, steps: int, speed=1.0, tol=1e-9, max_
     products = [0]
 
     def period_map(y):
+        # RK4 through the tables' corners, as the integrators step; the variational
+        # equations (the monodromy) step straight over them: their Newton steps are those
+        # of a Jacobian a step's kink error off, their fixed point the same
         return p.integrate(y, 0.0, T, steps, every=steps, speed=speed, max_rows=1)[3]
 
     while True:
-        if krylov:
-            yT = period_map(y)
-        else:
-            yT, Phi = p.integrate_variational(y, 0.0, T, steps, speed)
+        yT = period_map(y)
+        if not krylov:
+            Phi = p.integrate_variational(y, 0.0, T, steps, speed)[1]
         d = Pr @ (yT - y)
         dscale = max(float(np.max(np.abs(V @ y[:n]), initial=0.0)),
                      float(np.max(np.abs(V @ yT[:n]), initial=0.0)), 1e-300)

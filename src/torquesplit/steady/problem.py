@@ -131,6 +131,24 @@ class PeriodicProblem:
         A[n:, n:] = av
         return A
 
+    def corner_times(self, t0: float, t1: float, speed=1.0) -> np.ndarray:
+        """Sorted times in [t0, t1) where the excitation table of an element has a corner
+        (:func:`torquesplit.solve.kernel_data.corner_nodes`; mesh phase s = f t + phase,
+        node = frac(s) x table length), at ``speed`` times the model's speed."""
+        m = self.model
+        n_tab = m.stiffness_table.shape[1]
+        out = []
+        for e in np.asarray(m.tv_el):
+            nodes = np.asarray(m.corner_node[m.corner_ptr[e]:m.corner_ptr[e + 1]], float)
+            if nodes.size == 0:
+                continue
+            f = float(m.frequency[e]) * speed
+            ph = float(m.phase[e])
+            c = np.arange(math.floor(f * t0 + ph) - 1, math.ceil(f * t1 + ph) + 1)
+            tc = ((c[:, None] + nodes[None, :] / n_tab) - ph).ravel() / f
+            out.append(tc[(tc >= t0) & (tc < t1)])
+        return np.unique(np.concatenate(out)) if out else np.zeros(0)
+
     # ---------------------------------------------------------------- integration
     def integrate_variational(self, y0, t0, period, steps, speed=1.0, columns=None):
         """RK4 over one ``period`` in ``steps`` steps from ``y0`` at ``t0`` with the
@@ -154,21 +172,30 @@ class PeriodicProblem:
                               "diverges: start from a converged neighbour or check the model.")
         return w.Y[kd.Y_STATE].copy(), Phi
 
-    def integrate(self, y0, t0, duration, steps, every=1, speed=1.0, max_rows=None):
-        """Plain RK4 (exact excitation per stage) from ``y0``: returns (t, Y, F) every
-        ``every`` steps."""
+    def integrate(self, y0, t0, duration, steps, every=1, speed=1.0, max_rows=None,
+                  corners=False):
+        """RK4 (exact excitation per stage, stepping through the tables' corners) from
+        ``y0``: returns (t, Y, F, y_end) every ``every`` steps; with ``corners`` also
+        (t, Y, F) at the corner instants inside the steps."""
         rows = steps // every + 1 if max_rows is None else int(max_rows)
         out_t = np.empty(rows)
         out_y = np.empty((rows, 2 * self.n))
         out_f = np.empty((rows, self.ne))
+        nc = (self.corner_times(t0, t0 + duration, speed).size + 1) if corners else 0
+        c_t = np.empty(nc)
+        c_y = np.empty((nc, 2 * self.n))
+        c_f = np.empty((nc, self.ne))
         self.work.Y[kd.Y_STATE] = y0
-        got = sk.rk4_samples(float(t0), float(duration) / steps, int(steps), int(every),
-                             self.model_at(speed), self.work, self.code.function,
-                             self.code.generated, out_t, out_y, out_f)
+        got, n_c = sk.rk4_samples(float(t0), float(duration) / steps, int(steps), int(every),
+                                  self.model_at(speed), self.work, self.code.function,
+                                  self.code.generated, out_t, out_y, out_f, c_t, c_y, c_f)
         if got < 0:
             raise SolverError("the time integration diverged (non-finite state); use more "
                               "steps per period or check the model.")
-        return out_t[:got], out_y[:got], out_f[:got], self.work.Y[kd.Y_STATE].copy()
+        out = (out_t[:got], out_y[:got], out_f[:got], self.work.Y[kd.Y_STATE].copy())
+        if corners:
+            out += (c_t[:n_c], c_y[:n_c], c_f[:n_c])
+        return out
 
     def rk4_steps(self, period, steps_per_cycle=None, max_order=1):
         """RK4 steps for one period: ``steps_per_cycle`` per cycle of the fastest
