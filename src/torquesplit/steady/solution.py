@@ -270,15 +270,14 @@ def periodic_solution(structure, period: Period, *, method: str = "auto", harmon
                 multipliers = floquet_hill(hb, x, speed, None if stability == "hill" else H)
                 stab_method = "hill"
         defect = math.nan
-        if check or (stability and multipliers is None):
-            y0 = np.concatenate([q[0], v[0]])
-            yT, Phi = p.integrate_variational(y0, 0.0, T, steps, speed,
-                                              columns=None if (stability and multipliers is None)
-                                              else np.zeros((2 * p.n, 0)))
+        y0 = np.concatenate([q[0], v[0]])
+        if check:  # one period as the integrators step it (through the tables' corners)
+            yT = p.integrate(y0, 0.0, T, steps, every=steps, speed=speed, max_rows=1)[3]
             defect = _defect(p, y0, yT)
-            if stability and multipliers is None:
-                multipliers = floquet_monodromy(p, Phi)
-                stab_method = "monodromy"
+        if stability and multipliers is None:
+            multipliers = floquet_monodromy(p, p.integrate_variational(y0, 0.0, T, steps,
+                                                                       speed)[1])
+            stab_method = "monodromy"
         msg = (f"harmonic balance, {H} harmonics of {f:.6g} Hz, {hb.N} samples: "
                + ("converged" if info.converged else "did NOT converge")
                + f" in {info.iterations} Newton steps (residual {info.residual:.2e})")
