@@ -172,10 +172,10 @@ def steady_state(model, *, method: str = "auto", harmonics: int | None = None,
     model : Model, str or Path
     method : {"auto", "hb", "shooting"}
         Harmonic balance with alternating frequency-time evaluation, or shooting (Newton
-        on the period map; robust for contact loss and impacts; matrix-free on long
-        periods).  ``"auto"`` (default): harmonic balance unless the period holds 8 or
-        more cycles of the fastest excitation (then shooting, faster and closer to the
-        step-converged peaks there), or ``harmonics`` or Hill's stability is asked for.
+        on the period map, stepping through the tables' corners; robust for contact loss
+        and impacts; matrix-free on long periods).  ``"auto"`` (default): shooting, the
+        faster and more accurate on every shipped example, unless ``harmonics`` or
+        Hill's stability is asked for (then harmonic balance).
     harmonics : int, optional
         HB harmonics of the fundamental frequency.  Default: 8 per cycle of the fastest
         excitation to start with, raised (``adaptive``) until the highest quarter of the

@@ -61,8 +61,8 @@ def register(app, load, fail, console, err_console, json_default):
     def steady(
         model: str = typer.Argument(..., help="Model file (.toml/.json) or example name."),
         method: str = typer.Option(
-            "auto", "--method", help="hb (harmonic balance), shooting, or auto: hb unless the "
-            "period holds 8 or more cycles of the fastest excitation."),
+            "auto", "--method", help="hb (harmonic balance), shooting, or auto: shooting unless "
+            "--harmonics is given."),
         harmonics: Optional[int] = typer.Option(
             None, "--harmonics", help="HB harmonics of the fundamental (default: 8 per cycle "
             "of the fastest excitation, doubled until converged)."),

@@ -55,6 +55,7 @@ class PeriodicProblem:
         c = np.einsum("ir,i,ir->r", phi, s.ground_damping, phi) if phi.size else np.zeros(0)
         self.rigid_damped = c > 1e-12 * max(float(np.max(s.ground_damping, initial=0.0)), 1e-300)
         self._models: dict[float, kd.KernelModel] = {}
+        self._stable_step: float | None = None
 
     @property
     def nr(self) -> int:
@@ -199,13 +200,19 @@ class PeriodicProblem:
 
     def rk4_steps(self, period, steps_per_cycle=None, max_order=1):
         """RK4 steps for one period: ``steps_per_cycle`` per cycle of the fastest
-        excitation (default 100, refined so that omega_max h <= 1 for the highest mode,
-        as the integrator's default)."""
-        from torquesplit.solve.stability import highest_mode
+        excitation (default 100), refined as the integrator's default step is: omega_max
+        h <= 1 for the highest mode, and h within the safe share of the RK4 stability
+        limit (a stiff damping such as a spline's friction sets it on Dong et al.
+        2021's drive)."""
+        from torquesplit.solve.stability import SAFETY, highest_mode, stable_step
 
         spc = 100 if steps_per_cycle is None else int(steps_per_cycle)
         n = spc * max(1, int(max_order))
         f_hi, _ = highest_mode(self.structure)
         if f_hi > 0:
             n = max(n, int(math.ceil(2 * math.pi * f_hi * period)))
+        if self._stable_step is None:
+            self._stable_step = stable_step(self.structure)
+        if self._stable_step < math.inf:
+            n = max(n, int(math.ceil(period / (SAFETY * self._stable_step))))
         return n

@@ -40,12 +40,12 @@ shooting (at 32 harmonics); 1e-7 brings them within 4e-4 and Ji & Li's within 6e
 (benchmarks/STEADY_RESULTS.md)."""
 HILL_LIMIT = 800
 """Largest Hill matrix (complex, square) for Hill's method; larger: the monodromy."""
-AUTO_SHOOTING_CYCLES = 8
-"""``method='auto'`` shoots when the period holds at least this many cycles of the
-fastest excitation, else it balances harmonics.  A long period needs harmonics in
-proportion to its cycles while shooting's Newton steps grow cheap (matrix-free: every mode
-decays over the period); on Ji & Li's full 168-cycle period shooting is the faster and the
-closer to the step-converged dynamic factors (benchmarks/STEADY_RESULTS.md)."""
+AUTO = "shooting unless harmonics or Hill's method are asked for"
+"""What ``method='auto'`` does.  Since shooting steps through the tables' corners it is
+the faster and the more accurate of the two on every shipped example (closer to long
+time integration by one to three orders; benchmarks/STEADY_RESULTS.md), short periods
+included; harmonic balance stays for a number of harmonics asked for, Hill's stability
+and the speed continuation."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -227,7 +227,7 @@ def periodic_solution(structure, period: Period, *, method: str = "auto", harmon
     t_start = time.perf_counter()
     if method not in ("auto", "hb", "shooting"):
         raise SolverError(f"unknown method {method!r}; use method='hb' (harmonic balance), "
-                          "method='shooting' or method='auto' (chosen by the period).")
+                          "method='shooting' or method='auto' (shooting unless harmonics are given).")
     if period.frequency <= 0:
         raise SolverError("the structure has no time-varying excitation, so its steady state "
                           "is the static equilibrium; use static_equilibrium instead.")
@@ -236,13 +236,8 @@ def periodic_solution(structure, period: Period, *, method: str = "auto", harmon
     f = period.frequency * speed
     T = 1.0 / f
     steps = p.rk4_steps(T, steps_per_cycle, order)
-    chosen = ""
-    if method == "auto":
-        method = ("hb" if harmonics is not None or stability == "hill"
-                  or order < AUTO_SHOOTING_CYCLES else "shooting")
-        if method == "shooting":
-            chosen = (f" (chosen: the period holds {order} cycles of the fastest "
-                      f"excitation)")
+    if method == "auto":  # see AUTO
+        method = "hb" if harmonics is not None or stability == "hill" else "shooting"
     multipliers = None
     stab_method = ""
     if method == "hb":
@@ -313,7 +308,7 @@ def periodic_solution(structure, period: Period, *, method: str = "auto", harmon
                + ("converged" if info.converged else "did NOT converge")
                + f" in {info.iterations} Newton steps (defect {info.residual:.2e}"
                + (f", {info.products} matrix-free monodromy products)" if info.products
-                  else ")") + chosen)
+                  else ")"))
         coeffs = None
     return PeriodicSolution(
         method=method, converged=info.converged, message=msg, speed=float(speed),
