@@ -101,7 +101,8 @@ class HarmonicBalance:
         if shift:
             c = c * np.exp(2j * np.pi * shift * np.arange(self.H + 1) / self.N)[:, None]
         k = np.arange(self.H + 1)[:, None] * self.omega(speed)
-        return self._time(c), self._time(1j * k * c), self._time(-(k**2) * c)
+        qva = self._time(np.stack([c, 1j * k * c, -(k**2) * c], axis=1))  # one transform
+        return qva[:, 0], qva[:, 1], qva[:, 2]
 
     def evaluate_at(self, x, t, speed=1.0):
         """q, v at arbitrary times t (direct sums; for checks off the sample grid)."""
@@ -163,9 +164,9 @@ class HarmonicBalance:
         lam = dx[:, (2 * H + 1) * n:]
         c = np.stack([self.to_complex(U[i]) for i in range(nd)], axis=1)  # (H+1, nd, n)
         k = (np.arange(H + 1) * self.omega(speed))[:, None, None]
-        dq = np.moveaxis(self._time(c), 1, 0)
-        dv = np.moveaxis(self._time(1j * k * c), 1, 0)
-        dacc = np.moveaxis(self._time(-(k**2) * c), 1, 0)
+        # q, q', q'' of every direction in one transform: (N, 3, nd, n)
+        qva = self._time(np.stack([c, 1j * k * c, -(k**2) * c], axis=1))
+        dq, dv, dacc = (np.moveaxis(qva[:, i], 1, 0) for i in range(3))
         if p.nr and np.any(p.rigid_damped):
             dv_in = dv + (lam[:, p.rigid_damped] @ p.rigid[:, p.rigid_damped].T)[:, None, :]
         else:
@@ -217,7 +218,7 @@ class HarmonicBalance:
             ou[0] = z0[:n]
             out[(2 * H + 1) * n:] = z0[n:]
             rho = 0.5 * (u[1::2] - 1j * u[2::2])
-            c = np.einsum("kij,kj->ki", Zi, rho)
+            c = np.matmul(Zi, rho[:, :, None])[:, :, 0]
             ou[1::2] = 2 * c.real
             ou[2::2] = -2 * c.imag
             return out
