@@ -26,23 +26,32 @@ import numpy as np
 
 from torquesplit.assembly.structure import Structure
 from torquesplit.errors import SolverError
-from torquesplit.solve import codegen
 from torquesplit.solve import kernel_data as kd
 from torquesplit.solve.static import rigid_body_modes
 from torquesplit.steady import _kernels as sk
 
 
+RHS_CALLS = 2e6
+"""Right-hand-side evaluations a periodic solution is expected to take (a few RK4 periods
+of shooting, or the AFT samples of harmonic-balance Newton steps): what decides whether
+generating the model's right-hand side repays its compilation."""
+
+
 class PeriodicProblem:
     """``structure`` with fundamental frequency ``frequency`` [Hz] at speed factor 1."""
 
-    def __init__(self, structure: Structure, frequency: float):
+    def __init__(self, structure: Structure, frequency: float, rhs: str = "auto"):
         if not (frequency > 0 and math.isfinite(frequency)):
             raise SolverError(f"the fundamental frequency must be a positive number of Hz, "
                               f"got {frequency!r}; see steady.fundamental_period.")
+        from torquesplit.solve.integrate import _rhs_code
+
         self.structure = structure
         self.frequency = float(frequency)
         self.model = kd.kernel_model(structure)
-        self.code = codegen.general_rhs()
+        # the integrators' right-hand side: generated for this model when that repays
+        # its compilation over RHS_CALLS evaluations ("auto"), else the general loop
+        self.code = _rhs_code(rhs, self.model, RHS_CALLS)
         self.work = kd.make_work(self.model, self.code.parameters)
         s = structure
         self.n = s.n_dof
