@@ -274,8 +274,9 @@ Monte Carlo and sensitivity ranking are `torquesplit study` files: [studies.md](
 
 Where are the resonances between 2400 and 3600 rpm, and how large is the dynamic factor
 there?  `sweep-speed` follows the periodic steady state along the speed range by
-continuation (harmonic balance, its harmonics converged at the first speed), instead of
-integrating from rest at every speed.  `--keep split` keeps the excitations of the split
+continuation (shooting: one period integrated as `run` steps it, Newton on the state
+that repeats, the monodromy giving stability at every point), instead of integrating
+from rest at every speed.  `--keep split` keeps the excitations of the split
 stage (the combine stage's stiffness variation is replaced by its mean; `torquesplit
 steady three_branch.toml --keep split` lists what is dropped), so that one period is one
 split-stage mesh cycle:

@@ -225,6 +225,53 @@ def test_backlash_benchmark_jump_impacts_and_time_integration():
     assert peaks_dn[-1, 0] > 1.5 * peaks_up[-1, 0]
 
 
+def test_shooting_continuation_finds_the_backlash_jumps_of_harmonic_balance():
+    """The same softening branch followed by shooting continuation: turning points at the
+    speeds harmonic balance finds (its 64 harmonics converged to ~1e-3 there), stable
+    outer branches and an unstable middle one (a real multiplier beyond +1), and the
+    peaks of the two methods equal on both stable branches between the jumps.  (Where
+    contact is just lost the period map is only piecewise smooth and the multiplier
+    hovers about 1 near the lower turning point: the stability flag is not required to
+    change exactly there.)"""
+    from torquesplit.steady.sweep import continue_in_speed_shooting, shooting_point_metrics
+
+    s = backlash_oscillator(0.05, 0.1, 0.05)
+    per = fundamental_period(s)
+    p = PeriodicProblem(s, per.frequency)
+    q0 = np.array([1.1])
+    hb, hpts, hfolds, msg, complete, _ = continue_in_speed(p, per, q0, 0.5, 1.5, points=60,
+                                                           harmonics=64)
+    assert complete, msg
+    cont, pts, folds, msg, complete, _ = continue_in_speed_shooting(p, per, q0, 0.5, 1.5,
+                                                                    points=60)
+    assert complete, msg
+    assert [k for _, k in folds] == [k for _, k in hfolds]
+    for (f, _), (g, _) in zip(folds, hfolds, strict=True):
+        assert f == pytest.approx(g, abs=5e-3)
+    stab = np.array([q.stable for q in pts])
+    assert stab[0] and stab[-1]
+    worst = max(pts, key=lambda q: q.max_multiplier)
+    assert not worst.stable and folds[1][0] < worst.speed < folds[0][0]
+    mu = cont.multipliers(worst.x, worst.speed)
+    assert mu[0].real > 1 and abs(mu[0].imag) < 1e-6
+    w_mid = 0.5 * (folds[0][0] + folds[1][0])
+
+    def both_branches(points, solve, peak):
+        """Peak force at w_mid on the lower and the upper stable branch, each solved
+        from the branch's stable point nearest to w_mid."""
+        near = [q for q in points if q.stable and abs(q.speed - w_mid) < 0.05]
+        out = sorted(peak(solve(q.x, w_mid), w_mid) for q in near)
+        return out[0], out[-1]
+
+    sh = both_branches(pts, lambda x, w: cont.solve(x, w)[0],
+                       lambda x, w: shooting_point_metrics(
+                           cont, x, w, [0], [], np.ones(1), np.ones(1))["peak_force"][0])
+    ref = both_branches(hpts, lambda x, w: solve_hb(hb, x, w)[0],
+                        lambda x, w: hb.residual_samples(x, w)[2][:, 0].max())
+    assert sh[1] > 1.5 * sh[0]
+    np.testing.assert_allclose(sh, ref, rtol=5e-3)
+
+
 def test_hb_and_shooting_agree_with_long_time_integration_on_a_geared_model():
     """Two meshes with stepped stiffness and backlash never opened, 3 DOFs."""
     f = 50.0

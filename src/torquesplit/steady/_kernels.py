@@ -130,10 +130,12 @@ def _linearise(slot, iy, m, w, force, kd, cr, spt, frv, fps):
 
 
 @_inline
-def _jvp(m, kd, cr, spt, frv, fps, dq, dv, out, df):
-    """out = A_q dq + A_v dv for one linearisation (1-D arrays of n; ``df`` scratch of
-    ne): -M^-1 [sum_e V_e (kd_e V_e.dq + cr_e V_e.dv) + splines + friction slopes
-    + C_g dv + G dv + K_f dq]."""
+def _jvp(m, kd, cr, spt, frv, fps, DQ, DV, OUT, DF):
+    """OUT[:, c] = A_q DQ[:, c] + A_v DV[:, c] for every column c of the (n, n_col)
+    arrays, for one linearisation (``DF`` scratch (ne, n_col)): -M^-1 [sum_e V_e (kd_e
+    V_e.dq + cr_e V_e.dv) + splines + friction slopes + C_g dv + G dv + K_f dq].  The
+    columns are the innermost loop (contiguous, vectorised): the monodromy's 2n columns
+    go through each element once."""
     v_ptr, v_dof, v_coef = m.v_ptr, m.v_dof, m.v_coef
     inv_mass, ground = m.inv_mass, m.ground_damping
     sp_el, fr_el, fr_ptr, fr_dof, fr_coef, fr_row = (m.sp_el, m.fr_el, m.fr_ptr, m.fr_dof,
@@ -142,46 +144,77 @@ def _jvp(m, kd, cr, spt, frv, fps, dq, dv, out, df):
     fs_ptr, fs_idx, fs_coef = m.fs_ptr, m.fs_idx, m.fs_coef
     n = inv_mass.shape[0]
     ne = v_ptr.shape[0] - 1
+    nc = DQ.shape[1]
     for i in range(n):
-        out[i] = -ground[i] * dv[i]
+        g = ground[i]
+        for c in range(nc):
+            OUT[i, c] = -g * DV[i, c]
         for j in range(gy_ptr[i], gy_ptr[i + 1]):
-            out[i] -= gy_coef[j] * dv[np.int64(gy_idx[j]) - n]
+            k = np.int64(gy_idx[j]) - n
+            cf = gy_coef[j]
+            for c in range(nc):
+                OUT[i, c] -= cf * DV[k, c]
         for j in range(fs_ptr[i], fs_ptr[i + 1]):
-            out[i] -= fs_coef[j] * dq[np.int64(fs_idx[j])]
+            k = np.int64(fs_idx[j])
+            cf = fs_coef[j]
+            for c in range(nc):
+                OUT[i, c] -= cf * DQ[k, c]
     for el in range(ne):
-        a = 0.0
-        b = 0.0
-        for j in range(v_ptr[el], v_ptr[el + 1]):
-            a += v_coef[j] * dq[v_dof[j]]
-            b += v_coef[j] * dv[v_dof[j]]
-        df[el] = kd[el] * a + cr[el] * b
+        a = kd[el]
+        b = cr[el]
+        j0 = v_ptr[el]
+        j1 = v_ptr[el + 1]
+        if (a == 0.0 and b == 0.0) or j1 == j0:
+            for c in range(nc):
+                DF[el, c] = 0.0
+            continue
+        ca = a * v_coef[j0]
+        cb = b * v_coef[j0]
+        d = v_dof[j0]
+        for c in range(nc):  # columns innermost: contiguous, vectorised
+            DF[el, c] = ca * DQ[d, c] + cb * DV[d, c]
+        for j in range(j0 + 1, j1):
+            ca = a * v_coef[j]
+            cb = b * v_coef[j]
+            d = v_dof[j]
+            for c in range(nc):
+                DF[el, c] += ca * DQ[d, c] + cb * DV[d, c]
     for k in range(sp_el.shape[0]):
         ex = sp_el[k, 0]
         ey = sp_el[k, 1]
-        ax = 0.0
-        bx = 0.0
-        for j in range(v_ptr[ex], v_ptr[ex + 1]):
-            ax += v_coef[j] * dq[v_dof[j]]
-            bx += v_coef[j] * dv[v_dof[j]]
-        ay = 0.0
-        by = 0.0
-        for j in range(v_ptr[ey], v_ptr[ey + 1]):
-            ay += v_coef[j] * dq[v_dof[j]]
-            by += v_coef[j] * dv[v_dof[j]]
-        df[ex] = spt[k, 0] * ax + spt[k, 1] * ay + spt[k, 4] * bx + spt[k, 5] * by
-        df[ey] = spt[k, 2] * ax + spt[k, 3] * ay + spt[k, 6] * bx + spt[k, 7] * by
+        for c in range(nc):
+            ax = 0.0
+            bx = 0.0
+            for j in range(v_ptr[ex], v_ptr[ex + 1]):
+                ax += v_coef[j] * DQ[v_dof[j], c]
+                bx += v_coef[j] * DV[v_dof[j], c]
+            ay = 0.0
+            by = 0.0
+            for j in range(v_ptr[ey], v_ptr[ey + 1]):
+                ay += v_coef[j] * DQ[v_dof[j], c]
+                by += v_coef[j] * DV[v_dof[j], c]
+            DF[ex, c] = spt[k, 0] * ax + spt[k, 1] * ay + spt[k, 4] * bx + spt[k, 5] * by
+            DF[ey, c] = spt[k, 2] * ax + spt[k, 3] * ay + spt[k, 6] * bx + spt[k, 7] * by
     for el in range(ne):
-        x = df[el]
-        if x != 0.0:
-            for j in range(v_ptr[el], v_ptr[el + 1]):
-                out[v_dof[j]] -= v_coef[j] * x
+        for j in range(v_ptr[el], v_ptr[el + 1]):
+            cf = v_coef[j]
+            d = v_dof[j]
+            for c in range(nc):
+                OUT[d, c] -= cf * DF[el, c]
     for i in range(fr_el.shape[0]):
-        x = fps[i] * df[fr_el[i]]
-        if x != 0.0:
-            for j in range(fr_ptr[i], fr_ptr[i + 1]):
-                out[fr_dof[j]] -= fr_coef[j] * frv[fr_row[j]] * x
+        e = fr_el[i]
+        slope = fps[i]
+        if slope == 0.0:
+            continue
+        for j in range(fr_ptr[i], fr_ptr[i + 1]):
+            cf = fr_coef[j] * frv[fr_row[j]] * slope
+            d = fr_dof[j]
+            for c in range(nc):
+                OUT[d, c] -= cf * DF[e, c]
     for i in range(n):
-        out[i] *= inv_mass[i]
+        im = inv_mass[i]
+        for c in range(nc):
+            OUT[i, c] *= im
 
 
 @_kernel
@@ -202,36 +235,41 @@ def sample_linearise(ts, Y, m, w, F, KD, CR, SPT, FRV, FPS):
 def sample_jvp(m, KD, CR, SPT, FRV, FPS, dQ, dV, out, df):
     """``out[c, j] = A_q(t_j) dQ[c, j] + A_v(t_j) dV[c, j]`` for every direction c and
     sample j (arrays (n_dir, n_samples, n)); ``df`` scratch (ne,)."""
-    for c in range(dQ.shape[0]):
-        for j in range(dQ.shape[1]):
-            _jvp(m, KD[j], CR[j], SPT[j], FRV[j], FPS[j], dQ[c, j], dV[c, j], out[c, j], df)
+    nd, N, n = dQ.shape
+    # one column each: views made once (a reshape per sample costs more than its jvp)
+    DQ = dQ.reshape((nd, N, n, 1))
+    DV = dV.reshape((nd, N, n, 1))
+    OUT = out.reshape((nd, N, n, 1))
+    DF = df.reshape((df.shape[0], 1))
+    for c in range(nd):
+        for j in range(N):
+            _jvp(m, KD[j], CR[j], SPT[j], FRV[j], FPS[j], DQ[c, j], DV[c, j], OUT[c, j], DF)
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
 def _var_stage(slot, iy, idy, m, w, rhs_fn, gen, extra, Pin, Pout, force, kd, cr, spt,
-               frv, fps, df, tmp):
+               frv, fps, DF):
     """One stage of the state (row idy of w.Y) and of its variations:
-    Pout[:, c] = A(t, y) Pin[:, c] for every column c (first-order form)."""
+    Pout[:, c] = A(t, y) Pin[:, c] for every column c (first-order form); ``DF``
+    scratch (ne, n_col)."""
     _stage(slot, iy, idy, F_MAIN, m, w, rhs_fn, gen, extra)
     if Pin.shape[1] == 0:  # the state alone
         return
     _linearise(slot, iy, m, w, force, kd, cr, spt, frv, fps)
     n = m.inv_mass.shape[0]
-    for c in range(Pin.shape[1]):
-        for i in range(n):
+    for i in range(n):
+        for c in range(Pin.shape[1]):
             Pout[i, c] = Pin[n + i, c]
-        _jvp(m, kd, cr, spt, frv, fps, Pin[:n, c], Pin[n:, c], tmp, df)
-        for i in range(n):
-            Pout[n + i, c] = tmp[i]
+    _jvp(m, kd, cr, spt, frv, fps, Pin[:n], Pin[n:], Pout[n:], DF)
 
 
 @_kernel
 def rk4_variational(t0, h, n_steps, m, w, rhs_fn, gen, Phi, S, force, kd, cr, spt, frv,
-                    fps, df, tmp):
+                    fps, DF):
     """Classic RK4 from state row Y_STATE of w.Y and variations ``Phi`` (2n, n_col) over
     ``n_steps`` steps of ``h`` from ``t0``, both advanced in place: the variations obey
     the RK4 discretisation of dPhi/dt = A(t, y(t)) Phi (so Phi is the exact derivative of
-    the discrete step map).  ``S`` scratch (5, 2n, n_col).  Returns 0, or 1 if the state
+    the discrete step map).  ``S`` scratch (5, 2n, n_col), ``DF`` (ne, n_col).  Returns 0, or 1 if the state
     became non-finite."""
     Y = w.Y
     n2 = Y.shape[1]
@@ -251,27 +289,27 @@ def rk4_variational(t0, h, n_steps, m, w, rhs_fn, gen, Phi, S, force, kd, cr, sp
         t = t0 + it * h
         excite(t, s0, np.int64(-1), m, w)
         _var_stage(s0, Y_STATE, k1, m, w, rhs_fn, gen, extra, Phi, K1, force, kd, cr,
-                   spt, frv, fps, df, tmp)
+                   spt, frv, fps, DF)
         excite(t + hh, s1, np.int64(-1), m, w)
         for k in range(n2):
             Y[Y_TRIAL, k] = Y[Y_STATE, k] + hh * Y[k1, k]
             for c in range(nc):
                 PT[k, c] = Phi[k, c] + hh * K1[k, c]
         _var_stage(s1, Y_TRIAL, k2, m, w, rhs_fn, gen, extra, PT, K2, force, kd, cr,
-                   spt, frv, fps, df, tmp)
+                   spt, frv, fps, DF)
         for k in range(n2):
             Y[Y_TRIAL, k] = Y[Y_STATE, k] + hh * Y[k2, k]
             for c in range(nc):
                 PT[k, c] = Phi[k, c] + hh * K2[k, c]
         _var_stage(s1, Y_TRIAL, k3, m, w, rhs_fn, gen, extra, PT, K3, force, kd, cr,
-                   spt, frv, fps, df, tmp)
+                   spt, frv, fps, DF)
         excite(t0 + (it + 1) * h, s2, np.int64(-1), m, w)
         for k in range(n2):
             Y[Y_TRIAL, k] = Y[Y_STATE, k] + h * Y[k3, k]
             for c in range(nc):
                 PT[k, c] = Phi[k, c] + h * K3[k, c]
         _var_stage(s2, Y_TRIAL, k4, m, w, rhs_fn, gen, extra, PT, K4, force, kd, cr,
-                   spt, frv, fps, df, tmp)
+                   spt, frv, fps, DF)
         bad = False
         for k in range(n2):
             Y[Y_STATE, k] += h6 * (Y[k1, k] + 2.0 * (Y[k2, k] + Y[k3, k]) + Y[k4, k])

@@ -157,6 +157,9 @@ def register(app, load, fail, console, err_console, json_default):
         start: str = typer.Option(..., "--from", help="First speed, e.g. '500 rpm'."),
         stop: str = typer.Option(..., "--to", help="Last speed, e.g. '3000 rpm'."),
         points: int = typer.Option(50, "--points", help="Initial steps over the range."),
+        method: str = typer.Option(
+            "auto", "--method", help="shooting (one monodromy per point), hb (harmonic "
+            "balance), or auto: shooting unless --harmonics is given."),
         harmonics: Optional[int] = typer.Option(
             None, "--harmonics", help="HB harmonics (default: as 'steady' chooses them at the "
             "first speed, then kept along the curve)."),
@@ -172,6 +175,9 @@ def register(app, load, fail, console, err_console, json_default):
     ):
         """Speed response by continuation: dynamic factor, load sharing, RMS TE vs speed."""
         try:
+            if method not in ("auto", "hb", "shooting"):
+                raise TorquesplitError(f"--method {method!r} is unknown; use auto, hb or "
+                                       "shooting")
             from torquesplit.results.files import NETCDF_FORMATS
             from torquesplit.steady.maps import sweep_speed
 
@@ -185,7 +191,7 @@ def register(app, load, fail, console, err_console, json_default):
                 ds = sweep_speed(m, _speed(start, "--from"), _speed(stop, "--to"),
                                  points=points, harmonics=harmonics, keep=_keep(keep),
                                  max_cycles=max_cycles, stability=not no_stability,
-                                 cross_check=cross_check)
+                                 cross_check=cross_check, method=method)
         except (TorquesplitError, ValueError, OSError) as exc:
             fail(exc)
             return

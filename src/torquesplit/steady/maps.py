@@ -20,7 +20,13 @@ from torquesplit.steady.period import (
     keep_excitations,
 )
 from torquesplit.steady.problem import PeriodicProblem
-from torquesplit.steady.sweep import continue_in_speed, point_metrics, stepped_sweep
+from torquesplit.steady.sweep import (
+    continue_in_speed,
+    continue_in_speed_shooting,
+    point_metrics,
+    shooting_point_metrics,
+    stepped_sweep,
+)
 
 RPM = 60.0 / (2 * math.pi)
 
@@ -54,7 +60,8 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
                 harmonics: int | None = None, samples: int | None = None, keep=None,
                 max_cycles: int | None = MAX_CYCLES, stability: bool = True,
                 max_step: float | None = None, cross_check: bool = False,
-                settle_periods: int = 200, progress=None):
+                settle_periods: int = 200, progress=None, method: str = "auto",
+                steps_per_cycle: int | None = None):
     """Frequency (speed) response of the periodic state by pseudo-arclength continuation.
 
     Parameters
@@ -64,6 +71,14 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
         Speeds of the first drive [rad/s]; the sweep runs from ``start`` to ``stop``.
     points : int
         Initial number of steps over the range (the step adapts; folds add points).
+    method : {"auto", "shooting", "hb"}
+        Continuation of the shooting equations (:class:`~torquesplit.steady.sweep.
+        ShootingContinuation`: one monodromy per point, the tables' corners stepped
+        through) or of the harmonic-balance equations; "auto" (default): shooting unless
+        ``harmonics`` are given.
+    steps_per_cycle : int, optional
+        Shooting: RK4 steps per cycle of the fastest excitation (default 100, refined as
+        :func:`~torquesplit.steady.steady_state` refines them, at the lowest speed).
     harmonics, samples, keep, max_cycles
         As :func:`torquesplit.steady.steady_state`.
     stability : bool
@@ -95,11 +110,20 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
     if per.frequency <= 0:
         raise SolverError("the model has no time-varying excitation: its response does not "
                           "change with speed; nothing to sweep.")
+    if method not in ("auto", "shooting", "hb"):
+        raise SolverError(f"unknown method {method!r}; use 'shooting', 'hb' or 'auto'.")
+    if method == "auto":
+        method = "hb" if harmonics is not None else "shooting"
     problem = PeriodicProblem(s, per.frequency)
-    hb, pts, folds, msg, complete, _ = continue_in_speed(
-        problem, per, static.q, s0, s1, points=points, harmonics=harmonics, samples=samples,
-        stability=stability, max_step=None if max_step is None else max_step / w_ref,
-        progress=progress)
+    step_max = None if max_step is None else max_step / w_ref
+    if method == "shooting":
+        cont, pts, folds, msg, complete, _ = continue_in_speed_shooting(
+            problem, per, static.q, s0, s1, points=points, stability=stability,
+            max_step=step_max, progress=progress, steps_per_cycle=steps_per_cycle)
+    else:
+        hb, pts, folds, msg, complete, _ = continue_in_speed(
+            problem, per, static.q, s0, s1, points=points, harmonics=harmonics,
+            samples=samples, stability=stability, max_step=step_max, progress=progress)
     mesh_names = list(model.meshes)
     names = list(s.element_names)
     track = [names.index(m) for m in mesh_names]
@@ -108,8 +132,12 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
     gcols = [[mesh_names.index(m) for m in g] for g in groups.values()]
     static_f = np.array([static.element_forces[e] for e in track])
     nominal = np.array([kin.meshes[m].force for m in mesh_names])
-    rows = [point_metrics(hb, p.x, p.speed, track, gcols, static_f, nominal,
-                          order=per.max_order) for p in pts]
+    if method == "shooting":
+        rows = [shooting_point_metrics(cont, p.x, p.speed, track, gcols, static_f, nominal)
+                for p in pts]
+    else:
+        rows = [point_metrics(hb, p.x, p.speed, track, gcols, static_f, nominal,
+                              order=per.max_order) for p in pts]
     sp = np.array([p.speed for p in pts])
 
     def stack(key):
@@ -139,8 +167,12 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
     )
     crit = critical_speeds(s, static.q, kin, model, min(s0, s1) * w_ref, max(s0, s1) * w_ref)
     ds.attrs.update(
-        model=model.model.name, method="harmonic balance, pseudo-arclength continuation",
-        harmonics=hb.H, samples=hb.N, fundamental_frequency_at_model_speed_Hz=per.frequency,
+        model=model.model.name,
+        method=("shooting" if method == "shooting" else "harmonic balance")
+        + ", pseudo-arclength continuation",
+        harmonics=0 if method == "shooting" else hb.H,
+        samples=cont.steps if method == "shooting" else hb.N,
+        fundamental_frequency_at_model_speed_Hz=per.frequency,
         complete=int(complete), message=msg,
         fold_speeds_rpm=[f * w_ref * RPM for f, _ in folds],
         fold_kinds=[k for _, k in folds],

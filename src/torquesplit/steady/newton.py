@@ -43,34 +43,48 @@ class NewtonInfo:
     """Shooting, matrix-free: variational products Phi v taken (0: monodromy formed)."""
 
 
+FLOOR = 10.0
+"""Harmonic-balance Newton accepts a residual up to FLOOR x its tolerance when no step
+can lower it any more (its rounding floor)."""
+
+
 def solve_hb(hb: HarmonicBalance, x0, speed=1.0, tol=1e-10, max_iter=25) -> tuple:
     """Damped Newton on the HB equations from ``x0``; returns (x, NewtonInfo).
 
     Converged when the largest residual harmonic is below ``tol`` times the largest
-    sampled acceleration.  A step that does not lower the residual is halved (up to 12
+    sampled acceleration, or below FLOOR times that when no step lowers it further (the
+    rounding floor).  A step that does not lower the residual is halved (up to 12
     times)."""
     x = np.array(x0, dtype=float)
     R, scale = hb.residual(x, speed, linearise=True)
     err = float(np.max(np.abs(R))) / scale
     hist = [err]
     it = 0
+    floor = False
     while err > tol and it < max_iter:
         it += 1
         dx = hb.solve_linear(-R, speed)
         alpha = 1.0
+        lowered = False
         for _ in range(13):
             xt = x + alpha * dx
             Rt, st = hb.residual(xt, speed, linearise=True)
             et = float(np.max(np.abs(Rt))) / st
-            if np.isfinite(et) and et < err * (1 - 1e-4 * alpha) or alpha < 1e-3:
+            lowered = bool(np.isfinite(et) and et < err * (1 - 1e-4 * alpha))
+            if lowered or alpha < 1e-3:
                 break
             alpha *= 0.5
+        if not lowered and err <= FLOOR * tol:
+            # no step lowers a residual this close to the tolerance: it is the rounding
+            # floor of the sampled equations (a difference of large element forces)
+            floor = True
+            break
         if not np.isfinite(et):
             break
         x, R, scale, err = xt, Rt, st, et
         hist.append(err)
         log.debug("HB Newton %d: residual %.3e (step %.3g)", it, err, alpha)
-    return x, NewtonInfo(err <= tol, it, err, hist)
+    return x, NewtonInfo(err <= tol or floor, it, err, hist)
 
 
 # ------------------------------------------------------------------------ rigid subspace

@@ -174,8 +174,8 @@ class PeriodicProblem:
             float(t0), float(period) / steps, int(steps), self.model_at(speed), w,
             self.code.function, self.code.generated, Phi, S, np.empty(self.ne),
             np.empty(self.ne), np.empty(self.ne), np.zeros((max(self.ns, 1), 8)),
-            np.zeros(max(3 * self.nf, 1)), np.zeros(max(self.nf, 1)), np.empty(self.ne),
-            np.empty(self.n))
+            np.zeros(max(3 * self.nf, 1)), np.zeros(max(self.nf, 1)),
+            np.empty((self.ne, nc)))
         if status != 0:
             raise SolverError("the state became non-finite while integrating one period; "
                               "the periodic state is far from the guess or the model "

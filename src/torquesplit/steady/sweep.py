@@ -70,6 +70,24 @@ PRECONDITIONER_REUSE = 0.01
 """Relative speed change after which a continuation rebuilds its GMRES preconditioner."""
 
 
+FOLD_RESOLUTION = 1e-3
+"""Turning points closer than this share of the speed range to a turning point of the
+opposite kind just before them are a zig-zag of the branch's numerical tangent, not a
+jump (shooting across the kinks of a contact that is just lost: the period map is only
+piecewise smooth there); :func:`merge_folds` drops such pairs."""
+
+
+def merge_folds(folds, gap):
+    """``folds`` without consecutive opposite pairs closer than ``gap`` in speed."""
+    out = []
+    for f in folds:
+        if out and out[-1][1] != f[1] and abs(out[-1][0] - f[0]) < gap:
+            out.pop()
+        else:
+            out.append(f)
+    return out
+
+
 class Continuation:
     """Pseudo-arclength continuation of ``hb`` (a :class:`HarmonicBalance`) in speed."""
 
@@ -126,10 +144,14 @@ class Continuation:
     def _weights(self, x):
         return 1.0 / max(float(np.linalg.norm(x)), 1e-300)
 
+    def lowest_speed(self, s0, s1) -> float:
+        """Below this speed factor the branch has left the range backwards."""
+        return min(s0, s1) - 0.5 * abs(s1 - s0)
+
     def tangent(self, x, s, prev=None):
         R0, _ = self._R(x, s, lin=True)
         Rs = self._Rs(x, s, R0)
-        n = self.hb.size
+        n = self.size
         tw = np.zeros(n + 1)
         if prev is None:
             tw[n] = 1.0
@@ -183,13 +205,20 @@ class Continuation:
         _, Phi = p.integrate_variational(y0, 0.0, T, steps, s)
         return floquet_monodromy(p, Phi)
 
-    def run(self, x0, s0, s1, step, max_step, min_step, max_points=2000, progress=None):
-        hb = self.hb
-        n = hb.size
-        direction = 1.0 if s1 > s0 else -1.0
+    @property
+    def size(self) -> int:
+        return self.hb.size
+
+    def solve(self, x0, s):
+        """The periodic state at speed factor s from ``x0``: (x, NewtonInfo)."""
         from torquesplit.steady.newton import solve_hb
 
-        x, info = solve_hb(hb, x0, s0, self.tol)
+        return solve_hb(self.hb, x0, s, self.tol)
+
+    def run(self, x0, s0, s1, step, max_step, min_step, max_points=2000, progress=None):
+        n = self.size
+        direction = 1.0 if s1 > s0 else -1.0
+        x, info = self.solve(x0, s0)
         if not info.converged:
             raise SolverError(f"no periodic state at the start of the sweep (speed factor "
                               f"{s0:.4g}, residual {info.residual:.1e}); start the sweep "
@@ -212,7 +241,7 @@ class Continuation:
                 progress(min(1.0, abs(z[n] - s0) / abs(s1 - s0)))
             if (z[n] - s1) * direction >= 0:
                 if z[n] != s1 and len(pts) > 1:  # past the end: the state at the end itself
-                    x_end, info_end = solve_hb(hb, z[:n].copy(), s1, self.tol)
+                    x_end, info_end = self.solve(z[:n].copy(), s1)
                     if info_end.converged:
                         mu = self.multipliers(x_end, s1) if self.stability else None
                         m = float(np.max(np.abs(mu))) if mu is not None and mu.size \
@@ -253,14 +282,224 @@ class Continuation:
                 folds.append((float(s_f), "turns back" if t[n] * direction > 0 else "turns on"))
             z, t = zc, t_new
             h = min(max_step, h * (1.5 if its <= 3 else (1.0 if its <= 5 else 0.6)))
-            if zc[n] < min(s0, s1) - 0.5 * abs(s1 - s0):
+            if zc[n] < self.lowest_speed(s0, s1):
                 message = "the branch left the speed range backwards; curve kept."
                 complete = False
                 break
         else:
             message = f"stopped after {max_points} points; curve kept."
             complete = False
-        return pts, folds, message, complete
+        return pts, merge_folds(folds, FOLD_RESOLUTION * abs(s1 - s0)), message, complete
+
+
+class ShootingContinuation(Continuation):
+    """Pseudo-arclength continuation in speed of the shooting equations
+    G(x, s) = Q^T (phi_T(s)(Q x) - Q x) = 0, x the state's coordinates on the complement
+    Q of the rigid subspace (:func:`~torquesplit.steady.newton.complement`) and phi the
+    period map stepping through the tables' corners.  The period is T = 1 / (f0 s) in a
+    fixed number of RK4 steps (those of the lowest speed the branch may reach), so G is
+    smooth in s.  At every point the monodromy Phi (variational equations) gives the
+    Jacobian Q^T Phi Q - I of the tangent and of the next point's corrector (a chord
+    iteration: the corrector only integrates the state), and the Floquet multipliers;
+    dG/ds is a forward difference.  Per point: one monodromy and a few state periods."""
+
+    def __init__(self, problem, period, s_low, q_static, tol=1e-9, stability=True,
+                 steps_per_cycle=None):
+        from torquesplit.steady.newton import complement
+
+        self.p = problem
+        self.tol = tol
+        self.stability = stability
+        self.Q = complement(problem)
+        n = problem.n
+        # complement columns are pure displacement or pure velocity (the rigid subspace is)
+        is_v = np.abs(self.Q[n:]).sum(axis=0) > np.abs(self.Q[:n]).sum(axis=0)
+        size = max(float(np.linalg.norm(self.Q[:n].T @ q_static)), 1e-300)
+        w_v = 2 * math.pi * problem.frequency  # omega at the model's speed
+        self._w = np.where(is_v, 1.0 / (w_v * size), 1.0 / size)
+        order = max(period.max_order, 1)
+        self.s_low = s_low
+        self.steps = problem.rk4_steps(1.0 / (problem.frequency * s_low), steps_per_cycle,
+                                       order)
+        self._J = None  # (z it was formed at, Jacobian, multipliers)
+
+    @property
+    def size(self) -> int:
+        return self.Q.shape[1]
+
+    def lowest_speed(self, s0, s1) -> float:
+        return self.s_low
+
+    def _weights(self, x):
+        """Per-coordinate weights of the arclength metric, the same all along the branch:
+        displacements over the static deflection's size, velocities over omega times it
+        (a velocity is omega times a displacement), so that neither dominates the step
+        (the state at t = 0 itself passes near zero where the phase turns)."""
+        return self._w
+
+    def period(self, s):
+        return 1.0 / (self.p.frequency * s)
+
+    def state(self, x):
+        return self.Q @ x
+
+    def G(self, x, s):
+        y = self.Q @ x
+        yT = self.p.integrate(y, 0.0, self.period(s), self.steps, every=self.steps,
+                              speed=s, max_rows=1)[3]
+        return self.Q.T @ (yT - y)
+
+    def Gs(self, x, s, G0):
+        eps = 1e-7 * s
+        return (self.G(x, s + eps) - G0) / eps
+
+    def error(self, x, s, G):
+        """Defect over the largest deformation (velocities over omega), as shooting."""
+        p = self.p
+        n = p.n
+        V = p.structure.projection_matrix()
+        y, d = self.Q @ x, self.Q @ G
+        w = 2 * math.pi / self.period(s)
+        scale = max(float(np.max(np.abs(V @ y[:n]), initial=0.0)), 1e-300)
+        return max(float(np.max(np.abs(V @ d[:n]), initial=0.0)),
+                   float(np.max(np.abs(V @ d[n:]), initial=0.0)) / w) / scale
+
+    def jacobian(self, x, s):
+        """Q^T Phi Q - I at (x, s), and the Floquet multipliers (eigenvalues of
+        Q^T Phi Q), kept for the point."""
+        _, Phi = self.p.integrate_variational(self.Q @ x, 0.0, self.period(s), self.steps, s)
+        M = self.Q.T @ Phi @ self.Q
+        mu = np.linalg.eigvals(M)
+        self._J = (np.concatenate([x, [s]]), M - np.eye(self.size),
+                   mu[np.argsort(-np.abs(mu))])
+        return self._J[1]
+
+    def solve(self, x0, s):
+        from torquesplit.steady.newton import solve_shooting
+
+        y, Phi, info = solve_shooting(self.p, self.Q @ x0, self.steps, s, self.tol,
+                                      krylov=False)
+        return self.Q.T @ y, info
+
+    def _bordered(self, J, Gs, tw, rhs):
+        n = self.size
+        B = np.zeros((n + 1, n + 1))
+        B[:n, :n] = J
+        B[:n, n] = Gs
+        B[n] = tw
+        try:
+            return np.linalg.solve(B, rhs)
+        except np.linalg.LinAlgError:
+            return np.linalg.lstsq(B, rhs, rcond=None)[0]
+
+    def tangent(self, x, s, prev=None):
+        n = self.size
+        J = self.jacobian(x, s)
+        Gs = self.Gs(x, s, self.G(x, s))
+        tw = np.zeros(n + 1)
+        if prev is None:
+            tw[n] = 1.0
+        else:
+            tw[:] = prev
+        rhs = np.zeros(n + 1)
+        rhs[n] = 1.0
+        t = self._bordered(J, Gs, tw, rhs)
+        w = self._weights(x)
+        t = t / math.sqrt(float(np.linalg.norm(w * t[:n])) ** 2 + t[n] ** 2)
+        if prev is not None and (t[:n] @ prev[:n] + t[n] * prev[n]) < 0:  # prev weighted
+            t = -t
+        return t
+
+    def correct(self, z_pred, t, max_iter=12):
+        """Chord iterations with the Jacobian of the last point (formed again once if
+        they stall)."""
+        n = self.size
+        z = z_pred.copy()
+        w = self._weights(z[:n])
+        tw = np.concatenate([t[:n] * w * w, [t[n]]])
+        J = self._J[1] if self._J is not None else self.jacobian(z[:n], z[n])
+        last = math.inf
+        refreshed = False
+        for it in range(1, max_iter + 1):
+            x, s = z[:n], z[n]
+            if not s > 0:
+                return None, it
+            G = self.G(x, s)
+            err = self.error(x, s, G)
+            arc = tw @ (z - z_pred)
+            if err <= self.tol and abs(arc) < 1e-9:
+                return z, it
+            if err > 0.5 * last and not refreshed:  # the chord stalls: a fresh Jacobian
+                J = self.jacobian(x, s)
+                refreshed = True
+            last = err
+            dz = self._bordered(J, self.Gs(x, s, G), tw, -np.concatenate([G, [arc]]))
+            z = z + dz
+            if not np.all(np.isfinite(z)):
+                return None, it
+        return None, max_iter
+
+    def multipliers(self, x, s):
+        z = np.concatenate([x, [s]])
+        if self._J is None or not np.array_equal(self._J[0], z):
+            self.jacobian(x, s)
+        return self._J[2]
+
+
+def shooting_point_metrics(cont: ShootingContinuation, x, s, track, groups, static_forces,
+                           nominal):
+    """As :func:`point_metrics`, from one period of the shooting state integrated with its
+    samples and the forces at the tables' corners (peaks and the load-sharing ratio's
+    extremes take both; means and the RMS transmission error the samples)."""
+    p = cont.p
+    tt, Y, F, _, _, _, Fc = p.integrate(cont.state(x), 0.0, cont.period(s), cont.steps, 1,
+                                        speed=s, corners=True)
+    _, _, D = p.accelerations(tt[:-1], Y[:-1], s)
+    f = F[:-1, track]
+    fall = np.vstack([f, Fc[:, track]])
+    d = D[:, track]
+    peak = fall.max(axis=0)
+    lsc = np.full(len(track), np.nan)
+    for cols in groups:
+        sub = fall[:, cols]
+        tot = sub.sum(axis=1, keepdims=True)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            r = len(cols) * sub / np.where(tot != 0, tot, np.nan)  # Ji & Li eq. 18
+        lsc[cols] = np.nanmax(r, axis=0)
+    rms = np.sqrt(np.mean((d - d.mean(axis=0)) ** 2, axis=0))
+    return dict(peak_force=peak, dynamic_factor=peak / static_forces,
+                peak_to_nominal=peak / nominal, load_sharing=lsc,
+                rms_transmission_error=rms, mean_force=f.mean(axis=0))
+
+
+def continue_in_speed_shooting(problem, period, q_static, s0, s1, *, points=50,
+                               stability=True, max_step=None, tol=1e-9, progress=None,
+                               steps_per_cycle=None):
+    """Continuation of the shooting state of ``problem`` from speed factor s0 to s1
+    (:class:`ShootingContinuation`); returns (continuation, points, folds, message,
+    complete, seconds).  The branch may dip to 0.8 x the lower end of the range."""
+    t0 = time.perf_counter()
+    _check_range(s0, s1)
+    cont = ShootingContinuation(problem, period, 0.8 * min(s0, s1), q_static, tol,
+                                stability, steps_per_cycle)
+    T = cont.period(s0)
+    y = np.concatenate([q_static, np.zeros(problem.n)])
+    # some transient first (as steady shooting does): closer to the attracting orbit
+    k = 5 if period.max_order < 8 else 1
+    y = problem.integrate(y, 0.0, k * T, k * cont.steps, every=k * cont.steps, speed=s0,
+                          max_rows=1)[3]
+    step = abs(s1 - s0) / max(points - 1, 1)
+    max_step = step * 2 if max_step is None else max_step
+    pts, folds, msg, complete = cont.run(cont.Q.T @ y, s0, s1, step, max_step, step * 1e-3,
+                                         progress=progress)
+    return cont, pts, folds, msg, complete, time.perf_counter() - t0
+
+
+def _check_range(s0, s1):
+    if not (s0 > 0 and s1 > 0 and math.isfinite(s0) and math.isfinite(s1)) or s0 == s1:
+        raise SolverError(f"the speed range {s0:.4g}..{s1:.4g} (times the model's speed) "
+                          f"must be two different positive speeds; e.g. --from '1000 rpm' "
+                          f"--to '3000 rpm'.")
 
 
 def continue_in_speed(problem, period, q_static, s0, s1, *, points=50, harmonics=None,
@@ -268,10 +507,7 @@ def continue_in_speed(problem, period, q_static, s0, s1, *, points=50, harmonics
                       progress=None, initial=None):
     """Continuation of the HB state of ``problem`` from speed factor s0 to s1."""
     t0 = time.perf_counter()
-    if not (s0 > 0 and s1 > 0 and math.isfinite(s0) and math.isfinite(s1)) or s0 == s1:
-        raise SolverError(f"the speed range {s0:.4g}..{s1:.4g} (times the model's speed) "
-                          f"must be two different positive speeds; e.g. --from '1000 rpm' "
-                          f"--to '3000 rpm'.")
+    _check_range(s0, s1)
     order = max(period.max_order, 1)
     if harmonics is None:  # as steady_state chooses them at the first speed, then kept
         hb, x0, info, energy = converged_hb(problem, HARMONICS_PER_CYCLE * order, samples,
