@@ -14,12 +14,14 @@ module             what it does
                    Jacobian, RK4 with variational equations
 ``harmonic``       harmonic balance with alternating frequency-time evaluation, its
                    Jacobian (matrix-free, harmonic-by-harmonic preconditioner, GMRES)
-``newton``         Newton for HB and shooting; Floquet multipliers (monodromy, Hill)
+``newton``         Newton for HB and shooting (matrix-free Newton-Krylov on long
+                   periods); Floquet multipliers (monodromy, Hill)
 ``solution``       :func:`periodic_solution` on a structure: :class:`PeriodicSolution`
 ``api``            :func:`steady_state` on a model: :class:`SteadyState` (per-mesh
                    table, conversion to :class:`torquesplit.results.Results`)
-``sweep``          pseudo-arclength continuation in speed, folds, stepped run-up /
-                   run-down time-integration cross-check
+``sweep``          pseudo-arclength continuation in speed of the shooting (default) or
+                   HB equations, folds, stepped run-up / run-down time-integration
+                   cross-check
 ``maps``           :func:`sweep_speed` and :func:`campbell` (xarray Datasets)
 ``plot``           figures of a sweep and of a Campbell diagram
 ``cli``            the ``steady`` and ``sweep-speed`` commands

@@ -269,8 +269,8 @@ def rk4_variational(t0, h, n_steps, m, w, rhs_fn, gen, Phi, S, force, kd, cr, sp
     """Classic RK4 from state row Y_STATE of w.Y and variations ``Phi`` (2n, n_col) over
     ``n_steps`` steps of ``h`` from ``t0``, both advanced in place: the variations obey
     the RK4 discretisation of dPhi/dt = A(t, y(t)) Phi (so Phi is the exact derivative of
-    the discrete step map).  ``S`` scratch (5, 2n, n_col), ``DF`` (ne, n_col).  Returns 0, or 1 if the state
-    became non-finite."""
+    the discrete step map).  ``S`` scratch (5, 2n, n_col), ``DF`` (ne, n_col).
+    Returns 0, or 1 if the state became non-finite."""
     Y = w.Y
     n2 = Y.shape[1]
     nc = Phi.shape[1]

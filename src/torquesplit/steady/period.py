@@ -28,8 +28,8 @@ from torquesplit.assembly.structure import Structure
 from torquesplit.errors import LongPeriodError, PeriodError, SolverError  # noqa: F401 - re-exported
 
 __all__ = ["ExcitationSource", "Period", "PeriodError", "LongPeriodError",
-           "default_max_cycles", "excitation_sources", "fundamental_period", "keep_excitations", "scale_speed",
-           "base_frequency"]
+           "default_max_cycles", "excitation_sources", "fundamental_period",
+           "keep_excitations", "scale_speed", "base_frequency"]
 
 MAX_DENOMINATOR = 10**6
 """Largest denominator of a frequency ratio accepted as rational (tooth-count products

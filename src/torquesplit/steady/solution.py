@@ -227,7 +227,8 @@ def periodic_solution(structure, period: Period, *, method: str = "auto", harmon
     t_start = time.perf_counter()
     if method not in ("auto", "hb", "shooting"):
         raise SolverError(f"unknown method {method!r}; use method='hb' (harmonic balance), "
-                          "method='shooting' or method='auto' (shooting unless harmonics are given).")
+                          "method='shooting' or method='auto' (shooting unless harmonics "
+                          "are given).")
     if period.frequency <= 0:
         raise SolverError("the structure has no time-varying excitation, so its steady state "
                           "is the static equilibrium; use static_equilibrium instead.")

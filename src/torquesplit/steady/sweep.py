@@ -566,8 +566,8 @@ def stepped_sweep(problem, period, q_static, speeds, *, settle_periods=200,
                   record_periods=1, steps_per_cycle=None, track=(), progress=None):
     """Time-integration cross-check: RK4 (through the tables' corners) at each speed
     factor of ``speeds`` in order, ``settle_periods`` periods from the previous end state
-    (the first from the static state), then ``record_periods`` recorded.  Returns the per-mesh peak forces
-    (n_speeds, n_track) and the RMS transmission errors."""
+    (the first from the static state), then ``record_periods`` recorded.  Returns the
+    per-mesh peak forces (n_speeds, n_track) and the RMS transmission errors."""
     p = problem
     y = np.concatenate([q_static, np.zeros(p.n)])
     peaks = np.full((len(speeds), len(track)), np.nan)
