@@ -330,5 +330,25 @@ def test_continuation_failure_keeps_the_partial_curve(monkeypatch):
                                                           stability=False)
     assert not complete and 3 <= len(pts) <= 6
     assert "continuation failed at speed factor" in msg and "kept" in msg
+    assert "--method shooting" in msg
     with pytest.raises(SolverError, match="two different positive speeds"):
         continue_in_speed(p, per, np.array([1.1]), -1.0, 1.5)
+    # the same for the shooting continuation: partial curve, its own remedy
+    from torquesplit.steady.sweep import continue_in_speed_shooting
+
+    calls["n"] = 0
+    orig_sh = sw.ShootingContinuation.correct
+
+    def flaky_sh(self, z_pred, t, max_iter=12):
+        calls["n"] += 1
+        if calls["n"] > 5:
+            return None, max_iter
+        return orig_sh(self, z_pred, t, max_iter)
+
+    monkeypatch.setattr(sw.ShootingContinuation, "correct", flaky_sh)
+    _, pts, _, msg, complete, _ = continue_in_speed_shooting(
+        p, per, np.array([1.1]), 0.5, 1.5, points=20, stability=False)
+    assert not complete and 3 <= len(pts) <= 6
+    assert "kept" in msg and "--method hb" in msg
+    with pytest.raises(SolverError, match="two different positive speeds"):
+        continue_in_speed_shooting(p, per, np.array([1.1]), 1.5, 1.5)

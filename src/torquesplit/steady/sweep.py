@@ -148,6 +148,10 @@ class Continuation:
         """Below this speed factor the branch has left the range backwards."""
         return min(s0, s1) - 0.5 * abs(s1 - s0)
 
+    remedy = ("Use more harmonics, a smaller --max-step, or the shooting continuation "
+              "(--method shooting).")
+    """What to try when the corrector fails (said in the message)."""
+
     def tangent(self, x, s, prev=None):
         R0, _ = self._R(x, s, lin=True)
         Rs = self._Rs(x, s, R0)
@@ -262,9 +266,8 @@ class Continuation:
                 if h < min_step:
                     message = (f"continuation failed at speed factor {z[n]:.6g}: the "
                                f"corrector did not converge down to the smallest step "
-                               f"{min_step:.3g}; the curve up to there is kept. Use more "
-                               f"harmonics, a smaller --max-step, or method='shooting' at "
-                               f"single speeds there.")
+                               f"{min_step:.3g}; the curve up to there is kept. "
+                               f"{self.remedy}")
                     complete = False
                     break
             if zc is None:
@@ -329,6 +332,9 @@ class ShootingContinuation(Continuation):
 
     def lowest_speed(self, s0, s1) -> float:
         return self.s_low
+
+    remedy = ("Use more RK4 steps per cycle (steps_per_cycle), a smaller --max-step, or "
+              "harmonic balance (--method hb), whose smoothing can pass a grazing contact.")
 
     def _weights(self, x):
         """Per-coordinate weights of the arclength metric, the same all along the branch:
