@@ -322,6 +322,21 @@ def rk4_variational(t0, h, n_steps, m, w, rhs_fn, gen, Phi, S, force, kd, cr, sp
     return 0
 
 
+@_inline
+def _keep(row, t, w, out_t, out_y, out_f):
+    """Time, state (row Y_STATE) and forces (row F_MAIN) into row ``row`` of the outputs
+    while they have rows; returns the next row."""
+    if row >= out_t.shape[0]:
+        return row
+    Y, F = w.Y, w.F
+    out_t[row] = t
+    for k in range(out_y.shape[1]):
+        out_y[row, k] = Y[Y_STATE, k]
+    for e in range(out_f.shape[1]):
+        out_f[row, e] = F[F_MAIN, e]
+    return row + 1
+
+
 @_kernel
 def rk4_samples(t0, h, n_steps, every, m, w, rhs_fn, gen, out_t, out_y, out_f, c_t, c_y,
                 c_f):
@@ -335,7 +350,6 @@ def rk4_samples(t0, h, n_steps, every, m, w, rhs_fn, gen, out_t, out_y, out_f, c
     became non-finite."""
     Y = w.Y
     n2 = Y.shape[1]
-    ne = out_f.shape[1]
     extra = m.fr_el.shape[0] > 0 or m.sp_el.shape[0] > 0
     minus = np.int64(-1)
     s_half = np.int64(1)
@@ -343,7 +357,6 @@ def rk4_samples(t0, h, n_steps, every, m, w, rhs_fn, gen, out_t, out_y, out_f, c
     b = np.int64(2)
     row = 0
     crow = 0
-    WF = w.F
     t_corner = math.inf
     if m.corner_node.shape[0] > 0 and n_steps > 0:
         t_corner = first_corners(t0, m, w)
@@ -351,13 +364,8 @@ def rk4_samples(t0, h, n_steps, every, m, w, rhs_fn, gen, out_t, out_y, out_f, c
     for it in range(n_steps + 1):
         t = t0 + it * h
         _stage(a, Y_STATE, Y_K1, F_MAIN, m, w, rhs_fn, gen, extra)
-        if it % every == 0 and row < out_t.shape[0]:
-            out_t[row] = t
-            for k in range(n2):
-                out_y[row, k] = Y[Y_STATE, k]
-            for e in range(ne):
-                out_f[row, e] = WF[F_MAIN, e]
-            row += 1
+        if it % every == 0:
+            row = _keep(row, t, w, out_t, out_y, out_f)
         if it == n_steps:
             break
         tb = t0 + (it + 1) * h
@@ -368,13 +376,7 @@ def rk4_samples(t0, h, n_steps, every, m, w, rhs_fn, gen, out_t, out_y, out_f, c
                 te = t_corner if t_corner < tb - 1e-6 * h else tb
                 if not first:  # at a corner: its forces, and k1 of the next sub-step
                     _stage(a, Y_STATE, Y_K1, F_MAIN, m, w, rhs_fn, gen, extra)
-                    if crow < c_t.shape[0]:
-                        c_t[crow] = ts
-                        for k in range(n2):
-                            c_y[crow, k] = Y[Y_STATE, k]
-                        for e in range(ne):
-                            c_f[crow, e] = WF[F_MAIN, e]
-                        crow += 1
+                    crow = _keep(crow, ts, w, c_t, c_y, c_f)
                 if te - ts > 1e-6 * h:
                     _rk4_step(ts + 0.5 * (te - ts), te, te - ts, s_half, b, minus, minus, m,
                               w, rhs_fn, gen, extra)

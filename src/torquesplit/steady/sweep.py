@@ -152,9 +152,14 @@ class Continuation:
               "(--method shooting).")
     """What to try when the corrector fails (said in the message)."""
 
-    def tangent(self, x, s, prev=None):
+    def _tangent_system(self, x, s, tw, rhs):
+        """Solve the bordered system [[dR/dx, dR/ds], [tw]] t = rhs at (x, s)."""
         R0, _ = self._R(x, s, lin=True)
-        Rs = self._Rs(x, s, R0)
+        return self._solve_bordered(s, self._Rs(x, s, R0), tw, rhs)
+
+    def tangent(self, x, s, prev=None):
+        """Unit tangent of the branch at (x, s) in the weighted metric, oriented along
+        ``prev`` (the previous tangent with its state part already weighted twice)."""
         n = self.size
         tw = np.zeros(n + 1)
         if prev is None:
@@ -163,11 +168,10 @@ class Continuation:
             tw[:] = prev
         rhs = np.zeros(n + 1)
         rhs[n] = 1.0
-        t = self._solve_bordered(s, Rs, tw, rhs)
+        t = self._tangent_system(x, s, tw, rhs)
         w = self._weights(x)
-        nrm = math.sqrt((w * np.linalg.norm(t[:n])) ** 2 + t[n] ** 2)
-        t = t / nrm
-        if prev is not None and (w * w * (t[:n] @ prev[:n]) + t[n] * prev[n]) < 0:
+        t = t / math.sqrt(float(np.linalg.norm(w * t[:n])) ** 2 + t[n] ** 2)
+        if prev is not None and (t[:n] @ prev[:n] + t[n] * prev[n]) < 0:
             t = -t
         return t
 
@@ -398,23 +402,9 @@ class ShootingContinuation(Continuation):
         except np.linalg.LinAlgError:
             return np.linalg.lstsq(B, rhs, rcond=None)[0]
 
-    def tangent(self, x, s, prev=None):
-        n = self.size
-        J = self.jacobian(x, s)
-        Gs = self.Gs(x, s, self.G(x, s))
-        tw = np.zeros(n + 1)
-        if prev is None:
-            tw[n] = 1.0
-        else:
-            tw[:] = prev
-        rhs = np.zeros(n + 1)
-        rhs[n] = 1.0
-        t = self._bordered(J, Gs, tw, rhs)
-        w = self._weights(x)
-        t = t / math.sqrt(float(np.linalg.norm(w * t[:n])) ** 2 + t[n] ** 2)
-        if prev is not None and (t[:n] @ prev[:n] + t[n] * prev[n]) < 0:  # prev weighted
-            t = -t
-        return t
+    def _tangent_system(self, x, s, tw, rhs):
+        J = self.jacobian(x, s)  # also the next corrector's and the multipliers
+        return self._bordered(J, self.Gs(x, s, self.G(x, s)), tw, rhs)
 
     def correct(self, z_pred, t, max_iter=12):
         """Chord iterations with the Jacobian of the last point (formed again once if
@@ -462,12 +452,19 @@ def shooting_point_metrics(cont: ShootingContinuation, x, s, track, groups, stat
                                         speed=s, corners=True)
     _, _, D = p.accelerations(tt[:-1], Y[:-1], s)
     f = F[:-1, track]
-    fall = np.vstack([f, Fc[:, track]])
-    d = D[:, track]
-    peak = fall.max(axis=0)
-    lsc = np.full(len(track), np.nan)
+    return _point_outputs(f, np.vstack([f, Fc[:, track]]), D[:, track], groups,
+                          static_forces, nominal)
+
+
+def _point_outputs(f, f_all, d, groups, static_forces, nominal):
+    """A sweep point's outputs per tracked mesh from its force samples ``f`` (means),
+    those and any instants between them ``f_all`` (extremes) and the deformation
+    samples ``d``: peak force, dynamic factors, load sharing (largest instantaneous
+    ratio in its group, Ji & Li eq. 18), RMS transmission error, mean force."""
+    peak = f_all.max(axis=0)
+    lsc = np.full(f.shape[1], np.nan)
     for cols in groups:
-        sub = fall[:, cols]
+        sub = f_all[:, cols]
         tot = sub.sum(axis=1, keepdims=True)
         with np.errstate(divide="ignore", invalid="ignore"):
             r = len(cols) * sub / np.where(tot != 0, tot, np.nan)  # Ji & Li eq. 18
@@ -553,19 +550,7 @@ def point_metrics(hb: HarmonicBalance, x, s, track, groups, static_forces, nomin
         hb2, x2 = hb, x
     _, _, F, D, _, _ = hb2.residual_samples(x2, s)
     f = F[:, track]
-    d = D[:, track]
-    peak = f.max(axis=0)
-    lsc = np.full(len(track), np.nan)
-    for cols in groups:
-        sub = f[:, cols]
-        tot = sub.sum(axis=1, keepdims=True)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            r = len(cols) * sub / np.where(tot != 0, tot, np.nan)  # Ji & Li eq. 18
-        lsc[cols] = np.nanmax(r, axis=0)
-    rms = np.sqrt(np.mean((d - d.mean(axis=0)) ** 2, axis=0))
-    return dict(peak_force=peak, dynamic_factor=peak / static_forces,
-                peak_to_nominal=peak / nominal, load_sharing=lsc,
-                rms_transmission_error=rms, mean_force=f.mean(axis=0))
+    return _point_outputs(f, f, D[:, track], groups, static_forces, nominal)
 
 
 def stepped_sweep(problem, period, q_static, speeds, *, settle_periods=200,
