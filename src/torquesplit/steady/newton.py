@@ -186,7 +186,7 @@ still has to fall below the shooting tolerance)."""
 
 
 def solve_shooting(p: PeriodicProblem, y0, steps: int, speed=1.0, tol=1e-9, max_iter=25,
-                   krylov: bool | None = None):
+                   krylov: bool | None = None, monodromy: bool = True):
     """Newton on the period map: returns (y0, monodromy or None, NewtonInfo).
 
     Converged when one period returns to the start within ``tol`` of the largest
@@ -201,7 +201,8 @@ def solve_shooting(p: PeriodicProblem, y0, steps: int, speed=1.0, tol=1e-9, max_
     has not converged after about the work of one monodromy, the step is taken with the
     full monodromy, and so are the following.  Default: on when the monodromy would cost
     more than ``KRYLOV_WORK`` column-steps.  The monodromy is returned only when it was
-    formed at the returned state (None otherwise)."""
+    formed at the returned state (None otherwise); with ``monodromy=False`` it is formed
+    only for the Newton steps that need it (never at the returned state)."""
     n = p.n
     T = 1.0 / (p.frequency * speed)
     w = 2 * math.pi / T
@@ -229,7 +230,8 @@ def solve_shooting(p: PeriodicProblem, y0, steps: int, speed=1.0, tol=1e-9, max_
 
     while True:
         yT = period_map(y)
-        if not krylov:
+        Phi = None
+        if not krylov and monodromy:
             Phi = p.integrate_variational(y, 0.0, T, steps, speed)[1]
         d = Pr @ (yT - y)
         dscale = max(float(np.max(np.abs(V @ y[:n]), initial=0.0)),
@@ -265,6 +267,8 @@ def solve_shooting(p: PeriodicProblem, y0, steps: int, speed=1.0, tol=1e-9, max_
                 krylov = False
                 _, Phi = p.integrate_variational(y, 0.0, T, steps, speed)
         if dy is None:
+            if Phi is None:
+                Phi = p.integrate_variational(y, 0.0, T, steps, speed)[1]
             A = np.vstack([Pr @ (Phi - np.eye(2 * n)), R.T])
             b = -np.concatenate([d, R.T @ y])
             dy = np.linalg.lstsq(A, b, rcond=None)[0]

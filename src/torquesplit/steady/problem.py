@@ -207,6 +207,14 @@ class PeriodicProblem:
             out += (c_t[:n_c], c_y[:n_c], c_f[:n_c])
         return out
 
+    def settled_start(self, y0, period, steps, speed=1.0, order=1):
+        """``y0`` after some transient (closer to the attracting orbit for shooting): five
+        periods, or one where the period holds 8 or more cycles of the fastest
+        excitation (as long as several short ones)."""
+        k = 5 if order < 8 else 1
+        return self.integrate(y0, 0.0, k * period, k * steps, every=k * steps, speed=speed,
+                              max_rows=1)[3]
+
     def rk4_steps(self, period, steps_per_cycle=None, max_order=1):
         """RK4 steps for one period: ``steps_per_cycle`` per cycle of the fastest
         excitation (default 100), refined as the integrator's default step is: omega_max

@@ -285,11 +285,8 @@ def periodic_solution(structure, period: Period, *, method: str = "auto", harmon
         else:
             y0 = np.concatenate([q_static if q_static is not None else np.zeros(p.n),
                                  np.zeros(p.n)])
-            # some transient first: closer to the attracting orbit (a few periods; one
-            # where the period holds many cycles, as long as several short ones)
-            k = 5 if order < 8 else 1
-            _, _, _, y0 = p.integrate(y0, 0.0, k * T, k * steps, every=k * steps, speed=speed)
-        y0, Phi, info = solve_shooting(p, y0, steps, speed, tol)
+            y0 = p.settled_start(y0, T, steps, speed, order)
+        y0, Phi, info = solve_shooting(p, y0, steps, speed, tol, monodromy=bool(stability))
         tt, Y, F, _, corner_t, _, corner_f = p.integrate(y0, 0.0, T, steps, 1, speed,
                                                           corners=True)
         t, q, v = tt[:-1], Y[:-1, :p.n], Y[:-1, p.n:]

@@ -77,6 +77,20 @@ jump (shooting across the kinks of a contact that is just lost: the period map i
 piecewise smooth there); :func:`merge_folds` drops such pairs."""
 
 
+def bordered_solve(J, Rs, tw, rhs):
+    """Solve the dense bordered system [[J, Rs], [tw^T]] z = rhs (least squares if it is
+    singular)."""
+    n = J.shape[0]
+    B = np.zeros((n + 1, n + 1))
+    B[:n, :n] = J
+    B[:n, n] = Rs
+    B[n] = tw
+    try:
+        return np.linalg.solve(B, rhs)
+    except np.linalg.LinAlgError:
+        return np.linalg.lstsq(B, rhs, rcond=None)[0]
+
+
 def merge_folds(folds, gap):
     """``folds`` without consecutive opposite pairs closer than ``gap`` in speed."""
     out = []
@@ -111,15 +125,7 @@ class Continuation:
         hb = self.hb
         n = hb.size
         if n <= 1500:
-            J = hb.dense_jacobian(s)
-            B = np.zeros((n + 1, n + 1))
-            B[:n, :n] = J
-            B[:n, n] = Rs
-            B[n] = tw
-            try:
-                return np.linalg.solve(B, rhs)
-            except np.linalg.LinAlgError:
-                return np.linalg.lstsq(B, rhs, rcond=None)[0]
+            return bordered_solve(hb.dense_jacobian(s), Rs, tw, rhs)
         from torquesplit.steady.harmonic import gmres
 
         def mv(z):
@@ -387,24 +393,13 @@ class ShootingContinuation(Continuation):
     def solve(self, x0, s):
         from torquesplit.steady.newton import solve_shooting
 
-        y, Phi, info = solve_shooting(self.p, self.Q @ x0, self.steps, s, self.tol,
-                                      krylov=False)
+        y, _, info = solve_shooting(self.p, self.Q @ x0, self.steps, s, self.tol,
+                                    krylov=False, monodromy=False)
         return self.Q.T @ y, info
-
-    def _bordered(self, J, Gs, tw, rhs):
-        n = self.size
-        B = np.zeros((n + 1, n + 1))
-        B[:n, :n] = J
-        B[:n, n] = Gs
-        B[n] = tw
-        try:
-            return np.linalg.solve(B, rhs)
-        except np.linalg.LinAlgError:
-            return np.linalg.lstsq(B, rhs, rcond=None)[0]
 
     def _tangent_system(self, x, s, tw, rhs):
         J = self.jacobian(x, s)  # also the next corrector's and the multipliers
-        return self._bordered(J, self.Gs(x, s, self.G(x, s)), tw, rhs)
+        return bordered_solve(J, self.Gs(x, s, self.G(x, s)), tw, rhs)
 
     def correct(self, z_pred, t, max_iter=12):
         """Chord iterations with the Jacobian of the last point (formed again once if
@@ -429,7 +424,7 @@ class ShootingContinuation(Continuation):
                 J = self.jacobian(x, s)
                 refreshed = True
             last = err
-            dz = self._bordered(J, self.Gs(x, s, G), tw, -np.concatenate([G, [arc]]))
+            dz = bordered_solve(J, self.Gs(x, s, G), tw, -np.concatenate([G, [arc]]))
             z = z + dz
             if not np.all(np.isfinite(z)):
                 return None, it
@@ -485,12 +480,8 @@ def continue_in_speed_shooting(problem, period, q_static, s0, s1, *, points=50,
     _check_range(s0, s1)
     cont = ShootingContinuation(problem, period, 0.8 * min(s0, s1), q_static, tol,
                                 stability, steps_per_cycle)
-    T = cont.period(s0)
-    y = np.concatenate([q_static, np.zeros(problem.n)])
-    # some transient first (as steady shooting does): closer to the attracting orbit
-    k = 5 if period.max_order < 8 else 1
-    y = problem.integrate(y, 0.0, k * T, k * cont.steps, every=k * cont.steps, speed=s0,
-                          max_rows=1)[3]
+    y = problem.settled_start(np.concatenate([q_static, np.zeros(problem.n)]),
+                              cont.period(s0), cont.steps, s0, period.max_order)
     step = abs(s1 - s0) / max(points - 1, 1)
     max_step = step * 2 if max_step is None else max_step
     pts, folds, msg, complete = cont.run(cont.Q.T @ y, s0, s1, step, max_step, step * 1e-3,
