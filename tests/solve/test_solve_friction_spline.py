@@ -222,3 +222,40 @@ def test_cycle_index_counts_boundary_samples_in_the_cycle_they_start():
     # cycle's new (higher-stiffness) state and is counted in the cycle it starts
     starts = sol.cycle_start[:, 0]
     np.testing.assert_allclose(f * starts, np.arange(len(starts)), atol=1e-9)
+
+
+def _friction_jump_pair():
+    """A loaded mesh (constant stiffness, stays in contact) whose friction table jumps at
+    0.3 of the cycle and at its end, as the sliding direction reverses at a pitch point."""
+    n = 256
+    ph = np.arange(n) / n
+    row = np.where(ph < 0.3, 0.05, -0.05) * (1.0 + ph)
+    return build_structure(
+        ["a.theta", "b.theta", "b.x"], [1e3, 5e2, 1.0],
+        [dict(name="m", kind=MESH, dofs=[0, 1, 2], coefs=[0.05, 0.08, 1.0],
+              stiffness=[2e8, 2e8], frequency=1000.0, damping=200.0,
+              friction=dict(table=[row, 0.02 * row, -0.01 * row], dofs=[0, 1, 2],
+                            coefs=[1.0, 1.0, 0.5], rows=[1, 2, 0])),
+         dict(name="ka", kind=SPRING, dofs=[0], coefs=[1.0], stiffness=1e6, damping=10.0),
+         dict(name="kb", kind=SPRING, dofs=[1], coefs=[1.0], stiffness=1e6, damping=10.0),
+         dict(name="kx", kind=SPRING, dofs=[2], coefs=[1.0], stiffness=1e8, damping=100.0)],
+        external_force=[0.0, 0.0, 1000.0], n_table=n)
+
+
+def test_rk4_keeps_its_order_through_the_jumps_of_a_friction_table():
+    """The jumps of a friction table are corners (kernel_data._corners): RK4 steps end on
+    them, so halving the step divides the error by about 16.  Stepped over (as before,
+    and as with corners=False here), the differences fall by 7x and then 1.4x."""
+    from torquesplit.solve.kernel_data import kernel_model
+
+    s = _friction_jump_pair()
+    m = kernel_model(s)
+    assert {76, 77} <= set(m.corner_node[m.corner_ptr[0]:m.corner_ptr[1]].tolist())
+    y0 = static_equilibrium(s).y0
+    finals = []
+    for spc in (40, 80, 160, 320):
+        sol = integrate(s, y0, (0.0, 0.01), method="rk4", step=1e-3 / spc)
+        assert sol.success and sol.cycle_min.min() > 300.0  # in contact: no force kink
+        finals.append(sol.y_final)
+    diffs = [float(np.max(np.abs(a - b))) for a, b in zip(finals, finals[1:])]
+    assert diffs[0] / diffs[1] > 8.0 and diffs[1] / diffs[2] > 8.0, diffs
