@@ -255,3 +255,34 @@ def test_coinciding_critical_speeds_share_one_line_in_the_sweep_figure():
     assert groups[0][0] == pytest.approx(2640.5)
     ax = sweep_figure(ds).axes[0]
     assert len([t for t in ax.texts if "mode" in t.get_text()]) == 2
+
+
+def test_a_long_period_keeps_every_step_of_the_meshes_and_samples_the_rest(monkeypatch):
+    """A period of more than MAX_SAMPLES steps: the state and every element's force are
+    kept every k-th step (k divides the steps), the meshes at every step, so the mesh
+    table and the Results metrics are those of the run that keeps every step, and the
+    kept samples are its rows (the deformations as the right-hand side gives them)."""
+    import torquesplit.steady.solution as sol
+
+    def solve():
+        return steady_state(example_path(EXAMPLE), stability=False, check=False)
+
+    full = solve()
+    monkeypatch.setattr(sol, "MAX_SAMPLES", 1000)
+    lean = solve()
+    a, b = full.solution, lean.solution
+    steps = a.t.size
+    k = b.sample_every
+    assert a.sample_every == 1 and k > 1 and steps % k == 0 and b.t.size == steps // k
+    np.testing.assert_array_equal(b.t, a.t[::k])
+    np.testing.assert_array_equal(b.forces, a.forces[::k])
+    np.testing.assert_array_equal(b.mesh_forces, a.mesh_forces)
+    assert b.mesh_t.size == steps and b.mesh_forces.shape[1] == len(full.mesh_names)
+    _, _, D = full.problem.accelerations(a.t, np.hstack([a.q, a.v]))
+    np.testing.assert_allclose(a.deformations, D, rtol=0, atol=1e-15 * np.abs(D).max())
+    assert full.mesh_table() == lean.mesh_table()
+    ma, mb = full.to_results().metrics(), lean.to_results().metrics()
+    for ra, rb in zip(ma.rows, mb.rows, strict=True):
+        assert (ra.peak_force, ra.min_force, ra.mean_force, ra.load_sharing,
+                ra.contact_loss) == (rb.peak_force, rb.min_force, rb.mean_force,
+                                     rb.load_sharing, rb.contact_loss)

@@ -323,32 +323,35 @@ def rk4_variational(t0, h, n_steps, m, w, rhs_fn, gen, Phi, S, force, kd, cr, sp
 
 
 @_inline
-def _keep(row, t, w, out_t, out_y, out_f):
-    """Time, state (row Y_STATE) and forces (row F_MAIN) into row ``row`` of the outputs
-    while they have rows; returns the next row."""
+def _keep(row, t, w, out_t, out_y, out_f, out_d):
+    """Time, state (row Y_STATE), forces and deformations (row F_MAIN) into row ``row``
+    of the outputs while they have rows; returns the next row."""
     if row >= out_t.shape[0]:
         return row
-    Y, F = w.Y, w.F
+    Y, F, D = w.Y, w.F, w.D
     out_t[row] = t
     for k in range(out_y.shape[1]):
         out_y[row, k] = Y[Y_STATE, k]
     for e in range(out_f.shape[1]):
         out_f[row, e] = F[F_MAIN, e]
+        out_d[row, e] = D[F_MAIN, e]
     return row + 1
 
 
 @_kernel
-def rk4_samples(t0, h, n_steps, every, m, w, rhs_fn, gen, out_t, out_y, out_f, c_t, c_y,
-                c_f):
+def rk4_samples(t0, h, n_steps, every, m, w, rhs_fn, gen, out_t, out_y, out_f, out_d, c_t,
+                c_y, c_f, track, fine_f, fine_d):
     """Classic RK4 from state row Y_STATE over ``n_steps`` steps of ``h`` from ``t0``, as
     ``_kernels.rk4_run`` steps: the excitation exact at each distinct stage time, and a
     step that holds corners of the tables taken in sub-steps that end on them (so that no
     step straddles a kink of the right-hand side, which would cost RK4 its order).
-    Every ``every`` steps (and at the start) the time, state and element forces are
-    stored in ``out_*`` while they have rows; the time, state and forces at every corner
-    in ``c_*`` while they have rows.  Returns (rows, corner rows), rows -1 if the state
-    became non-finite."""
-    Y = w.Y
+    Every ``every`` steps (and at the start) the time, state, element forces and
+    deformations are stored in ``out_*`` while they have rows; the forces and
+    deformations of the elements ``track`` at every step in ``fine_*`` while they have
+    rows; the time and forces at every corner in ``c_t``, ``c_f`` while they have rows
+    (the state in ``c_y`` too while it has rows).  Returns (rows, corner rows), rows -1
+    if the state became non-finite."""
+    Y, F, D = w.Y, w.F, w.D
     n2 = Y.shape[1]
     extra = m.fr_el.shape[0] > 0 or m.sp_el.shape[0] > 0
     minus = np.int64(-1)
@@ -357,6 +360,7 @@ def rk4_samples(t0, h, n_steps, every, m, w, rhs_fn, gen, out_t, out_y, out_f, c
     b = np.int64(2)
     row = 0
     crow = 0
+    n_fine = fine_f.shape[0]
     t_corner = math.inf
     if m.corner_node.shape[0] > 0 and n_steps > 0:
         t_corner = first_corners(t0, m, w)
@@ -365,7 +369,11 @@ def rk4_samples(t0, h, n_steps, every, m, w, rhs_fn, gen, out_t, out_y, out_f, c
         t = t0 + it * h
         _stage(a, Y_STATE, Y_K1, F_MAIN, m, w, rhs_fn, gen, extra)
         if it % every == 0:
-            row = _keep(row, t, w, out_t, out_y, out_f)
+            row = _keep(row, t, w, out_t, out_y, out_f, out_d)
+        if it < n_fine:
+            for j in range(track.shape[0]):
+                fine_f[it, j] = F[F_MAIN, track[j]]
+                fine_d[it, j] = D[F_MAIN, track[j]]
         if it == n_steps:
             break
         tb = t0 + (it + 1) * h
@@ -376,7 +384,14 @@ def rk4_samples(t0, h, n_steps, every, m, w, rhs_fn, gen, out_t, out_y, out_f, c
                 te = t_corner if t_corner < tb - 1e-6 * h else tb
                 if not first:  # at a corner: its forces, and k1 of the next sub-step
                     _stage(a, Y_STATE, Y_K1, F_MAIN, m, w, rhs_fn, gen, extra)
-                    crow = _keep(crow, ts, w, c_t, c_y, c_f)
+                    if crow < c_t.shape[0]:
+                        c_t[crow] = ts
+                        if crow < c_y.shape[0]:
+                            for k in range(n2):
+                                c_y[crow, k] = Y[Y_STATE, k]
+                        for e in range(c_f.shape[1]):
+                            c_f[crow, e] = F[F_MAIN, e]
+                        crow += 1
                 if te - ts > 1e-6 * h:
                     _rk4_step(ts + 0.5 * (te - ts), te, te - ts, s_half, b, minus, minus, m,
                               w, rhs_fn, gen, extra)

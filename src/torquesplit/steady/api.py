@@ -98,7 +98,8 @@ class SteadyState:
         """(t, forces, deformations) over one period: HB at ``n`` equally spaced times
         (default: at least ``per_cycle`` per cycle of the fastest excitation; q and v by
         trigonometric interpolation, the forces from the model's laws at those times);
-        shooting at its RK4 steps."""
+        shooting at its samples (every ``sample_every``-th RK4 step; the meshes at every
+        step: :meth:`mesh_series`)."""
         ps = self.solution
         if ps.method != "hb":
             return ps.t, ps.forces, ps.deformations
@@ -120,6 +121,18 @@ class SteadyState:
         _, F, D = self.problem.accelerations(t, Y, ps.speed)
         return t, F, D
 
+    def mesh_series(self, elements):
+        """(t, forces, deformations) of the elements ``elements`` (indices) over one
+        period at their finest: every RK4 step for meshes (shooting keeps the other
+        elements every ``sample_every`` steps only), the samples otherwise."""
+        ps = self.solution
+        cols = {int(e): j for j, e in enumerate(ps.mesh_elements)}
+        if ps.method != "hb" and ps.mesh_t.size and all(int(e) in cols for e in elements):
+            idx = [cols[int(e)] for e in elements]
+            return ps.mesh_t, ps.mesh_forces[:, idx], ps.mesh_deformations[:, idx]
+        t, F, D = self.samples()
+        return t, F[:, list(elements)], D[:, list(elements)]
+
     def to_results(self, periods: int | None = None):
         """The periodic state as :class:`~torquesplit.results.Results` (the state
         repeated over ``periods`` periods: default enough for 4 settle windows)."""
@@ -137,19 +150,19 @@ class SteadyState:
         res = self.to_results()
         met = res.metrics(definition)
         names = self.structure.element_names
-        _, F, D = self.samples()
+        _, F, D = self.mesh_series([names.index(r.mesh) for r in met.rows])
         Fc = self.solution.corner_forces  # instants at table corners (shooting)
         if Fc.shape[0] == 0:
-            Fc = np.zeros((0, F.shape[1]))
+            Fc = np.zeros((0, self.structure.n_elements))
         out = []
-        for r in met.rows:
+        for j, r in enumerate(met.rows):
             e = names.index(r.mesh)
-            d = D[:, e]
-            peak = float(max(F[:, e].max(), Fc[:, e].max(initial=-np.inf)))
-            least = float(min(F[:, e].min(), Fc[:, e].min(initial=np.inf)))
+            f, d = F[:, j], D[:, j]
+            peak = float(max(f.max(), Fc[:, e].max(initial=-np.inf)))
+            least = float(min(f.min(), Fc[:, e].min(initial=np.inf)))
             out.append(MeshSteady(
                 mesh=r.mesh, group=r.group, nominal_force=r.nominal_force,
-                static_force=r.static_force, mean_force=float(F[:, e].mean()),
+                static_force=r.static_force, mean_force=float(f.mean()),
                 min_force=least, peak_force=peak,
                 dynamic_factor=peak / r.static_force,
                 peak_to_nominal=peak / r.nominal_force,
@@ -301,13 +314,21 @@ def _as_solution(st: SteadyState, shell, periods):
                 1 << int(math.floor(math.log2(max(RESULT_ROWS // periods, 2)))))
         if n < len(t1):
             t1, F1, D1 = st.samples(n=n)
-    N = len(t1)
     t = (t1[None, :] + T * np.arange(periods)[:, None]).ravel()
     F = np.tile(F1, (periods, 1))
+    # the meshes' statistics from their finest series (shooting: every RK4 step, where
+    # the other elements may be kept every few steps only)
+    if ps.method == "hb":
+        tm, Fm, Dm = t1, F1[:, track], D1[:, track]
+    else:
+        tm, Fm, Dm = st.mesh_series(track)
+    tt = (tm[None, :] + T * np.arange(periods)[:, None]).ravel()
+    Ft = np.tile(Fm, (periods, 1))
     # instants at table corners (shooting): in the per-cycle extremes, as the integrator's
     # corner events, not in sums, counts or contact time
     tc = (ps.corner_t[None, :] + T * np.arange(periods)[:, None]).ravel()
-    Fc = np.tile(ps.corner_forces, (periods, 1)) if tc.size else np.zeros((0, F.shape[1]))
+    Fc = (np.tile(ps.corner_forces[:, track], (periods, 1)) if tc.size
+          else np.zeros((0, len(track))))
     n_tr = len(track)
     cyc_n = []
     per_el = []
@@ -319,7 +340,7 @@ def _as_solution(st: SteadyState, shell, periods):
         return fl + (sph - fl >= 1 - 1e-9)
 
     for e in track:
-        c = cycle_of(e, t)
+        c = cycle_of(e, tt)
         base = c[0]
         idx = (c - base).astype(np.int64)
         per_el.append((idx, base))
@@ -335,14 +356,14 @@ def _as_solution(st: SteadyState, shell, periods):
     cstart = np.zeros((nc, n_tr))
     for j, e in enumerate(track):
         idx, base = per_el[j]
-        f = F[:, e]
+        f = Ft[:, j]
         mx = np.full(nc, -np.inf)
         mn = np.full(nc, np.inf)
         np.maximum.at(mx, idx, f)
         np.minimum.at(mn, idx, f)
         ic, keep = corner_idx[j]
-        np.maximum.at(mx, ic, Fc[keep, e])
-        np.minimum.at(mn, ic, Fc[keep, e])
+        np.maximum.at(mx, ic, Fc[keep, j])
+        np.minimum.at(mn, ic, Fc[keep, j])
         sm = np.zeros(nc)
         np.add.at(sm, idx, f)
         cnt = np.bincount(idx, minlength=nc)
@@ -370,12 +391,12 @@ def _as_solution(st: SteadyState, shell, periods):
         least = GROUP_MIN_LOAD * sum(abs(st.kinematics.meshes[m].force) for m in members)
 
         def ratios(forces, least=least, cols=cols):
-            x = forces[:, [track[c] for c in cols]]
+            x = forces[:, cols]
             total = x.sum(axis=1, keepdims=True)
             with np.errstate(invalid="ignore", divide="ignore"):
                 return len(cols) * x / np.where(total > least, total, np.nan)
 
-        ratio, ratio_c = ratios(F), ratios(Fc)
+        ratio, ratio_c = ratios(Ft), ratios(Fc)
         for i, c in enumerate(cols):
             idx, _ = per_el[c]
             mx = np.full(nc, -np.inf)
@@ -392,13 +413,13 @@ def _as_solution(st: SteadyState, shell, periods):
     sep = np.zeros(s.n_elements)
     back = np.zeros(s.n_elements)
     for e in range(s.n_elements):
+        te, d = (tm, Dm[:, track.index(e)]) if e in track else (t1, D1[:, e])
         gaps = s.gap_values[s.gap_ptr[e]:s.gap_ptr[e + 1]]
         if gaps.size == 1:
-            g = np.full(N, gaps[0])
+            g = np.full(te.size, gaps[0])
         else:
-            cyc = np.floor(s.frequency[e] * t1 + s.phase[e]).astype(np.int64) % gaps.size
+            cyc = np.floor(s.frequency[e] * te + s.phase[e]).astype(np.int64) % gaps.size
             g = gaps[cyc]
-        d = D1[:, e]
         sep[e] = np.mean((g > 0) & (np.abs(d) <= g))
         back[e] = np.mean(np.where(g > 0, d < -g, (s.element_kind[e] == 1) & (d < 0)))
     span = periods * T

@@ -21,6 +21,7 @@ phase) do not.
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 
@@ -35,6 +36,25 @@ RHS_CALLS = 2e6
 """Right-hand-side evaluations a periodic solution is expected to take (a few RK4 periods
 of shooting, or the AFT samples of harmonic-balance Newton steps): what decides whether
 generating the model's right-hand side repays its compilation."""
+
+
+class Run(NamedTuple):
+    """What :meth:`PeriodicProblem.run` returns: samples every ``every`` steps (time,
+    state, forces and deformations of every element), the final state, the instants at
+    the tables' corners (their forces; their states when asked), and the forces and
+    deformations of the ``track`` elements at every step (rows: steps + 1)."""
+
+    t: np.ndarray
+    y: np.ndarray
+    forces: np.ndarray
+    deformations: np.ndarray
+    y_end: np.ndarray
+    corner_t: np.ndarray
+    corner_y: np.ndarray
+    corner_forces: np.ndarray
+    track: np.ndarray
+    track_forces: np.ndarray
+    track_deformations: np.ndarray
 
 
 class PeriodicProblem:
@@ -186,26 +206,44 @@ class PeriodicProblem:
                   corners=False):
         """RK4 (exact excitation per stage, stepping through the tables' corners) from
         ``y0``: returns (t, Y, F, y_end) every ``every`` steps; with ``corners`` also
-        (t, Y, F) at the corner instants inside the steps."""
+        (t, Y, F) at the corner instants inside the steps.  :meth:`run` gives more."""
+        r = self.run(y0, t0, duration, steps, every=every, speed=speed, max_rows=max_rows,
+                     corners=corners, corner_states=corners)
+        out = (r.t, r.y, r.forces, r.y_end)
+        if corners:
+            out += (r.corner_t, r.corner_y, r.corner_forces)
+        return out
+
+    def run(self, y0, t0, duration, steps, *, every=1, speed=1.0, max_rows=None,
+            corners=False, corner_states=False, track=()) -> Run:
+        """RK4 as :meth:`integrate`, with the element deformations at the samples, and the
+        forces and deformations of the elements ``track`` at every step (the source of
+        exact extremes and means when the samples are every ``every`` steps)."""
         rows = steps // every + 1 if max_rows is None else int(max_rows)
         out_t = np.empty(rows)
         out_y = np.empty((rows, 2 * self.n))
         out_f = np.empty((rows, self.ne))
+        out_d = np.empty((rows, self.ne))
         nc = (self.corner_times(t0, t0 + duration, speed).size + 1) if corners else 0
         c_t = np.empty(nc)
-        c_y = np.empty((nc, 2 * self.n))
+        c_y = np.empty((nc if corner_states else 0, 2 * self.n))
         c_f = np.empty((nc, self.ne))
+        track = np.asarray(track, dtype=np.int64)
+        n_fine = steps + 1 if track.size else 0
+        fine_f = np.empty((n_fine, track.size))
+        fine_d = np.empty((n_fine, track.size))
         self.work.Y[kd.Y_STATE] = y0
         got, n_c = sk.rk4_samples(float(t0), float(duration) / steps, int(steps), int(every),
                                   self.model_at(speed), self.work, self.code.function,
-                                  self.code.generated, out_t, out_y, out_f, c_t, c_y, c_f)
+                                  self.code.generated, out_t, out_y, out_f, out_d, c_t, c_y,
+                                  c_f, track, fine_f, fine_d)
         if got < 0:
             raise SolverError("the time integration diverged (non-finite state); use more "
                               "steps per period or check the model.")
-        out = (out_t[:got], out_y[:got], out_f[:got], self.work.Y[kd.Y_STATE].copy())
-        if corners:
-            out += (c_t[:n_c], c_y[:n_c], c_f[:n_c])
-        return out
+        return Run(t=out_t[:got], y=out_y[:got], forces=out_f[:got], deformations=out_d[:got],
+                   y_end=self.work.Y[kd.Y_STATE].copy(), corner_t=c_t[:n_c],
+                   corner_y=c_y[:n_c], corner_forces=c_f[:n_c], track=track,
+                   track_forces=fine_f, track_deformations=fine_d)
 
     def settled_start(self, y0, period, steps, speed=1.0, order=1):
         """``y0`` after some transient (closer to the attracting orbit for shooting): five

@@ -17,6 +17,7 @@ import numpy as np
 
 from torquesplit.errors import ModelWarning, SolverError
 from torquesplit.solve._frozen import freeze_arrays
+from torquesplit.solve._kernels import MESH_KIND
 from torquesplit.steady.harmonic import HarmonicBalance
 from torquesplit.steady.newton import (
     floquet_hill,
@@ -38,6 +39,11 @@ ENERGY_TOL = 1e-7
 the velocity energy.  1e-6 left Liu et al. 2021's spur-split dynamic factors 0.4 % from
 shooting (at 32 harmonics); 1e-7 brings them within 4e-4 and Ji & Li's within 6e-5
 (benchmarks/STEADY_RESULTS.md)."""
+MAX_SAMPLES = 1 << 16
+"""Shooting keeps the state and every element's force at most this many times a period
+(every k-th RK4 step, k the smallest divisor of the steps that gets there), the meshes'
+forces and deformations at every step: Jin et al. 2019's full period (725,200 steps, 52
+DOFs) held 2.2 GB at every step, 3.0 GB with its Results."""
 HILL_LIMIT = 800
 """Largest Hill matrix (complex, square) for Hill's method; larger: the monodromy."""
 AUTO = "shooting unless harmonics or Hill's method are asked for"
@@ -105,6 +111,19 @@ class PeriodicSolution:
     corner_forces: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
     """(len(corner_t), n_el) element forces at those instants.  For extremes only: they
     are instants, not samples (means and spectra use ``t`` alone)."""
+    mesh_elements: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    """Indices of the mesh elements, the columns of ``mesh_forces``."""
+    mesh_t: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    """(M,) times of ``mesh_forces``: every RK4 step of the period (shooting; ``t`` holds
+    every ``sample_every``-th), the samples ``t`` (HB)."""
+    mesh_forces: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    """(M, len(mesh_elements)) forces of the meshes at ``mesh_t``: what the peaks, means,
+    per-cycle statistics and load sharing are taken from."""
+    mesh_deformations: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    """(M, len(mesh_elements)) their deformations (transmission error, contact loss)."""
+    sample_every: int = 1
+    """Shooting: ``t``, ``q``, ``v``, ``forces``, ``deformations`` are every this many RK4
+    steps (1 unless the period has more than :data:`MAX_SAMPLES` steps)."""
 
     def __post_init__(self):
         freeze_arrays(self)
@@ -215,6 +234,15 @@ def converged_hb(p, H, samples, speed, q_static, initial, tol, *, adaptive=True,
         H *= 2**doublings
 
 
+def sample_stride(steps: int, most: int | None = None) -> int:
+    """Smallest divisor k of ``steps`` with steps / k <= ``most`` (default
+    :data:`MAX_SAMPLES`): the samples stay equally spaced over the period."""
+    k = max(1, -(-int(steps) // int(MAX_SAMPLES if most is None else most)))
+    while steps % k:
+        k += 1
+    return k
+
+
 def periodic_solution(structure, period: Period, *, method: str = "auto", harmonics=None,
                       samples=None, speed: float = 1.0, q_static=None, initial=None,
                       tol: float | None = None, adaptive: bool = False,
@@ -241,6 +269,8 @@ def periodic_solution(structure, period: Period, *, method: str = "auto", harmon
         method = "hb" if harmonics is not None or stability == "hill" else "shooting"
     multipliers = None
     stab_method = ""
+    meshes = np.flatnonzero(np.asarray(p.model.element_kind) == MESH_KIND).astype(np.int64)
+    every = 1
     if method == "hb":
         H = int(harmonics) if harmonics is not None else HARMONICS_PER_CYCLE * order
         tol = 1e-10 if tol is None else tol
@@ -278,6 +308,7 @@ def periodic_solution(structure, period: Period, *, method: str = "auto", harmon
                + ("converged" if info.converged else "did NOT converge")
                + f" in {info.iterations} Newton steps (residual {info.residual:.2e})")
         coeffs = x
+        mesh_t, mesh_f, mesh_d = t, F[:, meshes], D[:, meshes]
     else:
         tol = 1e-9 if tol is None else tol
         if initial is not None and np.size(initial) == 2 * p.n:
@@ -287,11 +318,14 @@ def periodic_solution(structure, period: Period, *, method: str = "auto", harmon
                                  np.zeros(p.n)])
             y0 = p.settled_start(y0, T, steps, speed, order)
         y0, Phi, info = solve_shooting(p, y0, steps, speed, tol, monodromy=bool(stability))
-        tt, Y, F, _, corner_t, _, corner_f = p.integrate(y0, 0.0, T, steps, 1, speed,
-                                                          corners=True)
-        t, q, v = tt[:-1], Y[:-1, :p.n], Y[:-1, p.n:]
-        _, _, D = p.accelerations(t, Y[:-1], speed)
-        F = F[:-1]
+        every = sample_stride(steps)
+        run = p.run(y0, 0.0, T, steps, every=every, speed=speed, corners=True,
+                    track=meshes)
+        corner_t, corner_f = run.corner_t, run.corner_forces
+        t, q, v = run.t[:-1], run.y[:-1, :p.n], run.y[:-1, p.n:]
+        F, D = run.forces[:-1], run.deformations[:-1]
+        mesh_t = np.arange(steps) * (T / steps)
+        mesh_f, mesh_d = run.track_forces[:-1], run.track_deformations[:-1]
         t_res = info.residual
         defect = info.residual
         energy = math.nan
@@ -316,6 +350,8 @@ def periodic_solution(structure, period: Period, *, method: str = "auto", harmon
         q=np.asarray(q), v=np.asarray(v), forces=np.asarray(F), deformations=np.asarray(D),
         rigid_load=np.asarray(lam, dtype=float), coefficients=coeffs,
         wall_time=time.perf_counter() - t_start,
+        mesh_elements=meshes, mesh_t=np.asarray(mesh_t), mesh_forces=np.asarray(mesh_f),
+        mesh_deformations=np.asarray(mesh_d), sample_every=every,
         **({} if method == "hb" else dict(corner_t=corner_t, corner_forces=corner_f)))
 
 

@@ -443,12 +443,11 @@ def shooting_point_metrics(cont: ShootingContinuation, x, s, track, groups, stat
     samples and the forces at the tables' corners (peaks and the load-sharing ratio's
     extremes take both; means and the RMS transmission error the samples)."""
     p = cont.p
-    tt, Y, F, _, _, _, Fc = p.integrate(cont.state(x), 0.0, cont.period(s), cont.steps, 1,
-                                        speed=s, corners=True)
-    _, _, D = p.accelerations(tt[:-1], Y[:-1], s)
-    f = F[:-1, track]
-    return _point_outputs(f, np.vstack([f, Fc[:, track]]), D[:, track], groups,
-                          static_forces, nominal)
+    r = p.run(cont.state(x), 0.0, cont.period(s), cont.steps, every=cont.steps, speed=s,
+              corners=True, track=track)
+    f = r.track_forces[:-1]
+    return _point_outputs(f, np.vstack([f, r.corner_forces[:, track]]),
+                          r.track_deformations[:-1], groups, static_forces, nominal)
 
 
 def _point_outputs(f, f_all, d, groups, static_forces, nominal):
@@ -561,16 +560,16 @@ def stepped_sweep(problem, period, q_static, speeds, *, settle_periods=200,
         try:
             _, _, _, y = p.integrate(y, 0.0, settle_periods * T, settle_periods * steps,
                                      every=settle_periods * steps, speed=s)
-            tt, Y, F, y, _, _, Fc = p.integrate(y, 0.0, record_periods * T,
-                                                record_periods * steps, 1, speed=s,
-                                                corners=True)
+            r = p.run(y, 0.0, record_periods * T, record_periods * steps,
+                      every=record_periods * steps, speed=s, corners=True, track=track)
         except SolverError:
             break
-        _, _, D = p.accelerations(tt, Y, s)
-        # the peaks at the tables' corners too, as the integrators' statistics take them
-        peaks[i] = np.vstack([F[:, list(track)], Fc[:, list(track)]]).max(axis=0)
-        d = D[:, list(track)]
-        rms[i] = np.sqrt(np.mean((d - d.mean(axis=0)) ** 2, axis=0))
+        y = r.y_end
+        if len(track):
+            # the peaks at the tables' corners too, as the integrators' statistics take them
+            peaks[i] = np.vstack([r.track_forces, r.corner_forces[:, list(track)]]).max(axis=0)
+            d = r.track_deformations
+            rms[i] = np.sqrt(np.mean((d - d.mean(axis=0)) ** 2, axis=0))
         if progress is not None:
             progress((i + 1) / len(speeds))
     return peaks, rms
