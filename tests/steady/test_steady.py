@@ -360,3 +360,28 @@ def test_continuation_failure_keeps_the_partial_curve(monkeypatch):
     assert "kept" in msg and "--method hb" in msg
     with pytest.raises(SolverError, match="two different positive speeds"):
         continue_in_speed_shooting(p, per, np.array([1.1]), 1.5, 1.5)
+
+
+def test_cycle_extremes_equal_a_scatter_over_the_samples():
+    """The per-cycle max / min of a Results record from a periodic state are reductions
+    over runs of equal cycle index; against np.maximum.at / np.minimum.at over every
+    sample, NaN samples (a group carrying no load) and instants between them included."""
+    from torquesplit.steady.api import cycle_extremes
+
+    rng = np.random.default_rng(5)
+    cyc = np.sort(rng.integers(0, 40, 3000))
+    cyc[cyc == 7] = 8  # a cycle without samples
+    v = rng.normal(size=cyc.size)
+    v[rng.random(cyc.size) < 0.2] = np.nan
+    v[cyc == 11] = np.nan  # a cycle with only NaN samples
+    ec = rng.integers(0, 42, 50)
+    ev = rng.normal(scale=3.0, size=50)
+    ev[:5] = np.nan
+    mx, mn = cycle_extremes(v, cyc, 42, ec, ev)
+    rx, rn = np.full(42, -np.inf), np.full(42, np.inf)
+    for c, x in ((cyc, v), (ec, ev)):
+        ok = ~np.isnan(x)
+        np.maximum.at(rx, c[ok], x[ok])
+        np.minimum.at(rn, c[ok], x[ok])
+    np.testing.assert_array_equal(mx, rx)
+    np.testing.assert_array_equal(mn, rn)

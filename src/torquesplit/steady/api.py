@@ -129,6 +129,8 @@ class SteadyState:
         cols = {int(e): j for j, e in enumerate(ps.mesh_elements)}
         if ps.method != "hb" and ps.mesh_t.size and all(int(e) in cols for e in elements):
             idx = [cols[int(e)] for e in elements]
+            if idx == list(range(len(cols))):  # all of them, in order: no copy
+                return ps.mesh_t, ps.mesh_forces, ps.mesh_deformations
             return ps.mesh_t, ps.mesh_forces[:, idx], ps.mesh_deformations[:, idx]
         t, F, D = self.samples()
         return t, F[:, list(elements)], D[:, list(elements)]
@@ -289,6 +291,32 @@ RESULT_ROWS = 1 << 18
 statistics and history), before the samples per period are reduced."""
 
 
+def cycle_extremes(values, cycles, n, extra_cycles=None, extra=None):
+    """Per-cycle max and min (arrays of ``n``; -inf / inf where a cycle has none) of
+    ``values`` in cycles ``cycles`` (non-decreasing: the samples of a cycle form one run)
+    and of the instants ``extra`` in ``extra_cycles`` (any order); NaN values (a group
+    carrying no load) left out."""
+    mx = np.full(n, -np.inf)
+    mn = np.full(n, np.inf)
+    for v, c, runs in ((values, cycles, True), (extra, extra_cycles, False)):
+        if v is None:
+            continue
+        ok = ~np.isnan(v)
+        v, c = v[ok], c[ok]
+        if not v.size:
+            continue
+        if runs:  # a reduction per run instead of a scatter per sample
+            starts = np.concatenate([[0], np.flatnonzero(np.diff(c)) + 1])
+            c, vmax, vmin = c[starts], np.maximum.reduceat(v, starts), np.minimum.reduceat(
+                v, starts)
+            mx[c] = np.maximum(mx[c], vmax)
+            mn[c] = np.minimum(mn[c], vmin)
+        else:
+            np.maximum.at(mx, c, v)
+            np.minimum.at(mn, c, v)
+    return mx, mn
+
+
 def _as_solution(st: SteadyState, shell, periods):
     """An integrate.Solution made of the periodic state repeated over a few periods."""
     from torquesplit.solve.integrate import Solution
@@ -323,59 +351,52 @@ def _as_solution(st: SteadyState, shell, periods):
     else:
         tm, Fm, Dm = st.mesh_series(track)
     tt = (tm[None, :] + T * np.arange(periods)[:, None]).ravel()
-    Ft = np.tile(Fm, (periods, 1))
     # instants at table corners (shooting): in the per-cycle extremes, as the integrator's
     # corner events, not in sums, counts or contact time
     tc = (ps.corner_t[None, :] + T * np.arange(periods)[:, None]).ravel()
     Fc = (np.tile(ps.corner_forces[:, track], (periods, 1)) if tc.size
           else np.zeros((0, len(track))))
     n_tr = len(track)
-    cyc_n = []
-    per_el = []
-    corner_idx = []
 
-    def cycle_of(e, times):
+    def cycle_of(e, times):  # the statistics cycle of element e at each time (laws.stat_cycle)
         sph = s.frequency[e] * times + s.phase[e]
         fl = np.floor(sph)
         return fl + (sph - fl >= 1 - 1e-9)
 
-    for e in track:
-        c = cycle_of(e, tt)
-        base = c[0]
-        idx = (c - base).astype(np.int64)
-        per_el.append((idx, base))
-        cyc_n.append(int(idx.max()) + 1)
-        ic = (cycle_of(e, tc) - base).astype(np.int64)
-        keep = (ic >= 0) & (ic <= idx.max())
-        corner_idx.append((ic[keep], keep))
+    bases = [cycle_of(e, tt[:1])[0] for e in track]
+
+    def cycles(j, times):
+        return (cycle_of(track[j], times) - bases[j]).astype(np.int64)
+
+    cyc_n = [int(cycles(j, tt[-1:])[0]) + 1 for j in range(n_tr)]
     nc = max(cyc_n) if cyc_n else 0
+    corner_idx = []
+    for j in range(n_tr):
+        ic = cycles(j, tc)
+        keep = (ic >= 0) & (ic < cyc_n[j])
+        corner_idx.append((ic[keep], keep))
     cmax = np.full((nc, n_tr), np.nan)
     cmin = np.full((nc, n_tr), np.nan)
     csum = np.zeros((nc, n_tr))
     ccnt = np.zeros((nc, n_tr), dtype=np.int64)
     cstart = np.zeros((nc, n_tr))
     for j, e in enumerate(track):
-        idx, base = per_el[j]
-        f = Ft[:, j]
-        mx = np.full(nc, -np.inf)
-        mn = np.full(nc, np.inf)
-        np.maximum.at(mx, idx, f)
-        np.minimum.at(mn, idx, f)
+        idx = cycles(j, tt)
+        f = np.tile(Fm[:, j], periods)
         ic, keep = corner_idx[j]
-        np.maximum.at(mx, ic, Fc[keep, j])
-        np.minimum.at(mn, ic, Fc[keep, j])
-        sm = np.zeros(nc)
-        np.add.at(sm, idx, f)
-        cnt = np.bincount(idx, minlength=nc)
+        mx, mn = cycle_extremes(f, idx, nc, ic, Fc[keep, j])
+        sm = np.bincount(idx, weights=f, minlength=nc)
+        counts = np.bincount(idx, minlength=nc)
+        cnt = counts.copy()
         # the first and last cycles are partial (phase offsets): left out
         cnt[0] = 0
         cnt[cyc_n[j] - 1:] = 0
         ok = cnt > 0
         cmax[ok, j] = mx[ok]
         cmin[ok, j] = mn[ok]
-        csum[ok, j] = sm[ok] / np.bincount(idx, minlength=nc)[ok]
+        csum[ok, j] = sm[ok] / counts[ok]
         ccnt[:, j] = cnt
-        cstart[:, j] = (base + np.arange(nc) - s.phase[e]) / s.frequency[e]
+        cstart[:, j] = (bases[j] + np.arange(nc) - s.phase[e]) / s.frequency[e]
     # per-cycle extremes of the instantaneous load-sharing ratio N f_i / sum_j f_j of each
     # group (Ji & Li eq. 18), from the same samples (what the integrator streams)
     from torquesplit.metrics.load_sharing import group_meshes
@@ -390,22 +411,16 @@ def _as_solution(st: SteadyState, shell, periods):
 
         least = GROUP_MIN_LOAD * sum(abs(st.kinematics.meshes[m].force) for m in members)
 
-        def ratios(forces, least=least, cols=cols):
-            x = forces[:, cols]
+        def ratios(x, least=least):
             total = x.sum(axis=1, keepdims=True)
             with np.errstate(invalid="ignore", divide="ignore"):
-                return len(cols) * x / np.where(total > least, total, np.nan)
+                return x.shape[1] * x / np.where(total > least, total, np.nan)
 
-        ratio, ratio_c = ratios(Ft), ratios(Fc)
+        ratio = ratios(np.tile(Fm[:, cols], (periods, 1)))
+        ratio_c = ratios(Fc[:, cols])
         for i, c in enumerate(cols):
-            idx, _ = per_el[c]
-            mx = np.full(nc, -np.inf)
-            mn = np.full(nc, np.inf)
-            for ix, rt in ((idx, ratio[:, i]),
-                           (corner_idx[c][0], ratio_c[corner_idx[c][1], i])):
-                ok_s = np.isfinite(rt)
-                np.maximum.at(mx, ix[ok_s], rt[ok_s])
-                np.minimum.at(mn, ix[ok_s], rt[ok_s])
+            ic, keep = corner_idx[c]
+            mx, mn = cycle_extremes(ratio[:, i], cycles(c, tt), nc, ic, ratio_c[keep, i])
             ok = ccnt[:, c] > 0
             rmax[ok, c] = mx[ok]
             rmin[ok, c] = mn[ok]
