@@ -286,3 +286,26 @@ def test_a_long_period_keeps_every_step_of_the_meshes_and_samples_the_rest(monke
         assert (ra.peak_force, ra.min_force, ra.mean_force, ra.load_sharing,
                 ra.contact_loss) == (rb.peak_force, rb.min_force, rb.mean_force,
                                      rb.load_sharing, rb.contact_loss)
+
+
+def test_the_monodromy_is_the_derivative_of_the_cornered_period_map():
+    """The variational equations step through the stiffness tables' corners in the
+    sub-steps of the period map shooting solves for: the state they carry is that map's
+    to the bit, and the monodromy equals its central differences (to their own error,
+    about 1e-8 here; stepping over the corners left 1e-5 to 4e-5)."""
+    st = steady_state(example_path(EXAMPLE), keep="stage1", method="shooting",
+                      stability=False, check=False)
+    p, ps = st.problem, st.solution
+    steps, T, y0 = ps.t.size, ps.period, ps.y0
+    assert ps.corner_t.size > 0
+
+    def period_map(y):
+        return p.integrate(y, 0.0, T, steps, every=steps, max_rows=1)[3]
+
+    yT, Phi = p.integrate_variational(y0, 0.0, T, steps)
+    np.testing.assert_array_equal(yT, period_map(y0))
+    rng = np.random.default_rng(0)
+    for _ in range(4):
+        v = rng.normal(size=y0.size) * (np.abs(y0) + 1e-12)
+        fd = (period_map(y0 + 1e-6 * v) - period_map(y0 - 1e-6 * v)) / 2e-6
+        assert np.linalg.norm(fd - Phi @ v) <= 1e-6 * np.linalg.norm(fd)

@@ -263,18 +263,16 @@ def _var_stage(slot, iy, idy, m, w, rhs_fn, gen, extra, Pin, Pout, force, kd, cr
     _jvp(m, kd, cr, spt, frv, fps, Pin[:n], Pin[n:], Pout[n:], DF)
 
 
-@_kernel
-def rk4_variational(t0, h, n_steps, m, w, rhs_fn, gen, Phi, S, force, kd, cr, spt, frv,
-                    fps, DF):
-    """Classic RK4 from state row Y_STATE of w.Y and variations ``Phi`` (2n, n_col) over
-    ``n_steps`` steps of ``h`` from ``t0``, both advanced in place: the variations obey
-    the RK4 discretisation of dPhi/dt = A(t, y(t)) Phi (so Phi is the exact derivative of
-    the discrete step map).  ``S`` scratch (5, 2n, n_col), ``DF`` (ne, n_col).
-    Returns 0, or 1 if the state became non-finite."""
+@_inline
+def _var_step(t_mid, t_end, hs, m, w, rhs_fn, gen, extra, Phi, S, force, kd, cr, spt, frv,
+              fps, DF):
+    """One classic RK4 step of length hs of the state (row Y_STATE) and its variations
+    Phi, from the excitation already in slot 0 to t_end (slot 2), midpoint t_mid (slot
+    1), both evaluated exactly: the arithmetic of ``_kernels._rk4_step``.  Returns True
+    if the state became non-finite."""
     Y = w.Y
     n2 = Y.shape[1]
     nc = Phi.shape[1]
-    extra = m.fr_el.shape[0] > 0 or m.sp_el.shape[0] > 0
     s0 = np.int64(0)
     s1 = np.int64(1)
     s2 = np.int64(2)
@@ -282,42 +280,77 @@ def rk4_variational(t0, h, n_steps, m, w, rhs_fn, gen, Phi, S, force, kd, cr, sp
     k2 = Y_K1 + 1
     k3 = Y_K1 + 2
     k4 = Y_K1 + 3
-    hh = 0.5 * h
-    h6 = h / 6.0
+    hh = 0.5 * hs
     K1, K2, K3, K4, PT = S[0], S[1], S[2], S[3], S[4]
+    _var_stage(s0, Y_STATE, k1, m, w, rhs_fn, gen, extra, Phi, K1, force, kd, cr, spt, frv,
+               fps, DF)
+    excite(t_mid, s1, np.int64(-1), m, w)
+    for k in range(n2):
+        Y[Y_TRIAL, k] = Y[Y_STATE, k] + hh * Y[k1, k]
+        for c in range(nc):
+            PT[k, c] = Phi[k, c] + hh * K1[k, c]
+    _var_stage(s1, Y_TRIAL, k2, m, w, rhs_fn, gen, extra, PT, K2, force, kd, cr, spt, frv,
+               fps, DF)
+    for k in range(n2):
+        Y[Y_TRIAL, k] = Y[Y_STATE, k] + hh * Y[k2, k]
+        for c in range(nc):
+            PT[k, c] = Phi[k, c] + hh * K2[k, c]
+    _var_stage(s1, Y_TRIAL, k3, m, w, rhs_fn, gen, extra, PT, K3, force, kd, cr, spt, frv,
+               fps, DF)
+    excite(t_end, s2, np.int64(-1), m, w)
+    for k in range(n2):
+        Y[Y_TRIAL, k] = Y[Y_STATE, k] + hs * Y[k3, k]
+        for c in range(nc):
+            PT[k, c] = Phi[k, c] + hs * K3[k, c]
+    _var_stage(s2, Y_TRIAL, k4, m, w, rhs_fn, gen, extra, PT, K4, force, kd, cr, spt, frv,
+               fps, DF)
+    h6 = hs / 6.0
+    bad = False
+    for k in range(n2):
+        Y[Y_STATE, k] += h6 * (Y[k1, k] + 2.0 * (Y[k2, k] + Y[k3, k]) + Y[k4, k])
+        if not np.isfinite(Y[Y_STATE, k]):
+            bad = True
+        for c in range(nc):
+            Phi[k, c] += h6 * (K1[k, c] + 2.0 * (K2[k, c] + K3[k, c]) + K4[k, c])
+    excite(t_end, s0, np.int64(-1), m, w)  # the next step's start
+    return bad
+
+
+@_kernel
+def rk4_variational(t0, h, n_steps, m, w, rhs_fn, gen, Phi, S, force, kd, cr, spt, frv,
+                    fps, DF):
+    """Classic RK4 from state row Y_STATE of w.Y and variations ``Phi`` (2n, n_col) over
+    ``n_steps`` steps of ``h`` from ``t0``, both advanced in place, stepping through the
+    tables' corners in the sub-steps :func:`rk4_samples` takes: the variations obey the
+    RK4 discretisation of dPhi/dt = A(t, y(t)) Phi, so Phi is the exact derivative of
+    the discrete period map that shooting solves for (and its Floquet multipliers those
+    of that map).  ``S`` scratch (5, 2n, n_col), ``DF`` (ne, n_col).
+    Returns 0, or 1 if the state became non-finite."""
+    extra = m.fr_el.shape[0] > 0 or m.sp_el.shape[0] > 0
+    t_corner = math.inf
+    if m.corner_node.shape[0] > 0 and n_steps > 0:
+        t_corner = first_corners(t0, m, w)
+    excite(t0, np.int64(0), np.int64(-1), m, w)
     for it in range(n_steps):
         t = t0 + it * h
-        excite(t, s0, np.int64(-1), m, w)
-        _var_stage(s0, Y_STATE, k1, m, w, rhs_fn, gen, extra, Phi, K1, force, kd, cr,
-                   spt, frv, fps, DF)
-        excite(t + hh, s1, np.int64(-1), m, w)
-        for k in range(n2):
-            Y[Y_TRIAL, k] = Y[Y_STATE, k] + hh * Y[k1, k]
-            for c in range(nc):
-                PT[k, c] = Phi[k, c] + hh * K1[k, c]
-        _var_stage(s1, Y_TRIAL, k2, m, w, rhs_fn, gen, extra, PT, K2, force, kd, cr,
-                   spt, frv, fps, DF)
-        for k in range(n2):
-            Y[Y_TRIAL, k] = Y[Y_STATE, k] + hh * Y[k2, k]
-            for c in range(nc):
-                PT[k, c] = Phi[k, c] + hh * K2[k, c]
-        _var_stage(s1, Y_TRIAL, k3, m, w, rhs_fn, gen, extra, PT, K3, force, kd, cr,
-                   spt, frv, fps, DF)
-        excite(t0 + (it + 1) * h, s2, np.int64(-1), m, w)
-        for k in range(n2):
-            Y[Y_TRIAL, k] = Y[Y_STATE, k] + h * Y[k3, k]
-            for c in range(nc):
-                PT[k, c] = Phi[k, c] + h * K3[k, c]
-        _var_stage(s2, Y_TRIAL, k4, m, w, rhs_fn, gen, extra, PT, K4, force, kd, cr,
-                   spt, frv, fps, DF)
-        bad = False
-        for k in range(n2):
-            Y[Y_STATE, k] += h6 * (Y[k1, k] + 2.0 * (Y[k2, k] + Y[k3, k]) + Y[k4, k])
-            if not np.isfinite(Y[Y_STATE, k]):
-                bad = True
-            for c in range(nc):
-                Phi[k, c] += h6 * (K1[k, c] + 2.0 * (K2[k, c] + K3[k, c]) + K4[k, c])
-        if bad:
+        tb = t0 + (it + 1) * h
+        if t_corner < tb:
+            ts = t
+            while True:
+                te = t_corner if t_corner < tb - 1e-6 * h else tb
+                if te - ts > 1e-6 * h:
+                    if _var_step(ts + 0.5 * (te - ts), te, te - ts, m, w, rhs_fn, gen, extra,
+                                 Phi, S, force, kd, cr, spt, frv, fps, DF):
+                        return 1
+                    ts = te
+                if te >= tb:
+                    break
+                t_corner = advance_corners(te, m, w)
+            if ts < tb:  # the last corner fell within 1e-6 h of tb
+                excite(tb, np.int64(0), np.int64(-1), m, w)
+            t_corner = advance_corners(tb, m, w)
+        elif _var_step(t + 0.5 * h, tb, h, m, w, rhs_fn, gen, extra, Phi, S, force, kd, cr,
+                       spt, frv, fps, DF):
             return 1
     return 0
 

@@ -223,9 +223,8 @@ def solve_shooting(p: PeriodicProblem, y0, steps: int, speed=1.0, tol=1e-9, max_
     products = [0]
 
     def period_map(y):
-        # RK4 through the tables' corners, as the integrators step; the variational
-        # equations (the monodromy) step straight over them: their Newton steps are those
-        # of a Jacobian a step's kink error off, their fixed point the same
+        # RK4 through the tables' corners, as the integrators step (the variational
+        # equations take the same sub-steps: the monodromy is this map's derivative)
         return p.integrate(y, 0.0, T, steps, every=steps, speed=speed, max_rows=1)[3]
 
     while True:
