@@ -274,6 +274,7 @@ def test_a_long_period_keeps_every_step_of_the_meshes_and_samples_the_rest(monke
     steps = a.t.size
     k = b.sample_every
     assert a.sample_every == 1 and k > 1 and steps % k == 0 and b.t.size == steps // k
+    assert f"kept every {k} steps" in b.message and "kept every" not in a.message
     np.testing.assert_array_equal(b.t, a.t[::k])
     np.testing.assert_array_equal(b.forces, a.forces[::k])
     np.testing.assert_array_equal(b.mesh_forces, a.mesh_forces)

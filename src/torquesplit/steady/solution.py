@@ -340,7 +340,9 @@ def periodic_solution(structure, period: Period, *, method: str = "auto", harmon
                + ("converged" if info.converged else "did NOT converge")
                + f" in {info.iterations} Newton steps (defect {info.residual:.2e}"
                + (f", {info.products} matrix-free monodromy products)" if info.products
-                  else ")"))
+                  else ")")
+               + (f"; waveforms kept every {every} steps, the meshes' forces at every step"
+                  if every > 1 else ""))
         coeffs = None
     return PeriodicSolution(
         method=method, converged=info.converged, message=msg, speed=float(speed),
