@@ -310,3 +310,28 @@ def test_the_monodromy_is_the_derivative_of_the_cornered_period_map():
         v = rng.normal(size=y0.size) * (np.abs(y0) + 1e-12)
         fd = (period_map(y0 + 1e-6 * v) - period_map(y0 - 1e-6 * v)) / 2e-6
         assert np.linalg.norm(fd - Phi @ v) <= 1e-6 * np.linalg.norm(fd)
+
+
+def test_newton_picard_step_on_a_period_over_which_every_mode_decays():
+    """Liu et al. 2021's full period (3638 bevel cycles): every mode of the linearised
+    model keeps less than PICARD_RHO of itself over it, so after the first matrix-free
+    Newton step the second is taken on the products already made (Newton-Picard): fewer
+    products, the same periodic state.  Ji & Li's slow load-characteristic mode (0.88
+    over its period) rules the step out there."""
+    from torquesplit.steady.newton import _slow_modes, solve_shooting
+
+    ji = steady_state(example_path(EXAMPLE), stability=False, check=False)
+    assert _slow_modes(ji.problem, ji.solution.period) > 0
+    st = steady_state(example_path("liu2021_split_torque_helicopter"), stability=False,
+                      check=False, max_cycles=5000, tol=1e-2)  # the problem, cheaply
+    p, ps = st.problem, st.solution
+    assert _slow_modes(p, ps.period) == 0 and st.period.max_order > 3000
+    steps = ps.mesh_t.size
+    y0 = p.settled_start(np.concatenate([st.static.q, np.zeros(p.n)]), ps.period, steps,
+                         1.0, st.period.max_order)
+    runs = [solve_shooting(p, y0, steps, monodromy=False, newton_picard=npk)
+            for npk in (True, False)]
+    (ya, _, a), (yb, _, b) = runs
+    assert a.converged and b.converged and a.products < b.products
+    V = st.structure.projection_matrix()
+    assert np.max(np.abs(V @ (ya - yb)[:p.n])) <= 1e-8 * np.max(np.abs(V @ yb[:p.n]))
