@@ -264,6 +264,16 @@ def _var_stage(slot, iy, idy, m, w, rhs_fn, gen, extra, Pin, Pout, force, kd, cr
 
 
 @_inline
+def _var_trial(w, k_row, Phi, K, PT, scale):
+    """Trial state y + scale k (row Y_TRIAL of w.Y) and variations Phi + scale K (PT)."""
+    Y = w.Y
+    for k in range(Y.shape[1]):
+        Y[Y_TRIAL, k] = Y[Y_STATE, k] + scale * Y[k_row, k]
+        for c in range(PT.shape[1]):
+            PT[k, c] = Phi[k, c] + scale * K[k, c]
+
+
+@_inline
 def _var_step(t_mid, t_end, hs, m, w, rhs_fn, gen, extra, Phi, S, force, kd, cr, spt, frv,
               fps, DF):
     """One classic RK4 step of length hs of the state (row Y_STATE) and its variations
@@ -285,23 +295,14 @@ def _var_step(t_mid, t_end, hs, m, w, rhs_fn, gen, extra, Phi, S, force, kd, cr,
     _var_stage(s0, Y_STATE, k1, m, w, rhs_fn, gen, extra, Phi, K1, force, kd, cr, spt, frv,
                fps, DF)
     excite(t_mid, s1, np.int64(-1), m, w)
-    for k in range(n2):
-        Y[Y_TRIAL, k] = Y[Y_STATE, k] + hh * Y[k1, k]
-        for c in range(nc):
-            PT[k, c] = Phi[k, c] + hh * K1[k, c]
+    _var_trial(w, k1, Phi, K1, PT, hh)
     _var_stage(s1, Y_TRIAL, k2, m, w, rhs_fn, gen, extra, PT, K2, force, kd, cr, spt, frv,
                fps, DF)
-    for k in range(n2):
-        Y[Y_TRIAL, k] = Y[Y_STATE, k] + hh * Y[k2, k]
-        for c in range(nc):
-            PT[k, c] = Phi[k, c] + hh * K2[k, c]
+    _var_trial(w, k2, Phi, K2, PT, hh)
     _var_stage(s1, Y_TRIAL, k3, m, w, rhs_fn, gen, extra, PT, K3, force, kd, cr, spt, frv,
                fps, DF)
     excite(t_end, s2, np.int64(-1), m, w)
-    for k in range(n2):
-        Y[Y_TRIAL, k] = Y[Y_STATE, k] + hs * Y[k3, k]
-        for c in range(nc):
-            PT[k, c] = Phi[k, c] + hs * K3[k, c]
+    _var_trial(w, k3, Phi, K3, PT, hs)
     _var_stage(s2, Y_TRIAL, k4, m, w, rhs_fn, gen, extra, PT, K4, force, kd, cr, spt, frv,
                fps, DF)
     h6 = hs / 6.0
