@@ -335,3 +335,23 @@ def test_newton_picard_step_on_a_period_over_which_every_mode_decays():
     assert a.converged and b.converged and a.products < b.products
     V = st.structure.projection_matrix()
     assert np.max(np.abs(V @ (ya - yb)[:p.n])) <= 1e-8 * np.max(np.abs(V @ yb[:p.n]))
+
+
+def test_progress_says_what_a_long_steady_state_is_doing():
+    """The progress callback hears each phase: the transient, every Newton step with its
+    defect (matrix-free: with the products so far), the waveforms, the monodromy; for
+    harmonic balance the harmonics tried and the Floquet multipliers."""
+    heard = []
+    st = steady_state(example_path(EXAMPLE), stability=True, check=False,
+                      progress=lambda fraction, what: heard.append((fraction, what)))
+    texts = [w for _, w in heard]
+    assert all(f is None for f, _ in heard)
+    assert texts[0].startswith("settling the transient")
+    newton = [t for t in texts if "Newton step" in t]
+    assert len(newton) == st.solution.iterations + 1 and "products" in newton[-1]
+    assert f"{st.solution.residual:.1e}" in newton[-1]
+    assert texts[-2] == "the period's waveforms" and "monodromy" in texts[-1]
+    heard.clear()
+    steady_state(example_path(EXAMPLE), keep="stage1", harmonics=16,
+                 progress=lambda fraction, what: heard.append(what))
+    assert heard[0] == "harmonic balance, 16 harmonics" and "Floquet multipliers" in heard

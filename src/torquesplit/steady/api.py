@@ -179,7 +179,7 @@ def steady_state(model, *, method: str = "auto", harmonics: int | None = None,
                  max_cycles: int | None | str = "auto", stability: bool | str = True,
                  adaptive: bool | None = None, energy_tol: float = ENERGY_TOL,
                  tol: float | None = None, steps_per_cycle: int | None = None,
-                 check: bool = True, initial=None) -> SteadyState:
+                 check: bool = True, initial=None, progress=None) -> SteadyState:
     """Periodic steady state of a model at one speed.
 
     Parameters
@@ -226,6 +226,10 @@ def steady_state(model, *, method: str = "auto", harmonics: int | None = None,
         (default 100, refined for the highest mode).
     check : bool
         HB: integrate one period from the solution and report the periodicity defect.
+    progress : callable, optional
+        ``progress(None, what)`` is called as the solver moves on (settling, each Newton
+        step with its defect, the harmonics tried, the Floquet multipliers): what a long
+        run is doing, e.g. for the command line's spinner.
 
     Returns
     -------
@@ -267,7 +271,7 @@ def steady_state(model, *, method: str = "auto", harmonics: int | None = None,
                             samples=samples, speed=factor, q_static=static.q, initial=initial,
                             tol=tol, adaptive=adaptive, energy_tol=energy_tol,
                             stability=stability, steps_per_cycle=steps_per_cycle,
-                            check=check, problem=problem)
+                            check=check, problem=problem, progress=progress)
     return SteadyState(model=model, kinematics=kin, structure=structure, static=static,
                        period=per, solution=sol, dropped=dropped, problem=problem)
 

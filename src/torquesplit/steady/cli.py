@@ -91,10 +91,12 @@ def register(app, load, fail, console, err_console, json_default):
             m, _ = load(model)
             from torquesplit.cli_support import collect_warnings, progress
 
-            with collect_warnings(), progress("periodic steady state", as_json, total=None):
+            with collect_warnings(), progress("periodic steady state", as_json,
+                                              total=None) as update:
                 st = steady_state(m, method=method, harmonics=harmonics, adaptive=adaptive,
                                   keep=_keep(keep), speed=_speed(speed, "--speed"),
-                                  max_cycles="auto" if max_cycles is None else max_cycles)
+                                  max_cycles="auto" if max_cycles is None else max_cycles,
+                                  progress=update)
             rows = st.mesh_table()
             saved = st.to_results().save(out) if out is not None else None
         except (TorquesplitError, ValueError, OSError) as exc:

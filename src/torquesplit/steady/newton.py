@@ -209,7 +209,7 @@ def _slow_modes(p: PeriodicProblem, T: float) -> int:
 
 def solve_shooting(p: PeriodicProblem, y0, steps: int, speed=1.0, tol=1e-9, max_iter=25,
                    krylov: bool | None = None, monodromy: bool = True,
-                   newton_picard: bool = True):
+                   newton_picard: bool = True, say=None):
     """Newton on the period map: returns (y0, monodromy or None, NewtonInfo).
 
     Converged when one period returns to the start within ``tol`` of the largest
@@ -231,7 +231,8 @@ def solve_shooting(p: PeriodicProblem, y0, steps: int, speed=1.0, tol=1e-9, max_
     made, without new ones (Newton in their span, the rest of the monodromy taken as 0:
     Lust, Roose, Spence & Champneys 1998, SIAM J. Sci. Comput. 19(4)) where every mode of
     the linearised model decays over the period (:data:`PICARD_RHO`); where the defect
-    does not then fall tenfold, GMRES from there on."""
+    does not then fall tenfold, GMRES from there on.  ``say(text)``, if given, hears of
+    each Newton step (its defect and the products so far)."""
     n = p.n
     T = 1.0 / (p.frequency * speed)
     w = 2 * math.pi / T
@@ -278,6 +279,9 @@ def solve_shooting(p: PeriodicProblem, y0, steps: int, speed=1.0, tol=1e-9, max_
         recycled = False
         hist.append(err)
         log.debug("shooting Newton %d: defect %.3e", it, err)
+        if say is not None:
+            say(f"shooting, Newton step {it}: defect {err:.1e} (tolerance {tol:.0e})"
+                + (f", {products[0]} products" if products[0] else ""))
         if err <= tol or it >= max_iter:
             break
         it += 1

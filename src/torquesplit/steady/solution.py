@@ -186,7 +186,7 @@ def top_energy(hb: HarmonicBalance, x, speed=1.0) -> float:
 
 
 def converged_hb(p, H, samples, speed, q_static, initial, tol, *, adaptive=True,
-                 energy_tol=ENERGY_TOL, max_harmonics=2**15, smallest=False):
+                 energy_tol=ENERGY_TOL, max_harmonics=2**15, smallest=False, say=None):
     """HB solution with H harmonics; with ``adaptive``, H raised (each solve started from
     the last) until the top quarter of the harmonics holds at most ``energy_tol`` of the
     velocity energy.  H is doubled, or after two converged solves multiplied by the power
@@ -200,6 +200,8 @@ def converged_hb(p, H, samples, speed, q_static, initial, tol, *, adaptive=True,
     info, top energy)."""
     best, last, stalled, jumped = None, None, 0, False
     while True:
+        if say is not None:
+            say(f"harmonic balance, {H} harmonics")
         hb = HarmonicBalance(p, H, samples)
         x0 = _initial_hb(hb, q_static, initial)
         x, info = solve_hb(hb, x0, speed, tol)
@@ -248,11 +250,16 @@ def periodic_solution(structure, period: Period, *, method: str = "auto", harmon
                       tol: float | None = None, adaptive: bool = False,
                       energy_tol: float = ENERGY_TOL, max_harmonics: int = 2**15,
                       stability: bool | str = True, steps_per_cycle: int | None = None,
-                      check: bool = True, problem: PeriodicProblem | None = None
-                      ) -> PeriodicSolution:
+                      check: bool = True, problem: PeriodicProblem | None = None,
+                      progress=None) -> PeriodicSolution:
     """Periodic steady state of ``structure`` over ``period`` (see :func:`steady_state`
     for the parameters).  ``q_static`` starts the iteration (HB: as the mean)."""
     t_start = time.perf_counter()
+
+    def say(what: str) -> None:
+        if progress is not None:
+            progress(None, what)
+
     if method not in ("auto", "hb", "shooting"):
         raise SolverError(f"unknown method {method!r}; use method='hb' (harmonic balance), "
                           "method='shooting' or method='auto' (shooting unless harmonics "
@@ -276,7 +283,7 @@ def periodic_solution(structure, period: Period, *, method: str = "auto", harmon
         tol = 1e-10 if tol is None else tol
         hb, x, info, energy = converged_hb(p, H, samples, speed, q_static, initial, tol,
                                            adaptive=adaptive, energy_tol=energy_tol,
-                                           max_harmonics=max_harmonics)
+                                           max_harmonics=max_harmonics, say=say)
         H = hb.H
         if adaptive and info.converged and energy > energy_tol:
             warnings.warn(
@@ -292,6 +299,7 @@ def periodic_solution(structure, period: Period, *, method: str = "auto", harmon
         _, lam = hb.split(x)
         v = hb._states(q, v, lam)[:, p.n:]  # physical velocity (rigid speed offset included)
         if stability:
+            say("Floquet multipliers")
             if stability == "hill" or (stability is True and hill_applies(p, H, f)):
                 multipliers = floquet_hill(hb, x, speed, None if stability == "hill" else H)
                 stab_method = "hill"
@@ -316,8 +324,11 @@ def periodic_solution(structure, period: Period, *, method: str = "auto", harmon
         else:
             y0 = np.concatenate([q_static if q_static is not None else np.zeros(p.n),
                                  np.zeros(p.n)])
+            say(f"settling the transient ({steps:,} RK4 steps per period)")
             y0 = p.settled_start(y0, T, steps, speed, order)
-        y0, Phi, info = solve_shooting(p, y0, steps, speed, tol, monodromy=bool(stability))
+        y0, Phi, info = solve_shooting(p, y0, steps, speed, tol, monodromy=bool(stability),
+                                       say=say)
+        say("the period's waveforms")
         every = sample_stride(steps)
         run = p.run(y0, 0.0, T, steps, every=every, speed=speed, corners=True,
                     track=meshes)
@@ -333,6 +344,8 @@ def periodic_solution(structure, period: Period, *, method: str = "auto", harmon
         lam = np.zeros(p.nr)
         if stability:
             if Phi is None:  # matrix-free Newton: the monodromy at the solution
+                say(f"Floquet multipliers: the monodromy, {2 * p.n} columns over "
+                    f"{steps:,} RK4 steps")
                 _, Phi = p.integrate_variational(y0, 0.0, T, steps, speed)
             multipliers = floquet_monodromy(p, Phi)
             stab_method = "monodromy"
