@@ -88,7 +88,8 @@ class PeriodicSolution:
     stability_method: str
     """'monodromy', 'hill' or '' (not computed)."""
     t: np.ndarray
-    """(N,) sample times over one period [s]."""
+    """(N,) sample times over one period [s]: HB's samples; shooting's RK4 steps, every
+    ``sample_every``-th on a long period (the meshes at every step: ``mesh_t``)."""
     q: np.ndarray
     """(N, n) displacements [m, rad]."""
     v: np.ndarray
