@@ -201,6 +201,11 @@ def test_cli_steady_sweep_and_campbell(tmp_path):
     out = json.loads(r.output)
     assert out["converged"] and out["harmonics"] == 16 and out["stable"]
     assert set(out["meshes"]) == {"m11", "m21", "m12", "m22"}
+    r = CliRunner().invoke(app, ["steady", EXAMPLE, "--keep", "stage1", "--no-stability"])
+    assert r.exit_code == 0 and "stability: not computed (--no-stability)" in r.output
+    r = CliRunner().invoke(app, ["steady", EXAMPLE, "--keep", "stage1", "--no-stability",
+                                 "--json"])
+    assert json.loads(r.output)["stable"] is None
     r = CliRunner().invoke(app, ["sweep-speed", EXAMPLE, "--keep", "stage1", "--from",
                                  "700 rpm", "--to", "790 rpm", "--points", "4",
                                  "--harmonics", "8", "--no-stability", "--plot",

@@ -72,11 +72,15 @@ def register(app, load, fail, console, err_console, json_default):
         keep: Optional[str] = typer.Option(
             None, "--keep", help="Keep only the excitations periodic with this stage, mesh, "
             "body or frequency [Hz]; the others by their means."),
-        speed: Optional[str] = typer.Option(None, "--speed",
-                                            help="Input speed, e.g. '1200 rpm' (default the model's)."),
+        speed: Optional[str] = typer.Option(
+            None, "--speed", help="Input speed, e.g. '1200 rpm' (default the model's)."),
         max_cycles: Optional[int] = typer.Option(
             None, "--max-cycles", help="Longest period accepted, in cycles of the fastest "
             "excitation (default 1000 for hb, 10000 for shooting and auto)."),
+        stability: bool = typer.Option(
+            True, "--stability/--no-stability", help="Floquet multipliers of the periodic "
+            "state. Over a period of thousands of cycles the monodromy (2n variational "
+            "columns) can take most of the run."),
         out: Optional[Path] = typer.Option(None, "--out", help="Write results (.nc, .mat, .csv)."),
         as_json: bool = typer.Option(False, "--json", help="Print the results as JSON."),
     ):
@@ -96,7 +100,7 @@ def register(app, load, fail, console, err_console, json_default):
                 st = steady_state(m, method=method, harmonics=harmonics, adaptive=adaptive,
                                   keep=_keep(keep), speed=_speed(speed, "--speed"),
                                   max_cycles="auto" if max_cycles is None else max_cycles,
-                                  progress=update)
+                                  stability=stability, progress=update)
             rows = st.mesh_table()
             saved = st.to_results().save(out) if out is not None else None
         except (TorquesplitError, ValueError, OSError) as exc:
@@ -136,6 +140,8 @@ def register(app, load, fail, console, err_console, json_default):
                 console.print(f"stability ({ps.stability_method}): "
                               f"{'stable' if ps.stable else 'UNSTABLE'}, largest Floquet "
                               f"multiplier |mu| = {abs(mu[0]):.6f}")
+            elif not stability:
+                console.print("stability: not computed (--no-stability)")
             t = Table(title="meshes (periodic steady state)")
             for col in ("mesh", "group", "static F [N]", "mean F [N]", "peak F [N]",
                         "DF (peak/static)", "peak/nominal", "LSC", "RMS TE [µm]",
