@@ -40,9 +40,9 @@ MAX_CYCLES = 1000
 """Default largest number of cycles of the fastest excitation in one period (harmonic
 balance: its harmonics grow with the cycles)."""
 MAX_CYCLES_SHOOTING = 10_000
-"""The same for shooting (its cost grows with the RK4 steps of one period: on a 2-core
-machine Liu et al. 2021's full period, 3638 cycles, takes about 10 s, Jin et al. 2019's,
-7252 cycles with tooth friction, about 20 s)."""
+"""The same for shooting (its cost grows with the RK4 steps of one period: Liu et al.
+2021's full period holds 3638 cycles, Jin et al. 2019's 7252; their times are in
+benchmarks/STEADY_RESULTS.md)."""
 
 
 def default_max_cycles(method: str) -> int:
