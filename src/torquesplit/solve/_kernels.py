@@ -602,6 +602,17 @@ def bad_state(iy, blowup, w):
     Twin: ``np.flatnonzero(~np.isfinite(y) | (abs(q) > blowup))[:1]``."""
     y = w.Y
     n = y.shape[1] // 2
+    # fast path without a branch per entry: x - x is 0 for a finite x, NaN otherwise
+    big = 0.0
+    spread = 0.0
+    for i in range(n):
+        a = abs(y[iy, i])
+        big = a if a > big else big
+        spread += y[iy, i] - y[iy, i]
+    for i in range(n, y.shape[1]):
+        spread += y[iy, i] - y[iy, i]
+    if big <= blowup and spread == 0.0:
+        return -1
     for i in range(n):
         if not abs(y[iy, i]) <= blowup:  # also true for NaN
             return i
