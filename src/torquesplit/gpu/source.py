@@ -513,13 +513,13 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
         w("ts = t")
         w("first = True")
         with w.block("while True:"):
-            w("te = t_corner if t_corner < tb - 1e-6 * h else tb")
+            w(f"te = t_corner if t_corner < tb - {kern.MERGE!r} * h else tb")
             with w.block("if not first:"):
                 w(f"rhs(I0, I{W_Y}, I{W_K1}, X, W, P, PT, PI, c)")
                 w("record_extrema(X, WI, W, OF, OI, P, PT, PI, c)")
                 w(f"WI[{WI_CNT + _I.I_RHS}] += 1")
                 w(f"WI[{WI_CNT + _I.I_EVENTS}] += 1")
-            with w.block("if te - ts > 1e-6 * h:"):
+            with w.block(f"if te - ts > {kern.MERGE!r} * h:"):
                 w("rk4_step(ts + 0.5 * (te - ts), te, te - ts, IM1, IM1, X, WI, W, P, PT, PI, "
                   "c, TK, TF, TFR, GS)")
                 w("copy_slot(X, WI)")

@@ -623,6 +623,19 @@ def bad_state(iy, blowup, w):
 
 
 # ======================================================================== RK4
+MERGE = 1e-6
+"""A corner within MERGE x h of the end of its step (or of the previous corner) takes no
+sub-step of its own: every loop through the corners (``rk4_through_corners``, the
+steady-state kernels, the GPU source) splits a step by :func:`sub_step_end` alone."""
+
+
+@_inline
+def sub_step_end(t_corner, tb, h):
+    """End of the next sub-step of a step ending at tb: the next corner, or tb when that
+    corner lies within MERGE h of it."""
+    return t_corner if t_corner < tb - MERGE * h else tb
+
+
 @njit(inline="always", error_model="numpy")
 def _rk4_step(t_mid, t_end, hs, s_half, sb, src_half, src_end, m, w, rhs_fn, gen, extra):
     """One classic RK4 step of length hs, the state in row Y_STATE and its derivative
@@ -669,13 +682,13 @@ def rk4_through_corners(t, tb, t_corner, sa, sb, m, w, r, rhs_fn, gen, counters)
     ts = t
     first = True
     while True:
-        te = t_corner if t_corner < tb - 1e-6 * h else tb
+        te = sub_step_end(t_corner, tb, h)
         if not first:  # the corner: its exact forces, and k1 of the next sub-step
             _stage(sa, Y_STATE, Y_K1, F_MAIN, m, w, rhs_fn, gen, extra)
             record_extrema(sa, np.int64(F_MAIN), w, r)
             counters[I_RHS] += 1
             counters[I_EVENTS] += 1
-        if te - ts > 1e-6 * h:
+        if te - ts > MERGE * h:
             _rk4_step(ts + 0.5 * (te - ts), te, te - ts, s_half, sb, minus, minus, m, w,
                       rhs_fn, gen, extra)
             counters[I_RHS] += 3
@@ -685,7 +698,7 @@ def rk4_through_corners(t, tb, t_corner, sa, sb, m, w, r, rhs_fn, gen, counters)
         if te >= tb:
             break
         t_corner = advance_corners(te, m, w)
-    if ts < tb:  # the last corner fell within 1e-6 h of tb: nothing left to step
+    if ts < tb:  # the last corner fell within MERGE h of tb: nothing left to step
         excite(tb, sa, minus, m, w)
     return sa, advance_corners(tb, m, w)
 

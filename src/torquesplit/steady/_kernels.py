@@ -42,11 +42,13 @@ from numba import njit
 
 from torquesplit.solve import laws
 from torquesplit.solve._kernels import (
+    MERGE,
     _rk4_step,
     _stage,
     advance_corners,
     excite,
     first_corners,
+    sub_step_end,
 )
 from torquesplit.solve.kernel_data import F_MAIN, Y_K1, Y_STATE, Y_TRIAL
 
@@ -274,18 +276,18 @@ def _var_trial(w, k_row, Phi, K, PT, scale):
 
 
 @_inline
-def _var_step(t_mid, t_end, hs, m, w, rhs_fn, gen, extra, Phi, S, force, kd, cr, spt, frv,
-              fps, DF):
+def _var_step(t_mid, t_end, hs, sa, sb, m, w, rhs_fn, gen, extra, Phi, S, force, kd, cr,
+              spt, frv, fps, DF):
     """One classic RK4 step of length hs of the state (row Y_STATE) and its variations
-    Phi, from the excitation already in slot 0 to t_end (slot 2), midpoint t_mid (slot
-    1), both evaluated exactly: the arithmetic of ``_kernels._rk4_step``.  Returns True
-    if the state became non-finite."""
+    Phi, from the excitation already in slot ``sa`` to t_end (into slot ``sb``), midpoint
+    t_mid (slot 1), both evaluated exactly: the arithmetic of ``_kernels._rk4_step``.
+    Returns True if the state became non-finite."""
     Y = w.Y
     n2 = Y.shape[1]
     nc = Phi.shape[1]
-    s0 = np.int64(0)
+    s0 = sa
     s1 = np.int64(1)
-    s2 = np.int64(2)
+    s2 = sb
     k1 = Y_K1
     k2 = Y_K1 + 1
     k3 = Y_K1 + 2
@@ -313,7 +315,6 @@ def _var_step(t_mid, t_end, hs, m, w, rhs_fn, gen, extra, Phi, S, force, kd, cr,
             bad = True
         for c in range(nc):
             Phi[k, c] += h6 * (K1[k, c] + 2.0 * (K2[k, c] + K3[k, c]) + K4[k, c])
-    excite(t_end, s0, np.int64(-1), m, w)  # the next step's start
     return bad
 
 
@@ -331,28 +332,33 @@ def rk4_variational(t0, h, n_steps, m, w, rhs_fn, gen, Phi, S, force, kd, cr, sp
     t_corner = math.inf
     if m.corner_node.shape[0] > 0 and n_steps > 0:
         t_corner = first_corners(t0, m, w)
-    excite(t0, np.int64(0), np.int64(-1), m, w)
+    a = np.int64(0)  # slot of the excitation at the current time
+    b = np.int64(2)
+    excite(t0, a, np.int64(-1), m, w)
     for it in range(n_steps):
         t = t0 + it * h
         tb = t0 + (it + 1) * h
         if t_corner < tb:
             ts = t
             while True:
-                te = t_corner if t_corner < tb - 1e-6 * h else tb
-                if te - ts > 1e-6 * h:
-                    if _var_step(ts + 0.5 * (te - ts), te, te - ts, m, w, rhs_fn, gen, extra,
-                                 Phi, S, force, kd, cr, spt, frv, fps, DF):
+                te = sub_step_end(t_corner, tb, h)
+                if te - ts > MERGE * h:
+                    if _var_step(ts + 0.5 * (te - ts), te, te - ts, a, b, m, w, rhs_fn, gen,
+                                 extra, Phi, S, force, kd, cr, spt, frv, fps, DF):
                         return 1
+                    a, b = b, a
                     ts = te
                 if te >= tb:
                     break
                 t_corner = advance_corners(te, m, w)
-            if ts < tb:  # the last corner fell within 1e-6 h of tb
-                excite(tb, np.int64(0), np.int64(-1), m, w)
+            if ts < tb:  # the last corner fell within MERGE h of tb
+                excite(tb, a, np.int64(-1), m, w)
             t_corner = advance_corners(tb, m, w)
-        elif _var_step(t + 0.5 * h, tb, h, m, w, rhs_fn, gen, extra, Phi, S, force, kd, cr,
-                       spt, frv, fps, DF):
-            return 1
+        else:
+            if _var_step(t + 0.5 * h, tb, h, a, b, m, w, rhs_fn, gen, extra, Phi, S, force,
+                         kd, cr, spt, frv, fps, DF):
+                return 1
+            a, b = b, a
     return 0
 
 
@@ -415,7 +421,7 @@ def rk4_samples(t0, h, n_steps, every, m, w, rhs_fn, gen, out_t, out_y, out_f, o
             ts = t
             first = True
             while True:
-                te = t_corner if t_corner < tb - 1e-6 * h else tb
+                te = sub_step_end(t_corner, tb, h)
                 if not first:  # at a corner: its forces, and k1 of the next sub-step
                     _stage(a, Y_STATE, Y_K1, F_MAIN, m, w, rhs_fn, gen, extra)
                     if crow < c_t.shape[0]:
@@ -426,7 +432,7 @@ def rk4_samples(t0, h, n_steps, every, m, w, rhs_fn, gen, out_t, out_y, out_f, o
                         for e in range(c_f.shape[1]):
                             c_f[crow, e] = F[F_MAIN, e]
                         crow += 1
-                if te - ts > 1e-6 * h:
+                if te - ts > MERGE * h:
                     _rk4_step(ts + 0.5 * (te - ts), te, te - ts, s_half, b, minus, minus, m,
                               w, rhs_fn, gen, extra)
                     a, b = b, a
@@ -435,7 +441,7 @@ def rk4_samples(t0, h, n_steps, every, m, w, rhs_fn, gen, out_t, out_y, out_f, o
                 if te >= tb:
                     break
                 t_corner = advance_corners(te, m, w)
-            if ts < tb:  # the last corner fell within 1e-6 h of tb
+            if ts < tb:  # the last corner fell within MERGE h of tb
                 excite(tb, a, minus, m, w)
             t_corner = advance_corners(tb, m, w)
         else:

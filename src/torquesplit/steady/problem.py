@@ -52,7 +52,6 @@ class Run(NamedTuple):
     corner_t: np.ndarray
     corner_y: np.ndarray
     corner_forces: np.ndarray
-    track: np.ndarray
     track_forces: np.ndarray
     track_deformations: np.ndarray
 
@@ -242,8 +241,8 @@ class PeriodicProblem:
                               "steps per period or check the model.")
         return Run(t=out_t[:got], y=out_y[:got], forces=out_f[:got], deformations=out_d[:got],
                    y_end=self.work.Y[kd.Y_STATE].copy(), corner_t=c_t[:n_c],
-                   corner_y=c_y[:n_c], corner_forces=c_f[:n_c], track=track,
-                   track_forces=fine_f, track_deformations=fine_d)
+                   corner_y=c_y[:n_c], corner_forces=c_f[:n_c], track_forces=fine_f,
+                   track_deformations=fine_d)
 
     def settled_start(self, y0, period, steps, speed=1.0, order=1):
         """``y0`` after some transient (closer to the attracting orbit for shooting): five

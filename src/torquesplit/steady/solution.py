@@ -113,10 +113,11 @@ class PeriodicSolution:
     """(len(corner_t), n_el) element forces at those instants.  For extremes only: they
     are instants, not samples (means and spectra use ``t`` alone)."""
     mesh_elements: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
-    """Indices of the mesh elements, the columns of ``mesh_forces``."""
+    """Shooting: indices of the mesh elements, the columns of ``mesh_forces`` (HB: empty,
+    its samples ``t`` serve)."""
     mesh_t: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    """(M,) times of ``mesh_forces``: every RK4 step of the period (shooting; ``t`` holds
-    every ``sample_every``-th), the samples ``t`` (HB)."""
+    """(M,) times of ``mesh_forces``: every RK4 step of the period (``t`` holds every
+    ``sample_every``-th)."""
     mesh_forces: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
     """(M, len(mesh_elements)) forces of the meshes at ``mesh_t``: what the peaks, means,
     per-cycle statistics and load sharing are taken from."""
@@ -277,7 +278,6 @@ def periodic_solution(structure, period: Period, *, method: str = "auto", harmon
         method = "hb" if harmonics is not None or stability == "hill" else "shooting"
     multipliers = None
     stab_method = ""
-    meshes = np.flatnonzero(np.asarray(p.model.element_kind) == MESH_KIND).astype(np.int64)
     every = 1
     if method == "hb":
         H = int(harmonics) if harmonics is not None else HARMONICS_PER_CYCLE * order
@@ -317,7 +317,6 @@ def periodic_solution(structure, period: Period, *, method: str = "auto", harmon
                + ("converged" if info.converged else "did NOT converge")
                + f" in {info.iterations} Newton steps (residual {info.residual:.2e})")
         coeffs = x
-        mesh_t, mesh_f, mesh_d = t, F[:, meshes], D[:, meshes]
     else:
         tol = 1e-9 if tol is None else tol
         if initial is not None and np.size(initial) == 2 * p.n:
@@ -331,6 +330,7 @@ def periodic_solution(structure, period: Period, *, method: str = "auto", harmon
                                        say=say)
         say("the period's waveforms")
         every = sample_stride(steps)
+        meshes = np.flatnonzero(np.asarray(p.model.element_kind) == MESH_KIND)
         run = p.run(y0, 0.0, T, steps, every=every, speed=speed, corners=True,
                     track=meshes)
         corner_t, corner_f = run.corner_t, run.corner_forces
@@ -366,9 +366,10 @@ def periodic_solution(structure, period: Period, *, method: str = "auto", harmon
         q=np.asarray(q), v=np.asarray(v), forces=np.asarray(F), deformations=np.asarray(D),
         rigid_load=np.asarray(lam, dtype=float), coefficients=coeffs,
         wall_time=time.perf_counter() - t_start,
-        mesh_elements=meshes, mesh_t=np.asarray(mesh_t), mesh_forces=np.asarray(mesh_f),
-        mesh_deformations=np.asarray(mesh_d), sample_every=every,
-        **({} if method == "hb" else dict(corner_t=corner_t, corner_forces=corner_f)))
+        sample_every=every,
+        **({} if method == "hb" else dict(
+            corner_t=corner_t, corner_forces=corner_f, mesh_elements=meshes,
+            mesh_t=mesh_t, mesh_forces=mesh_f, mesh_deformations=mesh_d)))
 
 
 def hill_applies(p: PeriodicProblem, H: int, frequency: float) -> bool:
