@@ -87,11 +87,54 @@ def test_matrix_free_shooting_reaches_the_monodromy_s_state():
     p = PeriodicProblem(_lti(), F0)
     y0 = np.array([1e-3, -2e-3, 0.1, 0.0])
     y_d, Phi, info_d = solve_shooting(p, y0, 800, krylov=False)
-    y_k, none, info_k = solve_shooting(p, y0, 800, krylov=True)
+    y_k, none, info_k = solve_shooting(p, y0, 800, krylov=True, anderson=False)
     assert info_d.converged and info_k.converged and none is None and Phi is not None
     assert info_d.iterations == 1 and info_d.products == 0
     assert info_k.iterations <= 2 and 0 < info_k.products <= 4 * info_k.iterations
+    assert info_k.anderson == 0
     assert np.max(np.abs(y_k - y_d)) <= 1e-8 * np.max(np.abs(y_d))
+
+
+def test_anderson_accelerated_shooting_is_gmres_on_a_linear_map():
+    """On a linear period map Anderson acceleration with full memory is GMRES (Walker &
+    Ni 2011, Theorem 2.2): after the settling map, once its secants span the 4 state
+    dimensions the next map lands on the periodic state (the defect falls to rounding at
+    once, from above 0.1), with no products.  Each defect map's record is the period from
+    the state it started at, and the returned one is the returned state's."""
+    p = PeriodicProblem(_lti(), F0)
+    y0 = np.array([1e-3, -2e-3, 0.1, 0.0])
+    T = 1.0 / F0
+    y_d, _, _ = solve_shooting(p, y0, 800, krylov=False)
+    kept = [None]
+
+    def record(y):
+        kept[0] = p.run(y, 0.0, T, 800, every=100, corners=True, track=[1], out=kept[0])
+        return kept[0]
+
+    y_a, none, info = solve_shooting(p, y0, 800, krylov=True, record=record)
+    assert info.converged and none is None and info.products == 0
+    assert info.anderson == info.iterations <= 1 + 1 + 4 + 1
+    assert min(info.history[:-1]) > 0.1 and info.history[-1] <= 1e-12
+    assert np.max(np.abs(y_a - y_d)) <= 1e-8 * np.max(np.abs(y_d))
+    fresh = p.run(y_a, 0.0, T, 800, every=100, corners=True, track=[1])
+    for a, b in zip(info.run, fresh):
+        assert np.array_equal(a, b)
+    assert np.array_equal(info.run.y[0], y_a)
+
+
+def test_anderson_hands_over_to_newton_when_it_stalls(monkeypatch):
+    """Where the Anderson iteration has not converged within its maps, Newton-Krylov goes
+    on from its best state (here after 3 maps, on the linear case that needs 7)."""
+    import torquesplit.steady.newton as newton
+
+    monkeypatch.setattr(newton, "ANDERSON_MAPS", 3)
+    p = PeriodicProblem(_lti(), F0)
+    y0 = np.array([1e-3, -2e-3, 0.1, 0.0])
+    y_d, _, _ = solve_shooting(p, y0, 800, krylov=False)
+    y_a, _, info = solve_shooting(p, y0, 800, krylov=True)
+    assert info.converged and info.anderson == 3 and info.products > 0
+    assert info.iterations > info.anderson
+    assert np.max(np.abs(y_a - y_d)) <= 1e-8 * np.max(np.abs(y_d))
 
 
 def test_shooting_and_floquet_of_the_lti_case():

@@ -138,13 +138,13 @@ def test_harmonics_short_of_convergence_are_said():
 
 
 def test_a_long_period_is_shot_matrix_free():
-    """Ji & Li's full period holds 168 stage-1 mesh cycles: the default method shoots,
-    Newton-Krylov (a few products of the period map, no monodromy), and the state it
+    """Ji & Li's full period holds 168 stage-1 mesh cycles: the default method shoots
+    matrix-free (Anderson-accelerated period maps, no monodromy), and the state it
     returns is periodic when integrated again, independently of the solver's check."""
     st = steady_state(example_path(EXAMPLE), stability=False, check=False)
     ps = st.solution
     assert ps.method == "shooting" and ps.converged and st.period.max_order == 168
-    assert "matrix-free" in ps.message
+    assert "Anderson-accelerated period maps" in ps.message and "Newton" not in ps.message
     p = st.problem
     y0 = np.concatenate([ps.q[0], ps.v[0]])
     steps = ps.t.size
@@ -322,7 +322,8 @@ def test_newton_picard_step_on_a_period_over_which_every_mode_decays():
     model keeps less than PICARD_RHO of itself over it, so after the first matrix-free
     Newton step the second is taken on the products already made (Newton-Picard): fewer
     products, the same periodic state.  Ji & Li's slow load-characteristic mode (0.88
-    over its period) rules the step out there."""
+    over its period) rules the step out there.  The default (Anderson-accelerated period
+    maps) needs fewer maps than either."""
     from torquesplit.steady.newton import _slow_modes, solve_shooting
 
     ji = steady_state(example_path(EXAMPLE), stability=False, check=False)
@@ -334,28 +335,33 @@ def test_newton_picard_step_on_a_period_over_which_every_mode_decays():
     steps = ps.mesh_t.size
     y0 = p.settled_start(np.concatenate([st.static.q, np.zeros(p.n)]), ps.period, steps,
                          1.0, st.period.max_order)
-    runs = [solve_shooting(p, y0, steps, monodromy=False, newton_picard=npk)
-            for npk in (True, False)]
+    runs = [solve_shooting(p, y0, steps, monodromy=False, newton_picard=npk,
+                           anderson=False) for npk in (True, False)]
     (ya, _, a), (yb, _, b) = runs
     assert a.converged and b.converged and a.products < b.products
     V = st.structure.projection_matrix()
     assert np.max(np.abs(V @ (ya - yb)[:p.n])) <= 1e-8 * np.max(np.abs(V @ yb[:p.n]))
+    # the default, Anderson-accelerated maps: the same state in fewer period maps than
+    # either Newton (a defect map per step and one per product)
+    yc, _, c = solve_shooting(p, y0, steps, monodromy=False)
+    assert c.converged and c.anderson == c.iterations and c.products == 0
+    assert c.anderson < a.iterations + 1 + a.products
+    assert np.max(np.abs(V @ (yc - yb)[:p.n])) <= 1e-8 * np.max(np.abs(V @ yb[:p.n]))
 
 
 def test_progress_says_what_a_long_steady_state_is_doing():
-    """The progress callback hears each phase: the transient, every Newton step with its
-    defect (matrix-free: with the products so far), the waveforms, the monodromy; for
-    harmonic balance the harmonics tried and the Floquet multipliers."""
+    """The progress callback hears each phase: every period map of the matrix-free
+    (Anderson-accelerated) iteration with its defect, the monodromy; for harmonic
+    balance the harmonics tried and the Floquet multipliers."""
     heard = []
     st = steady_state(example_path(EXAMPLE), stability=True, check=False,
                       progress=lambda fraction, what: heard.append((fraction, what)))
     texts = [w for _, w in heard]
     assert all(f is None for f, _ in heard)
-    assert texts[0].startswith("settling the transient")
-    newton = [t for t in texts if "Newton step" in t]
-    assert len(newton) == st.solution.iterations + 1 and "products" in newton[-1]
-    assert f"{st.solution.residual:.1e}" in newton[-1]
-    assert texts[-2] == "the period's waveforms" and "monodromy" in texts[-1]
+    maps = [t for t in texts if "Anderson step" in t]
+    assert texts[:len(maps)] == maps and len(maps) == st.solution.iterations
+    assert f"{st.solution.residual:.1e}" in maps[-1]
+    assert len(texts) == len(maps) + 1 and "monodromy" in texts[-1]
     heard.clear()
     steady_state(example_path(EXAMPLE), keep="stage1", harmonics=16,
                  progress=lambda fraction, what: heard.append(what))

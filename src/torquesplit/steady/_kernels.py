@@ -46,6 +46,7 @@ from torquesplit.solve._kernels import (
     _rk4_step,
     _stage,
     advance_corners,
+    bad_state,
     excite,
     first_corners,
     sub_step_end,
@@ -54,6 +55,10 @@ from torquesplit.solve.kernel_data import F_MAIN, Y_K1, Y_STATE, Y_TRIAL
 
 _kernel = njit(cache=True, error_model="numpy", _nrt=False)
 _inline = njit(inline="always", error_model="numpy")
+
+NO_BLOWUP = 1.7976931348623157e308
+"""The divergence check of the period maps: a non-finite state only (``bad_state``
+with the largest float as its bound, so that an infinite displacement counts)."""
 
 
 @_kernel
@@ -448,7 +453,6 @@ def rk4_samples(t0, h, n_steps, every, m, w, rhs_fn, gen, out_t, out_y, out_f, o
             _rk4_step(t + 0.5 * h, tb, h, s_half, b, minus, minus, m, w, rhs_fn, gen,
                       extra)
             a, b = b, a
-        for k in range(n2):
-            if not np.isfinite(Y[Y_STATE, k]):
-                return -1, crow
+        if bad_state(Y_STATE, NO_BLOWUP, w) >= 0:
+            return -1, crow
     return row, crow

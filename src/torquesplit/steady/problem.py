@@ -214,23 +214,30 @@ class PeriodicProblem:
         return out
 
     def run(self, y0, t0, duration, steps, *, every=1, speed=1.0, max_rows=None,
-            corners=False, corner_states=False, track=()) -> Run:
+            corners=False, corner_states=False, track=(), out: Run | None = None) -> Run:
         """RK4 as :meth:`integrate`, with the element deformations at the samples, and the
         forces and deformations of the elements ``track`` at every step (the source of
-        exact extremes and means when the samples are every ``every`` steps)."""
-        rows = steps // every + 1 if max_rows is None else int(max_rows)
-        out_t = np.empty(rows)
-        out_y = np.empty((rows, 2 * self.n))
-        out_f = np.empty((rows, self.ne))
-        out_d = np.empty((rows, self.ne))
-        nc = (self.corner_times(t0, t0 + duration, speed).size + 1) if corners else 0
-        c_t = np.empty(nc)
-        c_y = np.empty((nc if corner_states else 0, 2 * self.n))
-        c_f = np.empty((nc, self.ne))
+        exact extremes and means when the samples are every ``every`` steps).  ``out``:
+        the Run of an earlier call with the same arguments, whose arrays this one fills
+        again (its results are then overwritten: repeated periods without allocating)."""
+        if out is None:
+            rows = steps // every + 1 if max_rows is None else int(max_rows)
+            nc = (self.corner_times(t0, t0 + duration, speed).size + 1) if corners else 0
+            n_fine = steps + 1 if len(track) else 0
+            out = Run(t=np.empty(rows), y=np.empty((rows, 2 * self.n)),
+                      forces=np.empty((rows, self.ne)), deformations=np.empty((rows, self.ne)),
+                      y_end=None, corner_t=np.empty(nc),
+                      corner_y=np.empty((nc if corner_states else 0, 2 * self.n)),
+                      corner_forces=np.empty((nc, self.ne)),
+                      track_forces=np.empty((n_fine, len(track))),
+                      track_deformations=np.empty((n_fine, len(track))))
+        else:  # the arrays in full (a Run returned holds views of the rows filled)
+            out = out._replace(**{k: v.base if v.base is not None else v
+                                  for k, v in out._asdict().items() if k != "y_end"})
+        out_t, out_y, out_f, out_d = out.t, out.y, out.forces, out.deformations
+        c_t, c_y, c_f = out.corner_t, out.corner_y, out.corner_forces
+        fine_f, fine_d = out.track_forces, out.track_deformations
         track = np.asarray(track, dtype=np.int64)
-        n_fine = steps + 1 if track.size else 0
-        fine_f = np.empty((n_fine, track.size))
-        fine_d = np.empty((n_fine, track.size))
         self.work.Y[kd.Y_STATE] = y0
         got, n_c = sk.rk4_samples(float(t0), float(duration) / steps, int(steps), int(every),
                                   self.model_at(speed), self.work, self.code.function,

@@ -22,6 +22,7 @@ from torquesplit.steady.harmonic import HarmonicBalance
 from torquesplit.steady.newton import (
     floquet_hill,
     floquet_monodromy,
+    matrix_free,
     solve_hb,
     solve_shooting,
 )
@@ -319,20 +320,27 @@ def periodic_solution(structure, period: Period, *, method: str = "auto", harmon
         coeffs = x
     else:
         tol = 1e-9 if tol is None else tol
+        every = sample_stride(steps)
+        meshes = np.flatnonzero(np.asarray(p.model.element_kind) == MESH_KIND)
+
+        kept = [None]
+
+        def record(y):  # every defect map keeps the period's waveforms (in one set of
+            kept[0] = p.run(y, 0.0, T, steps, every=every, speed=speed, corners=True,
+                            track=meshes, out=kept[0])  # arrays: the last map's)
+            return kept[0]
+
         if initial is not None and np.size(initial) == 2 * p.n:
             y0 = np.asarray(initial, dtype=float)
         else:
             y0 = np.concatenate([q_static if q_static is not None else np.zeros(p.n),
                                  np.zeros(p.n)])
-            say(f"settling the transient ({steps:,} RK4 steps per period)")
-            y0 = p.settled_start(y0, T, steps, speed, order)
+            if not matrix_free(p, steps):  # (Anderson's first map is the settling)
+                say(f"settling the transient ({steps:,} RK4 steps per period)")
+                y0 = p.settled_start(y0, T, steps, speed, order)
         y0, Phi, info = solve_shooting(p, y0, steps, speed, tol, monodromy=bool(stability),
-                                       say=say)
-        say("the period's waveforms")
-        every = sample_stride(steps)
-        meshes = np.flatnonzero(np.asarray(p.model.element_kind) == MESH_KIND)
-        run = p.run(y0, 0.0, T, steps, every=every, speed=speed, corners=True,
-                    track=meshes)
+                                       record=record, say=say)
+        run = info.run
         corner_t, corner_f = run.corner_t, run.corner_forces
         t, q, v = run.t[:-1], run.y[:-1, :p.n], run.y[:-1, p.n:]
         F, D = run.forces[:-1], run.deformations[:-1]
@@ -350,9 +358,13 @@ def periodic_solution(structure, period: Period, *, method: str = "auto", harmon
                 _, Phi = p.integrate_variational(y0, 0.0, T, steps, speed)
             multipliers = floquet_monodromy(p, Phi)
             stab_method = "monodromy"
+        newton = info.iterations - info.anderson
+        steps_taken = " and ".join(
+            [f"{info.anderson} Anderson-accelerated period maps"] * bool(info.anderson)
+            + [f"{newton} Newton steps"] * bool(newton or not info.anderson))
         msg = (f"shooting, {steps} RK4 steps per period of {T:.6g} s: "
                + ("converged" if info.converged else "did NOT converge")
-               + f" in {info.iterations} Newton steps (defect {info.residual:.2e}"
+               + f" in {steps_taken} (defect {info.residual:.2e}"
                + (f", {info.products} matrix-free monodromy products)" if info.products
                   else ")")
                + (f"; waveforms kept every {every} steps, the meshes' forces at every step"
