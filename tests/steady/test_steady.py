@@ -122,6 +122,22 @@ def test_anderson_accelerated_shooting_is_gmres_on_a_linear_map():
     assert np.array_equal(info.run.y[0], y_a)
 
 
+def test_monodromy_columns_on_threads_are_bit_for_bit_the_serial_ones():
+    """The variational equations split into column blocks on threads (each with its own
+    copy of the state) give the serial monodromy exactly, and the same end state; the
+    default uses one thread below PARALLEL_WORK column-steps."""
+    from torquesplit.steady.problem import PARALLEL_WORK, threads_for
+
+    p = PeriodicProblem(_lti(), F0)
+    y0 = np.array([1e-3, -2e-3, 0.1, 0.0])
+    cols = np.random.default_rng(3).normal(size=(4, 7))
+    y1, Phi1 = p.integrate_variational(y0, 0.0, 1.0 / F0, 800, columns=cols, threads=1)
+    y3, Phi3 = p.integrate_variational(y0, 0.0, 1.0 / F0, 800, columns=cols, threads=3)
+    assert np.array_equal(Phi1, Phi3) and np.array_equal(y1, y3)
+    assert not np.allclose(Phi1, cols)  # the map did something
+    assert threads_for(PARALLEL_WORK - 1, 98) == 1 and threads_for(10**9, 20) == 1
+
+
 def test_anderson_hands_over_to_newton_when_it_stalls(monkeypatch):
     """Where the Anderson iteration has not converged within its maps, Newton-Krylov goes
     on from its best state (here after 3 maps, on the linear case that needs 7)."""

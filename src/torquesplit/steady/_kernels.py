@@ -323,7 +323,7 @@ def _var_step(t_mid, t_end, hs, sa, sb, m, w, rhs_fn, gen, extra, Phi, S, force,
     return bad
 
 
-@_kernel
+@njit(cache=True, error_model="numpy", _nrt=False, nogil=True)  # threads: column blocks
 def rk4_variational(t0, h, n_steps, m, w, rhs_fn, gen, Phi, S, force, kd, cr, spt, frv,
                     fps, DF):
     """Classic RK4 from state row Y_STATE of w.Y and variations ``Phi`` (2n, n_col) over

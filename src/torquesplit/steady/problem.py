@@ -21,6 +21,8 @@ phase) do not.
 from __future__ import annotations
 
 import math
+import os
+from concurrent.futures import ThreadPoolExecutor
 from typing import NamedTuple
 
 import numpy as np
@@ -36,6 +38,25 @@ RHS_CALLS = 2e6
 """Right-hand-side evaluations a periodic solution is expected to take (a few RK4 periods
 of shooting, or the AFT samples of harmonic-balance Newton steps): what decides whether
 generating the model's right-hand side repays its compilation."""
+
+
+PARALLEL_WORK = 2_000_000
+"""RK4 column-steps of the variational equations above which their columns are split
+over threads (:meth:`PeriodicProblem.integrate_variational`): each thread integrates the
+state too, so a block should hold enough columns to repay it."""
+BLOCK_COLUMNS = 16
+"""The fewest columns a thread takes."""
+
+
+def threads_for(column_steps: int, columns: int) -> int:
+    """Threads for variational equations of ``column_steps`` work over ``columns``
+    columns: 1 below PARALLEL_WORK, else as many as the CPUs this process may use, with
+    at least BLOCK_COLUMNS columns each."""
+    if column_steps < PARALLEL_WORK:
+        return 1
+    cpus = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (
+        os.cpu_count() or 1)
+    return max(1, min(cpus, columns // BLOCK_COLUMNS))
 
 
 class Run(NamedTuple):
@@ -179,27 +200,51 @@ class PeriodicProblem:
         return np.unique(np.concatenate(out)) if out else np.zeros(0)
 
     # ---------------------------------------------------------------- integration
-    def integrate_variational(self, y0, t0, period, steps, speed=1.0, columns=None):
+    def integrate_variational(self, y0, t0, period, steps, speed=1.0, columns=None,
+                              threads=None):
         """RK4 over one ``period`` in ``steps`` steps from ``y0`` at ``t0`` with the
         variational equations: returns (y(T), Phi) with Phi = dy(T)/dy0 applied to
-        ``columns`` (2n, k; identity by default).  Raises SolverError if it diverged."""
+        ``columns`` (2n, k; identity by default).  Raises SolverError if it diverged.
+
+        ``threads``: the columns are split into blocks integrated at once on that many
+        threads, each with its own copy of the state (a column's arithmetic does not
+        depend on the others: the same Phi bit for bit).  Default: :func:`threads_for`
+        the work."""
         n2 = 2 * self.n
-        Phi = np.ascontiguousarray(np.eye(n2) if columns is None else columns, dtype=float)
+        Phi = np.array(np.eye(n2) if columns is None else columns, dtype=float)  # a copy
         nc = Phi.shape[1]
-        w = self.work
-        w.Y[kd.Y_STATE] = y0
-        S = np.empty((5, n2, nc))
-        status = sk.rk4_variational(
-            float(t0), float(period) / steps, int(steps), self.model_at(speed), w,
-            self.code.function, self.code.generated, Phi, S, np.empty(self.ne),
-            np.empty(self.ne), np.empty(self.ne), np.zeros((max(self.ns, 1), 8)),
-            np.zeros(max(3 * self.nf, 1)), np.zeros(max(self.nf, 1)),
-            np.empty((self.ne, nc)))
-        if status != 0:
+        k = threads_for(steps * nc, nc) if threads is None else max(1, min(int(threads), nc))
+        blocks = np.array_split(np.arange(nc), k)
+        works = [self.work] + [kd.make_work(self.model, self.code.parameters)
+                               for _ in blocks[1:]]
+        model = self.model_at(speed)
+
+        def block(cols, w):
+            P = np.ascontiguousarray(Phi[:, cols])
+            w.Y[kd.Y_STATE] = y0
+            status = sk.rk4_variational(
+                float(t0), float(period) / steps, int(steps), model, w,
+                self.code.function, self.code.generated, P, np.empty((5, n2, cols.size)),
+                np.empty(self.ne), np.empty(self.ne), np.empty(self.ne),
+                np.zeros((max(self.ns, 1), 8)), np.zeros(max(3 * self.nf, 1)),
+                np.zeros(max(self.nf, 1)), np.empty((self.ne, cols.size)))
+            return status, P
+
+        if k == 1:
+            done = [block(blocks[0], works[0])]
+        else:
+            with ThreadPoolExecutor(k) as pool:
+                done = list(pool.map(block, blocks, works))
+        if any(status != 0 for status, _ in done):
             raise SolverError("the state became non-finite while integrating one period; "
                               "the periodic state is far from the guess or the model "
                               "diverges: start from a converged neighbour or check the model.")
-        return w.Y[kd.Y_STATE].copy(), Phi
+        if k > 1:
+            for cols, (_, P) in zip(blocks, done):
+                Phi[:, cols] = P
+        else:
+            Phi = done[0][1]
+        return self.work.Y[kd.Y_STATE].copy(), Phi
 
     def integrate(self, y0, t0, duration, steps, every=1, speed=1.0, max_rows=None,
                   corners=False):
