@@ -8,8 +8,9 @@ and STEADY_RESULTS.json.
   row): Ji & Li's mill drive over its full period (168 mesh cycles of stage 1: shooting,
   and harmonic balance asked for) and with stage 1's excitations kept; Liu et al. 2021
   with the spur-split stage kept and over its full period (3638 cycles of its fastest
-  excitation), also with Floquet stability; Jin et al. 2019 over its full period.  Wall time of ``steady_state`` from the model
-  file, after a warm-up call (compilation), best of 2 (Jin et al. 2019: 1); accuracy
+  excitation), also with Floquet stability; Jin et al. 2019 over its full period.  Wall
+  time of ``steady_state`` from the model file, after a warm-up call (compilation), best
+  of 2 (Jin et al. 2019 and Liu et al. 2021 with stability: 1); accuracy
   against shooting at 1600 RK4 steps per cycle, whose own change at 800 is reported
   beside it (not over the full periods).
 * a 200-point speed sweep of Liu et al. 2021 (spur split kept, Floquet stability on);
@@ -233,7 +234,8 @@ def report(res: dict) -> str:
              "harmonics are asked for) "
              "unless the method column says 'hb (asked)'; stability (unless the row says "
              "otherwise: the monodromy's columns on as many threads as the CPUs) and the "
-             "periodicity check off.  Accuracy: the largest relative difference of a mesh's dynamic factor to "
+             "periodicity check off.  Accuracy: the largest relative difference of a "
+             "mesh's dynamic factor to "
              f"shooting with {REF_STEPS[1]} RK4 steps per cycle of the fastest excitation on "
              f"the same excitations; 'reference moves' is how far that reference's own "
              f"dynamic factors move at {REF_STEPS[0]} steps per cycle (not run over the "
