@@ -236,6 +236,15 @@ leaves out the start-up transient before computing anything.
   contact; had their forces turned negative (the back flank loaded) the table and a
   warning would say so.
 
+How many of those digits hold?  `--check-step` runs the model again at half the step
+and says, for every number, how many significant digits stay put; it costs about twice
+the run:
+
+$ torquesplit run three_branch.toml --check-step --quiet
+
+A number that moves in a printed digit is listed with the digits that hold; refine the
+step (`--steps-per-period`) until the digits you report hold.
+
 A dynamic factor of about {{{{dynamic_factor}}}} is large.  The modes show why:
 
 $ torquesplit modes three_branch.toml --count 8

@@ -297,6 +297,9 @@ def run(
                                                metavar="PATH=VALUE"),
     as_json: bool = _flag("--json", "Print metrics, statistics and warnings as JSON."),
     quiet: bool = _flag("--quiet", "No progress bar."),
+    check: bool = _flag("--check-step", "Run again at half the step and report how many "
+                        "significant digits of every number hold (about three times the "
+                        "integration time)."),
 ):
     """Static equilibrium, then the dynamic response: load sharing and dynamic factors.
 
@@ -349,6 +352,13 @@ def run(
             if out is not None:
                 res.save(out, overwrite=force, definition=chosen)
                 state["saved"] = list(plan.files)
+            step_check = None
+            if check and met is not None:
+                from .convergence import check_step
+
+                with ux.collect_warnings(), ux.progress("checking the step (half of it)",
+                                                        quiet or as_json) as cb:
+                    step_check = check_step(res, definitions=[chosen], progress=cb)
         except _EXPECTED as exc:
             _fail(exc)
             return
@@ -366,9 +376,13 @@ def run(
                       "metrics": met.to_dict(), "statistics": res.statistics(),
                       "results_file": str(saved[0]) if saved else None,
                       "results_files": [str(f) for f in saved],
-                      "figures": [str(f) for f in figures]}, _json_default)
+                      "figures": [str(f) for f in figures],
+                      **({"step_check": step_check.to_dict()} if step_check else {})},
+                     _json_default)
     else:
         _render_run(res, met, saved)
+        if step_check is not None:
+            _render_step_check(step_check)
         if figures:
             console.print(f"{len(figures)} figure files written to {plots}")
 
@@ -496,7 +510,7 @@ def _render_run(res, met, saved) -> None:
     console.print(run_table(met))
     console.print(group_table(met))
     console.print(f"system load-sharing coefficient ({met.definition}): "
-                  f"[bold]{met.load_sharing.system:.5f}[/]", highlight=False)
+                  f"[bold]{met.load_sharing.system:.4f}[/]", highlight=False)
     console.print(
         f"LSC ({met.definition}): {DEFINITION_TEXT[met.definition]}; "
         f"{DEFINITION_USE[met.definition]}.  Dynamic factor = settled peak / the mesh's own "
@@ -508,6 +522,39 @@ def _render_run(res, met, saved) -> None:
         markup=False, highlight=False)
     if saved:
         console.print("results written to " + ", ".join(str(f) for f in saved),
+                      highlight=False)
+
+
+PRINTED_DIGITS = 5
+"""Significant digits the run tables print (1.0800, 12.036 kN)."""
+
+
+def _render_step_check(check, rows: int = 12) -> None:
+    """How many significant digits of the run's numbers hold at half the step: a summary
+    and the least converged numbers (those holding fewer than the tables print)."""
+    table = check.rows()
+    short = [r for r in table if r[4] < PRINTED_DIGITS]
+    what = ("half the step" if check.method == "rk4" else
+            f"a {check.step / check.halved_step:.0f}-fold tighter tolerance")
+    was = (f"{check.step:.3g} s -> {check.halved_step:.3g} s" if check.method == "rk4"
+           else f"rtol {check.step:.3g} -> {check.halved_step:.3g}")
+    console.print(
+        f"step check, the same run at {what} ({was}): "
+        + (f"all {len(table)} numbers hold the {PRINTED_DIGITS} significant digits printed"
+           if not short else
+           f"{len(table) - len(short)} of {len(table)} numbers hold the {PRINTED_DIGITS} "
+           f"significant digits printed; these hold fewer (trust only those digits, or "
+           f"refine the step: --steps-per-period):"), highlight=False, markup=False)
+    if not short:
+        return
+    t = Table()
+    for col in ("number", "value", "at half the step", "digits that hold"):
+        t.add_column(col, justify="left" if col == "number" else "right")
+    for name, a, b, _, d in short[:rows]:
+        t.add_row(name, f"{a:.6g}", f"{b:.6g}", str(d))
+    console.print(t)
+    if len(short) > rows:
+        console.print(f"... and {len(short) - rows} more (--json lists every number)",
                       highlight=False)
 
 

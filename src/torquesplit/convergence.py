@@ -1,0 +1,107 @@
+"""How far a run's reported numbers move when its step is halved: which digits to trust.
+
+A fixed-step RK4 run is an approximation whose error falls with the step; a number is
+worth the digits that do not move when the step is halved.  :func:`check_step` runs the
+same simulation again at half the step the first run took (not half the step it asked
+for: a stiff damping or a resolved mode may have set a finer one) and compares every
+metric of :meth:`Results.metric_values <torquesplit.results.Results.metric_values>`;
+:class:`StepCheck` says, per metric, how many significant digits agree.  For the
+adaptive Dormand-Prince method the tolerance is tightened 32-fold instead (its local
+error is fifth order in the step, so that about halves the steps).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+__all__ = ["StepCheck", "check_step", "halved_steps_per_period", "agreeing_digits"]
+
+TIGHTER_RTOL = 32.0
+"""Dormand-Prince: the check's tolerance is the run's divided by this (~ half the step)."""
+
+
+def agreeing_digits(a: float, b: float, most: int = 15) -> int:
+    """Significant digits of ``a`` that ``b`` confirms: the largest s with
+    |a - b| <= 0.5 x 10^(e - s + 1), e the decimal exponent of a (0 if none agree; ``most``
+    if they are equal).  6.7389 against 6.7394 agree to 4 (6.739)."""
+    if a == b:
+        return most
+    if not (math.isfinite(a) and math.isfinite(b)) or a == 0.0:
+        return 0
+    e = math.floor(math.log10(abs(a)))
+    s = math.floor(e + 1 - math.log10(2.0 * abs(a - b)))
+    return max(0, min(most, s))
+
+
+@dataclass(frozen=True)
+class StepCheck:
+    """Every metric of a run and of the same run at half its step."""
+
+    values: dict
+    """Metric name -> value of the run (:meth:`Results.metric_values`)."""
+    halved: dict
+    """The same metrics at half the step (Dormand-Prince: a 32-fold tighter tolerance)."""
+    method: str
+    step: float
+    """The run's RK4 step [s] (Dormand-Prince: its relative tolerance)."""
+    halved_step: float
+    """The check's RK4 step [s] (Dormand-Prince: its relative tolerance)."""
+
+    def rows(self) -> list[tuple[str, float, float, float, int]]:
+        """(name, value, at half the step, relative change, agreeing significant digits)
+        for every metric finite in both runs, the least converged first."""
+        out = []
+        for name, a in self.values.items():
+            b = self.halved.get(name, math.nan)
+            if not (math.isfinite(a) and math.isfinite(b)):
+                continue
+            rel = abs(a - b) / max(abs(a), abs(b)) if a != b else 0.0
+            out.append((name, a, b, rel, agreeing_digits(a, b)))
+        out.sort(key=lambda r: (r[4], -r[3], r[0]))
+        return out
+
+    def digits(self, name: str) -> int:
+        """Significant digits of metric ``name`` that halving the step leaves alone."""
+        return agreeing_digits(self.values[name], self.halved[name])
+
+    def to_dict(self) -> dict:
+        """Plain data (JSON): the steps and, per metric, both values, the relative change
+        and the agreeing digits."""
+        return {"method": self.method, "step": self.step, "halved_step": self.halved_step,
+                "metrics": {n: {"value": a, "halved": b, "relative_change": r, "digits": d}
+                            for n, a, b, r, d in self.rows()}}
+
+
+def halved_steps_per_period(results) -> int:
+    """RK4 steps per shortest mesh period that take at most half the step ``results``
+    took (its step may be finer than its ``steps_per_period`` asked, e.g. set by the RK4
+    stability of a stiff damping: then doubling the steps asked would not halve it)."""
+    f_max = max(results.kinematics.meshes[m].frequency for m in results.mesh_names)
+    taken = 1.0 / (f_max * results.solution.step)  # steps per period the run took
+    return math.ceil(2.0 * taken * (1.0 - 1e-12))
+
+
+def check_step(results, *, definitions=None, rtol: float | None = None,
+               progress=None) -> StepCheck:
+    """The run of ``results`` again at half its step (same model, duration and method;
+    Dormand-Prince: its tolerance ``rtol``, default the model's, / TIGHTER_RTOL), every
+    metric of the load-sharing ``definitions`` (default: all) compared.  Costs about
+    twice the first run."""
+    from .simulation import simulate
+
+    sol = results.solution
+    duration = sol.t_span[1] - sol.t_span[0]
+    if sol.method == "rk4":
+        spp = halved_steps_per_period(results)
+        half = simulate(results.model, duration=duration, method="rk4",
+                        steps_per_period=spp, progress=progress)
+        step, halved_step = sol.step, half.solution.step
+    else:
+        rtol = float(results.model.analysis.rtol if rtol is None else rtol)
+        half = simulate(results.model, duration=duration, method=sol.method,
+                        rtol=rtol / TIGHTER_RTOL, progress=progress)
+        step, halved_step = rtol, rtol / TIGHTER_RTOL
+    return StepCheck(values=results.metric_values(definitions),
+                     halved=half.metric_values(definitions),
+                     method=sol.method, step=float(step), halved_step=float(halved_step))

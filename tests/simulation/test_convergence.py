@@ -1,0 +1,88 @@
+"""The step check: a run again at half the step it took, and the digits that hold."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import pytest
+from typer.testing import CliRunner
+
+import torquesplit
+from model_texts import SPUR_PAIR, write_model
+from torquesplit.cli import app
+from torquesplit.convergence import (
+    StepCheck,
+    agreeing_digits,
+    check_step,
+    halved_steps_per_period,
+)
+from torquesplit.model.io import load_model, model_from_dict
+from torquesplit.model.overrides import apply_overrides, read_raw
+
+
+@pytest.mark.parametrize("a, b, digits", [
+    (6.7389, 6.7394, 4),      # 6.739: an error of 5e-4 is within half a unit of the 4th
+    (6.7389, 6.7389, 15),
+    (1.0, 2.0, 0),
+    (123.45, 123.40, 4),      # 0.05 is half a unit of the 4th digit (123.4)
+    (123.45, 123.39, 3),
+    (-0.0012345, -0.0012346, 4),
+    (0.0, 1e-9, 0),
+    (1.0, math.nan, 0),
+])
+def test_agreeing_digits_by_hand(a, b, digits):
+    assert agreeing_digits(a, b) == digits
+
+
+def test_step_check_rows_least_converged_first():
+    c = StepCheck(values={"x": 1.0, "y": 2.0, "z": 3.0, "w": math.nan},
+                  halved={"x": 1.0, "y": 2.1, "z": 3.001}, method="rk4", step=2e-6,
+                  halved_step=1e-6)
+    rows = c.rows()
+    assert [r[0] for r in rows] == ["y", "z", "x"]  # w: not finite in both, left out
+    assert rows[0][3] == pytest.approx(0.1 / 2.1) and c.digits("z") == 3
+    assert json.loads(json.dumps(c.to_dict()))["metrics"]["y"]["digits"] == 1
+
+
+def _stiff_pair(tmp_path):
+    """A spur pair so stiff that its highest mode, not the 100 steps per mesh period
+    asked for, sets the RK4 step."""
+    data = apply_overrides(read_raw(write_model(tmp_path, SPUR_PAIR, "pair.toml")),
+                           {"meshes.m.stiffness": "4e10 N/m"})
+    return load_model(model_from_dict(data, source="stiff pair"))
+
+
+def test_the_check_halves_the_step_the_run_took_not_the_one_it_asked_for(tmp_path):
+    """Where something else than the steps asked for set the step, doubling the steps
+    asked for leaves it almost unchanged; the check takes half the step the run took."""
+    model = _stiff_pair(tmp_path)
+    res = torquesplit.simulate(model, cycles=10)
+    h = res.solution.step
+    assert res.solution.step_limited_by.startswith("the highest mode")
+    doubled = torquesplit.simulate(model, cycles=10, steps_per_period=200).solution.step
+    assert doubled > 0.6 * h  # what the old check did: not half the step
+    spp = halved_steps_per_period(res)
+    check = check_step(res)
+    assert check.step == h and 0.45 * h <= check.halved_step <= 0.5 * h * (1 + 1e-9)
+    assert spp > 200
+    assert set(check.values) == set(res.metric_values())
+    assert all(d >= 2 for *_, d in check.rows())  # a smooth run: the numbers converge
+
+
+def test_run_check_step_on_the_command_line(tmp_path):
+    """``run --check-step`` says how many digits hold, on the terminal and in the JSON."""
+    path = write_model(tmp_path, SPUR_PAIR, "pair.toml")
+    runner = CliRunner()
+    out = runner.invoke(app, ["run", str(path), "--cycles", "20", "--check-step", "--quiet"])
+    assert out.exit_code == 0, out.output
+    assert "step check, the same run at half the step" in out.output
+    res = runner.invoke(app, ["run", str(path), "--cycles", "20", "--check-step", "--json"])
+    data = json.loads(res.output[res.output.index("{"):])
+    check = data["step_check"]
+    assert check["method"] == "rk4" and check["halved_step"] < 0.51 * check["step"]
+    assert "dynamic_factor.m" in check["metrics"]
+    assert all("digits" in v for v in check["metrics"].values())
+    plain = json.loads(runner.invoke(app, ["run", str(path), "--cycles", "20",
+                                           "--json"]).output)
+    assert "step_check" not in plain
