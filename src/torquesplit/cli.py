@@ -529,22 +529,28 @@ PRINTED_DIGITS = 5
 """Significant digits the run tables print (1.0800, 12.036 kN)."""
 
 
-def _render_step_check(check, rows: int = 12) -> None:
-    """How many significant digits of the run's numbers hold at half the step: a summary
-    and the least converged numbers (those holding fewer than the tables print)."""
+def _render_step_check(check, rows: int = 12, printed: int = PRINTED_DIGITS,
+                       refine: str = "--steps-per-period") -> None:
+    """How many significant digits of the numbers hold at half the step (harmonic
+    balance: twice the harmonics): a summary and the least converged numbers (those
+    holding fewer than the ``printed`` digits of the tables)."""
     table = check.rows()
-    short = [r for r in table if r[4] < PRINTED_DIGITS]
-    what = ("half the step" if check.method == "rk4" else
-            f"a {check.step / check.halved_step:.0f}-fold tighter tolerance")
-    was = (f"{check.step:.3g} s -> {check.halved_step:.3g} s" if check.method == "rk4"
-           else f"rtol {check.step:.3g} -> {check.halved_step:.3g}")
+    short = [r for r in table if r[4] < printed]
+    if check.method == "hb":
+        what, was = "twice the harmonics", f"{check.step:.0f} -> {check.halved_step:.0f}"
+    elif check.method == "dopri":
+        what = f"a {check.step / check.halved_step:.0f}-fold tighter tolerance"
+        was = f"rtol {check.step:.3g} -> {check.halved_step:.3g}"
+    else:
+        what, was = "half the step", f"{check.step:.3g} s -> {check.halved_step:.3g} s"
     console.print(
-        f"step check, the same run at {what} ({was}): "
-        + (f"all {len(table)} numbers hold the {PRINTED_DIGITS} significant digits printed"
+        f"step check, the same {'run' if check.method in ('rk4', 'dopri') else 'state'} at "
+        f"{what} ({was}): "
+        + (f"all {len(table)} numbers hold the {printed} significant digits printed"
            if not short else
-           f"{len(table) - len(short)} of {len(table)} numbers hold the {PRINTED_DIGITS} "
+           f"{len(table) - len(short)} of {len(table)} numbers hold the {printed} "
            f"significant digits printed; these hold fewer (trust only those digits, or "
-           f"refine the step: --steps-per-period):"), highlight=False, markup=False)
+           f"refine: {refine}):"), highlight=False, markup=False)
     if not short:
         return
     t = Table()

@@ -15,7 +15,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-__all__ = ["StepCheck", "check_step", "halved_steps_per_period", "agreeing_digits"]
+import numpy as np
+
+__all__ = ["StepCheck", "check_step", "check_steady", "halved_steps_per_period",
+           "agreeing_digits"]
 
 TIGHTER_RTOL = 32.0
 """Dormand-Prince: the check's tolerance is the run's divided by this (~ half the step)."""
@@ -105,3 +108,36 @@ def check_step(results, *, definitions=None, rtol: float | None = None,
     return StepCheck(values=results.metric_values(definitions),
                      halved=half.metric_values(definitions),
                      method=sol.method, step=float(step), halved_step=float(halved_step))
+
+
+def _steady_values(st) -> dict:
+    """The numbers of a steady state's mesh table by flat name (``field.mesh``)."""
+    fields = ("mean_force", "min_force", "peak_force", "dynamic_factor", "peak_to_nominal",
+              "load_sharing", "rms_transmission_error", "contact_loss")
+    return {f"{f}.{r.mesh}": float(getattr(r, f)) for r in st.mesh_table() for f in fields}
+
+
+def check_steady(st, *, progress=None) -> StepCheck:
+    """The periodic steady state ``st`` (:func:`torquesplit.steady.steady_state`) again
+    with twice its resolution, every number of its mesh table compared: shooting at half
+    the RK4 step it took (from its own periodic state, so the finer solve needs few
+    maps), harmonic balance with twice the harmonics.  ``step`` / ``halved_step`` are the
+    RK4 steps [s], or the harmonics for harmonic balance."""
+    from .steady.api import steady_state
+
+    ps = st.solution
+    same = dict(st.options, stability=False, check=False, progress=progress)
+    if ps.method == "shooting":
+        steps = ps.t.size * ps.sample_every  # the samples are every k-th step
+        order = max(st.period.max_order, 1)
+        fine = steady_state(st.model, method="shooting",
+                            steps_per_cycle=math.ceil(2 * steps / order),
+                            initial=np.concatenate([ps.q[0], ps.v[0]]), **same)
+        fine_steps = fine.solution.t.size * fine.solution.sample_every
+        step, halved = ps.period / steps, fine.solution.period / fine_steps
+    else:
+        fine = steady_state(st.model, method="hb", harmonics=2 * ps.harmonics, adaptive=False,
+                            **same)
+        step, halved = float(ps.harmonics), float(fine.solution.harmonics)
+    return StepCheck(values=_steady_values(st), halved=_steady_values(fine), method=ps.method,
+                     step=float(step), halved_step=float(halved))

@@ -76,8 +76,11 @@ class SteadyState:
     """A periodic steady state of a model and everything needed to interpret it."""
 
     def __init__(self, *, model, kinematics, structure, static, period, solution,
-                 dropped, problem):
+                 dropped, problem, options=None):
         self.model = model
+        #: the arguments of :func:`steady_state` that chose the problem (keep, speed,
+        #: max_cycles), so that it can be solved again (e.g. finer: convergence.check_steady)
+        self.options = dict(options or {})
         self.kinematics = kinematics
         self.structure = structure
         self.static = static
@@ -152,19 +155,21 @@ class SteadyState:
         res = self.to_results()
         met = res.metrics(definition)
         names = self.structure.element_names
-        _, F, D = self.mesh_series([names.index(r.mesh) for r in met.rows])
+        t, F, D = self.mesh_series([names.index(r.mesh) for r in met.rows])
         Fc = self.solution.corner_forces  # instants at table corners (shooting)
         if Fc.shape[0] == 0:
             Fc = np.zeros((0, self.structure.n_elements))
+        ws, wc = period_weights(t, self.solution.corner_t[:Fc.shape[0]], self.solution.period)
         out = []
         for j, r in enumerate(met.rows):
             e = names.index(r.mesh)
             f, d = F[:, j], D[:, j]
             peak = float(max(f.max(), Fc[:, e].max(initial=-np.inf)))
             least = float(min(f.min(), Fc[:, e].min(initial=np.inf)))
+            mean = float((ws @ f + wc @ Fc[:, e]) / self.solution.period)
             out.append(MeshSteady(
                 mesh=r.mesh, group=r.group, nominal_force=r.nominal_force,
-                static_force=r.static_force, mean_force=float(f.mean()),
+                static_force=r.static_force, mean_force=mean,
                 min_force=least, peak_force=peak,
                 dynamic_factor=peak / r.static_force,
                 peak_to_nominal=peak / r.nominal_force,
@@ -273,7 +278,8 @@ def steady_state(model, *, method: str = "auto", harmonics: int | None = None,
                             stability=stability, steps_per_cycle=steps_per_cycle,
                             check=check, problem=problem, progress=progress)
     return SteadyState(model=model, kinematics=kin, structure=structure, static=static,
-                       period=per, solution=sol, dropped=dropped, problem=problem)
+                       period=per, solution=sol, dropped=dropped, problem=problem,
+                       options=dict(keep=keep, speed=speed, max_cycles=max_cycles))
 
 
 def _at_base(per, base):
@@ -293,6 +299,21 @@ def _at_base(per, base):
 RESULT_ROWS = 1 << 18
 """Largest number of time samples of a steady state's Results record (its per-cycle
 statistics and history), before the samples per period are reduced."""
+
+
+def period_weights(t, corners, period):
+    """Trapezoid-rule weights [s] of the sample times ``t`` and the corner instants
+    ``corners`` (both in [0, period)) over one period, the corners as breakpoints: each
+    instant carries half of the interval to each neighbour (periodically), so that the
+    weights sum to the period.  Returns (weights of t, weights of corners)."""
+    t = np.asarray(t, dtype=float)
+    every = np.concatenate([t, np.asarray(corners, dtype=float)])
+    order = np.argsort(every, kind="stable")
+    ts = every[order]
+    after = np.diff(np.concatenate([ts, ts[:1] + period]))  # interval to the next instant
+    w = np.empty_like(ts)
+    w[order] = 0.5 * (after + np.roll(after, 1))
+    return w[:t.size], w[t.size:]
 
 
 def cycle_extremes(values, cycles, n, extra_cycles=None, extra=None):
@@ -379,6 +400,11 @@ def _as_solution(st: SteadyState, shell, periods):
         ic = cycles(j, tc)
         keep = (ic >= 0) & (ic < cyc_n[j])
         corner_idx.append((ic[keep], keep))
+    # time weights of the samples and corner instants (trapezoid rule, the corners as
+    # breakpoints): means of a force with steep table ramps or impact pulses converge
+    # with the step only so (the plain mean of the step samples is first order there)
+    ws1, wc1 = period_weights(tm, ps.corner_t, T)
+    ws, wc = np.tile(ws1, periods), np.tile(wc1, periods)
     cmax = np.full((nc, n_tr), np.nan)
     cmin = np.full((nc, n_tr), np.nan)
     csum = np.zeros((nc, n_tr))
@@ -389,16 +415,18 @@ def _as_solution(st: SteadyState, shell, periods):
         f = np.tile(Fm[:, j], periods)
         ic, keep = corner_idx[j]
         mx, mn = cycle_extremes(f, idx, nc, ic, Fc[keep, j])
-        sm = np.bincount(idx, weights=f, minlength=nc)
-        counts = np.bincount(idx, minlength=nc)
-        cnt = counts.copy()
+        sm = (np.bincount(idx, weights=ws * f, minlength=nc)
+              + np.bincount(ic, weights=wc[keep] * Fc[keep, j], minlength=nc))
+        span = (np.bincount(idx, weights=ws, minlength=nc)
+                + np.bincount(ic, weights=wc[keep], minlength=nc))
+        cnt = np.bincount(idx, minlength=nc)
         # the first and last cycles are partial (phase offsets): left out
         cnt[0] = 0
         cnt[cyc_n[j] - 1:] = 0
         ok = cnt > 0
         cmax[ok, j] = mx[ok]
         cmin[ok, j] = mn[ok]
-        csum[ok, j] = sm[ok] / counts[ok]
+        csum[ok, j] = sm[ok] / span[ok]
         ccnt[:, j] = cnt
         cstart[:, j] = (bases[j] + np.arange(nc) - s.phase[e]) / s.frequency[e]
     # per-cycle extremes of the instantaneous load-sharing ratio N f_i / sum_j f_j of each

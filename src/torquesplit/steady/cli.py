@@ -83,12 +83,22 @@ def register(app, load, fail, console, err_console, json_default):
             "columns) can take most of the run."),
         out: Optional[Path] = typer.Option(None, "--out", help="Write results (.nc, .mat, .csv)."),
         as_json: bool = typer.Option(False, "--json", help="Print the results as JSON."),
+        steps_per_cycle: Optional[int] = typer.Option(
+            None, "--steps-per-cycle", help="Shooting: RK4 steps per cycle of the fastest "
+            "excitation (default 100, refined for the highest mode).", metavar="N"),
+        check: bool = typer.Option(
+            False, "--check-step", help="Solve again at half the RK4 step (harmonic "
+            "balance: twice the harmonics) and report how many significant digits of "
+            "every number hold."),
     ):
         """Periodic steady state at one speed: per-mesh table, residual, harmonics, stability."""
         try:
             if method not in ("auto", "hb", "shooting"):
                 raise TorquesplitError(f"--method {method!r} is unknown; use auto, hb or "
                                        "shooting")
+            if steps_per_cycle is not None and steps_per_cycle < 10:
+                raise TorquesplitError(f"--steps-per-cycle must be at least 10 (e.g. 200), "
+                                       f"got {steps_per_cycle}")
             from torquesplit.steady.api import steady_state
 
             _check_out(out)
@@ -100,9 +110,17 @@ def register(app, load, fail, console, err_console, json_default):
                 st = steady_state(m, method=method, harmonics=harmonics, adaptive=adaptive,
                                   keep=_keep(keep), speed=_speed(speed, "--speed"),
                                   max_cycles="auto" if max_cycles is None else max_cycles,
-                                  stability=stability, progress=update)
+                                  stability=stability, steps_per_cycle=steps_per_cycle,
+                                  progress=update)
             rows = st.mesh_table()
             saved = st.to_results().save(out) if out is not None else None
+            step_check = None
+            if check:
+                from torquesplit.convergence import check_steady
+
+                with collect_warnings(), progress("checking the resolution", as_json,
+                                                  total=None) as update:
+                    step_check = check_steady(st, progress=update)
         except (TorquesplitError, ValueError, OSError) as exc:
             fail(exc)
             return
@@ -121,6 +139,7 @@ def register(app, load, fail, console, err_console, json_default):
             "meshes": {r.mesh: {k: v for k, v in r.__dict__.items() if k != "mesh"}
                        for r in rows},
             "results_file": str(saved) if saved else None,
+            **({"step_check": step_check.to_dict()} if step_check else {}),
         }
         if as_json:
             _emit(info, json_default)
@@ -154,6 +173,12 @@ def register(app, load, fail, console, err_console, json_default):
                           f"{1e6 * r.rms_transmission_error:.4g}",
                           f"{100 * r.contact_loss:.2f} %")
             console.print(t)
+            if step_check is not None:
+                from torquesplit.cli import _render_step_check
+
+                _render_step_check(step_check, printed=6,
+                                   refine="--harmonics" if ps.method == "hb" else
+                                   "--steps-per-cycle")
             if saved:
                 console.print(f"results written to {saved}")
         if not ps.converged:
