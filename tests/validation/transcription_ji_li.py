@@ -610,23 +610,56 @@ def excite(t, table, frequency, phase, bl_ptr, bl_val, k, b, cyc, bl_cyc):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def record(F, cyc, base, cyc_max, cyc_min, cyc_sum, cyc_cnt):
-    """Per-mesh-cycle max, min, sum and count of the mesh forces (streamed)."""
+def record(t, F, cyc, base, frequency, phase, cyc_max, cyc_min, cyc_sum, cyc_wt, cyc_cnt,
+           prev):
+    """Per-mesh-cycle max, min and count of the mesh forces, and their time integral
+    (streamed): the trapezoid rule over the interval from the last sample, split where a
+    mesh cycle begins.  ``prev``: the last sample's time, then its forces and cycles
+    (time NaN before the first sample)."""
+    cap = cyc_max.shape[0]
+    ta = prev[0]
+    span = t - ta
+    entered = span >= 0.0
     for j in range(4):
         c = cyc[j] - base[j]
-        if 0 <= c < cyc_max.shape[0]:
-            f = F[j]
+        f = F[j]
+        if 0 <= c < cap:
             if f > cyc_max[c, j]:
                 cyc_max[c, j] = f
             if f < cyc_min[c, j]:
                 cyc_min[c, j] = f
-            cyc_sum[c, j] += f
             cyc_cnt[c, j] += 1
+        if entered:
+            fa = prev[1 + j]
+            cp = np.int64(prev[5 + j])
+            if c == cp + 1:
+                tb = (c + base[j] - phase[j]) / frequency[j]
+                th = min(max((tb - ta) / span, 0.0), 1.0) if span > 0.0 else 1.0
+                fb = fa + th * (f - fa)
+                da = th * span
+                db = span - da
+                if 0 <= cp < cap:
+                    cyc_sum[cp, j] += 0.5 * da * (fa + fb)
+                    cyc_wt[cp, j] += da
+                if 0 <= c < cap:
+                    cyc_sum[c, j] += 0.5 * db * (fb + f)
+                    cyc_wt[c, j] += db
+            else:
+                half = 0.5 * span
+                if 0 <= cp < cap:
+                    cyc_sum[cp, j] += half * fa
+                    cyc_wt[cp, j] += half
+                if 0 <= c < cap:
+                    cyc_sum[c, j] += half * f
+                    cyc_wt[c, j] += half
+        prev[1 + j] = f
+        prev[5 + j] = c
+    prev[0] = t
 
 
 @njit(cache=True, error_model="numpy")
 def rk4(y, t0, h, n_steps, e, table, frequency, phase, bl_ptr, bl_val, base,
-        cyc_max, cyc_min, cyc_sum, cyc_cnt, f_end):
+        cyc_max, cyc_min, cyc_sum, cyc_wt, cyc_cnt, prev, f_end):
     """Classic RK4 (Ji & Li eq. 17, misprinted there) over ``n_steps`` steps of ``h``.
 
     ``y`` (28) is advanced in place.  The mesh forces of the state at the start of every
@@ -650,7 +683,8 @@ def rk4(y, t0, h, n_steps, e, table, frequency, phase, bl_ptr, bl_val, base,
     excite(t0, table, frequency, phase, bl_ptr, bl_val, ka, b, cyc, bl_cyc)
     for i in range(n_steps):
         eom(y, e, ka, b, k1, F)
-        record(F, cyc, base, cyc_max, cyc_min, cyc_sum, cyc_cnt)
+        record(t0 + i * h, F, cyc, base, frequency, phase, cyc_max, cyc_min, cyc_sum,
+               cyc_wt, cyc_cnt, prev)
         excite(t0 + (i + 0.5) * h, table, frequency, phase, bl_ptr, bl_val, kh, b, cyc,
                bl_cyc)
         for m in range(28):
@@ -668,7 +702,8 @@ def rk4(y, t0, h, n_steps, e, table, frequency, phase, bl_ptr, bl_val, base,
             y[m] += h / 6.0 * (k1[m] + 2.0 * (k2[m] + k3[m]) + k4[m])
         ka, kb = kb, ka
     eom(y, e, ka, b, k1, F)
-    record(F, cyc, base, cyc_max, cyc_min, cyc_sum, cyc_cnt)
+    record(t0 + n_steps * h, F, cyc, base, frequency, phase, cyc_max, cyc_min, cyc_sum,
+           cyc_wt, cyc_cnt, prev)
     for j in range(4):
         f_end[j] = F[j]
 
@@ -700,8 +735,9 @@ def arrays(p: Seed001, t0: float, h: float, n_steps: int) -> dict:
     return dict(e=p.eom, table=p.table, frequency=p.frequency, phase=p.phase,
                 bl_ptr=p.backlash_ptr, bl_val=p.half_backlash, base=base,
                 cyc_max=np.full((cap, 4), -np.inf), cyc_min=np.full((cap, 4), np.inf),
-                cyc_sum=np.zeros((cap, 4)), cyc_cnt=np.zeros((cap, 4), dtype=np.int64),
-                f_end=np.empty(4))
+                cyc_sum=np.zeros((cap, 4)), cyc_wt=np.zeros((cap, 4)),
+                cyc_cnt=np.zeros((cap, 4), dtype=np.int64),
+                prev=np.concatenate([[np.nan], np.zeros(8)]), f_end=np.empty(4))
 
 
 def integrate(p: Seed001, y0, h: float, n_steps: int, t0: float = 0.0) -> Run:
@@ -713,7 +749,8 @@ def integrate(p: Seed001, y0, h: float, n_steps: int, t0: float = 0.0) -> Run:
     used = np.flatnonzero(cnt.any(axis=1))
     n = int(used[-1]) + 1 if used.size else 0
     empty = cnt[:n] == 0
-    mean = np.where(empty, np.nan, a["cyc_sum"][:n] / np.maximum(cnt[:n], 1))
+    wt = a["cyc_wt"][:n]
+    mean = np.where(empty | (wt <= 0), np.nan, a["cyc_sum"][:n] / np.where(wt > 0, wt, 1.0))
     mx = np.where(empty, np.nan, a["cyc_max"][:n])
     mn = np.where(empty, np.nan, a["cyc_min"][:n])
     return Run(y_final=y, forces_final=a["f_end"].copy(), cycle_max=mx, cycle_min=mn,

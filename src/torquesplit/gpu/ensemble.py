@@ -253,6 +253,7 @@ def _solution(p: _Planned, run, g, src, of, oi, precision, target, share):
     rec.cyc_sum[:] = st[:, :, 2]
     rec.rat_max[:] = st[:, :, 3]
     rec.rat_min[:] = st[:, :, 4]
+    rec.cyc_wt[:] = st[:, :, 5]
     rec.cyc_cnt[:] = oi[:cap * n_tr].reshape(cap, n_tr)
     for k, el in enumerate(g.layout.watch):
         rec.sep_time[el] = of[src.of_contact + 2 * k]

@@ -48,7 +48,7 @@ from .layout import Group
 __all__ = ["KernelSource", "kernel_source"]
 
 #: rows of the statistics of a tracked element's cycle: max, min, sum, ratio max, ratio min
-N_STAT = 5
+N_STAT = 6
 _I = kern  # counter indices I_* and status codes
 
 
@@ -157,7 +157,9 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
     nxs = max(len(k_off), 1)
     X_RT = 3 * nxs
     X_ST = X_RT + 2 * n_sin
-    X_CT = X_ST + N_STAT * n_tr
+    X_PF = X_ST + N_STAT * n_tr  # the last instant's force per tracked element
+    X_PT = X_PF + n_tr  # the last instant's time (NaN before the first)
+    X_CT = X_PT + 1
     n_x = X_CT + 2 * len(watch) + 1
     n_tv = max(len(tv), 1)
     WI_SC = 3 * n_tv
@@ -347,7 +349,7 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
         w(f"cur = WI[{WI_SC} + 2 * j]")
         with w.block("if cur >= 0 and cur < cap:"):
             w(f"o = (cur * {n_tr} + j) * {N_STAT}")
-            for q, op in enumerate((">", "<", None, ">", "<")):
+            for q, op in enumerate((">", "<", None, ">", "<", None)):
                 if op is None:
                     w(f"OF[o + {q}, c] += X[st + {q}]")
                     continue
@@ -359,7 +361,8 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
     with w.block("def new_cycle(j, cy, X, WI, OF, OI, c, cap):"):
         w("flush(j, X, WI, OF, OI, c, cap)")
         w(f"st = {X_ST} + {N_STAT} * j")
-        for q, v in enumerate(("-math.inf", "math.inf", "0.0", "-math.inf", "math.inf")):
+        for q, v in enumerate(("-math.inf", "math.inf", "0.0", "-math.inf", "math.inf",
+                               "0.0")):
             w(f"X[st + {q}] = {v}")
         w(f"WI[{WI_SC} + 2 * j] = cy")
         w(f"WI[{WI_SC} + 2 * j + 1] = 0")
@@ -367,21 +370,56 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
     w()
 
     def record_body(full: bool):
+        # the time integral of each cycle (_kernels.mean_sample): the interval from the
+        # last instant, split where a cycle begins; part A into the last instant's cycle
+        # (still the current one), part B into this instant's (after new_cycle)
         w("bi = 0  # slot A")
         w(f"cap = {par(('cap',))}")
+        w(f"ta = X[{X_PT}]")
+        w("span = t - ta")
+        w("entered = span >= 0.0")
         for j, el in enumerate(L.track):
+            s = X_ST + N_STAT * j
             w(f"cy{j} = WI[bi + {tv_pos[el]}] - {par(('base', j))}")
+            w(f"fe = W[{W_F + el}]")
+            w("part = 0.0")
+            w("dpart = 0.0")
+            with w.block("if entered:"):
+                w(f"fa = X[{X_PF + j}]")
+                with w.block(f"if cy{j} == WI[{WI_SC + 2 * j}] + 1:"):
+                    w(f"tb = (cy{j} + {par(('base', j))} - {par(('ph', el))}) / "
+                      f"{par(('f', el))}")
+                    w("th = 1.0")
+                    with w.block("if span > 0.0:"):  # clipped to [0, 1]
+                        w("th = (tb - ta) / span")
+                        with w.block("if th < 0.0:"):
+                            w("th = 0.0")
+                        with w.block("if th > 1.0:"):
+                            w("th = 1.0")
+                    w("fb = fa + th * (fe - fa)")
+                    w("da = th * span")
+                    w("dpart = span - da")
+                    w(f"X[{s + 2}] += 0.5 * da * (fa + fb)")
+                    w(f"X[{s + 5}] += da")
+                    w("part = 0.5 * dpart * (fb + fe)")
+                with w.block("else:"):
+                    w("dpart = 0.5 * span")
+                    w(f"X[{s + 2}] += dpart * fa")
+                    w(f"X[{s + 5}] += dpart")
+                    w("part = dpart * fe")
             with w.block(f"if cy{j} != WI[{WI_SC + 2 * j}]:"):
                 w(f"new_cycle(I{j}, cy{j}, X, WI, OF, OI, c, cap)")
-            w(f"fe = W[{W_F + el}]")
-            s = X_ST + N_STAT * j
+            with w.block("if entered:"):
+                w(f"X[{s + 2}] += part")
+                w(f"X[{s + 5}] += dpart")
+            w(f"X[{X_PF + j}] = fe")
             with w.block(f"if fe > X[{s}]:"):
                 w(f"X[{s}] = fe")
             with w.block(f"if fe < X[{s + 1}]:"):
                 w(f"X[{s + 1}] = fe")
             if full:
-                w(f"X[{s + 2}] += fe")
                 w(f"WI[{WI_SC + 2 * j + 1}] += 1")
+        w(f"X[{X_PT}] = t")
         for kg, grp in enumerate(L.groups):
             w("total = 0.0")
             for j in grp:
@@ -413,11 +451,11 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
                     w(f"X[{X_CT + 2 * k + 1}] += weight")
         w(f"WI[{WI_CNT + _I.I_SAMPLES}] += 1")
 
-    with w.block("def record(weight, X, WI, W, OF, OI, P, PT, PI, c):"):
+    with w.block("def record(t, weight, X, WI, W, OF, OI, P, PT, PI, c):"):
         record_body(True)
         w("return 0")
     w()
-    with w.block("def record_extrema(X, WI, W, OF, OI, P, PT, PI, c):"):
+    with w.block("def record_extrema(t, X, WI, W, OF, OI, P, PT, PI, c):"):
         record_body(False)
         w("return 0")
     w()
@@ -516,7 +554,7 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
             w(f"te = t_corner if t_corner < tb - {kern.MERGE!r} * h else tb")
             with w.block("if not first:"):
                 w(f"rhs(I0, I{W_Y}, I{W_K1}, X, W, P, PT, PI, c)")
-                w("record_extrema(X, WI, W, OF, OI, P, PT, PI, c)")
+                w("record_extrema(ts, X, WI, W, OF, OI, P, PT, PI, c)")
                 w(f"WI[{WI_CNT + _I.I_RHS}] += 1")
                 w(f"WI[{WI_CNT + _I.I_EVENTS}] += 1")
             with w.block(f"if te - ts > {kern.MERGE!r} * h:"):
@@ -550,12 +588,14 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
                 w("OF[o + 2, c] = 0.0")
                 w("OF[o + 3, c] = -math.inf")
                 w("OF[o + 4, c] = math.inf")
+                w("OF[o + 5, c] = 0.0")
                 w(f"OI[row * {n_tr} + {j}, c] = 0")
         with w.block(f"for k in range({n2}):"):
             w(f"W[{W_Y} + k] = {cast('Y0[k, c]')}")
         for j in range(n_tr):
             w(f"WI[{WI_SC + 2 * j}] = -4611686018427387904")  # no cycle yet (-2**62)
             w(f"WI[{WI_SC + 2 * j + 1}] = 0")
+        w(f"X[{X_PT}] = math.nan  # no instant entered yet")
         with w.block(f"for k in range({2 * len(watch)}):"):
             w(f"X[{X_CT} + k] = 0.0")
             w(f"WI[{WI_CC} + k] = 0")
@@ -577,7 +617,7 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
                 with w.block("if i > 0 and i % chunk == 0:"):
                     w("t_corner = first_corners(t, WI, PT, c, CN)")
             w(f"rhs(I0, I{W_Y}, I{W_K1}, X, W, P, PT, PI, c)")
-            w("record(h, X, WI, W, OF, OI, P, PT, PI, c)")
+            w("record(t, h, X, WI, W, OF, OI, P, PT, PI, c)")
             w("tb = t0 + (i + 1) * h")
             with w.block("if t_corner < tb:"):
                 w("t_corner = through_corners(t, tb, t_corner, X, WI, W, OF, OI, P, PT, PI, "
@@ -597,7 +637,7 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
                 w("break")
         with w.block(f"if WI[{WI_CNT + _I.I_STATUS}] == 0 and n_steps > 0:"):
             w(f"rhs(I0, I{W_Y}, I{W_K1}, X, W, P, PT, PI, c)")
-            w("record(0.0, X, WI, W, OF, OI, P, PT, PI, c)")
+            w("record(t_final, 0.0, X, WI, W, OF, OI, P, PT, PI, c)")
         for j in range(n_tr):
             w(f"flush(I{j}, X, WI, OF, OI, c, cap)")
         with w.block(f"for k in range({2 * len(watch)}):"):

@@ -348,11 +348,60 @@ def evaluate(t, m, w, rhs_fn, gen):
 
 # ================================================================== recording
 @_inline
-def record(slot, i_f, weight, m, w, r, counters):
-    """Enter one accepted state (forces in row ``i_f``) in the statistics.
+def mean_sample(t, slot, i_f, m, w, r):
+    """Enter the forces (row ``i_f``) at time ``t`` in the cycles' time integrals: the
+    trapezoid rule over the interval from the last instant entered, split where a cycle
+    of the element begins (the linear interpolant integrated on each side, so that a
+    cycle's mean is second order in the step).  Instants come in time order (the step
+    samples and, with RK4, the corners between them: a table ramp steeper than a step or
+    an impact pulse between two steps is then integrated, not missed).
+    Twin: :func:`torquesplit.solve.reference.cycle_statistics_numpy`."""
+    force, CY = w.F, w.CY
+    track_el, track_base = r.track_el, r.track_base
+    cyc_sum, cyc_wt, prev_f, prev_c = r.cyc_sum, r.cyc_wt, r.prev_f, r.prev_c
+    cap = cyc_sum.shape[0]
+    ta = r.prev_t[0]
+    span = t - ta
+    first = not (span >= 0.0)  # NaN before the first instant: nothing entered yet
+    for j in range(track_el.shape[0]):
+        el = track_el[j]
+        c = CY[slot, el] - track_base[j]
+        fe = force[i_f, el]
+        if not first:
+            cp = prev_c[j]
+            fa = prev_f[j]
+            if c == cp + 1:  # the interval holds the start of cycle c: split it there
+                tb = (c + track_base[j] - m.phase[el]) / m.frequency[el]
+                th = min(max((tb - ta) / span, 0.0), 1.0) if span > 0.0 else 1.0
+                fb = fa + th * (fe - fa)
+                da = th * span
+                db = span - da
+                if cp >= 0 and cp < cap:
+                    cyc_sum[cp, j] += 0.5 * da * (fa + fb)
+                    cyc_wt[cp, j] += da
+                if c >= 0 and c < cap:
+                    cyc_sum[c, j] += 0.5 * db * (fb + fe)
+                    cyc_wt[c, j] += db
+            else:  # one cycle (or, past a skipped cycle, half to each end's cycle)
+                half = 0.5 * span
+                if cp >= 0 and cp < cap:
+                    cyc_sum[cp, j] += half * fa
+                    cyc_wt[cp, j] += half
+                if c >= 0 and c < cap:
+                    cyc_sum[c, j] += half * fe
+                    cyc_wt[c, j] += half
+        prev_f[j] = fe
+        prev_c[j] = c
+    r.prev_t[0] = t
+
+
+@_inline
+def record(t, slot, i_f, weight, m, w, r, counters):
+    """Enter one accepted state at time ``t`` (forces in row ``i_f``) in the statistics.
 
     Per tracked element j: cycle c = CY - track_base[j] (cycles at or beyond the
-    capacity are ignored); force max, min, sum and count of the cycle; per load-sharing
+    capacity are ignored); force max, min and sample count of the cycle and its time
+    integral (:func:`mean_sample`); per load-sharing
     group the instantaneous ratio N f_i / sum_j f_j of each member (Ji & Li eq. 18) and
     its max and min in the member's cycle.  Contact counters: separation |delta| <= g
     with g > 0; back-side contact delta < -g with g > 0, or delta < 0 for a mesh
@@ -362,7 +411,7 @@ def record(slot, i_f, weight, m, w, r, counters):
     """
     force, defl, CY, G, watch_el = w.F, w.D, w.CY, w.G, w.watch_el
     track_el, track_base = r.track_el, r.track_base
-    cyc_max, cyc_min, cyc_sum, cyc_cnt = r.cyc_max, r.cyc_min, r.cyc_sum, r.cyc_cnt
+    cyc_max, cyc_min, cyc_cnt = r.cyc_max, r.cyc_min, r.cyc_cnt
     grp_ptr, grp_col, rat_max, rat_min = r.grp_ptr, r.grp_col, r.rat_max, r.rat_min
     grp_min = r.grp_min
     sep_count, sep_time, back_count, back_time = (r.sep_count, r.sep_time, r.back_count,
@@ -378,8 +427,8 @@ def record(slot, i_f, weight, m, w, r, counters):
                 cyc_max[c, j] = fe
             if fe < cyc_min[c, j]:
                 cyc_min[c, j] = fe
-            cyc_sum[c, j] += fe
             cyc_cnt[c, j] += 1
+    mean_sample(t, slot, i_f, m, w, r)
     for g in range(grp_ptr.shape[0] - 1):
         total = 0.0
         for k in range(grp_ptr[g], grp_ptr[g + 1]):
@@ -414,10 +463,12 @@ def record(slot, i_f, weight, m, w, r, counters):
 
 
 @_kernel
-def record_extrema(slot, i_f, w, r):
-    """Enter the forces of row ``i_f`` in the per-cycle max / min of the force and of the
-    instantaneous load-sharing ratio only (a corner event: an instant, not a sample of
-    the run, so no sums, counts or contact time).  Twin: the max / min part of
+def record_extrema(t, mean, slot, i_f, m, w, r):
+    """Enter the forces of row ``i_f`` at time ``t`` in the per-cycle max / min of the
+    force and of the instantaneous load-sharing ratio (a corner event: an instant, not a
+    sample of the run, so no counts or contact time), and with ``mean`` in the cycles'
+    time integrals (:func:`mean_sample`: RK4's corners come in time order, not
+    Dormand-Prince's, taken element by element).  Twin: the max / min part of
     :func:`record`."""
     force, CY = w.F, w.CY
     track_el, track_base = r.track_el, r.track_base
@@ -450,6 +501,8 @@ def record_extrema(slot, i_f, w, r):
                         rat_max[c, j] = ratio
                     if ratio < rat_min[c, j]:
                         rat_min[c, j] = ratio
+    if mean:
+        mean_sample(t, slot, i_f, m, w, r)
 
 
 @_kernel
@@ -565,7 +618,7 @@ def corner_events(t_a, t_b, ya, fa, yb, fb, m, w, r, rhs_fn, gen, counters):
                 hermite((tc - t_a) / h, h, ya, fa, yb, fb, Y_SAMPLE, w)
                 excite(tc, slot, np.int64(-1), m, w)
                 _stage(slot, Y_SAMPLE, Y_DSAMPLE, F_TMP, m, w, rhs_fn, gen, extra)
-                record_extrema(slot, np.int64(F_TMP), w, r)
+                record_extrema(tc, False, slot, np.int64(F_TMP), m, w, r)
                 counters[I_EVENTS] += 1
             next_node[e] = _following_corner(node, c0, c1, n_tab, corner_node)
     return next_corner_time(m, w)
@@ -685,7 +738,7 @@ def rk4_through_corners(t, tb, t_corner, sa, sb, m, w, r, rhs_fn, gen, counters)
         te = sub_step_end(t_corner, tb, h)
         if not first:  # the corner: its exact forces, and k1 of the next sub-step
             _stage(sa, Y_STATE, Y_K1, F_MAIN, m, w, rhs_fn, gen, extra)
-            record_extrema(sa, np.int64(F_MAIN), w, r)
+            record_extrema(ts, True, sa, np.int64(F_MAIN), m, w, r)
             counters[I_RHS] += 1
             counters[I_EVENTS] += 1
         if te - ts > MERGE * h:
@@ -747,7 +800,7 @@ def rk4_run(t0, h, n_first, n_steps, record_final, record_every, blowup, m, w, r
                 next_sync += RESYNC
         # stage 1 at t: its forces are those of the accepted state y(t)
         _stage(a, Y_STATE, Y_K1, F_MAIN, m, w, rhs_fn, gen, extra)
-        record(a, F_MAIN, h, m, w, r, counters)
+        record(t, a, F_MAIN, h, m, w, r, counters)
         if i == next_rec:
             next_rec += every
             if record_every > 0 and counters[I_HIST] < n_hist:
@@ -778,7 +831,7 @@ def rk4_run(t0, h, n_first, n_steps, record_final, record_every, blowup, m, w, r
         i = n_first + n_steps
         t = t0 + i * h
         _stage(a, Y_STATE, Y_K1, F_MAIN, m, w, rhs_fn, gen, extra)
-        record(a, F_MAIN, 0.0, m, w, r, counters)
+        record(t, a, F_MAIN, 0.0, m, w, r, counters)
         if (record_every > 0 and i % record_every == 0
                 and counters[I_HIST] < n_hist):
             store_history(counters[I_HIST], t, np.int64(Y_STATE), np.int64(F_MAIN), w, r)
@@ -848,7 +901,7 @@ def dopri_run(t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, blowup, dt
         counters[I_RHS] += 1
         counters[I_FSAL] = 1
         if counters[I_SAMPLES] == 0:
-            record(s1, F_MAIN, 0.0, m, w, r, counters)
+            record(t, s1, F_MAIN, 0.0, m, w, r, counters)
         while counters[I_NEXT] < n_hist and t0 + counters[I_NEXT] * dt_sample <= t:
             row = counters[I_NEXT]
             store_history(row, t, np.int64(Y_STATE), np.int64(F_MAIN), w, r)
@@ -960,7 +1013,7 @@ def dopri_run(t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, blowup, dt
                 clock[F_HMIN] = hs
             if hs > clock[F_HMAX]:
                 clock[F_HMAX] = hs
-            record(s1, F_MAIN, hs, m, w, r, counters)
+            record(t, s1, F_MAIN, hs, m, w, r, counters)
             fac = fac11 / facold ** _BETA
             fac = max(1.0 / _FAC_MAX, min(1.0 / _FAC_MIN, fac / _SAFE))
             h_new = hs / fac

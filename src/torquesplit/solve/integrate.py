@@ -819,11 +819,14 @@ def _cycle_summary(rec: kd.Record, s: Structure, sel: _Selection) -> dict:
     used = np.flatnonzero(cnt_all.any(axis=1))
     n_cyc = int(used[-1]) + 1 if used.size else 0
     empty = cnt_all == 0
-    for buf in (rec.cyc_max, rec.cyc_min, rec.cyc_sum):
+    for buf in (rec.cyc_max, rec.cyc_min):
         buf[empty] = np.nan
     for buf in (rec.rat_max, rec.rat_min):
         buf[~np.isfinite(buf)] = np.nan
-    np.divide(rec.cyc_sum, cnt_all, out=rec.cyc_sum, where=~empty)
+    # the time integral over the cycle's time: its mean force (NaN without samples)
+    timed = ~empty & (rec.cyc_wt > 0.0)
+    np.divide(rec.cyc_sum, rec.cyc_wt, out=rec.cyc_sum, where=timed)
+    rec.cyc_sum[~timed] = np.nan
     tr = np.array(sel.track, dtype=np.int64)
     rows = np.arange(n_cyc)[:, None]
     start = (sel.track_base[None, :] + rows - s.phase[tr][None, :]) \

@@ -81,13 +81,17 @@ addresses for the generated right-hand side (``A_*``); ``par`` its parameter vec
 corner."""
 
 Record = namedtuple("Record", (
-    "track_el", "track_base", "cyc_max", "cyc_min", "cyc_sum", "cyc_cnt",
-    "grp_ptr", "grp_col", "grp_min", "rat_max", "rat_min",
+    "track_el", "track_base", "cyc_max", "cyc_min", "cyc_sum", "cyc_cnt", "cyc_wt",
+    "prev_t", "prev_f", "prev_c", "grp_ptr", "grp_col", "grp_min", "rat_max", "rat_min",
     "sep_count", "back_count", "sep_time", "back_time",
     "hist_el", "hist_dof", "hist_t", "hist_f", "hist_q", "hist_v", "full_t", "full_y",
 ))
 """Outputs of a run.  Per tracked element (columns) and cycle (rows, counted from the
-cycle containing the start time): force max, min, sum and sample count; per
+cycle containing the start time): force max, min, time integral (trapezoid rule over
+the step samples and the corner instants, each half-interval in its end's cycle) and
+its time (``cyc_wt``: their ratio is the cycle's mean force), sample count; the last
+instant entered (``prev_t`` (1,), NaN before the first; ``prev_f``, ``prev_c`` its
+forces and cycles); per
 load-sharing group (``grp_col[grp_ptr[g]:grp_ptr[g+1]]`` its tracked columns) the
 largest and smallest instantaneous ratio ``N f_i / sum_j f_j`` of each member in each of
 its cycles (``rat_max``, ``rat_min``), formed only while the group's total force exceeds
@@ -345,7 +349,8 @@ def make_record(track_el, track_base, n_cycles_cap: int, groups, n_el: int, hist
         track_base=np.asarray(track_base, dtype=np.int64),
         cyc_max=np.full((cap, n_tr), -np.inf), cyc_min=np.full((cap, n_tr), np.inf),
         cyc_sum=np.zeros((cap, n_tr)), cyc_cnt=np.zeros((cap, n_tr), dtype=np.int64),
-        grp_ptr=grp_ptr, grp_col=grp_col,
+        cyc_wt=np.zeros((cap, n_tr)), prev_t=np.full(1, np.nan), prev_f=np.zeros(n_tr),
+        prev_c=np.zeros(n_tr, dtype=np.int64), grp_ptr=grp_ptr, grp_col=grp_col,
         grp_min=(np.zeros(len(groups)) if group_min is None
                  else np.asarray(group_min, dtype=np.float64).reshape(len(groups))),
         rat_max=np.full((cap, n_tr), -np.inf), rat_min=np.full((cap, n_tr), np.inf),
@@ -363,4 +368,4 @@ def record_bytes(n_cycles_cap: int, n_tracked: int, n_hist: int, n_hist_el: int,
                  n_hist_dof: int, n_full: int, n_dof: int) -> int:
     """Bytes of the output arrays :func:`make_record` would allocate."""
     return 8 * (n_hist * (1 + n_hist_el + 2 * n_hist_dof) + n_full * (1 + 2 * n_dof)
-                + 6 * n_cycles_cap * n_tracked)
+                + 7 * n_cycles_cap * n_tracked)

@@ -202,13 +202,19 @@ def hermite_numpy(theta, h, y0, f0, y1, f1):
     return h00 * y0 + h10 * h * f0 + h01 * y1 + h11 * h * f1
 
 
-def cycle_statistics_numpy(times, forces, frequency, phase, t0, n_cycles_cap):
-    """Per-excitation-cycle max, min, sum and count of one element's force samples.
+def cycle_statistics_numpy(times, forces, frequency, phase, t0, n_cycles_cap,
+                           counted=None):
+    """Per-excitation-cycle max, min, mean and sample count of one element's force at the
+    instants ``times`` (increasing: the step samples and any corner instants between).
 
-    Cycle index of a sample at t is c(f t + phase) - c(f t0 + phase), c the statistics
-    cycle index (:func:`cycle_index_numpy`).  Returns four arrays of length
-    ``n_cycles_cap`` (max -inf / min +inf where empty).
-    Twin of the cycle part of ``_kernels.record``.
+    Cycle index of an instant at t is c(f t + phase) - c(f t0 + phase), c the statistics
+    cycle index (:func:`cycle_index_numpy`).  Mean: the trapezoid rule over the intervals
+    between consecutive instants, an interval that holds the start of a cycle split there
+    (the linear interpolant integrated on each side; past a skipped cycle, half to each
+    end's cycle), divided by the time so entered.  ``counted``: which instants are
+    samples of the run (the counts; default all).  Returns four arrays of length
+    ``n_cycles_cap`` (max -inf / min +inf / mean NaN where empty).
+    Twin of the cycle part of ``_kernels.record`` and ``_kernels.mean_sample``.
     """
     times = np.asarray(times, dtype=float)
     forces = np.asarray(forces, dtype=float)
@@ -217,13 +223,33 @@ def cycle_statistics_numpy(times, forces, frequency, phase, t0, n_cycles_cap):
     cmax = np.full(n_cycles_cap, -np.inf)
     cmin = np.full(n_cycles_cap, np.inf)
     csum = np.zeros(n_cycles_cap)
+    cwt = np.zeros(n_cycles_cap)
     ccnt = np.zeros(n_cycles_cap, dtype=np.int64)
     ok = (idx >= 0) & (idx < n_cycles_cap)
     np.maximum.at(cmax, idx[ok], forces[ok])
     np.minimum.at(cmin, idx[ok], forces[ok])
-    np.add.at(csum, idx[ok], forces[ok])
-    np.add.at(ccnt, idx[ok], 1)
-    return cmax, cmin, csum, ccnt
+    cnt = ok if counted is None else ok & np.asarray(counted, dtype=bool)
+    np.add.at(ccnt, idx[cnt], 1)
+    base = int(cycle_index_numpy(frequency * t0 + phase))
+    for a in range(times.size - 1):  # each interval, split where a cycle begins
+        ta, tb, fa, fb, ca, cb = (times[a], times[a + 1], forces[a], forces[a + 1],
+                                  idx[a], idx[a + 1])
+        span = tb - ta
+        if cb == ca + 1:
+            tc = (cb + base - phase) / frequency
+            th = min(max((tc - ta) / span, 0.0), 1.0) if span > 0 else 1.0
+            fc = fa + th * (fb - fa)
+            parts = ((ca, th * span, 0.5 * th * span * (fa + fc)),
+                     (cb, span - th * span, 0.5 * (span - th * span) * (fc + fb)))
+        else:
+            parts = ((ca, 0.5 * span, 0.5 * span * fa), (cb, 0.5 * span, 0.5 * span * fb))
+        for c, dt, integral in parts:
+            if 0 <= c < n_cycles_cap:
+                csum[c] += integral
+                cwt[c] += dt
+    mean = np.full(n_cycles_cap, np.nan)
+    np.divide(csum, cwt, out=mean, where=cwt > 0)
+    return cmax, cmin, mean, ccnt
 
 
 def rk4_numpy(structure: Structure, y0, t0: float, h: float, n_steps: int, times=None):

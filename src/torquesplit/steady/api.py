@@ -316,6 +316,34 @@ def period_weights(t, corners, period):
     return w[:t.size], w[t.size:]
 
 
+def cycle_integrals(t, f, cycles, n, start, period):
+    """Time integral of ``f`` and the time in each of ``n`` cycles, from its values at
+    the increasing instants ``t`` in cycles ``cycles`` (cycle c begins at start + c
+    period): the trapezoid rule, an interval that holds the start of a cycle split there
+    (the linear interpolant on each side), past a skipped cycle half to each end's cycle;
+    cycles outside [0, n) left out.  The integrator's ``_kernels.mean_sample`` over a
+    record."""
+    ta, tb, fa, fb = t[:-1], t[1:], f[:-1], f[1:]
+    ca, cb = cycles[:-1], cycles[1:]
+    span = tb - ta
+    split = cb == ca + 1
+    th = np.where(split & (span > 0),
+                  np.clip((start + cb * period - ta) / np.where(span > 0, span, 1.0), 0, 1),
+                  1.0)
+    fm = fa + th * (fb - fa)
+    da = np.where(split, th * span, 0.5 * span)
+    db = span - da
+    ia = np.where(split, 0.5 * da * (fa + fm), da * fa)
+    ib = np.where(split, 0.5 * db * (fm + fb), db * fb)
+    total = np.zeros(n)
+    time = np.zeros(n)
+    for c, integral, dt in ((ca, ia, da), (cb, ib, db)):
+        ok = (c >= 0) & (c < n)
+        total += np.bincount(c[ok], weights=integral[ok], minlength=n)[:n]
+        time += np.bincount(c[ok], weights=dt[ok], minlength=n)[:n]
+    return total, time
+
+
 def cycle_extremes(values, cycles, n, extra_cycles=None, extra=None):
     """Per-cycle max and min (arrays of ``n``; -inf / inf where a cycle has none) of
     ``values`` in cycles ``cycles`` (non-decreasing: the samples of a cycle form one run)
@@ -400,11 +428,10 @@ def _as_solution(st: SteadyState, shell, periods):
         ic = cycles(j, tc)
         keep = (ic >= 0) & (ic < cyc_n[j])
         corner_idx.append((ic[keep], keep))
-    # time weights of the samples and corner instants (trapezoid rule, the corners as
-    # breakpoints): means of a force with steep table ramps or impact pulses converge
-    # with the step only so (the plain mean of the step samples is first order there)
-    ws1, wc1 = period_weights(tm, ps.corner_t, T)
-    ws, wc = np.tile(ws1, periods), np.tile(wc1, periods)
+    # every instant (steps and corners) in time order, for the cycles' time integrals
+    t_all = np.concatenate([tt, tc, [periods * T]])
+    order = np.argsort(t_all, kind="stable")
+    t_all = t_all[order]
     cmax = np.full((nc, n_tr), np.nan)
     cmin = np.full((nc, n_tr), np.nan)
     csum = np.zeros((nc, n_tr))
@@ -415,10 +442,10 @@ def _as_solution(st: SteadyState, shell, periods):
         f = np.tile(Fm[:, j], periods)
         ic, keep = corner_idx[j]
         mx, mn = cycle_extremes(f, idx, nc, ic, Fc[keep, j])
-        sm = (np.bincount(idx, weights=ws * f, minlength=nc)
-              + np.bincount(ic, weights=wc[keep] * Fc[keep, j], minlength=nc))
-        span = (np.bincount(idx, weights=ws, minlength=nc)
-                + np.bincount(ic, weights=wc[keep], minlength=nc))
+        f_all = np.concatenate([f, Fc[:, j], f[:1]])[order]
+        sm, span = cycle_integrals(t_all, f_all, cycles(j, t_all), nc,
+                                   (bases[j] - s.phase[e]) / s.frequency[e],
+                                   1.0 / s.frequency[e])
         cnt = np.bincount(idx, minlength=nc)
         # the first and last cycles are partial (phase offsets): left out
         cnt[0] = 0
