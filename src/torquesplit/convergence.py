@@ -7,7 +7,9 @@ for: a stiff damping or a resolved mode may have set a finer one) and compares e
 metric of :meth:`Results.metric_values <torquesplit.results.Results.metric_values>`;
 :class:`StepCheck` says, per metric, how many significant digits agree.  For the
 adaptive Dormand-Prince method the tolerance is tightened 32-fold instead (its local
-error is fifth order in the step, so that about halves the steps).
+error is fifth order in the step, so that about halves the steps).  :func:`check_steady`
+does the same for a periodic steady state (shooting at half its RK4 step, harmonic
+balance with twice its harmonics).
 """
 
 from __future__ import annotations
@@ -39,17 +41,19 @@ def agreeing_digits(a: float, b: float, most: int = 15) -> int:
 
 @dataclass(frozen=True)
 class StepCheck:
-    """Every metric of a run and of the same run at half its step."""
+    """Every metric of a run (or steady state) and of the same at half its step."""
 
     values: dict
     """Metric name -> value of the run (:meth:`Results.metric_values`)."""
     halved: dict
     """The same metrics at half the step (Dormand-Prince: a 32-fold tighter tolerance)."""
     method: str
+    """rk4 or dopri (a run), shooting or hb (a steady state)."""
     step: float
-    """The run's RK4 step [s] (Dormand-Prince: its relative tolerance)."""
+    """The RK4 step [s] (Dormand-Prince: the relative tolerance; harmonic balance: the
+    harmonics)."""
     halved_step: float
-    """The check's RK4 step [s] (Dormand-Prince: its relative tolerance)."""
+    """The check's, in the same terms."""
 
     def rows(self) -> list[tuple[str, float, float, float, int]]:
         """(name, value, at half the step, relative change, agreeing significant digits)

@@ -17,6 +17,7 @@ from torquesplit.convergence import (
     check_step,
     halved_steps_per_period,
 )
+from torquesplit.errors import ModelWarning
 from torquesplit.model.io import load_model, model_from_dict
 from torquesplit.model.overrides import apply_overrides, read_raw
 
@@ -50,7 +51,8 @@ def _stiff_pair(tmp_path):
     asked for, sets the RK4 step."""
     data = apply_overrides(read_raw(write_model(tmp_path, SPUR_PAIR, "pair.toml")),
                            {"meshes.m.stiffness": "4e10 N/m"})
-    return load_model(model_from_dict(data, source="stiff pair"))
+    with pytest.warns(ModelWarning, match="ISO 6336 estimate"):  # stiff on purpose
+        return load_model(model_from_dict(data, source="stiff pair"))
 
 
 def test_the_check_halves_the_step_the_run_took_not_the_one_it_asked_for(tmp_path):
@@ -68,6 +70,14 @@ def test_the_check_halves_the_step_the_run_took_not_the_one_it_asked_for(tmp_pat
     assert spp > 200
     assert set(check.values) == set(res.metric_values())
     assert all(d >= 2 for *_, d in check.rows())  # a smooth run: the numbers converge
+
+
+def test_the_check_of_an_adaptive_run_tightens_its_tolerance(tmp_path):
+    path = write_model(tmp_path, SPUR_PAIR, "pair.toml")
+    res = torquesplit.simulate(path, cycles=10, method="dopri", rtol=1e-6)
+    check = check_step(res, rtol=1e-6)
+    assert check.method == "dopri" and check.halved_step == pytest.approx(1e-6 / 32)
+    assert set(check.values) == set(check.halved) and check.rows()
 
 
 def test_run_check_step_on_the_command_line(tmp_path):

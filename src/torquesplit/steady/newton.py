@@ -240,8 +240,9 @@ def solve_shooting(p: PeriodicProblem, y0, steps: int, speed=1.0, tol=1e-9, max_
     SIAM J. Numer. Anal. 49(4), eqs. 2.1-2.2; the least squares in the norm of the
     convergence test): on a linear map its iterates are GMRES's (their Theorem 2.2), so
     each period map is a defect and a product at once, where Newton-Krylov pays one map
-    for each.  On Liu et al. 2021's full period it converges in 6 maps from the static
-    state against 7 for settling and Newton-Krylov.  Where it has not converged in
+    for each.  On Liu et al. 2021's full period it converges in 5 maps from the static
+    state, where settling, Newton-Krylov and a map for the waveforms took 8.  Where it
+    has not converged in
     ``ANDERSON_MAPS`` maps, or its smallest defect has not fallen tenfold in
     ``ANDERSON_STALL``, (or a map from an extrapolated state diverges), Newton goes on
     from its best state.

@@ -325,9 +325,11 @@ def periodic_solution(structure, period: Period, *, method: str = "auto", harmon
 
         kept = [None]
 
-        def record(y):  # every defect map keeps the period's waveforms (in one set of
+        # every defect map keeps the period's waveforms, in one set of arrays refilled
+        # by each (what is kept is the last map's: the solution's, once converged)
+        def record(y):
             kept[0] = p.run(y, 0.0, T, steps, every=every, speed=speed, corners=True,
-                            track=meshes, out=kept[0])  # arrays: the last map's)
+                            track=meshes, out=kept[0])
             return kept[0]
 
         if initial is not None and np.size(initial) == 2 * p.n:
