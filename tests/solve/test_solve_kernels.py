@@ -187,7 +187,7 @@ def test_cycle_extremes_include_the_forces_at_the_table_corners():
     forces = np.array([element_forces_numpy(s, ti, yi)[0][0] for ti, yi in zip(t, ys)])
     on = np.isin(t, steps)
     cmax, cmin, cmean, ccnt = cycle_statistics_numpy(t, forces, 1000.0, 0.37, 0.0, 100,
-                                                     counted=on)
+                                                     counted=on, corners=corners)
     n = sol.cycle_max.shape[0]
     np.testing.assert_allclose(sol.cycle_max[:, 0], cmax[:n], rtol=1e-10)
     np.testing.assert_allclose(sol.cycle_min[:, 0], cmin[:n], rtol=1e-10)
@@ -247,3 +247,23 @@ def test_cycle_means_converge_with_the_step_through_the_corners():
 
     coarse, fine = means(200), means(800)
     assert np.max(np.abs(coarse / fine - 1)) < 5e-5
+
+
+def test_peaks_between_the_steps_are_found():
+    """A smooth stiffness wave (no corners): a force peak between two RK4 steps is missed
+    by the step samples by up to (omega h)^2 / 8 of the oscillation; the vertex of the
+    parabola through the three samples around it finds it.  At 100 steps per mesh period
+    the peak is within 3e-5 of 3200 steps' (the samples: 2e-4 low) and the trough within
+    5e-4 (the samples: 8e-3)."""
+    s = spur_pair(damping=100.0, frequency=1000.0, phase=0.37, n_table=256,
+                  stiffness=2e8 * (1 + 0.3 * np.sin(2 * np.pi * np.arange(256) / 256)),
+                  errors=[(2e-6, 2 * np.pi * 60, 0.0)])
+    y0 = np.array([1e-4, -5e-5, 0.0, 0.0])
+    ref = integrate(s, y0, (0.0, 0.02), steps_per_period=3200)
+    sol = integrate(s, y0, (0.0, 0.02), steps_per_period=100, record_every=1)
+    top, low = np.nanmax(ref.cycle_max[5:15, 0]), np.nanmin(ref.cycle_min[5:15, 0])
+    assert abs(np.nanmax(sol.cycle_max[5:15, 0]) / top - 1) < 3e-5
+    assert abs(np.nanmin(sol.cycle_min[5:15, 0]) / low - 1) < 5e-4
+    t, f = sol.history_t, sol.history_forces[:, 0]
+    inside = (t >= sol.cycle_start[5, 0]) & (t < sol.cycle_start[15, 0])
+    assert f[inside].max() < top * (1 - 1e-4)  # what the samples alone give

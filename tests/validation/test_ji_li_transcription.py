@@ -120,7 +120,7 @@ def test_compiled_eq9_is_the_matrices(shipped):
         y = np.concatenate([q, v])
         assert np.all(tr.mesh_rows(p.eom) @ q > b)  # every mesh in contact
         dy, forces = np.empty(28), np.empty(4)
-        tr.eom(y, p.eom, p.k_mean.copy(), b, dy, forces)
+        tr.eom(y, p.eom, p.k_mean.copy(), b, dy, forces, np.empty(4))
         assert np.array_equal(dy[:14], v)
         # each row of M q'' = F + Fb - K q - C v, to round-off of its largest term
         residual = M @ dy[14:] - (F + Fb - K @ q - C @ v)

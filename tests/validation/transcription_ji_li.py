@@ -524,8 +524,9 @@ def mesh_force(Y, dY, k, c, b):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def eom(y, e, k, b, dy, F):
-    """dy = [q', q''] of Ji & Li eq. 9 at state y; k, b: k_vij(t), b_ij(t); F: F_ij.
+def eom(y, e, k, b, dy, F, D):
+    """dy = [q', q''] of Ji & Li eq. 9 at state y; k, b: k_vij(t), b_ij(t); F: F_ij;
+    D: the normal deflections Y_ij.
 
     Legend: th_i, w_i rotation and speed of body i (0 motor .. 7 mill); X_i, V_i
     translation and velocity of gear z_i; e the :class:`Eom` coefficients.
@@ -552,6 +553,7 @@ def eom(y, e, k, b, dy, F):
     F21 = mesh_force(Y21, dY21, k[1], e.cv21, b[1])
     F12 = mesh_force(Y12, dY12, k[2], e.cv12, b[2])
     F22 = mesh_force(Y22, dY22, k[3], e.cv22, b[3])
+    D[0], D[1], D[2], D[3] = Y11, Y21, Y12, Y22
 
     # shaft torques k_T (th_m - th_n) + c_T (w_m - w_n) of eq. 9
     M0 = e.kT0 * (th0 - th1) + e.cT0 * (w0 - w1)
@@ -610,12 +612,28 @@ def excite(t, table, frequency, phase, bl_ptr, bl_val, k, b, cyc, bl_cyc):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def record(t, F, cyc, base, frequency, phase, cyc_max, cyc_min, cyc_sum, cyc_wt, cyc_cnt,
-           prev):
+def vertex(t0, t1, t2, f0, f1, f2):
+    """Value at the vertex of the parabola through three points."""
+    d1 = (f1 - f0) / (t1 - t0)
+    d2 = (f2 - f1) / (t2 - t1)
+    a = (d2 - d1) / (t2 - t0)
+    if a == 0.0:
+        return f1
+    sl = (d1 * (t2 - t1) + d2 * (t1 - t0)) / (t2 - t0)
+    return f1 - sl * sl / (4.0 * a)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def record(t, F, D, b, cyc, base, frequency, phase, cyc_max, cyc_min, cyc_sum, cyc_wt,
+           cyc_cnt, prev, pk):
     """Per-mesh-cycle max, min and count of the mesh forces, and their time integral
     (streamed): the trapezoid rule over the interval from the last sample, split where a
     mesh cycle begins.  ``prev``: the last sample's time, then its forces and cycles
-    (time NaN before the first sample)."""
+    (time NaN before the first sample).  Extremes between samples: where the middle of
+    the last three samples is the largest (smallest) and all three are in one contact
+    regime, the vertex of the parabola through them enters the middle one's cycle.
+    ``pk``: the last two samples' times, then per mesh their forces, cycles and regimes,
+    then the samples so far."""
     cap = cyc_max.shape[0]
     ta = prev[0]
     span = t - ta
@@ -654,12 +672,33 @@ def record(t, F, cyc, base, frequency, phase, cyc_max, cyc_min, cyc_sum, cyc_wt,
                     cyc_wt[c, j] += half
         prev[1 + j] = f
         prev[5 + j] = c
+        # the peak between samples (engine: _kernels.peak_sample)
+        g2 = 1.0
+        if b[j] > 0.0:
+            g2 = 1.0 if D[j] > b[j] else (-1.0 if D[j] < -b[j] else 0.0)
+        k = 2 + 6 * j
+        f0, f1, c1, g0, g1 = pk[k], pk[k + 1], np.int64(pk[k + 3]), pk[k + 4], pk[k + 5]
+        if (pk[26] >= 2 and g1 != 0.0 and g0 == g1 and g2 == g1 and 0 <= c1 < cap
+                and (f1 != f0 or f1 != f)):
+            if f1 >= f0 and f1 >= f:
+                v = vertex(pk[0], pk[1], t, f0, f1, f)
+                if v > cyc_max[c1, j]:
+                    cyc_max[c1, j] = v
+            elif f1 <= f0 and f1 <= f:
+                v = vertex(pk[0], pk[1], t, f0, f1, f)
+                if v < cyc_min[c1, j]:
+                    cyc_min[c1, j] = v
+        pk[k], pk[k + 1] = f1, f
+        pk[k + 2], pk[k + 3] = pk[k + 3], c
+        pk[k + 4], pk[k + 5] = g1, g2
+    pk[0], pk[1] = pk[1], t
+    pk[26] += 1
     prev[0] = t
 
 
 @njit(cache=True, error_model="numpy")
 def rk4(y, t0, h, n_steps, e, table, frequency, phase, bl_ptr, bl_val, base,
-        cyc_max, cyc_min, cyc_sum, cyc_wt, cyc_cnt, prev, f_end):
+        cyc_max, cyc_min, cyc_sum, cyc_wt, cyc_cnt, prev, pk, f_end):
     """Classic RK4 (Ji & Li eq. 17, misprinted there) over ``n_steps`` steps of ``h``.
 
     ``y`` (28) is advanced in place.  The mesh forces of the state at the start of every
@@ -675,6 +714,8 @@ def rk4(y, t0, h, n_steps, e, table, frequency, phase, bl_ptr, bl_val, base,
     bl_cyc = np.full(4, -(2**62), dtype=np.int64)
     F = np.empty(4)
     Ft = np.empty(4)
+    D = np.empty(4)
+    Dt = np.empty(4)
     k1 = np.empty(28)
     k2 = np.empty(28)
     k3 = np.empty(28)
@@ -682,28 +723,28 @@ def rk4(y, t0, h, n_steps, e, table, frequency, phase, bl_ptr, bl_val, base,
     yt = np.empty(28)
     excite(t0, table, frequency, phase, bl_ptr, bl_val, ka, b, cyc, bl_cyc)
     for i in range(n_steps):
-        eom(y, e, ka, b, k1, F)
-        record(t0 + i * h, F, cyc, base, frequency, phase, cyc_max, cyc_min, cyc_sum,
-               cyc_wt, cyc_cnt, prev)
+        eom(y, e, ka, b, k1, F, D)
+        record(t0 + i * h, F, D, b, cyc, base, frequency, phase, cyc_max, cyc_min, cyc_sum,
+               cyc_wt, cyc_cnt, prev, pk)
         excite(t0 + (i + 0.5) * h, table, frequency, phase, bl_ptr, bl_val, kh, b, cyc,
                bl_cyc)
         for m in range(28):
             yt[m] = y[m] + 0.5 * h * k1[m]
-        eom(yt, e, kh, b, k2, Ft)
+        eom(yt, e, kh, b, k2, Ft, Dt)
         for m in range(28):
             yt[m] = y[m] + 0.5 * h * k2[m]
-        eom(yt, e, kh, b, k3, Ft)
+        eom(yt, e, kh, b, k3, Ft, Dt)
         excite(t0 + (i + 1) * h, table, frequency, phase, bl_ptr, bl_val, kb, b, cyc,
                bl_cyc)
         for m in range(28):
             yt[m] = y[m] + h * k3[m]
-        eom(yt, e, kb, b, k4, Ft)
+        eom(yt, e, kb, b, k4, Ft, Dt)
         for m in range(28):
             y[m] += h / 6.0 * (k1[m] + 2.0 * (k2[m] + k3[m]) + k4[m])
         ka, kb = kb, ka
-    eom(y, e, ka, b, k1, F)
-    record(t0 + n_steps * h, F, cyc, base, frequency, phase, cyc_max, cyc_min, cyc_sum,
-           cyc_wt, cyc_cnt, prev)
+    eom(y, e, ka, b, k1, F, D)
+    record(t0 + n_steps * h, F, D, b, cyc, base, frequency, phase, cyc_max, cyc_min,
+           cyc_sum, cyc_wt, cyc_cnt, prev, pk)
     for j in range(4):
         f_end[j] = F[j]
 
@@ -737,7 +778,8 @@ def arrays(p: Seed001, t0: float, h: float, n_steps: int) -> dict:
                 cyc_max=np.full((cap, 4), -np.inf), cyc_min=np.full((cap, 4), np.inf),
                 cyc_sum=np.zeros((cap, 4)), cyc_wt=np.zeros((cap, 4)),
                 cyc_cnt=np.zeros((cap, 4), dtype=np.int64),
-                prev=np.concatenate([[np.nan], np.zeros(8)]), f_end=np.empty(4))
+                prev=np.concatenate([[np.nan], np.zeros(8)]), pk=np.zeros(27),
+                f_end=np.empty(4))
 
 
 def integrate(p: Seed001, y0, h: float, n_steps: int, t0: float = 0.0) -> Run:

@@ -159,7 +159,12 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
     X_ST = X_RT + 2 * n_sin
     X_PF = X_ST + N_STAT * n_tr  # the last instant's force per tracked element
     X_PT = X_PF + n_tr  # the last instant's time (NaN before the first)
-    X_CT = X_PT + 1
+    X_PK = X_PT + 1  # per tracked element: the last two step samples' forces and regimes
+    X_PKT = X_PK + 4 * n_tr  # their times
+    X_PKK = X_PKT + 2  # whether each is a corner
+    X_PN = X_PKK + 2  # instants entered
+    X_PX = X_PN + 1  # whether the next sample is a corner
+    X_CT = X_PX + 1
     n_x = X_CT + 2 * len(watch) + 1
     n_tv = max(len(tv), 1)
     WI_SC = 3 * n_tv
@@ -374,10 +379,15 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
         # last instant, split where a cycle begins; part A into the last instant's cycle
         # (still the current one), part B into this instant's (after new_cycle)
         w("bi = 0  # slot A")
+        w("b = 0  # slot A")
         w(f"cap = {par(('cap',))}")
         w(f"ta = X[{X_PT}]")
         w("span = t - ta")
         w("entered = span >= 0.0")
+        # the extremes between the instants (_kernels.peak_sample); a corner instant, and
+        # a sample flagged as one, can end a parabola but not be its middle
+        w(f"kink = X[{X_PX}]" if full else "kink = 1.0")
+        w(f"smooth = X[{X_PN}] >= 2.0 and X[{X_PKK + 1}] == 0.0")
         for j, el in enumerate(L.track):
             s = X_ST + N_STAT * j
             w(f"cy{j} = WI[bi + {tv_pos[el]}] - {par(('base', j))}")
@@ -407,6 +417,31 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
                     w(f"X[{s + 2}] += dpart * fa")
                     w(f"X[{s + 5}] += dpart")
                     w("part = dpart * fe")
+            # into the current cycle: the middle instant's when smooth
+            w(f"g = {g_of(el)}")
+            w(f"d = W[{W_D + el}]")
+            w("g2 = 1")
+            with w.block("if g > 0.0:"):
+                w("g2 = 1 if d > g else (-1 if d < -g else 0)")
+            k = X_PK + 4 * j
+            with w.block("if smooth:"):
+                w(f"f0 = X[{k}]")
+                w(f"f1 = X[{k + 1}]")
+                w(f"g1 = X[{k + 3}]")
+                with w.block(f"if (g1 != 0.0 and X[{k + 2}] == g1 and g2 == g1 "
+                             f"and (f1 != f0 or f1 != fe)):"):
+                    with w.block("if f1 >= f0 and f1 >= fe:"):
+                        w(f"v = vertex(X[{X_PKT}], X[{X_PKT + 1}], t, f0, f1, fe)")
+                        with w.block(f"if v > X[{s}]:"):
+                            w(f"X[{s}] = v")
+                    with w.block("elif f1 <= f0 and f1 <= fe:"):
+                        w(f"v = vertex(X[{X_PKT}], X[{X_PKT + 1}], t, f0, f1, fe)")
+                        with w.block(f"if v < X[{s + 1}]:"):
+                            w(f"X[{s + 1}] = v")
+            w(f"X[{k}] = X[{k + 1}]")
+            w(f"X[{k + 1}] = fe")
+            w(f"X[{k + 2}] = X[{k + 3}]")
+            w(f"X[{k + 3}] = g2")
             with w.block(f"if cy{j} != WI[{WI_SC + 2 * j}]:"):
                 w(f"new_cycle(I{j}, cy{j}, X, WI, OF, OI, c, cap)")
             with w.block("if entered:"):
@@ -420,6 +455,13 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
             if full:
                 w(f"WI[{WI_SC + 2 * j + 1}] += 1")
         w(f"X[{X_PT}] = t")
+        w(f"X[{X_PKT}] = X[{X_PKT + 1}]")
+        w(f"X[{X_PKT + 1}] = t")
+        w(f"X[{X_PKK}] = X[{X_PKK + 1}]")
+        w(f"X[{X_PKK + 1}] = kink")
+        w(f"X[{X_PN}] += 1.0")
+        if full:
+            w(f"X[{X_PX}] = 0.0")
         for kg, grp in enumerate(L.groups):
             w("total = 0.0")
             for j in grp:
@@ -434,7 +476,6 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
                         w(f"X[{s + 4}] = ratio")
         if not full:
             return
-        w("b = 0  # slot A")
         for k, el in enumerate(watch):
             w(f"g = {g_of(el)}")
             w(f"d = W[{W_D + el}]")
@@ -451,6 +492,15 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
                     w(f"X[{X_CT + 2 * k + 1}] += weight")
         w(f"WI[{WI_CNT + _I.I_SAMPLES}] += 1")
 
+    with w.block("def vertex(t0, t1, t2, f0, f1, f2):"):  # _kernels.vertex
+        w("d1 = (f1 - f0) / (t1 - t0)")
+        w("d2 = (f2 - f1) / (t2 - t1)")
+        w("a = (d2 - d1) / (t2 - t0)")
+        with w.block("if a == 0.0:"):
+            w("return f1")
+        w("sl = (d1 * (t2 - t1) + d2 * (t1 - t0)) / (t2 - t0)")
+        w("return f1 - sl * sl / (4.0 * a)")
+    w()
     with w.block("def record(t, weight, X, WI, W, OF, OI, P, PT, PI, c):"):
         record_body(True)
         w("return 0")
@@ -564,7 +614,11 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
                 w(f"WI[{WI_CNT + _I.I_RHS}] += 3")
                 w("ts = te")
                 w("first = False")
+            with w.block("elif first:"):  # a corner on the step's start: so is its sample
+                w(f"X[{X_PKK + 1}] = 1.0")
             with w.block("if te >= tb:"):
+                with w.block(f"if t_corner <= tb + {kern.MERGE!r} * h:"):  # on its end
+                    w(f"X[{X_PX}] = 1.0")
                 w("break")
             w("t_corner = advance_corners(te, WI, PT, c, CN)")
         with w.block("if ts < tb:"):
@@ -596,6 +650,10 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
             w(f"WI[{WI_SC + 2 * j}] = -4611686018427387904")  # no cycle yet (-2**62)
             w(f"WI[{WI_SC + 2 * j + 1}] = 0")
         w(f"X[{X_PT}] = math.nan  # no instant entered yet")
+        w(f"X[{X_PN}] = 0.0")
+        w(f"X[{X_PX}] = 0.0")
+        w(f"X[{X_PKK}] = 0.0")
+        w(f"X[{X_PKK + 1}] = 0.0")
         with w.block(f"for k in range({2 * len(watch)}):"):
             w(f"X[{X_CT} + k] = 0.0")
             w(f"WI[{WI_CC} + k] = 0")

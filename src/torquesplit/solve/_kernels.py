@@ -396,6 +396,80 @@ def mean_sample(t, slot, i_f, m, w, r):
 
 
 @_inline
+def regime(d, g):
+    """Contact regime of an element with deformation ``d`` and half-gap ``g``: 1 in
+    contact (d > g, or no gap), -1 in back-side contact (d < -g), 0 apart."""
+    if g > 0.0:
+        if d > g:
+            return 1
+        if d < -g:
+            return -1
+        return 0
+    return 1
+
+
+@_inline
+def vertex(t0, t1, t2, f0, f1, f2):
+    """Value at the vertex of the parabola through (t0, f0), (t1, f1), (t2, f2), t0 < t1
+    < t2: f1 - s^2 / (4 a), s its slope at t1, a half its curvature (f1 if a = 0)."""
+    d1 = (f1 - f0) / (t1 - t0)
+    d2 = (f2 - f1) / (t2 - t1)
+    a = (d2 - d1) / (t2 - t0)
+    if a == 0.0:
+        return f1
+    s = (d1 * (t2 - t1) + d2 * (t1 - t0)) / (t2 - t0)
+    return f1 - s * s / (4.0 * a)
+
+
+@_inline
+def peak_sample(t, kink, slot, i_f, w, r):
+    """The extremes between the instants (step samples and RK4's corner instants, in
+    time order): where the middle one of the last three is the largest (smallest), is
+    not a corner (``kink``: a kink or jump of the force may sit there; as an end point it
+    is exact) and all three share one contact regime, the vertex of the parabola
+    through them enters the middle instant's cycle maximum (minimum).  A peak between
+    two steps was otherwise missed by up to (omega h)^2 / 8 of the oscillation (6e-4 of
+    a dynamic factor at 100 steps per cycle).
+    Twin: :func:`torquesplit.solve.reference.cycle_statistics_numpy`."""
+    force, defl, CY, G = w.F, w.D, w.CY, w.G
+    track_el, track_base = r.track_el, r.track_base
+    cyc_max, cyc_min = r.cyc_max, r.cyc_min
+    pk_t, pk_f, pk_c, pk_g = r.pk_t, r.pk_f, r.pk_c, r.pk_g
+    cap = cyc_max.shape[0]
+    smooth = r.pk_n[0] >= 2 and r.pk_k[1] == 0
+    for j in range(track_el.shape[0]):
+        el = track_el[j]
+        f2 = force[i_f, el]
+        g2 = regime(defl[i_f, el], G[slot, el])
+        if smooth:
+            f0 = pk_f[j, 0]
+            f1 = pk_f[j, 1]
+            c1 = pk_c[j, 1]
+            g1 = pk_g[j, 1]
+            if (g1 != 0 and pk_g[j, 0] == g1 and g2 == g1 and c1 >= 0 and c1 < cap
+                    and (f1 != f0 or f1 != f2)):
+                if f1 >= f0 and f1 >= f2:
+                    v = vertex(pk_t[0], pk_t[1], t, f0, f1, f2)
+                    if v > cyc_max[c1, j]:
+                        cyc_max[c1, j] = v
+                elif f1 <= f0 and f1 <= f2:
+                    v = vertex(pk_t[0], pk_t[1], t, f0, f1, f2)
+                    if v < cyc_min[c1, j]:
+                        cyc_min[c1, j] = v
+        pk_f[j, 0] = pk_f[j, 1]
+        pk_c[j, 0] = pk_c[j, 1]
+        pk_g[j, 0] = pk_g[j, 1]
+        pk_f[j, 1] = f2
+        pk_c[j, 1] = CY[slot, el] - track_base[j]
+        pk_g[j, 1] = g2
+    pk_t[0] = pk_t[1]
+    pk_t[1] = t
+    r.pk_k[0] = r.pk_k[1]
+    r.pk_k[1] = kink
+    r.pk_n[0] += 1
+
+
+@_inline
 def record(t, slot, i_f, weight, m, w, r, counters):
     """Enter one accepted state at time ``t`` (forces in row ``i_f``) in the statistics.
 
@@ -429,6 +503,8 @@ def record(t, slot, i_f, weight, m, w, r, counters):
                 cyc_min[c, j] = fe
             cyc_cnt[c, j] += 1
     mean_sample(t, slot, i_f, m, w, r)
+    peak_sample(t, r.pk_x[0], slot, i_f, w, r)
+    r.pk_x[0] = 0
     for g in range(grp_ptr.shape[0] - 1):
         total = 0.0
         for k in range(grp_ptr[g], grp_ptr[g + 1]):
@@ -501,8 +577,12 @@ def record_extrema(t, mean, slot, i_f, m, w, r):
                         rat_max[c, j] = ratio
                     if ratio < rat_min[c, j]:
                         rat_min[c, j] = ratio
-    if mean:
+    if mean:  # RK4's corners: instants in time order, corners among the samples
         mean_sample(t, slot, i_f, m, w, r)
+        peak_sample(t, np.int64(1), slot, i_f, w, r)
+    else:  # Dormand-Prince's, element by element: no parabola across the step
+        r.pk_k[1] = 1
+        r.pk_x[0] = 1
 
 
 @_kernel
@@ -748,7 +828,11 @@ def rk4_through_corners(t, tb, t_corner, sa, sb, m, w, r, rhs_fn, gen, counters)
             sa, sb = sb, sa
             ts = te
             first = False
+        elif first:  # a corner on the step's start: its sample is that corner
+            r.pk_k[1] = 1
         if te >= tb:
+            if t_corner <= tb + MERGE * h:  # a corner on the step's end: so is its sample
+                r.pk_x[0] = 1
             break
         t_corner = advance_corners(te, m, w)
     if ts < tb:  # the last corner fell within MERGE h of tb: nothing left to step

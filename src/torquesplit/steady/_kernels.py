@@ -385,7 +385,7 @@ def _keep(row, t, w, out_t, out_y, out_f, out_d):
 
 @_kernel
 def rk4_samples(t0, h, n_steps, every, m, w, rhs_fn, gen, out_t, out_y, out_f, out_d, c_t,
-                c_y, c_f, track, fine_f, fine_d):
+                c_y, c_f, c_d, track, fine_f, fine_d):
     """Classic RK4 from state row Y_STATE over ``n_steps`` steps of ``h`` from ``t0``, as
     ``_kernels.rk4_run`` steps: the excitation exact at each distinct stage time, and a
     step that holds corners of the tables taken in sub-steps that end on them (so that no
@@ -393,8 +393,8 @@ def rk4_samples(t0, h, n_steps, every, m, w, rhs_fn, gen, out_t, out_y, out_f, o
     Every ``every`` steps (and at the start) the time, state, element forces and
     deformations are stored in ``out_*`` while they have rows; the forces and
     deformations of the elements ``track`` at every step in ``fine_*`` while they have
-    rows; the time and forces at every corner in ``c_t``, ``c_f`` while they have rows
-    (the state in ``c_y`` too while it has rows).  Returns (rows, corner rows), rows -1
+    rows; the time, forces and deformations at every corner in ``c_t``, ``c_f``, ``c_d``
+    while they have rows (the state in ``c_y`` too while it has rows).  Returns (rows, corner rows), rows -1
     if the state became non-finite."""
     Y, F, D = w.Y, w.F, w.D
     n2 = Y.shape[1]
@@ -436,6 +436,7 @@ def rk4_samples(t0, h, n_steps, every, m, w, rhs_fn, gen, out_t, out_y, out_f, o
                                 c_y[crow, k] = Y[Y_STATE, k]
                         for e in range(c_f.shape[1]):
                             c_f[crow, e] = F[F_MAIN, e]
+                            c_d[crow, e] = D[F_MAIN, e]
                         crow += 1
                 if te - ts > MERGE * h:
                     _rk4_step(ts + 0.5 * (te - ts), te, te - ts, s_half, b, minus, minus, m,

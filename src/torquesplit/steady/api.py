@@ -159,13 +159,23 @@ class SteadyState:
         Fc = self.solution.corner_forces  # instants at table corners (shooting)
         if Fc.shape[0] == 0:
             Fc = np.zeros((0, self.structure.n_elements))
-        ws, wc = period_weights(t, self.solution.corner_t[:Fc.shape[0]], self.solution.period)
+        T = self.solution.period
+        tc = self.solution.corner_t[:Fc.shape[0]]
+        ws, wc = period_weights(t, tc, T)
+        kinks = (self.problem.corner_times(0.0, T, self.solution.speed)
+                 if self.solution.method != "hb" else np.zeros(0))
         out = []
         for j, r in enumerate(met.rows):
             e = names.index(r.mesh)
             f, d = F[:, j], D[:, j]
-            peak = float(max(f.max(), Fc[:, e].max(initial=-np.inf)))
-            least = float(min(f.min(), Fc[:, e].min(initial=np.inf)))
+            vmax, vmin = np.full(1, -np.inf), np.full(1, np.inf)
+            if self.solution.method != "hb":  # (a truncated series rings between samples)
+                t_c, f_c, d_c = corner_columns(self.solution, e)
+                vmax, vmin = between_samples(t, f, d, half_gaps(self.structure, e, t), T,
+                                             t_c, f_c, d_c, half_gaps(self.structure, e, t_c),
+                                             kinks=kinks)
+            peak = float(max(f.max(), Fc[:, e].max(initial=-np.inf), vmax.max()))
+            least = float(min(f.min(), Fc[:, e].min(initial=np.inf), vmin.min()))
             mean = float((ws @ f + wc @ Fc[:, e]) / self.solution.period)
             out.append(MeshSteady(
                 mesh=r.mesh, group=r.group, nominal_force=r.nominal_force,
@@ -316,6 +326,91 @@ def period_weights(t, corners, period):
     return w[:t.size], w[t.size:]
 
 
+def corner_columns(ps, e):
+    """(times, forces, deformations) of element ``e`` at the corner instants of a
+    periodic solution (empty for harmonic balance)."""
+    n = ps.corner_forces.shape[0]
+    if n == 0:
+        return np.zeros(0), np.zeros(0), np.zeros(0)
+    d = (ps.corner_deformations[:, e] if ps.corner_deformations.shape[0] == n
+         else np.zeros(n))
+    return ps.corner_t[:n], ps.corner_forces[:, e], d
+
+
+def half_gaps(structure, e, t):
+    """Half-gap of element ``e`` at the times ``t`` (a per-cycle backlash sequence
+    indexed by the element's cycle, as the integrators take it)."""
+    s = structure
+    gaps = s.gap_values[s.gap_ptr[e]:s.gap_ptr[e + 1]]
+    if gaps.size == 1:
+        return np.full(np.shape(t), gaps[0])
+    cyc = np.floor(s.frequency[e] * np.asarray(t) + s.phase[e]).astype(np.int64) % gaps.size
+    return gaps[cyc]
+
+
+def between_samples(t, f, d, g, period, corners=(), fc=(), dc=(), gc=(), periodic=True,
+                    kinks=None):
+    """The extremes between the instants of one record: for each sample at the times
+    ``t`` (force ``f``, deformation ``d``, half-gap ``g``), the vertex of the parabola
+    through it and its neighbours among all instants (the samples and the corner
+    instants ``corners`` with ``fc``, ``dc``, ``gc``) where it is their largest
+    (``vmax``) or smallest (``vmin``), is no corner (a sample within ``MERGE`` steps of
+    one of ``kinks``, every corner time, default ``corners``, is that corner: the RK4
+    kernels record no instant of their own there) and the three share one contact
+    regime; -inf / +inf elsewhere.
+    ``periodic``: the record is one period (its ends neighbours).  The integrators'
+    ``_kernels.peak_sample`` over a record."""
+    from torquesplit.solve._kernels import MERGE
+
+    t = np.asarray(t, dtype=float)
+    n = t.size
+    tt = np.concatenate([t, np.asarray(corners, dtype=float)])
+    ff = np.concatenate([f, np.asarray(fc, dtype=float)])
+    dd = np.concatenate([d, np.asarray(dc, dtype=float)])
+    gg = np.concatenate([g, np.asarray(gc, dtype=float)])
+    kink = np.arange(tt.size) >= n
+    c = np.sort(np.asarray(tt[n:] if kinks is None else kinks, dtype=float))
+    if c.size and n > 1:  # samples on a corner
+        h = float(np.min(np.diff(t)))
+        k = np.clip(np.searchsorted(c, t), 1, c.size - 1) if c.size > 1 else np.zeros(n, int)
+        near = np.minimum(np.abs(t - c[k]), np.abs(t - c[np.maximum(k - 1, 0)]))
+        if periodic:
+            near = np.minimum(near, np.minimum(np.abs(t + period - c[0]),
+                                               np.abs(t - period - c[-1])))
+        kink[:n] = near <= MERGE * h * (1 + 1e-9)
+    order = np.argsort(tt, kind="stable")
+    ts, fs, ks = tt[order], ff[order], kink[order]
+    reg = np.where(gg > 0, np.where(dd > gg, 1, np.where(dd < -gg, -1, 0)), 1)[order]
+    if periodic:
+        tp = np.concatenate([ts[-1:] - period, ts[:-1]])
+        tn = np.concatenate([ts[1:], ts[:1] + period])
+        f0, f2, r0, r2 = np.roll(fs, 1), np.roll(fs, -1), np.roll(reg, 1), np.roll(reg, -1)
+        ends = np.zeros(ts.size, dtype=bool)
+    else:
+        tp = np.concatenate([ts[:1], ts[:-1]])
+        tn = np.concatenate([ts[1:], ts[-1:]])
+        f0 = np.concatenate([fs[:1], fs[:-1]])
+        f2 = np.concatenate([fs[1:], fs[-1:]])
+        r0 = np.concatenate([reg[:1], reg[:-1]])
+        r2 = np.concatenate([reg[1:], reg[-1:]])
+        ends = np.zeros(ts.size, dtype=bool)
+        ends[[0, -1]] = True
+    ok = (~ks & ~ends & (reg != 0) & (r0 == reg) & (r2 == reg)
+          & ~((fs == f0) & (fs == f2)))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        d1 = (fs - f0) / (ts - tp)
+        d2 = (f2 - fs) / (tn - ts)
+        a = (d2 - d1) / (tn - tp)
+        sl = (d1 * (tn - ts) + d2 * (ts - tp)) / (tn - tp)
+        v = np.where(a == 0.0, fs, fs - sl * sl / (4.0 * a))
+    top = (fs >= f0) & (fs >= f2)
+    vmax = np.where(ok & top & np.isfinite(v), v, -np.inf)
+    vmin = np.where(ok & ~top & (fs <= f0) & (fs <= f2) & np.isfinite(v), v, np.inf)
+    back = np.empty_like(order)
+    back[order] = np.arange(order.size)
+    return vmax[back[:n]], vmin[back[:n]]
+
+
 def cycle_integrals(t, f, cycles, n, start, period):
     """Time integral of ``f`` and the time in each of ``n`` cycles, from its values at
     the increasing instants ``t`` in cycles ``cycles`` (cycle c begins at start + c
@@ -428,6 +523,8 @@ def _as_solution(st: SteadyState, shell, periods):
         ic = cycles(j, tc)
         keep = (ic >= 0) & (ic < cyc_n[j])
         corner_idx.append((ic[keep], keep))
+    kinks = (st.problem.corner_times(0.0, T, ps.speed) if ps.method != "hb"
+             else np.zeros(0))
     # every instant (steps and corners) in time order, for the cycles' time integrals
     t_all = np.concatenate([tt, tc, [periods * T]])
     order = np.argsort(t_all, kind="stable")
@@ -442,6 +539,14 @@ def _as_solution(st: SteadyState, shell, periods):
         f = np.tile(Fm[:, j], periods)
         ic, keep = corner_idx[j]
         mx, mn = cycle_extremes(f, idx, nc, ic, Fc[keep, j])
+        # the extremes between the samples, in the middle sample's cycle
+        if ps.method != "hb":  # (a truncated series rings between its samples)
+            t_c, f_c, d_c = corner_columns(ps, e)
+            vmax, vmin = between_samples(tm, Fm[:, j], Dm[:, j], half_gaps(s, e, tm), T,
+                                         t_c, f_c, d_c, half_gaps(s, e, t_c), kinks=kinks)
+            inside = (idx >= 0) & (idx < nc)
+            np.maximum.at(mx, idx[inside], np.tile(vmax, periods)[inside])
+            np.minimum.at(mn, idx[inside], np.tile(vmin, periods)[inside])
         f_all = np.concatenate([f, Fc[:, j], f[:1]])[order]
         sm, span = cycle_integrals(t_all, f_all, cycles(j, t_all), nc,
                                    (bases[j] - s.phase[e]) / s.frequency[e],
@@ -488,12 +593,7 @@ def _as_solution(st: SteadyState, shell, periods):
     back = np.zeros(s.n_elements)
     for e in range(s.n_elements):
         te, d = (tm, Dm[:, track.index(e)]) if e in track else (t1, D1[:, e])
-        gaps = s.gap_values[s.gap_ptr[e]:s.gap_ptr[e + 1]]
-        if gaps.size == 1:
-            g = np.full(te.size, gaps[0])
-        else:
-            cyc = np.floor(s.frequency[e] * te + s.phase[e]).astype(np.int64) % gaps.size
-            g = gaps[cyc]
+        g = half_gaps(s, e, te)
         sep[e] = np.mean((g > 0) & (np.abs(d) <= g))
         back[e] = np.mean(np.where(g > 0, d < -g, (s.element_kind[e] == 1) & (d < 0)))
     span = periods * T

@@ -62,8 +62,9 @@ def threads_for(column_steps: int, columns: int) -> int:
 class Run(NamedTuple):
     """What :meth:`PeriodicProblem.run` returns: samples every ``every`` steps (time,
     state, forces and deformations of every element), the final state, the instants at
-    the tables' corners (their forces; their states when asked), and the forces and
-    deformations of the ``track`` elements at every step (rows: steps + 1)."""
+    the tables' corners (their forces and deformations; their states when asked), and
+    the forces and deformations of the ``track`` elements at every step (rows: steps +
+    1)."""
 
     t: np.ndarray
     y: np.ndarray
@@ -73,6 +74,7 @@ class Run(NamedTuple):
     corner_t: np.ndarray
     corner_y: np.ndarray
     corner_forces: np.ndarray
+    corner_deformations: np.ndarray
     track_forces: np.ndarray
     track_deformations: np.ndarray
 
@@ -274,6 +276,7 @@ class PeriodicProblem:
                       y_end=None, corner_t=np.empty(nc),
                       corner_y=np.empty((nc if corner_states else 0, 2 * self.n)),
                       corner_forces=np.empty((nc, self.ne)),
+                      corner_deformations=np.empty((nc, self.ne)),
                       track_forces=np.empty((n_fine, len(track))),
                       track_deformations=np.empty((n_fine, len(track))))
         else:  # the arrays in full (a Run returned holds views of the rows filled)
@@ -281,19 +284,21 @@ class PeriodicProblem:
                                   for k, v in out._asdict().items() if k != "y_end"})
         out_t, out_y, out_f, out_d = out.t, out.y, out.forces, out.deformations
         c_t, c_y, c_f = out.corner_t, out.corner_y, out.corner_forces
+        c_d = out.corner_deformations
         fine_f, fine_d = out.track_forces, out.track_deformations
         track = np.asarray(track, dtype=np.int64)
         self.work.Y[kd.Y_STATE] = y0
         got, n_c = sk.rk4_samples(float(t0), float(duration) / steps, int(steps), int(every),
                                   self.model_at(speed), self.work, self.code.function,
                                   self.code.generated, out_t, out_y, out_f, out_d, c_t, c_y,
-                                  c_f, track, fine_f, fine_d)
+                                  c_f, c_d, track, fine_f, fine_d)
         if got < 0:
             raise SolverError("the time integration diverged (non-finite state); use more "
                               "steps per period or check the model.")
         return Run(t=out_t[:got], y=out_y[:got], forces=out_f[:got], deformations=out_d[:got],
                    y_end=self.work.Y[kd.Y_STATE].copy(), corner_t=c_t[:n_c],
-                   corner_y=c_y[:n_c], corner_forces=c_f[:n_c], track_forces=fine_f,
+                   corner_y=c_y[:n_c], corner_forces=c_f[:n_c],
+                   corner_deformations=c_d[:n_c], track_forces=fine_f,
                    track_deformations=fine_d)
 
     def settled_start(self, y0, period, steps, speed=1.0, order=1):

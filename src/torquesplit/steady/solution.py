@@ -111,8 +111,10 @@ class PeriodicSolution:
     empty.  A force peak sits at a corner of a stiffness table more often than not (on
     Ji & Li's drive, stage 1 kept, the steps alone left a dynamic factor 2.4e-3 low)."""
     corner_forces: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
-    """(len(corner_t), n_el) element forces at those instants.  For extremes only: they
-    are instants, not samples (means and spectra use ``t`` alone)."""
+    """(len(corner_t), n_el) element forces at those instants: in the extremes, and as
+    breakpoints of the means (spectra use ``t`` alone)."""
+    corner_deformations: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    """(len(corner_t), n_el) element deformations at those instants (contact regimes)."""
     mesh_elements: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
     """Shooting: indices of the mesh elements, the columns of ``mesh_forces`` (HB: empty,
     its samples ``t`` serve)."""
@@ -343,7 +345,7 @@ def periodic_solution(structure, period: Period, *, method: str = "auto", harmon
         y0, Phi, info = solve_shooting(p, y0, steps, speed, tol, monodromy=bool(stability),
                                        record=record, say=say)
         run = info.run
-        corner_t, corner_f = run.corner_t, run.corner_forces
+        corner_t, corner_f, corner_d = run.corner_t, run.corner_forces, run.corner_deformations
         t, q, v = run.t[:-1], run.y[:-1, :p.n], run.y[:-1, p.n:]
         F, D = run.forces[:-1], run.deformations[:-1]
         mesh_t = np.arange(steps) * (T / steps)
@@ -382,7 +384,8 @@ def periodic_solution(structure, period: Period, *, method: str = "auto", harmon
         wall_time=time.perf_counter() - t_start,
         sample_every=every,
         **({} if method == "hb" else dict(
-            corner_t=corner_t, corner_forces=corner_f, mesh_elements=meshes,
+            corner_t=corner_t, corner_forces=corner_f, corner_deformations=corner_d,
+            mesh_elements=meshes,
             mesh_t=mesh_t, mesh_forces=mesh_f, mesh_deformations=mesh_d)))
 
 

@@ -443,19 +443,57 @@ def shooting_point_metrics(cont: ShootingContinuation, x, s, track, groups, stat
     samples and the forces at the tables' corners (peaks and the load-sharing ratio's
     extremes take both; means and the RMS transmission error the samples)."""
     p = cont.p
-    r = p.run(cont.state(x), 0.0, cont.period(s), cont.steps, every=cont.steps, speed=s,
+    T = cont.period(s)
+    r = p.run(cont.state(x), 0.0, T, cont.steps, every=cont.steps, speed=s,
               corners=True, track=track)
     f = r.track_forces[:-1]
+    peak, mean = record_extremes(p, r, T, s, track, periodic=True)
     return _point_outputs(f, np.vstack([f, r.corner_forces[:, track]]),
-                          r.track_deformations[:-1], groups, static_forces, nominal)
+                          r.track_deformations[:-1], groups, static_forces, nominal,
+                          peak, mean)
 
 
-def _point_outputs(f, f_all, d, groups, static_forces, nominal):
-    """A sweep point's outputs per tracked mesh from its force samples ``f`` (means),
-    those and any instants between them ``f_all`` (extremes) and the deformation
-    samples ``d``: peak force, dynamic factors, load sharing (largest instantaneous
-    ratio in its group, Ji & Li eq. 18), RMS transmission error, mean force."""
-    peak = f_all.max(axis=0)
+def record_extremes(p, r, span, speed, track, periodic):
+    """Peak force and time mean of each ``track`` element over a record ``r`` of
+    :meth:`PeriodicProblem.run` spanning ``span`` from 0, as the integrators' statistics
+    take them: the peaks of the samples, the corner instants and the parabolas between
+    them (:func:`~torquesplit.steady.api.between_samples`), the mean by the trapezoid
+    rule with the corners as breakpoints.  ``periodic``: the record is one period."""
+    from torquesplit.steady.api import between_samples, half_gaps, period_weights
+
+    s = p.structure
+    n = r.track_forces.shape[0] - (1 if periodic else 0)
+    t = np.arange(n) * (span / (r.track_forces.shape[0] - 1))
+    tc = r.corner_t
+    kinks = p.corner_times(0.0, span, speed)
+    peak = np.empty(len(track))
+    mean = np.empty(len(track))
+    if periodic:
+        ws, wc = period_weights(t, tc, span)
+    for j, e in enumerate(track):
+        f, d = r.track_forces[:n, j], r.track_deformations[:n, j]
+        fc = r.corner_forces[:, e]
+        vmax, _ = between_samples(t, f, d, half_gaps(s, e, t), span, tc, fc,
+                                  r.corner_deformations[:, e], half_gaps(s, e, tc),
+                                  periodic=periodic, kinks=kinks)
+        peak[j] = max(f.max(), fc.max(initial=-np.inf), vmax.max())
+        if periodic:
+            mean[j] = (ws @ f + wc @ fc) / span
+        else:
+            tt = np.concatenate([t, tc])
+            o = np.argsort(tt, kind="stable")
+            ff = np.concatenate([f, fc])[o]
+            mean[j] = np.sum(0.5 * (ff[1:] + ff[:-1]) * np.diff(tt[o])) / (tt[o][-1] - tt[o][0])
+    return peak, mean
+
+
+def _point_outputs(f, f_all, d, groups, static_forces, nominal, peak, mean):
+    """A sweep point's outputs per tracked mesh from its force samples ``f``, those and
+    any instants between them ``f_all`` (the load-sharing ratio's extremes), the
+    deformation samples ``d``, the peak forces ``peak`` and mean forces ``mean``
+    (:func:`record_extremes`): peak force, dynamic factors, load sharing (largest
+    instantaneous ratio in its group, Ji & Li eq. 18), RMS transmission error, mean
+    force."""
     lsc = np.full(f.shape[1], np.nan)
     for cols in groups:
         sub = f_all[:, cols]
@@ -466,7 +504,7 @@ def _point_outputs(f, f_all, d, groups, static_forces, nominal):
     rms = np.sqrt(np.mean((d - d.mean(axis=0)) ** 2, axis=0))
     return dict(peak_force=peak, dynamic_factor=peak / static_forces,
                 peak_to_nominal=peak / nominal, load_sharing=lsc,
-                rms_transmission_error=rms, mean_force=f.mean(axis=0))
+                rms_transmission_error=rms, mean_force=mean)
 
 
 def continue_in_speed_shooting(problem, period, q_static, s0, s1, *, points=50,
@@ -540,7 +578,9 @@ def point_metrics(hb: HarmonicBalance, x, s, track, groups, static_forces, nomin
         hb2, x2 = hb, x
     _, _, F, D, _, _ = hb2.residual_samples(x2, s)
     f = F[:, track]
-    return _point_outputs(f, f, D[:, track], groups, static_forces, nominal)
+    # the samples' extremes (a truncated series rings between them: no parabola)
+    return _point_outputs(f, f, D[:, track], groups, static_forces, nominal,
+                          f.max(axis=0), f.mean(axis=0))
 
 
 def stepped_sweep(problem, period, q_static, speeds, *, settle_periods=200,
@@ -566,8 +606,10 @@ def stepped_sweep(problem, period, q_static, speeds, *, settle_periods=200,
             break
         y = r.y_end
         if len(track):
-            # the peaks at the tables' corners too, as the integrators' statistics take them
-            peaks[i] = np.vstack([r.track_forces, r.corner_forces[:, list(track)]]).max(axis=0)
+            # the peaks at the tables' corners and between the samples too, as the
+            # integrators' statistics take them
+            peaks[i] = record_extremes(p, r, record_periods * T, s, list(track),
+                                       periodic=False)[0]
             d = r.track_deformations
             rms[i] = np.sqrt(np.mean((d - d.mean(axis=0)) ** 2, axis=0))
         if progress is not None:
