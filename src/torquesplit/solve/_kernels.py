@@ -431,42 +431,42 @@ def peak_sample(t, kink, slot, i_f, w, r):
     two steps was otherwise missed by up to (omega h)^2 / 8 of the oscillation (6e-4 of
     a dynamic factor at 100 steps per cycle).
     Twin: :func:`torquesplit.solve.reference.cycle_statistics_numpy`."""
-    force, defl, CY, G = w.F, w.D, w.CY, w.G
-    track_el, track_base = r.track_el, r.track_base
+    force, defl, G = w.F, w.D, w.G
+    track_el = r.track_el
     cyc_max, cyc_min = r.cyc_max, r.cyc_min
-    pk_t, pk_f, pk_c, pk_g = r.pk_t, r.pk_f, r.pk_c, r.pk_g
+    pk_t, pk_f, pk_g, pk_k = r.pk_t, r.pk_f, r.pk_g, r.pk_k
+    prev_f, prev_c = r.prev_f, r.prev_c  # the last instant's (mean_sample runs after)
     cap = cyc_max.shape[0]
-    smooth = r.pk_n[0] >= 2 and r.pk_k[1] == 0
+    n = r.pk_n[0]
+    o = n & 1  # the two instants alternate between the slots: o the older, 1 - o the last
+    p = 1 - o
+    smooth = n >= 2 and pk_k[p] == 0
+    t0 = pk_t[o]
+    t1 = pk_t[p]
     for j in range(track_el.shape[0]):
         el = track_el[j]
         f2 = force[i_f, el]
         g2 = regime(defl[i_f, el], G[slot, el])
+        f1 = prev_f[j]
         if smooth:
-            f0 = pk_f[j, 0]
-            f1 = pk_f[j, 1]
-            c1 = pk_c[j, 1]
-            g1 = pk_g[j, 1]
-            if (g1 != 0 and pk_g[j, 0] == g1 and g2 == g1 and c1 >= 0 and c1 < cap
-                    and (f1 != f0 or f1 != f2)):
-                if f1 >= f0 and f1 >= f2:
-                    v = vertex(pk_t[0], pk_t[1], t, f0, f1, f2)
-                    if v > cyc_max[c1, j]:
-                        cyc_max[c1, j] = v
-                elif f1 <= f0 and f1 <= f2:
-                    v = vertex(pk_t[0], pk_t[1], t, f0, f1, f2)
-                    if v < cyc_min[c1, j]:
-                        cyc_min[c1, j] = v
-        pk_f[j, 0] = pk_f[j, 1]
-        pk_c[j, 0] = pk_c[j, 1]
-        pk_g[j, 0] = pk_g[j, 1]
-        pk_f[j, 1] = f2
-        pk_c[j, 1] = CY[slot, el] - track_base[j]
-        pk_g[j, 1] = g2
-    pk_t[0] = pk_t[1]
-    pk_t[1] = t
-    r.pk_k[0] = r.pk_k[1]
-    r.pk_k[1] = kink
-    r.pk_n[0] += 1
+            f0 = pk_f[j]
+            if (f1 - f0) * (f2 - f1) <= 0.0 and (f1 != f0 or f1 != f2):  # an extremum
+                g1 = pk_g[j, p]
+                c1 = prev_c[j]
+                if g1 != 0 and pk_g[j, o] == g1 and g2 == g1 and c1 >= 0 and c1 < cap:
+                    if f1 >= f0 and f1 >= f2:
+                        v = vertex(t0, t1, t, f0, f1, f2)
+                        if v > cyc_max[c1, j]:
+                            cyc_max[c1, j] = v
+                    elif f1 <= f0 and f1 <= f2:
+                        v = vertex(t0, t1, t, f0, f1, f2)
+                        if v < cyc_min[c1, j]:
+                            cyc_min[c1, j] = v
+        pk_f[j] = f1  # the last instant's force becomes the older one
+        pk_g[j, o] = g2
+    pk_t[o] = t
+    pk_k[o] = kink
+    r.pk_n[0] = n + 1
 
 
 @_inline
@@ -502,9 +502,9 @@ def record(t, slot, i_f, weight, m, w, r, counters):
             if fe < cyc_min[c, j]:
                 cyc_min[c, j] = fe
             cyc_cnt[c, j] += 1
-    mean_sample(t, slot, i_f, m, w, r)
-    peak_sample(t, r.pk_x[0], slot, i_f, w, r)
+    peak_sample(t, r.pk_x[0], slot, i_f, w, r)  # (before mean_sample: the last instant)
     r.pk_x[0] = 0
+    mean_sample(t, slot, i_f, m, w, r)
     for g in range(grp_ptr.shape[0] - 1):
         total = 0.0
         for k in range(grp_ptr[g], grp_ptr[g + 1]):
@@ -578,10 +578,10 @@ def record_extrema(t, mean, slot, i_f, m, w, r):
                     if ratio < rat_min[c, j]:
                         rat_min[c, j] = ratio
     if mean:  # RK4's corners: instants in time order, corners among the samples
-        mean_sample(t, slot, i_f, m, w, r)
         peak_sample(t, np.int64(1), slot, i_f, w, r)
+        mean_sample(t, slot, i_f, m, w, r)
     else:  # Dormand-Prince's, element by element: no parabola across the step
-        r.pk_k[1] = 1
+        r.pk_k[(r.pk_n[0] - 1) & 1] = 1
         r.pk_x[0] = 1
 
 
@@ -828,8 +828,8 @@ def rk4_through_corners(t, tb, t_corner, sa, sb, m, w, r, rhs_fn, gen, counters)
             sa, sb = sb, sa
             ts = te
             first = False
-        elif first:  # a corner on the step's start: its sample is that corner
-            r.pk_k[1] = 1
+        elif first:  # a corner on the step's start: its sample (the last instant) is that corner
+            r.pk_k[(r.pk_n[0] - 1) & 1] = 1
         if te >= tb:
             if t_corner <= tb + MERGE * h:  # a corner on the step's end: so is its sample
                 r.pk_x[0] = 1

@@ -82,7 +82,7 @@ corner."""
 
 Record = namedtuple("Record", (
     "track_el", "track_base", "cyc_max", "cyc_min", "cyc_sum", "cyc_cnt", "cyc_wt",
-    "prev_t", "prev_f", "prev_c", "pk_t", "pk_f", "pk_c", "pk_g", "pk_k", "pk_n", "pk_x",
+    "prev_t", "prev_f", "prev_c", "pk_t", "pk_f", "pk_g", "pk_k", "pk_n", "pk_x",
     "grp_ptr", "grp_col", "grp_min", "rat_max", "rat_min",
     "sep_count", "back_count", "sep_time", "back_time",
     "hist_el", "hist_dof", "hist_t", "hist_f", "hist_q", "hist_v", "full_t", "full_y",
@@ -92,10 +92,11 @@ cycle containing the start time): force max, min, time integral (trapezoid rule 
 the step samples and the corner instants, each half-interval in its end's cycle) and
 its time (``cyc_wt``: their ratio is the cycle's mean force), sample count; the last
 instant entered (``prev_t`` (1,), NaN before the first; ``prev_f``, ``prev_c`` its
-forces and cycles); the last two instants for the peaks between them (``pk_t`` (2,)
-their times, ``pk_f``, ``pk_c``, ``pk_g`` (n_tr, 2) forces, cycles and contact regimes,
-``pk_k`` (2,) whether each is a corner, ``pk_n`` (1,) instants entered, ``pk_x`` (1,)
-whether the next sample is a corner); per
+forces and cycles); for the peaks between the instants, the last two (slots
+alternating): ``pk_t`` (2,) their times, ``pk_g`` (n_tr, 2) contact regimes, ``pk_k``
+(2,) whether each is a corner, ``pk_f`` (n_tr,) the older one's forces (the last one's
+are ``prev_f``), ``pk_n`` (1,) instants entered, ``pk_x`` (1,) whether the next sample
+is a corner; per
 load-sharing group (``grp_col[grp_ptr[g]:grp_ptr[g+1]]`` its tracked columns) the
 largest and smallest instantaneous ratio ``N f_i / sum_j f_j`` of each member in each of
 its cycles (``rat_max``, ``rat_min``), formed only while the group's total force exceeds
@@ -354,8 +355,8 @@ def make_record(track_el, track_base, n_cycles_cap: int, groups, n_el: int, hist
         cyc_max=np.full((cap, n_tr), -np.inf), cyc_min=np.full((cap, n_tr), np.inf),
         cyc_sum=np.zeros((cap, n_tr)), cyc_cnt=np.zeros((cap, n_tr), dtype=np.int64),
         cyc_wt=np.zeros((cap, n_tr)), prev_t=np.full(1, np.nan), prev_f=np.zeros(n_tr),
-        prev_c=np.zeros(n_tr, dtype=np.int64), pk_t=np.zeros(2), pk_f=np.zeros((n_tr, 2)),
-        pk_c=np.zeros((n_tr, 2), dtype=np.int64), pk_g=np.zeros((n_tr, 2), dtype=np.int64),
+        prev_c=np.zeros(n_tr, dtype=np.int64), pk_t=np.zeros(2), pk_f=np.zeros(n_tr),
+        pk_g=np.zeros((n_tr, 2), dtype=np.int64),
         pk_k=np.zeros(2, dtype=np.int64), pk_n=np.zeros(1, dtype=np.int64),
         pk_x=np.zeros(1, dtype=np.int64), grp_ptr=grp_ptr, grp_col=grp_col,
         grp_min=(np.zeros(len(groups)) if group_min is None
