@@ -217,9 +217,10 @@ def cycle_statistics_numpy(times, forces, frequency, phase, t0, n_cycles_cap,
     largest (smallest), is no corner and all three share one contact regime
     (``regimes``: default all 1; 0 apart), the vertex of the parabola through them, in
     the middle instant's cycle.  ``corners``: every corner time; a sample within
-    ``_kernels.MERGE`` steps of one is that corner.  Returns four arrays of length ``n_cycles_cap`` (max -inf / min +inf
-    / mean NaN where empty).  Twin of the cycle part of ``_kernels.record``,
-    ``_kernels.mean_sample`` and ``_kernels.peak_sample``.
+    ``_kernels.MERGE`` steps of one is that corner.  Returns four arrays of length
+    ``n_cycles_cap`` (max -inf / min +inf / mean NaN where empty).  Twin of the cycle
+    part of ``_kernels.record``, ``_kernels.mean_sample`` and ``_kernels.peak_sample``
+    (whose parabola formula, ``_kernels.vertex``, it calls).
     """
     times = np.asarray(times, dtype=float)
     forces = np.asarray(forces, dtype=float)
@@ -256,7 +257,7 @@ def cycle_statistics_numpy(times, forces, frequency, phase, t0, n_cycles_cap,
     np.divide(csum, cwt, out=mean, where=cwt > 0)
     step = np.ones(times.size, dtype=bool) if counted is None else np.asarray(counted, bool)
     reg = np.ones(times.size, dtype=np.int64) if regimes is None else np.asarray(regimes)
-    from torquesplit.solve._kernels import MERGE
+    from torquesplit.solve._kernels import MERGE, vertex  # (the parabola's formula)
 
     kinks = np.asarray(corners, dtype=float)
     h = np.min(np.diff(times[step])) if np.sum(step) > 1 else 0.0
@@ -272,22 +273,10 @@ def cycle_statistics_numpy(times, forces, frequency, phase, t0, n_cycles_cap,
                 or not 0 <= cb < n_cycles_cap or (f1 == f0 and f1 == f2)):
             continue
         if f1 >= f0 and f1 >= f2:
-            cmax[cb] = max(cmax[cb], vertex_numpy(times[a], times[b], times[c], f0, f1, f2))
+            cmax[cb] = max(cmax[cb], vertex(times[a], times[b], times[c], f0, f1, f2))
         elif f1 <= f0 and f1 <= f2:
-            cmin[cb] = min(cmin[cb], vertex_numpy(times[a], times[b], times[c], f0, f1, f2))
+            cmin[cb] = min(cmin[cb], vertex(times[a], times[b], times[c], f0, f1, f2))
     return cmax, cmin, mean, ccnt
-
-
-def vertex_numpy(t0, t1, t2, f0, f1, f2):
-    """Value at the vertex of the parabola through three points.  Twin of
-    ``_kernels.vertex``."""
-    d1 = (f1 - f0) / (t1 - t0)
-    d2 = (f2 - f1) / (t2 - t1)
-    a = (d2 - d1) / (t2 - t0)
-    if a == 0.0:
-        return f1
-    sl = (d1 * (t2 - t1) + d2 * (t1 - t0)) / (t2 - t0)
-    return f1 - sl * sl / (4.0 * a)
 
 
 def rk4_numpy(structure: Structure, y0, t0: float, h: float, n_steps: int, times=None):
