@@ -382,7 +382,7 @@ def run(
     else:
         _render_run(res, met, saved)
         if step_check is not None:
-            _render_step_check(step_check)
+            ux.render_step_check(step_check)
         if figures:
             console.print(f"{len(figures)} figure files written to {plots}")
 
@@ -522,45 +522,6 @@ def _render_run(res, met, saved) -> None:
         markup=False, highlight=False)
     if saved:
         console.print("results written to " + ", ".join(str(f) for f in saved),
-                      highlight=False)
-
-
-PRINTED_DIGITS = 5
-"""Significant digits the run tables print (1.0800, 12.036 kN)."""
-
-
-def _render_step_check(check, rows: int = 12, printed: int = PRINTED_DIGITS,
-                       refine: str = "--steps-per-period") -> None:
-    """How many significant digits of the numbers hold at half the step (harmonic
-    balance: twice the harmonics): a summary and the least converged numbers (those
-    holding fewer than the ``printed`` digits of the tables)."""
-    table = check.rows()
-    short = [r for r in table if r[4] < printed]
-    if check.method == "hb":
-        what, was = "twice the harmonics", f"{check.step:.0f} -> {check.halved_step:.0f}"
-    elif check.method == "dopri":
-        what = f"a {check.step / check.halved_step:.0f}-fold tighter tolerance"
-        was = f"rtol {check.step:.3g} -> {check.halved_step:.3g}"
-    else:
-        what, was = "half the step", f"{check.step:.3g} s -> {check.halved_step:.3g} s"
-    console.print(
-        f"step check, the same {'run' if check.method in ('rk4', 'dopri') else 'state'} at "
-        f"{what} ({was}): "
-        + (f"all {len(table)} numbers hold the {printed} significant digits printed"
-           if not short else
-           f"{len(table) - len(short)} of {len(table)} numbers hold the {printed} "
-           f"significant digits printed; these hold fewer (trust only those digits, or "
-           f"refine: {refine}):"), highlight=False, markup=False)
-    if not short:
-        return
-    t = Table()
-    for col in ("number", "value", "at half the step", "digits that hold"):
-        t.add_column(col, justify="left" if col == "number" else "right")
-    for name, a, b, _, d in short[:rows]:
-        t.add_row(name, f"{a:.6g}", f"{b:.6g}", str(d))
-    console.print(t)
-    if len(short) > rows:
-        console.print(f"... and {len(short) - rows} more (--json lists every number)",
                       highlight=False)
 
 

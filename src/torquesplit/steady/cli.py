@@ -174,11 +174,11 @@ def register(app, load, fail, console, err_console, json_default):
                           f"{100 * r.contact_loss:.2f} %")
             console.print(t)
             if step_check is not None:
-                from torquesplit.cli import _render_step_check
+                from torquesplit.cli_support import render_step_check
 
-                _render_step_check(step_check, printed=6,
-                                   refine="--harmonics" if ps.method == "hb" else
-                                   "--steps-per-cycle")
+                render_step_check(step_check, printed=6,
+                                  refine="--harmonics" if ps.method == "hb" else
+                                  "--steps-per-cycle")
             if saved:
                 console.print(f"results written to {saved}")
         if not ps.converged:

@@ -459,7 +459,12 @@ def record_extremes(p, r, span, speed, track, periodic):
     take them: the peaks of the samples, the corner instants and the parabolas between
     them (:func:`~torquesplit.steady.api.between_samples`), the mean by the trapezoid
     rule with the corners as breakpoints.  ``periodic``: the record is one period."""
-    from torquesplit.steady.api import between_samples, half_gaps, period_weights
+    from torquesplit.steady.api import (
+        between_samples,
+        cycle_integrals,
+        half_gaps,
+        period_weights,
+    )
 
     s = p.structure
     n = r.track_forces.shape[0] - (1 if periodic else 0)
@@ -479,11 +484,12 @@ def record_extremes(p, r, span, speed, track, periodic):
         peak[j] = max(f.max(), fc.max(initial=-np.inf), vmax.max())
         if periodic:
             mean[j] = (ws @ f + wc @ fc) / span
-        else:
+        else:  # the record as one cycle
             tt = np.concatenate([t, tc])
             o = np.argsort(tt, kind="stable")
-            ff = np.concatenate([f, fc])[o]
-            mean[j] = np.sum(0.5 * (ff[1:] + ff[:-1]) * np.diff(tt[o])) / (tt[o][-1] - tt[o][0])
+            total, time = cycle_integrals(tt[o], np.concatenate([f, fc])[o],
+                                          np.zeros(tt.size, dtype=np.int64), 1, 0.0, span)
+            mean[j] = total[0] / time[0]
     return peak, mean
 
 
