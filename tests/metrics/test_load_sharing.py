@@ -128,6 +128,18 @@ def test_settle_never_counts_a_transient_cycle_for_any_run_length(k):
         assert peaks[st.first_cycle["a"]:].max() < 1.01
 
 
+def test_a_run_shorter_than_two_windows_is_not_settled():
+    """Steady peaks, but fewer cycles than two windows of the longest excitation period
+    (here 168 cycles, a gear revolution): the run cannot show that the response repeats,
+    so it is not settled and says by how much it is short; with 336 cycles it is."""
+    for n, settled in ((60, False), (335, False), (336, True)):
+        i = np.arange(n)
+        st = ls.settle(np.ones((n, 1)), (i / 100.0)[:, None], ["a"], window=168,
+                       tolerance=0.01)
+        assert st.settled is settled, n
+        assert st.short == ({} if settled else {"a": (n, 168)})
+
+
 def test_one_settle_time_per_group_used_by_every_member():
     """Mesh a settles late (transient 60 cycles), mesh b at once: both members of the
     group start at a's settle time, and so do the group's coefficients."""

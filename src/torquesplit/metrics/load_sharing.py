@@ -103,6 +103,10 @@ class Settling:
     """Group -> settle time [s]: the latest of its meshes' own settle times."""
     own_first_cycle: dict[str, int] = field(default_factory=dict)
     """Mesh -> first settled cycle by its own peaks alone."""
+    short: dict[str, tuple[int, int]] = field(default_factory=dict)
+    """Mesh -> (its cycles, the window it needs) where the run holds fewer than two
+    windows: too short to check settling over the longest excitation period, so not
+    settled (its metrics then use a shorter window, a best effort)."""
 
 
 @dataclass(frozen=True)
@@ -144,10 +148,13 @@ def settle(cycle_max: np.ndarray, cycle_start: np.ndarray, names, window=20,
     whole window (fewer than W) are never counted as settled: they were not checked.  A
     drift that lasts until the end leaves only the last windows, and a mesh whose settled
     part is shorter than a quarter of its cycles is reported as not settled (its last
-    half is used).  A group is settled from the latest settle time of its meshes, and
-    every metric of the group starts there.
+    half is used).  A run shorter than two windows cannot show that the response repeats
+    over the longest excitation period: it is reported as not settled (``short``), and
+    its windows shrink to a quarter of its cycles.  A group is settled from the latest
+    settle time of its meshes, and every metric of the group starts there.
     """
     own: dict[str, int] = {}
+    short: dict[str, tuple[int, int]] = {}
     settled = True
     t_own: dict[str, float] = {}
     for j, name in enumerate(names):
@@ -157,6 +164,9 @@ def settle(cycle_max: np.ndarray, cycle_start: np.ndarray, names, window=20,
         n = peaks.size
         w_req = int(window[j] if np.ndim(window) else window)
         w = max(2, min(w_req, n // 4))
+        if n < 2 * w_req:
+            short[name] = (n, w_req)
+            settled = False
         k_set = n // 2
         ok = False
         if n >= 2 * w:
@@ -190,7 +200,7 @@ def settle(cycle_max: np.ndarray, cycle_start: np.ndarray, names, window=20,
             first[m] = min(max(k, own[m]), max(len(starts) - 1, 0))
     start_time = max(group_time.values()) if group_time else 0.0
     return Settling(start_time=start_time, settled=settled, first_cycle=first,
-                    group_time=group_time, own_first_cycle=own)
+                    group_time=group_time, own_first_cycle=own, short=short)
 
 
 def _ratio(x: np.ndarray) -> np.ndarray:

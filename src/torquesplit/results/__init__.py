@@ -54,8 +54,9 @@ class MeshRow:
     """Fraction of the run in back-flank contact (tensile force for a mesh without
     backlash: double-flank contact)."""
     back_flank_force: float = 0.0
-    """Largest back-flank force over the run (complete cycles, transient included, like
-    ``back_contact``) [N], >= 0: minus the smallest force when that is negative."""
+    """Largest back-flank force over the settled cycles (like the peak force) [N], >= 0:
+    minus the smallest settled force when that is negative.  The start-up transient's,
+    if any, is left out; the plausibility warnings name it."""
     double_flank: bool = False
     """The mesh has no backlash: its back flank is always in reach (double-flank
     contact), so it can carry tension."""
@@ -265,7 +266,7 @@ class Results:
                 peak_to_nominal=dyn.peak_to_nominal[m], load_sharing=lsc.per_mesh[m],
                 contact_loss=float(s.separation_fraction[el.index(m)]),
                 back_contact=float(s.back_contact_fraction[el.index(m)]),
-                back_flank_force=_back_flank_force(c_min[:, j]),
+                back_flank_force=back_flank_force(c_min[k0:, j]),
                 double_flank=not (self.model.meshes[m].backlash.nominal > 0),
             ))
         return Metrics(definition, st, lsc, dyn, rows)
@@ -483,7 +484,7 @@ class Results:
         return model_to_json(self.model)
 
 
-def _back_flank_force(cycle_min: np.ndarray) -> float:
+def back_flank_force(cycle_min: np.ndarray) -> float:
     """Largest back-flank (tensile) force [N] from the per-cycle smallest forces."""
     smallest = -ls._nanmax(-np.asarray(cycle_min, dtype=float))
     return max(0.0, -smallest) if math.isfinite(smallest) else 0.0

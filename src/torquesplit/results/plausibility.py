@@ -70,11 +70,16 @@ def contact_loss(results, metrics) -> list[tuple[str, str]]:
 def back_flank(results, metrics) -> list[tuple[str, str]]:
     """Back-flank contact: with backlash the teeth rattle through it; without backlash the
     mesh is in double-flank contact and carries tensile force."""
+    from . import back_flank_force
+
     out = []
+    c_min = None
     for r in metrics.rows:
         if r.back_contact <= FRACTION_FLOOR:
             continue
-        largest = r.back_flank_force
+        if c_min is None:  # the fraction counts the whole run: so does the force named here
+            c_min = results.complete_cycle_statistics()[1]
+        largest = back_flank_force(c_min[:, results.mesh_names.index(r.mesh)])
         if r.min_force >= 0:  # none in the settled part
             when = " (in the start-up transient only: the settled part has none)"
         else:
@@ -122,6 +127,19 @@ def settling(results, metrics) -> list[tuple[str, str]]:
     """A transient that did not settle by the end of the run."""
     if metrics.settling.settled:
         return []
+    short = metrics.settling.short
+    if short:  # too short to tell: name the mesh that needs the longest run
+        kin = results.kinematics
+        need = {m: 2 * w / kin.meshes[m].frequency for m, (_, w) in short.items()}
+        m = max(need, key=need.get)
+        n, w = short[m]
+        return [("analysis", (
+            f"the run is too short to tell whether the response has settled: mesh {m} "
+            f"completes {n} cycles, fewer than two settle windows of {w} cycles (a window "
+            f"spans at least 20 cycles and the longest excitation period, e.g. a gear "
+            f"revolution when errors turn with the gears), so the metrics may not average "
+            f"over whole excitation periods; simulate at least {need[m]:.3g} s "
+            f"(--duration) plus the transient"))]
     return [("analysis", (
         "the transient did not die out within the run (the peaks still drift), so the last "
         "half of the run was used for the metrics; simulate longer (--cycles or --duration) "
