@@ -41,3 +41,43 @@ def test_a_run_too_short_for_its_windows_says_so(three_branch_run):
     assert not met.settling.settled
     said = dict(result_warnings(three_branch_run, met))
     assert "too short to tell whether the response has settled" in said["analysis"]
+
+
+class _Stub:
+    """What `peak_drift` reads of a run: per-cycle peaks of one mesh, windows of 20."""
+
+    mesh_names = ["a"]
+
+    def __init__(self, peaks):
+        self.peaks = np.asarray(peaks, dtype=float)[:, None]
+
+    def complete_cycle_statistics(self):
+        return (self.peaks,)
+
+    def settle_windows(self):
+        return [20]
+
+
+def _metrics(first_cycle=0):
+    from types import SimpleNamespace
+
+    row = SimpleNamespace(mesh="a", static_force=100.0, dynamic_factor=1.5)
+    settling = SimpleNamespace(settled=True, first_cycle={"a": first_cycle})
+    return SimpleNamespace(settling=settling, rows=[row])
+
+
+@pytest.mark.parametrize("drop, warned", [(0.0, False), (0.0005, False), (0.003, True)])
+def test_peaks_that_still_drift_after_settling_are_said(drop, warned):
+    """Peaks falling by `drop` (relative) over 200 settled cycles: above PEAK_DRIFT the
+    warning names the mesh and gives the last window's dynamic factor."""
+    from torquesplit.results.plausibility import PEAK_DRIFT, peak_drift
+
+    assert PEAK_DRIFT == 1e-3
+    k = np.arange(200)
+    peaks = 150.0 * (1.0 + drop * (1.0 - k / 199.0))
+    said = peak_drift(_Stub(peaks), _metrics())
+    assert bool(said) is warned
+    if warned:
+        (where, text), = said
+        assert where == "meshes.a"
+        assert f"the last window alone gives {peaks[-20:].max() / 100.0:.4g}" in text

@@ -17,7 +17,11 @@ check                      says
                            tensile tooth force no real pair with backlash carries
 :func:`resonance`          dynamic factor above :data:`RESONANCE_FACTOR`: the run is near
                            a resonance (``torquesplit modes``)
-:func:`settling`           the transient did not die out: the last half was used
+:func:`settling`           the transient did not die out: the last half was used; or
+                           the run is too short to tell
+:func:`peak_drift`         settled peaks that still change from the first settled
+                           window to the last by more than :data:`PEAK_DRIFT` (a slowly
+                           decaying mode, or a response that never repeats)
 =========================  ===========================================================
 """
 
@@ -25,11 +29,17 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 #: a dynamic factor (settled peak / the mesh's own static force) above this is reported
 #: as "near a resonance"; gear standards' K_v rarely exceeds 2
 RESONANCE_FACTOR = 3.0
 #: time fractions below this (of the run) are rounding: not reported
 FRACTION_FLOOR = 1e-4
+#: settled peaks whose first and last settle windows differ by more than this (relative)
+#: leave the third digit of the dynamic factor open: said (the settle criterion itself
+#: accepts 1 %, what a transient's end looks like, not what a printed digit needs)
+PEAK_DRIFT = 1e-3
 
 
 def _kn(force: float) -> str:
@@ -146,8 +156,44 @@ def settling(results, metrics) -> list[tuple[str, str]]:
         "or add damping"))]
 
 
+def peak_drift(results, metrics) -> list[tuple[str, str]]:
+    """Settled per-cycle peaks that still differ between the first and the last settle
+    window (each of the run's settle windows, the longest excitation period at least):
+    a lightly damped mode still decaying, or a response that does not repeat.  The
+    dynamic factor and the peak-based coefficients take the largest settled peak, so they
+    carry that difference; one message, for the mesh where it is largest."""
+    if not metrics.settling.settled:
+        return []  # said by `settling`
+    c_max = results.complete_cycle_statistics()[0]
+    worst = None
+    for j, (m, w) in enumerate(zip(results.mesh_names, results.settle_windows())):
+        p = c_max[metrics.settling.first_cycle[m]:, j]
+        p = p[np.isfinite(p)]
+        if p.size < 2 * w:
+            continue
+        first, last = float(p[:w].max()), float(p[-w:].max())
+        if last <= 0:
+            continue
+        change = (last - first) / last
+        if abs(change) > PEAK_DRIFT and (worst is None or abs(change) > abs(worst[1])):
+            worst = (m, change, first, last)
+    if worst is None:
+        return []
+    m, change, first, last = worst
+    row = next(r for r in metrics.rows if r.mesh == m)
+    alone = (f"; the last window alone gives {last / row.static_force:.4g}"
+             if row.static_force > 0 else "")
+    return [(f"meshes.{m}", (
+        f"the settled peaks are not steady: the largest force of the first settled window "
+        f"is {_kn(first)}, of the last {_kn(last)} ({100 * change:+.2g} %): a lightly "
+        f"damped mode still decaying, or a response that does not repeat (impacts); the "
+        f"dynamic factor ({row.dynamic_factor:.4g}) and the peak-based coefficients take "
+        f"the largest settled peak{alone}; for the steady-state values solve the periodic "
+        f"state (`torquesplit steady`)"))]
+
+
 #: every check, in the order the messages are listed
-CHECKS = (static_force, contact_loss, back_flank, resonance, settling)
+CHECKS = (static_force, contact_loss, back_flank, resonance, settling, peak_drift)
 
 
 def result_warnings(results, metrics) -> list[tuple[str, str]]:
