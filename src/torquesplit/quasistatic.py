@@ -1,6 +1,7 @@
 """Quasi-static load sharing: equilibrium at each mesh position (Mo et al. 2017).
 
-At every time of a sweep over one revolution of the slowest gear (or more), the
+At every time of a sweep over the common period of the excitations (the errors turn with
+their gears: the positions repeat only when every gear is back where it started), the
 static equilibrium of the assembled system is solved with the mesh stiffness, the
 errors (eccentricity, run-out... as functions of rotation) and the clearances at that
 position: displacement compatibility with floating members and loss of contact.  The
@@ -12,6 +13,7 @@ from __future__ import annotations
 
 import json
 import math
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -114,15 +116,28 @@ class QuasiStaticResults:
         return plan.path
 
 
-def quasi_static_load_sharing(model, *, revolutions: float = 1.0, points_per_cycle: int = 8,
-                              max_points: int = 20000, progress=None) -> QuasiStaticResults:
-    """Equilibria over ``revolutions`` of the slowest gear (in its mesh's frame: relative
-    to the carrier for a planet mesh), ``points_per_cycle`` per cycle of the fastest mesh
-    (capped at ``max_points``).
+MAX_REVOLUTIONS = 100.0
+"""Longest default sweep in revolutions of the slowest gear: the common period of a
+hunting-tooth train can be thousands (the sweep then says what it covers)."""
 
-    ``progress``, if given, is called with the fraction of positions done."""
+
+def quasi_static_load_sharing(model, *, revolutions: float | None = None,
+                              points_per_cycle: int = 32, max_points: int = 20000,
+                              progress=None) -> QuasiStaticResults:
+    """Equilibria over one common period of the excitations (default: errors, stiffness
+    and backlash tables, :func:`torquesplit.steady.period.fundamental_period`; at most
+    :data:`MAX_REVOLUTIONS` of the slowest gear, said when cut) or over ``revolutions`` of
+    the slowest gear (in its mesh's frame: relative to the carrier for a planet mesh), at
+    ``points_per_cycle`` positions per cycle of the fastest excitation (the fastest mesh
+    when nothing varies), at most ``max_points`` (said when that thins them).
+
+    A shorter sweep sees only some of the error combinations: its largest ratios are too
+    small and its mean forces unequal (Mo et al. 2017's example repeats every 25
+    revolutions of its slowest gear).  ``progress``, if given, is called with the
+    fraction of positions done."""
     from .assembly.assemble import assemble
     from .solve.static import quasi_static
+    from .steady.period import excitation_sources
 
     if not hasattr(model, "meshes"):
         model = load_model(model)
@@ -132,9 +147,47 @@ def quasi_static_load_sharing(model, *, revolutions: float = 1.0, points_per_cyc
     # a held ring stands still in the housing but turns in the carrier's frame)
     speeds = [abs(v) for mk in kin.meshes.values() for v in (mk.driver_speed, mk.driven_speed)
               if v != 0]
-    period = revolutions * 2 * math.pi / min(speeds)
-    f_max = max(mk.frequency for mk in kin.meshes.values())
-    n = int(min(max_points, max(16, math.ceil(period * f_max * points_per_cycle))))
+    turn = 2 * math.pi / min(speeds)  # one revolution of the slowest gear [s]
+    if revolutions is None:
+        period = _excitation_period(structure, turn)
+    elif not revolutions > 0:
+        raise ValueError(f"revolutions must be positive, got {revolutions!r}")
+    else:
+        period = revolutions * turn
+    sources = excitation_sources(structure)
+    f_max = (max(x.frequency for x in sources) if sources
+             else max(mk.frequency for mk in kin.meshes.values()))
+    wanted = max(16, math.ceil(period * f_max * points_per_cycle))
+    n = int(min(max_points, wanted))
+    if n < wanted:
+        warnings.warn(
+            f"the quasi-static sweep is cut to max_points = {max_points} positions, "
+            f"{n / (period * f_max):.3g} per cycle of the fastest excitation ({f_max:.6g} "
+            f"Hz) instead of {points_per_cycle}; raise max_points (or give fewer "
+            f"revolutions) for the full density", stacklevel=2)
     times = np.arange(n) * (period / n)
     sol = quasi_static(structure, times, progress=progress)
     return QuasiStaticResults(model=model, kinematics=kin, structure=structure, solution=sol)
+
+
+def _excitation_period(structure, turn: float) -> float:
+    """The common period of the excitations [s], at most MAX_REVOLUTIONS x ``turn`` (one
+    revolution of the slowest gear; also when no common period exists), said when cut."""
+    from .steady.period import PeriodError, fundamental_period
+
+    cap = MAX_REVOLUTIONS * turn
+    try:
+        per = fundamental_period(structure, max_cycles=None)
+    except PeriodError as exc:
+        why = f"the excitations have no common period ({exc})"
+    else:
+        if per.frequency <= 0:  # nothing varies: every position is the same
+            return turn
+        period = 1.0 / per.frequency
+        if period <= cap * (1 + 1e-9):
+            return period
+        why = (f"the excitations repeat only every {period / turn:.6g} revolutions of the "
+               f"slowest gear")
+    warnings.warn(f"{why}; the quasi-static sweep covers {MAX_REVOLUTIONS:g} of them: give "
+                  f"revolutions to choose", stacklevel=3)
+    return cap

@@ -68,3 +68,38 @@ def test_errors_unbalance_the_paths(with_errors):
     met = with_errors.metrics()
     assert met.system > 1.001  # 6 um errors against 1e7 N/m meshes are not negligible
     assert max(met.per_group.values()) == met.system
+
+
+def test_default_sweep_covers_the_common_period_of_the_errors(with_errors):
+    """The errors turn with their gears and repeat only every 25 revolutions of the
+    slowest gear: the default sweep covers exactly that period, so the three paths, alike
+    but for their position, carry the same mean force (one revolution leaves them 0.3 %
+    apart and the largest ratio too small)."""
+    from torquesplit.steady.period import fundamental_period
+
+    times = with_errors.times
+    period = fundamental_period(with_errors.structure, max_cycles=None).period
+    assert times[-1] + (times[1] - times[0]) == pytest.approx(period, rel=1e-12)
+    kin = with_errors.kinematics
+    slowest = min(abs(v) for mk in kin.meshes.values()
+                  for v in (mk.driver_speed, mk.driven_speed) if v)
+    assert period * slowest / (2 * np.pi) == pytest.approx(25.0, rel=1e-9)
+    means = with_errors.mesh_forces().mean(axis=0)
+    np.testing.assert_allclose(means[:3], means[0], rtol=1e-9)
+    one = quasi_static_load_sharing(_model(True), revolutions=1.0, points_per_cycle=2)
+    spread = np.ptp(one.mesh_forces().mean(axis=0)[:3]) / means[0]
+    assert spread > 1e-3
+    assert one.metrics().system < with_errors.metrics().system - 1e-3
+
+
+def test_a_common_period_too_long_is_cut_and_said(monkeypatch):
+    import torquesplit.quasistatic as qs
+
+    monkeypatch.setattr(qs, "MAX_REVOLUTIONS", 4.0)
+    with pytest.warns(UserWarning, match="repeat only every 25 revolutions.*covers 4 of"):
+        res = quasi_static_load_sharing(_model(True), points_per_cycle=2)
+    kin = res.kinematics
+    slowest = min(abs(v) for mk in kin.meshes.values()
+                  for v in (mk.driver_speed, mk.driven_speed) if v)
+    span = res.times[-1] + (res.times[1] - res.times[0])
+    assert span * slowest / (2 * np.pi) == pytest.approx(4.0, rel=1e-12)
