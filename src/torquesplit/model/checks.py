@@ -17,6 +17,7 @@ check                           what it refuses
 kinematics                      loops that cannot turn, power that does not balance,
                                 carriers and planets (model/epicyclic.py)
 :func:`shaft_axis_issues`       shafts joining bodies that are not on a common axis
+:func:`overlap_issues`          gears that do not mesh but occupy the same space
 :func:`nominal_load_issues`     meshes that carry no load (no power passes them)
 :func:`balance_issues`          torques out of balance by more than
                                 :data:`BALANCE_TOLERANCE` (what the static solution of
@@ -82,7 +83,7 @@ def check_model(model: Model, source: str | None = None, *, deep: bool = False) 
         kin = solve_kinematics(model)
     except KinematicsError as exc:
         raise ModelError(exc.issues, source) from None
-    issues = shaft_axis_issues(model, kin)
+    issues = shaft_axis_issues(model, kin) + overlap_issues(model, kin)
     issues += nominal_load_issues(model, kin) + balance_issues(model, kin)
     issues += stiffness_table_issues(model, kin) + planet_fit_issues(model, kin)
     notes = []
@@ -418,6 +419,147 @@ def shaft_axis_issues(model: Model, kin, *, rigid: bool = False) -> list[tuple[s
     return issues
 
 
+#: gears whose tooth regions overlap by less than this [m] are taken to touch, not overlap
+OVERLAP_TOLERANCE = 1e-6
+
+
+def overlap_issues(model: Model, kin) -> list[tuple[str, str]]:
+    """Gears that do not mesh with each other but whose teeth would occupy the same
+    space: parallel axes, face widths that overlap along the axis, and tooth regions
+    that intersect in the plane (a placement angle or a position typed wrong).
+
+    An external gear's region is its tip disc; an internal gear's the annulus between
+    its tip and root circles (its rim beyond is not modelled), so that a planet inside
+    its ring is fine, while a gear reaching past a ring's tip circle into its teeth is
+    not.  Meshing pairs (their centre distance is the mesh's), gears on one shaft line
+    (shafts and splines; ``shaft_axis_issues`` checks those) and bevel and face gears
+    are left out, and so are gears whose plane the file does not state (see
+    :func:`_axially_located`).  Positions are those at t = 0."""
+    from .kinematics import gear_geometry
+
+    mates = {frozenset(m.gears) for m in model.meshes.values()}
+    line = _shaft_lines(model)
+    located = _axially_located(model)
+    gears = []
+    for name, g in model.gears.items():
+        if g.gear_type in ("bevel", "face") or name not in located or name not in kin.bodies:
+            continue
+        try:
+            geo = gear_geometry(g)
+        except (ModelError, ValueError, ArithmeticError):  # pragma: no cover - checked before
+            continue
+        inner, outer = ((geo.tip_radius, geo.root_radius) if g.gear_type == "internal"
+                        else (0.0, geo.tip_radius))
+        body = kin.bodies[name]
+        gears.append((name, np.asarray(body.position, float), np.asarray(body.axis, float),
+                      geo.total_face_width, inner, outer))
+    issues = []
+    for i, (a, pa, ua, wa, ia, oa) in enumerate(gears):
+        for b, pb, ub, wb, ib, ob in gears[i + 1:]:
+            if frozenset((a, b)) in mates or line.get(a, a) == line.get(b, b):
+                continue
+            if math.acos(min(1.0, abs(float(np.dot(ua, ub))))) > SHAFT_AXIS_ANGLE:
+                continue
+            rel = pb - pa
+            axial = float(np.dot(rel, ua))
+            if abs(axial) >= (wa + wb) / 2 - OVERLAP_TOLERANCE:
+                continue  # side by side along the axis: different planes
+            d = float(np.linalg.norm(rel - axial * ua))
+            d = d if d > 1e-12 else 0.0  # coaxial (round-off of the placement)
+            tol = OVERLAP_TOLERANCE
+            # two annuli [inner, outer] about centres d apart share a point iff:
+            if not (d < oa + ob - tol and ib < oa + d - tol and ia < ob + d - tol):
+                continue
+            issues.append(_overlap_issue(model, (a, ia, oa), (b, ib, ob), d))
+    return issues
+
+
+def _overlap_issue(model: Model, first, second, d: float) -> tuple[str, str]:
+    """(location, message) for two overlapping gears; the one to move is the second, or
+    the external gear in a ring."""
+    (a, ia, oa), (b, ib, ob) = first, second
+    ring = [n for n, inner in ((a, ia), (b, ib)) if inner > 0]
+    move = b if len(ring) != 1 or ring[0] == a else a
+    fix = f"check gears.{move}.place / position"
+    plane = "with their faces in the same plane"
+    if not ring:
+        return (f"gears.{move}", f"gears {a} and {b} overlap: centre distance {d * 1e3:.4g} mm "
+                                 f"< sum of tip radii {(oa + ob) * 1e3:.4g} mm {plane}; {fix}")
+    if len(ring) == 1:
+        r = ring[0]
+        ra, rf, tip = (ia, oa, ob) if r == a else (ib, ob, oa)
+        return (f"gears.{move}", (
+            f"gears {a} and {b} overlap: {move} (tip radius {tip * 1e3:.4g} mm, centre "
+            f"{d * 1e3:.4g} mm from {r}'s) reaches into the teeth of internal gear {r} "
+            f"(tip radius {ra * 1e3:.4g} mm, root radius {rf * 1e3:.4g} mm) {plane}; {fix}"))
+    return (f"gears.{move}", (
+        f"gears {a} and {b} overlap: the teeth of these internal gears (radii "
+        f"{ia * 1e3:.4g}-{oa * 1e3:.4g} mm and {ib * 1e3:.4g}-{ob * 1e3:.4g} mm, centres "
+        f"{d * 1e3:.4g} mm apart) intersect {plane}; {fix}"))
+
+
+def _axially_located(model: Model) -> set[str]:
+    """Gears whose plane the file states: a given position, or placed (by 'place' or
+    next to a mate) from such a gear.  A gear on a shaft without a position takes the
+    centre of a body on that shaft (kinematics ``_layout``), so its axial position is a
+    stand-in, and so is that of the gears it meshes with, directly or through other
+    cylindrical meshes (a planar model that gives every position with z = 0): their
+    overlaps cannot be judged."""
+    gears = model.gears
+    joined = {b for s in list(model.shafts.values()) + list(model.splines.values())
+              for b in s.connects}
+    mates: dict[str, set[str]] = {n: set() for n in gears}
+    for m in model.meshes.values():
+        a, b = m.gears
+        if a in mates and b in mates:
+            mates[a].add(b)
+            mates[b].add(a)
+    known = {n for n, g in gears.items() if g.position is not None}
+    if not known and gears:  # nothing given: the layout anchors the first gear
+        first = next(iter(gears))
+        if gears[first].place is None and first not in joined:
+            known.add(first)
+    grew = True
+    while grew:
+        grew = False
+        for n, g in gears.items():
+            if n in known:
+                continue
+            if g.place is not None:
+                ok = g.place.from_gear in known
+            else:
+                ok = g.position is None and n not in joined and bool(mates[n] & known)
+            if ok:
+                known.add(n)
+                grew = True
+    # meshing gears share a plane: a stand-in plane makes that of its whole train one
+    flat = {n for n, g in gears.items() if g.gear_type not in ("bevel", "face")}
+    stack = [n for n in gears if n not in known]
+    while stack:
+        for mate in mates.get(stack.pop(), ()):
+            if mate in known and mate in flat:
+                known.discard(mate)
+                stack.append(mate)
+    return known
+
+
+def _shaft_lines(model: Model) -> dict[str, str]:
+    """Body -> a representative of the bodies joined to it by shafts and splines."""
+    parent = {n: n for n in model.body_names()}
+
+    def root(n):
+        while parent[n] != n:
+            parent[n] = parent[parent[n]]
+            n = parent[n]
+        return n
+
+    for s in list(model.shafts.values()) + list(model.splines.values()):
+        a, b = s.connects
+        if a in parent and b in parent:
+            parent[root(a)] = root(b)
+    return {n: root(n) for n in parent}
+
+
 def _mm(p) -> str:
     return "(" + ", ".join(f"{1e3 * float(v):.4g}" for v in p) + ") mm"
 
@@ -519,8 +661,9 @@ SIZE_RATIO = 100.0
 #: a given mass or polar inertia outside [1/r, r] times the gear's solid-disc value (an
 #: inertia may include the gear's shaft: Dong et al. 2021's pinion has 22 times its disc's)
 INERTIA_RATIO = 100.0
-#: pitch-line speed beyond which gears do not run [m/s] (turbine gears reach ~200)
-MAX_PITCH_SPEED = 500.0
+#: pitch-line speed beyond which gears do not run [m/s] (turbine gears reach ~200): a
+#: speed in rpm or Hz written as a bare number (read in rad/s) usually crosses it
+MAX_PITCH_SPEED = 300.0
 #: tooth load per face width beyond what steel teeth carry [N/m] (10 kN/mm)
 MAX_LOAD_PER_WIDTH = 1e7
 
@@ -605,7 +748,8 @@ def magnitude_warnings(model: Model, kin) -> list[tuple[str, str]]:
             if w * d / 2 > MAX_PITCH_SPEED:
                 out.append((loc, f"runs at a pitch-line speed of {w * d / 2:.4g} m/s (the "
                                  f"fastest gears run about 200 m/s); check the drive's "
-                                 f"speed and its unit"))
+                                 f"speed and its unit (a bare number is read in rad/s: "
+                                 f"write '3000 rpm' or '50 Hz')"))
     for name, b in model.bodies.items():
         against_size(f"bodies.{name}.position", max(abs(v) for v in b.position), small=False)
     for name, sh in model.shafts.items():

@@ -9,6 +9,12 @@ What reaches pint is guarded: a string longer than :data:`MAX_QUANTITY_CHARS` is
 refused before pint's preprocessing (its time grows with the square of the length), a
 unit without a number (``"mm"``, which pint reads as 1 mm) is refused, booleans are
 not numbers, and messages quote at most ~80 characters of a value.
+
+Speeds and frequencies: pint reads Hz as 1/s and the radian as dimensionless, so both
+have the dimension 1/[time] and a plain conversion would read "50 Hz" as 50 rad/s.  Here
+a rate without an angle (Hz, 1/s, kHz, 1/min) counts revolutions: a speed given as
+"50 Hz" is 3000 rpm (2 pi x 50 rad/s), and a frequency given as "12000 rpm" or in rad/s
+is 200 Hz (see :func:`_rotation`).
 """
 
 from __future__ import annotations
@@ -132,8 +138,49 @@ def _parse_string(text: str, kind: str) -> float:
         )
     if kind == "angle" and not (q.unitless or _is_angle_unit(q)):
         raise ValueError(f"{_short(text)} is not an angle; write e.g. '{example}'")
+    if kind in _TURNS:
+        return _rotation(q, kind, text)
     try:
         magnitude = q.to(si_unit).magnitude
+        return float(magnitude) if isinstance(magnitude, (int, float)) else math.nan
+    except (ArithmeticError, TypeError, ValueError):
+        return math.nan
+
+
+#: kinds measured per unit time whose SI unit holds a power of the radian: a speed
+#: (rad/s) holds one, a frequency (Hz, revolutions or cycles per second) none
+_TURNS = {"speed": 1, "frequency": 0}
+
+_PI = re.compile(r"\bpi\b", re.IGNORECASE)
+
+
+def _angle_power(q) -> float:
+    """Power of the radian in ``q``'s units: 1 for rpm, rad/s, deg/s; 0 for Hz, 1/s."""
+    return dict(q.to_root_units().unit_items()).get("radian", 0)
+
+
+def _rotation(q, kind: str, text: str) -> float:
+    """``q`` (of dimension 1/[time]) as a speed [rad/s] or a frequency [Hz]: a rate
+    without an angle counts revolutions (50 Hz = 3000 rpm), so that Hz, rpm and rad/s
+    mean the same rotation whatever the field.  Refuses what cannot be read one way."""
+    si_unit, example = KINDS[kind]
+    have, want = _angle_power(q), _TURNS[kind]
+    if have == 0 and want == 1 and _PI.search(text):
+        raise ValueError(
+            f"{_short(text)} is ambiguous: a rate with pi but no angle unit may mean rad/s or "
+            f"revolutions per second; write the angle unit (e.g. '100 pi rad/s') or "
+            f"revolutions (e.g. '50 Hz', '{example}')")
+    if have not in (0, 1):
+        raise ValueError(
+            f"{_short(text)} has the angle unit to the power {have:g}; write {_label(kind)} "
+            f"such as '{example}' (rpm, rad/s, deg/s; Hz counts revolutions)")
+    try:
+        if have == want:
+            magnitude = q.to(si_unit).magnitude
+        elif want == 1:  # revolutions per unit time -> rad/s
+            magnitude = q.to("1/s").magnitude * (2 * math.pi)
+        else:  # an angular speed -> revolutions per second
+            magnitude = q.to("rad/s").magnitude / (2 * math.pi)
         return float(magnitude) if isinstance(magnitude, (int, float)) else math.nan
     except (ArithmeticError, TypeError, ValueError):
         return math.nan
@@ -174,14 +221,22 @@ def _label(kind: str) -> str:
 
 def format_quantity(value: float, unit: str, digits: int = 6) -> str:
     """Format an SI value in ``unit`` for display, e.g. ``format_quantity(1e9, 'N/mm')``."""
-    ureg = registry()
-    q = ureg.Quantity(value, _si_of(unit)).to(unit)
-    return f"{q.magnitude:.{digits}g} {unit}"
+    return f"{convert(value, _si_of(unit), unit):.{digits}g} {unit}"
 
 
 def convert(value: float, from_unit: str, to_unit: str) -> float:
-    """Convert a float between two units (used for display and reports)."""
-    return float(registry().Quantity(value, from_unit).to(to_unit).magnitude)
+    """Convert a float between two units (used for display and reports).  Between a
+    speed and a frequency a rate without an angle counts revolutions, as when parsing:
+    ``convert(2 * pi * 50, 'rad/s', 'Hz') == 50``, ``convert(200, 'Hz', 'rpm') == 12000``."""
+    ureg = registry()
+    q = ureg.Quantity(value, from_unit)
+    target = ureg.Quantity(1.0, to_unit)
+    if q.dimensionality == target.dimensionality == ureg.Quantity(1.0, "Hz").dimensionality:
+        have, want = _angle_power(q), _angle_power(target)
+        if {have, want} == {0, 1}:
+            q = q.to("1/s") * 2 * math.pi * ureg.rad if want == 1 else q.to("rad/s") / (
+                2 * math.pi * ureg.rad)
+    return float(q.to(to_unit).magnitude)
 
 
 def _si_of(unit: str) -> str:
