@@ -10,6 +10,7 @@ holds them and computes the metrics on demand.
 from __future__ import annotations
 
 import math
+import numbers
 import warnings
 from dataclasses import dataclass
 from typing import Callable
@@ -53,16 +54,19 @@ def simulate(
     ----------
     model : Model, str or Path
         A validated model or a model file.
-    duration : float, optional
-        Simulated time [s].  Default: the model's ``[analysis]``, else ``cycles``.
+    duration : float or str, optional
+        Simulated time: seconds, or a string with a time unit (``"5 ms"``).  Default:
+        ``cycles`` if given, else the model's ``[analysis]``.
     cycles : int, optional
-        Number of cycles of the slowest mesh to simulate (default 200).
+        Number of cycles of the slowest mesh to simulate (default 200): a whole number
+        >= 1 (``3.0`` is read as 3; ``2.5`` is refused).  Give ``duration`` or
+        ``cycles``, not both (an :class:`~torquesplit.errors.OptionError`).
     method : {"rk4", "dopri"}, optional
         Integrator; default from ``[analysis]``.
     steps_per_period : int, optional
         RK4 steps per shortest mesh period (default 100, as in the papers).
     samples_per_period : int
-        Decimated history samples per shortest mesh period (plots and exports only: every
+        Decimated history samples per shortest mesh period, >= 1 (plots and exports only: every
         metric is computed from statistics streamed at every step).
     history_dofs : list of str, optional
         DOF names (``"gear.x"``) whose displacement and velocity histories to keep.
@@ -91,6 +95,8 @@ def simulate(
     >>> res.success
     True
     """
+    duration, cycles, samples_per_period = check_run_length(duration, cycles,
+                                                             samples_per_period)
     if not hasattr(model, "meshes"):
         model = load_model(model)
     notes: list[str] = []
@@ -129,6 +135,62 @@ def _simulate(model, *, duration, cycles, method, steps_per_period, rtol,
     solution = integrate(run.structure, run.y0, (0.0, run.duration), **run.integrate_kwargs)
     return Results(model=run.model, kinematics=run.kinematics, structure=run.structure,
                    static=run.static, solution=solution)
+
+
+def check_run_length(duration, cycles, samples_per_period=20):
+    """The run-length arguments of :func:`simulate` and :func:`prepare_run`, checked:
+    ``(duration in s or None, cycles or None, samples_per_period)``.
+
+    ``duration``: a positive number of seconds or a time string (``"5 ms"``); ``cycles``
+    and ``samples_per_period``: whole numbers >= 1 (``3.0`` is read as 3, ``2.5`` is
+    refused); ``duration`` and ``cycles`` together are refused (a run has one length).
+
+    Examples
+    --------
+    >>> check_run_length("5 ms", None)
+    (0.005, None, 20)
+    """
+    from .errors import OptionError
+
+    if duration is not None and cycles is not None:
+        raise OptionError(f"duration={duration!r} and cycles={cycles!r} both set the run "
+                          "length; give only one of them")
+    if duration is not None:
+        duration = _positive_time(duration)
+    if cycles is not None:
+        cycles = _whole(cycles, "cycles", "cycles=200")
+    samples_per_period = _whole(samples_per_period, "samples_per_period",
+                                "samples_per_period=20")
+    return duration, cycles, samples_per_period
+
+
+def _positive_time(value) -> float:
+    """``duration`` in seconds: a number (seconds) or a string with a time unit."""
+    from .errors import OptionError
+    from .model.units import parse_quantity
+
+    hint = "give e.g. duration=0.5 (seconds) or duration='500 ms'"
+    try:
+        x = parse_quantity(value, "time")
+    except ValueError as exc:
+        raise OptionError(f"duration: {exc}") from None
+    if not x > 0:  # parse_quantity refuses inf and nan
+        raise OptionError(f"duration must be a positive time, got {value!r}; {hint}")
+    return x
+
+
+def _whole(value, name: str, example: str) -> int:
+    """A whole-number argument >= 1 (a float with a whole value is accepted)."""
+    from .errors import OptionError
+
+    ok = isinstance(value, numbers.Integral) and not isinstance(value, bool)
+    if isinstance(value, numbers.Real) and not isinstance(value, (bool, numbers.Integral)):
+        ok = math.isfinite(value) and float(value).is_integer()
+    if not ok:
+        raise OptionError(f"{name} must be a whole number, got {value!r}; give e.g. {example}")
+    if value < 1:
+        raise OptionError(f"{name} must be >= 1, got {value!r}; give e.g. {example}")
+    return int(value)
 
 
 @dataclass(frozen=True)
@@ -181,6 +243,8 @@ def prepare_run(
     """The set-up of :func:`simulate` (same parameters) without the integration: model,
     kinematics, structure, static equilibrium, initial state, run length and the
     arguments of ``integrate``; refuses what ``simulate`` refuses, warns as it warns."""
+    duration, cycles, samples_per_period = check_run_length(duration, cycles,
+                                                             samples_per_period)
     if not hasattr(model, "meshes"):
         model = load_model(model)
     an = model.analysis
@@ -217,9 +281,9 @@ def prepare_run(
             duration = an.duration
         else:
             duration = (an.cycles or 200) / f_min
-    if duration <= 0 or not math.isfinite(duration):
-        raise SolverError(f"duration must be positive, got {duration!r} s; give --duration or "
-                          f"--cycles")
+    if duration <= 0 or not math.isfinite(duration):  # e.g. from the model's [analysis]
+        raise SolverError(f"the run length must be positive, got {duration!r} s; give a "
+                          "positive duration or cycles")
     y0 = np.concatenate([static.q, np.zeros_like(static.q)])
 
     names = structure.element_names
@@ -288,5 +352,5 @@ def _check_cost(structure, duration: float, steps_per_period: int, max_steps: in
         took = f"{seconds / 60:.2g} min" if seconds >= 60 else f"{seconds:.2g} s"
         warnings.warn(f"this run takes {n_steps:,} RK4 steps of {h:.3g} s ({why}): about "
                       f"{took} of integration and {memory / 1024**2:,.0f} MB of results; "
-                      f"shorten --duration/--cycles for a quicker look", ModelWarning,
+                      f"shorten the run (duration or cycles) for a quicker look", ModelWarning,
                       stacklevel=4)

@@ -75,7 +75,8 @@ def test_changed_study_or_model_refuses_resume(tmp_path, split_file):
     path = _write(tmp_path, data)
     out = tmp_path / "out"
     Study(path).run(workers=1, out=out, figures=False)
-    with pytest.raises(StudyError, match="already holds a study; add --resume"):
+    with pytest.raises(StudyError, match=r"^out: .* already holds a study; add resume=True "
+                                         r"to continue it, overwrite=True to start it again"):
         Study(path).run(workers=1, out=out)
     # done: resuming recomputes nothing
     ds = Study(path).run(workers=1, out=out, resume=True, figures=False)
@@ -84,8 +85,9 @@ def test_changed_study_or_model_refuses_resume(tmp_path, split_file):
     assert ds.sizes["meshes.a1.transmission_error.constant"] == 2
     data["grid"]["parameters"][0]["stop"] = "12 um"
     _write(tmp_path, data)
-    with pytest.raises(StudyError, match=r"study file changed .*grid\.parameters\.0\.stop: "
-                                         r"'9 um' -> '12 um'"):
+    with pytest.raises(StudyError, match=r"^resume: the study file changed .*grid\.parameters"
+                                         r"\.0\.stop: '9 um' -> '12 um'.*another out or "
+                                         r"overwrite=True$"):
         Study(path).run(workers=1, out=out, resume=True)
     data["grid"]["parameters"][0]["stop"] = "9 um"
     _write(tmp_path, data)
@@ -134,7 +136,8 @@ def test_a_dead_worker_stops_the_study_without_losing_cases(tmp_path, split_file
 
     data = grid_study(split_file, GRID)
     out = tmp_path / "out"
-    with pytest.raises(StudyError, match="stopped after 3 cases: BrokenProcessPool.*--resume"):
+    with pytest.raises(StudyError, match="stopped after 3 cases: BrokenProcessPool.*with "
+                                         "resume=True"):
         Study(data).run(runner=flaky, out=out)
     ds = Study(data).run(workers=1, out=out, resume=True, figures=False)
     assert (ds["status"] == "ok").all()
@@ -156,3 +159,97 @@ def test_one_run_at_a_time_per_folder(tmp_path, split_file):
         held.release()
     ds = Study(grid_study(split_file, GRID[:1])).run(workers=1, out=out, figures=False)
     assert ds.sizes[GRID[0]["path"]] == 10
+
+
+def test_python_api_names_its_arguments_the_cli_its_flags(tmp_path, split_file):
+    data = grid_study(split_file, GRID[:1])
+    data["grid"]["parameters"][0]["num"] = 2
+    path = _write(tmp_path, data)
+    out = tmp_path / "out"
+    Study(path).run(workers=1, out=out, figures=False)
+    for kwargs, words in [({"out": out}, "resume=True"),
+                          ({"precision": "fp32"}, "backend='gpu' or leave precision out"),
+                          ({"backend": "gpu", "scheduler": "tcp://127.0.0.1:1"},
+                           "leave out scheduler, client and runner"),
+                          ({"workers": 0}, "workers: got 0; give at least 1 worker")]:
+        with pytest.raises(StudyError, match=words) as info:
+            Study(path).run(**kwargs)
+        assert "--" not in str(info.value)
+    res = CliRunner().invoke(app, ["study", str(path), "--out", str(out), "--quiet"])
+    assert res.exit_code == 2
+    assert "--out: " in res.output and "add --resume to continue it, --overwrite" in res.output
+    res = CliRunner().invoke(app, ["study", str(path), "--out", str(out), "--quiet",
+                                   "--precision", "fp32"])
+    assert res.exit_code == 2 and "add --backend gpu or leave --precision out" in res.output
+
+
+def _stop_while_writing_figures(monkeypatch):
+    """Ctrl-C after the first figure of the study is written (every case done)."""
+    from torquesplit.study import figures
+
+    real = figures.write_study_figures
+
+    def interrupted(ds, directory, **kwargs):
+        real(ds, directory, formats=("png",))
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(figures, "write_study_figures", interrupted)
+
+
+def _runs(out):
+    with sqlite3.connect(out / "study.sqlite") as db:
+        return db.execute("SELECT state, computed FROM runs ORDER BY run").fetchall()
+
+
+def test_ctrl_c_while_writing_figures_is_a_stop_and_resume_writes_them(tmp_path, split_file,
+                                                                        monkeypatch):
+    data = grid_study(split_file, GRID[:1])
+    data["grid"]["parameters"][0]["num"] = 3
+    out = tmp_path / "out"
+    with monkeypatch.context() as m:
+        _stop_while_writing_figures(m)
+        with pytest.raises(StudyInterrupted) as info:
+            Study(data).run(workers=1, out=out)
+    assert "3 of 3" in str(info.value) and "resume=True" in str(info.value)
+    assert _runs(out) == [("interrupted", 3)]  # not finished: the figures are not all there
+    assert not list((out / "figures").glob("*.svg"))
+    Study(data).run(workers=1, out=out, resume=True)
+    assert _runs(out) == [("interrupted", 3), ("finished", 0)]
+    assert list((out / "figures").glob("*.svg")) and (out / "results.nc").exists()
+
+
+def test_cli_says_how_to_resume_after_ctrl_c_while_writing_figures(tmp_path, split_file,
+                                                                   monkeypatch):
+    data = grid_study(split_file, GRID[:1])
+    data["grid"]["parameters"][0]["num"] = 2
+    path = _write(tmp_path, data)
+    out = tmp_path / "out"
+    args = ["study", str(path), "--out", str(out), "--workers", "1", "--quiet"]
+    with monkeypatch.context() as m:
+        _stop_while_writing_figures(m)
+        res = CliRunner().invoke(app, args)
+    assert res.exit_code == 130
+    assert "stopped: 2 of 2 cases done and saved in" in res.output
+    assert "figures not all written; to finish, run the same command with --resume" in res.output
+    assert _runs(out) == [("interrupted", 2)]
+    res = CliRunner().invoke(app, args + ["--resume"])
+    assert res.exit_code == 0, res.output
+    assert _runs(out)[-1] == ("finished", 0) and list((out / "figures").glob("*.svg"))
+
+
+def test_a_figure_is_whole_or_absent(tmp_path, split_file, monkeypatch):
+    from matplotlib.figure import Figure
+
+    from torquesplit.study.figures import write_study_figures
+
+    ds = Study(grid_study(split_file, GRID[:1])).run(workers=1)
+
+    def half_then_stop(self, fname, **kwargs):
+        with open(fname, "wb") as f:
+            f.write(b"half a figure")
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(Figure, "savefig", half_then_stop)
+    with pytest.raises(KeyboardInterrupt):
+        write_study_figures(ds, tmp_path / "figures")
+    assert list((tmp_path / "figures").iterdir()) == []

@@ -34,6 +34,13 @@ def _bad_cases(model):
                         "the range is empty"),
         "start equals stop": (grid_study(model, [dict(K, stop="2e8 N/m")]),
                               "grid.parameters.0.stop", "the range is empty"),
+        "one point of two values": (grid_study(model, [dict(K, num=1)]),
+                                    "grid.parameters.0.num",
+                                    "1 point but start 2e8 N/m != stop 6e8 N/m; give num >= 2 "
+                                    "or start = stop"),
+        "one point, unit option": (grid_study(model, [dict(K, start=1, stop=2, num=1,
+                                                           unit="N/mm")]),
+                                   "grid.parameters.0.num", "start 1 N/mm != stop 2 N/mm"),
         "negative samples": (negative, "monte_carlo.samples", "must be at least 1"),
         "two designs": (two, "monte_carlo", "one design"),
         "unknown output": (grid_study(model, [K], outputs=["load_sharing.engneering.*"]),
@@ -80,6 +87,12 @@ def test_toml_syntax_error_names_the_file(tmp_path):
     path.write_text("[study\nname = 1\n")
     with pytest.raises(StudyError, match="broken.toml: TOML syntax error"):
         Study(path)
+
+
+def test_one_point_range_with_start_equal_to_stop_runs_that_point(split_file):
+    study = Study(grid_study(split_file, [dict(K, stop="200 N/um", num=1)]))
+    assert study.n_cases == 1
+    assert study.plan().design.axes[0].tolist() == [2e8]
 
 
 def test_model_path_relative_to_study_file(tmp_path, split_file):

@@ -86,7 +86,7 @@ def _list() -> None:
 def _run(source, *, workers, scheduler, out, resume, overwrite, figures, quiet, as_json,
          name_hint: str | None = None, backend: str = "cpu", precision: str | None = None):
     from ..errors import TorquesplitError
-    from .core import Study
+    from .core import CLI_WORDS, Study
     from .errors import StudyInterrupted
 
     ui = _ui()
@@ -113,16 +113,20 @@ def _run(source, *, workers, scheduler, out, resume, overwrite, figures, quiet, 
                         f"[yellow]--backend gpu:[/] {why}; running on the CPU runner "
                         "(same results, CPU speed)", highlight=False)
                 warnings.simplefilter("ignore", GpuFallbackWarning)
-            ds = _with_bar(lambda cb: st.run(workers=workers, scheduler=scheduler, out=out,
-                                             resume=resume, overwrite=overwrite, progress=cb,
-                                             figures=figures, backend=backend,
-                                             precision=precision),
+            # the messages name the flags (--resume), not Study.run's arguments
+            ds = _with_bar(lambda cb: st._run(CLI_WORDS, workers=workers, client=None,
+                                              scheduler=scheduler, runner=None, out=out,
+                                              resume=resume, overwrite=overwrite,
+                                              progress=cb, figures=figures, backend=backend,
+                                              precision=precision),
                            plan.n_cases, quiet or as_json)
     except StudyInterrupted as exc:
+        # every case done: stopped while results.nc and the figures were written
+        unwritten = "; results.nc and figures not all written" if exc.done >= exc.total else ""
         ui.err_console.print("[yellow]stopped:[/] ", end="")
-        ui.err_console.print(f"{exc.done} of {exc.total} cases done and saved in {out}; to "
-                             f"finish, run the same command with --resume", markup=False,
-                             highlight=False, soft_wrap=True)
+        ui.err_console.print(f"{exc.done} of {exc.total} cases done and saved in {out}"
+                             f"{unwritten}; to finish, run the same command with --resume",
+                             markup=False, highlight=False, soft_wrap=True)
         raise typer.Exit(130)
     except (TorquesplitError, ValueError, OSError) as exc:
         ui._fail(exc)

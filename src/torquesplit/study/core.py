@@ -39,6 +39,32 @@ RESULTS_NAME = "results.nc"
 
 
 @dataclass(frozen=True)
+class Words:
+    """How messages name the options of a run: the keyword arguments of
+    :meth:`Study.run` (:data:`API_WORDS`) or the command-line flags (:data:`CLI_WORDS`,
+    used by ``torquesplit study`` and ``sweep``)."""
+
+    out: str
+    resume: str
+    resume_on: str
+    overwrite_on: str
+    backend: str
+    backend_gpu: str
+    precision: str
+    scheduler: str
+    workers: str
+
+
+API_WORDS = Words(out="out", resume="resume", resume_on="resume=True",
+                  overwrite_on="overwrite=True", backend="backend", backend_gpu="backend='gpu'",
+                  precision="precision", scheduler="scheduler, client and runner",
+                  workers="workers")
+CLI_WORDS = Words(out="--out", resume="--resume", resume_on="--resume",
+                  overwrite_on="--overwrite", backend="--backend", backend_gpu="--backend gpu",
+                  precision="--precision", scheduler="--scheduler", workers="--workers")
+
+
+@dataclass(frozen=True)
 class Progress:
     """What the progress callback is told after each finished case."""
 
@@ -155,52 +181,80 @@ class Study:
             Bad study file, or ``out`` holds another study (the message says what
             changed) - before any case runs.
         StudyInterrupted
-            On Ctrl-C, after committing every finished case.
+            On Ctrl-C, after committing every finished case (also while ``results.nc``
+            and the figures are written: the run is recorded as finished only once they
+            are, and ``resume=True`` writes them again).
         """
+        return self._run(API_WORDS, workers=workers, client=client, scheduler=scheduler,
+                         runner=runner, out=out, resume=resume, overwrite=overwrite,
+                         progress=progress, figures=figures, backend=backend,
+                         precision=precision)
+
+    def _run(self, words: Words, *, workers, client, scheduler, runner, out, resume,
+             overwrite, progress, figures, backend, precision):
+        """:meth:`run`, its messages naming the options as ``words`` says."""
         plan = self.plan()
+        if workers is not None and (isinstance(workers, bool) or workers < 1):
+            raise StudyError(words.workers, f"got {workers!r}; give at least 1 worker (1 "
+                                            "runs the cases in this process)")
         chosen = _backend_runner(plan, backend, precision, client, scheduler, runner,
-                                 workers)
-        store = _open_store(plan, out, resume, overwrite)
+                                 workers, words)
+        store = _open_store(plan, out, resume, overwrite, words)
         try:
             run = _Driver(plan, store, chosen or make_runner(workers, client=client,
                                                              scheduler=scheduler,
                                                              runner=runner),
-                          progress, out)
+                          progress, out, words)
             run.execute()
-            report = getattr(run.runner, "report", None)
-            if report is not None:
-                store.write_meta({"gpu_backend": report})
-            ds = dataset_from_store(plan, store, run.n_used)
+            try:
+                report = getattr(run.runner, "report", None)
+                if report is not None:
+                    store.write_meta({"gpu_backend": report})
+                ds = dataset_from_store(plan, store, run.n_used)
+                if out is not None:
+                    _write_outputs(ds, Path(out), figures)
+            except KeyboardInterrupt:
+                # the cases are all saved; resuming writes the results and figures again
+                store.end_run("interrupted")
+                raise StudyInterrupted(int(run.finished.sum()), run.n_used, run.out) from None
+            except BaseException:
+                store.end_run("failed")
+                raise
+            store.end_run("finished")
         finally:
             store.close()
-        if out is not None:
-            from .dataset import write_dataset
-
-            write_dataset(ds, Path(out) / RESULTS_NAME)
-            if figures:
-                from .figures import write_study_figures
-
-                write_study_figures(ds, Path(out) / "figures")
         return ds
 
 
+def _write_outputs(ds, out: Path, figures: bool) -> None:
+    """``results.nc`` and (if asked) the figures of a study whose cases are all done."""
+    from .dataset import write_dataset
+
+    write_dataset(ds, out / RESULTS_NAME)
+    if figures:
+        from .figures import write_study_figures
+
+        write_study_figures(ds, out / "figures")
+
+
 def _backend_runner(plan: Plan, backend: str, precision, client, scheduler, runner,
-                    workers=None):
+                    workers=None, words: Words = API_WORDS):
     """The GPU runner for ``backend="gpu"`` (None: use the CPU runners), after refusing
     options that do not go together and, by name, what the GPU kernel does not do."""
+    w = words
     if backend not in ("cpu", "gpu"):
-        raise StudyError("--backend", f"unknown backend {backend!r}; use 'cpu' or 'gpu'")
+        raise StudyError(w.backend, f"unknown backend {backend!r}; use 'cpu' or 'gpu'")
     if backend == "cpu":
         if precision is not None:
-            raise StudyError("--precision", "applies to the GPU backend only; add "
-                                            "--backend gpu or leave --precision out")
+            raise StudyError(w.precision, f"applies to the GPU backend only; add "
+                                          f"{w.backend_gpu} or leave {w.precision} out")
         return None
     if precision not in (None, "fp64", "fp32"):
-        raise StudyError("--precision", f"unknown precision {precision!r}; use 'fp64' or "
-                                        f"'fp32'")
+        raise StudyError(w.precision, f"unknown precision {precision!r}; use 'fp64' or "
+                                      f"'fp32'")
     if client is not None or scheduler is not None or runner is not None:
-        raise StudyError("--backend", "the GPU backend runs the cases on this machine's GPU; "
-                                      "leave out --scheduler (or client / runner)")
+        raise StudyError(w.backend, "the GPU backend runs the cases on this machine's GPU; "
+                                    f"leave out {w.scheduler}")
     from ..gpu.backend import check_plan, make_gpu_runner
 
     check_plan(plan)
@@ -236,11 +290,12 @@ def _provenance(plan: Plan) -> dict:
     }
 
 
-def _open_store(plan: Plan, out, resume: bool, overwrite: bool) -> Store:
+def _open_store(plan: Plan, out, resume: bool, overwrite: bool,
+                words: Words = API_WORDS) -> Store:
     if out is None:
         if resume:
-            raise StudyError("--out", "resume needs the output folder of the earlier run; "
-                                      "give out=DIR")
+            raise StudyError(words.out, "resume needs the output folder of the earlier run; "
+                                        "give out=DIR")
         store = Store(":memory:")
         store.write_meta(_provenance(plan))
         return store
@@ -249,10 +304,11 @@ def _open_store(plan: Plan, out, resume: bool, overwrite: bool) -> Store:
     try:
         lock = StoreLock(out)
     except BlockingIOError as exc:
-        raise StudyError("--out", f"{out} is in use by another run of a study ({exc}); wait "
-                                  f"for it to finish or stop it, or choose another folder") from None
+        raise StudyError(words.out, f"{out} is in use by another run of a study ({exc}); "
+                                    f"wait for it to finish or stop it, or choose another "
+                                    f"folder") from None
     try:
-        store = _open_folder(plan, out, resume, overwrite)
+        store = _open_folder(plan, out, resume, overwrite, words)
     except BaseException:
         lock.release()
         raise
@@ -260,44 +316,46 @@ def _open_store(plan: Plan, out, resume: bool, overwrite: bool) -> Store:
     return store
 
 
-def _open_folder(plan: Plan, out: Path, resume: bool, overwrite: bool) -> Store:
+def _open_folder(plan: Plan, out: Path, resume: bool, overwrite: bool,
+                 words: Words) -> Store:
     path = out / STORE_NAME
     if path.exists() and overwrite:
         for suffix in ("", "-wal", "-shm"):
             Path(str(path) + suffix).unlink(missing_ok=True)
     exists = path.exists()
     if exists and not resume:
-        raise StudyError("--out", f"{out} already holds a study; add --resume to continue it, "
-                                  f"--overwrite to start it again, or choose another folder")
+        raise StudyError(words.out, f"{out} already holds a study; add {words.resume_on} to "
+                                    f"continue it, {words.overwrite_on} to start it again, or "
+                                    f"choose another folder")
     store = Store(path)
     if store.is_new():
         store.write_meta(_provenance(plan))
         return store
     try:
-        _check_same(plan, store.meta(), out)
+        _check_same(plan, store.meta(), out, words)
     except StudyError:
         store.close()
         raise
     return store
 
 
-def _check_same(plan: Plan, meta: dict, out: Path) -> None:
+def _check_same(plan: Plan, meta: dict, out: Path, words: Words = API_WORDS) -> None:
     from .. import __version__
 
+    w = words
+    again = f"start a new study with another {w.out} or {w.overwrite_on}"
     if meta.get("study_hash") != plan.study_hash:
         changes = _diff(meta.get("study", {}), plan.spec.canonical())
-        raise StudyError("--resume", f"the study file changed since {out} was started "
-                                     f"({changes}); undo the change, or start a new study "
-                                     f"with another --out or --overwrite")
+        raise StudyError(w.resume, f"the study file changed since {out} was started "
+                                   f"({changes}); undo the change, or {again}")
     if meta.get("model_hash") != plan.model_hash:
         changes = _diff(meta.get("model", {}), plan.model_dict)
-        raise StudyError("--resume", f"the model changed since {out} was started "
-                                     f"({changes}); undo the change, or start a new study "
-                                     f"with another --out or --overwrite")
+        raise StudyError(w.resume, f"the model changed since {out} was started "
+                                   f"({changes}); undo the change, or {again}")
     if meta.get("torquesplit_version") != __version__:
-        raise StudyError("--resume", f"{out} was computed with torquesplit "
-                                     f"{meta.get('torquesplit_version')}, this is {__version__}; "
-                                     f"finish it with that version or start a new study")
+        raise StudyError(w.resume, f"{out} was computed with torquesplit "
+                                   f"{meta.get('torquesplit_version')}, this is {__version__}; "
+                                   f"finish it with that version or start a new study")
 
 
 def _diff(old, new, prefix: str = "", limit: int = 3) -> str:
@@ -327,12 +385,14 @@ def _short(x) -> str:
 
 # ============================================================================ driver
 class _Driver:
-    def __init__(self, plan: Plan, store: Store, runner, progress, out):
+    def __init__(self, plan: Plan, store: Store, runner, progress, out,
+                 words: Words = API_WORDS):
         self.plan = plan
         self.store = store
         self.runner = runner
         self.progress = progress
         self.out = None if out is None else str(out)
+        self.words = words
         d = plan.design
         self.total = d.n_cases
         self.n_used = d.n_cases
@@ -369,12 +429,12 @@ class _Driver:
                     self.progress(Progress(int(self.finished[: self._target()].sum()),
                                            self.failed, self._target(), self.computed,
                                            time.perf_counter() - t0, r))
-            state = "finished"
+            state = "cases done"  # Study.run marks it finished once the outputs are written
         except KeyboardInterrupt:
             raise StudyInterrupted(int(self.finished.sum()), self._target(), self.out) from None
         except (OSError, RuntimeError) as exc:  # a worker process died, a cluster went away
             state = "failed"
-            again = ("run it again with --resume" if self.out else
+            again = (f"run it again with {self.words.resume_on}" if self.out else
                      "give an output folder to keep finished cases")
             raise StudyError("", f"the study stopped after {int(self.finished.sum())} cases: "
                                  f"{type(exc).__name__}: {exc}; every finished case is "
@@ -383,7 +443,8 @@ class _Driver:
             close = getattr(results, "close", None)
             if close is not None:
                 close()
-            store.end_run(state)
+            if state != "cases done":
+                store.end_run(state)
         if self.stop is not None:
             self.n_used = self.stop_at if self.stop_at is not None else self.total
         missing = int((~self.finished[: self.n_used]).sum())

@@ -70,7 +70,13 @@ def write_study_figures(ds, directory, formats=("png", "svg"), dpi: int = 130) -
         fig = make()
         for fmt in formats:
             path = directory / f"{name}.{fmt}"
-            fig.savefig(path, dpi=dpi)
+            # whole or absent: a Ctrl-C while saving leaves no half-written figure
+            tmp = path.with_name(f".{path.name}.tmp")
+            try:
+                fig.savefig(tmp, dpi=dpi, format=fmt)
+                tmp.replace(path)
+            finally:
+                tmp.unlink(missing_ok=True)
             written.append(path)
     return written
 

@@ -1,0 +1,42 @@
+"""The run-length arguments of ``simulate`` and ``prepare_run``: refused with one message
+naming the argument (never a bare TypeError or ZeroDivisionError), a time string read."""
+
+from __future__ import annotations
+
+import pytest
+
+import torquesplit
+from torquesplit.errors import OptionError
+from torquesplit.simulation import prepare_run
+
+BAD = [
+    ({"duration": 0.005, "cycles": 30}, r"duration=0\.005 and cycles=30 .*only one of them"),
+    ({"duration": "5 xx"}, r"^duration: cannot read '5 xx' as a time"),
+    ({"duration": "5 m"}, r"^duration: '5 m' is not a time"),
+    ({"duration": -1.0}, r"^duration must be a positive time, got -1\.0"),
+    ({"duration": "0 s"}, r"^duration must be a positive time"),
+    ({"duration": [1]}, r"^duration: got \[1\]"),
+    ({"cycles": 2.5}, r"^cycles must be a whole number, got 2\.5; give e\.g\. cycles=200$"),
+    ({"cycles": "3"}, r"^cycles must be a whole number"),
+    ({"cycles": -3}, r"^cycles must be >= 1, got -3; give e\.g\. cycles=200$"),
+    ({"cycles": 0}, r"^cycles must be >= 1"),
+    ({"samples_per_period": 0}, r"^samples_per_period must be >= 1, got 0"),
+    ({"samples_per_period": 0.5}, r"^samples_per_period must be a whole number"),
+]
+
+
+@pytest.mark.parametrize("function", [torquesplit.simulate, prepare_run])
+@pytest.mark.parametrize("kwargs, message", BAD)
+def test_bad_run_length_is_refused_naming_the_argument(spur_pair, function, kwargs, message):
+    with pytest.raises(OptionError, match=message) as info:
+        function(spur_pair, **kwargs)
+    assert "--" not in str(info.value)  # the Python API names its own arguments
+
+
+def test_duration_string_and_whole_float_cycles_are_read(spur_pair):
+    run = prepare_run(spur_pair, duration="5 ms")
+    assert run.duration == pytest.approx(0.005)
+    f_min = min(m.frequency for m in run.kinematics.meshes.values())
+    assert prepare_run(spur_pair, cycles=3.0).duration == pytest.approx(3 / f_min)
+    res = torquesplit.simulate(spur_pair, duration="2 ms")
+    assert res.success and res.solution.t_final == pytest.approx(0.002)
