@@ -203,6 +203,24 @@ def settle(cycle_max: np.ndarray, cycle_start: np.ndarray, names, window=20,
                     group_time=group_time, own_first_cycle=own, short=short)
 
 
+def periodic(cycle_max: np.ndarray, cycle_start: np.ndarray, names,
+             groups: dict[str, list[str]] | None = None) -> Settling:
+    """Settling of a periodic state's record (the steady state repeated): no transient,
+    every complete cycle counts, from each mesh's first one (the record holds whole
+    periods of each mesh's cycles, so every mean is over whole periods)."""
+    first: dict[str, int] = {}
+    t_own: dict[str, float] = {}
+    for j, name in enumerate(names):
+        idx = np.flatnonzero(np.isfinite(cycle_max[:, j]))
+        first[name] = int(idx[0]) if idx.size else 0
+        t_own[name] = float(cycle_start[first[name], j]) if idx.size else -math.inf
+    groups = groups or {name: [name] for name in names}
+    group_time = {g: max(t_own[m] for m in ms) for g, ms in groups.items()}
+    return Settling(start_time=max(group_time.values()) if group_time else 0.0,
+                    settled=True, first_cycle=first, group_time=group_time,
+                    own_first_cycle=dict(first))
+
+
 def _ratio(x: np.ndarray) -> np.ndarray:
     """N x_i / sum_j x_j along the last axis (NaN where the sum vanishes)."""
     s = x.sum(axis=-1, keepdims=True)

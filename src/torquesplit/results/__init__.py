@@ -125,8 +125,11 @@ class Results:
     """A finished (or stopped) dynamic run and everything needed to interpret it."""
 
     def __init__(self, *, model, kinematics, structure, static, solution,
-                 run_warnings=(), model_warnings=None):
+                 run_warnings=(), model_warnings=None, periodic: bool = False):
         self.model = model
+        self.periodic = periodic
+        """The record is a periodic state repeated over whole periods (a steady state):
+        no transient to detect, every complete cycle counts."""
         self.kinematics = kinematics
         self.structure = structure
         self.static = static
@@ -239,7 +242,9 @@ class Results:
         c_max, c_min, c_mean, c_cnt, c_ratio = self.complete_cycle_statistics()
         c_start = s.cycle_start[:, self._mesh_columns]
         groups = self.groups
-        st = ls.settle(c_max, c_start, names, self.settle_windows(window), tolerance, groups)
+        st = (ls.periodic(c_max, c_start, names, groups) if self.periodic else
+              ls.settle(c_max, c_start, names, self.settle_windows(window), tolerance,
+                        groups))
         if definition == "cycle_peak":
             lsc = ls.cycle_peak(c_max, c_start, names, groups, st.first_cycle)
         elif definition == "mean_force":

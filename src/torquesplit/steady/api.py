@@ -140,14 +140,15 @@ class SteadyState:
 
     def to_results(self, periods: int | None = None):
         """The periodic state as :class:`~torquesplit.results.Results` (the state
-        repeated over ``periods`` periods: default enough for 4 settle windows)."""
+        repeated over ``periods`` periods: default enough for 4 settle windows), whose
+        metrics take every complete cycle of whole periods (``Results.periodic``)."""
         from torquesplit.results import Results
 
         shell = Results(model=self.model, kinematics=self.kinematics,
                         structure=self.structure, static=self.static, solution=None)
         sol = _as_solution(self, shell, periods)
         return Results(model=self.model, kinematics=self.kinematics, structure=self.structure,
-                       static=self.static, solution=sol)
+                       static=self.static, solution=sol, periodic=True)
 
     def mesh_table(self, definition: str | None = None) -> list[MeshSteady]:
         """Per-mesh static, mean, min and peak force, dynamic factors, load sharing
@@ -552,9 +553,14 @@ def _as_solution(st: SteadyState, shell, periods):
                                    (bases[j] - s.phase[e]) / s.frequency[e],
                                    1.0 / s.frequency[e])
         cnt = np.bincount(idx, minlength=nc)
-        # the first and last cycles are partial (phase offsets): left out
+        # the first and last cycles are partial (phase offsets): left out; a mesh whose
+        # cycles divide the period keeps whole periods of them (cycles 1 .. (P - 1) n),
+        # so that every mean over its cycles is a mean over whole periods
         cnt[0] = 0
         cnt[cyc_n[j] - 1:] = 0
+        per = s.frequency[e] * T
+        if abs(per - round(per)) < 1e-6 * max(per, 1.0) and round(per) >= 1:
+            cnt[1 + (periods - 1) * int(round(per)):] = 0
         ok = cnt > 0
         cmax[ok, j] = mx[ok]
         cmin[ok, j] = mn[ok]

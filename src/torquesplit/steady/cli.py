@@ -126,10 +126,12 @@ def register(app, load, fail, console, err_console, json_default):
             return
         ps = st.solution
         mu = ps.multipliers
+        # the period found at the model's speeds, told at the speed solved
+        period_text = st.period.describe(ps.frequency / st.period.frequency)
         info = {
             "model": m.model.name, "method": ps.method, "converged": ps.converged,
             "message": ps.message, "period_s": ps.period, "fundamental_Hz": ps.frequency,
-            "period": st.period.describe(), "harmonics": ps.harmonics,
+            "period": period_text, "harmonics": ps.harmonics,
             "residual": ps.residual, "time_residual": ps.time_residual,
             "periodicity_defect": ps.periodicity_defect,
             "top_harmonic_energy": ps.top_harmonic_energy,
@@ -145,7 +147,7 @@ def register(app, load, fail, console, err_console, json_default):
             _emit(info, json_default)
         else:
             console.print(f"[bold]{m.model.name}[/]: {ps.message}")
-            console.print(f"{st.period.describe()}")
+            console.print(period_text)
             if st.dropped:
                 console.print("kept excitations periodic with the base; replaced by their "
                               "means: " + "; ".join(d.describe() for d in st.dropped))

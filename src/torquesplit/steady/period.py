@@ -63,8 +63,9 @@ class ExcitationSource:
     index: int
     """Element index (error sinusoids: the index of the sinusoid)."""
 
-    def describe(self) -> str:
-        return f"{self.kind} of {self.element} at {self.frequency:.6g} Hz"
+    def describe(self, speed: float = 1.0) -> str:
+        """In words, at ``speed`` times the model's speeds."""
+        return f"{self.kind} of {self.element} at {self.frequency * speed:.6g} Hz"
 
 
 @dataclass(frozen=True)
@@ -86,14 +87,16 @@ class Period:
     def max_order(self) -> int:
         return max(self.orders, default=0)
 
-    def describe(self) -> str:
+    def describe(self, speed: float = 1.0) -> str:
+        """In words, at ``speed`` times the model's speeds (every frequency scales)."""
         if not self.sources:
             return "no time-varying excitation (any period; the steady state is static)"
         top = max(range(len(self.sources)), key=lambda i: self.orders[i])
         slow = min(range(len(self.sources)), key=lambda i: self.orders[i])
-        return (f"least common period {self.period:.6g} s (f0 = {self.frequency:.6g} Hz): "
-                f"{self.orders[top]} cycles of the {self.sources[top].describe()}, "
-                f"{self.orders[slow]} of the {self.sources[slow].describe()}")
+        return (f"least common period {self.period / speed:.6g} s (f0 = "
+                f"{self.frequency * speed:.6g} Hz): {self.orders[top]} cycles of the "
+                f"{self.sources[top].describe(speed)}, {self.orders[slow]} of the "
+                f"{self.sources[slow].describe(speed)}")
 
 
 def _varies(row: np.ndarray) -> bool:

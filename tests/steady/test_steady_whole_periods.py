@@ -1,0 +1,51 @@
+"""A steady state's table is over whole periods, at the step its meshes' cycles need."""
+
+import numpy as np
+import pytest
+
+from torquesplit import example_path
+from torquesplit.steady.api import steady_state
+from torquesplit.steady.problem import MESH_CYCLE_STEPS
+
+
+@pytest.fixture(scope="module")
+def mo_star():
+    """Mo et al. 2017's star reducer: three identical paths, 10 kHz meshes of constant
+    stiffness, errors turning with the gears (period 0.486 s, fastest error 666.7 Hz)."""
+    return steady_state(example_path("mo2017_star_reducer"), stability=False)
+
+
+def test_mean_force_sharing_of_identical_paths_is_one(mo_star):
+    """Over whole periods the three paths carry the same mean force (1e-12), so the
+    mean-force coefficients are 1; the record repeated twice and settled part-way gave
+    1.0003."""
+    rows = mo_star.mesh_table("mean_force")
+    means = np.array([r.mean_force for r in rows])
+    np.testing.assert_allclose(means[:3], means[0], rtol=1e-12)
+    for r in rows:
+        assert r.load_sharing == pytest.approx(1.0, abs=1e-9), r.mesh
+    met = mo_star.to_results().metrics("mean_force")
+    assert met.settling.settled and met.load_sharing.system == pytest.approx(1.0, abs=1e-9)
+
+
+def test_steps_resolve_the_cycles_of_a_constant_stiffness_mesh(mo_star):
+    """The errors alone would set 100 steps per 666.7 Hz cycle, 6.7 per 10 kHz mesh
+    cycle; the per-cycle statistics get at least MESH_CYCLE_STEPS per mesh cycle."""
+    st = mo_star
+    f_mesh = float(np.max(st.structure.frequency))
+    cycles = f_mesh * st.solution.period
+    assert cycles == pytest.approx(round(cycles)) and st.period.max_order * 100 < 10 * cycles
+    assert st.solution.mesh_t.size >= MESH_CYCLE_STEPS * round(cycles)
+
+
+def test_period_text_is_that_of_the_speed_solved():
+    """At 2/3 of the model's speed the period and every frequency in the text scale."""
+    from torquesplit.steady.period import fundamental_period
+
+    import torquesplit
+
+    s = torquesplit.assemble(torquesplit.load_model(example_path("ji_li_mill_drive")))
+    per = fundamental_period(s)
+    text = per.describe(2 / 3)
+    assert f"least common period {per.period * 1.5:.6g} s" in text
+    assert f"f0 = {per.frequency * 2 / 3:.6g} Hz" in text
