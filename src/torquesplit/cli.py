@@ -135,8 +135,10 @@ def _positive(value, option: str, example: str) -> None:
                           f"e.g. {option} {example}")
 
 
-def _check_plots_folder(plots: Optional[Path], option: str = "--plots") -> None:
-    """A figures folder must be a folder (or creatable), checked before computing."""
+def _check_plots_folder(plots: Optional[Path], option: str = "--plots", names=(),
+                        force: bool = True) -> None:
+    """A figures folder, checked before computing: a folder (or creatable) that files can
+    be written in, holding none of the figure files ``names`` unless ``force``."""
     if plots is None:
         return
     if plots.exists() and not plots.is_dir():
@@ -148,11 +150,41 @@ def _check_plots_folder(plots: Optional[Path], option: str = "--plots") -> None:
     if not parent.is_dir():
         raise OptionError(f"{option} {plots} cannot be created: {parent} is not a folder; "
                           f"give a folder for the figures")
+    from .results import files
+
+    try:
+        files.check_writable_folder(parent, plots)
+    except OSError as exc:
+        raise OptionError(f"{option}: {exc}") from None
+    existing = [] if force or not plots.is_dir() else [n for n in names
+                                                       if (plots / n).exists()]
+    if existing:
+        more = f" and {len(existing) - 1} more figure files" if len(existing) > 1 else ""
+        raise OptionError(f"{option} {plots} already holds {existing[0]}{more}; use --force "
+                          f"to replace the figures, or choose another folder")
 
 
-def _check_figure_file(path: Optional[Path], option: str, force: bool = True) -> None:
-    """A single figure file (``mesh --plot k.png``): a format matplotlib writes, in an
-    existing folder, checked before computing."""
+def _figure_error(exc: BaseException, option: str, target: Path, kept: str):
+    """A figure that could not be written after the computation: one line saying what
+    was kept (``kept``) and what to do."""
+    from .errors import OutputError
+
+    reason = getattr(exc, "strerror", None) or str(exc).strip() or type(exc).__name__
+    return OutputError(f"{option} {target}: cannot write the figures ({clip_message(reason)}); "
+                       f"{kept}; choose a folder you can write to")
+
+
+def _kept_results(saved) -> str:
+    """What a command that failed to write its figures kept."""
+    if saved:
+        return "results kept in " + ", ".join(str(f) for f in saved)
+    return "the results are printed but not saved (no --out)"
+
+
+def _check_figure_file(path: Optional[Path], option: str, force: bool = False) -> None:
+    """A single figure file (``mesh --plot k.png``), checked before computing: a format
+    matplotlib writes, in an existing folder that can be written, no existing file unless
+    ``force``."""
     if path is None:
         return
     from .results import files
@@ -167,19 +199,31 @@ def _check_figure_file(path: Optional[Path], option: str, force: bool = True) ->
 
 def _resolve_model_path(model: str) -> Path:
     """A file path, or the name of a shipped example (an old example name gives the new
-    one, with a note)."""
+    one, with a note); a missing file named like an example is refused naming it."""
     p = Path(model)
-    if p.exists() or p.suffix in (".toml", ".json"):
+    if p.exists():
         return p
     from .examples import current_name, example_names, example_path
 
     name, note = current_name(model)
-    if name in example_names():
+    if not p.suffix and name in example_names():
         if note:
             ux.warn(note, label="note")
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", FutureWarning)
             return example_path(name)
+    if p.parent == Path(".") and p.suffix.lower() in ("", ".toml", ".json"):
+        import difflib
+
+        names = {n.lower(): n for n in example_names()}
+        close = difflib.get_close_matches(p.stem.lower(), names, n=3, cutoff=0.6)
+        if close or not p.suffix:
+            from .errors import ModelError
+
+            hint = f"did you mean {' or '.join(names[c] for c in close)}? " if close else ""
+            raise ModelError([("", f"no such file or example; {hint}'torquesplit examples' "
+                                   f"lists the examples (current folder: {Path.cwd()})")],
+                             model)
     return p
 
 
@@ -193,6 +237,7 @@ def _load(model: str, assignments: Optional[list[str]] = None, *, deep: bool = F
     from .model.io import load_model, model_from_dict
 
     path = _resolve_model_path(model)
+    where: dict[str, str] = {}
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", ModelWarning)
         if assignments:
@@ -208,9 +253,11 @@ def _load(model: str, assignments: Optional[list[str]] = None, *, deep: bool = F
         else:
             m = load_model(path, check=False)
             check_model(m, source=str(path), deep=deep)
+    from .model.overrides import attribute_warning
+
     for w in caught:
         if issubclass(w.category, ModelWarning):
-            ux.warn(str(w.message))
+            ux.warn(attribute_warning(str(w.message), where, str(path)))
     return m, path
 
 
@@ -280,7 +327,8 @@ def run(
     method: Optional[str] = typer.Option(None, "--method", help="rk4 (fixed step) or dopri.",
                                          metavar="rk4|dopri"),
     steps_per_period: Optional[int] = typer.Option(
-        None, "--steps-per-period", help="RK4 steps per shortest mesh period (default 100).",
+        None, "--steps-per-period", help="RK4 steps per shortest mesh period (default: the model's "
+        "[analysis] steps_per_period, else 100).",
         metavar="N"),
     max_steps: Optional[int] = typer.Option(
         None, "--max-steps", help="Refuse an RK4 run needing more steps (default 2e8).",
@@ -290,7 +338,7 @@ def run(
     out: Optional[Path] = typer.Option(
         None, "--out", help="Write results: .nc (NetCDF), .mat (MATLAB) or .csv (three "
         "spreadsheet files: NAME.csv, NAME_history.csv, NAME_cycles.csv).", metavar="FILE"),
-    force: bool = _flag("--force", "Replace existing results files."),
+    force: bool = _flag("--force", "Replace existing results files and figures."),
     plots: Optional[Path] = typer.Option(None, "--plots", help="Write report figures (PNG, "
                                          "SVG) into this folder.", metavar="DIR"),
     assign: Optional[list[str]] = typer.Option(None, "--set", help=_SET_HELP,
@@ -298,8 +346,9 @@ def run(
     as_json: bool = _flag("--json", "Print metrics, statistics and warnings as JSON."),
     quiet: bool = _flag("--quiet", "No progress bar."),
     check: bool = _flag("--check-step", "Run again at half the step and report how many "
-                        "significant digits of every number hold (about three times the "
-                        "integration time)."),
+                        "significant digits of every number hold.  The second run takes twice "
+                        "the steps: about three times the integration time of a plain run in "
+                        "all."),
 ):
     """Static equilibrium, then the dynamic response: load sharing and dynamic factors.
 
@@ -335,6 +384,11 @@ def run(
                 stack.enter_context(files.claim_output(plan))
             m, path = _load(model, assign)
             chosen = _run_definition(m, definition)
+            if plots is not None and not force:
+                from .plot.figures import RUN_FIGURES, figure_files
+
+                _check_plots_folder(plots, names=figure_files(RUN_FIGURES, definition=chosen),
+                                    force=False)
             from .simulation import simulate
 
             with ux.collect_warnings(), ux.progress("integrating", quiet or as_json) as cb:
@@ -366,11 +420,23 @@ def run(
         if met is None:
             _render_stopped(res, saved, as_json)
             raise typer.Exit(1)
-        figures = []
+        figures, failed = [], None
         if plots is not None:
             state["figures"] = []
-            figures = _write_run_figures(res, plots, met.definition, quiet or as_json)
+            try:
+                figures = _write_run_figures(res, plots, met.definition, quiet or as_json)
+            except OSError as exc:
+                failed = _figure_error(exc, "--plots", plots, _kept_results(saved))
             state["figures"] = None
+    if failed is None:
+        _print_run(m, res, met, saved, figures, step_check, plots, as_json)
+    else:
+        _print_run(m, res, met, saved, [], step_check, None, as_json)
+        _fail(failed)
+
+
+def _print_run(m, res, met, saved, figures, step_check, plots, as_json) -> None:
+    """A finished run's tables (or JSON)."""
     if as_json:
         ux.emit_json({"model": m.model.name, "success": res.success,
                       "metrics": met.to_dict(), "statistics": res.statistics(),
@@ -563,14 +629,15 @@ def group_table(met) -> Table:
 @app.command()
 def static(
     model: str = typer.Argument(..., help=_MODEL_HELP, metavar="MODEL"),
-    revolutions: float = typer.Option(1.0, "--revolutions",
-                                      help="Revolutions of the slowest gear.", metavar="N"),
-    points_per_cycle: int = typer.Option(8, "--points-per-cycle",
-                                         help="Positions per cycle of the fastest mesh.",
-                                         metavar="N"),
+    revolutions: Optional[float] = typer.Option(
+        None, "--revolutions", help="Revolutions of the slowest gear (default: whole "
+        "periods of the errors and tables, at least one revolution).", metavar="N"),
+    points_per_cycle: int = typer.Option(32, "--points-per-cycle",
+                                         help="Positions per cycle of the fastest "
+                                         "excitation.", metavar="N"),
     out: Optional[Path] = typer.Option(None, "--out", help="Write results to this NetCDF "
                                        "file (.nc).", metavar="FILE"),
-    force: bool = _flag("--force", "Replace an existing results file."),
+    force: bool = _flag("--force", "Replace an existing results file and figures."),
     plots: Optional[Path] = typer.Option(None, "--plots", help="Write report figures (PNG, "
                                          "SVG) into this folder.", metavar="DIR"),
     assign: Optional[list[str]] = typer.Option(None, "--set", help=_SET_HELP,
@@ -586,9 +653,13 @@ def static(
     with contextlib.ExitStack() as stack, ux.interruptible(
             lambda: f"results kept in {state['saved']}" if state["saved"] else ""):
         try:
-            _positive(revolutions, "--revolutions", "1")
-            _at_least(points_per_cycle, 1, "--points-per-cycle", "8")
-            _check_plots_folder(plots)
+            if revolutions is not None:
+                _positive(revolutions, "--revolutions", "1")
+            _at_least(points_per_cycle, 1, "--points-per-cycle", "32")
+            if plots is not None:
+                from .plot.figures import STATIC_FIGURES, figure_files
+
+                _check_plots_folder(plots, names=figure_files(STATIC_FIGURES), force=force)
             if out is not None:
                 plan = files.check_output(out, formats=files.NETCDF_FORMATS, overwrite=force)
                 stack.enter_context(files.claim_output(plan))
@@ -610,12 +681,23 @@ def static(
         saved = state["saved"]
         met = res.metrics()
         orbits = res.orbits()
-        figures = []
+        figures, failed = [], None
         if plots is not None:
             from .plot import write_static_figures
 
-            with ux.progress("writing figures", quiet or as_json, total=None):
-                figures = write_static_figures(res, plots)
+            try:
+                with ux.progress("writing figures", quiet or as_json, total=None):
+                    figures = write_static_figures(res, plots)
+            except OSError as exc:
+                failed = _figure_error(exc, "--plots", plots,
+                                       _kept_results([saved] if saved else []))
+    _print_static(m, res, met, orbits, saved, figures, plots, as_json)
+    if failed is not None:
+        _fail(failed)
+
+
+def _print_static(m, res, met, orbits, saved, figures, plots, as_json) -> None:
+    """A quasi-static sweep's tables (or JSON)."""
     forces = res.mesh_forces()
     if as_json:
         ux.emit_json({
@@ -669,14 +751,15 @@ def mesh(
     pair: str = typer.Option(..., "--pair", help="Name of the mesh to inspect.", metavar="MESH"),
     plot: Optional[Path] = typer.Option(None, "--plot", help="Save k(phase) of every method "
                                         "(.png, .svg or .pdf).", metavar="FILE"),
+    force: bool = _flag("--force", "Replace an existing --plot file."),
     points: int = typer.Option(256, "--points", help="Samples per mesh cycle.", metavar="N"),
     as_json: bool = _flag("--json", "Print the comparison as JSON."),
 ):
     """Mesh stiffness k(phase) of one mesh by every applicable method, with the ISO value
-    (N/µm along the line of action, as in the figures)."""
+    (N/µm along the line of action, in the table and in the --plot figure)."""
     try:
         _at_least(points, 16, "--points", "256")
-        _check_figure_file(plot, "--plot")
+        _check_figure_file(plot, "--plot", force)
         m, _ = _load(model)
         if pair not in m.meshes:
             raise OptionError(f"--pair: no mesh named {pair!r}; use one of "
@@ -700,10 +783,22 @@ def mesh(
     except _EXPECTED as exc:
         _fail(exc)
         return
+    failed = None
     if plot is not None:
         from .plot.mesh import plot_mesh_stiffness
 
-        plot_mesh_stiffness(cmp, plot, title=f"{m.model.name}: mesh {pair}")
+        try:
+            plot_mesh_stiffness(cmp, plot, title=f"{m.model.name}: mesh {pair}")
+        except OSError as exc:
+            failed = _figure_error(exc, "--plot", plot, "the table is printed, nothing saved")
+            plot = None
+    _print_mesh(pair, cmp, plot, as_json)
+    if failed is not None:
+        _fail(failed)
+
+
+def _print_mesh(pair, cmp, plot, as_json) -> None:
+    """The mesh-stiffness comparison (or JSON)."""
     if as_json:
         ux.emit_json({"mesh": pair, "methods": cmp.rows(), "units": "N/m",
                       "iso_c_prime_N_per_mm_um": cmp.iso.c_prime_iso,
@@ -740,6 +835,7 @@ def contact(
                                      "(default the driven gear)."),
     plot: Optional[Path] = typer.Option(None, "--plot", help="Write the figures (PNG) into "
                                         "this folder.", metavar="DIR"),
+    force: bool = _flag("--force", "Replace existing figures in the --plot folder."),
     positions: Optional[int] = typer.Option(None, "--positions", help="Mesh positions per cycle.",
                                             metavar="N"),
     slices: Optional[int] = typer.Option(None, "--slices", help="Slices across the face.",
@@ -753,7 +849,10 @@ def contact(
     """Loaded tooth contact analysis of one mesh: transmission error, stiffness, load
     distribution, contact pressure, Harris map, meshing-in impact."""
     try:
-        _check_plots_folder(plot, "--plot")
+        if plot is not None:
+            from .plot.contact import contact_figure_files
+
+            _check_plots_folder(plot, "--plot", names=contact_figure_files(), force=force)
         _at_least(positions, 4, "--positions", "64")
         _at_least(slices, 2, "--slices", "40")
         _at_least(harris, 0, "--harris", "10")
@@ -790,17 +889,30 @@ def contact(
             impact = loaded_meshing_in(op, omega_driving=abs(drv.speed),
                                        inertia_driving=drv.polar_inertia,
                                        inertia_driven=dvn.polar_inertia)
-    except (TorquesplitError, ValueError) as exc:
+    except _EXPECTED as exc:
         _fail(exc)
         return
-    figures = []
+    figures, failed = [], None
     if plot is not None:
         from .plot.contact import write_contact_figures
 
         if hm is None:
             hm = cm.harris_map(loads)
-        figures = write_contact_figures(results, hm, plot, operating=op, operating_load=op_load,
-                                        title=f"{m.model.name} {pair}")
+        try:
+            figures = write_contact_figures(results, hm, plot, operating=op,
+                                            operating_load=op_load,
+                                            title=f"{m.model.name} {pair}")
+        except OSError as exc:
+            failed = _figure_error(exc, "--plot", plot, "the tables are printed, nothing saved")
+    _print_contact(m, pair, names, op_load, cm, results, hm, impact, op, figures, plot,
+                   as_json)
+    if failed is not None:
+        _fail(failed)
+
+
+def _print_contact(m, pair, names, op_load, cm, results, hm, impact, op, figures, plot,
+                   as_json) -> None:
+    """The loaded tooth contact analysis (or JSON)."""
     rows = [r.summary() for r in results]
     if as_json:
         ux.emit_json({
@@ -953,7 +1065,7 @@ def modes(
     as_json: bool = _flag("--json", "Print the modes, with their shapes, as JSON."),
     out: Optional[Path] = typer.Option(None, "--out", help="Write the modes and shapes to "
                                        "this NetCDF file.", metavar="FILE"),
-    force: bool = _flag("--force", "Replace an existing output file."),
+    force: bool = _flag("--force", "Replace an existing --out or --plot file."),
     campbell: bool = _flag("--campbell", "Resonance map over --from..--to."),
     start: Optional[str] = typer.Option(None, "--from", help="Campbell: first speed, e.g. "
                                         "'500 rpm' (a bare number is rad/s).", metavar="SPEED"),
@@ -970,7 +1082,7 @@ def modes(
 
     try:
         _at_least(count, 1, "--count", "20")
-        _check_figure_file(plot, "--plot")
+        _check_figure_file(plot, "--plot", force)
         limit = ux.quantity(below, "frequency", "--below")
         _positive(limit, "--below", "'5 kHz'")
         if out is not None:
@@ -1043,7 +1155,7 @@ def examples():
         label = name + ("\n(start here)" if name == FIRST_EXAMPLE else "")
         t.add_row(label, info.get("description", ""), info.get("reference", ""))
     console.print(t)
-    console.print("The names used before version 0.2 still work for a while: "
+    console.print("The earlier names still work, with a note: "
                   + ", ".join(f"{old} -> {new}" for old, new in RENAMED.items()),
                   highlight=False)
 

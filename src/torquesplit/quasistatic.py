@@ -124,11 +124,12 @@ hunting-tooth train can be thousands (the sweep then says what it covers)."""
 def quasi_static_load_sharing(model, *, revolutions: float | None = None,
                               points_per_cycle: int = 32, max_points: int = 20000,
                               progress=None) -> QuasiStaticResults:
-    """Equilibria over one common period of the excitations (default: errors, stiffness
-    and backlash tables, :func:`torquesplit.steady.period.fundamental_period`; at most
-    :data:`MAX_REVOLUTIONS` of the slowest gear, said when cut) or over ``revolutions`` of
-    the slowest gear (in its mesh's frame: relative to the carrier for a planet mesh), at
-    ``points_per_cycle`` positions per cycle of the fastest excitation (the fastest mesh
+    """Equilibria over whole common periods of the excitations (default: errors, stiffness
+    and backlash tables, :func:`torquesplit.steady.period.fundamental_period`), at least
+    one revolution of the slowest gear and at most :data:`MAX_REVOLUTIONS` (said when cut),
+    or over ``revolutions`` of the slowest gear (in its mesh's frame: relative to the
+    carrier for a planet mesh), at ``points_per_cycle`` positions per cycle of the fastest
+    excitation (the fastest mesh
     when nothing varies), at most ``max_points`` (said when that thins them).
 
     A shorter sweep sees only some of the error combinations: its largest ratios are too
@@ -171,8 +172,9 @@ def quasi_static_load_sharing(model, *, revolutions: float | None = None,
 
 
 def _excitation_period(structure, turn: float) -> float:
-    """The common period of the excitations [s], at most MAX_REVOLUTIONS x ``turn`` (one
-    revolution of the slowest gear; also when no common period exists), said when cut."""
+    """Whole common periods of the excitations [s] covering at least ``turn`` (one
+    revolution of the slowest gear: the orbits and figures go round once), at most
+    MAX_REVOLUTIONS x ``turn`` (also when no common period exists), said when cut."""
     from .steady.period import PeriodError, fundamental_period
 
     cap = MAX_REVOLUTIONS * turn
@@ -184,8 +186,8 @@ def _excitation_period(structure, turn: float) -> float:
         if per.frequency <= 0:  # nothing varies: every position is the same
             return turn
         period = 1.0 / per.frequency
-        if period <= cap * (1 + 1e-9):
-            return period
+        if period <= cap * (1 + 1e-9):  # whole periods, at least one revolution
+            return period * max(1, math.ceil(turn / period - 1e-9))
         why = (f"the excitations repeat only every {period / turn:.6g} revolutions of the "
                f"slowest gear")
     warnings.warn(f"{why}; the quasi-static sweep covers {MAX_REVOLUTIONS:g} of them: give "

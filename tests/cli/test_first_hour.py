@@ -272,7 +272,7 @@ def test_examples_have_names_users_know_and_old_names_still_work(tmp_path):
                  "jin2019_friction_split", "mo2017_star_reducer"):
         assert name in listing.stdout
     assert "(start here)" in listing.stdout
-    table = listing.stdout.split("The names used before")[0]
+    table = listing.stdout.split("The earlier names")[0]
     assert "seed0" not in table
     res = runner.invoke(app, ["example", "seed001_mill_drive", "--dir", str(tmp_path)])
     assert res.exit_code == 0, res.output

@@ -133,20 +133,44 @@ def attribute_errors(exc: ModelError, where: Mapping[str, str], source: str) -> 
     section that an override changed (``meshes.m`` for ``--set meshes.m.damping=...``)
     against the file *with* that argument; any other against the file (``source``).
     """
-    def cause(loc: str) -> str:
-        for path, text in where.items():
-            if loc == path or loc.startswith(path + "."):
-                return f"--set {clip_text(text)}"
-        for path, text in where.items():
-            if loc and path.startswith(loc + "."):
-                return f"{source} with --set {clip_text(text)}"
-        return source
-
-    causes = [cause(loc) for loc, _ in exc.issues]
+    causes = [_cause(loc, where, source) for loc, _ in exc.issues]
     if len(set(causes)) == 1:
         return ModelError(exc.issues, causes[0])
     return ModelError([(f"{c}: {loc}" if loc else c, msg)
                        for c, (loc, msg) in zip(causes, exc.issues)])
+
+
+def attribute_warning(text: str, where: Mapping[str, str], source: str) -> str:
+    """A warning ``"SOURCE: FIELD: message"`` reported against what caused it, as
+    :func:`attribute_errors` does for errors.
+
+    Examples
+    --------
+    >>> attribute_warning("m.toml: gears.g.errors.installation: 15 m is large",
+    ...                   {"gears.g.errors.installation": "gears.g.errors.installation=15"},
+    ...                   "m.toml")
+    '--set gears.g.errors.installation=15: gears.g.errors.installation: 15 m is large'
+    """
+    head = f"{source}: "
+    if not where or not text.startswith(head):
+        return text
+    loc, sep, msg = text[len(head):].partition(": ")
+    if not sep or not loc or " " in loc:  # a warning about the whole model
+        return text
+    return f"{_cause(loc, where, source)}: {loc}: {msg}"
+
+
+def _cause(loc: str, where: Mapping[str, str], source: str) -> str:
+    """Where an issue at field ``loc`` comes from: a ``--set`` argument that set it (or
+    a field above it), the file with the argument that changed its section, else the
+    file."""
+    for path, text in where.items():
+        if loc == path or loc.startswith(path + "."):
+            return f"--set {clip_text(text)}"
+    for path, text in where.items():
+        if loc and path.startswith(loc + "."):
+            return f"{source} with --set {clip_text(text)}"
+    return source
 
 
 def read_raw(source) -> dict:

@@ -184,6 +184,15 @@ def pressure_figure(result, title: str | None = None):
     return fig
 
 
+#: the figures ``write_contact_figures`` writes, each as ``contact_NAME.png``
+CONTACT_FIGURES = ("te", "harris", "load_distribution", "stiffness", "pressure")
+
+
+def contact_figure_files() -> list[str]:
+    """The file names :func:`write_contact_figures` writes."""
+    return [f"contact_{n}.png" for n in CONTACT_FIGURES]
+
+
 def write_contact_figures(results: Sequence, harris, directory, *, operating=None,
                           operating_load: float | None = None, title: str = "") -> list[Path]:
     """Write every figure as PNG into ``directory``; returns the paths.
@@ -205,8 +214,8 @@ def write_contact_figures(results: Sequence, harris, directory, *, operating=Non
         "pressure": pressure_figure(op, f"{prefix}contact pressure at {op.load / 1e3:.4g} kN"),
     }
     paths = []
-    for name, fig in figs.items():
-        path = directory / f"contact_{name}.png"
+    for name in CONTACT_FIGURES:
+        fig, path = figs[name], directory / f"contact_{name}.png"
         fig.savefig(path, dpi=120)
         paths.append(path)
     return paths

@@ -678,23 +678,42 @@ def write_figures(results, directory, formats=("png", "svg"), *,
     return write_jobs(jobs, directory, formats, prefix=prefix, dpi=dpi)
 
 
+#: file names (no suffix) of every figure a dynamic run may write, in order
+RUN_FIGURES = ("mesh_force", "mesh_force_end", "cycle_peak_force", "load_sharing_{definition}",
+               "dynamic_factors", "support_force_spectrum", "orbits", "mesh_stiffness")
+#: file names (no suffix) of every figure a quasi-static sweep may write, in order
+STATIC_FIGURES = ("static_mesh_force", "static_load_sharing", "static_orbits", "mesh_stiffness")
+
+
+def figure_files(names, formats=("png", "svg"), *, prefix: str = "",
+                 definition: str = "") -> list[str]:
+    """The file names ``write_jobs`` may write for ``names`` (:data:`RUN_FIGURES`,
+    :data:`STATIC_FIGURES`): what a command checks for before it computes.
+
+    >>> figure_files(STATIC_FIGURES[:1])
+    ['static_mesh_force.png', 'static_mesh_force.svg']
+    """
+    return [f"{prefix}{n.format(definition=definition)}.{f.lower().lstrip('.')}"
+            for n in names for f in formats]
+
+
 def figure_jobs(results, *, definition: str | None = None,
                 last_cycles: float = 5.0) -> list[tuple[str, Callable[[], Figure]]]:
     """``(file name, make figure)`` of every figure :func:`write_figures` writes for a
     dynamic run, in order (what :func:`write_jobs` and the HTML report draw)."""
     definition = results.metrics(definition).definition
-    jobs = [
-        ("mesh_force", lambda: mesh_force_figure(results)),
-        ("mesh_force_end", lambda: mesh_force_figure(results, last_cycles=last_cycles)),
-        ("cycle_peak_force", lambda: cycle_peak_figure(results)),
-        (f"load_sharing_{definition}", lambda: load_sharing_figure(results, definition)),
-        ("dynamic_factors", lambda: dynamic_factor_figure(results, definition)),
-        ("support_force_spectrum", lambda: support_spectrum_figure(results)),
-        ("orbits", lambda: orbit_figure(results)),
+    makers = [
+        lambda: mesh_force_figure(results),
+        lambda: mesh_force_figure(results, last_cycles=last_cycles),
+        lambda: cycle_peak_figure(results),
+        lambda: load_sharing_figure(results, definition),
+        lambda: dynamic_factor_figure(results, definition),
+        lambda: support_spectrum_figure(results),
+        lambda: orbit_figure(results),
+        lambda: mesh_stiffness_figure(results),
     ]
-    if _stiffness_varies(results):
-        jobs.append(("mesh_stiffness", lambda: mesh_stiffness_figure(results)))
-    return jobs
+    jobs = [(n.format(definition=definition), make) for n, make in zip(RUN_FIGURES, makers)]
+    return jobs if _stiffness_varies(results) else jobs[:-1]
 
 
 def write_static_figures(results, directory, formats=("png", "svg"), *, prefix: str = "",
@@ -713,14 +732,14 @@ def write_static_figures(results, directory, formats=("png", "svg"), *, prefix: 
 
 def static_figure_jobs(results) -> list[tuple[str, Callable[[], Figure]]]:
     """``(file name, make figure)`` of every figure of a quasi-static sweep."""
-    jobs = [
-        ("static_mesh_force", lambda: static_mesh_force_figure(results)),
-        ("static_load_sharing", lambda: static_load_sharing_figure(results)),
-        ("static_orbits", lambda: orbit_figure(results)),
+    makers = [
+        lambda: static_mesh_force_figure(results),
+        lambda: static_load_sharing_figure(results),
+        lambda: orbit_figure(results),
+        lambda: mesh_stiffness_figure(results),
     ]
-    if _stiffness_varies(results):
-        jobs.append(("mesh_stiffness", lambda: mesh_stiffness_figure(results)))
-    return jobs
+    jobs = list(zip(STATIC_FIGURES, makers))
+    return jobs if _stiffness_varies(results) else jobs[:-1]
 
 
 def _check_formats(formats) -> tuple[str, ...]:

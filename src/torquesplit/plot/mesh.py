@@ -17,6 +17,7 @@ def plot_mesh_stiffness(comparison, path, *, cycles: int = 2, title: str | None 
         the ISO 6336-1 mean mesh stiffness ``c_gamma b`` is drawn as a dashed line.
     path : str or Path
         Output file; the format follows the suffix (``.png``, ``.pdf``, ``.svg``).
+        Stiffness is drawn in N/µm (= 1e6 N/m), as ``torquesplit mesh`` prints it.
     cycles : int
         Number of mesh cycles to draw (the waveform repeats).
     title : str, optional
@@ -45,12 +46,12 @@ def plot_mesh_stiffness(comparison, path, *, cycles: int = 2, title: str | None 
     for lab, r in zip(labels, results):
         ph = np.concatenate([r.phase + c for c in range(cycles)] + [np.array([float(cycles)])])
         k = np.concatenate([r.stiffness] * cycles + [r.stiffness[:1]])
-        ax.step(ph, k / 1e8, where="post", label=f"{lab} (mean {r.mean:.3e} N/m)")
+        ax.step(ph, k / 1e6, where="post", label=f"{lab} (mean {r.mean / 1e6:.5g} N/µm)")
     if iso is not None:
-        ax.axhline(iso / 1e8, color="k", linestyle="--", linewidth=1.0,
-                   label=f"ISO 6336-1 $c_\\gamma b$ = {iso:.3e} N/m")
+        ax.axhline(iso / 1e6, color="k", linestyle="--", linewidth=1.0,
+                   label=f"ISO 6336-1 $c_\\gamma b$ = {iso / 1e6:.5g} N/µm")
     ax.set_xlabel("mesh phase [mesh cycles]")
-    ax.set_ylabel("mesh stiffness [$10^8$ N/m]")
+    ax.set_ylabel("mesh stiffness along the line of action [N/µm]")
     ax.set_xlim(0, cycles)
     ax.grid(True, alpha=0.3)
     fig.legend(loc="outside lower center", ncols=2, fontsize="small")

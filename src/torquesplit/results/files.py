@@ -156,9 +156,7 @@ def check_output(path, *, formats: dict[str, str] | None = None, overwrite: bool
     if not parent.is_dir():
         raise OutputError(f"cannot write {clip_text(str(path))}: {clip_text(str(parent))} is "
                           f"not a folder; choose a path in a folder")
-    if not os.access(parent, os.W_OK | os.X_OK):
-        raise OutputError(f"cannot write in the folder {clip_text(str(parent))} (permission "
-                          f"denied); choose a folder you can write to")
+    check_writable_folder(parent, path)
     fmt = formats[suffix]
     targets = companion_files(path, fmt)
     for f in targets:
@@ -170,6 +168,31 @@ def check_output(path, *, formats: dict[str, str] | None = None, overwrite: bool
         if (f.exists() or f.is_symlink()) and not overwrite:
             raise OutputError(f"{clip_text(str(f))} exists; {_OVERWRITE_HINT}")
     return OutputPlan(path=path, format=fmt, files=targets, overwrite=overwrite)
+
+
+def check_writable_folder(folder, target=None) -> None:
+    """Refuse a folder in which no file can be created, by creating (and removing) one.
+
+    ``os.access`` is not enough: it says yes to root, and to ``/proc`` or a read-only
+    mount.  ``target`` is the file the user named, for the message.
+    """
+    folder = Path(folder)
+    named = clip_text(str(target if target is not None else folder))
+    where = clip_text(str(folder))
+    if not os.access(folder, os.W_OK | os.X_OK):
+        reason = "permission denied"
+    else:
+        probe = folder / f".{Path(str(target or 'torquesplit')).name}.{secrets.token_hex(6)}.tmp"
+        try:
+            os.close(os.open(probe, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600))
+        except OSError as exc:
+            reason = exc.strerror or exc.__class__.__name__
+        else:
+            with contextlib.suppress(OSError):
+                os.unlink(probe)
+            return
+    raise OutputError(f"cannot write {named}: the folder {where} is not writable ({reason}); "
+                      f"choose a folder you can write to")
 
 
 # --------------------------------------------------------------------------- provenance
@@ -349,7 +372,14 @@ def _acquire(lock_path: Path, info: dict, target: Path) -> int:
         os.write(fd, text)
         return fd
     for _ in range(100):
-        fd = os.open(lock_path, os.O_RDWR | os.O_CREAT | getattr(os, "O_CLOEXEC", 0), 0o644)
+        try:
+            fd = os.open(lock_path, os.O_RDWR | os.O_CREAT | getattr(os, "O_CLOEXEC", 0),
+                         0o644)
+        except OSError as exc:
+            raise OutputError(f"cannot write {clip_text(str(target))}: the folder "
+                              f"{clip_text(str(lock_path.parent))} is not writable "
+                              f"({exc.strerror or exc}); choose a folder you can write "
+                              f"to") from None
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError as exc:

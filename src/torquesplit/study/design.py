@@ -223,8 +223,9 @@ def _analysis(spec: StudySpec) -> dict:
     a = spec.analysis
     out = {"type": a.type}
     if a.type == "static":
-        out["revolutions"] = 1.0 if a.revolutions is None else float(a.revolutions)
-        out["points_per_cycle"] = 8 if a.points_per_cycle is None else int(a.points_per_cycle)
+        # defaults: those of torquesplit static (whole periods of the errors and tables)
+        out["revolutions"] = None if a.revolutions is None else float(a.revolutions)
+        out["points_per_cycle"] = 32 if a.points_per_cycle is None else int(a.points_per_cycle)
         return out
     out["duration"] = (None if a.duration is None
                        else P.to_si(a.duration, "time", None, "analysis.duration"))
@@ -346,6 +347,11 @@ def _display_unit(values, unit: str | None) -> str | None:
     return None
 
 
+def _shown(v, unit: str | None) -> str:
+    """A start or stop value as the study file writes it (with the table's unit)."""
+    return f"{v:g} {unit}" if unit and not isinstance(v, str) else str(v)
+
+
 def _value(v, p: Parameter, unit, where) -> float:
     x = P.to_si(v, p.kind, unit, where)
     if p.mode == "set" and p.fields[0].integer and x != round(x):
@@ -369,6 +375,10 @@ def _grid(spec: StudySpec, raw: dict) -> Design:
             if t.num > 1 and a == b:
                 raise StudyError(f"{where}.stop", "equals 'start': the range is empty; give a "
                                                   "different stop, or 'values'")
+            if t.num == 1 and a != b:
+                raise StudyError(f"{where}.num", f"1 point but start {_shown(t.start, t.unit)} "
+                                                 f"!= stop {_shown(t.stop, t.unit)}; give "
+                                                 "num >= 2 or start = stop")
             if t.spacing == "log":
                 if a <= 0 or b <= 0:
                     raise StudyError(f"{where}.start", "a log range needs positive start and "

@@ -106,9 +106,11 @@ class AnalysisSpec(_Strict):
     steps_per_period: int | None = Field(None, ge=10, description="RK4 steps per period (run).")
     rtol: float | None = Field(None, gt=0, lt=1, description="Relative tolerance (dopri).")
     settle: SettleRule | None = Field(None, description="Stop-when-settled rule (run).")
-    revolutions: float | None = Field(None, gt=0, description="Revolutions (static), default 1.")
+    revolutions: float | None = Field(None, gt=0, description=(
+        "Revolutions of the slowest gear (static); default: whole periods of the errors "
+        "and tables, at least one revolution."))
     points_per_cycle: int | None = Field(None, ge=1, description=(
-        "Positions per mesh cycle (static), default 8."))
+        "Positions per cycle of the fastest excitation (static), default 32."))
 
     @model_validator(mode="after")
     def _fits_type(self):
@@ -347,7 +349,8 @@ def read_study(source) -> tuple[StudySpec, Path | None, str]:
         else:
             raise StudyError("", "no such study file (nor a shipped study of that name); "
                                  "check the path, or list shipped studies with "
-                                 "'torquesplit study --list'", str(source))
+                                 "'torquesplit study --list' (in Python: "
+                                 "torquesplit.study.shipped.study_names())", str(source))
     try:
         text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
