@@ -49,3 +49,20 @@ def test_period_text_is_that_of_the_speed_solved():
     text = per.describe(2 / 3)
     assert f"least common period {per.period * 1.5:.6g} s" in text
     assert f"f0 = {per.frequency * 2 / 3:.6g} Hz" in text
+
+
+def test_speed_with_its_unit():
+    """speed='3000 rpm' and speed='50 Hz' are the same speed (rad/s as a bare number)."""
+    import math
+
+    from torquesplit.errors import SolverError
+    from torquesplit.steady.api import reference_speed, speed_factor
+
+    import torquesplit
+
+    m = torquesplit.load_model(example_path("ji_li_mill_drive"))
+    w = 100 * math.pi
+    assert speed_factor(m, "3000 rpm") == pytest.approx(w / reference_speed(m), rel=1e-12)
+    assert speed_factor(m, "50 Hz") == pytest.approx(speed_factor(m, w), rel=1e-12)
+    with pytest.raises(SolverError, match="speed"):
+        speed_factor(m, "3000 mm")

@@ -62,13 +62,20 @@ def reference_speed(model) -> float:
 
 
 def speed_factor(model, speed) -> float:
-    """Speed factor of an input speed [rad/s] (None: 1)."""
+    """Speed factor of an input speed: rad/s, or a string with its unit ('3000 rpm',
+    '50 Hz': revolutions per second); None: 1."""
     if speed is None:
         return 1.0
-    s = abs(float(speed)) / reference_speed(model)
+    from torquesplit.model.units import parse_quantity
+
+    try:
+        value = parse_quantity(speed, "speed")
+    except ValueError as exc:
+        raise SolverError(f"speed: {exc}") from None
+    s = abs(value) / reference_speed(model)
     if not (s > 0 and math.isfinite(s)):
-        raise SolverError(f"speed {speed!r} rad/s is not a positive finite speed; give e.g. "
-                          f"speed=300.0 (rad/s) or '3000 rpm' on the command line.")
+        raise SolverError(f"speed {speed!r} is not a positive finite speed; give e.g. "
+                          f"speed='3000 rpm' or speed=314.16 (rad/s).")
     return s
 
 
@@ -191,7 +198,7 @@ class SteadyState:
 
 
 def steady_state(model, *, method: str = "auto", harmonics: int | None = None,
-                 samples: int | None = None, keep=None, speed: float | None = None,
+                 samples: int | None = None, keep=None, speed: float | str | None = None,
                  max_cycles: int | None | str = "auto", stability: bool | str = True,
                  adaptive: bool | None = None, energy_tol: float = ENERGY_TOL,
                  tol: float | None = None, steps_per_cycle: int | None = None,
@@ -228,8 +235,9 @@ def steady_state(model, *, method: str = "auto", harmonics: int | None = None,
         Longest period accepted, in cycles of the fastest excitation; None: no limit;
         "auto" (default): 1000 for harmonic balance, 10,000 for shooting and "auto"
         (:func:`~torquesplit.steady.period.default_max_cycles`).
-    speed : float, optional
-        Input speed of the first drive [rad/s] (default the model's).  Torques are kept
+    speed : float or str, optional
+        Input speed of the first drive: rad/s, or a string with its unit ('3000 rpm',
+        '50 Hz' = 50 revolutions per second) (default the model's).  Torques are kept
         (a speed change at constant load); excitation tables are functions of the mesh
         phase and stay.
     stability : bool or "hill" or "monodromy"
