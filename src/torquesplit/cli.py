@@ -129,6 +129,13 @@ def _at_least(value, minimum, option: str, example: str) -> None:
                           f"{value}; give e.g. {option} {example}")
 
 
+def _one_run_length(duration, cycles) -> None:
+    """Refuse ``--duration`` with ``--cycles``: both set the run length."""
+    if duration is not None and cycles is not None:
+        raise OptionError(f"--cycles {cycles} and --duration {duration} both set the run "
+                          "length; give only one of them")
+
+
 def _positive(value, option: str, example: str) -> None:
     if value is not None and not (value > 0 and math.isfinite(value)):
         raise OptionError(f"{option} must be a positive finite number, got {value}; give "
@@ -371,6 +378,7 @@ def run(
         try:
             if method is not None and method not in ("rk4", "dopri"):
                 raise OptionError(f"--method {method!r} is unknown; use rk4 or dopri")
+            _one_run_length(duration, cycles)
             dur = ux.quantity(duration, "time", "--duration")
             _positive(dur, "--duration", "'0.5 s'")
             _at_least(cycles, 1, "--cycles", "200")
@@ -582,9 +590,10 @@ def _render_run(res, met, saved) -> None:
         f"{DEFINITION_USE[met.definition]}.  Dynamic factor = settled peak / the mesh's own "
         f"static force (K_v sense, >= 1 in contact); peak/nominal = settled peak / "
         f"equal-split nominal force (Ji & Li eq. 19) = load sharing and dynamics together.  "
-        f"Contact loss: drive flanks apart (a mesh with no backlash cannot lose contact: it "
-        f"is in double-flank contact); back flank: time in back-flank contact and its "
-        f"largest force.",
+        f"Contact loss: share of the whole run (start-up included) with the drive flanks "
+        f"apart (a mesh with no backlash cannot lose contact: it is in double-flank "
+        f"contact); back flank: share of the whole run in back-flank contact, and the "
+        f"largest settled back-flank force.",
         markup=False, highlight=False)
     if saved:
         console.print("results written to " + ", ".join(str(f) for f in saved),

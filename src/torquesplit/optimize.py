@@ -27,7 +27,7 @@ The optimisation file (TOML)::
 
     [[variables]]                    # any model path; tables on the way are created
     path = "gears.L6.modifications.topological.y1"
-    lower = "0 mm"                   # quantities with units, or SI numbers
+    lower = "0 mm"                   # as in the model file: units, or SI numbers
     upper = "0.06 mm"
     also = ["gears.L7.modifications.topological.y1"]   # set to the same value
 
@@ -124,10 +124,30 @@ class OptimizationSpec:
     base_dir: Path = field(default_factory=Path.cwd)
 
 
-def _si(value, where: str) -> float:
+def _kind(path) -> str | None:
+    """The quantity kind of the model field at ``path`` ("speed"...), None if unknown."""
+    from .errors import TorquesplitError
+    from .study.paths import schema_field
+
+    try:
+        return schema_field(str(path), "path").kind
+    except (TorquesplitError, ValueError, TypeError):
+        return None  # not a schema field: refused by name when the model is built
+
+
+def _si(value, where: str, kind: str | None = None) -> float:
+    """``value`` in SI units: read as a quantity of ``kind`` (a speed in Hz counts
+    revolutions, as in the model file) when the field's kind is known."""
     if isinstance(value, bool):
         raise ModelError([(where, f"must be a number or a quantity, got {value!r}; write e.g. "
                                   "'0.05 mm'")])
+    if kind is not None:
+        from .model.units import parse_quantity
+
+        try:
+            return parse_quantity(value, kind)
+        except ValueError as exc:
+            raise ModelError([(where, str(exc))]) from None
     if isinstance(value, (int, float)):
         return float(value)
     from .model.units import registry
@@ -201,7 +221,9 @@ def read_spec(source) -> OptimizationSpec:
         if not isinstance(v, dict) or "path" not in v or "lower" not in v or "upper" not in v:
             issues.append((where, "needs path, lower and upper; add them"))
             continue
-        lo, hi = _si(v["lower"], f"{where}.lower"), _si(v["upper"], f"{where}.upper")
+        kind = _kind(v["path"])
+        lo = _si(v["lower"], f"{where}.lower", kind)
+        hi = _si(v["upper"], f"{where}.upper", kind)
         if not lo < hi:
             issues.append((f"{where}.upper", f"must exceed lower ({lo:g}); correct the bounds"))
         unknown = sorted(set(v) - {"path", "lower", "upper", "also"})

@@ -66,3 +66,37 @@ def test_speed_with_its_unit():
     assert speed_factor(m, "50 Hz") == pytest.approx(speed_factor(m, w), rel=1e-12)
     with pytest.raises(SolverError, match="speed"):
         speed_factor(m, "3000 mm")
+
+
+def test_steady_out_keeps_an_existing_file_unless_forced(tmp_path):
+    """`steady --out` on an existing file is refused before solving, as `run --out` is;
+    --force replaces it."""
+    from typer.testing import CliRunner
+
+    from torquesplit.cli import app
+
+    out = tmp_path / "s.nc"
+    out.write_bytes(b"keep me")
+    args = ["steady", "ji_li_mill_drive", "--keep", "stage1", "--no-stability", "--out",
+            str(out)]
+    runner = CliRunner()
+    refused = runner.invoke(app, args)
+    assert refused.exit_code == 2 and "--force" in refused.output
+    assert out.read_bytes() == b"keep me"
+    done = runner.invoke(app, args + ["--force"])
+    assert done.exit_code == 0, done.output
+    assert out.read_bytes() != b"keep me"
+
+
+def test_resonance_map_orders_follow_the_stiffness_spectrum():
+    """A rectangular single/double contact wave of duty 0.6 still has 9 % of its
+    fundamental at the 7th harmonic: the map's mesh lines go that far (at most 10, at
+    least 3 for a constant stiffness)."""
+    from torquesplit.steady.maps import MAX_ORDERS, MIN_ORDERS, mesh_orders
+
+    phase = np.arange(256) / 256
+    wave = np.where(phase < 0.6, 1.1, 1.0)
+    assert mesh_orders(wave) >= 7
+    assert mesh_orders(np.ones(256)) == MIN_ORDERS
+    assert mesh_orders(np.where(phase < 0.5, 1.1, 1.0) + 0 * phase) <= MAX_ORDERS
+    assert mesh_orders(1.0 + 0.1 * np.cos(2 * np.pi * phase)) == MIN_ORDERS

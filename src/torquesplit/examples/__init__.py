@@ -24,8 +24,8 @@ name                               system (paper)
 
 ``optimize/liu2021_dh_modification`` is an optimisation file (``torquesplit optimize``).
 
-The names used before version 0.2 (``seed000_split_torque`` ...) still work for a while:
-:func:`example_path` maps them to the new names with a :class:`FutureWarning`
+The earlier names (``seed000_split_torque`` ...) still work, with a note:
+:func:`example_path` maps them to the current names with a :class:`FutureWarning`
 (:data:`RENAMED`).
 """
 
@@ -36,7 +36,7 @@ import warnings
 from importlib import resources
 from pathlib import Path
 
-#: names used before version 0.2 -> their current names (accepted with a FutureWarning)
+#: the earlier names -> the current names (still accepted, with a FutureWarning)
 RENAMED = {
     "seed000_split_torque": "liu2021_split_torque_helicopter",
     "seed001_mill_drive": "ji_li_mill_drive",
@@ -64,8 +64,8 @@ def example_names() -> list[str]:
 
 
 def current_name(name: str, renamed: dict[str, str] | None = None) -> tuple[str, str | None]:
-    """``(current name, note)`` of an example name: a name used before version 0.2 gives
-    its new name and a note saying so (None for a current name).
+    """``(current name, note)`` of an example name: an earlier name (``seed001_mill_drive``)
+    gives its current name and a note saying so (None for a current name).
 
     Examples
     --------
@@ -86,8 +86,8 @@ def current_name(name: str, renamed: dict[str, str] | None = None) -> tuple[str,
 def example_path(name: str) -> Path:
     """Path of a shipped example model file.
 
-    A name used before version 0.2 (:data:`RENAMED`) gives the renamed file with a
-    :class:`FutureWarning`.
+    An earlier name (:data:`RENAMED`: ``seed000_split_torque`` ...) still works: it gives
+    the renamed file, with a :class:`FutureWarning`.
 
     Raises
     ------

@@ -23,9 +23,8 @@ Jia et al. 2021 eqs. 1-2) and :func:`eccentricity_installation_error_difference_
 (the gears' terms subtracted: Dong, Zhang, Zhao & Duan 2021 eq. 11) reproduce the
 papers' expressions literally, for comparison and for the example models.  Their
 differences from the physical form are listed in their docstrings and in
-docs/theory/excitations.md.  (Before version 0.2 they were called
-``seed000_mesh_error`` and ``seed002_mesh_error``; those names still work, with a
-FutureWarning.)
+docs/theory/excitations.md.  (Their earlier names, ``seed000_mesh_error`` and
+``seed002_mesh_error``, still work, with a FutureWarning.)
 
 Sources: Liu et al. 2021 eqs. 1-2; Dong et al. 2021 eq. 11; Mo, Ma, Jin et al. 2017
 section 4 (tooth thickness, pitch, bearing errors as equivalent linear/angular meshing

@@ -43,7 +43,8 @@ def check_plan(plan) -> None:
     if a["type"] == "static":
         raise GpuUnsupportedError(
             "quasi-static analyses ([analysis] type = \"static\")",
-            "run this study with the CPU backend (leave out --backend gpu)")
+            "run this study with the CPU backend (backend='cpu'; on the command line, "
+            "leave out --backend gpu)")
     if a.get("method") not in (None, "rk4"):
         raise GpuUnsupportedError(
             f"adaptive time stepping (method = {a['method']!r})",
@@ -367,9 +368,9 @@ def make_gpu_runner(*, precision: str = "fp64", batch: int = BATCH,
 
     ok, why = cuda_available()
     if not ok:
-        msg = (f"--backend gpu: {why}; the study runs on the CPU runner instead (same "
-               "results, CPU speed). Run it on a machine with an NVIDIA GPU for the GPU "
-               "backend.")
+        msg = (f"backend='gpu' (--backend gpu): {why}; the study runs on the CPU runner "
+               "instead (same results, CPU speed). Run it on a machine with an NVIDIA GPU "
+               "for the GPU backend.")
         log.info(msg)
         warnings.warn(msg, GpuFallbackWarning, stacklevel=3)
         return None

@@ -272,9 +272,21 @@ def geometry_issues(model: Model) -> list[tuple[str, str]]:
             cylindrical_pair(ga, gb).operating_center_distance  # noqa: B018 - validates
         except ModelError as exc:
             for _, msg in exc.issues:
-                msg = re.sub(r"\b(pinion|wheel)\b", lambda m: role[m.group()], msg)
+                msg = _ROLE.sub(lambda m: _gear_named(role[m[1]], m[2]), msg)
                 issues.append((f"meshes.{name}", f"gears {a!r} and {b!r}: {_teach(msg)}"))
     return issues
+
+
+#: "the pinion", "the wheel's", "its pinion", "the wheel tip" in a pair's messages
+_ROLE = re.compile(r"\b(?:(?:the|its) )?(pinion|wheel)\b('s| tip| profile shift| addendum)?")
+
+
+def _gear_named(name: str, tail: str | None) -> str:
+    """A gear's name where a pair's message says pinion or wheel: "b1's tip", not
+    "the b1 tip"."""
+    if tail is None:
+        return name
+    return f"{name}'s" + ("" if tail == "'s" else tail)
 
 
 def modification_issues(model: Model) -> list[tuple[str, str]]:

@@ -97,7 +97,12 @@ characters.
 Angles are the usual trap: a bare number is in **radians**, so write
 `pressure_angle = "20 deg"`, not `20` (a pressure or helix angle of 20 rad is refused
 with a hint; other angles, such as a placement angle, cannot be checked).  Inside
-torquesplit every value is SI.  The kinds of quantity:
+torquesplit every value is SI.
+
+Speeds and frequencies: a speed written in Hz (or `1/s`, `rps`, `kHz`) counts
+revolutions, so `speed = "50 Hz"` is 3000 rpm (2 pi x 50 rad/s); a bare number is rad/s
+(`speed = 50` is 477.5 rpm).  A frequency written in rpm or rad/s is converted the same
+way (`"12000 rpm"` is 200 Hz).  `"pi/s"` is refused as ambiguous.  The kinds of quantity:
 """
 
 

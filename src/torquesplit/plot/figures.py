@@ -342,8 +342,9 @@ def support_spectrum_figure(results, *, start_time: float | None = None, orders:
         Smallest amplitude shown on a log axis, relative to the largest.
     bodies : iterable of str, optional
         Supported bodies to show, one panel each.  Default: the ``max_panels`` bodies
-        with the strongest dynamic support force; the title names how many more there
-        are (``bodies=`` shows any of them).
+        with the largest spectral line, and any as large as the smallest of them (up to
+        twice ``max_panels``); the title names those not drawn (``bodies=`` shows any of
+        them).
     max_panels : int
         Largest number of panels drawn by default.
     content_range : float
@@ -434,12 +435,7 @@ def support_spectrum_figure(results, *, start_time: float | None = None, orders:
                 if largest > 0 and (a > content_range * largest).any()]
         content = max(tops) if tops else f_cap
         f_top = min(f_cap, max(1.25 * content, 1.5 * min(mesh_f)))
-    shown = list(supports)
-    hidden: list[str] = []
-    if not chosen and len(shown) > max_panels:
-        shown = sorted(shown, key=lambda b: -strength[b])[:max_panels]
-        hidden = [b for b in supports if b not in shown]
-        shown = [b for b in supports if b in shown]  # model order
+    shown, hidden = _strongest(strength, max_panels) if not chosen else (list(supports), [])
     fscale, funit = (1e-3, "kHz") if f_top >= 1e4 else (1.0, "Hz")
     show = freq <= f_top
     ncols = 1 if len(shown) <= max(4, max_panels) else 2
@@ -489,11 +485,31 @@ def support_spectrum_figure(results, *, start_time: float | None = None, orders:
         _label(ax, f"frequency [{funit}]", "force amplitude [N]")
         _legend(ax)
     span = grid.size * dt
-    more = (f"\n{len(hidden)} weaker supports not drawn: {', '.join(hidden)}"
-            if hidden else "")
+    least = min((strength[b] for b in shown), default=0.0)
+    smaller = [b for b in hidden if strength[b] < (1.0 - 1e-3) * least]
+    others = [b for b in hidden if b not in smaller]
+    more = ((f"\nnot drawn (smaller forces): {', '.join(smaller)}" if smaller else "")
+            + (f"\nnot drawn ({len(shown)} panels at most; bodies= chooses): "
+               f"{', '.join(others)}" if others else ""))
     _suptitle(fig, results, f"support force spectrum\n{grid[0]:.4g} s ≤ t < "
                             f"{grid[0] + span:.4g} s, resolution {1 / span:.3g} Hz{more}")
     return fig
+
+
+def _strongest(strength: dict[str, float], max_panels: int,
+               tie: float = 1e-3) -> tuple[list[str], list[str]]:
+    """``(shown, hidden)`` bodies, both in model order: the ``max_panels`` with the largest
+    line, and any as large as the smallest of those (within ``tie``, relative: a
+    symmetric twin is drawn, not called weaker)."""
+    if len(strength) <= max_panels:
+        return list(strength), []
+    ranked = sorted(strength, key=lambda b: -strength[b])
+    cut = strength[ranked[max_panels - 1]]
+    keep = set(ranked[:max_panels])
+    if cut > 0.0:
+        keep |= {b for b in ranked[max_panels:2 * max_panels]
+                 if strength[b] >= (1.0 - tie) * cut}
+    return [b for b in strength if b in keep], [b for b in strength if b not in keep]
 
 
 def _peak_pool(freq: np.ndarray, amp: np.ndarray, max_points: int):

@@ -12,7 +12,7 @@ mesh                red arrow: the line of action through the pitch point, point
                     the force the driver exerts on the driven gear; blue arrow: the power
                     flow, driver towards driven; mesh name, backlash if any
 shaft               thick grey line between the centres of the bodies it joins (rigid:
-                    solid, elastic: with a spring zig-zag); name
+                    solid, elastic: dashed); name
 spline              dashed line; name and radial clearance
 support             ground hatch below the body; stiffness, clearance if any
 other body          square (motor, load inertia, carrier); name
@@ -44,6 +44,9 @@ from matplotlib.figure import Figure
 
 __all__ = ["layout_figure", "layout_svg"]
 
+#: rigid shafts solid, elastic ones in short dashes (in line widths: 1.5 on, 1 off),
+#: short enough to show on the shortest shaft
+_SHAFT_STYLE = {"rigid": "-", "elastic": (0, (1.5, 1.0))}
 #: colours of the sketch
 COLORS = {"gear": "0.15", "loa": "tab:red", "power": "tab:blue", "shaft": "0.55",
           "spline": "tab:orange", "support": "0.35", "drive": "tab:green", "load": "tab:purple",
@@ -191,9 +194,9 @@ def layout_figure(model, kin=None, *, width: float = 10.0) -> Figure:
     # ---- shafts and splines
     for name, s in model.shafts.items():
         a, b = (proj(centre[x]) for x in s.connects)
-        style = "-" if s.rigid else (0, (6, 2))
-        ax.plot([a[0], b[0]], [a[1], b[1]], color=COLORS["shaft"], lw=4.0, ls=style,
-                solid_capstyle="round", zorder=2, alpha=0.8)
+        ax.plot([a[0], b[0]], [a[1], b[1]], color=COLORS["shaft"], lw=4.0,
+                ls=_SHAFT_STYLE["rigid" if s.rigid else "elastic"], solid_capstyle="round",
+                zorder=2, alpha=0.8)
         m = (a + b) / 2
         what = "rigid" if s.rigid else "elastic"
         ax.annotate(f"shaft {name} ({what})", m, xytext=(6, 2), textcoords="offset points",
@@ -262,7 +265,10 @@ def layout_figure(model, kin=None, *, width: float = 10.0) -> Figure:
     ax.plot([], [], color=COLORS["loa"], lw=1.6, label="line of action (force on the driven "
             "gear)")
     ax.plot([], [], color=COLORS["power"], lw=1.2, label="power flow (driver to driven)")
-    ax.plot([], [], color=COLORS["shaft"], lw=4, label="shaft (dashed: elastic)")
+    for what in ("rigid", "elastic"):  # a key entry drawn as the shafts are
+        if any(sh.rigid == (what == "rigid") for sh in model.shafts.values()):
+            ax.plot([], [], color=COLORS["shaft"], lw=4, ls=_SHAFT_STYLE[what],
+                    alpha=0.8, label=f"shaft, {what}")
     if model.splines:
         ax.plot([], [], color=COLORS["spline"], lw=2, ls="--", label="spline")
     if supported:

@@ -174,6 +174,7 @@ def _report_inputs(h, ux, source, assign, duration, cycles, definition, quiet):
         for note in res.model_warnings or []:
             ux.warn(note)
         return res, None, attrs, _quasi_if_static(res.model, ux, quiet)
+    h._one_run_length(duration, cycles)
     m, model_path = h._load(source, assign)
     dur = ux.quantity(duration, "time", "--duration")
     h._positive(dur, "--duration", "'0.5 s'")

@@ -56,12 +56,14 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
                                         "static equilibrium displacement"),
             "contact_loss_fraction": _var(("element",),
                                           s.separation_fraction[list(s.history_elements)], "1",
-                                          "fraction of the run with the element inside its "
-                                          "dead zone (drive flank separated)"),
+                                          "fraction of the whole run (start-up included) with "
+                                          "the element inside its dead zone (drive flank "
+                                          "separated)"),
             "back_contact_fraction": _var(("element",),
                                           s.back_contact_fraction[list(s.history_elements)],
-                                          "1", "fraction of the run in back-flank contact "
-                                          "(mesh without backlash: tensile force)"),
+                                          "1", "fraction of the whole run (start-up included) "
+                                          "in back-flank contact (mesh without backlash: "
+                                          "tensile force)"),
         },
         coords={
             "time": _var(("time",), s.history_t, "s", "time"),
@@ -78,6 +80,7 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
                                   "displacement from the nominal rigid motion")
         ds["velocity"] = _var(("time", "history_dof"), s.history_v, "m/s or rad/s",
                               "vibratory velocity")
+    _note_sampling(ds, s.history_t, res.statistics().get("step_s"))
     try:
         met = res.metrics(definition)
         ds["load_sharing"] = _var(("mesh",), [met.load_sharing.per_mesh[m] for m in meshes],
@@ -91,7 +94,7 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
                                      "eq. 19)")
         ds["back_flank_force"] = _var(("mesh",), [r.back_flank_force for r in met.rows], "N",
                                       "largest back-flank (tensile) force over the settled "
-                                      "part")
+                                      "cycles")
         ds["double_flank"] = _var(("mesh",), [int(r.double_flank) for r in met.rows], "1",
                                   "1: the mesh has no backlash (double-flank contact)")
         ds.attrs["load_sharing_definition"] = met.definition
@@ -114,6 +117,24 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
         "software": "torquesplit",
     })
     return ds
+
+
+def _note_sampling(ds: xr.Dataset, t, step) -> None:
+    """Say on each history variable that it is decimated, and its sample interval [s]."""
+    t = np.asarray(t, dtype=float)
+    if t.size < 2:
+        return
+    dt = float(np.median(np.diff(t)))
+    steps = (f"the integration step is {step:.4g} s" if step else "adaptive integration "
+             "steps")
+    note = (f"decimated history for plots, sampled every {dt:.4g} s ({steps}); the metrics "
+            "come from statistics of every step")
+    if step and dt < 1.5 * step:
+        note = f"history of every integration step ({dt:.4g} s)"
+    for name in ("element_force", "displacement", "velocity"):
+        if name in ds:
+            ds[name].attrs.update(sampling=note, sample_interval=dt,
+                                  sample_interval_units="s")
 
 
 def results_from_dataset(ds: xr.Dataset):

@@ -24,12 +24,13 @@ def _speed(text, what):
     return quantity(text, "speed", what)
 
 
-def _check_out(path, formats=None):
-    """Check an output path before computing (folder, suffix, an existing file)."""
+def _check_out(path, formats=None, force=False):
+    """Check an output path before computing (folder, suffix, an existing file: kept
+    unless --force)."""
     from torquesplit.results import files
 
     if path is not None:
-        files.check_output(path, formats=formats, overwrite=True)
+        files.check_output(path, formats=formats, overwrite=force)
 
 
 def _emit(data, json_default):
@@ -82,6 +83,7 @@ def register(app, load, fail, console, err_console, json_default):
             "state. Over a period of thousands of cycles the monodromy (2n variational "
             "columns) can take most of the run."),
         out: Optional[Path] = typer.Option(None, "--out", help="Write results (.nc, .mat, .csv)."),
+        force: bool = typer.Option(False, "--force", help="Replace an existing --out file."),
         as_json: bool = typer.Option(False, "--json", help="Print the results as JSON."),
         steps_per_cycle: Optional[int] = typer.Option(
             None, "--steps-per-cycle", help="Shooting: RK4 steps per cycle of the fastest "
@@ -101,7 +103,7 @@ def register(app, load, fail, console, err_console, json_default):
                                        f"got {steps_per_cycle}")
             from torquesplit.steady.api import steady_state
 
-            _check_out(out)
+            _check_out(out, force=force)
             m, _ = load(model)
             from torquesplit.cli_support import collect_warnings, progress
 
@@ -113,7 +115,8 @@ def register(app, load, fail, console, err_console, json_default):
                                   stability=stability, steps_per_cycle=steps_per_cycle,
                                   progress=update)
             rows = st.mesh_table()
-            saved = st.to_results().save(out) if out is not None else None
+            saved = (st.to_results().save(out, overwrite=force) if out is not None
+                     else None)
             step_check = None
             if check:
                 from torquesplit.convergence import check_steady
@@ -206,6 +209,8 @@ def register(app, load, fail, console, err_console, json_default):
                                          help="Also run-up and run-down time integrations."),
         out: Optional[Path] = typer.Option(None, "--out", help="Write the Dataset (.nc)."),
         plot: Optional[Path] = typer.Option(None, "--plot", help="Write the figure (.png/.svg)."),
+        force: bool = typer.Option(False, "--force", help="Replace existing --out / --plot "
+                                   "files."),
         as_json: bool = typer.Option(False, "--json", help="Print a summary as JSON."),
     ):
         """Speed response by continuation: dynamic factor, load sharing, RMS TE vs speed."""
@@ -216,9 +221,9 @@ def register(app, load, fail, console, err_console, json_default):
             from torquesplit.results.files import NETCDF_FORMATS
             from torquesplit.steady.maps import sweep_speed
 
-            _check_out(out, NETCDF_FORMATS)
+            _check_out(out, NETCDF_FORMATS, force)
             if plot is not None:
-                _check_out(plot, {".png": "png", ".svg": "svg", ".pdf": "pdf"})
+                _check_out(plot, {".png": "png", ".svg": "svg", ".pdf": "pdf"}, force)
             m, _ = load(model)
             from torquesplit.cli_support import collect_warnings, progress
 
@@ -231,7 +236,7 @@ def register(app, load, fail, console, err_console, json_default):
             fail(exc)
             return
         if out is not None:
-            _to_netcdf(ds, out)
+            _to_netcdf(ds, out, force)
         if plot is not None:
             from torquesplit.steady.plot import save, sweep_figure
 
@@ -272,7 +277,7 @@ def register(app, load, fail, console, err_console, json_default):
 import numpy as np  # noqa: E402  (used by the commands above)
 
 
-def _to_netcdf(ds, path):
+def _to_netcdf(ds, path, overwrite=False):
     """Write atomically (complete or absent; see torquesplit.results.files)."""
     from torquesplit.results import files
 
@@ -280,7 +285,7 @@ def _to_netcdf(ds, path):
     for k, v in list(ds.attrs.items()):
         if isinstance(v, list):
             ds.attrs[k] = json.dumps(v)
-    files.write_atomically(path, files.netcdf_bytes(ds), overwrite=True,
+    files.write_atomically(path, files.netcdf_bytes(ds), overwrite=overwrite,
                            formats=files.NETCDF_FORMATS)
 
 

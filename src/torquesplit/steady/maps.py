@@ -199,9 +199,10 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
     return ds
 
 
-def critical_speeds(structure, q, kin, model, w_lo, w_hi, orders=3):
+def critical_speeds(structure, q, kin, model, w_lo, w_hi, orders=None):
     """Natural frequencies about ``q`` and their crossings with the mesh-frequency
-    harmonics (orders 1..``orders``) of every mesh and the rotation of every gear,
+    harmonics (orders 1..``orders``; None: :func:`mesh_orders` of each mesh's stiffness
+    table) of every mesh and the rotation of every gear,
     between input speeds ``w_lo`` and ``w_hi`` [rad/s].  The natural frequencies of
     the model do not depend on speed unless it has speed-dependent (gyroscopic) terms;
     then they are recomputed per speed by :func:`campbell`."""
@@ -209,7 +210,7 @@ def critical_speeds(structure, q, kin, model, w_lo, w_hi, orders=3):
 
     sol = modal_analysis(structure, q)
     w_ref = reference_speed(model)
-    lines = _order_lines(kin, model, orders)
+    lines = _order_lines(kin, model, orders, structure)
     out = []
     for i, fn in enumerate(sol.frequencies):
         if fn <= 0:
@@ -225,17 +226,42 @@ def critical_speeds(structure, q, kin, model, w_lo, w_hi, orders=3):
                 lines=lines, reference_speed=w_ref)
 
 
-def _order_lines(kin, model, orders):
-    """(label, order, Hz per rad/s of input speed) of every excitation line."""
+HARMONIC_SHARE = 0.05
+"""A mesh-frequency harmonic whose amplitude in the stiffness table is at least this share
+of the fundamental's is an excitation line of the resonance map."""
+MIN_ORDERS, MAX_ORDERS = 3, 10
+
+
+def mesh_orders(table) -> int:
+    """Highest mesh-frequency order worth a line: the last harmonic of the stiffness table
+    (one mesh cycle) with HARMONIC_SHARE of the fundamental's amplitude, within
+    [MIN_ORDERS, MAX_ORDERS] (a rectangular single/double contact wave of contact ratio
+    1.6 has 9 % at the 7th; a constant stiffness gets the minimum)."""
+    amp = np.abs(np.fft.rfft(np.asarray(table, dtype=float)))[1:MAX_ORDERS + 1]
+    if amp.size == 0 or amp[0] <= 0:
+        return MIN_ORDERS
+    strong = np.flatnonzero(amp >= HARMONIC_SHARE * amp[0])
+    return int(min(MAX_ORDERS, max(MIN_ORDERS, strong[-1] + 1)))
+
+
+def _order_lines(kin, model, orders, structure=None):
+    """(label, order, Hz per rad/s of input speed) of every excitation line: orders
+    1..``orders`` of each mesh frequency (None: :func:`mesh_orders` of the mesh's table),
+    and the rotation of every gear."""
     w_ref = reference_speed(model)
     lines = []
     seen = set()
+    names = list(structure.element_names) if structure is not None else []
     for name, mk in kin.meshes.items():
         key = round(mk.frequency, 9)
         if key in seen:
             continue
         seen.add(key)
-        for h in range(1, orders + 1):
+        top = orders
+        if top is None:
+            top = (mesh_orders(structure.stiffness_table[names.index(name)])
+                   if name in names else MIN_ORDERS)
+        for h in range(1, top + 1):
             lines.append((f"mesh {name}", h, mk.frequency / w_ref))
     shafts = set()
     for b, bk in kin.bodies.items():
@@ -247,10 +273,11 @@ def _order_lines(kin, model, orders):
     return lines
 
 
-def campbell(model, start: float, stop: float, *, points: int = 41, orders: int = 3,
-             count: int | None = None):
+def campbell(model, start: float, stop: float, *, points: int = 41,
+             orders: int | None = None, count: int | None = None):
     """Resonance (Campbell) map: natural frequencies against input speed [rad/s] with the
-    mesh-frequency harmonics of every stage and the shaft orders, and every crossing in
+    mesh-frequency harmonics of every stage (orders 1..``orders``; None: those the
+    stiffness table excites, :func:`mesh_orders`) and the shaft orders, and every crossing in
     the range as a critical speed with the mode's strain-energy shares.
 
     Natural frequencies are those of the model linearised about its static equilibrium

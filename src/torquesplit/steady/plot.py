@@ -83,19 +83,47 @@ def campbell_figure(ds):
     fig = _figure(8, 5)
     ax = fig.add_subplot()
     rpm = ds["speed_rpm"].values
-    for m in range(ds.sizes["mode"]):
-        ax.plot(rpm, ds["natural_frequency"].values[:, m], color="k", lw=0.8)
-    for j, lab in enumerate(ds["line"].values):
-        ax.plot(rpm, ds["excitation_frequency"].values[:, j], lw=0.8, ls="--", label=str(lab))
     fmax = float(np.nanmax(ds["excitation_frequency"].values))
+    for m in range(ds.sizes["mode"]):
+        fn = ds["natural_frequency"].values[:, m]
+        ax.plot(rpm, fn, color="k", lw=0.8)
+        if np.isfinite(fn[-1]) and 0 < fn[-1] <= fmax * 1.05:  # mode number at its end
+            ax.annotate(f"{int(ds['mode'].values[m])}", (rpm[-1], fn[-1]), fontsize=6,
+                        xytext=(2, 0), textcoords="offset points", va="center")
+    # one colour per source (a mesh: its orders 1..k, labelled at the top; a shaft), one
+    # legend entry each
+    sources: dict[str, list[tuple[int, int]]] = {}
+    for j, lab in enumerate(ds["line"].values):
+        order, _, source = str(lab).partition(" x ")
+        sources.setdefault(source, []).append((j, int(order)))
+    colours = plt_colours()
+    for k, (source, members) in enumerate(sources.items()):
+        colour = colours[k % len(colours)]
+        orders = [o for _, o in members]
+        label = source if orders == [1] else f"{source} x {min(orders)}..{max(orders)}"
+        for i, (j, order) in enumerate(members):
+            fe = ds["excitation_frequency"].values[:, j]
+            ax.plot(rpm, fe, lw=0.8, ls="--", color=colour, label=label if i == 0 else None)
+            inside = np.flatnonzero(fe <= fmax * 1.05)
+            if len(members) > 1 and inside.size:  # the order at the line's last point
+                ax.annotate(f"{order}x", (rpm[inside[-1]], fe[inside[-1]]), fontsize=5,
+                            color=colour, xytext=(0, 2), textcoords="offset points")
     for c in ds.attrs.get("critical_speeds_rpm", []):
         ax.axvline(c, color="r", lw=0.5, alpha=0.5)
     ax.set_ylim(0, fmax * 1.05)
     ax.set_xlabel("input speed [rpm]")
     ax.set_ylabel("frequency [Hz]")
-    ax.set_title(f"{ds.attrs.get('model', '')}: Campbell diagram", fontsize=9)
-    ax.legend(fontsize=6, ncol=2)
+    ax.set_title(f"{ds.attrs.get('model', '')}: Campbell diagram (solid: natural "
+                 f"frequencies, numbered; dashed: excitation orders)", fontsize=9)
+    ax.legend(fontsize=6, loc="upper left")
     return fig
+
+
+def plt_colours() -> list[str]:
+    """Matplotlib's colour cycle."""
+    import matplotlib.pyplot as plt
+
+    return plt.rcParams["axes.prop_cycle"].by_key()["color"]
 
 
 def save(fig, path) -> Path:

@@ -183,6 +183,8 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
     design = ds.attrs["design"]
     if design == "grid" and status.size <= 60 and len(out_vars) <= 8:
         t = Table(title=f"{ds.attrs['study_name']}")
+        from rich.markup import escape
+
         from .figures import _coord
 
         dims = list(ds[out_vars[0]].dims)
@@ -190,7 +192,8 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
         for d in dims:
             values, unit = _coord(ds, d)
             shown[d] = dict(zip(ds[d].values.tolist(), values.tolist()))
-            t.add_column(f"{d} [{unit}]", justify="right")
+            # escaped: Rich would read "[um]" as markup and drop it
+            t.add_column(escape(f"{d} [{unit}]"), justify="right")
         for v in out_vars:
             t.add_column(v, justify="right")
         t.add_column("status")
@@ -283,8 +286,10 @@ def sweep(
         ..., "--vary", help="PATH=START:STOP:NUM[unit], e.g. shafts.drive1.diameter="
                             "130:400:28mm; several paths set together: P1,P2=..."),
     output: Optional[list[str]] = typer.Option(
-        None, "--output", help="Output name or pattern (repeatable); default: the model's "
-                               "load-sharing definition, every group."),
+        None, "--output", help="Output name or pattern (repeatable); default "
+                               "load_sharing.DEF.* with DEF the model's load-sharing "
+                               "definition: the coefficient of every group and of every mesh "
+                               "(add --output load_sharing.DEF for the system's)."),
     log_spacing: bool = typer.Option(False, "--log", help="Logarithmic spacing."),
     static: bool = typer.Option(False, "--static", help="Quasi-static analysis instead of a run."),
     duration: Optional[str] = typer.Option(None, "--duration", help="Simulated time per case."),
@@ -313,6 +318,7 @@ def sweep(
     try:
         from ..model.overrides import parse_assignment
 
+        ui._one_run_length(duration, cycles)
         param = parse_vary(vary)
         if log_spacing:
             param["spacing"] = "log"

@@ -188,5 +188,6 @@ def make_runner(workers: int | None = None, *, client=None, scheduler: str | Non
         return DaskRunner(address=scheduler)
     n = int(workers or os.cpu_count() or 1)
     if n < 1:
-        raise ValueError(f"workers must be >= 1, got {workers}; give e.g. --workers 2")
+        raise ValueError(f"workers must be at least 1, got {workers}; give e.g. workers=2 "
+                         "(on the command line: --workers 2)")
     return SerialRunner() if n == 1 else LocalPool(n)
