@@ -141,10 +141,12 @@ def mo2017(quick: bool) -> dict:
     the errors' common period (the default sweep), and how far the coefficients move
     when the positions are doubled."""
     ppc = 2 if quick else 32
+    t0 = time.perf_counter()
     res = quasi_static_load_sharing(_model("mo2017_star_reducer"), points_per_cycle=ppc)
     met = res.metrics()
-    fine = quasi_static_load_sharing(_model("mo2017_star_reducer"),
-                                     points_per_cycle=2 * ppc).metrics()
+    wall = time.perf_counter() - t0
+    fine = quasi_static_load_sharing(_model("mo2017_star_reducer"), points_per_cycle=2 * ppc,
+                                     max_points=10**6).metrics()
     kin = res.kinematics
     slowest = min(abs(v) for mk in kin.meshes.values()
                   for v in (mk.driver_speed, mk.driven_speed) if v)
@@ -155,6 +157,7 @@ def mo2017(quick: bool) -> dict:
     return {"per_mesh": met.per_mesh, "per_group": met.per_group, "system": met.system,
             "orbits": orbits, "positions": int(res.times.size),
             "points_per_cycle": ppc, "revolutions": span * slowest / (2 * math.pi),
+            "wall_time_s": wall,
             "doubled_positions_change": max(abs(fine.per_mesh[m] - v)
                                             for m, v in met.per_mesh.items()),
             "converged": bool(res.solution.converged.all())}

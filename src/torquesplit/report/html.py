@@ -208,7 +208,7 @@ def _run_section(res, met) -> str:
     rows = []
     for r in met.rows:
         back = f"{100 * r.back_contact:.2f} %"
-        if r.back_contact > 0:
+        if r.back_flank_force > 0:  # settled (a transient's is in the warnings)
             back += f", up to {r.back_flank_force / 1e3:.4g} kN"
         rows.append([r.mesh, r.group, _g(r.nominal_force / 1e3), _g(r.static_force / 1e3),
                      _g(r.mean_force / 1e3), _g(r.peak_force / 1e3), f"{r.dynamic_factor:.4f}",
