@@ -96,10 +96,16 @@ def compare(name, keep=None, settle_s=None, harmonics=None, steps_per_cycle=None
         out["transient_left"] = out["largest_multiplier"] ** out["settle_periods"]
     res = {}
     for label, st in states.items():
-        t, F, _ = st.samples(n=steps)
+        # the meshes at their finest: shooting's every RK4 step (samples() may interpolate
+        # rows kept every few steps on a long period), the harmonic series at every step
+        if st.solution.method == "hb":
+            t, F, _ = st.samples(n=steps)
+            F = F[:, meshes]
+        else:
+            t, F, _ = st.mesh_series(meshes)
         errs = {}
         for j, e in enumerate(meshes):
-            f = np.interp(tt, t, F[:, e], period=T)
+            f = np.interp(tt, t, F[:, j], period=T)
             amp = float(np.ptp(F_ti[:, j]))
             errs[ref.mesh_names[j]] = float(np.max(np.abs(f - F_ti[:, j]))) / max(amp, 1e-300)
         res[label] = errs
