@@ -42,6 +42,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from torquesplit.solve import _kernels as kern
+from torquesplit.solve import kernel_data as kd
 
 from .layout import Group
 
@@ -390,10 +391,17 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
         w(f"smooth = X[{X_PN}] >= 2.0 and X[{X_PKK + 1}] == 0.0")
         for j, el in enumerate(L.track):
             s = X_ST + N_STAT * j
+            # the force is continuous where its cycles begin (no table corner at node 0,
+            # _kernels.continuous_start): a cycle start between two instants enters the
+            # interpolated force in both cycles' extremes
+            smooth_start = kd.continuous_start(L.corner_ptr, L.corner_node, el)
             w(f"cy{j} = WI[bi + {tv_pos[el]}] - {par(('base', j))}")
             w(f"fe = W[{W_F + el}]")
             w("part = 0.0")
             w("dpart = 0.0")
+            if smooth_start:
+                w("bnd = False")
+                w("fb = 0.0")
             with w.block("if entered:"):
                 w(f"fa = X[{X_PF + j}]")
                 with w.block(f"if cy{j} == WI[{WI_SC + 2 * j}] + 1:"):
@@ -407,6 +415,8 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
                         with w.block("if th > 1.0:"):
                             w("th = 1.0")
                     w("fb = fa + th * (fe - fa)")
+                    if smooth_start:
+                        w("bnd = True")
                     w("da = th * span")
                     w("dpart = span - da")
                     w(f"X[{s + 2}] += 0.5 * da * (fa + fb)")
@@ -442,8 +452,20 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
             w(f"X[{k + 1}] = fe")
             w(f"X[{k + 2}] = X[{k + 3}]")
             w(f"X[{k + 3}] = g2")
+            if smooth_start:  # the ending cycle's extremes take the force at its end
+                with w.block("if bnd:"):
+                    with w.block(f"if fb > X[{s}]:"):
+                        w(f"X[{s}] = fb")
+                    with w.block(f"if fb < X[{s + 1}]:"):
+                        w(f"X[{s + 1}] = fb")
             with w.block(f"if cy{j} != WI[{WI_SC + 2 * j}]:"):
                 w(f"new_cycle(I{j}, cy{j}, X, WI, OF, OI, c, cap)")
+            if smooth_start:  # and the beginning cycle's, at its start
+                with w.block("if bnd:"):
+                    with w.block(f"if fb > X[{s}]:"):
+                        w(f"X[{s}] = fb")
+                    with w.block(f"if fb < X[{s + 1}]:"):
+                        w(f"X[{s + 1}] = fb")
             with w.block("if entered:"):
                 w(f"X[{s + 2}] += part")
                 w(f"X[{s + 5}] += dpart")

@@ -354,11 +354,19 @@ def mean_sample(t, slot, i_f, m, w, r):
     of the element begins (the linear interpolant integrated on each side, so that a
     cycle's mean is second order in the step).  Instants come in time order (the step
     samples and, with RK4, the corners between them: a table ramp steeper than a step or
-    an impact pulse between two steps is then integrated, not missed).
+    an impact pulse between two steps is then integrated, not missed).  Where a cycle
+    begins and the element's force is continuous there (``r.trk_cont``: no corner of its
+    table at node 0, :func:`kernel_data.continuous_start`), the force interpolated at
+    that start also enters both
+    cycles' max and min (on an instant, that instant's force): a force still rising
+    (falling) across the boundary has the ending cycle's extreme there, which its samples
+    alone miss by up to its slope times a step (first order: constant-stiffness meshes
+    under slower errors, Mo et al. 2017).
     Twin: :func:`torquesplit.solve.reference.cycle_statistics_numpy`."""
     force, CY = w.F, w.CY
     track_el, track_base = r.track_el, r.track_base
     cyc_sum, cyc_wt, prev_f, prev_c = r.cyc_sum, r.cyc_wt, r.prev_f, r.prev_c
+    cyc_max, cyc_min, trk_cont = r.cyc_max, r.cyc_min, r.trk_cont
     cap = cyc_sum.shape[0]
     ta = r.prev_t[0]
     span = t - ta
@@ -382,6 +390,13 @@ def mean_sample(t, slot, i_f, m, w, r):
                 if c >= 0 and c < cap:
                     cyc_sum[c, j] += 0.5 * db * (fb + fe)
                     cyc_wt[c, j] += db
+                if trk_cont[j] != 0:  # (on an instant too: fb is that force)
+                    for cb in (cp, c):
+                        if cb >= 0 and cb < cap:
+                            if fb > cyc_max[cb, j]:
+                                cyc_max[cb, j] = fb
+                            if fb < cyc_min[cb, j]:
+                                cyc_min[cb, j] = fb
             else:  # one cycle (or, past a skipped cycle, half to each end's cycle)
                 half = 0.5 * span
                 if cp >= 0 and cp < cap:

@@ -488,6 +488,7 @@ def integrate(
         raise ValueError(f"t_span must be (start, end) with end > start, got {t_span!r}.")
     y = _initial_state(s, y0)
     model = kd.kernel_model(s)
+    full_model = model  # (plain steps drop the corners, not what they say of the force)
     if not corners:
         model = model._replace(corner_node=np.zeros(0, dtype=np.int64),
                                corner_ptr=np.zeros_like(model.corner_ptr))
@@ -514,7 +515,9 @@ def integrate(
         raise ValueError("load_sharing_min_total needs one value per load-sharing group.")
     rec = kd.make_record(sel.track, sel.track_base, sel.n_cycles_cap, sel.groups,
                          s.n_elements, sel.hist_el, sel.hist_dof, n_hist, plan.n_full,
-                         s.n_dof, load_sharing_min_total)
+                         s.n_dof, load_sharing_min_total,
+                         [kd.continuous_start(full_model.corner_ptr, full_model.corner_node, e)
+                          for e in sel.track])
     work = kd.make_work(model, rhs_code.parameters)
     work.Y[kd.Y_STATE] = y
     counters = np.zeros(kern.N_COUNTERS, dtype=np.int64)

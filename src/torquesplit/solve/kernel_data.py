@@ -81,15 +81,16 @@ addresses for the generated right-hand side (``A_*``); ``par`` its parameter vec
 corner."""
 
 Record = namedtuple("Record", (
-    "track_el", "track_base", "cyc_max", "cyc_min", "cyc_sum", "cyc_cnt", "cyc_wt",
+    "track_el", "track_base", "trk_cont", "cyc_max", "cyc_min", "cyc_sum", "cyc_cnt", "cyc_wt",
     "prev_t", "prev_f", "prev_c", "pk_t", "pk_f", "pk_g", "pk_k", "pk_n", "pk_x",
     "grp_ptr", "grp_col", "grp_min", "rat_max", "rat_min",
     "sep_count", "back_count", "sep_time", "back_time",
     "hist_el", "hist_dof", "hist_t", "hist_f", "hist_q", "hist_v", "full_t", "full_y",
 ))
-"""Outputs of a run.  Per tracked element (columns) and cycle (rows, counted from the
-cycle containing the start time): force max, min, time integral (trapezoid rule over
-the step samples and the corner instants, each half-interval in its end's cycle) and
+"""Outputs of a run.  Per tracked element: ``trk_cont`` 1 where its force is continuous
+at its cycle starts (:func:`continuous_start`), else 0.  Per tracked element (columns)
+and cycle (rows, counted from the cycle containing the start time): force max, min,
+time integral (trapezoid rule over the step samples and the corner instants, each half-interval in its end's cycle) and
 its time (``cyc_wt``: their ratio is the cycle's mean force), sample count; the last
 instant entered (``prev_t`` (1,), NaN before the first; ``prev_f``, ``prev_c`` its
 forces and cycles); for the peaks between the instants, the last two (slots
@@ -338,11 +339,22 @@ def make_work(m: KernelModel, rhs_parameters: np.ndarray | None = None) -> Work:
     return w
 
 
+def continuous_start(corner_ptr, corner_node, e: int) -> bool:
+    """Whether element ``e``'s force is continuous where its cycles begin: no corner of
+    its table (a jump of stiffness or force, a half-gap changing per cycle) at node 0,
+    so the force interpolated at a cycle start belongs to both cycles' extremes."""
+    k = int(corner_ptr[e])
+    return not (k < int(corner_ptr[e + 1]) and int(corner_node[k]) == 0)
+
+
 def make_record(track_el, track_base, n_cycles_cap: int, groups, n_el: int, hist_el,
-                hist_dof, n_hist: int, n_full: int, n_dof: int, group_min=None) -> Record:
+                hist_dof, n_hist: int, n_full: int, n_dof: int, group_min=None,
+                continuous=None) -> Record:
     """Output arrays of a run.  ``groups``: lists of tracked columns, one per
     load-sharing group (the ratio statistics); ``group_min``: the group total force below
-    which no ratio is formed [N] (default 0: any positive total)."""
+    which no ratio is formed [N] (default 0: any positive total); ``continuous``: per
+    tracked element, whether its force is continuous at its cycle starts (default none:
+    no forces interpolated at cycle starts)."""
     n_tr = len(track_el)
     cap = int(n_cycles_cap)
     grp_ptr = np.zeros(len(groups) + 1, dtype=np.int64)
@@ -352,6 +364,8 @@ def make_record(track_el, track_base, n_cycles_cap: int, groups, n_el: int, hist
     return Record(
         track_el=np.asarray(track_el, dtype=np.int64),
         track_base=np.asarray(track_base, dtype=np.int64),
+        trk_cont=(np.zeros(n_tr, dtype=np.int64) if continuous is None
+                  else np.asarray(continuous, dtype=np.int64).reshape(n_tr)),
         cyc_max=np.full((cap, n_tr), -np.inf), cyc_min=np.full((cap, n_tr), np.inf),
         cyc_sum=np.zeros((cap, n_tr)), cyc_cnt=np.zeros((cap, n_tr), dtype=np.int64),
         cyc_wt=np.zeros((cap, n_tr)), prev_t=np.full(1, np.nan), prev_f=np.zeros(n_tr),

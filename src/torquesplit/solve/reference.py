@@ -203,7 +203,7 @@ def hermite_numpy(theta, h, y0, f0, y1, f1):
 
 
 def cycle_statistics_numpy(times, forces, frequency, phase, t0, n_cycles_cap,
-                           counted=None, regimes=None, corners=()):
+                           counted=None, regimes=None, corners=(), continuous_start=False):
     """Per-excitation-cycle max, min, mean and sample count of one element's force at the
     instants ``times`` (increasing: the step samples and any corner instants between).
 
@@ -217,7 +217,10 @@ def cycle_statistics_numpy(times, forces, frequency, phase, t0, n_cycles_cap,
     largest (smallest), is no corner and all three share one contact regime
     (``regimes``: default all 1; 0 apart), the vertex of the parabola through them, in
     the middle instant's cycle.  ``corners``: every corner time; a sample within
-    ``_kernels.MERGE`` steps of one is that corner.  Returns four arrays of length
+    ``_kernels.MERGE`` steps of one is that corner.  ``continuous_start``: the force is
+    continuous where a cycle begins (no table corner at node 0,
+    ``kernel_data.continuous_start``): the force interpolated at each cycle start enters
+    both cycles' max and min.  Returns four arrays of length
     ``n_cycles_cap`` (max -inf / min +inf / mean NaN where empty).  Twin of the cycle
     part of ``_kernels.record``, ``_kernels.mean_sample`` and ``_kernels.peak_sample``
     (whose parabola formula, ``_kernels.vertex``, it calls).
@@ -247,6 +250,11 @@ def cycle_statistics_numpy(times, forces, frequency, phase, t0, n_cycles_cap,
             fc = fa + th * (fb - fa)
             parts = ((ca, th * span, 0.5 * th * span * (fa + fc)),
                      (cb, span - th * span, 0.5 * (span - th * span) * (fc + fb)))
+            if continuous_start:
+                for c in (ca, cb):
+                    if 0 <= c < n_cycles_cap:
+                        cmax[c] = max(cmax[c], fc)
+                        cmin[c] = min(cmin[c], fc)
         else:
             parts = ((ca, 0.5 * span, 0.5 * span * fa), (cb, 0.5 * span, 0.5 * span * fb))
         for c, dt, integral in parts:

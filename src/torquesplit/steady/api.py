@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from torquesplit.errors import SolverError
+from torquesplit.solve.kernel_data import continuous_start
 from torquesplit.steady.period import (
     base_frequency,
     default_max_cycles,
@@ -448,6 +449,24 @@ def cycle_integrals(t, f, cycles, n, start, period):
     return total, time
 
 
+def boundary_extremes(t, f, start, period, mx, mn):
+    """Enter in ``mx`` / ``mn`` (per cycle, cycle k from ``start + k period``) the force
+    interpolated at every cycle start between the instants ``t`` (in time order, forces
+    ``f``; on an instant, its force), in both cycles it divides: as
+    ``_kernels.mean_sample`` does for an element whose force is continuous there."""
+    n = mx.shape[0]
+    k = np.arange(1, n)
+    tb = start + k * period
+    i = np.searchsorted(t, tb, side="right") - 1
+    inside = (i >= 0) & (i < t.size - 1)
+    k, tb, i = k[inside], tb[inside], i[inside]
+    th = np.clip((tb - t[i]) / np.where(t[i + 1] > t[i], t[i + 1] - t[i], 1.0), 0.0, 1.0)
+    fb = f[i] + th * (f[i + 1] - f[i])
+    for c in (k - 1, k):
+        np.maximum.at(mx, c, fb)
+        np.minimum.at(mn, c, fb)
+
+
 def cycle_extremes(values, cycles, n, extra_cycles=None, extra=None):
     """Per-cycle max and min (arrays of ``n``; -inf / inf where a cycle has none) of
     ``values`` in cycles ``cycles`` (non-decreasing: the samples of a cycle form one run)
@@ -560,6 +579,9 @@ def _as_solution(st: SteadyState, shell, periods):
         sm, span = cycle_integrals(t_all, f_all, cycles(j, t_all), nc,
                                    (bases[j] - s.phase[e]) / s.frequency[e],
                                    1.0 / s.frequency[e])
+        if continuous_start(st.problem.model.corner_ptr, st.problem.model.corner_node, e):
+            boundary_extremes(t_all, f_all, (bases[j] - s.phase[e]) / s.frequency[e],
+                              1.0 / s.frequency[e], mx, mn)
         cnt = np.bincount(idx, minlength=nc)
         # the first and last cycles are partial (phase offsets): left out; a mesh whose
         # cycles divide the period keeps whole periods of them (cycles 1 .. (P - 1) n),
