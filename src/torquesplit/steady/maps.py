@@ -312,6 +312,8 @@ def campbell(model, start: float, stop: float, *, points: int = 41,
     crit = critical_speeds(s, static.q, kin, model, lo, hi, orders)
     lines = crit["lines"]
     L = np.array([[o * per * w for (_, o, per) in lines] for w in speeds])
+    if s.n_gyroscopic:  # the frequencies move with speed: cross the curves themselves
+        crit["crossings"] = _curve_crossings(model, static.q, speeds, F, lines, w_ref)
     crossings = [c for c in crit["crossings"] if count is None or c["mode"] <= count]
     ds = xr.Dataset(
         {"natural_frequency": (("speed", "mode"), F, {"units": "Hz"}),
@@ -325,6 +327,29 @@ def campbell(model, start: float, stop: float, *, points: int = 41,
     ds.attrs["critical_speed_labels"] = [f"mode {c['mode']} ({c['frequency_Hz']:.5g} Hz) x "
                                          f"{c['order']} {c['source']}" for c in crossings]
     return ds, crossings
+
+
+def _curve_crossings(model, q, speeds, F, lines, w_ref):
+    """Crossings of the natural-frequency curves ``F`` (speeds x modes) with the
+    excitation lines, located by linear interpolation between the speeds where their
+    difference changes sign; the strain-energy shares from the modes at the crossing's
+    speed (the frequencies of a turning frame depend on speed: the crossings of the
+    model's-speed frequencies would be off by the frequencies' change)."""
+    from torquesplit.solve.modal import modal_analysis
+
+    out = []
+    for label, order, per_rad in lines:
+        g = F - (order * per_rad * speeds)[:, None]
+        for m in range(F.shape[1]):
+            for i in np.flatnonzero(np.sign(g[:-1, m]) * np.sign(g[1:, m]) < 0):
+                th = g[i, m] / (g[i, m] - g[i + 1, m])
+                w = speeds[i] + th * (speeds[i + 1] - speeds[i])
+                sol = modal_analysis(_structure_at(model, w / w_ref), q)
+                out.append(dict(mode=m + 1, frequency_Hz=float(sol.frequencies[m]),
+                                order=order, source=label, speed_rpm=float(w * RPM),
+                                energy=sol.dominant_elements(m, 4)))
+    out.sort(key=lambda c: c["speed_rpm"])
+    return out
 
 
 def _structure_at(model, factor):  # the model at another speed (a turning carrier)
