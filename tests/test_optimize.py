@@ -8,6 +8,8 @@ with a seed.  Coarse LTCA grid and a small population to keep the test short.
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -69,3 +71,56 @@ def test_bad_optimisation_files_name_the_field(change, location):
     with pytest.raises(ModelError) as exc:
         read_spec(d)
     assert location in [loc for loc, _ in exc.value.issues]
+
+
+def test_results_show_variables_in_the_unit_of_their_bounds(tmp_path):
+    """pareto.csv and chosen.toml write y1..y6 in mm (the bounds' unit), named in the
+    header; the objectives' columns say they are ratios to the baseline."""
+    import csv
+    import tomllib
+
+    from torquesplit.optimize import OptimizationResult
+
+    spec = read_spec(spec_dict())
+    assert [v.unit for v in spec.variables] == ["mm"] * 6
+    assert spec.variables[0].scale == pytest.approx(1e-3)
+    res = OptimizationResult(spec=spec, X=np.array([PAPER, PAPER]), F=np.array([[0.5, 0.1],
+                                                                                 [0.3, 0.2]]),
+                             outputs=({}, {}), baseline={}, chosen=1, evaluations=2, computed=2)
+    assert res.objective_labels() == ["ltca.L68.te_peak_to_peak_arcsec (/ baseline)",
+                                      "ltca.L68.impact_peak_force_N (/ baseline)"]
+    res.write(tmp_path)
+    chosen = tomllib.loads((tmp_path / "chosen.toml").read_text(encoding="utf-8"))
+    topo = chosen["gears"]["L6"]["modifications"]["topological"]
+    assert topo["y1"] == "0.023 mm" and topo["y6"] == "8.19 mm"
+    rows = list(csv.reader((tmp_path / "pareto.csv").open()))
+    assert rows[0][1] == "gears.L6.modifications.topological.y1 [mm]"
+    assert rows[0][-1] == "ltca.L68.impact_peak_force_N (/ baseline)"
+    assert float(rows[2][1]) == pytest.approx(0.023) and rows[2][0] == "1"
+
+
+def test_shipped_example_sets_every_double_helical_mesh_to_ltca():
+    """chosen.toml's modification of L6, L7, R6, R7 acts on all four paths alike."""
+    from torquesplit.examples import optimization_path
+
+    spec = read_spec(optimization_path("liu2021_dh_modification"))
+    for mesh in ("L68", "L78", "R68", "R78"):
+        assert spec.fixed[f"meshes.{mesh}.stiffness"]["method"] == "ltca", mesh
+
+
+def test_optimize_command_names_units_and_ratios(tmp_path):
+    import tomli_w
+    from typer.testing import CliRunner
+
+    from torquesplit.cli import app
+
+    spec = tmp_path / "opt.toml"
+    spec.write_text(tomli_w.dumps(spec_dict(store="evals.jsonl")), encoding="utf-8")
+    res = CliRunner().invoke(app, ["optimize", str(spec), "--population", "4",
+                                   "--generations", "1", "--out", str(tmp_path / "o")])
+    assert res.exit_code == 0, res.output
+    text = " ".join(res.stdout.split())
+    assert "y1 [mm]" in text and "(/ baseline)" in text
+    assert "baseline (the model without the variables): ltca.L68.te_peak_to_peak_arcsec =" in text
+    assert " arc s" in text and " N" in text
+    assert re.search(r'\ny1 = "[0-9.e-]+ mm"\n', (tmp_path / "o" / "chosen.toml").read_text())

@@ -444,17 +444,23 @@ def run(
 
 
 def _print_run(m, res, met, saved, figures, step_check, plots, as_json) -> None:
-    """A finished run's tables (or JSON)."""
+    """A finished run's tables (or JSON).  A model with a planetary stage adds the planet
+    table (K_gamma per stage, the factor per planet) and the JSON key
+    ``planet_load_sharing``; a model without planets has neither."""
+    planets = ux.planet_sharing(met.load_sharing, res.kinematics)
     if as_json:
         ux.emit_json({"model": m.model.name, "success": res.success,
-                      "metrics": met.to_dict(), "statistics": res.statistics(),
+                      "metrics": met.to_dict(),
+                      **({"planet_load_sharing": ux.planet_sharing_dict(planets)}
+                         if planets else {}),
+                      "statistics": res.statistics(),
                       "results_file": str(saved[0]) if saved else None,
                       "results_files": [str(f) for f in saved],
                       "figures": [str(f) for f in figures],
                       **({"step_check": step_check.to_dict()} if step_check else {})},
                      _json_default)
     else:
-        _render_run(res, met, saved)
+        _render_run(res, met, saved, planets)
         if step_check is not None:
             ux.render_step_check(step_check)
         if figures:
@@ -566,7 +572,7 @@ def _with_progress(job, quiet: bool, label: str = "working"):
         return job(None if quiet else (lambda f: cb(f)))
 
 
-def _render_run(res, met, saved) -> None:
+def _render_run(res, met, saved, planets=None) -> None:
     from .metrics.load_sharing import DEFINITION_TEXT, DEFINITION_USE
 
     st = res.statistics()
@@ -576,13 +582,15 @@ def _render_run(res, met, saved) -> None:
         f"integration {st['wall_time_s']:.3g} s, compile/load {st['compile_time_s']:.3g} s "
         f"(+{st['rhs_compile_time_s']:.2g} s for the {st['rhs']} right-hand side); "
         f"transient discarded: {met.settling.start_time:.4g} s"
-        + ("" if met.settling.settled else " (not settled: last half used)"), highlight=False)
+        + ("" if met.settling.settled else " (not settled: see the warnings)"), highlight=False)
     why = st.get("step_limited_by") or ""
     if why and why != "excitation period":  # a finer step than asked: say what set it
         console.print(f"step {st['step_s']:.3g} s, set by {why}", highlight=False,
                       markup=False)
     console.print(run_table(met))
     console.print(group_table(met))
+    if planets is not None:
+        _print_planets(planets, res.kinematics)
     console.print(f"system load-sharing coefficient ({met.definition}): "
                   f"[bold]{met.load_sharing.system:.4f}[/]", highlight=False)
     console.print(
@@ -632,6 +640,18 @@ def group_table(met) -> Table:
                   f"{d.per_group_peak_to_nominal[name]:.4f}",
                   f"{d.per_group_peak_to_nominal_engineering[name]:.4f}")
     return g
+
+
+def _print_planets(planets, kinematics) -> None:
+    """The planet table (K_gamma per stage, the factor per planet) and what it shows."""
+    t = Table(title=f"planets (load sharing: {planets.definition})")
+    for i, col in enumerate(ux.PLANET_HEADER):
+        t.add_column(_h(col.format(definition=planets.definition)),
+                     justify="right" if i == 3 else "left")
+    for row in ux.planet_rows(planets, kinematics):
+        t.add_row(*row)
+    console.print(t)
+    console.print(f"{ux.PLANET_TEXT} ({planets.definition}).", markup=False, highlight=False)
 
 
 # --------------------------------------------------------------------------- static
@@ -706,8 +726,10 @@ def static(
 
 
 def _print_static(m, res, met, orbits, saved, figures, plots, as_json) -> None:
-    """A quasi-static sweep's tables (or JSON)."""
+    """A quasi-static sweep's tables (or JSON); the planet table and JSON key
+    ``planet_load_sharing`` (static_torque) as in ``run``, for a planetary model only."""
     forces = res.mesh_forces()
+    planets = ux.planet_sharing(met, res.kinematics)
     if as_json:
         ux.emit_json({
             "model": m.model.name, "positions": int(res.times.size),
@@ -715,6 +737,7 @@ def _print_static(m, res, met, orbits, saved, figures, plots, as_json) -> None:
             "load_sharing": {"definition": "static_torque", "per_mesh": met.per_mesh,
                              "per_group": met.per_group, "system": met.system,
                              "groups": met.groups},
+            **({"planet_load_sharing": ux.planet_sharing_dict(planets)} if planets else {}),
             "mesh_force_N": {name: {"min": float(forces[:, j].min()),
                                     "mean": float(forces[:, j].mean()),
                                     "max": float(forces[:, j].max())}
@@ -738,6 +761,8 @@ def _print_static(m, res, met, orbits, saved, figures, plots, as_json) -> None:
     console.print(t)
     for g, v in met.per_group.items():
         console.print(f"group {g}: {v:.5f}", highlight=False)
+    if planets is not None:
+        _print_planets(planets, res.kinematics)
     console.print(f"system load-sharing coefficient (static_torque): [bold]{met.system:.5f}[/]")
     if orbits:
         o = Table(title="floating orbits (centre displacement from its nominal position)")
@@ -861,7 +886,8 @@ def contact(
         if plot is not None:
             from .plot.contact import contact_figure_files
 
-            _check_plots_folder(plot, "--plot", names=contact_figure_files(), force=force)
+            _check_plots_folder(plot, "--plot", names=contact_figure_files(harris > 0),
+                                force=force)
         _at_least(positions, 4, "--positions", "64")
         _at_least(slices, 2, "--slices", "40")
         _at_least(harris, 0, "--harris", "10")
@@ -892,7 +918,10 @@ def contact(
             hm = cm.harris_map(np.linspace(0.1, 1.5, harris) * top) if harris > 0 else None
         op = max(results, key=lambda r: r.load)
         impact = None
-        if not cm.pair.is_internal and not reverse:
+        if cm.pair.is_internal:  # (reverse: a ring that drives, internal too)
+            if as_json:  # the table prints it under the table
+                ux.warn(_INTERNAL_IMPACT, label="note")
+        elif not reverse:
             mk = kin.meshes[pair]
             drv, dvn = kin.bodies[mk.driver], kin.bodies[mk.driven]
             impact = loaded_meshing_in(op, omega_driving=abs(drv.speed),
@@ -905,8 +934,6 @@ def contact(
     if plot is not None:
         from .plot.contact import write_contact_figures
 
-        if hm is None:
-            hm = cm.harris_map(loads)
         try:
             figures = write_contact_figures(results, hm, plot, operating=op,
                                             operating_load=op_load,
@@ -964,8 +991,15 @@ def _print_contact(m, pair, names, op_load, cm, results, hm, impact, op, figures
         console.print(f"meshing-in impact at {op.load / 1e3:.5g} kN: {impact.peak_force:.5g} N "
                       f"(premature approach {impact.advance * 1e6:.3g} µm, corner relief "
                       f"{impact.corner_separation * 1e6:.3g} µm)", highlight=False)
+    elif cm.pair.is_internal:
+        console.print(_INTERNAL_IMPACT, highlight=False, markup=False)
     if figures:
         console.print(f"{len(figures)} figures written to {plot}")
+
+
+#: the line ``contact`` prints (and ``--json`` lists in its warnings) for an internal mesh
+_INTERNAL_IMPACT = ("meshing-in impact: not computed for internal gears (the corner-contact "
+                    "model of Liu et al. 2021 eqs. 6-10 is that of an external pair)")
 
 
 def _contact_load(text, model, kin, pair, names, on, cm, parse_quantity) -> float:
@@ -1038,23 +1072,37 @@ def optimize(
             return
     names = [v.path for v in res.spec.variables]
     objs = [o.output for o in res.spec.objectives]
+    values = res.objective_values()
     if as_json:
         ux.emit_json({"pareto": [{"x": dict(zip(names, map(float, x))),
                                   "objectives": dict(zip(objs, map(float, f)))}
-                                 for x, f in zip(res.X, res.F)],
+                                 for x, f in zip(res.X, values)],
+                      "x_units": "SI",
+                      "objectives_relative_to": {o.output: o.relative_to
+                                                 for o in res.spec.objectives},
                       "chosen": int(res.chosen), "baseline": res.baseline,
                       "evaluations": res.evaluations, "computed": res.computed,
                       "files": [str(f) for f in files]}, _json_default)
         return
+    from .optimize import output_unit
+
     t = Table(title=f"Pareto front ({res.spec.algorithm}, {res.evaluations} evaluations, "
                     f"{res.computed} computed)")
-    for col in ("", *[n.split(".")[-1] for n in names], *objs):
-        t.add_column(col, justify="right")
-    for i, (x, f) in enumerate(zip(res.X, res.F)):
-        t.add_row("*" if i == res.chosen else "", *[f"{v:.4g}" for v in x], *[f"{v:.4g}" for v in f])
+    for col in ("", *[v.label(v.path.split(".")[-1]) for v in res.spec.variables],
+                *res.objective_labels()):
+        t.add_column(_h(col), justify="right")
+    for i, (x, f) in enumerate(zip(res.X, values)):
+        t.add_row("*" if i == res.chosen else "",
+                  *[f"{v.shown(a):.4g}" for v, a in zip(res.spec.variables, x)],
+                  *[f"{v:.4g}" for v in f])
     console.print(t)
+    relative = [o.output for o in res.spec.objectives if o.relative_to]
+    if relative:
+        console.print("baseline (the model without the variables): " + ", ".join(
+            f"{o} = {res.baseline[o]:.5g}" + (f" {output_unit(o)}" if output_unit(o) else "")
+            for o in relative), highlight=False)
     console.print(f"chosen design (*) written to {target / 'chosen.toml'}; front in "
-                  f"{target / 'pareto.csv'}")
+                  f"{target / 'pareto.csv'}", highlight=False)
 
 
 # --------------------------------------------------------------------------- modes
@@ -1071,6 +1119,8 @@ def modes(
                                         help="Include the Coriolis and centripetal terms of "
                                         "a turning carrier (off: stationary carrier).",
                                         metavar=""),
+    assign: Optional[list[str]] = typer.Option(None, "--set", help=_SET_HELP,
+                                               metavar="PATH=VALUE"),
     as_json: bool = _flag("--json", "Print the modes, with their shapes, as JSON."),
     out: Optional[Path] = typer.Option(None, "--out", help="Write the modes and shapes to "
                                        "this NetCDF file.", metavar="FILE"),
@@ -1096,7 +1146,7 @@ def modes(
         _positive(limit, "--below", "'5 kHz'")
         if out is not None:
             files.check_output(out, formats=files.NETCDF_FORMATS, overwrite=force)
-        m, _ = _load(model)
+        m, _ = _load(model, assign)
         if campbell:
             if start is None or stop is None:
                 raise TorquesplitError("--campbell needs a speed range: add --from '500 rpm' "

@@ -16,6 +16,9 @@ helper                      what it does
                             3`` is 3 s), as in model files
 :func:`header`              a table header with its unit in brackets, safe from rich markup
                             (``"speed [rpm]"`` would otherwise lose ``[rpm]``)
+:func:`planet_sharing`      the planet load-sharing factor K_gamma of a planetary model, its
+                            rows (:func:`planet_rows`, tables of ``run``, ``static``,
+                            ``report``) and its ``--json`` entry (:func:`planet_sharing_dict`)
 ==========================  ==============================================================
 
 No state survives a command: :func:`reset` starts each one (the app's callback calls it).
@@ -240,3 +243,42 @@ def render_step_check(check, rows: int = 12, printed: int = PRINTED_DIGITS,
     if len(short) > rows:
         console.print(f"... and {len(short) - rows} more (--json lists every number)",
                       highlight=False)
+
+
+#: what the planet table's numbers are (the line under it in ``run``, ``static``, ``report``)
+PLANET_TEXT = ("K_gamma of a stage: its largest planet load over the mean planet load (the "
+               "mesh-load factor of AGMA 6123 / ISO 6336-1), the largest load-sharing "
+               "coefficient of its sun and ring mesh groups; a planet's factor: the largest "
+               "coefficient of its meshes")
+#: the planet table's columns (the factor's takes the definition)
+PLANET_HEADER = ("carrier", "planet", "mesh groups", "factor ({definition})")
+
+
+def planet_sharing(load_sharing, kinematics):
+    """K_gamma of every planetary stage of a load-sharing result
+    (:func:`torquesplit.metrics.planetary.planet_load_sharing`, any definition), or None
+    for a model without planets."""
+    from .metrics.planetary import planet_load_sharing
+
+    k = planet_load_sharing(load_sharing, kinematics)
+    return k if k.per_stage else None
+
+
+def planet_rows(k, kinematics) -> list[list[str]]:
+    """Rows of the planet table: per stage (carrier) its K_gamma and the groups it is taken
+    over, then each of its planets' factor."""
+    rows = []
+    for carrier, value in k.per_stage.items():
+        rows.append([carrier, "K_gamma (stage)", ", ".join(k.groups[carrier]), f"{value:.4f}"])
+        for planet in kinematics.carriers.get(carrier, ()):
+            if planet in k.per_planet:
+                rows.append(["", planet, "", f"{k.per_planet[planet]:.4f}"])
+    return rows
+
+
+def planet_sharing_dict(k) -> dict:
+    """The ``--json`` entry ``planet_load_sharing`` of a planetary model (commands leave
+    the key out for a model without planets): the definition, K_gamma per stage (carrier),
+    the factor per planet and the mesh groups of each stage."""
+    return {"definition": k.definition, "per_stage": dict(k.per_stage),
+            "per_planet": dict(k.per_planet), "groups": {c: list(g) for c, g in k.groups.items()}}

@@ -12,7 +12,12 @@ carrier):
   eigensolver picked) on the DOFs of the members that are not planets ("central"):
   ``rotational`` when the central members do not translate, ``translational`` when they
   do not rotate, ``planet`` when they do not move at all, ``mixed`` otherwise (each
-  below ``tol`` of the mode's motion);
+  below ``tol`` of the mode's motion).  The labels follow this rule, not Lin & Parker's
+  counts: when no central member translates (sun, ring and carrier ``dofs = ["theta"]``),
+  the degenerate pair of each translational type loses its central motion and is labelled
+  ``planet``; with equally spaced planets it falls at the planet modes' frequency, so
+  the planet groups have multiplicity N - 1 (2 for three planets, which have no Lin &
+  Parker planet modes; docs/theory/planetary.md);
 * **strain energy per element of a group** -- the sum over the group's mass-normalised
   modes of each element's strain energy over the group's total: the trace of the
   element's stiffness over the group's subspace, the same in any basis of a degenerate
@@ -137,7 +142,16 @@ def _groups(freqs: np.ndarray, rtol: float) -> list[list[int]]:
 
 
 def classify(structure, sol, *, rtol: float = 1e-6, tol: float = 1e-6) -> list[ModeRow]:
-    """Group and label the modes of ``sol`` (a ModalSolution of ``structure``)."""
+    """Group and label the modes of ``sol`` (a ModalSolution of ``structure``).
+
+    ``planet``: the central members (not planets) carry less than ``tol`` of the group's
+    mass-weighted motion.  With central members that cannot translate this includes Lin &
+    Parker's translational-type pairs (net force, no net torque of the planets on a centre
+    that cannot translate): with equally spaced planets they fall at the planet modes'
+    frequency, so such a model lists planet groups of multiplicity N - 1, not N - 3 (2
+    for N = 3, which has no planet modes of Lin & Parker's kind).  Not a relabelling: the
+    central members do not move in these modes.
+    """
     meta = structure.metadata
     planets = set(meta.get("planet_bodies", {}))
     names = list(structure.dof_names)

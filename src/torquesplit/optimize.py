@@ -49,13 +49,16 @@ Outputs: ``ltca.MESH.KEY`` -- any key of the LTCA summary of a mesh with
 (:func:`torquesplit.simulate`, per-cycle peak definitions; slow).
 
 Results: the Pareto front (table ``pareto.csv`` and figure ``pareto.png``) and the chosen
-design written back as a model file (``chosen.toml``).
+design written back as a model file (``chosen.toml``).  Variables are shown (tables,
+``pareto.csv``) and written (``chosen.toml``: '0.023 mm') in the unit of their bounds;
+objectives with ``relative_to`` are ratios, headed ``(/ baseline)``.
 """
 
 from __future__ import annotations
 
 import csv
 import json
+import re
 import tomllib
 import warnings
 from concurrent.futures import ProcessPoolExecutor, as_completed
@@ -68,7 +71,7 @@ import numpy as np
 from .errors import ModelError, ModelWarning, TorquesplitError
 
 __all__ = ["ALGORITHMS", "OptimizationSpec", "OptimizationResult", "read_spec", "optimize",
-           "evaluate_design"]
+           "evaluate_design", "output_unit"]
 
 #: pymoo algorithms by name (module, class); any of them takes ``pop_size``
 ALGORITHMS = {
@@ -93,6 +96,24 @@ class Variable:
     lower: float
     upper: float
     also: tuple[str, ...] = ()
+    unit: str = ""
+    """The unit the bounds are written in ("mm"; "" for SI numbers): tables, pareto.csv
+    and chosen.toml show the values in it."""
+    scale: float = 1.0
+    """SI value of one ``unit``."""
+
+    def shown(self, value: float) -> float:
+        """``value`` (SI) in :attr:`unit`."""
+        return float(value) / self.scale
+
+    def label(self, name: str | None = None) -> str:
+        """A column header: the name (default the path) and the unit in brackets."""
+        name = name or self.path
+        return f"{name} [{self.unit}]" if self.unit else name
+
+    def written(self, value: float):
+        """``value`` (SI) as a model file writes it: '0.023 mm', or a number in SI."""
+        return f"{self.shown(value):.6g} {self.unit}" if self.unit else float(value)
 
 
 @dataclass(frozen=True)
@@ -158,6 +179,42 @@ def _si(value, where: str, kind: str | None = None) -> float:
     except Exception:
         raise ModelError([(where, f"{value!r} is not a quantity; write e.g. '0.05 mm' or a "
                                   "number in SI units")]) from None
+
+
+_NUMBER = re.compile(r"^\s*[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?\s*")
+
+
+def _unit_of(values, where: str, kind: str | None) -> tuple[str, float]:
+    """(unit, SI value of one unit) of the first bound written with a unit ('0.05 mm'),
+    ("", 1.0) for bounds in SI numbers."""
+    for value in values:
+        if not isinstance(value, str):
+            continue
+        m = _NUMBER.match(value)
+        unit = value[m.end():].strip() if m else ""
+        if not unit:
+            continue
+        try:
+            scale = _si(f"1 {unit}", where, kind)
+        except ModelError:
+            continue
+        if scale > 0 and np.isfinite(scale):
+            return unit, scale
+    return "", 1.0
+
+
+#: units of the outputs by the suffix of their names (the LTCA summary's keys)
+_OUTPUT_UNITS = (("_arcsec", "arc s"), ("_N_per_m", "N/m"), ("_Pa", "Pa"), ("_N", "N"),
+                 ("_m", "m"))
+
+
+def output_unit(output: str) -> str:
+    """The unit of an output by its name (``..._arcsec``: arc s, ``..._N``: N); "" for a
+    ratio (dynamic factor, load sharing, contact ratio)."""
+    for suffix, unit in _OUTPUT_UNITS:
+        if output.endswith(suffix):
+            return unit
+    return ""
 
 
 def read_spec(source) -> OptimizationSpec:
@@ -229,7 +286,9 @@ def read_spec(source) -> OptimizationSpec:
         unknown = sorted(set(v) - {"path", "lower", "upper", "also"})
         if unknown:
             issues.append((f"{where}.{unknown[0]}", "unknown field; use path, lower, upper, also"))
-        variables.append(Variable(str(v["path"]), lo, hi, tuple(v.get("also", ()))))
+        unit, scale = _unit_of((v["lower"], v["upper"]), f"{where}.lower", kind)
+        variables.append(Variable(str(v["path"]), lo, hi, tuple(v.get("also", ())), unit,
+                                  scale))
     if not variables:
         issues.append(("variables", "no variables; add [[variables]] with path, lower, upper"))
 
@@ -294,7 +353,9 @@ def _set_deep(data: dict, path: str, value) -> dict:
     return set_parameter(data, path, value)
 
 
-def _model_data(spec: OptimizationSpec, x) -> dict:
+def _model_data(spec: OptimizationSpec, x, units: bool = False) -> dict:
+    """The model data of design ``x`` (SI); ``units``: the variables written with the
+    unit of their bounds ('0.023 mm'), as in a model file."""
     import copy
 
     from .model.overrides import apply_overrides
@@ -302,7 +363,7 @@ def _model_data(spec: OptimizationSpec, x) -> dict:
     data = apply_overrides(copy.deepcopy(spec.model_data), spec.fixed)
     for var, value in zip(spec.variables, [] if x is None else x):
         for p in (var.path, *var.also):
-            data = _set_deep(data, p, float(value))
+            data = _set_deep(data, p, var.written(value) if units else float(value))
     # the optimiser's designs are not kept in the LTCA disk cache
     for name in _ltca_meshes(spec):
         data = _set_deep(data, f"meshes.{name}.stiffness.ltca.cache", False)
@@ -417,40 +478,59 @@ class OptimizationResult:
     def chosen_x(self) -> np.ndarray:
         return self.X[self.chosen]
 
-    def chosen_model_data(self) -> dict:
-        """The model file data of the chosen design (fixed overrides and variables set)."""
-        data = _model_data(self.spec, self.chosen_x)
+    def chosen_model_data(self, units: bool = False) -> dict:
+        """The model file data of the chosen design (fixed overrides and variables set:
+        SI numbers, or with ``units`` in the unit of their bounds, '0.023 mm')."""
+        data = _model_data(self.spec, self.chosen_x, units)
         for name in _ltca_meshes(self.spec):  # keep the user's cache setting
             data["meshes"][name]["stiffness"]["ltca"].pop("cache", None)
         return data
 
+    def objective_labels(self) -> list[str]:
+        """Headers of the objective columns: '(/ baseline)' for a ratio to the baseline,
+        else the output's unit in brackets."""
+        out = []
+        for o in self.spec.objectives:
+            unit = output_unit(o.output)
+            out.append(f"{o.output} (/ baseline)" if o.relative_to
+                       else f"{o.output} [{unit}]" if unit else o.output)
+        return out
+
+    def objective_values(self) -> np.ndarray:
+        """(n, n_obj) the objectives as defined ('max' objectives not negated)."""
+        sign = np.array([(-1.0 if o.sense == "max" else 1.0) for o in self.spec.objectives])
+        return self.F * sign
+
     def write(self, directory) -> list[Path]:
-        """pareto.csv, pareto.png and chosen.toml in ``directory``."""
+        """pareto.csv (variables in the unit of their bounds, named in the header),
+        pareto.png and chosen.toml (variables with units) in ``directory``."""
         import tomli_w
 
         d = Path(directory)
         d.mkdir(parents=True, exist_ok=True)
-        names = [v.path for v in self.spec.variables]
-        objs = [o.output + (" / baseline" if o.relative_to else "") for o in self.spec.objectives]
+        names = [v.label() for v in self.spec.variables]
+        objs = self.objective_labels()
         paths = [d / "pareto.csv", d / "chosen.toml"]
         with paths[0].open("w", newline="") as fh:
             w = csv.writer(fh)
             w.writerow(["chosen", *names, *objs])
-            for i, (x, f) in enumerate(zip(self.X, self.F)):
-                sign = [(-1 if o.sense == "max" else 1) for o in self.spec.objectives]
-                w.writerow([int(i == self.chosen), *map(float, x), *(s * v for s, v in zip(sign, f))])
+            for i, (x, f) in enumerate(zip(self.X, self.objective_values())):
+                w.writerow([int(i == self.chosen),
+                            *(v.shown(a) for v, a in zip(self.spec.variables, x)),
+                            *map(float, f)])
         paths[1].write_text("# chosen by torquesplit optimize (" + self.spec.choose + ")\n"
-                            + tomli_w.dumps(self.chosen_model_data()))
+                            + tomli_w.dumps(self.chosen_model_data(units=True)))
         if self.F.shape[1] >= 2:
             from matplotlib.figure import Figure
 
             fig = Figure(figsize=(6.5, 5.0), layout="constrained")
             ax = fig.add_subplot()
-            ax.scatter(self.F[:, 0], self.F[:, 1], label="Pareto front")
-            ax.scatter(self.F[self.chosen, 0], self.F[self.chosen, 1], marker="*", s=200,
+            F = self.objective_values()
+            ax.scatter(F[:, 0], F[:, 1], label="Pareto front")
+            ax.scatter(F[self.chosen, 0], F[self.chosen, 1], marker="*", s=200,
                        color="tab:red", label="chosen")
-            ax.set_xlabel(objs[0] + " [-]" if self.spec.objectives[0].relative_to else objs[0])
-            ax.set_ylabel(objs[1] + " [-]" if self.spec.objectives[1].relative_to else objs[1])
+            ax.set_xlabel(objs[0])
+            ax.set_ylabel(objs[1])
             ax.grid(True, alpha=0.3)
             ax.legend()
             ax.set_title(f"{self.spec.algorithm}: {len(self.F)} Pareto designs, "

@@ -52,3 +52,9 @@ def test_main_writes_the_file(tmp_path):
     target = tmp_path / "model-file.md"
     assert docs.main([str(target)]) == 0
     assert target.read_text(encoding="utf-8") == docs.render()
+
+
+def test_a_list_of_tables_is_documented_as_a_list():
+    """pin_errors is [{radial, tangential}, ...]: a table there gives 'must be a list'."""
+    row = next(ln for ln in docs.render().splitlines() if ln.startswith("| `pin_errors` |"))
+    assert row.startswith("| `pin_errors` | list of tables, each as [`["), row

@@ -601,6 +601,9 @@ def tolerance_warnings(model: Model, kin) -> list[tuple[str, str]]:
       against the ISO 1328-1 runout tolerance F_rT of the gear at grade 11, the coarsest,
       and at the grade the file states (``errors.grade``, one grade step of margin);
     * single pitch error against f_pT the same way;
+    * a planet pin position error (as an installation error, a runout of twice its
+      size) and the eccentricity of the carrier that holds the gear against F_rT of the
+      gear at grade 11;
     * backlash against ten times the minimum of ISO/TR 10064-2,
       j_bn,min = 2/3 (0.06 + 0.0005 a + 0.03 m_n) mm;
     * support clearance against half a percent of the pitch diameter.
@@ -650,6 +653,7 @@ def tolerance_warnings(model: Model, kin) -> list[tuple[str, str]]:
                 f"{g.support.clearance * 1e6:.4g} um is {g.support.clearance / d * 100:.2g} % "
                 f"of the pitch diameter ({d * 1e3:.4g} mm); bearing clearances are a few "
                 f"thousandths of the bore at most: check the value and its unit")))
+    out += _seat_tolerance_warnings(model, kin)
     for name, m in model.meshes.items():
         mk = kin.meshes.get(name)
         bl = m.backlash.nominal + m.backlash.tolerance
@@ -667,6 +671,44 @@ def tolerance_warnings(model: Model, kin) -> list[tuple[str, str]]:
     return out
 
 
+def _seat_tolerance_warnings(model: Model, kin) -> list[tuple[str, str]]:
+    """Pin position errors of gears and eccentricities of the bodies that hold them,
+    beyond F_rT of the gear at grade 11 (each moves the gear like an installation error:
+    a runout of twice its size); a carrier is compared with its finest-toleranced gear."""
+    from ..gears import grades
+    from .kinematics import gear_geometry
+
+    seats: dict[str, list] = {}  # field -> [value, what, tolerance, gear, d]
+    for name, g in model.gears.items():
+        if g.support is None:
+            continue
+        try:
+            d = 2 * gear_geometry(g).reference_radius
+            tol = grades.runout_tolerance(11, g.module, d)
+        except (ModelError, ValueError, ArithmeticError):
+            continue  # outside the standard's scope: the size checks apply
+        fields = [(f"gears.{name}.support.pin_error.{f}", getattr(g.support.pin_error, f),
+                   "pin position errors") for f in ("radial", "tangential")]
+        body = model.bodies.get(g.support.on) if g.support.on else None
+        if body is not None:
+            fields.append((f"bodies.{g.support.on}.eccentricity", body.eccentricity,
+                           "carrier eccentricities"))
+        for loc, value, what in fields:
+            if value and math.isfinite(value) and (loc not in seats or tol < seats[loc][2]):
+                seats[loc] = [value, what, tol, name, d]
+    out = []
+    for loc, (value, what, tol, name, d) in seats.items():
+        if 2 * abs(value) > tol:
+            m_n = model.gears[name].module
+            out.append((loc, (
+                f"{_length_text(abs(value))} (as a runout: {_length_text(2 * abs(value))}) "
+                f"is beyond the ISO 1328-1 runout tolerance F_rT of the coarsest grade, 11, "
+                f"of {name} ({tol * 1e6:.4g} um for d = {d * 1e3:.4g} mm, m_n = "
+                f"{m_n * 1e3:.4g} mm); {what} are microns: check the value and its unit (a "
+                f"bare number is read in m)")))
+    return out
+
+
 #: a length more than this many times the largest gear (or less than its inverse) is
 #: flagged as a probable unit mistake
 SIZE_RATIO = 100.0
@@ -678,14 +720,20 @@ INERTIA_RATIO = 100.0
 MAX_PITCH_SPEED = 300.0
 #: tooth load per face width beyond what steel teeth carry [N/m] (10 kN/mm)
 MAX_LOAD_PER_WIDTH = 1e7
+#: a tooth modification amount (relief, crowning, helix slope) above this fraction of the
+#: module is flagged: modifications remove a few to tens of microns (tip relief of the
+#: order of the tooth deflection, 0.01-0.02 m_n for heavily loaded teeth)
+MODIFICATION_MODULE_RATIO = 0.05
 
 
 def magnitude_warnings(model: Model, kin) -> list[tuple[str, str]]:
     """Sizes that are possible but usually a unit mistake ("560 parsec" for a shaft).
 
-    Lengths are compared with the gears' size (the largest pitch diameter ``D``), errors
-    and clearances with the module, a given mass or inertia with the gear's solid-disc
-    value, speeds and tooth loads with what gears carry.  Each names the field.
+    Lengths are compared with the gears' size (the largest pitch diameter ``D``), errors,
+    clearances, pin position errors and eccentricities with the module, tooth
+    modifications with :data:`MODIFICATION_MODULE_RATIO` of the module, a given mass or
+    inertia with the gear's solid-disc value, speeds and tooth loads with what gears
+    carry.  Each names the field.
     """
     from .kinematics import gear_geometry
 
@@ -738,10 +786,15 @@ def magnitude_warnings(model: Model, kin) -> list[tuple[str, str]]:
         if g.support is not None:
             against_module(f"{loc}.support.clearance", g.support.clearance, g.module,
                            "bearing clearances")
+            for field in ("radial", "tangential"):
+                against_module(f"{loc}.support.pin_error.{field}",
+                               getattr(g.support.pin_error, field), g.module,
+                               "pin position errors ([[planetary]] pin_errors)")
             if g.support.shaft is not None:
                 for field in ("diameter", "span", "position"):
                     against_size(f"{loc}.support.shaft.{field}",
                                  getattr(g.support.shaft, field))
+        out += _modification_warnings(loc, g)
         body = kin.bodies.get(name)
         if body is not None and d:
             m_geo, j_geo = _disc_mass_inertia(g, d)
@@ -764,6 +817,12 @@ def magnitude_warnings(model: Model, kin) -> list[tuple[str, str]]:
                                  f"write '3000 rpm' or '50 Hz')"))
     for name, b in model.bodies.items():
         against_size(f"bodies.{name}.position", max(abs(v) for v in b.position), small=False)
+        # the planets on a carrier set the scale of its eccentricity, else any gear
+        held = [g.module for g in model.gears.values()
+                if g.support is not None and g.support.on == name]
+        against_module(f"bodies.{name}.eccentricity", b.eccentricity,
+                       min(held or [g.module for g in model.gears.values()]),
+                       "carrier eccentricities")
     for name, sh in model.shafts.items():
         for field in ("diameter", "length"):
             against_size(f"shafts.{name}.{field}", getattr(sh, field))
@@ -789,6 +848,35 @@ def magnitude_warnings(model: Model, kin) -> list[tuple[str, str]]:
             out.append((f"splines.{name}.radial_clearance", (
                 f"{sp.radial_clearance * 1e3:.4g} mm is larger than the pitch radius "
                 f"({sp.pitch_radius * 1e3:.4g} mm); check the value and its unit")))
+    return out
+
+
+def _modification_warnings(loc: str, gear) -> list[tuple[str, str]]:
+    """Tooth modification amounts above :data:`MODIFICATION_MODULE_RATIO` of the module."""
+    spec = gear.modifications
+    if spec is None:
+        return []
+    limit = MODIFICATION_MODULE_RATIO * gear.module
+    out = []
+    for flank, where in ((spec, f"{loc}.modifications"),
+                         (spec.second_helix, f"{loc}.modifications.second_helix")):
+        if flank is None:
+            continue
+        amounts = [("crowning", flank.crowning), ("helix_slope", flank.helix_slope)]
+        for name in ("tip_relief", "root_relief", "end_relief"):
+            if getattr(flank, name) is not None:
+                amounts.append((f"{name}.amount", getattr(flank, name).amount))
+        if flank.topological is not None:
+            amounts += [(f"topological.{y}", getattr(flank.topological, y))
+                        for y in ("y1", "y2", "y5")]
+        for field, value in amounts:
+            if math.isfinite(value) and abs(value) > limit:
+                out.append((f"{where}.{field}", (
+                    f"{_length_text(abs(value))} is {abs(value) / gear.module:.3g} times the "
+                    f"module ({gear.module * 1e3:.4g} mm); tooth modifications remove a few "
+                    f"to tens of microns (rarely over {MODIFICATION_MODULE_RATIO:g} m_n): "
+                    f"check the value and its unit (a bare number is read in m: write "
+                    f"'15 um')")))
     return out
 
 

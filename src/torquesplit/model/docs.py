@@ -158,7 +158,9 @@ def _section(path: str, cls: type[BaseModel], paths: dict[type, str],
             if sub not in paths:
                 paths[sub] = f"{path}.{name}"
                 nested.append(sub)
-            kind = f"table, see [`[{paths[sub]}]`](#{_anchor(paths[sub])})"
+            link = f"[`[{paths[sub]}]`](#{_anchor(paths[sub])})"
+            kind = (f"list of tables, each as {link}" if _is_table_list(field.annotation)
+                    else f"table, see {link}")
             shorthand = _unit(field.annotation, field.metadata)
             if shorthand is not None:
                 kind = f"{_quantity_text(shorthand)}, or a {kind}"
@@ -197,6 +199,12 @@ def _section_class(tp) -> type[BaseModel] | None:
 
 def _is_table(tp) -> bool:
     return isinstance(tp, type) and issubclass(tp, Strict)
+
+
+def _is_table_list(tp) -> bool:
+    """A (possibly optional) list of tables, written ``[{...}, {...}]``."""
+    tp = _strip_optional(tp)
+    return typing.get_origin(tp) is list and _is_table(typing.get_args(tp)[0])
 
 
 def _header(name: str, tp) -> str:

@@ -115,7 +115,9 @@ _TYPE_MESSAGES = {
 def _message(err: dict, parts: list[str]) -> str:
     kind = err["type"]
     ctx = err.get("ctx") or {}
-    got = _short(err.get("input"))
+    value = err.get("input")
+    # a converted quantity carries float noise ("-5 um" is -4.9999999999999996e-06 m)
+    got = f"{value:.6g}" if isinstance(value, float) else _short(value)
     if kind == "extra_forbidden":
         name, section = (parts[-1], parts[:-1]) if parts else ("", [])
         guess = difflib.get_close_matches(name, _fields_at(section), n=1, cutoff=0.6)

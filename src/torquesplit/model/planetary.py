@@ -174,7 +174,9 @@ class Planetary(Strict):
     planet_bearing: Support = Field(description="Bearing of each planet on its carrier pin "
                                     "(its other end is on the carrier: leave 'on' out).")
     pin_errors: list[PinError] | None = Field(
-        None, description="Pin position error of each planet (radial, tangential).")
+        None, description="Pin position error of each planet: one {radial, tangential} "
+        "table per planet, in planet order, e.g. [{tangential = '20 um'}, {}, {}] (pin "
+        "errors are typically microns); default none.")
     sun_mesh: PlanetaryMesh = Field(description="The sun-planet meshes.")
     ring_mesh: PlanetaryMesh = Field(description="The ring-planet meshes.")
 

@@ -8,9 +8,9 @@ Each function takes LTCA results (:class:`~torquesplit.gears.contact.LtcaResult`
 function                        shows
 ==============================  ==============================================================
 ``te_figure``                   loaded static transmission error over two mesh cycles at
-                                several loads, um along the flank normal (left axis) and arc
+                                several loads, µm along the flank normal (left axis) and arc
                                 seconds of gear 2 (right axis, Liu et al. 2021 eq. 3)
-``harris_figure``               Harris map: TE peak-to-peak against load (um and arc s), with
+``harris_figure``               Harris map: TE peak-to-peak against load (µm and arc s), with
                                 the actual contact ratio
 ``load_distribution_figure``    load per unit contact-line length on the face (2-D map of the
                                 flank: face position against roll length of gear 1) at
@@ -20,7 +20,8 @@ function                        shows
                                 load sharing
 ==============================  ==============================================================
 
-Units on the axes: um, arc seconds, N/mm, N/um (= 1e6 N/m), MPa, mm, kN.
+Units on the axes and in the legends: µm, arc seconds, N/mm, N/µm (= 1e6 N/m), MPa, mm, kN
+(µm, as in the tables of ``torquesplit contact``).
 """
 
 from __future__ import annotations
@@ -47,10 +48,10 @@ def _cycles(phase, values, cycles=2):
 
 
 def _arcsec_axis(ax, result):
-    """Right axis in arc seconds of gear 2 for a left axis in um (normal)."""
+    """Right axis in arc seconds of gear 2 for a left axis in µm (normal)."""
     from torquesplit.gears.contact.ltca import ARCSEC_PER_RAD
 
-    f = float(result.model.te_angle(1e-6)) * ARCSEC_PER_RAD      # arcsec per um
+    f = float(result.model.te_angle(1e-6)) * ARCSEC_PER_RAD      # arcsec per µm
     sec = ax.secondary_yaxis("right", functions=(lambda u: u * f, lambda a: a / f))
     sec.set_ylabel("TE of gear 2 [arc s]")
     return sec
@@ -62,10 +63,10 @@ def te_figure(results: Sequence, title: str | None = None):
     ax = fig.add_subplot()
     for r in sorted(results, key=lambda r: r.load):
         ph, z = _cycles(r.phase, r.transmission_error * 1e6)
-        ax.plot(ph, z, label=f"{r.load / 1e3:.4g} kN: p-p {r.te_peak_to_peak * 1e6:.3g} um "
+        ax.plot(ph, z, label=f"{r.load / 1e3:.4g} kN: p-p {r.te_peak_to_peak * 1e6:.3g} µm "
                              f"= {r.te_peak_to_peak_arcsec:.3g} arc s")
     ax.set_xlabel("mesh phase [mesh cycles]")
-    ax.set_ylabel("loaded transmission error, flank normal [um]")
+    ax.set_ylabel("loaded transmission error, flank normal [µm]")
     ax.set_xlim(0, 2)
     ax.grid(True, alpha=0.3)
     _arcsec_axis(ax, results[0])
@@ -81,7 +82,7 @@ def harris_figure(harris, title: str | None = None, design_load: float | None = 
     loads = harris.loads / 1e3
     ax.plot(loads, harris.te_peak_to_peak * 1e6, "o-", label="TE peak-to-peak")
     ax.set_xlabel("normal load [kN]")
-    ax.set_ylabel("TE peak-to-peak, flank normal [um]")
+    ax.set_ylabel("TE peak-to-peak, flank normal [µm]")
     ax.grid(True, alpha=0.3)
     _arcsec_axis(ax, harris.results[0])
     if design_load is not None:
@@ -152,9 +153,9 @@ def stiffness_figure(result, title: str | None = None):
     ax = fig.add_subplot()
     for label, k in (("secant P/Z", result.stiffness_secant), ("tangent dP/dZ", result.stiffness_tangent)):
         ph, v = _cycles(result.phase, k / 1e6)
-        ax.plot(ph, v, label=f"{label} (mean {k.mean():.4g} N/m)")
+        ax.plot(ph, v, label=f"{label} (mean {k.mean() / 1e6:.4g} N/µm)")
     ax.set_xlabel("mesh phase [mesh cycles]")
-    ax.set_ylabel("mesh stiffness [N/um]")
+    ax.set_ylabel("mesh stiffness [N/µm]")
     ax.set_xlim(0, 2)
     ax.grid(True, alpha=0.3)
     fig.legend(loc="outside lower center", ncols=2, fontsize="small")
@@ -188,9 +189,10 @@ def pressure_figure(result, title: str | None = None):
 CONTACT_FIGURES = ("te", "harris", "load_distribution", "stiffness", "pressure")
 
 
-def contact_figure_files() -> list[str]:
-    """The file names :func:`write_contact_figures` writes."""
-    return [f"contact_{n}.png" for n in CONTACT_FIGURES]
+def contact_figure_files(harris: bool = True) -> list[str]:
+    """The file names :func:`write_contact_figures` writes (``harris=False``: without a
+    Harris map)."""
+    return [f"contact_{n}.png" for n in CONTACT_FIGURES if harris or n != "harris"]
 
 
 def write_contact_figures(results: Sequence, harris, directory, *, operating=None,
@@ -198,7 +200,8 @@ def write_contact_figures(results: Sequence, harris, directory, *, operating=Non
     """Write every figure as PNG into ``directory``; returns the paths.
 
     ``operating`` is the result drawn in the single-load figures (default the largest
-    load); ``operating_load`` [N] is marked on the Harris map.
+    load); ``operating_load`` [N] is marked on the Harris map; ``harris=None`` (``contact
+    --harris 0``) writes no Harris map.
     """
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
@@ -206,15 +209,17 @@ def write_contact_figures(results: Sequence, harris, directory, *, operating=Non
     prefix = f"{title}: " if title else ""
     figs = {
         "te": te_figure(results, f"{prefix}loaded static transmission error"),
-        "harris": harris_figure(harris, f"{prefix}Harris map",
-                                design_load=op.load if operating_load is None else operating_load),
         "load_distribution": load_distribution_figure(op, title=f"{prefix}load distribution at "
                                                                  f"{op.load / 1e3:.4g} kN"),
         "stiffness": stiffness_figure(op, f"{prefix}mesh stiffness at {op.load / 1e3:.4g} kN"),
         "pressure": pressure_figure(op, f"{prefix}contact pressure at {op.load / 1e3:.4g} kN"),
     }
+    if harris is not None:
+        figs["harris"] = harris_figure(
+            harris, f"{prefix}Harris map",
+            design_load=op.load if operating_load is None else operating_load)
     paths = []
-    for name in CONTACT_FIGURES:
+    for name in (n for n in CONTACT_FIGURES if n in figs):
         fig, path = figs[name], directory / f"contact_{name}.png"
         fig.savefig(path, dpi=120)
         paths.append(path)

@@ -9,7 +9,8 @@
 3. the model: bodies, meshes, supports, shafts and splines, with units;
 4. the layout drawing (:mod:`torquesplit.plot.layout`);
 5. the run's settings and the per-mesh and per-group tables, with what the load-sharing
-   definition measures and when to report it;
+   definition measures and when to report it; for a planetary model the planet table
+   (K_gamma per stage, the factor per planet);
 6. figures: load sharing, dynamic factors, cycle peaks, mesh force at the end of the run,
    support-force spectrum (whatever applies);
 7. natural modes, those near a mesh frequency or its harmonics marked;
@@ -202,7 +203,7 @@ def _run_section(res, met) -> str:
                 ["steps", f"{st['steps']:,}"],
                 ["step [s]", _g(st["step_s"], 4) if st["step_s"] else "adaptive"],
                 ["transient discarded [s]", _g(met.settling.start_time, 5)
-                 + ("" if met.settling.settled else " (not settled: last half used)")],
+                 + ("" if met.settling.settled else " (not settled: see the warnings)")],
                 ["load-sharing definition", met.definition],
                 ["status", res.message]]
     rows = []
@@ -234,7 +235,21 @@ def _run_section(res, met) -> str:
             "and the largest settled back-flank force. "
             f"System load-sharing coefficient: <b>{met.load_sharing.system:.5f}</b>.</p>")
     return (_table(["setting", "value"], settings, left=2) + what + "<h3>Per mesh</h3>"
-            + per_mesh + "<h3>Per load-sharing group</h3>" + groups)
+            + per_mesh + "<h3>Per load-sharing group</h3>" + groups
+            + _planets(met.load_sharing, res.kinematics))
+
+
+def _planets(load_sharing, kinematics) -> str:
+    """The planet table (K_gamma per stage, the factor per planet) of a planetary model;
+    nothing for a model without planets."""
+    from ..cli_support import PLANET_HEADER, PLANET_TEXT, planet_rows, planet_sharing
+
+    k = planet_sharing(load_sharing, kinematics)
+    if k is None:
+        return ""
+    header = [h.format(definition=k.definition) for h in PLANET_HEADER]
+    return ("<h3>Planets</h3>" + _table(header, planet_rows(k, kinematics), left=3)
+            + f'<p class="note">{_e(PLANET_TEXT)} ({_e(k.definition)}).</p>')
 
 
 def _figure(fig_svg: str, caption: str) -> str:
@@ -305,7 +320,8 @@ def _static_section(quasi) -> str:
            f"<b>{met.system:.5f}</b> (static torque ratio, largest over the positions, Mo "
            f"et al. 2017 eqs. 14-15).</p>"
            + _table(["mesh", "min F [kN]", "mean F [kN]", "max F [kN]", "LSC (static_torque)"],
-                    rows))
+                    rows)
+           + _planets(met, quasi.kinematics))
     try:
         out += _figure(F.figure_svg(F.static_load_sharing_figure(quasi), "static_ls"),
                        "Quasi-static load sharing over one revolution of the slowest gear.")

@@ -302,8 +302,10 @@ class LtcaResult:
         Normal load of each slice [N] (0 where not in contact).
     transmission_error : (M,)
         Loaded static transmission error: approach of the gear bodies along the flank
-        normal [m], measured from the conjugate position of the unmodified, aligned
-        pair (Liu et al. 2021: "normal deformation Z").
+        normal [m] (Liu et al. 2021: "normal deformation Z"), measured from the
+        conjugate position of the most prominent point: the separations of the
+        modifications and misalignment are shifted so that their minimum over the contact
+        zone at all positions is zero (``model.separation_shift``; docs/theory/ltca.md).
     stiffness_tangent : (M,)
         ``dP/dZ`` with the contact set held [N/m].
     iterations, status : (M,)

@@ -79,13 +79,21 @@ __all__ = [
 _SHAPES = {"linear": 1.0, "parabolic": 2.0}
 
 
+def _num(value, unit: str = "") -> str:
+    """A number for a message without float noise ("-5e-06 m", not -4.9999999999999996e-06)."""
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
+        return f"{value:.6g}" + (f" {unit}" if unit else "")
+    return repr(value)
+
+
 def _exponent(shape: str, exponent: float, where: str) -> float:
     if shape in _SHAPES:
         return _SHAPES[shape]
     if shape == "power":
         if not (exponent > 0 and math.isfinite(exponent)):
             raise ModelError([(f"{where}.exponent", f"must be a positive number, got "
-                                                    f"{exponent!r}; give e.g. 2 for a parabola")])
+                                                    f"{_num(exponent)}; give e.g. 2 for a "
+                                                    "parabola")])
         return float(exponent)
     raise ModelError([(f"{where}.shape", f"unknown shape {shape!r}; use 'linear', 'parabolic' "
                                          "or 'power'")])
@@ -120,7 +128,7 @@ class Relief:
         """Raise ModelError (location ``where.field``) if the relief is ill-defined."""
         if not (self.amount >= 0 and math.isfinite(self.amount)):
             raise ModelError([(f"{where}.amount", f"must be a non-negative length, got "
-                                                  f"{self.amount!r}; give e.g. '20 um'")])
+                                                  f"{_num(self.amount, 'm')}; give e.g. '20 um'")])
         given = [n for n in ("length", "start_diameter", "start_roll_angle", "height")
                  if getattr(self, n) is not None]
         if len(given) != 1:
@@ -128,8 +136,9 @@ class Relief:
                                       f"start_roll_angle, height (got {given or 'none'}); give one")])
         v = getattr(self, given[0])
         if not (v > 0 and math.isfinite(v)):
-            raise ModelError([(f"{where}.{given[0]}", f"must be positive, got {v!r}; correct "
-                                                      "the value")])
+            unit = "rad" if given[0] == "start_roll_angle" else "m"
+            raise ModelError([(f"{where}.{given[0]}", f"must be positive, got {_num(v, unit)}; "
+                                                      "correct the value")])
         _exponent(self.shape, self.exponent, where)
 
     @property
@@ -154,9 +163,10 @@ class EndRelief:
     def check(self, where: str, face_width: float | None = None) -> None:
         if not (self.amount >= 0 and math.isfinite(self.amount)):
             raise ModelError([(f"{where}.amount", f"must be a non-negative length, got "
-                                                  f"{self.amount!r}; give e.g. '10 um'")])
+                                                  f"{_num(self.amount, 'm')}; give e.g. '10 um'")])
         if not (self.length > 0 and math.isfinite(self.length)):
-            raise ModelError([(f"{where}.length", f"must be positive, got {self.length!r}; "
+            raise ModelError([(f"{where}.length", f"must be positive, got "
+                                                  f"{_num(self.length, 'm')}; "
                                                   "correct the value")])
         if face_width is not None and 2.0 * self.length > face_width * (1 + 1e-12):
             raise ModelError([(f"{where}.length", (
@@ -393,8 +403,9 @@ def lead_separation(mod: FlankModification, y, face_width: float, where: str = "
     out = np.zeros_like(y)
     if mod.crowning:
         if mod.crowning < 0:
-            raise ModelError([(f"{where}.crowning", f"must not be negative, got {mod.crowning!r}; "
-                                                    "give zero or a positive amount")])
+            raise ModelError([(f"{where}.crowning", f"must not be negative, got "
+                                                    f"{_num(mod.crowning, 'm')}; give zero or a "
+                                                    "positive amount")])
         out = out + mod.crowning * (2.0 * y / b - 1.0) ** 2
     if mod.end_relief is not None:
         er = mod.end_relief
