@@ -251,7 +251,10 @@ def test_a_real_sigint_stops_a_run_and_writes_nothing(tmp_path):
     proc = subprocess.Popen([sys.executable, "-m", "torquesplit.cli", "run", str(model),
                              "--cycles", "3000000", "--max-steps", "1000000000", "--out",
                              str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True, env=dict(os.environ, PYTHONPATH=SRC))
+                            text=True, env=dict(os.environ, PYTHONPATH=SRC),
+                            # Ctrl-C as a terminal delivers it, even where the test runner
+                            # itself runs with SIGINT ignored (a background job: nohup ... &)
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     deadline = time.monotonic() + 120
     while not (tmp_path / ".r.nc.lock").exists():  # claimed: the run has started
         assert proc.poll() is None and time.monotonic() < deadline, proc.communicate()
