@@ -129,8 +129,8 @@ def quasi_static_load_sharing(model, *, revolutions: float | None = None,
     one revolution of the slowest gear and at most :data:`MAX_REVOLUTIONS` (said when cut),
     or over ``revolutions`` of the slowest gear (in its mesh's frame: relative to the
     carrier for a planet mesh), at ``points_per_cycle`` positions per cycle of the fastest
-    excitation (the fastest mesh
-    when nothing varies), at most ``max_points`` (said when that thins them).
+    excitation (the fastest mesh when nothing varies), at most ``max_points`` (said when
+    that thins them).
 
     A shorter sweep sees only some of the error combinations: its largest ratios are too
     small and its mean forces unequal (Mo et al. 2017's example repeats every 25
@@ -190,6 +190,6 @@ def _excitation_period(structure, turn: float) -> float:
             return period * max(1, math.ceil(turn / period - 1e-9))
         why = (f"the excitations repeat only every {period / turn:.6g} revolutions of the "
                f"slowest gear")
-    warnings.warn(f"{why}; the quasi-static sweep covers {MAX_REVOLUTIONS:g} of them: give "
-                  f"revolutions to choose", stacklevel=3)
+    warnings.warn(f"{why}; the quasi-static sweep covers {MAX_REVOLUTIONS:g} revolutions of "
+                  f"the slowest gear: give revolutions to choose", stacklevel=3)
     return cap

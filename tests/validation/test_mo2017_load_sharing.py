@@ -96,7 +96,7 @@ def test_a_common_period_too_long_is_cut_and_said(monkeypatch):
     import torquesplit.quasistatic as qs
 
     monkeypatch.setattr(qs, "MAX_REVOLUTIONS", 4.0)
-    with pytest.warns(UserWarning, match="repeat only every 25 revolutions.*covers 4 of"):
+    with pytest.warns(UserWarning, match="repeat only every 25 revolutions.*covers 4 revolutions"):
         res = quasi_static_load_sharing(_model(True), points_per_cycle=2)
     kin = res.kinematics
     slowest = min(abs(v) for mk in kin.meshes.values()
