@@ -96,9 +96,8 @@ def campbell_figure(ds):
     for j, lab in enumerate(ds["line"].values):
         order, _, source = str(lab).partition(" x ")
         sources.setdefault(source, []).append((j, int(order)))
-    colours = plt_colours()
     for k, (source, members) in enumerate(sources.items()):
-        colour = colours[k % len(colours)]
+        colour = f"C{k % 10}"  # matplotlib's colour cycle
         orders = [o for _, o in members]
         label = source if orders == [1] else f"{source} x {min(orders)}..{max(orders)}"
         for i, (j, order) in enumerate(members):
@@ -117,13 +116,6 @@ def campbell_figure(ds):
                  f"frequencies, numbered; dashed: excitation orders)", fontsize=9)
     ax.legend(fontsize=6, loc="upper left")
     return fig
-
-
-def plt_colours() -> list[str]:
-    """Matplotlib's colour cycle."""
-    import matplotlib.pyplot as plt
-
-    return plt.rcParams["axes.prop_cycle"].by_key()["color"]
 
 
 def save(fig, path) -> Path:
