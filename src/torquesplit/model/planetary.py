@@ -29,6 +29,11 @@ tooth-count assembly condition ``(z_s + z_r) psi / 360 deg`` whole for every pla
 angle psi), they do not overlap, sun-planet and planet-ring centre distances agree, the
 ring is internal, the pins sit on the planet circle.
 
+Tooth modifications of a member (``sun.modifications``, ``planet.modifications`` -- every
+planet gets it --, ``ring.modifications``) and the ``misalignment`` of ``sun_mesh`` /
+``ring_mesh`` go to the generated gears and meshes, where stiffness method ``"ltca"``
+uses them as for any gear and mesh (the LTCA analyses the internal ring-planet pair).
+
 After validation the model holds the general elements only (a model written back to a
 file has no ``[[planetary]]`` table).
 """
@@ -51,6 +56,8 @@ from .schema import (
     Inertia,
     Length,
     Mass,
+    MisalignmentSpec,
+    ModificationsSpec,
     Number,
     PinError,
     StiffnessSpec,
@@ -74,7 +81,8 @@ class PlanetaryGear(Strict):
 
     teeth: Count = Field(gt=0, le=10_000, description="Number of teeth.")
     kind: Literal["spur", "helical", "double_helical", "internal"] | None = Field(
-        None, description="Gear type; default from the stage (the ring is internal).")
+        None, description="Gear type; default from the stage (the ring is internal; "
+        "'double_helical' is refused: the internal ring has one helix).")
     profile_shift: Number = Field(0.0, ge=-5, le=5, description="Profile shift coefficient x.")
     face_width: Length | None = Field(None, gt=0, description="Face width; default the "
                                       "stage's.")
@@ -91,6 +99,9 @@ class PlanetaryGear(Strict):
         None, description="Holds the member against rotation (a fixed ring).")
     errors: GearErrors = Field(GearErrors(), description="Manufacturing and assembly errors "
                                "(every planet gets these).")
+    modifications: ModificationsSpec | None = Field(
+        None, description="Tooth modification of the loaded flank, as for [gears.NAME] "
+        "(every planet gets it; used by stiffness method 'ltca' of sun_mesh / ring_mesh).")
 
     @model_validator(mode="after")
     def _dofs(self):
@@ -133,6 +144,9 @@ class PlanetaryMesh(Strict):
     backlash: Annotated[
         BacklashSpec, BeforeValidator(_backlash_shorthand), Unit("length")
     ] = Field(0.0, description="Total backlash (\"100 um\"; 0 = none), or a [backlash] table.")
+    misalignment: MisalignmentSpec = Field(MisalignmentSpec(), description="Misalignment and "
+                                           "base pitch deviation of every planet's mesh "
+                                           "(stiffness method 'ltca').")
 
     @model_validator(mode="after")
     def _one(self):
@@ -207,8 +221,28 @@ class Planetary(Strict):
             if getattr(self, member).kind == "internal":
                 raise FieldError(f"{member}.kind", f"the {member} meshes outside the planets"
                                  f"' teeth and cannot be internal; remove 'kind'")
+            if getattr(self, member).kind == "double_helical":
+                # the ring is an internal gear, and an internal gear has one helix here
+                raise FieldError(f"{member}.kind", (
+                    "a [[planetary]] stage is spur or helical: its ring is an internal gear "
+                    "with one helix, which cannot mesh with double-helical planets; use "
+                    "kind = 'helical' (with the stage's helix_angle) or remove 'kind'"))
+        self._check_modifications()
         self._check_fit()
         return self
+
+    def _check_modifications(self) -> None:
+        """What [gears.NAME] refuses of its modifications, named as written here: a second
+        helix on a gear with one helix, which every member of a stage is (see
+        _consistent).  Every member is cylindrical, so every one may be modified; the
+        LTCA analyses the internal ring-planet pair too."""
+        for member in ("sun", "planet", "ring"):
+            spec = getattr(self, member).modifications
+            if spec is not None and spec.second_helix is not None:
+                raise FieldError(f"{member}.modifications.second_helix", (
+                    "a second helix exists on double-helical gears only, and the gears of a "
+                    "[[planetary]] stage have one helix (spur or helical); remove "
+                    "second_helix"))
 
     # ------------------------------------------------------------------ layout
     def planet_angles(self) -> list[float]:
@@ -317,7 +351,8 @@ class Planetary(Strict):
                      face_width=member.face_width or self.face_width,
                      profile_shift=member.profile_shift, bore_diameter=member.bore_diameter,
                      axis=self.axis, dofs=member.dofs or dofs, errors=member.errors,
-                     torsional_support=member.torsional_support)
+                     torsional_support=member.torsional_support,
+                     modifications=member.modifications)
             if member.mass is not None:
                 d["mass"] = member.mass
             if member.polar_inertia is not None:
@@ -353,10 +388,12 @@ class Planetary(Strict):
                                      ("ring", self.ring_mesh, names["ring_meshes"])):
             for mname, pname in zip(mnames, names["planets"]):
                 d = dict(gears=(names[member], pname), stiffness=spec.stiffness,
-                         backlash=spec.backlash, stage=f"{self.name}-{member}")
+                         backlash=spec.backlash, stage=f"{self.name}-{member}",
+                         misalignment=spec.misalignment)
                 if spec.damping is not None:
                     d["damping"] = spec.damping
                 if spec.damping_ratio is not None:
                     d["damping_ratio"] = spec.damping_ratio
                 meshes[mname] = d
         return gears, bodies, meshes
+
