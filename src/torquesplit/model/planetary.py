@@ -337,6 +337,42 @@ class Planetary(Strict):
                                                  range(self.planets)],
                     ring_meshes=[f"{n}_ring_planet{i + 1}" for i in range(self.planets)])
 
+    def origins(self, index: int) -> dict[str, str]:
+        """Where the user wrote what the expansion generates: the location of each
+        generated element, and of its fields that come from elsewhere in the stage table
+        -> the field of ``[[planetary]]`` number ``index`` (``gears.st_planet2`` ->
+        ``planetary.0.planet``, ``gears.st_planet2.support.pin_error`` ->
+        ``planetary.0.pin_errors.1``, ``gears.st_sun.module`` -> ``planetary.0.module``),
+        so that messages name the field as written (:meth:`Model.written_at`)."""
+        here = f"planetary.{index}"
+        names = self.names()
+        out: dict[str, str] = {}
+        members = [("sun", names["sun"]), ("ring", names["ring"])]
+        members += [("planet", p) for p in names["planets"]]
+        for member, gear in members:
+            loc, spec = f"gears.{gear}", getattr(self, member)
+            out[loc] = f"{here}.{member}"
+            for field in ("module", "pressure_angle", "helix_angle", "hand", "axis"):
+                out[f"{loc}.{field}"] = f"{here}.{field}"
+            if spec.face_width is None:
+                out[f"{loc}.face_width"] = f"{here}.face_width"
+            if member != "planet":
+                out[f"{loc}.position"] = f"{here}.position"
+        for i, planet in enumerate(names["planets"]):
+            loc = f"gears.{planet}"
+            where = f"{here}.angles.{i}" if self.angles is not None else f"{here}.planets"
+            out[f"{loc}.place"] = out[f"{loc}.position"] = where
+            out[f"{loc}.support"] = f"{here}.planet_bearing"
+            out[f"{loc}.support.pin_error"] = f"{here}.pin_errors.{i}"
+        loc = f"bodies.{names['carrier']}"
+        out[loc] = f"{here}.carrier"
+        out[f"{loc}.position"] = f"{here}.position"
+        out[f"{loc}.axis"] = f"{here}.axis"
+        for member in ("sun", "ring"):
+            for mesh in names[f"{member}_meshes"]:
+                out[f"meshes.{mesh}"] = f"{here}.{member}_mesh"
+        return out
+
     def expand(self) -> tuple[dict, dict, dict]:
         """(gears, bodies, meshes) as dicts of SI values and schema objects, ready for
         the general schema sections."""
@@ -397,3 +433,16 @@ class Planetary(Strict):
                 meshes[mname] = d
         return gears, bodies, meshes
 
+
+def written_at(origins: dict[str, str], loc: str) -> str:
+    """``loc`` (``gears.st_planet2.modifications.crowning``) as the user wrote it
+    (``planetary.0.planet.modifications.crowning``) by the longest generated prefix in
+    ``origins`` (:meth:`Planetary.origins`); a location of no stage is returned as is."""
+    if not origins or not loc:
+        return loc
+    parts = loc.split(".")
+    for n in range(len(parts), 0, -1):
+        head = ".".join(parts[:n])
+        if head in origins:
+            return origins[head] + loc[len(head):]
+    return loc
