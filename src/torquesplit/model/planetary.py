@@ -273,15 +273,25 @@ class Planetary(Strict):
         from ..errors import ModelError
         from ..gears.geometry import PairGeometry
 
+        geo, member = {}, None
         try:
-            sun, planet = self._geometry(self.sun), self._geometry(self.planet)
-            ring = self._geometry(self.ring, internal=True)
+            for member in ("sun", "planet", "ring"):
+                geo[member] = self._geometry(getattr(self, member), internal=member == "ring")
+            member = None
+            sun, planet, ring = geo["sun"], geo["planet"], geo["ring"]
             a_sp = PairGeometry(sun, planet).operating_center_distance
             a_rp = PairGeometry(planet, ring).operating_center_distance
         except ModelError as exc:
             loc, msg = exc.issues[0]
-            raise FieldError("ring.teeth" if "internal" in msg else "planet.teeth",
-                             msg if ";" in msg else f"{msg}; correct the tooth counts") from None
+            # a gear's own geometry names its field (the stage's module, the member's
+            # teeth); a pair that cannot mesh, the tooth counts
+            field = {"normal_module": "module", "normal_pressure_angle": "pressure_angle",
+                     "helix_angle": "helix_angle", "teeth": f"{member}.teeth",
+                     "addendum": f"{member}.profile_shift"}.get(loc) if member else None
+            if field is None:
+                field = "ring.teeth" if "internal" in msg else "planet.teeth"
+            fix = "tooth counts" if field.endswith(".teeth") else "value"
+            raise FieldError(field, msg if ";" in msg else f"{msg}; correct the {fix}") from None
         zs, zp, zr = self.sun.teeth, self.planet.teeth, self.ring.teeth
         if abs(a_sp - a_rp) > 1e-6 * a_sp:
             raise FieldError("ring.teeth", (
