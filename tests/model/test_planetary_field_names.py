@@ -140,3 +140,16 @@ def test_set_of_a_planet_modification_warns_on_the_argument(tmp_path):
     assert res.exit_code == 0, res.output
     assert f"warning: --set {arg}: planetary.0.planet.modifications.crowning: 1 mm" \
         in res.stderr, res.stderr
+
+
+def test_run_names_the_stages_field_when_the_assembly_refuses(tmp_path):
+    """'run' checks less than 'check' before it assembles: the assembly's refusal (a
+    bearing with two stiffnesses in the turning carrier's frame) names the field too."""
+    raw = small_ltca_raw()
+    raw["planetary"][0]["ring"].update(dofs=["theta", "x", "y"], support={
+        "stiffness": "1e8 N/m", "stiffness_y": "2e8 N/m"})
+    path = tmp_path / "stage.json"
+    path.write_text(json.dumps(raw))
+    res = CliRunner().invoke(app, ["run", str(path), "--cycles", "5"])
+    assert res.exit_code == 2, res.output
+    assert "error: planetary.0.ring.support.stiffness_y: " in res.stderr, res.stderr
