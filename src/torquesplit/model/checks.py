@@ -2,7 +2,9 @@
 
 Errors are collected (all of them, not only the first) and raised as one
 :class:`~torquesplit.errors.ModelError`.  Values that look wrong but can be right are
-reported as :class:`~torquesplit.errors.ModelWarning`.
+reported as :class:`~torquesplit.errors.ModelWarning`.  Both name the field as the user
+wrote it: what a ``[[planetary]]`` stage generated is named by the stage's field
+(:func:`as_written`: ``planetary.0.pin_errors.1``, not ``gears.st_planet2.support...``).
 
 ``torquesplit check`` and ``torquesplit run`` share these checks, so that a model that
 passes ``check`` is never refused by ``run`` for a modelling reason:
