@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import copy
 import math
+import tomllib
 import warnings
 
 import torquesplit
@@ -88,3 +89,42 @@ def cp_raw(planets: int = 4, sun_speed: str = "100 rpm") -> dict:
                           "mode": "speed"}},
         "loads": {"out": {"body": "output"}},
     }
+
+
+#: a small planetary stage (3 planets, 21/24/69 teeth, sun in, carrier out, ring held)
+#: whose meshes use the LTCA with few positions and slices (fast): the stage of the
+#: tooth-modification tests
+SMALL_LTCA_STAGE = """\
+[model]
+name = "small planetary, LTCA meshes"
+
+[[planetary]]
+name = "st"
+planets = 3
+module = "2 mm"
+face_width = "20 mm"
+sun = {teeth = 21}
+planet = {teeth = 24}
+ring = {teeth = 69, torsional_support = {stiffness = "1e7 N m/rad"}}
+carrier = {polar_inertia = "0.05 kg m^2"}
+planet_bearing = {stiffness = "1e8 N/m"}
+sun_mesh = {stiffness = {method = "ltca", slices = 4, ltca = {positions = 16}}}
+ring_mesh = {stiffness = {method = "ltca", slices = 4, ltca = {positions = 16}}}
+
+[drives.input]
+body = "st_sun"
+speed = "1000 rpm"
+torque = "100 N m"
+
+[loads.output]
+body = "st_carrier"
+"""
+
+
+def small_ltca_raw(**modifications) -> dict:
+    """:data:`SMALL_LTCA_STAGE` as data; ``sun=``, ``planet=``, ``ring=`` give those
+    members' ``modifications``."""
+    data = tomllib.loads(SMALL_LTCA_STAGE)
+    for member, spec in modifications.items():
+        data["planetary"][0][member]["modifications"] = copy.deepcopy(spec)
+    return data

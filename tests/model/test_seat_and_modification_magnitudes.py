@@ -115,17 +115,17 @@ def test_the_small_stage_and_micron_seat_errors_are_quiet():
 @pytest.mark.parametrize("value", ["10 mm", "0.5 mm"])
 def test_pin_error_in_mm_warns_naming_the_field(field, value):
     found = _warnings(_stage(pin_errors=[{}, {field: value}, {}]))
-    loc = f"gears.st_planet2.support.pin_error.{field}:"
+    loc = f"planetary.0.pin_errors.1.{field}:"  # as written, not the generated planet
     mine = [w for w in found if w.startswith(loc)]
     assert mine, found
     assert all("microns" in w and "check the value" in w and "\n" not in w for w in mine)
-    assert not [w for w in found if "st_planet1" in w or "st_planet3" in w], found
+    assert not [w for w in found if "pin_errors.0" in w or "pin_errors.2" in w], found
 
 
 @pytest.mark.parametrize("value, count", [("10 mm", 2), ("0.5 mm", 1)])
 def test_carrier_eccentricity_in_mm_warns_naming_the_field(value, count):
     found = _warnings(_stage(carrier__eccentricity=value))
-    mine = [w for w in found if w.startswith("bodies.st_carrier.eccentricity:")]
+    mine = [w for w in found if w.startswith("planetary.0.carrier.eccentricity:")]
     # beyond the module (10 mm), beyond ISO 1328-1 grade 11 of a planet (both): once each,
     # not once per planet
     assert len(mine) == count, found
@@ -140,7 +140,7 @@ def test_check_command_warns_on_a_pin_error_in_mm(tmp_path):
     model.write_text(text)
     res = runner.invoke(app, ["check", str(model)])
     assert res.exit_code == 0, res.output
-    assert "gears.st_planet1.support.pin_error.tangential: 10 mm" in res.stderr, res.stderr
+    assert "planetary.0.pin_errors.0.tangential: 10 mm" in res.stderr, res.stderr
 
 
 # --------------------------------------------------------------------- modifications

@@ -136,7 +136,19 @@ def number_dofs(model: Model, kin: Kinematics) -> tuple[DofMap, np.ndarray]:
 
 def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None = None,
              options: dict | None = None) -> Structure:
-    """Assemble the equations of motion of ``model`` (see module docstring)."""
+    """Assemble the equations of motion of ``model`` (see module docstring); a refusal
+    names the field as the user wrote it (a ``[[planetary]]`` stage's, not the element
+    it generated), as ``torquesplit check`` does."""
+    try:
+        return _assemble(model, kin, n_table=n_table, options=options)
+    except ModelError as exc:
+        from ..model.checks import as_written
+
+        raise ModelError(as_written(model, exc.issues), exc.source) from None
+
+
+def _assemble(model: Model, kin: Kinematics | None, *, n_table: int | None,
+              options: dict | None) -> Structure:
     kin = kin or solve_kinematics(model)
     n_table = n_table or model.analysis.table_points
     options = dict(options or {})

@@ -2,7 +2,9 @@
 
 Errors are collected (all of them, not only the first) and raised as one
 :class:`~torquesplit.errors.ModelError`.  Values that look wrong but can be right are
-reported as :class:`~torquesplit.errors.ModelWarning`.
+reported as :class:`~torquesplit.errors.ModelWarning`.  Both name the field as the user
+wrote it: what a ``[[planetary]]`` stage generated is named by the stage's field
+(:func:`as_written`: ``planetary.0.pin_errors.1``, not ``gears.st_planet2.support...``).
 
 ``torquesplit check`` and ``torquesplit run`` share these checks, so that a model that
 passes ``check`` is never refused by ``run`` for a modelling reason:
@@ -75,14 +77,14 @@ def check_model(model: Model, source: str | None = None, *, deep: bool = False) 
     if not issues:
         issues = geometry_issues(model) + support_issues(model) + modification_issues(model)
     if issues:
-        raise ModelError(issues, source)
+        raise ModelError(as_written(model, issues), source)
     # the kinematic pass finds loops that cannot turn and power that does not balance
     from .kinematics import KinematicsError, solve_kinematics
 
     try:
         kin = solve_kinematics(model)
     except KinematicsError as exc:
-        raise ModelError(exc.issues, source) from None
+        raise ModelError(as_written(model, exc.issues), source) from None
     issues = shaft_axis_issues(model, kin) + overlap_issues(model, kin)
     issues += nominal_load_issues(model, kin) + balance_issues(model, kin)
     issues += stiffness_table_issues(model, kin) + planet_fit_issues(model, kin)
@@ -90,9 +92,21 @@ def check_model(model: Model, source: str | None = None, *, deep: bool = False) 
     if not issues and deep:
         issues, notes = _readiness(model, kin)
     if issues:
-        raise ModelError(issues, source)
-    for loc, msg in plausibility_warnings(model, kin) + notes:
+        raise ModelError(as_written(model, issues), source)
+    for loc, msg in as_written(model, plausibility_warnings(model, kin) + notes):
         warnings.warn(f"{source + ': ' if source else ''}{loc}: {msg}", ModelWarning, stacklevel=3)
+
+
+def as_written(model: Model, issues) -> list[tuple[str, str]]:
+    """``(location, message)`` pairs with each location named as the user wrote it (a
+    ``[[planetary]]`` stage's field rather than the element it generated:
+    :meth:`Model.written_at`), once each (every planet of a stage gives the same)."""
+    out: list[tuple[str, str]] = []
+    for loc, msg in issues:
+        item = (model.written_at(loc), msg)
+        if item not in out:
+            out.append(item)
+    return out
 
 
 def reference_issues(model: Model) -> list[tuple[str, str]]:
@@ -297,6 +311,12 @@ def modification_issues(model: Model) -> list[tuple[str, str]]:
     from ..gears.line_of_action import cylindrical_pair, is_conical
 
     issues: list[tuple[str, str]] = []
+    # a gear with mates of different sizes (a planet: sun and ring) is checked against
+    # each: its messages name the mate (as written: every planet of a stage the same)
+    mates: dict[str, set[str]] = {}
+    for mesh in model.meshes.values():
+        for g, other in (mesh.gears, mesh.gears[::-1]):
+            mates.setdefault(g, set()).add(model.written_at(f"gears.{other}"))
     for name, mesh in model.meshes.items():
         a, b = mesh.gears
         ga, gb = model.gears[a], model.gears[b]
@@ -320,7 +340,10 @@ def modification_issues(model: Model) -> list[tuple[str, str]]:
                 check_modification(modification_from_spec(spec, pair.face_width, where), pair,
                                    index, where)
             except ModelError as exc:
-                issues += [i for i in exc.issues if i not in issues]
+                mate = model.written_at(f"gears.{b if g == a else a}")
+                found = [(loc, f"in the mesh with {mate}: {msg}" if len(mates[g]) > 1 else msg)
+                         for loc, msg in exc.issues]
+                issues += [i for i in found if i not in issues]
     return issues
 
 
@@ -359,10 +382,15 @@ def plausibility_warnings(model: Model, kin) -> list[tuple[str, str]]:
     ltca_gears = {g for m in model.meshes.values() if m.stiffness.method == "ltca" for g in m.gears}
     for name, gear in model.gears.items():
         if gear.modifications is not None and name not in ltca_gears:
-            out.append((f"gears.{name}.modifications",
-                        "only the stiffness method 'ltca' uses tooth modifications and no mesh of "
-                        "this gear uses it; set stiffness.method = 'ltca' on its meshes or remove "
-                        "the modifications"))
+            loc = f"gears.{name}.modifications"
+            meshes = "its meshes"
+            if model.written_at(loc).startswith("planetary."):  # planetary.0.sun.modif...
+                _, k, member = model.written_at(loc).split(".")[:3]
+                meshes = (f"planetary.{k}.{member}_mesh" if member != "planet" else
+                          f"planetary.{k}.sun_mesh and/or planetary.{k}.ring_mesh")
+            out.append((loc, "only the stiffness method 'ltca' uses tooth modifications and no "
+                             f"mesh of this gear uses it; set stiffness.method = 'ltca' on "
+                             f"{meshes} or remove the modifications"))
     for name, m in model.meshes.items():
         if m.stiffness.method != "ltca" and m.misalignment != type(m.misalignment)():
             out.append((f"meshes.{name}.misalignment",

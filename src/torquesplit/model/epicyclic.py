@@ -456,10 +456,11 @@ def solve_torques(model: Model, axes, frames, groups, speeds, layout: EpicyclicL
         if abs(p) <= 1e-9 * p_scale:
             drv = m.driver or ga
             if m.driver is None:
-                warnings.warn(
-                    f"meshes.{n}: no power passes this mesh in the nominal load, so its loaded "
-                    f"flank is not determined; {ga!r} (listed first) is taken as the driver: "
-                    f"give 'driver' to choose the flank", ModelWarning, stacklevel=4)
+                warnings.warn(  # named as written (a [[planetary]] stage's mesh table)
+                    f"{model.written_at('meshes.' + n)}: no power passes this mesh in the "
+                    f"nominal load, so its loaded flank is not determined; {ga!r} (listed "
+                    f"first) is taken as the driver: give 'driver' to choose the flank",
+                    ModelWarning, stacklevel=4)
         else:
             drv = ga if p < 0 else gb  # negative: the mesh takes power from the first gear
             if m.driver is not None and m.driver != drv:

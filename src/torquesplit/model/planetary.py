@@ -29,6 +29,11 @@ tooth-count assembly condition ``(z_s + z_r) psi / 360 deg`` whole for every pla
 angle psi), they do not overlap, sun-planet and planet-ring centre distances agree, the
 ring is internal, the pins sit on the planet circle.
 
+Tooth modifications of a member (``sun.modifications``, ``planet.modifications`` -- every
+planet gets it --, ``ring.modifications``) and the ``misalignment`` of ``sun_mesh`` /
+``ring_mesh`` go to the generated gears and meshes, where stiffness method ``"ltca"``
+uses them as for any gear and mesh (the LTCA analyses the internal ring-planet pair).
+
 After validation the model holds the general elements only (a model written back to a
 file has no ``[[planetary]]`` table).
 """
@@ -51,6 +56,8 @@ from .schema import (
     Inertia,
     Length,
     Mass,
+    MisalignmentSpec,
+    ModificationsSpec,
     Number,
     PinError,
     StiffnessSpec,
@@ -74,7 +81,8 @@ class PlanetaryGear(Strict):
 
     teeth: Count = Field(gt=0, le=10_000, description="Number of teeth.")
     kind: Literal["spur", "helical", "double_helical", "internal"] | None = Field(
-        None, description="Gear type; default from the stage (the ring is internal).")
+        None, description="Gear type; default from the stage (the ring is internal; "
+        "'double_helical' is refused: the internal ring has one helix).")
     profile_shift: Number = Field(0.0, ge=-5, le=5, description="Profile shift coefficient x.")
     face_width: Length | None = Field(None, gt=0, description="Face width; default the "
                                       "stage's.")
@@ -91,6 +99,9 @@ class PlanetaryGear(Strict):
         None, description="Holds the member against rotation (a fixed ring).")
     errors: GearErrors = Field(GearErrors(), description="Manufacturing and assembly errors "
                                "(every planet gets these).")
+    modifications: ModificationsSpec | None = Field(
+        None, description="Tooth modification of the loaded flank, as for [gears.NAME] "
+        "(every planet gets it; used by stiffness method 'ltca' of sun_mesh / ring_mesh).")
 
     @model_validator(mode="after")
     def _dofs(self):
@@ -133,6 +144,9 @@ class PlanetaryMesh(Strict):
     backlash: Annotated[
         BacklashSpec, BeforeValidator(_backlash_shorthand), Unit("length")
     ] = Field(0.0, description="Total backlash (\"100 um\"; 0 = none), or a [backlash] table.")
+    misalignment: MisalignmentSpec = Field(MisalignmentSpec(), description="Misalignment and "
+                                           "base pitch deviation of every planet's mesh "
+                                           "(stiffness method 'ltca').")
 
     @model_validator(mode="after")
     def _one(self):
@@ -207,8 +221,28 @@ class Planetary(Strict):
             if getattr(self, member).kind == "internal":
                 raise FieldError(f"{member}.kind", f"the {member} meshes outside the planets"
                                  f"' teeth and cannot be internal; remove 'kind'")
+            if getattr(self, member).kind == "double_helical":
+                # the ring is an internal gear, and an internal gear has one helix here
+                raise FieldError(f"{member}.kind", (
+                    "a [[planetary]] stage is spur or helical: its ring is an internal gear "
+                    "with one helix, which cannot mesh with double-helical planets; use "
+                    "kind = 'helical' (with the stage's helix_angle) or remove 'kind'"))
+        self._check_modifications()
         self._check_fit()
         return self
+
+    def _check_modifications(self) -> None:
+        """What [gears.NAME] refuses of its modifications, named as written here: a second
+        helix on a gear with one helix, which every member of a stage is (see
+        _consistent).  Every member is cylindrical, so every one may be modified; the
+        LTCA analyses the internal ring-planet pair too."""
+        for member in ("sun", "planet", "ring"):
+            spec = getattr(self, member).modifications
+            if spec is not None and spec.second_helix is not None:
+                raise FieldError(f"{member}.modifications.second_helix", (
+                    "a second helix exists on double-helical gears only, and the gears of a "
+                    "[[planetary]] stage have one helix (spur or helical); remove "
+                    "second_helix"))
 
     # ------------------------------------------------------------------ layout
     def planet_angles(self) -> list[float]:
@@ -239,15 +273,25 @@ class Planetary(Strict):
         from ..errors import ModelError
         from ..gears.geometry import PairGeometry
 
+        geo, member = {}, None
         try:
-            sun, planet = self._geometry(self.sun), self._geometry(self.planet)
-            ring = self._geometry(self.ring, internal=True)
+            for member in ("sun", "planet", "ring"):
+                geo[member] = self._geometry(getattr(self, member), internal=member == "ring")
+            member = None
+            sun, planet, ring = geo["sun"], geo["planet"], geo["ring"]
             a_sp = PairGeometry(sun, planet).operating_center_distance
             a_rp = PairGeometry(planet, ring).operating_center_distance
         except ModelError as exc:
             loc, msg = exc.issues[0]
-            raise FieldError("ring.teeth" if "internal" in msg else "planet.teeth",
-                             msg if ";" in msg else f"{msg}; correct the tooth counts") from None
+            # a gear's own geometry names its field (the stage's module, the member's
+            # teeth); a pair that cannot mesh, the tooth counts
+            field = {"normal_module": "module", "normal_pressure_angle": "pressure_angle",
+                     "helix_angle": "helix_angle", "teeth": f"{member}.teeth",
+                     "addendum": f"{member}.profile_shift"}.get(loc) if member else None
+            if field is None:
+                field = "ring.teeth" if "internal" in msg else "planet.teeth"
+            fix = "tooth counts" if field.endswith(".teeth") else "value"
+            raise FieldError(field, msg if ";" in msg else f"{msg}; correct the {fix}") from None
         zs, zp, zr = self.sun.teeth, self.planet.teeth, self.ring.teeth
         if abs(a_sp - a_rp) > 1e-6 * a_sp:
             raise FieldError("ring.teeth", (
@@ -303,6 +347,42 @@ class Planetary(Strict):
                                                  range(self.planets)],
                     ring_meshes=[f"{n}_ring_planet{i + 1}" for i in range(self.planets)])
 
+    def origins(self, index: int) -> dict[str, str]:
+        """Where the user wrote what the expansion generates: the location of each
+        generated element, and of its fields that come from elsewhere in the stage table
+        -> the field of ``[[planetary]]`` number ``index`` (``gears.st_planet2`` ->
+        ``planetary.0.planet``, ``gears.st_planet2.support.pin_error`` ->
+        ``planetary.0.pin_errors.1``, ``gears.st_sun.module`` -> ``planetary.0.module``),
+        so that messages name the field as written (:meth:`Model.written_at`)."""
+        here = f"planetary.{index}"
+        names = self.names()
+        out: dict[str, str] = {}
+        members = [("sun", names["sun"]), ("ring", names["ring"])]
+        members += [("planet", p) for p in names["planets"]]
+        for member, gear in members:
+            loc, spec = f"gears.{gear}", getattr(self, member)
+            out[loc] = f"{here}.{member}"
+            for field in ("module", "pressure_angle", "helix_angle", "hand", "axis"):
+                out[f"{loc}.{field}"] = f"{here}.{field}"
+            if spec.face_width is None:
+                out[f"{loc}.face_width"] = f"{here}.face_width"
+            if member != "planet":
+                out[f"{loc}.position"] = f"{here}.position"
+        for i, planet in enumerate(names["planets"]):
+            loc = f"gears.{planet}"
+            where = f"{here}.angles.{i}" if self.angles is not None else f"{here}.planets"
+            out[f"{loc}.place"] = out[f"{loc}.position"] = where
+            out[f"{loc}.support"] = f"{here}.planet_bearing"
+            out[f"{loc}.support.pin_error"] = f"{here}.pin_errors.{i}"
+        loc = f"bodies.{names['carrier']}"
+        out[loc] = f"{here}.carrier"
+        out[f"{loc}.position"] = f"{here}.position"
+        out[f"{loc}.axis"] = f"{here}.axis"
+        for member in ("sun", "ring"):
+            for mesh in names[f"{member}_meshes"]:
+                out[f"meshes.{mesh}"] = f"{here}.{member}_mesh"
+        return out
+
     def expand(self) -> tuple[dict, dict, dict]:
         """(gears, bodies, meshes) as dicts of SI values and schema objects, ready for
         the general schema sections."""
@@ -317,7 +397,8 @@ class Planetary(Strict):
                      face_width=member.face_width or self.face_width,
                      profile_shift=member.profile_shift, bore_diameter=member.bore_diameter,
                      axis=self.axis, dofs=member.dofs or dofs, errors=member.errors,
-                     torsional_support=member.torsional_support)
+                     torsional_support=member.torsional_support,
+                     modifications=member.modifications)
             if member.mass is not None:
                 d["mass"] = member.mass
             if member.polar_inertia is not None:
@@ -353,10 +434,25 @@ class Planetary(Strict):
                                      ("ring", self.ring_mesh, names["ring_meshes"])):
             for mname, pname in zip(mnames, names["planets"]):
                 d = dict(gears=(names[member], pname), stiffness=spec.stiffness,
-                         backlash=spec.backlash, stage=f"{self.name}-{member}")
+                         backlash=spec.backlash, stage=f"{self.name}-{member}",
+                         misalignment=spec.misalignment)
                 if spec.damping is not None:
                     d["damping"] = spec.damping
                 if spec.damping_ratio is not None:
                     d["damping_ratio"] = spec.damping_ratio
                 meshes[mname] = d
         return gears, bodies, meshes
+
+
+def written_at(origins: dict[str, str], loc: str) -> str:
+    """``loc`` (``gears.st_planet2.modifications.crowning``) as the user wrote it
+    (``planetary.0.planet.modifications.crowning``) by the longest generated prefix in
+    ``origins`` (:meth:`Planetary.origins`); a location of no stage is returned as is."""
+    if not origins or not loc:
+        return loc
+    parts = loc.split(".")
+    for n in range(len(parts), 0, -1):
+        head = ".".join(parts[:n])
+        if head in origins:
+            return origins[head] + loc[len(head):]
+    return loc

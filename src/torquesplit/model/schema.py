@@ -16,7 +16,8 @@ from __future__ import annotations
 import math
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, model_validator
+from pydantic import (BaseModel, BeforeValidator, ConfigDict, Field, PrivateAttr,
+                      ValidationError, model_validator)
 from pydantic import Strict as StrictType
 
 from ..errors import FieldError  # noqa: F401 - used by validators here and re-exported
@@ -682,6 +683,9 @@ class Model(Strict):
         [], description="Planetary stages in one table each ([[planetary]]); expanded to "
         "the general sections (gears, bodies, meshes) on reading.")
 
+    _origins: dict[str, str] = PrivateAttr(default_factory=dict)
+    """Generated location -> the ``[[planetary]]`` field it came from (see written_at)."""
+
     @model_validator(mode="after")
     def _expand_planetary(self):
         """Replace each [[planetary]] table by its general elements (model/planetary.py)."""
@@ -692,9 +696,13 @@ class Model(Strict):
                         f"the model has no {section}; add [{section}.NAME] sections (see "
                         f"docs/model-file.md) or a [[planetary]] stage"))
             return self
+        from .planetary import written_at
+
         gears, bodies, meshes = dict(self.gears), dict(self.bodies), dict(self.meshes)
+        origins: dict[str, str] = {}
         for k, stage in enumerate(self.planetary):
             g, b, m = stage.expand()
+            origins.update(stage.origins(k))
             for section, new, have in (("gears", g, gears), ("bodies", b, bodies),
                                        ("meshes", m, meshes)):
                 for name, spec in new.items():
@@ -703,12 +711,28 @@ class Model(Strict):
                             f"the stage would create {section}.{name}, which exists already; "
                             f"give the stage another 'name'"))
                     cls = {"gears": Gear, "bodies": Body, "meshes": Mesh}[section]
-                    have[name] = cls.model_validate(spec)
+                    try:
+                        have[name] = cls.model_validate(spec)
+                    except ValidationError as exc:  # named as the stage's field
+                        from .io import _format_errors
+
+                        loc, msg = _format_errors(exc)[0]
+                        where = f"{section}.{name}" + (f".{loc}" if loc else "")
+                        raise FieldError(written_at(origins, where), msg) from None
         object.__setattr__(self, "gears", gears)
         object.__setattr__(self, "bodies", bodies)
         object.__setattr__(self, "meshes", meshes)
         object.__setattr__(self, "planetary", [])
+        self._origins = origins
         return self
+
+    def written_at(self, loc: str) -> str:
+        """A location (``gears.st_planet2.support.pin_error.radial``) as the user wrote
+        it: the field of the ``[[planetary]]`` stage that generated it
+        (``planetary.0.pin_errors.1.radial``), else ``loc`` itself."""
+        from .planetary import written_at
+
+        return written_at(self._origins, loc)
 
     def body_names(self) -> list[str]:
         return list(self.gears) + list(self.bodies)
