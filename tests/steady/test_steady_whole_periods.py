@@ -100,3 +100,19 @@ def test_resonance_map_orders_follow_the_stiffness_spectrum():
     assert mesh_orders(np.ones(256)) == MIN_ORDERS
     assert mesh_orders(np.where(phase < 0.5, 1.1, 1.0) + 0 * phase) <= MAX_ORDERS
     assert mesh_orders(1.0 + 0.1 * np.cos(2 * np.pi * phase)) == MIN_ORDERS
+
+
+def test_ratio_extremes_take_the_cycle_starts(mo_star, monkeypatch):
+    """Mo et al. 2017's meshes have constant stiffness (continuous at their cycle starts):
+    the load-sharing ratio interpolated at each start enters the per-cycle ratio
+    extremes (``boundary_ratios``, as the integrator's ``ratio_starts``), which raises
+    some cycle maxima above their instants' and never lowers one."""
+    import torquesplit.steady.api as api
+
+    with_starts = mo_star.to_results().solution.cycle_ratio_max
+    monkeypatch.setattr(api, "boundary_ratios", lambda *a, **k: None)
+    without = mo_star.to_results().solution.cycle_ratio_max
+    ok = np.isfinite(with_starts) & np.isfinite(without)
+    assert ok.sum() > 100
+    assert np.all(with_starts[ok] >= without[ok])
+    assert np.sum(with_starts[ok] > without[ok] * (1 + 1e-12)) > 10

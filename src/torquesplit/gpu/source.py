@@ -389,6 +389,47 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
         # a sample flagged as one, can end a parabola but not be its middle
         w(f"kink = X[{X_PX}]" if full else "kink = 1.0")
         w(f"smooth = X[{X_PN}] >= 2.0 and X[{X_PKK + 1}] == 0.0")
+        # the load-sharing ratio at a member's cycle start between two instants, from every
+        # member's force interpolated there (_kernels.ratio_starts), before the last
+        # instant's forces X[X_PF + i] are overwritten below
+        ratio_start = set()
+        for kg, grp in enumerate(L.groups):
+            for j in grp:
+                el = L.track[j]
+                if not kd.continuous_start(L.corner_ptr, L.corner_node, el):
+                    continue
+                ratio_start.add(j)
+                w(f"rbn{j} = False")
+                w(f"rb{j} = 0.0")
+                with w.block("if entered:"):
+                    w(f"cb = WI[bi + {tv_pos[el]}] - {par(('base', j))}")
+                    with w.block(f"if cb == WI[{WI_SC + 2 * j}] + 1:"):
+                        w(f"tb = (cb + {par(('base', j))} - {par(('ph', el))}) / "
+                          f"{par(('f', el))}")
+                        w("th = 1.0")
+                        with w.block("if span > 0.0:"):  # clipped to [0, 1]
+                            w("th = (tb - ta) / span")
+                            with w.block("if th < 0.0:"):
+                                w("th = 0.0")
+                            with w.block("if th > 1.0:"):
+                                w("th = 1.0")
+                        w("total = 0.0")
+                        for i in grp:
+                            w(f"total += X[{X_PF + i}] + th * (W[{W_F + L.track[i]}] - "
+                              f"X[{X_PF + i}])")
+                        with w.block(f"if total > {par(('gmin', kg))}:"):
+                            w(f"fa = X[{X_PF + j}]")
+                            w(f"rb{j} = {len(grp)} * (fa + th * (W[{W_F + el}] - fa)) / total")
+                            w(f"rbn{j} = True")
+
+        def enter_ratio_start(j, s):
+            if j in ratio_start:
+                with w.block(f"if rbn{j}:"):
+                    with w.block(f"if rb{j} > X[{s + 3}]:"):
+                        w(f"X[{s + 3}] = rb{j}")
+                    with w.block(f"if rb{j} < X[{s + 4}]:"):
+                        w(f"X[{s + 4}] = rb{j}")
+
         for j, el in enumerate(L.track):
             s = X_ST + N_STAT * j
             # the force is continuous where its cycles begin (no table corner at node 0,
@@ -458,6 +499,7 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
                         w(f"X[{s}] = fb")
                     with w.block(f"if fb < X[{s + 1}]:"):
                         w(f"X[{s + 1}] = fb")
+            enter_ratio_start(j, s)  # (and the ratio there)
             with w.block(f"if cy{j} != WI[{WI_SC + 2 * j}]:"):
                 w(f"new_cycle(I{j}, cy{j}, X, WI, OF, OI, c, cap)")
             if smooth_start:  # and the beginning cycle's, at its start
@@ -466,6 +508,7 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
                         w(f"X[{s}] = fb")
                     with w.block(f"if fb < X[{s + 1}]:"):
                         w(f"X[{s + 1}] = fb")
+            enter_ratio_start(j, s)
             with w.block("if entered:"):
                 w(f"X[{s + 2}] += part")
                 w(f"X[{s + 5}] += dpart")

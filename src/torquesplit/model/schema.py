@@ -726,6 +726,16 @@ class Model(Strict):
         self._origins = origins
         return self
 
+    def __eq__(self, other):
+        """Field by field: where a ``[[planetary]]`` stage's elements came from
+        (``_origins``, for messages only) is no part of the model, so a model written to
+        a file and read back (no stage tables then) equals the model it came from."""
+        if not isinstance(other, Model):
+            return NotImplemented
+        return self.__dict__ == other.__dict__
+
+    __hash__ = None  # (as before: its dict fields make a model unhashable)
+
     def written_at(self, loc: str) -> str:
         """A location (``gears.st_planet2.support.pin_error.radial``) as the user wrote
         it: the field of the ``[[planetary]]`` stage that generated it

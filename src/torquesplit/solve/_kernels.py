@@ -411,6 +411,51 @@ def mean_sample(t, slot, i_f, m, w, r):
 
 
 @_inline
+def ratio_starts(t, slot, i_f, m, w, r):
+    """The instantaneous load-sharing ratio N f_j / sum_i f_i (Ji & Li eq. 18) at each
+    cycle start of a group member j between the last instant entered and ``t``, into the
+    max and min of both cycles it divides, where j's force is continuous there
+    (``r.trk_cont``): every member's force interpolated linearly at that start, as
+    :func:`mean_sample` does for the force.  Without it the ratio's extremes at a cycle
+    start (a ratio still rising as its cycle ends) were missed by up to its slope times
+    a step, first order.  Runs before :func:`mean_sample` (which overwrites the last
+    instant's forces).  Twin: :func:`torquesplit.solve.reference.cycle_ratio_numpy`."""
+    force, CY = w.F, w.CY
+    track_el, track_base, trk_cont = r.track_el, r.track_base, r.trk_cont
+    grp_ptr, grp_col, grp_min = r.grp_ptr, r.grp_col, r.grp_min
+    rat_max, rat_min, prev_f, prev_c = r.rat_max, r.rat_min, r.prev_f, r.prev_c
+    cap = rat_max.shape[0]
+    ta = r.prev_t[0]
+    span = t - ta
+    if not (span >= 0.0):  # NaN before the first instant: no interval yet
+        return
+    for g in range(grp_ptr.shape[0] - 1):
+        for k in range(grp_ptr[g], grp_ptr[g + 1]):
+            j = grp_col[k]
+            el = track_el[j]
+            c = CY[slot, el] - track_base[j]
+            cp = prev_c[j]
+            if c != cp + 1 or trk_cont[j] == 0:
+                continue
+            tb = (c + track_base[j] - m.phase[el]) / m.frequency[el]
+            th = min(max((tb - ta) / span, 0.0), 1.0) if span > 0.0 else 1.0
+            total = 0.0
+            for kk in range(grp_ptr[g], grp_ptr[g + 1]):
+                i = grp_col[kk]
+                fa = prev_f[i]
+                total += fa + th * (force[i_f, track_el[i]] - fa)
+            if total > grp_min[g]:
+                fa = prev_f[j]
+                ratio = (grp_ptr[g + 1] - grp_ptr[g]) * (fa + th * (force[i_f, el] - fa)) / total
+                for cb in (cp, c):
+                    if cb >= 0 and cb < cap:
+                        if ratio > rat_max[cb, j]:
+                            rat_max[cb, j] = ratio
+                        if ratio < rat_min[cb, j]:
+                            rat_min[cb, j] = ratio
+
+
+@_inline
 def regime(d, g):
     """Contact regime of an element with deformation ``d`` and half-gap ``g``: 1 in
     contact (d > g, or no gap), -1 in back-side contact (d < -g), 0 apart."""
@@ -519,6 +564,7 @@ def record(t, slot, i_f, weight, m, w, r, counters):
             cyc_cnt[c, j] += 1
     peak_sample(t, r.pk_x[0], slot, i_f, w, r)  # (before mean_sample: the last instant)
     r.pk_x[0] = 0
+    ratio_starts(t, slot, i_f, m, w, r)  # (before mean_sample too)
     mean_sample(t, slot, i_f, m, w, r)
     for g in range(grp_ptr.shape[0] - 1):
         total = 0.0
@@ -595,6 +641,7 @@ def record_extrema(t, mean, slot, i_f, m, w, r):
                         rat_min[c, j] = ratio
     if mean != 0:  # RK4's corners: instants in time order, corners among the samples
         peak_sample(t, np.int64(1), slot, i_f, w, r)
+        ratio_starts(t, slot, i_f, m, w, r)
         mean_sample(t, slot, i_f, m, w, r)
     else:  # Dormand-Prince's, element by element: no parabola across the step
         r.pk_k[(r.pk_n[0] - 1) & 1] = 1

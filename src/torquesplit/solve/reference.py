@@ -287,6 +287,47 @@ def cycle_statistics_numpy(times, forces, frequency, phase, t0, n_cycles_cap,
     return cmax, cmin, mean, ccnt
 
 
+def cycle_ratio_numpy(times, forces, frequency, phase, t0, n_cycles_cap, group_min=0.0,
+                      continuous_start=None):
+    """Per-cycle max and min of the instantaneous load-sharing ratio N f_j / sum_i f_i
+    (Ji & Li eq. 18) of each member j of one group, from the members' forces ``forces``
+    (n_instants, N) at the instants ``times`` (increasing); member j's cycles as in
+    :func:`cycle_statistics_numpy` from ``frequency[j]``, ``phase[j]``.  A ratio enters
+    only where the group's total force exceeds ``group_min``.  Where member j's force is
+    continuous at its cycle starts (``continuous_start[j]``), the ratio of the forces
+    interpolated linearly at each start between two instants enters both cycles.  Twin
+    of the ratio part of ``_kernels.record`` and of ``_kernels.ratio_starts``; returns
+    (max, min), each (n_cycles_cap, N), -inf / +inf where empty."""
+    times = np.asarray(times, dtype=float)
+    forces = np.asarray(forces, dtype=float)
+    nm = forces.shape[1]
+    cont = np.zeros(nm, bool) if continuous_start is None else np.asarray(continuous_start)
+    rmax = np.full((n_cycles_cap, nm), -np.inf)
+    rmin = np.full((n_cycles_cap, nm), np.inf)
+    total = forces.sum(axis=1)
+    for j in range(nm):
+        base = int(cycle_index_numpy(frequency[j] * t0 + phase[j]))
+        idx = (cycle_index_numpy(frequency[j] * times + phase[j]) - base).astype(int)
+        ok = (idx >= 0) & (idx < n_cycles_cap) & (total > group_min)
+        ratio = nm * forces[ok, j] / total[ok]
+        np.maximum.at(rmax[:, j], idx[ok], ratio)
+        np.minimum.at(rmin[:, j], idx[ok], ratio)
+        if not cont[j]:
+            continue
+        for a in np.flatnonzero(np.diff(idx) == 1):  # an interval holding a cycle start
+            ta, span, cb = times[a], times[a + 1] - times[a], idx[a + 1]
+            tc = (cb + base - phase[j]) / frequency[j]
+            th = min(max((tc - ta) / span, 0.0), 1.0) if span > 0 else 1.0
+            fc = forces[a] + th * (forces[a + 1] - forces[a])
+            if fc.sum() > group_min:
+                for c in (cb - 1, cb):
+                    if 0 <= c < n_cycles_cap:
+                        r = nm * fc[j] / fc.sum()
+                        rmax[c, j] = max(rmax[c, j], r)
+                        rmin[c, j] = min(rmin[c, j], r)
+    return rmax, rmin
+
+
 def rk4_numpy(structure: Structure, y0, t0: float, h: float, n_steps: int, times=None):
     """Classic RK4 with a Python call per stage; returns ``(t, y)`` of all steps.
 

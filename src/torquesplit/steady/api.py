@@ -449,22 +449,44 @@ def cycle_integrals(t, f, cycles, n, start, period):
     return total, time
 
 
-def boundary_extremes(t, f, start, period, mx, mn):
-    """Enter in ``mx`` / ``mn`` (per cycle, cycle k from ``start + k period``) the force
-    interpolated at every cycle start between the instants ``t`` (in time order, forces
-    ``f``; on an instant, its force), in both cycles it divides: as
-    ``_kernels.mean_sample`` does for an element whose force is continuous there."""
-    n = mx.shape[0]
+def cycle_start_points(t, start, period, n):
+    """The cycle starts ``start + k period`` (k = 1 .. n - 1) that lie within the instants
+    ``t`` (in time order): (k, i, th), each start at ``t[i] + th (t[i + 1] - t[i])``
+    (on an instant, that instant)."""
     k = np.arange(1, n)
     tb = start + k * period
     i = np.searchsorted(t, tb, side="right") - 1
     inside = (i >= 0) & (i < t.size - 1)
     k, tb, i = k[inside], tb[inside], i[inside]
     th = np.clip((tb - t[i]) / np.where(t[i + 1] > t[i], t[i + 1] - t[i], 1.0), 0.0, 1.0)
+    return k, i, th
+
+
+def boundary_extremes(t, f, start, period, mx, mn):
+    """Enter in ``mx`` / ``mn`` (per cycle, cycle k from ``start + k period``) the force
+    interpolated at every cycle start between the instants ``t`` (in time order, forces
+    ``f``; on an instant, its force), in both cycles it divides: as
+    ``_kernels.mean_sample`` does for an element whose force is continuous there."""
+    k, i, th = cycle_start_points(t, start, period, mx.shape[0])
     fb = f[i] + th * (f[i + 1] - f[i])
     for c in (k - 1, k):
         np.maximum.at(mx, c, fb)
         np.minimum.at(mn, c, fb)
+
+
+def boundary_ratios(t, forces, member, start, period, least, mx, mn):
+    """Enter in ``mx`` / ``mn`` the load-sharing ratio N f_j / sum_i f_i of group member
+    ``member`` (column of ``forces`` (n_instants, N) at the instants ``t``) at each of
+    its cycle starts, from every member's force interpolated there, where the total
+    exceeds ``least``: as ``_kernels.ratio_starts`` does."""
+    k, i, th = cycle_start_points(t, start, period, mx.shape[0])
+    fb = forces[i] + th[:, None] * (forces[i + 1] - forces[i])
+    total = fb.sum(axis=1)
+    keep = total > least
+    r = forces.shape[1] * fb[keep, member] / total[keep]
+    for c in (k[keep] - 1, k[keep]):
+        np.maximum.at(mx, c, r)
+        np.minimum.at(mn, c, r)
 
 
 def cycle_extremes(values, cycles, n, extra_cycles=None, extra=None):
@@ -618,9 +640,15 @@ def _as_solution(st: SteadyState, shell, periods):
 
         ratio = ratios(np.tile(Fm[:, cols], (periods, 1)))
         ratio_c = ratios(Fc[:, cols])
+        f_all = np.concatenate([np.tile(Fm[:, cols], (periods, 1)), Fc[:, cols],
+                                Fm[:1, cols]])[order]
         for i, c in enumerate(cols):
             ic, keep = corner_idx[c]
             mx, mn = cycle_extremes(ratio[:, i], cycles(c, tt), nc, ic, ratio_c[keep, i])
+            e = track[c]
+            if continuous_start(st.problem.model.corner_ptr, st.problem.model.corner_node, e):
+                boundary_ratios(t_all, f_all, i, (bases[c] - s.phase[e]) / s.frequency[e],
+                                1.0 / s.frequency[e], least, mx, mn)
             ok = ccnt[:, c] > 0
             rmax[ok, c] = mx[ok]
             rmin[ok, c] = mn[ok]
