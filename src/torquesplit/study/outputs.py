@@ -109,8 +109,12 @@ def output_values(result, definitions=None) -> dict[str, float]:
 
 
 def _quasi_static_values(result) -> dict[str, float]:
+    from ..metrics.planetary import planet_load_sharing
+
     out: dict[str, float] = {}
-    _put_load_sharing(out, STATIC_DEFINITION, result.metrics())
+    lsc = result.metrics()
+    _put_load_sharing(out, STATIC_DEFINITION, lsc)
+    out.update(planet_load_sharing(lsc, result.kinematics).values())  # K_gamma (planets)
     forces = result.mesh_forces()
     for j, m in enumerate(result.mesh_names):
         f = forces[:, j]
@@ -137,11 +141,15 @@ def _f(x) -> float:
 
 
 # ========================================================================= catalogue
-def available_outputs(mesh_names, groups: dict[str, list[str]], analysis: str) -> list[str]:
+def available_outputs(mesh_names, groups: dict[str, list[str]], analysis: str,
+                      planets: dict[str, list[str]] | None = None) -> list[str]:
     """Every output name a run of this model gives (``analysis``: "run" or "static").
 
-    ``groups`` are the load-sharing groups (key -> meshes).  Used to check a study's
-    requested names before any case runs.
+    ``groups`` are the load-sharing groups (key -> meshes); ``planets`` the planetary
+    stages (carrier -> planets), whose mesh-load factor K_gamma is
+    ``planet_load_sharing.<definition>[.<carrier>|.<planet>]``
+    (:mod:`torquesplit.metrics.planetary`).  Used to check a study's requested names
+    before any case runs.
     """
     names: list[str] = []
     defs = (STATIC_DEFINITION,) if analysis == "static" else DYNAMIC_DEFINITIONS
@@ -149,6 +157,10 @@ def available_outputs(mesh_names, groups: dict[str, list[str]], analysis: str) -
         names.append(f"load_sharing.{d}")
         names += [f"load_sharing.{d}.{g}" for g in groups]
         names += [f"load_sharing.{d}.{m}" for m in mesh_names]
+        if planets:
+            names.append(f"planet_load_sharing.{d}")
+            for carrier, members in planets.items():
+                names += [f"planet_load_sharing.{d}.{x}" for x in (carrier, *members)]
     if analysis == "static":
         for fam in ("peak_force", "min_force", "mean_force"):
             names += [f"{fam}.{m}" for m in mesh_names]
@@ -184,7 +196,8 @@ def definitions_needed(names) -> list[str]:
     """The dynamic load-sharing definitions that the output ``names`` need."""
     need = []
     for d in DYNAMIC_DEFINITIONS:
-        if any(n == f"load_sharing.{d}" or n.startswith(f"load_sharing.{d}.") for n in names):
+        heads = (f"load_sharing.{d}", f"planet_load_sharing.{d}")
+        if any(n in heads or n.startswith(tuple(h + "." for h in heads)) for n in names):
             need.append(d)
     return need
 

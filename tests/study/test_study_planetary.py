@@ -1,0 +1,55 @@
+"""Studies of a ``[[planetary]]`` stage: its own fields can be varied (cases start from
+the file's data, where the stage table is) and its mesh-load factor K_gamma
+(``planet_load_sharing.*``) is an output of run and static studies."""
+
+from __future__ import annotations
+
+import pytest
+import tomli_w
+
+from planetary_models import lp_raw
+from torquesplit.study import Study, run_study
+from torquesplit.study.errors import StudyError
+
+
+@pytest.fixture
+def lp_file(tmp_path):
+    """Lin & Parker's 4-planet stage with a zero pin error on every planet (a field the
+    study varies)."""
+    path = tmp_path / "lp.toml"
+    data = lp_raw(4, pin_errors=[{"tangential": "0 um"} for _ in range(4)])
+    path.write_text(tomli_w.dumps(data), encoding="utf-8")
+    return path
+
+
+def _study(model, path, outputs, analysis):
+    return {"study": {"name": "pin", "model": str(model), "outputs": outputs},
+            "analysis": analysis,
+            "grid": {"parameters": [{"path": path, "values": ["0 um", "10 um"]}]}}
+
+
+def test_a_stage_field_varies_and_k_gamma_is_an_output(lp_file):
+    """A tangential pin error on planet 1 loads it (static: K_gamma 1 without it, > 1
+    with it); planet 2's factor and the stage's are outputs by name."""
+    ds = run_study(_study(lp_file, "planetary.0.pin_errors.0.tangential",
+                          ["planet_load_sharing.*"],
+                          {"type": "static", "revolutions": 0.02}))
+    assert set(ds["status"].values) == {"ok"}
+    k = ds["planet_load_sharing.static_torque"].values
+    assert k[0] == pytest.approx(1.0, abs=1e-9) and k[1] > 1.01
+    planets = [v for v in ds.data_vars if v.startswith("planet_load_sharing.static_torque.")]
+    assert "planet_load_sharing.static_torque.stage_carrier" in planets and len(planets) == 5
+
+
+def test_a_dynamic_study_gives_k_gamma_of_its_definition(lp_file):
+    ds = run_study(_study(lp_file, "planetary.0.pin_errors.0.tangential",
+                          ["planet_load_sharing.mean_force"], {"cycles": 40}))
+    k = ds["planet_load_sharing.mean_force"].values
+    assert k[0] == pytest.approx(1.0, abs=1e-6) and k[1] > 1.01
+
+
+def test_a_generated_element_is_refused_with_the_stage_field(lp_file):
+    spec = _study(lp_file, "meshes.stage_sun_planet1.backlash", ["load_sharing.*"],
+                  {"cycles": 40})
+    with pytest.raises(StudyError, match=r"planetary\.0\.sun_mesh\.backlash"):
+        Study(spec).plan()
