@@ -352,10 +352,11 @@ def run(
                                                metavar="PATH=VALUE"),
     as_json: bool = _flag("--json", "Print metrics, statistics and warnings as JSON."),
     quiet: bool = _flag("--quiet", "No progress bar."),
-    check: bool = _flag("--check-step", "Run again at half the step and report how many "
-                        "significant digits of every number hold.  The second run takes twice "
-                        "the steps: about three times the integration time of a plain run in "
-                        "all."),
+    check: bool = _flag("--check-step", "Run again at half the step (and with 4x the "
+                        "table points where the excitation tables have jumps) and report how "
+                        "many significant digits of every number hold.  The second run takes "
+                        "twice the steps: about three times the integration time of a plain "
+                        "run in all."),
 ):
     """Static equilibrium, then the dynamic response: load sharing and dynamic factors.
 

@@ -224,6 +224,11 @@ def render_step_check(check, rows: int = 12, printed: int = PRINTED_DIGITS,
         was = f"rtol {check.step:.3g} -> {check.halved_step:.3g}"
     else:
         what, was = "half the step", f"{check.step:.3g} s -> {check.halved_step:.3g} s"
+    if check.check_table_points > check.table_points:  # tables with jumps: finer too
+        what += " and finer tables"
+        was += (f"; {check.table_points} -> {check.check_table_points} table points: "
+                f"the tables have jumps")
+        refine = f"{refine} and [analysis] table_points"
     console.print(
         f"step check, the same {'run' if check.method in ('rk4', 'dopri') else 'state'} at "
         f"{what} ({was}): "
@@ -235,7 +240,7 @@ def render_step_check(check, rows: int = 12, printed: int = PRINTED_DIGITS,
     if not short:
         return
     t = Table()
-    for col in ("number", "value", "at half the step", "digits that hold"):
+    for col in ("number", "value", "checked", "digits that hold"):
         t.add_column(col, justify="left" if col == "number" else "right")
     for name, a, b, _, d in short[:rows]:
         t.add_row(name, f"{a:.6g}", f"{b:.6g}", str(d))

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import warnings
 
 import pytest
 from typer.testing import CliRunner
@@ -16,6 +17,7 @@ from torquesplit.convergence import (
     agreeing_digits,
     check_step,
     halved_steps_per_period,
+    has_jumps,
 )
 from torquesplit.errors import ModelWarning
 from torquesplit.model.io import load_model, model_from_dict
@@ -96,3 +98,33 @@ def test_run_check_step_on_the_command_line(tmp_path):
     plain = runner.invoke(app, ["run", str(path), "--cycles", "20", "--json"]).output
     plain = json.loads(plain[plain.index("{"):])  # after the warnings (stderr mixed in)
     assert "step_check" not in plain
+
+
+def _rectangular_pair(tmp_path, points: int):
+    """The spur pair with a rectangular single/double contact wave (jumps) of ``points``
+    table points."""
+    data = apply_overrides(read_raw(write_model(tmp_path, SPUR_PAIR, "pair.toml")), {
+        "meshes.m.stiffness": {"method": "constant", "value": "4e8 N/m",
+                               "peak_to_peak": 0.4},
+        "analysis": {"table_points": points}})
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ModelWarning)
+        return load_model(model_from_dict(data, source="rectangular pair"))
+
+
+def test_tables_with_jumps_are_checked_with_finer_tables(tmp_path):
+    """A jump of the stiffness becomes a ramp one table spacing long: the check refines
+    the tables of such a model too (4x), and its numbers then move with the tables, not
+    only with the step; a smooth model keeps its tables."""
+    res = torquesplit.simulate(_rectangular_pair(tmp_path, 64), cycles=30)
+    assert has_jumps(res.structure)
+    check = check_step(res, definitions=["cycle_peak"])
+    assert (check.table_points, check.check_table_points) == (64, 256)
+    finer = torquesplit.simulate(_rectangular_pair(tmp_path, 256), cycles=30,
+                                 steps_per_period=halved_steps_per_period(res))
+    assert check.halved == finer.metric_values(["cycle_peak"])
+    assert check.digits("dynamic_factor.m") < 4  # the 64-point ramps cost digits
+    smooth = torquesplit.simulate(write_model(tmp_path, SPUR_PAIR, "pair.toml"), cycles=10)
+    assert not has_jumps(smooth.structure)
+    plain = check_step(smooth)
+    assert plain.check_table_points == plain.table_points
