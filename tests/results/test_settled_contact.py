@@ -81,3 +81,41 @@ def test_peaks_that_still_drift_after_settling_are_said(drop, warned):
         (where, text), = said
         assert where == "meshes.a"
         assert f"the last window alone gives {peaks[-20:].max() / 100.0:.4g}" in text
+
+
+class _MeanStub:
+    """What `mean_drift` reads of a run: per-cycle means and counts of two meshes."""
+
+    mesh_names = ["a", "b"]
+
+    def __init__(self, means):
+        self.means = np.asarray(means, dtype=float)
+        self.counts = np.ones_like(self.means, dtype=np.int64)
+
+    def complete_cycle_statistics(self):
+        return None, None, self.means, self.counts, None
+
+
+@pytest.mark.parametrize("swing, warned", [(0.0, False), (0.0004, False), (0.01, True)])
+def test_mean_force_coefficients_that_differ_between_halves_are_said(swing, warned):
+    """Two meshes whose mean forces trade load slowly (a quarter of a slow period over 200
+    settled cycles): above MEAN_DRIFT between the two halves the warning gives both
+    halves' coefficients."""
+    from types import SimpleNamespace
+
+    from torquesplit.results.plausibility import MEAN_DRIFT, mean_drift
+
+    assert MEAN_DRIFT == 1e-3
+    k = np.arange(200)
+    a = 100.0 * (1.0 + swing * np.sin(0.5 * np.pi * k / 199.0))
+    b = 200.0 - a
+    ls = SimpleNamespace(groups={"g": ["a", "b"]}, per_group={"g": 1.0})
+    met = SimpleNamespace(definition="mean_force", load_sharing=ls,
+                          settling=SimpleNamespace(first_cycle={"a": 0, "b": 0}))
+    said = mean_drift(_MeanStub(np.stack([a, b], axis=1)), met)
+    assert bool(said) is warned
+    if warned:
+        (where, text), = said
+        assert where == "analysis" and "over its first half" in text
+    met_peak = SimpleNamespace(**{**vars(met), "definition": "cycle_peak"})
+    assert mean_drift(_MeanStub(np.stack([a, b], axis=1)), met_peak) == []

@@ -22,6 +22,9 @@ check                      says
 :func:`peak_drift`         settled peaks that still change from the first settled
                            window to the last by more than :data:`PEAK_DRIFT` (a slowly
                            decaying mode, or a response that never repeats)
+:func:`mean_drift`         mean-force coefficients that differ between the two halves
+                           of the settled part by more than :data:`MEAN_DRIFT` (slow
+                           excitations whose common period is longer than the run)
 =========================  ===========================================================
 """
 
@@ -40,6 +43,9 @@ FRACTION_FLOOR = 1e-4
 #: leave the third digit of the dynamic factor open: said (the settle criterion itself
 #: accepts 1 %, what a transient's end looks like, not what a printed digit needs)
 PEAK_DRIFT = 1e-3
+#: mean-force coefficients of the two halves of the settled part that differ by more than
+#: this (absolute) leave their third decimal to the run length: said
+MEAN_DRIFT = 1e-3
 
 
 def _kn(force: float) -> str:
@@ -192,8 +198,51 @@ def peak_drift(results, metrics) -> list[tuple[str, str]]:
         f"state (`torquesplit steady`)"))]
 
 
+def mean_drift(results, metrics) -> list[tuple[str, str]]:
+    """Mean-force coefficients (Dong et al. 2021 eq. 12) that differ between the first and
+    the second half of the settled part: the mean forces still change over the run
+    (errors turning with different shafts beat over a common period longer than the
+    run), so the coefficient depends on where the run ends.  One message, for the group
+    where the halves differ most."""
+    if metrics.definition != "mean_force":
+        return []
+    _, _, c_mean, c_cnt, _ = results.complete_cycle_statistics()
+    col = {m: j for j, m in enumerate(results.mesh_names)}
+    worst = None
+    for g, members in metrics.load_sharing.groups.items():
+        halves = []
+        for m in members:
+            k0, j = metrics.settling.first_cycle[m], col[m]
+            done = np.flatnonzero(c_cnt[:, j] > 0)
+            end = int(done[-1]) + 1 if done.size else k0
+            mid = k0 + (end - k0) // 2
+            if mid - k0 < 2:
+                break
+            halves.append([float(np.sum(np.nan_to_num(c_mean[a:b, j]) * c_cnt[a:b, j])
+                                 / max(np.sum(c_cnt[a:b, j]), 1)) for a, b in
+                           ((k0, mid), (mid, end))])
+        if len(halves) != len(members) or len(members) < 2:
+            continue
+        h = np.asarray(halves)  # (members, 2)
+        coef = [float(np.max(len(members) * h[:, i] / h[:, i].sum())) for i in (0, 1)]
+        change = abs(coef[1] - coef[0])
+        if change > MEAN_DRIFT and (worst is None or change > worst[1]):
+            worst = (g, change, coef)
+    if worst is None:
+        return []
+    g, change, (a, b) = worst
+    return [("analysis", (
+        f"the mean-force coefficient of {g} is {metrics.load_sharing.per_group[g]:.4g} over "
+        f"the settled part, {a:.4g} over its first half and {b:.4g} over its second: the "
+        f"mean forces still change over the run (slow excitations, e.g. errors turning "
+        f"with different shafts, whose common period is longer than the run), so its "
+        f"digits beyond the change ({change:.2g}) depend on the run length; simulate much "
+        f"longer and compare"))]
+
+
 #: every check, in the order the messages are listed
-CHECKS = (static_force, contact_loss, back_flank, resonance, settling, peak_drift)
+CHECKS = (static_force, contact_loss, back_flank, resonance, settling, peak_drift,
+          mean_drift)
 
 
 def result_warnings(results, metrics) -> list[tuple[str, str]]:
