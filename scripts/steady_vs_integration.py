@@ -37,8 +37,22 @@ METHODS = {"mo2017_star_reducer": ("shooting",)}
 """Its period holds 324 mesh cycles (errors at the shaft rotations): shooting only."""
 
 
+def _model(name, table_points=None):
+    """The example (its file), or the example with ``table_points`` per mesh period."""
+    if table_points is None:
+        return example_path(name)
+    from torquesplit.model.io import load_model, model_from_dict
+    from torquesplit.model.overrides import apply_overrides, read_raw
+
+    data = apply_overrides(read_raw(example_path(name)),
+                           {"analysis.table_points": int(table_points)})
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return load_model(model_from_dict(data, source=name))
+
+
 def compare(name, keep=None, settle_s=None, harmonics=None, steps_per_cycle=None,
-            methods=None):
+            methods=None, table_points=None):
     """Largest difference of each mesh-force waveform over one period between the steady
     state (by each method) and the last period of a long RK4 run from the static state,
     over the waveform's peak-to-peak amplitude.  A model without time-varying excitation
@@ -52,7 +66,7 @@ def compare(name, keep=None, settle_s=None, harmonics=None, steps_per_cycle=None
         t0 = time.perf_counter()
         try:
             states[method] = steady_state(
-                example_path(name), keep=keep, method=method,
+                _model(name, table_points), keep=keep, method=method,
                 stability=method == "shooting",
                 harmonics=harmonics if method == "hb" else None,
                 steps_per_cycle=steps_per_cycle)

@@ -90,3 +90,28 @@ def test_no_ratio_at_cycle_starts_where_the_force_jumps():
     across = cycle_ratio_numpy(sol.history_t, sol.history_forces, f, ph, 0.0, n,
                                continuous_start=[True, True])
     assert not np.allclose(across[0], plain[0], rtol=1e-9)
+
+
+def test_the_ratio_is_of_the_loads_the_teeth_carry():
+    """A mesh that separates (backlash, a large error) can show a negative force while
+    its damping force exceeds the elastic one: the ratio takes the positive parts, so no
+    member exceeds N = 2 (and the engine equals the twin, which clips too)."""
+    meshes = []
+    for i in range(2):
+        meshes.append(dict(name=f"m{i}", kind=MESH, dofs=[0, i + 1], coefs=[R1, -R2],
+                           stiffness=np.full(64, 2e8), damping=2e4, frequency=F_MESH,
+                           phase=PHASES[i], gaps=5e-6,
+                           errors=[(60e-6, 2 * np.pi * 800, 0.0)] if i == 0 else []))
+    s = build_structure(["p.theta", "a.theta", "b.theta"], [100.0, 25.0, 25.0], meshes,
+                        external_force=[200.0, -200.0, -200.0], n_table=64)
+    sol = _run(s, 97)
+    assert sol.success and np.nanmin(sol.history_forces) < 0.0  # tension while separating
+    n = sol.cycle_ratio_max.shape[0]
+    f, ph = np.full(2, F_MESH), np.array(PHASES)
+    rmax, rmin = cycle_ratio_numpy(sol.history_t, sol.history_forces, f, ph, 0.0, n,
+                                   continuous_start=[True, True])
+    np.testing.assert_allclose(sol.cycle_ratio_max, rmax, rtol=1e-13)
+    np.testing.assert_allclose(sol.cycle_ratio_min, rmin, rtol=1e-13)
+    finite = np.isfinite(sol.cycle_ratio_max)
+    assert finite.sum() > 10 and np.all(sol.cycle_ratio_max[finite] <= 2.0)
+    assert np.any(sol.cycle_ratio_max[finite] == 2.0)  # one mesh carrying all

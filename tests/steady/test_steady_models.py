@@ -16,6 +16,25 @@ from torquesplit.steady import campbell, steady_state
 from torquesplit.steady.period import LongPeriodError
 
 EXAMPLE = "ji_li_mill_drive"
+SOLVER_TABLE = 256
+"""The harmonic-balance tests run Ji & Li with 256 table points (its jumps ramps of 1/256
+cycle, which 64-128 harmonics resolve): the example's own 65536 points make the jumps
+sharp, and a harmonic series converges on a jump as slowly as a Fourier series on a step
+(Gibbs), 1.4e-4 of shooting at the default harmonics: shooting is the method for such
+tables (docs/theory/steady.md)."""
+
+
+def _ji_li(points: int = SOLVER_TABLE):
+    """Ji & Li's example with ``points`` table points per mesh period."""
+    import warnings
+
+    from torquesplit.model.io import model_from_dict
+    from torquesplit.model.overrides import apply_overrides, read_raw
+
+    data = apply_overrides(read_raw(example_path(EXAMPLE)), {"analysis.table_points": points})
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return load_model(model_from_dict(data, source=EXAMPLE))
 
 
 def test_steady_state_of_one_stage_and_its_results():
@@ -39,8 +58,7 @@ def test_default_harmonics_converge_the_dynamic_factor_to_shooting():
     number asked for, HB doubles them until converged and agrees with shooting (RK4, 400
     steps per cycle); a fixed 8 per cycle (the first guess) does not."""
     def factors(**kw):
-        st = steady_state(example_path(EXAMPLE), keep="stage1", stability=False,
-                          check=False, **kw)
+        st = steady_state(_ji_li(), keep="stage1", stability=False, check=False, **kw)
         return st, np.array([r.dynamic_factor for r in st.mesh_table()])
 
     _, ref = factors(method="shooting", steps_per_cycle=400)
@@ -57,8 +75,7 @@ def test_shooting_steps_through_table_corners_and_samples_the_peaks_there():
     dynamic factors do not move when the steps are doubled and agree with converged
     harmonic balance; its RK4 samples alone leave the peak of m21 low."""
     def solve(**kw):
-        st = steady_state(example_path(EXAMPLE), keep="stage1", stability=False,
-                          check=False, **kw)
+        st = steady_state(_ji_li(), keep="stage1", stability=False, check=False, **kw)
         return st, np.array([r.dynamic_factor for r in st.mesh_table()])
 
     st, df = solve(method="shooting")
@@ -87,9 +104,11 @@ def test_steady_states_equal_long_time_integration_on_shipped_examples():
     spec = importlib.util.spec_from_file_location("steady_vs_integration", path)
     svi = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(svi)
-    for name, methods, shooting_tol in ((EXAMPLE, ("hb", "shooting"), 1e-6),
-                                        ("dong2021_face_gear", ("shooting",), 1e-4)):
-        r = svi.compare(name, svi.KEEP[name], methods=methods)
+    for name, methods, shooting_tol, points in (
+            (EXAMPLE, ("hb", "shooting"), 1e-6, SOLVER_TABLE),
+            (EXAMPLE, ("shooting",), 1e-6, None),  # the example's own sharp tables
+            ("dong2021_face_gear", ("shooting",), 1e-4, None)):
+        r = svi.compare(name, svi.KEEP[name], methods=methods, table_points=points)
         err = {m: max(v.values()) for m, v in r["max_error_over_amplitude"].items()}
         assert r["transient_left"] < 1e-3, r
         assert max(err.values()) <= 1e-3 and err["shooting"] <= shooting_tol, (name, err)
@@ -152,7 +171,8 @@ def test_a_long_period_is_shot_matrix_free():
     V = st.structure.projection_matrix()
     drift = np.max(np.abs(V @ (yT - y0)[:p.n])) / np.max(np.abs(V @ y0[:p.n]))
     assert drift <= 1e-9
-    assert all(1.07 < r.dynamic_factor < 1.09 for r in st.mesh_table())
+    # (stage 2 with the example's sharp contact-wave jumps: 1.105; docs/validation.md)
+    assert all(1.07 < r.dynamic_factor < 1.11 for r in st.mesh_table())
 
 
 def test_long_period_is_refused_with_the_fix():

@@ -415,11 +415,12 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
                                 w("th = 1.0")
                         w("total = 0.0")
                         for i in grp:
-                            w(f"total += X[{X_PF + i}] + th * (W[{W_F + L.track[i]}] - "
-                              f"X[{X_PF + i}])")
+                            w(f"total += positive_part(X[{X_PF + i}] + th * "
+                              f"(W[{W_F + L.track[i]}] - X[{X_PF + i}]))[0]")
                         with w.block(f"if total > {par(('gmin', kg))}:"):
                             w(f"fa = X[{X_PF + j}]")
-                            w(f"rb{j} = {len(grp)} * (fa + th * (W[{W_F + el}] - fa)) / total")
+                            w(f"fb = positive_part(fa + th * (W[{W_F + el}] - fa))[0]")
+                            w(f"rb{j} = {len(grp)} * fb / total")
                             w(f"rbn{j} = True")
 
         def enter_ratio_start(j, s):
@@ -529,12 +530,13 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
             w(f"X[{X_PX}] = 0.0")
         for kg, grp in enumerate(L.groups):
             w("total = 0.0")
-            for j in grp:
-                w(f"total += W[{W_F + L.track[j]}]")
+            for j in grp:  # the loads the teeth carry (_kernels.ratio_sample)
+                w(f"total += positive_part(W[{W_F + L.track[j]}])[0]")
             with w.block(f"if total > {par(('gmin', kg))}:"):
                 for j in grp:
                     s = X_ST + N_STAT * j
-                    w(f"ratio = {len(grp)} * W[{W_F + L.track[j]}] / total")
+                    w(f"ratio = {len(grp)} * positive_part(W[{W_F + L.track[j]}])[0] "
+                      f"/ total")
                     with w.block(f"if ratio > X[{s + 3}]:"):
                         w(f"X[{s + 3}] = ratio")
                     with w.block(f"if ratio < X[{s + 4}]:"):

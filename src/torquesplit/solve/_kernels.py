@@ -439,14 +439,15 @@ def ratio_starts(t, slot, i_f, m, w, r):
                 continue
             tb = (c + track_base[j] - m.phase[el]) / m.frequency[el]
             th = min(max((tb - ta) / span, 0.0), 1.0) if span > 0.0 else 1.0
-            total = 0.0
+            total = 0.0  # (of the loads the teeth carry, as ratio_sample)
             for kk in range(grp_ptr[g], grp_ptr[g + 1]):
                 i = grp_col[kk]
                 fa = prev_f[i]
-                total += fa + th * (force[i_f, track_el[i]] - fa)
+                total += laws.positive_part(fa + th * (force[i_f, track_el[i]] - fa))[0]
             if total > grp_min[g]:
                 fa = prev_f[j]
-                ratio = (grp_ptr[g + 1] - grp_ptr[g]) * (fa + th * (force[i_f, el] - fa)) / total
+                fb = laws.positive_part(fa + th * (force[i_f, el] - fa))[0]
+                ratio = (grp_ptr[g + 1] - grp_ptr[g]) * fb / total
                 for cb in (cp, c):
                     if cb >= 0 and cb < cap:
                         if ratio > rat_max[cb, j]:
@@ -530,6 +531,38 @@ def peak_sample(t, kink, slot, i_f, w, r):
 
 
 @_inline
+def ratio_sample(slot, i_f, w, r):
+    """The instantaneous load-sharing ratio N f_i / sum_j f_j (Ji & Li eq. 18) of every
+    group member at this instant (forces in row ``i_f``) into its cycle's max and min.
+    Formed from the loads the teeth carry (:func:`laws.positive_part`: a damping force
+    exceeding the elastic one while a mesh separates is no tension of the teeth, and
+    would lift another member's ratio above N: Liu et al. 2021's spur stage gave 78 for
+    two meshes), and only while the group's total exceeds ``r.grp_min``.
+    Twin: :func:`torquesplit.solve.reference.cycle_ratio_numpy`."""
+    force, CY = w.F, w.CY
+    track_el, track_base = r.track_el, r.track_base
+    grp_ptr, grp_col, rat_max, rat_min = r.grp_ptr, r.grp_col, r.rat_max, r.rat_min
+    grp_min = r.grp_min
+    cap = rat_max.shape[0]
+    for g in range(grp_ptr.shape[0] - 1):
+        total = 0.0
+        for k in range(grp_ptr[g], grp_ptr[g + 1]):
+            total += laws.positive_part(force[i_f, track_el[grp_col[k]]])[0]
+        if total > grp_min[g]:
+            nm = grp_ptr[g + 1] - grp_ptr[g]
+            for k in range(grp_ptr[g], grp_ptr[g + 1]):
+                j = grp_col[k]
+                el = track_el[j]
+                c = CY[slot, el] - track_base[j]
+                if c >= 0 and c < cap:
+                    ratio = nm * laws.positive_part(force[i_f, el])[0] / total
+                    if ratio > rat_max[c, j]:
+                        rat_max[c, j] = ratio
+                    if ratio < rat_min[c, j]:
+                        rat_min[c, j] = ratio
+
+
+@_inline
 def record(t, slot, i_f, weight, m, w, r, counters):
     """Enter one accepted state at time ``t`` (forces in row ``i_f``) in the statistics.
 
@@ -546,8 +579,6 @@ def record(t, slot, i_f, weight, m, w, r, counters):
     force, defl, CY, G, watch_el = w.F, w.D, w.CY, w.G, w.watch_el
     track_el, track_base = r.track_el, r.track_base
     cyc_max, cyc_min, cyc_cnt = r.cyc_max, r.cyc_min, r.cyc_cnt
-    grp_ptr, grp_col, rat_max, rat_min = r.grp_ptr, r.grp_col, r.rat_max, r.rat_min
-    grp_min = r.grp_min
     sep_count, sep_time, back_count, back_time = (r.sep_count, r.sep_time, r.back_count,
                                                   r.back_time)
     element_kind = m.element_kind
@@ -566,22 +597,7 @@ def record(t, slot, i_f, weight, m, w, r, counters):
     r.pk_x[0] = 0
     ratio_starts(t, slot, i_f, m, w, r)  # (before mean_sample too)
     mean_sample(t, slot, i_f, m, w, r)
-    for g in range(grp_ptr.shape[0] - 1):
-        total = 0.0
-        for k in range(grp_ptr[g], grp_ptr[g + 1]):
-            total += force[i_f, track_el[grp_col[k]]]
-        if total > grp_min[g]:
-            nm = grp_ptr[g + 1] - grp_ptr[g]
-            for k in range(grp_ptr[g], grp_ptr[g + 1]):
-                j = grp_col[k]
-                el = track_el[j]
-                c = CY[slot, el] - track_base[j]
-                if c >= 0 and c < cap:
-                    ratio = nm * force[i_f, el] / total
-                    if ratio > rat_max[c, j]:
-                        rat_max[c, j] = ratio
-                    if ratio < rat_min[c, j]:
-                        rat_min[c, j] = ratio
+    ratio_sample(slot, i_f, w, r)
     for j in range(watch_el.shape[0]):
         el = watch_el[j]
         g = G[slot, el]
@@ -611,8 +627,6 @@ def record_extrema(t, mean, slot, i_f, m, w, r):
     force, CY = w.F, w.CY
     track_el, track_base = r.track_el, r.track_base
     cyc_max, cyc_min = r.cyc_max, r.cyc_min
-    grp_ptr, grp_col, rat_max, rat_min = r.grp_ptr, r.grp_col, r.rat_max, r.rat_min
-    grp_min = r.grp_min
     cap = cyc_max.shape[0]
     for j in range(track_el.shape[0]):
         el = track_el[j]
@@ -623,22 +637,7 @@ def record_extrema(t, mean, slot, i_f, m, w, r):
                 cyc_max[c, j] = fe
             if fe < cyc_min[c, j]:
                 cyc_min[c, j] = fe
-    for g in range(grp_ptr.shape[0] - 1):
-        total = 0.0
-        for k in range(grp_ptr[g], grp_ptr[g + 1]):
-            total += force[i_f, track_el[grp_col[k]]]
-        if total > grp_min[g]:
-            nm = grp_ptr[g + 1] - grp_ptr[g]
-            for k in range(grp_ptr[g], grp_ptr[g + 1]):
-                j = grp_col[k]
-                el = track_el[j]
-                c = CY[slot, el] - track_base[j]
-                if c >= 0 and c < cap:
-                    ratio = nm * force[i_f, el] / total
-                    if ratio > rat_max[c, j]:
-                        rat_max[c, j] = ratio
-                    if ratio < rat_min[c, j]:
-                        rat_min[c, j] = ratio
+    ratio_sample(slot, i_f, w, r)
     if mean != 0:  # RK4's corners: instants in time order, corners among the samples
         peak_sample(t, np.int64(1), slot, i_f, w, r)
         ratio_starts(t, slot, i_f, m, w, r)

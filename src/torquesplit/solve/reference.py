@@ -290,8 +290,9 @@ def cycle_statistics_numpy(times, forces, frequency, phase, t0, n_cycles_cap,
 def cycle_ratio_numpy(times, forces, frequency, phase, t0, n_cycles_cap, group_min=0.0,
                       continuous_start=None):
     """Per-cycle max and min of the instantaneous load-sharing ratio N f_j / sum_i f_i
-    (Ji & Li eq. 18) of each member j of one group, from the members' forces ``forces``
-    (n_instants, N) at the instants ``times`` (increasing); member j's cycles as in
+    (Ji & Li eq. 18) of each member j of one group, from the loads the members' teeth
+    carry (the positive parts of their forces ``forces`` (n_instants, N), no tension) at
+    the instants ``times`` (increasing); member j's cycles as in
     :func:`cycle_statistics_numpy` from ``frequency[j]``, ``phase[j]``.  A ratio enters
     only where the group's total force exceeds ``group_min``.  Where member j's force is
     continuous at its cycle starts (``continuous_start[j]``), the ratio of the forces
@@ -299,7 +300,8 @@ def cycle_ratio_numpy(times, forces, frequency, phase, t0, n_cycles_cap, group_m
     of the ratio part of ``_kernels.record`` and of ``_kernels.ratio_starts``; returns
     (max, min), each (n_cycles_cap, N), -inf / +inf where empty."""
     times = np.asarray(times, dtype=float)
-    forces = np.asarray(forces, dtype=float)
+    raw = np.asarray(forces, dtype=float)
+    forces = np.maximum(raw, 0.0)
     nm = forces.shape[1]
     cont = np.zeros(nm, bool) if continuous_start is None else np.asarray(continuous_start)
     rmax = np.full((n_cycles_cap, nm), -np.inf)
@@ -318,7 +320,7 @@ def cycle_ratio_numpy(times, forces, frequency, phase, t0, n_cycles_cap, group_m
             ta, span, cb = times[a], times[a + 1] - times[a], idx[a + 1]
             tc = (cb + base - phase[j]) / frequency[j]
             th = min(max((tc - ta) / span, 0.0), 1.0) if span > 0 else 1.0
-            fc = forces[a] + th * (forces[a + 1] - forces[a])
+            fc = np.maximum(raw[a] + th * (raw[a + 1] - raw[a]), 0.0)
             if fc.sum() > group_min:
                 for c in (cb - 1, cb):
                     if 0 <= c < n_cycles_cap:

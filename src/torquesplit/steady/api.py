@@ -477,10 +477,11 @@ def boundary_extremes(t, f, start, period, mx, mn):
 def boundary_ratios(t, forces, member, start, period, least, mx, mn):
     """Enter in ``mx`` / ``mn`` the load-sharing ratio N f_j / sum_i f_i of group member
     ``member`` (column of ``forces`` (n_instants, N) at the instants ``t``) at each of
-    its cycle starts, from every member's force interpolated there, where the total
-    exceeds ``least``: as ``_kernels.ratio_starts`` does."""
+    its cycle starts, from every member's force interpolated there (its positive part:
+    the load the teeth carry), where the total exceeds ``least``: as
+    ``_kernels.ratio_starts`` does."""
     k, i, th = cycle_start_points(t, start, period, mx.shape[0])
-    fb = forces[i] + th[:, None] * (forces[i + 1] - forces[i])
+    fb = np.maximum(forces[i] + th[:, None] * (forces[i + 1] - forces[i]), 0.0)  # no tension
     total = fb.sum(axis=1)
     keep = total > least
     r = forces.shape[1] * fb[keep, member] / total[keep]
@@ -633,7 +634,8 @@ def _as_solution(st: SteadyState, shell, periods):
 
         least = GROUP_MIN_LOAD * sum(abs(st.kinematics.meshes[m].force) for m in members)
 
-        def ratios(x, least=least):
+        def ratios(x, least=least):  # of the loads the teeth carry (no tension)
+            x = np.maximum(x, 0.0)
             total = x.sum(axis=1, keepdims=True)
             with np.errstate(invalid="ignore", divide="ignore"):
                 return x.shape[1] * x / np.where(total > least, total, np.nan)
