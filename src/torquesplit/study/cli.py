@@ -176,6 +176,8 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
         if ds.attrs["design"] == "sensitivity":
             data["ranking"] = {ds[v].attrs["output"]: ranking(ds, ds[v].attrs["output"])
                                for v in out_vars}
+            data["sensitivity_warnings"] = json.loads(ds.attrs.get("sensitivity_warnings",
+                                                                    "[]"))
         print(json.dumps(data, indent=2))
         return
     from rich.table import Table
@@ -213,6 +215,8 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
             rank = ranking(ds, ds[v].attrs["output"])
             t.add_row(v, ", ".join(f"{f} {x:.3g}" for f, x in rank))
         ui.console.print(t)
+        for note in json.loads(ds.attrs.get("sensitivity_warnings", "[]")):
+            ui.console.print(f"warning: {note}", markup=False, highlight=False)
     else:
         t = Table(title=f"{ds.attrs['study_name']}: {status.size} cases")
         for col in ("output", "mean", "std", "min", "p5", "p95", "max"):

@@ -18,7 +18,9 @@ output variables       one per requested output, named as the output
                        differs between two runs of the same study)
 sensitivity            variables over (``output``, ``factor``): ``mu_star``, ``mu``,
                        ``sigma``, ``mu_star_conf`` (Morris) or ``S1``, ``ST``,
-                       ``S1_conf``, ``ST_conf`` (Sobol)
+                       ``S1_conf``, ``ST_conf`` (Sobol; attribute
+                       ``sensitivity_warnings``: JSON list of factors whose S1 exceeds
+                       ST beyond the intervals)
 attributes             study name, description, reference, design, the study file's
                        text, the model (JSON, SI) and both hashes, torquesplit version
 =====================  ==================================================================
@@ -141,7 +143,26 @@ def _add_indices(ds, plan, values):
                           factor=("factor", factors))
     ds.attrs.update(sensitivity_method=d.extra["method"], ranking=ranking_key(d),
                     seed=plan.spec.sensitivity.seed)
+    notes = sobol_warnings(ds) if d.extra["method"] == "sobol" else []
+    if notes:
+        ds.attrs["sensitivity_warnings"] = json.dumps(notes)
     return ds
+
+
+def sobol_warnings(ds) -> list[str]:
+    """Factors whose first-order index exceeds the total index by more than the two
+    bootstrap half-widths together (S1 <= ST always holds for the true indices: too few
+    samples, or an output with failed cases)."""
+    notes = []
+    for o, out_name in enumerate(ds["output"].values):
+        for f, factor in enumerate(ds["factor"].values):
+            s1, st = float(ds["S1"].values[o, f]), float(ds["ST"].values[o, f])
+            c1, ct = float(ds["S1_conf"].values[o, f]), float(ds["ST_conf"].values[o, f])
+            if s1 - st > np.nan_to_num(c1) + np.nan_to_num(ct):
+                notes.append(f"{out_name}: S1 of {factor} ({s1:.3g} +/- {c1:.2g}) exceeds its "
+                             f"ST ({st:.3g} +/- {ct:.2g}) beyond the 95 % intervals; the "
+                             f"indices are not converged, raise sensitivity.samples")
+    return notes
 
 
 _INDEX_NAMES = {

@@ -219,11 +219,16 @@ def tornado_figure(ds, var: str) -> Figure:
     fig = _figure(WIDTH, 0.45 * len(factors) + 1.6)
     ax = fig.add_subplot()
     pos = np.arange(len(factors))
-    ax.barh(pos, row[order], xerr=conf[order], color=_color(0), alpha=0.85,
-            label="mu* (Morris)" if key == "mu_star" else "ST (total)")
-    if key == "ST":
+    if key == "ST":  # side by side, each bar with its own interval
         s1 = ds["S1"].sel(output=var).values
-        ax.barh(pos, s1[order], height=0.4, color=_color(1), label="S1 (first order)")
+        s1_conf = ds["S1_conf"].sel(output=var).values
+        ax.barh(pos + 0.2, row[order], height=0.4, xerr=conf[order], color=_color(0),
+                alpha=0.85, label="ST (total)")
+        ax.barh(pos - 0.2, s1[order], height=0.4, xerr=s1_conf[order], color=_color(1),
+                alpha=0.85, label="S1 (first order)")
+    else:
+        ax.barh(pos, row[order], xerr=conf[order], color=_color(0), alpha=0.85,
+                label="mu* (Morris)")
     ax.set_yticks(pos, [factors[i] for i in order], fontsize=8)
     unit, _ = _out_unit(var)
     ax.set_xlabel("mu*: mean |output change| over each factor's range [" + unit + "]"
