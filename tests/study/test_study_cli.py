@@ -85,3 +85,17 @@ def test_shipped_studies_check_out(name):
     text = plan.study_text
     assert "seed" not in study.spec.study.reference.lower()  # cite authors, not seed numbers
     assert study.spec.study.reference and "#" in text  # every file explains itself
+
+
+def test_sweep_refuses_a_bare_range_for_a_field_with_units(tmp_path, split_file):
+    from torquesplit.study.cli import _refuse_bare_range
+
+    res = runner.invoke(app, ["sweep", str(split_file), "--vary",
+                              "meshes.a1.transmission_error.constant=0:40:5", "--cycles", "40",
+                              "--out", str(tmp_path / "s"), "--quiet"])
+    assert res.exit_code == 2, res.output
+    assert "0:40:5um" in res.output and "0 to 40 m" in res.output
+    assert "Traceback" not in res.output and not (tmp_path / "s").exists()
+    # with a unit, or for a plain number, the range stands
+    _refuse_bare_range("x", parse_vary("meshes.a1.transmission_error.constant=0:40:5um"))
+    _refuse_bare_range("x", parse_vary("meshes.a1.damping_ratio=0.05:0.1:2"))

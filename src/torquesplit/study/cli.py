@@ -277,6 +277,34 @@ def parse_vary(text: str) -> dict:
     return table
 
 
+def _refuse_bare_range(text: str, table: dict) -> None:
+    """A ``--vary`` range of bare numbers for a field with units is refused: it would be
+    read in SI (``0:40:5`` for an eccentricity: 0 to 40 m)."""
+    from .errors import StudyError
+    from .paths import is_pattern, schema_field, si_unit
+
+    if "unit" in table or isinstance(table["start"], str) or isinstance(table["stop"], str):
+        return
+    for path in table.get("paths") or [table["path"]]:
+        if is_pattern(path):
+            continue
+        try:
+            kind = schema_field(path, "--vary").kind
+        except StudyError:  # reported with the study's own words when it is resolved
+            continue
+        if kind is None:
+            continue
+        from ..model.units import KINDS
+
+        si = si_unit(kind)
+        example = KINDS[kind][1].split(" ", 1)[1]
+        a, b, n = table["start"], table["stop"], table["num"]
+        raise ValueError(f"--vary {text!r}: {path} is a {kind.replace('_', ' ')} and the "
+                         f"range has no unit (it would be read as {a:g} to {b:g} {si}); "
+                         f"write the unit after the count, e.g. '{a:g}:{b:g}:{n}{example}' "
+                         f"(or '{a:g}:{b:g}:{n}{si}' if {si} is meant)")
+
+
 def _number(text: str):
     try:
         return float(text)
@@ -324,6 +352,7 @@ def sweep(
 
         ui._one_run_length(duration, cycles)
         param = parse_vary(vary)
+        _refuse_bare_range(vary, param)
         if log_spacing:
             param["spacing"] = "log"
         path = ui._resolve_model_path(model)
