@@ -62,7 +62,8 @@ def run_case(p: dict) -> dict:
         except Exception as exc:  # a bug, a memory error...: record it, keep the study going
             out.update(status="error", reason=f"{type(exc).__name__}: {_one_line(exc)}",
                        values=nan)
-    out["warnings"] = sorted({_one_line(w.message) for w in caught})
+    # the model's warnings (unit slips...) and the run's (too short, unsettled...)
+    out["warnings"] = sorted({_one_line(w.message) for w in caught} | set(out["warnings"]))
     out["wall_time"] = time.perf_counter() - t0
     return out
 
@@ -86,6 +87,9 @@ def _static(model, p, out) -> list[float]:
         out["status"] = "diverged"
         out["reason"] = (f"the quasi-static equilibrium did not converge at "
                          f"{int((~conv).sum())} of {conv.size} mesh positions")
+    from ..results.plausibility import static_warnings
+
+    out["warnings"] += [f"{loc}: {msg}" for loc, msg in static_warnings(res)]
     vals = output_values(res)
     return [vals.get(n, math.nan) for n in p["outputs"]]
 
@@ -118,6 +122,10 @@ def _dynamic(model, p, out) -> list[float]:
             break
         if length >= full:
             out["settled"] = False
+            out["warnings"].append(
+                f"analysis.settle: the outputs still changed by more than the tolerance "
+                f"{settle['tolerance']:g} at the longest run ({full:.4g} s); raise the run "
+                f"length (duration or cycles) or the tolerance")
             break
         previous = current
         length = min(length * settle["growth"], full)
@@ -170,6 +178,9 @@ def _finish(res, names, defs, out, output_values, vals=None) -> list[float]:
         vals = output_values(res, defs)
     met = res.metrics("cycle_peak")  # settling and contact loss: the same for every definition
     out["settled"] = out["settled"] and met.settling.settled
+    from ..results.plausibility import result_warnings
+
+    out["warnings"] += [f"{loc}: {msg}" for loc, msg in result_warnings(res, met)]
     lost = [(r.mesh, r.contact_loss) for r in met.rows if r.contact_loss > 0]
     if lost:
         out["status"] = "contact_lost"

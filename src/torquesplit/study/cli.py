@@ -156,10 +156,13 @@ def _with_bar(job, total: int, quiet: bool):
 def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
     import numpy as np
 
-    from .dataset import ranking
+    from .dataset import case_ranges, ranking, warning_groups
 
     ui = _ui()
     status = ds["status"].values.ravel()
+    groups = warning_groups(ds)
+    n_warned = (int((ds["warning_count"].values.ravel() > 0).sum())
+                if "warning_count" in ds else 0)
     counts = {s: int((status == s).sum()) for s in sorted(set(status.tolist()))}
     out_vars = [v for v in ds.data_vars if "output" in ds[v].attrs]
     figs = sorted(str(p) for p in (out / "figures").glob("*.png")) if figures else []
@@ -172,7 +175,9 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
                                 and ds[c].dtype.kind == "f"},
                 "outputs": {ds[v].attrs["output"]: [_num(x) for x in ds[v].values.ravel()]
                             for v in out_vars},
-                "reasons": sorted({r for r in ds["reason"].values.ravel().tolist() if r})}
+                "reasons": sorted({r for r in ds["reason"].values.ravel().tolist() if r}),
+                "cases_warned": n_warned,
+                "warnings": [{"text": g["text"], "cases": g["cases"]} for g in groups]}
         if ds.attrs["design"] == "sensitivity":
             data["ranking"] = {ds[v].attrs["output"]: ranking(ds, ds[v].attrs["output"])
                                for v in out_vars}
@@ -236,6 +241,15 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
                       if s != "ok"})
     for r in reasons[:5]:
         ui.console.print(f"  not ok: {r}", markup=False, highlight=False)
+    if n_warned:
+        ui.console.print(f"[yellow]{n_warned} of {status.size} cases warned[/] (variable "
+                         f"'warnings' of results.nc has each case's):", highlight=False)
+        for g in groups[:5]:
+            ui.console.print(f"  {case_ranges(g['cases'])}: {g['text']}", markup=False,
+                             highlight=False, soft_wrap=True)
+        if len(groups) > 5:
+            ui.console.print(f"  ... and {len(groups) - 5} more kinds of warning",
+                             highlight=False)
     ui.console.print(f"results: {out / 'results.nc'}; store: {out / 'study.sqlite'}"
                      + (f"; {len(figs)} figures in {out / 'figures'}" if figs else ""))
 

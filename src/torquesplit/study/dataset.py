@@ -13,6 +13,9 @@ output variables       one per requested output, named as the output
 ``status``             ok / contact_lost / diverged / refused / error (/ missing)
 ``reason``             why a case is not ok ("" when it is)
 ``settled``            the metrics found a settled part (and the settle rule converged)
+``warnings``           the case's warnings, one a line ("" when none): the model checks'
+                       (a unit slip), the run's (too short to tell whether it settled,
+                       not settled, contact loss...); ``warning_count``: how many
 ``simulated_time``     simulated time of the (last) run of each case [s]
 ``case_wall_time``     seconds each case took on its worker (the only variable that
                        differs between two runs of the same study)
@@ -30,6 +33,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -54,6 +58,8 @@ def build_dataset(plan, rows, n: int, meta: dict):
     settled = np.zeros(n, dtype=bool)
     sim_time = np.full(n, np.nan)
     wall = np.full(n, np.nan)
+    warned = np.full(n, "", dtype=object)
+    n_warned = np.zeros(n, dtype=np.int32)
     for r in rows:
         i = r["index"]
         values[i] = [math.nan if v is None else v for v in r["values"]]
@@ -62,6 +68,9 @@ def build_dataset(plan, rows, n: int, meta: dict):
         settled[i] = r["settled"]
         sim_time[i] = np.nan if r["simulated_time"] is None else r["simulated_time"]
         wall[i] = r["wall_time"]
+        notes = r.get("warnings") or []
+        warned[i] = "\n".join(notes)
+        n_warned[i] = len(notes)
     if d.kind == "grid":
         dims = tuple(p.name for p in d.parameters)
         shape = d.shape
@@ -88,6 +97,10 @@ def build_dataset(plan, rows, n: int, meta: dict):
     data["reason"] = var(reason.astype(str), {"long_name": "why the case is not ok"})
     data["settled"] = var(settled.astype(np.int8), {
         "units": "1", "long_name": "settled part found (1) or not (0)"})
+    data["warnings"] = var(warned.astype(str), {
+        "long_name": "the case's warnings (model checks, run plausibility), one a line"})
+    data["warning_count"] = var(n_warned, {"units": "1", "long_name": "number of warnings "
+                                                                      "of the case"})
     data["simulated_time"] = var(sim_time, {"units": "s", "long_name": "simulated time of "
                                                                        "the case's run"})
     data["case_wall_time"] = var(wall, {"units": "s", "long_name": "wall time of the case "
@@ -192,3 +205,33 @@ def ranking(ds, output: str) -> list[tuple[str, float]]:
     row = ds[key].sel(output=variable_name(output)).values
     order = np.argsort(-np.nan_to_num(row, nan=-np.inf))
     return [(str(ds["factor"].values[i]), float(row[i])) for i in order]
+
+
+_NUMBER = re.compile(r"[-+]?\d+(?:\.\d*)?(?:[eE][-+]?\d+)?")
+
+
+def warning_groups(ds) -> list[dict]:
+    """The cases' warnings grouped by what they say (texts that differ only in numbers
+    are one group): ``[{"text": the first case's text, "cases": [case indices]}]``, the
+    group with most cases first."""
+    if "warnings" not in ds:
+        return []
+    groups: dict[str, dict] = {}
+    for i, text in enumerate(ds["warnings"].values.ravel().tolist()):
+        for line in filter(None, str(text).split("\n")):
+            g = groups.setdefault(_NUMBER.sub("#", line), {"text": line, "cases": []})
+            if not g["cases"] or g["cases"][-1] != i:
+                g["cases"].append(i)
+    return sorted(groups.values(), key=lambda g: (-len(g["cases"]), g["cases"][0]))
+
+
+def case_ranges(cases: list[int]) -> str:
+    """[0, 1, 2, 5] -> "cases 0-2, 5"."""
+    parts, start = [], None
+    for j, c in enumerate(cases):
+        if start is None:
+            start = c
+        if j + 1 == len(cases) or cases[j + 1] != c + 1:
+            parts.append(f"{start}" if start == c else f"{start}-{c}")
+            start = None
+    return ("case " if len(cases) == 1 else "cases ") + ", ".join(parts)
