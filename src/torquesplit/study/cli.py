@@ -178,6 +178,10 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
                 "reasons": sorted({r for r in ds["reason"].values.ravel().tolist() if r}),
                 "cases_warned": n_warned,
                 "warnings": [{"text": g["text"], "cases": g["cases"]} for g in groups]}
+        if "stopping_target_met" in ds.attrs:
+            data["stopping_rule"] = {k[len("stopping_"):]: ds.attrs[k] for k in ds.attrs
+                                     if k.startswith("stopping_") and k != "stopping_rule"}
+            data["stopping_rule"]["target_met"] = bool(data["stopping_rule"]["target_met"])
         if ds.attrs["design"] == "sensitivity":
             data["ranking"] = {ds[v].attrs["output"]: ranking(ds, ds[v].attrs["output"])
                                for v in out_vars}
@@ -223,20 +227,36 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
         for note in json.loads(ds.attrs.get("sensitivity_warnings", "[]")):
             ui.console.print(f"warning: {note}", markup=False, highlight=False)
     else:
-        t = Table(title=f"{ds.attrs['study_name']}: {status.size} cases")
-        for col in ("output", "mean", "std", "min", "p5", "p95", "max"):
+        used = {v: int(np.isfinite(ds[v].values).sum()) for v in out_vars}
+        fewer = sorted({u for u in used.values() if u < status.size})
+        title = f"{ds.attrs['study_name']}: {status.size} cases"
+        if len(fewer) == 1 and all(u == fewer[0] for u in used.values()):
+            title = f"{ds.attrs['study_name']}: statistics over {fewer[0]} of {status.size} cases"
+        t = Table(title=title)
+        cols = ["output", "mean", "std", "min", "p5", "p95", "max"]
+        if len(fewer) and "over" not in title:
+            cols.append("cases")
+        for col in cols:
             t.add_column(col, justify="left" if col == "output" else "right")
         for v in out_vars:
             x = ds[v].values.ravel()
             x = x[np.isfinite(x)]
+            count = [f"{x.size} of {status.size}"] if "cases" in cols else []
             if not x.size:
-                t.add_row(v, *["-"] * 6)
+                t.add_row(v, *["-"] * 6, *count)
                 continue
             t.add_row(v, *[f"{s:.6g}" for s in (x.mean(), x.std(ddof=1) if x.size > 1 else
                                                 0.0, x.min(), np.quantile(x, 0.05),
-                                                np.quantile(x, 0.95), x.max())])
+                                                np.quantile(x, 0.95), x.max())], *count)
         ui.console.print(t)
+        if fewer:
+            ui.console.print(f"statistics over the cases with a finite value only: "
+                             f"{min(used.values())} of {status.size} at the fewest",
+                             highlight=False)
     ui.console.print("cases: " + ", ".join(f"{n} {s}" for s, n in counts.items()))
+    line = stopping_line(ds)
+    if line:
+        ui.console.print(line, markup=False, highlight=False)
     reasons = sorted({r for r, s in zip(ds["reason"].values.ravel().tolist(), status)
                       if s != "ok"})
     for r in reasons[:5]:
@@ -252,6 +272,24 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
                              highlight=False)
     ui.console.print(f"results: {out / 'results.nc'}; store: {out / 'study.sqlite'}"
                      + (f"; {len(figs)} figures in {out / 'figures'}" if figs else ""))
+
+
+def stopping_line(ds) -> str:
+    """The stopping rule's outcome in one line ("" without a rule)."""
+    a = ds.attrs
+    if "stopping_target_met" not in a:
+        return ""
+    rule = json.loads(a["stopping_rule"])
+    n, finite = int(a["stopping_cases"]), int(a["stopping_finite_cases"])
+    over = (f" over {finite} of {n} cases ({n - finite} without a finite value left out)"
+            if finite < n else f" over {n} cases")
+    outcome = ("target met" if a["stopping_target_met"] else
+               f"target NOT met: max_samples = {rule['max_samples']} reached; raise it or "
+               f"widen half_width")
+    return (f"stopping rule: {a['stopping_statistic']} of {rule['output']} = "
+            f"{a['stopping_estimate']:.6g} +/- {a['stopping_half_width']:.3g} "
+            f"({rule['confidence']:.0%} interval){over}; target half-width "
+            f"{a['stopping_target']:.3g}: {outcome}")
 
 
 def _num(x):

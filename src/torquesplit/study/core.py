@@ -211,6 +211,7 @@ class Study:
                 if report is not None:
                     store.write_meta({"gpu_backend": report})
                 ds = dataset_from_store(plan, store, run.n_used)
+                ds.attrs.update(run.stop_report)
                 if out is not None:
                     _write_outputs(ds, Path(out), figures)
             except KeyboardInterrupt:
@@ -399,6 +400,8 @@ class _Driver:
         stop = plan.spec.monte_carlo.stop if plan.spec.monte_carlo is not None else None
         self.stop = stop
         self.stop_at: int | None = None
+        self.stop_report: dict = {}
+        """The stopping rule's outcome (Dataset attributes), once it stopped."""
         self._checked: int | None = None
         self.watch = np.full(d.n_cases, np.nan) if stop else None
         self.finished = np.zeros(d.n_cases, dtype=bool)
@@ -484,10 +487,19 @@ class _Driver:
                 return
             half, stat = confidence_half_width(self.watch[:n], s.statistic, s.confidence)
             target = s.half_width * (abs(stat) if s.relative else 1.0)
+            finite = int(np.isfinite(self.watch[:n]).sum())
             log.info("stopping rule at n = %d: %s = %.6g +/- %.3g (target %.3g)", n,
                      s.statistic, stat, half, target)
+            if finite < n:  # failed cases have no value: the interval is over the others
+                log.warning("stopping rule at n = %d: %s over %d of %d cases (%d without a "
+                            "finite value left out)", n, s.statistic, finite, n, n - finite)
             if half <= target or n >= s.max_samples:
                 self.stop_at = n
+                self.stop_report = {
+                    "stopping_statistic": s.statistic, "stopping_estimate": float(stat),
+                    "stopping_half_width": float(half), "stopping_target": float(target),
+                    "stopping_target_met": int(half <= target), "stopping_cases": int(n),
+                    "stopping_finite_cases": finite}
                 return
             self._checked = n
 

@@ -485,22 +485,45 @@ def _random_variable(t, p: Parameter, model, where) -> RandomVariable:
     def si(name):
         return P.to_si(getattr(t, name), kind, t.unit, f"{where}.{name}")
 
+    nonneg = [f.path for f in p.fields if f.nonnegative]
     if d == "normal":
         mean, std = si("mean"), si("std")
         if std <= 0:
             raise StudyError(f"{where}.std", "must be positive; give the standard deviation")
+        below = 0.5 * math.erfc(mean / (std * math.sqrt(2)))  # P(x < 0)
+        if nonneg and below > NEGATIVE_PROBABILITY:
+            raise StudyError(f"{where}.distribution", (
+                f"a normal distribution with mean {_shown(t.mean, t.unit)} and std "
+                f"{_shown(t.std, t.unit)} draws negative values ({100 * below:.3g} % of the "
+                f"samples), which {nonneg[0]} refuses (those cases would be left out of the "
+                f"statistics); use distribution = \"truncated_normal\" with low = 0 "
+                f"(and high)"))
         return RandomVariable("normal", (mean, std))
     if d == "uniform":
         low, high = si("low"), si("high")
         if not high > low:
             raise StudyError(f"{where}.high", "must exceed 'low'; correct the bounds")
+        _refuse_negative_low(low, t, nonneg, where)
         return RandomVariable("uniform", (low, high))
     mean, std, low, high = si("mean"), si("std"), si("low"), si("high")
     if std <= 0:
         raise StudyError(f"{where}.std", "must be positive; give the standard deviation")
     if not high > low:
         raise StudyError(f"{where}.high", "must exceed 'low'; correct the bounds")
+    _refuse_negative_low(low, t, nonneg, where)
     return RandomVariable("truncated_normal", (mean, std, low, high))
+
+
+#: a normal distribution of a field that refuses negative values is refused when it draws
+#: a negative value with more than this probability (one case in a billion)
+NEGATIVE_PROBABILITY = 1e-9
+
+
+def _refuse_negative_low(low: float, t, nonneg: list[str], where: str) -> None:
+    if nonneg and low < 0:
+        raise StudyError(f"{where}.low", f"is {_shown(t.low, t.unit)}, but {nonneg[0]} refuses "
+                                         f"negative values (those cases would be left out of "
+                                         f"the statistics); give low >= 0")
 
 
 def _iso_variable(t, p: Parameter, model, where) -> RandomVariable:

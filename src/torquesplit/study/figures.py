@@ -192,6 +192,7 @@ def monte_carlo_figure(ds, var: str, confidence: float = 0.95) -> Figure:
         ax_v.plot(k, mean, color=_color(0), label="running mean")
         p95 = [np.quantile(seq[:j], 0.95) for j in range(1, seq.size + 1)]
         ax_v.plot(k, p95, color=_color(1), ls="--", label="running 95th percentile")
+        _stopping_band(ds, var, ax_v, scale)
     ax_h.set_xlabel(label, fontsize=8)
     ax_h.set_ylabel("cases")
     ax_c.set_xlabel(label, fontsize=8)
@@ -204,8 +205,25 @@ def monte_carlo_figure(ds, var: str, confidence: float = 0.95) -> Figure:
     ax_v.legend(fontsize=7)
     failed = int((ds["status"].values != "ok").sum())
     note = f" ({failed} of {y.size} cases not ok)" if failed else ""
-    fig.suptitle(f"{ds.attrs['study_name']}: {n} samples{note}", fontsize=11)
+    what = f"statistics over {n} of {y.size} cases" if n < y.size else f"{n} samples"
+    fig.suptitle(f"{ds.attrs['study_name']}: {what}{note}", fontsize=11)
     return fig
+
+
+def _stopping_band(ds, var, ax, scale) -> None:
+    """The stopping rule's target band around its final estimate, on the watched
+    output's running statistic."""
+    a = ds.attrs
+    if "stopping_target_met" not in a:
+        return
+    rule = json.loads(a["stopping_rule"])
+    if ds[var].attrs.get("output") != rule["output"]:
+        return
+    est, target = a["stopping_estimate"] * scale, a["stopping_target"] * scale
+    met = "met" if a["stopping_target_met"] else "not met"
+    ax.axhspan(est - target, est + target, color=_color(2), alpha=0.2,
+               label=f"stopping target +/-{target:.3g} ({a['stopping_statistic']}, {met})")
+    ax.axvline(a["stopping_cases"], color=_color(2), lw=1, ls=":")
 
 
 # ============================================================================ sensitivity
