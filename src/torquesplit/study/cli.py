@@ -192,29 +192,14 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
     from rich.table import Table
 
     design = ds.attrs["design"]
-    if design == "grid" and status.size <= 60 and len(out_vars) <= 8:
-        t = Table(title=f"{ds.attrs['study_name']}")
-        from rich.markup import escape
-
-        from .figures import _coord
-
-        dims = list(ds[out_vars[0]].dims)
-        shown = {}
-        for d in dims:
-            values, unit = _coord(ds, d)
-            shown[d] = dict(zip(ds[d].values.tolist(), values.tolist()))
-            # escaped: Rich would read "[um]" as markup and drop it
-            t.add_column(escape(f"{d} [{unit}]"), justify="right")
-        for v in out_vars:
-            t.add_column(v, justify="right")
-        t.add_column("status")
-        flat = ds.stack(case=dims)
-        for k in range(flat.sizes["case"]):
-            row = [f"{shown[d][float(flat[d].values[k])]:.6g}" for d in dims]
-            row += [f"{float(flat[v].values[k]):.6g}" for v in out_vars]
-            row.append(str(flat["status"].values[k]))
-            t.add_row(*row)
-        ui.console.print(t)
+    if design == "grid" and status.size <= MAX_TABLE_CASES:
+        for title, columns in _grid_tables(ds, out_vars):
+            ui.console.print(_grid_table(ds, title, columns))
+    elif design == "grid":  # never Monte Carlo statistics over grid points
+        ui.console.print(f"{ds.attrs['study_name']}: a grid of {status.size} cases "
+                         f"({' x '.join(str(n) for n in ds[out_vars[0]].shape)}), too many "
+                         f"to print; the values are in {out / 'results.nc'} and the figures",
+                         highlight=False)
     elif design == "sensitivity":
         t = Table(title=f"{ds.attrs['study_name']}: factors ranked by "
                         f"{ds.attrs['ranking']} (most important first)")
@@ -272,6 +257,64 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
                              highlight=False)
     ui.console.print(f"results: {out / 'results.nc'}; store: {out / 'study.sqlite'}"
                      + (f"; {len(figs)} figures in {out / 'figures'}" if figs else ""))
+
+
+MAX_TABLE_CASES = 60
+"""A grid with more cases is not printed (the results file and figures have it)."""
+MAX_TABLE_OUTPUTS = 8
+"""Output columns per printed table of a grid (more outputs: more tables)."""
+
+
+def _grid_tables(ds, out_vars: list[str]) -> list[tuple[str, list[tuple[str, str]]]]:
+    """The tables that print a grid: one per output family (the family in the title, the
+    columns its members, "system", "a1", ..., not names a narrow terminal cuts to the same
+    "load_sharing.me..."), each split after :data:`MAX_TABLE_OUTPUTS` columns; one table
+    of full names when each output is of another family.  Returns (title, [(column
+    header, variable)])."""
+    from . import outputs as out_mod
+
+    name = ds.attrs["study_name"]
+    fams: dict[str, list[tuple[str, str]]] = {}
+    for v in out_vars:
+        fam, member = out_mod.family(ds[v].attrs["output"])
+        fams.setdefault(fam, []).append((member, v))
+    if len(out_vars) <= MAX_TABLE_OUTPUTS and len(fams) == len(out_vars):
+        return [(name, [(v, v) for v in out_vars])]  # one output of each family
+    tables = []
+    for fam, members in fams.items():
+        parts = -(-len(members) // MAX_TABLE_OUTPUTS)
+        for k in range(parts):
+            part = f" ({k + 1} of {parts})" if parts > 1 else ""
+            tables.append((f"{name}: {fam}{part}",
+                           members[k * MAX_TABLE_OUTPUTS: (k + 1) * MAX_TABLE_OUTPUTS]))
+    return tables
+
+
+def _grid_table(ds, title: str, columns: list[tuple[str, str]]):
+    """One table of a grid's cases: the parameters, the ``columns`` and the status."""
+    from rich.markup import escape
+    from rich.table import Table
+
+    from .figures import _coord
+
+    t = Table(title=escape(title))
+    dims = list(ds[columns[0][1]].dims)
+    shown = {}
+    for d in dims:
+        values, unit = _coord(ds, d)
+        shown[d] = dict(zip(ds[d].values.tolist(), values.tolist()))
+        # escaped: Rich would read "[um]" as markup and drop it
+        t.add_column(escape(f"{d} [{unit}]"), justify="right")
+    for header, _ in columns:
+        t.add_column(escape(header), justify="right")
+    t.add_column("status")
+    flat = ds.stack(case=dims)
+    for k in range(flat.sizes["case"]):
+        row = [f"{shown[d][float(flat[d].values[k])]:.6g}" for d in dims]
+        row += [f"{float(flat[v].values[k]):.6g}" for _, v in columns]
+        row.append(str(flat["status"].values[k]))
+        t.add_row(*row)
+    return t
 
 
 def stopping_line(ds) -> str:
