@@ -12,7 +12,9 @@ output variables       one per requested output, named as the output
                        failed
 ``status``             ok / contact_lost / diverged / refused / error (/ missing)
 ``reason``             why a case is not ok ("" when it is)
-``settled``            the metrics found a settled part (and the settle rule converged)
+``settled``            1 when the metrics found a settled part and, with a settle rule,
+                       the outputs (``settle_time`` excepted) agreed between the last
+                       two run lengths; 0 otherwise
 ``warnings``           the case's warnings, one a line ("" when none): the model checks'
                        (a unit slip), the run's (too short to tell whether it settled,
                        not settled, contact loss...); ``warning_count``: how many
@@ -96,7 +98,9 @@ def build_dataset(plan, rows, n: int, meta: dict):
                                                      "missing"})
     data["reason"] = var(reason.astype(str), {"long_name": "why the case is not ok"})
     data["settled"] = var(settled.astype(np.int8), {
-        "units": "1", "long_name": "settled part found (1) or not (0)"})
+        "units": "1", "long_name": "1: the run's metrics found a settled part and, with "
+                                   "analysis.settle, the outputs (settle_time excepted) "
+                                   "agreed between the last two run lengths; 0: not"})
     data["warnings"] = var(warned.astype(str), {
         "long_name": "the case's warnings (model checks, run plausibility), one a line"})
     data["warning_count"] = var(n_warned, {"units": "1", "long_name": "number of warnings "
