@@ -153,3 +153,16 @@ def test_tornado_draws_each_interval_on_its_own_bar():
         # the interval is centred on the end of its own bar
         centres = sorted(seg[:, 0].mean() for seg in c.errorbar.lines[2][0].get_segments())
         np.testing.assert_allclose(centres, sorted(vals[key]))
+
+
+def test_indices_over_fewer_rows_say_so(split_file, tmp_path):
+    from torquesplit import cli as ui
+    from torquesplit.study.cli import _summary
+
+    ds = run_study(_study(split_file, "morris", trajectories=2), workers=1)
+    assert ds["trajectories_used"].values.tolist() == [2, 2]
+    assert ds["trajectories_used"].attrs["total"] == 2
+    ds["trajectories_used"].values[0] = 1  # as if a case of one trajectory failed
+    with ui.console.capture() as cap:
+        _summary(ds, tmp_path, False, False)
+    assert "indices over 1 of 2 trajectories at the fewest" in cap.get()

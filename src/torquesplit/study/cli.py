@@ -209,6 +209,15 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
             rank = ranking(ds, ds[v].attrs["output"])
             t.add_row(v, ", ".join(f"{f} {x:.3g}" for f, x in rank))
         ui.console.print(t)
+        used_var = next((u for u in ("samples_used", "trajectories_used") if u in ds), None)
+        if used_var is not None:
+            total = int(ds[used_var].attrs["total"])
+            fewest = int(ds[used_var].values.min())
+            if fewest < total:
+                unit = "trajectory" if used_var.startswith("traj") else "base row"
+                ui.console.print(f"indices over {fewest} of {total} "
+                                 f"{used_var.split('_')[0]} at the fewest (a failed case "
+                                 f"drops its {unit})", highlight=False)
         for note in json.loads(ds.attrs.get("sensitivity_warnings", "[]")):
             ui.console.print(f"warning: {note}", markup=False, highlight=False)
     else:

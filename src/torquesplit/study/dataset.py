@@ -156,6 +156,12 @@ def _add_indices(ds, plan, values):
     for k in keys:
         ds[k] = (("output", "factor"), np.array([r[k] for r in results]),
                  {"units": "1", "long_name": _INDEX_NAMES.get(k, k)})
+    used = "trajectories_used" if d.extra["method"] == "morris" else "samples_used"
+    total = d.extra["trajectories"] if d.extra["method"] == "morris" else d.extra["samples"]
+    ds[used] = (("output",), np.array([int(r[used]) for r in results]), {
+        "units": "1", "total": int(total),
+        "long_name": f"{used.split('_')[0]} whose cases all have a finite value (the "
+                     f"indices are over these, of {int(total)})"})
     ds = ds.assign_coords(output=("output", [variable_name(n) for n in names]),
                           factor=("factor", factors))
     ds.attrs.update(sensitivity_method=d.extra["method"], ranking=ranking_key(d),
