@@ -354,8 +354,9 @@ def _safe(name: str) -> str:
 
 
 # --------------------------------------------------------------------------- sweep
-_RANGE = re.compile(r"^\s*(?P<start>[^:]+?)\s*:\s*(?P<stop>[^:]+?)\s*:\s*(?P<num>\d+)\s*"
-                    r"(?P<unit>[^\d\s].*?)?\s*$")
+_RANGE = re.compile(r"^\s*(?P<start>[^:]+?)\s*:\s*(?P<stop>[^:]+?)\s*:\s*"
+                    r"(?P<num>[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*"
+                    r"(?P<unit>[^\d\s.].*?)?\s*$")
 
 
 def parse_vary(text: str) -> dict:
@@ -374,8 +375,14 @@ def parse_vary(text: str) -> dict:
         table["path"] = paths[0]
     else:
         table["paths"] = paths
-        table["name"] = paths[0].split(".")[-1]
-    table.update(start=_number(m["start"]), stop=_number(m["stop"]), num=int(m["num"]))
+    if len(paths) > 1 or any(c in paths[0] for c in "*?["):  # several fields: named by
+        table["name"] = paths[0].split(".")[-1]                # the last segment
+    num = m["num"]
+    if not re.fullmatch(r"\d+", num) or int(num) < 1:
+        raise ValueError(f"--vary {text!r}: the count {num!r} after the second ':' is the "
+                         f"number of points, a whole number >= 1 (not a step); write e.g. "
+                         f"{m['start'].strip()}:{m['stop'].strip()}:5{m['unit'] or ''}")
+    table.update(start=_number(m["start"]), stop=_number(m["stop"]), num=int(num))
     if m["unit"]:
         table["unit"] = m["unit"].strip()
     return table
@@ -385,14 +392,12 @@ def _refuse_bare_range(text: str, table: dict) -> None:
     """A ``--vary`` range of bare numbers for a field with units is refused: it would be
     read in SI (``0:40:5`` for an eccentricity: 0 to 40 m)."""
     from .errors import StudyError
-    from .paths import is_pattern, schema_field, si_unit
+    from .paths import schema_field, si_unit
 
     if "unit" in table or isinstance(table["start"], str) or isinstance(table["stop"], str):
         return
     for path in table.get("paths") or [table["path"]]:
-        if is_pattern(path):
-            continue
-        try:
+        try:  # a pattern's '*' stands for a key of a table of gears, meshes...: its kind
             kind = schema_field(path, "--vary").kind
         except StudyError:  # reported with the study's own words when it is resolved
             continue
@@ -469,6 +474,12 @@ def sweep(
             from ..model.io import load_model
 
             outputs = [f"load_sharing.{_default_definition(load_model, path)}.*"]
+        if static and (duration is not None or cycles is not None or settle is not None):
+            flag = ("--duration" if duration is not None else "--cycles" if cycles is not None
+                    else "--settle")
+            raise ValueError(f"{flag} sets the length of a dynamic run; a quasi-static sweep "
+                             f"(--static) turns the gears through whole revolutions: leave "
+                             f"{flag} out or drop --static")
         analysis: dict = {"type": "static" if static else "run"}
         if duration is not None:
             analysis["duration"] = duration
