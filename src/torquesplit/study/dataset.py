@@ -76,8 +76,9 @@ def build_dataset(plan, rows, n: int, meta: dict):
     if d.kind == "grid":
         dims = tuple(p.name for p in d.parameters)
         shape = d.shape
-        coords = {p.name: (p.name, axis, _param_attrs(p))
-                  for p, axis in zip(d.parameters, d.axes, strict=True)}
+        spacing = d.extra.get("spacing") or ["values"] * len(d.parameters)
+        coords = {p.name: (p.name, axis, {**_param_attrs(p), "spacing": sp})
+                  for p, axis, sp in zip(d.parameters, d.axes, spacing, strict=True)}
     else:
         dims = ("sample",)
         shape = (n,)

@@ -388,6 +388,7 @@ def _value(v, p: Parameter, unit, where) -> float:
 def _grid(spec: StudySpec, raw: dict) -> Design:
     params: list[Parameter] = []
     axes: list[np.ndarray] = []
+    spacings: list[str] = []
     for i, t in enumerate(spec.grid.parameters):
         where = f"grid.parameters.{i}"
         p = _parameter(t, raw, where)
@@ -419,8 +420,11 @@ def _grid(spec: StudySpec, raw: dict) -> Design:
             raise StudyError(f"{where}.values", "repeats a value; give each value once")
         p = Parameter(p.name, p.fields, p.mode, p.base,
                       None if p.mode == "scale" else _display_unit(shown, t.unit))
+        if p.display_unit and p.display_unit != p.unit:
+            vals = np.array([decimal_si(x, p.display_unit, p.unit) for x in vals])
         params.append(p)
         axes.append(vals)
+        spacings.append(t.spacing if t.values is None else "values")
     names = [p.name for p in params]
     if len(set(names)) != len(names):
         raise StudyError("grid.parameters", f"two parameters are named {names}; give each a "
@@ -428,7 +432,26 @@ def _grid(spec: StudySpec, raw: dict) -> Design:
     _check_disjoint(params, "grid.parameters")
     shape = tuple(len(a) for a in axes)
     values = np.array(list(itertools.product(*axes)), dtype=float).reshape(-1, len(axes))
-    return Design("grid", params, values, shape=shape, axes=axes)
+    return Design("grid", params, values, shape=shape, axes=axes,
+                  extra={"spacing": spacings})
+
+
+def decimal_si(x: float, unit: str, si: str) -> float:
+    """The SI value ``x`` of a value the study wrote in ``unit``, as the decimal product of
+    that value (to 12 digits) and the unit's factor: 30 um is 3e-05 m, not the
+    2.9999999999999997e-05 of 30 * 1e-6, so that ``ds.sel`` finds it.  ``x`` unchanged when
+    the two differ by more than rounding."""
+    from decimal import Decimal, InvalidOperation
+
+    from ..model.units import convert
+
+    try:
+        factor = convert(1.0, unit, si)
+        shown = float(f"{x / factor:.12g}")
+        exact = float(Decimal(repr(shown)) * Decimal(repr(factor)))
+    except (ValueError, ArithmeticError, InvalidOperation):  # a unit pint cannot convert
+        return float(x)
+    return exact if abs(exact - x) <= 1e-12 * abs(x) else float(x)
 
 
 # ============================================================================ Monte Carlo

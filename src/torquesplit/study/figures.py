@@ -98,6 +98,7 @@ def curves_figure(ds, family: str, members: list[tuple[str, str]]) -> Figure:
             ax.plot(x, y, color=_color(i), lw=1.4, ls=_DASHES[i % len(_DASHES)], marker="o",
                     ms=2.5, label=member)
     _mark_failed(ax, x, ds["status"].values)
+    _log_axis(ds, pname, ax.set_xscale)
     ax.set_xlabel(f"{_param_label(ds, pname)} [{xunit}]")
     ax.set_ylabel(f"{family} [{unit}]")
     ax.grid(True, alpha=0.3)
@@ -131,6 +132,10 @@ def maps_figure(ds, family: str, members: list[tuple[str, str]]) -> Figure:
     unit, scale = _out_unit(members[0][1])
     for ax, ((member, var), r) in zip(axes, panels):
         data = ds[var]
+        # one colour scale per member over every value of the third parameter
+        full = data.values * scale
+        limits = ({"vmin": float(np.nanmin(full)), "vmax": float(np.nanmax(full))}
+                  if third and np.isfinite(full).any() else {})
         status = ds["status"]
         title = member
         if third:
@@ -139,7 +144,10 @@ def maps_figure(ds, family: str, members: list[tuple[str, str]]) -> Figure:
             tv, tu = _coord(ds, third)
             title += f", {third} = {tv[r]:.4g} {tu}"
         z = data.transpose(dims[1], dims[0]).values * scale
-        mesh = ax.pcolormesh(x, y, np.ma.masked_invalid(z), shading="nearest", cmap="viridis")
+        mesh = ax.pcolormesh(x, y, np.ma.masked_invalid(z), shading="nearest", cmap="viridis",
+                             **limits)
+        _log_axis(ds, dims[0], ax.set_xscale)
+        _log_axis(ds, dims[1], ax.set_yscale)
         if np.isfinite(z).all() and len(x) > 1 and len(y) > 1 and np.nanstd(z) > 0:
             ax.contour(x, y, z, colors="w", linewidths=0.6, alpha=0.7)
         bad = status.transpose(dims[1], dims[0]).values != "ok"
@@ -308,6 +316,12 @@ def _coord(ds, name) -> tuple[np.ndarray, str]:
         except Exception:  # an unknown display unit: show SI
             return values, si
     return values, ("-" if si == "1" else si)
+
+
+def _log_axis(ds, name, set_scale) -> None:
+    """A parameter spaced logarithmically (``spacing = "log"``) on a log axis."""
+    if ds[name].attrs.get("spacing") == "log":
+        set_scale("log")
 
 
 def _param_label(ds, name) -> str:
