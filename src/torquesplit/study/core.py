@@ -345,7 +345,8 @@ def _check_same(plan: Plan, meta: dict, out: Path, words: Words = API_WORDS) -> 
 
     w = words
     again = f"start a new study with another {w.out} or {w.overwrite_on}"
-    if meta.get("study_hash") != plan.study_hash:
+    if (meta.get("study_hash") != plan.study_hash
+            and _results_part(meta.get("study", {})) != _results_part(plan.spec.canonical())):
         changes = _diff(meta.get("study", {}), plan.spec.canonical())
         raise StudyError(w.resume, f"the study file changed since {out} was started "
                                    f"({changes}); undo the change, or {again}")
@@ -357,6 +358,18 @@ def _check_same(plan: Plan, meta: dict, out: Path, words: Words = API_WORDS) -> 
         raise StudyError(w.resume, f"{out} was computed with torquesplit "
                                    f"{meta.get('torquesplit_version')}, this is {__version__}; "
                                    f"finish it with that version or start a new study")
+
+
+#: fields of [study] that do not change any case: a resume accepts a change of them
+WORDING = ("description", "reference")
+
+
+def _results_part(study: dict) -> dict:
+    """A canonical study without the fields that only describe it (:data:`WORDING`)."""
+    out = dict(study)
+    if isinstance(out.get("study"), dict):
+        out["study"] = {k: v for k, v in out["study"].items() if k not in WORDING}
+    return out
 
 
 def _diff(old, new, prefix: str = "", limit: int = 3) -> str:
