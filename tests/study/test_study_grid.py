@@ -177,3 +177,16 @@ def test_grid_axes_and_figures_of_log_and_3_parameter_grids(split_file):
     fig = curves_figure(one, "load_sharing.cycle_peak",
                         [("system", "load_sharing.cycle_peak")])
     assert fig.axes[0].get_xscale() == "log"
+
+
+def test_refused_cases_show_the_values_in_the_unit_written(split_file):
+    from torquesplit.study import StudyError
+
+    err = "gears.pinion.errors.eccentricity"
+    ds = run_study(grid_study(split_file, [{"path": err, "values": ["10 um", "-30 um"]}]),
+                   workers=1)
+    assert ds["status"].values.tolist() == ["ok", "refused"]
+    assert ds["reason"].values[1].endswith(f"(this case: {err} = -30 um)")
+    with pytest.raises(StudyError, match=rf"case 0 \({err} = -20 um\) gives an invalid model"):
+        Study(grid_study(split_file, [{"path": err, "start": -20, "stop": 0, "num": 2,
+                                       "unit": "um"}])).plan()

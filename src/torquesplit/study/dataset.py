@@ -67,6 +67,10 @@ def build_dataset(plan, rows, n: int, meta: dict):
         values[i] = [math.nan if v is None else v for v in r["values"]]
         status[i] = r["status"]
         reason[i] = r["reason"]
+        if r["status"] == "refused" and i < d.n_cases:  # the model speaks SI: add the
+            reason[i] += " (this case: " + ", ".join(  # values as the study wrote them
+                f"{p.name} = {p.show(v)}" for p, v in zip(d.parameters, d.values[i],
+                                                            strict=True)) + ")"
         settled[i] = r["settled"]
         sim_time[i] = np.nan if r["simulated_time"] is None else r["simulated_time"]
         wall[i] = r["wall_time"]

@@ -71,6 +71,20 @@ class Parameter:
             out[f.path] = int(round(v)) if f.integer else float(v)
         return out
 
+    def show(self, value: float) -> str:
+        """A value as the study file wrote it: in its unit ("-30 um", not "-3e-05")."""
+        if self.mode == "scale" or self.kind is None:
+            return f"{value:g}" + (" (factor)" if self.mode == "scale" else "")
+        unit = self.display_unit or self.unit
+        if unit != self.unit:
+            from ..model.units import convert
+
+            try:
+                return f"{convert(value, self.unit, unit):.6g} {unit}"
+            except Exception:  # a unit pint cannot convert: SI
+                pass
+        return f"{value:.6g} {self.unit}"
+
     def describe(self) -> str:
         what = "scales" if self.mode == "scale" else "sets"
         paths = self.paths
@@ -225,7 +239,7 @@ def _validated(data: dict, model_source: str, where: str, case=None, design=None
     except TorquesplitError as exc:
         what = "the model with the study's changes is invalid"
         if case is not None:
-            vals = ", ".join(f"{p.name} = {v:g}" for p, v in
+            vals = ", ".join(f"{p.name} = {p.show(v)}" for p, v in
                              zip(design.parameters, design.values[case], strict=True))
             what = f"case {case} ({vals}) gives an invalid model"
         raise StudyError(where, f"{what}: {_one_line(exc)}") from None
