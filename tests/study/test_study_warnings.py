@@ -49,3 +49,12 @@ def test_a_unit_slip_warns_for_its_case_only(split_file):
 def test_case_ranges():
     assert case_ranges([0, 1, 2, 5, 7, 8]) == "cases 0-2, 5, 7-8"
     assert case_ranges([4]) == "case 4"
+
+
+def test_a_settle_rule_that_reaches_its_cap_warns(split_file):
+    data = grid_study(split_file, [{"path": "meshes.a1.transmission_error.constant",
+                                    "values": ["4 um"]}], outputs=["load_sharing.cycle_peak"],
+                      cycles=40, settle={"tolerance": 0.002, "start": "0.08 s"})
+    ds = run_study(data, workers=1)
+    assert ds["settled"].values[0] == 0
+    assert "analysis.settle: the outputs still changed" in str(ds["warnings"].values[0])

@@ -63,9 +63,20 @@ def run_case(p: dict) -> dict:
             out.update(status="error", reason=f"{type(exc).__name__}: {_one_line(exc)}",
                        values=nan)
     # the model's warnings (unit slips...) and the run's (too short, unsettled...)
-    out["warnings"] = sorted({_one_line(w.message) for w in caught} | set(out["warnings"]))
+    out["warnings"] = sorted({_one_line(w.message) for w in caught})
     out["wall_time"] = time.perf_counter() - t0
     return out
+
+
+class CaseWarning(UserWarning):
+    """A run's plausibility warning (too short to tell whether it settled, unsettled,
+    resonance...): raised as a warning so that every runner that records a case's
+    warnings (run_case, the GPU backend) records it."""
+
+
+def _warn(pairs) -> None:
+    for loc, msg in pairs:
+        warnings.warn(f"{loc}: {msg}", CaseWarning, stacklevel=2)
 
 
 def _one_line(exc) -> str:
@@ -89,7 +100,7 @@ def _static(model, p, out) -> list[float]:
                          f"{int((~conv).sum())} of {conv.size} mesh positions")
     from ..results.plausibility import static_warnings
 
-    out["warnings"] += [f"{loc}: {msg}" for loc, msg in static_warnings(res)]
+    _warn(static_warnings(res))
     vals = output_values(res)
     return [vals.get(n, math.nan) for n in p["outputs"]]
 
@@ -123,10 +134,6 @@ def _dynamic(model, p, out) -> list[float]:
             break
         if length >= full:
             out["settled"] = False
-            out["warnings"].append(
-                f"analysis.settle: the outputs still changed by more than the tolerance "
-                f"{settle['tolerance']:g} at the longest run ({full:.4g} s); raise the run "
-                f"length (duration or cycles) or the tolerance")
             break
         previous = current
         length = min(length * settle["growth"], full)
@@ -185,10 +192,15 @@ def _finish(res, names, defs, out, output_values, vals=None) -> list[float]:
     if vals is None:
         vals = output_values(res, defs)
     met = res.metrics("cycle_peak")  # settling and contact loss: the same for every definition
+    if not out["settled"]:  # only the settle rule, at its cap, has cleared it before
+        _warn([("analysis.settle", f"the outputs still changed by more than the rule's "
+                                   f"tolerance at the longest run ({out['simulated_time']:.4g} "
+                                   f"s); raise the run length (duration or cycles) or the "
+                                   f"tolerance")])
     out["settled"] = out["settled"] and met.settling.settled
     from ..results.plausibility import result_warnings
 
-    out["warnings"] += [f"{loc}: {msg}" for loc, msg in result_warnings(res, met)]
+    _warn(result_warnings(res, met))
     lost = [(r.mesh, r.contact_loss) for r in met.rows if r.contact_loss > 0]
     if lost:
         out["status"] = "contact_lost"
