@@ -13,7 +13,7 @@ already evaluated (pymoo with a fixed seed proposes the same designs again).
 The optimisation file (TOML)::
 
     [optimization]
-    model = "liu2021_split_torque_helicopter"   # example name, or a model file relative to this file
+    model = "liu2021_split_torque_helicopter"   # example name, or a model file (relative)
     algorithm = "nsga2"              # any pymoo algorithm by name (see ALGORITHMS)
     population = 40
     generations = 50
@@ -231,7 +231,8 @@ def read_spec(source) -> OptimizationSpec:
         try:
             data = tomllib.loads(path.read_text(encoding="utf-8"))
         except tomllib.TOMLDecodeError as exc:
-            raise ModelError([("", f"TOML syntax error: {exc}; fix the line it names")], str(path)) from None
+            raise ModelError([("", f"TOML syntax error: {exc}; fix the line it names")],
+                             str(path)) from None
         base, name = path.resolve().parent, str(path)
     known = {"optimization", "set", "variables", "objectives", "constraints"}
     extra = sorted(set(data) - known)
@@ -241,8 +242,9 @@ def read_spec(source) -> OptimizationSpec:
     issues = []
     model_ref = opt.pop("model", None)
     if not isinstance(model_ref, str):
-        raise ModelError([("optimization.model", "required: an example name or a model file; "
-                                                 "add model = \"liu2021_split_torque_helicopter\"")], name)
+        raise ModelError([("optimization.model",
+                           "required: an example name or a model file; "
+                           "add model = \"liu2021_split_torque_helicopter\"")], name)
     mpath = (base / model_ref) if not Path(model_ref).is_absolute() else Path(model_ref)
     if not mpath.exists():
         from .examples import example_names, example_path
@@ -259,7 +261,8 @@ def read_spec(source) -> OptimizationSpec:
                               ("choose", str, "min_sum"), ("store", str, None)):
         v = opt.pop(key, default)
         if v is not None and not isinstance(v, typ):
-            issues.append((f"optimization.{key}", f"must be a {typ.__name__}, got {v!r}; correct it"))
+            issues.append((f"optimization.{key}",
+                           f"must be a {typ.__name__}, got {v!r}; correct it"))
         kw[key] = v
     if opt:
         issues.append((f"optimization.{sorted(opt)[0]}", "unknown field; check the spelling "
@@ -271,7 +274,8 @@ def read_spec(source) -> OptimizationSpec:
         issues.append(("optimization.population", "population >= 4, generations >= 1 and "
                                                   "workers >= 1 are needed; correct them"))
     if kw["choose"] not in ("min_sum", "knee"):
-        issues.append(("optimization.choose", f"unknown choice {kw['choose']!r}; use 'min_sum' or 'knee'"))
+        issues.append(("optimization.choose",
+                       f"unknown choice {kw['choose']!r}; use 'min_sum' or 'knee'"))
     variables = []
     for i, v in enumerate(data.get("variables", [])):
         where = f"variables[{i}]"
@@ -297,8 +301,8 @@ def read_spec(source) -> OptimizationSpec:
         for i, o in enumerate(data.get(key, [])):
             where = f"{key}[{i}]"
             if not isinstance(o, dict) or "output" not in o:
-                issues.append((where, "needs an output, e.g. output = \"ltca.m.te_peak_to_peak_m\"; "
-                                      "add it"))
+                issues.append((where, "needs an output, e.g. output = "
+                                      "\"ltca.m.te_peak_to_peak_m\"; add it"))
                 continue
             unknown = sorted(set(o) - {"output", "relative_to", "sense", "lower", "upper", "name"})
             if unknown:
@@ -309,13 +313,14 @@ def read_spec(source) -> OptimizationSpec:
                 issues.append((f"{where}.output", f"{o['output']!r} is not an output; write "
                                                   "ltca.MESH.KEY or dynamic.GROUP.KEY"))
             if o.get("relative_to") not in (None, "baseline"):
-                issues.append((f"{where}.relative_to", "must be 'baseline'; write relative_to = 'baseline' "
-                                                      "or remove it"))
+                issues.append((f"{where}.relative_to", "must be 'baseline'; write "
+                                                      "relative_to = 'baseline' or remove it"))
             if o.get("sense", "min") not in ("min", "max"):
                 issues.append((f"{where}.sense", "must be 'min' or 'max'; use one of them"))
+            lower = None if o.get("lower") is None else _si(o["lower"], f"{where}.lower")
+            upper = None if o.get("upper") is None else _si(o["upper"], f"{where}.upper")
             out.append(Output(str(o["output"]), o.get("relative_to"), o.get("sense", "min"),
-                              None if o.get("lower") is None else _si(o["lower"], f"{where}.lower"),
-                              None if o.get("upper") is None else _si(o["upper"], f"{where}.upper")))
+                              lower, upper))
         return out
 
     objectives, constraints = outputs("objectives"), outputs("constraints")

@@ -85,3 +85,43 @@ def test_shipped_studies_check_out(name):
     text = plan.study_text
     assert "seed" not in study.spec.study.reference.lower()  # cite authors, not seed numbers
     assert study.spec.study.reference and "#" in text  # every file explains itself
+
+
+def test_sweep_refuses_a_bare_range_for_a_field_with_units(tmp_path, split_file):
+    from torquesplit.study.cli import _refuse_bare_range
+
+    res = runner.invoke(app, ["sweep", str(split_file), "--vary",
+                              "meshes.a1.transmission_error.constant=0:40:5", "--cycles", "40",
+                              "--out", str(tmp_path / "s"), "--quiet"])
+    assert res.exit_code == 2, res.output
+    assert "0:40:5um" in res.output and "0 to 40 m" in res.output
+    assert "Traceback" not in res.output and not (tmp_path / "s").exists()
+    # with a unit, or for a plain number, the range stands
+    _refuse_bare_range("x", parse_vary("meshes.a1.transmission_error.constant=0:40:5um"))
+    _refuse_bare_range("x", parse_vary("meshes.a1.damping_ratio=0.05:0.1:2"))
+
+
+def test_parse_vary_refuses_a_step_for_the_count():
+    with pytest.raises(ValueError, match="number of points, a whole number"):
+        parse_vary("meshes.a1.transmission_error.constant=0:40:2.5um")
+    with pytest.raises(ValueError, match="number of points"):
+        parse_vary("a.b=0:40:0um")
+    # a pattern is named by its last segment (sweep has no --name)
+    assert parse_vary("gears.*.errors.eccentricity=0:40:2um")["name"] == "eccentricity"
+
+
+def test_sweep_pattern_and_static_run_length_flags(tmp_path, split_file):
+    res = runner.invoke(app, ["sweep", str(split_file), "--vary",
+                              "gears.*.errors.eccentricity=0:40:2", "--quiet"])
+    assert res.exit_code == 2 and "0:40:2um" in res.output  # a pattern's kind is known too
+    res = runner.invoke(app, ["sweep", str(split_file), "--vary",
+                              "meshes.a*.transmission_error.constant=0:4:2um", "--cycles", "40",
+                              "--output", "load_sharing.cycle_peak", "--workers", "1",
+                              "--out", str(tmp_path / "p"), "--quiet", "--json",
+                              "--no-figures"])
+    assert res.exit_code == 0, res.output
+    assert json.loads(res.stdout)["status"] == {"ok": 2}
+    res = runner.invoke(app, ["sweep", str(split_file), "--static", "--duration", "0.5 s",
+                              "--vary", "meshes.a1.transmission_error.constant=0:4:2um"])
+    assert res.exit_code == 2 and "--duration" in res.output
+    assert "analysis.duration" not in res.output

@@ -139,3 +139,54 @@ def test_cases_start_from_an_exact_si_copy_of_the_model(name):
         again = load_model(model_from_dict(model_to_dict(model)))
     assert again == model
     assert model_to_dict(again) == model_to_dict(model)
+
+
+def test_coordinates_are_the_decimal_values_written():
+    from torquesplit.study.design import decimal_si
+
+    # 30 um is 3e-05 m, not 30 * 1e-6 = 2.9999999999999997e-05
+    assert decimal_si(30 * 1e-6, "um", "m") == 3e-05
+    assert decimal_si(0.1 + 0.2, "m", "m") == 0.3
+    assert decimal_si(1.2345678901234e-05, "um", "m") == 1.2345678901234e-05  # kept
+
+
+def test_grid_axes_and_figures_of_log_and_3_parameter_grids(split_file):
+    from torquesplit.study.figures import curves_figure, maps_figure
+
+    plan = Study(grid_study(split_file, [{"path": "meshes.b1.transmission_error.constant",
+                                          "start": 0, "stop": 40, "num": 5,
+                                          "unit": "um"}])).plan()
+    assert plan.design.axes[0].tolist() == [0.0, 1e-05, 2e-05, 3e-05, 4e-05]
+    ds = run_study(grid_study(split_file, [
+        {"path": "meshes.a1.stiffness", "start": "2e8 N/m", "stop": "8e8 N/m", "num": 2,
+         "spacing": "log"},
+        {"path": "meshes.b1.transmission_error.constant", "values": ["10 um", "30 um"]},
+        {"path": "meshes.a2.transmission_error.constant", "values": ["0 um", "5 um"]}],
+        outputs=["load_sharing.cycle_peak"]), workers=1)
+    err = "meshes.b1.transmission_error.constant"
+    assert ds[err].values.tolist() == [1e-05, 3e-05]
+    assert ds["load_sharing.cycle_peak"].sel({err: 30e-6}).shape == (2, 2)
+    assert ds["meshes.a1.stiffness"].attrs["spacing"] == "log"
+    fig = maps_figure(ds, "load_sharing.cycle_peak", [("system", "load_sharing.cycle_peak")])
+    panels = [a for a in fig.axes if a.collections and a.get_xscale() == "log"]
+    assert len(panels) == 2  # both values of the third parameter, on a log axis
+    clims = {a.collections[0].get_clim() for a in panels}
+    assert len(clims) == 1  # one colour scale for the member across the third parameter
+    one = run_study(grid_study(split_file, [{**STIFFNESS, "spacing": "log"}],
+                               outputs=["load_sharing.cycle_peak"]), workers=1)
+    fig = curves_figure(one, "load_sharing.cycle_peak",
+                        [("system", "load_sharing.cycle_peak")])
+    assert fig.axes[0].get_xscale() == "log"
+
+
+def test_refused_cases_show_the_values_in_the_unit_written(split_file):
+    from torquesplit.study import StudyError
+
+    err = "gears.pinion.errors.eccentricity"
+    ds = run_study(grid_study(split_file, [{"path": err, "values": ["10 um", "-30 um"]}]),
+                   workers=1)
+    assert ds["status"].values.tolist() == ["ok", "refused"]
+    assert ds["reason"].values[1].endswith(f"(this case: {err} = -30 um)")
+    with pytest.raises(StudyError, match=rf"case 0 \({err} = -20 um\) gives an invalid model"):
+        Study(grid_study(split_file, [{"path": err, "start": -20, "stop": 0, "num": 2,
+                                       "unit": "um"}])).plan()

@@ -106,3 +106,70 @@ def test_latin_hypercube_cannot_stop_early(split_file):
     stop = {"output": OUT, "half_width": 0.01, "max_samples": 100}
     with pytest.raises(StudyError, match="monte_carlo.sampling: a Latin hypercube"):
         Study(mc_study(split_file, stop=stop, sampling="latin_hypercube"))
+
+
+@pytest.mark.parametrize("table,where", [
+    ({"distribution": "normal", "mean": "2 um", "std": "3 um"},
+     "monte_carlo.parameters.0.distribution"),
+    ({"distribution": "uniform", "low": "-1 um", "high": "3 um"}, "monte_carlo.parameters.0.low"),
+    ({"distribution": "truncated_normal", "mean": "0 um", "std": "3 um", "low": "-5 um",
+      "high": "5 um"}, "monte_carlo.parameters.0.low")])
+def test_a_distribution_drawing_values_the_field_refuses_is_refused(split_file, table, where):
+    from torquesplit.study import StudyError
+
+    data = mc_study(split_file, samples=8)
+    data["monte_carlo"]["parameters"] = [{"path": "gears.pinion.errors.eccentricity", **table}]
+    with pytest.raises(StudyError) as info:
+        Study(data).plan()
+    msg = str(info.value)
+    assert where in msg and "gears.pinion.errors.eccentricity refuses" in msg
+    if table["distribution"] == "normal":
+        assert "truncated_normal" in msg
+    # far from zero, or truncated at zero: accepted
+    ok = {"distribution": "truncated_normal", "mean": "0 um", "std": "3 um", "low": "0 um",
+          "high": "5 um"}
+    for t in (ok, {"distribution": "normal", "mean": "60 um", "std": "3 um"}):
+        data["monte_carlo"]["parameters"] = [{"path": "gears.pinion.errors.eccentricity", **t}]
+        Study(data).plan()
+
+
+def test_statistics_over_fewer_cases_say_so(split_file, tmp_path):
+    from torquesplit import cli as ui
+    from torquesplit.study.cli import _summary
+    from torquesplit.study.figures import monte_carlo_figure
+
+    ds = run_study(mc_study(split_file, samples=8), workers=1)
+    ds[OUT].values[[2, 5]] = np.nan  # two cases without a value (refused, say)
+    ds["status"].values[[2, 5]] = "refused"
+    with ui.console.capture() as cap:
+        _summary(ds, tmp_path, False, False)
+    assert "statistics over 6 of 8 cases" in cap.get()
+    title = monte_carlo_figure(ds, OUT)._suptitle.get_text()
+    assert "statistics over 6 of 8 cases" in title
+
+
+def test_stopping_rule_outcome_is_reported(split_file, tmp_path):
+    from torquesplit import cli as ui
+    from torquesplit.study.cli import _summary, stopping_line
+    from torquesplit.study.figures import monte_carlo_figure
+
+    stop = {"output": OUT, "statistic": "mean", "half_width": 0.01, "confidence": 0.95,
+            "min_samples": 16, "batch": 8, "max_samples": 400}
+    ds = run_study(mc_study(split_file, stop=stop, sampling="sobol"), workers=1)
+    a = ds.attrs
+    assert a["stopping_target_met"] == 1 and a["stopping_cases"] == ds.sizes["sample"]
+    assert a["stopping_half_width"] <= a["stopping_target"] == 0.01
+    assert a["stopping_estimate"] == pytest.approx(float(ds[OUT].mean()))
+    with ui.console.capture() as cap:
+        _summary(ds, tmp_path, False, False)
+    assert "stopping rule: mean of load_sharing.cycle_peak" in cap.get()
+    assert "target met" in cap.get()
+    labels = [t.get_text() for t in monte_carlo_figure(ds, OUT).axes[2].get_legend().texts]
+    assert any(t.startswith("stopping target +/-0.01 (mean, met)") for t in labels)
+    # a rule that runs out of samples says so, and a count of values left out
+    stop.update(half_width=1e-6, max_samples=24)
+    ds = run_study(mc_study(split_file, stop=stop, sampling="sobol"), workers=1)
+    assert ds.attrs["stopping_target_met"] == 0 and ds.sizes["sample"] == 24
+    assert "target NOT met: max_samples = 24 reached" in stopping_line(ds)
+    ds.attrs["stopping_finite_cases"] = 22
+    assert "over 22 of 24 cases (2 without a finite value left out)" in stopping_line(ds)

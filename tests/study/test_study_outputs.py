@@ -79,3 +79,21 @@ def test_patterns_and_families():
     assert definitions_needed(chosen + ["peak_force.m1"]) == ["engineering"]
     assert family("load_sharing.mean_force.O2/II") == ("load_sharing.mean_force", "O2/II")
     assert family("dynamic_factor") == ("dynamic_factor", "system")
+
+
+def test_the_settle_rule_does_not_wait_for_settle_time(split_file):
+    """settle_time moves with the run length by nature (80 -> 160 cycles here, while the
+    load sharing does not change): asking for it must not lengthen the runs."""
+    from study_helpers import grid_study
+    from torquesplit.study import run_study
+
+    runs = {}
+    for outs in (["load_sharing.cycle_peak"], ["load_sharing.cycle_peak", "settle_time"]):
+        data = grid_study(split_file, [{"path": "meshes.a1.transmission_error.constant",
+                                        "values": ["4 um"]}], outputs=outs, cycles=640,
+                          settle={"tolerance": 0.002, "start": "0.16 s"})
+        ds = run_study(data, workers=1)
+        runs[len(outs)] = float(ds["simulated_time"].values[0])
+        assert ds["settled"].values[0] == 1
+        assert "analysis.settle" in ds["settled"].attrs["long_name"]
+    assert runs[1] == pytest.approx(0.32) and runs[2] == runs[1]

@@ -253,3 +253,22 @@ def test_a_figure_is_whole_or_absent(tmp_path, split_file, monkeypatch):
     with pytest.raises(KeyboardInterrupt):
         write_study_figures(ds, tmp_path / "figures")
     assert list((tmp_path / "figures").iterdir()) == []
+
+
+def test_resume_accepts_a_changed_description(tmp_path, split_file):
+    data = grid_study(split_file, GRID[:1])
+    data["grid"]["parameters"][0]["num"] = 2
+    path = _write(tmp_path, data)
+    out = tmp_path / "out"
+    Study(path).run(workers=1, out=out, figures=False)
+    data["study"]["description"] = "now with a better description"
+    data["study"]["reference"] = "a paper"
+    _write(tmp_path, data)
+    ds = Study(path).run(workers=1, out=out, resume=True, figures=False)
+    assert ds.attrs["description"] == "now with a better description"
+    with sqlite3.connect(out / "study.sqlite") as db:
+        assert [c for (c,) in db.execute("SELECT computed FROM runs ORDER BY run")] == [2, 0]
+    data["study"]["name"] = "another name"  # not wording only: still refused
+    _write(tmp_path, data)
+    with pytest.raises(StudyError, match=r"study\.name"):
+        Study(path).run(workers=1, out=out, resume=True)

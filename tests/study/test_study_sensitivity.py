@@ -90,3 +90,79 @@ def test_ranking_of_a_constructed_model(split_file, tmp_path, method, kw):
         none = ds[key].sel(output=out, factor="gears.pinion.density").item()
         assert none == 0.0
     assert ds.sizes["sample"] == (4 * 4 if method == "morris" else 16 * 5)
+
+
+def _ishigami(d):
+    x = -np.pi + 2 * np.pi * d.values
+    return np.sin(x[:, 0]) + 7 * np.sin(x[:, 1]) ** 2 + 0.1 * x[:, 2] ** 4 * np.sin(x[:, 0])
+
+
+@pytest.mark.parametrize("offset", [1.0, 1e3])
+def test_sobol_indices_do_not_change_with_a_constant_added_to_the_output(offset):
+    d = _design("sobol", 3, samples=256)
+    y = _ishigami(d)
+    plain = indices(d, y)
+    shifted = indices(d, y + offset)  # e.g. a load-sharing coefficient, near 1
+    for k in ("S1", "ST", "S1_conf", "ST_conf"):
+        np.testing.assert_allclose(shifted[k], plain[k], atol=1e-9 * offset)
+    np.testing.assert_allclose(shifted["S1"], [0.3139, 0.4424, 0.0], atol=0.12)
+    assert (shifted["S1_conf"] < 0.3).all()
+
+
+def test_sobol_of_an_additive_output_near_one():
+    """y = 1 + 0.01 x0 + 0.02 x1: S1 = ST = (1/5, 4/5), whatever the constant."""
+    d = _design("sobol", 2, samples=512)
+    y = 1.0 + 0.01 * d.values[:, 0] + 0.02 * d.values[:, 1]
+    res = indices(d, y)
+    np.testing.assert_allclose(res["S1"], [0.2, 0.8], atol=0.03)
+    np.testing.assert_allclose(res["ST"], [0.2, 0.8], atol=0.03)
+    assert (res["S1_conf"] < 0.1).all()
+
+
+def test_s1_above_st_beyond_the_intervals_is_a_warning():
+    import xarray as xr
+
+    from torquesplit.study.dataset import sobol_warnings
+
+    ds = xr.Dataset({k: (("output", "factor"), np.array([v])) for k, v in {
+        "S1": [0.9, 0.3], "ST": [0.5, 0.32], "S1_conf": [0.1, 0.1],
+        "ST_conf": [0.1, 0.1]}.items()},
+        coords={"output": ["y"], "factor": ["a", "b"]})
+    notes = sobol_warnings(ds)
+    assert len(notes) == 1 and "y: S1 of a (0.9" in notes[0] and "samples" in notes[0]
+
+
+def test_tornado_draws_each_interval_on_its_own_bar():
+    import xarray as xr
+
+    from torquesplit.study.figures import tornado_figure
+
+    vals = {"S1": [0.2, 0.6], "ST": [0.3, 0.7], "S1_conf": [0.05, 0.01],
+            "ST_conf": [0.02, 0.03]}
+    ds = xr.Dataset({k: (("output", "factor"), np.array([v])) for k, v in vals.items()},
+                    coords={"output": ["y"], "factor": ["a", "b"]},
+                    attrs={"ranking": "ST", "study_name": "t"})
+    ds["y"] = ("sample", np.zeros(2), {"output": "y"})
+    ax = tornado_figure(ds, "y").axes[0]
+    bars = {c.get_label(): c for c in ax.containers}
+    for label, key in (("ST (total)", "ST"), ("S1 (first order)", "S1")):
+        c = bars[label]
+        assert c.errorbar is not None, label
+        ends = sorted(np.ptp(seg[:, 0]) / 2 for seg in c.errorbar.lines[2][0].get_segments())
+        np.testing.assert_allclose(ends, sorted(vals[f"{key}_conf"]))
+        # the interval is centred on the end of its own bar
+        centres = sorted(seg[:, 0].mean() for seg in c.errorbar.lines[2][0].get_segments())
+        np.testing.assert_allclose(centres, sorted(vals[key]))
+
+
+def test_indices_over_fewer_rows_say_so(split_file, tmp_path):
+    from torquesplit import cli as ui
+    from torquesplit.study.cli import _summary
+
+    ds = run_study(_study(split_file, "morris", trajectories=2), workers=1)
+    assert ds["trajectories_used"].values.tolist() == [2, 2]
+    assert ds["trajectories_used"].attrs["total"] == 2
+    ds["trajectories_used"].values[0] = 1  # as if a case of one trajectory failed
+    with ui.console.capture() as cap:
+        _summary(ds, tmp_path, False, False)
+    assert "indices over 1 of 2 trajectories at the fewest" in cap.get()

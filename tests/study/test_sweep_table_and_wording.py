@@ -35,3 +35,39 @@ def test_make_runner_names_the_argument_and_the_flag():
     with pytest.raises(ValueError) as info:
         make_runner(-1)
     assert "workers=2" in str(info.value) and "--workers 2" in str(info.value)
+
+
+def test_a_grid_with_many_outputs_prints_grid_tables_not_statistics(tmp_path, split_file):
+    import tomli_w
+
+    from study_helpers import grid_study
+
+    data = grid_study(split_file, [{"path": "meshes.a1.transmission_error.constant",
+                                    "values": ["0 um", "4 um"]}],
+                      outputs=["load_sharing.cycle_peak*", "peak_force.*"])
+    path = tmp_path / "g.toml"
+    path.write_text(tomli_w.dumps(data))
+    res = runner.invoke(app, ["study", str(path), "--out", str(tmp_path / "o"), "--workers",
+                              "1", "--quiet", "--no-figures"], terminal_width=200)
+    assert res.exit_code == 0, res.output
+    text = res.stdout
+    assert "p95" not in text and "mean " not in text
+    # a table per family, the family in the title, the members as column headers
+    assert "test grid: load_sharing.cycle_peak" in text and "test grid: peak_force" in text
+    for member in ("system", "split", "a1", "a2", "b1", "b2"):
+        assert f" {member} " in text
+    assert "cycle_peak.a1" not in text and "peak_force.a1" not in text
+
+
+def test_a_large_grid_is_not_summarised_as_a_sample(tmp_path, split_file, monkeypatch):
+    from torquesplit.study import cli as study_cli
+
+    monkeypatch.setattr(study_cli, "MAX_TABLE_CASES", 1)
+    res = runner.invoke(app, ["sweep", str(split_file), "--vary",
+                              "meshes.a1.transmission_error.constant=0:10:2um",
+                              "--output", "load_sharing.cycle_peak", "--cycles", str(CYCLES),
+                              "--workers", "1", "--out", str(tmp_path / "sw"), "--quiet",
+                              "--no-figures"])
+    assert res.exit_code == 0, res.output
+    assert "a grid of 2 cases (2), too many to print" in res.stdout
+    assert "p95" not in res.stdout

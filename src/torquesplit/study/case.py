@@ -62,9 +62,21 @@ def run_case(p: dict) -> dict:
         except Exception as exc:  # a bug, a memory error...: record it, keep the study going
             out.update(status="error", reason=f"{type(exc).__name__}: {_one_line(exc)}",
                        values=nan)
+    # the model's warnings (unit slips...) and the run's (too short, unsettled...)
     out["warnings"] = sorted({_one_line(w.message) for w in caught})
     out["wall_time"] = time.perf_counter() - t0
     return out
+
+
+class CaseWarning(UserWarning):
+    """A run's plausibility warning (too short to tell whether it settled, unsettled,
+    resonance...): raised as a warning so that every runner that records a case's
+    warnings (run_case, the GPU backend) records it."""
+
+
+def _warn(pairs) -> None:
+    for loc, msg in pairs:
+        warnings.warn(f"{loc}: {msg}", CaseWarning, stacklevel=2)
 
 
 def _one_line(exc) -> str:
@@ -86,6 +98,9 @@ def _static(model, p, out) -> list[float]:
         out["status"] = "diverged"
         out["reason"] = (f"the quasi-static equilibrium did not converge at "
                          f"{int((~conv).sum())} of {conv.size} mesh positions")
+    from ..results.plausibility import static_warnings
+
+    _warn(static_warnings(res))
     vals = output_values(res)
     return [vals.get(n, math.nan) for n in p["outputs"]]
 
@@ -114,7 +129,8 @@ def _dynamic(model, p, out) -> list[float]:
         vals = output_values(res, defs)
         current = [vals.get(n, math.nan) for n in names]
         settled = res.metrics("cycle_peak").settling.settled  # the same for every definition
-        if previous is not None and settled and _close(previous, current, settle["tolerance"]):
+        if previous is not None and settled and _close(previous, current, settle["tolerance"],
+                                                       names):
             break
         if length >= full:
             out["settled"] = False
@@ -141,8 +157,15 @@ def _full_duration(model, a) -> tuple[float, float]:
     return (an.cycles or 200) / f_min, f_min
 
 
-def _close(a, b, tol) -> bool:
-    for x, y in zip(a, b, strict=True):
+def _close(a, b, tol, names=None) -> bool:
+    """Two runs' outputs agree within the relative ``tol``; with ``names``, outputs
+    that change with the run length by nature (``settle_time``:
+    :data:`~torquesplit.study.outputs.NOT_CONVERGING`) are not compared."""
+    from .outputs import NOT_CONVERGING
+
+    for j, (x, y) in enumerate(zip(a, b, strict=True)):
+        if names is not None and names[j] in NOT_CONVERGING:
+            continue
         if math.isnan(x) and math.isnan(y):
             continue
         if not abs(x - y) <= tol * max(abs(x), abs(y)):
@@ -169,7 +192,15 @@ def _finish(res, names, defs, out, output_values, vals=None) -> list[float]:
     if vals is None:
         vals = output_values(res, defs)
     met = res.metrics("cycle_peak")  # settling and contact loss: the same for every definition
+    if not out["settled"]:  # only the settle rule, at its cap, has cleared it before
+        _warn([("analysis.settle", f"the outputs still changed by more than the rule's "
+                                   f"tolerance at the longest run ({out['simulated_time']:.4g} "
+                                   f"s); raise the run length (duration or cycles) or the "
+                                   f"tolerance")])
     out["settled"] = out["settled"] and met.settling.settled
+    from ..results.plausibility import result_warnings
+
+    _warn(result_warnings(res, met))
     lost = [(r.mesh, r.contact_loss) for r in met.rows if r.contact_loss > 0]
     if lost:
         out["status"] = "contact_lost"

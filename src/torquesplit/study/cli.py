@@ -156,10 +156,13 @@ def _with_bar(job, total: int, quiet: bool):
 def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
     import numpy as np
 
-    from .dataset import ranking
+    from .dataset import case_ranges, ranking, warning_groups
 
     ui = _ui()
     status = ds["status"].values.ravel()
+    groups = warning_groups(ds)
+    n_warned = (int((ds["warning_count"].values.ravel() > 0).sum())
+                if "warning_count" in ds else 0)
     counts = {s: int((status == s).sum()) for s in sorted(set(status.tolist()))}
     out_vars = [v for v in ds.data_vars if "output" in ds[v].attrs]
     figs = sorted(str(p) for p in (out / "figures").glob("*.png")) if figures else []
@@ -172,38 +175,31 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
                                 and ds[c].dtype.kind == "f"},
                 "outputs": {ds[v].attrs["output"]: [_num(x) for x in ds[v].values.ravel()]
                             for v in out_vars},
-                "reasons": sorted({r for r in ds["reason"].values.ravel().tolist() if r})}
+                "reasons": sorted({r for r in ds["reason"].values.ravel().tolist() if r}),
+                "cases_warned": n_warned,
+                "warnings": [{"text": g["text"], "cases": g["cases"]} for g in groups]}
+        if "stopping_target_met" in ds.attrs:
+            data["stopping_rule"] = {k[len("stopping_"):]: ds.attrs[k] for k in ds.attrs
+                                     if k.startswith("stopping_") and k != "stopping_rule"}
+            data["stopping_rule"]["target_met"] = bool(data["stopping_rule"]["target_met"])
         if ds.attrs["design"] == "sensitivity":
             data["ranking"] = {ds[v].attrs["output"]: ranking(ds, ds[v].attrs["output"])
                                for v in out_vars}
+            data["sensitivity_warnings"] = json.loads(ds.attrs.get("sensitivity_warnings",
+                                                                    "[]"))
         print(json.dumps(data, indent=2))
         return
     from rich.table import Table
 
     design = ds.attrs["design"]
-    if design == "grid" and status.size <= 60 and len(out_vars) <= 8:
-        t = Table(title=f"{ds.attrs['study_name']}")
-        from rich.markup import escape
-
-        from .figures import _coord
-
-        dims = list(ds[out_vars[0]].dims)
-        shown = {}
-        for d in dims:
-            values, unit = _coord(ds, d)
-            shown[d] = dict(zip(ds[d].values.tolist(), values.tolist()))
-            # escaped: Rich would read "[um]" as markup and drop it
-            t.add_column(escape(f"{d} [{unit}]"), justify="right")
-        for v in out_vars:
-            t.add_column(v, justify="right")
-        t.add_column("status")
-        flat = ds.stack(case=dims)
-        for k in range(flat.sizes["case"]):
-            row = [f"{shown[d][float(flat[d].values[k])]:.6g}" for d in dims]
-            row += [f"{float(flat[v].values[k]):.6g}" for v in out_vars]
-            row.append(str(flat["status"].values[k]))
-            t.add_row(*row)
-        ui.console.print(t)
+    if design == "grid" and status.size <= MAX_TABLE_CASES:
+        for title, columns in _grid_tables(ds, out_vars):
+            ui.console.print(_grid_table(ds, title, columns))
+    elif design == "grid":  # never Monte Carlo statistics over grid points
+        ui.console.print(f"{ds.attrs['study_name']}: a grid of {status.size} cases "
+                         f"({' x '.join(str(n) for n in ds[out_vars[0]].shape)}), too many "
+                         f"to print; the values are in {out / 'results.nc'} and the figures",
+                         highlight=False)
     elif design == "sensitivity":
         t = Table(title=f"{ds.attrs['study_name']}: factors ranked by "
                         f"{ds.attrs['ranking']} (most important first)")
@@ -213,27 +209,139 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
             rank = ranking(ds, ds[v].attrs["output"])
             t.add_row(v, ", ".join(f"{f} {x:.3g}" for f, x in rank))
         ui.console.print(t)
+        used_var = next((u for u in ("samples_used", "trajectories_used") if u in ds), None)
+        if used_var is not None:
+            total = int(ds[used_var].attrs["total"])
+            fewest = int(ds[used_var].values.min())
+            if fewest < total:
+                unit = "trajectory" if used_var.startswith("traj") else "base row"
+                ui.console.print(f"indices over {fewest} of {total} "
+                                 f"{used_var.split('_')[0]} at the fewest (a failed case "
+                                 f"drops its {unit})", highlight=False)
+        for note in json.loads(ds.attrs.get("sensitivity_warnings", "[]")):
+            ui.console.print(f"warning: {note}", markup=False, highlight=False)
     else:
-        t = Table(title=f"{ds.attrs['study_name']}: {status.size} cases")
-        for col in ("output", "mean", "std", "min", "p5", "p95", "max"):
+        used = {v: int(np.isfinite(ds[v].values).sum()) for v in out_vars}
+        fewer = sorted({u for u in used.values() if u < status.size})
+        title = f"{ds.attrs['study_name']}: {status.size} cases"
+        if len(fewer) == 1 and all(u == fewer[0] for u in used.values()):
+            title = f"{ds.attrs['study_name']}: statistics over {fewer[0]} of {status.size} cases"
+        t = Table(title=title)
+        cols = ["output", "mean", "std", "min", "p5", "p95", "max"]
+        if len(fewer) and "over" not in title:
+            cols.append("cases")
+        for col in cols:
             t.add_column(col, justify="left" if col == "output" else "right")
         for v in out_vars:
             x = ds[v].values.ravel()
             x = x[np.isfinite(x)]
+            count = [f"{x.size} of {status.size}"] if "cases" in cols else []
             if not x.size:
-                t.add_row(v, *["-"] * 6)
+                t.add_row(v, *["-"] * 6, *count)
                 continue
             t.add_row(v, *[f"{s:.6g}" for s in (x.mean(), x.std(ddof=1) if x.size > 1 else
                                                 0.0, x.min(), np.quantile(x, 0.05),
-                                                np.quantile(x, 0.95), x.max())])
+                                                np.quantile(x, 0.95), x.max())], *count)
         ui.console.print(t)
+        if fewer:
+            ui.console.print(f"statistics over the cases with a finite value only: "
+                             f"{min(used.values())} of {status.size} at the fewest",
+                             highlight=False)
     ui.console.print("cases: " + ", ".join(f"{n} {s}" for s, n in counts.items()))
+    line = stopping_line(ds)
+    if line:
+        ui.console.print(line, markup=False, highlight=False)
     reasons = sorted({r for r, s in zip(ds["reason"].values.ravel().tolist(), status)
                       if s != "ok"})
     for r in reasons[:5]:
         ui.console.print(f"  not ok: {r}", markup=False, highlight=False)
+    if n_warned:
+        ui.console.print(f"[yellow]{n_warned} of {status.size} cases warned[/] (variable "
+                         f"'warnings' of results.nc has each case's):", highlight=False)
+        for g in groups[:5]:
+            ui.console.print(f"  {case_ranges(g['cases'])}: {g['text']}", markup=False,
+                             highlight=False, soft_wrap=True)
+        if len(groups) > 5:
+            ui.console.print(f"  ... and {len(groups) - 5} more kinds of warning",
+                             highlight=False)
     ui.console.print(f"results: {out / 'results.nc'}; store: {out / 'study.sqlite'}"
                      + (f"; {len(figs)} figures in {out / 'figures'}" if figs else ""))
+
+
+MAX_TABLE_CASES = 60
+"""A grid with more cases is not printed (the results file and figures have it)."""
+MAX_TABLE_OUTPUTS = 8
+"""Output columns per printed table of a grid (more outputs: more tables)."""
+
+
+def _grid_tables(ds, out_vars: list[str]) -> list[tuple[str, list[tuple[str, str]]]]:
+    """The tables that print a grid: one per output family (the family in the title, the
+    columns its members, "system", "a1", ..., not names a narrow terminal cuts to the same
+    "load_sharing.me..."), each split after :data:`MAX_TABLE_OUTPUTS` columns; one table
+    of full names when each output is of another family.  Returns (title, [(column
+    header, variable)])."""
+    from . import outputs as out_mod
+
+    name = ds.attrs["study_name"]
+    fams: dict[str, list[tuple[str, str]]] = {}
+    for v in out_vars:
+        fam, member = out_mod.family(ds[v].attrs["output"])
+        fams.setdefault(fam, []).append((member, v))
+    if len(out_vars) <= MAX_TABLE_OUTPUTS and len(fams) == len(out_vars):
+        return [(name, [(v, v) for v in out_vars])]  # one output of each family
+    tables = []
+    for fam, members in fams.items():
+        parts = -(-len(members) // MAX_TABLE_OUTPUTS)
+        for k in range(parts):
+            part = f" ({k + 1} of {parts})" if parts > 1 else ""
+            tables.append((f"{name}: {fam}{part}",
+                           members[k * MAX_TABLE_OUTPUTS: (k + 1) * MAX_TABLE_OUTPUTS]))
+    return tables
+
+
+def _grid_table(ds, title: str, columns: list[tuple[str, str]]):
+    """One table of a grid's cases: the parameters, the ``columns`` and the status."""
+    from rich.markup import escape
+    from rich.table import Table
+
+    from .figures import _coord
+
+    t = Table(title=escape(title))
+    dims = list(ds[columns[0][1]].dims)
+    shown = {}
+    for d in dims:
+        values, unit = _coord(ds, d)
+        shown[d] = dict(zip(ds[d].values.tolist(), values.tolist()))
+        # escaped: Rich would read "[um]" as markup and drop it
+        t.add_column(escape(f"{d} [{unit}]"), justify="right")
+    for header, _ in columns:
+        t.add_column(escape(header), justify="right")
+    t.add_column("status")
+    flat = ds.stack(case=dims)
+    for k in range(flat.sizes["case"]):
+        row = [f"{shown[d][float(flat[d].values[k])]:.6g}" for d in dims]
+        row += [f"{float(flat[v].values[k]):.6g}" for _, v in columns]
+        row.append(str(flat["status"].values[k]))
+        t.add_row(*row)
+    return t
+
+
+def stopping_line(ds) -> str:
+    """The stopping rule's outcome in one line ("" without a rule)."""
+    a = ds.attrs
+    if "stopping_target_met" not in a:
+        return ""
+    rule = json.loads(a["stopping_rule"])
+    n, finite = int(a["stopping_cases"]), int(a["stopping_finite_cases"])
+    over = (f" over {finite} of {n} cases ({n - finite} without a finite value left out)"
+            if finite < n else f" over {n} cases")
+    outcome = ("target met" if a["stopping_target_met"] else
+               f"target NOT met: max_samples = {rule['max_samples']} reached; raise it or "
+               f"widen half_width")
+    return (f"stopping rule: {a['stopping_statistic']} of {rule['output']} = "
+            f"{a['stopping_estimate']:.6g} +/- {a['stopping_half_width']:.3g} "
+            f"({rule['confidence']:.0%} interval){over}; target half-width "
+            f"{a['stopping_target']:.3g}: {outcome}")
 
 
 def _num(x):
@@ -246,8 +354,9 @@ def _safe(name: str) -> str:
 
 
 # --------------------------------------------------------------------------- sweep
-_RANGE = re.compile(r"^\s*(?P<start>[^:]+?)\s*:\s*(?P<stop>[^:]+?)\s*:\s*(?P<num>\d+)\s*"
-                    r"(?P<unit>[^\d\s].*?)?\s*$")
+_RANGE = re.compile(r"^\s*(?P<start>[^:]+?)\s*:\s*(?P<stop>[^:]+?)\s*:\s*"
+                    r"(?P<num>[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*"
+                    r"(?P<unit>[^\d\s.].*?)?\s*$")
 
 
 def parse_vary(text: str) -> dict:
@@ -266,11 +375,43 @@ def parse_vary(text: str) -> dict:
         table["path"] = paths[0]
     else:
         table["paths"] = paths
-        table["name"] = paths[0].split(".")[-1]
-    table.update(start=_number(m["start"]), stop=_number(m["stop"]), num=int(m["num"]))
+    if len(paths) > 1 or any(c in paths[0] for c in "*?["):  # several fields: named by
+        table["name"] = paths[0].split(".")[-1]                # the last segment
+    num = m["num"]
+    if not re.fullmatch(r"\d+", num) or int(num) < 1:
+        raise ValueError(f"--vary {text!r}: the count {num!r} after the second ':' is the "
+                         f"number of points, a whole number >= 1 (not a step); write e.g. "
+                         f"{m['start'].strip()}:{m['stop'].strip()}:5{m['unit'] or ''}")
+    table.update(start=_number(m["start"]), stop=_number(m["stop"]), num=int(num))
     if m["unit"]:
         table["unit"] = m["unit"].strip()
     return table
+
+
+def _refuse_bare_range(text: str, table: dict) -> None:
+    """A ``--vary`` range of bare numbers for a field with units is refused: it would be
+    read in SI (``0:40:5`` for an eccentricity: 0 to 40 m)."""
+    from .errors import StudyError
+    from .paths import schema_field, si_unit
+
+    if "unit" in table or isinstance(table["start"], str) or isinstance(table["stop"], str):
+        return
+    for path in table.get("paths") or [table["path"]]:
+        try:  # a pattern's '*' stands for a key of a table of gears, meshes...: its kind
+            kind = schema_field(path, "--vary").kind
+        except StudyError:  # reported with the study's own words when it is resolved
+            continue
+        if kind is None:
+            continue
+        from ..model.units import KINDS
+
+        si = si_unit(kind)
+        example = KINDS[kind][1].split(" ", 1)[1]
+        a, b, n = table["start"], table["stop"], table["num"]
+        raise ValueError(f"--vary {text!r}: {path} is a {kind.replace('_', ' ')} and the "
+                         f"range has no unit (it would be read as {a:g} to {b:g} {si}); "
+                         f"write the unit after the count, e.g. '{a:g}:{b:g}:{n}{example}' "
+                         f"(or '{a:g}:{b:g}:{n}{si}' if {si} is meant)")
 
 
 def _number(text: str):
@@ -320,6 +461,7 @@ def sweep(
 
         ui._one_run_length(duration, cycles)
         param = parse_vary(vary)
+        _refuse_bare_range(vary, param)
         if log_spacing:
             param["spacing"] = "log"
         path = ui._resolve_model_path(model)
@@ -332,6 +474,12 @@ def sweep(
             from ..model.io import load_model
 
             outputs = [f"load_sharing.{_default_definition(load_model, path)}.*"]
+        if static and (duration is not None or cycles is not None or settle is not None):
+            flag = ("--duration" if duration is not None else "--cycles" if cycles is not None
+                    else "--settle")
+            raise ValueError(f"{flag} sets the length of a dynamic run; a quasi-static sweep "
+                             f"(--static) turns the gears through whole revolutions: leave "
+                             f"{flag} out or drop --static")
         analysis: dict = {"type": "static" if static else "run"}
         if duration is not None:
             analysis["duration"] = duration

@@ -211,6 +211,7 @@ class Study:
                 if report is not None:
                     store.write_meta({"gpu_backend": report})
                 ds = dataset_from_store(plan, store, run.n_used)
+                ds.attrs.update(run.stop_report)
                 if out is not None:
                     _write_outputs(ds, Path(out), figures)
             except KeyboardInterrupt:
@@ -344,7 +345,8 @@ def _check_same(plan: Plan, meta: dict, out: Path, words: Words = API_WORDS) -> 
 
     w = words
     again = f"start a new study with another {w.out} or {w.overwrite_on}"
-    if meta.get("study_hash") != plan.study_hash:
+    if (meta.get("study_hash") != plan.study_hash
+            and _results_part(meta.get("study", {})) != _results_part(plan.spec.canonical())):
         changes = _diff(meta.get("study", {}), plan.spec.canonical())
         raise StudyError(w.resume, f"the study file changed since {out} was started "
                                    f"({changes}); undo the change, or {again}")
@@ -356,6 +358,18 @@ def _check_same(plan: Plan, meta: dict, out: Path, words: Words = API_WORDS) -> 
         raise StudyError(w.resume, f"{out} was computed with torquesplit "
                                    f"{meta.get('torquesplit_version')}, this is {__version__}; "
                                    f"finish it with that version or start a new study")
+
+
+#: fields of [study] that do not change any case: a resume accepts a change of them
+WORDING = ("description", "reference")
+
+
+def _results_part(study: dict) -> dict:
+    """A canonical study without the fields that only describe it (:data:`WORDING`)."""
+    out = dict(study)
+    if isinstance(out.get("study"), dict):
+        out["study"] = {k: v for k, v in out["study"].items() if k not in WORDING}
+    return out
 
 
 def _diff(old, new, prefix: str = "", limit: int = 3) -> str:
@@ -399,6 +413,8 @@ class _Driver:
         stop = plan.spec.monte_carlo.stop if plan.spec.monte_carlo is not None else None
         self.stop = stop
         self.stop_at: int | None = None
+        self.stop_report: dict = {}
+        """The stopping rule's outcome (Dataset attributes), once it stopped."""
         self._checked: int | None = None
         self.watch = np.full(d.n_cases, np.nan) if stop else None
         self.finished = np.zeros(d.n_cases, dtype=bool)
@@ -484,10 +500,19 @@ class _Driver:
                 return
             half, stat = confidence_half_width(self.watch[:n], s.statistic, s.confidence)
             target = s.half_width * (abs(stat) if s.relative else 1.0)
+            finite = int(np.isfinite(self.watch[:n]).sum())
             log.info("stopping rule at n = %d: %s = %.6g +/- %.3g (target %.3g)", n,
                      s.statistic, stat, half, target)
+            if finite < n:  # failed cases have no value: the interval is over the others
+                log.warning("stopping rule at n = %d: %s over %d of %d cases (%d without a "
+                            "finite value left out)", n, s.statistic, finite, n, n - finite)
             if half <= target or n >= s.max_samples:
                 self.stop_at = n
+                self.stop_report = {
+                    "stopping_statistic": s.statistic, "stopping_estimate": float(stat),
+                    "stopping_half_width": float(half), "stopping_target": float(target),
+                    "stopping_target_met": int(half <= target), "stopping_cases": int(n),
+                    "stopping_finite_cases": finite}
                 return
             self._checked = n
 

@@ -12,13 +12,20 @@ output variables       one per requested output, named as the output
                        failed
 ``status``             ok / contact_lost / diverged / refused / error (/ missing)
 ``reason``             why a case is not ok ("" when it is)
-``settled``            the metrics found a settled part (and the settle rule converged)
+``settled``            1 when the metrics found a settled part and, with a settle rule,
+                       the outputs (``settle_time`` excepted) agreed between the last
+                       two run lengths; 0 otherwise
+``warnings``           the case's warnings, one a line ("" when none): the model checks'
+                       (a unit slip), the run's (too short to tell whether it settled,
+                       not settled, contact loss...); ``warning_count``: how many
 ``simulated_time``     simulated time of the (last) run of each case [s]
 ``case_wall_time``     seconds each case took on its worker (the only variable that
                        differs between two runs of the same study)
 sensitivity            variables over (``output``, ``factor``): ``mu_star``, ``mu``,
                        ``sigma``, ``mu_star_conf`` (Morris) or ``S1``, ``ST``,
-                       ``S1_conf``, ``ST_conf`` (Sobol)
+                       ``S1_conf``, ``ST_conf`` (Sobol; attribute
+                       ``sensitivity_warnings``: JSON list of factors whose S1 exceeds
+                       ST beyond the intervals)
 attributes             study name, description, reference, design, the study file's
                        text, the model (JSON, SI) and both hashes, torquesplit version
 =====================  ==================================================================
@@ -28,6 +35,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -52,19 +60,29 @@ def build_dataset(plan, rows, n: int, meta: dict):
     settled = np.zeros(n, dtype=bool)
     sim_time = np.full(n, np.nan)
     wall = np.full(n, np.nan)
+    warned = np.full(n, "", dtype=object)
+    n_warned = np.zeros(n, dtype=np.int32)
     for r in rows:
         i = r["index"]
         values[i] = [math.nan if v is None else v for v in r["values"]]
         status[i] = r["status"]
         reason[i] = r["reason"]
+        if r["status"] == "refused" and i < d.n_cases:  # the model speaks SI: add the
+            reason[i] += " (this case: " + ", ".join(  # values as the study wrote them
+                f"{p.name} = {p.show(v)}" for p, v in zip(d.parameters, d.values[i],
+                                                            strict=True)) + ")"
         settled[i] = r["settled"]
         sim_time[i] = np.nan if r["simulated_time"] is None else r["simulated_time"]
         wall[i] = r["wall_time"]
+        notes = r.get("warnings") or []
+        warned[i] = "\n".join(notes)
+        n_warned[i] = len(notes)
     if d.kind == "grid":
         dims = tuple(p.name for p in d.parameters)
         shape = d.shape
-        coords = {p.name: (p.name, axis, _param_attrs(p))
-                  for p, axis in zip(d.parameters, d.axes, strict=True)}
+        spacing = d.extra.get("spacing") or ["values"] * len(d.parameters)
+        coords = {p.name: (p.name, axis, {**_param_attrs(p), "spacing": sp})
+                  for p, axis, sp in zip(d.parameters, d.axes, spacing, strict=True)}
     else:
         dims = ("sample",)
         shape = (n,)
@@ -85,7 +103,13 @@ def build_dataset(plan, rows, n: int, meta: dict):
                                                      "missing"})
     data["reason"] = var(reason.astype(str), {"long_name": "why the case is not ok"})
     data["settled"] = var(settled.astype(np.int8), {
-        "units": "1", "long_name": "settled part found (1) or not (0)"})
+        "units": "1", "long_name": "1: the run's metrics found a settled part and, with "
+                                   "analysis.settle, the outputs (settle_time excepted) "
+                                   "agreed between the last two run lengths; 0: not"})
+    data["warnings"] = var(warned.astype(str), {
+        "long_name": "the case's warnings (model checks, run plausibility), one a line"})
+    data["warning_count"] = var(n_warned, {"units": "1", "long_name": "number of warnings "
+                                                                      "of the case"})
     data["simulated_time"] = var(sim_time, {"units": "s", "long_name": "simulated time of "
                                                                        "the case's run"})
     data["case_wall_time"] = var(wall, {"units": "s", "long_name": "wall time of the case "
@@ -137,11 +161,36 @@ def _add_indices(ds, plan, values):
     for k in keys:
         ds[k] = (("output", "factor"), np.array([r[k] for r in results]),
                  {"units": "1", "long_name": _INDEX_NAMES.get(k, k)})
+    used = "trajectories_used" if d.extra["method"] == "morris" else "samples_used"
+    total = d.extra["trajectories"] if d.extra["method"] == "morris" else d.extra["samples"]
+    ds[used] = (("output",), np.array([int(r[used]) for r in results]), {
+        "units": "1", "total": int(total),
+        "long_name": f"{used.split('_')[0]} whose cases all have a finite value (the "
+                     f"indices are over these, of {int(total)})"})
     ds = ds.assign_coords(output=("output", [variable_name(n) for n in names]),
                           factor=("factor", factors))
     ds.attrs.update(sensitivity_method=d.extra["method"], ranking=ranking_key(d),
                     seed=plan.spec.sensitivity.seed)
+    notes = sobol_warnings(ds) if d.extra["method"] == "sobol" else []
+    if notes:
+        ds.attrs["sensitivity_warnings"] = json.dumps(notes)
     return ds
+
+
+def sobol_warnings(ds) -> list[str]:
+    """Factors whose first-order index exceeds the total index by more than the two
+    bootstrap half-widths together (S1 <= ST always holds for the true indices: too few
+    samples, or an output with failed cases)."""
+    notes = []
+    for o, out_name in enumerate(ds["output"].values):
+        for f, factor in enumerate(ds["factor"].values):
+            s1, st = float(ds["S1"].values[o, f]), float(ds["ST"].values[o, f])
+            c1, ct = float(ds["S1_conf"].values[o, f]), float(ds["ST_conf"].values[o, f])
+            if s1 - st > np.nan_to_num(c1) + np.nan_to_num(ct):
+                notes.append(f"{out_name}: S1 of {factor} ({s1:.3g} +/- {c1:.2g}) exceeds its "
+                             f"ST ({st:.3g} +/- {ct:.2g}) beyond the 95 % intervals; the "
+                             f"indices are not converged, raise sensitivity.samples")
+    return notes
 
 
 _INDEX_NAMES = {
@@ -171,3 +220,33 @@ def ranking(ds, output: str) -> list[tuple[str, float]]:
     row = ds[key].sel(output=variable_name(output)).values
     order = np.argsort(-np.nan_to_num(row, nan=-np.inf))
     return [(str(ds["factor"].values[i]), float(row[i])) for i in order]
+
+
+_NUMBER = re.compile(r"[-+]?\d+(?:\.\d*)?(?:[eE][-+]?\d+)?")
+
+
+def warning_groups(ds) -> list[dict]:
+    """The cases' warnings grouped by what they say (texts that differ only in numbers
+    are one group): ``[{"text": the first case's text, "cases": [case indices]}]``, the
+    group with most cases first."""
+    if "warnings" not in ds:
+        return []
+    groups: dict[str, dict] = {}
+    for i, text in enumerate(ds["warnings"].values.ravel().tolist()):
+        for line in filter(None, str(text).split("\n")):
+            g = groups.setdefault(_NUMBER.sub("#", line), {"text": line, "cases": []})
+            if not g["cases"] or g["cases"][-1] != i:
+                g["cases"].append(i)
+    return sorted(groups.values(), key=lambda g: (-len(g["cases"]), g["cases"][0]))
+
+
+def case_ranges(cases: list[int]) -> str:
+    """[0, 1, 2, 5] -> "cases 0-2, 5"."""
+    parts, start = [], None
+    for j, c in enumerate(cases):
+        if start is None:
+            start = c
+        if j + 1 == len(cases) or cases[j + 1] != c + 1:
+            parts.append(f"{start}" if start == c else f"{start}-{c}")
+            start = None
+    return ("case " if len(cases) == 1 else "cases ") + ", ".join(parts)

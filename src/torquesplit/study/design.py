@@ -71,6 +71,20 @@ class Parameter:
             out[f.path] = int(round(v)) if f.integer else float(v)
         return out
 
+    def show(self, value: float) -> str:
+        """A value as the study file wrote it: in its unit ("-30 um", not "-3e-05")."""
+        if self.mode == "scale" or self.kind is None:
+            return f"{value:g}" + (" (factor)" if self.mode == "scale" else "")
+        unit = self.display_unit or self.unit
+        if unit != self.unit:
+            from ..model.units import convert
+
+            try:
+                return f"{convert(value, self.unit, unit):.6g} {unit}"
+            except Exception:  # a unit pint cannot convert: SI
+                pass
+        return f"{value:.6g} {self.unit}"
+
     def describe(self) -> str:
         what = "scales" if self.mode == "scale" else "sets"
         paths = self.paths
@@ -225,7 +239,7 @@ def _validated(data: dict, model_source: str, where: str, case=None, design=None
     except TorquesplitError as exc:
         what = "the model with the study's changes is invalid"
         if case is not None:
-            vals = ", ".join(f"{p.name} = {v:g}" for p, v in
+            vals = ", ".join(f"{p.name} = {p.show(v)}" for p, v in
                              zip(design.parameters, design.values[case], strict=True))
             what = f"case {case} ({vals}) gives an invalid model"
         raise StudyError(where, f"{what}: {_one_line(exc)}") from None
@@ -388,6 +402,7 @@ def _value(v, p: Parameter, unit, where) -> float:
 def _grid(spec: StudySpec, raw: dict) -> Design:
     params: list[Parameter] = []
     axes: list[np.ndarray] = []
+    spacings: list[str] = []
     for i, t in enumerate(spec.grid.parameters):
         where = f"grid.parameters.{i}"
         p = _parameter(t, raw, where)
@@ -419,8 +434,11 @@ def _grid(spec: StudySpec, raw: dict) -> Design:
             raise StudyError(f"{where}.values", "repeats a value; give each value once")
         p = Parameter(p.name, p.fields, p.mode, p.base,
                       None if p.mode == "scale" else _display_unit(shown, t.unit))
+        if p.display_unit and p.display_unit != p.unit:
+            vals = np.array([decimal_si(x, p.display_unit, p.unit) for x in vals])
         params.append(p)
         axes.append(vals)
+        spacings.append(t.spacing if t.values is None else "values")
     names = [p.name for p in params]
     if len(set(names)) != len(names):
         raise StudyError("grid.parameters", f"two parameters are named {names}; give each a "
@@ -428,7 +446,26 @@ def _grid(spec: StudySpec, raw: dict) -> Design:
     _check_disjoint(params, "grid.parameters")
     shape = tuple(len(a) for a in axes)
     values = np.array(list(itertools.product(*axes)), dtype=float).reshape(-1, len(axes))
-    return Design("grid", params, values, shape=shape, axes=axes)
+    return Design("grid", params, values, shape=shape, axes=axes,
+                  extra={"spacing": spacings})
+
+
+def decimal_si(x: float, unit: str, si: str) -> float:
+    """The SI value ``x`` of a value the study wrote in ``unit``, as the decimal product of
+    that value (to 12 digits) and the unit's factor: 30 um is 3e-05 m, not the
+    2.9999999999999997e-05 of 30 * 1e-6, so that ``ds.sel`` finds it.  ``x`` unchanged when
+    the two differ by more than rounding."""
+    from decimal import Decimal, InvalidOperation
+
+    from ..model.units import convert
+
+    try:
+        factor = convert(1.0, unit, si)
+        shown = float(f"{x / factor:.12g}")
+        exact = float(Decimal(repr(shown)) * Decimal(repr(factor)))
+    except (ValueError, ArithmeticError, InvalidOperation):  # a unit pint cannot convert
+        return float(x)
+    return exact if abs(exact - x) <= 1e-12 * abs(x) else float(x)
 
 
 # ============================================================================ Monte Carlo
@@ -485,22 +522,45 @@ def _random_variable(t, p: Parameter, model, where) -> RandomVariable:
     def si(name):
         return P.to_si(getattr(t, name), kind, t.unit, f"{where}.{name}")
 
+    nonneg = [f.path for f in p.fields if f.nonnegative]
     if d == "normal":
         mean, std = si("mean"), si("std")
         if std <= 0:
             raise StudyError(f"{where}.std", "must be positive; give the standard deviation")
+        below = 0.5 * math.erfc(mean / (std * math.sqrt(2)))  # P(x < 0)
+        if nonneg and below > NEGATIVE_PROBABILITY:
+            raise StudyError(f"{where}.distribution", (
+                f"a normal distribution with mean {_shown(t.mean, t.unit)} and std "
+                f"{_shown(t.std, t.unit)} draws negative values ({100 * below:.3g} % of the "
+                f"samples), which {nonneg[0]} refuses (those cases would be left out of the "
+                f"statistics); use distribution = \"truncated_normal\" with low = 0 "
+                f"(and high)"))
         return RandomVariable("normal", (mean, std))
     if d == "uniform":
         low, high = si("low"), si("high")
         if not high > low:
             raise StudyError(f"{where}.high", "must exceed 'low'; correct the bounds")
+        _refuse_negative_low(low, t, nonneg, where)
         return RandomVariable("uniform", (low, high))
     mean, std, low, high = si("mean"), si("std"), si("low"), si("high")
     if std <= 0:
         raise StudyError(f"{where}.std", "must be positive; give the standard deviation")
     if not high > low:
         raise StudyError(f"{where}.high", "must exceed 'low'; correct the bounds")
+    _refuse_negative_low(low, t, nonneg, where)
     return RandomVariable("truncated_normal", (mean, std, low, high))
+
+
+#: a normal distribution of a field that refuses negative values is refused when it draws
+#: a negative value with more than this probability (one case in a billion)
+NEGATIVE_PROBABILITY = 1e-9
+
+
+def _refuse_negative_low(low: float, t, nonneg: list[str], where: str) -> None:
+    if nonneg and low < 0:
+        raise StudyError(f"{where}.low", f"is {_shown(t.low, t.unit)}, but {nonneg[0]} refuses "
+                                         f"negative values (those cases would be left out of "
+                                         f"the statistics); give low >= 0")
 
 
 def _iso_variable(t, p: Parameter, model, where) -> RandomVariable:

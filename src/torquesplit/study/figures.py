@@ -98,6 +98,7 @@ def curves_figure(ds, family: str, members: list[tuple[str, str]]) -> Figure:
             ax.plot(x, y, color=_color(i), lw=1.4, ls=_DASHES[i % len(_DASHES)], marker="o",
                     ms=2.5, label=member)
     _mark_failed(ax, x, ds["status"].values)
+    _log_axis(ds, pname, ax.set_xscale)
     ax.set_xlabel(f"{_param_label(ds, pname)} [{xunit}]")
     ax.set_ylabel(f"{family} [{unit}]")
     ax.grid(True, alpha=0.3)
@@ -131,6 +132,10 @@ def maps_figure(ds, family: str, members: list[tuple[str, str]]) -> Figure:
     unit, scale = _out_unit(members[0][1])
     for ax, ((member, var), r) in zip(axes, panels):
         data = ds[var]
+        # one colour scale per member over every value of the third parameter
+        full = data.values * scale
+        limits = ({"vmin": float(np.nanmin(full)), "vmax": float(np.nanmax(full))}
+                  if third and np.isfinite(full).any() else {})
         status = ds["status"]
         title = member
         if third:
@@ -139,7 +144,10 @@ def maps_figure(ds, family: str, members: list[tuple[str, str]]) -> Figure:
             tv, tu = _coord(ds, third)
             title += f", {third} = {tv[r]:.4g} {tu}"
         z = data.transpose(dims[1], dims[0]).values * scale
-        mesh = ax.pcolormesh(x, y, np.ma.masked_invalid(z), shading="nearest", cmap="viridis")
+        mesh = ax.pcolormesh(x, y, np.ma.masked_invalid(z), shading="nearest", cmap="viridis",
+                             **limits)
+        _log_axis(ds, dims[0], ax.set_xscale)
+        _log_axis(ds, dims[1], ax.set_yscale)
         if np.isfinite(z).all() and len(x) > 1 and len(y) > 1 and np.nanstd(z) > 0:
             ax.contour(x, y, z, colors="w", linewidths=0.6, alpha=0.7)
         bad = status.transpose(dims[1], dims[0]).values != "ok"
@@ -192,6 +200,7 @@ def monte_carlo_figure(ds, var: str, confidence: float = 0.95) -> Figure:
         ax_v.plot(k, mean, color=_color(0), label="running mean")
         p95 = [np.quantile(seq[:j], 0.95) for j in range(1, seq.size + 1)]
         ax_v.plot(k, p95, color=_color(1), ls="--", label="running 95th percentile")
+        _stopping_band(ds, var, ax_v, scale)
     ax_h.set_xlabel(label, fontsize=8)
     ax_h.set_ylabel("cases")
     ax_c.set_xlabel(label, fontsize=8)
@@ -204,8 +213,25 @@ def monte_carlo_figure(ds, var: str, confidence: float = 0.95) -> Figure:
     ax_v.legend(fontsize=7)
     failed = int((ds["status"].values != "ok").sum())
     note = f" ({failed} of {y.size} cases not ok)" if failed else ""
-    fig.suptitle(f"{ds.attrs['study_name']}: {n} samples{note}", fontsize=11)
+    what = f"statistics over {n} of {y.size} cases" if n < y.size else f"{n} samples"
+    fig.suptitle(f"{ds.attrs['study_name']}: {what}{note}", fontsize=11)
     return fig
+
+
+def _stopping_band(ds, var, ax, scale) -> None:
+    """The stopping rule's target band around its final estimate, on the watched
+    output's running statistic."""
+    a = ds.attrs
+    if "stopping_target_met" not in a:
+        return
+    rule = json.loads(a["stopping_rule"])
+    if ds[var].attrs.get("output") != rule["output"]:
+        return
+    est, target = a["stopping_estimate"] * scale, a["stopping_target"] * scale
+    met = "met" if a["stopping_target_met"] else "not met"
+    ax.axhspan(est - target, est + target, color=_color(2), alpha=0.2,
+               label=f"stopping target +/-{target:.3g} ({a['stopping_statistic']}, {met})")
+    ax.axvline(a["stopping_cases"], color=_color(2), lw=1, ls=":")
 
 
 # ============================================================================ sensitivity
@@ -219,11 +245,16 @@ def tornado_figure(ds, var: str) -> Figure:
     fig = _figure(WIDTH, 0.45 * len(factors) + 1.6)
     ax = fig.add_subplot()
     pos = np.arange(len(factors))
-    ax.barh(pos, row[order], xerr=conf[order], color=_color(0), alpha=0.85,
-            label="mu* (Morris)" if key == "mu_star" else "ST (total)")
-    if key == "ST":
+    if key == "ST":  # side by side, each bar with its own interval
         s1 = ds["S1"].sel(output=var).values
-        ax.barh(pos, s1[order], height=0.4, color=_color(1), label="S1 (first order)")
+        s1_conf = ds["S1_conf"].sel(output=var).values
+        ax.barh(pos + 0.2, row[order], height=0.4, xerr=conf[order], color=_color(0),
+                alpha=0.85, label="ST (total)")
+        ax.barh(pos - 0.2, s1[order], height=0.4, xerr=s1_conf[order], color=_color(1),
+                alpha=0.85, label="S1 (first order)")
+    else:
+        ax.barh(pos, row[order], xerr=conf[order], color=_color(0), alpha=0.85,
+                label="mu* (Morris)")
     ax.set_yticks(pos, [factors[i] for i in order], fontsize=8)
     unit, _ = _out_unit(var)
     ax.set_xlabel("mu*: mean |output change| over each factor's range [" + unit + "]"
@@ -285,6 +316,12 @@ def _coord(ds, name) -> tuple[np.ndarray, str]:
         except Exception:  # an unknown display unit: show SI
             return values, si
     return values, ("-" if si == "1" else si)
+
+
+def _log_axis(ds, name, set_scale) -> None:
+    """A parameter spaced logarithmically (``spacing = "log"``) on a log axis."""
+    if ds[name].attrs.get("spacing") == "log":
+        set_scale("log")
 
 
 def _param_label(ds, name) -> str:

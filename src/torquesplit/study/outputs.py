@@ -69,6 +69,9 @@ FAMILIES: dict[str, tuple[str, str]] = {
     "settle_time": ("s", "start of the settled part of the run"),
 }
 
+#: outputs that change with the run length by nature (the settled part starts later in a
+#: longer run): the settle rule does not wait for them to stop changing
+NOT_CONVERGING = frozenset({"settle_time"})
 
 # ============================================================================ values
 def output_values(result, definitions=None) -> dict[str, float]:

@@ -228,8 +228,9 @@ def check_settable(raw: dict, field: Field, where: str) -> None:
         numeric = [k for k, v in value.items()
                    if isinstance(v, (int, float, str)) and not isinstance(v, bool)
                    and k not in ("method", "distribution", "model")]
+        inner = (numeric or list(value))[0]
         raise StudyError(where, f"{field.path!r} is a table in the model ({keys}); address "
-                                f"the field to vary, e.g. {field.path}.{(numeric or list(value))[0]}")
+                                f"the field to vary, e.g. {field.path}.{inner}")
 
 
 def base_value(raw: dict, field: Field, where: str) -> float:

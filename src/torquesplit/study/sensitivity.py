@@ -17,8 +17,12 @@ Morris (Morris 1991; mu* of Campolongo et al. 2007)
 
 Sobol (Saltelli et al. 2010, Table 2: first order (b), total Jansen 1999 (f))
     Base matrices A, B (N x k) from a scrambled Sobol sequence in 2k dimensions; AB_i is
-    A with column i from B.  With V = Var[y(A), y(B)]:
-    S1_i = mean(y(B) (y(AB_i) - y(A))) / V,  ST_i = mean((y(A) - y(AB_i))^2) / (2 V).
+    A with column i from B.  The outputs are first centred on the mean m of y(A), y(B)
+    (as SALib does; without it S1 of an output near 1, such as a load-sharing coefficient,
+    is a small difference of large products and lands far outside [0, 1]); with
+    f = y - m and V = Var[y(A), y(B)]:
+    S1_i = mean(f(B) (f(AB_i) - f(A))) / V,  ST_i = mean((f(A) - f(AB_i))^2) / (2 V),
+    so both are unchanged by adding a constant to the output.
     Cost N (k + 2) cases, ordered by base row (A_j, B_j, AB_1j ... AB_kj) so that every
     finished prefix of rows is a complete smaller estimate.  ``*_conf``: half-width of the
     95 % bootstrap interval over base rows.
@@ -143,7 +147,8 @@ def sobol_indices(design: Design, y: np.ndarray) -> dict[str, np.ndarray]:
                 "samples_used": np.array(y.shape[0])}
 
     def estimate(rows):
-        fa, fb, fab = rows[:, 0], rows[:, 1], rows[:, 2:]
+        centre = np.mean(rows[:, :2])
+        fa, fb, fab = rows[:, 0] - centre, rows[:, 1] - centre, rows[:, 2:] - centre
         v = np.var(np.concatenate([fa, fb]))
         if not v > 0:
             return nan, nan

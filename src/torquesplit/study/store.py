@@ -142,7 +142,7 @@ class Store:
     def cases(self, below: int | None = None):
         """Finished cases ordered by index: dicts with status, reason, values..."""
         sql = ("SELECT idx, status, reason, vals, wall_time, integration_time, compile_time, "
-               "simulated_time, runs, settled, worker, run FROM cases")
+               "simulated_time, runs, settled, worker, run, warnings FROM cases")
         args: tuple = ()
         if below is not None:
             sql += " WHERE idx < ?"
@@ -152,7 +152,8 @@ class Store:
                    "values": json.loads(row[3]), "wall_time": row[4],
                    "integration_time": row[5], "compile_time": row[6],
                    "simulated_time": row[7], "runs": row[8], "settled": bool(row[9]),
-                   "worker": row[10], "run": row[11]}
+                   "worker": row[10], "run": row[11],
+                   "warnings": json.loads(row[12]) if row[12] else []}
 
     def close(self) -> None:
         self.db.close()

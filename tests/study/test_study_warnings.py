@@ -1,0 +1,60 @@
+"""A case's warnings (the model checks' unit slips, a run too short to tell whether it
+settled) reach the Dataset and the command line's summary; none is dropped."""
+
+from __future__ import annotations
+
+import json
+
+import tomli_w
+from typer.testing import CliRunner
+
+from study_helpers import grid_study
+from torquesplit.cli import app
+from torquesplit.study import run_study
+from torquesplit.study.dataset import case_ranges, warning_groups
+
+runner = CliRunner()
+
+
+def test_a_run_too_short_warns_in_the_dataset_and_the_summary(tmp_path, split_file):
+    data = grid_study(split_file, [{"path": "meshes.a1.transmission_error.constant",
+                                    "values": ["0 um", "4 um", "8 um"]}],
+                      outputs=["load_sharing.cycle_peak"], cycles=5)
+    path = tmp_path / "s.toml"
+    path.write_text(tomli_w.dumps(data))
+    res = runner.invoke(app, ["study", str(path), "--out", str(tmp_path / "o"), "--workers",
+                              "1", "--quiet", "--no-figures"])
+    assert res.exit_code == 0, res.output
+    assert "3 of 3 cases warned" in res.stdout
+    assert "cases 0-2: analysis: the run is too short" in res.stdout
+    res = runner.invoke(app, ["study", str(path), "--out", str(tmp_path / "o"), "--resume",
+                              "--json", "--no-figures"])
+    got = json.loads(res.stdout)
+    assert got["cases_warned"] == 3 and got["warnings"][0]["cases"] == [0, 1, 2]
+    assert "too short" in got["warnings"][0]["text"]
+
+
+def test_a_unit_slip_warns_for_its_case_only(split_file):
+    data = grid_study(split_file, [{"path": "gears.pinion.errors.eccentricity",
+                                    "values": ["0 um", 0.5]}],  # 0.5: read in m
+                      outputs=["load_sharing.cycle_peak"])
+    ds = run_study(data, workers=1)
+    assert "eccentricity" not in str(ds["warnings"].values[0])
+    assert "gears.pinion.errors.eccentricity: 500 mm" in str(ds["warnings"].values[1])
+    assert ds["warning_count"].values[1] > ds["warning_count"].values[0]
+    slips = [g for g in warning_groups(ds) if "larger than the module" in g["text"]]
+    assert [g["cases"] for g in slips] == [[1]]
+
+
+def test_case_ranges():
+    assert case_ranges([0, 1, 2, 5, 7, 8]) == "cases 0-2, 5, 7-8"
+    assert case_ranges([4]) == "case 4"
+
+
+def test_a_settle_rule_that_reaches_its_cap_warns(split_file):
+    data = grid_study(split_file, [{"path": "meshes.a1.transmission_error.constant",
+                                    "values": ["4 um"]}], outputs=["load_sharing.cycle_peak"],
+                      cycles=40, settle={"tolerance": 0.002, "start": "0.08 s"})
+    ds = run_study(data, workers=1)
+    assert ds["settled"].values[0] == 0
+    assert "analysis.settle: the outputs still changed" in str(ds["warnings"].values[0])
