@@ -67,6 +67,7 @@ from .schema import (
     Unit,
     _backlash_shorthand,
     _check_angle,
+    _check_rim,
     _stiffness_shorthand,
     _unique_dofs,
 )
@@ -90,7 +91,14 @@ class PlanetaryGear(Strict):
     polar_inertia: Inertia | None = Field(None, gt=0, description="Polar moment of inertia; "
                                           "from geometry if omitted.")
     bore_diameter: Length = Field(0.0, ge=0, description="Bore diameter used for computed "
-                                  "mass and inertia.")
+                                  "mass and inertia (sun and planets).")
+    outer_diameter: Length | None = Field(None, gt=0, description="Outer diameter of the "
+                                          "ring's rim, used for computed mass and inertia; "
+                                          "default the root diameter + 2 rim_thickness.")
+    rim_thickness: Length | None = Field(None, gt=0, description="Rim thickness of the ring "
+                                         "from its root circle outwards, used for computed "
+                                         "mass and inertia; default 3.5 m_n (ISO 6336-3:2006 "
+                                         "Y_B = 1 from there).")
     dofs: list[Dof] | None = Field(None, description="Degrees of freedom; default "
                                    "['theta', 'x', 'y'] for the planets, ['theta'] else.")
     support: Support | None = Field(None, description="Support of the translational DOFs "
@@ -217,6 +225,13 @@ class Planetary(Strict):
             raise FieldError("ring.kind", f"the ring of a planetary stage is an internal "
                              f"gear, not {self.ring.kind!r}; remove 'kind' or write "
                              f"kind = 'internal'")
+        for member in ("sun", "planet", "ring"):
+            spec = getattr(self, member)
+            try:
+                _check_rim(spec.outer_diameter, spec.rim_thickness, member == "ring",
+                           "the ring", lambda: 2 * self._geometry(spec, True).root_radius)
+            except FieldError as exc:
+                raise FieldError(f"{member}.{exc.field}", str(exc)) from None
         for member in ("sun", "planet"):
             if getattr(self, member).kind == "internal":
                 raise FieldError(f"{member}.kind", f"the {member} meshes outside the planets"
@@ -396,6 +411,7 @@ class Planetary(Strict):
                      hand=hand if self.helix_angle != 0 else None, kind=kind,
                      face_width=member.face_width or self.face_width,
                      profile_shift=member.profile_shift, bore_diameter=member.bore_diameter,
+                     outer_diameter=member.outer_diameter, rim_thickness=member.rim_thickness,
                      axis=self.axis, dofs=member.dofs or dofs, errors=member.errors,
                      torsional_support=member.torsional_support,
                      modifications=member.modifications)

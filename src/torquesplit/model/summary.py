@@ -14,6 +14,8 @@ def summary(model: Model) -> dict:
     """A JSON-serialisable summary: speeds, torques, mesh frequencies, geometry, forces."""
     from ..assembly.excitation import stage_label
 
+    from .kinematics import mass_basis
+
     kin = solve_kinematics(model)
     bodies = {}
     for name, b in kin.bodies.items():
@@ -25,6 +27,8 @@ def summary(model: Model) -> dict:
             "polar_inertia_kgm2": b.polar_inertia,
             "mass_computed": b.mass_computed,
             "inertia_computed": b.inertia_computed,
+            "computed_from": (mass_basis(model.gears[name]) if name in model.gears
+                              and (b.mass_computed or b.inertia_computed) else None),
             "position_mm": [1e3 * float(v) for v in b.position],
             "position_computed": name in kin.positions_computed,
         }
@@ -86,10 +90,12 @@ def render_summary(s: dict, console) -> None:
         t.add_column(escape(col), justify="right" if col not in ("body", "position [mm]")
                      else "left")
     for name, b in s["bodies"].items():
-        mark = lambda flag: " (computed)" if flag else ""  # noqa: E731
+        basis = f": {b['computed_from']}" if (b.get("computed_from") or "").startswith("rim") \
+            else ""
+        mark = lambda flag, note="": f" (computed{note})" if flag else ""  # noqa: E731
         pos = "(" + ", ".join(f"{round(v, 4) + 0.0:.6g}" for v in b["position_mm"]) + ")"
         t.add_row(name, f"{b['speed_rpm']:.6g}", f"{b['torque_Nm']:.6g}",
-                  f"{b['mass_kg']:.5g}{mark(b['mass_computed'])}",
+                  f"{b['mass_kg']:.5g}{mark(b['mass_computed'], basis)}",
                   f"{b['polar_inertia_kgm2']:.5g}{mark(b['inertia_computed'])}",
                   pos + (" (placed)" if b["position_computed"] else ""))
     console.print(t)

@@ -1,0 +1,135 @@
+"""Planetary review: the computed mass of a ring (the rim from its root circle outwards,
+not a solid disc), errors in bare metres refused, the pin_radius, bare-radian angle and
+missing-table messages."""
+
+from __future__ import annotations
+
+import copy
+import math
+import tomllib
+import warnings
+
+import pytest
+
+import torquesplit
+from torquesplit.errors import ModelError, ModelWarning
+from torquesplit.model.kinematics import solve_kinematics
+
+#: the reviewer's helical 3-planet stage (24/30/84, m_n 3 mm, 15 deg, 50 mm wide)
+P3 = tomllib.loads("""
+[model]
+name = "p3"
+
+[[planetary]]
+name = "st"
+planets = 3
+module = "3 mm"
+pressure_angle = "20 deg"
+helix_angle = "15 deg"
+hand = "right"
+face_width = "50 mm"
+sun = {teeth = 24, dofs = ["theta", "x", "y"], support = {stiffness = "1e8 N/m"}}
+planet = {teeth = 30}
+ring = {teeth = 84, torsional_support = {rigid = true}}
+carrier = {polar_inertia = "0.5 kg m^2", mass = "20 kg"}
+planet_bearing = {stiffness = "5e8 N/m"}
+sun_mesh = {stiffness = "5e8 N/m"}
+ring_mesh = {stiffness = "5e8 N/m"}
+
+[drives.motor]
+body = "st_sun"
+speed = "1500 rpm"
+power = "100 kW"
+
+[loads.out]
+body = "st_carrier"
+""")
+
+
+def _raw(**stage):
+    raw = copy.deepcopy(P3)
+    for key, value in stage.items():
+        target, *path = key.split("__")
+        node = raw["planetary"][0]
+        for part in [target, *path][:-1]:
+            node = node.setdefault(part, {})
+        node[([target, *path])[-1]] = value
+    return raw
+
+
+def _load(raw):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ModelWarning)
+        return torquesplit.load_model(raw)
+
+
+def _issue(raw) -> tuple[str, str]:
+    with pytest.raises(ModelError) as exc:
+        _load(raw)
+    (loc, msg), = exc.value.issues
+    assert "\n" not in msg
+    return loc, msg
+
+
+def _ring_annulus(ro):
+    """Mass and inertia of the ring's rim by hand: m_t = 3 mm / cos 15 deg, root radius
+    r + 1.25 m_n, out to ``ro`` [m]."""
+    r = 84 * 3e-3 / math.cos(math.radians(15)) / 2
+    rf = r + 1.25 * 3e-3
+    m = 7850 * math.pi * (ro**2 - rf**2) * 0.05
+    return m, m * (ro**2 + rf**2) / 2, rf
+
+
+# ------------------------------------------------------------------ 1. ring mass
+def test_a_ring_is_its_rim_from_the_root_circle_with_3_5_modules_by_default():
+    ring = solve_kinematics(_load(_raw())).bodies["st_ring"]
+    rf = _ring_annulus(0.1)[2]
+    m, j, _ = _ring_annulus(rf + 3.5 * 3e-3)
+    assert ring.mass == pytest.approx(m, rel=1e-9) and ring.mass_computed
+    assert ring.polar_inertia == pytest.approx(j, rel=1e-9)
+    # a rim of a few kg, not the 20.98 kg / 0.1785 kg m^2 of a solid disc of the pitch circle
+    assert 3.5 < ring.mass < 3.7 and 0.06 < ring.polar_inertia < 0.08
+
+
+def test_a_rings_outer_diameter_or_rim_thickness_gives_its_rim():
+    ring = solve_kinematics(_load(_raw(ring__outer_diameter="300 mm"))).bodies["st_ring"]
+    assert ring.mass == pytest.approx(_ring_annulus(0.150)[0], rel=1e-9)
+    rf = _ring_annulus(0.1)[2]
+    ring = solve_kinematics(_load(_raw(ring__rim_thickness="20 mm"))).bodies["st_ring"]
+    assert ring.polar_inertia == pytest.approx(_ring_annulus(rf + 0.02)[1], rel=1e-9)
+    # given values win
+    ring = solve_kinematics(_load(_raw(ring__mass="9 kg"))).bodies["st_ring"]
+    assert ring.mass == 9 and not ring.mass_computed
+
+
+def test_a_general_internal_gear_is_a_rim_too():
+    from torquesplit.model.kinematics import gear_mass_properties
+
+    g = _load(_raw()).gears["st_ring"]
+    assert g.gear_type == "internal" and g.outer_diameter is None
+    mass, inertia, mc, ic = gear_mass_properties(g.model_copy(update={"rim_thickness": 0.02}))
+    rf = _ring_annulus(0.1)[2]
+    assert mass == pytest.approx(_ring_annulus(rf + 0.02)[0], rel=1e-9) and mc and ic
+
+
+@pytest.mark.parametrize("stage, loc, words", [
+    ({"ring__outer_diameter": "200 mm"}, "planetary.0.ring.outer_diameter",
+     ("root circle", "268.39")),
+    ({"sun__rim_thickness": "10 mm"}, "planetary.0.sun.rim_thickness", ("internal",)),
+    ({"ring__rim_thickness": "10 mm", "ring__outer_diameter": "300 mm"},
+     "planetary.0.ring.rim_thickness", ("remove one",)),
+])
+def test_a_rim_that_cannot_be_is_refused_naming_the_field(stage, loc, words):
+    got, msg = _issue(_raw(**stage))
+    assert got == loc and all(w in msg for w in words), (got, msg)
+
+
+def test_check_says_what_a_computed_ring_is():
+    from rich.console import Console
+
+    from torquesplit.model.summary import render_summary, summary
+
+    console = Console(width=300, record=True)
+    render_summary(summary(_load(_raw())), console)
+    text = console.export_text()
+    assert "(computed: rim 10.5 mm = 3.5 m_n, d_o 289.39 mm)" in text, text
