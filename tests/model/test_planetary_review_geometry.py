@@ -133,3 +133,83 @@ def test_check_says_what_a_computed_ring_is():
     render_summary(summary(_load(_raw())), console)
     text = console.export_text()
     assert "(computed: rim 10.5 mm = 3.5 m_n, d_o 289.39 mm)" in text, text
+
+
+# ------------------------------------------------------------------ 2. bare metres
+@pytest.mark.parametrize("stage, loc, fix", [
+    ({"pin_errors": [{"tangential": 20}, {}, {}]}, "planetary.0.pin_errors.0.tangential",
+     "write '20 um'"),
+    ({"pin_errors": [{}, {}, {"radial": -5}]}, "planetary.0.pin_errors.2.radial",
+     "write '-5 um'"),
+    ({"sun__errors": {"eccentricity": 20}}, "planetary.0.sun.errors.eccentricity",
+     "write '20 um'"),
+    ({"ring__errors": {"installation": 15}}, "planetary.0.ring.errors.installation",
+     "write '15 um'"),
+    ({"planet__errors": {"tooth_thickness": "10 mm"}},
+     "planetary.0.planet.errors.tooth_thickness", "write '10 um'"),
+    ({"carrier__eccentricity": 8}, "planetary.0.carrier.eccentricity", "write '8 um'"),
+])
+def test_an_error_larger_than_the_module_is_refused_with_the_fix(stage, loc, fix):
+    got, msg = _issue(_raw(**stage))
+    assert got == loc and fix in msg and "larger than the module (3 mm)" in msg, (got, msg)
+    if "mm" not in str(stage):
+        assert "bare number is read in metres" in msg, msg
+
+
+def test_errors_below_the_module_are_not_refused():
+    _load(_raw(pin_errors=[{"tangential": "2.9 mm"}, {}, {}],
+               sun__errors={"eccentricity": "20 um"}, carrier__eccentricity="1 mm"))
+
+
+# ------------------------------------------------------------------ 3. pin radius
+@pytest.mark.parametrize("radius, side, offset", [
+    ("80 mm", "inside", None), ("83.86 mm", "outside", "2.629 um")])
+def test_a_pin_radius_off_the_mesh_circle_says_where_and_the_exact_value(radius, side, offset):
+    loc, msg = _issue(_raw(pin_radius=radius))
+    assert loc == "planetary.0.pin_radius" and f"um {side} the circle" in msg, msg
+    assert "pin_radius = '83.8573706 mm'" in msg and "tolerance 1e-06" in msg, msg
+    # a small offset is a real pin error: pointed to; 3.9 mm is beyond the module
+    assert ("pin_errors = [{radial = '2.629 um'}" in msg) == (offset is not None), msg
+
+
+def test_the_exact_pin_radius_is_accepted():
+    _load(_raw(pin_radius="83.8573706 mm"))
+
+
+# ------------------------------------------------------------------ 4. bare angles
+def test_bare_angles_in_degrees_get_the_unit_hint():
+    loc, msg = _issue(_raw(angles=[0, 90, 180]))
+    assert loc == "planetary.0.angles" and "read in radians" in msg, msg
+    assert "write '90 deg'" in msg, msg
+    loc, msg = _issue(_raw(angles=[0, 2, 4]))  # radians within a turn: no hint
+    assert "radians" not in msg and "multiples of 360 deg" in msg, msg
+
+
+# ------------------------------------------------------------------ 5. --set of a table
+@pytest.mark.parametrize("arg, form", [
+    ("planetary.0.sun.errors.eccentricity=20 um",
+     "--set 'planetary.0.sun.errors={eccentricity = \"20 um\"}'"),
+    ("planetary.0.ring.errors.installation_phase=0.5",
+     "--set 'planetary.0.ring.errors={installation_phase = 0.5}'"),
+])
+def test_set_into_a_schema_table_the_file_lacks_shows_the_inline_table(arg, form):
+    from torquesplit.model.overrides import apply_assignments, parse_assignment
+
+    with pytest.raises(ModelError) as exc:
+        apply_assignments(P3, [arg])
+    (loc, msg), = exc.value.issues
+    assert form in msg, msg
+    # and that form works
+    data, _ = apply_assignments(P3, [form[len("--set '"):-1]])
+    path, value = parse_assignment(arg)
+    assert _load(data).gears[f"st_{path.split('.')[2]}"].errors.model_dump()[
+        path.split(".")[-1]] == pytest.approx(2e-5 if "um" in arg else 0.5)
+
+
+def test_set_into_an_unknown_table_still_lists_what_exists():
+    from torquesplit.model.overrides import apply_assignments
+
+    with pytest.raises(ModelError) as exc:
+        apply_assignments(P3, ["planetary.0.sun.erors.eccentricity=20 um"])
+    (loc, msg), = exc.value.issues
+    assert "does not exist" in msg and "{" not in msg, msg

@@ -258,9 +258,9 @@ def _check_rim(outer_diameter, rim_thickness, internal: bool, what: str,
     the root circle (``root_diameter`` a callable, called only when needed)."""
     for field, value in (("outer_diameter", outer_diameter), ("rim_thickness", rim_thickness)):
         if value is not None and not internal:
-            raise FieldError(field, f"{field} gives the rim of an internal gear ({what}); an external "
-                             f"gear's computed mass is a disc less its bore_diameter: remove "
-                             f"{field}")
+            raise FieldError(field, (
+                f"{field} gives the rim of an internal gear ({what}); an external gear's "
+                f"computed mass is a disc less its bore_diameter: remove {field}"))
     if outer_diameter is not None and rim_thickness is not None:
         raise FieldError("rim_thickness", "outer_diameter and rim_thickness both give the "
                          "rim; remove one of them")
