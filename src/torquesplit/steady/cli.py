@@ -298,16 +298,29 @@ def campbell_command(m, start, stop, plot, as_json, console, json_default):
         from torquesplit.steady.plot import campbell_figure, save
 
         save(campbell_figure(ds), plot)
+    from torquesplit.steady.maps import split_suppressed
+
+    critical, suppressed = split_suppressed(crossings)
     if as_json:
-        _emit({"critical_speeds": crossings,
-               "natural_frequencies_Hz": ds["natural_frequency"].values[0].tolist()},
-              json_default)
+        out = {"critical_speeds": critical,
+               "natural_frequencies_Hz": ds["natural_frequency"].values[0].tolist()}
+        if suppressed:
+            out["suppressed_by_mesh_phasing"] = suppressed
+        _emit(out, json_default)
         return
-    t = Table(title=f"critical speeds between {start} and {stop}")
-    for col in ("speed [rpm]", "mode", "f [Hz]", "excitation", "strain energy (largest shares)"):
+    phased = any("suppressed" in c for c in crossings)
+    t = Table(title=f"critical speeds between {start} and {stop}" + (
+        f" ({len(critical)} critical; {len(suppressed)} crossings that the planets' mesh "
+        f"phasing leaves unexcited, Parker & Lin 2004, marked 'suppressed')" if phased
+        else ""))
+    cols = ["speed [rpm]", "mode", "f [Hz]", "excitation"]
+    cols += ["mode type", "phasing"] if phased else []
+    for col in cols + ["strain energy (largest shares)"]:
         t.add_column(_h(col))
     for c in crossings:
+        extra = ([c.get("mode_type") or "-", "suppressed" if c["suppressed"] else "excited"]
+                 if phased else [])
         t.add_row(f"{c['speed_rpm']:.6g}", str(c["mode"]), f"{c['frequency_Hz']:.6g}",
-                  f"{c['order']} x {c['source']}",
+                  f"{c['order']} x {c['source']}", *extra,
                   ", ".join(f"{n} {100 * v:.0f} %" for n, v in c["energy"]))
     console.print(t)
