@@ -203,6 +203,25 @@ def gear_mass_properties(gear: Gear) -> tuple[float, float, bool, bool]:
     return mass, inertia, gear.mass is None, gear.polar_inertia is None
 
 
+def support_frame(kin, body: str) -> tuple[str | None, float | None, float]:
+    """(carrier, rotation frequency of ``body`` in the frame of its support force,
+    rotation frequency of that frame) [Hz]: the force on a body whose translations are
+    measured in a turning carrier's frame (docs/theory/planetary.md) is in that frame,
+    where the body turns at its speed relative to the carrier; (None, absolute frequency,
+    0) for the housing's frame (or a carrier that does not turn); None for a body the
+    kinematics do not know."""
+    bodies = getattr(kin, "bodies", {})
+    info = bodies.get(body)
+    if info is None:
+        return None, None, 0.0
+    carrier = getattr(kin, "frames", {}).get(body)
+    w_frame = abs(kin.frame_speed(body)) if carrier is not None else 0.0
+    if carrier is None or w_frame == 0.0:
+        return carrier, abs(info.speed) / (2 * math.pi), 0.0
+    return (carrier, abs(kin.relative_speed(body, carrier)) / (2 * math.pi),
+            w_frame / (2 * math.pi))
+
+
 # --------------------------------------------------------------------------- solver
 @remember_last
 def solve_kinematics(model: Model) -> Kinematics:

@@ -12,6 +12,21 @@ def _var(dims, data, units, long_name):
     return xr.Variable(dims, np.asarray(data), attrs={"units": units, "long_name": long_name})
 
 
+def _element_frames(res, names: list[str]) -> list[str]:
+    """Frame of each recorded element force (see the ``element_frame`` coordinate)."""
+    from ..model.kinematics import support_frame
+
+    out = []
+    for name in names:
+        body, sep, _ = name.partition(".support.")
+        if not sep:
+            out.append("")
+            continue
+        carrier, _, f_frame = support_frame(res.kinematics, body)
+        out.append(f"carrier {carrier} (turning)" if carrier and f_frame else "housing")
+    return out
+
+
 def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
     """Histories, per-cycle statistics, static and nominal forces, metrics (of
     ``definition``, default the model's), warnings, run info.
@@ -73,6 +88,11 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
             "dof": ("dof", list(st.dof_names)),
         },
     )
+    ds = ds.assign_coords(element_frame=("element", _element_frames(res, hist_names), {
+        "long_name": "frame of the element force: a support force of a body measured in "
+                     "a turning carrier's frame is in that frame (its shaft orders are "
+                     "speeds relative to the carrier); 'housing' the fixed frame; '' a "
+                     "mesh's normal force"}))
     if len(s.history_dofs):
         names = [st.dof_names[i] for i in s.history_dofs]
         ds = ds.assign_coords(history_dof=("history_dof", names))
