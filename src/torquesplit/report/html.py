@@ -242,14 +242,13 @@ def _run_section(res, met) -> str:
 def _planets(load_sharing, kinematics) -> str:
     """The planet table (K_gamma per stage, the factor per planet) of a planetary model;
     nothing for a model without planets."""
-    from ..cli_support import PLANET_HEADER, PLANET_TEXT, planet_rows, planet_sharing
+    from ..cli_support import planet_header, planet_rows, planet_sharing, planet_text
 
     k = planet_sharing(load_sharing, kinematics)
     if k is None:
         return ""
-    header = [h.format(definition=k.definition) for h in PLANET_HEADER]
-    return ("<h3>Planets</h3>" + _table(header, planet_rows(k, kinematics), left=3)
-            + f'<p class="note">{_e(PLANET_TEXT)} ({_e(k.definition)}).</p>')
+    return ("<h3>Planets</h3>" + _table(planet_header(k), planet_rows(k, kinematics), left=3)
+            + f'<p class="note">{_e(planet_text(k))}</p>')
 
 
 def _figure(fig_svg: str, caption: str) -> str:
