@@ -222,6 +222,9 @@ class Planetary(Strict):
         if self.pin_errors is not None and len(self.pin_errors) != n:
             raise FieldError("pin_errors", f"gives {len(self.pin_errors)} errors for {n} "
                              f"planets; give one {{radial, tangential}} per planet")
+        if self.planet.support is not None:
+            raise FieldError("planet.support", "the planets sit on 'planet_bearing'; "
+                             "remove planet.support (give its stiffness in planet_bearing)")
         if self.planet_bearing.on is not None:
             raise FieldError("planet_bearing.on", "the planet bearings sit on the stage's "
                              "carrier; remove 'on'")
@@ -479,9 +482,6 @@ class Planetary(Strict):
         for i, (pname, psi) in enumerate(zip(names["planets"], self.planet_angles())):
             bearing = self.planet_bearing.model_copy(update={"on": names["carrier"],
                                                              "pin_error": pins[i]})
-            if self.planet.support is not None:
-                raise FieldError("planet.support", "the planets sit on 'planet_bearing'; "
-                                 "remove planet.support")
             gears[pname] = gear(self.planet, self._kind(self.planet), other,
                                 ["theta", "x", "y"],
                                 place={"from_gear": names["sun"], "angle": psi},

@@ -167,13 +167,14 @@ def register(app, load, fail, console, err_console, json_default):
             elif not stability:
                 console.print("stability: not computed (--no-stability)")
             t = Table(title="meshes (periodic steady state)")
-            for col in ("mesh", "group", "static F [N]", "mean F [N]", "peak F [N]",
+            for col in ("mesh", "group", "static F [kN]", "mean F [kN]", "peak F [kN]",
                         "DF (peak/static)", "peak/nominal", "LSC", "RMS TE [µm]",
                         "contact loss"):
                 t.add_column(_h(col), justify="left" if col in ("mesh", "group") else "right")
             for r in rows:
-                t.add_row(r.mesh, r.group, f"{r.static_force:.6g}", f"{r.mean_force:.6g}",
-                          f"{r.peak_force:.6g}", f"{r.dynamic_factor:.5f}",
+                t.add_row(r.mesh, r.group, f"{r.static_force / 1e3:.6g}",
+                          f"{r.mean_force / 1e3:.6g}", f"{r.peak_force / 1e3:.6g}",
+                          f"{r.dynamic_factor:.5f}",
                           f"{r.peak_to_nominal:.5f}", f"{r.load_sharing:.5f}",
                           f"{1e6 * r.rms_transmission_error:.4g}",
                           f"{100 * r.contact_loss:.2f} %")
