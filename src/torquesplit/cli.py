@@ -646,13 +646,12 @@ def group_table(met) -> Table:
 def _print_planets(planets, kinematics) -> None:
     """The planet table (K_gamma per stage, the factor per planet) and what it shows."""
     t = Table(title=f"planets (load sharing: {planets.definition})")
-    for i, col in enumerate(ux.PLANET_HEADER):
-        t.add_column(_h(col.format(definition=planets.definition)),
-                     justify="right" if i == 3 else "left")
+    for i, col in enumerate(ux.planet_header(planets)):
+        t.add_column(_h(col), justify="right" if i >= 3 else "left")
     for row in ux.planet_rows(planets, kinematics):
         t.add_row(*row)
     console.print(t)
-    console.print(f"{ux.PLANET_TEXT} ({planets.definition}).", markup=False, highlight=False)
+    console.print(ux.planet_text(planets), markup=False, highlight=False)
 
 
 # --------------------------------------------------------------------------- static
@@ -969,8 +968,11 @@ def _print_contact(m, pair, names, op_load, cm, results, hm, impact, op, figures
                   f"{cm.phase.size} positions x {cm.y.size} slices"
                   + (" x 2 helices" if cm.helices == 2 else "")
                   + f"; operating normal load {op_load / 1e3:.5g} kN")
+    # the angular transmission error is that of the driven gear (LTCA gear 2; Liu et al.
+    # 2021 eq. 3: Z / (r_b2 cos beta_b))
+    arcsec = f"TE p-p [arc s of {names[1]}]"
     t = Table(title="loaded tooth contact analysis (normal direction)")
-    for col in ("load [kN]", "TE mean [µm]", "TE p-p [µm]", "TE p-p [arc s]", "k secant [N/µm]",
+    for col in ("load [kN]", "TE mean [µm]", "TE p-p [µm]", arcsec, "k secant [N/µm]",
                 "k tangent [N/µm]", "p_H max [MPa]", "contact ratio"):
         t.add_column(_h(col), justify="right")
     for r, row in zip(results, rows):
@@ -982,7 +984,7 @@ def _print_contact(m, pair, names, op_load, cm, results, hm, impact, op, figures
     console.print(t)
     if hm is not None:
         h = Table(title="Harris map")
-        for col in ("load [kN]", "TE p-p [µm]", "TE p-p [arc s]", "contact ratio"):
+        for col in ("load [kN]", "TE p-p [µm]", arcsec, "contact ratio"):
             h.add_column(_h(col), justify="right")
         for f, pp, pa, cr in zip(hm.loads, hm.te_peak_to_peak, hm.te_peak_to_peak_arcsec,
                                  hm.contact_ratio):

@@ -257,6 +257,29 @@ PLANET_TEXT = ("K_gamma of a stage: its largest planet load over the mean planet
                "coefficient of its meshes")
 #: the planet table's columns (the factor's takes the definition)
 PLANET_HEADER = ("carrier", "planet", "mesh groups", "factor ({definition})")
+#: what a quasi-static sweep's planet table shows (K_gamma from the position-averaged
+#: loads; the instantaneous peak in a column of its own)
+PLANET_TEXT_STATIC = (
+    "K_gamma of a stage: its largest planet load over the mean planet load, each planet's "
+    "load averaged over the mesh positions (the mesh-load factor of AGMA 6123 / ISO "
+    "6336-1), the largest over its sun and ring mesh groups; a planet's factor: the "
+    "largest of its meshes; 'peak instantaneous ratio': the largest ratio at one mesh "
+    "position (Mo et al. 2017), not K_gamma (it exceeds 1 for sequentially phased planets "
+    "with equal mean loads)")
+
+
+def planet_header(k) -> list[str]:
+    """The planet table's columns for ``k``: a quasi-static one has the peak apart."""
+    head = [h.format(definition=k.definition) for h in PLANET_HEADER]
+    if k.peak_per_stage:
+        head[3] = "K_gamma / factor (position-averaged loads)"
+        head.append("peak instantaneous ratio")
+    return head
+
+
+def planet_text(k) -> str:
+    """The line under the planet table."""
+    return (PLANET_TEXT_STATIC if k.peak_per_stage else PLANET_TEXT) + f" ({k.definition})."
 
 
 def planet_sharing(load_sharing, kinematics):
@@ -273,11 +296,14 @@ def planet_rows(k, kinematics) -> list[list[str]]:
     """Rows of the planet table: per stage (carrier) its K_gamma and the groups it is taken
     over, then each of its planets' factor."""
     rows = []
+    peak = bool(k.peak_per_stage)
     for carrier, value in k.per_stage.items():
-        rows.append([carrier, "K_gamma (stage)", ", ".join(k.groups[carrier]), f"{value:.4f}"])
+        rows.append([carrier, "K_gamma (stage)", ", ".join(k.groups[carrier]), f"{value:.4f}"]
+                    + ([f"{k.peak_per_stage[carrier]:.4f}"] if peak else []))
         for planet in kinematics.carriers.get(carrier, ()):
             if planet in k.per_planet:
-                rows.append(["", planet, "", f"{k.per_planet[planet]:.4f}"])
+                rows.append(["", planet, "", f"{k.per_planet[planet]:.4f}"]
+                            + ([f"{k.peak_per_planet[planet]:.4f}"] if peak else []))
     return rows
 
 
@@ -285,5 +311,10 @@ def planet_sharing_dict(k) -> dict:
     """The ``--json`` entry ``planet_load_sharing`` of a planetary model (commands leave
     the key out for a model without planets): the definition, K_gamma per stage (carrier),
     the factor per planet and the mesh groups of each stage."""
-    return {"definition": k.definition, "per_stage": dict(k.per_stage),
-            "per_planet": dict(k.per_planet), "groups": {c: list(g) for c, g in k.groups.items()}}
+    out = {"definition": k.definition, "per_stage": dict(k.per_stage),
+           "per_planet": dict(k.per_planet), "groups": {c: list(g) for c, g in k.groups.items()}}
+    if k.peak_per_stage:
+        out["per_stage_basis"] = "loads averaged over the mesh positions (AGMA 6123 / ISO 6336-1)"
+        out["peak_instantaneous_ratio"] = {"per_stage": dict(k.peak_per_stage),
+                                           "per_planet": dict(k.peak_per_planet)}
+    return out

@@ -33,7 +33,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["ModeRow", "ModalReport", "classify", "model_modes", "MODE_TYPES"]
+__all__ = ["ModeRow", "ModalReport", "classify", "model_modes", "MODE_TYPES",
+           "PhasedStage", "phased_stages", "phasing_suppresses"]
 
 MODE_TYPES = ("rotational", "translational", "planet", "mixed")
 
@@ -247,3 +248,110 @@ def model_modes(model, *, rotating_frame: bool = True, below: float | None = Non
     return ModalReport(solution=sol, rows=rows, rigid_modes=int(sol.rigid_modes.shape[1]),
                        dof_names=tuple(st.dof_names),
                        rotating_frame=bool(st.metadata.get("rotating_frame", False)))
+
+
+# --------------------------------------------------------------------------- mesh phasing
+#: planets closer than this to equal spacing [rad] are equally spaced
+SPACING_TOLERANCE = 1e-6
+
+
+@dataclass(frozen=True)
+class PhasedStage:
+    """A stage whose mesh phasing selects the modes a mesh harmonic excites: one carrier,
+    N >= 3 identical planets equally spaced on it, each meshing with one sun and one
+    ring, no pin errors (equal planet loads), and a central member that translates (else
+    the translational modes are labelled ``planet``, :func:`classify`)."""
+
+    carrier: str
+    planets: int
+    sun_teeth: int
+    meshes: frozenset[str]
+    """The stage's sun-planet and ring-planet meshes."""
+
+    def excites(self, order: int, mode_type: str | None) -> bool:
+        """Whether mesh harmonic ``order`` excites a mode of ``mode_type``: Parker & Lin
+        2004 ("Mesh phasing relationships in planetary and epicyclic gears", J. Mech.
+        Des. 126), with equally spaced planets harmonic l excites the rotational modes
+        only when l z_s / N is an integer, the translational modes only when
+        (l z_s +- 1) / N is, the planet modes only when neither is.  A mode of no pure
+        type (``mixed``, None) is always excited."""
+        n, lz = self.planets, order * self.sun_teeth
+        rot = lz % n == 0
+        trans = (lz + 1) % n == 0 or (lz - 1) % n == 0
+        if mode_type == "rotational":
+            return rot
+        if mode_type == "translational":
+            return trans
+        if mode_type == "planet":
+            return not (rot or trans)
+        return True
+
+
+def phased_stages(model, kin) -> list[PhasedStage]:
+    """The stages of ``model`` to which Parker & Lin 2004's phasing rule applies
+    (:class:`PhasedStage`); [] for a model with more than one carrier or none, unequal
+    spacing, unlike planets, pin errors, or central members that do not translate."""
+    from .model.kinematics import gear_geometry
+
+    if len(kin.carriers) != 1:
+        return []
+    (carrier, planets), = kin.carriers.items()
+    n = len(planets)
+    if n < 3 or any(p not in model.gears for p in planets):
+        return []
+    gears = [model.gears[p] for p in planets]
+    first = gears[0].model_dump(exclude={"position", "place", "support"})
+    if any(g.model_dump(exclude={"position", "place", "support"}) != first for g in gears):
+        return []  # unlike planets
+    if any(g.support is None or not g.support.pin_error.is_zero
+           or g.support.model_dump(exclude={"pin_error"})
+           != gears[0].support.model_dump(exclude={"pin_error"}) for g in gears):
+        return []  # pin errors or unlike bearings: unequal planet loads
+    c = kin.bodies[carrier]
+    axis = np.asarray(c.axis, float)
+    ref = None
+    angles = []
+    for p in planets:
+        r = np.asarray(kin.bodies[p].position, float) - np.asarray(c.position, float)
+        r = r - axis * float(r @ axis)
+        if ref is None:
+            ref = r / np.linalg.norm(r)
+        angles.append(float(np.arctan2(np.cross(ref, r) @ axis, ref @ r)) % (2 * np.pi))
+    angles.sort()
+    step = 2 * np.pi / n
+    if any(abs(a - k * step) > SPACING_TOLERANCE for k, a in enumerate(angles)):
+        return []
+    # one sun and one ring, each meshing with every planet, the planets with nothing else
+    mates: dict[str, set[str]] = {}
+    meshes: set[str] = set()
+    for name, m in model.meshes.items():
+        a, b = m.gears
+        for p, o in ((a, b), (b, a)):
+            if p in planets:
+                if o in planets:
+                    return []
+                mates.setdefault(o, set()).add(p)
+                meshes.add(name)
+    if len(mates) != 2 or any(len(v) != n for v in mates.values()):
+        return []
+    kinds = {o: model.gears[o].gear_type == "internal" for o in mates if o in model.gears}
+    if sorted(kinds.values()) != [False, True] or len(meshes) != 2 * n:
+        return []
+    sun = next(o for o, internal in kinds.items() if not internal)
+    ring = next(o for o, internal in kinds.items() if internal)
+    if not any(any(d != "theta" for d in _dofs(model, b)) for b in (sun, ring, carrier)):
+        return []
+    gear_geometry(model.gears[sun])  # a sun of valid geometry
+    return [PhasedStage(carrier=carrier, planets=n, sun_teeth=model.gears[sun].teeth,
+                        meshes=frozenset(meshes))]
+
+
+def _dofs(model, body) -> list[str]:
+    spec = model.gears.get(body) or model.bodies.get(body)
+    return list(spec.dofs) if spec is not None else []
+
+
+def phasing_suppresses(stages, mesh: str, order: int, mode_type: str | None) -> bool:
+    """Whether harmonic ``order`` of ``mesh`` leaves a mode of ``mode_type`` unexcited by
+    the planets' mesh phasing (Parker & Lin 2004; :meth:`PhasedStage.excites`)."""
+    return any(mesh in st.meshes and not st.excites(order, mode_type) for st in stages)

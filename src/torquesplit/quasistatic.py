@@ -101,7 +101,9 @@ class QuasiStaticResults:
                                                "per_group": met.per_group,
                                                "system": met.system})},
         )
-        return ds
+        from .results.dataset import add_planet_load_sharing
+
+        return add_planet_load_sharing(ds, met, self.kinematics)
 
     def to_netcdf(self, path, *, overwrite: bool = False):
         """Save as NetCDF, atomically, keeping an existing file unless ``overwrite``; the

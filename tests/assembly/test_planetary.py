@@ -360,7 +360,7 @@ def test_bad_planetary_input_names_the_field(change, where, text):
 @pytest.mark.parametrize("stage, where, text", [
     ({"planets": 7}, "planetary.0.planets", "assembly condition"),
     ({"planets": 6}, "planetary.0.planets", "planets overlap"),
-    ({"pin_radius": "110 mm"}, "planetary.0.pin_radius", "outside the mesh circle"),
+    ({"pin_radius": "110 mm"}, "planetary.0.pin_radius", "outside the circle the planets"),
     ({"angles": ["0 deg", "90 deg"]}, "planetary.0.angles", "one angle per planet"),
 ])
 def test_bad_shorthand_names_the_field(stage, where, text):

@@ -124,6 +124,10 @@ class LoadSharing:
     ratio, or the ratio of the cycle means (``mean_force``)."""
     cycle_time: dict[str, np.ndarray] = field(default_factory=dict, repr=False)
     """Mesh -> start time of each of those cycles [s]."""
+    position_mean: dict[str, float] = field(default_factory=dict)
+    """``static_torque`` only: mesh -> N x its force averaged over the mesh positions /
+    the sum of its group's averages (the mean load of a path over the mean of all: the
+    planets' K_gamma of AGMA 6123 / ISO 6336-1, :mod:`torquesplit.metrics.planetary`)."""
 
 
 def group_meshes(mesh_meta: dict[str, dict]) -> dict[str, list[str]]:
@@ -304,16 +308,20 @@ def static_torque(times, forces, names, groups) -> LoadSharing:
     """Mo et al. 2017 eqs. 14-15: ratios of the quasi-static mesh forces at every mesh
     position (``forces`` (n_positions, n_meshes)), the largest over the positions."""
     col = {n: j for j, n in enumerate(names)}
-    per_mesh, per_group, per_cycle, ts = {}, {}, {}, {}
+    per_mesh, per_group, per_cycle, ts, mean = {}, {}, {}, {}, {}
     for g, members in groups.items():
-        r = _ratio(forces[:, [col[m] for m in members]])  # Mo et al. 2017 eq. 14
+        f = forces[:, [col[m] for m in members]]
+        r = _ratio(f)  # Mo et al. 2017 eq. 14
+        with np.errstate(invalid="ignore"):
+            r_mean = _ratio(np.nanmean(f, axis=0)) if len(f) else np.full(len(members), np.nan)
         for i, m in enumerate(members):
             per_cycle[m] = r[:, i]
             ts[m] = np.asarray(times, dtype=float)
             per_mesh[m] = _nanmax(r[:, i])
+            mean[m] = float(r_mean[i])
         per_group[g] = max(per_mesh[m] for m in members)  # eq. 15
     return LoadSharing("static_torque", per_mesh, per_group, max(per_group.values()),
-                       groups, per_cycle, ts)
+                       groups, per_cycle, ts, mean)
 
 
 @dataclass(frozen=True)

@@ -9,9 +9,13 @@ sun meshes form one load-sharing group, its ring meshes another (the stage label
 general elements), and each group's coefficient is max_i N X_i / sum_j X_j = largest
 over mean.  So every definition gives its K_gamma:
 
-* quasi-static (``static_torque``, Mo et al. 2017 eqs. 14-15 generalised to planets):
-  the largest ratio over the mesh positions of a quasi-static sweep -- the standards'
-  K_gamma, with pin position errors, carrier eccentricity and floating members;
+* quasi-static (``static_torque``, with pin position errors, carrier eccentricity and
+  floating members): K_gamma from each planet's load averaged over the mesh positions of
+  the sweep -- the mean load per planet over the mean of all, as the standards define it
+  (AGMA 6123-B06 §5, ISO 6336-1) -- and, apart, the peak of the instantaneous ratio over
+  the positions (Mo et al. 2017 eqs. 14-15 generalised to planets), which is not
+  K_gamma: with sequentially phased planets it exceeds 1 (1.0841 for a 25/29/83 spur
+  stage) although every planet carries the same mean load;
 * dynamic (``cycle_peak``, ``mean_force``, ``instantaneous``, ``engineering``): the
   same ratio of the dynamic forces.
 
@@ -22,7 +26,7 @@ largest coefficient of its meshes.  Names for studies: ``planet_load_sharing.<de
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 
 __all__ = ["PlanetLoadSharing", "planet_load_sharing"]
 
@@ -38,6 +42,11 @@ class PlanetLoadSharing:
     """Planet -> the largest load-sharing coefficient of its meshes."""
     groups: dict[str, list[str]]
     """Carrier -> the load-sharing groups of its planet meshes."""
+    peak_per_stage: dict[str, float] = field(default_factory=dict)
+    """Quasi-static only: carrier -> the peak of the instantaneous ratio over the mesh
+    positions (Mo et al. 2017), not K_gamma."""
+    peak_per_planet: dict[str, float] = field(default_factory=dict)
+    """Quasi-static only: planet -> the peak instantaneous ratio of its meshes."""
 
     def values(self) -> dict[str, float]:
         key = f"planet_load_sharing.{self.definition}"
@@ -62,6 +71,16 @@ def planet_load_sharing(load_sharing, kinematics) -> PlanetLoadSharing:
     1.0
     """
     ls = load_sharing
+    position_mean = getattr(ls, "position_mean", None)
+    if position_mean:
+        # quasi-static: K_gamma from the loads averaged over the positions, the peak of
+        # the instantaneous ratio apart
+        mean = replace(ls, per_mesh=dict(position_mean), per_group={
+            g: max(position_mean[m] for m in ms) for g, ms in ls.groups.items()},
+            position_mean={})
+        k = planet_load_sharing(mean, kinematics)
+        peak = planet_load_sharing(replace(ls, position_mean={}), kinematics)
+        return replace(k, peak_per_stage=peak.per_stage, peak_per_planet=peak.per_planet)
     per_stage: dict[str, float] = {}
     per_planet: dict[str, float] = {}
     groups: dict[str, list[str]] = {}

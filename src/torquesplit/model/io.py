@@ -159,8 +159,9 @@ def _message(err: dict, parts: list[str]) -> str:
     return f"{msg}, got {got}; correct the value ({_SEE_DOCS})"
 
 
-def _fields_at(parts: list[str]) -> list[str]:
-    """Field names of the schema section at location ``parts`` ([] if there is none)."""
+def _fields_at(parts: list[str], lists: bool = False) -> list[str]:
+    """Field names of the schema section at location ``parts`` ([] if there is none);
+    with ``lists``, an index steps into a list of sections (``planetary.0.sun``)."""
     node = Model
     for part in parts:
         node = _strip(node)
@@ -171,6 +172,8 @@ def _fields_at(parts: list[str]) -> list[str]:
             node = field.annotation
         elif typing.get_origin(node) is dict:
             node = typing.get_args(node)[1]
+        elif lists and typing.get_origin(node) is list and part.isdigit():
+            node = typing.get_args(node)[0]
         else:
             return []
     node = _strip(node)

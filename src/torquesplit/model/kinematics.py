@@ -152,17 +152,74 @@ def _unit(v) -> np.ndarray:
     return v / np.linalg.norm(v)
 
 
+#: default rim thickness of an internal gear from its root circle outwards, in normal
+#: modules: ISO 6336-3:2006 (rim thickness factor Y_B) finds no rim influence on the tooth
+#: root stress of an internal gear from s_R = 3.5 m_n up (Y_B = 1; thinner rims, down to
+#: 1.75 m_n, raise it), the rim a ring gear is designed with at least (cf. AGMA 6123 on
+#: ring gear rims)
+RIM_THICKNESS_MODULES = 3.5
+
+
+def internal_rim(gear: Gear) -> tuple[float, float, bool]:
+    """(root radius, outer radius, outer radius computed) of an internal gear's rim: the
+    outer radius is ``outer_diameter / 2``, or the root radius plus ``rim_thickness``
+    (default :data:`RIM_THICKNESS_MODULES` normal modules)."""
+    r_f = gear_geometry(gear).root_radius
+    if gear.outer_diameter is not None:
+        return r_f, gear.outer_diameter / 2, False
+    rim = (gear.rim_thickness if gear.rim_thickness is not None
+           else RIM_THICKNESS_MODULES * gear.module)
+    return r_f, r_f + rim, True
+
+
+def mass_basis(gear: Gear) -> str:
+    """What computed mass and inertia of ``gear`` are made of, for ``check``'s table."""
+    if gear.gear_type == "internal":
+        r_f, r_o, _ = internal_rim(gear)
+        rim = r_o - r_f
+        of = (f" = {rim / gear.module:.3g} m_n" if gear.outer_diameter is None
+              and gear.rim_thickness is None else "")
+        return f"rim {rim * 1e3:.4g} mm{of}, d_o {2 * r_o * 1e3:.5g} mm"
+    return "disc of d" + (f", bore {gear.bore_diameter * 1e3:.4g} mm"
+                          if gear.bore_diameter else "")
+
+
 def gear_mass_properties(gear: Gear) -> tuple[float, float, bool, bool]:
-    """Mass and polar inertia, from the model or from a solid disc of the pitch diameter."""
-    geo = gear_geometry(gear)
-    d = 2 * geo.reference_radius
+    """Mass and polar inertia, from the model or computed: a solid disc of the pitch
+    diameter less the bore, or for an internal gear the annulus of its rim from the root
+    circle to the outer diameter (:func:`internal_rim`; the teeth inside the root circle
+    are left out, about a tenth of a ring's mass at the default rim)."""
     width = gear.face_width * (2 if gear.gear_type == "double_helical" else 1)
-    di = min(gear.bore_diameter, 0.9 * d)
-    m_geo = gear.density * math.pi * (d**2 - di**2) / 4 * width
-    j_geo = m_geo * (d**2 + di**2) / 8
+    if gear.gear_type == "internal":
+        ri, ro, _ = internal_rim(gear)
+        do, di = 2 * ro, 2 * ri
+    else:
+        do = 2 * gear_geometry(gear).reference_radius
+        di = min(gear.bore_diameter, 0.9 * do)
+    m_geo = gear.density * math.pi * (do**2 - di**2) / 4 * width
+    j_geo = m_geo * (do**2 + di**2) / 8
     mass = gear.mass if gear.mass is not None else m_geo
     inertia = gear.polar_inertia if gear.polar_inertia is not None else j_geo
     return mass, inertia, gear.mass is None, gear.polar_inertia is None
+
+
+def support_frame(kin, body: str) -> tuple[str | None, float | None, float]:
+    """(carrier, rotation frequency of ``body`` in the frame of its support force,
+    rotation frequency of that frame) [Hz]: the force on a body whose translations are
+    measured in a turning carrier's frame (docs/theory/planetary.md) is in that frame,
+    where the body turns at its speed relative to the carrier; (None, absolute frequency,
+    0) for the housing's frame (or a carrier that does not turn); None for a body the
+    kinematics do not know."""
+    bodies = getattr(kin, "bodies", {})
+    info = bodies.get(body)
+    if info is None:
+        return None, None, 0.0
+    carrier = getattr(kin, "frames", {}).get(body)
+    w_frame = abs(kin.frame_speed(body)) if carrier is not None else 0.0
+    if carrier is None or w_frame == 0.0:
+        return carrier, abs(info.speed) / (2 * math.pi), 0.0
+    return (carrier, abs(kin.relative_speed(body, carrier)) / (2 * math.pi),
+            w_frame / (2 * math.pi))
 
 
 # --------------------------------------------------------------------------- solver

@@ -29,6 +29,8 @@ def set_parameter(data: dict, path: str, value: Any) -> dict:
     out = _copy_node(data)
     node = out
     for i, key in enumerate(parts[:-1]):
+        if isinstance(node, dict) and key not in node:
+            _missing_table(parts, i, value)
         child = _copy_node(_child(node, key, ".".join(parts[: i + 1]), path))
         node[_index(key, node, path) if isinstance(node, list) else key] = child
         node = child
@@ -178,6 +180,35 @@ def read_raw(source) -> dict:
     from .io import read_file
 
     return read_file(Path(source))
+
+
+def _missing_table(parts: list[str], i: int, value) -> None:
+    """A table on the path that the file does not have but the schema knows
+    (``planetary.0.sun.errors`` of ``planetary.0.sun.errors.eccentricity``): refused with
+    the inline-table form that sets it (``--set 'planetary.0.sun.errors={eccentricity =
+    "20 um"}'``).  A path the schema does not know returns to :func:`_child`'s message."""
+    from .io import _fields_at
+
+    if parts[i] not in _fields_at(parts[:i], lists=True):
+        return
+    head, rest = ".".join(parts[: i + 1]), ".".join(parts[i + 1:])
+    form = f"{head}={{{rest} = {_toml_value(value)}}}"
+    raise ModelError([(".".join(parts), (
+        f"{head!r} is a field that this file does not write; set it as a table: "
+        f"--set '{form}'"))])
+
+
+def _toml_value(value) -> str:
+    """``value`` as TOML source (for a --set hint)."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, str):
+        return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_toml_value(v) for v in value) + "]"
+    if isinstance(value, dict):
+        return "{" + ", ".join(f"{k} = {_toml_value(v)}" for k, v in value.items()) + "}"
+    return repr(value)
 
 
 def _child(node, key, where, path):

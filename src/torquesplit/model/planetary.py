@@ -67,12 +67,16 @@ from .schema import (
     Unit,
     _backlash_shorthand,
     _check_angle,
+    _check_rim,
     _stiffness_shorthand,
     _unique_dofs,
 )
 
 #: relative tolerance of the assembly condition (a whole number of teeth)
 FIT_TOLERANCE = 1e-6
+#: relative tolerance of pin_radius against the sun-planet centre distance (the pins are
+#: the planets' nominal centres; an offset is a pin error, pin_errors.radial)
+PIN_TOLERANCE = 1e-6
 
 
 class PlanetaryGear(Strict):
@@ -90,7 +94,14 @@ class PlanetaryGear(Strict):
     polar_inertia: Inertia | None = Field(None, gt=0, description="Polar moment of inertia; "
                                           "from geometry if omitted.")
     bore_diameter: Length = Field(0.0, ge=0, description="Bore diameter used for computed "
-                                  "mass and inertia.")
+                                  "mass and inertia (sun and planets).")
+    outer_diameter: Length | None = Field(None, gt=0, description="Outer diameter of the "
+                                          "ring's rim, used for computed mass and inertia; "
+                                          "default the root diameter + 2 rim_thickness.")
+    rim_thickness: Length | None = Field(None, gt=0, description="Rim thickness of the ring "
+                                         "from its root circle outwards, used for computed "
+                                         "mass and inertia; default 3.5 m_n (ISO 6336-3:2006 "
+                                         "Y_B = 1 from there).")
     dofs: list[Dof] | None = Field(None, description="Degrees of freedom; default "
                                    "['theta', 'x', 'y'] for the planets, ['theta'] else.")
     support: Support | None = Field(None, description="Support of the translational DOFs "
@@ -180,7 +191,8 @@ class Planetary(Strict):
     axis: tuple[Number, Number, Number] = Field((0.0, 0.0, 1.0), description="Stage axis.")
     pin_radius: Length | None = Field(
         None, gt=0, description="Radius of the planet pins; must equal the sun-planet "
-        "centre distance (checked); default that distance.")
+        "centre distance (to 1e-6 of it; an offset of the pins is pin_errors.radial); "
+        "default that distance.")
     sun: PlanetaryGear = Field(description="The sun gear.")
     planet: PlanetaryGear = Field(description="Every planet gear.")
     ring: PlanetaryGear = Field(description="The ring gear (internal).")
@@ -210,6 +222,9 @@ class Planetary(Strict):
         if self.pin_errors is not None and len(self.pin_errors) != n:
             raise FieldError("pin_errors", f"gives {len(self.pin_errors)} errors for {n} "
                              f"planets; give one {{radial, tangential}} per planet")
+        if self.planet.support is not None:
+            raise FieldError("planet.support", "the planets sit on 'planet_bearing'; "
+                             "remove planet.support (give its stiffness in planet_bearing)")
         if self.planet_bearing.on is not None:
             raise FieldError("planet_bearing.on", "the planet bearings sit on the stage's "
                              "carrier; remove 'on'")
@@ -217,6 +232,13 @@ class Planetary(Strict):
             raise FieldError("ring.kind", f"the ring of a planetary stage is an internal "
                              f"gear, not {self.ring.kind!r}; remove 'kind' or write "
                              f"kind = 'internal'")
+        for member in ("sun", "planet", "ring"):
+            spec = getattr(self, member)
+            try:
+                _check_rim(spec.outer_diameter, spec.rim_thickness, member == "ring",
+                           "the ring", lambda: 2 * self._geometry(spec, True).root_radius)
+            except FieldError as exc:
+                raise FieldError(f"{member}.{exc.field}", str(exc)) from None
         for member in ("sun", "planet"):
             if getattr(self, member).kind == "internal":
                 raise FieldError(f"{member}.kind", f"the {member} meshes outside the planets"
@@ -228,8 +250,41 @@ class Planetary(Strict):
                     "with one helix, which cannot mesh with double-helical planets; use "
                     "kind = 'helical' (with the stage's helix_angle) or remove 'kind'"))
         self._check_modifications()
+        self._check_error_sizes()
         self._check_fit()
         return self
+
+    def _check_error_sizes(self) -> None:
+        """Pin errors, gear errors and the carrier eccentricity of a stage larger than its
+        module are refused: they are microns, and one larger than the tooth is a length
+        written as a bare number (read in metres: ``tangential = 20`` is 20 m), which the
+        equations would carry through to nonsense (a planet factor of -384366)."""
+        if not 0 < self.module < 0.1:
+            return  # a module in bare metres: _check_fit refuses it first
+        fields = []
+        for i, pin in enumerate(self.pin_errors or []):
+            fields += [(f"pin_errors.{i}.{f}", getattr(pin, f), "pin position errors")
+                       for f in ("radial", "tangential")]
+        for member in ("sun", "planet", "ring"):
+            e = getattr(self, member).errors
+            fields += [(f"{member}.errors.{f}", getattr(e, f), "gear errors")
+                       for f in ("eccentricity", "installation", "tooth_thickness", "pitch",
+                                 "bearing_runout")]
+        fields.append(("carrier.eccentricity", self.carrier.eccentricity,
+                       "carrier eccentricities"))
+        for field, value, what in fields:
+            if not abs(value) > self.module:
+                continue
+            # what was probably meant: the same digits in microns (a bare 20 -> '20 um';
+            # '20 mm' -> '20 um')
+            bare = abs(value) >= 1
+            digits = math.copysign(abs(value) if bare else abs(value) * 1e3, value)
+            size = f"{abs(value):.6g} m" if bare else f"{abs(value) * 1e3:.6g} mm"
+            raise FieldError(field, (
+                f"{size} is larger than the module ({self.module * 1e3:.4g} mm), which the "
+                f"equations cannot carry (the teeth would part); {what} are microns" + (
+                    " and a bare number is read in metres" if bare else "") +
+                f": write '{digits:g} um'"))
 
     def _check_modifications(self) -> None:
         """What [gears.NAME] refuses of its modifications, named as written here: a second
@@ -299,11 +354,17 @@ class Planetary(Strict):
                 f"distance is {a_sp * 1e3:.4f} mm, the planet-ring one {a_rp * 1e3:.4f} mm; "
                 f"without profile shifts the ring needs z_s + 2 z_p = {zs + 2 * zp} teeth: "
                 f"correct the tooth counts or the profile shifts"))
-        if self.pin_radius is not None and abs(self.pin_radius - a_sp) > 1e-6 * a_sp:
+        if self.pin_radius is not None and abs(self.pin_radius - a_sp) > PIN_TOLERANCE * a_sp:
+            off = self.pin_radius - a_sp
             raise FieldError("pin_radius", (
-                f"pins at {self.pin_radius * 1e3:.4f} mm from the axis put the planets "
-                f"outside the mesh circle (the sun-planet centre distance is "
-                f"{a_sp * 1e3:.4f} mm); remove 'pin_radius' or correct it"))
+                f"pins at {self.pin_radius * 1e3:.9g} mm from the axis are "
+                f"{abs(off) * 1e6:.4g} um {'outside' if off > 0 else 'inside'} the circle "
+                f"the planets mesh on (the operating sun-planet centre distance, "
+                f"{a_sp * 1e3:.9g} mm; tolerance {PIN_TOLERANCE:g} of it, "
+                f"{PIN_TOLERANCE * a_sp * 1e6:.2g} um): remove 'pin_radius' or write "
+                f"pin_radius = '{a_sp * 1e3:.9g} mm'" + (
+                    f"; give a real offset of the pins as pin_errors = [{{radial = "
+                    f"'{off * 1e6:.4g} um'}}, ...]" if abs(off) <= self.module else "")))
         angles = self.planet_angles()
         where = "angles" if self.angles is not None else "planets"
         period = 2 * math.pi / (zs + zr)
@@ -319,6 +380,10 @@ class Planetary(Strict):
                         if self.angles is None else
                         f"give angles that are multiples of 360 deg / (z_s + z_r) = "
                         f"{math.degrees(period):.6g} deg from the first planet")
+                if self.angles is not None and max(abs(a) for a in angles) > 2 * math.pi:
+                    # an angle beyond a turn is a number of degrees written bare
+                    hint = (f"a bare number is read in radians: planet {i}'s angle "
+                            f"{psi:g} is {math.degrees(psi):.6g} deg; write '{psi:g} deg'")
                 raise FieldError(where, (
                     f"planet {i} does not fit: at {math.degrees(psi - angles[0]):.6g} deg from "
                     f"planet 1 it is {steps:.6g} tooth periods of sun and ring away "
@@ -396,6 +461,7 @@ class Planetary(Strict):
                      hand=hand if self.helix_angle != 0 else None, kind=kind,
                      face_width=member.face_width or self.face_width,
                      profile_shift=member.profile_shift, bore_diameter=member.bore_diameter,
+                     outer_diameter=member.outer_diameter, rim_thickness=member.rim_thickness,
                      axis=self.axis, dofs=member.dofs or dofs, errors=member.errors,
                      torsional_support=member.torsional_support,
                      modifications=member.modifications)
@@ -416,9 +482,6 @@ class Planetary(Strict):
         for i, (pname, psi) in enumerate(zip(names["planets"], self.planet_angles())):
             bearing = self.planet_bearing.model_copy(update={"on": names["carrier"],
                                                              "pin_error": pins[i]})
-            if self.planet.support is not None:
-                raise FieldError("planet.support", "the planets sit on 'planet_bearing'; "
-                                 "remove planet.support")
             gears[pname] = gear(self.planet, self._kind(self.planet), other,
                                 ["theta", "x", "y"],
                                 place={"from_gear": names["sun"], "angle": psi},

@@ -251,6 +251,31 @@ class Placement(Strict):
     )
 
 
+def _check_rim(outer_diameter, rim_thickness, internal: bool, what: str,
+               root_diameter=None) -> None:
+    """The rim of an internal gear: outer_diameter or rim_thickness, not both, only on an
+    internal gear (an external gear's mass is a disc less its bore_diameter), and outside
+    the root circle (``root_diameter`` a callable, called only when needed)."""
+    for field, value in (("outer_diameter", outer_diameter), ("rim_thickness", rim_thickness)):
+        if value is not None and not internal:
+            raise FieldError(field, (
+                f"{field} gives the rim of an internal gear ({what}); an external gear's "
+                f"computed mass is a disc less its bore_diameter: remove {field}"))
+    if outer_diameter is not None and rim_thickness is not None:
+        raise FieldError("rim_thickness", "outer_diameter and rim_thickness both give the "
+                         "rim; remove one of them")
+    if outer_diameter is not None and root_diameter is not None:
+        try:
+            d_f = root_diameter()
+        except (ValueError, ArithmeticError):  # the geometry's own check names it
+            return
+        if outer_diameter <= d_f:
+            raise FieldError("outer_diameter", (
+                f"{outer_diameter * 1e3:.6g} mm is not outside the root circle of the internal "
+                f"gear (d_f = {d_f * 1e3:.6g} mm): the rim lies from the root circle outwards; "
+                f"give a larger outer diameter, or rim_thickness"))
+
+
 class Gear(Strict):
     """A gear: one rigid body with involute teeth."""
 
@@ -274,6 +299,13 @@ class Gear(Strict):
         None, gt=0, description="Polar moment of inertia; from geometry and density if omitted."
     )
     bore_diameter: Length = Field(0.0, ge=0, description="Bore diameter used for computed mass/inertia.")
+    outer_diameter: Length | None = Field(None, gt=0, description=(
+        "Outer diameter of an internal gear's rim, used for computed mass/inertia (the rim "
+        "from the root circle outwards); default the root diameter + 2 rim_thickness."))
+    rim_thickness: Length | None = Field(None, gt=0, description=(
+        "Rim thickness of an internal gear from its root circle outwards, used for computed "
+        "mass/inertia; default 3.5 m_n (the rim above which ISO 6336-3:2006's rim "
+        "thickness factor Y_B of an internal gear is 1)."))
     density: Density = Field(7850.0, gt=0, description="Material density.")
     youngs_modulus: Pressure = Field(206e9, gt=0, description="Young's modulus of the gear material.")
     poisson_ratio: Number = Field(0.3, gt=0, lt=0.5, description="Poisson's ratio.")
@@ -314,9 +346,16 @@ class Gear(Strict):
                              "hand = 'right' or hand = 'left'")
         if self.position is not None and self.place is not None:
             raise ValueError("both 'position' and 'place' are given; remove one of them")
+        _check_rim(self.outer_diameter, self.rim_thickness, self.gear_type == "internal",
+                   "kind = 'internal'", self._root_diameter)
         _check_axis(self.axis)
         _unique_dofs(self.dofs)
         return self
+
+    def _root_diameter(self) -> float:
+        from ..gears import line_of_action as loa
+
+        return 2 * loa.gear_geometry(self).root_radius
 
     @property
     def gear_type(self) -> str:

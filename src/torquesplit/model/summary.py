@@ -14,7 +14,10 @@ def summary(model: Model) -> dict:
     """A JSON-serialisable summary: speeds, torques, mesh frequencies, geometry, forces."""
     from ..assembly.excitation import stage_label
 
+    from .kinematics import mass_basis
+
     kin = solve_kinematics(model)
+    idlers = _idlers(model)
     bodies = {}
     for name, b in kin.bodies.items():
         bodies[name] = {
@@ -25,8 +28,11 @@ def summary(model: Model) -> dict:
             "polar_inertia_kgm2": b.polar_inertia,
             "mass_computed": b.mass_computed,
             "inertia_computed": b.inertia_computed,
+            "computed_from": (mass_basis(model.gears[name]) if name in model.gears
+                              and (b.mass_computed or b.inertia_computed) else None),
             "position_mm": [1e3 * float(v) for v in b.position],
             "position_computed": name in kin.positions_computed,
+            "idler": name in idlers,
         }
     meshes = {}
     for name, mk in kin.meshes.items():
@@ -65,6 +71,21 @@ def summary(model: Model) -> dict:
     }
 
 
+def _idlers(model) -> set[str]:
+    """Gears that only pass torque from one mesh to another (an idler, a simple planet):
+    no drive, load, torsional support, shaft or spline on them, and two meshes or more.
+    Their net torque is zero; ``torque_Nm`` is the torque of one mesh on them."""
+    ends = {d.body for d in model.drives.values()} | {ld.body for ld in model.loads.values()}
+    for part in (*model.shafts.values(), *model.splines.values()):
+        ends.update(part.connects)
+    count: dict[str, int] = {}
+    for m in model.meshes.values():
+        for g in m.gears:
+            count[g] = count.get(g, 0) + 1
+    return {name for name, g in model.gears.items() if name not in ends
+            and g.torsional_support is None and count.get(name, 0) >= 2}
+
+
 def _num(x):
     return None if x is None or not math.isfinite(x) else float(x)
 
@@ -86,10 +107,14 @@ def render_summary(s: dict, console) -> None:
         t.add_column(escape(col), justify="right" if col not in ("body", "position [mm]")
                      else "left")
     for name, b in s["bodies"].items():
-        mark = lambda flag: " (computed)" if flag else ""  # noqa: E731
+        basis = f": {b['computed_from']}" if (b.get("computed_from") or "").startswith("rim") \
+            else ""
+        mark = lambda flag, note="": f" (computed{note})" if flag else ""  # noqa: E731
         pos = "(" + ", ".join(f"{round(v, 4) + 0.0:.6g}" for v in b["position_mm"]) + ")"
-        t.add_row(name, f"{b['speed_rpm']:.6g}", f"{b['torque_Nm']:.6g}",
-                  f"{b['mass_kg']:.5g}{mark(b['mass_computed'])}",
+        torque = f"{b['torque_Nm']:.6g}" + (" per mesh (idler: net 0)" if b.get("idler")
+                                             else "")
+        t.add_row(name, f"{b['speed_rpm']:.6g}", torque,
+                  f"{b['mass_kg']:.5g}{mark(b['mass_computed'], basis)}",
                   f"{b['polar_inertia_kgm2']:.5g}{mark(b['inertia_computed'])}",
                   pos + (" (placed)" if b["position_computed"] else ""))
     console.print(t)

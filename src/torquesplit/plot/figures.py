@@ -466,10 +466,21 @@ def support_spectrum_figure(results, *, start_time: float | None = None, orders:
                     ax.axvline(k * f * fscale, color=_order_color(j), ls=":", lw=1.2, zorder=1,
                                label=f"{label} mesh: {_hz(f)} x 1..{orders}"
                                if k == 1 and n_panel == 0 else None)
-        f_rot = _rotation_frequency(results, body)
+        # shaft orders in the frame of the force: a body measured in a turning carrier's
+        # frame (planet bearings, and sun and ring with that carrier) turns at its speed
+        # relative to the carrier there, and a load fixed in the housing turns at the
+        # carrier's speed
+        from ..model.kinematics import support_frame
+
+        frame, f_rot, f_frame = support_frame(results.kinematics, body)
         if f_rot is not None and 0 < f_rot <= f_top:
             ax.axvline(f_rot * fscale, color="0.45", ls="-.", lw=1.0, zorder=1,
-                       label=f"rotation of {body}: {_hz(f_rot)}")
+                       label=f"rotation of {body}" + (
+                           f" relative to {frame}" if f_frame else "") + f": {_hz(f_rot)}")
+        if f_frame and f_frame <= f_top:
+            ax.axvline(f_frame * fscale, color="0.3", ls=(0, (5, 2, 1, 2, 1, 2)), lw=1.0,
+                       zorder=1, label=f"rotation of {frame} (housing seen from its "
+                       f"frame): {_hz(f_frame)}")
         ax.set_xlim(0, f_top * fscale)
         if quiet:  # do not blow rounding noise up to full scale
             ax.set_ylim(0, 1)
@@ -481,8 +492,10 @@ def support_spectrum_figure(results, *, start_time: float | None = None, orders:
             ax.yaxis.set_minor_locator(NullLocator())  # decades only: readable, fast
         else:
             ax.set_ylim(0, 1.08 * largest)
-        ax.set_title(f"support of {body}", fontsize=FONT["title"])
-        _label(ax, f"frequency [{funit}]", "force amplitude [N]")
+        ax.set_title(f"support of {body} ({_frame_text(results.kinematics, body)})",
+                     fontsize=FONT["title"])
+        _label(ax, f"frequency [{funit}]" + (" in the force's frame" if f_frame else ""),
+               "force amplitude [N]")
         _legend(ax)
     span = grid.size * dt
     least = min((strength[b] for b in shown), default=0.0)
@@ -875,10 +888,16 @@ def _spectral_lines(amp: np.ndarray, threshold: float) -> np.ndarray:
     return inner[amp[inner] > threshold]
 
 
-def _rotation_frequency(results, body: str) -> float | None:
-    """Rotation frequency [Hz] of a body, or None if the kinematics do not know it."""
-    info = getattr(results.kinematics, "bodies", {}).get(body)
-    return abs(info.speed) / (2 * math.pi) if info is not None else None
+def _frame_text(kin, body: str) -> str:
+    """The frame a body's support force is given in, in words."""
+    from ..model.kinematics import support_frame
+
+    carrier, _, f_frame = support_frame(kin, body)
+    if carrier is None:
+        return "force in the housing frame"
+    if not f_frame:
+        return f"force in the housing frame: {carrier} does not turn"
+    return f"force in {carrier}'s turning frame"
 
 
 def _cycle_columns(results) -> dict[str, int]:

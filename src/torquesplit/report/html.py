@@ -242,14 +242,13 @@ def _run_section(res, met) -> str:
 def _planets(load_sharing, kinematics) -> str:
     """The planet table (K_gamma per stage, the factor per planet) of a planetary model;
     nothing for a model without planets."""
-    from ..cli_support import PLANET_HEADER, PLANET_TEXT, planet_rows, planet_sharing
+    from ..cli_support import planet_header, planet_rows, planet_sharing, planet_text
 
     k = planet_sharing(load_sharing, kinematics)
     if k is None:
         return ""
-    header = [h.format(definition=k.definition) for h in PLANET_HEADER]
-    return ("<h3>Planets</h3>" + _table(header, planet_rows(k, kinematics), left=3)
-            + f'<p class="note">{_e(PLANET_TEXT)} ({_e(k.definition)}).</p>')
+    return ("<h3>Planets</h3>" + _table(planet_header(k), planet_rows(k, kinematics), left=3)
+            + f'<p class="note">{_e(planet_text(k))}</p>')
 
 
 def _figure(fig_svg: str, caption: str) -> str:
@@ -288,12 +287,19 @@ def _modes(res) -> str:
         rep = model_modes(res.model, count=MODES_LISTED)
     except Exception as exc:  # noqa: BLE001 - the report goes on without its modes
         return f'<p class="note">Natural modes not computed: {_e(exc)}</p>'
+    from ..modes import phased_stages, phasing_suppresses
+
     mesh_f = {n: mk.frequency for n, mk in res.kinematics.meshes.items()}
     typed = any(r.type for r in rep.rows)
+    # a mesh order that the planets' mesh phasing leaves unexcited for the mode's type
+    # (Parker & Lin 2004) is listed as suppressed, not as a possible resonance
+    stages = phased_stages(res.model, res.kinematics)
     rows = []
     for r in rep.rows:
         f = float(r.frequency)
-        near = [f"{k}×{name}" for name, fm in mesh_f.items() for k in (1, 2, 3)
+        near = [f"{k}×{name}" + (" (suppressed by phasing)" if phasing_suppresses(
+                    stages, name, k, r.type) else "")
+                for name, fm in mesh_f.items() for k in (1, 2, 3)
                 if abs(f - k * fm) <= NEAR_FRACTION * k * fm]
         energy = ", ".join(f"{n} {100 * v:.0f} %" for n, v in list(r.strain_energy.items())[:3])
         rows.append([str(r.mode), _g(f, 6), str(r.multiplicity)]
@@ -305,7 +311,11 @@ def _modes(res) -> str:
     return (_table(header, rows, left=1)
             + f'<p class="note">{rep.rigid_modes} rigid-body mode(s) left out. Mesh '
               "frequencies: " + _e(", ".join(f"{k} {v:.5g} Hz" for k, v in mesh_f.items()))
-            + ".</p>")
+            + "." + (" With equally spaced planets, mesh harmonic l excites the rotational "
+                     "modes only when l z_s / N is an integer, the translational modes only "
+                     "when (l z_s ± 1) / N is, the planet modes otherwise (Parker &amp; Lin "
+                     "2004); the other orders are marked suppressed." if stages else "")
+            + "</p>")
 
 
 def _static_section(quasi) -> str:

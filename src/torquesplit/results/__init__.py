@@ -452,6 +452,7 @@ class Results:
                      r.peak_force, r.min_force, r.dynamic_factor,
                      r.dynamic_factor_engineering, r.peak_to_nominal, r.load_sharing,
                      r.contact_loss, r.back_contact, r.back_flank_force] for r in met.rows]
+            rows = self._planet_columns(header, rows, met)
         else:
             header.append("status")
             group_of = {m: g for g, ms in self.groups.items() for m in ms}
@@ -476,6 +477,26 @@ class Results:
         with files.claim_output(plan) as claim:
             claim.write(contents)
         return path
+
+    def _planet_columns(self, header: list, rows: list, met) -> list:
+        """The CSV summary of a planetary model gets each mesh's stage K_gamma and its
+        planet's factor (empty for a mesh of no planet); other models are unchanged."""
+        from ..cli_support import planet_sharing
+
+        k = planet_sharing(met.load_sharing, self.kinematics)
+        if k is None:
+            return rows
+        header += [f"K_gamma_{k.definition}", f"planet_factor_{k.definition}"]
+        kin = self.kinematics
+        out = []
+        for row in rows:
+            mk = kin.meshes.get(row[0])
+            carrier = getattr(mk, "carrier", None)
+            planet = next((b for b in (mk.driver, mk.driven) if b in k.per_planet), None) \
+                if mk is not None else None
+            out.append(row + [k.per_stage.get(carrier, ""),
+                              k.per_planet.get(planet, "") if planet else ""])
+        return out
 
     def write_figures(self, directory, formats=("png", "svg"), **kwargs):
         """Write the report figures (see :func:`torquesplit.plot.write_figures`)."""

@@ -12,6 +12,49 @@ def _var(dims, data, units, long_name):
     return xr.Variable(dims, np.asarray(data), attrs={"units": units, "long_name": long_name})
 
 
+def add_planet_load_sharing(ds: xr.Dataset, load_sharing, kinematics) -> xr.Dataset:
+    """``ds`` with the planet load-sharing factor of a planetary model (nothing for other
+    models): ``planet_load_sharing`` over ``planet_entity`` (each carrier's K_gamma, then
+    each planet's factor), a quasi-static sweep's ``planet_peak_instantaneous_ratio``
+    beside it, and the ``--json`` entry as the attribute ``planet_load_sharing_json``."""
+    from ..cli_support import planet_sharing, planet_sharing_dict
+
+    k = planet_sharing(load_sharing, kinematics)
+    if k is None:
+        return ds
+    names = [*k.per_stage, *k.per_planet]
+    what = "K_gamma of each stage (carrier: largest planet load over the mean, AGMA 6123 / " \
+           "ISO 6336-1) and each planet's factor"
+    ds = ds.assign_coords(planet_entity=("planet_entity", names))
+    basis = " (loads averaged over the mesh positions)" if k.peak_per_stage else ""
+    ds["planet_load_sharing"] = _var(
+        ("planet_entity",), [{**k.per_stage, **k.per_planet}[n] for n in names], "1",
+        f"{what}, {k.definition}{basis}")
+    if k.peak_per_stage:
+        peak = {**k.peak_per_stage, **k.peak_per_planet}
+        ds["planet_peak_instantaneous_ratio"] = _var(
+            ("planet_entity",), [peak[n] for n in names], "1",
+            "largest instantaneous ratio over the mesh positions (Mo et al. 2017), not "
+            "K_gamma")
+    ds.attrs["planet_load_sharing_json"] = json.dumps(planet_sharing_dict(k), default=float)
+    return ds
+
+
+def _element_frames(res, names: list[str]) -> list[str]:
+    """Frame of each recorded element force (see the ``element_frame`` coordinate)."""
+    from ..model.kinematics import support_frame
+
+    out = []
+    for name in names:
+        body, sep, _ = name.partition(".support.")
+        if not sep:
+            out.append("")
+            continue
+        carrier, _, f_frame = support_frame(res.kinematics, body)
+        out.append(f"carrier {carrier} (turning)" if carrier and f_frame else "housing")
+    return out
+
+
 def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
     """Histories, per-cycle statistics, static and nominal forces, metrics (of
     ``definition``, default the model's), warnings, run info.
@@ -73,6 +116,11 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
             "dof": ("dof", list(st.dof_names)),
         },
     )
+    ds = ds.assign_coords(element_frame=("element", _element_frames(res, hist_names), {
+        "long_name": "frame of the element force: a support force of a body measured in "
+                     "a turning carrier's frame is in that frame (its shaft orders are "
+                     "speeds relative to the carrier); 'housing' the fixed frame; '' a "
+                     "mesh's normal force"}))
     if len(s.history_dofs):
         names = [st.dof_names[i] for i in s.history_dofs]
         ds = ds.assign_coords(history_dof=("history_dof", names))
@@ -99,6 +147,7 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
                                   "1: the mesh has no backlash (double-flank contact)")
         ds.attrs["load_sharing_definition"] = met.definition
         ds.attrs["metrics_json"] = json.dumps(met.to_dict(), default=float)
+        ds = add_planet_load_sharing(ds, met.load_sharing, res.kinematics)
     except Exception as exc:  # metrics of a diverged run may be undefined; keep the data
         ds.attrs["metrics_error"] = str(exc)
     notes = res.warnings(definition) if hasattr(res, "warnings") else []

@@ -167,13 +167,14 @@ def register(app, load, fail, console, err_console, json_default):
             elif not stability:
                 console.print("stability: not computed (--no-stability)")
             t = Table(title="meshes (periodic steady state)")
-            for col in ("mesh", "group", "static F [N]", "mean F [N]", "peak F [N]",
+            for col in ("mesh", "group", "static F [kN]", "mean F [kN]", "peak F [kN]",
                         "DF (peak/static)", "peak/nominal", "LSC", "RMS TE [µm]",
                         "contact loss"):
                 t.add_column(_h(col), justify="left" if col in ("mesh", "group") else "right")
             for r in rows:
-                t.add_row(r.mesh, r.group, f"{r.static_force:.6g}", f"{r.mean_force:.6g}",
-                          f"{r.peak_force:.6g}", f"{r.dynamic_factor:.5f}",
+                t.add_row(r.mesh, r.group, f"{r.static_force / 1e3:.6g}",
+                          f"{r.mean_force / 1e3:.6g}", f"{r.peak_force / 1e3:.6g}",
+                          f"{r.dynamic_factor:.5f}",
                           f"{r.peak_to_nominal:.5f}", f"{r.load_sharing:.5f}",
                           f"{1e6 * r.rms_transmission_error:.4g}",
                           f"{100 * r.contact_loss:.2f} %")
@@ -298,16 +299,29 @@ def campbell_command(m, start, stop, plot, as_json, console, json_default):
         from torquesplit.steady.plot import campbell_figure, save
 
         save(campbell_figure(ds), plot)
+    from torquesplit.steady.maps import split_suppressed
+
+    critical, suppressed = split_suppressed(crossings)
     if as_json:
-        _emit({"critical_speeds": crossings,
-               "natural_frequencies_Hz": ds["natural_frequency"].values[0].tolist()},
-              json_default)
+        out = {"critical_speeds": critical,
+               "natural_frequencies_Hz": ds["natural_frequency"].values[0].tolist()}
+        if suppressed:
+            out["suppressed_by_mesh_phasing"] = suppressed
+        _emit(out, json_default)
         return
-    t = Table(title=f"critical speeds between {start} and {stop}")
-    for col in ("speed [rpm]", "mode", "f [Hz]", "excitation", "strain energy (largest shares)"):
+    phased = any("suppressed" in c for c in crossings)
+    t = Table(title=f"critical speeds between {start} and {stop}" + (
+        f" ({len(critical)} critical; {len(suppressed)} crossings that the planets' mesh "
+        f"phasing leaves unexcited, Parker & Lin 2004, marked 'suppressed')" if phased
+        else ""))
+    cols = ["speed [rpm]", "mode", "f [Hz]", "excitation"]
+    cols += ["mode type", "phasing"] if phased else []
+    for col in cols + ["strain energy (largest shares)"]:
         t.add_column(_h(col))
     for c in crossings:
+        extra = ([c.get("mode_type") or "-", "suppressed" if c["suppressed"] else "excited"]
+                 if phased else [])
         t.add_row(f"{c['speed_rpm']:.6g}", str(c["mode"]), f"{c['frequency_Hz']:.6g}",
-                  f"{c['order']} x {c['source']}",
+                  f"{c['order']} x {c['source']}", *extra,
                   ", ".join(f"{n} {100 * v:.0f} %" for n, v in c["energy"]))
     console.print(t)

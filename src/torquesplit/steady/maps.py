@@ -166,6 +166,7 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
                 "mesh": mesh_names},
     )
     crit = critical_speeds(s, static.q, kin, model, min(s0, s1) * w_ref, max(s0, s1) * w_ref)
+    critical, suppressed = split_suppressed(crit["crossings"])
     ds.attrs.update(
         model=model.model.name,
         method=("shooting" if method == "shooting" else "harmonic balance")
@@ -179,9 +180,14 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
         kept_excitations="all" if keep is None else str(keep),
         dropped_excitations=[x.describe() for x in dropped],
         natural_frequencies_Hz=list(crit["natural_frequencies"]),
-        critical_speeds_rpm=[c["speed_rpm"] for c in crit["crossings"]],
+        critical_speeds_rpm=[c["speed_rpm"] for c in critical],
         critical_speed_labels=[f"mode {c['mode']} x {c['order']} {c['source']}"
-                               for c in crit["crossings"]],
+                               for c in critical],
+        **({"suppressed_speeds_rpm": [c["speed_rpm"] for c in suppressed],
+            "suppressed_speed_labels": [
+                f"mode {c['mode']} x {c['order']} {c['source']} ({c['mode_type']} mode: "
+                f"suppressed by mesh phasing, Parker & Lin 2004)" for c in suppressed]}
+           if suppressed else {}),
         loads="torques held at the model's values",
         wall_time_s=time.perf_counter() - t_start,
     )
@@ -211,6 +217,8 @@ def critical_speeds(structure, q, kin, model, w_lo, w_hi, orders=None):
     sol = modal_analysis(structure, q)
     w_ref = reference_speed(model)
     lines = _order_lines(kin, model, orders, structure)
+    phasing = _Phasing(model, kin)
+    types = phasing.types(structure, sol)
     out = []
     for i, fn in enumerate(sol.frequencies):
         if fn <= 0:
@@ -218,12 +226,51 @@ def critical_speeds(structure, q, kin, model, w_lo, w_hi, orders=None):
         for label, order, per_rad in lines:  # f = order * per_rad * w_input
             w = fn / (order * per_rad)
             if w_lo <= w <= w_hi:
-                out.append(dict(mode=i + 1, frequency_Hz=float(fn), order=order,
-                                source=label, speed_rpm=float(w * RPM),
-                                energy=sol.dominant_elements(i, 4)))
+                out.append(phasing.mark(dict(
+                    mode=i + 1, frequency_Hz=float(fn), order=order, source=label,
+                    speed_rpm=float(w * RPM), energy=sol.dominant_elements(i, 4)), types))
     out.sort(key=lambda c: c["speed_rpm"])
     return dict(natural_frequencies=sol.frequencies, crossings=out, modal=sol,
                 lines=lines, reference_speed=w_ref)
+
+
+class _Phasing:
+    """Marks the crossings that the planets' mesh phasing leaves unexcited (Parker & Lin
+    2004, :func:`torquesplit.modes.phased_stages`): ``suppressed`` True for a mode whose
+    type the stage's mesh harmonic does not excite, with the mode's ``mode_type``; a model
+    without such a stage gets neither key (its crossings are as before)."""
+
+    def __init__(self, model, kin):
+        from torquesplit.modes import phased_stages
+
+        self.stages = phased_stages(model, kin)
+
+    def types(self, structure, sol) -> dict[int, str | None]:
+        """1-based mode -> type (only for a model with a phased stage)."""
+        if not self.stages:
+            return {}
+        from torquesplit.modes import classify
+
+        return {r.mode: r.type for r in classify(structure, sol)}
+
+    def mark(self, crossing: dict, types: dict[int, str | None]) -> dict:
+        if not self.stages:
+            return crossing
+        from torquesplit.modes import phasing_suppresses
+
+        kind = types.get(crossing["mode"])
+        src = crossing["source"]
+        mesh = src[len("mesh "):] if src.startswith("mesh ") else None
+        crossing["mode_type"] = kind
+        crossing["suppressed"] = bool(mesh is not None and phasing_suppresses(
+            self.stages, mesh, crossing["order"], kind))
+        return crossing
+
+
+def split_suppressed(crossings: list[dict]) -> tuple[list[dict], list[dict]]:
+    """(critical, suppressed by mesh phasing) crossings."""
+    return ([c for c in crossings if not c.get("suppressed")],
+            [c for c in crossings if c.get("suppressed")])
 
 
 HARMONIC_SHARE = 0.05
@@ -315,6 +362,7 @@ def campbell(model, start: float, stop: float, *, points: int = 41,
     if s.n_gyroscopic:  # the frequencies move with speed: cross the curves themselves
         crit["crossings"] = _curve_crossings(model, static.q, speeds, F, lines, w_ref)
     crossings = [c for c in crit["crossings"] if count is None or c["mode"] <= count]
+    critical, suppressed = split_suppressed(crossings)
     ds = xr.Dataset(
         {"natural_frequency": (("speed", "mode"), F, {"units": "Hz"}),
          "excitation_frequency": (("speed", "line"), L, {"units": "Hz"})},
@@ -323,9 +371,16 @@ def campbell(model, start: float, stop: float, *, points: int = 41,
                 "mode": np.arange(1, F.shape[1] + 1),
                 "line": [f"{o} x {lab}" for lab, o, _ in lines]})
     ds.attrs["model"] = model.model.name
-    ds.attrs["critical_speeds_rpm"] = [c["speed_rpm"] for c in crossings]
-    ds.attrs["critical_speed_labels"] = [f"mode {c['mode']} ({c['frequency_Hz']:.5g} Hz) x "
-                                         f"{c['order']} {c['source']}" for c in crossings]
+    label = lambda c: (f"mode {c['mode']} ({c['frequency_Hz']:.5g} Hz) x "  # noqa: E731
+                       f"{c['order']} {c['source']}")
+    ds.attrs["critical_speeds_rpm"] = [c["speed_rpm"] for c in critical]
+    ds.attrs["critical_speed_labels"] = [label(c) for c in critical]
+    if suppressed:
+        # crossings that the planets' mesh phasing leaves unexcited (Parker & Lin 2004)
+        ds.attrs["suppressed_speeds_rpm"] = [c["speed_rpm"] for c in suppressed]
+        ds.attrs["suppressed_speed_labels"] = [
+            f"{label(c)} ({c['mode_type']} mode: suppressed by mesh phasing)"
+            for c in suppressed]
     return ds, crossings
 
 
@@ -337,6 +392,9 @@ def _curve_crossings(model, q, speeds, F, lines, w_ref):
     model's-speed frequencies would be off by the frequencies' change)."""
     from torquesplit.solve.modal import modal_analysis
 
+    from torquesplit.model.kinematics import solve_kinematics
+
+    phasing = _Phasing(model, solve_kinematics(model))
     out = []
     for label, order, per_rad in lines:
         g = F - (order * per_rad * speeds)[:, None]
@@ -344,10 +402,12 @@ def _curve_crossings(model, q, speeds, F, lines, w_ref):
             for i in np.flatnonzero(np.sign(g[:-1, m]) * np.sign(g[1:, m]) < 0):
                 th = g[i, m] / (g[i, m] - g[i + 1, m])
                 w = speeds[i] + th * (speeds[i + 1] - speeds[i])
-                sol = modal_analysis(_structure_at(model, w / w_ref), q)
-                out.append(dict(mode=m + 1, frequency_Hz=float(sol.frequencies[m]),
-                                order=order, source=label, speed_rpm=float(w * RPM),
-                                energy=sol.dominant_elements(m, 4)))
+                st = _structure_at(model, w / w_ref)
+                sol = modal_analysis(st, q)
+                out.append(phasing.mark(dict(
+                    mode=m + 1, frequency_Hz=float(sol.frequencies[m]), order=order,
+                    source=label, speed_rpm=float(w * RPM),
+                    energy=sol.dominant_elements(m, 4)), phasing.types(st, sol)))
     out.sort(key=lambda c: c["speed_rpm"])
     return out
 

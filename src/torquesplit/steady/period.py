@@ -93,8 +93,16 @@ class Period:
             return "no time-varying excitation (any period; the steady state is static)"
         top = max(range(len(self.sources)), key=lambda i: self.orders[i])
         slow = min(range(len(self.sources)), key=lambda i: self.orders[i])
-        return (f"least common period {self.period / speed:.6g} s (f0 = "
-                f"{self.frequency * speed:.6g} Hz): {self.orders[top]} cycles of the "
+        head = (f"least common period {self.period / speed:.6g} s (f0 = "
+                f"{self.frequency * speed:.6g} Hz): ")
+        cycles = lambda k: f"{k} cycle{'s' if k != 1 else ''}"  # noqa: E731
+        if self.orders[top] == self.orders[slow]:  # one frequency: name one source
+            more = len(self.sources) - 1
+            return (head + f"{cycles(self.orders[top])} of the "
+                    f"{self.sources[top].describe(speed)}"
+                    + (f" and of {more} more excitation{'s' if more != 1 else ''} at that "
+                       f"frequency" if more else ""))
+        return (head + f"{cycles(self.orders[top])} of the "
                 f"{self.sources[top].describe(speed)}, {self.orders[slow]} of the "
                 f"{self.sources[slow].describe(speed)}")
 

@@ -107,8 +107,13 @@ def campbell_figure(ds):
             if len(members) > 1 and inside.size:  # the order at the line's last point
                 ax.annotate(f"{order}x", (rpm[inside[-1]], fe[inside[-1]]), fontsize=5,
                             color=colour, xytext=(0, 2), textcoords="offset points")
-    for c in ds.attrs.get("critical_speeds_rpm", []):
-        ax.axvline(c, color="r", lw=0.5, alpha=0.5)
+    for i, c in enumerate(ds.attrs.get("critical_speeds_rpm", [])):
+        ax.axvline(c, color="r", lw=0.5, alpha=0.5,
+                   label="critical speed" if i == 0 else None)
+    # crossings that the planets' mesh phasing leaves unexcited (Parker & Lin 2004)
+    for i, c in enumerate(ds.attrs.get("suppressed_speeds_rpm", [])):
+        ax.axvline(c, color="0.6", lw=0.5, ls=":",
+                   label="suppressed by mesh phasing (Parker & Lin 2004)" if i == 0 else None)
     ax.set_ylim(0, fmax * 1.05)
     ax.set_xlabel("input speed [rpm]")
     ax.set_ylabel("frequency [Hz]")

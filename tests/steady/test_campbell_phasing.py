@@ -1,0 +1,136 @@
+"""Crossings that the planets' mesh phasing leaves unexcited (Parker & Lin 2004) are
+marked suppressed in the resonance map, its table and the report, not counted as critical;
+models without an equally spaced stage are unchanged."""
+
+from __future__ import annotations
+
+import copy
+import json
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+import torquesplit
+from torquesplit import example_path, load_model
+from torquesplit.cli import app
+from torquesplit.model.kinematics import solve_kinematics
+from torquesplit.modes import PhasedStage, phased_stages, phasing_suppresses
+from torquesplit.steady.maps import campbell
+
+RPM = np.pi / 30
+
+
+@pytest.mark.parametrize("zs, n, order, excited", [
+    # z_s = 24, N = 3: every harmonic has l z_s / N whole -> rotational modes only
+    (24, 3, 1, {"rotational"}), (24, 3, 2, {"rotational"}),
+    # z_s = 25, N = 3: l = 1 -> (25 - 1)/3 whole: translational; l = 3 -> 75/3: rotational
+    (25, 3, 1, {"translational"}), (25, 3, 3, {"rotational"}),
+    # Lin & Parker's example, z_s = 42, N = 4: l = 1 -> 42/4, 41/4, 43/4: planet modes
+    (42, 4, 1, {"planet"}), (42, 4, 2, {"rotational"}),
+    # z_s = 21, N = 5: l = 1 -> 20/5 whole: translational; l = 2 -> 42/5, 41/5 no, 43/5 no
+    (21, 5, 1, {"translational"}), (21, 5, 2, {"planet"}),
+])
+def test_the_rule_of_parker_and_lin_2004(zs, n, order, excited):
+    st = PhasedStage(carrier="c", planets=n, sun_teeth=zs, meshes=frozenset({"m"}))
+    got = {t for t in ("rotational", "translational", "planet") if st.excites(order, t)}
+    assert got == excited
+    assert st.excites(order, "mixed") and st.excites(order, None)
+    assert phasing_suppresses([st], "m", order, "planet") == ("planet" not in excited)
+    assert not phasing_suppresses([st], "other mesh", order, "planet")
+
+
+def _lp(**stage):
+    raw = torquesplit.model.io.read_file(example_path("lin_parker1999_planetary"))
+    raw = copy.deepcopy(raw)
+    raw["planetary"][0].update(stage)
+    return load_model(raw)
+
+
+def _stages(model):
+    return phased_stages(model, solve_kinematics(model))
+
+
+def test_only_equally_spaced_identical_planets_with_equal_loads_are_phased():
+    (st,) = _stages(load_model(example_path("lin_parker1999_planetary")))
+    assert (st.planets, st.sun_teeth, len(st.meshes)) == (4, 42, 8)
+    assert _stages(_lp(pin_errors=[{"tangential": "10 um"}, {}, {}, {}])) == []
+    assert len(_stages(_lp(angles=["0 deg", "90 deg", "180 deg", "270 deg"]))) == 1
+    # fits (multiples of 360 deg / (z_s + z_r) = 2 deg) but not equally spaced
+    assert _stages(_lp(angles=["0 deg", "82 deg", "180 deg", "270 deg"])) == []
+    # no central member translates: the translational pairs are labelled planet
+    raw = copy.deepcopy(torquesplit.model.io.read_file(example_path("lin_parker1999_planetary")))
+    for member in ("sun", "ring", "carrier"):
+        raw["planetary"][0][member]["dofs"] = ["theta"]
+        raw["planetary"][0][member].pop("support", None)
+    assert _stages(load_model(raw)) == []
+
+
+@pytest.fixture(scope="module")
+def lp_map():
+    model = load_model(example_path("lin_parker1999_planetary"))
+    return campbell(model, 500 * RPM, 3000 * RPM, points=21)
+
+
+def test_campbell_marks_suppressed_crossings_and_does_not_count_them(lp_map):
+    ds, crossings = lp_map
+    mesh = [c for c in crossings if c["source"].startswith("mesh ")]
+    assert mesh and all("suppressed" in c and "mode_type" in c for c in crossings)
+    st = _stages(load_model(example_path("lin_parker1999_planetary")))
+    for c in mesh:
+        assert c["suppressed"] == phasing_suppresses(st, c["source"][5:], c["order"],
+                                                     c["mode_type"])
+    suppressed = [c for c in crossings if c["suppressed"]]
+    excited = [c for c in crossings if not c["suppressed"]]
+    assert suppressed and excited
+    assert {c["mode_type"] for c in suppressed} <= {"rotational", "translational", "planet"}
+    assert ds.attrs["critical_speeds_rpm"] == [c["speed_rpm"] for c in excited]
+    assert ds.attrs["suppressed_speeds_rpm"] == [c["speed_rpm"] for c in suppressed]
+    assert not [c for c in crossings if not c["source"].startswith("mesh ")
+                and c["suppressed"]]  # shaft orders are never suppressed
+
+
+def test_a_model_without_planets_is_unchanged():
+    model = load_model(example_path("ji_li_mill_drive"))
+    ds, crossings = campbell(model, 200 * RPM, 1500 * RPM, points=5)
+    assert crossings and not [c for c in crossings if "suppressed" in c]
+    assert "suppressed_speeds_rpm" not in ds.attrs
+    assert len(ds.attrs["critical_speeds_rpm"]) == len(crossings)
+
+
+def test_the_campbell_table_and_json_say_which_are_suppressed():
+    runner = CliRunner()
+    args = ["modes", str(example_path("lin_parker1999_planetary")), "--campbell",
+            "--from", "500 rpm", "--to", "3000 rpm"]
+    res = runner.invoke(app, args + ["--json"])
+    assert res.exit_code == 0, res.output
+    data = json.loads(res.stdout)
+    assert data["suppressed_by_mesh_phasing"]
+    assert not [c for c in data["critical_speeds"] if c["suppressed"]]
+    res = runner.invoke(app, args)
+    assert res.exit_code == 0, res.output
+    assert "phasing" in res.stdout and "suppressed" in res.stdout
+    assert "Parker & Lin 2004" in res.stdout
+
+
+def test_the_report_mode_table_marks_suppressed_orders():
+    from types import SimpleNamespace
+
+    from torquesplit.report.html import _modes
+
+    model = load_model(example_path("lin_parker1999_planetary"))
+    html = _modes(SimpleNamespace(model=model, kinematics=solve_kinematics(model)))
+    assert "Parker &amp; Lin 2004" in html
+    assert "(suppressed by phasing)" in html, html
+    model = load_model(example_path("ji_li_mill_drive"))
+    html = _modes(SimpleNamespace(model=model, kinematics=solve_kinematics(model)))
+    assert "suppressed" not in html and "Parker" not in html
+
+
+def test_the_campbell_figure_draws_suppressed_crossings_apart(lp_map):
+    from torquesplit.steady.plot import campbell_figure
+
+    fig = campbell_figure(lp_map[0])
+    labels = fig.axes[0].get_legend_handles_labels()[1]
+    assert "suppressed by mesh phasing (Parker & Lin 2004)" in labels
+    assert "critical speed" in labels
