@@ -330,7 +330,7 @@ class _Job:
         current = [vals.get(n, math.nan) for n in names]
         settled = res.metrics("cycle_peak").settling.settled
         if (self.previous is not None and settled
-                and _close(self.previous, current, self.settle["tolerance"])):
+                and _close(self.previous, current, self.settle["tolerance"], names)):
             self._finish(res, vals)
             return
         if self.length >= self.full:
