@@ -375,6 +375,17 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
         w("return 0")
     w()
 
+    def start_fraction():
+        # th: where the cycle start tb falls between the last instant ta and t, clipped to
+        # [0, 1] (_kernels.mean_sample and ratio_starts)
+        w("th = 1.0")
+        with w.block("if span > 0.0:"):
+            w("th = (tb - ta) / span")
+            with w.block("if th < 0.0:"):
+                w("th = 0.0")
+            with w.block("if th > 1.0:"):
+                w("th = 1.0")
+
     def record_body(full: bool):
         # the time integral of each cycle (_kernels.mean_sample): the interval from the
         # last instant, split where a cycle begins; part A into the last instant's cycle
@@ -406,13 +417,7 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
                     with w.block(f"if cb == WI[{WI_SC + 2 * j}] + 1:"):
                         w(f"tb = (cb + {par(('base', j))} - {par(('ph', el))}) / "
                           f"{par(('f', el))}")
-                        w("th = 1.0")
-                        with w.block("if span > 0.0:"):  # clipped to [0, 1]
-                            w("th = (tb - ta) / span")
-                            with w.block("if th < 0.0:"):
-                                w("th = 0.0")
-                            with w.block("if th > 1.0:"):
-                                w("th = 1.0")
+                        start_fraction()
                         w("total = 0.0")
                         for i in grp:
                             w(f"total += positive_part(X[{X_PF + i}] + th * "
@@ -449,13 +454,7 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
                 with w.block(f"if cy{j} == WI[{WI_SC + 2 * j}] + 1:"):
                     w(f"tb = (cy{j} + {par(('base', j))} - {par(('ph', el))}) / "
                       f"{par(('f', el))}")
-                    w("th = 1.0")
-                    with w.block("if span > 0.0:"):  # clipped to [0, 1]
-                        w("th = (tb - ta) / span")
-                        with w.block("if th < 0.0:"):
-                            w("th = 0.0")
-                        with w.block("if th > 1.0:"):
-                            w("th = 1.0")
+                    start_fraction()
                     w("fb = fa + th * (fe - fa)")
                     if smooth_start:
                         w("bnd = True")
