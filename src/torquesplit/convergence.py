@@ -52,8 +52,9 @@ def has_jumps(structure) -> bool:
 
 
 def check_model(results):
-    """The model of ``results`` as the check runs it, and its table points before and in
-    the check: TABLE_REFINEMENT times as many where the tables have jumps."""
+    """The model of ``results`` (a run, or a steady state) as the check runs it, and its
+    table points before and in the check: TABLE_REFINEMENT times as many where the tables
+    have jumps."""
     model = results.model
     n = int(model.analysis.table_points)
     if not has_jumps(results.structure):
@@ -170,23 +171,26 @@ def check_steady(st, *, progress=None) -> StepCheck:
     """The periodic steady state ``st`` (:func:`torquesplit.steady.steady_state`) again
     with twice its resolution, every number of its mesh table compared: shooting at half
     the RK4 step it took (from its own periodic state, so the finer solve needs few
-    maps), harmonic balance with twice the harmonics.  ``step`` / ``halved_step`` are the
-    RK4 steps [s], or the harmonics for harmonic balance."""
+    maps), harmonic balance with twice the harmonics; with TABLE_REFINEMENT times the
+    table points where the tables have jumps (:func:`check_model`).  ``step`` /
+    ``halved_step`` are the RK4 steps [s], or the harmonics for harmonic balance."""
     from .steady.api import steady_state
 
     ps = st.solution
     same = dict(st.options, stability=False, check=False, progress=progress)
+    model, n, n_check = check_model(st)
     if ps.method == "shooting":
         steps = ps.t.size * ps.sample_every  # the samples are every k-th step
         order = max(st.period.max_order, 1)
-        fine = steady_state(st.model, method="shooting",
+        fine = steady_state(model, method="shooting",
                             steps_per_cycle=math.ceil(2 * steps / order),
                             initial=np.concatenate([ps.q[0], ps.v[0]]), **same)
         fine_steps = fine.solution.t.size * fine.solution.sample_every
         step, halved = ps.period / steps, fine.solution.period / fine_steps
     else:
-        fine = steady_state(st.model, method="hb", harmonics=2 * ps.harmonics, adaptive=False,
+        fine = steady_state(model, method="hb", harmonics=2 * ps.harmonics, adaptive=False,
                             **same)
         step, halved = float(ps.harmonics), float(fine.solution.harmonics)
     return StepCheck(values=_steady_values(st), halved=_steady_values(fine), method=ps.method,
-                     step=float(step), halved_step=float(halved))
+                     step=float(step), halved_step=float(halved), table_points=n,
+                     check_table_points=n_check)

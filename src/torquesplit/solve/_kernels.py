@@ -797,9 +797,9 @@ def bad_state(iy, blowup, w):
     Twin: ``np.flatnonzero(~np.isfinite(y) | (abs(q) > blowup))[:1]``."""
     y = w.Y
     n = y.shape[1] // 2
-    # fast path without a branch per entry: a conjunction of comparisons (false for NaN),
-    # which LLVM may reorder and vectorise; a sum or a max of floating-point values would
-    # be a chain of dependent instructions (measured: 32 ns of a 255 ns Ji & Li step)
+    # fast path without a branch per entry: a conjunction of comparisons (false for NaN);
+    # the sum of x - x it replaces is a chain of dependent additions (28 states, in
+    # isolation: 14.4 ns before, 11.9 ns now)
     ok = True
     for i in range(n):
         ok &= abs(y[iy, i]) <= blowup
