@@ -19,8 +19,11 @@ from ..errors import ModelError, clip_text
 def set_parameter(data: dict, path: str, value: Any) -> dict:
     """Return a copy of ``data`` with the field at dotted ``path`` set to ``value``.
 
-    The parent table must exist; the field itself may be new (it is then checked by the
-    schema like any other field).  List items are addressed by index (``axis.2``).
+    The field itself may be new (it is then checked by the schema like any other field),
+    and so may a table on the path that the schema knows but the file does not write
+    (``analysis`` of ``analysis.table_points``, ``errors`` of
+    ``planetary.0.sun.errors.eccentricity``): it is created.  List items are addressed by
+    index (``axis.2``).
     Only the tables and lists on the path are copied; the rest is shared with ``data``
     (neither is ever changed in place: a study sets a dozen parameters of a large model
     per case, and copying the whole model for each cost milliseconds).
@@ -29,8 +32,8 @@ def set_parameter(data: dict, path: str, value: Any) -> dict:
     out = _copy_node(data)
     node = out
     for i, key in enumerate(parts[:-1]):
-        if isinstance(node, dict) and key not in node:
-            _missing_table(parts, i, value)
+        if isinstance(node, dict) and key not in node and _schema_table(parts, i):
+            node[key] = {}  # a table the schema knows, absent from the file: created
         child = _copy_node(_child(node, key, ".".join(parts[: i + 1]), path))
         node[_index(key, node, path) if isinstance(node, list) else key] = child
         node = child
@@ -182,33 +185,12 @@ def read_raw(source) -> dict:
     return read_file(Path(source))
 
 
-def _missing_table(parts: list[str], i: int, value) -> None:
-    """A table on the path that the file does not have but the schema knows
-    (``planetary.0.sun.errors`` of ``planetary.0.sun.errors.eccentricity``): refused with
-    the inline-table form that sets it (``--set 'planetary.0.sun.errors={eccentricity =
-    "20 um"}'``).  A path the schema does not know returns to :func:`_child`'s message."""
+def _schema_table(parts: list[str], i: int) -> bool:
+    """Whether ``parts[i]`` is a field the schema knows at ``parts[:i]`` (a path the
+    schema does not know gets :func:`_child`'s message, listing what exists)."""
     from .io import _fields_at
 
-    if parts[i] not in _fields_at(parts[:i], lists=True):
-        return
-    head, rest = ".".join(parts[: i + 1]), ".".join(parts[i + 1:])
-    form = f"{head}={{{rest} = {_toml_value(value)}}}"
-    raise ModelError([(".".join(parts), (
-        f"{head!r} is a field that this file does not write; set it as a table: "
-        f"--set '{form}'"))])
-
-
-def _toml_value(value) -> str:
-    """``value`` as TOML source (for a --set hint)."""
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, str):
-        return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
-    if isinstance(value, (list, tuple)):
-        return "[" + ", ".join(_toml_value(v) for v in value) + "]"
-    if isinstance(value, dict):
-        return "{" + ", ".join(f"{k} = {_toml_value(v)}" for k, v in value.items()) + "}"
-    return repr(value)
+    return parts[i] in _fields_at(parts[:i], lists=True)
 
 
 def _child(node, key, where, path):
