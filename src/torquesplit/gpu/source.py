@@ -375,9 +375,11 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
         w("return 0")
     w()
 
-    def start_fraction():
-        # th: where the cycle start tb falls between the last instant ta and t, clipped to
-        # [0, 1] (_kernels.mean_sample and ratio_starts)
+    def start_fraction(cycle: str, j: int, el: int):
+        # tb: the start of cycle `cycle` of tracked element j (element el); th: where it
+        # falls between the last instant ta and t, clipped to [0, 1]
+        # (_kernels.start_fraction)
+        w(f"tb = ({cycle} + {par(('base', j))} - {par(('ph', el))}) / {par(('f', el))}")
         w("th = 1.0")
         with w.block("if span > 0.0:"):
             w("th = (tb - ta) / span")
@@ -415,9 +417,7 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
                 with w.block("if entered:"):
                     w(f"cb = WI[bi + {tv_pos[el]}] - {par(('base', j))}")
                     with w.block(f"if cb == WI[{WI_SC + 2 * j}] + 1:"):
-                        w(f"tb = (cb + {par(('base', j))} - {par(('ph', el))}) / "
-                          f"{par(('f', el))}")
-                        start_fraction()
+                        start_fraction("cb", j, el)
                         w("total = 0.0")
                         for i in grp:
                             w(f"total += positive_part(X[{X_PF + i}] + th * "
@@ -452,9 +452,7 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
             with w.block("if entered:"):
                 w(f"fa = X[{X_PF + j}]")
                 with w.block(f"if cy{j} == WI[{WI_SC + 2 * j}] + 1:"):
-                    w(f"tb = (cy{j} + {par(('base', j))} - {par(('ph', el))}) / "
-                      f"{par(('f', el))}")
-                    start_fraction()
+                    start_fraction(f"cy{j}", j, el)
                     w("fb = fa + th * (fe - fa)")
                     if smooth_start:
                         w("bnd = True")

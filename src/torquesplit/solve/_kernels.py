@@ -348,6 +348,28 @@ def evaluate(t, m, w, rhs_fn, gen):
 
 # ================================================================== recording
 @_inline
+def start_fraction(c, base, phase, frequency, ta, span):
+    """Where the start of cycle c (statistics index + ``base``) of an element of
+    ``frequency`` and ``phase`` falls in the interval from ``ta`` of length ``span``: the
+    fraction in [0, 1] (1 for an interval of no length)."""
+    tb = (c + base - phase) / frequency
+    return min(max((tb - ta) / span, 0.0), 1.0) if span > 0.0 else 1.0
+
+
+@_inline
+def enter_both(v, cp, c, j, mx, mn):
+    """``v`` (a value at a cycle start) into column j's max ``mx`` and min ``mn`` of both
+    cycles it divides, ``cp`` and ``c`` (those within the arrays' rows)."""
+    cap = mx.shape[0]
+    for cb in (cp, c):
+        if cb >= 0 and cb < cap:
+            if v > mx[cb, j]:
+                mx[cb, j] = v
+            if v < mn[cb, j]:
+                mn[cb, j] = v
+
+
+@_inline
 def mean_sample(t, slot, i_f, m, w, r):
     """Enter the forces (row ``i_f``) at time ``t`` in the cycles' time integrals: the
     trapezoid rule over the interval from the last instant entered, split where a cycle
@@ -379,8 +401,7 @@ def mean_sample(t, slot, i_f, m, w, r):
             cp = prev_c[j]
             fa = prev_f[j]
             if c == cp + 1:  # the interval holds the start of cycle c: split it there
-                tb = (c + track_base[j] - m.phase[el]) / m.frequency[el]
-                th = min(max((tb - ta) / span, 0.0), 1.0) if span > 0.0 else 1.0
+                th = start_fraction(c, track_base[j], m.phase[el], m.frequency[el], ta, span)
                 fb = fa + th * (fe - fa)
                 da = th * span
                 db = span - da
@@ -391,12 +412,7 @@ def mean_sample(t, slot, i_f, m, w, r):
                     cyc_sum[c, j] += 0.5 * db * (fb + fe)
                     cyc_wt[c, j] += db
                 if trk_cont[j] != 0:  # (on an instant too: fb is that force)
-                    for cb in (cp, c):
-                        if cb >= 0 and cb < cap:
-                            if fb > cyc_max[cb, j]:
-                                cyc_max[cb, j] = fb
-                            if fb < cyc_min[cb, j]:
-                                cyc_min[cb, j] = fb
+                    enter_both(fb, cp, c, j, cyc_max, cyc_min)
             else:  # one cycle (or, past a skipped cycle, half to each end's cycle)
                 half = 0.5 * span
                 if cp >= 0 and cp < cap:
@@ -424,7 +440,6 @@ def ratio_starts(t, slot, i_f, m, w, r):
     track_el, track_base, trk_cont = r.track_el, r.track_base, r.trk_cont
     grp_ptr, grp_col, grp_min = r.grp_ptr, r.grp_col, r.grp_min
     rat_max, rat_min, prev_f, prev_c = r.rat_max, r.rat_min, r.prev_f, r.prev_c
-    cap = rat_max.shape[0]
     ta = r.prev_t[0]
     span = t - ta
     if not (span >= 0.0):  # NaN before the first instant: no interval yet
@@ -437,8 +452,7 @@ def ratio_starts(t, slot, i_f, m, w, r):
             cp = prev_c[j]
             if c != cp + 1 or trk_cont[j] == 0:
                 continue
-            tb = (c + track_base[j] - m.phase[el]) / m.frequency[el]
-            th = min(max((tb - ta) / span, 0.0), 1.0) if span > 0.0 else 1.0
+            th = start_fraction(c, track_base[j], m.phase[el], m.frequency[el], ta, span)
             total = 0.0  # (of the loads the teeth carry, as ratio_sample)
             for kk in range(grp_ptr[g], grp_ptr[g + 1]):
                 i = grp_col[kk]
@@ -448,12 +462,7 @@ def ratio_starts(t, slot, i_f, m, w, r):
                 fa = prev_f[j]
                 fb = laws.positive_part(fa + th * (force[i_f, el] - fa))[0]
                 ratio = (grp_ptr[g + 1] - grp_ptr[g]) * fb / total
-                for cb in (cp, c):
-                    if cb >= 0 and cb < cap:
-                        if ratio > rat_max[cb, j]:
-                            rat_max[cb, j] = ratio
-                        if ratio < rat_min[cb, j]:
-                            rat_min[cb, j] = ratio
+                enter_both(ratio, cp, c, j, rat_max, rat_min)
 
 
 @_inline
