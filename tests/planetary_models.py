@@ -128,3 +128,42 @@ def small_ltca_raw(**modifications) -> dict:
     for member, spec in modifications.items():
         data["planetary"][0][member]["modifications"] = copy.deepcopy(spec)
     return data
+
+
+def three_planet_toml(name: str, *, teeth=(24, 30, 84), face_width: str = "40 mm",
+                      floating_sun: bool = True, mesh: str = '"5e8 N/m"',
+                      damping_ratio: float | None = 0.05,
+                      carrier: str = 'polar_inertia = "0.5 kg m^2"', extra: str = "") -> str:
+    """A small 3-planet ``[[planetary]]`` stage named ``st`` (module 3 mm, ring held, sun
+    driven at 1500 rpm / 100 kW, carrier loaded) as model-file text: ``teeth`` of sun,
+    planet and ring; a sun floating on 1e8 N/m bearings or turning only; ``mesh`` the
+    TOML of both meshes' stiffness; ``extra`` more lines of the stage table."""
+    sun = f"teeth = {teeth[0]}"
+    if floating_sun:
+        sun += ', dofs = ["theta", "x", "y"], support = {stiffness = "1e8 N/m"}'
+    damp = "" if damping_ratio is None else f", damping_ratio = {damping_ratio}"
+    return f"""
+[model]
+name = "{name}"
+
+[[planetary]]
+name = "st"
+planets = 3
+module = "3 mm"
+{extra}face_width = "{face_width}"
+sun = {{{sun}}}
+planet = {{teeth = {teeth[1]}}}
+ring = {{teeth = {teeth[2]}, torsional_support = {{rigid = true}}}}
+carrier = {{{carrier}}}
+planet_bearing = {{stiffness = "5e8 N/m"}}
+sun_mesh = {{stiffness = {mesh}{damp}}}
+ring_mesh = {{stiffness = {mesh}{damp}}}
+
+[drives.motor]
+body = "st_sun"
+speed = "1500 rpm"
+power = "100 kW"
+
+[loads.out]
+body = "st_carrier"
+"""

@@ -11,38 +11,16 @@ import warnings
 import pytest
 from typer.testing import CliRunner
 
+from planetary_models import three_planet_toml
 import torquesplit
 from torquesplit.cli import app
 from torquesplit.errors import ModelError
 
 runner = CliRunner()
 
-STAGE = """
-[model]
-name = "pol"
-
-[[planetary]]
-name = "st"
-planets = 3
-module = "3 mm"
-face_width = "40 mm"
-sun = {teeth = 24, dofs = ["theta", "x", "y"], support = {stiffness = "1e8 N/m"}}
-planet = {teeth = 30}
-ring = {teeth = 84, torsional_support = {rigid = true}}
-carrier = {polar_inertia = "0.5 kg m^2"}
-planet_bearing = {stiffness = "5e8 N/m"}
-pin_errors = [{tangential = "10 um"}, {}, {}]
-sun_mesh = {stiffness = {method = "iso6336"}, damping_ratio = 0.05}
-ring_mesh = {stiffness = {method = "iso6336"}, damping_ratio = 0.05}
-
-[drives.motor]
-body = "st_sun"
-speed = "1500 rpm"
-power = "100 kW"
-
-[loads.out]
-body = "st_carrier"
-"""
+STAGE = three_planet_toml(
+    "pol", mesh='{method = "iso6336"}',
+    extra='pin_errors = [{tangential = "10 um"}, {}, {}]\n')
 
 
 @pytest.fixture(scope="module")

@@ -11,39 +11,16 @@ import warnings
 
 import pytest
 
+from planetary_models import three_planet_toml
 import torquesplit
 from torquesplit.errors import ModelError, ModelWarning
 from torquesplit.model.kinematics import solve_kinematics
 
 #: the reviewer's helical 3-planet stage (24/30/84, m_n 3 mm, 15 deg, 50 mm wide)
-P3 = tomllib.loads("""
-[model]
-name = "p3"
-
-[[planetary]]
-name = "st"
-planets = 3
-module = "3 mm"
-pressure_angle = "20 deg"
-helix_angle = "15 deg"
-hand = "right"
-face_width = "50 mm"
-sun = {teeth = 24, dofs = ["theta", "x", "y"], support = {stiffness = "1e8 N/m"}}
-planet = {teeth = 30}
-ring = {teeth = 84, torsional_support = {rigid = true}}
-carrier = {polar_inertia = "0.5 kg m^2", mass = "20 kg"}
-planet_bearing = {stiffness = "5e8 N/m"}
-sun_mesh = {stiffness = "5e8 N/m"}
-ring_mesh = {stiffness = "5e8 N/m"}
-
-[drives.motor]
-body = "st_sun"
-speed = "1500 rpm"
-power = "100 kW"
-
-[loads.out]
-body = "st_carrier"
-""")
+P3 = tomllib.loads(three_planet_toml(
+    "p3", face_width="50 mm", carrier='polar_inertia = "0.5 kg m^2", mass = "20 kg"',
+    damping_ratio=None,
+    extra='pressure_angle = "20 deg"\nhelix_angle = "15 deg"\nhand = "right"\n'))
 
 
 def _raw(**stage):

@@ -8,35 +8,12 @@ import warnings
 
 import pytest
 
+from planetary_models import three_planet_toml
 import torquesplit
 from torquesplit.model.kinematics import solve_kinematics, support_frame
 from torquesplit.results.dataset import results_to_dataset
 
-STAGE = """
-[model]
-name = "frames"
-
-[[planetary]]
-name = "st"
-planets = 3
-module = "3 mm"
-face_width = "40 mm"
-sun = {teeth = 24, dofs = ["theta", "x", "y"], support = {stiffness = "1e8 N/m"}}
-planet = {teeth = 30}
-ring = {teeth = 84, torsional_support = {rigid = true}}
-carrier = {polar_inertia = "0.5 kg m^2"}
-planet_bearing = {stiffness = "5e8 N/m"}
-sun_mesh = {stiffness = "5e8 N/m", damping_ratio = 0.05}
-ring_mesh = {stiffness = "5e8 N/m", damping_ratio = 0.05}
-
-[drives.motor]
-body = "st_sun"
-speed = "1500 rpm"
-power = "100 kW"
-
-[loads.out]
-body = "st_carrier"
-"""
+STAGE = three_planet_toml("frames")
 
 
 @pytest.fixture(scope="module")

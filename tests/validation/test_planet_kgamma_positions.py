@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
+from planetary_models import three_planet_toml
 import torquesplit
 from torquesplit.cli import app
 from torquesplit.metrics.planetary import planet_load_sharing
@@ -19,31 +20,8 @@ from torquesplit.quasistatic import quasi_static_load_sharing
 
 #: three sequentially phased planets (z_s = 25: the sun meshes are a third of a cycle
 #: apart), no errors: equal mean planet loads
-SEQ = """
-[model]
-name = "p3seq"
-
-[[planetary]]
-name = "st"
-planets = 3
-module = "3 mm"
-face_width = "50 mm"
-sun = {teeth = 25}
-planet = {teeth = 29}
-ring = {teeth = 83, torsional_support = {rigid = true}}
-carrier = {polar_inertia = "0.5 kg m^2"}
-planet_bearing = {stiffness = "5e8 N/m"}
-sun_mesh = {stiffness = {method = "iso6336"}}
-ring_mesh = {stiffness = {method = "iso6336"}}
-
-[drives.motor]
-body = "st_sun"
-speed = "1500 rpm"
-power = "100 kW"
-
-[loads.out]
-body = "st_carrier"
-"""
+SEQ = three_planet_toml("p3seq", teeth=(25, 29, 83), face_width="50 mm", floating_sun=False,
+                       mesh='{method = "iso6336"}', damping_ratio=None)
 
 
 def _sweep(**stage):
