@@ -216,7 +216,8 @@ that it is the gearbox you meant before running it.
 
 $ torquesplit run three_branch.toml
 
-The run starts from the static equilibrium, integrates 200 cycles of the slowest mesh and
+The run starts from the static equilibrium at t = 0 (stiffness and errors as they are at
+the start), integrates 200 cycles of the slowest mesh and
 leaves out the start-up transient before computing anything.
 
 ## 5. Read the table
