@@ -192,3 +192,91 @@ def test_every_example_has_no_overlap(name):
         warnings.simplefilter("ignore", ModelWarning)
         model = torquesplit.load_model(torquesplit.example_path(name), check=False)
     assert overlap_issues(model, solve_kinematics(model)) == []
+
+
+RIM = """
+[model]
+name = "ring and a gear beside it"
+
+[gears.ring]
+teeth = 80
+module = "2 mm"
+kind = "internal"
+face_width = "20 mm"
+position = ["0 mm", "0 mm", "0 mm"]
+RIM_FIELD
+[gears.p]
+teeth = 20
+module = "2 mm"
+face_width = "20 mm"
+place = {from_gear = "ring", angle = "0 deg"}
+[gears.r2]
+teeth = 60
+module = "2 mm"
+face_width = "20 mm"
+position = ["0 mm", "0 mm", "30 mm"]
+[gears.x]
+teeth = 48
+module = "2 mm"
+face_width = "20 mm"
+position = ["108 mm", "0 mm", "30 mm"]
+[gears.x2]
+teeth = 20
+module = "2 mm"
+face_width = "20 mm"
+position = ["108 mm", "0 mm", "0 mm"]
+[shafts.input]
+connects = ["x2", "x"]
+rigid = true
+[shafts.ring_shaft]
+connects = ["r2", "ring"]
+rigid = true
+[meshes.m1]
+gears = ["x", "r2"]
+stiffness = "4e8 N/m"
+[meshes.m2]
+gears = ["ring", "p"]
+stiffness = "4e8 N/m"
+[drives.motor]
+body = "x2"
+speed = "3000 rpm"
+torque = "100 N m"
+[loads.out]
+body = "p"
+"""
+
+
+def _rim_model(field: str):
+    data = tomllib.loads(RIM.replace("RIM_FIELD", field))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", ModelWarning)
+        torquesplit.load_model(data)
+    return [str(w.message) for w in caught if issubclass(w.category, ModelWarning)]
+
+
+def test_a_gear_in_the_given_rim_of_a_ring_is_refused():
+    """x2 (tip radius 22 mm, 108 mm from the ring's axis, in its plane) clears the ring's
+    teeth (root radius 82.5 mm) but not a 5 mm rim (outer radius 87.5 mm)."""
+    for field in ('rim_thickness = "5 mm"', 'outer_diameter = "175 mm"'):
+        with pytest.raises(ModelError) as err:
+            _rim_model(field)
+        (loc, msg), = err.value.issues
+        assert loc == "gears.x2"
+        assert msg.startswith("gears ring and x2 overlap: x2 (tip radius 22 mm, centre 108 mm "
+                              "from ring's) reaches into the teeth or rim of internal gear "
+                              "ring (tip radius 78 mm, outer radius of its rim 87.5 mm)")
+
+
+def test_a_gear_in_the_assumed_rim_of_a_ring_is_warned_of():
+    """Without a rim in the file the ring's rim is assumed 3.5 m_n = 7 mm (outer radius
+    89.5 mm, as its computed mass): a warning naming both fields, no refusal."""
+    msgs = [m for m in _rim_model("") if "rim" in m]
+    assert len(msgs) == 1 and msgs[0].startswith(
+        "gears.x2: x2 (tip radius 22 mm, centre 108 mm from ring's) reaches into the rim of "
+        "internal gear ring as assumed (outer radius 89.5 mm, 3.5 normal modules outside its "
+        "root circle); give gears.ring.rim_thickness or outer_diameter")
+
+
+def test_a_gear_outside_a_thin_rim_passes():
+    assert not [m for m in _rim_model('rim_thickness = "2 mm"') if "overlap" in m or
+                "rim" in m]

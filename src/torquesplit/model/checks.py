@@ -31,6 +31,8 @@ kinematics                      loops that cannot turn, power that does not bala
                                 integrates: assembly and the static equilibrium
 ==============================  ========================================================
 
+:func:`rim_overlap_warnings` warns of a gear in the rim an internal gear is assumed to
+have (no ``rim_thickness`` or ``outer_diameter`` in the file).
 :func:`plausibility_warnings` flag magnitudes that are possible but usually a wrong
 unit: lengths against the size of the gears, inertias and masses against the gear's
 geometry, stiffness against ISO 6336, speeds and tooth loads against what gears carry;
@@ -93,7 +95,8 @@ def check_model(model: Model, source: str | None = None, *, deep: bool = False) 
         issues, notes = _readiness(model, kin)
     if issues:
         raise ModelError(as_written(model, issues), source)
-    for loc, msg in as_written(model, plausibility_warnings(model, kin) + notes):
+    warned = plausibility_warnings(model, kin) + rim_overlap_warnings(model, kin) + notes
+    for loc, msg in as_written(model, warned):
         warnings.warn(f"{source + ': ' if source else ''}{loc}: {msg}", ModelWarning, stacklevel=3)
 
 
@@ -464,18 +467,51 @@ OVERLAP_TOLERANCE = 1e-6
 
 
 def overlap_issues(model: Model, kin) -> list[tuple[str, str]]:
-    """Gears that do not mesh with each other but whose teeth would occupy the same
-    space: parallel axes, face widths that overlap along the axis, and tooth regions
-    that intersect in the plane (a placement angle or a position typed wrong).
+    """Gears that do not mesh with each other but whose bodies would occupy the same
+    space: parallel axes, face widths that overlap along the axis, and regions that
+    intersect in the plane (a placement angle or a position typed wrong).
 
-    An external gear's region is its tip disc; an internal gear's the annulus between
-    its tip and root circles (its rim beyond is not modelled), so that a planet inside
-    its ring is fine, while a gear reaching past a ring's tip circle into its teeth is
-    not.  Meshing pairs (their centre distance is the mesh's), gears on one shaft line
-    (shafts and splines; ``shaft_axis_issues`` checks those) and bevel and face gears
-    are left out, and so are gears whose plane the file does not state (see
+    An external gear's region is its tip disc; an internal gear's the annulus from its
+    tip circle to the outside of its rim where the file gives the rim (``outer_diameter``
+    or ``rim_thickness``), else to its root circle (:func:`rim_overlap_warnings` warns
+    of a gear in the rim assumed then), so that a planet inside its ring is fine, while
+    a gear reaching past a ring's tip circle into its teeth or rim is not.  Meshing
+    pairs (their centre distance is the mesh's), gears on one shaft line (shafts and
+    splines; ``shaft_axis_issues`` checks those) and bevel and face gears are left out,
+    and so are gears whose plane the file does not state (see
     :func:`_axially_located`).  Positions are those at t = 0."""
-    from .kinematics import gear_geometry
+    return [_overlap_issue(model, a, b, d)
+            for a, b, d in _overlapping_pairs(model, kin, assumed_rims=False)]
+
+
+def rim_overlap_warnings(model: Model, kin) -> list[tuple[str, str]]:
+    """Gears that reach into the rim an internal gear is assumed to have (the default
+    :data:`~torquesplit.model.kinematics.RIM_THICKNESS_MODULES` normal modules outside its
+    root circle, as its computed mass), but not into its teeth: a warning, not a
+    refusal, since the file does not say how thick the rim is."""
+    from .kinematics import RIM_THICKNESS_MODULES
+
+    refused = {(a[0], b[0]) for a, b, _ in _overlapping_pairs(model, kin, assumed_rims=False)}
+    out = []
+    for a, b, d in _overlapping_pairs(model, kin, assumed_rims=True):
+        if (a[0], b[0]) in refused:
+            continue
+        (ring, _, outer), (other, _, tip) = (a, b) if a[1] > 0 else (b, a)
+        out.append((f"gears.{other}", (
+            f"{other} (tip radius {tip * 1e3:.4g} mm, centre {d * 1e3:.4g} mm from {ring}'s) "
+            f"reaches into the rim of internal gear {ring} as assumed (outer radius "
+            f"{outer * 1e3:.4g} mm, {RIM_THICKNESS_MODULES:g} normal modules outside its "
+            f"root circle); give gears.{ring}.rim_thickness or outer_diameter, or check "
+            f"gears.{other}.place / position")))
+    return out
+
+
+def _overlapping_pairs(model: Model, kin, *, assumed_rims: bool):
+    """((name, inner, outer), (name, inner, outer), centre distance) of every pair of
+    gears of :func:`overlap_issues` whose regions intersect; an internal gear's region
+    reaches to the outside of its rim where the file gives it, or with ``assumed_rims``
+    where it is assumed too, else to its root circle."""
+    from .kinematics import gear_geometry, internal_rim
 
     mates = {frozenset(m.gears) for m in model.meshes.values()}
     line = _shaft_lines(model)
@@ -488,12 +524,16 @@ def overlap_issues(model: Model, kin) -> list[tuple[str, str]]:
             geo = gear_geometry(g)
         except (ModelError, ValueError, ArithmeticError):  # pragma: no cover - checked before
             continue
-        inner, outer = ((geo.tip_radius, geo.root_radius) if g.gear_type == "internal"
-                        else (0.0, geo.tip_radius))
+        if g.gear_type == "internal":
+            r_f, r_o, _ = internal_rim(g)
+            assumed = g.outer_diameter is None and g.rim_thickness is None
+            inner, outer = geo.tip_radius, (r_o if assumed_rims or not assumed else r_f)
+        else:
+            inner, outer = 0.0, geo.tip_radius
         body = kin.bodies[name]
         gears.append((name, np.asarray(body.position, float), np.asarray(body.axis, float),
                       geo.total_face_width, inner, outer))
-    issues = []
+    pairs = []
     for i, (a, pa, ua, wa, ia, oa) in enumerate(gears):
         for b, pb, ub, wb, ib, ob in gears[i + 1:]:
             if frozenset((a, b)) in mates or line.get(a, a) == line.get(b, b):
@@ -510,8 +550,8 @@ def overlap_issues(model: Model, kin) -> list[tuple[str, str]]:
             # two annuli [inner, outer] about centres d apart share a point iff:
             if not (d < oa + ob - tol and ib < oa + d - tol and ia < ob + d - tol):
                 continue
-            issues.append(_overlap_issue(model, (a, ia, oa), (b, ib, ob), d))
-    return issues
+            pairs.append(((a, ia, oa), (b, ib, ob), d))
+    return pairs
 
 
 def _overlap_issue(model: Model, first, second, d: float) -> tuple[str, str]:
@@ -528,12 +568,16 @@ def _overlap_issue(model: Model, first, second, d: float) -> tuple[str, str]:
     if len(ring) == 1:
         r = ring[0]
         ra, rf, tip = (ia, oa, ob) if r == a else (ib, ob, oa)
+        given = model.gears[r].outer_diameter is not None or model.gears[r].rim_thickness \
+            is not None
+        part, rim = ("teeth or rim", "outer radius of its rim") if given else ("teeth",
+                                                                             "root radius")
         return (f"gears.{move}", (
             f"gears {a} and {b} overlap: {move} (tip radius {tip * 1e3:.4g} mm, centre "
-            f"{d * 1e3:.4g} mm from {r}'s) reaches into the teeth of internal gear {r} "
-            f"(tip radius {ra * 1e3:.4g} mm, root radius {rf * 1e3:.4g} mm) {plane}; {fix}"))
+            f"{d * 1e3:.4g} mm from {r}'s) reaches into the {part} of internal gear {r} "
+            f"(tip radius {ra * 1e3:.4g} mm, {rim} {rf * 1e3:.4g} mm) {plane}; {fix}"))
     return (f"gears.{move}", (
-        f"gears {a} and {b} overlap: the teeth of these internal gears (radii "
+        f"gears {a} and {b} overlap: these internal gears (radii "
         f"{ia * 1e3:.4g}-{oa * 1e3:.4g} mm and {ib * 1e3:.4g}-{ob * 1e3:.4g} mm, centres "
         f"{d * 1e3:.4g} mm apart) intersect {plane}; {fix}"))
 
