@@ -30,7 +30,16 @@ REMOVALS = {
     "right-hand side (4 calls)": [("        rhs_fn(a[A_Y] + row * np.uint64(iy)", None)],
     "excitation (t + h/2, t + h)": [("    excite(t_mid, s_half, src_half, m, w)\n", ""),
                                     ("    excite(t_end, sb, src_end, m, w)\n", "")],
-    "statistics (record)": [("        record(a, F_MAIN, h, m, w, r, counters)\n", "")],
+    "statistics (record)": [("        record(t, a, F_MAIN, 0.0 if last else h, m, w, r, counters)\n",
+                             "")],
+    "  of it: parabola vertices (peak_sample)": [
+        ("    peak_sample(t, r.pk_x[0], slot, i_f, w, r)  #", "    pass  #")],
+    "  of it: ratio at cycle starts (ratio_starts)": [
+        ("    ratio_starts(t, slot, i_f, m, w, r)  #", "    pass  #")],
+    "  of it: cycle means (mean_sample)": [("    mean_sample(t, slot, i_f, m, w, r)\n    ratio_sample",
+                                            "    ratio_sample")],
+    "  of it: instantaneous ratio (ratio_sample)": [
+        ("    ratio_sample(slot, i_f, w, r)\n    for j in range(watch_el", "    for j in range(watch_el")],
     "divergence check": [("        bad = bad_state(Y_STATE, blowup, w)\n", "        bad = -1\n")],
 }
 
@@ -45,7 +54,7 @@ mod = importlib.util.module_from_spec(spec); spec.loader.exec_module(mod)
 I = sys.modules["torquesplit.solve.integrate"]
 I.kern = mod
 from torquesplit.solve import static_equilibrium
-s = ts.assemble(ts.load_model(ts.example_path("ji_li_mill_drive")))
+s = ts.assemble(ts.load_model(ts.example_path({example!r})))
 y0 = static_equilibrium(s).y0
 f = float(s.frequency[s.frequency > 0].max())
 h = 1.0 / (400 * f)
@@ -75,30 +84,32 @@ def _patched(source: str, removals) -> str | None:
     return source
 
 
-def _time(source: str, steps: int, repeat: int) -> dict:
+def _time(source: str, steps: int, repeat: int, example: str) -> dict:
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / "_kernels_part.py"
         path.write_text(source.replace("cache=True, ", ""), encoding="utf-8")
-        code = _RUN.format(src=str(ROOT / "src"), path=str(path), steps=steps, repeat=repeat)
+        code = _RUN.format(src=str(ROOT / "src"), path=str(path), steps=steps, repeat=repeat,
+                           example=example)
         out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                              timeout=900, check=True).stdout
     return json.loads(out.strip().splitlines()[-1])
 
 
-def breakdown(steps: int = 200_000, repeat: int = 3) -> dict:
+def breakdown(steps: int = 200_000, repeat: int = 3, example: str = "ji_li_mill_drive") -> dict:
     """Marginal ns per step of each part (see the module docstring) and of the whole."""
     source = KERNELS.read_text(encoding="utf-8")
-    base = _time(source, steps, repeat)
+    base = _time(source, steps, repeat, example)
     parts, skipped = {}, {}
     for name, removals in REMOVALS.items():
         patched = _patched(source, removals)
         if patched is None:
             skipped[name] = "its text is no longer in _kernels.py"
             continue
-        without = _time(patched, steps, repeat)["ns_per_step"]
+        without = _time(patched, steps, repeat, example)["ns_per_step"]
         cost = base["ns_per_step"] - without
         parts[name] = {"ns_per_step": cost, "share": cost / base["ns_per_step"]}
-    rest = base["ns_per_step"] - sum(p["ns_per_step"] for p in parts.values())
+    rest = base["ns_per_step"] - sum(p["ns_per_step"] for k, p in parts.items()
+                                     if not k.startswith("  of it"))
     parts["rest (RK4 vectors, loop, bookkeeping)"] = {
         "ns_per_step": rest, "share": rest / base["ns_per_step"]}
     return {"step_ns": base["ns_per_step"], "n_dof": base["n_dof"],
@@ -106,7 +117,8 @@ def breakdown(steps: int = 200_000, repeat: int = 3) -> dict:
 
 
 if __name__ == "__main__":
-    res = breakdown()
-    print(f"Ji & Li drive, {res['step_ns']:.0f} ns per RK4 step:")
+    name = sys.argv[1] if len(sys.argv) > 1 else "ji_li_mill_drive"
+    res = breakdown(example=name)
+    print(f"{name}, {res['step_ns']:.0f} ns per RK4 step:")
     for k, v in res["parts"].items():
         print(f"  {k:40s} {v['ns_per_step']:7.1f} ns  {100 * v['share']:5.1f} %")

@@ -28,16 +28,20 @@ more than the arithmetic.  What it computes, for one excitation slot::
     f_e     = spring_force(K_e, c_e, delta_e, rate_e, G_e) + P_e     (the law)
     dy      = [v, M^-1 (F_ext - C_g v - sum_e V_e f_e - G v - K_f q)]  (CSR order of
               V^T, of G, of K_f)
+    splines: (f_x, f_y) = spline_force(delta_x, delta_y, rate_x, rate_y, par) on the
+              two component elements of each, then dy -= M^-1 V_e f_e of both
+    friction: dy -= M^-1 W_e(s) max(f_e, 0) of each friction mesh
+              (both as ``rhs_extra`` does them after ``rhs_slot``)
 
-The code depends only on the sparsity of V and G and on which elements have a dead zone; the
-values (coefficients, damping, masses, forces) are read from a parameter vector at fixed
-offsets.  Compiled code is therefore kept per pattern and reused by every model with the
+The code depends only on the sparsity of V and G, on which elements have a dead zone and
+which are spline components; the values (coefficients, damping, masses, forces) are read
+from a parameter vector at fixed offsets.  Compiled code is therefore kept per pattern and reused by every model with the
 same pattern (a parameter sweep compiles once).
 
 Calling convention (C)::
 
     void rhs(uint64 y, uint64 dy, uint64 force, uint64 defl, uint64 K, uint64 G,
-             uint64 E, uint64 ED, uint64 P, uint64 par, int64 off)
+             uint64 E, uint64 ED, uint64 P, uint64 par, uint64 FR, int64 off)
 
 Every argument but ``off`` is the address of a float64 array's data (``Work.addr``:
 taken once per run; a state row's address is base + row x stride).  K, G, E, ED, P are the kernels' whole
@@ -57,9 +61,10 @@ from . import laws
 
 __all__ = ["GeneratedRhs", "generated_rhs", "general_rhs", "rhs_ir", "worth_generating"]
 
-ARG_NAMES = ("y", "dy", "force", "defl", "K", "G", "E", "ED", "P", "par")
+ARG_NAMES = ("y", "dy", "force", "defl", "K", "G", "E", "ED", "P", "par", "FR")
 SLOT_ARGS = ("K", "G", "E", "ED", "P")
-"""Excitation arrays (n_slot, ne), passed whole: the function reads row ``off / ne``."""
+"""Excitation arrays (n_slot, ne), passed whole: the function reads row ``off / ne``.  The
+friction table values FR (n_slot, 3 n_friction) are read in row ``off / ne`` too."""
 
 
 @dataclass(frozen=True)
@@ -84,29 +89,30 @@ def _arrays(model) -> dict:
     return model._asdict()
 
 
-_LAW = None
+_LAWS: dict = {}
 
 
-def _law_ir() -> tuple[str, str]:
-    """LLVM IR of the compiled element law and the name of its function (numba calling
-    convention: ``i32 (ptr retptr, ptr excinfo, double k, c, d, r, g)``, the force
-    stored at retptr)."""
-    global _LAW
-    if _LAW is None:
-        cf = laws.spring_force_c()
+def _law_ir(kind: str = "spring") -> tuple[str, str]:
+    """LLVM IR of a compiled element law and the name of its function (numba calling
+    convention: ``i32 (ptr retptr, ptr excinfo, <the law's arguments>)``): ``"spring"``
+    :func:`~torquesplit.solve.laws.spring_force_c` (double k, c, d, r, g; the force
+    stored at retptr), ``"spline"`` :func:`~torquesplit.solve.laws.spline_force_c`
+    (ten doubles and the address the two force components are written to)."""
+    if kind not in _LAWS:
+        cf = laws.spring_force_c() if kind == "spring" else laws.spline_force_c()
         name = cf.native_name
         ir = cf.inspect_llvm()
         inner = name[len("cfunc."):]
         if not name.startswith("cfunc.") or f"@{inner}(" not in ir:
             raise RuntimeError(f"the compiled law {name!r} has no LLVM function to link")
-        _LAW = (ir, inner)
-    return _LAW
+        _LAWS[kind] = (ir, inner)
+    return _LAWS[kind]
 
 
 def rhs_ir(model) -> tuple[str, list[tuple[str, int]]]:
     """LLVM IR of the right-hand side of a kernel model ``model``
     (:class:`~torquesplit.solve.kernel_data.KernelModel`) and the parameter layout: entry
-    i of ``par`` is ``model.<name>[index]`` for the i-th ``(name, index)``.  The IR calls
+    i of ``par`` is ``model.<name>`` (flattened) ``[index]`` for the i-th ``(name, index)``.  The IR calls
     the element law by name (:func:`_law_ir`); :func:`_Compiler.compile` links it in."""
     a = _arrays(model)
     n = a["inv_mass"].shape[0]
@@ -117,7 +123,13 @@ def rhs_ir(model) -> tuple[str, list[tuple[str, int]]]:
     fs_ptr, fs_idx = a["fs_ptr"].astype(np.int64), a["fs_idx"].astype(np.int64)
     gap_ptr, gap_values = a["gap_ptr"], a["gap_values"]
     has_error, has_force = _error_and_force_flags(a)
+    sp_el = np.asarray(a["sp_el"], dtype=np.int64).reshape(-1, 2)
+    fr_el, fr_ptr = a["fr_el"].astype(np.int64), a["fr_ptr"].astype(np.int64)
+    fr_dof, fr_row = a["fr_dof"].astype(np.int64), a["fr_row"].astype(np.int64)
+    n_fr_rows = int(a["friction_table"].shape[0])
+    spline_part = set(sp_el.ravel().tolist())
     _, law = _law_ir()
+    spline_law = _law_ir("spline")[1] if sp_el.shape[0] else None
     layout: list[tuple[str, int]] = []
     body: list[str] = []
     count = 0
@@ -134,6 +146,14 @@ def rhs_ir(model) -> tuple[str, list[tuple[str, int]]]:
             body.append(f"  {k} = add i64 %off, {i}")
             i = k
         body.append(f"  {p} = getelementptr inbounds double, ptr %{ptr}, i64 {i}")
+        body.append(f"  {v} = load double, ptr {p}, align 8")
+        return v
+
+    def load_friction(row: int) -> str:
+        """Entry ``row`` of the friction values of this slot (row off / ne of FR)."""
+        k, p, v = new(), new(), new()
+        body.append(f"  {k} = add i64 %off_fr, {row}")
+        body.append(f"  {p} = getelementptr inbounds double, ptr %FR, i64 {k}")
         body.append(f"  {v} = load double, ptr {p}, align 8")
         return v
 
@@ -171,6 +191,9 @@ def rhs_ir(model) -> tuple[str, list[tuple[str, int]]]:
             r = pr if r is None else op("fadd", r, pr)
         if d is None:  # an element without projection entries
             d, r = "0.0", "0.0"
+        if e in spline_part:  # zero stiffness and damping here: its law is the spline's
+            store("defl", e, d)
+            continue
         k = load("K", e)
         c = param("damping", e)
         # the law (laws.spring_force) on this element: its own compiled code, inlined
@@ -185,22 +208,76 @@ def rhs_ir(model) -> tuple[str, list[tuple[str, int]]]:
         store("force", e, f)
         store("defl", e, d)
         force[e] = f
+    acc_out = {}
     for i in range(n):
         v = load("y", n + i)
         acc = op("fsub", param("external_force", i), op("fmul", param("ground_damping", i), v))
         for j in range(vt_ptr[i], vt_ptr[i + 1]):
+            if int(vt_el[j]) in spline_part:  # (its force is added below)
+                continue
             acc = op("fsub", acc, op("fmul", param("vt_coef", j), force[int(vt_el[j])]))
         for j in range(gy_ptr[i], gy_ptr[i + 1]):
             acc = op("fsub", acc, op("fmul", param("gy_coef", j), load("y", gy_idx[j])))
         for j in range(fs_ptr[i], fs_ptr[i + 1]):
             acc = op("fsub", acc, op("fmul", param("fs_coef", j), load("y", fs_idx[j])))
         store("dy", i, v)
-        store("dy", n + i, op("fmul", param("inv_mass", i), acc))
+        acc_out[i] = op("fmul", param("inv_mass", i), acc)
+    # splines, as rhs_extra does them after rhs_slot (same sums in the same order): the
+    # radial law (laws.spline_force, its own compiled code) on the relative displacement
+    # of the two component elements, their forces scattered through V
+    for j in range(sp_el.shape[0]):
+        comp = []
+        for e in sp_el[j]:
+            dd, rr = "0.0", "0.0"
+            for i in range(vr_ptr[e], vr_ptr[e + 1]):
+                c = param("v_coef", i)
+                dd = op("fadd", dd, op("fmul", c, load("y", vq_idx[i])))
+                rr = op("fadd", rr, op("fmul", c, load("y", n + vq_idx[i])))
+            comp.append((dd, rr))
+        (dx, rx), (dyy, ry) = comp
+        pars = ", ".join(f"double {param('sp_par', 6 * j + q)}" for q in range(6))
+        st = new()
+        body.append(f"  {st} = call i32 @{spline_law}(ptr %ret, ptr %exc, double {dx}, "
+                    f"double {dyy}, double {rx}, double {ry}, {pars}, ptr %pair) #0")
+        fx, fy = new(), new()
+        body.append(f"  {fx} = load double, ptr %pair, align 8")
+        p1 = new()
+        body.append(f"  {p1} = getelementptr inbounds double, ptr %pair, i64 1")
+        body.append(f"  {fy} = load double, ptr {p1}, align 8")
+        for e, dd, fe in ((sp_el[j, 0], dx, fx), (sp_el[j, 1], dyy, fy)):
+            store("defl", e, dd)
+            store("force", e, fe)
+        for e, fe in ((sp_el[j, 0], fx), (sp_el[j, 1], fy)):
+            for i in range(vr_ptr[e], vr_ptr[e + 1]):
+                q = int(vq_idx[i])
+                scaled = op("fmul", param("inv_mass", q), op("fmul", param("v_coef", i), fe))
+                acc_out[q] = op("fsub", acc_out[q], scaled)
+    # tooth friction, as rhs_extra does it after the splines: -M^-1 W_e(s) max(f_e, 0)
+    # on the working flank only (laws.positive_part; here max(f_e, 0) by a select, and
+    # the product with 0 subtracted where the flank is unloaded: the same value)
+    if fr_el.shape[0]:
+        sl, off_fr = new(), "%off_fr"
+        body.append(f"  {sl} = udiv i64 %off, {max(ne, 1)}")
+        body.append(f"  {off_fr} = mul i64 {sl}, {n_fr_rows}")
+    for j in range(fr_el.shape[0]):
+        f = force[int(fr_el[j])]
+        pos, fp = new(), new()
+        body.append(f"  {pos} = fcmp ogt double {f}, 0.0")
+        body.append(f"  {fp} = select i1 {pos}, double {f}, double 0.0")
+        for i in range(fr_ptr[j], fr_ptr[j + 1]):
+            q = int(fr_dof[i])
+            w_i = op("fmul", op("fmul", param("fr_coef", i), load_friction(int(fr_row[i]))), fp)
+            acc_out[q] = op("fsub", acc_out[q], op("fmul", param("inv_mass", q), w_i))
+    for i in range(n):
+        store("dy", n + i, acc_out[i])
     args = ", ".join(f"ptr noalias nocapture %{x}" for x in ARG_NAMES) + ", i64 %off"
     ir = (f"define internal void @rhs_body({args}) nounwind alwaysinline {{\nentry:\n"
           "  %ret = alloca double, align 8\n  %exc = alloca ptr, align 8\n"
+          "  %pair = alloca [2 x double], align 8\n"
           + "\n".join(body) + "\n  ret void\n}\n\n"
           + f"declare i32 @{law}(ptr, ptr, double, double, double, double, double)\n\n"
+          + (f"declare i32 @{spline_law}(ptr, ptr, {', '.join(['double'] * 10)}, ptr)\n\n"
+             if spline_law else "")
           + _entry_point() + "\nattributes #0 = { alwaysinline }\n")
     return ir, layout
 
@@ -231,7 +308,8 @@ def _error_and_force_flags(a: dict):
 
 def _pattern_key(model) -> str:
     """What the generated code depends on: sparsity of V, V^T and G, which elements have
-    a dead zone, an error, an additive force."""
+    a dead zone, an error, an additive force, which are spline components, which meshes
+    have tooth friction on which DOFs."""
     a = _arrays(model)
     gp, gv = a["gap_ptr"], a["gap_values"]
     gapped = np.array([np.any(gv[gp[e]:gp[e + 1]] > 0.0) for e in range(gp.shape[0] - 1)])
@@ -239,7 +317,9 @@ def _pattern_key(model) -> str:
     h = hashlib.sha256()
     for x in (np.int64(a["inv_mass"].shape[0]), a["vr_ptr"], a["vq_idx"], a["vt_ptr"],
               a["vt_el"], a["gy_ptr"], a["gy_idx"], a["fs_ptr"], a["fs_idx"], gapped,
-              has_error, has_force):
+              has_error, has_force, np.asarray(a["sp_el"], dtype=np.int64), a["fr_el"],
+              a["fr_ptr"], a["fr_dof"], a["fr_row"],
+              np.int64(a["friction_table"].shape[0])):
         arr = np.ascontiguousarray(x)
         h.update(str((arr.dtype, arr.shape)).encode())
         h.update(arr.tobytes())
@@ -288,12 +368,14 @@ class _Compiler:
         from numba.core.compiler_lock import global_compiler_lock
 
         ir = ir.replace("@rhs(", f"@{name}(").replace("@rhs_body(", f"@{name}_body(")
-        law_ir, _ = _law_ir()
+        law_irs = [_law_ir()[0]] + ([_law_ir("spline")[0]] if f"@{_law_ir('spline')[1]}("
+                                                              in ir else [])
         with global_compiler_lock:
             llvm = self._setup()
             mod = llvm.parse_assembly(ir)
             own = {f.name for f in mod.functions if not f.is_declaration}
-            mod.link_in(llvm.parse_assembly(law_ir))
+            for law_ir in law_irs:
+                mod.link_in(llvm.parse_assembly(law_ir))
             for sym in list(mod.functions) + list(mod.global_variables):
                 # the law's symbols are private to this module (each pattern links its
                 # own copy into the one engine): only the entry point is exported
@@ -386,7 +468,7 @@ def general_rhs() -> GeneratedRhs:
     return _GENERAL
 
 
-def _noop(y, dy, force, defl, K, G, E, ED, P, par, off):  # noqa: N803 - kernel names
+def _noop(y, dy, force, defl, K, G, E, ED, P, par, FR, off):  # noqa: N803 - kernel names
     """Body of the general placeholder (never called: the kernels test ``gen`` first)."""
     return
 
@@ -418,5 +500,5 @@ def generated_rhs(model) -> GeneratedRhs:
     before in this process."""
     (address, layout, lines), seconds = _COMPILER.get(model)
     a = _arrays(model)
-    par = np.array([a[name][i] for name, i in layout], dtype=np.float64)
+    par = np.array([np.ravel(a[name])[i] for name, i in layout], dtype=np.float64)
     return GeneratedRhs(_function(address), par, seconds, lines)

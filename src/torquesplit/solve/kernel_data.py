@@ -139,7 +139,7 @@ them costs nothing measurable (measured: the metrics of the shipped examples mov
 less than 1e-6 between 0.05 and 1e-3) while treating them as corners would double the
 steps of the Liu et al. 2021 model."""
 # indices of Work.addr
-A_Y, A_F, A_D, A_K, A_G, A_E, A_ED, A_P, A_PAR = range(9)
+A_Y, A_F, A_D, A_K, A_G, A_E, A_ED, A_P, A_PAR, A_FR = range(10)
 
 
 def _check(s: Structure) -> None:
@@ -331,10 +331,10 @@ def make_work(m: KernelModel, rhs_parameters: np.ndarray | None = None) -> Work:
         FR=np.zeros((N_SLOT, m.friction_table.shape[0])),
         gap_cyc=np.full(ne, -(2**62), dtype=np.int64), gap_val=np.zeros(ne),
         has_force=has_force, watch_el=watch, rot=np.zeros((2, n_sin)),
-        addr=np.zeros(9, dtype=np.uint64), par=par, next_node=np.zeros(ne, dtype=np.int64),
+        addr=np.zeros(10, dtype=np.uint64), par=par, next_node=np.zeros(ne, dtype=np.int64),
     )
     for i, arr in ((A_Y, w.Y), (A_F, w.F), (A_D, w.D), (A_K, w.K), (A_G, w.G), (A_E, w.E),
-                   (A_ED, w.ED), (A_P, w.P), (A_PAR, par)):
+                   (A_ED, w.ED), (A_P, w.P), (A_PAR, par), (A_FR, w.FR)):
         w.addr[i] = arr.ctypes.data
     return w
 

@@ -4,7 +4,8 @@ Each law is a small scalar function compiled by numba with ``inline="always"``: 
 compiled kernels inline it where they use it, and every other consumer calls the very
 same function — the integrators (:mod:`torquesplit.solve._kernels`), the straight-line
 right-hand side generated for a model (:mod:`torquesplit.solve.codegen` links the law's
-own compiled code, see :func:`spring_force_c`), static and quasi-static Newton
+own compiled code, see :func:`spring_force_c` and :func:`spline_force_c`), static and
+quasi-static Newton
 (:mod:`torquesplit.solve.static`), the modal linearisation
 (:mod:`torquesplit.solve.modal`) and the numpy twin of the tests
 (:mod:`torquesplit.solve.reference`).  Python callers use the batch evaluators at the
@@ -283,3 +284,26 @@ def spring_force_c():
 
 def _spring_force_scalar(k, c, d, r, g):
     return spring_force(k, c, d, r, g)[0]
+
+
+_SPLINE_FORCE_C = None
+
+
+def spline_force_c():
+    """:func:`spline_force` compiled by numba with a C signature ``void(double dx, dy,
+    rx, ry, k, c, S1, S2, F_m, v, double *out)`` (out[0], out[1] = f_x, f_y), linked into
+    the generated right-hand side of a model with splines as :func:`spring_force_c` is
+    (compiled on first use)."""
+    global _SPLINE_FORCE_C
+    if _SPLINE_FORCE_C is None:
+        sig = types.void(*([types.float64] * 10), types.CPointer(types.float64))
+        _SPLINE_FORCE_C = cfunc(sig, error_model="numpy")(_spline_force_scalar)
+    return _SPLINE_FORCE_C
+
+
+def _spline_force_scalar(dx, dy, rx, ry, k, c, stick_limit, clearance, friction_force,
+                         velocity, out):
+    fx, fy = spline_force(dx, dy, rx, ry, k, c, stick_limit, clearance, friction_force,
+                          velocity)
+    out[0] = fx
+    out[1] = fy
