@@ -36,10 +36,11 @@ REMOVALS = {
         ("    peak_sample(t, r.pk_x[0], slot, i_f, w, r)  #", "    pass  #")],
     "  of it: ratio at cycle starts (ratio_starts)": [
         ("    ratio_starts(t, slot, i_f, m, w, r)  #", "    pass  #")],
-    "  of it: cycle means (mean_sample)": [("    mean_sample(t, slot, i_f, m, w, r)\n    ratio_sample",
-                                            "    ratio_sample")],
+    "  of it: cycle means (mean_sample)": [
+        ("    mean_sample(t, slot, i_f, m, w, r)\n    ratio_sample", "    ratio_sample")],
     "  of it: instantaneous ratio (ratio_sample)": [
-        ("    ratio_sample(slot, i_f, w, r)\n    for j in range(watch_el", "    for j in range(watch_el")],
+        ("    ratio_sample(slot, i_f, w, r)\n    for j in range(watch_el",
+         "    for j in range(watch_el")],
     "divergence check": [("        bad = bad_state(Y_STATE, blowup, w)\n", "        bad = -1\n")],
 }
 

@@ -15,7 +15,8 @@ from torquesplit.solve.static import static_equilibrium
 
 from ..model_texts import SPUR_PAIR, write_model
 
-ECCENTRIC = SPUR_PAIR.replace('position = ["0 mm", "0 mm", "0 mm"]', '''position = ["0 mm", "0 mm", "0 mm"]
+_AT = 'position = ["0 mm", "0 mm", "0 mm"]'
+ECCENTRIC = SPUR_PAIR.replace(_AT, _AT + '''
 
 [gears.pinion.errors]
 eccentricity = "20 um"

@@ -33,10 +33,10 @@ more than the arithmetic.  What it computes, for one excitation slot::
     friction: dy -= M^-1 W_e(s) max(f_e, 0) of each friction mesh
               (both as ``rhs_extra`` does them after ``rhs_slot``)
 
-The code depends only on the sparsity of V and G, on which elements have a dead zone and
-which are spline components; the values (coefficients, damping, masses, forces) are read
-from a parameter vector at fixed offsets.  Compiled code is therefore kept per pattern and reused by every model with the
-same pattern (a parameter sweep compiles once).
+The code depends only on the sparsity of V and G, on which elements have a dead zone, which
+are spline components and which meshes have tooth friction; the values (coefficients, damping, masses, forces) are read
+from a parameter vector at fixed offsets.  Compiled code is therefore kept per pattern and
+reused by every model with the same pattern (a parameter sweep compiles once).
 
 Calling convention (C)::
 
@@ -44,9 +44,9 @@ Calling convention (C)::
              uint64 E, uint64 ED, uint64 P, uint64 par, uint64 FR, int64 off)
 
 Every argument but ``off`` is the address of a float64 array's data (``Work.addr``:
-taken once per run; a state row's address is base + row x stride).  K, G, E, ED, P are the kernels' whole
-(n_slot, ne) excitation arrays; the function reads the slot starting at flat index
-``off`` = slot * ne.
+taken once per run; a state row's address is base + row x stride).  K, G, E, ED, P are
+the kernels' whole (n_slot, ne) excitation arrays; the function reads the slot starting
+at flat index ``off`` = slot * ne (and row off / ne of the friction values FR).
 """
 
 from __future__ import annotations
@@ -112,7 +112,8 @@ def _law_ir(kind: str = "spring") -> tuple[str, str]:
 def rhs_ir(model) -> tuple[str, list[tuple[str, int]]]:
     """LLVM IR of the right-hand side of a kernel model ``model``
     (:class:`~torquesplit.solve.kernel_data.KernelModel`) and the parameter layout: entry
-    i of ``par`` is ``model.<name>`` (flattened) ``[index]`` for the i-th ``(name, index)``.  The IR calls
+    i of ``par`` is ``model.<name>`` (flattened) ``[index]`` for the i-th ``(name,
+    index)``.  The IR calls
     the element law by name (:func:`_law_ir`); :func:`_Compiler.compile` links it in."""
     a = _arrays(model)
     n = a["inv_mass"].shape[0]
