@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 __all__ = ["StepCheck", "check_step", "check_steady", "halved_steps_per_period",
-           "agreeing_digits"]
+           "agreeing_digits", "has_jumps", "jump_elements", "coarse_table_warning"]
 
 TIGHTER_RTOL = 32.0
 """Dormand-Prince: the check's tolerance is the run's divided by this (~ half the step)."""
@@ -39,16 +39,43 @@ def has_jumps(structure) -> bool:
     """Whether a time-varying stiffness or additive-force table of ``structure`` changes
     by more than :data:`JUMP` of its range between two neighbouring points (a step the
     table resolves as a ramp of one spacing)."""
+    return bool(jump_elements(structure))
+
+
+def jump_elements(structure) -> list[str]:
+    """Names of the elements of ``structure`` with a table that jumps (:func:`has_jumps`)."""
+    jumps = np.zeros(len(structure.element_names), dtype=bool)
     for table in (structure.stiffness_table, structure.force_table):
         t = np.asarray(table, dtype=float)
-        if t.ndim != 2 or t.shape[1] < 2:
+        if t.ndim != 2 or t.shape[1] < 2 or t.shape[0] != jumps.shape[0]:
             continue
         span = t.max(axis=1) - t.min(axis=1)
         step = np.max(np.abs(t - np.roll(t, 1, axis=1)), axis=1)
         moving = (span > 1e-9 * np.max(np.abs(t), axis=1)) & (structure.frequency > 0)
-        if np.any(moving & (step > JUMP * span)):
-            return True
-    return False
+        jumps |= moving & (step > JUMP * span)
+    return [structure.element_names[i] for i in np.flatnonzero(jumps)]
+
+
+COARSE_TABLE = 4096
+"""Fewer table points than this where tables jump: :func:`coarse_table_warning`."""
+
+
+def coarse_table_warning(model, structure) -> str | None:
+    """A warning when tables jump and ``[analysis] table_points`` is below
+    :data:`COARSE_TABLE`: each jump is then a ramp of 1/n of a cycle, and the dynamic
+    peaks come out low (the shipped examples at the default 256 points: Liu et al. 2021's
+    spur stage 0.6 %, Jin et al. 2019's 1 %, a planetary differential's sun mesh 9 %)."""
+    n = int(model.analysis.table_points)
+    names = jump_elements(structure) if n < COARSE_TABLE else []
+    if not names:
+        return None
+    listed = ", ".join(names[:4]) + (f" and {len(names) - 4} more" if len(names) > 4 else "")
+    return (f"analysis.table_points: the tables of {listed} step (a tooth pair entering or "
+            f"leaving, an impact pulse); with {n} points per cycle each step is a ramp 1/{n} "
+            "of a cycle long, which lowers the dynamic peaks (0.6-9 % on the shipped "
+            "examples at 256); set [analysis] table_points = 16384 (no cost per step; a "
+            "mesh with stiffness.method = 'ltca' then runs its LTCA at every point) and "
+            "confirm with --check-step")
 
 
 def check_model(results):

@@ -289,6 +289,11 @@ def prepare_run(
             "the static equilibrium did not converge exactly (members free inside their "
             f"clearances: {', '.join(static.separated) or 'none reported'}); the dynamic run "
             "starts from the regularised solution", ModelWarning, stacklevel=3)
+    from .convergence import coarse_table_warning
+
+    coarse = coarse_table_warning(model, structure)
+    if coarse:
+        warnings.warn(coarse, ModelWarning, stacklevel=3)
     mesh_names = list(model.meshes)
     freqs = np.array([kin.meshes[m].frequency for m in mesh_names])
     f_min, f_max = float(freqs.min()), float(freqs.max())

@@ -128,3 +128,25 @@ def test_tables_with_jumps_are_checked_with_finer_tables(tmp_path):
     assert not has_jumps(smooth.structure)
     plain = check_step(smooth)
     assert plain.check_table_points == plain.table_points
+
+
+def test_coarse_tables_with_jumps_are_warned_of(tmp_path):
+    """Tables that jump, at fewer than COARSE_TABLE points, lower the peaks: the run warns,
+    naming the meshes and the field; at 4096 points, or with smooth tables, it does not."""
+    from torquesplit.convergence import COARSE_TABLE, jump_elements
+    from torquesplit.simulation import prepare_run
+
+    def said(model):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", ModelWarning)
+            prepare_run(model, cycles=5)
+        return [str(w.message) for w in caught if "table_points" in str(w.message)]
+
+    coarse = _rectangular_pair(tmp_path, 256)
+    (msg,) = said(coarse)
+    assert msg.startswith("analysis.table_points: the tables of m step")
+    assert "with 256 points per cycle each step is a ramp 1/256" in msg
+    assert "set [analysis] table_points = 16384" in msg
+    assert jump_elements(prepare_run(coarse, cycles=5).structure) == ["m"]
+    assert said(_rectangular_pair(tmp_path, COARSE_TABLE)) == []
+    assert said(write_model(tmp_path, SPUR_PAIR, "pair.toml")) == []
