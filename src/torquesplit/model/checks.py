@@ -496,6 +496,13 @@ def rim_overlap_warnings(model: Model, kin) -> list[tuple[str, str]]:
     for a, b, d in _overlapping_pairs(model, kin, assumed_rims=True):
         if (a[0], b[0]) in refused:
             continue
+        if a[1] > 0 and b[1] > 0:  # two internal gears
+            out.append((f"gears.{b[0]}", (
+                f"the rims of internal gears {a[0]} and {b[0]} as assumed "
+                f"({RIM_THICKNESS_MODULES:g} normal modules outside their root circles; "
+                f"centres {d * 1e3:.4g} mm apart) intersect; give their rim_thickness or "
+                f"outer_diameter, or check gears.{b[0]}.place / position")))
+            continue
         (ring, _, outer), (other, _, tip) = (a, b) if a[1] > 0 else (b, a)
         out.append((f"gears.{other}", (
             f"{other} (tip radius {tip * 1e3:.4g} mm, centre {d * 1e3:.4g} mm from {ring}'s) "

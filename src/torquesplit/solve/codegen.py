@@ -34,9 +34,10 @@ more than the arithmetic.  What it computes, for one excitation slot::
               (both as ``rhs_extra`` does them after ``rhs_slot``)
 
 The code depends only on the sparsity of V and G, on which elements have a dead zone, which
-are spline components and which meshes have tooth friction; the values (coefficients, damping, masses, forces) are read
-from a parameter vector at fixed offsets.  Compiled code is therefore kept per pattern and
-reused by every model with the same pattern (a parameter sweep compiles once).
+are spline components and which meshes have tooth friction; the values (coefficients,
+damping, masses, forces) are read from a parameter vector at fixed offsets.  Compiled
+code is therefore kept per pattern and reused by every model with the same pattern (a
+parameter sweep compiles once).
 
 Calling convention (C)::
 
@@ -113,8 +114,8 @@ def rhs_ir(model) -> tuple[str, list[tuple[str, int]]]:
     """LLVM IR of the right-hand side of a kernel model ``model``
     (:class:`~torquesplit.solve.kernel_data.KernelModel`) and the parameter layout: entry
     i of ``par`` is ``model.<name>`` (flattened) ``[index]`` for the i-th ``(name,
-    index)``.  The IR calls
-    the element law by name (:func:`_law_ir`); :func:`_Compiler.compile` links it in."""
+    index)``.  The IR calls the element laws by name (:func:`_law_ir`);
+    :func:`_Compiler.compile` links them in."""
     a = _arrays(model)
     n = a["inv_mass"].shape[0]
     ne = a["vr_ptr"].shape[0] - 1
@@ -193,7 +194,6 @@ def rhs_ir(model) -> tuple[str, list[tuple[str, int]]]:
         if d is None:  # an element without projection entries
             d, r = "0.0", "0.0"
         if e in spline_part:  # zero stiffness and damping here: its law is the spline's
-            store("defl", e, d)
             continue
         k = load("K", e)
         c = param("damping", e)
@@ -369,8 +369,8 @@ class _Compiler:
         from numba.core.compiler_lock import global_compiler_lock
 
         ir = ir.replace("@rhs(", f"@{name}(").replace("@rhs_body(", f"@{name}_body(")
-        law_irs = [_law_ir()[0]] + ([_law_ir("spline")[0]] if f"@{_law_ir('spline')[1]}("
-                                                              in ir else [])
+        kinds = ("spring", "spline") if "spline_force_scalar" in ir else ("spring",)
+        law_irs = [_law_ir(kind)[0] for kind in kinds]  # (the spline law where declared)
         with global_compiler_lock:
             llvm = self._setup()
             mod = llvm.parse_assembly(ir)
