@@ -262,8 +262,8 @@ $ torquesplit run three_branch.toml --check-step --quiet
 
 A number that moves in a printed digit is listed with the digits that hold.  Here the
 peaks move in their second digit: the drive runs near a resonance (next paragraph),
-where the peaks depend on the step and on how sharply the tables resolve the jumps (at
-16384 table points they still move by 1 %).  Refine both (`--steps-per-period`, `--set
+where the peaks depend on the step and on how sharply the tables resolve the jumps (half
+the step and 65536 table points move them by about 1 %).  Refine both (`--steps-per-period`, `--set
 analysis.table_points=...`), and report only the digits that hold; the mean-force
 coefficients move far less than the peaks (`--json` gives every number's digits).
 
