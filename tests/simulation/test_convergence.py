@@ -150,3 +150,14 @@ def test_coarse_tables_with_jumps_are_warned_of(tmp_path):
     assert jump_elements(prepare_run(coarse, cycles=5).structure) == ["m"]
     assert said(_rectangular_pair(tmp_path, COARSE_TABLE)) == []
     assert said(write_model(tmp_path, SPUR_PAIR, "pair.toml")) == []
+
+
+def test_check_warns_of_coarse_tables_as_a_run_does(tmp_path):
+    iso = SPUR_PAIR.replace('stiffness = "4e8 N/m"', 'stiffness = {method = "iso6336"}')
+    out = CliRunner().invoke(app, ["check", str(write_model(tmp_path, iso, "iso.toml"))])
+    assert out.exit_code == 0, out.output
+    text = " ".join(out.output.split())
+    assert "analysis.table_points: the tables of m step" in text
+    fine = iso + "\n[analysis]\ntable_points = 4096\n"
+    out = CliRunner().invoke(app, ["check", str(write_model(tmp_path, fine, "fine.toml"))])
+    assert out.exit_code == 0 and "table_points" not in out.output

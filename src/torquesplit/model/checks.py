@@ -1134,7 +1134,10 @@ def _readiness(model: Model, kin=None) -> tuple[list, list]:
                       f"accepts ({blowup:g}): a stiffness is far too small for the load; "
                       f"check the stiffness values and their units (shafts, supports, "
                       f"meshes)")], []
-    return [], []
+    from ..convergence import coarse_table_warning
+
+    coarse = coarse_table_warning(model, structure)  # (what every run warns of)
+    return [], ([tuple(coarse.split(": ", 1))] if coarse else [])
 
 
 def integrator_blowup() -> float:
