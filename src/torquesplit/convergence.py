@@ -73,9 +73,8 @@ def coarse_table_warning(model, structure) -> str | None:
     return (f"analysis.table_points: the tables of {listed} step (a tooth pair entering or "
             f"leaving, an impact pulse); with {n} points per cycle each step is a ramp 1/{n} "
             "of a cycle long, which lowers the dynamic peaks (0.6-9 % on the shipped "
-            "examples at 256); set [analysis] table_points = 16384 (no cost per step; a "
-            "mesh with stiffness.method = 'ltca' then runs its LTCA at every point) and "
-            "confirm with --check-step")
+            "examples at 256); set [analysis] table_points = 16384 (no cost per step for "
+            "most models) and confirm with --check-step")
 
 
 def check_model(results):
