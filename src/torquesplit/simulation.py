@@ -246,8 +246,8 @@ def starting_equilibria(structure):
     from .solve.static import static_equilibrium
 
     static = static_equilibrium(structure)
-    try:
-        at0 = static_equilibrium(structure, 0.0)
+    try:  # (Newton from the mean equilibrium: Dong et al. 2021 5 steps, not 22)
+        at0 = static_equilibrium(structure, 0.0, initial=static.q)
     except SolverError:
         at0 = None
     if at0 is not None and at0.converged and np.all(np.isfinite(at0.q)):

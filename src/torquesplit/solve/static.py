@@ -590,6 +590,7 @@ def static_equilibrium(
     regularisation: float = 1e-9,
     balance_tolerance: float = 1e-8,
     max_iterations: int = 200,
+    initial=None,
 ) -> StaticSolution:
     """Static equilibrium ``sum_e V_e f_e(q) = F_ext`` with dead zones and rigid modes.
 
@@ -607,6 +608,9 @@ def static_equilibrium(
         accepted as round-off.
     max_iterations : int
         Linear solves (Newton steps) before giving up (``converged=False``).
+    initial : array, optional
+        Displacements to start Newton from (e.g. the equilibrium at a nearby time or
+        of the mean stiffness), instead of the closed-contact linear solve.
 
     Raises
     ------
@@ -624,7 +628,7 @@ def static_equilibrium(
     (2000.0, 1e-05)
     """
     problem = _StaticProblem(structure, regularisation, balance_tolerance)
-    r = problem.solve(t, max_iterations=max_iterations)
+    r = problem.solve(t, q0=initial, max_iterations=max_iterations)
     names = tuple(structure.element_names[i] for i in np.flatnonzero(~r["contact"]))
     return StaticSolution(q=r["q"], element_forces=r["forces"], deformations=r["delta"],
                           in_contact=r["contact"], iterations=r["it"],
