@@ -678,7 +678,10 @@ class Analysis(Strict):
     duration: Time | None = Field(None, gt=0, description="Simulated time.")
     cycles: Count | None = Field(None, gt=0, description="Simulated cycles of the slowest mesh.")
     rtol: Number = Field(1e-6, gt=0, lt=1, description="Relative tolerance (dopri).")
-    table_points: Count = Field(256, ge=16, description="Samples per mesh period of excitation tables.")
+    table_points: Count = Field(256, ge=16, description=(
+        "Samples per mesh period of excitation tables. Where a table steps (a tooth pair "
+        "entering, an impact pulse) each step becomes a ramp 1/n of a period long and the "
+        "peaks come out low: use 16384 or more then (a run warns below 4096)."))
     spline_velocity_scale: Number = Field(
         1e-3, gt=0, description="Radial sliding speed [m/s] over which spline friction "
         "reaches its Coulomb value (regularisation of sgn; smaller is stiffer to integrate).")
