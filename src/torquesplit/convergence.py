@@ -165,21 +165,26 @@ def check_step(results, *, definitions=None, rtol: float | None = None,
     with TABLE_REFINEMENT times its table points where its tables have jumps
     (:func:`check_model`), every metric of the load-sharing ``definitions`` (default:
     all) compared.  Costs about twice the first run."""
+    import warnings
+
     from .simulation import simulate
 
     sol = results.solution
     duration = sol.t_span[1] - sol.t_span[0]
     model, n, n_check = check_model(results)
-    if sol.method == "rk4":
-        spp = halved_steps_per_period(results)
-        half = simulate(model, duration=duration, method="rk4",
-                        steps_per_period=spp, progress=progress)
-        step, halved_step = sol.step, half.solution.step
-    else:
-        rtol = float(results.model.analysis.rtol if rtol is None else rtol)
-        half = simulate(model, duration=duration, method=sol.method,
-                        rtol=rtol / TIGHTER_RTOL, progress=progress)
-        step, halved_step = rtol, rtol / TIGHTER_RTOL
+    with warnings.catch_warnings():
+        # the check's own table points are no setting of the user's: the run warned
+        warnings.filterwarnings("ignore", message="analysis.table_points: ")
+        if sol.method == "rk4":
+            spp = halved_steps_per_period(results)
+            half = simulate(model, duration=duration, method="rk4",
+                            steps_per_period=spp, progress=progress)
+            step, halved_step = sol.step, half.solution.step
+        else:
+            rtol = float(results.model.analysis.rtol if rtol is None else rtol)
+            half = simulate(model, duration=duration, method=sol.method,
+                            rtol=rtol / TIGHTER_RTOL, progress=progress)
+            step, halved_step = rtol, rtol / TIGHTER_RTOL
     return StepCheck(values=results.metric_values(definitions),
                      halved=half.metric_values(definitions),
                      method=sol.method, step=float(step), halved_step=float(halved_step),

@@ -227,32 +227,42 @@ def _set_up(model):
 
     kin = solve_kinematics(model)
     structure = assemble(model, kin)
-    static, start = starting_equilibria(structure)
-    return kin, structure, static, start
+    return (kin, structure) + starting_equilibria(structure)
 
 
 def starting_equilibria(structure):
-    """The mean-stiffness static equilibrium and the state a run starts from.
+    """The mean-stiffness static equilibrium and the one a run starts from.
 
     The start is the equilibrium under the excitation at t = 0 (each mesh's stiffness at
     its phase, the errors' values, the gaps of the current engagement): started from the
     mean-stiffness one, a run first swings about the instantaneous equilibrium by the
     difference (a spur pair with a 20 um eccentricity: first-cycle peak 33 % above the
     steady one, 0.2 % from the t = 0 equilibrium), a start-up transient that costs settle
-    time and is counted in the start-up contact loss.  Where
-    the t = 0 solve does not converge (a member floating in its clearance), the start is
-    the mean-stiffness equilibrium.  Returns ``(static, (q0, "t0" | "mean"))``.
+    time and is counted in the start-up contact loss.  Where the t = 0 solve fails, the
+    start is the mean-stiffness equilibrium, and a warning says so (one that does not
+    converge exactly, a member floating in its clearance, is the regularised solution:
+    a valid start, and :func:`prepare_run` says so).  Returns ``(static, start,
+    which)``: two :class:`~torquesplit.solve.static.StaticSolution` and ``"t0"`` or
+    ``"mean"``.
     """
     from .solve.static import static_equilibrium
 
     static = static_equilibrium(structure)
     try:  # (Newton from the mean equilibrium: Dong et al. 2021 5 steps, not 22)
         at0 = static_equilibrium(structure, 0.0, initial=static.q)
-    except SolverError:
-        at0 = None
-    if at0 is not None and at0.converged and np.all(np.isfinite(at0.q)):
-        return static, (at0.q, "t0")
-    return static, (static.q, "mean")
+        # (not converged exactly but finite: the regularised solution, a valid start, as
+        # prepare_run says)
+        why = "" if np.all(np.isfinite(at0.q)) else "it has no finite solution"
+    except (SolverError, ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:
+        at0, why = None, f"it failed ({exc})"
+    if not why:
+        return static, at0, "t0"
+    if np.all(np.isfinite(static.q)):
+        warnings.warn(f"the static equilibrium at t = 0 could not start the run ({why}); it "
+                      "starts from the mean-stiffness equilibrium, so its first cycles hold "
+                      "a start-up swing that the settled metrics leave out", ModelWarning,
+                      stacklevel=4)
+    return static, static, "mean"
 
 
 def prepare_run(
@@ -278,17 +288,17 @@ def prepare_run(
     if not hasattr(model, "meshes"):
         model = load_model(model)
     an = model.analysis
-    kin, structure, static, (q0, start) = _set_up(model)
+    kin, structure, static, begin, start = _set_up(model)
     if not np.all(np.isfinite(static.q)):
         raise SolverError(
             "the static equilibrium failed; check the clearances and the supports "
             "(a body free to move inside its clearance needs a support or a spring)")
-    if not static.converged:
+    if not begin.converged:  # (the state the run starts from)
         # e.g. a member floating inside its clearance with no net load: its position is
         # not determined; the regularised solution is a valid starting state
         warnings.warn(
             "the static equilibrium did not converge exactly (members free inside their "
-            f"clearances: {', '.join(static.separated) or 'none reported'}); the dynamic run "
+            f"clearances: {', '.join(begin.separated) or 'none reported'}); the dynamic run "
             "starts from the regularised solution", ModelWarning, stacklevel=3)
     from .convergence import coarse_table_warning
 
@@ -319,7 +329,7 @@ def prepare_run(
     if duration <= 0 or not math.isfinite(duration):  # e.g. from the model's [analysis]
         raise SolverError(f"the run length must be positive, got {duration!r} s; give a "
                           "positive duration or cycles")
-    y0 = np.concatenate([q0, np.zeros_like(q0)])
+    y0 = np.concatenate([begin.q, np.zeros_like(begin.q)])
 
     names = structure.element_names
     track = [names.index(m) for m in mesh_names]

@@ -274,9 +274,26 @@ def test_a_gear_in_the_assumed_rim_of_a_ring_is_warned_of():
     assert len(msgs) == 1 and msgs[0].startswith(
         "gears.x2: x2 (tip radius 22 mm, centre 108 mm from ring's) reaches into the rim of "
         "internal gear ring as assumed (outer radius 89.5 mm, 3.5 normal modules outside its "
-        "root circle); give gears.ring.rim_thickness or outer_diameter")
+        "root circle); give gears.ring.rim_thickness or gears.ring.outer_diameter")
 
 
 def test_a_gear_outside_a_thin_rim_passes():
     assert not [m for m in _rim_model('rim_thickness = "2 mm"') if "overlap" in m or
                 "rim" in m]
+
+
+def test_the_rim_of_a_planetary_stage_ring_is_named_as_written():
+    """A [[planetary]] ring has no [gears.*] table of its own: the rim fields are the
+    stage's (the reviewer's case: 'give gears.st_ring.rim_thickness' named a table the
+    file does not have)."""
+    import sys
+
+    from torquesplit.model.checks import _rim_fields
+
+    sys.path.insert(0, str(ROOT / "tests"))
+    from planetary_models import three_planet_toml
+
+    model = _load(three_planet_toml("st"))
+    ring = next(n for n, g in model.gears.items() if g.gear_type == "internal")
+    assert _rim_fields(model, ring) == ("planetary.0.ring.rim_thickness or "
+                                        "planetary.0.ring.outer_diameter")

@@ -26,8 +26,8 @@ def three_branch_run(tmp_path_factory):
     real = sim.starting_equilibria
 
     def mean_start(structure):
-        static, _ = real(structure)
-        return static, (static.q, "mean")
+        static, _, _ = real(structure)
+        return static, static, "mean"
 
     with pytest.MonkeyPatch.context() as mp:
         mp.setattr(sim, "starting_equilibria", mean_start)

@@ -161,3 +161,16 @@ def test_check_warns_of_coarse_tables_as_a_run_does(tmp_path):
     fine = iso + "\n[analysis]\ntable_points = 4096\n"
     out = CliRunner().invoke(app, ["check", str(write_model(tmp_path, fine, "fine.toml"))])
     assert out.exit_code == 0 and "table_points" not in out.output
+
+
+def test_the_step_check_does_not_warn_of_its_own_table_points(tmp_path):
+    """The check runs at 4x the user's table points (1024 here, still coarse): the user's
+    run warned of 256; the check's run is no setting of theirs and says nothing."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = torquesplit.simulate(_rectangular_pair(tmp_path, 256), cycles=10)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        check = check_step(res)
+    assert check.check_table_points == 1024
+    assert not [w for w in caught if "table_points" in str(w.message)]

@@ -7,6 +7,7 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
+import pytest
 
 import torquesplit as ts
 from torquesplit.simulation import prepare_run
@@ -58,17 +59,41 @@ def test_no_start_up_swing_about_the_instantaneous_equilibrium(tmp_path):
     assert np.abs(first - later).max() < 5e-3 * np.abs(later).max()
 
 
-def test_falls_back_to_the_mean_equilibrium_when_t0_does_not_converge(tmp_path,
-                                                                     monkeypatch):
+def test_falls_back_to_the_mean_equilibrium_when_the_t0_solve_fails(tmp_path, monkeypatch):
     import torquesplit.solve.static as static_mod
+    from torquesplit.errors import ModelWarning, SolverError
 
     real = static_mod.static_equilibrium
 
     def failing(structure, t=None, **kw):
+        if t is not None:
+            raise SolverError("a DOF has no support (made up)")
+        return real(structure, t, **kw)
+
+    monkeypatch.setattr(static_mod, "static_equilibrium", failing)
+    with pytest.warns(ModelWarning, match=r"the static equilibrium at t = 0 could not start "
+                                          r"the run \(it failed \(a DOF has no support"):
+        run = prepare_run(write_model(tmp_path, ECCENTRIC), cycles=5)
+    assert run.start == "mean"
+    np.testing.assert_array_equal(run.y0[:run.structure.n_dof], run.static.q)
+
+
+def test_a_t0_solve_that_does_not_converge_exactly_still_starts_the_run(tmp_path,
+                                                                         monkeypatch):
+    """Not converged exactly (a member floating in its clearance) is the regularised
+    solution at t = 0: the run starts there, and says that it did not converge."""
+    import torquesplit.solve.static as static_mod
+    from torquesplit.errors import ModelWarning
+
+    real = static_mod.static_equilibrium
+
+    def loose(structure, t=None, **kw):
         sol = real(structure, t, **kw)
         return sol if t is None else dataclasses.replace(sol, converged=False)
 
-    monkeypatch.setattr(static_mod, "static_equilibrium", failing)
-    run = prepare_run(write_model(tmp_path, ECCENTRIC), cycles=5)
-    assert run.start == "mean"
-    np.testing.assert_array_equal(run.y0[:run.structure.n_dof], run.static.q)
+    monkeypatch.setattr(static_mod, "static_equilibrium", loose)
+    with pytest.warns(ModelWarning, match="did not converge exactly"):
+        run = prepare_run(write_model(tmp_path, ECCENTRIC), cycles=5)
+    assert run.start == "t0"
+    np.testing.assert_array_equal(run.y0[:run.structure.n_dof],
+                                  real(run.structure, 0.0).q)

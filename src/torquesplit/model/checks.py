@@ -496,21 +496,35 @@ def rim_overlap_warnings(model: Model, kin) -> list[tuple[str, str]]:
     for a, b, d in _overlapping_pairs(model, kin, assumed_rims=True):
         if (a[0], b[0]) in refused:
             continue
-        if a[1] > 0 and b[1] > 0:  # two internal gears
+        if a[1] > 0 and b[1] > 0:  # two internal gears: name those whose rim is assumed
+            assumed = [n for n in (a[0], b[0]) if _rim_assumed(model.gears[n])]
+            fields = " and ".join(_rim_fields(model, n) for n in assumed)
             out.append((f"gears.{b[0]}", (
-                f"the rims of internal gears {a[0]} and {b[0]} as assumed "
-                f"({RIM_THICKNESS_MODULES:g} normal modules outside their root circles; "
-                f"centres {d * 1e3:.4g} mm apart) intersect; give their rim_thickness or "
-                f"outer_diameter, or check gears.{b[0]}.place / position")))
+                f"the rims of internal gears {a[0]} and {b[0]} (centres {d * 1e3:.4g} mm "
+                f"apart) intersect where {' and '.join(assumed)}'s is assumed "
+                f"({RIM_THICKNESS_MODULES:g} normal modules outside the root circle); give "
+                f"{fields}, or check gears.{b[0]}.place / position")))
             continue
         (ring, _, outer), (other, _, tip) = (a, b) if a[1] > 0 else (b, a)
         out.append((f"gears.{other}", (
             f"{other} (tip radius {tip * 1e3:.4g} mm, centre {d * 1e3:.4g} mm from {ring}'s) "
             f"reaches into the rim of internal gear {ring} as assumed (outer radius "
             f"{outer * 1e3:.4g} mm, {RIM_THICKNESS_MODULES:g} normal modules outside its "
-            f"root circle); give gears.{ring}.rim_thickness or outer_diameter, or check "
+            f"root circle); give {_rim_fields(model, ring)}, or check "
             f"gears.{other}.place / position")))
     return out
+
+
+def _rim_assumed(gear) -> bool:
+    """An internal gear whose file gives neither ``rim_thickness`` nor ``outer_diameter``."""
+    return gear.outer_diameter is None and gear.rim_thickness is None
+
+
+def _rim_fields(model: Model, ring: str) -> str:
+    """Where the rim of ``ring`` is given, as the user writes it (a ``[[planetary]]``
+    stage's ring, or the gear's own table)."""
+    at = model.written_at(f"gears.{ring}.rim_thickness")
+    return f"{at} or {at.rsplit('.', 1)[0]}.outer_diameter"
 
 
 def _overlapping_pairs(model: Model, kin, *, assumed_rims: bool):
@@ -533,7 +547,7 @@ def _overlapping_pairs(model: Model, kin, *, assumed_rims: bool):
             continue
         if g.gear_type == "internal":
             r_f, r_o, _ = internal_rim(g)
-            assumed = g.outer_diameter is None and g.rim_thickness is None
+            assumed = _rim_assumed(g)
             inner, outer = geo.tip_radius, (r_o if assumed_rims or not assumed else r_f)
         else:
             inner, outer = 0.0, geo.tip_radius
@@ -575,8 +589,7 @@ def _overlap_issue(model: Model, first, second, d: float) -> tuple[str, str]:
     if len(ring) == 1:
         r = ring[0]
         ra, rf, tip = (ia, oa, ob) if r == a else (ib, ob, oa)
-        given = model.gears[r].outer_diameter is not None or model.gears[r].rim_thickness \
-            is not None
+        given = not _rim_assumed(model.gears[r])
         part, rim = ("teeth or rim", "outer radius of its rim") if given else ("teeth",
                                                                              "root radius")
         return (f"gears.{move}", (
