@@ -481,7 +481,7 @@ def overlap_issues(model: Model, kin) -> list[tuple[str, str]]:
     and so are gears whose plane the file does not state (see
     :func:`_axially_located`).  Positions are those at t = 0."""
     return [_overlap_issue(model, a, b, d)
-            for a, b, d in _overlapping_pairs(model, kin, assumed_rims=False)]
+            for a, b, d, refused in _overlapping_pairs(model, kin) if refused]
 
 
 def rim_overlap_warnings(model: Model, kin) -> list[tuple[str, str]]:
@@ -491,10 +491,9 @@ def rim_overlap_warnings(model: Model, kin) -> list[tuple[str, str]]:
     refusal, since the file does not say how thick the rim is."""
     from .kinematics import RIM_THICKNESS_MODULES
 
-    refused = {(a[0], b[0]) for a, b, _ in _overlapping_pairs(model, kin, assumed_rims=False)}
     out = []
-    for a, b, d in _overlapping_pairs(model, kin, assumed_rims=True):
-        if (a[0], b[0]) in refused:
+    for a, b, d, refused in _overlapping_pairs(model, kin):
+        if refused:
             continue
         if a[1] > 0 and b[1] > 0:  # two internal gears: name those whose rim is assumed
             assumed = [n for n in (a[0], b[0]) if _rim_assumed(model.gears[n])]
@@ -527,11 +526,12 @@ def _rim_fields(model: Model, ring: str) -> str:
     return f"{at} or {at.rsplit('.', 1)[0]}.outer_diameter"
 
 
-def _overlapping_pairs(model: Model, kin, *, assumed_rims: bool):
-    """((name, inner, outer), (name, inner, outer), centre distance) of every pair of
-    gears of :func:`overlap_issues` whose regions intersect; an internal gear's region
-    reaches to the outside of its rim where the file gives it, or with ``assumed_rims``
-    where it is assumed too, else to its root circle."""
+def _overlapping_pairs(model: Model, kin):
+    """``((name, inner, outer), (name, inner, outer), centre distance, refused)`` of every
+    pair of gears of :func:`overlap_issues` whose regions intersect where the internal
+    gears' rims are counted, given or assumed.  ``refused``: they intersect also with
+    the assumed rims left out (an internal gear's region then ends at its root circle),
+    and ``outer`` is the radius of that verdict."""
     from .kinematics import gear_geometry, internal_rim
 
     mates = {frozenset(m.gears) for m in model.meshes.values()}
@@ -547,31 +547,34 @@ def _overlapping_pairs(model: Model, kin, *, assumed_rims: bool):
             continue
         if g.gear_type == "internal":
             r_f, r_o, _ = internal_rim(g)
-            assumed = _rim_assumed(g)
-            inner, outer = geo.tip_radius, (r_o if assumed_rims or not assumed else r_f)
+            inner, outers = geo.tip_radius, ((r_f if _rim_assumed(g) else r_o), r_o)
         else:
-            inner, outer = 0.0, geo.tip_radius
+            inner, outers = 0.0, (geo.tip_radius, geo.tip_radius)
         body = kin.bodies[name]
         gears.append((name, np.asarray(body.position, float), np.asarray(body.axis, float),
-                      geo.total_face_width, inner, outer))
+                      geo.total_face_width, inner, outers))
+    tol = OVERLAP_TOLERANCE
+
+    def meet(d, ia, oa, ib, ob):  # two annuli [inner, outer] about centres d apart
+        return d < oa + ob - tol and ib < oa + d - tol and ia < ob + d - tol
+
     pairs = []
-    for i, (a, pa, ua, wa, ia, oa) in enumerate(gears):
-        for b, pb, ub, wb, ib, ob in gears[i + 1:]:
+    for i, (a, pa, ua, wa, ia, oas) in enumerate(gears):
+        for b, pb, ub, wb, ib, obs in gears[i + 1:]:
             if frozenset((a, b)) in mates or line.get(a, a) == line.get(b, b):
                 continue
             if math.acos(min(1.0, abs(float(np.dot(ua, ub))))) > SHAFT_AXIS_ANGLE:
                 continue
             rel = pb - pa
             axial = float(np.dot(rel, ua))
-            if abs(axial) >= (wa + wb) / 2 - OVERLAP_TOLERANCE:
+            if abs(axial) >= (wa + wb) / 2 - tol:
                 continue  # side by side along the axis: different planes
             d = float(np.linalg.norm(rel - axial * ua))
             d = d if d > 1e-12 else 0.0  # coaxial (round-off of the placement)
-            tol = OVERLAP_TOLERANCE
-            # two annuli [inner, outer] about centres d apart share a point iff:
-            if not (d < oa + ob - tol and ib < oa + d - tol and ia < ob + d - tol):
+            if not meet(d, ia, oas[1], ib, obs[1]):
                 continue
-            pairs.append(((a, ia, oa), (b, ib, ob), d))
+            k = 0 if meet(d, ia, oas[0], ib, obs[0]) else 1
+            pairs.append(((a, ia, oas[k]), (b, ib, obs[k]), d, k == 0))
     return pairs
 
 

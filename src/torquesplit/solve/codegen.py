@@ -180,6 +180,8 @@ def rhs_ir(model) -> tuple[str, list[tuple[str, int]]]:
 
     force = {}
     for e in range(ne):
+        if e in spline_part:  # zero stiffness and damping here: the spline's law, below
+            continue
         # an element without error: its E and E' are 0, and -0 + x == x for every x, so
         # the sums start at their first product (same result as rhs_slot, fewer loads)
         errs = bool(has_error[e])
@@ -193,8 +195,6 @@ def rhs_ir(model) -> tuple[str, list[tuple[str, int]]]:
             r = pr if r is None else op("fadd", r, pr)
         if d is None:  # an element without projection entries
             d, r = "0.0", "0.0"
-        if e in spline_part:  # zero stiffness and damping here: its law is the spline's
-            continue
         k = load("K", e)
         c = param("damping", e)
         # the law (laws.spring_force) on this element: its own compiled code, inlined
