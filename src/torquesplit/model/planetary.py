@@ -96,11 +96,13 @@ class PlanetaryGear(Strict):
     bore_diameter: Length = Field(0.0, ge=0, description="Bore diameter used for computed "
                                   "mass and inertia (sun and planets).")
     outer_diameter: Length | None = Field(None, gt=0, description="Outer diameter of the "
-                                          "ring's rim, used for computed mass and inertia; "
-                                          "default the root diameter + 2 rim_thickness.")
+                                          "ring's rim, used for computed mass and inertia "
+                                          "and, given, for the overlap check; default "
+                                          "the root diameter + 2 rim_thickness.")
     rim_thickness: Length | None = Field(None, gt=0, description="Rim thickness of the ring "
                                          "from its root circle outwards, used for computed "
-                                         "mass and inertia; default 3.5 m_n (ISO 6336-3:2006 "
+                                         "mass and inertia and, given, for the overlap "
+                                         "check; default 3.5 m_n (ISO 6336-3:2006 "
                                          "Y_B = 1 from there).")
     dofs: list[Dof] | None = Field(None, description="Degrees of freedom; default "
                                    "['theta', 'x', 'y'] for the planets, ['theta'] else.")

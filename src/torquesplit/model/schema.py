@@ -301,10 +301,12 @@ class Gear(Strict):
     bore_diameter: Length = Field(0.0, ge=0, description="Bore diameter used for computed mass/inertia.")
     outer_diameter: Length | None = Field(None, gt=0, description=(
         "Outer diameter of an internal gear's rim, used for computed mass/inertia (the rim "
-        "from the root circle outwards); default the root diameter + 2 rim_thickness."))
+        "from the root circle outwards) and, given, for the overlap check; default the "
+        "root diameter + 2 rim_thickness."))
     rim_thickness: Length | None = Field(None, gt=0, description=(
         "Rim thickness of an internal gear from its root circle outwards, used for computed "
-        "mass/inertia; default 3.5 m_n (the rim above which ISO 6336-3:2006's rim "
+        "mass/inertia and, given, for the overlap check (a gear in the assumed rim is "
+        "warned of); default 3.5 m_n (the rim above which ISO 6336-3:2006's rim "
         "thickness factor Y_B of an internal gear is 1)."))
     density: Density = Field(7850.0, gt=0, description="Material density.")
     youngs_modulus: Pressure = Field(206e9, gt=0, description="Young's modulus of the gear material.")
