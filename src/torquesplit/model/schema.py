@@ -118,8 +118,11 @@ class ShaftBending(Strict):
     )
     youngs_modulus: Pressure = Field(206e9, gt=0, description="Young's modulus of the shaft.")
     bearing_stiffness: Stiffness | None = Field(
-        None, gt=0, description="Radial stiffness of each bearing, in series with the shaft."
-    )
+        None, gt=0, description=(
+            "Radial stiffness of the bearings as the gear sees them, one k_C in series with "
+            "the shaft (Ji & Li eq. 10: k = k_S k_C / (k_S + k_C)).  Not the stiffness of "
+            "each bearing: two bearings k_1, k_2 at a and b from the gear (l = a + b) give "
+            "k_C = l^2 / (b^2 / k_1 + a^2 / k_2), twice k_1 = k_2 at mid-span."))
 
     @model_validator(mode="after")
     def _inside(self):

@@ -55,8 +55,12 @@ class MeshRow:
     backlash: double-flank contact)."""
     back_flank_force: float = 0.0
     """Largest back-flank force over the settled cycles (like the peak force) [N], >= 0:
-    minus the smallest settled force when that is negative.  The start-up transient's,
-    if any, is left out; the plausibility warnings name it."""
+    minus the smallest settled force when that is negative and the back flank was
+    reached (``back_contact`` > 0, or no backlash).  A mesh with backlash that never
+    reaches its back flank reports 0: a negative force there is the damping force of
+    the drive flank as it separates (Kelvin-Voigt contact, Ji & Li eq. 11), not a
+    back-flank load.  The start-up transient's, if any, is left out; the plausibility
+    warnings name it."""
     double_flank: bool = False
     """The mesh has no backlash: its back flank is always in reach (double-flank
     contact), so it can carry tension."""
@@ -262,6 +266,8 @@ class Results:
             k0 = st.first_cycle[m]
             c = c_cnt[k0:, j]
             mean = float((np.nan_to_num(c_mean[k0:, j]) * c).sum() / max(c.sum(), 1))
+            back = float(s.back_contact_fraction[el.index(m)])
+            double = not (self.model.meshes[m].backlash.nominal > 0)
             rows.append(MeshRow(
                 mesh=m, group=group_of[m], nominal_force=nominal[m], static_force=static[m],
                 mean_force=mean, peak_force=ls._nanmax(c_max[k0:, j]),
@@ -270,9 +276,9 @@ class Results:
                 dynamic_factor_engineering=dyn.dynamic_factor_engineering[m],
                 peak_to_nominal=dyn.peak_to_nominal[m], load_sharing=lsc.per_mesh[m],
                 contact_loss=float(s.separation_fraction[el.index(m)]),
-                back_contact=float(s.back_contact_fraction[el.index(m)]),
-                back_flank_force=back_flank_force(c_min[k0:, j]),
-                double_flank=not (self.model.meshes[m].backlash.nominal > 0),
+                back_contact=back,
+                back_flank_force=back_flank_force(c_min[k0:, j]) if back > 0 or double else 0.0,
+                double_flank=double,
             ))
         return Metrics(definition, st, lsc, dyn, rows)
 
