@@ -582,7 +582,7 @@ def _render_run(res, met, saved, planets=None) -> None:
         f"{st['steps']:,} steps ({st['method']}), {st['microseconds_per_step']:.3g} µs/step, "
         f"integration {st['wall_time_s']:.3g} s, compile/load {st['compile_time_s']:.3g} s "
         f"(+{st['rhs_compile_time_s']:.2g} s for the {st['rhs']} right-hand side); "
-        f"transient discarded: {met.settling.start_time:.4g} s"
+        f"transient discarded: {met.settle_times_text()}"
         + ("" if met.settling.settled else " (not settled: see the warnings)"), highlight=False)
     why = st.get("step_limited_by") or ""
     if why and why != "excitation period":  # a finer step than asked: say what set it

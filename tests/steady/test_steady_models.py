@@ -284,8 +284,11 @@ def test_coinciding_critical_speeds_share_one_line_in_the_sweep_figure():
     assert [labs for _, labs in groups] == [["mode 2 x 2 m1", "mode 3 x 2 m1"],
                                             ["mode 4 x 1 m1"]]
     assert groups[0][0] == pytest.approx(2640.5)
-    ax = sweep_figure(ds).axes[0]
-    assert len([t for t in ax.texts if "mode" in t.get_text()]) == 2
+    fig = sweep_figure(ds)
+    tags = [t.get_text() for t in fig.axes[0].texts]
+    assert tags == ["1", "2"]  # one tag per line, above the top panel
+    listed = "".join(t.get_text() for t in fig.axes[-1].texts).splitlines()
+    assert listed == ["1: 2640 rpm, mode 2 x 2 m1, mode 3 x 2 m1", "2: 3430 rpm, mode 4 x 1 m1"]
 
 
 def test_a_long_period_keeps_every_step_of_the_meshes_and_samples_the_rest(monkeypatch):
@@ -447,3 +450,29 @@ def test_steady_check_step_on_the_command_line():
                if k.startswith(("dynamic_factor", "mean_force")))
     bad = runner.invoke(app, ["steady", EXAMPLE, "--steps-per-cycle", "3"])
     assert bad.exit_code != 0 and "--steps-per-cycle" in bad.output
+
+
+def test_the_largest_dynamic_factor_of_a_sweep_is_that_of_its_stable_points():
+    """A softening branch: continuation passes a fold and runs down the unstable middle
+    branch, whose dynamic factor exceeded every stable one; 'sweep-speed' reported it
+    as the sweep's largest (a reviewer's spur pair with backlash: 2.507 at 7624 rpm, on
+    a point its own dataset marks unstable).  Time integrations of --cross-check are
+    reported beside it."""
+    import xarray as xr
+
+    from torquesplit.steady.cli import sweep_maxima
+
+    rpm = np.array([7000.0, 7500.0, 8000.0, 7800.0, 7600.0])
+    df = np.array([[1.5], [2.0], [2.3], [2.4], [2.6]])
+    ds = xr.Dataset(
+        {"stable": ("point", np.array([True, True, True, False, False])),
+         "dynamic_factor": (("point", "mesh"), df),
+         "run_up_dynamic_factor": (("check", "mesh"), np.array([[1.4], [3.7]])),
+         "run_down_dynamic_factor": (("check", "mesh"), np.array([[3.9], [2.0]]))},
+        coords={"speed_rpm": ("point", rpm), "mesh": ["m"],
+                "check_speed_rpm": ("check", np.array([7000.0, 8000.0]))})
+    got = sweep_maxima(ds)["m"]
+    assert got["stable"] == (2.3, 8000.0)
+    assert got["run_up"] == (3.7, 8000.0) and got["run_down"] == (3.9, 7000.0)
+    ds["stable"][:] = False
+    assert all(math.isnan(v) for v in sweep_maxima(ds)["m"]["stable"])

@@ -155,7 +155,7 @@ def cycle_peak_figure(results, *, dense_above: int = DENSE_CYCLES) -> Figure:
     """Peak mesh force of every complete mesh cycle against the cycle's start time.
 
     One panel per load-sharing group; the nominal static force is dashed, the start of
-    the settled part (the settle criterion of :meth:`Results.metrics`, which works on
+    the group's settled part (the settle criterion of :meth:`Results.metrics`, which works on
     these peaks) is the dotted vertical line and the transient before it is shaded.  The
     cycle cut off by the end of the run is not drawn (its peak is that of part of a
     cycle).  More than ``dense_above`` cycles are drawn as the range of the peaks over
@@ -164,7 +164,7 @@ def cycle_peak_figure(results, *, dense_above: int = DENSE_CYCLES) -> Figure:
     s = results.solution
     groups = results.groups
     nominal = results.nominal_forces()
-    settle = results.metrics().settling.start_time
+    settling = results.metrics().settling
     peaks = results.complete_cycle_statistics()[0]
     col = {m: j for j, m in enumerate(results.mesh_names)}
     cols = _cycle_columns(results)
@@ -177,7 +177,9 @@ def cycle_peak_figure(results, *, dense_above: int = DENSE_CYCLES) -> Figure:
             _dense_line(ax, start[ok] * scale, peak[ok] * _KN, m,
                         _line_style(i, len(members)), dense_above)
         _nominal_lines(ax, [nominal[m] for m in members])
-        _mark_settled(ax, settle * scale, s.t_span[0] * scale, unit)
+        # the group's own settle time: its metrics start there
+        _mark_settled(ax, settling.group_time.get(g, settling.start_time) * scale,
+                      s.t_span[0] * scale, unit)
         ax.set_title(_group_label(g, members), fontsize=FONT["title"])
         _label(ax, f"cycle start time [{unit}]", "peak force in cycle [kN]")
         _legend(ax)

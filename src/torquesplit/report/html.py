@@ -202,7 +202,7 @@ def _run_section(res, met) -> str:
     settings = [["method", st["method"]], ["simulated time [s]", _g(st["simulated_time_s"], 6)],
                 ["steps", f"{st['steps']:,}"],
                 ["step [s]", _g(st["step_s"], 4) if st["step_s"] else "adaptive"],
-                ["transient discarded [s]", _g(met.settling.start_time, 5)
+                ["transient discarded", met.settle_times_text()
                  + ("" if met.settling.settled else " (not settled: see the warnings)")],
                 ["load-sharing definition", met.definition],
                 ["status", res.message]]

@@ -82,6 +82,8 @@ class Metrics:
             "definition": self.definition,
             "definition_text": ls.DEFINITION_TEXT[self.definition],
             "settle_time_s": self.settling.start_time,
+            "settle_time_note": "the latest group's; each group's metrics start at its own "
+                                "(groups.<name>.settle_time_s)",
             "settled": self.settling.settled,
             "system_load_sharing": self.load_sharing.system,
             "groups": {g: {"meshes": self.load_sharing.groups[g],
@@ -95,6 +97,14 @@ class Metrics:
             "meshes": {r.mesh: {k: v for k, v in r.__dict__.items() if k != "mesh"}
                        for r in self.rows},
         }
+
+    def settle_times_text(self) -> str:
+        """The transient the metrics leave out: '0.04 s', or per group where the groups'
+        differ ('split 0.02 s, combine 0.04 s': each group's metrics start at its own)."""
+        times = self.settling.group_time
+        if len(set(times.values())) <= 1:
+            return f"{self.settling.start_time:.4g} s"
+        return ", ".join(f"{g} {t:.4g} s" for g, t in times.items())
 
     def values(self) -> dict[str, float]:
         """Every number of these metrics by a flat name (what studies ask for):

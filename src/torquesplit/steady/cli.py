@@ -208,6 +208,12 @@ def register(app, load, fail, console, err_console, json_default):
                                           help="Skip the Floquet multipliers."),
         cross_check: bool = typer.Option(False, "--cross-check",
                                          help="Also run-up and run-down time integrations."),
+        max_step: Optional[str] = typer.Option(
+            None, "--max-step", help="Largest continuation step in speed, e.g. '5 rpm' "
+            "(default: twice the initial spacing).", metavar="SPEED"),
+        steps_per_cycle: Optional[int] = typer.Option(
+            None, "--steps-per-cycle", help="Shooting: RK4 steps per cycle of the fastest "
+            "excitation (default 100, refined for the highest mode).", metavar="N"),
         out: Optional[Path] = typer.Option(None, "--out", help="Write the Dataset (.nc)."),
         plot: Optional[Path] = typer.Option(None, "--plot", help="Write the figure (.png/.svg)."),
         force: bool = typer.Option(False, "--force", help="Replace existing --out / --plot "
@@ -222,6 +228,13 @@ def register(app, load, fail, console, err_console, json_default):
             from torquesplit.results.files import NETCDF_FORMATS
             from torquesplit.steady.maps import sweep_speed
 
+            if steps_per_cycle is not None and steps_per_cycle < 10:
+                raise TorquesplitError(f"--steps-per-cycle must be at least 10 (e.g. 200), "
+                                       f"got {steps_per_cycle}")
+            step = None if max_step is None else _speed(max_step, "--max-step")
+            if step is not None and not step > 0:
+                raise TorquesplitError(f"--max-step must be a positive speed, e.g. '5 rpm'; "
+                                       f"got {max_step!r}")
             _check_out(out, NETCDF_FORMATS, force)
             if plot is not None:
                 _check_out(plot, {".png": "png", ".svg": "svg", ".pdf": "pdf"}, force)
@@ -232,7 +245,8 @@ def register(app, load, fail, console, err_console, json_default):
                 ds = sweep_speed(m, _speed(start, "--from"), _speed(stop, "--to"),
                                  points=points, harmonics=harmonics, keep=_keep(keep),
                                  max_cycles=max_cycles, stability=not no_stability,
-                                 cross_check=cross_check, method=method)
+                                 cross_check=cross_check, method=method, max_step=step,
+                                 steps_per_cycle=steps_per_cycle)
         except (TorquesplitError, ValueError, OSError) as exc:
             fail(exc)
             return
@@ -242,16 +256,25 @@ def register(app, load, fail, console, err_console, json_default):
             from torquesplit.steady.plot import save, sweep_figure
 
             save(sweep_figure(ds), plot)
+        largest = sweep_maxima(ds)
         summary = {
             "model": ds.attrs["model"], "points": int(ds.sizes["point"]),
             "complete": bool(ds.attrs["complete"]), "message": ds.attrs["message"],
             "fold_speeds_rpm": ds.attrs["fold_speeds_rpm"],
             "critical_speeds_rpm": ds.attrs["critical_speeds_rpm"],
-            "max_dynamic_factor": {str(k): float(ds["dynamic_factor"].sel(mesh=k).max())
-                                   for k in ds["mesh"].values},
+            "max_dynamic_factor": {k: v["stable"][0] for k, v in largest.items()},
+            "max_dynamic_factor_speed_rpm": {k: v["stable"][1] for k, v in largest.items()},
+            "max_dynamic_factor_of": "the stable points of the branch (unstable ones are "
+                                     "not observable)",
             "unstable_points": int((~ds["stable"].values).sum()),
             "wall_time_s": ds.attrs["wall_time_s"],
         }
+        if cross_check:
+            for key in ("run_up", "run_down"):
+                summary[f"{key}_max_dynamic_factor"] = {k: v[key][0]
+                                                        for k, v in largest.items()}
+                summary[f"{key}_max_dynamic_factor_speed_rpm"] = {
+                    k: v[key][1] for k, v in largest.items()}
         if as_json:
             _emit(summary, json_default)
         else:
@@ -261,21 +284,53 @@ def register(app, load, fail, console, err_console, json_default):
                 console.print("turning points (jump speeds): " + ", ".join(
                     f"{f:.5g} rpm ({k})" for f, k in zip(summary["fold_speeds_rpm"],
                                                         ds.attrs["fold_kinds"], strict=True)))
-            t = Table(title="largest dynamic factor over the sweep")
-            for col in ("mesh", "DF (peak/static)", "at [rpm]"):
+            t = Table(title="largest dynamic factor over the stable points of the sweep"
+                          + (" and the time integrations" if cross_check else ""))
+            cols = ["mesh", "DF (peak/static)", "at [rpm]"]
+            cols += ["run-up DF", "at [rpm]", "run-down DF", "at [rpm]"] if cross_check else []
+            for col in cols:
                 t.add_column(_h(col))
-            for k in ds["mesh"].values:
-                df = ds["dynamic_factor"].sel(mesh=k).values
-                i = int(np.nanargmax(df))
-                t.add_row(str(k), f"{df[i]:.5f}", f"{ds['speed_rpm'].values[i]:.6g}")
+            for k, v in largest.items():
+                cells = [k] + [c for key in ("stable", "run_up", "run_down")
+                               if key in v for c in (f"{v[key][0]:.5f}", f"{v[key][1]:.6g}")]
+                t.add_row(*cells)
             console.print(t)
-            console.print(f"unstable points: {summary['unstable_points']}")
+            console.print(f"unstable points: {summary['unstable_points']} (dashed in the "
+                          f"figure; left out of the largest dynamic factor)")
         if not ds.attrs["complete"]:
             err_console.print(f"[yellow]warning:[/] {ds.attrs['message']}")
             raise typer.Exit(1)
 
 
 import numpy as np  # noqa: E402  (used by the commands above)
+
+
+def sweep_maxima(ds) -> dict[str, dict[str, tuple[float, float]]]:
+    """Per mesh, the largest dynamic factor and its speed [rpm] over the stable points of
+    a speed sweep (``"stable"``; an unstable periodic state is never observed, so its
+    peak is not a result) and, where present, over the run-up and run-down time
+    integrations of ``--cross-check`` (``"run_up"``, ``"run_down"``).  NaN where there is
+    no such point."""
+    out = {}
+    stable = np.asarray(ds["stable"].values, bool)
+    rpm = np.asarray(ds["speed_rpm"].values, float)
+
+    def peak(values, speeds):
+        values = np.where(np.isfinite(values), values, -np.inf)
+        if not values.size or not np.isfinite(values.max()):
+            return (math.nan, math.nan)
+        i = int(np.argmax(values))
+        return (float(values[i]), float(speeds[i]))
+
+    for j, k in enumerate(ds["mesh"].values):
+        df = np.asarray(ds["dynamic_factor"].values[:, j], float)
+        row = {"stable": peak(df[stable], rpm[stable])}
+        for key in ("run_up", "run_down"):
+            if f"{key}_dynamic_factor" in ds:
+                row[key] = peak(np.asarray(ds[f"{key}_dynamic_factor"].values[:, j], float),
+                                np.asarray(ds["check_speed_rpm"].values, float))
+        out[str(k)] = row
+    return out
 
 
 def _to_netcdf(ds, path, overwrite=False):

@@ -92,9 +92,10 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
     -------
     xarray.Dataset
         dims ``point`` and ``mesh``: speed, mesh frequency, dynamic factor (peak / the
-        mesh's static force), peak-to-nominal, load-sharing coefficient (largest
-        instantaneous ratio in its group over the period), RMS transmission error, peak
-        force, stability and largest Floquet multiplier; attributes: turning points
+        mesh's static force), peak-to-nominal, load-sharing coefficients (``load_sharing``:
+        the ratio of mean forces, as ``run`` and ``steady`` report by default;
+        ``load_sharing_instantaneous``: the largest instantaneous ratio in its group
+        over the period), RMS transmission error, peak and mean force, stability and largest Floquet multiplier; attributes: turning points
         (jump speeds), natural frequencies and their mesh-order crossings, status
         message.  A continuation that fails keeps the points computed so far
         (``attrs['complete'] == 0`` and the reason in ``attrs['message']``).
@@ -152,11 +153,23 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
                                {"units": "1", "long_name": "peak / the mesh's static force"}),
             "peak_to_nominal": (("point", "mesh"), stack("peak_to_nominal"),
                                 {"units": "1", "long_name": "peak / equal-split nominal force"}),
-            "load_sharing": (("point", "mesh"), stack("load_sharing"),
-                             {"units": "1", "long_name": "largest instantaneous N F_i / sum F_j"}),
+            "load_sharing": (("point", "mesh"), stack("load_sharing"), {
+                "units": "1", "definition": "mean_force",
+                "long_name": "load-sharing coefficient N mean F_i / sum of the group's "
+                             "mean forces (mean_force, Dong et al. 2021 eq. 12)"}),
+            "load_sharing_instantaneous": (("point", "mesh"),
+                                           stack("load_sharing_instantaneous"), {
+                "units": "1", "definition": "instantaneous",
+                "long_name": "largest instantaneous N F_i / sum F_j over the period "
+                             "(Ji & Li eq. 18)"}),
             "rms_transmission_error": (("point", "mesh"), stack("rms_transmission_error"),
-                                       {"units": "m"}),
-            "peak_force": (("point", "mesh"), stack("peak_force"), {"units": "N"}),
+                                       {"units": "m", "long_name": "RMS dynamic "
+                                        "transmission error (mesh deflection about its "
+                                        "mean)"}),
+            "peak_force": (("point", "mesh"), stack("peak_force"),
+                           {"units": "N", "long_name": "peak mesh force"}),
+            "mean_force": (("point", "mesh"), stack("mean_force"),
+                           {"units": "N", "long_name": "mean mesh force"}),
             "stable": ("point", np.array([bool(p.stable) if p.stable is not None else True
                                           for p in pts], dtype=bool)),
             "max_multiplier": ("point", np.array([p.max_multiplier for p in pts]),

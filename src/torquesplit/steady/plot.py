@@ -19,50 +19,134 @@ def _figure(w, h):
     return fig
 
 
-def sweep_figure(ds, variable: str = "dynamic_factor"):
-    """``variable`` per mesh against speed: stable solid, unstable dashed, turning points
-    (jump speeds) and critical speeds (natural frequency x mesh order) marked, run-up /
-    run-down time integrations as markers when present."""
-    fig = _figure(8, 4.5)
-    ax = fig.add_subplot()
+_SWEEP_AXES = {  # variable -> (axis label, scale of the stored SI value)
+    "dynamic_factor": ("dynamic factor\n(peak / static force) [-]", 1.0),
+    "peak_to_nominal": ("peak / nominal force [-]", 1.0),
+    "load_sharing": ("load-sharing coefficient\n(mean forces) [-]", 1.0),
+    "load_sharing_instantaneous": ("load-sharing coefficient\n(largest instantaneous) [-]",
+                                   1.0),
+    "rms_transmission_error": ("RMS dynamic\ntransmission error [µm]", 1e6),
+    "peak_force": ("peak mesh force [kN]", 1e-3),
+}
+
+
+def sweep_variables(ds) -> list[str]:
+    """The panels of :func:`sweep_figure` by default: the dynamic factor, the load-sharing
+    coefficient where some mesh shares its load with others (a coefficient that is 1
+    everywhere says nothing), and the RMS transmission error."""
+    out = ["dynamic_factor"]
+    lsc = ds["load_sharing"].values if "load_sharing" in ds else np.ones(1)
+    if np.any(np.abs(np.nan_to_num(lsc, nan=1.0) - 1.0) > 1e-9):
+        out.append("load_sharing")
+    if "rms_transmission_error" in ds:
+        out.append("rms_transmission_error")
+    return out
+
+
+def sweep_figure(ds, variables=None):
+    """Speed response of a sweep (:func:`~torquesplit.steady.maps.sweep_speed`), one panel
+    per variable (``variables``: a name or a list; default :func:`sweep_variables`), each
+    mesh against speed: stable solid, unstable dashed, turning points (jump speeds)
+    dotted, critical speeds (natural frequency x mesh order) as grey lines labelled in
+    the top panel, run-up / run-down time integrations as markers when present."""
+    if variables is None:
+        variables = sweep_variables(ds)
+    elif isinstance(variables, str):
+        variables = [variables]
     rpm = ds["speed_rpm"].values
-    stable = ds["stable"].values
-    colors = {}
-    for j, mesh in enumerate(ds["mesh"].values):
-        y = ds[variable].values[:, j]
-        line = None
-        for k in range(len(rpm) - 1):
-            st = stable[k] and stable[k + 1]
-            (line,) = ax.plot(rpm[k:k + 2], y[k:k + 2], "-" if st else "--",
-                              color=None if line is None else line.get_color(),
-                              label=str(mesh) if k == 0 else None, lw=1.3)
-        colors[mesh] = line.get_color() if line is not None else None
-        check = f"run_up_{variable}"
-        if check in ds:
-            ax.plot(ds["check_speed_rpm"].values, ds[check].values[:, j], "^", ms=4,
-                    color=colors[mesh], alpha=0.7,
-                    label="run-up (time integration)" if j == 0 else None)
-            ax.plot(ds["check_speed_rpm"].values, ds[f"run_down_{variable}"].values[:, j],
-                    "v", ms=4, color=colors[mesh], alpha=0.7,
-                    label="run-down (time integration)" if j == 0 else None)
-    for f in ds.attrs.get("fold_speeds_rpm", []):
-        ax.axvline(f, color="k", lw=0.8, ls=":")
     lo, hi = float(np.nanmin(rpm)), float(np.nanmax(rpm))
-    for c, labels in critical_speed_groups(ds, lo, hi):
-        ax.axvline(c, color="0.6", lw=0.6)
-        ax.text(c, 1.0, "\n".join(labels), rotation=90, fontsize=6, va="top", ha="right",
-                transform=ax.get_xaxis_transform(), color="0.4")
-    ax.set_xlabel("input speed [rpm]")
-    ax.set_ylabel(ds[variable].attrs.get("long_name", variable))
-    ax.set_title(f"{ds.attrs.get('model', '')}: {variable.replace('_', ' ')} "
-                 f"(solid stable, dashed unstable, dotted: turning points)", fontsize=9)
-    ax.legend(fontsize=7, ncol=2)
+    groups = critical_speed_groups(ds, lo, hi)
+    fig = _figure(9, 1.6 + 2.6 * len(variables) + 0.12 * len(groups))
+    grid = fig.add_gridspec(len(variables) + 1, 1,
+                            height_ratios=[2.6] * len(variables) + [0.1 + 0.12 * len(groups)])
+    axes = [fig.add_subplot(grid[0])]
+    axes += [fig.add_subplot(grid[i], sharex=axes[0]) for i in range(1, len(variables))]
+    for n, (ax, variable) in enumerate(zip(axes, variables)):
+        _sweep_panel(ax, ds, variable)
+        for f in ds.attrs.get("fold_speeds_rpm", []):
+            ax.axvline(f, color="k", lw=0.8, ls=":")
+        for k, (c, _) in enumerate(groups):
+            ax.axvline(c, color="0.6", lw=0.6)
+            if n == 0:  # a short tag above the panel (two rows where tags crowd), the
+                # full labels listed under the figure
+                row = k % 2 if len(groups) > 1 and _crowded(groups, k, hi - lo) else 0
+                ax.annotate(str(k + 1), (c, 1.0), xycoords=ax.get_xaxis_transform(),
+                            xytext=(0, 2 + 8 * row), textcoords="offset points",
+                            fontsize=6, ha="center", va="bottom", color="0.35")
+        label, _ = _SWEEP_AXES.get(variable, (ds[variable].attrs.get("long_name", variable),
+                                              1.0))
+        ax.set_ylabel(label, fontsize=8)
+        ax.grid(alpha=0.3)
+        if n < len(variables) - 1:
+            ax.tick_params(labelbottom=False)
+    axes[0].legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    axes[-1].set_xlabel("input speed [rpm]")
+    notes = fig.add_subplot(grid[-1])
+    notes.axis("off")
+    if groups:
+        tags = [f"{k + 1}: {c:.0f} rpm, {', '.join(labs)}" for k, (c, labs) in
+                enumerate(groups)]
+        notes.text(0.0, 1.0, "\n".join(tags), fontsize=6, va="top", ha="left",
+                   transform=notes.transAxes, color="0.3")
+        notes.set_title("critical speeds (natural frequency = order x excitation "
+                        "frequency)", fontsize=7, loc="left")
+    dropped = ds.attrs.get("dropped_excitations") or []
+    if isinstance(dropped, str):  # a file's attribute: the list as JSON
+        import json
+
+        try:
+            dropped = json.loads(dropped)
+        except ValueError:
+            dropped = [dropped]
+    note = f"\nreplaced by their means: {'; '.join(dropped)}" if dropped else ""
+    axes[0].set_title(f"{ds.attrs.get('model', '')}: speed response (solid stable, dashed "
+                      f"unstable, dotted: turning points, grey: critical speeds){note}",
+                      fontsize=9, pad=16)
     return fig
 
 
-def critical_speed_groups(ds, lo: float, hi: float, merge: float = 0.005):
+def _crowded(groups, k, span) -> bool:
+    """Whether tag k sits within 2 % of the range of a neighbour's."""
+    c = groups[k][0]
+    near = [abs(c - groups[i][0]) for i in (k - 1, k + 1) if 0 <= i < len(groups)]
+    return bool(near) and min(near) < 0.02 * max(span, 1e-12)
+
+
+def _sweep_panel(ax, ds, variable):
+    """One variable of a sweep per mesh, and its run-up / run-down markers."""
+    rpm = ds["speed_rpm"].values
+    stable = ds["stable"].values
+    _, scale = _SWEEP_AXES.get(variable, ("", 1.0))
+    for j, mesh in enumerate(ds["mesh"].values):
+        y = ds[variable].values[:, j] * scale
+        line = None
+        # one polyline per run of stable (or unstable) segments: a dash pattern drawn
+        # segment by segment restarts at every point and looks solid
+        seg = [bool(stable[k] and stable[k + 1]) for k in range(len(rpm) - 1)]
+        k = 0
+        while k < len(seg):
+            e = k
+            while e + 1 < len(seg) and seg[e + 1] == seg[k]:
+                e += 1
+            (line,) = ax.plot(rpm[k:e + 2], y[k:e + 2], "-" if seg[k] else "--",
+                              color=None if line is None else line.get_color(),
+                              label=str(mesh) if k == 0 else None, lw=1.3)
+            k = e + 1
+        colour = line.get_color() if line is not None else None
+        check = f"run_up_{variable}"
+        if check in ds:
+            ax.plot(ds["check_speed_rpm"].values, ds[check].values[:, j] * scale, "^", ms=4,
+                    color=colour, alpha=0.7,
+                    label="run-up (time integration)" if j == 0 else None)
+            ax.plot(ds["check_speed_rpm"].values,
+                    ds[f"run_down_{variable}"].values[:, j] * scale, "v", ms=4, color=colour,
+                    alpha=0.7, label="run-down (time integration)" if j == 0 else None)
+
+
+def critical_speed_groups(ds, lo: float, hi: float, merge: float = 0.025):
     """Critical speeds of ``ds`` inside [lo, hi] rpm as (speed, labels): crossings closer
-    than ``merge`` of the range (a degenerate pair of modes, two orders meeting) share one
+    than ``merge`` of the range (a degenerate pair of modes, two orders meeting; 2.5 %:
+    about the width of a label at the figure's size) share one
     line and one label block instead of printing over each other."""
     crit = sorted((float(c), str(lab)) for c, lab in zip(
         ds.attrs.get("critical_speeds_rpm", []), ds.attrs.get("critical_speed_labels", []),

@@ -154,8 +154,8 @@ class Continuation:
         """Below this speed factor the branch has left the range backwards."""
         return min(s0, s1) - 0.5 * abs(s1 - s0)
 
-    remedy = ("Use more harmonics, a smaller --max-step, or the shooting continuation "
-              "(--method shooting).")
+    remedy = ("Use more harmonics (--harmonics), a smaller --max-step, or the shooting "
+              "continuation (--method shooting).")
     """What to try when the corrector fails (said in the message)."""
 
     def _tangent_system(self, x, s, tw, rhs):
@@ -343,7 +343,7 @@ class ShootingContinuation(Continuation):
     def lowest_speed(self, s0, s1) -> float:
         return self.s_low
 
-    remedy = ("Use more RK4 steps per cycle (steps_per_cycle), a smaller --max-step, or "
+    remedy = ("Use more RK4 steps per cycle (--steps-per-cycle), a smaller --max-step, or "
               "harmonic balance (--method hb), whose smoothing can pass a grazing contact.")
 
     def _weights(self, x):
@@ -497,20 +497,26 @@ def _point_outputs(f, f_all, d, groups, static_forces, nominal, peak, mean):
     """A sweep point's outputs per tracked mesh from its force samples ``f``, those and
     any instants between them ``f_all`` (the load-sharing ratio's extremes), the
     deformation samples ``d``, the peak forces ``peak`` and mean forces ``mean``
-    (:func:`record_extremes`): peak force, dynamic factors, load sharing (largest
-    instantaneous ratio in its group, Ji & Li eq. 18), RMS transmission error, mean
-    force."""
+    (:func:`record_extremes`): peak force, dynamic factors, load sharing (the ratio of
+    the mean forces in its group, Dong et al. 2021 eq. 12, as ``run`` and ``steady``
+    report it by default, and the largest instantaneous ratio, Ji & Li eq. 18), RMS
+    transmission error, mean force."""
     lsc = np.full(f.shape[1], np.nan)
+    lsc_inst = np.full(f.shape[1], np.nan)
+    mean = np.asarray(mean, dtype=float)
     for cols in groups:
         sub = f_all[:, cols]
         tot = sub.sum(axis=1, keepdims=True)
         with np.errstate(divide="ignore", invalid="ignore"):
             r = len(cols) * sub / np.where(tot != 0, tot, np.nan)  # Ji & Li eq. 18
-        lsc[cols] = np.nanmax(r, axis=0)
+            # Dong et al. 2021 eq. 12: N mean F_i / sum_j mean F_j
+            lsc[cols] = len(cols) * mean[cols] / mean[cols].sum()
+        lsc_inst[cols] = np.nanmax(r, axis=0)
     rms = np.sqrt(np.mean((d - d.mean(axis=0)) ** 2, axis=0))
     return dict(peak_force=peak, dynamic_factor=peak / static_forces,
                 peak_to_nominal=peak / nominal, load_sharing=lsc,
-                rms_transmission_error=rms, mean_force=mean)
+                load_sharing_instantaneous=lsc_inst, rms_transmission_error=rms,
+                mean_force=mean)
 
 
 def continue_in_speed_shooting(problem, period, q_static, s0, s1, *, points=50,
