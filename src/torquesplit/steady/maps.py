@@ -95,8 +95,8 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
         mesh's static force), peak-to-nominal, load-sharing coefficients (``load_sharing``:
         the ratio of mean forces, as ``run`` and ``steady`` report by default;
         ``load_sharing_instantaneous``: the largest instantaneous ratio in its group
-        over the period), RMS transmission error, peak and mean force, stability and largest Floquet multiplier; attributes: turning points
-        (jump speeds), natural frequencies and their mesh-order crossings, status
+        over the period), RMS transmission error, peak and mean force, stability and
+        largest Floquet multiplier; attributes: turning points (jump speeds), natural frequencies and their mesh-order crossings, status
         message.  A continuation that fails keeps the points computed so far
         (``attrs['complete'] == 0`` and the reason in ``attrs['message']``).
     """
