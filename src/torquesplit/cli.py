@@ -340,6 +340,10 @@ def run(
     max_steps: Optional[int] = typer.Option(
         None, "--max-steps", help="Refuse an RK4 run needing more steps (default 2e8).",
         metavar="N"),
+    samples_per_period: int = typer.Option(
+        20, "--samples-per-period", help="History samples per shortest mesh period, for "
+        "--out files and --plots figures (the metrics are streamed at every step and do "
+        "not depend on it); a run warns when the history misses the peaks.", metavar="N"),
     definition: Optional[str] = typer.Option(None, "--definition", help=_definition_help(),
                                              metavar="NAME"),
     out: Optional[Path] = typer.Option(
@@ -385,6 +389,7 @@ def run(
             _at_least(cycles, 1, "--cycles", "200")
             _at_least(steps_per_period, 10, "--steps-per-period", "100")
             _at_least(max_steps, 1, "--max-steps", "200000000")
+            _at_least(samples_per_period, 1, "--samples-per-period", "100")
             _check_definition(definition)
             _check_plots_folder(plots)
             plan = None
@@ -403,7 +408,7 @@ def run(
             with ux.collect_warnings(), ux.progress("integrating", quiet or as_json) as cb:
                 res = simulate(m, duration=dur, cycles=cycles, method=method,
                                steps_per_period=steps_per_period, max_steps=max_steps,
-                               progress=cb)
+                               samples_per_period=samples_per_period, progress=cb)
             res.model_warnings = [w for w in _model_warnings() if w not in res.run_warnings]
             met = None
             if res.success:

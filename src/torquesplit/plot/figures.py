@@ -93,10 +93,13 @@ def mesh_force_figure(results, *, last_cycles: float | None = None,
         own time window).  Default: the whole run.
     band_above : float
         A panel showing more than this many mesh cycles draws each mesh as the band
-        between its smallest and largest recorded force in each mesh cycle (or in runs of
-        whole cycles, at most ``bins`` per panel): every peak and trough of the history
-        is kept, and single cycles would not be visible anyway.  Fewer cycles are drawn
-        sample by sample.
+        between its smallest and largest force in each mesh cycle (or in runs of whole
+        cycles, at most ``bins`` per panel), from the per-cycle extremes the integrator
+        streams at every step (and at the tables' corners), not from the decimated
+        history, which can miss peaks between its samples.  Fewer cycles are drawn
+        sample by sample from the history, with each complete cycle's streamed largest
+        and smallest force as short dotted steps over it: where they stand clear of the
+        line, the history is too coarse for the waveform (``samples_per_period``).
     bins : int
         Largest number of time bins of a band.
 
@@ -110,6 +113,8 @@ def mesh_force_figure(results, *, last_cycles: float | None = None,
     names, groups = results.mesh_names, results.groups
     nominal = results.nominal_forces()
     freq = _group_frequencies(results)
+    c_max, c_min = (_finite(a) for a in results.complete_cycle_statistics()[:2])
+    starts, cols = results.solution.cycle_start, _cycle_columns(results)
     fig, axes = _panels(len(groups), sharex=last_cycles is None)
     scale, unit = _time_unit(t)
     for ax, (g, members) in zip(axes, groups.items()):
@@ -123,23 +128,32 @@ def mesh_force_figure(results, *, last_cycles: float | None = None,
         tk = t[keep]
         n_cycles = (tk[-1] - tk[0]) * freq[g] if tk.size else 0.0
         band = n_cycles > band_above
-        if band:  # bins of whole mesh cycles, so that each bin holds its cycle's peak
-            per_bin = math.ceil(n_cycles / bins)
-            # + 1e-6 cycle: a sample on a cycle boundary (t f integer up to rounding)
-            # always opens the new cycle, never sometimes closes the previous one
-            bin_index = np.floor((tk - tk[0]) * freq[g] / per_bin + 1e-6).astype(np.int64)
         for i, m in enumerate(members):
             style = _line_style(i, len(members))
-            y = forces[keep, names.index(m)] * _KN
-            if band:
-                tb, lo, hi = _bin_extremes(tk, y, bin_index)
+            j, col = names.index(m), cols[m]
+            ok = np.isfinite(c_max[:, j]) & np.isfinite(c_min[:, j])
+            t0, hi, lo = starts[ok, col], c_max[ok, j] * _KN, c_min[ok, j] * _KN
+            if band:  # the streamed extremes of every cycle, in bins of whole cycles
+                per_bin = max(1, math.ceil(t0.size / bins))
+                idx = np.arange(t0.size) // per_bin
+                tb, lo_b, _ = _bin_extremes(t0, lo, idx)
+                _, _, hi_b = _bin_extremes(t0, hi, idx)
+                tb = tb + 0.5 / freq[g]  # the bins' middles (t0 are cycle starts)
                 # light fill, edges in the mesh's own dash: overlapping bands stay apart
-                ax.fill_between(tb * scale, lo, hi, color=style["color"], alpha=0.12, lw=0,
-                                label=f"{m} (min-max band)")
-                ax.plot(tb * scale, hi, color=style["color"], lw=1.1, ls=style["ls"])
-                ax.plot(tb * scale, lo, color=style["color"], lw=1.1, ls=style["ls"])
-            else:
-                ax.plot(tk * scale, y, label=m, **style)
+                ax.fill_between(tb * scale, lo_b, hi_b, color=style["color"], alpha=0.12,
+                                lw=0, label=f"{m} (min-max of each cycle)")
+                ax.plot(tb * scale, hi_b, color=style["color"], lw=1.1, ls=style["ls"])
+                ax.plot(tb * scale, lo_b, color=style["color"], lw=1.1, ls=style["ls"])
+                continue
+            ax.plot(tk * scale, forces[keep, j] * _KN, label=m, **style)
+            shown = (t0 >= tk[0] - 1e-12) & (t0 + 1.0 / freq[g] <= tk[-1] + 1e-9) if (
+                tk.size) else np.zeros(t0.shape, bool)
+            if shown.any():  # each complete cycle's streamed extremes over it
+                edges = np.stack([t0[shown], t0[shown] + 1.0 / freq[g]], axis=1) * scale
+                for ext, lab in ((hi[shown], "largest"), (lo[shown], "smallest")):
+                    ax.plot(edges.ravel(), np.repeat(ext, 2), color=style["color"], lw=0.8,
+                            ls=":", label="largest / smallest of each cycle (streamed)"
+                            if i == 0 and lab == "largest" else None)
         _nominal_lines(ax, [nominal[m] for m in members])
         window = f", last {last_cycles:g} mesh cycles" if last_cycles is not None else ""
         ax.set_title(f"{_group_label(g, members)}, mesh frequency {_hz(freq[g])}{window}",

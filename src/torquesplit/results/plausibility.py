@@ -25,6 +25,9 @@ check                      says
 :func:`mean_drift`         mean-force coefficients that differ between the two halves
                            of the settled part by more than :data:`MEAN_DRIFT` (slow
                            excitations whose common period is longer than the run)
+:func:`coarse_history`     a decimated history (files, figures) that misses the settled
+                           peak force by more than :data:`HISTORY_MISS`: its waveform is
+                           not the response's (the metrics are streamed, unaffected)
 =========================  ===========================================================
 """
 
@@ -34,6 +37,9 @@ import math
 
 import numpy as np
 
+#: a history whose largest settled force is this much below the streamed peak is too
+#: coarse for the waveform (:func:`coarse_history`)
+HISTORY_MISS = 0.05
 #: a dynamic factor (settled peak / the mesh's own static force) above this is reported
 #: as "near a resonance"; gear standards' K_v rarely exceeds 2
 RESONANCE_FACTOR = 3.0
@@ -241,8 +247,48 @@ def mean_drift(results, metrics) -> list[tuple[str, str]]:
 
 
 #: every check, in the order the messages are listed
+def coarse_history(results, metrics) -> list[tuple[str, str]]:
+    """The decimated history (saved to files, drawn in the figures) against the settled
+    peak the integrator streams at every step: where its largest settled sample falls
+    short by more than :data:`HISTORY_MISS`, the response has content faster than the
+    history's sampling (a resonance at a high mesh order, impacts) and its waveform is
+    not the response's.  One message, for the mesh where it misses most; none where the
+    history keeps every (fixed) step already."""
+    if results.solution is None or not results.solution.history_t.size:
+        return []
+    t, forces = results.mesh_force_history()
+    if t.size < 2:
+        return []
+    step = results.statistics().get("step_s") or 0.0
+    if step and float(np.median(np.diff(t))) < 1.5 * step:
+        return []  # every step is kept: a finer history needs a finer step, not more samples
+    worst = None
+    for j, row in enumerate(metrics.rows):
+        start = metrics.settling.group_time.get(row.group, metrics.settling.start_time)
+        seen = forces[t >= start, j]
+        seen = seen[np.isfinite(seen)]
+        if not (seen.size and row.peak_force > 0 and math.isfinite(row.peak_force)):
+            continue
+        miss = 1.0 - float(seen.max()) / row.peak_force
+        if miss > HISTORY_MISS and (worst is None or miss > worst[1]):
+            worst = (row.mesh, miss, float(seen.max()), row.peak_force)
+    if worst is None:
+        return []
+    m, miss, seen, peak = worst
+    f_max = max(float(results._mesh_meta[k]["frequency"]) for k in results.mesh_names)
+    per = 1.0 / (f_max * float(np.median(np.diff(t)))) if f_max > 0 else math.nan
+    more = max(100, 5 * round(per)) if math.isfinite(per) else 100
+    return [("analysis", (
+        f"the history ({per:.3g} samples per shortest mesh period), which the results "
+        f"files and the figures hold, misses the settled peak force of mesh {m} by "
+        f"{100 * miss:.2g} % ({_kn(seen)} against {_kn(peak)}): the response is faster "
+        f"than its sampling and the saved waveform is not the response's.  The table's "
+        f"numbers are streamed at every step and unaffected; for waveforms, run again "
+        f"with --samples-per-period {more} (Python: samples_per_period={more})"))]
+
+
 CHECKS = (static_force, contact_loss, back_flank, resonance, settling, peak_drift,
-          mean_drift)
+          mean_drift, coarse_history)
 
 
 def result_warnings(results, metrics) -> list[tuple[str, str]]:
