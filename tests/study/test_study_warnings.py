@@ -58,3 +58,21 @@ def test_a_settle_rule_that_reaches_its_cap_warns(split_file):
     ds = run_study(data, workers=1)
     assert ds["settled"].values[0] == 0
     assert "analysis.settle: the outputs still changed" in str(ds["warnings"].values[0])
+
+
+def test_grouped_warnings_say_nothing_one_case_contradicts():
+    """Three cases of a sweep warned about different meshes and values; the summary
+    printed the first case's mesh and numbers for all three ('cases 1-3: meshes.in1 ...
+    15.75 kN'), while cases 2 and 3 were about in2 at 15.1 and 18.34 kN."""
+    import numpy as np
+    import xarray as xr
+
+    texts = ["meshes.in1: peak 15.75 kN, dynamic factor 2.06",
+             "meshes.in2: peak 15.1 kN, dynamic factor 2.029",
+             "meshes.in2: peak 18.34 kN, dynamic factor 2.475\nanalysis: 1e-3 s step"]
+    ds = xr.Dataset({"warnings": ("case", np.array(texts, dtype=object))})
+    groups = warning_groups(ds)
+    assert groups[0] == {"text": "meshes.in2: peak 15.1 to 18.34 kN, dynamic factor 2.029 "
+                                 "to 2.475", "cases": [1, 2]}
+    assert {"text": texts[0], "cases": [0]} in groups
+    assert {"text": "analysis: 1e-3 s step", "cases": [2]} in groups

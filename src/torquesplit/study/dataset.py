@@ -222,22 +222,45 @@ def ranking(ds, output: str) -> list[tuple[str, float]]:
     return [(str(ds["factor"].values[i]), float(row[i])) for i in order]
 
 
-_NUMBER = re.compile(r"[-+]?\d+(?:\.\d*)?(?:[eE][-+]?\d+)?")
+# a number standing alone (not the digits of a name such as mesh 'in1' or 'm46')
+_NUMBER = re.compile(r"(?<![\w.])[-+]?\d+(?:\.\d*)?(?:[eE][-+]?\d+)?(?![\w])")
 
 
 def warning_groups(ds) -> list[dict]:
-    """The cases' warnings grouped by what they say (texts that differ only in numbers
-    are one group): ``[{"text": the first case's text, "cases": [case indices]}]``, the
-    group with most cases first."""
+    """The cases' warnings grouped by what they say (texts that differ only in their
+    numbers are one group; names such as 'in1' and 'in2' are not numbers):
+    ``[{"text": ..., "cases": [case indices]}]``, the group with most cases first.  The
+    text is the cases' common text with each number that differs between them given as
+    its range over the group ('15.1 to 18.34 kN'), so that it says nothing about one
+    case that another contradicts."""
     if "warnings" not in ds:
         return []
     groups: dict[str, dict] = {}
     for i, text in enumerate(ds["warnings"].values.ravel().tolist()):
         for line in filter(None, str(text).split("\n")):
-            g = groups.setdefault(_NUMBER.sub("#", line), {"text": line, "cases": []})
+            g = groups.setdefault(_NUMBER.sub("#", line), {"lines": [], "cases": []})
             if not g["cases"] or g["cases"][-1] != i:
                 g["cases"].append(i)
-    return sorted(groups.values(), key=lambda g: (-len(g["cases"]), g["cases"][0]))
+                g["lines"].append(line)
+    out = [{"text": _merged(g["lines"]), "cases": g["cases"]} for g in groups.values()]
+    return sorted(out, key=lambda g: (-len(g["cases"]), g["cases"][0]))
+
+
+def _merged(lines: list[str]) -> str:
+    """One text for lines that differ only in their numbers: each number as the range
+    of its values over the lines where they differ."""
+    numbers = [[m.group(0) for m in _NUMBER.finditer(line)] for line in lines]
+    parts = iter(range(len(numbers[0])))
+
+    def one(match) -> str:
+        k = next(parts)
+        seen = [n[k] for n in numbers]
+        if len(set(seen)) == 1:
+            return seen[0]
+        by_value = sorted(seen, key=float)
+        return f"{by_value[0]} to {by_value[-1]}"
+
+    return _NUMBER.sub(one, lines[0])
 
 
 def case_ranges(cases: list[int]) -> str:
