@@ -182,3 +182,19 @@ def test_draw_defaults_to_the_model_name_and_refuses_to_overwrite(tmp_path, monk
     assert res.exit_code == 2 and "exists; use --force" in res.stderr
     res = runner.invoke(app, ["draw", str(model), "--out", str(tmp_path / "l.png")])
     assert res.exit_code == 0 and (tmp_path / "l.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_modes_near_a_high_mesh_order_of_a_rectangular_wave_are_flagged(tmp_path):
+    """The tutorial's drive resonates near 7 x its split mesh frequency (its rectangular
+    contact waves excite the 7th order); the report's 'near a mesh order' column looked
+    at orders 1-3 only and printed '-' for every mode."""
+    from torquesplit.report.html import _modes
+
+    text = re.search(r"```toml\n(.*?)```", (Path(__file__).resolve().parents[2] / "docs"
+                                            / "tutorial.md").read_text(), re.S).group(1)
+    path = write_model(tmp_path, text)
+    res = torquesplit.simulate(torquesplit.load_model(path), duration=0.01)
+    rows = [re.findall(r"<td[^>]*>(.*?)</td>", r) for r in
+            re.findall(r"<tr>(.*?)</tr>", _modes(res), re.S)]
+    near = {r[1]: r[-1] for r in rows if r}
+    assert "7×in1" in near["6949.48"] and near["879.628"] == "-"

@@ -289,7 +289,14 @@ def _modes(res) -> str:
         return f'<p class="note">Natural modes not computed: {_e(exc)}</p>'
     from ..modes import phased_stages, phasing_suppresses
 
+    from ..steady.maps import mesh_orders
+
     mesh_f = {n: mk.frequency for n, mk in res.kinematics.meshes.items()}
+    # the orders each mesh's stiffness table excites (a rectangular contact wave reaches
+    # the 7th and beyond; a smooth one the 3rd)
+    names = list(res.structure.element_names)
+    top = {n: mesh_orders(res.structure.stiffness_table[names.index(n)]) if n in names
+           else 3 for n in mesh_f}
     typed = any(r.type for r in rep.rows)
     # a mesh order that the planets' mesh phasing leaves unexcited for the mode's type
     # (Parker & Lin 2004) is listed as suppressed, not as a possible resonance
@@ -299,7 +306,7 @@ def _modes(res) -> str:
         f = float(r.frequency)
         near = [f"{k}×{name}" + (" (suppressed by phasing)" if phasing_suppresses(
                     stages, name, k, r.type) else "")
-                for name, fm in mesh_f.items() for k in (1, 2, 3)
+                for name, fm in mesh_f.items() for k in range(1, top[name] + 1)
                 if abs(f - k * fm) <= NEAR_FRACTION * k * fm]
         energy = ", ".join(f"{n} {100 * v:.0f} %" for n, v in list(r.strain_energy.items())[:3])
         rows.append([str(r.mode), _g(f, 6), str(r.multiplicity)]
@@ -307,7 +314,7 @@ def _modes(res) -> str:
                     + [energy, ", ".join(sorted(set(near))) or "-"])
     header = (["mode", "f [Hz]", "mult."] + (["type"] if typed else [])
               + ["strain energy of the group (largest shares)",
-                 f"within {NEAR_FRACTION:.0%} of a mesh order"])
+                 f"within {NEAR_FRACTION:.0%} of a mesh order its table excites"])
     return (_table(header, rows, left=1)
             + f'<p class="note">{rep.rigid_modes} rigid-body mode(s) left out. Mesh '
               "frequencies: " + _e(", ".join(f"{k} {v:.5g} Hz" for k, v in mesh_f.items()))
