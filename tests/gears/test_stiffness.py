@@ -107,8 +107,8 @@ def test_iso_standard_spur_values_are_near_the_standards_14_and_20(z1, z2):
 def test_iso_spur_waveform_single_and_double_zones():
     p = spur()
     v = iso6336_values(p)
-    k = iso6336_stiffness(p, n=1000)
-    # single contact: c' b, double contact: 2 c' b (scale 'single_pair', the spur default)
+    k = iso6336_stiffness(p, n=1000, scale="single_pair")
+    # single contact: c' b, double contact: 2 c' b (scale 'single_pair')
     assert k.minimum == pytest.approx(v.c_prime * 20e-3, rel=1e-12)
     assert k.maximum == pytest.approx(2 * v.c_prime * 20e-3, rel=1e-12)
     assert double_fraction(k) == pytest.approx(p.transverse_contact_ratio - 1, abs=2e-3)
@@ -116,6 +116,11 @@ def test_iso_spur_waveform_single_and_double_zones():
     assert k.stiffness[0] == k.maximum
     scaled = iso6336_stiffness(p, n=1000, scale="c_gamma")
     assert scaled.mean == pytest.approx(v.mesh_stiffness, rel=1e-12)
+    # the default is ISO's mean mesh stiffness for a spur pair as for a helical one: the
+    # mean does not jump by 10 % between a helix angle of 0 and 0.01 deg
+    assert np.array_equal(iso6336_stiffness(p, n=1000).stiffness, scaled.stiffness)
+    near = helical(20, 40, 2e-3, 0.01 * DEG, 20e-3)
+    assert iso6336_stiffness(near, n=1000).mean == pytest.approx(scaled.mean, rel=1e-4)
     assert iso6336_mesh_stiffness_value(p) == pytest.approx(v.c_gamma * 20e-3, rel=1e-12)
 
 
@@ -348,8 +353,8 @@ def test_mesh_stiffness_result_behaviour():
 def test_compare_methods_and_plot(tmp_path):
     c = compare_methods(spur(), n=128)
     labels = [r["method"] for r in c.rows()]
-    assert labels[:2] == ["iso6336 (single_pair)", "iso6336 (c_gamma)"] and "potential_energy" in labels
-    assert c.results[1].mean == pytest.approx(c.iso_mesh_stiffness)
+    assert labels[:2] == ["iso6336 (c_gamma)", "iso6336 (single_pair)"] and "potential_energy" in labels
+    assert c.results[0].mean == pytest.approx(c.iso_mesh_stiffness)
     assert c.iso_mesh_stiffness == pytest.approx(iso6336_values(spur()).mesh_stiffness)
     assert "c_gamma" in c.table()
     from torquesplit.plot.mesh import plot_mesh_stiffness

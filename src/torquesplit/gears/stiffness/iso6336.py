@@ -239,8 +239,11 @@ def iso6336_stiffness(pair: PairGeometry, n: int = 256, *, scale: str | None = N
       mesh stiffness ``c_gamma b / cos^2(beta_b)``.
 
     Both are along the normal to the flanks (see the module docstring).
-    * ``None`` (default): ``"single_pair"`` for spur pairs and ``"c_gamma"`` for
-      helical and double-helical pairs.
+    * ``None`` (default): ``"c_gamma"`` for every pair.  ISO's mean mesh stiffness
+      ``c_gamma = c' (0.75 eps_alpha + 0.25)`` is below ``c' eps_alpha`` (``c'`` is the
+      largest single-pair stiffness; the pairs near tip and root are softer), and the
+      helical pairs take it: a spur default of ``"single_pair"`` made the mean jump by
+      10 % between a helix angle of 0 and 0.01 deg.
 
     ``stagger`` [cycles] offsets the second helix of a double-helical pair (0: the
     two helices mesh in phase).  Other options as :func:`iso6336_values`.
@@ -250,7 +253,7 @@ def iso6336_stiffness(pair: PairGeometry, n: int = 256, *, scale: str | None = N
     values = iso6336_values(pair, blank_factor=blank_factor, young_modulus=young_modulus,
                             line_load=line_load)
     if scale is None:
-        scale = "single_pair" if pair.gear1.beta == 0 else "c_gamma"
+        scale = "c_gamma"
     if scale not in ("single_pair", "c_gamma"):
         raise ModelError([("scale", f"must be 'single_pair' or 'c_gamma', got {scale!r}")])
     phase = phase_grid(n)
