@@ -855,9 +855,10 @@ def _print_mesh(pair, cmp, plot, as_json) -> None:
                   f"{r['mean_over_iso']:.3f}")
     console.print(t)
     console.print(f"ISO 6336-1: c' = {cmp.iso.c_prime_iso:.3f} N/(mm µm), c_gamma = "
-                  f"{cmp.iso.c_gamma_iso:.3f} N/(mm µm), c_gamma b = "
-                  f"{cmp.iso_mesh_stiffness / 1e6:.5g} N/µm (1 N/µm = 1e6 N/m = 1 N/(mm µm) "
-                  f"per mm of face)", highlight=False)
+                  f"{cmp.iso.c_gamma_iso:.3f} N/(mm µm) (transverse), c_gamma b / "
+                  f"cos² β_b = {cmp.iso_mesh_stiffness / 1e6:.5g} N/µm along the flank "
+                  f"normal, as the table (1 N/µm = 1e6 N/m = 1 N/(mm µm) per mm of face)",
+                  highlight=False)
     if plot is not None:
         console.print(f"plot written to {plot}")
 

@@ -382,6 +382,7 @@ def plausibility_warnings(model: Model, kin) -> list[tuple[str, str]]:
         if ratio is not None and ratio > 1:
             out.append((loc, f"{ratio:g} is above critical damping (1); check the value "
                              f"(typical 0.02-0.1)"))
+    out += _friction_drift(model)
     ltca_gears = {g for m in model.meshes.values() if m.stiffness.method == "ltca" for g in m.gears}
     for name, gear in model.gears.items():
         if gear.modifications is not None and name not in ltca_gears:
@@ -1011,6 +1012,24 @@ def nominal_load_issues(model: Model, kin) -> list[tuple[str, str]]:
             f"divide by zero: put the loads where the power must pass the meshes, or "
             f"remove the mesh")))
     return issues
+
+
+def _friction_drift(model: Model) -> list[tuple[str, str]]:
+    """Tooth friction with torque drives and a 'balanced' load of no speed dependence:
+    the load takes the whole input power, friction takes some too, so the train slows
+    down over the run (a reviewer's pair: 33 % below nominal speed after 0.3 s)."""
+    friction = [n for n, m in model.meshes.items() if m.friction is not None]
+    if not friction or any(d.mode != "torque" for d in model.drives.values()):
+        return []
+    return [(f"loads.{n}.torque", (
+        f"'balanced' takes the whole input power, but the tooth friction of "
+        f"{', '.join('meshes.' + m for m in friction)} dissipates some of it: the train "
+        f"decelerates over the run (the mesh forces follow the nominal mesh phase and are "
+        f"not affected, the speeds and the power balance are); give the load a "
+        f"speed_coefficient (dT/dw, as a rotor or fan has) or drive a body at a held "
+        f"speed (mode = \"speed\")"))
+        for n, load in model.loads.items()
+        if load.torque is None and not load.speed_coefficient]
 
 
 def balance_issues(model: Model, kin) -> list[tuple[str, str]]:

@@ -19,7 +19,8 @@ from .units import _short
 
 
 def load_model(source, *, check: bool = True) -> Model:
-    """Read a model file (``.toml`` or ``.json``), a dict or a :class:`Model`.
+    """Read a model file (``.toml`` or ``.json``), a shipped example by name (as the
+    command line takes it: ``"ji_li_mill_drive"``), a dict or a :class:`Model`.
 
     All values are converted to SI.  With ``check`` the topology and physical
     consistency checks of :mod:`torquesplit.model.checks` run too.  Bad input raises
@@ -38,6 +39,11 @@ def load_model(source, *, check: bool = True) -> Model:
         model, name = model_from_dict(source), None
     else:
         path = Path(source)
+        if not path.exists() and path.suffix == "" and path.parent == Path("."):
+            from torquesplit.examples import example_names, example_path
+
+            if str(source) in example_names():  # a shipped example by name
+                path = example_path(str(source))
         name = str(path)
         data = read_file(path)
         model = model_from_dict(data, source=name)

@@ -189,6 +189,17 @@ class Results:
             return []
 
     # ------------------------------------------------------------------ status
+    def __repr__(self) -> str:
+        s = self.solution
+        if s is None:
+            return f"<Results of {self.model.model.name!r}: no solution>"
+        kind = "periodic steady state" if self.periodic else "dynamic run"
+        return (f"<Results of {self.model.model.name!r}: {kind}, {s.t_final - s.t_span[0]:.4g} "
+                f"s simulated, {len(self.mesh_names)} meshes, "
+                f"{'ok' if self.success else 'stopped: ' + self.message}; "
+                f".metrics(), .metric_values(), .warnings(), .save(path), "
+                f".write_figures(dir)>")
+
     @property
     def success(self) -> bool:
         return self.solution.success

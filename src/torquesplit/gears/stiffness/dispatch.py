@@ -130,8 +130,8 @@ class MethodComparison:
             lines.append(f"{r['method']:<42}{r['mean']:12.4e}{r['minimum']:12.4e}{r['maximum']:12.4e}"
                          f"{r['peak_to_peak']:12.4e}{r['mean_over_iso']:10.3f}")
         lines.append(f"ISO 6336-1: c' = {self.iso.c_prime_iso:.3f} N/(mm um), c_gamma = "
-                     f"{self.iso.c_gamma_iso:.3f} N/(mm um), c_gamma b = {self.iso_mesh_stiffness:.4e} N/m "
-                     f"(normal), eps_alpha = {self.pair.transverse_contact_ratio:.4f}, "
+                     f"{self.iso.c_gamma_iso:.3f} N/(mm um) (transverse), c_gamma b / "
+                     f"cos^2 beta_b = {self.iso_mesh_stiffness:.4e} N/m (normal), eps_alpha = {self.pair.transverse_contact_ratio:.4f}, "
                      f"eps_beta = {self.pair.overlap_contact_ratio:.4f}")
         return "\n".join(lines)
 
