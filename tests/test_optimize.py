@@ -13,7 +13,7 @@ import re
 import numpy as np
 import pytest
 
-from torquesplit.errors import ModelError
+from torquesplit.errors import ModelError, ModelWarning, OptionError
 from torquesplit.optimize import evaluate_design, optimize, read_spec
 
 Y = ("y1", "y2", "y3", "y4", "y5", "y6")
@@ -61,9 +61,51 @@ def test_interrupted_optimisation_resumes_from_its_store(tmp_path):
     np.testing.assert_array_equal(first.F, resumed.F)
 
 
+def test_a_store_of_another_model_is_not_reused(tmp_path):
+    """The store was keyed by the variables' values alone: a changed [set] reused the
+    evaluations of the old model ('4 evaluations, 0 computed', a reviewer)."""
+    store = tmp_path / "evals.jsonl"
+    d = spec_dict(store=str(store), generations=1, population=4)
+    first = optimize(read_spec(d))
+    assert first.computed > 0
+    d["set"]["meshes.L68.stiffness"]["slices"] = 10
+    with pytest.warns(ModelWarning, match="not reused"):
+        changed = optimize(read_spec(d))
+    assert changed.computed == first.computed
+
+
+@pytest.mark.parametrize("override", [dict(generations=0), dict(population=2), dict(seed=-1),
+                                      dict(workers=0)])
+def test_overrides_are_checked_like_the_file(override):
+    """--generations 0 ended in a ZeroDivisionError traceback, --population 2 ran."""
+    with pytest.raises(OptionError, match=f"{next(iter(override))} must be a whole number"):
+        optimize(read_spec(spec_dict()), **override)
+
+
+@pytest.mark.parametrize("change, location", [
+    # a bound the field refuses: before, every design failed and 'no feasible design'
+    ({"variables": [{"path": "gears.L6.modifications.topological.y1", "lower": "-1 mm",
+                     "upper": "0 mm"}]}, "variables[0].lower"),
+    # a misspelt path
+    ({"variables": [{"path": "gears.L6.modifications.topological.y9", "lower": "0 mm",
+                     "upper": "1 mm"}]}, "variables[0].lower"),
+])
+def test_bounds_are_built_before_anything_runs(change, location):
+    d = spec_dict()
+    d.update(change)
+    with pytest.raises(ModelError) as exc:
+        optimize(read_spec(d))
+    assert location in [loc for loc, _ in exc.value.issues]
+
+
 @pytest.mark.parametrize("change, location", [
     ({"optimization": {"model": "liu2021_split_torque_helicopter", "algorithm": "simplex"}},
      "optimization.algorithm"),
+    # a unit on a plain-number field, a constraint bound of the wrong kind
+    ({"variables": [{"path": "meshes.L68.damping_ratio", "lower": "1 mm", "upper": "2 mm"}]},
+     "variables[0].lower"),
+    ({"constraints": [{"output": "ltca.L68.te_peak_to_peak_arcsec", "upper": "1 kg"}]},
+     "constraints[0].upper"),
     ({"objectives": [{"output": "ltca.L68"}]}, "objectives[0].output"),
     ({"variables": [{"path": "gears.L6.modifications.topological.y1", "lower": "1 mm",
                      "upper": "0 mm"}]}, "variables[0].upper"),

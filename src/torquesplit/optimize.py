@@ -57,10 +57,12 @@ objectives with ``relative_to`` are ratios, headed ``(/ baseline)``.
 from __future__ import annotations
 
 import csv
+import hashlib
 import json
 import re
 import tomllib
 import warnings
+from collections import Counter
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -68,7 +70,7 @@ from typing import Callable
 
 import numpy as np
 
-from .errors import ModelError, ModelWarning, TorquesplitError
+from .errors import ModelError, ModelWarning, OptionError, TorquesplitError
 
 __all__ = ["ALGORITHMS", "OptimizationSpec", "OptimizationResult", "read_spec", "optimize",
            "evaluate_design", "output_unit"]
@@ -154,6 +156,37 @@ def _kind(path) -> str | None:
         return schema_field(str(path), "path").kind
     except (TorquesplitError, ValueError, TypeError):
         return None  # not a schema field: refused by name when the model is built
+
+
+def _bound(value, where: str, output: str) -> float:
+    """A constraint's bound in SI, its unit checked against the output's
+    (:func:`output_unit`: a ratio takes a plain number, a force a force...)."""
+    si = _si(value, where)
+    if not isinstance(value, str) or not _NUMBER.sub("", value).strip():
+        return si
+    unit = output_unit(output)
+    from .model.units import registry
+
+    ureg = registry()
+    given = ureg.Quantity(value)
+    if not unit:
+        raise ModelError([(where, f"{output} is a ratio (no unit), but the bound {value!r} has "
+                                  f"a unit; write the number alone")])
+    want = ureg.Quantity(1, "arcsecond" if unit == "arc s" else unit)
+    if given.dimensionality != want.dimensionality:
+        raise ModelError([(where, f"{output} is in {unit}, but the bound {value!r} is not; "
+                                  f"write e.g. '1 {unit}'")])
+    return si
+
+
+def _plain_number_field(path) -> bool:
+    """Whether ``path`` names a schema field that takes a plain number (no unit)."""
+    from .study.paths import schema_field
+
+    try:
+        return schema_field(str(path), "path").kind is None
+    except (TorquesplitError, ValueError, TypeError):
+        return False
 
 
 def _si(value, where: str, kind: str | None = None) -> float:
@@ -283,6 +316,12 @@ def read_spec(source) -> OptimizationSpec:
             issues.append((where, "needs path, lower and upper; add them"))
             continue
         kind = _kind(v["path"])
+        if kind is None and _plain_number_field(v["path"]):
+            for end in ("lower", "upper"):
+                if isinstance(v[end], str) and _NUMBER.sub("", v[end]).strip():
+                    issues.append((f"{where}.{end}", (
+                        f"{v['path']} is a plain number, but the bound {v[end]!r} has a "
+                        f"unit; write the number alone")))
         lo = _si(v["lower"], f"{where}.lower", kind)
         hi = _si(v["upper"], f"{where}.upper", kind)
         if not lo < hi:
@@ -317,8 +356,10 @@ def read_spec(source) -> OptimizationSpec:
                                                       "relative_to = 'baseline' or remove it"))
             if o.get("sense", "min") not in ("min", "max"):
                 issues.append((f"{where}.sense", "must be 'min' or 'max'; use one of them"))
-            lower = None if o.get("lower") is None else _si(o["lower"], f"{where}.lower")
-            upper = None if o.get("upper") is None else _si(o["upper"], f"{where}.upper")
+            lower = None if o.get("lower") is None else _bound(o["lower"], f"{where}.lower",
+                                                                 str(o["output"]))
+            upper = None if o.get("upper") is None else _bound(o["upper"], f"{where}.upper",
+                                                                 str(o["output"]))
             out.append(Output(str(o["output"]), o.get("relative_to"), o.get("sense", "min"),
                               lower, upper))
         return out
@@ -369,9 +410,12 @@ def _model_data(spec: OptimizationSpec, x, units: bool = False) -> dict:
     for var, value in zip(spec.variables, [] if x is None else x):
         for p in (var.path, *var.also):
             data = _set_deep(data, p, var.written(value) if units else float(value))
-    # the optimiser's designs are not kept in the LTCA disk cache
+    # the optimiser's designs are not kept in the LTCA disk cache (a mesh that does not
+    # use the LTCA is left as it is: evaluate_design says what it needs)
     for name in _ltca_meshes(spec):
-        data = _set_deep(data, f"meshes.{name}.stiffness.ltca.cache", False)
+        stiffness = data.get("meshes", {}).get(name, {}).get("stiffness")
+        if isinstance(stiffness, dict) and stiffness.get("method") == "ltca":
+            data = _set_deep(data, f"meshes.{name}.stiffness.ltca.cache", False)
     return data
 
 
@@ -435,16 +479,55 @@ def _evaluate_job(spec: OptimizationSpec, x: tuple[float, ...]) -> dict:
         return {"x": list(x), "outputs": None, "error": str(exc).splitlines()[0]}
 
 
-class _Store:
-    """Evaluations by variable values, appended to a JSON-lines file as they finish."""
+def fingerprint(spec: OptimizationSpec) -> str:
+    """What an evaluation depends on besides the variables' values: the model with the
+    fixed settings ([set]), the variables' paths and the outputs asked for.  A stored
+    evaluation of another fingerprint is not reused (a changed [set] reused them)."""
+    wanted = sorted(o.output for o in (*spec.objectives, *spec.constraints))
+    text = json.dumps({"model": _model_data(spec, None), "outputs": wanted,
+                       "variables": [(v.path, list(v.also)) for v in spec.variables]},
+                      sort_keys=True, default=str)
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
 
-    def __init__(self, path: Path | None):
+
+def check_bounds(spec: OptimizationSpec) -> None:
+    """Build the model at every variable's lower and upper bound (the others at their
+    lower bounds) before anything runs: a misspelt path or a bound the field refuses
+    (a negative damping ratio) is an error naming the variable, not a run of failed
+    designs."""
+    from .model.io import model_from_dict
+
+    lows = [v.lower for v in spec.variables]
+    for i, var in enumerate(spec.variables):
+        for end in ("lower", "upper"):
+            x = list(lows)
+            x[i] = getattr(var, end)
+            try:
+                model_from_dict(_model_data(spec, x), source=spec.model_source)
+            except ModelError as exc:
+                loc, msg = exc.issues[0] if exc.issues else ("", str(exc))
+                raise ModelError([(f"variables[{i}].{end}", (
+                    f"the model with {var.path} = {x[i]:g} (SI) is refused: "
+                    f"{loc + ': ' if loc else ''}{msg}"))]) from None
+
+
+class _Store:
+    """Evaluations by variable values, appended to a JSON-lines file as they finish;
+    only those of this ``fingerprint`` (:func:`fingerprint`) are reused."""
+
+    def __init__(self, path: Path | None, fingerprint: str = ""):
         self.path = path
+        self.fingerprint = fingerprint
         self.records: dict[tuple, dict] = {}
+        self.other = 0
+        """Stored evaluations of another model or outputs, not reused."""
         if path is not None and path.exists():
             for line in path.read_text().splitlines():
                 try:
                     rec = json.loads(line)
+                    if rec.get("fingerprint", "") != fingerprint:
+                        self.other += 1
+                        continue
                     self.records[tuple(rec["x"])] = rec
                 except (ValueError, KeyError):
                     continue  # a line cut by an interruption
@@ -456,6 +539,7 @@ class _Store:
         return self.records[tuple(x)]
 
     def add(self, rec: dict) -> None:
+        rec = {**rec, "fingerprint": self.fingerprint}
         self.records[tuple(rec["x"])] = rec
         if self.path is not None:
             self.path.parent.mkdir(parents=True, exist_ok=True)
@@ -563,11 +647,20 @@ def optimize(source, *, workers: int | None = None, generations: int | None = No
     spec = source if isinstance(source, OptimizationSpec) else read_spec(source)
     over = {k: v for k, v in dict(workers=workers, generations=generations,
                                   population=population, seed=seed).items() if v is not None}
+    least = dict(workers=1, generations=1, population=4, seed=0)
+    for key, value in over.items():
+        if isinstance(value, bool) or not isinstance(value, int) or value < least[key]:
+            raise OptionError(f"{key} must be a whole number >= {least[key]} "
+                              f"(--{key} on the command line), got {value!r}")
     if over:
         from dataclasses import replace
 
         spec = replace(spec, **over)
-    store = _Store(spec.store)
+    check_bounds(spec)
+    store = _Store(spec.store, fingerprint(spec))
+    if store.other:
+        warnings.warn(f"optimization.store: {store.other} stored evaluation(s) are of another "
+                      f"model, [set] or outputs and are not reused", ModelWarning, stacklevel=2)
     baseline = evaluate_design(spec, None)
     for o in (*spec.objectives,):
         if o.relative_to and not baseline[o.output]:
@@ -631,8 +724,13 @@ def optimize(source, *, workers: int | None = None, generations: int | None = No
         if pool is not None:
             pool.shutdown()
     if res.X is None:
+        errors = Counter(r["error"] for r in store.records.values() if r.get("error"))
+        why = ""
+        if errors:
+            text, n = errors.most_common(1)[0]
+            why = (f"; {n} of {len(store.records)} designs failed, e.g.: {text}")
         raise TorquesplitError("no feasible design found; widen the bounds or relax the "
-                               "constraints")
+                               "constraints" + why)
     X = np.atleast_2d(res.X)
     F = np.atleast_2d(res.F)
     order = np.lexsort(F.T[::-1])
