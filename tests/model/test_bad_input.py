@@ -244,6 +244,12 @@ CASES = [
     ("gear and body of the same name",
      setting("bodies.wheel", {"polar_inertia": "0.2 kg m^2"}),
      "bodies.wheel", r"used by a gear too; rename one"),
+    # a reviewer's x = 5 (and 3) passed check and run; x = -5 said 'inverse involute of a
+    # negative value'
+    ("pointed teeth", setting("gears.pinion.profile_shift", 3),
+     "gears.pinion.profile_shift", r"the teeth are pointed.*towards 0"),
+    ("no tooth left", setting("gears.pinion.profile_shift", -5),
+     "gears.pinion.profile_shift", r"the teeth are pointed.*towards 0"),
 ]
 
 

@@ -272,3 +272,17 @@ def test_resume_accepts_a_changed_description(tmp_path, split_file):
     _write(tmp_path, data)
     with pytest.raises(StudyError, match=r"study\.name"):
         Study(path).run(workers=1, out=out, resume=True)
+
+
+def test_resume_and_overwrite_together_are_refused(tmp_path, split_file):
+    """--resume --overwrite reset the store and recomputed the finished cases."""
+    from study_helpers import grid_study
+    from torquesplit.errors import StudyError
+    from torquesplit.study import Study
+
+    study = Study(grid_study(split_file, [{"path": "meshes.a1.damping_ratio",
+                                           "values": [0.05, 0.06]}], cycles=5))
+    with pytest.raises(StudyError, match="resume=True continues the stored study and "
+                                         "overwrite=True starts it again"):
+        study.run(out=tmp_path / "o", resume=True, overwrite=True)
+    assert not (tmp_path / "o").exists()

@@ -166,3 +166,15 @@ def test_indices_over_fewer_rows_say_so(split_file, tmp_path):
     with ui.console.capture() as cap:
         _summary(ds, tmp_path, False, False)
     assert "indices over 1 of 2 trajectories at the fewest" in cap.get()
+
+
+def test_sobol_samples_must_be_a_power_of_2():
+    """samples = 3 was accepted, though the docs say a power of 2 (the Sobol sequence is
+    balanced only there)."""
+    from torquesplit.study.spec import Sensitivity
+
+    par = [{"path": f"meshes.a1.damping_ratio", "low": 0.01, "high": 0.1},
+           {"path": "meshes.b1.damping_ratio", "low": 0.01, "high": 0.1}]
+    with pytest.raises(Exception, match="3 is not a power of 2.*give 2 or 4"):
+        Sensitivity(method="sobol", seed=1, samples=3, parameters=par)
+    assert Sensitivity(method="sobol", seed=1, samples=64, parameters=par).samples == 64

@@ -55,6 +55,12 @@ def _bad_cases(model):
         "invalid first case": (grid_study(model, [{"path": "meshes.a1.damping_ratio",
                                                    "values": [-0.1, 0.1]}]),
                                "grid.parameters", "case 0"),
+        # a grid of 1e8 points grew to GB before its first case, silently
+        "huge range": (grid_study(model, [dict(K, num=100_000_000)]),
+                       "grid.parameters.0.num", "at most 1,000,000 cases"),
+        "huge grid": (grid_study(model, [dict(K, num=2000), dict(K, path="meshes.b1.stiffness",
+                                                              num=2000)]),
+                      "grid.parameters", "2000 x 2000 = 4,000,000 cases"),
     }
 
 

@@ -206,6 +206,14 @@ class GearGeometry:
             issues.append(("tool_tip_radius", "must be non-negative"))
         if issues:
             raise ModelError(issues, source="GearGeometry")
+        if not self.internal and self.tip_thickness <= 0.0:
+            raise ModelError(
+                [("addendum", f"the teeth are pointed: with profile shift x = "
+                              f"{self.profile_shift:g} the tooth thickness at the tip circle "
+                              f"is {1e3 * self.tip_thickness:.3g} mm (it must stay positive, "
+                              f"usually above 0.2 m_n); change the profile shift towards 0")],
+                source="GearGeometry",
+            )
         if self.base_radius >= self.tip_radius and self.internal:
             raise ModelError(
                 [("addendum", f"the tip circle of the ring gear (r_a = {self.tip_radius:.6g} m) lies "
@@ -297,6 +305,19 @@ class GearGeometry:
             raise ModelError([("internal", "the tooth half angle is defined for external gears only")])
         return ((math.pi / 2 + 2.0 * self.profile_shift * math.tan(self.normal_pressure_angle))
                 / self.teeth + float(involute(self.transverse_pressure_angle)))
+
+    @property
+    def tip_thickness(self) -> float:
+        """Transverse tooth thickness on the tip circle [m] (external gears; negative where
+        the flanks cross below the tip: a pointed tooth).
+
+        ``s_at = 2 r_a (psi_b - inv(alpha_at))`` with ``cos(alpha_at) = r_b / r_a`` and
+        ``psi_b`` the half angle at the base circle (:attr:`base_half_angle`; ISO 21771
+        tooth thickness carried along the involute)."""
+        ra, rb = self.tip_radius, self.base_radius
+        if ra <= rb:
+            return 2.0 * ra * self.base_half_angle
+        return 2.0 * ra * (self.base_half_angle - float(involute(math.acos(rb / ra))))
 
     @property
     def root_half_angle(self) -> float:

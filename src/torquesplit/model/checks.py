@@ -383,6 +383,16 @@ def plausibility_warnings(model: Model, kin) -> list[tuple[str, str]]:
             out.append((loc, f"{ratio:g} is above critical damping (1); check the value "
                              f"(typical 0.02-0.1)"))
     out += _friction_drift(model)
+    pairs: dict[frozenset, str] = {}
+    for name, m in model.meshes.items():
+        key = frozenset(m.gears)
+        if key in pairs and len(key) == 2:
+            first = pairs[key]
+            out.append((f"meshes.{name}", (
+                f"joins the same gears as meshes.{first} ({', '.join(m.gears)}): the two "
+                f"meshes act in parallel and double the mesh stiffness and load; remove one "
+                f"(a double-helical pair is one mesh of double-helical gears)")))
+        pairs.setdefault(key, name)
     ltca_gears = {g for m in model.meshes.values() if m.stiffness.method == "ltca" for g in m.gears}
     for name, gear in model.gears.items():
         if gear.modifications is not None and name not in ltca_gears:

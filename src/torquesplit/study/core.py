@@ -193,6 +193,10 @@ class Study:
     def _run(self, words: Words, *, workers, client, scheduler, runner, out, resume,
              overwrite, progress, figures, backend, precision):
         """:meth:`run`, its messages naming the options as ``words`` says."""
+        if resume and overwrite:
+            raise StudyError(words.overwrite_on, (
+                f"{words.resume_on} continues the stored study and {words.overwrite_on} "
+                f"starts it again: give one of them"))
         plan = self.plan()
         if workers is not None and (isinstance(workers, bool) or workers < 1):
             raise StudyError(words.workers, f"got {workers!r}; give at least 1 worker (1 "

@@ -399,6 +399,10 @@ def _value(v, p: Parameter, unit, where) -> float:
     return x
 
 
+MAX_CASES = 1_000_000
+"""Most cases a study holds (a grid of 1e8 points grew to GB before its first case)."""
+
+
 def _grid(spec: StudySpec, raw: dict) -> Design:
     params: list[Parameter] = []
     axes: list[np.ndarray] = []
@@ -413,6 +417,9 @@ def _grid(spec: StudySpec, raw: dict) -> Design:
         else:
             a = _value(t.start, p, t.unit, f"{where}.start")
             b = _value(t.stop, p, t.unit, f"{where}.stop")
+            if t.num > MAX_CASES:
+                raise StudyError(f"{where}.num", f"{t.num:,} points; a study holds at most "
+                                                 f"{MAX_CASES:,} cases: give fewer")
             if t.num > 1 and a == b:
                 raise StudyError(f"{where}.stop", "equals 'start': the range is empty; give a "
                                                   "different stop, or 'values'")
@@ -445,6 +452,10 @@ def _grid(spec: StudySpec, raw: dict) -> Design:
                                             f"different name")
     _check_disjoint(params, "grid.parameters")
     shape = tuple(len(a) for a in axes)
+    if math.prod(shape) > MAX_CASES:
+        raise StudyError("grid.parameters", f"{' x '.join(map(str, shape))} = "
+                                            f"{math.prod(shape):,} cases; a study holds at most "
+                                            f"{MAX_CASES:,}: give fewer points")
     values = np.array(list(itertools.product(*axes)), dtype=float).reshape(-1, len(axes))
     return Design("grid", params, values, shape=shape, axes=axes,
                   extra={"spacing": spacings})

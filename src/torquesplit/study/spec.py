@@ -240,7 +240,7 @@ class MonteCarlo(_Strict):
     sampling: Literal["random", "sobol", "latin_hypercube"] = Field("random", description=(
         "Independent random draws, scrambled Sobol points, or a Latin hypercube."))
     seed: int = Field(description="Seed of the sampler (results depend only on it).")
-    samples: int | None = Field(None, ge=1, description="Number of samples.")
+    samples: int | None = Field(None, ge=1, le=1_000_000, description="Number of samples.")
     stop: StopRule | None = Field(None, description="Or: a stopping rule.")
     parameters: list[MonteCarloParameter] = Field(min_length=1, description="Random inputs.")
 
@@ -289,6 +289,11 @@ class Sensitivity(_Strict):
             _forbid(self, ("samples",), "to method = 'morris' (use 'trajectories')")
         else:
             _forbid(self, ("trajectories", "levels"), "to method = 'sobol' (use 'samples')")
+            n = self.samples
+            if n is not None and n & (n - 1):  # Saltelli's scheme on Sobol points
+                lower = 1 << (n.bit_length() - 1)
+                raise _Problem("samples", f"{n} is not a power of 2 (Sobol sequences balance "
+                                          f"only there); give {lower} or {2 * lower}")
         return self
 
 
