@@ -173,7 +173,7 @@ def test_sobol_samples_must_be_a_power_of_2():
     balanced only there)."""
     from torquesplit.study.spec import Sensitivity
 
-    par = [{"path": f"meshes.a1.damping_ratio", "low": 0.01, "high": 0.1},
+    par = [{"path": "meshes.a1.damping_ratio", "low": 0.01, "high": 0.1},
            {"path": "meshes.b1.damping_ratio", "low": 0.01, "high": 0.1}]
     with pytest.raises(Exception, match="3 is not a power of 2.*give 2 or 4"):
         Sensitivity(method="sobol", seed=1, samples=3, parameters=par)
