@@ -71,3 +71,19 @@ def test_a_large_grid_is_not_summarised_as_a_sample(tmp_path, split_file, monkey
     assert res.exit_code == 0, res.output
     assert "a grid of 2 cases (2), too many to print" in res.stdout
     assert "p95" not in res.stdout
+
+
+@pytest.mark.parametrize("args, said", [
+    # the first --vary was dropped silently
+    (["--vary", "meshes.a1.damping_ratio=0.01:0.1:2", "--vary",
+      "meshes.b1.damping_ratio=0.01:0.1:2"], "--vary is given twice"),
+    # --set on the varied path was accepted silently
+    (["--vary", "meshes.a1.damping_ratio=0.01:0.1:2", "--set", "meshes.a1.damping_ratio=0.05"],
+     "sets a path that --vary varies"),
+    # rich printed ':100:' as an emoji
+    (["--vary", "meshes.a1.backlash=10:100:2"], "'meshes.a1.backlash=10:100:2'"),
+])
+def test_sweep_refuses_what_it_would_drop_and_prints_the_text_as_given(split_file, args, said):
+    res = runner.invoke(app, ["sweep", str(split_file), *args])
+    assert res.exit_code == 2 and said in res.stderr, res.stderr
+    assert "\U0001f4af" not in res.stderr

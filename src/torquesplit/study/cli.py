@@ -423,7 +423,7 @@ def _number(text: str):
 
 def sweep(
     model: str = typer.Argument(..., help="Model file (.toml/.json) or example name."),
-    vary: str = typer.Option(
+    vary: list[str] = typer.Option(
         ..., "--vary", help="PATH=START:STOP:NUM[unit], e.g. shafts.drive1.diameter="
                             "130:400:28mm; several paths set together: P1,P2=..."),
     output: Optional[list[str]] = typer.Option(
@@ -460,8 +460,18 @@ def sweep(
         from ..model.overrides import parse_assignment
 
         ui._one_run_length(duration, cycles)
+        if len(vary) != 1:
+            raise ValueError("--vary is given twice: a sweep varies one parameter (several "
+                             "paths set together: --vary P1,P2=START:STOP:NUM); for a grid of "
+                             "two or three parameters write a study file (docs/studies.md)")
+        vary = vary[0]
         param = parse_vary(vary)
         _refuse_bare_range(vary, param)
+        varied = set(param.get("paths") or [param["path"]])
+        for a in assign or []:
+            if a.partition("=")[0].strip() in varied:
+                raise ValueError(f"--set {a!r} sets a path that --vary varies; leave one of "
+                                 f"them out")
         if log_spacing:
             param["spacing"] = "log"
         path = ui._resolve_model_path(model)
@@ -488,7 +498,8 @@ def sweep(
         if settle is not None:
             analysis["settle"] = {"tolerance": settle}
         first = (param.get("path") or param["paths"][0])
-        name = f"sweep_{first}"
+        more = len(param.get("paths") or []) - 1
+        name = f"sweep_{first}" + (f"_and_{more}_more" if more > 0 else "")
         data = {"study": {"name": name, "model": model_ref, "outputs": outputs},
                 "analysis": analysis, "grid": {"parameters": [param]},
                 "set": dict(parse_assignment(a) for a in (assign or []))}
