@@ -888,6 +888,13 @@ def contact(
 ):
     """Loaded tooth contact analysis of one mesh: transmission error, stiffness, load
     distribution, contact pressure, Harris map, meshing-in impact."""
+    with ux.interruptible():
+        _contact(model, pair, load, on, plot, force, positions, slices, harris, assign,
+                 as_json)
+
+
+def _contact(model, pair, load, on, plot, force, positions, slices, harris, assign,
+             as_json) -> None:
     try:
         if plot is not None:
             from .plot.contact import contact_figure_files
@@ -896,6 +903,9 @@ def contact(
                                 force=force)
         _at_least(positions, 4, "--positions", "64")
         _at_least(slices, 2, "--slices", "40")
+        for value, option, most in ((positions, "--positions", 4096), (slices, "--slices", 400)):
+            if value is not None and value > most:  # as the model file's ltca fields
+                raise OptionError(f"{option} {value} is more than {most}; give at most {most}")
         _at_least(harris, 0, "--harris", "10")
         m, _ = _load(model, assign)
         if pair not in m.meshes:

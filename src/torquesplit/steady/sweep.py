@@ -246,61 +246,66 @@ class Continuation:
         message = "complete"
         complete = True
         h = step
-        while len(pts) < max_points:
-            mu = self.multipliers(z[:n], z[n]) if self.stability else None
-            m = float(np.max(np.abs(mu))) if mu is not None and mu.size else math.nan
-            pts.append(SweepPoint(float(z[n]), z[:n].copy(),
-                                  None if mu is None else bool(m <= 1 + 1e-6), m, 0))
-            if progress is not None:
-                progress(min(1.0, abs(z[n] - s0) / abs(s1 - s0)))
-            if (z[n] - s1) * direction >= 0:
-                if z[n] != s1 and len(pts) > 1:  # past the end: the state at the end itself
-                    x_end, info_end = self.solve(z[:n].copy(), s1)
-                    if info_end.converged:
-                        mu = self.multipliers(x_end, s1) if self.stability else None
-                        m = float(np.max(np.abs(mu))) if mu is not None and mu.size \
-                            else math.nan
-                        pts[-1] = SweepPoint(float(s1), x_end.copy(), None if mu is None
-                                             else bool(m <= 1 + 1e-6), m, 0)
-                break
-            while True:
-                z_pred = z + h * t
-                try:
-                    zc, its = self.correct(z_pred, t)
-                except SolverError as exc:
-                    zc, its = None, 99
-                    log.info("corrector failed: %s", exc)
-                if zc is not None:
+        try:  # Ctrl-C keeps the curve computed so far, as any other stop does
+            while len(pts) < max_points:
+                mu = self.multipliers(z[:n], z[n]) if self.stability else None
+                m = float(np.max(np.abs(mu))) if mu is not None and mu.size else math.nan
+                pts.append(SweepPoint(float(z[n]), z[:n].copy(),
+                                      None if mu is None else bool(m <= 1 + 1e-6), m, 0))
+                if progress is not None:
+                    progress(min(1.0, abs(z[n] - s0) / abs(s1 - s0)))
+                if (z[n] - s1) * direction >= 0:
+                    if z[n] != s1 and len(pts) > 1:  # past the end: the state at the end itself
+                        x_end, info_end = self.solve(z[:n].copy(), s1)
+                        if info_end.converged:
+                            mu = self.multipliers(x_end, s1) if self.stability else None
+                            m = float(np.max(np.abs(mu))) if mu is not None and mu.size \
+                                else math.nan
+                            pts[-1] = SweepPoint(float(s1), x_end.copy(), None if mu is None
+                                                 else bool(m <= 1 + 1e-6), m, 0)
                     break
-                h *= 0.5
-                if h < min_step:
-                    message = (f"continuation failed at speed factor {z[n]:.6g}: the "
-                               f"corrector did not converge down to the smallest step "
-                               f"{min_step:.3g}; the curve up to there is kept. "
-                               f"{self.remedy}")
+                while True:
+                    z_pred = z + h * t
+                    try:
+                        zc, its = self.correct(z_pred, t)
+                    except SolverError as exc:
+                        zc, its = None, 99
+                        log.info("corrector failed: %s", exc)
+                    if zc is not None:
+                        break
+                    h *= 0.5
+                    if h < min_step:
+                        message = (f"continuation failed at speed factor {z[n]:.6g}: the "
+                                   f"corrector did not converge down to the smallest step "
+                                   f"{min_step:.3g}; the curve up to there is kept. "
+                                   f"{self.remedy}")
+                        complete = False
+                        break
+                if zc is None:
+                    break
+                try:
+                    t_new = self.tangent(zc[:n], zc[n], np.concatenate(
+                        [t[:n] * self._weights(zc[:n]) ** 2, [t[n]]]))
+                except SolverError as exc:
+                    message = f"tangent failed at speed factor {zc[n]:.6g} ({exc}); curve kept."
                     complete = False
                     break
-            if zc is None:
-                break
-            try:
-                t_new = self.tangent(zc[:n], zc[n], np.concatenate(
-                    [t[:n] * self._weights(zc[:n]) ** 2, [t[n]]]))
-            except SolverError as exc:
-                message = f"tangent failed at speed factor {zc[n]:.6g} ({exc}); curve kept."
+                if t_new[n] * t[n] < 0:  # fold: ds/darc changed sign
+                    a = t[n] / (t[n] - t_new[n])
+                    s_f = z[n] + a * (zc[n] - z[n])
+                    folds.append((float(s_f), "turns back" if t[n] * direction > 0 else "turns on"))
+                z, t = zc, t_new
+                h = min(max_step, h * (1.5 if its <= 3 else (1.0 if its <= 5 else 0.6)))
+                if zc[n] < self.lowest_speed(s0, s1):
+                    message = "the branch left the speed range backwards; curve kept."
+                    complete = False
+                    break
+            else:
+                message = f"stopped after {max_points} points; curve kept."
                 complete = False
-                break
-            if t_new[n] * t[n] < 0:  # fold: ds/darc changed sign
-                a = t[n] / (t[n] - t_new[n])
-                s_f = z[n] + a * (zc[n] - z[n])
-                folds.append((float(s_f), "turns back" if t[n] * direction > 0 else "turns on"))
-            z, t = zc, t_new
-            h = min(max_step, h * (1.5 if its <= 3 else (1.0 if its <= 5 else 0.6)))
-            if zc[n] < self.lowest_speed(s0, s1):
-                message = "the branch left the speed range backwards; curve kept."
-                complete = False
-                break
-        else:
-            message = f"stopped after {max_points} points; curve kept."
+        except KeyboardInterrupt:
+            message = (f"interrupted (Ctrl-C) after {len(pts)} points; the curve up to "
+                       f"there is kept.")
             complete = False
         return pts, merge_folds(folds, FOLD_RESOLUTION * abs(s1 - s0)), message, complete
 
