@@ -476,3 +476,13 @@ def test_the_largest_dynamic_factor_of_a_sweep_is_that_of_its_stable_points():
     assert got["run_up"] == (3.7, 8000.0) and got["run_down"] == (3.9, 7000.0)
     ds["stable"][:] = False
     assert all(math.isnan(v) for v in sweep_maxima(ds)["m"]["stable"])
+
+
+def test_a_record_far_beyond_its_limit_is_refused_before_it_is_allocated():
+    """'steady --speed 1e9 rpm' asked for 22 GiB (killed, or a MemoryError traceback)."""
+    from torquesplit.errors import SolverError
+    from torquesplit.steady.api import RESULT_ROWS, _check_record_size
+
+    _check_record_size(64, RESULT_ROWS // 64, 10)  # within: nothing said
+    with pytest.raises(SolverError, match=r"29,333,334 periods of 100 samples \(21\.9 GiB\)"):
+        _check_record_size(29_333_334, 100, 1)

@@ -516,6 +516,19 @@ def cycle_extremes(values, cycles, n, extra_cycles=None, extra=None):
     return mx, mn
 
 
+def _check_record_size(periods: int, samples: int, columns: int) -> None:
+    """Refuse a repeated record far beyond :data:`RESULT_ROWS` (a speed far outside the
+    model's: a reviewer's 1e9 rpm asked for 22 GiB and was killed)."""
+    rows = periods * samples
+    if rows > 64 * RESULT_ROWS:
+        raise SolverError(
+            f"the periodic state would be repeated over {periods:,} periods of {samples:,} "
+            f"samples ({rows * 8 * max(columns, 1) / 2**30:.3g} GiB) to cover the settle "
+            f"windows of its slowest excitation: the speed is far from the model's, or an "
+            f"excitation is much slower than the meshes; check --speed, or leave the slow "
+            f"excitation out (--keep)")
+
+
 def _as_solution(st: SteadyState, shell, periods):
     """An integrate.Solution made of the periodic state repeated over a few periods."""
     from torquesplit.solve.integrate import Solution
@@ -541,6 +554,7 @@ def _as_solution(st: SteadyState, shell, periods):
                 1 << int(math.floor(math.log2(max(RESULT_ROWS // periods, 2)))))
         if n < len(t1):
             t1, F1, D1 = st.samples(n=n)
+    _check_record_size(periods, len(t1), F1.shape[1])
     t = (t1[None, :] + T * np.arange(periods)[:, None]).ravel()
     F = np.tile(F1, (periods, 1))
     # the meshes' statistics from their finest series (shooting: every RK4 step, where
@@ -549,6 +563,7 @@ def _as_solution(st: SteadyState, shell, periods):
         tm, Fm, Dm = t1, F1[:, track], D1[:, track]
     else:
         tm, Fm, Dm = st.mesh_series(track)
+    _check_record_size(periods, len(tm), len(track))
     tt = (tm[None, :] + T * np.arange(periods)[:, None]).ravel()
     # instants at table corners (shooting): in the per-cycle extremes, as the integrator's
     # corner events, not in sums, counts or contact time
