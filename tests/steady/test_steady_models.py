@@ -486,3 +486,13 @@ def test_a_record_far_beyond_its_limit_is_refused_before_it_is_allocated():
     _check_record_size(64, RESULT_ROWS // 64, 10)  # within: nothing said
     with pytest.raises(SolverError, match=r"29,333,334 periods of 100 samples \(21\.9 GiB\)"):
         _check_record_size(29_333_334, 100, 1)
+
+
+def test_critical_speeds_between_far_apart_points_are_said():
+    """A sweep to 1e9 rpm in 31 points said 'complete' and missed a resonance between two
+    of its points."""
+    from torquesplit.steady.maps import unresolved_critical_speeds
+
+    speeds = np.array([1000.0, 1050.0, 1100.0, 5000.0])
+    assert unresolved_critical_speeds(speeds, [1040.0, 3000.0, 9000.0]) == [3000.0]
+    assert unresolved_critical_speeds(speeds, [1099.0, 4800.0]) == []
