@@ -53,7 +53,10 @@ def test_back_flank_force_is_that_of_the_settled_cycles(three_branch_run):
     assert row.back_flank_force == 0.0
     said = _said(result_warnings(res, met))
     assert "in the start-up transient only" in said["meshes.out2"]
-    assert "81.4 N" in said["meshes.out2"]  # the transient's, named as such
+    from torquesplit.results.plausibility import _kn
+
+    # the transient's, named as such
+    assert _kn(-np.nanmin(c_min[:, j])) in said["meshes.out2"]
 
 
 def test_a_run_too_short_for_its_windows_says_so(three_branch_run):

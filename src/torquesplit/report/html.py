@@ -294,8 +294,9 @@ def _modes(res) -> str:
     mesh_f = {n: mk.frequency for n, mk in res.kinematics.meshes.items()}
     # the orders each mesh's stiffness table excites (a rectangular contact wave reaches
     # the 7th and beyond; a smooth one the 3rd)
-    names = list(res.structure.element_names)
-    top = {n: mesh_orders(res.structure.stiffness_table[names.index(n)]) if n in names
+    structure = getattr(res, "structure", None)
+    names = list(structure.element_names) if structure is not None else []
+    top = {n: mesh_orders(structure.stiffness_table[names.index(n)]) if n in names
            else 3 for n in mesh_f}
     typed = any(r.type for r in rep.rows)
     # a mesh order that the planets' mesh phasing leaves unexcited for the mode's type
