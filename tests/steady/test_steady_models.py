@@ -498,3 +498,17 @@ def test_critical_speeds_between_far_apart_points_are_said():
     speeds = np.array([1000.0, 1050.0, 1100.0, 5000.0])
     assert unresolved_critical_speeds(speeds, [1040.0, 3000.0, 9000.0]) == [3000.0]
     assert unresolved_critical_speeds(speeds, [1099.0, 4800.0]) == []
+
+
+@pytest.mark.parametrize("args, said", [
+    (["--max-cycles", "2"], "(--keep <stage, mesh or body>, the others by their means"),
+    (["--max-cycles", "2"], "accept the long period (--max-cycles 168)"),
+    (["--max-cycles", "0"], "--max-cycles must be a whole number >= 1"),
+    (["--harmonics", "0"], "--harmonics must be a whole number >= 1"),
+    (["--speed", "0"], "--speed must be a positive speed"),
+])
+def test_steady_messages_name_the_flags(args, said):
+    """The command's messages said keep='...', max_cycles=168, harmonics=16 (Python)."""
+    r = CliRunner().invoke(app, ["steady", "ji_li_mill_drive", *args])
+    assert r.exit_code == 2 and said in r.stderr, r.stderr
+    assert "max_cycles=" not in r.stderr and "keep='" not in r.stderr

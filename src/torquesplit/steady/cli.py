@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from pathlib import Path
 from typing import Optional
 
@@ -43,6 +44,29 @@ def _h(text):
     from torquesplit.cli_support import header
 
     return header(text)
+
+
+_API_TO_FLAGS = ((re.compile(r"keep='([^']*)'"), r"--keep \1"),
+                 (re.compile(r"max_cycles=(\d+)"), r"--max-cycles \1"),
+                 (re.compile(r"harmonics=(\d+)"), r"--harmonics \1"),
+                 (re.compile(r"speed='([^']*)'"), r"--speed '\1'"))
+
+
+def _in_flags(exc):
+    """The solver's message with its Python keywords (keep='stage1', max_cycles=4000) as
+    the command's flags (--keep stage1, --max-cycles 4000); the same exception type."""
+    from torquesplit.errors import TorquesplitError
+
+    text = str(exc)
+    new = text
+    for pattern, flag in _API_TO_FLAGS:
+        new = pattern.sub(flag, new)
+    if new == text or not isinstance(exc, TorquesplitError):
+        return exc
+    try:
+        return type(exc)(new)
+    except TypeError:  # an error class with other arguments: the original
+        return exc
 
 
 def _keep(keep):
@@ -101,6 +125,14 @@ def register(app, load, fail, console, err_console, json_default):
             if steps_per_cycle is not None and steps_per_cycle < 10:
                 raise TorquesplitError(f"--steps-per-cycle must be at least 10 (e.g. 200), "
                                        f"got {steps_per_cycle}")
+            for value, option, example in ((max_cycles, "--max-cycles", "10000"),
+                                           (harmonics, "--harmonics", "16")):
+                if value is not None and value < 1:
+                    raise TorquesplitError(f"{option} must be a whole number >= 1 (e.g. "
+                                           f"{example}), got {value}")
+            if speed is not None and not _speed(speed, "--speed") > 0:
+                raise TorquesplitError(f"--speed must be a positive speed, e.g. '3000 rpm'; "
+                                       f"got {speed!r}")
             from torquesplit.steady.api import steady_state
 
             _check_out(out, force=force)
@@ -125,7 +157,7 @@ def register(app, load, fail, console, err_console, json_default):
                                                   total=None) as update:
                     step_check = check_steady(st, progress=update)
         except (TorquesplitError, ValueError, OSError) as exc:
-            fail(exc)
+            fail(_in_flags(exc))
             return
         ps = st.solution
         mu = ps.multipliers
