@@ -405,7 +405,11 @@ def run(
                                     force=False)
             from .simulation import simulate
 
-            with ux.collect_warnings(), ux.progress("integrating", quiet or as_json) as cb:
+            from .solve.integrate import stop_on_interrupt
+
+            # Ctrl-C ends the run as a stopped one: what it computed is saved and reported
+            with ux.collect_warnings(), stop_on_interrupt(), \
+                    ux.progress("integrating", quiet or as_json) as cb:
                 res = simulate(m, duration=dur, cycles=cycles, method=method,
                                steps_per_period=steps_per_period, max_steps=max_steps,
                                samples_per_period=samples_per_period, progress=cb)
@@ -433,7 +437,9 @@ def run(
         saved = state["saved"]
         if met is None:
             _render_stopped(res, saved, as_json)
-            raise typer.Exit(1)
+            from .solve.integrate import INTERRUPTED
+
+            raise typer.Exit(130 if res.solution.status == INTERRUPTED else 1)
         figures, failed = [], None
         if plots is not None:
             state["figures"] = []
@@ -701,7 +707,8 @@ def static(
             from .quasistatic import quasi_static_load_sharing
             from .results.plausibility import static_warnings
 
-            with ux.progress("quasi-static equilibria", quiet or as_json) as cb:
+            with ux.collect_warnings(), ux.progress("quasi-static equilibria",
+                                                    quiet or as_json) as cb:
                 res = quasi_static_load_sharing(m, revolutions=revolutions,
                                                 points_per_cycle=points_per_cycle,
                                                 progress=cb)

@@ -18,6 +18,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .errors import ModelWarning
+
 from .metrics import load_sharing as ls
 from .model.io import load_model
 from .model.kinematics import solve_kinematics
@@ -167,7 +169,7 @@ def quasi_static_load_sharing(model, *, revolutions: float | None = None,
             f"the quasi-static sweep is cut to max_points = {max_points} positions, "
             f"{n / (period * f_max):.3g} per cycle of the fastest excitation ({f_max:.6g} "
             f"Hz) instead of {points_per_cycle}; raise max_points (or give fewer "
-            f"revolutions) for the full density", stacklevel=2)
+            f"revolutions) for the full density", ModelWarning, stacklevel=2)
     times = np.arange(n) * (period / n)
     sol = quasi_static(structure, times, progress=progress)
     return QuasiStaticResults(model=model, kinematics=kin, structure=structure, solution=sol)
@@ -193,5 +195,5 @@ def _excitation_period(structure, turn: float) -> float:
         why = (f"the excitations repeat only every {period / turn:.6g} revolutions of the "
                f"slowest gear")
     warnings.warn(f"{why}; the quasi-static sweep covers {MAX_REVOLUTIONS:g} revolutions of "
-                  f"the slowest gear: give revolutions to choose", stacklevel=3)
+                  f"the slowest gear: give revolutions to choose", ModelWarning, stacklevel=3)
     return cap

@@ -58,3 +58,43 @@ def test_an_interrupted_speed_sweep_keeps_its_curve(monkeypatch):
                      points=30)
     assert ds.sizes["point"] == 2 and not ds.attrs["complete"]
     assert ds.attrs["message"].startswith("interrupted (Ctrl-C) after 2 points")
+
+
+def _interrupting_progress(at: float):
+    def progress(fraction):
+        if fraction >= at:
+            raise KeyboardInterrupt
+    return progress
+
+
+def test_an_interrupted_run_is_a_stopped_run_inside_stop_on_interrupt():
+    """'run' threw away everything on Ctrl-C ('interrupted; nothing written'); inside
+    stop_on_interrupt the run ends as a stopped one that keeps what it recorded.  Outside
+    it (studies) the interrupt propagates as before."""
+    import torquesplit
+    from torquesplit.solve.integrate import INTERRUPTED, stop_on_interrupt
+
+    model = torquesplit.load_model("ji_li_mill_drive")
+    with stop_on_interrupt():
+        res = torquesplit.simulate(model, duration=0.2, progress=_interrupting_progress(0.3))
+    s = res.solution
+    assert s.status == INTERRUPTED and not res.success
+    assert res.message.startswith("Interrupted (Ctrl-C) at t = ")
+    assert 0.05 < s.t_final < 0.2 and s.history_t.size > 0 and s.history_t[-1] <= s.t_final
+    with pytest.raises(KeyboardInterrupt):
+        torquesplit.simulate(model, duration=0.2, progress=_interrupting_progress(0.3))
+
+
+def test_the_run_command_saves_what_it_computed_when_interrupted(tmp_path, monkeypatch):
+    import contextlib
+
+    @contextlib.contextmanager
+    def progress(label, quiet, total=1.0):
+        yield _interrupting_progress(0.3)
+
+    monkeypatch.setattr(ux, "progress", progress)
+    out = tmp_path / "r.nc"
+    res = CliRunner().invoke(app, ["run", "ji_li_mill_drive", "--duration", "0.2",
+                                   "--out", str(out)])
+    assert res.exit_code == 130, res.output
+    assert "Interrupted (Ctrl-C)" in res.stdout and out.exists()

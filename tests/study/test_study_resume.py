@@ -286,3 +286,16 @@ def test_resume_and_overwrite_together_are_refused(tmp_path, split_file):
                                          "overwrite=True starts it again"):
         study.run(out=tmp_path / "o", resume=True, overwrite=True)
     assert not (tmp_path / "o").exists()
+
+
+def test_a_study_folder_that_is_a_file_is_refused(tmp_path, split_file):
+    from study_helpers import grid_study
+    from torquesplit.errors import StudyError
+    from torquesplit.study import Study
+
+    f = tmp_path / "taken.toml"
+    f.write_text("x = 1\n")
+    study = Study(grid_study(split_file, [{"path": "meshes.a1.damping_ratio",
+                                           "values": [0.05, 0.06]}], cycles=5))
+    with pytest.raises(StudyError, match="is a file; a study writes a folder"):
+        study.run(out=f)

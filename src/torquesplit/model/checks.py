@@ -383,6 +383,7 @@ def plausibility_warnings(model: Model, kin) -> list[tuple[str, str]]:
             out.append((loc, f"{ratio:g} is above critical damping (1); check the value "
                              f"(typical 0.02-0.1)"))
     out += _friction_drift(model)
+    out += _locked_speed_drives(model)
     pairs: dict[frozenset, str] = {}
     for name, m in model.meshes.items():
         key = frozenset(m.gears)
@@ -1022,6 +1023,35 @@ def nominal_load_issues(model: Model, kin) -> list[tuple[str, str]]:
             f"divide by zero: put the loads where the power must pass the meshes, or "
             f"remove the mesh")))
     return issues
+
+
+def _locked_speed_drives(model: Model) -> list[tuple[str, str]]:
+    """Two speed drives on one gear train (joined by meshes and shafts): the train's speed
+    is prescribed twice, so the torque between them is undetermined and the meshes between
+    carry no load (a reviewer's pair: static force 0, load sharing NaN, no word)."""
+    parent: dict[str, str] = {}
+
+    def root(b: str) -> str:
+        while parent.get(b, b) != b:
+            b = parent[b]
+        return b
+
+    def join(a: str, b: str) -> None:
+        parent[root(a)] = root(b)
+
+    for m in model.meshes.values():
+        join(*m.gears)
+    for sh in model.shafts.values():
+        join(*sh.connects)
+    by_train: dict[str, list[str]] = {}
+    for name, d in model.drives.items():
+        if d.mode == "speed":
+            by_train.setdefault(root(d.body), []).append(name)
+    return [(f"drives.{names[1]}.mode", (
+        f"drives.{names[0]} and drives.{names[1]} both prescribe the speed of one gear "
+        f"train: the torque between them is undetermined and the meshes between them carry "
+        f"no load; make all but one of them torque drives (mode = \"torque\")"))
+        for names in by_train.values() if len(names) > 1]
 
 
 def _friction_drift(model: Model) -> list[tuple[str, str]]:

@@ -79,6 +79,11 @@ def read_model_file(path) -> dict[str, Any]:
     """
     path = Path(path)
     source = str(path)
+    if path.suffix.lower() in (".nc", ".netcdf", ".h5", ".mat", ".csv"):
+        raise ModelError([("", (
+            f"is a results file ({path.suffix}), not a model file; read results with "
+            f"torquesplit.results.load_results (.nc) or open them in MATLAB or a "
+            f"spreadsheet, and give the model file (.toml or .json) here"))], source)
     raw = _read_bytes(path, source)
     text = decode_model_bytes(raw, source)
     return parse_model_text(text, "json" if path.suffix.lower() == ".json" else "toml", source)

@@ -239,7 +239,8 @@ class GearErrors(Strict):
     bearing_runout: Length = Field(0.0, ge=0, description="Bearing run-out amplitude (Mo et al. 2017 §4).")
     bearing_runout_phase: Angle = Field(0.0, description="Phase of the bearing run-out.")
     grade: Count | None = Field(
-        None, ge=1, le=12, description="ISO 1328-1 accuracy grade, used for tolerance sampling."
+        None, ge=1, le=11, description="ISO 1328-1:2013 accuracy grade (1 to 11), used for "
+        "tolerance sampling and the checks of the errors against it."
     )
 
 

@@ -150,6 +150,12 @@ def _report_inputs(h, ux, source, assign, duration, cycles, definition, quiet):
     """(Results, model file or None, results-file attributes or None, quasi-static sweep
     or None) for ``report SOURCE``: a results file is read back, a model is run."""
     path = Path(source)
+    if path.suffix.lower() in (".mat", ".csv"):
+        from ..errors import OptionError
+
+        raise OptionError(f"{source}: 'report' reads the NetCDF results of 'torquesplit run "
+                          f"--out F.nc' (the .mat and .csv exports leave out what the report "
+                          f"needs); give the .nc file, or the model file to run it again")
     if path.suffix.lower() in (".nc", ".netcdf", ".h5"):
         from ..errors import OptionError
         from ..results import open_results

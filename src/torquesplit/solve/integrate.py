@@ -18,9 +18,11 @@ except for the explicitly sized output arrays:
 
 from __future__ import annotations
 
+import contextlib
 import difflib
 import logging
 import math
+import threading
 import time
 import warnings
 from dataclasses import dataclass
@@ -50,12 +52,47 @@ __all__ = ["Solution", "integrate", "planned_step", "rhs", "element_forces", "rh
 
 log = logging.getLogger(__name__)
 
+INTERRUPTED = 4
+"""Status of a run stopped by Ctrl-C inside :func:`stop_on_interrupt` (set here, between
+chunks of the kernels, never by them)."""
+
 STATUS_MESSAGES = {
     kern.FINISHED: "finished",
     kern.DIVERGED: "diverged",
     kern.STEP_UNDERFLOW: "step size underflow",
     kern.MAX_STEPS: "maximum number of steps reached",
+    INTERRUPTED: "interrupted",
 }
+
+_stop_on_interrupt = threading.local()
+
+
+@contextlib.contextmanager
+def stop_on_interrupt():
+    """Within this context, Ctrl-C during an integration ends it as a stopped run (status
+    ``INTERRUPTED``, everything recorded so far kept, as a diverged run keeps it) instead
+    of raising KeyboardInterrupt: ``torquesplit run`` saves and reports what it has.
+    Outside it (studies, whose workers must stop at once) the interrupt propagates."""
+    before = getattr(_stop_on_interrupt, "on", False)
+    _stop_on_interrupt.on = True
+    try:
+        yield
+    finally:
+        _stop_on_interrupt.on = before
+
+
+def _interrupted(exc: BaseException) -> bool:
+    """An interrupt to turn into a status: inside :func:`stop_on_interrupt`, a
+    KeyboardInterrupt or an error chained from one (Ctrl-C inside compiled code)."""
+    if not getattr(_stop_on_interrupt, "on", False):
+        return False
+    seen = 0
+    while exc is not None and seen < 50:
+        if isinstance(exc, KeyboardInterrupt):
+            return True
+        exc = exc.__cause__ or exc.__context__
+        seen += 1
+    return False
 
 _N_CHUNKS = 64  # progress granularity: about 1.5 % of the run per chunk
 _MIN_CHUNK_STEPS = 16 * kern.RESYNC
@@ -905,14 +942,20 @@ def _run_rk4(t0, plan, blowup, model, work, rec, rhs_code, counters, clock, prog
         last = done + m == plan.limit_steps
         args = (t0, plan.h, done, m, last, plan.every, blowup, model, work, rec,
                 rhs_code.function, rhs_code.generated, counters, clock)
-        run(*args)
-        if run is kern.rk4_run:
-            run = _compiled(kern.rk4_run, args)
-        done += m
-        if counters[kern.I_STATUS] != kern.FINISHED:
+        try:
+            run(*args)
+            if run is kern.rk4_run:
+                run = _compiled(kern.rk4_run, args)
+            done += m
+            if counters[kern.I_STATUS] != kern.FINISHED:
+                return
+            if progress is not None:
+                progress(done / plan.n_steps)
+        except (KeyboardInterrupt, SystemError) as exc:
+            if not _interrupted(exc):
+                raise
+            counters[kern.I_STATUS] = INTERRUPTED
             return
-        if progress is not None:
-            progress(done / plan.n_steps)
     if plan.limit_steps < plan.n_steps:
         counters[kern.I_STATUS] = kern.MAX_STEPS
 
@@ -928,13 +971,19 @@ def _run_dopri(t0, t_end, plan, blowup, model, work, rec, rhs_code, counters, cl
         t_stop = t_end if k == _N_CHUNKS else t0 + span * k / _N_CHUNKS
         if clock[kern.F_T] >= t_stop:
             continue
-        kern.dopri_run(t0, t_end, t_stop, plan.rtol, plan.atol, plan.h_max, plan.h_min,
-                       plan.limit_steps, blowup, plan.dt_sample, model, work, rec,
-                       rhs_code.function, rhs_code.generated, counters, clock)
-        if counters[kern.I_STATUS] != kern.FINISHED:
+        try:
+            kern.dopri_run(t0, t_end, t_stop, plan.rtol, plan.atol, plan.h_max, plan.h_min,
+                           plan.limit_steps, blowup, plan.dt_sample, model, work, rec,
+                           rhs_code.function, rhs_code.generated, counters, clock)
+            if counters[kern.I_STATUS] != kern.FINISHED:
+                return
+            if progress is not None:
+                progress(min(1.0, (clock[kern.F_T] - t0) / span))
+        except (KeyboardInterrupt, SystemError) as exc:
+            if not _interrupted(exc):
+                raise
+            counters[kern.I_STATUS] = INTERRUPTED
             return
-        if progress is not None:
-            progress(min(1.0, (clock[kern.F_T] - t0) / span))
 
 
 def _initial_step(s, y, t0, t_end, rtol, atol, model) -> float:
@@ -976,6 +1025,9 @@ def _message(status, s, y, t_final, t_end, counters, clock, blowup, limit_steps,
                "balance, or raise blowup if such a displacement is real.")
         return (f"Integration diverged at t = {t_final:.6g} s (step {n_steps}): {why}. "
                 f"Everything recorded before that time is valid. {fix}")
+    if status == INTERRUPTED:
+        return (f"Interrupted (Ctrl-C) at t = {t_final:.6g} s (step {n_steps}) of "
+                f"t_end = {t_end:.6g} s. Everything recorded before that time is valid.")
     if status == kern.STEP_UNDERFLOW:
         return (f"Required step size {clock[kern.F_H]:.3g} s fell below the minimum at "
                 f"t = {t_final:.6g} s (step {n_steps}); the response is too stiff or "
