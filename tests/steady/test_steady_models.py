@@ -512,3 +512,22 @@ def test_steady_messages_name_the_flags(args, said):
     r = CliRunner().invoke(app, ["steady", "ji_li_mill_drive", *args])
     assert r.exit_code == 2 and said in r.stderr, r.stderr
     assert "max_cycles=" not in r.stderr and "keep='" not in r.stderr
+
+
+def test_a_saved_steady_state_says_what_it_is():
+    """Its file omitted the RMS transmission error, the Floquet stability, the residual
+    and the excitations replaced by their means, and described a 0.177 s 'run' with a
+    start-up (a reviewer)."""
+    st = steady_state(example_path(EXAMPLE), keep="stage1", harmonics=16)
+    ds = st.to_results().to_dataset()
+    info = st.summary()
+    assert ds.attrs["analysis"] == "periodic steady state"
+    assert ds.attrs["steady_method"] == info["method"] == "hb"
+    assert ds.attrs["steady_residual"] == info["residual"]
+    assert ds.attrs["dropped_excitations"] == "; ".join(info["dropped_excitations"]) != ""
+    assert "repeated" in ds.attrs["record"]
+    np.testing.assert_array_equal(
+        ds["rms_transmission_error"].values,
+        [info["meshes"][m]["rms_transmission_error"] for m in ds["mesh"].values])
+    assert "start-up" not in ds["contact_loss_fraction"].attrs["long_name"]
+    assert json.loads(ds.attrs["steady_json"])["period_s"] == pytest.approx(info["period_s"])

@@ -141,6 +141,10 @@ class Results:
     def __init__(self, *, model, kinematics, structure, static, solution,
                  run_warnings=(), model_warnings=None, periodic: bool = False):
         self.model = model
+        self.steady = None
+        """The :class:`~torquesplit.steady.SteadyState` this record repeats (a steady
+        state's :meth:`~torquesplit.steady.SteadyState.to_results`), else None: its
+        summary goes into the saved file."""
         self.periodic = periodic
         """The record is a periodic state repeated over whole periods (a steady state):
         no transient to detect, every complete cycle counts."""

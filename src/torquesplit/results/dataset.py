@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 
 import numpy as np
 import xarray as xr
@@ -150,6 +151,9 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
         ds = add_planet_load_sharing(ds, met.load_sharing, res.kinematics)
     except Exception as exc:  # metrics of a diverged run may be undefined; keep the data
         ds.attrs["metrics_error"] = str(exc)
+    steady = getattr(res, "steady", None)
+    if steady is not None:  # a periodic steady state: one period repeated, not a run
+        _steady_attributes(ds, res, steady)
     notes = res.warnings(definition) if hasattr(res, "warnings") else []
     ds.attrs.update({
         "warnings": "\n".join(notes),
@@ -166,6 +170,38 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
         "software": "torquesplit",
     })
     return ds
+
+
+def _steady_attributes(ds: xr.Dataset, res, steady) -> None:
+    """What a saved steady state needs beside its repeated record: the solver's summary
+    (period, residuals, stability, excitations replaced by their means), the RMS
+    transmission error per mesh, and words that do not describe a run it never made."""
+    info = steady.summary()
+    ds["rms_transmission_error"] = _var(
+        ("mesh",), [info["meshes"][m]["rms_transmission_error"] for m in res.mesh_names],
+        "m", "RMS dynamic transmission error (mesh deflection about its mean)")
+    periods = (float(res.solution.t_final - res.solution.t_span[0]) / info["period_s"]
+               if info["period_s"] else math.nan)
+    ds.attrs.update(
+        analysis="periodic steady state",
+        steady_json=json.dumps(info, default=float),
+        steady_method=info["method"], steady_period_s=info["period_s"],
+        steady_residual=info["residual"],
+        steady_stable=("unknown" if info["stable"] is None else str(bool(info["stable"]))),
+        steady_largest_multiplier=(math.nan if info["largest_multiplier"] is None
+                                   else info["largest_multiplier"]),
+        dropped_excitations="; ".join(info["dropped_excitations"]) or "none",
+        record=f"one period of the steady state repeated {periods:.0f} times (no start-up: "
+               f"t_start..t_end is that record, not a simulated run)")
+    for name in ("contact_loss_fraction", "back_contact_fraction"):
+        text = ds[name].attrs.get("long_name", "")
+        ds[name].attrs["long_name"] = text.replace("of the whole run (start-up included)",
+                                                   "of the period")
+    for name in ("element_force", "displacement", "velocity"):
+        if name in ds:
+            ds[name].attrs["sampling"] = (
+                f"the steady state's samples over one period "
+                f"({info['method']}), repeated; the metrics come from every step of it")
 
 
 def _note_sampling(ds: xr.Dataset, t, step) -> None:
@@ -200,7 +236,6 @@ def results_from_dataset(ds: xr.Dataset):
     ValueError
         The Dataset is not a torquesplit dynamic-run file.
     """
-    import math
 
     from ..assembly.assemble import assemble
     from ..metrics.load_sharing import group_meshes

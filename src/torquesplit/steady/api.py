@@ -155,8 +155,32 @@ class SteadyState:
         shell = Results(model=self.model, kinematics=self.kinematics,
                         structure=self.structure, static=self.static, solution=None)
         sol = _as_solution(self, shell, periods)
-        return Results(model=self.model, kinematics=self.kinematics, structure=self.structure,
-                       static=self.static, solution=sol, periodic=True)
+        res = Results(model=self.model, kinematics=self.kinematics, structure=self.structure,
+                      static=self.static, solution=sol, periodic=True)
+        res.steady = self
+        return res
+
+    def summary(self, rows=None) -> dict:
+        """What ``torquesplit steady`` prints, as a dict (its ``--json`` and the
+        ``steady_json`` attribute of a saved steady state): method, period, residuals,
+        stability, the excitations replaced by their means, and the per-mesh table
+        (``rows``: :meth:`mesh_table`, computed when not given)."""
+        ps = self.solution
+        mu = ps.multipliers
+        rows = self.mesh_table() if rows is None else rows
+        return {
+            "model": self.model.model.name, "method": ps.method, "converged": ps.converged,
+            "message": ps.message, "period_s": ps.period, "fundamental_Hz": ps.frequency,
+            "period": self.period.describe(ps.frequency / self.period.frequency),
+            "harmonics": ps.harmonics, "residual": ps.residual,
+            "time_residual": ps.time_residual, "periodicity_defect": ps.periodicity_defect,
+            "top_harmonic_energy": ps.top_harmonic_energy,
+            "stable": ps.stable, "stability_method": ps.stability_method,
+            "largest_multiplier": float(abs(mu[0])) if mu is not None and mu.size else None,
+            "dropped_excitations": [d.describe() for d in self.dropped],
+            "meshes": {r.mesh: {k: v for k, v in r.__dict__.items() if k != "mesh"}
+                       for r in rows},
+        }
 
     def mesh_table(self, definition: str | None = None) -> list[MeshSteady]:
         """Per-mesh static, mean, min and peak force, dynamic factors, load sharing

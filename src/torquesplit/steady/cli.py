@@ -164,17 +164,7 @@ def register(app, load, fail, console, err_console, json_default):
         # the period found at the model's speeds, told at the speed solved
         period_text = st.period.describe(ps.frequency / st.period.frequency)
         info = {
-            "model": m.model.name, "method": ps.method, "converged": ps.converged,
-            "message": ps.message, "period_s": ps.period, "fundamental_Hz": ps.frequency,
-            "period": period_text, "harmonics": ps.harmonics,
-            "residual": ps.residual, "time_residual": ps.time_residual,
-            "periodicity_defect": ps.periodicity_defect,
-            "top_harmonic_energy": ps.top_harmonic_energy,
-            "stable": ps.stable, "stability_method": ps.stability_method,
-            "largest_multiplier": float(abs(mu[0])) if mu is not None and mu.size else None,
-            "dropped_excitations": [d.describe() for d in st.dropped],
-            "meshes": {r.mesh: {k: v for k, v in r.__dict__.items() if k != "mesh"}
-                       for r in rows},
+            **st.summary(rows),
             "results_file": str(saved) if saved else None,
             **({"step_check": step_check.to_dict()} if step_check else {}),
         }
