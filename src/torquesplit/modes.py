@@ -116,7 +116,8 @@ class ModalReport:
              "group": (("mode",), [r.group for r in self.rows],
                        {"units": "1", "long_name": "group of equal frequencies"}),
              "type": (("mode",), [r.type or "" for r in self.rows],
-                      {"long_name": "mode type (rotational, translational, planet, mixed)"}),
+                      {"long_name": "mode type of a planetary stage (rotational, translational, "
+                                   "planet, mixed); empty for a model without one"}),
              "strain_energy": (("mode", "element"), energy,
                                {"units": "1", "long_name": "share of the group's strain "
                                 "energy (basis-independent)"}),

@@ -363,6 +363,8 @@ def _to_netcdf(ds, path, overwrite=False):
     for k, v in list(ds.attrs.items()):
         if isinstance(v, list):
             ds.attrs[k] = json.dumps(v)
+    # which software and command wrote it, as a run's results file says
+    ds.attrs.update(files.provenance(files.new_run_id()))
     files.write_atomically(path, files.netcdf_bytes(ds), overwrite=overwrite,
                            formats=files.NETCDF_FORMATS)
 
