@@ -133,4 +133,25 @@ def test_the_campbell_figure_draws_suppressed_crossings_apart(lp_map):
     fig = campbell_figure(lp_map[0])
     labels = fig.axes[0].get_legend_handles_labels()[1]
     assert "suppressed by mesh phasing (Parker & Lin 2004)" in labels
-    assert "critical speed" in labels
+    assert "critical speed (a crossing)" in labels
+
+
+def test_campbell_labels_that_would_overprint_share_one_text():
+    """Degenerate pairs printed '6/7' over each other, coinciding harmonics '52x' (a
+    reviewer's Campbell diagram)."""
+    import xarray as xr
+
+    from torquesplit.steady.plot import campbell_figure
+
+    rpm = np.array([1000.0, 2000.0])
+    ds = xr.Dataset(
+        {"natural_frequency": (("speed", "mode"), [[500.0, 500.5, 900.0]] * 2),
+         "excitation_frequency": (("speed", "line"), [[100.0, 200.0, 200.0],
+                                                      [500.0, 1000.0, 1000.0]])},
+        coords={"speed_rpm": ("speed", rpm), "mode": [1, 2, 3],
+                "line": ["1 x mesh a", "2 x mesh a", "4 x mesh b"]},
+        attrs={"critical_speeds_rpm": [1500.0]})
+    texts = [t.get_text() for t in campbell_figure(ds).axes[0].texts]
+    assert "1, 2" in texts and "3" in texts
+    assert "2x a = 4x b" in texts
+    assert "1500" in texts

@@ -163,48 +163,81 @@ def critical_speed_groups(ds, lo: float, hi: float, merge: float = 0.025):
 
 
 def campbell_figure(ds):
-    """Natural frequencies and excitation lines against speed; crossings marked."""
-    fig = _figure(8, 5)
+    """Natural frequencies and excitation lines against speed; crossings marked.
+
+    Labels that would print over each other share one text: modes of equal frequency
+    ('6, 7': a degenerate pair), excitation lines that end at the same frequency ('10x in1
+    = 20x out1': coinciding harmonics).  Critical speeds are grey dotted lines with their
+    speeds (the shaft orders keep the colours)."""
+    fig = _figure(9, 5.5)
     ax = fig.add_subplot()
     rpm = ds["speed_rpm"].values
     fmax = float(np.nanmax(ds["excitation_frequency"].values))
+    near = 0.012 * fmax * 1.05  # two labels closer than this (in Hz) would overlap
+    ends: list[tuple[float, list[str]]] = []
     for m in range(ds.sizes["mode"]):
         fn = ds["natural_frequency"].values[:, m]
         ax.plot(rpm, fn, color="k", lw=0.8)
         if np.isfinite(fn[-1]) and 0 < fn[-1] <= fmax * 1.05:  # mode number at its end
-            ax.annotate(f"{int(ds['mode'].values[m])}", (rpm[-1], fn[-1]), fontsize=6,
-                        xytext=(2, 0), textcoords="offset points", va="center")
+            _merge_label(ends, float(fn[-1]), f"{int(ds['mode'].values[m])}", near)
+    for f, labels in ends:
+        ax.annotate(", ".join(labels), (rpm[-1], f), fontsize=6, xytext=(2, 0),
+                    textcoords="offset points", va="center")
     # one colour per source (a mesh: its orders 1..k, labelled at the top; a shaft), one
     # legend entry each
     sources: dict[str, list[tuple[int, int]]] = {}
     for j, lab in enumerate(ds["line"].values):
         order, _, source = str(lab).partition(" x ")
         sources.setdefault(source, []).append((j, int(order)))
+    tops: list[tuple[float, float, list[str], str]] = []  # (x, y, labels, colour)
     for k, (source, members) in enumerate(sources.items()):
         colour = f"C{k % 10}"  # matplotlib's colour cycle
         orders = [o for _, o in members]
         label = source if orders == [1] else f"{source} x {min(orders)}..{max(orders)}"
+        short = source.replace("mesh ", "")
         for i, (j, order) in enumerate(members):
             fe = ds["excitation_frequency"].values[:, j]
             ax.plot(rpm, fe, lw=0.8, ls="--", color=colour, label=label if i == 0 else None)
             inside = np.flatnonzero(fe <= fmax * 1.05)
             if len(members) > 1 and inside.size:  # the order at the line's last point
-                ax.annotate(f"{order}x", (rpm[inside[-1]], fe[inside[-1]]), fontsize=5,
-                            color=colour, xytext=(0, 2), textcoords="offset points")
-    for i, c in enumerate(ds.attrs.get("critical_speeds_rpm", [])):
-        ax.axvline(c, color="r", lw=0.5, alpha=0.5,
-                   label="critical speed" if i == 0 else None)
+                x, y = float(rpm[inside[-1]]), float(fe[inside[-1]])
+                same = next((t for t in tops if abs(t[0] - x) < 1e-9 * max(abs(x), 1.0)
+                             and abs(t[1] - y) <= near), None)
+                if same is None:
+                    tops.append((x, y, [f"{order}x {short}"], colour))
+                else:
+                    same[2].append(f"{order}x {short}")
+    for x, y, labels, colour in tops:
+        ax.annotate(" = ".join(labels), (x, y), fontsize=5, color=colour, xytext=(-2, 2),
+                    textcoords="offset points", ha="right" if len(labels) > 1 else "left")
+    crit = sorted(ds.attrs.get("critical_speeds_rpm", []))
+    for i, c in enumerate(crit):
+        ax.axvline(c, color="0.35", lw=0.6, ls=":",
+                   label="critical speed (a crossing)" if i == 0 else None)
+        ax.annotate(f"{c:.0f}", (c, 1.0), xycoords=ax.get_xaxis_transform(), fontsize=5,
+                    rotation=90, ha="center", va="bottom", color="0.35",
+                    xytext=(0, 2), textcoords="offset points")
     # crossings that the planets' mesh phasing leaves unexcited (Parker & Lin 2004)
     for i, c in enumerate(ds.attrs.get("suppressed_speeds_rpm", [])):
-        ax.axvline(c, color="0.6", lw=0.5, ls=":",
+        ax.axvline(c, color="0.75", lw=0.5, ls="-.",
                    label="suppressed by mesh phasing (Parker & Lin 2004)" if i == 0 else None)
     ax.set_ylim(0, fmax * 1.05)
     ax.set_xlabel("input speed [rpm]")
     ax.set_ylabel("frequency [Hz]")
     ax.set_title(f"{ds.attrs.get('model', '')}: Campbell diagram (solid: natural "
-                 f"frequencies, numbered; dashed: excitation orders)", fontsize=9)
-    ax.legend(fontsize=6, loc="upper left")
+                 f"frequencies, numbered; dashed: excitation orders; dotted: critical "
+                 f"speeds [rpm])", fontsize=9, pad=22)
+    ax.legend(fontsize=6, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     return fig
+
+
+def _merge_label(ends: list, y: float, text: str, near: float) -> None:
+    """Add ``text`` at height ``y`` to the label within ``near`` of it, or a new one."""
+    for f, labels in ends:
+        if abs(f - y) <= near:
+            labels.append(text)
+            return
+    ends.append((y, [text]))
 
 
 def save(fig, path) -> Path:
