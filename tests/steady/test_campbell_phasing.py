@@ -146,12 +146,12 @@ def test_campbell_labels_that_would_overprint_share_one_text():
     rpm = np.array([1000.0, 2000.0])
     ds = xr.Dataset(
         {"natural_frequency": (("speed", "mode"), [[500.0, 500.5, 900.0]] * 2),
-         "excitation_frequency": (("speed", "line"), [[100.0, 200.0, 200.0],
-                                                      [500.0, 1000.0, 1000.0]])},
+         "excitation_frequency": (("speed", "line"), [[100.0, 200.0, 100.0, 200.0],
+                                                      [500.0, 1000.0, 500.0, 1000.0]])},
         coords={"speed_rpm": ("speed", rpm), "mode": [1, 2, 3],
-                "line": ["1 x mesh a", "2 x mesh a", "4 x mesh b"]},
+                "line": ["1 x mesh a", "2 x mesh a", "2 x mesh b", "4 x mesh b"]},
         attrs={"critical_speeds_rpm": [1500.0]})
     texts = [t.get_text() for t in campbell_figure(ds).axes[0].texts]
     assert "1, 2" in texts and "3" in texts
-    assert "2x a = 4x b" in texts
+    assert "2x a = 4x b" in texts and "1x a = 2x b" in texts
     assert "1500" in texts
