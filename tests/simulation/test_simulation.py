@@ -104,8 +104,21 @@ def test_mat_and_csv_exports(split, tmp_path):
     res.save(tmp_path / "run.csv")
     with open(tmp_path / "run.csv", newline="") as fh:
         rows = list(csv.DictReader(fh))
-    assert [r["mesh"] for r in rows] == res.mesh_names
-    assert float(rows[0]["peak_force_N"]) == pytest.approx(res.metrics().rows[0].peak_force)
+    met = res.metrics()
+    n = len(res.mesh_names)
+    assert [r["mesh"] for r in rows[:n]] == res.mesh_names
+    assert float(rows[0]["peak_force_N"]) == pytest.approx(met.rows[0].peak_force)
+    # then the groups' and the system's rows, as the run's tables print them
+    key = f"load_sharing_{met.definition}"
+    groups = {r["group"]: float(r[key]) for r in rows[n:]}
+    assert groups.pop("(system)") == pytest.approx(met.load_sharing.system)
+    assert groups == pytest.approx(met.load_sharing.per_group)
+    with open(tmp_path / "run_cycles.csv", newline="") as fh:
+        cycles = list(csv.DictReader(fh))
+    assert cycles[1]["cycle"] == "1"  # a whole number, not 1.0
+    m = res.mesh_names[0]
+    lo, mean, hi = (float(cycles[1][f"{m}_{q}_N"]) for q in ("min", "mean", "peak"))
+    assert lo * (1 - 1e-12) <= mean <= hi * (1 + 1e-12)  # (a trapezoid mean's rounding)
     hist = np.loadtxt(tmp_path / "run_history.csv", delimiter=",", skiprows=1)
     np.testing.assert_allclose(hist[:, 0], res.solution.history_t)
     with pytest.raises(ValueError, match=r"\.nc, \.mat or \.csv"):

@@ -458,8 +458,10 @@ class Results:
         return plan.path
 
     def to_csv(self, path, *, overwrite: bool = False, definition: str | None = None) -> Path:
-        """Save spreadsheet tables: ``NAME.csv`` (per-mesh summary) and beside it
-        ``NAME_history.csv`` (decimated forces) and ``NAME_cycles.csv`` (cycle peaks).
+        """Save spreadsheet tables: ``NAME.csv`` (per-mesh summary, then a row per
+        load-sharing group and one for the system, their mesh cell empty) and beside it
+        ``NAME_history.csv`` (decimated forces) and ``NAME_cycles.csv`` (start, peak,
+        smallest and mean force of every mesh cycle).
 
         All three are written atomically, and none replaces an existing file unless
         ``overwrite``.  A run that did not finish has no metrics: its summary lists the
@@ -484,6 +486,17 @@ class Results:
                      r.dynamic_factor_engineering, r.peak_to_nominal, r.load_sharing,
                      r.contact_loss, r.back_contact, r.back_flank_force] for r in met.rows]
             rows = self._planet_columns(header, rows, met)
+            # then each group's and the system's coefficients and factors (mesh left
+            # empty): what the run's group table and system line print
+            d, width = met.dynamic_factors, len(header)
+            for g, members in met.load_sharing.groups.items():
+                row = ["", g] + [""] * (width - 2)
+                row[7], row[9] = d.per_group_dynamic_factor[g], d.per_group_peak_to_nominal[g]
+                row[10] = met.load_sharing.per_group[g]
+                rows.append(row)
+            system = ["", "(system)"] + [""] * (width - 2)
+            system[10] = met.load_sharing.system
+            rows.append(system)
         else:
             header.append("status")
             group_of = {m: g for g, ms in self.groups.items() for m in ms}
@@ -498,11 +511,12 @@ class Results:
         contents = {
             history: files.csv_bytes(["time_s"] + [f"{n}_N" for n in names],
                                      np.column_stack([s.history_t, s.history_forces]).tolist()),
-            cycles: files.csv_bytes(["cycle"] + [f"{m}_start_s" for m in self.mesh_names]
-                                    + [f"{m}_peak_N" for m in self.mesh_names],
-                                    np.column_stack([np.arange(s.cycle_max.shape[0]),
-                                                     s.cycle_start[:, cols],
-                                                     s.cycle_max[:, cols]]).tolist()),
+            cycles: files.csv_bytes(
+                ["cycle"] + [f"{m}_{q}" for q in ("start_s", "peak_N", "min_N", "mean_N")
+                             for m in self.mesh_names],
+                [[k] + row for k, row in enumerate(np.column_stack(
+                    [s.cycle_start[:, cols], s.cycle_max[:, cols], s.cycle_min[:, cols],
+                     s.cycle_mean[:, cols]]).tolist())]),
             summary: files.csv_bytes(header, rows),  # last: its presence marks the set
         }
         with files.claim_output(plan) as claim:
