@@ -245,7 +245,9 @@ def test_ctrl_c_after_saving_says_what_was_kept(tmp_path, monkeypatch):
     assert "figures incomplete" in last and (tmp_path / "r.nc").exists()
 
 
-def test_a_real_sigint_stops_a_run_and_writes_nothing(tmp_path):
+def test_a_real_sigint_stops_a_run_and_keeps_what_it_computed(tmp_path):
+    """Ctrl-C during the integration ends the run as a stopped one: its partial results
+    are written (with their status) and said; nothing is lost, no traceback."""
     model = write_model(tmp_path, SPUR_PAIR)
     out = tmp_path / "r.nc"
     proc = subprocess.Popen([sys.executable, "-m", "torquesplit.cli", "run", str(model),
@@ -261,10 +263,13 @@ def test_a_real_sigint_stops_a_run_and_writes_nothing(tmp_path):
         time.sleep(0.1)
     time.sleep(2.0)
     proc.send_signal(signal.SIGINT)
-    _, err = proc.communicate(timeout=120)
+    stdout, err = proc.communicate(timeout=120)
     assert proc.returncode == 130, err
-    assert err.strip().splitlines()[-1] == "interrupted; nothing written", err
-    assert "Traceback" not in err and not out.exists()
+    assert "stopped: Interrupted (Ctrl-C) at t = " in stdout, (stdout, err)
+    assert "the partial results (with their status) are in" in " ".join(stdout.split())
+    assert "Traceback" not in err and out.exists()
+    with xr.open_dataset(out, engine="h5netcdf") as ds:
+        assert ds.attrs["message"].startswith("Interrupted (Ctrl-C)") and ds.attrs["status"] == 4
 
 
 # =========================================================================== finding 3
