@@ -1,7 +1,7 @@
 """Multi-objective optimisation of model parameters with pymoo (NSGA-II by default).
 
     torquesplit optimize OPT.toml [--workers 2] [--out DIR]
-    torquesplit.optimize("OPT.toml")
+    from torquesplit.optimize import optimize; optimize("OPT.toml")
 
 Self-contained: the evaluations run in a local process pool of this module, not through
 the study runner (which is being written apart); they are stored in a JSON-lines file
