@@ -74,6 +74,26 @@ def test_a_store_of_another_model_is_not_reused(tmp_path):
     assert changed.computed == first.computed
 
 
+def test_evaluations_run_through_a_studies_runner(tmp_path):
+    """A Dask client or scheduler (or any runner of torquesplit.study.runners) runs the
+    evaluations, as a study's cases; the same front as the local run."""
+    from torquesplit.study.runners import SerialRunner
+
+    class Counting(SerialRunner):
+        batches = 0
+
+        def __call__(self, function, payloads):
+            Counting.batches += 1
+            yield from super().__call__(function, payloads)
+
+    d = spec_dict(store=str(tmp_path / "a.jsonl"), generations=2, population=4)
+    local = optimize(read_spec(d))
+    d["optimization"]["store"] = str(tmp_path / "b.jsonl")
+    through = optimize(read_spec(d), runner=Counting())
+    assert Counting.batches == 2 and through.computed == local.computed
+    np.testing.assert_array_equal(through.F, local.F)
+
+
 @pytest.mark.parametrize("override", [dict(generations=0), dict(population=2), dict(seed=-1),
                                       dict(workers=0)])
 def test_overrides_are_checked_like_the_file(override):

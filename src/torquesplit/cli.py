@@ -1065,6 +1065,9 @@ def optimize(
     population: Optional[int] = typer.Option(None, "--population", help="Population size.",
                                              metavar="N"),
     seed: Optional[int] = typer.Option(None, "--seed", help="Random seed.", metavar="N"),
+    scheduler: Optional[str] = typer.Option(
+        None, "--scheduler", help="Dask scheduler address: the evaluations run on that "
+        "cluster (as a study's).", metavar="ADDRESS"),
     as_json: bool = _flag("--json", "Print the Pareto front as JSON."),
 ):
     """Optimise model parameters (NSGA-II or any pymoo algorithm) on LTCA or dynamic outputs;
@@ -1090,7 +1093,8 @@ def optimize(
             _check_plots_folder(target, "--out")
             res = _with_progress(lambda cb: run_optimization(
                 path, workers=workers, generations=generations, population=population,
-                seed=seed, progress=None if cb is None else (lambda g, n: cb(g / max(n + 1, 1)))),
+                seed=seed, scheduler=scheduler,
+                progress=None if cb is None else (lambda g, n: cb(g / max(n + 1, 1)))),
                 as_json, "optimising")
             files = res.write(target)
         except _EXPECTED as exc:

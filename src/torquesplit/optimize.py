@@ -3,12 +3,15 @@
     torquesplit optimize OPT.toml [--workers 2] [--out DIR]
     from torquesplit.optimize import optimize; optimize("OPT.toml")
 
-Self-contained: the evaluations run in a local process pool of this module, not through
-the study runner (which is being written apart); they are stored in a JSON-lines file
-as they finish (``OPT.evaluations.jsonl`` in the current folder, or ``store = "..."``
-relative to the optimisation file), keyed by the variable values, so that an
-interrupted optimisation run again with the same file and seed recomputes nothing it has
-already evaluated (pymoo with a fixed seed proposes the same designs again).
+The evaluations of a generation run in a local process pool kept for the whole
+optimisation (the studies' pool starts its workers per batch, a second each, too slow
+for 50 generations of LTCA evaluations of a tenth of a second), or through the studies'
+runners on a Dask cluster (``--scheduler``, ``client=``); they are stored in a
+JSON-lines file as they finish (``OPT.evaluations.jsonl`` in the current folder, or
+``store = "..."`` relative to the optimisation file), keyed by the variable values and
+a fingerprint of the model, its [set] and the outputs, so that an interrupted
+optimisation run again with the same file and seed recomputes nothing it has already
+evaluated (pymoo with a fixed seed proposes the same designs again).
 
 The optimisation file (TOML)::
 
@@ -57,6 +60,7 @@ objectives with ``relative_to`` are ratios, headed ``(/ baseline)``.
 from __future__ import annotations
 
 import csv
+import functools
 import hashlib
 import json
 import re
@@ -633,11 +637,16 @@ class OptimizationResult:
 # ============================================================================= driver
 def optimize(source, *, workers: int | None = None, generations: int | None = None,
              population: int | None = None, seed: int | None = None,
-             progress: Callable[[int, int], None] | None = None) -> OptimizationResult:
+             progress: Callable[[int, int], None] | None = None, scheduler: str | None = None,
+             client=None, runner=None) -> OptimizationResult:
     """Run the optimisation of an optimisation file (path, dict or OptimizationSpec).
 
     Keyword arguments override the file's settings.  ``progress(generation, total)`` is
-    called after each generation.
+    called after each generation.  The evaluations of a generation run in a local
+    process pool kept for the whole optimisation (``workers``), or through the studies'
+    runners: a Dask cluster (``scheduler`` address or ``client``, as
+    :class:`torquesplit.study.Study`) or any ``runner(function, payloads)``
+    (:mod:`torquesplit.study.runners`).
     """
     import importlib
 
@@ -667,7 +676,13 @@ def optimize(source, *, workers: int | None = None, generations: int | None = No
             raise ModelError([("objectives", f"the baseline value of {o.output!r} is 0; it cannot "
                                              "be a reference: remove relative_to")])
     counters = {"computed": 0, "evaluations": 0, "generation": 0}
-    pool = ProcessPoolExecutor(max_workers=spec.workers) if spec.workers > 1 else None
+    external = None
+    if any(x is not None for x in (scheduler, client, runner)):
+        from .study.runners import make_runner
+
+        external = make_runner(client=client, scheduler=scheduler, runner=runner)
+    pool = (ProcessPoolExecutor(max_workers=spec.workers)
+            if spec.workers > 1 and external is None else None)
 
     def objectives_of(rec):
         if rec["outputs"] is None:
@@ -698,7 +713,11 @@ def optimize(source, *, workers: int | None = None, generations: int | None = No
         def _evaluate(self, X, out, *args, **kwargs):
             keys = [tuple(float(v) for v in x) for x in X]
             todo = sorted({k for k in keys if k not in store})
-            if pool is None:
+            if external is not None:  # the studies' runner (Dask): stored as they finish
+                for rec in external(functools.partial(_evaluate_job, spec), todo):
+                    store.add(rec)
+                    counters["computed"] += 1
+            elif pool is None:
                 for k in todo:
                     store.add(_evaluate_job(spec, k))
                     counters["computed"] += 1
