@@ -900,6 +900,11 @@ def contact(
                  as_json)
 
 
+MAX_FLANK_PRESSURE = 4e9
+"""Hertz pressure [Pa] no steel flank carries (case-hardened gears: about 1.5 GPa
+allowable, 3 GPa static limit): above it a contact load is a slip of units."""
+
+
 def _contact(model, pair, load, on, plot, force, positions, slices, harris, assign,
              as_json) -> None:
     try:
@@ -940,6 +945,13 @@ def _contact(model, pair, load, on, plot, force, positions, slices, harris, assi
             top = max(loads)
             hm = cm.harris_map(np.linspace(0.1, 1.5, harris) * top) if harris > 0 else None
         op = max(results, key=lambda r: r.load)
+        for r in results:  # beyond any steel flank: the elastic LTCA says nothing there
+            p_h = float(r.max_pressure.max())
+            if p_h > MAX_FLANK_PRESSURE:
+                ux.warn(f"meshes.{pair}: at {r.load / 1e3:.4g} kN the largest Hertz pressure "
+                        f"is {p_h / 1e6:.4g} MPa, beyond what any steel flank carries "
+                        f"({MAX_FLANK_PRESSURE / 1e6:.0f} MPa); the linear-elastic contact "
+                        f"analysis is not valid there: check the load and its unit")
         impact = None
         if cm.pair.is_internal:  # (reverse: a ring that drives, internal too)
             if as_json:  # the table prints it under the table
@@ -1177,6 +1189,9 @@ def modes(
         if out is not None:
             files.check_output(out, formats=files.NETCDF_FORMATS, overwrite=force)
         m, _ = _load(model, assign)
+        if not campbell and (start is not None or stop is not None):
+            raise TorquesplitError("--from and --to give the speed range of a Campbell "
+                                   "diagram; add --campbell, or leave them out")
         if campbell:
             if start is None or stop is None:
                 raise TorquesplitError("--campbell needs a speed range: add --from '500 rpm' "

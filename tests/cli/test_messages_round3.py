@@ -10,6 +10,37 @@ from torquesplit.errors import ModelError
 
 runner = CliRunner()
 
+SPUR = """
+[model]
+name = "spur pair"
+
+[gears.pinion]
+teeth = 20
+module = "2 mm"
+face_width = "20 mm"
+position = ["0 mm", "0 mm", "0 mm"]
+
+[gears.wheel]
+teeth = 40
+module = "2 mm"
+face_width = "20 mm"
+place = {from_gear = "pinion", angle = "0 deg"}
+
+[meshes.m]
+gears = ["pinion", "wheel"]
+stiffness = "4e8 N/m"
+damping_ratio = 0.05
+backlash = "100 um"
+
+[drives.motor]
+body = "pinion"
+speed = "3000 rpm"
+torque = "100 N m"
+
+[loads.out]
+body = "wheel"
+"""
+
 
 @pytest.mark.parametrize("suffix", [".csv", ".mat"])
 def test_report_of_an_export_says_it_reads_netcdf(tmp_path, suffix):
@@ -26,7 +57,21 @@ def test_a_results_file_given_as_a_model_is_named_as_such(tmp_path):
         torquesplit.load_model(f)
 
 
-def test_an_impossible_contact_load_is_said_in_words():
+def test_an_impossible_contact_load_is_said_in_words(tmp_path):
+    """1e9 N on a mill drive's pair printed p_H = 87 GPa without a word; on a small spur
+    pair scipy's 'f(a) and f(b) must have different signs'."""
     res = runner.invoke(app, ["contact", "ji_li_mill_drive", "--pair", "m11", "--load", "1e9 N",
                               "--harris", "0"])
-    assert res.exit_code == 2 and "too large for this tooth geometry" in res.stderr, res.stderr
+    assert res.exit_code == 0 and "beyond what any steel flank carries" in res.stderr
+    spur = tmp_path / "spur.toml"
+    spur.write_text(SPUR)
+    res = runner.invoke(app, ["contact", str(spur), "--pair", "m", "--load", "1e7 N",
+                              "--harris", "0"])
+    assert res.exit_code == 2 and "too large for this tooth geometry" in res.stderr
+
+
+def test_a_campbell_range_without_campbell_is_refused():
+    """'modes --from/--to' without --campbell ignored the range silently."""
+    res = runner.invoke(app, ["modes", "ji_li_mill_drive", "--from", "300 rpm", "--to",
+                              "900 rpm"])
+    assert res.exit_code == 2 and "add --campbell" in res.stderr
