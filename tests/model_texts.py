@@ -38,6 +38,42 @@ body = "wheel"
 """
 
 
+PAIR_4MM = """
+[model]
+name = "4 mm pair"
+
+[gears.pinion]
+teeth = 20
+module = "4 mm"
+face_width = "25 mm"
+position = ["0 mm", "0 mm", "0 mm"]
+polar_inertia = "0.002 kg m^2"
+mass = "2 kg"
+
+[gears.wheel]
+teeth = 40
+module = "4 mm"
+face_width = "25 mm"
+place = {from_gear = "pinion", angle = "0 deg"}
+polar_inertia = "0.03 kg m^2"
+mass = "6 kg"
+
+[meshes.m]
+gears = ["pinion", "wheel"]
+stiffness = "4e8 N/m"
+damping_ratio = 0.05
+
+[drives.motor]
+body = "pinion"
+speed = "3000 rpm"
+torque = "200 N m"
+
+[loads.out]
+body = "wheel"
+"""
+"""A torsional 20/40-tooth, 4 mm spur pair with masses (reviewers' models)."""
+
+
 def split_model(error_a: str = "0 um", extra: str = "") -> str:
     """A torsional locked-train split: pinion -> A, B (40 t) -> A2, B2 (20 t) -> out (60 t).
 

@@ -36,7 +36,7 @@ from typing import Callable, Iterator, Optional
 
 from rich.markup import escape
 
-from .errors import ModelWarning, OptionError, clip_message
+from .errors import ModelWarning, OptionError, clip_message, from_interrupt
 
 
 @dataclass
@@ -166,7 +166,7 @@ def interruptible(kept: Callable[[], str] | None = None) -> Iterator[None]:
     except (KeyboardInterrupt, SystemError) as exc:
         # a Ctrl-C that lands inside compiled code comes back as a SystemError ("returned
         # a result with an exception set") whose context is the interrupt
-        if isinstance(exc, SystemError) and not _from_interrupt(exc):
+        if isinstance(exc, SystemError) and not from_interrupt(exc):
             raise
         what = ""
         try:
@@ -180,17 +180,6 @@ def interruptible(kept: Callable[[], str] | None = None) -> Iterator[None]:
         else:
             con.print(text, markup=False, highlight=False)
         raise typer.Exit(130) from None
-
-
-def _from_interrupt(exc: BaseException) -> bool:
-    """Whether a KeyboardInterrupt is in the chain of causes of ``exc``."""
-    seen = 0
-    while exc is not None and seen < 50:
-        if isinstance(exc, KeyboardInterrupt):
-            return True
-        exc = exc.__cause__ or exc.__context__
-        seen += 1
-    return False
 
 
 def quantity(text: Optional[str], kind: str, option: str) -> Optional[float]:

@@ -209,3 +209,15 @@ class GpuFallbackWarning(UserWarning):
 
 class ModelWarning(UserWarning):
     """A value that looks wrong but can be right (damping above critical, ...)."""
+
+
+def from_interrupt(exc: BaseException | None) -> bool:
+    """Whether a KeyboardInterrupt is in the chain of causes of ``exc`` (Ctrl-C that lands
+    inside numba-compiled code comes back as SystemErrors chained from it)."""
+    seen = 0
+    while exc is not None and seen < 50:
+        if isinstance(exc, KeyboardInterrupt):
+            return True
+        exc = exc.__cause__ or exc.__context__
+        seen += 1
+    return False

@@ -5,41 +5,13 @@ import pytest
 from typer.testing import CliRunner
 
 import torquesplit
+from model_texts import SPUR_PAIR
 from torquesplit.cli import app
 from torquesplit.errors import ModelError
 
 runner = CliRunner()
 
-SPUR = """
-[model]
-name = "spur pair"
-
-[gears.pinion]
-teeth = 20
-module = "2 mm"
-face_width = "20 mm"
-position = ["0 mm", "0 mm", "0 mm"]
-
-[gears.wheel]
-teeth = 40
-module = "2 mm"
-face_width = "20 mm"
-place = {from_gear = "pinion", angle = "0 deg"}
-
-[meshes.m]
-gears = ["pinion", "wheel"]
-stiffness = "4e8 N/m"
-damping_ratio = 0.05
-backlash = "100 um"
-
-[drives.motor]
-body = "pinion"
-speed = "3000 rpm"
-torque = "100 N m"
-
-[loads.out]
-body = "wheel"
-"""
+SPUR = SPUR_PAIR.replace("damping_ratio = 0.05\n", 'damping_ratio = 0.05\nbacklash = "100 um"\n')
 
 
 @pytest.mark.parametrize("suffix", [".csv", ".mat"])

@@ -8,41 +8,10 @@ import warnings
 import pytest
 
 import torquesplit
+from model_texts import PAIR_4MM
 
-PAIR = """
-[model]
-name = "fric1"
-
-[gears.pinion]
-teeth = 20
-module = "4 mm"
-face_width = "25 mm"
-position = ["0 mm", "0 mm", "0 mm"]
-polar_inertia = "0.002 kg m^2"
-mass = "2 kg"
-
-[gears.wheel]
-teeth = 40
-module = "4 mm"
-face_width = "25 mm"
-place = {from_gear = "pinion", angle = "0 deg"}
-polar_inertia = "0.03 kg m^2"
-mass = "6 kg"
-
-[meshes.m]
-gears = ["pinion", "wheel"]
-stiffness = "4e8 N/m"
-damping_ratio = 0.05
-friction = { model = "constant", coefficient = 0.1 }
-
-[drives.motor]
-body = "pinion"
-speed = "3000 rpm"
-torque = "200 N m"
-
-[loads.out]
-body = "wheel"
-"""
+PAIR = PAIR_4MM.replace('damping_ratio = 0.05\n', 'damping_ratio = 0.05\n'
+                        'friction = { model = "constant", coefficient = 0.1 }\n')
 
 
 def _said(text):

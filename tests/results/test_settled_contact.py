@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import torquesplit
+from model_texts import PAIR_4MM
 from torquesplit.results.plausibility import result_warnings
 
 TUTORIAL = Path(__file__).resolve().parents[2] / "docs" / "tutorial.md"
@@ -144,43 +145,11 @@ def test_mean_force_coefficients_that_differ_between_halves_are_said(swing, warn
     assert mean_drift(_MeanStub(np.stack([a, b], axis=1)), met_peak) == []
 
 
-SEPARATING_PAIR = """
-[model]
-name = "separating pair"
-
-[gears.pinion]
-teeth = 20
-module = "4 mm"
-face_width = "25 mm"
-position = ["0 mm", "0 mm", "0 mm"]
-polar_inertia = "0.002 kg m^2"
-mass = "2 kg"
-
-[gears.wheel]
-teeth = 40
-module = "4 mm"
-face_width = "25 mm"
-place = {from_gear = "pinion", angle = "0 deg"}
-polar_inertia = "0.03 kg m^2"
-mass = "6 kg"
-
-[meshes.m]
-gears = ["pinion", "wheel"]
-stiffness = { method = "constant", value = "4e8 N/m", peak_to_peak = 0.3 }
-backlash = "100 um"
-damping_ratio = 0.05
-
-[drives.motor]
-body = "pinion"
-speed = "8500 rpm"
-torque = "200 N m"
-
-[loads.out]
-body = "wheel"
-
-[analysis]
-table_points = 4096
-"""
+SEPARATING_PAIR = PAIR_4MM.replace(
+    'stiffness = "4e8 N/m"\n',
+    'stiffness = { method = "constant", value = "4e8 N/m", peak_to_peak = 0.3 }\n'
+    'backlash = "100 um"\n').replace('speed = "3000 rpm"', 'speed = "8500 rpm"') + (
+    "\n[analysis]\ntable_points = 4096\n")
 
 
 def test_separation_tension_is_not_a_back_flank_force(tmp_path):

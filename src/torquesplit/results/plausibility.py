@@ -246,7 +246,6 @@ def mean_drift(results, metrics) -> list[tuple[str, str]]:
         f"longer and compare"))]
 
 
-#: every check, in the order the messages are listed
 def coarse_history(results, metrics) -> list[tuple[str, str]]:
     """The decimated history (saved to files, drawn in the figures) against the settled
     peak the integrator streams at every step: where its largest settled sample falls
@@ -287,6 +286,7 @@ def coarse_history(results, metrics) -> list[tuple[str, str]]:
         f"with --samples-per-period {more} (Python: samples_per_period={more})"))]
 
 
+#: every check, in the order the messages are listed
 CHECKS = (static_force, contact_loss, back_flank, resonance, settling, peak_drift,
           mean_drift, coarse_history)
 

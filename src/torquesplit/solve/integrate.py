@@ -32,7 +32,7 @@ import numpy as np
 
 from torquesplit._memo import remember_last
 from torquesplit.assembly.structure import Structure
-from torquesplit.errors import ModelWarning, SolverError
+from torquesplit.errors import ModelWarning, SolverError, from_interrupt
 from torquesplit.solve import _kernels as kern
 from torquesplit.solve import codegen
 from torquesplit.solve import kernel_data as kd
@@ -84,15 +84,7 @@ def stop_on_interrupt():
 def _interrupted(exc: BaseException) -> bool:
     """An interrupt to turn into a status: inside :func:`stop_on_interrupt`, a
     KeyboardInterrupt or an error chained from one (Ctrl-C inside compiled code)."""
-    if not getattr(_stop_on_interrupt, "on", False):
-        return False
-    seen = 0
-    while exc is not None and seen < 50:
-        if isinstance(exc, KeyboardInterrupt):
-            return True
-        exc = exc.__cause__ or exc.__context__
-        seen += 1
-    return False
+    return bool(getattr(_stop_on_interrupt, "on", False)) and from_interrupt(exc)
 
 _N_CHUNKS = 64  # progress granularity: about 1.5 % of the run per chunk
 _MIN_CHUNK_STEPS = 16 * kern.RESYNC
