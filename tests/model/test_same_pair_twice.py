@@ -33,3 +33,18 @@ def test_two_speed_drives_on_one_train_are_said():
             torquesplit.load_model(tomllib.loads(source))
         said = [str(w.message) for w in caught if "both prescribe the speed" in str(w.message)]
         assert len(said) == expected, [str(w.message) for w in caught]
+
+
+def test_modifications_without_ltca_say_that_contact_uses_them():
+    """The warning said only 'ltca' uses modifications, while 'torquesplit contact'
+    analysed them (a reviewer)."""
+    from model_texts import SPUR_PAIR
+
+    text = SPUR_PAIR.replace('place = {from_gear = "pinion", angle = "0 deg"}\n',
+                             'place = {from_gear = "pinion", angle = "0 deg"}\n'
+                             'modifications = {crowning = "5 um"}\n')
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        torquesplit.load_model(tomllib.loads(text))
+    said = [str(w.message) for w in caught if "gears.wheel.modifications" in str(w.message)]
+    assert len(said) == 1 and "'torquesplit contact' analyses them either way" in said[0]

@@ -403,9 +403,11 @@ def plausibility_warnings(model: Model, kin) -> list[tuple[str, str]]:
                 _, k, member = model.written_at(loc).split(".")[:3]
                 meshes = (f"planetary.{k}.{member}_mesh" if member != "planet" else
                           f"planetary.{k}.sun_mesh and/or planetary.{k}.ring_mesh")
-            out.append((loc, "only the stiffness method 'ltca' uses tooth modifications and no "
-                             f"mesh of this gear uses it; set stiffness.method = 'ltca' on "
-                             f"{meshes} or remove the modifications"))
+            out.append((loc, "a dynamic run uses tooth modifications only through the "
+                             "stiffness method 'ltca', and no mesh of this gear uses it "
+                             "('torquesplit contact' analyses them either way); set "
+                             f"stiffness.method = 'ltca' on {meshes} or remove the "
+                             f"modifications"))
     for name, m in model.meshes.items():
         if m.stiffness.method != "ltca" and m.misalignment != type(m.misalignment)():
             out.append((f"meshes.{name}.misalignment",
