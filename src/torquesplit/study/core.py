@@ -305,6 +305,9 @@ def _open_store(plan: Plan, out, resume: bool, overwrite: bool,
         store.write_meta(_provenance(plan))
         return store
     out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise StudyError(words.out, f"{out} is a file; a study writes a folder (its store, "
+                                    f"results and figures): give a folder name")
     out.mkdir(parents=True, exist_ok=True)
     try:
         lock = StoreLock(out)
@@ -323,9 +326,6 @@ def _open_store(plan: Plan, out, resume: bool, overwrite: bool,
 
 def _open_folder(plan: Plan, out: Path, resume: bool, overwrite: bool,
                  words: Words) -> Store:
-    if out.exists() and not out.is_dir():
-        raise StudyError(words.out, f"{out} is a file; a study writes a folder (its store, "
-                                    f"results and figures): give a folder name")
     path = out / STORE_NAME
     if path.exists() and overwrite:
         for suffix in ("", "-wal", "-shm"):
