@@ -270,7 +270,7 @@ def register(app, load, fail, console, err_console, json_default):
                                  cross_check=cross_check, method=method, max_step=step,
                                  steps_per_cycle=steps_per_cycle)
         except (TorquesplitError, ValueError, OSError) as exc:
-            fail(exc)
+            fail(_in_flags(exc))
             return
         if out is not None:
             _to_netcdf(ds, out, force)
