@@ -200,3 +200,16 @@ def test_modes_near_a_high_mesh_order_of_a_rectangular_wave_are_flagged(tmp_path
     f7 = min(near, key=lambda f: abs(f - 7000.0))  # the mode the tutorial names, near 7 kHz
     assert abs(f7 - 7000.0) < 700.0 and "7×in1" in near[f7]
     assert near[min(near)] == "-"  # the lowest mode (below 1 kHz) is near no order
+
+
+def test_the_model_has_one_identity_in_reports_of_its_file_and_of_its_results(made):
+    """The report's model SHA-256 differed between a report of the model file and one of
+    its results file (the file's bytes against the embedded JSON); both reports now give
+    the model's data hash too, and it is the same."""
+    d, _ = made
+
+    def canonical(page):
+        return re.search(r"its data, SI JSON[^<]*</t[dh]>\s*<td[^>]*>([0-9a-f]{64})<", page).group(1)
+
+    pages = [(d / f).read_text(encoding="utf-8") for f in ("model.html", "file.html")]
+    assert canonical(pages[0]) == canonical(pages[1])

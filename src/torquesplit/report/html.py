@@ -102,9 +102,13 @@ def _provenance(res, source: Path | None, results_attrs: dict | None) -> str:
     from .. import __version__
 
     what, digest = model_hash(source, res.model_json())
+    # the model's own identity too, the same from its file and from its results file
+    canonical = hashlib.sha256(res.model_json().encode("utf-8")).hexdigest()
     rows = [["torquesplit", f"{__version__}, commit {_commit()}"],
             ["model", res.model.model.name],
             ["model file", what], ["model SHA-256", digest],
+            ["model SHA-256 (its data, SI JSON: the same from the file and its results)",
+             canonical],
             ["report written (UTC)", datetime.datetime.now(datetime.timezone.utc)
              .isoformat(timespec="seconds")]]
     if results_attrs:

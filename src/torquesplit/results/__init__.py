@@ -437,7 +437,8 @@ class Results:
         return writer(plan.path, overwrite=overwrite, definition=definition)
 
     def to_mat(self, path, *, overwrite: bool = False, definition: str | None = None) -> Path:
-        """Save for MATLAB (scipy.io.savemat): every variable of the Dataset, SI units,
+        """Save for MATLAB (scipy.io.savemat): every variable of the Dataset, SI units, a
+        ``units`` and a ``descriptions`` struct (each variable's unit and what it is),
         and a ``provenance`` struct naming the run; written atomically."""
         from . import files
 
@@ -450,6 +451,12 @@ class Results:
                 data[name] = (np.asarray(values, dtype=object) if values.dtype.kind in "UO"
                               else np.asarray(values))
             data["units"] = {name: ds[name].attrs.get("units", "") for name in ds.data_vars}
+            data["units"]["time"] = "s"
+            # what each variable is, as the NetCDF's long_name (and its sampling note)
+            data["descriptions"] = {
+                name: " ".join(filter(None, (ds[name].attrs.get("long_name", ""),
+                                             ds[name].attrs.get("sampling", ""))))
+                for name in list(ds.data_vars) + ["time"]}
             data["model_json"] = ds.attrs["model_json"]
             data["metrics_json"] = ds.attrs.get("metrics_json", "")
             data["warnings"] = np.asarray(self.warnings(definition) or [""], dtype=object)
