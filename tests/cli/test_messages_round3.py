@@ -47,3 +47,27 @@ def test_a_campbell_range_without_campbell_is_refused():
     res = runner.invoke(app, ["modes", "ji_li_mill_drive", "--from", "300 rpm", "--to",
                               "900 rpm"])
     assert res.exit_code == 2 and "add --campbell" in res.stderr
+
+
+def test_a_positive_base_pitch_deviation_brings_the_entering_pair_early(tmp_path):
+    """The field said 'driver minus driven', but the analysis (rightly, for the premature
+    contact the field is there for) takes f_pb > 0 as early engagement, which is driven
+    minus driver: the driver's next flank lies p_b(driver) behind, the driven gear's
+    p_b(driven) behind (a reviewer).  Now the description says what the code does."""
+    import json
+
+    from torquesplit.model.schema_modifications import MisalignmentSpec
+
+    said = MisalignmentSpec.model_fields["base_pitch_deviation"].description
+    assert said.startswith("Normal base pitch of the driven gear minus that of the driver")
+    spur = tmp_path / "spur.toml"
+    spur.write_text(SPUR_PAIR)
+    impact = {}
+    for f in (10, -10):
+        res = runner.invoke(app, ["contact", str(spur), "--pair", "m", "--positions", "32",
+                                  "--slices", "4", "--harris", "0", "--json", "--set",
+                                  f"meshes.m.misalignment.base_pitch_deviation={f} um"])
+        assert res.exit_code == 0, res.output
+        impact[f] = json.loads(res.stdout)["impact"]
+    assert impact[10]["advance_m"] > impact[-10]["advance_m"]  # earlier, deeper approach
+    assert impact[10]["corner_separation_m"] == 0.0 < impact[-10]["corner_separation_m"]

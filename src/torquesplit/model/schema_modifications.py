@@ -138,8 +138,10 @@ class MisalignmentSpec(Strict):
                                   "over the face of one helix (ISO 1328-1 f_Hbeta).")
     shaft_misalignment: Angle = Field(0.0, description="Tilt of the axes against each other in "
                                       "the plane of action.")
-    base_pitch_deviation: Length = Field(0.0, description="Normal base pitch of the driver minus "
-                                         "that of the driven gear.")
+    base_pitch_deviation: Length = Field(0.0, description=(
+        "Normal base pitch of the driven gear minus that of the driver: > 0 brings each "
+        "entering tooth pair that much early into contact (premature contact at the driven "
+        "gear's tip, as tooth deflection does); < 0 delays it."))
 
 
 class LtcaSpec(Strict):

@@ -46,10 +46,12 @@ Pair separations (:class:`Misalignment`)
 against each other in the plane of action; at axial position ``z`` (measured from the
 middle of the gear) the flanks separate by ``theta z cos(beta_b)`` along the normal --
 continuous across both helices of a double-helical gear (the central groove is not
-modelled).  ``base_pitch_deviation`` f_pb = p_bn(driver) - p_bn(driven): the
+modelled).  ``base_pitch_deviation`` f_pb = p_bn(driven) - p_bn(driver): the
 equivalent base-circle mismatch, a separation ``f_pb (s - s_mid) / p_bt`` linear along
 the path, so that each newer tooth pair is ``f_pb`` closer (premature contact at
-engagement for f_pb > 0) while the analysis stays mesh-periodic.
+engagement for f_pb > 0: the driver's next flank, p_bn(driver) behind its current one,
+meets the driven gear's next flank, p_bn(driven) behind, that much early) while the
+analysis stays mesh-periodic.
 
 Units: metres, radians.  Everything here is plain numpy (it runs once per analysis).
 """
