@@ -33,7 +33,10 @@ A power-split gearbox divides its torque between parallel paths; the load-sharin
 coefficient (LSC) of a mesh says how much more than its equal share it carries.  In a
 group of N parallel meshes (the meshes with the same `stage` and `path` labels in the
 model file) each definition forms `N X_i / sum_j X_j` of some quantity X of mesh i, so an
-equal split gives 1 for every mesh and the coefficients of a group sum to N.  The papers
+equal split gives 1 for every mesh.  Only the ratio of mean forces (`mean_force`) sums to
+N over a group; the others take each mesh's largest ratio over time (or over cycle
+peaks), so in a dynamic run every mesh can exceed 1 at some instant and their sum
+exceeds N (the table below: Ji & Li's two split meshes, symmetric, both above 1).  The papers
 torquesplit reproduces use four different X, and for the same run they give different
 numbers (the table at the end shows by how much).  Choose with `--definition` (`run`,
 `report`) or `[analysis] load_sharing` in the model file; every table says which it shows.

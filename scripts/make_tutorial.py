@@ -248,8 +248,8 @@ leaves out the start-up transient before computing anything.
   tends to.
 * **the second warning**: the history a results file and the figures hold (20 samples
   per split-mesh period by default) misses the settled peak of in2 by {{{{history_miss}}}} %:
-  the response rings at its modes near 7 times the mesh frequency, faster than that
-  sampling.  The table's numbers are streamed at every integration step and do not
+  the response rings at its mesh modes near order {{{{order}}}} of the mesh frequency
+  (section 5), faster than that sampling.  The table's numbers are streamed at every integration step and do not
   depend on it; the figures draw each cycle's streamed extremes over the samples; for a
   waveform to put in a report, run again with `--samples-per-period 100` (every step at
   this model's step).
@@ -321,11 +321,16 @@ split-stage mesh cycle:
 
 $ {SPEED_SWEEP}
 
-The table gives each mesh's largest dynamic factor over the range and the speed where it
-occurs.  The figure draws the dynamic factor of every mesh against speed (dashed where the
-periodic state is unstable) and marks the critical speeds, where a natural frequency
-crosses a harmonic of a mesh frequency (`torquesplit modes three_branch.toml --campbell
---from "2400 rpm" --to "3600 rpm"` lists them with the elements that carry each mode):
+The table gives each mesh's largest dynamic factor over the stable points of the range
+and the speed where it occurs.  The combine stage's rows leave out its own excitation
+(its stiffness variation was replaced by its mean, as the line under the table says):
+they are not the combine meshes' dynamic factors, which `run` or `steady` without
+`--keep` give at a speed.  The figure draws the dynamic factor, the load sharing and the
+RMS transmission error of every mesh against speed (dashed where the periodic state is
+unstable) and numbers the critical speeds, where a natural frequency crosses a harmonic
+of a mesh frequency, listing them under the plot (`torquesplit modes three_branch.toml
+--campbell --from "2400 rpm" --to "3600 rpm"` lists them with the elements that carry
+each mode).  The mode of the critical speed a peak sits on is the one to detune:
 
 ![dynamic factor against speed](tutorial/speed_response.svg)
 

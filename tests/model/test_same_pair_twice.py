@@ -48,3 +48,24 @@ def test_modifications_without_ltca_say_that_contact_uses_them():
         torquesplit.load_model(tomllib.loads(text))
     said = [str(w.message) for w in caught if "gears.wheel.modifications" in str(w.message)]
     assert len(said) == 1 and "'torquesplit contact' analyses them either way" in said[0]
+
+
+def test_a_support_stiffness_off_by_a_unit_is_said_by_check_run_and_static(tmp_path):
+    """'500 N/mm' for '500 N/um': the pinion sat millimetres off its centre without a word
+    from check, run or static (a reviewer's 21 mm)."""
+    from typer.testing import CliRunner
+
+    from model_texts import SPUR_PAIR
+    from torquesplit.cli import app
+
+    slip = SPUR_PAIR.replace('position = ["0 mm", "0 mm", "0 mm"]\n',
+                             'position = ["0 mm", "0 mm", "0 mm"]\ndofs = ["x", "y", "theta"]\n'
+                             'mass = "0.5 kg"\nsupport = { stiffness = "500 N/mm" }\n')
+    for text, expected in ((slip, 1), (slip.replace("500 N/mm", "500 N/um"), 0)):
+        path = tmp_path / f"pair{expected}.toml"
+        path.write_text(text)
+        for command in (["check"], ["run", "--cycles", "20"], ["static"]):
+            res = CliRunner().invoke(app, [command[0], str(path), *command[1:]])
+            said = [ln for ln in res.stderr.splitlines()
+                    if "gears.pinion.support: the static deflection of pinion." in ln]
+            assert len(said) == expected, (command, res.stderr)

@@ -1212,9 +1212,11 @@ def _readiness(model: Model, kin=None) -> tuple[list, list]:
                       f"check the stiffness values and their units (shafts, supports, "
                       f"meshes)")], []
     from ..convergence import coarse_table_warning
+    from ..results.plausibility import deflection_warnings
 
     coarse = coarse_table_warning(model, structure)  # (what every run warns of)
-    return [], ([tuple(coarse.split(": ", 1))] if coarse else [])
+    notes = [tuple(coarse.split(": ", 1))] if coarse else []
+    return [], notes + deflection_warnings(model, structure, q)  # (and every run)
 
 
 def integrator_blowup() -> float:

@@ -432,7 +432,8 @@ class Shaft(Strict):
     inner_diameter: Length = Field(0.0, ge=0, description="Bore of a hollow shaft.")
     length: Length | None = Field(None, gt=0, description="Length between the two bodies.")
     shear_modulus: Pressure = Field(79.3e9, gt=0, description="Shear modulus of the shaft.")
-    damping: TorsionalDamping | None = Field(None, ge=0, description="Torsional damping.")
+    damping: TorsionalDamping | None = Field(None, ge=0, description=(
+        "Torsional damping (neither this nor damping_ratio: the shaft is undamped)."))
     damping_ratio: Number | None = Field(
         None, ge=0, description="Torsional damping as a fraction of critical."
     )

@@ -12,6 +12,8 @@ check                      says
 =========================  ===========================================================
 :func:`static_force`       a mesh whose static force is negative (loaded on its back
                            flank at rest: an error or a sign against the power flow)
+:func:`static_deflection`  a static translation beyond half the module of its gear (a
+                           stiffness far too small: a unit slip)
 :func:`contact_loss`       drive flank separated (the teeth move inside the backlash)
 :func:`back_flank`         back-flank contact; without backlash: double-flank contact,
                            tensile tooth force no real pair with backlash carries
@@ -74,6 +76,38 @@ def static_force(results, metrics) -> list[tuple[str, str]]:
                 f"and backlash of this mesh and of its gears and their units (a '20 mm' for "
                 f"'20 um' does this)")))
     return out
+
+
+def deflection_warnings(model, structure, q) -> list[tuple[str, str]]:
+    """Translations of the static equilibrium ``q`` larger than half the module of their
+    gear (or 1 mm for a body without teeth): a support or shaft stiffness far too small
+    for the load, usually a unit slip ('500 N/mm' for '500 N/um': a reviewer's pinion sat
+    21 mm off its centre without a word).  One message per body, at its largest DOF."""
+    q = np.asarray(q, dtype=float)
+    worst: dict[str, tuple[float, str]] = {}
+    for name, value in zip(structure.dof_names, q):
+        body, _, dof = str(name).rpartition(".")
+        if dof == "theta" or not np.isfinite(value):
+            continue
+        if abs(value) > worst.get(body, (0.0, ""))[0]:
+            worst[body] = (abs(value), dof)
+    out = []
+    for body, (size, dof) in worst.items():
+        gear = model.gears.get(body)
+        limit, what = ((0.5 * gear.module, f"half the module ({0.5e3 * gear.module:g} mm)")
+                       if gear is not None else (1e-3, "1 mm"))
+        if size > limit:
+            where = (f"gears.{body}.support" if gear is not None else f"bodies.{body}")
+            out.append((where, (
+                f"the static deflection of {body}.{dof} is {1e3 * size:.4g} mm, more than "
+                f"{what}: a support or shaft stiffness far too small for the load; check "
+                f"its value and unit (N/mm written for N/um gives this)")))
+    return out
+
+
+def static_deflection(results, metrics) -> list[tuple[str, str]]:
+    """:func:`deflection_warnings` of a run's static equilibrium."""
+    return deflection_warnings(results.model, results.structure, results.static.q)
 
 
 def contact_loss(results, metrics) -> list[tuple[str, str]]:
@@ -287,8 +321,8 @@ def coarse_history(results, metrics) -> list[tuple[str, str]]:
 
 
 #: every check, in the order the messages are listed
-CHECKS = (static_force, contact_loss, back_flank, resonance, settling, peak_drift,
-          mean_drift, coarse_history)
+CHECKS = (static_force, static_deflection, contact_loss, back_flank, resonance, settling,
+          peak_drift, mean_drift, coarse_history)
 
 
 def result_warnings(results, metrics) -> list[tuple[str, str]]:
@@ -304,8 +338,11 @@ def static_warnings(results) -> list[tuple[str, str]]:
     on their back flank."""
     import numpy as np
 
-    out = []
     conv = np.asarray(results.solution.converged, bool)
+    q = np.asarray(results.solution.q, dtype=float)
+    out = deflection_warnings(results.model, results.structure,
+                              q[conv][np.argmax(np.abs(q[conv]).max(axis=1))] if conv.any()
+                              else np.zeros(q.shape[1]))
     if conv.size and not conv.all():
         out.append(("analysis", (
             f"{int((~conv).sum())} of {conv.size} positions did not converge and are left "

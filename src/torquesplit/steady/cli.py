@@ -175,7 +175,9 @@ def register(app, load, fail, console, err_console, json_default):
             console.print(period_text)
             if st.dropped:
                 console.print("kept excitations periodic with the base; replaced by their "
-                              "means: " + "; ".join(d.describe() for d in st.dropped))
+                              "means: " + "; ".join(d.describe() for d in st.dropped)
+                              + ": the rows of those meshes leave out their own excitation",
+                              highlight=False)
             console.print(
                 f"residual {ps.residual:.2e}, time-domain: midpoint residual "
                 f"{ps.time_residual:.2e}, one-period integration defect "
@@ -201,6 +203,10 @@ def register(app, load, fail, console, err_console, json_default):
                           f"{1e6 * r.rms_transmission_error:.4g}",
                           f"{100 * r.contact_loss:.2f} %")
             console.print(t)
+            console.print("RMS TE: root mean square over the period of the mesh deflection "
+                          "about its mean (the elastic part of the dynamic transmission "
+                          "error, along the line of action; the geometric errors excite it "
+                          "but are not in it)", highlight=False)
             if step_check is not None:
                 from torquesplit.cli_support import render_step_check
 
@@ -317,6 +323,12 @@ def register(app, load, fail, console, err_console, json_default):
                                if key in v for c in (f"{v[key][0]:.5f}", f"{v[key][1]:.6g}")]
                 t.add_row(*cells)
             console.print(t)
+            dropped = ds.attrs.get("dropped_excitations") or []
+            if dropped:
+                console.print("kept excitations periodic with the base; replaced by their "
+                              "means: " + "; ".join(dropped) + ": the rows of those meshes "
+                              "leave out their own excitation (run 'steady' without --keep "
+                              "at a speed for their full response)", highlight=False)
             console.print(f"unstable points: {summary['unstable_points']} (dashed in the "
                           f"figure; left out of the largest dynamic factor)")
         if not ds.attrs["complete"]:
