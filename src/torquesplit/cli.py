@@ -821,11 +821,18 @@ def mesh(
             raise OptionError(f"mesh {pair!r} is a bevel/face mesh: only its model-file "
                               f"stiffness applies (no involute stiffness methods); choose a "
                               f"cylindrical mesh")
+        spec = m.meshes[pair].stiffness
+        label = spec.method
+        if spec.method == "ltca":  # which stiffness of the contact analysis the run takes
+            label = (f"ltca, {spec.ltca.excitation}: "
+                     + ("dP/dZ" if spec.ltca.excitation == "tangent" else "P/Z")
+                     + " at the operating load")
         model_k = MeshStiffness.from_samples(stiffness_table(m, kin, pair, points),
-                                             method=f"model file ({m.meshes[pair].stiffness.method})")
+                                             method=f"model file ({label})")
         g = m.gears[mk.driver]
+        row = "model file" if spec.method != "ltca" else f"model file ({label})"
         cmp = compare_methods(mk.geometry, points, young_modulus=g.youngs_modulus,
-                              poisson_ratio=g.poisson_ratio, extra={"model file": model_k})
+                              poisson_ratio=g.poisson_ratio, extra={row: model_k})
     except _EXPECTED as exc:
         _fail(exc)
         return
@@ -976,14 +983,15 @@ def _contact(model, pair, load, on, plot, force, positions, slices, harris, assi
         except OSError as exc:
             failed = _figure_error(exc, "--plot", plot, "the tables are printed, nothing saved")
     _print_contact(m, pair, names, op_load, cm, results, hm, impact, op, figures, plot,
-                   as_json)
+                   as_json, reverse)
     if failed is not None:
         _fail(failed)
 
 
 def _print_contact(m, pair, names, op_load, cm, results, hm, impact, op, figures, plot,
-                   as_json) -> None:
-    """The loaded tooth contact analysis (or JSON)."""
+                   as_json, reverse=False) -> None:
+    """The loaded tooth contact analysis (or JSON); ``reverse``: the second gear (a ring)
+    drives."""
     rows = [r.summary() for r in results]
     if as_json:
         ux.emit_json({
@@ -999,7 +1007,8 @@ def _print_contact(m, pair, names, op_load, cm, results, hm, impact, op, figures
                 "corner_separation_m": impact.corner_separation},
             "figures": [str(f) for f in figures]}, _json_default)
         return
-    console.print(f"[bold]{m.model.name}[/]: LTCA of mesh {pair} ({names[0]} drives {names[1]}), "
+    driver, driven = (names[1], names[0]) if reverse else (names[0], names[1])
+    console.print(f"[bold]{m.model.name}[/]: LTCA of mesh {pair} ({driver} drives {driven}), "
                   f"{cm.phase.size} positions x {cm.y.size} slices"
                   + (" x 2 helices" if cm.helices == 2 else "")
                   + f"; operating normal load {op_load / 1e3:.5g} kN")

@@ -71,3 +71,49 @@ def test_a_positive_base_pitch_deviation_brings_the_entering_pair_early(tmp_path
         impact[f] = json.loads(res.stdout)["impact"]
     assert impact[10]["advance_m"] > impact[-10]["advance_m"]  # earlier, deeper approach
     assert impact[10]["corner_separation_m"] == 0.0 < impact[-10]["corner_separation_m"]
+
+
+RING_DRIVES = """
+[model]
+name = "internal 24/60, ring drives"
+
+[gears.pinion]
+teeth = 24
+module = "4 mm"
+face_width = "25 mm"
+position = ["0 mm", "0 mm", "0 mm"]
+
+[gears.ring]
+teeth = 60
+module = "4 mm"
+face_width = "25 mm"
+kind = "internal"
+place = {from_gear = "pinion", angle = "0 deg"}
+
+[meshes.m]
+gears = ["pinion", "ring"]
+stiffness = {method = "ltca", ltca = {positions = 16}}
+damping_ratio = 0.05
+
+[drives.motor]
+body = "ring"
+speed = "400 rpm"
+torque = "500 N m"
+
+[loads.out]
+body = "pinion"
+"""
+
+
+def test_contact_and_mesh_say_who_drives_and_which_stiffness_the_run_takes(tmp_path):
+    """A driving ring was printed as 'pinion drives ring'; the mesh table's 'model file'
+    row of an LTCA mesh did not say it is the tangent at the operating load (a reviewer)."""
+    path = tmp_path / "ring.toml"
+    path.write_text(RING_DRIVES)
+    res = runner.invoke(app, ["contact", str(path), "--pair", "m", "--positions", "16",
+                              "--slices", "4", "--harris", "0"])
+    assert res.exit_code == 0, res.output
+    assert "(ring drives pinion)" in res.stdout
+    res = runner.invoke(app, ["mesh", str(path), "--pair", "m"])
+    assert res.exit_code == 0, res.output
+    assert "model file (ltca, tangent:" in res.stdout and "dP/dZ" in res.stdout  # (wrapped)
