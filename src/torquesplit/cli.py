@@ -979,7 +979,7 @@ def _contact(model, pair, load, on, plot, force, positions, slices, harris, assi
         try:
             figures = write_contact_figures(results, hm, plot, operating=op,
                                             operating_load=op_load,
-                                            title=f"{m.model.name} {pair}")
+                                            title=f"{m.model.name} {pair}", gear=names[1])
         except OSError as exc:
             failed = _figure_error(exc, "--plot", plot, "the tables are printed, nothing saved")
     _print_contact(m, pair, names, op_load, cm, results, hm, impact, op, figures, plot,

@@ -117,3 +117,17 @@ def test_contact_and_mesh_say_who_drives_and_which_stiffness_the_run_takes(tmp_p
     res = runner.invoke(app, ["mesh", str(path), "--pair", "m"])
     assert res.exit_code == 0, res.output
     assert "model file (ltca, tangent:" in res.stdout and "dP/dZ" in res.stdout  # (wrapped)
+
+
+def test_the_arc_seconds_axis_names_its_gear(tmp_path):
+    """The figures' right axis read 'TE of gear 2' without naming the gear."""
+    from torquesplit.gears.contact.coupling import contact_model_for_mesh
+    from torquesplit.model.kinematics import solve_kinematics
+    from torquesplit.plot.contact import te_figure
+
+    path = tmp_path / "ring.toml"
+    path.write_text(RING_DRIVES)
+    model = torquesplit.load_model(path)
+    cm, load, names, _ = contact_model_for_mesh(model, solve_kinematics(model), "m")
+    ax = te_figure([cm.solve(load)], gear=names[1]).axes[0]
+    assert ax.child_axes[0].get_ylabel() == "TE, arc seconds of ring [arc s]"

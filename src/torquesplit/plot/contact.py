@@ -47,18 +47,20 @@ def _cycles(phase, values, cycles=2):
     return ph, v
 
 
-def _arcsec_axis(ax, result):
-    """Right axis in arc seconds of gear 2 for a left axis in µm (normal)."""
+def _arcsec_axis(ax, result, gear: str | None = None):
+    """Right axis in arc seconds of gear 2 (named ``gear``) for a left axis in µm
+    (normal)."""
     from torquesplit.gears.contact.ltca import ARCSEC_PER_RAD
 
     f = float(result.model.te_angle(1e-6)) * ARCSEC_PER_RAD      # arcsec per µm
     sec = ax.secondary_yaxis("right", functions=(lambda u: u * f, lambda a: a / f))
-    sec.set_ylabel("TE of gear 2 [arc s]")
+    sec.set_ylabel(f"TE, arc seconds of {gear or 'gear 2'} [arc s]")
     return sec
 
 
-def te_figure(results: Sequence, title: str | None = None):
-    """Loaded static transmission error against mesh phase at each load."""
+def te_figure(results: Sequence, title: str | None = None, gear: str | None = None):
+    """Loaded static transmission error against mesh phase at each load (the right axis
+    in arc seconds of gear 2, named ``gear``)."""
     fig = _figure()
     ax = fig.add_subplot()
     for r in sorted(results, key=lambda r: r.load):
@@ -69,14 +71,16 @@ def te_figure(results: Sequence, title: str | None = None):
     ax.set_ylabel("loaded transmission error, flank normal [µm]")
     ax.set_xlim(0, 2)
     ax.grid(True, alpha=0.3)
-    _arcsec_axis(ax, results[0])
+    _arcsec_axis(ax, results[0], gear)
     fig.legend(loc="outside lower center", ncols=2, fontsize="small")
     ax.set_title(title or "loaded static transmission error")
     return fig
 
 
-def harris_figure(harris, title: str | None = None, design_load: float | None = None):
-    """Transmission error peak-to-peak against load (Harris map)."""
+def harris_figure(harris, title: str | None = None, design_load: float | None = None,
+                  gear: str | None = None):
+    """Transmission error peak-to-peak against load (Harris map; arc seconds of gear 2,
+    named ``gear``)."""
     fig = _figure()
     ax = fig.add_subplot()
     loads = harris.loads / 1e3
@@ -84,7 +88,7 @@ def harris_figure(harris, title: str | None = None, design_load: float | None = 
     ax.set_xlabel("normal load [kN]")
     ax.set_ylabel("TE peak-to-peak, flank normal [µm]")
     ax.grid(True, alpha=0.3)
-    _arcsec_axis(ax, harris.results[0])
+    _arcsec_axis(ax, harris.results[0], gear)
     if design_load is not None:
         ax.axvline(design_load / 1e3, color="k", linestyle="--", linewidth=1.0,
                    label=f"operating load {design_load / 1e3:.4g} kN")
@@ -196,19 +200,21 @@ def contact_figure_files(harris: bool = True) -> list[str]:
 
 
 def write_contact_figures(results: Sequence, harris, directory, *, operating=None,
-                          operating_load: float | None = None, title: str = "") -> list[Path]:
+                          operating_load: float | None = None, title: str = "",
+                          gear: str | None = None) -> list[Path]:
     """Write every figure as PNG into ``directory``; returns the paths.
 
     ``operating`` is the result drawn in the single-load figures (default the largest
     load); ``operating_load`` [N] is marked on the Harris map; ``harris=None`` (``contact
-    --harris 0``) writes no Harris map.
+    --harris 0``) writes no Harris map; ``gear`` names gear 2, whose arc seconds the
+    transmission-error axes give.
     """
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
     op = operating or max(results, key=lambda r: r.load)
     prefix = f"{title}: " if title else ""
     figs = {
-        "te": te_figure(results, f"{prefix}loaded static transmission error"),
+        "te": te_figure(results, f"{prefix}loaded static transmission error", gear),
         "load_distribution": load_distribution_figure(op, title=f"{prefix}load distribution at "
                                                                  f"{op.load / 1e3:.4g} kN"),
         "stiffness": stiffness_figure(op, f"{prefix}mesh stiffness at {op.load / 1e3:.4g} kN"),
@@ -217,7 +223,7 @@ def write_contact_figures(results: Sequence, harris, directory, *, operating=Non
     if harris is not None:
         figs["harris"] = harris_figure(
             harris, f"{prefix}Harris map",
-            design_load=op.load if operating_load is None else operating_load)
+            design_load=op.load if operating_load is None else operating_load, gear=gear)
     paths = []
     for name in (n for n in CONTACT_FIGURES if n in figs):
         fig, path = figs[name], directory / f"contact_{name}.png"
