@@ -1040,6 +1040,10 @@ def _print_contact(m, pair, names, op_load, cm, results, hm, impact, op, figures
                       f"{impact.corner_separation * 1e6:.3g} µm)", highlight=False)
     elif cm.pair.is_internal:
         console.print(_INTERNAL_IMPACT, highlight=False, markup=False)
+    console.print("contact ratio: mean number of loaded tooth pairs, within the theoretical "
+                  "path of contact (contact beyond the tips, which a heavy load brings "
+                  "early, is not modelled: at most the geometric ratio; the meshing-in line "
+                  "gives that premature approach)", highlight=False)
     if figures:
         console.print(f"{len(figures)} figures written to {plot}")
 

@@ -94,8 +94,10 @@ def harris_figure(harris, title: str | None = None, design_load: float | None = 
                    label=f"operating load {design_load / 1e3:.4g} kN")
     ax2 = ax.twinx()
     ax2.spines["right"].set_position(("outward", 55))
-    ax2.plot(loads, harris.contact_ratio, "s:", color="tab:green", label="loaded tooth pairs (mean)")
-    ax2.set_ylabel("actual contact ratio [-]", color="tab:green")
+    ax2.plot(loads, harris.contact_ratio, "s:", color="tab:green",
+             label="loaded contact ratio (mean loaded tooth pairs)")
+    ax2.set_ylabel("loaded contact ratio (within the path of contact) [-]",
+                   color="tab:green")
     fig.legend(loc="outside lower center", ncols=3, fontsize="small")
     ax.set_title(title or "Harris map")
     return fig
