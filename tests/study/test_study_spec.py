@@ -123,3 +123,12 @@ def test_table_field_must_be_addressed_inside(tmp_path):
         Study(grid_study(model, [K])).plan()
     ok = Study(grid_study(model, [dict(K, path="meshes.a1.stiffness.value")]))
     assert ok.n_cases == 3
+
+
+def test_a_plan_says_what_it_will_run(split_file):
+    """Study.plan() (studies.md: 'check a study without running it') printed a repr of
+    many thousands of characters."""
+    plan = Study(grid_study(split_file, [dict(K, num=3)])).plan()
+    text = repr(plan)
+    assert text.startswith("<Plan of ") and "grid over" in text and "(3 = 3 cases)" in text
+    assert len(text) < 400

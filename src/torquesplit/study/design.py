@@ -144,6 +144,15 @@ class Plan:
     def n_cases(self) -> int:
         return self.design.n_cases
 
+    def __repr__(self) -> str:
+        d = self.design
+        shape = " x ".join(map(str, d.shape)) if d.shape else str(d.n_cases)
+        params = ", ".join(p.name for p in d.parameters)
+        return (f"<Plan of {self.spec.study.name!r}: {d.kind} over {params} ({shape} = "
+                f"{d.n_cases} cases), {self.analysis.get('type', 'run')} of "
+                f"{self.model_source}, outputs {', '.join(self.outputs[:6])}"
+                f"{' ...' if len(self.outputs) > 6 else ''}>")
+
 
 # ============================================================================ resolve
 def resolve(spec: StudySpec, folder: Path | None, text: str, source: str | None = None) -> Plan:
