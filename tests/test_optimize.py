@@ -74,6 +74,15 @@ def test_a_store_of_another_model_is_not_reused(tmp_path):
     assert changed.computed == first.computed
 
 
+def test_constraint_bounds_are_read_in_their_outputs_unit():
+    """'0.5 arcsec' on an output in arc seconds was turned into radians (2.4e-6)."""
+    from torquesplit.optimize import _bound
+
+    assert _bound("0.5 arcsec", "c", "ltca.L68.te_peak_to_peak_arcsec") == pytest.approx(0.5)
+    assert _bound(0.5, "c", "ltca.L68.te_peak_to_peak_arcsec") == 0.5
+    assert _bound("2 kN", "c", "ltca.L68.impact_peak_force_N") == pytest.approx(2000.0)
+
+
 def test_evaluations_run_through_a_studies_runner(tmp_path):
     """A Dask client or scheduler (or any runner of torquesplit.study.runners) runs the
     evaluations, as a study's cases; the same front as the local run."""

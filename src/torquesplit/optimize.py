@@ -163,8 +163,9 @@ def _kind(path) -> str | None:
 
 
 def _bound(value, where: str, output: str) -> float:
-    """A constraint's bound in SI, its unit checked against the output's
-    (:func:`output_unit`: a ratio takes a plain number, a force a force...)."""
+    """A constraint's bound in the output's unit (:func:`output_unit`: SI, arc seconds
+    for ``..._arcsec``), its unit checked against the output's (a ratio takes a plain
+    number, a force a force...); a plain number is read in the output's unit."""
     si = _si(value, where)
     if not isinstance(value, str) or not _NUMBER.sub("", value).strip():
         return si
@@ -180,7 +181,8 @@ def _bound(value, where: str, output: str) -> float:
     if given.dimensionality != want.dimensionality:
         raise ModelError([(where, f"{output} is in {unit}, but the bound {value!r} is not; "
                                   f"write e.g. '1 {unit}'")])
-    return si
+    # in the output's own unit (an LTCA output in arc seconds is compared in arc seconds)
+    return float(given.to(want.units).magnitude)
 
 
 def _plain_number_field(path) -> bool:
