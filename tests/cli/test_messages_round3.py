@@ -131,3 +131,19 @@ def test_the_arc_seconds_axis_names_its_gear(tmp_path):
     cm, load, names, _ = contact_model_for_mesh(model, solve_kinematics(model), "m")
     ax = te_figure([cm.solve(load)], gear=names[1]).axes[0]
     assert ax.child_axes[0].get_ylabel() == "TE, arc seconds of ring [arc s]"
+
+
+def test_an_absurd_inertia_is_named_beside_the_statics_it_breaks(tmp_path):
+    """A wheel of 1e-30 kg m^2 was refused as 'make the drive and load torques consistent'
+    (the load was 'balanced'); the inertia is named now, and an implausible one warned."""
+    path = tmp_path / "pair.toml"
+    path.write_text(SPUR_PAIR.replace('polar_inertia = "6e-4 kg m^2"',
+                                      'polar_inertia = "1e-30 kg m^2"'))
+    res = runner.invoke(app, ["check", str(path)])
+    assert res.exit_code == 2
+    assert "gears.wheel.polar_inertia: 1e-30 kg m^2 is" in res.stderr
+    assert "times that of a steel disc of this gear's size" in res.stderr
+    path.write_text(SPUR_PAIR.replace('polar_inertia = "6e-4 kg m^2"',
+                                      'polar_inertia = "600 kg m^2"'))  # kg mm^2 meant
+    res = runner.invoke(app, ["check", str(path)])
+    assert res.exit_code == 0 and "gears.wheel.polar_inertia: 600 kg m^2 is" in res.stderr

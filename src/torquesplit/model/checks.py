@@ -384,6 +384,7 @@ def plausibility_warnings(model: Model, kin) -> list[tuple[str, str]]:
                              f"(typical 0.02-0.1)"))
     out += _friction_drift(model)
     out += _locked_speed_drives(model)
+    out += _mass_magnitudes(model)
     pairs: dict[frozenset, str] = {}
     for name, m in model.meshes.items():
         key = frozenset(m.gears)
@@ -1027,6 +1028,39 @@ def nominal_load_issues(model: Model, kin) -> list[tuple[str, str]]:
     return issues
 
 
+#: a gear's given mass or inertia beyond these multiples of a steel disc of its size is a
+#: unit slip (kg mm^2 for kg m^2 is 1e6; a shaft or rotor counted with a gear stays below
+#: 1e4, the shipped examples below 25), or a stand-in value (1e-30) that breaks the statics
+MASS_RATIO = (1e-8, 1e4)
+
+
+def _mass_magnitudes(model: Model) -> list[tuple[str, str]]:
+    """Given masses and inertias of gears far from those of a steel disc of their size
+    (a reviewer's 1e-30 kg m^2 ended in a message about unbalanced torques)."""
+    from .kinematics import gear_mass_properties
+
+    out = []
+    for name, gear in model.gears.items():
+        if gear.mass is None and gear.polar_inertia is None:
+            continue
+        try:
+            m_disc, j_disc, _, _ = gear_mass_properties(
+                gear.model_copy(update={"mass": None, "polar_inertia": None}))
+        except (ModelError, ValueError, ZeroDivisionError):
+            continue  # (the geometry checks name it)
+        for field, given, disc, unit in (("mass", gear.mass, m_disc, "kg"),
+                                         ("polar_inertia", gear.polar_inertia, j_disc,
+                                          "kg m^2")):
+            if given is None or not disc > 0:
+                continue
+            ratio = given / disc
+            if not MASS_RATIO[0] <= ratio <= MASS_RATIO[1]:
+                out.append((f"gears.{name}.{field}", (
+                    f"{given:.3g} {unit} is {ratio:.3g} times that of a steel disc of this "
+                    f"gear's size ({disc:.3g} {unit}); check the value and its unit")))
+    return out
+
+
 def _locked_speed_drives(model: Model) -> list[tuple[str, str]]:
     """Two speed drives on one gear train (joined by meshes and shafts): the train's speed
     is prescribed twice, so the torque between them is undetermined and the meshes between
@@ -1189,9 +1223,11 @@ def _readiness(model: Model, kin=None) -> tuple[list, list]:
             static = static_equilibrium(structure)
     except SolverError as exc:
         loc, msg = _located(str(exc), "the static equilibrium that starts every run fails")
-        return [(loc or "loads", msg)], []
+        # a mass or inertia off by orders of magnitude is the likelier cause: said with it
+        return [(loc or "loads", msg)] + _mass_magnitudes(model), []
     except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:
-        return [_located(str(exc), "the static equilibrium that starts every run fails")], []
+        return ([_located(str(exc), "the static equilibrium that starts every run fails")]
+                + _mass_magnitudes(model)), []
     q = np.asarray(static.q, dtype=float)
     if not np.all(np.isfinite(q)):
         return [("", "the static equilibrium that starts every run has no finite solution; "
