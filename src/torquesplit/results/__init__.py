@@ -385,6 +385,41 @@ class Results:
             out.append(max(minimum, int(math.ceil(f / f_slow))) if f_slow else minimum)
         return out
 
+    def bearing_forces(self, start_time: float | None = None) -> list[dict]:
+        """Per supported body, its bearing (support) force over the settled part: the mean
+        of each direction [N], the magnitude of that mean and the largest magnitude of the
+        force vector [N], from the history from ``start_time`` (default the latest group
+        settle time).  The history is decimated (``samples_per_period``): a peak between
+        its samples is missed, as :func:`~torquesplit.results.plausibility.coarse_history`
+        says for the meshes; the means are not affected.  Forces are in the frame of the
+        support (a turning carrier's for planets)."""
+        s = self.solution
+        if s is None or not s.history_t.size:
+            return []
+        el = self.structure.element_names
+        by_body: dict[str, list[tuple[str, int]]] = {}
+        for col, e in enumerate(s.history_elements):
+            if ".support." in el[e]:
+                body, direction = el[e].split(".support.", 1)
+                by_body.setdefault(body, []).append((direction, col))
+        if not by_body:
+            return []
+        t0 = self.metrics().settling.start_time if start_time is None else float(start_time)
+        keep = s.history_t >= t0
+        if not keep.any():
+            keep = np.ones(s.history_t.shape, bool)
+        out = []
+        for body, parts in by_body.items():
+            forces = s.history_forces[keep][:, [c for _, c in parts]]
+            mean = forces.mean(axis=0)
+            magnitude = np.sqrt((forces ** 2).sum(axis=1))
+            out.append({"body": body, "directions": [d for d, _ in parts],
+                        "mean": [float(v) for v in mean],
+                        "mean_magnitude": float(np.sqrt((mean ** 2).sum())),
+                        "peak_magnitude": float(magnitude.max()),
+                        "samples": int(keep.sum())})
+        return out
+
     def mesh_force_history(self) -> tuple[np.ndarray, np.ndarray]:
         """Decimated time and mesh forces (n_samples, n_meshes) [s, N], for plots and
         exports (no metric is computed from it)."""

@@ -149,6 +149,17 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
         ds.attrs["load_sharing_definition"] = met.definition
         ds.attrs["metrics_json"] = json.dumps(met.to_dict(), default=float)
         ds = add_planet_load_sharing(ds, met.load_sharing, res.kinematics)
+        bearings = res.bearing_forces()
+        if bearings:
+            ds = ds.assign_coords(bearing=("bearing", [b["body"] for b in bearings]))
+            ds["bearing_mean_force"] = _var(("bearing",), [b["mean_magnitude"] for b in bearings],
+                                            "N", "magnitude of the settled mean bearing force "
+                                            "(from the history)")
+            ds["bearing_peak_force"] = _var(("bearing",), [b["peak_magnitude"] for b in bearings],
+                                            "N", "largest settled bearing force magnitude "
+                                            "(from the history: a peak between its samples "
+                                            "is missed)")
+            ds.attrs["bearing_forces_json"] = json.dumps(bearings)
     except Exception as exc:  # metrics of a diverged run may be undefined; keep the data
         ds.attrs["metrics_error"] = str(exc)
     steady = getattr(res, "steady", None)
