@@ -466,7 +466,7 @@ def _print_run(m, res, met, saved, figures, step_check, plots, as_json) -> None:
                       **({"planet_load_sharing": ux.planet_sharing_dict(planets)}
                          if planets else {}),
                       "statistics": res.statistics(),
-                      "bearing_forces_N": res.bearing_forces(),
+                      "bearing_forces_N": res.bearing_forces(met.settling.start_time),
                       "results_file": str(saved[0]) if saved else None,
                       "results_files": [str(f) for f in saved],
                       "figures": [str(f) for f in figures],
@@ -604,7 +604,7 @@ def _render_run(res, met, saved, planets=None) -> None:
     console.print(group_table(met))
     if planets is not None:
         _print_planets(planets, res.kinematics)
-    bearings = res.bearing_forces()
+    bearings = res.bearing_forces(met.settling.start_time)
     if bearings:
         console.print(bearing_table(bearings, res))
     console.print(f"system load-sharing coefficient ({met.definition}): "
@@ -647,11 +647,7 @@ def run_table(met) -> Table:
 def bearing_table(bearings: list[dict], res) -> Table:
     """The supported bodies' bearing forces over the settled part (kN), from the run's
     history (:meth:`Results.bearing_forces`)."""
-    import numpy as np
-
-    t = res.solution.history_t
-    f_max = max((float(mk.frequency) for mk in res.kinematics.meshes.values()), default=0.0)
-    per = 1.0 / (f_max * float(np.median(np.diff(t)))) if f_max > 0 and t.size > 1 else 0.0
+    per = res.history_samples_per_period()
     b = Table(title=f"bearing forces (settled; from the history, {per:.3g} samples per "
                     f"shortest mesh period)")
     for col in ("body", "mean force by direction\n[kN]", "|mean|\n[kN]", "peak |F|\n[kN]"):

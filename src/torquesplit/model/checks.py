@@ -169,9 +169,8 @@ def _one_of(names, what: str) -> str:
     return f"add a {sections} section first"
 
 
-def topology_issues(model: Model) -> list[tuple[str, str]]:
-    """Every body must be connected to the drive train; a drive and a load per train."""
-    issues = []
+def _adjacency(model: Model) -> dict[str, set[str]]:
+    """Body -> the bodies a mesh, shaft, spline or bearing on another body joins it to."""
     names = model.body_names()
     adj: dict[str, set[str]] = {n: set() for n in names}
     for m in model.meshes.values():
@@ -188,16 +187,14 @@ def topology_issues(model: Model) -> list[tuple[str, str]]:
         if on in adj and on != n:
             adj[n].add(on)
             adj[on].add(n)
-    for n in names:
-        if not adj[n]:
-            kind = "gears" if n in model.gears else "bodies"
-            issues.append((f"{kind}.{n}", "this body is connected to nothing; add a mesh or a "
-                           "shaft that joins it to the gearbox, or delete it"))
-    if issues:
-        return issues
-    # connected components: each needs a drive and a load
+    return adj
+
+
+def _trains(adj: dict[str, set[str]]) -> list[set[str]]:
+    """The connected components of :func:`_adjacency`: the separate gear trains."""
     seen: set[str] = set()
-    for start in names:
+    out = []
+    for start in adj:
         if start in seen:
             continue
         comp = {start}
@@ -208,6 +205,24 @@ def topology_issues(model: Model) -> list[tuple[str, str]]:
                     comp.add(nb)
                     stack.append(nb)
         seen |= comp
+        out.append(comp)
+    return out
+
+
+def topology_issues(model: Model) -> list[tuple[str, str]]:
+    """Every body must be connected to the drive train; a drive and a load per train."""
+    issues = []
+    names = model.body_names()
+    adj = _adjacency(model)
+    for n in names:
+        if not adj[n]:
+            kind = "gears" if n in model.gears else "bodies"
+            issues.append((f"{kind}.{n}", "this body is connected to nothing; add a mesh or a "
+                           "shaft that joins it to the gearbox, or delete it"))
+    if issues:
+        return issues
+    # connected components: each needs a drive and a load
+    for comp in _trains(adj):
         has_drive = any(d.body in comp for d in model.drives.values())
         has_load = any(ld.body in comp for ld in model.loads.values())
         if len(comp) < len(names) or not (has_drive and has_load):
@@ -1062,27 +1077,16 @@ def _mass_magnitudes(model: Model) -> list[tuple[str, str]]:
 
 
 def _locked_speed_drives(model: Model) -> list[tuple[str, str]]:
-    """Two speed drives on one gear train (joined by meshes and shafts): the train's speed
+    """Two speed drives on one gear train (:func:`_trains`): the train's speed
     is prescribed twice, so the torque between them is undetermined and the meshes between
     carry no load (a reviewer's pair: static force 0, load sharing NaN, no word)."""
-    parent: dict[str, str] = {}
-
-    def root(b: str) -> str:
-        while parent.get(b, b) != b:
-            b = parent[b]
-        return b
-
-    def join(a: str, b: str) -> None:
-        parent[root(a)] = root(b)
-
-    for m in model.meshes.values():
-        join(*m.gears)
-    for sh in model.shafts.values():
-        join(*sh.connects)
-    by_train: dict[str, list[str]] = {}
+    trains = _trains(_adjacency(model))
+    by_train: dict[int, list[str]] = {}
     for name, d in model.drives.items():
         if d.mode == "speed":
-            by_train.setdefault(root(d.body), []).append(name)
+            k = next((i for i, comp in enumerate(trains) if d.body in comp), None)
+            if k is not None:
+                by_train.setdefault(k, []).append(name)
     return [(f"drives.{names[1]}.mode", (
         f"drives.{names[0]} and drives.{names[1]} both prescribe the speed of one gear "
         f"train: the torque between them is undetermined and the meshes between them carry "
@@ -1248,11 +1252,37 @@ def _readiness(model: Model, kin=None) -> tuple[list, list]:
                       f"check the stiffness values and their units (shafts, supports, "
                       f"meshes)")], []
     from ..convergence import coarse_table_warning
-    from ..results.plausibility import deflection_warnings
 
     coarse = coarse_table_warning(model, structure)  # (what every run warns of)
     notes = [tuple(coarse.split(": ", 1))] if coarse else []
     return [], notes + deflection_warnings(model, structure, q)  # (and every run)
+
+
+def deflection_warnings(model, structure, q) -> list[tuple[str, str]]:
+    """Translations of the static equilibrium ``q`` larger than half the module of their
+    gear (or 1 mm for a body without teeth): a support or shaft stiffness far too small
+    for the load, usually a unit slip ('500 N/mm' for '500 N/um': a reviewer's pinion sat
+    21 mm off its centre without a word).  One message per body, at its largest DOF."""
+    q = np.asarray(q, dtype=float)
+    worst: dict[str, tuple[float, str]] = {}
+    for name, value in zip(structure.dof_names, q):
+        body, _, dof = str(name).rpartition(".")
+        if dof == "theta" or not np.isfinite(value):
+            continue
+        if abs(value) > worst.get(body, (0.0, ""))[0]:
+            worst[body] = (abs(value), dof)
+    out = []
+    for body, (size, dof) in worst.items():
+        gear = model.gears.get(body)
+        limit, what = ((0.5 * gear.module, f"half the module ({0.5e3 * gear.module:g} mm)")
+                       if gear is not None else (1e-3, "1 mm"))
+        if size > limit:
+            where = (f"gears.{body}.support" if gear is not None else f"bodies.{body}")
+            out.append((where, (
+                f"the static deflection of {body}.{dof} is {1e3 * size:.4g} mm, more than "
+                f"{what}: a support or shaft stiffness far too small for the load; check "
+                f"its value and unit (N/mm written for N/um gives this)")))
+    return out
 
 
 def integrator_blowup() -> float:

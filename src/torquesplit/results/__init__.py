@@ -385,12 +385,22 @@ class Results:
             out.append(max(minimum, int(math.ceil(f / f_slow))) if f_slow else minimum)
         return out
 
+    def history_samples_per_period(self) -> float:
+        """Samples of the history per shortest mesh period (0 without a history)."""
+        t = self.solution.history_t if self.solution is not None else np.zeros(0)
+        f_max = max((float(self._mesh_meta[m]["frequency"]) for m in self.mesh_names),
+                    default=0.0)
+        if t.size < 2 or not f_max > 0:
+            return 0.0
+        return 1.0 / (f_max * float(np.median(np.diff(t))))
+
     def bearing_forces(self, start_time: float | None = None) -> list[dict]:
         """Per supported body, its bearing (support) force over the settled part: the mean
         of each direction [N], the magnitude of that mean and the largest magnitude of the
         force vector [N], from the history from ``start_time`` (default the latest group
-        settle time).  The history is decimated (``samples_per_period``): a peak between
-        its samples is missed, as :func:`~torquesplit.results.plausibility.coarse_history`
+        settle time: pass ``metrics().settling.start_time`` when the metrics are at
+        hand).  The history is decimated (``samples_per_period``): a peak between its
+        samples is missed, as :func:`~torquesplit.results.plausibility.coarse_history`
         says for the meshes; the means are not affected.  Forces are in the frame of the
         support (a turning carrier's for planets)."""
         s = self.solution

@@ -149,7 +149,7 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
         ds.attrs["load_sharing_definition"] = met.definition
         ds.attrs["metrics_json"] = json.dumps(met.to_dict(), default=float)
         ds = add_planet_load_sharing(ds, met.load_sharing, res.kinematics)
-        bearings = res.bearing_forces()
+        bearings = res.bearing_forces(met.settling.start_time)
         if bearings:
             ds = ds.assign_coords(bearing=("bearing", [b["body"] for b in bearings]))
             ds["bearing_mean_force"] = _var(("bearing",), [b["mean_magnitude"] for b in bearings],
@@ -187,7 +187,7 @@ def _steady_attributes(ds: xr.Dataset, res, steady) -> None:
     """What a saved steady state needs beside its repeated record: the solver's summary
     (period, residuals, stability, excitations replaced by their means), the RMS
     transmission error per mesh, and words that do not describe a run it never made."""
-    info = steady.summary()
+    info = steady.summary(results=res)  # (the record at hand, not a second one)
     ds["rms_transmission_error"] = _var(
         ("mesh",), [info["meshes"][m]["rms_transmission_error"] for m in res.mesh_names],
         "m", "RMS dynamic transmission error (mesh deflection about its mean)")

@@ -78,35 +78,11 @@ def static_force(results, metrics) -> list[tuple[str, str]]:
     return out
 
 
-def deflection_warnings(model, structure, q) -> list[tuple[str, str]]:
-    """Translations of the static equilibrium ``q`` larger than half the module of their
-    gear (or 1 mm for a body without teeth): a support or shaft stiffness far too small
-    for the load, usually a unit slip ('500 N/mm' for '500 N/um': a reviewer's pinion sat
-    21 mm off its centre without a word).  One message per body, at its largest DOF."""
-    q = np.asarray(q, dtype=float)
-    worst: dict[str, tuple[float, str]] = {}
-    for name, value in zip(structure.dof_names, q):
-        body, _, dof = str(name).rpartition(".")
-        if dof == "theta" or not np.isfinite(value):
-            continue
-        if abs(value) > worst.get(body, (0.0, ""))[0]:
-            worst[body] = (abs(value), dof)
-    out = []
-    for body, (size, dof) in worst.items():
-        gear = model.gears.get(body)
-        limit, what = ((0.5 * gear.module, f"half the module ({0.5e3 * gear.module:g} mm)")
-                       if gear is not None else (1e-3, "1 mm"))
-        if size > limit:
-            where = (f"gears.{body}.support" if gear is not None else f"bodies.{body}")
-            out.append((where, (
-                f"the static deflection of {body}.{dof} is {1e3 * size:.4g} mm, more than "
-                f"{what}: a support or shaft stiffness far too small for the load; check "
-                f"its value and unit (N/mm written for N/um gives this)")))
-    return out
-
-
 def static_deflection(results, metrics) -> list[tuple[str, str]]:
-    """:func:`deflection_warnings` of a run's static equilibrium."""
+    """:func:`~torquesplit.model.checks.deflection_warnings` of a run's static
+    equilibrium."""
+    from ..model.checks import deflection_warnings
+
     return deflection_warnings(results.model, results.structure, results.static.q)
 
 
@@ -308,8 +284,7 @@ def coarse_history(results, metrics) -> list[tuple[str, str]]:
     if worst is None:
         return []
     m, miss, seen, peak = worst
-    f_max = max(float(results._mesh_meta[k]["frequency"]) for k in results.mesh_names)
-    per = 1.0 / (f_max * float(np.median(np.diff(t)))) if f_max > 0 else math.nan
+    per = results.history_samples_per_period() or math.nan
     more = max(100, 5 * round(per)) if math.isfinite(per) else 100
     return [("analysis", (
         f"the history ({per:.3g} samples per shortest mesh period), which the results "
@@ -337,6 +312,8 @@ def static_warnings(results) -> list[tuple[str, str]]:
     """Warnings of a quasi-static sweep: positions that did not converge, meshes loaded
     on their back flank."""
     import numpy as np
+
+    from ..model.checks import deflection_warnings
 
     conv = np.asarray(results.solution.converged, bool)
     q = np.asarray(results.solution.q, dtype=float)

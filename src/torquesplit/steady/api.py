@@ -160,14 +160,15 @@ class SteadyState:
         res.steady = self
         return res
 
-    def summary(self, rows=None) -> dict:
+    def summary(self, rows=None, results=None) -> dict:
         """What ``torquesplit steady`` prints, as a dict (its ``--json`` and the
         ``steady_json`` attribute of a saved steady state): method, period, residuals,
         stability, the excitations replaced by their means, and the per-mesh table
-        (``rows``: :meth:`mesh_table`, computed when not given)."""
+        (``rows``: :meth:`mesh_table`, computed when not given, from ``results`` when
+        given: the :meth:`to_results` already at hand)."""
         ps = self.solution
         mu = ps.multipliers
-        rows = self.mesh_table() if rows is None else rows
+        rows = self.mesh_table(results=results) if rows is None else rows
         return {
             "model": self.model.model.name, "method": ps.method, "converged": ps.converged,
             "message": ps.message, "period_s": ps.period, "fundamental_Hz": ps.frequency,
@@ -182,10 +183,11 @@ class SteadyState:
                        for r in rows},
         }
 
-    def mesh_table(self, definition: str | None = None) -> list[MeshSteady]:
+    def mesh_table(self, definition: str | None = None, results=None) -> list[MeshSteady]:
         """Per-mesh static, mean, min and peak force, dynamic factors, load sharing
-        (``definition``: the model's by default), RMS transmission error, contact loss."""
-        res = self.to_results()
+        (``definition``: the model's by default), RMS transmission error, contact loss;
+        ``results``: this state's :meth:`to_results` if already made."""
+        res = self.to_results() if results is None else results
         met = res.metrics(definition)
         names = self.structure.element_names
         t, F, D = self.mesh_series([names.index(r.mesh) for r in met.rows])
