@@ -382,6 +382,26 @@ def test_every_problem_is_reported_at_once():
     assert {"gears.pinion.teeth", "meshes.m.backlash.nominal", "drives.motor.speed"} <= locations
 
 
+def test_problems_found_after_the_schema_are_reported_at_once():
+    """A gear connected to nothing, gears that cannot mesh, a translation without a
+    support and a pair with interference: one error lists all four (they came in rounds,
+    one kind per attempt)."""
+    data = pair_dict()
+    _idler(data)
+    data["gears"]["wheel"]["module"] = "3 mm"
+    data["gears"]["pinion"]["dofs"] = ["x", "y", "theta"]
+    data["gears"]["idler2"] = {"teeth": 4, "module": "2 mm", "face_width": "20 mm",
+                               "place": {"from_gear": "pinion", "angle": "90 deg"}}
+    data["meshes"]["m2"] = {"gears": ["pinion", "idler2"], "stiffness": "4e8 N/m"}
+    with pytest.raises(torquesplit.ModelError) as info:
+        load(data)
+    locations = [loc for loc, _ in info.value.issues]
+    assert {"gears.idler", "meshes.m", "gears.pinion.support", "meshes.m2"} <= set(locations)
+    # the pair that cannot mesh gets no second, derived message about its geometry
+    assert locations.count("meshes.m") == 1
+    assert_teaches(info.value)
+
+
 # --------------------------------------------------------------------------- warnings
 def test_damping_ratio_above_critical_warns():
     data = pair_dict()

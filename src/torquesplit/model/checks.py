@@ -1,7 +1,9 @@
 """Checks a validated schema cannot express: references, topology, physics consistency.
 
 Errors are collected (all of them, not only the first) and raised as one
-:class:`~torquesplit.errors.ModelError`.  Values that look wrong but can be right are
+:class:`~torquesplit.errors.ModelError`: the names first (every other check needs them to
+resolve), then everything that needs only the names at once, then the checks that need
+the kinematics (speeds, positions).  Values that look wrong but can be right are
 reported as :class:`~torquesplit.errors.ModelWarning`.  Both name the field as the user
 wrote it: what a ``[[planetary]]`` stage generated is named by the stage's field
 (:func:`as_written`: ``planetary.0.pin_errors.1``, not ``gears.st_planet2.support...``).
@@ -72,12 +74,11 @@ def check_model(model: Model, source: str | None = None, *, deep: bool = False) 
         model errors (:func:`readiness_issues`; ``torquesplit check`` does).
     """
     issues = reference_issues(model)
-    if not issues:
-        issues = topology_issues(model)
-    if not issues:
-        issues = mesh_compatibility_issues(model)
-    if not issues:
-        issues = geometry_issues(model) + support_issues(model) + modification_issues(model)
+    if not issues:  # the names resolve: every check that needs only them, in one round
+        mismatched = mesh_compatibility_issues(model)
+        skip = {loc for loc, _ in mismatched}  # (no pair geometry for gears that cannot mesh)
+        issues = topology_issues(model) + mismatched + geometry_issues(model, skip)
+        issues += support_issues(model) + modification_issues(model, skip)
     if issues:
         raise ModelError(as_written(model, issues), source)
     # the kinematic pass finds loops that cannot turn and power that does not balance
@@ -273,11 +274,13 @@ _GEOMETRY_FIELDS = {
 }
 
 
-def geometry_issues(model: Model) -> list[tuple[str, str]]:
+def geometry_issues(model: Model, skip=frozenset()) -> list[tuple[str, str]]:
     """What the involute geometry refuses (too few teeth, interference...), by field.
 
     Runs the geometry of :mod:`torquesplit.gears.geometry` on every gear and every
-    cylindrical pair before the kinematics, so that its errors name the model's fields.
+    cylindrical pair before the kinematics, so that its errors name the model's fields;
+    the pairs of the meshes in ``skip`` (``meshes.NAME``: gears that cannot mesh) are left
+    out.
     """
     from ..gears.line_of_action import cylindrical_pair, is_conical
     from .kinematics import gear_geometry
@@ -295,7 +298,7 @@ def geometry_issues(model: Model) -> list[tuple[str, str]]:
     for name, mesh in model.meshes.items():
         a, b = mesh.gears
         ga, gb = model.gears[a], model.gears[b]
-        if not {a, b} <= good or is_conical(ga, gb):
+        if not {a, b} <= good or is_conical(ga, gb) or f"meshes.{name}" in skip:
             continue
         # the pair's messages say pinion (gear1) and wheel (gear2); an internal gear is
         # put second: name the gears instead
@@ -321,10 +324,11 @@ def _gear_named(name: str, tail: str | None) -> str:
     return f"{name}'s" + ("" if tail == "'s" else tail)
 
 
-def modification_issues(model: Model) -> list[tuple[str, str]]:
+def modification_issues(model: Model, skip=frozenset()) -> list[tuple[str, str]]:
     """Tooth modifications that do not fit the active profile of a mating pair (a relief
     longer than the active profile, tip and root relief overlapping, an end relief longer
-    than half the face), and the LTCA asked of a bevel or face mesh, named by field."""
+    than half the face), and the LTCA asked of a bevel or face mesh, named by field (the
+    pairs of the meshes in ``skip`` left out, as in :func:`geometry_issues`)."""
     from ..gears.contact.modifications import check_modification, modification_from_spec
     from ..gears.line_of_action import cylindrical_pair, is_conical
 
@@ -342,7 +346,8 @@ def modification_issues(model: Model) -> list[tuple[str, str]]:
             issues.append((f"meshes.{name}.stiffness.method", (
                 "the LTCA is implemented for cylindrical pairs (spur, helical, double-helical, "
                 "internal); use a table or a constant for this bevel/face mesh")))
-        if (ga.modifications is None and gb.modifications is None) or is_conical(ga, gb):
+        if ((ga.modifications is None and gb.modifications is None) or is_conical(ga, gb)
+                or f"meshes.{name}" in skip):
             continue
         try:
             pair = cylindrical_pair(ga, gb)
