@@ -6,6 +6,8 @@ The pipeline, one stage per subpackage (each stage returns a new object)::
     solve_kinematics(model)     -> Kinematics  (model/: speeds, torques, line of action)
     assemble(model)             -> Structure   (assembly/: DOFs, mass, element arrays)
     simulate(model, ...)        -> Results     (solve/ + metrics/ + results/)
+    quasi_static_load_sharing(model) -> QuasiStaticResults (equilibria over mesh positions)
+    model_modes(model)          -> ModalReport (natural modes about the static equilibrium)
     run_study(study_file)       -> Dataset     (study/: grids, Monte Carlo, sensitivity)
 """
 
@@ -16,6 +18,8 @@ from .errors import ModelError, ModelWarning, SolverError, StepTooLargeError, To
 from .examples import example_names, example_path
 from .model.io import load_model
 from .model.kinematics import solve_kinematics
+from .modes import model_modes
+from .quasistatic import quasi_static_load_sharing
 from .simulation import simulate
 
 __version__ = "0.1.0"
@@ -23,7 +27,7 @@ __version__ = "0.1.0"
 __all__ = [
     "ModelError", "ModelWarning", "SolverError", "StepTooLargeError", "TorquesplitError",
     "example_names", "example_path", "load_model", "solve_kinematics", "assemble", "simulate",
-    "Study", "run_study",
+    "quasi_static_load_sharing", "model_modes", "Study", "run_study",
 ]
 
 

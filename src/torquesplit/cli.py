@@ -725,9 +725,11 @@ def static(
             m, _ = _load(model, assign)
             from .quasistatic import quasi_static_load_sharing
             from .results.plausibility import static_warnings
+            from .solve.integrate import stop_on_interrupt
 
-            with ux.collect_warnings(), ux.progress("quasi-static equilibria",
-                                                    quiet or as_json) as cb:
+            # Ctrl-C ends the sweep with the positions done: saved and reported as such
+            with ux.collect_warnings(), stop_on_interrupt(), \
+                    ux.progress("quasi-static equilibria", quiet or as_json) as cb:
                 res = quasi_static_load_sharing(m, revolutions=revolutions,
                                                 points_per_cycle=points_per_cycle,
                                                 progress=cb)
@@ -754,6 +756,8 @@ def static(
     _print_static(m, res, met, orbits, saved, figures, plots, as_json)
     if failed is not None:
         _fail(failed)
+    elif res.solution.interrupted:
+        ux.exit_interrupted(f"results kept in {saved}" if saved else "")
 
 
 def _print_static(m, res, met, orbits, saved, figures, plots, as_json) -> None:

@@ -12,6 +12,8 @@ helper                      what it does
                             terminal, nothing elsewhere; its callback takes the fraction
                             done and, optionally, what is being done
 :func:`interruptible`       Ctrl-C prints "interrupted; ..." with what was kept, exit 130
+                            (:func:`exit_interrupted`, also after a command that stopped
+                            on Ctrl-C with what it had)
 :func:`quantity`            an option value with units; a bare number is SI (``--duration
                             3`` is 3 s), as in model files
 :func:`header`              a table header with its unit in brackets, safe from rich markup
@@ -159,8 +161,6 @@ def interruptible(kept: Callable[[], str] | None = None) -> Iterator[None]:
 
     ``kept()`` says what is on disk ("nothing written" when it returns an empty text).
     """
-    import typer
-
     try:
         yield
     except (KeyboardInterrupt, SystemError) as exc:
@@ -173,13 +173,21 @@ def interruptible(kept: Callable[[], str] | None = None) -> Iterator[None]:
             what = kept() if kept is not None else ""
         except Exception:  # pragma: no cover - never hide the interrupt
             what = ""
-        con = _session.err_console
-        text = f"interrupted; {what or 'nothing written'}"
-        if con is None:  # pragma: no cover
-            print(text, file=sys.stderr)
-        else:
-            con.print(text, markup=False, highlight=False)
-        raise typer.Exit(130) from None
+        exit_interrupted(what)
+
+
+def exit_interrupted(what: str = "") -> None:
+    """Print ``interrupted; <what was kept>`` on stderr and exit with status 130 (also
+    after a command that stopped on Ctrl-C and reported what it had computed)."""
+    import typer
+
+    con = _session.err_console
+    text = f"interrupted; {what or 'nothing written'}"
+    if con is None:  # pragma: no cover
+        print(text, file=sys.stderr)
+    else:
+        con.print(text, markup=False, highlight=False)
+    raise typer.Exit(130) from None
 
 
 def quantity(text: Optional[str], kind: str, option: str) -> Optional[float]:

@@ -98,3 +98,47 @@ def test_the_run_command_saves_what_it_computed_when_interrupted(tmp_path, monke
                                    "--out", str(out)])
     assert res.exit_code == 130, res.output
     assert "Interrupted (Ctrl-C)" in res.stdout and out.exists()
+
+
+def test_an_interrupted_static_sweep_keeps_the_positions_done(tmp_path, monkeypatch):
+    """'static' threw its sweep away on Ctrl-C (a minute on some examples); it now ends
+    with the positions done: tables, a warning that says how many, the file, status 130."""
+    import contextlib
+
+    import xarray as xr
+
+    @contextlib.contextmanager
+    def progress(label, quiet, total=1.0):
+        yield _interrupting_progress(0.5)
+
+    monkeypatch.setattr(ux, "progress", progress)
+    out = tmp_path / "s.nc"
+    res = CliRunner().invoke(app, ["static", "ji_li_mill_drive", "--revolutions", "0.2",
+                                   "--out", str(out)])
+    assert res.exit_code == 130, res.output
+    assert "quasi-static load sharing" in res.stdout
+    assert f"interrupted; results kept in {out}" in res.stderr
+    ds = xr.open_dataset(out)
+    n = ds.sizes["time"]
+    assert 0 < n and f"stopped by Ctrl-C after {n} of " in ds.attrs["warnings"]
+    ds.close()
+
+
+def test_a_static_sweep_interrupted_before_its_first_position_or_outside_the_context():
+    import torquesplit
+    from torquesplit.solve.integrate import stop_on_interrupt
+
+    model = torquesplit.load_model("ji_li_mill_drive")
+    with pytest.raises(KeyboardInterrupt):  # outside stop_on_interrupt: as before
+        torquesplit.quasi_static_load_sharing(model, revolutions=0.2,
+                                              progress=_interrupting_progress(0.5))
+    with stop_on_interrupt(), pytest.raises(KeyboardInterrupt):  # nothing done to keep
+        torquesplit.quasi_static_load_sharing(model, revolutions=0.2,
+                                              progress=_interrupting_progress(0.0))
+    with stop_on_interrupt():
+        res = torquesplit.quasi_static_load_sharing(model, revolutions=0.2,
+                                                    progress=_interrupting_progress(0.5))
+    sol = res.solution
+    assert sol.interrupted and 0 < sol.times.size < sol.planned
+    assert sol.q.shape[0] == sol.element_forces.shape[0] == sol.times.size
+    assert any("stopped by Ctrl-C" in w for w in res.all_warnings())

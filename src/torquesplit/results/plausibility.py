@@ -315,11 +315,17 @@ def static_warnings(results) -> list[tuple[str, str]]:
 
     from ..model.checks import deflection_warnings
 
-    conv = np.asarray(results.solution.converged, bool)
-    q = np.asarray(results.solution.q, dtype=float)
+    sol = results.solution
+    conv = np.asarray(sol.converged, bool)
+    q = np.asarray(sol.q, dtype=float)
     out = deflection_warnings(results.model, results.structure,
                               q[conv][np.argmax(np.abs(q[conv]).max(axis=1))] if conv.any()
                               else np.zeros(q.shape[1]))
+    if getattr(sol, "interrupted", False):
+        out.append(("analysis", (
+            f"stopped by Ctrl-C after {conv.size} of {sol.planned} positions: the load "
+            f"sharing and orbits cover only the positions done; run it again to the end "
+            f"(or give fewer --revolutions) for the whole period")))
     if conv.size and not conv.all():
         out.append(("analysis", (
             f"{int((~conv).sum())} of {conv.size} positions did not converge and are left "

@@ -129,9 +129,17 @@ class QuasiStaticSolution:
     """(n_times,) int."""
     rigid_modes: np.ndarray
     """(n_dof, n_rigid) mass-normalised rigid-body modes."""
+    planned: int = 0
+    """Positions the sweep was asked for; more than ``times.size`` when Ctrl-C stopped it
+    (0: as many as it has)."""
 
     def __post_init__(self):
         freeze_arrays(self)
+
+    @property
+    def interrupted(self) -> bool:
+        """Ctrl-C stopped the sweep before its last position (the positions done kept)."""
+        return self.planned > self.times.size
 
 
 def rigid_body_modes(structure: Structure, active: np.ndarray | None = None,
@@ -652,8 +660,12 @@ def quasi_static(
     The projection matrix, rigid-body modes and their constraint are built once; each
     time starts its Newton iteration from the previous time's displacements, so a
     smooth sweep usually needs one or two linear solves per time.  ``progress``, if
-    given, is called with the fraction of times done (about a hundred times).
+    given, is called with the fraction of times done (about a hundred times).  Inside
+    :func:`torquesplit.solve.integrate.stop_on_interrupt`, Ctrl-C ends the sweep with the
+    positions done (``interrupted``; raised again if none is).
     """
+    from .integrate import _interrupted
+
     times = np.atleast_1d(np.asarray(times, dtype=float))
     problem = _StaticProblem(structure, regularisation, balance_tolerance)
     n, n_el, nt = structure.n_dof, structure.n_elements, times.size
@@ -665,13 +677,20 @@ def quasi_static(
     its = np.zeros(nt, dtype=np.int64)
     q = None
     every = max(1, nt // 100)
-    for i, t in enumerate(times):
-        if progress is not None and i % every == 0:
-            progress(i / nt)
-        r = problem.solve(t, q, max_iterations)
-        q = r["q"] if r["converged"] else None
-        Q[i], F[i], D[i], C[i] = r["q"], r["forces"], r["delta"], r["contact"]
-        conv[i], its[i] = r["converged"], r["it"]
-    return QuasiStaticSolution(times=times, q=Q, element_forces=F, deformations=D,
-                               in_contact=C, converged=conv, iterations=its,
-                               rigid_modes=problem.phi)
+    done = 0
+    try:
+        for i, t in enumerate(times):
+            if progress is not None and i % every == 0:
+                progress(i / nt)
+            r = problem.solve(t, q, max_iterations)
+            q = r["q"] if r["converged"] else None
+            Q[i], F[i], D[i], C[i] = r["q"], r["forces"], r["delta"], r["contact"]
+            conv[i], its[i] = r["converged"], r["it"]
+            done = i + 1
+    except BaseException as exc:
+        if done == 0 or not _interrupted(exc):
+            raise
+    cut = slice(0, done)
+    return QuasiStaticSolution(times=times[cut], q=Q[cut], element_forces=F[cut],
+                               deformations=D[cut], in_contact=C[cut], converged=conv[cut],
+                               iterations=its[cut], rigid_modes=problem.phi, planned=nt)
