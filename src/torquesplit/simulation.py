@@ -18,6 +18,7 @@ from typing import Callable
 import numpy as np
 
 from ._memo import remember_last
+from .assembly.structure import history_elements
 from .errors import ModelWarning, SolverError
 from .model.io import load_model
 from .model.kinematics import solve_kinematics
@@ -333,8 +334,7 @@ def prepare_run(
 
     names = structure.element_names
     track = [names.index(m) for m in mesh_names]
-    supports = [i for i, n in enumerate(names) if ".support." in n]
-    hist_el = track + supports
+    hist_el = history_elements(structure, mesh_names)
     hist_dofs = list(history_dofs or [])
     sample_interval = 1.0 / (samples_per_period * f_max)
     n_records = duration / sample_interval

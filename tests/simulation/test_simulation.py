@@ -83,7 +83,7 @@ def test_two_runs_identical_and_netcdf_round_trip(split, tmp_path):
     path = r1.to_netcdf(tmp_path / "run.nc")
     ds = open_results(path)
     np.testing.assert_array_equal(ds["element_force"].values, r1.solution.history_forces)
-    assert ds["element_force"].attrs["units"] == "N"
+    assert ds["element_force"].attrs["units"] == "N"  # (rigid shafts: no torque element)
     for name in ds.data_vars:
         assert "units" in ds[name].attrs and "long_name" in ds[name].attrs, name
     again = torquesplit.simulate(model_from_results(ds), cycles=30)
@@ -185,3 +185,26 @@ def test_bearing_forces_of_the_settled_part(tmp_path):
     out = CliRunner().invoke(app, ["run", str(tmp_path / "model.toml"), "--duration", "0.1",
                                    "--quiet"])
     assert "bearing forces (settled; from the history" in out.stdout
+
+
+def test_every_element_force_is_kept_shaft_torques_in_newton_metres(tmp_path):
+    """The history kept meshes and bearings only: a branch shaft's torque was nowhere in
+    the files.  Now every element is, each with its unit (NetCDF coordinate
+    'element_unit', CSV column suffix)."""
+    res = torquesplit.simulate("ji_li_mill_drive", cycles=20)
+    names = res.structure.element_names
+    ds = res.to_dataset()
+    units = dict(zip(ds["element"].values, ds["element_unit"].values))
+    assert set(units) == set(names)
+    assert [units[n] for n in ("input", "drive1", "drive2", "output")] == ["N m"] * 4
+    assert all(units[n] == "N" for n in names if n not in res.model.shafts)
+    assert ds["element_force"].attrs["units"] == "N or N m"
+    # the shaft torque is the shaft's law on the saved state: k (theta_a - theta_b) at
+    # the static equilibrium is the torque it carries (the branch's share of the input)
+    col = list(ds["element"].values).index("drive1")
+    static = res.static.element_forces[names.index("drive1")]
+    assert ds["element_force"].values[0, col] == pytest.approx(static, rel=1e-9)
+    res.to_csv(tmp_path / "r.csv")
+    header = (tmp_path / "r_history.csv").read_text().splitlines()[0].split(",")
+    assert "drive1_Nm" in header and "m11_N" in header and len(header) == len(names) + 1
+

@@ -455,3 +455,28 @@ def _resample_periodic(values, grid: np.ndarray) -> np.ndarray:
         return np.full(grid.shape, arr[0])
     src = np.arange(arr.size) / arr.size
     return np.interp(grid, src, arr, period=1.0)
+
+
+def element_units(structure: Structure) -> list[str]:
+    """Unit of each element's force: ``"N m"`` for a spring that joins rotations only
+    (shaft, spline torsion, torsional support: its force is a torque), else ``"N"`` (a
+    mesh's normal force also on a torsional model, whose projection holds base radii)."""
+    theta = np.array([n.endswith(".theta") for n in structure.dof_names], dtype=bool)
+    out = []
+    for e in range(len(structure.element_names)):
+        dofs = structure.v_dof[structure.v_ptr[e]:structure.v_ptr[e + 1]]
+        torque = structure.element_kind[e] == SPRING and dofs.size and theta[dofs].all()
+        out.append("N m" if torque else "N")
+    return out
+
+
+def history_elements(structure: Structure, mesh_names) -> list[int]:
+    """Elements whose forces a run's history keeps, in its column order: the meshes (as
+    named), the supports (bearing forces), then every other element (shaft and spline
+    torques, torsional supports)."""
+    names = list(structure.element_names)
+    track = [names.index(m) for m in mesh_names]
+    supports = [i for i, n in enumerate(names) if ".support." in n and i not in track]
+    rest = [i for i in range(len(names)) if i not in track and i not in supports]
+    return track + supports + rest
+

@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..assembly.structure import element_units
 from ..errors import SolverError
 from ..metrics import load_sharing as ls
 
@@ -512,7 +513,8 @@ class Results:
     def to_csv(self, path, *, overwrite: bool = False, definition: str | None = None) -> Path:
         """Save spreadsheet tables: ``NAME.csv`` (per-mesh summary, then a row per
         load-sharing group and one for the system, their mesh cell empty) and beside it
-        ``NAME_history.csv`` (decimated forces) and ``NAME_cycles.csv`` (start, peak,
+        ``NAME_history.csv`` (decimated forces and torques, each column's unit in its
+        name: ``m1_N``, ``shaft_Nm``) and ``NAME_cycles.csv`` (start, peak,
         smallest and mean force of every mesh cycle).
 
         All three are written atomically, and none replaces an existing file unless
@@ -558,10 +560,12 @@ class Results:
         s = self.solution
         el = self.structure.element_names
         names = [el[i] for i in s.history_elements]
+        units = element_units(self.structure)
         cols = [list(s.tracked_elements).index(el.index(m)) for m in self.mesh_names]
         history, cycles, summary = plan.files[1], plan.files[2], plan.files[0]
         contents = {
-            history: files.csv_bytes(["time_s"] + [f"{n}_N" for n in names],
+            history: files.csv_bytes(["time_s"] + [f"{n}_{units[i].replace(' ', '')}"
+                                                   for n, i in zip(names, s.history_elements)],
                                      np.column_stack([s.history_t, s.history_forces]).tolist()),
             cycles: files.csv_bytes(
                 ["cycle"] + [f"{m}_{q}" for q in ("start_s", "peak_N", "min_N", "mean_N")

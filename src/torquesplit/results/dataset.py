@@ -8,6 +8,8 @@ import math
 import numpy as np
 import xarray as xr
 
+from ..assembly.structure import element_units
+
 
 def _var(dims, data, units, long_name):
     return xr.Variable(dims, np.asarray(data), attrs={"units": units, "long_name": long_name})
@@ -68,12 +70,17 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
     meshes = res.mesh_names
     el = st.element_names
     hist_names = [el[i] for i in s.history_elements]
+    all_units = element_units(st)
+    hist_units = [all_units[i] for i in s.history_elements]
     mesh_cols = [list(s.tracked_elements).index(el.index(m)) for m in meshes]
     ds = xr.Dataset(
         data_vars={
-            "element_force": _var(("time", "element"), s.history_forces, "N",
+            "element_force": _var(("time", "element"), s.history_forces,
+                                  "N" if set(hist_units) <= {"N"} else "N or N m",
                                   "element force (mesh: normal tooth force; support: bearing "
-                                  "force)"),
+                                  "force; shaft, spline torsion, torsional support: torque "
+                                  "[N m], k (theta_a - theta_b) + damping, a the first body "
+                                  "it connects; each element's unit in 'element_unit')"),
             "cycle_start": _var(("cycle", "mesh"), s.cycle_start[:, mesh_cols], "s",
                                 "start time of each mesh cycle"),
             "cycle_max_force": _var(("cycle", "mesh"), s.cycle_max[:, mesh_cols], "N",
@@ -117,6 +124,8 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
             "dof": ("dof", list(st.dof_names)),
         },
     )
+    ds = ds.assign_coords(element_unit=("element", hist_units, {
+        "long_name": "unit of each element's force: N, or N m for a torque"}))
     ds = ds.assign_coords(element_frame=("element", _element_frames(res, hist_names), {
         "long_name": "frame of the element force: a support force of a body measured in "
                      "a turning carrier's frame is in that frame (its shaft orders are "

@@ -557,6 +557,7 @@ def _check_record_size(periods: int, samples: int, columns: int) -> None:
 
 def _as_solution(st: SteadyState, shell, periods):
     """An integrate.Solution made of the periodic state repeated over a few periods."""
+    from torquesplit.assembly.structure import history_elements
     from torquesplit.solve.integrate import Solution
 
     s = st.structure
@@ -565,8 +566,7 @@ def _as_solution(st: SteadyState, shell, periods):
     names = list(s.element_names)
     mesh_names = st.mesh_names
     track = [names.index(m) for m in mesh_names]
-    supports = [i for i, n in enumerate(names) if ".support." in n]
-    hist = track + supports
+    hist = history_elements(s, mesh_names)
     if periods is None:
         win = max(shell.settle_windows(20))
         per_period = min(float(s.frequency[e]) * T for e in track) if track else 1.0
