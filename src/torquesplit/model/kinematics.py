@@ -596,8 +596,56 @@ def _propagate_speeds(model: Model, axes, frames, issues) -> dict[str, float]:
     return speeds
 
 
+_FLAT = 1e-9
+"""Fall of the flow potential below which an edge carries no nominal power (round-off)."""
+
+
+def _flow_potential(model: Model, groups, g_adj) -> dict[str, float]:
+    """The potential of :func:`_power_flow` per rigid group: 1 at a drive's group, 0 at a
+    load's (a group with both: 0), harmonic in between (unit conductance per edge).
+    Groups joined to no drive or load keep 0 (the topology check refuses them)."""
+    names = list(g_adj)
+    for d in model.drives.values():
+        if groups[d.body] not in g_adj:
+            names.append(groups[d.body])
+    index = {g: i for i, g in enumerate(names)}
+    fixed = {groups[d.body]: 1.0 for d in model.drives.values()}
+    fixed.update({groups[ld.body]: 0.0 for ld in model.loads.values()})
+    free = [g for g in names if g not in fixed]
+    x = np.zeros(len(names))
+    for g, v in fixed.items():
+        if g in index:
+            x[index[g]] = v
+    if free:
+        col = {g: i for i, g in enumerate(free)}
+        lap = np.zeros((len(free), len(free)))
+        rhs = np.zeros(len(free))
+        for g in free:
+            i = col[g]
+            for _, h in g_adj.get(g, []):
+                lap[i, i] += 1.0
+                if h in col:
+                    lap[i, col[h]] -= 1.0
+                else:
+                    rhs[i] += x[index[h]]
+        # lstsq: a free part joined to no drive or load is singular (refused elsewhere)
+        sol = np.linalg.lstsq(lap, rhs, rcond=None)[0]
+        for g in free:
+            x[index[g]] = sol[col[g]]
+    return {g: float(x[index[g]]) for g in names}
+
+
 def _power_flow(model: Model, speeds, groups, issues):
-    """Equal-split power flow from the drives to the loads."""
+    """Equal-split power flow from the drives to the loads.
+
+    Each edge (mesh, elastic shaft or spline between rigid groups) is directed by a
+    potential: 1 at the drives, 0 at the loads, and between them the solution of the
+    graph's Laplacian with unit conductances (every group at the mean of its neighbours).
+    Power flows downhill, and a group splits what it receives equally among its downhill
+    edges.  Unlike hop counts to the load, a potential falls along every path from a split
+    to where the paths join, whatever their lengths: a branch with one body more (a torque
+    meter, a coupling hub) still gets its share.  An edge with no fall (a dead end, the
+    rung of a balanced bridge) carries no nominal power."""
     # graph of rigid groups: edges are meshes and elastic shafts/splines
     edges: list[tuple[str, str, str]] = []  # (name, body_a, body_b)
     for name, m in model.meshes.items():
@@ -610,20 +658,7 @@ def _power_flow(model: Model, speeds, groups, issues):
         ga, gb = groups[a], groups[b]
         g_adj.setdefault(ga, []).append((name, gb))
         g_adj.setdefault(gb, []).append((name, ga))
-    # distance of every group to the nearest load
-    dist: dict[str, int] = {}
-    queue = deque()
-    for ld in model.loads.values():
-        g = groups[ld.body]
-        if g not in dist:
-            dist[g] = 0
-            queue.append(g)
-    while queue:
-        g = queue.popleft()
-        for _, h in g_adj.get(g, []):
-            if h not in dist:
-                dist[h] = dist[g] + 1
-                queue.append(h)
+    potential = _flow_potential(model, groups, g_adj)
     # inputs
     drive_torques = {}
     group_power: dict[str, float] = {}
@@ -637,10 +672,11 @@ def _power_flow(model: Model, speeds, groups, issues):
         group_power[g] = group_power.get(g, 0.0) + p
     edge_power: dict[str, float] = {name: 0.0 for name, _, _ in edges}
     edge_dir: dict[str, tuple[str, str]] = {}
-    order = sorted(dist, key=lambda g: -dist[g])
+    order = sorted(potential, key=lambda g: -potential[g])
     for g in order:
         p = group_power.get(g, 0.0)
-        outs = [(name, h) for name, h in g_adj.get(g, []) if dist[h] < dist[g]]
+        outs = [(name, h) for name, h in g_adj.get(g, [])
+                if potential[h] < potential[g] - _FLAT]
         if not outs:
             continue
         share = p / len(outs)

@@ -1,0 +1,66 @@
+"""The equal-split nominal power flow (model/kinematics._power_flow) on branches of unequal
+length: each branch of a split carries its share, however many bodies it has."""
+
+from __future__ import annotations
+
+import tomllib
+
+import pytest
+from model_texts import split_model
+
+import torquesplit
+
+#: branch 'a' of the two-path split gets a hub body between two elastic shafts (a torque
+#: meter, a coupling hub): one body more than branch 'b'
+_LONGER_BRANCH = {
+    '''[shafts.sa]
+connects = ["a", "a2"]
+rigid = true''': '''[bodies.hub]
+polar_inertia = "1e-4 kg m^2"
+position = ["-60 mm", "0 mm", "-20 mm"]
+
+[shafts.sa]
+connects = ["a", "hub"]
+torsional_stiffness = "2e4 N m/rad"
+
+[shafts.sa2]
+connects = ["hub", "a2"]
+torsional_stiffness = "2e4 N m/rad"''',
+    '''[gears.a2]
+teeth = 20''': '''[gears.a2]
+position = ["-60 mm", "0 mm", "-40 mm"]
+teeth = 20''',
+    '''[gears.b2]
+teeth = 20''': '''[gears.b2]
+position = ["60 mm", "0 mm", "-40 mm"]
+teeth = 20''',
+    '52.91502622129181 mm", "0 mm"': '52.91502622129181 mm", "-40 mm"',
+}
+
+
+def _model(replacements: dict[str, str]):
+    text = split_model()
+    for old, new in replacements.items():
+        assert old in text
+        text = text.replace(old, new)
+    return torquesplit.load_model(tomllib.loads(text))
+
+
+def test_a_branch_with_one_body_more_carries_its_half():
+    """Counting hops to the load gave the longer branch no power and refused the model
+    ("meshes.a2: carries no nominal load")."""
+    kin = torquesplit.solve_kinematics(_model(_LONGER_BRANCH))
+    m = kin.meshes
+    assert m["a1"].force == pytest.approx(m["b1"].force, rel=1e-12)
+    assert m["a2"].force == pytest.approx(m["b2"].force, rel=1e-12)
+    # 100 N m in, split in two: each first-stage mesh carries 50 N m on the pinion
+    assert m["a1"].force * m["a1"].arm_driver == pytest.approx(50.0, rel=1e-12)
+    assert kin.bodies["hub"].torque == pytest.approx(kin.bodies["a"].torque, rel=1e-12)
+    assert [m[n].driver for n in ("a1", "b1", "a2", "b2")] == ["pinion", "pinion", "a2", "b2"]
+
+
+def test_the_equal_length_split_is_unchanged():
+    kin = torquesplit.solve_kinematics(_model({}))
+    m = kin.meshes
+    assert m["a1"].force * m["a1"].arm_driver == pytest.approx(50.0, rel=1e-12)
+    assert m["a2"].force == pytest.approx(m["b2"].force, rel=1e-12)
