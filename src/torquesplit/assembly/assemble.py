@@ -372,16 +372,8 @@ def _assemble(model: Model, kin: Kinematics | None, *, n_table: int | None,
     if rotating and kin.frames:
         from .rotating import rotating_frame_terms
 
-        def pin_stiffness(body, direction):
-            spec = model.gears.get(body) or model.bodies[body]
-            sup = spec.support
-            if sup is None or sup.on != kin.planet_bodies.get(body):
-                return None
-            k_rad = support_stiffness(sup)
-            k_xyz = np.array([k_rad, sup.stiffness_y or k_rad, sup.axial_stiffness or k_rad])
-            return float(k_xyz @ np.asarray(direction) ** 2)
-
-        frame_stiffness, gyroscopic = rotating_frame_terms(kin, dmap, ext, pin_stiffness)
+        frame_stiffness, gyroscopic = rotating_frame_terms(kin, dmap, ext,
+                                                           pin_stiffness(model, kin))
 
     # ---- drives and loads
     for name, d in model.drives.items():
@@ -532,6 +524,23 @@ def _friction_projection(model: Model, kin: Kinematics, dmap: DofMap, name: str,
             coefs.append(c)
             rows.append(0)
     return dict(table=table, dofs=dofs, coefs=coefs, rows=rows)
+
+
+def pin_stiffness(model, kin):
+    """``f(body, direction)``: the stiffness of a planet's bearing on its carrier's pin
+    along a unit direction [N/m] (None for a body not on a pin), for the centrifugal
+    pin-preload term of :func:`torquesplit.assembly.rotating.rotating_frame_terms`."""
+
+    def stiffness(body, direction):
+        spec = model.gears.get(body) or model.bodies[body]
+        sup = spec.support
+        if sup is None or sup.on != kin.planet_bodies.get(body):
+            return None
+        k_rad = support_stiffness(sup)
+        k_xyz = np.array([k_rad, sup.stiffness_y or k_rad, sup.axial_stiffness or k_rad])
+        return float(k_xyz @ np.asarray(direction) ** 2)
+
+    return stiffness
 
 
 def support_stiffness(sup, where: str = "support") -> float:

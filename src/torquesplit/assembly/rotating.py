@@ -133,3 +133,35 @@ def rotating_frame_terms(kin, dmap, ext: np.ndarray, pin_stiffness=None):
     for c_name, (idx, s_c, k) in preload.items():
         frame.append((idx, idx, k * s_c * s_c))
     return frame, gyro
+
+
+def frame_terms_at(model, kin, structure, factor: float):
+    """The rotating-frame terms of ``structure`` with every speed ``factor`` times the
+    model's (a speed sweep at constant load): ``(gy_coef, fs_coef, external_force)`` in
+    the structure's own order.  Coriolis scales with the carrier's speed, centripetal
+    softening and centrifugal force with its square, the planets' pin preload as
+    m Omega^2 R k_t / (k_t - m Omega^2): recomputed here, not scaled.  The drive and
+    load torques stay the file's."""
+    import dataclasses
+
+    from .assemble import pin_stiffness
+
+    dmap = structure.metadata["dof_map"]
+    scaled = dataclasses.replace(kin, bodies={
+        n: dataclasses.replace(b, speed=b.speed * factor) for n, b in kin.bodies.items()})
+    stiff = pin_stiffness(model, kin)
+    n = structure.n_dof
+    out = []
+    for k in (kin, scaled):
+        ext = np.zeros(n)
+        frame, gyro = rotating_frame_terms(k, dmap, ext, stiff)
+        out.append((sorted(frame), sorted(gyro), ext))
+    (_, _, ext_1), (frame, gyro, ext_s) = out
+    if (len(gyro) != structure.gy_coef.size or len(frame) != structure.fs_coef.size
+            or [j for _, j, _ in gyro] != structure.gy_idx.tolist()
+            or [j for _, j, _ in frame] != structure.fs_idx.tolist()):
+        raise ValueError("the rotating-frame terms at another speed do not have the "
+                         "structure's pattern (was it assembled with rotating_frame=False?)")
+    return (np.array([g for _, _, g in gyro]), np.array([k for _, _, k in frame]),
+            structure.external_force - ext_1 + ext_s)
+

@@ -23,7 +23,7 @@ from torquesplit.steady.period import (
     fundamental_period,
     keep_excitations,
 )
-from torquesplit.steady.problem import PeriodicProblem
+from torquesplit.steady.problem import PeriodicProblem, periodic_problem
 from torquesplit.steady.solution import ENERGY_TOL, PeriodicSolution, periodic_solution
 
 __all__ = ["steady_state", "SteadyState", "MeshSteady", "speed_factor", "reference_speed"]
@@ -317,7 +317,7 @@ def steady_state(model, *, method: str = "auto", harmonics: int | None = None,
     factor = speed_factor(model, speed)
     if adaptive is None:
         adaptive = harmonics is None
-    problem = PeriodicProblem(structure, per.frequency)
+    problem = periodic_problem(model, kin, structure, per.frequency)
     sol = periodic_solution(structure, per, method=method, harmonics=harmonics,
                             samples=samples, speed=factor, q_static=static.q, initial=initial,
                             tol=tol, adaptive=adaptive, energy_tol=energy_tol,

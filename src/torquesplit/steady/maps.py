@@ -19,7 +19,7 @@ from torquesplit.steady.period import (
     fundamental_period,
     keep_excitations,
 )
-from torquesplit.steady.problem import PeriodicProblem
+from torquesplit.steady.problem import periodic_problem
 from torquesplit.steady.sweep import (
     continue_in_speed,
     continue_in_speed_shooting,
@@ -115,7 +115,7 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
         raise SolverError(f"unknown method {method!r}; use 'shooting', 'hb' or 'auto'.")
     if method == "auto":
         method = "hb" if harmonics is not None else "shooting"
-    problem = PeriodicProblem(s, per.frequency)
+    problem = periodic_problem(model, kin, s, per.frequency)
     step_max = None if max_step is None else max_step / w_ref
     if method == "shooting":
         cont, pts, folds, msg, complete, _ = continue_in_speed_shooting(

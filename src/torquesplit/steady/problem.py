@@ -84,10 +84,26 @@ MESH_CYCLE_STEPS = 20
 statistics (peaks between the steps are found by the parabola through three)."""
 
 
+def periodic_problem(model, kinematics, structure: Structure, frequency: float,
+                     rhs: str = "auto") -> PeriodicProblem:
+    """The :class:`PeriodicProblem` of an assembled model, with the speed dependence of a
+    turning carrier's frame (:func:`torquesplit.assembly.rotating.frame_terms_at`) where
+    the structure has one."""
+    terms = None
+    if structure.metadata.get("rotating_frame"):
+        from functools import partial
+
+        from torquesplit.assembly.rotating import frame_terms_at
+
+        terms = partial(frame_terms_at, model, kinematics, structure)
+    return PeriodicProblem(structure, frequency, rhs, frame_terms=terms)
+
+
 class PeriodicProblem:
     """``structure`` with fundamental frequency ``frequency`` [Hz] at speed factor 1."""
 
-    def __init__(self, structure: Structure, frequency: float, rhs: str = "auto"):
+    def __init__(self, structure: Structure, frequency: float, rhs: str = "auto",
+                 frame_terms=None):
         if not (frequency > 0 and math.isfinite(frequency)):
             raise SolverError(f"the fundamental frequency must be a positive number of Hz, "
                               f"got {frequency!r}; see steady.fundamental_period.")
@@ -112,13 +128,19 @@ class PeriodicProblem:
         self.rigid_damped = c > 1e-12 * max(float(np.max(s.ground_damping, initial=0.0)), 1e-300)
         self._models: dict[float, kd.KernelModel] = {}
         self._stable_step: float | None = None
+        # f(speed factor) -> (gy_coef, fs_coef, external_force) of a turning carrier's
+        # frame at that speed (assembly.rotating.frame_terms_at); None: no turning frame
+        self._frame_terms = frame_terms
+        self._par_speed = 1.0  # the speed the generated code's parameters hold
 
     @property
     def nr(self) -> int:
         return int(self.rigid.shape[1])
 
     def model_at(self, speed: float) -> kd.KernelModel:
-        """Kernel model at ``speed`` times the model's speed."""
+        """Kernel model at ``speed`` times the model's speed: excitation frequencies
+        scaled, and a turning carrier's Coriolis, centripetal and centrifugal terms at
+        that speed (the generated code's parameters follow the last model asked for)."""
         key = float(speed)
         m = self._models.get(key)
         if m is None:
@@ -126,7 +148,25 @@ class PeriodicProblem:
                 self._models.clear()
             m = self.model._replace(frequency=self.model.frequency * key,
                                     error_omega=self.model.error_omega * key)
+            if (self._frame_terms is None and key != 1.0
+                    and self.structure.metadata.get("rotating_frame")):
+                raise SolverError(
+                    "this structure has a turning carrier, whose Coriolis, centripetal and "
+                    "centrifugal terms depend on the speed: build its problem with "
+                    "steady.problem.periodic_problem(model, kinematics, structure, "
+                    "frequency) to solve at another speed (steady_state and sweep_speed "
+                    "do)")
+            if self._frame_terms is not None and key != 1.0:
+                gy, fs, ext = self._frame_terms(key)
+                m = m._replace(gy_coef=np.ascontiguousarray(gy, dtype=np.float64),
+                               fs_coef=np.ascontiguousarray(fs, dtype=np.float64),
+                               external_force=np.ascontiguousarray(ext, dtype=np.float64))
             self._models[key] = m
+        if self._frame_terms is not None and key != self._par_speed and self.code.generated:
+            from torquesplit.solve.codegen import generated_rhs
+
+            self.work.par[:] = generated_rhs(m).parameters  # (a cached pattern: no compile)
+            self._par_speed = key
         return m
 
     # ---------------------------------------------------------------- evaluation
@@ -222,9 +262,8 @@ class PeriodicProblem:
         nc = Phi.shape[1]
         k = threads_for(steps * nc, nc) if threads is None else max(1, min(int(threads), nc))
         blocks = np.array_split(np.arange(nc), k)
-        works = [self.work] + [kd.make_work(self.model, self.code.parameters)
-                               for _ in blocks[1:]]
-        model = self.model_at(speed)
+        model = self.model_at(speed)  # (first: it sets the generated code's parameters)
+        works = [self.work] + [kd.make_work(model, self.work.par) for _ in blocks[1:]]
 
         def block(cols, w):
             P = np.ascontiguousarray(Phi[:, cols])
