@@ -64,3 +64,63 @@ def test_the_equal_length_split_is_unchanged():
     m = kin.meshes
     assert m["a1"].force * m["a1"].arm_driver == pytest.approx(50.0, rel=1e-12)
     assert m["a2"].force == pytest.approx(m["b2"].force, rel=1e-12)
+
+
+_SPEED_HELD = {'''[drives.motor]
+body = "pinion"
+speed = "3000 rpm"
+torque = "100 N m"
+
+[loads.out]
+body = "out"''': '''[drives.motor]
+body = "pinion"
+speed = "3000 rpm"
+mode = "speed"
+
+[loads.out]
+body = "out"
+torque = "600 N m"'''}
+
+
+def test_a_speed_held_drive_puts_in_what_the_given_load_takes():
+    """A 'speed' drive needed a power balancing the loads to 1e-3 (computed by hand);
+    without power or torque it now takes the loads' power."""
+    kin = torquesplit.solve_kinematics(_model(_SPEED_HELD))
+    # 600 N m at a third of the speed: 200 N m... at the pinion, 100 N m (ratio 2 x 3)
+    assert kin.drive_torques["motor"] == pytest.approx(100.0, rel=1e-12)
+    assert kin.input_power == pytest.approx(kin.output_power, rel=1e-12)
+    assert kin.meshes["a1"].force * kin.meshes["a1"].arm_driver == pytest.approx(50.0,
+                                                                                rel=1e-12)
+
+
+@pytest.mark.parametrize("change, location, words", [
+    ({'torque = "600 N m"': ""}, "loads.out.torque", "this load is 'balanced'"),
+    ({'mode = "speed"': 'mode = "torque"'}, "drives.motor", "neither 'power' nor 'torque'"),
+])
+def test_an_open_speed_drive_needs_the_loads_torques(change, location, words):
+    replacements = dict(_SPEED_HELD)
+    key = next(iter(replacements))
+    for old, new in change.items():
+        replacements[key] = replacements[key].replace(old, new)
+    with pytest.raises(torquesplit.ModelError) as info:
+        _model(replacements)
+    assert any(loc == location and words in msg for loc, msg in info.value.issues), \
+        info.value.issues
+
+
+def test_a_speed_held_sun_puts_in_what_the_carrier_takes():
+    """The same on a planetary stage (its torques come from the epicyclic equations)."""
+    from torquesplit.model.overrides import read_raw
+
+    raw = read_raw(torquesplit.example_path("lin_parker1999_planetary"))
+    raw["drives"]["input"].pop("torque")
+    raw["drives"]["input"]["mode"] = "speed"
+    raw["loads"]["output"]["torque"] = "400 N m"
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        kin = torquesplit.solve_kinematics(torquesplit.load_model(raw))
+    sun, carrier = kin.bodies["stage_sun"], kin.bodies["stage_carrier"]
+    assert kin.drive_torques["input"] * abs(sun.speed) == pytest.approx(
+        400.0 * abs(carrier.speed), rel=1e-12)

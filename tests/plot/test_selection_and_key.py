@@ -39,3 +39,15 @@ def test_layout_key_shows_shafts_as_drawn(tmp_path):
                                                                       split_model())))
     assert "shaft, elastic" not in rigid and drawn == {rigid["shaft, rigid"]} == {"-"}
     assert elastic["shaft, elastic"] != "-"
+
+
+def test_the_layout_writes_large_torques_without_an_exponent():
+    """A reviewer's mill drive read 'load mill: 2e+05 N m' on its drawing."""
+    import re
+
+    import torquesplit
+    from torquesplit.plot.layout import layout_svg
+
+    svg = layout_svg(torquesplit.load_model("ji_li_mill_drive"))
+    labels = re.findall(r"load \w+: [^<]*", svg) + re.findall(r"drive \w+: [^<]*", svg)
+    assert labels and not any("e+" in text for text in labels), labels

@@ -377,9 +377,14 @@ def solve_torques(model: Model, axes, frames, groups, speeds, layout: EpicyclicL
     for k, rep in enumerate(held_reps):
         A[col[rep], off + k] += 1.0
     off += len(held_reps)
+    from .kinematics import drive_input_torques
+
     drive_torques, load_torques = {}, {}
+    given = drive_input_torques(model, speeds, issues)
+    if issues:
+        return None
     for name, d in model.drives.items():
-        t = d.input_torque
+        t = given[name]
         drive_torques[name] = t
         known(d.body, math.copysign(t, d.speed))
     for name, ld in model.loads.items():

@@ -596,6 +596,40 @@ def _propagate_speeds(model: Model, axes, frames, issues) -> dict[str, float]:
     return speeds
 
 
+def drive_input_torques(model: Model, speeds, issues) -> dict[str, float]:
+    """Each drive's input torque magnitude [N m]: its own (torque, or power / speed), and
+    for a 'speed' drive given neither, the power that the loads' given torques take (less
+    the other drives'), at its speed.  Such a drive needs every load's torque: a
+    'balanced' load beside it is an issue (appended to ``issues``)."""
+    out = {n: d.input_torque for n, d in model.drives.items()}
+    open_ = [n for n, t in out.items() if t is None]
+    if not open_:
+        return out
+    balanced = [n for n, ld in model.loads.items() if ld.torque is None]
+    if len(open_) > 1:
+        issues.append((f"drives.{open_[1]}", (
+            f"the 'speed' drives {open_} have neither power nor torque, so the loads' power "
+            f"cannot be split between them; give all but one of them a power or torque")))
+        return out
+    if balanced:
+        issues.append((f"loads.{balanced[0]}.torque", (
+            f"the 'speed' drive {open_[0]!r} has neither power nor torque, so it puts in "
+            f"what the loads take, but this load is 'balanced' (it takes what the drives put "
+            f"in); give this load's torque, or the drive's power or torque")))
+        return out
+    p_loads = sum(ld.torque * abs(speeds[ld.body]) for ld in model.loads.values())
+    p_other = sum(t * abs(model.drives[n].speed) for n, t in out.items() if t is not None)
+    name = open_[0]
+    if not p_loads > p_other:
+        issues.append((f"drives.{name}", (
+            f"the other drives put in {p_other / 1e3:.6g} kW, all the loads take "
+            f"({p_loads / 1e3:.6g} kW): nothing is left for this 'speed' drive; give its "
+            f"power or torque, or correct the loads")))
+        return out
+    out[name] = (p_loads - p_other) / abs(model.drives[name].speed)
+    return out
+
+
 _FLAT = 1e-9
 """Fall of the flow potential below which an edge carries no nominal power (round-off)."""
 
@@ -663,8 +697,11 @@ def _power_flow(model: Model, speeds, groups, issues):
     drive_torques = {}
     group_power: dict[str, float] = {}
     p_in = 0.0
+    given = drive_input_torques(model, speeds, issues)
+    if issues:
+        return {}, {}, {}, {}, {}, 0.0, 0.0
     for name, d in model.drives.items():
-        t = d.input_torque
+        t = given[name]
         p = t * abs(d.speed)
         drive_torques[name] = t
         p_in += p

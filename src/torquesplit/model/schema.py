@@ -641,7 +641,9 @@ class Drive(Strict):
 
     body: str = Field(description="The driven body.")
     speed: Speed = Field(description="Nominal speed, signed about the body's axis.")
-    power: Power | None = Field(None, gt=0, description="Input power (gives the torque).")
+    power: Power | None = Field(None, gt=0, description=(
+        "Input power (gives the torque). A 'speed' drive may leave power and torque out: "
+        "it then puts in what the loads' given torques take."))
     torque: Torque | None = Field(None, gt=0, description="Input torque magnitude.")
     mode: Literal["torque", "speed"] = Field(
         "torque", description="'torque': constant torque; 'speed': prescribed speed (DOF removed)."
@@ -651,18 +653,22 @@ class Drive(Strict):
     def _one(self):
         if self.power is not None and self.torque is not None:
             raise ValueError("both 'power' and 'torque' are given; remove one of them")
-        if self.power is None and self.torque is None:
+        if self.power is None and self.torque is None and self.mode != "speed":
             raise ValueError("the drive has neither 'power' nor 'torque'; add one of them, e.g. "
-                             "torque = '100 N m'")
+                             "torque = '100 N m' (or make it mode = 'speed' to put in what the "
+                             "loads' torques take)")
         if abs(self.speed) < 1e-6:
             raise FieldError("speed", "must not be zero (below 1e-6 rad/s); give the nominal "
                              "speed, e.g. '3000 rpm'")
         return self
 
     @property
-    def input_torque(self) -> float:
-        """Torque magnitude [N m]."""
-        return self.torque if self.torque is not None else self.power / abs(self.speed)
+    def input_torque(self) -> float | None:
+        """Torque magnitude [N m]; None for a 'speed' drive given neither power nor torque
+        (:func:`torquesplit.model.kinematics.drive_input_torques` finds it)."""
+        if self.torque is not None:
+            return self.torque
+        return self.power / abs(self.speed) if self.power is not None else None
 
 
 class Load(Strict):

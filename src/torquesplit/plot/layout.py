@@ -246,14 +246,14 @@ def layout_figure(model, kin=None, *, width: float = 10.0) -> Figure:
         c = proj(centre[d.body])
         what = (f"{abs(d.speed) * 30 / math.pi:.5g} rpm" + (
             f", {d.power / 1e3:.4g} kW" if d.power else
-            f", {d.torque:.4g} N m" if d.torque else ""))
+            f", {_torque_text(d.torque)}" if d.torque else ""))
         ax.annotate(f"drive {name}: {what}", c, xytext=(-10, 14), textcoords="offset points",
                     fontsize=fs, color=COLORS["drive"], fontweight="bold", zorder=7,
                     gid=f"drive:{name}")
     for name, ld in model.loads.items():
         c = proj(centre[ld.body])
         torque = kin.load_torques.get(name) if hasattr(kin, "load_torques") else None
-        what = f": {torque:.5g} N m" if isinstance(torque, (int, float)) else ""
+        what = f": {_torque_text(torque)}" if isinstance(torque, (int, float)) else ""
         ax.annotate(f"load {name}{what}", c, xytext=(-10, 24), textcoords="offset points",
                     fontsize=fs, color=COLORS["load"], fontweight="bold", zorder=7,
                     gid=f"load:{name}")
@@ -321,3 +321,12 @@ def layout_svg(model, kin=None, *, salt: str = "layout") -> str:
     from .figures import figure_svg
 
     return figure_svg(layout_figure(model, kin), salt)
+
+
+def _torque_text(torque: float) -> str:
+    """'850 N m', '12.5 kN m', '2.1 MN m': no exponent on a drawing."""
+    for scale, unit in ((1e6, "MN m"), (1e3, "kN m")):
+        if abs(torque) >= 10 * scale:
+            return f"{torque / scale:.4g} {unit}"
+    return f"{torque:.5g} N m" if abs(torque) >= 1e-3 or torque == 0 else f"{torque:.3g} N m"
+
