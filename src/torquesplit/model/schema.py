@@ -421,7 +421,8 @@ def _check_axis(axis):
 
 # --------------------------------------------------------------------------- connections
 class Shaft(Strict):
-    """A torsional connection between two bodies on a common axis."""
+    """A torsional connection between two bodies on a common axis.  The shaft is massless:
+    put its polar inertia into the bodies it joins (half into each is the usual lumping)."""
 
     connects: tuple[str, str] = Field(description="The two bodies the shaft joins.")
     rigid: Flag = Field(False, description="Join the bodies rigidly (one rotational DOF).")
@@ -447,6 +448,13 @@ class Shaft(Strict):
                 "the shaft has no stiffness; give 'torsional_stiffness' (e.g. '2.5e6 N m/rad'), "
                 "or 'diameter' and 'length', or rigid = true"
             )
+        if self.torsional_stiffness is not None and (self.diameter is not None
+                                                     or self.length is not None):
+            given = [f for f in ("diameter", "length") if getattr(self, f) is not None]
+            raise FieldError("torsional_stiffness", (
+                f"both 'torsional_stiffness' and {' and '.join(repr(f) for f in given)} are "
+                f"given: the stiffness would be used and the dimensions ignored (a change of "
+                f"diameter would change nothing); remove one of them"))
         if self.diameter is not None and self.inner_diameter >= self.diameter:
             raise FieldError("inner_diameter", "must be smaller than 'diameter'; correct one "
                              "of them")
