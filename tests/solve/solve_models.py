@@ -67,7 +67,8 @@ def random_structure(seed: int = 0):
 
 def random_structure_extras(seed: int = 0, gyroscopic: bool = False):
     """:func:`random_structure` plus tooth friction on its four meshes and two spline
-    radial elements (one with a stick limit and a clearance, one without clearance), so
+    radial elements (one with a stick limit and a clearance, one with a clearance and
+    errors on its components, as a bearing's radial clearance has), so
     that every branch of the spline law and of the friction scatter is reachable; with
     ``gyroscopic`` also a gyroscopic coupling of DOFs 0 and 1 (and a diagonal entry) and
     a frame stiffness on them."""
@@ -100,8 +101,12 @@ def random_structure_extras(seed: int = 0, gyroscopic: bool = False):
     els.append(dict(name="spA", kind=SPLINE, x=([0, 1], [1.0, -1.0]), y=([2], [-1.0]),
                     stiffness=5e7, damping=20.0, stick_limit=1e-6, clearance=3e-6,
                     friction_force=30.0, velocity_scale=1e-3))
+    # spB carries errors on its components, as a bearing with a radial clearance does
+    # (its seat offset and the body's eccentricity): d = V q - e in every consumer
     els.append(dict(name="spB", kind=SPLINE, x=([3], [-1.0]), y=([4], [-1.0]),
-                    stiffness=2e7, damping=5.0, friction_force=10.0, velocity_scale=1e-3))
+                    stiffness=2e7, damping=5.0, friction_force=10.0, velocity_scale=1e-3,
+                    clearance=1e-6, error_constant_x=1.5e-6,
+                    errors_y=[(1e-6, 250.0, 0.3)]))
     # gyroscopic coupling of two translations (a body in a rotating frame), so that the
     # velocity-coupling term of every right-hand side is exercised too
     gyro = [(0, 1, -35.0), (1, 0, 35.0), (3, 3, 2.0)] if gyroscopic else []

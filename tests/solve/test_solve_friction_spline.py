@@ -56,7 +56,8 @@ def test_friction_and_spline_terms_of_the_twin_by_hand():
     t = 0.0123
     y = np.concatenate([rng.normal(scale=3e-6, size=n), rng.normal(scale=1e-3, size=n)])
     force, delta = element_forces_numpy(s, t, y)
-    rate = s.projection_matrix() @ y[n:]
+    # (delta is V q - e; the rate less the errors' rate: spB's components carry errors)
+    rate = s.projection_matrix() @ y[n:] - excitation_numpy(s, t).error_rate
     for (ex, ey), par in zip(s.sp_el, s.sp_par, strict=True):
         fx, fy = spline_law_numpy(par, delta[ex], delta[ey], rate[ex], rate[ey])
         assert (force[ex], force[ey]) == (fx, fy)

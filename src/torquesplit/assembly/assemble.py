@@ -279,6 +279,10 @@ def _assemble(model: Model, kin: Kinematics | None, *, n_table: int | None,
             seat_const, seat_sines = _eccentricity(model, kin, on)
             pin_offset = pin_offset + seat_const
             ecc_sines = ecc_sines + seat_sines
+        # a radial clearance joins the two translations across the body's axis into one
+        # circular law (the spline's, without stick or friction); the others stay apart
+        pair = _radial_pair(sup, dmap.axes[body], kin.bodies[body].axis)
+        radial = {}
         for d, j in tr.items():
             u = dmap.axes[body][d]
             k = float(k_xyz @ u ** 2)
@@ -307,9 +311,29 @@ def _assemble(model: Model, kin: Kinematics | None, *, n_table: int | None,
             err = float(pin_offset @ u) + float(ecc_const @ u)
             sines = [(float(a @ u), om, ph) for a, om, ph in ecc_sines
                      if abs(float(a @ u)) > 0.0]
+            if d in pair:
+                radial[d] = dict(dofs=dofs, coefs=coefs, stiffness=k, damping=c,
+                                 error_constant=err, errors=sines)
+                continue
             elements.append(dict(name=f"{body}.support.{d}", kind=SPRING, dofs=dofs,
                                  coefs=coefs, stiffness=k, damping=c, gaps=sup.clearance,
                                  error_constant=err, errors=sines))
+        if radial:
+            a, b = (radial[d] for d in pair)
+            if not (math.isclose(a["stiffness"], b["stiffness"], rel_tol=1e-9)
+                    and math.isclose(a["damping"], b["damping"], rel_tol=1e-9, abs_tol=1e-12)):
+                raise ModelError([(f"{where}.clearance_shape", (
+                    f"a radial clearance needs one stiffness across the axis, but "
+                    f"{pair[0]!r} has {a['stiffness']:.4g} N/m and {pair[1]!r} "
+                    f"{b['stiffness']:.4g} N/m (stiffness_y or axial_stiffness); give them "
+                    f"equal, or clearance_shape = 'per_axis'"))])
+            elements.append(dict(
+                name=f"{body}.support", kind=SPLINE, component_names=pair,
+                x=(a["dofs"], a["coefs"]), y=(b["dofs"], b["coefs"]),
+                stiffness=a["stiffness"], damping=a["damping"], stick_limit=0.0,
+                clearance=sup.clearance, friction_force=0.0, velocity_scale=v_reg,
+                error_constant_x=a["error_constant"], errors_x=a["errors"],
+                error_constant_y=b["error_constant"], errors_y=b["errors"]))
 
     # ---- splines: torsion spring + 2-D radial element (Dong et al. 2021 eq. 6)
     for name, sp in model.splines.items():
@@ -524,6 +548,16 @@ def _friction_projection(model: Model, kin: Kinematics, dmap: DofMap, name: str,
             coefs.append(c)
             rows.append(0)
     return dict(table=table, dofs=dofs, coefs=coefs, rows=rows)
+
+
+def _radial_pair(sup, axes: dict, axis) -> tuple[str, ...]:
+    """The two translational DOFs across ``axis`` that a radial clearance joins (empty
+    without a clearance, for 'per_axis', or unless exactly two DOFs lie across it)."""
+    if not sup.clearance > 0 or sup.clearance_shape != "radial":
+        return ()
+    a = np.asarray(axis, dtype=float) / np.linalg.norm(axis)
+    across = tuple(d for d, u in axes.items() if abs(float(np.asarray(u) @ a)) < 1e-9)
+    return across if len(across) == 2 else ()
 
 
 def pin_stiffness(model, kin):

@@ -29,7 +29,9 @@ Two optional extensions, both empty (and free) when a model does not use them:
   ``F = k R + c Rdot`` (R < S1), ``F = F_m tanh(Rdot / v)`` (S1 <= R <= S2),
   ``F = k (R - S2) + c Rdot + F_m tanh(Rdot / v)`` (R > S2), and the two component
   elements carry ``f_x = F dx / R`` and ``f_y = F dy / R`` (0 at R = 0), so the usual
-  ``-V_e f_e`` applies it.
+  ``-V_e f_e`` applies it.  A bearing with a radial clearance is the same law without
+  stick limit and friction (``F = k (R - S2) + c Rdot`` beyond S2) on the body's two
+  translations across its axis, less their errors (``d = V q - e``, as every element).
 
 All quantities are SI: metres, radians, newtons, newton-metres, kilograms, kg m^2,
 seconds.  Rotational DOFs are the vibratory angle about the body's own axis, measured
@@ -285,10 +287,12 @@ def build_structure(
     table row each entry scales).  See the module docstring.
 
     A SPLINE describes a whole radial element and becomes two component elements named
-    ``<name>.x`` and ``<name>.y``: give ``x`` and ``y`` as ``(dofs, coefs)`` (the rows
-    of the relative displacement hub - floating member; either may be empty), and
-    ``stiffness``, ``damping``, ``stick_limit``, ``clearance``, ``friction_force`` and
-    ``velocity_scale`` (scalars, SI).
+    ``<name>.x`` and ``<name>.y`` (or ``component_names``): give ``x`` and ``y`` as
+    ``(dofs, coefs)`` (the rows of the relative displacement hub - floating member; either
+    may be empty), and ``stiffness``, ``damping``, ``stick_limit``, ``clearance``,
+    ``friction_force`` and ``velocity_scale`` (scalars, SI); optionally each component's
+    error ``error_constant_x`` / ``errors_x`` (and ``_y``), subtracted from its
+    displacement like an element's (a radial bearing's seat offset and eccentricity).
 
     ``gyroscopic`` lists ``(i, j, g)`` entries of the gyroscopic matrix: the generalized
     force on DOF i gets ``-g v_j`` (entries on one (i, j) add up); ``frame_stiffness``
@@ -305,12 +309,15 @@ def build_structure(
         k = float(el.get("stiffness", 0.0))
         c = float(el.get("damping", 0.0))
         idx = []
-        for comp in ("x", "y"):
+        names = el.get("component_names", ("x", "y"))
+        for comp, label in zip(("x", "y"), names, strict=True):
             dofs, coefs = el.get(comp, ((), ()))
             idx.append(len(expanded))
-            expanded.append({"name": f"{el['name']}.{comp}", "kind": SPLINE,
+            expanded.append({"name": f"{el['name']}.{label}", "kind": SPLINE,
                              "dofs": list(dofs), "coefs": list(coefs), "stiffness": k,
-                             "damping": c})
+                             "damping": c,
+                             "error_constant": el.get(f"error_constant_{comp}", 0.0),
+                             "errors": el.get(f"errors_{comp}", [])})
         s1 = float(el.get("stick_limit", 0.0))
         s2 = float(el.get("clearance", 0.0))
         if not 0.0 <= s1 <= s2:

@@ -315,10 +315,10 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
         # splines (rhs_extra): the radial law on the two component elements
         for j in range(L.sp_el.shape[0]):
             ex, ey = int(L.sp_el[j, 0]), int(L.sp_el[j, 1])
-            for var, el in (("dx", ex), ("dyy", ey)):
+            for var, el in (("dx", ex), ("dyy", ey)):  # less the components' errors
                 rv = "rx" if var == "dx" else "ry"
-                w(f"{var} = {cast('0.0')}")
-                w(f"{rv} = {cast('0.0')}")
+                w(f"{var} = -{e_of(el)}")
+                w(f"{rv} = -{ed_of(el)}")
                 for i in range(v_ptr[el], v_ptr[el + 1]):
                     q = int(v_dof[i])
                     w(f"{var} += {par(('v', i))} * W[yo + {q}]")

@@ -198,8 +198,16 @@ class Support(Strict):
         None, ge=0, description="Damping as a fraction of critical, c = 2 zeta sqrt(k m)."
     )
     clearance: Length = Field(
-        0.0, ge=0, description="Radial clearance (dead zone, Dong et al. 2021 eq. 7); 0 = none."
+        0.0, ge=0, description="Clearance of the bearing (half the diametral play): no "
+        "force until the body has moved this far; 0 = none. Its shape: 'clearance_shape'."
     )
+    clearance_shape: Literal["radial", "per_axis"] = Field(
+        "radial", description="'radial': a circular clearance of the two translations "
+        "across the body's axis, in contact when their resultant exceeds it (a bearing's "
+        "radial play; the same in every orientation of the axes); 'per_axis': a dead zone "
+        "on each translational DOF on its own (Dong et al. 2021 eq. 7: a square clearance, "
+        "larger along the diagonals). A single translation (e.g. 'loa') or the axial one: "
+        "the two are the same.")
     on: str | None = Field(
         None, description="Body the bearing sits on (its translations carry the bearing's "
         "other end: a planet pin on its carrier, a moving housing); default: the fixed "

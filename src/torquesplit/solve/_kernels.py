@@ -280,7 +280,7 @@ def rhs_extra(slot, iy, idy, i_f, m, w):
     (:func:`laws.positive_part`: friction on the working flank only).
     Twin: the spline and friction parts of :func:`torquesplit.solve.reference.rhs_numpy`.
     """
-    Y, force, defl = w.Y, w.F, w.D
+    Y, force, defl, E, ED = w.Y, w.F, w.D, w.E, w.ED
     v_ptr, vq_idx, vv_idx, v_coef = m.vr_ptr, m.vq_idx, m.vv_idx, m.v_coef
     inv_mass, sp_el, sp_par, FR = m.inv_mass, m.sp_el, m.sp_par, w.FR
     fr_el, fr_ptr, fr_dof, fr_coef, fr_row = m.fr_el, m.fr_ptr, m.fr_dof, m.fr_coef, m.fr_row
@@ -288,13 +288,15 @@ def rhs_extra(slot, iy, idy, i_f, m, w):
     for j in range(sp_el.shape[0]):
         ex = sp_el[j, 0]
         ey = sp_el[j, 1]
-        dx = 0.0
-        rx = 0.0
+        # the relative displacement less the components' errors (a radial bearing's seat
+        # offset and eccentricity; 0 for a spline)
+        dx = -E[slot, ex]
+        rx = -ED[slot, ex]
         for i in range(v_ptr[ex], v_ptr[ex + 1]):
             dx += v_coef[i] * Y[iy, vq_idx[i]]
             rx += v_coef[i] * Y[iy, vv_idx[i]]
-        dyy = 0.0
-        ry = 0.0
+        dyy = -E[slot, ey]
+        ry = -ED[slot, ey]
         for i in range(v_ptr[ey], v_ptr[ey + 1]):
             dyy += v_coef[i] * Y[iy, vq_idx[i]]
             ry += v_coef[i] * Y[iy, vv_idx[i]]

@@ -229,7 +229,11 @@ def rhs_ir(model) -> tuple[str, list[tuple[str, int]]]:
     for j in range(sp_el.shape[0]):
         comp = []
         for e in sp_el[j]:
-            dd, rr = "0.0", "0.0"
+            # less the component's error where it has one (a radial bearing's), as
+            # rhs_extra: -0 + x == x, so a component without error starts at 0
+            errs = bool(has_error[e])
+            dd = neg(load("E", e)) if errs else "0.0"
+            rr = neg(load("ED", e)) if errs else "0.0"
             for i in range(vr_ptr[e], vr_ptr[e + 1]):
                 c = param("v_coef", i)
                 dd = op("fadd", dd, op("fmul", c, load("y", vq_idx[i])))

@@ -107,13 +107,13 @@ def _linearise(slot, iy, m, w, force, kd, cr, spt, frv, fps):
     for k in range(sp_el.shape[0]):
         ex = sp_el[k, 0]
         ey = sp_el[k, 1]
-        dx = 0.0
-        rx = 0.0
+        dx = -E[slot, ex]
+        rx = -ED[slot, ex]
         for j in range(v_ptr[ex], v_ptr[ex + 1]):
             dx += v_coef[j] * Y[iy, v_dof[j]]
             rx += v_coef[j] * Y[iy, n + v_dof[j]]
-        dy = 0.0
-        ry = 0.0
+        dy = -E[slot, ey]
+        ry = -ED[slot, ey]
         for j in range(v_ptr[ey], v_ptr[ey + 1]):
             dy += v_coef[j] * Y[iy, v_dof[j]]
             ry += v_coef[j] * Y[iy, n + v_dof[j]]
