@@ -103,8 +103,8 @@ class ModalReport:
         import xarray as xr
 
         sol = self.solution
-        phi = np.asarray(sol.mode_shapes)
         mode = [r.mode for r in self.rows]
+        phi = np.asarray(sol.mode_shapes)[:, [m - 1 for m in mode]]  # the kept modes
         elements = list(sol.element_names)
         energy = np.array([[r.strain_energy.get(e, 0.0) for e in elements]
                            for r in self.rows]).reshape(len(self.rows), len(elements))

@@ -1,0 +1,84 @@
+"""``torquesplit modes`` output after a modal review: files of a subset of the modes,
+modal damping, units and the planetary-only entries."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+import xarray as xr
+from typer.testing import CliRunner
+
+from torquesplit.cli import app
+
+runner = CliRunner()
+
+# motor - shaft - pinion = wheel - shaft - load: three elastic modes (53.9, 559, 1737 Hz)
+ROTOR4 = """
+[model]
+name = "motor-pinion-wheel-load torsional train"
+[bodies.motor]
+polar_inertia = "0.5 kg m^2"
+[gears.pinion]
+teeth = 20
+module = "2 mm"
+face_width = "20 mm"
+position = ["0 mm", "0 mm", "0 mm"]
+polar_inertia = "0.002 kg m^2"
+mass = "1 kg"
+[gears.wheel]
+teeth = 40
+module = "2 mm"
+face_width = "20 mm"
+place = {from_gear = "pinion", angle = "0 deg"}
+polar_inertia = "0.02 kg m^2"
+mass = "4 kg"
+[bodies.load]
+polar_inertia = "1.0 kg m^2"
+position = ["60 mm", "0 mm", "0 mm"]
+[shafts.s1]
+connects = ["motor", "pinion"]
+diameter = "50 mm"
+length = "1 m"
+[shafts.s2]
+connects = ["wheel", "load"]
+diameter = "60 mm"
+inner_diameter = "40 mm"
+length = "0.5 m"
+[meshes.m]
+gears = ["pinion", "wheel"]
+stiffness = "4e8 N/m"
+damping_ratio = 0.05
+[drives.d]
+body = "motor"
+speed = "3000 rpm"
+torque = "100 N m"
+[loads.l]
+body = "load"
+"""
+
+
+@pytest.fixture(scope="module")
+def rotor4(tmp_path_factory):
+    path = tmp_path_factory.mktemp("rotor4") / "rotor4.toml"
+    path.write_text(ROTOR4, encoding="utf-8")
+    return path
+
+
+def _modes(*args):
+    res = runner.invoke(app, ["modes", *map(str, args)])
+    assert res.exit_code == 0, res.output
+    return res
+
+
+@pytest.mark.parametrize("keep", [["--count", "1"], ["--below", "100"]])
+def test_a_file_of_some_modes_holds_their_shapes(rotor4, tmp_path, keep):
+    """--count / --below with --out failed: the shapes kept every mode's column."""
+    full, part = tmp_path / "all.nc", tmp_path / "part.nc"
+    _modes(rotor4, "--out", full)
+    _modes(rotor4, *keep, "--out", part)
+    with xr.open_dataset(full) as a, xr.open_dataset(part) as b:
+        assert b.sizes["mode"] == 1 and list(b["mode"].values) == [1]
+        assert b["shape_real"].shape == (a.sizes["dof"], 1)
+        np.testing.assert_allclose(b["shape_real"].sel(mode=1), a["shape_real"].sel(mode=1))
