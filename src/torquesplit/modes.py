@@ -38,6 +38,13 @@ __all__ = ["ModeRow", "ModalReport", "classify", "model_modes", "MODE_TYPES",
 
 MODE_TYPES = ("rotational", "translational", "planet", "mixed")
 
+DAMPING_RATIO_DEFINITION = (
+    "modal (proportional-damping) approximation zeta = phi^H C phi / (2 omega) of the "
+    "mass-normalised undamped mode, 2 omega + Im(phi^H G phi) in a turning carrier's frame "
+    "(G: Coriolis terms), the coupling of modes through C ignored; mean over the "
+    "degenerate group; C: the damping of the elements in contact at the static "
+    "equilibrium and of speed-dependent loads")
+
 
 @dataclass(frozen=True)
 class ModeRow:
@@ -58,6 +65,15 @@ class ModeRow:
     motion: dict[str, float] = field(default_factory=dict)
     """Share of the group's mass-weighted motion: central rotation, central translation,
     planets."""
+    damping_ratio: float = float("nan")
+    """Modal damping ratio: :data:`DAMPING_RATIO_DEFINITION`."""
+
+    @property
+    def damped_frequency(self) -> float:
+        """f sqrt(1 - zeta^2) [Hz] (0 when zeta >= 1, nan for an unstable mode)."""
+        if not self.frequency > 0:
+            return float("nan")
+        return self.frequency * float(np.sqrt(max(0.0, 1.0 - self.damping_ratio**2)))
 
 
 @dataclass(frozen=True)
@@ -82,7 +98,9 @@ class ModalReport:
         complex modes of a rotating frame)."""
         out = []
         for r in self.rows:
-            d = dict(mode=r.mode, frequency_Hz=r.frequency, group=r.group,
+            d = dict(mode=r.mode, frequency_Hz=r.frequency,
+                     damping_ratio=_finite(r.damping_ratio),
+                     damped_frequency_Hz=_finite(r.damped_frequency), group=r.group,
                      multiplicity=r.multiplicity, type=r.type,
                      strain_energy={k: v for k, v in list(r.strain_energy.items())[:6]},
                      motion=r.motion)
@@ -95,7 +113,7 @@ class ModalReport:
                     d["shape"] = {n: float(v) for n, v in zip(self.dof_names, sh)}
             out.append(d)
         return dict(rigid_body_modes=self.rigid_modes, rotating_frame=self.rotating_frame,
-                    modes=out)
+                    damping_ratio=DAMPING_RATIO_DEFINITION, modes=out)
 
     def to_dataset(self):
         """The modes as an xarray Dataset (frequencies, multiplicity, type, group
@@ -111,6 +129,12 @@ class ModalReport:
         return xr.Dataset(
             {"frequency": (("mode",), [r.frequency for r in self.rows],
                            {"units": "Hz", "long_name": "natural frequency"}),
+             "damping_ratio": (("mode",), [r.damping_ratio for r in self.rows],
+                               {"units": "1", "long_name": "modal damping ratio, "
+                                + DAMPING_RATIO_DEFINITION}),
+             "damped_frequency": (("mode",), [r.damped_frequency for r in self.rows],
+                                  {"units": "Hz", "long_name": "damped natural frequency "
+                                   "f sqrt(1 - zeta^2) of the damping-ratio estimate"}),
              "multiplicity": (("mode",), [r.multiplicity for r in self.rows],
                               {"units": "1", "long_name": "modes of equal frequency"}),
              "group": (("mode",), [r.group for r in self.rows],
@@ -131,6 +155,10 @@ class ModalReport:
             coords={"mode": mode, "dof": list(self.dof_names), "element": elements},
             attrs={"rigid_body_modes": self.rigid_modes,
                    "rotating_frame": int(self.rotating_frame)})
+
+
+def _finite(x: float) -> float | None:
+    return float(x) if np.isfinite(x) else None
 
 
 def _groups(freqs: np.ndarray, rtol: float) -> list[list[int]]:
@@ -169,6 +197,7 @@ def classify(structure, sol, *, rtol: float = 1e-6, tol: float = 1e-6) -> list[M
     phi = np.asarray(sol.mode_shapes)
     freqs = np.asarray(sol.frequencies)
     frac = np.asarray(sol.strain_energy_fraction)
+    zeta = np.asarray(sol.damping_ratios)
     rows: list[ModeRow] = []
     for gi, members in enumerate(_groups(freqs, rtol), start=1):
         w = mass[:, None] * np.abs(phi[:, members]) ** 2
@@ -199,7 +228,8 @@ def classify(structure, sol, *, rtol: float = 1e-6, tol: float = 1e-6) -> list[M
                                 multiplicity=len(members), type=kind,
                                 strain_energy=energy,
                                 motion={"central_rotation": c_rot,
-                                        "central_translation": c_tr, "planets": p}))
+                                        "central_translation": c_tr, "planets": p},
+                                damping_ratio=float(zeta[members].mean())))
     return rows
 
 

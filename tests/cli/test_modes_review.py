@@ -82,3 +82,47 @@ def test_a_file_of_some_modes_holds_their_shapes(rotor4, tmp_path, keep):
         assert b.sizes["mode"] == 1 and list(b["mode"].values) == [1]
         assert b["shape_real"].shape == (a.sizes["dof"], 1)
         np.testing.assert_allclose(b["shape_real"].sel(mode=1), a["shape_real"].sel(mode=1))
+
+
+def _state_space_damping(path):
+    """Damping ratios -Re(lambda)/|lambda| of the damped model's eigenvalues."""
+    import torquesplit
+
+    st = torquesplit.assemble(torquesplit.load_model(path))
+    n = st.n_dof
+    V = st.projection_matrix()
+    C = V.T @ (st.damping[:, None] * V)
+    A = np.zeros((2 * n, 2 * n))
+    A[:n, n:] = np.eye(n)
+    A[n:, :n] = -np.asarray(st.inv_mass)[:, None] * st.stiffness_matrix()
+    A[n:, n:] = -np.asarray(st.inv_mass)[:, None] * C
+    lam = np.linalg.eigvals(A)
+    lam = lam[lam.imag > 1.0]
+    lam = lam[np.argsort(lam.imag)]
+    return -lam.real / np.abs(lam), lam.imag / (2 * np.pi)
+
+
+def test_the_modal_damping_is_listed_in_the_table_json_and_file(rotor4, tmp_path):
+    zeta, f_d = _state_space_damping(rotor4)
+    data = json.loads(_modes(rotor4, "--json").stdout)
+    assert "phi^H C phi" in data["damping_ratio"]
+    got = [m["damping_ratio"] for m in data["modes"]]
+    np.testing.assert_allclose(got, zeta, rtol=2e-3)
+    assert zeta[-1] > 0.04  # the mesh mode (83 % of its strain energy in the 5 % mesh)
+    np.testing.assert_allclose([m["damped_frequency_Hz"] for m in data["modes"]], f_d,
+                               rtol=1e-4)
+    out = tmp_path / "modes.nc"
+    res = _modes(rotor4, "--out", out)
+    assert "zeta" in res.stdout and "f_d [Hz]" in res.stdout
+    with xr.open_dataset(out) as ds:
+        np.testing.assert_allclose(ds["damping_ratio"].values, got)
+        assert ds["damping_ratio"].attrs["units"] == "1"
+        assert "proportional" in ds["damping_ratio"].attrs["long_name"]
+        assert ds["damped_frequency"].attrs["units"] == "Hz"
+
+
+def test_the_help_says_what_the_modes_are_about():
+    res = runner.invoke(app, ["modes", "--help"], env={"COLUMNS": "200"})
+    text = " ".join(res.stdout.split())
+    assert "MEAN mesh stiffness" in text and "massless" in text
+    assert "separated at the equilibrium" in text
