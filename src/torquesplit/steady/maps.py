@@ -331,7 +331,12 @@ def mesh_orders(table) -> int:
 def _order_lines(kin, model, orders, structure=None):
     """(label, order, Hz per rad/s of input speed) of every excitation line: orders
     1..``orders`` of each mesh frequency (None: :func:`mesh_orders` of the mesh's table),
-    and the rotation of every gear."""
+    and the rotation of every gear in the frame its translations are measured in (its
+    speed relative to a turning carrier, as its eccentricity is applied and as the
+    carrier-frame natural frequencies are: :func:`~torquesplit.model.kinematics.
+    support_frame`)."""
+    from torquesplit.model.kinematics import support_frame
+
     w_ref = reference_speed(model)
     lines = []
     seen = set()
@@ -348,12 +353,14 @@ def _order_lines(kin, model, orders, structure=None):
         for h in range(1, top + 1):
             lines.append((f"mesh {name}", h, mk.frequency / w_ref))
     shafts = set()
-    for b, bk in kin.bodies.items():
-        key = round(abs(bk.speed), 9)
-        if key in shafts or bk.speed == 0:
+    for b in kin.bodies:
+        frame, f_rot, f_frame = support_frame(kin, b)
+        key = round(f_rot or 0.0, 9)
+        if key in shafts or not f_rot:
             continue
         shafts.add(key)
-        lines.append((f"rotation of {b}", 1, abs(bk.speed) / (2 * math.pi) / w_ref))
+        where = f" relative to {frame}" if f_frame else ""
+        lines.append((f"rotation of {b}{where}", 1, f_rot / w_ref))
     return lines
 
 
