@@ -1273,20 +1273,24 @@ def modes(
     console.print(f"{rep.rigid_modes} rigid-body mode(s) left out{frame}; mesh frequencies: "
                   + ", ".join(f"{k} {v:.5g} Hz" for k, v in mesh_f.items()), highlight=False)
     typed = any(r.type for r in rep.rows)
+    whirls = any(r.whirl for r in rep.rows)
     t = Table(title="natural modes")
     cols = ["mode", "f [Hz]", "zeta", "f_d [Hz]", "mult."] + (["type"] if typed else []) + \
-        ["strain energy of the group (largest shares)"]
+        (["whirl"] if whirls else []) + ["strain energy of the group (largest shares)"]
     for col in cols:
         t.add_column(_h(col))
     for r in rep.rows:
         energy = ", ".join(f"{n} {100 * v:.0f} %" for n, v in list(r.strain_energy.items())[:3])
         t.add_row(str(r.mode), f"{r.frequency:.6g}", _ratio(r.damping_ratio),
                   f"{r.damped_frequency:.6g}" if r.frequency > 0 else "-",
-                  str(r.multiplicity), *([r.type or ""] if typed else []), energy)
+                  str(r.multiplicity), *([r.type or ""] if typed else []),
+                  *([{"forward": "FW", "backward": "BW"}.get(r.whirl, "")] if whirls else []),
+                  energy)
     console.print(t)
     console.print("zeta: modal damping ratio phi^H C phi / (2 omega) (proportional "
-                  "approximation, coupling of modes ignored); f_d = f sqrt(1 - zeta^2)",
-                  highlight=False)
+                  "approximation, coupling of modes ignored); f_d = f sqrt(1 - zeta^2)"
+                  + ("; whirl: FW/BW, the central members whirl with/against the carrier's "
+                     "rotation in its frame" if whirls else ""), highlight=False)
     if saved:
         console.print(f"modes written to {saved}")
 

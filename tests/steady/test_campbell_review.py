@@ -16,6 +16,68 @@ from torquesplit.steady.maps import campbell
 
 RPM = math.pi / 30
 
+# a 3-planet 43/47/137 stage after Lin & Parker 1999 (ring held, sun in, carrier out)
+LP3 = """
+[model]
+name = "lp3"
+[[planetary]]
+name = "stage"
+planets = 3
+module = "2.25 mm"
+pressure_angle = "24.6 deg"
+face_width = "30 mm"
+[planetary.sun]
+teeth = 43
+mass = "0.4 kg"
+polar_inertia = "0.39 kg * (42.9614 mm)**2"
+dofs = ["theta", "x", "y"]
+support = {stiffness = "1e8 N/m"}
+[planetary.planet]
+teeth = 47
+mass = "0.66 kg"
+polar_inertia = "0.61 kg * (49.0987 mm)**2"
+[planetary.ring]
+teeth = 137
+mass = "2.35 kg"
+polar_inertia = "3.00 kg * (141.1589 mm)**2"
+dofs = ["theta", "x", "y"]
+support = {stiffness = "1e8 N/m"}
+torsional_support = {stiffness = "1e9 N/m * (141.1589 mm)**2"}
+[planetary.carrier]
+mass = "5.43 kg"
+polar_inertia = "6.29 kg * (101.25 mm)**2"
+dofs = ["theta", "x", "y"]
+support = {stiffness = "1e8 N/m"}
+[planetary.planet_bearing]
+stiffness = "1e8 N/m"
+[planetary.sun_mesh]
+stiffness = {method = "constant", value = "5e8 N/m", peak_to_peak = 0.2}
+damping_ratio = 0.005
+[planetary.ring_mesh]
+stiffness = {method = "constant", value = "5e8 N/m", peak_to_peak = 0.2}
+damping_ratio = 0.005
+[drives.input]
+body = "stage_sun"
+speed = "1000 rpm"
+torque = "100 N m"
+[loads.output]
+body = "stage_carrier"
+"""
+
+
+def _lp3(fixed: str = "ring"):
+    """The stage with the ring held (sun input), or the sun held (ring input): the sun
+    turns relative to the carrier with, or against, the carrier's rotation."""
+    import tomllib
+
+    raw = tomllib.loads(LP3)
+    if fixed == "sun":
+        st = raw["planetary"][0]
+        st["sun"]["torsional_support"] = {"stiffness": "1e9 N/m * (42.9614 mm)**2"}
+        st["ring"].pop("torsional_support")
+        raw["drives"]["input"]["body"] = "stage_ring"
+    return load_model(raw)
+
 
 def _lp_with_eccentricities():
     raw = copy.deepcopy(torquesplit.model.io.read_file(example_path("lin_parker1999_planetary")))
@@ -57,3 +119,74 @@ def test_a_fixed_axis_train_keeps_its_absolute_shaft_orders():
             assert "relative" not in str(name)
             body = str(name).split("rotation of ")[1]
             assert f == pytest.approx(abs(kin.bodies[body].speed) * w / 2 / math.pi)
+
+
+@pytest.mark.parametrize("fixed", ["ring", "sun"])
+def test_a_mesh_harmonic_drives_one_whirl_of_each_split_pair(fixed):
+    """The modal force phi^H F of harmonic l of the phased mesh stiffness on each whirl of
+    the split translational pairs: the whirl the rule keeps gets all of it, the other
+    none (Parker & Lin 2004's (l z_s -+ 1) / N, by the sense of the sun's rotation
+    relative to the carrier: forward with a held ring, backward with a held sun)."""
+    from torquesplit.modes import model_modes, phased_stages
+    from torquesplit.solve.static import static_equilibrium
+
+    model = _lp3(fixed)
+    kin = solve_kinematics(model)
+    (stage,) = phased_stages(model, kin)
+    assert stage.sun_sense == (1 if fixed == "ring" else -1)
+    rep = model_modes(model)
+    st = torquesplit.assemble(model)
+    d0 = st.projection_matrix() @ static_equilibrium(st).q - st.error_constant
+    tab = np.fft.rfft(st.stiffness_table, axis=1) / st.stiffness_table.shape[1]
+    pairs = [r for r in rep.rows if r.type == "translational"][:4]  # two split pairs
+    assert [r.whirl for r in pairs] == ["forward", "backward"] * 2
+    for order in (1, 2):  # 43 - 1 and 86 + 1 are multiples of 3
+        amp = np.where(st.frequency > 0, 2 * tab[:, order] * np.exp(2j * np.pi * order
+                                                                     * st.phase), 0)
+        force = -(st.projection_matrix().T @ (amp * d0))
+        modal = [abs(rep.solution.mode_shapes[:, r.mode - 1].conj() @ force) for r in pairs]
+        driven = "forward" if (order == 1) == (fixed == "ring") else "backward"
+        for r in pairs:
+            assert stage.excites(order, "translational", r.whirl) == (r.whirl == driven)
+        for fw, bw in ((modal[0], modal[1]), (modal[2], modal[3])):
+            small, large = (bw, fw) if driven == "forward" else (fw, bw)
+            assert small < 1e-6 * large
+
+
+def test_the_campbell_lists_one_whirl_of_a_pair_as_excited():
+    """It marked both whirls of a split pair as excited by a mesh harmonic."""
+    from torquesplit.steady.maps import mode_kind
+
+    ds, crossings = campbell(_lp3(), 500 * RPM, 1500 * RPM, points=11)
+    trans = [c for c in crossings if c.get("mode_type") == "translational"
+             and c["source"].startswith("mesh ")]
+    assert trans and all(c["whirl"] in ("forward", "backward") for c in trans)
+    for c in trans:
+        lz = c["order"] * 43
+        assert c["suppressed"] == (lz % 3 != (1 if c["whirl"] == "forward" else 2)), c
+    excited = {(c["order"], c["whirl"]) for c in trans if not c["suppressed"]}
+    assert (1, "forward") in excited and (1, "backward") not in excited
+    assert (2, "backward") in excited and (2, "forward") not in excited
+    assert any("backward whirl mode: suppressed" in lab
+               for lab in ds.attrs["suppressed_speed_labels"])
+    assert mode_kind(trans[0]).startswith("translational, ")
+
+
+def test_the_modes_table_and_json_give_the_whirl(tmp_path):
+    import json
+
+    from typer.testing import CliRunner
+
+    from torquesplit.cli import app
+
+    path = tmp_path / "lp3.toml"
+    path.write_text(LP3, encoding="utf-8")
+    runner = CliRunner()
+    res = runner.invoke(app, ["modes", str(path), "--count", "4"], env={"COLUMNS": "200"})
+    assert res.exit_code == 0, res.output
+    assert "whirl" in res.stdout and "FW" in res.stdout and "BW" in res.stdout
+    res = runner.invoke(app, ["modes", str(path), "--count", "4", "--json"])
+    assert [m["whirl"] for m in json.loads(res.stdout)["modes"]] == ["forward", "backward"] * 2
+    res = runner.invoke(app, ["modes", str(path), "--count", "4", "--json",
+                              "--no-rotating-frame"])  # degenerate pairs: no whirl
+    assert {m["whirl"] for m in json.loads(res.stdout)["modes"]} == {None}

@@ -198,7 +198,7 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
                                for c in critical],
         **({"suppressed_speeds_rpm": [c["speed_rpm"] for c in suppressed],
             "suppressed_speed_labels": [
-                f"mode {c['mode']} x {c['order']} {c['source']} ({c['mode_type']} mode: "
+                f"mode {c['mode']} x {c['order']} {c['source']} ({mode_kind(c)} mode: "
                 f"suppressed by mesh phasing, Parker & Lin 2004)" for c in suppressed]}
            if suppressed else {}),
         loads="torques held at the model's values",
@@ -280,28 +280,37 @@ class _Phasing:
     def __init__(self, model, kin):
         from torquesplit.modes import phased_stages
 
+        self.kin = kin
         self.stages = phased_stages(model, kin)
 
-    def types(self, structure, sol) -> dict[int, str | None]:
-        """1-based mode -> type (only for a model with a phased stage)."""
+    def types(self, structure, sol) -> dict[int, tuple[str | None, str | None]]:
+        """1-based mode -> (type, whirl) (only for a model with a phased stage)."""
         if not self.stages:
             return {}
         from torquesplit.modes import classify
 
-        return {r.mode: r.type for r in classify(structure, sol)}
+        return {r.mode: (r.type, r.whirl) for r in classify(structure, sol, kin=self.kin)}
 
-    def mark(self, crossing: dict, types: dict[int, str | None]) -> dict:
+    def mark(self, crossing: dict, types: dict[int, tuple[str | None, str | None]]) -> dict:
         if not self.stages:
             return crossing
         from torquesplit.modes import phasing_suppresses
 
-        kind = types.get(crossing["mode"])
+        kind, whirl = types.get(crossing["mode"], (None, None))
         src = crossing["source"]
         mesh = src[len("mesh "):] if src.startswith("mesh ") else None
         crossing["mode_type"] = kind
+        if whirl:
+            crossing["whirl"] = whirl
         crossing["suppressed"] = bool(mesh is not None and phasing_suppresses(
-            self.stages, mesh, crossing["order"], kind))
+            self.stages, mesh, crossing["order"], kind, whirl))
         return crossing
+
+
+def mode_kind(crossing: dict) -> str:
+    """The crossing's mode type, with its whirl (``translational, forward whirl``)."""
+    kind = str(crossing.get("mode_type"))
+    return kind + (f", {crossing['whirl']} whirl" if crossing.get("whirl") else "")
 
 
 def split_suppressed(crossings: list[dict]) -> tuple[list[dict], list[dict]]:
@@ -423,7 +432,7 @@ def campbell(model, start: float, stop: float, *, points: int = 41,
         # crossings that the planets' mesh phasing leaves unexcited (Parker & Lin 2004)
         ds.attrs["suppressed_speeds_rpm"] = [c["speed_rpm"] for c in suppressed]
         ds.attrs["suppressed_speed_labels"] = [
-            f"{label(c)} ({c['mode_type']} mode: suppressed by mesh phasing)"
+            f"{label(c)} ({mode_kind(c)} mode: suppressed by mesh phasing)"
             for c in suppressed]
     return ds, crossings
 
