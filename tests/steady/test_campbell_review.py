@@ -159,7 +159,7 @@ def test_the_campbell_lists_one_whirl_of_a_pair_as_excited():
 
     ds, crossings = campbell(_lp3(), 500 * RPM, 1500 * RPM, points=11)
     trans = [c for c in crossings if c.get("mode_type") == "translational"
-             and c["source"].startswith("mesh ")]
+             and c["source"].startswith("mesh")]
     assert trans and all(c["whirl"] in ("forward", "backward") for c in trans)
     for c in trans:
         lz = c["order"] * 43
@@ -190,3 +190,46 @@ def test_the_modes_table_and_json_give_the_whirl(tmp_path):
     res = runner.invoke(app, ["modes", str(path), "--count", "4", "--json",
                               "--no-rotating-frame"])  # degenerate pairs: no whirl
     assert {m["whirl"] for m in json.loads(res.stdout)["modes"]} == {None}
+
+
+@pytest.fixture(scope="module")
+def lp3_figure():
+    from torquesplit.steady.plot import campbell_figure
+
+    raw = __import__("tomllib").loads(LP3)
+    raw["model"]["name"] = "a planetary stage with a rather long name " * 3
+    ds, _ = campbell(load_model(raw), 500 * RPM, 3000 * RPM, points=5)
+    fig = campbell_figure(ds)
+    fig.canvas.draw()
+    return ds, fig
+
+
+def test_the_campbell_figure_fits_its_title_and_keeps_the_legend_off_the_lines(lp3_figure):
+    """A reviewer's figure: the title cut off on the left, order labels under the legend,
+    critical speeds printed at 5 pt, one mesh's name for eight meshes, no operating
+    speed."""
+    ds, fig = lp3_figure
+    ax = fig.axes[0]
+    width = fig.bbox.width
+    title = ax.title.get_window_extent()
+    assert title.x0 >= 0 and title.x1 <= width
+    legend = ax.get_legend().get_window_extent()
+    assert not legend.overlaps(ax.get_window_extent())
+    for t in ax.texts:  # every label inside the figure, none under the legend
+        box = t.get_window_extent()
+        assert box.x0 >= -1 and box.x1 <= width + 1, t.get_text()
+        assert not box.overlaps(legend), t.get_text()
+    speeds = {f"{c:.0f}" for c in ds.attrs["critical_speeds_rpm"]}
+    crit = [t for t in ax.texts if t.get_text() in speeds and t.get_rotation() == 90]
+    assert crit and min(t.get_fontsize() for t in crit) >= 7
+    labels = ax.get_legend_handles_labels()[1]
+    assert "meshes stage_sun_planet1..3, stage_ring_planet1..3 x 1..10" in labels, labels
+    assert "operating speed (the model's drive): 1000 rpm" in labels
+
+
+def test_the_operating_speed_is_drawn_only_inside_the_range():
+    from torquesplit.steady.plot import campbell_figure
+
+    ds, _ = campbell(_lp3(), 1500 * RPM, 3000 * RPM, points=3)
+    labels = campbell_figure(ds).axes[0].get_legend_handles_labels()[1]
+    assert not [lab for lab in labels if lab.startswith("operating speed")]
