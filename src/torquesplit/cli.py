@@ -1264,14 +1264,24 @@ def modes(
         _fail(exc)
         return
     mesh_f = {n: mk.frequency for n, mk in kin.meshes.items()}
+    # the carriers' speeds the modes are computed at (their frame's terms depend on it)
+    carrier_rpm = {c: kin.bodies[c].speed * 30 / math.pi for c in kin.carriers}
     if as_json:
         data = rep.to_dict(shapes=True)
         data.update(mesh_frequencies_Hz=mesh_f, results_file=str(saved) if saved else None)
+        if carrier_rpm:
+            data["carrier_speed_rpm"] = carrier_rpm
         ux.emit_json(data, _json_default)
         return
     frame = (" (turning carrier frame)" if rep.rotating_frame else "")
     console.print(f"{rep.rigid_modes} rigid-body mode(s) left out{frame}; mesh frequencies: "
                   + ", ".join(f"{k} {v:.5g} Hz" for k, v in mesh_f.items()), highlight=False)
+    if carrier_rpm:
+        console.print("modes at the model's speed: " + ", ".join(
+            f"carrier {c} turning at {v:.5g} rpm" for c, v in carrier_rpm.items())
+            + ("" if rep.rotating_frame or not any(carrier_rpm.values())
+               else " (its Coriolis and centripetal terms left out: --no-rotating-frame)"),
+            highlight=False)
     typed = any(r.type for r in rep.rows)
     whirls = any(r.whirl for r in rep.rows)
     t = Table(title="natural modes")

@@ -41,6 +41,20 @@ __all__ = ["ModeRow", "ModalReport", "classify", "model_modes", "MODE_TYPES",
 
 MODE_TYPES = ("rotational", "translational", "planet", "mixed")
 
+#: shape units of a mass-normalised mode: phi^H M phi = 1 with M in kg on translations
+#: and kg m^2 on rotations, so the modal coordinate is in m kg^(1/2) (sqrt(kg m^2))
+SHAPE_UNITS = "kg-1/2 (translations), rad m-1 kg-1/2 (rotations)"
+NORMALISATION = ("phi^H M phi = 1, M in kg (translations) and kg m^2 (rotations): a shape "
+                 "times a modal coordinate in m kg^(1/2) gives m or rad")
+#: strain-energy shares listed per group in --json and the table's summaries
+STRAIN_ENERGY_LISTED = 6
+
+
+def shape_unit(dof: str) -> str:
+    """Unit of a mass-normalised shape on ``dof`` (:data:`SHAPE_UNITS`)."""
+    return "rad m-1 kg-1/2" if dof.endswith(".theta") else "kg-1/2"
+
+
 DAMPING_RATIO_DEFINITION = (
     "modal (proportional-damping) approximation zeta = phi^H C phi / (2 omega) of the "
     "mass-normalised undamped mode, 2 omega + Im(phi^H G phi) in a turning carrier's frame "
@@ -102,15 +116,19 @@ class ModalReport:
 
     def to_dict(self, shapes: bool = True) -> dict:
         """JSON-serialisable summary (shapes as real numbers, or [re, im] pairs for the
-        complex modes of a rotating frame)."""
+        complex modes of a rotating frame), with a ``units`` entry; ``motion`` and ``whirl``
+        only for a model with planets (they describe a planetary stage)."""
         out = []
+        truncated = False
         for r in self.rows:
-            d = dict(mode=r.mode, frequency_Hz=r.frequency, whirl=r.whirl,
+            truncated |= len(r.strain_energy) > STRAIN_ENERGY_LISTED
+            d = dict(mode=r.mode, frequency_Hz=r.frequency,
                      damping_ratio=_finite(r.damping_ratio),
                      damped_frequency_Hz=_finite(r.damped_frequency), group=r.group,
                      multiplicity=r.multiplicity, type=r.type,
-                     strain_energy={k: v for k, v in list(r.strain_energy.items())[:6]},
-                     motion=r.motion)
+                     strain_energy=dict(list(r.strain_energy.items())[:STRAIN_ENERGY_LISTED]))
+            if r.type is not None:
+                d.update(motion=r.motion, whirl=r.whirl)
             if shapes:
                 sh = self.solution.mode_shapes[:, r.mode - 1]
                 if np.iscomplexobj(sh):
@@ -119,8 +137,14 @@ class ModalReport:
                 else:
                     d["shape"] = {n: float(v) for n, v in zip(self.dof_names, sh)}
             out.append(d)
+        units = dict(frequency_Hz="Hz", damped_frequency_Hz="Hz", damping_ratio="1",
+                     strain_energy="1 (share of the group's strain energy)",
+                     shape=SHAPE_UNITS, normalisation=NORMALISATION)
+        if truncated:
+            units["strain_energy"] += (f"; the {STRAIN_ENERGY_LISTED} largest shares of each "
+                                       f"group (--out keeps every element's)")
         return dict(rigid_body_modes=self.rigid_modes, rotating_frame=self.rotating_frame,
-                    damping_ratio=DAMPING_RATIO_DEFINITION, modes=out)
+                    damping_ratio=DAMPING_RATIO_DEFINITION, units=units, modes=out)
 
     def to_dataset(self):
         """The modes as an xarray Dataset (frequencies, multiplicity, type, group
@@ -157,13 +181,15 @@ class ModalReport:
                                {"units": "1", "long_name": "share of the group's strain "
                                 "energy (basis-independent)"}),
              "shape_real": (("dof", "mode"), np.real(phi),
-                            {"units": "m or rad per sqrt(kg)",
+                            {"units": SHAPE_UNITS, "normalisation": NORMALISATION,
                              "long_name": "mass-normalised mode shape, real part"}),
              "shape_imag": (("dof", "mode"), np.imag(phi) if np.iscomplexobj(phi)
                             else np.zeros_like(phi),
-                            {"units": "m or rad per sqrt(kg)",
+                            {"units": SHAPE_UNITS, "normalisation": NORMALISATION,
                              "long_name": "mass-normalised mode shape, imaginary part"})},
-            coords={"mode": mode, "dof": list(self.dof_names), "element": elements},
+            coords={"mode": mode, "dof": list(self.dof_names), "element": elements,
+                    "shape_unit": ("dof", [shape_unit(n) for n in self.dof_names],
+                                   {"long_name": "unit of the shape on this DOF"})},
             attrs={"rigid_body_modes": self.rigid_modes,
                    "rotating_frame": int(self.rotating_frame)})
 

@@ -126,3 +126,45 @@ def test_the_help_says_what_the_modes_are_about():
     text = " ".join(res.stdout.split())
     assert "MEAN mesh stiffness" in text and "massless" in text
     assert "separated at the equilibrium" in text
+
+
+def test_units_normalisation_and_no_planetary_entries_for_a_plain_train(rotor4, tmp_path):
+    """Shapes are kg^-1/2 on translations and rad m^-1 kg^-1/2 on rotations (phi^T M phi
+    = 1 with M in kg and kg m^2): they said 'm or rad per sqrt(kg)'; a train without
+    planets got a meaningless 'motion' entry."""
+    import torquesplit
+
+    data = json.loads(_modes(rotor4, "--json").stdout)
+    assert data["units"]["shape"] == "kg-1/2 (translations), rad m-1 kg-1/2 (rotations)"
+    assert "phi^H M phi = 1" in data["units"]["normalisation"]
+    assert "largest" not in data["units"]["strain_energy"]  # three elements: all listed
+    assert "carrier_speed_rpm" not in data
+    for m in data["modes"]:
+        assert "motion" not in m and "whirl" not in m
+    out = tmp_path / "modes.nc"
+    _modes(rotor4, "--out", out)
+    st = torquesplit.assemble(torquesplit.load_model(rotor4))
+    with xr.open_dataset(out) as ds:
+        assert ds["shape_real"].attrs["units"] == data["units"]["shape"]
+        units = dict(zip(ds["dof"].values, ds["shape_unit"].values))
+        assert units["pinion.theta"] == "rad m-1 kg-1/2"
+        phi = ds["shape_real"].values
+    np.testing.assert_allclose((phi**2 / np.asarray(st.inv_mass)[:, None]).sum(axis=0), 1.0,
+                               rtol=1e-9)
+
+
+def test_a_planetary_model_states_its_carrier_speed_and_truncated_lists():
+    lp = "lin_parker1999_planetary"
+    res = _modes(lp, "--count", "2")
+    # ring held: the carrier turns at z_s / (z_s + z_r) = 42 / 180 of the sun's 1000 rpm
+    assert "carrier stage_carrier turning at 233.33 rpm" in " ".join(res.stdout.split())
+    data = json.loads(_modes(lp, "--count", "2", "--json").stdout)
+    assert data["carrier_speed_rpm"]["stage_carrier"] == pytest.approx(1000 * 42 / 180)
+    assert "the 6 largest shares" in data["units"]["strain_energy"]
+    assert "motion" in data["modes"][0] and len(data["modes"][0]["strain_energy"]) == 6
+
+
+def test_the_campbell_json_says_at_which_speed_its_frequencies_are(rotor4):
+    data = json.loads(_modes(rotor4, "--campbell", "--from", "1000 rpm", "--to", "2000 rpm",
+                             "--json").stdout)
+    assert data["natural_frequencies_at_speed_rpm"] == pytest.approx(1000.0)

@@ -41,8 +41,9 @@ class ModalSolution:
     """(n_modes,) natural frequencies [Hz] of the elastic modes; a negative value marks
     a statically unstable mode (negative stiffness), its magnitude sqrt(|lambda|)/2 pi."""
     mode_shapes: np.ndarray
-    """(n_dof, n_modes) mass-normalised mode shapes [m or rad per sqrt(kg)] (complex
-    with a gyroscopic matrix: phi^H M phi = 1)."""
+    """(n_dof, n_modes) mass-normalised mode shapes, phi^H M phi = 1 (complex with a
+    gyroscopic matrix): [kg^-1/2] on translations, [rad m^-1 kg^-1/2] on rotations
+    (M in kg and kg m^2; the modal coordinate in m kg^1/2)."""
     strain_energy_fraction: np.ndarray
     """(n_modes, n_el) share of each element in the mode's strain energy (rows sum to 1)."""
     damping_ratios: np.ndarray

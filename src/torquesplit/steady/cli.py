@@ -395,7 +395,9 @@ def campbell_command(m, start, stop, plot, as_json, console, json_default):
     critical, suppressed = split_suppressed(crossings)
     if as_json:
         out = {"critical_speeds": critical,
-               "natural_frequencies_Hz": ds["natural_frequency"].values[0].tolist()}
+               "natural_frequencies_Hz": ds["natural_frequency"].values[0].tolist(),
+               # a turning carrier's frequencies change with speed: those at --from
+               "natural_frequencies_at_speed_rpm": float(ds["speed_rpm"].values[0])}
         if suppressed:
             out["suppressed_by_mesh_phasing"] = suppressed
         _emit(out, json_default)
