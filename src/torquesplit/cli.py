@@ -1213,8 +1213,16 @@ def modes(
     quiet: bool = _flag("--quiet", "No progress display."),
 ):
     """Natural modes about the static equilibrium: every mode (or those asked for), its
-    multiplicity, type (rotational, translational, planet for a planetary stage) and the
-    strain-energy shares of its group."""
+    multiplicity, type (rotational, translational, planet for a planetary stage), modal
+    damping ratio and the strain-energy shares of its group.
+
+    The model is linearised about its static equilibrium with the MEAN mesh stiffness; a
+    mesh (or clearance) separated at the equilibrium contributes no stiffness and no
+    damping. Shafts are massless torsional springs: lump their inertia into the bodies
+    they join. The damping ratio zeta is the modal (proportional-damping) approximation
+    phi^H C phi / (2 omega) of the undamped mass-normalised mode (coupling of modes
+    through C ignored; Coriolis term added with a turning carrier); f_d = f sqrt(1 -
+    zeta^2)."""
     from .results import files
 
     try:
@@ -1256,27 +1264,49 @@ def modes(
         _fail(exc)
         return
     mesh_f = {n: mk.frequency for n, mk in kin.meshes.items()}
+    # the carriers' speeds the modes are computed at (their frame's terms depend on it)
+    carrier_rpm = {c: kin.bodies[c].speed * 30 / math.pi for c in kin.carriers}
     if as_json:
         data = rep.to_dict(shapes=True)
         data.update(mesh_frequencies_Hz=mesh_f, results_file=str(saved) if saved else None)
+        if carrier_rpm:
+            data["carrier_speed_rpm"] = carrier_rpm
         ux.emit_json(data, _json_default)
         return
     frame = (" (turning carrier frame)" if rep.rotating_frame else "")
     console.print(f"{rep.rigid_modes} rigid-body mode(s) left out{frame}; mesh frequencies: "
                   + ", ".join(f"{k} {v:.5g} Hz" for k, v in mesh_f.items()), highlight=False)
+    if carrier_rpm:
+        console.print("modes at the model's speed: " + ", ".join(
+            f"carrier {c} turning at {v:.5g} rpm" for c, v in carrier_rpm.items())
+            + ("" if rep.rotating_frame or not any(carrier_rpm.values())
+               else " (its Coriolis and centripetal terms left out: --no-rotating-frame)"),
+            highlight=False)
     typed = any(r.type for r in rep.rows)
+    whirls = any(r.whirl for r in rep.rows)
     t = Table(title="natural modes")
-    cols = ["mode", "f [Hz]", "mult."] + (["type"] if typed else []) + \
-        ["strain energy of the group (largest shares)"]
+    cols = ["mode", "f [Hz]", "zeta", "f_d [Hz]", "mult."] + (["type"] if typed else []) + \
+        (["whirl"] if whirls else []) + ["strain energy of the group (largest shares)"]
     for col in cols:
         t.add_column(_h(col))
     for r in rep.rows:
         energy = ", ".join(f"{n} {100 * v:.0f} %" for n, v in list(r.strain_energy.items())[:3])
-        t.add_row(str(r.mode), f"{r.frequency:.6g}", str(r.multiplicity),
-                  *([r.type or ""] if typed else []), energy)
+        t.add_row(str(r.mode), f"{r.frequency:.6g}", _ratio(r.damping_ratio),
+                  f"{r.damped_frequency:.6g}" if r.frequency > 0 else "-",
+                  str(r.multiplicity), *([r.type or ""] if typed else []),
+                  *([{"forward": "FW", "backward": "BW"}.get(r.whirl, "")] if whirls else []),
+                  energy)
     console.print(t)
+    console.print("zeta: modal damping ratio phi^H C phi / (2 omega) (proportional "
+                  "approximation, coupling of modes ignored); f_d = f sqrt(1 - zeta^2)"
+                  + ("; whirl: FW/BW, the central members whirl with/against the carrier's "
+                     "rotation in its frame" if whirls else ""), highlight=False)
     if saved:
         console.print(f"modes written to {saved}")
+
+
+def _ratio(x: float) -> str:
+    return f"{x:.3g}" if math.isfinite(x) else "-"
 
 
 # --------------------------------------------------------------------------- examples

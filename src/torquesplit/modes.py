@@ -18,6 +18,9 @@ carrier):
   ``planet``; with equally spaced planets it falls at the planet modes' frequency, so
   the planet groups have multiplicity N - 1 (2 for three planets, which have no Lin &
   Parker planet modes; docs/theory/planetary.md);
+* **whirl** (turning carrier) -- each translational mode's whirl in the carrier's frame,
+  forward or backward against its rotation (:func:`whirl_senses`), which selects the mesh
+  harmonics that excite it (:meth:`PhasedStage.excites`);
 * **strain energy per element of a group** -- the sum over the group's mass-normalised
   modes of each element's strain energy over the group's total: the trace of the
   element's stiffness over the group's subspace, the same in any basis of a degenerate
@@ -34,9 +37,30 @@ from dataclasses import dataclass, field
 import numpy as np
 
 __all__ = ["ModeRow", "ModalReport", "classify", "model_modes", "MODE_TYPES",
-           "PhasedStage", "phased_stages", "phasing_suppresses"]
+           "PhasedStage", "phased_stages", "phasing_suppresses", "whirl_senses"]
 
 MODE_TYPES = ("rotational", "translational", "planet", "mixed")
+
+#: shape units of a mass-normalised mode: phi^H M phi = 1 with M in kg on translations
+#: and kg m^2 on rotations, so the modal coordinate is in m kg^(1/2) (sqrt(kg m^2))
+SHAPE_UNITS = "kg-1/2 (translations), rad m-1 kg-1/2 (rotations)"
+NORMALISATION = ("phi^H M phi = 1, M in kg (translations) and kg m^2 (rotations): a shape "
+                 "times a modal coordinate in m kg^(1/2) gives m or rad")
+#: strain-energy shares listed per group in --json and the table's summaries
+STRAIN_ENERGY_LISTED = 6
+
+
+def shape_unit(dof: str) -> str:
+    """Unit of a mass-normalised shape on ``dof`` (:data:`SHAPE_UNITS`)."""
+    return "rad m-1 kg-1/2" if dof.endswith(".theta") else "kg-1/2"
+
+
+DAMPING_RATIO_DEFINITION = (
+    "modal (proportional-damping) approximation zeta = phi^H C phi / (2 omega) of the "
+    "mass-normalised undamped mode, 2 omega + Im(phi^H G phi) in a turning carrier's frame "
+    "(G: Coriolis terms), the coupling of modes through C ignored; mean over the "
+    "degenerate group; C: the damping of the elements in contact at the static "
+    "equilibrium and of speed-dependent loads")
 
 
 @dataclass(frozen=True)
@@ -58,6 +82,19 @@ class ModeRow:
     motion: dict[str, float] = field(default_factory=dict)
     """Share of the group's mass-weighted motion: central rotation, central translation,
     planets."""
+    damping_ratio: float = float("nan")
+    """Modal damping ratio: :data:`DAMPING_RATIO_DEFINITION`."""
+    whirl: str | None = None
+    """``forward`` or ``backward``: the sense of the central members' whirl in the
+    turning carrier's frame against the carrier's rotation (a translational mode of a
+    turning carrier; None otherwise, and for a degenerate pair: :func:`whirl_senses`)."""
+
+    @property
+    def damped_frequency(self) -> float:
+        """f sqrt(1 - zeta^2) [Hz] (0 when zeta >= 1, nan for an unstable mode)."""
+        if not self.frequency > 0:
+            return float("nan")
+        return self.frequency * float(np.sqrt(max(0.0, 1.0 - self.damping_ratio**2)))
 
 
 @dataclass(frozen=True)
@@ -79,13 +116,19 @@ class ModalReport:
 
     def to_dict(self, shapes: bool = True) -> dict:
         """JSON-serialisable summary (shapes as real numbers, or [re, im] pairs for the
-        complex modes of a rotating frame)."""
+        complex modes of a rotating frame), with a ``units`` entry; ``motion`` and ``whirl``
+        only for a model with planets (they describe a planetary stage)."""
         out = []
+        truncated = False
         for r in self.rows:
-            d = dict(mode=r.mode, frequency_Hz=r.frequency, group=r.group,
+            truncated |= len(r.strain_energy) > STRAIN_ENERGY_LISTED
+            d = dict(mode=r.mode, frequency_Hz=r.frequency,
+                     damping_ratio=_finite(r.damping_ratio),
+                     damped_frequency_Hz=_finite(r.damped_frequency), group=r.group,
                      multiplicity=r.multiplicity, type=r.type,
-                     strain_energy={k: v for k, v in list(r.strain_energy.items())[:6]},
-                     motion=r.motion)
+                     strain_energy=dict(list(r.strain_energy.items())[:STRAIN_ENERGY_LISTED]))
+            if r.type is not None:
+                d.update(motion=r.motion, whirl=r.whirl)
             if shapes:
                 sh = self.solution.mode_shapes[:, r.mode - 1]
                 if np.iscomplexobj(sh):
@@ -94,8 +137,14 @@ class ModalReport:
                 else:
                     d["shape"] = {n: float(v) for n, v in zip(self.dof_names, sh)}
             out.append(d)
+        units = dict(frequency_Hz="Hz", damped_frequency_Hz="Hz", damping_ratio="1",
+                     strain_energy="1 (share of the group's strain energy)",
+                     shape=SHAPE_UNITS, normalisation=NORMALISATION)
+        if truncated:
+            units["strain_energy"] += (f"; the {STRAIN_ENERGY_LISTED} largest shares of each "
+                                       f"group (--out keeps every element's)")
         return dict(rigid_body_modes=self.rigid_modes, rotating_frame=self.rotating_frame,
-                    modes=out)
+                    damping_ratio=DAMPING_RATIO_DEFINITION, units=units, modes=out)
 
     def to_dataset(self):
         """The modes as an xarray Dataset (frequencies, multiplicity, type, group
@@ -103,14 +152,20 @@ class ModalReport:
         import xarray as xr
 
         sol = self.solution
-        phi = np.asarray(sol.mode_shapes)
         mode = [r.mode for r in self.rows]
+        phi = np.asarray(sol.mode_shapes)[:, [m - 1 for m in mode]]  # the kept modes
         elements = list(sol.element_names)
         energy = np.array([[r.strain_energy.get(e, 0.0) for e in elements]
                            for r in self.rows]).reshape(len(self.rows), len(elements))
         return xr.Dataset(
             {"frequency": (("mode",), [r.frequency for r in self.rows],
                            {"units": "Hz", "long_name": "natural frequency"}),
+             "damping_ratio": (("mode",), [r.damping_ratio for r in self.rows],
+                               {"units": "1", "long_name": "modal damping ratio, "
+                                + DAMPING_RATIO_DEFINITION}),
+             "damped_frequency": (("mode",), [r.damped_frequency for r in self.rows],
+                                  {"units": "Hz", "long_name": "damped natural frequency "
+                                   "f sqrt(1 - zeta^2) of the damping-ratio estimate"}),
              "multiplicity": (("mode",), [r.multiplicity for r in self.rows],
                               {"units": "1", "long_name": "modes of equal frequency"}),
              "group": (("mode",), [r.group for r in self.rows],
@@ -118,19 +173,29 @@ class ModalReport:
              "type": (("mode",), [r.type or "" for r in self.rows],
                       {"long_name": "mode type of a planetary stage (rotational, translational, "
                                    "planet, mixed); empty for a model without one"}),
+             "whirl": (("mode",), [r.whirl or "" for r in self.rows],
+                       {"long_name": "whirl of a translational mode of a turning carrier "
+                        "in its frame against its rotation (forward, backward); empty "
+                        "otherwise"}),
              "strain_energy": (("mode", "element"), energy,
                                {"units": "1", "long_name": "share of the group's strain "
                                 "energy (basis-independent)"}),
              "shape_real": (("dof", "mode"), np.real(phi),
-                            {"units": "m or rad per sqrt(kg)",
+                            {"units": SHAPE_UNITS, "normalisation": NORMALISATION,
                              "long_name": "mass-normalised mode shape, real part"}),
              "shape_imag": (("dof", "mode"), np.imag(phi) if np.iscomplexobj(phi)
                             else np.zeros_like(phi),
-                            {"units": "m or rad per sqrt(kg)",
+                            {"units": SHAPE_UNITS, "normalisation": NORMALISATION,
                              "long_name": "mass-normalised mode shape, imaginary part"})},
-            coords={"mode": mode, "dof": list(self.dof_names), "element": elements},
+            coords={"mode": mode, "dof": list(self.dof_names), "element": elements,
+                    "shape_unit": ("dof", [shape_unit(n) for n in self.dof_names],
+                                   {"long_name": "unit of the shape on this DOF"})},
             attrs={"rigid_body_modes": self.rigid_modes,
                    "rotating_frame": int(self.rotating_frame)})
+
+
+def _finite(x: float) -> float | None:
+    return float(x) if np.isfinite(x) else None
 
 
 def _groups(freqs: np.ndarray, rtol: float) -> list[list[int]]:
@@ -143,7 +208,49 @@ def _groups(freqs: np.ndarray, rtol: float) -> list[list[int]]:
     return groups
 
 
-def classify(structure, sol, *, rtol: float = 1e-6, tol: float = 1e-6) -> list[ModeRow]:
+#: |sum m Im(U x conj U) . axis| / sum m |U|^2 above which a mode whirls (1: circular
+#: orbits; 0: straight lines, the real modes of a degenerate pair)
+WHIRL_CIRCULARITY = 0.5
+
+
+def whirl_senses(structure, sol, kin) -> dict[int, int]:
+    """0-based mode -> +1 (-1) when the central members (not planets) whirl in (against)
+    the sense of the turning carrier's rotation in its frame, from the complex shape:
+    the whirl orbit's angular momentum ``sum m Im(U x conj U)`` along the carrier's axis
+    (``q = Re(phi e^(i omega t))``), U the member's complex translation.  0 for a mode
+    whose orbits are not circular enough (:data:`WHIRL_CIRCULARITY`: the real shapes of
+    a degenerate pair of a carrier at rest, or a model without a rotating frame); {} for
+    a model without exactly one turning carrier."""
+    carriers = getattr(kin, "carriers", {})
+    if len(carriers) != 1:
+        return {}
+    (carrier, planets), = carriers.items()
+    w_c = kin.bodies[carrier].speed
+    phi = np.asarray(sol.mode_shapes)
+    if w_c == 0 or not np.iscomplexobj(phi) or not phi.size:
+        return {}
+    axis = np.asarray(kin.bodies[carrier].axis, float)
+    names = list(structure.dof_names)
+    mass = 1.0 / np.asarray(structure.inv_mass)
+    L = np.zeros(phi.shape[1])
+    total = np.zeros(phi.shape[1])
+    for b in kin.bodies:
+        if b in planets or kin.frames.get(b) != carrier:
+            continue
+        rows = [names.index(f"{b}.{c}") if f"{b}.{c}" in names else -1 for c in "xyz"]
+        if sum(r >= 0 for r in rows) < 2:
+            continue
+        U = np.array([phi[r] if r >= 0 else np.zeros(phi.shape[1]) for r in rows])
+        m = mass[next(r for r in rows if r >= 0)]
+        L += m * np.imag(np.cross(U, U.conj(), axis=0).T @ axis)
+        total += m * np.real(np.sum(U * U.conj(), axis=0))
+    ratio = np.divide(L, total, out=np.zeros_like(L), where=total > 0)
+    sense = np.where(ratio > WHIRL_CIRCULARITY, 1, np.where(ratio < -WHIRL_CIRCULARITY, -1, 0))
+    return {k: int(v) * int(np.sign(w_c)) for k, v in enumerate(sense)}
+
+
+def classify(structure, sol, *, rtol: float = 1e-6, tol: float = 1e-6,
+             kin=None) -> list[ModeRow]:
     """Group and label the modes of ``sol`` (a ModalSolution of ``structure``).
 
     ``planet``: the central members (not planets) carry less than ``tol`` of the group's
@@ -152,7 +259,8 @@ def classify(structure, sol, *, rtol: float = 1e-6, tol: float = 1e-6) -> list[M
     that cannot translate): with equally spaced planets they fall at the planet modes'
     frequency, so such a model lists planet groups of multiplicity N - 1, not N - 3 (2
     for N = 3, which has no planet modes of Lin & Parker's kind).  Not a relabelling: the
-    central members do not move in these modes.
+    central members do not move in these modes.  With ``kin`` (the model's kinematics),
+    a translational mode of a turning carrier gets its whirl (:func:`whirl_senses`).
     """
     meta = structure.metadata
     planets = set(meta.get("planet_bodies", {}))
@@ -169,6 +277,8 @@ def classify(structure, sol, *, rtol: float = 1e-6, tol: float = 1e-6) -> list[M
     phi = np.asarray(sol.mode_shapes)
     freqs = np.asarray(sol.frequencies)
     frac = np.asarray(sol.strain_energy_fraction)
+    zeta = np.asarray(sol.damping_ratios)
+    senses = whirl_senses(structure, sol, kin) if kin is not None and planets else {}
     rows: list[ModeRow] = []
     for gi, members in enumerate(_groups(freqs, rtol), start=1):
         w = mass[:, None] * np.abs(phi[:, members]) ** 2
@@ -195,11 +305,14 @@ def classify(structure, sol, *, rtol: float = 1e-6, tol: float = 1e-6) -> list[M
         energy = {structure.element_names[k]: float(share[k]) for k in order
                   if share[k] > 1e-12}
         for k in members:
+            sense = senses.get(k, 0) if kind == "translational" else 0
             rows.append(ModeRow(mode=k + 1, frequency=float(freqs[k]), group=gi,
                                 multiplicity=len(members), type=kind,
                                 strain_energy=energy,
                                 motion={"central_rotation": c_rot,
-                                        "central_translation": c_tr, "planets": p}))
+                                        "central_translation": c_tr, "planets": p},
+                                damping_ratio=float(zeta[members].mean()),
+                                whirl={1: "forward", -1: "backward"}.get(sense)))
     return rows
 
 
@@ -240,7 +353,7 @@ def model_modes(model, *, rotating_frame: bool = True, below: float | None = Non
     kin = solve_kinematics(model)
     st = assemble(model, kin, options={"rotating_frame": rotating_frame})
     sol = modal_analysis(st, static_equilibrium(st).q)
-    rows = classify(st, sol, rtol=rtol)
+    rows = classify(st, sol, rtol=rtol, kin=kin)
     if below is not None:
         rows = [r for r in rows if r.frequency < below]
     if count is not None and len(rows) > count:
@@ -268,20 +381,34 @@ class PhasedStage:
     sun_teeth: int
     meshes: frozenset[str]
     """The stage's sun-planet and ring-planet meshes."""
+    sun_sense: int = 0
+    """+1 (-1): the sun turns relative to the carrier in (against) the carrier's sense of
+    rotation; 0: the carrier does not turn (the whirl of a mode is not used)."""
 
-    def excites(self, order: int, mode_type: str | None) -> bool:
+    def excites(self, order: int, mode_type: str | None, whirl: str | None = None) -> bool:
         """Whether mesh harmonic ``order`` excites a mode of ``mode_type``: Parker & Lin
         2004 ("Mesh phasing relationships in planetary and epicyclic gears", J. Mech.
         Des. 126), with equally spaced planets harmonic l excites the rotational modes
         only when l z_s / N is an integer, the translational modes only when
         (l z_s +- 1) / N is, the planet modes only when neither is.  A mode of no pure
-        type (``mixed``, None) is always excited."""
+        type (``mixed``, None) is always excited.
+
+        With a turning carrier the translational pairs split into whirls (``whirl``
+        forward or backward against the carrier's rotation): the planets' net mesh force
+        of harmonic l turns in the carrier's frame in the sense of the sun's rotation
+        relative to the carrier when (l z_s - 1) / N is an integer, against it when
+        (l z_s + 1) / N is (sum_n cos(l omega t - l z_s psi_n) e^(i psi_n)), and excites
+        only the whirl of its sense (a forced response of a 3-planet stage: ~900 times
+        less on the other)."""
         n, lz = self.planets, order * self.sun_teeth
         rot = lz % n == 0
         trans = (lz + 1) % n == 0 or (lz - 1) % n == 0
         if mode_type == "rotational":
             return rot
         if mode_type == "translational":
+            if whirl in ("forward", "backward") and self.sun_sense:
+                with_sun = (whirl == "forward") == (self.sun_sense > 0)
+                return (lz - 1) % n == 0 if with_sun else (lz + 1) % n == 0
             return trans
         if mode_type == "planet":
             return not (rot or trans)
@@ -343,8 +470,11 @@ def phased_stages(model, kin) -> list[PhasedStage]:
     if not any(any(d != "theta" for d in _dofs(model, b)) for b in (sun, ring, carrier)):
         return []
     gear_geometry(model.gears[sun])  # a sun of valid geometry
+    # the sun's speed relative to the carrier, about the carrier's axis, against its speed
+    w_rel = kin.relative_speed(sun, carrier) * float(np.asarray(kin.bodies[sun].axis) @ axis)
+    sense = int(np.sign(w_rel * c.speed))
     return [PhasedStage(carrier=carrier, planets=n, sun_teeth=model.gears[sun].teeth,
-                        meshes=frozenset(meshes))]
+                        meshes=frozenset(meshes), sun_sense=sense)]
 
 
 def _dofs(model, body) -> list[str]:
@@ -352,7 +482,10 @@ def _dofs(model, body) -> list[str]:
     return list(spec.dofs) if spec is not None else []
 
 
-def phasing_suppresses(stages, mesh: str, order: int, mode_type: str | None) -> bool:
-    """Whether harmonic ``order`` of ``mesh`` leaves a mode of ``mode_type`` unexcited by
-    the planets' mesh phasing (Parker & Lin 2004; :meth:`PhasedStage.excites`)."""
-    return any(mesh in st.meshes and not st.excites(order, mode_type) for st in stages)
+def phasing_suppresses(stages, mesh: str, order: int, mode_type: str | None,
+                       whirl: str | None = None) -> bool:
+    """Whether harmonic ``order`` of ``mesh`` leaves a mode of ``mode_type`` (and
+    ``whirl``) unexcited by the planets' mesh phasing (Parker & Lin 2004;
+    :meth:`PhasedStage.excites`)."""
+    return any(mesh in st.meshes and not st.excites(order, mode_type, whirl)
+               for st in stages)

@@ -213,7 +213,7 @@ def test_campbell_crossings_at_hand_computed_speeds():
             if 0.5 * w_model <= w <= 1.5 * w_model:
                 hand.append((i + 1, h, w * 60 / (2 * math.pi)))
     got = [(c["mode"], c["order"], c["speed_rpm"]) for c in crossings
-           if c["source"] in ("mesh m11", "mesh m21")]
+           if c.get("meshes") == ["m11", "m21"]]
     assert len(got) == len(hand) > 0
     for (mo, h, rpm), (mo2, h2, rpm2) in zip(sorted(hand), sorted(got), strict=True):
         assert (mo, h) == (mo2, h2) and rpm2 == pytest.approx(rpm, rel=1e-9)

@@ -310,7 +310,7 @@ def _modes(res) -> str:
     for r in rep.rows:
         f = float(r.frequency)
         near = [f"{k}×{name}" + (" (suppressed by phasing)" if phasing_suppresses(
-                    stages, name, k, r.type) else "")
+                    stages, name, k, r.type, r.whirl) else "")
                 for name, fm in mesh_f.items() for k in range(1, top[name] + 1)
                 if abs(f - k * fm) <= NEAR_FRACTION * k * fm]
         energy = ", ".join(f"{n} {100 * v:.0f} %" for n, v in list(r.strain_energy.items())[:3])

@@ -41,12 +41,15 @@ class ModalSolution:
     """(n_modes,) natural frequencies [Hz] of the elastic modes; a negative value marks
     a statically unstable mode (negative stiffness), its magnitude sqrt(|lambda|)/2 pi."""
     mode_shapes: np.ndarray
-    """(n_dof, n_modes) mass-normalised mode shapes [m or rad per sqrt(kg)] (complex
-    with a gyroscopic matrix: phi^H M phi = 1)."""
+    """(n_dof, n_modes) mass-normalised mode shapes, phi^H M phi = 1 (complex with a
+    gyroscopic matrix): [kg^-1/2] on translations, [rad m^-1 kg^-1/2] on rotations
+    (M in kg and kg m^2; the modal coordinate in m kg^1/2)."""
     strain_energy_fraction: np.ndarray
     """(n_modes, n_el) share of each element in the mode's strain energy (rows sum to 1)."""
     damping_ratios: np.ndarray
-    """(n_modes,) modal damping estimate phi^T C phi / (2 omega) (coupling ignored)."""
+    """(n_modes,) modal damping estimate Re(phi^H C phi) / (2 omega + Im(phi^H G phi)):
+    the first-order change of the eigenvalue by C, the coupling of modes through C
+    ignored (phi^T C phi / (2 omega) without a gyroscopic matrix G)."""
     rigid_modes: np.ndarray
     """(n_dof, n_rigid) mass-normalised rigid-body modes."""
     active: np.ndarray
@@ -119,9 +122,9 @@ def modal_analysis(structure: Structure, q=None, *, rigid_tolerance: float = 1e-
     for _, _, h2, rows in sp_tangent:
         K = K + rows.T @ h2 @ rows
     C = V.T @ (np.where(active, s.damping, 0.0)[:, None] * V) + np.diag(s.ground_damping)
-    if s.n_gyroscopic:
-        freqs, phi_e, phi_r, lam_e = _gyroscopic_modes(K, s.gyroscopic_matrix(), s.inv_mass,
-                                                       rigid_tolerance)
+    Gm = s.gyroscopic_matrix() if s.n_gyroscopic else None
+    if Gm is not None:
+        freqs, phi_e, phi_r, lam_e = _gyroscopic_modes(K, Gm, s.inv_mass, rigid_tolerance)
     else:
         d = np.sqrt(s.inv_mass)
         A = d[:, None] * K * d[None, :]
@@ -142,8 +145,14 @@ def modal_analysis(structure: Structure, q=None, *, rigid_tolerance: float = 1e-
     total = energy.sum(axis=1, keepdims=True)
     with np.errstate(invalid="ignore", divide="ignore"):
         fraction = np.where(total != 0, energy / total, 0.0)
+    # (lam^2 M + lam (G + C) + K) phi = 0, lam = i omega + d: phi^H (2 lam M + G) phi dlam
+    # = -lam phi^H C phi gives -Re(dlam) / omega = phi^H C phi / (2 omega + Im(phi^H G phi))
+    # (phi^H M phi = 1; the left eigenvector of the undamped gyroscopic problem is phi)
     omega = np.sqrt(np.abs(lam_e))
-    zeta = (np.real(np.einsum("im,ij,jm->m", phi_e.conj(), C, phi_e)) / (2 * omega)
+    denom = 2 * omega
+    if Gm is not None and omega.size:
+        denom = denom + np.imag(np.einsum("im,ij,jm->m", phi_e.conj(), Gm, phi_e))
+    zeta = (np.real(np.einsum("im,ij,jm->m", phi_e.conj(), C, phi_e)) / denom
             if omega.size else np.zeros(0))
     return ModalSolution(frequencies=freqs, mode_shapes=phi_e,
                          strain_energy_fraction=fraction, damping_ratios=zeta,

@@ -390,12 +390,14 @@ def campbell_command(m, start, stop, plot, as_json, console, json_default):
         from torquesplit.steady.plot import campbell_figure, save
 
         save(campbell_figure(ds), plot)
-    from torquesplit.steady.maps import split_suppressed
+    from torquesplit.steady.maps import mode_kind, split_suppressed
 
     critical, suppressed = split_suppressed(crossings)
     if as_json:
         out = {"critical_speeds": critical,
-               "natural_frequencies_Hz": ds["natural_frequency"].values[0].tolist()}
+               "natural_frequencies_Hz": ds["natural_frequency"].values[0].tolist(),
+               # a turning carrier's frequencies change with speed: those at --from
+               "natural_frequencies_at_speed_rpm": float(ds["speed_rpm"].values[0])}
         if suppressed:
             out["suppressed_by_mesh_phasing"] = suppressed
         _emit(out, json_default)
@@ -410,7 +412,8 @@ def campbell_command(m, start, stop, plot, as_json, console, json_default):
     for col in cols + ["strain energy (largest shares)"]:
         t.add_column(_h(col))
     for c in crossings:
-        extra = ([c.get("mode_type") or "-", "suppressed" if c["suppressed"] else "excited"]
+        extra = ([mode_kind(c) if c.get("mode_type") else "-",
+                  "suppressed" if c["suppressed"] else "excited"]
                  if phased else [])
         t.add_row(f"{c['speed_rpm']:.6g}", str(c["mode"]), f"{c['frequency_Hz']:.6g}",
                   f"{c['order']} x {c['source']}", *extra,

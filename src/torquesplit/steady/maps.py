@@ -198,7 +198,7 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
                                for c in critical],
         **({"suppressed_speeds_rpm": [c["speed_rpm"] for c in suppressed],
             "suppressed_speed_labels": [
-                f"mode {c['mode']} x {c['order']} {c['source']} ({c['mode_type']} mode: "
+                f"mode {c['mode']} x {c['order']} {c['source']} ({mode_kind(c)} mode: "
                 f"suppressed by mesh phasing, Parker & Lin 2004)" for c in suppressed]}
            if suppressed else {}),
         loads="torques held at the model's values",
@@ -280,28 +280,40 @@ class _Phasing:
     def __init__(self, model, kin):
         from torquesplit.modes import phased_stages
 
+        self.kin = kin
         self.stages = phased_stages(model, kin)
+        self.groups = mesh_groups(kin)
 
-    def types(self, structure, sol) -> dict[int, str | None]:
-        """1-based mode -> type (only for a model with a phased stage)."""
+    def types(self, structure, sol) -> dict[int, tuple[str | None, str | None]]:
+        """1-based mode -> (type, whirl) (only for a model with a phased stage)."""
         if not self.stages:
             return {}
         from torquesplit.modes import classify
 
-        return {r.mode: r.type for r in classify(structure, sol)}
+        return {r.mode: (r.type, r.whirl) for r in classify(structure, sol, kin=self.kin)}
 
-    def mark(self, crossing: dict, types: dict[int, str | None]) -> dict:
+    def mark(self, crossing: dict, types: dict[int, tuple[str | None, str | None]]) -> dict:
+        meshes = self.groups.get(crossing["source"])
+        if meshes:
+            crossing["meshes"] = list(meshes)
         if not self.stages:
             return crossing
         from torquesplit.modes import phasing_suppresses
 
-        kind = types.get(crossing["mode"])
-        src = crossing["source"]
-        mesh = src[len("mesh "):] if src.startswith("mesh ") else None
+        kind, whirl = types.get(crossing["mode"], (None, None))
         crossing["mode_type"] = kind
-        crossing["suppressed"] = bool(mesh is not None and phasing_suppresses(
-            self.stages, mesh, crossing["order"], kind))
+        if whirl:
+            crossing["whirl"] = whirl
+        # suppressed when no mesh of the line's group excites the mode
+        crossing["suppressed"] = bool(meshes) and all(phasing_suppresses(
+            self.stages, m, crossing["order"], kind, whirl) for m in meshes)
         return crossing
+
+
+def mode_kind(crossing: dict) -> str:
+    """The crossing's mode type, with its whirl (``translational, forward whirl``)."""
+    kind = str(crossing.get("mode_type"))
+    return kind + (f", {crossing['whirl']} whirl" if crossing.get("whirl") else "")
 
 
 def split_suppressed(crossings: list[dict]) -> tuple[list[dict], list[dict]]:
@@ -328,32 +340,74 @@ def mesh_orders(table) -> int:
     return int(min(MAX_ORDERS, max(MIN_ORDERS, strong[-1] + 1)))
 
 
+def mesh_groups(kin) -> dict[str, list[str]]:
+    """Excitation-line label -> the meshes of one mesh frequency (one line stands for
+    them all): ``mesh NAME`` for one, ``meshes a1..4, b1..4`` (:func:`names_label`) for
+    several."""
+    by_f: dict[float, list[str]] = {}
+    for name, mk in kin.meshes.items():
+        by_f.setdefault(round(mk.frequency, 9), []).append(name)
+    return {(f"mesh {g[0]}" if len(g) == 1 else f"meshes {names_label(g)}"): g
+            for g in by_f.values()}
+
+
+def names_label(names) -> str:
+    """Names with a common stem and numbered ends in short: ``a_planet1..4, b_planet1..4``
+    (a run of consecutive numbers as first..last)."""
+    import re
+
+    stems: dict[str, list[int]] = {}
+    plain: list[str] = []
+    order: list[str] = []
+    for n in names:
+        m = re.fullmatch(r"(.*?)(\d+)", n)
+        if m is None:
+            plain.append(n)
+            order.append(n)
+            continue
+        if m.group(1) not in stems:
+            order.append(m.group(1))
+        stems.setdefault(m.group(1), []).append(int(m.group(2)))
+    out = []
+    for key in order:
+        if key in plain:
+            out.append(key)
+            continue
+        nums = sorted(stems[key])
+        run = nums == list(range(nums[0], nums[0] + len(nums)))
+        out.append(f"{key}{nums[0]}..{nums[-1]}" if run and len(nums) > 2 else
+                   ", ".join(f"{key}{k}" for k in nums))
+    return ", ".join(out)
+
+
 def _order_lines(kin, model, orders, structure=None):
     """(label, order, Hz per rad/s of input speed) of every excitation line: orders
     1..``orders`` of each mesh frequency (None: :func:`mesh_orders` of the mesh's table),
-    and the rotation of every gear."""
+    and the rotation of every gear in the frame its translations are measured in (its
+    speed relative to a turning carrier, as its eccentricity is applied and as the
+    carrier-frame natural frequencies are: :func:`~torquesplit.model.kinematics.
+    support_frame`)."""
+    from torquesplit.model.kinematics import support_frame
+
     w_ref = reference_speed(model)
     lines = []
-    seen = set()
     names = list(structure.element_names) if structure is not None else []
-    for name, mk in kin.meshes.items():
-        key = round(mk.frequency, 9)
-        if key in seen:
-            continue
-        seen.add(key)
+    for label, group in mesh_groups(kin).items():
         top = orders
         if top is None:
-            top = (mesh_orders(structure.stiffness_table[names.index(name)])
-                   if name in names else MIN_ORDERS)
+            top = max(mesh_orders(structure.stiffness_table[names.index(n)])
+                      if n in names else MIN_ORDERS for n in group)
         for h in range(1, top + 1):
-            lines.append((f"mesh {name}", h, mk.frequency / w_ref))
+            lines.append((label, h, kin.meshes[group[0]].frequency / w_ref))
     shafts = set()
-    for b, bk in kin.bodies.items():
-        key = round(abs(bk.speed), 9)
-        if key in shafts or bk.speed == 0:
+    for b in kin.bodies:
+        frame, f_rot, f_frame = support_frame(kin, b)
+        key = round(f_rot or 0.0, 9)
+        if key in shafts or not f_rot:
             continue
         shafts.add(key)
-        lines.append((f"rotation of {b}", 1, abs(bk.speed) / (2 * math.pi) / w_ref))
+        where = f" relative to {frame}" if f_frame else ""
+        lines.append((f"rotation of {b}{where}", 1, f_rot / w_ref))
     return lines
 
 
@@ -408,6 +462,7 @@ def campbell(model, start: float, stop: float, *, points: int = 41,
                 "mode": np.arange(1, F.shape[1] + 1),
                 "line": [f"{o} x {lab}" for lab, o, _ in lines]})
     ds.attrs["model"] = model.model.name
+    ds.attrs["model_speed_rpm"] = w_ref * RPM  # the drive's speed: the operating point
     label = lambda c: (f"mode {c['mode']} ({c['frequency_Hz']:.5g} Hz) x "  # noqa: E731
                        f"{c['order']} {c['source']}")
     ds.attrs["critical_speeds_rpm"] = [c["speed_rpm"] for c in critical]
@@ -416,7 +471,7 @@ def campbell(model, start: float, stop: float, *, points: int = 41,
         # crossings that the planets' mesh phasing leaves unexcited (Parker & Lin 2004)
         ds.attrs["suppressed_speeds_rpm"] = [c["speed_rpm"] for c in suppressed]
         ds.attrs["suppressed_speed_labels"] = [
-            f"{label(c)} ({c['mode_type']} mode: suppressed by mesh phasing)"
+            f"{label(c)} ({mode_kind(c)} mode: suppressed by mesh phasing)"
             for c in suppressed]
     return ds, crossings
 

@@ -168,12 +168,16 @@ def campbell_figure(ds):
     Labels that would print over each other share one text: modes of equal frequency
     ('6, 7': a degenerate pair), excitation lines that end at the same frequency ('10x in1
     = 20x out1': coinciding harmonics).  Critical speeds are grey dotted lines with their
-    speeds (the shaft orders keep the colours)."""
-    fig = _figure(9, 5.5)
+    speeds (staggered in rows; one too close to the others in every row is left
+    unlabelled), the model's operating speed a solid line; the legend sits under the
+    axes, clear of the lines' labels."""
+    import textwrap
+
+    fig = _figure(9, 6.5)
     ax = fig.add_subplot()
     rpm = ds["speed_rpm"].values
     fmax = float(np.nanmax(ds["excitation_frequency"].values))
-    near = 0.012 * fmax * 1.05  # two labels closer than this (in Hz) would overlap
+    near = 0.02 * fmax * 1.05  # two labels closer than this (in Hz) would overlap
     ends: list[tuple[float, list[str]]] = []
     for m in range(ds.sizes["mode"]):
         fn = ds["natural_frequency"].values[:, m]
@@ -181,54 +185,94 @@ def campbell_figure(ds):
         if np.isfinite(fn[-1]) and 0 < fn[-1] <= fmax * 1.05:  # mode number at its end
             _merge_label(ends, float(fn[-1]), f"{int(ds['mode'].values[m])}", near)
     for f, labels in ends:
-        ax.annotate(", ".join(labels), (rpm[-1], f), fontsize=6, xytext=(2, 0),
+        ax.annotate(", ".join(labels), (rpm[-1], f), fontsize=7, xytext=(3, 0),
                     textcoords="offset points", va="center")
-    # one colour per source (a mesh: its orders 1..k, labelled at the top; a shaft), one
-    # legend entry each
+    # one colour per source (a mesh or a group of meshes of one frequency: its orders
+    # 1..k, labelled inside the axes at their ends; a shaft), one legend entry each
     sources: dict[str, list[tuple[int, int]]] = {}
     for j, lab in enumerate(ds["line"].values):
         order, _, source = str(lab).partition(" x ")
         sources.setdefault(source, []).append((j, int(order)))
+    several = sum(len(m) > 1 for m in sources.values()) > 1
     tops: list[tuple[float, float, list[str], str]] = []  # (x, y, labels, colour)
     for k, (source, members) in enumerate(sources.items()):
         colour = f"C{k % 10}"  # matplotlib's colour cycle
         orders = [o for _, o in members]
         label = source if orders == [1] else f"{source} x {min(orders)}..{max(orders)}"
-        short = source.replace("mesh ", "")
+        short = _short(source) if several else ""
         for i, (j, order) in enumerate(members):
             fe = ds["excitation_frequency"].values[:, j]
             ax.plot(rpm, fe, lw=0.8, ls="--", color=colour, label=label if i == 0 else None)
             inside = np.flatnonzero(fe <= fmax * 1.05)
             if len(members) > 1 and inside.size:  # the order at the line's last point
                 x, y = float(rpm[inside[-1]]), float(fe[inside[-1]])
+                text = f"{order}x {short}".strip()
                 same = next((t for t in tops if abs(t[0] - x) < 1e-9 * max(abs(x), 1.0)
                              and abs(t[1] - y) <= near), None)
                 if same is None:
-                    tops.append((x, y, [f"{order}x {short}"], colour))
+                    tops.append((x, y, [text], colour))
                 else:
-                    same[2].append(f"{order}x {short}")
-    for x, y, labels, colour in tops:
-        ax.annotate(" = ".join(labels), (x, y), fontsize=5, color=colour, xytext=(-2, 2),
-                    textcoords="offset points", ha="right" if len(labels) > 1 else "left")
-    crit = sorted(ds.attrs.get("critical_speeds_rpm", []))
-    for i, c in enumerate(crit):
-        ax.axvline(c, color="0.35", lw=0.6, ls=":",
-                   label="critical speed (a crossing)" if i == 0 else None)
-        ax.annotate(f"{c:.0f}", (c, 1.0), xycoords=ax.get_xaxis_transform(), fontsize=5,
-                    rotation=90, ha="center", va="bottom", color="0.35",
-                    xytext=(0, 2), textcoords="offset points")
+                    same[2].append(text)
+    for x, y, labels, colour in tops:  # right-aligned at the line's end: inside the axes
+        ax.annotate(" = ".join(labels), (x, y), fontsize=7, color=colour, xytext=(-3, 2),
+                    textcoords="offset points", ha="right", va="bottom")
+    rows = _critical_labels(ax, sorted(ds.attrs.get("critical_speeds_rpm", [])),
+                            float(rpm.min()), float(rpm.max()))
     # crossings that the planets' mesh phasing leaves unexcited (Parker & Lin 2004)
     for i, c in enumerate(ds.attrs.get("suppressed_speeds_rpm", [])):
         ax.axvline(c, color="0.75", lw=0.5, ls="-.",
                    label="suppressed by mesh phasing (Parker & Lin 2004)" if i == 0 else None)
+    op = ds.attrs.get("model_speed_rpm")
+    if op is not None and float(rpm.min()) <= float(op) <= float(rpm.max()):
+        ax.axvline(float(op), color="C3", lw=1.4, alpha=0.7,
+                   label=f"operating speed (the model's drive): {float(op):.5g} rpm")
     ax.set_ylim(0, fmax * 1.05)
+    ax.set_xlim(float(rpm.min()), float(rpm.max()))
     ax.set_xlabel("input speed [rpm]")
     ax.set_ylabel("frequency [Hz]")
-    ax.set_title(f"{ds.attrs.get('model', '')}: Campbell diagram (solid: natural "
-                 f"frequencies, numbered; dashed: excitation orders; dotted: critical "
-                 f"speeds [rpm])", fontsize=9, pad=22)
-    ax.legend(fontsize=6, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    name = textwrap.shorten(str(ds.attrs.get("model", "")), 90, placeholder="...")
+    ax.set_title(f"{name}: Campbell diagram\nsolid: natural frequencies (numbered); dashed: "
+                 "excitation orders; dotted: critical speeds [rpm]", fontsize=9,
+                 pad=6 + 26 * max(rows, 1))
+    ncol = 2 if len(ax.get_legend_handles_labels()[1]) > 3 else 1
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.1), ncol=ncol,
+              frameon=False)
     return fig
+
+
+#: a critical speed's label [points]: rotated text of this size, and the least gap
+#: between two labels of one row
+CRITICAL_FONT, CRITICAL_GAP, CRITICAL_ROWS = 7, 9.0, 3
+
+
+def _critical_labels(ax, crit, lo, hi) -> int:
+    """Draw the critical speeds ``crit`` [rpm] as dotted lines, their speeds above the
+    axes in up to CRITICAL_ROWS rows (a label goes to the first row where it clears the
+    last one by CRITICAL_GAP points; none is printed where no row has room).  Returns the
+    rows used."""
+    width_pt = ax.figure.get_figwidth() * 72 * 0.8  # about the axes' width
+    last: list[float] = []
+    for i, c in enumerate(crit):
+        ax.axvline(c, color="0.35", lw=0.6, ls=":",
+                   label="critical speed (a crossing)" if i == 0 else None)
+        x = (c - lo) / max(hi - lo, 1e-12) * width_pt
+        row = next((r for r, p in enumerate(last) if x - p >= CRITICAL_GAP), None)
+        if row is None and len(last) < CRITICAL_ROWS:
+            row = len(last)
+            last.append(x)
+        if row is None:
+            continue
+        last[row] = x
+        ax.annotate(f"{c:.0f}", (c, 1.0), xycoords=ax.get_xaxis_transform(),
+                    fontsize=CRITICAL_FONT, rotation=90, ha="center", va="bottom",
+                    color="0.35", xytext=(0, 2 + 26 * row), textcoords="offset points")
+    return len(last)
+
+
+def _short(source: str) -> str:
+    """A short tag of an excitation source for a line's label."""
+    text = source.removeprefix("meshes ").removeprefix("mesh ")
+    return text if len(text) <= 18 else text[:16] + "..."
 
 
 def _merge_label(ends: list, y: float, text: str, near: float) -> None:
