@@ -15,7 +15,7 @@ Each child prints one JSON line with, in seconds:
 * ``compile_dopri`` -- then ``compile_kernels(("dopri",))``: the Dormand-Prince kernels,
   compiled on the first adaptive run; ``compile + compile_dopri`` is every kernel;
 * ``kernels`` -- numba's own compile timers per kernel (inclusive of its callees);
-* ``first_run`` -- then assembling seed 001 and integrating 1000 RK4 steps;
+* ``first_run`` -- then assembling the Ji & Li mill drive and integrating 1000 RK4 steps;
 * ``total`` -- wall time from the start of the child to the end of that first run
   (the interpreter start-up itself excluded).
 """

@@ -1,10 +1,10 @@
 """The GPU ensemble backend (torquesplit.gpu); writes benchmarks/GPU_RESULTS.json / .md.
 
     python benchmarks/bench_gpu.py              # everything that this machine can run
-    python benchmarks/bench_gpu.py --quick      # 1,000-case Monte Carlo, 100 seed 000 cases
+    python benchmarks/bench_gpu.py --quick      # 1,000-case Monte Carlo, 100 Liu et al. 2021 cases
     python benchmarks/bench_gpu.py layout       # one part: layout, monte_carlo, liu2021
 
-Not part of the test suite; nothing here asserts a threshold.  The issue's targets are
+Not part of the test suite; nothing here asserts a threshold.  The design targets are
 printed beside the measured values.  Parts that need a CUDA device are recorded as not
 run, with the reason, where there is none (never estimated).
 
@@ -14,7 +14,7 @@ layout       Needs no device, only NVIDIA's compilers (libNVVM, ptxas): for ever
              one-case-per-thread stays in registers as the DOF count grows.
 monte_carlo  Device: Ji & Li's drive (14 DOF), a Monte Carlo over the backlash of its
              four meshes and their damping ratios, 10 s simulated per case (the
-             issue's 10,000-case study; --quick 1,000), ``Study.run(backend="gpu")`` end
+             design target's 10,000-case study; --quick 1,000), ``Study.run(backend="gpu")`` end
              to end (CPU set-up of every case incl. its static equilibrium, kernel,
              metrics, store), the kernel time alone, sample-steps per second, the FP32
              run with its error; the CPU study runner on 2 workers on a subsample of the
@@ -297,9 +297,9 @@ def _markdown(r: dict) -> str:
             lines.append(f"| {k} | {v['dof']} | {v['cases']} | {v['prepare_ms']:.1f} | "
                          f"{v['plan_ms']:.1f} | {v['prepare_ms'] + v['plan_ms']:.1f} |")
         lines.append("")
-    for part, target in (("monte_carlo", "issue target: 10,000 cases <= 2 s end to end, "
+    for part, target in (("monte_carlo", "design target: 10,000 cases <= 2 s end to end, "
                                          "kernel <= 0.6 s, >= 300x the 2-core CPU runner"),
-                         ("liu2021", "issue target: 1,000 cases <= 60 s")):
+                         ("liu2021", "design target: 1,000 cases <= 60 s")):
         if part not in r:
             continue
         v = r[part]

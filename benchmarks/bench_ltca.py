@@ -1,4 +1,4 @@
-"""Speed of the loaded tooth contact analysis (issue 11 targets printed beside).
+"""Speed of the loaded tooth contact analysis (design targets printed beside).
 
     python benchmarks/bench_ltca.py [--repeat 3] [--output benchmarks/LTCA_RESULTS.md]
 

@@ -1,11 +1,11 @@
-"""Peak memory of a long seed 001 run with streaming outputs, in a fresh process.
+"""Peak memory of a long Ji & Li mill drive run with streaming outputs, in a fresh process.
 
 :func:`measure` runs this file as a child process (so that nothing measured earlier in
 the benchmark run inflates its peak) and reads one JSON line back.  The child loads the
-kernels (from numba's cache), assembles seed 001, then integrates ``--steps`` RK4 steps
-at 100 steps per shortest mesh period with the outputs ``simulate`` streams: per-cycle
-statistics of every mesh and a history of every element force and DOF every
-``--record-every`` steps.  It reports, in MiB:
+kernels (from numba's cache), assembles the Ji & Li mill drive, then integrates
+``--steps`` RK4 steps at 100 steps per shortest mesh period with the outputs
+``simulate`` streams: per-cycle statistics of every mesh and a history of every element
+force and DOF every ``--record-every`` steps.  It reports, in MiB:
 
 * ``tracemalloc_peak`` -- the largest Python/numpy allocation total during the
   ``integrate`` call (numpy registers its buffers with tracemalloc; numba's scratch

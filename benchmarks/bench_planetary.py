@@ -9,9 +9,9 @@ default (generated) right-hand side and the general kernel, best of ``--repeat``
   centripetal springs, pin preload) and without it (``rotating_frame=False``: the same
   model in a stationary frame) -- their ratio is the cost of the rotating-frame terms;
 * the generated 2- and 4-branch split models of ``models.py`` (20 and 32 DOFs), the
-  split models the issue compares ns per DOF per step with.
+  split models the design targets compare ns per DOF per step with.
 
-Targets (issue 16): ns per DOF per step of the planetary no worse than the split
+Design targets: ns per DOF per step of the planetary no worse than the split
 models'; rotating-frame terms < 15 % per step.  Nothing is asserted; the ratios are
 printed beside the targets.
 """
@@ -121,7 +121,7 @@ def main(argv=None) -> int:
             f"{r['cpu_us_per_step']:.3g} | {r['cpu_us_per_step'] / r['n_dof'] * 1e3:.3g} | "
             f"{r['cpu_us_per_step'] / r['nnz_projection'] * 1e3:.3g} | "
             f"{r['general_us_per_step']:.3g} | {r['rhs']} |")
-    lines += ["", "## Targets (issue 16)", "", "| quantity | target | measured |", "|---|---|---|"]
+    lines += ["", "## Design targets", "", "| quantity | target | measured |", "|---|---|---|"]
     for planets, rr in ratios.items():
         lines.append(f"| rotating-frame terms, cost per step, N = {planets} (turning / "
                      f"stationary frame) | < 1.15 | {rr['cpu']:.3f} (CPU), {rr['wall']:.3f} "

@@ -8,7 +8,7 @@ element loop, no generality.  It is compiled with numba (same flags as the engin
 timed in the same process as the engine, so the ratio does not depend on how loaded the
 machine is.  Because its equations come from the assembly, it measures the overhead of
 the kernels but cannot reveal an error of the assembly; the independent baseline, the
-seed 001 equations written by hand from the paper, is ``bench_transcription.py``.
+Ji & Li equations written by hand from the paper, is ``bench_transcription.py``.
 
 What the specialised code does per step, like the engine: classic RK4; mesh stiffness
 interpolated in the same periodic tables at each distinct stage time (t, t + h/2,

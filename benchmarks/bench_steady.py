@@ -23,7 +23,7 @@ and STEADY_RESULTS.json.
   converges to at the first speed) and twice as many (how far the truncation still moves
   it).  Every call as a user makes it: defaults unless stated.
 
-Not part of the test suite; nothing here asserts a threshold.  The issue's targets are
+Not part of the test suite; nothing here asserts a threshold.  The design targets are
 printed beside the measured values.
 """
 
@@ -241,8 +241,8 @@ def report(res: dict) -> str:
              f"dynamic factors move at {REF_STEPS[0]} steps per cycle (not run over the "
              f"full periods of thousands of cycles: '-').  'Arrays kept': the solution's "
              f"samples, corner instants and per-step mesh series (a long period keeps the "
-             f"meshes at every RK4 step, the rest at up to 65,536 steps).  The issue sets no "
-             f"target for Jin et al. 2019.", "",
+             f"meshes at every RK4 step, the rest at up to 65,536 steps).  The design targets "
+             f"name none for Jin et al. 2019.", "",
              "| model | excitations | method | harmonics | wall [s] | of which solver [s] | "
              "arrays kept [MiB] | dynamic factor vs reference | reference moves | target | "
              "status |",

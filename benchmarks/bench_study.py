@@ -4,7 +4,7 @@
     python benchmarks/bench_study.py --quick      # fewer Monte Carlo cases
     python benchmarks/bench_study.py diameter     # one part: diameter, monte_carlo, memory
 
-Not part of the test suite; nothing here asserts a threshold.  The issue's targets are
+Not part of the test suite; nothing here asserts a threshold.  The design targets are
 printed beside the measured values.
 
 diameter     Ji & Li's drive-shaft diameter study (28 diameters, the shipped
@@ -168,7 +168,7 @@ def monte_carlo(n: int) -> dict:
     out: dict = {"capacity_before": parallel_capacity()}
     for workers in (1, 2):
         with tempfile.TemporaryDirectory() as tmp:
-            _log(f"Monte Carlo, seed 002 model: {n} cases on {workers} worker(s)")
+            _log(f"Monte Carlo, Dong et al. 2021 model: {n} cases on {workers} worker(s)")
             t0 = time.perf_counter()
             Study(study).run(workers=workers, out=Path(tmp), figures=False)
             wall = time.perf_counter() - t0

@@ -1,9 +1,9 @@
-"""The engine against the hand transcription of Ji & Li's equations of motion (seed 001).
+"""The engine against the hand transcription of Ji & Li's equations of motion.
 
 ``tests/validation/transcription_ji_li.py`` writes the paper's 14-DOF eq. 9 by hand
 as numba code from the model's physical parameters, without the assembler (the test
 beside it shows that it agrees with the engine to 1e-9).  Here it is the speed
-baseline: the issue asks for the engine within 1.2 times of it per RK4 step (generated
+baseline: the design targets ask for the engine within 1.2 times of it per RK4 step (generated
 right-hand side, the default) and the general element loop (``rhs="general"``) within
 1.5 times.
 
@@ -92,7 +92,7 @@ def compare(n_steps: int = 200_000, repeat: int = 3) -> dict:
 if __name__ == "__main__":
     n = int(sys.argv[1]) if len(sys.argv) > 1 else 200_000
     r = compare(n, repeat=5)
-    print(f"seed 001, {r['steps']:,} RK4 steps of {r['step']:.4g} s, best CPU time of 5:")
+    print(f"Ji & Li mill drive, {r['steps']:,} RK4 steps of {r['step']:.4g} s, best CPU time of 5:")
     print(f"  engine, generated rhs : {r['engine_us']:.3f} µs/step "
           f"({r['ratio']:.2f}x the transcription; target <= 1.2)")
     print(f"  engine, general rhs   : {r['general_us']:.3f} µs/step "

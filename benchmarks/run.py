@@ -4,7 +4,7 @@
     python benchmarks/run.py --quick    # fewer steps, 1-million-step memory run
 
 Every comparison is a ratio against a baseline measured in the same run, never an
-absolute threshold; the issue's targets are printed beside the measured values.  See
+absolute threshold; the design targets are printed beside the measured values.  See
 benchmarks/README.md for what each number means.  Not part of the test suite.
 """
 
@@ -29,11 +29,11 @@ import bench_engine
 import bench_memory
 
 TARGETS = {
-    "us_per_step": 1.0,  # seed 001, microseconds per RK4 step
+    "us_per_step": 1.0,  # Ji & Li mill drive, microseconds per RK4 step
     "speedup": 1000.0,  # engine / scipy baseline, simulated seconds per wall second
     "compile": 20.0,  # first (cold) compilation, seconds
     "memory": 300.0,  # MB (MiB) for a 10-million-step run
-    "hand_ratio": 1.2,  # engine / hand transcription of seed 001, CPU time per step
+    "hand_ratio": 1.2,  # engine / hand transcription of Ji & Li, CPU time per step
     "hand_ratio_general": 1.5,  # the same with rhs="general"
 }
 SEED001 = "ji_li_mill_drive"
@@ -78,7 +78,7 @@ def run(quick: bool, repeat: int, skip_compile: bool = False) -> dict:
         res["engine"].append(r)
     eng = {r["model"]: r for r in res["engine"]}
 
-    _log("engine against the hand transcription of Ji & Li's equations (seed 001)")
+    _log("engine against the hand transcription of Ji & Li's equations")
     import bench_transcription
 
     res["transcription"] = bench_transcription.compare(cfg["engine_steps"], max(3, repeat))
@@ -116,7 +116,7 @@ def run(quick: bool, repeat: int, skip_compile: bool = False) -> dict:
 
     res["parts"] = bench_kernel_parts.breakdown(cfg["engine_steps"], 2 if quick else 3)
 
-    _log(f"memory: {cfg['memory_steps']:,} steps of seed 001 in a fresh process")
+    _log(f"memory: {cfg['memory_steps']:,} steps of the Ji & Li mill drive in a fresh process")
     res["memory"] = bench_memory.measure(cfg["memory_steps"], 100)
 
     if skip_compile:
@@ -238,12 +238,12 @@ def report(res: dict) -> str:
              "the cpu count) it is the better estimate of an idle core.\n")
 
     # ---------------------------------------------------------------- targets
-    L.append("## Targets from the issue\n")
+    L.append("## Design targets\n")
     rows = [
-        ["µs per RK4 step, seed 001", f"<= {TARGETS['us_per_step']:g}",
+        ["µs per RK4 step, Ji & Li mill drive", f"<= {TARGETS['us_per_step']:g}",
          f"{_f(e001['us_per_step'])} (CPU {_f(e001['cpu_us_per_step'])})",
          _ok(e001["us_per_step"] <= TARGETS["us_per_step"])],
-        ["speed-up over the scipy baseline (simulated s per wall s), seed 001",
+        ["speed-up over the scipy baseline (simulated s per wall s), Ji & Li mill drive",
          f">= {TARGETS['speedup']:g}x", f"{_f(speed001)}x",
          _ok(speed001 >= TARGETS["speedup"])],
         ["speed-up over the scipy baseline, smallest over all models",
@@ -259,7 +259,7 @@ def report(res: dict) -> str:
                      f"on the first adaptive run",
                      _ok(cold["compile"] < TARGETS["compile"])])
     n_mem = mem["n_steps"]
-    rows.append([f"peak memory, {n_mem:,}-step seed 001 run (peak RSS during the run)",
+    rows.append([f"peak memory, {n_mem:,}-step Ji & Li mill drive run (peak RSS during the run)",
                  f"< {TARGETS['memory']:g} MB"
                  + ("" if n_mem >= 10_000_000 else " (for 10 million steps)"),
                  (f"{_f(mem['rss_peak'])} MiB (run itself: +{_f(mem['rss_delta'])} MiB RSS, "
@@ -270,11 +270,11 @@ def report(res: dict) -> str:
     ht = res.get("transcription") or {}
     if "ratio" in ht:
         rows[1:1] = [
-            ["engine / hand transcription of Ji & Li's equations, seed 001 (CPU time per "
+            ["engine / hand transcription of Ji & Li's equations (CPU time per "
              "RK4 step, same run)", f"<= {TARGETS['hand_ratio']:g}",
              f"{_f(ht['ratio'])} ({_f(ht['engine_us'])} / {_f(ht['hand_us'])} µs)",
              _ok(ht["ratio"] <= TARGETS["hand_ratio"])],
-            ["engine with `rhs=\"general\"` / hand transcription, seed 001",
+            ["engine with `rhs=\"general\"` / hand transcription of Ji & Li's equations",
              f"<= {TARGETS['hand_ratio_general']:g}",
              f"{_f(ht['ratio_general'])} ({_f(ht['general_us'])} / {_f(ht['hand_us'])} µs)",
              _ok(ht["ratio_general"] <= TARGETS["hand_ratio_general"])]]
@@ -349,8 +349,7 @@ def report(res: dict) -> str:
                      "engine dopri sim s/wall s", "dopri / scipy"], rows))
 
     if "ratio" in ht:
-        L.append("\n## Engine against the hand transcription of Ji & Li's equations "
-                 "(seed 001)\n")
+        L.append("\n## Engine against the hand transcription of Ji & Li's equations\n")
         L.append("`tests/validation/transcription_ji_li.py` writes the paper's 14-DOF "
                  "eq. 9 by hand as numba code from the model's physical parameters, without "
                  "the assembler (`tests/validation/test_ji_li_transcription.py`: it agrees "
@@ -373,8 +372,8 @@ def report(res: dict) -> str:
 
     if "ratio" in sp:
         L.append("\n## Engine against a transcription generated from the assembled structure "
-                 "(checks kernel overhead, not assembly; seed 001)\n")
-        L.append("`bench_specialised.py` writes the engine's own assembled seed 001 structure "
+                 "(checks kernel overhead, not assembly; Ji & Li mill drive)\n")
+        L.append("`bench_specialised.py` writes the engine's own assembled Ji & Li structure "
                  "out as straight-line numba code: one statement per non-zero, every "
                  "coefficient and index a literal, the same stiffness tables, dead zones, "
                  "per-cycle statistics and history, no error sinusoids/friction/splines/"
@@ -424,7 +423,7 @@ def report(res: dict) -> str:
                          _f(d["first_run"]), _f(d["total"])])
         L.append(_table(["process", "import [s]", "compile_kernels(('rk4',)) [s]", "its CPU [s]",
                          "then compile_kernels(('dopri',)) [s]",
-                         "assemble + 1000 steps seed 001 [s]", "total [s]"], rows))
+                         "assemble + 1000 steps Ji & Li [s]", "total [s]"], rows))
         L.append("\nnumba's compile timers per kernel in the cold process (inclusive of the "
                  "kernels each one calls, so they do not add up; 'signatures' is how many "
                  "specialisations were compiled):\n")
@@ -434,7 +433,7 @@ def report(res: dict) -> str:
         L.append(_table(["kernel", "signatures", "compile [s]", "of which LLVM [s]"], rows))
 
     # ---------------------------------------------------------------- memory
-    L.append(f"\n## Memory: {mem['n_steps']:,}-step seed 001 run"
+    L.append(f"\n## Memory: {mem['n_steps']:,}-step Ji & Li mill drive run"
              + ("" if mem["n_steps"] >= 10_000_000 else
                 " (quick mode: 1 million steps, not 10 million)") + "\n")
     L.append(f"Fresh process, `integrate(method='rk4', record_every={mem['record_every']})`: "

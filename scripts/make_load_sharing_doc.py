@@ -36,10 +36,12 @@ model file) each definition forms `N X_i / sum_j X_j` of some quantity X of mesh
 equal split gives 1 for every mesh.  Only the ratio of mean forces (`mean_force`) sums to
 N over a group; the others take each mesh's largest ratio over time (or over cycle
 peaks), so in a dynamic run every mesh can exceed 1 at some instant and their sum
-exceeds N (the table below: Ji & Li's two split meshes, symmetric, both above 1).  The papers
-torquesplit reproduces use four different X, and for the same run they give different
-numbers (the table at the end shows by how much).  Choose with `--definition` (`run`,
-`report`) or `[analysis] load_sharing` in the model file; every table says which it shows.
+exceeds N.  The table at the end shows system values: for Ji & Li's symmetric drive the
+mean-force coefficient is 1, while the peak-based ones are above 1 because each of its two
+split meshes is above its share at some instants.  The papers torquesplit reproduces use
+four different X, and for the same run they give different numbers (the table at the end
+shows by how much).  Choose with `--definition` (`run`, `report`) or `[analysis]
+load_sharing` in the model file; every table says which it shows.
 
 ## The definitions
 
@@ -75,10 +77,13 @@ worst cycle or instant shares, not to put into a rating calculation next to K_v.
 * **dynamic factor** = settled peak / the mesh's own static force: the K_v sense, at
   least 1 for a mesh that stays in contact; what is in the static force (the static
   load sharing) is not in it.
-* **peak/nominal** = settled peak / the equal-split nominal force (Ji & Li eq. 19): load
-  sharing and dynamics together, the largest tooth force relative to the design share.
+* **peak/nominal** = settled peak / the equal-split nominal force (Ji & Li eq. 19, G_i):
+  load sharing and dynamics together, the largest tooth force relative to the design share.
 * **peak/nominal (eng.)** per group: the mean over settled cycles of the largest member's
-  per-cycle peak over the nominal force (Ji & Li, G_it).
+  per-cycle peak over the nominal force (Ji & Li eq. 19, engineering coefficient G_it).
+
+In the run's group table, *dynamic factor* and *peak/nominal* are the largest over the
+group's meshes.
 
 A dynamic factor above 3 is reported as a warning: the run is near a resonance, and
 `torquesplit modes` lists the natural frequencies and the elements that carry them.
@@ -87,6 +92,18 @@ A dynamic factor above 3 is reported as a warning: the run is near a resonance, 
 
 """
 
+
+#: what the table's numbers of an example need said (after the table)
+NOTES = """
+`dong2021_face_gear` does not settle in its 1.21 s (the run warns so), and its herringbone
+meshes lose contact a few per cent of the time.  Its `cycle_peak` and `instantaneous`
+values of 2.0000 are the largest a pair can give: one mesh of a pair carried the pair's
+whole load while the other had lost contact (`instantaneous`: at some instant;
+`cycle_peak`: through a whole mesh cycle).  Its system `mean_force` coefficient is the
+face-gear stage's, which does not drift; the herringbone stage's mean-force coefficients
+change with the run length by about 0.2 ([validation.md](validation.md)), and its
+peak-based numbers are those of impacts.
+"""
 
 def main() -> None:
     lines = [HEAD]
@@ -111,6 +128,7 @@ def main() -> None:
         print(f"{name} done", file=sys.stderr)
     lines.append("\nThe peak-based coefficients include the dynamic increment: they differ "
                  "from the mean-force one by how differently the paths respond.\n")
+    lines.append(NOTES)
     DOC.write_text("".join(lines), encoding="utf-8")
     print(f"wrote {DOC}", file=sys.stderr)
 

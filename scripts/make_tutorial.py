@@ -240,6 +240,15 @@ leaves out the start-up transient before computing anything.
 * **dynamic factor**: the settled peak over the mesh's own static force, the K_v of the
   standards.  **peak/nominal** is both together: the largest tooth force over the equal
   share.
+* **load-sharing groups**: per group, the largest LSC, dynamic factor and peak/nominal of
+  its meshes, and **peak/nominal (eng.)**: the mean over settled cycles of the largest
+  member's per-cycle peak over the nominal force (Ji & Li's engineering dynamic load
+  coefficient G_it, from their eq. 19).
+* **bearing forces**: for each supported body (here `input`), the settled mean bearing
+  force by direction, the magnitude of that mean and the peak magnitude |F|.  They come
+  from the history, not from the streamed statistics (see the second warning).  `--json`
+  gives them as `bearing_forces_N`, a results file (`--out`) as `bearing_mean_force` and
+  `bearing_peak_force`.
 * **the warning** above the table: the transient has settled to within the settle
   criterion (1 %), but in1's largest force still falls by {{{{drift}}}} % from the first
   settled window to the last, a lightly damped mode dying out slowly.  The dynamic factor
@@ -249,10 +258,11 @@ leaves out the start-up transient before computing anything.
 * **the second warning**: the history a results file and the figures hold (20 samples
   per split-mesh period by default) misses the settled peak of in2 by {{{{history_miss}}}} %:
   the response rings at its mesh modes near order {{{{order}}}} of the mesh frequency
-  (section 5), faster than that sampling.  The table's numbers are streamed at every integration step and do not
-  depend on it; the figures draw each cycle's streamed extremes over the samples; for a
-  waveform to put in a report, run again with `--samples-per-period 100` (every step at
-  this model's step).
+  (section 5), faster than that sampling.  The mesh table's numbers are streamed at every
+  integration step and do not depend on it; the figures draw each cycle's streamed
+  extremes over the samples.  The bearing table is computed from the history, so its
+  peak |F| is low too.  For a waveform to put in a report, or the bearing peaks, run
+  again with `--samples-per-period 100` (every step at this model's step).
 * **contact loss** and **back flank**: these meshes have no backlash, so they cannot lose
   contact; had their forces turned negative (the back flank loaded) the table and a
   warning would say so.
@@ -274,7 +284,7 @@ the step and 65536 table points move them by about 1 %).  Refine both (`--steps-
 analysis.table_points=...`), and report only the digits that hold; the mean-force
 coefficients move far less than the peaks (`--json` gives every number's digits).
 
-A dynamic factor of about {{{{dynamic_factor}}}} is large.  The modes show why:
+A dynamic factor of about {{{{dynamic_factor}}}} is large.  The modes show where it can come from:
 
 $ torquesplit modes three_branch.toml --count 8
 
@@ -284,6 +294,14 @@ spur pair jumps by a factor of {{{{jump}}}} between single and double tooth cont
 harmonic-rich excitation.
 Tooth modifications (`stiffness.method = "ltca"` with `[gears.NAME.modifications]`)
 smooth it; see the `contact` command.
+
+The split-stage mesh frequency itself (order 1) also crosses two lower modes, on either
+side of this run's 3000 rpm: the input-bearing mode ({{{{bearing_Hz}}}} Hz) at
+{{{{bearing_rpm}}}} rpm and the branch-shaft mode ({{{{shaft_Hz}}}} Hz) at {{{{shaft_rpm}}}} rpm
+(`torquesplit modes three_branch.toml --campbell --from "2400 rpm" --to "3600 rpm"`
+lists them).  The speed sweep of section 8 finds its largest dynamic factor next to the
+first.  Near those speeds the remedy is to detune the input bearing or the branch shafts
+(their stiffness, or the inertias they carry), which moves the critical speed away.
 
 ## 6. Change a parameter
 
@@ -399,6 +417,17 @@ def _numbers(work: Path) -> dict[str, str]:
         raise SystemExit("the tutorial's text expects the coarse-history warning")
     history_miss = re.search(r"by (\d+(?:\.\d+)?) %", coarse[0]).group(1)
     modes = json.loads(_run("torquesplit modes three_branch.toml --count 8 --json 2>/dev/null", work))
+    campbell = json.loads(_run('torquesplit modes three_branch.toml --campbell --from '
+                               '"2400 rpm" --to "3600 rpm" --json 2>/dev/null', work))
+    first = {}  # first-order crossings of the split mesh (a double mode listed once)
+    for c in campbell["critical_speeds"]:
+        if c["order"] == 1 and c["source"] == "mesh in1":
+            first.setdefault(round(c["speed_rpm"], 1), c)
+    bearing, shaft = (first[s] for s in sorted(first)) if len(first) == 2 else (None, None)
+    if not (bearing and ".support." in bearing["energy"][0][0]
+            and shaft["energy"][0][0] in ("s1", "s2", "s3")):
+        raise SystemExit("the tutorial's text expects two first-order crossings of the split "
+                         "mesh: an input-bearing mode, then a branch-shaft mode")
     met = run["metrics"]
     meshes = set(met["meshes"])
     f_split = modes["mesh_frequencies_Hz"]["in1"]
@@ -421,6 +450,10 @@ def _numbers(work: Path) -> dict[str, str]:
         "f_split": f"{f_split:.4g}",
         "jump": f"{k.max() / k.min():.2g}",
         "drift": drift,
+        "bearing_Hz": f"{bearing['frequency_Hz']:.0f}",
+        "bearing_rpm": f"{bearing['speed_rpm']:.0f}",
+        "shaft_Hz": f"{shaft['frequency_Hz']:.0f}",
+        "shaft_rpm": f"{shaft['speed_rpm']:.0f}",
     }
 
 

@@ -162,6 +162,20 @@ OURS = {
         "when the mean was known to +/-0.001."),
 }
 
+#: said once, above the studies of the Dong et al. 2021 example: its run does not settle
+DONG_RUN_LENGTH = (
+    "**The Dong et al. 2021 studies** (`dong_2021_*`) run every case for the example's "
+    "1.21 s, which does not settle: `torquesplit run dong2021_face_gear` warns that the "
+    "transient did not die out and that the mean-force coefficient of its O2 idler-output "
+    "pair is 1.114 over the part used, 1.234 over its first half and 1.005 over its second "
+    "(1.0695 with `--duration \"2.4 s\"`; docs/validation.md).  Their stage-II coefficients "
+    "(Omega_II) therefore depend on the run length by about 0.2; stage I (Omega_I) does "
+    "not drift.  The differences between cases are differences at this one run length: a "
+    "stage-II trend or ranking smaller than that drift may not survive a longer run.")
+#: said under each of them
+DONG_SECTION = ("**Run length:** the run does not settle; Omega_II depends on the run length "
+                "by about 0.2 (see the top of this page).")
+
 
 def _run(names, results: Path) -> None:
     from torquesplit.study import Study
@@ -257,6 +271,8 @@ def markdown(data: dict) -> str:
              "and trends read off missing figures. The example models assume what the papers "
              "leave out (see each model file and docs/validation.md), and nothing was tuned "
              "to a published number, so the comparison is of trend and magnitude.", ""]
+    if any(name.startswith("dong_2021") for name in data):
+        lines += [DONG_RUN_LENGTH, ""]
     for name, e in data.items():
         if name.startswith("_"):
             continue
@@ -308,6 +324,15 @@ def markdown(data: dict) -> str:
                                  f"{f} {_fmt(x)}" for f, x in rank))
         if e.get("ours"):
             lines += ["", "**Ours:** " + e["ours"]]
+        if name.startswith("dong_2021"):
+            lines += ["", DONG_SECTION]
+            if e["design"] == "sensitivity":
+                top = max(x for out, rank in e["ranking"].items() if "II_" in out
+                          or out == "load_sharing.mean_force" for _, x in rank
+                          if x is not None)
+                lines[-1] += (f"  The largest mu_star of the stage-II and system "
+                              f"coefficients, {top:.2f}, is of the size of that drift, so "
+                              f"their ranking is not resolved by these runs.")
         lines += ["", f"Figures: `torquesplit study {name}` writes them to "
                       f"`study_{name}/figures/`.", ""]
     notes = data.get("_notes", [])

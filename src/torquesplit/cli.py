@@ -327,10 +327,12 @@ def _definition_help() -> str:
 def run(
     model: str = typer.Argument(..., help=_MODEL_HELP, metavar="MODEL"),
     duration: Optional[str] = typer.Option(
-        None, "--duration", help="Simulated time, e.g. '0.5 s' (a bare number is seconds).",
-        metavar="TIME"),
-    cycles: Optional[int] = typer.Option(None, "--cycles", help="Cycles of the slowest mesh.",
-                                         metavar="N"),
+        None, "--duration", help="Simulated time, e.g. '0.5 s' (a bare number is seconds).  "
+        "Default: the model's [analysis] duration or cycles, else 200 cycles of the slowest "
+        "mesh.", metavar="TIME"),
+    cycles: Optional[int] = typer.Option(
+        None, "--cycles", help="Cycles of the slowest mesh to simulate (default as for "
+        "--duration: the model's [analysis], else 200).", metavar="N"),
     method: Optional[str] = typer.Option(None, "--method", help="rk4 (fixed step) or dopri.",
                                          metavar="rk4|dopri"),
     steps_per_period: Optional[int] = typer.Option(
@@ -342,8 +344,9 @@ def run(
         metavar="N"),
     samples_per_period: int = typer.Option(
         20, "--samples-per-period", help="History samples per shortest mesh period, for "
-        "--out files and --plots figures (the metrics are streamed at every step and do "
-        "not depend on it); a run warns when the history misses the peaks.", metavar="N"),
+        "--out files, --plots figures and the bearing-force table (the mesh table's "
+        "forces and coefficients are streamed at every step and do not depend on it); a "
+        "run warns when the history misses the peaks.", metavar="N"),
     definition: Optional[str] = typer.Option(None, "--definition", help=_definition_help(),
                                              metavar="NAME"),
     out: Optional[Path] = typer.Option(
@@ -617,7 +620,12 @@ def _render_run(res, met, saved, planets=None) -> None:
         f"Contact loss: share of the whole run (start-up included) with the drive flanks "
         f"apart (a mesh with no backlash cannot lose contact: it is in double-flank "
         f"contact); back flank: share of the whole run in back-flank contact, and the "
-        f"largest settled back-flank force.",
+        f"largest settled back-flank force.  Groups: dynamic factor and peak/nominal are the "
+        f"largest of the group's meshes; peak/nominal (eng.) = mean over settled cycles of "
+        f"the largest member's per-cycle peak / nominal force (Ji & Li eq. 19, engineering "
+        f"coefficient G_it)."
+        + ("  Bearing forces: from the history, not streamed, so a peak between its samples "
+           "is missed (--samples-per-period)." if bearings else ""),
         markup=False, highlight=False)
     if saved:
         console.print("results written to " + ", ".join(str(f) for f in saved),
@@ -1063,10 +1071,12 @@ def _print_contact(m, pair, names, op_load, cm, results, hm, impact, op, figures
                       f"{impact.corner_separation * 1e6:.3g} µm)", highlight=False)
     elif cm.pair.is_internal:
         console.print(_INTERNAL_IMPACT, highlight=False, markup=False)
-    console.print("contact ratio: mean number of loaded tooth pairs, within the theoretical "
-                  "path of contact (contact beyond the tips, which a heavy load brings "
-                  "early, is not modelled: at most the geometric ratio; the meshing-in line "
-                  "gives that premature approach)", highlight=False)
+    console.print("contact ratio: mean number of loaded tooth pairs over the --positions "
+                  "sampled in a mesh cycle, within the theoretical path of contact: the "
+                  "geometric ratio to within one position's share (1/positions), so it can "
+                  "exceed it slightly (contact beyond the tips, which a heavy load brings "
+                  "early, is not modelled; the meshing-in line gives that premature "
+                  "approach)", highlight=False)
     if figures:
         console.print(f"{len(figures)} figures written to {plot}")
 
@@ -1325,7 +1335,8 @@ def examples():
         label = name + ("\n(start here)" if name == FIRST_EXAMPLE else "")
         t.add_row(label, info.get("description", ""), info.get("reference", ""))
     console.print(t)
-    console.print("The earlier names still work, with a note: "
+    console.print("The earlier names still work for old scripts but are deprecated (use "
+                  "the names above; a deprecated name prints a note): "
                   + ", ".join(f"{old} -> {new}" for old, new in RENAMED.items()),
                   highlight=False)
 

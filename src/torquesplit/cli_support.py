@@ -280,6 +280,23 @@ PLANET_TEXT_STATIC = (
     "with equal mean loads)")
 
 
+#: the line under the planet table of a peak-based definition, whose stage value is not
+#: K_gamma (``{definition}``: the definition)
+PLANET_TEXT_PEAK = (
+    "planet load-sharing coefficient of a stage: the largest {definition} coefficient of "
+    "its sun and ring mesh groups, peak forces with the dynamics in them; a planet's "
+    "factor: the largest coefficient of its meshes.  K_gamma (the mesh-load factor of AGMA "
+    "6123 / ISO 6336-1, a ratio of mean loads) is the stage value of --definition "
+    "mean_force")
+
+
+def is_k_gamma(k) -> bool:
+    """Whether the stage value of ``k`` is the standards' K_gamma: the mean-force
+    coefficient of a run, or a quasi-static sweep's (position-averaged loads); a
+    peak-based definition's is that definition's planet coefficient."""
+    return k.definition == "mean_force" or bool(k.peak_per_stage)
+
+
 def planet_header(k) -> list[str]:
     """The planet table's columns for ``k``: a quasi-static one has the peak apart."""
     head = [h.format(definition=k.definition) for h in PLANET_HEADER]
@@ -291,6 +308,8 @@ def planet_header(k) -> list[str]:
 
 def planet_text(k) -> str:
     """The line under the planet table."""
+    if not is_k_gamma(k):
+        return PLANET_TEXT_PEAK.format(definition=k.definition) + "."
     return (PLANET_TEXT_STATIC if k.peak_per_stage else PLANET_TEXT) + f" ({k.definition})."
 
 
@@ -305,12 +324,15 @@ def planet_sharing(load_sharing, kinematics):
 
 
 def planet_rows(k, kinematics) -> list[list[str]]:
-    """Rows of the planet table: per stage (carrier) its K_gamma and the groups it is taken
-    over, then each of its planets' factor."""
+    """Rows of the planet table: per stage (carrier) its K_gamma (a peak-based
+    definition: its planet load-sharing coefficient) and the groups it is taken over,
+    then each of its planets' factor."""
     rows = []
     peak = bool(k.peak_per_stage)
+    label = ("K_gamma (stage)" if is_k_gamma(k)
+             else f"planet load-sharing coefficient ({k.definition})")
     for carrier, value in k.per_stage.items():
-        rows.append([carrier, "K_gamma (stage)", ", ".join(k.groups[carrier]), f"{value:.4f}"]
+        rows.append([carrier, label, ", ".join(k.groups[carrier]), f"{value:.4f}"]
                     + ([f"{k.peak_per_stage[carrier]:.4f}"] if peak else []))
         for planet in kinematics.carriers.get(carrier, ()):
             if planet in k.per_planet:

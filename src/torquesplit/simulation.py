@@ -68,8 +68,9 @@ def simulate(
     steps_per_period : int, optional
         RK4 steps per shortest mesh period (default 100, as in the papers).
     samples_per_period : int
-        Decimated history samples per shortest mesh period, >= 1 (plots and exports only: every
-        metric is computed from statistics streamed at every step).
+        Decimated history samples per shortest mesh period, >= 1 (plots, exports and the
+        bearing forces: every mesh metric is computed from statistics streamed at every
+        step).
     history_dofs : list of str, optional
         DOF names (``"gear.x"``) whose displacement and velocity histories to keep.
     full_history : bool

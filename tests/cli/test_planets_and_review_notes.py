@@ -77,6 +77,16 @@ def test_run_shows_and_reports_planet_load_sharing(planetary):
     assert f"{k['per_stage']['st_carrier']:.4f}" in text
 
 
+def test_a_peak_based_definition_labels_the_stage_value_not_k_gamma(planetary):
+    """K_gamma is the standards' ratio of mean loads: a peak-based definition's stage
+    value is that definition's planet coefficient, and the table says so."""
+    text = _invoke(["run", str(planetary), "--quiet", "--definition", "cycle_peak"])
+    assert "planets (load sharing: cycle_peak)" in text
+    assert "K_gamma (stage)" not in text
+    assert "planet load-sharing coefficient (cycle_peak)" in " ".join(text.split())
+    assert "is the stage value of --definition mean_force" in " ".join(text.split())
+
+
 def test_static_shows_planet_load_sharing_equal_to_the_dynamic_mean(planetary):
     data = json.loads(_invoke(["static", str(planetary), "--quiet", "--json"]))
     k = _planet_json(data, "static_torque")

@@ -14,7 +14,7 @@ module                 content
                        errors along the line of action (seeds 000, 002, 004)
 ``backlash``           constant and random per-engagement backlash (Ji & Li eq. 14)
 ``friction``           EHL tooth friction coefficient and friction tables (Jin et al. 2019)
-``impact``             meshing-in impact (Liu et al. 2021 eqs. 5-10)
+``impact``             meshing-in impact (Liu et al. 2021 eqs. 6-10)
 ``grades``             ISO 1328-1 tolerances per accuracy grade, error sampling
 =====================  ===============================================================
 

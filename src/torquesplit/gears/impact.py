@@ -408,7 +408,7 @@ def meshing_in_impact(
     exponent: float = 1.0,
     base_pitch_difference: float = 0.0,
 ) -> MeshingInImpact:
-    """Meshing-in impact of a standard involute pair (Liu et al. 2021 eqs. 5-10).
+    """Meshing-in impact of a standard involute pair (Liu et al. 2021 eqs. 6-10).
 
     Steps: deflection delta = F / k (eq. 5) -> advance = delta + (p_bp - p_bg)
     -> meshing-in point D off the line of action (eqs. 6-8, reversal method)

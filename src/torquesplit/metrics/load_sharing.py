@@ -3,7 +3,9 @@
 Meshes are grouped into *load-sharing groups*: meshes with the same ``path`` and
 ``stage`` labels (model file) carry parallel shares of one flow of power.  In a group
 of N meshes each definition forms ``N X_i / sum_j X_j`` of some per-mesh quantity X,
-so a perfect split gives 1 for every mesh and the coefficients of a group sum to N.
+so a perfect split gives 1 for every mesh.  Only the ``mean_force`` coefficients of a
+group sum to N; the others take each mesh's largest ratio over time, cycles or positions
+(``engineering``: the mean of its per-cycle peaks), so their sum can exceed N.
 Every definition is computed from quantities the integrator streams at every step (per
 mesh cycle: force max, min and mean, and the largest instantaneous ratio), never from
 the decimated history, so a coefficient does not depend on how often the history is
@@ -18,8 +20,8 @@ definition          X and reduction
 ``instantaneous``   X = force at each instant; the largest over the settled part
                     (Ji & Li eq. 18, g_i)
 ``engineering``     mean over settled mesh cycles of the per-cycle peak of the
-                    instantaneous coefficient (Ji & Li, g_it: "average value of the
-                    periodic peak")
+                    instantaneous coefficient (Ji & Li eq. 18, engineering
+                    coefficient g_it: "average value of the periodic peak")
 ``mean_force``      X = mean force over the settled part (Dong et al. 2021 eq. 12)
 ``static_torque``   X = quasi-static force at each mesh position; the largest over
                     the positions (Mo et al. 2017 eqs. 14-15); quasi-static runs only
@@ -35,7 +37,8 @@ Dynamic factors (per mesh, over the settled part), named for what they are:
   :mod:`torquesplit.model.kinematics`: load sharing and dynamics together (Ji & Li eq.
   19, G_i: the largest over the group's meshes);
 * ``peak_to_nominal_engineering`` (per group) = mean over settled cycles of the
-  largest member's per-cycle peak / nominal force (Ji & Li, G_it).
+  largest member's per-cycle peak / nominal force (Ji & Li eq. 19, engineering
+  coefficient G_it).
 
 The transient is excluded by a settle criterion (:func:`settle`): one settle time per
 group, used by every metric of that group.
@@ -57,7 +60,7 @@ DEFINITION_TEXT = {
     "instantaneous": "ratio of the meshes' forces at each instant, largest over the settled "
                      "part (Ji & Li eq. 18)",
     "engineering": "mean over settled mesh cycles of the per-cycle peak of the "
-                   "instantaneous ratio (Ji & Li, engineering coefficient)",
+                   "instantaneous ratio (Ji & Li eq. 18, engineering coefficient g_it)",
     "mean_force": "ratio of the meshes' mean forces over the settled part (Dong et al. "
                   "2021 eq. 12)",
     "static_torque": "ratio of quasi-static mesh forces, largest over the mesh positions "
@@ -340,7 +343,7 @@ class DynamicFactors:
     """Group -> largest member peak / nominal (Ji & Li eq. 19, G_i)."""
     per_group_peak_to_nominal_engineering: dict[str, float]
     """Group -> mean over settled cycles of the largest member's per-cycle peak /
-    nominal force (Ji & Li, G_it)."""
+    nominal force (Ji & Li eq. 19, engineering coefficient G_it)."""
 
 
 def dynamic_factors(cycle_max, names, groups, first_cycle, static_force, nominal_force,

@@ -7,7 +7,9 @@ of :mod:`torquesplit.metrics.load_sharing` restricted to the planet meshes: a pl
 sun meshes form one load-sharing group, its ring meshes another (the stage labels of
 ``[[planetary]]``, ``<name>-sun`` and ``<name>-ring``, or the tooth-count labels of
 general elements), and each group's coefficient is max_i N X_i / sum_j X_j = largest
-over mean.  So every definition gives its K_gamma:
+over mean.  Every definition gives a planet coefficient; the standards' K_gamma, a
+ratio of mean loads, is the ``mean_force`` one (dynamic) or the position-averaged one
+(quasi-static):
 
 * quasi-static (``static_torque``, with pin position errors, carrier eccentricity and
   floating members): K_gamma from each planet's load averaged over the mesh positions of
@@ -16,10 +18,12 @@ over mean.  So every definition gives its K_gamma:
   the positions (Mo et al. 2017 eqs. 14-15 generalised to planets), which is not
   K_gamma: with sequentially phased planets it exceeds 1 (1.0841 for a 25/29/83 spur
   stage) although every planet carries the same mean load;
-* dynamic (``cycle_peak``, ``mean_force``, ``instantaneous``, ``engineering``): the
-  same ratio of the dynamic forces.
+* dynamic: ``mean_force`` gives K_gamma from the mean forces of the settled run; the
+  peak-based ``cycle_peak``, ``instantaneous`` and ``engineering`` give the same ratio of
+  peak forces, a planet load-sharing coefficient that contains the dynamics (not
+  K_gamma: do not multiply it by a dynamic factor).
 
-``K_gamma`` of a stage is the largest over its sun and ring groups; per planet the
+The coefficient of a stage is the largest over its sun and ring groups; per planet the
 largest coefficient of its meshes.  Names for studies: ``planet_load_sharing.<def>``
 (the largest stage), ``.<carrier>`` and ``.<planet>``.
 """

@@ -533,7 +533,9 @@ class BacklashSpec(Strict):
 class TransmissionErrorSpec(Strict):
     """An additional error along the line of action: constant plus mesh-frequency harmonic."""
 
-    constant: Length = Field(0.0, description="Constant error (installation along the LOA).")
+    constant: Length = Field(0.0, description=(
+        "Constant error along the LOA (installation). Positive opens a gap at the mesh, "
+        "which unloads it: '20 um' lowers this mesh's load share, '-20 um' raises it."))
     amplitude: Length = Field(0.0, ge=0, description="Amplitude at mesh frequency.")
     phase: Angle = Field(0.0, description="Phase of the mesh-frequency error.")
 
@@ -704,8 +706,12 @@ class Analysis(Strict):
 
     method: Literal["rk4", "dopri"] = Field("rk4", description="Time integrator.")
     steps_per_period: Count = Field(100, ge=10, description="RK4 steps per shortest mesh period.")
-    duration: Time | None = Field(None, gt=0, description="Simulated time.")
-    cycles: Count | None = Field(None, gt=0, description="Simulated cycles of the slowest mesh.")
+    duration: Time | None = Field(None, gt=0, description=(
+        "Simulated time. Without it a run lasts `cycles` cycles of the slowest mesh (200 "
+        "if `cycles` is not given either)."))
+    cycles: Count | None = Field(None, gt=0, description=(
+        "Simulated cycles of the slowest mesh, used when `duration` is not given "
+        "(default 200)."))
     rtol: Number = Field(1e-6, gt=0, lt=1, description="Relative tolerance (dopri).")
     table_points: Count = Field(256, ge=16, description=(
         "Samples per mesh period of excitation tables. Where a table steps (a tooth pair "

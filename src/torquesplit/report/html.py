@@ -236,7 +236,8 @@ def _run_section(res, met) -> str:
             "force (Ji &amp; Li eq. 19), load sharing and dynamics together. "
             "<b>Contact loss</b>: share of the whole run (start-up included) with the drive "
             "flanks apart. <b>Back flank</b>: share of the whole run in back-flank contact, "
-            "and the largest settled back-flank force. "
+            "and the largest settled back-flank force. In the group table, dynamic factor "
+            "and peak/nominal are the largest of the group's meshes. "
             f"System load-sharing coefficient: <b>{met.load_sharing.system:.5f}</b>.</p>")
     return (_table(["setting", "value"], settings, left=2) + what + "<h3>Per mesh</h3>"
             + per_mesh + "<h3>Per load-sharing group</h3>" + groups

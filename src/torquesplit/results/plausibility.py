@@ -27,9 +27,10 @@ check                      says
 :func:`mean_drift`         mean-force coefficients that differ between the two halves
                            of the settled part by more than :data:`MEAN_DRIFT` (slow
                            excitations whose common period is longer than the run)
-:func:`coarse_history`     a decimated history (files, figures) that misses the settled
-                           peak force by more than :data:`HISTORY_MISS`: its waveform is
-                           not the response's (the metrics are streamed, unaffected)
+:func:`coarse_history`     a decimated history (files, figures, bearing forces) that
+                           misses the settled peak force by more than
+                           :data:`HISTORY_MISS`: its waveform and the bearing peaks are
+                           not the response's (the mesh metrics are streamed, unaffected)
 =========================  ===========================================================
 """
 
@@ -118,22 +119,25 @@ def back_flank(results, metrics) -> list[tuple[str, str]]:
             when = ""
         if largest <= 0:  # deflection reversed, force still compressive (damping)
             out.append((f"meshes.{r.mesh}", (
-                f"the mesh deflection is reversed {_pct(r.back_contact)} of the time{when}, "
+                f"the mesh deflection is reversed {_pct(r.back_contact)} of the time over "
+                f"the whole run, start-up included{when}, "
                 f"the force staying compressive only through the damping: a real pair "
                 f"{'with backlash ' if r.double_flank else ''}would be about to lose contact "
                 f"there; check meshes.{r.mesh}.backlash and the excitation")))
             continue
         if r.double_flank:
             out.append((f"meshes.{r.mesh}", (
-                f"double-flank contact {_pct(r.back_contact)} of the time, back-flank force "
-                f"up to {_kn(largest)}{when}: the mesh has no backlash, so the model lets it carry "
+                f"double-flank contact {_pct(r.back_contact)} of the time and back-flank "
+                f"force up to {_kn(largest)} over the whole run, start-up included{when}: "
+                f"the mesh has no backlash, so the model lets it carry "
                 f"tension, which a real pair with backlash cannot; give "
                 f"meshes.{r.mesh}.backlash its real value (e.g. '100 um') or read its peak "
                 f"and load sharing as those of a double-flank (anti-backlash) mesh")))
         else:
             out.append((f"meshes.{r.mesh}", (
-                f"back-flank contact {_pct(r.back_contact)} of the time, back-flank force up "
-                f"to {_kn(largest)}{when}: the teeth rattle through the backlash; peak forces are "
+                f"back-flank contact {_pct(r.back_contact)} of the time and back-flank force "
+                f"up to {_kn(largest)} over the whole run, start-up included{when}: the "
+                f"teeth rattle through the backlash; peak forces are "
                 f"impacts and the load sharing is not meaningful; check the excitation "
                 f"and meshes.{r.mesh}.backlash")))
     return out
@@ -290,9 +294,11 @@ def coarse_history(results, metrics) -> list[tuple[str, str]]:
         f"the history ({per:.3g} samples per shortest mesh period), which the results "
         f"files and the figures hold, misses the settled peak force of mesh {m} by "
         f"{100 * miss:.2g} % ({_kn(seen)} against {_kn(peak)}): the response is faster "
-        f"than its sampling and the saved waveform is not the response's.  The table's "
-        f"numbers are streamed at every step and unaffected; for waveforms, run again "
-        f"with --samples-per-period {more} (Python: samples_per_period={more})"))]
+        f"than its sampling and the saved waveform is not the response's.  The mesh "
+        f"table's forces, load sharing and dynamic factors are streamed at every step and "
+        f"unaffected; the bearing table is computed from this history, so its peak |F| "
+        f"can be low too; for waveforms and bearing peaks, run again with "
+        f"--samples-per-period {more} (Python: samples_per_period={more})"))]
 
 
 #: every check, in the order the messages are listed

@@ -191,9 +191,11 @@ def register(app, load, fail, console, err_console, json_default):
             elif not stability:
                 console.print("stability: not computed (--no-stability)")
             t = Table(title="meshes (periodic steady state)")
+            chosen = m.analysis.load_sharing  # mesh_table()'s (Results.default_definition)
+            chosen = "mean_force" if chosen == "static_torque" else chosen
             for col in ("mesh", "group", "static F [kN]", "mean F [kN]", "peak F [kN]",
-                        "DF (peak/static)", "peak/nominal", "LSC", "RMS TE [µm]",
-                        "contact loss"):
+                        "DF (peak/static)", "peak/nominal", f"LSC ({chosen})",
+                        "RMS TE [µm]", "contact loss"):
                 t.add_column(_h(col), justify="left" if col in ("mesh", "group") else "right")
             for r in rows:
                 t.add_row(r.mesh, r.group, f"{r.static_force / 1e3:.6g}",
@@ -231,7 +233,10 @@ def register(app, load, fail, console, err_console, json_default):
             None, "--harmonics", help="HB harmonics (default: as 'steady' chooses them at the "
             "first speed, then kept along the curve)."),
         keep: Optional[str] = typer.Option(None, "--keep", help="As for 'steady'."),
-        max_cycles: int = typer.Option(1000, "--max-cycles", help="As for 'steady'."),
+        max_cycles: int = typer.Option(
+            1000, "--max-cycles", help="Longest period accepted, in cycles of the fastest "
+            "excitation (default 1000 for every method; 'steady' accepts 10000 for "
+            "shooting and auto)."),
         no_stability: bool = typer.Option(False, "--no-stability",
                                           help="Skip the Floquet multipliers."),
         cross_check: bool = typer.Option(False, "--cross-check",

@@ -19,8 +19,9 @@ import typer
 
 BACKEND_HELP = ("cpu (default) or gpu: integrate the cases as ensembles on a CUDA GPU, one "
                 "case per thread (falls back to the CPU with a warning when there is none).")
-PRECISION_HELP = ("GPU backend: fp64 (default, equal to the CPU engine) or fp32 (its error "
-                  "against fp64 is reported).")
+PRECISION_HELP = ("GPU backend: fp64 (default; equal to the CPU engine under the CUDA "
+                  "simulator and in the kernels' CPU build, not yet measured on a GPU) or "
+                  "fp32 (its error against fp64 is reported).")
 
 
 def _ui():
