@@ -178,7 +178,10 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
         coords={"speed_rpm": ("point", sp * w_ref * RPM, {"units": "rpm"}),
                 "mesh": mesh_names},
     )
-    crit = critical_speeds(s, static.q, kin, model, min(s0, s1) * w_ref, max(s0, s1) * w_ref)
+    w_lo, w_hi = min(s0, s1) * w_ref, max(s0, s1) * w_ref
+    crit = critical_speeds(s, static.q, kin, model, w_lo, w_hi)
+    if s.n_gyroscopic:  # frequencies that move with speed: the Campbell map's crossings
+        crit["crossings"] = campbell(model, w_lo, w_hi)[1]
     critical, suppressed = split_suppressed(crit["crossings"])
     ds.attrs.update(
         model=model.model.name,
@@ -193,6 +196,7 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
         kept_excitations="all" if keep is None else str(keep),
         dropped_excitations=[x.describe() for x in dropped],
         natural_frequencies_Hz=list(crit["natural_frequencies"]),
+        natural_frequencies_at_speed_rpm=w_ref * RPM,
         critical_speeds_rpm=[c["speed_rpm"] for c in critical],
         critical_speed_labels=[f"mode {c['mode']} x {c['order']} {c['source']}"
                                for c in critical],
