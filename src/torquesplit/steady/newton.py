@@ -112,12 +112,28 @@ def rigid_subspace(p: PeriodicProblem) -> np.ndarray:
 
 
 def complement(p: PeriodicProblem) -> np.ndarray:
-    """Orthonormal (2n, 2n - k) basis of the complement of R."""
-    R = rigid_subspace(p)
-    if R.shape[1] == 0:
-        return np.eye(2 * p.n)
-    q, _ = np.linalg.qr(np.hstack([R, np.eye(2 * p.n)]))
-    return q[:, R.shape[1]:2 * p.n]
+    """Orthonormal (2n, 2n - k) basis of the complement of R, block by block: its columns
+    are pure displacements (orthogonal to the rigid modes) or pure velocities (orthogonal
+    to the undamped ones), as R's are.  (A complement of R in the whole state space, from
+    a QR of [R, I], mixed the two in some columns; the continuation's metric, which weights
+    displacements and velocities apart, then over-weighted a velocity by omega T.)"""
+    n = p.n
+    if p.nr == 0:
+        return np.eye(2 * n)
+
+    def perp(B):
+        if B.shape[1] == 0:
+            return np.eye(n)
+        u, sv, _ = np.linalg.svd(B, full_matrices=True)
+        rank = int(np.sum(sv > 1e-10 * sv[0]))
+        return u[:, rank:]
+
+    cd = perp(p.rigid)
+    cv = perp(p.rigid[:, ~np.asarray(p.rigid_damped, bool)])
+    Q = np.zeros((2 * n, cd.shape[1] + cv.shape[1]))
+    Q[:n, :cd.shape[1]] = cd
+    Q[n:, cd.shape[1]:] = cv
+    return Q
 
 
 def floquet_monodromy(p: PeriodicProblem, Phi) -> np.ndarray:
