@@ -399,17 +399,23 @@ def _assemble(model: Model, kin: Kinematics | None, *, n_table: int | None,
         frame_stiffness, gyroscopic = rotating_frame_terms(kin, dmap, ext,
                                                            pin_stiffness(model, kin))
 
-    # ---- drives and loads
+    # ---- drives and loads (and their torque fluctuations: elements of an additive force)
+    fixed_frequency: list[str] = []
     for name, d in model.drives.items():
         idx, s = dmap.theta[d.body]
         if idx >= 0 and d.mode == "torque":
             ext[idx] += s * math.copysign(kin.drive_torques[name], d.speed)
+        elements += _fluctuations(f"drives.{name}", d.fluctuation, idx,
+                                  -s * math.copysign(1.0, d.speed), abs(d.speed), n_table,
+                                  fixed_frequency)
     for name, ld in model.loads.items():
         idx, s = dmap.theta[ld.body]
+        w = kin.bodies[ld.body].speed
         if idx >= 0:
-            w = kin.bodies[ld.body].speed
             ext[idx] -= s * math.copysign(kin.load_torques[name], w)
             ground[idx] += ld.speed_coefficient
+        elements += _fluctuations(f"loads.{name}", ld.fluctuation, idx,
+                                  s * math.copysign(1.0, w), abs(w), n_table, fixed_frequency)
 
     meta = dict(
         model_name=model.model.name,
@@ -422,6 +428,9 @@ def _assemble(model: Model, kin: Kinematics | None, *, n_table: int | None,
         planet_bodies=dict(kin.planet_bodies),
         frames=dict(kin.frames),
         rotating_frame=bool(rotating and gyroscopic),
+        fixed_frequency_elements=fixed_frequency,
+        torque_fluctuation_elements=[el["name"] for el in elements
+                                     if ".fluctuation" in el["name"]],
     )
     return build_structure(dmap.names, inv_mass, elements, external_force=ext,
                            ground_damping=ground, gyroscopic=gyroscopic,
@@ -548,6 +557,32 @@ def _friction_projection(model: Model, kin: Kinematics, dmap: DofMap, name: str,
             coefs.append(c)
             rows.append(0)
     return dict(table=table, dofs=dofs, coefs=coefs, rows=rows)
+
+
+def _fluctuations(where: str, harmonics, idx: int, coef: float, speed: float,
+                  n_table: int, fixed: list) -> list[dict]:
+    """One element per harmonic of a drive's or load's torque fluctuation: no stiffness,
+    an additive force table T_a sin(2 pi s + phase) over its own period, on the body's
+    rotation (``coef``: the sign that makes a positive value add to the nominal torque).
+    Fixed-frequency harmonics are listed in ``fixed`` (a speed sweep does not scale
+    them)."""
+    if not harmonics:
+        return []
+    if idx < 0:
+        raise ModelError([(f"{where}.fluctuation", (
+            "the body has no rotation of its own (held by a 'speed' drive or rigidly): its "
+            "torque cannot fluctuate; put the fluctuation on a body that turns freely"))])
+    grid = np.arange(n_table) / n_table
+    out = []
+    for k, h in enumerate(harmonics, start=1):
+        f = h.order * speed / (2 * math.pi) if h.order is not None else h.frequency
+        name = f"{where.split('.', 1)[1]}.fluctuation{k}"
+        if h.order is None:
+            fixed.append(name)
+        out.append(dict(name=name, kind=SPRING, dofs=[idx], coefs=[coef], stiffness=0.0,
+                        frequency=f, phase=0.0,
+                        force=h.amplitude * np.sin(2 * math.pi * grid + h.phase)))
+    return out
 
 
 def _radial_pair(sup, axes: dict, axis) -> tuple[str, ...]:

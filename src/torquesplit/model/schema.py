@@ -78,6 +78,7 @@ Power = Q("power")
 Torque = Q("torque")
 Time = Q("time")
 Viscosity = Q("viscosity")
+Frequency = Q("frequency")
 
 Dof = Literal["x", "y", "z", "loa", "theta"]
 """Body DOFs: translations along the global x, y, z; 'loa' a single translation along
@@ -654,6 +655,27 @@ class Spline(Strict):
 
 
 # --------------------------------------------------------------------------- drives
+class TorqueHarmonic(Strict):
+    """One harmonic of a fluctuating drive or load torque, T_a sin(2 pi f t + phase) on top
+    of the nominal torque (a mill's charge, a compressor's strokes, an engine's firing):
+    f an ``order`` of the body's own rotation frequency or a fixed ``frequency``."""
+
+    amplitude: Torque = Field(gt=0, description="Torque amplitude T_a.")
+    order: Number | None = Field(None, gt=0, description=(
+        "Frequency as a multiple of the body's rotation frequency (e.g. 2 for twice per "
+        "revolution); follows the speed in a speed sweep."))
+    frequency: Frequency | None = Field(None, gt=0, description=(
+        "A fixed frequency instead of an order (e.g. '50 Hz'); a speed sweep keeps it."))
+    phase: Angle = Field(0.0, description="Phase at t = 0.")
+
+    @model_validator(mode="after")
+    def _one(self):
+        if (self.order is None) == (self.frequency is None):
+            raise ValueError("give exactly one of 'order' and 'frequency', e.g. order = 2 "
+                             "(twice per revolution of the body) or frequency = '50 Hz'")
+        return self
+
+
 class Drive(Strict):
     """A power input: torque, power or prescribed speed at a body."""
 
@@ -666,6 +688,9 @@ class Drive(Strict):
     mode: Literal["torque", "speed"] = Field(
         "torque", description="'torque': constant torque; 'speed': prescribed speed (DOF removed)."
     )
+    fluctuation: list[TorqueHarmonic] = Field([], description=(
+        "Harmonics of the drive torque about its nominal value (a 'torque' drive only), "
+        "e.g. [{amplitude = '500 N m', frequency = '100 Hz'}] (see TorqueHarmonic)."))
 
     @model_validator(mode="after")
     def _one(self):
@@ -678,6 +703,10 @@ class Drive(Strict):
         if abs(self.speed) < 1e-6:
             raise FieldError("speed", "must not be zero (below 1e-6 rad/s); give the nominal "
                              "speed, e.g. '3000 rpm'")
+        if self.fluctuation and self.mode == "speed":
+            raise FieldError("fluctuation", "a 'speed' drive holds its speed, so its torque "
+                             "is what the gearbox takes; put the fluctuation on a load (or "
+                             "make the drive mode = 'torque')")
         return self
 
     @property
@@ -699,6 +728,9 @@ class Load(Strict):
     speed_coefficient: TorsionalDamping = Field(
         0.0, ge=0, description="dT/d(speed) of the load characteristic (removes rigid-body drift)."
     )
+    fluctuation: list[TorqueHarmonic] = Field([], description=(
+        "Harmonics of the load torque about its nominal value, e.g. [{amplitude = "
+        "'20 kN m', order = 2}] (see TorqueHarmonic)."))
 
 
 class Analysis(Strict):

@@ -237,7 +237,15 @@ class _StaticProblem:
             ex = excitation_numpy(s, float(t))
             k, p, e, g, fr = ex.stiffness, ex.force, ex.error, ex.half_gap, ex.friction
         W = s.friction_matrix(fr) if s.n_friction else None
-        return _Loads(k, p, e, g, W, s.external_force - self.V.T @ p)
+        f_eff = s.external_force - self.V.T @ p
+        names = s.metadata.get("torque_fluctuation_elements") if s.metadata else None
+        if names and self.phi.shape[1]:
+            fluct = [s.element_names.index(name) for name in names]
+            # a drive's or load's torque fluctuation accelerates the rigid train: its
+            # inertial (d'Alembert) load -M phi phi^T g, phi mass-normalised, balances it
+            g_f = -self.V[fluct].T @ p[fluct]
+            f_eff = f_eff - self.mass * (self.phi @ (self.phi.T @ g_f))
+        return _Loads(k, p, e, g, W, f_eff)
 
     def check_balance(self, f_eff, friction_load=None):
         """Raise if the effective external forces do work along a rigid-body mode.

@@ -148,6 +148,13 @@ class PeriodicProblem:
                 self._models.clear()
             m = self.model._replace(frequency=self.model.frequency * key,
                                     error_omega=self.model.error_omega * key)
+            fixed = self.structure.metadata.get("fixed_frequency_elements") or []
+            if fixed and key != 1.0:
+                raise SolverError(
+                    f"{', '.join(fixed)}: a torque harmonic of a fixed frequency does not "
+                    f"follow the speed, so the period at another speed is not the model's "
+                    f"scaled; give it as an 'order' of the body's rotation, or solve at the "
+                    f"model's speed")
             if (self._frame_terms is None and key != 1.0
                     and self.structure.metadata.get("rotating_frame")):
                 raise SolverError(
