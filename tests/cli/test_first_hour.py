@@ -145,6 +145,12 @@ def test_errors_beyond_the_stated_grade_and_odd_backlash_are_flagged(tmp_path):
     assert any("meshes.a2.backlash" in w and "ISO/TR 10064-2" in w for w in said), said
     quiet = runner.invoke(app, ["check", str(write_model(tmp_path, split_model(), "ok.toml"))])
     assert not warnings_of(quiet), quiet.stderr  # a sound model: no warning at all
+    # an installation error is the bore's, which the gear's grade does not bound (a
+    # reviewer's 20 um on an 845 mm centre distance was flagged against grade 5's F_rT)
+    bore = split_model().replace(
+        "[gears.b2]", '[gears.a.errors]\ninstallation = "20 um"\ngrade = 3\n\n[gears.b2]')
+    res = runner.invoke(app, ["check", str(write_model(tmp_path, bore, "bore.toml"))])
+    assert res.exit_code == 0 and not warnings_of(res), res.stderr
 
 
 def test_a_dynamic_factor_above_three_points_to_modes(tension_run):

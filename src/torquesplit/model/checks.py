@@ -729,7 +729,9 @@ def tolerance_warnings(model: Model, kin) -> list[tuple[str, str]]:
 
     * eccentricity (a runout of twice its size), installation error and bearing runout
       against the ISO 1328-1 runout tolerance F_rT of the gear at grade 11, the coarsest,
-      and at the grade the file states (``errors.grade``, one grade step of margin);
+      and (not the installation error: a housing's bore position, which the gear's grade
+      does not bound) at the grade the file states (``errors.grade``, one grade step of
+      margin);
     * single pitch error against f_pT the same way;
     * a planet pin position error (as an installation error, a runout of twice its
       size) and the eccentricity of the carrier that holds the gear against F_rT of the
@@ -761,7 +763,9 @@ def tolerance_warnings(model: Model, kin) -> list[tuple[str, str]]:
                 tol = (grades.runout_tolerance if kind == "runout"
                        else grades.single_pitch_tolerance)
                 coarsest = tol(11, g.module, d)
-                own = tol(stated, g.module, d) if stated else None
+                # the gear's grade bounds the gear, not the bore that holds it: an
+                # installation error gets the unit-slip check of grade 11 only
+                own = tol(stated, g.module, d) if stated and field != "installation" else None
             except ModelError:
                 continue  # outside the standard's scope: the size checks apply
             name_tol = "runout tolerance F_rT" if kind == "runout" else                 "single pitch tolerance f_pT"

@@ -445,8 +445,10 @@ class Shaft(Strict):
     damping: TorsionalDamping | None = Field(None, ge=0, description=(
         "Torsional damping (neither this nor damping_ratio: the shaft is undamped)."))
     damping_ratio: Number | None = Field(
-        None, ge=0, description="Torsional damping as a fraction of critical."
-    )
+        None, ge=0, description=(
+            "Torsional damping as a fraction of critical of this shaft between its two end "
+            "inertias alone, c = 2 zeta sqrt(k J_a J_b / (J_a + J_b)); a mode of the whole "
+            "train gets less of it (the 'modes' table gives each mode's damping ratio)."))
 
     @model_validator(mode="after")
     def _stiffness(self):
