@@ -114,7 +114,8 @@ def render_summary(s: dict, console) -> None:
         torque = f"{b['torque_Nm']:.6g}" + (" per mesh (idler: net 0)" if b.get("idler")
                                              else "")
         t.add_row(name, f"{b['speed_rpm']:.6g}", torque,
-                  f"{b['mass_kg']:.5g}{mark(b['mass_computed'], basis)}",
+                  (f"{b['mass_kg']:.5g}{mark(b['mass_computed'], basis)}" if b["mass_kg"]
+                   else "-"),  # (a body that only turns needs no mass)
                   f"{b['polar_inertia_kgm2']:.5g}{mark(b['inertia_computed'])}",
                   pos + (" (placed)" if b["position_computed"] else ""))
     console.print(t)

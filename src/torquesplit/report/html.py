@@ -139,8 +139,9 @@ def _model_tables(res) -> str:
     rows = []
     for name, b in s["bodies"].items():
         rows.append([name, "gear" if name in m.gears else "body", _g(b["speed_rpm"], 6),
-                     _g(b["torque_Nm"], 6), _g(b["mass_kg"]) + (" *" if b["mass_computed"]
-                                                                 else ""),
+                     _g(b["torque_Nm"], 6),
+                     (_g(b["mass_kg"]) + (" *" if b["mass_computed"] else "")
+                      if b["mass_kg"] else "–"),  # (a body that only turns needs no mass)
                      _g(b["polar_inertia_kgm2"]) + (" *" if b["inertia_computed"] else ""),
                      "(" + ", ".join(f"{round(v, 3) + 0.0:.5g}" for v in b["position_mm"])
                      + ")"])
