@@ -8,9 +8,13 @@ element         deformation ``V . q``                         stiffness
 mesh            ``n.(u_d - u_n) + arm_d th_d - arm_n th_n``   k(phase) table [N/m]
 shaft           ``th_a - th_b``                               torsional [N m/rad]
 support         ``u_i`` (one translational DOF; ``- u_seat``  bearing [N/m], clearance
-                for a bearing on another body, ``on``)
+                for a bearing on another body, ``on``)       per axis
+radial bearing  the two translations across the axis, 2-D    the spline's radial law,
+                (a support with a 'radial' clearance)         no stick, no friction
 spline torsion  ``th_hub - th_float``                         torsional [N m/rad]
 spline radial   ``u_hub - u_float``, radial plane, 2-D        radial law, Dong et al. 2021 eq. 6
+torque harmonic ``+-th`` of a drive's or load's body          none; a force table of
+                                                              the torque [N m]
 ==============  ==========================================  =========================
 
 A mesh with ``friction`` also gets its friction projection W (Jin et al. 2019; forces only):
