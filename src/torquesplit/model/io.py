@@ -18,12 +18,15 @@ from .schema import FieldError, Model
 from .units import _short
 
 
-def load_model(source, *, check: bool = True) -> Model:
+def load_model(source, *, check: bool = True, changes=None) -> Model:
     """Read a model file (``.toml`` or ``.json``), a shipped example by name (as the
     command line takes it: ``"ji_li_mill_drive"``), a dict or a :class:`Model`.
 
     All values are converted to SI.  With ``check`` the topology and physical
-    consistency checks of :mod:`torquesplit.model.checks` run too.  Bad input raises
+    consistency checks of :mod:`torquesplit.model.checks` run too.  ``changes`` maps
+    field paths to values as ``--set`` takes them (``{"meshes.m11.damping_ratio": 0.1,
+    "shafts.drive1.diameter": "250 mm"}``), applied before the validation (a model is
+    frozen: change one with :meth:`Model.with_changes`).  Bad input raises
     :class:`~torquesplit.errors.ModelError` naming the file, field and fix.
 
     Examples
@@ -32,18 +35,21 @@ def load_model(source, *, check: bool = True) -> Model:
     >>> m = torquesplit.load_model(torquesplit.example_path("ji_li_mill_drive"))
     >>> m.gears["z1"].teeth
     19
+    >>> stiffer = m.with_changes({"shafts.drive1.diameter": "300 mm"})
     """
+    if changes:
+        from .overrides import apply_overrides, read_raw
+
+        if isinstance(source, Model):
+            return source.with_changes(changes)
+        raw = source if isinstance(source, dict) else read_raw(_resolve(source))
+        return load_model(apply_overrides(raw, dict(changes)), check=check)
     if isinstance(source, Model):
         model, name = source, None
     elif isinstance(source, dict):
         model, name = model_from_dict(source), None
     else:
-        path = Path(source)
-        if not path.exists() and path.suffix == "" and path.parent == Path("."):
-            from torquesplit.examples import example_names, example_path
-
-            if str(source) in example_names():  # a shipped example by name
-                path = example_path(str(source))
+        path = _resolve(source)
         name = str(path)
         data = read_file(path)
         model = model_from_dict(data, source=name)
@@ -52,6 +58,17 @@ def load_model(source, *, check: bool = True) -> Model:
 
         check_model(model, source=name)
     return model
+
+
+def _resolve(source) -> Path:
+    """A model file's path: ``source`` itself, or the shipped example of that name."""
+    path = Path(source)
+    if not path.exists() and path.suffix == "" and path.parent == Path("."):
+        from torquesplit.examples import example_names, example_path
+
+        if str(source) in example_names():  # a shipped example by name
+            path = example_path(str(source))
+    return path
 
 
 def read_file(path: Path) -> dict[str, Any]:

@@ -223,12 +223,31 @@ def support_frame(kin, body: str) -> tuple[str | None, float | None, float]:
 
 
 # --------------------------------------------------------------------------- solver
-@remember_last
-def solve_kinematics(model: Model) -> Kinematics:
+def solve_kinematics(model) -> Kinematics:
     """Layout, speeds, power flow, torques and forces of the nominal equal split.
 
-    The result is kept while the model lives (models and kinematics are frozen): loading
-    a model checks it through its kinematics, and the run set up next needs them again."""
+    ``model``: a :class:`Model`, or what :func:`~torquesplit.load_model` reads (a file, a
+    shipped example's name, a dict).  The result is kept while the model lives (models
+    and kinematics are frozen): loading a model checks it through its kinematics, and
+    the run set up next needs them again.  A model changed in place after loading is
+    refused (:meth:`Model.changed_in_place`)."""
+    if not isinstance(model, Model):
+        from .io import load_model
+
+        model = load_model(model)
+    if model.changed_in_place():
+        from ..errors import ModelError
+
+        raise ModelError([("", (
+            "the model was changed in place after it was loaded (an entry of one of its "
+            "sections replaced, added or deleted): that change is not checked, and results "
+            "kept for the model would not see it; make it with model.with_changes({'PATH': "
+            "value}) or load_model(source, changes={...})"))])
+    return _kinematics(model)
+
+
+@remember_last
+def _kinematics(model: Model) -> Kinematics:
     return _solve_kinematics(model)
 
 

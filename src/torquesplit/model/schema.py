@@ -796,6 +796,35 @@ class Model(Strict):
 
     _origins: dict[str, str] = PrivateAttr(default_factory=dict)
     """Generated location -> the ``[[planetary]]`` field it came from (see written_at)."""
+    _identity: tuple = PrivateAttr(default=())
+    """The sections' entries as validated (see :meth:`changed_in_place`)."""
+
+    def model_post_init(self, __context) -> None:
+        self._identity = self._entries()
+
+    def _entries(self) -> tuple:
+        """Every entry of every section, by name and object identity."""
+        return tuple((section, tuple((k, id(v)) for k, v in getattr(self, section).items()))
+                     for section in ("gears", "bodies", "shafts", "meshes", "splines",
+                                     "drives", "loads"))
+
+    def changed_in_place(self) -> bool:
+        """True when an entry of a section was replaced, added or deleted after the model
+        was validated (the sections are plain dicts): such a change is not checked, and
+        results computed before it would be reused for it."""
+        return self._entries() != self._identity
+
+    def with_changes(self, changes) -> "Model":
+        """A new, validated and checked model with ``changes`` applied: a mapping of field
+        paths to values, as ``--set`` takes them (``{"meshes.m11.damping_ratio": 0.1,
+        "shafts.s1.diameter": "250 mm"}``; a bare number is SI).  The model itself is not
+        changed (it is frozen)."""
+        import json
+
+        from .io import load_model, model_to_json
+        from .overrides import apply_overrides
+
+        return load_model(apply_overrides(json.loads(model_to_json(self)), dict(changes)))
 
     @model_validator(mode="after")
     def _expand_planetary(self):
@@ -835,6 +864,7 @@ class Model(Strict):
         object.__setattr__(self, "meshes", meshes)
         object.__setattr__(self, "planetary", [])
         self._origins = origins
+        self._identity = self._entries()  # (the expanded sections are the validated ones)
         return self
 
     def __eq__(self, other):

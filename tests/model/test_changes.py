@@ -1,0 +1,57 @@
+"""Changing a model from Python: with_changes / load_model(changes=...), and a model
+changed in place refused (a reviewer's edit of a loaded model's dict ran with the old
+kinematics, silently)."""
+
+from __future__ import annotations
+
+import warnings
+
+import pytest
+
+import torquesplit
+
+
+@pytest.fixture(scope="module")
+def model():
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return torquesplit.load_model("ji_li_mill_drive")
+
+
+def test_with_changes_gives_a_new_checked_model(model):
+    new = model.with_changes({"meshes.m11.damping_ratio": 0.2,
+                              "shafts.drive1.diameter": "300 mm"})
+    assert new.meshes["m11"].damping_ratio == 0.2 and new.shafts["drive1"].diameter == 0.3
+    assert model.meshes["m11"].damping_ratio != 0.2  # the model itself is unchanged
+    k_old = torquesplit.assemble(model)
+    k_new = torquesplit.assemble(new)
+    e = k_new.element_names.index("drive1")
+    assert k_new.stiffness_table[e, 0] > k_old.stiffness_table[e, 0]
+    with pytest.raises(torquesplit.ModelError, match="meshes.m11.damping_ratio"):
+        model.with_changes({"meshes.m11.damping_ratio": -3})
+
+
+def test_load_model_takes_changes_for_a_file_an_example_or_a_dict(model):
+    by_name = torquesplit.load_model("ji_li_mill_drive",
+                                     changes={"shafts.drive1.diameter": "250 mm"})
+    assert by_name.shafts["drive1"].diameter == pytest.approx(0.25)
+    assert torquesplit.load_model(model, changes={"drives.motor.speed": "700 rpm"}) \
+        .drives["motor"].speed == pytest.approx(700 * 3.141592653589793 / 30)
+    with pytest.raises(torquesplit.ModelError, match="gears.nope"):
+        torquesplit.load_model("ji_li_mill_drive", changes={"gears.nope.teeth": 3})
+
+
+@pytest.mark.parametrize("edit", ["replace", "delete"])
+def test_a_model_changed_in_place_is_refused(edit):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        m = torquesplit.load_model("ji_li_mill_drive")
+    torquesplit.solve_kinematics(m)  # (kept for the model)
+    if edit == "replace":
+        d = m.drives["motor"]
+        m.drives["motor"] = d.model_copy(update={"speed": 2 * d.speed})
+    else:
+        del m.meshes["m22"]
+    assert m.changed_in_place()
+    with pytest.raises(torquesplit.ModelError, match="changed in place.*with_changes"):
+        torquesplit.simulate(m, duration=0.01)
