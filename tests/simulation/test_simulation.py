@@ -208,3 +208,18 @@ def test_every_element_force_is_kept_shaft_torques_in_newton_metres(tmp_path):
     header = (tmp_path / "r_history.csv").read_text().splitlines()[0].split(",")
     assert "drive1_Nm" in header and "m11_N" in header and len(header) == len(names) + 1
 
+
+
+def test_a_misspelt_definition_is_refused_by_every_export(tmp_path):
+    """It was dropped: the file was written without metrics (and metric_values iterated
+    the letters of one definition)."""
+    res = torquesplit.simulate("ji_li_mill_drive", cycles=20)
+    for call in (lambda: res.to_dataset("mean_forse"),
+                 lambda: res.save(tmp_path / "r.nc", definition="foo"),
+                 lambda: res.to_csv(tmp_path / "r.csv", definition="foo"),
+                 lambda: res.warnings("foo")):
+        with pytest.raises(ValueError, match="unknown load-sharing definition"):
+            call()
+    assert not list(tmp_path.iterdir())
+    one = res.metric_values("mean_force")
+    assert one == res.metric_values(["mean_force"]) and "load_sharing.mean_force" in one

@@ -172,6 +172,8 @@ class Results:
         """
         from .plausibility import result_warnings
 
+        if definition is not None:
+            self.check_definition(definition)
         out = list(self.model_warnings) if self.model_warnings is not None else [
             f"{loc}: {msg}" for loc, msg in self._model_plausibility()]
         out += self.run_warnings
@@ -257,16 +259,7 @@ class Results:
         Every number comes from the per-cycle statistics streamed by the integrator at
         every step; the settle criterion (``window`` cycles at least, ``tolerance``) gives
         one settle time per load-sharing group, used by all of its metrics."""
-        definition = definition or self.default_definition
-        if definition in ("static", "static_torque"):
-            raise SolverError(
-                "'static_torque' is the load sharing of quasi-static equilibria (Mo et al. "
-                "2017 eqs. 14-15), not of a dynamic run; compute it with `torquesplit "
-                "static MODEL` (or torquesplit.quasistatic.quasi_static_load_sharing), or "
-                f"choose one of {', '.join(ls.DYNAMIC_DEFINITIONS)} for this run.")
-        if definition not in ls.DEFINITIONS:
-            raise ValueError(f"unknown load-sharing definition {definition!r}; choose one of "
-                             f"{', '.join(ls.DYNAMIC_DEFINITIONS)}")
+        definition = self.check_definition(definition)
         s = self.solution
         names = self.mesh_names
         c_max, c_min, c_mean, c_cnt, c_ratio = self.complete_cycle_statistics()
@@ -344,6 +337,21 @@ class Results:
             out.append(a)
         return tuple(out)
 
+    def check_definition(self, definition: str | None) -> str:
+        """``definition``, or the model's default when None; an unknown one, or the
+        quasi-static 'static_torque', raises (before anything is computed or written)."""
+        definition = definition or self.default_definition
+        if definition in ("static", "static_torque"):
+            raise SolverError(
+                "'static_torque' is the load sharing of quasi-static equilibria (Mo et al. "
+                "2017 eqs. 14-15), not of a dynamic run; compute it with `torquesplit "
+                "static MODEL` (or torquesplit.quasi_static_load_sharing), or "
+                f"choose one of {', '.join(ls.DYNAMIC_DEFINITIONS)} for this run.")
+        if definition not in ls.DEFINITIONS:
+            raise ValueError(f"unknown load-sharing definition {definition!r}; choose one of "
+                             f"{', '.join(ls.DYNAMIC_DEFINITIONS)}")
+        return definition
+
     def metric_values(self, definitions=None, *, window: int = 20,
                       tolerance: float = 0.01) -> dict[str, float]:
         """Every metric of the run by a flat name (:meth:`Metrics.values`), for every
@@ -353,6 +361,8 @@ class Results:
         from ..metrics.planetary import planet_load_sharing
 
         out: dict[str, float] = {}
+        if isinstance(definitions, str):  # one definition (not its letters)
+            definitions = [definitions]
         for d in definitions or ls.DYNAMIC_DEFINITIONS:
             met = self.metrics(d, window=window, tolerance=tolerance)
             out.update(met.values())
@@ -523,6 +533,8 @@ class Results:
         """
         from . import files
 
+        if definition is not None:
+            self.check_definition(definition)  # (before any file is claimed)
         plan = files.check_output(path, formats={".csv": "csv"}, overwrite=overwrite)
         path = plan.path
         header = ["mesh", "group", "nominal_force_N", "static_force_N", "mean_force_N",

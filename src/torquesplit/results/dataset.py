@@ -139,6 +139,8 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
         ds["velocity"] = _var(("time", "history_dof"), s.history_v, "m/s or rad/s",
                               "vibratory velocity")
     _note_sampling(ds, s.history_t, res.statistics().get("step_s"))
+    if definition is not None and hasattr(res, "check_definition"):
+        res.check_definition(definition)  # a misspelt one raises; a diverged run's do not
     try:
         met = res.metrics(definition)
         ds["load_sharing"] = _var(("mesh",), [met.load_sharing.per_mesh[m] for m in meshes],
