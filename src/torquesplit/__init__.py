@@ -8,13 +8,17 @@ The pipeline, one stage per subpackage (each stage returns a new object)::
     simulate(model, ...)        -> Results     (solve/ + metrics/ + results/)
     quasi_static_load_sharing(model) -> QuasiStaticResults (equilibria over mesh positions)
     model_modes(model)          -> ModalReport (natural modes about the static equilibrium)
+    steady_state(model, speed)  -> SteadyState (steady/: periodic state; sweep_speed,
+                                                campbell over a speed range)
+    load_results(file.nc)       -> Results     (a saved run, its metrics recomputed)
     run_study(study_file)       -> Dataset     (study/: grids, Monte Carlo, sensitivity)
 """
 
 from __future__ import annotations
 
 from .assembly.assemble import assemble
-from .errors import ModelError, ModelWarning, SolverError, StepTooLargeError, TorquesplitError
+from .errors import (ModelError, ModelWarning, OptionError, SolverError, StepTooLargeError,
+                     TorquesplitError)
 from .examples import example_names, example_path
 from .model.io import load_model
 from .model.kinematics import solve_kinematics
@@ -25,16 +29,24 @@ from .simulation import simulate
 __version__ = "0.1.0"
 
 __all__ = [
-    "ModelError", "ModelWarning", "SolverError", "StepTooLargeError", "TorquesplitError",
-    "example_names", "example_path", "load_model", "solve_kinematics", "assemble", "simulate",
-    "quasi_static_load_sharing", "model_modes", "Study", "run_study",
+    "ModelError", "ModelWarning", "OptionError", "SolverError", "StepTooLargeError",
+    "TorquesplitError", "example_names", "example_path", "load_model", "solve_kinematics",
+    "assemble", "simulate", "quasi_static_load_sharing", "model_modes", "steady_state",
+    "sweep_speed", "campbell", "load_results", "Study", "run_study",
 ]
+
+#: loaded only when asked for (the study and steady-state layers, xarray, scipy.stats)
+_LAZY = {"Study": "study", "run_study": "study", "steady_state": "steady",
+         "sweep_speed": "steady", "campbell": "steady", "load_results": "results"}
 
 
 def __getattr__(name):
-    # the study layer (and xarray, scipy.stats) load only when asked for
-    if name in ("Study", "run_study"):
-        from . import study
+    if name in _LAZY:
+        import importlib
 
-        return getattr(study, name)
+        return getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
     raise AttributeError(f"module 'torquesplit' has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | set(__all__))

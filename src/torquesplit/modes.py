@@ -109,8 +109,18 @@ class ModalReport:
     rotating_frame: bool
     """True if the modes include the carrier-frame Coriolis and centripetal terms."""
 
+    def __repr__(self) -> str:
+        f = [r.frequency for r in self.rows]
+        span = f", {f[0]:.5g}..{f[-1]:.5g} Hz" if f else ""
+        return (f"ModalReport({len(self.rows)} modes{span}, {self.rigid_modes} rigid-body, "
+                f"{len(self.dof_names)} DOFs{', turning frame' if self.rotating_frame else ''})")
+
     def shape(self, mode: int) -> dict[str, complex]:
         """Mass-normalised shape of ``mode`` (1-based) by DOF name."""
+        n = self.solution.mode_shapes.shape[1]
+        if not (isinstance(mode, (int, np.integer)) and 1 <= mode <= n):
+            raise ValueError(f"mode must be a whole number 1..{n} (1-based, ascending "
+                             f"frequency), got {mode!r}")
         phi = self.solution.mode_shapes[:, mode - 1]
         return {n: complex(v) for n, v in zip(self.dof_names, phi)}
 
@@ -348,6 +358,11 @@ def model_modes(model, *, rotating_frame: bool = True, below: float | None = Non
     from .solve.modal import modal_analysis
     from .solve.static import static_equilibrium
 
+    if count is not None and not (isinstance(count, (int, np.integer)) and count >= 1):
+        raise ValueError(f"count must be a whole number of modes, 1 or more, got {count!r}")
+    if below is not None and not (isinstance(below, (int, float)) and below > 0):
+        raise ValueError(f"below must be a positive frequency in Hz (a number), got "
+                         f"{below!r}")
     if not hasattr(model, "meshes"):
         model = load_model(model)
     kin = solve_kinematics(model)

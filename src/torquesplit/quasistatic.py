@@ -37,6 +37,16 @@ class QuasiStaticResults:
     """Warnings of the sweep as text (the command line puts the model's in too); empty:
     :func:`torquesplit.results.plausibility.static_warnings` on demand."""
 
+    def __repr__(self) -> str:
+        sol = self.solution
+        stopped = f", stopped after {sol.times.size} of {sol.planned}" if getattr(
+            sol, "interrupted", False) else ""
+        span = float(sol.times[-1] - sol.times[0]) if sol.times.size else 0.0
+        return (f"QuasiStaticResults({self.model.model.name!r}: {sol.times.size} mesh "
+                f"positions over {span:.4g} s{stopped}, "
+                f"{'all' if sol.converged.all() else 'NOT all'} converged, "
+                f"{len(self.mesh_names)} meshes)")
+
     def all_warnings(self) -> list[str]:
         """The warnings kept with the sweep, else those of its results."""
         if self.warnings:

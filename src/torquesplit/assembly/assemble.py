@@ -140,9 +140,14 @@ def number_dofs(model: Model, kin: Kinematics) -> tuple[DofMap, np.ndarray]:
 
 def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None = None,
              options: dict | None = None) -> Structure:
-    """Assemble the equations of motion of ``model`` (see module docstring); a refusal
-    names the field as the user wrote it (a ``[[planetary]]`` stage's, not the element
-    it generated), as ``torquesplit check`` does."""
+    """Assemble the equations of motion of ``model`` (see module docstring; a
+    :class:`Model` or what :func:`~torquesplit.load_model` reads); a refusal names the
+    field as the user wrote it (a ``[[planetary]]`` stage's, not the element it
+    generated), as ``torquesplit check`` does."""
+    if not isinstance(model, Model):
+        from ..model.io import load_model
+
+        model = load_model(model)
     try:
         return _assemble(model, kin, n_table=n_table, options=options)
     except ModelError as exc:

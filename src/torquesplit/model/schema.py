@@ -877,6 +877,12 @@ class Model(Strict):
 
     __hash__ = None  # (as before: its dict fields make a model unhashable)
 
+    def __repr__(self) -> str:
+        parts = [f"{len(getattr(self, k))} {k}" for k in ("gears", "bodies", "shafts",
+                                                           "meshes", "splines")
+                 if getattr(self, k)]
+        return f"Model({self.model.name!r}: {', '.join(parts)})"
+
     def written_at(self, loc: str) -> str:
         """A location (``gears.st_planet2.support.pin_error.radial``) as the user wrote
         it: the field of the ``[[planetary]]`` stage that generated it

@@ -97,6 +97,12 @@ class SteadyState:
         self.dropped = dropped
         self.problem: PeriodicProblem = problem
 
+    def __repr__(self) -> str:
+        sol = self.solution
+        return (f"SteadyState({self.model.model.name!r}: {sol.method} at speed factor "
+                f"{sol.speed:.6g}, period {1.0 / (self.period.frequency * sol.speed):.4g} s, "
+                f"{'converged' if sol.converged else 'NOT converged'})")
+
     @property
     def success(self) -> bool:
         return self.solution.converged

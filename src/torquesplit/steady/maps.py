@@ -424,9 +424,11 @@ def campbell(model, start: float, stop: float, *, points: int = 41,
 
     Natural frequencies are those of the model linearised about its static equilibrium
     (mean mesh stiffness); a model with speed-dependent terms (a gyroscopic matrix from
-    a rotating frame) is re-assembled at each speed.  Returns an :class:`xarray.Dataset`
-    (dims ``speed``, ``mode``, ``line``) with ``attrs['critical_speeds']`` a list of
-    dicts (mode, frequency, order, source, speed, strain-energy shares).
+    a rotating frame) is re-assembled at each speed.  Returns ``(dataset, crossings)``:
+    an :class:`xarray.Dataset` (dims ``speed``, ``mode``, ``line``; ``attrs``
+    ``critical_speeds_rpm`` and ``critical_speed_labels``, and the crossings that the
+    planets' mesh phasing suppresses apart) and the list of crossings as dicts (mode,
+    frequency_Hz, order, source, speed_rpm, energy: the strain-energy shares).
     """
     import xarray as xr
 

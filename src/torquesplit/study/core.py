@@ -111,6 +111,12 @@ class Study:
         self.source = str(source) if isinstance(source, (str, Path)) else None
         self._plan: Plan | None = None
 
+    def __repr__(self) -> str:
+        design = next((d for d in ("grid", "monte_carlo", "sensitivity")
+                       if getattr(self.spec, d, None) is not None), "?")
+        return (f"Study({self.name!r}: {design} on {self.spec.study.model!r}"
+                f"{', from ' + self.source if self.source else ''})")
+
     @classmethod
     def from_file(cls, path) -> "Study":
         return cls(path)

@@ -1,0 +1,57 @@
+"""The Python API as a notebook user meets it: what the package lists, short reprs,
+argument checks that name the argument (a reviewer's findings)."""
+
+from __future__ import annotations
+
+import warnings
+
+import pytest
+
+import torquesplit
+
+
+@pytest.fixture(scope="module")
+def model():
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return torquesplit.load_model("ji_li_mill_drive")
+
+
+def test_everything_listed_is_there_and_listed():
+    for name in torquesplit.__all__:
+        assert getattr(torquesplit, name) is not None, name
+        assert name in dir(torquesplit), name  # (tab completion of the lazy ones too)
+    assert issubclass(torquesplit.OptionError, torquesplit.TorquesplitError)
+
+
+def test_the_pipeline_functions_take_what_load_model_reads(model):
+    assert torquesplit.solve_kinematics("ji_li_mill_drive").input_power == \
+        torquesplit.solve_kinematics(model).input_power
+    assert torquesplit.assemble("ji_li_mill_drive").n_dof == torquesplit.assemble(model).n_dof
+
+
+def test_reprs_are_one_short_line(model):
+    objects = [model, torquesplit.model_modes(model),
+               torquesplit.quasi_static_load_sharing(model, revolutions=0.05),
+               torquesplit.steady_state(model, method="hb"),
+               torquesplit.Study({"study": {"name": "k", "model": "ji_li_mill_drive",
+                                            "outputs": ["load_sharing.engineering"]},
+                                  "grid": {"parameters": [{"path": "meshes.m11.damping_ratio",
+                                                           "values": [0.05, 0.1]}]}})]
+    for obj in objects:
+        text = repr(obj)
+        assert len(text) < 160 and "\n" not in text and " at 0x" not in text, text
+        assert type(obj).__name__ in text
+
+
+def test_mode_numbers_and_counts_are_checked(model):
+    report = torquesplit.model_modes(model)
+    assert report.shape(1) and report.shape(len(report.solution.frequencies))
+    for bad in (0, -1, 99, 1.5):
+        with pytest.raises(ValueError, match="1-based"):
+            report.shape(bad)
+    for bad in (0, -1):
+        with pytest.raises(ValueError, match="count must be"):
+            torquesplit.model_modes(model, count=bad)
+    with pytest.raises(ValueError, match="below must be a positive frequency"):
+        torquesplit.model_modes(model, below="1 kHz")
