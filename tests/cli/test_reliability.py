@@ -258,6 +258,9 @@ def test_a_diverged_run_prints_no_coefficients_but_its_likely_cause(tmp_path):
     assert "static deflection" in data["likely_cause"]
     with xr.open_dataset(tmp_path / "partial.nc", engine="h5netcdf") as ds:
         assert int(ds.attrs["status"]) != 0 and "diverged" in ds.attrs["message"]
+        # the failure is among the file's warnings too (its metrics are NaN)
+        assert any(w.startswith("run: ") and "diverged" in w
+                   for w in json.loads(ds.attrs["warnings_json"]))
     # check refuses the model outright: no run of it can succeed
     one_line_error(runner.invoke(app, ["check", str(model)]),
                    "beyond what any run accepts", "check the stiffness values")

@@ -177,6 +177,8 @@ class Results:
         out = list(self.model_warnings) if self.model_warnings is not None else [
             f"{loc}: {msg}" for loc, msg in self._model_plausibility()]
         out += self.run_warnings
+        if not self.success:  # (its metrics are NaN: say why beside them)
+            out.append(f"run: {self.message}")
         if self.success:
             try:
                 met = self.metrics(definition)
