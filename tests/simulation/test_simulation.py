@@ -223,3 +223,15 @@ def test_a_misspelt_definition_is_refused_by_every_export(tmp_path):
     assert not list(tmp_path.iterdir())
     one = res.metric_values("mean_force")
     assert one == res.metric_values(["mean_force"]) and "load_sharing.mean_force" in one
+
+
+def test_group_and_system_metrics_are_dataset_variables():
+    """They were only inside the metrics_json attribute."""
+    res = torquesplit.simulate("ji_li_mill_drive", cycles=20)
+    met, ds = res.metrics(), res.to_dataset()
+    assert list(ds["group"].values) == list(met.load_sharing.per_group)
+    for g, v in met.load_sharing.per_group.items():
+        assert float(ds["load_sharing_group"].sel(group=g)) == v
+        assert float(ds["dynamic_factor_group"].sel(group=g)) == \
+            met.dynamic_factors.per_group_dynamic_factor[g]
+    assert float(ds["load_sharing_system"]) == met.load_sharing.system

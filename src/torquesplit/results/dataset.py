@@ -157,6 +157,23 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
                                       "cycles")
         ds["double_flank"] = _var(("mesh",), [int(r.double_flank) for r in met.rows], "1",
                                   "1: the mesh has no backlash (double-flank contact)")
+        # each load-sharing group's and the system's numbers as variables too (for
+        # xarray, MATLAB and spreadsheet users: not only inside metrics_json)
+        groups = list(met.load_sharing.per_group)
+        ds = ds.assign_coords(group=("group", groups))
+        ds["load_sharing_group"] = _var(("group",), [met.load_sharing.per_group[g]
+                                                     for g in groups], "1",
+                                        f"load-sharing coefficient of each group "
+                                        f"({met.definition})")
+        ds["dynamic_factor_group"] = _var(("group",), [d.per_group_dynamic_factor[g]
+                                                       for g in groups], "1",
+                                          "largest dynamic factor of the group's meshes")
+        ds["peak_to_nominal_group"] = _var(("group",), [d.per_group_peak_to_nominal[g]
+                                                        for g in groups], "1",
+                                           "largest peak/nominal of the group's meshes")
+        ds["load_sharing_system"] = _var((), met.load_sharing.system, "1",
+                                         f"system load-sharing coefficient "
+                                         f"({met.definition})")
         ds.attrs["load_sharing_definition"] = met.definition
         ds.attrs["metrics_json"] = json.dumps(met.to_dict(), default=float)
         ds = add_planet_load_sharing(ds, met.load_sharing, res.kinematics)
