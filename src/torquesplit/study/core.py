@@ -114,7 +114,9 @@ class Study:
     def __repr__(self) -> str:
         design = next((d for d in ("grid", "monte_carlo", "sensitivity")
                        if getattr(self.spec, d, None) is not None), "?")
-        return (f"Study({self.name!r}: {design} on {self.spec.study.model!r}"
+        model = self.spec.study.model
+        model = repr(model) if isinstance(model, str) else "a model given as data"
+        return (f"Study({self.name!r}: {design} on {model}"
                 f"{', from ' + self.source if self.source else ''})")
 
     @classmethod

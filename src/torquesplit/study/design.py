@@ -215,9 +215,13 @@ def _check_generated_paths(spec: StudySpec, model) -> None:
                     f"field instead: {written!r} (it sets every planet's alike)"))
 
 
-def _model_data(name: str, folder: Path | None) -> tuple[str, dict]:
+def _model_data(name, folder: Path | None) -> tuple[str, dict]:
     from ..examples import example_names, example_path
 
+    if isinstance(name, dict):  # a model given as data (Python)
+        import copy
+
+        return "study.model (data)", copy.deepcopy(name)
     path = Path(name)
     if not path.is_absolute() and folder is not None:
         path = folder / path

@@ -78,7 +78,9 @@ class StudyInfo(_Strict):
     name: str = Field(description="Short name (used for output files).")
     description: str = Field("", description="One line on what the study shows.")
     reference: str = Field("", description="The figure or section of the paper it follows.")
-    model: str = Field(description="Model file (relative to the study file) or example name.")
+    model: str | dict[str, Any] = Field(description=(
+        "Model file (relative to the study file) or example name; from Python also a "
+        "model as a dict or a torquesplit Model."))
     outputs: list[str] = Field(min_length=1, description=(
         "Output names or patterns (`load_sharing.engineering.*`); see docs/studies.md."))
 
@@ -341,6 +343,12 @@ def read_study(source) -> tuple[StudySpec, Path | None, str]:
     if isinstance(source, StudySpec):
         return source, None, json.dumps(source.canonical())
     if isinstance(source, dict):
+        study = source.get("study")
+        if isinstance(study, dict) and hasattr(study.get("model"), "meshes"):
+            # a Model: its data (SI), which the cases change and the store fingerprints
+            from ..model.io import model_to_dict
+
+            source = {**source, "study": {**study, "model": model_to_dict(study["model"])}}
         return parse_study(source), None, json.dumps(source, default=str)
     from .shipped import study_names, study_path
 
