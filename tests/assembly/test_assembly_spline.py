@@ -224,3 +224,28 @@ def model_default_velocity_scale() -> float:
     from torquesplit.model.schema import Analysis
 
     return Analysis().spline_velocity_scale
+
+
+def test_a_splines_backlash_is_a_dead_zone_of_its_torsion_spring():
+    """A gear coupling's circumferential backlash (a reviewer could not give one): the
+    torsion spring carries its torque only beyond +-backlash / (2 r_p) of rotation."""
+    import warnings
+
+    import torquesplit
+    from torquesplit.solve.static import static_equilibrium
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        base = torquesplit.load_model("dong2021_face_gear")
+    sp = base.splines["spline4"]
+    out = []
+    for backlash in (0.0, 100e-6):
+        model = base.with_changes({"splines.spline4.backlash": backlash})
+        s = torquesplit.assemble(model)
+        st = static_equilibrium(s)
+        e = s.element_names.index("spline4.torsion")
+        out.append(((s.projection_matrix() @ st.q)[e], st.element_forces[e]))
+    (d0, f0), (d1, f1) = out
+    assert abs(f0) > 1e3 and f1 == pytest.approx(f0, rel=1e-2)
+    half = 0.5 * 100e-6 / sp.pitch_radius
+    assert d1 == pytest.approx(f1 / sp.torsional_stiffness + half * np.sign(f1), rel=1e-9)

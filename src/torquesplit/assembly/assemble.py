@@ -356,9 +356,10 @@ def _assemble(model: Model, kin: Kinematics | None, *, n_table: int | None,
         if if_ >= 0:
             dofs.append(if_)
             coefs.append(-sf)
-        if dofs:
+        if dofs:  # its dead zone: half the circumferential backlash, as an angle
             elements.append(dict(name=f"{name}.torsion", kind=SPRING, dofs=dofs, coefs=coefs,
-                                 stiffness=sp.torsional_stiffness))
+                                 stiffness=sp.torsional_stiffness,
+                                 gaps=0.5 * sp.backlash / sp.pitch_radius))
         # the radial plane: normal to the floating member's axis (global x, y for an
         # axis along z); the law is isotropic, so any orthonormal pair of directions does
         axis = kin.bodies[flo].axis / np.linalg.norm(kin.bodies[flo].axis)

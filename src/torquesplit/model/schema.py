@@ -647,6 +647,10 @@ class Spline(Strict):
     stick_limit: Length = Field(0.0, ge=0, description="Radial displacement S_1 below which "
                                 "the spline sticks (Dong et al. 2021 eq. 6; 0 = slides at once).")
     torsional_stiffness: TorsionalStiffness = Field(gt=0, description="Torsional stiffness of the spline.")
+    backlash: Length = Field(0.0, ge=0, description=(
+        "Circumferential backlash of the spline's teeth at the pitch radius (total play, "
+        "as a gear coupling's): the torsion spring carries no torque inside +-backlash / "
+        "(2 pitch_radius) of relative rotation; 0 = none."))
 
     @model_validator(mode="after")
     def _limits(self):
