@@ -124,3 +124,81 @@ def test_a_speed_held_sun_puts_in_what_the_carrier_takes():
     sun, carrier = kin.bodies["stage_sun"], kin.bodies["stage_carrier"]
     assert kin.drive_torques["input"] * abs(sun.speed) == pytest.approx(
         400.0 * abs(carrier.speed), rel=1e-12)
+
+
+_CHAIN = """
+[model]
+name = "three gears"
+
+[gears.pinion]
+teeth = 20
+module = "2 mm"
+face_width = "20 mm"
+position = ["0 mm", "0 mm", "0 mm"]
+
+[gears.wheel]
+teeth = 40
+module = "2 mm"
+face_width = "20 mm"
+place = {from_gear = "pinion", angle = "0 deg"}
+
+[gears.wheel2]
+teeth = 40
+module = "2 mm"
+face_width = "20 mm"
+place = {from_gear = "WHERE", angle = "ANGLE"}
+
+[meshes.m1]
+gears = ["pinion", "wheel"]
+stiffness = "4e8 N/m"
+
+[meshes.m2]
+gears = ["SECOND", "wheel2"]
+stiffness = "4e8 N/m"
+
+[drives.motor]
+body = "pinion"
+speed = "3000 rpm"
+torque = "TORQUE"
+"""
+
+
+def _chain(second: str, extra: str, torque: str = "100 N m"):
+    """pinion -> wheel, and wheel2 on the wheel (a chain) or on the pinion (a fork)."""
+    text = (_CHAIN.replace("WHERE", second).replace("SECOND", second)
+            .replace("ANGLE", "0 deg" if second == "wheel" else "180 deg")
+            .replace("TORQUE", torque)) + extra
+    return torquesplit.solve_kinematics(torquesplit.load_model(tomllib.loads(text)))
+
+
+def _torque(kin, mesh):
+    return kin.meshes[mesh].force * kin.meshes[mesh].arm_driver
+
+
+def test_a_second_drive_on_an_intermediate_gear():
+    """Both drives sat at one potential: the mesh between them got no power and the model
+    was refused (a reviewer's regression of the potential)."""
+    kin = _chain("wheel", '[drives.motor2]\nbody = "wheel"\nspeed = "-1500 rpm"\n'
+                          'torque = "50 N m"\n[loads.out]\nbody = "wheel2"\n')
+    assert _torque(kin, "m1") == pytest.approx(100.0, rel=1e-12)  # the pinion's own
+    assert kin.meshes["m2"].force * kin.meshes["m2"].arm_driven == pytest.approx(
+        250.0, rel=1e-12)  # the wheel passes on both drives' power
+
+
+def test_a_power_take_off_on_an_intermediate_gear():
+    """A load on the wheel took everything downstream of it (refused: m2 carried none)."""
+    kin = _chain("wheel", '[loads.pump]\nbody = "wheel"\ntorque = "50 N m"\n'
+                          '[loads.out]\nbody = "wheel2"\n')
+    assert _torque(kin, "m1") == pytest.approx(100.0, rel=1e-12)
+    assert kin.meshes["m2"].force * kin.meshes["m2"].arm_driven == pytest.approx(
+        150.0, rel=1e-12)  # 200 N m at the wheel, less the pump's 50
+
+
+def test_loads_with_given_torques_take_them_in_a_fork():
+    """Split equally, the two branches' nominal forces were 150/150 N m at the pinion for
+    loads of 200 and 600 N m on wheels of the same ratio."""
+    kin = _chain("pinion", '[loads.out]\nbody = "wheel"\ntorque = "200 N m"\n'
+                           '[loads.out2]\nbody = "wheel2"\ntorque = "600 N m"\n',
+                 torque="400 N m")
+    assert _torque(kin, "m1") == pytest.approx(100.0, rel=1e-12)
+    assert _torque(kin, "m2") == pytest.approx(300.0, rel=1e-12)

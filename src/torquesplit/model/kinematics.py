@@ -653,22 +653,16 @@ _FLAT = 1e-9
 """Fall of the flow potential below which an edge carries no nominal power (round-off)."""
 
 
-def _flow_potential(model: Model, groups, g_adj) -> dict[str, float]:
-    """The potential of :func:`_power_flow` per rigid group: 1 at a drive's group, 0 at a
-    load's (a group with both: 0), harmonic in between (unit conductance per edge).
-    Groups joined to no drive or load keep 0 (the topology check refuses them)."""
+def _potential(g_adj, high: str, low: str) -> dict[str, float]:
+    """The potential of :func:`_power_flow` for one drive and one load: 1 at the drive's
+    group ``high``, 0 at the load's ``low``, harmonic at every other group (the mean of its
+    neighbours': unit conductance per edge).  A dead end takes its neighbour's value."""
     names = list(g_adj)
-    for d in model.drives.values():
-        if groups[d.body] not in g_adj:
-            names.append(groups[d.body])
-    index = {g: i for i, g in enumerate(names)}
-    fixed = {groups[d.body]: 1.0 for d in model.drives.values()}
-    fixed.update({groups[ld.body]: 0.0 for ld in model.loads.values()})
-    free = [g for g in names if g not in fixed]
-    x = np.zeros(len(names))
-    for g, v in fixed.items():
-        if g in index:
-            x[index[g]] = v
+    for g in (high, low):
+        if g not in g_adj:
+            names.append(g)
+    free = [g for g in names if g not in (high, low)]
+    x = {high: 1.0, low: 0.0}
     if free:
         col = {g: i for i, g in enumerate(free)}
         lap = np.zeros((len(free), len(free)))
@@ -680,25 +674,26 @@ def _flow_potential(model: Model, groups, g_adj) -> dict[str, float]:
                 if h in col:
                     lap[i, col[h]] -= 1.0
                 else:
-                    rhs[i] += x[index[h]]
-        # lstsq: a free part joined to no drive or load is singular (refused elsewhere)
+                    rhs[i] += x[h]
+        # lstsq: a part joined to neither is singular (the topology check refuses it)
         sol = np.linalg.lstsq(lap, rhs, rcond=None)[0]
-        for g in free:
-            x[index[g]] = sol[col[g]]
-    return {g: float(x[index[g]]) for g in names}
+        x.update({g: float(sol[col[g]]) for g in free})
+    return x
 
 
 def _power_flow(model: Model, speeds, groups, issues):
     """Equal-split power flow from the drives to the loads.
 
-    Each edge (mesh, elastic shaft or spline between rigid groups) is directed by a
-    potential: 1 at the drives, 0 at the loads, and between them the solution of the
-    graph's Laplacian with unit conductances (every group at the mean of its neighbours).
-    Power flows downhill, and a group splits what it receives equally among its downhill
-    edges.  Unlike hop counts to the load, a potential falls along every path from a split
-    to where the paths join, whatever their lengths: a branch with one body more (a torque
-    meter, a coupling hub) still gets its share.  An edge with no fall (a dead end, the
-    rung of a balanced bridge) carries no nominal power."""
+    Each load takes its given torque's power (a 'balanced' load an equal share of what is
+    left), and each drive feeds every load in proportion to the load's power.  The power
+    of one drive to one load flows down a potential, 1 at that drive, 0 at that load and
+    harmonic in between (every rigid group at the mean of its neighbours: unit
+    conductance per mesh, elastic shaft or spline), and a group splits what it receives
+    equally among its downhill edges.  A potential falls along every branch of a split,
+    whatever the number of bodies on each (hop counts to the load gave a branch with one
+    body more no power); a dead end (another drive's or load's branch, a power take-off
+    on an intermediate gear) has no fall and takes nothing of that pair.  The pairs' flows
+    add up on each edge, which is directed by the sum."""
     # graph of rigid groups: edges are meshes and elastic shafts/splines
     edges: list[tuple[str, str, str]] = []  # (name, body_a, body_b)
     for name, m in model.meshes.items():
@@ -707,39 +702,24 @@ def _power_flow(model: Model, speeds, groups, issues):
         if not getattr(s, "rigid", False):
             edges.append((name, *s.connects))
     g_adj: dict[str, list[tuple[str, str]]] = {}
+    ends = {}
     for name, a, b in edges:
         ga, gb = groups[a], groups[b]
+        ends[name] = (ga, gb)
         g_adj.setdefault(ga, []).append((name, gb))
         g_adj.setdefault(gb, []).append((name, ga))
-    potential = _flow_potential(model, groups, g_adj)
     # inputs
     drive_torques = {}
-    group_power: dict[str, float] = {}
     p_in = 0.0
     given = drive_input_torques(model, speeds, issues)
     if issues:
         return {}, {}, {}, {}, {}, 0.0, 0.0
+    drive_power = {}
     for name, d in model.drives.items():
         t = given[name]
-        p = t * abs(d.speed)
         drive_torques[name] = t
-        p_in += p
-        g = groups[d.body]
-        group_power[g] = group_power.get(g, 0.0) + p
-    edge_power: dict[str, float] = {name: 0.0 for name, _, _ in edges}
-    edge_dir: dict[str, tuple[str, str]] = {}
-    order = sorted(potential, key=lambda g: -potential[g])
-    for g in order:
-        p = group_power.get(g, 0.0)
-        outs = [(name, h) for name, h in g_adj.get(g, [])
-                if potential[h] < potential[g] - _FLAT]
-        if not outs:
-            continue
-        share = p / len(outs)
-        for name, h in outs:
-            edge_power[name] += share
-            edge_dir[name] = (g, h)
-            group_power[h] = group_power.get(h, 0.0) + share
+        drive_power[name] = t * abs(d.speed)
+        p_in += drive_power[name]
     # loads
     load_torques = {}
     balanced = [n for n, ld in model.loads.items() if ld.torque is None]
@@ -759,7 +739,42 @@ def _power_flow(model: Model, speeds, groups, issues):
         issues.append(("loads", (
             f"power does not balance: the drives put in {p_in / 1e3:.6g} kW and the loads take "
             f"{p_fixed / 1e3:.6g} kW; set a load's torque to \"balanced\" or correct the values")))
+    load_power = {n: max(load_torques[n], 0.0) * abs(speeds[ld.body])
+                  for n, ld in model.loads.items()}
     p_out = sum(load_torques[n] * abs(speeds[model.loads[n].body]) for n in model.loads)
+    # route each drive's power to each load (in proportion to the loads' powers)
+    flow: dict[str, float] = {name: 0.0 for name, _, _ in edges}  # signed, a -> b
+    inflow: dict[str, float] = {}
+    total = sum(load_power.values())
+    for dn, d in model.drives.items():
+        gd = groups[d.body]
+        for ln, ld in model.loads.items():
+            gl = groups[ld.body]
+            share = drive_power[dn] * load_power[ln] / total if total > 0 else 0.0
+            if gd == gl or not share > 0:
+                continue
+            potential = _potential(g_adj, gd, gl)
+            at = {gd: share}
+            for g in sorted(potential, key=lambda k: -potential[k]):
+                p = at.pop(g, 0.0)
+                outs = [(name, h) for name, h in g_adj.get(g, [])
+                        if potential[h] < potential[g] - _FLAT]
+                if not (p > 0 and outs):
+                    continue
+                for name, h in outs:
+                    flow[name] += p / len(outs) * (1.0 if ends[name][0] == g else -1.0)
+                    at[h] = at.get(h, 0.0) + p / len(outs)
+    edge_power = {name: abs(f) for name, f in flow.items()}
+    edge_dir: dict[str, tuple[str, str]] = {}
+    for name, f in flow.items():
+        if abs(f) > _FLAT * max(p_in, 1e-300):
+            ga, gb = ends[name]
+            edge_dir[name] = (ga, gb) if f > 0 else (gb, ga)
+            inflow[edge_dir[name][1]] = inflow.get(edge_dir[name][1], 0.0) + abs(f)
+    group_power: dict[str, float] = dict(inflow)
+    for dn, d in model.drives.items():
+        g = groups[d.body]
+        group_power[g] = group_power.get(g, 0.0) + drive_power[dn]
     # power through each body (groups share their power)
     power = {b: group_power.get(groups[b], 0.0) for b in model.body_names()}
     drivers = {}
