@@ -85,3 +85,26 @@ def test_the_bearing_elements_keep_their_names_and_an_eccentricity_still_counts(
     assert {"pinion.support.x", "pinion.support.y"} <= set(s.element_names)
     assert s.n_splines == 1
     assert math.isclose(s.sp_par[0, 3], C)
+
+
+def test_planets_floating_in_pin_clearances_of_a_turning_carrier():
+    """The open clearance's regularising spring (1e-9 k) was below the planet's centripetal
+    softening m Omega^2: Newton ran a planet 9 m off its pin and called it converged (a
+    reviewer's Lin & Parker 1999 stage with 20 um pin clearances at 1000 rpm).  The pin
+    forces are the equilibrium's, the same as without clearance."""
+    import warnings
+
+    from torquesplit.model.overrides import read_raw, set_parameter
+
+    raw = read_raw(torquesplit.example_path("lin_parker1999_planetary"))
+    forces = []
+    for clearance in ("0 um", "20 um"):
+        data = set_parameter(raw, "planetary.0.planet_bearing.clearance", clearance)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            s = torquesplit.assemble(torquesplit.load_model(data))
+        st = static_equilibrium(s)
+        f = dict(zip(s.element_names, st.element_forces))
+        forces.append(np.hypot(f["stage_planet1.support.x"], f["stage_planet1.support.y"]))
+        assert np.max(np.abs(st.q)) < 1e-3
+    assert forces[1] == pytest.approx(forces[0], rel=1e-6) and forces[0] > 100.0

@@ -216,6 +216,19 @@ class _StaticProblem:
         self.balance_tolerance = balance_tolerance
         self.sp_x = s.sp_el[:, 0].astype(int)
         self.sp_y = s.sp_el[:, 1].astype(int)
+        soft = float(np.max(-np.diag(self.Kf), initial=0.0))
+        if soft > 0 and regularisation > 0:
+            # a member floating in a clearance of a turning frame: its regularising spring
+            # must beat the frame's centripetal softening m Omega^2, or the tangent is
+            # indefinite and Newton runs off (a planet 9 m off its pin, "converged")
+            k_gap = [float(np.max(s.stiffness_table[e]))
+                     for e in range(s.n_elements)
+                     if np.any(s.gap_values[s.gap_ptr[e]:s.gap_ptr[e + 1]] > 0)]
+            k_gap += [float(k) for k, c in zip(s.sp_par[:, SP_STIFFNESS],
+                                               s.sp_par[:, SP_CLEARANCE]) if c > 0]
+            k_gap = [k for k in k_gap if k > 0]
+            if k_gap:
+                self.reg = max(regularisation, 10.0 * soft / min(k_gap))
         self.linear = np.ones(s.n_elements, dtype=bool)  # ordinary (1-D) elements
         self.linear[self.sp_x] = False
         self.linear[self.sp_y] = False
