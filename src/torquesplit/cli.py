@@ -792,7 +792,9 @@ def _print_static(m, res, met, orbits, saved, figures, plots, as_json) -> None:
             "figures": [str(f) for f in figures],
         }, _json_default)
         return
-    console.print(f"[bold]{m.model.name}[/]: {res.times.size} mesh positions, "
+    stopped = (f" (stopped by Ctrl-C: {res.times.size} of {res.solution.planned})"
+               if res.solution.interrupted else "")
+    console.print(f"[bold]{m.model.name}[/]: {res.times.size} mesh positions{stopped}, "
                   f"{'all converged' if res.solution.converged.all() else 'NOT all converged'}",
                   highlight=False)
     t = Table(title="quasi-static load sharing (static torque ratio, largest over positions)")

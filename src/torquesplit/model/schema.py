@@ -671,7 +671,9 @@ class TorqueHarmonic(Strict):
         "Frequency as a multiple of the body's rotation frequency (e.g. 2 for twice per "
         "revolution); follows the speed in a speed sweep."))
     frequency: Frequency | None = Field(None, gt=0, description=(
-        "A fixed frequency instead of an order (e.g. '50 Hz'); a speed sweep keeps it."))
+        "A fixed frequency instead of an order (e.g. '50 Hz'): for runs and the steady "
+        "state at the model's speed (a steady state at another speed or a speed sweep "
+        "refuses it: the period would not scale with the speed)."))
     phase: Angle = Field(0.0, description="Phase at t = 0.")
 
     @model_validator(mode="after")

@@ -57,7 +57,8 @@ class ExcitationSource:
 
     element: str
     kind: str
-    """'stiffness', 'impact force', 'friction', 'error' or 'backlash sequence'."""
+    """'stiffness', 'impact force', 'torque fluctuation', 'friction', 'error' or
+    'backlash sequence'."""
     frequency: float
     """[Hz]"""
     index: int
@@ -124,7 +125,9 @@ def excitation_sources(structure: Structure) -> list[ExcitationSource]:
         if _varies(s.stiffness_table[e]):
             out.append(ExcitationSource(name, "stiffness", f, e))
         if _varies(s.force_table[e]):
-            out.append(ExcitationSource(name, "impact force", f, e))
+            fluct = name in (s.metadata.get("torque_fluctuation_elements") or ())
+            out.append(ExcitationSource(name, "torque fluctuation" if fluct else
+                                        "impact force", f, e))
         gaps = s.gap_values[s.gap_ptr[e]:s.gap_ptr[e + 1]]
         if gaps.size > 1 and _varies(gaps):
             out.append(ExcitationSource(name, "backlash sequence", f / gaps.size, e))
@@ -254,7 +257,7 @@ def keep_excitations(structure: Structure, base: float):
         dropped.append(x)
         if x.kind == "stiffness":
             ktab[x.index] = ktab[x.index].mean()
-        elif x.kind == "impact force":
+        elif x.kind in ("impact force", "torque fluctuation"):
             ftab[x.index] = ftab[x.index].mean()
         elif x.kind == "friction":
             j = int(np.flatnonzero(s.fr_el == x.index)[0])
