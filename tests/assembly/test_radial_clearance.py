@@ -108,3 +108,30 @@ def test_planets_floating_in_pin_clearances_of_a_turning_carrier():
         forces.append(np.hypot(f["stage_planet1.support.x"], f["stage_planet1.support.y"]))
         assert np.max(np.abs(st.q)) < 1e-3
     assert forces[1] == pytest.approx(forces[0], rel=1e-6) and forces[0] > 100.0
+
+
+def test_the_modes_damping_of_a_radial_bearing_is_the_laws():
+    """`modes` damped both components of a radial bearing (c I) while the law damps only
+    the radial rate (c n n^T): its damping ratios were up to 3x the state-space ones (a
+    reviewer's idler).  Here against the eigenvalues of the kernels' own linearisation at
+    the static equilibrium."""
+    from torquesplit.solve.modal import modal_analysis
+    from torquesplit.steady.problem import PeriodicProblem
+
+    s = torquesplit.assemble(_pair(20.0, damping_ratio=0.05))
+    q = static_equilibrium(s).q
+    modal = modal_analysis(s, q)
+    p = PeriodicProblem(s, 1000.0)
+    y = np.concatenate([q, np.zeros_like(q)])[None, :]
+    lin = p.linearise(np.zeros(1), y)
+    aq, av = p.mean_jacobian(lin)
+    n = s.n_dof
+    A = np.block([[np.zeros((n, n)), np.eye(n)], [aq, av]])
+    lam = np.linalg.eigvals(A)
+    lam = lam[lam.imag > 1e-3 * np.abs(lam).max()]
+    exact = sorted(zip(np.abs(lam) / (2 * np.pi), -lam.real / np.abs(lam)))
+    f = [x for x in modal.frequencies if x > 0]
+    assert len(f) == len(exact)
+    for (fe, ze), fm, zm in zip(exact, f, modal.damping_ratios[-len(f):]):
+        assert fm == pytest.approx(fe, rel=2e-3)
+        assert zm == pytest.approx(ze, rel=0.05, abs=2e-4)

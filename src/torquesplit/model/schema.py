@@ -205,7 +205,8 @@ class Support(Strict):
     clearance_shape: Literal["radial", "per_axis"] = Field(
         "radial", description="'radial': a circular clearance of the two translations "
         "across the body's axis, in contact when their resultant exceeds it (a bearing's "
-        "radial play; the same in every orientation of the axes); 'per_axis': a dead zone "
+        "radial play; the same in every orientation of the axes; damped on the radial "
+        "rate only, as a spline); 'per_axis': a dead zone "
         "on each translational DOF on its own (Dong et al. 2021 eq. 7: a square clearance, "
         "larger along the diagonals). A single translation (e.g. 'loa') or the axial one: "
         "the two are the same.")

@@ -115,13 +115,21 @@ def modal_analysis(structure: Structure, q=None, *, rigid_tolerance: float = 1e-
         ex, ey = (int(i) for i in s.sp_el[j])
         dx, dy = (0.0, 0.0) if delta is None else (delta[ex], delta[ey])
         h2 = _spline_tangent(s.sp_par[j], dx, dy, closed=delta is None)
+        c2 = _spline_damping(s.sp_par[j], dx, dy, closed=delta is None)
         k_act[ex] = k_act[ey] = 0.0
         active[ex] = active[ey] = bool(np.any(h2 != 0))
-        sp_tangent.append((ex, ey, h2, V[[ex, ey]]))
+        sp_tangent.append((ex, ey, h2, c2, V[[ex, ey]]))
     K = V.T @ (k_act[:, None] * V) + s.frame_stiffness_matrix()
-    for _, _, h2, rows in sp_tangent:
+    for _, _, h2, _, rows in sp_tangent:
         K = K + rows.T @ h2 @ rows
-    C = V.T @ (np.where(active, s.damping, 0.0)[:, None] * V) + np.diag(s.ground_damping)
+    # damping: each element's along its projection while in contact; a radial law's as it
+    # acts, on the radial rate only (its 2 x 2 rate tangent), not on both components
+    c_el = np.where(active, s.damping, 0.0)
+    for ex, ey, _, _, _ in sp_tangent:
+        c_el[ex] = c_el[ey] = 0.0
+    C = V.T @ (c_el[:, None] * V) + np.diag(s.ground_damping)
+    for _, _, _, c2, rows in sp_tangent:
+        C = C + rows.T @ c2 @ rows
     Gm = s.gyroscopic_matrix() if s.n_gyroscopic else None
     if Gm is not None:
         freqs, phi_e, phi_r, lam_e = _gyroscopic_modes(K, Gm, s.inv_mass, rigid_tolerance)
@@ -138,10 +146,13 @@ def modal_analysis(structure: Structure, q=None, *, rigid_tolerance: float = 1e-
         phi_r = phi[:, rigid]
         freqs = np.sign(lam_e) * np.sqrt(np.abs(lam_e)) / (2 * math.pi)
     energy = k_act[None, :] * np.abs(V @ phi_e).T ** 2
-    for ex, ey, h2, rows in sp_tangent:  # half of the spline's energy on each component
+    for ex, ey, h2, _, rows in sp_tangent:
+        # the law's energy u^H h2 u, each component's term u_i^H (h2 u)_i (a bearing's
+        # motion along x stores its energy in the x component, not half in each)
         u = rows @ phi_e  # (2, n_modes)
-        energy[:, ex] = energy[:, ey] = 0.5 * np.real(np.einsum("im,ij,jm->m", u.conj(),
-                                                               h2, u))
+        hu = h2 @ u
+        energy[:, ex] = np.real(u[0].conj() * hu[0])
+        energy[:, ey] = np.real(u[1].conj() * hu[1])
     total = energy.sum(axis=1, keepdims=True)
     with np.errstate(invalid="ignore", divide="ignore"):
         fraction = np.where(total != 0, energy / total, 0.0)
@@ -192,6 +203,16 @@ def _gyroscopic_modes(K, Gm, inv_mass, rigid_tolerance):
     lk_max = float(np.max(np.abs(lk))) if lk.size else 0.0
     phi_r = d[:, None] * psi[:, np.abs(lk) <= rigid_tolerance * lk_max]
     return w / (2 * math.pi), phi, phi_r, np.sign(w) * w**2
+
+
+def _spline_damping(par, dx: float, dy: float, closed: bool) -> np.ndarray:
+    """2 x 2 rate tangent (damping) of a spline's law at rest at (dx, dy): c + F_m / v on
+    the radial direction in contact, F_m / v floating, c in the stick region
+    (:func:`laws.spline_tangent`); ``closed``: as in contact, isotropic at R = 0."""
+    if closed:
+        return (float(par[1]) + float(par[4]) / float(par[5])) * np.eye(2)
+    t = laws.spline_tangent(float(dx), float(dy), 0.0, 0.0, *map(float, par))
+    return np.array([[t[4], t[5]], [t[6], t[7]]])
 
 
 def _spline_tangent(par, dx: float, dy: float, closed: bool) -> np.ndarray:
