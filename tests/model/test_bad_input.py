@@ -397,10 +397,17 @@ def test_problems_found_after_the_schema_are_reported_at_once():
     data["gears"]["idler2"] = {"teeth": 4, "module": "2 mm", "face_width": "20 mm",
                                "place": {"from_gear": "pinion", "angle": "90 deg"}}
     data["meshes"]["m2"] = {"gears": ["pinion", "idler2"], "stiffness": "4e8 N/m"}
+    # and a gear placed where it cannot mesh (found by the kinematics, a round later)
+    data["gears"]["far"] = {"teeth": 30, "module": "2 mm", "face_width": "20 mm",
+                            "position": ["0 mm", "-500 mm", "0 mm"]}
+    data["meshes"]["m3"] = {"gears": ["pinion", "far"], "stiffness": "4e8 N/m"}
     with pytest.raises(torquesplit.ModelError) as info:
         load(data)
     locations = [loc for loc, _ in info.value.issues]
-    assert {"gears.idler", "meshes.m", "gears.pinion.support", "meshes.m2"} <= set(locations)
+    assert {"gears.idler", "meshes.m", "gears.pinion.support", "meshes.m2",
+            "meshes.m3"} <= set(locations)
+    assert any(loc == "meshes.m3" and "centre distance" in msg
+               for loc, msg in info.value.issues)
     # the pair that cannot mesh gets no second, derived message about its geometry
     assert locations.count("meshes.m") == 1
     assert_teaches(info.value)

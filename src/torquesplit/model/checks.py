@@ -77,8 +77,10 @@ def check_model(model: Model, source: str | None = None, *, deep: bool = False) 
     if not issues:  # the names resolve: every check that needs only them, in one round
         mismatched = mesh_compatibility_issues(model)
         skip = {loc for loc, _ in mismatched}  # (no pair geometry for gears that cannot mesh)
-        issues = topology_issues(model) + mismatched + geometry_issues(model, skip)
+        geometry = geometry_issues(model, skip)
+        issues = topology_issues(model) + mismatched + geometry
         issues += support_issues(model) + modification_issues(model, skip)
+        issues += [i for i in placement_issues(model, skip, geometry) if i not in issues]
     if issues:
         raise ModelError(as_written(model, issues), source)
     # the kinematic pass finds loops that cannot turn and power that does not balance
@@ -309,6 +311,34 @@ def geometry_issues(model: Model, skip=frozenset()) -> list[tuple[str, str]]:
             for _, msg in exc.issues:
                 msg = _ROLE.sub(lambda m: _gear_named(role[m[1]], m[2]), msg)
                 issues.append((f"meshes.{name}", f"gears {a!r} and {b!r}: {_teach(msg)}"))
+    return issues
+
+
+def placement_issues(model: Model, skip=frozenset(), found=()) -> list[tuple[str, str]]:
+    """Gears placed where they cannot mesh (the positions against the operating centre
+    distance, as the kinematics checks them), in the same round as the checks above:
+    meshes in ``skip`` and those of a gear whose geometry ``found`` refuses are left out
+    (their message would follow from the first)."""
+    from ..gears import line_of_action as loa
+    from .kinematics import _layout
+
+    placed: list[tuple[str, str]] = []
+    try:
+        positions, axes, computed = _layout(model, placed)
+    except (ValueError, ArithmeticError, KeyError):  # pragma: no cover - the kinematics say
+        return []
+    named = {loc.split(".")[1] for loc, _ in found if loc.startswith("gears.")}
+    for name in skip:  # (a gear placed from a mate it cannot mesh with has no position)
+        if name.startswith("meshes.") and name[7:] in model.meshes:
+            named |= set(model.meshes[name[7:]].gears) & set(computed)
+    issues = [(loc, msg) for loc, msg in placed if loc.split(".")[1] not in named]
+    for name, mesh in model.meshes.items():
+        if f"meshes.{name}" in skip or named & set(mesh.gears):
+            continue
+        try:
+            loa.contact_frame(model, name, positions, axes)
+        except ValueError as exc:
+            issues.append((f"meshes.{name}", str(exc)))
     return issues
 
 
