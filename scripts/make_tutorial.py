@@ -421,7 +421,7 @@ def _numbers(work: Path) -> dict[str, str]:
                                '"2400 rpm" --to "3600 rpm" --json 2>/dev/null', work))
     first = {}  # first-order crossings of the split mesh (a double mode listed once)
     for c in campbell["critical_speeds"]:
-        if c["order"] == 1 and c["source"] == "mesh in1":
+        if c["order"] == 1 and "in1" in c.get("meshes", [c["source"].split()[-1]]):
             first.setdefault(round(c["speed_rpm"], 1), c)
     bearing, shaft = (first[s] for s in sorted(first)) if len(first) == 2 else (None, None)
     if not (bearing and ".support." in bearing["energy"][0][0]
