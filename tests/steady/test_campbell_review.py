@@ -233,3 +233,25 @@ def test_the_operating_speed_is_drawn_only_inside_the_range():
     ds, _ = campbell(_lp3(), 1500 * RPM, 3000 * RPM, points=3)
     labels = campbell_figure(ds).axes[0].get_legend_handles_labels()[1]
     assert not [lab for lab in labels if lab.startswith("operating speed")]
+
+
+def test_each_mesh_crossing_is_rated_by_its_stiffness_harmonic():
+    """37 crossings up to 10x the mesh frequency, unranked (a reviewer's helical mill
+    drive, whose high orders the overlap ratio all but removes): each mesh crossing now
+    carries the amplitude of its order of the mesh stiffness over the mean."""
+    import tomllib
+
+    from model_texts import PAIR_4MM
+
+    text = PAIR_4MM.replace('stiffness = "4e8 N/m"', 'stiffness = {method = "fourier", '
+                            'mean = "4e8 N/m", cos = ["4e7 N/m", "1e7 N/m"]}')
+    model = torquesplit.load_model(tomllib.loads(text))
+    rpm = math.pi / 30
+    _, crossings = campbell(model, 100 * rpm, 20000 * rpm)
+    rated = {c["order"]: c["stiffness_harmonic"] for c in crossings
+             if c["source"].startswith("mesh")}
+    assert rated[1] == pytest.approx(0.1, rel=1e-9)
+    assert rated[2] == pytest.approx(0.025, rel=1e-9)
+    assert all(v < 1e-9 for k, v in rated.items() if k > 2)
+    assert all("stiffness_harmonic" not in c for c in crossings
+               if c["source"].startswith("rotation"))

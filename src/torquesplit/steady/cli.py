@@ -412,7 +412,7 @@ def campbell_command(m, start, stop, plot, as_json, console, json_default):
         f" ({len(critical)} critical; {len(suppressed)} crossings that the planets' mesh "
         f"phasing leaves unexcited, Parker & Lin 2004, marked 'suppressed')" if phased
         else ""))
-    cols = ["speed [rpm]", "mode", "f [Hz]", "excitation"]
+    cols = ["speed [rpm]", "mode", "f [Hz]", "excitation", "k harmonic [%]"]
     cols += ["mode type", "phasing"] if phased else []
     for col in cols + ["strain energy (largest shares)"]:
         t.add_column(_h(col))
@@ -420,7 +420,12 @@ def campbell_command(m, start, stop, plot, as_json, console, json_default):
         extra = ([mode_kind(c) if c.get("mode_type") else "-",
                   "suppressed" if c["suppressed"] else "excited"]
                  if phased else [])
+        k_h = c.get("stiffness_harmonic")
         t.add_row(f"{c['speed_rpm']:.6g}", str(c["mode"]), f"{c['frequency_Hz']:.6g}",
-                  f"{c['order']} x {c['source']}", *extra,
+                  f"{c['order']} x {c['source']}",
+                  "-" if k_h is None else f"{100 * k_h:.3g}", *extra,
                   ", ".join(f"{n} {100 * v:.0f} %" for n, v in c["energy"]))
     console.print(t)
+    console.print("k harmonic: the amplitude of that order of the mesh stiffness over its "
+                  "mean (how strongly the stiffness variation drives the crossing; errors "
+                  "and shaft orders are not rated: '-')", highlight=False)

@@ -258,6 +258,7 @@ def critical_speeds(structure, q, kin, model, w_lo, w_hi, orders=None):
     sol = modal_analysis(structure, q)
     w_ref = reference_speed(model)
     lines = _order_lines(kin, model, orders, structure)
+    strength = _stiffness_harmonics(kin, structure, lines)
     phasing = _Phasing(model, kin)
     types = phasing.types(structure, sol)
     out = []
@@ -269,10 +270,41 @@ def critical_speeds(structure, q, kin, model, w_lo, w_hi, orders=None):
             if w_lo <= w <= w_hi:
                 out.append(phasing.mark(dict(
                     mode=i + 1, frequency_Hz=float(fn), order=order, source=label,
-                    speed_rpm=float(w * RPM), energy=sol.dominant_elements(i, 4)), types))
+                    speed_rpm=float(w * RPM), energy=sol.dominant_elements(i, 4),
+                    **_strength_of(strength, label, order)), types))
     out.sort(key=lambda c: c["speed_rpm"])
     return dict(natural_frequencies=sol.frequencies, crossings=out, modal=sol,
-                lines=lines, reference_speed=w_ref)
+                lines=lines, reference_speed=w_ref, strength=strength)
+
+
+def _stiffness_harmonics(kin, structure, lines) -> dict:
+    """(line label, order) -> amplitude of that harmonic of the mesh stiffness over its
+    mean (the largest over the group's meshes): how strongly the stiffness variation
+    drives a crossing (a helical pair with a large overlap ratio has almost none at high
+    orders).  Rotation lines and errors are not rated (their amplitude is elsewhere)."""
+    if structure is None:
+        return {}
+    names = list(structure.element_names)
+    groups = mesh_groups(kin)
+    out = {}
+    for label, order, _ in lines:
+        amps = []
+        for n in groups.get(label, ()):
+            if n not in names:
+                continue
+            table = np.asarray(structure.stiffness_table[names.index(n)], dtype=float)
+            mean = float(table.mean())
+            if mean > 0 and order < table.size // 2:
+                amps.append(2 * abs(np.fft.rfft(table)[order]) / table.size / mean)
+        if amps:
+            out[(label, order)] = float(max(amps))
+    return out
+
+
+def _strength_of(strength: dict, label: str, order: int) -> dict:
+    """``{"stiffness_harmonic": value}`` of a crossing's line, or nothing."""
+    v = strength.get((label, order))
+    return {} if v is None else {"stiffness_harmonic": v}
 
 
 class _Phasing:
@@ -457,7 +489,8 @@ def campbell(model, start: float, stop: float, *, points: int = 41,
     lines = crit["lines"]
     L = np.array([[o * per * w for (_, o, per) in lines] for w in speeds])
     if s.n_gyroscopic:  # the frequencies move with speed: cross the curves themselves
-        crit["crossings"] = _curve_crossings(model, static.q, speeds, F, lines, w_ref)
+        crit["crossings"] = _curve_crossings(model, static.q, speeds, F, lines, w_ref,
+                                             crit["strength"])
     crossings = [c for c in crit["crossings"] if count is None or c["mode"] <= count]
     critical, suppressed = split_suppressed(crossings)
     ds = xr.Dataset(
@@ -482,7 +515,7 @@ def campbell(model, start: float, stop: float, *, points: int = 41,
     return ds, crossings
 
 
-def _curve_crossings(model, q, speeds, F, lines, w_ref):
+def _curve_crossings(model, q, speeds, F, lines, w_ref, strength=None):
     """Crossings of the natural-frequency curves ``F`` (speeds x modes) with the
     excitation lines, located by linear interpolation between the speeds where their
     difference changes sign; the strain-energy shares from the modes at the crossing's
@@ -505,7 +538,8 @@ def _curve_crossings(model, q, speeds, F, lines, w_ref):
                 out.append(phasing.mark(dict(
                     mode=m + 1, frequency_Hz=float(sol.frequencies[m]), order=order,
                     source=label, speed_rpm=float(w * RPM),
-                    energy=sol.dominant_elements(m, 4)), phasing.types(st, sol)))
+                    energy=sol.dominant_elements(m, 4),
+                    **_strength_of(strength or {}, label, order)), phasing.types(st, sol)))
     out.sort(key=lambda c: c["speed_rpm"])
     return out
 
