@@ -100,3 +100,24 @@ def test_the_quasi_static_sweep_carries_the_fluctuation_with_the_trains_inertia(
     share = r_w * J_PINION / den if where == "load" else J_WHEEL * r_p / den
     assert res.solution.converged.all()
     assert res.mesh_forces()[0, 0] - mesh.force == pytest.approx(20.0 * share, rel=1e-9)
+
+
+def test_a_drives_slip_damps_the_trains_speed_swing():
+    """A motor's torque-speed slope (speed_coefficient, a reviewer's request): the rigid
+    train's speed swing under a slow load fluctuation is T_a/i / |i w J_eq + c|, J_eq
+    the inertia referred to the pinion, i = 2 the ratio."""
+    c = 0.06  # N m s/rad
+    model = _pair('fluctuation = [{amplitude = "0.2 N m", order = 2}]',
+                  f'speed_coefficient = "{c} N m s/rad"')
+    s = torquesplit.assemble(model)
+    i = list(s.dof_names).index("pinion.theta")
+    assert s.ground_damping[i] == pytest.approx(c)
+    res = torquesplit.simulate(model, duration=0.4, history_dofs=["pinion.theta"])
+    t, v = res.solution.history_t, res.solution.history_v[:, 0]
+    late = v[t > 0.2]
+    w = 2 * np.pi * 50.0  # order 2 of the wheel at 1500 rpm
+    j_eq = J_PINION + J_WHEEL / 4
+    expected = 0.2 / 2 / abs(1j * w * j_eq + c)
+    assert (late.max() - late.min()) / 2 == pytest.approx(expected, rel=5e-3)
+    with pytest.raises(torquesplit.ModelError, match="speed_coefficient"):
+        _pair(drive_extra='mode = "speed"\nspeed_coefficient = "0.1 N m s/rad"')

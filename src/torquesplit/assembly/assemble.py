@@ -415,6 +415,7 @@ def _assemble(model: Model, kin: Kinematics | None, *, n_table: int | None,
         idx, s = dmap.theta[d.body]
         if idx >= 0 and d.mode == "torque":
             ext[idx] += s * math.copysign(kin.drive_torques[name], d.speed)
+            ground[idx] += d.speed_coefficient  # (its slip: T falls as it speeds up)
         elements += _fluctuations(f"drives.{name}", d.fluctuation, idx,
                                   -s * math.copysign(1.0, d.speed), abs(d.speed), n_table,
                                   fixed_frequency)

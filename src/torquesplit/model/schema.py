@@ -700,6 +700,10 @@ class Drive(Strict):
     fluctuation: list[TorqueHarmonic] = Field([], description=(
         "Harmonics of the drive torque about its nominal value (a 'torque' drive only), "
         "e.g. [{amplitude = '500 N m', frequency = '100 Hz'}] (see TorqueHarmonic)."))
+    speed_coefficient: TorsionalDamping = Field(0.0, ge=0, description=(
+        "Slope of the drive's torque-speed characteristic, -dT/d(speed) at the nominal "
+        "point (an induction motor's slip: its torque falls as it runs faster); a "
+        "'torque' drive only."))
 
     @model_validator(mode="after")
     def _one(self):
@@ -712,6 +716,10 @@ class Drive(Strict):
         if abs(self.speed) < 1e-6:
             raise FieldError("speed", "must not be zero (below 1e-6 rad/s); give the nominal "
                              "speed, e.g. '3000 rpm'")
+        if self.speed_coefficient and self.mode == "speed":
+            raise FieldError("speed_coefficient", "a 'speed' drive holds its speed (an "
+                             "infinitely stiff characteristic); give the slope to a 'torque' "
+                             "drive, or remove it")
         if self.fluctuation and self.mode == "speed":
             raise FieldError("fluctuation", "a 'speed' drive holds its speed, so its torque "
                              "is what the gearbox takes; put the fluctuation on a load (or "

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from .kinematics import solve_kinematics
 from .schema import Model
 
@@ -52,6 +54,9 @@ def summary(model: Model) -> dict:
             "torque_driver_Nm": mk.torque_driver,
             "torque_driven_Nm": mk.torque_driven,
             "tooth_force_N": mk.force,
+            # its axial component on the driver (a helical mesh's thrust on the bearings)
+            "axial_force_N": mk.force * abs(float(
+                np.asarray(mk.line_of_action) @ _unit(kin.bodies[mk.driver].axis))),
             "power_kW": mk.power / 1e3,
             "equivalent_mass_kg": mk.equivalent_mass,
             "critical_damping_Ns_per_m": mk.critical_damping,
@@ -122,7 +127,7 @@ def render_summary(s: dict, console) -> None:
     t = Table(title="meshes (eps: transverse, overlap and total contact ratios; LOA n: unit "
                     "line of action)")
     for col in ("mesh", "driver->driven", "stage", "f_mesh [Hz]", "r_b [mm]", "eps_a", "eps_b",
-                "eps_g", "LOA n", "T_driver [N m]", "F_n [kN]"):
+                "eps_g", "LOA n", "T_driver [N m]", "F_n [kN]", "F_a [kN]"):
         t.add_column(escape(col), justify="left" if col in ("mesh", "driver->driven", "stage",
                                                             "LOA n") else "right")
     for name, m in s["meshes"].items():
@@ -132,5 +137,12 @@ def render_summary(s: dict, console) -> None:
                   fmt(m["transverse_contact_ratio"]), fmt(m["overlap_contact_ratio"]),
                   fmt(m["total_contact_ratio"]),
                   "(" + ", ".join(f"{v:+.3f}" for v in m["line_of_action"]) + ")",
-                  f"{m['torque_driver_Nm']:.6g}", f"{m['tooth_force_N'] / 1e3:.5g}")
+                  f"{m['torque_driver_Nm']:.6g}", f"{m['tooth_force_N'] / 1e3:.5g}",
+                  f"{m['axial_force_N'] / 1e3:.5g}")
     console.print(t)
+
+
+def _unit(v) -> np.ndarray:
+    v = np.asarray(v, dtype=float)
+    return v / np.linalg.norm(v)
+
