@@ -553,3 +553,20 @@ def test_results_metrics_leave_out_the_cut_off_cycles(tmp_path):
         per_cycle = res.metrics(definition).load_sharing.per_cycle
         for j, m in enumerate(res.mesh_names):
             assert np.all(np.isnan(per_cycle[m][~complete[:, j]]))
+
+
+def test_check_gives_a_helical_meshs_axial_force_and_a_spur_table_stays_narrow(tmp_path):
+    """The axial thrust of a helical mesh was nowhere (a reviewer's mill drive: 19.8 kN on
+    its input pinion, F_n sin(beta_b))."""
+    import math
+
+    res = runner.invoke(app, ["check", "ji_li_mill_drive", "--json"])
+    data = json.loads(res.stdout)
+    m = data["meshes"]["m11"]
+    kin = torquesplit.solve_kinematics("ji_li_mill_drive")
+    beta_b = math.asin(abs(kin.meshes["m11"].line_of_action[2]))
+    assert m["axial_force_N"] == pytest.approx(m["tooth_force_N"] * math.sin(beta_b), rel=1e-9)
+    assert 0.15 < m["axial_force_N"] / m["tooth_force_N"] < 0.25  # (beta_b about 11 deg)
+    assert "F_a [kN]" in runner.invoke(app, ["check", "ji_li_mill_drive"]).stdout
+    spur = runner.invoke(app, ["check", str(write_model(tmp_path, split_model()))])
+    assert "F_a" not in spur.stdout

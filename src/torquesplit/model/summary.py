@@ -126,8 +126,11 @@ def render_summary(s: dict, console) -> None:
     console.print(t)
     t = Table(title="meshes (eps: transverse, overlap and total contact ratios; LOA n: unit "
                     "line of action)")
+    # the axial force only where a mesh has one (helical): spur gearboxes keep the width
+    axial = any(m["axial_force_N"] > 1e-9 * m["tooth_force_N"] for m in s["meshes"].values())
     for col in ("mesh", "driver->driven", "stage", "f_mesh [Hz]", "r_b [mm]", "eps_a", "eps_b",
-                "eps_g", "LOA n", "T_driver [N m]", "F_n [kN]", "F_a [kN]"):
+                "eps_g", "LOA n", "T_driver [N m]", "F_n [kN]") + (("F_a [kN]",) if axial
+                                                                   else ()):
         t.add_column(escape(col), justify="left" if col in ("mesh", "driver->driven", "stage",
                                                             "LOA n") else "right")
     for name, m in s["meshes"].items():
@@ -138,7 +141,7 @@ def render_summary(s: dict, console) -> None:
                   fmt(m["total_contact_ratio"]),
                   "(" + ", ".join(f"{v:+.3f}" for v in m["line_of_action"]) + ")",
                   f"{m['torque_driver_Nm']:.6g}", f"{m['tooth_force_N'] / 1e3:.5g}",
-                  f"{m['axial_force_N'] / 1e3:.5g}")
+                  *([f"{m['axial_force_N'] / 1e3:.5g}"] if axial else []))
     console.print(t)
 
 
