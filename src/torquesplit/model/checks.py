@@ -320,13 +320,20 @@ def placement_issues(model: Model, skip=frozenset(), found=()) -> list[tuple[str
     meshes in ``skip`` and those of a gear whose geometry ``found`` refuses are left out
     (their message would follow from the first)."""
     from ..gears import line_of_action as loa
-    from .kinematics import _layout
+    from . import epicyclic as epi
+    from .kinematics import _layout, _rigid_groups
 
     placed: list[tuple[str, str]] = []
     try:
         positions, axes, computed = _layout(model, placed)
+        # carriers and planets first, as the kinematics do: a ring of the wrong kind is
+        # named as such, not as a centre distance that does not fit
+        layout: list[tuple[str, str]] = []
+        epi.find_layout(model, positions, axes, _rigid_groups(model), layout)
     except (ValueError, ArithmeticError, KeyError):  # pragma: no cover - the kinematics say
         return []
+    if layout:
+        return layout
     named = {loc.split(".")[1] for loc, _ in found if loc.startswith("gears.")}
     for name in skip:  # (a gear placed from a mate it cannot mesh with has no position)
         if name.startswith("meshes.") and name[7:] in model.meshes:
