@@ -135,3 +135,35 @@ def test_the_modes_damping_of_a_radial_bearing_is_the_laws():
     for (fe, ze), fm, zm in zip(exact, f, modal.damping_ratios[-len(f):]):
         assert fm == pytest.approx(fe, rel=2e-3)
         assert zm == pytest.approx(ze, rel=0.05, abs=2e-4)
+
+
+def test_the_turning_frames_regularisation_leaves_the_forces_in_contact_alone():
+    """A reviewer's case against a first version of the fix above (one larger factor for
+    every dead zone, kept while any member floats): the sun-planet forces of a stage
+    with backlash dropped from 581.9 to 419.8 N when an unloaded body floated in a
+    bearing clearance elsewhere.  The forces in contact are now those without it."""
+    import json
+    import warnings
+
+    from torquesplit.model.io import model_to_json
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        base = json.loads(model_to_json(torquesplit.load_model("lin_parker1999_planetary")))
+    for mesh in base["meshes"].values():
+        mesh["backlash"] = {"nominal": 2e-4}
+    out = []
+    for clearance in (0.0, 2e-5):
+        raw = json.loads(json.dumps(base))
+        raw.setdefault("bodies", {})["idle"] = {
+            "polar_inertia": "0.001 kg m^2", "mass": "1 kg", "dofs": ["theta", "x", "y"],
+            "position": ["0 mm", "0 mm", "-200 mm"],
+            "support": {"stiffness": 1e7, "clearance": clearance}}
+        raw.setdefault("shafts", {})["sidle"] = {"connects": ["stage_sun", "idle"],
+                                                 "torsional_stiffness": 1e4}
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            s = torquesplit.assemble(torquesplit.load_model(raw))
+        st = static_equilibrium(s)
+        out.append(st.element_forces[s.element_names.index("stage_sun_planet1")])
+    assert out[0] > 500.0 and out[1] == pytest.approx(out[0], rel=1e-9)

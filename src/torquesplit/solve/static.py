@@ -212,29 +212,44 @@ class _StaticProblem:
         self.mass = 1.0 / s.inv_mass
         self.phi = rigid_body_modes(s)
         self.B = self.mass[:, None] * self.phi
-        self.reg = regularisation
         self.balance_tolerance = balance_tolerance
         self.sp_x = s.sp_el[:, 0].astype(int)
         self.sp_y = s.sp_el[:, 1].astype(int)
-        soft = float(np.max(-np.diag(self.Kf), initial=0.0))
-        if soft > 0 and regularisation > 0:
-            # a member floating in a clearance of a turning frame: its regularising spring
-            # must beat the frame's centripetal softening m Omega^2, or the tangent is
-            # indefinite and Newton runs off (a planet 9 m off its pin, "converged")
-            k_gap = [float(np.max(s.stiffness_table[e]))
-                     for e in range(s.n_elements)
-                     if np.any(s.gap_values[s.gap_ptr[e]:s.gap_ptr[e + 1]] > 0)]
-            k_gap += [float(k) for k, c in zip(s.sp_par[:, SP_STIFFNESS],
-                                               s.sp_par[:, SP_CLEARANCE]) if c > 0]
-            k_gap = [k for k in k_gap if k > 0]
-            if k_gap:
-                self.reg = max(regularisation, 10.0 * soft / min(k_gap))
+        self._spline_set = set(self.sp_x.tolist()) | set(self.sp_y.tolist())
+        self._spline_row = {int(e): j for j, pair in enumerate(s.sp_el) for e in pair}
+        self.reg = self._regularisation(regularisation)
         self.linear = np.ones(s.n_elements, dtype=bool)  # ordinary (1-D) elements
         self.linear[self.sp_x] = False
         self.linear[self.sp_y] = False
         self.has_gaps = bool(np.any(s.gap_values > 0)
                              or np.any(s.sp_par[:, SP_CLEARANCE] > 0)
                              or np.any(s.sp_par[:, SP_STICK] > 0))
+
+    def _regularisation(self, base: float):
+        """The regularisation factor of every element: ``base``, and where a dead zone's
+        DOF is softened by a turning frame (a planet floating in its pin clearance:
+        -m Omega^2 on its translations), enough that reg k V^2 beats the softening twice
+        over: with 1e-9 k the tangent was indefinite and Newton ran a planet 9 m off
+        its pin.  Scalar where nothing is softened."""
+        s = self.s
+        soft = np.maximum(-np.diag(self.Kf), 0.0)
+        if not (base > 0 and np.any(soft > 0)):
+            return base
+        reg = np.full(s.n_elements, float(base))
+        spline_gap = np.zeros(s.n_elements)
+        spline_gap[self.sp_x] = spline_gap[self.sp_y] = s.sp_par[:, SP_CLEARANCE]
+        for e in range(s.n_elements):
+            gaps = s.gap_values[s.gap_ptr[e]:s.gap_ptr[e + 1]]
+            k = float(np.max(s.stiffness_table[e])) if s.stiffness_table.shape[1] else 0.0
+            if e in self._spline_set:
+                k = float(s.sp_par[self._spline_row[e], SP_STIFFNESS])
+            if not (k > 0 and (np.any(gaps > 0) or spline_gap[e] > 0)):
+                continue
+            for j in range(s.v_ptr[e], s.v_ptr[e + 1]):
+                i, c = s.v_dof[j], s.v_coef[j]
+                if soft[i] > 0 and c != 0:
+                    reg[e] = max(reg[e], 2.0 * soft[i] / (k * c * c))
+        return reg
 
     # ------------------------------------------------------------------ loads
     def loads(self, t) -> _Loads:
@@ -334,7 +349,7 @@ class _StaticProblem:
         out = np.empty((s.n_splines, 12))
         laws.spline_forces(dx, dy, zero, zero, np.ascontiguousarray(s.sp_par), out)
         rad = np.hypot(dx, dy)
-        rk = reg * s.sp_par[:, SP_STIFFNESS]
+        rk = (reg[self.sp_x] if np.ndim(reg) else reg) * s.sp_par[:, SP_STIFFNESS]
         s2 = s.sp_par[:, SP_CLEARANCE]
         inner = np.minimum(rad, s2)
         f_reg = rk * inner
@@ -540,21 +555,26 @@ class _StaticProblem:
             q = np.asarray(q0, dtype=float).copy()
         q, n, ok = self.equilibrium(q, L, self.reg, max_iterations - solves)
         solves += n
-        if ok and self.has_gaps and self.reg > 0:
-            # drop the regularisation if the elements in contact hold every DOF
+        if ok and self.has_gaps and np.any(np.asarray(self.reg) > 0):
+            # drop the regularisation where the elements in contact hold every DOF; else
+            # keep it only on the open elements (in contact, the clipped spring would add
+            # its constant reg k g to the force)
             _, _, _, _, state, _ = self.forces(q, L, 0.0)
             on = (np.abs(L.k) > 0) & (state != SEPARATED) & (state != FLOAT)
             on[self.sp_x] &= state[self.sp_x] != FLOAT
-            if rigid_body_modes(s, active=on).shape[1] == self.phi.shape[1]:
-                try:
-                    q2, n2, ok2 = self.equilibrium(q, L, 0.0, max_iterations - solves)
-                except SolverError:
-                    n2, ok2 = 1, False
-                solves += n2
-                if ok2:
-                    state2 = self.forces(q2, L, 0.0)[4]
-                    if np.array_equal(state2, state):
-                        q = q2
+            on[self.sp_x] &= on[self.sp_y]
+            on[self.sp_y] = on[self.sp_x]
+            held = rigid_body_modes(s, active=on).shape[1] == self.phi.shape[1]
+            reg2 = 0.0 if held else np.where(on, 0.0, np.broadcast_to(self.reg, on.shape))
+            try:
+                q2, n2, ok2 = self.equilibrium(q, L, reg2, max_iterations - solves)
+            except SolverError:
+                n2, ok2 = 1, False
+            solves += n2
+            if ok2:
+                state2 = self.forces(q2, L, 0.0)[4]
+                if np.array_equal(state2, state):
+                    q = q2
         return self._result(q, L, solves, ok)
 
     def _result(self, q, L: _Loads, solves, ok):
