@@ -220,8 +220,15 @@ class PreparedRun:
     used where the t = 0 solve did not converge)."""
 
 
-@remember_last
 def _set_up(model):
+    """:func:`_kept_set_up`, after refusing a model changed in place since it was kept."""
+    if model.changed_in_place():
+        solve_kinematics(model)  # (raises the ModelError that says what to do)
+    return _kept_set_up(model)
+
+
+@remember_last
+def _kept_set_up(model):
     """Kinematics, structure, static equilibrium (mean stiffness: the nominal forces) and
     the starting equilibrium of a model (kept while the model lives: a study case run
     until settled sets the same model up for each run length)."""

@@ -55,3 +55,30 @@ def test_a_model_changed_in_place_is_refused(edit):
     assert m.changed_in_place()
     with pytest.raises(torquesplit.ModelError, match="changed in place.*with_changes"):
         torquesplit.simulate(m, duration=0.01)
+
+
+def test_a_model_changed_after_a_run_is_refused_by_the_next_run_and_copies_are_not():
+    """simulate kept its set-up per model: a change in place after one run ran the kept
+    structure (a reviewer); and a pickled or copied model is not 'changed'."""
+    import copy
+    import pickle
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        m = torquesplit.load_model("ji_li_mill_drive")
+    torquesplit.simulate(m, duration=0.01)
+    for twin in (pickle.loads(pickle.dumps(m)), copy.deepcopy(m)):
+        assert not twin.changed_in_place()
+        torquesplit.solve_kinematics(twin)
+    d = m.drives["motor"]
+    m.drives["motor"] = d.model_copy(update={"speed": 2 * d.speed})
+    with pytest.raises(torquesplit.ModelError, match="changed in place"):
+        torquesplit.simulate(m, duration=0.01)
+
+
+def test_with_changes_reaches_a_planetary_stages_own_fields():
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        m = torquesplit.load_model("lin_parker1999_planetary")
+    assert len(m.with_changes({"planetary.0.planets": 3}).meshes) == 6
+

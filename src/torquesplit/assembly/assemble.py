@@ -291,6 +291,18 @@ def _assemble(model: Model, kin: Kinematics | None, *, n_table: int | None,
         # a radial clearance joins the two translations across the body's axis into one
         # circular law (the spline's, without stick or friction); the others stay apart
         pair = _radial_pair(sup, dmap.axes[body], kin.bodies[body].axis)
+        if (sup.clearance > 0 and sup.clearance_shape == "radial" and not pair
+                and sum(1 for d in tr if d != "loa") >= 2):
+            import warnings
+
+            from ..errors import ModelWarning
+
+            warnings.warn(
+                f"{where}.clearance_shape: 'radial' needs two translations across the "
+                f"body's axis ('x', 'y' for an axis along z, ...); this body's "
+                f"{sorted(tr)} are not, so its clearance acts per axis (a square dead "
+                f"zone); give the body an axis along x, y or z, or clearance_shape = "
+                f"'per_axis' to say so", ModelWarning, stacklevel=3)
         radial = {}
         for d, j in tr.items():
             u = dmap.axes[body][d]
@@ -587,7 +599,7 @@ def _fluctuations(where: str, harmonics, idx: int, coef: float, speed: float,
     out = []
     for k, h in enumerate(harmonics, start=1):
         f = h.order * speed / (2 * math.pi) if h.order is not None else h.frequency
-        name = f"{where.split('.', 1)[1]}.fluctuation{k}"
+        name = f"{where}.fluctuation{k}"  # (a drive and a load may share a name)
         if h.order is None:
             fixed.append(name)
         out.append(dict(name=name, kind=SPRING, dofs=[idx], coefs=[coef], stiffness=0.0,

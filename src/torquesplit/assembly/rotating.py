@@ -154,7 +154,13 @@ def frame_terms_at(model, kin, structure, factor: float):
     out = []
     for k in (kin, scaled):
         ext = np.zeros(n)
-        frame, gyro = rotating_frame_terms(k, dmap, ext, stiff)
+        try:
+            frame, gyro = rotating_frame_terms(k, dmap, ext, stiff)
+        except ModelError as exc:  # (a sweep keeps its curve on a SolverError)
+            from ..errors import SolverError
+
+            raise SolverError(f"at {factor:.6g} times the model's speed: "
+                              f"{'; '.join(m for _, m in exc.issues)}") from None
         out.append((sorted(frame), sorted(gyro), ext))
     (_, _, ext_1), (frame, gyro, ext_s) = out
     if (len(gyro) != structure.gy_coef.size or len(frame) != structure.fs_coef.size

@@ -86,9 +86,13 @@ def model_from_dict(data: dict[str, Any], source: str | None = None) -> Model:
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("error", pydantic.warnings.PydanticDeprecationWarning)
-            return Model.model_validate(data)
+            model = Model.model_validate(data)
     except pydantic.ValidationError as exc:
         raise ModelError(_format_errors(exc), source) from None
+    import copy
+
+    model._source = copy.deepcopy(data)  # (with_changes applies changes to it)
+    return model
 
 
 def _format_errors(exc: pydantic.ValidationError) -> list[tuple[str, str]]:

@@ -813,21 +813,33 @@ class Model(Strict):
     """Generated location -> the ``[[planetary]]`` field it came from (see written_at)."""
     _identity: tuple = PrivateAttr(default=())
     """The sections' entries as validated (see :meth:`changed_in_place`)."""
+    _source: dict | None = PrivateAttr(default=None)
+    """The data the model was validated from (set by :func:`~torquesplit.model.io.
+    model_from_dict`), for :meth:`with_changes`."""
 
     def model_post_init(self, __context) -> None:
         self._identity = self._entries()
 
     def _entries(self) -> tuple:
-        """Every entry of every section, by name and object identity."""
-        return tuple((section, tuple((k, id(v)) for k, v in getattr(self, section).items()))
+        """Every entry of every section, by name, as the objects themselves (a copy or a
+        pickle of the model keeps them paired, so it is not 'changed')."""
+        return tuple((section, tuple(getattr(self, section).items()))
                      for section in ("gears", "bodies", "shafts", "meshes", "splines",
                                      "drives", "loads"))
 
     def changed_in_place(self) -> bool:
         """True when an entry of a section was replaced, added or deleted after the model
         was validated (the sections are plain dicts): such a change is not checked, and
-        results computed before it would be reused for it."""
-        return self._entries() != self._identity
+        results computed before it would be reused for it.  (A list inside an entry,
+        changed in place, is not seen: change a model with :meth:`with_changes`.)"""
+        now = self._entries()
+        if len(now) != len(self._identity):
+            return True
+        for (_, a), (_, b) in zip(now, self._identity):
+            if len(a) != len(b) or any(ka != kb or va is not vb
+                                       for (ka, va), (kb, vb) in zip(a, b)):
+                return True
+        return False
 
     def with_changes(self, changes) -> "Model":
         """A new, validated and checked model with ``changes`` applied: a mapping of field
@@ -839,7 +851,10 @@ class Model(Strict):
         from .io import load_model, model_to_json
         from .overrides import apply_overrides
 
-        return load_model(apply_overrides(json.loads(model_to_json(self)), dict(changes)))
+        # the data it was read from where kept (a [[planetary]] stage's own fields then
+        # exist, as for --set), else the model itself in SI
+        base = self._source if self._source is not None else json.loads(model_to_json(self))
+        return load_model(apply_overrides(base, dict(changes)))
 
     @model_validator(mode="after")
     def _expand_planetary(self):
