@@ -55,3 +55,21 @@ def test_mode_numbers_and_counts_are_checked(model):
             torquesplit.model_modes(model, count=bad)
     with pytest.raises(ValueError, match="below must be a positive frequency"):
         torquesplit.model_modes(model, below="1 kHz")
+
+
+def test_speeds_with_units_and_series_by_name(model):
+    """sweep_speed and campbell took only rad/s (a reviewer's '2400 rpm' failed with
+    'could not convert string to float'); mesh_series took only element indices."""
+    rpm = 3.141592653589793 / 30
+    by_text = torquesplit.campbell(model, "600 rpm", "800 rpm")[1]
+    by_number = torquesplit.campbell(model, 600 * rpm, 800 * rpm)[1]
+    assert [c["speed_rpm"] for c in by_text] == [c["speed_rpm"] for c in by_number]
+    with pytest.raises(torquesplit.SolverError, match="start: '600 kg' is not a speed"):
+        torquesplit.campbell(model, "600 kg", "800 rpm")
+    st = torquesplit.steady_state(model, method="hb")
+    names = list(st.structure.element_names)
+    t_name, f_name, _ = st.mesh_series(["m11", "m21"])
+    t_index, f_index, _ = st.mesh_series([names.index("m11"), names.index("m21")])
+    assert (f_name == f_index).all() and (t_name == t_index).all()
+    with pytest.raises(ValueError, match="unknown element 'm99'"):
+        st.mesh_series(["m99"])

@@ -139,9 +139,17 @@ class SteadyState:
         return t, F, D
 
     def mesh_series(self, elements):
-        """(t, forces, deformations) of the elements ``elements`` (indices) over one
-        period at their finest: every RK4 step for meshes (shooting keeps the other
-        elements every ``sample_every`` steps only), the samples otherwise."""
+        """(t, forces, deformations) of the elements ``elements`` (indices or element
+        names such as mesh names) over one period at their finest: every RK4 step for
+        meshes (shooting keeps the other elements every ``sample_every`` steps only), the
+        samples otherwise."""
+        names = list(self.structure.element_names)
+        try:
+            elements = [names.index(e) if isinstance(e, str) else int(e) for e in elements]
+        except ValueError:
+            unknown = [e for e in elements if isinstance(e, str) and e not in names]
+            raise ValueError(f"unknown element {unknown[0]!r}; the elements are "
+                             f"{names}") from None
         ps = self.solution
         cols = {int(e): j for j, e in enumerate(ps.mesh_elements)}
         if ps.method != "hb" and ps.mesh_t.size and all(int(e) in cols for e in elements):

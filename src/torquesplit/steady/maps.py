@@ -33,6 +33,18 @@ RPM = 60.0 / (2 * math.pi)
 __all__ = ["sweep_speed", "campbell"]
 
 
+def _rad_per_s(value, name: str) -> float:
+    """A speed in rad/s: a number (rad/s) or a text with its unit ('2400 rpm')."""
+    if isinstance(value, str):
+        from torquesplit.model.units import parse_quantity
+
+        try:
+            return float(parse_quantity(value, "speed"))
+        except ValueError as exc:
+            raise SolverError(f"{name}: {exc}") from None
+    return float(value)
+
+
 def _prepare(model, keep, max_cycles):
     from torquesplit.assembly.assemble import assemble
     from torquesplit.model.io import load_model
@@ -67,8 +79,9 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
     Parameters
     ----------
     model : Model, str or Path
-    start, stop : float
-        Speeds of the first drive [rad/s]; the sweep runs from ``start`` to ``stop``.
+    start, stop : float or str
+        Speeds of the first drive [rad/s], or texts with their unit ('2400 rpm'); the
+        sweep runs from ``start`` to ``stop``.
     points : int
         Initial number of steps over the range (the step adapts; folds add points).
     method : {"auto", "shooting", "hb"}
@@ -107,7 +120,7 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
     t_start = time.perf_counter()
     model, kin, s, dropped, per, static = _prepare(model, keep, max_cycles)
     w_ref = reference_speed(model)
-    s0, s1 = float(start) / w_ref, float(stop) / w_ref
+    s0, s1 = _rad_per_s(start, "start") / w_ref, _rad_per_s(stop, "stop") / w_ref
     if per.frequency <= 0:
         raise SolverError("the model has no time-varying excitation: its response does not "
                           "change with speed; nothing to sweep.")
@@ -468,7 +481,7 @@ def campbell(model, start: float, stop: float, *, points: int = 41,
 
     model, kin, s, _, _, static = _prepare(model, None, None)
     w_ref = reference_speed(model)
-    lo, hi = float(start), float(stop)
+    lo, hi = _rad_per_s(start, "start"), _rad_per_s(stop, "stop")
     if not (lo > 0 and hi > lo and math.isfinite(hi)):
         raise SolverError(f"the speed range {lo:g}..{hi:g} rad/s must be increasing and "
                           f"positive; e.g. --from '1000 rpm' --to '3000 rpm'.")
