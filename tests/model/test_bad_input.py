@@ -489,3 +489,25 @@ def test_cli_check_prints_warnings(tmp_path):
     assert result.exit_code == 0
     assert result.stderr.startswith("warning:")
     json.loads(result.stdout)
+
+
+def test_a_model_can_accept_a_warning_with_its_reason():
+    """A shipped example warned of its paper's own values on every load (a reviewer's
+    notebook printed six ModelWarnings for mo2017_star_reducer): a model may accept a
+    warned field, with the reason, which 'check' lists."""
+    data = pair_dict()
+    data["meshes"]["m"]["stiffness"] = "1e7 N/m"
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        torquesplit.load_model(data)
+    assert any("meshes.m.stiffness" in str(w.message) for w in said)
+    data["model"]["accepted_warnings"] = [{"field": "meshes.*.stiffness",
+                                           "reason": "as measured on the test rig"}]
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        model = torquesplit.load_model(data)
+    assert not [w for w in said if "meshes.m.stiffness" in str(w.message)]
+    assert summary(model)["accepted_warnings"][0]["reason"] == "as measured on the test rig"
+    data["model"]["accepted_warnings"] = [{"field": "meshes.*.stiffness", "reason": ""}]
+    with pytest.raises(torquesplit.ModelError, match="accepted_warnings.0.reason"):
+        load(data)

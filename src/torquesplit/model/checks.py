@@ -100,7 +100,20 @@ def check_model(model: Model, source: str | None = None, *, deep: bool = False) 
         raise ModelError(as_written(model, issues), source)
     warned = plausibility_warnings(model, kin) + rim_overlap_warnings(model, kin) + notes
     for loc, msg in as_written(model, warned):
+        if accepted(model, loc) is not None:
+            continue  # known and accepted in the file, with its reason
         warnings.warn(f"{source + ': ' if source else ''}{loc}: {msg}", ModelWarning, stacklevel=3)
+
+
+def accepted(model: Model, loc: str) -> str | None:
+    """The reason of the model's ``accepted_warnings`` entry that matches the warned
+    field ``loc`` ('*' matches any part), or None."""
+    import fnmatch
+
+    for a in model.model.accepted_warnings:
+        if fnmatch.fnmatchcase(loc, a.field):
+            return a.reason
+    return None
 
 
 def as_written(model: Model, issues) -> list[tuple[str, str]]:

@@ -779,12 +779,26 @@ class Analysis(Strict):
     )
 
 
+class AcceptedWarning(Strict):
+    """A plausibility warning the model's author has checked and accepts, with why."""
+
+    field: str = Field(min_length=1, description=(
+        "The warned field, as the warning names it; '*' matches any part "
+        "(e.g. 'meshes.*.stiffness')."))
+    reason: str = Field(min_length=1, description=(
+        "Why the value is right although it looks wrong (e.g. 'the paper's values, "
+        "Table 2'); required."))
+
+
 class ModelInfo(Strict):
     """Name and source of the model."""
 
     name: str = Field(description="Short name of the model.")
     description: str = Field("", description="One-line description.")
     reference: str = Field("", description="Source of the data (paper, drawing).")
+    accepted_warnings: list[AcceptedWarning] = Field([], description=(
+        "Plausibility warnings of the model checks that are known and accepted, each with "
+        "its reason: not repeated on every load ('check' still lists them as accepted)."))
 
 
 # the [[planetary]] shorthand builds on the sections above

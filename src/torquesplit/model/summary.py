@@ -71,6 +71,8 @@ def summary(model: Model) -> dict:
         "power_balance": (kin.input_power - kin.output_power) / kin.input_power,
         "drive_torques_Nm": kin.drive_torques,
         "load_torques_Nm": kin.load_torques,
+        "accepted_warnings": [{"field": a.field, "reason": a.reason}
+                              for a in model.model.accepted_warnings],
         "bodies": bodies,
         "meshes": meshes,
     }
@@ -143,6 +145,9 @@ def render_summary(s: dict, console) -> None:
                   f"{m['torque_driver_Nm']:.6g}", f"{m['tooth_force_N'] / 1e3:.5g}",
                   *([f"{m['axial_force_N'] / 1e3:.5g}"] if axial else []))
     console.print(t)
+    for a in s.get("accepted_warnings", ()):  # (the file's own, with its reason)
+        console.print(f"accepted warning: {escape(a['field'])} ({escape(a['reason'])})",
+                      highlight=False)
 
 
 def _unit(v) -> np.ndarray:
