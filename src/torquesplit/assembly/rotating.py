@@ -135,39 +135,46 @@ def rotating_frame_terms(kin, dmap, ext: np.ndarray, pin_stiffness=None):
     return frame, gyro
 
 
-def frame_terms_at(model, kin, structure, factor: float):
-    """The rotating-frame terms of ``structure`` with every speed ``factor`` times the
-    model's (a speed sweep at constant load): ``(gy_coef, fs_coef, external_force)`` in
-    the structure's own order.  Coriolis scales with the carrier's speed, centripetal
-    softening and centrifugal force with its square, the planets' pin preload as
-    m Omega^2 R k_t / (k_t - m Omega^2): recomputed here, not scaled.  The drive and
-    load torques stay the file's."""
-    import dataclasses
+class FrameTermsAt:
+    """The rotating-frame terms of ``structure`` at ``factor`` times the model's speeds
+    (a speed sweep at constant load), called as ``terms(factor) -> (gy_coef, fs_coef,
+    external_force)`` in the structure's own order.  Coriolis scales with the carrier's
+    speed, centripetal softening and centrifugal force with its square, the planets' pin
+    preload as m Omega^2 R k_t / (k_t - m Omega^2): recomputed, not scaled.  The drive and
+    load torques stay the file's (the model's own centrifugal forces are taken out of the
+    structure's external forces once, here)."""
 
-    from .assemble import pin_stiffness
+    def __init__(self, model, kin, structure):
+        from .assemble import pin_stiffness
 
-    dmap = structure.metadata["dof_map"]
-    scaled = dataclasses.replace(kin, bodies={
-        n: dataclasses.replace(b, speed=b.speed * factor) for n, b in kin.bodies.items()})
-    stiff = pin_stiffness(model, kin)
-    n = structure.n_dof
-    out = []
-    for k in (kin, scaled):
-        ext = np.zeros(n)
+        self.kin = kin
+        self.structure = structure
+        self.dmap = structure.metadata["dof_map"]
+        self.stiff = pin_stiffness(model, kin)
+        own = np.zeros(structure.n_dof)
+        rotating_frame_terms(kin, self.dmap, own, self.stiff)
+        self.loads = structure.external_force - own  # (without the centrifugal forces)
+
+    def __call__(self, factor: float):
+        import dataclasses
+
+        s, kin = self.structure, self.kin
+        scaled = dataclasses.replace(kin, bodies={
+            n: dataclasses.replace(b, speed=b.speed * factor) for n, b in kin.bodies.items()})
+        ext = np.zeros(s.n_dof)
         try:
-            frame, gyro = rotating_frame_terms(k, dmap, ext, stiff)
+            frame, gyro = rotating_frame_terms(scaled, self.dmap, ext, self.stiff)
         except ModelError as exc:  # (a sweep keeps its curve on a SolverError)
             from ..errors import SolverError
 
             raise SolverError(f"at {factor:.6g} times the model's speed: "
                               f"{'; '.join(m for _, m in exc.issues)}") from None
-        out.append((sorted(frame), sorted(gyro), ext))
-    (_, _, ext_1), (frame, gyro, ext_s) = out
-    if (len(gyro) != structure.gy_coef.size or len(frame) != structure.fs_coef.size
-            or [j for _, j, _ in gyro] != structure.gy_idx.tolist()
-            or [j for _, j, _ in frame] != structure.fs_idx.tolist()):
-        raise ValueError("the rotating-frame terms at another speed do not have the "
-                         "structure's pattern (was it assembled with rotating_frame=False?)")
-    return (np.array([g for _, _, g in gyro]), np.array([k for _, _, k in frame]),
-            structure.external_force - ext_1 + ext_s)
-
+        frame, gyro = sorted(frame), sorted(gyro)
+        if (len(gyro) != s.gy_coef.size or len(frame) != s.fs_coef.size
+                or [j for _, j, _ in gyro] != s.gy_idx.tolist()
+                or [j for _, j, _ in frame] != s.fs_idx.tolist()):
+            raise ValueError("the rotating-frame terms at another speed do not have the "
+                             "structure's pattern (was it assembled with "
+                             "rotating_frame=False?)")
+        return (np.array([g for _, _, g in gyro]), np.array([k for _, _, k in frame]),
+                self.loads + ext)

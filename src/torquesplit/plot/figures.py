@@ -381,12 +381,7 @@ def support_spectrum_figure(results, *, start_time: float | None = None, orders:
         each mesh frequency; dash-dot grey: rotation frequency of the supported body.
     """
     s = results.solution
-    el = results.structure.element_names
-    supports: dict[str, list[tuple[str, int]]] = {}
-    for col, e in enumerate(s.history_elements):
-        if ".support." in el[e]:
-            body, direction = el[e].split(".support.", 1)
-            supports.setdefault(body, []).append((direction, col))
+    supports = results.support_columns()
     chosen = bodies is not None
     if chosen:
         wanted = list(bodies)

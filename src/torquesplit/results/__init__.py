@@ -407,6 +407,16 @@ class Results:
             return 0.0
         return 1.0 / (f_max * float(np.median(np.diff(t))))
 
+    def support_columns(self) -> dict[str, list[tuple[str, int]]]:
+        """Supported body -> its bearing elements' (direction, column of the history)."""
+        el = self.structure.element_names
+        out: dict[str, list[tuple[str, int]]] = {}
+        for col, e in enumerate(self.solution.history_elements):
+            if ".support." in el[e]:
+                body, direction = el[e].split(".support.", 1)
+                out.setdefault(body, []).append((direction, col))
+        return out
+
     def bearing_forces(self, start_time: float | None = None) -> list[dict]:
         """Per supported body, its bearing (support) force over the settled part: the mean
         of each direction [N], the magnitude of that mean and the largest magnitude of the
@@ -419,12 +429,7 @@ class Results:
         s = self.solution
         if s is None or not s.history_t.size:
             return []
-        el = self.structure.element_names
-        by_body: dict[str, list[tuple[str, int]]] = {}
-        for col, e in enumerate(s.history_elements):
-            if ".support." in el[e]:
-                body, direction = el[e].split(".support.", 1)
-                by_body.setdefault(body, []).append((direction, col))
+        by_body = self.support_columns()
         if not by_body:
             return []
         t0 = self.metrics().settling.start_time if start_time is None else float(start_time)

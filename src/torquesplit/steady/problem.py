@@ -87,15 +87,13 @@ statistics (peaks between the steps are found by the parabola through three)."""
 def periodic_problem(model, kinematics, structure: Structure, frequency: float,
                      rhs: str = "auto") -> PeriodicProblem:
     """The :class:`PeriodicProblem` of an assembled model, with the speed dependence of a
-    turning carrier's frame (:func:`torquesplit.assembly.rotating.frame_terms_at`) where
+    turning carrier's frame (:class:`torquesplit.assembly.rotating.FrameTermsAt`) where
     the structure has one."""
     terms = None
     if structure.metadata.get("rotating_frame"):
-        from functools import partial
+        from torquesplit.assembly.rotating import FrameTermsAt
 
-        from torquesplit.assembly.rotating import frame_terms_at
-
-        terms = partial(frame_terms_at, model, kinematics, structure)
+        terms = FrameTermsAt(model, kinematics, structure)
     return PeriodicProblem(structure, frequency, rhs, frame_terms=terms)
 
 
@@ -129,7 +127,7 @@ class PeriodicProblem:
         self._models: dict[float, kd.KernelModel] = {}
         self._stable_step: float | None = None
         # f(speed factor) -> (gy_coef, fs_coef, external_force) of a turning carrier's
-        # frame at that speed (assembly.rotating.frame_terms_at); None: no turning frame
+        # frame at that speed (assembly.rotating.FrameTermsAt); None: no turning frame
         self._frame_terms = frame_terms
         self._par_speed = 1.0  # the speed the generated code's parameters hold
 
