@@ -702,8 +702,9 @@ def static(
     points_per_cycle: int = typer.Option(32, "--points-per-cycle",
                                          help="Positions per cycle of the fastest "
                                          "excitation.", metavar="N"),
-    out: Optional[Path] = typer.Option(None, "--out", help="Write results to this NetCDF "
-                                       "file (.nc).", metavar="FILE"),
+    out: Optional[Path] = typer.Option(None, "--out", help="Write results: .nc (NetCDF), .mat "
+                                       "(MATLAB) or .csv (NAME.csv per position, NAME_mesh.csv "
+                                       "per mesh).", metavar="FILE"),
     force: bool = _flag("--force", "Replace an existing results file and figures."),
     plots: Optional[Path] = typer.Option(None, "--plots", help="Write report figures (PNG, "
                                          "SVG) into this folder.", metavar="DIR"),
@@ -715,6 +716,7 @@ def static(
     """Quasi-static load sharing: the equilibrium at each mesh position, with the errors
     and clearances at that position (Mo et al. 2017); floating orbits in µm."""
     from .results import files
+    from .results.export import check_dataset_output
 
     state = {"saved": None}
     with contextlib.ExitStack() as stack, ux.interruptible(
@@ -728,7 +730,9 @@ def static(
 
                 _check_plots_folder(plots, names=figure_files(STATIC_FIGURES), force=force)
             if out is not None:
-                plan = files.check_output(out, formats=files.NETCDF_FORMATS, overwrite=force)
+                # (the CSV tables: per position, per mesh, per planet of a stage)
+                plan = check_dataset_output(out, ("time", "mesh", "planet_entity"),
+                                            overwrite=force)
                 stack.enter_context(files.claim_output(plan))
             m, _ = _load(model, assign)
             from .quasistatic import quasi_static_load_sharing
@@ -744,14 +748,18 @@ def static(
             for loc, msg in static_warnings(res):
                 ux.warn(f"{loc}: {msg}")
             res.warnings = list(ux.session().warnings)
-            state["saved"] = res.to_netcdf(out, overwrite=force) if out is not None else None
         except _EXPECTED as exc:
             _fail(exc)
             return
+        failed = None
+        try:  # a file that cannot be written: the results are still printed, then the error
+            state["saved"] = res.save(out, overwrite=force) if out is not None else None
+        except _EXPECTED as exc:
+            failed = exc
         saved = state["saved"]
         met = res.metrics()
         orbits = res.orbits()
-        figures, failed = [], None
+        figures = []
         if plots is not None:
             from .plot import write_static_figures
 
@@ -759,8 +767,8 @@ def static(
                 with ux.progress("writing figures", quiet or as_json, total=None):
                     figures = write_static_figures(res, plots)
             except OSError as exc:
-                failed = _figure_error(exc, "--plots", plots,
-                                       _kept_results([saved] if saved else []))
+                failed = failed or _figure_error(exc, "--plots", plots,
+                                                 _kept_results([saved] if saved else []))
     _print_static(m, res, met, orbits, saved, figures, plots, as_json)
     if failed is not None:
         _fail(failed)
@@ -832,6 +840,8 @@ def mesh(
                                         "(.png, .svg or .pdf).", metavar="FILE"),
     force: bool = _flag("--force", "Replace an existing --plot file."),
     points: int = typer.Option(256, "--points", help="Samples per mesh cycle.", metavar="N"),
+    assign: Optional[list[str]] = typer.Option(None, "--set", help=_SET_HELP,
+                                               metavar="PATH=VALUE"),
     as_json: bool = _flag("--json", "Print the comparison as JSON."),
 ):
     """Mesh stiffness k(phase) of one mesh by every applicable method, with the ISO value
@@ -839,7 +849,7 @@ def mesh(
     try:
         _at_least(points, 16, "--points", "256")
         _check_figure_file(plot, "--plot", force)
-        m, _ = _load(model)
+        m, _ = _load(model, assign)
         if pair not in m.meshes:
             raise OptionError(f"--pair: no mesh named {pair!r}; use one of "
                               f"{', '.join(m.meshes)}")
@@ -1212,8 +1222,9 @@ def modes(
     assign: Optional[list[str]] = typer.Option(None, "--set", help=_SET_HELP,
                                                metavar="PATH=VALUE"),
     as_json: bool = _flag("--json", "Print the modes, with their shapes, as JSON."),
-    out: Optional[Path] = typer.Option(None, "--out", help="Write the modes and shapes to "
-                                       "this NetCDF file.", metavar="FILE"),
+    out: Optional[Path] = typer.Option(None, "--out", help="Write the modes and shapes (with "
+                                       "--campbell: the map): .nc, .mat or .csv.",
+                                       metavar="FILE"),
     force: bool = _flag("--force", "Replace an existing --out or --plot file."),
     campbell: bool = _flag("--campbell", "Resonance map over --from..--to."),
     start: Optional[str] = typer.Option(None, "--from", help="Campbell: first speed, e.g. "
@@ -1236,14 +1247,16 @@ def modes(
     through C ignored; Coriolis term added with a turning carrier); f_d = f sqrt(1 -
     zeta^2)."""
     from .results import files
+    from .results.export import check_dataset_output, save_dataset
 
     try:
         _at_least(count, 1, "--count", "20")
         _check_figure_file(plot, "--plot", force)
         limit = ux.quantity(below, "frequency", "--below")
         _positive(limit, "--below", "'5 kHz'")
-        if out is not None:
-            files.check_output(out, formats=files.NETCDF_FORMATS, overwrite=force)
+        if out is not None:  # (the CSV tables: per mode and per DOF, or per speed)
+            check_dataset_output(out, ("speed",) if campbell else ("mode", "dof"),
+                                 overwrite=force)
         m, _ = _load(model, assign)
         if not campbell and (start is not None or stop is not None):
             raise TorquesplitError("--from and --to give the speed range of a Campbell "
@@ -1254,10 +1267,11 @@ def modes(
                                        "--to '3000 rpm'")
             from .steady.cli import campbell_command
 
-            return campbell_command(m, start, stop, plot, as_json, console, _json_default)
+            return campbell_command(m, start, stop, plot, as_json, console, _json_default,
+                                    out=out, force=force)
         plan = None
         if out is not None:
-            plan = files.check_output(out, formats=files.NETCDF_FORMATS, overwrite=force)
+            plan = check_dataset_output(out, ("mode", "dof"), overwrite=force)
         from .model.kinematics import solve_kinematics
         from .modes import model_modes
 
@@ -1266,12 +1280,10 @@ def modes(
             rep = model_modes(m, rotating_frame=rotating_frame, below=limit, count=count)
         saved = None
         if plan is not None:
-            with files.claim_output(plan) as claim:
+            with files.claim_output(plan):
                 ds = rep.to_dataset()
-                ds.attrs.update(files.provenance(claim.run_id))
                 ds.attrs["model"] = m.model.name
-                claim.write({plan.path: files.netcdf_bytes(ds)})
-            saved = plan.path
+                saved = save_dataset(ds, plan.path, overwrite=force)
     except _EXPECTED as exc:
         _fail(exc)
         return
@@ -1382,7 +1394,7 @@ def example(
 
 from .steady.cli import register as _register_steady  # noqa: E402
 
-_register_steady(app, lambda model: _load(model), _fail, console, err_console, _json_default)
+_register_steady(app, _load, _fail, console, err_console, _json_default, set_help=_SET_HELP)
 
 # --------------------------------------------------------------------------- studies
 from .study.cli import study as _study, sweep as _sweep  # noqa: E402  (typer signatures only)

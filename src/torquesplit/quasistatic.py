@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .assembly.structure import dof_units
 from .errors import ModelWarning
 
 from .metrics import load_sharing as ls
@@ -103,7 +104,9 @@ class QuasiStaticResults:
             },
             coords={"time": ("time", self.times, {"units": "s", "long_name": "time"}),
                     "mesh": ("mesh", self.mesh_names),
-                    "dof": ("dof", list(self.structure.dof_names))},
+                    "dof": ("dof", list(self.structure.dof_names)),
+                    "dof_unit": ("dof", dof_units(self.structure),
+                                 {"long_name": "unit of each DOF's displacement"})},
             attrs={"title": f"torquesplit quasi-static: {self.model.model.name}",
                    "warnings": "\n".join(self.all_warnings()),
                    "warnings_json": json.dumps(self.all_warnings()),
@@ -122,12 +125,17 @@ class QuasiStaticResults:
         attributes say which run wrote it (see :mod:`torquesplit.results.files`)."""
         from .results import files
 
-        plan = files.check_output(path, formats=files.NETCDF_FORMATS, overwrite=overwrite)
-        with files.claim_output(plan) as claim:
-            ds = self.to_dataset()
-            ds.attrs.update(files.provenance(claim.run_id))
-            claim.write({plan.path: files.netcdf_bytes(ds)})
-        return plan.path
+        files.check_output(path, formats=files.NETCDF_FORMATS, overwrite=overwrite)
+        return self.save(path, overwrite=overwrite)
+
+    def save(self, path, *, overwrite: bool = False):
+        """Save by suffix: ``.nc`` NetCDF, ``.mat`` MATLAB, ``.csv`` spreadsheet tables
+        (``NAME.csv`` a row per position, ``NAME_mesh.csv`` a row per mesh; see
+        :mod:`torquesplit.results.export`); atomically, an existing file kept unless
+        ``overwrite``.  Returns the path written."""
+        from .results.export import save_dataset
+
+        return save_dataset(self.to_dataset(), path, overwrite=overwrite)
 
 
 MAX_REVOLUTIONS = 100.0

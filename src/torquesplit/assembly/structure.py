@@ -477,6 +477,12 @@ def element_units(structure: Structure) -> list[str]:
     return out
 
 
+def dof_units(structure: Structure) -> list[str]:
+    """Unit of each DOF's displacement: ``"rad"`` for a rotation (``*.theta``), else
+    ``"m"``."""
+    return ["rad" if n.endswith(".theta") else "m" for n in structure.dof_names]
+
+
 def history_elements(structure: Structure, mesh_names) -> list[int]:
     """Elements whose forces a run's history keeps, in its column order: the meshes (as
     named), the supports (bearing forces), then every other element (shaft and spline

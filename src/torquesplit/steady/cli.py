@@ -6,7 +6,6 @@ print one line and exit with status 2 (the main CLI's ``_fail``).
 
 from __future__ import annotations
 
-import json
 import math
 import re
 from pathlib import Path
@@ -78,8 +77,9 @@ def _keep(keep):
         return keep
 
 
-def register(app, load, fail, console, err_console, json_default):
-    """Add the commands to ``app`` (helpers of :mod:`torquesplit.cli` passed in)."""
+def register(app, load, fail, console, err_console, json_default, set_help=""):
+    """Add the commands to ``app`` (helpers of :mod:`torquesplit.cli` passed in; ``load``
+    takes the model argument and the ``--set`` assignments)."""
     from torquesplit.errors import TorquesplitError
 
     @app.command()
@@ -116,6 +116,8 @@ def register(app, load, fail, console, err_console, json_default):
             False, "--check-step", help="Solve again at half the RK4 step (harmonic "
             "balance: twice the harmonics) and report how many significant digits of "
             "every number hold."),
+        assign: Optional[list[str]] = typer.Option(None, "--set", help=set_help,
+                                                   metavar="PATH=VALUE"),
     ):
         """Periodic steady state at one speed: per-mesh table, residual, harmonics, stability."""
         try:
@@ -136,7 +138,7 @@ def register(app, load, fail, console, err_console, json_default):
             from torquesplit.steady.api import steady_state
 
             _check_out(out, force=force)
-            m, _ = load(model)
+            m, _ = load(model, assign)
             from torquesplit.cli_support import collect_warnings, progress
 
             with collect_warnings(), progress("periodic steady state", as_json,
@@ -247,18 +249,21 @@ def register(app, load, fail, console, err_console, json_default):
         steps_per_cycle: Optional[int] = typer.Option(
             None, "--steps-per-cycle", help="Shooting: RK4 steps per cycle of the fastest "
             "excitation (default 100, refined for the highest mode).", metavar="N"),
-        out: Optional[Path] = typer.Option(None, "--out", help="Write the Dataset (.nc)."),
+        out: Optional[Path] = typer.Option(None, "--out", help="Write the curves: .nc, .mat or "
+                                           ".csv (a row per speed)."),
         plot: Optional[Path] = typer.Option(None, "--plot", help="Write the figure (.png/.svg)."),
         force: bool = typer.Option(False, "--force", help="Replace existing --out / --plot "
                                    "files."),
         as_json: bool = typer.Option(False, "--json", help="Print a summary as JSON."),
+        assign: Optional[list[str]] = typer.Option(None, "--set", help=set_help,
+                                                   metavar="PATH=VALUE"),
     ):
         """Speed response by continuation: dynamic factor, load sharing, RMS TE vs speed."""
         try:
             if method not in ("auto", "hb", "shooting"):
                 raise TorquesplitError(f"--method {method!r} is unknown; use auto, hb or "
                                        "shooting")
-            from torquesplit.results.files import NETCDF_FORMATS
+            from torquesplit.results.export import check_dataset_output
             from torquesplit.steady.maps import sweep_speed
 
             if steps_per_cycle is not None and steps_per_cycle < 10:
@@ -268,10 +273,11 @@ def register(app, load, fail, console, err_console, json_default):
             if step is not None and not step > 0:
                 raise TorquesplitError(f"--max-step must be a positive speed, e.g. '5 rpm'; "
                                        f"got {max_step!r}")
-            _check_out(out, NETCDF_FORMATS, force)
+            if out is not None:  # (the CSV tables: per speed, per run-up/-down speed)
+                check_dataset_output(out, ("point", "check"), overwrite=force)
             if plot is not None:
                 _check_out(plot, {".png": "png", ".svg": "svg", ".pdf": "pdf"}, force)
-            m, _ = load(model)
+            m, _ = load(model, assign)
             from torquesplit.cli_support import collect_warnings, progress
 
             with collect_warnings(), progress("speed sweep", as_json, total=None):
@@ -283,12 +289,16 @@ def register(app, load, fail, console, err_console, json_default):
         except (TorquesplitError, ValueError, OSError) as exc:
             fail(_in_flags(exc))
             return
-        if out is not None:
-            _to_netcdf(ds, out, force)
-        if plot is not None:
-            from torquesplit.steady.plot import save, sweep_figure
+        saved, failed = None, None
+        try:  # a file that cannot be written: the curves are still printed, then the error
+            if out is not None:
+                saved = _save(ds, out, force)
+            if plot is not None:
+                from torquesplit.steady.plot import save, sweep_figure
 
-            save(sweep_figure(ds), plot)
+                save(sweep_figure(ds), plot)
+        except (TorquesplitError, OSError) as exc:
+            failed = exc
         largest = sweep_maxima(ds)
         summary = {
             "model": ds.attrs["model"], "points": int(ds.sizes["point"]),
@@ -301,6 +311,7 @@ def register(app, load, fail, console, err_console, json_default):
                                      "not observable)",
             "unstable_points": int((~ds["stable"].values).sum()),
             "wall_time_s": ds.attrs["wall_time_s"],
+            "results_file": str(saved) if saved else None,
         }
         if cross_check:
             for key in ("run_up", "run_down"):
@@ -336,6 +347,11 @@ def register(app, load, fail, console, err_console, json_default):
                               "at a speed for their full response)", highlight=False)
             console.print(f"unstable points: {summary['unstable_points']} (dashed in the "
                           f"figure; left out of the largest dynamic factor)")
+            if saved:
+                console.print(f"results written to {saved}", highlight=False)
+        if failed is not None:
+            fail(failed)
+            return
         if not ds.attrs["complete"]:
             err_console.print(f"[yellow]warning:[/] {ds.attrs['message']}")
             raise typer.Exit(1)
@@ -372,29 +388,33 @@ def sweep_maxima(ds) -> dict[str, dict[str, tuple[float, float]]]:
     return out
 
 
-def _to_netcdf(ds, path, overwrite=False):
-    """Write atomically (complete or absent; see torquesplit.results.files)."""
-    from torquesplit.results import files
+def _save(ds, path, overwrite=False):
+    """Write by suffix, atomically (complete or absent; torquesplit.results.export)."""
+    from torquesplit.results.export import save_dataset
 
-    ds = ds.copy()
-    for k, v in list(ds.attrs.items()):
-        if isinstance(v, list):
-            ds.attrs[k] = json.dumps(v)
-    # which software and command wrote it, as a run's results file says
-    ds.attrs.update(files.provenance(files.new_run_id()))
-    files.write_atomically(path, files.netcdf_bytes(ds), overwrite=overwrite,
-                           formats=files.NETCDF_FORMATS)
+    return save_dataset(ds, path, overwrite=overwrite)
 
 
-def campbell_command(m, start, stop, plot, as_json, console, json_default):
-    """``modes --campbell``: the resonance map and the critical speeds."""
+def campbell_command(m, start, stop, plot, as_json, console, json_default, out=None,
+                     force=False):
+    """``modes --campbell``: the resonance map and the critical speeds (the map written
+    to ``out`` if given)."""
     from torquesplit.steady.maps import campbell
 
-    ds, crossings = campbell(m, _speed(start, "--from"), _speed(stop, "--to"))
-    if plot is not None:
-        from torquesplit.steady.plot import campbell_figure, save
+    from torquesplit.errors import TorquesplitError
 
-        save(campbell_figure(ds), plot)
+    ds, crossings = campbell(m, _speed(start, "--from"), _speed(stop, "--to"))
+    written, failed = [], None
+    try:  # a file that cannot be written: the map is still printed, then the error
+        if out is not None:
+            written.append(_save(ds, out, force))
+        if plot is not None:
+            from torquesplit.steady.plot import campbell_figure, save
+
+            save(campbell_figure(ds), plot)
+            written.append(plot)
+    except (TorquesplitError, OSError) as exc:
+        failed = exc
     from torquesplit.steady.maps import mode_kind, split_suppressed
 
     critical, suppressed = split_suppressed(crossings)
@@ -405,7 +425,10 @@ def campbell_command(m, start, stop, plot, as_json, console, json_default):
                "natural_frequencies_at_speed_rpm": float(ds["speed_rpm"].values[0])}
         if suppressed:
             out["suppressed_by_mesh_phasing"] = suppressed
+        out["files"] = [str(w) for w in written]
         _emit(out, json_default)
+        if failed is not None:
+            raise failed
         return
     phased = any("suppressed" in c for c in crossings)
     t = Table(title=f"critical speeds between {start} and {stop}" + (
@@ -429,3 +452,7 @@ def campbell_command(m, start, stop, plot, as_json, console, json_default):
     console.print("k harmonic: the amplitude of that order of the mesh stiffness over its "
                   "mean (how strongly the stiffness variation drives the crossing; errors "
                   "and shaft orders are not rated: '-')", highlight=False)
+    for w in written:
+        console.print(f"wrote {w}", highlight=False)
+    if failed is not None:
+        raise failed

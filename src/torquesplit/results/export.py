@@ -1,0 +1,179 @@
+"""Any result Dataset as a NetCDF, MATLAB or spreadsheet file, chosen by the suffix.
+
+The quasi-static sweep, the speed sweep, the natural modes and the Campbell map are
+xarray Datasets; this module writes each of them in the three formats a gearbox engineer
+opens (Python, MATLAB, a spreadsheet), safely (:mod:`torquesplit.results.files`).
+A dynamic run has its own richer writer (``Results.save``).
+
+CSV: one table per *row dimension* (the first dimension of each variable, in order):
+``NAME.csv`` for the first, ``NAME_<dim>.csv`` beside it for each other.  A row per
+coordinate value; a 1-D variable is one column, a variable with more dimensions one
+column per label of the others (``dynamic_factor_m11``); every column's unit is in its
+name (``speed_rad/s``), as in a run's CSV files.  Scalar variables are columns of the
+first table.  MATLAB: every variable and coordinate, with ``units``, ``descriptions`` and
+``attributes`` structs and a ``provenance`` struct naming the run.
+"""
+
+from __future__ import annotations
+
+import itertools
+import json
+import re
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import OutputError, clip_text
+from . import files
+
+#: suffix -> format of a Dataset export
+DATASET_FORMATS = {".nc": "netcdf", ".netcdf": "netcdf", ".h5": "netcdf", ".mat": "mat",
+                   ".csv": "table"}
+
+__all__ = ["DATASET_FORMATS", "row_dims", "check_dataset_output", "save_dataset"]
+
+
+def row_dims(ds) -> tuple[str, ...]:
+    """The row dimension of each CSV table: the first dimension of each data variable, in
+    the order the variables come (a Dataset of scalars only: the table '' of one row)."""
+    out: list[str] = []
+    for name in ds.data_vars:
+        dims = ds[name].dims
+        if dims and dims[0] not in out:
+            out.append(dims[0])
+    return tuple(out) or ("",)
+
+
+def check_dataset_output(path, tables: tuple[str, ...] = (), *, overwrite: bool = False,
+                         what: str = "results") -> files.OutputPlan:
+    """Check ``path`` as :func:`files.check_output` does, for a Dataset export: before
+    the computation with ``tables`` empty (the file named), at the save with the
+    Dataset's :func:`row_dims` (a ``.csv`` also writes ``NAME_<dim>.csv`` beside
+    ``NAME.csv`` for each but the first)."""
+    plan = files.check_output(path, formats=DATASET_FORMATS, overwrite=overwrite, what=what)
+    if plan.format != "table":
+        return plan
+    extra = tuple(plan.path.with_name(f"{plan.path.stem}_{d}.csv") for d in tables[1:])
+    for f in extra:
+        if (f.exists() or f.is_symlink()) and not overwrite:
+            raise OutputError(f"{clip_text(str(f))} exists; use --force (overwrite=True in "
+                              f"Python) to replace it, or choose another file")
+    return files.OutputPlan(path=plan.path, format="table", files=(plan.path,) + extra,
+                            overwrite=overwrite)
+
+
+def _unit_suffix(attrs) -> str:
+    unit = str(attrs.get("units", "")).replace(" ", "")
+    return "" if unit in ("", "1") else f"_{unit}"
+
+
+def _column(name: str, suffix: str) -> str:
+    """A column name with its unit (not twice: ``speed_rpm`` stays as it is)."""
+    return name if name.endswith(suffix) else name + suffix
+
+
+def _cell(v):
+    if isinstance(v, (np.floating, float)):
+        return float(v)
+    if isinstance(v, (np.integer, int, np.bool_, bool)):
+        return int(v)
+    return str(v)
+
+
+def _labels(ds, dim) -> list[str]:
+    values = ds[dim].values if dim in ds.coords else np.arange(ds.sizes[dim])
+    return [str(_cell(v)) for v in values]
+
+
+def _table(ds, dim) -> tuple[list[str], list[list]]:
+    """Header and rows of the table whose rows run along ``dim`` ('' = one row)."""
+    n = ds.sizes[dim] if dim else 1
+    header: list[str] = []
+    columns: list[np.ndarray] = []
+    if dim:
+        coord = ds[dim] if dim in ds.coords else None
+        header.append(_column(dim, _unit_suffix(coord.attrs)) if coord is not None else dim)
+        columns.append(coord.values if coord is not None else np.arange(n))
+        for c in ds.coords:  # the other coordinates along the rows (speed_rpm by point)
+            if c != dim and ds[c].dims == (dim,):
+                header.append(_column(c, _unit_suffix(ds[c].attrs)))
+                columns.append(ds[c].values)
+    first = row_dims(ds)[0]
+    for name in ds.data_vars:
+        da = ds[name]
+        if (da.dims[0] if da.dims else first) != dim:
+            continue
+        unit = _unit_suffix(da.attrs)
+        if da.ndim <= 1:
+            header.append(_column(name, unit))
+            columns.append(np.broadcast_to(da.values, (n,)))
+            continue
+        rest = da.dims[1:]
+        # a unit per column where the variable's differs along its last dimension
+        # ("m or rad": a coordinate DIM_unit names each, as element_unit does)
+        per = f"{rest[-1]}_unit"
+        units = ([_unit_suffix({"units": u}) for u in ds[per].values]
+                 if " or " in str(da.attrs.get("units", "")) and per in ds.coords else None)
+        for idx in itertools.product(*(range(ds.sizes[d]) for d in rest)):
+            label = "_".join(_labels(ds, d)[i] for d, i in zip(rest, idx))
+            header.append(f"{name}_{label}{unit if units is None else units[idx[-1]]}")
+            columns.append(da.values[(slice(None),) + idx])
+    rows = [[_cell(col[i]) for col in columns] for i in range(n)]
+    return header, rows
+
+
+def _mat_name(name: str) -> str:
+    """A MATLAB identifier for a variable name (letters, digits, '_'; a letter first)."""
+    out = re.sub(r"\W", "_", name)
+    return out if out[:1].isalpha() else "v_" + out
+
+
+def _mat_data(ds, run_id: str) -> dict:
+    data = {}
+    for name in list(ds.data_vars) + list(ds.coords):
+        values = ds[name].values
+        data[_mat_name(name)] = (np.asarray(values, dtype=object) if values.dtype.kind in "UO"
+                                 else np.asarray(values))
+    names = list(ds.data_vars) + list(ds.coords)
+    data["units"] = {_mat_name(n): str(ds[n].attrs.get("units", "")) for n in names}
+    data["descriptions"] = {_mat_name(n): str(ds[n].attrs.get("long_name", "")) for n in names}
+    data["attributes"] = {_mat_name(k): v if isinstance(v, str) else json.dumps(
+        v.tolist() if isinstance(v, np.ndarray) else v, default=str)
+        for k, v in ds.attrs.items()}
+    data["provenance"] = files.provenance(run_id)
+    return data
+
+
+def _write(ds, plan: files.OutputPlan, claim: files.OutputClaim) -> Path:
+    """Write ``ds`` to the files of ``plan`` under ``claim`` (NetCDF with the run's
+    provenance in its attributes, MATLAB, or the CSV tables)."""
+    ds = ds.copy()
+    for k, v in list(ds.attrs.items()):  # NetCDF attributes: strings and numbers
+        if isinstance(v, (list, tuple, dict)):
+            ds.attrs[k] = json.dumps(v, default=str)
+    if plan.format == "netcdf":
+        ds.attrs.update(files.provenance(claim.run_id))
+        claim.write({plan.path: files.netcdf_bytes(ds)})
+    elif plan.format == "mat":
+        claim.write({plan.path: files.mat_bytes(_mat_data(ds, claim.run_id))})
+    else:
+        dims = row_dims(ds)
+        contents = {f: files.csv_bytes(*_table(ds, d)) for f, d in zip(plan.files[1:], dims[1:])}
+        contents[plan.path] = files.csv_bytes(*_table(ds, dims[0]))  # last: marks the set
+        claim.write(contents)
+    return plan.path
+
+
+def save_dataset(ds, path, *, overwrite: bool = False) -> Path:
+    """Save a result Dataset by suffix: ``.nc`` NetCDF, ``.mat`` MATLAB, ``.csv``
+    spreadsheet tables (module docstring); atomically, an existing file kept unless
+    ``overwrite``.  Returns the path written.
+
+    Raises
+    ------
+    OutputError
+        As :func:`files.check_output` (a companion CSV that exists included).
+    """
+    plan = check_dataset_output(path, row_dims(ds), overwrite=overwrite)
+    with files.claim_output(plan) as claim:
+        return _write(ds, plan, claim)

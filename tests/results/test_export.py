@@ -1,0 +1,140 @@
+"""Result Datasets in the three formats users open (NetCDF, MATLAB, CSV), and the commands
+that write them (static, sweep-speed, modes and its Campbell map)."""
+
+from __future__ import annotations
+
+import csv
+import json
+
+import numpy as np
+import pytest
+import scipy.io
+import xarray as xr
+from typer.testing import CliRunner
+
+from torquesplit.cli import app
+from torquesplit.errors import OutputError
+from torquesplit.results.export import row_dims, save_dataset
+
+EXAMPLE = "ji_li_mill_drive"
+
+
+def _dataset():
+    """Two row dimensions (position, mesh), a unit per DOF, a scalar, strings."""
+    t = np.array([0.0, 0.5, 1.0])
+    return xr.Dataset(
+        {"force": (("time", "mesh"), np.arange(6.0).reshape(3, 2), {"units": "N",
+                                                                     "long_name": "force"}),
+         "q": (("time", "dof"), np.array([[1.0, 2.0]] * 3), {"units": "m or rad"}),
+         "share": (("mesh",), np.array([1.1, 0.9]), {"units": "1"}),
+         "total": ((), 7.0, {"units": "N m"})},
+        coords={"time": ("time", t, {"units": "s"}), "mesh": ["a", "b"],
+                "dof": ["g.theta", "g.x"], "dof_unit": ("dof", ["rad", "m"]),
+                "time_ms": ("time", 1e3 * t, {"units": "ms"})},
+        attrs={"title": "test", "labels": ["x", "y"]})
+
+
+def _read(path):
+    with open(path, newline="") as fh:
+        rows = list(csv.reader(fh))
+    return rows[0], rows[1:]
+
+
+def test_csv_tables_by_row_dimension_with_units_in_the_names(tmp_path):
+    ds = _dataset()
+    assert row_dims(ds) == ("time", "mesh")
+    path = save_dataset(ds, tmp_path / "r.csv")
+    header, rows = _read(path)
+    assert header == ["time_s", "time_ms", "force_a_N", "force_b_N", "q_g.theta_rad",
+                      "q_g.x_m", "total_Nm"]
+    assert len(rows) == 3
+    assert [float(v) for v in rows[2]] == [1.0, 1000.0, 4.0, 5.0, 1.0, 2.0, 7.0]
+    header, rows = _read(tmp_path / "r_mesh.csv")
+    assert header == ["mesh", "share"] and rows == [["a", "1.1"], ["b", "0.9"]]
+
+
+def test_mat_and_netcdf_keep_every_variable_and_unit(tmp_path):
+    ds = _dataset()
+    data = scipy.io.loadmat(save_dataset(ds, tmp_path / "r.mat"), simplify_cells=True)
+    np.testing.assert_array_equal(data["force"], ds["force"].values)
+    assert data["units"]["force"] == "N" and data["units"]["time"] == "s"
+    assert data["descriptions"]["force"] == "force"
+    assert json.loads(data["attributes"]["labels"]) == ["x", "y"]
+    assert list(data["mesh"]) == ["a", "b"] and "run_id" in data["provenance"]
+    back = xr.open_dataset(save_dataset(ds, tmp_path / "r.nc"), engine="h5netcdf")
+    np.testing.assert_array_equal(back["force"].values, ds["force"].values)
+    assert back.attrs["run_id"] and json.loads(back.attrs["labels"]) == ["x", "y"]
+    back.close()
+
+
+def test_a_companion_table_is_not_replaced_unless_asked(tmp_path):
+    (tmp_path / "r_mesh.csv").write_text("mine")
+    with pytest.raises(OutputError, match="r_mesh.csv exists"):
+        save_dataset(_dataset(), tmp_path / "r.csv")
+    assert (tmp_path / "r_mesh.csv").read_text() == "mine"
+    assert not (tmp_path / "r.csv").exists()
+    save_dataset(_dataset(), tmp_path / "r.csv", overwrite=True)
+    assert _read(tmp_path / "r_mesh.csv")[0] == ["mesh", "share"]
+
+
+def test_static_writes_matlab_and_spreadsheet_files(tmp_path):
+    args = ["static", EXAMPLE, "--revolutions", "0.02", "--points-per-cycle", "2", "--quiet"]
+    r = CliRunner().invoke(app, args + ["--out", str(tmp_path / "q.csv"), "--json"])
+    assert r.exit_code == 0, r.output
+    share = json.loads(r.output)["load_sharing"]["per_mesh"]
+    header, rows = _read(tmp_path / "q_mesh.csv")
+    assert {m: float(v) for m, v in rows} == pytest.approx(share, rel=1e-12)
+    header, rows = _read(tmp_path / "q.csv")
+    assert header[:2] == ["time_s", "mesh_force_m11_N"] and "displacement_z1.theta_rad" in header
+    r = CliRunner().invoke(app, args + ["--out", str(tmp_path / "q.mat")])
+    assert r.exit_code == 0, r.output
+    data = scipy.io.loadmat(tmp_path / "q.mat", simplify_cells=True)
+    np.testing.assert_allclose(data["mesh_force"][:, 0], [float(row[1]) for row in rows],
+                               rtol=1e-12)
+    # a companion that exists is refused before the sweep, not after it
+    (tmp_path / "x_mesh.csv").write_text("")
+    r = CliRunner().invoke(app, args + ["--out", str(tmp_path / "x.csv")])
+    assert r.exit_code == 2 and "x_mesh.csv exists" in r.output
+    assert "quasi-static" not in r.output
+
+
+def test_the_campbell_map_is_written_where_asked(tmp_path):
+    """'modes --campbell --out' checked the file and then wrote nothing."""
+    out = tmp_path / "map.csv"
+    r = CliRunner().invoke(app, ["modes", EXAMPLE, "--campbell", "--from", "300 rpm", "--to",
+                                 "1200 rpm", "--out", str(out), "--json"])
+    assert r.exit_code == 0, r.output
+    assert json.loads(r.output)["files"] == [str(out)]
+    header, rows = _read(out)
+    assert header[:3] == ["speed_rad/s", "speed_rpm", "natural_frequency_1_Hz"]
+    assert float(rows[0][1]) == pytest.approx(300.0) and float(rows[-1][1]) == pytest.approx(1200)
+
+
+def test_sweep_speed_writes_a_spreadsheet(tmp_path):
+    out = tmp_path / "s.csv"
+    r = CliRunner().invoke(app, ["sweep-speed", EXAMPLE, "--keep", "stage1", "--from",
+                                 "700 rpm", "--to", "790 rpm", "--points", "4",
+                                 "--harmonics", "8", "--no-stability", "--out", str(out),
+                                 "--json"])
+    assert r.exit_code == 0, r.output
+    assert json.loads(r.output)["results_file"] == str(out)
+    header, rows = _read(out)
+    assert header[:3] == ["point", "speed_rpm", "speed_rad/s"]
+    assert "dynamic_factor_m11" in header and "peak_force_m11_N" in header
+    assert float(rows[0][1]) == pytest.approx(700.0)
+
+
+def test_set_overrides_reach_steady_and_mesh():
+    """--set was missing from 'steady', 'sweep-speed' and 'mesh'."""
+    base = ["steady", EXAMPLE, "--keep", "stage1", "--harmonics", "8", "--no-stability",
+            "--json"]
+    a = json.loads(CliRunner().invoke(app, base).output)
+    r = CliRunner().invoke(app, base + ["--set", "loads.mill.torque=0.5*"])
+    assert r.exit_code == 2 and "--set" in r.output
+    r = CliRunner().invoke(app, base + ["--set", "meshes.m11.damping_ratio=0.2"])
+    assert r.exit_code == 0, r.output
+    b = json.loads(r.output)
+    assert b["meshes"]["m11"]["dynamic_factor"] != a["meshes"]["m11"]["dynamic_factor"]
+    r = CliRunner().invoke(app, ["mesh", EXAMPLE, "--pair", "m11", "--json", "--set",
+                                 "meshes.m11.stiffness.method=iso6336"])
+    assert r.exit_code == 0, r.output
