@@ -25,7 +25,7 @@ from rich.table import Table
 
 from . import cli_support as ux
 from .cli_support import header as _h
-from .errors import ModelWarning, OptionError, TorquesplitError, clip_message
+from .errors import ModelError, ModelWarning, OptionError, TorquesplitError, clip_message
 
 class _Command(typer.core.TyperCommand):
     """A command listed in --help without type noise: no ``<bool>`` on flags, no
@@ -1002,16 +1002,20 @@ def _contact(model, pair, load, on, plot, force, positions, slices, harris, assi
                         f"is {p_h / 1e6:.4g} MPa, beyond what any steel flank carries "
                         f"({MAX_FLANK_PRESSURE / 1e6:.0f} MPa); the linear-elastic contact "
                         f"analysis is not valid there: check the load and its unit")
-        impact = None
+        impact, impact_note = None, None
         if cm.pair.is_internal:  # (reverse: a ring that drives, internal too)
-            if as_json:  # the table prints it under the table
-                ux.warn(_INTERNAL_IMPACT, label="note")
+            impact_note = _INTERNAL_IMPACT
         elif not reverse:
             mk = kin.meshes[pair]
             drv, dvn = kin.bodies[mk.driver], kin.bodies[mk.driven]
-            impact = loaded_meshing_in(op, omega_driving=abs(drv.speed),
-                                       inertia_driving=drv.polar_inertia,
-                                       inertia_driven=dvn.polar_inertia)
+            try:  # a side result: the contact analysis stands without it
+                impact = loaded_meshing_in(op, omega_driving=abs(drv.speed),
+                                           inertia_driving=drv.polar_inertia,
+                                           inertia_driven=dvn.polar_inertia)
+            except ModelError as exc:
+                impact_note = f"meshing-in impact: not computed ({exc.issues[0][1]})"
+        if impact_note is not None and as_json:  # the table prints it under the table
+            ux.warn(impact_note, label="note")
     except _EXPECTED as exc:
         _fail(exc)
         return
@@ -1026,15 +1030,15 @@ def _contact(model, pair, load, on, plot, force, positions, slices, harris, assi
         except OSError as exc:
             failed = _figure_error(exc, "--plot", plot, "the tables are printed, nothing saved")
     _print_contact(m, pair, names, op_load, cm, results, hm, impact, op, figures, plot,
-                   as_json, reverse)
+                   as_json, reverse, impact_note)
     if failed is not None:
         _fail(failed)
 
 
 def _print_contact(m, pair, names, op_load, cm, results, hm, impact, op, figures, plot,
-                   as_json, reverse=False) -> None:
+                   as_json, reverse=False, impact_note=None) -> None:
     """The loaded tooth contact analysis (or JSON); ``reverse``: the second gear (a ring)
-    drives."""
+    drives; ``impact_note``: why there is no meshing-in impact."""
     rows = [r.summary() for r in results]
     if as_json:
         ux.emit_json({
@@ -1081,8 +1085,8 @@ def _print_contact(m, pair, names, op_load, cm, results, hm, impact, op, figures
         console.print(f"meshing-in impact at {op.load / 1e3:.5g} kN: {impact.peak_force:.5g} N "
                       f"(premature approach {impact.advance * 1e6:.3g} µm, corner relief "
                       f"{impact.corner_separation * 1e6:.3g} µm)", highlight=False)
-    elif cm.pair.is_internal:
-        console.print(_INTERNAL_IMPACT, highlight=False, markup=False)
+    elif impact_note is not None:
+        console.print(impact_note, highlight=False, markup=False)
     console.print("contact ratio: mean number of loaded tooth pairs over the --positions "
                   "sampled in a mesh cycle, within the theoretical path of contact: the "
                   "geometric ratio to within one position's share (1/positions), so it can "

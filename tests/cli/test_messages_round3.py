@@ -39,7 +39,11 @@ def test_an_impossible_contact_load_is_said_in_words(tmp_path):
     spur.write_text(SPUR)
     res = runner.invoke(app, ["contact", str(spur), "--pair", "m", "--load", "1e7 N",
                               "--harris", "0"])
-    assert res.exit_code == 2 and "too large for this tooth geometry" in res.stderr
+    # the impact is a side result: its failure no longer ends the analysis (a reviewer
+    # lost the whole table to it, with a message naming an internal function)
+    assert res.exit_code == 0, res.output
+    assert "meshing-in impact: not computed (no corner contact" in res.stdout
+    assert "check the load" in res.stdout and "TE p-p" in res.stdout
 
 
 def test_a_campbell_range_without_campbell_is_refused():

@@ -254,7 +254,12 @@ def test_meshing_in_impact_falls_as_the_corner_relief_grows_and_vanishes_beyond_
     kw = dict(omega_driving=300.0, inertia_driving=0.01, inertia_driven=0.08)
     plain = ContactModel(pair, options=opts(slices=1)).solve(P)
     base = loaded_meshing_in(plain, **kw)
-    assert base.corner_separation == 0.0 and base.advance == pytest.approx(plain.transmission_error[0])
+    # the approach is that of the single pair in contact just before the new one enters
+    # (the last positions of the cycle), not the double-contact value at the entry itself
+    # (a reviewer's 14.9 instead of 25 um)
+    te = plain.transmission_error
+    assert base.corner_separation == 0.0 and base.advance == base.approach
+    assert base.approach == pytest.approx(te[-1], rel=0.01) and base.approach > 1.3 * te[0]
     assert base.peak_force > 0
     forces = []
     for amount in (2e-6, 5e-6, 1.2 * float(plain.transmission_error.max())):

@@ -267,18 +267,18 @@ def meshing_in_point(
             lo = hi - step
             if hi - lo > s_start:
                 raise ModelError(
-                    "meshing_in_point: no corner contact found; the advance "
-                    f"{advance:.3g} m is too large for this tooth geometry."
-                )
+                    f"no corner contact: a loaded approach of {advance * 1e6:.4g} um is more "
+                    "than this tooth geometry allows (a load far beyond the pair's "
+                    "capacity, or a large misalignment or slope): check the load")
         from scipy.optimize import brentq  # here: importing scipy.optimize takes 0.4 s
 
         try:
             s_p = brentq(gap, lo, hi, xtol=1e-15, rtol=1e-14)
         except ValueError:  # no sign change: the corner never reaches the flank
             raise ModelError(
-                "meshing_in_point: no corner contact found; the loaded approach "
-                f"{advance:.3g} m is too large for this tooth geometry (a load far beyond the "
-                "pair's capacity): give a smaller load") from None
+                f"no corner contact: a loaded approach of {advance * 1e6:.4g} um is more "
+                "than this tooth geometry allows (a load far beyond the pair's "
+                "capacity, or a large misalignment or slope): check the load") from None
     d = corner(s_p)
     r_d = float(math.hypot(d[0], d[1]))
     if tip_radius_driving is not None and r_d > tip_radius_driving:

@@ -21,7 +21,7 @@ import numpy as np
 __all__ = ["CACHE_VERSION", "cache_dir", "cache_key", "load", "store"]
 
 #: bump when the LTCA model changes
-CACHE_VERSION = 3
+CACHE_VERSION = 4
 
 
 def cache_dir() -> Path:

@@ -12,8 +12,11 @@ Here, for the helix in which a new pair enters at mesh phase ``phi_e`` (the face
 ``y = 0`` of that helix, path position ``s_A``: the driver's start of active profile,
 the driven gear's tip):
 
-* ``Z`` -- loaded transmission error at ``phi_e`` from the LTCA (approach along the
-  flank normal, measured from the conjugate unmodified position);
+* ``Z`` -- loaded transmission error of the pairs in contact *before* the new pair
+  enters: the LTCA's transmission error as the phase tends to ``phi_e`` from below
+  (approach along the flank normal, measured from the conjugate unmodified position).
+  At ``phi_e`` itself the new pair already shares the load: a spur pair's transmission
+  error drops there from its single-pair to its double-pair value;
 * ``w_c`` -- initial separation of the engaging corner (modifications of both gears
   at ``s_A``, ``y = 0``, misalignment and pitch deviation; the same reference as ``Z``);
 * the premature approach ``Z - w_c`` along the normal, ``(Z - w_c) / cos(beta_b)`` in
@@ -54,7 +57,7 @@ class LoadedMeshingIn:
     entry_phase : float
         Mesh phase at which the new pair of that helix reaches its start of contact.
     approach : float
-        Loaded transmission error there [m] (normal).
+        Loaded transmission error of the pairs in contact just before it [m] (normal).
     corner_separation : float
         Initial separation of the engaging corner [m] (normal).
     advance : float
@@ -80,6 +83,17 @@ class LoadedMeshingIn:
         if self.impact is None:
             return np.zeros_like(np.asarray(phase, dtype=float))
         return self.impact.force(phase)
+
+
+def _before(phase, values, at: float) -> float:
+    """The limit of the periodic samples ``values(phase)`` as the phase tends to ``at``
+    from below: linear through the two samples before ``at`` (a sample at ``at`` itself
+    belongs to the other side of a jump)."""
+    back = np.mod(at - np.asarray(phase, dtype=float), 1.0)
+    back[back < 1e-9] = np.inf  # (a sample on ``at``, or a hair after it on the circle)
+    i1, i2 = np.argsort(back)[:2]
+    d1, d2 = back[i1], back[i2]
+    return float(values[i1] + (values[i1] - values[i2]) * d1 / (d2 - d1))
 
 
 def loaded_meshing_in(result, *, omega_driving: float, inertia_driving: float,
@@ -110,7 +124,7 @@ def loaded_meshing_in(result, *, omega_driving: float, inertia_driving: float,
     best = None
     for h in range(cm.helices):
         entry = float(np.mod(-h * cm.options.stagger, 1.0))
-        z = float(np.interp(entry, np.append(phase, 1.0), np.append(te, te[0])))
+        z = _before(phase, te, entry)
         w_c = float(cm.raw_separation(np.array([pair.path_start]), np.array([0.0]), h)[0]
                     - cm.separation_shift)
         adv = z - w_c
