@@ -995,6 +995,13 @@ def _contact(model, pair, load, on, plot, force, positions, slices, harris, assi
             top = max(loads)
             hm = cm.harris_map(np.linspace(0.1, 1.5, harris) * top) if harris > 0 else None
         op = max(results, key=lambda r: r.load)
+        shares = op.helix_load.mean(axis=0) / op.load
+        if cm.helices == 2 and not opts.axial_float and shares.max() > 0.525:
+            ux.warn(f"meshes.{pair}: the helices carry {100 * shares[0]:.0f} % and "
+                    f"{100 * shares[1]:.0f} % of the load with both members held axially; "
+                    f"if one member floats (as double-helical drives usually do), set "
+                    f"stiffness.ltca.axial_float = true: the helices then share equally",
+                    label="note")
         for r in results:  # beyond any steel flank: the elastic LTCA says nothing there
             p_h = float(r.max_pressure.max())
             if p_h > MAX_FLANK_PRESSURE:

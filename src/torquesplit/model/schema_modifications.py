@@ -161,4 +161,8 @@ class LtcaSpec(Strict):
                                "default the mesh's nominal normal force from the power flow.")
     stagger: Number = Field(0.0, ge=0, lt=1, description="Phase offset of the second helix of a "
                            "double-helical pair [mesh cycles].")
+    axial_float: Flag = Field(False, description="Double-helical pair: one member floats "
+                              "axially, so the helices carry equal loads, each with its own "
+                              "approach (the transmission error is their mean); false: both "
+                              "members held axially (a misalignment then loads one helix more).")
     cache: Flag = Field(True, description="Keep results on disk, keyed by a hash of the inputs.")

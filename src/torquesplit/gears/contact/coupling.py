@@ -115,7 +115,8 @@ def _options(spec) -> LtcaOptions:
     lt = spec.ltca
     return LtcaOptions(positions=int(lt.positions), slices=int(spec.slices),
                        contact_model=lt.contact_model, coupling=bool(lt.coupling),
-                       stagger=float(lt.stagger), fillet_foundation=bool(spec.fillet_foundation))
+                       stagger=float(lt.stagger), axial_float=bool(lt.axial_float),
+                       fillet_foundation=bool(spec.fillet_foundation))
 
 
 def contact_model_for_mesh(model, kin, mesh_name: str, *, options: LtcaOptions | None = None):

@@ -119,12 +119,11 @@ def loaded_meshing_in(result, *, omega_driving: float, inertia_driving: float,
         raise ModelError([("impact", "meshing-in impact from the LTCA is implemented for external "
                                      "pairs; set impact = false for this internal mesh")])
     cb = cm.normal_factor
-    te = result.transmission_error
     phase = cm.phase
     best = None
     for h in range(cm.helices):
         entry = float(np.mod(-h * cm.options.stagger, 1.0))
-        z = _before(phase, te, entry)
+        z = _before(phase, result.approach(h), entry)
         w_c = float(cm.raw_separation(np.array([pair.path_start]), np.array([0.0]), h)[0]
                     - cm.separation_shift)
         adv = z - w_c

@@ -70,6 +70,13 @@ class LtcaOptions:
         False gives independent slices (the potential-energy slice method).
     stagger : float
         Phase offset of the second helix of a double-helical pair [mesh cycles].
+    axial_float : bool
+        Double-helical pair: one member floats axially (its bearings take no thrust), so
+        the axial forces of the helices balance and each helix carries half the load
+        with an approach of its own (the float shifts one helix's flanks towards, the
+        other's away from the mating gear); the transmission error is the mean of the two
+        approaches (the floating member's rotation).  False: both members held axially,
+        one approach for both helices (a misalignment then loads one helix more).
     fillet_foundation : bool
         Include the fillet-foundation flexibility (Sainsot et al. 2004).
     grid : int
@@ -85,6 +92,7 @@ class LtcaOptions:
     contact_model: str = "weber"
     coupling: bool = True
     stagger: float = 0.0
+    axial_float: bool = False
     fillet_foundation: bool = True
     grid: int = 256
     tolerance: float = 1e-10
@@ -248,22 +256,45 @@ class ContactModel:
         if not (load > 0 and math.isfinite(load)):
             raise ModelError([("load", f"must be a positive normal force in N, got {load!r}; "
                                        "give the operating load")])
-        args = self._kernel_args(load)
-        if twin:
-            p, Z, kt = _kernels.ltca_solve_twin(*args)
-            it = np.zeros(Z.size, dtype=np.int64)
-            st = np.zeros(Z.size, dtype=np.int64)
-        else:
-            p, Z, kt, it, st = _kernels.ltca_solve(*args)
+        if self.helices == 2 and self.options.axial_float:
+            # each helix on its own with half the load (axial forces balance); the float
+            # takes up the difference of their approaches
+            parts = [self._solve(0.5 * load, twin, helix=h) for h in range(2)]
+            p = np.concatenate([q[0] for q in parts], axis=1)
+            Zh = np.stack([q[1] for q in parts], axis=1)
+            k0, k1 = parts[0][2], parts[1][2]
+            # dZ/dP = (dZ0/dP0 + dZ1/dP1) / 4 with P_h = P/2 and Z = (Z0 + Z1)/2
+            kt = 4.0 * k0 * k1 / (k0 + k1)
+            it = np.maximum(parts[0][3], parts[1][3])
+            st = np.maximum(parts[0][4], parts[1][4])
+            return LtcaResult(model=self, load=float(load), slice_load=p,
+                              transmission_error=Zh.mean(axis=1), stiffness_tangent=kt,
+                              iterations=it, status=st, helix_approach=Zh)
+        p, Z, kt, it, st = self._solve(load, twin)
         return LtcaResult(model=self, load=float(load), slice_load=p, transmission_error=Z,
                           stiffness_tangent=kt, iterations=it, status=st)
 
-    def _kernel_args(self, load: float) -> tuple:
+    def _solve(self, load: float, twin: bool, helix: int | None = None) -> tuple:
+        """The kernel (or its twin) on every helix, or on ``helix`` alone."""
+        args = self._kernel_args(load, helix)
+        if twin:
+            p, Z, kt = _kernels.ltca_solve_twin(*args)
+            return (p, Z, kt, np.zeros(Z.size, dtype=np.int64), np.zeros(Z.size, dtype=np.int64))
+        return _kernels.ltca_solve(*args)
+
+    def _kernel_args(self, load: float, helix: int | None = None) -> tuple:
         o = self.options
         a = self._arrays
         (e1, e2), (n1, n2) = self.young_modulus, self.poisson_ratio
-        return (self.zone, self.fraction, a["kb1"], a["kb2"], a["g1"], a["g2"], a["loc"],
-                self.separation, a["radius"], a["depth1"], a["depth2"], self.slice_width,
+        if helix is not None:  # the (M, H, K, N) arrays of that helix alone
+            cut = slice(helix, helix + 1)  # (contiguous: the kernel's compiled layout)
+            a = {k: np.ascontiguousarray(v[:, cut]) for k, v in a.items()}
+            zone, fraction, sep = (np.ascontiguousarray(x[:, cut]) for x in
+                                   (self.zone, self.fraction, self.separation))
+        else:
+            zone, fraction, sep = self.zone, self.fraction, self.separation
+        return (zone, fraction, a["kb1"], a["kb2"], a["g1"], a["g2"], a["loc"],
+                sep, a["radius"], a["depth1"], a["depth2"], self.slice_width,
                 self.line_length, (1 - n1 * n1) / e1, (1 - n2 * n2) / e2, n1, n2,
                 1 if o.contact_model == "weber" else 0, self.hertz_linear, bool(o.coupling),
                 float(load), float(o.tolerance), int(o.max_iterations))
@@ -310,6 +341,9 @@ class LtcaResult:
         ``dP/dZ`` with the contact set held [N/m].
     iterations, status : (M,)
         Active-set iterations and status code (see ``_kernels.STATUS``) per position.
+    helix_approach : (M, H) or None
+        Approach of each helix [m] where they differ (a floating double-helical member,
+        ``LtcaOptions.axial_float``); None: every helix at ``transmission_error``.
     """
 
     model: ContactModel = field(repr=False)
@@ -319,6 +353,13 @@ class LtcaResult:
     stiffness_tangent: np.ndarray = field(repr=False)
     iterations: np.ndarray = field(repr=False)
     status: np.ndarray = field(repr=False)
+    helix_approach: np.ndarray | None = field(default=None, repr=False)
+
+    def approach(self, helix: int) -> np.ndarray:
+        """(M,) approach of the gear bodies at ``helix`` [m] (module docstring)."""
+        if self.helix_approach is None:
+            return self.transmission_error
+        return self.helix_approach[:, helix]
 
     @property
     def converged(self) -> bool:
