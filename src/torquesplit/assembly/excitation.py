@@ -329,10 +329,13 @@ def mesh_errors(model: Model, kin: Kinematics, mesh_name: str):
 def impact_force_table(model: Model, kin: Kinematics, mesh_name: str, n: int):
     """Meshing-in impact force over one mesh cycle [N], or None (Liu et al. 2021 eqs. 6-10).
 
-    Inputs the seed leaves open: the loaded stiffness is the mean mesh stiffness and
-    the single-pair stiffness at the engagement point is that mean divided by the
-    transverse contact ratio (linear contact law, n = 1); the pulse is a half sine
-    (see gears/impact.py).
+    The loaded deflection that brings the new pair early is that of the pairs in contact
+    just before it enters (Liu et al. 2021 eq. 7: the loaded transmission error of the
+    pair in mesh): the force over the stiffness table's value at the end of the cycle
+    (phase 0 is the entry; a spur pair's single-pair stiffness).  Inputs the paper leaves
+    open: the single-pair stiffness at the engagement point is the mean mesh stiffness
+    divided by the transverse contact ratio (linear contact law, n = 1); the pulse is a
+    half sine (see gears/impact.py).
     """
     mesh = model.meshes[mesh_name]
     if not mesh.impact:
@@ -349,7 +352,8 @@ def impact_force_table(model: Model, kin: Kinematics, mesh_name: str, n: int):
     if geo is None:
         raise ValueError(f"meshes.{mesh_name}.impact: meshing-in impact needs a cylindrical "
                          f"pair; set impact = false for bevel and face meshes")
-    k_mean = float(np.mean(stiffness_table(model, kin, mesh_name, n)))
+    table = stiffness_table(model, kin, mesh_name, n)
+    k_mean = float(np.mean(table))
     driver_first = model.gears[mk.driver].gear_type != "internal" and (
         geo.gear1.teeth == model.gears[mk.driver].teeth)
     g_drv, g_dvn = (geo.gear1, geo.gear2) if driver_first else (geo.gear2, geo.gear1)
@@ -357,7 +361,7 @@ def impact_force_table(model: Model, kin: Kinematics, mesh_name: str, n: int):
         base_radius_driving=mk.base_radii[0], base_radius_driven=mk.base_radii[1],
         tip_radius_driven=g_dvn.tip_radius, centre_distance=mk.center_distance,
         base_pitch=geo.base_pitch, omega_driving=abs(mk.driver_speed),
-        normal_load=mk.force, loaded_stiffness=k_mean,
+        normal_load=mk.force, loaded_stiffness=float(table[-1]),  # just before the entry
         inertia_driving=kin.bodies[mk.driver].polar_inertia,
         inertia_driven=kin.bodies[mk.driven].polar_inertia,
         impact_stiffness=k_mean / max(mk.transverse_contact_ratio, 1.0),
