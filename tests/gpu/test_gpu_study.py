@@ -78,7 +78,9 @@ def test_fp32_reports_its_error_per_output():
     err = json.loads(ds.attrs["gpu_backend"])["fp32_error"]
     assert set(err) <= set(ds.attrs["outputs"] and json.loads(ds.attrs["outputs"]))
     assert "load_sharing.engineering" in err and len(err) > 10
-    worst = max(e["rel"] for e in err.values())
+    # (the settle time moves by whole windows where FP32's rounding, ~1e-3 of a peak,
+    # exceeds the settle rule's start tolerance, 1e-4 of it: not a continuous output)
+    worst = max(e["rel"] for k, e in err.items() if k != "settle_time")
     assert 0.0 < worst < 1e-2
 
 

@@ -531,3 +531,23 @@ def test_a_saved_steady_state_says_what_it_is():
         [info["meshes"][m]["rms_transmission_error"] for m in ds["mesh"].values])
     assert "start-up" not in ds["contact_loss_fraction"].attrs["long_name"]
     assert json.loads(ds.attrs["steady_json"])["period_s"] == pytest.approx(info["period_s"])
+
+
+def test_a_kept_frequency_is_that_at_the_speed_asked_for():
+    """--keep 5350.67 (the mesh frequency at --speed 16052 rpm) was read at the model
+    file's speed: the mesh's own stiffness was dropped and a flat DF 1.00000 printed."""
+    from torquesplit.model.kinematics import solve_kinematics
+    from torquesplit.steady.api import reference_speed
+
+    m = _ji_li()
+    kin = solve_kinematics(m)
+    f1, f2 = kin.meshes["m11"].frequency, kin.meshes["m12"].frequency
+    speed = 1.5 * reference_speed(m)
+    kw = dict(speed=speed, harmonics=8, stability=False, adaptive=False)
+    by_stage = steady_state(m, keep="stage1", **kw)
+    by_hz = steady_state(m, keep=1.5 * f1, **kw)
+    assert by_hz.dropped_text() == by_stage.dropped_text()
+    assert any(f"at {1.5 * f2:.6g} Hz" in t for t in by_hz.dropped_text())
+    a, b = by_stage.summary()["meshes"]["m11"], by_hz.summary()["meshes"]["m11"]
+    assert b["dynamic_factor"] == pytest.approx(a["dynamic_factor"], rel=1e-12)
+    assert b["dynamic_factor"] > 1.001

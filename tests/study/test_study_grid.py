@@ -190,3 +190,17 @@ def test_refused_cases_show_the_values_in_the_unit_written(split_file):
     with pytest.raises(StudyError, match=rf"case 0 \({err} = -20 um\) gives an invalid model"):
         Study(grid_study(split_file, [{"path": err, "start": -20, "stop": 0, "num": 2,
                                        "unit": "um"}])).plan()
+
+
+def test_map_cells_of_a_log_parameter_are_centred_on_its_values():
+    """A factor 0.1 / 1 / 10 had its cell edges at 0.55 and 5.5 (arithmetic midpoints):
+    on the log axis 1 was not in the middle of its cell."""
+    import xarray as xr
+
+    from torquesplit.study.figures import _edges
+
+    ds = xr.Dataset(coords={"k": ("k", [0.1, 1.0, 10.0], {"spacing": "log"}),
+                            "e": ("e", [0.0, 4.0, 8.0])})
+    np.testing.assert_allclose(_edges(ds, "k", ds["k"].values),
+                               [10 ** -1.5, 10 ** -0.5, 10 ** 0.5, 10 ** 1.5], rtol=1e-12)
+    np.testing.assert_allclose(_edges(ds, "e", ds["e"].values), [-2, 2, 6, 10])

@@ -70,6 +70,26 @@ def test_iso1328_distribution_uses_the_gears_tolerance(split_file):
         assert x.max() > 0.5 * half_runout  # the band is used, not a sliver of it
 
 
+def test_a_shared_iso1328_value_of_gears_with_other_tolerances_is_refused(split_file):
+    """One value shared by gears of 20 and 40 teeth took the first gear's tolerance for
+    both: the other's errors were drawn outside its own band, by path order."""
+    from torquesplit.errors import StudyError
+
+    data = mc_study(split_file, samples=16)
+    par = {"paths": ["gears.pinion.errors.eccentricity", "gears.a.errors.eccentricity"],
+           "distribution": "iso1328", "grade": 7, "shared": True, "name": "ecc"}
+    data["monte_carlo"]["parameters"] = [par]
+    with pytest.raises(StudyError, match="shared.*tolerances differ.*gear = \"pinion\""):
+        Study(data).plan()
+    par["gear"] = "a"  # named: that gear's band bounds the shared value
+    plan = Study(data).plan()
+    runout = flank_tolerances(7, 2e-3, 40 * 2e-3, 20e-3).runout
+    assert plan.design.values.max() <= 0.5 * runout
+    par.pop("gear")  # gears of one size share their tolerance: fine
+    par["paths"] = ["gears.a.errors.eccentricity", "gears.b.errors.eccentricity"]
+    assert Study(data).plan().design.values.shape == (16, 1)
+
+
 def test_stopping_rule_stops_when_interval_is_narrow(split_file):
     stop = {"output": OUT, "statistic": "mean", "half_width": 0.01, "confidence": 0.95,
             "min_samples": 16, "batch": 8, "max_samples": 400}
@@ -98,6 +118,27 @@ def test_percentile_interval_is_distribution_free():
     assert est == pytest.approx(1.645, abs=0.1) and 0.01 < half < 0.15
     half_small, _ = confidence_half_width(x[:20], "p95", 0.95)
     assert half_small == math.inf  # 20 samples cannot bound a 95th percentile
+
+
+@pytest.mark.parametrize("confidence", [0.8, 0.95])
+def test_percentile_interval_covers_at_least_its_confidence_and_says_its_bounds(confidence):
+    """The order-statistic ranks must cover the 95th percentile with at least the
+    confidence (exactly, from the binomial law): at n = 96 they covered 0.9416 < 0.95; the
+    interval is not centred on the estimate (it was reported as +/- h), and a valid one
+    exists from 59 samples (below 73 it was infinite)."""
+    from torquesplit.study.core import confidence_interval
+
+    rng = np.random.default_rng(1)
+    for n in list(range(59, 130)) + [200, 256, 1000]:
+        x = np.sort(rng.lognormal(size=n))
+        half, est, lo, hi = confidence_interval(x, "p95", confidence)
+        assert np.isfinite(half) and lo <= est <= hi and half == pytest.approx((hi - lo) / 2)
+        l, u = int(np.searchsorted(x, lo)), int(np.searchsorted(x, hi))
+        cdf = stats.binom.cdf([l, u], n, 0.95)
+        assert cdf[1] - cdf[0] >= confidence - 1e-12, n
+    assert confidence_interval(rng.normal(size=58), "p95", 0.95)[0] == math.inf
+    half, est, lo, hi = confidence_interval(rng.normal(size=40), "mean", 0.95)
+    assert hi - est == pytest.approx(est - lo) == pytest.approx(half)
 
 
 def test_latin_hypercube_cannot_stop_early(split_file):
@@ -160,12 +201,20 @@ def test_stopping_rule_outcome_is_reported(split_file, tmp_path):
     assert a["stopping_target_met"] == 1 and a["stopping_cases"] == ds.sizes["sample"]
     assert a["stopping_half_width"] <= a["stopping_target"] == 0.01
     assert a["stopping_estimate"] == pytest.approx(float(ds[OUT].mean()))
+    assert a["stopping_upper"] - a["stopping_lower"] == pytest.approx(2 * a["stopping_half_width"])
     with ui.console.capture() as cap:
         _summary(ds, tmp_path, False, False)
     assert "stopping rule: mean of load_sharing.cycle_peak" in cap.get()
-    assert "target met" in cap.get()
+    assert "target met" in cap.get() and "95% interval" in cap.get()
     labels = [t.get_text() for t in monte_carlo_figure(ds, OUT).axes[2].get_legend().texts]
     assert any(t.startswith("stopping target +/-0.01 (mean, met)") for t in labels)
+    assert "95% interval at the stop" in labels
+    # the running mean's band at the rule's confidence (it was 95 % for any rule)
+    from torquesplit.study.figures import _confidence
+
+    ds.attrs["stopping_rule"] = ds.attrs["stopping_rule"].replace('"confidence": 0.95',
+                                                                  '"confidence": 0.8')
+    assert _confidence(ds) == 0.8
     # a rule that runs out of samples says so, and a count of values left out
     stop.update(half_width=1e-6, max_samples=24)
     ds = run_study(mc_study(split_file, stop=stop, sampling="sobol"), workers=1)

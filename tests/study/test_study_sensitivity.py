@@ -89,6 +89,10 @@ def test_ranking_of_a_constructed_model(split_file, tmp_path, method, kw):
         key = ds.attrs["ranking"]
         none = ds[key].sel(output=out, factor="gears.pinion.density").item()
         assert none == 0.0
+    # Morris's effects carry each output's unit (the force's in N); Sobol's are shares
+    assert list(ds["output_unit"].values) == ["1", "N"]
+    unit = "per output: see output_unit" if method == "morris" else "1"
+    assert ds[key].attrs["units"] == unit
     assert ds.sizes["sample"] == (4 * 4 if method == "morris" else 16 * 5)
 
 

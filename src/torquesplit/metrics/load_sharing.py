@@ -142,6 +142,12 @@ def group_meshes(mesh_meta: dict[str, dict]) -> dict[str, list[str]]:
     return groups
 
 
+START_TOLERANCE = 1e-4
+"""A window whose mean or largest peak lies outside the range of the last half's windows
+by more than this [x the last window's largest peak] is still transient (:func:`settle`):
+below the fifth digit of a printed dynamic factor."""
+
+
 def settle(cycle_max: np.ndarray, cycle_start: np.ndarray, names, window=20,
            tolerance: float = 0.01, groups: dict[str, list[str]] | None = None) -> Settling:
     """Find where the transient ends, from the per-cycle peak forces.
@@ -151,7 +157,13 @@ def settle(cycle_max: np.ndarray, cycle_start: np.ndarray, names, window=20,
     gear revolution when errors rotate with the gears) aligned with the end of the run.
     The last window is the reference; the mesh is settled from the start of the window
     after the last one whose mean or largest peak differs from the reference's by more
-    than ``tolerance`` x the reference's largest peak.  The cycles before the first
+    than ``tolerance`` x the reference's largest peak (else the run is not settled, see
+    below), and in any case from the window after the last one that lies outside the
+    range of the windows of the run's last half by more than :data:`START_TOLERANCE` x
+    that peak or, if more, half that range: a start-up peak within the tolerance (0.8 %
+    above the steady ones in a reviewer's run) is still transient and must not set the
+    dynamic factor, while the windows of a response that does not repeat over W vary by
+    as much as the last half's do.  The cycles before the first
     whole window (fewer than W) are never counted as settled: they were not checked.  A
     drift that lasts until the end leaves only the last windows, and a mesh whose settled
     part is shorter than a quarter of its cycles is reported as not settled (its last
@@ -186,8 +198,16 @@ def settle(cycle_max: np.ndarray, cycle_start: np.ndarray, names, window=20,
                     & (np.abs(blocks.max(axis=1) - ref_max) <= tolerance * scale))
             bad = np.flatnonzero(~good)
             b0 = int(bad[-1]) + 1 if bad.size else 0
+            ok = (n - (start + b0 * w)) >= n / 4
+            inside = np.ones(n_win, dtype=bool)
+            for stat in (blocks.mean(axis=1), blocks.max(axis=1)):
+                lo, hi = stat[n_win // 2:].min(), stat[n_win // 2:].max()
+                margin = max(START_TOLERANCE * scale, 0.5 * (hi - lo))
+                inside &= (stat >= lo - margin) & (stat <= hi + margin)
+            out = np.flatnonzero(~inside)
+            if out.size:
+                b0 = max(b0, int(out[-1]) + 1)
             k_set = start + b0 * w
-            ok = (n - k_set) >= n / 4
         if not ok:
             settled = False
             k_set = n // 2 if n else 0

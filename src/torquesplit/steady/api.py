@@ -192,10 +192,16 @@ class SteadyState:
             "top_harmonic_energy": ps.top_harmonic_energy,
             "stable": ps.stable, "stability_method": ps.stability_method,
             "largest_multiplier": float(abs(mu[0])) if mu is not None and mu.size else None,
-            "dropped_excitations": [d.describe() for d in self.dropped],
+            "dropped_excitations": self.dropped_text(),
             "meshes": {r.mesh: {k: v for k, v in r.__dict__.items() if k != "mesh"}
                        for r in rows},
         }
+
+    def dropped_text(self) -> list[str]:
+        """The excitations ``keep`` replaced by their means, in words, at this state's
+        speed."""
+        ps = self.solution
+        return [d.describe(ps.frequency / self.period.frequency) for d in self.dropped]
 
     def mesh_table(self, definition: str | None = None, results=None) -> list[MeshSteady]:
         """Per-mesh static, mean, min and peak force, dynamic factors, load sharing
@@ -269,7 +275,7 @@ def steady_state(model, *, method: str = "auto", harmonics: int | None = None,
         HB time samples per period (default: a power of two >= 4 H + 2).
     keep : str or float, optional
         Keep only the excitations periodic with this base (a stage label, a mesh or body
-        name, or a frequency in Hz); the others are replaced by their means and listed
+        name, or a frequency in Hz at ``speed``); the others are replaced by their means and listed
         in ``SteadyState.dropped``.  Default: every excitation, over their least common
         period (refused when longer than ``max_cycles`` cycles of the fastest one).
     max_cycles : int, None or "auto"
@@ -311,6 +317,12 @@ def steady_state(model, *, method: str = "auto", harmonics: int | None = None,
     full = assemble(model, kin)
     dropped = []
     structure = full
+    factor = speed_factor(model, speed)
+    keep_asked = keep
+    if isinstance(keep, (int, float)) and not isinstance(keep, bool):
+        # a frequency at the speed asked for; the structure's are at the model's speed
+        # (a reviewer's --keep 5350.67 at 16052 rpm was read at the file's 3000 rpm)
+        keep = keep / factor
     if keep is not None:
         structure, dropped = keep_excitations(full, base_frequency(full, keep, kin))
     if max_cycles == "auto":
@@ -328,7 +340,6 @@ def steady_state(model, *, method: str = "auto", harmonics: int | None = None,
                           "no errors or tables), so its steady state is the static "
                           "equilibrium: run `torquesplit static` (or static_equilibrium) "
                           "instead, or give a mesh a stiffness variation or an error.")
-    factor = speed_factor(model, speed)
     if adaptive is None:
         adaptive = harmonics is None
     problem = periodic_problem(model, kin, structure, per.frequency)
@@ -339,7 +350,7 @@ def steady_state(model, *, method: str = "auto", harmonics: int | None = None,
                             check=check, problem=problem, progress=progress)
     return SteadyState(model=model, kinematics=kin, structure=structure, static=static,
                        period=per, solution=sol, dropped=dropped, problem=problem,
-                       options=dict(keep=keep, speed=speed, max_cycles=max_cycles))
+                       options=dict(keep=keep_asked, speed=speed, max_cycles=max_cycles))
 
 
 def _at_base(per, base):

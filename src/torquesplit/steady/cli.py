@@ -96,7 +96,7 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
             "< 1e-7 of the velocity energy (default unless --harmonics is given)."),
         keep: Optional[str] = typer.Option(
             None, "--keep", help="Keep only the excitations periodic with this stage, mesh, "
-            "body or frequency [Hz]; the others by their means."),
+            "body or frequency [Hz, at --speed]; the others by their means."),
         speed: Optional[str] = typer.Option(
             None, "--speed", help="Input speed, e.g. '1200 rpm' (default the model's)."),
         max_cycles: Optional[int] = typer.Option(
@@ -177,7 +177,7 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
             console.print(period_text)
             if st.dropped:
                 console.print("kept excitations periodic with the base; replaced by their "
-                              "means: " + "; ".join(d.describe() for d in st.dropped)
+                              "means: " + "; ".join(st.dropped_text())
                               + ": the rows of those meshes leave out their own excitation",
                               highlight=False)
             console.print(
@@ -234,7 +234,8 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
         harmonics: Optional[int] = typer.Option(
             None, "--harmonics", help="HB harmonics (default: as 'steady' chooses them at the "
             "first speed, then kept along the curve)."),
-        keep: Optional[str] = typer.Option(None, "--keep", help="As for 'steady'."),
+        keep: Optional[str] = typer.Option(None, "--keep", help="As for 'steady' (a frequency "
+                                           "in Hz is at the model file's speed)."),
         max_cycles: int = typer.Option(
             1000, "--max-cycles", help="Longest period accepted, in cycles of the fastest "
             "excitation (default 1000 for every method; 'steady' accepts 10000 for "

@@ -339,9 +339,14 @@ def stopping_line(ds) -> str:
     outcome = ("target met" if a["stopping_target_met"] else
                f"target NOT met: max_samples = {rule['max_samples']} reached; raise it or "
                f"widen half_width")
+    if "stopping_lower" in a:  # (a percentile's interval is not centred on its estimate)
+        interval = (f"{rule['confidence']:.0%} interval {a['stopping_lower']:.6g} .. "
+                    f"{a['stopping_upper']:.6g}, half-width {a['stopping_half_width']:.3g}")
+    else:
+        interval = (f"+/- {a['stopping_half_width']:.3g} ({rule['confidence']:.0%} "
+                    f"interval)")
     return (f"stopping rule: {a['stopping_statistic']} of {rule['output']} = "
-            f"{a['stopping_estimate']:.6g} +/- {a['stopping_half_width']:.3g} "
-            f"({rule['confidence']:.0%} interval){over}; target half-width "
+            f"{a['stopping_estimate']:.6g}, {interval}{over}; target half-width "
             f"{a['stopping_target']:.3g}: {outcome}")
 
 

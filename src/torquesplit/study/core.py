@@ -513,7 +513,8 @@ class _Driver:
             n = self._next_checkpoint()
             if n is None or not self.finished[:n].all():
                 return
-            half, stat = confidence_half_width(self.watch[:n], s.statistic, s.confidence)
+            half, stat, lower, upper = confidence_interval(self.watch[:n], s.statistic,
+                                                           s.confidence)
             target = s.half_width * (abs(stat) if s.relative else 1.0)
             finite = int(np.isfinite(self.watch[:n]).sum())
             log.info("stopping rule at n = %d: %s = %.6g +/- %.3g (target %.3g)", n,
@@ -526,6 +527,7 @@ class _Driver:
                 self.stop_report = {
                     "stopping_statistic": s.statistic, "stopping_estimate": float(stat),
                     "stopping_half_width": float(half), "stopping_target": float(target),
+                    "stopping_lower": float(lower), "stopping_upper": float(upper),
                     "stopping_target_met": int(half <= target), "stopping_cases": int(n),
                     "stopping_finite_cases": finite}
                 return
@@ -540,29 +542,50 @@ class _Driver:
         return min(n, s.max_samples)
 
 
-def confidence_half_width(values, statistic: str, confidence: float) -> tuple[float, float]:
-    """Half-width of the confidence interval of the mean (Student t) or of the 95th
-    percentile (distribution-free, from binomial order statistics), and the statistic,
-    over the finite ``values``."""
+def confidence_interval(values, statistic: str, confidence: float):
+    """``(half_width, statistic, lower, upper)``: the confidence interval of the mean
+    (Student t, symmetric) or of the 95th percentile over the finite ``values``.
+
+    The percentile's interval is distribution-free: the order statistics x_(l), x_(u)
+    (0-based) cover the q-quantile with probability F(u) - F(l), F the Binomial(n, q)
+    distribution function (B = the samples below the quantile); l is the largest rank
+    with F(l) <= alpha/2, u the smallest with F(u) >= 1 - alpha/2, so the coverage is at
+    least ``confidence``; where u is the largest sample (or would pass it), the interval
+    ends there (u = n - 1) and l is the largest rank that keeps the coverage (finite
+    from 59 samples at 95 %).  It is not centred on the estimate: the half-width is half its
+    length."""
     from scipy import stats
 
     x = np.sort(np.asarray(values, dtype=float))
     x = x[np.isfinite(x)]
     n = x.size
     if n < 2:
-        return math.inf, math.nan
+        return math.inf, math.nan, -math.inf, math.inf
     if statistic == "mean":
         m = float(x.mean())
-        t = stats.t.ppf(0.5 + confidence / 2, n - 1)
-        return float(t * x.std(ddof=1) / math.sqrt(n)), m
+        h = float(stats.t.ppf(0.5 + confidence / 2, n - 1) * x.std(ddof=1) / math.sqrt(n))
+        return h, m, m - h, m + h
     q = 0.95
     est = float(np.quantile(x, q))
     alpha = 1 - confidence
-    lo = int(stats.binom.ppf(alpha / 2, n, q))  # order-statistic ranks (0-based)
-    hi = int(stats.binom.ppf(1 - alpha / 2, n, q))
-    if lo < 0 or hi >= n:
-        return math.inf, est
-    return float((x[hi] - x[lo]) / 2), est
+    F = stats.binom.cdf(np.arange(n), n, q)  # F[k] = P(B <= k)
+    u = int(np.searchsorted(F, 1 - alpha / 2 - 1e-12))
+    if u >= n - 1:  # the interval ends at the largest sample: l as high as coverage allows
+        u = n - 1
+        ok = np.flatnonzero(F[u] - F >= confidence - 1e-12)
+        lo = int(ok[-1]) if ok.size else -1
+    else:
+        below = np.flatnonzero(F <= alpha / 2 + 1e-12)
+        lo = int(below[-1]) if below.size else -1
+    if lo < 0:
+        return math.inf, est, -math.inf, float(x[u])
+    return float((x[u] - x[lo]) / 2), est, float(x[lo]), float(x[u])
+
+
+def confidence_half_width(values, statistic: str, confidence: float) -> tuple[float, float]:
+    """Half-width and statistic of :func:`confidence_interval`."""
+    half, est, _, _ = confidence_interval(values, statistic, confidence)
+    return half, est
 
 
 # ============================================================================ dataset

@@ -158,9 +158,14 @@ def _add_indices(ds, plan, values):
     results = [indices(d, values[:, j]) for j in range(len(names))]
     keys = [k for k in results[0] if np.ndim(results[0][k]) == 1]
     factors = [p.name for p in d.parameters]
+    # Morris's effects are changes of the output: its unit (Sobol's indices are shares)
+    units = [ds[variable_name(n)].attrs.get("units", "1") if variable_name(n) in ds else "1"
+             for n in names]
+    one = units[0] if len(set(units)) == 1 else "per output: see output_unit"
     for k in keys:
         ds[k] = (("output", "factor"), np.array([r[k] for r in results]),
-                 {"units": "1", "long_name": _INDEX_NAMES.get(k, k)})
+                 {"units": one if k in _EFFECTS else "1",
+                  "long_name": _INDEX_NAMES.get(k, k)})
     used = "trajectories_used" if d.extra["method"] == "morris" else "samples_used"
     total = d.extra["trajectories"] if d.extra["method"] == "morris" else d.extra["samples"]
     ds[used] = (("output",), np.array([int(r[used]) for r in results]), {
@@ -168,7 +173,9 @@ def _add_indices(ds, plan, values):
         "long_name": f"{used.split('_')[0]} whose cases all have a finite value (the "
                      f"indices are over these, of {int(total)})"})
     ds = ds.assign_coords(output=("output", [variable_name(n) for n in names]),
-                          factor=("factor", factors))
+                          factor=("factor", factors),
+                          output_unit=("output", units, {"long_name": "unit of each output "
+                                                         "(and of its Morris effects)"}))
     ds.attrs.update(sensitivity_method=d.extra["method"], ranking=ranking_key(d),
                     seed=plan.spec.sensitivity.seed)
     notes = sobol_warnings(ds) if d.extra["method"] == "sobol" else []
@@ -192,6 +199,9 @@ def sobol_warnings(ds) -> list[str]:
                              f"indices are not converged, raise sensitivity.samples")
     return notes
 
+
+#: indices in the output's unit (the others are dimensionless)
+_EFFECTS = ("mu_star", "mu", "sigma", "mu_star_conf")
 
 _INDEX_NAMES = {
     "mu_star": "Morris mu*: mean |elementary effect| (output change over the factor's range)",

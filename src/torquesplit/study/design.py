@@ -611,12 +611,27 @@ def _iso_variable(t, p: Parameter, model, where) -> RandomVariable:
         raise StudyError(f"{where}.tolerance", f"say which ISO 1328 tolerance bounds "
                                                f"{parts[-1]!r}: tolerance = \"runout\", "
                                                f"\"single_pitch\", ...")
-    d = g.teeth * g.module / math.cos(g.helix_angle)
-    try:
-        tol = grades.flank_tolerances(grade, g.module, d, g.face_width)
-    except TorquesplitError as exc:
-        raise StudyError(f"{where}.grade", _one_line(exc)) from None
-    value = getattr(tol, tol_name) * factor
+    def tolerance_of(g):
+        d = g.teeth * g.module / math.cos(g.helix_angle)
+        try:
+            tol = grades.flank_tolerances(grade, g.module, d, g.face_width)
+        except TorquesplitError as exc:
+            raise StudyError(f"{where}.grade", _one_line(exc)) from None
+        return getattr(tol, tol_name) * factor
+
+    value = tolerance_of(g)
+    if t.gear is None:  # a value shared by fields of other gears: their tolerances too
+        for f in p.fields[1:]:
+            other = f.path.split(".")
+            if other[0] != "gears" or other[1] == gear or other[1] not in model.gears:
+                continue
+            v = tolerance_of(model.gears[other[1]])
+            if abs(v - value) > 1e-9 * value:
+                raise StudyError(f"{where}.shared", (
+                    f"one shared value for gears {gear!r} and {other[1]!r}, whose grade-{grade} "
+                    f"{tol_name} tolerances differ ({value * 1e6:.4g} and {v * 1e6:.4g} um); "
+                    f"draw them apart (shared = false) or name the gear whose tolerance "
+                    f"bounds the shared value (gear = \"{gear}\")"))
     signed = not all(f.nonnegative for f in p.fields)
     return RandomVariable("iso1328", (value, t.shape, signed))
 

@@ -58,7 +58,8 @@ def write_study_figures(ds, directory, formats=("png", "svg"), dpi: int = 130) -
                 jobs.append((f"map_{_safe(fam)}", lambda f=fam, m=members: maps_figure(ds, f, m)))
     elif design == "monte_carlo":
         for var in _output_vars(ds):
-            jobs.append((f"mc_{_safe(var)}", lambda v=var: monte_carlo_figure(ds, v)))
+            jobs.append((f"mc_{_safe(var)}",
+                         lambda v=var: monte_carlo_figure(ds, v, _confidence(ds))))
     elif design == "sensitivity":
         for var in _output_vars(ds):
             jobs.append((f"tornado_{_safe(var)}", lambda v=var: tornado_figure(ds, v)))
@@ -144,8 +145,8 @@ def maps_figure(ds, family: str, members: list[tuple[str, str]]) -> Figure:
             tv, tu = _coord(ds, third)
             title += f", {third} = {tv[r]:.4g} {tu}"
         z = data.transpose(dims[1], dims[0]).values * scale
-        mesh = ax.pcolormesh(x, y, np.ma.masked_invalid(z), shading="nearest", cmap="viridis",
-                             **limits)
+        mesh = ax.pcolormesh(_edges(ds, dims[0], x), _edges(ds, dims[1], y),
+                             np.ma.masked_invalid(z), shading="flat", cmap="viridis", **limits)
         _log_axis(ds, dims[0], ax.set_xscale)
         _log_axis(ds, dims[1], ax.set_yscale)
         if np.isfinite(z).all() and len(x) > 1 and len(y) > 1 and np.nanstd(z) > 0:
@@ -218,6 +219,12 @@ def monte_carlo_figure(ds, var: str, confidence: float = 0.95) -> Figure:
     return fig
 
 
+def _confidence(ds) -> float:
+    """The stopping rule's confidence (its intervals are drawn at it), else 0.95."""
+    rule = ds.attrs.get("stopping_rule")
+    return float(json.loads(rule)["confidence"]) if rule else 0.95
+
+
 def _stopping_band(ds, var, ax, scale) -> None:
     """The stopping rule's target band around its final estimate, on the watched
     output's running statistic."""
@@ -232,6 +239,11 @@ def _stopping_band(ds, var, ax, scale) -> None:
     ax.axhspan(est - target, est + target, color=_color(2), alpha=0.2,
                label=f"stopping target +/-{target:.3g} ({a['stopping_statistic']}, {met})")
     ax.axvline(a["stopping_cases"], color=_color(2), lw=1, ls=":")
+    if "stopping_lower" in a and np.isfinite(a["stopping_lower"]):  # the interval itself
+        lo, hi = a["stopping_lower"] * scale, a["stopping_upper"] * scale
+        ax.errorbar([a["stopping_cases"]], [est], yerr=[[est - lo], [hi - est]],
+                    color=_color(2), capsize=4, lw=1.5,
+                    label=f"{rule['confidence']:.0%} interval at the stop")
 
 
 # ============================================================================ sensitivity
@@ -316,6 +328,20 @@ def _coord(ds, name) -> tuple[np.ndarray, str]:
         except Exception:  # an unknown display unit: show SI
             return values, si
     return values, ("-" if si == "1" else si)
+
+
+def _edges(ds, name, values) -> np.ndarray:
+    """Cell edges of a map around each parameter value: midway between neighbours, on a
+    log scale for a log-spaced parameter (each value centred in its cell on a log axis)."""
+    v = np.asarray(values, dtype=float)
+    log = ds[name].attrs.get("spacing") == "log" and v.size and (v > 0).all()
+    u = np.log(v) if log else v
+    if u.size == 1:
+        e = u[0] + np.array([-0.5, 0.5]) * (max(abs(u[0]), 1.0) * 0.1 if not log else 0.1)
+    else:
+        mid = 0.5 * (u[1:] + u[:-1])
+        e = np.concatenate([[u[0] - (mid[0] - u[0])], mid, [u[-1] + (u[-1] - mid[-1])]])
+    return np.exp(e) if log else e
 
 
 def _log_axis(ds, name, set_scale) -> None:
