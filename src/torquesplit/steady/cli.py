@@ -68,6 +68,18 @@ def _in_flags(exc):
         return exc
 
 
+#: what an unstable periodic state means for its numbers, by how it loses stability
+_INSTABILITY = {
+    "period doubling": "period doubling: a Floquet multiplier below -1, so the response "
+                       "near this speed is an orbit of twice the period or longer with "
+                       "other forces, not this one; 'torquesplit run' gives it",
+    "fold": "a real Floquet multiplier above 1 (a fold: the middle of a jump): the "
+            "response is on another branch; 'torquesplit sweep-speed' shows both",
+    "torus": "a complex pair of Floquet multipliers outside the unit circle: the response "
+             "is quasi-periodic, not this orbit; 'torquesplit run' gives it",
+}
+
+
 def _keep(keep):
     if keep is None:
         return None
@@ -163,10 +175,20 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
             return
         ps = st.solution
         mu = ps.multipliers
+        from torquesplit.cli_support import warn
+        from torquesplit.steady.sweep import instability
+
+        kind = instability(mu) if ps.converged else ""
+        if not ps.converged:
+            warn(f"the periodic state did not converge ({ps.message}): its numbers are "
+                 f"those of the last iterate; try --method hb, more --steps-per-cycle, or "
+                 f"'torquesplit run' (contact loss makes shooting harder to converge)")
+        elif kind and as_json:
+            warn(_INSTABILITY[kind])
         # the period found at the model's speeds, told at the speed solved
         period_text = st.period.describe(ps.frequency / st.period.frequency)
         info = {
-            **st.summary(rows),
+            **st.summary(rows), "instability": kind or None,
             "results_file": str(saved) if saved else None,
             **({"step_check": step_check.to_dict()} if step_check else {}),
         }
@@ -186,13 +208,20 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
                 f"{ps.periodicity_defect:.2e}"
                 + (f"; harmonics {ps.harmonics} (top-quarter energy "
                    f"{ps.top_harmonic_energy:.1e})" if ps.harmonics else ""))
-            if mu is not None:
+            if not ps.converged:
+                console.print("stability: not meaningful (the periodic state did not "
+                              "converge; the table is the last iterate's)")
+            elif mu is not None:
                 console.print(f"stability ({ps.stability_method}): "
                               f"{'stable' if ps.stable else 'UNSTABLE'}, largest Floquet "
-                              f"multiplier |mu| = {abs(mu[0]):.6f}")
+                              f"multiplier |mu| = {abs(mu[0]):.6f}", highlight=False)
+                if kind:
+                    console.print(f"[yellow]{_INSTABILITY[kind]}[/]")
             elif not stability:
                 console.print("stability: not computed (--no-stability)")
-            t = Table(title="meshes (periodic steady state)")
+            t = Table(title="meshes (periodic steady state)" if ps.converged else
+                      "meshes: NOT CONVERGED (the last Newton iterate, not a periodic "
+                      "state)")
             chosen = m.analysis.load_sharing  # mesh_table()'s (Results.default_definition)
             chosen = "mean_force" if chosen == "static_torque" else chosen
             for col in ("mesh", "group", "static F [kN]", "mean F [kN]", "peak F [kN]",
@@ -311,6 +340,8 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
             "max_dynamic_factor_of": "the stable points of the branch (unstable ones are "
                                      "not observable)",
             "unstable_points": int((~ds["stable"].values).sum()),
+            "period_doubling_rpm": _runs(ds, ds["instability"].values == "period doubling"),
+            "max_contact_loss": _largest_loss(ds),
             "wall_time_s": ds.attrs["wall_time_s"],
             "results_file": str(saved) if saved else None,
         }
@@ -348,6 +379,16 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
                               "at a speed for their full response)", highlight=False)
             console.print(f"unstable points: {summary['unstable_points']} (dashed in the "
                           f"figure; left out of the largest dynamic factor)")
+            for a, b in summary["period_doubling_rpm"]:
+                console.print(f"[yellow]period doubling[/] between {a:.6g} and {b:.6g} rpm (a "
+                              f"Floquet multiplier below -1): the response there is not on "
+                              f"this curve but an orbit of twice the period or longer, with "
+                              f"other forces; 'torquesplit run' at those speeds gives it")
+            lost = {k: v for k, v in summary["max_contact_loss"].items() if v[0] > 0}
+            if lost:
+                console.print("contact loss on the stable points: " + ", ".join(
+                    f"{k} up to {100 * v[0]:.3g} % of the period (at {v[1]:.6g} rpm)"
+                    for k, v in lost.items()), highlight=False)
             if saved:
                 console.print(f"results written to {saved}", highlight=False)
         if failed is not None:
@@ -359,6 +400,32 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
 
 
 import numpy as np  # noqa: E402  (used by the commands above)
+
+
+def _runs(ds, flag) -> list[list[float]]:
+    """[first, last] speed [rpm] of each run of consecutive points where ``flag``."""
+    rpm = np.asarray(ds["speed_rpm"].values, float)
+    out, start = [], None
+    for i, f in enumerate(np.append(np.asarray(flag, bool), False)):
+        if f and start is None:
+            start = i
+        elif not f and start is not None:
+            out.append([float(rpm[start]), float(rpm[i - 1])])
+            start = None
+    return out
+
+
+def _largest_loss(ds) -> dict[str, list[float]]:
+    """Per mesh, the largest contact-loss fraction over the stable points and its speed
+    [rpm] ([0, nan] without one)."""
+    stable = np.asarray(ds["stable"].values, bool)
+    rpm = np.asarray(ds["speed_rpm"].values, float)[stable]
+    out = {}
+    for j, k in enumerate(ds["mesh"].values):
+        loss = np.asarray(ds["contact_loss"].values[:, j], float)[stable]
+        i = int(np.argmax(loss)) if loss.size else -1
+        out[str(k)] = [float(loss[i]), float(rpm[i])] if i >= 0 else [0.0, math.nan]
+    return out
 
 
 def sweep_maxima(ds) -> dict[str, dict[str, tuple[float, float]]]:

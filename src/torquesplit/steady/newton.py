@@ -305,6 +305,7 @@ def solve_shooting(p: PeriodicProblem, y0, steps: int, speed=1.0, tol=1e-9, max_
     Phi = None
     it = 0
     err = math.inf
+    best = (math.inf, y)  # the Newton iterate of smallest defect
     products = [0]
     runs = [None]  # the record of the last defect map
 
@@ -413,10 +414,30 @@ def solve_shooting(p: PeriodicProblem, y0, steps: int, speed=1.0, tol=1e-9, max_
             A = np.vstack([Pr @ (Phi - np.eye(2 * n)), R.T])
             b = -np.concatenate([d, R.T @ y])
             dy = np.linalg.lstsq(A, b, rcond=None)[0]
+        if err < best[0]:
+            best = (err, y)
         y = y + dy
         if not np.all(np.isfinite(y)):
             raise SolverError("the shooting iteration diverged; start from a better guess "
                               "(the harmonic-balance solution or a converged neighbour).")
+    if err > tol and not anderson and best[0] < math.inf:
+        # Newton stalls where the flow is not smooth (teeth that separate: the damping
+        # force jumps at an instant the variational equations do not move with, so the
+        # monodromy misses a term); a stable orbit still attracts the period map itself:
+        # the Anderson-accelerated fixed-point iteration from the best Newton iterate
+        log.info("shooting: Newton at %.1e after %d steps; Anderson-accelerated period "
+                 "maps from its best iterate", err, it)
+        y2, g2, err2, hist2, maps2 = _anderson(
+            defect_map, lambda y: Pr @ y, measure,
+            lambda d: np.concatenate([V @ d[:n], V @ d[n:] / w]), best[1], tol, say)
+        hist += hist2
+        aa_maps += maps2
+        if err2 < err:
+            y, err, Phi = y2, err2, None
+            if g2 is None and record is not None:  # the waveforms of the state kept
+                defect_map(y)
+            if monodromy and not krylov:  # (its stability: the caller's multipliers)
+                Phi = p.integrate_variational(y, 0.0, T, steps, speed)[1]
     return y, (None if krylov else Phi), NewtonInfo(err <= tol, aa_maps + it, err, hist,
                                                     products[0], aa_maps, runs[0])
 

@@ -133,6 +133,17 @@ def _sweep_panel(ax, ds, variable):
                               label=str(mesh) if k == 0 else None, lw=1.3)
             k = e + 1
         colour = line.get_color() if line is not None else None
+        if j == 0 and "instability" in ds:  # where the response is not on the curve
+            flag = np.append(ds["instability"].values == "period doubling", False)
+            first = None
+            for i, f in enumerate(flag):
+                if f and first is None:
+                    first = i
+                elif not f and first is not None:
+                    ax.axvspan(rpm[first], rpm[i - 1], color="tab:red", alpha=0.08, lw=0,
+                               label="period doubling (the response is\nnot on this curve)" if first == int(np.argmax(flag))
+                               else None)
+                    first = None
         check = f"run_up_{variable}"
         if check in ds:
             ax.plot(ds["check_speed_rpm"].values, ds[check].values[:, j] * scale, "^", ms=4,

@@ -41,6 +41,23 @@ from torquesplit.steady.solution import (
 log = logging.getLogger(__name__)
 
 
+def instability(mu) -> str:
+    """How a periodic orbit with Floquet multipliers ``mu`` loses stability, from the
+    largest: "" (stable, or not computed), "period doubling" (a real multiplier below -1:
+    the response is an orbit of twice the period or longer, not this one), "fold" (a real
+    one above 1: a jump to another branch) or "torus" (a complex pair: a quasi-periodic
+    response, Neimark-Sacker)."""
+    if mu is None or not np.size(mu):
+        return ""
+    mu = np.asarray(mu, dtype=complex)
+    top = mu[np.argmax(np.abs(mu))]
+    if abs(top) <= 1 + 1e-6:
+        return ""
+    if abs(top.imag) > 1e-6 * abs(top):
+        return "torus"
+    return "period doubling" if top.real < 0 else "fold"
+
+
 @dataclass
 class SweepPoint:
     speed: float
@@ -49,6 +66,8 @@ class SweepPoint:
     stable: bool | None
     max_multiplier: float
     iterations: int
+    instability: str = ""
+    """:func:`instability` of the point's orbit."""
 
 
 @dataclass
@@ -251,7 +270,8 @@ class Continuation:
                 mu = self.multipliers(z[:n], z[n]) if self.stability else None
                 m = float(np.max(np.abs(mu))) if mu is not None and mu.size else math.nan
                 pts.append(SweepPoint(float(z[n]), z[:n].copy(),
-                                      None if mu is None else bool(m <= 1 + 1e-6), m, 0))
+                                      None if mu is None else bool(m <= 1 + 1e-6), m, 0,
+                                      instability(mu)))
                 if progress is not None:
                     progress(min(1.0, abs(z[n] - s0) / abs(s1 - s0)))
                 if (z[n] - s1) * direction >= 0:
@@ -262,7 +282,8 @@ class Continuation:
                             m = float(np.max(np.abs(mu))) if mu is not None and mu.size \
                                 else math.nan
                             pts[-1] = SweepPoint(float(s1), x_end.copy(), None if mu is None
-                                                 else bool(m <= 1 + 1e-6), m, 0)
+                                                 else bool(m <= 1 + 1e-6), m, 0,
+                                                 instability(mu))
                     break
                 while True:
                     z_pred = z + h * t
@@ -505,7 +526,8 @@ def _point_outputs(f, f_all, d, groups, static_forces, nominal, peak, mean):
     (:func:`record_extremes`): peak force, dynamic factors, load sharing (the ratio of
     the mean forces in its group, Dong et al. 2021 eq. 12, as ``run`` and ``steady``
     report it by default, and the largest instantaneous ratio, Ji & Li eq. 18), RMS
-    transmission error, mean force."""
+    transmission error, mean force, contact loss (the fraction of the samples in which
+    the mesh carries no force)."""
     lsc = np.full(f.shape[1], np.nan)
     lsc_inst = np.full(f.shape[1], np.nan)
     mean = np.asarray(mean, dtype=float)
@@ -518,10 +540,12 @@ def _point_outputs(f, f_all, d, groups, static_forces, nominal, peak, mean):
             lsc[cols] = len(cols) * mean[cols] / mean[cols].sum()
         lsc_inst[cols] = np.nanmax(r, axis=0)
     rms = np.sqrt(np.mean((d - d.mean(axis=0)) ** 2, axis=0))
+    # out of contact the mesh law's force is exactly 0 (samples uniform in time)
+    loss = np.mean(f == 0.0, axis=0)
     return dict(peak_force=peak, dynamic_factor=peak / static_forces,
                 peak_to_nominal=peak / nominal, load_sharing=lsc,
                 load_sharing_instantaneous=lsc_inst, rms_transmission_error=rms,
-                mean_force=mean)
+                mean_force=mean, contact_loss=loss)
 
 
 def continue_in_speed_shooting(problem, period, q_static, s0, s1, *, points=50,
