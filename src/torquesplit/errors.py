@@ -61,6 +61,10 @@ class TorquesplitError(Exception):
     """Base class of every error raised on purpose by torquesplit."""
 
 
+_PAIR_PREFIX = re.compile(r"^gears '[^']*' and '[^']*': ")
+"""A mesh issue's prefix naming its pair (the location names the mesh too)."""
+
+
 class ModelError(TorquesplitError, ValueError):
     """A model file or model object is invalid.
 
@@ -73,14 +77,31 @@ class ModelError(TorquesplitError, ValueError):
     def __init__(self, issues, source: str | None = None):
         if isinstance(issues, str):
             issues = [("", issues)]
-        self.issues = [(clip_text(str(loc), 2 * QUOTE_LIMIT), clip_message(str(msg)))
-                       for loc, msg in issues]
+        self.issues = []
+        seen = set()
+        for loc, msg in issues:  # one problem found twice at one place is said once
+            loc, msg = clip_text(str(loc), 2 * QUOTE_LIMIT), clip_message(str(msg))
+            key = (loc, _PAIR_PREFIX.sub("", msg))
+            if key not in seen:
+                seen.add(key)
+                self.issues.append((loc, msg))
         self.source = source
-        lines = []
+        # one cause at several places (a profile shift that breaks every mesh of a gear
+        # and the placement of its mates): one line naming the places
+        groups: dict[str, list[tuple[str, str]]] = {}
         for loc, msg in self.issues:
-            where = f"{clip_text(source, 2 * QUOTE_LIMIT)}: " if source else ""
-            where += f"{loc}: " if loc else ""
-            lines.append(where + msg)
+            groups.setdefault(_PAIR_PREFIX.sub("", msg) if loc else msg, []).append((loc, msg))
+        where = f"{clip_text(source, 2 * QUOTE_LIMIT)}: " if source else ""
+        lines = []
+        for core, members in groups.items():
+            if len(members) == 1:
+                loc, msg = members[0]
+                lines.append(where + (f"{loc}: " if loc else "") + msg)
+                continue
+            named = [loc for loc, _ in members if loc]
+            if len(named) > 3:
+                named = named[:2] + [f"{len(named) - 2} more"]
+            lines.append(where + (f"{', '.join(named)}: " if named else "") + core)
         super().__init__("\n".join(lines))
 
 

@@ -513,8 +513,9 @@ def test_a_bare_module_says_it_is_metres(tmp_path):
     text = SPUR_PAIR.replace('module = "2 mm"', "module = 3")
     res = runner.invoke(app, ["check", str(write_model(tmp_path, text))])
     assert res.exit_code == 2 and "Traceback" not in res.output
-    assert "gears.pinion.module: 3 m is implausibly large; a bare number is read in metres: " \
-           "write '3 mm'" in res.stderr
+    # (one cause at two places: one line naming both)
+    assert "gears.pinion.module, gears.wheel.module: 3 m is implausibly large; a bare number " \
+           "is read in metres: write '3 mm'" in res.stderr
     text = SPUR_PAIR.replace('face_width = "20 mm"', "face_width = 20", 1)
     res = runner.invoke(app, ["check", str(write_model(tmp_path, text, "w.toml"))])
     said = [w for w in warnings_of(res) if "gears.pinion.face_width" in w]

@@ -348,9 +348,14 @@ def placement_issues(model: Model, skip=frozenset(), found=()) -> list[tuple[str
     if layout:
         return layout
     named = {loc.split(".")[1] for loc, _ in found if loc.startswith("gears.")}
-    for name in skip:  # (a gear placed from a mate it cannot mesh with has no position)
+    unplaced = {loc.split(".")[1] for loc, _ in placed}
+    # a mesh whose pair geometry is refused: its placement and frame fail for that reason
+    skip = set(skip) | {".".join(loc.split(".")[:2]) for loc, _ in found
+                        if loc.startswith("meshes.")}
+    for name in skip:  # (a gear placed from a mate it cannot mesh with has no position:
+        # its placement fails for the reason the mesh's geometry gave)
         if name.startswith("meshes.") and name[7:] in model.meshes:
-            named |= set(model.meshes[name[7:]].gears) & set(computed)
+            named |= set(model.meshes[name[7:]].gears) & (set(computed) | unplaced)
     issues = [(loc, msg) for loc, msg in placed if loc.split(".")[1] not in named]
     for name, mesh in model.meshes.items():
         if f"meshes.{name}" in skip or named & set(mesh.gears):

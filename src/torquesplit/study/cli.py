@@ -85,7 +85,10 @@ def _list() -> None:
 
 
 def _run(source, *, workers, scheduler, out, resume, overwrite, figures, quiet, as_json,
-         name_hint: str | None = None, backend: str = "cpu", precision: str | None = None):
+         name_hint: str | None = None, backend: str = "cpu", precision: str | None = None,
+         flag: str | None = None):
+    """Run a study from the command line; ``flag``: the option that wrote its only grid
+    parameter ('--vary'), named in errors instead of the study field."""
     from ..errors import TorquesplitError
     from .core import CLI_WORDS, Study
     from .errors import StudyInterrupted
@@ -130,6 +133,13 @@ def _run(source, *, workers, scheduler, out, resume, overwrite, figures, quiet, 
                              markup=False, highlight=False, soft_wrap=True)
         raise typer.Exit(130)
     except (TorquesplitError, ValueError, OSError) as exc:
+        from .errors import StudyError
+
+        field = getattr(exc, "field", None)
+        if flag and isinstance(exc, StudyError) and field and field.startswith(
+                "grid.parameters.0"):
+            sub = field[len("grid.parameters.0"):].lstrip(".")
+            exc = StudyError(f"{flag}" + (f" ({sub})" if sub else ""), exc.reason)
         ui._fail(exc)
         return
     _summary(ds, Path(out), as_json, figures)
@@ -514,7 +524,7 @@ def sweep(
         return
     _run(data, workers=workers, scheduler=scheduler, out=out, resume=resume,
          overwrite=overwrite, figures=not no_figures, quiet=quiet, as_json=as_json,
-         name_hint=name, backend=backend, precision=precision)
+         name_hint=name, backend=backend, precision=precision, flag="--vary")
 
 
 def _default_definition(load_model, path) -> str:
