@@ -126,3 +126,40 @@ def test_harmonic_balance_over_contact_loss_is_warned_of(pair):
     assert r.exit_code == 0 and "harmonic balance over contact loss" in r.stderr
     r = CliRunner().invoke(app, args)
     assert "harmonic balance over contact loss" not in r.stderr
+
+
+def test_the_period_doubled_response_is_found_with_a_period_of_two_cycles(pair):
+    """Where the period-1 orbit loses stability by period doubling, 'steady' with --keep
+    half the mesh frequency shot over two cycles from near the unstable orbit and found it
+    again (|mu| = 1.169 = 1.081^2); it now settles onto the response first: the reviewer's
+    own integration gave DF 3.102 with 29 % contact loss and cycle peaks alternating."""
+    import torquesplit
+
+    one = torquesplit.steady_state(pair, speed="16052 rpm")
+    assert instability(one.solution.multipliers) == "period doubling"
+    f = one.solution.frequency
+    two = torquesplit.steady_state(pair, speed="16052 rpm", keep=round(f / 2, 3))
+    ps = two.solution
+    assert ps.converged and ps.stable and ps.repeats_within == 1
+    assert ps.frequency == pytest.approx(f / 2, rel=1e-12)  # the typed 2675.333 snapped
+    row = two.mesh_table()[0]
+    assert row.dynamic_factor == pytest.approx(3.102, abs=0.005)
+    assert row.contact_loss == pytest.approx(0.29, abs=0.01)
+    # against a long time integration at that speed (its settled cycles' largest peak)
+    run = torquesplit.simulate(torquesplit.load_model(pair).with_changes(
+        {"drives.motor.speed": "16052 rpm"}), cycles=1500)
+    df = run.metrics().rows[0].dynamic_factor
+    assert df == pytest.approx(row.dynamic_factor, rel=0.01)
+
+
+def test_a_period_of_two_cycles_where_the_response_has_one_says_so(pair):
+    import torquesplit
+
+    one = torquesplit.steady_state(pair, speed="13000 rpm")
+    assert one.solution.stable
+    two = torquesplit.steady_state(pair, speed="13000 rpm",
+                                   keep=one.solution.frequency / 2)
+    assert two.solution.repeats_within == 2
+    assert "no response of 2 excitation periods" in two.solution.message
+    assert two.mesh_table()[0].dynamic_factor == pytest.approx(
+        one.mesh_table()[0].dynamic_factor, rel=1e-6)

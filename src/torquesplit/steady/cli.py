@@ -72,7 +72,9 @@ def _in_flags(exc):
 _INSTABILITY = {
     "period doubling": "period doubling: a Floquet multiplier below -1, so the response "
                        "near this speed is an orbit of twice the period or longer with "
-                       "other forces, not this one; 'torquesplit run' gives it",
+                       "other forces, not this one; 'torquesplit run' gives it, and "
+                       "'steady' with --keep half the fundamental frequency solves for the "
+                       "orbit of two periods",
     "fold": "a real Floquet multiplier above 1 (a fold: the middle of a jump): the "
             "response is on another branch; 'torquesplit sweep-speed' shows both",
     "torus": "a complex pair of Floquet multipliers outside the unit circle: the response "
@@ -178,7 +180,9 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
         from torquesplit.cli_support import warn
         from torquesplit.steady.sweep import instability
 
-        kind = instability(mu) if ps.converged else ""
+        # (an orbit of a fraction of the period asked for: its multipliers are powers of
+        # the shorter orbit's, which do not tell how that one loses stability)
+        kind = instability(mu) if ps.converged and ps.repeats_within == 1 else ""
         if not ps.converged:
             warn(f"the periodic state did not converge ({ps.message}): its numbers are "
                  f"those of the last iterate; try --method hb, more --steps-per-cycle, or "
@@ -216,7 +220,9 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
                               f"{'stable' if ps.stable else 'UNSTABLE'}, largest Floquet "
                               f"multiplier |mu| = {abs(mu[0]):.6f}", highlight=False)
                 if kind:
-                    console.print(f"[yellow]{_INSTABILITY[kind]}[/]")
+                    console.print(f"[yellow]{_INSTABILITY[kind]}[/]"
+                                  + (f" (--keep {ps.frequency / 2:.9g})"
+                                     if kind == "period doubling" else ""), highlight=False)
             elif not stability:
                 console.print("stability: not computed (--no-stability)")
             t = Table(title="meshes (periodic steady state)" if ps.converged else

@@ -36,6 +36,9 @@ MAX_DENOMINATOR = 10**6
 of real trains are far below)."""
 RTOL = 1e-9
 """Relative mismatch below which a frequency ratio equals its rational approximation."""
+TYPED_RTOL = 1e-5
+"""Relative mismatch of a base frequency given as a number (``keep=2675.335``) from a
+whole fraction of an excitation's frequency, below which it is that fraction."""
 MAX_CYCLES = 1000
 """Default largest number of cycles of the fastest excitation in one period (harmonic
 balance: its harmonics grow with the cycles)."""
@@ -209,6 +212,13 @@ def base_frequency(structure: Structure, keep, kinematics=None) -> float:
     if isinstance(keep, (int, float)):
         if not keep > 0:
             raise SolverError(f"keep={keep!r}: a base frequency must be > 0 Hz.")
+        # a frequency as typed (2675.335 Hz for half of 5350.67 Hz): the excitation's own
+        # fraction where it lies within TYPED_RTOL of one, so that its multiples are kept
+        # and the period is exact
+        for x in excitation_sources(structure):
+            k = round(x.frequency / keep)
+            if k >= 1 and abs(x.frequency / keep - k) <= TYPED_RTOL * k:
+                return x.frequency / k
         return float(keep)
     names = structure.element_names
     meshes = structure.metadata.get("meshes", {})

@@ -129,6 +129,10 @@ class PeriodicSolution:
     sample_every: int = 1
     """Shooting: ``t``, ``q``, ``v``, ``forces``, ``deformations`` are every this many RK4
     steps (1 unless the period has more than :data:`MAX_SAMPLES` steps)."""
+    repeats_within: int = 1
+    """k > 1: a period of k cycles of every excitation was asked for (a subharmonic,
+    ``keep=``), but the orbit found repeats after one k-th of it: no such response from
+    this start (its multipliers are those of the shorter orbit to the k-th power)."""
 
     def __post_init__(self):
         freeze_arrays(self)
@@ -274,6 +278,10 @@ def periodic_solution(structure, period: Period, *, method: str = "auto", harmon
                           "is the static equilibrium; use static_equilibrium instead.")
     p = problem or PeriodicProblem(structure, period.frequency)
     order = max(period.max_order, 1)
+    # cycles of every excitation in the period: > 1 where ``keep`` asked for a fraction
+    # of their frequencies (a period-doubled response: two mesh cycles)
+    sub = math.gcd(*[int(k) for k in period.orders]) if period.orders else 1
+    repeats = False
     f = period.frequency * speed
     T = 1.0 / f
     steps = p.rk4_steps(T, steps_per_cycle, order)
@@ -339,11 +347,19 @@ def periodic_solution(structure, period: Period, *, method: str = "auto", harmon
         else:
             y0 = np.concatenate([q_static if q_static is not None else np.zeros(p.n),
                                  np.zeros(p.n)])
-            if not matrix_free(p, steps):  # (Anderson's first map is the settling)
+            if sub > 1:  # a subharmonic: settle onto it, off the orbit of 1/sub the period
+                say(f"settling onto a response of {sub} excitation periods (up to "
+                    f"{SUBHARMONIC_SETTLE} periods)")
+                y0 = settle_periods(p, y0, T, steps, speed, SUBHARMONIC_SETTLE)
+            elif not matrix_free(p, steps):  # (Anderson's first map is the settling)
                 say(f"settling the transient ({steps:,} RK4 steps per period)")
                 y0 = p.settled_start(y0, T, steps, speed, order)
         y0, Phi, info = solve_shooting(p, y0, steps, speed, tol, monodromy=bool(stability),
                                        record=record, say=say)
+        if sub > 1 and steps % sub == 0:  # the orbit of the period's fraction after all?
+            y_part = p.integrate(y0, 0.0, T / sub, steps // sub, every=steps // sub,
+                                 speed=speed, max_rows=1)[3]
+            repeats = _defect(p, y0, y_part) <= 1e-6
         run = info.run
         corner_t, corner_f, corner_d = run.corner_t, run.corner_forces, run.corner_deformations
         t, q, v = run.t[:-1], run.y[:-1, :p.n], run.y[:-1, p.n:]
@@ -372,7 +388,9 @@ def periodic_solution(structure, period: Period, *, method: str = "auto", harmon
                + (f", {info.products} matrix-free monodromy products)" if info.products
                   else ")")
                + (f"; waveforms kept every {every} steps, the meshes' forces at every step"
-                  if every > 1 else ""))
+                  if every > 1 else "")
+               + (f"; the orbit repeats every 1/{sub} of the period: no response of {sub} "
+                  f"excitation periods from this start" if repeats else ""))
         coeffs = None
     return PeriodicSolution(
         method=method, converged=info.converged, message=msg, speed=float(speed),
@@ -382,7 +400,7 @@ def periodic_solution(structure, period: Period, *, method: str = "auto", harmon
         q=np.asarray(q), v=np.asarray(v), forces=np.asarray(F), deformations=np.asarray(D),
         rigid_load=np.asarray(lam, dtype=float), coefficients=coeffs,
         wall_time=time.perf_counter() - t_start,
-        sample_every=every,
+        sample_every=every, repeats_within=sub if repeats else 1,
         **({} if method == "hb" else dict(
             corner_t=corner_t, corner_forces=corner_f, corner_deformations=corner_d,
             mesh_elements=meshes,
@@ -398,6 +416,26 @@ def hill_applies(p: PeriodicProblem, H: int, frequency: float) -> bool:
     m2 = 2 * p.n - (p.nr + int(np.sum(~p.rigid_damped)))
     f_hi, _ = highest_mode(p.structure)
     return m2 * (2 * H + 1) <= HILL_LIMIT and H * frequency >= 1.5 * f_hi
+
+
+SUBHARMONIC_SETTLE = 400
+"""Most periods integrated before shooting a response of several excitation periods: an
+unstable orbit of the excitation's period (period doubling, multiplier -1.08) is left
+at the rate of its multiplier, and Newton from near it would find it again."""
+
+
+def settle_periods(p: PeriodicProblem, y, T, steps, speed, most: int):
+    """``y`` integrated period by period until one period changes the state by less than
+    1e-7 of the largest deformation, or ``most`` periods."""
+    for _ in range(most):
+        y_next = p.integrate(y, 0.0, T, steps, every=steps, speed=speed, max_rows=1)[3]
+        if not np.all(np.isfinite(y_next)):
+            break
+        done = _defect(p, y, y_next) <= 1e-7
+        y = y_next
+        if done:
+            break
+    return y
 
 
 def _defect(p: PeriodicProblem, y0, yT) -> float:
