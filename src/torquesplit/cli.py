@@ -416,17 +416,20 @@ def run(
                 res = simulate(m, duration=dur, cycles=cycles, method=method,
                                steps_per_period=steps_per_period, max_steps=max_steps,
                                samples_per_period=samples_per_period, progress=cb)
-            res.model_warnings = [w for w in _model_warnings() if w not in res.run_warnings]
-            met = None
-            if res.success:
-                met = res.metrics(chosen)
-                from .results.plausibility import result_warnings
+            # the run is done: a Ctrl-C now waits until its results are on disk
+            with ux.finish_before_interrupt():
+                res.model_warnings = [w for w in _model_warnings()
+                                      if w not in res.run_warnings]
+                met = None
+                if res.success:
+                    met = res.metrics(chosen)
+                    from .results.plausibility import result_warnings
 
-                for loc, msg in result_warnings(res, met):
-                    ux.warn(f"{loc}: {msg}")
-            if out is not None:
-                res.save(out, overwrite=force, definition=chosen)
-                state["saved"] = list(plan.files)
+                    for loc, msg in result_warnings(res, met):
+                        ux.warn(f"{loc}: {msg}")
+                if out is not None:
+                    res.save(out, overwrite=force, definition=chosen)
+                    state["saved"] = list(plan.files)
             step_check = None
             if check and met is not None:
                 from .convergence import check_step
@@ -753,7 +756,8 @@ def static(
             return
         failed = None
         try:  # a file that cannot be written: the results are still printed, then the error
-            state["saved"] = res.save(out, overwrite=force) if out is not None else None
+            with ux.finish_before_interrupt():  # (a Ctrl-C now waits for the file)
+                state["saved"] = res.save(out, overwrite=force) if out is not None else None
         except _EXPECTED as exc:
             failed = exc
         saved = state["saved"]

@@ -176,6 +176,34 @@ def interruptible(kept: Callable[[], str] | None = None) -> Iterator[None]:
         exit_interrupted(what)
 
 
+@contextlib.contextmanager
+def finish_before_interrupt() -> Iterator[None]:
+    """Within this block a Ctrl-C waits: the block (metrics and the results files of a
+    finished computation) runs to its end, then the interrupt is raised, so that what was
+    computed is on disk when :func:`interruptible` says what was kept.  A second Ctrl-C
+    interrupts at once.  Main thread only (elsewhere the block runs unguarded)."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    hits = []
+
+    def later(signum, frame):
+        hits.append(signum)
+        if len(hits) > 1:
+            raise KeyboardInterrupt
+
+    before = signal.signal(signal.SIGINT, later)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, before)
+    if hits:
+        raise KeyboardInterrupt
+
+
 def exit_interrupted(what: str = "") -> None:
     """Print ``interrupted; <what was kept>`` on stderr and exit with status 130 (also
     after a command that stopped on Ctrl-C and reported what it had computed)."""

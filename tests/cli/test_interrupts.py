@@ -142,3 +142,31 @@ def test_a_static_sweep_interrupted_before_its_first_position_or_outside_the_con
     assert sol.interrupted and 0 < sol.times.size < sol.planned
     assert sol.q.shape[0] == sol.element_forces.shape[0] == sol.times.size
     assert any("stopped by Ctrl-C" in w for w in res.all_warnings())
+
+
+@pytest.mark.parametrize("command", ["run", "static"])
+def test_a_ctrl_c_while_results_are_written_keeps_them(command, tmp_path, monkeypatch):
+    """A Ctrl-C after the computation, while the results were being saved, lost them all
+    ('interrupted; nothing written'): now the file is finished first."""
+    import os
+    import signal
+
+    import torquesplit.quasistatic as qs
+    import torquesplit.results as rs
+    from model_texts import SPUR_PAIR, write_model
+
+    cls = rs.Results if command == "run" else qs.QuasiStaticResults
+    save = cls.save
+
+    def interrupted_save(self, *a, **k):
+        os.kill(os.getpid(), signal.SIGINT)  # Ctrl-C lands as the file is written
+        return save(self, *a, **k)
+
+    monkeypatch.setattr(cls, "save", interrupted_save)
+    out = tmp_path / "r.csv"
+    args = [command, str(write_model(tmp_path, SPUR_PAIR)), "--out", str(out), "--quiet"]
+    args += ["--cycles", "30"] if command == "run" else ["--points-per-cycle", "2"]
+    res = CliRunner().invoke(app, args)
+    assert res.exit_code == 130, res.output
+    assert f"interrupted; results kept in {out}" in res.stderr and out.exists()
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
