@@ -198,3 +198,12 @@ def test_optimize_command_names_units_and_ratios(tmp_path):
     assert "baseline (the model without the variables): ltca.L68.te_peak_to_peak_arcsec =" in text
     assert " arc s" in text and " N" in text
     assert re.search(r'\ny1 = "[0-9.e-]+ mm"\n', (tmp_path / "o" / "chosen.toml").read_text())
+    assert f"evaluations stored in {tmp_path / 'evals.jsonl'}" in text
+    # a second run does not write over the first one's front without --force
+    before = (tmp_path / "o" / "pareto.csv").read_bytes()
+    args = ["optimize", str(spec), "--population", "4", "--generations", "1", "--seed", "5",
+            "--out", str(tmp_path / "o")]
+    res = CliRunner().invoke(app, args)
+    assert res.exit_code == 2 and "add --force" in res.stderr
+    assert (tmp_path / "o" / "pareto.csv").read_bytes() == before
+    assert CliRunner().invoke(app, args + ["--force"]).exit_code == 0

@@ -1153,6 +1153,8 @@ def optimize(
     scheduler: Optional[str] = typer.Option(
         None, "--scheduler", help="Dask scheduler address: the evaluations run on that "
         "cluster (as a study's).", metavar="ADDRESS"),
+    force: bool = _flag("--force", "Replace the pareto.csv, pareto.png and chosen.toml of an "
+                        "earlier optimisation in --out."),
     as_json: bool = _flag("--json", "Print the Pareto front as JSON."),
 ):
     """Optimise model parameters (NSGA-II or any pymoo algorithm) on LTCA or dynamic outputs;
@@ -1176,6 +1178,14 @@ def optimize(
                           "same command again to resume"):
         try:
             _check_plots_folder(target, "--out")
+            old = [f for f in ("pareto.csv", "chosen.toml", "pareto.png")
+                   if (target / f).exists()]
+            if old and not force:
+                from .errors import OutputError
+
+                raise OutputError(f"--out {target} holds the {old[0]} of an earlier "
+                                  f"optimisation; add --force to replace it, or choose "
+                                  f"another folder")
             res = _with_progress(lambda cb: run_optimization(
                 path, workers=workers, generations=generations, population=population,
                 seed=seed, scheduler=scheduler,
@@ -1197,6 +1207,7 @@ def optimize(
                                                  for o in res.spec.objectives},
                       "chosen": int(res.chosen), "baseline": res.baseline,
                       "evaluations": res.evaluations, "computed": res.computed,
+                      "store": None if res.spec.store is None else str(res.spec.store),
                       "files": [str(f) for f in files]}, _json_default)
         return
     from .optimize import output_unit
@@ -1218,6 +1229,9 @@ def optimize(
             for o in relative), highlight=False)
     console.print(f"chosen design (*) written to {target / 'chosen.toml'}; front in "
                   f"{target / 'pareto.csv'}", highlight=False)
+    if res.spec.store is not None:
+        console.print(f"evaluations stored in {res.spec.store} (the same command run from "
+                      f"this folder resumes from it)", highlight=False)
 
 
 # --------------------------------------------------------------------------- modes

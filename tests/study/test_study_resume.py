@@ -69,6 +69,21 @@ def test_sigkill_then_resume_computes_each_case_once(tmp_path, split_file):
                                 clean.drop_vars("case_wall_time"))
 
 
+def test_a_folder_of_other_results_is_not_written_over(tmp_path, split_file):
+    """'study --out DIR' replaced another run's results.nc and figures in DIR, silently."""
+    data = grid_study(split_file, GRID[:1])
+    data["grid"]["parameters"][0]["num"] = 2
+    path = _write(tmp_path, data)
+    out = tmp_path / "other"
+    out.mkdir()
+    (out / "results.nc").write_bytes(b"someone else's")
+    with pytest.raises(StudyError, match=r"^out: .* holds results.nc of another run"):
+        Study(path).run(workers=1, out=out, figures=False)
+    assert (out / "results.nc").read_bytes() == b"someone else's"
+    Study(path).run(workers=1, out=out, figures=False, overwrite=True)
+    assert (out / "results.nc").read_bytes() != b"someone else's"
+
+
 def test_changed_study_or_model_refuses_resume(tmp_path, split_file):
     data = grid_study(split_file, GRID[:1])
     data["grid"]["parameters"][0]["num"] = 2

@@ -343,6 +343,12 @@ def _open_folder(plan: Plan, out: Path, resume: bool, overwrite: bool,
         raise StudyError(words.out, f"{out} already holds a study; add {words.resume_on} to "
                                     f"continue it, {words.overwrite_on} to start it again, or "
                                     f"choose another folder")
+    # a folder of other results (no study store): what this study writes would replace them
+    theirs = [f for f in (out / RESULTS_NAME, out / "figures") if f.exists()]
+    if not exists and theirs and not overwrite:
+        raise StudyError(words.out, f"{out} holds {theirs[0].name} of another run, which this "
+                                    f"study would replace; choose another folder or add "
+                                    f"{words.overwrite_on}")
     store = Store(path)
     if store.is_new():
         store.write_meta(_provenance(plan))
