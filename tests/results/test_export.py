@@ -138,3 +138,48 @@ def test_set_overrides_reach_steady_and_mesh():
     r = CliRunner().invoke(app, ["mesh", EXAMPLE, "--pair", "m11", "--json", "--set",
                                  "meshes.m11.stiffness.method=iso6336"])
     assert r.exit_code == 0, r.output
+
+
+DIVERGING = """
+[model]
+name = "undamped pair in parametric resonance"
+[gears.pinion]
+teeth = 20
+module = "2 mm"
+face_width = "20 mm"
+position = ["0 mm", "0 mm", "0 mm"]
+polar_inertia = "1e-3 kg m^2"
+[gears.wheel]
+teeth = 40
+module = "2 mm"
+face_width = "20 mm"
+place = {from_gear = "pinion", angle = "0 deg"}
+polar_inertia = "4e-3 kg m^2"
+[meshes.m]
+gears = ["pinion", "wheel"]
+stiffness = {method = "fourier", mean = "4e8 N/m", cos = ["1.2e8 N/m"], sin = []}
+damping_ratio = 0.0
+[drives.motor]
+body = "pinion"
+speed = "16052 rpm"
+torque = "100 N m"
+[loads.out]
+body = "wheel"
+"""
+
+
+def test_a_stopped_run_file_holds_no_coefficients_and_is_not_reported(tmp_path):
+    """A stopped run's CSV left the coefficients out ('a partial run's are not results'),
+    but its .nc/.mat held them, and 'report' printed them as results."""
+    import torquesplit
+
+    model = tmp_path / "diverging.toml"
+    model.write_text(DIVERGING)
+    res = torquesplit.simulate(model, cycles=3000)  # (mesh frequency = 2 x natural)
+    assert not res.success
+    ds = res.to_dataset()
+    assert "load_sharing" not in ds and "dynamic_factor" not in ds
+    assert "stopped" in ds.attrs["metrics_error"]
+    path = res.save(tmp_path / "p.nc")
+    r = CliRunner().invoke(app, ["report", str(path), "--out", str(tmp_path / "p.html")])
+    assert r.exit_code == 2 and "the run stopped" in r.stderr

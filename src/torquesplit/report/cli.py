@@ -177,6 +177,11 @@ def _report_inputs(h, ux, source, assign, duration, cycles, definition, quiet):
         except (OSError, KeyError) as exc:
             raise OptionError(f"{source}: cannot read it as torquesplit results ({exc}); give "
                               f"a .nc file written by 'torquesplit run --out F.nc'") from None
+        if not res.success:  # (its coefficients would be those of a part of the run)
+            from ..errors import SolverError
+
+            raise SolverError(f"{source}: the run stopped ({res.message}), so there is "
+                              f"nothing to report; run the model again to the end")
         for note in res.model_warnings or []:
             ux.warn(note)
         return res, None, attrs, _quasi_if_static(res.model, ux, quiet)

@@ -142,6 +142,8 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
     if definition is not None and hasattr(res, "check_definition"):
         res.check_definition(definition)  # a misspelt one raises; a diverged run's do not
     try:
+        if not res.success:  # a stopped run: its coefficients are not results (as its CSV)
+            raise ValueError("the run stopped before its end: no metrics of a part of it")
         met = res.metrics(definition)
         ds["load_sharing"] = _var(("mesh",), [met.load_sharing.per_mesh[m] for m in meshes],
                                   "1", f"load-sharing coefficient ({met.definition})")
