@@ -183,3 +183,23 @@ def test_a_stopped_run_file_holds_no_coefficients_and_is_not_reported(tmp_path):
     path = res.save(tmp_path / "p.nc")
     r = CliRunner().invoke(app, ["report", str(path), "--out", str(tmp_path / "p.html")])
     assert r.exit_code == 2 and "the run stopped" in r.stderr
+
+
+def test_spreadsheet_and_matlab_details(tmp_path):
+    """NaN written as 'nan' (text in a spreadsheet), a unit with commas and labels with
+    spaces in the header, names longer than MATLAB's 63 characters or meeting after
+    cleaning ('a.b', 'a_b'), integers that MATLAB cannot mix with doubles."""
+    long = "x" * 70
+    ds = xr.Dataset({"a.b": (("k",), [1.0, np.nan]), "a_b": (("k",), [2.0, np.inf]),
+                     long: (("k",), [3.0, 4.0]), "n": (("k",), np.array([1, 2])),
+                     "shape": (("k", "line"), np.ones((2, 1)),
+                               {"units": "kg^-1/2 (translations), rad (rotations)"})},
+                    coords={"k": [0, 1], "line": ["1 x meshes m11, m21"]})
+    header, rows = _read(save_dataset(ds, tmp_path / "d.csv"))
+    assert "shape_1_x_meshes_m11_m21" in header
+    assert rows[1][header.index("a.b")] == "" and rows[1][header.index("a_b")] == "inf"
+    data = scipy.io.loadmat(save_dataset(ds, tmp_path / "d.mat"), simplify_cells=True)
+    assert {"a_b", "a_b_2", "x" * 63} <= set(data)
+    assert sorted(data["names"].values()) == sorted(["a.b", "a_b", long, "n", "shape", "k",
+                                                     "line"])
+    assert data["n"].dtype == float

@@ -508,7 +508,10 @@ class Results:
         plan = files.check_output(path, formats={".mat": "mat"}, overwrite=overwrite)
         with files.claim_output(plan) as claim:
             ds = self.to_dataset(definition)
-            data = {name: np.asarray(ds[name].values) for name in ds.data_vars}
+            # (integers as doubles: MATLAB refuses int64 in arithmetic with doubles)
+            data = {name: np.asarray(ds[name].values, dtype=float)
+                    if ds[name].dtype.kind in "iub" else np.asarray(ds[name].values)
+                    for name in ds.data_vars}
             for name in ds.coords:
                 values = ds[name].values
                 data[name] = (np.asarray(values, dtype=object) if values.dtype.kind in "UO"

@@ -63,8 +63,10 @@ def check_dataset_output(path, tables: tuple[str, ...] = (), *, overwrite: bool 
 
 
 def _unit_suffix(attrs) -> str:
+    """``_unit`` for a column name ("" for none, "1", or a unit in words with commas that
+    would break the header: its description says it)."""
     unit = str(attrs.get("units", "")).replace(" ", "")
-    return "" if unit in ("", "1") else f"_{unit}"
+    return "" if unit in ("", "1") or "," in unit or "(" in unit else f"_{unit}"
 
 
 def _column(name: str, suffix: str) -> str:
@@ -81,8 +83,9 @@ def _cell(v):
 
 
 def _labels(ds, dim) -> list[str]:
+    """A dimension's labels as parts of column names (no commas or spaces)."""
     values = ds[dim].values if dim in ds.coords else np.arange(ds.sizes[dim])
-    return [str(_cell(v)) for v in values]
+    return [re.sub(r"[^\w.+-]+", "_", str(_cell(v))).strip("_") for v in values]
 
 
 def _table(ds, dim) -> tuple[list[str], list[list]]:
@@ -122,22 +125,34 @@ def _table(ds, dim) -> tuple[list[str], list[list]]:
     return header, rows
 
 
-def _mat_name(name: str) -> str:
-    """A MATLAB identifier for a variable name (letters, digits, '_'; a letter first)."""
+def _mat_name(name: str, taken: set) -> str:
+    """A MATLAB identifier for a variable name, not in ``taken``: letters, digits and
+    '_', a letter first, at most 63 characters, a number added where two names meet."""
     out = re.sub(r"\W", "_", name)
-    return out if out[:1].isalpha() else "v_" + out
+    out = (out if out[:1].isalpha() else "v_" + out)[:63]
+    base, k = out, 2
+    while out in taken:
+        tail = f"_{k}"
+        out, k = base[:63 - len(tail)] + tail, k + 1
+    taken.add(out)
+    return out
 
 
 def _mat_data(ds, run_id: str) -> dict:
-    data = {}
-    for name in list(ds.data_vars) + list(ds.coords):
-        values = ds[name].values
-        data[_mat_name(name)] = (np.asarray(values, dtype=object) if values.dtype.kind in "UO"
-                                 else np.asarray(values))
     names = list(ds.data_vars) + list(ds.coords)
-    data["units"] = {_mat_name(n): str(ds[n].attrs.get("units", "")) for n in names}
-    data["descriptions"] = {_mat_name(n): str(ds[n].attrs.get("long_name", "")) for n in names}
-    data["attributes"] = {_mat_name(k): v if isinstance(v, str) else json.dumps(
+    taken = {"units", "descriptions", "attributes", "provenance", "names"}
+    ident = {n: _mat_name(n, taken) for n in names}
+    data = {}
+    for name in names:
+        values = ds[name].values
+        data[ident[name]] = (np.asarray(values, dtype=object) if values.dtype.kind in "UO"
+                             else np.asarray(values, dtype=float) if values.dtype.kind in "iub"
+                             else np.asarray(values))
+    data["units"] = {ident[n]: str(ds[n].attrs.get("units", "")) for n in names}
+    data["descriptions"] = {ident[n]: str(ds[n].attrs.get("long_name", "")) for n in names}
+    data["names"] = {ident[n]: n for n in names}  # the Dataset's own names
+    akeys: set = set()
+    data["attributes"] = {_mat_name(k, akeys): v if isinstance(v, str) else json.dumps(
         v.tolist() if isinstance(v, np.ndarray) else v, default=str)
         for k, v in ds.attrs.items()}
     data["provenance"] = files.provenance(run_id)

@@ -570,11 +570,16 @@ def mat_bytes(data: dict) -> bytes:
 
 
 def csv_bytes(header, rows) -> bytes:
-    """A table as UTF-8 CSV bytes."""
+    """A table as UTF-8 CSV bytes; a NaN is an empty cell (spreadsheets read 'nan' as
+    text), an infinity 'inf' / '-inf'."""
     import csv
+    import math
+
+    def cell(v):
+        return "" if isinstance(v, float) and math.isnan(v) else v
 
     buffer = io.StringIO(newline="")
     writer = csv.writer(buffer)
     writer.writerow(header)
-    writer.writerows(rows)
+    writer.writerows([cell(v) for v in row] for row in rows)
     return buffer.getvalue().encode("utf-8")
