@@ -348,6 +348,12 @@ def prepare_run(
     n_records = duration / sample_interval
     if n_records > MAX_HISTORY_RECORDS:
         sample_interval = duration / MAX_HISTORY_RECORDS
+        warnings.warn(
+            f"analysis: the history holds at most {MAX_HISTORY_RECORDS:,} samples, so this "
+            f"run keeps {1.0 / (sample_interval * f_max):.3g} per shortest mesh period "
+            f"instead of {samples_per_period:g}: the files' waveforms and the bearing table "
+            f"are that coarse (the mesh table is streamed at every step); for fine "
+            f"waveforms run a shorter span", ModelWarning, stacklevel=3)
     from .metrics.load_sharing import group_meshes
 
     mesh_groups = list(group_meshes(structure.metadata["meshes"]).values())

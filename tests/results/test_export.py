@@ -203,3 +203,29 @@ def test_spreadsheet_and_matlab_details(tmp_path):
     assert sorted(data["names"].values()) == sorted(["a.b", "a_b", long, "n", "shape", "k",
                                                      "line"])
     assert data["n"].dtype == float
+
+
+def test_cycle_starts_end_with_the_run_and_a_capped_history_is_said():
+    """A slower mesh's cycle rows past its last cycle had start times far beyond the run
+    (124 s in a 12.6 s run); a history cut to 200,000 samples (4 per period for 50 asked)
+    was said only in the bearing table's title."""
+    import warnings
+
+    import torquesplit
+    from torquesplit import simulation
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = torquesplit.simulate(torquesplit.example_path(EXAMPLE), cycles=200)
+    s = res.solution
+    assert np.nanmax(s.cycle_start) <= s.t_span[1] * (1 + 1e-12)
+    np.testing.assert_array_equal(np.isnan(s.cycle_start), s.cycle_count == 0)
+    cap = simulation.MAX_HISTORY_RECORDS
+    try:
+        simulation.MAX_HISTORY_RECORDS = 1000
+        with warnings.catch_warnings():
+            warnings.simplefilter("always")  # (an ignored warning is not kept either)
+            res = torquesplit.simulate(torquesplit.example_path(EXAMPLE), cycles=200)
+    finally:
+        simulation.MAX_HISTORY_RECORDS = cap
+    assert any("the history holds at most 1,000 samples" in w for w in res.run_warnings)

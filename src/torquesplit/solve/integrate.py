@@ -863,6 +863,10 @@ def _cycle_summary(rec: kd.Record, s: Structure, sel: _Selection) -> dict:
     rows = np.arange(n_cyc)[:, None]
     start = (sel.track_base[None, :] + rows - s.phase[tr][None, :]) \
         / s.frequency[tr][None, :] if tr.size else np.zeros((n_cyc, 0))
+    # a slower mesh's rows past its last cycle are no cycles: no start time (the rows
+    # run to the fastest mesh's count; their starts lay far beyond the run's end)
+    if tr.size:
+        start[_rows(cnt_all, n_cyc) == 0] = np.nan
     return dict(cycle_start=start, cycle_max=_rows(rec.cyc_max, n_cyc),
                 cycle_min=_rows(rec.cyc_min, n_cyc), cycle_mean=_rows(rec.cyc_sum, n_cyc),
                 cycle_count=_rows(cnt_all, n_cyc),
