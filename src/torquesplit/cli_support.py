@@ -185,7 +185,9 @@ def finish_before_interrupt() -> Iterator[None]:
     import signal
     import threading
 
-    if threading.current_thread() is not threading.main_thread():
+    current = (signal.getsignal(signal.SIGINT)
+               if threading.current_thread() is threading.main_thread() else None)
+    if current in (None, signal.SIG_IGN):  # not ours to change (a thread, a nohup job)
         yield
         return
     hits = []

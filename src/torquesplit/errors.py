@@ -81,7 +81,7 @@ class ModelError(TorquesplitError, ValueError):
         seen = set()
         for loc, msg in issues:  # one problem found twice at one place is said once
             loc, msg = clip_text(str(loc), 2 * QUOTE_LIMIT), clip_message(str(msg))
-            key = (loc, _PAIR_PREFIX.sub("", msg))
+            key = (loc, _PAIR_PREFIX.sub("", msg) if loc else msg)
             if key not in seen:
                 seen.add(key)
                 self.issues.append((loc, msg))
@@ -99,8 +99,8 @@ class ModelError(TorquesplitError, ValueError):
                 lines.append(where + (f"{loc}: " if loc else "") + msg)
                 continue
             named = [loc for loc, _ in members if loc]
-            if len(named) > 3:
-                named = named[:2] + [f"{len(named) - 2} more"]
+            if len(named) > 10:
+                named = named[:9] + [f"{len(named) - 9} more"]
             lines.append(where + (f"{', '.join(named)}: " if named else "") + core)
         super().__init__("\n".join(lines))
 

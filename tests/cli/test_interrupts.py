@@ -170,3 +170,17 @@ def test_a_ctrl_c_while_results_are_written_keeps_them(command, tmp_path, monkey
     assert res.exit_code == 130, res.output
     assert f"interrupted; results kept in {out}" in res.stderr and out.exists()
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+
+
+def test_finishing_before_an_interrupt_leaves_an_ignored_sigint_alone():
+    """A job started with SIGINT ignored (nohup, a script's background job) became
+    interruptible inside the block."""
+    import signal
+
+    before = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        with ux.finish_before_interrupt():
+            assert signal.getsignal(signal.SIGINT) is signal.SIG_IGN
+        assert signal.getsignal(signal.SIGINT) is signal.SIG_IGN
+    finally:
+        signal.signal(signal.SIGINT, before)

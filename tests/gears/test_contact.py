@@ -308,3 +308,18 @@ def test_a_floating_double_helical_member_shares_the_load_equally_between_its_he
     entry = mi.entry_phase
     near = np.argmin(np.mod(entry - res.phase - 1e-12, 1.0))  # the last position before it
     assert mi.approach == pytest.approx(z[near, h], rel=0.05)
+
+
+def test_the_approach_before_entry_is_not_extrapolated_across_the_contact_jump():
+    """A line through the two samples before the entry crossed the single-to-double
+    contact step where the single-pair zone is narrower than two positions (contact ratio
+    1.946 at 32 positions: 35.0 um for 24.9 um)."""
+    from torquesplit.gears.contact.impact import _before
+
+    phase = np.arange(8) / 8
+    z = np.array([15.0, 15, 15, 15, 15, 15, 15, 25.0])  # single contact only at 7/8
+    pairs = np.array([2, 2, 2, 2, 2, 2, 2, 1])
+    assert _before(phase, z, 0.0, pairs) == 25.0
+    assert _before(phase, z, 0.0) == pytest.approx(25.0 + 10.0)  # (the line, unguarded)
+    smooth = 20.0 + phase
+    assert _before(phase, smooth, 0.0, np.ones(8)) == pytest.approx(21.0)

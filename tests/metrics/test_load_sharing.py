@@ -190,3 +190,19 @@ def test_static_torque_is_largest_ratio_over_positions():
                            {"s": ["p1", "p2", "p3"]})
     assert res.per_mesh["p1"] == pytest.approx(3 * 110 / 300)
     assert res.system == pytest.approx(1.1)
+
+
+def test_only_a_leading_transient_is_cut_and_a_short_record_is_left_to_the_tolerance():
+    """A window outside the last half's range after one inside it is the response's own
+    variation (a beat), not a transient; with fewer than three windows in the last
+    half their range means nothing and only the 1 % tolerance applies."""
+    i = np.arange(400)
+    peaks = 1.0 + 0.001 * np.sin(2 * np.pi * i / 130.0)  # a beat over several windows
+    peaks[:3] = 1.008  # and a start-up transient
+    st = ls.settle(peaks[:, None], (i / 100.0)[:, None], ["a"], window=20, tolerance=0.01)
+    assert st.first_cycle["a"] == 20
+    short = np.ones(80)
+    short[0] = 1.008
+    st = ls.settle(short[:, None], (np.arange(80) / 100.0)[:, None], ["a"], window=20,
+                   tolerance=0.01)
+    assert st.first_cycle["a"] == 0  # (4 windows: 2 in the last half)

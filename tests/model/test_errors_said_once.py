@@ -31,7 +31,7 @@ def test_one_message_at_several_places_is_one_line_naming_them():
     err = ModelError(issues, "m.toml")
     assert len(err.issues) == 5  # every place kept for programs
     assert str(err).splitlines() == [
-        "m.toml: meshes.a, meshes.b, 2 more: k must be positive; give it",
+        "m.toml: meshes.a, meshes.b, meshes.c, meshes.d: k must be positive; give it",
         "m.toml: gears.x.teeth: must be at least 5"]
     (loc, msg), = ModelError([("meshes.a", "gears 'x' and 'y': bad")]).issues
     assert str(ModelError([(loc, msg)])) == "meshes.a: gears 'x' and 'y': bad"
@@ -41,3 +41,12 @@ def test_one_message_at_several_places_is_one_line_naming_them():
 def test_unlocated_messages_stay_apart(where):
     err = ModelError([("", "first"), ("", "second")], where or None)
     assert len(str(err).splitlines()) == 2
+
+
+def test_many_places_are_listed_up_to_ten():
+    err = ModelError([(f"loads.l{i}.torque", "Field required") for i in range(12)])
+    assert str(err) == ", ".join(f"loads.l{i}.torque" for i in range(9)) + \
+        ", 3 more: Field required"
+    # a pair's prefix is a location only where the issue has none
+    issues = [("", "gears 'a' and 'b': X"), ("", "gears 'c' and 'd': X")]
+    assert len(ModelError(issues).issues) == 2

@@ -222,3 +222,15 @@ def test_stopping_rule_outcome_is_reported(split_file, tmp_path):
     assert "target NOT met: max_samples = 24 reached" in stopping_line(ds)
     ds.attrs["stopping_finite_cases"] = 22
     assert "over 22 of 24 cases (2 without a finite value left out)" in stopping_line(ds)
+
+
+def test_a_percentile_rule_that_cannot_stop_is_refused(split_file):
+    """max_samples below 59 can never bound a 95th percentile at 95 %: the rule ran to its
+    end and advised widening half_width, which cannot help."""
+    from torquesplit.study import StudyError
+
+    stop = {"output": OUT, "statistic": "p95", "half_width": 0.01, "confidence": 0.95,
+            "min_samples": 16, "batch": 8, "max_samples": 48}
+    with pytest.raises(StudyError, match="max_samples: 48 samples cannot bound a 95th "
+                                         "percentile with 95% confidence \\(it takes 59\\)"):
+        Study(mc_study(split_file, stop=stop)).plan()

@@ -326,6 +326,10 @@ def mesh_errors(model: Model, kin: Kinematics, mesh_name: str):
 
 
 # --------------------------------------------------------------------------- impact
+#: stiffness methods whose tables start (phase 0) where a new tooth pair enters contact
+ENTRY_PHASED = ("iso6336", "potential_energy")
+
+
 def impact_force_table(model: Model, kin: Kinematics, mesh_name: str, n: int):
     """Meshing-in impact force over one mesh cycle [N], or None (Liu et al. 2021 eqs. 6-10).
 
@@ -361,7 +365,10 @@ def impact_force_table(model: Model, kin: Kinematics, mesh_name: str, n: int):
         base_radius_driving=mk.base_radii[0], base_radius_driven=mk.base_radii[1],
         tip_radius_driven=g_dvn.tip_radius, centre_distance=mk.center_distance,
         base_pitch=geo.base_pitch, omega_driving=abs(mk.driver_speed),
-        normal_load=mk.force, loaded_stiffness=float(table[-1]),  # just before the entry
+        # just before the entry where the table's phase 0 is the entry (ISO 6336, the
+        # potential-energy method); a table or series written by hand has its own phase
+        normal_load=mk.force,
+        loaded_stiffness=float(table[-1]) if mesh.stiffness.method in ENTRY_PHASED else k_mean,
         inertia_driving=kin.bodies[mk.driver].polar_inertia,
         inertia_driven=kin.bodies[mk.driven].polar_inertia,
         impact_stiffness=k_mean / max(mk.transverse_contact_ratio, 1.0),

@@ -159,8 +159,9 @@ def settle(cycle_max: np.ndarray, cycle_start: np.ndarray, names, window=20,
     after the last one whose mean or largest peak differs from the reference's by more
     than ``tolerance`` x the reference's largest peak (else the run is not settled, see
     below), and in any case from the window after the last one that lies outside the
-    range of the windows of the run's last half by more than :data:`START_TOLERANCE` x
-    that peak or, if more, half that range: a start-up peak within the tolerance (0.8 %
+    range of the windows of the run's last half (three or more) by more than
+    :data:`START_TOLERANCE` x that peak or, if more, half that range, in the leading run
+    of such windows: a start-up peak within the tolerance (0.8 %
     above the steady ones in a reviewer's run) is still transient and must not set the
     dynamic factor, while the windows of a response that does not repeat over W vary by
     as much as the last half's do.  The cycles before the first
@@ -199,14 +200,15 @@ def settle(cycle_max: np.ndarray, cycle_start: np.ndarray, names, window=20,
             bad = np.flatnonzero(~good)
             b0 = int(bad[-1]) + 1 if bad.size else 0
             ok = (n - (start + b0 * w)) >= n / 4
-            inside = np.ones(n_win, dtype=bool)
-            for stat in (blocks.mean(axis=1), blocks.max(axis=1)):
-                lo, hi = stat[n_win // 2:].min(), stat[n_win // 2:].max()
-                margin = max(START_TOLERANCE * scale, 0.5 * (hi - lo))
-                inside &= (stat >= lo - margin) & (stat <= hi + margin)
-            out = np.flatnonzero(~inside)
-            if out.size:
-                b0 = max(b0, int(out[-1]) + 1)
+            if n_win - n_win // 2 >= 3:  # (a range needs a few windows to mean anything)
+                inside = np.ones(n_win, dtype=bool)
+                for stat in (blocks.mean(axis=1), blocks.max(axis=1)):
+                    lo, hi = stat[n_win // 2:].min(), stat[n_win // 2:].max()
+                    margin = max(START_TOLERANCE * scale, 0.5 * (hi - lo))
+                    inside &= (stat >= lo - margin) & (stat <= hi + margin)
+                # the start-up transient is the leading run of windows outside the range
+                # (a later one outside it is the response's own variation)
+                b0 = max(b0, int(np.argmax(inside)) if inside.any() else 0)
             k_set = start + b0 * w
         if not ok:
             settled = False

@@ -193,6 +193,7 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
         period_text = st.period.describe(ps.frequency / st.period.frequency)
         info = {
             **st.summary(rows), "instability": kind or None,
+            **({} if ps.converged else {"stable": None}),
             "results_file": str(saved) if saved else None,
             **({"step_check": step_check.to_dict()} if step_check else {}),
         }
@@ -386,7 +387,8 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
             console.print(f"unstable points: {summary['unstable_points']} (dashed in the "
                           f"figure; left out of the largest dynamic factor)")
             for a, b in summary["period_doubling_rpm"]:
-                console.print(f"[yellow]period doubling[/] between {a:.6g} and {b:.6g} rpm (a "
+                where = f"at {a:.6g}" if a == b else f"between {a:.6g} and {b:.6g}"
+                console.print(f"[yellow]period doubling[/] {where} rpm (a "
                               f"Floquet multiplier below -1): the response there is not on "
                               f"this curve but an orbit of twice the period or longer, with "
                               f"other forces; 'torquesplit run' at those speeds gives it")
@@ -423,14 +425,14 @@ def _runs(ds, flag) -> list[list[float]]:
 
 def _largest_loss(ds) -> dict[str, list[float]]:
     """Per mesh, the largest contact-loss fraction over the stable points and its speed
-    [rpm] ([0, nan] without one)."""
+    [rpm] ([0, None] without one)."""
     stable = np.asarray(ds["stable"].values, bool)
     rpm = np.asarray(ds["speed_rpm"].values, float)[stable]
     out = {}
     for j, k in enumerate(ds["mesh"].values):
         loss = np.asarray(ds["contact_loss"].values[:, j], float)[stable]
         i = int(np.argmax(loss)) if loss.size else -1
-        out[str(k)] = [float(loss[i]), float(rpm[i])] if i >= 0 else [0.0, math.nan]
+        out[str(k)] = [float(loss[i]), float(rpm[i])] if i >= 0 else [0.0, None]
     return out
 
 

@@ -356,6 +356,8 @@ def solve_shooting(p: PeriodicProblem, y0, steps: int, speed=1.0, tol=1e-9, max_
             recycle = False  # the Newton-Picard step did not pay: GMRES from here on
         recycled = False
         hist.append(err)
+        if err < best[0]:
+            best = (err, y)
         log.debug("shooting Newton %d: defect %.3e", it, err)
         if say is not None:
             say(f"shooting, Newton step {it}: defect {err:.1e} (tolerance {tol:.0e})"
@@ -414,8 +416,6 @@ def solve_shooting(p: PeriodicProblem, y0, steps: int, speed=1.0, tol=1e-9, max_
             A = np.vstack([Pr @ (Phi - np.eye(2 * n)), R.T])
             b = -np.concatenate([d, R.T @ y])
             dy = np.linalg.lstsq(A, b, rcond=None)[0]
-        if err < best[0]:
-            best = (err, y)
         y = y + dy
         if not np.all(np.isfinite(y)):
             raise SolverError("the shooting iteration diverged; start from a better guess "
@@ -438,6 +438,8 @@ def solve_shooting(p: PeriodicProblem, y0, steps: int, speed=1.0, tol=1e-9, max_
                 defect_map(y)
             if monodromy and not krylov:  # (its stability: the caller's multipliers)
                 Phi = p.integrate_variational(y, 0.0, T, steps, speed)[1]
+        elif record is not None:  # the last map was Anderson's: record Newton's state
+            defect_map(y)
     return y, (None if krylov else Phi), NewtonInfo(err <= tol, aa_maps + it, err, hist,
                                                     products[0], aa_maps, runs[0])
 

@@ -139,8 +139,10 @@ def _sweep_panel(ax, ds, variable):
             for i, f in enumerate(flag):
                 if f and first is None:
                     first = i
-                elif not f and first is not None:
-                    ax.axvspan(rpm[first], rpm[i - 1], color="tab:red", alpha=0.08, lw=0,
+                elif not f and first is not None:  # (to midway to the stable neighbours)
+                    lo = 0.5 * (rpm[first - 1] + rpm[first]) if first > 0 else rpm[first]
+                    hi = 0.5 * (rpm[i - 1] + rpm[i]) if i < len(rpm) else rpm[i - 1]
+                    ax.axvspan(lo, hi, color="tab:red", alpha=0.08, lw=0,
                                label="period doubling (the response is\nnot on this curve)" if first == int(np.argmax(flag))
                                else None)
                     first = None

@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import difflib
 import json
+import math
 import tomllib
 import typing
 from pathlib import Path
@@ -233,6 +234,14 @@ class StopRule(_Strict):
         if self.min_samples > self.max_samples:
             raise _Problem("min_samples", f"{self.min_samples} exceeds max_samples = "
                                           f"{self.max_samples}; lower it")
+        if self.statistic == "p95":
+            # the fewest samples whose largest bounds the 95th percentile with the
+            # confidence: 1 - 0.95^n >= confidence (59 at 95 %)
+            least = math.ceil(math.log(1 - self.confidence) / math.log(0.95))
+            if self.max_samples < least:
+                raise _Problem("max_samples", f"{self.max_samples} samples cannot bound a "
+                                              f"95th percentile with {self.confidence:.0%} "
+                                              f"confidence (it takes {least}); raise it")
         return self
 
 

@@ -85,13 +85,17 @@ class LoadedMeshingIn:
         return self.impact.force(phase)
 
 
-def _before(phase, values, at: float) -> float:
+def _before(phase, values, at: float, state=None) -> float:
     """The limit of the periodic samples ``values(phase)`` as the phase tends to ``at``
-    from below: linear through the two samples before ``at`` (a sample at ``at`` itself
-    belongs to the other side of a jump)."""
+    from below: linear through the two samples before ``at`` where both have the same
+    ``state`` (the number of loaded tooth pairs), else the last sample's value (a line
+    through samples on both sides of a jump lands far off it; a sample at ``at`` itself
+    belongs to the other side of the jump)."""
     back = np.mod(at - np.asarray(phase, dtype=float), 1.0)
-    back[back < 1e-9] = np.inf  # (a sample on ``at``, or a hair after it on the circle)
+    back[back < 1e-9] = np.inf  # (a sample on ``at`` itself)
     i1, i2 = np.argsort(back)[:2]
+    if state is not None and state[i1] != state[i2]:
+        return float(values[i1])
     d1, d2 = back[i1], back[i2]
     return float(values[i1] + (values[i1] - values[i2]) * d1 / (d2 - d1))
 
@@ -123,7 +127,8 @@ def loaded_meshing_in(result, *, omega_driving: float, inertia_driving: float,
     best = None
     for h in range(cm.helices):
         entry = float(np.mod(-h * cm.options.stagger, 1.0))
-        z = _before(phase, result.approach(h), entry)
+        loaded = (result.pair_load[:, h] > 1e-9 * result.load).sum(axis=1)
+        z = _before(phase, result.approach(h), entry, loaded)
         w_c = float(cm.raw_separation(np.array([pair.path_start]), np.array([0.0]), h)[0]
                     - cm.separation_shift)
         adv = z - w_c

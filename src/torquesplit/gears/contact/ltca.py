@@ -263,7 +263,8 @@ class ContactModel:
             p = np.concatenate([q[0] for q in parts], axis=1)
             Zh = np.stack([q[1] for q in parts], axis=1)
             k0, k1 = parts[0][2], parts[1][2]
-            # dZ/dP = (dZ0/dP0 + dZ1/dP1) / 4 with P_h = P/2 and Z = (Z0 + Z1)/2
+            # dZ/dP = (dZ0/dP0 + dZ1/dP1) / 4 with P_h = P/2 and Z = (Z0 + Z1)/2: the two
+            # helices in parallel (2 k for equal ones), the float free
             kt = 4.0 * k0 * k1 / (k0 + k1)
             it = np.maximum(parts[0][3], parts[1][3])
             st = np.maximum(parts[0][4], parts[1][4])
