@@ -658,15 +658,25 @@ def run_table(met) -> Table:
 def bearing_table(bearings: list[dict], res) -> Table:
     """The supported bodies' bearing forces over the settled part (kN), from the run's
     history (:meth:`Results.bearing_forces`)."""
+    from .model.kinematics import support_frame
+
     per = res.history_samples_per_period()
     b = Table(title=f"bearing forces (settled; from the history, {per:.3g} samples per "
                     f"shortest mesh period)")
-    for col in ("body", "mean force by direction\n[kN]", "|mean|\n[kN]", "peak |F|\n[kN]"):
-        b.add_column(_h(col), justify="left" if col == "body" else "right")
+    # the force on the body's bearing, by direction of the frame it is written in: a
+    # planet's (and any body's of a turning carrier's model) turns with the carrier
+    frames = []
     for r in bearings:
+        carrier, _, turning = support_frame(res.kinematics, r["body"])
+        frames.append(f"carrier {carrier} (turning)" if carrier and turning else "housing")
+    turning = any(f != "housing" for f in frames)
+    cols = ["body", "mean force by direction\n[kN]", "|mean|\n[kN]", "peak |F|\n[kN]"]
+    for col in cols + (["directions in"] if turning else []):
+        b.add_column(_h(col), justify="left" if col in ("body", "directions in") else "right")
+    for r, frame in zip(bearings, frames):
         means = ", ".join(f"{d} {v / 1e3:.5g}" for d, v in zip(r["directions"], r["mean"]))
         b.add_row(r["body"], means, f"{r['mean_magnitude'] / 1e3:.5g}",
-                  f"{r['peak_magnitude'] / 1e3:.5g}")
+                  f"{r['peak_magnitude'] / 1e3:.5g}", *([frame] if turning else []))
     return b
 
 

@@ -341,8 +341,14 @@ def static_warnings(results) -> list[tuple[str, str]]:
     for j, m in enumerate(results.mesh_names):
         fmin = float(np.nanmin(forces[conv, j])) if conv.any() else math.nan
         if fmin < 0:
+            st = results.structure
+            e = st.element_names.index(m)
+            gap = float(np.max(st.gap_values[st.gap_ptr[e]:st.gap_ptr[e + 1]], initial=0.0))
+            note = ("; without backlash its teeth pull (double-flank contact), and the "
+                    "load-sharing coefficients count that pull (a planet's factor can then "
+                    "exceed the number of planets): give the backlash" if gap <= 0 else "")
             out.append((f"meshes.{m}", (
                 f"the quasi-static force reaches {_kn(fmin)}: the mesh is loaded on its back "
                 f"flank at some positions, against the power flow; check the errors and "
-                f"backlash of this mesh and their units")))
+                f"backlash of this mesh and their units{note}")))
     return out

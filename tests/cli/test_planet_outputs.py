@@ -1,0 +1,40 @@
+"""A planetary analyst's notes: the bearing table says its frame, and a planet factor
+that counts pulling teeth says so."""
+
+from __future__ import annotations
+
+import json
+
+from typer.testing import CliRunner
+
+from torquesplit.cli import app
+
+EXAMPLE = "lin_parker1999_planetary"
+
+
+def test_the_bearing_table_says_which_frame_its_directions_are_in():
+    """Planet 1's 'x 0.042, y 1.034 kN' is the force on its pin in the turning carrier's
+    frame (tangential 2 F cos(alpha), radial m Omega^2 R); only the results file said so."""
+    res = CliRunner().invoke(app, ["run", EXAMPLE, "--cycles", "30"])
+    assert res.exit_code == 0, res.output
+    table = res.stdout[res.stdout.index("bearing forces"):]
+    assert "directions in" in table and "carrier stage_carrier (turning)" in table
+
+
+def test_a_planet_factor_that_counts_pulling_teeth_says_so():
+    """Without backlash an unloaded planet's teeth pull, and K_gamma counts the pull
+    (4.37 > N = 4 on a reviewer's stage): the warning names the cause and the fix."""
+    res = CliRunner().invoke(app, [
+        "static", EXAMPLE, "--quiet", "--json", "--points-per-cycle", "2",
+        "--set", 'planetary.0.pin_errors=[{tangential="-60 um"},{},{},{}]',
+        "--set", 'planetary.0.sun.dofs=["theta"]'])
+    assert res.exit_code == 0, res.output
+    said = [w for w in json.loads(res.stdout)["warnings"] if "teeth pull" in w]
+    assert said and "give the backlash" in said[0]
+    res = CliRunner().invoke(app, [
+        "static", EXAMPLE, "--quiet", "--json", "--points-per-cycle", "2",
+        "--set", 'planetary.0.pin_errors=[{tangential="-60 um"},{},{},{}]',
+        "--set", 'planetary.0.sun.dofs=["theta"]',
+        "--set", "planetary.0.sun_mesh.backlash=300um",
+        "--set", "planetary.0.ring_mesh.backlash=300um"])
+    assert not [w for w in json.loads(res.stdout)["warnings"] if "teeth pull" in w]
