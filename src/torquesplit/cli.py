@@ -1322,7 +1322,10 @@ def modes(
             with files.claim_output(plan):
                 ds = rep.to_dataset()
                 ds.attrs["model"] = m.model.name
-                saved = save_dataset(ds, plan.path, overwrite=force)
+                from .results.export import with_model
+
+                saved = save_dataset(with_model(ds, m, ux.session().warnings), plan.path,
+                                     overwrite=force)
     except _EXPECTED as exc:
         _fail(exc)
         return

@@ -229,3 +229,21 @@ def test_cycle_starts_end_with_the_run_and_a_capped_history_is_said():
     finally:
         simulation.MAX_HISTORY_RECORDS = cap
     assert any("the history holds at most 1,000 samples" in w for w in res.run_warnings)
+
+
+def test_a_replaced_csv_set_leaves_no_stale_companion_and_files_carry_their_model(tmp_path):
+    """--force left an earlier save's NAME_dof.csv beside a Campbell map's NAME.csv; the
+    modes, sweep and Campbell files held neither the model nor the warnings printed."""
+    out = tmp_path / "x.csv"
+    r = CliRunner().invoke(app, ["modes", EXAMPLE, "--out", str(out)])
+    assert r.exit_code == 0 and (tmp_path / "x_dof.csv").exists()
+    r = CliRunner().invoke(app, ["modes", EXAMPLE, "--campbell", "--from", "300 rpm",
+                                 "--to", "900 rpm", "--out", str(out), "--force"])
+    assert r.exit_code == 0 and not (tmp_path / "x_dof.csv").exists()
+    nc = tmp_path / "m.nc"
+    r = CliRunner().invoke(app, ["modes", EXAMPLE, "--out", str(nc), "--set",
+                                 "gears.z1.mass=154000 kg"])
+    assert r.exit_code == 0, r.output
+    with xr.open_dataset(nc, engine="h5netcdf") as ds:
+        assert "gears.z1.mass" in ds.attrs["warnings"]
+        assert json.loads(ds.attrs["model_json"])["model"]["name"] == "ji_li_mill_drive"

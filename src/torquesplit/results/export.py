@@ -179,6 +179,23 @@ def _write(ds, plan: files.OutputPlan, claim: files.OutputClaim) -> Path:
     return plan.path
 
 
+def with_model(ds, model, warnings=()):
+    """``ds`` with the model it came from (``model_json``, as a run's file holds it: the
+    file can be re-run) and the warnings its command printed."""
+    from ..model.io import model_to_json
+
+    ds = ds.copy()
+    ds.attrs["model_json"] = model_to_json(model)
+    ds.attrs["warnings"] = "\n".join(warnings)
+    ds.attrs["warnings_json"] = json.dumps(list(warnings))
+    return ds
+
+
+#: row dimensions of the Datasets the commands write: a replaced CSV set's companions
+#: named so, left from an earlier save of another shape, are removed with it
+KNOWN_TABLES = ("time", "mesh", "planet_entity", "dof", "mode", "point", "check", "speed")
+
+
 def save_dataset(ds, path, *, overwrite: bool = False) -> Path:
     """Save a result Dataset by suffix: ``.nc`` NetCDF, ``.mat`` MATLAB, ``.csv``
     spreadsheet tables (module docstring); atomically, an existing file kept unless
@@ -191,4 +208,10 @@ def save_dataset(ds, path, *, overwrite: bool = False) -> Path:
     """
     plan = check_dataset_output(path, row_dims(ds), overwrite=overwrite)
     with files.claim_output(plan) as claim:
-        return _write(ds, plan, claim)
+        out = _write(ds, plan, claim)
+    if plan.format == "table" and overwrite:  # (replacing: no stale companion beside it)
+        for d in KNOWN_TABLES:
+            old = plan.path.with_name(f"{plan.path.stem}_{d}.csv")
+            if old not in plan.files and old.is_file():
+                old.unlink()
+    return out

@@ -329,7 +329,7 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
         saved, failed = None, None
         try:  # a file that cannot be written: the curves are still printed, then the error
             if out is not None:
-                saved = _save(ds, out, force)
+                saved = _save(_with_model(ds, m), out, force)
             if plot is not None:
                 from torquesplit.steady.plot import save, sweep_figure
 
@@ -464,6 +464,14 @@ def sweep_maxima(ds) -> dict[str, dict[str, tuple[float, float]]]:
     return out
 
 
+def _with_model(ds, model):
+    """The Dataset with its model and this command's warnings (results.export)."""
+    from torquesplit.cli_support import session
+    from torquesplit.results.export import with_model
+
+    return with_model(ds, model, session().warnings)
+
+
 def _save(ds, path, overwrite=False):
     """Write by suffix, atomically (complete or absent; torquesplit.results.export)."""
     from torquesplit.results.export import save_dataset
@@ -483,7 +491,7 @@ def campbell_command(m, start, stop, plot, as_json, console, json_default, out=N
     written, failed = [], None
     try:  # a file that cannot be written: the map is still printed, then the error
         if out is not None:
-            written.append(_save(ds, out, force))
+            written.append(_save(_with_model(ds, m), out, force))
         if plot is not None:
             from torquesplit.steady.plot import campbell_figure, save
 
