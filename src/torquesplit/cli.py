@@ -696,12 +696,7 @@ def group_table(met) -> Table:
 
 def _print_planets(planets, kinematics) -> None:
     """The planet table (K_gamma per stage, the factor per planet) and what it shows."""
-    t = Table(title=f"planets (load sharing: {planets.definition})")
-    for i, col in enumerate(ux.planet_header(planets)):
-        t.add_column(_h(col), justify="right" if i >= 3 else "left")
-    for row in ux.planet_rows(planets, kinematics):
-        t.add_row(*row)
-    console.print(t)
+    console.print(ux.planet_table(planets, kinematics))
     console.print(ux.planet_text(planets), markup=False, highlight=False)
 
 

@@ -353,6 +353,18 @@ def planet_sharing(load_sharing, kinematics):
     return k if k.per_stage else None
 
 
+def planet_table(k, kinematics):
+    """The planet table (K_gamma per stage, the factor per planet) as a rich Table."""
+    from rich.table import Table
+
+    t = Table(title=f"planets (load sharing: {k.definition})")
+    for i, col in enumerate(planet_header(k)):
+        t.add_column(header(col), justify="right" if i >= 3 else "left")
+    for row in planet_rows(k, kinematics):
+        t.add_row(*row)
+    return t
+
+
 def planet_rows(k, kinematics) -> list[list[str]]:
     """Rows of the planet table: per stage (carrier) its K_gamma (a peak-based
     definition: its planet load-sharing coefficient) and the groups it is taken over,

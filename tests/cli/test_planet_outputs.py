@@ -38,3 +38,18 @@ def test_a_planet_factor_that_counts_pulling_teeth_says_so():
         "--set", "planetary.0.sun_mesh.backlash=300um",
         "--set", "planetary.0.ring_mesh.backlash=300um"])
     assert not [w for w in json.loads(res.stdout)["warnings"] if "teeth pull" in w]
+
+
+def test_steady_gives_the_planet_load_sharing_as_run_does():
+    """'steady' printed no planet table and its JSON had no planet_load_sharing (its
+    results file had the variable)."""
+    fourier = '{method = "fourier", mean = "5e8 N/m", cos = ["1e8 N/m"], sin = []}'
+    args = ["steady", EXAMPLE, "--no-stability",
+            "--set", f"planetary.0.sun_mesh.stiffness={fourier}",
+            "--set", f"planetary.0.ring_mesh.stiffness={fourier}"]
+    res = CliRunner().invoke(app, args + ["--json"])
+    assert res.exit_code == 0, res.output
+    k = json.loads(res.stdout)["planet_load_sharing"]
+    assert abs(k["per_stage"]["stage_carrier"] - 1.0) < 1e-6  # equal spacing, no errors
+    res = CliRunner().invoke(app, args)
+    assert "planets (load sharing" in res.stdout

@@ -162,9 +162,9 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
                                   max_cycles="auto" if max_cycles is None else max_cycles,
                                   stability=stability, steps_per_cycle=steps_per_cycle,
                                   progress=update)
-            rows = st.mesh_table()
-            saved = (st.to_results().save(out, overwrite=force) if out is not None
-                     else None)
+            res = st.to_results()
+            rows = st.mesh_table(results=res)
+            saved = res.save(out, overwrite=force) if out is not None else None
             step_check = None
             if check:
                 from torquesplit.convergence import check_steady
@@ -191,8 +191,14 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
             warn(_INSTABILITY[kind])
         # the period found at the model's speeds, told at the speed solved
         period_text = st.period.describe(ps.frequency / st.period.frequency)
+        from torquesplit.cli_support import planet_sharing, planet_sharing_dict
+
+        # a planetary stage: K_gamma over the period, as 'run' gives it
+        planets = (planet_sharing(res.metrics().load_sharing, st.kinematics)
+                   if ps.converged else None)
         info = {
             **st.summary(rows), "instability": kind or None,
+            **({"planet_load_sharing": planet_sharing_dict(planets)} if planets else {}),
             **({} if ps.converged else {"stable": None}),
             "results_file": str(saved) if saved else None,
             **({"step_check": step_check.to_dict()} if step_check else {}),
@@ -243,6 +249,11 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
                           f"{1e6 * r.rms_transmission_error:.4g}",
                           f"{100 * r.contact_loss:.2f} %")
             console.print(t)
+            if planets:
+                from torquesplit.cli_support import planet_table, planet_text
+
+                console.print(planet_table(planets, st.kinematics))
+                console.print(planet_text(planets), markup=False, highlight=False)
             console.print("RMS TE: root mean square over the period of the mesh deflection "
                           "about its mean (the elastic part of the dynamic transmission "
                           "error, along the line of action; the geometric errors excite it "
