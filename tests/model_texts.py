@@ -38,6 +38,42 @@ body = "wheel"
 """
 
 
+PARAMETRIC_PAIR = """
+[model]
+name = "pair_param"
+
+[gears.pinion]
+teeth = 20
+module = "2 mm"
+face_width = "20 mm"
+position = ["0 mm", "0 mm", "0 mm"]
+polar_inertia = "1e-3 kg m^2"
+
+[gears.wheel]
+teeth = 40
+module = "2 mm"
+face_width = "20 mm"
+place = {from_gear = "pinion", angle = "0 deg"}
+polar_inertia = "4e-3 kg m^2"
+
+[meshes.m]
+gears = ["pinion", "wheel"]
+stiffness = {method = "fourier", mean = "4e8 N/m", cos = ["1.2e8 N/m"], sin = []}
+damping_ratio = 0.05
+backlash = "100 um"
+
+[drives.motor]
+body = "pinion"
+speed = "3000 rpm"
+torque = "100 N m"
+
+[loads.out]
+body = "wheel"
+"""
+"""A single spur pair (natural frequency 2675 Hz) with a +-30 % stiffness wave and
+backlash: period doubling near 16052 rpm (mesh frequency twice the natural one), contact
+loss above its primary resonance (a reviewer's model)."""
+
 PAIR_4MM = """
 [model]
 name = "4 mm pair"

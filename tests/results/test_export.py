@@ -12,6 +12,7 @@ import scipy.io
 import xarray as xr
 from typer.testing import CliRunner
 
+from model_texts import PARAMETRIC_PAIR
 from torquesplit.cli import app
 from torquesplit.errors import OutputError
 from torquesplit.results.export import row_dims, save_dataset
@@ -140,32 +141,9 @@ def test_set_overrides_reach_steady_and_mesh():
     assert r.exit_code == 0, r.output
 
 
-DIVERGING = """
-[model]
-name = "undamped pair in parametric resonance"
-[gears.pinion]
-teeth = 20
-module = "2 mm"
-face_width = "20 mm"
-position = ["0 mm", "0 mm", "0 mm"]
-polar_inertia = "1e-3 kg m^2"
-[gears.wheel]
-teeth = 40
-module = "2 mm"
-face_width = "20 mm"
-place = {from_gear = "pinion", angle = "0 deg"}
-polar_inertia = "4e-3 kg m^2"
-[meshes.m]
-gears = ["pinion", "wheel"]
-stiffness = {method = "fourier", mean = "4e8 N/m", cos = ["1.2e8 N/m"], sin = []}
-damping_ratio = 0.0
-[drives.motor]
-body = "pinion"
-speed = "16052 rpm"
-torque = "100 N m"
-[loads.out]
-body = "wheel"
-"""
+DIVERGING = (PARAMETRIC_PAIR.replace("damping_ratio = 0.05", "damping_ratio = 0.0")
+             .replace('backlash = "100 um"\n', "").replace('"3000 rpm"', '"16052 rpm"'))
+"""Undamped, without backlash, at twice its natural frequency: it grows until stopped."""
 
 
 def test_a_stopped_run_file_holds_no_coefficients_and_is_not_reported(tmp_path):

@@ -10,41 +10,11 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
+from model_texts import PARAMETRIC_PAIR
 from torquesplit.cli import app
 from torquesplit.steady.sweep import instability
 
-PAIR = """\
-[model]
-name = "pair_param"
-
-[gears.pinion]
-teeth = 20
-module = "2 mm"
-face_width = "20 mm"
-position = ["0 mm", "0 mm", "0 mm"]
-polar_inertia = "1e-3 kg m^2"
-
-[gears.wheel]
-teeth = 40
-module = "2 mm"
-face_width = "20 mm"
-place = {from_gear = "pinion", angle = "0 deg"}
-polar_inertia = "4e-3 kg m^2"
-
-[meshes.m]
-gears = ["pinion", "wheel"]
-stiffness = {method = "fourier", mean = "4e8 N/m", cos = ["1.2e8 N/m"], sin = []}
-damping_ratio = 0.05
-backlash = "100 um"
-
-[drives.motor]
-body = "pinion"
-speed = "3000 rpm"
-torque = "100 N m"
-
-[loads.out]
-body = "wheel"
-"""
+PAIR = PARAMETRIC_PAIR
 
 
 @pytest.fixture
