@@ -163,13 +163,18 @@ def test_a_ctrl_c_while_results_are_written_keeps_them(command, tmp_path, monkey
         return save(self, *a, **k)
 
     monkeypatch.setattr(cls, "save", interrupted_save)
+    # Ctrl-C as at a terminal (a background job, e.g. CI started with '&', ignores it)
+    before = signal.signal(signal.SIGINT, signal.default_int_handler)
     out = tmp_path / "r.csv"
     args = [command, str(write_model(tmp_path, SPUR_PAIR)), "--out", str(out), "--quiet"]
     args += ["--cycles", "30"] if command == "run" else ["--points-per-cycle", "2"]
-    res = CliRunner().invoke(app, args)
-    assert res.exit_code == 130, res.output
-    assert f"interrupted; results kept in {out}" in res.stderr and out.exists()
-    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+    try:
+        res = CliRunner().invoke(app, args)
+        assert res.exit_code == 130, res.output
+        assert f"interrupted; results kept in {out}" in res.stderr and out.exists()
+        assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+    finally:
+        signal.signal(signal.SIGINT, before)
 
 
 def test_finishing_before_an_interrupt_leaves_an_ignored_sigint_alone():
