@@ -133,3 +133,18 @@ def test_a_period_of_two_cycles_where_the_response_has_one_says_so(pair):
     assert "no response of 2 excitation periods" in two.solution.message
     assert two.mesh_table()[0].dynamic_factor == pytest.approx(
         one.mesh_table()[0].dynamic_factor, rel=1e-6)
+
+
+def test_a_sweep_over_two_excitation_cycles_names_no_instability(pair, tmp_path):
+    """Over a period of two mesh cycles (--keep half the mesh frequency) the period-1
+    orbit's multiplier -1.08 reads +1.17, which was labelled a fold."""
+    import xarray as xr
+
+    out = tmp_path / "s.nc"
+    r = CliRunner().invoke(app, ["sweep-speed", pair, "--from", "15500 rpm", "--to",
+                                 "16500 rpm", "--points", "6", "--keep", "500", "--json",
+                                 "--out", str(out)])
+    assert r.exit_code == 0, r.output
+    assert json.loads(r.stdout)["unstable_points"] > 0
+    with xr.open_dataset(out, engine="h5netcdf") as ds:
+        assert set(ds["instability"].values.tolist()) == {""}

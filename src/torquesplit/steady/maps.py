@@ -120,6 +120,7 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
 
     t_start = time.perf_counter()
     model, kin, s, dropped, per, static = _prepare(model, keep, max_cycles)
+    sub = math.gcd(*[int(k) for k in per.orders]) if per.orders else 1
     w_ref = reference_speed(model)
     s0, s1 = _rad_per_s(start, "start") / w_ref, _rad_per_s(stop, "stop") / w_ref
     if per.frequency <= 0:
@@ -191,7 +192,11 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
                                           for p in pts], dtype=bool)),
             "max_multiplier": ("point", np.array([p.max_multiplier for p in pts]),
                                {"units": "1", "long_name": "largest |Floquet multiplier|"}),
-            "instability": ("point", np.array([p.instability for p in pts], dtype=str), {
+            # (over a period of several excitation cycles, a keep= fraction, a period-1
+            # orbit's multipliers are powers of its own: they do not say how it loses
+            # stability, so none is named)
+            "instability": ("point", np.array([p.instability if sub == 1 else ""
+                                               for p in pts], dtype=str), {
                 "long_name": "how an unstable orbit loses stability: 'period doubling' (a "
                              "multiplier below -1: the response is not this orbit), 'fold' "
                              "(above 1), 'torus' (a complex pair); empty where stable"}),
