@@ -248,8 +248,8 @@ leaves out the start-up transient before computing anything.
 * **bearing forces**: for each supported body (here `input`), the settled mean bearing
   force by direction, the magnitude of that mean and the peak magnitude |F|.  They come
   from the history, not from the streamed statistics (see the history warning).  `--json`
-  gives them as `bearing_forces_N`, a results file (`--out`) as `bearing_mean_force` and
-  `bearing_peak_force`.
+  gives them as `bearing_forces_N`, a .nc or .mat results file (`--out`) as
+  `bearing_mean_force` and `bearing_peak_force`.
 {{{{drift_text}}}}
 * **the history warning** above the table: the history a results file and the figures hold
   (20 samples per split-mesh period by default) misses the settled peak of in2 by {{{{history_miss}}}} %:
@@ -415,11 +415,11 @@ def _numbers(work: Path) -> dict[str, str]:
             "`torquesplit steady`) gives the value the run tends to.")
     else:
         drift_text = (
-            "* **the transient** is left out: the settled part starts after the last "
-            "window of 20 cycles whose peaks differ from those of the run's last half by "
-            "more than 1e-4 of the peak (docs/theory/model.md), so the dynamic factor is "
-            "that of the response the run tends to; the periodic steady state (section 8, "
-            "`torquesplit steady`) gives it directly.")
+            "* **the transient** is left out: the settled part starts after the leading "
+            "windows of 20 cycles whose peaks lie outside the range of the run's last "
+            "half by more than 1e-4 of the peak (docs/theory/model.md), so the dynamic "
+            "factor is that of the response the run tends to; the periodic steady state "
+            "(section 8, `torquesplit steady`) gives it directly.")
     coarse = [w for w in run["warnings"] if w.startswith("analysis: the history")]
     if not coarse:
         raise SystemExit("the tutorial's text expects the coarse-history warning")
