@@ -162,7 +162,7 @@ def settle(cycle_max: np.ndarray, cycle_start: np.ndarray, names, window=20,
     range of the windows of the run's last half (three or more) by more than
     :data:`START_TOLERANCE` x that peak or, if more, half that range, in the leading run
     of such windows: a start-up peak within the tolerance (0.8 %
-    above the steady ones in a reviewer's run) is still transient and must not set the
+    above the steady ones on a single spur pair) is still transient and must not set the
     dynamic factor, while the windows of a response that does not repeat over W vary by
     as much as the last half's do.  The cycles before the first
     whole window (fewer than W) are never counted as settled: they were not checked.  A

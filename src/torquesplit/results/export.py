@@ -117,8 +117,9 @@ def _table(ds, dim) -> tuple[list[str], list[list]]:
         per = f"{rest[-1]}_unit"
         units = ([_unit_suffix({"units": u}) for u in ds[per].values]
                  if " or " in str(da.attrs.get("units", "")) and per in ds.coords else None)
+        labels = [_labels(ds, d) for d in rest]
         for idx in itertools.product(*(range(ds.sizes[d]) for d in rest)):
-            label = "_".join(_labels(ds, d)[i] for d, i in zip(rest, idx))
+            label = "_".join(lab[i] for lab, i in zip(labels, idx))
             header.append(f"{name}_{label}{unit if units is None else units[idx[-1]]}")
             columns.append(da.values[(slice(None),) + idx])
     rows = [[_cell(col[i]) for col in columns] for i in range(n)]

@@ -423,15 +423,10 @@ import numpy as np  # noqa: E402  (used by the commands above)
 
 def _runs(ds, flag) -> list[list[float]]:
     """[first, last] speed [rpm] of each run of consecutive points where ``flag``."""
+    from torquesplit.steady.sweep import flag_runs
+
     rpm = np.asarray(ds["speed_rpm"].values, float)
-    out, start = [], None
-    for i, f in enumerate(np.append(np.asarray(flag, bool), False)):
-        if f and start is None:
-            start = i
-        elif not f and start is not None:
-            out.append([float(rpm[start]), float(rpm[i - 1])])
-            start = None
-    return out
+    return [[float(rpm[a]), float(rpm[b])] for a, b in flag_runs(flag)]
 
 
 def _largest_loss(ds) -> dict[str, list[float]]:

@@ -134,18 +134,15 @@ def _sweep_panel(ax, ds, variable):
             k = e + 1
         colour = line.get_color() if line is not None else None
         if j == 0 and "instability" in ds:  # where the response is not on the curve
-            flag = np.append(ds["instability"].values == "period doubling", False)
-            first = None
-            for i, f in enumerate(flag):
-                if f and first is None:
-                    first = i
-                elif not f and first is not None:  # (to midway to the stable neighbours)
-                    lo = 0.5 * (rpm[first - 1] + rpm[first]) if first > 0 else rpm[first]
-                    hi = 0.5 * (rpm[i - 1] + rpm[i]) if i < len(rpm) else rpm[i - 1]
-                    ax.axvspan(lo, hi, color="tab:red", alpha=0.08, lw=0,
-                               label="period doubling (the response is\nnot on this curve)" if first == int(np.argmax(flag))
-                               else None)
-                    first = None
+            from torquesplit.steady.sweep import flag_runs
+
+            runs = flag_runs(ds["instability"].values == "period doubling")
+            for k, (a, b) in enumerate(runs):  # (to midway to the stable neighbours)
+                lo = 0.5 * (rpm[a - 1] + rpm[a]) if a > 0 else rpm[a]
+                hi = 0.5 * (rpm[b] + rpm[b + 1]) if b + 1 < len(rpm) else rpm[b]
+                ax.axvspan(lo, hi, color="tab:red", alpha=0.08, lw=0,
+                           label="period doubling (the response is\nnot on this curve)"
+                           if k == 0 else None)
         check = f"run_up_{variable}"
         if check in ds:
             ax.plot(ds["check_speed_rpm"].values, ds[check].values[:, j] * scale, "^", ms=4,

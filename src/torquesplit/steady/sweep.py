@@ -58,6 +58,19 @@ def instability(mu) -> str:
     return "period doubling" if top.real < 0 else "fold"
 
 
+def flag_runs(flags) -> list[tuple[int, int]]:
+    """(first, last) index of each run of consecutive true ``flags`` (the period-doubling
+    bands of a sweep: its line and its figure)."""
+    out, start = [], None
+    for i, f in enumerate(np.append(np.asarray(flags, bool), False)):
+        if f and start is None:
+            start = i
+        elif not f and start is not None:
+            out.append((start, i - 1))
+            start = None
+    return out
+
+
 @dataclass
 class SweepPoint:
     speed: float
