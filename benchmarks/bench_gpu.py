@@ -157,14 +157,20 @@ def _study_part(spec, cpu_cases: int) -> dict:
     rep = json.loads(ds.attrs["gpu_backend"])
     res["gpu_fp64"] = {"end_to_end_s": wall, **rep,
                        "sample_steps_per_s_kernel": rep["sample_steps"] / rep["kernel_time_s"]}
+    _log(f"gpu fp64: {json.dumps(res['gpu_fp64'], default=str)}")  # kept if stopped later
     wall32, ds32 = _timed_study(spec, backend="gpu", precision="fp32")
     rep32 = json.loads(ds32.attrs["gpu_backend"])
     res["gpu_fp32"] = {"end_to_end_s": wall32, **rep32}
+    _log(f"gpu fp32: {json.dumps(res['gpu_fp32'], default=str)}")
     sub = json.loads(json.dumps(spec))
     sub["monte_carlo"]["samples"] = cpu_cases
     cwall, cds = _timed_study(sub, workers=2)
     res["cpu_2_workers"] = {"cases": cpu_cases, "wall_s": cwall,
-                            "per_case_s": cwall / cpu_cases}
+                            "per_case_s": cwall / cpu_cases,
+                            # the cases' own times on their workers (no pool start-up):
+                            # the 2-core runner's throughput on a long study
+                            "case_wall_sum_s": float(cds["case_wall_time"].sum())}
+    _log(f"cpu: {json.dumps(res['cpu_2_workers'])}")
     # same cases, same values: the CPU subsample against the GPU's first cases
     diffs = []
     for v in cds.data_vars:
@@ -177,6 +183,8 @@ def _study_part(spec, cpu_cases: int) -> dict:
                                                                              1e-300))))
     res["fp64_max_rel_difference_to_cpu"] = max(diffs) if diffs else None
     res["ratio_to_cpu_runner_end_to_end"] = (res["cpu_2_workers"]["per_case_s"] * n) / wall
+    res["ratio_to_cpu_case_throughput"] = (
+        res["cpu_2_workers"]["case_wall_sum_s"] / 2 / cpu_cases * n) / wall
     return res
 
 

@@ -31,7 +31,8 @@ def main() -> None:
     for i, (r, sol) in enumerate(zip(runs, res.solutions, strict=True)):
         ref = engine(r)
         out.append([f"case {i}", ref.status, ref.n_steps, compare(sol, ref)])
-    print(json.dumps({"device": res.device, "patterns": res.patterns, "cases": out}))
+    print(json.dumps({"device": res.device, "patterns": res.patterns, "cases": out,
+                      "law_binding": res.law_binding}))
 
 
 if __name__ == "__main__":

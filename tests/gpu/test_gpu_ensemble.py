@@ -117,3 +117,29 @@ def test_generator_knows_every_kernel_array_of_the_engine():
     from torquesplit.solve.kernel_data import KernelModel
 
     assert tuple(KernelModel._fields) == KNOWN_FIELDS
+
+
+def test_cases_that_share_tables_plan_the_kernel_model_of_their_own_structure():
+    """The planner makes the tables' copies and corner nodes once per table object (a
+    study's cases share them); a structure with the same table objects whose other
+    corner inputs differ (here: an element that no longer varies) must still get exactly
+    ``kernel_model`` of its own structure, field by field."""
+    import dataclasses
+
+    from torquesplit.gpu.ensemble import _kernel_model, case_arrays
+    from torquesplit.solve import kernel_data as kd
+
+    runs = feature_runs() + [example_run("ji_li_mill_drive", 1e-3)]
+    s = runs[0].structure
+    varied = dataclasses.replace(s, frequency=np.where(np.arange(len(s.frequency)) == 0,
+                                                       0.0, s.frequency))
+    shared = [r for r in runs if r.structure.stiffness_table is s.stiffness_table]
+    assert len(shared) >= 2
+    structures = [r.structure for r in runs] + [varied, s]
+    for st in structures:
+        want, got = kd.kernel_model(st), _kernel_model(st)
+        for f in want._fields:
+            a, b = getattr(got, f), getattr(want, f)
+            assert np.shape(a) == np.shape(b) and np.array_equal(a, b), f
+    models = [case_arrays(r).case.model for r in shared[:2]]
+    assert models[0].stiffness_table is models[1].stiffness_table

@@ -28,6 +28,7 @@ def test_cuda_kernel_in_the_simulator_equals_the_engine():
     report = json.loads(proc.stdout.strip().splitlines()[-1])
     assert "simulator" in report["device"]
     assert report["patterns"] == 3
+    assert report["law_binding"] == "device"  # the laws as CUDA device functions
     statuses = [c[1] for c in report["cases"]]
     assert statuses == [0, 0, 1, 0, 0]  # the third case diverges, as in the engine
     for label, _, n_steps, bad in report["cases"]:

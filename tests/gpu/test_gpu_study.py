@@ -163,3 +163,35 @@ def test_cases_set_up_in_worker_processes_give_the_same_dataset():
     assert runner._pool is None  # shut down when the study ends
     with pytest.raises(ValueError, match="workers"):
         GpuRunner(workers=0)
+
+
+def test_workers_send_a_table_set_once_and_the_cases_share_it():
+    """Ji & Li's cases carry 14 MB of phase tables each; a pool worker sends a table set
+    the first time and then runs without it, and the runner puts the one set back: every
+    case then holds the same object, bit for bit the tables it would have had."""
+    from torquesplit.gpu.backend import TABLES, _Job, prepare_case
+    from torquesplit.study.case import payload
+
+    spec = {**GRID, "analysis": {"duration": "0.01 s"},
+            "grid": {"parameters": [{"path": "meshes.m11.damping_ratio",
+                                     "values": [0.05, 0.07, 0.09, 0.11, 0.13, 0.15]}]}}
+    plan = torquesplit.Study(spec).plan()
+    ps = [payload(i, plan, plan.design.overrides(i)) for i in range(6)]
+    runner = GpuRunner(target="cpu", workers=2)
+    jobs = [_Job(p, "w") for p in ps]
+    try:
+        runner._prepare(jobs, True)
+    finally:
+        runner._pool.shutdown()
+    assert len(runner._tables) == 1
+    fresh = prepare_case(ps[-1])["run"].structure
+    for name in TABLES:
+        objs = {id(getattr(j.run.structure, name)) for j in jobs}
+        assert len(objs) == 1, name
+        assert np.array_equal(getattr(jobs[-1].run.structure, name), getattr(fresh, name))
+    # a worker that has sent the set sends the next case without it
+    first = prepare_case(ps[0], worker=True)
+    again = prepare_case(ps[1], worker=True)
+    assert not first.get("tables_stripped") and again["tables_stripped"]
+    assert again["tables"] == first["tables"]
+    assert again["run"].structure.stiffness_table.size == 0

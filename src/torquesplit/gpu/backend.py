@@ -23,16 +23,24 @@ to the store's metadata and the dataset's attributes by :meth:`Study.run`).
 
 from __future__ import annotations
 
+import dataclasses
+import hashlib
 import logging
 import math
 import os
 import time
 import warnings
+from collections import OrderedDict
+
+import numpy as np
 
 log = logging.getLogger(__name__)
 
-BATCH = 1024
-"""Cases set up and integrated together (the store still gets them one by one)."""
+BATCH = 16384
+"""Cases set up and integrated together (the store still gets them one by one): one case
+a thread, a launch must hold enough cases to occupy every multiprocessor (an H100 has
+132; with 64-thread blocks 1,024 cases kept 16 of them busy), and a set-up case costs
+little memory (cases share their phase tables)."""
 
 
 def check_plan(plan) -> None:
@@ -85,7 +93,7 @@ class GpuRunner:
         if target not in TARGETS:
             raise ValueError(f"target must be one of {TARGETS}, got {target!r}")
         if batch < 1:
-            raise ValueError(f"batch must be >= 1, got {batch}; give e.g. batch=1024")
+            raise ValueError(f"batch must be >= 1, got {batch}; give e.g. batch=16384")
         self.precision = precision
         self.target = target
         self.batch = int(batch)
@@ -94,6 +102,7 @@ class GpuRunner:
             raise ValueError(f"workers must be >= 1, got {workers}; give e.g. workers=4")
         self.workers = int(workers)
         self._pool = None
+        self._tables: dict[str, tuple] = {}  # phase tables the pool's workers sent
         self.device = ""
         self.report: dict = {"backend": "gpu", "target": target, "precision": precision,
                              "cases": 0, "ensembles": 0, "kernel_time_s": 0.0,
@@ -119,6 +128,7 @@ class GpuRunner:
             if self._pool is not None:
                 self._pool.shutdown(wait=False, cancel_futures=True)
                 self._pool = None
+                self._tables = {}
 
     def _prepare(self, jobs: list["_Job"], first: bool) -> None:
         """Set the jobs' next runs up, in a process pool when ``workers`` > 1."""
@@ -134,11 +144,30 @@ class GpuRunner:
                     self.workers, mp_context=multiprocessing.get_context("spawn"),
                     initializer=_ignore_sigint)
             chunk = max(1, len(jobs) // (4 * self.workers))
-            results = list(self._pool.map(prepare_case, *zip(*args), chunksize=chunk))
+            results = list(self._pool.map(prepare_case, *zip(*args), [True] * len(args),
+                                          chunksize=chunk))
+            self._attach_tables(results, args)
         else:
             results = [prepare_case(p, length) for p, length in args]
         for job, res in zip(jobs, results, strict=True):
             job.apply_prepared(res)
+
+    def _attach_tables(self, results: list[dict], args: list[tuple]) -> None:
+        """Give the runs that a worker sent without their phase tables (it had sent those
+        tables before) the tables it sent, so every case of one table set shares one
+        object; a case whose tables never came is set up again here (cannot happen while
+        the pool lives; correct if it does)."""
+        for res in results:
+            key = res.get("tables")
+            if key and not res.get("tables_stripped"):
+                s = res["run"].structure
+                kept = self._tables.setdefault(key, tuple(getattr(s, f) for f in TABLES))
+                res["run"] = _with_tables(res["run"], kept)
+        for k, res in enumerate(results):
+            if res.get("tables_stripped"):
+                kept = self._tables.get(res["tables"])
+                results[k] = (prepare_case(*args[k]) if kept is None
+                              else {**res, "run": _with_tables(res["run"], kept)})
 
     # ----------------------------------------------------------------------- batches
     def _run_batch(self, payloads: list[dict]):
@@ -165,6 +194,8 @@ class GpuRunner:
         self.device = res.device
         r = self.report
         r["device"] = res.device
+        if res.law_binding:
+            r["law_binding"] = res.law_binding
         r["ensembles"] += 1
         r["cases"] += len(runs)
         r["kernel_time_s"] += res.kernel_time
@@ -211,12 +242,57 @@ class GpuRunner:
         return f"{os.uname().nodename}:{os.getpid()}:{where}"
 
 
-def prepare_case(p: dict, length: float | None = None) -> dict:
+#: the structure's phase tables over one excitation period (the bulk of a prepared run:
+#: 14 MB for Ji & Li's drive, whose period is a hunting period of 65,536 samples)
+TABLES = ("stiffness_table", "force_table", "friction_table")
+_SEEN: OrderedDict = OrderedDict()  # this process's table sets: key -> arrays
+_SENT: set = set()  # keys whose tables this worker has sent to the runner
+
+
+def _with_tables(run, tables: tuple):
+    s = dataclasses.replace(run.structure, **dict(zip(TABLES, tables, strict=True)))
+    return dataclasses.replace(run, structure=s)
+
+
+def _bits_equal(a: np.ndarray, b: np.ndarray) -> bool:
+    if a.shape != b.shape or a.dtype != b.dtype:
+        return False
+    if a.size == 0:
+        return True
+    if a.dtype.kind == "f" and a.flags.c_contiguous and b.flags.c_contiguous:
+        a, b = a.view(np.uint8), b.view(np.uint8)  # bit for bit (-0.0 is not 0.0)
+    return bool(a.flat[0] == b.flat[0]) and bool(np.array_equal(a, b))
+
+
+def _share_tables(run) -> tuple[object, str]:
+    """``run`` with its phase tables replaced by an equal (bit for bit) set this process
+    has seen, so that cases share one object, and the set's key."""
+    s = run.structure
+    current = tuple(getattr(s, f) for f in TABLES)
+    for key, seen in _SEEN.items():
+        if all(_bits_equal(a, b) for a, b in zip(current, seen, strict=True)):
+            _SEEN.move_to_end(key)
+            return _with_tables(run, seen), key
+    h = hashlib.blake2b(digest_size=16)
+    for a in current:
+        h.update(str((a.dtype, a.shape)).encode())
+        h.update(np.ascontiguousarray(a).tobytes())
+    key = h.hexdigest()
+    _SEEN[key] = current
+    while len(_SEEN) > 8:
+        _SEEN.popitem(last=False)
+    return run, key
+
+
+def prepare_case(p: dict, length: float | None = None, worker: bool = False) -> dict:
     """Set up one case as :func:`torquesplit.study.case.run_case` sets it up (the study's
     overrides, validation, :func:`torquesplit.simulation.prepare_run`), in this process or
-    in a pool worker: ``{run, status, reason, warnings, full, length}``.  With a settle
-    rule, ``length`` is the run length of this round (None: the first, which is computed
-    here, with ``full``, the cap of the rule); errors become statuses, as in run_case."""
+    in a pool worker: ``{run, status, reason, warnings, full, length, tables}``.  With a
+    settle rule, ``length`` is the run length of this round (None: the first, which is
+    computed here, with ``full``, the cap of the rule); errors become statuses, as in
+    run_case.  Cases with equal phase tables share one table object (``tables``: the
+    set's key); a ``worker`` sends a set once and then runs without it
+    (``tables_stripped``; :meth:`GpuRunner._attach_tables` puts them back)."""
     from ..errors import SolverError, TorquesplitError
     from ..model.io import load_model, model_from_dict
     from ..model.overrides import apply_overrides
@@ -247,6 +323,13 @@ def prepare_case(p: dict, length: float | None = None) -> dict:
         except Exception as exc:  # noqa: BLE001 - recorded, the study goes on
             out.update(status="error", reason=f"{type(exc).__name__}: {_one_line(exc)}")
     out["warnings"] = [_one_line(w.message) for w in caught]
+    if out["run"] is not None:
+        out["run"], out["tables"] = _share_tables(out["run"])
+        if worker and out["tables"] in _SENT:
+            empty = tuple(np.zeros((0, 0)) for _ in TABLES)
+            out["run"], out["tables_stripped"] = _with_tables(out["run"], empty), True
+        elif worker:
+            _SENT.add(out["tables"])
     return out
 
 

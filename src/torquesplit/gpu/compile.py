@@ -8,6 +8,13 @@ is added per target: for the CPU a loop over the cases in one compiled function
 (:func:`cpu_driver`), for CUDA a kernel with one case per thread whose scratch arrays are
 thread-local (``cuda.local.array``, indexed by constants: registers).
 
+For CUDA the laws are bound as CUDA device functions compiled from the laws' own Python
+(numba-cuda's documented way for one device function to call another); where that
+binding does not compile, the kernel is compiled again with the laws as plain numba
+functions (numba compiles a ``@jit`` function called from a kernel for the CUDA target),
+and the binding used is reported.  The CUDA kernel is compiled eagerly, for the one
+signature the ensemble launches, so that compile time is never counted as kernel time.
+
 Compiled kernels are kept per process by the hash of their source (a study that runs
 batch after batch of one pattern compiles once).  Under ``NUMBA_ENABLE_CUDASIM=1`` the
 CUDA path runs in numba's simulator (the tests without a GPU).
@@ -18,6 +25,7 @@ from __future__ import annotations
 import hashlib
 import math
 import threading
+import types
 
 import numpy as np
 
@@ -25,7 +33,8 @@ from torquesplit.solve import laws
 
 from .source import KernelSource
 
-__all__ = ["cpu_driver", "cuda_kernel", "cuda_available", "cuda_simulated", "ptx"]
+__all__ = ["cpu_driver", "cuda_kernel", "cuda_available", "cuda_simulated", "ptx",
+           "kernel_signature"]
 
 _LOCK = threading.Lock()
 _CACHE: dict[tuple, object] = {}
@@ -73,6 +82,29 @@ def law_functions() -> dict:
         return dict(_LAW_DISPATCHERS)
 
 
+#: the scalar laws, among them those that the laws of :data:`LAWS` call
+SCALAR_LAWS = ("dead_zone", "spring_force", "spline_radial", "spline_force",
+               "spline_tangent", "positive_part", "table_phase", "lerp", "stat_cycle")
+_CUDA_LAWS: dict = {}
+
+
+def cuda_law_functions() -> dict:
+    """The laws as CUDA device functions: each law's own Python function, bound in a copy
+    of the laws module's globals in which the laws it calls are device functions too (so
+    the arithmetic is the laws' own, and no CPU dispatcher is called from a kernel)."""
+    from numba import cuda
+
+    with _LOCK:
+        if not _CUDA_LAWS:
+            scope = dict(vars(laws))
+            for name in SCALAR_LAWS:
+                f = getattr(laws, name).py_func
+                scope[name] = cuda.jit(device=True)(types.FunctionType(
+                    f.__code__, scope, name, f.__defaults__, f.__closure__))
+            _CUDA_LAWS.update({name: scope[name] for name in LAWS})
+        return dict(_CUDA_LAWS)
+
+
 def _namespace(src: KernelSource, literal_calls: bool = False) -> dict:
     import numba
 
@@ -99,10 +131,14 @@ def _functions(ns: dict) -> list[str]:
             and v.__code__.co_filename.startswith("<torquesplit.gpu kernel")]
 
 
-def _cuda_namespace(src: KernelSource) -> dict:
+def _cuda_namespace(src: KernelSource, binding: str = "device") -> dict:
+    """The kernel's namespace for CUDA; ``binding``: the laws as CUDA device functions
+    (``"device"``) or as plain numba functions (``"njit"``)."""
     from numba import cuda
 
     ns = _namespace(src, literal_calls=True)
+    if binding == "device":
+        ns.update(cuda_law_functions())
     ns["cuda"] = cuda
     for name in _functions(ns):
         ns[name] = cuda.jit(device=True)(ns[name])
@@ -132,10 +168,26 @@ def cpu_driver(src: KernelSource):
     return fn
 
 
-def cuda_kernel(src: KernelSource):
+#: how the laws were bound in the last CUDA kernel compiled, and why not the first way
+LAST_BINDING: dict = {}
+
+
+def kernel_signature(precision: str) -> tuple:
+    """The numba types of the kernel's arguments (``P`` in the working precision)."""
+    from numba import float32, float64, int64
+
+    dt = float64 if precision == "fp64" else float32
+    return (int64, dt[:, ::1], float64[:, ::1], int64[:, ::1], float64[:, ::1],
+            float64[:, :, ::1], float64[:, :, ::1], float64[:, :, ::1], float64[:, ::1],
+            int64[::1], float64[:, ::1], int64[:, ::1])
+
+
+def cuda_kernel(src: KernelSource, bindings: tuple[str, ...] = ("device", "njit")):
     """The generated code as a CUDA kernel ``kernel[blocks, threads](n_cases, P, PT, PI,
-    Y0, TK, TF, TFR, GS, CN, OF, OI)``: one case per thread (compiled on first launch;
-    numba's simulator under ``NUMBA_ENABLE_CUDASIM=1``)."""
+    Y0, TK, TF, TFR, GS, CN, OF, OI)``: one case per thread, compiled here for its one
+    signature (numba's simulator under ``NUMBA_ENABLE_CUDASIM=1``).  The law bindings
+    are tried in turn (see the module's docstring); the last error is raised when none
+    compiles."""
     from numba import cuda
 
     key = ("cuda", _digest(src), cuda_simulated())
@@ -143,8 +195,19 @@ def cuda_kernel(src: KernelSource):
         hit = _CACHE.get(key)
     if hit is not None:
         return hit
-    ns = _cuda_namespace(src)
-    kern = cuda.jit(ns["kernel"])
+    sig = kernel_signature(src.precision)
+    failed = []
+    for binding in bindings:
+        ns = _cuda_namespace(src, binding)
+        try:
+            kern = cuda.jit(sig)(ns["kernel"])
+        except Exception as exc:  # noqa: BLE001 - a binding this numba-cuda cannot type
+            failed.append(f"{binding}: {type(exc).__name__}: {str(exc)[:300]}")
+            if binding == bindings[-1]:
+                raise
+            continue
+        break
+    LAST_BINDING.update(binding=binding, failed=failed)
     with _LOCK:
         _CACHE.setdefault(key, kern)
     return kern
@@ -163,17 +226,14 @@ def ptx(src: KernelSource, cc: tuple[int, int] = (9, 0)) -> str:
     from types import SimpleNamespace
     from unittest import mock
 
-    from numba import cuda, float32, float64, int64, njit
+    from numba import cuda, njit
 
     ns = _namespace(src, literal_calls=True)
     ns["cuda"] = cuda
     for name in _functions(ns):
         ns[name] = njit(ns[name])
     exec(_CUDA_KERNEL.format(n_w=src.n_w, n_x=src.n_x, n_wi=src.n_wi), ns)
-    dt = float64 if src.precision == "fp64" else float32
-    sig = (int64, dt[:, ::1], float64[:, ::1], int64[:, ::1], float64[:, ::1],
-           float64[:, :, ::1], float64[:, :, ::1], float64[:, :, ::1], float64[:, ::1],
-           int64[::1], float64[:, ::1], int64[:, ::1])
+    sig = kernel_signature(src.precision)
     stand_in = SimpleNamespace(compute_capability=tuple(cc))
     with mock.patch("numba.cuda.dispatcher.get_current_device", lambda: stand_in):
         text, _ = cuda.compile_ptx(ns["kernel"], sig, cc=cc)

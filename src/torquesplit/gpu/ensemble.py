@@ -20,6 +20,7 @@ study output reads them): a GPU run's Solution has empty ``history_*`` arrays.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from dataclasses import dataclass, field
@@ -30,8 +31,8 @@ from torquesplit.errors import GpuUnsupportedError
 from torquesplit.solve import _kernels as kern
 from torquesplit.solve import kernel_data as kd
 
-from .compile import cpu_driver, cuda_available, cuda_kernel
-from .layout import CaseArrays, build_group, group_cases, unknown_fields
+from .compile import LAST_BINDING, cpu_driver, cuda_available, cuda_kernel
+from .layout import CaseArrays, IdentityMemo, build_group, group_cases, unknown_fields
 from .source import N_STAT, kernel_source
 
 __all__ = ["EnsembleResult", "case_arrays", "run_ensemble", "TARGETS", "PRECISIONS",
@@ -75,6 +76,9 @@ class EnsembleResult:
     """Sum over the cases of the RK4 steps they took."""
     lines: list[int] = field(default_factory=list)
     """Lines of generated source per pattern."""
+    law_binding: str = ""
+    """How the CUDA kernel called the laws ("device" functions or "njit" callees; see
+    :mod:`torquesplit.gpu.compile`); empty for the CPU target."""
 
 
 def check_supported(run) -> None:
@@ -97,7 +101,7 @@ def case_arrays(run) -> _Planned:
     check_supported(run)
     s = run.structure
     kw = run.integrate_kwargs
-    model = kd.kernel_model(s)
+    model = _kernel_model(s)
     unknown = unknown_fields(model)
     if unknown:
         raise GpuUnsupportedError(
@@ -119,6 +123,38 @@ def case_arrays(run) -> _Planned:
                       cap=int(sel.n_cycles_cap), groups=[list(g) for g in sel.groups],
                       blowup=BLOWUP, group_min=_group_min(kw, len(sel.groups)))
     return _Planned(case, sel, plan)
+
+
+_KERNEL_TABLES = IdentityMemo()
+
+
+#: KernelModel fields computed from the structure's phase tables (copies, corner nodes)
+_FROM_TABLES = ("stiffness_table", "force_table", "friction_table", "corner_ptr",
+                "corner_node")
+
+
+def _kernel_model(s):
+    """``kd.kernel_model(s)``, with what it computes from the phase tables (their copies,
+    the corner nodes) made once per structure table object: the cases of a study share
+    their tables (see :mod:`torquesplit.gpu.backend`), so they share these too, and
+    neither the copy (29 MB a case for Ji & Li's drive), the corner search nor the
+    layout's look at them is repeated.  The other inputs of the corner nodes (which
+    elements vary, spline components, tooth-friction rows, multi-value gaps) are
+    compared, not assumed."""
+    src = (s.stiffness_table, s.force_table, s.friction_table)
+    gaps = [np.ptp(s.gap_values[s.gap_ptr[e]:s.gap_ptr[e + 1]]) > 0 if
+            s.gap_ptr[e + 1] > s.gap_ptr[e] else False for e in range(len(s.gap_ptr) - 1)]
+    aux = b"|".join(np.ascontiguousarray(a).tobytes() for a in (
+        np.asarray(s.sp_el, dtype=np.int64), s.frequency > 0.0,
+        np.asarray(s.fr_el, dtype=np.int64), np.asarray(gaps, dtype=bool)))
+    hit = _KERNEL_TABLES.peek(src)
+    if hit is None or hit[0] != aux:
+        model = kd.kernel_model(s)
+        _KERNEL_TABLES.put(src, (aux, {f: getattr(model, f) for f in _FROM_TABLES}))
+        return model
+    small = {f: np.zeros(a.shape[:-1] + (1,)) for f, a in zip(
+        ("stiffness_table", "force_table", "friction_table"), src, strict=True)}
+    return kd.kernel_model(dataclasses.replace(s, **small))._replace(**hit[1])
 
 
 def _group_min(kw: dict, n_groups: int) -> np.ndarray:
@@ -203,6 +239,8 @@ def run_ensemble(runs, *, target: str = "cuda", precision: str = "fp64",
             t = time.perf_counter()
             fn = cuda_kernel(src) if target == "cuda" else cpu_driver(src)
             out.compile_time += time.perf_counter() - t
+            if target == "cuda":
+                out.law_binding = LAST_BINDING.get("binding", out.law_binding)
             out.lines.append(src.n_lines)
             t = time.perf_counter()
             OF, OI = _launch(fn, target, g, src, threads_per_block)

@@ -21,6 +21,9 @@ generated code reads exactly the numbers the CPU kernels read.
 from __future__ import annotations
 
 import hashlib
+import threading
+import weakref
+from collections import OrderedDict
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -73,6 +76,49 @@ def unknown_fields(model) -> list[str]:
     return [f for f in model._fields if f not in KNOWN_FIELDS]
 
 
+class IdentityMemo:
+    """Values computed once per tuple of array *objects* (checked by weak reference, so a
+    recycled ``id`` never hits).  A study's cases share their phase tables (the host
+    side of the GPU backend makes them share the objects; Ji & Li's drive has 14 MB of
+    tables a case): anything computed from a table is computed once, not once a case."""
+
+    def __init__(self, size: int = 64):
+        self._entries: OrderedDict = OrderedDict()
+        self._size = size
+        self._lock = threading.Lock()
+
+    def peek(self, arrays: tuple):
+        """The value kept for these very objects, or None."""
+        with self._lock:
+            hit = self._entries.get(tuple(id(a) for a in arrays))
+        if hit is not None and all(r() is a for r, a in zip(hit[0], arrays, strict=True)):
+            return hit[1]
+        return None
+
+    def put(self, arrays: tuple, value) -> None:
+        with self._lock:
+            self._entries[tuple(id(a) for a in arrays)] = ([weakref.ref(a) for a in arrays],
+                                                           value)
+            while len(self._entries) > self._size:
+                self._entries.popitem(last=False)
+
+    def get(self, arrays: tuple, compute):
+        """The value kept for these objects, else ``compute()`` (then kept)."""
+        value = self.peek(arrays)
+        if value is None:
+            value = compute()
+            self.put(arrays, value)
+        return value
+
+
+_HAS_FORCE = IdentityMemo()
+
+
+def has_force(m) -> np.ndarray:
+    """Elements with a force table (a meshing-in impact or friction force row)."""
+    return _HAS_FORCE.get((m.force_table,), lambda: np.any(m.force_table != 0.0, axis=1))
+
+
 def _gapped(m) -> np.ndarray:
     gp, gv = m.gap_ptr, m.gap_values
     return np.array([bool(np.any(gv[gp[e]:gp[e + 1]] > 0.0)) for e in range(len(gp) - 1)],
@@ -87,7 +133,7 @@ def pattern_key(case: CaseArrays) -> str:
     parts = [
         np.int64(m.inv_mass.shape[0]), np.int64(ne), m.element_kind, m.vr_ptr, m.vq_idx,
         m.vt_ptr, m.vt_el, m.gy_ptr, m.gy_idx, m.fs_ptr, m.fs_idx, m.frequency > 0.0,
-        np.any(m.force_table != 0.0, axis=1), _gapped(m), np.diff(m.gap_ptr), m.error_ptr,
+        has_force(m), _gapped(m), np.diff(m.gap_ptr), m.error_ptr,
         m.fr_el, m.fr_ptr, m.fr_dof, m.fr_row, m.sp_el, m.corner_ptr, m.corner_node,
         np.int64(m.stiffness_table.shape[1]), np.int64(m.friction_table.shape[1]),
         np.asarray(case.track, dtype=np.int64),
@@ -176,7 +222,7 @@ class Layout:
             fs_ptr=np.asarray(m.fs_ptr, dtype=np.int64),
             fs_col=np.asarray(m.fs_idx, dtype=np.int64),
             tv=np.flatnonzero(m.frequency > 0.0),
-            has_force=np.any(m.force_table != 0.0, axis=1), gapped=gapped,
+            has_force=has_force(m), gapped=gapped,
             n_gaps=np.diff(m.gap_ptr), error_ptr=np.asarray(m.error_ptr),
             err_el=np.asarray(m.err_el), fr_el=np.asarray(m.fr_el),
             fr_ptr=np.asarray(m.fr_ptr), fr_dof=np.asarray(m.fr_dof),
@@ -327,15 +373,22 @@ def build_group(cases: list[CaseArrays], indices: list[int], precision) -> Group
     n_c = len(indices)
     # table sets, de-duplicated (a case reads set PI[tset])
     sets: dict[bytes, int] = {}
+    by_object: dict[tuple, int] = {}  # cases that share the table objects: one look
     tset = np.zeros(n_c, dtype=np.int64)
     tables = []
     for k, i in enumerate(indices):
+        m = cases[i].model
+        ident = (id(m.stiffness_table), id(m.force_table), id(m.friction_table),
+                 m.gap_ptr.tobytes(), m.gap_values.tobytes())
+        if ident in by_object:  # the cases (and so the objects) live through this loop
+            tset[k] = by_object[ident]
+            continue
         t = _tables(L, cases[i])
         key = b"".join(np.ascontiguousarray(a, dtype=np.float64).tobytes() for a in t)
         if key not in sets:
             sets[key] = len(tables)
             tables.append(t)
-        tset[k] = sets[key]
+        tset[k] = by_object[ident] = sets[key]
     if len(tables) > 1:
         g.columns[("tset",)] = ("PI", len(rows_i))
         rows_i.append(tset)
