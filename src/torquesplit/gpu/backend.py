@@ -196,6 +196,8 @@ class GpuRunner:
         r["device"] = res.device
         if res.law_binding:
             r["law_binding"] = res.law_binding
+        if res.binding_errors:
+            r["law_binding_errors"] = res.binding_errors
         r["ensembles"] += 1
         r["cases"] += len(runs)
         r["kernel_time_s"] += res.kernel_time

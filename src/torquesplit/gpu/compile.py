@@ -186,8 +186,8 @@ def cuda_kernel(src: KernelSource, bindings: tuple[str, ...] = ("device", "njit"
     """The generated code as a CUDA kernel ``kernel[blocks, threads](n_cases, P, PT, PI,
     Y0, TK, TF, TFR, GS, CN, OF, OI)``: one case per thread, compiled here for its one
     signature (numba's simulator under ``NUMBA_ENABLE_CUDASIM=1``).  The law bindings
-    are tried in turn (see the module's docstring); the last error is raised when none
-    compiles."""
+    are tried in turn (see the module's docstring); where none compiles eagerly, the
+    first is left to compile at the first launch (which then raises numba's error)."""
     from numba import cuda
 
     key = ("cuda", _digest(src), cuda_simulated())
@@ -203,10 +203,11 @@ def cuda_kernel(src: KernelSource, bindings: tuple[str, ...] = ("device", "njit"
             kern = cuda.jit(sig)(ns["kernel"])
         except Exception as exc:  # noqa: BLE001 - a binding this numba-cuda cannot type
             failed.append(f"{binding}: {type(exc).__name__}: {str(exc)[:300]}")
-            if binding == bindings[-1]:
-                raise
             continue
         break
+    else:  # no eager compile worked: numba compiles at the first launch (or says why)
+        binding = f"{bindings[0]} (compiled at launch)"
+        kern = cuda.jit(_cuda_namespace(src, bindings[0])["kernel"])
     LAST_BINDING.update(binding=binding, failed=failed)
     with _LOCK:
         _CACHE.setdefault(key, kern)

@@ -79,6 +79,8 @@ class EnsembleResult:
     law_binding: str = ""
     """How the CUDA kernel called the laws ("device" functions or "njit" callees; see
     :mod:`torquesplit.gpu.compile`); empty for the CPU target."""
+    binding_errors: list[str] = field(default_factory=list)
+    """Why the bindings tried before it did not compile."""
 
 
 def check_supported(run) -> None:
@@ -241,6 +243,7 @@ def run_ensemble(runs, *, target: str = "cuda", precision: str = "fp64",
             out.compile_time += time.perf_counter() - t
             if target == "cuda":
                 out.law_binding = LAST_BINDING.get("binding", out.law_binding)
+                out.binding_errors = list(LAST_BINDING.get("failed", ()))
             out.lines.append(src.n_lines)
             t = time.perf_counter()
             OF, OI = _launch(fn, target, g, src, threads_per_block)
