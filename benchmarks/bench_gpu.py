@@ -210,6 +210,96 @@ def liu2021(quick: bool) -> dict:
     return {"run": True, **_study_part(spec, 4)}
 
 
+def agreement() -> dict:
+    """Device: where FP64 GPU results leave the CPU engine's, for the synthetic feature
+    runs of the device test (gyroscopic coupling, tooth friction, splines, multi-value
+    gaps, error sinusoids) and Ji & Li's drive.  Per run: the largest relative difference
+    of the end state and the cycle peaks over run lengths 1..12 ms, for each way the CUDA
+    kernel can bind the laws, and for the generated code compiled for the CPU with FMA
+    contraction (the GPU's rounding class; a measure of how far rounding alone moves a
+    run); then the GPU again with one feature switched off at a time (values only)."""
+    import dataclasses
+    import functools
+
+    import numpy as np
+
+    sys.path[:0] = [str(HERE.parent / "tests" / "gpu"), str(HERE.parent / "tests" / "solve")]
+    from gpu_cases import engine, example_run, feature_runs
+    from numba import njit
+
+    from torquesplit.gpu import compile as comp
+    from torquesplit.gpu import ensemble as ens
+    from torquesplit.solve import laws
+
+    ok, why = _device()
+    if not ok:
+        return {"run": False, "reason": why}
+
+    def diff(sol, ref):
+        out = {}
+        for f in ("y_final", "cycle_max"):
+            a, b = np.asarray(getattr(sol, f)), np.asarray(getattr(ref, f))
+            m = np.isfinite(a) & np.isfinite(b)
+            out[f] = (float(np.abs(a[m] - b[m]).max() / max(np.abs(b[m]).max(), 1e-300))
+                      if m.any() else None)
+        return out
+
+    def fma_driver(src):  # the generated code on the CPU, mul+add contracted to FMA
+        ns = comp._namespace(src)
+        for name in comp.LAWS:
+            ns[name] = njit(error_model="numpy", fastmath={"contract"})(
+                getattr(laws, name).py_func)
+        jit = njit(error_model="numpy", fastmath={"contract"})
+        for name in comp._functions(ns):
+            ns[name] = jit(ns[name])
+        exec(comp._CPU_DRIVER.format(n_w=src.n_w, n_x=src.n_x, n_wi=src.n_wi), ns)
+        return jit(ns["run_all"])
+
+    base = feature_runs()[:2] + feature_runs()[3:] + [example_run("ji_li_mill_drive", 0.012)]
+    rows = []
+    for ms in (1, 2, 4, 8, 12):
+        runs = [dataclasses.replace(r, duration=ms * 1e-3) for r in base]
+        refs = [engine(r) for r in runs]
+        variants = {"device": ("cuda", functools.partial(comp.cuda_kernel,
+                                                         bindings=("device",))),
+                    "njit": ("cuda", functools.partial(comp.cuda_kernel, bindings=("njit",))),
+                    "cpu_fma": ("cpu", fma_driver)}
+        for label, (target, maker) in variants.items():
+            saved = ens.cuda_kernel, ens.cpu_driver
+            try:
+                if target == "cuda":
+                    ens.cuda_kernel = maker
+                else:
+                    ens.cpu_driver = maker
+                res = ens.run_ensemble(runs, target=target)
+                for i, (sol, ref) in enumerate(zip(res.solutions, refs, strict=True)):
+                    rows.append({"ms": ms, "variant": label, "run": i, **diff(sol, ref)})
+            except Exception as exc:  # noqa: BLE001 - recorded
+                rows.append({"ms": ms, "variant": label, "error": f"{exc!r}"[:300]})
+            finally:
+                ens.cuda_kernel, ens.cpu_driver = saved
+        _log(f"agreement {ms} ms: {rows[-len(base):]}")
+    # one feature off at a time (run 0: every feature), 12 ms
+    r0 = dataclasses.replace(base[0], duration=0.012)
+    s0 = r0.structure
+    sp = np.array(s0.sp_par, dtype=float).reshape(-1, 6)
+    off = {"gyroscopic": {"gy_coef": np.zeros_like(s0.gy_coef)},
+           "tooth_friction": {"friction_table": np.zeros_like(s0.friction_table)},
+           "error_sinusoids": {"error_amplitude": np.zeros_like(s0.error_amplitude)},
+           "spline_friction": {"sp_par": np.where(np.arange(6) == 4, 0.0, sp).reshape(
+               np.shape(s0.sp_par))}}
+    features = {}
+    for name, change in off.items():
+        run = dataclasses.replace(r0, structure=dataclasses.replace(s0, **change))
+        try:
+            sol = ens.run_ensemble([run], target="cuda").solutions[0]
+            features[name] = diff(sol, engine(run))
+        except Exception as exc:  # noqa: BLE001
+            features[name] = {"error": f"{exc!r}"[:300]}
+        _log(f"agreement without {name}: {features[name]}")
+    return {"run": True, "rows": rows, "feature_off_run0_12ms": features}
+
+
 def setup() -> dict:
     """Host set-up per case (no device needed), one core."""
     import torquesplit
@@ -262,11 +352,13 @@ def main(argv=None) -> int:
         if part == "layout":
             result["layout"] = layout()
         elif part == "monte_carlo":
-            result["monte_carlo"] = monte_carlo(args.quick)
+            result["monte_carlo"] = _stamped(monte_carlo(args.quick))
         elif part == "liu2021":
-            result["liu2021"] = liu2021(args.quick)
+            result["liu2021"] = _stamped(liu2021(args.quick))
         elif part == "setup":
             result["setup"] = setup()
+        elif part == "agreement":
+            result["agreement"] = _stamped(agreement())
         else:
             ap.error(f"unknown part {part!r}")
         result.setdefault("part_dates", {})[part] = _dt.datetime.now().isoformat(
@@ -277,10 +369,20 @@ def main(argv=None) -> int:
     return 0
 
 
+def _stamped(part: dict) -> dict:
+    """A device part's results with where and when they were measured."""
+    if part.get("run"):
+        part.update(device=_device()[1], host=f"{platform.node()} ({os.cpu_count()} CPUs)",
+                    measured=_dt.datetime.now().isoformat(timespec="seconds"))
+    return part
+
+
 def _markdown(r: dict) -> str:
     lines = ["# GPU ensemble backend: measurements", "",
-             f"{r['date']} on {r['host']} ({r['cpus']} CPUs, load {r['load_average']}).",
-             f"Device: {r['device'] or 'none (' + str(r['device_missing_reason']) + ')'}.", ""]
+             f"Generated by benchmarks/bench_gpu.py; last run {r['date']} on {r['host']} "
+             f"({r['cpus']} CPUs, load {r['load_average']}), device there: "
+             f"{r['device'] or 'none (' + str(r['device_missing_reason']) + ')'}. Each part "
+             "keeps its last results and says where it ran.", ""]
     if r.get("part_dates"):
         lines += ["Parts last run: " + ", ".join(f"{k} {v}" for k, v in
                                                  r["part_dates"].items()) + ".", ""]
@@ -305,9 +407,12 @@ def _markdown(r: dict) -> str:
             lines.append(f"| {k} | {v['dof']} | {v['cases']} | {v['prepare_ms']:.1f} | "
                          f"{v['plan_ms']:.1f} | {v['prepare_ms'] + v['plan_ms']:.1f} |")
         lines.append("")
+    if r.get("device_notes"):
+        lines += ["## Device sessions", ""] + [f"- {n}" for n in r["device_notes"]] + [""]
     for part, target in (("monte_carlo", "design target: 10,000 cases <= 2 s end to end, "
                                          "kernel <= 0.6 s, >= 300x the 2-core CPU runner"),
-                         ("liu2021", "design target: 1,000 cases <= 60 s")):
+                         ("liu2021", "design target: 1,000 cases <= 60 s"),
+                         ("agreement", "FP64 against the CPU engine; see agreement()")):
         if part not in r:
             continue
         v = r[part]
@@ -315,7 +420,18 @@ def _markdown(r: dict) -> str:
         if not v.get("run"):
             lines += [f"Not run: {v.get('reason')}.", ""]
             continue
+        if v.get("device"):
+            lines += [f"Device: {v['device']}, measured {v.get('measured', '?')} (host: "
+                      f"{v.get('host', r['host'])}).", ""]
         lines += ["```json", json.dumps(v, indent=1, default=str), "```", ""]
+    tpb = r.get("threads_per_block")
+    if tpb:
+        lines += ["## Threads per block", "", f"{tpb['study']}; {tpb['device']}, measured "
+                  f"{tpb['measured']}.", "", "| precision | cases | threads/block | kernel [s] "
+                  "| sample-steps/s |", "|---|---|---|---|---|"]
+        lines += [f"| {x['precision']} | {x['cases']} | {x['tpb']} | {x['kernel_s']} | "
+                  f"{x['sample_steps_per_s']:.3g} |" for x in tpb["rows"]]
+        lines.append("")
     return "\n".join(lines) + "\n"
 
 

@@ -40,19 +40,89 @@ def test_kernel_compiles_to_ptx_without_a_device():
     assert "fma.rn.f64" in text or "mul.f64" in text
 
 
+def _mismatches(i, sol, ref) -> list[str]:
+    """Where a device Solution differs from the engine's by more than 1e-9 (every field;
+    for per-cycle fields the first differing cycle and tracked element)."""
+    out = []
+    if sol.status != ref.status or sol.n_steps != ref.n_steps:
+        return [f"run {i}: status/steps {sol.status}/{sol.n_steps} != {ref.status}/"
+                f"{ref.n_steps}"]
+    for f in ("cycle_max", "cycle_min", "cycle_mean", "cycle_ratio_max", "y_final"):
+        a, b = np.asarray(getattr(sol, f)), np.asarray(getattr(ref, f))
+        ok = np.isfinite(b)
+        if not np.array_equal(np.isfinite(a), ok):
+            out.append(f"run {i}: {f} finite at other places")
+            continue
+        scale = np.abs(b[ok]).max() if ok.any() else 0.0
+        bad = ok & ~np.isclose(np.where(ok, a, 0.0), np.where(ok, b, 0.0), rtol=1e-9,
+                               atol=1e-9 * scale)
+        if bad.any():
+            where = tuple(int(k) for k in np.argwhere(bad)[0])
+            out.append(f"run {i}: {f} differs at {bad.sum()} places, first {where}: "
+                       f"{a[where]!r} != {b[where]!r}")
+    return out
+
+
+#: run length of the synthetic feature runs on the device: their dynamics are sensitive
+#: to rounding (discontinuous spline law, grazing contacts): over 12 ms the generated
+#: code compiled for the CPU with FMA contraction, the GPU's rounding class, moves one
+#: of them by 30 % and the H200 moved another's last cycle peaks by up to O(1); over
+#: this length the FMA build agrees to 1e-12 (test_feature_runs_are_insensitive_...).
+FEATURE_LENGTH = 2e-3
+
+
+def short_feature_runs():
+    import dataclasses
+
+    return [dataclasses.replace(r, duration=FEATURE_LENGTH) for r in feature_runs()]
+
+
+def test_feature_runs_are_insensitive_to_rounding_over_the_device_length():
+    """The premise of the device test: compiled with FMA contraction (rounding as a GPU
+    rounds), the generated code agrees with the engine to 1e-12 on the feature runs at
+    the device test's length, so a larger device difference is an error, not rounding."""
+    from numba import njit
+
+    from torquesplit.gpu import compile as comp
+    from torquesplit.gpu import ensemble as ens
+    from torquesplit.solve import laws
+
+    def fma_driver(src):
+        ns = comp._namespace(src)
+        for name in comp.LAWS:
+            ns[name] = njit(error_model="numpy", fastmath={"contract"})(
+                getattr(laws, name).py_func)
+        jit = njit(error_model="numpy", fastmath={"contract"})
+        for name in comp._functions(ns):
+            ns[name] = jit(ns[name])
+        exec(comp._CPU_DRIVER.format(n_w=src.n_w, n_x=src.n_x, n_wi=src.n_wi), ns)
+        return jit(ns["run_all"])
+
+    runs = short_feature_runs()
+    saved = ens.cpu_driver
+    try:
+        ens.cpu_driver = fma_driver
+        res = ens.run_ensemble(runs, target="cpu")
+    finally:
+        ens.cpu_driver = saved
+    for i, (run, sol) in enumerate(zip(runs, res.solutions, strict=True)):
+        ref = engine(run)
+        assert sol.status == ref.status and sol.n_steps == ref.n_steps
+        for f in ("cycle_max", "y_final"):
+            a, b = np.asarray(getattr(sol, f)), np.asarray(getattr(ref, f))
+            ok = np.isfinite(b)
+            assert np.allclose(a[ok], b[ok], rtol=1e-12, atol=1e-12 * np.abs(b[ok]).max()), (
+                i, f)
+
+
 @pytest.mark.gpu
 @needs_device
 def test_gpu_equals_the_engine_to_1e_9():
-    runs = feature_runs() + [example_run("ji_li_mill_drive", 5e-3)]
+    runs = short_feature_runs() + [example_run("ji_li_mill_drive", 5e-3)]
     res = run_ensemble(runs, target="cuda")
-    for run, sol in zip(runs, res.solutions, strict=True):
-        ref = engine(run)
-        assert sol.status == ref.status and sol.n_steps == ref.n_steps
-        for f in ("cycle_max", "cycle_min", "cycle_mean", "cycle_ratio_max", "y_final"):
-            a, b = getattr(sol, f), getattr(ref, f)
-            ok = np.isfinite(b)
-            assert np.array_equal(np.isfinite(a), ok), f
-            assert np.allclose(a[ok], b[ok], rtol=1e-9, atol=1e-9 * np.abs(b[ok]).max()), f
+    problems = []
+    for i, (run, sol) in enumerate(zip(runs, res.solutions, strict=True)):
+        problems += _mismatches(i, sol, engine(run))
     run = runs[-1]
 
     def values(s):
@@ -61,5 +131,7 @@ def test_gpu_equals_the_engine_to_1e_9():
 
     a, b = values(res.solutions[-1]), values(engine(run))
     for k in b:
-        assert (math.isnan(a[k]) and math.isnan(b[k])) or abs(a[k] - b[k]) <= 1e-9 * max(
-            abs(b[k]), 1.0), k
+        if not ((math.isnan(a[k]) and math.isnan(b[k]))
+                or abs(a[k] - b[k]) <= 1e-9 * max(abs(b[k]), 1.0)):
+            problems.append(f"Ji & Li output {k}: {a[k]!r} != {b[k]!r}")
+    assert not problems, "\n".join(problems)

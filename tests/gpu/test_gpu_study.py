@@ -195,3 +195,31 @@ def test_workers_send_a_table_set_once_and_the_cases_share_it():
     assert not first.get("tables_stripped") and again["tables_stripped"]
     assert again["tables"] == first["tables"]
     assert again["run"].structure.stiffness_table.size == 0
+
+
+def test_a_device_whose_toolchain_cannot_compile_falls_back_with_the_reason(monkeypatch):
+    """Seen on an H200 machine: the driver sees the device, but numba-cuda cannot compile
+    (its typing registry needs ``np.row_stack``, gone in numpy 2.5).  The study must fall
+    back to the CPU runner naming that, not stop with a traceback in the kernel launch."""
+    from types import SimpleNamespace
+
+    from numba import cuda
+
+    import torquesplit.gpu.compile as compile_mod
+    from torquesplit.gpu.backend import make_gpu_runner
+
+    def broken_jit(*args, **kwargs):
+        raise AttributeError("module 'numpy' has no attribute 'row_stack'")
+
+    monkeypatch.setattr(cuda, "is_available", lambda: True)
+    monkeypatch.setattr(cuda, "get_current_device", lambda: SimpleNamespace(name=b"Fake GPU"))
+    monkeypatch.setattr(cuda, "jit", broken_jit)
+    monkeypatch.setattr(compile_mod, "_PROBE", {})
+    ok, why = compile_mod.cuda_available()
+    assert not ok
+    assert why.startswith("Fake GPU: numba-cuda cannot compile") and "row_stack" in why
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        assert make_gpu_runner() is None
+    msgs = [str(w.message) for w in caught if issubclass(w.category, GpuFallbackWarning)]
+    assert msgs and "row_stack" in msgs[0] and "CPU runner" in msgs[0]

@@ -261,8 +261,8 @@ def _bits_equal(a: np.ndarray, b: np.ndarray) -> bool:
         return False
     if a.size == 0:
         return True
-    if a.dtype.kind == "f" and a.flags.c_contiguous and b.flags.c_contiguous:
-        a, b = a.view(np.uint8), b.view(np.uint8)  # bit for bit (-0.0 is not 0.0)
+    if a.dtype == np.float64 and a.flags.c_contiguous and b.flags.c_contiguous:
+        a, b = a.view(np.int64), b.view(np.int64)  # bit for bit (-0.0 is not 0.0)
     return bool(a.flat[0] == b.flat[0]) and bool(np.array_equal(a, b))
 
 

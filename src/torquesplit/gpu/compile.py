@@ -190,11 +190,12 @@ def cuda_kernel(src: KernelSource, bindings: tuple[str, ...] = ("device", "njit"
     first is left to compile at the first launch (which then raises numba's error)."""
     from numba import cuda
 
-    key = ("cuda", _digest(src), cuda_simulated())
+    key = ("cuda", _digest(src), cuda_simulated(), tuple(bindings))
     with _LOCK:
         hit = _CACHE.get(key)
     if hit is not None:
-        return hit
+        LAST_BINDING.update(hit[1])
+        return hit[0]
     sig = kernel_signature(src.precision)
     failed = []
     for binding in bindings:
@@ -208,9 +209,10 @@ def cuda_kernel(src: KernelSource, bindings: tuple[str, ...] = ("device", "njit"
     else:  # no eager compile worked: numba compiles at the first launch (or says why)
         binding = f"{bindings[0]} (compiled at launch)"
         kern = cuda.jit(_cuda_namespace(src, bindings[0])["kernel"])
-    LAST_BINDING.update(binding=binding, failed=failed)
+    info = {"binding": binding, "failed": failed}
+    LAST_BINDING.update(info)
     with _LOCK:
-        _CACHE.setdefault(key, kern)
+        _CACHE.setdefault(key, (kern, info))
     return kern
 
 
@@ -248,8 +250,40 @@ def cuda_simulated() -> bool:
     return bool(config.ENABLE_CUDASIM)
 
 
+_PROBE: dict = {}
+
+
+def _probe_compile() -> str:
+    """Compile and run a one-line kernel once per process: an empty string when it works,
+    else why not.  A driver can see the device while numba-cuda cannot compile (seen on
+    an H200 machine: numba-cuda 0.30.4 with numpy 2.5 fails in its typing registry on
+    ``np.row_stack``), and a study should then fall back with that reason, not stop."""
+    if "why" not in _PROBE:
+        try:
+            from numba import cuda
+
+            @cuda.jit("void(float64[::1])")
+            def _twice(a):  # pragma: no cover - runs on the device
+                i = cuda.grid(1)
+                if i < a.shape[0]:
+                    a[i] = 2.0 * a[i]
+
+            d = cuda.to_device(np.ones(4))
+            _twice[1, 4](d)
+            ok = bool(np.all(d.copy_to_host() == 2.0))
+            _PROBE["why"] = "" if ok else "a test kernel gave wrong results"
+        except Exception as exc:  # noqa: BLE001 - any failure of the CUDA tool chain
+            import numpy
+
+            _PROBE["why"] = (f"numba-cuda cannot compile a kernel here ({type(exc).__name__}: "
+                             f"{str(exc)[:200]}; numpy {numpy.__version__}): install a "
+                             "numba-cuda that supports this numpy, or an older numpy")
+    return _PROBE["why"]
+
+
 def cuda_available() -> tuple[bool, str]:
-    """Whether a CUDA device (or numba's simulator) can run the kernels, and if not why."""
+    """Whether a CUDA device (or numba's simulator) can run the kernels, and if not why
+    (the device is opened and a one-line kernel compiled and run, once per process)."""
     try:
         from numba import cuda
     except Exception as exc:  # noqa: BLE001 - a broken CUDA installation
@@ -267,4 +301,7 @@ def cuda_available() -> tuple[bool, str]:
         name = dev.name.decode() if isinstance(dev.name, bytes) else str(dev.name)
     except Exception as exc:  # noqa: BLE001
         return False, f"the CUDA device cannot be opened ({type(exc).__name__}: {exc})"
+    why = _probe_compile()
+    if why:
+        return False, f"{name}: {why}"
     return True, name
