@@ -155,8 +155,10 @@ def rigid_body_modes(structure: Structure, active: np.ndarray | None = None,
     nominal torques balance.
     """
     s = structure
-    if active is None:
-        active = np.abs(s.stiffness_table).max(axis=1) > 0
+    if active is None:  # max and min: no temporary the size of the tables (14 MB for a
+        # hunting-period table set), which cost more than the rest of this function
+        k = s.stiffness_table
+        active = (k.max(axis=1) > 0) | (k.min(axis=1) < 0)
     active = np.asarray(active, dtype=bool).copy()
     d = np.sqrt(s.inv_mass)
     A = s.projection_matrix()[active] * d[None, :]
