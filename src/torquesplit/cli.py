@@ -21,7 +21,7 @@ from typing import Optional
 
 import typer
 from rich.console import Console
-from rich.table import Table
+from torquesplit._table import Table
 
 from . import cli_support as ux
 from .cli_support import header as _h

@@ -254,7 +254,7 @@ def render_step_check(check, rows: int = 12, printed: int = PRINTED_DIGITS,
     """How many significant digits of the numbers hold at half the step (harmonic
     balance: twice the harmonics): a summary and the least converged numbers (those
     holding fewer than the ``printed`` digits of the tables)."""
-    from rich.table import Table
+    from torquesplit._table import Table
 
     console = session().console
     table = check.rows()
@@ -355,7 +355,7 @@ def planet_sharing(load_sharing, kinematics):
 
 def planet_table(k, kinematics):
     """The planet table (K_gamma per stage, the factor per planet) as a rich Table."""
-    from rich.table import Table
+    from torquesplit._table import Table
 
     t = Table(title=f"planets (load sharing: {k.definition})")
     for i, col in enumerate(planet_header(k)):

@@ -100,7 +100,7 @@ def _num(x):
 def render_summary(s: dict, console) -> None:
     """Print the summary as rich tables (units in every header)."""
     from rich.markup import escape
-    from rich.table import Table
+    from torquesplit._table import Table
 
     console.print(f"[bold]{escape(s['model'])}[/]  {escape(s['description'])}")
     if s["reference"]:

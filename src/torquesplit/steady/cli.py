@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import Optional
 
 import typer
-from rich.table import Table
+from torquesplit._table import Table
 
 RPM = 60.0 / (2 * math.pi)
 

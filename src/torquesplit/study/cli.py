@@ -67,7 +67,7 @@ def study(
 
 
 def _list() -> None:
-    from rich.table import Table
+    from torquesplit._table import Table
 
     from .shipped import study_info, study_names
 
@@ -200,7 +200,7 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
                                                                     "[]"))
         print(json.dumps(data, indent=2))
         return
-    from rich.table import Table
+    from torquesplit._table import Table
 
     design = ds.attrs["design"]
     if design == "grid" and status.size <= MAX_TABLE_CASES:
@@ -313,7 +313,7 @@ def _grid_tables(ds, out_vars: list[str]) -> list[tuple[str, list[tuple[str, str
 def _grid_table(ds, title: str, columns: list[tuple[str, str]]):
     """One table of a grid's cases: the parameters, the ``columns`` and the status."""
     from rich.markup import escape
-    from rich.table import Table
+    from torquesplit._table import Table
 
     from .figures import _coord
 

@@ -473,6 +473,11 @@ class _Driver:
             state = "failed"
             again = (f"run it again with {self.words.resume_on}" if self.out else
                      "give an output folder to keep finished cases")
+            if type(exc).__name__ == "BrokenProcessPool" and _unguarded_script():
+                again = ("worker processes start by running your script "
+                         f"{_unguarded_script()!r} from the top, study call and all: put "
+                         "the code that runs the study under `if __name__ == \"__main__\":`"
+                         f" (or use workers=1), then {again}")
             raise StudyError("", f"the study stopped after {int(self.finished.sum())} cases: "
                                  f"{type(exc).__name__}: {exc}; every finished case is "
                                  f"saved, {again}") from exc
@@ -602,3 +607,13 @@ def dataset_from_store(plan: Plan, store: Store, n_used: int | None = None):
 
     n = plan.n_cases if n_used is None else n_used
     return build_dataset(plan, store.cases(below=n), n, store.meta())
+
+
+def _unguarded_script() -> str:
+    """The script run as ``__main__`` when it is a file (its worker processes re-run it:
+    a study or a file write at its top level then fails in every worker), else ''."""
+    import sys
+
+    main = sys.modules.get("__main__")
+    path = getattr(main, "__file__", None) or ""
+    return path if path.endswith(".py") else ""
