@@ -237,6 +237,9 @@ def quantity(text: Optional[str], kind: str, option: str) -> Optional[float]:
     if not math.isfinite(value):
         raise OptionError(f"{option} {text!r} is not a finite number; give e.g. {option} "
                           f"'{KINDS[kind][1]}'")
+    if kind == "speed" and value != 0.0:  # engineers write speeds in rpm
+        warn(f"{option} {text}: a bare number is a speed in rad/s ({value:g} rad/s = "
+             f"{value * 60.0 / (2.0 * math.pi):.6g} rpm); write '{text} rpm' for rpm")
     return value
 
 

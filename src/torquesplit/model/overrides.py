@@ -122,7 +122,21 @@ def apply_assignments(data: dict, assignments) -> tuple[dict, dict[str, str]]:
                       for loc, msg in exc.issues]
             raise ModelError(issues, exc.source or source) from None
         where[path] = text
+        if path.rsplit(".", 1)[-1] == "speed" and _bare_number(value):
+            import math
+            import warnings
+
+            from ..errors import ModelWarning
+
+            warnings.warn(ModelWarning(
+                f"--set {clip_text(text)}: a bare number is a speed in rad/s ({value:g} rad/s"
+                f" = {value * 60.0 / (2.0 * math.pi):.6g} rpm); write "
+                f"--set {path}='{value:g} rpm' for rpm"), stacklevel=2)
     return data, where
+
+
+def _bare_number(value) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and value != 0
 
 
 def path_of(text: str) -> str:

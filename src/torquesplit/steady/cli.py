@@ -24,6 +24,15 @@ def _speed(text, what):
     return quantity(text, "speed", what)
 
 
+def _speed_text(text) -> str:
+    """An option's speed as given, with its unit: a bare number is rad/s."""
+    try:
+        value = float(text)
+    except (TypeError, ValueError):
+        return str(text)
+    return f"{value:g} rad/s ({value * RPM:.6g} rpm)"
+
+
 def _check_out(path, formats=None, force=False):
     """Check an output path before computing (folder, suffix, an existing file: kept
     unless --force)."""
@@ -521,7 +530,8 @@ def campbell_command(m, start, stop, plot, as_json, console, json_default, out=N
             raise failed
         return
     phased = any("suppressed" in c for c in crossings)
-    t = Table(title=f"critical speeds between {start} and {stop}" + (
+    lo, hi = (_speed_text(x) for x in (start, stop))
+    t = Table(title=f"critical speeds between {lo} and {hi}" + (
         f" ({len(critical)} critical; {len(suppressed)} crossings that the planets' mesh "
         f"phasing leaves unexcited, Parker & Lin 2004, marked 'suppressed')" if phased
         else ""))

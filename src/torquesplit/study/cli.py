@@ -1,7 +1,7 @@
 """``torquesplit study`` and ``torquesplit sweep``: run a study from the command line.
 
 Registered on the main ``torquesplit`` app by :mod:`torquesplit.cli`.  Progress is a rich
-bar on stderr (cases done, failed, elapsed, remaining); the summary table goes to
+bar on stderr (cases done, not ok, elapsed, remaining); the summary table goes to
 stdout.  Bad input: one line naming the field, exit status 2, before any case runs.
 Ctrl-C: every finished case is already saved; one line says how to resume; status 130.
 """
@@ -19,9 +19,9 @@ import typer
 
 BACKEND_HELP = ("cpu (default) or gpu: integrate the cases as ensembles on a CUDA GPU, one "
                 "case per thread (falls back to the CPU with a warning when there is none).")
-PRECISION_HELP = ("GPU backend: fp64 (default; equal to the CPU engine under the CUDA "
-                  "simulator and in the kernels' CPU build, not yet measured on a GPU) or "
-                  "fp32 (its error against fp64 is reported).")
+PRECISION_HELP = ("GPU backend: fp64 (default; the CPU runner's values up to the GPU's "
+                  "rounding, see docs/studies.md) or fp32 (its error against fp64 is "
+                  "reported).")
 
 
 def _ui():
@@ -153,7 +153,7 @@ def _with_bar(job, total: int, quiet: bool):
 
     ui = _ui()
     with Progress(TextColumn("cases"), BarColumn(), MofNCompleteColumn(),
-                  TextColumn("[red]{task.fields[failed]} failed"), TimeElapsedColumn(),
+                  TextColumn("[red]{task.fields[failed]} not ok"), TimeElapsedColumn(),
                   TextColumn("ETA"), TimeRemainingColumn(), console=ui.err_console,
                   transient=False) as bar:
         task = bar.add_task("study", total=total, failed=0)

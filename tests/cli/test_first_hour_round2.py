@@ -1,0 +1,53 @@
+"""What a first-time user met (second first-hour review): speeds typed as bare numbers,
+a study run from an unguarded script."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+from typer.testing import CliRunner
+
+from torquesplit.cli import app
+
+SRC = Path(__file__).resolve().parents[2] / "src"
+
+
+def test_a_bare_campbell_speed_is_said_to_be_rad_s_and_titled_with_its_unit():
+    res = CliRunner().invoke(app, ["modes", "ji_li_mill_drive", "--campbell", "--from",
+                                   "2400", "--to", "40000 rpm"])
+    assert res.exit_code == 0, res.output
+    assert "--from 2400: a bare number is a speed in rad/s" in res.output
+    assert "22918.3 rpm" in res.output and "write '2400 rpm' for rpm" in res.output
+    assert "--to 40000 rpm:" not in res.output  # a speed with its unit is not questioned
+    assert "between 2400 rad/s (22918.3 rpm) and 40000 rpm" in " ".join(res.output.split())
+
+
+def test_a_bare_speed_in_set_is_said_to_be_rad_s():
+    res = CliRunner().invoke(app, ["check", "ji_li_mill_drive", "--set",
+                                   "drives.motor.speed=3000"])
+    assert "drives.motor.speed=3000: a bare number is a speed in rad/s" in res.output
+    assert "28647.9 rpm" in res.output
+    res = CliRunner().invoke(app, ["check", "ji_li_mill_drive", "--set",
+                                   "drives.motor.speed='3000 rpm'"])
+    assert "a bare number is a speed" not in res.output
+
+
+def test_a_study_from_an_unguarded_script_says_to_guard_it(tmp_path):
+    script = tmp_path / "snip.py"
+    script.write_text(
+        "import torquesplit\n"
+        "open('marker.txt', 'x').write('x')  # a top-level action a worker repeats\n"
+        "spec = {'study': {'name': 's', 'model': 'ji_li_mill_drive',\n"
+        "                  'outputs': ['load_sharing.engineering']},\n"
+        "        'analysis': {'duration': '0.01 s'},\n"
+        "        'grid': {'parameters': [{'path': 'meshes.m11.damping_ratio',\n"
+        "                                 'values': [0.05, 0.1]}]}}\n"
+        "torquesplit.run_study(spec, workers=2, out='out')\n")
+    proc = subprocess.run([sys.executable, str(script)], cwd=tmp_path, capture_output=True,
+                          text=True, timeout=600, env={"PYTHONPATH": str(SRC),
+                                                       "PATH": "/usr/bin:/bin"})
+    assert proc.returncode != 0
+    assert "if __name__ == \"__main__\":" in proc.stderr
+    assert str(script) in proc.stderr
