@@ -51,3 +51,26 @@ def test_a_study_from_an_unguarded_script_says_to_guard_it(tmp_path):
     assert proc.returncode != 0
     assert "if __name__ == \"__main__\":" in proc.stderr
     assert str(script) in proc.stderr
+
+
+def test_a_misspelt_sweep_output_is_reported_against_output(tmp_path):
+    res = CliRunner().invoke(app, ["sweep", "ji_li_mill_drive", "--vary",
+                                   "meshes.m11.damping_ratio=0.05:0.1:2", "--output",
+                                   "load_sharing.enginering", "--duration", "0.01 s",
+                                   "--out", str(tmp_path / "s")])
+    assert res.exit_code == 2
+    assert "--output: 'load_sharing.enginering' matches no output" in res.output
+    assert "study.outputs" not in res.output
+
+
+def test_a_finished_study_folder_holds_no_lock_file(tmp_path):
+    import torquesplit
+
+    spec = {"study": {"name": "s", "model": "ji_li_mill_drive",
+                      "outputs": ["load_sharing.engineering"]},
+            "analysis": {"duration": "0.01 s"},
+            "grid": {"parameters": [{"path": "meshes.m11.damping_ratio", "values": [0.1]}]}}
+    torquesplit.run_study(spec, workers=1, out=tmp_path / "s")
+    assert (tmp_path / "s" / "results.nc").exists()
+    assert not (tmp_path / "s" / "study.lock").exists()
+    torquesplit.run_study(spec, workers=1, out=tmp_path / "s", resume=True)  # still works

@@ -140,6 +140,8 @@ def _run(source, *, workers, scheduler, out, resume, overwrite, figures, quiet, 
                 "grid.parameters.0"):
             sub = field[len("grid.parameters.0"):].lstrip(".")
             exc = StudyError(f"{flag}" + (f" ({sub})" if sub else ""), exc.reason)
+        elif flag and isinstance(exc, StudyError) and field == "study.outputs":
+            exc = StudyError("--output", exc.reason)  # the sweep's words, not the study's
         ui._fail(exc)
         return
     _summary(ds, Path(out), as_json, figures)

@@ -72,7 +72,13 @@ class StoreLock:
         self.file.flush()
 
     def release(self) -> None:
+        """Remove the lock file (still holding the lock) and let go: a finished study
+        folder holds no stale ``study.lock``."""
         if not self.file.closed:
+            try:
+                self.path.unlink()
+            except OSError:
+                pass
             self.file.close()
 
 
