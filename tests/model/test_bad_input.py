@@ -234,7 +234,7 @@ CASES = [
     ("infinite module", setting("gears.pinion.module", "inf mm"),
      "gears.pinion.module", r"not a finite number; write a length"),
     ("number with a unit missing", setting("gears.pinion.face_width", "20"),
-     "gears.pinion.face_width", r"'20' is not a length.*add the unit, e.g\. '20 um'"),
+     "gears.pinion.face_width", r"'20' is not a length.*add its unit: '20 mm', '20 um' or '20 m'"),
     ("stiffness table phase outside a cycle",
      setting("meshes.m.stiffness", {"method": "table", "phase": [0, 1.5],
                                     "values": ["4e8 N/m", "3e8 N/m"]}),

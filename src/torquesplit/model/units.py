@@ -129,7 +129,9 @@ def _parse_string(text: str, kind: str) -> float:
     ref = _reference(kind)
     if q.dimensionality != ref.dimensionality:
         if _is_number(text):  # (text is at most MAX_QUANTITY_CHARS long)
-            fix = f"add the unit, e.g. '{text.strip()} {example.split(' ', 1)[1]}'"
+            n = text.strip()
+            fix = (f"add its unit: '{n} mm', '{n} um' or '{n} m'" if kind == "length"
+                   else f"add the unit, e.g. '{n} {example.split(' ', 1)[1]}'")
         else:
             fix = f"write it in {si_unit} or a compatible unit, e.g. '{example}'"
         raise ValueError(
