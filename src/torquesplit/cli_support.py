@@ -137,6 +137,7 @@ def progress(label: str, quiet: bool = False, *, total: Optional[float] = 1.0):
                if total is None else
                [TextColumn("{task.description}"), BarColumn(),
                 TextColumn("{task.percentage:>3.0f}%"), TimeRemainingColumn()])
+    columns.append(_compile_hint_column())
     with Progress(*columns, console=con, transient=True) as bar:
         task = bar.add_task(label, total=total)
 
@@ -149,6 +150,27 @@ def progress(label: str, quiet: bool = False, *, total: Optional[float] = 1.0):
             bar.update(task, **kwargs)
 
         yield update
+
+
+#: seconds without progress after which a bar says that a first run compiles
+COMPILE_HINT_AFTER = 4.0
+
+
+def _compile_hint_column():
+    from rich.progress import ProgressColumn
+    from rich.text import Text
+
+    class CompileHint(ProgressColumn):
+        """A bar that has not moved for a few seconds says why it may not: the first run
+        on a machine compiles the numba kernels (about 20 s; cached for later runs)."""
+
+        def render(self, task):
+            if task.completed == 0 and (task.elapsed or 0.0) > COMPILE_HINT_AFTER:
+                return Text("(a first run also compiles the kernels: about 20 s, once)",
+                            style="dim")
+            return Text("")
+
+    return CompileHint()
 
 
 class Interrupted(Exception):

@@ -74,3 +74,15 @@ def test_a_finished_study_folder_holds_no_lock_file(tmp_path):
     assert (tmp_path / "s" / "results.nc").exists()
     assert not (tmp_path / "s" / "study.lock").exists()
     torquesplit.run_study(spec, workers=1, out=tmp_path / "s", resume=True)  # still works
+
+
+def test_a_bar_that_has_not_moved_says_a_first_run_compiles():
+    from types import SimpleNamespace
+
+    from torquesplit.cli_support import COMPILE_HINT_AFTER, _compile_hint_column
+
+    col = _compile_hint_column()
+    assert "compiles the kernels" in col.render(
+        SimpleNamespace(completed=0, elapsed=COMPILE_HINT_AFTER + 1)).plain
+    assert col.render(SimpleNamespace(completed=0, elapsed=1.0)).plain == ""
+    assert col.render(SimpleNamespace(completed=0.3, elapsed=60.0)).plain == ""
