@@ -86,3 +86,19 @@ def test_a_bar_that_has_not_moved_says_a_first_run_compiles():
         SimpleNamespace(completed=0, elapsed=COMPILE_HINT_AFTER + 1)).plain
     assert col.render(SimpleNamespace(completed=0, elapsed=1.0)).plain == ""
     assert col.render(SimpleNamespace(completed=0.3, elapsed=60.0)).plain == ""
+
+
+def test_a_critical_speed_printed_once_even_when_two_crossings_share_it():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from torquesplit.steady.plot import _critical_labels
+
+    fig, ax = plt.subplots()
+    _critical_labels(ax, [2483.2, 2483.4, 2632.1, 2632.3, 3100.0], 2000.0, 3500.0)
+    texts = [t.get_text() for t in ax.texts]
+    plt.close(fig)
+    assert sorted(texts) == ["2483", "2632", "3100"]
+    assert len(ax.lines) == 5  # every crossing keeps its line

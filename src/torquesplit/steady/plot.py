@@ -262,9 +262,13 @@ def _critical_labels(ax, crit, lo, hi) -> int:
     rows used."""
     width_pt = ax.figure.get_figwidth() * 72 * 0.8  # about the axes' width
     last: list[float] = []
-    for i, c in enumerate(crit):
+    said: set[str] = set()  # two crossings at one printed speed (a degenerate pair of
+    for i, c in enumerate(crit):  # modes, two lines of one frequency): one label
         ax.axvline(c, color="0.35", lw=0.6, ls=":",
                    label="critical speed (a crossing)" if i == 0 else None)
+        if f"{c:.0f}" in said:
+            continue
+        said.add(f"{c:.0f}")
         x = (c - lo) / max(hi - lo, 1e-12) * width_pt
         row = next((r for r, p in enumerate(last) if x - p >= CRITICAL_GAP), None)
         if row is None and len(last) < CRITICAL_ROWS:
