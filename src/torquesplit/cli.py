@@ -40,8 +40,11 @@ class _Command(typer.core.TyperCommand):
     def get_params(self, ctx):
         params = super().get_params(ctx)
         for p in params:
-            if isinstance(p, typer.core.TyperArgument) and p.metavar:
+            if isinstance(p, typer.core.TyperArgument):
+                p.metavar = p.metavar or p.name.upper()  # STUDY_FILE, not study_file <str>
                 p.display_type_rich = lambda ctx: None  # the metavar says it
+            elif isinstance(p, typer.core.TyperOption) and p.is_flag and not p.metavar:
+                p.metavar = ""  # a flag takes no value: no <bool>
         return params
 
 
