@@ -165,12 +165,17 @@ def test_cases_set_up_in_worker_processes_give_the_same_dataset():
         GpuRunner(workers=0)
 
 
-def test_workers_send_a_table_set_once_and_the_cases_share_it():
+def test_workers_send_a_table_set_once_and_the_cases_share_it(monkeypatch):
     """Ji & Li's cases carry 14 MB of phase tables each; a pool worker sends a table set
     the first time and then runs without it, and the runner puts the one set back: every
     case then holds the same object, bit for bit the tables it would have had."""
+    from collections import OrderedDict
+
+    from torquesplit.gpu import backend
     from torquesplit.gpu.backend import TABLES, _Job, prepare_case
     from torquesplit.study.case import payload
+
+    monkeypatch.setattr(backend, "_SENT", OrderedDict())  # this process as a fresh worker
 
     spec = {**GRID, "analysis": {"duration": "0.01 s"},
             "grid": {"parameters": [{"path": "meshes.m11.damping_ratio",
@@ -223,3 +228,23 @@ def test_a_device_whose_toolchain_cannot_compile_falls_back_with_the_reason(monk
         assert make_gpu_runner() is None
     msgs = [str(w.message) for w in caught if issubclass(w.category, GpuFallbackWarning)]
     assert msgs and "row_stack" in msgs[0] and "CPU runner" in msgs[0]
+
+
+def test_batches_shrink_where_every_case_has_its_own_tables():
+    """A stiffness Monte Carlo gives every case its own 14 MB table set (three copies on
+    the host): the batch is sized to TABLE_BUDGET, after a first batch of FIRST_BATCH."""
+    from torquesplit.gpu import backend
+    from torquesplit.gpu.backend import FIRST_BATCH, TABLE_BUDGET
+
+    runner = GpuRunner(target="cpu")
+    assert runner._next_size() == runner.batch  # nothing measured: the full batch
+    runner._case_bytes = 3 * 14.7e6 / 4  # four cases to a set
+    assert runner._next_size() == int(TABLE_BUDGET // runner._case_bytes) == 194
+    runner._case_bytes = 1e12
+    assert runner._next_size() == FIRST_BATCH
+    runner._case_bytes = 3 * 14.7e6 / 1000  # one set shared by a thousand cases
+    assert runner._next_size() == runner.batch
+    kept = backend.OrderedDict()
+    for k in range(20):
+        backend._remember(kept, f"set{k}", k)
+    assert list(kept) == [f"set{k}" for k in range(20 - backend.KEPT_SETS, 20)]

@@ -455,9 +455,12 @@ def _assemble(model: Model, kin: Kinematics | None, *, n_table: int | None,
         torque_fluctuation_elements=[el["name"] for el in elements
                                      if ".fluctuation" in el["name"]],
     )
-    return build_structure(dmap.names, inv_mass, elements, external_force=ext,
-                           ground_damping=ground, gyroscopic=gyroscopic,
-                           frame_stiffness=frame_stiffness, n_table=n_table, metadata=meta)
+    from .tables import share_tables
+
+    return share_tables(build_structure(dmap.names, inv_mass, elements, external_force=ext,
+                                        ground_damping=ground, gyroscopic=gyroscopic,
+                                        frame_stiffness=frame_stiffness, n_table=n_table,
+                                        metadata=meta))
 
 
 def _bearing_seat(model: Model, dmap: DofMap, body: str, on: str | None,

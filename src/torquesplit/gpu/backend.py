@@ -34,6 +34,9 @@ from collections import OrderedDict
 
 import numpy as np
 
+from ..assembly.tables import TABLES as _TABLE_FIELDS
+from .layout import IdentityMemo
+
 log = logging.getLogger(__name__)
 
 BATCH = 16384
@@ -62,6 +65,12 @@ def check_plan(plan) -> None:
             f"adaptive time stepping (the model's [analysis] method = "
             f"{plan.model.analysis.method!r})",
             "set [analysis] method = \"rk4\" in the study, or use the CPU backend")
+
+
+#: cases in a study's first batch (its tables' memory a case is not known yet)
+FIRST_BATCH = 64
+#: host memory for the distinct phase tables of one batch [bytes]
+TABLE_BUDGET = 2 * 1024**3
 
 
 class GpuRunner:
@@ -102,7 +111,7 @@ class GpuRunner:
             raise ValueError(f"workers must be >= 1, got {workers}; give e.g. workers=4")
         self.workers = int(workers)
         self._pool = None
-        self._tables: dict[str, tuple] = {}  # phase tables the pool's workers sent
+        self._tables: OrderedDict = OrderedDict()  # table sets workers sent (bounded)
         self.device = ""
         self.report: dict = {"backend": "gpu", "target": target, "precision": precision,
                              "cases": 0, "ensembles": 0, "kernel_time_s": 0.0,
@@ -116,19 +125,21 @@ class GpuRunner:
     # ----------------------------------------------------------------- runner protocol
     def __call__(self, function, payloads):
         batch: list[dict] = []
+        size = min(self.batch, FIRST_BATCH)  # until the tables' memory a case is known
         try:
             for p in payloads:
                 batch.append(p)
-                if len(batch) >= self.batch:
+                if len(batch) >= size:
                     yield from self._run_batch(batch)
                     batch = []
+                    size = self._next_size()
             if batch:
                 yield from self._run_batch(batch)
         finally:
             if self._pool is not None:
                 self._pool.shutdown(wait=False, cancel_futures=True)
                 self._pool = None
-                self._tables = {}
+                self._tables = OrderedDict()
 
     def _prepare(self, jobs: list["_Job"], first: bool) -> None:
         """Set the jobs' next runs up, in a process pool when ``workers`` > 1."""
@@ -161,11 +172,14 @@ class GpuRunner:
             key = res.get("tables")
             if key and not res.get("tables_stripped"):
                 s = res["run"].structure
-                kept = self._tables.setdefault(key, tuple(getattr(s, f) for f in TABLES))
+                kept = self._tables.get(key) or tuple(getattr(s, f) for f in TABLES)
+                _remember(self._tables, key, kept)
                 res["run"] = _with_tables(res["run"], kept)
         for k, res in enumerate(results):
             if res.get("tables_stripped"):
                 kept = self._tables.get(res["tables"])
+                if kept is not None:
+                    _remember(self._tables, res["tables"], kept)
                 results[k] = (prepare_case(*args[k]) if kept is None
                               else {**res, "run": _with_tables(res["run"], kept)})
 
@@ -183,8 +197,29 @@ class GpuRunner:
             if ready:
                 self._integrate(ready)
             active = [j for j in active if not j.finished]
+        self._measure_tables(jobs)
         for job in jobs:
             yield job.result()
+
+    def _measure_tables(self, jobs: list["_Job"]) -> None:
+        """Host memory of the distinct phase-table sets of a batch, per case: each
+        distinct set is held by the structure, copied into the kernel model and stacked
+        into the launch (about three times its size)."""
+        sets = {}
+        for j in jobs:
+            if j.run is not None:
+                s = j.run.structure
+                sets[id(s.stiffness_table)] = sum(getattr(s, f).nbytes for f in TABLES)
+        if jobs:
+            self._case_bytes = 3.0 * sum(sets.values()) / len(jobs)
+
+    def _next_size(self) -> int:
+        """Cases in the next batch: the runner's ``batch``, fewer where the cases' own
+        phase tables would hold more than TABLE_BUDGET (a stiffness Monte Carlo of Ji &
+        Li's drive: 44 MB a case)."""
+        per = getattr(self, "_case_bytes", 0.0)
+        fit = int(TABLE_BUDGET // per) if per > 0 else self.batch
+        return max(min(self.batch, FIRST_BATCH), min(self.batch, fit))
 
     def _integrate(self, jobs: list["_Job"]) -> None:
         from .ensemble import run_ensemble
@@ -245,10 +280,14 @@ class GpuRunner:
 
 
 #: the structure's phase tables over one excitation period (the bulk of a prepared run:
-#: 14 MB for Ji & Li's drive, whose period is a hunting period of 65,536 samples)
-TABLES = ("stiffness_table", "force_table", "friction_table")
-_SEEN: OrderedDict = OrderedDict()  # this process's table sets: key -> arrays
-_SENT: set = set()  # keys whose tables this worker has sent to the runner
+#: 14 MB for Ji & Li's drive, whose period is a hunting period of 65,536 samples); the
+#: cases of one process share equal sets (torquesplit.assembly.tables)
+TABLES = _TABLE_FIELDS
+#: table sets a worker remembers having sent, and the runner keeps to give back (the same
+#: bound: a worker that strips a set the runner no longer has costs a set-up here, no error)
+KEPT_SETS = 8
+_SENT: OrderedDict = OrderedDict()  # keys of the sets this worker has sent (recent last)
+_KEYS = IdentityMemo()
 
 
 def _with_tables(run, tables: tuple):
@@ -256,34 +295,25 @@ def _with_tables(run, tables: tuple):
     return dataclasses.replace(run, structure=s)
 
 
-def _bits_equal(a: np.ndarray, b: np.ndarray) -> bool:
-    if a.shape != b.shape or a.dtype != b.dtype:
-        return False
-    if a.size == 0:
-        return True
-    if a.dtype == np.float64 and a.flags.c_contiguous and b.flags.c_contiguous:
-        a, b = a.view(np.int64), b.view(np.int64)  # bit for bit (-0.0 is not 0.0)
-    return bool(a.flat[0] == b.flat[0]) and bool(np.array_equal(a, b))
+def _table_key(run) -> str:
+    """A digest of the run's table set (computed once per set object)."""
+    current = tuple(getattr(run.structure, f) for f in TABLES)
+
+    def digest():
+        h = hashlib.blake2b(digest_size=16)
+        for a in current:
+            h.update(str((a.dtype, a.shape)).encode())
+            h.update(np.ascontiguousarray(a).tobytes())
+        return h.hexdigest()
+
+    return _KEYS.get(current, digest)
 
 
-def _share_tables(run) -> tuple[object, str]:
-    """``run`` with its phase tables replaced by an equal (bit for bit) set this process
-    has seen, so that cases share one object, and the set's key."""
-    s = run.structure
-    current = tuple(getattr(s, f) for f in TABLES)
-    for key, seen in _SEEN.items():
-        if all(_bits_equal(a, b) for a, b in zip(current, seen, strict=True)):
-            _SEEN.move_to_end(key)
-            return _with_tables(run, seen), key
-    h = hashlib.blake2b(digest_size=16)
-    for a in current:
-        h.update(str((a.dtype, a.shape)).encode())
-        h.update(np.ascontiguousarray(a).tobytes())
-    key = h.hexdigest()
-    _SEEN[key] = current
-    while len(_SEEN) > 8:
-        _SEEN.popitem(last=False)
-    return run, key
+def _remember(kept: OrderedDict, key, value=True) -> None:
+    kept[key] = value
+    kept.move_to_end(key)
+    while len(kept) > KEPT_SETS:
+        kept.popitem(last=False)
 
 
 def prepare_case(p: dict, length: float | None = None, worker: bool = False) -> dict:
@@ -292,8 +322,8 @@ def prepare_case(p: dict, length: float | None = None, worker: bool = False) -> 
     in a pool worker: ``{run, status, reason, warnings, full, length, tables}``.  With a
     settle rule, ``length`` is the run length of this round (None: the first, which is
     computed here, with ``full``, the cap of the rule); errors become statuses, as in
-    run_case.  Cases with equal phase tables share one table object (``tables``: the
-    set's key); a ``worker`` sends a set once and then runs without it
+    run_case.  Cases with equal phase tables share one table object (the assembly does
+    it); a ``worker`` sends a set once (``tables``: its key) and then runs without it
     (``tables_stripped``; :meth:`GpuRunner._attach_tables` puts them back)."""
     from ..errors import SolverError, TorquesplitError
     from ..model.io import load_model, model_from_dict
@@ -325,13 +355,12 @@ def prepare_case(p: dict, length: float | None = None, worker: bool = False) -> 
         except Exception as exc:  # noqa: BLE001 - recorded, the study goes on
             out.update(status="error", reason=f"{type(exc).__name__}: {_one_line(exc)}")
     out["warnings"] = [_one_line(w.message) for w in caught]
-    if out["run"] is not None:
-        out["run"], out["tables"] = _share_tables(out["run"])
-        if worker and out["tables"] in _SENT:
+    if out["run"] is not None and worker:
+        out["tables"] = key = _table_key(out["run"])
+        if key in _SENT:
             empty = tuple(np.zeros((0, 0)) for _ in TABLES)
             out["run"], out["tables_stripped"] = _with_tables(out["run"], empty), True
-        elif worker:
-            _SENT.add(out["tables"])
+        _remember(_SENT, key)
     return out
 
 
