@@ -225,11 +225,9 @@ def agreement() -> dict:
 
     sys.path[:0] = [str(HERE.parent / "tests" / "gpu"), str(HERE.parent / "tests" / "solve")]
     from gpu_cases import engine, example_run, feature_runs
-    from numba import njit
 
     from torquesplit.gpu import compile as comp
     from torquesplit.gpu import ensemble as ens
-    from torquesplit.solve import laws
 
     ok, why = _device()
     if not ok:
@@ -244,16 +242,8 @@ def agreement() -> dict:
                       if m.any() else None)
         return out
 
-    def fma_driver(src):  # the generated code on the CPU, mul+add contracted to FMA
-        ns = comp._namespace(src)
-        for name in comp.LAWS:
-            ns[name] = njit(error_model="numpy", fastmath={"contract"})(
-                getattr(laws, name).py_func)
-        jit = njit(error_model="numpy", fastmath={"contract"})
-        for name in comp._functions(ns):
-            ns[name] = jit(ns[name])
-        exec(comp._CPU_DRIVER.format(n_w=src.n_w, n_x=src.n_x, n_wi=src.n_wi), ns)
-        return jit(ns["run_all"])
+    # the generated code on the CPU with mul+add contracted to FMA (the GPU's rounding)
+    fma_driver = functools.partial(comp.cpu_driver, contract=True)
 
     base = feature_runs()[:2] + feature_runs()[3:] + [example_run("ji_li_mill_drive", 0.012)]
     rows = []

@@ -81,22 +81,12 @@ def test_feature_runs_are_insensitive_to_rounding_over_the_device_length():
     """The premise of the device test: compiled with FMA contraction (rounding as a GPU
     rounds), the generated code agrees with the engine to 1e-12 on the feature runs at
     the device test's length, so a larger device difference is an error, not rounding."""
-    from numba import njit
+    import functools
 
     from torquesplit.gpu import compile as comp
     from torquesplit.gpu import ensemble as ens
-    from torquesplit.solve import laws
 
-    def fma_driver(src):
-        ns = comp._namespace(src)
-        for name in comp.LAWS:
-            ns[name] = njit(error_model="numpy", fastmath={"contract"})(
-                getattr(laws, name).py_func)
-        jit = njit(error_model="numpy", fastmath={"contract"})
-        for name in comp._functions(ns):
-            ns[name] = jit(ns[name])
-        exec(comp._CPU_DRIVER.format(n_w=src.n_w, n_x=src.n_x, n_wi=src.n_wi), ns)
-        return jit(ns["run_all"])
+    fma_driver = functools.partial(comp.cpu_driver, contract=True)
 
     runs = short_feature_runs()
     saved = ens.cpu_driver

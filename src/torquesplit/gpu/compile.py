@@ -146,19 +146,24 @@ def _cuda_namespace(src: KernelSource, binding: str = "device") -> dict:
     return ns
 
 
-def cpu_driver(src: KernelSource):
+def cpu_driver(src: KernelSource, contract: bool = False):
     """The generated code compiled with numba for the CPU: ``run_all(n_cases, P, PT, PI,
     Y0, TK, TF, TFR, GS, CN, OF, OI)`` runs every case in turn (the reference the CUDA
-    kernel is tested against; not a fast path)."""
+    kernel is tested against; not a fast path).  ``contract``: multiply-adds fused, as a
+    GPU compiles them (the laws too): how far rounding of the GPU's kind moves a run."""
     from numba import njit
 
-    key = ("cpu", _digest(src))
+    key = ("cpu", _digest(src), contract)
     with _LOCK:
         hit = _CACHE.get(key)
     if hit is not None:
         return hit
     ns = _namespace(src)
-    jit = njit(error_model="numpy")
+    flags = {"error_model": "numpy"} | ({"fastmath": {"contract"}} if contract else {})
+    if contract:
+        for name in LAWS:
+            ns[name] = njit(**flags)(getattr(laws, name).py_func)
+    jit = njit(**flags)
     for name in _functions(ns):
         ns[name] = jit(ns[name])
     exec(_CPU_DRIVER.format(n_w=src.n_w, n_x=src.n_x, n_wi=src.n_wi), ns)
