@@ -245,6 +245,7 @@ def test_batches_shrink_where_every_case_has_its_own_tables():
     runner._case_bytes = 3 * 14.7e6 / 1000  # one set shared by a thousand cases
     assert runner._next_size() == runner.batch
     kept = backend.OrderedDict()
-    for k in range(20):
+    for k in range(40):
         backend._remember(kept, f"set{k}", k)
-    assert list(kept) == [f"set{k}" for k in range(20 - backend.KEPT_SETS, 20)]
+    assert list(kept) == [f"set{k}" for k in range(40 - backend.RUNNER_SETS, 40)]
+    assert backend.WORKER_SETS < backend.RUNNER_SETS  # a worker strips only what we keep

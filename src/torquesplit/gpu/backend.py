@@ -112,6 +112,7 @@ class GpuRunner:
         self.workers = int(workers)
         self._pool = None
         self._tables: OrderedDict = OrderedDict()  # table sets workers sent (bounded)
+        self._case_bytes = 0.0  # host memory of a case's own tables (measured per batch)
         self.device = ""
         self.report: dict = {"backend": "gpu", "target": target, "precision": precision,
                              "cases": 0, "ensembles": 0, "kernel_time_s": 0.0,
@@ -217,7 +218,7 @@ class GpuRunner:
         """Cases in the next batch: the runner's ``batch``, fewer where the cases' own
         phase tables would hold more than TABLE_BUDGET (a stiffness Monte Carlo of Ji &
         Li's drive: 44 MB a case)."""
-        per = getattr(self, "_case_bytes", 0.0)
+        per = self._case_bytes
         fit = int(TABLE_BUDGET // per) if per > 0 else self.batch
         return max(min(self.batch, FIRST_BATCH), min(self.batch, fit))
 
@@ -283,9 +284,10 @@ class GpuRunner:
 #: 14 MB for Ji & Li's drive, whose period is a hunting period of 65,536 samples); the
 #: cases of one process share equal sets (torquesplit.assembly.tables)
 TABLES = _TABLE_FIELDS
-#: table sets a worker remembers having sent, and the runner keeps to give back (the same
-#: bound: a worker that strips a set the runner no longer has costs a set-up here, no error)
-KEPT_SETS = 8
+#: table sets a worker remembers having sent (it strips only those), and the runner keeps
+#: to give back: more, so that a set recent for one worker is still there (a worker that
+#: strips a set the runner no longer has costs one set-up in the runner, no error)
+WORKER_SETS, RUNNER_SETS = 4, 32
 _SENT: OrderedDict = OrderedDict()  # keys of the sets this worker has sent (recent last)
 _KEYS = IdentityMemo()
 
@@ -309,10 +311,10 @@ def _table_key(run) -> str:
     return _KEYS.get(current, digest)
 
 
-def _remember(kept: OrderedDict, key, value=True) -> None:
+def _remember(kept: OrderedDict, key, value=True, bound: int = RUNNER_SETS) -> None:
     kept[key] = value
     kept.move_to_end(key)
-    while len(kept) > KEPT_SETS:
+    while len(kept) > bound:
         kept.popitem(last=False)
 
 
@@ -360,7 +362,7 @@ def prepare_case(p: dict, length: float | None = None, worker: bool = False) -> 
         if key in _SENT:
             empty = tuple(np.zeros((0, 0)) for _ in TABLES)
             out["run"], out["tables_stripped"] = _with_tables(out["run"], empty), True
-        _remember(_SENT, key)
+        _remember(_SENT, key, bound=WORKER_SETS)
     return out
 
 
