@@ -102,3 +102,22 @@ def test_a_critical_speed_printed_once_even_when_two_crossings_share_it():
     plt.close(fig)
     assert sorted(texts) == ["2483", "2632", "3100"]
     assert len(ax.lines) == 5  # every crossing keeps its line
+
+
+def test_the_run_csv_gives_each_groups_engineering_peak_to_nominal(tmp_path):
+    """The run's group table prints G_it (peak/nominal, eng.); its CSV had no column."""
+    import csv
+    import warnings
+
+    import torquesplit
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = torquesplit.simulate(torquesplit.load_model("ji_li_mill_drive"), duration=0.3)
+    res.to_csv(tmp_path / "r.csv")
+    rows = list(csv.DictReader(open(tmp_path / "r.csv")))
+    want = res.metrics("engineering").dynamic_factors.per_group_peak_to_nominal_engineering
+    groups = {r["group"]: r for r in rows if not r["mesh"]}
+    for g, value in want.items():
+        assert float(groups[g]["peak_to_nominal_engineering"]) == value
+    assert all(r["peak_to_nominal_engineering"] == "" for r in rows if r["mesh"])

@@ -550,7 +550,8 @@ class Results:
         header = ["mesh", "group", "nominal_force_N", "static_force_N", "mean_force_N",
                   "peak_force_N", "min_force_N", "dynamic_factor",
                   "dynamic_factor_engineering", "peak_to_nominal", "load_sharing",
-                  "contact_loss_fraction", "back_contact_fraction", "back_flank_force_N"]
+                  "contact_loss_fraction", "back_contact_fraction", "back_flank_force_N",
+                  "peak_to_nominal_engineering"]  # a group's G_it (Ji & Li eq. 19)
         try:
             met = self.metrics(definition) if self.success else None
         except (ValueError, ArithmeticError):
@@ -560,7 +561,8 @@ class Results:
             rows = [[r.mesh, r.group, r.nominal_force, r.static_force, r.mean_force,
                      r.peak_force, r.min_force, r.dynamic_factor,
                      r.dynamic_factor_engineering, r.peak_to_nominal, r.load_sharing,
-                     r.contact_loss, r.back_contact, r.back_flank_force] for r in met.rows]
+                     r.contact_loss, r.back_contact, r.back_flank_force, ""]
+                    for r in met.rows]
             rows = self._planet_columns(header, rows, met)
             # then each group's and the system's coefficients and factors (mesh left
             # empty): what the run's group table and system line print
@@ -569,6 +571,7 @@ class Results:
                 row = ["", g] + [""] * (width - 2)
                 row[7], row[9] = d.per_group_dynamic_factor[g], d.per_group_peak_to_nominal[g]
                 row[10] = met.load_sharing.per_group[g]
+                row[14] = d.per_group_peak_to_nominal_engineering.get(g, "")
                 rows.append(row)
             system = ["", "(system)"] + [""] * (width - 2)
             system[10] = met.load_sharing.system
@@ -577,7 +580,7 @@ class Results:
             header.append("status")
             group_of = {m: g for g, ms in self.groups.items() for m in ms}
             nominal, static = self.nominal_forces(), self.static_forces()
-            rows = [[m, group_of.get(m, ""), nominal[m], static[m]] + [""] * 10
+            rows = [[m, group_of.get(m, ""), nominal[m], static[m]] + [""] * 11
                     + [self.message] for m in self.mesh_names]
         s = self.solution
         el = self.structure.element_names
