@@ -143,3 +143,19 @@ def test_cases_that_share_tables_plan_the_kernel_model_of_their_own_structure():
             assert np.shape(a) == np.shape(b) and np.array_equal(a, b), f
     models = [case_arrays(r).case.model for r in shared[:2]]
     assert models[0].stiffness_table is models[1].stiffness_table
+
+
+def test_a_memo_value_goes_with_its_arrays():
+    """The planner's copies of a table set (29 MB for Ji & Li's drive) must not outlive
+    the cases that use them."""
+    import gc
+
+    from torquesplit.gpu.layout import IdentityMemo
+
+    memo = IdentityMemo()
+    a, b = np.ones(3), np.zeros(3)
+    assert memo.get((a, b), lambda: "v") == "v" and len(memo) == 1
+    assert memo.get((a, b), lambda: "other") == "v"
+    del a
+    gc.collect()
+    assert len(memo) == 0

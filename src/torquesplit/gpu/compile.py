@@ -278,10 +278,8 @@ def _probe_compile() -> str:
             ok = bool(np.all(d.copy_to_host() == 2.0))
             _PROBE["why"] = "" if ok else "a test kernel gave wrong results"
         except Exception as exc:  # noqa: BLE001 - any failure of the CUDA tool chain
-            import numpy
-
             _PROBE["why"] = (f"numba-cuda cannot compile a kernel here ({type(exc).__name__}: "
-                             f"{str(exc)[:200]}; numpy {numpy.__version__}): install a "
+                             f"{str(exc)[:200]}; numpy {np.__version__}): install a "
                              "numba-cuda that supports this numpy, or an older numpy")
     return _PROBE["why"]
 

@@ -85,7 +85,7 @@ class IdentityMemo:
     def __init__(self, size: int = 64):
         self._entries: OrderedDict = OrderedDict()
         self._size = size
-        self._lock = threading.Lock()
+        self._lock = threading.RLock()  # a weakref callback may run while it is held
 
     def peek(self, arrays: tuple):
         """The value kept for these very objects, or None."""
@@ -96,11 +96,23 @@ class IdentityMemo:
         return None
 
     def put(self, arrays: tuple, value) -> None:
+        """Keep ``value`` for these objects, until one of them dies (then it goes: a value
+        such as a table's copy must not outlive the cases that use it)."""
+        key = tuple(id(a) for a in arrays)
+        refs = [weakref.ref(a, lambda r, key=key: self._drop(key, r)) for a in arrays]
         with self._lock:
-            self._entries[tuple(id(a) for a in arrays)] = ([weakref.ref(a) for a in arrays],
-                                                           value)
+            self._entries[key] = (refs, value)
             while len(self._entries) > self._size:
                 self._entries.popitem(last=False)
+
+    def _drop(self, key, ref) -> None:
+        with self._lock:
+            hit = self._entries.get(key)
+            if hit is not None and any(r is ref for r in hit[0]):
+                del self._entries[key]
+
+    def __len__(self) -> int:
+        return len(self._entries)
 
     def get(self, arrays: tuple, compute):
         """The value kept for these objects, else ``compute()`` (then kept)."""
