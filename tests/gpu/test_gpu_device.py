@@ -21,9 +21,9 @@ DEVICE = _OK and not cuda_simulated()
 needs_device = pytest.mark.skipif(not DEVICE, reason=f"no CUDA device: {_WHY}")
 
 
-def _ptx_or_skip(src):
+def _ptx_or_skip(src, binding="njit"):
     try:
-        return ptx(src)
+        return ptx(src, binding=binding)
     except Exception as exc:  # noqa: BLE001 - no libNVVM / CUDA toolkit here
         name = type(exc).__name__
         if "Nvvm" in name or "CudaSupport" in name or "libNVVM" in str(exc):
@@ -31,11 +31,14 @@ def _ptx_or_skip(src):
         raise
 
 
-def test_kernel_compiles_to_ptx_without_a_device():
+@pytest.mark.parametrize("binding", ["device", "njit"])
+def test_kernel_compiles_to_ptx_without_a_device(binding):
+    """Both ways the CUDA kernel binds the laws compile for sm_90 (the simulator types
+    nothing: a broken binding would otherwise show only on a device, behind the other)."""
     run = feature_runs()[0]
     p = case_arrays(run)
     g = build_group([p.case], [0], np.float64)
-    text = _ptx_or_skip(kernel_source(g, "fp64"))
+    text = _ptx_or_skip(kernel_source(g, "fp64"), binding)
     assert ".entry" in text and ".target sm_90" in text
     assert "fma.rn.f64" in text or "mul.f64" in text
 

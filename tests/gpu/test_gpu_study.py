@@ -249,3 +249,71 @@ def test_batches_shrink_where_every_case_has_its_own_tables():
         backend._remember(kept, f"set{k}", k)
     assert list(kept) == [f"set{k}" for k in range(40 - backend.RUNNER_SETS, 40)]
     assert backend.WORKER_SETS < backend.RUNNER_SETS  # a worker strips only what we keep
+
+
+def test_stripped_cases_get_their_set_back_however_many_sets_a_batch_has(monkeypatch):
+    """More distinct table sets in one batch than the runner keeps for later batches:
+    every stripped case still gets the set its worker sent earlier in the batch (none is
+    set up again in the runner)."""
+    import dataclasses
+
+    from torquesplit.gpu import backend
+
+    template = backend.prepare_case(_payloads(1)[0])["run"]
+
+    def run_with(k):
+        tabs = tuple(np.full((2, 4), float(k)) for _ in backend.TABLES)
+        return backend._with_tables(template, tabs)
+
+    def boom(*a, **kw):
+        raise AssertionError("a stripped case was set up again")
+
+    monkeypatch.setattr(backend, "prepare_case", boom)
+    n = backend.RUNNER_SETS + 8
+    empty = tuple(np.zeros((0, 0)) for _ in backend.TABLES)
+    results = ([{"run": run_with(k), "tables": f"k{k}"} for k in range(n)]
+               + [{"run": backend._with_tables(template, empty), "tables": f"k{k}",
+                   "tables_stripped": True} for k in range(n)])
+    runner = GpuRunner(target="cpu")
+    runner._attach_tables(results, [(None, None)] * len(results))
+    for k in range(n):
+        sent, back = results[k]["run"].structure, results[n + k]["run"].structure
+        assert back.stiffness_table is sent.stiffness_table, k
+    assert len(runner._tables) == backend.RUNNER_SETS
+    assert dataclasses.is_dataclass(results[-1]["run"])
+
+
+def test_a_worker_hashes_a_table_set_once(monkeypatch):
+    """A worker holds the sets it sent: the next case with equal tables shares them, and
+    their 14.7 MB digest is not computed again."""
+    from collections import OrderedDict
+
+    from torquesplit.gpu import backend
+
+    monkeypatch.setattr(backend, "_SENT", OrderedDict())
+    calls = []
+    real = backend.hashlib.blake2b
+
+    def counting(*a, **kw):
+        calls.append(1)
+        return real(*a, **kw)
+
+    monkeypatch.setattr(backend.hashlib, "blake2b", counting)
+    import gc
+
+    stripped = []
+    for p in _payloads(3):  # each result leaves the worker (nothing of it kept here)
+        stripped.append(backend.prepare_case(p, worker=True).get("tables_stripped", False))
+        gc.collect()
+    assert len(calls) == 1
+    assert stripped == [False, True, True]
+
+
+def _payloads(n):
+    from torquesplit.study.case import payload
+
+    spec = {**GRID, "analysis": {"duration": "0.01 s"},
+            "grid": {"parameters": [{"path": "meshes.m11.damping_ratio",
+                                     "values": [0.05 + 0.01 * k for k in range(n)]}]}}
+    plan = torquesplit.Study(spec).plan()
+    return [payload(i, plan, plan.design.overrides(i)) for i in range(n)]

@@ -166,23 +166,27 @@ class GpuRunner:
 
     def _attach_tables(self, results: list[dict], args: list[tuple]) -> None:
         """Give the runs that a worker sent without their phase tables (it had sent those
-        tables before) the tables it sent, so every case of one table set shares one
-        object; a case whose tables never came is set up again here (cannot happen while
-        the pool lives; correct if it does)."""
-        for res in results:
-            key = res.get("tables")
-            if key and not res.get("tables_stripped"):
-                s = res["run"].structure
-                kept = self._tables.get(key) or tuple(getattr(s, f) for f in TABLES)
-                _remember(self._tables, key, kept)
-                res["run"] = _with_tables(res["run"], kept)
+        tables before: earlier in this call, or in an earlier one) the tables it sent, so
+        every case of one table set shares one object.  One pass in order, with every set
+        of this call at hand (the bounded memory is for later calls only); a case whose
+        tables never came is set up again here (correct, slower) and its set kept."""
+        this_call: dict[str, tuple] = {}
         for k, res in enumerate(results):
+            key = res.get("tables")
+            if not key:
+                continue
+            kept = this_call.get(key) or self._tables.get(key)
             if res.get("tables_stripped"):
-                kept = self._tables.get(res["tables"])
-                if kept is not None:
-                    _remember(self._tables, res["tables"], kept)
-                results[k] = (prepare_case(*args[k]) if kept is None
-                              else {**res, "run": _with_tables(res["run"], kept)})
+                if kept is None:
+                    res = results[k] = prepare_case(*args[k])
+                    if res["run"] is None:
+                        continue
+                    kept = tuple(getattr(res["run"].structure, f) for f in TABLES)
+            elif kept is None:
+                kept = tuple(getattr(res["run"].structure, f) for f in TABLES)
+            this_call[key] = kept
+            _remember(self._tables, key, kept)
+            results[k] = {**res, "run": _with_tables(res["run"], kept)}
 
     # ----------------------------------------------------------------------- batches
     def _run_batch(self, payloads: list[dict]):
@@ -288,7 +292,7 @@ TABLES = _TABLE_FIELDS
 #: to give back: more, so that a set recent for one worker is still there (a worker that
 #: strips a set the runner no longer has costs one set-up in the runner, no error)
 WORKER_SETS, RUNNER_SETS = 4, 32
-_SENT: OrderedDict = OrderedDict()  # keys of the sets this worker has sent (recent last)
+_SENT: OrderedDict = OrderedDict()  # sets this worker has sent: key -> tables (recent last)
 _KEYS = IdentityMemo()
 
 
@@ -359,10 +363,13 @@ def prepare_case(p: dict, length: float | None = None, worker: bool = False) -> 
     out["warnings"] = [_one_line(w.message) for w in caught]
     if out["run"] is not None and worker:
         out["tables"] = key = _table_key(out["run"])
+        current = tuple(getattr(out["run"].structure, f) for f in TABLES)
         if key in _SENT:
             empty = tuple(np.zeros((0, 0)) for _ in TABLES)
             out["run"], out["tables_stripped"] = _with_tables(out["run"], empty), True
-        _remember(_SENT, key, bound=WORKER_SETS)
+        # held here (strongly): the next case's set-up finds the set alive and shares it,
+        # and its key is not hashed again (a 14.7 MB digest a case otherwise)
+        _remember(_SENT, key, current, bound=WORKER_SETS)
     return out
 
 

@@ -221,26 +221,29 @@ def cuda_kernel(src: KernelSource, bindings: tuple[str, ...] = ("device", "njit"
     return kern
 
 
-def ptx(src: KernelSource, cc: tuple[int, int] = (9, 0)) -> str:
+def ptx(src: KernelSource, cc: tuple[int, int] = (9, 0), binding: str = "njit") -> str:
     """PTX of the CUDA kernel for compute capability ``cc``, compiled without a device
     (needs NVIDIA's libNVVM, e.g. a CUDA toolkit, which numba finds itself or through
     ``CUDA_HOME``): a check that the laws and the generated code compile for the GPU.
 
-    The generated functions are bound as plain numba functions here (CUDA device
-    functions need a device to compile; numba compiles the same Python for the CUDA
-    target when a kernel calls a plain numba function; numba asks the current device for
-    its compute capability then, so a stand-in answering ``cc`` is put in its place for
-    the call), with the call-site literals of :func:`cuda_kernel`."""
+    ``binding="device"``: the kernel exactly as :func:`cuda_kernel` compiles it first
+    (generated functions and laws as CUDA device functions); ``"njit"``: its fallback
+    (plain numba functions, which numba compiles for the CUDA target when a kernel calls
+    them).  numba asks the current device for its compute capability, so a stand-in
+    answering ``cc`` is put in its place for the call."""
     from types import SimpleNamespace
     from unittest import mock
 
     from numba import cuda, njit
 
-    ns = _namespace(src, literal_calls=True)
-    ns["cuda"] = cuda
-    for name in _functions(ns):
-        ns[name] = njit(ns[name])
-    exec(_CUDA_KERNEL.format(n_w=src.n_w, n_x=src.n_x, n_wi=src.n_wi), ns)
+    if binding == "device":
+        ns = _cuda_namespace(src, "device")
+    else:
+        ns = _namespace(src, literal_calls=True)
+        ns["cuda"] = cuda
+        for name in _functions(ns):
+            ns[name] = njit(ns[name])
+        exec(_CUDA_KERNEL.format(n_w=src.n_w, n_x=src.n_x, n_wi=src.n_wi), ns)
     sig = kernel_signature(src.precision)
     stand_in = SimpleNamespace(compute_capability=tuple(cc))
     with mock.patch("numba.cuda.dispatcher.get_current_device", lambda: stand_in):
