@@ -121,3 +121,16 @@ def test_the_run_csv_gives_each_groups_engineering_peak_to_nominal(tmp_path):
     for g, value in want.items():
         assert float(groups[g]["peak_to_nominal_engineering"]) == value
     assert all(r["peak_to_nominal_engineering"] == "" for r in rows if r["mesh"])
+
+
+def test_a_guarded_script_is_not_told_to_add_the_guard(tmp_path, monkeypatch):
+    import types
+
+    from torquesplit.study.core import _unguarded_script
+
+    guarded, bare = tmp_path / "guarded.py", tmp_path / "bare.py"
+    guarded.write_text("if __name__ == '__main__':\n    pass\n")
+    bare.write_text("x = 1\n")
+    for path, want in ((guarded, ""), (bare, str(bare))):
+        monkeypatch.setitem(sys.modules, "__main__", types.SimpleNamespace(__file__=str(path)))
+        assert _unguarded_script() == want

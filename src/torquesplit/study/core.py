@@ -610,10 +610,17 @@ def dataset_from_store(plan: Plan, store: Store, n_used: int | None = None):
 
 
 def _unguarded_script() -> str:
-    """The script run as ``__main__`` when it is a file (its worker processes re-run it:
-    a study or a file write at its top level then fails in every worker), else ''."""
+    """The script run as ``__main__`` when it is a file without an ``if __name__ ==
+    "__main__"`` guard (its worker processes re-run it: a study or a file write at its
+    top level then fails in every worker), else ''."""
     import sys
 
     main = sys.modules.get("__main__")
     path = getattr(main, "__file__", None) or ""
-    return path if path.endswith(".py") else ""
+    if not path.endswith(".py"):
+        return ""
+    try:  # a script with the guard broke the pool some other way (memory, a crash)
+        guarded = "__main__" in Path(path).read_text(errors="replace")
+    except OSError:
+        guarded = False
+    return "" if guarded else path
