@@ -260,8 +260,10 @@ def quantity(text: Optional[str], kind: str, option: str) -> Optional[float]:
         raise OptionError(f"{option} {text!r} is not a finite number; give e.g. {option} "
                           f"'{KINDS[kind][1]}'")
     if kind == "speed" and value != 0.0:  # engineers write speeds in rpm
-        warn(f"{option} {text}: a bare number is a speed in rad/s ({value:g} rad/s = "
-             f"{value * 60.0 / (2.0 * math.pi):.6g} rpm); write '{text} rpm' for rpm")
+        from .model.units import rad_s_text
+
+        warn(f"{option} {text}: a bare number is a speed in rad/s ({rad_s_text(value)}); "
+             f"write '{text} rpm' for rpm")
     return value
 
 

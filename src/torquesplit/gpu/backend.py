@@ -34,7 +34,7 @@ from collections import OrderedDict
 
 import numpy as np
 
-from ..assembly.tables import TABLES as _TABLE_FIELDS
+from ..assembly.tables import TABLES
 from .layout import IdentityMemo
 
 log = logging.getLogger(__name__)
@@ -284,10 +284,8 @@ class GpuRunner:
         return f"{os.uname().nodename}:{os.getpid()}:{where}"
 
 
-#: the structure's phase tables over one excitation period (the bulk of a prepared run:
-#: 14 MB for Ji & Li's drive, whose period is a hunting period of 65,536 samples); the
-#: cases of one process share equal sets (torquesplit.assembly.tables)
-TABLES = _TABLE_FIELDS
+#: (TABLES, the structure's phase tables, are the bulk of a prepared run: 14 MB for Ji &
+#: Li's drive; the cases of one process share equal sets, torquesplit.assembly.tables)
 #: table sets a worker remembers having sent (it strips only those), and the runner keeps
 #: to give back: more, so that a set recent for one worker is still there (a worker that
 #: strips a set the runner no longer has costs one set-up in the runner, no error)

@@ -123,15 +123,15 @@ def apply_assignments(data: dict, assignments) -> tuple[dict, dict[str, str]]:
             raise ModelError(issues, exc.source or source) from None
         where[path] = text
         if path.rsplit(".", 1)[-1] == "speed" and _bare_number(value):
-            import math
             import warnings
 
             from ..errors import ModelWarning
+            from .units import rad_s_text
 
             warnings.warn(ModelWarning(
-                f"--set {clip_text(text)}: a bare number is a speed in rad/s ({value:g} rad/s"
-                f" = {value * 60.0 / (2.0 * math.pi):.6g} rpm); write "
-                f"--set {path}='{value:g} rpm' for rpm"), stacklevel=2)
+                f"--set {clip_text(text)}: a bare number is a speed in rad/s "
+                f"({rad_s_text(value)}); write --set {path}='{value:g} rpm' for rpm"),
+                stacklevel=2)
     return data, where
 
 

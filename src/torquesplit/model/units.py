@@ -244,3 +244,9 @@ def convert(value: float, from_unit: str, to_unit: str) -> float:
 def _si_of(unit: str) -> str:
     ureg = registry()
     return str(ureg.Quantity(1.0, unit).to_base_units().units)
+
+
+def rad_s_text(value: float) -> str:
+    """A speed given as a bare number (rad/s) with its rpm: ``'2400 rad/s = 22918.3 rpm'``
+    (what a warning about a bare speed quotes)."""
+    return f"{value:g} rad/s = {value * 30.0 / math.pi:.6g} rpm"
