@@ -247,18 +247,18 @@ leaves out the start-up transient before computing anything.
   coefficient G_it, from their eq. 19).
 * **bearing forces**: for each supported body (here `input`), the settled mean bearing
   force by direction, the magnitude of that mean and the peak magnitude |F|.  They come
-  from the history, not from the streamed statistics (see the history warning).  `--json`
-  gives them as `bearing_forces_N`, a .nc or .mat results file (`--out`) as
-  `bearing_mean_force` and `bearing_peak_force`.
+  from the history, not from the streamed statistics (next bullet).  `--json` gives them
+  as `bearing_forces_N`, a .nc or .mat results file (`--out`) as `bearing_mean_force`
+  and `bearing_peak_force`.
 {{{{drift_text}}}}
-* **the history warning** above the table: the history a results file and the figures hold
-  (20 samples per split-mesh period by default) misses the settled peak of in2 by {{{{history_miss}}}} %:
-  the response rings at its mesh modes near order {{{{order}}}} of the mesh frequency
-  (section 5), faster than that sampling.  The mesh table's numbers are streamed at every
-  integration step and do not depend on it; the figures draw each cycle's streamed
-  extremes over the samples.  The bearing table is computed from the history, so its
-  peak |F| is low too.  For a waveform to put in a report, or the bearing peaks, run
-  again with `--samples-per-period 100` (every step at this model's step).
+* **the history**, which results files (`--out`), figures (`--plots`) and the bearing
+  table are made from, holds every integration step of this run ({{{{history_samples}}}} samples):
+  by default a run keeps every step up to 50,000 samples, and a longer one 50,000 evenly
+  spread but at least 20 per shortest mesh period.  This drive rings at its mesh modes
+  near order {{{{order}}}} of the mesh frequency (section 5): a history of 20 samples per
+  split-mesh period (`--samples-per-period 20`) misses the settled peak of in2 by
+  {{{{history_miss}}}} %, and the run says so in a warning.  The mesh table's numbers are
+  streamed at every integration step and never depend on the history.
 * **contact loss** and **back flank**: these meshes have no backlash, so they cannot lose
   contact; had their forces turned negative (the back flank loaded) the table and a
   warning would say so.
@@ -420,9 +420,15 @@ def _numbers(work: Path) -> dict[str, str]:
             "half by more than 1e-4 of the peak (docs/theory/model.md), so the dynamic "
             "factor is that of the response the run tends to; the periodic steady state "
             "(section 8, `torquesplit steady`) gives it directly.")
-    coarse = [w for w in run["warnings"] if w.startswith("analysis: the history")]
+    if any(w.startswith("analysis: the history") for w in run["warnings"]):
+        raise SystemExit("the tutorial's text expects a history that keeps every step")
+    history_samples = f"{run['statistics']['history_samples']:,}"
+    coarse = json.loads(_run("torquesplit run three_branch.toml --samples-per-period 20 "
+                             "--json 2>/dev/null", work))
+    coarse = [w for w in coarse["warnings"] if w.startswith("analysis: the history")]
     if not coarse:
-        raise SystemExit("the tutorial's text expects the coarse-history warning")
+        raise SystemExit("the tutorial's text expects the coarse-history warning at 20 "
+                         "samples per period")
     history_miss = re.search(r"by (\d+(?:\.\d+)?) %", coarse[0]).group(1)
     modes = json.loads(_run("torquesplit modes three_branch.toml --count 8 --json 2>/dev/null", work))
     campbell = json.loads(_run('torquesplit modes three_branch.toml --campbell --from '
@@ -452,6 +458,7 @@ def _numbers(work: Path) -> dict[str, str]:
     return {
         "overload": f"{100 * (met['meshes']['in1']['load_sharing'] - 1):.1f}",
         "history_miss": history_miss,
+        "history_samples": history_samples,
         "dynamic_factor": f"{met['groups']['split']['dynamic_factor']:.1f}",
         "mesh_modes": f"{low / 1e3:.1f}–{high / 1e3:.1f}",
         "order": f"{round(low / f_split)}",

@@ -125,6 +125,35 @@ def _fail(exc: BaseException) -> None:
 _EXPECTED = (TorquesplitError, ValueError, OSError)
 
 
+class _OptionErrors:
+    """Every bad option of one command line, reported together: each check runs through
+    this collector (``value = opts(check, *args)``: None where it failed) and
+    :meth:`raise_any` raises one :class:`OptionError` with a line per problem, the
+    model file's and ``--set`` problems added, instead of one problem per attempt."""
+
+    def __init__(self) -> None:
+        self.messages: list[str] = []
+
+    def __call__(self, check, *args, **kwargs):
+        try:
+            return check(*args, **kwargs)
+        except OptionError as exc:
+            self.messages.append(str(exc))
+            return None
+
+    def raise_any(self, model: str | None = None, assign=None) -> None:
+        """Raise what was collected (nothing when every option is good), with the
+        problems of ``model`` and its ``--set`` arguments, read without warnings."""
+        if not self.messages:
+            return
+        if model is not None:
+            try:
+                _load(model, assign, warn=False)
+            except _EXPECTED as exc:
+                self.messages.append(str(exc).strip())
+        raise OptionError("\n".join(self.messages))
+
+
 def _at_least(value, minimum, option: str, example: str) -> None:
     """Refuse a count below ``minimum`` (``--count -1``) before any computation."""
     if value is not None and value < minimum:
@@ -132,11 +161,21 @@ def _at_least(value, minimum, option: str, example: str) -> None:
                           f"{value}; give e.g. {option} {example}")
 
 
+def _check_method(method: Optional[str]) -> None:
+    if method is not None and method not in ("rk4", "dopri"):
+        raise OptionError(f"--method {method!r} is unknown; use rk4 or dopri")
+
+
 def _one_run_length(duration, cycles) -> None:
     """Refuse ``--duration`` with ``--cycles``: both set the run length."""
     if duration is not None and cycles is not None:
         raise OptionError(f"--cycles {cycles} and --duration {duration} both set the run "
                           "length; give only one of them")
+
+
+def _at_most(value, most, option: str) -> None:
+    if value is not None and value > most:
+        raise OptionError(f"{option} {value} is more than {most}; give at most {most}")
 
 
 def _positive(value, option: str, example: str) -> None:
@@ -237,7 +276,8 @@ def _resolve_model_path(model: str) -> Path:
     return p
 
 
-def _load(model: str, assignments: Optional[list[str]] = None, *, deep: bool = False):
+def _load(model: str, assignments: Optional[list[str]] = None, *, deep: bool = False,
+          warn: bool = True):
     """Read, validate and check a model; ``--set`` overrides are applied to the file's
     data first, and their errors are reported against the ``--set`` argument.
 
@@ -266,7 +306,7 @@ def _load(model: str, assignments: Optional[list[str]] = None, *, deep: bool = F
     from .model.overrides import attribute_warning
 
     for w in caught:
-        if issubclass(w.category, ModelWarning):
+        if warn and issubclass(w.category, ModelWarning):
             ux.warn(attribute_warning(str(w.message), where, str(path)))
     return m, path
 
@@ -345,11 +385,12 @@ def run(
     max_steps: Optional[int] = typer.Option(
         None, "--max-steps", help="Refuse an RK4 run needing more steps (default 2e8).",
         metavar="N"),
-    samples_per_period: int = typer.Option(
-        20, "--samples-per-period", help="History samples per shortest mesh period, for "
+    samples_per_period: Optional[int] = typer.Option(
+        None, "--samples-per-period", help="History samples per shortest mesh period, for "
         "--out files, --plots figures and the bearing-force table (the mesh table's "
-        "forces and coefficients are streamed at every step and do not depend on it); a "
-        "run warns when the history misses the peaks.", metavar="N"),
+        "forces and coefficients are streamed at every step and do not depend on it); "
+        "default: every step up to 50,000 samples, else 50,000 over the run but at least "
+        "20 per period; a run warns when the history misses the peaks.", metavar="N"),
     definition: Optional[str] = typer.Option(None, "--definition", help=_definition_help(),
                                              metavar="NAME"),
     out: Optional[Path] = typer.Option(
@@ -387,17 +428,18 @@ def run(
 
     with contextlib.ExitStack() as stack, ux.interruptible(kept):
         try:
-            if method is not None and method not in ("rk4", "dopri"):
-                raise OptionError(f"--method {method!r} is unknown; use rk4 or dopri")
-            _one_run_length(duration, cycles)
-            dur = ux.quantity(duration, "time", "--duration")
-            _positive(dur, "--duration", "'0.5 s'")
-            _at_least(cycles, 1, "--cycles", "200")
-            _at_least(steps_per_period, 10, "--steps-per-period", "100")
-            _at_least(max_steps, 1, "--max-steps", "200000000")
-            _at_least(samples_per_period, 1, "--samples-per-period", "100")
-            _check_definition(definition)
-            _check_plots_folder(plots)
+            opts = _OptionErrors()
+            opts(_check_method, method)
+            opts(_one_run_length, duration, cycles)
+            dur = opts(ux.quantity, duration, "time", "--duration")
+            opts(_positive, dur, "--duration", "'0.5 s'")
+            opts(_at_least, cycles, 1, "--cycles", "200")
+            opts(_at_least, steps_per_period, 10, "--steps-per-period", "100")
+            opts(_at_least, max_steps, 1, "--max-steps", "200000000")
+            opts(_at_least, samples_per_period, 1, "--samples-per-period", "100")
+            opts(_check_definition, definition)
+            opts(_check_plots_folder, plots)
+            opts.raise_any(model, assign)
             plan = None
             if out is not None:
                 plan = files.check_output(out, overwrite=force)
@@ -663,9 +705,9 @@ def bearing_table(bearings: list[dict], res) -> Table:
     history (:meth:`Results.bearing_forces`)."""
     from .model.kinematics import support_frame
 
-    per = res.history_samples_per_period()
-    b = Table(title=f"bearing forces (settled; from the history, {per:.3g} samples per "
-                    f"shortest mesh period)")
+    per = ("every step" if res.history_keeps_every_step() else
+           f"{res.history_samples_per_period():.3g} samples per shortest mesh period")
+    b = Table(title=f"bearing forces (settled; from the history, {per})")
     # the force on the body's bearing, by direction of the frame it is written in: a
     # planet's (and any body's of a turning carrier's model) turns with the carrier
     frames = []
@@ -733,13 +775,15 @@ def static(
     with contextlib.ExitStack() as stack, ux.interruptible(
             lambda: f"results kept in {state['saved']}" if state["saved"] else ""):
         try:
-            if revolutions is not None:
-                _positive(revolutions, "--revolutions", "1")
-            _at_least(points_per_cycle, 1, "--points-per-cycle", "32")
+            opts = _OptionErrors()
+            opts(_positive, revolutions, "--revolutions", "1")
+            opts(_at_least, points_per_cycle, 1, "--points-per-cycle", "32")
             if plots is not None:
                 from .plot.figures import STATIC_FIGURES, figure_files
 
-                _check_plots_folder(plots, names=figure_files(STATIC_FIGURES), force=force)
+                opts(_check_plots_folder, plots, names=figure_files(STATIC_FIGURES),
+                     force=force)
+            opts.raise_any(model, assign)
             if out is not None:
                 # (the CSV tables: per position, per mesh, per planet of a stage)
                 plan = check_dataset_output(out, ("time", "mesh", "planet_entity"),
@@ -859,8 +903,10 @@ def mesh(
     """Mesh stiffness k(phase) of one mesh by every applicable method, with the ISO value
     (N/µm along the line of action, in the table and in the --plot figure)."""
     try:
-        _at_least(points, 16, "--points", "256")
-        _check_figure_file(plot, "--plot", force)
+        opts = _OptionErrors()
+        opts(_at_least, points, 16, "--points", "256")
+        opts(_check_figure_file, plot, "--plot", force)
+        opts.raise_any(model, assign)
         m, _ = _load(model, assign)
         if pair not in m.meshes:
             raise OptionError(f"--pair: no mesh named {pair!r}; use one of "
@@ -970,17 +1016,18 @@ allowable, 3 GPa static limit): above it a contact load is a slip of units."""
 def _contact(model, pair, load, on, plot, force, positions, slices, harris, assign,
              as_json) -> None:
     try:
+        opts = _OptionErrors()
         if plot is not None:
             from .plot.contact import contact_figure_files
 
-            _check_plots_folder(plot, "--plot", names=contact_figure_files(harris > 0),
-                                force=force)
-        _at_least(positions, 4, "--positions", "64")
-        _at_least(slices, 2, "--slices", "40")
+            opts(_check_plots_folder, plot, "--plot", names=contact_figure_files(harris > 0),
+                 force=force)
+        opts(_at_least, positions, 4, "--positions", "64")
+        opts(_at_least, slices, 2, "--slices", "40")
         for value, option, most in ((positions, "--positions", 4096), (slices, "--slices", 400)):
-            if value is not None and value > most:  # as the model file's ltca fields
-                raise OptionError(f"{option} {value} is more than {most}; give at most {most}")
-        _at_least(harris, 0, "--harris", "10")
+            opts(_at_most, value, most, option)  # as the model file's ltca fields
+        opts(_at_least, harris, 0, "--harris", "10")
+        opts.raise_any(model, assign)
         m, _ = _load(model, assign)
         if pair not in m.meshes:
             raise TorquesplitError(f"no mesh named {pair!r}; name one of {', '.join(m.meshes)}")
@@ -1287,10 +1334,12 @@ def modes(
     from .results.export import check_dataset_output, save_dataset
 
     try:
-        _at_least(count, 1, "--count", "20")
-        _check_figure_file(plot, "--plot", force)
-        limit = ux.quantity(below, "frequency", "--below")
-        _positive(limit, "--below", "'5 kHz'")
+        opts = _OptionErrors()
+        opts(_at_least, count, 1, "--count", "20")
+        opts(_check_figure_file, plot, "--plot", force)
+        limit = opts(ux.quantity, below, "frequency", "--below")
+        opts(_positive, limit, "--below", "'5 kHz'")
+        opts.raise_any(model, assign)
         if out is not None:  # (the CSV tables: per mode and per DOF, or per speed)
             check_dataset_output(out, ("speed",) if campbell else ("mode", "dof"),
                                  overwrite=force)

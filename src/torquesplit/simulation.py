@@ -25,6 +25,11 @@ from .model.kinematics import solve_kinematics
 
 #: largest number of decimated history records kept by default
 MAX_HISTORY_RECORDS = 200_000
+#: the default history (``samples_per_period=None``) keeps every RK4 step while the run
+#: has at most this many, else this many samples evenly over the run, but never fewer
+#: than :data:`MIN_SAMPLES_PER_PERIOD` per shortest mesh period
+AUTO_HISTORY_RECORDS = 50_000
+MIN_SAMPLES_PER_PERIOD = 20
 #: default step budget of a run (about 1-5 minutes of integration on one core)
 MAX_STEPS = 200_000_000
 #: runs longer than this many steps are announced with a warning (cost estimate)
@@ -42,7 +47,7 @@ def simulate(
     method: str | None = None,
     steps_per_period: int | None = None,
     rtol: float | None = None,
-    samples_per_period: int = 20,
+    samples_per_period: int | None = None,
     history_dofs=None,
     full_history: bool = False,
     progress: Callable[[float], None] | None = None,
@@ -67,10 +72,12 @@ def simulate(
         Integrator; default from ``[analysis]``.
     steps_per_period : int, optional
         RK4 steps per shortest mesh period (default 100, as in the papers).
-    samples_per_period : int
-        Decimated history samples per shortest mesh period, >= 1 (plots, exports and the
-        bearing forces: every mesh metric is computed from statistics streamed at every
-        step).
+    samples_per_period : int, optional
+        History samples per shortest mesh period, >= 1 (plots, exports and the bearing
+        forces: every mesh metric is computed from statistics streamed at every step).
+        Default: every RK4 step while the run has at most
+        :data:`AUTO_HISTORY_RECORDS`, else that many samples evenly over the run, never
+        fewer than :data:`MIN_SAMPLES_PER_PERIOD` per period.
     history_dofs : list of str, optional
         DOF names (``"gear.x"``) whose displacement and velocity histories to keep.
     full_history : bool
@@ -140,18 +147,19 @@ def _simulate(model, *, duration, cycles, method, steps_per_period, rtol,
                    static=run.static, solution=solution)
 
 
-def check_run_length(duration, cycles, samples_per_period=20):
+def check_run_length(duration, cycles, samples_per_period=None):
     """The run-length arguments of :func:`simulate` and :func:`prepare_run`, checked:
     ``(duration in s or None, cycles or None, samples_per_period)``.
 
     ``duration``: a positive number of seconds or a time string (``"5 ms"``); ``cycles``
     and ``samples_per_period``: whole numbers >= 1 (``3.0`` is read as 3, ``2.5`` is
-    refused); ``duration`` and ``cycles`` together are refused (a run has one length).
+    refused; ``None``: the default history); ``duration`` and ``cycles`` together are
+    refused (a run has one length).
 
     Examples
     --------
-    >>> check_run_length("5 ms", None)
-    (0.005, None, 20)
+    >>> check_run_length("5 ms", None, 40)
+    (0.005, None, 40)
     """
     from .errors import OptionError
 
@@ -162,8 +170,9 @@ def check_run_length(duration, cycles, samples_per_period=20):
         duration = _positive_time(duration)
     if cycles is not None:
         cycles = _whole(cycles, "cycles", "cycles=200")
-    samples_per_period = _whole(samples_per_period, "samples_per_period",
-                                "samples_per_period=20")
+    if samples_per_period is not None:
+        samples_per_period = _whole(samples_per_period, "samples_per_period",
+                                    "samples_per_period=100")
     return duration, cycles, samples_per_period
 
 
@@ -282,7 +291,7 @@ def prepare_run(
     method: str | None = None,
     steps_per_period: int | None = None,
     rtol: float | None = None,
-    samples_per_period: int = 20,
+    samples_per_period: int | None = None,
     history_dofs=None,
     full_history: bool = False,
     progress: Callable[[float], None] | None = None,
@@ -344,14 +353,15 @@ def prepare_run(
     track = [names.index(m) for m in mesh_names]
     hist_el = history_elements(structure, mesh_names)
     hist_dofs = list(history_dofs or [])
-    sample_interval = 1.0 / (samples_per_period * f_max)
+    sample_interval = history_interval(duration, f_max, samples_per_period)
     n_records = duration / sample_interval
     if n_records > MAX_HISTORY_RECORDS:
+        asked = 1.0 / (sample_interval * f_max)
         sample_interval = duration / MAX_HISTORY_RECORDS
         warnings.warn(
             f"analysis: the history holds at most {MAX_HISTORY_RECORDS:,} samples, so this "
             f"run keeps {1.0 / (sample_interval * f_max):.3g} per shortest mesh period "
-            f"instead of {samples_per_period:g}: the files' waveforms and the bearing table "
+            f"instead of {asked:.3g}: the files' waveforms and the bearing table "
             f"are that coarse (the mesh table is streamed at every step); for fine "
             f"waveforms run a shorter span", ModelWarning, stacklevel=3)
     from .metrics.load_sharing import group_meshes
@@ -378,6 +388,17 @@ def prepare_run(
         kwargs["rtol"] = rtol or an.rtol
     return PreparedRun(model=model, kinematics=kin, structure=structure, static=static,
                        y0=y0, duration=float(duration), integrate_kwargs=kwargs, start=start)
+
+
+def history_interval(duration: float, f_max: float, samples_per_period: int | None) -> float:
+    """Time between history samples [s]: ``samples_per_period`` per shortest mesh period
+    (``f_max`` its frequency), or by default :data:`AUTO_HISTORY_RECORDS` over the run
+    but at least :data:`MIN_SAMPLES_PER_PERIOD` a period.  An interval shorter than the
+    RK4 step keeps every step (the history is sampled in time, so its size never depends
+    on the step)."""
+    if samples_per_period is not None:
+        return 1.0 / (samples_per_period * f_max)
+    return min(1.0 / (MIN_SAMPLES_PER_PERIOD * f_max), duration / AUTO_HISTORY_RECORDS)
 
 
 #: runs estimated to take longer than this [s] or to keep more than ANNOUNCE_BYTES of

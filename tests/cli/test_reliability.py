@@ -198,6 +198,24 @@ def test_numeric_options_are_checked_first(tmp_path, no_compute, args, pattern):
     one_line_error(res, pattern)
 
 
+def test_every_bad_option_and_set_argument_is_reported_at_once(tmp_path, no_compute):
+    """A bad --duration hid two bad --set arguments and a bad --samples-per-period: the
+    user fixed them one attempt at a time."""
+    model = write_model(tmp_path, SPUR_PAIR)
+    res = runner.invoke(app, ["run", str(model), "--duration", "-1 s", "--samples-per-period",
+                              "0", "--set", "foo=1", "--set", "meshes.m.stiffness=50 kg"])
+    assert res.exit_code == 2
+    lines = [ln for ln in res.output.splitlines() if ln.startswith("error: ")]
+    assert len(lines) == 4, res.output
+    for pattern in ("--duration must be a positive", "--samples-per-period must be a whole",
+                    "--set foo=1: foo: unknown field",
+                    "--set meshes.m.stiffness=50 kg: meshes.m.stiffness.value"):
+        assert any(pattern in ln for ln in lines), (pattern, res.output)
+    res = runner.invoke(app, ["modes", str(model), "--count", "0", "--below", "-1 kHz"])
+    assert [ln.split(" must")[0] for ln in res.output.splitlines()] == [
+        "error: --count", "error: --below"], res.output
+
+
 def test_plots_must_be_a_folder(tmp_path, no_compute):
     model = write_model(tmp_path, SPUR_PAIR)
     (tmp_path / "figs").write_text("a file")

@@ -25,7 +25,8 @@ def test_cycles_and_duration_together_are_refused_by_flag(tmp_path, command):
 def test_saved_force_history_says_its_sample_interval(tmp_path):
     path = write_model(tmp_path, split_model())
     out = tmp_path / "r.nc"
-    res = runner.invoke(app, ["run", str(path), "--cycles", "20", "--json", "--out", str(out)])
+    res = runner.invoke(app, ["run", str(path), "--cycles", "20", "--json", "--out", str(out),
+                              "--samples-per-period", "10"])
     assert res.exit_code == 0, res.output
     with xr.open_dataset(out) as ds:
         force = ds["element_force"]
@@ -34,3 +35,10 @@ def test_saved_force_history_says_its_sample_interval(tmp_path):
         assert force.attrs["sample_interval_units"] == "s"
         note = force.attrs["sampling"]
         assert "decimated" in note and f"{dt:.4g} s" in note and "every step" in note
+    # by default a run this short keeps every step, and the file says so
+    res = runner.invoke(app, ["run", str(path), "--cycles", "20", "--json", "--out", str(out),
+                              "--force"])
+    assert res.exit_code == 0, res.output
+    with xr.open_dataset(out) as ds:
+        assert ds["element_force"].attrs["sampling"].startswith(
+            "history of every integration step")

@@ -40,3 +40,20 @@ def test_duration_string_and_whole_float_cycles_are_read(spur_pair):
     assert prepare_run(spur_pair, cycles=3.0).duration == pytest.approx(3 / f_min)
     res = torquesplit.simulate(spur_pair, duration="2 ms")
     assert res.success and res.solution.t_final == pytest.approx(0.002)
+
+
+def test_the_default_history_keeps_every_step_of_a_short_run_and_a_budget_of_a_long_one():
+    """20 samples per period by default missed the peaks of short runs whose every step
+    costs nothing to keep; a long run keeps AUTO_HISTORY_RECORDS, never fewer than
+    MIN_SAMPLES_PER_PERIOD a period."""
+    from torquesplit.simulation import (AUTO_HISTORY_RECORDS, MIN_SAMPLES_PER_PERIOD,
+                                        history_interval)
+
+    f_max = 1000.0
+    short = history_interval(0.1, f_max, None)
+    assert short == pytest.approx(0.1 / AUTO_HISTORY_RECORDS)  # below any usual step
+    long = history_interval(1e3, f_max, None)
+    assert long == pytest.approx(1.0 / (MIN_SAMPLES_PER_PERIOD * f_max))
+    middle = history_interval(1.0, f_max, None)  # 50 a period: the budget
+    assert 1.0 / middle == pytest.approx(AUTO_HISTORY_RECORDS)
+    assert history_interval(1e3, f_max, 7) == pytest.approx(1.0 / 7e3)

@@ -222,7 +222,8 @@ class Results:
         return list(self.model.meshes)
 
     def statistics(self) -> dict:
-        """Integration statistics: steps, rhs evaluations, step size, times."""
+        """Integration statistics: steps, rhs evaluations, step size, times, and the
+        history's size (samples, and samples per shortest mesh period)."""
         s = self.solution
         return {
             "method": s.method, "status": s.status, "message": s.message,
@@ -233,6 +234,8 @@ class Results:
             "compile_time_s": s.compile_time, "wall_time_s": s.wall_time,
             "microseconds_per_step": 1e6 * s.wall_time / max(s.n_steps, 1),
             "rhs": s.rhs, "rhs_compile_time_s": s.rhs_compile_time,
+            "history_samples": int(s.history_t.size),
+            "history_samples_per_period": self.history_samples_per_period(),
         }
 
     # ------------------------------------------------------------------ metrics
@@ -406,6 +409,12 @@ class Results:
         if t.size < 2 or not f_max > 0:
             return 0.0
         return 1.0 / (f_max * float(np.median(np.diff(t))))
+
+    def history_keeps_every_step(self) -> bool:
+        """Whether the history holds every (fixed) step: a finer one needs a finer step."""
+        t = self.solution.history_t if self.solution is not None else np.zeros(0)
+        step = self.solution.step if self.solution is not None else None
+        return bool(t.size >= 2 and step and float(np.median(np.diff(t))) < 1.5 * step)
 
     def support_columns(self) -> dict[str, list[tuple[str, int]]]:
         """Supported body -> its bearing elements' (direction, column of the history)."""

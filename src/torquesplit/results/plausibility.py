@@ -272,9 +272,8 @@ def coarse_history(results, metrics) -> list[tuple[str, str]]:
     t, forces = results.mesh_force_history()
     if t.size < 2:
         return []
-    step = results.statistics().get("step_s") or 0.0
-    if step and float(np.median(np.diff(t))) < 1.5 * step:
-        return []  # every step is kept: a finer history needs a finer step, not more samples
+    if results.history_keeps_every_step():
+        return []  # a finer history needs a finer step, not more samples
     worst = None
     for j, row in enumerate(metrics.rows):
         start = metrics.settling.group_time.get(row.group, metrics.settling.start_time)
