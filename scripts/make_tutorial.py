@@ -156,7 +156,7 @@ torque = "balanced"                  # takes whatever the drive puts in
 [analysis]
 # the ISO 6336 stiffness steps where a tooth pair enters and leaves; a table of n points
 # per mesh cycle makes each step a ramp 1/n of a cycle long: 16384 points resolve it, at
-# no cost per step (with the default 256 the peaks come out low, and a run says so)
+# no cost per step (the default where a table steps; 256 where every table is smooth)
 table_points = 16384
 '''
 
@@ -267,9 +267,9 @@ How many of those digits hold?  `--check-step` runs the model again at half the 
 and says, for every number, how many significant digits stay put; the second run takes
 twice the steps, so the command integrates about three times as long as a plain run.
 The ISO 6336 stiffness steps between single and double tooth contact, and a table of n
-points per mesh cycle (`[analysis] table_points`: 256 by default, 16384 in this model)
-makes each step a ramp one n-th of a cycle long, so the check also runs with four times
-the table points:
+points per mesh cycle (`[analysis] table_points`: 16384 here, the default where a table
+steps) makes each step a ramp one n-th of a cycle long, so the check also runs with four
+times the table points:
 
 $ torquesplit run three_branch.toml --check-step --quiet
 

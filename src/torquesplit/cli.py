@@ -754,7 +754,10 @@ def static(
         "periods of the errors and tables, at least one revolution).", metavar="N"),
     points_per_cycle: int = typer.Option(32, "--points-per-cycle",
                                          help="Positions per cycle of the fastest "
-                                         "excitation.", metavar="N"),
+                                         "excitation (raised to a multiple of the meshes' "
+                                         "phase offsets, e.g. 96 for three planets 1/3 of a "
+                                         "cycle apart, so that each samples the same "
+                                         "phases).", metavar="N"),
     out: Optional[Path] = typer.Option(None, "--out", help="Write results: .nc (NetCDF), .mat "
                                        "(MATLAB) or .csv (NAME.csv per position, NAME_mesh.csv "
                                        "per mesh).", metavar="FILE"),

@@ -444,6 +444,7 @@ def evaluate_design(spec: OptimizationSpec, x) -> dict[str, float]:
         out: dict[str, float] = {}
         wanted = [o.output for o in (*spec.objectives, *spec.constraints)]
         if any(w.startswith("ltca.") for w in wanted):
+            from .assembly.excitation import table_points
             from .gears.contact.coupling import mesh_ltca
             from .model.kinematics import solve_kinematics
 
@@ -455,7 +456,7 @@ def evaluate_design(spec: OptimizationSpec, x) -> dict[str, float]:
                 if model.meshes[mesh].stiffness.method != "ltca":
                     raise ModelError([(f"meshes.{mesh}.stiffness.method", (
                         "an ltca output needs stiffness.method = 'ltca'; set it in [set]"))])
-                summary = mesh_ltca(model, kin, mesh, model.analysis.table_points).summary
+                summary = mesh_ltca(model, kin, mesh, table_points(model, kin)).summary
                 for k, v in summary.items():
                     if isinstance(v, (int, float)) and not isinstance(v, bool):
                         out[f"ltca.{mesh}.{k}"] = float(v)

@@ -150,7 +150,7 @@ def test_assembled_mesh_reproduces_the_loaded_transmission_error():
         kin = solve_kinematics(m)
         st = assemble(m, kin)
         i = st.element_names.index("m")
-        tab = coupling.mesh_ltca(m, kin, "m", m.analysis.table_points)
+        tab = coupling.mesh_ltca(m, kin, "m", st.n_table)
         M = tab.te.size
         f, ph0 = st.frequency[i], st.phase[i]
         phases = np.arange(M) / M

@@ -159,7 +159,7 @@ def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None
 def _assemble(model: Model, kin: Kinematics | None, *, n_table: int | None,
               options: dict | None) -> Structure:
     kin = kin or solve_kinematics(model)
-    n_table = n_table or model.analysis.table_points
+    n_table = n_table or excitation.table_points(model, kin)
     options = dict(options or {})
     unknown = sorted(set(options) - _OPTIONS)
     if unknown:

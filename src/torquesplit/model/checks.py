@@ -1223,10 +1223,10 @@ _CHEAP_STIFFNESS = ("constant", "table", "fourier")
 def stiffness_table_issues(model: Model, kin) -> list[tuple[str, str]]:
     """Each mesh's stiffness table, sampled as every run samples it
     (``[analysis] table_points`` phases), must be positive and finite everywhere."""
-    from ..assembly.excitation import stiffness_table
+    from ..assembly.excitation import stiffness_table, table_points
 
     issues = []
-    n = model.analysis.table_points
+    n = table_points(model, kin)
     for name, mesh in model.meshes.items():
         if mesh.stiffness.method not in _CHEAP_STIFFNESS:
             continue

@@ -762,10 +762,11 @@ class Analysis(Strict):
         "Simulated cycles of the slowest mesh, used when `duration` is not given "
         "(default 200)."))
     rtol: Number = Field(1e-6, gt=0, lt=1, description="Relative tolerance (dopri).")
-    table_points: Count = Field(256, ge=16, description=(
+    table_points: Count | None = Field(None, ge=16, description=(
         "Samples per mesh period of excitation tables. Where a table steps (a tooth pair "
         "entering, an impact pulse) each step becomes a ramp 1/n of a period long and the "
-        "peaks come out low: use 16384 or more then (a run warns below 4096)."))
+        "peaks come out low (a run warns below 4096 then). Default: 16384 where a mesh's "
+        "stiffness table steps or a mesh has an impact or an LTCA stiffness, else 256."))
     spline_velocity_scale: Number = Field(
         1e-3, gt=0, description="Radial sliding speed [m/s] over which spline friction "
         "reaches its Coulomb value (regularisation of sgn; smaller is stiffer to integrate).")
