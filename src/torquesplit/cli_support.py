@@ -309,10 +309,13 @@ def render_step_check(check, rows: int = 12, printed: int = PRINTED_DIGITS,
     if not short:
         return
     t = Table()
-    for col in ("number", "value", "checked", "digits that hold"):
-        t.add_column(col, justify="left" if col == "number" else "right")
+    for col in ("number", "unit", "value", "checked", "digits that hold"):
+        t.add_column(col, justify="left" if col in ("number", "unit") else "right")
     for name, a, b, _, d in short[:rows]:
-        t.add_row(name, f"{a:.6g}", f"{b:.6g}", str(d))
+        # forces in kN, as the run's mesh table prints them
+        kn = name.split(".")[0].endswith("_force")
+        scale, unit = (1e-3, "kN") if kn else (1.0, "")
+        t.add_row(name, unit, f"{a * scale:.6g}", f"{b * scale:.6g}", str(d))
     console.print(t)
     if len(short) > rows:
         console.print(f"... and {len(short) - rows} more (--json lists every number)",

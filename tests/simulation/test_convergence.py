@@ -197,3 +197,22 @@ def test_the_step_check_does_not_warn_of_its_own_table_points(tmp_path):
         check = check_step(res)
     assert check.check_table_points == 1024
     assert not [w for w in caught if "table_points" in str(w.message)]
+
+
+def test_the_step_check_table_gives_forces_in_kn_as_the_run_table(capsys):
+    """The run's mesh table prints forces in kN; its step check listed them in N."""
+    from rich.console import Console
+
+    from torquesplit.cli_support import render_step_check, reset
+    from torquesplit.convergence import StepCheck
+
+    reset(Console(width=120), Console(stderr=True))
+    check = StepCheck(values={"peak_force.m": 13084.9, "dynamic_factor.m": 1.71193},
+                      halved={"peak_force.m": 13253.0, "dynamic_factor.m": 1.73392},
+                      method="rk4", step=1e-5, halved_step=5e-6)
+    render_step_check(check)
+    out = capsys.readouterr().out
+    force = next(ln for ln in out.splitlines() if "peak_force.m" in ln)
+    assert "kN" in force and "13.0849" in force and "13.253" in force
+    factor = next(ln for ln in out.splitlines() if "dynamic_factor.m" in ln)
+    assert "kN" not in factor and "1.71193" in factor

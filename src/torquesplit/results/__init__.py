@@ -540,15 +540,15 @@ class Results:
         return plan.path
 
     def to_csv(self, path, *, overwrite: bool = False, definition: str | None = None) -> Path:
-        """Save spreadsheet tables: ``NAME.csv`` (per-mesh summary, then a row per
-        load-sharing group and one for the system, their mesh cell empty) and beside it
-        ``NAME_history.csv`` (decimated forces and torques, each column's unit in its
-        name: ``m1_N``, ``shaft_Nm``) and ``NAME_cycles.csv`` (start, peak,
-        smallest and mean force of every mesh cycle).
+        """Save spreadsheet tables: ``NAME.csv`` (a row per mesh) and beside it
+        ``NAME_groups.csv`` (a row per load-sharing group, then one for the system: what
+        the run's group table and system line print), ``NAME_history.csv`` (the history's
+        forces and torques, each column's unit in its name: ``m1_N``, ``shaft_Nm``) and
+        ``NAME_cycles.csv`` (start, peak, smallest and mean force of every mesh cycle).
 
-        All three are written atomically, and none replaces an existing file unless
+        All four are written atomically, and none replaces an existing file unless
         ``overwrite``.  A run that did not finish has no metrics: its summary lists the
-        meshes with empty metric columns and its status.
+        meshes with empty metric columns and its status, its groups file the groups.
         """
         from . import files
 
@@ -559,45 +559,45 @@ class Results:
         header = ["mesh", "group", "nominal_force_N", "static_force_N", "mean_force_N",
                   "peak_force_N", "min_force_N", "dynamic_factor",
                   "dynamic_factor_engineering", "peak_to_nominal", "load_sharing",
-                  "contact_loss_fraction", "back_contact_fraction", "back_flank_force_N",
-                  "peak_to_nominal_engineering"]  # a group's G_it (Ji & Li eq. 19)
+                  "contact_loss_fraction", "back_contact_fraction", "back_flank_force_N"]
+        group_header = ["group", "meshes", "load_sharing", "dynamic_factor",
+                        "peak_to_nominal",
+                        "peak_to_nominal_engineering"]  # G_it (Ji & Li eq. 19)
         try:
             met = self.metrics(definition) if self.success else None
         except (ValueError, ArithmeticError):
             met = None
         if met is not None:
-            header[10] = f"load_sharing_{met.definition}"
+            header[10] = group_header[2] = f"load_sharing_{met.definition}"
             rows = [[r.mesh, r.group, r.nominal_force, r.static_force, r.mean_force,
                      r.peak_force, r.min_force, r.dynamic_factor,
                      r.dynamic_factor_engineering, r.peak_to_nominal, r.load_sharing,
-                     r.contact_loss, r.back_contact, r.back_flank_force, ""]
+                     r.contact_loss, r.back_contact, r.back_flank_force]
                     for r in met.rows]
             rows = self._planet_columns(header, rows, met)
-            # then each group's and the system's coefficients and factors (mesh left
-            # empty): what the run's group table and system line print
-            d, width = met.dynamic_factors, len(header)
-            for g, members in met.load_sharing.groups.items():
-                row = ["", g] + [""] * (width - 2)
-                row[7], row[9] = d.per_group_dynamic_factor[g], d.per_group_peak_to_nominal[g]
-                row[10] = met.load_sharing.per_group[g]
-                row[14] = d.per_group_peak_to_nominal_engineering.get(g, "")
-                rows.append(row)
-            system = ["", "(system)"] + [""] * (width - 2)
-            system[10] = met.load_sharing.system
-            rows.append(system)
+            # each group's and the system's coefficients and factors: what the run's
+            # group table and system line print
+            d, ls_ = met.dynamic_factors, met.load_sharing
+            group_rows = [[g, " ".join(members), ls_.per_group[g],
+                           d.per_group_dynamic_factor[g], d.per_group_peak_to_nominal[g],
+                           d.per_group_peak_to_nominal_engineering.get(g, "")]
+                          for g, members in ls_.groups.items()]
+            group_rows.append(["(system)", " ".join(self.mesh_names), ls_.system, "", "", ""])
         else:
             header.append("status")
             group_of = {m: g for g, ms in self.groups.items() for m in ms}
             nominal, static = self.nominal_forces(), self.static_forces()
-            rows = [[m, group_of.get(m, ""), nominal[m], static[m]] + [""] * 11
+            rows = [[m, group_of.get(m, ""), nominal[m], static[m]] + [""] * 10
                     + [self.message] for m in self.mesh_names]
+            group_rows = [[g, " ".join(ms)] + [""] * 4 for g, ms in self.groups.items()]
         s = self.solution
         el = self.structure.element_names
         names = [el[i] for i in s.history_elements]
         units = element_units(self.structure)
         cols = [list(s.tracked_elements).index(el.index(m)) for m in self.mesh_names]
-        history, cycles, summary = plan.files[1], plan.files[2], plan.files[0]
+        summary, history, cycles, groups = plan.files
         contents = {
+            groups: files.csv_bytes(group_header, group_rows),
             history: files.csv_bytes(["time_s"] + [f"{n}_{units[i].replace(' ', '')}"
                                                    for n, i in zip(names, s.history_elements)],
                                      np.column_stack([s.history_t, s.history_forces]).tolist()),

@@ -97,11 +97,12 @@ class OutputPlan:
 
 
 def companion_files(path: Path, fmt: str) -> tuple[Path, ...]:
-    """The files a save of ``fmt`` to ``path`` writes: CSV writes ``NAME_history.csv``
-    and ``NAME_cycles.csv`` beside ``NAME.csv``."""
+    """The files a save of ``fmt`` to ``path`` writes: CSV writes ``NAME_groups.csv``,
+    ``NAME_history.csv`` and ``NAME_cycles.csv`` beside ``NAME.csv``."""
     if fmt == "csv":
         return (path, path.with_name(path.stem + "_history.csv"),
-                path.with_name(path.stem + "_cycles.csv"))
+                path.with_name(path.stem + "_cycles.csv"),
+                path.with_name(path.stem + "_groups.csv"))
     return (path,)
 
 

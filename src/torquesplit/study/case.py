@@ -106,12 +106,15 @@ def _static(model, p, out) -> list[float]:
 
 
 def _dynamic(model, p, out) -> list[float]:
-    from ..simulation import simulate
+    from ..simulation import MIN_SAMPLES_PER_PERIOD, simulate
     from .outputs import output_values
 
     a = p["analysis"]
     names, defs = p["outputs"], p["definitions"]
     kw = {k: a[k] for k in ("method", "steps_per_period", "rtol") if a.get(k) is not None}
+    # no output of a study comes from the history: the sparse one of earlier versions
+    # (the default keeps every step of a short run, 30 % of a small model's step time)
+    kw["samples_per_period"] = MIN_SAMPLES_PER_PERIOD
     settle = a.get("settle")
     if settle is None:
         res = simulate(model, duration=a.get("duration"), cycles=a.get("cycles"), **kw)
