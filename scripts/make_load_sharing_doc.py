@@ -102,7 +102,9 @@ whole load while the other had lost contact (`instantaneous`: at some instant;
 `cycle_peak`: through a whole mesh cycle).  Its system `mean_force` coefficient is the
 face-gear stage's, which does not drift; the herringbone stage's mean-force coefficients
 change with the run length by about 0.2 ([validation.md](validation.md)), and its
-peak-based numbers are those of impacts.
+peak-based numbers are those of impacts, which rounding-level differences move by
+per cents (the same code on another build of the numeric libraries moved its largest
+peak/nominal by 3 %): quote them to two digits at most.
 """
 
 def main() -> None:

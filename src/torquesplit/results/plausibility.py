@@ -305,11 +305,14 @@ CHECKS = (static_force, static_deflection, contact_loss, back_flank, resonance, 
           peak_drift, mean_drift, coarse_history)
 
 
-def result_warnings(results, metrics) -> list[tuple[str, str]]:
-    """Every plausibility warning of a finished run, as ``(location, message)``."""
+def result_warnings(results, metrics, *, history: bool = True) -> list[tuple[str, str]]:
+    """Every plausibility warning of a finished run, as ``(location, message)``;
+    ``history=False`` leaves out :func:`coarse_history` (a study's case: nothing it
+    reports comes from the history)."""
     out: list[tuple[str, str]] = []
     for check in CHECKS:
-        out += check(results, metrics)
+        if history or check is not coarse_history:
+            out += check(results, metrics)
     return out
 
 

@@ -203,7 +203,7 @@ def _finish(res, names, defs, out, output_values, vals=None) -> list[float]:
     out["settled"] = out["settled"] and met.settling.settled
     from ..results.plausibility import result_warnings
 
-    _warn(result_warnings(res, met))
+    _warn(result_warnings(res, met, history=False))  # (no output is from the history)
     lost = [(r.mesh, r.contact_loss) for r in met.rows if r.contact_loss > 0]
     if lost:
         out["status"] = "contact_lost"
