@@ -125,33 +125,9 @@ def _fail(exc: BaseException) -> None:
 _EXPECTED = (TorquesplitError, ValueError, OSError)
 
 
-class _OptionErrors:
-    """Every bad option of one command line, reported together: each check runs through
-    this collector (``value = opts(check, *args)``: None where it failed) and
-    :meth:`raise_any` raises one :class:`OptionError` with a line per problem, the
-    model file's and ``--set`` problems added, instead of one problem per attempt."""
-
-    def __init__(self) -> None:
-        self.messages: list[str] = []
-
-    def __call__(self, check, *args, **kwargs):
-        try:
-            return check(*args, **kwargs)
-        except OptionError as exc:
-            self.messages.append(str(exc))
-            return None
-
-    def raise_any(self, model: str | None = None, assign=None) -> None:
-        """Raise what was collected (nothing when every option is good), with the
-        problems of ``model`` and its ``--set`` arguments, read without warnings."""
-        if not self.messages:
-            return
-        if model is not None:
-            try:
-                _load(model, assign, warn=False)
-            except _EXPECTED as exc:
-                self.messages.append(str(exc).strip())
-        raise OptionError("\n".join(self.messages))
+def _option_errors() -> ux.OptionErrors:
+    """A collector of this command's bad options (:class:`cli_support.OptionErrors`)."""
+    return ux.OptionErrors(load=_load)
 
 
 def _at_least(value, minimum, option: str, example: str) -> None:
@@ -429,7 +405,7 @@ def run(
 
     with contextlib.ExitStack() as stack, ux.interruptible(kept):
         try:
-            opts = _OptionErrors()
+            opts = _option_errors()
             opts(_check_method, method)
             opts(_one_run_length, duration, cycles)
             dur = opts(ux.quantity, duration, "time", "--duration")
@@ -779,7 +755,7 @@ def static(
     with contextlib.ExitStack() as stack, ux.interruptible(
             lambda: f"results kept in {state['saved']}" if state["saved"] else ""):
         try:
-            opts = _OptionErrors()
+            opts = _option_errors()
             opts(_positive, revolutions, "--revolutions", "1")
             opts(_at_least, points_per_cycle, 1, "--points-per-cycle", "32")
             if plots is not None:
@@ -907,7 +883,7 @@ def mesh(
     """Mesh stiffness k(phase) of one mesh by every applicable method, with the ISO value
     (N/µm along the line of action, in the table and in the --plot figure)."""
     try:
-        opts = _OptionErrors()
+        opts = _option_errors()
         opts(_at_least, points, 16, "--points", "256")
         opts(_check_figure_file, plot, "--plot", force)
         opts.raise_any(model, assign)
@@ -1020,7 +996,7 @@ allowable, 3 GPa static limit): above it a contact load is a slip of units."""
 def _contact(model, pair, load, on, plot, force, positions, slices, harris, assign,
              as_json) -> None:
     try:
-        opts = _OptionErrors()
+        opts = _option_errors()
         if plot is not None:
             from .plot.contact import contact_figure_files
 
@@ -1338,7 +1314,7 @@ def modes(
     from .results.export import check_dataset_output, save_dataset
 
     try:
-        opts = _OptionErrors()
+        opts = _option_errors()
         opts(_at_least, count, 1, "--count", "20")
         opts(_check_figure_file, plot, "--plot", force)
         limit = opts(ux.quantity, below, "frequency", "--below")

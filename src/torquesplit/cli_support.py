@@ -276,6 +276,41 @@ PRINTED_DIGITS = 5
 """Significant digits the run tables print (1.0800, 12.036 kN)."""
 
 
+class OptionErrors:
+    """Every bad option of one command line, reported together: each check runs through
+    this collector (``value = opts(check, *args)``: None where it failed) and
+    :meth:`raise_any` raises one :class:`~torquesplit.errors.OptionError` with a line per
+    problem, the model file's and ``--set`` problems added, instead of one problem per
+    attempt.  ``load(model, assign, warn=False)`` reads a model as the command does."""
+
+    def __init__(self, load=None) -> None:
+        self.messages: list[str] = []
+        self.load = load
+
+    def __call__(self, check, *args, **kwargs):
+        from torquesplit.errors import OptionError, OutputError
+
+        try:
+            return check(*args, **kwargs)
+        except (OptionError, OutputError) as exc:  # (an --out path that cannot be written)
+            self.messages.append(str(exc))
+            return None
+
+    def raise_any(self, model: str | None = None, assign=None) -> None:
+        """Raise what was collected (nothing when every option is good), with the
+        problems of ``model`` and its ``--set`` arguments, read without warnings."""
+        from torquesplit.errors import OptionError, TorquesplitError
+
+        if not self.messages:
+            return
+        if model is not None and self.load is not None:
+            try:
+                self.load(model, assign, warn=False)
+            except (TorquesplitError, ValueError, OSError) as exc:
+                self.messages.append(str(exc).strip())
+        raise OptionError("\n".join(self.messages))
+
+
 def render_step_check(check, rows: int = 12, printed: int = PRINTED_DIGITS,
                       refine: str = "--steps-per-period") -> None:
     """How many significant digits of the numbers hold at half the step (harmonic

@@ -242,7 +242,15 @@ def test_cli_steady_sweep_and_campbell(tmp_path):
     assert out["complete"] and out["points"] >= 4 and (tmp_path / "s.png").exists()
     r = CliRunner().invoke(app, ["sweep-speed", EXAMPLE, "--keep", "stage1", "--from",
                                  "-700 rpm", "--to", "-700 rpm"])
-    assert r.exit_code == 2 and "positive speeds" in r.output
+    assert r.exit_code == 2 and "--from must be a positive speed" in r.output
+    assert "--to must be a positive speed" in r.output  # (both at once)
+    r = CliRunner().invoke(app, ["sweep-speed", EXAMPLE, "--keep", "stage1", "--from",
+                                 "700 rpm", "--to", "700 rpm"])
+    assert r.exit_code == 2 and "two different positive speeds" in r.output
+    r = CliRunner().invoke(app, ["sweep-speed", EXAMPLE, "--from", "700 rpm", "--to",
+                                 "800 rpm", "--points", "0", "--steps-per-cycle", "1"])
+    assert r.exit_code == 2 and "--points must be a whole number >= 1" in r.output
+    assert "--steps-per-cycle must be at least 10" in r.output
     r = CliRunner().invoke(app, ["modes", EXAMPLE, "--campbell", "--from", "300 rpm",
                                  "--to", "1200 rpm", "--json"])
     assert r.exit_code == 0, r.output

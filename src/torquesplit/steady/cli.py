@@ -13,6 +13,8 @@ from typing import Optional
 
 import typer
 from torquesplit._table import Table
+from torquesplit.cli_support import OptionErrors
+from torquesplit.errors import OptionError
 
 RPM = 60.0 / (2 * math.pi)
 
@@ -91,6 +93,32 @@ _INSTABILITY = {
 }
 
 
+def _check_method(method: str) -> None:
+    if method not in ("auto", "hb", "shooting"):
+        raise OptionError(f"--method {method!r} is unknown; use auto, hb or shooting")
+
+
+def _check_steps_per_cycle(steps_per_cycle) -> None:
+    if steps_per_cycle is not None and steps_per_cycle < 10:
+        raise OptionError(f"--steps-per-cycle must be at least 10 (e.g. 200), got "
+                          f"{steps_per_cycle}")
+
+
+def _check_count(value, option: str, example: str) -> None:
+    if value is not None and value < 1:
+        raise OptionError(f"{option} must be a whole number >= 1 (e.g. {example}), got {value}")
+
+
+def _check_positive_speed(text, option: str, example: str):
+    """The speed of an option [rad/s] (None if not given), refused unless positive."""
+    if text is None:
+        return None
+    value = _speed(text, option)
+    if not value > 0:
+        raise OptionError(f"{option} must be a positive speed, e.g. {example}; got {text!r}")
+    return value
+
+
 def _keep(keep):
     if keep is None:
         return None
@@ -144,23 +172,17 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
     ):
         """Periodic steady state at one speed: per-mesh table, residual, harmonics, stability."""
         try:
-            if method not in ("auto", "hb", "shooting"):
-                raise TorquesplitError(f"--method {method!r} is unknown; use auto, hb or "
-                                       "shooting")
-            if steps_per_cycle is not None and steps_per_cycle < 10:
-                raise TorquesplitError(f"--steps-per-cycle must be at least 10 (e.g. 200), "
-                                       f"got {steps_per_cycle}")
+            opts = OptionErrors(load)
+            opts(_check_method, method)
+            opts(_check_steps_per_cycle, steps_per_cycle)
             for value, option, example in ((max_cycles, "--max-cycles", "10000"),
                                            (harmonics, "--harmonics", "16")):
-                if value is not None and value < 1:
-                    raise TorquesplitError(f"{option} must be a whole number >= 1 (e.g. "
-                                           f"{example}), got {value}")
-            if speed is not None and not _speed(speed, "--speed") > 0:
-                raise TorquesplitError(f"--speed must be a positive speed, e.g. '3000 rpm'; "
-                                       f"got {speed!r}")
+                opts(_check_count, value, option, example)
+            opts(_check_positive_speed, speed, "--speed", "'3000 rpm'")
+            opts(_check_out, out, force=force)
+            opts.raise_any(model, assign)
             from torquesplit.steady.api import steady_state
 
-            _check_out(out, force=force)
             m, _ = load(model, assign)
             from torquesplit.cli_support import collect_warnings, progress
 
@@ -317,23 +339,23 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
     ):
         """Speed response by continuation: dynamic factor, load sharing, RMS TE vs speed."""
         try:
-            if method not in ("auto", "hb", "shooting"):
-                raise TorquesplitError(f"--method {method!r} is unknown; use auto, hb or "
-                                       "shooting")
             from torquesplit.results.export import check_dataset_output
             from torquesplit.steady.maps import sweep_speed
 
-            if steps_per_cycle is not None and steps_per_cycle < 10:
-                raise TorquesplitError(f"--steps-per-cycle must be at least 10 (e.g. 200), "
-                                       f"got {steps_per_cycle}")
-            step = None if max_step is None else _speed(max_step, "--max-step")
-            if step is not None and not step > 0:
-                raise TorquesplitError(f"--max-step must be a positive speed, e.g. '5 rpm'; "
-                                       f"got {max_step!r}")
+            opts = OptionErrors(load)
+            opts(_check_method, method)
+            opts(_check_steps_per_cycle, steps_per_cycle)
+            opts(_check_count, points, "--points", "50")
+            opts(_check_count, harmonics, "--harmonics", "16")
+            opts(_check_count, max_cycles, "--max-cycles", "1000")
+            for text, option in ((start, "--from"), (stop, "--to")):
+                opts(_check_positive_speed, text, option, "'1000 rpm'")
+            step = opts(_check_positive_speed, max_step, "--max-step", "'5 rpm'")
             if out is not None:  # (the CSV tables: per speed, per run-up/-down speed)
-                check_dataset_output(out, ("point", "check"), overwrite=force)
+                opts(check_dataset_output, out, ("point", "check"), overwrite=force)
             if plot is not None:
-                _check_out(plot, {".png": "png", ".svg": "svg", ".pdf": "pdf"}, force)
+                opts(_check_out, plot, {".png": "png", ".svg": "svg", ".pdf": "pdf"}, force)
+            opts.raise_any(model, assign)
             m, _ = load(model, assign)
             from torquesplit.cli_support import collect_warnings, progress
 

@@ -118,6 +118,8 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
 
     from torquesplit.metrics.load_sharing import group_meshes
 
+    if not (isinstance(points, (int, np.integer)) and points >= 1):
+        raise ValueError(f"points must be a whole number >= 1, got {points!r}")
     t_start = time.perf_counter()
     model, kin, s, dropped, per, static = _prepare(model, keep, max_cycles)
     sub = math.gcd(*[int(k) for k in per.orders]) if per.orders else 1
