@@ -11,6 +11,7 @@ text the run table and ``run --help`` print.
 
 from __future__ import annotations
 
+import math
 import sys
 import warnings
 from pathlib import Path
@@ -19,6 +20,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "src"))
 
 import torquesplit  # noqa: E402
+from torquesplit.convergence import agreeing_digits, check_step  # noqa: E402
 from torquesplit.metrics.load_sharing import (  # noqa: E402
     DEFINITION_TEXT, DEFINITION_USE, DYNAMIC_DEFINITIONS, STANDARD_DEFINITION)
 
@@ -107,6 +109,14 @@ per cents (the same code on another build of the numeric libraries moved its lar
 peak/nominal by 3 %): quote them to two digits at most.
 """
 
+def _held(value: float, checked: float, most: int = 5) -> str:
+    """``value`` to the significant digits ``checked`` confirms (at least one, trailing
+    zeros kept: 2.0000 is five digits)."""
+    digits = max(1, min(most, agreeing_digits(value, checked, most)))
+    decimals = max(0, digits - 1 - math.floor(math.log10(abs(value)))) if value else digits
+    return f"{value:.{decimals}f}"
+
+
 def main() -> None:
     lines = [HEAD]
     for d in DYNAMIC_DEFINITIONS:
@@ -115,7 +125,9 @@ def main() -> None:
     lines.append(ARGUMENT)
     lines.append("System load-sharing coefficient of each run by every definition, and the "
                  "largest dynamic factor (`python scripts/make_load_sharing_doc.py`; each "
-                 "example with its own `[analysis]` settings):\n\n")
+                 "example with its own `[analysis]` settings), each to the digits that hold "
+                 "when the run is repeated at half the step with four times the table points "
+                 "(`torquesplit run --check-step`; at most 5):\n\n")
     lines.append("| example | " + " | ".join(f"`{d}`" for d in DYNAMIC_DEFINITIONS)
                  + " | dynamic factor | peak/nominal |\n")
     lines.append("|---|" + "---|" * (len(DYNAMIC_DEFINITIONS) + 2) + "\n")
@@ -123,10 +135,11 @@ def main() -> None:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             res = torquesplit.simulate(torquesplit.load_model(torquesplit.example_path(name)))
-        values = res.metric_values()
-        cells = [f"{values[f'load_sharing.{d}']:.4f}" for d in DYNAMIC_DEFINITIONS]
-        lines.append(f"| `{name}` | " + " | ".join(cells)
-                     + f" | {values['dynamic_factor']:.3f} | {values['peak_to_nominal']:.3f} |\n")
+            check = check_step(res, definitions=DYNAMIC_DEFINITIONS)
+        keys = [f"load_sharing.{d}" for d in DYNAMIC_DEFINITIONS] + ["dynamic_factor",
+                                                                      "peak_to_nominal"]
+        cells = [_held(check.values[k], check.halved[k]) for k in keys]
+        lines.append(f"| `{name}` | " + " | ".join(cells) + " |\n")
         print(f"{name} done", file=sys.stderr)
     lines.append("\nThe peak-based coefficients include the dynamic increment: they differ "
                  "from the mean-force one by how differently the paths respond.\n")

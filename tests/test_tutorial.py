@@ -55,3 +55,30 @@ def test_the_tutorial_shows_every_step_and_links_only_shipped_files():
     for link in re.findall(r"\]\(([^)#]+)\)", text):
         assert (TUTORIAL.parent / link).exists(), link
     assert "Traceback" not in text and "error:" not in text
+
+
+def test_the_load_sharing_doc_prints_ji_and_lis_digits_that_hold():
+    """docs/load-sharing.md's table is a run's numbers to the digits that survive half the
+    step (it printed Dong et al. 2021's peak/nominal as 2.968, a value that moves by 3 %
+    with rounding-level changes)."""
+    import importlib.util
+    import warnings
+
+    from torquesplit.convergence import check_step
+    from torquesplit.metrics.load_sharing import DYNAMIC_DEFINITIONS
+
+    spec = importlib.util.spec_from_file_location(
+        "make_load_sharing_doc", ROOT / "scripts" / "make_load_sharing_doc.py")
+    gen = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(gen)
+    row = re.search(r"^\| `ji_li_mill_drive` \|(.*)\|$", gen.DOC.read_text(encoding="utf-8"),
+                    re.M)
+    assert row, "regenerate docs/load-sharing.md: python scripts/make_load_sharing_doc.py"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = torquesplit.simulate(torquesplit.example_path("ji_li_mill_drive"))
+        check = check_step(res, definitions=DYNAMIC_DEFINITIONS)
+    keys = [f"load_sharing.{d}" for d in DYNAMIC_DEFINITIONS] + ["dynamic_factor",
+                                                                  "peak_to_nominal"]
+    expected = [gen._held(check.values[k], check.halved[k]) for k in keys]
+    assert [c.strip() for c in row.group(1).split("|")] == expected
