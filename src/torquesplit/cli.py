@@ -25,7 +25,9 @@ from torquesplit._table import Table
 
 from . import cli_support as ux
 from .cli_support import header as _h
-from .errors import ModelError, ModelWarning, OptionError, TorquesplitError, clip_message
+from .errors import (ModelError, ModelWarning, OptionError, OutputError, TorquesplitError,
+                     clip_message)
+
 
 class _Command(typer.core.TyperCommand):
     """A command listed in --help without type noise: no ``<bool>`` on flags, no
@@ -135,6 +137,18 @@ def _at_least(value, minimum, option: str, example: str) -> None:
     if value is not None and value < minimum:
         raise OptionError(f"{option} must be a whole number of at least {minimum}, got "
                           f"{value}; give e.g. {option} {example}")
+
+
+def _check_out(out: Optional[Path], force: bool):
+    """The output plan of ``--out`` (None without it), its problems named by the option."""
+    if out is None:
+        return None
+    from .results import files
+
+    try:
+        return files.check_output(out, overwrite=force)
+    except OutputError as exc:
+        raise OptionError(f"--out: {exc}") from None
 
 
 def _check_method(method: Optional[str]) -> None:
@@ -416,10 +430,9 @@ def run(
             opts(_at_least, samples_per_period, 1, "--samples-per-period", "100")
             opts(_check_definition, definition)
             opts(_check_plots_folder, plots)
+            plan = opts(_check_out, out, force)
             opts.raise_any(model, assign)
-            plan = None
-            if out is not None:
-                plan = files.check_output(out, overwrite=force)
+            if plan is not None:
                 stack.enter_context(files.claim_output(plan))
             m, path = _load(model, assign)
             chosen = _run_definition(m, definition)
@@ -735,6 +748,9 @@ def static(
                                          "phase offsets, e.g. 96 for three planets 1/3 of a "
                                          "cycle apart, so that each samples the same "
                                          "phases).", metavar="N"),
+    max_points: int = typer.Option(20000, "--max-points", help="Most positions of the sweep "
+                                   "(a longer common period of the errors thins them, and "
+                                   "says so).", metavar="N"),
     out: Optional[Path] = typer.Option(None, "--out", help="Write results: .nc (NetCDF), .mat "
                                        "(MATLAB) or .csv (NAME.csv per position, NAME_mesh.csv "
                                        "per mesh).", metavar="FILE"),
@@ -758,6 +774,7 @@ def static(
             opts = _option_errors()
             opts(_positive, revolutions, "--revolutions", "1")
             opts(_at_least, points_per_cycle, 1, "--points-per-cycle", "32")
+            opts(_at_least, max_points, 16, "--max-points", "50000")
             if plots is not None:
                 from .plot.figures import STATIC_FIGURES, figure_files
 
@@ -779,7 +796,7 @@ def static(
                     ux.progress("quasi-static equilibria", quiet or as_json) as cb:
                 res = quasi_static_load_sharing(m, revolutions=revolutions,
                                                 points_per_cycle=points_per_cycle,
-                                                progress=cb)
+                                                max_points=max_points, progress=cb)
             for loc, msg in static_warnings(res):
                 ux.warn(f"{loc}: {msg}")
             res.warnings = list(ux.session().warnings)

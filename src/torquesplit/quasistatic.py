@@ -191,8 +191,8 @@ def quasi_static_load_sharing(model, *, revolutions: float | None = None,
         warnings.warn(
             f"the quasi-static sweep is cut to max_points = {max_points} positions, "
             f"{n / (period * f_max):.3g} per cycle of the fastest excitation ({f_max:.6g} "
-            f"Hz) instead of {per_cycle}; raise max_points (or give fewer "
-            f"revolutions) for the full density", ModelWarning, stacklevel=2)
+            f"Hz) instead of {per_cycle}; raise max_points (--max-points) or "
+            f"give fewer revolutions for the full density", ModelWarning, stacklevel=2)
     times = np.arange(n) * (period / n)
     sol = quasi_static(structure, times, progress=progress)
     return QuasiStaticResults(model=model, kinematics=kin, structure=structure, solution=sol)

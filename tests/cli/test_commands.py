@@ -48,6 +48,11 @@ def test_static_mesh_and_modes(tmp_path):
     path = write_model(tmp_path, split_model())
     data = json.loads(_ok(["static", str(path), "--json", "--points-per-cycle", "2"]))
     assert data["converged"] and data["load_sharing"]["system"] == pytest.approx(1.0)
+    # the sweep's advice to raise max_points has its option (it had none)
+    thin = runner.invoke(app, ["static", str(path), "--json", "--max-points", "16"])
+    assert thin.exit_code == 0, thin.output
+    assert any("cut to max_points = 16" in w and "--max-points" in w
+               for w in json.loads(thin.stdout)["warnings"])
     pair = write_model(tmp_path, SPUR_PAIR, "pair.toml")
     mesh = json.loads(_ok(["mesh", str(pair), "--pair", "m", "--json",
                            "--plot", str(tmp_path / "k.png")]))

@@ -7,6 +7,7 @@ Every test runs the command line on small models (a 6-gear, two-path split of
 from __future__ import annotations
 
 import json
+import math
 import os
 import re
 import signal
@@ -151,6 +152,28 @@ def test_errors_beyond_the_stated_grade_and_odd_backlash_are_flagged(tmp_path):
         "[gears.b2]", '[gears.a.errors]\ninstallation = "20 um"\ngrade = 3\n\n[gears.b2]')
     res = runner.invoke(app, ["check", str(write_model(tmp_path, bore, "bore.toml"))])
     assert res.exit_code == 0 and not warnings_of(res), res.stderr
+
+
+def test_a_pitch_error_is_checked_as_the_total_cumulative_deviation_it_models(tmp_path):
+    """The dynamics take ``pitch`` as F_p (a once-per-revolution harmonic of F_p/2), but
+    the check compared it with the single pitch tolerance f_pT, about 3x smaller: a
+    pitch error of a grade-6 gear was flagged as coarser than its grade."""
+    from torquesplit.gears import grades
+
+    model = torquesplit.load_model(write_model(tmp_path, split_model(), "m.toml"))
+    g = model.gears["a"]
+    d = g.teeth * g.module / math.cos(g.helix_angle)
+    f_pt = grades.single_pitch_tolerance(6, g.module, d)
+    big_f_pt = grades.total_cumulative_pitch_tolerance(6, g.module, d)
+    assert big_f_pt > 2 * f_pt
+    value = f"{0.5 * (f_pt + big_f_pt) * 1e6:.3f} um"  # above f_pT, within F_pT
+    text = split_model().replace(
+        "[gears.b2]", f'[gears.a.errors]\npitch = "{value}"\ngrade = 6\n\n[gears.b2]')
+    res = runner.invoke(app, ["check", str(write_model(tmp_path, text))])
+    assert res.exit_code == 0 and not warnings_of(res), res.stderr
+    text = text.replace(value, f"{2 * big_f_pt * 1e6:.3f} um")
+    res = runner.invoke(app, ["check", str(write_model(tmp_path, text))])
+    assert any("gears.a.errors.pitch" in w and "F_pT" in w for w in warnings_of(res)), res.stderr
 
 
 def test_a_dynamic_factor_above_three_points_to_modes(tension_run):

@@ -787,7 +787,7 @@ def tolerance_warnings(model: Model, kin) -> list[tuple[str, str]]:
       and (not the installation error: a housing's bore position, which the gear's grade
       does not bound) at the grade the file states (``errors.grade``, one grade step of
       margin);
-    * single pitch error against f_pT the same way;
+    * total cumulative pitch deviation (``pitch``) against F_pT the same way;
     * a planet pin position error (as an installation error, a runout of twice its
       size) and the eccentricity of the carrier that holds the gear against F_rT of the
       gear at grade 11;
@@ -816,14 +816,14 @@ def tolerance_warnings(model: Model, kin) -> list[tuple[str, str]]:
                 continue
             try:
                 tol = (grades.runout_tolerance if kind == "runout"
-                       else grades.single_pitch_tolerance)
+                       else grades.total_cumulative_pitch_tolerance)
                 coarsest = tol(11, g.module, d)
                 # the gear's grade bounds the gear, not the bore that holds it: an
                 # installation error gets the unit-slip check of grade 11 only
                 own = tol(stated, g.module, d) if stated and field != "installation" else None
             except ModelError:
                 continue  # outside the standard's scope: the size checks apply
-            name_tol = "runout tolerance F_rT" if kind == "runout" else                 "single pitch tolerance f_pT"
+            name_tol = "runout tolerance F_rT" if kind == "runout" else                 "total cumulative pitch tolerance F_pT"
             size = (f"{_length_text(value / 2)} ({what} {_length_text(value)})" if what
                     else _length_text(value))
             where = f"d = {d * 1e3:.4g} mm, m_n = {g.module * 1e3:.4g} mm"

@@ -245,7 +245,10 @@ class GearErrors(Strict):
     installation: Length = Field(0.0, ge=0, description="Installation (mounting) error amplitude.")
     installation_phase: Angle = Field(0.0, description="Direction of the installation error.")
     tooth_thickness: Length = Field(0.0, description="Tooth thickness error (Mo et al. 2017 §4).")
-    pitch: Length = Field(0.0, ge=0, description="Single pitch error amplitude (Mo et al. 2017 §4).")
+    pitch: Length = Field(0.0, ge=0, description=(
+        "Total cumulative pitch deviation F_p (peak-to-peak over a revolution, on the "
+        "reference circle), modelled by its once-per-revolution harmonic of amplitude "
+        "F_p/2 (Mo et al. 2017 §4.1); checked against the tolerance F_pT of ISO 1328-1."))
     bearing_runout: Length = Field(0.0, ge=0, description="Bearing run-out amplitude (Mo et al. 2017 §4).")
     bearing_runout_phase: Angle = Field(0.0, description="Phase of the bearing run-out.")
     grade: Count | None = Field(

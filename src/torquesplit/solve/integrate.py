@@ -783,7 +783,9 @@ def _plan_rk4(s, span, step, steps_per_period, check_stability, record_every,
                 f"the RK4 step is {per / spp:.3g} times shorter than {spp} steps per "
                 f"excitation period: {limited_by}; the run takes "
                 f"{math.ceil(span / h):,} steps. Check that element's stiffness and unit "
-                f"(and the inertias it joins), or use method='dopri'.", ModelWarning,
+                f"(and the inertias it joins): a stiffness this high is usually a slip of "
+                f"units; an adaptive method (dopri) is explicit too and needs as short a "
+                f"step, so it does not help.", ModelWarning,
                 stacklevel=4)
     else:
         h = float(step)

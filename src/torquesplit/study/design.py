@@ -494,7 +494,7 @@ def decimal_si(x: float, unit: str, si: str) -> float:
 
 # ============================================================================ Monte Carlo
 _ISO_DEFAULTS = {"eccentricity": ("runout", 0.5), "bearing_runout": ("runout", 1.0),
-                 "pitch": ("single_pitch", 1.0)}
+                 "pitch": ("total_cumulative_pitch", 1.0)}
 
 
 @dataclass(frozen=True)

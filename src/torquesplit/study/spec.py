@@ -188,7 +188,7 @@ class MonteCarloParameter(_Target):
     tolerance: Literal["runout", "single_pitch", "total_cumulative_pitch", "profile_slope",
                        "helix_slope"] | None = Field(None, description=(
         "iso1328: which tolerance bounds the value (default from the field: eccentricity -> "
-        "runout / 2, pitch -> single_pitch)."))
+        "runout / 2, pitch -> total_cumulative_pitch: the model's pitch is F_p)."))
     shape: Literal["normal", "uniform"] = Field("normal", description=(
         "iso1328: normal with +/-3 sigma = tolerance (truncated), or uniform in the band."))
     gear: str | None = Field(None, description=(
