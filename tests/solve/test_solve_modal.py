@@ -107,3 +107,19 @@ def test_damping_ratios_of_a_whirling_mass_match_the_damped_eigenvalues():
     lam = lam[lam.imag > 0][np.argsort(lam[lam.imag > 0].imag)]
     np.testing.assert_allclose(modes.frequencies, lam.imag / (2 * math.pi), rtol=1e-4)
     np.testing.assert_allclose(modes.damping_ratios, -lam.real / np.abs(lam), rtol=1e-4)
+
+
+@pytest.mark.parametrize("dx,closed,expected", [(0.0, True, 30.0),    # closed, at rest
+                                                (0.0, False, 0.0),    # floating at rest
+                                                (60e-6, False, 30.0)])  # radial contact
+def test_a_splines_modal_damping_leaves_its_friction_out(dx, closed, expected):
+    """The module leaves spline friction out of the modes, but the damping took its
+    regularised slope F_m / v (a 1e3 N friction over 1 mm/s: 1e6 N s/m, a damping ratio
+    of 42 on a reviewer's quill mode): only the law's damping c remains."""
+    from torquesplit.solve.modal import _spline_damping
+
+    # k, c, stick_limit, clearance, friction_force, velocity
+    par = [1e8, 30.0, 0.0, 50e-6, 1e3, 1e-3]
+    c2 = _spline_damping(par, dx, 0.0, closed=closed)
+    assert c2[0, 0] == pytest.approx(expected) and abs(c2[0, 1]) < 1e-12
+    assert np.all(c2 <= 30.0 + 1e-9)  # never the friction's 1e6 N s/m

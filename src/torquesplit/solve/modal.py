@@ -206,12 +206,17 @@ def _gyroscopic_modes(K, Gm, inv_mass, rigid_tolerance):
 
 
 def _spline_damping(par, dx: float, dy: float, closed: bool) -> np.ndarray:
-    """2 x 2 rate tangent (damping) of a spline's law at rest at (dx, dy): c + F_m / v on
-    the radial direction in contact, F_m / v floating, c in the stick region
-    (:func:`laws.spline_tangent`); ``closed``: as in contact, isotropic at R = 0."""
+    """2 x 2 rate tangent (damping) of a spline's law at rest at (dx, dy) without its
+    friction: c on the radial direction in contact and in the stick region, nothing
+    floating (:func:`laws.spline_tangent` with no friction force); ``closed``: as in
+    contact, isotropic at R = 0.  The friction is left out as for the stiffness: its
+    regularised slope at rest, F_m / v, is a viscous damping of the regularisation's
+    making (a ratio of 42 on a reviewer's quill mode), not the spline's."""
     if closed:
-        return (float(par[1]) + float(par[4]) / float(par[5])) * np.eye(2)
-    t = laws.spline_tangent(float(dx), float(dy), 0.0, 0.0, *map(float, par))
+        return float(par[1]) * np.eye(2)
+    p = [float(v) for v in par]
+    p[4] = 0.0  # friction_force
+    t = laws.spline_tangent(float(dx), float(dy), 0.0, 0.0, *p)
     return np.array([[t[4], t[5]], [t[6], t[7]]])
 
 
