@@ -137,3 +137,37 @@ def test_a_guarded_script_is_not_told_to_add_the_guard(tmp_path, monkeypatch):
     for path, want in ((guarded, ""), (bare, str(bare))):
         monkeypatch.setitem(sys.modules, "__main__", types.SimpleNamespace(__file__=str(path)))
         assert _unguarded_script() == want
+
+
+def test_campbell_order_labels_claim_equality_only_for_coinciding_lines():
+    """'1x m11, m21 = 8x m12, m22 = 9x ...' joined line ends 2 % of the axis apart, which
+    do not coincide, and printed dense low orders over each other."""
+    from torquesplit.steady.plot import _stacked, _thinned
+
+    # ten orders of a 32 Hz line end 32 Hz apart; a label is 100 Hz tall
+    ends = [(1000.0, 32.0 * k, f"{k}x m12") for k in range(1, 11)]
+    kept = _thinned(ends, 100.0)
+    heights = [y for _, y, _ in kept]
+    assert kept[0][2] == "1x m12" and kept[-1][2] == "10x m12"  # the range's ends
+    assert all(b - a >= 100.0 - 1e-9 for a, b in zip(heights[:-2], heights[1:-1]))
+    assert len(kept) < len(ends)
+    # two sources' labels 3 Hz apart: stacked a label's height apart, not joined
+    out = _stacked([(1000.0, 317.0, ["1x m11"], "C0"), (1000.0, 320.0, ["10x m12"], "C1")],
+                   100.0)
+    (_, y0, at0, _, _), (_, y1, at1, _, _) = out
+    assert at0 == y0 and at1 - at0 >= 100.0
+
+
+def test_campbell_labels_one_of_two_critical_speeds_half_a_percent_apart():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from torquesplit.steady.plot import _critical_labels
+
+    fig, ax = plt.subplots()
+    _critical_labels(ax, [527.4, 528.1, 600.0], 500.0, 1000.0)
+    texts = sorted(t.get_text() for t in ax.texts)
+    plt.close(fig)
+    assert texts == ["527", "600"] and len(ax.lines) == 3

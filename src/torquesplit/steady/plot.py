@@ -5,6 +5,7 @@ The figures consume the Datasets of :mod:`.maps` and recompute nothing.
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -187,7 +188,7 @@ def campbell_figure(ds):
     ax = fig.add_subplot()
     rpm = ds["speed_rpm"].values
     fmax = float(np.nanmax(ds["excitation_frequency"].values))
-    near = 0.02 * fmax * 1.05  # two labels closer than this (in Hz) would overlap
+    near = 0.02 * fmax * 1.05  # two mode labels closer than this (in Hz) would overlap
     ends: list[tuple[float, list[str]]] = []
     for m in range(ds.sizes["mode"]):
         fn = ds["natural_frequency"].values[:, m]
@@ -204,28 +205,37 @@ def campbell_figure(ds):
         order, _, source = str(lab).partition(" x ")
         sources.setdefault(source, []).append((j, int(order)))
     several = sum(len(m) > 1 for m in sources.values()) > 1
+    # a label's height in Hz: order labels closer than this are thinned (one source) or
+    # stacked with a leader line (lines of different sources)
+    height = (fmax * 1.05) * 9.0 / (fig.get_figheight() * 72 * ax.get_position().height)
     tops: list[tuple[float, float, list[str], str]] = []  # (x, y, labels, colour)
     for k, (source, members) in enumerate(sources.items()):
-        colour = f"C{k % 10}"  # matplotlib's colour cycle
+        colour = LINE_COLOURS[k % len(LINE_COLOURS)]
         orders = [o for _, o in members]
         label = source if orders == [1] else f"{source} x {min(orders)}..{max(orders)}"
         short = _short(source) if several else ""
+        ends = []
         for i, (j, order) in enumerate(members):
             fe = ds["excitation_frequency"].values[:, j]
             ax.plot(rpm, fe, lw=0.8, ls="--", color=colour, label=label if i == 0 else None)
             inside = np.flatnonzero(fe <= fmax * 1.05)
             if len(members) > 1 and inside.size:  # the order at the line's last point
-                x, y = float(rpm[inside[-1]]), float(fe[inside[-1]])
-                text = f"{order}x {short}".strip()
-                same = next((t for t in tops if abs(t[0] - x) < 1e-9 * max(abs(x), 1.0)
-                             and abs(t[1] - y) <= near), None)
-                if same is None:
-                    tops.append((x, y, [text], colour))
-                else:
-                    same[2].append(text)
-    for x, y, labels, colour in tops:  # right-aligned at the line's end: inside the axes
-        ax.annotate(" = ".join(labels), (x, y), fontsize=7, color=colour, xytext=(-3, 2),
-                    textcoords="offset points", ha="right", va="bottom")
+                ends.append((float(rpm[inside[-1]]), float(fe[inside[-1]]),
+                             f"{order}x {short}".strip()))
+        for x, y, text in _thinned(ends, height):
+            # '=' only for lines that coincide (a harmonic of one mesh on another's)
+            same = next((t for t in tops if abs(t[0] - x) < 1e-9 * max(abs(x), 1.0)
+                         and abs(t[1] - y) <= COINCIDE * max(abs(y), 1e-12)), None)
+            if same is None:
+                tops.append((x, y, [text], colour))
+            else:
+                same[2].append(text)
+    for x, y, at, labels, colour in _stacked(tops, height):  # right-aligned at the line's
+        ax.annotate(" = ".join(labels), (x, y), xytext=(x, at), textcoords="data",
+                    fontsize=7, color=colour, ha="right", va="bottom",
+                    bbox=dict(fc="white", ec="none", alpha=0.8, pad=0.3),
+                    arrowprops=(dict(arrowstyle="-", color=colour, lw=0.4) if at > y + 1e-9
+                                else None))
     rows = _critical_labels(ax, sorted(ds.attrs.get("critical_speeds_rpm", [])),
                             float(rpm.min()), float(rpm.max()))
     # crossings that the planets' mesh phasing leaves unexcited (Parker & Lin 2004)
@@ -250,9 +260,16 @@ def campbell_figure(ds):
     return fig
 
 
+#: excitation lines' colours: matplotlib's cycle without C3, the operating speed's red
+LINE_COLOURS = tuple(f"C{i}" for i in range(10) if i != 3)
+#: two order lines' ends printed as one label ("1x m11 = 8x m12") within this fraction
+COINCIDE = 1e-3
+
 #: a critical speed's label [points]: rotated text of this size, and the least gap
 #: between two labels of one row
 CRITICAL_FONT, CRITICAL_GAP, CRITICAL_ROWS = 7, 9.0, 3
+#: critical speeds within this fraction of a labelled one get no label of their own
+CRITICAL_SAME = 5e-3
 
 
 def _critical_labels(ax, crit, lo, hi) -> int:
@@ -262,13 +279,13 @@ def _critical_labels(ax, crit, lo, hi) -> int:
     rows used."""
     width_pt = ax.figure.get_figwidth() * 72 * 0.8  # about the axes' width
     last: list[float] = []
-    said: set[str] = set()  # two crossings at one printed speed (a degenerate pair of
-    for i, c in enumerate(crit):  # modes, two lines of one frequency): one label
-        ax.axvline(c, color="0.35", lw=0.6, ls=":",
+    said: list[float] = []  # crossings within CRITICAL_SAME of a labelled one (a
+    for i, c in enumerate(crit):  # degenerate pair of modes, two lines of one
+        ax.axvline(c, color="0.35", lw=0.6, ls=":",  # frequency): one label
                    label="critical speed (a crossing)" if i == 0 else None)
-        if f"{c:.0f}" in said:
+        if any(abs(c - p) <= CRITICAL_SAME * abs(p) for p in said):
             continue
-        said.add(f"{c:.0f}")
+        said.append(c)
         x = (c - lo) / max(hi - lo, 1e-12) * width_pt
         row = next((r for r, p in enumerate(last) if x - p >= CRITICAL_GAP), None)
         if row is None and len(last) < CRITICAL_ROWS:
@@ -287,6 +304,34 @@ def _short(source: str) -> str:
     """A short tag of an excitation source for a line's label."""
     text = source.removeprefix("meshes ").removeprefix("mesh ")
     return text if len(text) <= 18 else text[:16] + "..."
+
+
+def _thinned(ends: list, height: float) -> list:
+    """One source's order labels ``(x, y, text)`` at its lines' ends, every one whose end
+    clears the last kept by ``height`` (the lowest and the highest order always: the
+    legend gives the range), so that dense low orders do not print over each other."""
+    ends = sorted(ends, key=lambda e: (e[0], e[1]))
+    kept: list = []
+    for e in ends:
+        if not kept or e[0] != kept[-1][0] or e[1] - kept[-1][1] >= height:
+            kept.append(e)
+    if ends and kept[-1] is not ends[-1]:  # the highest order replaces the last kept
+        kept[-1 if len(kept) > 1 else len(kept):] = [ends[-1]]
+    return kept
+
+
+def _stacked(tops: list, near: float) -> list:
+    """The order labels ``(x, y, texts, colour)`` with a text height each: labels that end
+    at one speed are stacked upwards at least ``near`` apart (a leader line joins a
+    moved one to its line), not printed over each other."""
+    out = []
+    for x in sorted({t[0] for t in tops}):
+        column = sorted((t for t in tops if t[0] == x), key=lambda t: t[1])
+        at = -math.inf
+        for _, y, texts, colour in column:
+            at = max(y, at + near)
+            out.append((x, y, at, texts, colour))
+    return out
 
 
 def _merge_label(ends: list, y: float, text: str, near: float) -> None:
