@@ -81,7 +81,7 @@ _REPORTED_TEXT = {
 
 # ============================================================ dynamic run figures
 def mesh_force_figure(results, *, last_cycles: float | None = None,
-                      band_above: float = 150.0, bins: int = 400) -> Figure:
+                      band_above: float = 30.0, bins: int = 400) -> Figure:
     """Mesh force against time, one panel per load-sharing group, the paths overlaid.
 
     Parameters
@@ -92,9 +92,10 @@ def mesh_force_figure(results, *, last_cycles: float | None = None,
         Show only the last ``last_cycles`` mesh cycles of each group (each panel has its
         own time window).  Default: the whole run.
     band_above : float
-        A panel showing more than this many mesh cycles draws each mesh as the band
-        between its smallest and largest force in each mesh cycle (or in runs of whole
-        cycles, at most ``bins`` per panel), from the per-cycle extremes the integrator
+        Where a panel shows more than this many mesh cycles (a waveform there is a solid
+        block of colour), every panel draws each mesh as the band between its smallest
+        and largest force in each mesh cycle (or in runs of whole cycles, at most
+        ``bins`` per panel), from the per-cycle extremes the integrator
         streams at every step (and at the tables' corners), not from the decimated
         history, which can miss peaks between its samples.  Fewer cycles are drawn
         sample by sample from the history, with each complete cycle's streamed largest
@@ -117,7 +118,8 @@ def mesh_force_figure(results, *, last_cycles: float | None = None,
     starts, cols = results.solution.cycle_start, _cycle_columns(results)
     fig, axes = _panels(len(groups), sharex=last_cycles is None)
     scale, unit = _time_unit(t)
-    for ax, (g, members) in zip(axes, groups.items()):
+    shown_times = {}
+    for g, members in groups.items():
         keep = np.ones(t.shape, bool)
         if last_cycles is not None and t.size:
             # the end of the finite record (a diverged run stops being finite before t[-1])
@@ -125,9 +127,13 @@ def mesh_force_figure(results, *, last_cycles: float | None = None,
                                     .all(axis=1))
             t_end = t[finite[-1]] if finite.size else t[-1]
             keep = (t >= t_end - last_cycles / freq[g]) & (t <= t_end)
+        shown_times[g] = keep
+    # one way of drawing for the whole figure: bands where any panel is too dense
+    band = any(((t[k][-1] - t[k][0]) * freq[g] if k.any() else 0.0) > band_above
+               for g, k in shown_times.items())
+    for ax, (g, members) in zip(axes, groups.items()):
+        keep = shown_times[g]
         tk = t[keep]
-        n_cycles = (tk[-1] - tk[0]) * freq[g] if tk.size else 0.0
-        band = n_cycles > band_above
         for i, m in enumerate(members):
             style = _line_style(i, len(members))
             j, col = names.index(m), cols[m]
@@ -139,10 +145,14 @@ def mesh_force_figure(results, *, last_cycles: float | None = None,
                 tb, lo_b, _ = _bin_extremes(t0, lo, idx)
                 _, _, hi_b = _bin_extremes(t0, hi, idx)
                 tb = tb + 0.5 / freq[g]  # the bins' middles (t0 are cycle starts)
-                # light fill, edges in the mesh's own dash: overlapping bands stay apart
-                ax.fill_between(tb * scale, lo_b, hi_b, color=style["color"], alpha=0.12,
-                                lw=0, label=f"{m} (min-max of each cycle)")
-                ax.plot(tb * scale, hi_b, color=style["color"], lw=1.1, ls=style["ls"])
+                # edges in the mesh's own dash; a light fill for a lone mesh only (the
+                # fills of overlapping bands blend into a colour no legend entry has)
+                lab = f"{m} (largest and smallest of each cycle)"
+                if len(members) == 1:
+                    ax.fill_between(tb * scale, lo_b, hi_b, color=style["color"],
+                                    alpha=0.12, lw=0)
+                ax.plot(tb * scale, hi_b, color=style["color"], lw=1.1, ls=style["ls"],
+                        label=lab)
                 ax.plot(tb * scale, lo_b, color=style["color"], lw=1.1, ls=style["ls"])
                 continue
             ax.plot(tk * scale, forces[keep, j] * _KN, label=m, **style)
