@@ -176,6 +176,20 @@ def test_a_pitch_error_is_checked_as_the_total_cumulative_deviation_it_models(tm
     assert any("gears.a.errors.pitch" in w and "F_pT" in w for w in warnings_of(res)), res.stderr
 
 
+def test_a_position_off_the_operating_centre_distance_is_said_to_be_ignored(tmp_path):
+    """A wheel 50 um off the 60 mm centre distance (within the 0.1 % the layout accepts)
+    changed nothing and said nothing; 2 um (typed rounding) stays quiet."""
+    for offset, said in ((50, True), (2, False)):
+        text = SPUR_PAIR.replace('place = {from_gear = "pinion", angle = "0 deg"}',
+                                 f'position = ["{60 + offset * 1e-3:.6f} mm", "0 mm", "0 mm"]')
+        res = runner.invoke(app, ["check", str(write_model(tmp_path, text, f"o{offset}.toml"))])
+        assert res.exit_code == 0, res.output
+        hits = [w for w in warnings_of(res) if "off their operating centre distance" in w]
+        assert bool(hits) == said, res.stderr
+        if said:
+            assert "meshes.m" in hits[0] and f"+{offset} um" in hits[0]
+
+
 def test_a_dynamic_factor_above_three_points_to_modes(tension_run):
     data, stderr, nc, model = tension_run
     over = [m for m, r in data["metrics"]["meshes"].items() if r["dynamic_factor"] > 3]
