@@ -100,3 +100,13 @@ def test_a_speed_in_rpm_written_as_a_bare_number_is_flagged():
         torquesplit.load_model(data)
     texts = [str(w.message) for w in caught if issubclass(w.category, ModelWarning)]
     assert any("pitch-line speed" in t and "a bare number is read in rad/s" in t for t in texts)
+
+
+def test_a_unit_of_another_kind_is_named_by_that_kind():
+    """'50 N' for a length said '[mass] * [length] / [time] ** 2': it is a force."""
+    from torquesplit.model.units import parse_quantity
+
+    with pytest.raises(ValueError, match=r"is not a length \(it is a force, of dimension "):
+        parse_quantity("50 N", "length")
+    with pytest.raises(ValueError, match=r"it is of dimension \[length\] / \[time\]\)"):
+        parse_quantity("3 m/s", "inertia")

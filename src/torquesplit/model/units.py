@@ -135,7 +135,7 @@ def _parse_string(text: str, kind: str) -> float:
         else:
             fix = f"write it in {si_unit} or a compatible unit, e.g. '{example}'"
         raise ValueError(
-            f"{_short(text)} is not {_label(kind)} (its dimension is {_dimension_text(q)}); "
+            f"{_short(text)} is not {_label(kind)} ({_dimension_text(q)}); "
             f"{fix}"
         )
     if kind == "angle" and not (q.unitless or _is_angle_unit(q)):
@@ -205,8 +205,14 @@ def _is_angle_unit(q) -> bool:
 
 
 def _dimension_text(q) -> str:
+    """What a quantity of the wrong kind is: the kinds it could be (``a force``), and its
+    dimension (``[mass] * [length] / [time] ** 2``)."""
     dim = str(q.dimensionality)
-    return "dimensionless" if dim == "dimensionless" else dim
+    if dim == "dimensionless":
+        return "it is dimensionless"
+    kinds = [k for k in KINDS if _reference(k).dimensionality == q.dimensionality]
+    named = f"{' or '.join(_label(k) for k in kinds)}, of " if kinds else "of "
+    return f"it is {named}dimension {dim}"
 
 
 def _short(value, limit: int = QUOTE_LIMIT) -> str:
