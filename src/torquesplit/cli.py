@@ -379,8 +379,9 @@ def run(
         None, "--samples-per-period", help="History samples per shortest mesh period, for "
         "--out files, --plots figures and the bearing-force table (the mesh table's "
         "forces and coefficients are streamed at every step and do not depend on it); "
-        "default: every step up to 50,000 samples, else 50,000 over the run but at least "
-        "20 per period; a run warns when the history misses the peaks.", metavar="N"),
+        "default: every step of a run of at most 50,000, else every k-th step (at most "
+        "50,000 samples) but at least 20 per period; a run warns when the history misses "
+        "the peaks.", metavar="N"),
     definition: Optional[str] = typer.Option(None, "--definition", help=_definition_help(),
                                              metavar="NAME"),
     out: Optional[Path] = typer.Option(

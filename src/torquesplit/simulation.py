@@ -76,8 +76,9 @@ def simulate(
         History samples per shortest mesh period, >= 1 (plots, exports and the bearing
         forces: every mesh metric is computed from statistics streamed at every step).
         Default: every RK4 step while the run has at most
-        :data:`AUTO_HISTORY_RECORDS`, else that many samples evenly over the run, never
-        fewer than :data:`MIN_SAMPLES_PER_PERIOD` per period.
+        :data:`AUTO_HISTORY_RECORDS`, else every k-th step (at most that many samples;
+        Dormand-Prince: that many evenly over the run), never fewer than
+        :data:`MIN_SAMPLES_PER_PERIOD` per period.
     history_dofs : list of str, optional
         DOF names (``"gear.x"``) whose displacement and velocity histories to keep.
     full_history : bool
@@ -353,7 +354,14 @@ def prepare_run(
     track = [names.index(m) for m in mesh_names]
     hist_el = history_elements(structure, mesh_names)
     hist_dofs = list(history_dofs or [])
-    sample_interval = history_interval(duration, f_max, samples_per_period)
+    step = None
+    if method == "rk4" and samples_per_period is None:
+        # the default keeps every k-th of the run's whole number of fixed steps
+        from .solve.integrate import planned_step
+
+        h, _ = planned_step(structure, steps_per_period, duration)
+        step = duration / max(1, math.ceil(duration / h * (1 - 1e-12)))
+    sample_interval = history_interval(duration, f_max, samples_per_period, step)
     n_records = duration / sample_interval
     if n_records > MAX_HISTORY_RECORDS:
         asked = 1.0 / (sample_interval * f_max)
@@ -390,15 +398,21 @@ def prepare_run(
                        y0=y0, duration=float(duration), integrate_kwargs=kwargs, start=start)
 
 
-def history_interval(duration: float, f_max: float, samples_per_period: int | None) -> float:
+def history_interval(duration: float, f_max: float, samples_per_period: int | None,
+                     step: float | None = None) -> float:
     """Time between history samples [s]: ``samples_per_period`` per shortest mesh period
     (``f_max`` its frequency), or by default :data:`AUTO_HISTORY_RECORDS` over the run
     but at least :data:`MIN_SAMPLES_PER_PERIOD` a period.  An interval shorter than the
     RK4 step keeps every step (the history is sampled in time, so its size never depends
-    on the step)."""
+    on the step); given the fixed ``step``, the default is a whole number of steps, so
+    that the budget holds (rounding 1.2 steps to 1 kept 20 % more)."""
     if samples_per_period is not None:
         return 1.0 / (samples_per_period * f_max)
-    return min(1.0 / (MIN_SAMPLES_PER_PERIOD * f_max), duration / AUTO_HISTORY_RECORDS)
+    coarsest = 1.0 / (MIN_SAMPLES_PER_PERIOD * f_max)
+    if step:
+        every = math.ceil(duration / step / AUTO_HISTORY_RECORDS * (1 - 1e-12))
+        return min(max(every, 1) * step, coarsest)
+    return min(coarsest, duration / AUTO_HISTORY_RECORDS)
 
 
 #: runs estimated to take longer than this [s] or to keep more than ANNOUNCE_BYTES of

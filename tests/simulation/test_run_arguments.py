@@ -57,3 +57,16 @@ def test_the_default_history_keeps_every_step_of_a_short_run_and_a_budget_of_a_l
     middle = history_interval(1.0, f_max, None)  # 50 a period: the budget
     assert 1.0 / middle == pytest.approx(AUTO_HISTORY_RECORDS)
     assert history_interval(1e3, f_max, 7) == pytest.approx(1.0 / 7e3)
+
+
+def test_the_default_history_of_a_fixed_step_run_keeps_its_budget():
+    """60,512 steps kept 60,513 samples for a budget of 50,000 (an interval of 1.2 steps
+    rounded to 1): the default is a whole number of steps now."""
+    from torquesplit.simulation import AUTO_HISTORY_RECORDS, history_interval
+
+    step, n = 2e-5, 60_512
+    interval = history_interval(n * step, 100.0, None, step)
+    assert interval == pytest.approx(2 * step) and n * step / interval <= AUTO_HISTORY_RECORDS
+    assert history_interval(1e3 * step, 100.0, None, step) == pytest.approx(step)  # all
+    # never coarser than 20 samples per shortest mesh period
+    assert history_interval(1e7 * step, 100.0, None, step) == pytest.approx(1 / 2000)
