@@ -14,7 +14,8 @@ def plot_mesh_stiffness(comparison, path, *, cycles: int = 2, title: str | None 
     ----------
     comparison : MethodComparison, MeshStiffness or sequence of MeshStiffness
         What to draw.  For a :class:`~torquesplit.gears.stiffness.MethodComparison`
-        the ISO 6336-1 mean mesh stiffness ``c_gamma b`` is drawn as a dashed line.
+        the ISO 6336-1 mean mesh stiffness along the flank normal, ``c_gamma b /
+        cos^2 beta_b`` (as ``torquesplit mesh`` prints it), is drawn as a dashed line.
     path : str or Path
         Output file; the format follows the suffix (``.png``, ``.pdf``, ``.svg``).
         Stiffness is drawn in N/µm (= 1e6 N/m), as ``torquesplit mesh`` prints it.
@@ -43,13 +44,19 @@ def plot_mesh_stiffness(comparison, path, *, cycles: int = 2, title: str | None 
 
     fig = Figure(figsize=(7.5, 5.0), layout="constrained")
     ax = fig.add_subplot()
-    for lab, r in zip(labels, results):
+    # distinct dashes and widths, the first drawn widest: curves that coincide (a
+    # constant method on the ISO value) stay visible under each other
+    dashes = ["-", "--", "-.", ":", (0, (5, 1, 1, 1)), (0, (3, 1))]
+    for i, (lab, r) in enumerate(zip(labels, results)):
         ph = np.concatenate([r.phase + c for c in range(cycles)] + [np.array([float(cycles)])])
         k = np.concatenate([r.stiffness] * cycles + [r.stiffness[:1]])
-        ax.step(ph, k / 1e6, where="post", label=f"{lab} (mean {r.mean / 1e6:.5g} N/µm)")
+        ax.step(ph, k / 1e6, where="post", ls=dashes[i % len(dashes)],
+                lw=max(0.9, 2.6 - 0.5 * i), zorder=2 + i,
+                label=f"{lab} (mean {r.mean / 1e6:.5g} N/µm)")
     if iso is not None:
-        ax.axhline(iso / 1e6, color="k", linestyle="--", linewidth=1.0,
-                   label=f"ISO 6336-1 $c_\\gamma b$ = {iso / 1e6:.5g} N/µm")
+        ax.axhline(iso / 1e6, color="k", linestyle=(0, (8, 4)), linewidth=0.8, zorder=10,
+                   label=f"ISO 6336-1 $c_\\gamma b / \\cos^2\\beta_b$ = {iso / 1e6:.5g} N/µm "
+                         f"(along the flank normal)")
     ax.set_xlabel("mesh phase [mesh cycles]")
     ax.set_ylabel("mesh stiffness along the line of action [N/µm]")
     ax.set_xlim(0, cycles)
