@@ -172,6 +172,20 @@ def test_grid_axes_and_figures_of_log_and_3_parameter_grids(split_file):
     assert len(panels) == 2  # both values of the third parameter, on a log axis
     clims = {a.collections[0].get_clim() for a in panels}
     assert len(clims) == 1  # one colour scale for the member across the third parameter
+    # a small grid prints each cell's value (contours between the cells' centres crossed
+    # flat cells unlabelled); the error axis in µm, as the rest of the tool writes it
+    var = ds["load_sharing.cycle_peak"]
+    d = var.dims
+    values = var.isel({d[2]: 0}).transpose(d[1], d[0]).values.ravel()
+    texts = [t.get_text() for t in panels[0].texts]
+    assert texts == [f"{v:.4g}" for v in values]
+    assert "[µm]" in fig.axes[0].get_ylabel() or "[µm]" in fig.axes[0].get_xlabel() or any(
+        "µm" in a.get_title() for a in fig.axes)
+    ds["scaled"] = 2 * ds["load_sharing.cycle_peak"]  # a second member of the family
+    fig = maps_figure(ds, "load_sharing.cycle_peak", [("system", "load_sharing.cycle_peak"),
+                                                      ("twice", "scaled")])
+    clims = {a.collections[0].get_clim() for a in fig.axes if a.get_title()}
+    assert len(clims) == 1  # one scale for the family: a colour is a value in every panel
     one = run_study(grid_study(split_file, [{**STIFFNESS, "spacing": "log"}],
                                outputs=["load_sharing.cycle_peak"]), workers=1)
     fig = curves_figure(one, "load_sharing.cycle_peak",

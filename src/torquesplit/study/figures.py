@@ -131,12 +131,13 @@ def maps_figure(ds, family: str, members: list[tuple[str, str]]) -> Figure:
     x, xunit = _coord(ds, dims[0])
     y, yunit = _coord(ds, dims[1])
     unit, scale = _out_unit(members[0][1])
+    # one colour scale for the family (every member, every value of a third parameter):
+    # the same colour is the same value in every panel
+    full = np.concatenate([np.ravel(ds[v].values) * scale for _, v in members])
+    limits = ({"vmin": float(np.nanmin(full)), "vmax": float(np.nanmax(full))}
+              if np.isfinite(full).any() else {})
     for ax, ((member, var), r) in zip(axes, panels):
         data = ds[var]
-        # one colour scale per member over every value of the third parameter
-        full = data.values * scale
-        limits = ({"vmin": float(np.nanmin(full)), "vmax": float(np.nanmax(full))}
-                  if third and np.isfinite(full).any() else {})
         status = ds["status"]
         title = member
         if third:
@@ -149,13 +150,16 @@ def maps_figure(ds, family: str, members: list[tuple[str, str]]) -> Figure:
                              np.ma.masked_invalid(z), shading="flat", cmap="viridis", **limits)
         _log_axis(ds, dims[0], ax.set_xscale)
         _log_axis(ds, dims[1], ax.set_yscale)
-        if np.isfinite(z).all() and len(x) > 1 and len(y) > 1 and np.nanstd(z) > 0:
-            ax.contour(x, y, z, colors="w", linewidths=0.6, alpha=0.7)
+        if z.size <= CELL_VALUES:  # a small grid: each cell's value in it
+            _cell_values(ax, x, y, z, mesh)
+        elif np.isfinite(z).all() and len(x) > 1 and len(y) > 1 and np.nanstd(z) > 0:
+            lines = ax.contour(x, y, z, colors="w", linewidths=0.6, alpha=0.8)
+            ax.clabel(lines, fontsize=6, fmt="%.4g")
         bad = status.transpose(dims[1], dims[0]).values != "ok"
         if bad.any():
             yy, xx = np.nonzero(bad)
             ax.plot(np.asarray(x)[xx], np.asarray(y)[yy], "rx", ms=6, label="not ok")
-        bar = fig.colorbar(mesh, ax=ax, label=f"[{unit}]")
+        bar = fig.colorbar(mesh, ax=ax, label=f"[{unit}]")  # (the quantity: the title)
         bar.formatter.set_useOffset(False)
         bar.update_ticks()
         ax.set_title(title, fontsize=9)
@@ -314,6 +318,22 @@ def _out_unit(var_or_name: str) -> tuple[str, float]:
     return ("-" if unit == "1" else unit), 1.0
 
 
+#: a grid of at most this many cells prints each cell's value in it (no contours: drawn
+#: between the cells' centres, they crossed flat cells and missed the jumps between them)
+CELL_VALUES = 64
+
+
+def _cell_values(ax, x, y, z, mesh) -> None:
+    """Each cell's value at its centre, dark on light colours and light on dark ones."""
+    for (i, j), v in np.ndenumerate(z):
+        if not np.isfinite(v):
+            continue
+        r, g, b, _ = mesh.cmap(mesh.norm(v))
+        dark = 0.299 * r + 0.587 * g + 0.114 * b > 0.5
+        ax.text(x[j], y[i], f"{v:.4g}", ha="center", va="center", fontsize=6,
+                color="k" if dark else "w")
+
+
 def _coord(ds, name) -> tuple[np.ndarray, str]:
     """Coordinate values in the study's display unit."""
     c = ds[name]
@@ -324,10 +344,17 @@ def _coord(ds, name) -> tuple[np.ndarray, str]:
         from ..model.units import convert
 
         try:
-            return np.array([convert(v, si, disp) for v in values]), disp
+            return np.array([convert(v, si, disp) for v in values]), _unit_text(disp)
         except Exception:  # an unknown display unit: show SI
-            return values, si
-    return values, ("-" if si == "1" else si)
+            return values, _unit_text(si)
+    return values, ("-" if si == "1" else _unit_text(si))
+
+
+def _unit_text(unit: str) -> str:
+    """A unit as the figures write it: µm, not um."""
+    import re
+
+    return re.sub(r"\bu(?=[mgsNV]\b)", "µ", unit)
 
 
 def _edges(ds, name, values) -> np.ndarray:
