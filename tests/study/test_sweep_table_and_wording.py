@@ -21,7 +21,7 @@ def test_sweep_table_header_carries_the_unit(tmp_path, split_file):
                               "--workers", "1", "--out", str(tmp_path / "sw"), "--quiet",
                               "--no-figures"])
     assert res.exit_code == 0, res.output
-    assert "constant [um]" in res.stdout
+    assert "constant [µm]" in res.stdout
 
 
 def test_sweep_refuses_cycles_with_duration_by_flag(split_file):
