@@ -96,6 +96,9 @@ def test_zero_backlash_mesh_reports_double_flank_contact_everywhere(tension_run)
         j = list(ds["mesh"].values).index("a1")
         assert float(ds["back_flank_force"][j]) == pytest.approx(a1["back_flank_force"])
         assert int(ds["double_flank"][j]) == 1
+        # the mesh table's forces are variables of the file too (not only in metrics_json)
+        for name in ("mean_force", "peak_force", "min_force", "dynamic_factor_engineering"):
+            assert float(ds[name][j]) == pytest.approx(a1[name]), name
     table = runner.invoke(app, ["run", str(model), "--cycles", "60"])
     row = next(ln for ln in table.stdout.splitlines() if ln.lstrip("│ ").startswith("a1 "))
     cells = [c.strip() for c in row.split("│")]

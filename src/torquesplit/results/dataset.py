@@ -154,6 +154,16 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
         ds["peak_to_nominal"] = _var(("mesh",), [d.peak_to_nominal[m] for m in meshes], "1",
                                      "settled peak / equal-split nominal force (Ji & Li "
                                      "eq. 19)")
+        # the mesh table's forces, as the CSV has them (a .nc or .mat held them only
+        # inside metrics_json)
+        for name, field, text in (
+                ("mean_force", "mean_force", "mean force over the settled cycles"),
+                ("peak_force", "peak_force", "largest force over the settled cycles"),
+                ("min_force", "min_force", "smallest force over the settled cycles")):
+            ds[name] = _var(("mesh",), [getattr(r, field) for r in met.rows], "N", text)
+        ds["dynamic_factor_engineering"] = _var(
+            ("mesh",), [r.dynamic_factor_engineering for r in met.rows], "1",
+            "mean over settled cycles of the per-cycle peak / the mesh's own static force")
         ds["back_flank_force"] = _var(("mesh",), [r.back_flank_force for r in met.rows], "N",
                                       "largest back-flank (tensile) force over the settled "
                                       "cycles")
