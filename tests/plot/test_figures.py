@@ -408,3 +408,16 @@ def test_a_figure_of_many_cycles_draws_bands_in_every_panel(run):
         ax = _panel(fig, f"group {g}")
         labels = {ln.get_label() for ln in ax.get_lines()}
         assert all(f"{m} (largest and smallest of each cycle)" in labels for m in members)
+
+
+def test_a_tooth_pairs_load_is_one_continuous_curve_over_the_cycles():
+    """Pairs were numbered by the LTCA's column, which passes to the next pair each mesh
+    cycle: every curve jumped at phase 1 (15.2 -> 0 kN on a reviewer's helical pair)."""
+    from torquesplit.plot.contact import _pair_tracks
+
+    phase = np.arange(4) / 4.0
+    life = np.arange(8) / 4.0  # a pair's load over its two cycles in contact
+    loads = np.stack([life[:4], life[4:]], axis=1)  # column 0: its first cycle, 1: second
+    tracks = _pair_tracks(phase, loads)
+    whole = [v for ph, v in tracks if np.allclose(v[:8], life)]
+    assert len(whole) == 1  # one curve follows the pair through both cycles

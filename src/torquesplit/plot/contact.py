@@ -47,6 +47,32 @@ def _cycles(phase, values, cycles=2):
     return ph, v
 
 
+def _pair_tracks(phase, loads, cycles: int = 2) -> list:
+    """Each physical tooth pair's load over ``cycles`` mesh cycles, ``(phase, load)``.
+
+    ``loads`` (M positions, K pairs) numbers the pairs in contact at a position; after a
+    mesh cycle every pair has moved one place on (the next pair takes its number), so the
+    pair of column k continues in column k + s, s = +1 or -1: the shift whose columns
+    join without a jump.  Numbering by column would swap the curves at each cycle."""
+    m, k = loads.shape
+    jump = {s: sum(abs(loads[-1, c] - loads[0, c + s]) for c in range(k) if 0 <= c + s < k)
+            for s in (1, -1)}
+    shift = min(jump, key=jump.get) if k > 1 else 0
+    zero = np.zeros(m)
+    tracks = []
+    for first in range(-abs(shift) * cycles, k + abs(shift) * cycles):
+        cols = [first + c * shift for c in range(cycles)]
+        parts = [loads[:, c] if 0 <= c < k else zero for c in cols]
+        v = np.concatenate(parts)
+        if not v.max() > 0:
+            continue
+        last = cols[-1] + shift  # the value at the end: the next cycle's first sample
+        end = loads[:1, last] if 0 <= last < k else np.zeros(1)
+        tracks.append((np.concatenate([phase + c for c in range(cycles)] + [[float(cycles)]]),
+                       np.concatenate([v, end])))
+    return tracks
+
+
 def _arcsec_axis(ax, result, gear: str | None = None):
     """Right axis in arc seconds of gear 2 (named ``gear``) for a left axis in µm
     (normal)."""
@@ -178,15 +204,13 @@ def pressure_figure(result, title: str | None = None):
     ax1.set_ylabel("max Hertz pressure [MPa]")
     ax1.grid(True, alpha=0.3)
     loads = result.pair_load.sum(axis=1)            # (M, K) both helices
-    for k in range(loads.shape[1]):
-        if loads[:, k].max() > 0:
-            ph, v = _cycles(result.phase, loads[:, k] / 1e3)
-            ax2.plot(ph, v, label=f"tooth pair {k}")
+    for j, (ph, v) in enumerate(_pair_tracks(np.asarray(result.phase), loads / 1e3)):
+        ax2.plot(ph, v, label=f"tooth pair {j + 1}")
     ax2.set_xlabel("mesh phase [mesh cycles]")
     ax2.set_ylabel("tooth-pair load [kN]")
     ax2.set_xlim(0, 2)
     ax2.grid(True, alpha=0.3)
-    ax2.legend(fontsize="small", ncols=3)
+    ax2.legend(fontsize="small", ncols=4, loc="upper center", bbox_to_anchor=(0.5, -0.18))
     fig.suptitle(title or f"contact pressure and load sharing at {result.load / 1e3:.4g} kN")
     return fig
 
