@@ -504,8 +504,9 @@ def campbell(model, start: float, stop: float, *, points: int = 41,
     w_ref = reference_speed(model)
     lo, hi = _rad_per_s(start, "start"), _rad_per_s(stop, "stop")
     if not (lo > 0 and hi > lo and math.isfinite(hi)):
-        raise SolverError(f"the speed range {lo:g}..{hi:g} rad/s must be increasing and "
-                          f"positive; e.g. --from '1000 rpm' --to '3000 rpm'.")
+        rpm = 60.0 / (2.0 * math.pi)
+        raise SolverError(f"the speed range {lo * rpm:.6g}..{hi * rpm:.6g} rpm must be "
+                          f"increasing and positive; e.g. --from '1000 rpm' --to '3000 rpm'.")
     speeds = np.linspace(lo, hi, points)
     if s.n_gyroscopic:
         freqs = []
