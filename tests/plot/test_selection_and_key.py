@@ -51,3 +51,25 @@ def test_the_layout_writes_large_torques_without_an_exponent():
     svg = layout_svg(torquesplit.load_model("ji_li_mill_drive"))
     labels = re.findall(r"load \w+: [^<]*", svg) + re.findall(r"drive \w+: [^<]*", svg)
     assert labels and not any("e+" in text for text in labels), labels
+
+
+def test_the_layout_drawing_keeps_its_labels_apart():
+    """Fixed label offsets piled names on each other where parts sit close (17 overlapping
+    pairs on Ji & Li's drive: 'm11 backlash' over 'm21' and 'z1 19 T')."""
+    import itertools
+
+    import torquesplit
+    from torquesplit.plot.layout import layout_figure
+
+    fig = layout_figure(torquesplit.load_model(torquesplit.example_path("ji_li_mill_drive")))
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    boxes = [t.get_window_extent(renderer) for ax in fig.axes for t in ax.texts
+             if t.get_text().strip()]
+    assert len(boxes) > 10
+
+    def overlap(a, b):
+        return (min(a.x1, b.x1) - max(a.x0, b.x0) > 2
+                and min(a.y1, b.y1) - max(a.y0, b.y0) > 2)
+
+    assert sum(overlap(a, b) for a, b in itertools.combinations(boxes, 2)) == 0

@@ -280,7 +280,45 @@ def layout_figure(model, kin=None, *, width: float = 10.0) -> Figure:
                  f"{len(model.meshes)} meshes\nviewed along {depth} (depth along the "
                  f"diagonal at half scale); pitch circles", fontsize=11)
     ax.margins(0.12)
+    _separate_labels(fig, ax)
     return fig
+
+
+#: where a label that overlaps one placed before it is tried instead: its offsets from
+#: where it was put [points], nearest first
+_NUDGES = [(0, -11), (0, 11), (0, -22), (0, 22), (0, -33), (0, 33), (40, 0), (-40, 0),
+           (40, -16), (-40, 16), (0, -44), (0, 44), (70, 0), (-70, 0), (40, 22),
+           (-40, -22), (0, -55), (0, 55), (70, -22), (-70, 22)]
+
+
+def _separate_labels(fig, ax) -> None:
+    """Move each named label that overlaps one placed before it (in the order drawn:
+    gears first) to the nearest of :data:`_NUDGES` where it overlaps none (at most 74
+    points from where it was: still beside its part); a label with no free place stays
+    where it was.  The offsets
+    of the drawing code put every label beside its part, but neighbouring gears, a
+    support under a mesh label or a drive over a load piled them up (51 overlapping pairs
+    on Dong et al. 2021's drive)."""
+    from matplotlib.text import Annotation
+
+    fig.canvas.draw()  # (text extents need a renderer)
+    renderer = fig.canvas.get_renderer()
+    px = fig.dpi / 72.0
+    placed = []
+    for ann in [t for t in ax.texts if isinstance(t, Annotation) and t.get_text()]:
+        if ann.anncoords != "offset points":
+            placed.append(ann.get_window_extent(renderer).padded(1.0))
+            continue
+        x0, y0 = ann.xyann
+        box = ann.get_window_extent(renderer).padded(1.0)
+        if any(box.overlaps(b) for b in placed):
+            for dx, dy in _NUDGES:
+                moved = box.translated(dx * px, dy * px)
+                if not any(moved.overlaps(b) for b in placed):
+                    ann.xyann = (x0 + dx, y0 + dy)
+                    box = moved
+                    break
+        placed.append(box)
 
 
 def _support_text(sup) -> str:
