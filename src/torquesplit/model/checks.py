@@ -860,7 +860,8 @@ def tolerance_warnings(model: Model, kin) -> list[tuple[str, str]]:
                 own = tol(stated, g.module, d) if stated and field != "installation" else None
             except ModelError:
                 continue  # outside the standard's scope: the size checks apply
-            name_tol = "runout tolerance F_rT" if kind == "runout" else                 "total cumulative pitch tolerance F_pT"
+            name_tol = ("runout tolerance F_rT" if kind == "runout"
+                        else "total cumulative pitch tolerance F_pT")
             size = (f"{_length_text(value / 2)} ({what} {_length_text(value)})" if what
                     else _length_text(value))
             where = f"d = {d * 1e3:.4g} mm, m_n = {g.module * 1e3:.4g} mm"
