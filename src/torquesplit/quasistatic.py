@@ -200,11 +200,11 @@ def quasi_static_load_sharing(model, *, revolutions: float | None = None,
 
 def _positions_per_cycle(structure, f_max: float, points_per_cycle: int,
                          most: int = 64) -> int:
-    """``points_per_cycle`` made a multiple of the denominators of
-    the meshes' phase offsets (sequentially phased planets, branches 120 deg apart: thirds
-    of a cycle), so that every mesh of the fastest frequency samples the same phases of its
-    cycle: its position-averaged load is then that of the others exactly, not up to a
-    sampling error of the stiffness steps (0.24 % on K_gamma for three planets at 32).
+    """``points_per_cycle`` made a multiple of the denominators of the meshes' phase
+    offsets (sequentially phased planets, branches 120 deg apart: thirds of a cycle), so
+    that every mesh of the fastest frequency samples the same phases of its cycle: its
+    position-averaged load is then that of the others exactly, not up to a sampling error
+    of the stiffness steps (0.24 % on K_gamma for three planets at 32).
     The least common multiple keeps every position the density gave (a factor of at most
     4), else the density is rounded up to a multiple.  Offsets with no denominator up to
     ``most`` leave the density as it is."""

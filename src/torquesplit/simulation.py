@@ -26,8 +26,8 @@ from .model.kinematics import solve_kinematics
 #: largest number of decimated history records kept by default
 MAX_HISTORY_RECORDS = 200_000
 #: the default history (``samples_per_period=None``) keeps every RK4 step while the run
-#: has at most this many, else this many samples evenly over the run, but never fewer
-#: than :data:`MIN_SAMPLES_PER_PERIOD` per shortest mesh period
+#: has at most this many, else every k-th step (at most this many samples), but never
+#: fewer than :data:`MIN_SAMPLES_PER_PERIOD` per shortest mesh period
 AUTO_HISTORY_RECORDS = 50_000
 MIN_SAMPLES_PER_PERIOD = 20
 #: default step budget of a run (about 1-5 minutes of integration on one core)
