@@ -314,3 +314,23 @@ def test_a_study_folder_that_is_a_file_is_refused(tmp_path, split_file):
                                            "values": [0.05, 0.06]}], cycles=5))
     with pytest.raises(StudyError, match="is a file; a study writes a folder"):
         study.run(out=f)
+
+
+def test_progress_is_told_when_the_cases_start_and_a_refused_sweep_draws_no_bar(
+        tmp_path, split_file):
+    """The bar now shows from the first report, so a study refused before it starts (its
+    folder holds another study) drew an empty 'cases 0/3' bar above its error; the first
+    report comes before the first case (which may compile for 20 s)."""
+    from typer.testing import CliRunner
+
+    from torquesplit.cli import app
+
+    seen = []
+    out = tmp_path / "out"
+    Study(grid_study(split_file, GRID)).run(workers=1, out=out, figures=False,
+                                            progress=lambda p: seen.append((p.computed, p.last)))
+    assert seen[0] == (0, None) and seen[-1][0] == 10
+    res = CliRunner().invoke(app, ["sweep", str(split_file), "--vary",
+                                   "meshes.a1.stiffness=2e8:4e8:3 N/m", "--out", str(out)])
+    assert res.exit_code == 2 and "already holds a study" in res.stderr
+    assert "cases" not in res.stderr.replace("cases (grid", ""), res.stderr

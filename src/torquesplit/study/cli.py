@@ -154,16 +154,24 @@ def _with_bar(job, total: int, quiet: bool):
                                TimeElapsedColumn, TimeRemainingColumn)
 
     ui = _ui()
-    with Progress(TextColumn("cases"), BarColumn(), MofNCompleteColumn(),
-                  TextColumn("[red]{task.fields[failed]} not ok"), TimeElapsedColumn(),
-                  TextColumn("ETA"), TimeRemainingColumn(), console=ui.err_console,
-                  transient=False) as bar:
-        task = bar.add_task("study", total=total, failed=0)
+    bar = Progress(TextColumn("cases"), BarColumn(), MofNCompleteColumn(),
+                   TextColumn("[red]{task.fields[failed]} not ok"), TimeElapsedColumn(),
+                   TextColumn("ETA"), TimeRemainingColumn(), console=ui.err_console,
+                   transient=False)
+    task = []  # the bar shows from the first report: a study refused before it starts
+    #            (its folder holds another study) draws no empty bar above the error
 
-        def cb(p):
-            bar.update(task, completed=p.done, total=p.total, failed=p.failed)
+    def cb(p):
+        if not task:
+            bar.start()
+            task.append(bar.add_task("study", total=total, failed=0))
+        bar.update(task[0], completed=p.done, total=p.total, failed=p.failed)
 
+    try:
         return job(cb)
+    finally:
+        if task:
+            bar.stop()
 
 
 def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:

@@ -66,7 +66,8 @@ CLI_WORDS = Words(out="--out", resume="--resume", resume_on="--resume",
 
 @dataclass(frozen=True)
 class Progress:
-    """What the progress callback is told after each finished case."""
+    """What the progress callback is told when the cases start (``last`` None, nothing
+    computed yet) and after each finished case."""
 
     done: int
     """Cases finished (this run and earlier runs of the same study)."""
@@ -79,7 +80,7 @@ class Progress:
     elapsed: float
     """Seconds since this run started."""
     last: dict | None
-    """The case that just finished (index, status, reason, values...)."""
+    """The case that just finished (index, status, reason, values...); None at the start."""
 
 
 class Study:
@@ -456,6 +457,10 @@ class _Driver:
         results = self.runner(run_case, self._payloads())
         state = "interrupted"
         try:
+            # the cases start: a progress bar shows at once (a first case compiles)
+            if self.progress is not None:
+                self.progress(Progress(int(self.finished[: self._target()].sum()),
+                                       self.failed, self._target(), 0, 0.0, None))
             for r in results:
                 store.put(r)
                 self.computed += 1
