@@ -511,3 +511,23 @@ def test_a_model_can_accept_a_warning_with_its_reason():
     data["model"]["accepted_warnings"] = [{"field": "meshes.*.stiffness", "reason": ""}]
     with pytest.raises(torquesplit.ModelError, match="accepted_warnings.0.reason"):
         load(data)
+
+
+def test_an_accepted_warning_that_matches_nothing_is_said_by_check(tmp_path):
+    """An entry that matched no warning was listed by 'check' as accepted, silently
+    accepting nothing (a misspelt field, or a warning the model no longer raises)."""
+    from typer.testing import CliRunner
+
+    from torquesplit.cli import app
+
+    data = pair_dict()
+    data["meshes"]["m"]["stiffness"] = "1e7 N/m"  # warned: accepted by the first entry
+    data["model"]["accepted_warnings"] = [
+        {"field": "meshes.*.stiffness", "reason": "as measured on the test rig"},
+        {"field": "meshes.*.stifness", "reason": "a typing error"}]
+    path = tmp_path / "m.json"
+    path.write_text(json.dumps(data))
+    res = CliRunner().invoke(app, ["check", str(path)])
+    assert res.exit_code == 0, res.output
+    said = [ln for ln in res.stderr.splitlines() if "accepted_warnings" in ln]
+    assert len(said) == 1 and "accepted_warnings.1" in said[0] and "stifness" in said[0]

@@ -98,11 +98,22 @@ def check_model(model: Model, source: str | None = None, *, deep: bool = False) 
         issues, notes = _readiness(model, kin)
     if issues:
         raise ModelError(as_written(model, issues), source)
-    warned = plausibility_warnings(model, kin) + rim_overlap_warnings(model, kin) + notes
-    for loc, msg in as_written(model, warned):
+    warned = as_written(model, plausibility_warnings(model, kin)
+                        + rim_overlap_warnings(model, kin) + notes)
+    for loc, msg in warned:
         if accepted(model, loc) is not None:
             continue  # known and accepted in the file, with its reason
         warnings.warn(f"{source + ': ' if source else ''}{loc}: {msg}", ModelWarning, stacklevel=3)
+    if deep:  # (every check ran: an entry that matches none of them accepts nothing)
+        import fnmatch
+
+        for i, a in enumerate(model.model.accepted_warnings):
+            if not any(fnmatch.fnmatchcase(loc, a.field) for loc, _ in warned):
+                warnings.warn(
+                    f"{source + ': ' if source else ''}model.accepted_warnings.{i}: "
+                    f"{a.field!r} matches no warning of this model's checks; remove the "
+                    f"entry, or correct its field (the field a warning names, '*' for any "
+                    f"part)", ModelWarning, stacklevel=3)
 
 
 def accepted(model: Model, loc: str) -> str | None:
