@@ -158,8 +158,9 @@ def _with_bar(job, total: int, quiet: bool):
                    TextColumn("[red]{task.fields[failed]} not ok"), TimeElapsedColumn(),
                    TextColumn("ETA"), TimeRemainingColumn(), console=ui.err_console,
                    transient=False)
-    task = []  # the bar shows from the first report: a study refused before it starts
-    #            (its folder holds another study) draws no empty bar above the error
+    # the bar shows from the first report: a study refused before it starts (its folder
+    # holds another study) draws no empty bar above the error
+    task = []
 
     def cb(p):
         if not task:
