@@ -354,13 +354,12 @@ def prepare_run(
     track = [names.index(m) for m in mesh_names]
     hist_el = history_elements(structure, mesh_names)
     hist_dofs = list(history_dofs or [])
-    step = None
-    if method == "rk4" and samples_per_period is None:
-        # the default keeps every k-th of the run's whole number of fixed steps
-        from .solve.integrate import planned_step
+    planned = step = None
+    if method == "rk4":  # (the fixed step: the history's default and the cost use it)
+        from .solve.integrate import planned_step, whole_steps
 
-        h, _ = planned_step(structure, steps_per_period, duration)
-        step = duration / max(1, math.ceil(duration / h * (1 - 1e-12)))
+        planned = planned_step(structure, steps_per_period, duration)
+        step = whole_steps(duration, planned[0])[1]
     sample_interval = history_interval(duration, f_max, samples_per_period, step)
     n_records = duration / sample_interval
     if n_records > MAX_HISTORY_RECORDS:
@@ -389,7 +388,7 @@ def prepare_run(
     )
     if method == "rk4":
         kwargs["steps_per_period"] = steps_per_period
-        _check_cost(structure, duration, steps_per_period,
+        _check_cost(structure, duration, planned,
                     MAX_STEPS if max_steps is None else int(max_steps),
                     n_meshes=len(mesh_names), f_max=f_max, n_history=len(hist_el))
     else:
@@ -421,15 +420,14 @@ ANNOUNCE_SECONDS = 20.0
 ANNOUNCE_BYTES = 500 * 1024**2
 
 
-def _check_cost(structure, duration: float, steps_per_period: int, max_steps: int, *,
+def _check_cost(structure, duration: float, planned: tuple[float, str], max_steps: int, *,
                 n_meshes: int = 0, f_max: float = 0.0, n_history: int = 0) -> None:
     """Refuse an RK4 run beyond the step budget, announce a long one (the cost known
-    before integrating: the step is fixed) with its time and memory."""
-    from .solve.integrate import planned_step
-
+    before integrating: the step is fixed) with its time and memory; ``planned`` is
+    :func:`~torquesplit.solve.integrate.planned_step`'s ``(step, what sets it)``."""
     if max_steps < 1:
         raise SolverError(f"max_steps must be >= 1, got {max_steps}")
-    h, why = planned_step(structure, steps_per_period, duration)
+    h, why = planned
     n_steps = math.ceil(duration / h)
     # about 60 ns per DOF and step with the generated right-hand side (benchmarks/)
     seconds = n_steps * 6e-8 * max(structure.n_dof, 1)

@@ -105,10 +105,8 @@ def check_model(model: Model, source: str | None = None, *, deep: bool = False) 
             continue  # known and accepted in the file, with its reason
         warnings.warn(f"{source + ': ' if source else ''}{loc}: {msg}", ModelWarning, stacklevel=3)
     if deep:  # (every check ran: an entry that matches none of them accepts nothing)
-        import fnmatch
-
         for i, a in enumerate(model.model.accepted_warnings):
-            if not any(fnmatch.fnmatchcase(loc, a.field) for loc, _ in warned):
+            if not any(_accepts(a, loc) for loc, _ in warned):
                 warnings.warn(
                     f"{source + ': ' if source else ''}model.accepted_warnings.{i}: "
                     f"{a.field!r} matches no warning of this model's checks; remove the "
@@ -119,12 +117,17 @@ def check_model(model: Model, source: str | None = None, *, deep: bool = False) 
 def accepted(model: Model, loc: str) -> str | None:
     """The reason of the model's ``accepted_warnings`` entry that matches the warned
     field ``loc`` ('*' matches any part), or None."""
-    import fnmatch
-
     for a in model.model.accepted_warnings:
-        if fnmatch.fnmatchcase(loc, a.field):
+        if _accepts(a, loc):
             return a.reason
     return None
+
+
+def _accepts(entry, loc: str) -> bool:
+    """Whether an ``accepted_warnings`` entry names the warned field ``loc``."""
+    import fnmatch
+
+    return fnmatch.fnmatchcase(loc, entry.field)
 
 
 def as_written(model: Model, issues) -> list[tuple[str, str]]:

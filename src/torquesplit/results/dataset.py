@@ -138,7 +138,8 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
                                   "displacement from the nominal rigid motion")
         ds["velocity"] = _var(("time", "history_dof"), s.history_v, "m/s or rad/s",
                               "vibratory velocity")
-    _note_sampling(ds, s.history_t, res.statistics().get("step_s"))
+    _note_sampling(ds, s.history_t, res.statistics().get("step_s"),
+                   res.history_keeps_every_step())
     if definition is not None and hasattr(res, "check_definition"):
         res.check_definition(definition)  # a misspelt one raises; a diverged run's do not
     try:
@@ -255,8 +256,9 @@ def _steady_attributes(ds: xr.Dataset, res, steady) -> None:
                 f"({info['method']}), repeated; the metrics come from every step of it")
 
 
-def _note_sampling(ds: xr.Dataset, t, step) -> None:
-    """Say on each history variable that it is decimated, and its sample interval [s]."""
+def _note_sampling(ds: xr.Dataset, t, step, every_step: bool) -> None:
+    """Say on each history variable that it is decimated (or holds ``every_step``), and
+    its sample interval [s]."""
     t = np.asarray(t, dtype=float)
     if t.size < 2:
         return
@@ -265,7 +267,7 @@ def _note_sampling(ds: xr.Dataset, t, step) -> None:
              "steps")
     note = (f"decimated history for plots, sampled every {dt:.4g} s ({steps}); the metrics "
             "come from statistics of every step")
-    if step and dt < 1.5 * step:
+    if every_step:
         note = f"history of every integration step ({dt:.4g} s)"
     for name in ("element_force", "displacement", "velocity"):
         if name in ds:

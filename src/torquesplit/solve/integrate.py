@@ -769,6 +769,18 @@ def planned_step(structure: Structure, steps_per_period: int | None = None,
     return h, why
 
 
+def whole_steps(span: float, h: float) -> tuple[int, float]:
+    """``(n, step)``: the fixed RK4 steps that span ``span`` [s] with steps of at most
+    about ``h`` (h is kept when it already divides the span)."""
+    n_float = span / h
+    n_steps = int(round(n_float))
+    if n_steps < 1 or abs(n_float - n_steps) > 1e-9 * n_float:
+        n_steps = max(1, int(math.ceil(n_float)))
+    if abs(n_steps * h - span) > 1e-12 * span:
+        h = span / n_steps
+    return n_steps, h
+
+
 def _plan_rk4(s, span, step, steps_per_period, check_stability, record_every,
               sample_interval, full_history, max_steps) -> _Plan:
     spp = 100 if steps_per_period is None else int(steps_per_period)
@@ -793,13 +805,7 @@ def _plan_rk4(s, span, step, steps_per_period, check_stability, record_every,
             check_step(s, h)
         elif not (h > 0 and math.isfinite(h)):
             raise ValueError(f"step must be a positive number of seconds, got {step!r}.")
-    # a whole number of steps spans t_span (h is kept when it already divides it)
-    n_float = span / h
-    n_steps = int(round(n_float))
-    if n_steps < 1 or abs(n_float - n_steps) > 1e-9 * n_float:
-        n_steps = max(1, int(math.ceil(n_float)))
-    if abs(n_steps * h - span) > 1e-12 * span:
-        h = span / n_steps
+    n_steps, h = whole_steps(span, h)
     if sample_interval is not None:
         every = max(1, int(round(float(sample_interval) / h)))
     else:
