@@ -711,7 +711,8 @@ def bearing_table(bearings: list[dict], res) -> Table:
         b.add_column(_h(col), justify="left" if col in ("body", "directions in") else "right")
     for r, frame in zip(bearings, frames):
         means = ", ".join(f"{d} {v / 1e3:.5g}" for d, v in zip(r["directions"], r["mean"]))
-        b.add_row(r["body"], means, f"{r['mean_magnitude'] / 1e3:.5g}",
+        body = f"{r['body']} (spline {r['via']})" if r.get("via") else r["body"]
+        b.add_row(body, means, f"{r['mean_magnitude'] / 1e3:.5g}",
                   f"{r['peak_magnitude'] / 1e3:.5g}", *([frame] if turning else []))
     return b
 

@@ -249,3 +249,32 @@ def test_a_splines_backlash_is_a_dead_zone_of_its_torsion_spring():
     assert abs(f0) > 1e3 and f1 == pytest.approx(f0, rel=1e-2)
     half = 0.5 * 100e-6 / sp.pitch_radius
     assert d1 == pytest.approx(f1 / sp.torsional_stiffness + half * np.sign(f1), rel=1e-9)
+
+
+def test_a_body_held_by_its_spline_alone_has_its_bearing_force_in_the_table():
+    """A new user's floating pinion was missing from the bearing table (only supports were
+    listed).  The spline's radial force is its bearing force: on average it takes the net
+    force the two meshes put on the pinion (the paths unbalanced by the error)."""
+    model = torquesplit.load_model(tomllib.loads(floating_pinion(clearance="0 um")),
+                                   check=False)
+    res = torquesplit.simulate(model, cycles=200)
+    rows = {r["body"]: r for r in res.bearing_forces()}
+    assert rows["pinion"]["via"] == "sp" and rows["pinion"]["directions"] == ["x", "y"]
+    s, el = res.solution, res.structure
+    keep = s.history_t >= res.metrics().settling.start_time
+    V = el.projection_matrix()
+    hist = list(s.history_elements)
+    # force of the meshes on the pinion: -V_e^T f_e on its DOFs; the bearing takes it
+    net = np.zeros(2)
+    for m in ("pa", "pb"):
+        e = el.element_names.index(m)
+        f = s.history_forces[keep, hist.index(e)].mean()
+        net -= f * np.array([V[e, el.dof_names.index(f"pinion.{d}")] for d in "xy"])
+    assert np.linalg.norm(net) > 10.0  # the error unbalances the paths
+    np.testing.assert_allclose(rows["pinion"]["mean"], net, rtol=2e-3)
+    from torquesplit.cli import bearing_table
+    from rich.console import Console
+
+    console = Console(width=200, record=True)
+    console.print(bearing_table(res.bearing_forces(), res))
+    assert "pinion (spline sp)" in console.export_text()

@@ -392,6 +392,7 @@ def support_spectrum_figure(results, *, start_time: float | None = None, orders:
     """
     s = results.solution
     supports = results.support_columns()
+    via = results.bearing_via()
     chosen = bodies is not None
     if chosen:
         wanted = list(bodies)
@@ -433,8 +434,8 @@ def support_spectrum_figure(results, *, start_time: float | None = None, orders:
     strength: dict[str, float] = {}
     for body, dirs in supports.items():
         lines, size = [], 0.0
-        for direction, col in dirs:
-            x = _finite(s.history_forces[keep, col])
+        for direction, col, sign in dirs:
+            x = sign * _finite(s.history_forces[keep, col])
             if not uniform:
                 x = np.interp(grid, tk, x)
             mean = float(np.nanmean(x))
@@ -517,7 +518,8 @@ def support_spectrum_figure(results, *, start_time: float | None = None, orders:
             ax.yaxis.set_minor_locator(NullLocator())  # decades only: readable, fast
         else:
             ax.set_ylim(0, 1.08 * largest)
-        ax.set_title(f"support of {body} ({_frame_text(results.kinematics, body)})",
+        held = f"spline {via[body]} of {body}" if body in via else f"support of {body}"
+        ax.set_title(f"{held} ({_frame_text(results.kinematics, body)})",
                      fontsize=FONT["title"])
         _label(ax, f"frequency [{funit}]" + (" in the force's frame" if f_frame else ""),
                "force amplitude [N]")

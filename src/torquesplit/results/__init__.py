@@ -416,20 +416,42 @@ class Results:
         step = self.solution.step if self.solution is not None else None
         return bool(t.size >= 2 and step and float(np.median(np.diff(t))) < 1.5 * step)
 
-    def support_columns(self) -> dict[str, list[tuple[str, int]]]:
-        """Supported body -> its bearing elements' (direction, column of the history)."""
+    def support_columns(self) -> dict[str, list[tuple[str, int, float]]]:
+        """Supported body -> its bearing elements' (direction, column of the history, sign
+        that turns the element's force into the force the body puts on its bearing).
+
+        A body held radially by a spline alone (Dong et al. 2021's floating pinions: no
+        support of its own) has the spline's radial element as its bearing: the spline's
+        force acts on the floating member with the opposite sign of a support's."""
         el = self.structure.element_names
-        out: dict[str, list[tuple[str, int]]] = {}
-        for col, e in enumerate(self.solution.history_elements):
+        hist = list(self.solution.history_elements)
+        out: dict[str, list[tuple[str, int, float]]] = {}
+        for col, e in enumerate(hist):
             if ".support." in el[e]:
                 body, direction = el[e].split(".support.", 1)
-                out.setdefault(body, []).append((direction, col))
+                out.setdefault(body, []).append((direction, col, 1.0))
+        for name, spline in getattr(self.model, "splines", {}).items():
+            body = spline.connects[1]
+            if body in out:
+                continue
+            for direction in ("x", "y"):
+                e = f"{name}.radial.{direction}"
+                if e in el and el.index(e) in hist:
+                    out.setdefault(body, []).append((direction, hist.index(el.index(e)), -1.0))
         return out
+
+    def bearing_via(self) -> dict[str, str]:
+        """Body -> the spline that is its bearing, for the bodies a spline alone holds."""
+        supported = {n.split(".support.", 1)[0] for n in self.structure.element_names
+                     if ".support." in n}
+        return {sp.connects[1]: name for name, sp in getattr(self.model, "splines", {}).items()
+                if sp.connects[1] not in supported}
 
     def bearing_forces(self, start_time: float | None = None) -> list[dict]:
         """Per supported body, its bearing (support) force over the settled part: the mean
         of each direction [N], the magnitude of that mean and the largest magnitude of the
-        force vector [N], from the history from ``start_time`` (default the latest group
+        force vector [N] (a body held by a spline alone: the spline's radial force, its
+        name in ``via``), from the history from ``start_time`` (default the latest group
         settle time: pass ``metrics().settling.start_time`` when the metrics are at
         hand).  The history is decimated (``samples_per_period``): a peak between its
         samples is missed, as :func:`~torquesplit.results.plausibility.coarse_history`
@@ -446,11 +468,14 @@ class Results:
         if not keep.any():
             keep = np.ones(s.history_t.shape, bool)
         out = []
+        via = self.bearing_via()
         for body, parts in by_body.items():
-            forces = s.history_forces[keep][:, [c for _, c in parts]]
+            forces = s.history_forces[keep][:, [c for _, c, _ in parts]]
+            forces = forces * np.array([sign for _, _, sign in parts])
             mean = forces.mean(axis=0)
             magnitude = np.sqrt((forces ** 2).sum(axis=1))
-            out.append({"body": body, "directions": [d for d, _ in parts],
+            out.append({"body": body, "via": via.get(body),
+                        "directions": [d for d, _, _ in parts],
                         "mean": [float(v) for v in mean],
                         "mean_magnitude": float(np.sqrt((mean ** 2).sum())),
                         "peak_magnitude": float(magnitude.max()),
