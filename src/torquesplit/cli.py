@@ -116,9 +116,11 @@ def _fail(exc: BaseException) -> None:
         where = f"{exc.filename}: " if exc.filename else ""
         msg = f"{where}{exc.strerror or msg}; check the path and its permissions"
     msg = clip_message(msg)
-    for line in msg.splitlines() or [msg]:
+    lines = msg.splitlines() or [msg]
+    for line in lines:
         err_console.print("[bold red]error:[/] ", end="")
         err_console.print(line, markup=False, highlight=False, soft_wrap=True)
+    ux.emit_json_errors(lines)
     raise typer.Exit(2)
 
 
@@ -317,7 +319,7 @@ def check(
     model: str = typer.Argument(..., help=_MODEL_HELP, metavar="MODEL"),
     assign: Optional[list[str]] = typer.Option(None, "--set", help=_SET_HELP,
                                                metavar="PATH=VALUE"),
-    as_json: bool = _flag("--json", "Print the summary as JSON."),
+    as_json: bool = ux.json_option("Print the summary as JSON."),
     quiet: bool = _flag("--quiet", "No progress display."),
 ):
     """Validate a model and print its kinematic and static summary.
@@ -393,7 +395,7 @@ def run(
                                          "SVG) into this folder.", metavar="DIR"),
     assign: Optional[list[str]] = typer.Option(None, "--set", help=_SET_HELP,
                                                metavar="PATH=VALUE"),
-    as_json: bool = _flag("--json", "Print metrics, statistics and warnings as JSON."),
+    as_json: bool = ux.json_option("Print metrics, statistics and warnings as JSON."),
     quiet: bool = _flag("--quiet", "No progress bar."),
     check: bool = _flag("--check-step", "Run again at half the step (and with 4x the "
                         "table points where the excitation tables have jumps) and report how "
@@ -761,7 +763,7 @@ def static(
                                          "SVG) into this folder.", metavar="DIR"),
     assign: Optional[list[str]] = typer.Option(None, "--set", help=_SET_HELP,
                                                metavar="PATH=VALUE"),
-    as_json: bool = _flag("--json", "Print the results and warnings as JSON."),
+    as_json: bool = ux.json_option("Print the results and warnings as JSON."),
     quiet: bool = _flag("--quiet", "No progress bar."),
 ):
     """Quasi-static load sharing: the equilibrium at each mesh position, with the errors
@@ -897,7 +899,7 @@ def mesh(
     points: int = typer.Option(256, "--points", help="Samples per mesh cycle.", metavar="N"),
     assign: Optional[list[str]] = typer.Option(None, "--set", help=_SET_HELP,
                                                metavar="PATH=VALUE"),
-    as_json: bool = _flag("--json", "Print the comparison as JSON."),
+    as_json: bool = ux.json_option("Print the comparison as JSON."),
 ):
     """Mesh stiffness k(phase) of one mesh by every applicable method, with the ISO value
     (N/µm along the line of action, in the table and in the --plot figure)."""
@@ -998,7 +1000,7 @@ def contact(
                                "the largest load); 0 for none.", metavar="N"),
     assign: Optional[list[str]] = typer.Option(None, "--set", help=_SET_HELP,
                                                metavar="PATH=VALUE"),
-    as_json: bool = _flag("--json", "Print the results as JSON."),
+    as_json: bool = ux.json_option("Print the results as JSON."),
 ):
     """Loaded tooth contact analysis of one mesh: transmission error, stiffness, load
     distribution, contact pressure, Harris map, meshing-in impact."""
@@ -1209,7 +1211,7 @@ def optimize(
         "cluster (as a study's).", metavar="ADDRESS"),
     force: bool = _flag("--force", "Replace the pareto.csv, pareto.png and chosen.toml of an "
                         "earlier optimisation in --out."),
-    as_json: bool = _flag("--json", "Print the Pareto front as JSON."),
+    as_json: bool = ux.json_option("Print the Pareto front as JSON."),
 ):
     """Optimise model parameters (NSGA-II or any pymoo algorithm) on LTCA or dynamic outputs;
     evaluations are stored as they finish, so an interrupted run resumes."""
@@ -1304,7 +1306,7 @@ def modes(
                                         metavar=""),
     assign: Optional[list[str]] = typer.Option(None, "--set", help=_SET_HELP,
                                                metavar="PATH=VALUE"),
-    as_json: bool = _flag("--json", "Print the modes, with their shapes, as JSON."),
+    as_json: bool = ux.json_option("Print the modes, with their shapes, as JSON."),
     out: Optional[Path] = typer.Option(None, "--out", help="Write the modes and shapes (with "
                                        "--campbell: the map): .nc, .mat or .csv.",
                                        metavar="FILE"),

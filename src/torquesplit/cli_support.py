@@ -49,6 +49,10 @@ class Session:
     console: object = None
     err_console: object = None
     debug: bool = False
+    json: bool = False
+    """Whether the command was given ``--json`` (:func:`json_option`)."""
+    json_printed: bool = False
+    """Whether the command has printed its JSON (an error after it is not printed again)."""
 
 
 _session = Session()
@@ -107,6 +111,28 @@ def emit_json(data: dict, default: Callable | None = None) -> None:
     data = dict(data)
     data["warnings"] = list(_session.warnings)
     print(json.dumps(data, indent=2, default=default or json_default))
+    _session.json_printed = True
+
+
+def json_option(help: str):
+    """The ``--json`` option of a command: it also makes the command's errors JSON
+    (:func:`emit_json_errors`)."""
+    import typer
+
+    def remember(value: bool) -> bool:
+        _session.json = bool(value)
+        return value
+
+    return typer.Option(False, "--json", help=help, metavar="", callback=remember)
+
+
+def emit_json_errors(lines: list[str]) -> None:
+    """A command run with ``--json`` that fails prints its errors as JSON on stdout too
+    (``success`` false, ``errors``, ``warnings``), unless it has printed its JSON already:
+    a script that reads stdout gets a document either way."""
+    if not _session.json or _session.json_printed:
+        return
+    emit_json({"success": False, "errors": lines})
 
 
 def json_default(x):

@@ -216,6 +216,26 @@ def test_every_bad_option_and_set_argument_is_reported_at_once(tmp_path, no_comp
         "error: --count", "error: --below"], res.output
 
 
+def test_errors_of_a_json_command_are_json_too(tmp_path, no_compute):
+    """A script reading ``run --json`` got an empty stdout on a bad option: the errors
+    were plain text on stderr only.  They are on stderr still, and a JSON document with
+    ``success`` false and every error is on stdout, for each command that has --json."""
+    model = write_model(tmp_path, SPUR_PAIR)
+    for args in (["run", str(model), "--duration", "-1 s", "--set", "foo=1"],
+                 ["static", str(model), "--max-points", "0"],
+                 ["modes", str(model), "--count", "0"],
+                 ["study", str(tmp_path / "none.toml")],
+                 ["steady", str(model), "--harmonics", "0"]):
+        res = runner.invoke(app, args + ["--json"])
+        assert res.exit_code == 2, (args, res.output)
+        doc = json.loads(res.stdout)
+        errors = [ln[len("error: "):] for ln in res.stderr.strip().splitlines()]
+        assert doc["success"] is False and doc["errors"] == errors and errors, args
+        assert doc["warnings"] == []
+        plain = runner.invoke(app, args)
+        assert plain.exit_code == 2 and plain.stdout == "", args
+
+
 def test_plots_must_be_a_folder(tmp_path, no_compute):
     model = write_model(tmp_path, SPUR_PAIR)
     (tmp_path / "figs").write_text("a file")

@@ -13,7 +13,7 @@ from typing import Optional
 
 import typer
 from torquesplit._table import Table
-from torquesplit.cli_support import OptionErrors
+from torquesplit.cli_support import OptionErrors, json_option
 from torquesplit.errors import OptionError
 
 RPM = 60.0 / (2 * math.pi)
@@ -159,7 +159,7 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
             "columns) can take most of the run."),
         out: Optional[Path] = typer.Option(None, "--out", help="Write results (.nc, .mat, .csv)."),
         force: bool = typer.Option(False, "--force", help="Replace an existing --out file."),
-        as_json: bool = typer.Option(False, "--json", help="Print the results as JSON."),
+        as_json: bool = json_option("Print the results as JSON."),
         steps_per_cycle: Optional[int] = typer.Option(
             None, "--steps-per-cycle", help="Shooting: RK4 steps per cycle of the fastest "
             "excitation (default 100, refined for the highest mode).", metavar="N"),
@@ -333,7 +333,7 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
         plot: Optional[Path] = typer.Option(None, "--plot", help="Write the figure (.png/.svg)."),
         force: bool = typer.Option(False, "--force", help="Replace existing --out / --plot "
                                    "files."),
-        as_json: bool = typer.Option(False, "--json", help="Print a summary as JSON."),
+        as_json: bool = json_option("Print a summary as JSON."),
         assign: Optional[list[str]] = typer.Option(None, "--set", help=set_help,
                                                    metavar="PATH=VALUE"),
     ):

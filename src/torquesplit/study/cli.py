@@ -17,6 +17,8 @@ from typing import Optional
 
 import typer
 
+from ..cli_support import json_option
+
 BACKEND_HELP = ("cpu (default) or gpu: integrate the cases as ensembles on a CUDA GPU, one "
                 "case per thread (falls back to the CPU with a warning when there is none).")
 PRECISION_HELP = ("GPU backend: fp64 (default; the CPU runner's values up to the GPU's "
@@ -50,7 +52,7 @@ def study(
     precision: Optional[str] = typer.Option(None, "--precision", help=PRECISION_HELP),
     no_figures: bool = typer.Option(False, "--no-figures", help="Do not write figures."),
     quiet: bool = typer.Option(False, "--quiet", help="No progress bar."),
-    as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
+    as_json: bool = json_option("Print the summary as JSON."),
 ):
     """Run a study: a grid, a Monte Carlo or a sensitivity ranking of a model."""
     ui = _ui()
@@ -477,7 +479,7 @@ def sweep(
     precision: Optional[str] = typer.Option(None, "--precision", help=PRECISION_HELP),
     no_figures: bool = typer.Option(False, "--no-figures", help="Do not write figures."),
     quiet: bool = typer.Option(False, "--quiet", help="No progress bar."),
-    as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
+    as_json: bool = json_option("Print the summary as JSON."),
 ):
     """One-parameter grid in one line: an output against a model parameter."""
     from ..errors import TorquesplitError
