@@ -124,6 +124,20 @@ def test_mat_and_csv_exports(split, tmp_path):
     m = res.mesh_names[0]
     lo, mean, hi = (float(cycles[1][f"{m}_{q}_N"]) for q in ("min", "mean", "peak"))
     assert lo * (1 - 1e-12) <= mean <= hi * (1 + 1e-12)  # (a trapezoid mean's rounding)
+    # a cycle cut by the start or the end of the run (its start before t = 0, or its end
+    # after the run's) is listed with its start and empty statistics, in the .nc too: a
+    # spreadsheet's average of a column was biased by the part-cycles
+    ds = res.to_dataset()
+    complete = res.complete_cycles
+    seen = np.isfinite(res.solution.cycle_max[:, res._mesh_columns])  # (a slower mesh:
+    assert (seen & ~complete).any()  # fewer cycles, the rest of its column empty)
+    for k, row in enumerate(cycles):
+        for j, m in enumerate(res.mesh_names):
+            cut = not complete[k, j]
+            assert (row[f"{m}_peak_N"] == "") == cut and (row[f"{m}_mean_N"] == "") == cut
+            assert (row[f"{m}_start_s"] != "") == seen[k, j]
+            assert np.isnan(ds["cycle_max_force"].values[k, j]) == cut
+            assert np.isnan(ds["cycle_ratio_min"].values[k, j]) or not cut
     hist = np.loadtxt(tmp_path / "run_history.csv", delimiter=",", skiprows=1)
     np.testing.assert_allclose(hist[:, 0], res.solution.history_t)
     with pytest.raises(ValueError, match=r"\.nc, \.mat or \.csv"):

@@ -569,7 +569,8 @@ class Results:
         ``NAME_groups.csv`` (a row per load-sharing group, then one for the system: what
         the run's group table and system line print), ``NAME_history.csv`` (the history's
         forces and torques, each column's unit in its name: ``m1_N``, ``shaft_Nm``) and
-        ``NAME_cycles.csv`` (start, peak, smallest and mean force of every mesh cycle).
+        ``NAME_cycles.csv`` (start, peak, smallest and mean force of every mesh cycle;
+        empty for a cycle the start or the end of the run cuts, :attr:`complete_cycles`).
 
         All four are written atomically, and none replaces an existing file unless
         ``overwrite``.  A run that did not finish has no metrics: its summary lists the
@@ -630,8 +631,8 @@ class Results:
                 ["cycle"] + [f"{m}_{q}" for q in ("start_s", "peak_N", "min_N", "mean_N")
                              for m in self.mesh_names],
                 [[k] + row for k, row in enumerate(np.column_stack(
-                    [s.cycle_start[:, cols], s.cycle_max[:, cols], s.cycle_min[:, cols],
-                     s.cycle_mean[:, cols]]).tolist())]),
+                    [s.cycle_start[:, cols], *self.complete_cycle_statistics()[:3]]
+                ).tolist())]),
             summary: files.csv_bytes(header, rows),  # last: its presence marks the set
         }
         with files.claim_output(plan) as claim:

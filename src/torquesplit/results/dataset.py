@@ -58,6 +58,9 @@ def _element_frames(res, names: list[str]) -> list[str]:
     return out
 
 
+CUT = " (NaN: a cycle cut by the start or the end of the run)"
+
+
 def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
     """Histories, per-cycle statistics, static and nominal forces, metrics (of
     ``definition``, default the model's), warnings, run info.
@@ -73,6 +76,9 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
     all_units = element_units(st)
     hist_units = [all_units[i] for i in s.history_elements]
     mesh_cols = [list(s.tracked_elements).index(el.index(m)) for m in meshes]
+    # a cycle cut by the start or the end of the run holds part of a cycle: emptied
+    c_max, c_min, c_mean, _, c_ratio = res.complete_cycle_statistics()
+    ratio_min = np.where(res.complete_cycles, s.cycle_ratio_min[:, mesh_cols], np.nan)
     ds = xr.Dataset(
         data_vars={
             "element_force": _var(("time", "element"), s.history_forces,
@@ -83,20 +89,20 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
                                   "it connects; each element's unit in 'element_unit')"),
             "cycle_start": _var(("cycle", "mesh"), s.cycle_start[:, mesh_cols], "s",
                                 "start time of each mesh cycle"),
-            "cycle_max_force": _var(("cycle", "mesh"), s.cycle_max[:, mesh_cols], "N",
-                                    "largest mesh force in each mesh cycle"),
-            "cycle_min_force": _var(("cycle", "mesh"), s.cycle_min[:, mesh_cols], "N",
-                                    "smallest mesh force in each mesh cycle"),
-            "cycle_mean_force": _var(("cycle", "mesh"), s.cycle_mean[:, mesh_cols], "N",
-                                     "mean mesh force in each mesh cycle"),
+            "cycle_max_force": _var(("cycle", "mesh"), c_max, "N",
+                                    "largest mesh force in each mesh cycle" + CUT),
+            "cycle_min_force": _var(("cycle", "mesh"), c_min, "N",
+                                    "smallest mesh force in each mesh cycle" + CUT),
+            "cycle_mean_force": _var(("cycle", "mesh"), c_mean, "N",
+                                     "mean mesh force in each mesh cycle" + CUT),
             "cycle_count": _var(("cycle", "mesh"), s.cycle_count[:, mesh_cols], "1",
                                 "integration states in each mesh cycle"),
-            "cycle_ratio_max": _var(("cycle", "mesh"), s.cycle_ratio_max[:, mesh_cols], "1",
+            "cycle_ratio_max": _var(("cycle", "mesh"), c_ratio, "1",
                                     "largest instantaneous load-sharing ratio in each mesh "
-                                    "cycle"),
-            "cycle_ratio_min": _var(("cycle", "mesh"), s.cycle_ratio_min[:, mesh_cols], "1",
+                                    "cycle" + CUT),
+            "cycle_ratio_min": _var(("cycle", "mesh"), ratio_min, "1",
                                     "smallest instantaneous load-sharing ratio in each mesh "
-                                    "cycle"),
+                                    "cycle" + CUT),
             "nominal_force": _var(("mesh",), [res.kinematics.meshes[m].force for m in meshes],
                                   "N", "equal-split nominal tooth force"),
             "static_force": _var(("mesh",), list(res.static_forces().values()), "N",
