@@ -83,10 +83,12 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
         data_vars={
             "element_force": _var(("time", "element"), s.history_forces,
                                   "N" if set(hist_units) <= {"N"} else "N or N m",
-                                  "element force (mesh: normal tooth force; support: bearing "
-                                  "force; shaft, spline torsion, torsional support: torque "
-                                  "[N m], k (theta_a - theta_b) + damping, a the first body "
-                                  "it connects; each element's unit in 'element_unit')"),
+                                  "element force (mesh: normal tooth force, negative in "
+                                  "back-flank contact; support: the force on the bearing; "
+                                  "shaft, spline torsion, torsional support: torque [N m], "
+                                  "k (theta_a - theta_b) + damping, a the first body it "
+                                  "connects, both angles about a's axis; each element's "
+                                  "unit in 'element_unit')"),
             "cycle_start": _var(("cycle", "mesh"), s.cycle_start[:, mesh_cols], "s",
                                 "start time of each mesh cycle"),
             "cycle_max_force": _var(("cycle", "mesh"), c_max, "N",
