@@ -401,6 +401,34 @@ def test_static_figures_follow_rotation_and_report(static):
             assert _line(ax, m).get_ydata().max() == pytest.approx(met.per_mesh[m], rel=1e-9)
 
 
+def test_static_figures_over_many_revolutions_show_one_and_the_range(model):
+    """Mo et al. 2017's 25 revolutions of quasi-static sharing were a solid block of
+    lines.  Over more than two revolutions the figure draws the revolution that holds
+    the largest value (its line peaks at the reported value) and, as a band, the range of
+    every revolution at each angle (every position inside it)."""
+    static = quasi_static_load_sharing(model, revolutions=4)
+    met = static.metrics()
+    angle = F._positions(static)[0]
+    fig = F.static_load_sharing_figure(static)
+    assert "range of every revolution" in fig.get_suptitle()
+    for g, members in met.groups.items():
+        ax = _panel(fig, f"group {g}")
+        assert "in revolution" in ax.get_xlabel() and ax.get_xlim() == (0.0, 360.0)
+        tops = [_line(ax, m).get_ydata().max() for m in members]
+        assert max(tops) == pytest.approx(met.per_group[g], rel=1e-12)
+        for m in members:
+            x = _line(ax, m).get_xdata()
+            assert 0.0 <= x.min() and x.max() < 360.0 and x.size < angle.size / 3
+        bands = [c.get_paths()[0].vertices[:, 1] for c in ax.collections]
+        assert len(bands) == len(members)
+        for band, m in zip(bands, members):
+            y = met.per_cycle[m]
+            assert band.min() == pytest.approx(np.nanmin(y)) and \
+                band.max() == pytest.approx(np.nanmax(y))
+    one = F.static_mesh_force_figure(quasi_static_load_sharing(model))
+    assert "revolution" not in one.get_suptitle()
+
+
 def test_dynamic_factor_bars_are_the_metrics(run):
     met = run.metrics("cycle_peak")
     fig = F.dynamic_factor_figure(run, "cycle_peak")

@@ -58,6 +58,10 @@ REFERENCE_COLOR = "0.15"
 DENSE_CYCLES = 400
 #: number of runs of cycles (bins) of a dense series
 DENSE_BINS = 300
+#: a quasi-static sweep over more revolutions of its slowest gear than this is drawn
+#: over the one revolution that holds the group's largest value, with every revolution's
+#: range at each angle as a band (Mo et al. 2017's 25 revolutions were a solid block)
+FOLD_REVOLUTIONS = 2.0
 
 _KN = 1e-3  # N -> kN
 _UM = 1e6  # m -> um
@@ -645,27 +649,34 @@ def mesh_stiffness_figure(results, *, cycles: float = 2.0, points_per_cycle: int
 
 # ============================================================ quasi-static figures
 def static_mesh_force_figure(results) -> Figure:
-    """Quasi-static mesh force against mesh position, one panel per group."""
+    """Quasi-static mesh force against mesh position, one panel per group (over many
+    revolutions: one revolution and every revolution's range, :func:`_revolution`)."""
     angle, xlabel = _positions(results)
     forces = _finite(_static_forces(results))
     names, groups = results.mesh_names, _groups(results)
     nominal = {m: results.kinematics.meshes[m].force for m in names}
     fig, axes = _panels(len(groups), sharex=True)
+    folded = []
     for ax, (g, members) in zip(axes, groups.items()):
-        for i, m in enumerate(members):
-            ax.plot(angle, forces[:, names.index(m)] * _KN, label=m,
-                    **_line_style(i, len(members)))
+        ys = [forces[:, names.index(m)] * _KN for m in members]
+        x, keep, text = _revolution(angle, ys, xlabel)
+        for i, (m, y) in enumerate(zip(members, ys)):
+            _folded_line(ax, angle, x, keep, y, m, _line_style(i, len(members)))
         _nominal_lines(ax, [nominal[m] for m in members])
-        ax.set_xlim(angle[0], angle[-1])
+        ax.set_xlim(*((x[0], x[-1]) if keep is None else (0.0, 360.0)))
         ax.set_title(_group_label(g, members), fontsize=FONT["title"])
-        _label(ax, xlabel, "mesh force [kN]")
+        _label(ax, text, "mesh force [kN]")
         _legend(ax)
-    _suptitle(fig, results, f"quasi-static mesh force{_unconverged_note(results)}")
+        folded.append(text != xlabel)
+    _suptitle(fig, results, f"quasi-static mesh force{_fold_note(folded)}"
+                            f"{_unconverged_note(results)}")
     return fig
 
 
 def static_load_sharing_figure(results) -> Figure:
-    """Static torque ratio ``N F_i / sum_j F_j`` (Mo et al. 2017 eq. 14) against position.
+    """Static torque ratio ``N F_i / sum_j F_j`` (Mo et al. 2017 eq. 14) against position
+    (over many revolutions: the one that holds the largest ratio, and every
+    revolution's range, :func:`_revolution`).
 
     The dashed line is the group's reported value (largest over the positions,
     Mo et al. 2017 eq. 15: ``results.metrics().per_group``).
@@ -678,20 +689,70 @@ def static_load_sharing_figure(results) -> Figure:
             "'stage' (and 'path') label in the model file to group them")
     met = results.metrics()
     fig, axes = _panels(len(groups), sharex=True)
+    folded = []
     for ax, (g, members) in zip(axes, groups.items()):
-        for i, m in enumerate(members):  # the metric's own per-position ratios
-            ax.plot(angle, _finite(met.per_cycle[m]), label=m, **_line_style(i, len(members)))
+        ys = [_finite(met.per_cycle[m]) for m in members]  # the metric's own ratios
+        x, keep, text = _revolution(angle, ys, xlabel)
+        for i, (m, y) in enumerate(zip(members, ys)):
+            _folded_line(ax, angle, x, keep, y, m, _line_style(i, len(members)))
         ax.axhline(1.0, color="0.6", lw=0.8)
         ax.axhline(met.per_group[g], color=REFERENCE_COLOR, ls="--", lw=1.2,
                    label=f"reported {met.per_group[g]:.6g}\n(largest over positions)")
-        ax.set_xlim(angle[0], angle[-1])
+        ax.set_xlim(*((x[0], x[-1]) if keep is None else (0.0, 360.0)))
         ax.set_title(_group_label(g, members), fontsize=FONT["title"])
-        _label(ax, xlabel, "static torque ratio [-]")
+        _label(ax, text, "static torque ratio [-]")
         _legend(ax)
+        folded.append(text != xlabel)
     _suptitle(fig, results, "quasi-static load sharing, "
                             r"$N\,F_i\,/\,\Sigma_j F_j$ at each position"
-                            f"{_unconverged_note(results)}")
+                            f"{_fold_note(folded)}{_unconverged_note(results)}")
     return fig
+
+
+def _revolution(angle: np.ndarray, ys, xlabel: str):
+    """Where a sweep spans more than :data:`FOLD_REVOLUTIONS` revolutions: the positions
+    of the revolution that holds the largest of ``ys`` (a mask), their angle within it
+    [deg] and the axis label that says which; else every position, as it is."""
+    span = float(angle[-1] - angle[0]) if angle.size else 0.0
+    if span <= FOLD_REVOLUTIONS * 360.0:
+        return angle, None, xlabel
+    turn = np.floor((angle - angle[0]) / 360.0 + 1e-9)
+    stacked = np.array(ys, dtype=float)
+    if not np.isfinite(stacked).any():
+        return angle, None, xlabel
+    k = turn[np.nanargmax(stacked, axis=1)[np.nanargmax(np.nanmax(stacked, axis=1))]]
+    keep = turn == k
+    x = angle[keep] - angle[0] - 360.0 * k
+    n = int(turn[-1]) + (1 if angle[-1] - angle[0] - 360.0 * turn[-1] > 1e-6 else 0)
+    return x, keep, xlabel.replace(
+        " [deg]", f" in revolution {int(k) + 1} of {n} (it holds the largest value) [deg]")
+
+
+def _folded_line(ax, angle, x, keep, y, label: str, style: dict) -> None:
+    """``y`` over the revolution ``keep`` (:func:`_revolution`), with the range of every
+    revolution at each angle as a light band (positions binned by angle within a
+    revolution, as many bins as a revolution has positions); all of ``y`` when
+    ``keep`` is None."""
+    if keep is None:
+        ax.plot(x, y, label=label, **style)
+        return
+    within = np.mod(angle - angle[0], 360.0)
+    bins = max(int(keep.sum()), 2)
+    index = np.minimum((within / 360.0 * bins).astype(int), bins - 1)
+    lo = np.full(bins, np.nan)
+    hi = np.full(bins, np.nan)
+    ok = np.isfinite(y)
+    np.fmin.at(lo, index[ok], y[ok])
+    np.fmax.at(hi, index[ok], y[ok])
+    centre = (np.arange(bins) + 0.5) * 360.0 / bins
+    ax.fill_between(centre, lo, hi, color=style["color"], alpha=0.15, lw=0)
+    ax.plot(x, y[keep], label=label, **style)
+
+
+def _fold_note(folded) -> str:
+    """The title's note of a figure drawn over one revolution (:func:`_revolution`)."""
+    return ("\none revolution (lines) and the range of every revolution (bands)"
+            if any(folded) else "")
 
 
 # ============================================================ writing
