@@ -29,7 +29,6 @@ No state survives a command: :func:`reset` starts each one (the app's callback c
 from __future__ import annotations
 
 import contextlib
-import json
 import math
 import sys
 import warnings
@@ -38,6 +37,7 @@ from typing import Callable, Iterator, Optional
 
 from rich.markup import escape
 
+from . import _json
 from .errors import ModelWarning, OptionError, clip_message, from_interrupt
 
 
@@ -110,7 +110,7 @@ def emit_json(data: dict, default: Callable | None = None) -> None:
     """Print ``data`` as JSON with the command's ``warnings`` list added."""
     data = dict(data)
     data["warnings"] = list(_session.warnings)
-    print(json.dumps(data, indent=2, default=default or json_default))
+    print(_json.dumps(data, indent=2, default=default or json_default))
     _session.json_printed = True
 
 

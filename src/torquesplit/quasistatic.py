@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from . import _json
 from .assembly.structure import dof_units
 from .errors import ModelWarning
 
@@ -112,9 +113,9 @@ class QuasiStaticResults:
                    "warnings_json": json.dumps(self.all_warnings()),
                    "load_sharing_definition": "static_torque",
                    "model_json": model_to_json(self.model),
-                   "metrics_json": json.dumps({"per_mesh": met.per_mesh,
-                                               "per_group": met.per_group,
-                                               "system": met.system})},
+                   "metrics_json": _json.dumps({"per_mesh": met.per_mesh,
+                                                "per_group": met.per_group,
+                                                "system": met.system})},
         )
         from .results.dataset import add_planet_load_sharing
 

@@ -89,6 +89,26 @@ def test_force_replaces_and_the_file_says_which_run_wrote_it(tmp_path):
         first = dict(ds.attrs)
     assert {"run_id", "created_utc", "software", "command"} <= set(first)
     assert first["software"].startswith("torquesplit ")
+    # traceable a month later: the commit that wrote it, the model's hash, the folder,
+    # and a command a shell takes back whole ('35 mm' was two arguments)
+    import hashlib
+    import shlex
+
+    from torquesplit.results.files import software_commit
+
+    assert software_commit() == "" or f"(commit {software_commit()})" in first["software"]
+    assert first["model_sha256"] == hashlib.sha256(first["model_json"].encode()).hexdigest()
+    assert first["working_directory"] == os.getcwd()
+    import sys as _sys
+
+    argv = _sys.argv
+    try:
+        _sys.argv = ["torquesplit", "run", "m.toml", "--set", "shafts.s.diameter=35 mm"]
+        from torquesplit.results.files import provenance
+
+        assert shlex.split(provenance("x")["command"])[-1] == "shafts.s.diameter=35 mm"
+    finally:
+        _sys.argv = argv
     one_line_error(runner.invoke(app, args), "exists; use --force")
     assert runner.invoke(app, args + ["--force"]).exit_code == 0
     with xr.open_dataset(out, engine="h5netcdf") as ds:

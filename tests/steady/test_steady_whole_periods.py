@@ -1,5 +1,7 @@
 """A steady state's table is over whole periods, at the step its meshes' cycles need."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -116,3 +118,63 @@ def test_ratio_extremes_take_the_cycle_starts(mo_star, monkeypatch):
     assert ok.sum() > 100
     assert np.all(with_starts[ok] >= without[ok])
     assert np.sum(with_starts[ok] > without[ok] * (1 + 1e-12)) > 10
+
+
+def test_steady_says_its_results_warnings_and_leaves_out_cycles_without_samples(tmp_path):
+    """A reviewer found a warning in the steady state's file that the command never
+    printed (nor listed under --json), advising an option 'steady' does not have; and the
+    cycles table gave a mean force of 0.0 where the cycle had no sample (blank peak)."""
+    import csv
+    import json
+    import re
+
+    from typer.testing import CliRunner
+
+    from torquesplit.cli import app
+
+    tutorial = Path(__file__).resolve().parents[2] / "docs" / "tutorial.md"
+    model = tmp_path / "three_branch.toml"
+    model.write_text(re.search(r"```toml\n(.*?)```", tutorial.read_text(), re.S).group(1))
+    out = tmp_path / "sd.csv"
+    res = CliRunner().invoke(app, ["steady", str(model), "--no-stability", "--json", "--out",
+                                   str(out)])
+    assert res.exit_code == 0, res.output
+    said = json.loads(res.stdout)["warnings"]
+    waveform = [w for w in said if "saved waveform of the periodic state" in w]
+    assert waveform and "--steps-per-cycle" in waveform[0]
+    assert not any("--samples-per-period" in w for w in said)
+    rows = list(csv.DictReader(open(tmp_path / "sd_cycles.csv", newline="")))
+    for row in rows:
+        for key in [k for k in row if k.endswith("_peak_N")]:
+            mean = row[key.replace("_peak_N", "_mean_N")]
+            assert (row[key] == "") == (mean == ""), (row["cycle"], key)
+    assert any(row["in1_peak_N"] == "" for row in rows)
+
+
+def test_json_output_and_file_attributes_hold_no_bare_nan(tmp_path):
+    """'steady --json' printed "top_harmonic_energy": NaN, which is not JSON (node and
+    MATLAB's jsondecode refuse the whole document); the file's statistics_json and
+    steady_json did the same.  Non-finite numbers are null now."""
+    import json
+
+    import xarray as xr
+    from typer.testing import CliRunner
+
+    from torquesplit import _json
+    from torquesplit.cli import app
+
+    def refuse(token):
+        raise ValueError(f"bare {token} in the JSON")
+
+    out = tmp_path / "s.nc"
+    res = CliRunner().invoke(app, ["steady", "ji_li_mill_drive", "--keep", "stage1",
+                                   "--no-stability", "--json", "--out", str(out)])
+    assert res.exit_code == 0, res.output
+    doc = json.loads(res.stdout, parse_constant=refuse)
+    assert "top_harmonic_energy" in json.dumps(doc)
+    with xr.open_dataset(out) as ds:
+        for key, text in ds.attrs.items():
+            if key.endswith("_json"):
+                json.loads(text, parse_constant=refuse)
+    assert _json.dumps({"a": [float("nan"), np.float64("-inf"), np.array([1.0, np.nan])]}) \
+        == '{"a": [null, null, [1.0, null]]}'

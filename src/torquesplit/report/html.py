@@ -27,13 +27,15 @@ import datetime
 import hashlib
 import html
 import math
-import subprocess
 from pathlib import Path
 
 import numpy as np
 
 #: natural modes listed
 MODES_LISTED = 12
+#: a results file's attributes that say which run wrote it (results.files.provenance)
+PROVENANCE_KEYS = ("run_id", "created_utc", "software", "command", "working_directory",
+                   "model_sha256")
 #: a mode within this fraction of a mesh frequency (or of its 2nd or 3rd harmonic) is
 #: marked as a possible resonance
 NEAR_FRACTION = 0.1
@@ -74,21 +76,6 @@ def _g(x, digits: int = 5) -> str:
     return f"{x:.{digits}g}"
 
 
-def _commit() -> str:
-    """The git commit of the installed torquesplit, or how it was installed."""
-    here = Path(__file__).resolve().parent
-    try:
-        out = subprocess.run(["git", "-C", str(here), "rev-parse", "--short", "HEAD"],
-                             capture_output=True, text=True, timeout=3)
-        dirty = subprocess.run(["git", "-C", str(here), "status", "--porcelain", "--",
-                                str(here.parent)], capture_output=True, text=True, timeout=3)
-    except (OSError, subprocess.SubprocessError):
-        return "not a git checkout"
-    if out.returncode != 0 or not out.stdout.strip():
-        return "not a git checkout"
-    return out.stdout.strip() + (" (with local changes)" if dirty.stdout.strip() else "")
-
-
 def model_hash(source: Path | None, model_json: str) -> tuple[str, str]:
     """(what was hashed, SHA-256): the model file's bytes, else the model's JSON."""
     if source is not None and source.is_file() and source.suffix.lower() in (".toml", ".json"):
@@ -104,7 +91,10 @@ def _provenance(res, source: Path | None, results_attrs: dict | None) -> str:
     what, digest = model_hash(source, res.model_json())
     # the model's own identity too, the same from its file and from its results file
     canonical = hashlib.sha256(res.model_json().encode("utf-8")).hexdigest()
-    rows = [["torquesplit", f"{__version__}, commit {_commit()}"],
+    from ..results.files import software_commit
+
+    commit = software_commit() or "not a git checkout"
+    rows = [["torquesplit writing this report", f"{__version__}, commit {commit}"],
             ["model", res.model.model.name],
             ["model file", what], ["model SHA-256", digest],
             ["model SHA-256 (its data, SI JSON: the same from the file and its results)",
@@ -112,7 +102,7 @@ def _provenance(res, source: Path | None, results_attrs: dict | None) -> str:
             ["report written (UTC)", datetime.datetime.now(datetime.timezone.utc)
              .isoformat(timespec="seconds")]]
     if results_attrs:
-        for key in ("run_id", "created_utc", "command", "software"):
+        for key in PROVENANCE_KEYS:
             if results_attrs.get(key):
                 rows.append([f"results file: {key}", results_attrs[key]])
     info = res.model.model
@@ -452,8 +442,7 @@ def build_report(res, *, definition: str | None = None, source: Path | None = No
 
 def results_attributes(ds) -> dict:
     """The provenance attributes of a results Dataset (for :func:`build_report`)."""
-    return {k: ds.attrs.get(k) for k in ("run_id", "created_utc", "command", "software")
-            if ds.attrs.get(k)}
+    return {k: ds.attrs.get(k) for k in PROVENANCE_KEYS if ds.attrs.get(k)}
 
 
 def report_json_summary(res, definition: str | None = None) -> dict:

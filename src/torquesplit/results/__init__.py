@@ -517,7 +517,7 @@ class Results:
         plan = files.check_output(path, formats=files.NETCDF_FORMATS, overwrite=overwrite)
         with files.claim_output(plan) as claim:
             ds = self.to_dataset(definition)
-            ds.attrs.update(files.provenance(claim.run_id))
+            ds.attrs.update(files.provenance(claim.run_id, ds.attrs.get("model_json")))
             claim.write({plan.path: files.netcdf_bytes(ds)})
         return plan.path
 
@@ -560,7 +560,7 @@ class Results:
             data["model_json"] = ds.attrs["model_json"]
             data["metrics_json"] = ds.attrs.get("metrics_json", "")
             data["warnings"] = np.asarray(self.warnings(definition) or [""], dtype=object)
-            data["provenance"] = files.provenance(claim.run_id)
+            data["provenance"] = files.provenance(claim.run_id, ds.attrs["model_json"])
             claim.write({plan.path: files.mat_bytes(data)})
         return plan.path
 

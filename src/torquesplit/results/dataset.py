@@ -8,6 +8,7 @@ import math
 import numpy as np
 import xarray as xr
 
+from .. import _json
 from ..assembly.structure import element_units
 
 
@@ -39,7 +40,7 @@ def add_planet_load_sharing(ds: xr.Dataset, load_sharing, kinematics) -> xr.Data
             ("planet_entity",), [peak[n] for n in names], "1",
             "largest instantaneous ratio over the mesh positions (Mo et al. 2017), not "
             "K_gamma")
-    ds.attrs["planet_load_sharing_json"] = json.dumps(planet_sharing_dict(k), default=float)
+    ds.attrs["planet_load_sharing_json"] = _json.dumps(planet_sharing_dict(k), default=float)
     return ds
 
 
@@ -196,7 +197,7 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
                                          f"system load-sharing coefficient "
                                          f"({met.definition})")
         ds.attrs["load_sharing_definition"] = met.definition
-        ds.attrs["metrics_json"] = json.dumps(met.to_dict(), default=float)
+        ds.attrs["metrics_json"] = _json.dumps(met.to_dict(), default=float)
         ds = add_planet_load_sharing(ds, met.load_sharing, res.kinematics)
         bearings = res.bearing_forces(met.settling.start_time)
         if bearings:
@@ -208,7 +209,7 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
                                             "N", "largest settled bearing force magnitude "
                                             "(from the history: a peak between its samples "
                                             "is missed)")
-            ds.attrs["bearing_forces_json"] = json.dumps(bearings)
+            ds.attrs["bearing_forces_json"] = _json.dumps(bearings)
     except Exception as exc:  # metrics of a diverged run may be undefined; keep the data
         ds.attrs["metrics_error"] = str(exc)
     steady = getattr(res, "steady", None)
@@ -224,7 +225,7 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
         "title": f"torquesplit results: {res.model.model.name}",
         "model_name": res.model.model.name,
         "model_json": res.model_json(),
-        "statistics_json": json.dumps(res.statistics(), default=float),
+        "statistics_json": _json.dumps(res.statistics(), default=float),
         "status": int(s.status),
         "message": s.message,
         "software": "torquesplit",
@@ -244,7 +245,7 @@ def _steady_attributes(ds: xr.Dataset, res, steady) -> None:
                if info["period_s"] else math.nan)
     ds.attrs.update(
         analysis="periodic steady state",
-        steady_json=json.dumps(info, default=float),
+        steady_json=_json.dumps(info, default=float),
         steady_method=info["method"], steady_period_s=info["period_s"],
         steady_residual=info["residual"],
         steady_stable=("unknown" if info["stable"] is None else str(bool(info["stable"]))),

@@ -23,6 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import _json
 from ..errors import OutputError, clip_text
 from . import files
 
@@ -153,10 +154,10 @@ def _mat_data(ds, run_id: str) -> dict:
     data["descriptions"] = {ident[n]: str(ds[n].attrs.get("long_name", "")) for n in names}
     data["names"] = {ident[n]: n for n in names}  # the Dataset's own names
     akeys: set = set()
-    data["attributes"] = {_mat_name(k, akeys): v if isinstance(v, str) else json.dumps(
+    data["attributes"] = {_mat_name(k, akeys): v if isinstance(v, str) else _json.dumps(
         v.tolist() if isinstance(v, np.ndarray) else v, default=str)
         for k, v in ds.attrs.items()}
-    data["provenance"] = files.provenance(run_id)
+    data["provenance"] = files.provenance(run_id, ds.attrs.get("model_json"))
     return data
 
 
@@ -166,9 +167,9 @@ def _write(ds, plan: files.OutputPlan, claim: files.OutputClaim) -> Path:
     ds = ds.copy()
     for k, v in list(ds.attrs.items()):  # NetCDF attributes: strings and numbers
         if isinstance(v, (list, tuple, dict)):
-            ds.attrs[k] = json.dumps(v, default=str)
+            ds.attrs[k] = _json.dumps(v, default=str)
     if plan.format == "netcdf":
-        ds.attrs.update(files.provenance(claim.run_id))
+        ds.attrs.update(files.provenance(claim.run_id, ds.attrs.get("model_json")))
         claim.write({plan.path: files.netcdf_bytes(ds)})
     elif plan.format == "mat":
         claim.write({plan.path: files.mat_bytes(_mat_data(ds, claim.run_id))})

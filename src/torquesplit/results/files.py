@@ -51,6 +51,7 @@ from __future__ import annotations
 import contextlib
 import datetime
 import errno
+import functools
 import io
 import json
 import os
@@ -202,24 +203,54 @@ def new_run_id() -> str:
     return str(uuid.uuid4())
 
 
-def provenance(run_id: str) -> dict[str, str]:
-    """Attributes that say which run wrote a file.
+def provenance(run_id: str, model_json: str | None = None) -> dict[str, str]:
+    """Attributes that say which run wrote a file: its id and time, the software with
+    its git commit (:func:`software_commit`), the command as a shell would take it back
+    and the folder it ran in, and with ``model_json`` (the model embedded in the file)
+    that model's SHA-256, the same for the same model whatever file it came from.
 
     Examples
     --------
-    >>> sorted(provenance("abc"))
-    ['command', 'created_utc', 'run_id', 'software']
+    >>> sorted(provenance("abc", "{}"))
+    ['command', 'created_utc', 'model_sha256', 'run_id', 'software', 'working_directory']
     """
+    import hashlib
+    import shlex
+
     from .. import __version__
 
-    return {
+    commit = software_commit()
+    out = {
         "run_id": run_id,
         "created_utc": datetime.datetime.now(datetime.timezone.utc).isoformat(
             timespec="seconds"),
-        "software": f"torquesplit {__version__}",
-        "command": clip_text(" ".join([Path(sys.argv[0]).name] + sys.argv[1:])
+        "software": f"torquesplit {__version__}" + (f" (commit {commit})" if commit else ""),
+        "command": clip_text(shlex.join([Path(sys.argv[0]).name] + sys.argv[1:])
                              if sys.argv else "", 500),
+        "working_directory": clip_text(os.getcwd(), 500),
     }
+    if model_json is not None:
+        out["model_sha256"] = hashlib.sha256(model_json.encode("utf-8")).hexdigest()
+    return out
+
+
+@functools.lru_cache(maxsize=1)
+def software_commit() -> str:
+    """The git commit of this torquesplit ("1fac9aa, with local changes" when its
+    sources differ from it), or "" when it is not run from a git checkout."""
+    import subprocess
+
+    here = Path(__file__).resolve().parents[1]
+    try:
+        head = subprocess.run(["git", "-C", str(here), "rev-parse", "--short", "HEAD"],
+                              capture_output=True, text=True, timeout=3)
+        dirty = subprocess.run(["git", "-C", str(here), "status", "--porcelain", "--",
+                                str(here)], capture_output=True, text=True, timeout=3)
+    except (OSError, subprocess.SubprocessError):
+        return ""
+    if head.returncode != 0 or not head.stdout.strip():
+        return ""
+    return head.stdout.strip() + (", with local changes" if dirty.stdout.strip() else "")
 
 
 # --------------------------------------------------------------------------- claims

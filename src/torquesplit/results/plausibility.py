@@ -261,19 +261,18 @@ def mean_drift(results, metrics) -> list[tuple[str, str]]:
 
 
 def coarse_history(results, metrics) -> list[tuple[str, str]]:
-    """The decimated history (saved to files, drawn in the figures) against the settled
-    peak the integrator streams at every step: where its largest settled sample falls
-    short by more than :data:`HISTORY_MISS`, the response has content faster than the
-    history's sampling (a resonance at a high mesh order, impacts) and its waveform is
-    not the response's.  One message, for the mesh where it misses most; none where the
-    history keeps every (fixed) step already."""
+    """The history (saved to files, drawn in the figures) against the settled peak the
+    integrator streams at every step and at the tables' corners: where its largest
+    settled sample falls short by more than :data:`HISTORY_MISS`, its waveform is not the
+    response's.  One message, for the mesh where it misses most, with the advice that
+    fits: more samples of a decimated history; a finer step where it keeps every step
+    already (the peak then falls at a table corner inside a step, where RK4 splits the
+    step, or between two steps); more steps per cycle of a periodic steady state."""
     if results.solution is None or not results.solution.history_t.size:
         return []
     t, forces = results.mesh_force_history()
     if t.size < 2:
         return []
-    if results.history_keeps_every_step():
-        return []  # a finer history needs a finer step, not more samples
     worst = None
     for j, row in enumerate(metrics.rows):
         start = metrics.settling.group_time.get(row.group, metrics.settling.start_time)
@@ -288,11 +287,28 @@ def coarse_history(results, metrics) -> list[tuple[str, str]]:
         return []
     m, miss, seen, peak = worst
     per = results.history_samples_per_period() or math.nan
+    missed = (f"misses the settled peak force of mesh {m} by {100 * miss:.2g} % "
+              f"({_kn(seen)} against {_kn(peak)})")
+    exact = ("The mesh table's forces, load sharing and dynamic factors (and peak_force in "
+             "the files) include every step and the instants between them")
+    if getattr(results, "steady", None) is not None:
+        return [("analysis", (
+            f"the saved waveform of the periodic state ({per:.3g} samples per shortest "
+            f"mesh period), which the results files and the figures hold, {missed}: the "
+            f"peak falls between its samples, at a corner of a stiffness table or between "
+            f"kept steps.  {exact}; the waveform and the bearing forces do not.  More "
+            f"--steps-per-cycle (Python: steps_per_cycle=) brings the waveform closer"))]
+    if results.history_keeps_every_step():
+        return [("analysis", (
+            f"the history keeps every RK4 step, yet {missed}: the peak falls inside a "
+            f"step, at a corner of a stiffness table (a tooth pair entering or leaving "
+            f"contact), where the step is split.  {exact}; the history, the figures' "
+            f"waveforms and the bearing table's peak |F| do not.  A finer step "
+            f"(--steps-per-period; Python: steps_per_period=) brings them closer"))]
     more = max(100, 5 * round(per)) if math.isfinite(per) else 100
     return [("analysis", (
         f"the history ({per:.3g} samples per shortest mesh period), which the results "
-        f"files and the figures hold, misses the settled peak force of mesh {m} by "
-        f"{100 * miss:.2g} % ({_kn(seen)} against {_kn(peak)}): the response is faster "
+        f"files and the figures hold, {missed}: the response is faster "
         f"than its sampling and the saved waveform is not the response's.  The mesh "
         f"table's forces, load sharing and dynamic factors are streamed at every step and "
         f"unaffected; the bearing table is computed from this history, so its peak |F| "

@@ -648,7 +648,7 @@ def _as_solution(st: SteadyState, shell, periods):
     t_all = t_all[order]
     cmax = np.full((nc, n_tr), np.nan)
     cmin = np.full((nc, n_tr), np.nan)
-    csum = np.zeros((nc, n_tr))
+    csum = np.full((nc, n_tr), np.nan)  # (NaN: a cycle left out, as the integrator's)
     ccnt = np.zeros((nc, n_tr), dtype=np.int64)
     cstart = np.zeros((nc, n_tr))
     for j, e in enumerate(track):

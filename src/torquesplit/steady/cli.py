@@ -194,6 +194,12 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
                                   stability=stability, steps_per_cycle=steps_per_cycle,
                                   progress=update)
             res = st.to_results()
+            if st.solution.converged:  # what the results say, as 'run' prints it
+                from torquesplit.cli_support import warn
+                from torquesplit.results.plausibility import result_warnings
+
+                for loc, msg in result_warnings(res, res.metrics()):
+                    warn(f"{loc}: {msg}")
             rows = st.mesh_table(results=res)
             saved = res.save(out, overwrite=force) if out is not None else None
             step_check = None

@@ -17,6 +17,7 @@ from typing import Optional
 
 import typer
 
+from .. import _json
 from ..cli_support import json_option
 
 BACKEND_HELP = ("cpu (default) or gpu: integrate the cases as ensembles on a CUDA GPU, one "
@@ -211,7 +212,7 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
                                for v in out_vars}
             data["sensitivity_warnings"] = json.loads(ds.attrs.get("sensitivity_warnings",
                                                                     "[]"))
-        print(json.dumps(data, indent=2))
+        print(_json.dumps(data, indent=2))
         return
     from torquesplit._table import Table
 
