@@ -381,9 +381,9 @@ def run(
         None, "--samples-per-period", help="History samples per shortest mesh period, for "
         "--out files, --plots figures and the bearing-force table (the mesh table's "
         "forces and coefficients are streamed at every step and do not depend on it); "
-        "default: every step of a run of at most 50,000, else every k-th step (at most "
-        "50,000 samples) but at least 20 per period; a run warns when the history misses "
-        "the peaks.", metavar="N"),
+        "default: every step of a run of at most 50,000, else every k-th step: 50,000 "
+        "samples, or more where 20 per period need more; a run warns when the history "
+        "misses the peaks.", metavar="N"),
     definition: Optional[str] = typer.Option(None, "--definition", help=_definition_help(),
                                              metavar="NAME"),
     out: Optional[Path] = typer.Option(
@@ -686,8 +686,8 @@ def run_table(met) -> Table:
         if r.back_flank_force > 0:  # (settled; a transient's is in the warnings)
             back += f", {r.back_flank_force / 1e3:.4g} kN"
         loss = "no backlash" if r.double_flank else f"{100 * r.contact_loss:.2f} %"
-        t.add_row(r.mesh, r.group, f"{r.nominal_force / 1e3:.5g}", f"{r.static_force / 1e3:.5g}",
-                  f"{r.mean_force / 1e3:.5g}", f"{r.peak_force / 1e3:.5g}",
+        t.add_row(r.mesh, r.group, f"{r.nominal_force / 1e3:#.5g}", f"{r.static_force / 1e3:#.5g}",
+                  f"{r.mean_force / 1e3:#.5g}", f"{r.peak_force / 1e3:#.5g}",
                   f"{r.dynamic_factor:.4f}", f"{r.peak_to_nominal:.4f}",
                   f"{r.load_sharing:.4f}", loss, back)
     return t
@@ -712,10 +712,10 @@ def bearing_table(bearings: list[dict], res) -> Table:
     for col in cols + (["directions in"] if turning else []):
         b.add_column(_h(col), justify="left" if col in ("body", "directions in") else "right")
     for r, frame in zip(bearings, frames):
-        means = ", ".join(f"{d} {v / 1e3:.5g}" for d, v in zip(r["directions"], r["mean"]))
+        means = ", ".join(f"{d} {v / 1e3:#.5g}" for d, v in zip(r["directions"], r["mean"]))
         body = f"{r['body']} (spline {r['via']})" if r.get("via") else r["body"]
-        b.add_row(body, means, f"{r['mean_magnitude'] / 1e3:.5g}",
-                  f"{r['peak_magnitude'] / 1e3:.5g}", *([frame] if turning else []))
+        b.add_row(body, means, f"{r['mean_magnitude'] / 1e3:#.5g}",
+                  f"{r['peak_magnitude'] / 1e3:#.5g}", *([frame] if turning else []))
     return b
 
 
@@ -866,8 +866,8 @@ def _print_static(m, res, met, orbits, saved, figures, plots, as_json) -> None:
     for col in ("mesh", "min F [kN]", "mean F [kN]", "max F [kN]", "LSC (static_torque)"):
         t.add_column(_h(col), justify="left" if col == "mesh" else "right")
     for j, name in enumerate(res.mesh_names):
-        t.add_row(name, f"{forces[:, j].min() / 1e3:.5g}", f"{forces[:, j].mean() / 1e3:.5g}",
-                  f"{forces[:, j].max() / 1e3:.5g}", f"{met.per_mesh[name]:.5f}")
+        t.add_row(name, f"{forces[:, j].min() / 1e3:#.5g}", f"{forces[:, j].mean() / 1e3:#.5g}",
+                  f"{forces[:, j].max() / 1e3:#.5g}", f"{met.per_mesh[name]:.5f}")
     console.print(t)
     for g, v in met.per_group.items():
         console.print(f"group {g}: {v:.5f}", highlight=False)
@@ -966,8 +966,8 @@ def _print_mesh(pair, cmp, plot, as_json) -> None:
                 "mean / ISO"):
         t.add_column(_h(col), justify="left" if col == "method" else "right")
     for r in cmp.rows():
-        t.add_row(r["method"], f"{r['mean'] / 1e6:.5g}", f"{r['minimum'] / 1e6:.5g}",
-                  f"{r['maximum'] / 1e6:.5g}", f"{r['peak_to_peak'] / 1e6:.5g}",
+        t.add_row(r["method"], f"{r['mean'] / 1e6:#.5g}", f"{r['minimum'] / 1e6:#.5g}",
+                  f"{r['maximum'] / 1e6:#.5g}", f"{r['peak_to_peak'] / 1e6:#.5g}",
                   f"{r['mean_over_iso']:.3f}")
     console.print(t)
     console.print(f"ISO 6336-1: c' = {cmp.iso.c_prime_iso:.3f} N/(mm µm), c_gamma = "
@@ -1134,11 +1134,12 @@ def _print_contact(m, pair, names, op_load, cm, results, hm, impact, op, figures
                 "k tangent [N/µm]", "p_H max [MPa]", "contact ratio"):
         t.add_column(_h(col), justify="right")
     for r, row in zip(results, rows):
-        t.add_row(f"{r.load / 1e3:.5g}", f"{row['te_mean_m'] * 1e6:.4g}",
-                  f"{row['te_peak_to_peak_m'] * 1e6:.4g}", f"{row['te_peak_to_peak_arcsec']:.4g}",
-                  f"{row['stiffness_secant_mean_N_per_m'] / 1e6:.5g}",
-                  f"{row['stiffness_tangent_mean_N_per_m'] / 1e6:.5g}",
-                  f"{row['max_hertz_pressure_Pa'] / 1e6:.5g}", f"{row['actual_contact_ratio']:.3f}")
+        t.add_row(f"{r.load / 1e3:#.5g}", f"{row['te_mean_m'] * 1e6:#.4g}",
+                  f"{row['te_peak_to_peak_m'] * 1e6:#.4g}", f"{row['te_peak_to_peak_arcsec']:#.4g}",
+                  f"{row['stiffness_secant_mean_N_per_m'] / 1e6:#.5g}",
+                  f"{row['stiffness_tangent_mean_N_per_m'] / 1e6:#.5g}",
+                  f"{row['max_hertz_pressure_Pa'] / 1e6:#.5g}",
+                  f"{row['actual_contact_ratio']:.3f}")
     console.print(t)
     if hm is not None:
         h = Table(title="Harris map")
@@ -1146,7 +1147,7 @@ def _print_contact(m, pair, names, op_load, cm, results, hm, impact, op, figures
             h.add_column(_h(col), justify="right")
         for f, pp, pa, cr in zip(hm.loads, hm.te_peak_to_peak, hm.te_peak_to_peak_arcsec,
                                  hm.contact_ratio):
-            h.add_row(f"{f / 1e3:.4g}", f"{pp * 1e6:.4g}", f"{pa:.4g}", f"{cr:.3f}")
+            h.add_row(f"{f / 1e3:#.4g}", f"{pp * 1e6:#.4g}", f"{pa:#.4g}", f"{cr:.3f}")
         console.print(h)
     if impact is not None:
         console.print(f"meshing-in impact at {op.load / 1e3:.5g} kN: {impact.peak_force:.5g} N "
@@ -1405,8 +1406,8 @@ def modes(
         t.add_column(_h(col))
     for r in rep.rows:
         energy = ", ".join(f"{n} {100 * v:.0f} %" for n, v in list(r.strain_energy.items())[:3])
-        t.add_row(str(r.mode), f"{r.frequency:.6g}", _ratio(r.damping_ratio),
-                  f"{r.damped_frequency:.6g}" if r.frequency > 0 else "-",
+        t.add_row(str(r.mode), f"{r.frequency:#.6g}", _ratio(r.damping_ratio),
+                  f"{r.damped_frequency:#.6g}" if r.frequency > 0 else "-",
                   str(r.multiplicity), *([r.type or ""] if typed else []),
                   *([{"forward": "FW", "backward": "BW"}.get(r.whirl, "")] if whirls else []),
                   energy)

@@ -193,6 +193,17 @@ def test_bearing_forces_of_the_settled_part(tmp_path):
     assert list(ds["bearing"].values) == [r["body"] for r in rows]
     np.testing.assert_allclose(ds["bearing_peak_force"].values,
                                [r["peak_magnitude"] for r in rows])
+    # what the table prints by direction, and each group's numbers, are variables too
+    # (a MATLAB user found them only inside JSON attributes)
+    comp = ds["bearing_mean_force_component"]
+    for r in rows:
+        for d, v in zip(r["directions"], r["mean"]):
+            assert comp.sel(bearing=r["body"], bearing_direction=d).item() == v
+    met = res.metrics()
+    for g, members in met.load_sharing.groups.items():
+        assert [str(m) for m in ds["mesh"].values[ds["mesh_group"].values == g]] == members
+        assert ds["peak_to_nominal_engineering_group"].sel(group=g).item() == \
+            met.dynamic_factors.per_group_peak_to_nominal_engineering[g]
     from typer.testing import CliRunner
 
     from torquesplit.cli import app

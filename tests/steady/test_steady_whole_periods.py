@@ -149,6 +149,12 @@ def test_steady_says_its_results_warnings_and_leaves_out_cycles_without_samples(
             mean = row[key.replace("_peak_N", "_mean_N")]
             assert (row[key] == "") == (mean == ""), (row["cycle"], key)
     assert any(row["in1_peak_N"] == "" for row in rows)
+    # the table's RMS transmission error is in the summary file as in the .nc
+    summary = {r["mesh"]: r for r in csv.DictReader(open(out, newline=""))}
+    printed = json.loads(res.stdout)["meshes"]
+    for mesh, row in summary.items():
+        assert float(row["rms_transmission_error_m"]) == pytest.approx(
+            printed[mesh]["rms_transmission_error"], rel=1e-12)
 
 
 def test_json_output_and_file_attributes_hold_no_bare_nan(tmp_path):

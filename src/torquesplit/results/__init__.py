@@ -601,6 +601,11 @@ class Results:
                      r.contact_loss, r.back_contact, r.back_flank_force]
                     for r in met.rows]
             rows = self._planet_columns(header, rows, met)
+            steady = getattr(self, "steady", None)
+            if steady is not None:  # the steady table's RMS transmission error too
+                info = steady.summary(results=self)["meshes"]
+                header.append("rms_transmission_error_m")
+                rows = [row + [info[row[0]]["rms_transmission_error"]] for row in rows]
             # each group's and the system's coefficients and factors: what the run's
             # group table and system line print
             d, ls_ = met.dynamic_factors, met.load_sharing

@@ -193,6 +193,14 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
         ds["peak_to_nominal_group"] = _var(("group",), [d.per_group_peak_to_nominal[g]
                                                         for g in groups], "1",
                                            "largest peak/nominal of the group's meshes")
+        ds["peak_to_nominal_engineering_group"] = _var(
+            ("group",), [d.per_group_peak_to_nominal_engineering.get(g, np.nan)
+                         for g in groups], "1",
+            "mean over settled cycles of the group's largest per-cycle peak / nominal force "
+            "(Ji & Li eq. 19, engineering coefficient G_it)")
+        of_mesh = {m: g for g, ms in met.load_sharing.groups.items() for m in ms}
+        ds = ds.assign_coords(mesh_group=("mesh", [of_mesh.get(str(m), "")
+                                                   for m in ds["mesh"].values]))
         ds["load_sharing_system"] = _var((), met.load_sharing.system, "1",
                                          f"system load-sharing coefficient "
                                          f"({met.definition})")
@@ -209,6 +217,14 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
                                             "N", "largest settled bearing force magnitude "
                                             "(from the history: a peak between its samples "
                                             "is missed)")
+            directions = sorted({d for b in bearings for d in b["directions"]})
+            ds = ds.assign_coords(bearing_direction=("bearing_direction", directions))
+            ds["bearing_mean_force_component"] = _var(
+                ("bearing", "bearing_direction"),
+                [[dict(zip(b["directions"], b["mean"])).get(d, np.nan) for d in directions]
+                 for b in bearings], "N",
+                "settled mean bearing force along each direction of the support's frame "
+                "(NaN: no support in that direction)")
             ds.attrs["bearing_forces_json"] = _json.dumps(bearings)
     except Exception as exc:  # metrics of a diverged run may be undefined; keep the data
         ds.attrs["metrics_error"] = str(exc)

@@ -279,11 +279,11 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
                         "RMS TE [µm]", "contact loss"):
                 t.add_column(_h(col), justify="left" if col in ("mesh", "group") else "right")
             for r in rows:
-                t.add_row(r.mesh, r.group, f"{r.static_force / 1e3:.6g}",
-                          f"{r.mean_force / 1e3:.6g}", f"{r.peak_force / 1e3:.6g}",
+                t.add_row(r.mesh, r.group, f"{r.static_force / 1e3:#.6g}",
+                          f"{r.mean_force / 1e3:#.6g}", f"{r.peak_force / 1e3:#.6g}",
                           f"{r.dynamic_factor:.5f}",
                           f"{r.peak_to_nominal:.5f}", f"{r.load_sharing:.5f}",
-                          f"{1e6 * r.rms_transmission_error:.4g}",
+                          f"{1e6 * r.rms_transmission_error:#.4g}",
                           f"{100 * r.contact_loss:.2f} %")
             console.print(t)
             if planets:
@@ -572,7 +572,7 @@ def campbell_command(m, start, stop, plot, as_json, console, json_default, out=N
                   "suppressed" if c["suppressed"] else "excited"]
                  if phased else [])
         k_h = c.get("stiffness_harmonic")
-        t.add_row(f"{c['speed_rpm']:.6g}", str(c["mode"]), f"{c['frequency_Hz']:.6g}",
+        t.add_row(f"{c['speed_rpm']:#.6g}", str(c["mode"]), f"{c['frequency_Hz']:#.6g}",
                   f"{c['order']} x {c['source']}",
                   "-" if k_h is None else f"{100 * k_h:.3g}", *extra,
                   ", ".join(f"{n} {100 * v:.0f} %" for n, v in c["energy"]))
