@@ -100,6 +100,12 @@ def test_mat_and_csv_exports(split, tmp_path):
     res = torquesplit.simulate(split, cycles=20)
     mat = loadmat(res.save(tmp_path / "run.mat"))
     np.testing.assert_allclose(mat["element_force"], res.solution.history_forces)
+    # MATLAB: time a column beside the (time x element) forces; no integer arrays (int64
+    # refuses arithmetic with doubles)
+    assert mat["time"].shape == (res.solution.history_t.size, 1)
+    assert all(v.dtype.kind not in "iu" for k, v in mat.items()
+               if isinstance(v, np.ndarray) and not k.startswith("__")), \
+        [k for k, v in mat.items() if isinstance(v, np.ndarray) and v.dtype.kind in "iu"]
     assert mat["static_force"].ravel() == pytest.approx(list(res.static_forces().values()))
     # each variable's unit and what it is (the .mat had units only, time none)
     desc = mat["descriptions"][0, 0]

@@ -549,6 +549,7 @@ class Results:
             for name in ds.coords:
                 values = ds[name].values
                 data[name] = (np.asarray(values, dtype=object) if values.dtype.kind in "UO"
+                              else np.asarray(values, dtype=float) if values.dtype.kind in "iub"
                               else np.asarray(values))
             data["units"] = {name: ds[name].attrs.get("units", "") for name in ds.data_vars}
             data["units"]["time"] = "s"

@@ -593,11 +593,12 @@ def netcdf_bytes(dataset) -> bytes:
 
 
 def mat_bytes(data: dict) -> bytes:
-    """A dict as MATLAB .mat bytes (scipy.io.savemat), serialised in memory."""
+    """A dict as MATLAB .mat bytes (scipy.io.savemat), serialised in memory.  A vector is
+    a column (N x 1), as a history's time beside its (N x n) forces."""
     from scipy.io import savemat
 
     buffer = io.BytesIO()
-    savemat(buffer, data, long_field_names=True, do_compression=True)
+    savemat(buffer, data, long_field_names=True, do_compression=True, oned_as="column")
     return buffer.getvalue()
 
 
