@@ -687,7 +687,9 @@ def optimize(source, *, workers: int | None = None, generations: int | None = No
         from .study.runners import make_runner
 
         external = make_runner(client=client, scheduler=scheduler, runner=runner)
-    pool = (ProcessPoolExecutor(max_workers=spec.workers)
+    from .study.runners import worker_start
+
+    pool = (ProcessPoolExecutor(max_workers=spec.workers, initializer=worker_start)
             if spec.workers > 1 and external is None else None)
 
     def objectives_of(rec):

@@ -334,3 +334,47 @@ def test_progress_is_told_when_the_cases_start_and_a_refused_sweep_draws_no_bar(
                                    "meshes.a1.stiffness=2e8:4e8:3 N/m", "--out", str(out)])
     assert res.exit_code == 2 and "already holds a study" in res.stderr
     assert "cases" not in res.stderr.replace("cases (grid", ""), res.stderr
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
+def test_workers_exit_when_their_driver_is_killed(tmp_path, split_file):
+    """A reviewer killed a 2-worker study's driver with SIGKILL: its workers waited for
+    work forever (228 MB each), until killed by hand.  They exit with it now."""
+    from pathlib import Path
+
+    def children(pid):
+        out = []
+        for stat in Path("/proc").glob("[0-9]*/stat"):
+            try:
+                fields = stat.read_text().rsplit(")", 1)[1].split()
+            except (OSError, IndexError):
+                continue
+            if int(fields[1]) == pid:
+                out.append(int(stat.parent.name))
+        return out
+
+    data = grid_study(split_file, GRID, cycles=2000)
+    path = _write(tmp_path, data)
+    out = tmp_path / "out"
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+    proc = subprocess.Popen([sys.executable, "-m", "torquesplit.cli", "study", str(path),
+                             "--out", str(out), "--workers", "2", "--quiet", "--no-figures"],
+                            env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    deadline = time.monotonic() + 120
+    while _count(out / "study.sqlite") < 1:
+        assert proc.poll() is None, proc.stderr.read().decode()
+        assert time.monotonic() < deadline, "the study did not start"
+        time.sleep(0.05)
+    workers = children(proc.pid)
+    assert workers, "a 2-worker study has worker processes"
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+    deadline = time.monotonic() + 20
+    alive = workers
+    while alive and time.monotonic() < deadline:
+        time.sleep(0.1)
+        alive = [w for w in alive if Path(f"/proc/{w}").exists()
+                 and " Z " not in Path(f"/proc/{w}/stat").read_text()]
+    for w in alive:  # (leave nothing behind, then fail)
+        os.kill(w, signal.SIGKILL)
+    assert not alive, f"workers {alive} outlived their driver"

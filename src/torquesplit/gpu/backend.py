@@ -150,11 +150,11 @@ class GpuRunner:
                 import multiprocessing
                 from concurrent.futures import ProcessPoolExecutor
 
-                from ..study.runners import _ignore_sigint
+                from ..study.runners import worker_start
 
                 self._pool = ProcessPoolExecutor(
                     self.workers, mp_context=multiprocessing.get_context("spawn"),
-                    initializer=_ignore_sigint)
+                    initializer=worker_start)
             chunk = max(1, len(jobs) // (4 * self.workers))
             results = list(self._pool.map(prepare_case, *zip(*args), [True] * len(args),
                                           chunksize=chunk))

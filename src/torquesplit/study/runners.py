@@ -43,9 +43,26 @@ class SerialRunner:
         return "SerialRunner()"
 
 
-def _ignore_sigint() -> None:  # pragma: no cover - runs in the worker processes
-    # Ctrl-C goes to the whole process group: the driver stops the workers itself
+def worker_start() -> None:  # pragma: no cover - runs in the worker processes
+    """A worker's set-up: Ctrl-C ignored (it goes to the whole process group: the driver
+    stops the workers itself), and an exit as soon as the driver is gone.  A driver
+    killed outright (SIGKILL, the out-of-memory killer) cannot stop its pool, whose
+    workers then waited for work forever: a daemon thread waits on the parent
+    process's sentinel, which becomes ready when it dies."""
+    import multiprocessing
+    import threading
+    from multiprocessing.connection import wait
+
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    parent = multiprocessing.parent_process()
+    if parent is None:
+        return
+
+    def watch():
+        wait([parent.sentinel])
+        os._exit(1)
+
+    threading.Thread(target=watch, name="torquesplit-driver-watch", daemon=True).start()
 
 
 class LocalPool:
@@ -70,7 +87,7 @@ class LocalPool:
         from concurrent.futures import ProcessPoolExecutor
 
         ctx = multiprocessing.get_context(self.start_method)
-        pool = ProcessPoolExecutor(self.workers, mp_context=ctx, initializer=_ignore_sigint)
+        pool = ProcessPoolExecutor(self.workers, mp_context=ctx, initializer=worker_start)
         items = iter(payloads)
         pending: set = set()
         finished = False
