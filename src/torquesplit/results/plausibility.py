@@ -300,11 +300,11 @@ def coarse_history(results, metrics) -> list[tuple[str, str]]:
             f"--steps-per-cycle (Python: steps_per_cycle=) brings the waveform closer"))]
     if results.history_keeps_every_step():
         return [("analysis", (
-            f"the history keeps every RK4 step, yet {missed}: the peak falls inside a "
-            f"step, at a corner of a stiffness table (a tooth pair entering or leaving "
-            f"contact), where the step is split.  {exact}; the history, the figures' "
-            f"waveforms and the bearing table's peak |F| do not.  A finer step "
-            f"(--steps-per-period; Python: steps_per_period=) brings them closer"))]
+            f"the history keeps every RK4 step, yet {missed}: that peak falls inside a "
+            f"step, at a corner of a stiffness table, which the mesh table's numbers (and "
+            f"peak_force in the files) include and the history (files, figures, the "
+            f"bearing table's peak |F|) does not; a finer step (--steps-per-period) brings "
+            f"it closer"))]
     more = max(100, 5 * round(per)) if math.isfinite(per) else 100
     return [("analysis", (
         f"the history ({per:.3g} samples per shortest mesh period), which the results "
