@@ -80,8 +80,12 @@ def test_a_folder_of_other_results_is_not_written_over(tmp_path, split_file):
     with pytest.raises(StudyError, match=r"^out: .* holds results.nc of another run"):
         Study(path).run(workers=1, out=out, figures=False)
     assert (out / "results.nc").read_bytes() == b"someone else's"
+    (out / "figures").mkdir()
+    (out / "figures" / "dynamic_factor.png").write_bytes(b"another study's figure")
     Study(path).run(workers=1, out=out, figures=False, overwrite=True)
     assert (out / "results.nc").read_bytes() != b"someone else's"
+    # its figures went with it: they stayed beside the new study's, from other outputs
+    assert not (out / "figures" / "dynamic_factor.png").exists()
 
 
 def test_changed_study_or_model_refuses_resume(tmp_path, split_file):

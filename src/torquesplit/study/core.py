@@ -339,6 +339,9 @@ def _open_folder(plan: Plan, out: Path, resume: bool, overwrite: bool,
     if path.exists() and overwrite:
         for suffix in ("", "-wal", "-shm"):
             Path(str(path) + suffix).unlink(missing_ok=True)
+    if overwrite:  # the earlier study's figures go with it (they stayed beside the new)
+        for figure in [*(out / "figures").glob("*.png"), *(out / "figures").glob("*.svg")]:
+            figure.unlink(missing_ok=True)
     exists = path.exists()
     if exists and not resume:
         raise StudyError(words.out, f"{out} already holds a study; add {words.resume_on} to "
