@@ -149,17 +149,27 @@ class StudyError(TorquesplitError, ValueError):
     ``field`` is the dotted location in the study file (``grid.parameters.0.start``).
     """
 
-    def __init__(self, field: str, message: str, source: str | None = None):
+    def __init__(self, field: str, message: str, source: str | None = None, *,
+                 more: list[tuple[str, str]] = ()):
         self.field = field
         self.source = source
         self.reason = message
+        self.problems = [(field, message), *more]
+        """Every problem found, ``(field, message)``: a bad study file is refused with all
+        of them at once, one line each (the first is ``field`` and ``reason``)."""
         where = f"{source}: " if source else ""
-        where += f"{field}: " if field else ""
-        super().__init__(where + message)
+        super().__init__("\n".join(where + (f"{f}: " if f else "") + m
+                                   for f, m in self.problems))
+
+    @classmethod
+    def of(cls, problems: list[tuple[str, str]], source: str | None = None) -> "StudyError":
+        """One error holding every problem of ``problems`` (in their order, each once)."""
+        unique = list(dict.fromkeys(problems))
+        return cls(*unique[0], source, more=unique[1:])
 
     def with_source(self, source: str | None) -> "StudyError":
         """The same error, naming the file it came from."""
-        return StudyError(self.field, self.reason, source)
+        return StudyError.of(self.problems, source)
 
 
 class StudyInterrupted(TorquesplitError, KeyboardInterrupt):

@@ -88,6 +88,61 @@ def test_cli_refuses_bad_file_before_any_case(tmp_path, split_file):
     assert not (out / "study.sqlite").exists()
 
 
+def test_every_problem_of_a_study_file_is_said_at_once(tmp_path, split_file):
+    """A reviewer fixed a study file with eight mistakes in eight attempts (one line
+    each).  The file's structure is checked first, all of it; then, against the model,
+    every parameter, the outputs and the analysis, all at once; the sweep names its
+    options for them."""
+    data = grid_study(split_file, [dict(K, path="meshes.a1.stifness"),
+                                   dict(K, path="meshes.b1.stiffness", start="2e8 kg"),
+                                   dict(K, path="meshes.a2.stiffness", num=0)],
+                      outputs=["load_sharing.engneering.*"])
+    data["study"]["descripton"] = "typo"
+    data["analysis"]["steps_per_period"] = 0
+    with pytest.raises(StudyError) as info:
+        Study(data).plan()
+    fields = [f for f, _ in info.value.problems]
+    assert fields == ["study.descripton", "analysis.steps_per_period",
+                      "grid.parameters.2.num"], fields
+    assert str(info.value).count("\n") == 2
+    del data["study"]["descripton"]
+    data["analysis"]["steps_per_period"] = 100
+    data["grid"]["parameters"][2]["num"] = 3
+    data["analysis"].pop("cycles", None)
+    data["analysis"]["duration"] = "-1 s"
+    with pytest.raises(StudyError) as info:
+        Study(data).plan()
+    fields = [f for f, _ in info.value.problems]
+    assert fields == ["analysis.duration", "study.outputs", "grid.parameters.0.path",
+                      "grid.parameters.1.start"], fields
+    path = tmp_path / "bad.toml"
+    path.write_text(tomli_w.dumps(data))
+    res = CliRunner().invoke(app, ["study", str(path), "--quiet"])
+    lines = [ln for ln in res.output.splitlines() if ln.strip()]
+    assert res.exit_code == 2 and len(lines) == 4 and all(
+        ln.startswith(f"error: {path}: ") for ln in lines), res.output
+    res = CliRunner().invoke(app, ["sweep", str(split_file), "--vary",
+                                   "meshes.a1.stifness=2e8:6e8:3 N/m", "--output", "nope",
+                                   "--duration", "-1 s", "--quiet"])
+    assert res.exit_code == 2
+    assert [":".join(ln.split(":")[:2]) for ln in res.output.splitlines() if ln.strip()] == [
+        "error: --duration", "error: --output", "error: --vary (path)"], res.output
+
+
+def test_a_grid_value_that_gives_an_invalid_model_is_said_before_the_cases_run(split_file):
+    """A sweep down to a negative damping ratio ran its first cases and only then
+    recorded the last as refused.  The grid's extreme values are checked when the study
+    is planned: said at once (the case still runs as refused, the others as usual)."""
+    study = Study(grid_study(split_file, [{"path": "meshes.a1.damping_ratio",
+                                           "values": [0.1, 0.05, -0.1]}]))
+    notes = study.plan().notes
+    assert len(notes) == 1 and "case 2 (meshes.a1.damping_ratio = -0.1)" in notes[0]
+    assert "recorded as refused" in notes[0]
+    with pytest.warns(UserWarning, match="case 2"):
+        ds = study.run(workers=1, figures=False)
+    assert ds["status"].values.tolist() == ["ok", "ok", "refused"]
+
+
 def test_toml_syntax_error_names_the_file(tmp_path):
     path = tmp_path / "broken.toml"
     path.write_text("[study\nname = 1\n")

@@ -109,6 +109,8 @@ def _run(source, *, workers, scheduler, out, resume, overwrite, figures, quiet, 
                 f"[bold]{st.name}[/]: {plan.n_cases} cases ({plan.design.kind}, "
                 f"{plan.analysis['type']}), {len(plan.outputs)} outputs -> {out}",
                 highlight=False)
+        for note in plan.notes:  # cases known invalid before any runs
+            ui.ux.warn(_sweep_note(note, flag) if flag else note)
         with warnings.catch_warnings():
             if backend == "gpu":  # no device: say so in one line, not as a Python warning
                 from ..errors import GpuFallbackWarning
@@ -138,16 +140,36 @@ def _run(source, *, workers, scheduler, out, resume, overwrite, figures, quiet, 
     except (TorquesplitError, ValueError, OSError) as exc:
         from .errors import StudyError
 
-        field = getattr(exc, "field", None)
-        if flag and isinstance(exc, StudyError) and field and field.startswith(
-                "grid.parameters.0"):
-            sub = field[len("grid.parameters.0"):].lstrip(".")
-            exc = StudyError(f"{flag}" + (f" ({sub})" if sub else ""), exc.reason)
-        elif flag and isinstance(exc, StudyError) and field == "study.outputs":
-            exc = StudyError("--output", exc.reason)  # the sweep's words, not the study's
+        if flag and isinstance(exc, StudyError):  # the sweep's words, not the study's
+            exc = StudyError.of([(_sweep_option(f, flag), m) for f, m in exc.problems])
         ui._fail(exc)
         return
     _summary(ds, Path(out), as_json, figures)
+
+
+#: a study field -> the ``sweep`` option that wrote it
+_SWEEP_OPTIONS = (("study.outputs", "--output"), ("analysis.duration", "--duration"),
+                  ("analysis.cycles", "--cycles"), ("analysis.settle", "--settle"),
+                  ("set", "--set"), ("study.model", "MODEL"))
+
+
+def _sweep_option(field: str, flag: str) -> str:
+    """The option of ``sweep`` that wrote study field ``field`` (its only grid parameter
+    is ``flag``'s); the field itself where no option wrote it."""
+    if field == "grid.parameters":  # (a case of the only parameter)
+        return flag
+    if field.startswith("grid.parameters.0"):
+        sub = field[len("grid.parameters.0"):].lstrip(".")
+        return flag + (f" ({sub})" if sub else "")
+    for prefix, option in _SWEEP_OPTIONS:
+        if field == prefix or field.startswith(prefix + "."):
+            return option
+    return field
+
+
+def _sweep_note(note: str, flag: str) -> str:
+    """A plan's note in the sweep's words (its grid parameter is ``flag``'s)."""
+    return note.replace("grid.parameters: ", f"{flag}: ", 1)
 
 
 def _with_bar(job, total: int, quiet: bool):

@@ -194,6 +194,12 @@ class Study:
             and the figures are written: the run is recorded as finished only once they
             are, and ``resume=True`` writes them again).
         """
+        import warnings
+
+        from ..errors import ModelWarning
+
+        for note in self.plan().notes:  # (before any case runs)
+            warnings.warn(note, ModelWarning, stacklevel=2)
         return self._run(API_WORDS, workers=workers, client=client, scheduler=scheduler,
                          runner=runner, out=out, resume=resume, overwrite=overwrite,
                          progress=progress, figures=figures, backend=backend,

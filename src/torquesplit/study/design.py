@@ -139,6 +139,9 @@ class Plan:
     definitions: list[str]
     analysis: dict
     design: Design
+    notes: list[str] = field(default_factory=list)
+    """Cases found invalid before the study runs (a grid parameter at its smallest or
+    largest value): they will be recorded as refused; said before any case runs."""
 
     @property
     def n_cases(self) -> int:
@@ -155,6 +158,26 @@ class Plan:
 
 
 # ============================================================================ resolve
+class _Problems:
+    """Every problem of a study file, collected, so that the file is refused with all of
+    them at once (a reviewer fixed eight mistakes in eight attempts)."""
+
+    def __init__(self):
+        self.items: list[tuple[str, str]] = []
+
+    def attempt(self, function, *args, **kwargs):
+        """``function(*args, **kwargs)``, or None with its StudyError's problems kept."""
+        try:
+            return function(*args, **kwargs)
+        except StudyError as exc:
+            self.items.extend(exc.problems)
+            return None
+
+    def raise_any(self) -> None:
+        if self.items:
+            raise StudyError.of(self.items)
+
+
 def resolve(spec: StudySpec, folder: Path | None, text: str, source: str | None = None) -> Plan:
     """Check a study against its model and compute every case's values (no case runs)."""
     try:
@@ -172,22 +195,37 @@ def _resolve(spec, folder, text, source) -> Plan:
     model = _validated(base, model_source, "set" if spec.set else "study.model")
     canon = model_to_dict(model)
     model_hash = _hash(canon)
-    analysis = _analysis(spec)
-    outputs, definitions = _outputs(spec, model, analysis["type"])
+    # the checks below do not depend on each other: every problem is said at once
+    problems = _Problems()
+    analysis = problems.attempt(_analysis, spec)
+    chosen = problems.attempt(_outputs, spec, model, spec.analysis.type)
     kind = spec.design
-    _check_generated_paths(spec, model)
+    problems.attempt(_check_generated_paths, spec, model)
     if kind == "grid":
-        design = _grid(spec, base)
+        design = problems.attempt(_grid, spec, base)
     elif kind == "monte_carlo":
-        design = _monte_carlo(spec, base, model)
+        design = problems.attempt(_monte_carlo, spec, base, model)
     else:
         from .sensitivity import sensitivity_design
 
-        design = sensitivity_design(spec.sensitivity, _sensitivity_parameters(spec, base))
+        factors = problems.attempt(_sensitivity_parameters, spec, base)
+        design = (problems.attempt(sensitivity_design, spec.sensitivity, factors)
+                  if factors is not None else None)
+    problems.raise_any()
+    outputs, definitions = chosen
     # probe: a study whose first case gives an invalid model is refused (almost always a
-    # mistake in the file); an invalid later case is recorded as refused when it runs
+    # mistake in the file); an invalid later case is recorded as refused when it runs,
+    # and one the grid reaches at a parameter's smallest or largest value is said now
+    cases = _probe_cases(design)
     _validated(apply_overrides(base, design.overrides(0)), model_source,
                f"{kind}.parameters", case=0, design=design)
+    notes = []
+    for case in cases[1:]:
+        try:
+            _validated(apply_overrides(base, design.overrides(case)), model_source,
+                       f"{kind}.parameters", case=case, design=design)
+        except StudyError as exc:
+            notes.append(f"{exc}; it will be recorded as refused (the other cases run)")
     canonical = spec.canonical()
     # a [[planetary]] stage's fields exist in the file's own data only (the validated copy
     # holds the elements the stage generated): cases varying one start from that data
@@ -198,7 +236,23 @@ def _resolve(spec, folder, text, source) -> Plan:
                 base_data=base, case_data=case_data, model=model, model_hash=model_hash,
                 model_dict=canon,
                 study_hash=_hash(canonical), outputs=outputs, definitions=definitions,
-                analysis=analysis, design=design)
+                analysis=analysis, design=design, notes=notes)
+
+
+def _probe_cases(design) -> list[int]:
+    """Cases checked before any runs: the first, and for a grid each parameter at its
+    smallest and largest value with the others at their first values."""
+    cases = [0]
+    if design.kind == "grid" and design.values.shape[0] > 1:
+        first = design.values[0]
+        for j, axis in enumerate(design.axes):
+            for v in (axis.min(), axis.max()):
+                row = first.copy()
+                row[j] = v
+                hit = np.flatnonzero(np.all(design.values == row, axis=1))
+                if hit.size and int(hit[0]) not in cases:
+                    cases.append(int(hit[0]))
+    return cases
 
 
 def _check_generated_paths(spec: StudySpec, model) -> None:
@@ -255,7 +309,10 @@ def _validated(data: dict, model_source: str, where: str, case=None, design=None
             vals = ", ".join(f"{p.name} = {p.show(v)}" for p, v in
                              zip(design.parameters, design.values[case], strict=True))
             what = f"case {case} ({vals}) gives an invalid model"
-        raise StudyError(where, f"{what}: {_one_line(exc)}") from None
+        issues = getattr(exc, "issues", None)
+        why = (" | ".join(f"{loc}: {msg}" if loc else msg for loc, msg in issues) if issues
+               else _one_line(exc))
+        raise StudyError(where, f"{what}: {why}") from None
 
 
 def _one_line(exc: BaseException) -> str:
@@ -305,14 +362,16 @@ def _outputs(spec: StudySpec, model, analysis: str) -> tuple[list[str], list[str
                                           planets)
     names, unmatched = out_mod.select_outputs(spec.study.outputs, available)
     if unmatched:
-        p = unmatched[0]
         import difflib
 
-        close = difflib.get_close_matches(p, available, n=3)
-        hint = f"close: {', '.join(close)}; " if close else ""
-        raise StudyError("study.outputs", f"{p!r} matches no output of a {analysis!r} analysis "
-                                          f"of this model; {hint}see docs/studies.md for the "
-                                          f"names")
+        problems = []
+        for p in unmatched:
+            close = difflib.get_close_matches(p, available, n=3)
+            hint = f"close: {', '.join(close)}; " if close else ""
+            problems.append(("study.outputs", f"{p!r} matches no output of a {analysis!r} "
+                                              f"analysis of this model; {hint}see "
+                                              f"docs/studies.md for the names"))
+        raise StudyError.of(problems)
     stop = spec.monte_carlo.stop if spec.monte_carlo is not None else None
     if stop is not None:
         if stop.output not in available:
@@ -420,45 +479,14 @@ def _grid(spec: StudySpec, raw: dict) -> Design:
     params: list[Parameter] = []
     axes: list[np.ndarray] = []
     spacings: list[str] = []
+    problems = _Problems()
     for i, t in enumerate(spec.grid.parameters):
-        where = f"grid.parameters.{i}"
-        p = _parameter(t, raw, where)
-        if t.values is not None:
-            vals = np.array([_value(v, p, t.unit, f"{where}.values.{j}")
-                             for j, v in enumerate(t.values)], dtype=float)
-            shown = t.values
-        else:
-            a = _value(t.start, p, t.unit, f"{where}.start")
-            b = _value(t.stop, p, t.unit, f"{where}.stop")
-            if t.num > MAX_CASES:
-                raise StudyError(f"{where}.num", f"{t.num:,} points; a study holds at most "
-                                                 f"{MAX_CASES:,} cases: give fewer")
-            if t.num > 1 and a == b:
-                raise StudyError(f"{where}.stop", "equals 'start': the range is empty; give a "
-                                                  "different stop, or 'values'")
-            if t.num == 1 and a != b:
-                raise StudyError(f"{where}.num", f"1 point but start {_shown(t.start, t.unit)} "
-                                                 f"!= stop {_shown(t.stop, t.unit)}; give "
-                                                 "num >= 2 or start = stop")
-            if t.spacing == "log":
-                if a <= 0 or b <= 0:
-                    raise StudyError(f"{where}.start", "a log range needs positive start and "
-                                                       "stop; use spacing = \"linear\"")
-                vals = np.geomspace(a, b, t.num)
-            else:
-                vals = np.linspace(a, b, t.num)
-            if p.mode == "set" and p.fields[0].integer:
-                vals = np.round(vals)
-            shown = [t.start, t.stop]
-        if len(np.unique(vals)) != len(vals):
-            raise StudyError(f"{where}.values", "repeats a value; give each value once")
-        p = Parameter(p.name, p.fields, p.mode, p.base,
-                      None if p.mode == "scale" else _display_unit(shown, t.unit))
-        if p.display_unit and p.display_unit != p.unit:
-            vals = np.array([decimal_si(x, p.display_unit, p.unit) for x in vals])
-        params.append(p)
-        axes.append(vals)
-        spacings.append(t.spacing if t.values is None else "values")
+        got = problems.attempt(_grid_axis, t, raw, f"grid.parameters.{i}")
+        if got is not None:
+            params.append(got[0])
+            axes.append(got[1])
+            spacings.append(t.spacing if t.values is None else "values")
+    problems.raise_any()
     names = [p.name for p in params]
     if len(set(names)) != len(names):
         raise StudyError("grid.parameters", f"two parameters are named {names}; give each a "
@@ -472,6 +500,45 @@ def _grid(spec: StudySpec, raw: dict) -> Design:
     values = np.array(list(itertools.product(*axes)), dtype=float).reshape(-1, len(axes))
     return Design("grid", params, values, shape=shape, axes=axes,
                   extra={"spacing": spacings})
+
+
+def _grid_axis(t, raw: dict, where: str) -> tuple[Parameter, np.ndarray]:
+    """One grid parameter and its values (SI)."""
+    p = _parameter(t, raw, where)
+    if t.values is not None:
+        vals = np.array([_value(v, p, t.unit, f"{where}.values.{j}")
+                         for j, v in enumerate(t.values)], dtype=float)
+        shown = t.values
+    else:
+        a = _value(t.start, p, t.unit, f"{where}.start")
+        b = _value(t.stop, p, t.unit, f"{where}.stop")
+        if t.num > MAX_CASES:
+            raise StudyError(f"{where}.num", f"{t.num:,} points; a study holds at most "
+                                             f"{MAX_CASES:,} cases: give fewer")
+        if t.num > 1 and a == b:
+            raise StudyError(f"{where}.stop", "equals 'start': the range is empty; give a "
+                                              "different stop, or 'values'")
+        if t.num == 1 and a != b:
+            raise StudyError(f"{where}.num", f"1 point but start {_shown(t.start, t.unit)} "
+                                             f"!= stop {_shown(t.stop, t.unit)}; give "
+                                             "num >= 2 or start = stop")
+        if t.spacing == "log":
+            if a <= 0 or b <= 0:
+                raise StudyError(f"{where}.start", "a log range needs positive start and "
+                                                   "stop; use spacing = \"linear\"")
+            vals = np.geomspace(a, b, t.num)
+        else:
+            vals = np.linspace(a, b, t.num)
+        if p.mode == "set" and p.fields[0].integer:
+            vals = np.round(vals)
+        shown = [t.start, t.stop]
+    if len(np.unique(vals)) != len(vals):
+        raise StudyError(f"{where}.values", "repeats a value; give each value once")
+    p = Parameter(p.name, p.fields, p.mode, p.base,
+                  None if p.mode == "scale" else _display_unit(shown, t.unit))
+    if p.display_unit and p.display_unit != p.unit:
+        vals = np.array([decimal_si(x, p.display_unit, p.unit) for x in vals])
+    return p, vals
 
 
 def decimal_si(x: float, unit: str, si: str) -> float:
@@ -509,22 +576,13 @@ def _monte_carlo(spec: StudySpec, raw: dict, model) -> Design:
     mc = spec.monte_carlo
     params: list[Parameter] = []
     rvs: list[RandomVariable] = []
+    problems = _Problems()
     for i, t in enumerate(mc.parameters):
-        where = f"monte_carlo.parameters.{i}"
-        fields = _target_fields(t, raw, where)
-        P.check_unit(t.unit, fields[0].kind, f"{where}.unit")
-        groups = [fields] if (t.shared or len(fields) == 1) else [[f] for f in fields]
-        for g in groups:
-            if t.name and len(groups) == 1:
-                name = t.name
-            elif t.name:
-                name = f"{t.name}.{g[0].path}"
-            else:
-                name = g[0].path
-            shown = [v for v in (t.mean, t.low, t.high) if v is not None]
-            p = Parameter(name, tuple(g), "set", (), _display_unit(shown, t.unit))
+        got = problems.attempt(_mc_parameter, t, raw, model, f"monte_carlo.parameters.{i}")
+        for p, rv in got or ():
             params.append(p)
-            rvs.append(_random_variable(t, p, model, where))
+            rvs.append(rv)
+    problems.raise_any()
     names = [p.name for p in params]
     dup = {n for n in names if names.count(n) > 1}
     if dup:
@@ -535,6 +593,26 @@ def _monte_carlo(spec: StudySpec, raw: dict, model) -> Design:
     u = uniform_points(mc.sampling, n, len(params), mc.seed)
     values = np.column_stack([transform(rv, u[:, j]) for j, rv in enumerate(rvs)])
     return Design("monte_carlo", params, values, extra={"random_variables": rvs})
+
+
+def _mc_parameter(t, raw: dict, model, where: str) -> list[tuple[Parameter, RandomVariable]]:
+    """A Monte Carlo parameter table -> its parameters (one per field unless shared) and
+    their random variables."""
+    fields = _target_fields(t, raw, where)
+    P.check_unit(t.unit, fields[0].kind, f"{where}.unit")
+    groups = [fields] if (t.shared or len(fields) == 1) else [[f] for f in fields]
+    out = []
+    for g in groups:
+        if t.name and len(groups) == 1:
+            name = t.name
+        elif t.name:
+            name = f"{t.name}.{g[0].path}"
+        else:
+            name = g[0].path
+        shown = [v for v in (t.mean, t.low, t.high) if v is not None]
+        p = Parameter(name, tuple(g), "set", (), _display_unit(shown, t.unit))
+        out.append((p, _random_variable(t, p, model, where)))
+    return out
 
 
 def _random_variable(t, p: Parameter, model, where) -> RandomVariable:
@@ -688,22 +766,30 @@ def iso_band(u: np.ndarray, tolerance: float, shape: str, signed: bool) -> np.nd
 # ============================================================================ sensitivity
 def _sensitivity_parameters(spec: StudySpec, raw: dict):
     out = []
+    problems = _Problems()
     for i, t in enumerate(spec.sensitivity.parameters):
-        where = f"sensitivity.parameters.{i}"
-        p = _parameter(t, raw, where)
-        low = _value(t.low, p, t.unit, f"{where}.low")
-        high = _value(t.high, p, t.unit, f"{where}.high")
-        if not high > low:
-            raise StudyError(f"{where}.high", "must exceed 'low'; give the range low < high")
-        if t.spacing == "log" and low <= 0:
-            raise StudyError(f"{where}.low", "a log range needs low > 0; use spacing = "
-                                             "\"linear\"")
-        p = Parameter(p.name, p.fields, p.mode, p.base,
-                      None if p.mode == "scale" else _display_unit([t.low, t.high], t.unit))
-        out.append((p, low, high, t.spacing))
+        got = problems.attempt(_sensitivity_factor, t, raw, f"sensitivity.parameters.{i}")
+        if got is not None:
+            out.append(got)
+    problems.raise_any()
     names = [p.name for p, *_ in out]
     if len(set(names)) != len(names):
         raise StudyError("sensitivity.parameters", "two factors have the same name; give each "
                                                    "a different name")
     _check_disjoint([p for p, *_ in out], "sensitivity.parameters")
     return out
+
+
+def _sensitivity_factor(t, raw: dict, where: str):
+    """A sensitivity parameter table -> (Parameter, low, high, spacing), bounds in SI."""
+    p = _parameter(t, raw, where)
+    low = _value(t.low, p, t.unit, f"{where}.low")
+    high = _value(t.high, p, t.unit, f"{where}.high")
+    if not high > low:
+        raise StudyError(f"{where}.high", "must exceed 'low'; give the range low < high")
+    if t.spacing == "log" and low <= 0:
+        raise StudyError(f"{where}.low", "a log range needs low > 0; use spacing = "
+                                         "\"linear\"")
+    p = Parameter(p.name, p.fields, p.mode, p.base,
+                  None if p.mode == "scale" else _display_unit([t.low, t.high], t.unit))
+    return p, low, high, t.spacing

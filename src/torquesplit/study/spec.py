@@ -390,24 +390,26 @@ def read_study(source) -> tuple[StudySpec, Path | None, str]:
 
 
 def parse_study(data: dict) -> StudySpec:
-    """Validate study data; the first problem becomes a one-line StudyError."""
+    """Validate study data; every problem becomes one line of a StudyError."""
     try:
         return StudySpec.model_validate(data)
     except pydantic.ValidationError as exc:
-        err = _first(exc)
-        raise StudyError(*err) from None
+        raise StudyError.of(_problems(exc)) from None
 
 
-def _first(exc: pydantic.ValidationError) -> tuple[str, str]:
+def _problems(exc: pydantic.ValidationError) -> list[tuple[str, str]]:
+    """(field, message) of every error, a validator's own problems before missing fields
+    (more telling than a missing field elsewhere)."""
     errors = exc.errors(include_url=False)
-    # a validator's own problem is more telling than a missing-field error elsewhere
     errors.sort(key=lambda e: e["type"] == "missing")
-    err = errors[0]
-    parts = [str(p) for p in err["loc"] if not _internal(p)]
-    problem = (err.get("ctx") or {}).get("error")
-    if isinstance(problem, _Problem):
-        parts.append(problem.field)
-    return ".".join(parts), _message(err, parts)
+    out = []
+    for err in errors:
+        parts = [str(p) for p in err["loc"] if not _internal(p)]
+        problem = (err.get("ctx") or {}).get("error")
+        if isinstance(problem, _Problem):
+            parts.append(problem.field)
+        out.append((".".join(parts), _message(err, parts)))
+    return out
 
 
 def _internal(part) -> bool:
