@@ -125,3 +125,24 @@ def test_sweep_pattern_and_static_run_length_flags(tmp_path, split_file):
                               "--vary", "meshes.a1.transmission_error.constant=0:4:2um"])
     assert res.exit_code == 2 and "--duration" in res.output
     assert "analysis.duration" not in res.output
+
+
+def test_summary_names_the_case_of_each_failure_units_and_an_empty_resume(tmp_path,
+                                                                        split_file):
+    """A reviewer's sweep printed three near-identical 'not ok' lines without saying which
+    case each was, force columns without their unit, and '--resume' into a mistyped
+    folder started the study again without a word."""
+    data = grid_study(split_file, [{"path": "drives.motor.torque",
+                                    "values": ["100 N m", "1e10 N m", "120 N m"]}],
+                      outputs=["peak_force.a1", "load_sharing.cycle_peak"])
+    path = tmp_path / "s.toml"
+    path.write_text(tomli_w.dumps(data))
+    res = runner.invoke(app, ["study", str(path), "--out", str(tmp_path / "typo"),
+                              "--resume", "--workers", "1", "--no-figures", "--quiet"])
+    assert res.exit_code == 0, res.output
+    assert "holds no study to resume: the study starts from its first case" in res.stderr
+    lines = res.stdout.splitlines()
+    assert any(ln.strip().startswith("not ok, case 1: Integration diverged") for ln in lines), \
+        res.stdout
+    assert "peak_force.a1 [N]" in res.stdout and "load_sharing.cycle_peak [" not in res.stdout
+    assert "2 outputs" in res.stderr

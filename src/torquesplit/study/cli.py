@@ -107,10 +107,14 @@ def _run(source, *, workers, scheduler, out, resume, overwrite, figures, quiet, 
         if not as_json:
             ui.err_console.print(
                 f"[bold]{st.name}[/]: {plan.n_cases} cases ({plan.design.kind}, "
-                f"{plan.analysis['type']}), {len(plan.outputs)} outputs -> {out}",
+                f"{plan.analysis['type']}), {_count(len(plan.outputs), 'output')} -> {out}",
                 highlight=False)
+        from .core import nothing_to_resume
+
         for note in plan.notes:  # cases known invalid before any runs
             ui.ux.warn(_sweep_note(note, flag) if flag else note)
+        for note in nothing_to_resume(out, resume, CLI_WORDS):
+            ui.ux.warn(note)
         with warnings.catch_warnings():
             if backend == "gpu":  # no device: say so in one line, not as a Python warning
                 from ..errors import GpuFallbackWarning
@@ -284,9 +288,9 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
             x = x[np.isfinite(x)]
             count = [f"{x.size} of {status.size}"] if "cases" in cols else []
             if not x.size:
-                t.add_row(v, *["-"] * 6, *count)
+                t.add_row(v + _unit_suffix(ds[v]), *["-"] * 6, *count)
                 continue
-            t.add_row(v, *[f"{s:.6g}" for s in (x.mean(), x.std(ddof=1) if x.size > 1 else
+            t.add_row(v + _unit_suffix(ds[v]), *[f"{s:.6g}" for s in (x.mean(), x.std(ddof=1) if x.size > 1 else
                                                 0.0, x.min(), np.quantile(x, 0.05),
                                                 np.quantile(x, 0.95), x.max())], *count)
         ui.console.print(t)
@@ -298,10 +302,18 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
     line = stopping_line(ds)
     if line:
         ui.console.print(line, markup=False, highlight=False)
-    reasons = sorted({r for r, s in zip(ds["reason"].values.ravel().tolist(), status)
-                      if s != "ok"})
-    for r in reasons[:5]:
-        ui.console.print(f"  not ok: {r}", markup=False, highlight=False)
+    # each reason with the cases it is of (three near-identical lines said nothing of
+    # which case each was)
+    of_reason: dict[str, list[int]] = {}
+    for k, (r, s) in enumerate(zip(ds["reason"].values.ravel().tolist(), status)):
+        if s != "ok":
+            of_reason.setdefault(r, []).append(k)
+    for r, cases in list(of_reason.items())[:5]:
+        ui.console.print(f"  not ok, {case_ranges(cases)}: {r}", markup=False,
+                         highlight=False, soft_wrap=True)
+    if len(of_reason) > 5:
+        ui.console.print(f"  ... and {len(of_reason) - 5} more reasons (variable 'reason' "
+                         f"of results.nc)", highlight=False)
     if n_warned:
         ui.console.print(f"[yellow]{n_warned} of {status.size} cases warned[/] (variable "
                          f"'warnings' of results.nc has each case's):", highlight=False)
@@ -312,7 +324,18 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
             ui.console.print(f"  ... and {len(groups) - 5} more kinds of warning",
                              highlight=False)
     ui.console.print(f"results: {out / 'results.nc'}; store: {out / 'study.sqlite'}"
-                     + (f"; {len(figs)} figures in {out / 'figures'}" if figs else ""))
+                     + (f"; {_count(len(figs), 'figure')} in {out / 'figures'}" if figs else ""))
+
+
+def _unit_suffix(var) -> str:
+    """" [N]" after an output's name where it has a unit (none for a ratio)."""
+    unit = str(var.attrs.get("units", ""))
+    return f" [{unit}]" if unit not in ("", "1", "-") else ""
+
+
+def _count(n: int, what: str) -> str:
+    """"1 output", "3 outputs"."""
+    return f"{n} {what}" + ("" if n == 1 else "s")
 
 
 MAX_TABLE_CASES = 60
@@ -361,8 +384,8 @@ def _grid_table(ds, title: str, columns: list[tuple[str, str]]):
         shown[d] = dict(zip(ds[d].values.tolist(), values.tolist()))
         # escaped: Rich would read "[um]" as markup and drop it
         t.add_column(escape(f"{d} [{unit}]"), justify="right")
-    for header, _ in columns:
-        t.add_column(escape(header), justify="right")
+    for header, v in columns:
+        t.add_column(escape(header + _unit_suffix(ds[v])), justify="right")
     t.add_column("status")
     flat = ds.stack(case=dims)
     for k in range(flat.sizes["case"]):

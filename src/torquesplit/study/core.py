@@ -198,8 +198,8 @@ class Study:
 
         from ..errors import ModelWarning
 
-        for note in self.plan().notes:  # (before any case runs)
-            warnings.warn(note, ModelWarning, stacklevel=2)
+        for note in self.plan().notes + nothing_to_resume(out, resume, API_WORDS):
+            warnings.warn(note, ModelWarning, stacklevel=2)  # (before any case runs)
         return self._run(API_WORDS, workers=workers, client=client, scheduler=scheduler,
                          runner=runner, out=out, resume=resume, overwrite=overwrite,
                          progress=progress, figures=figures, backend=backend,
@@ -244,6 +244,15 @@ class Study:
         finally:
             store.close()
         return ds
+
+
+def nothing_to_resume(out, resume: bool, words: Words) -> list[str]:
+    """The note of a resume whose folder holds no study (a typo in the folder restarted a
+    long study without a word): it starts from its first case."""
+    if not resume or out is None or (Path(out) / STORE_NAME).exists():
+        return []
+    return [f"{words.out} {out} holds no study to resume: the study starts from its first "
+            f"case"]
 
 
 def _write_outputs(ds, out: Path, figures: bool) -> None:
