@@ -191,6 +191,15 @@ def test_grid_axes_and_figures_of_log_and_3_parameter_grids(split_file):
     fig = curves_figure(one, "load_sharing.cycle_peak",
                         [("system", "load_sharing.cycle_peak")])
     assert fig.axes[0].get_xscale() == "log"
+    # a curve equal to one drawn (the system is its worst group) was drawn under it, its
+    # legend entry showing a line nowhere to be seen: its name joins that entry instead
+    one["other"] = one["load_sharing.cycle_peak"] * 1.01
+    one["same"] = one["load_sharing.cycle_peak"].copy()
+    fig = curves_figure(one, "load_sharing.cycle_peak",
+                        [("system", "load_sharing.cycle_peak"), ("a1", "other"),
+                         ("stage", "same")])
+    labels = [ln.get_label() for ln in fig.axes[0].get_lines()]
+    assert labels == ["system = stage", "a1"], labels
 
 
 def test_refused_cases_show_the_values_in_the_unit_written(split_file):

@@ -185,8 +185,16 @@ def test_statistics_over_fewer_cases_say_so(split_file, tmp_path):
     with ui.console.capture() as cap:
         _summary(ds, tmp_path, False, False)
     assert "statistics over 6 of 8 cases" in cap.get()
-    title = monte_carlo_figure(ds, OUT)._suptitle.get_text()
+    fig = monte_carlo_figure(ds, OUT)
+    title = fig._suptitle.get_text()
     assert "statistics over 6 of 8 cases" in title
+    # counts on whole-number ticks; no 95th percentile of fewer than 20 samples (it is
+    # their largest), nor its legend entry
+    ticks = fig.axes[0].get_yticks()
+    assert np.all(ticks == np.round(ticks)), ticks
+    labels = [t.get_text() for t in fig.axes[2].get_legend().texts]
+    assert not any("95th percentile" in t for t in labels), labels
+    assert fig.axes[1].get_ylabel() == "cumulative probability [-]"
 
 
 def test_stopping_rule_outcome_is_reported(split_file, tmp_path):

@@ -31,6 +31,7 @@ from pathlib import Path
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
+from matplotlib.ticker import MaxNLocator
 
 from . import outputs as out_mod
 
@@ -91,13 +92,24 @@ def curves_figure(ds, family: str, members: list[tuple[str, str]]) -> Figure:
     fig = _figure(WIDTH, 4.2)
     ax = fig.add_subplot()
     unit, scale = _out_unit(var0)
+    # a curve equal to one drawn already (the system's coefficient is its worst group's,
+    # a group of one mesh is that mesh) is not drawn again, hidden under it: its name
+    # joins that curve's legend entry
+    drawn: list[tuple[np.ndarray, object]] = []
     for i, (member, var) in enumerate(members[:MAX_MEMBERS]):
         y = ds[var].values * scale
+        same = next((line for yy, line in drawn
+                     if np.allclose(y, yy, rtol=1e-12, atol=0.0, equal_nan=True)), None)
+        if same is not None:
+            same.set_label(f"{same.get_label()} = {member}")
+            continue
         if member == "system":
-            ax.plot(x, y, color="k", lw=2.4, marker="o", ms=3, label="system", zorder=5)
+            line, = ax.plot(x, y, color="k", lw=2.4, marker="o", ms=3, label="system",
+                            zorder=5)
         else:
-            ax.plot(x, y, color=_color(i), lw=1.4, ls=_DASHES[i % len(_DASHES)], marker="o",
-                    ms=2.5, label=member)
+            line, = ax.plot(x, y, color=_color(i), lw=1.4, ls=_DASHES[i % len(_DASHES)],
+                            marker="o", ms=2.5, label=member)
+        drawn.append((y, line))
     _mark_failed(ax, x, ds["status"].values)
     _log_axis(ds, pname, ax.set_xscale)
     ax.set_xlabel(f"{_param_label(ds, pname)} [{xunit}]")
@@ -203,15 +215,19 @@ def monte_carlo_figure(ds, var: str, confidence: float = 0.95) -> Figure:
             ax_v.fill_between(k, mean - half, mean + half, color=_color(0), alpha=0.25,
                               label=f"{confidence:.0%} interval of the mean")
         ax_v.plot(k, mean, color=_color(0), label="running mean")
-        p95 = [np.quantile(seq[:j], 0.95) for j in range(1, seq.size + 1)]
-        ax_v.plot(k, p95, color=_color(1), ls="--", label="running 95th percentile")
+        # a 95th percentile of fewer than 20 samples is their largest: drawn from 20 on
+        if seq.size >= P95_FROM:
+            p95 = [np.quantile(seq[:j], 0.95) for j in range(P95_FROM, seq.size + 1)]
+            ax_v.plot(k[P95_FROM - 1:], p95, color=_color(1), ls="--",
+                      label=f"running 95th percentile (from {P95_FROM} samples)")
         _stopping_band(ds, var, ax_v, scale)
     ax_h.set_xlabel(label, fontsize=8)
     ax_h.set_ylabel("cases")
+    ax_h.yaxis.set_major_locator(MaxNLocator(integer=True))  # counts: whole numbers
     ax_c.set_xlabel(label, fontsize=8)
-    ax_c.set_ylabel("cumulative probability [1]")
+    ax_c.set_ylabel("cumulative probability [-]")
     ax_v.set_xlabel("samples")
-    ax_v.set_ylabel(f"[{unit}]")
+    ax_v.set_ylabel(label, fontsize=8)
     for ax in (ax_h, ax_c, ax_v):
         ax.grid(True, alpha=0.3)
     ax_c.legend(fontsize=7, loc="lower right")
@@ -221,6 +237,10 @@ def monte_carlo_figure(ds, var: str, confidence: float = 0.95) -> Figure:
     what = f"statistics over {n} of {y.size} cases" if n < y.size else f"{n} samples"
     fig.suptitle(f"{ds.attrs['study_name']}: {what}{note}", fontsize=11)
     return fig
+
+
+#: the running 95th percentile of a Monte Carlo is drawn from this many samples on
+P95_FROM = 20
 
 
 def _confidence(ds) -> float:
@@ -274,7 +294,7 @@ def tornado_figure(ds, var: str) -> Figure:
     ax.set_yticks(pos, [factors[i] for i in order], fontsize=8)
     unit, _ = _out_unit(var)
     ax.set_xlabel("mu*: mean |output change| over each factor's range [" + unit + "]"
-                  if key == "mu_star" else "Sobol index [1]")
+                  if key == "mu_star" else "Sobol index [-]")
     ax.grid(True, axis="x", alpha=0.3)
     ax.legend(fontsize=8, loc="lower right")
     fig.suptitle(f"{ds.attrs['study_name']}: {ds[var].attrs.get('output', var)}", fontsize=11)
