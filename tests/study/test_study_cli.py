@@ -106,8 +106,14 @@ def test_parse_vary_refuses_a_step_for_the_count():
         parse_vary("meshes.a1.transmission_error.constant=0:40:2.5um")
     with pytest.raises(ValueError, match="number of points"):
         parse_vary("a.b=0:40:0um")
-    # a pattern is named by its last segment (sweep has no --name)
-    assert parse_vary("gears.*.errors.eccentricity=0:40:2um")["name"] == "eccentricity"
+    # a pattern is named by itself (sweep has no --name): its last segment alone lost
+    # which fields it sets; its folder writes '*' as 'all'
+    assert parse_vary("gears.*.errors.eccentricity=0:40:2um")["name"] == \
+        "gears.*.errors.eccentricity"
+    assert parse_vary("shafts.a.diameter,shafts.b.diameter=1:2:2mm")["name"] == "diameter"
+    from torquesplit.study.cli import _safe
+
+    assert _safe("sweep_meshes.*.damping_ratio") == "sweep_meshes.all.damping_ratio"
 
 
 def test_sweep_pattern_and_static_run_length_flags(tmp_path, split_file):

@@ -425,7 +425,8 @@ def _num(x):
 
 
 def _safe(name: str) -> str:
-    return re.sub(r"[^A-Za-z0-9_.-]+", "_", name).strip("_") or "study"
+    """A folder name for a study's name (a pattern's '*' as 'all')."""
+    return re.sub(r"[^A-Za-z0-9_.-]+", "_", name.replace("*", "all")).strip("_") or "study"
 
 
 # --------------------------------------------------------------------------- sweep
@@ -450,8 +451,10 @@ def parse_vary(text: str) -> dict:
         table["path"] = paths[0]
     else:
         table["paths"] = paths
-    if len(paths) > 1 or any(c in paths[0] for c in "*?["):  # several fields: named by
-        table["name"] = paths[0].split(".")[-1]                # the last segment
+    if any(c in paths[0] for c in "*?[") and len(paths) == 1:  # a pattern: named by it
+        table["name"] = paths[0]
+    elif len(paths) > 1:  # several fields: by their last segment
+        table["name"] = paths[0].split(".")[-1]
     num = m["num"]
     if not re.fullmatch(r"\d+", num) or int(num) < 1:
         raise ValueError(f"--vary {text!r}: the count {num!r} after the second ':' is the "

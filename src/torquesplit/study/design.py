@@ -89,6 +89,8 @@ class Parameter:
         what = "scales" if self.mode == "scale" else "sets"
         paths = self.paths
         shown = ", ".join(paths[:4]) + (f" and {len(paths) - 4} more" if len(paths) > 4 else "")
+        if self.mode != "scale" and list(paths) == [self.name]:
+            return self.name  # (not "x sets x")
         return f"{self.name} {what} {shown}"
 
 
