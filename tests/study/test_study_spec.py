@@ -21,7 +21,14 @@ def _bad_cases(model):
     negative["monte_carlo"]["samples"] = -3
     typo = grid_study(model, [K])
     typo["study"]["outputz"] = ["x"]
+    lone = grid_study(model, [K])
+    del lone["grid"]
+    lone["sensitivity"] = {"method": "sobol", "seed": 1, "parameters": [
+        {"path": "meshes.a1.stiffness", "low": "2e8 N/m", "high": "6e8 N/m"}]}
     return {
+        # (the count, not the raw table: "got [{'path': 'meshes...")
+        "one sensitivity factor": (lone, "sensitivity.parameters",
+                                   "has 1 item(s); give at least 2"),
         "unknown path": (grid_study(model, [dict(K, path="meshes.zz.stiffness")]),
                          "grid.parameters.0.path", "'meshes.zz' does not exist"),
         "unknown field": (grid_study(model, [dict(K, path="meshes.a1.stifness")]),

@@ -442,11 +442,13 @@ def _message(err: dict, parts: list[str]) -> str:
                f"correct the value"
     if kind == "literal_error":
         return f"must be {ctx.get('expected')}, got {got}; use one of these"
-    if kind == "too_short":
-        return f"is empty or too short (got {got}); give at least {ctx.get('min_length')} " \
-               f"item(s)"
-    if kind == "too_long":
-        return f"has too many items (got {got}); give at most {ctx.get('max_length')}"
+    if kind in ("too_short", "too_long"):  # (the count, not the items: tables read badly)
+        given = err.get("input")
+        n = len(given) if hasattr(given, "__len__") else got
+        least, most = ctx.get("min_length"), ctx.get("max_length")
+        if kind == "too_short":
+            return f"has {n} item(s); give at least {least}"
+        return f"has {n} items; give at most {most}"
     if kind.startswith(("model_type", "dict_type", "model_attributes_type")):
         return f"must be a table, got {got}; write it as a [section] or {{key = value}}"
     if kind.startswith("list_type"):
