@@ -92,6 +92,9 @@ def test_static_writes_matlab_and_spreadsheet_files(tmp_path):
     data = scipy.io.loadmat(tmp_path / "q.mat", simplify_cells=True)
     np.testing.assert_allclose(data["mesh_force"][:, 0], [float(row[1]) for row in rows],
                                rtol=1e-12)
+    # the model and the metrics at the top, where a run's .mat has them
+    assert json.loads(data["model_json"])["model"]["name"] == "ji_li_mill_drive"
+    assert json.loads(data["metrics_json"])["per_mesh"] == pytest.approx(share, rel=1e-12)
     # a companion that exists is refused before the sweep, not after it
     (tmp_path / "x_mesh.csv").write_text("")
     r = CliRunner().invoke(app, args + ["--out", str(tmp_path / "x.csv")])

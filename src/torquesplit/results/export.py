@@ -157,6 +157,14 @@ def _mat_data(ds, run_id: str) -> dict:
     data["attributes"] = {_mat_name(k, akeys): v if isinstance(v, str) else _json.dumps(
         v.tolist() if isinstance(v, np.ndarray) else v, default=str)
         for k, v in ds.attrs.items()}
+    # the model, metrics and warnings at the top, where a run's .mat has them (not only
+    # inside 'attributes')
+    for key in ("model_json", "metrics_json"):
+        if isinstance(ds.attrs.get(key), str) and key not in data:
+            data[key] = ds.attrs[key]
+    if isinstance(ds.attrs.get("warnings_json"), str) and "warnings" not in data:
+        data["warnings"] = np.asarray(json.loads(ds.attrs["warnings_json"]) or [""],
+                                      dtype=object)
     data["provenance"] = files.provenance(run_id, ds.attrs.get("model_json"))
     return data
 
