@@ -290,9 +290,9 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
             if not x.size:
                 t.add_row(v + _unit_suffix(ds[v]), *["-"] * 6, *count)
                 continue
-            t.add_row(v + _unit_suffix(ds[v]), *[f"{s:.6g}" for s in (x.mean(), x.std(ddof=1) if x.size > 1 else
-                                                0.0, x.min(), np.quantile(x, 0.05),
-                                                np.quantile(x, 0.95), x.max())], *count)
+            stats = (x.mean(), x.std(ddof=1) if x.size > 1 else 0.0, x.min(),
+                     np.quantile(x, 0.05), np.quantile(x, 0.95), x.max())
+            t.add_row(v + _unit_suffix(ds[v]), *[f"{s:.6g}" for s in stats], *count)
         ui.console.print(t)
         if fewer:
             ui.console.print(f"statistics over the cases with a finite value only: "
