@@ -159,7 +159,7 @@ def settle(cycle_max: np.ndarray, cycle_start: np.ndarray, names, window=20,
     after the last one whose mean or largest peak differs from the reference's by more
     than ``tolerance`` x the reference's largest peak (else the run is not settled, see
     below), and in any case from the window after the last one that lies outside the
-    range of the windows of the run's last half (three or more) by more than
+    range of the windows of the run's last half (two or more) by more than
     :data:`START_TOLERANCE` x that peak or, if more, half that range, in the leading run
     of such windows: a start-up peak within the tolerance (0.8 %
     above the steady ones on a single spur pair) is still transient and must not set the
@@ -199,8 +199,7 @@ def settle(cycle_max: np.ndarray, cycle_start: np.ndarray, names, window=20,
                     & (np.abs(blocks.max(axis=1) - ref_max) <= tolerance * scale))
             bad = np.flatnonzero(~good)
             b0 = int(bad[-1]) + 1 if bad.size else 0
-            ok = (n - (start + b0 * w)) >= n / 4
-            if n_win - n_win // 2 >= 3:  # (a range needs a few windows to mean anything)
+            if n_win - n_win // 2 >= 2:  # (a range needs two windows at least)
                 inside = np.ones(n_win, dtype=bool)
                 for stat in (blocks.mean(axis=1), blocks.max(axis=1)):
                     lo, hi = stat[n_win // 2:].min(), stat[n_win // 2:].max()
@@ -210,6 +209,7 @@ def settle(cycle_max: np.ndarray, cycle_start: np.ndarray, names, window=20,
                 # (a later one outside it is the response's own variation)
                 b0 = max(b0, int(np.argmax(inside)) if inside.any() else 0)
             k_set = start + b0 * w
+            ok = (n - k_set) >= n / 4
         if not ok:
             settled = False
             k_set = n // 2 if n else 0
