@@ -24,6 +24,7 @@ from rich.console import Console
 from torquesplit._table import Table
 
 from . import cli_support as ux
+from .model.checks import MODIFICATIONS_UNUSED
 from .cli_support import header as _h
 from .errors import (ModelError, ModelWarning, OptionError, OutputError, TorquesplitError,
                      clip_message)
@@ -269,12 +270,13 @@ def _resolve_model_path(model: str) -> Path:
 
 
 def _load(model: str, assignments: Optional[list[str]] = None, *, deep: bool = False,
-          warn: bool = True):
+          warn: bool = True, irrelevant: tuple[str, ...] = ()):
     """Read, validate and check a model; ``--set`` overrides are applied to the file's
     data first, and their errors are reported against the ``--set`` argument.
 
     The model's warnings are printed at once and kept for ``--json``
-    (:mod:`torquesplit.cli_support`)."""
+    (:mod:`torquesplit.cli_support`), but for those that contain a text of
+    ``irrelevant`` (advice that does not apply to the command)."""
     from .model.checks import check_model
     from .model.io import load_model, model_from_dict
 
@@ -298,7 +300,8 @@ def _load(model: str, assignments: Optional[list[str]] = None, *, deep: bool = F
     from .model.overrides import attribute_warning
 
     for w in caught:
-        if warn and issubclass(w.category, ModelWarning):
+        if (warn and issubclass(w.category, ModelWarning)
+                and not any(text in str(w.message) for text in irrelevant)):
             ux.warn(attribute_warning(str(w.message), where, str(path)))
     return m, path
 
@@ -908,7 +911,9 @@ def mesh(
         opts(_at_least, points, 16, "--points", "256")
         opts(_check_figure_file, plot, "--plot", force)
         opts.raise_any(model, assign)
-        m, _ = _load(model, assign)
+        # (the advice to use the modifications in a dynamic run through 'ltca' is not
+        # for the command that analyses them)
+        m, _ = _load(model, assign, irrelevant=(MODIFICATIONS_UNUSED,))
         if pair not in m.meshes:
             raise OptionError(f"--pair: no mesh named {pair!r}; use one of "
                               f"{', '.join(m.meshes)}")
@@ -1029,7 +1034,9 @@ def _contact(model, pair, load, on, plot, force, positions, slices, harris, assi
             opts(_at_most, value, most, option)  # as the model file's ltca fields
         opts(_at_least, harris, 0, "--harris", "10")
         opts.raise_any(model, assign)
-        m, _ = _load(model, assign)
+        # (the advice to use the modifications in a dynamic run through 'ltca' is not
+        # for the command that analyses them)
+        m, _ = _load(model, assign, irrelevant=(MODIFICATIONS_UNUSED,))
         if pair not in m.meshes:
             raise TorquesplitError(f"no mesh named {pair!r}; name one of {', '.join(m.meshes)}")
         from .gears.contact.coupling import contact_model_for_mesh, _options

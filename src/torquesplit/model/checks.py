@@ -444,6 +444,13 @@ def _teach(msg: str) -> str:
     return msg if ";" in msg else f"{msg}; correct the value"
 
 
+#: the start of the warning that a gear's modifications do not enter the dynamics
+MODIFICATIONS_UNUSED = ("a dynamic run uses tooth modifications only through the stiffness "
+                        "method 'ltca'")
+#: fewest slices across the face that resolve a lead modification (crowning, end relief)
+LEAD_SLICES = 5
+
+
 def support_issues(model: Model) -> list[tuple[str, str]]:
     """Translational DOFs need a support to the housing (bearing or shaft bending), or a
     spline that holds the body radially (Dong et al. 2021 floating pinion)."""
@@ -453,9 +460,16 @@ def support_issues(model: Model) -> list[tuple[str, str]]:
         for name, body in items.items():
             free = [d for d in body.dofs if d != "theta"]
             if free and body.support is None and name not in on_spline:
+                written = model.written_at(f"{kind}.{name}")
+                floating = (written.startswith("planetary.") and written.endswith(".sun"))
+                hint = ("; a floating sun, held by its planet meshes alone: a support of "
+                        "negligible stiffness, e.g. support = {stiffness = '1 N/m'} (a stiff "
+                        "one holds it: 1e8 N/m takes most of the equalising away)"
+                        if floating else "")
                 issues.append((f"{kind}.{name}.support", (
                     f"the translational DOFs {free} have no support; add one, e.g. "
-                    f"support = {{stiffness = '1e8 N/m'}}, or remove them from 'dofs'")))
+                    f"support = {{stiffness = '1e8 N/m'}}, or remove them from 'dofs'"
+                    f"{hint}")))
     return issues
 
 
@@ -494,12 +508,19 @@ def plausibility_warnings(model: Model, kin) -> list[tuple[str, str]]:
                 _, k, member = model.written_at(loc).split(".")[:3]
                 meshes = (f"planetary.{k}.{member}_mesh" if member != "planet" else
                           f"planetary.{k}.sun_mesh and/or planetary.{k}.ring_mesh")
-            out.append((loc, "a dynamic run uses tooth modifications only through the "
-                             "stiffness method 'ltca', and no mesh of this gear uses it "
+            out.append((loc, MODIFICATIONS_UNUSED + ", and no mesh of this gear uses it "
                              "('torquesplit contact' analyses them either way); set "
                              f"stiffness.method = 'ltca' on {meshes} or remove the "
                              f"modifications"))
     for name, m in model.meshes.items():
+        lead = [g for g in m.gears if model.gears[g].modifications is not None
+                and (model.gears[g].modifications.crowning > 0
+                     or model.gears[g].modifications.end_relief is not None)]
+        if m.stiffness.method == "ltca" and lead and m.stiffness.slices < LEAD_SLICES:
+            out.append((f"meshes.{name}.stiffness.slices", (
+                f"{m.stiffness.slices} slice(s) across the face cannot resolve the lead "
+                f"modification of {', '.join(lead)} (crowning, end relief): the LTCA "
+                f"sees an unmodified lead; give slices >= {LEAD_SLICES} (default 40)")))
         if m.stiffness.method != "ltca" and m.misalignment != type(m.misalignment)():
             out.append((f"meshes.{name}.misalignment",
                         "only the stiffness method 'ltca' uses the misalignment; set "

@@ -381,7 +381,9 @@ class Planetary(Strict):
                         f"counts with z_s + z_r divisible by {self.planets}, or give 'angles'"
                         if self.angles is None else
                         f"give angles that are multiples of 360 deg / (z_s + z_r) = "
-                        f"{math.degrees(period):.6g} deg from the first planet")
+                        f"{math.degrees(period):.6g} deg from the first planet; the "
+                        f"nearest for planet {i}: "
+                        f"{math.degrees(angles[0] + round(steps) * period):.10g} deg")
                 if self.angles is not None and max(abs(a) for a in angles) > 2 * math.pi:
                     # an angle beyond a turn is a number of degrees written bare
                     hint = (f"a bare number is read in radians: planet {i}'s angle "

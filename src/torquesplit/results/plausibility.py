@@ -79,6 +79,47 @@ def static_force(results, metrics) -> list[tuple[str, str]]:
     return out
 
 
+#: a mesh whose static force differs from its LTCA tables' load by more than this
+#: fraction is said (the tables are those of another load)
+LTCA_LOAD_MISMATCH = 0.1
+
+
+def ltca_load(results, metrics) -> list[tuple[str, str]]:
+    """Meshes with LTCA tables built at a load their static equilibrium does not carry:
+    a planetary stage's meshes share one table load, the nominal equal share, while a
+    pin error puts 45 % more on one planet (a reviewer's K_gamma 1.45, silently).  One
+    message per table field (a stage's sun or ring mesh: all its planets' meshes)."""
+    model, kin = results.model, results.kinematics
+    off: dict[str, list] = {}
+    for r in metrics.rows:
+        mesh = model.meshes.get(r.mesh)
+        if mesh is None or mesh.stiffness.method != "ltca":
+            continue
+        given = mesh.stiffness.ltca.load
+        load = float(given if given is not None else kin.meshes[r.mesh].force)
+        if load > 0 and abs(r.static_force / load - 1.0) > LTCA_LOAD_MISMATCH:
+            where = model.written_at(f"meshes.{r.mesh}.stiffness.ltca.load")
+            off.setdefault(where, []).append((r.mesh, r.static_force, load, given))
+    out = []
+    for where, rows in off.items():
+        load, given = rows[0][2], rows[0][3]
+        forces = [f for _, f, _, _ in rows]
+        carried = (_kn(forces[0]) if len(rows) == 1 else
+                   f"{_kn(min(forces))} to {_kn(max(forces))} "
+                   f"({', '.join(m for m, _, _, _ in rows)})")
+        fix = (f"give {where} = '{forces[0] / 1e3:.4g} kN'" if len(rows) == 1 else
+               f"one {where} serves every planet's mesh of the stage: give the load of "
+               f"the planet whose peak matters (the most loaded: "
+               f"'{max(forces) / 1e3:.4g} kN'); per-planet tables are not supported")
+        loc = f"meshes.{rows[0][0]}" if len(rows) == 1 else where.rsplit(".stiffness", 1)[0]
+        out.append((loc, (
+            f"LTCA stiffness and transmission error are tables at {_kn(load)} "
+            f"({'given' if given is not None else 'the nominal load'}), but the static "
+            f"equilibrium puts {carried} on the mesh: the tables are those of another "
+            f"load; {fix}")))
+    return out
+
+
 def static_deflection(results, metrics) -> list[tuple[str, str]]:
     """:func:`~torquesplit.model.checks.deflection_warnings` of a run's static
     equilibrium."""
@@ -317,7 +358,7 @@ def coarse_history(results, metrics) -> list[tuple[str, str]]:
 
 
 #: every check, in the order the messages are listed
-CHECKS = (static_force, static_deflection, contact_loss, back_flank, resonance, settling,
+CHECKS = (static_force, ltca_load, static_deflection, contact_loss, back_flank, resonance, settling,
           peak_drift, mean_drift, coarse_history)
 
 

@@ -1,0 +1,84 @@
+"""Messages a reviewer of the planetary and LTCA workflows found missing or misleading:
+a floating sun's recipe, the nearest angle that fits, a lead modification the slices
+cannot resolve, and the dynamic-run advice printed by the command that analyses
+modifications."""
+
+from __future__ import annotations
+
+import tomllib
+
+import pytest
+from typer.testing import CliRunner
+
+import torquesplit
+from model_texts import SPUR_PAIR, write_model
+from planetary_models import three_planet_toml
+from torquesplit.cli import app
+from torquesplit.errors import ModelError
+from torquesplit.model.checks import MODIFICATIONS_UNUSED, plausibility_warnings
+from torquesplit.model.kinematics import solve_kinematics
+
+
+def test_a_sun_without_support_is_told_how_to_float():
+    """The 'add a support, e.g. 1e8 N/m' hint held the sun: K_gamma 1.054 with a pin
+    error, where a floating sun equalises three planets.  A sun gets the recipe."""
+    text = three_planet_toml("float").replace(', support = {stiffness = "1e8 N/m"}', "")
+    with pytest.raises(ModelError, match=r"planetary\.0\.sun\.support: .*a floating sun, "
+                                         r"held by its planet meshes alone: .*'1 N/m'"):
+        torquesplit.load_model(tomllib.loads(text))
+
+
+def test_a_planet_angle_off_the_assembly_condition_is_given_the_nearest_that_fits():
+    text = three_planet_toml("angles", extra='angles = ["0 deg", "120 deg", "236.67 deg"]\n')
+    with pytest.raises(ModelError, match=r"71\.001 tooth periods.*the nearest for planet 3: "
+                                         r"236\.6666667 deg"):
+        torquesplit.load_model(tomllib.loads(text))
+
+
+def test_crowning_that_too_few_slices_cannot_see_is_said(tmp_path):
+    """slices = 1 or 2 with 10 um of crowning gave exactly the unmodified LTCA."""
+    data = tomllib.loads(SPUR_PAIR)
+    mesh = next(iter(data["meshes"]))
+    gear = data["meshes"][mesh]["gears"][0]
+    data["gears"][gear]["modifications"] = {"crowning": "10 um"}
+    for slices, said in ((2, True), (5, False)):
+        data["meshes"][mesh]["stiffness"] = {"method": "ltca", "slices": slices}
+        model = torquesplit.load_model(data, check=False)
+        found = dict(plausibility_warnings(model, solve_kinematics(model)))
+        key = f"meshes.{mesh}.stiffness.slices"
+        assert (key in found) == said, found
+        if said:
+            assert "cannot resolve the lead modification" in found[key]
+
+
+def test_contact_does_not_advise_using_modifications_in_a_dynamic_run(tmp_path):
+    data = tomllib.loads(SPUR_PAIR)
+    mesh = next(iter(data["meshes"]))
+    gear = data["meshes"][mesh]["gears"][0]
+    import tomli_w
+
+    data["gears"][gear]["modifications"] = {"crowning": "10 um"}
+    path = write_model(tmp_path, tomli_w.dumps(data))
+    res = CliRunner().invoke(app, ["contact", str(path), "--pair", mesh, "--json",
+                                   "--harris", "0"])
+    assert res.exit_code == 0, res.output
+    assert MODIFICATIONS_UNUSED not in res.output
+    res = CliRunner().invoke(app, ["check", str(path), "--json"])
+    assert MODIFICATIONS_UNUSED in res.output  # (said where it applies)
+
+
+def test_ltca_tables_at_a_load_the_mesh_does_not_carry_are_said():
+    """A pin error put 46 % more on one planet, whose LTCA tables stayed at the nominal
+    equal share, silently.  One message per stage mesh, with the planets' range; a
+    pair whose given table load is off says the load to give."""
+    from planetary_models import small_ltca_raw
+    from torquesplit.results.plausibility import ltca_load
+
+    data = small_ltca_raw()
+    data["planetary"][0]["pin_errors"] = [{"tangential": "-30 um"}, {}, {}]
+    res = torquesplit.simulate(torquesplit.load_model(data), cycles=20)
+    said = dict(ltca_load(res, res.metrics()))
+    assert set(said) == {"planetary.0.sun_mesh", "planetary.0.ring_mesh"}, said
+    assert "per-planet tables are not supported" in said["planetary.0.sun_mesh"]
+    even = torquesplit.simulate(torquesplit.load_model(small_ltca_raw()), cycles=20)
+    assert ltca_load(even, even.metrics()) == []
