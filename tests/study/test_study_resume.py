@@ -37,20 +37,27 @@ def _count(db_path) -> int:
         return 0
 
 
-def test_sigkill_then_resume_computes_each_case_once(tmp_path, split_file):
-    # 2000 cycles: about 0.1-0.3 s a case, so the kill lands in the middle of the study
-    data = grid_study(split_file, GRID, cycles=2000)
-    path = _write(tmp_path, data)
+def _study_process(tmp_path, split_file, *, workers: int, done: int):
+    """(study file, out folder, process) of a 10-case study run by the command line in a
+    process of its own, once ``done`` cases are committed (about 0.1-0.3 s a case)."""
+    path = _write(tmp_path, grid_study(split_file, GRID, cycles=2000))
     out = tmp_path / "out"
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
     proc = subprocess.Popen([sys.executable, "-m", "torquesplit.cli", "study", str(path),
-                             "--out", str(out), "--workers", "1", "--quiet", "--no-figures"],
+                             "--out", str(out), "--workers", str(workers), "--quiet",
+                             "--no-figures"],
                             env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     deadline = time.monotonic() + 120
-    while _count(out / "study.sqlite") < 3:
+    while _count(out / "study.sqlite") < done:
         assert proc.poll() is None, proc.stderr.read().decode()
         assert time.monotonic() < deadline, "the study did not start"
         time.sleep(0.05)
+    return path, out, proc
+
+
+def test_sigkill_then_resume_computes_each_case_once(tmp_path, split_file):
+    # the kill lands in the middle of the study
+    path, out, proc = _study_process(tmp_path, split_file, workers=1, done=3)
     proc.send_signal(signal.SIGKILL)
     proc.wait()
     first = _count(out / "study.sqlite")
@@ -357,18 +364,7 @@ def test_workers_exit_when_their_driver_is_killed(tmp_path, split_file):
                 out.append(int(stat.parent.name))
         return out
 
-    data = grid_study(split_file, GRID, cycles=2000)
-    path = _write(tmp_path, data)
-    out = tmp_path / "out"
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
-    proc = subprocess.Popen([sys.executable, "-m", "torquesplit.cli", "study", str(path),
-                             "--out", str(out), "--workers", "2", "--quiet", "--no-figures"],
-                            env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-    deadline = time.monotonic() + 120
-    while _count(out / "study.sqlite") < 1:
-        assert proc.poll() is None, proc.stderr.read().decode()
-        assert time.monotonic() < deadline, "the study did not start"
-        time.sleep(0.05)
+    _, _, proc = _study_process(tmp_path, split_file, workers=2, done=1)
     workers = children(proc.pid)
     assert workers, "a 2-worker study has worker processes"
     proc.send_signal(signal.SIGKILL)
