@@ -195,9 +195,17 @@ class FieldError(TorquesplitError, ValueError):
     to the section's location, so that the message names ``gears.g1.hand``, not
     ``gears.g1`` (a ValueError, as pydantic validators require)."""
 
-    def __init__(self, field: str, message: str):
+    def __init__(self, field: str, message: str, *, more: list[tuple[str, str]] = ()):
         super().__init__(message)
         self.field = field
+        self.more = list(more)
+        """Further problems of the same section, ``(field, message)``: a validator may
+        raise only one error, and every problem is said at once."""
+
+    @classmethod
+    def of(cls, problems: list[tuple[str, str]]) -> "FieldError":
+        """One error holding every problem of ``problems`` (the first as its own)."""
+        return cls(*problems[0], more=problems[1:])
 
 
 class KinematicsError(TorquesplitError, ValueError):

@@ -76,5 +76,7 @@ def test_planets_that_do_not_fit_are_one_line_errors(tmp_path):
     res = runner.invoke(app, ["check", str(path)])
     assert res.exit_code == 2
     lines = [ln for ln in res.output.splitlines() if ln.strip()]
-    assert len(lines) == 1 and lines[0].startswith("error:")
+    # one line per problem, all at once: the assembly condition, and the overlap
+    assert all(ln.startswith("error:") for ln in lines) and 1 <= len(lines) <= 2, lines
     assert "planetary.0.planets" in lines[0] and "assembly condition" in lines[0]
+    assert len(lines) == 1 or "planets overlap" in lines[1]

@@ -82,3 +82,21 @@ def test_ltca_tables_at_a_load_the_mesh_does_not_carry_are_said():
     assert "per-planet tables are not supported" in said["planetary.0.sun_mesh"]
     even = torquesplit.simulate(torquesplit.load_model(small_ltca_raw()), cycles=20)
     assert ltca_load(even, even.metrics()) == []
+
+
+def test_every_problem_of_a_planetary_stage_is_said_at_once():
+    """A stage with five planets that break the assembly condition and overlap, or with
+    two pin errors for three planets and a ring that cannot mesh, said one problem per
+    attempt."""
+    text = three_planet_toml("five").replace("planets = 3", "planets = 5")
+    with pytest.raises(ModelError) as info:
+        torquesplit.load_model(tomllib.loads(text))
+    said = [msg for _, msg in info.value.issues]
+    assert any("does not fit" in m for m in said) and any("planets overlap" in m
+                                                          for m in said), said
+    text = three_planet_toml("two", teeth=(24, 30, 85),
+                             extra='pin_errors = [{tangential = "5 um"}, {}]\n')
+    with pytest.raises(ModelError) as info:
+        torquesplit.load_model(tomllib.loads(text))
+    assert [loc for loc, _ in info.value.issues] == ["planetary.0.pin_errors",
+                                                     "planetary.0.ring.teeth"]

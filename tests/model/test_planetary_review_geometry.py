@@ -158,8 +158,13 @@ def test_bare_angles_in_degrees_get_the_unit_hint():
     loc, msg = _issue(_raw(angles=[0, 90, 180]))
     assert loc == "planetary.0.angles" and "read in radians" in msg, msg
     assert "write '90 deg'" in msg, msg
-    loc, msg = _issue(_raw(angles=[0, 2, 4]))  # radians within a turn: no hint
-    assert "radians" not in msg and "multiples of 360 deg" in msg, msg
+    # radians within a turn: no hint; every planet that does not fit is said at once
+    with pytest.raises(ModelError) as exc:
+        _load(_raw(angles=[0, 2, 4]))
+    said = [msg for _, msg in exc.value.issues]
+    assert [m.split(":")[0] for m in said] == ["planet 2 does not fit",
+                                               "planet 3 does not fit"], said
+    assert all("radians" not in m and "multiples of 360 deg" in m for m in said), said
 
 
 # ------------------------------------------------------------------ 5. --set of a table

@@ -101,14 +101,18 @@ def _format_errors(exc: pydantic.ValidationError) -> list[tuple[str, str]]:
     for err in exc.errors(include_url=False):
         parts = [str(p) for p in err["loc"] if not _is_internal_tag(p)]
         error = (err.get("ctx") or {}).get("error")
+        base = list(parts)
         if isinstance(error, FieldError):
             parts.append(error.field)
         loc = ".".join(parts)
         msg = _message(err, parts)
-        key = (loc, msg)
-        if key not in seen:
-            seen.add(key)
-            out.append(key)
+        found = [(loc, msg)]
+        if isinstance(error, FieldError):  # the section's other problems
+            found += [(".".join(base + [f]), m) for f, m in error.more]
+        for key in found:
+            if key not in seen:
+                seen.add(key)
+                out.append(key)
     return out
 
 

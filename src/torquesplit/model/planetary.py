@@ -212,48 +212,62 @@ class Planetary(Strict):
     def _consistent(self):
         _check_angle(self.pressure_angle, "pressure_angle", 45)
         _check_angle(self.helix_angle, "helix_angle", 60)
+        problems: list[tuple[str, str]] = []  # (every one is said at once)
         if self.helix_angle != 0 and self.hand is None:
-            raise FieldError("hand", "a helical stage needs the sun's hand; add "
-                             "hand = 'right' or hand = 'left'")
+            problems.append(("hand", "a helical stage needs the sun's hand; add "
+                             "hand = 'right' or hand = 'left'"))
         if not math.hypot(*self.axis) > 0:
-            raise FieldError("axis", "the zero vector has no direction; give e.g. [0, 0, 1]")
+            problems.append(("axis", "the zero vector has no direction; give e.g. [0, 0, 1]"))
         n = self.planets
         if self.angles is not None and len(self.angles) != n:
-            raise FieldError("angles", f"gives {len(self.angles)} angles for {n} planets; "
-                             f"give one angle per planet")
+            problems.append(("angles", f"gives {len(self.angles)} angles for {n} planets; "
+                             f"give one angle per planet"))
         if self.pin_errors is not None and len(self.pin_errors) != n:
-            raise FieldError("pin_errors", f"gives {len(self.pin_errors)} errors for {n} "
-                             f"planets; give one {{radial, tangential}} per planet")
+            problems.append(("pin_errors", f"gives {len(self.pin_errors)} errors for {n} "
+                             f"planets; give one {{radial, tangential}} per planet"))
         if self.planet.support is not None:
-            raise FieldError("planet.support", "the planets sit on 'planet_bearing'; "
-                             "remove planet.support (give its stiffness in planet_bearing)")
+            problems.append(("planet.support", "the planets sit on 'planet_bearing'; "
+                             "remove planet.support (give its stiffness in planet_bearing)"))
         if self.planet_bearing.on is not None:
-            raise FieldError("planet_bearing.on", "the planet bearings sit on the stage's "
-                             "carrier; remove 'on'")
+            problems.append(("planet_bearing.on", "the planet bearings sit on the stage's "
+                             "carrier; remove 'on'"))
         if self.ring.kind not in (None, "internal"):
-            raise FieldError("ring.kind", f"the ring of a planetary stage is an internal "
+            problems.append(("ring.kind", f"the ring of a planetary stage is an internal "
                              f"gear, not {self.ring.kind!r}; remove 'kind' or write "
-                             f"kind = 'internal'")
+                             f"kind = 'internal'"))
         for member in ("sun", "planet", "ring"):
             spec = getattr(self, member)
             try:
                 _check_rim(spec.outer_diameter, spec.rim_thickness, member == "ring",
                            "the ring", lambda: 2 * self._geometry(spec, True).root_radius)
             except FieldError as exc:
-                raise FieldError(f"{member}.{exc.field}", str(exc)) from None
+                problems.append((f"{member}.{exc.field}", str(exc)))
         for member in ("sun", "planet"):
             if getattr(self, member).kind == "internal":
-                raise FieldError(f"{member}.kind", f"the {member} meshes outside the planets"
-                                 f"' teeth and cannot be internal; remove 'kind'")
+                problems.append((f"{member}.kind", f"the {member} meshes outside the "
+                                 f"planets' teeth and cannot be internal; remove 'kind'"))
             if getattr(self, member).kind == "double_helical":
                 # the ring is an internal gear, and an internal gear has one helix here
-                raise FieldError(f"{member}.kind", (
+                problems.append((f"{member}.kind", (
                     "a [[planetary]] stage is spur or helical: its ring is an internal gear "
                     "with one helix, which cannot mesh with double-helical planets; use "
-                    "kind = 'helical' (with the stage's helix_angle) or remove 'kind'"))
-        self._check_modifications()
-        self._check_error_sizes()
-        self._check_fit()
+                    "kind = 'helical' (with the stage's helix_angle) or remove 'kind'")))
+        # (these read the counts and kinds checked above: each runs where those it
+        # reads are sound)
+        said = {field for field, _ in problems}
+        checks = [self._check_modifications]
+        if not said & {"angles", "pin_errors"}:
+            checks.append(self._check_error_sizes)
+        if not any(f == "angles" or f.endswith((".kind", "_diameter", "_thickness"))
+                   for f in said):
+            checks.append(self._check_fit)
+        for check in checks:
+            try:
+                check()
+            except FieldError as exc:
+                problems += [(exc.field, str(exc)), *exc.more]
+        if problems:
+            raise FieldError.of(problems)
         return self
 
     def _check_error_sizes(self) -> None:
@@ -370,6 +384,7 @@ class Planetary(Strict):
         angles = self.planet_angles()
         where = "angles" if self.angles is not None else "planets"
         period = 2 * math.pi / (zs + zr)
+        fit: list[tuple[str, str]] = []
         for i, psi in enumerate(angles[1:], start=2):
             # tooth-count assembly condition: a planet fits sun and ring at once only at
             # angles that are multiples of 360 deg / (z_s + z_r) from the first
@@ -385,13 +400,20 @@ class Planetary(Strict):
                         f"nearest for planet {i}: "
                         f"{math.degrees(angles[0] + round(steps) * period):.10g} deg")
                 if self.angles is not None and max(abs(a) for a in angles) > 2 * math.pi:
-                    # an angle beyond a turn is a number of degrees written bare
-                    hint = (f"a bare number is read in radians: planet {i}'s angle "
-                            f"{psi:g} is {math.degrees(psi):.6g} deg; write '{psi:g} deg'")
-                raise FieldError(where, (
+                    # an angle beyond a turn is a number of degrees written bare: that
+                    # one message (the other angles are misread the same way)
+                    raise FieldError(where, (
+                        f"planet {i} does not fit: at {math.degrees(psi - angles[0]):.6g} "
+                        f"deg from planet 1 it is {steps:.6g} tooth periods of sun and ring "
+                        f"away (the tooth-count assembly condition); a bare number is read "
+                        f"in radians: planet {i}'s angle {psi:g} is {math.degrees(psi):.6g} "
+                        f"deg; write '{psi:g} deg'"))
+                fit.append((where, (
                     f"planet {i} does not fit: at {math.degrees(psi - angles[0]):.6g} deg from "
                     f"planet 1 it is {steps:.6g} tooth periods of sun and ring away "
-                    f"(the tooth-count assembly condition); {hint}"))
+                    f"(the tooth-count assembly condition); {hint}")))
+                if self.angles is None:
+                    break  # (equal spacing: one message says it for every planet)
         order = sorted(a % (2 * math.pi) for a in angles)
         tip = planet.tip_radius
         for k in range(len(order)):
@@ -400,11 +422,14 @@ class Planetary(Strict):
                 break
             chord = 2 * a_sp * math.sin(min(gap, 2 * math.pi) / 2)
             if chord <= 2 * tip:
-                raise FieldError(where, (
+                fit.append((where, (
                     f"planets overlap: two planets {math.degrees(gap):.4g} deg apart are "
                     f"{chord * 1e3:.4f} mm apart, less than the planet tip diameter "
                     f"{2 * tip * 1e3:.4f} mm; use fewer planets, smaller planets or wider "
-                    f"angles"))
+                    f"angles")))
+                break  # (one overlap said)
+        if fit:
+            raise FieldError.of(fit)
 
     # ------------------------------------------------------------------ expansion
     def names(self) -> dict[str, object]:
