@@ -1033,6 +1033,8 @@ def _contact(model, pair, load, on, plot, force, positions, slices, harris, assi
         for value, option, most in ((positions, "--positions", 4096), (slices, "--slices", 400)):
             opts(_at_most, value, most, option)  # as the model file's ltca fields
         opts(_at_least, harris, 0, "--harris", "10")
+        for text in load or []:  # (each with the other options and the model's problems)
+            opts(_check_load_text, text)
         opts.raise_any(model, assign)
         # (the advice to use the modifications in a dynamic run through 'ltca' is not
         # for the command that analyses them)
@@ -1177,26 +1179,35 @@ _INTERNAL_IMPACT = ("meshing-in impact: not computed for internal gears (the cor
                     "model of Liu et al. 2021 eqs. 6-10 is that of an external pair)")
 
 
-def _contact_load(text, model, kin, pair, names, on, cm, parse_quantity) -> float:
-    """A --load value as a normal force [N]: a force as given, a torque on a gear divided
-    by its base radius times cos(beta_b)."""
+def _check_load_text(text: str) -> None:
+    """A --load value is a positive force or torque (checked before the model is read)."""
+    from .model.units import parse_quantity
+
     for kind in ("force", "torque"):
         try:
             value = parse_quantity(text, kind)
         except ValueError:
             continue
         if not (value > 0):
-            raise TorquesplitError(f"--load {text!r} must be positive; give e.g. '40 kN'")
-        if kind == "force":
-            return value
-        gear = on or kin.meshes[pair].driven
-        if gear not in names:
-            raise TorquesplitError(f"--on {gear!r} is not a gear of mesh {pair!r}; name one of "
-                                   f"{', '.join(names)}")
-        g = cm.pair.gear1 if gear == names[0] else cm.pair.gear2
-        return value / (g.base_radius * cm.normal_factor)
-    raise TorquesplitError(f"--load {text!r} is neither a force nor a torque; write e.g. '40 kN' "
-                           f"or '17500 N m'")
+            raise OptionError(f"--load {text!r} must be positive; give e.g. '40 kN'")
+        return
+    raise OptionError(f"--load {text!r} is neither a force nor a torque; write e.g. '40 kN' "
+                      f"or '17500 N m'")
+
+
+def _contact_load(text, model, kin, pair, names, on, cm, parse_quantity) -> float:
+    """A --load value (checked by :func:`_check_load_text`) as a normal force [N]: a force
+    as given, a torque on a gear divided by its base radius times cos(beta_b)."""
+    try:
+        return parse_quantity(text, "force")
+    except ValueError:
+        value = parse_quantity(text, "torque")
+    gear = on or kin.meshes[pair].driven
+    if gear not in names:
+        raise TorquesplitError(f"--on {gear!r} is not a gear of mesh {pair!r}; name one of "
+                               f"{', '.join(names)}")
+    g = cm.pair.gear1 if gear == names[0] else cm.pair.gear2
+    return value / (g.base_radius * cm.normal_factor)
 
 
 # --------------------------------------------------------------------------- optimize

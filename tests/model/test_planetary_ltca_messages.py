@@ -100,3 +100,25 @@ def test_every_problem_of_a_planetary_stage_is_said_at_once():
         torquesplit.load_model(tomllib.loads(text))
     assert [loc for loc, _ in info.value.issues] == ["planetary.0.pin_errors",
                                                      "planetary.0.ring.teeth"]
+
+
+def test_contact_says_every_bad_load_with_the_models_problems(tmp_path, monkeypatch):
+    """'--load "40 kg" --load "-5 kN" --set <negative crowning>' said the crowning only."""
+    import torquesplit.gears.contact.coupling as coupling
+
+    def computed(*args, **kwargs):
+        raise AssertionError("the command computed before refusing")
+
+    monkeypatch.setattr(coupling, "contact_model_for_mesh", computed)
+    data = tomllib.loads(SPUR_PAIR)
+    mesh = next(iter(data["meshes"]))
+    gear = data["meshes"][mesh]["gears"][0]
+    path = write_model(tmp_path, SPUR_PAIR)
+    res = CliRunner().invoke(app, ["contact", str(path), "--pair", mesh, "--load", "40 kg",
+                                   "--load", "-5 kN", "--set",
+                                   f'gears.{gear}.modifications.crowning="-5 um"'])
+    assert res.exit_code == 2
+    lines = [ln for ln in res.output.splitlines() if ln.strip()]
+    assert len(lines) == 3 and all(ln.startswith("error: ") for ln in lines), res.output
+    assert "'40 kg' is neither a force nor a torque" in lines[0]
+    assert "'-5 kN' must be positive" in lines[1] and "crowning" in lines[2]
