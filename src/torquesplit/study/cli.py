@@ -172,8 +172,10 @@ def _sweep_option(field: str, flag: str) -> str:
 
 
 def _sweep_note(note: str, flag: str) -> str:
-    """A plan's note in the sweep's words (its grid parameter is ``flag``'s)."""
-    return note.replace("grid.parameters: ", f"{flag}: ", 1)
+    """A plan's note ("field: message") in the sweep's words, as its errors
+    (:func:`_sweep_option`)."""
+    field, sep, message = note.partition(": ")
+    return f"{_sweep_option(field, flag)}{sep}{message}" if sep else note
 
 
 def _with_bar(job, total: int, quiet: bool):
