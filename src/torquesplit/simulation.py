@@ -365,6 +365,10 @@ def prepare_run(
     if n_records > MAX_HISTORY_RECORDS:
         asked = 1.0 / (sample_interval * f_max)
         sample_interval = duration / MAX_HISTORY_RECORDS
+    # only a sampling the user asked for is worth a warning: the default one is a choice
+    # of the library, and what it kept is in the bearing table's title and the files'
+    # history_samples_per_period (a default run of Liu et al. 2021 warned)
+    if n_records > MAX_HISTORY_RECORDS and samples_per_period is not None:
         warnings.warn(
             f"analysis: the history holds at most {MAX_HISTORY_RECORDS:,} samples, so this "
             f"run keeps {1.0 / (sample_interval * f_max):.3g} per shortest mesh period "

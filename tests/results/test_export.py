@@ -189,7 +189,8 @@ def test_spreadsheet_and_matlab_details(tmp_path):
 def test_cycle_starts_end_with_the_run_and_a_capped_history_is_said():
     """A slower mesh's cycle rows past its last cycle had start times far beyond the run
     (124 s in a 12.6 s run); a history cut to 200,000 samples (4 per period for 50 asked)
-    was said only in the bearing table's title."""
+    was said only in the bearing table's title.  Said where the user asked for the rate;
+    the default rate is the library's choice and stays in the title and the files."""
     import warnings
 
     import torquesplit
@@ -206,10 +207,16 @@ def test_cycle_starts_end_with_the_run_and_a_capped_history_is_said():
         simulation.MAX_HISTORY_RECORDS = 1000
         with warnings.catch_warnings():
             warnings.simplefilter("always")  # (an ignored warning is not kept either)
-            res = torquesplit.simulate(torquesplit.example_path(EXAMPLE), cycles=200)
+            res = torquesplit.simulate(torquesplit.example_path(EXAMPLE), cycles=200,
+                                       samples_per_period=20)
+            default = torquesplit.simulate(torquesplit.example_path(EXAMPLE), cycles=200)
     finally:
         simulation.MAX_HISTORY_RECORDS = cap
     assert any("the history holds at most 1,000 samples" in w for w in res.run_warnings)
+    assert res.history_samples_per_period() < 20
+    # the library's own sampling is cut to the cap silently (its rate is in the results)
+    assert not any("the history holds" in w for w in default.run_warnings)
+    assert default.solution.history_t.size <= 1001
 
 
 def test_a_replaced_csv_set_leaves_no_stale_companion_and_files_carry_their_model(tmp_path):
