@@ -201,8 +201,24 @@ def test_negative_amount_is_refused_without_float_noise(tmp_path, path):
     model.write_text(SPUR)
     res = runner.invoke(app, ["check", str(model), "--set", f"{path}=-5 um"])
     assert res.exit_code == 2, res.output
-    assert f"{path}: must not be negative, got -5e-06;" in res.stderr, res.stderr
+    # the value as written: the SI number of a quantity was foreign to the user
+    assert f"{path}: must not be negative, got '-5 um';" in res.stderr, res.stderr
     assert "4.99999" not in res.stderr
+
+
+def test_a_value_out_of_range_is_quoted_as_written_and_in_si_beside_a_nonzero_bound(
+        tmp_path):
+    model = tmp_path / "spur.toml"
+    model.write_text(SPUR)
+    res = runner.invoke(app, ["check", str(model), "--set", "gears.pinion.face_width=-5 mm"])
+    assert res.exit_code == 2, res.output
+    assert "gears.pinion.face_width: must be greater than 0.0, got '-5 mm';" in res.stderr
+    bare = runner.invoke(app, ["check", str(model), "--set", "gears.pinion.face_width=-0.005"])
+    assert "face_width: must be greater than 0.0, got -0.005;" in bare.stderr, bare.stderr
+    from torquesplit.model.io import _message
+
+    err = {"type": "greater_than_equal", "ctx": {"ge": 0.002}, "input": 0.001}
+    assert "got '1 mm' (= 0.001 in SI units)" in _message(err, ["x"], "1 mm")
 
 
 def test_library_checks_of_modifications_format_values_readably():

@@ -88,14 +88,16 @@ def model_from_dict(data: dict[str, Any], source: str | None = None) -> Model:
             warnings.simplefilter("error", pydantic.warnings.PydanticDeprecationWarning)
             model = Model.model_validate(data)
     except pydantic.ValidationError as exc:
-        raise ModelError(_format_errors(exc), source) from None
+        raise ModelError(_format_errors(exc, data), source) from None
     import copy
 
     model._source = copy.deepcopy(data)  # (with_changes applies changes to it)
     return model
 
 
-def _format_errors(exc: pydantic.ValidationError) -> list[tuple[str, str]]:
+def _format_errors(exc: pydantic.ValidationError, data=None) -> list[tuple[str, str]]:
+    """(field, message) of every problem; ``data``: the dict that was validated, whose
+    values the messages quote as written (a quantity is validated in SI)."""
     out = []
     seen = set()
     for err in exc.errors(include_url=False):
@@ -105,7 +107,7 @@ def _format_errors(exc: pydantic.ValidationError) -> list[tuple[str, str]]:
         if isinstance(error, FieldError):
             parts.append(error.field)
         loc = ".".join(parts)
-        msg = _message(err, parts)
+        msg = _message(err, parts, _written(data, parts))
         found = [(loc, msg)]
         if isinstance(error, FieldError):  # the section's other problems
             found += [(".".join(base + [f]), m) for f, m in error.more]
@@ -143,12 +145,31 @@ _TYPE_MESSAGES = {
 }
 
 
-def _message(err: dict, parts: list[str]) -> str:
+def _written(data, parts: list[str]):
+    """The value at ``parts`` in the file's dict as the user wrote it; a one-value
+    shorthand of a table (``backlash = "-10 um"`` for ``backlash.nominal``) is that
+    value; None where there is none."""
+    node = data
+    for part in parts:
+        if isinstance(node, dict) and part in node:
+            node = node[part]
+        elif isinstance(node, list) and part.isdigit() and int(part) < len(node):
+            node = node[int(part)]
+        else:
+            return node if isinstance(node, str) and node is not data else None
+    return node
+
+
+def _message(err: dict, parts: list[str], written=None) -> str:
     kind = err["type"]
     ctx = err.get("ctx") or {}
     value = err.get("input")
     # a converted quantity carries float noise ("-5 um" is -4.9999999999999996e-06 m)
     got = f"{value:.6g}" if isinstance(value, float) else _short(value)
+    if isinstance(value, float) and isinstance(written, str):
+        # a bound other than zero is in SI units, as the converted value
+        zero = ctx.get("gt", ctx.get("ge", ctx.get("lt", ctx.get("le")))) == 0
+        got = _short(written) if zero else f"{_short(written)} (= {got} in SI units)"
     if kind == "extra_forbidden":
         name, section = (parts[-1], parts[:-1]) if parts else ("", [])
         guess = difflib.get_close_matches(name, _fields_at(section), n=1, cutoff=0.6)
