@@ -390,9 +390,11 @@ def run(
     definition: Optional[str] = typer.Option(None, "--definition", help=_definition_help(),
                                              metavar="NAME"),
     out: Optional[Path] = typer.Option(
-        None, "--out", help="Write results: .nc (NetCDF), .mat (MATLAB) or .csv (four "
-        "spreadsheet files: NAME.csv a row per mesh, NAME_groups.csv a row per load-sharing "
-        "group and the system, NAME_history.csv, NAME_cycles.csv).", metavar="FILE"),
+        None, "--out", help="Write results: .nc or .h5 (NetCDF-4), .mat (MATLAB) or .csv "
+        "(spreadsheet files: NAME.csv a row per mesh, NAME_groups.csv a row per "
+        "load-sharing group and the system, NAME_bearings.csv, NAME_history.csv, "
+        "NAME_cycles.csv, and NAME_about.json: model, warnings, metrics, provenance).",
+        metavar="FILE"),
     force: bool = _flag("--force", "Replace existing results files and figures."),
     plots: Optional[Path] = typer.Option(None, "--plots", help="Write report figures (PNG, "
                                          "SVG) into this folder.", metavar="DIR"),

@@ -94,6 +94,7 @@ def test_two_runs_identical_and_netcdf_round_trip(split, tmp_path):
 
 def test_mat_and_csv_exports(split, tmp_path):
     import csv
+    import json
 
     from scipy.io import loadmat
 
@@ -119,11 +120,21 @@ def test_mat_and_csv_exports(split, tmp_path):
     assert [r["mesh"] for r in rows] == res.mesh_names and len(rows) == n
     assert float(rows[0]["peak_force_N"]) == pytest.approx(met.rows[0].peak_force)
     # the groups' and the system's rows, as the run's tables print them
-    key = f"load_sharing_{met.definition}"
+    # the same columns whatever the definition, which a column names
+    assert rows[0]["load_sharing_definition"] == met.definition
+    assert float(rows[0]["load_sharing"]) == pytest.approx(met.rows[0].load_sharing)
     with open(tmp_path / "run_groups.csv", newline="") as fh:
-        groups = {r["group"]: float(r[key]) for r in csv.DictReader(fh)}
+        group_rows = list(csv.DictReader(fh))
+    groups = {r["group"]: float(r["load_sharing"]) for r in group_rows}
+    assert {r["load_sharing_definition"] for r in group_rows} == {met.definition}
     assert groups.pop("(system)") == pytest.approx(met.load_sharing.system)
     assert groups == pytest.approx(met.load_sharing.per_group)
+    # what the tables cannot hold
+    about = json.loads((tmp_path / "run_about.json").read_text())
+    assert about["model"] == json.loads(res.model_json())
+    assert about["warnings"] == res.warnings()
+    assert about["metrics"]["definition"] == met.definition
+    assert about["provenance"]["model_sha256"] and about["provenance"]["run_id"]
     with open(tmp_path / "run_cycles.csv", newline="") as fh:
         cycles = list(csv.DictReader(fh))
     assert cycles[1]["cycle"] == "1"  # a whole number, not 1.0
@@ -205,6 +216,17 @@ def test_bearing_forces_of_the_settled_part(tmp_path):
     for r in rows:
         for d, v in zip(r["directions"], r["mean"]):
             assert comp.sel(bearing=r["body"], bearing_direction=d).item() == v
+    # and in the spreadsheet set (it had no bearing table)
+    import csv
+
+    res.to_csv(tmp_path / "r.csv")
+    with open(tmp_path / "r_bearings.csv", newline="") as fh:
+        table = {r["body"]: r for r in csv.DictReader(fh)}
+    assert list(table) == [r["body"] for r in rows]
+    for r in rows:
+        assert float(table[r["body"]]["peak_force_magnitude_N"]) == r["peak_magnitude"]
+        for d, v in zip(r["directions"], r["mean"]):
+            assert float(table[r["body"]][f"mean_force_{d}_N"]) == v
     met = res.metrics()
     for g, members in met.load_sharing.groups.items():
         assert [str(m) for m in ds["mesh"].values[ds["mesh_group"].values == g]] == members

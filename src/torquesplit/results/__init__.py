@@ -569,11 +569,15 @@ class Results:
         """Save spreadsheet tables: ``NAME.csv`` (a row per mesh) and beside it
         ``NAME_groups.csv`` (a row per load-sharing group, then one for the system: what
         the run's group table and system line print), ``NAME_history.csv`` (the history's
-        forces and torques, each column's unit in its name: ``m1_N``, ``shaft_Nm``) and
+        forces and torques, each column's unit in its name: ``m1_N``, ``shaft_Nm``),
         ``NAME_cycles.csv`` (start, peak, smallest and mean force of every mesh cycle;
-        empty for a cycle the start or the end of the run cuts, :attr:`complete_cycles`).
+        empty for a cycle the start or the end of the run cuts, :attr:`complete_cycles`),
+        ``NAME_bearings.csv`` (the bearing table: :meth:`bearing_forces`) and
+        ``NAME_about.json`` (the run's provenance, model, warnings and metrics:
+        :func:`files.about_bytes`).  The column names do not depend on the load-sharing
+        definition: a column ``load_sharing_definition`` names it.
 
-        All four are written atomically, and none replaces an existing file unless
+        All six are written atomically, and none replaces an existing file unless
         ``overwrite``.  A run that did not finish has no metrics: its summary lists the
         meshes with empty metric columns and its status, its groups file the groups.
         """
@@ -586,19 +590,21 @@ class Results:
         header = ["mesh", "group", "nominal_force_N", "static_force_N", "mean_force_N",
                   "peak_force_N", "min_force_N", "dynamic_factor",
                   "dynamic_factor_engineering", "peak_to_nominal", "load_sharing",
-                  "contact_loss_fraction", "back_contact_fraction", "back_flank_force_N"]
-        group_header = ["group", "meshes", "load_sharing", "dynamic_factor",
-                        "peak_to_nominal",
+                  "load_sharing_definition", "contact_loss_fraction", "back_contact_fraction",
+                  "back_flank_force_N"]
+        group_header = ["group", "meshes", "load_sharing", "load_sharing_definition",
+                        "dynamic_factor", "peak_to_nominal",
                         "peak_to_nominal_engineering"]  # G_it (Ji & Li eq. 19)
         try:
             met = self.metrics(definition) if self.success else None
         except (ValueError, ArithmeticError):
             met = None
+        bearings: list[dict] = []
         if met is not None:
-            header[10] = group_header[2] = f"load_sharing_{met.definition}"
+            name = met.definition
             rows = [[r.mesh, r.group, r.nominal_force, r.static_force, r.mean_force,
                      r.peak_force, r.min_force, r.dynamic_factor,
-                     r.dynamic_factor_engineering, r.peak_to_nominal, r.load_sharing,
+                     r.dynamic_factor_engineering, r.peak_to_nominal, r.load_sharing, name,
                      r.contact_loss, r.back_contact, r.back_flank_force]
                     for r in met.rows]
             rows = self._planet_columns(header, rows, met)
@@ -610,26 +616,37 @@ class Results:
             # each group's and the system's coefficients and factors: what the run's
             # group table and system line print
             d, ls_ = met.dynamic_factors, met.load_sharing
-            group_rows = [[g, " ".join(members), ls_.per_group[g],
+            group_rows = [[g, " ".join(members), ls_.per_group[g], name,
                            d.per_group_dynamic_factor[g], d.per_group_peak_to_nominal[g],
                            d.per_group_peak_to_nominal_engineering.get(g, "")]
                           for g, members in ls_.groups.items()]
-            group_rows.append(["(system)", " ".join(self.mesh_names), ls_.system, "", "", ""])
+            group_rows.append(["(system)", " ".join(self.mesh_names), ls_.system, name, "",
+                               "", ""])
+            bearings = self.bearing_forces(met.settling.start_time)
         else:
             header.append("status")
             group_of = {m: g for g, ms in self.groups.items() for m in ms}
             nominal, static = self.nominal_forces(), self.static_forces()
-            rows = [[m, group_of.get(m, ""), nominal[m], static[m]] + [""] * 10
+            rows = [[m, group_of.get(m, ""), nominal[m], static[m]] + [""] * 11
                     + [self.message] for m in self.mesh_names]
-            group_rows = [[g, " ".join(ms)] + [""] * 4 for g, ms in self.groups.items()]
+            group_rows = [[g, " ".join(ms)] + [""] * 5 for g, ms in self.groups.items()]
+        # the bearing table, one column per direction of any support's frame
+        directions = sorted({d for b in bearings for d in b["directions"]})
+        bearing_header = (["body", "via"] + [f"mean_force_{d}_N" for d in directions]
+                          + ["mean_force_magnitude_N", "peak_force_magnitude_N", "samples"])
+        bearing_rows = [[b["body"], b["via"] or ""]
+                        + [dict(zip(b["directions"], b["mean"])).get(d, "") for d in directions]
+                        + [b["mean_magnitude"], b["peak_magnitude"], b["samples"]]
+                        for b in bearings]
         s = self.solution
         el = self.structure.element_names
         names = [el[i] for i in s.history_elements]
         units = element_units(self.structure)
         cols = [list(s.tracked_elements).index(el.index(m)) for m in self.mesh_names]
-        summary, history, cycles, groups = plan.files
+        summary, history, cycles, groups, bearing_file, about = plan.files
         contents = {
             groups: files.csv_bytes(group_header, group_rows),
+            bearing_file: files.csv_bytes(bearing_header, bearing_rows),
             history: files.csv_bytes(["time_s"] + [f"{n}_{units[i].replace(' ', '')}"
                                                    for n, i in zip(names, s.history_elements)],
                                      np.column_stack([s.history_t, s.history_forces]).tolist()),
@@ -639,9 +656,15 @@ class Results:
                 [[k] + row for k, row in enumerate(np.column_stack(
                     [s.cycle_start[:, cols], *self.complete_cycle_statistics()[:3]]
                 ).tolist())]),
-            summary: files.csv_bytes(header, rows),  # last: its presence marks the set
         }
         with files.claim_output(plan) as claim:
+            contents[about] = files.about_bytes(
+                claim.run_id, self.model_json(), self.warnings(definition),
+                load_sharing_definition=met.definition if met is not None else None,
+                metrics=met.to_dict() if met is not None else None,
+                history_samples_per_period=self.history_samples_per_period(),
+                status=self.message)
+            contents[summary] = files.csv_bytes(header, rows)  # last: marks the set
             claim.write(contents)
         return path
 
@@ -653,7 +676,7 @@ class Results:
         k = planet_sharing(met.load_sharing, self.kinematics)
         if k is None:
             return rows
-        header += [f"K_gamma_{k.definition}", f"planet_factor_{k.definition}"]
+        header += ["K_gamma", "planet_factor"]  # (of load_sharing_definition)
         kin = self.kinematics
         out = []
         for row in rows:

@@ -99,12 +99,33 @@ class OutputPlan:
 
 def companion_files(path: Path, fmt: str) -> tuple[Path, ...]:
     """The files a save of ``fmt`` to ``path`` writes: CSV writes ``NAME_groups.csv``,
-    ``NAME_history.csv`` and ``NAME_cycles.csv`` beside ``NAME.csv``."""
+    ``NAME_history.csv``, ``NAME_cycles.csv``, ``NAME_bearings.csv`` and
+    ``NAME_about.json`` (:func:`about_bytes`) beside ``NAME.csv``."""
     if fmt == "csv":
         return (path, path.with_name(path.stem + "_history.csv"),
                 path.with_name(path.stem + "_cycles.csv"),
-                path.with_name(path.stem + "_groups.csv"))
+                path.with_name(path.stem + "_groups.csv"),
+                path.with_name(path.stem + "_bearings.csv"), about_path(path))
     return (path,)
+
+
+def about_path(path: Path) -> Path:
+    """``NAME_about.json`` beside the CSV table ``NAME.csv``."""
+    return path.with_name(path.stem + "_about.json")
+
+
+def about_bytes(run_id: str, model_json: str | None, warnings=(), **more) -> bytes:
+    """What a CSV set cannot hold in its tables, as JSON (NaN as null, :mod:`torquesplit.
+    _json`): the :func:`provenance` of the run, the model, the warnings the command
+    printed, and ``more`` (the metrics, the load-sharing definition...).  The ``model``
+    entry is a model file in JSON (SI numbers): saved alone, it runs again."""
+    from .. import _json
+
+    about = {"provenance": provenance(run_id, model_json),
+             "model": json.loads(model_json) if model_json else None,
+             "warnings": list(warnings)}
+    about.update(more)
+    return (_json.dumps(about, indent=1, default=str) + "\n").encode("utf-8")
 
 
 def check_output(path, *, formats: dict[str, str] | None = None, overwrite: bool = False,
