@@ -209,3 +209,41 @@ def write_model(tmp_path, text: str, name: str = "model.toml"):
     path = tmp_path / name
     path.write_text(text, encoding="utf-8")
     return path
+
+
+#: a spur pair with tip relief and crowning whose mesh stiffness and transmission error
+#: come from the LTCA
+RELIEVED_SPUR_LTCA = """\
+[model]
+name = "relieved spur pair"
+
+[gears.pinion]
+teeth = 25
+module = "3 mm"
+face_width = "30 mm"
+position = ["0 mm", "0 mm", "0 mm"]
+[gears.pinion.modifications]
+tip_relief = {amount = "15 um", length = "5 mm"}
+crowning = "5 um"
+
+[gears.wheel]
+teeth = 50
+module = "3 mm"
+face_width = "30 mm"
+place = {from_gear = "pinion", angle = "0 deg"}
+[gears.wheel.modifications]
+tip_relief = {amount = "15 um", length = "5 mm", shape = "parabolic"}
+
+[meshes.m]
+gears = ["pinion", "wheel"]
+stiffness = {method = "ltca", slices = 6, ltca = {positions = 32}}
+damping_ratio = 0.05
+
+[drives.motor]
+body = "pinion"
+speed = "3000 rpm"
+torque = "150 N m"
+
+[loads.out]
+body = "wheel"
+"""

@@ -374,8 +374,9 @@ def run(
     method: Optional[str] = typer.Option(None, "--method", help="rk4 (fixed step) or dopri.",
                                          metavar="rk4|dopri"),
     steps_per_period: Optional[int] = typer.Option(
-        None, "--steps-per-period", help="RK4 steps per shortest mesh period (default: the model's "
-        "[analysis] steps_per_period, else 100).",
+        None, "--steps-per-period", help="RK4 steps per shortest mesh period, or per "
+        "period of a faster error sinusoid (an LTCA transmission-error harmonic; the run "
+        "says so) (default: the model's [analysis] steps_per_period, else 100).",
         metavar="N"),
     max_steps: Optional[int] = typer.Option(
         None, "--max-steps", help="Refuse an RK4 run needing more steps (default 2e8).",

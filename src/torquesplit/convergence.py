@@ -157,11 +157,18 @@ class StepCheck:
 
 
 def halved_steps_per_period(results) -> int:
-    """RK4 steps per shortest mesh period that take at most half the step ``results``
-    took (its step may be finer than its ``steps_per_period`` asked, e.g. set by the RK4
-    stability of a stiff damping: then doubling the steps asked would not halve it)."""
-    f_max = max(results.kinematics.meshes[m].frequency for m in results.mesh_names)
-    taken = 1.0 / (f_max * results.solution.step)  # steps per period the run took
+    """RK4 steps per period (as ``steps_per_period`` counts them: of the shortest
+    excitation, :func:`~torquesplit.solve.integrate.shortest_excitation_period`) that
+    take at most half the step ``results`` took (its step may be finer than its
+    ``steps_per_period`` asked, e.g. set by the RK4 stability of a stiff damping: then
+    doubling the steps asked would not halve it)."""
+    from .solve.integrate import shortest_excitation_period
+
+    period = shortest_excitation_period(results.structure)
+    if not math.isfinite(period):
+        f_max = max(results.kinematics.meshes[m].frequency for m in results.mesh_names)
+        period = 1.0 / f_max
+    taken = period / results.solution.step  # steps per period the run took
     return math.ceil(2.0 * taken * (1.0 - 1e-12))
 
 

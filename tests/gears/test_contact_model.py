@@ -19,40 +19,8 @@ from torquesplit.gears.contact import coupling
 from torquesplit.model.kinematics import solve_kinematics
 from torquesplit.solve.static import quasi_static
 
-SPUR = """\
-[model]
-name = "relieved spur pair"
+from model_texts import RELIEVED_SPUR_LTCA as SPUR
 
-[gears.pinion]
-teeth = 25
-module = "3 mm"
-face_width = "30 mm"
-position = ["0 mm", "0 mm", "0 mm"]
-[gears.pinion.modifications]
-tip_relief = {amount = "15 um", length = "5 mm"}
-crowning = "5 um"
-
-[gears.wheel]
-teeth = 50
-module = "3 mm"
-face_width = "30 mm"
-place = {from_gear = "pinion", angle = "0 deg"}
-[gears.wheel.modifications]
-tip_relief = {amount = "15 um", length = "5 mm", shape = "parabolic"}
-
-[meshes.m]
-gears = ["pinion", "wheel"]
-stiffness = {method = "ltca", slices = 6, ltca = {positions = 32}}
-damping_ratio = 0.05
-
-[drives.motor]
-body = "pinion"
-speed = "3000 rpm"
-torque = "150 N m"
-
-[loads.out]
-body = "wheel"
-"""
 
 _FIX_VERBS = re.compile(r"\b(add|give|write|remove|correct|check|make|use|set|reduce|shorten|"
                         r"increase|change)\b")

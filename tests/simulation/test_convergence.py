@@ -216,3 +216,24 @@ def test_the_step_check_table_gives_forces_in_kn_as_the_run_table(capsys):
     assert "kN" in force and "13.0849" in force and "13.253" in force
     factor = next(ln for ln in out.splitlines() if "dynamic_factor.m" in ln)
     assert "kN" not in factor and "1.71193" in factor
+
+
+def test_an_error_harmonic_that_sets_the_step_is_said_and_the_check_halves_it(tmp_path):
+    """An LTCA mesh's transmission-error series reaches mesh order 14 here: 100 steps per
+    period of that harmonic made the run 14 times longer than a user who asked for 100
+    per mesh period expected, with nothing said; and the step check asked for twice the
+    steps per *mesh* period the run took, per harmonic period: a step 28 times finer."""
+    from model_texts import RELIEVED_SPUR_LTCA
+
+    model = torquesplit.load_model(write_model(tmp_path, RELIEVED_SPUR_LTCA, "ltca.toml"))
+    res = torquesplit.simulate(model, cycles=5)
+    s, f_mesh = res.solution, res.kinematics.meshes["m"].frequency
+    why = s.step_limited_by
+    assert "error sinusoid of element 'm'" in why and "transmission-error harmonic" in why
+    order = round(float(max(abs(res.structure.error_omega))) / (2 * math.pi * f_mesh))
+    assert order > 1 and f"order {order} of its mesh frequency" in why
+    assert f"{100 * order} per shortest mesh period" in why
+    assert s.step == pytest.approx(1 / (100 * order * f_mesh), rel=1e-9)
+    halved = torquesplit.simulate(model, cycles=5,
+                                  steps_per_period=halved_steps_per_period(res))
+    assert halved.solution.step == pytest.approx(s.step / 2, rel=1e-9)

@@ -757,7 +757,10 @@ class Analysis(Strict):
     """Default settings of the analyses (the CLI can override them)."""
 
     method: Literal["rk4", "dopri"] = Field("rk4", description="Time integrator.")
-    steps_per_period: Count = Field(100, ge=10, description="RK4 steps per shortest mesh period.")
+    steps_per_period: Count = Field(100, ge=10, description=(
+        "RK4 steps per shortest excitation period: the shortest mesh period, or an error "
+        "sinusoid's where one is faster (an LTCA transmission-error harmonic; the run says "
+        "so)."))
     duration: Time | None = Field(None, gt=0, description=(
         "Simulated time. Without it a run lasts `cycles` cycles of the slowest mesh (200 "
         "if `cycles` is not given either)."))

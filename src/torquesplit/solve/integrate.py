@@ -738,9 +738,17 @@ def _default_step(s: Structure, span: float, spp: int, check: bool):
 _STEPS = _default_step.cache  # id(structure) -> its last step (entries leave with it)
 
 
-def _step_for(s: Structure, span: float, spp: int, check: bool):
+def shortest_excitation_period(s: Structure) -> float:
+    """The period that ``steps_per_period`` divides [s]: the shortest of the meshes' and
+    the error sinusoids' (inf where nothing is excited)."""
     periods = _excitation_periods(s)
-    period = float(periods.min()) if periods.size else _natural_period_min(s)
+    return float(periods.min()) if periods.size else math.inf
+
+
+def _step_for(s: Structure, span: float, spp: int, check: bool):
+    period = shortest_excitation_period(s)
+    if not math.isfinite(period):
+        period = _natural_period_min(s)
     if not math.isfinite(period):  # nothing oscillates: 1000 steps
         period = span * spp / 1000.0
     h = period / spp
@@ -748,7 +756,7 @@ def _step_for(s: Structure, span: float, spp: int, check: bool):
     h_lim = ACCURACY / (2 * math.pi * f_hi) if f_hi > 0 else math.inf
     h_stable = SAFETY * stable_step(s) if check else math.inf
     if h <= min(h_lim, h_stable):
-        return h, "excitation period", spp
+        return h, _error_sets_step(s, period, spp) or "excitation period", spp
     per = math.ceil(period / min(h_lim, h_stable))  # a whole number of steps per period
     if h_lim <= h_stable:
         why = (f"the highest mode, {f_hi:.6g} Hz (mostly element '{element}'), needs "
@@ -758,6 +766,27 @@ def _step_for(s: Structure, span: float, spp: int, check: bool):
                f"period instead of {spp}")
     log.info("RK4 step limited: %s", why)
     return period / per, why, per
+
+
+def _error_sets_step(s: Structure, period: float, spp: int) -> str | None:
+    """What it is, where an error sinusoid faster than every mesh (an LTCA transmission
+    -error harmonic) sets the excitation period: the step is then many times shorter
+    than ``spp`` per mesh period, which a user otherwise sees only as a slow run."""
+    om = np.abs(s.error_omega)
+    f_mesh = float(s.frequency.max(initial=0.0))
+    if not om.size or not 2 * math.pi / om.max() < (1.0 / f_mesh if f_mesh > 0 else math.inf):
+        return None
+    j = int(np.argmax(om))
+    e = int(np.searchsorted(s.error_ptr, j, side="right") - 1)
+    f = om[j] / (2 * math.pi)
+    what = f"the {f:.6g} Hz error sinusoid of element '{s.element_names[e]}'"
+    if s.frequency[e] > 0:
+        order = f / s.frequency[e]
+        what += (f" (order {order:.3g} of its mesh frequency: a transmission-error "
+                 f"harmonic)")
+    per_mesh = spp / (period * f_mesh) if f_mesh > 0 else math.nan
+    return (f"{what}, {spp} steps per its period ({per_mesh:.4g} per shortest mesh "
+            f"period); fewer (--steps-per-period, checked by --check-step) make the run shorter")
 
 
 def planned_step(structure: Structure, steps_per_period: int | None = None,
