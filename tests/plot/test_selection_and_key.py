@@ -73,3 +73,58 @@ def test_the_layout_drawing_keeps_its_labels_apart():
                 and min(a.y1, b.y1) - max(a.y0, b.y0) > 2)
 
     assert sum(overlap(a, b) for a, b in itertools.combinations(boxes, 2)) == 0
+
+
+def _overlapping_label_pairs(fig) -> int:
+    import itertools
+
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    boxes = [t.get_window_extent(renderer) for ax in fig.axes for t in ax.texts
+             if t.get_text().strip()]
+
+    def overlap(a, b):
+        return (min(a.x1, b.x1) - max(a.x0, b.x0) > 2
+                and min(a.y1, b.y1) - max(a.y0, b.y0) > 2)
+
+    return sum(overlap(a, b) for a, b in itertools.combinations(boxes, 2))
+
+
+def test_the_layout_of_a_planetary_stage_shows_its_carrier_ring_hold_and_pin_errors():
+    """A reviewer's drawing of a planetary stage had no carrier, no sign that the ring
+    is held, no pin error, and the drive's label on the sun's."""
+    model = torquesplit.load_model("lin_parker1999_planetary", changes={
+        "planetary.0.pin_errors": [{"radial": "0 um", "tangential": "0 um"},
+                                   {"radial": "20 um", "tangential": "-5 um"}]
+        + [{"radial": "0 um", "tangential": "0 um"}] * 2})
+    fig = layout_figure(model)
+    ax = fig.axes[0]
+    texts = [t.get_text() for t in ax.texts]
+    hold = [t for t in texts if "held in rotation" in t]
+    assert hold == ["stage_ring held in rotation by 1.99e+07 N m/rad"], hold
+    assert sum("pin error 20 µm radial, -5 µm tangential" in t for t in texts) == 1
+    key = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert "pin circle of stage_carrier (planet bearings: dotted)" in key
+    radius = 0.5 * (model.gears["stage_sun"].teeth + model.gears["stage_planet1"].teeth)
+    circles = [ln for ln in ax.get_lines() if ln.get_linestyle() == "--"
+               and len(ln.get_xdata()) > 50]
+    r = [max(abs(ln.get_xdata())) for ln in circles]  # [mm], centred on the carrier
+    module = model.gears["stage_sun"].module * 1e3
+    assert any(abs(x - radius * module) < 0.02 * radius * module for x in r), (r, radius)
+    assert _overlapping_label_pairs(fig) <= 1
+    star = torquesplit.load_model("lin_parker1999_star")
+    texts = [t.get_text() for t in layout_figure(star).axes[0].texts]
+    assert "stage_carrier held in rotation rigidly" in texts
+
+
+def test_many_supports_of_few_kinds_are_lettered_with_their_values_in_the_key():
+    """Dong et al. 2021's drawing piled eight two-line support labels on its gears."""
+    model = torquesplit.load_model("dong2021_face_gear")
+    fig = layout_figure(model)
+    ax = fig.axes[0]
+    key = [t.get_text() for t in ax.get_legend().get_texts()]
+    lettered = [k for k in key if k.startswith("support ") and k[9:11] == ": "]
+    assert len(lettered) >= 2 and lettered[0].startswith("support A: ")
+    labels = [t.get_text() for t in ax.texts if t.get_text().startswith("support")]
+    assert labels and all(len(t) == len("support A") for t in labels), labels
+    assert _overlapping_label_pairs(fig) <= 2  # (11 before)

@@ -14,7 +14,10 @@ mesh                red arrow: the line of action through the pitch point, point
 shaft               thick grey line between the centres of the bodies it joins (rigid:
                     solid, elastic: dashed); name
 spline              dashed line; name and radial clearance
-support             ground hatch below the body; stiffness, clearance if any
+support             ground hatch below the body; stiffness, clearance if any; a bearing
+                    on another body (a planet on its carrier's pin): dotted line to that
+                    body, its pin error if any, and the pin circle dashed
+rotation hold       "held in rotation" and its stiffness (a ring gear, a star's carrier)
 other body          square (motor, load inertia, carrier); name
 drive, load         green / purple label at the body: speed and torque or power
 ==================  ======================================================================
@@ -136,6 +139,8 @@ def layout_figure(model, kin=None, *, width: float = 10.0) -> Figure:
 
     kin = kin or solve_kinematics(model)
     proj = _Projection(_main_axis(model, kin))
+    if len(model.gears) > 8:  # room for the labels of a large train
+        width *= 1.3
     fig = Figure(figsize=(width, width * 0.8), layout="constrained")
     FigureCanvasAgg(fig)
     ax = fig.add_subplot()
@@ -153,6 +158,7 @@ def layout_figure(model, kin=None, *, width: float = 10.0) -> Figure:
     size = max(radius.values()) if radius else 0.1
     fs = 8.0 if len(model.gears) <= 8 else 7.0
     centre = _drawing_centres(model, kin, proj)
+    label_at: dict[str, np.ndarray] = {}  # where each gear's name is written
     # ---- gears
     for name, g in model.gears.items():
         pts = proj(_circle(centre[name], kin.bodies[name].axis, radius[name]))
@@ -160,7 +166,9 @@ def layout_figure(model, kin=None, *, width: float = 10.0) -> Figure:
         c = proj(centre[name])
         ax.plot(*c, marker="+", color=COLORS["gear"], ms=7, zorder=3)
         kind = g.gear_type if g.gear_type not in (None, "spur") else ""
-        ax.annotate(f"{name}\n{g.teeth} T" + (f", {kind}" if kind else ""), c,
+        # a gear around others (a ring) is named at its rim, not among its sun's labels
+        at = label_at[name] = c if g.gear_type != "internal" else pts[len(pts) // 8]
+        ax.annotate(f"{name}\n{g.teeth} T" + (f", {kind}" if kind else ""), at,
                     xytext=(4, 4), textcoords="offset points", fontsize=fs, zorder=6,
                     color=COLORS["gear"], gid=f"gear:{name}")
     # ---- other bodies
@@ -216,6 +224,12 @@ def layout_figure(model, kin=None, *, width: float = 10.0) -> Figure:
     grounded = [name for _, name, body in supported if not getattr(body.support, "on", None)]
     texts = {name: _support_text(body.support) for _, name, body in supported}
     same = len({texts[n] for n in grounded}) == 1 and len(grounded) > 3
+    # many supports of a few kinds: each hatch says its kind's letter, the key the values
+    # (Dong et al. 2021's drive had eight two-line labels piled on its gears)
+    kinds = list(dict.fromkeys(texts[n] for n in grounded))
+    letter = ({t: "ABCDEFGHIJKLMNOPQRSTUVWXYZ"[i] for i, t in enumerate(kinds)}
+              if not same and len(grounded) > 3 and len(kinds) <= len(grounded) / 2
+              and len(kinds) <= 26 else {})
     for kind, name, body in supported:
         c = proj(centre[name])
         seat = getattr(body.support, "on", None)
@@ -223,9 +237,12 @@ def layout_figure(model, kin=None, *, width: float = 10.0) -> Figure:
             s = proj(centre[seat])
             ax.plot([c[0], s[0]], [c[1], s[1]], color=COLORS["support"], lw=0.9, ls=":",
                     zorder=1)
-            ax.annotate(f"bearing on {seat}", c, xytext=(-10, -14), textcoords="offset points",
-                        fontsize=fs - 1.0, color=COLORS["support"], zorder=6,
-                        gid=f"support:{name}")
+            pin = body.support.pin_error
+            err = ("" if pin.is_zero else f"\npin error {_si(pin.radial, 'um')} radial, "
+                   f"{_si(pin.tangential, 'um')} tangential")
+            ax.annotate(f"bearing on {seat}{err}", c, xytext=(-10, -14 - 8 * bool(err)),
+                        textcoords="offset points", fontsize=fs - 1.0,
+                        color=COLORS["support"], zorder=6, gid=f"support:{name}")
             continue
         drop = 0.18 * size * 1e3 + (radius.get(name, 0.0) * 1e3 if kind == "gears" else 0)
         g0 = c - np.array([0.0, drop])
@@ -237,10 +254,31 @@ def layout_figure(model, kin=None, *, width: float = 10.0) -> Figure:
             x0 = g0[0] - half + k * half / 2
             ax.plot([x0, x0 - half / 3], [g0[1], g0[1] - half / 3],
                     color=COLORS["support"], lw=0.8, zorder=1)
-        label = "support" if same else f"support {name}\n{texts[name]}"
-        ax.annotate(label, g0, xytext=(-10, -12 if same else -20),
+        label = ("support" if same else f"support {letter[texts[name]]}"
+                 if letter else f"support {name}\n{texts[name]}")
+        ax.annotate(label, g0, xytext=(-10, -12 if same or letter else -20),
                     textcoords="offset points", fontsize=fs - 1.0,
                     color=COLORS["support"], zorder=6, gid=f"support:{name}")
+    # ---- a carrier's pin circle: the bodies that seat bearings of others
+    pins: dict[str, list[float]] = {}
+    for _, name, body in supported:
+        seat = getattr(body.support, "on", None)
+        if seat and seat in centre and seat not in model.gears:
+            pins.setdefault(seat, []).append(float(np.linalg.norm(centre[name] - centre[seat])))
+    for seat, radii in pins.items():
+        for r in sorted({round(r, 9) for r in radii}):
+            pts = proj(_circle(centre[seat], kin.bodies[seat].axis, r))
+            ax.plot(pts[:, 0], pts[:, 1], color=COLORS["body"], lw=0.9, ls="--", zorder=1)
+    # ---- members held against rotation (a ring gear, a star stage's carrier)
+    for name, body in [*model.gears.items(), *model.bodies.items()]:
+        hold = getattr(body, "torsional_support", None)
+        if hold is None:
+            continue
+        what = "rigidly" if hold.rigid else f"by {hold.stiffness:.3g} N m/rad"
+        at = label_at.get(name, proj(centre[name]))
+        ax.annotate(f"{name} held in rotation {what}", at, xytext=(4, -8),
+                    textcoords="offset points", fontsize=fs - 1.0, color=COLORS["support"],
+                    zorder=6, gid=f"hold:{name}")
     # ---- drives and loads
     for name, d in model.drives.items():
         c = proj(centre[d.body])
@@ -275,6 +313,11 @@ def layout_figure(model, kin=None, *, width: float = 10.0) -> Figure:
         ax.plot([], [], color=COLORS["support"], lw=1.6,
                 label="support to the housing" + (f": {texts[grounded[0]]} each"
                                                   if same else ""))
+        for t, k in letter.items():
+            ax.plot([], [], ls="none", label=f"support {k}: {t}")
+    if pins:
+        ax.plot([], [], color=COLORS["body"], lw=0.9, ls="--",
+                label=f"pin circle of {', '.join(pins)} (planet bearings: dotted)")
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=fs, frameon=False)
     ax.set_title(f"{model.model.name}: layout, {len(model.gears)} gears, "
                  f"{len(model.meshes)} meshes\nviewed along {depth} (depth along the "
@@ -293,9 +336,9 @@ _NUDGES = [(0, -11), (0, 11), (0, -22), (0, 22), (0, -33), (0, 33), (40, 0), (-4
 
 def _separate_labels(fig, ax) -> None:
     """Move each named label that overlaps one placed before it (in the order drawn:
-    gears first) to the nearest of :data:`_NUDGES` where it overlaps none (at most 74
-    points from where it was: still beside its part); a label with no free place stays
-    where it was.  The offsets
+    gears first) or a mesh's arrow to the nearest of :data:`_NUDGES` where it overlaps
+    none (at most 74 points from where it was: still beside its part); a label with no
+    free place goes where it overlaps fewest.  The offsets
     of the drawing code put every label beside its part, but neighbouring gears, a
     support under a mesh label or a drive over a load piled them up (51 overlapping pairs
     on Dong et al. 2021's drive)."""
@@ -304,20 +347,38 @@ def _separate_labels(fig, ax) -> None:
     fig.canvas.draw()  # (text extents need a renderer)
     renderer = fig.canvas.get_renderer()
     px = fig.dpi / 72.0
+    # the arrows of the meshes are obstacles too (a drive's label sat on a planetary's
+    # line of action), each as the box of its shaft's middle half, so that a label still
+    # finds room beside a long arrow
     placed = []
+    for t in ax.texts:
+        if isinstance(t, Annotation) and not t.get_text() and t.arrow_patch is not None:
+            b = t.arrow_patch.get_window_extent(renderer)
+            placed.append(b.shrunk(0.5, 0.5).translated(b.width / 4, b.height / 4))
+    n_arrows = len(placed)
     for ann in [t for t in ax.texts if isinstance(t, Annotation) and t.get_text()]:
         if ann.anncoords != "offset points":
             placed.append(ann.get_window_extent(renderer).padded(1.0))
             continue
         x0, y0 = ann.xyann
         box = ann.get_window_extent(renderer).padded(1.0)
-        if any(box.overlaps(b) for b in placed):
+
+        def clashes(b):  # a label over a label counts more than over an arrow
+            return sum((2 if k >= n_arrows else 1) * b.overlaps(o)
+                       for k, o in enumerate(placed))
+
+        worst = clashes(box)
+        if worst:  # the free place nearest, else the one with the fewest clashes
+            best = (worst, 0.0, 0.0)
             for dx, dy in _NUDGES:
-                moved = box.translated(dx * px, dy * px)
-                if not any(moved.overlaps(b) for b in placed):
-                    ann.xyann = (x0 + dx, y0 + dy)
-                    box = moved
-                    break
+                n = clashes(box.translated(dx * px, dy * px))
+                if n < best[0]:
+                    best = (n, dx, dy)
+                    if n == 0:
+                        break
+            _, dx, dy = best
+            ann.xyann = (x0 + dx, y0 + dy)
+            box = box.translated(dx * px, dy * px)
         placed.append(box)
 
 
