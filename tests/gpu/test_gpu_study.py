@@ -95,6 +95,9 @@ def test_refused_by_name_before_any_case_runs():
     dopri = {**GRID, "analysis": {"duration": "0.05 s", "method": "dopri"}}
     with pytest.raises(GpuUnsupportedError, match="adaptive time stepping"):
         check_plan(torquesplit.Study(dopri).plan())
+    bearings = {**GRID, "study": {**GRID["study"], "outputs": ["bearing_peak_force.*"]}}
+    with pytest.raises(GpuUnsupportedError, match="read from the history.*keeps none"):
+        check_plan(torquesplit.Study(bearings).plan())
     with pytest.raises(StudyError, match="GPU backend only"):
         torquesplit.Study(GRID).run(precision="fp32")
     with pytest.raises(StudyError, match="unknown backend"):

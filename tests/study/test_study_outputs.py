@@ -97,3 +97,45 @@ def test_the_settle_rule_does_not_wait_for_settle_time(split_file):
         assert ds["settled"].values[0] == 1
         assert "analysis.settle" in ds["settled"].attrs["long_name"]
     assert runs[1] == pytest.approx(0.32) and runs[2] == runs[1]
+
+
+def test_bearing_forces_are_study_outputs_as_the_run_table_gives_them():
+    """A study could vary a support clearance (Dong et al. 2021's question) but not read
+    the bearing forces that the run's table prints."""
+    import numpy as np
+
+    from torquesplit.results import bearing_bodies
+    from torquesplit.study import run_study
+
+    res = torquesplit.simulate("ji_li_mill_drive", cycles=20)
+    vals = output_values(res, ["engineering"])
+    table = res.bearing_forces()
+    assert [b["body"] for b in table] == ["z1", "z2", "z3", "z4", "z5", "z6"]
+    for b in table:
+        assert vals[f"bearing_mean_force.{b['body']}"] == b["mean_magnitude"]
+        assert vals[f"bearing_peak_force.{b['body']}"] == b["peak_magnitude"]
+    bodies = bearing_bodies(res.structure, res.model)
+    promised = available_outputs(res.mesh_names, res.groups, "run", bearings=bodies)
+    assert {n for n in vals if n.startswith("bearing")} == {
+        n for n in promised if n.startswith("bearing")}
+    # a spline-held floating member (no support of its own) is in both as well
+    dong = torquesplit.simulate("dong2021_face_gear", duration=0.002)
+    assert bearing_bodies(dong.structure, dong.model) == [
+        b["body"] for b in dong.bearing_forces()]
+    assert any(b["via"] for b in dong.bearing_forces())
+    spec = {"study": {"name": "b", "model": "ji_li_mill_drive",
+                      "outputs": ["bearing_peak_force.z2", "bearing_mean_force.*"]},
+            "analysis": {"cycles": 20},
+            "grid": {"parameters": [{"path": "meshes.m11.damping_ratio",
+                                     "values": [0.05, 0.1]}]}}
+    ds = run_study(spec, workers=1)
+    assert list(ds["status"].values) == ["ok", "ok"]
+    assert ds["bearing_peak_force.z2"].attrs["units"] == "N"
+    assert ds["bearing_mean_force.z4"].values[0] == pytest.approx(
+        [b["mean_magnitude"] for b in table if b["body"] == "z4"][0], rel=1e-3)
+    assert np.all(ds["bearing_peak_force.z2"].values >= ds["bearing_mean_force.z2"].values)
+    bad = {**spec, "study": {**spec["study"], "outputs": ["bearing_peak_force.z9"]}}
+    from torquesplit.study import StudyError
+
+    with pytest.raises(StudyError, match="close: bearing_peak_force"):
+        run_study(bad, workers=1)

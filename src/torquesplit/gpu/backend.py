@@ -65,6 +65,14 @@ def check_plan(plan) -> None:
             f"adaptive time stepping (the model's [analysis] method = "
             f"{plan.model.analysis.method!r})",
             "set [analysis] method = \"rk4\" in the study, or use the CPU backend")
+    from ..study.outputs import HISTORY_FAMILIES
+
+    history = [n for n in plan.outputs if n.split(".")[0] in HISTORY_FAMILIES]
+    if history:  # (a GPU run keeps no history: they would be NaN)
+        raise GpuUnsupportedError(
+            f"outputs read from the history ({', '.join(history[:3])}"
+            f"{', ...' if len(history) > 3 else ''}: a GPU run keeps none)",
+            "leave the bearing forces out of study.outputs, or use the CPU backend")
 
 
 #: cases in a study's first batch (its tables' memory a case is not known yet)

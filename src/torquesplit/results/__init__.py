@@ -426,18 +426,10 @@ class Results:
         el = self.structure.element_names
         hist = list(self.solution.history_elements)
         out: dict[str, list[tuple[str, int, float]]] = {}
-        for col, e in enumerate(hist):
-            if ".support." in el[e]:
-                body, direction = el[e].split(".support.", 1)
-                out.setdefault(body, []).append((direction, col, 1.0))
-        for name, spline in getattr(self.model, "splines", {}).items():
-            body = spline.connects[1]
-            if body in out:
-                continue
-            for direction in ("x", "y"):
-                e = f"{name}.radial.{direction}"
-                if e in el and el.index(e) in hist:
-                    out.setdefault(body, []).append((direction, hist.index(el.index(e)), -1.0))
+        for body, parts in _bearing_elements(el, self.model).items():
+            for direction, e, sign in parts:
+                if e in hist:
+                    out.setdefault(body, []).append((direction, hist.index(e), sign))
         return out
 
     def bearing_via(self) -> dict[str, str]:
@@ -698,6 +690,33 @@ class Results:
         from ..model.io import model_to_json
 
         return model_to_json(self.model)
+
+
+def _bearing_elements(element_names, model) -> dict[str, list[tuple[str, int, float]]]:
+    """Supported body -> its bearing elements' (direction, element index, sign), as
+    :meth:`Results.support_columns` describes them (by element, not history column)."""
+    index = {n: i for i, n in enumerate(element_names)}
+    out: dict[str, list[tuple[str, int, float]]] = {}
+    for i, n in enumerate(element_names):
+        if ".support." in n:
+            body, direction = n.split(".support.", 1)
+            out.setdefault(body, []).append((direction, i, 1.0))
+    for name, spline in getattr(model, "splines", {}).items():
+        body = spline.connects[1]
+        if body in out:
+            continue
+        for direction in ("x", "y"):
+            e = f"{name}.radial.{direction}"
+            if e in index:
+                out.setdefault(body, []).append((direction, index[e], -1.0))
+    return out
+
+
+def bearing_bodies(structure, model) -> list[str]:
+    """The bodies a run's bearing table lists (:meth:`Results.bearing_forces`), in its
+    order, from the assembled ``structure`` alone (no run needed: a study checks its
+    output names with it)."""
+    return list(_bearing_elements(structure.element_names, model))
 
 
 def back_flank_force(cycle_min: np.ndarray) -> float:

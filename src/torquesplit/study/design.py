@@ -360,8 +360,14 @@ def _outputs(spec: StudySpec, model, analysis: str) -> tuple[list[str], list[str
 
     kin = solve_kinematics(model)  # (planetary stages: their K_gamma outputs)
     planets = {c: [p for p, cc in kin.planet_bodies.items() if cc == c] for c in kin.carriers}
+    bearings = []
+    if analysis != "static" and any("bearing" in p for p in spec.study.outputs):
+        from ..assembly.assemble import assemble
+        from ..results import bearing_bodies
+
+        bearings = bearing_bodies(assemble(model, kin), model)
     available = out_mod.available_outputs(list(model.meshes), group_meshes(meta), analysis,
-                                          planets)
+                                          planets, bearings)
     names, unmatched = out_mod.select_outputs(spec.study.outputs, available)
     if unmatched:
         import difflib

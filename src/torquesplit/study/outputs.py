@@ -32,6 +32,12 @@ name                                        value
 ``back_contact.<mesh>``                     fraction of the run in back-flank contact
 ``back_flank_force.<mesh>``                 largest back-flank (tensile) force [N]
 ``settle_time``                             start of the settled part of the run [s]
+``bearing_mean_force.<body>``               magnitude of the settled mean bearing force
+                                            of a supported body [N] (the run's bearing
+                                            table, :meth:`Results.bearing_forces`)
+``bearing_peak_force.<body>``               largest settled bearing force magnitude [N]
+                                            (from the history: a peak between its
+                                            samples is missed)
 ==========================================  ==============================================
 
 Quasi-static results give ``load_sharing.static_torque[.<group|mesh>]`` and
@@ -67,7 +73,14 @@ FAMILIES: dict[str, tuple[str, str]] = {
     "back_contact": ("1", "fraction of time in back-flank contact"),
     "back_flank_force": ("N", "largest back-flank (tensile) force"),
     "settle_time": ("s", "start of the settled part of the run"),
+    "bearing_mean_force": ("N", "settled mean bearing force (magnitude)"),
+    "bearing_peak_force": ("N", "largest settled bearing force (magnitude, from the "
+                                "history)"),
 }
+
+#: output families read from the history (not streamed): a run without one (the GPU
+#: backend's) cannot give them
+HISTORY_FAMILIES = ("bearing_mean_force", "bearing_peak_force")
 
 #: outputs that change with the run length by nature (the settled part starts later in a
 #: longer run): the settle rule does not wait for them to stop changing
@@ -108,7 +121,12 @@ def output_values(result, definitions=None) -> dict[str, float]:
         raise ValueError(f"unknown load-sharing definition(s) {unknown} for a dynamic run; "
                          f"use {', '.join(DYNAMIC_DEFINITIONS)}")
     # no load sharing asked for: one (cheap) definition still gives the other metrics
-    return {k: float(v) for k, v in result.metric_values(defs or ["cycle_peak"]).items()}
+    out = {k: float(v) for k, v in result.metric_values(defs or ["cycle_peak"]).items()}
+    if result.success:
+        for b in result.bearing_forces():  # the run's bearing table
+            out[f"bearing_mean_force.{b['body']}"] = float(b["mean_magnitude"])
+            out[f"bearing_peak_force.{b['body']}"] = float(b["peak_magnitude"])
+    return out
 
 
 def _quasi_static_values(result) -> dict[str, float]:
@@ -145,14 +163,16 @@ def _f(x) -> float:
 
 # ========================================================================= catalogue
 def available_outputs(mesh_names, groups: dict[str, list[str]], analysis: str,
-                      planets: dict[str, list[str]] | None = None) -> list[str]:
+                      planets: dict[str, list[str]] | None = None,
+                      bearings=()) -> list[str]:
     """Every output name a run of this model gives (``analysis``: "run" or "static").
 
     ``groups`` are the load-sharing groups (key -> meshes); ``planets`` the planetary
     stages (carrier -> planets), whose mesh-load factor K_gamma is
     ``planet_load_sharing.<definition>[.<carrier>|.<planet>]``
-    (:mod:`torquesplit.metrics.planetary`).  Used to check a study's requested names
-    before any case runs.
+    (:mod:`torquesplit.metrics.planetary`); ``bearings`` the supported bodies
+    (:func:`torquesplit.results.bearing_bodies`).  Used to check a study's requested
+    names before any case runs.
     """
     names: list[str] = []
     defs = (STATIC_DEFINITION,) if analysis == "static" else DYNAMIC_DEFINITIONS
@@ -177,6 +197,8 @@ def available_outputs(mesh_names, groups: dict[str, list[str]], analysis: str,
                 "contact_loss", "back_contact", "back_flank_force"):
         names += [f"{fam}.{m}" for m in mesh_names]
     names.append("settle_time")
+    for fam in HISTORY_FAMILIES:
+        names += [f"{fam}.{b}" for b in bearings]
     return names
 
 
