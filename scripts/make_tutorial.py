@@ -254,7 +254,8 @@ leaves out the start-up transient before computing anything.
 * **the history**, which results files (`--out`), figures (`--plots`) and the bearing
   table are made from, holds every integration step of this run ({{{{history_samples}}}} samples):
   by default a run keeps every step up to 50,000 samples, and a longer one every k-th
-  step: 50,000 samples, or more where 20 per shortest mesh period need more.  This drive rings at its mesh modes
+  step: 50,000 samples, or more where 20 per shortest mesh period need more (at most
+  200,000: fewer per period on a very long run).  This drive rings at its mesh modes
   near order {{{{order}}}} of the mesh frequency (section 5): a history of 20 samples per
   split-mesh period (`--samples-per-period 20`) misses the settled peak of in2 by
   {{{{history_miss}}}} %, and the run says so in a warning.  Even every step misses

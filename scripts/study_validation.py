@@ -162,19 +162,24 @@ OURS = {
         "when the mean was known to +/-0.001."),
 }
 
-#: said once, above the studies of the Dong et al. 2021 example: its run does not settle
-DONG_RUN_LENGTH = (
-    "**The Dong et al. 2021 studies** (`dong_2021_*`) run every case for the example's "
-    "1.21 s, which does not settle: `torquesplit run dong2021_face_gear` warns that the "
-    "transient did not die out and that the mean-force coefficient of its O2 idler-output "
-    "pair is 1.114 over the part used, 1.234 over its first half and 1.005 over its second "
-    "(1.0695 with `--duration \"2.4 s\"`; docs/validation.md).  Their stage-II coefficients "
-    "(Omega_II) therefore depend on the run length by about 0.2; stage I (Omega_I) does "
-    "not drift.  The differences between cases are differences at this one run length: a "
-    "stage-II trend or ranking smaller than that drift may not survive a longer run.")
+def dong_run_length() -> str:
+    """Said once, above the studies of the Dong et al. 2021 example: its run does not
+    settle (the numbers from docs/validation_results.json, ``scripts/validate.py``)."""
+    d = json.loads((ROOT / "docs" / "validation_results.json").read_text())["dong2021"]["drift"]
+    return (
+        "**The Dong et al. 2021 studies** (`dong_2021_*`) run every case for the example's "
+        "1.21 s, which does not settle: `torquesplit run dong2021_face_gear` warns that the "
+        f"transient did not die out and that the mean-force coefficient of its group "
+        f"{d['group']} is {d['whole']:.4g} over the part used, {d['first']:.4g} over its "
+        f"first half and {d['second']:.4g} over its second ({d['long']:.4g} with "
+        f"`--duration \"2.4 s\"`; docs/validation.md).  Their stage-II coefficients "
+        f"(Omega_II) therefore depend on the run length by about {d['change']:.1f}; stage I "
+        f"(Omega_I) does not drift ({d['stage1_change']:.1g}).  The differences between cases "
+        "are differences at this one run length: a stage-II trend or ranking smaller than "
+        "that drift may not survive a longer run.")
 #: said under each of them
 DONG_SECTION = ("**Run length:** the run does not settle; Omega_II depends on the run length "
-                "by about 0.2 (see the top of this page).")
+                "(by how much: see the top of this page).")
 
 
 def _run(names, results: Path) -> None:
@@ -272,7 +277,7 @@ def markdown(data: dict) -> str:
              "leave out (see each model file and docs/validation.md), and nothing was tuned "
              "to a published number, so the comparison is of trend and magnitude.", ""]
     if any(name.startswith("dong_2021") for name in data):
-        lines += [DONG_RUN_LENGTH, ""]
+        lines += [dong_run_length(), ""]
     for name, e in data.items():
         if name.startswith("_"):
             continue

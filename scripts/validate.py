@@ -116,8 +116,30 @@ def ji_li(quick: bool) -> dict:
 
 
 def dong2021(quick: bool) -> dict:
-    """Omega_I, Omega_II and every Omega_ij (mean-force definition, Dong et al. 2021 eq. 12)."""
-    return {"baseline": _run(_model("dong2021_face_gear"), cycles=100 if quick else None)}
+    """Omega_I, Omega_II and every Omega_ij (mean-force definition, Dong et al. 2021 eq. 12),
+    and how the mean-force coefficients drift: over each half of the settled part, and
+    over a run twice as long (the run does not settle)."""
+    from torquesplit.results.plausibility import mean_force_halves
+
+    out = {"baseline": _run(_model("dong2021_face_gear"), cycles=100 if quick else None)}
+    res = torquesplit.simulate(_model("dong2021_face_gear"), cycles=100 if quick else None)
+    met = res.metrics("mean_force")
+    halves = mean_force_halves(res, met)
+    # the group whose halves differ most: the one the run's warning names
+    g = max(halves, key=lambda k: abs(halves[k][1] - halves[k][0]))
+    longer = torquesplit.simulate(_model("dong2021_face_gear"),
+                                  **({"cycles": 200} if quick else {"duration": 2.4}))
+    long_met = longer.metrics("mean_force")
+    out["drift"] = {"group": g, "whole": met.load_sharing.per_group[g],
+                    "first": halves[g][0], "second": halves[g][1],
+                    "change": abs(halves[g][1] - halves[g][0]),
+                    "stage1_change": max((abs(b - a) for k, (a, b) in halves.items()
+                                          if k.endswith("_I") or "/I_" in k or k == "I"),
+                                         default=float("nan")),
+                    "long_duration_s": longer.solution.t_final - longer.solution.t_span[0],
+                    "long_settled": bool(long_met.settling.settled),
+                    "long": long_met.load_sharing.per_group[g]}
+    return out
 
 
 def jin2019(quick: bool) -> dict:

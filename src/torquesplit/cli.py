@@ -386,8 +386,9 @@ def run(
         "--out files, --plots figures and the bearing-force table (the mesh table's "
         "forces and coefficients are streamed at every step and do not depend on it); "
         "default: every step of a run of at most 50,000, else every k-th step: 50,000 "
-        "samples, or more where 20 per period need more; a run warns when the history "
-        "misses the peaks.", metavar="N"),
+        "samples, or more where 20 per period need more, at most 200,000 (the bearing "
+        "table's title says how many per period); a run warns when the history misses "
+        "the peaks.", metavar="N"),
     definition: Optional[str] = typer.Option(None, "--definition", help=_definition_help(),
                                              metavar="NAME"),
     out: Optional[Path] = typer.Option(

@@ -259,17 +259,13 @@ def peak_drift(results, metrics) -> list[tuple[str, str]]:
         f"state (`torquesplit steady`)"))]
 
 
-def mean_drift(results, metrics) -> list[tuple[str, str]]:
-    """Mean-force coefficients (Dong et al. 2021 eq. 12) that differ between the first and
-    the second half of the settled part: the mean forces still change over the run
-    (errors turning with different shafts beat over a common period longer than the
-    run), so the coefficient depends on where the run ends.  One message, for the group
-    where the halves differ most."""
-    if metrics.definition != "mean_force":
-        return []
+def mean_force_halves(results, metrics) -> dict[str, tuple[float, float]]:
+    """Group -> its mean-force coefficient (Dong et al. 2021 eq. 12: the largest member's
+    N F_i / sum F_j of the mean forces) over the first and over the second half of each
+    member's settled cycles; groups of one mesh, or too few settled cycles, left out."""
     _, _, c_mean, c_cnt, _ = results.complete_cycle_statistics()
     col = {m: j for j, m in enumerate(results.mesh_names)}
-    worst = None
+    out = {}
     for g, members in metrics.load_sharing.groups.items():
         halves = []
         for m in members:
@@ -285,7 +281,20 @@ def mean_drift(results, metrics) -> list[tuple[str, str]]:
         if len(halves) != len(members) or len(members) < 2:
             continue
         h = np.asarray(halves)  # (members, 2)
-        coef = [float(np.max(len(members) * h[:, i] / h[:, i].sum())) for i in (0, 1)]
+        out[g] = tuple(float(np.max(len(members) * h[:, i] / h[:, i].sum())) for i in (0, 1))
+    return out
+
+
+def mean_drift(results, metrics) -> list[tuple[str, str]]:
+    """Mean-force coefficients (Dong et al. 2021 eq. 12) that differ between the first and
+    the second half of the settled part (:func:`mean_force_halves`): the mean forces still
+    change over the run (errors turning with different shafts beat over a common period
+    longer than the run), so the coefficient depends on where the run ends.  One message,
+    for the group where the halves differ most."""
+    if metrics.definition != "mean_force":
+        return []
+    worst = None
+    for g, coef in mean_force_halves(results, metrics).items():
         change = abs(coef[1] - coef[0])
         if change > MEAN_DRIFT and (worst is None or change > worst[1]):
             worst = (g, change, coef)
