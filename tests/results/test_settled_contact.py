@@ -107,6 +107,31 @@ def test_peaks_that_still_drift_after_settling_are_said(drop, warned):
         assert f"the last window alone gives {peaks[-20:].max() / 100.0:.4g}" in text
 
 
+def test_peaks_that_beat_with_another_stage_are_not_a_drift():
+    """Stage-1 peaks that repeat every 50 of its cycles (the stage-2 mesh turns once per
+    50): windows of 20 cycles saw a first and a last maximum 0.8 % apart and said "not
+    steady" (a steady state of Ji & Li's drive at 20 rpm: +7.8 %); windows of the meshes'
+    common period see the same maximum.  A peak that does fall is still said."""
+    from torquesplit.results.plausibility import _mesh_beat, peak_drift
+
+    k = np.arange(200)
+    beating = 150.0 * (1.0 + 0.01 * np.sin(2 * np.pi * k / 50.0))
+    stub = _Stub(beating)
+    assert peak_drift(stub, _metrics())  # one stage alone: the beat looks like a drift
+    stub._mesh_meta = {"a": {"frequency": 10.0}, "b": {"frequency": 0.2}}
+    stub.mesh_names = ["a", "b"]
+    stub.peaks = np.column_stack([beating, np.full(200, 150.0)])
+    stub.settle_windows = lambda: [20, 20]
+    metrics = _metrics()
+    metrics.settling.first_cycle["b"] = 0
+    metrics.rows.append(type(metrics.rows[0])(mesh="b", static_force=100.0,
+                                              dynamic_factor=1.5))
+    assert _mesh_beat(stub) == pytest.approx(0.2)
+    assert peak_drift(stub, metrics) == []
+    stub.peaks[:, 0] *= 1.0 + 0.003 * (1.0 - k / 199.0)
+    assert [w for w, _ in peak_drift(stub, metrics)] == ["meshes.a"]
+
+
 class _MeanStub:
     """What `mean_drift` reads of a run: per-cycle means and counts of two meshes."""
 

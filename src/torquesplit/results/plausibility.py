@@ -223,19 +223,52 @@ def settling(results, metrics) -> list[tuple[str, str]]:
         "or add damping"))]
 
 
+def _mesh_beat(results) -> float | None:
+    """Frequency [Hz] of the common period of the meshes' stiffness cycles (the beat of
+    two stages: Ji & Li's stage-1 peaks repeat every 168 of its cycles), None where the
+    meshes have no common period within 10^5 cycles of the fastest."""
+    from fractions import Fraction
+
+    meta = getattr(results, "_mesh_meta", None)
+    if meta is None:
+        return None
+    f = [float(meta[m]["frequency"]) for m in results.mesh_names]
+    f = [x for x in f if x > 0]
+    if not f:
+        return None
+    top = max(f)
+    num, den = 0, 1
+    for x in f:
+        r = Fraction(x / top).limit_denominator(10**6)
+        if abs(float(r) - x / top) > 1e-9 * x / top:
+            return None
+        num = math.gcd(num * r.denominator, r.numerator * den)
+        den *= r.denominator
+        g = math.gcd(num, den)
+        num, den = num // g, den // g
+    return top * num / den if den / num <= 1e5 else None
+
+
 def peak_drift(results, metrics) -> list[tuple[str, str]]:
-    """Settled per-cycle peaks that still differ between the first and the last settle
-    window (each of the run's settle windows, the longest excitation period at least):
-    a lightly damped mode still decaying, or a response that does not repeat.  The
-    dynamic factor and the peak-based coefficients take the largest settled peak, so they
-    carry that difference; one message, for the mesh where it is largest."""
-    if not metrics.settling.settled:
-        return []  # said by `settling`
+    """Settled per-cycle peaks that still differ between the first and the last window
+    of the settled part (each mesh's settle window, the longest excitation period at
+    least, widened to the meshes' common period: the peaks of one stage's cycles beat
+    with the other stage's; a mesh whose settled part holds fewer than two windows is
+    not judged): a lightly damped mode
+    still decaying, or a response that does not repeat.  The dynamic factor and the
+    peak-based coefficients take the largest settled peak, so they carry that
+    difference; one message, for the mesh where it is largest.  None for a periodic
+    steady state (its record repeats one period: nothing decays)."""
+    if not metrics.settling.settled or getattr(results, "periodic", False):
+        return []  # (not settled: said by `settling`)
     c_max = results.complete_cycle_statistics()[0]
+    beat = _mesh_beat(results)
     worst = None
     for j, (m, w) in enumerate(zip(results.mesh_names, results.settle_windows())):
         p = c_max[metrics.settling.first_cycle[m]:, j]
         p = p[np.isfinite(p)]
+        if beat:
+            w = max(w, math.ceil(float(results._mesh_meta[m]["frequency"]) / beat - 1e-9))
         if p.size < 2 * w:
             continue
         first, last = float(p[:w].max()), float(p[-w:].max())
@@ -290,8 +323,8 @@ def mean_drift(results, metrics) -> list[tuple[str, str]]:
     the second half of the settled part (:func:`mean_force_halves`): the mean forces still
     change over the run (errors turning with different shafts beat over a common period
     longer than the run), so the coefficient depends on where the run ends.  One message,
-    for the group where the halves differ most."""
-    if metrics.definition != "mean_force":
+    for the group where the halves differ most.  None for a periodic steady state."""
+    if metrics.definition != "mean_force" or getattr(results, "periodic", False):
         return []
     worst = None
     for g, coef in mean_force_halves(results, metrics).items():
