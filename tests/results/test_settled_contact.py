@@ -229,3 +229,28 @@ def test_a_history_too_coarse_for_the_response_is_said(tmp_path):
         result_warnings(fine, fine.metrics())).get("analysis", "")
     # the metrics are streamed: the same whatever the history
     assert every_step.metrics().rows[0].peak_force == coarse.metrics().rows[0].peak_force
+
+
+@pytest.mark.parametrize("periodic", [False, True])
+def test_a_reversed_deflection_under_compression_is_not_put_in_the_start_up(periodic):
+    """A mesh whose force stays compressive has a settled smallest force >= 0 whenever its
+    deflection reverses, so the message always said 'in the start-up transient only',
+    also of a periodic steady state (which has no start-up)."""
+    from types import SimpleNamespace
+
+    from torquesplit.results.plausibility import back_flank
+
+    class Run:
+        mesh_names = ["a"]
+
+        def complete_cycle_statistics(self):
+            return None, np.full((10, 1), 50.0)
+
+    run = Run()
+    run.periodic = periodic
+    row = SimpleNamespace(mesh="a", back_contact=0.03, min_force=40.0, double_flank=False)
+    (where, text), = back_flank(run, SimpleNamespace(rows=[row]))
+    assert where == "meshes.a" and "deflection is reversed 3" in text
+    assert "start-up transient only" not in text
+    assert ("of the periodic state" in text) is periodic
+    assert ("over the whole run, start-up included" in text) is not periodic

@@ -154,14 +154,19 @@ def back_flank(results, metrics) -> list[tuple[str, str]]:
         if c_min is None:  # the fraction counts the whole run: so does the force named here
             c_min = results.complete_cycle_statistics()[1]
         largest = back_flank_force(c_min[:, results.mesh_names.index(r.mesh)])
-        if r.min_force >= 0:  # none in the settled part
-            when = " (in the start-up transient only: the settled part has none)"
-        else:
+        if getattr(results, "periodic", False):  # a steady state: no start-up
+            span = "of the periodic state"
             when = ""
+        else:
+            span = "over the whole run, start-up included"
+            # (a force that stays compressive says nothing of when the deflection
+            # reversed: the settled part's smallest force is then always >= 0)
+            when = (" (in the start-up transient only: the settled part has none)"
+                    if r.min_force >= 0 and largest > 0 else "")
         if largest <= 0:  # deflection reversed, force still compressive (damping)
             out.append((f"meshes.{r.mesh}", (
-                f"the mesh deflection is reversed {_pct(r.back_contact)} of the time over "
-                f"the whole run, start-up included{when}, "
+                f"the mesh deflection is reversed {_pct(r.back_contact)} of the time "
+                f"{span}, "
                 f"the force staying compressive only through the damping: a real pair "
                 f"{'with backlash ' if r.double_flank else ''}would be about to lose contact "
                 f"there; check meshes.{r.mesh}.backlash and the excitation")))
@@ -169,7 +174,7 @@ def back_flank(results, metrics) -> list[tuple[str, str]]:
         if r.double_flank:
             out.append((f"meshes.{r.mesh}", (
                 f"double-flank contact {_pct(r.back_contact)} of the time and back-flank "
-                f"force up to {_kn(largest)} over the whole run, start-up included{when}: "
+                f"force up to {_kn(largest)} {span}{when}: "
                 f"the mesh has no backlash, so the model lets it carry "
                 f"tension, which a real pair with backlash cannot; give "
                 f"meshes.{r.mesh}.backlash its real value (e.g. '100 um') or read its peak "
@@ -177,7 +182,7 @@ def back_flank(results, metrics) -> list[tuple[str, str]]:
         else:
             out.append((f"meshes.{r.mesh}", (
                 f"back-flank contact {_pct(r.back_contact)} of the time and back-flank force "
-                f"up to {_kn(largest)} over the whole run, start-up included{when}: the "
+                f"up to {_kn(largest)} {span}{when}: the "
                 f"teeth rattle through the backlash; peak forces are "
                 f"impacts and the load sharing is not meaningful; check the excitation "
                 f"and meshes.{r.mesh}.backlash")))
