@@ -197,3 +197,25 @@ def test_a_periodic_state_is_not_said_to_drift():
     res = sd.to_results()
     assert res.periodic and res.success
     assert not any("not steady" in w or "over its first half" in w for w in res.warnings())
+
+
+def test_keep_takes_a_frequency_with_its_unit():
+    """--keep '235.917 Hz' was refused as 'no mesh, stage or body ... or a frequency in
+    Hz' although the help asks for a frequency in Hz."""
+    from typer.testing import CliRunner
+
+    from torquesplit.cli import app
+
+    runner = CliRunner()
+    args = ["steady", "ji_li_mill_drive", "--no-stability", "--json", "--keep"]
+    bare = runner.invoke(app, args + ["235.917"])
+    unit = runner.invoke(app, args + ["235.917 Hz"])
+    assert bare.exit_code == unit.exit_code == 0, unit.output
+    import json
+
+    a, b = json.loads(bare.stdout), json.loads(unit.stdout)
+    assert a["dropped_excitations"] == b["dropped_excitations"] and a["dropped_excitations"]
+    assert a["meshes"] == b["meshes"]
+    wrong = runner.invoke(app, args + ["235.917 mm"])
+    assert wrong.exit_code == 2 and "--keep '235.917 mm'" in wrong.stderr
+    assert "not a frequency" in wrong.stderr

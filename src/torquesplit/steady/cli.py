@@ -120,12 +120,21 @@ def _check_positive_speed(text, option: str, example: str):
 
 
 def _keep(keep):
+    """--keep: a name, or a frequency (a bare number in Hz, or a number with its unit)."""
     if keep is None:
         return None
     try:
         return float(keep)
     except ValueError:
-        return keep
+        pass
+    if re.match(r"\s*[-+]?(\d|\.\d)", keep):  # a number with a unit: a frequency
+        from torquesplit.model.units import parse_quantity
+
+        try:
+            return parse_quantity(keep, "frequency")
+        except ValueError as exc:
+            raise OptionError(f"--keep {keep!r}: {exc}") from None
+    return keep
 
 
 def register(app, load, fail, console, err_console, json_default, set_help=""):
