@@ -404,9 +404,33 @@ def coarse_history(results, metrics) -> list[tuple[str, str]]:
         f"--samples-per-period {more} (Python: samples_per_period={more})"))]
 
 
+def harmonic_truncation(results, metrics) -> list[tuple[str, str]]:
+    """A harmonic-balance steady state whose series is cut short: its top quarter of
+    harmonics holds more of the velocity energy than an adaptive solve accepts
+    (:data:`torquesplit.steady.solution.ENERGY_TOL`).  With a fixed count (--harmonics
+    --fixed) 16 harmonics of Ji & Li's stage 1 gave dynamic factors 1.6 % low and two
+    symmetric meshes different factors, with nothing said."""
+    steady = getattr(results, "steady", None)
+    ps = getattr(steady, "solution", None)
+    if ps is None or ps.method != "hb" or not ps.converged:
+        return []
+    from ..steady.solution import ENERGY_TOL
+
+    top = ps.top_harmonic_energy
+    if not (math.isfinite(top) and top > ENERGY_TOL):
+        return []
+    return [("analysis", (
+        f"harmonic balance with {ps.harmonics} harmonics: the top quarter of them holds "
+        f"{top:.2g} of the velocity energy (a converged series: below {ENERGY_TOL:g}; the "
+        f"time-domain residual is {ps.time_residual:.2g}), so the series is cut short and "
+        f"the peaks and dynamic factors can be off by percent; let the harmonics double "
+        f"(--adaptive, the default without --harmonics) or solve by shooting "
+        f"(--method shooting)"))]
+
+
 #: every check, in the order the messages are listed
 CHECKS = (static_force, ltca_load, static_deflection, contact_loss, back_flank, resonance, settling,
-          peak_drift, mean_drift, coarse_history)
+          peak_drift, mean_drift, coarse_history, harmonic_truncation)
 
 
 def result_warnings(results, metrics, *, history: bool = True) -> list[tuple[str, str]]:
