@@ -233,3 +233,22 @@ def test_a_harmonic_balance_cut_short_is_said():
     assert said and "--method shooting" in said[0]
     full = steady_state(model, keep="stage1", method="hb", stability=False).to_results()
     assert not any("harmonic balance with" in w for w in full.warnings())
+
+
+def test_sweep_speed_says_which_load_sharing_it_gives():
+    """Over speed the coefficient is the mean-force one whatever the model asks for; a
+    reviewer read Ji & Li's 1.0000 there against 1.0656 (engineering) from 'steady'."""
+    import json
+
+    from typer.testing import CliRunner
+
+    from torquesplit.cli import app
+
+    args = ["sweep-speed", "ji_li_mill_drive", "--from", "740 rpm", "--to", "750 rpm",
+            "--points", "3", "--keep", "stage1", "--no-stability"]
+    r = CliRunner().invoke(app, args)
+    assert r.exit_code == 0, r.output
+    text = " ".join(r.stdout.split())
+    assert "the model's definition 'engineering' is not computed by the sweep" in text
+    data = json.loads(CliRunner().invoke(app, args + ["--json"]).stdout)
+    assert data["load_sharing_definitions"] == ["mean_force", "instantaneous"]

@@ -408,7 +408,15 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
             "max_contact_loss": _largest_loss(ds),
             "wall_time_s": ds.attrs["wall_time_s"],
             "results_file": str(saved) if saved else None,
+            # (the sweep's load sharing: these two, whatever the model's definition)
+            "load_sharing_definitions": ["mean_force", "instantaneous"],
         }
+        chosen = m.analysis.load_sharing
+        other = (f"load sharing over speed: the mean-force coefficient (Dong et al. 2021 eq. "
+                 f"12, 'load_sharing' in the files) and the largest instantaneous ratio (Ji "
+                 f"& Li eq. 18); the model's definition {chosen!r} is not computed by the "
+                 f"sweep: 'torquesplit steady --speed S' gives it at a speed"
+                 if chosen not in (None, "mean_force", "instantaneous") else None)
         if cross_check:
             for key in ("run_up", "run_down"):
                 summary[f"{key}_max_dynamic_factor"] = {k: v[key][0]
@@ -454,6 +462,8 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
                 console.print("contact loss on the stable points: " + ", ".join(
                     f"{k} up to {100 * v[0]:.3g} % of the period (at {v[1]:.6g} rpm)"
                     for k, v in lost.items()), highlight=False)
+            if other:
+                console.print(other, highlight=False)
             if saved:
                 console.print(f"results written to {saved}", highlight=False)
         if failed is not None:

@@ -107,7 +107,8 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
     xarray.Dataset
         dims ``point`` and ``mesh``: speed, mesh frequency, dynamic factor (peak / the
         mesh's static force), peak-to-nominal, load-sharing coefficients (``load_sharing``:
-        the ratio of mean forces, as ``run`` and ``steady`` report by default;
+        the ratio of mean forces, Dong et al. 2021 eq. 12, whatever the model's
+        ``[analysis] load_sharing``;
         ``load_sharing_instantaneous``: the largest instantaneous ratio in its group
         over the period), RMS transmission error, peak and mean force, stability and
         largest Floquet multiplier; attributes: turning points (jump speeds), natural frequencies and their mesh-order crossings, status

@@ -537,8 +537,8 @@ def _point_outputs(f, f_all, d, groups, static_forces, nominal, peak, mean):
     any instants between them ``f_all`` (the load-sharing ratio's extremes), the
     deformation samples ``d``, the peak forces ``peak`` and mean forces ``mean``
     (:func:`record_extremes`): peak force, dynamic factors, load sharing (the ratio of
-    the mean forces in its group, Dong et al. 2021 eq. 12, as ``run`` and ``steady``
-    report it by default, and the largest instantaneous ratio, Ji & Li eq. 18), RMS
+    the mean forces in its group, Dong et al. 2021 eq. 12, whatever the model's
+    definition, and the largest instantaneous ratio, Ji & Li eq. 18), RMS
     transmission error, mean force, contact loss (the fraction of the samples in which
     the mesh carries no force)."""
     lsc = np.full(f.shape[1], np.nan)
