@@ -1371,6 +1371,18 @@ def modes(
         if not campbell and (start is not None or stop is not None):
             raise TorquesplitError("--from and --to give the speed range of a Campbell "
                                    "diagram; add --campbell, or leave them out")
+        # options of the other form would be ignored silently (a --plot without the map
+        # wrote nothing and said nothing)
+        if not campbell and plot is not None:
+            raise TorquesplitError("--plot draws the Campbell diagram; add --campbell "
+                                   "--from A --to B, or leave --plot out")
+        if campbell and (count is not None or below is not None):
+            given = " and ".join(o for o, v in (("--count", count), ("--below", below))
+                                 if v is not None)
+            verb = "limit" if " and " in given else "limits"
+            raise TorquesplitError(f"{given} {verb} the list of modes; the Campbell map "
+                                   f"takes every mode: leave {given} out, or run 'modes' "
+                                   f"without --campbell for the list")
         if campbell:
             if start is None or stop is None:
                 raise TorquesplitError("--campbell needs a speed range: add --from '500 rpm' "

@@ -53,6 +53,22 @@ def test_a_campbell_range_without_campbell_is_refused():
     assert res.exit_code == 2 and "add --campbell" in res.stderr
 
 
+@pytest.mark.parametrize("args, said", [
+    (["--plot", "x.png"], "--plot draws the Campbell diagram; add --campbell"),
+    (["--campbell", "--from", "100 rpm", "--to", "200 rpm", "--count", "2"],
+     "--count limits the list of modes; the Campbell map takes every mode"),
+    (["--campbell", "--from", "100 rpm", "--to", "200 rpm", "--count", "2", "--below",
+      "60 Hz"], "--count and --below limit the list of modes"),
+])
+def test_modes_options_of_the_other_form_are_refused_not_ignored(tmp_path, args, said):
+    """A reviewer's 'modes --plot x.png' wrote nothing and said nothing; --count and
+    --below printed the same Campbell critical speeds as without them."""
+    args = [a if a != "x.png" else str(tmp_path / a) for a in args]
+    res = runner.invoke(app, ["modes", "ji_li_mill_drive", *args])
+    assert res.exit_code == 2 and said in " ".join(res.stderr.split()), res.output
+    assert not (tmp_path / "x.png").exists()
+
+
 def test_a_positive_base_pitch_deviation_brings_the_entering_pair_early(tmp_path):
     """The field said 'driver minus driven', but the analysis (rightly, for the premature
     contact the field is there for) takes f_pb > 0 as early engagement, which is driven
