@@ -252,3 +252,22 @@ def test_sweep_speed_says_which_load_sharing_it_gives():
     assert "the model's definition 'engineering' is not computed by the sweep" in text
     data = json.loads(CliRunner().invoke(app, args + ["--json"]).stdout)
     assert data["load_sharing_definitions"] == ["mean_force", "instantaneous"]
+
+
+def test_a_sweep_panel_of_a_nearly_constant_coefficient_is_not_all_noise():
+    """A coefficient of 1 within 1e-8 filled its panel with rounding wiggles ('1e-8+1')."""
+    from matplotlib.figure import Figure
+
+    from torquesplit.steady.plot import _least_span
+
+    ax = Figure().add_subplot()
+    ax.plot([400, 500, 600], [1.0, 1.0 + 6e-10, 1.0 - 3e-10])
+    _least_span(ax)
+    lo, hi = ax.get_ylim()
+    assert hi - lo == pytest.approx(0.02) and lo < 1.0 < hi
+    assert not ax.yaxis.get_major_formatter().get_useOffset()
+    wide = Figure().add_subplot()
+    wide.plot([0, 1], [1.0, 1.5])
+    before = wide.get_ylim()
+    _least_span(wide)
+    assert wide.get_ylim() == before

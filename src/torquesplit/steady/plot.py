@@ -77,6 +77,7 @@ def sweep_figure(ds, variables=None):
         label, _ = _SWEEP_AXES.get(variable, (ds[variable].attrs.get("long_name", variable),
                                               1.0))
         ax.set_ylabel(label, fontsize=8)
+        _least_span(ax)
         ax.grid(alpha=0.3)
         if n < len(variables) - 1:
             ax.tick_params(labelbottom=False)
@@ -104,6 +105,17 @@ def sweep_figure(ds, variables=None):
                       f"unstable, dotted: turning points, grey: critical speeds){note}",
                       fontsize=9, pad=16)
     return fig
+
+
+def _least_span(ax, share: float = 0.02) -> None:
+    """At least ``share`` of the panel's value on its y axis, and no offset notation: a
+    coefficient of 1 within rounding filled its panel with 1e-8 wiggles ('1e-8+1')."""
+    lo, hi = ax.get_ylim()
+    mid = 0.5 * (lo + hi)
+    floor = share * abs(mid)
+    if floor > 0 and hi - lo < floor:
+        ax.set_ylim(mid - floor / 2, mid + floor / 2)
+    ax.ticklabel_format(axis="y", useOffset=False)
 
 
 def _crowded(groups, k, span) -> bool:
