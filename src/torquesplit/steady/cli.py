@@ -287,13 +287,16 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
                         "DF (peak/static)", "peak/nominal", f"LSC ({chosen})",
                         "RMS TE [µm]", "contact loss"):
                 t.add_column(_h(col), justify="left" if col in ("mesh", "group") else "right")
+            def cell(x, fmt):  # (an undefined number, as the JSON's null: no 'inf')
+                return format(x, fmt) if math.isfinite(x) else "-"
+
             for r in rows:
-                t.add_row(r.mesh, r.group, f"{r.static_force / 1e3:#.6g}",
-                          f"{r.mean_force / 1e3:#.6g}", f"{r.peak_force / 1e3:#.6g}",
-                          f"{r.dynamic_factor:.5f}",
-                          f"{r.peak_to_nominal:.5f}", f"{r.load_sharing:.5f}",
-                          f"{1e6 * r.rms_transmission_error:#.4g}",
-                          f"{100 * r.contact_loss:.2f} %")
+                t.add_row(r.mesh, r.group, cell(r.static_force / 1e3, "#.6g"),
+                          cell(r.mean_force / 1e3, "#.6g"), cell(r.peak_force / 1e3, "#.6g"),
+                          cell(r.dynamic_factor, ".5f"), cell(r.peak_to_nominal, ".5f"),
+                          cell(r.load_sharing, ".5f"),
+                          cell(1e6 * r.rms_transmission_error, "#.4g"),
+                          cell(100 * r.contact_loss, ".2f") + " %")
             console.print(t)
             if planets:
                 from torquesplit.cli_support import planet_table, planet_text
