@@ -271,3 +271,22 @@ def test_a_sweep_panel_of_a_nearly_constant_coefficient_is_not_all_noise():
     before = wide.get_ylim()
     _least_span(wide)
     assert wide.get_ylim() == before
+
+
+def test_a_speed_in_hz_far_from_the_models_is_said():
+    """'--speed 745 Hz' (a frequency pasted as a speed) ran Ji & Li's drive at 44,700 rpm
+    with no word; a speed in Hz near the model's is taken quietly."""
+    import warnings
+
+    import torquesplit
+    from torquesplit.errors import ModelWarning
+    from torquesplit.steady.api import speed_factor
+
+    m = torquesplit.load_model("ji_li_mill_drive")
+    with pytest.warns(ModelWarning, match=r"'745 Hz' is 745 revolutions per second = "
+                                          r"44,700 rpm, 60 times"):
+        assert speed_factor(m, "745 Hz") == pytest.approx(60.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        speed_factor(m, "12.4 Hz")
+        speed_factor(m, "7450 rpm")

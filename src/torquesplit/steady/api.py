@@ -77,7 +77,35 @@ def speed_factor(model, speed) -> float:
     if not (s > 0 and math.isfinite(s)):
         raise SolverError(f"speed {speed!r} is not a positive finite speed; give e.g. "
                           f"speed='3000 rpm' or speed=314.16 (rad/s).")
+    warn_hz_speed(model, speed)
     return s
+
+
+def warn_hz_speed(model, speed) -> None:
+    """Warn where a speed written in Hz is over 10 times, or under a tenth of, the
+    model's input speed: Hz is the unit of every frequency the tool prints, and a mesh
+    frequency pasted as a speed ran Ji & Li's drive at 44,700 rpm without a word."""
+    if not (isinstance(speed, str) and "hz" in speed.lower()):
+        return
+    from torquesplit.model.units import parse_quantity
+
+    try:
+        value = abs(parse_quantity(speed, "speed"))
+    except ValueError:
+        return
+    s = value / reference_speed(model)
+    if 0.1 <= s <= 10.0 or not math.isfinite(s):
+        return
+    import warnings
+
+    from torquesplit.errors import ModelWarning
+
+    rpm = 30.0 / math.pi
+    warnings.warn(
+        f"speed {speed!r} is {value / (2 * math.pi):.6g} revolutions per second = "
+        f"{value * rpm:,.6g} rpm, {s:.3g} times the model's input speed "
+        f"({reference_speed(model) * rpm:.6g} rpm); a speed in Hz counts revolutions per "
+        f"second: give it in rpm if a frequency was meant", ModelWarning, stacklevel=3)
 
 
 class SteadyState:

@@ -197,6 +197,9 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
 
             with collect_warnings(), progress("periodic steady state", as_json,
                                               total=None) as update:
+                from torquesplit.steady.api import warn_hz_speed
+
+                warn_hz_speed(m, speed)
                 st = steady_state(m, method=method, harmonics=harmonics, adaptive=adaptive,
                                   keep=_keep(keep), speed=_speed(speed, "--speed"),
                                   max_cycles="auto" if max_cycles is None else max_cycles,
