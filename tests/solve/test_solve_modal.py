@@ -123,3 +123,15 @@ def test_a_splines_modal_damping_leaves_its_friction_out(dx, closed, expected):
     c2 = _spline_damping(par, dx, 0.0, closed=closed)
     assert c2[0, 0] == pytest.approx(expected) and abs(c2[0, 1]) < 1e-12
     assert np.all(c2 <= 30.0 + 1e-9)  # never the friction's 1e6 N s/m
+
+
+def test_an_undamped_mode_has_a_damping_ratio_of_zero_not_rounding():
+    """'modes split_path_planetary_differential' printed zeta -3.16e-19 for two modes."""
+    import numpy as np
+
+    import torquesplit
+
+    rep = torquesplit.model_modes(torquesplit.load_model("split_path_planetary_differential"))
+    zeta = np.array([r.damping_ratio for r in rep.rows])
+    assert np.all(zeta >= 0.0) and np.any(zeta == 0.0)
+    assert not np.any((zeta > 0) & (zeta < 1e-12))

@@ -165,6 +165,8 @@ def modal_analysis(structure: Structure, q=None, *, rigid_tolerance: float = 1e-
         denom = denom + np.imag(np.einsum("im,ij,jm->m", phi_e.conj(), Gm, phi_e))
     zeta = (np.real(np.einsum("im,ij,jm->m", phi_e.conj(), C, phi_e)) / denom
             if omega.size else np.zeros(0))
+    # an undamped mode's ratio is rounding (-3e-19 was printed): 0
+    zeta = np.where(np.abs(zeta) < 1e-12, 0.0, zeta)
     return ModalSolution(frequencies=freqs, mode_shapes=phi_e,
                          strain_energy_fraction=fraction, damping_ratios=zeta,
                          rigid_modes=phi_r, active=active,
