@@ -780,7 +780,8 @@ def static(
 
     state = {"saved": None}
     with contextlib.ExitStack() as stack, ux.interruptible(
-            lambda: f"results kept in {state['saved']}" if state["saved"] else ""):
+            lambda: (f"results kept in {', '.join(str(f) for f in state['saved'])}"
+                     if state["saved"] else "")):
         try:
             opts = _option_errors()
             opts(_positive, revolutions, "--revolutions", "1")
@@ -817,7 +818,11 @@ def static(
         failed = None
         try:  # a file that cannot be written: the results are still printed, then the error
             with ux.finish_before_interrupt():  # (a Ctrl-C now waits for the file)
-                state["saved"] = res.save(out, overwrite=force) if out is not None else None
+                if out is not None:  # (every file named where the save is reported)
+                    from .results.export import dataset_files
+
+                    state["saved"] = dataset_files(res.to_dataset(),
+                                                   res.save(out, overwrite=force))
         except _EXPECTED as exc:
             failed = exc
         saved = state["saved"]
@@ -832,12 +837,13 @@ def static(
                     figures = write_static_figures(res, plots)
             except OSError as exc:
                 failed = failed or _figure_error(exc, "--plots", plots,
-                                                 _kept_results([saved] if saved else []))
+                                                 _kept_results(saved or []))
     _print_static(m, res, met, orbits, saved, figures, plots, as_json)
     if failed is not None:
         _fail(failed)
     elif res.solution.interrupted:
-        ux.exit_interrupted(f"results kept in {saved}" if saved else "")
+        ux.exit_interrupted(f"results kept in {', '.join(str(f) for f in saved)}"
+                            if saved else "")
 
 
 def _print_static(m, res, met, orbits, saved, figures, plots, as_json) -> None:
@@ -860,7 +866,8 @@ def _print_static(m, res, met, orbits, saved, figures, plots, as_json) -> None:
             "orbits_um": {b: {"x_range": [1e6 * float(o[:, 0].min()), 1e6 * float(o[:, 0].max())],
                               "y_range": [1e6 * float(o[:, 1].min()), 1e6 * float(o[:, 1].max())]}
                           for b, o in orbits.items()},
-            "results_file": str(saved) if saved else None,
+            "results_file": str(saved[0]) if saved else None,
+            "results_files": [str(f) for f in saved or []],
             "figures": [str(f) for f in figures],
         }, _json_default)
         return
@@ -890,7 +897,8 @@ def _print_static(m, res, met, orbits, saved, figures, plots, as_json) -> None:
                       f"{1e6 * xy[:, 1].min():.3f} .. {1e6 * xy[:, 1].max():.3f}")
         console.print(o)
     if saved:
-        console.print(f"results written to {saved}", highlight=False)
+        console.print("results written to " + ", ".join(str(f) for f in saved),
+                      highlight=False)
     if figures:
         console.print(f"{len(figures)} figure files written to {plots}", highlight=False)
 
@@ -1407,8 +1415,10 @@ def modes(
                 ds.attrs["model"] = m.model.name
                 from .results.export import with_model
 
-                saved = save_dataset(with_model(ds, m, ux.session().warnings), plan.path,
-                                     overwrite=force)
+                from .results.export import dataset_files
+
+                saved = dataset_files(ds, save_dataset(with_model(ds, m, ux.session().warnings),
+                                                       plan.path, overwrite=force))
     except _EXPECTED as exc:
         _fail(exc)
         return
@@ -1417,7 +1427,8 @@ def modes(
     carrier_rpm = {c: kin.bodies[c].speed * 30 / math.pi for c in kin.carriers}
     if as_json:
         data = rep.to_dict(shapes=True)
-        data.update(mesh_frequencies_Hz=mesh_f, results_file=str(saved) if saved else None)
+        data.update(mesh_frequencies_Hz=mesh_f, results_file=str(saved[0]) if saved else None,
+                    results_files=[str(f) for f in saved or []])
         if carrier_rpm:
             data["carrier_speed_rpm"] = carrier_rpm
         ux.emit_json(data, _json_default)
@@ -1451,7 +1462,7 @@ def modes(
                   + ("; whirl: FW/BW, the central members whirl with/against the carrier's "
                      "rotation in its frame" if whirls else ""), highlight=False)
     if saved:
-        console.print(f"modes written to {saved}")
+        console.print("modes written to " + ", ".join(str(f) for f in saved), highlight=False)
 
 
 def _ratio(x: float) -> str:

@@ -108,7 +108,10 @@ def test_the_campbell_map_is_written_where_asked(tmp_path):
     r = CliRunner().invoke(app, ["modes", EXAMPLE, "--campbell", "--from", "300 rpm", "--to",
                                  "1200 rpm", "--out", str(out), "--json"])
     assert r.exit_code == 0, r.output
-    assert json.loads(r.output)["files"] == [str(out)]
+    # every file written is named (a CSV set: the table and what it cannot hold)
+    about = tmp_path / "map_about.json"
+    assert json.loads(r.output)["files"] == [str(out), str(about)]
+    assert json.loads(about.read_text())["model"]["model"]["name"] == "ji_li_mill_drive"
     header, rows = _read(out)
     assert header[:3] == ["speed_rad/s", "speed_rpm", "natural_frequency_1_Hz"]
     assert float(rows[0][1]) == pytest.approx(300.0) and float(rows[-1][1]) == pytest.approx(1200)
@@ -132,12 +135,12 @@ def test_set_overrides_reach_steady_and_mesh():
     """--set was missing from 'steady', 'sweep-speed' and 'mesh'."""
     base = ["steady", EXAMPLE, "--keep", "stage1", "--harmonics", "8", "--no-stability",
             "--json"]
-    a = json.loads(CliRunner().invoke(app, base).output)
+    a = json.loads(CliRunner().invoke(app, base).stdout)  # (8 harmonics: a warning beside)
     r = CliRunner().invoke(app, base + ["--set", "loads.mill.torque=0.5*"])
     assert r.exit_code == 2 and "--set" in r.output
     r = CliRunner().invoke(app, base + ["--set", "meshes.m11.damping_ratio=0.2"])
     assert r.exit_code == 0, r.output
-    b = json.loads(r.output)
+    b = json.loads(r.stdout)
     assert b["meshes"]["m11"]["dynamic_factor"] != a["meshes"]["m11"]["dynamic_factor"]
     r = CliRunner().invoke(app, ["mesh", EXAMPLE, "--pair", "m11", "--json", "--set",
                                  "meshes.m11.stiffness.method=iso6336"])

@@ -224,21 +224,21 @@ def test_cli_steady_sweep_and_campbell(tmp_path):
     r = CliRunner().invoke(app, ["steady", EXAMPLE, "--keep", "stage1", "--harmonics", "16",
                                  "--json"])
     assert r.exit_code == 0, r.output
-    out = json.loads(r.output)
+    out = json.loads(r.stdout)
     assert out["converged"] and out["harmonics"] == 16 and out["stable"]
     assert set(out["meshes"]) == {"m11", "m21", "m12", "m22"}
     r = CliRunner().invoke(app, ["steady", EXAMPLE, "--keep", "stage1", "--no-stability"])
     assert r.exit_code == 0 and "stability: not computed (--no-stability)" in r.output
     r = CliRunner().invoke(app, ["steady", EXAMPLE, "--keep", "stage1", "--no-stability",
                                  "--json"])
-    assert json.loads(r.output)["stable"] is None
+    assert json.loads(r.stdout)["stable"] is None
     r = CliRunner().invoke(app, ["sweep-speed", EXAMPLE, "--keep", "stage1", "--from",
                                  "700 rpm", "--to", "790 rpm", "--points", "4",
                                  "--harmonics", "8", "--no-stability", "--plot",
                                  str(tmp_path / "s.png"), "--out", str(tmp_path / "s.nc"),
                                  "--json"])
     assert r.exit_code == 0, r.output
-    out = json.loads(r.output)
+    out = json.loads(r.stdout)
     assert out["complete"] and out["points"] >= 4 and (tmp_path / "s.png").exists()
     r = CliRunner().invoke(app, ["sweep-speed", EXAMPLE, "--keep", "stage1", "--from",
                                  "-700 rpm", "--to", "-700 rpm"])
@@ -265,7 +265,10 @@ def test_cli_steady_converges_its_harmonics_unless_told_not_to():
         r = CliRunner().invoke(app, ["steady", EXAMPLE, "--keep", "stage1", "--json",
                                      "--method", "hb", *flags])
         assert r.exit_code == 0, r.output
-        harmonics[tuple(flags)] = json.loads(r.output)["harmonics"]
+        data = json.loads(r.stdout)
+        harmonics[tuple(flags)] = data["harmonics"]
+        cut = [w for w in data["warnings"] if "harmonic balance with" in w]
+        assert bool(cut) == bool(flags), cut  # the fixed 8 are too few, and it is said
     assert harmonics[()] >= 64 and harmonics[("--fixed",)] == 8
     # nothing varies in time: the steady state is the static one, and the message says so
     r = CliRunner().invoke(app, ["steady", "lin_parker1999_star"])

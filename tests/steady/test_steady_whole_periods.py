@@ -290,3 +290,23 @@ def test_a_speed_in_hz_far_from_the_models_is_said():
         warnings.simplefilter("error")
         speed_factor(m, "12.4 Hz")
         speed_factor(m, "7450 rpm")
+
+
+def test_every_file_a_save_writes_is_named(tmp_path):
+    """'results written to x.csv' named one of the six files a steady state's CSV set
+    writes (and modes one of three)."""
+    import json
+
+    from typer.testing import CliRunner
+
+    from torquesplit.cli import app
+
+    out = tmp_path / "s.csv"
+    r = CliRunner().invoke(app, ["steady", "ji_li_mill_drive", "--keep", "stage1",
+                                 "--no-stability", "--json", "--out", str(out)])
+    listed = json.loads(r.stdout)["results_files"]
+    assert sorted(listed) == sorted(str(p) for p in tmp_path.iterdir()) and len(listed) == 6
+    r = CliRunner().invoke(app, ["modes", "ji_li_mill_drive", "--out", str(tmp_path / "m.csv")])
+    said = " ".join(r.stdout.split())
+    for name in ("m.csv", "m_dof.csv", "m_about.json"):
+        assert (tmp_path / name).exists() and str(tmp_path / name) in said

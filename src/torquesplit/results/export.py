@@ -6,7 +6,8 @@ opens (Python, MATLAB, a spreadsheet), safely (:mod:`torquesplit.results.files`)
 A dynamic run has its own richer writer (``Results.save``).
 
 CSV: one table per *row dimension* (the first dimension of each variable, in order):
-``NAME.csv`` for the first, ``NAME_<dim>.csv`` beside it for each other.  A row per
+``NAME.csv`` for the first, ``NAME_<dim>.csv`` beside it for each other, and
+``NAME_about.json`` (provenance, model, warnings, the Dataset's attributes).  A row per
 coordinate value; a 1-D variable is one column, a variable with more dimensions one
 column per label of the others (``dynamic_factor_m11``); every column's unit is in its
 name (``speed_rad/s``), as in a run's CSV files.  Scalar variables are columns of the
@@ -31,7 +32,8 @@ from . import files
 DATASET_FORMATS = {".nc": "netcdf", ".netcdf": "netcdf", ".h5": "netcdf", ".mat": "mat",
                    ".csv": "table"}
 
-__all__ = ["DATASET_FORMATS", "row_dims", "check_dataset_output", "save_dataset"]
+__all__ = ["DATASET_FORMATS", "row_dims", "check_dataset_output", "save_dataset",
+           "dataset_files"]
 
 
 def row_dims(ds) -> tuple[str, ...]:
@@ -55,6 +57,7 @@ def check_dataset_output(path, tables: tuple[str, ...] = (), *, overwrite: bool 
     if plan.format != "table":
         return plan
     extra = tuple(plan.path.with_name(f"{plan.path.stem}_{d}.csv") for d in tables[1:])
+    extra += (files.about_path(plan.path),)
     for f in extra:
         if (f.exists() or f.is_symlink()) and not overwrite:
             raise OutputError(f"{clip_text(str(f))} exists; use --force (overwrite=True in "
@@ -184,6 +187,12 @@ def _write(ds, plan: files.OutputPlan, claim: files.OutputClaim) -> Path:
     else:
         dims = row_dims(ds)
         contents = {f: files.csv_bytes(*_table(ds, d)) for f, d in zip(plan.files[1:], dims[1:])}
+        # what the tables cannot hold: provenance, model, warnings, the other attributes
+        warnings = json.loads(ds.attrs["warnings_json"]) if "warnings_json" in ds.attrs else []
+        rest = {k: v for k, v in ds.attrs.items()
+                if k not in ("model_json", "warnings", "warnings_json")}
+        contents[files.about_path(plan.path)] = files.about_bytes(
+            claim.run_id, ds.attrs.get("model_json"), warnings, attributes=rest)
         contents[plan.path] = files.csv_bytes(*_table(ds, dims[0]))  # last: marks the set
         claim.write(contents)
     return plan.path
@@ -202,6 +211,12 @@ def with_model(ds, model, warnings=()):
 
 
 #: row dimensions of the Datasets the commands write: a replaced CSV set's companions
+def dataset_files(ds, path) -> list[Path]:
+    """Every file a save of ``ds`` to ``path`` writes (a ``.csv``: ``NAME.csv`` and its
+    other tables), to name them all where the save is reported."""
+    return list(check_dataset_output(path, row_dims(ds), overwrite=True).files)
+
+
 #: named so, left from an earlier save of another shape, are removed with it
 KNOWN_TABLES = ("time", "mesh", "planet_entity", "dof", "mode", "point", "check", "speed")
 

@@ -213,7 +213,12 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
                 for loc, msg in result_warnings(res, res.metrics()):
                     warn(f"{loc}: {msg}")
             rows = st.mesh_table(results=res)
-            saved = res.save(out, overwrite=force) if out is not None else None
+            saved = None
+            if out is not None:  # (every file named where the save is reported)
+                from torquesplit.results.files import RESULT_FORMATS, companion_files
+
+                path = res.save(out, overwrite=force)
+                saved = list(companion_files(path, RESULT_FORMATS[path.suffix.lower()]))
             step_check = None
             if check:
                 from torquesplit.convergence import check_steady
@@ -249,7 +254,8 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
             **st.summary(rows), "instability": kind or None,
             **({"planet_load_sharing": planet_sharing_dict(planets)} if planets else {}),
             **({} if ps.converged else {"stable": None}),
-            "results_file": str(saved) if saved else None,
+            "results_file": str(saved[0]) if saved else None,
+            "results_files": [str(f) for f in saved or []],
             **({"step_check": step_check.to_dict()} if step_check else {}),
         }
         if as_json:
@@ -317,7 +323,8 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
                                   refine="--harmonics" if ps.method == "hb" else
                                   "--steps-per-cycle")
             if saved:
-                console.print(f"results written to {saved}")
+                console.print("results written to " + ", ".join(str(f) for f in saved),
+                              highlight=False)
         if not ps.converged:
             raise typer.Exit(1)
 
@@ -392,7 +399,9 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
         saved, failed = None, None
         try:  # a file that cannot be written: the curves are still printed, then the error
             if out is not None:
-                saved = _save(_with_model(ds, m), out, force)
+                from torquesplit.results.export import dataset_files
+
+                saved = dataset_files(ds, _save(_with_model(ds, m), out, force))
             if plot is not None:
                 from torquesplit.steady.plot import save, sweep_figure
 
@@ -413,7 +422,8 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
             "period_doubling_rpm": _runs(ds, ds["instability"].values == "period doubling"),
             "max_contact_loss": _largest_loss(ds),
             "wall_time_s": ds.attrs["wall_time_s"],
-            "results_file": str(saved) if saved else None,
+            "results_file": str(saved[0]) if saved else None,
+            "results_files": [str(f) for f in saved or []],
             # (the sweep's load sharing: these two, whatever the model's definition)
             "load_sharing_definitions": ["mean_force", "instantaneous"],
         }
@@ -471,7 +481,8 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
             if other:
                 console.print(other, highlight=False)
             if saved:
-                console.print(f"results written to {saved}", highlight=False)
+                console.print("results written to " + ", ".join(str(f) for f in saved),
+                              highlight=False)
         if failed is not None:
             fail(failed)
             return
@@ -559,7 +570,9 @@ def campbell_command(m, start, stop, plot, as_json, console, json_default, out=N
     written, failed = [], None
     try:  # a file that cannot be written: the map is still printed, then the error
         if out is not None:
-            written.append(_save(_with_model(ds, m), out, force))
+            from torquesplit.results.export import dataset_files
+
+            written += dataset_files(ds, _save(_with_model(ds, m), out, force))
         if plot is not None:
             from torquesplit.steady.plot import campbell_figure, save
 
