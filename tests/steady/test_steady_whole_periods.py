@@ -310,3 +310,24 @@ def test_every_file_a_save_writes_is_named(tmp_path):
     said = " ".join(r.stdout.split())
     for name in ("m.csv", "m_dof.csv", "m_about.json"):
         assert (tmp_path / name).exists() and str(tmp_path / name) in said
+
+
+def test_a_long_shooting_solve_is_announced_before_it_starts(monkeypatch):
+    """Ji & Li's drive at 1 rpm printed nothing for minutes (its highest mode sets 31.6
+    million steps per period); the announcement comes before the shooting starts."""
+    import torquesplit
+    from torquesplit.errors import ModelWarning
+    from torquesplit.steady import solution
+
+    class Stop(Exception):
+        pass
+
+    def stop(*a, **k):
+        raise Stop
+
+    monkeypatch.setattr(solution, "solve_shooting", stop)
+    model = torquesplit.load_model("ji_li_mill_drive")
+    with pytest.warns(ModelWarning, match=r"takes 31,5\d\d,\d\d\d RK4 steps per period "
+                                          r"\(the highest mode, 9476.6\d Hz"):
+        with pytest.raises(Stop):
+            steady_state(model, speed="1 rpm", stability=False)

@@ -45,6 +45,12 @@ MAX_SAMPLES = 1 << 16
 (every k-th RK4 step, k the smallest divisor of the steps that gets there), the meshes'
 forces and deformations at every step: Jin et al. 2019's full period (725,200 steps, 52
 DOFs) held 2.2 GB at every step, 3.0 GB with its Results."""
+ANNOUNCE_SECONDS = 2.0
+"""A shooting solve whose integration of one period is estimated to take longer is
+announced before it starts, with what sets its steps: Ji & Li's drive at 1 rpm ran for
+minutes without a word (its highest mode, not its slow meshes, sets the step)."""
+SECONDS_PER_DOF_STEP = 25e-9
+"""Rough cost of an RK4 step per DOF (benchmarks/RESULTS.md: 16-33 ns), for estimates."""
 HILL_LIMIT = 800
 """Largest Hill matrix (complex, square) for Hill's method; larger: the monodromy."""
 AUTO = "shooting unless harmonics or Hill's method are asked for"
@@ -194,6 +200,26 @@ def top_energy(hb: HarmonicBalance, x, speed=1.0) -> float:
     return float(e[k > 0.75 * hb.H].sum() / tot)
 
 
+def _announce(p, T, steps, stability) -> None:
+    """Warn before a shooting solve of ``steps`` RK4 steps per period ``T``: how long
+    each integration of the period is, roughly, and what sets the steps."""
+    from torquesplit.solve.stability import highest_mode
+
+    f_hi, element = highest_mode(p.structure)
+    n_mode = int(math.ceil(2 * math.pi * f_hi * T)) if f_hi > 0 else 0
+    why = (f"the highest mode, {f_hi:.6g} Hz (mostly element '{element}'), needs "
+           f"{n_mode:,} for the period of {T:.4g} s" if n_mode >= 0.9 * steps
+           else f"a period of {T:.4g} s")
+    per_map = SECONDS_PER_DOF_STEP * p.structure.n_dof * steps
+    more = (f"; the stability adds {2 * p.structure.n_dof} variational columns "
+            f"(--no-stability skips them)" if stability else "")
+    warnings.warn(
+        f"the periodic state takes {steps:,} RK4 steps per period ({why}): about "
+        f"{per_map:.2g} s per integration of the period, and the solve takes several"
+        f"{more}; a speed near the model's, or 'torquesplit run', is quicker",
+        ModelWarning, stacklevel=3)
+
+
 def converged_hb(p, H, samples, speed, q_static, initial, tol, *, adaptive=True,
                  energy_tol=ENERGY_TOL, max_harmonics=2**15, smallest=False, say=None):
     """HB solution with H harmonics; with ``adaptive``, H raised (each solve started from
@@ -287,6 +313,9 @@ def periodic_solution(structure, period: Period, *, method: str = "auto", harmon
     steps = p.rk4_steps(T, steps_per_cycle, order)
     if method == "auto":  # see AUTO
         method = "hb" if harmonics is not None or stability == "hill" else "shooting"
+    if method == "shooting" and (SECONDS_PER_DOF_STEP * p.structure.n_dof * steps
+                                 > ANNOUNCE_SECONDS):
+        _announce(p, T, steps, stability)
     multipliers = None
     stab_method = ""
     every = 1
