@@ -373,9 +373,11 @@ def render_step_check(check, rows: int = 12, printed: int = PRINTED_DIGITS,
     for col in ("number", "unit", "value", "checked", "digits that hold"):
         t.add_column(col, justify="left" if col in ("number", "unit") else "right")
     for name, a, b, _, d in short[:rows]:
-        # forces in kN, as the run's mesh table prints them
-        kn = name.split(".")[0].endswith("_force")
-        scale, unit = (1e-3, "kN") if kn else (1.0, "")
+        # in the units of the tables above: forces in kN, transmission errors in µm
+        head = name.split(".")[0]
+        scale, unit = ((1e-3, "kN") if head.endswith("_force") else
+                       (1e6, "µm") if head.endswith("transmission_error") else
+                       (1.0, "s") if head.endswith("_time") else (1.0, ""))
         t.add_row(name, unit, f"{a * scale:.6g}", f"{b * scale:.6g}", str(d))
     console.print(t)
     if len(short) > rows:

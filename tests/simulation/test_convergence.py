@@ -207,8 +207,10 @@ def test_the_step_check_table_gives_forces_in_kn_as_the_run_table(capsys):
     from torquesplit.convergence import StepCheck
 
     reset(Console(width=120), Console(stderr=True))
-    check = StepCheck(values={"peak_force.m": 13084.9, "dynamic_factor.m": 1.71193},
-                      halved={"peak_force.m": 13253.0, "dynamic_factor.m": 1.73392},
+    check = StepCheck(values={"peak_force.m": 13084.9, "dynamic_factor.m": 1.71193,
+                              "rms_transmission_error.m": 1.12926e-06},
+                      halved={"peak_force.m": 13253.0, "dynamic_factor.m": 1.73392,
+                              "rms_transmission_error.m": 1.2e-06},
                       method="rk4", step=1e-5, halved_step=5e-6)
     render_step_check(check)
     out = capsys.readouterr().out
@@ -216,6 +218,9 @@ def test_the_step_check_table_gives_forces_in_kn_as_the_run_table(capsys):
     assert "kN" in force and "13.0849" in force and "13.253" in force
     factor = next(ln for ln in out.splitlines() if "dynamic_factor.m" in ln)
     assert "kN" not in factor and "1.71193" in factor
+    # the steady table's transmission error in µm, as its mesh table prints it
+    te = next(ln for ln in out.splitlines() if "rms_transmission_error.m" in ln)
+    assert "µm" in te and "1.12926" in te and "e-06" not in te
 
 
 def test_an_error_harmonic_that_sets_the_step_is_said_and_the_check_halves_it(tmp_path):
