@@ -304,7 +304,11 @@ def test_every_file_a_save_writes_is_named(tmp_path):
     out = tmp_path / "s.csv"
     r = CliRunner().invoke(app, ["steady", "ji_li_mill_drive", "--keep", "stage1",
                                  "--no-stability", "--json", "--out", str(out)])
-    listed = json.loads(r.stdout)["results_files"]
+    data = json.loads(r.stdout)
+    listed = data["results_files"]
+    # every number of a mesh has its unit (the table prints kN and µm, the JSON SI)
+    assert set(data["units"]) == set(data["meshes"]["m11"]) - {"group"}
+    assert data["units"]["rms_transmission_error"] == "m"
     assert sorted(listed) == sorted(str(p) for p in tmp_path.iterdir()) and len(listed) == 6
     r = CliRunner().invoke(app, ["modes", "ji_li_mill_drive", "--out", str(tmp_path / "m.csv")])
     said = " ".join(r.stdout.split())

@@ -257,6 +257,11 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
             "results_file": str(saved[0]) if saved else None,
             "results_files": [str(f) for f in saved or []],
             **({"step_check": step_check.to_dict()} if step_check else {}),
+            # SI, as every JSON of the tool (the table prints kN and µm)
+            "units": {"nominal_force": "N", "static_force": "N", "mean_force": "N",
+                      "min_force": "N", "peak_force": "N", "dynamic_factor": "1",
+                      "peak_to_nominal": "1", "load_sharing": "1",
+                      "rms_transmission_error": "m", "contact_loss": "1"},
         }
         if as_json:
             _emit(info, json_default)
