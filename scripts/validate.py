@@ -138,6 +138,8 @@ def dong2021(quick: bool) -> dict:
                                          default=float("nan")),
                     "long_duration_s": longer.solution.t_final - longer.solution.t_span[0],
                     "long_settled": bool(long_met.settling.settled),
+                    "long_state": ("settled" if long_met.settling.settled
+                                   else "still not settled"),
                     "long": long_met.load_sharing.per_group[g]}
     return out
 
