@@ -300,6 +300,24 @@ def test_resume_accepts_a_changed_description(tmp_path, split_file):
         Study(path).run(workers=1, out=out, resume=True)
 
 
+def test_resume_compares_values_not_their_writing(tmp_path, split_file):
+    """'9 um' written '0.009 mm' was refused as a changed study; another value is."""
+    data = grid_study(split_file, GRID[:1])
+    data["grid"]["parameters"][0]["num"] = 2
+    path = _write(tmp_path, data)
+    out = tmp_path / "out"
+    Study(path).run(workers=1, out=out, figures=False)
+    data["grid"]["parameters"][0]["stop"] = "0.009 mm"
+    _write(tmp_path, data)
+    Study(path).run(workers=1, out=out, resume=True, figures=False)
+    with sqlite3.connect(out / "study.sqlite") as db:
+        assert [c for (c,) in db.execute("SELECT computed FROM runs ORDER BY run")] == [2, 0]
+    data["grid"]["parameters"][0]["stop"] = "0.008 mm"
+    _write(tmp_path, data)
+    with pytest.raises(StudyError, match="the study file changed"):
+        Study(path).run(workers=1, out=out, resume=True)
+
+
 def test_resume_and_overwrite_together_are_refused(tmp_path, split_file):
     """--resume --overwrite reset the store and recomputed the finished cases."""
     from study_helpers import grid_study

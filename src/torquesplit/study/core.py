@@ -19,6 +19,7 @@ from __future__ import annotations
 import json
 import logging
 import math
+import re
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -386,7 +387,8 @@ def _check_same(plan: Plan, meta: dict, out: Path, words: Words = API_WORDS) -> 
     w = words
     again = f"start a new study with another {w.out} or {w.overwrite_on}"
     if (meta.get("study_hash") != plan.study_hash
-            and _results_part(meta.get("study", {})) != _results_part(plan.spec.canonical())):
+            and _values(_results_part(meta.get("study", {})))
+            != _values(_results_part(plan.spec.canonical()))):
         changes = _diff(meta.get("study", {}), plan.spec.canonical())
         raise StudyError(w.resume, f"the study file changed since {out} was started "
                                    f"({changes}); undo the change, or {again}")
@@ -410,6 +412,26 @@ def _results_part(study: dict) -> dict:
     if isinstance(out.get("study"), dict):
         out["study"] = {k: v for k, v in out["study"].items() if k not in WORDING}
     return out
+
+
+def _values(obj):
+    """``obj`` with every quantity text ("30 s", "9 um") replaced by its value in base
+    units and its dimension, so that a resume compares values: "30 s" and "30000 ms" are
+    the same study (they were refused as a change).  Only text that starts like a number
+    is read as a quantity (a name such as "m" is not a metre)."""
+    if isinstance(obj, dict):
+        return {k: _values(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_values(v) for v in obj]
+    if isinstance(obj, str) and re.match(r"\s*[-+]?(\d|\.\d)", obj):
+        from ..model.units import registry
+
+        try:
+            q = registry().Quantity(obj).to_base_units()
+        except Exception:  # noqa: BLE001 - not a quantity (pint raises many kinds): as text
+            return obj
+        return (float(f"{float(q.magnitude):.12g}"), str(q.dimensionality))
+    return obj
 
 
 def _diff(old, new, prefix: str = "", limit: int = 3) -> str:
