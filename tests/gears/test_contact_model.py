@@ -219,3 +219,25 @@ def test_a_double_helical_helix_split_is_said_and_the_float_is_a_model_option(tm
     # the dynamic model takes the option too (its stiffness table from the floating LTCA)
     d = _set(data(text), "meshes.m.stiffness.ltca.axial_float", True)
     assert load(d).meshes["m"].stiffness.ltca.axial_float is True
+
+
+def test_a_secant_stiffness_softened_by_the_modifications_is_said():
+    """Secant coupling (Liu et al. 2021 eq. 5) counts the relief's separation as
+    compliance: 35 % below the tangent stiffness here, with nothing said.  An unmodified
+    pair (Hertzian softening only, 3 %) and the tangent coupling are quiet."""
+    for form, mods, said in (("secant", True, True), ("secant", False, False),
+                             ("tangent", True, False)):
+        d = data()
+        d["meshes"]["m"]["stiffness"]["ltca"]["excitation"] = form
+        if not mods:
+            for g in d["gears"].values():
+                g.pop("modifications", None)
+        m = load(d)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            assemble(m, solve_kinematics(m))
+        soft = [str(w.message) for w in caught if "secant LTCA stiffness" in str(w.message)]
+        assert bool(soft) is said, (form, mods, soft)
+        if said:
+            assert soft[0].startswith("meshes.m.stiffness: the secant LTCA stiffness P/Z")
+            assert 'ltca.excitation = "tangent"' in soft[0]

@@ -36,6 +36,35 @@ STEP_TABLE_POINTS = 16384
 SMOOTH_TABLE_POINTS = 256
 
 
+SECANT_SOFT = 0.8
+"""A secant LTCA stiffness below this share of the tangent one is said: the separation
+the modifications open (and the Hertzian softening) counts as compliance in P/Z."""
+
+
+def _warn_soft_secant(mesh_name: str, summary: dict) -> None:
+    """Warn where a mesh couples its LTCA by the secant stiffness (Liu et al. 2021 eq. 5,
+    k = P/Z) and that is well below the tangent dP/dZ: 20 um of tip relief took a pair
+    from 741 to 455 N/um while its tangent stiffness stayed at 756, with nothing said;
+    its natural frequencies come out low by the square root of that ratio."""
+    if summary.get("excitation") != "secant":
+        return
+    ks = summary.get("stiffness_secant_mean_N_per_m", math.nan)
+    kt = summary.get("stiffness_tangent_mean_N_per_m", math.nan)
+    if not (ks > 0 and kt > 0 and ks < SECANT_SOFT * kt):
+        return
+    import warnings
+
+    from ..errors import ModelWarning
+
+    warnings.warn(
+        f"meshes.{mesh_name}.stiffness: the secant LTCA stiffness P/Z ({ks / 1e6:.4g} N/um, "
+        f"Liu et al. 2021 eq. 5) is {100 * (1 - ks / kt):.0f} % below the tangent dP/dZ "
+        f"({kt / 1e6:.4g} N/um): the separation the modifications open counts as compliance, "
+        f"so the mesh's natural frequencies come out about {100 * (1 - math.sqrt(ks / kt)):.0f}"
+        f" % low; ltca.excitation = \"tangent\" (the default) keeps dP/dZ and drives the "
+        f"loaded transmission error instead", ModelWarning, stacklevel=2)
+
+
 def table_points(model: Model, kin: Kinematics) -> int:
     """Points per period of the excitation tables: ``[analysis] table_points``, or by
     default :data:`STEP_TABLE_POINTS` where a mesh's stiffness table steps or a mesh has
@@ -84,7 +113,9 @@ def stiffness_table(model: Model, kin: Kinematics, mesh_name: str, n: int) -> np
     if spec.method == "ltca":
         from ..gears.contact.coupling import mesh_ltca
 
-        return np.asarray(mesh_ltca(model, kin, mesh_name, n).stiffness)
+        tab = mesh_ltca(model, kin, mesh_name, n)
+        _warn_soft_secant(mesh_name, tab.summary)
+        return np.asarray(tab.stiffness)
     from ..gears import stiffness as gst
 
     if mk.geometry is None:
