@@ -62,7 +62,13 @@ def test_shipped_example_equals_the_engine(name):
                                      structure=run.structure, static=run.static,
                                      solution=s))
 
+    from torquesplit.study.outputs import HISTORY_FAMILIES
+
     a, b = values(sol), values(ref)
+    # the bearing forces come from the history, which a GPU run does not keep (a GPU
+    # study refuses them by name: test_gpu_study)
+    assert not any(k.split(".")[0] in HISTORY_FAMILIES for k in a)
+    b = {k: v for k, v in b.items() if k.split(".")[0] not in HISTORY_FAMILIES}
     assert a.keys() == b.keys() and len(a) > 50
     for k in a:
         assert a[k] == b[k] or (math.isnan(a[k]) and math.isnan(b[k])), k
