@@ -461,3 +461,24 @@ def test_a_tooth_pairs_load_is_one_continuous_curve_over_the_cycles():
     tracks = _pair_tracks(phase, loads)
     whole = [v for ph, v in tracks if np.allclose(v[:8], life)]
     assert len(whole) == 1  # one curve follows the pair through both cycles
+
+
+def test_a_held_ring_and_rounding_are_not_what_a_planetary_figure_shows():
+    """A planetary's quasi-static figures drew every position at 0 deg (the x axis was
+    the held ring's 'rotation'), its equal mesh forces as 0.25 mN of rounding over the
+    whole panel, and its held members' orbits as 1e-14 um with offset tick labels."""
+    import torquesplit
+
+    res = torquesplit.quasi_static_load_sharing(
+        torquesplit.load_model("lin_parker1999_planetary"), revolutions=0.2,
+        points_per_cycle=4)
+    ax = F.static_mesh_force_figure(res).axes[0]
+    assert "stage_ring" not in ax.get_xlabel()
+    x = ax.get_lines()[0].get_xdata()
+    assert np.ptp(x) > 10.0  # degrees of a turning gear
+    lo, hi = ax.get_ylim()
+    force = ax.get_lines()[0].get_ydata().mean()
+    assert hi - lo >= F.LEAST_SPAN * force * (1 - 1e-9)
+    titles = [a.get_title() for a in F.orbit_figure(res).axes if a.get_visible()]
+    held = [t for t in titles if "no motion" in t]
+    assert {t.split("\n")[0] for t in held} == {"stage_sun", "stage_ring", "stage_carrier"}

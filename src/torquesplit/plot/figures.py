@@ -599,6 +599,10 @@ def orbit_figure(results, *, bodies: Iterable[str] | None = None) -> Figure:
     axes = fig.subplots(nrows, ncols, squeeze=False).ravel()
     for ax in axes[n:]:
         ax.set_visible(False)
+    # a body that moves a million times less than the one that moves most is rounding (a
+    # held sun's 1e-14 um drew offset tick labels): drawn as no motion
+    largest = max(float(np.nanmax(np.abs(_finite(xy) * _UM), initial=0.0))
+                  for xy in orbits.values())
     for ax, (body, xy) in zip(axes, orbits.items()):
         xy = _finite(xy) * _UM
         ax.plot(xy[:, 0], xy[:, 1], color=_color(0), lw=1.0)
@@ -606,6 +610,16 @@ def orbit_figure(results, *, bodies: Iterable[str] | None = None) -> Figure:
         lo, hi = np.nanmin(xy, axis=0), np.nanmax(xy, axis=0)
         reach = max(float(np.max(hi - lo)), 1e-12)
         title = body
+        if float(np.nanmax(np.abs(xy), initial=0.0)) < 1e-6 * largest:
+            half = 0.5 * largest
+            ax.set_xlim(-half, half)
+            ax.set_ylim(-half, half)
+            ax.plot([0.0], [0.0], "+", color=REFERENCE_COLOR, ms=10, mew=1.5)
+            ax.set_title(f"{body}\n(no motion: below {1e-6 * largest:.1g} µm)",
+                         fontsize=FONT["title"])
+            ax.set_aspect("equal", adjustable="box")
+            _label(ax, "x [µm]", "y [µm]")
+            continue
         if np.all(lo - reach <= 0.0) and np.all(hi + reach >= 0.0):
             ax.plot([0.0], [0.0], "+", color=REFERENCE_COLOR, ms=10, mew=1.5)
         else:
@@ -1076,8 +1090,14 @@ def _positions(results) -> tuple[np.ndarray, str]:
     """Sweep positions as the rotation of the slowest gear [deg] (one revolution per
     360 deg, as :func:`torquesplit.quasistatic.quasi_static_load_sharing` sweeps)."""
     kin = results.kinematics
-    gear = min(results.model.gears, key=lambda g: abs(kin.bodies[g].speed))
-    angle = np.degrees(results.times * abs(kin.bodies[gear].speed))
+    # of the gears that turn: a held ring's "rotation" put every position at 0 deg (a
+    # planetary's quasi-static figures drew no curve)
+    speed = {g: abs(kin.bodies[g].speed) for g in results.model.gears}
+    turning = [g for g, w in speed.items() if w > 1e-9 * max(speed.values(), default=0.0)]
+    if not turning:
+        return np.asarray(results.times), "time [s]"
+    gear = min(turning, key=speed.get)
+    angle = np.degrees(results.times * speed[gear])
     return angle, f"rotation of {gear} [deg]"
 
 
@@ -1105,6 +1125,11 @@ def _panels(n: int, *, ncols: int = 1, sharex: bool = False, row_height: float =
     return fig, list(axes[:n])
 
 
+LEAST_SPAN = 0.04
+"""A panel's y axis spans at least this share of its largest value (a variation below
+it is drawn at that scale, not magnified to the panel's height)."""
+
+
 def _label(ax, xlabel: str, ylabel: str) -> None:
     ax.set_xlabel(xlabel, fontsize=FONT["label"])
     ax.set_ylabel(ylabel, fontsize=FONT["label"])
@@ -1116,9 +1141,11 @@ def _label(ax, xlabel: str, ylabel: str) -> None:
     ax.grid(True, alpha=0.3)
     lo, hi = ax.dataLim.intervaly
     size = max(abs(lo), abs(hi))
-    if np.isfinite(size) and hi - lo <= 1e-9 * size and ax.get_autoscaley_on():
-        # constant data: a +-2 % window instead of the 12th significant digit
-        pad = 0.02 * size if size > 0 else 1.0
+    if np.isfinite(size) and hi - lo <= LEAST_SPAN * size and ax.get_autoscaley_on():
+        # (nearly) constant data: a window of LEAST_SPAN of the value instead of the 8th
+        # significant digit at full height (a planetary's equal mesh forces drew 0.25 mN
+        # of rounding over the whole panel, the nominal line apparently above them)
+        pad = 0.5 * LEAST_SPAN * size if size > 0 else 1.0
         ax.set_ylim(0.5 * (lo + hi) - pad, 0.5 * (lo + hi) + pad)
 
 
