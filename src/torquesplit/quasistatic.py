@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import json
 import math
+import numbers
 import warnings
 from dataclasses import dataclass, field
 
@@ -164,6 +165,19 @@ def quasi_static_load_sharing(model, *, revolutions: float | None = None,
     from .solve.static import quasi_static
     from .steady.period import excitation_sources
 
+    # (0 positions divided by zero, -1 gave an empty sweep, 0 points a cycle 16 positions
+    # silently, a string or 2.5 a TypeError)
+    for name, value, example in (("points_per_cycle", points_per_cycle, 32),
+                                 ("max_points", max_points, 20000)):
+        if (isinstance(value, bool) or not isinstance(value, numbers.Real)
+                or not float(value).is_integer() or value < 1):
+            raise ValueError(f"{name} must be a whole number >= 1, got {value!r}; give "
+                             f"e.g. {name}={example}")
+    if revolutions is not None and (isinstance(revolutions, bool) or not isinstance(
+            revolutions, numbers.Real) or not (0 < revolutions < math.inf)):
+        raise ValueError(f"revolutions must be a positive number, got {revolutions!r}; "
+                         f"give e.g. revolutions=1 (of the slowest gear)")
+    points_per_cycle, max_points = int(points_per_cycle), int(max_points)
     if not hasattr(model, "meshes"):
         model = load_model(model)
     kin = solve_kinematics(model)
@@ -175,8 +189,6 @@ def quasi_static_load_sharing(model, *, revolutions: float | None = None,
     turn = 2 * math.pi / min(speeds)  # one revolution of the slowest gear [s]
     if revolutions is None:
         period = _excitation_period(structure, turn)
-    elif not revolutions > 0:
-        raise ValueError(f"revolutions must be positive, got {revolutions!r}")
     else:
         period = revolutions * turn
     sources = excitation_sources(structure)

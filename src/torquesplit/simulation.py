@@ -30,6 +30,8 @@ MAX_HISTORY_RECORDS = 200_000
 #: fewer than :data:`MIN_SAMPLES_PER_PERIOD` per shortest mesh period
 AUTO_HISTORY_RECORDS = 50_000
 MIN_SAMPLES_PER_PERIOD = 20
+#: fewest RK4 steps per excitation period a run takes (the model file's bound)
+MIN_STEPS_PER_PERIOD = 10
 #: default step budget of a run (about 1-5 minutes of integration on one core)
 MAX_STEPS = 200_000_000
 #: runs longer than this many steps are announced with a warning (cost estimate)
@@ -65,13 +67,16 @@ def simulate(
         Simulated time: seconds, or a string with a time unit (``"5 ms"``).  Default:
         ``cycles`` if given, else the model's ``[analysis]``.
     cycles : int, optional
-        Number of cycles of the slowest mesh to simulate (default 200): a whole number
-        >= 1 (``3.0`` is read as 3; ``2.5`` is refused).  Give ``duration`` or
-        ``cycles``, not both (an :class:`~torquesplit.errors.OptionError`).
+        Number of cycles of the slowest mesh to simulate: a whole number >= 1 (``3.0``
+        is read as 3; ``2.5`` is refused).  Give ``duration`` or ``cycles``, not both
+        (an :class:`~torquesplit.errors.OptionError`).  Neither: the model's
+        ``[analysis]`` duration or cycles, else 200 cycles.
     method : {"rk4", "dopri"}, optional
         Integrator; default from ``[analysis]``.
     steps_per_period : int, optional
-        RK4 steps per shortest mesh period (default 100, as in the papers).
+        RK4 steps per shortest excitation period (the shortest mesh period, or a faster
+        error sinusoid's), a whole number >= 10; default the model's ``[analysis]
+        steps_per_period`` (itself 100 unless set, as in the papers).
     samples_per_period : int, optional
         History samples per shortest mesh period, >= 1 (plots, exports and the bearing
         forces: every mesh metric is computed from statistics streamed at every step).
@@ -337,7 +342,17 @@ def prepare_run(
 
         raise OptionError(f"option(s) {wrong} do not apply to method={method!r}; remove "
                           "them or choose the other method")
-    steps_per_period = steps_per_period or an.steps_per_period
+    if steps_per_period is None:
+        steps_per_period = an.steps_per_period
+    else:  # as the model file takes it (0 fell back to the model's, 2.5 was cut to 2)
+        steps_per_period = _whole(steps_per_period, "steps_per_period",
+                                  "steps_per_period=100")
+        if steps_per_period < MIN_STEPS_PER_PERIOD:
+            from .errors import OptionError
+
+            raise OptionError(f"steps_per_period must be at least {MIN_STEPS_PER_PERIOD} "
+                              f"(as [analysis] steps_per_period), got {steps_per_period}; "
+                              f"give e.g. steps_per_period=100")
     if duration is None:
         if cycles is not None:
             duration = cycles / f_min

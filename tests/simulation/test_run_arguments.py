@@ -22,6 +22,10 @@ BAD = [
     ({"cycles": 0}, r"^cycles must be >= 1"),
     ({"samples_per_period": 0}, r"^samples_per_period must be >= 1, got 0"),
     ({"samples_per_period": 0.5}, r"^samples_per_period must be a whole number"),
+    # 0 fell back to the model's 100 and 2.5 was cut to 2, silently
+    ({"steps_per_period": 0}, r"^steps_per_period must be >= 1, got 0"),
+    ({"steps_per_period": 2.5}, r"^steps_per_period must be a whole number, got 2\.5"),
+    ({"steps_per_period": 3}, r"^steps_per_period must be at least 10 \(as \[analysis\]"),
 ]
 
 
@@ -31,6 +35,36 @@ def test_bad_run_length_is_refused_naming_the_argument(spur_pair, function, kwar
     with pytest.raises(OptionError, match=message) as info:
         function(spur_pair, **kwargs)
     assert "--" not in str(info.value)  # the Python API names its own arguments
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"window": 0}, r"^window must be a whole number of cycles >= 2, got 0"),
+    ({"window": 2.5}, r"^window must be a whole number"),
+    ({"tolerance": 0}, r"^tolerance must be a fraction between 0 and 1, got 0"),
+    ({"tolerance": -1}, r"^tolerance must be a fraction"),
+])
+def test_metrics_settle_arguments_are_checked(spur_pair, kwargs, message):
+    """window=0 was clamped to 2 and tolerance=-1 gave metrics from half the run, both
+    without a word."""
+    res = torquesplit.simulate(spur_pair, cycles=30)
+    with pytest.raises(ValueError, match=message):
+        res.metrics(**kwargs)
+    assert res.metrics(window=20.0, tolerance=0.02).load_sharing.system > 0
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"max_points": 0}, r"^max_points must be a whole number >= 1, got 0"),
+    ({"max_points": -1}, r"^max_points must be"),
+    ({"points_per_cycle": 0}, r"^points_per_cycle must be a whole number >= 1, got 0"),
+    ({"points_per_cycle": 2.5}, r"^points_per_cycle must be"),
+    ({"revolutions": "2"}, r"^revolutions must be a positive number, got '2'"),
+    ({"revolutions": -1}, r"^revolutions must be a positive number"),
+])
+def test_quasi_static_arguments_are_checked(spur_pair, kwargs, message):
+    """max_points=0 divided by zero, -1 gave an empty sweep, points_per_cycle=0 16
+    positions silently, a string revolutions a TypeError."""
+    with pytest.raises(ValueError, match=message):
+        torquesplit.quasi_static_load_sharing(spur_pair, **kwargs)
 
 
 def test_duration_string_and_whole_float_cycles_are_read(spur_pair):

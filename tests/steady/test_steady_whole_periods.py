@@ -290,6 +290,12 @@ def test_a_speed_in_hz_far_from_the_models_is_said():
         warnings.simplefilter("error")
         speed_factor(m, "12.4 Hz")
         speed_factor(m, "7450 rpm")
+    # a bare number in Python is rad/s: 745 meant as rpm runs 9.5 times too fast
+    with pytest.warns(ModelWarning, match=r"speed 745 is read in rad/s = 7,114.2\d rpm, "
+                                          r"9.55 times .* speed='745 rpm'"):
+        speed_factor(m, 745)
+    with pytest.raises(torquesplit.errors.SolverError, match="not a positive finite"):
+        speed_factor(m, -78.0)  # (its absolute value ran, silently)
 
 
 def test_every_file_a_save_writes_is_named(tmp_path):

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import json
 import math
+import numbers
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
@@ -263,8 +264,17 @@ class Results:
 
         Every number comes from the per-cycle statistics streamed by the integrator at
         every step; the settle criterion (``window`` cycles at least, ``tolerance``) gives
-        one settle time per load-sharing group, used by all of its metrics."""
+        one settle time per load-sharing group, used by all of its metrics: ``window`` a
+        whole number >= 2, ``tolerance`` a positive fraction (0.01: 1 %)."""
         definition = self.check_definition(definition)
+        if (isinstance(window, bool) or not isinstance(window, numbers.Real)
+                or not float(window).is_integer() or window < 2):
+            raise ValueError(f"window must be a whole number of cycles >= 2, got "
+                             f"{window!r}; give e.g. window=20")
+        if isinstance(tolerance, bool) or not (isinstance(tolerance, numbers.Real)
+                                               and 0 < tolerance < 1):
+            raise ValueError(f"tolerance must be a fraction between 0 and 1, got "
+                             f"{tolerance!r}; give e.g. tolerance=0.01 (1 %)")
         s = self.solution
         names = self.mesh_names
         c_max, c_min, c_mean, c_cnt, c_ratio = self.complete_cycle_statistics()

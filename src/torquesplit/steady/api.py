@@ -73,39 +73,41 @@ def speed_factor(model, speed) -> float:
         value = parse_quantity(speed, "speed")
     except ValueError as exc:
         raise SolverError(f"speed: {exc}") from None
-    s = abs(value) / reference_speed(model)
-    if not (s > 0 and math.isfinite(s)):
-        raise SolverError(f"speed {speed!r} is not a positive finite speed; give e.g. "
-                          f"speed='3000 rpm' or speed=314.16 (rad/s).")
-    warn_hz_speed(model, speed)
+    s = value / reference_speed(model)
+    if not (s > 0 and math.isfinite(s)):  # (a negative speed was turned round silently)
+        raise SolverError(f"speed {speed!r} is not a positive finite speed (its direction "
+                          f"is the model's); give e.g. speed='3000 rpm' or speed=314.16 "
+                          f"(rad/s).")
+    _warn_far_speed(model, speed, value, s)
     return s
 
 
-def warn_hz_speed(model, speed) -> None:
-    """Warn where a speed written in Hz is over 10 times, or under a tenth of, the
-    model's input speed: Hz is the unit of every frequency the tool prints, and a mesh
-    frequency pasted as a speed ran Ji & Li's drive at 44,700 rpm without a word."""
-    if not (isinstance(speed, str) and "hz" in speed.lower()):
+def _warn_far_speed(model, speed, value: float, s: float) -> None:
+    """Warn where a speed is far from the model's input speed in the way a unit slip
+    makes it: written in Hz and over 10 times (or under a tenth of) it (Hz is the unit of
+    every frequency the tool prints: a mesh frequency pasted as a speed ran Ji & Li's
+    drive at 44,700 rpm without a word), or a bare number (rad/s) over 5 times or under a
+    fifth of it (745 meant as rpm is 9.5 times 745 rpm).  The command line says a bare
+    number's unit itself."""
+    rpm = 30.0 / math.pi
+    at = (f"{s:.3g} times the model's input speed "
+          f"({reference_speed(model) * rpm:.6g} rpm)")
+    if isinstance(speed, str):
+        if "hz" not in speed.lower() or 0.1 <= s <= 10.0:
+            return
+        text = (f"speed {speed!r} is {value / (2 * math.pi):.6g} revolutions per second = "
+                f"{value * rpm:,.6g} rpm, {at}; a speed in Hz counts revolutions per "
+                f"second: give it in rpm if a frequency was meant")
+    elif 0.2 <= s <= 5.0:
         return
-    from torquesplit.model.units import parse_quantity
-
-    try:
-        value = abs(parse_quantity(speed, "speed"))
-    except ValueError:
-        return
-    s = value / reference_speed(model)
-    if 0.1 <= s <= 10.0 or not math.isfinite(s):
-        return
+    else:
+        text = (f"speed {speed!r} is read in rad/s = {value * rpm:,.6g} rpm, {at}; give "
+                f"speed='{speed:g} rpm' if rpm were meant")
     import warnings
 
     from torquesplit.errors import ModelWarning
 
-    rpm = 30.0 / math.pi
-    warnings.warn(
-        f"speed {speed!r} is {value / (2 * math.pi):.6g} revolutions per second = "
-        f"{value * rpm:,.6g} rpm, {s:.3g} times the model's input speed "
-        f"({reference_speed(model) * rpm:.6g} rpm); a speed in Hz counts revolutions per "
-        f"second: give it in rpm if a frequency was meant", ModelWarning, stacklevel=3)
+    warnings.warn(text, ModelWarning, stacklevel=4)
 
 
 class SteadyState:

@@ -26,6 +26,17 @@ def _speed(text, what):
     return quantity(text, "speed", what)
 
 
+def _speed_argument(text):
+    """--speed for :func:`steady_state`: a bare number as rad/s, a quantity as its text
+    (whose unit the library judges: a speed in Hz far from the model's is said)."""
+    if text is None:
+        return None
+    try:
+        return float(text)
+    except ValueError:
+        return text
+
+
 def _speed_text(text) -> str:
     """An option's speed as given, with its unit: a bare number is rad/s."""
     try:
@@ -197,11 +208,9 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
 
             with collect_warnings(), progress("periodic steady state", as_json,
                                               total=None) as update:
-                from torquesplit.steady.api import warn_hz_speed
-
-                warn_hz_speed(m, speed)
+                # (a speed with its unit as text, so that the unit is judged)
                 st = steady_state(m, method=method, harmonics=harmonics, adaptive=adaptive,
-                                  keep=_keep(keep), speed=_speed(speed, "--speed"),
+                                  keep=_keep(keep), speed=_speed_argument(speed),
                                   max_cycles="auto" if max_cycles is None else max_cycles,
                                   stability=stability, steps_per_cycle=steps_per_cycle,
                                   progress=update)
