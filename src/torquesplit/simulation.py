@@ -376,10 +376,20 @@ def prepare_run(
         planned = planned_step(structure, steps_per_period, duration)
         step = whole_steps(duration, planned[0])[1]
     sample_interval = history_interval(duration, f_max, samples_per_period, step)
-    n_records = duration / sample_interval
+    asked = 1.0 / (sample_interval * f_max)
+    # the history keeps at most every RK4 step: a finer rate asked for is the step's
+    # (a warning named the record cap and 4.05e3 per period where 400 were kept)
+    finer = bool(step) and sample_interval < step * (1 - 1e-9)
+    n_records = duration / (max(sample_interval, step) if finer else sample_interval)
     if n_records > MAX_HISTORY_RECORDS:
-        asked = 1.0 / (sample_interval * f_max)
         sample_interval = duration / MAX_HISTORY_RECORDS
+    elif finer and samples_per_period is not None:
+        warnings.warn(
+            f"analysis: samples_per_period={samples_per_period} asks for more samples than "
+            f"the run takes steps: the history keeps every RK4 step, "
+            f"{1.0 / (step * f_max):.4g} per shortest mesh period; a finer history needs "
+            f"a finer step (--steps-per-period; steps_per_period= in Python)", ModelWarning,
+            stacklevel=3)
     # only a sampling the user asked for is worth a warning: the default one is a choice
     # of the library, and what it kept is in the bearing table's title and the files'
     # history_samples_per_period (a default run of Liu et al. 2021 warned)

@@ -104,3 +104,17 @@ def test_the_default_history_of_a_fixed_step_run_keeps_its_budget():
     assert history_interval(1e3 * step, 100.0, None, step) == pytest.approx(step)  # all
     # never coarser than 20 samples per shortest mesh period
     assert history_interval(1e7 * step, 100.0, None, step) == pytest.approx(1 / 2000)
+
+
+def test_a_history_finer_than_the_step_is_said_as_the_step(spur_pair):
+    """samples_per_period=1e6 warned that the record cap kept 4.05e3 per period, where
+    the history kept every step: 400 per period (Ji & Li)."""
+    import warnings
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        res = torquesplit.simulate(spur_pair, cycles=5, samples_per_period=10**6)
+    said = [str(w.message) for w in caught if "history" in str(w.message)]
+    kept = res.history_samples_per_period()
+    assert len(said) == 1 and f"keeps every RK4 step, {kept:.4g} per shortest" in said[0]
+    assert "at most" not in said[0]
