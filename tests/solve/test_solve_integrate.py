@@ -186,6 +186,10 @@ def test_negative_stiffness_diverges_to_blowup():
     assert sol.status == 1
     assert "exceeds blowup" in sol.message
     assert len(sol.history_t) == sol.n_steps  # states before the blow-up are all kept
+    # where the bound is set (simulate has no blowup argument; the message said "raise
+    # blowup"), and the step's name as simulate and the command line take it
+    assert "blowup= of torquesplit.solve.integrate" in sol.message
+    assert "steps_per_period" in sol.message and "--steps-per-period" in sol.message
 
 
 def test_dopri_divergence_keeps_only_valid_records():

@@ -1046,16 +1046,19 @@ def _message(status, s, y, t_final, t_end, counters, clock, blowup, limit_steps,
     if status == kern.DIVERGED:
         i = int(counters[kern.I_BAD])
         name = s.dof_names[i % n] + (" (velocity)" if i >= n else "")
+        bound = ""
         if not math.isfinite(y[i]):
             why = f"the state of DOF '{name}' is not finite ({y[i]})"
         else:
             why = f"|q| of DOF '{name}' = {abs(y[i]):.3g} exceeds blowup = {blowup:.3g}"
-        fix = ("Use a smaller step (see torquesplit.solve.check_step) or method='dopri', "
-               "check stiffness signs and units and that drive and load torques balance, "
-               "or raise blowup if such a displacement is real."
-               if method == "rk4" else
+            # (simulate has no blowup argument: say where the bound is set)
+            bound = (" A displacement this large that is real needs a larger bound "
+                     "(blowup= of torquesplit.solve.integrate).")
+        fix = ("Use a smaller step (steps_per_period; the command line's "
+               "--steps-per-period) or method='dopri', and check stiffness signs and "
+               "units and that the drive and load torques balance." if method == "rk4" else
                "Check stiffness signs and units and that the drive and load torques "
-               "balance, or raise blowup if such a displacement is real.")
+               "balance.") + bound
         return (f"Integration diverged at t = {t_final:.6g} s (step {n_steps}): {why}. "
                 f"Everything recorded before that time is valid. {fix}")
     if status == INTERRUPTED:
