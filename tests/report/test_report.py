@@ -150,6 +150,37 @@ def test_report_of_a_shipped_example_compares_with_the_paper(tmp_path):
     assert ">Quasi-static load sharing</h2>" in page
 
 
+def test_report_says_what_it_leaves_out_and_keeps_the_sweeps_warnings(tmp_path, monkeypatch):
+    """The modes table was cut at 12 without a word (Ji & Li's 13th mode sets the step);
+    a turning carrier's frame, the damping and the whirl were not said; the quasi-static
+    sweep's warnings (its positions thinned) were dropped: 'No warnings'."""
+    import torquesplit.quasistatic as qs
+    from torquesplit.errors import ModelWarning
+
+    sweep = qs.quasi_static_load_sharing
+
+    def thinned(model, progress=None, **kwargs):  # (a short sweep that warns, as a long one)
+        warnings.warn("the quasi-static sweep is cut (a test's note)", ModelWarning)
+        return sweep(model, revolutions=0.05, progress=progress)
+
+    monkeypatch.setattr(qs, "quasi_static_load_sharing", thinned)
+    out = tmp_path / "lp.html"
+    res = runner.invoke(app, ["report", "lin_parker1999_planetary", "--cycles", "30",
+                              "--out", str(out), "--quiet", "--set",
+                              "analysis.load_sharing=static_torque"])
+    assert res.exit_code == 0, res.output
+    assert "warning: the quasi-static sweep is cut (a test's note)" in res.stderr
+    import html
+
+    page = " ".join(html.unescape(re.sub(r"<[^>]+>", " ", out.read_text(encoding="utf-8")))
+                    .split())
+    assert re.search(r"8 higher mode\(s\), 5964 to 1\.307e\+04 Hz, are not listed", page)
+    assert "carrier stage_carrier turning at 233.33 rpm" in page
+    assert "whirl" in page and "ζ (modal estimate)" in page
+    warned = page[page.index(" Warnings "):page.index(" Model ")]
+    assert "the quasi-static sweep is cut (a test's note)" in warned
+
+
 # --------------------------------------------------------------------------- draw
 def _examples():
     with warnings.catch_warnings():

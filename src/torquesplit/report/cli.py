@@ -212,9 +212,19 @@ def _quasi_if_static(model, ux, quiet):
     """The quasi-static sweep of a model whose definition is ``static_torque``."""
     if model.analysis.load_sharing not in ("static", "static_torque"):
         return None
+    from ..errors import ModelWarning
     from ..quasistatic import quasi_static_load_sharing
+    from ..results.plausibility import static_warnings
 
-    with warnings.catch_warnings():
+    with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("ignore")
+        warnings.simplefilter("always", ModelWarning)  # kept for the report, and said
         with ux.progress("quasi-static equilibria", quiet) as cb:
-            return quasi_static_load_sharing(model, progress=cb)
+            quasi = quasi_static_load_sharing(model, progress=cb)
+    said = list(dict.fromkeys(str(w.message) for w in caught
+                              if issubclass(w.category, ModelWarning)))
+    for text in said:
+        ux.warn(text if "quasi-static" in text else f"quasi-static sweep: {text}")
+    if said:
+        quasi.warnings = said + [f"{loc}: {msg}" for loc, msg in static_warnings(quasi)]
+    return quasi

@@ -295,6 +295,7 @@ def _modes(res) -> str:
     top = {n: mesh_orders(structure.stiffness_table[names.index(n)]) if n in names
            else 3 for n in mesh_f}
     typed = any(r.type for r in rep.rows)
+    whirls = any(r.whirl for r in rep.rows)
     # a mesh order that the planets' mesh phasing leaves unexcited for the mode's type
     # (Parker & Lin 2004) is listed as suppressed, not as a possible resonance
     stages = phased_stages(res.model, res.kinematics)
@@ -308,12 +309,30 @@ def _modes(res) -> str:
         energy = ", ".join(f"{n} {100 * v:.0f} %" for n, v in list(r.strain_energy.items())[:3])
         rows.append([str(r.mode), _g(f, 6), str(r.multiplicity)]
                     + ([r.type or ""] if typed else [])
-                    + [energy, ", ".join(sorted(set(near))) or "-"])
+                    + ([r.whirl or ""] if whirls else [])
+                    + [f"{r.damping_ratio:.3g}" if np.isfinite(r.damping_ratio) else "-",
+                       energy, ", ".join(sorted(set(near))) or "-"])
     header = (["mode", "f [Hz]", "mult."] + (["type"] if typed else [])
-              + ["strain energy of the group (largest shares)",
+              + (["whirl"] if whirls else []) + ["ζ (modal estimate)",
+                 "strain energy of the group (largest shares)",
                  f"within {NEAR_FRACTION:.0%} of a mesh order its table excites"])
+    # what the table leaves out, said (the mode that sets the step can be above it)
+    freqs = np.asarray(rep.solution.frequencies, dtype=float)  # (ascending)
+    shown = max((r.mode for r in rep.rows), default=0)
+    more = (f" {freqs.size - shown} higher mode(s), {_g(freqs[shown], 4)} to "
+            f"{_g(freqs[-1], 4)} Hz, are not listed (<code>torquesplit modes MODEL "
+            f"--count {freqs.size}</code> lists them)."
+            if freqs.size > shown else "")
+    carriers = {c: res.kinematics.bodies[c].speed * 30 / np.pi
+                for c in res.kinematics.carriers}
+    turning = ("" if not any(carriers.values()) else
+               " Modes at the model's speed: " + _e(", ".join(
+                   f"carrier {c} turning at {v:.5g} rpm" for c, v in carriers.items()))
+               + (" (in its frame: a degenerate pair of the stationary carrier splits into "
+                  "forward and backward whirl)" if rep.rotating_frame else "") + ".")
     return (_table(header, rows, left=1)
-            + f'<p class="note">{rep.rigid_modes} rigid-body mode(s) left out. Mesh '
+            + f'<p class="note">{rep.rigid_modes} rigid-body mode(s) left out.{more}'
+              f"{turning} Mesh "
               "frequencies: " + _e(", ".join(f"{k} {v:.5g} Hz" for k, v in mesh_f.items()))
             + "." + (" With equally spaced planets, mesh harmonic l excites the rotational "
                      "modes only when l z_s / N is an integer, the translational modes only "
@@ -337,8 +356,10 @@ def _static_section(quasi) -> str:
                     rows)
            + _planets(met, quasi.kinematics))
     try:
+        span = float(quasi.times[-1] - quasi.times[0]) if quasi.times.size else 0.0
         out += _figure(F.figure_svg(F.static_load_sharing_figure(quasi), "static_ls"),
-                       "Quasi-static load sharing over one revolution of the slowest gear.")
+                       f"Quasi-static load sharing over the sweep ({quasi.times.size} "
+                       f"positions over {span:.4g} s of the rated speed).")
     except F.FigureNotApplicableError:
         pass
     return out
@@ -413,7 +434,11 @@ def build_report(res, *, definition: str | None = None, source: Path | None = No
     parts = [f"<h1>{_e(name)}: dynamic load sharing</h1>",
              _provenance(res, source, results_attrs)]
     step(0.05, "warnings")
-    parts += ["<h2>Warnings</h2>", _warnings(res.warnings(met.definition))]
+    # the quasi-static sweep's too (its positions thinned: the report said "No warnings")
+    notes = res.warnings(met.definition) + (
+        [w if "quasi-static" in w else f"quasi-static sweep: {w}"
+         for w in quasi.all_warnings()] if quasi is not None else [])
+    parts += ["<h2>Warnings</h2>", _warnings(notes)]
     step(0.1, "model")
     parts += ["<h2>Model</h2>", _model_tables(res)]
     step(0.2, "layout")
