@@ -82,6 +82,14 @@ def test_report_of_a_results_file_gives_the_same_numbers(made):
             b.dynamic_factors.dynamic_factor, rel=1e-12)
     assert "results file: run_id" in page
     assert f"{res.metrics().load_sharing.system:.5f}" in page
+    # what the run prints: the groups' G_it (Ji & Li eq. 19) and the bearing table
+    met = res.metrics()
+    for g, v in met.dynamic_factors.per_group_peak_to_nominal_engineering.items():
+        assert f"{v:.4f}" in page, g
+    assert ">Bearing forces</h3>" in page
+    (pinion,) = [b for b in res.bearing_forces(met.settling.start_time)
+                 if b["body"] == "pinion"]
+    assert f"{pinion['peak_magnitude'] / 1e3:.5g}" in page
 
 
 def test_report_in_headless_chromium(made, tmp_path):

@@ -215,10 +215,13 @@ def _run_section(res, met) -> str:
                        "peak F [kN]", "dynamic factor", "peak/nominal",
                        f"LSC ({met.definition})", "contact loss", "back flank"], rows, left=2)
     d = met.dynamic_factors
+    eng = d.per_group_peak_to_nominal_engineering
     groups = _table(
-        ["group", "meshes", f"LSC ({met.definition})", "dynamic factor", "peak/nominal"],
+        ["group", "meshes", f"LSC ({met.definition})", "dynamic factor", "peak/nominal",
+         "peak/nominal (eng., G_it)"],
         [[g, ", ".join(ms), f"{met.load_sharing.per_group[g]:.4f}",
-          f"{d.per_group_dynamic_factor[g]:.4f}", f"{d.per_group_peak_to_nominal[g]:.4f}"]
+          f"{d.per_group_dynamic_factor[g]:.4f}", f"{d.per_group_peak_to_nominal[g]:.4f}",
+          f"{eng[g]:.4f}" if g in eng else "-"]
          for g, ms in met.load_sharing.groups.items()], left=2)
     what = (f"<p><b>Load sharing ({_e(met.definition)})</b>: "
             f"{_e(DEFINITION_TEXT[met.definition])}; {_e(DEFINITION_USE[met.definition])}. "
@@ -228,11 +231,37 @@ def _run_section(res, met) -> str:
             "<b>Contact loss</b>: share of the whole run (start-up included) with the drive "
             "flanks apart. <b>Back flank</b>: share of the whole run in back-flank contact, "
             "and the largest settled back-flank force. In the group table, dynamic factor "
-            "and peak/nominal are the largest of the group's meshes. "
+            "and peak/nominal are the largest of the group's meshes; peak/nominal (eng.) "
+            "is the mean over the settled cycles of the largest member's cycle peak over "
+            "the nominal force (Ji &amp; Li eq. 19, G_it). "
             f"System load-sharing coefficient: <b>{met.load_sharing.system:.5f}</b>.</p>")
     return (_table(["setting", "value"], settings, left=2) + what + "<h3>Per mesh</h3>"
             + per_mesh + "<h3>Per load-sharing group</h3>" + groups
-            + _planets(met.load_sharing, res.kinematics))
+            + _planets(met.load_sharing, res.kinematics)
+            + _bearings(res.bearing_forces(met.settling.start_time), res))
+
+
+def _bearings(bearings: list[dict], res) -> str:
+    """The bearing table the run prints (kN; a force a million times below the largest
+    is rounding, written 0), or nothing for a model without supports."""
+    if not bearings:
+        return ""
+    big = max(b["peak_magnitude"] for b in bearings) or 1.0
+
+    def kn(v):
+        return "0" if abs(v) < 1e-6 * big else _g(v / 1e3)
+
+    per = ("every step" if res.history_keeps_every_step() else
+           f"{res.history_samples_per_period():.3g} samples per shortest mesh period")
+    rows = [[b["body"] + (f" (spline {b['via']})" if b.get("via") else ""),
+             ", ".join(f"{d} {kn(v)}" for d, v in zip(b["directions"], b["mean"])),
+             kn(b["mean_magnitude"]), kn(b["peak_magnitude"])] for b in bearings]
+    return ("<h3>Bearing forces</h3>"
+            + _table(["body", "mean force by direction [kN]", "|mean| [kN]", "peak |F| [kN]"],
+                     rows, left=2)
+            + f'<p class="note">The force each body puts on its bearing over the settled '
+              f"part, from the history ({per}): a peak between its samples is missed, "
+              f"the means are not.</p>")
 
 
 def _planets(load_sharing, kinematics) -> str:
