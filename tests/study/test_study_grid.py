@@ -200,6 +200,10 @@ def test_grid_axes_and_figures_of_log_and_3_parameter_grids(split_file):
                          ("stage", "same")])
     labels = [ln.get_label() for ln in fig.axes[0].get_lines()]
     assert labels == ["system = stage", "a1"], labels
+    # the model in the title and the quantity in words (a title named only the study,
+    # the axis the output's key, "load_sharing.cycle_peak [-]")
+    assert fig.get_suptitle().startswith(f"{one.attrs['model_name']}, study test grid: ")
+    assert fig.axes[0].get_ylabel() == "load-sharing coefficient (cycle_peak) [-]"
 
 
 def test_refused_cases_show_the_values_in_the_unit_written(split_file):

@@ -117,6 +117,7 @@ def build_dataset(plan, rows, n: int, meta: dict):
     attrs = {
         "title": f"torquesplit study: {plan.spec.study.name}",
         "study_name": plan.spec.study.name,
+        "model_name": plan.model.model.name,
         "description": plan.spec.study.description,
         "reference": plan.spec.study.reference,
         "design": d.kind,

@@ -113,11 +113,11 @@ def curves_figure(ds, family: str, members: list[tuple[str, str]]) -> Figure:
     _mark_failed(ax, x, ds["status"].values)
     _log_axis(ds, pname, ax.set_xscale)
     ax.set_xlabel(f"{_param_label(ds, pname)} [{xunit}]")
-    ax.set_ylabel(f"{family} [{unit}]")
+    ax.set_ylabel(f"{_family_text(family)} [{unit}]")
     ax.grid(True, alpha=0.3)
     ax.yaxis.get_major_formatter().set_useOffset(False)
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False, fontsize=8)
-    fig.suptitle(f"{ds.attrs['study_name']}: {_family_text(family)}", fontsize=11)
+    fig.suptitle(f"{_title(ds)}: {_family_text(family)}", fontsize=11)
     return fig
 
 
@@ -178,7 +178,7 @@ def maps_figure(ds, family: str, members: list[tuple[str, str]]) -> Figure:
         ax.set_xlabel(f"{_param_label(ds, dims[0])} [{xunit}]", fontsize=8)
         ax.set_ylabel(f"{_param_label(ds, dims[1])} [{yunit}]", fontsize=8)
         ax.tick_params(labelsize=7)
-    fig.suptitle(f"{ds.attrs['study_name']}: {_family_text(family)}", fontsize=11)
+    fig.suptitle(f"{_title(ds)}: {_family_text(family)}", fontsize=11)
     return fig
 
 
@@ -235,7 +235,7 @@ def monte_carlo_figure(ds, var: str, confidence: float = 0.95) -> Figure:
     failed = int((ds["status"].values != "ok").sum())
     note = f" ({failed} of {y.size} cases not ok)" if failed else ""
     what = f"statistics over {n} of {y.size} cases" if n < y.size else f"{n} samples"
-    fig.suptitle(f"{ds.attrs['study_name']}: {what}{note}", fontsize=11)
+    fig.suptitle(f"{_title(ds)}: {what}{note}", fontsize=11)
     return fig
 
 
@@ -297,7 +297,7 @@ def tornado_figure(ds, var: str) -> Figure:
                   if key == "mu_star" else "Sobol index [-]")
     ax.grid(True, axis="x", alpha=0.3)
     ax.legend(fontsize=8, loc="lower right")
-    fig.suptitle(f"{ds.attrs['study_name']}: {ds[var].attrs.get('output', var)}", fontsize=11)
+    fig.suptitle(f"{_title(ds)}: {ds[var].attrs.get('output', var)}", fontsize=11)
     return fig
 
 
@@ -409,6 +409,14 @@ def _mark_failed(ax, x, status) -> None:
     if bad.any():
         ax.plot(np.asarray(x)[bad], np.zeros(bad.sum()), "rx", ms=7, clip_on=False,
                 transform=ax.get_xaxis_transform(), label="case not ok")
+
+
+def _title(ds) -> str:
+    """The model and the study a figure is of ("ji_li_mill_drive, study
+    ji_li_diameter"): a title named only the study ("sweep_shafts.drive1.diameter")."""
+    model = ds.attrs.get("model_name")
+    study = ds.attrs["study_name"]
+    return f"{model}, study {study}" if model else study
 
 
 def _family_text(family: str) -> str:
