@@ -368,7 +368,8 @@ def prepare_run(
     names = structure.element_names
     track = [names.index(m) for m in mesh_names]
     hist_el = history_elements(structure, mesh_names)
-    hist_dofs = list(history_dofs or [])
+    # one DOF name, not its letters ("unknown dof 'z'" for "z1.theta")
+    hist_dofs = [history_dofs] if isinstance(history_dofs, str) else list(history_dofs or [])
     planned = step = None
     if method == "rk4":  # (the fixed step: the history's default and the cost use it)
         from .solve.integrate import planned_step, whole_steps

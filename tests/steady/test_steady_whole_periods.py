@@ -341,3 +341,25 @@ def test_a_long_shooting_solve_is_announced_before_it_starts(monkeypatch):
                                           r"\(the highest mode, 9476.6\d Hz"):
         with pytest.raises(Stop):
             steady_state(model, speed="1 rpm", stability=False)
+
+
+def test_steady_and_campbell_options_are_checked_and_the_summary_names_its_definition():
+    """steps_per_cycle=0 ran, tol=-1 ran to 'NOT converged', stability='foo' was taken,
+    campbell(points=0) failed inside xarray; summary()'s load_sharing did not say which
+    coefficient it is (sweep_speed's is another)."""
+    import torquesplit
+    from torquesplit.errors import SolverError
+    from torquesplit.steady.maps import campbell
+
+    model = torquesplit.load_model("ji_li_mill_drive")
+    for kwargs, said in (({"steps_per_cycle": 0}, "steps_per_cycle must be a whole number"),
+                         ({"tol": -1}, "tol must be a small positive number"),
+                         ({"stability": "foo"}, "stability must be True, False, 'hill'")):
+        with pytest.raises(SolverError, match=said):
+            steady_state(model, keep="stage1", **kwargs)
+    with pytest.raises(ValueError, match="points must be a whole number >= 2, got 0"):
+        campbell(model, 60, 80, points=0)
+    summary = steady_state(model, keep="stage1", stability=False).summary()
+    assert summary["load_sharing_definition"] == "engineering"  # the model's
+    res = torquesplit.simulate(model, cycles=5, history_dofs="z1.theta")
+    assert res.solution.history_q.shape[1] == 1  # one DOF, not its letters

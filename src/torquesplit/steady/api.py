@@ -110,6 +110,27 @@ def _warn_far_speed(model, speed, value: float, s: float) -> None:
     warnings.warn(text, ModelWarning, stacklevel=4)
 
 
+def _check_options(*, steps_per_cycle, tol, stability, energy_tol) -> None:
+    """The solver options of :func:`steady_state`, refused by name before any work:
+    steps_per_cycle=0 and -3 ran, tol=-1 ran 3.6 s to 'NOT converged', stability='foo'
+    was taken (a reviewer)."""
+    import numbers
+
+    if steps_per_cycle is not None and (
+            isinstance(steps_per_cycle, bool) or not isinstance(steps_per_cycle, numbers.Real)
+            or not float(steps_per_cycle).is_integer() or steps_per_cycle < 10):
+        raise SolverError(f"steps_per_cycle must be a whole number >= 10, got "
+                          f"{steps_per_cycle!r}; give e.g. steps_per_cycle=100")
+    for name, value in (("tol", tol), ("energy_tol", energy_tol)):
+        if value is not None and (isinstance(value, bool) or not isinstance(
+                value, numbers.Real) or not 0 < value < 1):
+            raise SolverError(f"{name} must be a small positive number, got {value!r}; "
+                              f"leave it out for the default")
+    if not (isinstance(stability, bool) or stability in ("hill", "monodromy")):
+        raise SolverError(f"stability must be True, False, 'hill' or 'monodromy', got "
+                          f"{stability!r}")
+
+
 class SteadyState:
     """A periodic steady state of a model and everything needed to interpret it."""
 
@@ -212,7 +233,8 @@ class SteadyState:
         given: the :meth:`to_results` already at hand)."""
         ps = self.solution
         mu = ps.multipliers
-        rows = self.mesh_table(results=results) if rows is None else rows
+        res = self.to_results() if results is None else results
+        rows = self.mesh_table(results=res) if rows is None else rows
         return {
             "model": self.model.model.name, "method": ps.method, "converged": ps.converged,
             "message": ps.message, "period_s": ps.period, "fundamental_Hz": ps.frequency,
@@ -223,6 +245,8 @@ class SteadyState:
             "stable": ps.stable, "stability_method": ps.stability_method,
             "largest_multiplier": float(abs(mu[0])) if mu is not None and mu.size else None,
             "dropped_excitations": self.dropped_text(),
+            # which coefficient 'load_sharing' is (sweep_speed's is mean_force's)
+            "load_sharing_definition": res.metrics().definition,
             "meshes": {r.mesh: {k: v for k, v in r.__dict__.items() if k != "mesh"}
                        for r in rows},
         }
@@ -341,6 +365,8 @@ def steady_state(model, *, method: str = "auto", harmonics: int | None = None,
     from torquesplit.model.kinematics import solve_kinematics
     from torquesplit.solve.static import static_equilibrium
 
+    _check_options(steps_per_cycle=steps_per_cycle, tol=tol, stability=stability,
+                   energy_tol=energy_tol)
     if not hasattr(model, "meshes"):
         model = load_model(model)
     kin = solve_kinematics(model)

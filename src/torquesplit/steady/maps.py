@@ -501,6 +501,9 @@ def campbell(model, start: float, stop: float, *, points: int = 41,
 
     from torquesplit.solve.modal import modal_analysis
 
+    if not (isinstance(points, (int, np.integer)) and not isinstance(points, bool)
+            and points >= 2):  # (0 failed inside xarray)
+        raise ValueError(f"points must be a whole number >= 2, got {points!r}")
     model, kin, s, _, _, static = _prepare(model, None, None)
     w_ref = reference_speed(model)
     lo, hi = _rad_per_s(start, "start"), _rad_per_s(stop, "stop")
