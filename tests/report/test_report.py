@@ -87,6 +87,8 @@ def test_report_of_a_results_file_gives_the_same_numbers(made):
     for g, v in met.dynamic_factors.per_group_peak_to_nominal_engineering.items():
         assert f"{v:.4f}" in page, g
     assert ">Bearing forces</h3>" in page
+    # the model as it runs: the stiffness wave's size and the damping of each mesh
+    assert "stiffness peak-to-peak" in page and "damping ratio" in page
     (pinion,) = [b for b in res.bearing_forces(met.settling.start_time)
                  if b["body"] == "pinion"]
     assert f"{pinion['peak_magnitude'] / 1e3:.5g}" in page
@@ -156,6 +158,20 @@ def test_report_of_a_shipped_example_compares_with_the_paper(tmp_path):
     page = out.read_text(encoding="utf-8")
     assert ">Comparison with the paper</h2>" in page and "1.0619" in page
     assert ">Quasi-static load sharing</h2>" in page
+
+
+def test_report_gives_the_model_as_it_runs(tmp_path):
+    """Ji & Li's meshes read 'constant' (their stiffness is a 10 % rectangular wave), the
+    supports 'shaft bending' without the stiffness computed from it, and a footnote on
+    computed masses stood where no mass was computed."""
+    out = tmp_path / "jl.html"
+    res = runner.invoke(app, ["report", "ji_li_mill_drive", "--cycles", "20", "--out",
+                              str(out), "--quiet"])
+    assert res.exit_code == 0, res.output
+    page = " ".join(re.sub(r"<[^>]+>", " ", out.read_text(encoding="utf-8")).split())
+    assert "4500 10 % 0.1" in page  # m11: mean stiffness, its wave, its damping ratio
+    assert re.search(r"z1 gear loa 2993 \(shaft bending\)", page)
+    assert "computed from the gear" not in page
 
 
 def test_report_says_what_it_leaves_out_and_keeps_the_sweeps_warnings(tmp_path, monkeypatch):

@@ -135,34 +135,48 @@ def _model_tables(res) -> str:
                      _g(b["polar_inertia_kgm2"]) + (" *" if b["inertia_computed"] else ""),
                      "(" + ", ".join(f"{round(v, 3) + 0.0:.5g}" for v in b["position_mm"])
                      + ")"])
+    starred = any("*" in str(c) for row in rows for c in row)
     out.append("<h3>Bodies</h3>" + _table(
         ["body", "kind", "speed [rpm]", "torque [N m]", "mass [kg]", "J [kg m²]",
          "position [mm]"], rows, left=2)
-        + '<p class="note">* computed from the gear\'s geometry (solid steel disc of the '
-          "pitch diameter).</p>")
+        + ('<p class="note">* computed from the gear\'s geometry (solid steel disc of the '
+           "pitch diameter).</p>" if starred else ""))
     st = res.structure
     rows = []
     for name, mk in s["meshes"].items():
         mesh = m.meshes[name]
         e = st.element_names.index(name)
-        k = float(np.mean(st.stiffness_table[e])) if st.stiffness_table.shape[1] else math.nan
+        table = st.stiffness_table[e] if st.stiffness_table.shape[1] else np.full(1, math.nan)
+        k = float(np.mean(table))
+        # what the run uses: the time-varying wave's size (a "constant" method with a
+        # peak_to_peak is a rectangular wave), and the damping assumed
+        ptp = float(np.ptp(table)) / k if k > 0 else math.nan
+        zeta = (_g(mesh.damping_ratio, 3) if mesh.damping_ratio is not None else
+                f"{_g(mesh.damping, 4)} N s/m" if mesh.damping is not None else "-")
         rows.append([name, f"{mk['driver']} → {mk['driven']}", mk["stage"],
                      _g(mk["frequency_Hz"], 6),
                      "/".join(f"{r:.2f}" for r in mk["pitch_radii_mm"]),
                      _g(mk["total_contact_ratio"], 4), mesh.stiffness.method,
-                     _g(k / 1e6), _g(mesh.backlash.nominal * 1e6, 4),
-                     _g(mk["tooth_force_N"] / 1e3, 5)])
+                     _g(k / 1e6), f"{100 * ptp:.3g} %" if ptp > 1e-12 else "0", zeta,
+                     _g(mesh.backlash.nominal * 1e6, 4), _g(mk["tooth_force_N"] / 1e3, 5)])
     out.append("<h3>Meshes</h3>" + _table(
         ["mesh", "driver → driven", "stage", "f_mesh [Hz]", "pitch radii [mm]",
-         "contact ratio", "stiffness method", "mean stiffness [N/µm]", "backlash [µm]",
-         "nominal F_n [kN]"], rows, left=3))
+         "contact ratio", "stiffness method", "mean stiffness [N/µm]",
+         "stiffness peak-to-peak", "damping ratio", "backlash [µm]", "nominal F_n [kN]"],
+        rows, left=3))
     rows = []
     for kind, items in (("gear", m.gears), ("body", m.bodies)):
         for name, body in items.items():
             sup = body.support
             if sup is None:
                 continue
+            # a shaft's bending stiffness with the value the model computed from it
+            assembled = [float(np.mean(st.stiffness_table[i]))
+                         for i, n in enumerate(st.element_names)
+                         if n.startswith(f"{name}.support.")]
             k = (f"{sup.stiffness / 1e6:.4g}" if sup.stiffness else
+                 f"{assembled[0] / 1e6:.4g} (shaft bending)"
+                 if sup.shaft is not None and assembled else
                  "shaft bending" if sup.shaft is not None else "-")
             rows.append([name, kind, ", ".join(d for d in body.dofs if d != "theta") or "-",
                          k, _g(sup.damping_ratio, 3) if sup.damping_ratio is not None else "-",
