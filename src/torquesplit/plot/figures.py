@@ -449,7 +449,9 @@ def support_spectrum_figure(results, *, start_time: float | None = None, orders:
             size = max(size, float(np.nanmax(np.abs(x))))
         spectra[body] = lines
         strength[body] = max(float(a.max()) for _, _, a in lines)
-        if strength[body] <= 1e-9 * max(size, 1.0):
+        # (judged above the window's leakage of the lowest bins, as the legend's line)
+        if max(float(a[3:].max(initial=0.0)) for _, _, a in lines) <= QUIET_SHARE * max(
+                size, 1.0):
             strength[body] = 0.0  # rounding noise only
     f_cap = min(freq[-1], (orders + 0.5) * max(mesh_f))
     if max_frequency:
@@ -535,9 +537,21 @@ def support_spectrum_figure(results, *, start_time: float | None = None, orders:
     more = ((f"\nnot drawn (smaller forces): {', '.join(smaller)}" if smaller else "")
             + (f"\nnot drawn ({len(shown)} panels at most; bodies= chooses): "
                f"{', '.join(others)}" if others else ""))
+    # a decimated history folds what is above its Nyquist frequency back into the band
+    # (a 708 Hz harmonic drawn at 472 Hz from 5 samples per period)
+    alias = ("" if results.history_keeps_every_step() else
+             f"\nfrom a history of {results.history_samples_per_period():.3g} samples per "
+             f"shortest mesh period: content above {_hz(0.5 / dt)} folds back "
+             f"(--samples-per-period)")
     _suptitle(fig, results, f"support force spectrum\n{grid[0]:.4g} s ≤ t < "
-                            f"{grid[0] + span:.4g} s, resolution {1 / span:.3g} Hz{more}")
+                            f"{grid[0] + span:.4g} s, resolution {1 / span:.3g} Hz"
+                            f"{alias}{more}")
     return fig
+
+
+QUIET_SHARE = 1e-6
+"""A support force whose largest spectral line is below this share of the force has no
+dynamic content (a planetary's 1 mN against 1 kN was drawn on a log axis as a spectrum)."""
 
 
 def _strongest(strength: dict[str, float], max_panels: int,
