@@ -22,6 +22,13 @@ def test_everything_listed_is_there_and_listed():
         assert getattr(torquesplit, name) is not None, name
         assert name in dir(torquesplit), name  # (tab completion of the lazy ones too)
     assert issubclass(torquesplit.OptionError, torquesplit.TorquesplitError)
+    # the classes the functions return or raise are named at the top (a reviewer had to
+    # find torquesplit.results.Results, torquesplit.study.StudyError...)
+    res = torquesplit.simulate("ji_li_mill_drive", cycles=5)
+    assert isinstance(res, torquesplit.Results)
+    assert isinstance(torquesplit.load_model("ji_li_mill_drive"), torquesplit.Model)
+    for name in ("StudyError", "OutputError"):
+        assert issubclass(getattr(torquesplit, name), torquesplit.TorquesplitError)
 
 
 def test_the_pipeline_functions_take_what_load_model_reads(model):

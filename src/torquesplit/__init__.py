@@ -17,8 +17,8 @@ The pipeline, one stage per subpackage (each stage returns a new object)::
 from __future__ import annotations
 
 from .assembly.assemble import assemble
-from .errors import (ModelError, ModelWarning, OptionError, SolverError, StepTooLargeError,
-                     TorquesplitError)
+from .errors import (ModelError, ModelWarning, OptionError, OutputError, SolverError,
+                     StepTooLargeError, StudyError, TorquesplitError)
 from .examples import example_names, example_path
 from .model.io import load_model
 from .model.kinematics import solve_kinematics
@@ -29,15 +29,19 @@ from .simulation import simulate
 __version__ = "0.1.0"
 
 __all__ = [
-    "ModelError", "ModelWarning", "OptionError", "SolverError", "StepTooLargeError",
-    "TorquesplitError", "example_names", "example_path", "load_model", "solve_kinematics",
-    "assemble", "simulate", "quasi_static_load_sharing", "model_modes", "steady_state",
-    "sweep_speed", "campbell", "load_results", "Study", "run_study",
+    "ModelError", "ModelWarning", "OptionError", "OutputError", "SolverError",
+    "StepTooLargeError", "StudyError", "TorquesplitError", "example_names", "example_path",
+    "load_model", "solve_kinematics", "assemble", "simulate", "quasi_static_load_sharing",
+    "model_modes", "steady_state", "sweep_speed", "campbell", "load_results",
+    "open_results", "Results", "Model", "SteadyState", "Study", "run_study",
 ]
 
-#: loaded only when asked for (the study and steady-state layers, xarray, scipy.stats)
+#: loaded only when asked for (the study and steady-state layers, xarray, scipy.stats);
+#: the classes functions return, so that a user can name them (isinstance, annotations)
 _LAZY = {"Study": "study", "run_study": "study", "steady_state": "steady",
-         "sweep_speed": "steady", "campbell": "steady", "load_results": "results"}
+         "sweep_speed": "steady", "campbell": "steady", "load_results": "results",
+         "open_results": "results", "Results": "results", "SteadyState": "steady",
+         "Model": "model.schema"}
 
 
 def __getattr__(name):
