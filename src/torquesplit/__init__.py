@@ -8,7 +8,7 @@ The pipeline, one stage per subpackage (each stage returns a new object)::
     simulate(model, ...)        -> Results     (solve/ + metrics/ + results/)
     quasi_static_load_sharing(model) -> QuasiStaticResults (equilibria over mesh positions)
     model_modes(model)          -> ModalReport (natural modes about the static equilibrium)
-    steady_state(model, speed)  -> SteadyState (steady/: periodic state; sweep_speed,
+    steady_state(model, speed=...) -> SteadyState (steady/: periodic state; sweep_speed,
                                                 campbell over a speed range)
     load_results(file.nc)       -> Results     (a saved run, its metrics recomputed)
     run_study(study_file)       -> Dataset     (study/: grids, Monte Carlo, sensitivity)
