@@ -233,6 +233,11 @@ def test_a_harmonic_balance_cut_short_is_said():
     assert said and "--method shooting" in said[0]
     full = steady_state(model, keep="stage1", method="hb", stability=False).to_results()
     assert not any("harmonic balance with" in w for w in full.warnings())
+    # a looser limit asked for is not contradicted (a reviewer's energy_tol=1e-4 was told
+    # to let the harmonics double)
+    loose = steady_state(model, keep="stage1", method="hb", harmonics=16, adaptive=False,
+                         energy_tol=0.5, stability=False).to_results()
+    assert not any("harmonic balance with" in w for w in loose.warnings())
 
 
 def test_sweep_speed_says_which_load_sharing_it_gives():
@@ -296,6 +301,16 @@ def test_a_speed_in_hz_far_from_the_models_is_said():
         speed_factor(m, 745)
     with pytest.raises(torquesplit.errors.SolverError, match="not a positive finite"):
         speed_factor(m, -78.0)  # (its absolute value ran, silently)
+    # the command line says a bare number's unit once (the library repeated it)
+    from typer.testing import CliRunner
+
+    from torquesplit.cli import app
+
+    r = CliRunner().invoke(app, ["steady", "ji_li_mill_drive", "--speed", "7.8",
+                                 "--keep", "stage1", "--no-stability"])
+    assert r.exit_code == 0, r.output
+    said = [ln for ln in r.stderr.splitlines() if ln.startswith("warning:")]
+    assert len([ln for ln in said if "rad/s" in ln]) == 1, said
 
 
 def test_every_file_a_save_writes_is_named(tmp_path):

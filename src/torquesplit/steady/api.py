@@ -409,7 +409,8 @@ def steady_state(model, *, method: str = "auto", harmonics: int | None = None,
                             check=check, problem=problem, progress=progress)
     return SteadyState(model=model, kinematics=kin, structure=structure, static=static,
                        period=per, solution=sol, dropped=dropped, problem=problem,
-                       options=dict(keep=keep_asked, speed=speed, max_cycles=max_cycles))
+                       options=dict(keep=keep_asked, speed=speed, max_cycles=max_cycles,
+                                    energy_tol=energy_tol))
 
 
 def _at_base(per, base):

@@ -27,12 +27,13 @@ def _speed(text, what):
 
 
 def _speed_argument(text):
-    """--speed for :func:`steady_state`: a bare number as rad/s, a quantity as its text
-    (whose unit the library judges: a speed in Hz far from the model's is said)."""
+    """--speed for :func:`steady_state`: its text, whose unit the library judges (a speed
+    in Hz far from the model's is said); a bare number with its unit written out, rad/s
+    (the option has said so already: the library's bare-number warning would repeat it)."""
     if text is None:
         return None
     try:
-        return float(text)
+        return f"{float(text)!r} rad/s"
     except ValueError:
         return text
 
@@ -446,7 +447,8 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
                  f"12, 'load_sharing' in the files) and the largest instantaneous ratio (Ji "
                  f"& Li eq. 18); the model's definition {chosen!r} is not computed by the "
                  f"sweep: 'torquesplit steady --speed S' gives it at a speed"
-                 if chosen not in (None, "mean_force", "instantaneous") else None)
+                 if chosen not in (None, "mean_force", "instantaneous", "static",
+                                   "static_torque") else None)
         if cross_check:
             for key in ("run_up", "run_down"):
                 summary[f"{key}_max_dynamic_factor"] = {k: v[key][0]
