@@ -127,12 +127,16 @@ def test_bearing_forces_are_study_outputs_as_the_run_table_gives_them():
                       "outputs": ["bearing_peak_force.z2", "bearing_mean_force.*"]},
             "analysis": {"cycles": 20},
             "grid": {"parameters": [{"path": "meshes.m11.damping_ratio",
-                                     "values": [0.05, 0.1]}]}}
+                                     "values": [0.1, 0.2]}]}}  # (0.1: the model's)
     ds = run_study(spec, workers=1)
     assert list(ds["status"].values) == ["ok", "ok"]
     assert ds["bearing_peak_force.z2"].attrs["units"] == "N"
-    assert ds["bearing_mean_force.z4"].values[0] == pytest.approx(
-        [b["mean_magnitude"] for b in table if b["body"] == "z4"][0], rel=1e-3)
+    # the first case is the run above: the same history, the same table (the cases kept a
+    # sparser history than the run's: their peaks came out lower)
+    for b in table:
+        assert ds[f"bearing_mean_force.{b['body']}"].values[0] == b["mean_magnitude"]
+    z2 = [b for b in table if b["body"] == "z2"][0]
+    assert ds["bearing_peak_force.z2"].values[0] == z2["peak_magnitude"]
     assert np.all(ds["bearing_peak_force.z2"].values >= ds["bearing_mean_force.z2"].values)
     bad = {**spec, "study": {**spec["study"], "outputs": ["bearing_peak_force.z9"]}}
     from torquesplit.study import StudyError

@@ -112,9 +112,13 @@ def _dynamic(model, p, out) -> list[float]:
     a = p["analysis"]
     names, defs = p["outputs"], p["definitions"]
     kw = {k: a[k] for k in ("method", "steps_per_period", "rtol") if a.get(k) is not None}
-    # no output of a study comes from the history: the sparse one of earlier versions
-    # (the default keeps every step of a short run, 30 % of a small model's step time)
-    kw["samples_per_period"] = MIN_SAMPLES_PER_PERIOD
+    # only the bearing forces come from the history: without them the sparse one of
+    # earlier versions (the default keeps every step of a short run, 30 % of a small
+    # model's step time); with them the run's default, so that they are the run's table's
+    from .outputs import HISTORY_FAMILIES
+
+    if not any(n.split(".")[0] in HISTORY_FAMILIES for n in names):
+        kw["samples_per_period"] = MIN_SAMPLES_PER_PERIOD
     settle = a.get("settle")
     if settle is None:
         res = simulate(model, duration=a.get("duration"), cycles=a.get("cycles"), **kw)
