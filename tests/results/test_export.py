@@ -238,3 +238,21 @@ def test_a_replaced_csv_set_leaves_no_stale_companion_and_files_carry_their_mode
     with xr.open_dataset(nc, engine="h5netcdf") as ds:
         assert "gears.z1.mass" in ds.attrs["warnings"]
         assert json.loads(ds.attrs["model_json"])["model"]["name"] == "ji_li_mill_drive"
+
+
+def test_load_results_of_another_kind_of_file_says_what_reads_it(tmp_path):
+    """A .mat gave h5py's 'file signature not found'; a quasi-static .nc a message that
+    did not point to open_results."""
+    import torquesplit
+
+    res = torquesplit.simulate(torquesplit.example_path(EXAMPLE), cycles=10)
+    mat = res.to_mat(tmp_path / "r.mat")
+    with pytest.raises(ValueError, match=r"not a NetCDF results file .*scipy\.io\.loadmat"):
+        torquesplit.load_results(mat)
+    static = torquesplit.quasi_static_load_sharing(res.model, revolutions=0.02).save(
+        tmp_path / "q.nc")
+    with pytest.raises(ValueError, match="open this one as a Dataset with "
+                                         "torquesplit.open_results"):
+        torquesplit.load_results(static)
+    with torquesplit.open_results(static) as ds:
+        assert len(ds.data_vars) > 0

@@ -736,10 +736,27 @@ def back_flank_force(cycle_min: np.ndarray) -> float:
 
 
 def open_results(path):
-    """Open a results file written by :meth:`Results.to_netcdf` as an xarray Dataset."""
+    """Open a results file written by :meth:`Results.to_netcdf` (or any ``.nc`` file
+    torquesplit writes: quasi-static, modes, sweeps, studies) as an xarray Dataset.
+
+    Raises
+    ------
+    ValueError
+        The file is not a NetCDF file (a ``.mat`` or ``.csv`` of torquesplit is read with
+        ``scipy.io.loadmat`` or a spreadsheet): said so, not h5py's "file signature not
+        found".
+    """
     import xarray as xr
 
-    return xr.open_dataset(path, engine="h5netcdf")
+    try:
+        return xr.open_dataset(path, engine="h5netcdf")
+    except OSError as exc:
+        if not Path(path).is_file():
+            raise
+        raise ValueError(
+            f"{path}: not a NetCDF results file ({exc}); open_results and load_results "
+            f"read the .nc files torquesplit writes (a .mat opens with scipy.io.loadmat, a "
+            f".csv set with a spreadsheet or pandas)") from None
 
 
 def load_results(path):

@@ -326,7 +326,9 @@ def results_from_dataset(ds: xr.Dataset):
     if "model_json" not in ds.attrs or "cycle_max_force" not in ds:
         raise ValueError("not a torquesplit results file of a dynamic run (no embedded model "
                          "or cycle statistics); give a file written by 'torquesplit run "
-                         "--out F.nc'")
+                         "--out F.nc', or open this one as a Dataset with "
+                         "torquesplit.open_results (a quasi-static sweep's, modes', a "
+                         "sweep's or a study's file)")
     model = load_model(json.loads(ds.attrs["model_json"]))
     kin = solve_kinematics(model)
     structure = assemble(model, kin)
