@@ -140,6 +140,20 @@ class QuasiStaticResults:
         return save_dataset(self.to_dataset(), path, overwrite=overwrite)
 
 
+def slowest_gear(kin) -> tuple[str, float, str | None]:
+    """``(gear, |speed| [rad/s], carrier or None)``: the slowest turning of a gear in its
+    mesh's frame (a planet mesh: its carrier's; a held ring stands still in the housing
+    but turns in the carrier's frame), whose revolutions a sweep counts."""
+    best: tuple[str, float, str | None] | None = None
+    for mk in kin.meshes.values():
+        for gear, w in ((mk.driver, mk.driver_speed), (mk.driven, mk.driven_speed)):
+            if w and math.isfinite(w) and (best is None or abs(w) < best[1]):
+                best = (gear, abs(w), mk.carrier)
+    if best is None:
+        raise ValueError("no gear turns: a quasi-static sweep needs a turning mesh")
+    return best
+
+
 MAX_REVOLUTIONS = 100.0
 """Longest default sweep in revolutions of the slowest gear: the common period of a
 hunting-tooth train can be thousands (the sweep then says what it covers)."""
@@ -182,11 +196,7 @@ def quasi_static_load_sharing(model, *, revolutions: float | None = None,
         model = load_model(model)
     kin = solve_kinematics(model)
     structure = assemble(model, kin)
-    # the slowest turning of a gear in its mesh's frame (a planet mesh: its carrier's;
-    # a held ring stands still in the housing but turns in the carrier's frame)
-    speeds = [abs(v) for mk in kin.meshes.values() for v in (mk.driver_speed, mk.driven_speed)
-              if v != 0]
-    turn = 2 * math.pi / min(speeds)  # one revolution of the slowest gear [s]
+    turn = 2 * math.pi / slowest_gear(kin)[1]  # one revolution of the slowest gear [s]
     if revolutions is None:
         period = _excitation_period(structure, turn)
     else:

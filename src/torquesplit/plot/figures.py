@@ -1107,19 +1107,14 @@ def _static_forces(results) -> np.ndarray:
 def _positions(results) -> tuple[np.ndarray, str]:
     """Sweep positions as the rotation of the slowest gear [deg] (one revolution per
     360 deg, as :func:`torquesplit.quasistatic.quasi_static_load_sharing` sweeps)."""
-    kin = results.kinematics
-    # the sweep's own rule: the slowest turning of a gear in its mesh's frame (a planet
-    # mesh: its carrier's, where a held ring turns; the housing's 'rotation' of a held
-    # ring put every position at 0 deg, a planet's absolute one 674 deg a revolution)
-    speed: dict[str, tuple[float, str | None]] = {}
-    for mk in kin.meshes.values():
-        for gear, w in ((mk.driver, mk.driver_speed), (mk.driven, mk.driven_speed)):
-            if w and math.isfinite(w) and abs(w) < speed.get(gear, (math.inf, None))[0]:
-                speed[gear] = (abs(w), mk.carrier)
-    if not speed:
+    from ..quasistatic import slowest_gear
+
+    # the sweep's own gear and frame (the housing's 'rotation' of a held ring put every
+    # position at 0 deg, a planet's absolute one 674 deg a revolution)
+    try:
+        gear, w, carrier = slowest_gear(results.kinematics)
+    except ValueError:
         return np.asarray(results.times), "time [s]"
-    gear = min(speed, key=lambda g: speed[g][0])
-    w, carrier = speed[gear]
     frame = f" relative to {carrier}" if carrier else ""
     return np.degrees(results.times * w), f"rotation of {gear}{frame} [deg]"
 

@@ -321,8 +321,7 @@ class Results:
         """The load-sharing definition :meth:`metrics` reports when none is given: the
         model's ``[analysis] load_sharing``, or :data:`STANDARD_DEFINITION` when that is
         the quasi-static ``static_torque`` (which needs ``torquesplit static``)."""
-        chosen = self.model.analysis.load_sharing
-        return STANDARD_DEFINITION if chosen in ("static", "static_torque") else chosen
+        return default_definition(self.model)
 
     @cached_property
     def complete_cycles(self) -> np.ndarray:
@@ -700,6 +699,14 @@ class Results:
         from ..model.io import model_to_json
 
         return model_to_json(self.model)
+
+
+def default_definition(model) -> str:
+    """The dynamic load-sharing definition a run of ``model`` reports by default: its
+    ``[analysis] load_sharing``, or :data:`STANDARD_DEFINITION` for the quasi-static
+    ``static_torque``."""
+    chosen = model.analysis.load_sharing
+    return STANDARD_DEFINITION if chosen in ("static", "static_torque") else chosen
 
 
 def _bearing_elements(element_names, model) -> dict[str, list[tuple[str, int, float]]]:

@@ -231,13 +231,11 @@ class SteadyState:
         stability, the excitations replaced by their means, and the per-mesh table
         (``rows``: :meth:`mesh_table`, computed when not given, from ``results`` when
         given: the :meth:`to_results` already at hand)."""
-        from torquesplit.results import STANDARD_DEFINITION
+        from torquesplit.results import default_definition
 
         ps = self.solution
         mu = ps.multipliers
         rows = self.mesh_table(results=results) if rows is None else rows
-        chosen = self.model.analysis.load_sharing  # (mesh_table's: Results.default_definition)
-        chosen = STANDARD_DEFINITION if chosen in ("static", "static_torque") else chosen
         return {
             "model": self.model.model.name, "method": ps.method, "converged": ps.converged,
             "message": ps.message, "period_s": ps.period, "fundamental_Hz": ps.frequency,
@@ -249,7 +247,7 @@ class SteadyState:
             "largest_multiplier": float(abs(mu[0])) if mu is not None and mu.size else None,
             "dropped_excitations": self.dropped_text(),
             # which coefficient 'load_sharing' is (sweep_speed's is mean_force's)
-            "load_sharing_definition": chosen,
+            "load_sharing_definition": default_definition(self.model),
             "meshes": {r.mesh: {k: v for k, v in r.__dict__.items() if k != "mesh"}
                        for r in rows},
         }
