@@ -356,12 +356,18 @@ def report(res: dict) -> str:
                  "with the engine to 1e-9). `bench_transcription.py` runs it and the engine "
                  "(generated and general right-hand side) over the same steps from the same "
                  "state, each streaming the per-cycle statistics of the four mesh forces "
-                 "(the engine without a history), alternated, best CPU time of each.\n")
+                 "(the engine without a history), alternated, best CPU time of each. The cost "
+                 "per step is the difference between runs of 2 n and n steps over n; what is "
+                 "left is the fixed cost of a call (for the engine, the Python set-up of "
+                 "`integrate`: kernel arrays, step stability check, argument typing).\n")
         L.append(_table(["quantity", "value"], [
-            ["steps / step", f"{ht['steps']:,} / {_f(ht['step'])} s"],
+            ["steps (n) / step", f"{ht['steps']:,} / {_f(ht['step'])} s"],
             ["engine (generated rhs) CPU µs/step", _f(ht["engine_us"])],
             ["engine (`rhs=\"general\"`) CPU µs/step", _f(ht["general_us"])],
             ["hand transcription CPU µs/step", _f(ht["hand_us"])],
+            ["fixed cost of a call: engine / general / hand [ms]",
+             " / ".join(_f(ht.get(k, math.nan)) for k in ("engine_call_ms", "general_call_ms",
+                                                        "hand_call_ms"))],
             ["ratio engine / hand", f"**{_f(ht['ratio'])}** (target <= "
              f"{TARGETS['hand_ratio']:g})"],
             ["ratio general / hand", f"**{_f(ht['ratio_general'])}** (target <= "
