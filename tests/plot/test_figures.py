@@ -295,9 +295,12 @@ def test_support_spectrum_finds_a_known_sinusoid(run):
     assert freq[k] == pytest.approx(f0, rel=1e-9)
     assert amp[k] == pytest.approx(123.0, rel=1e-3)
     legend = next(ln for ln in ax.get_lines() if ln.get_label().startswith("x:"))
-    # in kN, as the run's tables print forces (a legend in N beside a table in kN)
+    # in N below 1 kN, as the axis reads ('0.123 kN' beside an axis at 123 N read as a
+    # mismatch), in kN and MN above, as the run's tables print forces
     label = legend.get_label()
-    assert "mean 0.5 kN" in label and "largest 0.123 kN at 2 kHz" in label
+    assert "mean 500 N" in label and "largest 123 N at 2 kHz" in label
+    assert [F._force_text(v) for v in (-0.1078, 3300.0, 2.5e6)] == ["-0.1078 N", "3.3 kN",
+                                                                   "2.5 MN"]
     np.testing.assert_allclose(legend.get_xydata(), [[f0, amp[k]]])  # the one strong line
     y = next(ln for ln in ax.get_lines() if ln.get_gid() == "pinion.support.y")
     assert np.max(y.get_ydata()) < 1e-9  # a constant force has no spectrum

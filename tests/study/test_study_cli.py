@@ -150,5 +150,12 @@ def test_summary_names_the_case_of_each_failure_units_and_an_empty_resume(tmp_pa
     lines = res.stdout.splitlines()
     assert any(ln.strip().startswith("not ok, case 1: Integration diverged") for ln in lines), \
         res.stdout
-    assert "peak_force.a1 [N]" in res.stdout and "load_sharing.cycle_peak [" not in res.stdout
+    # forces in kN, as the figures draw them and the run's tables print them
+    assert "peak_force.a1 [kN]" in res.stdout and "load_sharing.cycle_peak [" not in res.stdout
+    import xarray as xr
+
+    with xr.open_dataset(tmp_path / "typo" / "results.nc") as ds:
+        var = next(v for v in ds.data_vars if ds[v].attrs.get("output") == "peak_force.a1")
+        first = float(ds[var].values[0])
+    assert f"{first * 1e-3:.6g}" in res.stdout and f"{first:.6g}" not in res.stdout
     assert "2 outputs" in res.stderr

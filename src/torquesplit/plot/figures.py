@@ -1214,8 +1214,11 @@ def _spike_style(i: int, n: int) -> dict:
 
 
 def _force_text(value: float) -> str:
-    """A force in kN, as the run's tables print forces."""
-    return f"{value * _KN:.4g} kN"
+    """A force in N, kN or MN by its size, 4 significant digits: the spectrum's axis is
+    in N, and '0.1924 kN' beside an axis at 190 N read as a mismatch."""
+    a = abs(value)
+    scale, unit = (1.0, "N") if a < 1e3 else ((_KN, "kN") if a < 1e6 else (1e-6, "MN"))
+    return f"{value * scale:.4g} {unit}"
 
 
 def _short_text(text: str, most: int = 28) -> str:

@@ -286,15 +286,16 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
         for col in cols:
             t.add_column(col, justify="left" if col == "output" else "right")
         for v in out_vars:
+            suffix, scale = _shown(ds[v])
             x = ds[v].values.ravel()
-            x = x[np.isfinite(x)]
+            x = x[np.isfinite(x)] * scale
             count = [f"{x.size} of {status.size}"] if "cases" in cols else []
             if not x.size:
-                t.add_row(v + _unit_suffix(ds[v]), *["-"] * 6, *count)
+                t.add_row(v + suffix, *["-"] * 6, *count)
                 continue
             stats = (x.mean(), x.std(ddof=1) if x.size > 1 else 0.0, x.min(),
                      np.quantile(x, 0.05), np.quantile(x, 0.95), x.max())
-            t.add_row(v + _unit_suffix(ds[v]), *[f"{s:.6g}" for s in stats], *count)
+            t.add_row(v + suffix, *[f"{s:.6g}" for s in stats], *count)
         ui.console.print(t)
         if fewer:
             ui.console.print(f"statistics over the cases with a finite value only: "
@@ -329,10 +330,14 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
                      + (f"; {_count(len(figs), 'figure')} in {out / 'figures'}" if figs else ""))
 
 
-def _unit_suffix(var) -> str:
-    """" [N]" after an output's name where it has a unit (none for a ratio)."""
-    unit = str(var.attrs.get("units", ""))
-    return f" [{unit}]" if unit not in ("", "1", "-") else ""
+def _shown(var) -> tuple[str, float]:
+    """The unit an output is printed in, as its figure draws it (forces in kN, as the run's
+    tables print them: a table in N beside a figure in kN), and the factor from SI:
+    (" [kN]", 1e-3); no suffix for a ratio."""
+    from .figures import _out_unit
+
+    unit, scale = _out_unit(var.attrs["output"])
+    return (f" [{unit}]" if unit not in ("", "1", "-") else ""), scale
 
 
 def _count(n: int, what: str) -> str:
@@ -386,13 +391,14 @@ def _grid_table(ds, title: str, columns: list[tuple[str, str]]):
         shown[d] = dict(zip(ds[d].values.tolist(), values.tolist()))
         # escaped: Rich would read "[um]" as markup and drop it
         t.add_column(escape(f"{d} [{unit}]"), justify="right")
+    shown_unit = {v: _shown(ds[v]) for _, v in columns}
     for header, v in columns:
-        t.add_column(escape(header + _unit_suffix(ds[v])), justify="right")
+        t.add_column(escape(header + shown_unit[v][0]), justify="right")
     t.add_column("status")
     flat = ds.stack(case=dims)
     for k in range(flat.sizes["case"]):
         row = [f"{shown[d][float(flat[d].values[k])]:.6g}" for d in dims]
-        row += [f"{float(flat[v].values[k]):.6g}" for _, v in columns]
+        row += [f"{float(flat[v].values[k]) * shown_unit[v][1]:.6g}" for _, v in columns]
         row.append(str(flat["status"].values[k]))
         t.add_row(*row)
     return t
