@@ -38,8 +38,9 @@ def test_the_pipeline_functions_take_what_load_model_reads(model):
 
 
 def test_reprs_are_one_short_line(model):
-    objects = [model, torquesplit.model_modes(model),
-               torquesplit.quasi_static_load_sharing(model, revolutions=0.05),
+    quasi = torquesplit.quasi_static_load_sharing(model, revolutions=0.05)
+    run = torquesplit.simulate(model, cycles=20)
+    objects = [model, torquesplit.model_modes(model), quasi, run.metrics(), quasi.metrics(),
                torquesplit.steady_state(model, method="hb"),
                torquesplit.Study({"study": {"name": "k", "model": "ji_li_mill_drive",
                                             "outputs": ["load_sharing.engineering"]},

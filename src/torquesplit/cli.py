@@ -811,7 +811,7 @@ def static(
                                                 max_points=max_points, progress=cb)
             for loc, msg in static_warnings(res):
                 ux.warn(f"{loc}: {msg}")
-            res.warnings = list(ux.session().warnings)
+            res.kept_warnings = list(ux.session().warnings)
         except _EXPECTED as exc:
             _fail(exc)
             return

@@ -36,9 +36,9 @@ class QuasiStaticResults:
     kinematics: object
     structure: object
     solution: object
-    warnings: list = field(default_factory=list)
-    """Warnings of the sweep as text (the command line puts the model's in too); empty:
-    :func:`torquesplit.results.plausibility.static_warnings` on demand."""
+    kept_warnings: list = field(default_factory=list)
+    """Warnings kept with the sweep as text (the command line puts the model's in too);
+    empty: :meth:`warnings` derives them from the results."""
 
     def __repr__(self) -> str:
         sol = self.solution
@@ -50,10 +50,13 @@ class QuasiStaticResults:
                 f"{'all' if sol.converged.all() else 'NOT all'} converged, "
                 f"{len(self.mesh_names)} meshes)")
 
-    def all_warnings(self) -> list[str]:
-        """The warnings kept with the sweep, else those of its results."""
-        if self.warnings:
-            return list(self.warnings)
+    def warnings(self) -> list[str]:
+        """Every warning of the sweep, each ``"location: message"``, as
+        :meth:`torquesplit.results.Results.warnings` gives a run's: those kept with it,
+        else the plausibility of its results
+        (:func:`torquesplit.results.plausibility.static_warnings`)."""
+        if self.kept_warnings:
+            return list(self.kept_warnings)
         from .results.plausibility import static_warnings
 
         return [f"{loc}: {msg}" for loc, msg in static_warnings(self)]
@@ -110,8 +113,8 @@ class QuasiStaticResults:
                     "dof_unit": ("dof", dof_units(self.structure),
                                  {"long_name": "unit of each DOF's displacement"})},
             attrs={"title": f"torquesplit quasi-static: {self.model.model.name}",
-                   "warnings": "\n".join(self.all_warnings()),
-                   "warnings_json": json.dumps(self.all_warnings()),
+                   "warnings": "\n".join(self.warnings()),
+                   "warnings_json": json.dumps(self.warnings()),
                    "load_sharing_definition": "static_torque",
                    "model_json": model_to_json(self.model),
                    "metrics_json": _json.dumps({"per_mesh": met.per_mesh,

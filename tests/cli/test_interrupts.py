@@ -141,7 +141,7 @@ def test_a_static_sweep_interrupted_before_its_first_position_or_outside_the_con
     sol = res.solution
     assert sol.interrupted and 0 < sol.times.size < sol.planned
     assert sol.q.shape[0] == sol.element_forces.shape[0] == sol.times.size
-    assert any("stopped by Ctrl-C" in w for w in res.all_warnings())
+    assert any("stopped by Ctrl-C" in w for w in res.warnings())
 
 
 @pytest.mark.parametrize("command", ["run", "static"])

@@ -132,6 +132,11 @@ class LoadSharing:
     the sum of its group's averages (the mean load of a path over the mean of all: the
     planets' K_gamma of AGMA 6123 / ISO 6336-1, :mod:`torquesplit.metrics.planetary`)."""
 
+    def __repr__(self) -> str:
+        return (f"LoadSharing({self.definition!r}: system {self.system:.5g}, "
+                f"{len(self.per_group)} group{'s' if len(self.per_group) != 1 else ''}, "
+                f"{len(self.per_mesh)} mesh{'es' if len(self.per_mesh) != 1 else ''})")
+
 
 def group_meshes(mesh_meta: dict[str, dict]) -> dict[str, list[str]]:
     """Load-sharing groups keyed ``"path/stage"`` (or ``"stage"`` without a path)."""

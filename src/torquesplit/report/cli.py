@@ -226,5 +226,5 @@ def _quasi_if_static(model, ux, quiet):
     for text in said:
         ux.warn(text if "quasi-static" in text else f"quasi-static sweep: {text}")
     if said:
-        quasi.warnings = said + [f"{loc}: {msg}" for loc, msg in static_warnings(quasi)]
+        quasi.kept_warnings = said + [f"{loc}: {msg}" for loc, msg in static_warnings(quasi)]
     return quasi

@@ -480,7 +480,7 @@ def build_report(res, *, definition: str | None = None, source: Path | None = No
     # the quasi-static sweep's too (its positions thinned: the report said "No warnings")
     notes = res.warnings(met.definition) + (
         [w if "quasi-static" in w else f"quasi-static sweep: {w}"
-         for w in quasi.all_warnings()] if quasi is not None else [])
+         for w in quasi.warnings()] if quasi is not None else [])
     parts += ["<h2>Warnings</h2>", _warnings(notes)]
     step(0.1, "model")
     parts += ["<h2>Model</h2>", _model_tables(res)]

@@ -78,6 +78,19 @@ class Metrics:
     dynamic_factors: ls.DynamicFactors
     rows: list[MeshRow]
 
+    def __repr__(self) -> str:
+        """One line: the system and group coefficients, the dynamic factor, the settle
+        time (the dataclass's own repr printed every field: 3 kB)."""
+        d = self.dynamic_factors
+        groups = ", ".join(f"{g} {v:.5g}" for g, v in
+                           list(self.load_sharing.per_group.items())[:3])
+        more = len(self.load_sharing.per_group) - 3
+        groups += f" and {more} more" if more > 0 else ""
+        kv = ls._nanmax(list(d.per_group_dynamic_factor.values()))
+        return (f"Metrics({self.definition!r}: load sharing {self.load_sharing.system:.5g} "
+                f"({groups}), dynamic factor {kv:.4g}, settled from "
+                f"{self.settling.start_time:.4g} s)")
+
     def to_dict(self) -> dict:
         d = self.dynamic_factors
         return {
