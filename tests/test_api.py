@@ -55,14 +55,31 @@ def test_reprs_are_one_short_line(model):
 def test_mode_numbers_and_counts_are_checked(model):
     report = torquesplit.model_modes(model)
     assert report.shape(1) and report.shape(len(report.solution.frequencies))
+    # an argument out of range is an OptionError: a TorquesplitError (one except clause
+    # for the package's own errors) and a ValueError
     for bad in (0, -1, 99, 1.5):
-        with pytest.raises(ValueError, match="1-based"):
+        with pytest.raises(torquesplit.OptionError, match="1-based"):
             report.shape(bad)
     for bad in (0, -1):
-        with pytest.raises(ValueError, match="count must be"):
+        with pytest.raises(torquesplit.OptionError, match="count must be"):
             torquesplit.model_modes(model, count=bad)
-    with pytest.raises(ValueError, match="below must be a positive frequency"):
+    with pytest.raises(torquesplit.OptionError, match="below must be a positive frequency"):
         torquesplit.model_modes(model, below="1 kHz")
+
+
+def test_bad_arguments_raise_the_packages_own_error(model):
+    """A reviewer met ValueError from some functions and SolverError from others for the
+    same kind of mistake: an argument out of range is an OptionError everywhere."""
+    run = torquesplit.simulate(model, cycles=10)
+    calls = [lambda: torquesplit.simulate(model, cycles=10, steps_per_period=0),
+             lambda: torquesplit.simulate(model, cycles=10, method="euler"),
+             lambda: run.metrics(window=1),
+             lambda: run.metrics("no_such_definition"),
+             lambda: torquesplit.quasi_static_load_sharing(model, revolutions=-1),
+             lambda: torquesplit.steady_state(model, method="hb").mesh_series(["m99"])]
+    for call in calls:
+        with pytest.raises(torquesplit.OptionError):
+            call()
 
 
 def test_speeds_with_units_and_series_by_name(model):
@@ -79,5 +96,5 @@ def test_speeds_with_units_and_series_by_name(model):
     t_name, f_name, _ = st.mesh_series(["m11", "m21"])
     t_index, f_index, _ = st.mesh_series([names.index("m11"), names.index("m21")])
     assert (f_name == f_index).all() and (t_name == t_index).all()
-    with pytest.raises(ValueError, match="unknown element 'm99'"):
+    with pytest.raises(torquesplit.OptionError, match="unknown element 'm99'"):
         st.mesh_series(["m99"])

@@ -36,6 +36,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .errors import OptionError
+
 __all__ = ["ModeRow", "ModalReport", "classify", "model_modes", "MODE_TYPES",
            "PhasedStage", "phased_stages", "phasing_suppresses", "whirl_senses"]
 
@@ -119,7 +121,7 @@ class ModalReport:
         """Mass-normalised shape of ``mode`` (1-based) by DOF name."""
         n = self.solution.mode_shapes.shape[1]
         if not (isinstance(mode, (int, np.integer)) and 1 <= mode <= n):
-            raise ValueError(f"mode must be a whole number 1..{n} (1-based, ascending "
+            raise OptionError(f"mode must be a whole number 1..{n} (1-based, ascending "
                              f"frequency), got {mode!r}")
         phi = self.solution.mode_shapes[:, mode - 1]
         return {n: complex(v) for n, v in zip(self.dof_names, phi)}
@@ -359,9 +361,9 @@ def model_modes(model, *, rotating_frame: bool = True, below: float | None = Non
     from .solve.static import static_equilibrium
 
     if count is not None and not (isinstance(count, (int, np.integer)) and count >= 1):
-        raise ValueError(f"count must be a whole number of modes, 1 or more, got {count!r}")
+        raise OptionError(f"count must be a whole number of modes, 1 or more, got {count!r}")
     if below is not None and not (isinstance(below, (int, float)) and below > 0):
-        raise ValueError(f"below must be a positive frequency in Hz (a number), got "
+        raise OptionError(f"below must be a positive frequency in Hz (a number), got "
                          f"{below!r}")
     if not hasattr(model, "meshes"):
         model = load_model(model)

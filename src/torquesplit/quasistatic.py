@@ -21,7 +21,7 @@ import numpy as np
 
 from . import _json
 from .assembly.structure import dof_units
-from .errors import ModelWarning
+from .errors import ModelWarning, OptionError, SolverError
 
 from .metrics import load_sharing as ls
 from .model.io import load_model
@@ -153,7 +153,7 @@ def slowest_gear(kin) -> tuple[str, float, str | None]:
             if w and math.isfinite(w) and (best is None or abs(w) < best[1]):
                 best = (gear, abs(w), mk.carrier)
     if best is None:
-        raise ValueError("no gear turns: a quasi-static sweep needs a turning mesh")
+        raise SolverError("no gear turns: a quasi-static sweep needs a turning mesh")
     return best
 
 
@@ -188,11 +188,11 @@ def quasi_static_load_sharing(model, *, revolutions: float | None = None,
                                  ("max_points", max_points, 20000)):
         if (isinstance(value, bool) or not isinstance(value, numbers.Real)
                 or not float(value).is_integer() or value < 1):
-            raise ValueError(f"{name} must be a whole number >= 1, got {value!r}; give "
+            raise OptionError(f"{name} must be a whole number >= 1, got {value!r}; give "
                              f"e.g. {name}={example}")
     if revolutions is not None and (isinstance(revolutions, bool) or not isinstance(
             revolutions, numbers.Real) or not (0 < revolutions < math.inf)):
-        raise ValueError(f"revolutions must be a positive number, got {revolutions!r}; "
+        raise OptionError(f"revolutions must be a positive number, got {revolutions!r}; "
                          f"give e.g. revolutions=1 (of the slowest gear)")
     points_per_cycle, max_points = int(points_per_cycle), int(max_points)
     if not hasattr(model, "meshes"):

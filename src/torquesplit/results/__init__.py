@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from ..assembly.structure import element_units
-from ..errors import SolverError
+from ..errors import OptionError, SolverError
 from ..metrics import load_sharing as ls
 
 #: the load-sharing definition of a new model: the mean-force ratio, the mesh load factor
@@ -282,11 +282,11 @@ class Results:
         definition = self.check_definition(definition)
         if (isinstance(window, bool) or not isinstance(window, numbers.Real)
                 or not float(window).is_integer() or window < 2):
-            raise ValueError(f"window must be a whole number of cycles >= 2, got "
+            raise OptionError(f"window must be a whole number of cycles >= 2, got "
                              f"{window!r}; give e.g. window=20")
         if isinstance(tolerance, bool) or not (isinstance(tolerance, numbers.Real)
                                                and 0 < tolerance < 1):
-            raise ValueError(f"tolerance must be a fraction between 0 and 1, got "
+            raise OptionError(f"tolerance must be a fraction between 0 and 1, got "
                              f"{tolerance!r}; give e.g. tolerance=0.01 (1 %)")
         s = self.solution
         names = self.mesh_names
@@ -375,7 +375,7 @@ class Results:
                 "static MODEL` (or torquesplit.quasi_static_load_sharing), or "
                 f"choose one of {', '.join(ls.DYNAMIC_DEFINITIONS)} for this run.")
         if definition not in ls.DEFINITIONS:
-            raise ValueError(f"unknown load-sharing definition {definition!r}; choose one of "
+            raise OptionError(f"unknown load-sharing definition {definition!r}; choose one of "
                              f"{', '.join(ls.DYNAMIC_DEFINITIONS)}")
         return definition
 
@@ -773,7 +773,7 @@ def open_results(path):
     except OSError as exc:
         if not Path(path).is_file():
             raise
-        raise ValueError(
+        raise OptionError(
             f"{path}: not a NetCDF results file ({exc}); open_results and load_results "
             f"read the .nc files torquesplit writes (a .mat opens with scipy.io.loadmat, a "
             f".csv set with a spreadsheet or pandas)") from None

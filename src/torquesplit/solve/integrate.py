@@ -32,7 +32,7 @@ import numpy as np
 
 from torquesplit._memo import remember_last
 from torquesplit.assembly.structure import Structure
-from torquesplit.errors import ModelWarning, SolverError, from_interrupt
+from torquesplit.errors import ModelWarning, OptionError, SolverError, from_interrupt
 from torquesplit.solve import _kernels as kern
 from torquesplit.solve import codegen
 from torquesplit.solve import kernel_data as kd
@@ -213,7 +213,7 @@ class Solution:
         e = _resolve(self.element_names, [element], "element")[0]
         if e not in self.tracked_elements:
             names = [self.element_names[i] for i in self.tracked_elements]
-            raise ValueError(f"element {self.element_names[e]!r} was not tracked; tracked "
+            raise OptionError(f"element {self.element_names[e]!r} was not tracked; tracked "
                              f"elements are {names}. Pass track_elements=[...] to integrate.")
         j = self.tracked_elements.index(e)
         return {"start": self.cycle_start[:, j], "max": self.cycle_max[:, j],
@@ -239,7 +239,7 @@ def _evaluate(structure, t, y, model=None, code=None):
     general one, or ``code`` (a :class:`codegen.GeneratedRhs`)."""
     y = np.array(y, dtype=np.float64, order="C", copy=True)
     if y.shape != (2 * structure.n_dof,):
-        raise ValueError(f"state must have shape ({2 * structure.n_dof},) = [q, v], "
+        raise OptionError(f"state must have shape ({2 * structure.n_dof},) = [q, v], "
                          f"got {y.shape}.")
     m = kd.kernel_model(structure) if model is None else model
     code = codegen.general_rhs() if code is None else code
@@ -260,7 +260,7 @@ def compile_kernels(methods: Sequence[str] = ("rk4", "dopri")) -> float:
     """
     unknown = sorted(set(methods) - {"rk4", "dopri"})
     if unknown:
-        raise ValueError(f"unknown method(s) {unknown}; use 'rk4' or 'dopri'.")
+        raise OptionError(f"unknown method(s) {unknown}; use 'rk4' or 'dopri'.")
     for method in methods:
         if method in _COMPILE_TIMES:
             continue
@@ -298,13 +298,13 @@ def _resolve(names: Sequence[str], selection, what: str) -> list[int]:
             if item not in names:
                 close = difflib.get_close_matches(item, names, n=3)
                 hint = f" Did you mean {close}?" if close else ""
-                raise ValueError(f"unknown {what} {item!r}.{hint} Use one of the names in "
+                raise OptionError(f"unknown {what} {item!r}.{hint} Use one of the names in "
                                  f"structure.{what}_names or an index.")
             out.append(names.index(item))
         else:
             i = int(item)
             if not 0 <= i < len(names):
-                raise ValueError(f"{what} index {i} is out of range 0..{len(names) - 1}; "
+                raise OptionError(f"{what} index {i} is out of range 0..{len(names) - 1}; "
                                  f"use an index or a name from structure.{what}_names.")
             out.append(i)
     return out
@@ -514,7 +514,7 @@ def integrate(
     t0, t_end = (float(x) for x in t_span)
     span = t_end - t0
     if not (math.isfinite(span) and span > 0):
-        raise ValueError(f"t_span must be (start, end) with end > start, got {t_span!r}.")
+        raise OptionError(f"t_span must be (start, end) with end > start, got {t_span!r}.")
     y = _initial_state(s, y0)
     model = kd.kernel_model(s)
     full_model = model  # (plain steps drop the corners, not what they say of the force)
@@ -541,7 +541,7 @@ def integrate(
             "record_every / sample_interval, list fewer history_elements and "
             "history_dofs, drop full_history, or lower n_cycles_cap.")
     if load_sharing_min_total is not None and len(load_sharing_min_total) != len(sel.groups):
-        raise ValueError("load_sharing_min_total needs one value per load-sharing group.")
+        raise OptionError("load_sharing_min_total needs one value per load-sharing group.")
     rec = kd.make_record(sel.track, sel.track_base, sel.n_cycles_cap, sel.groups,
                          s.n_elements, sel.hist_el, sel.hist_dof, n_hist, plan.n_full,
                          s.n_dof, load_sharing_min_total,
@@ -634,16 +634,16 @@ def _check_options(method, progress, record_every, sample_interval, *, rk4_only,
                    dopri_only) -> bool:
     """Refuse unknown methods and options that the chosen method would ignore."""
     if method not in ("rk4", "dopri"):
-        raise ValueError(f"unknown method {method!r}; use method='rk4' (fixed step) or "
+        raise OptionError(f"unknown method {method!r}; use method='rk4' (fixed step) or "
                          "method='dopri' (adaptive Dormand-Prince 5(4)).")
     rk4 = method == "rk4"
     ignored = rk4_only if not rk4 else dopri_only
     wrong = [name for name, val in ignored.items() if val is not None]
     if wrong:
-        raise ValueError(f"option(s) {wrong} do not apply to method={method!r}; remove them "
+        raise OptionError(f"option(s) {wrong} do not apply to method={method!r}; remove them "
                          f"or choose the other method.")
     if record_every is not None and sample_interval is not None:
-        raise ValueError("give either record_every or sample_interval, not both.")
+        raise OptionError("give either record_every or sample_interval, not both.")
     if progress is not None and not callable(progress):
         raise TypeError("progress must be a callable taking the fraction done, e.g. "
                         "progress=lambda f: print(f'{f:.0%}').")
@@ -656,10 +656,10 @@ def _initial_state(s: Structure, y0) -> np.ndarray:
     if y.shape == (n,):
         y = np.concatenate([y, np.zeros(n)])
     if y.shape != (2 * n,):
-        raise ValueError(f"y0 must hold {2 * n} values [q, v] or {n} values q, got shape "
+        raise OptionError(f"y0 must hold {2 * n} values [q, v] or {n} values q, got shape "
                          f"{np.shape(y0)}.")
     if not np.all(np.isfinite(y)):
-        raise ValueError("y0 contains NaN or inf; start from finite displacements and "
+        raise OptionError("y0 contains NaN or inf; start from finite displacements and "
                          "velocities, e.g. static_equilibrium(structure).y0.")
     return y
 
@@ -682,7 +682,7 @@ def _select(s, t0, span, track_elements, n_cycles_cap, history_elements,
         track = _resolve(s.element_names, track_elements, "element")
         static_ones = [s.element_names[e] for e in track if not s.frequency[e] > 0]
         if static_ones:
-            raise ValueError(f"elements {static_ones} have no excitation frequency, so they "
+            raise OptionError(f"elements {static_ones} have no excitation frequency, so they "
                              "have no mesh cycles to track; leave them out of track_elements.")
     # same floating-point expressions as the kernel's cycle index at t0
     base = np.array([_cycle_index(s.frequency[e] * t0 + s.phase[e]) for e in track],
@@ -693,7 +693,7 @@ def _select(s, t0, span, track_elements, n_cycles_cap, history_elements,
     else:
         cap = int(n_cycles_cap)
         if cap < 0:
-            raise ValueError("n_cycles_cap must be >= 0.")
+            raise OptionError("n_cycles_cap must be >= 0.")
     hist_el = list(range(s.n_elements)) if history_elements is None else _resolve(
         s.element_names, history_elements, "element")
     hist_dof = list(range(s.n_dof)) if history_dofs is None else _resolve(
@@ -703,7 +703,7 @@ def _select(s, t0, span, track_elements, n_cycles_cap, history_elements,
         idx = _resolve(s.element_names, members, "element")
         loose = [s.element_names[e] for e in idx if e not in track]
         if loose or len(set(idx)) != len(idx) or not idx:
-            raise ValueError(f"load-sharing group {list(members)!r} must list distinct "
+            raise OptionError(f"load-sharing group {list(members)!r} must list distinct "
                              f"tracked elements; not tracked: {loose}. Track them "
                              f"(track_elements) or leave them out of the group.")
         groups.append([track.index(e) for e in idx])
@@ -814,7 +814,7 @@ def _plan_rk4(s, span, step, steps_per_period, check_stability, record_every,
               sample_interval, full_history, max_steps) -> _Plan:
     spp = 100 if steps_per_period is None else int(steps_per_period)
     if spp < 1:
-        raise ValueError("steps_per_period must be >= 1.")
+        raise OptionError("steps_per_period must be >= 1.")
     check = True if check_stability is None else bool(check_stability)
     limited_by = "excitation period"
     if step is None:
@@ -833,14 +833,14 @@ def _plan_rk4(s, span, step, steps_per_period, check_stability, record_every,
         if check:
             check_step(s, h)
         elif not (h > 0 and math.isfinite(h)):
-            raise ValueError(f"step must be a positive number of seconds, got {step!r}.")
+            raise OptionError(f"step must be a positive number of seconds, got {step!r}.")
     n_steps, h = whole_steps(span, h)
     if sample_interval is not None:
         every = max(1, int(round(float(sample_interval) / h)))
     else:
         every = 1 if record_every is None else int(record_every)
         if every < 1:
-            raise ValueError("record_every must be >= 1.")
+            raise OptionError("record_every must be >= 1.")
     limit = n_steps if max_steps is None else min(n_steps, int(max_steps))
     return _Plan(limit_steps=limit, n_hist=n_steps // every + 1,
                  n_full=n_steps + 1 if full_history else 0, h=h, n_steps=n_steps,
@@ -851,27 +851,27 @@ def _plan_dopri(s, span, rtol, atol, max_step, sample_interval, full_history,
                 max_steps) -> _Plan:
     rtol = 1e-6 if rtol is None else float(rtol)
     if not rtol > 0:
-        raise ValueError("rtol must be > 0, e.g. rtol=1e-6.")
+        raise OptionError("rtol must be > 0, e.g. rtol=1e-6.")
     if atol is None:
         atol = _default_atol(s, rtol)
     else:
         atol = np.ascontiguousarray(np.broadcast_to(np.asarray(atol, dtype=np.float64),
                                                     (2 * s.n_dof,))).copy()
         if not np.all(atol > 0):
-            raise ValueError("atol must be > 0 (scalar or one value per state [q, v]).")
+            raise OptionError("atol must be > 0 (scalar or one value per state [q, v]).")
     periods = _excitation_periods(s)
     if max_step is None:
         h_max = float(periods.min()) / 20.0 if periods.size else span
     else:
         h_max = float(max_step)
         if not h_max > 0:
-            raise ValueError("max_step must be > 0.")
+            raise OptionError("max_step must be > 0.")
     if sample_interval is None:
         dt = h_max if (periods.size or max_step is not None) else span / 1000.0
     else:
         dt = float(sample_interval)
         if not dt > 0:
-            raise ValueError("sample_interval must be > 0.")
+            raise OptionError("sample_interval must be > 0.")
     n_hist = int(math.floor(span / dt * (1 + 1e-12))) + 1
     limit = max(100_000, int(10 * span / h_max)) if max_steps is None else int(max_steps)
     return _Plan(limit_steps=limit, n_hist=n_hist, n_full=n_hist if full_history else 0,
@@ -929,7 +929,7 @@ def _rows(buf: np.ndarray, n: int) -> np.ndarray:
 def _rhs_code(kind: str, model, n_rhs: float) -> codegen.GeneratedRhs:
     """The right-hand side the kernels call (see ``integrate(rhs=...)``)."""
     if kind not in ("auto", "generated", "general"):
-        raise ValueError(f"rhs must be 'auto', 'generated' or 'general', got {kind!r}.")
+        raise OptionError(f"rhs must be 'auto', 'generated' or 'general', got {kind!r}.")
     if kind == "general" or (kind == "auto" and not codegen.worth_generating(model, n_rhs)):
         return codegen.general_rhs()
     try:

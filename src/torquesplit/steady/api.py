@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from torquesplit.errors import SolverError
+from torquesplit.errors import OptionError, SolverError
 from torquesplit.solve.kernel_data import continuous_start
 from torquesplit.steady.period import (
     base_frequency,
@@ -199,7 +199,7 @@ class SteadyState:
             elements = [names.index(e) if isinstance(e, str) else int(e) for e in elements]
         except ValueError:
             unknown = [e for e in elements if isinstance(e, str) and e not in names]
-            raise ValueError(f"unknown element {unknown[0]!r}; the elements are "
+            raise OptionError(f"unknown element {unknown[0]!r}; the elements are "
                              f"{names}") from None
         ps = self.solution
         cols = {int(e): j for j, e in enumerate(ps.mesh_elements)}
