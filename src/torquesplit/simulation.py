@@ -385,12 +385,19 @@ def prepare_run(
     if n_records > MAX_HISTORY_RECORDS:
         sample_interval = duration / MAX_HISTORY_RECORDS
     elif finer and samples_per_period is not None:
+        hint = "a finer step (--steps-per-period; steps_per_period= in Python)"
+        if planned[1] != "excitation period":  # (more steps per period than asked already)
+            from .solve.integrate import shortest_excitation_period
+
+            per = shortest_excitation_period(structure) / planned[0]
+            hint = (f"a finer step, which is set by {planned[1]} here: only a "
+                    f"--steps-per-period (steps_per_period= in Python) above the {per:.4g} "
+                    f"steps per shortest excitation period it makes refines it")
         warnings.warn(
             f"analysis: samples_per_period={samples_per_period} asks for more samples than "
             f"the run takes steps: the history keeps every RK4 step, "
             f"{1.0 / (step * f_max):.4g} per shortest mesh period; a finer history needs "
-            f"a finer step (--steps-per-period; steps_per_period= in Python)", ModelWarning,
-            stacklevel=3)
+            f"{hint}", ModelWarning, stacklevel=3)
     # only a sampling the user asked for is worth a warning: the default one is a choice
     # of the library, and what it kept is in the bearing table's title and the files'
     # history_samples_per_period (a default run of Liu et al. 2021 warned)

@@ -118,3 +118,24 @@ def test_a_history_finer_than_the_step_is_said_as_the_step(spur_pair):
     kept = res.history_samples_per_period()
     assert len(said) == 1 and f"keeps every RK4 step, {kept:.4g} per shortest" in said[0]
     assert "at most" not in said[0]
+    assert "a finer step (--steps-per-period" in said[0]  # the step is the period's here
+
+
+def test_a_history_finer_than_a_step_set_by_stability_says_what_refines_it():
+    """Where RK4 stability sets the step (190 steps per mesh period of Dong et al. 2021's
+    model where 100 were asked), 'a finer history needs a finer step
+    (--steps-per-period)' sent the user to an option that changes nothing below 190."""
+    import warnings
+
+    from torquesplit.solve.integrate import planned_step, shortest_excitation_period
+
+    model = torquesplit.load_model("dong2021_face_gear")
+    step, why = planned_step(torquesplit.assemble(model), 100)
+    per = shortest_excitation_period(torquesplit.assemble(model)) / step
+    assert why != "excitation period" and per > 150  # (the premise)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        torquesplit.simulate(model, cycles=3, samples_per_period=1000, steps_per_period=100)
+    said = [str(w.message) for w in caught if "asks for more samples" in str(w.message)]
+    assert len(said) == 1 and f"which is set by {why}" in said[0]
+    assert f"--steps-per-period (steps_per_period= in Python) above the {per:.4g}" in said[0]
