@@ -8,7 +8,10 @@ differ -- the inputs each paper leaves out -- is written in the example model fi
 
 Quasi-static entries (``analysis = "static"``) compare with ``torquesplit static``
 (:func:`torquesplit.quasistatic.quasi_static_load_sharing`); their keys are
-``load_sharing.static_torque`` plus ``.<group>`` or ``.<mesh>``.
+``load_sharing.static_torque`` plus ``.<group>`` or ``.<mesh>``.  Modal entries
+(``analysis = "modes"``) compare with the natural frequencies of the model at rest
+(:func:`modal_values`); their keys are ``mode.<type>.<k>``: the k-th distinct frequency
+of that mode type (a degenerate pair counts once), ascending, rigid-body modes left out.
 """
 
 from __future__ import annotations
@@ -25,7 +28,8 @@ class Published:
     keys: tuple[str, ...]
     """Flat metric names; ours is the largest of them."""
     analysis: str = "dynamic"
-    """``"dynamic"`` (a run) or ``"static"`` (the quasi-static sweep)."""
+    """``"dynamic"`` (a run), ``"static"`` (the quasi-static sweep) or ``"modes"`` (the
+    natural frequencies, :func:`modal_values`)."""
     where: str = ""
     """Where the paper gives it."""
 
@@ -65,6 +69,18 @@ PUBLISHED: dict[str, tuple[str, tuple[Published, ...]]] = {
                       ("load_sharing.static_torque.stage1",), analysis="static",
                       where="text on Figure 5"),
         )),
+    "lin_parker1999_planetary": (
+        "Lin & Parker 1999, Table 1 system with four planets: natural frequencies of the "
+        "planetary at rest (stationary carrier), by mode type; a translational frequency "
+        "is a degenerate pair, a planet mode has multiplicity N - 3.", tuple(
+            Published(f"{kind} mode {k + 1} [Hz]", f, (f"mode.{kind}.{k + 1}",),
+                      analysis="modes",
+                      where="natural frequencies, N = 4 (J. Lin's thesis, Table C.1)")
+            for kind, values in (
+                ("rotational", (1536.6, 1970.6, 2625.7, 7773.6, 13071.1)),
+                ("translational", (727.0, 1091.0, 1892.8, 2342.5, 7189.9, 10437.6)),
+                ("planet", (1808.2, 5963.8, 6981.7)))
+            for k, f in enumerate(values))),
     "ji_li_mill_drive": (
         "Ji & Li print no numerical results (their coefficients are in figures only); the "
         "paper's trends are discussed in the model file's comments.", ()),
@@ -72,6 +88,22 @@ PUBLISHED: dict[str, tuple[str, tuple[Published, ...]]] = {
         "Jin et al. 2019 print no numerical results (figures only); the model file's "
         "comments list the trends it reproduces.", ()),
 }
+
+
+def modal_values(report) -> dict[str, float]:
+    """``mode.<type>.<k>`` -> the k-th distinct natural frequency [Hz] of that type in a
+    :class:`torquesplit.modes.ModalReport` (one per degenerate group, ascending, the
+    rigid-body modes left out)."""
+    out: dict[str, float] = {}
+    seen: set[int] = set()
+    count: dict[str, int] = {}
+    for r in sorted(report.rows, key=lambda r: r.frequency):
+        if r.group in seen or not r.frequency > 0 or r.type is None:
+            continue
+        seen.add(r.group)
+        count[r.type] = count.get(r.type, 0) + 1
+        out[f"mode.{r.type}.{count[r.type]}"] = float(r.frequency)
+    return out
 
 
 def published_for(model_name: str) -> tuple[str, tuple[Published, ...]] | None:

@@ -311,8 +311,8 @@ def layout_figure(model, kin=None, *, width: float = 10.0) -> Figure:
         ax.plot([], [], color=COLORS["spline"], lw=2, ls="--", label="spline")
     if supported:
         ax.plot([], [], color=COLORS["support"], lw=1.6,
-                label="support to the housing" + (f": {texts[grounded[0]]} each"
-                                                  if same else ""))
+                label=(f"supports to the housing (each: {texts[grounded[0]]})" if same
+                       else "support to the housing"))
         for t, k in letter.items():
             ax.plot([], [], ls="none", label=f"support {k}: {t}")
     if pins:

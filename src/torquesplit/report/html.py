@@ -409,7 +409,7 @@ def _static_section(quasi) -> str:
 
 
 def _comparison(res, quasi) -> str:
-    from ..examples.published import published_for
+    from ..examples.published import modal_values, published_for
 
     entry = published_for(res.model.model.name)
     if entry is None:
@@ -429,6 +429,10 @@ def _comparison(res, quasi) -> str:
         values["load_sharing.static_torque"] = met.system
         values.update({f"load_sharing.static_torque.{g}": v for g, v in met.per_group.items()})
         values.update({f"load_sharing.static_torque.{m}": v for m, v in met.per_mesh.items()})
+    if any(p.analysis == "modes" for p in items):  # the papers' modal analyses: at rest
+        from ..modes import model_modes
+
+        values.update(modal_values(model_modes(res.model, rotating_frame=False)))
     rows = []
     for p in items:
         ours = [values[k] for k in p.keys if k in values and math.isfinite(values[k])]
@@ -437,7 +441,7 @@ def _comparison(res, quasi) -> str:
             continue
         v = max(ours)
         rows.append([p.quantity, p.where, _g(p.paper, 6), _g(v, 6),
-                     f"{100 * (v - p.paper) / p.paper:+.1f} %"])
+                     f"{100 * (v - p.paper) / p.paper:+.{2 if p.analysis == 'modes' else 1}f} %"])
     return ("<h2>Comparison with the paper</h2>" + f"<p>{_e(note)}</p>"
             + _table(["quantity", "where", "paper", "this run", "difference"], rows, left=2)
             + '<p class="note">The papers leave out inputs their dynamic results depend on '
