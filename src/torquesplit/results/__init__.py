@@ -154,7 +154,8 @@ class Results:
     """A finished (or stopped) dynamic run and everything needed to interpret it."""
 
     def __init__(self, *, model, kinematics, structure, static, solution,
-                 run_warnings=(), model_warnings=None, periodic: bool = False):
+                 run_warnings=(), model_warnings=None, periodic: bool = False,
+                 period: float | None = None):
         self.model = model
         self.steady = None
         """The :class:`~torquesplit.steady.SteadyState` this record repeats (a steady
@@ -163,6 +164,8 @@ class Results:
         self.periodic = periodic
         """The record is a periodic state repeated over whole periods (a steady state):
         no transient to detect, every complete cycle counts."""
+        self.period = period
+        """The period of a periodic record [s] (None for a run)."""
         self.kinematics = kinematics
         self.structure = structure
         self.static = static
@@ -467,7 +470,7 @@ class Results:
         force vector [N] (a body held by a spline alone: the spline's radial force, its
         name in ``via``), from the history from ``start_time`` (default the latest group
         settle time: pass ``metrics().settling.start_time`` when the metrics are at
-        hand).  The history is decimated (``samples_per_period``): a peak between its
+        hand; a periodic state's: its first whole period).  The history is decimated (``samples_per_period``): a peak between its
         samples is missed, as :func:`~torquesplit.results.plausibility.coarse_history`
         says for the meshes; the means are not affected.  Forces are in the frame of the
         support (a turning carrier's for planets)."""
@@ -477,8 +480,16 @@ class Results:
         by_body = self.support_columns()
         if not by_body:
             return []
-        t0 = self.metrics().settling.start_time if start_time is None else float(start_time)
-        keep = s.history_t >= t0
+        if self.periodic and self.period:  # one whole period: the state repeats it (a
+            # settle time inside the period weighted a part of it: a mean 6x too large)
+            from .dataset import period_samples
+
+            keep = np.zeros(s.history_t.shape, bool)
+            keep[:period_samples(s.history_t, self.period) or keep.size] = True
+        else:
+            t0 = (self.metrics().settling.start_time if start_time is None
+                  else float(start_time))
+            keep = s.history_t >= t0
         if not keep.any():
             keep = np.ones(s.history_t.shape, bool)
         out = []
@@ -658,12 +669,18 @@ class Results:
         units = element_units(self.structure)
         cols = [list(s.tracked_elements).index(el.index(m)) for m in self.mesh_names]
         summary, history, cycles, groups, bearing_file, about = plan.files
+        n_hist = s.history_t.size
+        if getattr(self, "steady", None) is not None:  # one period, as the .nc holds
+            from .dataset import period_samples
+
+            n_hist = period_samples(s.history_t, self.steady.solution.period) or n_hist
         contents = {
             groups: files.csv_bytes(group_header, group_rows),
             bearing_file: files.csv_bytes(bearing_header, bearing_rows),
             history: files.csv_bytes(["time_s"] + [f"{n}_{units[i].replace(' ', '')}"
                                                    for n, i in zip(names, s.history_elements)],
-                                     np.column_stack([s.history_t, s.history_forces]).tolist()),
+                                     np.column_stack([s.history_t[:n_hist],
+                                                      s.history_forces[:n_hist]]).tolist()),
             cycles: files.csv_bytes(
                 ["cycle"] + [f"{m}_{q}" for q in ("start_s", "peak_N", "min_N", "mean_N")
                              for m in self.mesh_names],

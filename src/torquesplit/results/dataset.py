@@ -231,6 +231,7 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
     steady = getattr(res, "steady", None)
     if steady is not None:  # a periodic steady state: one period repeated, not a run
         _steady_attributes(ds, res, steady)
+        ds = _one_period(ds, float(ds.attrs["steady_period_s"]))
     notes = res.warnings(definition) if hasattr(res, "warnings") else []
     ds.attrs.update({
         "warnings": "\n".join(notes),
@@ -277,8 +278,36 @@ def _steady_attributes(ds: xr.Dataset, res, steady) -> None:
     for name in ("element_force", "displacement", "velocity"):
         if name in ds:
             ds[name].attrs["sampling"] = (
-                f"the steady state's samples over one period "
-                f"({info['method']}), repeated; the metrics come from every step of it")
+                f"the steady state's samples over one period ({info['method']}); the "
+                f"metrics come from every step of it")
+
+
+def _one_period(ds: xr.Dataset, period: float) -> xr.Dataset:
+    """A steady state's history cut to its first period: the record repeats that period
+    (its metrics need whole settle windows), and the files held every repetition (Ji & Li's
+    steady state: 62 MB of CSV, one period 870 times).  The cycle statistics keep the
+    whole record: the metrics of a file read back are computed from them."""
+    if "time" not in ds.dims:
+        return ds
+    n = period_samples(ds["time"].values, period)
+    if n is None:
+        return ds
+    out = ds.isel(time=slice(0, n))
+    out.attrs["record"] = (
+        f"{ds.attrs['record']}; the history (time dimension) holds its first period "
+        f"({n} samples), the cycle statistics the whole record")
+    out.attrs["history_periods"] = 1
+    return out
+
+
+def period_samples(t, period: float) -> int | None:
+    """How many of the history times ``t`` fall in its first ``period`` (None where that
+    is not a proper part of it): what a steady state's files keep (:func:`_one_period`)."""
+    t = np.asarray(t, dtype=float)
+    if not (t.size and period > 0):
+        return None
+    n = int(np.count_nonzero(t < t[0] + period * (1.0 - 1e-9)))
+    return n if 2 <= n < t.size else None
 
 
 def _note_sampling(ds: xr.Dataset, t, step, every_step: bool) -> None:
@@ -393,7 +422,11 @@ def results_from_dataset(ds: xr.Dataset):
         back_contact_steps=np.zeros(len(names), np.int64),
         separation_time=sep_t, back_contact_time=back_t)
     notes = json.loads(ds.attrs.get("warnings_json", "[]"))
+    # a steady state's record repeats one period: every complete cycle counts, as when
+    # it was saved (its history holds the first period, :func:`_one_period`)
     res = Results(model=model, kinematics=kin, structure=structure, static=static,
-                  solution=solution, model_warnings=notes)
+                  solution=solution, model_warnings=notes,
+                  periodic=ds.attrs.get("analysis") == "periodic steady state",
+                  period=float(ds.attrs.get("steady_period_s", math.nan)) or None)
     res.saved_definition = ds.attrs.get("load_sharing_definition")
     return res

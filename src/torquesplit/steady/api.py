@@ -221,7 +221,8 @@ class SteadyState:
                         structure=self.structure, static=self.static, solution=None)
         sol = _as_solution(self, shell, periods)
         res = Results(model=self.model, kinematics=self.kinematics, structure=self.structure,
-                      static=self.static, solution=sol, periodic=True)
+                      static=self.static, solution=sol, periodic=True,
+                      period=self.solution.period)
         res.steady = self
         return res
 
