@@ -98,3 +98,15 @@ def test_speeds_with_units_and_series_by_name(model):
     assert (f_name == f_index).all() and (t_name == t_index).all()
     with pytest.raises(torquesplit.OptionError, match="unknown element 'm99'"):
         st.mesh_series(["m99"])
+
+
+def test_warnings_name_the_callers_line(model):
+    """A warning raised a few calls below the function the user called was attributed to
+    a line of torquesplit's own (simulation.py:131), not to the user's script."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        torquesplit.simulate(model, cycles=5, samples_per_period=10**6)
+        line = __import__("inspect").currentframe().f_lineno - 1
+    said = [w for w in caught if "asks for more samples" in str(w.message)]
+    assert len(said) == 1
+    assert (said[0].filename, said[0].lineno) == (__file__, line)

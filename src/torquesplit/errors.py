@@ -250,6 +250,25 @@ class ModelWarning(UserWarning):
     """A value that looks wrong but can be right (damping above critical, ...)."""
 
 
+def warn_user(message, category: type[Warning] | None = None) -> None:
+    """``warnings.warn`` attributed to the first caller outside torquesplit (a script's
+    line, a notebook's cell), however deep in the library the warning arose: a fixed
+    ``stacklevel`` named a line of torquesplit's own (``simulation.py:131``) for warnings
+    raised a few calls below the function the user called."""
+    import os
+    import sys
+    import warnings
+
+    package = os.path.dirname(os.path.abspath(__file__)) + os.sep
+    frame, level = sys._getframe(1), 2
+    while frame is not None and os.path.abspath(frame.f_code.co_filename).startswith(package):
+        frame, level = frame.f_back, level + 1
+    if category is None:
+        warnings.warn(message, stacklevel=level)
+    else:
+        warnings.warn(message, category, stacklevel=level)
+
+
 def from_interrupt(exc: BaseException | None) -> bool:
     """Whether a KeyboardInterrupt is in the chain of causes of ``exc`` (Ctrl-C that lands
     inside numba-compiled code comes back as SystemErrors chained from it)."""

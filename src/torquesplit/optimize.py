@@ -74,7 +74,7 @@ from typing import Callable
 
 import numpy as np
 
-from .errors import ModelError, ModelWarning, OptionError, TorquesplitError
+from .errors import ModelError, ModelWarning, OptionError, TorquesplitError, warn_user
 
 __all__ = ["ALGORITHMS", "OptimizationSpec", "OptimizationResult", "read_spec", "optimize",
            "evaluate_design", "output_unit"]
@@ -674,8 +674,8 @@ def optimize(source, *, workers: int | None = None, generations: int | None = No
     check_bounds(spec)
     store = _Store(spec.store, fingerprint(spec))
     if store.other:
-        warnings.warn(f"optimization.store: {store.other} stored evaluation(s) are of another "
-                      f"model, [set] or outputs and are not reused", ModelWarning, stacklevel=2)
+        warn_user(f"optimization.store: {store.other} stored evaluation(s) are of another "
+                      f"model, [set] or outputs and are not reused", ModelWarning)
     baseline = evaluate_design(spec, None)
     for o in (*spec.objectives,):
         if o.relative_to and not baseline[o.output]:

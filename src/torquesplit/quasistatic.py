@@ -14,14 +14,13 @@ from __future__ import annotations
 import json
 import math
 import numbers
-import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from . import _json
 from .assembly.structure import dof_units
-from .errors import ModelWarning, OptionError, SolverError
+from .errors import ModelWarning, OptionError, SolverError, warn_user
 
 from .metrics import load_sharing as ls
 from .model.io import load_model
@@ -214,11 +213,11 @@ def quasi_static_load_sharing(model, *, revolutions: float | None = None,
     wanted = max(16, math.ceil(cycles * per_cycle))
     n = int(min(max_points, wanted))
     if n < wanted:
-        warnings.warn(
+        warn_user(
             f"the quasi-static sweep is cut to max_points = {max_points} positions, "
             f"{n / (period * f_max):.3g} per cycle of the fastest excitation ({f_max:.6g} "
             f"Hz) instead of {per_cycle}; raise max_points (--max-points) or "
-            f"give fewer revolutions for the full density", ModelWarning, stacklevel=2)
+            f"give fewer revolutions for the full density", ModelWarning)
     times = np.arange(n) * (period / n)
     sol = quasi_static(structure, times, progress=progress)
     return QuasiStaticResults(model=model, kinematics=kin, structure=structure, solution=sol)
@@ -272,6 +271,6 @@ def _excitation_period(structure, turn: float) -> float:
             return period * max(1, math.ceil(turn / period - 1e-9))
         why = (f"the excitations repeat only every {period / turn:.6g} revolutions of the "
                f"slowest gear")
-    warnings.warn(f"{why}; the quasi-static sweep covers {MAX_REVOLUTIONS:g} revolutions of "
-                  f"the slowest gear: give revolutions to choose", ModelWarning, stacklevel=3)
+    warn_user(f"{why}; the quasi-static sweep covers {MAX_REVOLUTIONS:g} revolutions of "
+                  f"the slowest gear: give revolutions to choose", ModelWarning)
     return cap

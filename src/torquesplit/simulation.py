@@ -19,7 +19,7 @@ import numpy as np
 
 from ._memo import remember_last
 from .assembly.structure import history_elements
-from .errors import ModelWarning, SolverError
+from .errors import ModelWarning, SolverError, warn_user
 from .model.io import load_model
 from .model.kinematics import solve_kinematics
 
@@ -282,10 +282,9 @@ def starting_equilibria(structure):
     if not why:
         return static, at0, "t0"
     if np.all(np.isfinite(static.q)):
-        warnings.warn(f"the static equilibrium at t = 0 could not start the run ({why}); it "
+        warn_user(f"the static equilibrium at t = 0 could not start the run ({why}); it "
                       "starts from the mean-stiffness equilibrium, so its first cycles hold "
-                      "a start-up swing that the settled metrics leave out", ModelWarning,
-                      stacklevel=4)
+                      "a start-up swing that the settled metrics leave out", ModelWarning)
     return static, static, "mean"
 
 
@@ -320,15 +319,15 @@ def prepare_run(
     if not begin.converged:  # (the state the run starts from)
         # e.g. a member floating inside its clearance with no net load: its position is
         # not determined; the regularised solution is a valid starting state
-        warnings.warn(
+        warn_user(
             "the static equilibrium did not converge exactly (members free inside their "
             f"clearances: {', '.join(begin.separated) or 'none reported'}); the dynamic run "
-            "starts from the regularised solution", ModelWarning, stacklevel=3)
+            "starts from the regularised solution", ModelWarning)
     from .convergence import coarse_table_warning
 
     coarse = coarse_table_warning(model, structure)
     if coarse:
-        warnings.warn(coarse, ModelWarning, stacklevel=3)
+        warn_user(coarse, ModelWarning)
     mesh_names = list(model.meshes)
     freqs = np.array([kin.meshes[m].frequency for m in mesh_names])
     f_min, f_max = float(freqs.min()), float(freqs.max())
@@ -393,21 +392,21 @@ def prepare_run(
             hint = (f"a finer step, which is set by {planned[1]} here: only a "
                     f"--steps-per-period (steps_per_period= in Python) above the {per:.4g} "
                     f"steps per shortest excitation period it makes refines it")
-        warnings.warn(
+        warn_user(
             f"analysis: samples_per_period={samples_per_period} asks for more samples than "
             f"the run takes steps: the history keeps every RK4 step, "
             f"{1.0 / (step * f_max):.4g} per shortest mesh period; a finer history needs "
-            f"{hint}", ModelWarning, stacklevel=3)
+            f"{hint}", ModelWarning)
     # only a sampling the user asked for is worth a warning: the default one is a choice
     # of the library, and what it kept is in the bearing table's title and the files'
     # history_samples_per_period (a default run of Liu et al. 2021 warned)
     if n_records > MAX_HISTORY_RECORDS and samples_per_period is not None:
-        warnings.warn(
+        warn_user(
             f"analysis: the history holds at most {MAX_HISTORY_RECORDS:,} samples, so this "
             f"run keeps {1.0 / (sample_interval * f_max):.3g} per shortest mesh period "
             f"instead of {asked:.3g}: the files' waveforms and the bearing table "
             f"are that coarse (the mesh table is streamed at every step); for fine "
-            f"waveforms run a shorter span", ModelWarning, stacklevel=3)
+            f"waveforms run a shorter span", ModelWarning)
     from .metrics.load_sharing import group_meshes
 
     mesh_groups = list(group_meshes(structure.metadata["meshes"]).values())
@@ -479,7 +478,6 @@ def _check_cost(structure, duration: float, planned: tuple[float, str], max_step
                   + MAX_HISTORY_RECORDS * (1 + n_history))
     if n_steps > ANNOUNCE_STEPS or seconds > ANNOUNCE_SECONDS or memory > ANNOUNCE_BYTES:
         took = f"{seconds / 60:.2g} min" if seconds >= 60 else f"{seconds:.2g} s"
-        warnings.warn(f"this run takes {n_steps:,} RK4 steps of {h:.3g} s ({why}): about "
+        warn_user(f"this run takes {n_steps:,} RK4 steps of {h:.3g} s ({why}): about "
                       f"{took} of integration and {memory / 1024**2:,.0f} MB of results; "
-                      f"shorten the run (duration or cycles) for a quicker look", ModelWarning,
-                      stacklevel=4)
+                      f"shorten the run (duration or cycles) for a quicker look", ModelWarning)

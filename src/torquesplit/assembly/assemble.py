@@ -48,7 +48,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import ModelError
+from ..errors import ModelError, warn_user
 from ..gears import line_of_action as loa
 from ..gears.vectors import cross
 from ..model.kinematics import Kinematics, solve_kinematics
@@ -293,16 +293,14 @@ def _assemble(model: Model, kin: Kinematics | None, *, n_table: int | None,
         pair = _radial_pair(sup, dmap.axes[body], kin.bodies[body].axis)
         if (sup.clearance > 0 and sup.clearance_shape == "radial" and not pair
                 and sum(1 for d in tr if d != "loa") >= 2):
-            import warnings
-
             from ..errors import ModelWarning
 
-            warnings.warn(
+            warn_user(
                 f"{where}.clearance_shape: 'radial' needs two translations across the "
                 f"body's axis ('x', 'y' for an axis along z, ...); this body's "
                 f"{sorted(tr)} are not, so its clearance acts per axis (a square dead "
                 f"zone); give the body an axis along x, y or z, or clearance_shape = "
-                f"'per_axis' to say so", ModelWarning, stacklevel=3)
+                f"'per_axis' to say so", ModelWarning)
         radial = {}
         for d, j in tr.items():
             u = dmap.axes[body][d]

@@ -12,6 +12,7 @@ import math
 
 import numpy as np
 
+from ..errors import ModelWarning, warn_user
 from ..gears import line_of_action as loa
 from ..gears.vectors import cross
 from ..model.kinematics import Kinematics
@@ -52,17 +53,13 @@ def _warn_soft_secant(mesh_name: str, summary: dict) -> None:
     kt = summary.get("stiffness_tangent_mean_N_per_m", math.nan)
     if not (ks > 0 and kt > 0 and ks < SECANT_SOFT * kt):
         return
-    import warnings
-
-    from ..errors import ModelWarning
-
-    warnings.warn(
+    warn_user(
         f"meshes.{mesh_name}.stiffness: the secant LTCA stiffness P/Z ({ks / 1e6:.4g} N/um, "
         f"Liu et al. 2021 eq. 5) is {100 * (1 - ks / kt):.0f} % below the tangent dP/dZ "
         f"({kt / 1e6:.4g} N/um): the separation the modifications open counts as compliance, "
         f"so the mesh's natural frequencies come out about {100 * (1 - math.sqrt(ks / kt)):.0f}"
         f" % low; ltca.excitation = \"tangent\" (the default) keeps dP/dZ and drives the "
-        f"loaded transmission error instead", ModelWarning, stacklevel=2)
+        f"loaded transmission error instead", ModelWarning)
 
 
 def table_points(model: Model, kin: Kinematics) -> int:

@@ -36,6 +36,8 @@ import warnings
 from importlib import resources
 from pathlib import Path
 
+from ..errors import warn_user
+
 #: the earlier names -> the current names (still accepted, with a FutureWarning)
 RENAMED = {
     "seed000_split_torque": "liu2021_split_torque_helicopter",
@@ -96,7 +98,7 @@ def example_path(name: str) -> Path:
     """
     stem, note = current_name(name)
     if note:
-        warnings.warn(note, FutureWarning, stacklevel=2)
+        warn_user(note, FutureWarning)
     path = Path(str(resources.files(__name__) / f"{stem}.toml"))
     if not path.exists():
         raise FileNotFoundError(
@@ -111,7 +113,7 @@ def optimization_path(name: str) -> Path | None:
     if not path.exists():
         return None
     if note:
-        warnings.warn(note, FutureWarning, stacklevel=2)
+        warn_user(note, FutureWarning)
     return path
 
 

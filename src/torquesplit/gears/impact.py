@@ -32,12 +32,11 @@ Sources
 from __future__ import annotations
 
 import math
-import warnings
 from dataclasses import dataclass, replace
 
 import numpy as np
 
-from torquesplit.errors import ModelError, ModelWarning
+from torquesplit.errors import ModelError, ModelWarning, warn_user
 
 __all__ = [
     "involute",
@@ -282,11 +281,10 @@ def meshing_in_point(
     d = corner(s_p)
     r_d = float(math.hypot(d[0], d[1]))
     if tip_radius_driving is not None and r_d > tip_radius_driving:
-        warnings.warn(
+        warn_user(
             "meshing_in_point: the meshing-in point lies above the pinion tip circle; "
             "the advance is larger than the tooth geometry can absorb.",
             ModelWarning,
-            stacklevel=2,
         )
     # distance from the line of action through N_p with direction dvec
     n_p = rbp * np.array([cos_aw, -math.sin(aw)])
@@ -382,12 +380,11 @@ class MeshingInImpact:
         """
         phase = np.arange(n_phases) / n_phases
         if self.duration > 0 and self.duration / self.mesh_period * n_phases < 4:
-            warnings.warn(
+            warn_user(
                 f"MeshingInImpact.table: the impact pulse spans "
                 f"{self.duration / self.mesh_period * n_phases:.1f} samples; use "
                 f"n_phases >= {int(math.ceil(4 * self.mesh_period / self.duration))}.",
                 ModelWarning,
-                stacklevel=2,
             )
         return phase, self.force(phase, remove_mean=remove_mean)
 
@@ -454,11 +451,10 @@ def meshing_in_impact(
     duration = impact_duration(m_e, v_s, impact_stiffness, exponent)
     mesh_period = base_pitch / (abs(omega_driving) * base_radius_driving)
     if duration > mesh_period:
-        warnings.warn(
+        warn_user(
             f"meshing_in_impact: the impact lasts {duration / mesh_period:.2f} mesh periods; "
             "the pulse is clipped at one mesh period (check impact_stiffness and the inertias).",
             ModelWarning,
-            stacklevel=2,
         )
     return MeshingInImpact(
         peak_force=peak,

@@ -35,6 +35,7 @@ from collections import OrderedDict
 import numpy as np
 
 from ..assembly.tables import TABLES
+from ..errors import warn_user
 from .layout import IdentityMemo
 
 log = logging.getLogger(__name__)
@@ -501,7 +502,7 @@ def make_gpu_runner(*, precision: str = "fp64", batch: int = BATCH,
                "instead (same results, CPU speed). Run it on a machine with an NVIDIA GPU "
                "for the GPU backend.")
         log.info(msg)
-        warnings.warn(msg, GpuFallbackWarning, stacklevel=3)
+        warn_user(msg, GpuFallbackWarning)
         return None
     return GpuRunner(precision=precision, target="cuda", batch=batch,
                      workers=int(workers or os.cpu_count() or 1))

@@ -47,11 +47,10 @@ from __future__ import annotations
 
 import math
 import re
-import warnings
 
 import numpy as np
 
-from ..errors import ModelError, ModelWarning, SolverError
+from ..errors import ModelError, ModelWarning, SolverError, warn_user
 from .schema import Model
 
 #: largest net power along the train's rigid rotation, as a fraction of the input plus
@@ -103,15 +102,15 @@ def check_model(model: Model, source: str | None = None, *, deep: bool = False) 
     for loc, msg in warned:
         if accepted(model, loc) is not None:
             continue  # known and accepted in the file, with its reason
-        warnings.warn(f"{source + ': ' if source else ''}{loc}: {msg}", ModelWarning, stacklevel=3)
+        warn_user(f"{source + ': ' if source else ''}{loc}: {msg}", ModelWarning)
     if deep:  # (every check ran: an entry that matches none of them accepts nothing)
         for i, a in enumerate(model.model.accepted_warnings):
             if not any(_accepts(a, loc) for loc, _ in warned):
-                warnings.warn(
+                warn_user(
                     f"{source + ': ' if source else ''}model.accepted_warnings.{i}: "
                     f"{a.field!r} matches no warning of this model's checks; remove the "
                     f"entry, or correct its field (the field a warning names, '*' for any "
-                    f"part)", ModelWarning, stacklevel=3)
+                    f"part)", ModelWarning)
 
 
 def accepted(model: Model, loc: str) -> str | None:

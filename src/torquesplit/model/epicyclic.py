@@ -35,12 +35,11 @@ equal-power-split flow of :mod:`torquesplit.model.kinematics`.
 from __future__ import annotations
 
 import math
-import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import ModelWarning
+from ..errors import ModelWarning, warn_user
 from .schema import Model
 
 #: a body whose centre is farther than this from its bearing seat's axis orbits with it [m]
@@ -461,11 +460,11 @@ def solve_torques(model: Model, axes, frames, groups, speeds, layout: EpicyclicL
         if abs(p) <= 1e-9 * p_scale:
             drv = m.driver or ga
             if m.driver is None:
-                warnings.warn(  # named as written (a [[planetary]] stage's mesh table)
+                warn_user(  # named as written (a [[planetary]] stage's mesh table)
                     f"{model.written_at('meshes.' + n)}: no power passes this mesh in the "
                     f"nominal load, so its loaded flank is not determined; {ga!r} (listed "
                     f"first) is taken as the driver: give 'driver' to choose the flank",
-                    ModelWarning, stacklevel=4)
+                    ModelWarning)
         else:
             drv = ga if p < 0 else gb  # negative: the mesh takes power from the first gear
             if m.driver is not None and m.driver != drv:

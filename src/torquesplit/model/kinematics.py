@@ -17,14 +17,13 @@ All values SI.  Angles of rotation are signed about each body's own axis.
 from __future__ import annotations
 
 import math
-import warnings
 from collections import deque
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from .._memo import remember_last
-from ..errors import ModelWarning
+from ..errors import ModelWarning, warn_user
 from ..gears import line_of_action as loa
 from ..gears.geometry import GearGeometry, PairGeometry
 from ..gears.vectors import cross
@@ -257,7 +256,6 @@ def _solve_kinematics(model: Model) -> Kinematics:
     positions, axes, computed = _layout(model, issues)
     if issues:
         raise KinematicsError(issues)
-
     from . import epicyclic as epi
 
     # carriers and planets first: a ring of the wrong kind is named as such, not as a
@@ -785,10 +783,10 @@ def _power_flow(model: Model, speeds, groups, issues):
             # no power flows through the mesh in the nominal split (e.g. an idler loop)
             drv = m.driver or a
             if m.driver is None:
-                warnings.warn(
+                warn_user(
                     f"meshes.{name}: no power passes this mesh in the nominal split, so its "
                     f"loaded flank is not determined; {a!r} (listed first) is taken as the "
-                    f"driver: give 'driver' to choose the flank", ModelWarning, stacklevel=4)
+                    f"driver: give 'driver' to choose the flank", ModelWarning)
         else:
             drv = a if groups[a] == flow[0] else b
             if m.driver is not None and m.driver != drv:

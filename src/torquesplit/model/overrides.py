@@ -13,7 +13,7 @@ import tomllib
 from pathlib import Path
 from typing import Any, Mapping
 
-from ..errors import ModelError, clip_text
+from ..errors import ModelError, clip_text, warn_user
 
 
 def set_parameter(data: dict, path: str, value: Any) -> dict:
@@ -123,15 +123,12 @@ def apply_assignments(data: dict, assignments) -> tuple[dict, dict[str, str]]:
             raise ModelError(issues, exc.source or source) from None
         where[path] = text
         if path.rsplit(".", 1)[-1] == "speed" and _bare_number(value):
-            import warnings
-
             from ..errors import ModelWarning
             from .units import rad_s_text
 
-            warnings.warn(ModelWarning(
+            warn_user(ModelWarning(
                 f"--set {clip_text(text)}: a bare number is a speed in rad/s "
-                f"({rad_s_text(value)}); write --set {path}='{value:g} rpm' for rpm"),
-                stacklevel=2)
+                f"({rad_s_text(value)}); write --set {path}='{value:g} rpm' for rpm"))
     return data, where
 
 

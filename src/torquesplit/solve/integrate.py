@@ -24,7 +24,6 @@ import logging
 import math
 import threading
 import time
-import warnings
 from dataclasses import dataclass
 from typing import Callable, Sequence
 
@@ -32,7 +31,7 @@ import numpy as np
 
 from torquesplit._memo import remember_last
 from torquesplit.assembly.structure import Structure
-from torquesplit.errors import ModelWarning, OptionError, SolverError, from_interrupt
+from torquesplit.errors import ModelWarning, OptionError, SolverError, from_interrupt, warn_user
 from torquesplit.solve import _kernels as kern
 from torquesplit.solve import codegen
 from torquesplit.solve import kernel_data as kd
@@ -820,14 +819,13 @@ def _plan_rk4(s, span, step, steps_per_period, check_stability, record_every,
     if step is None:
         h, limited_by, per = _default_step(s, span, spp, check)
         if per > _STEP_WARN_FACTOR * spp:
-            warnings.warn(
+            warn_user(
                 f"the RK4 step is {per / spp:.3g} times shorter than {spp} steps per "
                 f"excitation period: {limited_by}; the run takes "
                 f"{math.ceil(span / h):,} steps. Check that element's stiffness and unit "
                 f"(and the inertias it joins): a stiffness this high is usually a slip of "
                 f"units; an adaptive method (dopri) is explicit too and needs as short a "
-                f"step, so it does not help.", ModelWarning,
-                stacklevel=4)
+                f"step, so it does not help.", ModelWarning)
     else:
         h = float(step)
         if check:
@@ -938,9 +936,9 @@ def _rhs_code(kind: str, model, n_rhs: float) -> codegen.GeneratedRhs:
         global _CODEGEN_WARNED
         if not _CODEGEN_WARNED:
             _CODEGEN_WARNED = True
-            warnings.warn(f"could not compile this model's right-hand side ({type(exc).__name__}: "
+            warn_user(f"could not compile this model's right-hand side ({type(exc).__name__}: "
                           f"{exc}); using the general kernel (same results, about half the "
-                          f"speed).", RuntimeWarning, stacklevel=3)
+                          f"speed).", RuntimeWarning)
         return codegen.general_rhs()
 
 

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from torquesplit.errors import OptionError, SolverError
+from torquesplit.errors import OptionError, SolverError, warn_user
 from torquesplit.solve.kernel_data import continuous_start
 from torquesplit.steady.period import (
     base_frequency,
@@ -103,11 +103,9 @@ def _warn_far_speed(model, speed, value: float, s: float) -> None:
     else:
         text = (f"speed {speed!r} is read in rad/s = {value * rpm:,.6g} rpm, {at}; give "
                 f"speed='{speed:g} rpm' if rpm were meant")
-    import warnings
-
     from torquesplit.errors import ModelWarning
 
-    warnings.warn(text, ModelWarning, stacklevel=4)
+    warn_user(text, ModelWarning)
 
 
 def _check_options(*, steps_per_cycle, tol, stability, energy_tol) -> None:

@@ -8,11 +8,10 @@ from __future__ import annotations
 
 import math
 import time
-import warnings
 
 import numpy as np
 
-from torquesplit.errors import ModelWarning, SolverError
+from torquesplit.errors import ModelWarning, SolverError, warn_user
 from torquesplit.steady.api import reference_speed
 from torquesplit.steady.period import (
     MAX_CYCLES,
@@ -238,11 +237,11 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
         wall_time_s=time.perf_counter() - t_start,
     )
     if method != "shooting" and rows and float(np.max(stack("contact_loss"))) > 0:
-        warnings.warn(
+        warn_user(
             "harmonic balance over contact loss: a truncated series rings where the teeth "
             "separate, so the jump speeds and the peaks there can be off by per cents (on a "
             "single spur pair a fold 6 % off); shooting (--method shooting, the default "
-            "without --harmonics) steps through the separations", ModelWarning, stacklevel=2)
+            "without --harmonics) steps through the separations", ModelWarning)
     gaps = unresolved_critical_speeds(sp * w_ref * RPM, [c["speed_rpm"] for c in critical])
     ds.attrs["unresolved_critical_speeds_rpm"] = gaps
     if gaps:

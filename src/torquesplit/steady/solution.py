@@ -10,12 +10,11 @@ from __future__ import annotations
 import logging
 import math
 import time
-import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from torquesplit.errors import ModelWarning, SolverError
+from torquesplit.errors import ModelWarning, SolverError, warn_user
 from torquesplit.solve._frozen import freeze_arrays
 from torquesplit.solve._kernels import MESH_KIND
 from torquesplit.steady.harmonic import HarmonicBalance
@@ -213,11 +212,11 @@ def _announce(p, T, steps, stability) -> None:
     per_map = SECONDS_PER_DOF_STEP * p.structure.n_dof * steps
     more = (f"; the stability adds {2 * p.structure.n_dof} variational columns "
             f"(--no-stability skips them)" if stability else "")
-    warnings.warn(
+    warn_user(
         f"the periodic state takes {steps:,} RK4 steps per period ({why}): about "
         f"{per_map:.2g} s per integration of the period, and the solve takes several"
         f"{more}; a speed near the model's, or 'torquesplit run', is quicker",
-        ModelWarning, stacklevel=3)
+        ModelWarning)
 
 
 def converged_hb(p, H, samples, speed, q_static, initial, tol, *, adaptive=True,
@@ -327,12 +326,12 @@ def periodic_solution(structure, period: Period, *, method: str = "auto", harmon
                                            max_harmonics=max_harmonics, say=say)
         H = hb.H
         if adaptive and info.converged and energy > energy_tol:
-            warnings.warn(
+            warn_user(
                 f"harmonic balance stopped at {H} harmonics (the limit is {max_harmonics}) "
                 f"with {energy:.1e} of the velocity energy in the top quarter, above "
                 f"{energy_tol:.0e}: peak forces may be off in the last digits; use "
                 f"method='shooting' (--method shooting), or keep one stage's excitations "
-                f"(keep=, --keep) for a shorter period", ModelWarning, stacklevel=3)
+                f"(keep=, --keep) for a shorter period", ModelWarning)
         r, a, F, D, q, v = hb.residual_samples(x, speed)
         rm = hb.residual_samples(x, speed, shift=0.5)[0]
         t_res = float(np.sqrt(np.mean(rm**2))) / max(float(np.max(np.abs(a))), 1e-300)

@@ -22,12 +22,11 @@ from __future__ import annotations
 import logging
 import math
 import time
-import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from torquesplit.errors import ModelWarning, SolverError
+from torquesplit.errors import ModelWarning, SolverError, warn_user
 from torquesplit.steady.harmonic import HarmonicBalance
 from torquesplit.steady.newton import floquet_hill, floquet_monodromy
 from torquesplit.steady.solution import (
@@ -600,12 +599,11 @@ def continue_in_speed(problem, period, q_static, s0, s1, *, points=50, harmonics
         if not info.converged:  # let the continuation's corrector report the failure
             x0 = _initial_hb(hb, q_static, initial)
         elif energy > ENERGY_TOL:
-            warnings.warn(
+            warn_user(
                 f"the sweep keeps {hb.H} harmonics, the most it could converge at its first "
                 f"speed, with {energy:.1e} of the velocity energy in the top quarter (above "
                 f"{ENERGY_TOL:.0e}): peak forces may be off in the last digits; keep one "
-                f"stage's excitations (--keep) for a shorter period", ModelWarning,
-                stacklevel=2)
+                f"stage's excitations (--keep) for a shorter period", ModelWarning)
     else:
         hb = HarmonicBalance(problem, int(harmonics), samples)
         x0 = _initial_hb(hb, q_static, initial)

@@ -21,6 +21,8 @@ import os
 import time
 import warnings
 
+from ..errors import warn_user
+
 STATUSES = ("ok", "contact_lost", "diverged", "refused", "error")
 """Case statuses, from best to worst."""
 
@@ -76,7 +78,7 @@ class CaseWarning(UserWarning):
 
 def _warn(pairs) -> None:
     for loc, msg in pairs:
-        warnings.warn(f"{loc}: {msg}", CaseWarning, stacklevel=2)
+        warn_user(f"{loc}: {msg}", CaseWarning)
 
 
 def _one_line(exc) -> str:

@@ -29,7 +29,7 @@ import numpy as np
 
 from .case import payload, run_case
 from .design import Plan, resolve
-from .errors import StudyError, StudyInterrupted
+from .errors import StudyError, StudyInterrupted, warn_user
 from .runners import make_runner
 from .spec import read_study
 from .store import STORE_NAME, Store, StoreLock
@@ -195,12 +195,11 @@ class Study:
             and the figures are written: the run is recorded as finished only once they
             are, and ``resume=True`` writes them again).
         """
-        import warnings
 
         from ..errors import ModelWarning
 
         for note in self.plan().notes + nothing_to_resume(out, resume, API_WORDS):
-            warnings.warn(note, ModelWarning, stacklevel=2)  # (before any case runs)
+            warn_user(note, ModelWarning)  # (before any case runs)
         return self._run(API_WORDS, workers=workers, client=client, scheduler=scheduler,
                          runner=runner, out=out, resume=resume, overwrite=overwrite,
                          progress=progress, figures=figures, backend=backend,

@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import TorquesplitError
+from ..errors import TorquesplitError, warn_user
 from ..model.io import load_model, model_from_dict, model_to_dict
 from ..model.overrides import apply_overrides, read_raw
 from . import outputs as out_mod
@@ -291,7 +291,7 @@ def _model_data(name, folder: Path | None) -> tuple[str, dict]:
     stem, note = current_name(name)
     if stem in example_names():
         if note:
-            warnings.warn(note, FutureWarning, stacklevel=2)
+            warn_user(note, FutureWarning)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", FutureWarning)
             return stem, read_raw(example_path(stem))

@@ -40,7 +40,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from torquesplit.errors import ModelError, ModelWarning
+from torquesplit.errors import ModelError, ModelWarning, warn_user
 from torquesplit.gears import impact as gim
 
 __all__ = ["LoadedMeshingIn", "loaded_meshing_in"]
@@ -154,9 +154,8 @@ def loaded_meshing_in(result, *, omega_driving: float, inertia_driving: float,
     duration = gim.impact_duration(m_e, v_n, k_s, exponent)
     mesh_period = pair.base_pitch / (abs(omega_driving) * g1.base_radius)
     if duration > mesh_period:
-        warnings.warn(f"meshing-in impact lasts {duration / mesh_period:.2f} mesh periods; the "
-                      "pulse is clipped at one mesh period (check the inertias)", ModelWarning,
-                      stacklevel=2)
+        warn_user(f"meshing-in impact lasts {duration / mesh_period:.2f} mesh periods; the "
+                      "pulse is clipped at one mesh period (check the inertias)", ModelWarning)
     imp = gim.MeshingInImpact(
         peak_force=peak, duration=duration, mesh_period=mesh_period,
         start_phase=float(np.mod(entry - lead, 1.0)), point=point, effective_mass=m_e,
