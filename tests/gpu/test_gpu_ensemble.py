@@ -151,6 +151,34 @@ def test_cases_that_share_tables_plan_the_kernel_model_of_their_own_structure():
     assert models[0].stiffness_table is models[1].stiffness_table
 
 
+@pytest.mark.parametrize("example", ["jin2019_friction_split", "dong2021_face_gear"])
+def test_the_planners_kernel_model_is_the_engines_and_goes_with_its_structure(example):
+    """The kernel model takes the structure's tables as they are: a memo value that held
+    one (or a view of the friction table) kept its own key alive, so a study's table
+    sets were never released (tooth friction: 17 MB each).  A hit must still give the
+    engine's kernel model, and neither may change the structure's tables (a spline
+    component's stiffness row is zeroed in a copy)."""
+    import gc
+
+    import torquesplit
+    from torquesplit.gpu import ensemble
+    from torquesplit.solve import kernel_data as kd
+
+    s = torquesplit.assemble(torquesplit.load_model(example))  # (a name is memoised)
+    before = s.stiffness_table.copy()
+    first, again, engine = ensemble._kernel_model(s), ensemble._kernel_model(s), \
+        kd.kernel_model(s)
+    for field in engine._fields:
+        for m in (first, again):
+            np.testing.assert_array_equal(getattr(m, field), getattr(engine, field), field)
+    np.testing.assert_array_equal(s.stiffness_table, before)
+    assert kd.kernel_model(s).force_table is s.force_table  # taken, not copied
+    held = len(ensemble._KERNEL_TABLES)
+    del s, first, again, engine, m  # (every kernel model holds the tables it takes)
+    gc.collect()
+    assert len(ensemble._KERNEL_TABLES) == held - 1
+
+
 def test_a_memo_value_goes_with_its_arrays():
     """The planner's copies of a table set (29 MB for Ji & Li's drive) must not outlive
     the cases that use them."""

@@ -217,15 +217,15 @@ class GpuRunner:
 
     def _measure_tables(self, jobs: list["_Job"]) -> None:
         """Host memory of the distinct phase-table sets of a batch, per case: each
-        distinct set is held by the structure, copied into the kernel model and stacked
-        into the launch (about three times its size)."""
+        distinct set is held by the structure (the kernel model takes its arrays as they
+        are) and stacked into the launch (about twice its size)."""
         sets = {}
         for j in jobs:
             if j.run is not None:
                 s = j.run.structure
                 sets[id(s.stiffness_table)] = sum(getattr(s, f).nbytes for f in TABLES)
         if jobs:
-            self._case_bytes = 3.0 * sum(sets.values()) / len(jobs)
+            self._case_bytes = 2.0 * sum(sets.values()) / len(jobs)
 
     def _next_size(self) -> int:
         """Cases in the next batch: the runner's ``batch``, fewer where the cases' own

@@ -130,17 +130,21 @@ def case_arrays(run) -> _Planned:
 _KERNEL_TABLES = IdentityMemo()
 
 
-#: KernelModel fields computed from the structure's phase tables (copies, corner nodes)
+#: KernelModel fields computed from the structure's phase tables (corner nodes, and the
+#: tables themselves: the structure's own arrays, or a copy where kernel_model changes
+#: one: spline components' stiffness rows zeroed)
 _FROM_TABLES = ("stiffness_table", "force_table", "friction_table", "corner_ptr",
                 "corner_node")
 
 
 def _kernel_model(s):
-    """``kd.kernel_model(s)``, with what it computes from the phase tables (their copies,
-    the corner nodes) made once per structure table object: the cases of a study share
-    their tables (see :mod:`torquesplit.gpu.backend`), so they share these too, and
-    neither the copy (29 MB a case for Ji & Li's drive), the corner search nor the
-    layout's look at them is repeated.  The other inputs of the corner nodes (which
+    """``kd.kernel_model(s)``, with what it computes from the phase tables (the corner
+    nodes, a copy where it changes one) made once per structure table object: the cases
+    of a study share their tables (see :mod:`torquesplit.gpu.backend`), so they share
+    these too, and neither the corner search, a copy nor the layout's look at them is
+    repeated.  The memo keeps only what is not the structure's own memory (a table the
+    kernel model takes as it is, or a view of it, would keep the structure's tables
+    alive, and with them the memo's entry).  The other inputs of the corner nodes (which
     elements vary, spline components, tooth-friction rows, multi-value gaps) are
     compared, not assumed."""
     src = (s.stiffness_table, s.force_table, s.friction_table)
@@ -152,11 +156,22 @@ def _kernel_model(s):
     hit = _KERNEL_TABLES.peek(src)
     if hit is None or hit[0] != aux:
         model = kd.kernel_model(s)
-        _KERNEL_TABLES.put(src, (aux, {f: getattr(model, f) for f in _FROM_TABLES}))
+        own = {f: getattr(model, f) for f in _FROM_TABLES
+               if not any(np.shares_memory(getattr(model, f), a) for a in src)}
+        _KERNEL_TABLES.put(src, (aux, own))
         return model
     small = {f: np.zeros(a.shape[:-1] + (1,)) for f, a in zip(
         ("stiffness_table", "force_table", "friction_table"), src, strict=True)}
-    return kd.kernel_model(dataclasses.replace(s, **small))._replace(**hit[1])
+    # the tables the memo does not hold: the structure's own, as kernel_model takes them
+    # (the friction rows 3 per friction mesh)
+    n_fm = len(s.fr_el)
+    taken = {f: kd.table_array(a) for f, a in zip(
+        ("stiffness_table", "force_table", "friction_table"), src, strict=True)
+        if f not in hit[1]}
+    if "friction_table" in taken:
+        taken["friction_table"] = (taken["friction_table"].reshape(3 * n_fm, -1) if n_fm
+                                   else np.zeros((0, 1)))
+    return kd.kernel_model(dataclasses.replace(s, **small))._replace(**hit[1], **taken)
 
 
 def _group_min(kw: dict, n_groups: int) -> np.ndarray:

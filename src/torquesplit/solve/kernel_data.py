@@ -207,12 +207,20 @@ def _fs_ptr(s: Structure) -> np.ndarray:
     return s.fs_ptr if len(s.fs_ptr) else np.zeros(s.n_dof + 1, dtype=np.int64)
 
 
+def table_array(a) -> np.ndarray:
+    """A phase table as the kernels take it: the array itself where it is contiguous,
+    float64 and writable (the kernels only read it), else a copy that is (a read-only
+    array would be typed apart by numba: a new compilation)."""
+    a = np.ascontiguousarray(a, dtype=np.float64)
+    return a if a.flags.writeable else a.copy()
+
+
 def kernel_model(structure: Structure) -> KernelModel:
     """The structure's arrays in kernel form (contiguous, writable, derived index arrays
     included); raises :class:`~torquesplit.errors.SolverError` if inconsistent.  The
-    phase tables are the structure's own arrays where they already are so (the kernels
-    only read them): copying them cost 7 ms a run of Ji & Li's drive (two 14 x 65536
-    tables), a third of a short study case's time outside the integration."""
+    phase tables are the structure's own arrays where they already are so
+    (:func:`table_array`): copying them cost about 4 ms of every run of Ji & Li's drive
+    (two 14 x 65536 tables)."""
     s = structure
     _check(s)
     n_el = s.n_elements
@@ -226,10 +234,6 @@ def kernel_model(structure: Structure) -> KernelModel:
     def u8(a):
         return np.array(a, dtype=np.uint64, order="C", copy=True)
 
-    def table(a):  # (a read-only array would be typed apart by numba: a new compilation)
-        a = np.ascontiguousarray(a, dtype=np.float64)
-        return a if a.flags.writeable else a.copy()
-
     varying = s.frequency > 0.0
     sin_el = np.repeat(np.arange(n_el, dtype=np.int64), np.diff(s.error_ptr))
     err_el = np.unique(sin_el)
@@ -241,7 +245,7 @@ def kernel_model(structure: Structure) -> KernelModel:
     # spline component elements: zero stiffness and damping in the element loop (their
     # force there is 0); the kernels' rhs_extra applies the radial law
     comps = np.asarray(s.sp_el, dtype=np.int64).ravel()
-    ktab, damp = (f8 if comps.size else table)(s.stiffness_table), f8(s.damping)
+    ktab, damp = (f8 if comps.size else table_array)(s.stiffness_table), f8(s.damping)
     ktab[comps] = 0.0
     damp[comps] = 0.0
     n_fm = len(s.fr_el)
@@ -254,13 +258,13 @@ def kernel_model(structure: Structure) -> KernelModel:
         gap_values=f8(s.gap_values), error_constant=f8(s.error_constant),
         error_ptr=i8(s.error_ptr), error_amplitude=f8(s.error_amplitude),
         error_omega=f8(s.error_omega), error_phase=f8(s.error_phase),
-        force_table=table(s.force_table), tv_el=i8(np.flatnonzero(varying)), err_el=i8(err_el),
+        force_table=table_array(s.force_table), tv_el=i8(np.flatnonzero(varying)), err_el=i8(err_el),
         sin_el=i8(sin_el), vr_ptr=u8(s.v_ptr), vq_idx=u8(s.v_dof),
         vv_idx=u8(np.asarray(s.v_dof) + s.n_dof), vt_ptr=u8(np.cumsum(vt_ptr)),
         vt_el=u8(owner[order]), vt_coef=f8(np.asarray(s.v_coef)[order]),
         fr_el=i8(s.fr_el), fr_ptr=i8(s.fr_ptr), fr_dof=i8(s.fr_dof), fr_coef=f8(s.fr_coef),
         fr_row=i8(s.fr_row),
-        friction_table=(table(s.friction_table).reshape(3 * n_fm, -1) if n_fm
+        friction_table=(table_array(s.friction_table).reshape(3 * n_fm, -1) if n_fm
                         else np.zeros((0, 1))),
         sp_el=i8(s.sp_el).reshape(n_sp, 2), sp_par=f8(s.sp_par).reshape(n_sp, 6),
         gy_ptr=u8(_gy_ptr(s)), gy_idx=u8(np.asarray(s.gy_idx) + s.n_dof),

@@ -27,9 +27,10 @@ from typing import Callable
 
 import numpy as np
 
+from ..errors import warn_user
 from .case import payload, run_case
 from .design import Plan, resolve
-from .errors import StudyError, StudyInterrupted, warn_user
+from .errors import StudyError, StudyInterrupted
 from .runners import make_runner
 from .spec import read_study
 from .store import STORE_NAME, Store, StoreLock
