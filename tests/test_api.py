@@ -76,10 +76,21 @@ def test_bad_arguments_raise_the_packages_own_error(model):
              lambda: run.metrics(window=1),
              lambda: run.metrics("no_such_definition"),
              lambda: torquesplit.quasi_static_load_sharing(model, revolutions=-1),
-             lambda: torquesplit.steady_state(model, method="hb").mesh_series(["m99"])]
+             lambda: torquesplit.steady_state(model, method="hb").mesh_series(["m99"]),
+             # checked before the period search (a LongPeriodError of another model)
+             lambda: torquesplit.steady_state(model, method="newton"),
+             lambda: torquesplit.steady_state(model, harmonics=0),
+             lambda: torquesplit.steady_state(model, speed="3000 mm"),
+             lambda: torquesplit.sweep_speed(model, "600 rpm", "800 rpm", points=0),
+             lambda: torquesplit.simulate(model, cycles=10, max_steps=0),
+             lambda: run.bearing_forces("x"),
+             lambda: run.write_figures("figs", formats=("xlsx",))]
     for call in calls:
         with pytest.raises(torquesplit.OptionError):
             call()
+    # a wrong kind of argument is also a TypeError
+    with pytest.raises(torquesplit.OptionTypeError):
+        torquesplit.simulate(model, cycles=10, progress="yes")
 
 
 def test_speeds_with_units_and_series_by_name(model):
@@ -89,7 +100,7 @@ def test_speeds_with_units_and_series_by_name(model):
     by_text = torquesplit.campbell(model, "600 rpm", "800 rpm")[1]
     by_number = torquesplit.campbell(model, 600 * rpm, 800 * rpm)[1]
     assert [c["speed_rpm"] for c in by_text] == [c["speed_rpm"] for c in by_number]
-    with pytest.raises(torquesplit.SolverError, match="start: '600 kg' is not a speed"):
+    with pytest.raises(torquesplit.OptionError, match="start: '600 kg' is not a speed"):
         torquesplit.campbell(model, "600 kg", "800 rpm")
     st = torquesplit.steady_state(model, method="hb")
     names = list(st.structure.element_names)

@@ -17,8 +17,8 @@ The pipeline, one stage per subpackage (each stage returns a new object)::
 from __future__ import annotations
 
 from .assembly.assemble import assemble
-from .errors import (ModelError, ModelWarning, OptionError, OutputError, SolverError,
-                     StepTooLargeError, StudyError, TorquesplitError)
+from .errors import (ModelError, ModelWarning, OptionError, OptionTypeError, OutputError,
+                     SolverError, StepTooLargeError, StudyError, TorquesplitError)
 from .examples import example_names, example_path
 from .model.io import load_model
 from .model.kinematics import solve_kinematics
@@ -29,7 +29,8 @@ from .simulation import simulate
 __version__ = "0.1.0"
 
 __all__ = [
-    "ModelError", "ModelWarning", "OptionError", "OutputError", "SolverError",
+    "ModelError", "ModelWarning", "OptionError", "OptionTypeError", "OutputError",
+    "SolverError",
     "StepTooLargeError", "StudyError", "TorquesplitError", "example_names", "example_path",
     "load_model", "solve_kinematics", "assemble", "simulate", "quasi_static_load_sharing",
     "model_modes", "steady_state", "sweep_speed", "campbell", "load_results",

@@ -109,6 +109,10 @@ class OptionError(TorquesplitError, ValueError):
     """A command-line option or function argument out of its range (``--count -1``)."""
 
 
+class OptionTypeError(OptionError, TypeError):
+    """A function argument of the wrong kind (a ``progress`` that is not callable)."""
+
+
 class OutputError(TorquesplitError, OSError):
     """Results cannot be written where asked: no such folder, a folder, a file that
     exists (and overwriting was not asked for), another run writing it, a full disk."""

@@ -122,7 +122,7 @@ class ModalReport:
         n = self.solution.mode_shapes.shape[1]
         if not (isinstance(mode, (int, np.integer)) and 1 <= mode <= n):
             raise OptionError(f"mode must be a whole number 1..{n} (1-based, ascending "
-                             f"frequency), got {mode!r}")
+                              f"frequency), got {mode!r}")
         phi = self.solution.mode_shapes[:, mode - 1]
         return {n: complex(v) for n, v in zip(self.dof_names, phi)}
 
@@ -364,7 +364,7 @@ def model_modes(model, *, rotating_frame: bool = True, below: float | None = Non
         raise OptionError(f"count must be a whole number of modes, 1 or more, got {count!r}")
     if below is not None and not (isinstance(below, (int, float)) and below > 0):
         raise OptionError(f"below must be a positive frequency in Hz (a number), got "
-                         f"{below!r}")
+                          f"{below!r}")
     if not hasattr(model, "meshes"):
         model = load_model(model)
     kin = solve_kinematics(model)

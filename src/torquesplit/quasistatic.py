@@ -188,11 +188,11 @@ def quasi_static_load_sharing(model, *, revolutions: float | None = None,
         if (isinstance(value, bool) or not isinstance(value, numbers.Real)
                 or not float(value).is_integer() or value < 1):
             raise OptionError(f"{name} must be a whole number >= 1, got {value!r}; give "
-                             f"e.g. {name}={example}")
+                              f"e.g. {name}={example}")
     if revolutions is not None and (isinstance(revolutions, bool) or not isinstance(
             revolutions, numbers.Real) or not (0 < revolutions < math.inf)):
         raise OptionError(f"revolutions must be a positive number, got {revolutions!r}; "
-                         f"give e.g. revolutions=1 (of the slowest gear)")
+                          f"give e.g. revolutions=1 (of the slowest gear)")
     points_per_cycle, max_points = int(points_per_cycle), int(max_points)
     if not hasattr(model, "meshes"):
         model = load_model(model)

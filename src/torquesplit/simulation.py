@@ -19,7 +19,7 @@ import numpy as np
 
 from ._memo import remember_last
 from .assembly.structure import history_elements
-from .errors import ModelWarning, SolverError, warn_user
+from .errors import ModelWarning, OptionError, SolverError, warn_user
 from .model.io import load_model
 from .model.kinematics import solve_kinematics
 
@@ -462,7 +462,8 @@ def _check_cost(structure, duration: float, planned: tuple[float, str], max_step
     before integrating: the step is fixed) with its time and memory; ``planned`` is
     :func:`~torquesplit.solve.integrate.planned_step`'s ``(step, what sets it)``."""
     if max_steps < 1:
-        raise SolverError(f"max_steps must be >= 1, got {max_steps}")
+        raise OptionError(f"max_steps must be >= 1, got {max_steps}; give e.g. "
+                          f"max_steps=10_000_000")
     h, why = planned
     n_steps = math.ceil(duration / h)
     # about 60 ns per DOF and step with the generated right-hand side (benchmarks/)

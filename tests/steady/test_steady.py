@@ -14,7 +14,7 @@ import pytest
 
 from oscillators import backlash_oscillator
 from torquesplit.assembly.structure import MESH, SPRING, build_structure
-from torquesplit.errors import SolverError
+from torquesplit.errors import OptionError, SolverError
 from torquesplit.solve.integrate import integrate
 from torquesplit.steady.harmonic import HarmonicBalance
 from torquesplit.steady.newton import (
@@ -398,7 +398,7 @@ def test_continuation_failure_keeps_the_partial_curve(monkeypatch):
     assert not complete and 3 <= len(pts) <= 6
     assert "continuation failed at speed factor" in msg and "kept" in msg
     assert "--method shooting" in msg
-    with pytest.raises(SolverError, match="two different positive speeds"):
+    with pytest.raises(OptionError, match="two different positive speeds"):
         continue_in_speed(p, per, np.array([1.1]), -1.0, 1.5)
     # the same for the shooting continuation: partial curve, its own remedy
     from torquesplit.steady.sweep import continue_in_speed_shooting
@@ -417,7 +417,7 @@ def test_continuation_failure_keeps_the_partial_curve(monkeypatch):
         p, per, np.array([1.1]), 0.5, 1.5, points=20, stability=False)
     assert not complete and 3 <= len(pts) <= 6
     assert "kept" in msg and "--method hb" in msg
-    with pytest.raises(SolverError, match="two different positive speeds"):
+    with pytest.raises(OptionError, match="two different positive speeds"):
         continue_in_speed_shooting(p, per, np.array([1.1]), 1.5, 1.5)
 
 

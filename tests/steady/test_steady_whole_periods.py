@@ -57,7 +57,7 @@ def test_speed_with_its_unit():
     """speed='3000 rpm' and speed='50 Hz' are the same speed (rad/s as a bare number)."""
     import math
 
-    from torquesplit.errors import SolverError
+    from torquesplit.errors import OptionError
     from torquesplit.steady.api import reference_speed, speed_factor
 
     import torquesplit
@@ -66,7 +66,7 @@ def test_speed_with_its_unit():
     w = 100 * math.pi
     assert speed_factor(m, "3000 rpm") == pytest.approx(w / reference_speed(m), rel=1e-12)
     assert speed_factor(m, "50 Hz") == pytest.approx(speed_factor(m, w), rel=1e-12)
-    with pytest.raises(SolverError, match="speed"):
+    with pytest.raises(OptionError, match="speed"):
         speed_factor(m, "3000 mm")
 
 
@@ -299,7 +299,7 @@ def test_a_speed_in_hz_far_from_the_models_is_said():
     with pytest.warns(ModelWarning, match=r"speed 745 is read in rad/s = 7,114.2\d rpm, "
                                           r"9.55 times .* speed='745 rpm'"):
         speed_factor(m, 745)
-    with pytest.raises(torquesplit.errors.SolverError, match="not a positive finite"):
+    with pytest.raises(torquesplit.errors.OptionError, match="not a positive finite"):
         speed_factor(m, -78.0)  # (its absolute value ran, silently)
     # the command line says a bare number's unit once (the library repeated it)
     from typer.testing import CliRunner
@@ -363,14 +363,14 @@ def test_steady_and_campbell_options_are_checked_and_the_summary_names_its_defin
     campbell(points=0) failed inside xarray; summary()'s load_sharing did not say which
     coefficient it is (sweep_speed's is another)."""
     import torquesplit
-    from torquesplit.errors import SolverError
+    from torquesplit.errors import OptionError
     from torquesplit.steady.maps import campbell
 
     model = torquesplit.load_model("ji_li_mill_drive")
     for kwargs, said in (({"steps_per_cycle": 0}, "steps_per_cycle must be a whole number"),
                          ({"tol": -1}, "tol must be a small positive number"),
                          ({"stability": "foo"}, "stability must be True, False, 'hill'")):
-        with pytest.raises(SolverError, match=said):
+        with pytest.raises(OptionError, match=said):
             steady_state(model, keep="stage1", **kwargs)
     with pytest.raises(ValueError, match="points must be a whole number >= 2, got 0"):
         campbell(model, 60, 80, points=0)

@@ -37,6 +37,7 @@ from matplotlib.figure import Figure
 from matplotlib.ticker import NullLocator
 
 from ..errors import FigureNotApplicableError, TorquesplitError  # noqa: F401 - re-exported
+from ..errors import OptionError, OptionTypeError
 
 __all__ = [
     "FigureNotApplicableError", "figure_jobs", "write_jobs", "figure_svg",
@@ -820,7 +821,8 @@ def write_figures(results, directory, formats=("png", "svg"), *,
         stiffness varies).
     """
     if hasattr(results, "orbits"):
-        raise TypeError("write_figures takes a dynamic run; for quasi-static results call "
+        raise OptionTypeError("write_figures takes a dynamic run; for quasi-static results "
+                              "call "
                         "write_static_figures(results, directory)")
     _check_formats(formats)
     jobs = figure_jobs(results, definition=definition, last_cycles=last_cycles)
@@ -874,7 +876,8 @@ def write_static_figures(results, directory, formats=("png", "svg"), *, prefix: 
     stiffness varies).  Arguments as in :func:`write_figures`.
     """
     if not hasattr(results, "orbits"):
-        raise TypeError("write_static_figures takes quasi-static results; for a dynamic run "
+        raise OptionTypeError("write_static_figures takes quasi-static results; for a "
+                              "dynamic run "
                         "call write_figures(results, directory)")
     return _write(static_figure_jobs(results), directory, formats, prefix, dpi)
 
@@ -896,7 +899,7 @@ def _check_formats(formats) -> tuple[str, ...]:
     supported = FigureCanvasAgg.get_supported_filetypes()
     bad = [f for f in formats if f.lower().lstrip(".") not in supported]
     if bad or not formats:
-        raise ValueError(f"cannot write figures as {', '.join(bad) or 'no format'}; choose "
+        raise OptionError(f"cannot write figures as {', '.join(bad) or 'no format'}; choose "
                          f"formats among {', '.join(sorted(supported))}")
     return formats
 

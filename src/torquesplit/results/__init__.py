@@ -286,11 +286,11 @@ class Results:
         if (isinstance(window, bool) or not isinstance(window, numbers.Real)
                 or not float(window).is_integer() or window < 2):
             raise OptionError(f"window must be a whole number of cycles >= 2, got "
-                             f"{window!r}; give e.g. window=20")
+                              f"{window!r}; give e.g. window=20")
         if isinstance(tolerance, bool) or not (isinstance(tolerance, numbers.Real)
                                                and 0 < tolerance < 1):
             raise OptionError(f"tolerance must be a fraction between 0 and 1, got "
-                             f"{tolerance!r}; give e.g. tolerance=0.01 (1 %)")
+                              f"{tolerance!r}; give e.g. tolerance=0.01 (1 %)")
         s = self.solution
         names = self.mesh_names
         c_max, c_min, c_mean, c_cnt, c_ratio = self.complete_cycle_statistics()
@@ -379,7 +379,7 @@ class Results:
                 f"choose one of {', '.join(ls.DYNAMIC_DEFINITIONS)} for this run.")
         if definition not in ls.DEFINITIONS:
             raise OptionError(f"unknown load-sharing definition {definition!r}; choose one of "
-                             f"{', '.join(ls.DYNAMIC_DEFINITIONS)}")
+                              f"{', '.join(ls.DYNAMIC_DEFINITIONS)}")
         return definition
 
     def metric_values(self, definitions=None, *, window: int = 20,
@@ -480,6 +480,10 @@ class Results:
         by_body = self.support_columns()
         if not by_body:
             return []
+        if start_time is not None and not (isinstance(start_time, numbers.Real)
+                                           and not isinstance(start_time, bool)):
+            raise OptionError(f"start_time must be a time in seconds (a number), got "
+                              f"{start_time!r}; give e.g. res.metrics().settling.start_time")
         if self.periodic and self.period:  # one whole period: the state repeats it (a
             # settle time inside the period weighted a part of it: a mean 6x too large)
             from .dataset import period_samples

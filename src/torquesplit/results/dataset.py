@@ -10,6 +10,7 @@ import xarray as xr
 
 from .. import _json
 from ..assembly.structure import element_units
+from ..errors import OptionError
 
 
 def _var(dims, data, units, long_name):
@@ -353,7 +354,7 @@ def results_from_dataset(ds: xr.Dataset):
     from . import Results
 
     if "model_json" not in ds.attrs or "cycle_max_force" not in ds:
-        raise ValueError("not a torquesplit results file of a dynamic run (no embedded model "
+        raise OptionError("not a torquesplit results file of a dynamic run (no embedded model "
                          "or cycle statistics); give a file written by 'torquesplit run "
                          "--out F.nc', or open this one as a Dataset with "
                          "torquesplit.open_results (a quasi-static sweep's, modes', a "

@@ -31,7 +31,8 @@ import numpy as np
 
 from torquesplit._memo import remember_last
 from torquesplit.assembly.structure import Structure
-from torquesplit.errors import ModelWarning, OptionError, SolverError, from_interrupt, warn_user
+from torquesplit.errors import (ModelWarning, OptionError, OptionTypeError, SolverError,
+                                from_interrupt, warn_user)
 from torquesplit.solve import _kernels as kern
 from torquesplit.solve import codegen
 from torquesplit.solve import kernel_data as kd
@@ -213,7 +214,7 @@ class Solution:
         if e not in self.tracked_elements:
             names = [self.element_names[i] for i in self.tracked_elements]
             raise OptionError(f"element {self.element_names[e]!r} was not tracked; tracked "
-                             f"elements are {names}. Pass track_elements=[...] to integrate.")
+                              f"elements are {names}. Pass track_elements=[...] to integrate.")
         j = self.tracked_elements.index(e)
         return {"start": self.cycle_start[:, j], "max": self.cycle_max[:, j],
                 "min": self.cycle_min[:, j], "mean": self.cycle_mean[:, j],
@@ -239,7 +240,7 @@ def _evaluate(structure, t, y, model=None, code=None):
     y = np.array(y, dtype=np.float64, order="C", copy=True)
     if y.shape != (2 * structure.n_dof,):
         raise OptionError(f"state must have shape ({2 * structure.n_dof},) = [q, v], "
-                         f"got {y.shape}.")
+                          f"got {y.shape}.")
     m = kd.kernel_model(structure) if model is None else model
     code = codegen.general_rhs() if code is None else code
     w = kd.make_work(m, code.parameters)
@@ -298,13 +299,13 @@ def _resolve(names: Sequence[str], selection, what: str) -> list[int]:
                 close = difflib.get_close_matches(item, names, n=3)
                 hint = f" Did you mean {close}?" if close else ""
                 raise OptionError(f"unknown {what} {item!r}.{hint} Use one of the names in "
-                                 f"structure.{what}_names or an index.")
+                                  f"structure.{what}_names or an index.")
             out.append(names.index(item))
         else:
             i = int(item)
             if not 0 <= i < len(names):
                 raise OptionError(f"{what} index {i} is out of range 0..{len(names) - 1}; "
-                                 f"use an index or a name from structure.{what}_names.")
+                                  f"use an index or a name from structure.{what}_names.")
             out.append(i)
     return out
 
@@ -634,18 +635,18 @@ def _check_options(method, progress, record_every, sample_interval, *, rk4_only,
     """Refuse unknown methods and options that the chosen method would ignore."""
     if method not in ("rk4", "dopri"):
         raise OptionError(f"unknown method {method!r}; use method='rk4' (fixed step) or "
-                         "method='dopri' (adaptive Dormand-Prince 5(4)).")
+                          "method='dopri' (adaptive Dormand-Prince 5(4)).")
     rk4 = method == "rk4"
     ignored = rk4_only if not rk4 else dopri_only
     wrong = [name for name, val in ignored.items() if val is not None]
     if wrong:
         raise OptionError(f"option(s) {wrong} do not apply to method={method!r}; remove them "
-                         f"or choose the other method.")
+                          f"or choose the other method.")
     if record_every is not None and sample_interval is not None:
         raise OptionError("give either record_every or sample_interval, not both.")
     if progress is not None and not callable(progress):
-        raise TypeError("progress must be a callable taking the fraction done, e.g. "
-                        "progress=lambda f: print(f'{f:.0%}').")
+        raise OptionTypeError("progress must be a callable taking the fraction done, e.g. "
+                              "progress=lambda f: print(f'{f:.0%}').")
     return rk4
 
 
@@ -656,10 +657,10 @@ def _initial_state(s: Structure, y0) -> np.ndarray:
         y = np.concatenate([y, np.zeros(n)])
     if y.shape != (2 * n,):
         raise OptionError(f"y0 must hold {2 * n} values [q, v] or {n} values q, got shape "
-                         f"{np.shape(y0)}.")
+                          f"{np.shape(y0)}.")
     if not np.all(np.isfinite(y)):
         raise OptionError("y0 contains NaN or inf; start from finite displacements and "
-                         "velocities, e.g. static_equilibrium(structure).y0.")
+                          "velocities, e.g. static_equilibrium(structure).y0.")
     return y
 
 
@@ -682,7 +683,7 @@ def _select(s, t0, span, track_elements, n_cycles_cap, history_elements,
         static_ones = [s.element_names[e] for e in track if not s.frequency[e] > 0]
         if static_ones:
             raise OptionError(f"elements {static_ones} have no excitation frequency, so they "
-                             "have no mesh cycles to track; leave them out of track_elements.")
+                              "have no mesh cycles to track; leave them out of track_elements.")
     # same floating-point expressions as the kernel's cycle index at t0
     base = np.array([_cycle_index(s.frequency[e] * t0 + s.phase[e]) for e in track],
                     dtype=np.int64)
@@ -703,8 +704,8 @@ def _select(s, t0, span, track_elements, n_cycles_cap, history_elements,
         loose = [s.element_names[e] for e in idx if e not in track]
         if loose or len(set(idx)) != len(idx) or not idx:
             raise OptionError(f"load-sharing group {list(members)!r} must list distinct "
-                             f"tracked elements; not tracked: {loose}. Track them "
-                             f"(track_elements) or leave them out of the group.")
+                              f"tracked elements; not tracked: {loose}. Track them "
+                              f"(track_elements) or leave them out of the group.")
         groups.append([track.index(e) for e in idx])
     return _Selection(track, base, cap, hist_el, hist_dof, groups)
 

@@ -72,10 +72,10 @@ def speed_factor(model, speed) -> float:
     try:
         value = parse_quantity(speed, "speed")
     except ValueError as exc:
-        raise SolverError(f"speed: {exc}") from None
+        raise OptionError(f"speed: {exc}") from None
     s = value / reference_speed(model)
     if not (s > 0 and math.isfinite(s)):  # (a negative speed was turned round silently)
-        raise SolverError(f"speed {speed!r} is not a positive finite speed (its direction "
+        raise OptionError(f"speed {speed!r} is not a positive finite speed (its direction "
                           f"is the model's); give e.g. speed='3000 rpm' or speed=314.16 "
                           f"(rad/s).")
     _warn_far_speed(model, speed, value, s)
@@ -108,7 +108,8 @@ def _warn_far_speed(model, speed, value: float, s: float) -> None:
     warn_user(text, ModelWarning)
 
 
-def _check_options(*, steps_per_cycle, tol, stability, energy_tol) -> None:
+def _check_options(*, steps_per_cycle, tol, stability, energy_tol, method="auto",
+                   harmonics=None) -> None:
     """The solver options of :func:`steady_state`, refused by name before any work:
     steps_per_cycle=0 and -3 ran, tol=-1 ran 3.6 s to 'NOT converged', stability='foo'
     was taken (a reviewer)."""
@@ -117,15 +118,22 @@ def _check_options(*, steps_per_cycle, tol, stability, energy_tol) -> None:
     if steps_per_cycle is not None and (
             isinstance(steps_per_cycle, bool) or not isinstance(steps_per_cycle, numbers.Real)
             or not float(steps_per_cycle).is_integer() or steps_per_cycle < 10):
-        raise SolverError(f"steps_per_cycle must be a whole number >= 10, got "
+        raise OptionError(f"steps_per_cycle must be a whole number >= 10, got "
                           f"{steps_per_cycle!r}; give e.g. steps_per_cycle=100")
     for name, value in (("tol", tol), ("energy_tol", energy_tol)):
         if value is not None and (isinstance(value, bool) or not isinstance(
                 value, numbers.Real) or not 0 < value < 1):
-            raise SolverError(f"{name} must be a small positive number, got {value!r}; "
+            raise OptionError(f"{name} must be a small positive number, got {value!r}; "
                               f"leave it out for the default")
+    if method not in ("auto", "hb", "shooting"):
+        raise OptionError(f"unknown method {method!r}; use method='hb' (harmonic balance), "
+                          f"'shooting' or 'auto'")
+    if harmonics is not None and (isinstance(harmonics, bool) or not isinstance(
+            harmonics, numbers.Integral) or harmonics < 1):
+        raise OptionError(f"harmonics must be a whole number >= 1, got {harmonics!r}; e.g. "
+                          f"harmonics=16 per excitation cycle")
     if not (isinstance(stability, bool) or stability in ("hill", "monodromy")):
-        raise SolverError(f"stability must be True, False, 'hill' or 'monodromy', got "
+        raise OptionError(f"stability must be True, False, 'hill' or 'monodromy', got "
                           f"{stability!r}")
 
 
@@ -198,7 +206,7 @@ class SteadyState:
         except ValueError:
             unknown = [e for e in elements if isinstance(e, str) and e not in names]
             raise OptionError(f"unknown element {unknown[0]!r}; the elements are "
-                             f"{names}") from None
+                              f"{names}") from None
         ps = self.solution
         cols = {int(e): j for j, e in enumerate(ps.mesh_elements)}
         if ps.method != "hb" and ps.mesh_t.size and all(int(e) in cols for e in elements):
@@ -366,7 +374,7 @@ def steady_state(model, *, method: str = "auto", harmonics: int | None = None,
     from torquesplit.solve.static import static_equilibrium
 
     _check_options(steps_per_cycle=steps_per_cycle, tol=tol, stability=stability,
-                   energy_tol=energy_tol)
+                   energy_tol=energy_tol, method=method, harmonics=harmonics)
     if not hasattr(model, "meshes"):
         model = load_model(model)
     kin = solve_kinematics(model)

@@ -11,7 +11,7 @@ import time
 
 import numpy as np
 
-from torquesplit.errors import ModelWarning, SolverError, warn_user
+from torquesplit.errors import ModelWarning, OptionError, SolverError, warn_user
 from torquesplit.steady.api import reference_speed
 from torquesplit.steady.period import (
     MAX_CYCLES,
@@ -41,7 +41,7 @@ def _rad_per_s(value, name: str) -> float:
         try:
             return float(parse_quantity(value, "speed"))
         except ValueError as exc:
-            raise SolverError(f"{name}: {exc}") from None
+            raise OptionError(f"{name}: {exc}") from None
     return float(value)
 
 
@@ -119,7 +119,7 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
     from torquesplit.metrics.load_sharing import group_meshes
 
     if not (isinstance(points, (int, np.integer)) and points >= 1):
-        raise ValueError(f"points must be a whole number >= 1, got {points!r}")
+        raise OptionError(f"points must be a whole number >= 1, got {points!r}")
     t_start = time.perf_counter()
     model, kin, s, dropped, per, static = _prepare(model, keep, max_cycles)
     sub = math.gcd(*[int(k) for k in per.orders]) if per.orders else 1
@@ -129,7 +129,7 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
         raise SolverError("the model has no time-varying excitation: its response does not "
                           "change with speed; nothing to sweep.")
     if method not in ("auto", "shooting", "hb"):
-        raise SolverError(f"unknown method {method!r}; use 'shooting', 'hb' or 'auto'.")
+        raise OptionError(f"unknown method {method!r}; use 'shooting', 'hb' or 'auto'.")
     if method == "auto":
         method = "hb" if harmonics is not None else "shooting"
     problem = periodic_problem(model, kin, s, per.frequency)
@@ -502,13 +502,13 @@ def campbell(model, start: float, stop: float, *, points: int = 41,
 
     if not (isinstance(points, (int, np.integer)) and not isinstance(points, bool)
             and points >= 2):  # (0 failed inside xarray)
-        raise ValueError(f"points must be a whole number >= 2, got {points!r}")
+        raise OptionError(f"points must be a whole number >= 2, got {points!r}")
     model, kin, s, _, _, static = _prepare(model, None, None)
     w_ref = reference_speed(model)
     lo, hi = _rad_per_s(start, "start"), _rad_per_s(stop, "stop")
     if not (lo > 0 and hi > lo and math.isfinite(hi)):
         rpm = 60.0 / (2.0 * math.pi)
-        raise SolverError(f"the speed range {lo * rpm:.6g}..{hi * rpm:.6g} rpm must be "
+        raise OptionError(f"the speed range {lo * rpm:.6g}..{hi * rpm:.6g} rpm must be "
                           f"increasing and positive; e.g. --from '1000 rpm' --to '3000 rpm'.")
     speeds = np.linspace(lo, hi, points)
     if s.n_gyroscopic:

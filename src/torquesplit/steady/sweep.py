@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from torquesplit.errors import ModelWarning, SolverError, warn_user
+from torquesplit.errors import ModelWarning, OptionError, SolverError, warn_user
 from torquesplit.steady.harmonic import HarmonicBalance
 from torquesplit.steady.newton import floquet_hill, floquet_monodromy
 from torquesplit.steady.solution import (
@@ -581,7 +581,7 @@ def continue_in_speed_shooting(problem, period, q_static, s0, s1, *, points=50,
 
 def _check_range(s0, s1):
     if not (s0 > 0 and s1 > 0 and math.isfinite(s0) and math.isfinite(s1)) or s0 == s1:
-        raise SolverError(f"the speed range {s0:.4g}..{s1:.4g} (times the model's speed) "
+        raise OptionError(f"the speed range {s0:.4g}..{s1:.4g} (times the model's speed) "
                           f"must be two different positive speeds; e.g. --from '1000 rpm' "
                           f"--to '3000 rpm'.")
 

@@ -27,6 +27,8 @@ import signal
 from concurrent.futures import FIRST_COMPLETED, wait
 from typing import Callable, Iterable, Iterator
 
+from ..errors import OptionError
+
 log = logging.getLogger(__name__)
 
 
@@ -196,7 +198,7 @@ def make_runner(workers: int | None = None, *, client=None, scheduler: str | Non
     ``client`` or ``scheduler`` address, else a local pool (one worker: this process)."""
     given = [x is not None for x in (runner, client, scheduler)]
     if sum(given) > 1:
-        raise ValueError("give only one of runner, client and scheduler")
+        raise OptionError("give only one of runner, client and scheduler")
     if runner is not None:
         return runner
     if client is not None:
@@ -205,6 +207,6 @@ def make_runner(workers: int | None = None, *, client=None, scheduler: str | Non
         return DaskRunner(address=scheduler)
     n = int(workers or os.cpu_count() or 1)
     if n < 1:
-        raise ValueError(f"workers must be at least 1, got {workers}; give e.g. workers=2 "
+        raise OptionError(f"workers must be at least 1, got {workers}; give e.g. workers=2 "
                          "(on the command line: --workers 2)")
     return SerialRunner() if n == 1 else LocalPool(n)
