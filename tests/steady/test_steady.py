@@ -14,7 +14,7 @@ import pytest
 
 from oscillators import backlash_oscillator
 from torquesplit.assembly.structure import MESH, SPRING, build_structure
-from torquesplit.errors import OptionError, SolverError
+from torquesplit.errors import OptionError
 from torquesplit.solve.integrate import integrate
 from torquesplit.steady.harmonic import HarmonicBalance
 from torquesplit.steady.newton import (
