@@ -230,6 +230,14 @@ def test_stopping_rule_outcome_is_reported(split_file, tmp_path):
     assert "target NOT met: max_samples = 24 reached" in stopping_line(ds)
     ds.attrs["stopping_finite_cases"] = 22
     assert "over 22 of 24 cases (2 without a finite value left out)" in stopping_line(ds)
+    # a force in kN, as the table above it prints forces (it printed N, with no unit)
+    import json
+
+    rule = json.loads(ds.attrs["stopping_rule"])
+    ds.attrs["stopping_rule"] = json.dumps(dict(rule, output="peak_force.a1"))
+    line = stopping_line(ds)
+    assert f"= {1e-3 * ds.attrs['stopping_estimate']:.6g} kN, " in line
+    assert f"target half-width {1e-3 * ds.attrs['stopping_target']:.3g} kN" in line
 
 
 def test_a_percentile_rule_that_cannot_stop_is_refused(split_file):

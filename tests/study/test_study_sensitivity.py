@@ -182,3 +182,21 @@ def test_sobol_samples_must_be_a_power_of_2():
     with pytest.raises(Exception, match="3 is not a power of 2.*give 2 or 4"):
         Sensitivity(method="sobol", seed=1, samples=3, parameters=par)
     assert Sensitivity(method="sobol", seed=1, samples=64, parameters=par).samples == 64
+
+
+def test_tornado_of_a_force_draws_mu_star_in_the_unit_its_axis_names():
+    """The axis read mu* [kN] while the bars were drawn in N: 1000 times too long."""
+    import xarray as xr
+
+    from torquesplit.study.figures import tornado_figure
+
+    out = "peak_force.m1"
+    ds = xr.Dataset({"mu_star": (("output", "factor"), [[2500.0, 400.0]]),
+                     "mu_star_conf": (("output", "factor"), [[100.0, 50.0]])},
+                    coords={"output": [out], "factor": ["a", "b"]},
+                    attrs={"ranking": "mu_star", "study_name": "t"})
+    ds[out] = ("sample", np.zeros(2), {"output": out, "units": "N"})
+    ax = tornado_figure(ds, out).axes[0]
+    assert ax.get_xlabel().endswith("[kN]")
+    widths = sorted(p.get_width() for p in ax.patches)
+    np.testing.assert_allclose(widths, [0.4, 2.5])

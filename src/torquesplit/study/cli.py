@@ -258,9 +258,11 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
                         f"{ds.attrs['ranking']} (most important first)")
         t.add_column("output")
         t.add_column("ranking")
+        morris = ds.attrs["ranking"] == "mu_star"  # (in the output's unit; Sobol's are 1)
         for v in out_vars:
             rank = ranking(ds, ds[v].attrs["output"])
-            t.add_row(v, ", ".join(f"{f} {x:.3g}" for f, x in rank))
+            suffix, scale = _shown(ds[v]) if morris else ("", 1.0)
+            t.add_row(v + suffix, ", ".join(f"{f} {x * scale:.3g}" for f, x in rank))
         ui.console.print(t)
         used_var = next((u for u in ("samples_used", "trajectories_used") if u in ds), None)
         if used_var is not None:
@@ -409,7 +411,11 @@ def stopping_line(ds) -> str:
     a = ds.attrs
     if "stopping_target_met" not in a:
         return ""
+    from .figures import _out_unit
+
     rule = json.loads(a["stopping_rule"])
+    unit, k = _out_unit(rule["output"])  # (as the table above prints the output)
+    unit = "" if unit == "-" else f" {unit}"
     n, finite = int(a["stopping_cases"]), int(a["stopping_finite_cases"])
     over = (f" over {finite} of {n} cases ({n - finite} without a finite value left out)"
             if finite < n else f" over {n} cases")
@@ -417,14 +423,15 @@ def stopping_line(ds) -> str:
                f"target NOT met: max_samples = {rule['max_samples']} reached; raise it or "
                f"widen half_width")
     if "stopping_lower" in a:  # (a percentile's interval is not centred on its estimate)
-        interval = (f"{rule['confidence']:.0%} interval {a['stopping_lower']:.6g} .. "
-                    f"{a['stopping_upper']:.6g}, half-width {a['stopping_half_width']:.3g}")
+        interval = (f"{rule['confidence']:.0%} interval {k * a['stopping_lower']:.6g} .. "
+                    f"{k * a['stopping_upper']:.6g}{unit}, half-width "
+                    f"{k * a['stopping_half_width']:.3g}{unit}")
     else:
-        interval = (f"+/- {a['stopping_half_width']:.3g} ({rule['confidence']:.0%} "
+        interval = (f"+/- {k * a['stopping_half_width']:.3g}{unit} ({rule['confidence']:.0%} "
                     f"interval)")
     return (f"stopping rule: {a['stopping_statistic']} of {rule['output']} = "
-            f"{a['stopping_estimate']:.6g}, {interval}{over}; target half-width "
-            f"{a['stopping_target']:.3g}: {outcome}")
+            f"{k * a['stopping_estimate']:.6g}{unit}, {interval}{over}; target half-width "
+            f"{k * a['stopping_target']:.3g}{unit}: {outcome}")
 
 
 def _num(x):

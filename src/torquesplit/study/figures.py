@@ -274,8 +274,11 @@ def _stopping_band(ds, var, ax, scale) -> None:
 def tornado_figure(ds, var: str) -> Figure:
     """Factors ranked by importance for one output (Morris mu* or Sobol ST)."""
     key = ds.attrs["ranking"]
-    row = ds[key].sel(output=var).values
-    conf = ds[f"{key}_conf"].sel(output=var).values
+    # mu* in the output's unit as the axis names it (kN for a force: it drew N on an axis
+    # labelled kN); Sobol indices have none
+    unit, scale = _out_unit(var) if key == "mu_star" else ("-", 1.0)
+    row = ds[key].sel(output=var).values * scale
+    conf = ds[f"{key}_conf"].sel(output=var).values * scale
     factors = [str(f) for f in ds["factor"].values]
     order = np.argsort(np.nan_to_num(row, nan=-np.inf))  # largest at the top
     fig = _figure(WIDTH, 0.45 * len(factors) + 1.6)
@@ -292,7 +295,6 @@ def tornado_figure(ds, var: str) -> Figure:
         ax.barh(pos, row[order], xerr=conf[order], color=_color(0), alpha=0.85,
                 label="mu* (Morris)")
     ax.set_yticks(pos, [factors[i] for i in order], fontsize=8)
-    unit, _ = _out_unit(var)
     ax.set_xlabel("mu*: mean |output change| over each factor's range [" + unit + "]"
                   if key == "mu_star" else "Sobol index [-]")
     ax.grid(True, axis="x", alpha=0.3)
