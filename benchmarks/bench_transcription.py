@@ -18,7 +18,8 @@ call (kernel arrays, a step stability check, the right-hand side's look-up, argu
 typing: about 10 ms) is reported apart, as the fixed cost of a call (it was 16 % of a
 200,000-step run, which the earlier per-step figure included).  Runs are alternated
 (engine generated, engine general, transcription) and the best process-CPU time of each
-is kept, so the ratios do not depend on how loaded the machine is.  Runnable alone: ``python benchmarks/bench_transcription.py [steps]``.
+is kept, so the ratios do not depend on how loaded the machine is.  Runnable alone:
+``python benchmarks/bench_transcription.py [steps]``.
 """
 
 from __future__ import annotations
@@ -50,8 +51,9 @@ def _case():
 
 
 def compare(n_steps: int = 200_000, repeat: int = 3) -> dict:
-    """Best CPU µs per RK4 step of the engine (generated, general) and of the hand
-    transcription, their ratios, and the scaled difference of the final states."""
+    """CPU µs per RK4 step of the engine (generated, general) and of the hand
+    transcription (the difference of the best times of 2 n and n steps, over n), the
+    fixed cost of a call, their ratios, and the scaled difference of the final states."""
     from torquesplit.solve import integrate
 
     tr, s, p, index, sign, y0, h = _case()

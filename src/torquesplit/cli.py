@@ -647,8 +647,10 @@ def _render_run(res, met, saved, planets=None) -> None:
         f"(+{st['rhs_compile_time_s']:.2g} s for the {st['rhs']} right-hand side); "
         f"transient discarded: {met.settle_times_text()}"
         + ("" if met.settling.settled else " (not settled: see the warnings)"), highlight=False)
+    from .solve.integrate import EXCITATION_PERIOD
+
     why = st.get("step_limited_by") or ""
-    if why and why != "excitation period":  # a finer step than asked: say what set it
+    if why and why != EXCITATION_PERIOD:  # a finer step than asked: say what set it
         console.print(f"step {st['step_s']:.3g} s, set by {why}", highlight=False,
                       markup=False)
     console.print(run_table(met))

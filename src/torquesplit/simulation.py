@@ -384,14 +384,9 @@ def prepare_run(
     if n_records > MAX_HISTORY_RECORDS:
         sample_interval = duration / MAX_HISTORY_RECORDS
     elif finer and samples_per_period is not None:
-        hint = "a finer step (--steps-per-period; steps_per_period= in Python)"
-        if planned[1] != "excitation period":  # (more steps per period than asked already)
-            from .solve.integrate import shortest_excitation_period
+        from .solve.integrate import finer_step_advice
 
-            per = shortest_excitation_period(structure) / planned[0]
-            hint = (f"a finer step, which is set by {planned[1]} here: only a "
-                    f"--steps-per-period (steps_per_period= in Python) above the {per:.4g} "
-                    f"steps per shortest excitation period it makes refines it")
+        hint = finer_step_advice(structure, planned[1], planned[0])
         warn_user(
             f"analysis: samples_per_period={samples_per_period} asks for more samples than "
             f"the run takes steps: the history keeps every RK4 step, "

@@ -299,8 +299,9 @@ def test_support_spectrum_finds_a_known_sinusoid(run):
     # mismatch), in kN and MN above, as the run's tables print forces
     label = legend.get_label()
     assert "mean 500 N" in label and "largest 123 N at 2 kHz" in label
-    assert [F._force_text(v) for v in (-0.1078, 3300.0, 2.5e6)] == ["-0.1078 N", "3.3 kN",
-                                                                   "2.5 MN"]
+    assert [F._force_text(v) for v in (-0.1078, 3300.0, 2.5e6, 999.96, 999960.0,
+                                       float("nan"))] == [
+        "-0.1078 N", "3.3 kN", "2.5 MN", "1 kN", "1 MN", "nan N"]
     np.testing.assert_allclose(legend.get_xydata(), [[f0, amp[k]]])  # the one strong line
     y = next(ln for ln in ax.get_lines() if ln.get_gid() == "pinion.support.y")
     assert np.max(y.get_ydata()) < 1e-9  # a constant force has no spectrum

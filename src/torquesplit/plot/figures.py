@@ -1217,11 +1217,16 @@ def _spike_style(i: int, n: int) -> dict:
 
 
 def _force_text(value: float) -> str:
-    """A force in N, kN or MN by its size, 4 significant digits: the spectrum's axis is
-    in N, and '0.1924 kN' beside an axis at 190 N read as a mismatch."""
-    a = abs(value)
-    scale, unit = (1.0, "N") if a < 1e3 else ((_KN, "kN") if a < 1e6 else (1e-6, "MN"))
-    return f"{value * scale:.4g} {unit}"
+    """A force in N, kN or MN by its size once rounded to 4 significant digits (999.96 N
+    reads '1 kN', not '1000 N'): the spectrum's axis is in N, and '0.1924 kN' beside an
+    axis at 190 N read as a mismatch.  A value that is not finite is said in N."""
+    if not math.isfinite(value):
+        return f"{value} N"
+    for scale, unit in ((1.0, "N"), (_KN, "kN"), (1e-6, "MN")):
+        text = f"{value * scale:.4g}"
+        if abs(float(text)) < 1e3 or unit == "MN":
+            return f"{text} {unit}"
+    raise AssertionError("unreachable")
 
 
 def _short_text(text: str, most: int = 28) -> str:

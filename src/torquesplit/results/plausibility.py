@@ -398,12 +398,16 @@ def coarse_history(results, metrics) -> list[tuple[str, str]]:
             f"kept steps.  {exact}; the waveform and the bearing forces do not.  More "
             f"--steps-per-cycle (Python: steps_per_cycle=) brings the waveform closer"))]
     if results.history_keeps_every_step():
+        from ..solve.integrate import finer_step_advice
+
+        s = results.solution
         return [("analysis", (
             f"the history keeps every RK4 step, yet {missed}: that peak falls inside a "
             f"step, at a corner of a stiffness table, which the mesh table's numbers (and "
             f"peak_force in the files) include and the history (files, figures, the "
-            f"bearing table's peak |F|) does not; a finer step (--steps-per-period) brings "
-            f"it closer"))]
+            f"bearing table's peak |F|) does not; "
+            f"{finer_step_advice(results.structure, s.step_limited_by, s.step or 0.0)} "
+            f"brings it closer"))]
     more = max(100, 5 * round(per)) if math.isfinite(per) else 100
     return [("analysis", (
         f"the history ({per:.3g} samples per shortest mesh period), which the results "

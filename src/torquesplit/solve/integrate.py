@@ -756,7 +756,7 @@ def _step_for(s: Structure, span: float, spp: int, check: bool):
     h_lim = ACCURACY / (2 * math.pi * f_hi) if f_hi > 0 else math.inf
     h_stable = SAFETY * stable_step(s) if check else math.inf
     if h <= min(h_lim, h_stable):
-        return h, _error_sets_step(s, period, spp) or "excitation period", spp
+        return h, _error_sets_step(s, period, spp) or EXCITATION_PERIOD, spp
     per = math.ceil(period / min(h_lim, h_stable))  # a whole number of steps per period
     if h_lim <= h_stable:
         why = (f"the highest mode, {f_hi:.6g} Hz (mostly element '{element}'), needs "
@@ -789,6 +789,27 @@ def _error_sets_step(s: Structure, period: float, spp: int) -> str | None:
             f"period); fewer (--steps-per-period, checked by --check-step) make the run shorter")
 
 
+EXCITATION_PERIOD = "excitation period"
+"""What sets the RK4 step when ``steps_per_period`` does (``step_limited_by``); else the
+highest mode, RK4 stability or an error sinusoid, in words."""
+
+
+def finer_step_advice(structure: Structure, limited_by: str, step: float) -> str:
+    """How to refine the RK4 step, in words: ``--steps-per-period`` where the excitation
+    period sets the step; where something else does (the highest mode, stability), that
+    only a number above the steps per period it makes refines it (the plain advice sent
+    users to an option that changed nothing below that number)."""
+    plain = "a finer step (--steps-per-period; steps_per_period= in Python)"
+    if not limited_by or limited_by == EXCITATION_PERIOD or not step > 0:
+        return plain
+    per = shortest_excitation_period(structure) / step
+    if not math.isfinite(per):
+        return plain
+    return (f"a finer step, which is set by {limited_by} here: only a --steps-per-period "
+            f"(steps_per_period= in Python) above the {round(per)} steps per shortest "
+            f"excitation period it makes refines it")
+
+
 def planned_step(structure: Structure, steps_per_period: int | None = None,
                  span: float = 1.0) -> tuple[float, str]:
     """The RK4 step :func:`integrate` would take by default and what sets it (the
@@ -816,7 +837,7 @@ def _plan_rk4(s, span, step, steps_per_period, check_stability, record_every,
     if spp < 1:
         raise OptionError("steps_per_period must be >= 1.")
     check = True if check_stability is None else bool(check_stability)
-    limited_by = "excitation period"
+    limited_by = EXCITATION_PERIOD
     if step is None:
         h, limited_by, per = _default_step(s, span, spp, check)
         if per > _STEP_WARN_FACTOR * spp:
