@@ -354,13 +354,17 @@ def mean_drift(results, metrics) -> list[tuple[str, str]]:
 
 
 def coarse_history(results, metrics) -> list[tuple[str, str]]:
-    """The history (saved to files, drawn in the figures) against the settled peak the
-    integrator streams at every step and at the tables' corners: where its largest
-    settled sample falls short by more than :data:`HISTORY_MISS`, its waveform is not the
-    response's.  One message, for the mesh where it misses most, with the advice that
-    fits: more samples of a decimated history; a finer step where it keeps every step
-    already (the peak then falls at a table corner inside a step, where RK4 splits the
-    step, or between two steps); more steps per cycle of a periodic steady state."""
+    """The history (saved to files, drawn in the figures) against the settled peak and
+    smallest force the integrator streams at every step and at the tables' corners:
+    where its largest settled sample falls short of the peak, or its smallest stays above
+    the smallest force, by more than :data:`HISTORY_MISS` of the peak (or
+    :data:`HISTORY_MISS_DYNAMIC` of the swing from the static force), its waveform is not
+    the response's (the force range matters for fatigue: Ji & Li's default history stayed
+    6 kN above the smallest force, silently).  One message, for the mesh and extreme it
+    misses most, with the advice that fits: more samples of a decimated history; a finer
+    step where it keeps every step already (the extreme then falls at a table corner
+    inside a step, where RK4 splits the step, or between two steps); more steps per cycle
+    of a periodic steady state."""
     if results.solution is None or not results.solution.history_t.size:
         return []
     t, forces = results.mesh_force_history()
@@ -373,28 +377,37 @@ def coarse_history(results, metrics) -> list[tuple[str, str]]:
         seen = seen[np.isfinite(seen)]
         if not (seen.size and row.peak_force > 0 and math.isfinite(row.peak_force)):
             continue
-        miss = 1.0 - float(seen.max()) / row.peak_force
-        rise = row.peak_force - row.static_force  # the dynamic part of the peak
-        of_rise = ((row.peak_force - float(seen.max())) / rise
-                   if rise > DYNAMIC_PART * row.peak_force else 0.0)
-        if ((miss > HISTORY_MISS or of_rise > HISTORY_MISS_DYNAMIC)
-                and (worst is None or miss > worst[1])):
-            worst = (row.mesh, miss, float(seen.max()), row.peak_force, of_rise)
+        # (kind, what the history shows, what the run streamed, the swing from static)
+        for kind, shown, streamed, swing in (
+                ("peak", float(seen.max()), row.peak_force, row.peak_force - row.static_force),
+                ("smallest", float(seen.min()), row.min_force,
+                 row.static_force - row.min_force)):
+            if not math.isfinite(streamed):
+                continue
+            short = abs(streamed - shown)  # (the history cannot pass what was streamed)
+            miss = short / row.peak_force
+            of_swing = short / swing if swing > DYNAMIC_PART * row.peak_force else 0.0
+            if ((miss > HISTORY_MISS or of_swing > HISTORY_MISS_DYNAMIC)
+                    and (worst is None or miss > worst[1])):
+                worst = (row.mesh, miss, shown, streamed, of_swing, kind)
     if worst is None:
         return []
-    m, miss, seen, peak, of_rise = worst
+    m, miss, seen, streamed, of_swing, kind = worst
     per = results.history_samples_per_period() or math.nan
-    rise = (f", {100 * of_rise:.2g} % of its rise above the static force"
-            if of_rise > HISTORY_MISS_DYNAMIC else "")
+    swing = (f", {100 * of_swing:.2g} % of its "
+             f"{'rise above' if kind == 'peak' else 'dip below'} the static force"
+             if of_swing > HISTORY_MISS_DYNAMIC else "")
     missed = (f"misses the settled peak force of mesh {m} by {100 * miss:.2g} % "
-              f"({_kn(seen)} against {_kn(peak)}{rise})")
+              f"({_kn(seen)} against {_kn(streamed)}{swing})" if kind == "peak" else
+              f"misses the settled smallest force of mesh {m} by {100 * miss:.2g} % of its "
+              f"peak ({_kn(seen)} against {_kn(streamed)}{swing})")
     exact = ("The mesh table's forces, load sharing and dynamic factors (and peak_force in "
              "the files) include every step and the instants between them")
     if getattr(results, "steady", None) is not None:
         return [("analysis", (
             f"the saved waveform of the periodic state ({per:.3g} samples per shortest "
             f"mesh period), which the results files and the figures hold, {missed}: the "
-            f"peak falls between its samples, at a corner of a stiffness table or between "
+            f"extreme falls between its samples, at a corner of a stiffness table or between "
             f"kept steps.  {exact}; the waveform and the bearing forces do not.  More "
             f"--steps-per-cycle (Python: steps_per_cycle=) brings the waveform closer"))]
     if results.history_keeps_every_step():
@@ -402,10 +415,10 @@ def coarse_history(results, metrics) -> list[tuple[str, str]]:
 
         s = results.solution
         return [("analysis", (
-            f"the history keeps every RK4 step, yet {missed}: that peak falls inside a "
+            f"the history keeps every RK4 step, yet {missed}: that extreme falls inside a "
             f"step, at a corner of a stiffness table, which the mesh table's numbers (and "
-            f"peak_force in the files) include and the history (files, figures, the "
-            f"bearing table's peak |F|) does not; "
+            f"peak_force, min_force in the files) include and the history (files, figures, "
+            f"the bearing table's peak |F|) does not; "
             f"{finer_step_advice(results.structure, s.step_limited_by, s.step or 0.0)} "
             f"brings it closer"))]
     more = max(100, 5 * round(per)) if math.isfinite(per) else 100
