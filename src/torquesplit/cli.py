@@ -521,7 +521,8 @@ def _print_run(m, res, met, saved, figures, step_check, plots, as_json) -> None:
                       "results_file": str(saved[0]) if saved else None,
                       "results_files": [str(f) for f in saved],
                       "figures": [str(f) for f in figures],
-                      **({"step_check": step_check.to_dict()} if step_check else {})},
+                      **({"step_check": step_check.to_dict()} if step_check else {}),
+                      "units": ux.MESH_UNITS},
                      _json_default)
     else:
         _render_run(res, met, saved, planets)

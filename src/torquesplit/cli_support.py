@@ -40,6 +40,16 @@ from rich.markup import escape
 from . import _json
 from .errors import ModelWarning, OptionError, clip_message, from_interrupt
 
+MESH_UNITS = {"nominal_force": "N", "static_force": "N", "mean_force": "N",
+              "min_force": "N", "peak_force": "N", "back_flank_force": "N",
+              "dynamic_factor": "1", "dynamic_factor_engineering": "1",
+              "peak_to_nominal": "1", "load_sharing": "1",
+              "contact_loss": "1 (fraction of the time)",
+              "back_contact": "1 (fraction of the time)",
+              "rms_transmission_error": "m", "settle_time_s": "s"}
+"""The unit of each per-mesh number of the ``--json`` outputs (``units`` key): SI, as
+every JSON of the tool, where the tables print kN, % and um."""
+
 
 @dataclass
 class Session:

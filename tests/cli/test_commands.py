@@ -40,6 +40,12 @@ def test_run_json_out_and_set(tmp_path):
     assert data["metrics"]["system_load_sharing"] == pytest.approx(1.0, abs=1e-6)
     assert data["statistics"]["steps"] > 0 and data["statistics"]["rhs_evaluations"] > 0
     assert (tmp_path / "r.nc").exists()
+    # every number of a mesh has its unit said (the table prints kN and %, the JSON N and
+    # fractions: a script had to guess)
+    for row in data["metrics"]["meshes"].values():
+        numbers = {k for k, v in row.items() if isinstance(v, float) or v is None}
+        assert numbers and numbers <= set(data["units"]), numbers - set(data["units"])
+    assert data["units"]["peak_force"] == "N" and data["units"]["load_sharing"] == "1"
     bad = runner.invoke(app, ["run", str(path), "--set", "meshes.zz.damping_ratio=1"])
     assert bad.exit_code == 2 and "meshes.zz" in bad.output
 

@@ -13,7 +13,7 @@ from typing import Optional
 
 import typer
 from torquesplit._table import Table
-from torquesplit.cli_support import OptionErrors, json_option
+from torquesplit.cli_support import MESH_UNITS, OptionErrors, json_option
 from torquesplit.errors import OptionError
 
 RPM = 60.0 / (2 * math.pi)
@@ -267,11 +267,7 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
             "results_file": str(saved[0]) if saved else None,
             "results_files": [str(f) for f in saved or []],
             **({"step_check": step_check.to_dict()} if step_check else {}),
-            # SI, as every JSON of the tool (the table prints kN and µm)
-            "units": {"nominal_force": "N", "static_force": "N", "mean_force": "N",
-                      "min_force": "N", "peak_force": "N", "dynamic_factor": "1",
-                      "peak_to_nominal": "1", "load_sharing": "1",
-                      "rms_transmission_error": "m", "contact_loss": "1"},
+            "units": MESH_UNITS,  # SI (the table prints kN and µm)
         }
         if as_json:
             _emit(info, json_default)
