@@ -94,13 +94,23 @@ class QuasiStaticResults:
         from .model.io import model_to_json
 
         met = self.metrics()
+        forces = self.mesh_forces()
+        group_of = {m: g for g, ms in met.groups.items() for m in ms}
         ds = xr.Dataset(
             {
-                "mesh_force": (("time", "mesh"), self.mesh_forces(),
+                "mesh_force": (("time", "mesh"), forces,
                                {"units": "N", "long_name": "quasi-static mesh force"}),
                 "load_sharing": (("mesh",), [met.per_mesh[m] for m in self.mesh_names],
                                  {"units": "1",
                                   "long_name": "static torque ratio, largest over positions"}),
+                # what the command's mesh table prints (the files held only load_sharing)
+                **{f"{k}_force": (("mesh",), f(forces, axis=0), {
+                    "units": "N", "long_name": f"{k} quasi-static mesh force over the "
+                                              f"positions"})
+                   for k, f in (("min", np.min), ("mean", np.mean), ("max", np.max))},
+                "group_load_sharing": (("group",), [met.per_group[g] for g in met.groups],
+                                       {"units": "1", "long_name": "static torque ratio of "
+                                        "the group: its largest member's"}),
                 "displacement": (("time", "dof"), self.solution.q,
                                  {"units": "m or rad", "long_name": "static displacement"}),
                 "converged": (("time",), self.solution.converged.astype(np.int8),
@@ -108,6 +118,9 @@ class QuasiStaticResults:
             },
             coords={"time": ("time", self.times, {"units": "s", "long_name": "time"}),
                     "mesh": ("mesh", self.mesh_names),
+                    "mesh_group": ("mesh", [group_of.get(m, "") for m in self.mesh_names],
+                                   {"long_name": "load-sharing group of each mesh"}),
+                    "group": ("group", list(met.groups)),
                     "dof": ("dof", list(self.structure.dof_names)),
                     "dof_unit": ("dof", dof_units(self.structure),
                                  {"long_name": "unit of each DOF's displacement"})},
@@ -115,6 +128,7 @@ class QuasiStaticResults:
                    "warnings": "\n".join(self.warnings()),
                    "warnings_json": json.dumps(self.warnings()),
                    "load_sharing_definition": "static_torque",
+                   "system_load_sharing": float(met.system),
                    "model_json": model_to_json(self.model),
                    "metrics_json": _json.dumps({"per_mesh": met.per_mesh,
                                                 "per_group": met.per_group,

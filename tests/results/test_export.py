@@ -82,9 +82,20 @@ def test_static_writes_matlab_and_spreadsheet_files(tmp_path):
     args = ["static", EXAMPLE, "--revolutions", "0.02", "--points-per-cycle", "2", "--quiet"]
     r = CliRunner().invoke(app, args + ["--out", str(tmp_path / "q.csv"), "--json"])
     assert r.exit_code == 0, r.output
-    share = json.loads(r.output)["load_sharing"]["per_mesh"]
+    data = json.loads(r.output)
+    share = data["load_sharing"]["per_mesh"]
     header, rows = _read(tmp_path / "q_mesh.csv")
-    assert {m: float(v) for m, v in rows} == pytest.approx(share, rel=1e-12)
+    col = {h: i for i, h in enumerate(header)}
+    assert {row[0]: float(row[col["load_sharing"]]) for row in rows} == pytest.approx(
+        share, rel=1e-12)
+    # the mesh table's forces and groups too (the file held only the coefficient)
+    for row in rows:
+        printed = data["mesh_force_N"][row[0]]
+        for k in ("min", "mean", "max"):
+            assert float(row[col[f"{k}_force_N"]]) == pytest.approx(printed[k], rel=1e-12)
+    header, groups = _read(tmp_path / "q_group.csv")
+    assert {g: float(v) for g, v in groups} == pytest.approx(
+        data["load_sharing"]["per_group"], rel=1e-12)
     header, rows = _read(tmp_path / "q.csv")
     assert header[:2] == ["time_s", "mesh_force_m11_N"] and "displacement_z1.theta_rad" in header
     r = CliRunner().invoke(app, args + ["--out", str(tmp_path / "q.mat")])
