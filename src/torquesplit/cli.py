@@ -1442,7 +1442,10 @@ def modes(
     if carrier_rpm:
         console.print("modes at the model's speed: " + ", ".join(
             f"carrier {c} turning at {v:.5g} rpm" for c, v in carrier_rpm.items())
-            + ("" if rep.rotating_frame or not any(carrier_rpm.values())
+            + ("" if not any(carrier_rpm.values()) else
+               " (Coriolis and centripetal terms in: a degenerate pair splits into forward "
+               "and backward whirl; --no-rotating-frame gives the modes at rest, as the "
+               "planetary benchmarks publish them)" if rep.rotating_frame
                else " (its Coriolis and centripetal terms left out: --no-rotating-frame)"),
             highlight=False)
     typed = any(r.type for r in rep.rows)
