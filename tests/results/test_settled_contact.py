@@ -283,3 +283,16 @@ def test_a_history_that_misses_much_of_the_dynamic_rise_is_said():
     assert 1 - seen / row.peak_force < HISTORY_MISS  # not by the old rule
     rise = (row.peak_force - seen) / (row.peak_force - row.static_force)
     assert rise > HISTORY_MISS_DYNAMIC and f"{100 * rise:.2g} % of its rise" in text
+
+
+def test_the_run_length_a_short_run_is_told_to_take_is_enough():
+    """--cycles 40 completed 39 cycles (the start cut the first) and was told to simulate
+    the 40 it had asked for."""
+    import re
+
+    said = [w for w in torquesplit.simulate("lin_parker1999_planetary", cycles=40).warnings()
+            if "too short to tell" in w]
+    assert len(said) == 1
+    cycles = int(re.search(r"\((\d+) cycles of ", said[0]).group(1))
+    longer = torquesplit.simulate("lin_parker1999_planetary", cycles=cycles)
+    assert not any("too short to tell" in w for w in longer.warnings())

@@ -217,16 +217,20 @@ def settling(results, metrics) -> list[tuple[str, str]]:
     short = metrics.settling.short
     if short:  # too short to tell: name the mesh that needs the longest run
         kin = results.kinematics
-        need = {m: 2 * w / kin.meshes[m].frequency for m, (_, w) in short.items()}
+        # two windows of whole cycles, and one more: the run's start cuts a cycle of a
+        # mesh that does not start at phase 0 (--cycles 40 completed 39, and the advice
+        # asked for the 40 it had)
+        need = {m: (2 * w + 1) / kin.meshes[m].frequency for m, (_, w) in short.items()}
         m = max(need, key=need.get)
         n, w = short[m]
         return [("analysis", (
             f"the run is too short to tell whether the response has settled: mesh {m} "
             f"completes {n} cycles, fewer than two settle windows of {w} cycles (a window "
             f"spans at least 20 cycles and the longest excitation period, e.g. a gear "
-            f"revolution when errors turn with the gears), so the metrics may not average "
-            f"over whole excitation periods; simulate at least {need[m]:.3g} s "
-            f"(--duration) plus the transient"))]
+            f"revolution when errors turn with the gears; a cycle the start or the end "
+            f"cuts does not count), so the metrics may not average over whole excitation "
+            f"periods; simulate at least {need[m]:.3g} s ({2 * w + 1} cycles of {m}) plus "
+            f"the transient"))]
     return [("analysis", (
         "the transient did not die out within the run (the peaks still drift), so the last "
         "half of the run was used for the metrics; simulate longer (--cycles or --duration) "
