@@ -257,8 +257,9 @@ leaves out the start-up transient before computing anything.
   step: 50,000 samples, or more where 20 per shortest mesh period need more (at most
   200,000: fewer per period on a very long run).  This drive rings at its mesh modes
   near order {{{{order}}}} of the mesh frequency (section 5): a history of 20 samples per
-  split-mesh period (`--samples-per-period 20`) misses the settled peak of in2 by
-  {{{{history_miss}}}} %, and the run says so in a warning.  Even every step misses
+  split-mesh period (`--samples-per-period 20`) misses the settled {{{{history_what}}}}
+  of {{{{history_mesh}}}} by {{{{history_miss}}}} %{{{{history_of}}}}, and the run says so in a
+  warning.  Even every step misses
   {{{{every_mesh}}}}'s settled peak by {{{{every_miss}}}} %, and this run's warning says
   that: the ISO stiffness steps up as a second tooth pair comes into contact, and the
   force peaks at that corner of the table, inside a step.  The integrator splits the
@@ -431,8 +432,12 @@ def _numbers(work: Path) -> dict[str, str]:
     if not every:
         raise SystemExit("the tutorial's text expects a history of every step that misses "
                          "a peak at a stiffness corner (the run's warning)")
-    every_mesh, every_miss = re.search(r"of mesh (\w+) by (\d+(?:\.\d+)?) %",
-                                       every[0]).groups()
+    every_kind, every_mesh, every_miss = re.search(
+        r"misses the settled (peak|smallest) force of mesh (\w+) by (\d+(?:\.\d+)?) %",
+        every[0]).groups()
+    if every_kind != "peak":
+        raise SystemExit("the tutorial's text expects the every-step history to miss a "
+                         f"peak at a stiffness corner, not the {every_kind} force")
     history_samples = f"{run['statistics']['history_samples']:,}"
     coarse = json.loads(_run("torquesplit run three_branch.toml --samples-per-period 20 "
                              "--json 2>/dev/null", work))
@@ -440,7 +445,11 @@ def _numbers(work: Path) -> dict[str, str]:
     if not coarse:
         raise SystemExit("the tutorial's text expects the coarse-history warning at 20 "
                          "samples per period")
-    history_miss = re.search(r"by (\d+(?:\.\d+)?) %", coarse[0]).group(1)
+    history_kind, history_mesh, history_miss = re.search(
+        r"misses the settled (peak|smallest) force of mesh (\w+) by (\d+(?:\.\d+)?) %",
+        coarse[0]).groups()
+    history_what = ("peak" if history_kind == "peak" else "smallest force")
+    history_of = "" if history_kind == "peak" else " of its peak"
     modes = json.loads(_run("torquesplit modes three_branch.toml --count 8 --json 2>/dev/null", work))
     campbell = json.loads(_run('torquesplit modes three_branch.toml --campbell --from '
                                '"2400 rpm" --to "3600 rpm" --json 2>/dev/null', work))
@@ -468,7 +477,8 @@ def _numbers(work: Path) -> dict[str, str]:
     low, high = min(mesh_modes), max(mesh_modes)
     return {
         "overload": f"{100 * (met['meshes']['in1']['load_sharing'] - 1):.1f}",
-        "history_miss": history_miss,
+        "history_miss": history_miss, "history_what": history_what,
+        "history_mesh": history_mesh, "history_of": history_of,
         "every_mesh": every_mesh,
         "every_miss": every_miss,
         "history_samples": history_samples,
