@@ -470,9 +470,10 @@ class Results:
         force vector [N] (a body held by a spline alone: the spline's radial force, its
         name in ``via``), from the history from ``start_time`` (default the latest group
         settle time: pass ``metrics().settling.start_time`` when the metrics are at
-        hand; a periodic state's: its first whole period).  The history is decimated (``samples_per_period``): a peak between its
-        samples is missed, as :func:`~torquesplit.results.plausibility.coarse_history`
-        says for the meshes; the means are not affected.  Forces are in the frame of the
+        hand; a periodic state's: its first whole period).  The history is decimated
+        (``samples_per_period``): a peak between its samples is missed, as
+        :func:`~torquesplit.results.plausibility.coarse_history` says for the meshes; the
+        means are not affected.  Forces are in the frame of the
         support (a turning carrier's for planets)."""
         s = self.solution
         if s is None or not s.history_t.size:
@@ -674,10 +675,10 @@ class Results:
         cols = [list(s.tracked_elements).index(el.index(m)) for m in self.mesh_names]
         summary, history, cycles, groups, bearing_file, about = plan.files
         n_hist = s.history_t.size
-        if getattr(self, "steady", None) is not None:  # one period, as the .nc holds
+        if self.periodic and self.period:  # one period, as the .nc holds
             from .dataset import period_samples
 
-            n_hist = period_samples(s.history_t, self.steady.solution.period) or n_hist
+            n_hist = period_samples(s.history_t, self.period) or n_hist
         contents = {
             groups: files.csv_bytes(group_header, group_rows),
             bearing_file: files.csv_bytes(bearing_header, bearing_rows),
