@@ -472,6 +472,9 @@ def run(
 
                     for loc, msg in result_warnings(res, met):
                         ux.warn(f"{loc}: {msg}")
+                    for text in _near_critical(res):  # (in the files' warnings too)
+                        res.run_warnings.append(text)
+                        ux.warn(text)
                 if out is not None:
                     res.save(out, overwrite=force, definition=chosen)
                     state["saved"] = list(plan.files)
@@ -504,6 +507,21 @@ def run(
     else:
         _print_run(m, res, met, saved, [], step_check, None, as_json)
         _fail(failed)
+
+
+def _near_critical(res) -> list[str]:
+    """``run``'s word on a critical speed next to the model's, from the run's own
+    structure and static equilibrium (a best effort: a model the Campbell map cannot take
+    says nothing)."""
+    import numpy as np
+
+    from .steady.maps import near_critical_speeds
+
+    try:
+        return [f"{loc}: {msg}" for loc, msg in near_critical_speeds(
+            res.model, res.structure, res.static.q, res.kinematics)]
+    except (TorquesplitError, ValueError, ArithmeticError, np.linalg.LinAlgError):
+        return []
 
 
 def _print_run(m, res, met, saved, figures, step_check, plots, as_json) -> None:
@@ -673,9 +691,9 @@ def _render_run(res, met, saved, planets=None) -> None:
         f"contact); back flank: share of the whole run with the deflection reversed (the "
         f"back flank engaged: the net force, damping included, can still push), and the "
         f"largest settled back-flank (tensile) force.  Groups: dynamic factor and "
-        f"peak/nominal are the largest of the group's meshes; peak/nominal (eng.) = mean over settled cycles of "
-        f"the largest member's per-cycle peak / nominal force (Ji & Li eq. 19, engineering "
-        f"coefficient G_it)."
+        f"peak/nominal are the largest of the group's meshes; peak/nominal (eng.) = mean "
+        f"over settled cycles of the largest member's per-cycle peak / nominal force (Ji & "
+        f"Li eq. 19, engineering coefficient G_it)."
         + ("  Bearing forces: from the history, not streamed, so a peak between its samples "
            "is missed (--samples-per-period)." if bearings else ""),
         markup=False, highlight=False)

@@ -30,7 +30,7 @@ from torquesplit.steady.sweep import (
 
 RPM = 60.0 / (2 * math.pi)
 
-__all__ = ["sweep_speed", "campbell"]
+__all__ = ["sweep_speed", "campbell", "near_critical_speeds"]
 
 
 def _rad_per_s(value, name: str) -> float:
@@ -592,3 +592,46 @@ def _structure_at(model, factor):  # the model at another speed (a turning carri
         d["speed"] = float(d["speed"]) * factor if isinstance(d["speed"], (int, float)) \
             else d["speed"]
     return assemble(model_from_dict(data))
+
+
+NEAR_CRITICAL = 0.01
+"""A critical speed within this share of the model's speed is said
+(:func:`near_critical_speeds`)."""
+DRIVING_HARMONIC = 0.01
+"""... when the harmonic of the mesh stiffness that drives it is at least this share of the
+mean stiffness (a helical pair's high orders, 1e-4 and below, drive next to nothing)."""
+
+
+def near_critical_speeds(model, structure, q, kinematics, within: float = NEAR_CRITICAL,
+                         least_harmonic: float = DRIVING_HARMONIC) -> list[tuple[str, str]]:
+    """The critical speeds (:func:`critical_speeds`: a mesh order meeting a natural
+    frequency of the structure linearised about ``q``) within ``within`` of the model's
+    own speed, driven by a stiffness harmonic of at least ``least_harmonic`` of the mean,
+    as one ``(location, message)`` warning naming the nearest: Ji & Li's drive runs at
+    745 rpm, 0.24 % above the critical speed where order 3 of its stage-2 mesh meets a
+    support mode (71.45 Hz, the largest line of its support-force spectrum), and ``run``
+    said nothing of it.  The frequencies are those at the model's speed (a turning
+    carrier's move by far less than ``within`` across the band).  Empty for a model
+    without a speed."""
+    w = reference_speed(model)
+    if not (w > 0 and math.isfinite(w)):
+        return []
+    crossings = critical_speeds(structure, q, kinematics, model, (1.0 - within) * w,
+                                (1.0 + within) * w, None)["crossings"]
+    driven = sorted((c for c in crossings if c.get("stiffness_harmonic", 0.0) >= least_harmonic),
+                    key=lambda c: abs(c["speed_rpm"] / (w * RPM) - 1.0))
+    if not driven:
+        return []
+    c = driven[0]
+    off = w * RPM / c["speed_rpm"] - 1.0
+    top, share = c["energy"][0] if c["energy"] else ("-", math.nan)
+    more = (f"; {len(driven) - 1} more within {100 * within:.2g} % (torquesplit modes "
+            f"--campbell lists them)" if len(driven) > 1 else "")
+    return [("analysis", (
+        f"the speed ({w * RPM:.5g} rpm) is {100 * abs(off):.2g} % "
+        f"{'above' if off > 0 else 'below'} a critical speed ({c['speed_rpm']:.5g} rpm): "
+        f"order {c['order']} of {c['source']} meets mode {c['mode']} "
+        f"({c['frequency_Hz']:.5g} Hz, {100 * share:.0f} % of its strain energy in {top}), "
+        f"driven by a harmonic of {100 * c['stiffness_harmonic']:.2g} % of the mean mesh "
+        f"stiffness: the response there is resonant and sensitive to small changes of "
+        f"speed or stiffness{more}"))]
