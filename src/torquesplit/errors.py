@@ -255,18 +255,23 @@ class ModelWarning(UserWarning):
 
 
 def warn_user(message, category: type[Warning] | None = None) -> None:
-    """``warnings.warn`` attributed to the first caller outside torquesplit (a script's
-    line, a notebook's cell), however deep in the library the warning arose: a fixed
-    ``stacklevel`` named a line of torquesplit's own (``simulation.py:131``) for warnings
-    raised a few calls below the function the user called."""
+    """``warnings.warn`` attributed to the line that called into torquesplit (a script's
+    line, a notebook's cell): the caller of the outermost torquesplit frame on the stack,
+    however deep in the library the warning arose (a fixed ``stacklevel`` named a line of
+    torquesplit's own, ``simulation.py:131``; the first frame outside the package would
+    name scipy's or numba's where they call back into it).  Where every frame is the
+    package's (``python -m torquesplit``), its outermost frame."""
     import os
     import sys
     import warnings
 
     package = os.path.dirname(os.path.abspath(__file__)) + os.sep
-    frame, level = sys._getframe(1), 2
-    while frame is not None and os.path.abspath(frame.f_code.co_filename).startswith(package):
+    frame, level, outermost = sys._getframe(1), 2, 2
+    while frame is not None:
+        if os.path.abspath(frame.f_code.co_filename).startswith(package):
+            outermost = level
         frame, level = frame.f_back, level + 1
+    level = outermost + 1 if outermost + 1 < level else outermost
     if category is None:
         warnings.warn(message, stacklevel=level)
     else:

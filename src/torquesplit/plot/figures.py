@@ -416,7 +416,7 @@ def support_spectrum_figure(results, *, start_time: float | None = None, orders:
             "the run recorded no support force; give a gear a [gears.<name>.support] table "
             "(with translational dofs) to get bearing forces")
     t = s.history_t
-    t0 = results.metrics().settling.start_time if start_time is None else float(start_time)
+    t0 = results.history_start() if start_time is None else float(start_time)
     keep = t >= t0
     if keep.sum() < 16:
         raise FigureNotApplicableError(

@@ -464,17 +464,29 @@ class Results:
         return {sp.connects[1]: name for name, sp in getattr(self.model, "splines", {}).items()
                 if sp.connects[1] not in supported}
 
+    def history_start(self, metrics=None, group: str | None = None) -> float:
+        """Where the settled part of the history starts [s]: the settle time (the
+        group's, where given), or a periodic record's first sample (a saved steady state
+        holds one period, which can end before a settle time: its spectrum figure found
+        no sample)."""
+        s = self.solution
+        if self.periodic and s is not None and s.history_t.size:
+            return float(s.history_t[0])
+        met = self.metrics() if metrics is None else metrics
+        return float(met.settling.group_time.get(group, met.settling.start_time)
+                     if group is not None else met.settling.start_time)
+
     def bearing_forces(self, start_time: float | None = None) -> list[dict]:
         """Per supported body, its bearing (support) force over the settled part: the mean
         of each direction [N], the magnitude of that mean and the largest magnitude of the
         force vector [N] (a body held by a spline alone: the spline's radial force, its
         name in ``via``), from the history from ``start_time`` (default the latest group
         settle time: pass ``metrics().settling.start_time`` when the metrics are at
-        hand; a periodic state's: its first whole period).  The history is decimated
-        (``samples_per_period``): a peak between its samples is missed, as
-        :func:`~torquesplit.results.plausibility.coarse_history` says for the meshes; the
-        means are not affected.  Forces are in the frame of the
-        support (a turning carrier's for planets)."""
+        hand; a periodic state's: its first whole period, whatever ``start_time``).  The
+        history is decimated (``samples_per_period``): a peak between its samples is
+        missed, as :func:`~torquesplit.results.plausibility.coarse_history` says for the
+        meshes; the means are not affected.  Forces are in the frame of the support (a
+        turning carrier's for planets)."""
         s = self.solution
         if s is None or not s.history_t.size:
             return []

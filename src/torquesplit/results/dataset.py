@@ -428,6 +428,7 @@ def results_from_dataset(ds: xr.Dataset):
     res = Results(model=model, kinematics=kin, structure=structure, static=static,
                   solution=solution, model_warnings=notes,
                   periodic=ds.attrs.get("analysis") == "periodic steady state",
-                  period=float(ds.attrs.get("steady_period_s", math.nan)) or None)
+                  period=(float(ds.attrs["steady_period_s"]) if "steady_period_s" in ds.attrs
+                          else None))
     res.saved_definition = ds.attrs.get("load_sharing_definition")
     return res

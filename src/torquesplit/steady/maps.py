@@ -618,7 +618,9 @@ def near_critical_speeds(model, structure, q, kinematics, within: float = NEAR_C
         return []
     crossings = critical_speeds(structure, q, kinematics, model, (1.0 - within) * w,
                                 (1.0 + within) * w, None)["crossings"]
-    driven = sorted((c for c in crossings if c.get("stiffness_harmonic", 0.0) >= least_harmonic),
+    # (a crossing the planets' mesh phasing leaves unexcited is none: Parker & Lin 2004)
+    driven = sorted((c for c in crossings if c.get("stiffness_harmonic", 0.0) >= least_harmonic
+                     and not c.get("suppressed")),
                     key=lambda c: abs(c["speed_rpm"] / (w * RPM) - 1.0))
     if not driven:
         return []
