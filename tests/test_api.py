@@ -84,7 +84,13 @@ def test_bad_arguments_raise_the_packages_own_error(model):
              lambda: torquesplit.sweep_speed(model, "600 rpm", "800 rpm", points=0),
              lambda: torquesplit.simulate(model, cycles=10, max_steps=0),
              lambda: run.bearing_forces("x"),
-             lambda: run.write_figures("figs", formats=("xlsx",))]
+             lambda: run.write_figures("figs", formats=("xlsx",)),
+             lambda: run.metrics("static_torque"),  # (a quasi-static definition)
+             lambda: torquesplit.assemble(model, options={"x": 1}),
+             lambda: torquesplit.steady_state(model, keep="zz"),
+             lambda: torquesplit.steady_state(model, method="hb", keep="stage1", samples=-3),
+             lambda: torquesplit.steady_state(model, max_cycles=0),
+             lambda: torquesplit.sweep_speed(model, "600 rpm", "800 rpm", max_step=-1)]
     for call in calls:
         with pytest.raises(torquesplit.OptionError):
             call()

@@ -48,7 +48,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import ModelError, warn_user
+from ..errors import ModelError, OptionError, warn_user
 from ..gears import line_of_action as loa
 from ..gears.vectors import cross
 from ..model.kinematics import Kinematics, solve_kinematics
@@ -163,13 +163,14 @@ def _assemble(model: Model, kin: Kinematics | None, *, n_table: int | None,
     options = dict(options or {})
     unknown = sorted(set(options) - _OPTIONS)
     if unknown:
-        raise ValueError(f"unknown assembly option(s) {unknown}; known: {sorted(_OPTIONS)}")
+        raise OptionError(f"unknown assembly option(s) {unknown}; known: {sorted(_OPTIONS)}")
     v_reg = float(options.get("spline_velocity_scale", model.analysis.spline_velocity_scale))
     rotating = options.get("rotating_frame", True)
     if not isinstance(rotating, bool):
-        raise ValueError(f"rotating_frame must be true or false, got {rotating!r}")
+        raise OptionError(f"rotating_frame must be true or false, got {rotating!r}")
     if not (v_reg > 0 and math.isfinite(v_reg)):
-        raise ValueError(f"spline_velocity_scale must be a positive speed in m/s, got {v_reg!r}")
+        raise OptionError(f"spline_velocity_scale must be a positive speed in m/s, got "
+                          f"{v_reg!r}")
     dmap, inv_mass = number_dofs(model, kin)
     n_dof = len(dmap.names)
     elements: list[dict] = []

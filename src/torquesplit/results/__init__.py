@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from ..assembly.structure import element_units
-from ..errors import OptionError, SolverError
+from ..errors import OptionError
 from ..metrics import load_sharing as ls
 
 #: the load-sharing definition of a new model: the mean-force ratio, the mesh load factor
@@ -372,7 +372,7 @@ class Results:
         quasi-static 'static_torque', raises (before anything is computed or written)."""
         definition = definition or self.default_definition
         if definition in ("static", "static_torque"):
-            raise SolverError(
+            raise OptionError(
                 "'static_torque' is the load sharing of quasi-static equilibria (Mo et al. "
                 "2017 eqs. 14-15), not of a dynamic run; compute it with `torquesplit "
                 "static MODEL` (or torquesplit.quasi_static_load_sharing), or "

@@ -109,7 +109,7 @@ def _warn_far_speed(model, speed, value: float, s: float) -> None:
 
 
 def _check_options(*, steps_per_cycle, tol, stability, energy_tol, method="auto",
-                   harmonics=None) -> None:
+                   harmonics=None, max_cycles=None) -> None:
     """The solver options of :func:`steady_state`, refused by name before any work:
     steps_per_cycle=0 and -3 ran, tol=-1 ran 3.6 s to 'NOT converged', stability='foo'
     was taken (a reviewer)."""
@@ -132,6 +132,11 @@ def _check_options(*, steps_per_cycle, tol, stability, energy_tol, method="auto"
             harmonics, numbers.Integral) or harmonics < 1):
         raise OptionError(f"harmonics must be a whole number >= 1, got {harmonics!r}; e.g. "
                           f"harmonics=16 per excitation cycle")
+    if not (max_cycles is None or max_cycles == "auto" or (
+            isinstance(max_cycles, numbers.Integral) and not isinstance(max_cycles, bool)
+            and max_cycles >= 1)):
+        raise OptionError(f"max_cycles must be a whole number >= 1, 'auto' or None, got "
+                          f"{max_cycles!r}")
     if not (isinstance(stability, bool) or stability in ("hill", "monodromy")):
         raise OptionError(f"stability must be True, False, 'hill' or 'monodromy', got "
                           f"{stability!r}")
@@ -374,7 +379,8 @@ def steady_state(model, *, method: str = "auto", harmonics: int | None = None,
     from torquesplit.solve.static import static_equilibrium
 
     _check_options(steps_per_cycle=steps_per_cycle, tol=tol, stability=stability,
-                   energy_tol=energy_tol, method=method, harmonics=harmonics)
+                   energy_tol=energy_tol, method=method, harmonics=harmonics,
+                   max_cycles=max_cycles)
     if not hasattr(model, "meshes"):
         model = load_model(model)
     kin = solve_kinematics(model)

@@ -267,7 +267,9 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
             "results_file": str(saved[0]) if saved else None,
             "results_files": [str(f) for f in saved or []],
             **({"step_check": step_check.to_dict()} if step_check else {}),
-            "units": MESH_UNITS,  # SI (the table prints kN and µm)
+            # SI (the table prints kN and µm), of exactly the keys the rows have
+            "units": {k: u for k, u in MESH_UNITS.items()
+                      if any(k in r.__dict__ for r in rows)},
         }
         if as_json:
             _emit(info, json_default)

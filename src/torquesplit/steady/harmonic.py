@@ -24,7 +24,7 @@ import math
 
 import numpy as np
 
-from torquesplit.errors import SolverError
+from torquesplit.errors import OptionError, SolverError
 from torquesplit.steady.problem import PeriodicProblem
 
 log = logging.getLogger(__name__)
@@ -47,10 +47,10 @@ class HarmonicBalance:
     def __init__(self, problem: PeriodicProblem, harmonics: int, samples: int | None = None):
         H = int(harmonics)
         if H < 1:
-            raise SolverError("harmonics must be >= 1; e.g. harmonics=16 per excitation cycle.")
+            raise OptionError("harmonics must be >= 1; e.g. harmonics=16 per excitation cycle.")
         N = default_samples(H) if samples is None else int(samples)
         if N < 2 * H + 2:
-            raise SolverError(f"{N} time samples cannot carry {H} harmonics; use at least "
+            raise OptionError(f"{N} time samples cannot carry {H} harmonics; use at least "
                               f"2 H + 2 = {2 * H + 2} samples.")
         self.p = problem
         self.H = H

@@ -120,6 +120,11 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
 
     if not (isinstance(points, (int, np.integer)) and points >= 1):
         raise OptionError(f"points must be a whole number >= 1, got {points!r}")
+    if max_step is not None and not (isinstance(max_step, (int, float))
+                                     and not isinstance(max_step, bool) and max_step > 0):
+        raise OptionError(f"max_step must be a positive speed in rad/s (the largest "
+                          f"continuation step), got {max_step!r}; leave it out for the "
+                          f"default")
     t_start = time.perf_counter()
     model, kin, s, dropped, per, static = _prepare(model, keep, max_cycles)
     sub = math.gcd(*[int(k) for k in per.orders]) if per.orders else 1

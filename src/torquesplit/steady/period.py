@@ -26,6 +26,7 @@ import numpy as np
 
 from torquesplit.assembly.structure import Structure
 from torquesplit.errors import LongPeriodError, PeriodError, SolverError  # noqa: F401 - re-exported
+from torquesplit.errors import OptionError
 
 __all__ = ["ExcitationSource", "Period", "PeriodError", "LongPeriodError",
            "default_max_cycles", "excitation_sources", "fundamental_period",
@@ -211,7 +212,7 @@ def base_frequency(structure: Structure, keep, kinematics=None) -> float:
     (its meshes' common frequency) or, with ``kinematics``, a body (one revolution)."""
     if isinstance(keep, (int, float)):
         if not keep > 0:
-            raise SolverError(f"keep={keep!r}: a base frequency must be > 0 Hz.")
+            raise OptionError(f"keep={keep!r}: a base frequency must be > 0 Hz.")
         # a frequency as typed (2675.335 Hz for half of 5350.67 Hz): the excitation's own
         # fraction where it lies within TYPED_RTOL of one, so that its multiples are kept
         # and the period is exact
@@ -230,12 +231,12 @@ def base_frequency(structure: Structure, keep, kinematics=None) -> float:
              if str(meta.get("stage")) == str(keep)]
     if stage:
         if max(stage) - min(stage) > RTOL * max(stage):
-            raise SolverError(f"the meshes of stage {keep!r} have different frequencies "
+            raise OptionError(f"the meshes of stage {keep!r} have different frequencies "
                               f"{sorted(set(stage))} Hz; keep one mesh by its name instead.")
         return stage[0]
     if kinematics is not None and keep in kinematics.bodies:
         return abs(kinematics.bodies[keep].speed) / (2 * math.pi)
-    raise SolverError(f"keep={keep!r} is no mesh, stage or body of the model; use one of "
+    raise OptionError(f"keep={keep!r} is no mesh, stage or body of the model; use one of "
                       f"the stages {_stages(structure)}, a mesh {list(meshes)} or a "
                       f"frequency in Hz.")
 
