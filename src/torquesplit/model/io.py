@@ -133,8 +133,8 @@ _TABLE = ("must be a table of fields", f"write it as a [section] or {{key = valu
 #: pydantic error type -> (what the value must be, what to write instead)
 _TYPE_MESSAGES = {
     "int": ("must be a whole number", "write an integer such as 20"),
-    "float": ("must be a number", "write a plain number such as 0.05"),
-    "finite_number": ("must be a finite number", "write a plain number such as 0.05"),
+    "float": ("must be a number", "write a plain number such as 0.05 (or '5 %')"),
+    "finite_number": ("must be a finite number", "write a plain number such as 0.05 (or '5 %')"),
     "string": ("must be text", 'write it in quotes, e.g. "pinion"'),
     "bool": ("must be true or false", "write true or false"),
     "dict": _TABLE,

@@ -14,6 +14,7 @@ torquesplit.model.docs``) and a test checks that it is up to date.
 from __future__ import annotations
 
 import math
+import re
 from typing import Annotated, Literal
 
 from pydantic import (BaseModel, BeforeValidator, ConfigDict, Field, PrivateAttr,
@@ -56,8 +57,28 @@ def _not_a_bool(what: str, example: str):
     return BeforeValidator(check)
 
 
-Number = Annotated[float, _not_a_bool("a number", "a plain number such as 0.05")]
-"""A plain (dimensionless) number; true/false are refused."""
+_PERCENT = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(?:%|percent)\s*$")
+
+
+def _plain_number():
+    """A validator for a dimensionless number: true/false refused, and a percentage
+    ('10 %', '10 percent') read as its fraction (a damping ratio of "10 %" was refused)."""
+    refuse_bool = _not_a_bool("a number", "a plain number such as 0.05").func
+
+    def check(v):
+        v = refuse_bool(v)
+        if isinstance(v, str):
+            m = _PERCENT.match(v)
+            if m:
+                return float(m.group(1)) / 100.0
+        return v
+
+    return BeforeValidator(check)
+
+
+Number = Annotated[float, _plain_number()]
+"""A plain (dimensionless) number, or a percentage ('5 %' is 0.05); true/false are
+refused."""
 Count = Annotated[int, _not_a_bool("a whole number", "an integer such as 20")]
 """A whole number; true/false are refused."""
 Flag = Annotated[bool, StrictType()]
