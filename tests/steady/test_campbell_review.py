@@ -255,3 +255,30 @@ def test_each_mesh_crossing_is_rated_by_its_stiffness_harmonic():
     assert all(v < 1e-9 for k, v in rated.items() if k > 2)
     assert all("stiffness_harmonic" not in c for c in crossings
                if c["source"].startswith("rotation"))
+
+
+def test_a_two_stage_drive_gets_a_panel_for_its_slower_meshes():
+    """Ji & Li's stage-2 orders and its first eight modes shared the bottom tenth of the
+    axis, their labels stacked over each other (a first-hour reviewer)."""
+    from torquesplit.steady.plot import ZOOM_SHARE, campbell_figure
+
+    ds, _ = campbell(load_model("ji_li_mill_drive"), 600 * RPM, 900 * RPM, points=5)
+    fig = campbell_figure(ds)
+    fig.canvas.draw()
+    top, low = fig.axes[:2]
+    assert low.get_ylim()[1] < ZOOM_SHARE * top.get_ylim()[1]
+    # the slower meshes' orders, labelled, and every mode below the panel's top numbered
+    texts = [t.get_text() for t in low.texts]
+    assert any(t.startswith("1x m12, m22") for t in texts), texts
+    below = sorted(int(m) for m, f in zip(ds["mode"].values, ds["natural_frequency"].values[-1])
+                   if f < low.get_ylim()[1])
+    numbered = {int(n) for t in texts for n in t.split(", ") if n.isdigit()}
+    assert set(below) <= numbered, (below, numbered)
+    legend = low.get_legend().get_window_extent()
+    assert not legend.overlaps(low.get_window_extent())
+    assert not legend.overlaps(low.xaxis.label.get_window_extent())
+
+
+def test_a_single_mesh_frequency_keeps_one_panel(lp3_figure):
+    _, fig = lp3_figure
+    assert len(fig.axes) == 1

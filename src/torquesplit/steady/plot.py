@@ -193,19 +193,72 @@ def campbell_figure(ds):
     = 20x out1': coinciding harmonics).  Critical speeds are grey dotted lines with their
     speeds (staggered in rows; one too close to the others in every row is left
     unlabelled), the model's operating speed a solid line; the legend sits under the
-    axes, clear of the lines' labels."""
+    axes, clear of the lines' labels.  Where the slowest mesh's orders end below
+    :data:`ZOOM_SHARE` of the highest line (a two-stage drive: the stage-2 orders and the
+    first modes shared the bottom tenth of the axis), a second panel below shows them."""
     import textwrap
 
-    fig = _figure(9, 6.5)
-    ax = fig.add_subplot()
-    rpm = ds["speed_rpm"].values
     fmax = float(np.nanmax(ds["excitation_frequency"].values))
-    near = 0.02 * fmax * 1.05  # two mode labels closer than this (in Hz) would overlap
+    zoom = _zoom_top(ds, fmax * 1.05)
+    if zoom is None:
+        fig = _figure(9, 6.5)
+        ax = fig.add_subplot()
+        axes = [ax]
+    else:
+        fig = _figure(9, 9.5)
+        ax, low = fig.subplots(2, 1, sharex=True, gridspec_kw=dict(height_ratios=[3, 2]))
+        axes = [ax, low]
+    rows = _campbell_panel(ax, ds, fmax * 1.05, labelled=True)
+    if zoom is not None:
+        _campbell_panel(low, ds, zoom, labelled=False)
+        ax.set_xlabel("")  # (the speed axis is the panel's below)
+        low.set_title(f"below {zoom:.4g} Hz: the slower meshes' orders and the lowest "
+                      f"modes", fontsize=8, loc="left")
+    name = textwrap.shorten(str(ds.attrs.get("model", "")), 90, placeholder="...")
+    ax.set_title(f"{name}: Campbell diagram\nsolid: natural frequencies (numbered); dashed: "
+                 "excitation orders; dotted: critical speeds [rpm]", fontsize=9,
+                 pad=6 + 26 * max(rows, 1))
+    under = axes[-1]
+    ncol = 2 if len(ax.get_legend_handles_labels()[1]) > 3 else 1
+    handles, labels = ax.get_legend_handles_labels()
+    under.legend(handles, labels, fontsize=7, loc="upper center",
+                 bbox_to_anchor=(0.5, -0.1 if zoom is None else -0.17), ncol=ncol,
+                 frameon=False)
+    return fig
+
+
+#: a second panel shows the slowest mesh's orders where they end below this share of the
+#: highest excitation line
+ZOOM_SHARE = 0.2
+
+
+def _zoom_top(ds, top: float) -> float | None:
+    """The top [Hz] of the low panel: a little above where the slowest mesh's orders end
+    at the highest speed, or None where they take more than ZOOM_SHARE of the axis."""
+    ends: dict[str, float] = {}
+    for j, lab in enumerate(ds["line"].values):
+        order, _, source = str(lab).partition(" x ")
+        if source.startswith("mesh"):
+            f = float(ds["excitation_frequency"].values[-1, j])
+            ends[source] = max(ends.get(source, 0.0), f)
+    if len(ends) < 2:
+        return None
+    slow = min(ends.values())
+    return 1.1 * slow if 0 < 1.1 * slow < ZOOM_SHARE * top else None
+
+
+def _campbell_panel(ax, ds, top: float, *, labelled: bool) -> int:
+    """One panel of the Campbell diagram from 0 to ``top`` Hz: natural frequencies with
+    their numbers, excitation lines with their orders, critical speeds (their speeds
+    printed above the axes where ``labelled``), the operating speed.  Returns the rows of
+    critical-speed labels."""
+    rpm = ds["speed_rpm"].values
+    near = 0.02 * top  # two mode labels closer than this (in Hz) would overlap
     ends: list[tuple[float, list[str]]] = []
     for m in range(ds.sizes["mode"]):
         fn = ds["natural_frequency"].values[:, m]
         ax.plot(rpm, fn, color="k", lw=0.8)
-        if np.isfinite(fn[-1]) and 0 < fn[-1] <= fmax * 1.05:  # mode number at its end
+        if np.isfinite(fn[-1]) and 0 < fn[-1] <= top:  # mode number at its end
             _merge_label(ends, float(fn[-1]), f"{int(ds['mode'].values[m])}", near)
     for f, labels in ends:
         ax.annotate(", ".join(labels), (rpm[-1], f), fontsize=7, xytext=(3, 0),
@@ -219,7 +272,7 @@ def campbell_figure(ds):
     several = sum(len(m) > 1 for m in sources.values()) > 1
     # a label's height in Hz: order labels closer than this are thinned (one source) or
     # stacked with a leader line (lines of different sources)
-    height = (fmax * 1.05) * 9.0 / (fig.get_figheight() * 72 * ax.get_position().height)
+    height = top * 9.0 / (ax.figure.get_figheight() * 72 * ax.get_position().height)
     tops: list[tuple[float, float, list[str], str]] = []  # (x, y, labels, colour)
     for k, (source, members) in enumerate(sources.items()):
         colour = LINE_COLOURS[k % len(LINE_COLOURS)]
@@ -230,7 +283,7 @@ def campbell_figure(ds):
         for i, (j, order) in enumerate(members):
             fe = ds["excitation_frequency"].values[:, j]
             ax.plot(rpm, fe, lw=0.8, ls="--", color=colour, label=label if i == 0 else None)
-            inside = np.flatnonzero(fe <= fmax * 1.05)
+            inside = np.flatnonzero(fe <= top)
             if len(members) > 1 and inside.size:  # the order at the line's last point
                 ends.append((float(rpm[inside[-1]]), float(fe[inside[-1]]),
                              f"{order}x {short}".strip()))
@@ -248,8 +301,13 @@ def campbell_figure(ds):
                     bbox=dict(fc="white", ec="none", alpha=0.8, pad=0.3),
                     arrowprops=(dict(arrowstyle="-", color=colour, lw=0.4) if at > y + 1e-9
                                 else None))
-    rows = _critical_labels(ax, sorted(ds.attrs.get("critical_speeds_rpm", [])),
-                            float(rpm.min()), float(rpm.max()))
+    crit = sorted(ds.attrs.get("critical_speeds_rpm", []))
+    if labelled:
+        rows = _critical_labels(ax, crit, float(rpm.min()), float(rpm.max()))
+    else:
+        rows = 0
+        for c in crit:
+            ax.axvline(c, color="0.35", lw=0.6, ls=":")
     # crossings that the planets' mesh phasing leaves unexcited (Parker & Lin 2004)
     for i, c in enumerate(ds.attrs.get("suppressed_speeds_rpm", [])):
         ax.axvline(c, color="0.75", lw=0.5, ls="-.",
@@ -258,18 +316,11 @@ def campbell_figure(ds):
     if op is not None and float(rpm.min()) <= float(op) <= float(rpm.max()):
         ax.axvline(float(op), color="C3", lw=1.4, alpha=0.7,
                    label=f"operating speed (the model's drive): {float(op):.5g} rpm")
-    ax.set_ylim(0, fmax * 1.05)
+    ax.set_ylim(0, top)
     ax.set_xlim(float(rpm.min()), float(rpm.max()))
     ax.set_xlabel("input speed [rpm]")
     ax.set_ylabel("frequency [Hz]")
-    name = textwrap.shorten(str(ds.attrs.get("model", "")), 90, placeholder="...")
-    ax.set_title(f"{name}: Campbell diagram\nsolid: natural frequencies (numbered); dashed: "
-                 "excitation orders; dotted: critical speeds [rpm]", fontsize=9,
-                 pad=6 + 26 * max(rows, 1))
-    ncol = 2 if len(ax.get_legend_handles_labels()[1]) > 3 else 1
-    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.1), ncol=ncol,
-              frameon=False)
-    return fig
+    return rows
 
 
 #: excitation lines' colours: matplotlib's cycle without C3, the operating speed's red
