@@ -240,6 +240,21 @@ def test_stopping_rule_outcome_is_reported(split_file, tmp_path):
     assert f"target half-width {1e-3 * ds.attrs['stopping_target']:.3g} kN" in line
 
 
+def test_the_statistics_table_of_a_force_says_its_unit(split_file, tmp_path):
+    """The Monte Carlo table printed a force in kN without its unit: Rich read the
+    unescaped " [kN]" as markup and dropped it, while results.nc holds N."""
+    from torquesplit import cli as ui
+    from torquesplit.study.cli import _summary
+
+    ds = run_study(mc_study(split_file, samples=4, outputs=("peak_force.a1",)), workers=1)
+    with ui.console.capture() as cap:
+        _summary(ds, tmp_path, False, False)
+    var = next(v for v in ds.data_vars if ds[v].attrs.get("output") == "peak_force.a1")
+    row = next(ln for ln in cap.get().splitlines() if var in ln)
+    assert f"{var} [kN]" in row
+    assert f"{1e-3 * float(ds[var].mean()):.6g}" in row
+
+
 def test_a_percentile_rule_that_cannot_stop_is_refused(split_file):
     """max_samples below 59 can never bound a 95th percentile at 95 %: the rule ran to its
     end and advised widening half_width, which cannot help."""

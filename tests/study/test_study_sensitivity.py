@@ -94,6 +94,21 @@ def test_ranking_of_a_constructed_model(split_file, tmp_path, method, kw):
     unit = "per output: see output_unit" if method == "morris" else "1"
     assert ds[key].attrs["units"] == unit
     assert ds.sizes["sample"] == (4 * 4 if method == "morris" else 16 * 5)
+    # the ranking table prints Morris's effect of a force in kN, with its unit (Rich read
+    # an unescaped " [kN]" as markup and dropped it); Sobol's shares have none
+    from torquesplit import cli as ui
+    from torquesplit.study.cli import _summary
+
+    with ui.console.capture() as cap:
+        _summary(ds, tmp_path, False, False)
+    text = cap.get()
+    var = next(v for v in ds.data_vars if ds[v].attrs.get("output") == "static_force.a1")
+    if method == "morris":
+        mu = ds["mu_star"].sel(output="static_force.a1",
+                               factor="meshes.a1.transmission_error.constant").item()
+        assert f"{var} [kN]" in text and f"{1e-3 * mu:.3g}" in text, text
+    else:
+        assert f"{var} [" not in text
 
 
 def _ishigami(d):

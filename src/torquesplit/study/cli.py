@@ -208,6 +208,7 @@ def _with_bar(job, total: int, quiet: bool):
 
 def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
     import numpy as np
+    from rich.markup import escape
 
     from .dataset import case_ranges, ranking, warning_groups
 
@@ -262,7 +263,8 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
         for v in out_vars:
             rank = ranking(ds, ds[v].attrs["output"])
             suffix, scale = _shown(ds[v]) if morris else ("", 1.0)
-            t.add_row(v + suffix, ", ".join(f"{f} {x * scale:.3g}" for f, x in rank))
+            # (escaped: Rich reads " [kN]" as markup and drops it)
+            t.add_row(escape(v + suffix), ", ".join(f"{f} {x * scale:.3g}" for f, x in rank))
         ui.console.print(t)
         used_var = next((u for u in ("samples_used", "trajectories_used") if u in ds), None)
         if used_var is not None:
@@ -293,11 +295,11 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
             x = x[np.isfinite(x)] * scale
             count = [f"{x.size} of {status.size}"] if "cases" in cols else []
             if not x.size:
-                t.add_row(v + suffix, *["-"] * 6, *count)
+                t.add_row(escape(v + suffix), *["-"] * 6, *count)
                 continue
             stats = (x.mean(), x.std(ddof=1) if x.size > 1 else 0.0, x.min(),
                      np.quantile(x, 0.05), np.quantile(x, 0.95), x.max())
-            t.add_row(v + suffix, *[f"{s:.6g}" for s in stats], *count)
+            t.add_row(escape(v + suffix), *[f"{s:.6g}" for s in stats], *count)
         ui.console.print(t)
         if fewer:
             ui.console.print(f"statistics over the cases with a finite value only: "
