@@ -159,3 +159,14 @@ def test_summary_names_the_case_of_each_failure_units_and_an_empty_resume(tmp_pa
         first = float(ds[var].values[0])
     assert f"{first * 1e-3:.6g}" in res.stdout and f"{first:.6g}" not in res.stdout
     assert "2 outputs" in res.stderr
+
+
+def test_a_sweeps_remedy_is_in_its_options(tmp_path):
+    """--log over a range from 0 answered 'use spacing = "linear"', the study file's
+    syntax, to a command line whose fix is to leave out --log."""
+    res = runner.invoke(app, ["sweep", "ji_li_mill_drive", "--vary",
+                              "meshes.m11.backlash=0:1:3mm", "--log", "--out",
+                              str(tmp_path / "s")])
+    assert res.exit_code == 2
+    assert "a log range needs positive start and stop; leave out --log" in res.stderr
+    assert "spacing" not in res.stderr

@@ -145,7 +145,8 @@ def _run(source, *, workers, scheduler, out, resume, overwrite, figures, quiet, 
         from .errors import StudyError
 
         if flag and isinstance(exc, StudyError):  # the sweep's words, not the study's
-            exc = StudyError.of([(_sweep_option(f, flag), m) for f, m in exc.problems])
+            exc = StudyError.of([(_sweep_option(f, flag), _sweep_words(m))
+                                 for f, m in exc.problems])
         ui._fail(exc)
         return
     _summary(ds, Path(out), as_json, figures)
@@ -171,11 +172,23 @@ def _sweep_option(field: str, flag: str) -> str:
     return field
 
 
+#: a study file's remedy -> the sweep's (its message spoke study-file syntax to a command
+#: line: 'use spacing = "linear"' where the fix is to leave out --log)
+_SWEEP_WORDS = (('use spacing = "linear"', "leave out --log"),)
+
+
+def _sweep_words(message: str) -> str:
+    """A study message's remedy in the sweep's options (:data:`_SWEEP_WORDS`)."""
+    for study, sweep in _SWEEP_WORDS:
+        message = message.replace(study, sweep)
+    return message
+
+
 def _sweep_note(note: str, flag: str) -> str:
     """A plan's note ("field: message") in the sweep's words, as its errors
     (:func:`_sweep_option`)."""
     field, sep, message = note.partition(": ")
-    return f"{_sweep_option(field, flag)}{sep}{message}" if sep else note
+    return f"{_sweep_option(field, flag)}{sep}{_sweep_words(message)}" if sep else note
 
 
 def _with_bar(job, total: int, quiet: bool):
