@@ -215,3 +215,23 @@ def test_tornado_of_a_force_draws_mu_star_in_the_unit_its_axis_names():
     assert ax.get_xlabel().endswith("[kN]")
     widths = sorted(p.get_width() for p in ax.patches)
     np.testing.assert_allclose(widths, [0.4, 2.5])
+
+
+def test_a_long_title_is_wrapped_inside_the_figure():
+    """A long model and study name ran the title off both edges of the figure."""
+    import xarray as xr
+
+    from torquesplit.study.figures import tornado_figure
+
+    out = "peak_force.m1"
+    ds = xr.Dataset({"mu_star": (("output", "factor"), [[2500.0, 400.0]]),
+                     "mu_star_conf": (("output", "factor"), [[100.0, 50.0]])},
+                    coords={"output": [out], "factor": ["a", "b"]},
+                    attrs={"ranking": "mu_star", "study_name": "a rather long study " * 5,
+                           "model_name": "ji_li_mill_drive with a long variant name " * 2})
+    ds[out] = ("sample", np.zeros(2), {"output": out, "units": "N"})
+    fig = tornado_figure(ds, out)
+    fig.canvas.draw()
+    box = fig._suptitle.get_window_extent()
+    assert box.x0 >= 0 and box.x1 <= fig.bbox.width
+    assert "\n" in fig._suptitle.get_text()

@@ -117,7 +117,7 @@ def curves_figure(ds, family: str, members: list[tuple[str, str]]) -> Figure:
     ax.grid(True, alpha=0.3)
     ax.yaxis.get_major_formatter().set_useOffset(False)
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False, fontsize=8)
-    fig.suptitle(f"{_title(ds)}: {_family_text(family)}", fontsize=11)
+    _suptitle(fig, f"{_title(ds)}: {_family_text(family)}")
     return fig
 
 
@@ -178,7 +178,7 @@ def maps_figure(ds, family: str, members: list[tuple[str, str]]) -> Figure:
         ax.set_xlabel(f"{_param_label(ds, dims[0])} [{xunit}]", fontsize=8)
         ax.set_ylabel(f"{_param_label(ds, dims[1])} [{yunit}]", fontsize=8)
         ax.tick_params(labelsize=7)
-    fig.suptitle(f"{_title(ds)}: {_family_text(family)}", fontsize=11)
+    _suptitle(fig, f"{_title(ds)}: {_family_text(family)}")
     return fig
 
 
@@ -235,7 +235,7 @@ def monte_carlo_figure(ds, var: str, confidence: float = 0.95) -> Figure:
     failed = int((ds["status"].values != "ok").sum())
     note = f" ({failed} of {y.size} cases not ok)" if failed else ""
     what = f"statistics over {n} of {y.size} cases" if n < y.size else f"{n} samples"
-    fig.suptitle(f"{_title(ds)}: {what}{note}", fontsize=11)
+    _suptitle(fig, f"{_title(ds)}: {what}{note}")
     return fig
 
 
@@ -299,7 +299,7 @@ def tornado_figure(ds, var: str) -> Figure:
                   if key == "mu_star" else "Sobol index [-]")
     ax.grid(True, axis="x", alpha=0.3)
     ax.legend(fontsize=8, loc="lower right")
-    fig.suptitle(f"{_title(ds)}: {ds[var].attrs.get('output', var)}", fontsize=11)
+    _suptitle(fig, f"{_title(ds)}: {ds[var].attrs.get('output', var)}")
     return fig
 
 
@@ -411,6 +411,16 @@ def _mark_failed(ax, x, status) -> None:
     if bad.any():
         ax.plot(np.asarray(x)[bad], np.zeros(bad.sum()), "rx", ms=7, clip_on=False,
                 transform=ax.get_xaxis_transform(), label="case not ok")
+
+
+def _suptitle(fig, text: str, fontsize: float = 11.0) -> None:
+    """The figure's title, wrapped to its width (a long model or study name ran off both
+    edges of the figure: a reviewer's '_li_mill_drive ... (mean cycle peak / nominal
+    forc')."""
+    import textwrap
+
+    per_line = max(20, int(fig.get_figwidth() * 72 / (0.55 * fontsize)))
+    fig.suptitle("\n".join(textwrap.wrap(text, per_line)), fontsize=fontsize)
 
 
 def _title(ds) -> str:
