@@ -265,3 +265,26 @@ def test_a_percentile_rule_that_cannot_stop_is_refused(split_file):
     with pytest.raises(StudyError, match="max_samples: 48 samples cannot bound a 95th "
                                          "percentile with 95% confidence \\(it takes 59\\)"):
         Study(mc_study(split_file, stop=stop)).plan()
+
+
+def test_a_stopping_half_width_takes_the_outputs_unit():
+    """half_width = "1 kN" was refused as not a number, and a bare number's unit (the
+    output's SI one) was said nowhere."""
+    from torquesplit.study import Study
+    from torquesplit.study.errors import StudyError
+
+    def spec(half_width, output="peak_force.m11"):
+        return {"study": {"name": "t", "model": "ji_li_mill_drive", "outputs": [output]},
+                "analysis": {"cycles": 20},
+                "monte_carlo": {"seed": 1, "parameters": [
+                    {"path": "meshes.m11.backlash", "distribution": "uniform",
+                     "low": "0.5 mm", "high": "1 mm"}],
+                    "stop": {"output": output, "half_width": half_width, "max_samples": 40,
+                             "min_samples": 8, "batch": 8}}}
+
+    assert Study(spec("1 kN")).plan().spec.monte_carlo.stop.half_width == 1000.0
+    assert Study(spec(250)).plan().spec.monte_carlo.stop.half_width == 250.0
+    with pytest.raises(StudyError, match=r"monte_carlo.stop.half_width: '1 kg' is not a force"):
+        Study(spec("1 kg")).plan()
+    with pytest.raises(StudyError, match=r"half_width: write a plain number"):
+        Study(spec("1 kN", output="load_sharing.cycle_peak")).plan()

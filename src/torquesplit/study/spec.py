@@ -38,7 +38,8 @@ from pathlib import Path
 from typing import Any, Literal, Union
 
 import pydantic
-from pydantic import BaseModel, ConfigDict, Field, StrictFloat, StrictInt, model_validator
+from pydantic import (BaseModel, ConfigDict, Field, StrictFloat, StrictInt, field_validator,
+                      model_validator)
 
 from ..errors import FieldError
 from .errors import StudyError
@@ -222,8 +223,27 @@ class StopRule(_Strict):
 
     output: str = Field(description="The output whose statistic is watched (exact name).")
     statistic: Literal["mean", "p95"] = Field("mean", description="Mean or 95th percentile.")
-    half_width: float = Field(gt=0, description="Target half-width of the interval.")
+    half_width: float = Field(gt=0, description=(
+        "Target half-width of the interval: in the output's SI unit, or with its unit "
+        "('1 kN' for a force); a fraction of |statistic| with relative = true."))
     relative: bool = Field(False, description="half_width relative to |statistic|.")
+
+    @field_validator("half_width", mode="before")
+    @classmethod
+    def _with_unit(cls, v, info):
+        """A half-width written with a unit ('1 kN'), read in the output's SI unit (it was
+        refused as 'not a valid number', and a bare number's unit was said nowhere)."""
+        if not isinstance(v, str):
+            return v
+        from ..model.units import KINDS, parse_quantity
+        from .outputs import output_unit
+
+        unit = output_unit(str(info.data.get("output", "")))
+        kind = next((k for k, (si, _) in KINDS.items() if si == unit), None)
+        if kind is None:
+            raise ValueError(f"write a plain number (the output {info.data.get('output')!r} "
+                             f"has no unit), got {v!r}")
+        return parse_quantity(v, kind)
     confidence: float = Field(0.95, gt=0, lt=1, description="Confidence level.")
     min_samples: int = Field(32, ge=4, description="Samples before the first check.")
     batch: int = Field(16, ge=1, description="Samples between checks.")
