@@ -738,11 +738,18 @@ def bearing_table(bearings: list[dict], res) -> Table:
     cols = ["body", "mean force by direction\n[kN]", "|mean|\n[kN]", "peak |F|\n[kN]"]
     for col in cols + (["directions in"] if turning else []):
         b.add_column(_h(col), justify="left" if col in ("body", "directions in") else "right")
+    # a force below 1e-9 of the largest bearing force is round-off (the sun of a
+    # symmetric planetary stage: x 6.0984e-17 kN, peak 3.6e-15 kN): 0
+    tiny = 1e-9 * max((r["peak_magnitude"] for r in bearings), default=0.0)
+
+    def kn(v):
+        return f"{(0.0 if abs(v) <= tiny else v) / 1e3:#.5g}"
+
     for r, frame in zip(bearings, frames):
-        means = ", ".join(f"{d} {v / 1e3:#.5g}" for d, v in zip(r["directions"], r["mean"]))
+        means = ", ".join(f"{d} {kn(v)}" for d, v in zip(r["directions"], r["mean"]))
         body = f"{r['body']} (spline {r['via']})" if r.get("via") else r["body"]
-        b.add_row(body, means, f"{r['mean_magnitude'] / 1e3:#.5g}",
-                  f"{r['peak_magnitude'] / 1e3:#.5g}", *([frame] if turning else []))
+        b.add_row(body, means, kn(r["mean_magnitude"]), kn(r["peak_magnitude"]),
+                  *([frame] if turning else []))
     return b
 
 

@@ -124,3 +124,12 @@ def test_static_nc_has_k_gamma_and_the_peak_apart(model_file, tmp_path):
         assert "planet_peak_instantaneous_ratio" in ds
         assert ds["planet_load_sharing"].sel(planet_entity="st_carrier") > 1.001
         assert "peak_instantaneous_ratio" in json.loads(ds.attrs["planet_load_sharing_json"])
+
+
+def test_round_off_bearing_forces_read_zero():
+    """The sun of a symmetric stage printed 'x 6.0984e-17, y 3.4230e-17' kN of round-off
+    beside the planets' 1.06 kN (a reviewer)."""
+    res = runner.invoke(app, ["run", "lin_parker1999_planetary", "--cycles", "41"])
+    assert res.exit_code == 0, res.output
+    row = next(ln for ln in res.stdout.splitlines() if ln.strip("│ ").startswith("stage_sun "))
+    assert "e-1" not in row and "x 0.0000, y 0.0000" in row, row
