@@ -185,6 +185,8 @@ def test_a_planetary_examples_report_compares_its_natural_frequencies(tmp_path):
         assert abs(diff) <= 0.05, (p.quantity, row)
         assert "(modes at rest)" in row  # which analysis 'this run' is
     assert "-0.00 %" not in section  # a difference that rounds to nothing has no sign
+    # an element given no damping is undamped, not unknown ('-')
+    assert "0 (undamped)" in page
 
 
 def test_report_gives_the_model_as_it_runs(tmp_path):
@@ -196,8 +198,9 @@ def test_report_gives_the_model_as_it_runs(tmp_path):
                               str(out), "--quiet"])
     assert res.exit_code == 0, res.output
     page = " ".join(re.sub(r"<[^>]+>", " ", out.read_text(encoding="utf-8")).split())
-    # m11 as its model file gives it: 4500 N/um, a 10 % wave, damping ratio 0.1
-    assert "4500 10 % 0.1" in page
+    # m11 as its model file gives it: 4500 N/um, a 10 % wave (the column's unit: % of the
+    # mean), damping ratio 0.1
+    assert "4500 10 0.1" in page and "stiffness peak-to-peak [% of mean]" in page
     # z1's support: Ji & Li eq. 10 of its shaft (the ShaftBending spec) in series with its
     # bearings, here from the spec by hand, not from the report's source
     sb = torquesplit.load_model("ji_li_mill_drive").gears["z1"].support.shaft

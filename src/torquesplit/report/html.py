@@ -152,17 +152,19 @@ def _model_tables(res) -> str:
         # peak_to_peak is a rectangular wave), and the damping assumed
         ptp = float(np.ptp(table)) / k if k > 0 else math.nan
         zeta = (_g(mesh.damping_ratio, 3) if mesh.damping_ratio is not None else
-                f"{_g(mesh.damping, 4)} N s/m" if mesh.damping is not None else "-")
+                f"{_g(mesh.damping, 4)} N s/m" if mesh.damping is not None else
+                "0 (undamped)")  # (neither given: no damping; '-' read as unknown)
         rows.append([name, f"{mk['driver']} → {mk['driven']}", mk["stage"],
                      _g(mk["frequency_Hz"], 6),
                      "/".join(f"{r:.2f}" for r in mk["pitch_radii_mm"]),
                      _g(mk["total_contact_ratio"], 4), mesh.stiffness.method,
-                     _g(k / 1e6), f"{100 * ptp:.3g} %" if ptp > 1e-12 else "0", zeta,
+                     _g(k / 1e6), f"{100 * ptp:.3g}" if ptp > 1e-12 else "0", zeta,
                      _g(mesh.backlash.nominal * 1e6, 4), _g(mk["tooth_force_N"] / 1e3, 5)])
     out.append("<h3>Meshes</h3>" + _table(
         ["mesh", "driver → driven", "stage", "f_mesh [Hz]", "pitch radii [mm]",
          "contact ratio", "stiffness method", "mean stiffness [N/µm]",
-         "stiffness peak-to-peak", "damping ratio", "backlash [µm]", "nominal F_n [kN]"],
+         "stiffness peak-to-peak [% of mean]", "damping ratio", "backlash [µm]",
+         "nominal F_n [kN]"],
         rows, left=3))
     rows = []
     for kind, items in (("gear", m.gears), ("body", m.bodies)):
@@ -179,7 +181,9 @@ def _model_tables(res) -> str:
                  if sup.shaft is not None and assembled else
                  "shaft bending" if sup.shaft is not None else "-")
             rows.append([name, kind, ", ".join(d for d in body.dofs if d != "theta") or "-",
-                         k, _g(sup.damping_ratio, 3) if sup.damping_ratio is not None else "-",
+                         k, _g(sup.damping_ratio, 3) if sup.damping_ratio is not None else
+                         f"{_g(sup.damping, 4)} N s/m" if sup.damping is not None else
+                         "0 (undamped)",
                          _g(sup.clearance * 1e6, 4)])
     if rows:
         out.append("<h3>Supports</h3>" + _table(
