@@ -1222,11 +1222,11 @@ def _force_text(value: float) -> str:
     axis at 190 N read as a mismatch.  A value that is not finite is said in N."""
     if not math.isfinite(value):
         return f"{value} N"
-    for scale, unit in ((1.0, "N"), (_KN, "kN"), (1e-6, "MN")):
+    for scale, unit in ((1.0, "N"), (_KN, "kN")):
         text = f"{value * scale:.4g}"
-        if abs(float(text)) < 1e3 or unit == "MN":
+        if abs(float(text)) < 1e3:
             return f"{text} {unit}"
-    raise AssertionError("unreachable")
+    return f"{value * 1e-6:.4g} MN"
 
 
 def _short_text(text: str, most: int = 28) -> str:

@@ -125,9 +125,9 @@ def _check_options(*, steps_per_cycle, tol, stability, energy_tol, method="auto"
                 value, numbers.Real) or not 0 < value < 1):
             raise OptionError(f"{name} must be a small positive number, got {value!r}; "
                               f"leave it out for the default")
-    if method not in ("auto", "hb", "shooting"):
-        raise OptionError(f"unknown method {method!r}; use method='hb' (harmonic balance), "
-                          f"'shooting' or 'auto'")
+    from torquesplit.steady.solution import check_method
+
+    check_method(method)
     if harmonics is not None and (isinstance(harmonics, bool) or not isinstance(
             harmonics, numbers.Integral) or harmonics < 1):
         raise OptionError(f"harmonics must be a whole number >= 1, got {harmonics!r}; e.g. "

@@ -13,6 +13,7 @@ import numpy as np
 
 from torquesplit.errors import ModelWarning, OptionError, SolverError, warn_user
 from torquesplit.steady.api import reference_speed
+from torquesplit.steady.solution import check_method
 from torquesplit.steady.period import (
     MAX_CYCLES,
     base_frequency,
@@ -133,8 +134,7 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
     if per.frequency <= 0:
         raise SolverError("the model has no time-varying excitation: its response does not "
                           "change with speed; nothing to sweep.")
-    if method not in ("auto", "shooting", "hb"):
-        raise OptionError(f"unknown method {method!r}; use 'shooting', 'hb' or 'auto'.")
+    check_method(method)
     if method == "auto":
         method = "hb" if harmonics is not None else "shooting"
     problem = periodic_problem(model, kin, s, per.frequency)

@@ -301,13 +301,8 @@ def _campbell_panel(ax, ds, top: float, *, labelled: bool) -> int:
                     bbox=dict(fc="white", ec="none", alpha=0.8, pad=0.3),
                     arrowprops=(dict(arrowstyle="-", color=colour, lw=0.4) if at > y + 1e-9
                                 else None))
-    crit = sorted(ds.attrs.get("critical_speeds_rpm", []))
-    if labelled:
-        rows = _critical_labels(ax, crit, float(rpm.min()), float(rpm.max()))
-    else:
-        rows = 0
-        for c in crit:
-            ax.axvline(c, color="0.35", lw=0.6, ls=":")
+    rows = _critical_labels(ax, sorted(ds.attrs.get("critical_speeds_rpm", [])),
+                            float(rpm.min()), float(rpm.max()), labelled=labelled)
     # crossings that the planets' mesh phasing leaves unexcited (Parker & Lin 2004)
     for i, c in enumerate(ds.attrs.get("suppressed_speeds_rpm", [])):
         ax.axvline(c, color="0.75", lw=0.5, ls="-.",
@@ -335,17 +330,19 @@ CRITICAL_FONT, CRITICAL_GAP, CRITICAL_ROWS = 7, 9.0, 3
 CRITICAL_SAME = 5e-3
 
 
-def _critical_labels(ax, crit, lo, hi) -> int:
+def _critical_labels(ax, crit, lo, hi, *, labelled: bool = True) -> int:
     """Draw the critical speeds ``crit`` [rpm] as dotted lines, their speeds above the
     axes in up to CRITICAL_ROWS rows (a label goes to the first row where it clears the
-    last one by CRITICAL_GAP points; none is printed where no row has room).  Returns the
-    rows used."""
+    last one by CRITICAL_GAP points; none is printed where no row has room; only the lines
+    where not ``labelled``: a second panel).  Returns the rows used."""
     width_pt = ax.figure.get_figwidth() * 72 * 0.8  # about the axes' width
     last: list[float] = []
     said: list[float] = []  # crossings within CRITICAL_SAME of a labelled one (a
     for i, c in enumerate(crit):  # degenerate pair of modes, two lines of one
         ax.axvline(c, color="0.35", lw=0.6, ls=":",  # frequency): one label
-                   label="critical speed (a crossing)" if i == 0 else None)
+                   label="critical speed (a crossing)" if i == 0 and labelled else None)
+        if not labelled:
+            continue
         if any(abs(c - p) <= CRITICAL_SAME * abs(p) for p in said):
             continue
         said.append(c)

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from torquesplit.errors import ModelWarning, SolverError, warn_user
+from torquesplit.errors import ModelWarning, OptionError, SolverError, warn_user
 from torquesplit.solve._frozen import freeze_arrays
 from torquesplit.solve._kernels import MESH_KIND
 from torquesplit.steady.harmonic import HarmonicBalance
@@ -279,6 +279,19 @@ def sample_stride(steps: int, most: int | None = None) -> int:
     return k
 
 
+METHODS = ("auto", "hb", "shooting")
+"""The steady-state methods: harmonic balance, shooting, or shooting unless harmonics are
+given."""
+
+
+def check_method(method) -> None:
+    """Refuse a steady-state method that is none of :data:`METHODS`."""
+    if method not in METHODS:
+        raise OptionError(f"unknown method {method!r}; use method='hb' (harmonic balance), "
+                          "method='shooting' or method='auto' (shooting unless harmonics "
+                          "are given).")
+
+
 def periodic_solution(structure, period: Period, *, method: str = "auto", harmonics=None,
                       samples=None, speed: float = 1.0, q_static=None, initial=None,
                       tol: float | None = None, adaptive: bool = False,
@@ -294,10 +307,7 @@ def periodic_solution(structure, period: Period, *, method: str = "auto", harmon
         if progress is not None:
             progress(None, what)
 
-    if method not in ("auto", "hb", "shooting"):
-        raise SolverError(f"unknown method {method!r}; use method='hb' (harmonic balance), "
-                          "method='shooting' or method='auto' (shooting unless harmonics "
-                          "are given).")
+    check_method(method)
     if period.frequency <= 0:
         raise SolverError("the structure has no time-varying excitation, so its steady state "
                           "is the static equilibrium; use static_equilibrium instead.")
