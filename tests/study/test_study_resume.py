@@ -111,7 +111,7 @@ def test_changed_study_or_model_refuses_resume(tmp_path, split_file):
     assert ds.sizes["meshes.a1.transmission_error.constant"] == 2
     data["grid"]["parameters"][0]["stop"] = "12 um"
     _write(tmp_path, data)
-    with pytest.raises(StudyError, match=r"^resume: the study file changed .*grid\.parameters"
+    with pytest.raises(StudyError, match=r"^resume: the study changed .*grid\.parameters"
                                          r"\.0\.stop: '9 um' -> '12 um'.*another out or "
                                          r"overwrite=True$"):
         Study(path).run(workers=1, out=out, resume=True)
@@ -314,7 +314,7 @@ def test_resume_compares_values_not_their_writing(tmp_path, split_file):
         assert [c for (c,) in db.execute("SELECT computed FROM runs ORDER BY run")] == [2, 0]
     data["grid"]["parameters"][0]["stop"] = "0.008 mm"
     _write(tmp_path, data)
-    with pytest.raises(StudyError, match="the study file changed"):
+    with pytest.raises(StudyError, match="the study changed"):
         Study(path).run(workers=1, out=out, resume=True)
 
 

@@ -19,6 +19,7 @@ import typer
 
 from .. import _json
 from ..cli_support import json_option
+from ..errors import OptionError
 
 BACKEND_HELP = ("cpu (default) or gpu: integrate the cases as ensembles on a CUDA GPU, one "
                 "case per thread (falls back to the CPU with a warning when there is none).")
@@ -49,6 +50,10 @@ def study(
     overwrite: bool = typer.Option(False, "--overwrite",
                                    help="Start again, deleting the study stored in --out."),
     list_studies: bool = typer.Option(False, "--list", help="List the shipped studies."),
+    duration: Optional[str] = typer.Option(
+        None, "--duration", help="Simulated time per case, instead of the study's."),
+    cycles: Optional[int] = typer.Option(
+        None, "--cycles", help="Cycles of the slowest mesh per case, instead of the study's."),
     backend: str = typer.Option("cpu", "--backend", help=BACKEND_HELP),
     precision: Optional[str] = typer.Option(None, "--precision", help=PRECISION_HELP),
     no_figures: bool = typer.Option(False, "--no-figures", help="Do not write figures."),
@@ -64,9 +69,10 @@ def study(
         ui._fail(ValueError("give a study file or a shipped study name; list them with "
                             "'torquesplit study --list'"))
         return
+    analysis = {k: v for k, v in (("duration", duration), ("cycles", cycles)) if v is not None}
     _run(study_file, workers=workers, scheduler=scheduler, out=out, resume=resume,
          overwrite=overwrite, figures=not no_figures, quiet=quiet, as_json=as_json,
-         backend=backend, precision=precision)
+         backend=backend, precision=precision, analysis=analysis)
 
 
 def _list() -> None:
@@ -89,16 +95,17 @@ def _list() -> None:
 
 def _run(source, *, workers, scheduler, out, resume, overwrite, figures, quiet, as_json,
          name_hint: str | None = None, backend: str = "cpu", precision: str | None = None,
-         flag: str | None = None):
+         flag: str | None = None, analysis: dict | None = None):
     """Run a study from the command line; ``flag``: the option that wrote its only grid
-    parameter ('--vary'), named in errors instead of the study field."""
+    parameter ('--vary'), named in errors instead of the study field; ``analysis``: the
+    ``[analysis]`` fields given as options (``--duration``, ``--cycles``)."""
     from ..errors import TorquesplitError
     from .core import CLI_WORDS, Study
     from .errors import StudyInterrupted
 
     ui = _ui()
     try:
-        st = Study(source)
+        st = _study_with(source, analysis)
         plan = st.plan()
         if out is None:
             out = Path(f"study_{_safe(name_hint or st.name)}")
@@ -150,6 +157,33 @@ def _run(source, *, workers, scheduler, out, resume, overwrite, figures, quiet, 
         ui._fail(exc)
         return
     _summary(ds, Path(out), as_json, figures)
+
+
+def _study_with(source, analysis: dict | None):
+    """The study of ``source`` with the run length of ``--duration``/``--cycles``
+    (checked first, their errors naming the option)."""
+    from .core import Study
+    from .errors import StudyError
+
+    if not analysis:
+        return Study(source)
+    ui = _ui()
+    ui._one_run_length(analysis.get("duration"), analysis.get("cycles"))
+    flag = "--duration" if "duration" in analysis else "--cycles"
+    if "duration" in analysis:
+        ui._positive(ui.ux.quantity(analysis["duration"], "time", flag), flag, "'0.5 s'")
+    else:
+        ui._at_least(analysis["cycles"], 1, flag, "200")
+    st = Study(source)
+    if st.spec.analysis.type == "static":
+        raise OptionError(f"{flag} sets the length of a dynamic run; the study "
+                          f"'{st.name}' is quasi-static (analysis type = 'static', which "
+                          f"turns the gears through whole revolutions): leave {flag} out")
+    try:
+        return Study(source, analysis=analysis)
+    except StudyError as exc:  # (not expected: the values are checked above)
+        raise StudyError.of([(flag if f.startswith("analysis.") else f, m)
+                             for f, m in exc.problems]) from None
 
 
 #: a study field -> the ``sweep`` option that wrote it

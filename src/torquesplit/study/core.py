@@ -92,6 +92,11 @@ class Study:
     ----------
     source : str, Path, dict or StudySpec
         A study file (``.toml``), the name of a shipped study, or its data.
+    analysis : dict, optional
+        Fields that replace the study's ``[analysis]`` ones, e.g. ``{"cycles": 50}`` for
+        a shorter trial of a shipped study (a run length replaces the study's:
+        ``duration`` drops its ``cycles`` and the other way round).  A resume compares
+        the study with them.
 
     Examples
     --------
@@ -109,8 +114,8 @@ class Study:
     ('meshes.m11.damping_ratio',)
     """
 
-    def __init__(self, source):
-        self.spec, self.folder, self.text = read_study(source)
+    def __init__(self, source, *, analysis: dict | None = None):
+        self.spec, self.folder, self.text = read_study(source, analysis)
         self.source = str(source) if isinstance(source, (str, Path)) else None
         self._plan: Plan | None = None
 
@@ -390,7 +395,7 @@ def _check_same(plan: Plan, meta: dict, out: Path, words: Words = API_WORDS) -> 
             and _values(_results_part(meta.get("study", {})))
             != _values(_results_part(plan.spec.canonical()))):
         changes = _diff(meta.get("study", {}), plan.spec.canonical())
-        raise StudyError(w.resume, f"the study file changed since {out} was started "
+        raise StudyError(w.resume, f"the study changed since {out} was started "
                                    f"({changes}); undo the change, or {again}")
     if meta.get("model_hash") != plan.model_hash:
         changes = _diff(meta.get("model", {}), plan.model_dict)

@@ -363,14 +363,39 @@ class StudySpec(_Strict):
 
 
 # ============================================================================ reading
-def read_study(source) -> tuple[StudySpec, Path | None, str]:
+def read_study(source, analysis: dict | None = None) -> tuple[StudySpec, Path | None, str]:
     """Read and validate a study: a ``.toml`` file, a dict or a :class:`StudySpec`.
 
-    Returns ``(spec, folder the model path is relative to, text of the file)``.
+    ``analysis``: fields that replace the study's ``[analysis]`` ones (a run length
+    replaces the study's: ``duration`` drops its ``cycles`` and the other way round).
+    Returns ``(spec, folder the model path is relative to, text of the file)``; the
+    text ends with a comment naming the replaced fields.
     Raises :class:`StudyError` (one line naming the field) on bad input.
     """
+    spec, folder, text = _read(source, analysis or {})
+    if analysis:
+        text += ("\n# [analysis] replaced when the study was run: "
+                 + ", ".join(f"{k} = {v!r}" for k, v in analysis.items()) + "\n")
+    return spec, folder, text
+
+
+def with_analysis(data: dict, analysis: dict) -> dict:
+    """Study data with its ``[analysis]`` fields replaced by ``analysis``."""
+    if not analysis:
+        return data
+    a = dict(data.get("analysis") or {})
+    if "duration" in analysis or "cycles" in analysis:  # one run length, the new one
+        a.pop("duration", None)
+        a.pop("cycles", None)
+    a.update(analysis)
+    return {**data, "analysis": a}
+
+
+def _read(source, analysis: dict) -> tuple[StudySpec, Path | None, str]:
     if isinstance(source, StudySpec):
-        return source, None, json.dumps(source.canonical())
+        if not analysis:
+            return source, None, json.dumps(source.canonical())
+        source = source.canonical()
     if isinstance(source, dict):
         study = source.get("study")
         if isinstance(study, dict) and hasattr(study.get("model"), "meshes"):
@@ -378,7 +403,8 @@ def read_study(source) -> tuple[StudySpec, Path | None, str]:
             from ..model.io import model_to_dict
 
             source = {**source, "study": {**study, "model": model_to_dict(study["model"])}}
-        return parse_study(source), None, json.dumps(source, default=str)
+        return parse_study(with_analysis(source, analysis)), None, json.dumps(source,
+                                                                               default=str)
     from .shipped import study_names, study_path
 
     path = Path(source)
@@ -404,7 +430,7 @@ def read_study(source) -> tuple[StudySpec, Path | None, str]:
         raise StudyError("", f"TOML syntax error: {exc}; fix the line it names",
                          str(path)) from None
     try:
-        return parse_study(data), path.parent, text
+        return parse_study(with_analysis(data, analysis)), path.parent, text
     except StudyError as exc:
         raise exc.with_source(str(path)) from None
 
