@@ -100,7 +100,7 @@ def _run(source, *, workers, scheduler, out, resume, overwrite, figures, quiet, 
     parameter ('--vary'), named in errors instead of the study field; ``analysis``: the
     ``[analysis]`` fields given as options (``--duration``, ``--cycles``)."""
     from ..errors import TorquesplitError
-    from .core import CLI_WORDS, Study
+    from .core import CLI_WORDS
     from .errors import StudyInterrupted
 
     ui = _ui()
