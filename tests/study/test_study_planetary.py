@@ -53,3 +53,24 @@ def test_a_generated_element_is_refused_with_the_stage_field(lp_file):
                   {"cycles": 40})
     with pytest.raises(StudyError, match=r"planetary\.0\.sun_mesh\.backlash"):
         Study(spec).plan()
+
+
+def test_a_model_object_takes_the_paths_of_its_file(lp_file):
+    """A Model read from the file, given to the study in Python, takes the stage's own
+    paths as the file does (it took only the generated ones) and gives the same dataset;
+    a generated path is refused the same way."""
+    import torquesplit
+
+    analysis = {"type": "static", "revolutions": 0.02}
+    path = "planetary.0.pin_errors.0.tangential"
+    ref = run_study(_study(lp_file, path, ["planet_load_sharing.*"], analysis))
+    spec = _study(lp_file, path, ["planet_load_sharing.*"], analysis)
+    spec["study"]["model"] = torquesplit.load_model(lp_file)
+    got = run_study(spec)
+    assert (got["planet_load_sharing.static_torque"].values
+            == ref["planet_load_sharing.static_torque"].values).all()
+    spec = _study(lp_file, "meshes.stage_sun_planet1.backlash", ["load_sharing.*"],
+                  {"cycles": 40})
+    spec["study"]["model"] = torquesplit.load_model(lp_file)
+    with pytest.raises(StudyError, match=r"planetary\.0\.sun_mesh\.backlash"):
+        Study(spec).plan()

@@ -41,7 +41,7 @@ import pydantic
 from pydantic import (BaseModel, ConfigDict, Field, StrictFloat, StrictInt, field_validator,
                       model_validator)
 
-from ..errors import FieldError
+from ..errors import FieldError, TorquesplitError
 from .errors import StudyError
 
 Value = Union[StrictInt, StrictFloat, str]
@@ -391,6 +391,25 @@ def with_analysis(data: dict, analysis: dict) -> dict:
     return {**data, "analysis": a}
 
 
+def _model_data(model) -> dict:
+    """The data of a Model given to a study: what it was read from where that still gives
+    it (a ``[[planetary]]`` stage's fields then exist, so the study takes the paths a
+    file takes, ``planetary.0.sun.mass``), else the model itself in SI."""
+    import copy
+
+    from ..model.io import model_from_dict, model_to_dict
+
+    data = model_to_dict(model)
+    source = getattr(model, "_source", None)
+    if source is not None:
+        try:
+            if model_to_dict(model_from_dict(source)) == data:
+                return copy.deepcopy(source)
+        except TorquesplitError:  # (a copy changed after reading: its own data)
+            pass
+    return data
+
+
 def _read(source, analysis: dict) -> tuple[StudySpec, Path | None, str]:
     if isinstance(source, StudySpec):
         if not analysis:
@@ -399,10 +418,8 @@ def _read(source, analysis: dict) -> tuple[StudySpec, Path | None, str]:
     if isinstance(source, dict):
         study = source.get("study")
         if isinstance(study, dict) and hasattr(study.get("model"), "meshes"):
-            # a Model: its data (SI), which the cases change and the store fingerprints
-            from ..model.io import model_to_dict
-
-            source = {**source, "study": {**study, "model": model_to_dict(study["model"])}}
+            # a Model: its data, which the cases change and the store fingerprints
+            source = {**source, "study": {**study, "model": _model_data(study["model"])}}
         return parse_study(with_analysis(source, analysis)), None, json.dumps(source,
                                                                                default=str)
     from .shipped import study_names, study_path
