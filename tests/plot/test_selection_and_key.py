@@ -3,6 +3,8 @@ the sketch does."""
 
 from __future__ import annotations
 
+import pytest
+
 import matplotlib
 
 import torquesplit
@@ -21,8 +23,8 @@ def test_a_support_as_strong_as_a_drawn_one_is_drawn_too():
 
 
 def _key_and_shafts(model):
-    ax = layout_figure(model).axes[0]
-    legend = ax.get_legend()
+    fig = layout_figure(model)
+    ax, legend = fig.axes[0], fig.legends[0]  # (the key below the drawing)
     key = {t.get_text(): h.get_linestyle()
            for t, h in zip(legend.get_texts(), legend.legend_handles)}
     drawn = {ln.get_linestyle() for ln in ax.get_lines()
@@ -90,6 +92,50 @@ def _overlapping_label_pairs(fig) -> int:
     return sum(overlap(a, b) for a, b in itertools.combinations(boxes, 2))
 
 
+def _labels_over_lines(fig) -> list[str]:
+    """The labels that cover a drawn line of a few points (shaft, support, hatch) or a
+    marker: each segment sampled every 2 points."""
+    import numpy as np
+
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    ax = fig.axes[0]
+    pts = []
+    for line in ax.lines:
+        xy = line.get_xydata()
+        if 0 < len(xy) <= 10:
+            d = ax.transData.transform(xy)
+            pts += list(d)
+            for a, b in zip(d[:-1], d[1:]):
+                pts += [a + f * (b - a) for f in np.linspace(0, 1, 2 + int(
+                    np.hypot(*(b - a)) / (2 * fig.dpi / 72)))]
+    pts = np.array(pts)
+    out = []
+    for t in ax.texts:
+        if t.get_text().strip():
+            b = t.get_window_extent(renderer)
+            inside = ((pts[:, 0] > b.x0 + 1) & (pts[:, 0] < b.x1 - 1)
+                      & (pts[:, 1] > b.y0 + 1) & (pts[:, 1] < b.y1 - 1))
+            if inside.any():
+                out.append(t.get_text())
+    return out
+
+
+@pytest.mark.parametrize("name", ["ji_li_mill_drive", "liu2021_split_torque_helicopter",
+                                  "split_path_planetary_differential"])
+def test_layout_labels_stay_off_each_other_and_the_drawn_lines(name):
+    """A reviewer's drawings had names written over shafts, supports and bodies (114
+    labels over lines on the shipped examples, 9 on Ji & Li's: 'z6' on its support,
+    'load mill' on the output shaft): labels now avoid the drawn lines and markers too,
+    with a leader line when moved away from their part."""
+    import torquesplit
+    from torquesplit.plot.layout import layout_figure
+
+    fig = layout_figure(torquesplit.load_model(torquesplit.example_path(name)))
+    assert _overlapping_label_pairs(fig) == 0
+    assert _labels_over_lines(fig) == []
+
+
 def test_the_layout_of_a_planetary_stage_shows_its_carrier_ring_hold_and_pin_errors():
     """A reviewer's drawing of a planetary stage had no carrier, no sign that the ring
     is held, no pin error, and the drive's label on the sun's."""
@@ -103,7 +149,7 @@ def test_the_layout_of_a_planetary_stage_shows_its_carrier_ring_hold_and_pin_err
     hold = [t for t in texts if "held in rotation" in t]
     assert hold == ["stage_ring held in rotation by 1.99e+07 N m/rad"], hold
     assert sum("pin error 20 µm radial, -5 µm tangential" in t for t in texts) == 1
-    key = [t.get_text() for t in ax.get_legend().get_texts()]
+    key = [t.get_text() for t in fig.legends[0].get_texts()]
     assert "pin circle of stage_carrier (planet bearings: dotted)" in key
     radius = 0.5 * (model.gears["stage_sun"].teeth + model.gears["stage_planet1"].teeth)
     circles = [ln for ln in ax.get_lines() if ln.get_linestyle() == "--"
@@ -122,7 +168,7 @@ def test_many_supports_of_few_kinds_are_lettered_with_their_values_in_the_key():
     model = torquesplit.load_model("dong2021_face_gear")
     fig = layout_figure(model)
     ax = fig.axes[0]
-    key = [t.get_text() for t in ax.get_legend().get_texts()]
+    key = [t.get_text() for t in fig.legends[0].get_texts()]
     lettered = [k for k in key if k.startswith("support ") and k[9:11] == ": "]
     assert len(lettered) >= 2 and lettered[0].startswith("support A: ")
     labels = [t.get_text() for t in ax.texts if t.get_text().startswith("support")]

@@ -26,7 +26,9 @@ The view: the train's main axis (the axis most gears turn about) points out of t
 the other two global axes lie in it, and depth along the main axis is drawn half-size
 along the 45 deg diagonal (cabinet projection).  Pitch circles of gears on the main axis
 stay circles; coaxial bodies at different depths separate along the diagonal.  Lengths in
-mm on the axes.
+mm on the axes.  The key sits below the drawing and the figure takes the drawing's
+proportions; a label that would cover another, an arrow, a line or a marker is moved to
+the nearest free place, with a thin leader line to its part when moved far.
 
 Examples
 --------
@@ -141,7 +143,7 @@ def layout_figure(model, kin=None, *, width: float = 10.0) -> Figure:
     proj = _Projection(_main_axis(model, kin))
     if len(model.gears) > 8:  # room for the labels of a large train
         width *= 1.3
-    fig = Figure(figsize=(width, width * 0.8), layout="constrained")
+    fig = Figure(figsize=(width, width * 0.8), layout="constrained")  # height: _fit_height
     FigureCanvasAgg(fig)
     ax = fig.add_subplot()
     ax.set_aspect("equal", adjustable="datalim")
@@ -318,68 +320,123 @@ def layout_figure(model, kin=None, *, width: float = 10.0) -> Figure:
     if pins:
         ax.plot([], [], color=COLORS["body"], lw=0.9, ls="--",
                 label=f"pin circle of {', '.join(pins)} (planet bearings: dotted)")
-    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=fs, frameon=False)
+    # the key below the drawing, so that the drawing has the figure's whole width
+    handles, labels = ax.get_legend_handles_labels()
+    fig.legend(handles, labels, loc="outside lower center", ncol=2, fontsize=fs,
+               frameon=False)
     ax.set_title(f"{model.model.name}: layout, {len(model.gears)} gears, "
                  f"{len(model.meshes)} meshes\nviewed along {depth} (depth along the "
                  f"diagonal at half scale); pitch circles", fontsize=11)
     ax.margins(0.12)
+    _fit_height(fig, ax, width, len(labels))
     _separate_labels(fig, ax)
     return fig
 
 
-#: where a label that overlaps one placed before it is tried instead: its offsets from
-#: where it was put [points], nearest first
-_NUDGES = [(0, -11), (0, 11), (0, -22), (0, 22), (0, -33), (0, 33), (40, 0), (-40, 0),
-           (40, -16), (-40, 16), (0, -44), (0, 44), (70, 0), (-70, 0), (40, 22),
-           (-40, -22), (0, -55), (0, 55), (70, -22), (-70, 22)]
+def _fit_height(fig, ax, width: float, key_entries: int) -> None:
+    """Figure height for the drawing's own proportions (equal scales on both axes): a
+    wide train is not drawn in a square figure with half of it empty."""
+    ax.autoscale_view()
+    x0, x1 = ax.get_xlim()
+    y0, y1 = ax.get_ylim()
+    aspect = (y1 - y0) / (x1 - x0) if x1 > x0 else 1.0
+    drawing = (width - 0.9) * min(max(aspect, 0.45), 1.0)  # axes height [in]
+    key = 0.2 * math.ceil(key_entries / 2) + 0.2
+    fig.set_size_inches(width, drawing + 1.1 + key)
+
+
+#: where a label that overlaps something is tried instead: its offsets from where it was
+#: put [points], nearest first (a line of text is 11 points high; a step sideways counts
+#: less than one across lines)
+_NUDGES = sorted(((dx, dy) for dx in range(-70, 71, 10) for dy in range(-55, 56, 11)
+                  if (dx, dy) != (0, 0)), key=lambda d: math.hypot(0.6 * d[0], d[1]))
+#: a label moved farther than this from where it was put [points] gets a leader line to
+#: its part
+_LEADER = 15.0
 
 
 def _separate_labels(fig, ax) -> None:
     """Move each named label that overlaps one placed before it (in the order drawn:
-    gears first) or a mesh's arrow to the nearest of :data:`_NUDGES` where it overlaps
-    none (at most 74 points from where it was: still beside its part); a label with no
-    free place goes where it overlaps fewest.  The offsets
-    of the drawing code put every label beside its part, but neighbouring gears, a
-    support under a mesh label or a drive over a load piled them up (51 overlapping pairs
-    on Dong et al. 2021's drive)."""
+    gears first), a mesh's arrow or a drawn line or marker (shaft, support, body) to the
+    nearest of :data:`_NUDGES` where it overlaps none (at most 89 points from where it
+    was, with a leader line to its part beyond :data:`_LEADER`); a label with no free
+    place goes where it overlaps least, a label over a label counting most.  The offsets of the drawing code put every label
+    beside its part, but neighbouring gears, a support under a mesh label or a drive over
+    a load piled them up (51 overlapping pairs on Dong et al. 2021's drive)."""
     from matplotlib.text import Annotation
 
     fig.canvas.draw()  # (text extents need a renderer)
     renderer = fig.canvas.get_renderer()
     px = fig.dpi / 72.0
-    # the arrows of the meshes are obstacles too (a drive's label sat on a planetary's
-    # line of action), each as the box of its shaft's middle half, so that a label still
-    # finds room beside a long arrow
-    placed = []
+    # obstacles [x0, y0, x1, y1] (display units) with their weight: the arrows of the
+    # meshes, each as the box of its shaft's middle half (a label still finds room beside
+    # a long arrow), and the drawn lines and markers as chains of small boxes
+    boxes = _line_obstacles(ax, px)
+    weights = [1.0] * len(boxes)
     for t in ax.texts:
         if isinstance(t, Annotation) and not t.get_text() and t.arrow_patch is not None:
             b = t.arrow_patch.get_window_extent(renderer)
-            placed.append(b.shrunk(0.5, 0.5).translated(b.width / 4, b.height / 4))
-    n_arrows = len(placed)
+            b = b.shrunk(0.5, 0.5).translated(b.width / 4, b.height / 4)
+            boxes.append((b.x0, b.y0, b.x1, b.y1))
+            weights.append(2.0)
+    obstacles = np.array(boxes, float).reshape(-1, 4)
+    weight = np.array(weights, float)
+    placed = []  # the labels placed so far: a label over one counts 4
+
+    def clashes(b) -> float:
+        hit = ((obstacles[:, 0] < b.x1) & (b.x0 < obstacles[:, 2])
+               & (obstacles[:, 1] < b.y1) & (b.y0 < obstacles[:, 3]))
+        return float(weight[hit].sum()) + 4.0 * sum(b.overlaps(o) for o in placed)
+
     for ann in [t for t in ax.texts if isinstance(t, Annotation) and t.get_text()]:
-        if ann.anncoords != "offset points":
-            placed.append(ann.get_window_extent(renderer).padded(1.0))
-            continue
-        x0, y0 = ann.xyann
         box = ann.get_window_extent(renderer).padded(1.0)
-
-        def clashes(b):  # a label over a label counts more than over an arrow
-            return sum((2 if k >= n_arrows else 1) * b.overlaps(o)
-                       for k, o in enumerate(placed))
-
-        worst = clashes(box)
-        if worst:  # the free place nearest, else the one with the fewest clashes
-            best = (worst, 0.0, 0.0)
-            for dx, dy in _NUDGES:
-                n = clashes(box.translated(dx * px, dy * px))
-                if n < best[0]:
-                    best = (n, dx, dy)
-                    if n == 0:
-                        break
-            _, dx, dy = best
-            ann.xyann = (x0 + dx, y0 + dy)
-            box = box.translated(dx * px, dy * px)
+        if ann.anncoords == "offset points":
+            x0, y0 = ann.xyann
+            worst = clashes(box)
+            if worst:  # the free place nearest, else the one with the fewest clashes
+                best = (worst, 0.0, 0.0)
+                for dx, dy in _NUDGES:
+                    n = clashes(box.translated(dx * px, dy * px))
+                    if n < best[0]:
+                        best = (n, dx, dy)
+                        if n == 0:
+                            break
+                _, dx, dy = best
+                ann.xyann = (x0 + dx, y0 + dy)
+                box = box.translated(dx * px, dy * px)
+                if math.hypot(dx, dy) > _LEADER:  # far from its part: a leader line
+                    ax.annotate("", ann.xy, xytext=ann.xyann, textcoords="offset points",
+                                arrowprops={"arrowstyle": "-", "lw": 0.5, "shrinkA": 0,
+                                            "shrinkB": 0, "color": ann.get_color(),
+                                            "alpha": 0.6}, zorder=ann.get_zorder())
         placed.append(box)
+
+
+def _line_obstacles(ax, px: float) -> list[tuple[float, float, float, float]]:
+    """The drawn lines and markers a label should not cover, as small boxes in display
+    units: each line of a few points (shaft, spline, support, hatch) sampled every 4
+    points along its length, each marker as its square; pitch and pin circles (many
+    points) are left out: a gear's name is written inside its circle."""
+    out = []
+    for line in ax.lines:
+        xy = line.get_xydata()
+        if len(xy) == 0 or len(xy) > 10:
+            continue
+        d = ax.transData.transform(xy)
+        if not np.all(np.isfinite(d)):
+            continue
+        if line.get_marker() not in (None, "None", "", " "):
+            r = 0.5 * line.get_markersize() * px
+            out += [(x - r, y - r, x + r, y + r) for x, y in d]
+        if len(d) < 2 or line.get_linestyle() in ("None", "", " "):
+            continue
+        r = 0.5 * max(line.get_linewidth(), 1.0) * px
+        for a, b in zip(d[:-1], d[1:]):
+            n = max(int(np.hypot(*(b - a)) / (4 * px)), 1)
+            for f in np.linspace(0.0, 1.0, n + 1):
+                x, y = a + f * (b - a)
+                out.append((x - r, y - r, x + r, y + r))
+    return out
 
 
 def _support_text(sup) -> str:
