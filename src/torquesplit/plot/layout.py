@@ -360,9 +360,10 @@ def _separate_labels(fig, ax) -> None:
     gears first), a mesh's arrow or a drawn line or marker (shaft, support, body) to the
     nearest of :data:`_NUDGES` where it overlaps none (at most 89 points from where it
     was, with a leader line to its part beyond :data:`_LEADER`); a label with no free
-    place goes where it overlaps least, a label over a label counting most.  The offsets of the drawing code put every label
-    beside its part, but neighbouring gears, a support under a mesh label or a drive over
-    a load piled them up (51 overlapping pairs on Dong et al. 2021's drive)."""
+    place goes where it overlaps least, a label over a label counting most.  The offsets
+    of the drawing code put every label beside its part, but neighbouring gears, a
+    support under a mesh label or a drive over a load piled them up (51 overlapping pairs
+    on Dong et al. 2021's drive)."""
     from matplotlib.text import Annotation
 
     fig.canvas.draw()  # (text extents need a renderer)
