@@ -61,3 +61,49 @@ def test_a_crossing_the_planets_phasing_suppresses_is_not_said():
     assert len(said) == 1
     assert f"({quiet[0]['speed_rpm']:.5g} rpm)" not in said[0][1]
     assert "meets mode 7 " not in said[0][1]
+
+
+def _split_near_its_crossing(tmp_path, amplitude: str):
+    """The two-path split (constant mesh stiffness) with a transmission error of
+    ``amplitude`` at mesh frequency on mesh a1, driven 0.3 % above the speed where order 1
+    of its first stage meets mode 1."""
+    from model_texts import split_model, write_model
+    from torquesplit.solve.static import static_equilibrium
+    from torquesplit.steady.maps import critical_speeds
+
+    text = split_model().replace('transmission_error = {constant = "0 um"}',
+                                 f'transmission_error = {{amplitude = "{amplitude}"}}')
+    m = torquesplit.load_model(write_model(tmp_path, text))
+    kin, s = torquesplit.solve_kinematics(m), torquesplit.assemble(m)
+    w = m.drives["motor"].speed
+    crossing, = [c for c in critical_speeds(s, static_equilibrium(s).q, kin, m, 2 * w,
+                                            8 * w)["crossings"]
+                 if c["source"] == "meshes a1, b1" and c["order"] == 1 and c["mode"] == 1]
+    return m.with_changes({"drives.motor.speed": f"{1.003 * crossing['speed_rpm']} rpm"})
+
+
+def _said(m):
+    from torquesplit.solve.static import static_equilibrium
+    from torquesplit.steady.maps import near_critical_speeds
+
+    s = torquesplit.assemble(m)
+    return near_critical_speeds(m, s, static_equilibrium(s).q, torquesplit.solve_kinematics(m))
+
+
+def test_a_critical_speed_driven_by_an_error_is_said(tmp_path):
+    """A constant-stiffness model excited by a transmission error (or an eccentricity)
+    at a critical speed got no word: only the stiffness harmonics were rated.  The error
+    is rated by its force amplitude k e over the mesh's nominal force, and only on its own
+    stage's lines (stage 2's order 2 has the same frequency: not it)."""
+    said = _said(_split_near_its_crossing(tmp_path, "5 um"))
+    assert len(said) == 1, said
+    text = said[0][1]
+    assert "0.3 % above" in text and "order 1 of meshes a1, b1 meets mode 1 " in text
+    share = re.search(r"an error of mesh a1 \(k e = ([\d.]+) % of its nominal force\)", text)
+    assert share, text
+    m = _split_near_its_crossing(tmp_path, "5 um")
+    kin, s = torquesplit.solve_kinematics(m), torquesplit.assemble(m)
+    expected = 4e8 * 5e-6 / kin.meshes["a1"].force  # k e / F, by hand
+    assert float(share.group(1)) == pytest.approx(100 * expected, rel=0.01)
+    assert "harmonic of" not in text  # (constant stiffness: not the stiffness)
+    assert _said(_split_near_its_crossing(tmp_path, "0 um")) == []

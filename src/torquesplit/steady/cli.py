@@ -615,7 +615,7 @@ def campbell_command(m, start, stop, plot, as_json, console, json_default, out=N
         f" ({len(critical)} critical; {len(suppressed)} crossings that the planets' mesh "
         f"phasing leaves unexcited, Parker & Lin 2004, marked 'suppressed')" if phased
         else ""))
-    cols = ["speed [rpm]", "mode", "f [Hz]", "excitation", "k harmonic [%]"]
+    cols = ["speed [rpm]", "mode", "f [Hz]", "excitation", "k harmonic [%]", "error [%]"]
     cols += ["mode type", "phasing"] if phased else []
     for col in cols + ["strain energy (largest shares)"]:
         t.add_column(_h(col))
@@ -623,15 +623,19 @@ def campbell_command(m, start, stop, plot, as_json, console, json_default, out=N
         extra = ([mode_kind(c) if c.get("mode_type") else "-",
                   "suppressed" if c["suppressed"] else "excited"]
                  if phased else [])
-        k_h = c.get("stiffness_harmonic")
+        k_h, err = c.get("stiffness_harmonic"), c.get("error_share")
         t.add_row(f"{c['speed_rpm']:#.6g}", str(c["mode"]), f"{c['frequency_Hz']:#.6g}",
                   f"{c['order']} x {c['source']}",
-                  "-" if k_h is None else f"{100 * k_h:.3g}", *extra,
+                  "-" if k_h is None else f"{100 * k_h:.3g}",
+                  "-" if err is None else f"{100 * err:.3g} ({c['error_mesh']})", *extra,
                   ", ".join(f"{n} {100 * v:.0f} %" for n, v in c["energy"]))
     console.print(t)
     console.print("k harmonic: the amplitude of that order of the mesh stiffness over its "
-                  "mean (how strongly the stiffness variation drives the crossing; errors "
-                  "and shaft orders are not rated: '-')", highlight=False)
+                  "mean (how strongly the stiffness variation drives the crossing; a shaft "
+                  "order has none: '-'); error: the force amplitude k e of the model's errors "
+                  "at that frequency (transmission error, eccentricity) over the mesh's "
+                  "nominal force, the largest and its mesh ('-': no error there)",
+                  highlight=False)
     for w in written:
         console.print(f"wrote {w}", highlight=False)
     if failed is not None:

@@ -297,7 +297,7 @@ def critical_speeds(structure, q, kin, model, w_lo, w_hi, orders=None):
     sol = modal_analysis(structure, q)
     w_ref = reference_speed(model)
     lines = _order_lines(kin, model, orders, structure)
-    strength = _stiffness_harmonics(kin, structure, lines)
+    strength = _line_strength(kin, structure, lines, w_ref)
     phasing = _Phasing(model, kin)
     types = phasing.types(structure, sol)
     out = []
@@ -340,10 +340,51 @@ def _stiffness_harmonics(kin, structure, lines) -> dict:
     return out
 
 
+def _error_shares(kin, structure, lines, w_ref: float) -> dict:
+    """(line label, order) -> (share, mesh): the error sinusoids of the meshes (a
+    transmission error's harmonics, a gear's eccentricity or runout turning with it) on
+    that line, rated as the force amplitude ``k_mean A`` over the mesh's nominal force
+    (the largest over the meshes; an error at no line's frequency is not rated)."""
+    if structure is None or not len(structure.error_amplitude) or not w_ref > 0:
+        return {}
+    names = list(structure.element_names)
+    groups = mesh_groups(kin)
+    k_mean = structure.mean_stiffness()
+    out: dict = {}
+    for name, mk in kin.meshes.items():
+        if name not in names or not mk.force > 0:
+            continue
+        e = names.index(name)
+        k = float(k_mean[e])
+        # a mesh's error is on its own stage's lines (another stage's harmonic may share
+        # the frequency) or on a shaft order (an eccentricity)
+        own = {(label, order): 2.0 * math.pi * order * per_rad * w_ref
+               for label, order, per_rad in lines
+               if name in groups.get(label, ()) or label not in groups}
+        for i in range(structure.error_ptr[e], structure.error_ptr[e + 1]):
+            share = k * abs(float(structure.error_amplitude[i])) / mk.force
+            om = abs(float(structure.error_omega[i]))
+            for key, w in own.items():
+                if abs(om - w) <= 1e-6 * w and share > out.get(key, (0.0, ""))[0]:
+                    out[key] = (share, name)
+    return out
+
+
+def _line_strength(kin, structure, lines, w_ref: float) -> dict:
+    """(line label, order) -> how the model drives that line: ``stiffness_harmonic``
+    (:func:`_stiffness_harmonics`) and ``error_share`` / ``error_mesh``
+    (:func:`_error_shares`), the keys that apply."""
+    out: dict = {}
+    for key, v in _stiffness_harmonics(kin, structure, lines).items():
+        out.setdefault(key, {})["stiffness_harmonic"] = v
+    for key, (share, mesh) in _error_shares(kin, structure, lines, w_ref).items():
+        out.setdefault(key, {}).update(error_share=share, error_mesh=mesh)
+    return out
+
+
 def _strength_of(strength: dict, label: str, order: int) -> dict:
-    """``{"stiffness_harmonic": value}`` of a crossing's line, or nothing."""
-    v = strength.get((label, order))
-    return {} if v is None else {"stiffness_harmonic": v}
+    """How the model drives a crossing's line (:func:`_line_strength`), or nothing."""
+    return dict(strength.get((label, order), {}))
 
 
 class _Phasing:
@@ -609,24 +650,26 @@ mean stiffness (a helical pair's high orders, 1e-4 and below, drive next to noth
 
 def near_critical_speeds(model, structure, q, kinematics, within: float = NEAR_CRITICAL,
                          least_harmonic: float = DRIVING_HARMONIC) -> list[tuple[str, str]]:
-    """The critical speeds (:func:`critical_speeds`: a mesh order meeting a natural
-    frequency of the structure linearised about ``q``) within ``within`` of the model's
-    own speed, driven by a stiffness harmonic of at least ``least_harmonic`` of the mean,
-    as one ``(location, message)`` warning naming the nearest: Ji & Li's drive runs at
-    745 rpm, 0.24 % above the critical speed where order 3 of its stage-2 mesh meets a
-    support mode (71.45 Hz, the largest line of its support-force spectrum), and ``run``
-    said nothing of it.  The frequencies are those at the model's speed (a turning
-    carrier's move by far less than ``within`` across the band).  Empty for a model
-    without a speed."""
+    """The critical speeds (:func:`critical_speeds`: a mesh order or a shaft order
+    meeting a natural frequency of the structure linearised about ``q``) within
+    ``within`` of the model's own speed, driven by a stiffness harmonic of at least
+    ``least_harmonic`` of the mean or by an error whose force amplitude ``k A`` is at least
+    ``least_harmonic`` of the mesh's nominal force, as one ``(location, message)``
+    warning naming the nearest: Ji & Li's drive runs at 745 rpm, 0.24 % above the
+    critical speed where order 3 of its stage-2 mesh meets a support mode (71.45 Hz, the
+    largest line of its support-force spectrum), and ``run`` said nothing of it.  The
+    frequencies are those at the model's speed (a turning carrier's move by far less than
+    ``within`` across the band).  Empty for a model without a speed."""
     w = reference_speed(model)
     if not (w > 0 and math.isfinite(w)):
         return []
     crossings = critical_speeds(structure, q, kinematics, model, (1.0 - within) * w,
                                 (1.0 + within) * w, None)["crossings"]
     # (a crossing the planets' mesh phasing leaves unexcited is none: Parker & Lin 2004)
-    driven = sorted((c for c in crossings if c.get("stiffness_harmonic", 0.0) >= least_harmonic
-                     and not c.get("suppressed")),
-                    key=lambda c: abs(c["speed_rpm"] / (w * RPM) - 1.0))
+    driven = sorted((c for c in crossings if not c.get("suppressed") and (
+        c.get("stiffness_harmonic", 0.0) >= least_harmonic
+        or c.get("error_share", 0.0) >= least_harmonic)),
+        key=lambda c: abs(c["speed_rpm"] / (w * RPM) - 1.0))
     if not driven:
         return []
     c = driven[0]
@@ -634,11 +677,17 @@ def near_critical_speeds(model, structure, q, kinematics, within: float = NEAR_C
     top, share = c["energy"][0] if c["energy"] else ("-", math.nan)
     more = (f"; {len(driven) - 1} more within {100 * within:.2g} % (torquesplit modes "
             f"--campbell lists them)" if len(driven) > 1 else "")
+    by = []
+    if c.get("stiffness_harmonic", 0.0) >= least_harmonic:
+        by.append(f"a harmonic of {100 * c['stiffness_harmonic']:.2g} % of the mean mesh "
+                  f"stiffness")
+    if c.get("error_share", 0.0) >= least_harmonic:
+        by.append(f"an error of mesh {c['error_mesh']} (k e = {100 * c['error_share']:.2g} % "
+                  f"of its nominal force)")
     return [("analysis", (
         f"the speed ({w * RPM:.5g} rpm) is {100 * abs(off):.2g} % "
         f"{'above' if off > 0 else 'below'} a critical speed ({c['speed_rpm']:.5g} rpm): "
         f"order {c['order']} of {c['source']} meets mode {c['mode']} "
         f"({c['frequency_Hz']:.5g} Hz, {100 * share:.0f} % of its strain energy in {top}), "
-        f"driven by a harmonic of {100 * c['stiffness_harmonic']:.2g} % of the mean mesh "
-        f"stiffness: the response there is resonant and sensitive to small changes of "
-        f"speed or stiffness{more}"))]
+        f"driven by {' and '.join(by)}: the response there is resonant and sensitive to "
+        f"small changes of speed or stiffness{more}"))]
