@@ -8,7 +8,9 @@ hand) and ``docs/validation_results.json`` (every number, written by
 ``scripts/validate.py``).  A placeholder ``{{path/to/value:fmt}}`` is replaced by the
 value at that path of the JSON (keys separated by ``/``; a key may hold spaces and
 dots) formatted with the Python format spec ``fmt``; ``{{=expression:fmt}}`` evaluates a
-small arithmetic expression over ``$[path]`` references (for ranges and ratios).
+small arithmetic expression over ``$[path]`` references (for ranges and ratios).  A
+list of texts (a run's warnings) is written as one markdown bullet per item (``:nested``:
+indented, inside a list item).
 ``benchmarks/RESULTS.md`` is rendered by ``benchmarks/run.py`` from
 ``benchmarks/RESULTS.json`` (``run.py --render`` re-renders it without measuring); both
 renderings are checked by ``tests/test_docs_data.py``.
@@ -74,6 +76,9 @@ def render(template: str, data) -> str:
     def field(m):
         value = _value(data, m.group(2), m.group(1) == "=")
         fmt = m.group(3)
+        if isinstance(value, list):  # bullets; fmt "nested": inside a list item
+            bullet = "  - " if fmt == "nested" else "- "
+            return "\n".join(bullet + str(item) for item in value) if value else bullet + "none"
         return format(value, fmt) if fmt else str(value)
     return _FIELD.sub(field, template)
 

@@ -48,7 +48,8 @@ def _run(model, **kwargs) -> dict:
     wall = time.perf_counter() - t0
     values = res.metric_values()
     out = {"wall_time_s": wall, "statistics": res.statistics(), "values": values,
-           "settled": bool(res.metrics().settling.settled)}
+           "settled": bool(res.metrics().settling.settled),
+           "warnings": res.warnings()}  # (as the command line prints them)
     for definition in ("cycle_peak", "engineering", "mean_force"):
         out[definition] = res.metrics(definition).to_dict()
     # the same run with half the step it took (not half the step it asked for: a stiff
