@@ -247,3 +247,113 @@ torque = "150 N m"
 [loads.out]
 body = "wheel"
 """
+
+
+#: a reviewer's two-path split-torque spur reducer (500 kW at 6000 rpm, ratio 10.2): input
+#: pinion to two idlers, shafts of unequal torsional stiffness to two pinions on a bull
+#: gear; backlash on every mesh and an eccentricity on idler i1 (its mesh a1 loses contact
+#: and its damping pulls as the teeth separate)
+TWO_PATH_SPUR_REDUCER = """\
+[model]
+name = "split2"
+description = "Two-path split-torque spur reducer, 500 kW at 6000 rpm, ratio 10.2"
+reference = "reviewer's own layout"
+
+[gears.input]
+teeth = 24
+module = "3 mm"
+face_width = "40 mm"
+position = ["0 mm", "0 mm", "0 mm"]
+dofs = ["x", "y", "theta"]
+support = { stiffness = "300 N/um", damping_ratio = 0.05 }
+
+[gears.i1]
+teeth = 60
+module = "3 mm"
+face_width = "38 mm"
+place = { from_gear = "input", angle = "60 deg" }
+dofs = ["x", "y", "theta"]
+support = { stiffness = "500 N/um", damping_ratio = 0.05 }
+errors = { eccentricity = "20 um", eccentricity_phase = "0 deg" }
+
+[gears.i2]
+teeth = 60
+module = "3 mm"
+face_width = "38 mm"
+place = { from_gear = "input", angle = "-60 deg" }
+dofs = ["x", "y", "theta"]
+support = { stiffness = "500 N/um", damping_ratio = 0.05 }
+
+[gears.bull]
+teeth = 90
+module = "4 mm"
+face_width = "55 mm"
+position = ["258.6246 mm", "0 mm", "-100 mm"]
+bore_diameter = "120 mm"
+dofs = ["x", "y", "theta"]
+support = { stiffness = "1000 N/um", damping_ratio = 0.05 }
+
+[gears.p1]
+teeth = 22
+module = "4 mm"
+face_width = "60 mm"
+place = { from_gear = "bull", angle = "150.8473 deg" }
+
+[gears.p2]
+teeth = 22
+module = "4 mm"
+face_width = "60 mm"
+place = { from_gear = "bull", angle = "-150.8473 deg" }
+
+[shafts.s1]
+connects = ["i1", "p1"]
+diameter = "35 mm"
+length = "100 mm"
+damping_ratio = 0.02
+
+[shafts.s2]
+connects = ["i2", "p2"]
+torsional_stiffness = "2.0e5 N m/rad"
+damping_ratio = 0.02
+
+[meshes.a1]
+gears = ["input", "i1"]
+stiffness = { method = "iso6336" }
+damping_ratio = 0.05
+backlash = "80 um"
+stage = "first"
+
+[meshes.a2]
+gears = ["input", "i2"]
+stiffness = { method = "iso6336" }
+damping_ratio = 0.05
+backlash = "80 um"
+stage = "first"
+
+[meshes.b1]
+gears = ["p1", "bull"]
+stiffness = { method = "iso6336" }
+damping_ratio = 0.05
+backlash = "100 um"
+stage = "second"
+
+[meshes.b2]
+gears = ["p2", "bull"]
+stiffness = { method = "iso6336" }
+damping_ratio = 0.05
+backlash = "100 um"
+stage = "second"
+
+[drives.turbine]
+body = "input"
+speed = "6000 rpm"
+power = "500 kW"
+
+[loads.rotor]
+body = "bull"
+torque = "balanced"
+speed_coefficient = "50 N m s/rad"
+
+[analysis]
+cycles = 40
+"""

@@ -17,6 +17,8 @@ check                      says
 :func:`contact_loss`       drive flank separated (the teeth move inside the backlash)
 :func:`back_flank`         back-flank contact; without backlash: double-flank contact,
                            tensile tooth force no real pair with backlash carries
+:func:`damping_pull`       a tensile force on the working flank: the mesh damping pulls
+                           while the teeth move apart (no contact can)
 :func:`resonance`          dynamic factor above :data:`RESONANCE_FACTOR`: the run is near
                            a resonance (``torquesplit modes``)
 :func:`settling`           the transient did not die out: the last half was used; or
@@ -60,6 +62,9 @@ PEAK_DRIFT = 1e-3
 #: mean-force coefficients of the two halves of the settled part that differ by more than
 #: this (absolute) leave their third decimal to the run length: said
 MEAN_DRIFT = 1e-3
+#: a settled tensile force on the working flank below this share of the static force is
+#: rounding, not a pull worth a word (:func:`damping_pull`)
+PULL_FLOOR = 0.01
 
 
 def _kn(force: float) -> str:
@@ -191,6 +196,27 @@ def back_flank(results, metrics) -> list[tuple[str, str]]:
                 f"teeth rattle through the backlash; peak forces are "
                 f"impacts and the load sharing is not meaningful; check the excitation "
                 f"and meshes.{r.mesh}.backlash")))
+    return out
+
+
+def damping_pull(results, metrics) -> list[tuple[str, str]]:
+    """Meshes whose settled force turns tensile on the working flank (no back-flank
+    contact): the viscous mesh damping outweighs the elastic force while the teeth move
+    apart, a pull that a contact cannot exert (the Kelvin-Voigt mesh law of the papers
+    allows it)."""
+    out = []
+    for r in metrics.rows:
+        if r.back_contact > FRACTION_FLOOR or not r.min_force < 0:
+            continue  # (back-flank contact: said by back_flank)
+        nominal = abs(r.static_force) or abs(r.nominal_force) or 1.0
+        if -r.min_force <= PULL_FLOOR * nominal:
+            continue
+        out.append((f"meshes.{r.mesh}", (
+            f"the settled tooth force goes down to {_kn(r.min_force)} on the working flank "
+            f"(no back-flank contact): the mesh damping outweighs the elastic force while "
+            f"the teeth move apart, a pull a real contact cannot exert; its smallest force "
+            f"and the history there are those of the viscous mesh model (a real pair would "
+            f"just lose contact); check meshes.{r.mesh}.damping_ratio and the excitation")))
     return out
 
 
@@ -468,8 +494,8 @@ def harmonic_truncation(results, metrics) -> list[tuple[str, str]]:
 
 
 #: every check, in the order the messages are listed
-CHECKS = (static_force, ltca_load, static_deflection, contact_loss, back_flank, resonance, settling,
-          peak_drift, mean_drift, coarse_history, harmonic_truncation)
+CHECKS = (static_force, ltca_load, static_deflection, contact_loss, back_flank, damping_pull,
+          resonance, settling, peak_drift, mean_drift, coarse_history, harmonic_truncation)
 
 
 def result_warnings(results, metrics, *, history: bool = True) -> list[tuple[str, str]]:
