@@ -231,8 +231,10 @@ leaves out the start-up transient before computing anything.
 ## 5. Read the table
 
 * **nominal F**: the tooth force of an equal split; **static F**: the force at the static
-  equilibrium, where the 15 µm error already shifts load onto branch 1; **mean F** and
-  **peak F**: over the settled part of the run.
+  equilibrium under the mean excitation (mean mesh stiffness, constant errors: the 15 µm
+  error already shifts load onto branch 1; an eccentricity turning with its gear would
+  average out), the denominator of the dynamic factor; the run itself starts from the
+  equilibrium at t = 0; **mean F** and **peak F**: over the settled part of the run.
 * **LSC (mean_force)**: the load-sharing coefficient, the mean force of a mesh over the
   mean of its group.  This is the number a design standard calls the mesh load factor
   K_γ (ISO 6336-1, AGMA 6123), and the one to report next to the dynamic factor: it is

@@ -681,7 +681,10 @@ def _render_run(res, met, saved, planets=None) -> None:
                   f"[bold]{met.load_sharing.system:.4f}[/]", highlight=False)
     console.print(
         f"LSC ({met.definition}): {DEFINITION_TEXT[met.definition]}; "
-        f"{DEFINITION_USE[met.definition]}.  Dynamic factor = settled peak / the mesh's own "
+        f"{DEFINITION_USE[met.definition]}.  Static F: the static equilibrium under the "
+        f"mean excitation (mean mesh stiffness, constant errors; an eccentricity or runout "
+        f"turning with its gear averages out), not the t = 0 state the run starts from.  "
+        f"Dynamic factor = settled peak / the mesh's own "
         f"static force (K_v sense, >= 1 in contact); peak/nominal = settled peak / "
         f"equal-split nominal force (Ji & Li eq. 19) = load sharing and dynamics together.  "
         f"Contact loss: share of the whole run (start-up included) with the drive flanks "

@@ -629,7 +629,13 @@ class Mesh(Strict):
     backlash: Annotated[
         BacklashSpec, BeforeValidator(_backlash_shorthand), Unit("length")
     ] = Field(
-        0.0, description="Total backlash (\"100 um\"; 0 = none), or a [backlash] table."
+        0.0, description=(
+            "Total backlash (\"100 um\"; 0 = none), or a [backlash] table.  The play is "
+            "centred: half of it on each flank at the nominal position, so the drive flank "
+            "takes load after half the backlash.  In a locked train (a split) a backlash "
+            "that differs between paths therefore shifts the static load split as a timing "
+            "error of half the difference would; for gears clocked at assembly (drive flanks "
+            "touching) add minus half the backlash to transmission_error.constant.")
     )
     transmission_error: TransmissionErrorSpec = Field(TransmissionErrorSpec(), description="Extra LOA error.")
     phase: Number | None = Field(None, description="Mesh phase at t = 0 in cycles (overrides clocking).")

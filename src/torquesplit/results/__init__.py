@@ -38,7 +38,9 @@ class MeshRow:
     nominal_force: float
     """Equal-split nominal tooth force."""
     static_force: float
-    """Force at the static equilibrium (static load sharing included)."""
+    """Force at the static equilibrium under the mean excitation (static load sharing
+    included): mean mesh stiffness, constant errors, an eccentricity or runout turning
+    with its gear averaged out; not the t = 0 equilibrium the run starts from."""
     mean_force: float
     peak_force: float
     min_force: float
@@ -269,7 +271,10 @@ class Results:
         return {m: self.kinematics.meshes[m].force for m in self.mesh_names}
 
     def static_forces(self) -> dict[str, float]:
-        """Mesh forces of the static equilibrium (the static load sharing) [N]."""
+        """Mesh forces of the static equilibrium under the mean excitation (the static
+        load sharing) [N]: mean mesh stiffness and constant errors; errors that turn with
+        the gears (eccentricity, runout) average out.  The run starts from the equilibrium
+        at t = 0 instead (``prepare_run``)."""
         names = self.structure.element_names
         return {m: float(self.static.element_forces[names.index(m)]) for m in self.mesh_names}
 
