@@ -200,6 +200,14 @@ def test_grid_axes_and_figures_of_log_and_3_parameter_grids(split_file):
                          ("stage", "same")])
     labels = [ln.get_label() for ln in fig.axes[0].get_lines()]
     assert labels == ["system = stage", "a1"], labels
+    # cases that are not ok, marked by kind: contact lost keeps its values (a reviewer
+    # saw 'case not ok' crosses under points drawn with their values)
+    one["status"] = one["status"].astype(object)  # (room for the longer names)
+    one["status"].values[:2] = ["contact_lost", "diverged"]
+    fig = curves_figure(one, "load_sharing.cycle_peak", [("system", "load_sharing.cycle_peak")])
+    marks = {ln.get_label(): ln.get_marker() for ln in fig.axes[0].get_lines()}
+    assert marks["teeth separate (contact lost; values kept)"] == "v"
+    assert marks["case failed (no values)"] == "x"
     # the model in the title and the quantity in words (a title named only the study,
     # the axis the output's key, "load_sharing.cycle_peak [-]")
     assert fig.get_suptitle().startswith(f"{one.attrs['model_name']}, study test grid: ")
@@ -231,3 +239,15 @@ def test_map_cells_of_a_log_parameter_are_centred_on_its_values():
     np.testing.assert_allclose(_edges(ds, "k", ds["k"].values),
                                [10 ** -1.5, 10 ** -0.5, 10 ** 0.5, 10 ** 1.5], rtol=1e-12)
     np.testing.assert_allclose(_edges(ds, "e", ds["e"].values), [-2, 2, 6, 10])
+
+
+def test_a_parameter_on_several_paths_names_them_on_the_axis(split_file):
+    """A sweep of the backlash of two meshes drew 'backlash [µm]' without saying which."""
+    from torquesplit.study.figures import curves_figure
+
+    paths = ["meshes.a1.transmission_error.constant", "meshes.a2.transmission_error.constant"]
+    ds = run_study(grid_study(split_file, [{"name": "error", "paths": paths,
+                                            "values": ["0 um", "4 um"]}],
+                              outputs=["load_sharing.cycle_peak"]), workers=1)
+    fig = curves_figure(ds, "load_sharing.cycle_peak", [("system", "load_sharing.cycle_peak")])
+    assert fig.axes[0].get_xlabel() == f"error ({', '.join(paths)}) [µm]"

@@ -188,6 +188,12 @@ def test_statistics_over_fewer_cases_say_so(split_file, tmp_path):
     fig = monte_carlo_figure(ds, OUT)
     title = fig._suptitle.get_text()
     assert "statistics over 6 of 8 cases" in title
+    # a case whose teeth separate keeps its values: said apart from the failed ones (a
+    # reviewer's title read '4 of 4 cases not ok' over statistics of all four)
+    ds["status"] = ds["status"].astype(object)  # (room for the longer name)
+    ds["status"].values[0] = "contact_lost"
+    title = monte_carlo_figure(ds, OUT)._suptitle.get_text()
+    assert "(1 lost contact and 2 failed of 8 cases)" in title, title
     # counts on whole-number ticks; no 95th percentile of fewer than 20 samples (it is
     # their largest), nor its legend entry
     ticks = fig.axes[0].get_yticks()

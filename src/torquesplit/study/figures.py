@@ -167,10 +167,12 @@ def maps_figure(ds, family: str, members: list[tuple[str, str]]) -> Figure:
         elif np.isfinite(z).all() and len(x) > 1 and len(y) > 1 and np.nanstd(z) > 0:
             lines = ax.contour(x, y, z, colors="w", linewidths=0.6, alpha=0.8)
             ax.clabel(lines, fontsize=6, fmt="%.4g")
-        bad = status.transpose(dims[1], dims[0]).values != "ok"
-        if bad.any():
-            yy, xx = np.nonzero(bad)
-            ax.plot(np.asarray(x)[xx], np.asarray(y)[yy], "rx", ms=6, label="not ok")
+        kind = _kind(status.transpose(dims[1], dims[0]).values)
+        for k, (marker, color, label) in _MARKS.items():
+            yy, xx = np.nonzero(kind == k)
+            if yy.size:
+                ax.plot(np.asarray(x)[xx], np.asarray(y)[yy], ls="none", marker=marker,
+                        color=color, ms=6, label=label)
         bar = fig.colorbar(mesh, ax=ax, label=f"[{unit}]")  # (the quantity: the title)
         bar.formatter.set_useOffset(False)
         bar.update_ticks()
@@ -232,8 +234,7 @@ def monte_carlo_figure(ds, var: str, confidence: float = 0.95) -> Figure:
         ax.grid(True, alpha=0.3)
     ax_c.legend(fontsize=7, loc="lower right")
     ax_v.legend(fontsize=7)
-    failed = int((ds["status"].values != "ok").sum())
-    note = f" ({failed} of {y.size} cases not ok)" if failed else ""
+    note = _status_note(ds["status"].values)
     what = f"statistics over {n} of {y.size} cases" if n < y.size else f"{n} samples"
     _suptitle(fig, f"{_title(ds)}: {what}{note}")
     return fig
@@ -403,14 +404,44 @@ def _param_label(ds, name) -> str:
     paths = json.loads(ds[name].attrs.get("paths", "[]"))
     if ds[name].attrs.get("mode") == "scale":
         return f"{name} (factor)"
-    return name if len(paths) != 1 or paths[0] == name else f"{name} ({paths[0]})"
+    if not paths or paths == [name]:
+        return name
+    if len(paths) <= 3:  # (a parameter set on several paths: name them, a reviewer's
+        return f"{name} ({', '.join(paths)})"  # 'backlash' did not say of which meshes)
+    return f"{name} ({paths[0]} and {len(paths) - 1} more)"
+
+
+#: how a case that is not ok is marked: contact lost keeps its values (plotted, marked
+#: apart), any other status has none
+_MARKS = {"contact_lost": ("v", "tab:orange", "teeth separate (contact lost; values kept)"),
+          "failed": ("x", "tab:red", "case failed (no values)")}
+
+
+def _kind(status) -> np.ndarray:
+    """Per case: "ok", "contact_lost" or "failed" (diverged, refused, error, missing)."""
+    s = np.asarray(status).astype(str)
+    return np.where((s == "ok") | (s == "contact_lost"), s, "failed")
 
 
 def _mark_failed(ax, x, status) -> None:
-    bad = np.asarray(status) != "ok"
-    if bad.any():
-        ax.plot(np.asarray(x)[bad], np.zeros(bad.sum()), "rx", ms=7, clip_on=False,
-                transform=ax.get_xaxis_transform(), label="case not ok")
+    """Marks on the axis under the cases that are not ok, by kind (:data:`_MARKS`)."""
+    kind = _kind(status)
+    for k, (marker, color, label) in _MARKS.items():
+        hit = kind == k
+        if hit.any():
+            ax.plot(np.asarray(x)[hit], np.zeros(hit.sum()), ls="none", marker=marker,
+                    color=color, ms=7, clip_on=False, transform=ax.get_xaxis_transform(),
+                    label=label)
+
+
+def _status_note(status) -> str:
+    """' (2 of 8 cases lost contact; 1 failed)', or '' when every case is ok."""
+    kind = _kind(status)
+    bits = [f"{int((kind == 'contact_lost').sum())} lost contact"
+            if (kind == "contact_lost").any() else "",
+            f"{int((kind == 'failed').sum())} failed" if (kind == "failed").any() else ""]
+    bits = [b for b in bits if b]
+    return f" ({' and '.join(bits)} of {kind.size} cases)" if bits else ""
 
 
 def _suptitle(fig, text: str, fontsize: float = 11.0) -> None:
