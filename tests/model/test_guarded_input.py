@@ -193,7 +193,7 @@ def test_numbers_are_not_booleans():
      "gears.pinion.polar_inertia", r"times that of a solid steel disc"),
     (lambda d: d["drives"]["motor"].update(speed="3e6 rpm"),
      "gears.pinion", r"pitch-line speed of 6283 m/s"),
-    (lambda d: d["meshes"]["m"].update(backlash="5 mm"),
+    (lambda d: d["meshes"]["m"].update(backlash="3 mm"),
      "meshes.m.backlash", r"larger than the module"),
     (lambda d: d["drives"]["motor"].update(torque="1e7 N m"),
      "meshes.m", r"N/mm of face width"),
@@ -217,6 +217,23 @@ def test_shipped_examples_pass_the_deep_check_without_new_warnings():
             check_model(model, deep=True)
         assert not [str(w.message) for w in record
                     if "ISO 6336" not in str(w.message)], name
+
+
+@pytest.mark.parametrize("mutate,location", [
+    (lambda d: d["gears"]["pinion"].update(errors={"eccentricity": 20}),
+     "gears.pinion.errors.eccentricity"),
+    (lambda d: d["meshes"]["m"].update(backlash="5 mm"), "meshes.m.backlash"),
+    (lambda d: d["gears"]["wheel"].update(dofs=["x", "y", "theta"], support={
+        "stiffness": "500 N/um", "clearance": "1 cm"}), "gears.wheel.support.clearance"),
+])
+def test_errors_deeper_than_the_tooth_are_refused(mutate, location):
+    """A reviewer's '--set gears.i1.errors.eccentricity=20' (20 m) ran, only warned, and
+    printed back-flank forces of 3e5 kN: an error, backlash or bearing clearance deeper
+    than the whole tooth (2.25 modules, 4.5 mm here) takes the teeth out of mesh."""
+    data = pair_dict()
+    mutate(data)
+    _refused(data, location, r"deeper than the whole tooth \(2\.25 x module = 4\.5 mm\): "
+                             r"the teeth would leave mesh; .* write '20 um'")
 
 
 # --------------------------------------------------------------------------- check = run

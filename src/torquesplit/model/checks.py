@@ -79,6 +79,7 @@ def check_model(model: Model, source: str | None = None, *, deep: bool = False) 
         geometry = geometry_issues(model, skip)
         issues = topology_issues(model) + mismatched + geometry
         issues += support_issues(model) + modification_issues(model, skip)
+        issues += error_size_issues(model)
         issues += [i for i in placement_issues(model, skip, geometry) if i not in issues]
     if issues:
         raise ModelError(as_written(model, issues), source)
@@ -448,6 +449,41 @@ MODIFICATIONS_UNUSED = ("a dynamic run uses tooth modifications only through the
                         "method 'ltca'")
 #: fewest slices across the face that resolve a lead modification (crowning, end relief)
 LEAD_SLICES = 5
+
+
+#: an error, backlash or bearing clearance beyond this many modules (the whole tooth depth,
+#: 2.25 m_n) takes the teeth out of mesh: refused, not warned (a reviewer's 20 m
+#: eccentricity, a unit slip, ran with back-flank forces of 3e5 kN)
+TOOTH_DEPTH = 2.25
+
+
+def error_size_issues(model: Model) -> list[tuple[str, str]]:
+    """Errors, backlash and bearing clearances deeper than the whole tooth (:data:`
+    TOOTH_DEPTH` modules): the teeth would leave mesh, so the value is a unit slip."""
+    issues = []
+
+    def deeper(loc, value, module, what):
+        depth = TOOTH_DEPTH * module
+        if value and math.isfinite(value) and abs(value) > depth:
+            issues.append((loc, f"{_length_text(abs(value))} is deeper than the whole tooth "
+                                f"({TOOTH_DEPTH:g} x module = {_length_text(depth)}): the teeth "
+                                f"would leave mesh; {what} are microns: check the value and "
+                                f"its unit (a bare number is read in m: write '20 um')"))
+
+    for name, g in model.gears.items():
+        for field in ("eccentricity", "installation", "tooth_thickness", "pitch",
+                      "bearing_runout"):
+            deeper(f"gears.{name}.errors.{field}", getattr(g.errors, field), g.module,
+                   "manufacturing and assembly errors")
+        if g.support is not None:
+            deeper(f"gears.{name}.support.clearance", g.support.clearance, g.module,
+                   "bearing clearances")
+    for name, m in model.meshes.items():
+        modules = [model.gears[x].module for x in m.gears if x in model.gears]
+        if modules:
+            deeper(f"meshes.{name}.backlash", m.backlash.nominal + m.backlash.tolerance,
+                   min(modules), "backlashes")
+    return issues
 
 
 def support_issues(model: Model) -> list[tuple[str, str]]:
