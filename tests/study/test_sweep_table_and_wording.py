@@ -87,3 +87,16 @@ def test_sweep_refuses_what_it_would_drop_and_prints_the_text_as_given(split_fil
     res = runner.invoke(app, ["sweep", str(split_file), *args])
     assert res.exit_code == 2 and said in res.stderr, res.stderr
     assert "\U0001f4af" not in res.stderr
+
+
+def test_sweep_reports_every_bad_option_at_once(split_file):
+    """A reviewer's bad --output hid --workers 0, and a range without its unit hid the bad
+    --output: each needed another attempt."""
+    res = runner.invoke(app, ["sweep", str(split_file), "--vary",
+                              "meshes.a1.transmission_error.constant=0:10:3",
+                              "--output", "load_sharing.peak", "--workers", "0"])
+    assert res.exit_code == 2, res.output
+    errors = [ln for ln in res.output.splitlines() if ln.startswith("error: ")]
+    assert [e.split(":")[1].split()[0] for e in errors] == ["--workers", "--vary", "--output"], \
+        res.output
+    assert "range has no unit" in errors[1] and "matches no output" in errors[2]

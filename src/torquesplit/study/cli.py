@@ -599,58 +599,106 @@ def sweep(
 
     ui = _ui()
     try:
-        from ..model.overrides import parse_assignment
-
-        ui._one_run_length(duration, cycles)
-        if len(vary) != 1:
-            raise ValueError("--vary is given twice: a sweep varies one parameter (several "
-                             "paths set together: --vary P1,P2=START:STOP:NUM); for a grid of "
-                             "two or three parameters write a study file (docs/studies.md)")
-        vary = vary[0]
-        param = parse_vary(vary)
-        _refuse_bare_range(vary, param)
-        varied = set(param.get("paths") or [param["path"]])
-        for a in assign or []:
-            if a.partition("=")[0].strip() in varied:
-                raise ValueError(f"--set {a!r} sets a path that --vary varies; leave one of "
-                                 f"them out")
-        if log_spacing:
-            param["spacing"] = "log"
-        path = ui._resolve_model_path(model)
-        model_ref = str(path.resolve()) if path.exists() else model
-        if output:
-            outputs = list(output)
-        elif static:
-            outputs = ["load_sharing.static_torque.*"]
-        else:
-            from ..model.io import load_model
-
-            outputs = [f"load_sharing.{_default_definition(load_model, path)}.*"]
-        if static and (duration is not None or cycles is not None or settle is not None):
-            flag = ("--duration" if duration is not None else "--cycles" if cycles is not None
-                    else "--settle")
-            raise ValueError(f"{flag} sets the length of a dynamic run; a quasi-static sweep "
-                             f"(--static) turns the gears through whole revolutions: leave "
-                             f"{flag} out or drop --static")
-        analysis: dict = {"type": "static" if static else "run"}
-        if duration is not None:
-            analysis["duration"] = duration
-        if cycles is not None:
-            analysis["cycles"] = cycles
-        if settle is not None:
-            analysis["settle"] = {"tolerance": settle}
-        first = (param.get("path") or param["paths"][0])
-        more = len(param.get("paths") or []) - 1
-        name = f"sweep_{first}" + (f"_and_{more}_more" if more > 0 else "")
-        data = {"study": {"name": name, "model": model_ref, "outputs": outputs},
-                "analysis": analysis, "grid": {"parameters": [param]},
-                "set": dict(parse_assignment(a) for a in (assign or []))}
+        data, name = _sweep_study(ui, model, vary, output, log_spacing, static, duration,
+                                  cycles, settle, assign, workers)
     except (TorquesplitError, ValueError) as exc:
         ui._fail(exc)
         return
     _run(data, workers=workers, scheduler=scheduler, out=out, resume=resume,
          overwrite=overwrite, figures=not no_figures, quiet=quiet, as_json=as_json,
          name_hint=name, backend=backend, precision=precision, flag="--vary")
+
+
+def _sweep_study(ui, model, vary, output, log_spacing, static, duration, cycles, settle,
+                 assign, workers) -> tuple[dict, str]:
+    """The study data of a ``sweep`` command line and its name; every bad option is
+    refused at once, with the study's own problems (an unknown output, a path the model
+    lacks) where the options get that far (a reviewer's bad --output hid --workers 0)."""
+    from ..model.overrides import parse_assignment
+    from .core import Study
+    from .errors import StudyError
+
+    opts = ui._option_errors()
+    opts(ui._one_run_length, duration, cycles)
+    opts(ui._at_least, workers, 1, "--workers", "2")
+    param = opts(_vary_table, vary, log_spacing)
+    if param is not None:
+        opts(_as_option, _refuse_bare_range, vary[0], param)
+        opts(_set_apart, param, assign)
+    opts(_static_length, static, duration, cycles, settle)
+    path = ui._resolve_model_path(model)
+    model_ref = str(path.resolve()) if path.exists() else model
+    if output:
+        outputs = list(output)
+    elif static:
+        outputs = ["load_sharing.static_torque.*"]
+    else:
+        from ..model.io import load_model
+
+        outputs = [f"load_sharing.{_default_definition(load_model, path)}.*"]
+    analysis: dict = {"type": "static" if static else "run"}
+    if not static:
+        for key, value in (("duration", duration), ("cycles", cycles)):
+            if value is not None:
+                analysis[key] = value
+        if settle is not None:
+            analysis["settle"] = {"tolerance": settle}
+    first = (param.get("path") or param["paths"][0]) if param else "parameter"
+    more = len(param.get("paths") or []) - 1 if param else 0
+    name = f"sweep_{first}" + (f"_and_{more}_more" if more > 0 else "")
+    data = {"study": {"name": name, "model": model_ref, "outputs": outputs},
+            "analysis": analysis, "grid": {"parameters": [param]},
+            "set": dict(parse_assignment(a) for a in (assign or []))}
+    if opts.messages:
+        if param is not None:  # the study's own problems beside the options'
+            try:
+                Study(data).plan()
+            except StudyError as exc:
+                opts.messages += [f"{_sweep_option(f, '--vary')}: {_sweep_words(m)}"
+                                  for f, m in exc.problems]
+            except (ValueError, ArithmeticError, OSError):  # said when the options are fixed
+                pass
+        opts.raise_any()
+    return data, name
+
+
+def _as_option(check, *args):
+    """``check(*args)`` with its ValueError an :class:`OptionError` (a bad option)."""
+    try:
+        return check(*args)
+    except OptionError:
+        raise
+    except ValueError as exc:
+        raise OptionError(str(exc)) from None
+
+
+def _vary_table(vary: list[str], log_spacing: bool) -> dict:
+    """The grid parameter of ``--vary`` (given once)."""
+    if len(vary) != 1:
+        raise OptionError("--vary is given twice: a sweep varies one parameter (several "
+                          "paths set together: --vary P1,P2=START:STOP:NUM); for a grid of "
+                          "two or three parameters write a study file (docs/studies.md)")
+    param = _as_option(parse_vary, vary[0])
+    if log_spacing:
+        param["spacing"] = "log"
+    return param
+
+
+def _set_apart(param: dict, assign) -> None:
+    varied = set(param.get("paths") or [param["path"]])
+    for a in assign or []:
+        if a.partition("=")[0].strip() in varied:
+            raise OptionError(f"--set {a!r} sets a path that --vary varies; leave one of "
+                              f"them out")
+
+
+def _static_length(static: bool, duration, cycles, settle) -> None:
+    if static and (duration is not None or cycles is not None or settle is not None):
+        flag = ("--duration" if duration is not None else "--cycles" if cycles is not None
+                else "--settle")
+        raise OptionError(f"{flag} sets the length of a dynamic run; a quasi-static sweep "
+                          f"(--static) turns the gears through whole revolutions: leave "
+                          f"{flag} out or drop --static")
 
 
 def _default_definition(load_model, path) -> str:
