@@ -210,6 +210,19 @@ def test_report_gives_the_model_as_it_runs(tmp_path):
         else k_s
     assert re.search(rf"z1 gear loa {k / 1e6:.4g} \(shaft bending\)", page), k
     assert "computed from the gear" not in page
+    # a shaft given by its geometry reads its stiffness too, G pi d^4 / (32 l) by hand, so
+    # that paths given one way and the other compare (a reviewer's 's1: d = 35 mm' beside
+    # 's2: 2e+05'); every error of the model is listed (an eccentricity was nowhere)
+    sh = torquesplit.load_model("ji_li_mill_drive").shafts["drive1"]
+    k_t = sh.shear_modulus * np.pi * sh.diameter ** 4 / 32 / sh.length
+    assert f"drive1 z2 – z4 {k_t:.5g} (d = 285 mm, l = 1000 mm)" in page, k_t
+    res = runner.invoke(app, ["report", "ji_li_mill_drive", "--cycles", "20", "--out",
+                              str(out), "--quiet", "--force",
+                              "--set", "gears.z1.errors.eccentricity=20 um",
+                              "--set", "gears.z1.errors.eccentricity_phase=30 deg"])
+    assert res.exit_code == 0, res.output
+    page = " ".join(re.sub(r"<[^>]+>", " ", out.read_text(encoding="utf-8")).split())
+    assert "Errors where error amplitude [µm] phase [deg] gear z1 eccentricity 20 30" in page
 
 
 def test_report_says_what_it_leaves_out_and_keeps_the_sweeps_warnings(tmp_path, monkeypatch):
