@@ -247,18 +247,23 @@ def layout_figure(model, kin=None, *, width: float = 10.0) -> Figure:
                         color=COLORS["support"], zorder=6, gid=f"support:{name}")
             continue
         drop = 0.18 * size * 1e3 + (radius.get(name, 0.0) * 1e3 if kind == "gears" else 0)
-        g0 = c - np.array([0.0, drop])
+        down = _support_direction(c, drop, name, centre, radius, proj)
+        across = np.array([-down[1], down[0]])  # along the ground line
+        g0 = c + drop * down
         ax.plot([c[0], g0[0]], [c[1], g0[1]], color=COLORS["support"], lw=1.0, zorder=1)
         half = 0.06 * size * 1e3
-        ax.plot([g0[0] - half, g0[0] + half], [g0[1], g0[1]], color=COLORS["support"],
-                lw=1.6, zorder=1)
+        a, b = g0 - half * across, g0 + half * across
+        ax.plot([a[0], b[0]], [a[1], b[1]], color=COLORS["support"], lw=1.6, zorder=1)
         for k in range(5):
-            x0 = g0[0] - half + k * half / 2
-            ax.plot([x0, x0 - half / 3], [g0[1], g0[1] - half / 3],
-                    color=COLORS["support"], lw=0.8, zorder=1)
+            p0 = a + k * half / 2 * across
+            p1 = p0 + half / 3 * (down - across)
+            ax.plot([p0[0], p1[0]], [p0[1], p1[1]], color=COLORS["support"], lw=0.8,
+                    zorder=1)
         label = ("support" if same else f"support {letter[texts[name]]}"
                  if letter else f"support {name}\n{texts[name]}")
-        ax.annotate(label, g0, xytext=(-10, -12 if same or letter else -20),
+        below = -12 if same or letter else -20
+        ax.annotate(label, g0, xytext=(-10, below) if down[1] < -0.5 else
+                    (-10, 6) if down[1] > 0.5 else (6 if down[0] > 0 else -50, -4),
                     textcoords="offset points", fontsize=fs - 1.0,
                     color=COLORS["support"], zorder=6, gid=f"support:{name}")
     # ---- a carrier's pin circle: the bodies that seat bearings of others
@@ -348,7 +353,7 @@ def _fit_height(fig, ax, width: float, key_entries: int) -> None:
 #: where a label that overlaps something is tried instead: its offsets from where it was
 #: put [points], nearest first (a line of text is 11 points high; a step sideways counts
 #: less than one across lines)
-_NUDGES = sorted(((dx, dy) for dx in range(-70, 71, 10) for dy in range(-55, 56, 11)
+_NUDGES = sorted(((dx, dy) for dx in range(-120, 121, 10) for dy in range(-66, 67, 11)
                   if (dx, dy) != (0, 0)), key=lambda d: math.hypot(0.6 * d[0], d[1]))
 #: a label moved farther than this from where it was put [points] gets a leader line to
 #: its part
@@ -358,7 +363,7 @@ _LEADER = 15.0
 def _separate_labels(fig, ax) -> None:
     """Move each named label that overlaps one placed before it (in the order drawn:
     gears first), a mesh's arrow or a drawn line or marker (shaft, support, body) to the
-    nearest of :data:`_NUDGES` where it overlaps none (at most 89 points from where it
+    nearest of :data:`_NUDGES` where it overlaps none (at most 137 points from where it
     was, with a leader line to its part beyond :data:`_LEADER`); a label with no free
     place goes where it overlaps least, a label over a label counting most.  The offsets
     of the drawing code put every label beside its part, but neighbouring gears, a
@@ -384,10 +389,15 @@ def _separate_labels(fig, ax) -> None:
     weight = np.array(weights, float)
     placed = []  # the labels placed so far: a label over one counts 4
 
+    frame = ax.get_window_extent(renderer)
+
     def clashes(b) -> float:
         hit = ((obstacles[:, 0] < b.x1) & (b.x0 < obstacles[:, 2])
                & (obstacles[:, 1] < b.y1) & (b.y0 < obstacles[:, 3]))
-        return float(weight[hit].sum()) + 4.0 * sum(b.overlaps(o) for o in placed)
+        outside = not (frame.x0 <= b.x0 and b.x1 <= frame.x1
+                       and frame.y0 <= b.y0 and b.y1 <= frame.y1)  # (off the drawing)
+        return (float(weight[hit].sum()) + 4.0 * sum(b.overlaps(o) for o in placed)
+                + 3.0 * outside)
 
     for ann in [t for t in ax.texts if isinstance(t, Annotation) and t.get_text()]:
         box = ann.get_window_extent(renderer).padded(1.0)
@@ -440,10 +450,39 @@ def _line_obstacles(ax, px: float) -> list[tuple[float, float, float, float]]:
     return out
 
 
+#: directions a support is drawn in from its body, the first that crosses no other gear
+#: (down unless a gear sits there: a reviewer's idler's support ran through the input gear)
+_SUPPORT_DIRECTIONS = ((0.0, -1.0), (0.0, 1.0), (1.0, 0.0), (-1.0, 0.0))
+
+
+def _support_direction(c, drop, name, centre, radius, proj) -> np.ndarray:
+    """The direction (unit, drawing plane) of the support line of body ``name`` at ``c``,
+    ``drop`` [mm] long: the first of :data:`_SUPPORT_DIRECTIONS` whose line keeps clear of
+    every other gear's pitch circle (as drawn, about its projected centre), else down."""
+    others = [(proj(centre[g]), r * 1e3) for g, r in radius.items()
+              if g != name and g in centre]
+    for d in _SUPPORT_DIRECTIONS:
+        d = np.asarray(d)
+        # the part of the line outside the body's own circle
+        start = c + d * radius.get(name, 0.0) * 1e3
+        end = c + d * drop
+        if all(_segment_distance(o, start, end) > r for o, r in others):
+            return d
+    return np.asarray(_SUPPORT_DIRECTIONS[0])
+
+
+def _segment_distance(p, a, b) -> float:
+    """Distance of point ``p`` from the segment ``a``-``b`` (2-D)."""
+    ab = b - a
+    t = float(np.clip(np.dot(p - a, ab) / max(float(np.dot(ab, ab)), 1e-30), 0.0, 1.0))
+    return float(np.linalg.norm(p - (a + t * ab)))
+
+
 def _support_text(sup) -> str:
     bits = []
     if sup.stiffness:
-        bits.append(f"{sup.stiffness / 1e6:.3g} N/µm")
+        k = sup.stiffness / 1e6  # (1000 N/µm, not '1e+03 N/µm')
+        bits.append(f"{k:.4g} N/µm" if 1e-3 <= k < 1e5 else f"{k:.3g} N/µm")
     elif sup.shaft is not None:
         bits.append("shaft bending")
     if sup.clearance > 0:
