@@ -174,3 +174,28 @@ def test_many_supports_of_few_kinds_are_lettered_with_their_values_in_the_key():
     labels = [t.get_text() for t in ax.texts if t.get_text().startswith("support")]
     assert labels and all(len(t) == len("support A") for t in labels), labels
     assert _overlapping_label_pairs(fig) <= 2  # (11 before)
+
+
+def test_a_support_is_drawn_clear_of_the_other_gears(tmp_path):
+    """A reviewer's idler i1 (above the input pinion) had its support line drawn down
+    through the input gear: it goes the first way that crosses no other gear."""
+
+    from model_texts import TWO_PATH_SPUR_REDUCER
+    from torquesplit.model.kinematics import solve_kinematics
+    from torquesplit.plot import layout as L
+
+    model = torquesplit.load_model(write_model(tmp_path, TWO_PATH_SPUR_REDUCER))
+    kin = solve_kinematics(model)
+    proj = L._Projection(L._main_axis(model, kin))
+    centre = L._drawing_centres(model, kin, proj)
+    radius = {n: mk_r for mk in kin.meshes.values()
+              for n, mk_r in zip((mk.driver, mk.driven), mk.pitch_radii)}
+    drop = 0.18 * max(radius.values()) * 1e3 + radius["i1"] * 1e3
+    c = proj(centre["i1"])
+    way = L._support_direction(c, drop, "i1", centre, radius, proj)
+    assert tuple(way) != (0.0, -1.0)  # (down crosses the input gear)
+    start, end = c + way * radius["i1"] * 1e3, c + way * drop
+    for g in ("input", "i2", "bull", "p1", "p2"):
+        assert L._segment_distance(proj(centre[g]), start, end) > radius[g] * 1e3, g
+    assert L._support_direction(proj(centre["bull"]), drop, "bull", centre, radius,
+                                proj).tolist() == [0.0, -1.0]  # (nothing below it)
