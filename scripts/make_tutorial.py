@@ -248,7 +248,9 @@ leaves out the start-up transient before computing anything.
   member's per-cycle peak over the nominal force (Ji & Li's engineering dynamic load
   coefficient G_it, from their eq. 19).
 * **bearing forces**: for each supported body (here `input`), the settled mean bearing
-  force by direction, the magnitude of that mean and the peak magnitude |F|.  They come
+  force by direction, the magnitude of that mean and the peak magnitude |F|; a gear with
+  no translations is held rigidly, and its row (marked so) is the sum of its meshes'
+  forces, in the housing's x, y (and z: the axial thrust of helical teeth).  They come
   from the history, not from the streamed statistics (next bullet).  `--json` gives them
   as `bearing_forces_N`, a .nc or .mat results file (`--out`) as `bearing_mean_force`
   and `bearing_peak_force`.

@@ -120,14 +120,21 @@ def test_backlash_mesh_reports_contact_loss_in_json_and_file(tmp_path):
 
 
 def test_a_20_mm_installation_error_is_flagged_before_and_after_the_run(tmp_path):
-    """A 20 mm installation error (typo for 20 um) passed check; run printed -123 kN."""
-    text = split_model().replace("[gears.b2]", '[gears.a.errors]\ninstallation = "20 mm"\n\n'
+    """A 20 mm installation error (typo for 20 um) passed check; run printed -123 kN.
+    Deeper than the whole tooth (4.5 mm here) it is refused; one between the module and
+    the tooth depth is flagged before and after the run."""
+    deep = split_model().replace("[gears.b2]", '[gears.a.errors]\ninstallation = "20 mm"\n\n'
                                                "[gears.b2]")
+    for command in ("check", "run"):
+        refused = runner.invoke(app, [command, str(write_model(tmp_path, deep, "deep.toml"))])
+        assert refused.exit_code == 2 and "gears.a.errors.installation: 20 mm is deeper " \
+            "than the whole tooth" in refused.output, refused.output
+    text = deep.replace('installation = "20 mm"', 'installation = "3 mm"')
     model = write_model(tmp_path, text)
     check = runner.invoke(app, ["check", str(model)])
     assert check.exit_code == 0, check.output
     said = [w for w in warnings_of(check) if "gears.a.errors.installation" in w]
-    assert any("20 mm is larger than the module" in w for w in said)
+    assert any("3 mm is larger than the module" in w for w in said)
     assert any("ISO 1328-1 runout tolerance" in w and "coarsest grade, 11" in w for w in said)
     res = runner.invoke(app, ["run", str(model), "--cycles", "30", "--json"])
     assert res.exit_code == 0, res.output

@@ -181,10 +181,10 @@ def test_set_warnings_name_the_argument_not_the_file(tmp_path):
     text = SPUR_PAIR.replace('teeth = 20\n', 'teeth = 20\nerrors = { installation = "5 um" }\n',
                              1)
     model = write_model(tmp_path, text)
-    arg = "gears.pinion.errors.installation=15"
+    arg = "gears.pinion.errors.installation=3mm"  # (beyond the module, within the tooth)
     res = runner.invoke(app, ["check", str(model), "--set", arg])
     assert res.exit_code == 0, res.output
-    warned = [ln for ln in res.stderr.splitlines() if "15 m" in ln]
+    warned = [ln for ln in res.stderr.splitlines() if "3 mm" in ln]
     assert warned and all(ln.startswith(f"warning: --set {arg}: ") for ln in warned), warned
     assert str(model) not in res.stderr
     clean = runner.invoke(app, ["check", str(model), "--set", "gears.pinion.errors."

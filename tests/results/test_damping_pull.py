@@ -26,3 +26,32 @@ def test_a_damping_pull_on_the_working_flank_is_said(tmp_path):
     assert "working flank" in said["meshes.a1"] and "damping" in said["meshes.a1"]
     assert any(w.startswith("meshes.a1: the settled tooth force goes down to")
                for w in res.warnings())
+
+
+def test_a_body_held_rigidly_has_its_bearing_row(tmp_path):
+    """The reviewer's pinions p1, p2 (rotation only, on torsion-only shafts) carried the
+    largest radial loads and had no bearing row: a body with no translational DOF is held
+    rigidly, its bearing carries the sum of its meshes' forces along their lines of
+    action (here one mesh each, so minus its settled mean force along its line of action
+    for a driver)."""
+    import numpy as np
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        model = torquesplit.load_model(write_model(tmp_path, TWO_PATH_SPUR_REDUCER))
+        res = torquesplit.simulate(model)
+    start = res.metrics().settling.start_time
+    rows = {b["body"]: b for b in res.bearing_forces(start)}
+    assert {"p1", "p2"} <= set(rows) and rows["p1"]["held"] == "rigid"
+    assert "held" not in rows["bull"]  # (a support of its own: its support's force)
+    t, f = res.mesh_force_history()
+    keep = t >= start
+    for body, mesh in (("p1", "b1"), ("p2", "b2")):
+        n = np.asarray(res.kinematics.meshes[mesh].line_of_action)
+        assert res.kinematics.meshes[mesh].driver == body
+        mean = -f[keep, res.mesh_names.index(mesh)].mean() * n  # the force on the driver
+        row = rows[body]
+        assert row["directions"] == ["x", "y"]  # (spur: no axial thrust)
+        np.testing.assert_allclose(row["mean"], mean[:2], rtol=1e-12)
+    from torquesplit.results import bearing_bodies
+    assert bearing_bodies(res.structure, model) == [b["body"] for b in res.bearing_forces()]

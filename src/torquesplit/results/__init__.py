@@ -485,7 +485,9 @@ class Results:
         """Per supported body, its bearing (support) force over the settled part: the mean
         of each direction [N], the magnitude of that mean and the largest magnitude of the
         force vector [N] (a body held by a spline alone: the spline's radial force, its
-        name in ``via``), from the history from ``start_time`` (default the latest group
+        name in ``via``; a body held rigidly, with no translational DOF: the sum of its
+        meshes' forces along their lines of action, in the housing's x, y, z, axial thrust
+        included, ``held`` "rigid"), from the history from ``start_time`` (default the latest group
         settle time: pass ``metrics().settling.start_time`` when the metrics are at
         hand; a periodic state's: its first whole period, whatever ``start_time``).  The
         history is decimated (``samples_per_period``): a peak between its samples is
@@ -516,17 +518,30 @@ class Results:
             keep = np.ones(s.history_t.shape, bool)
         out = []
         via = self.bearing_via()
-        for body, parts in by_body.items():
-            forces = s.history_forces[keep][:, [c for _, c, _ in parts]]
-            forces = forces * np.array([sign for _, _, sign in parts])
+
+        def row(body, directions, forces, **extra):
             mean = forces.mean(axis=0)
             magnitude = np.sqrt((forces ** 2).sum(axis=1))
-            out.append({"body": body, "via": via.get(body),
-                        "directions": [d for d, _, _ in parts],
-                        "mean": [float(v) for v in mean],
-                        "mean_magnitude": float(np.sqrt((mean ** 2).sum())),
-                        "peak_magnitude": float(magnitude.max()),
-                        "samples": int(keep.sum())})
+            return {"body": body, "via": via.get(body), "directions": directions,
+                    "mean": [float(v) for v in mean],
+                    "mean_magnitude": float(np.sqrt((mean ** 2).sum())),
+                    "peak_magnitude": float(magnitude.max()), "samples": int(keep.sum()),
+                    **extra}
+
+        for body, parts in by_body.items():
+            forces = s.history_forces[keep][:, [c for _, c, _ in parts]]
+            out.append(row(body, [d for d, _, _ in parts],
+                           forces * np.array([sign for _, _, sign in parts])))
+        # bodies held rigidly: the sum of their meshes' forces, in the housing's x, y, z
+        el, hist = self.structure.element_names, list(s.history_elements)
+        for body, terms in rigid_bearings(self.model, self.kinematics).items():
+            if body in by_body or any(el.index(m) not in hist for m, _ in terms):
+                continue
+            f = s.history_forces[keep][:, [hist.index(el.index(m)) for m, _ in terms]]
+            n = np.array([sign * np.asarray(self.kinematics.meshes[m].line_of_action, float)
+                          for m, sign in terms])  # (meshes, 3): force on the body per N
+            axes = [k for k in range(3) if np.any(np.abs(n[:, k]) > 1e-12)]
+            out.append(row(body, ["xyz"[k] for k in axes], (f @ n)[:, axes], held="rigid"))
         return out
 
     def mesh_force_history(self) -> tuple[np.ndarray, np.ndarray]:
@@ -681,7 +696,7 @@ class Results:
         directions = sorted({d for b in bearings for d in b["directions"]})
         bearing_header = (["body", "via"] + [f"mean_force_{d}_N" for d in directions]
                           + ["mean_force_magnitude_N", "peak_force_magnitude_N", "samples"])
-        bearing_rows = [[b["body"], b["via"] or ""]
+        bearing_rows = [[b["body"], b["via"] or b.get("held", "")]
                         + [dict(zip(b["directions"], b["mean"])).get(d, "") for d in directions]
                         + [b["mean_magnitude"], b["peak_magnitude"], b["samples"]]
                         for b in bearings]
@@ -781,11 +796,35 @@ def _bearing_elements(element_names, model) -> dict[str, list[tuple[str, int, fl
     return out
 
 
-def bearing_bodies(structure, model) -> list[str]:
+def rigid_bearings(model, kin) -> dict[str, list[tuple[str, float]]]:
+    """Bodies held rigidly (no translational DOF) that mesh -> their meshes and the sign
+    that turns a mesh's force along its line of action into the force on the body (+1
+    driven, -1 driver): their bearing carries the sum (a reviewer's pinions on
+    torsion-only shafts carried the largest radial loads and had no bearing row).  A body
+    whose meshes are analysed in a turning carrier's frame is left out (its mesh
+    directions turn with the carrier)."""
+    out: dict[str, list[tuple[str, float]]] = {}
+    for items in (getattr(model, "gears", {}), getattr(model, "bodies", {})):
+        for name, body in items.items():
+            if any(d != "theta" for d in getattr(body, "dofs", ("theta",))):
+                continue
+            terms = [(m, 1.0 if mk.driven == name else -1.0) for m, mk in kin.meshes.items()
+                     if name in (mk.driver, mk.driven)]
+            if terms and not any(kin.meshes[m].carrier for m, _ in terms):
+                out[name] = terms
+    return out
+
+
+def bearing_bodies(structure, model, kin=None) -> list[str]:
     """The bodies a run's bearing table lists (:meth:`Results.bearing_forces`), in its
-    order, from the assembled ``structure`` alone (no run needed: a study checks its
-    output names with it)."""
-    return list(_bearing_elements(structure.element_names, model))
+    order, from the assembled ``structure`` and the kinematics alone (no run needed: a
+    study checks its output names with it)."""
+    if kin is None:
+        from ..model.kinematics import solve_kinematics
+
+        kin = solve_kinematics(model)
+    held = list(_bearing_elements(structure.element_names, model))
+    return held + [b for b in rigid_bearings(model, kin) if b not in held]
 
 
 def back_flank_force(cycle_min: np.ndarray) -> float:

@@ -372,7 +372,7 @@ def _outputs(spec: StudySpec, model, analysis: str) -> tuple[list[str], list[str
         from ..assembly.assemble import assemble
         from ..results import bearing_bodies
 
-        bearings = bearing_bodies(assemble(model, kin), model)
+        bearings = bearing_bodies(assemble(model, kin), model, kin)
     available = out_mod.available_outputs(list(model.meshes), group_meshes(meta), analysis,
                                           planets, bearings)
     names, unmatched = out_mod.select_outputs(spec.study.outputs, available)
