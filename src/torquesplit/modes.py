@@ -101,7 +101,8 @@ class ModeRow:
 
 @dataclass(frozen=True)
 class ModalReport:
-    """Modes of a model, grouped and classified."""
+    """Modes of a model, grouped (degenerate groups) and, for a model with a planetary
+    stage, classified (rotational, translational, planet: Lin & Parker 1999)."""
 
     solution: object
     """The :class:`~torquesplit.solve.modal.ModalSolution`."""
@@ -330,7 +331,8 @@ def classify(structure, sol, *, rtol: float = 1e-6, tol: float = 1e-6,
 
 def model_modes(model, *, rotating_frame: bool = True, below: float | None = None,
                 count: int | None = None, rtol: float = 1e-6) -> ModalReport:
-    """Modes of a model about its static equilibrium, grouped and classified.
+    """Modes of a model about its static equilibrium, grouped, and classified where it has
+    a planetary stage (``ModeRow.type`` None otherwise).
 
     Parameters
     ----------
