@@ -194,3 +194,18 @@ def test_a_plan_says_what_it_will_run(split_file):
     text = repr(plan)
     assert text.startswith("<Plan of ") and "grid over" in text and "(3 = 3 cases)" in text
     assert len(text) < 400
+
+
+def test_a_phase_of_an_error_without_amplitude_is_said(split_file):
+    """A reviewer's 'gears.i*.errors.eccentricity_phase' matched a gear without
+    eccentricity too and sampled its phase unsaid: a varied phase whose amplitude is 0
+    and varied by no parameter changes nothing, which the plan says."""
+    data = grid_study(split_file, [{"path": "gears.a.errors.eccentricity_phase",
+                                    "values": ["0 deg", "90 deg"]}])
+    notes = Study(data).plan().notes
+    assert notes == ["grid.parameters: gears.a.errors.eccentricity_phase changes nothing: "
+                     "gears.a.errors.eccentricity is 0 in the model and no parameter varies "
+                     "it; leave the phase out, or give the error an amplitude"], notes
+    data["grid"]["parameters"].append({"path": "gears.a.errors.eccentricity",
+                                       "values": ["0 um", "10 um"]})
+    assert Study(data).plan().notes == []  # (varied: the phase matters where it is not 0)

@@ -36,11 +36,11 @@ def test_a_run_too_short_warns_in_the_dataset_and_the_summary(tmp_path, split_fi
 
 def test_a_unit_slip_warns_for_its_case_only(split_file):
     data = grid_study(split_file, [{"path": "gears.pinion.errors.eccentricity",
-                                    "values": ["0 um", 0.5]}],  # 0.5: read in m
+                                    "values": ["0 um", 0.003]}],  # 0.003: read in m
                       outputs=["load_sharing.cycle_peak"])
     ds = run_study(data, workers=1)
     assert "eccentricity" not in str(ds["warnings"].values[0])
-    assert "gears.pinion.errors.eccentricity: 500 mm" in str(ds["warnings"].values[1])
+    assert "gears.pinion.errors.eccentricity: 3 mm" in str(ds["warnings"].values[1])
     assert ds["warning_count"].values[1] > ds["warning_count"].values[0]
     slips = [g for g in warning_groups(ds) if "larger than the module" in g["text"]]
     assert [g["cases"] for g in slips] == [[1]]

@@ -228,6 +228,7 @@ def _resolve(spec, folder, text, source) -> Plan:
                        f"{kind}.parameters", case=case, design=design)
         except StudyError as exc:
             notes.append(f"{exc}; it will be recorded as refused (the other cases run)")
+    notes += _idle_phases(design, model, kind)
     canonical = spec.canonical()
     # a [[planetary]] stage's fields exist in the file's own data only (the validated copy
     # holds the elements the stage generated): cases varying one start from that data
@@ -239,6 +240,39 @@ def _resolve(spec, folder, text, source) -> Plan:
                 model_dict=canon,
                 study_hash=_hash(canonical), outputs=outputs, definitions=definitions,
                 analysis=analysis, design=design, notes=notes)
+
+
+def _idle_phases(design, model, kind: str) -> list[str]:
+    """Notes on varied phases of errors whose amplitude is 0 in the model and varied by no
+    parameter: they change nothing (a reviewer's 'gears.i*.errors.eccentricity_phase'
+    also matched the input gear, which has no eccentricity, and sampled it unsaid)."""
+    varied = {q for prm in design.parameters for q in prm.paths}
+    notes = []
+    for prm in design.parameters:  # (a pattern's paths may be parameters of their own)
+        for q in prm.paths:
+            head, _, last = q.rpartition(".")
+            if last == "phase":
+                amplitude = f"{head}.amplitude"
+            elif last.endswith("_phase"):
+                amplitude = f"{head}.{last[:-len('_phase')]}"
+            else:
+                continue
+            value = _model_value(model, amplitude)
+            if value == 0 and amplitude not in varied:
+                notes.append(f"{kind}.parameters: {q} changes nothing: {amplitude} is "
+                             f"0 in the model and no parameter varies it; leave the phase "
+                             f"out, or give the error an amplitude")
+    return notes
+
+
+def _model_value(model, path: str):
+    """The model's value at a dotted path (None where it has none)."""
+    obj = model
+    for part in path.split("."):
+        obj = obj.get(part) if isinstance(obj, dict) else getattr(obj, part, None)
+        if obj is None:
+            return None
+    return obj
 
 
 def _probe_cases(design) -> list[int]:
