@@ -199,6 +199,8 @@ def test_bearing_forces_of_the_settled_part(tmp_path):
     t0 = res.metrics().settling.start_time
     keep = s.history_t >= t0
     for r in rows:
+        if r.get("held") == "rigid":  # (its meshes' forces: tests/results/test_two_path...)
+            continue
         cols = [list(s.history_elements).index(el.index(f"{r['body']}.support.{d}"))
                 for d in r["directions"]]
         f = s.history_forces[keep][:, cols]

@@ -41,7 +41,11 @@ Dynamic factors (per mesh, over the settled part), named for what they are:
   coefficient G_it).
 
 The transient is excluded by a settle criterion (:func:`settle`): one settle time per
-group, used by every metric of that group.
+group, used by every metric of that group, except ``mean_force``: its means are over the
+same span for every group, from the latest group settle time (:func:`common_first_cycle`),
+so that the stages of one locked train, which carry the same mean path torques, give the
+same coefficients (over each group's own span they differed by the drift of the slow
+excitations between the two starts: a reviewer's 1.2014 and 1.2119).
 """
 
 from __future__ import annotations
@@ -235,6 +239,20 @@ def settle(cycle_max: np.ndarray, cycle_start: np.ndarray, names, window=20,
     start_time = max(group_time.values()) if group_time else 0.0
     return Settling(start_time=start_time, settled=settled, first_cycle=first,
                     group_time=group_time, own_first_cycle=own, short=short)
+
+
+def common_first_cycle(settling: "Settling", cycle_start: np.ndarray, names) -> dict[str, int]:
+    """Mesh -> its first cycle starting at or after the latest group settle time
+    (``settling.start_time``, round-off aside), and not before its own settled cycle: the
+    start of a span common to every group."""
+    out = {}
+    t = settling.start_time
+    tol = 1e-9 * max(abs(t), 1e-300)
+    for j, m in enumerate(names):
+        starts = cycle_start[:, j]
+        k = int(np.searchsorted(starts, t - tol, side="left"))
+        out[m] = min(max(k, settling.first_cycle[m]), max(len(starts) - 1, 0))
+    return out
 
 
 def periodic(cycle_max: np.ndarray, cycle_start: np.ndarray, names,
