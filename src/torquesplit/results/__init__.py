@@ -306,8 +306,10 @@ class Results:
                         groups))
         if definition == "cycle_peak":
             lsc = ls.cycle_peak(c_max, c_start, names, groups, st.first_cycle)
-        elif definition == "mean_force":  # (every group over the same span)
+        elif definition == "mean_force":  # (every group over the same span; a periodic
+            # state's groups over whole periods already)
             lsc = ls.mean_force(c_mean, c_cnt, c_start, names, groups,
+                                st.first_cycle if self.periodic else
                                 ls.common_first_cycle(st, c_start, names))
         else:
             lsc = ls.instantaneous(c_ratio, c_start, names, groups, st.first_cycle,

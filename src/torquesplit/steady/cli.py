@@ -325,10 +325,11 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
 
                 console.print(planet_table(planets, st.kinematics))
                 console.print(planet_text(planets), markup=False, highlight=False)
-            console.print("RMS TE: root mean square over the period of the mesh deflection "
-                          "about its mean (the elastic part of the dynamic transmission "
-                          "error, along the line of action; the geometric errors excite it "
-                          "but are not in it)", highlight=False)
+            console.print("RMS TE: root mean square over the period of the dynamic "
+                          "transmission error about its mean, along the line of action: the "
+                          "relative displacement of the flanks, elastic deflection and "
+                          "errors (tooth modifications, eccentricities) together, as a "
+                          "transmission-error measurement gives it", highlight=False)
             if step_check is not None:
                 from torquesplit.cli_support import render_step_check
 

@@ -175,6 +175,22 @@ class PeriodicProblem:
         return m
 
     # ---------------------------------------------------------------- evaluation
+    def line_errors(self, elements, t, speed=1.0) -> np.ndarray:
+        """The errors along the elements ``elements`` at the times ``t`` [m], (len(t),
+        len(elements)): constant plus every sinusoid (eccentricities, transmission
+        errors, an LTCA's loaded transmission error), their frequencies at ``speed``.
+        An element's deformation is ``V q - e``: its transmission error is the
+        deformation plus this."""
+        s = self.structure
+        t = np.asarray(t, dtype=float)
+        out = np.empty((t.size, len(elements)))
+        for j, e in enumerate(elements):
+            out[:, j] = s.error_constant[e]
+            for i in range(s.error_ptr[e], s.error_ptr[e + 1]):
+                out[:, j] += s.error_amplitude[i] * np.sin(s.error_omega[i] * speed * t
+                                                           + s.error_phase[i])
+        return out
+
     def accelerations(self, t, Y, speed=1.0):
         """(acceleration (N, n), element forces (N, ne), deformations (N, ne)) at the
         states ``Y`` (N, 2n) and times ``t`` (N,)."""

@@ -486,9 +486,10 @@ def shooting_point_metrics(cont: ShootingContinuation, x, s, track, groups, stat
               corners=True, track=track)
     f = r.track_forces[:-1]
     peak, mean = record_extremes(p, r, T, s, track, periodic=True)
+    t = np.arange(f.shape[0]) * (T / cont.steps)
     return _point_outputs(f, np.vstack([f, r.corner_forces[:, track]]),
-                          r.track_deformations[:-1], groups, static_forces, nominal,
-                          peak, mean)
+                          r.track_deformations[:-1] + p.line_errors(track, t, s), groups,
+                          static_forces, nominal, peak, mean)
 
 
 def record_extremes(p, r, span, speed, track, periodic):
@@ -534,7 +535,7 @@ def record_extremes(p, r, span, speed, track, periodic):
 def _point_outputs(f, f_all, d, groups, static_forces, nominal, peak, mean):
     """A sweep point's outputs per tracked mesh from its force samples ``f``, those and
     any instants between them ``f_all`` (the load-sharing ratio's extremes), the
-    deformation samples ``d``, the peak forces ``peak`` and mean forces ``mean``
+    transmission-error samples ``d`` (deformation plus error: ``V q``), the peak forces ``peak`` and mean forces ``mean``
     (:func:`record_extremes`): peak force, dynamic factors, load sharing (the ratio of
     the mean forces in its group, Dong et al. 2021 eq. 12, whatever the model's
     definition, and the largest instantaneous ratio, Ji & Li eq. 18), RMS
@@ -630,8 +631,9 @@ def point_metrics(hb: HarmonicBalance, x, s, track, groups, static_forces, nomin
         hb2, x2 = hb, x
     _, _, F, D, _, _ = hb2.residual_samples(x2, s)
     f = F[:, track]
+    te = D[:, track] + hb2.p.line_errors(track, hb2.times(s), s)
     # the samples' extremes (a truncated series rings between them: no parabola)
-    return _point_outputs(f, f, D[:, track], groups, static_forces, nominal,
+    return _point_outputs(f, f, te, groups, static_forces, nominal,
                           f.max(axis=0), f.mean(axis=0))
 
 
@@ -662,7 +664,8 @@ def stepped_sweep(problem, period, q_static, speeds, *, settle_periods=200,
             # integrators' statistics take them
             peaks[i] = record_extremes(p, r, record_periods * T, s, list(track),
                                        periodic=False)[0]
-            d = r.track_deformations
+            t = np.arange(r.track_deformations.shape[0]) * (T / steps)
+            d = r.track_deformations + p.line_errors(track, t, s)  # (the TE: V q)
             rms[i] = np.sqrt(np.mean((d - d.mean(axis=0)) ** 2, axis=0))
         if progress is not None:
             progress((i + 1) / len(speeds))
