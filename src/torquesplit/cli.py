@@ -1035,8 +1035,9 @@ def contact(
     load: Optional[list[str]] = typer.Option(
         None, "--load", help="Load: a normal force ('40 kN') or a torque ('17500 N m', on the "
         "gear named by --on); repeat for several.  Default: the operating load."),
-    on: Optional[str] = typer.Option(None, "--on", help="Gear a torque --load acts on "
-                                     "(default the driven gear)."),
+    on: Optional[list[str]] = typer.Option(
+        None, "--on", help="Gear a torque --load acts on (default the driven gear): once for "
+        "every --load, or once per --load, in their order."),
     plot: Optional[Path] = typer.Option(None, "--plot", help="Write the figures (PNG) into "
                                         "this folder.", metavar="DIR"),
     force: bool = _flag("--force", "Replace existing figures in the --plot folder."),
@@ -1078,6 +1079,7 @@ def _contact(model, pair, load, on, plot, force, positions, slices, harris, assi
         opts(_at_least, harris, 0, "--harris", "10")
         for text in load or []:  # (each with the other options and the model's problems)
             opts(_check_load_text, text)
+        ons = opts(_gear_per_load, on, load)
         opts.raise_any(model, assign)
         # (the advice to use the modifications in a dynamic run through 'ltca' is not
         # for the command that analyses them)
@@ -1098,8 +1100,8 @@ def _contact(model, pair, load, on, plot, force, positions, slices, harris, assi
             opts = replace(opts, positions=positions or opts.positions,
                            slices=slices or opts.slices)
         cm, op_load, names, reverse = contact_model_for_mesh(m, kin, pair, options=opts)
-        loads = [_contact_load(text, m, kin, pair, names, on, cm, parse_quantity)
-                 for text in (load or [])] or [op_load]
+        loads = [_contact_load(text, m, kin, pair, names, gear, cm, parse_quantity)
+                 for text, gear in zip(load or [], ons)] or [op_load]
         import numpy as np
 
         with ux.progress("loaded tooth contact analysis", as_json, total=None):
@@ -1148,17 +1150,22 @@ def _contact(model, pair, load, on, plot, force, positions, slices, harris, assi
                                             title=f"{m.model.name} {pair}", gear=names[1])
         except OSError as exc:
             failed = _figure_error(exc, "--plot", plot, "the tables are printed, nothing saved")
+    given = [f"{text} on {gear or kin.meshes[pair].driven}" if not _is_force(text) else text
+             for text, gear in zip(load or [], ons)] or None
     _print_contact(m, pair, names, op_load, cm, results, hm, impact, op, figures, plot,
-                   as_json, reverse, impact_note)
+                   as_json, reverse, impact_note, given)
     if failed is not None:
         _fail(failed)
 
 
 def _print_contact(m, pair, names, op_load, cm, results, hm, impact, op, figures, plot,
-                   as_json, reverse=False, impact_note=None) -> None:
+                   as_json, reverse=False, impact_note=None, given=None) -> None:
     """The loaded tooth contact analysis (or JSON); ``reverse``: the second gear (a ring)
-    drives; ``impact_note``: why there is no meshing-in impact."""
+    drives; ``impact_note``: why there is no meshing-in impact; ``given``: each load as
+    the command line gave it ('680 N m on wheel')."""
     rows = [r.summary() for r in results]
+    if given is not None:  # (what each load was given as, '680 N m on wheel')
+        rows = [{"given_as": g, **row} for row, g in zip(rows, given)]
     if as_json:
         ux.emit_json({
             "mesh": pair, "gears": list(names), "operating_load_N": op_load,
@@ -1182,11 +1189,14 @@ def _print_contact(m, pair, names, op_load, cm, results, hm, impact, op, figures
     # 2021 eq. 3: Z / (r_b2 cos beta_b))
     arcsec = f"TE p-p [arc s of {names[1]}]"
     t = Table(title="loaded tooth contact analysis (normal direction)")
-    for col in ("load [kN]", "TE mean [µm]", "TE p-p [µm]", arcsec, "k secant [N/µm]",
-                "k tangent [N/µm]", "p_H max [MPa]", "contact ratio"):
+    given = [""] * len(results) if given is None else given
+    for col in (["given as"] if any(given) else []) + [
+            "load [kN]", "TE mean [µm]", "TE p-p [µm]", arcsec, "k secant [N/µm]",
+            "k tangent [N/µm]", "p_H max [MPa]", "contact ratio"]:
         t.add_column(_h(col), justify="right")
-    for r, row in zip(results, rows):
-        t.add_row(f"{r.load / 1e3:#.5g}", f"{row['te_mean_m'] * 1e6:#.4g}",
+    for r, row, g in zip(results, rows, given):
+        t.add_row(*([g] if any(given) else []), f"{r.load / 1e3:#.5g}",
+                  f"{row['te_mean_m'] * 1e6:#.4g}",
                   f"{row['te_peak_to_peak_m'] * 1e6:#.4g}", f"{row['te_peak_to_peak_arcsec']:#.4g}",
                   f"{row['stiffness_secant_mean_N_per_m'] / 1e6:#.5g}",
                   f"{row['stiffness_tangent_mean_N_per_m'] / 1e6:#.5g}",
@@ -1236,6 +1246,28 @@ def _check_load_text(text: str) -> None:
         return
     raise OptionError(f"--load {text!r} is neither a force nor a torque; write e.g. '40 kN' "
                       f"or '17500 N m'")
+
+
+def _is_force(text: str) -> bool:
+    from .model.units import parse_quantity
+
+    try:
+        parse_quantity(text, "force")
+        return True
+    except ValueError:
+        return False
+
+
+def _gear_per_load(on, load) -> list:
+    """The gear of each --load (None: the default): one --on for all, or one per --load
+    (a repeated --on was silently the last one's, for every load)."""
+    load, on = list(load or []), list(on or [])
+    if len(on) > 1 and len(on) != len(load):
+        raise OptionError(f"--on is given {len(on)} times for {len(load)} --load values: give "
+                          f"it once (for every load) or once per --load, in their order")
+    if on and not load:
+        raise OptionError("--on names the gear a torque --load acts on; give the --load too")
+    return on * len(load) if len(on) == 1 else on or [None] * len(load)
 
 
 def _contact_load(text, model, kin, pair, names, on, cm, parse_quantity) -> float:

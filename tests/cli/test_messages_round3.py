@@ -167,3 +167,25 @@ def test_an_absurd_inertia_is_named_beside_the_statics_it_breaks(tmp_path):
                                       'polar_inertia = "600 kg m^2"'))  # kg mm^2 meant
     res = runner.invoke(app, ["check", str(path)])
     assert res.exit_code == 0 and "gears.wheel.polar_inertia: 600 kg m^2 is" in res.stderr
+
+
+def test_contact_takes_the_gear_of_each_torque_load(tmp_path):
+    """'--load "680 N m" --on wheel --load "340 N m" --on pinion' took the last --on for
+    both loads (the wheel's 680 N m read as 19.3 kN, twice the pinion's equal load): one
+    --on per --load, in their order; each row says what it was given as."""
+    import json
+
+    spur = tmp_path / "spur.toml"
+    spur.write_text(SPUR)
+    m = torquesplit.load_model(spur)
+    ratio = m.gears["wheel"].teeth / m.gears["pinion"].teeth  # (the same normal load)
+    res = runner.invoke(app, ["contact", str(spur), "--pair", "m", "--harris", "0", "--json",
+                              "--load", f"{20 * ratio} N m", "--on", "wheel",
+                              "--load", "20 N m", "--on", "pinion"])
+    assert res.exit_code == 0, res.output
+    rows = json.loads(res.stdout)["loads"]
+    assert rows[0]["load_N"] == pytest.approx(rows[1]["load_N"], rel=1e-12)
+    assert [r["given_as"] for r in rows] == [f"{20 * ratio} N m on wheel", "20 N m on pinion"]
+    bad = runner.invoke(app, ["contact", str(spur), "--pair", "m", "--load", "20 N m",
+                              "--on", "wheel", "--on", "pinion", "--on", "wheel"])
+    assert bad.exit_code == 2 and "--on is given 3 times for 1 --load" in bad.output
