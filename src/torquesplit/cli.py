@@ -1072,10 +1072,14 @@ def _contact(model, pair, load, on, plot, force, positions, slices, harris, assi
 
             opts(_check_plots_folder, plot, "--plot", names=contact_figure_files(harris > 0),
                  force=force)
-        opts(_at_least, positions, 4, "--positions", "64")
-        opts(_at_least, slices, 2, "--slices", "40")
-        for value, option, most in ((positions, "--positions", 4096), (slices, "--slices", 400)):
-            opts(_at_most, value, most, option)  # as the model file's ltca fields
+        from .model.schema_modifications import MAX_POSITIONS, MIN_POSITIONS
+
+        # the limits of the model file's fields (stiffness.ltca.positions, .slices)
+        opts(_at_least, positions, MIN_POSITIONS, "--positions", "64")
+        opts(_at_least, slices, 1, "--slices", "40")
+        for value, option, most in ((positions, "--positions", MAX_POSITIONS),
+                                    (slices, "--slices", 400)):
+            opts(_at_most, value, most, option)
         opts(_at_least, harris, 0, "--harris", "10")
         for text in load or []:  # (each with the other options and the model's problems)
             opts(_check_load_text, text)
@@ -1097,8 +1101,13 @@ def _contact(model, pair, load, on, plot, force, positions, slices, harris, assi
         if positions is not None or slices is not None:
             from dataclasses import replace
 
+            from .model.checks import lead_slices_note
+
             opts = replace(opts, positions=positions or opts.positions,
                            slices=slices or opts.slices)
+            note = lead_slices_note(m, pair, opts.slices, "--slices") if slices else ""
+            if note:  # (as the model file's slices warns)
+                ux.warn(f"--slices {slices}: {note}")
         cm, op_load, names, reverse = contact_model_for_mesh(m, kin, pair, options=opts)
         loads = [_contact_load(text, m, kin, pair, names, gear, cm, parse_quantity)
                  for text, gear in zip(load or [], ons)] or [op_load]

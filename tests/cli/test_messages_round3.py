@@ -189,3 +189,24 @@ def test_contact_takes_the_gear_of_each_torque_load(tmp_path):
     bad = runner.invoke(app, ["contact", str(spur), "--pair", "m", "--load", "20 N m",
                               "--on", "wheel", "--on", "pinion", "--on", "wheel"])
     assert bad.exit_code == 2 and "--on is given 3 times for 1 --load" in bad.output
+
+
+def test_contact_takes_the_model_files_limits_and_warnings(tmp_path):
+    """--positions 4 ran where the model file's ltca.positions refuses fewer than 8,
+    --slices 1 was refused where the file accepts it, and --slices 2 did not warn that a
+    crowned lead is not resolved, as the file's slices = 2 does."""
+    from model_texts import RELIEVED_SPUR_LTCA
+
+    spur = tmp_path / "spur.toml"
+    spur.write_text(RELIEVED_SPUR_LTCA)
+    few = runner.invoke(app, ["contact", str(spur), "--pair", "m", "--positions", "4"])
+    assert few.exit_code == 2 and "--positions must be a whole number of at least 8" \
+        in few.output
+    res = runner.invoke(app, ["contact", str(spur), "--pair", "m", "--slices", "2",
+                              "--positions", "16", "--harris", "0"])
+    assert res.exit_code == 0, res.output
+    assert ("warning: --slices 2: 2 slice(s) across the face cannot resolve the lead "
+            "modification of pinion") in res.stderr
+    one = runner.invoke(app, ["contact", str(spur), "--pair", "m", "--slices", "1",
+                              "--positions", "16", "--harris", "0"])
+    assert one.exit_code == 0, one.output

@@ -451,6 +451,21 @@ MODIFICATIONS_UNUSED = ("a dynamic run uses tooth modifications only through the
 LEAD_SLICES = 5
 
 
+def lead_slices_note(model: Model, mesh: str, slices: int, option: str) -> str:
+    """Why ``slices`` across the face of mesh ``mesh`` leave its gears' lead modifications
+    unresolved ('' when they resolve them or there are none); ``option`` names the setting
+    in the remedy (``slices``, ``--slices``), so that a model file and ``contact`` say the
+    same."""
+    lead = [g for g in model.meshes[mesh].gears if model.gears[g].modifications is not None
+            and (model.gears[g].modifications.crowning > 0
+                 or model.gears[g].modifications.end_relief is not None)]
+    if not lead or slices >= LEAD_SLICES:
+        return ""
+    return (f"{slices} slice(s) across the face cannot resolve the lead modification of "
+            f"{', '.join(lead)} (crowning, end relief): the LTCA sees an unmodified lead; "
+            f"give {option} >= {LEAD_SLICES} (default 40)")
+
+
 #: an error, backlash or bearing clearance beyond this many modules (the whole tooth depth,
 #: 2.25 m_n) takes the teeth out of mesh: refused, not warned (a reviewer's 20 m
 #: eccentricity, a unit slip, ran with back-flank forces of 3e5 kN)
@@ -548,14 +563,10 @@ def plausibility_warnings(model: Model, kin) -> list[tuple[str, str]]:
                              f"stiffness.method = 'ltca' on {meshes} or remove the "
                              f"modifications"))
     for name, m in model.meshes.items():
-        lead = [g for g in m.gears if model.gears[g].modifications is not None
-                and (model.gears[g].modifications.crowning > 0
-                     or model.gears[g].modifications.end_relief is not None)]
-        if m.stiffness.method == "ltca" and lead and m.stiffness.slices < LEAD_SLICES:
-            out.append((f"meshes.{name}.stiffness.slices", (
-                f"{m.stiffness.slices} slice(s) across the face cannot resolve the lead "
-                f"modification of {', '.join(lead)} (crowning, end relief): the LTCA "
-                f"sees an unmodified lead; give slices >= {LEAD_SLICES} (default 40)")))
+        if m.stiffness.method == "ltca":
+            note = lead_slices_note(model, name, m.stiffness.slices, "slices")
+            if note:
+                out.append((f"meshes.{name}.stiffness.slices", note))
         if m.stiffness.method != "ltca" and m.misalignment != type(m.misalignment)():
             out.append((f"meshes.{name}.misalignment",
                         "only the stiffness method 'ltca' uses the misalignment; set "

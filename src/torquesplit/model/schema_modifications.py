@@ -144,10 +144,15 @@ class MisalignmentSpec(Strict):
         "gear's tip, as tooth deflection does); < 0 delays it."))
 
 
+#: the mesh positions an LTCA takes (``ltca.positions``, ``contact --positions``)
+MIN_POSITIONS, MAX_POSITIONS = 8, 4096
+
+
 class LtcaSpec(Strict):
     """Options of the loaded tooth contact analysis of a mesh (stiffness method 'ltca')."""
 
-    positions: Count = Field(64, ge=8, le=4096, description="Mesh positions over one mesh cycle.")
+    positions: Count = Field(64, ge=MIN_POSITIONS, le=MAX_POSITIONS,
+                             description="Mesh positions over one mesh cycle.")
     contact_model: Literal["weber", "linear"] = Field(
         "weber", description="Hertzian contact of a slice: load dependent (Weber 1949 / Johnson "
         "1985) or linear (Yang & Lin 1987, as the potential-energy method).")
