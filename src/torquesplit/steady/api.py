@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from torquesplit.errors import OptionError, SolverError, warn_user
+from torquesplit.errors import ModelWarning, OptionError, SolverError, warn_user
 from torquesplit.solve.kernel_data import continuous_start
 from torquesplit.steady.period import (
     base_frequency,
@@ -415,6 +415,11 @@ def steady_state(model, *, method: str = "auto", harmonics: int | None = None,
                           "instead, or give a mesh a stiffness variation or an error.")
     if adaptive is None:
         adaptive = harmonics is None
+    from torquesplit.steady.solution import undamped_note
+
+    note = undamped_note(structure, static.q)
+    if note:
+        warn_user(note, ModelWarning)
     problem = periodic_problem(model, kin, structure, per.frequency)
     sol = periodic_solution(structure, per, method=method, harmonics=harmonics,
                             samples=samples, speed=factor, q_static=static.q, initial=initial,

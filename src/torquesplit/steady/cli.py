@@ -291,9 +291,11 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
                 console.print("stability: not meaningful (the periodic state did not "
                               "converge; the table is the last iterate's)")
             elif mu is not None:
-                console.print(f"stability ({ps.stability_method}): "
-                              f"{'stable' if ps.stable else 'UNSTABLE'}, largest Floquet "
-                              f"multiplier |mu| = {abs(mu[0]):.6f}", highlight=False)
+                state = ("stable, but only marginally (a multiplier on the unit circle: a "
+                         "mode without damping, see the warning; any change can make it "
+                         "unstable)" if ps.marginal else "stable" if ps.stable else "UNSTABLE")
+                console.print(f"stability ({ps.stability_method}): {state}, largest Floquet "
+                              f"multiplier |mu| = {abs(mu[0]):.6g}", highlight=False)
                 if kind:
                     console.print(f"[yellow]{_INSTABILITY[kind]}[/]"
                                   + (f" (--keep {ps.frequency / 2:.9g})"
@@ -433,6 +435,7 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
             "max_dynamic_factor_of": "the stable points of the branch (unstable ones are "
                                      "not observable)",
             "unstable_points": int((~ds["stable"].values).sum()),
+            "marginal_points": _marginal(ds),
             "period_doubling_rpm": _runs(ds, ds["instability"].values == "period doubling"),
             "max_contact_loss": _largest_loss(ds),
             "wall_time_s": ds.attrs["wall_time_s"],
@@ -463,7 +466,9 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
                 console.print("turning points (jump speeds): " + ", ".join(
                     f"{f:.5g} rpm ({k})" for f, k in zip(summary["fold_speeds_rpm"],
                                                         ds.attrs["fold_kinds"], strict=True)))
-            t = Table(title="largest dynamic factor over the stable points of the sweep"
+            t = Table(title=("largest dynamic factor of the sweep (stability not computed)"
+                             if no_stability else
+                             "largest dynamic factor over the stable points of the sweep")
                           + (" and the time integrations" if cross_check else ""))
             cols = ["mesh", "DF (peak/static)", "at [rpm]"]
             cols += ["run-up DF", "at [rpm]", "run-down DF", "at [rpm]"] if cross_check else []
@@ -480,8 +485,18 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
                               "means: " + "; ".join(dropped) + ": the rows of those meshes "
                               "leave out their own excitation (run 'steady' without --keep "
                               "at a speed for their full response)", highlight=False)
-            console.print(f"unstable points: {summary['unstable_points']} (dashed in the "
-                          f"figure; left out of the largest dynamic factor)")
+            if no_stability:
+                console.print("stability: not computed (--no-stability): every point is "
+                              "taken, an unstable one too")
+            else:
+                console.print(f"unstable points: {summary['unstable_points']} (dashed in the "
+                              f"figure; left out of the largest dynamic factor)")
+                if summary["marginal_points"]:
+                    console.print(
+                        f"[yellow]marginally stable points: {summary['marginal_points']}[/] "
+                        f"(a Floquet multiplier on the unit circle: a mode without damping, "
+                        f"see the warning); their dynamic factors are those of an undamped "
+                        f"resonance, not a design value", highlight=False)
             for a, b in summary["period_doubling_rpm"]:
                 where = f"at {a:.6g}" if a == b else f"between {a:.6g} and {b:.6g}"
                 console.print(f"[yellow]period doubling[/] {where} rpm (a "
@@ -507,6 +522,17 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
 
 
 import numpy as np  # noqa: E402  (used by the commands above)
+
+
+def _marginal(ds) -> int:
+    """Stable points whose largest Floquet multiplier is within MARGINAL_TOL of 1."""
+    from torquesplit.steady.solution import MARGINAL_TOL
+
+    if "max_multiplier" not in ds:
+        return 0
+    mu = np.asarray(ds["max_multiplier"].values, float)
+    stable = np.asarray(ds["stable"].values, bool)
+    return int((stable & (mu >= 1 - MARGINAL_TOL)).sum())
 
 
 def _runs(ds, flag) -> list[list[float]]:

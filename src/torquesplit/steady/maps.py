@@ -69,6 +69,40 @@ def _prepare(model, keep, max_cycles):
     return model, kin, structure, dropped, per, static
 
 
+def _message_in_rpm(msg: str, w_ref: float, pts, s1: float, complete: bool) -> str:
+    """The continuation's message with its speed factors in rpm; a sweep stopped by its
+    point limit says where it stopped against the end asked for, and why it crawls (a
+    reviewer's 20 points became 2000, the last 1100 within 4 rpm of an undamped
+    resonance, told only 'stopped after 2000 points; curve kept')."""
+    import re
+
+    msg = re.sub(r"speed factor ([-+0-9.eE]+)",
+                 lambda m: f"{float(m.group(1)) * w_ref * RPM:.6g} rpm", msg)
+    if not complete and msg.startswith("stopped after") and pts:
+        mu = pts[-1].max_multiplier
+        near = (f" and the largest Floquet multiplier approaches 1 (|mu| = {mu:.6g} at the "
+                f"last point): the edge of a parametric instability, or the resonance of a "
+                f"mode without damping (see the warnings), where the periodic state grows "
+                f"without bound; past it 'torquesplit run' at those speeds gives the "
+                f"response" if math.isfinite(mu) and mu > 0.99 else
+                ": the periodic state changes fast with speed there")
+        msg = (msg.rstrip(".").replace("; curve kept", "") + f" at "
+               f"{pts[-1].speed * w_ref * RPM:.6g} rpm, short of the {s1 * w_ref * RPM:.6g} "
+               f"rpm asked (the curve up to there is kept): the continuation's steps shrank "
+               f"as the response grew{near}")
+    return msg
+
+
+def _warn_undamped(structure, q) -> None:
+    """The modes without damping, as steady_state says them
+    (:func:`~torquesplit.steady.solution.undamped_note`)."""
+    from torquesplit.steady.solution import undamped_note
+
+    note = undamped_note(structure, q)
+    if note:
+        warn_user(note, ModelWarning)
+
+
 def sweep_speed(model, start: float, stop: float, *, points: int = 50,
                 harmonics: int | None = None, samples: int | None = None, keep=None,
                 max_cycles: int | None = MAX_CYCLES, stability: bool = True,
@@ -128,6 +162,7 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
                           f"default")
     t_start = time.perf_counter()
     model, kin, s, dropped, per, static = _prepare(model, keep, max_cycles)
+    _warn_undamped(s, static.q)
     sub = math.gcd(*[int(k) for k in per.orders]) if per.orders else 1
     w_ref = reference_speed(model)
     s0, s1 = _rad_per_s(start, "start") / w_ref, _rad_per_s(stop, "stop") / w_ref
@@ -147,6 +182,7 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
         hb, pts, folds, msg, complete, _ = continue_in_speed(
             problem, per, static.q, s0, s1, points=points, harmonics=harmonics,
             samples=samples, stability=stability, max_step=step_max, progress=progress)
+    msg = _message_in_rpm(msg, w_ref, pts, s1, complete)
     mesh_names = list(model.meshes)
     names = list(s.element_names)
     track = [names.index(m) for m in mesh_names]
@@ -186,8 +222,8 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
                              "(Ji & Li eq. 18)"}),
             "rms_transmission_error": (("point", "mesh"), stack("rms_transmission_error"),
                                        {"units": "m", "long_name": "RMS dynamic "
-                                        "transmission error (mesh deflection about its "
-                                        "mean)"}),
+                                        "transmission error about its mean (the flanks' "
+                                        "relative displacement, errors included)"}),
             "peak_force": (("point", "mesh"), stack("peak_force"),
                            {"units": "N", "long_name": "peak mesh force"}),
             "mean_force": (("point", "mesh"), stack("mean_force"),
@@ -224,6 +260,7 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
         samples=cont.steps if method == "shooting" else hb.N,
         fundamental_frequency_at_model_speed_Hz=per.frequency,
         complete=int(complete), message=msg,
+        requested_speeds_rpm=[s0 * w_ref * RPM, s1 * w_ref * RPM],
         fold_speeds_rpm=[f * w_ref * RPM for f, _ in folds],
         fold_kinds=[k for _, k in folds],
         kept_excitations="all" if keep is None else str(keep),

@@ -62,8 +62,21 @@ def sweep_figure(ds, variables=None):
                             height_ratios=[2.6] * len(variables) + [0.1 + 0.12 * len(groups)])
     axes = [fig.add_subplot(grid[0])]
     axes += [fig.add_subplot(grid[i], sharex=axes[0]) for i in range(1, len(variables))]
+    asked = ds.attrs.get("requested_speeds_rpm")
+    if isinstance(asked, str):  # (a file's attribute: the list as JSON)
+        import json
+
+        asked = json.loads(asked)
+    stopped = (not int(ds.attrs.get("complete", 1)) and asked is not None
+               and len(asked) == 2 and rpm.size)
     for n, (ax, variable) in enumerate(zip(axes, variables)):
         _sweep_panel(ax, ds, variable)
+        if stopped:  # the range asked that the sweep did not reach, said on the figure
+            a, b = sorted(asked)
+            gap = (float(rpm[-1]), b) if rpm[-1] >= rpm[0] else (a, float(rpm[-1]))
+            ax.axvspan(*gap, color="0.85", alpha=0.6, lw=0,
+                       label="not computed: the sweep stopped\n(see its message)"
+                       if n == 0 else None)
         for f in ds.attrs.get("fold_speeds_rpm", []):
             ax.axvline(f, color="k", lw=0.8, ls=":")
         for k, (c, _) in enumerate(groups):
@@ -101,9 +114,12 @@ def sweep_figure(ds, variables=None):
         except ValueError:
             dropped = [dropped]
     note = f"\nreplaced by their means: {'; '.join(dropped)}" if dropped else ""
-    axes[0].set_title(f"{ds.attrs.get('model', '')}: speed response (solid stable, dashed "
-                      f"unstable, dotted: turning points, grey: critical speeds){note}",
-                      fontsize=9, pad=16)
+    import textwrap
+
+    title = (f"{ds.attrs.get('model', '')}: speed response (solid stable, dashed unstable, "
+             f"dotted: turning points, grey: critical speeds)")
+    # (wrapped: a long model name ran the title off the figure's left edge)
+    axes[0].set_title(textwrap.fill(title, 80) + note, fontsize=9, pad=16)
     return fig
 
 
@@ -130,9 +146,16 @@ def _sweep_panel(ax, ds, variable):
     rpm = ds["speed_rpm"].values
     stable = ds["stable"].values
     _, scale = _SWEEP_AXES.get(variable, ("", 1.0))
+    drawn = []  # (values, first line): a curve equal to one drawn joins its label
     for j, mesh in enumerate(ds["mesh"].values):
         y = ds[variable].values[:, j] * scale
+        same = next((ln for yy, ln in drawn
+                     if np.allclose(y, yy, rtol=1e-9, atol=0.0, equal_nan=True)), None)
+        if same is not None:  # (identical planets: eight entries over one line)
+            same.set_label(f"{same.get_label()}, {mesh}")
+            continue
         line = None
+        first = None
         # one polyline per run of stable (or unstable) segments: a dash pattern drawn
         # segment by segment restarts at every point and looks solid
         seg = [bool(stable[k] and stable[k + 1]) for k in range(len(rpm) - 1)]
@@ -144,7 +167,10 @@ def _sweep_panel(ax, ds, variable):
             (line,) = ax.plot(rpm[k:e + 2], y[k:e + 2], "-" if seg[k] else "--",
                               color=None if line is None else line.get_color(),
                               label=str(mesh) if k == 0 else None, lw=1.3)
+            first = first or line
             k = e + 1
+        if first is not None:
+            drawn.append((y, first))
         colour = line.get_color() if line is not None else None
         if j == 0 and "instability" in ds:  # where the response is not on the curve
             from torquesplit.steady.sweep import flag_runs

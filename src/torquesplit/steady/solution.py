@@ -32,6 +32,37 @@ log = logging.getLogger(__name__)
 
 STABILITY_TOL = 1e-6
 """A periodic state is stable when every Floquet multiplier has |mu| <= 1 + this."""
+MARGINAL_TOL = 1e-5
+"""... and only marginally so when the largest is within this of 1 (a mode without
+damping: its multipliers sit on the unit circle, where any change can take them out)."""
+UNDAMPED = 1e-6
+"""A mode whose modal damping ratio is below this has no damping (:func:`undamped_note`)."""
+
+
+def undamped_note(structure, q) -> str:
+    """A warning naming the modes without damping (modal damping ratio below
+    :data:`UNDAMPED`) and the element with the largest share of each one's strain energy,
+    or '': their periodic response is marginally stable and unbounded at their resonances
+    (a reviewer's speed sweep crawled into one for 1100 points, to a dynamic factor of 85,
+    reported as the stable maximum; split_path_planetary_differential's pinion_b support
+    has no damping)."""
+    from torquesplit.solve.modal import modal_analysis
+
+    try:
+        sol = modal_analysis(structure, q)
+    except Exception:  # noqa: BLE001 - a note, never a reason to stop the analysis
+        return ""
+    idle = [i for i, (f, z) in enumerate(zip(sol.frequencies, sol.damping_ratios))
+            if f > 0 and abs(z) < UNDAMPED]
+    if not idle:
+        return ""
+    said = "; ".join(f"mode {i + 1} ({sol.frequencies[i]:.6g} Hz, "
+                     f"{100 * sol.dominant_elements(i, 1)[0][1]:.0f} % of its strain energy in "
+                     f"{sol.dominant_elements(i, 1)[0][0]})" for i in idle[:4])
+    more = f" and {len(idle) - 4} more" if len(idle) > 4 else ""
+    return (f"{len(idle)} mode(s) without damping: {said}{more}: a periodic state is at "
+            f"best marginally stable (|mu| = 1) and grows without bound at their "
+            f"resonances; give the elements they load a damping ratio")
 HARMONICS_PER_CYCLE = 8
 """Harmonics per cycle of the fastest excitation to start from (raised until converged)."""
 ENERGY_TOL = 1e-7
@@ -151,6 +182,12 @@ class PeriodicSolution:
         if self.multipliers is None:
             return None
         return bool(np.max(np.abs(self.multipliers), initial=0.0) <= 1 + STABILITY_TOL)
+
+    @property
+    def marginal(self) -> bool:
+        """Stable, but with a multiplier within :data:`MARGINAL_TOL` of the unit circle."""
+        return bool(self.stable and np.max(np.abs(self.multipliers), initial=0.0)
+                    >= 1 - MARGINAL_TOL)
 
     @property
     def y0(self) -> np.ndarray:
