@@ -74,3 +74,18 @@ def test_a_stopped_sweep_says_where_in_rpm_and_why():
     assert "|mu| = 0.9961" in msg and "parametric instability" in msg
     assert _message_in_rpm("tangent failed at speed factor 0.5 (x)", w_ref, pts, 1.1,
                            False) == "tangent failed at 1500 rpm (x)"
+
+
+def test_steady_says_a_critical_speed_at_its_own_speed():
+    """'run ji_li_mill_drive' warned of the critical speed 0.24 % below 745 rpm and
+    'steady' did not; at another speed, it judges that speed."""
+    from typer.testing import CliRunner
+
+    from torquesplit.cli import app
+
+    runner = CliRunner()
+    res = runner.invoke(app, ["steady", "ji_li_mill_drive"])
+    assert res.exit_code == 0, res.output
+    assert "the speed (745 rpm) is 0.24 % above a critical speed (743.25 rpm)" in res.stderr
+    far = runner.invoke(app, ["steady", "ji_li_mill_drive", "--speed", "700 rpm"])
+    assert far.exit_code == 0 and "critical speed" not in far.stderr

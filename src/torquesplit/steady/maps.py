@@ -686,7 +686,8 @@ mean stiffness (a helical pair's high orders, 1e-4 and below, drive next to noth
 
 
 def near_critical_speeds(model, structure, q, kinematics, within: float = NEAR_CRITICAL,
-                         least_harmonic: float = DRIVING_HARMONIC) -> list[tuple[str, str]]:
+                         least_harmonic: float = DRIVING_HARMONIC,
+                         speed: float | None = None) -> list[tuple[str, str]]:
     """The critical speeds (:func:`critical_speeds`: a mesh order or a shaft order
     meeting a natural frequency of the structure linearised about ``q``) within
     ``within`` of the model's own speed, driven by a stiffness harmonic of at least
@@ -696,8 +697,10 @@ def near_critical_speeds(model, structure, q, kinematics, within: float = NEAR_C
     critical speed where order 3 of its stage-2 mesh meets a support mode (71.45 Hz, the
     largest line of its support-force spectrum), and ``run`` said nothing of it.  The
     frequencies are those at the model's speed (a turning carrier's move by far less than
-    ``within`` across the band).  Empty for a model without a speed."""
-    w = reference_speed(model)
+    ``within`` across the band).  ``speed`` [rad/s]: another input speed to judge (a
+    steady state solved at one), default the model's.  Empty for a model without a
+    speed."""
+    w = reference_speed(model) if speed is None else float(speed)
     if not (w > 0 and math.isfinite(w)):
         return []
     crossings = critical_speeds(structure, q, kinematics, model, (1.0 - within) * w,
