@@ -89,3 +89,33 @@ def test_steady_says_a_critical_speed_at_its_own_speed():
     assert "the speed (745 rpm) is 0.24 % above a critical speed (743.25 rpm)" in res.stderr
     far = runner.invoke(app, ["steady", "ji_li_mill_drive", "--speed", "700 rpm"])
     assert far.exit_code == 0 and "critical speed" not in far.stderr
+
+
+def test_steady_and_sweep_options_said_in_their_own_words(tmp_path):
+    """--harmonics with --method shooting was ignored; a zero-width sweep range was said in
+    'times the model's speed'; a reversed Campbell range was refused where the sweep takes
+    one; sweep-speed refused a .jpg figure that modes --campbell writes, calling it
+    'results'; shooting printed its one residual three times."""
+    from typer.testing import CliRunner
+
+    from torquesplit.cli import app
+
+    runner = CliRunner()
+    both = runner.invoke(app, ["steady", "ji_li_mill_drive", "--harmonics", "8", "--method",
+                               "shooting"])
+    assert both.exit_code == 2 and "--harmonics 8 sets the harmonic balance" in both.output
+    flat = runner.invoke(app, ["sweep-speed", "ji_li_mill_drive", "--from", "500 rpm", "--to",
+                               "500 rpm"])
+    assert flat.exit_code == 2 and "the speed range 500..500 rpm must be" in flat.output
+    bad = runner.invoke(app, ["sweep-speed", "ji_li_mill_drive", "--from", "500 rpm", "--to",
+                              "600 rpm", "--plot", str(tmp_path / "y.xyz")])
+    assert bad.exit_code == 2 and "cannot save the figure as 'y.xyz'" in bad.output
+    assert ".jpg" in bad.output
+    from torquesplit.steady.maps import campbell
+
+    up = campbell("ji_li_mill_drive", "600 rpm", "800 rpm", points=3)[1]
+    down = campbell("ji_li_mill_drive", "800 rpm", "600 rpm", points=3)[1]
+    assert [c["speed_rpm"] for c in up] == [c["speed_rpm"] for c in down] and up
+    one = runner.invoke(app, ["steady", "ji_li_mill_drive"])
+    assert "one-period integration defect" in one.stdout
+    assert "midpoint residual" not in one.stdout  # (shooting: the one number, once)

@@ -149,6 +149,15 @@ def _keep(keep):
     return keep
 
 
+def _harmonics_need_hb(harmonics, method: str) -> None:
+    """--harmonics sets the harmonic balance: refused with --method shooting (it was
+    ignored without a word)."""
+    if harmonics is not None and method == "shooting":
+        raise OptionError(f"--harmonics {harmonics} sets the harmonic balance; --method "
+                          f"shooting integrates in time and takes none: leave one of them "
+                          f"out (--method hb, or no --harmonics)")
+
+
 def register(app, load, fail, console, err_console, json_default, set_help=""):
     """Add the commands to ``app`` (helpers of :mod:`torquesplit.cli` passed in; ``load``
     takes the model argument and the ``--set`` assignments)."""
@@ -201,6 +210,7 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
                 opts(_check_count, value, option, example)
             opts(_check_positive_speed, speed, "--speed", "'3000 rpm'")
             opts(_check_out, out, force=force)
+            opts(_harmonics_need_hb, harmonics, method)
             opts.raise_any(model, assign)
             from torquesplit.steady.api import steady_state
 
@@ -283,12 +293,17 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
                               "means: " + "; ".join(st.dropped_text())
                               + ": the rows of those meshes leave out their own excitation",
                               highlight=False)
-            console.print(
-                f"residual {ps.residual:.2e}, time-domain: midpoint residual "
-                f"{ps.time_residual:.2e}, one-period integration defect "
-                f"{ps.periodicity_defect:.2e}"
-                + (f"; harmonics {ps.harmonics} (top-quarter energy "
-                   f"{ps.top_harmonic_energy:.1e})" if ps.harmonics else ""))
+            if ps.method == "hb":  # three independent checks
+                console.print(
+                    f"residual {ps.residual:.2e}, time-domain: midpoint residual "
+                    f"{ps.time_residual:.2e}, one-period integration defect "
+                    f"{ps.periodicity_defect:.2e}"
+                    + (f"; harmonics {ps.harmonics} (top-quarter energy "
+                       f"{ps.top_harmonic_energy:.1e})" if ps.harmonics else ""))
+            else:  # (shooting's residual is its one-period defect: one number, said once)
+                console.print(f"one-period integration defect {ps.residual:.2e} (the "
+                              f"shooting residual: the state after one period against the "
+                              f"start, over the largest deformation)", highlight=False)
             if not ps.converged:
                 console.print("stability: not meaningful (the periodic state did not "
                               "converge; the table is the last iterate's)")
@@ -376,7 +391,8 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
             "excitation (default 100, refined for the highest mode).", metavar="N"),
         out: Optional[Path] = typer.Option(None, "--out", help="Write the curves: .nc, .mat or "
                                            ".csv (a row per speed)."),
-        plot: Optional[Path] = typer.Option(None, "--plot", help="Write the figure (.png/.svg)."),
+        plot: Optional[Path] = typer.Option(None, "--plot", help="Write the figure (.png, .svg, "
+                                            ".pdf or another format matplotlib writes)."),
         force: bool = typer.Option(False, "--force", help="Replace existing --out / --plot "
                                    "files."),
         as_json: bool = json_option("Print a summary as JSON."),
@@ -393,6 +409,7 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
             opts(_check_steps_per_cycle, steps_per_cycle)
             opts(_check_count, points, "--points", "50")
             opts(_check_count, harmonics, "--harmonics", "16")
+            opts(_harmonics_need_hb, harmonics, method)
             opts(_check_count, max_cycles, "--max-cycles", "1000")
             for text, option in ((start, "--from"), (stop, "--to")):
                 opts(_check_positive_speed, text, option, "'1000 rpm'")
@@ -400,7 +417,9 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
             if out is not None:  # (the CSV tables: per speed, per run-up/-down speed)
                 opts(check_dataset_output, out, ("point", "check"), overwrite=force)
             if plot is not None:
-                opts(_check_out, plot, {".png": "png", ".svg": "svg", ".pdf": "pdf"}, force)
+                from torquesplit import cli as ui  # (every figure option takes the same)
+
+                opts(ui._check_figure_file, plot, "--plot", force)
             opts.raise_any(model, assign)
             m, _ = load(model, assign)
             from torquesplit.cli_support import collect_warnings, progress

@@ -166,6 +166,10 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
     sub = math.gcd(*[int(k) for k in per.orders]) if per.orders else 1
     w_ref = reference_speed(model)
     s0, s1 = _rad_per_s(start, "start") / w_ref, _rad_per_s(stop, "stop") / w_ref
+    if not (s0 > 0 and s1 > 0 and math.isfinite(s0) and math.isfinite(s1)) or s0 == s1:
+        raise OptionError(f"the speed range {s0 * w_ref * RPM:.6g}..{s1 * w_ref * RPM:.6g} rpm "
+                          f"must be two different positive speeds; e.g. --from '1000 rpm' "
+                          f"--to '3000 rpm'")
     if per.frequency <= 0:
         raise SolverError("the model has no time-varying excitation: its response does not "
                           "change with speed; nothing to sweep.")
@@ -588,11 +592,11 @@ def campbell(model, start: float, stop: float, *, points: int = 41,
         raise OptionError(f"points must be a whole number >= 2, got {points!r}")
     model, kin, s, _, _, static = _prepare(model, None, None)
     w_ref = reference_speed(model)
-    lo, hi = _rad_per_s(start, "start"), _rad_per_s(stop, "stop")
+    lo, hi = sorted((_rad_per_s(start, "start"), _rad_per_s(stop, "stop")))  # (a map: the
+    # range either way round, as sweep_speed takes it)
     if not (lo > 0 and hi > lo and math.isfinite(hi)):
-        rpm = 60.0 / (2.0 * math.pi)
-        raise OptionError(f"the speed range {lo * rpm:.6g}..{hi * rpm:.6g} rpm must be "
-                          f"increasing and positive; e.g. --from '1000 rpm' --to '3000 rpm'.")
+        raise OptionError(f"the speed range {lo * RPM:.6g}..{hi * RPM:.6g} rpm must be two "
+                          f"different positive speeds; e.g. --from '1000 rpm' --to '3000 rpm'.")
     speeds = np.linspace(lo, hi, points)
     if s.n_gyroscopic:
         freqs = []
