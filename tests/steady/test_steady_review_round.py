@@ -119,3 +119,20 @@ def test_steady_and_sweep_options_said_in_their_own_words(tmp_path):
     one = runner.invoke(app, ["steady", "ji_li_mill_drive"])
     assert "one-period integration defect" in one.stdout
     assert "midpoint residual" not in one.stdout  # (shooting: the one number, once)
+
+
+def test_campbell_counts_the_crossings_the_model_drives():
+    """Lin & Parker's stage (constant mesh stiffness, no errors) reported '4 critical'
+    without saying that nothing in the model drives them."""
+    from typer.testing import CliRunner
+
+    from torquesplit.cli import app
+    from torquesplit.steady.maps import campbell, driven
+
+    res = CliRunner().invoke(app, ["modes", "lin_parker1999_planetary", "--campbell",
+                                   "--from", "100 rpm", "--to", "2000 rpm"])
+    assert res.exit_code == 0, res.output
+    text = " ".join(res.stdout.split())
+    assert "0 of 3 driven by at least 1 % (k harmonic or error)" in text, text[:400]
+    _, crossings = campbell("ji_li_mill_drive", "700 rpm", "800 rpm", points=3)
+    assert any(driven(c) for c in crossings)  # (its 10 % stiffness wave drives some)

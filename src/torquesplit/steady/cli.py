@@ -672,10 +672,15 @@ def campbell_command(m, start, stop, plot, as_json, console, json_default, out=N
         return
     phased = any("suppressed" in c for c in crossings)
     lo, hi = (_speed_text(x) for x in (start, stop))
+    from torquesplit.steady.maps import DRIVING_HARMONIC, driven
+
+    n_driven = sum(driven(c, DRIVING_HARMONIC) for c in critical)
     t = Table(title=f"critical speeds between {lo} and {hi}" + (
         f" ({len(critical)} critical; {len(suppressed)} crossings that the planets' mesh "
         f"phasing leaves unexcited, Parker & Lin 2004, marked 'suppressed')" if phased
-        else ""))
+        else "") + f"; {n_driven} of {len(critical)} driven by at least "
+        f"{100 * DRIVING_HARMONIC:g} % (k harmonic or error): the others only by what the "
+        f"model leaves out")
     cols = ["speed [rpm]", "mode", "f [Hz]", "excitation", "k harmonic [%]", "error [%]"]
     cols += ["mode type", "phasing"] if phased else []
     for col in cols + ["strain energy (largest shares)"]:

@@ -689,6 +689,14 @@ DRIVING_HARMONIC = 0.01
 mean stiffness (a helical pair's high orders, 1e-4 and below, drive next to nothing)."""
 
 
+def driven(crossing: dict, least: float = DRIVING_HARMONIC) -> bool:
+    """Whether the model drives a crossing: a stiffness harmonic or an error force of at
+    least ``least`` (:func:`critical_speeds`' ``stiffness_harmonic``, ``error_share``);
+    one it does not drive resonates only through what the model leaves out."""
+    return (crossing.get("stiffness_harmonic", 0.0) >= least
+            or crossing.get("error_share", 0.0) >= least)
+
+
 def near_critical_speeds(model, structure, q, kinematics, within: float = NEAR_CRITICAL,
                          least_harmonic: float = DRIVING_HARMONIC,
                          speed: float | None = None) -> list[tuple[str, str]]:
@@ -710,17 +718,16 @@ def near_critical_speeds(model, structure, q, kinematics, within: float = NEAR_C
     crossings = critical_speeds(structure, q, kinematics, model, (1.0 - within) * w,
                                 (1.0 + within) * w, None)["crossings"]
     # (a crossing the planets' mesh phasing leaves unexcited is none: Parker & Lin 2004)
-    driven = sorted((c for c in crossings if not c.get("suppressed") and (
-        c.get("stiffness_harmonic", 0.0) >= least_harmonic
-        or c.get("error_share", 0.0) >= least_harmonic)),
-        key=lambda c: abs(c["speed_rpm"] / (w * RPM) - 1.0))
-    if not driven:
+    near = sorted((c for c in crossings if not c.get("suppressed")
+                   and driven(c, least_harmonic)),
+                  key=lambda c: abs(c["speed_rpm"] / (w * RPM) - 1.0))
+    if not near:
         return []
-    c = driven[0]
+    c = near[0]
     off = w * RPM / c["speed_rpm"] - 1.0
     top, share = c["energy"][0] if c["energy"] else ("-", math.nan)
-    more = (f"; {len(driven) - 1} more within {100 * within:.2g} % (torquesplit modes "
-            f"--campbell lists them)" if len(driven) > 1 else "")
+    more = (f"; {len(near) - 1} more within {100 * within:.2g} % (torquesplit modes "
+            f"--campbell lists them)" if len(near) > 1 else "")
     by = []
     if c.get("stiffness_harmonic", 0.0) >= least_harmonic:
         by.append(f"a harmonic of {100 * c['stiffness_harmonic']:.2g} % of the mean mesh "
