@@ -1222,7 +1222,7 @@ def _print_contact(m, pair, names, op_load, cm, results, hm, impact, op, figures
         console.print(h)
     if impact is not None:
         console.print(f"meshing-in impact at {op.load / 1e3:.5g} kN: {impact.peak_force:.5g} N "
-                      f"(premature approach {impact.advance * 1e6:.3g} µm, corner relief "
+                      f"(premature approach {impact.advance * 1e6:.3g} µm, relief where it enters "
                       f"{impact.corner_separation * 1e6:.3g} µm)", highlight=False)
     elif impact_note is not None:
         console.print(impact_note, highlight=False, markup=False)

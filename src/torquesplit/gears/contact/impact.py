@@ -59,7 +59,9 @@ class LoadedMeshingIn:
     approach : float
         Loaded transmission error of the pairs in contact just before it [m] (normal).
     corner_separation : float
-        Initial separation of the engaging corner [m] (normal).
+        Initial separation where the engaging pair first touches [m] (normal): the
+        face-end corner of a helical pair, the least along the face of a spur pair
+        (:func:`_entry_separation`).
     advance : float
         Premature approach ``max(approach - corner_separation, 0)`` [m] (normal).
     impact : MeshingInImpact or None
@@ -100,6 +102,26 @@ def _before(phase, values, at: float, state=None) -> float:
     return float(values[i1] + (values[i1] - values[i2]) * d1 / (d2 - d1))
 
 
+#: face positions where a spur pair's entering contact line is searched for its least
+#: separation (:func:`_entry_separation`)
+ENTRY_FACE_POINTS = 41
+
+
+def _entry_separation(cm, helix: int) -> float:
+    """The separation of the flanks where the new pair first touches [m]: a helical
+    pair's contact line enters at the face-end corner (y = 0); a spur pair's enters along
+    the whole face at once, so it touches first where its separation is least (mid-face
+    on a crowned lead: the corner alone made 5 um of crowning cancel a 534 N impact)."""
+    pair = cm.pair
+    s0 = np.array([pair.path_start])
+    if abs(pair.base_helix_angle) > 1e-12:
+        y = np.array([0.0])
+    else:
+        y = np.linspace(0.0, pair.face_width, ENTRY_FACE_POINTS)
+    w = cm.raw_separation(s0, y, helix)
+    return float(np.min(w) - cm.separation_shift)
+
+
 def loaded_meshing_in(result, *, omega_driving: float, inertia_driving: float,
                       inertia_driven: float, exponent: float = 1.0,
                       impact_stiffness: float | None = None) -> LoadedMeshingIn:
@@ -129,8 +151,7 @@ def loaded_meshing_in(result, *, omega_driving: float, inertia_driving: float,
         entry = float(np.mod(-h * cm.options.stagger, 1.0))
         loaded = (result.pair_load[:, h] > 1e-9 * result.load).sum(axis=1)
         z = _before(phase, result.approach(h), entry, loaded)
-        w_c = float(cm.raw_separation(np.array([pair.path_start]), np.array([0.0]), h)[0]
-                    - cm.separation_shift)
+        w_c = _entry_separation(cm, h)
         adv = z - w_c
         if best is None or adv > best[3]:
             best = (h, entry, z, adv, w_c)
