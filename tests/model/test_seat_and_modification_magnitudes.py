@@ -150,9 +150,9 @@ def test_micron_modifications_are_quiet():
 
 
 @pytest.mark.parametrize("field, value", [
-    ("tip_relief", {"amount": "15 mm", "length": "5 mm"}),
+    ("tip_relief", {"amount": "5 mm", "length": "5 mm"}),
     ("root_relief", {"amount": "0.5 mm", "length": "2 mm"}),
-    ("crowning", "15 mm"),
+    ("crowning", "5 mm"),
     ("end_relief", {"amount": "1 mm", "length": "3 mm"}),
     ("helix_slope", "-2 mm"),
 ])
@@ -186,11 +186,21 @@ def test_topological_and_second_helix_amounts_are_checked_too():
 def test_set_of_a_tip_relief_in_mm_warns_on_the_argument(tmp_path):
     model = tmp_path / "spur.toml"
     model.write_text(SPUR)
-    arg = "gears.pinion.modifications.tip_relief.amount=15 mm"
+    arg = "gears.pinion.modifications.tip_relief.amount=5 mm"
     res = runner.invoke(app, ["check", str(model), "--set", arg])
     assert res.exit_code == 0, res.output
-    assert f"warning: --set {arg}: gears.pinion.modifications.tip_relief.amount: 15 mm" \
+    assert f"warning: --set {arg}: gears.pinion.modifications.tip_relief.amount: 5 mm" \
         in res.stderr, res.stderr
+    # deeper than the whole tooth (6.75 mm): refused (a reviewer's '=25', 25 m, only
+    # warned and ran); a relief zone in microns warns (it did nothing, unsaid)
+    deep = runner.invoke(app, ["check", str(model), "--set",
+                               "gears.pinion.modifications.tip_relief.amount=25"])
+    assert deep.exit_code == 2 and "25 m is deeper than the whole tooth (2.25 x module = " \
+        "6.75 mm)" in deep.output, deep.output
+    short = runner.invoke(app, ["check", str(model), "--set",
+                                "gears.pinion.modifications.tip_relief.length=6 um"])
+    assert short.exit_code == 0 and "tip_relief.length: 6 um is 0.002 times the module " \
+        "(3 mm): a relief zone this short does nothing" in short.stderr, short.stderr
 
 
 # ------------------------------------------------------------------ negative amounts

@@ -490,6 +490,8 @@ def error_size_issues(model: Model) -> list[tuple[str, str]]:
                       "bearing_runout"):
             deeper(f"gears.{name}.errors.{field}", getattr(g.errors, field), g.module,
                    "manufacturing and assembly errors")
+        for field, value in _modification_amounts(f"gears.{name}", g):
+            deeper(field, value, g.module, "tooth modifications")
         if g.support is not None:
             deeper(f"gears.{name}.support.clearance", g.support.clearance, g.module,
                    "bearing clearances")
@@ -1159,15 +1161,13 @@ def magnitude_warnings(model: Model, kin) -> list[tuple[str, str]]:
     return out
 
 
-def _modification_warnings(loc: str, gear) -> list[tuple[str, str]]:
-    """Tooth modification amounts above :data:`MODIFICATION_MODULE_RATIO` of the module."""
+def _modification_amounts(loc: str, gear) -> list[tuple[str, float]]:
+    """(field, amount [m]) of every tooth modification of a gear (both helices)."""
     spec = gear.modifications
-    if spec is None:
-        return []
-    limit = MODIFICATION_MODULE_RATIO * gear.module
     out = []
-    for flank, where in ((spec, f"{loc}.modifications"),
-                         (spec.second_helix, f"{loc}.modifications.second_helix")):
+    for flank, where in (((spec, f"{loc}.modifications"),
+                          (spec.second_helix, f"{loc}.modifications.second_helix"))
+                         if spec is not None else ()):
         if flank is None:
             continue
         amounts = [("crowning", flank.crowning), ("helix_slope", flank.helix_slope)]
@@ -1177,14 +1177,42 @@ def _modification_warnings(loc: str, gear) -> list[tuple[str, str]]:
         if flank.topological is not None:
             amounts += [(f"topological.{y}", getattr(flank.topological, y))
                         for y in ("y1", "y2", "y5")]
-        for field, value in amounts:
-            if math.isfinite(value) and abs(value) > limit:
-                out.append((f"{where}.{field}", (
-                    f"{_length_text(abs(value))} is {abs(value) / gear.module:.3g} times the "
-                    f"module ({gear.module * 1e3:.4g} mm); tooth modifications remove a few "
-                    f"to tens of microns (rarely over {MODIFICATION_MODULE_RATIO:g} m_n): "
-                    f"check the value and its unit (a bare number is read in m: write "
-                    f"'15 um')")))
+        out += [(f"{where}.{field}", value) for field, value in amounts]
+    return out
+
+
+#: a tip or root relief zone shorter than this share of the module is a unit slip
+#: ('6 um' for '6 mm': the relief then does nothing, and nothing was said)
+RELIEF_LENGTH_MODULE_RATIO = 0.02
+
+
+def _modification_warnings(loc: str, gear) -> list[tuple[str, str]]:
+    """Tooth modification amounts above :data:`MODIFICATION_MODULE_RATIO` of the module,
+    relief zones shorter than :data:`RELIEF_LENGTH_MODULE_RATIO` of it."""
+    limit = MODIFICATION_MODULE_RATIO * gear.module
+    out = []
+    for field, value in _modification_amounts(loc, gear):
+        if math.isfinite(value) and abs(value) > limit:
+            out.append((field, (
+                f"{_length_text(abs(value))} is {abs(value) / gear.module:.3g} times the "
+                f"module ({gear.module * 1e3:.4g} mm); tooth modifications remove a few "
+                f"to tens of microns (rarely over {MODIFICATION_MODULE_RATIO:g} m_n): "
+                f"check the value and its unit (a bare number is read in m: write "
+                f"'15 um')")))
+    spec = gear.modifications
+    for flank, where in (((spec, f"{loc}.modifications"),
+                          (spec.second_helix, f"{loc}.modifications.second_helix"))
+                         if spec is not None else ()):
+        for name in ("tip_relief", "root_relief") if flank is not None else ():
+            relief = getattr(flank, name)
+            for zone in ("length", "height"):
+                value = getattr(relief, zone, None) if relief is not None else None
+                if value and value < RELIEF_LENGTH_MODULE_RATIO * gear.module:
+                    out.append((f"{where}.{name}.{zone}", (
+                        f"{_length_text(value)} is {value / gear.module:.2g} times the module "
+                        f"({gear.module * 1e3:.4g} mm): a relief zone this short does "
+                        f"nothing; relief {zone}s are millimetres (about 0.3-1 m_n): check "
+                        f"the value and its unit (write e.g. '3 mm')")))
     return out
 
 
