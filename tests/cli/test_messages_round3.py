@@ -210,3 +210,44 @@ def test_contact_takes_the_model_files_limits_and_warnings(tmp_path):
     one = runner.invoke(app, ["contact", str(spur), "--pair", "m", "--slices", "1",
                               "--positions", "16", "--harris", "0"])
     assert one.exit_code == 0, one.output
+
+
+def test_modifications_and_an_ltca_on_a_bevel_pair_are_refused_together(tmp_path):
+    """A reviewer's bevel pair with modifications and method 'ltca' was refused for the
+    modifications alone; the LTCA's refusal came only after removing them."""
+    text = """
+[model]
+name = "bevel LTCA"
+[gears.pinion]
+teeth = 20
+module = "3 mm"
+kind = "bevel"
+face_width = "20 mm"
+position = ["0 mm", "0 mm", "0 mm"]
+modifications = {crowning = "10 um"}
+[gears.wheel]
+teeth = 40
+module = "3 mm"
+kind = "bevel"
+face_width = "20 mm"
+axis = [1, 0, 0]
+position = ["0 mm", "0 mm", "60 mm"]
+[meshes.m]
+gears = ["pinion", "wheel"]
+shaft_angle = "90 deg"
+damping_ratio = 0.05
+stiffness = {method = "ltca"}
+[drives.motor]
+body = "pinion"
+speed = "1500 rpm"
+torque = "100 N m"
+[loads.out]
+body = "wheel"
+"""
+    path = tmp_path / "bev.toml"
+    path.write_text(text)
+    res = runner.invoke(app, ["check", str(path)])
+    assert res.exit_code == 2
+    assert "gears.pinion.modifications: tooth modifications are analysed for cylindrical" \
+        in res.output and "meshes.m.stiffness.method: the LTCA is implemented for " \
+        "cylindrical pairs" in res.output, res.output

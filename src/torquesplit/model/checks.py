@@ -402,6 +402,11 @@ def modification_issues(model: Model, skip=frozenset()) -> list[tuple[str, str]]
     from ..gears.line_of_action import cylindrical_pair, is_conical
 
     issues: list[tuple[str, str]] = []
+    for name, g in model.gears.items():  # (said with the meshes' LTCA, not before them)
+        if g.modifications is not None and g.gear_type in ("bevel", "face"):
+            issues.append((f"gears.{name}.modifications", (
+                f"tooth modifications are analysed for cylindrical gears (spur, helical, "
+                f"double-helical, internal), not for a {g.gear_type} gear; remove them")))
     # a gear with mates of different sizes (a planet: sun and ring) is checked against
     # each: its messages name the mate (as written: every planet of a stage the same)
     mates: dict[str, set[str]] = {}

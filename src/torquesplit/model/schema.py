@@ -370,11 +370,8 @@ class Gear(Strict):
 
     @model_validator(mode="after")
     def _consistent(self):
-        if self.modifications is not None:
-            if self.gear_type in ("bevel", "face"):
-                raise FieldError("modifications", (
-                    f"tooth modifications are analysed for cylindrical gears (spur, helical, "
-                    f"double-helical, internal), not for a {self.gear_type} gear; remove them"))
+        if self.modifications is not None:  # (on a bevel or face gear: checks.py, with
+            # the model's other problems)
             if self.modifications.second_helix is not None and self.gear_type != "double_helical":
                 raise FieldError("modifications.second_helix", (
                     "a second helix exists on double-helical gears only; remove second_helix "
