@@ -1175,7 +1175,13 @@ def _print_contact(m, pair, names, op_load, cm, results, hm, impact, op, figures
     rows = [r.summary() for r in results]
     if given is not None:  # (what each load was given as, '680 N m on wheel')
         rows = [{"given_as": g, **row} for row, g in zip(rows, given)]
-    if as_json:
+    if as_json:  # the curves over the mesh cycle too (the scalars alone could not be
+        # compared with another LTCA: a reviewer)
+        phase = [float(x) for x in cm.phase]
+        rows = [{**row, "phase": phase, "te_m": [float(x) for x in r.transmission_error],
+                 "stiffness_secant_N_per_m": [float(x) for x in r.stiffness_secant],
+                 "stiffness_tangent_N_per_m": [float(x) for x in r.stiffness_tangent]}
+                for r, row in zip(results, rows)]
         ux.emit_json({
             "mesh": pair, "gears": list(names), "operating_load_N": op_load,
             "positions": int(cm.phase.size), "slices": int(cm.y.size), "loads": rows,

@@ -251,3 +251,21 @@ body = "wheel"
     assert "gears.pinion.modifications: tooth modifications are analysed for cylindrical" \
         in res.output and "meshes.m.stiffness.method: the LTCA is implemented for " \
         "cylindrical pairs" in res.output, res.output
+
+
+def test_contact_json_carries_the_curves_over_the_mesh_cycle(tmp_path):
+    """'contact --json' gave scalars only: the loaded TE curve could not be exported."""
+    import json
+
+    import numpy as np
+
+    spur = tmp_path / "spur.toml"
+    spur.write_text(SPUR)
+    res = runner.invoke(app, ["contact", str(spur), "--pair", "m", "--harris", "0",
+                              "--positions", "16", "--json"])
+    assert res.exit_code == 0, res.output
+    row, = json.loads(res.stdout)["loads"]
+    assert len(row["phase"]) == len(row["te_m"]) == len(row["stiffness_tangent_N_per_m"]) == 16
+    te = np.array(row["te_m"])
+    assert np.ptp(te) == pytest.approx(row["te_peak_to_peak_m"], rel=1e-12)
+    assert te.mean() == pytest.approx(row["te_mean_m"], rel=1e-12)
