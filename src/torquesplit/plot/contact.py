@@ -124,6 +124,9 @@ def harris_figure(harris, title: str | None = None, design_load: float | None = 
              label="loaded contact ratio (mean loaded tooth pairs)")
     ax2.set_ylabel("loaded contact ratio (within the path of contact) [-]",
                    color="tab:green")
+    cr = np.asarray(harris.contact_ratio, dtype=float)
+    if cr.size and np.ptp(cr) < 0.02:  # (flat: a zoomed axis spread a constant over it)
+        ax2.set_ylim(cr.mean() - 0.25, cr.mean() + 0.25)
     fig.legend(loc="outside lower center", ncols=3, fontsize="small")
     ax.set_title(title or "Harris map")
     return fig
@@ -166,9 +169,10 @@ def load_distribution_figure(result, positions: int = 4, title: str | None = Non
     fc_lo = min(cm.pair.roll_distances(np.array([cm.pair.path_start, cm.pair.path_end]))[0]) * 1e3
     fc_hi = max(cm.pair.roll_distances(np.array([cm.pair.path_start, cm.pair.path_end]))[0]) * 1e3
     width = (2.1 if cm.helices == 2 else 1.0) * cm.pair.face_width * 1e3
+    pad_x, pad_r = 0.02 * width, 0.02 * (fc_hi - fc_lo)  # (markers on the limits: whole)
     for ax in axes[:len(picks) + 1]:
-        ax.set_xlim(0, width)
-        ax.set_ylim(fc_lo, fc_hi)
+        ax.set_xlim(-pad_x, width + pad_x)
+        ax.set_ylim(fc_lo - pad_r, fc_hi + pad_r)
         ax.set_xlabel("face position [mm]")
         ax.set_ylabel("roll length, gear 1 [mm]")
         ax.grid(True, alpha=0.2)

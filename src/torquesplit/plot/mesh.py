@@ -61,7 +61,11 @@ def plot_mesh_stiffness(comparison, path, *, cycles: int = 2, title: str | None 
     ax.set_ylabel("mesh stiffness along the line of action [N/µm]")
     ax.set_xlim(0, cycles)
     ax.grid(True, alpha=0.3)
-    fig.legend(loc="outside lower center", ncols=2, fontsize="small")
+    # two columns only where the labels fit beside each other (a long LTCA label ran
+    # off both edges of the figure: a reviewer)
+    longest = max((len(t.get_label()) for t in ax.get_lines()), default=0)
+    fig.legend(loc="outside lower center", ncols=2 if longest <= 48 else 1,
+               fontsize="small")
     if title:
         ax.set_title(title)
     path = Path(path)
