@@ -366,7 +366,11 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
         model: str = typer.Argument(..., help="Model file (.toml/.json) or example name."),
         start: str = typer.Option(..., "--from", help="First speed, e.g. '500 rpm'."),
         stop: str = typer.Option(..., "--to", help="Last speed, e.g. '3000 rpm'."),
-        points: int = typer.Option(50, "--points", help="Initial steps over the range."),
+        points: int = typer.Option(
+            50, "--points", help="Points over the range to start from: the step is the "
+            "range / (points - 1), at most twice that, and shrinks where the response "
+            "changes fast, so the curve has about this many points or more; a peak "
+            "narrower than the step is missed: give more for narrow resonances."),
         method: str = typer.Option(
             "auto", "--method", help="shooting (one monodromy per point), hb (harmonic "
             "balance), or auto: shooting unless --harmonics is given."),
