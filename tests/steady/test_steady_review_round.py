@@ -136,3 +136,17 @@ def test_campbell_counts_the_crossings_the_model_drives():
     assert "0 of 3 driven by at least 1 % (k harmonic or error)" in text, text[:400]
     _, crossings = campbell("ji_li_mill_drive", "700 rpm", "800 rpm", points=3)
     assert any(driven(c) for c in crossings)  # (its 10 % stiffness wave drives some)
+
+
+def test_harmonics_beyond_the_harmonic_balance_limit_are_refused():
+    """--harmonics 1000000 ran 3 million samples for 13 s on one DOF (a larger model runs
+    out of memory): refused above the adaptive doubling's limit."""
+    from typer.testing import CliRunner
+
+    from torquesplit.cli import app
+    from torquesplit.steady.solution import MAX_HARMONICS
+
+    res = CliRunner().invoke(app, ["steady", "ji_li_mill_drive", "--harmonics",
+                                   str(MAX_HARMONICS + 1)])
+    assert res.exit_code == 2 and f"is more than {MAX_HARMONICS}" in res.output
+    assert "--method shooting" in res.output, res.output

@@ -134,6 +134,13 @@ def _check_options(*, steps_per_cycle, tol, stability, energy_tol, method="auto"
             harmonics, numbers.Integral) or harmonics < 1):
         raise OptionError(f"harmonics must be a whole number >= 1, got {harmonics!r}; e.g. "
                           f"harmonics=16 per excitation cycle")
+    from torquesplit.steady.solution import MAX_HARMONICS
+
+    if harmonics is not None and harmonics > MAX_HARMONICS:  # (1e6 on a 1-DOF model took
+        # 3 million samples and 13 s; a larger model runs out of memory)
+        raise OptionError(f"harmonics {harmonics} is more than {MAX_HARMONICS}, the most the "
+                          f"harmonic balance takes (the adaptive doubling's limit); a period "
+                          f"needing more is solved by shooting (method='shooting')")
     if not (max_cycles is None or max_cycles == "auto" or (
             isinstance(max_cycles, numbers.Integral) and not isinstance(max_cycles, bool)
             and max_cycles >= 1)):

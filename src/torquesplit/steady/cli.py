@@ -71,7 +71,8 @@ def _h(text):
 _API_TO_FLAGS = ((re.compile(r"keep='([^']*)'"), r"--keep \1"),
                  (re.compile(r"max_cycles=(\d+)"), r"--max-cycles \1"),
                  (re.compile(r"harmonics=(\d+)"), r"--harmonics \1"),
-                 (re.compile(r"speed='([^']*)'"), r"--speed '\1'"))
+                 (re.compile(r"speed='([^']*)'"), r"--speed '\1'"),
+                 (re.compile(r"method='(\w+)'"), r"--method \1"))
 
 
 def _in_flags(exc):

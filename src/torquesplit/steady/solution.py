@@ -35,6 +35,8 @@ STABILITY_TOL = 1e-6
 MARGINAL_TOL = 1e-5
 """... and only marginally so when the largest is within this of 1 (a mode without
 damping: its multipliers sit on the unit circle, where any change can take them out)."""
+MAX_HARMONICS = 2 ** 15
+"""Most harmonics the harmonic balance takes (given, or reached by adaptive doubling)."""
 UNDAMPED = 1e-6
 """A mode whose modal damping ratio is below this has no damping (:func:`undamped_note`)."""
 
@@ -332,7 +334,7 @@ def check_method(method) -> None:
 def periodic_solution(structure, period: Period, *, method: str = "auto", harmonics=None,
                       samples=None, speed: float = 1.0, q_static=None, initial=None,
                       tol: float | None = None, adaptive: bool = False,
-                      energy_tol: float = ENERGY_TOL, max_harmonics: int = 2**15,
+                      energy_tol: float = ENERGY_TOL, max_harmonics: int = MAX_HARMONICS,
                       stability: bool | str = True, steps_per_cycle: int | None = None,
                       check: bool = True, problem: PeriodicProblem | None = None,
                       progress=None) -> PeriodicSolution:
