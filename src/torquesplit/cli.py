@@ -1523,6 +1523,12 @@ def modes(
                "planetary benchmarks publish them)" if rep.rotating_frame
                else " (its Coriolis and centripetal terms left out: --no-rotating-frame)"),
             highlight=False)
+    if not rep.rows:  # (an empty table said nothing: a reviewer's --below "10 Hz")
+        lowest = [f for f in rep.solution.frequencies if f > 0]
+        console.print((f"no mode below {below}" if below is not None else "no elastic mode")
+                      + (f": the lowest is {min(lowest):.5g} Hz" if lowest else ""),
+                      highlight=False)
+        return
     typed = any(r.type for r in rep.rows)
     whirls = any(r.whirl for r in rep.rows)
     t = Table(title="natural modes")

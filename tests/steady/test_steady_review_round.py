@@ -150,3 +150,12 @@ def test_harmonics_beyond_the_harmonic_balance_limit_are_refused():
                                    str(MAX_HARMONICS + 1)])
     assert res.exit_code == 2 and f"is more than {MAX_HARMONICS}" in res.output
     assert "--method shooting" in res.output, res.output
+
+
+def test_modes_below_the_lowest_says_so():
+    from typer.testing import CliRunner
+
+    from torquesplit.cli import app
+
+    res = CliRunner().invoke(app, ["modes", "ji_li_mill_drive", "--below", "1 Hz"])
+    assert res.exit_code == 0 and "no mode below 1 Hz: the lowest is 4.5061 Hz" in res.stdout
