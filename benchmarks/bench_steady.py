@@ -339,10 +339,11 @@ def _waveform_table(rows: list) -> list:
               "long run not settled" if left > 1e-3 else
               "shooting ok, HB **not met**" if err.get("shooting", 1.0) <= 1e-3 else
               "**not met**")
+        again = (f" (re-measured {r['remeasured']})" if r.get("remeasured") else "")
         out.append(f"| {r['example']} | {r['keep'] or 'all'} | {r['settle_s']:.3g} | "
                    f"{left:.1e} | {r.get('harmonics') or '-'} | "
                    + " | ".join(f"{err[m]:.1e}" if m in err else "-"
-                                for m in ("hb", "shooting")) + f" | {ok} |")
+                                for m in ("hb", "shooting")) + f" | {ok}{again} |")
     out.append("")
     return out
 
