@@ -490,8 +490,8 @@ class Results:
         force vector [N] (a body held by a spline alone: the spline's radial force, its
         name in ``via``; a body held rigidly, with no translational DOF: the sum of its
         meshes' forces along their lines of action, in the housing's x, y, z, axial thrust
-        included, ``held`` "rigid"), from the history from ``start_time`` (default the latest group
-        settle time: pass ``metrics().settling.start_time`` when the metrics are at
+        included, ``held`` "rigid"), from the history from ``start_time`` (default the
+        latest group settle time: pass ``metrics().settling.start_time`` when the metrics are at
         hand; a periodic state's: its first whole period, whatever ``start_time``).  The
         history is decimated (``samples_per_period``): a peak between its samples is
         missed, as :func:`~torquesplit.results.plausibility.coarse_history` says for the

@@ -535,8 +535,8 @@ def record_extremes(p, r, span, speed, track, periodic):
 def _point_outputs(f, f_all, d, groups, static_forces, nominal, peak, mean):
     """A sweep point's outputs per tracked mesh from its force samples ``f``, those and
     any instants between them ``f_all`` (the load-sharing ratio's extremes), the
-    transmission-error samples ``d`` (deformation plus error: ``V q``), the peak forces ``peak`` and mean forces ``mean``
-    (:func:`record_extremes`): peak force, dynamic factors, load sharing (the ratio of
+    transmission-error samples ``d`` (deformation plus error: ``V q``), the peak forces
+    ``peak`` and mean forces ``mean`` (:func:`record_extremes`): peak force, dynamic factors, load sharing (the ratio of
     the mean forces in its group, Dong et al. 2021 eq. 12, whatever the model's
     definition, and the largest instantaneous ratio, Ji & Li eq. 18), RMS
     transmission error, mean force, contact loss (the fraction of the samples in which
