@@ -159,3 +159,21 @@ def test_modes_below_the_lowest_says_so():
 
     res = CliRunner().invoke(app, ["modes", "ji_li_mill_drive", "--below", "1 Hz"])
     assert res.exit_code == 0 and "no mode below 1 Hz: the lowest is 4.5061 Hz" in res.stdout
+
+
+def test_a_harmonic_of_a_meshs_error_series_is_named_so(tmp_path):
+    """'14 cycles of the error of m at 7583 Hz' read as a slow error: it is harmonic 14 of
+    the mesh's (LTCA) error series; kept excitations still drop it as an error."""
+    from torquesplit.steady.period import excitation_sources, keep_excitations
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        model = torquesplit.load_model(write_model(tmp_path, RELIEVED_SPUR_LTCA))
+    s = torquesplit.assemble(model)
+    kinds = {x.kind for x in excitation_sources(s) if "error" in x.kind}
+    assert "harmonic 2 of the error" in kinds, kinds
+    f_mesh = float(s.frequency.max())
+    kept, dropped = keep_excitations(s, 0.7 * f_mesh)  # (harmonics 7, 14 are multiples)
+    gone = [x.index for x in dropped if x.kind.startswith("harmonic")]
+    assert gone and np.all(kept.error_amplitude[gone] == 0.0)
+    assert np.all(s.error_amplitude[gone] != 0.0)  # (they had an amplitude)

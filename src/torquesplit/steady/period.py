@@ -61,8 +61,9 @@ class ExcitationSource:
 
     element: str
     kind: str
-    """'stiffness', 'impact force', 'torque fluctuation', 'friction', 'error' or
-    'backlash sequence'."""
+    """'stiffness', 'impact force', 'torque fluctuation', 'friction', 'error' (or
+    'harmonic k of the error', a harmonic of the mesh's error series) or 'backlash
+    sequence'."""
     frequency: float
     """[Hz]"""
     index: int
@@ -143,8 +144,14 @@ def excitation_sources(structure: Structure) -> list[ExcitationSource]:
     owner = np.repeat(np.arange(s.n_elements), np.diff(s.error_ptr))
     for i in range(len(s.error_amplitude)):
         if s.error_amplitude[i] != 0 and s.error_omega[i] != 0:
-            out.append(ExcitationSource(s.element_names[owner[i]], "error",
-                                        abs(float(s.error_omega[i])) / (2 * math.pi), i))
+            f = abs(float(s.error_omega[i])) / (2 * math.pi)
+            f_mesh = float(s.frequency[owner[i]])
+            k = round(f / f_mesh) if f_mesh > 0 else 0
+            # a harmonic of the mesh's own error series (an LTCA's loaded TE) named so:
+            # '14 cycles of the error of m at 7583 Hz' read as a slow error (a reviewer)
+            kind = (f"harmonic {k} of the error" if k > 1 and abs(f - k * f_mesh) <= 1e-9 * f
+                    else "error")
+            out.append(ExcitationSource(s.element_names[owner[i]], kind, f, i))
     return out
 
 
@@ -273,7 +280,7 @@ def keep_excitations(structure: Structure, base: float):
         elif x.kind == "friction":
             j = int(np.flatnonzero(s.fr_el == x.index)[0])
             frtab[3 * j:3 * j + 3] = frtab[3 * j:3 * j + 3].mean(axis=1, keepdims=True)
-        elif x.kind == "error":
+        elif x.kind.endswith("error"):  # (the error, or a harmonic of its series)
             amp[x.index] = 0.0
     drop_gaps = {x.index for x in dropped if x.kind == "backlash sequence"}
     for e in range(s.n_elements):
