@@ -177,3 +177,24 @@ def test_a_harmonic_of_a_meshs_error_series_is_named_so(tmp_path):
     gone = [x.index for x in dropped if x.kind.startswith("harmonic")]
     assert gone and np.all(kept.error_amplitude[gone] == 0.0)
     assert np.all(s.error_amplitude[gone] != 0.0)  # (they had an amplitude)
+
+
+def test_a_sweep_peak_between_points_is_said():
+    """An 8-point sweep put Ji & Li's peak at 585.7 rpm (1.09915); 77 points found it at
+    609.7 rpm (1.10207): a peak whose neighbours are well below it may lie between them."""
+    import xarray as xr
+
+    from torquesplit.steady.cli import unresolved_peaks
+
+    rpm = [500.0, 542.9, 585.7, 650.0, 714.3]
+    coarse = [1.08736, 1.08936, 1.09915, 1.09361, 1.07754]
+    fine = [1.0900, 1.0990, 1.09915, 1.0991, 1.0800]
+
+    def ds(df):
+        return xr.Dataset({"dynamic_factor": (("point", "mesh"), np.array(df)[:, None]),
+                           "stable": ("point", np.ones(5, bool))},
+                          coords={"speed_rpm": ("point", rpm), "mesh": ["m11"]})
+
+    said = unresolved_peaks(ds(coarse))
+    assert said == ["m11 (its neighbours 5.6 % of the dynamic increment lower, at 585.7 rpm)"]
+    assert unresolved_peaks(ds(fine)) == []

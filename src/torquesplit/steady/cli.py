@@ -462,6 +462,7 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
                                      "not observable)",
             "unstable_points": int((~ds["stable"].values).sum()),
             "marginal_points": _marginal(ds),
+            "unresolved_peaks": unresolved_peaks(ds),
             "period_doubling_rpm": _runs(ds, ds["instability"].values == "period doubling"),
             "max_contact_loss": _largest_loss(ds),
             "wall_time_s": ds.attrs["wall_time_s"],
@@ -529,6 +530,12 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
                               f"Floquet multiplier below -1): the response there is not on "
                               f"this curve but an orbit of twice the period or longer, with "
                               f"other forces; 'torquesplit run' at those speeds gives it")
+            coarse = unresolved_peaks(ds)
+            if coarse:  # (the curve's points may straddle its peak)
+                console.print(f"[yellow]peaks not resolved:[/] {', '.join(coarse)}: the "
+                              f"largest dynamic factor can lie between the points; give "
+                              f"more --points (or a smaller --max-step) around it",
+                              highlight=False)
             lost = {k: v for k, v in summary["max_contact_loss"].items() if v[0] > 0}
             if lost:
                 console.print("contact loss on the stable points: " + ", ".join(
@@ -592,6 +599,35 @@ def _largest_loss(ds) -> dict[str, list[float]]:
         loss = np.asarray(ds["contact_loss"].values[:, j], float)[stable]
         i = int(np.argmax(loss)) if loss.size else -1
         out[str(k)] = [float(loss[i]), float(rpm[i])] if i >= 0 else [0.0, None]
+    return out
+
+
+#: a sweep's largest dynamic factor whose neighbouring points are lower by more than this
+#: share of its dynamic increment (DF - 1) is said to be unresolved (:func:`unresolved_peaks`)
+PEAK_RESOLUTION = 0.02
+
+
+def unresolved_peaks(ds) -> list[str]:
+    """Meshes whose largest stable dynamic factor is an interior point with both
+    neighbours lower by more than :data:`PEAK_RESOLUTION` of its dynamic increment: the
+    true peak can lie between the points (a reviewer's 8-point sweep put the peak at
+    585.7 rpm, 1.09915, its neighbours 5.6 % of the increment lower; 77 points gave
+    609.7 rpm, 1.10207), as '<mesh> (<share> % ... at <rpm>)'."""
+    out = []
+    stable = np.asarray(ds["stable"].values, bool)
+    rpm = np.asarray(ds["speed_rpm"].values, float)
+    for j, k in enumerate(ds["mesh"].values):
+        df = np.where(stable, np.asarray(ds["dynamic_factor"].values[:, j], float), np.nan)
+        if not np.isfinite(df).any():
+            continue
+        i = int(np.nanargmax(df))
+        if i == 0 or i == df.size - 1 or not (stable[i - 1] and stable[i + 1]):
+            continue  # (at an end of the range, or next to an unstable point)
+        increment = df[i] - 1.0 if df[i] > 1.0 else df[i]
+        drop = (df[i] - max(df[i - 1], df[i + 1])) / increment
+        if drop > PEAK_RESOLUTION:
+            out.append(f"{k} (its neighbours {100 * drop:.2g} % of the dynamic increment "
+                       f"lower, at {rpm[i]:.6g} rpm)")
     return out
 
 
