@@ -643,9 +643,10 @@ def _sweep_study(ui, model, vary, output, log_spacing, static, duration, cycles,
                 analysis[key] = value
         if settle is not None:
             analysis["settle"] = {"tolerance": settle}
-    first = (param.get("path") or param["paths"][0]) if param else "parameter"
-    more = len(param.get("paths") or []) - 1 if param else 0
-    name = f"sweep_{first}" + (f"_and_{more}_more" if more > 0 else "")
+    # named by its path, or by the parameter's name where it sets several paths (the
+    # figures' titles read 'sweep_meshes.a1.backlash_and_1_more'; the axis names them)
+    name = (f"sweep_{param.get('name') or param.get('path')}" if param else
+            "sweep_parameter")
     data = {"study": {"name": name, "model": model_ref, "outputs": outputs},
             "analysis": analysis, "grid": {"parameters": [param]},
             "set": dict(parse_assignment(a) for a in (assign or []))}
