@@ -511,15 +511,10 @@ def run(
 
 def _near_critical(res) -> list[str]:
     """``run``'s word on a critical speed next to the model's, from the run's own
-    structure and static equilibrium (a best effort: a model the Campbell map cannot take
-    says nothing)."""
-    from .steady.maps import near_critical_speeds
+    structure and static equilibrium."""
+    from .steady.maps import near_critical_notes
 
-    try:
-        return [f"{loc}: {msg}" for loc, msg in near_critical_speeds(
-            res.model, res.structure, res.static.q, res.kinematics)]
-    except Exception:  # noqa: BLE001 - a note, never a reason to lose the run's results
-        return []
+    return near_critical_notes(res.model, res.structure, res.static.q, res.kinematics)
 
 
 def _print_run(m, res, met, saved, figures, step_check, plots, as_json) -> None:

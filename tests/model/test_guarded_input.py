@@ -305,3 +305,12 @@ def test_deep_check_cli_refuses_a_static_deflection_no_run_survives(tmp_path):
     text = text.replace('body = "pinion"', 'body = "motor"')
     err = check_cli(write(tmp_path, text))
     assert "static" in err and "rad" in err
+
+
+def test_a_transmission_error_deeper_than_the_tooth_is_refused():
+    """A code review: 'transmission_error = {amplitude = 20}' (20 m) only warned, while
+    the same slip on an eccentricity is refused."""
+    data = pair_dict()
+    data["meshes"]["m"]["transmission_error"] = {"amplitude": 20}
+    _refused(data, "meshes.m.transmission_error.amplitude", r"20 m is deeper than the whole "
+             r"tooth")

@@ -160,7 +160,8 @@ def test_mean_force_coefficients_that_differ_between_halves_are_said(swing, warn
     b = 200.0 - a
     ls = SimpleNamespace(groups={"g": ["a", "b"]}, per_group={"g": 1.0})
     met = SimpleNamespace(definition="mean_force", load_sharing=ls,
-                          settling=SimpleNamespace(first_cycle={"a": 0, "b": 0}))
+                          settling=SimpleNamespace(first_cycle={"a": 0, "b": 0},
+                                                   mean_first={"a": 0, "b": 0}))
     said = mean_drift(_MeanStub(np.stack([a, b], axis=1)), met)
     assert bool(said) is warned
     if warned:

@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import warnings
 
+import pytest
+
 import torquesplit
 from model_texts import TWO_PATH_SPUR_REDUCER, write_model
 from torquesplit.results.plausibility import PULL_FLOOR, damping_pull
@@ -71,3 +73,32 @@ def test_the_stages_of_a_locked_train_share_alike_by_mean_force(tmp_path):
     first, second = met.load_sharing.per_group["first"], met.load_sharing.per_group["second"]
     assert abs(first - second) < 1e-3, (first, second)
     assert met.settling.group_time["first"] != met.settling.group_time["second"]  # (premise)
+
+
+def test_a_model_of_rotations_only_has_rigid_bearing_rows_and_mean_f_matches_k_gamma(tmp_path):
+    """A code review: a model whose bodies only turn got no bearing rows at all (an early
+    return), though a study accepted their names; the table's mean F was over each group's
+    own span while K_gamma took the common one; a body on a rigid shaft with a supported
+    one (Dong et al. 2021's O1b beside O1) is not a bearing of its own."""
+    import numpy as np
+
+    from model_texts import SPUR_PAIR
+    from torquesplit.results import bearing_bodies, rigid_bearings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        pair = torquesplit.load_model(write_model(tmp_path, SPUR_PAIR, "pair.toml"))
+        res = torquesplit.simulate(pair, cycles=40)
+        reducer = torquesplit.simulate(torquesplit.load_model(
+            write_model(tmp_path, TWO_PATH_SPUR_REDUCER)))
+    rows = res.bearing_forces()
+    assert [r["body"] for r in rows] == bearing_bodies(res.structure, pair) == ["pinion",
+                                                                                "wheel"]
+    assert all(r["held"] == "rigid" for r in rows)
+    met = reducer.metrics("mean_force")
+    for g, members in met.load_sharing.groups.items():
+        mean = np.array([next(r.mean_force for r in met.rows if r.mesh == m) for m in members])
+        assert met.load_sharing.per_group[g] == pytest.approx(
+            float(np.max(len(mean) * mean / mean.sum())), rel=1e-12)
+    dong = torquesplit.load_model("dong2021_face_gear")
+    assert "O1b" not in rigid_bearings(dong, torquesplit.solve_kinematics(dong))

@@ -198,3 +198,16 @@ def test_a_sweep_peak_between_points_is_said():
     said = unresolved_peaks(ds(coarse))
     assert said == ["m11 (its neighbours 5.6 % of the dynamic increment lower, at 585.7 rpm)"]
     assert unresolved_peaks(ds(fine)) == []
+
+
+def test_sweep_speed_takes_steady_states_option_checks():
+    """A code review: sweep_speed took harmonics=1e6 and harmonics with method='shooting'
+    that steady_state refuses."""
+    from torquesplit.errors import OptionError
+    from torquesplit.steady.maps import sweep_speed
+
+    for kw in (dict(harmonics=10 ** 6), dict(harmonics=8, method="shooting")):
+        with pytest.raises(OptionError):
+            sweep_speed("ji_li_mill_drive", "700 rpm", "750 rpm", **kw)
+        with pytest.raises(OptionError):
+            torquesplit.steady_state("ji_li_mill_drive", **kw)

@@ -231,3 +231,13 @@ def test_study_analysis_replaced_in_python(split_file):
     assert Study(data).spec.analysis.cycles == data["analysis"]["cycles"]  # data untouched
     again = Study(st.spec, analysis={"cycles": 9})
     assert again.spec.analysis.cycles == 9 and again.spec.analysis.duration is None
+
+
+def test_an_analysis_field_given_beside_a_study_file_is_named_as_given():
+    """A code review: Study(static study, analysis={'cycles': 50}) blamed the study file
+    for a field it does not hold."""
+    from torquesplit.study import StudyError
+
+    with pytest.raises(StudyError, match=r"^analysis\['cycles'\] \(given with the study "
+                                         r"mo_2017_errors\.toml\): does not apply"):
+        Study("mo_2017_errors", analysis={"cycles": 50})

@@ -114,6 +114,15 @@ class Settling:
     """Mesh -> (its cycles, the window it needs) where the run holds fewer than two
     windows: too short to check settling over the longest excitation period, so not
     settled (its metrics then use a shorter window, a best effort)."""
+    mean_first_cycle: dict[str, int] = field(default_factory=dict)
+    """Mesh -> first cycle of the mean forces (mean_force coefficients, the mean F
+    column, the drift check): every group over one span, from ``start_time``
+    (:func:`common_first_cycle`); empty: ``first_cycle``."""
+
+    @property
+    def mean_first(self) -> dict[str, int]:
+        """:attr:`mean_first_cycle`, or :attr:`first_cycle` where it is not set."""
+        return self.mean_first_cycle or self.first_cycle
 
 
 @dataclass(frozen=True)
@@ -233,26 +242,26 @@ def settle(cycle_max: np.ndarray, cycle_start: np.ndarray, names, window=20,
         for m in ms:
             starts = cycle_start[:, col[m]]
             # first cycle starting at or after the group's settle time (round-off aside)
-            tol = 1e-9 * max(abs(group_time[g]), 1e-300)
-            k = int(np.searchsorted(starts, group_time[g] - tol, side="left"))
-            first[m] = min(max(k, own[m]), max(len(starts) - 1, 0))
+            first[m] = _first_cycle_from(starts, group_time[g], own[m])
     start_time = max(group_time.values()) if group_time else 0.0
     return Settling(start_time=start_time, settled=settled, first_cycle=first,
                     group_time=group_time, own_first_cycle=own, short=short)
 
 
+def _first_cycle_from(starts: np.ndarray, t: float, least: int) -> int:
+    """The first cycle of ``starts`` starting at or after ``t`` (round-off aside), not
+    before cycle ``least``, and not past the last."""
+    tol = 1e-9 * max(abs(t), 1e-300)
+    k = int(np.searchsorted(starts, t - tol, side="left"))
+    return min(max(k, least), max(len(starts) - 1, 0))
+
+
 def common_first_cycle(settling: "Settling", cycle_start: np.ndarray, names) -> dict[str, int]:
     """Mesh -> its first cycle starting at or after the latest group settle time
-    (``settling.start_time``, round-off aside), and not before its own settled cycle: the
-    start of a span common to every group."""
-    out = {}
-    t = settling.start_time
-    tol = 1e-9 * max(abs(t), 1e-300)
-    for j, m in enumerate(names):
-        starts = cycle_start[:, j]
-        k = int(np.searchsorted(starts, t - tol, side="left"))
-        out[m] = min(max(k, settling.first_cycle[m]), max(len(starts) - 1, 0))
-    return out
+    (``settling.start_time``), and not before its group's settled cycle: the start of a
+    span common to every group."""
+    return {m: _first_cycle_from(cycle_start[:, j], settling.start_time,
+                                 settling.first_cycle[m]) for j, m in enumerate(names)}
 
 
 def periodic(cycle_max: np.ndarray, cycle_start: np.ndarray, names,

@@ -500,12 +500,23 @@ def error_size_issues(model: Model) -> list[tuple[str, str]]:
         if g.support is not None:
             deeper(f"gears.{name}.support.clearance", g.support.clearance, g.module,
                    "bearing clearances")
+            for field in ("radial", "tangential"):
+                deeper(f"gears.{name}.support.pin_error.{field}",
+                       getattr(g.support.pin_error, field), g.module, "pin position errors")
+            seat = getattr(g.support, "on", None)
+            if seat in model.bodies:  # a carrier's eccentricity, against what it holds
+                deeper(f"bodies.{seat}.eccentricity", model.bodies[seat].eccentricity,
+                       g.module, "carrier eccentricities")
     for name, m in model.meshes.items():
         modules = [model.gears[x].module for x in m.gears if x in model.gears]
         if modules:
             deeper(f"meshes.{name}.backlash", m.backlash.nominal + m.backlash.tolerance,
                    min(modules), "backlashes")
-    return issues
+            for field in ("constant", "amplitude"):
+                deeper(f"meshes.{name}.transmission_error.{field}",
+                       getattr(m.transmission_error, field), min(modules),
+                       "transmission errors")
+    return list(dict.fromkeys(issues))  # (a carrier named once per planet it holds)
 
 
 def support_issues(model: Model) -> list[tuple[str, str]]:

@@ -238,6 +238,10 @@ def _error_rows(m) -> list[list[str]]:
                 if getattr(pin, field):
                     rows.append([f"gear {name}", f"pin position, {field}",
                                  _g(getattr(pin, field) * 1e6, 4), "–"])
+    for name, body in m.bodies.items():  # (a carrier's eccentricity)
+        if getattr(body, "eccentricity", 0.0):
+            rows.append([f"body {name}", "eccentricity", _g(body.eccentricity * 1e6, 4),
+                         _g(math.degrees(body.eccentricity_phase), 4)])
     for name, mesh in m.meshes.items():
         te = mesh.transmission_error
         if te.constant:

@@ -11,6 +11,8 @@ module        content
 
 from __future__ import annotations
 
+import dataclasses
+
 import json
 import math
 import numbers
@@ -304,13 +306,14 @@ class Results:
         st = (ls.periodic(c_max, c_start, names, groups) if self.periodic else
               ls.settle(c_max, c_start, names, self.settle_windows(window), tolerance,
                         groups))
+        if not self.periodic:  # the mean forces of every group over one span (a periodic
+            # state's groups are over whole periods already)
+            st = dataclasses.replace(st, mean_first_cycle=ls.common_first_cycle(
+                st, c_start, names))
         if definition == "cycle_peak":
             lsc = ls.cycle_peak(c_max, c_start, names, groups, st.first_cycle)
-        elif definition == "mean_force":  # (every group over the same span; a periodic
-            # state's groups over whole periods already)
-            lsc = ls.mean_force(c_mean, c_cnt, c_start, names, groups,
-                                st.first_cycle if self.periodic else
-                                ls.common_first_cycle(st, c_start, names))
+        elif definition == "mean_force":  # (every group over the same span)
+            lsc = ls.mean_force(c_mean, c_cnt, c_start, names, groups, st.mean_first)
         else:
             lsc = ls.instantaneous(c_ratio, c_start, names, groups, st.first_cycle,
                                    definition)
@@ -322,8 +325,9 @@ class Results:
         rows = []
         for j, m in enumerate(names):
             k0 = st.first_cycle[m]
-            c = c_cnt[k0:, j]
-            mean = float((np.nan_to_num(c_mean[k0:, j]) * c).sum() / max(c.sum(), 1))
+            km = st.mean_first[m]  # (the mean force over the span of the coefficients)
+            c = c_cnt[km:, j]
+            mean = float((np.nan_to_num(c_mean[km:, j]) * c).sum() / max(c.sum(), 1))
             back = float(s.back_contact_fraction[el.index(m)])
             double = not (self.model.meshes[m].backlash.nominal > 0)
             rows.append(MeshRow(
@@ -501,7 +505,8 @@ class Results:
         if s is None or not s.history_t.size:
             return []
         by_body = self.support_columns()
-        if not by_body:
+        rigid = rigid_bearings(self.model, self.kinematics)
+        if not by_body and not rigid:
             return []
         if start_time is not None and not (isinstance(start_time, numbers.Real)
                                            and not isinstance(start_time, bool)):
@@ -537,7 +542,7 @@ class Results:
                            forces * np.array([sign for _, _, sign in parts])))
         # bodies held rigidly: the sum of their meshes' forces, in the housing's x, y, z
         el, hist = self.structure.element_names, list(s.history_elements)
-        for body, terms in rigid_bearings(self.model, self.kinematics).items():
+        for body, terms in rigid.items():
             if body in by_body or any(el.index(m) not in hist for m, _ in terms):
                 continue
             f = s.history_forces[keep][:, [hist.index(el.index(m)) for m, _ in terms]]
@@ -803,17 +808,28 @@ def rigid_bearings(model, kin) -> dict[str, list[tuple[str, float]]]:
     """Bodies held rigidly (no translational DOF) that mesh -> their meshes and the sign
     that turns a mesh's force along its line of action into the force on the body (+1
     driven, -1 driver): their bearing carries the sum (a reviewer's pinions on
-    torsion-only shafts carried the largest radial loads and had no bearing row).  A body
-    whose meshes are analysed in a turning carrier's frame is left out (its mesh
-    directions turn with the carrier)."""
+    torsion-only shafts carried the largest radial loads and had no bearing row).  Left
+    out: a body whose meshes are analysed in a turning carrier's frame (their directions
+    turn with it), and one on a rigid shaft with a body that has translations (its load
+    goes to that body's bearings)."""
+    def translates(name) -> bool:
+        items = model.gears if name in getattr(model, "gears", {}) else model.bodies
+        return any(d != "theta" for d in getattr(items.get(name), "dofs", ("theta",)))
+
+    # a body on a rigid shaft with one that has translations: its load goes to that one's
+    # bearings (Dong et al. 2021's O1b beside O1), not to a bearing of its own
+    joined = {b for sh in getattr(model, "shafts", {}).values() if sh.rigid
+              for a, b in (sh.connects, sh.connects[::-1]) if translates(a)}
     out: dict[str, list[tuple[str, float]]] = {}
     for items in (getattr(model, "gears", {}), getattr(model, "bodies", {})):
-        for name, body in items.items():
-            if any(d != "theta" for d in getattr(body, "dofs", ("theta",))):
+        for name in items:
+            if translates(name) or name in joined:
                 continue
             terms = [(m, 1.0 if mk.driven == name else -1.0) for m, mk in kin.meshes.items()
                      if name in (mk.driver, mk.driven)]
-            if terms and not any(kin.meshes[m].carrier for m, _ in terms):
+            turning = any(kin.meshes[m].carrier and kin.bodies[kin.meshes[m].carrier].speed
+                          for m, _ in terms)  # (its meshes' directions turn with it)
+            if terms and not turning:
                 out[name] = terms
     return out
 

@@ -258,7 +258,8 @@ def _steady_attributes(ds: xr.Dataset, res, steady) -> None:
     info = steady.summary(results=res)  # (the record at hand, not a second one)
     ds["rms_transmission_error"] = _var(
         ("mesh",), [info["meshes"][m]["rms_transmission_error"] for m in res.mesh_names],
-        "m", "RMS dynamic transmission error (mesh deflection about its mean)")
+        "m", "RMS dynamic transmission error about its mean (the flanks' relative "
+        "displacement, errors included)")
     periods = (float(res.solution.t_final - res.solution.t_span[0]) / info["period_s"]
                if info["period_s"] else math.nan)
     ds.attrs.update(

@@ -344,7 +344,7 @@ def mean_force_halves(results, metrics) -> dict[str, tuple[float, float]]:
     for g, members in metrics.load_sharing.groups.items():
         halves = []
         for m in members:
-            k0, j = metrics.settling.first_cycle[m], col[m]
+            k0, j = metrics.settling.mean_first[m], col[m]  # (the coefficients' span)
             done = np.flatnonzero(c_cnt[:, j] > 0)
             end = int(done[-1]) + 1 if done.size else k0
             mid = k0 + (end - k0) // 2

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from torquesplit.errors import ModelWarning, OptionError, SolverError, warn_user
+from torquesplit.errors import OptionError, SolverError, warn_user
 from torquesplit.solve.kernel_data import continuous_start
 from torquesplit.steady.period import (
     base_frequency,
@@ -141,6 +141,10 @@ def _check_options(*, steps_per_cycle, tol, stability, energy_tol, method="auto"
         raise OptionError(f"harmonics {harmonics} is more than {MAX_HARMONICS}, the most the "
                           f"harmonic balance takes (the adaptive doubling's limit); a period "
                           f"needing more is solved by shooting (method='shooting')")
+    if harmonics is not None and method == "shooting":  # (ignored without a word)
+        raise OptionError(f"harmonics={harmonics} sets the harmonic balance; "
+                          f"method='shooting' integrates in time and takes none: leave one "
+                          f"of them out (method='hb', or no harmonics)")
     if not (max_cycles is None or max_cycles == "auto" or (
             isinstance(max_cycles, numbers.Integral) and not isinstance(max_cycles, bool)
             and max_cycles >= 1)):
@@ -422,11 +426,9 @@ def steady_state(model, *, method: str = "auto", harmonics: int | None = None,
                           "instead, or give a mesh a stiffness variation or an error.")
     if adaptive is None:
         adaptive = harmonics is None
-    from torquesplit.steady.solution import undamped_note
+    from torquesplit.steady.solution import warn_undamped
 
-    note = undamped_note(structure, static.q)
-    if note:
-        warn_user(note, ModelWarning)
+    warn_undamped(structure, static.q)
     problem = periodic_problem(model, kin, structure, per.frequency)
     sol = periodic_solution(structure, per, method=method, harmonics=harmonics,
                             samples=samples, speed=factor, q_static=static.q, initial=initial,

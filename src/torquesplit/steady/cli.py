@@ -233,8 +233,13 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
 
                 for loc, msg in result_warnings(res, res.metrics()):
                     warn(f"{loc}: {msg}")
-                for loc, msg in _near_critical(st):  # (as 'run' says it, at this speed)
-                    warn(f"{loc}: {msg}")
+                from torquesplit.steady.api import reference_speed
+                from torquesplit.steady.maps import near_critical_notes
+
+                for note in near_critical_notes(  # (as 'run' says it, at this speed)
+                        st.model, st.structure, st.static.q, st.kinematics,
+                        speed=st.solution.speed * reference_speed(st.model)):
+                    warn(note)
             rows = st.mesh_table(results=res)
             saved = None
             if out is not None:  # (every file named where the save is reported)
@@ -555,19 +560,6 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
 
 
 import numpy as np  # noqa: E402  (used by the commands above)
-
-
-def _near_critical(st) -> list[tuple[str, str]]:
-    """A critical speed within 1 % of the speed the steady state was solved at, as
-    ``run`` says it at the model's (a best effort: nothing where the map cannot tell)."""
-    from torquesplit.steady.api import reference_speed
-    from torquesplit.steady.maps import near_critical_speeds
-
-    try:
-        return near_critical_speeds(st.model, st.structure, st.static.q, st.kinematics,
-                                    speed=st.solution.speed * reference_speed(st.model))
-    except Exception:  # noqa: BLE001 - a note, never a reason to lose the results
-        return []
 
 
 def _marginal(ds) -> int:

@@ -12,6 +12,7 @@ import time
 import numpy as np
 
 from torquesplit.errors import ModelWarning, OptionError, SolverError, warn_user
+from torquesplit.steady.solution import warn_undamped
 from torquesplit.steady.api import reference_speed
 from torquesplit.steady.solution import check_method
 from torquesplit.steady.period import (
@@ -93,14 +94,6 @@ def _message_in_rpm(msg: str, w_ref: float, pts, s1: float, complete: bool) -> s
     return msg
 
 
-def _warn_undamped(structure, q) -> None:
-    """The modes without damping, as steady_state says them
-    (:func:`~torquesplit.steady.solution.undamped_note`)."""
-    from torquesplit.steady.solution import undamped_note
-
-    note = undamped_note(structure, q)
-    if note:
-        warn_user(note, ModelWarning)
 
 
 def sweep_speed(model, start: float, stop: float, *, points: int = 50,
@@ -161,8 +154,13 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
                           f"continuation step), got {max_step!r}; leave it out for the "
                           f"default")
     t_start = time.perf_counter()
+    from torquesplit.steady.api import _check_options
+
+    _check_options(steps_per_cycle=steps_per_cycle, tol=None, stability=stability,
+                   energy_tol=None, method=method, harmonics=harmonics,
+                   max_cycles=max_cycles)  # (as steady_state refuses them)
     model, kin, s, dropped, per, static = _prepare(model, keep, max_cycles)
-    _warn_undamped(s, static.q)
+    warn_undamped(s, static.q)
     sub = math.gcd(*[int(k) for k in per.orders]) if per.orders else 1
     w_ref = reference_speed(model)
     s0, s1 = _rad_per_s(start, "start") / w_ref, _rad_per_s(stop, "stop") / w_ref
@@ -687,6 +685,17 @@ NEAR_CRITICAL = 0.01
 DRIVING_HARMONIC = 0.01
 """... when the harmonic of the mesh stiffness that drives it is at least this share of the
 mean stiffness (a helical pair's high orders, 1e-4 and below, drive next to nothing)."""
+
+
+def near_critical_notes(model, structure, q, kinematics, speed=None) -> list[str]:
+    """:func:`near_critical_speeds` as ``"location: message"`` lines, a best effort (a
+    model the Campbell map cannot take says nothing): what ``run`` (at the model's speed)
+    and ``steady`` (at its own) print."""
+    try:
+        return [f"{loc}: {msg}" for loc, msg in near_critical_speeds(
+            model, structure, q, kinematics, speed=speed)]
+    except Exception:  # noqa: BLE001 - a note, never a reason to lose the results
+        return []
 
 
 def driven(crossing: dict, least: float = DRIVING_HARMONIC) -> bool:

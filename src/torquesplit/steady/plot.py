@@ -72,8 +72,9 @@ def sweep_figure(ds, variables=None):
     for n, (ax, variable) in enumerate(zip(axes, variables)):
         _sweep_panel(ax, ds, variable)
         if stopped:  # the range asked that the sweep did not reach, said on the figure
-            a, b = sorted(asked)
-            gap = (float(rpm[-1]), b) if rpm[-1] >= rpm[0] else (a, float(rpm[-1]))
+            # (in the direction asked: a branch that turned back still heads there)
+            end = float(asked[1])
+            gap = sorted((float(rpm[-1]), end))
             ax.axvspan(*gap, color="0.85", alpha=0.6, lw=0,
                        label="not computed: the sweep stopped\n(see its message)"
                        if n == 0 else None)

@@ -41,6 +41,15 @@ UNDAMPED = 1e-6
 """A mode whose modal damping ratio is below this has no damping (:func:`undamped_note`)."""
 
 
+def warn_undamped(structure, q) -> None:
+    """Warn (a ModelWarning) of the modes without damping (:func:`undamped_note`)."""
+    from torquesplit.errors import ModelWarning, warn_user
+
+    note = undamped_note(structure, q)
+    if note:
+        warn_user(note, ModelWarning)
+
+
 def undamped_note(structure, q) -> str:
     """A warning naming the modes without damping (modal damping ratio below
     :data:`UNDAMPED`) and the element with the largest share of each one's strain energy,

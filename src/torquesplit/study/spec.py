@@ -449,6 +449,11 @@ def _read(source, analysis: dict) -> tuple[StudySpec, Path | None, str]:
     try:
         return parse_study(with_analysis(data, analysis)), path.parent, text
     except StudyError as exc:
+        given = [(f, m) for f, m in exc.problems
+                 if f.startswith("analysis.") and f.split(".")[1] in analysis]
+        if given:  # (a field given beside the file, not in it: named as given)
+            raise StudyError.of([(f"analysis['{f.split('.')[1]}'] (given with the study "
+                                  f"{path.name})", m) for f, m in given]) from None
         raise exc.with_source(str(path)) from None
 
 
