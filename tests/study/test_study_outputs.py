@@ -21,9 +21,15 @@ def run(tmp_path_factory):
 
 
 def test_dynamic_names_and_values_come_from_the_metrics(run):
+    from torquesplit.results import bearing_bodies
+
     vals = output_values(run)
     groups = run.groups
-    assert set(vals) == set(available_outputs(run.mesh_names, groups, "run"))
+    # (its bodies only turn: each is held rigidly, its bearing the sum of its meshes')
+    bearings = bearing_bodies(run.structure, run.model)
+    assert bearings == [b["body"] for b in run.bearing_forces()] and bearings
+    assert set(vals) == set(available_outputs(run.mesh_names, groups, "run",
+                                              bearings=bearings))
     for d in ("cycle_peak", "instantaneous", "engineering", "mean_force"):
         met = run.metrics(d)
         assert vals[f"load_sharing.{d}"] == met.load_sharing.system
