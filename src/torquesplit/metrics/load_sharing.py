@@ -65,8 +65,8 @@ DEFINITION_TEXT = {
                      "part (Ji & Li eq. 18)",
     "engineering": "mean over settled mesh cycles of the per-cycle peak of the "
                    "instantaneous ratio (Ji & Li eq. 18, engineering coefficient g_it)",
-    "mean_force": "ratio of the meshes' mean forces over the settled part (Dong et al. "
-                  "2021 eq. 12)",
+    "mean_force": "ratio of the meshes' mean forces over the settled part, one span for "
+                  "every group (Dong et al. 2021 eq. 12)",
     "static_torque": "ratio of quasi-static mesh forces, largest over the mesh positions "
                      "(Mo et al. 2017 eqs. 14-15)",
 }
