@@ -1283,10 +1283,9 @@ def _gear_per_load(on, load) -> list:
 def _contact_load(text, model, kin, pair, names, on, cm, parse_quantity) -> float:
     """A --load value (checked by :func:`_check_load_text`) as a normal force [N]: a force
     as given, a torque on a gear divided by its base radius times cos(beta_b)."""
-    try:
+    if _is_force(text):
         return parse_quantity(text, "force")
-    except ValueError:
-        value = parse_quantity(text, "torque")
+    value = parse_quantity(text, "torque")
     gear = on or kin.meshes[pair].driven
     if gear not in names:
         raise TorquesplitError(f"--on {gear!r} is not a gear of mesh {pair!r}; name one of "

@@ -1177,15 +1177,20 @@ def magnitude_warnings(model: Model, kin) -> list[tuple[str, str]]:
     return out
 
 
+def _flanks(loc: str, gear):
+    """(flank modification, its location) of a gear's helices that have one."""
+    spec = gear.modifications
+    if spec is None:
+        return []
+    return [(f, w) for f, w in ((spec, f"{loc}.modifications"),
+                                (spec.second_helix, f"{loc}.modifications.second_helix"))
+            if f is not None]
+
+
 def _modification_amounts(loc: str, gear) -> list[tuple[str, float]]:
     """(field, amount [m]) of every tooth modification of a gear (both helices)."""
-    spec = gear.modifications
     out = []
-    for flank, where in (((spec, f"{loc}.modifications"),
-                          (spec.second_helix, f"{loc}.modifications.second_helix"))
-                         if spec is not None else ()):
-        if flank is None:
-            continue
+    for flank, where in _flanks(loc, gear):
         amounts = [("crowning", flank.crowning), ("helix_slope", flank.helix_slope)]
         for name in ("tip_relief", "root_relief", "end_relief"):
             if getattr(flank, name) is not None:
@@ -1215,11 +1220,8 @@ def _modification_warnings(loc: str, gear) -> list[tuple[str, str]]:
                 f"to tens of microns (rarely over {MODIFICATION_MODULE_RATIO:g} m_n): "
                 f"check the value and its unit (a bare number is read in m: write "
                 f"'15 um')")))
-    spec = gear.modifications
-    for flank, where in (((spec, f"{loc}.modifications"),
-                          (spec.second_helix, f"{loc}.modifications.second_helix"))
-                         if spec is not None else ()):
-        for name in ("tip_relief", "root_relief") if flank is not None else ():
+    for flank, where in _flanks(loc, gear):
+        for name in ("tip_relief", "root_relief"):
             relief = getattr(flank, name)
             for zone in ("length", "height"):
                 value = getattr(relief, zone, None) if relief is not None else None
