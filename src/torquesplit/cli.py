@@ -721,17 +721,12 @@ def run_table(met) -> Table:
 def bearing_table(bearings: list[dict], res) -> Table:
     """The supported bodies' bearing forces over the settled part (kN), from the run's
     history (:meth:`Results.bearing_forces`)."""
-    from .model.kinematics import support_frame
-
     per = ("every step" if res.history_keeps_every_step() else
            f"{res.history_samples_per_period():.3g} samples per shortest mesh period")
     b = Table(title=f"bearing forces (settled; from the history, {per})")
     # the force on the body's bearing, by direction of the frame it is written in: a
     # planet's (and any body's of a turning carrier's model) turns with the carrier
-    frames = []
-    for r in bearings:
-        carrier, _, turning = support_frame(res.kinematics, r["body"])
-        frames.append(f"carrier {carrier} (turning)" if carrier and turning else "housing")
+    frames = [r["frame"] for r in bearings]
     turning = any(f != "housing" for f in frames)
     cols = ["body", "mean force by direction\n[kN]", "|mean|\n[kN]", "peak |F|\n[kN]"]
     for col in cols + (["directions in"] if turning else []):

@@ -391,7 +391,7 @@ def prepare_run(
             f"analysis: samples_per_period={samples_per_period} asks for more samples than "
             f"the run takes steps: the history keeps every RK4 step, "
             f"{1.0 / (step * f_max):.4g} per shortest mesh period; a finer history needs "
-            f"{hint}", ModelWarning)
+            f"a finer step ({hint})", ModelWarning)
     # only a sampling the user asked for is worth a warning: the default one is a choice
     # of the library, and what it kept is in the bearing table's title and the files'
     # history_samples_per_period (a default run of Liu et al. 2021 warned)

@@ -171,6 +171,9 @@ CASES = [
      "drives", r"required field is missing; add it"),
     ("no load", setting("loads", {}),
      "loads", r"no load; add a \[loads\.NAME\] section"),
+    ("balanced load on the drive's body", setting("loads.out.body", "pinion"),
+     "loads.out.body", r"'pinion' is the body drives.motor drives: a balanced load there "
+                       r"takes the drive's power before it passes any gear; put the load"),
     ("power does not balance", setting("loads.out.torque", "150 N m"),
      "loads", r"power does not balance: .*31\.4159 kW.*23\.5619 kW"),
     ("unknown gear in a mesh", setting("meshes.m.gears", ["pinion", "wheeel"]),
@@ -437,6 +440,20 @@ def test_mesh_stiffness_far_from_iso_6336_warns():
     data["meshes"]["m"]["stiffness"] = "4e12 N/m"  # 4e9 N/mm typed as N/m, say
     with pytest.warns(ModelWarning, match=r"meshes\.m\.stiffness: .*ISO 6336 estimate"):
         torquesplit.load_model(data)
+
+
+def test_a_face_width_below_one_module_is_named():
+    """A planetary analyst's "60 um" for "60 mm": the stiffness and load-per-width
+    messages named every field but the face width."""
+    data = pair_dict()
+    data["gears"]["pinion"]["face_width"] = "20 um"
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        torquesplit.load_model(data)
+    said = [str(w.message) for w in caught]
+    assert any(re.search(r"gears\.pinion\.face_width: 20 um is 0\.01 times the module "
+                         r"\(2 mm\).*write '60 mm'", m) for m in said), said
+    assert any("meshes.m: carries" in m and "face_width" in m for m in said), said
 
 
 def test_valid_model_gives_no_warning():

@@ -192,3 +192,18 @@ def test_set_into_an_unknown_table_still_lists_what_exists():
         apply_assignments(P3, ["planetary.0.sun.erors.eccentricity=20 um"])
     (loc, msg), = exc.value.issues
     assert "does not exist" in msg and "{" not in msg, msg
+
+
+def test_a_stage_that_nothing_holds_names_the_ring_and_carrier_not_the_planets():
+    """A planetary analyst's stage without the ring's torsional_support was told that
+    its planets 'can turn freely against the rest': the planets spin fastest in the free
+    motion, but it is the ring and the carrier that nothing holds."""
+    from planetary_models import load, lp_raw
+
+    raw = lp_raw()
+    del raw["planetary"][0]["ring"]["torsional_support"]
+    with pytest.raises(ModelError) as exc:
+        load(raw)
+    said = str(exc.value)
+    assert "'stage_ring', 'stage_carrier' (with the planets) can turn freely" in said, said
+    assert "planet1'" not in said

@@ -226,6 +226,8 @@ def test_a_history_too_coarse_for_the_response_is_said(tmp_path):
     assert re.search("keeps every RK4 step, yet misses the settled (peak|smallest) force of "
                      "mesh out3", said), said
     assert "--steps-per-period" in said and "--samples-per-period" not in said
+    assert re.search(r"a finer step brings it closer \(--steps-per-period|a finer step "
+                     r"brings it closer \(a --steps-per-period above \d+", said), said
     t, f = every_step.mesh_force_history()
     j = every_step.mesh_names.index("out3")
     met = every_step.metrics()

@@ -182,8 +182,19 @@ def reference_issues(model: Model) -> list[tuple[str, str]]:
                                f"gear {g!r} does not exist; {_one_of(model.gears, 'gears')}"))
     for name, d in model.drives.items():
         need(f"drives.{name}.body", d.body)
+    driven_by = {d.body: name for name, d in model.drives.items()}
+    balanced = {ld.body for ld in model.loads.values() if ld.torque is None}
     for name, ld in model.loads.items():
         need(f"loads.{name}.body", ld.body)
+        # every drive on a body whose balanced load takes its power: no power passes any
+        # gear (a load with a given torque there is a take-off; a second drive on the
+        # output body, a booster: both fine)
+        if ld.torque is None and ld.body in driven_by and driven_by.keys() <= balanced:
+            issues.append((f"loads.{name}.body", (
+                f"{ld.body!r} is the body drives.{driven_by[ld.body]} drives: a balanced "
+                f"load there takes the drive's power before it passes any gear; put the "
+                f"load on the body the power leaves by (a power take-off on the input "
+                f"body: give its torque)")))
     if not model.drives:
         issues.append(("drives", "the model has no drive; add a [drives.NAME] section"))
     if not model.loads:
@@ -601,7 +612,8 @@ def plausibility_warnings(model: Model, kin) -> list[tuple[str, str]]:
         if spec.method == "constant" and iso and not (0.2 < spec.value / iso < 5):
             out.append((f"meshes.{name}.stiffness",
                         f"{spec.value:.3g} N/m is {spec.value / iso:.2g} times the ISO 6336 "
-                        f"estimate c_gamma*b = {iso:.3g} N/m; check the value and its unit"))
+                        f"estimate c_gamma*b = {iso:.3g} N/m (b the face width); check the "
+                        f"value, the gears' face_width and their units"))
     rigid = [(loc, msg.replace("a shaft joins bodies on one axis", "a rigid join locks "
                                "their rotations but not the motion of one about the other's "
                                "centre"))
@@ -1097,6 +1109,12 @@ def magnitude_warnings(model: Model, kin) -> list[tuple[str, str]]:
                                          f"and its unit (a bare number is read in m: "
                                          f"module = 3 means 3 m; write '3 mm')"))
         d = diameters.get(name)
+        if 0 < g.face_width < g.module:  # (b/m is 5-40 on gears that are made)
+            out.append((f"{loc}.face_width", (
+                f"{_length_text(g.face_width)} is {g.face_width / g.module:.3g} times the "
+                f"module ({g.module * 1e3:.4g} mm), where gears have face widths of a few "
+                f"modules or more; check the value and its unit (a bare number is read in "
+                f"m: write '60 mm')")))
         if d and g.face_width > 10 * d:
             out.append((f"{loc}.face_width", f"{g.face_width * 1e3:.4g} mm is "
                                              f"{g.face_width / d:.3g} times the pitch diameter "
@@ -1166,8 +1184,8 @@ def magnitude_warnings(model: Model, kin) -> list[tuple[str, str]]:
             if mk.force / width > MAX_LOAD_PER_WIDTH:
                 out.append((f"meshes.{name}", (
                     f"carries {mk.force / width / 1e3:.4g} N/mm of face width (steel teeth "
-                    f"carry up to about 2000 N/mm); check the drive's torque or power and "
-                    f"its unit")))
+                    f"carry up to about 2000 N/mm); check the drive's torque or power, "
+                    f"the gears' face_width and their units")))
     for name, sp in model.splines.items():
         against_size(f"splines.{name}.pitch_radius", sp.pitch_radius)
         if sp.radial_clearance > sp.pitch_radius:

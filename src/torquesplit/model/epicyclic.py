@@ -290,10 +290,17 @@ def solve_speeds(model: Model, axes, frames, groups, layout: EpicyclicLayout,
     if rank < len(reps):
         _, _, vt = np.linalg.svd(A)
         free = vt[-1]
-        moving = [reps[j] for j in np.argsort(-np.abs(free)) if abs(free[j]) > 1e-6][:4]
+        # the central members first: planets spin fastest in such a motion, but it is a
+        # ring or carrier that nothing holds
+        planets = {g for g, gear in model.gears.items()
+                   if gear.support is not None and gear.support.on}
+        turning = [j for j in np.argsort(-np.abs(free)) if abs(free[j]) > 1e-6]
+        central = [reps[j] for j in turning if reps[j] not in planets]
+        moving = (central or [reps[j] for j in turning])[:4]
+        with_planets = " (with the planets)" if central and len(central) < len(turning) else ""
         issues.append(("drives", (
-            f"the speeds are not determined: {', '.join(map(repr, moving))} can turn freely "
-            f"against the rest (a differential with one input); hold a member with "
+            f"the speeds are not determined: {', '.join(map(repr, moving))}{with_planets} "
+            f"can turn freely against the rest (a differential with one input); hold a member with "
             f"torsional_support (e.g. the ring of a planetary, the carrier of a star stage) "
             f"or give a second drive")))
         return {}

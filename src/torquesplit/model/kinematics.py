@@ -221,6 +221,14 @@ def support_frame(kin, body: str) -> tuple[str | None, float | None, float]:
             w_frame / (2 * math.pi))
 
 
+def bearing_frame(kin, body: str) -> str:
+    """The frame a body's bearing force is written in, in words: ``"housing"``, or
+    ``"carrier NAME (turning)"`` for a body whose translations are measured in a turning
+    carrier's frame (:func:`support_frame`)."""
+    carrier, _, turning = support_frame(kin, body)
+    return f"carrier {carrier} (turning)" if carrier and turning else "housing"
+
+
 # --------------------------------------------------------------------------- solver
 def solve_kinematics(model) -> Kinematics:
     """Layout, speeds, power flow, torques and forces of the nominal equal split.

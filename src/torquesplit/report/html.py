@@ -320,9 +320,11 @@ def _bearings(bearings: list[dict], res) -> str:
                           " (held rigidly)" if b.get("held") == "rigid" else ""),
              ", ".join(f"{d} {kn(v)}" for d, v in zip(b["directions"], b["mean"])),
              kn(b["mean_magnitude"]), kn(b["peak_magnitude"])] for b in bearings]
-    return ("<h3>Bearing forces</h3>"
-            + _table(["body", "mean force by direction [kN]", "|mean| [kN]", "peak |F| [kN]"],
-                     rows, left=2)
+    header = ["body", "mean force by direction [kN]", "|mean| [kN]", "peak |F| [kN]"]
+    if any(b["frame"] != "housing" for b in bearings):  # a planet's turns with its carrier
+        header.append("directions in")
+        rows = [r + [b["frame"]] for r, b in zip(rows, bearings)]
+    return ("<h3>Bearing forces</h3>" + _table(header, rows, left=2)
             + f'<p class="note">The force each body puts on its bearing over the settled '
               f"part, from the history ({per}): a peak between its samples is missed, "
               f"the means are not.</p>")

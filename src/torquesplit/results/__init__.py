@@ -25,6 +25,7 @@ import numpy as np
 from ..assembly.structure import element_units
 from ..errors import OptionError
 from ..metrics import load_sharing as ls
+from ..model.kinematics import bearing_frame
 
 #: the load-sharing definition of a new model: the mean-force ratio, the mesh load factor
 #: K_gamma of the design standards (see docs/load-sharing.md)
@@ -500,7 +501,8 @@ class Results:
         history is decimated (``samples_per_period``): a peak between its samples is
         missed, as :func:`~torquesplit.results.plausibility.coarse_history` says for the
         meshes; the means are not affected.  Forces are in the frame of the support (a
-        turning carrier's for planets)."""
+        turning carrier's for planets), which ``frame`` names: ``"housing"`` or
+        ``"carrier NAME (turning)"``."""
         s = self.solution
         if s is None or not s.history_t.size:
             return []
@@ -530,7 +532,8 @@ class Results:
         def row(body, directions, forces, **extra):
             mean = forces.mean(axis=0)
             magnitude = np.sqrt((forces ** 2).sum(axis=1))
-            return {"body": body, "via": via.get(body), "directions": directions,
+            return {"body": body, "via": via.get(body), "frame": bearing_frame(
+                        self.kinematics, body), "directions": directions,
                     "mean": [float(v) for v in mean],
                     "mean_magnitude": float(np.sqrt((mean ** 2).sum())),
                     "peak_magnitude": float(magnitude.max()), "samples": int(keep.sum()),
@@ -702,9 +705,9 @@ class Results:
             group_rows = [[g, " ".join(ms)] + [""] * 5 for g, ms in self.groups.items()]
         # the bearing table, one column per direction of any support's frame
         directions = sorted({d for b in bearings for d in b["directions"]})
-        bearing_header = (["body", "via"] + [f"mean_force_{d}_N" for d in directions]
+        bearing_header = (["body", "via", "frame"] + [f"mean_force_{d}_N" for d in directions]
                           + ["mean_force_magnitude_N", "peak_force_magnitude_N", "samples"])
-        bearing_rows = [[b["body"], b["via"] or b.get("held", "")]
+        bearing_rows = [[b["body"], b["via"] or b.get("held", ""), b["frame"]]
                         + [dict(zip(b["directions"], b["mean"])).get(d, "") for d in directions]
                         + [b["mean_magnitude"], b["peak_magnitude"], b["samples"]]
                         for b in bearings]

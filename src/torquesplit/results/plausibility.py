@@ -454,8 +454,8 @@ def coarse_history(results, metrics) -> list[tuple[str, str]]:
             f"step, at a corner of a stiffness table, which the mesh table's numbers (and "
             f"peak_force, min_force in the files) include and the history (files, figures, "
             f"the bearing table's peak |F|) does not; "
-            f"{finer_step_advice(results.structure, s.step_limited_by, s.step or 0.0)} "
-            f"brings it closer"))]
+            f"a finer step brings it closer "
+            f"({finer_step_advice(results.structure, s.step_limited_by, s.step or 0.0)})"))]
     more = max(100, 5 * round(per)) if math.isfinite(per) else 100
     return [("analysis", (
         f"the history ({per:.3g} samples per shortest mesh period), which the results "

@@ -797,19 +797,21 @@ highest mode, RK4 stability or an error sinusoid, in words."""
 
 
 def finer_step_advice(structure: Structure, limited_by: str, step: float) -> str:
-    """How to refine the RK4 step, in words: ``--steps-per-period`` where the excitation
-    period sets the step; where something else does (the highest mode, stability), that
-    only a number above the steps per period it makes refines it (the plain advice sent
-    users to an option that changed nothing below that number)."""
-    plain = "a finer step (--steps-per-period; steps_per_period= in Python)"
+    """How to ask for a finer RK4 step, in words to put in brackets after "a finer
+    step": ``--steps-per-period`` where the excitation period sets the step; where
+    something else does (the highest mode, stability), that only a number above the
+    steps per period that makes refines it (the plain advice sent users to an option
+    that changed nothing below that number)."""
+    plain = "--steps-per-period; steps_per_period= in Python"
     if not limited_by or limited_by == EXCITATION_PERIOD or not step > 0:
         return plain
     per = shortest_excitation_period(structure) / step
     if not math.isfinite(per):
         return plain
-    return (f"a finer step, which is set by {limited_by} here: only a --steps-per-period "
-            f"(steps_per_period= in Python) above the {round(per)} steps per shortest "
-            f"excitation period it makes refines it")
+    cause = limited_by.split(", needs ")[0]  # (what _step_for says, less its numbers)
+    return (f"a --steps-per-period above {round(per)}, steps_per_period= in Python: the "
+            f"step is set here by {cause}, at {round(per)} steps per shortest excitation "
+            f"period")
 
 
 def planned_step(structure: Structure, steps_per_period: int | None = None,
@@ -975,32 +977,53 @@ def rk4_chunk(limit_steps: int) -> int:
     return max(_MIN_CHUNK_STEPS, -(-per_chunk // kern.RESYNC) * kern.RESYNC)
 
 
+_ENTRIES: dict = {}
+
+
+def _type_key(a):
+    """What numba's typing of argument ``a`` depends on, found without typing it: an
+    array's dtype, dimensions, layout, writeability and alignment; a tuple's class and
+    its items'; any other value's class (a Python float is always float64, ...)."""
+    if isinstance(a, np.ndarray):
+        f = a.flags
+        return (a.dtype.str, a.ndim, f.c_contiguous, f.f_contiguous, f.writeable, f.aligned)
+    if isinstance(a, tuple):
+        return (type(a), tuple(_type_key(x) for x in a))
+    return type(a)
+
+
 def _compiled(dispatcher, args):
-    """The compiled function ``dispatcher(*args)`` ran, to call without numba's argument
-    typing (about 0.1 ms a call, a tenth of a short study run's kernel time: the kernel
-    is called once per chunk with arguments of the same types); the dispatcher itself
-    when it cannot be found."""
+    """The compiled function that ``dispatcher(*args)`` runs, to call without numba's
+    argument typing (a named tuple of 44 arrays costs about 2 ms to type, on every
+    call), found by :func:`_type_key`; the dispatcher itself when it has not run with
+    such arguments yet (call it, then ask again) or cannot be found."""
+    key = (dispatcher, tuple(_type_key(a) for a in args))
+    entry = _ENTRIES.get(key)
+    if entry is not None:
+        return entry
     try:
-        key = tuple(dispatcher.typeof_pyval(a) for a in args)
-        return dispatcher.overloads[key].entry_point
-    except Exception:  # noqa: BLE001 - any surprise: keep numba's own dispatch
+        sig = tuple(dispatcher.typeof_pyval(a) for a in args)
+        entry = dispatcher.overloads[sig].entry_point
+    except Exception:  # noqa: BLE001 - not compiled for these yet, or any surprise
         return dispatcher
+    _ENTRIES[key] = entry
+    return entry
 
 
 def _run_rk4(t0, plan, blowup, model, work, rec, rhs_code, counters, clock, progress):
     """Run the RK4 kernel in chunks (multiples of RESYNC steps, about 1.5 % each)."""
     chunk = rk4_chunk(plan.limit_steps)
     done = 0
-    run = kern.rk4_run
+    run = None
     while done < plan.limit_steps:
         m = min(chunk, plan.limit_steps - done)
         last = done + m == plan.limit_steps
         args = (t0, plan.h, done, m, last, plan.every, blowup, model, work, rec,
                 rhs_code.function, rhs_code.generated, counters, clock)
+        if run is None or run is kern.rk4_run:
+            run = _compiled(kern.rk4_run, args)
         try:
             run(*args)
-            if run is kern.rk4_run:
-                run = _compiled(kern.rk4_run, args)
             done += m
             if counters[kern.I_STATUS] != kern.FINISHED:
                 return
@@ -1022,14 +1045,18 @@ def _run_dopri(t0, t_end, plan, blowup, model, work, rec, rhs_code, counters, cl
     clock[kern.F_HMIN] = math.inf
     clock[kern.F_HMAX] = 0.0
     span = t_end - t0
+    run = None
     for k in range(1, _N_CHUNKS + 1):
         t_stop = t_end if k == _N_CHUNKS else t0 + span * k / _N_CHUNKS
         if clock[kern.F_T] >= t_stop:
             continue
+        args = (t0, t_end, t_stop, plan.rtol, plan.atol, plan.h_max, plan.h_min,
+                plan.limit_steps, blowup, plan.dt_sample, model, work, rec,
+                rhs_code.function, rhs_code.generated, counters, clock)
+        if run is None or run is kern.dopri_run:
+            run = _compiled(kern.dopri_run, args)
         try:
-            kern.dopri_run(t0, t_end, t_stop, plan.rtol, plan.atol, plan.h_max, plan.h_min,
-                           plan.limit_steps, blowup, plan.dt_sample, model, work, rec,
-                           rhs_code.function, rhs_code.generated, counters, clock)
+            run(*args)
             if counters[kern.I_STATUS] != kern.FINISHED:
                 return
             if progress is not None:

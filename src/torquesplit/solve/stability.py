@@ -18,6 +18,7 @@ import math
 
 import numpy as np
 
+from torquesplit._memo import remember_last
 from torquesplit.assembly.structure import Structure
 from torquesplit.errors import StepTooLargeError
 
@@ -55,18 +56,24 @@ def _system_matrix(structure: Structure) -> tuple[np.ndarray, np.ndarray]:
     return A, k_max
 
 
+@remember_last
 def system_eigenvalues(structure: Structure) -> np.ndarray:
     """Eigenvalues of the first-order system at maximum stiffness, all gaps closed [1/s].
 
-    Round-off positive real parts (below 1e-8 max|lambda|) are set to zero.
+    Round-off positive real parts (below 1e-8 max|lambda|) are set to zero.  Kept per
+    live structure (frozen) and returned read-only: a run with a given step checks it
+    with two of these eigenvalue problems (6 ms of every run of Ji & Li's drive).
     """
     if structure.n_dof == 0:
-        return np.zeros(0, dtype=complex)
-    A, _ = _system_matrix(structure)
-    lam = np.linalg.eigvals(A)
-    scale = np.max(np.abs(lam)) if lam.size else 0.0
-    tiny = (lam.real > 0) & (lam.real <= _REAL_TOL * scale)
-    return np.where(tiny, 1j * lam.imag, lam)
+        lam = np.zeros(0, dtype=complex)
+    else:
+        A, _ = _system_matrix(structure)
+        lam = np.linalg.eigvals(A)
+        scale = np.max(np.abs(lam)) if lam.size else 0.0
+        tiny = (lam.real > 0) & (lam.real <= _REAL_TOL * scale)
+        lam = np.where(tiny, 1j * lam.imag, lam)
+    lam.setflags(write=False)
+    return lam
 
 
 def highest_natural_frequency(structure: Structure) -> float:
@@ -141,10 +148,12 @@ def _is_stable(h: float, lam: np.ndarray) -> bool:
     return bool(np.all(np.abs(rk4_amplification(h * lam)) <= 1.0 + _R_TOL))
 
 
+@remember_last
 def stable_step(structure: Structure) -> float:
     """Largest RK4 step [s] for which every mode stays bounded (``inf`` if none limits).
 
-    Found by bisection on |R(h lambda)| <= 1 (RK4's region lies within |z| < 3).
+    Found by bisection on |R(h lambda)| <= 1 (RK4's region lies within |z| < 3); kept
+    per live structure, as its eigenvalues are.
     """
     lam = _limiting(system_eigenvalues(structure))
     if lam.size == 0:

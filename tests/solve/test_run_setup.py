@@ -1,0 +1,61 @@
+"""The set-up of a run, done once per structure: what a second run of the same structure
+reuses (kernel arrays, eigenvalues of the step check, the compiled kernel's entry point,
+the class of the generated function) and that reusing it changes no result."""
+
+from __future__ import annotations
+
+import sys
+
+import numpy as np
+import pytest
+from solve_models import random_structure, spur_pair
+
+from torquesplit.solve import _kernels as kern
+from torquesplit.solve import codegen, integrate, stability
+from torquesplit.solve.kernel_data import kernel_model
+
+integrate_module = sys.modules["torquesplit.solve.integrate"]
+
+
+def test_kernel_model_and_eigenvalues_are_kept_per_structure():
+    s, other = spur_pair(frequency=500.0), spur_pair(frequency=500.0)
+    assert kernel_model(s) is kernel_model(s)
+    assert kernel_model(other) is not kernel_model(s)
+    lam = stability.system_eigenvalues(s)
+    assert lam is stability.system_eigenvalues(s)
+    with pytest.raises(ValueError):  # shared between callers: read-only
+        lam[0] = 0.0
+    assert stability.stable_step(s) == stability.stable_step(other)
+
+
+def test_generated_functions_share_one_class():
+    """numba types a first-class function argument by a dispatch on its class: one class
+    for every generated function (a class per call missed that dispatch's cache)."""
+    a = codegen.generated_rhs(kernel_model(random_structure(0)))
+    b = codegen.generated_rhs(kernel_model(random_structure(1)))
+    assert a.generated and b.generated
+    assert type(a.function) is type(b.function)
+
+
+def test_type_key_follows_what_numba_types():
+    x = np.zeros(4)
+    ro = np.zeros(4)
+    ro.setflags(write=False)
+    key = integrate_module._type_key
+    assert key(x) == key(np.ones(4))
+    assert key(x) != key(ro)  # read-only arrays are typed apart
+    assert key(x) != key(np.zeros(4, dtype=np.int64))
+    assert key(x) != key(np.zeros((2, 2)))
+    assert key(np.zeros((4, 3))[:, 0]) != key(x)  # layout
+    assert key((x, 1.0)) != key((x, 1))
+
+
+def test_second_run_uses_the_entry_point_and_gives_the_same_result():
+    s = spur_pair(frequency=800.0, damping=50.0)
+    kw = dict(method="rk4", steps_per_period=50)
+    first = integrate(s, np.zeros(4), (0.0, 0.01), **kw)
+    args_key = [k for k in integrate_module._ENTRIES if k[0] is kern.rk4_run]
+    assert args_key, "the RK4 kernel's entry point was not kept after a run"
+    second = integrate(s, np.zeros(4), (0.0, 0.01), **kw)
+    np.testing.assert_array_equal(first.y_final, second.y_final)
+    np.testing.assert_array_equal(first.cycle_max, second.cycle_max)
