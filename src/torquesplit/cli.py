@@ -419,6 +419,7 @@ def run(
     from .results import files
 
     state = {"saved": [], "figures": None}
+    save_failed = None
 
     def kept() -> str:
         if state["saved"]:
@@ -476,8 +477,13 @@ def run(
                         res.run_warnings.append(text)
                         ux.warn(text)
                 if out is not None:
-                    res.save(out, overwrite=force, definition=chosen)
-                    state["saved"] = list(plan.files)
+                    try:
+                        res.save(out, overwrite=force, definition=chosen)
+                        state["saved"] = list(plan.files)
+                    except _EXPECTED as exc:  # (the folder went during the run, a
+                        # companion file appeared): the run is kept elsewhere, said last
+                        state["saved"], save_failed = _rescued(
+                            lambda p: res.save(p, definition=chosen), out, exc)
             step_check = None
             if check and met is not None:
                 from .convergence import check_step
@@ -491,22 +497,46 @@ def run(
         saved = state["saved"]
         if met is None:
             _render_stopped(res, saved, as_json)
+            if save_failed is not None:
+                _fail(save_failed)
             from .solve.integrate import INTERRUPTED
 
             raise typer.Exit(130 if res.solution.status == INTERRUPTED else 1)
-        figures, failed = [], None
+        figures, failed = [], save_failed
         if plots is not None:
             state["figures"] = []
             try:
                 figures = _write_run_figures(res, plots, met.definition, quiet or as_json)
             except OSError as exc:
-                failed = _figure_error(exc, "--plots", plots, _kept_results(saved))
+                failed = failed or _figure_error(exc, "--plots", plots, _kept_results(saved))
             state["figures"] = None
     if failed is None:
         _print_run(m, res, met, saved, figures, step_check, plots, as_json)
     else:
         _print_run(m, res, met, saved, [], step_check, None, as_json)
         _fail(failed)
+
+
+def _rescued(save, out, exc) -> tuple[list[Path], Exception]:
+    """A finished run whose results file cannot be written (checked at the start, the
+    folder went or a companion file appeared during the run): saved as ``NAME_rescued.nc``
+    in the current folder (else the temporary one) instead, and the error to report after
+    the tables, naming where the results are.  A run of hours is never lost to a path."""
+    import tempfile
+
+    from .errors import OutputError
+
+    stem = Path(str(out)).stem or "results"
+    for folder in (Path.cwd(), Path(tempfile.gettempdir())):
+        path = next(p for p in (folder / f"{stem}_rescued{'' if k == 1 else f'_{k}'}.nc"
+                                for k in range(1, 10**6)) if not p.exists())
+        try:
+            save(path)
+        except _EXPECTED:
+            continue
+        return [path], OutputError(f"{clip_message(str(exc))}; the results were saved to "
+                                   f"{path} instead")
+    return [], exc
 
 
 def _near_critical(res) -> list[str]:

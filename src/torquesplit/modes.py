@@ -367,6 +367,9 @@ def model_modes(model, *, rotating_frame: bool = True, below: float | None = Non
     if below is not None and not (isinstance(below, (int, float)) and below > 0):
         raise OptionError(f"below must be a positive frequency in Hz (a number), got "
                           f"{below!r}")
+    if not (isinstance(rtol, (int, float)) and not isinstance(rtol, bool) and 0 <= rtol < 1):
+        raise OptionError(f"rtol must be a relative difference of frequencies, 0 <= rtol < 1, "
+                          f"got {rtol!r}; give e.g. rtol=1e-6")
     if not hasattr(model, "meshes"):
         model = load_model(model)
     kin = solve_kinematics(model)

@@ -341,6 +341,12 @@ def prepare_run(
 
         raise OptionError(f"option(s) {wrong} do not apply to method={method!r}; remove "
                           "them or choose the other method")
+    if rtol is not None and not (isinstance(rtol, (int, float)) and not isinstance(rtol, bool)
+                                 and 0 < rtol < 1):
+        from .errors import OptionError
+
+        raise OptionError(f"rtol must be a number between 0 and 1 (as [analysis] rtol), got "
+                          f"{rtol!r}; give e.g. rtol=1e-6")
     if steps_per_period is None:
         steps_per_period = an.steps_per_period
     else:  # as the model file takes it (0 fell back to the model's, 2.5 was cut to 2)

@@ -232,3 +232,38 @@ def test_help_and_listing_say_what_the_commands_do():
     assert "[analysis] steps_per_period, else 100" in text
     listing = runner.invoke(app, ["examples"]).stdout
     assert "version 0.2" not in listing and "The earlier names still work" in listing
+
+
+def test_a_results_file_that_cannot_be_written_at_the_end_keeps_the_run(tmp_path,
+                                                                        monkeypatch):
+    """The --out folder went during the run (checked at the start): the finished run
+    printed nothing and saved nothing.  Now its tables are printed and it is saved as
+    NAME_rescued.nc in the current folder, which the error names."""
+    import shutil
+
+    import torquesplit.results as results_module
+    from torquesplit.errors import OutputError
+
+    model = write_model(tmp_path, SPUR_PAIR)
+    (tmp_path / "gone").mkdir()
+    real_save = results_module.Results.save
+
+    def folder_gone(self, path, **kw):
+        if "gone" in str(path):
+            shutil.rmtree(tmp_path / "gone", ignore_errors=True)
+            raise OutputError(f"cannot write {path}: the folder gone does not exist")
+        return real_save(self, path, **kw)
+
+    monkeypatch.setattr(results_module.Results, "save", folder_gone)
+    monkeypatch.chdir(tmp_path)
+    res = runner.invoke(app, ["run", str(model), "--cycles", "40", "--quiet",
+                              "--out", str(tmp_path / "gone" / "r.nc")])
+    last = error_line(res, "cannot write", "the results were saved to",
+                      "r_rescued.nc instead")
+    assert "system load-sharing coefficient" in res.stdout  # the tables came first
+    rescued = tmp_path / "r_rescued.nc"
+    assert rescued.exists(), last
+    import torquesplit
+
+    back = torquesplit.load_results(rescued)
+    assert back.success

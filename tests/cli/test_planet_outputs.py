@@ -21,6 +21,28 @@ def test_the_bearing_table_says_which_frame_its_directions_are_in():
     assert "directions in" in table and "carrier stage_carrier (turning)" in table
 
 
+def test_the_bearing_rows_of_the_files_say_their_frame_too(tmp_path):
+    """The JSON, the CSV and the report had the forces without their frame: a sun's force,
+    steady in the carrier's frame, read as a steady load on the housing."""
+    import csv
+
+    res = CliRunner().invoke(app, ["run", EXAMPLE, "--cycles", "30", "--json", "--out",
+                                   str(tmp_path / "r.csv")])
+    assert res.exit_code == 0, res.output
+    rows = json.loads(res.stdout)["bearing_forces_N"]
+    frames = {r["body"]: r["frame"] for r in rows}
+    assert frames["stage_planet1"] == "carrier stage_carrier (turning)", frames
+    path = next(tmp_path.glob("*bearings.csv"))
+    table = list(csv.DictReader(path.read_text().splitlines()))
+    assert {r["body"]: r["frame"] for r in table} == frames
+    res = CliRunner().invoke(app, ["report", EXAMPLE, "--cycles", "30", "--out",
+                                   str(tmp_path / "rep.html")])
+    assert res.exit_code == 0, res.output
+    html = (tmp_path / "rep.html").read_text()
+    bearings = html[html.index("<h3>Bearing forces</h3>"):]
+    assert "directions in" in bearings and "carrier stage_carrier (turning)" in bearings
+
+
 def test_a_planet_factor_that_counts_pulling_teeth_says_so():
     """Without backlash an unloaded planet's teeth pull, and K_gamma counts the pull
     (4.37 > N = 4 on a reviewer's stage): the warning names the cause and the fix."""

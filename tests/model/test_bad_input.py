@@ -135,6 +135,9 @@ CASES = [
      "gears.wheel.place.angle", r"'0 kg' is not an angle.*'20 deg'"),
     ("stiffness zero", setting("meshes.m.stiffness", 0),
      "meshes.m.stiffness.value", r"must be greater than 0, got 0; give a positive value"),
+    ("stiffness beyond any gear", setting("meshes.m.stiffness", "1e20 N/m"),
+     "meshes.m.stiffness", r"1e\+20 N/m is .* times the ISO 6336 estimate .*no gear mesh "
+                           r"is that stiff"),
     ("stiffness negative", setting("meshes.m.stiffness", "-4e8 N/m"),
      "meshes.m.stiffness.value", r"greater than 0, got '-4e8 N/m'"),
     ("mass zero", setting("gears.pinion.mass", "0 kg"),
@@ -178,10 +181,16 @@ CASES = [
      "loads", r"power does not balance: .*31\.4159 kW.*23\.5619 kW"),
     ("unknown gear in a mesh", setting("meshes.m.gears", ["pinion", "wheeel"]),
      "meshes.m.gears", r"gear 'wheeel' does not exist; use one of the gears \['pinion', 'wheel'\]"),
+    ("three gears in a mesh", setting("meshes.m.gears", ["pinion", "wheel", "pinion"]),
+     "meshes.m.gears", r"has 3 items, at most 2 allowed; give as many items"),
     ("gear meshes with itself", setting("meshes.m.gears", ["pinion", "pinion"]),
      "meshes.m.gears", r"'pinion' cannot mesh with itself; name two different gears"),
     ("both position and place", setting("gears.wheel.position", ["60 mm", "0 mm", "0 mm"]),
      "gears.wheel", r"both 'position' and 'place' are given; remove one"),
+    ("angle with its unit out of range", setting("gears.pinion.pressure_angle", "60 deg"),
+     "gears.pinion.pressure_angle", r"\(60 deg\) is outside \+/-45 deg; check the value"),
+    ("module in km", setting("gears.pinion.module", "2 km"),
+     "gears.pinion.module", r"2000 m is implausibly large; check the value and its unit"),
     ("bare angle read as radians", setting("gears.pinion.pressure_angle", 20),
      "gears.pinion.pressure_angle", r"20 rad .* outside \+/-45 deg.*write '20 deg'"),
     ("helical gear without hand", _helical(None, "left"),
@@ -454,6 +463,24 @@ def test_a_face_width_below_one_module_is_named():
     assert any(re.search(r"gears\.pinion\.face_width: 20 um is 0\.01 times the module "
                          r"\(2 mm\).*write '60 mm'", m) for m in said), said
     assert any("meshes.m: carries" in m and "face_width" in m for m in said), said
+
+
+def test_stage_labels_that_differ_only_in_spacing_are_named():
+    """'stage 1' beside 'stage1' split a stage into two groups of one mesh, each sharing
+    1.00000, without a word."""
+    import tomllib
+
+    from model_texts import split_model
+
+    data = tomllib.loads(split_model())
+    stages = {m.get("stage") for m in data["meshes"].values()}
+    label = sorted(s for s in stages if s)[0]
+    first = next(n for n, m in data["meshes"].items() if m.get("stage") == label)
+    data["meshes"][first]["stage"] = label.upper() + " "
+    with pytest.warns(ModelWarning, match=rf"meshes\.{first}\.stage: '{label.upper()} ' "
+                                          rf"differs from '{label}' only in spacing, case or "
+                                          rf"punctuation.*write the same label"):
+        torquesplit.load_model(data)
 
 
 def test_valid_model_gives_no_warning():

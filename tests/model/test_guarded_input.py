@@ -253,6 +253,9 @@ def test_a_mesh_without_nominal_load_is_a_check_error():
     """run printed DLF = inf and LSC = 202,305 for a load on the drive's own body."""
     data = pair_dict()
     data["loads"]["out"]["body"] = "pinion"
+    # a balanced load there: named as such at once (the drive's power never meets a gear)
+    _refused(data, "loads.out.body", r"'pinion' is the body drives.motor drives")
+    data["loads"]["out"]["torque"] = "100 N m"  # a given torque: a take-off, all of it
     _refused(data, "meshes.m", r"carries no nominal load .* 'pinion'")
 
 

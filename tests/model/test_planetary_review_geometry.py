@@ -207,3 +207,28 @@ def test_a_stage_that_nothing_holds_names_the_ring_and_carrier_not_the_planets()
     said = str(exc.value)
     assert "'stage_ring', 'stage_carrier' (with the planets) can turn freely" in said, said
     assert "planet1'" not in said
+
+
+def test_a_load_on_a_planet_of_a_turning_carrier_is_named():
+    """A balanced load on a planet was told that the power does not balance, to set the
+    load's torque to "balanced" (it was): the planet is named, and where to put it."""
+    from planetary_models import load, lp_raw
+
+    raw = lp_raw()
+    raw["loads"]["output"]["body"] = "stage_planet1"
+    with pytest.raises(ModelError) as exc:
+        load(raw)
+    said = str(exc.value)
+    assert ("loads.output.body: 'stage_planet1' is a planet of the turning carrier "
+            "'stage_carrier'") in said, said
+    assert "power does not balance" not in said
+
+
+def test_a_stage_name_with_a_space_says_what_a_name_may_hold():
+    """'st age', quoted, was told it 'must be text ... write it in quotes'."""
+    from planetary_models import load, lp_raw
+
+    raw = lp_raw(name="st age")
+    with pytest.raises(ModelError, match=r"planetary\.0\.name: 'st age' is not a name this "
+                                         r"field takes; use letters, digits and '_'"):
+        load(raw)

@@ -251,3 +251,35 @@ def test_a_parameter_on_several_paths_names_them_on_the_axis(split_file):
                               outputs=["load_sharing.cycle_peak"]), workers=1)
     fig = curves_figure(ds, "load_sharing.cycle_peak", [("system", "load_sharing.cycle_peak")])
     assert fig.axes[0].get_xlabel() == f"error ({', '.join(paths)}) [µm]"
+
+
+def test_a_study_is_written_for_a_spreadsheet_and_for_matlab(tmp_path, split_file):
+    """results.csv (a row per case) and results.mat (arrays of the grid's shape) beside
+    results.nc: a studies user had only NetCDF, where `run` writes .csv and .mat."""
+    import csv
+    import io
+
+    from scipy.io import loadmat
+
+    data = grid_study(split_file, [STIFFNESS, ERROR], outputs=("load_sharing.cycle_peak",
+                                                               "peak_force.a1"))
+    ds = Study(data).run(workers=1, out=tmp_path / "o", figures=False)
+    rows = list(csv.reader(io.StringIO((tmp_path / "o" / "results.csv").read_text())))
+    header, body = rows[0], rows[1:]
+    assert header[:2] == ["meshes.a1.stiffness [N/m]",
+                          "meshes.b1.transmission_error.constant [m]"]
+    assert "peak_force.a1 [N]" in header and "status" in header
+    assert len(body) == 8
+    col = header.index("peak_force.a1 [N]")
+    got = np.array([[float(r[col]) for r in body]]).reshape(4, 2)
+    np.testing.assert_array_equal(got, ds["peak_force.a1"].values)
+    assert {r[header.index("status")] for r in body} == {"ok"}
+    mat = loadmat(tmp_path / "o" / "results.mat")
+    names = {str(a[0]): str(b[0]) for a, b in mat["names"]}
+    assert names["peak_force_a1"] == "peak_force.a1"
+    np.testing.assert_array_equal(mat["peak_force_a1"], ds["peak_force.a1"].values)
+    np.testing.assert_array_equal(mat["meshes_a1_stiffness"].ravel(),
+                                  ds["meshes.a1.stiffness"].values)
+    units = {str(a[0]): (str(b[0]) if b.size else "") for a, b in mat["units"]}
+    assert units["peak_force_a1"] == "N"
+    assert str(mat["status"][0, 0][0]) == "ok"

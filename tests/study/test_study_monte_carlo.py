@@ -90,6 +90,22 @@ def test_a_shared_iso1328_value_of_gears_with_other_tolerances_is_refused(split_
     assert Study(data).plan().design.values.shape == (16, 1)
 
 
+@pytest.mark.parametrize("path", ["gears.a.face_width", "meshes.a1.backlash"])
+def test_an_iso1328_grade_on_a_field_that_is_not_a_gear_deviation_is_refused(split_file,
+                                                                            path):
+    """A studies user drew a shaft's diameter from a gear's runout tolerance (3-34 um):
+    every case ran, and lost contact."""
+    from torquesplit.errors import StudyError
+
+    data = mc_study(split_file, samples=4)
+    data["monte_carlo"]["parameters"] = [
+        {"path": path, "distribution": "iso1328", "grade": 7, "gear": "pinion",
+         "tolerance": "runout"}]
+    with pytest.raises(StudyError, match=r"ISO 1328-1 grade bounds a gear's manufacturing "
+                                         r"deviations .*not " + path.replace(".", r"\.")):
+        Study(data).plan()
+
+
 def test_stopping_rule_stops_when_interval_is_narrow(split_file):
     stop = {"output": OUT, "statistic": "mean", "half_width": 0.01, "confidence": 0.95,
             "min_samples": 16, "batch": 8, "max_samples": 400}
@@ -194,6 +210,11 @@ def test_statistics_over_fewer_cases_say_so(split_file, tmp_path):
     ds["status"].values[0] = "contact_lost"
     title = monte_carlo_figure(ds, OUT)._suptitle.get_text()
     assert "(1 lost contact and 2 failed of 8 cases)" in title, title
+    # and the summary says that the statistics hold it (a reviewer averaged four)
+    with ui.console.capture() as cap:
+        _summary(ds, tmp_path, False, False)
+    assert "1 of these 8 cases lost contact (status contact_lost): their values are in " \
+           "the statistics" in " ".join(cap.get().split()), cap.get()
     # counts on whole-number ticks; no 95th percentile of fewer than 20 samples (it is
     # their largest), nor its legend entry
     ticks = fig.axes[0].get_yticks()

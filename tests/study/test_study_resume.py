@@ -396,3 +396,37 @@ def test_workers_exit_when_their_driver_is_killed(tmp_path, split_file):
     for w in alive:  # (leave nothing behind, then fail)
         os.kill(w, signal.SIGKILL)
     assert not alive, f"workers {alive} outlived their driver"
+
+
+def test_resume_runs_again_the_cases_that_ended_in_an_error(tmp_path, split_file):
+    """A case that ended in an exception (a bug, the machine: here a file changed under a
+    running study) was kept as 'error' by every resume, and only --overwrite (which drops
+    the good cases too) ran it again.  Refused and diverged cases are the model's: kept."""
+    data = grid_study(split_file, GRID)
+    out = tmp_path / "out"
+
+    def one_error(function, payloads):
+        for p in payloads:
+            r = function(p)
+            if r["index"] == 2:
+                r = dict(r, status="error", reason="NameError: a stand-in",
+                         values=[float("nan")] * len(r["values"]))
+            yield r
+
+    first = Study(data).run(runner=one_error, out=out, figures=False)
+    assert list(first["status"].values).count("error") == 1
+    ran = []
+
+    def recording(function, payloads):
+        for p in payloads:
+            ran.append(p["index"])
+            yield function(p)
+
+    with pytest.warns(UserWarning, match=r"1 case of the study in .* ended in an error .* "
+                                         r"is run again"):
+        ds = Study(data).run(runner=recording, out=out, resume=True, figures=False)
+    assert ran == [2]
+    assert (ds["status"] == "ok").all()
+    clean = Study(data).run(workers=1, figures=False)
+    for name in Study(data).outputs:
+        xr.testing.assert_equal(ds[name], clean[name])

@@ -235,3 +235,29 @@ def test_a_long_title_is_wrapped_inside_the_figure():
     box = fig._suptitle.get_window_extent()
     assert box.x0 >= 0 and box.x1 <= fig.bbox.width
     assert "\n" in fig._suptitle.get_text()
+
+
+def test_a_factor_bound_that_makes_the_model_invalid_is_said_before_the_cases_run(
+        split_file):
+    """A studies user's Morris factor reached values the model refuses: 14 of 20 cases
+    came back refused, said only after they ran (a grid says it before)."""
+    from torquesplit.study import Study
+
+    data = _study(split_file, "morris", trajectories=2)
+    data["sensitivity"]["parameters"][1].update(low="-4e8 N/m", high="4e8 N/m")
+    notes = Study(data).plan().notes
+    assert any("gives an invalid model" in n and "meshes.b2.stiffness" in n
+               and "recorded as refused" in n for n in notes), notes
+
+
+def test_no_ranking_is_printed_where_no_index_could_be_computed(split_file, tmp_path):
+    from torquesplit import cli as ui
+    from torquesplit.study.cli import _summary
+
+    ds = run_study(_study(split_file, "morris", trajectories=2), workers=1)
+    ds["mu_star"].values[:] = np.nan  # as if every trajectory had lost a case
+    with ui.console.capture() as cap:
+        _summary(ds, tmp_path, False, False)
+    text = cap.get()
+    assert "none: no index could be computed" in text
+    assert "gears.pinion.density nan" not in text

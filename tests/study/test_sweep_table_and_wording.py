@@ -57,6 +57,21 @@ def test_a_grid_with_many_outputs_prints_grid_tables_not_statistics(tmp_path, sp
     for member in ("system", "split", "a1", "a2", "b1", "b2"):
         assert f" {member} " in text
     assert "cycle_peak.a1" not in text and "peak_force.a1" not in text
+    # what each family measures, as run's legend says it (a reviewer: the tables named
+    # their columns only)
+    from torquesplit.metrics.load_sharing import DEFINITION_TEXT
+
+    flat = " ".join(text.split())
+    assert f"load_sharing.cycle_peak: {DEFINITION_TEXT['cycle_peak']}" in flat, text
+    assert "peak_force: peak mesh force" in flat
+    res = runner.invoke(app, ["study", str(path), "--out", str(tmp_path / "o"), "--resume",
+                              "--json", "--no-figures"])
+    import json
+
+    data = json.loads(res.stdout)
+    assert data["output_dimensions"] == ["meshes.a1.transmission_error.constant"]
+    assert data["output_units"]["peak_force.a1"] == "N"
+    assert data["definitions"][0].startswith("load_sharing.cycle_peak: ")
 
 
 def test_a_large_grid_is_not_summarised_as_a_sample(tmp_path, split_file, monkeypatch):

@@ -186,10 +186,13 @@ class GearGeometry:
         if not (self.normal_module > 0 and math.isfinite(self.normal_module)):
             issues.append(("normal_module", f"must be a positive length in metres, got {self.normal_module!r}"))
         elif self.normal_module > 0.1:
-            issues.append(("normal_module", f"{self.normal_module:g} m is implausibly large; "
-                                            f"a bare number is read in metres: write "
-                                            f"'{self.normal_module:g} mm' (or "
-                                            f"{self.normal_module:g}e-3)"))
+            # (a bare number typed in mm is below 100; '2 km' is not a slip of that kind)
+            hint = (f"a bare number is read in metres: write '{self.normal_module:g} mm' (or "
+                    f"{self.normal_module:g}e-3)" if self.normal_module < 100 else
+                    "check the value and its unit (modules are 0.05-100 mm: write e.g. "
+                    "'3 mm')")
+            issues.append(("normal_module", f"{self.normal_module:g} m is implausibly "
+                                            f"large; {hint}"))
         if not (0 < self.normal_pressure_angle < math.radians(45)):
             issues.append(("normal_pressure_angle", f"must lie in (0, 45 deg) and is in radians, "
                                                     f"got {self.normal_pressure_angle!r}"))

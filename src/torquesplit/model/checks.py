@@ -91,8 +91,10 @@ def check_model(model: Model, source: str | None = None, *, deep: bool = False) 
     except KinematicsError as exc:
         raise ModelError(as_written(model, exc.issues), source) from None
     issues = shaft_axis_issues(model, kin) + overlap_issues(model, kin)
-    issues += nominal_load_issues(model, kin) + balance_issues(model, kin)
+    on_planets = planet_drive_issues(model, kin)
+    issues += nominal_load_issues(model, kin) + (on_planets or balance_issues(model, kin))
     issues += stiffness_table_issues(model, kin) + planet_fit_issues(model, kin)
+    issues += stiffness_magnitude_issues(model, kin)
     notes = []
     if not issues and deep:
         issues, notes = _readiness(model, kin)
@@ -552,6 +554,55 @@ def support_issues(model: Model) -> list[tuple[str, str]]:
     return issues
 
 
+#: a mesh stiffness beyond this multiple of the ISO 6336 estimate is refused: no gear is
+#: that stiff (a unit slip), and against it the other compliances and a backlash fall
+#: below what double precision resolves (1e20 N/m: a quasi-static sweep found every
+#: tooth force 0 and "converged", the modes no elastic mode)
+ISO_STIFFNESS_LIMIT = 1e6
+
+
+def stiffness_magnitude_issues(model: Model, kin) -> list[tuple[str, str]]:
+    """Constant mesh stiffnesses beyond :data:`ISO_STIFFNESS_LIMIT` times the ISO 6336
+    estimate (warned from 5 times)."""
+    out = []
+    for name, mk in kin.meshes.items():
+        spec, iso = model.meshes[name].stiffness, mk.iso_stiffness
+        if spec.method == "constant" and iso and spec.value / iso > ISO_STIFFNESS_LIMIT:
+            out.append((f"meshes.{name}.stiffness", (
+                f"{spec.value:.3g} N/m is {spec.value / iso:.2g} times the ISO 6336 estimate "
+                f"c_gamma*b = {iso:.3g} N/m: no gear mesh is that stiff, and beside it the "
+                f"other compliances fall below what the solvers resolve; check the value "
+                f"and its unit (meshes are 1e8-1e10 N/m: write e.g. '4e8 N/m' or "
+                f"'400 N/um')")))
+    return out
+
+
+def _label_slips(model: Model) -> list[tuple[str, str]]:
+    """Stage and path labels that differ only in spacing, case or punctuation: each
+    label is a load-sharing group of its own ('stage 1' beside 'stage1' split a stage
+    into two groups of one mesh, each sharing 1.00000, without a word)."""
+    out = []
+    for field in ("stage", "path"):
+        labels: dict[str, list[str]] = {}
+        for name, m in model.meshes.items():
+            label = getattr(m, field)
+            if label is not None:
+                labels.setdefault(label, []).append(name)
+        by_key: dict[str, list[str]] = {}
+        for label in labels:
+            by_key.setdefault(re.sub(r"[\W_]+", "", label).lower(), []).append(label)
+        for same in by_key.values():
+            if len(same) < 2:
+                continue
+            few = min(same, key=lambda lab: len(labels[lab]))
+            others = ", ".join(repr(lab) for lab in same if lab != few)
+            out.append((f"meshes.{labels[few][0]}.{field}", (
+                f"{few!r} differs from {others} only in spacing, case or punctuation; each "
+                f"{field} label is a load-sharing group of its own, so these meshes form "
+                f"{len(same)} groups: write the same label")))
+    return out
+
+
 def plausibility_warnings(model: Model, kin) -> list[tuple[str, str]]:
     """Values that can be right but usually are not."""
     out = []
@@ -564,7 +615,7 @@ def plausibility_warnings(model: Model, kin) -> list[tuple[str, str]]:
         if ratio is not None and ratio > 1:
             out.append((loc, f"{ratio:g} is above critical damping (1); check the value "
                              f"(typical 0.02-0.1)"))
-    out += _friction_drift(model)
+    out += _friction_drift(model) + _label_slips(model)
     out += _locked_speed_drives(model)
     out += _mass_magnitudes(model)
     out += _centre_distance_offsets(model, kin)
@@ -609,7 +660,8 @@ def plausibility_warnings(model: Model, kin) -> list[tuple[str, str]]:
                         f"are 0.02-0.1)"))
         iso = mk.iso_stiffness
         spec = m.stiffness
-        if spec.method == "constant" and iso and not (0.2 < spec.value / iso < 5):
+        if (spec.method == "constant" and iso and not (0.2 < spec.value / iso < 5)
+                and spec.value / iso <= ISO_STIFFNESS_LIMIT):
             out.append((f"meshes.{name}.stiffness",
                         f"{spec.value:.3g} N/m is {spec.value / iso:.2g} times the ISO 6336 "
                         f"estimate c_gamma*b = {iso:.3g} N/m (b the face width); check the "
@@ -1359,6 +1411,28 @@ def _friction_drift(model: Model) -> list[tuple[str, str]]:
         if load.torque is None and not load.speed_coefficient]
 
 
+def planet_drive_issues(model: Model, kin) -> list[tuple[str, str]]:
+    """Drives and loads on a planet of a turning carrier: its spin is relative to the
+    carrier, so the power it puts in or takes is not its torque x its speed (a balanced
+    load on one was told only that the power did not balance, to set it 'balanced')."""
+    from .kinematics import support_frame
+
+    issues = []
+    for kind, items in (("drives", model.drives), ("loads", model.loads)):
+        for name, x in items.items():
+            carrier, _, turning = support_frame(kin, x.body)
+            gear = model.gears.get(x.body)
+            on = gear.support.on if gear is not None and gear.support is not None else None
+            if carrier and turning and on == carrier:
+                issues.append((f"{kind}.{name}.body", (
+                    f"{x.body!r} is a planet of the turning carrier {carrier!r}: it spins "
+                    f"about its pin while the pin orbits, so the power a {kind[:-1]} there "
+                    f"exchanges is not its torque times its speed, and the power flow "
+                    f"cannot be balanced; put the {kind[:-1]} on the sun, the ring or the "
+                    f"carrier")))
+    return issues
+
+
 def balance_issues(model: Model, kin) -> list[tuple[str, str]]:
     """Drive and load torques must balance to :data:`BALANCE_TOLERANCE`, the tolerance
     of the static equilibrium that starts every run.
@@ -1474,11 +1548,11 @@ def _readiness(model: Model, kin=None) -> tuple[list, list]:
             static = static_equilibrium(structure)
     except SolverError as exc:
         loc, msg = _located(str(exc), "the static equilibrium that starts every run fails")
-        # a mass or inertia off by orders of magnitude is the likelier cause: said with it
-        return [(loc or "loads", msg)] + _mass_magnitudes(model), []
+        # a mass or inertia off by orders of magnitude is the likelier cause: said first
+        return _mass_magnitudes(model) + [(loc or "loads", msg)], []
     except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:
-        return ([_located(str(exc), "the static equilibrium that starts every run fails")]
-                + _mass_magnitudes(model)), []
+        return (_mass_magnitudes(model)
+                + [_located(str(exc), "the static equilibrium that starts every run fails")]), []
     q = np.asarray(static.q, dtype=float)
     if not np.all(np.isfinite(q)):
         return [("", "the static equilibrium that starts every run has no finite solution; "

@@ -37,13 +37,21 @@ def load_model(source, *, check: bool = True, changes=None) -> Model:
     19
     >>> stiffer = m.with_changes({"shafts.drive1.diameter": "300 mm"})
     """
+    import os
+
+    if not isinstance(source, (str, os.PathLike, dict, Model)):
+        from ..errors import OptionTypeError
+
+        raise OptionTypeError(f"load_model takes a model file's path, a shipped example's "
+                              f"name, a dict or a Model; got {_short(source)} "
+                              f"({type(source).__name__})")
     if changes:
         from .overrides import apply_overrides, read_raw
 
         if isinstance(source, Model):
             return source.with_changes(changes)
         raw = source if isinstance(source, dict) else read_raw(_resolve(source))
-        return load_model(apply_overrides(raw, dict(changes)), check=check)
+        return load_model(apply_overrides(raw, changes_mapping(changes)), check=check)
     if isinstance(source, Model):
         model, name = source, None
     elif isinstance(source, dict):
@@ -58,6 +66,31 @@ def load_model(source, *, check: bool = True, changes=None) -> Model:
 
         check_model(model, source=name)
     return model
+
+
+def changes_mapping(changes) -> dict:
+    """``changes`` as ``{path: value}``: a mapping of field paths (text) to values, or
+    ``"PATH=VALUE"`` texts as ``--set`` takes them (one, or a list); anything else is
+    refused saying what to give."""
+    from collections.abc import Mapping
+
+    from ..errors import OptionTypeError
+    from .overrides import parse_assignment
+
+    if isinstance(changes, str):
+        changes = [changes]
+    if isinstance(changes, Mapping):
+        bad = [k for k in changes if not isinstance(k, str)]
+        if not bad:
+            return dict(changes)
+        got = f"a key {_short(bad[0])} ({type(bad[0]).__name__})"
+    elif isinstance(changes, (list, tuple)) and all(isinstance(c, str) for c in changes):
+        return dict(parse_assignment(c) for c in changes)
+    else:
+        got = f"{_short(changes)} ({type(changes).__name__})"
+    raise OptionTypeError(f"changes must map field paths to values, e.g. "
+                          f"{{\"meshes.m11.damping_ratio\": 0.1}}, or be 'PATH=VALUE' texts as "
+                          f"--set takes them; got {got}")
 
 
 def _resolve(source) -> Path:
@@ -87,6 +120,8 @@ def model_from_dict(data: dict[str, Any], source: str | None = None) -> Model:
         with warnings.catch_warnings():
             warnings.simplefilter("error", pydantic.warnings.PydanticDeprecationWarning)
             model = Model.model_validate(data)
+    except ModelError as exc:  # (Model.model_validate formats pydantic's errors)
+        raise ModelError(exc.issues, source) from None
     except pydantic.ValidationError as exc:
         raise ModelError(_format_errors(exc, data), source) from None
     import copy
@@ -199,7 +234,15 @@ def _message(err: dict, parts: list[str], written=None) -> str:
     if kind == "literal_error":
         return f"must be {ctx.get('expected')}, got {got}; use one of these"
     if kind in ("too_long", "too_short"):
+        n, most, least = ctx.get("actual_length"), ctx.get("max_length"), ctx.get("min_length")
+        if n is not None and (most is not None or least is not None):
+            bound = (f"at most {most}" if kind == "too_long" else f"at least {least}")
+            return (f"has {n} item{'s' if n != 1 else ''}, {bound} allowed; give as many "
+                    f"items as docs/model-file.md says")
         return f"{err['msg']}; give as many items as docs/model-file.md says"
+    if kind == "string_pattern_mismatch":  # (names: the pattern of a Field)
+        return (f"{got} is not a name this field takes; use letters, digits and '_', "
+                f"starting with a letter (e.g. \"stage_1\")")
     # longest prefix first: 'model_attributes_type' before 'model_type'
     for base in sorted(_TYPE_MESSAGES, key=len, reverse=True):
         if kind.startswith(base):

@@ -21,7 +21,7 @@ from pydantic import (BaseModel, BeforeValidator, ConfigDict, Field, PrivateAttr
                       ValidationError, model_validator)
 from pydantic import Strict as StrictType
 
-from ..errors import FieldError  # noqa: F401 - used by validators here and re-exported
+from ..errors import FieldError, ModelError  # noqa: F401 - FieldError re-exported
 from .units import KINDS, parse_quantity
 
 
@@ -118,9 +118,14 @@ class Strict(BaseModel):
 
 def _check_angle(v: float, name: str, upper_deg: float) -> float:
     if not (-math.radians(upper_deg) <= v <= math.radians(upper_deg)):
+        # a number a user types bare (20, 14.5) is round and would be a valid angle in
+        # degrees; '60 deg' arrives as 1.0472 rad, for which that hint read as nonsense
+        bare = abs(v) <= upper_deg and abs(100 * v - round(100 * v)) < 1e-6
+        hint = (f"a bare number is read in radians: if you meant {v:g} degrees, write "
+                f"'{v:g} deg'" if bare else
+                f"check the value ({name.replace('_', ' ')}s lie within +/-{upper_deg:g} deg)")
         raise FieldError(name, (
-            f"{v:g} rad ({math.degrees(v):g} deg) is outside +/-{upper_deg:g} deg; a bare number "
-            f"is read in radians: if you meant {v:g} degrees, write '{v:g} deg'"))
+            f"{v:g} rad ({math.degrees(v):g} deg) is outside +/-{upper_deg:g} deg; {hint}"))
     return v
 
 
@@ -862,6 +867,27 @@ class Model(Strict):
     """The data the model was validated from (set by :func:`~torquesplit.model.io.
     model_from_dict`), for :meth:`with_changes`."""
 
+    def __init__(self, /, **data):
+        # built in Python (Model(gears=..., ...)): a bad field is a ModelError naming it,
+        # as a file's is, not pydantic's own text and documentation link
+        try:
+            super().__init__(**data)
+        except ValidationError as exc:
+            from .io import _format_errors
+
+            raise ModelError(_format_errors(exc, data)) from None
+
+    @classmethod
+    def model_validate(cls, obj, *args, **kwargs):
+        """Validate ``obj`` (a dict of sections); a bad field is a ModelError."""
+        try:
+            return super().model_validate(obj, *args, **kwargs)
+        except ValidationError as exc:
+            from .io import _format_errors
+
+            raise ModelError(_format_errors(exc, obj if isinstance(obj, dict) else None)
+                             ) from None
+
     def model_post_init(self, __context) -> None:
         self._identity = self._entries()
 
@@ -893,13 +919,14 @@ class Model(Strict):
         changed (it is frozen)."""
         import json
 
-        from .io import load_model, model_to_json
+        from .io import changes_mapping, load_model, model_to_json
         from .overrides import apply_overrides
 
+        changes = changes_mapping(changes)
         # the data it was read from where kept (a [[planetary]] stage's own fields then
         # exist, as for --set), else the model itself in SI
         base = self._source if self._source is not None else json.loads(model_to_json(self))
-        return load_model(apply_overrides(base, dict(changes)))
+        return load_model(apply_overrides(base, changes))
 
     @model_validator(mode="after")
     def _expand_planetary(self):

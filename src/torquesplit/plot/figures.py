@@ -918,7 +918,18 @@ def write_jobs(jobs, directory, formats=("png", "svg"), *, prefix: str = "", dpi
     """
     formats = _check_formats(formats)
     directory = Path(directory)
-    directory.mkdir(parents=True, exist_ok=True)
+    if directory.exists() and not directory.is_dir():  # (a model file passed by mistake)
+        from ..errors import OutputError
+
+        raise OutputError(f"{directory} is a file, not a folder; give the folder to write the "
+                          f"figures into (created if missing)")
+    try:
+        directory.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        from ..errors import OutputError
+
+        raise OutputError(f"cannot create the figure folder {directory} "
+                          f"({exc.strerror or exc}); choose another folder") from None
     written = []
     for i, (name, make) in enumerate(jobs):
         if progress is not None:

@@ -872,7 +872,14 @@ def open_results(path):
         return xr.open_dataset(path, engine="h5netcdf")
     except OSError as exc:
         if not Path(path).is_file():
-            raise
+            from ..errors import OutputError
+
+            where = Path(path)
+            what = ("a folder, not a results file" if where.is_dir() else
+                    "no such file" if where.parent.is_dir() else
+                    f"no such file (nor the folder {where.parent})")
+            raise OutputError(f"{path}: {what}; give the .nc file a run saved "
+                              f"(torquesplit run --out NAME.nc)") from None
         raise OptionError(
             f"{path}: not a NetCDF results file ({exc}); open_results and load_results "
             f"read the .nc files torquesplit writes (a .mat opens with scipy.io.loadmat, a "

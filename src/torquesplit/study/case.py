@@ -210,5 +210,12 @@ def _finish(res, names, defs, out, output_values, vals=None) -> list[float]:
     if lost:
         out["status"] = "contact_lost"
         out["reason"] = "contact lost in " + ", ".join(
-            f"{m} ({100 * f:.2g} % of the time)" for m, f in lost)
+            f"{m} ({_percent(f)} of the time)" for m, f in lost)
     return [vals.get(n, math.nan) for n in names]
+
+
+def _percent(f: float) -> str:
+    """A share as a percentage with two significant digits, never in exponent form
+    ('100 %', '12 %', '0.34 %'; '.2g' wrote 100 % as '1e+02 %')."""
+    p = 100.0 * f
+    return f"{p:.0f} %" if p >= 10 else f"{float(f'{p:.2g}'):g} %"

@@ -116,11 +116,11 @@ def _run(source, *, workers, scheduler, out, resume, overwrite, figures, quiet, 
                 f"[bold]{st.name}[/]: {plan.n_cases} cases ({plan.design.kind}, "
                 f"{plan.analysis['type']}), {_count(len(plan.outputs), 'output')} -> {out}",
                 highlight=False)
-        from .core import nothing_to_resume
+        from .core import resume_notes
 
         for note in plan.notes:  # cases known invalid before any runs
             ui.ux.warn(_sweep_note(note, flag) if flag else note)
-        for note in nothing_to_resume(out, resume, CLI_WORDS):
+        for note in resume_notes(out, resume, CLI_WORDS):
             ui.ux.warn(note)
         with warnings.catch_warnings():
             if backend == "gpu":  # no device: say so in one line, not as a Python warning
@@ -258,6 +258,7 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
     from rich.markup import escape
 
     from .dataset import case_ranges, ranking, warning_groups
+    from .outputs import output_definitions
 
     ui = _ui()
     status = ds["status"].values.ravel()
@@ -270,12 +271,19 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
     if as_json:
         data = {"study": ds.attrs["study_name"], "design": ds.attrs["design"],
                 "cases": int(status.size), "status": counts,
-                "results_file": str(out / "results.nc"), "figures": figs,
+                "results_file": str(out / "results.nc"),
+                "results_files": [str(out / f"results.{x}") for x in ("nc", "csv", "mat")],
+                "figures": figs,
                 "coordinates": {c: [float(x) for x in np.ravel(ds[c].values)]
                                 for c in ds.coords if c not in ("output", "factor")
                                 and ds[c].dtype.kind == "f"},
                 "outputs": {ds[v].attrs["output"]: [_num(x) for x in ds[v].values.ravel()]
                             for v in out_vars},
+                # each list runs over these dimensions, the last fastest (C order)
+                "output_dimensions": list(ds[out_vars[0]].dims) if out_vars else [],
+                "output_units": {ds[v].attrs["output"]: ds[v].attrs.get("units", "")
+                                 for v in out_vars},
+                "definitions": output_definitions([ds[v].attrs["output"] for v in out_vars]),
                 "reasons": sorted({r for r in ds["reason"].values.ravel().tolist() if r}),
                 "cases_warned": n_warned,
                 "warnings": [{"text": g["text"], "cases": g["cases"]} for g in groups]}
@@ -310,8 +318,13 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
         for v in out_vars:
             rank = ranking(ds, ds[v].attrs["output"])
             suffix, scale = _shown(ds[v]) if morris else ("", 1.0)
-            # (escaped: Rich reads " [kN]" as markup and drops it)
-            t.add_row(escape(v + suffix), ", ".join(f"{f} {x * scale:.3g}" for f, x in rank))
+            # (escaped: Rich reads " [kN]" as markup and drops it); no order where no index
+            # could be computed (every trajectory or base row lost a case)
+            text = (", ".join(f"{f} {x * scale:.3g}" for f, x in rank)
+                    if any(np.isfinite(x) for _, x in rank) else
+                    "none: no index could be computed (each trajectory or base row lost "
+                    "a case: see the cases' status)")
+            t.add_row(escape(v + suffix), text)
         ui.console.print(t)
         used_var = next((u for u in ("samples_used", "trajectories_used") if u in ds), None)
         if used_var is not None:
@@ -352,6 +365,16 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
             ui.console.print(f"statistics over the cases with a finite value only: "
                              f"{min(used.values())} of {status.size} at the fewest",
                              highlight=False)
+        lost = int((status == "contact_lost").sum())
+        if lost:  # (kept: a separating mesh is a result; but not one to average unawares)
+            ui.console.print(
+                f"{lost} of these {status.size} cases lost contact (status contact_lost): "
+                f"their values are in the statistics and the stopping rule, computed on a "
+                f"mesh that separated (select status == 'ok' in results.nc to leave them "
+                f"out)", markup=False, highlight=False)
+    # what the columns are (the run's table has this legend; the study's had only names)
+    for line in output_definitions([ds[v].attrs["output"] for v in out_vars]):
+        ui.console.print(line, markup=False, highlight=False, soft_wrap=True)
     ui.console.print("cases: " + ", ".join(f"{n} {s}" for s, n in counts.items()))
     line = stopping_line(ds)
     if line:
@@ -377,7 +400,8 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
         if len(groups) > 5:
             ui.console.print(f"  ... and {len(groups) - 5} more kinds of warning",
                              highlight=False)
-    ui.console.print(f"results: {out / 'results.nc'}; store: {out / 'study.sqlite'}"
+    ui.console.print(f"results: {out / 'results.nc'} (and .csv, .mat); store: "
+                     f"{out / 'study.sqlite'}"
                      + (f"; {_count(len(figs), 'figure')} in {out / 'figures'}" if figs else ""))
 
 

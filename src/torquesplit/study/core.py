@@ -204,7 +204,7 @@ class Study:
 
         from ..errors import ModelWarning
 
-        for note in self.plan().notes + nothing_to_resume(out, resume, API_WORDS):
+        for note in self.plan().notes + resume_notes(out, resume, API_WORDS):
             warn_user(note, ModelWarning)  # (before any case runs)
         return self._run(API_WORDS, workers=workers, client=client, scheduler=scheduler,
                          runner=runner, out=out, resume=resume, overwrite=overwrite,
@@ -252,13 +252,30 @@ class Study:
         return ds
 
 
-def nothing_to_resume(out, resume: bool, words: Words) -> list[str]:
-    """The note of a resume whose folder holds no study (a typo in the folder restarted a
-    long study without a word): it starts from its first case."""
-    if not resume or out is None or (Path(out) / STORE_NAME).exists():
+def resume_notes(out, resume: bool, words: Words) -> list[str]:
+    """What a resume does beyond skipping the finished cases: start from the first case
+    where the folder holds no study (a typo in the folder restarted a long study without
+    a word), run again the cases that ended in an error (an exception: a bug or the
+    machine, which a later run may not meet; a refusal or a divergence is the model's and
+    stays)."""
+    if not resume or out is None:
         return []
-    return [f"{words.out} {out} holds no study to resume: the study starts from its first "
-            f"case"]
+    path = Path(out) / STORE_NAME
+    if not path.exists():
+        return [f"{words.out} {out} holds no study to resume: the study starts from its "
+                f"first case"]
+    import sqlite3
+
+    try:
+        with sqlite3.connect(f"file:{path}?mode=ro", uri=True) as db:
+            n = db.execute("SELECT COUNT(*) FROM cases WHERE status = 'error'").fetchone()[0]
+    except sqlite3.Error:  # (the store's own checks say what is wrong with it)
+        return []
+    if not n:
+        return []
+    return [f"{n} case{'s' if n > 1 else ''} of the study in {out} ended in an error (an "
+            f"exception, not a refusal or a divergence of the model) and "
+            f"{'are' if n > 1 else 'is'} run again"]
 
 
 def _write_outputs(ds, out: Path, figures: bool) -> None:
@@ -491,7 +508,8 @@ class _Driver:
     def execute(self) -> None:
         plan, store = self.plan, self.store
         for r in store.cases():
-            self._note(r)
+            if r["status"] != "error":  # (an error is run again: resume_notes)
+                self._note(r)
         if self.stop is not None:
             self._check_stop()
         n_done = int(self.finished.sum())

@@ -216,13 +216,91 @@ _INDEX_NAMES = {
 
 
 def write_dataset(ds, path) -> Path:
-    """Save a study Dataset as NetCDF (h5netcdf)."""
+    """Save a study Dataset as NetCDF (h5netcdf), and beside it the same cases for a
+    spreadsheet (``.csv``: :func:`case_table_bytes`) and for MATLAB (``.mat``:
+    :func:`case_mat_bytes`); each file whole or absent."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_suffix(".nc.tmp")
     ds.to_netcdf(tmp, engine="h5netcdf")
     tmp.replace(path)
+    for suffix, data in ((".csv", case_table_bytes), (".mat", case_mat_bytes)):
+        target = path.with_suffix(suffix)
+        tmp = path.with_suffix(suffix + ".tmp")
+        tmp.write_bytes(data(ds))
+        tmp.replace(target)
     return path
+
+
+def _case_variables(ds) -> list[str]:
+    """The variables with one value per case (the status's dimensions): the outputs,
+    status, reason, timings; a Monte Carlo's or sensitivity's parameter values are
+    coordinates along ``sample``."""
+    dims = ds["status"].dims
+    return [v for v in ds.data_vars if ds[v].dims == dims and ds[v].dtype.kind in "fiubUSO"]
+
+
+def _header(ds, name: str) -> str:
+    unit = ds[name].attrs.get("units", "")
+    return name if unit in ("", "1") else f"{name} [{unit}]"
+
+
+def case_table_bytes(ds) -> bytes:
+    """The study as a spreadsheet: one row per case, the parameter values (SI, the unit
+    in the header) then every per-case variable (outputs, status, reason, timings)."""
+    from ..results.files import csv_bytes
+
+    names = _case_variables(ds)
+    frame = ds[names].reset_coords().to_dataframe().reset_index()
+    # the case's parameters first (a grid's dimensions, a sample's coordinates), then
+    # its variables
+    first = [c for c in frame.columns if c in ds.coords or c in ds.dims]
+    keep = first + [c for c in frame.columns if c in names and c not in first]
+    header = ["case" if c == "sample" else _header(ds, c) if c in ds.variables else c
+              for c in keep]
+    rows = frame[keep].itertuples(index=False, name=None)
+    return csv_bytes(header, [[v.item() if hasattr(v, "item") else v for v in r]
+                              for r in rows])
+
+
+def _mat_name(name: str, taken: set) -> str:
+    """A MATLAB field name (letters, digits, underscores, a letter first, <= 63)."""
+    base = re.sub(r"\W", "_", name).strip("_") or "x"
+    if not base[0].isalpha():
+        base = "v_" + base
+    base = base[:63]
+    out, k = base, 1
+    while out in taken:
+        k += 1
+        out = f"{base[:59]}_{k}"
+    taken.add(out)
+    return out
+
+
+def case_mat_bytes(ds) -> bytes:
+    """The study for MATLAB: each per-case variable and coordinate as an array of the
+    study's shape (a grid's dimensions, or one per sample), strings as cell arrays;
+    ``names`` maps each field to the Dataset's name, ``units`` gives its SI unit."""
+    from ..results.files import mat_bytes
+
+    taken: set = set()
+    data: dict = {}
+    names, units = [], []
+    for v in [*ds["status"].dims, *[c for c in ds.coords if c not in ds["status"].dims
+                                    and ds[c].dims and set(ds[c].dims) <= set(ds["status"].dims)],
+              *_case_variables(ds)]:
+        arr = ds[v].values
+        if arr.dtype.kind in "USO":
+            arr = np.array(arr.astype(str), dtype=object)
+        field = _mat_name(str(v), taken)
+        data[field] = arr
+        names.append([field, str(v)])
+        units.append([field, str(ds[v].attrs.get("units", ""))])
+    data["names"] = np.array(names, dtype=object)
+    data["units"] = np.array(units, dtype=object)
+    data["dimensions"] = np.array(list(ds["status"].dims), dtype=object)
+    data["study_name"] = str(ds.attrs.get("study_name", ""))
+    return mat_bytes(data)
 
 
 def ranking(ds, output: str) -> list[tuple[str, float]]:

@@ -277,8 +277,20 @@ def _model_value(model, path: str):
 
 def _probe_cases(design) -> list[int]:
     """Cases checked before any runs: the first, and for a grid each parameter at its
-    smallest and largest value with the others at their first values."""
+    smallest and largest value with the others at their first values; for a Monte Carlo
+    or a sensitivity design, a case where each parameter takes its smallest and one
+    where it takes its largest value (a factor's bound that makes the model invalid
+    refused 14 of 20 Morris cases, said only after they ran)."""
     cases = [0]
+    if design.kind != "grid" and design.values.shape[0] > 1:
+        for j in range(design.values.shape[1]):
+            col = design.values[:, j]
+            if not np.issubdtype(col.dtype, np.number) or not np.isfinite(col).any():
+                continue
+            for i in (int(np.nanargmin(col)), int(np.nanargmax(col))):
+                if i not in cases:
+                    cases.append(i)
+        return cases
     if design.kind == "grid" and design.values.shape[0] > 1:
         first = design.values[0]
         for j, axis in enumerate(design.axes):
@@ -723,6 +735,12 @@ def _iso_variable(t, p: Parameter, model, where) -> RandomVariable:
                                                   f"but {f0.path} is not a length; use another "
                                                   f"distribution")
     parts = f0.path.split(".")
+    for f in p.fields:  # (a shaft's diameter drawn at 3-34 um ran every case)
+        if "errors" not in f.path.split(".") and "transmission_error" not in f.path:
+            raise StudyError(f"{where}.distribution", (
+                f"an ISO 1328-1 grade bounds a gear's manufacturing deviations (the fields "
+                f"under gears.NAME.errors, a mesh's transmission_error), not {f.path}; use "
+                f"distribution = \"normal\", \"uniform\" or \"truncated_normal\""))
     gear = t.gear or (parts[1] if parts[0] == "gears" else None)
     if gear is None or gear not in model.gears:
         raise StudyError(f"{where}.gear", "name the gear whose size sets the tolerance; add "

@@ -26,6 +26,7 @@ from __future__ import annotations
 import json
 import logging
 import math
+import textwrap
 from pathlib import Path
 
 import numpy as np
@@ -177,8 +178,9 @@ def maps_figure(ds, family: str, members: list[tuple[str, str]]) -> Figure:
         bar.formatter.set_useOffset(False)
         bar.update_ticks()
         ax.set_title(title, fontsize=9)
-        ax.set_xlabel(f"{_param_label(ds, dims[0])} [{xunit}]", fontsize=8)
-        ax.set_ylabel(f"{_param_label(ds, dims[1])} [{yunit}]", fontsize=8)
+        # (wrapped: a parameter set on three paths ran into the next panel's label)
+        ax.set_xlabel(textwrap.fill(f"{_param_label(ds, dims[0])} [{xunit}]", 40), fontsize=8)
+        ax.set_ylabel(textwrap.fill(f"{_param_label(ds, dims[1])} [{yunit}]", 40), fontsize=8)
         ax.tick_params(labelsize=7)
     _suptitle(fig, f"{_title(ds)}: {_family_text(family)}")
     return fig

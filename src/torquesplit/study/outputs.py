@@ -245,6 +245,26 @@ def output_unit(name: str) -> str:
     return FAMILIES.get(name.split(".")[0], ("1", ""))[0]
 
 
+def output_definitions(names) -> list[str]:
+    """What each family of the outputs ``names`` measures, one line per family in the
+    order met (a study's summary table names its columns only): the load-sharing
+    definitions in their own words, the others as their long names say."""
+    from ..metrics.load_sharing import DEFINITION_TEXT
+
+    seen: dict[str, str] = {}
+    for n in names:
+        parts = n.split(".")
+        sharing = parts[0] in ("load_sharing", "planet_load_sharing") and len(parts) > 1
+        head = ".".join(parts[:2]) if sharing else parts[0]
+        if head in seen:
+            continue
+        if sharing and parts[1] in DEFINITION_TEXT:
+            seen[head] = DEFINITION_TEXT[parts[1]]
+        elif head in FAMILIES:
+            seen[head] = FAMILIES[head][1]
+    return [f"{head}: {text}" for head, text in seen.items()]
+
+
 def output_long_name(name: str) -> str:
     """A readable description of an output, e.g. "load-sharing coefficient (engineering),
     stage1"."""

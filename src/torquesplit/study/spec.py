@@ -32,6 +32,7 @@ from __future__ import annotations
 import difflib
 import json
 import math
+import os
 import tomllib
 import typing
 from pathlib import Path
@@ -424,6 +425,11 @@ def _read(source, analysis: dict) -> tuple[StudySpec, Path | None, str]:
                                                                                default=str)
     from .shipped import study_names, study_path
 
+    if not isinstance(source, (str, os.PathLike)):
+        from ..errors import OptionTypeError
+
+        raise OptionTypeError(f"a study is a study file's path, a shipped study's name, a dict "
+                              f"or a StudySpec; got {source!r:.60} ({type(source).__name__})")
     path = Path(source)
     if not path.is_file():
         if str(source) in study_names():

@@ -131,7 +131,8 @@ class Store:
         with self.db:
             self.db.execute("BEGIN")
             self.db.execute(
-                "INSERT INTO cases VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                # (replaces a case that ended in an error, run again on resume)
+                "INSERT OR REPLACE INTO cases VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
                 (int(r["index"]), r["status"], r["reason"], json.dumps(list(r["values"])),
                  r["wall_time"], r["integration_time"], r["compile_time"],
                  r["simulated_time"], r["runs"], int(bool(r["settled"])), r["worker"],

@@ -1,0 +1,67 @@
+"""A QA review of the Python API's bad input: each refusal is a torquesplit error naming
+what to give (pydantic's text, a ValueError of dict(), pathlib's TypeError, h5py's
+FileNotFoundError and an accepted rtol=2 before)."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+import torquesplit
+from torquesplit.errors import ModelError, OptionError, OptionTypeError, OutputError
+from torquesplit.model.schema import Model
+
+EXAMPLE = "ji_li_mill_drive"
+
+
+def test_a_model_built_in_python_names_its_bad_fields():
+    data = dict(model={"name": "x"}, gears={"a": {"teeth": -1}}, drives={}, loads={})
+    for build in (lambda: Model(**data), lambda: Model.model_validate(data)):
+        with pytest.raises(ModelError) as exc:
+            build()
+        said = str(exc.value)
+        assert "gears.a.teeth: must be greater than 0, got -1; give a positive value" in said
+        assert "pydantic" not in said
+
+
+def test_changes_are_a_mapping_of_paths_or_set_texts():
+    m = torquesplit.load_model(EXAMPLE, changes="meshes.m11.damping_ratio=0.08")
+    assert m.meshes["m11"].damping_ratio == 0.08
+    m = torquesplit.load_model(EXAMPLE, changes=["meshes.m11.damping_ratio=0.09"])
+    assert m.meshes["m11"].damping_ratio == 0.09
+    for bad in ({5: 1}, 3):
+        with pytest.raises(OptionTypeError, match="changes must map field paths to values"):
+            torquesplit.load_model(EXAMPLE, changes=bad)
+        with pytest.raises(OptionTypeError, match="changes must map field paths to values"):
+            m.with_changes(bad)
+
+
+@pytest.mark.parametrize("call, pattern", [
+    (lambda: torquesplit.load_model(None), "load_model takes a model file's path"),
+    (lambda: torquesplit.run_study(None), "a study is a study file's path"),
+])
+def test_nothing_given_is_said_as_such(call, pattern):
+    with pytest.raises(OptionTypeError, match=pattern):
+        call()
+
+
+def test_paths_that_are_not_there_or_not_folders(tmp_path):
+    with pytest.raises(OutputError, match=r"nope\.nc: no such file; give the \.nc file"):
+        torquesplit.load_results(tmp_path / "nope.nc")
+    with pytest.raises(OutputError, match=r"no such file \(nor the folder"):
+        torquesplit.load_results(tmp_path / "gone" / "nope.nc")
+    res = torquesplit.simulate(EXAMPLE, cycles=3)
+    model_file = tmp_path / "m.toml"
+    model_file.write_text("x")
+    with pytest.raises(OutputError, match="is a file, not a folder"):
+        res.write_figures(model_file)
+
+
+def test_tolerances_out_of_range_are_refused():
+    with pytest.raises(OptionError, match=r"rtol must be a number between 0 and 1"):
+        torquesplit.simulate(EXAMPLE, method="dopri", rtol=2, cycles=2)
+    from torquesplit.modes import model_modes
+
+    with pytest.raises(OptionError, match=r"rtol must be a relative difference"):
+        model_modes(EXAMPLE, rtol=math.nan)
