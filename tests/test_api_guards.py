@@ -65,3 +65,14 @@ def test_tolerances_out_of_range_are_refused():
 
     with pytest.raises(OptionError, match=r"rtol must be a relative difference"):
         model_modes(EXAMPLE, rtol=math.nan)
+
+
+def test_a_dopri_run_that_diverges_names_its_tolerance(tmp_path):
+    """--method dopri with rtol = 0.9 diverged with advice about stiffness signs only."""
+    from model_texts import SPUR_PAIR, write_model
+
+    path = write_model(tmp_path, SPUR_PAIR.replace('damping_ratio = 0.05',
+                                                   'damping_ratio = 0.05\nbacklash = "100 um"'))
+    res = torquesplit.simulate(path, method="dopri", rtol=0.9, cycles=50)
+    assert not res.success
+    assert "diverged" in res.message and "Tighten rtol" in res.message, res.message

@@ -392,7 +392,8 @@ def run(
     definition: Optional[str] = typer.Option(None, "--definition", help=_definition_help(),
                                              metavar="NAME"),
     out: Optional[Path] = typer.Option(
-        None, "--out", help="Write results: .nc or .h5 (NetCDF-4), .mat (MATLAB) or .csv "
+        None, "--out", help="Write results: .nc (NetCDF-4; .h5 and .netcdf are read as .nc), "
+        ".mat (MATLAB) or .csv "
         "(spreadsheet files: NAME.csv a row per mesh, NAME_groups.csv a row per "
         "load-sharing group and the system, NAME_bearings.csv, NAME_history.csv, "
         "NAME_cycles.csv, and NAME_about.json: model, warnings, metrics, provenance).",

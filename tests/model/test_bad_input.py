@@ -177,6 +177,8 @@ CASES = [
     ("balanced load on the drive's body", setting("loads.out.body", "pinion"),
      "loads.out.body", r"'pinion' is the body drives.motor drives: a balanced load there "
                        r"takes the drive's power before it passes any gear; put the load"),
+    ("load torque 'balance'", setting("loads.out.torque", "balance"),
+     "loads.out.torque", r"'balance' is not a torque; did you mean \"balanced\""),
     ("power does not balance", setting("loads.out.torque", "150 N m"),
      "loads", r"power does not balance: .*31\.4159 kW.*23\.5619 kW"),
     ("unknown gear in a mesh", setting("meshes.m.gears", ["pinion", "wheeel"]),
@@ -481,6 +483,22 @@ def test_stage_labels_that_differ_only_in_spacing_are_named():
                                           rf"differs from '{label}' only in spacing, case or "
                                           rf"punctuation.*write the same label"):
         torquesplit.load_model(data)
+
+
+def test_an_impact_pulse_too_short_for_the_table_names_table_points():
+    """It said 'MeshingInImpact.table: ... use n_phases >= 67': a class and an argument
+    no model file has."""
+    data = pair_dict()
+    data["meshes"]["m"]["impact"] = True
+    data.setdefault("analysis", {})["table_points"] = 16
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        torquesplit.assemble(torquesplit.load_model(data))
+    said = [str(w.message) for w in caught if "impact pulse" in str(w.message)]
+    assert said and re.search(r"meshes\.m\.impact: .*set \[analysis\] table_points to at "
+                              r"least \d+", said[0]), said
+    assert not any("MeshingInImpact" in str(w.message) or "n_phases" in str(w.message)
+                   for w in caught)
 
 
 def test_valid_model_gives_no_warning():

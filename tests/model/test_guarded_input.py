@@ -317,3 +317,16 @@ def test_a_transmission_error_deeper_than_the_tooth_is_refused():
     data["meshes"]["m"]["transmission_error"] = {"amplitude": 20}
     _refused(data, "meshes.m.transmission_error.amplitude", r"20 m is deeper than the whole "
              r"tooth")
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="no named pipes here")
+def test_a_named_pipe_is_refused_not_waited_on(tmp_path):
+    """check of a FIFO hung until it was killed."""
+    from torquesplit.model.reader import read_model_file
+
+    pipe = tmp_path / "m.toml"
+    os.mkfifo(pipe)
+    from torquesplit.errors import ModelError
+
+    with pytest.raises(ModelError, match="is a pipe or socket, not a model file"):
+        read_model_file(pipe)

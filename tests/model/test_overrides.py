@@ -33,3 +33,9 @@ def test_a_bad_path_is_named(path):
     with pytest.raises(ModelError) as err:
         set_parameter(_data(), path, 1)
     assert path in str(err.value)
+
+
+def test_a_list_item_in_brackets_is_told_the_dotted_index():
+    """'position[0]' was an 'unknown field' of the gear."""
+    with pytest.raises(ModelError, match=r"not brackets; write shafts\.s1\.axis\.2"):
+        set_parameter(_data(), "shafts.s1.axis[2]", -1.0)

@@ -68,6 +68,7 @@ def test_iso1328_distribution_uses_the_gears_tolerance(split_file):
         x = plan.design.values[:, j]
         assert x.min() >= 0 and x.max() <= half_runout
         assert x.max() > 0.5 * half_runout  # the band is used, not a sliver of it
+        assert p.display_unit == "um"  # (tolerances are microns; it showed metres)
 
 
 def test_a_shared_iso1328_value_of_gears_with_other_tolerances_is_refused(split_file):

@@ -430,3 +430,21 @@ def test_resume_runs_again_the_cases_that_ended_in_an_error(tmp_path, split_file
     clean = Study(data).run(workers=1, figures=False)
     for name in Study(data).outputs:
         xr.testing.assert_equal(ds[name], clean[name])
+
+
+def test_ctrl_c_while_the_workers_start_is_a_stop_with_the_hint(tmp_path, split_file,
+                                                               monkeypatch):
+    """A Ctrl-C during the worker start-up left exit 130 without the resume hint."""
+    import torquesplit.study.core as core
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(core, "make_runner", interrupted)
+    out = tmp_path / "out"
+    with pytest.raises(StudyInterrupted, match="0 of 10 cases.*resume"):
+        Study(grid_study(split_file, GRID)).run(workers=2, out=out)
+    monkeypatch.undo()
+    ds = Study(grid_study(split_file, GRID)).run(workers=1, out=out, resume=True,
+                                                 figures=False)
+    assert (ds["status"] == "ok").all()

@@ -50,6 +50,10 @@ def _bad_cases(model):
                                    "grid.parameters.0.num", "start 1 N/mm != stop 2 N/mm"),
         "negative samples": (negative, "monte_carlo.samples", "must be at least 1"),
         "two designs": (two, "monte_carlo", "one design"),
+        # (a second design missing its fields was told those first)
+        "two designs, one incomplete": ({**grid_study(model, [K]), "monte_carlo": {}},
+                                        "monte_carlo", "a study has one design, here grid "
+                                                       "and monte_carlo"),
         "unknown output": (grid_study(model, [K], outputs=["load_sharing.engneering.*"]),
                            "study.outputs", "matches no output"),
         "unknown key": (typo, "study.outputz", "unknown field"),

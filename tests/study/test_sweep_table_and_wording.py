@@ -115,3 +115,13 @@ def test_sweep_reports_every_bad_option_at_once(split_file):
     assert [e.split(":")[1].split()[0] for e in errors] == ["--workers", "--vary", "--output"], \
         res.output
     assert "range has no unit" in errors[1] and "matches no output" in errors[2]
+    assert "'0:10:3mm' or '0:10:3um'" in errors[1]  # (a length: a diameter's or a gap's)
+
+
+def test_a_wrong_unit_of_vary_is_told_in_the_sweeps_words(split_file):
+    """It said 'write e.g. unit = "um"': the study file's syntax, not --vary's."""
+    res = runner.invoke(app, ["sweep", str(split_file), "--vary",
+                              "meshes.a1.transmission_error.constant=0:10:3Nm"])
+    assert res.exit_code == 2, res.output
+    assert "write the unit after the count, e.g. START:STOP:NUMum" in res.stderr, res.stderr
+    assert 'unit = "' not in res.stderr

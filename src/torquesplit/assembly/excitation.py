@@ -430,7 +430,17 @@ def impact_force_table(model: Model, kin: Kinematics, mesh_name: str, n: int):
         inertia_driven=kin.bodies[mk.driven].polar_inertia,
         impact_stiffness=k_mean / max(mk.transverse_contact_ratio, 1.0),
     )
-    _, force = imp.table(n)
+    import warnings
+
+    with warnings.catch_warnings(record=True) as caught:  # said in the model's words
+        warnings.simplefilter("always")
+        _, force = imp.table(n)
+    if caught and imp.duration > 0:
+        need = int(math.ceil(4 * imp.mesh_period / imp.duration))
+        warn_user(f"meshes.{mesh_name}.impact: the meshing-in impact pulse spans "
+                  f"{imp.duration / imp.mesh_period * n:.1f} of the {n} table points per "
+                  f"mesh cycle, too few to resolve its peak; set [analysis] table_points to "
+                  f"at least {need}", ModelWarning)
     return np.asarray(force)
 
 

@@ -9,6 +9,7 @@ argument, not against the model file (:func:`apply_assignments`,
 
 from __future__ import annotations
 
+import re
 import tomllib
 from pathlib import Path
 from typing import Any, Mapping
@@ -28,6 +29,10 @@ def set_parameter(data: dict, path: str, value: Any) -> dict:
     (neither is ever changed in place: a study sets a dozen parameters of a large model
     per case, and copying the whole model for each cost milliseconds).
     """
+    if re.search(r"\[\s*\d+\s*\]", path):  # 'position[0]': written the way paths index
+        dotted = re.sub(r"\[\s*(\d+)\s*\]", r".\1", path)
+        raise ModelError([(path, f"a list item is addressed with a dot and its index, not "
+                                 f"brackets; write {dotted}")])
     parts = path.split(".")
     out = _copy_node(data)
     node = out

@@ -66,7 +66,7 @@ from .schema import (
     TorsionalSupport,
     Unit,
     _backlash_shorthand,
-    _check_angle,
+    _angle_field,
     _check_rim,
     _stiffness_shorthand,
     _unique_dofs,
@@ -208,10 +208,11 @@ class Planetary(Strict):
     sun_mesh: PlanetaryMesh = Field(description="The sun-planet meshes.")
     ring_mesh: PlanetaryMesh = Field(description="The ring-planet meshes.")
 
+    _pressure_angle_range = _angle_field("pressure_angle", 45)
+    _helix_angle_range = _angle_field("helix_angle", 60)
+
     @model_validator(mode="after")
     def _consistent(self):
-        _check_angle(self.pressure_angle, "pressure_angle", 45)
-        _check_angle(self.helix_angle, "helix_angle", 60)
         problems: list[tuple[str, str]] = []  # (every one is said at once)
         if self.helix_angle != 0 and self.hand is None:
             problems.append(("hand", "a helical stage needs the sun's hand; add "

@@ -94,6 +94,9 @@ def _read_bytes(path: Path, source: str) -> bytes:
         if path.is_dir():
             raise ModelError([("", "is a folder, not a model file; give the path of a .toml "
                                    "or .json file (or an example name)")], source)
+        if path.is_fifo() or path.is_socket():  # (reading one waits for a writer: a hang)
+            raise ModelError([("", "is a pipe or socket, not a model file; give the path of "
+                                   "a .toml or .json file")], source)
         with open(path, "rb") as fh:
             raw = fh.read(MAX_FILE_BYTES + 1)
     except FileNotFoundError:

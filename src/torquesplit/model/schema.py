@@ -18,7 +18,7 @@ import re
 from typing import Annotated, Literal
 
 from pydantic import (BaseModel, BeforeValidator, ConfigDict, Field, PrivateAttr,
-                      ValidationError, model_validator)
+                      ValidationError, field_validator, model_validator)
 from pydantic import Strict as StrictType
 
 from ..errors import FieldError, ModelError  # noqa: F401 - FieldError re-exported
@@ -114,6 +114,20 @@ class Strict(BaseModel):
                               allow_inf_nan=False)
 
 
+
+
+def _angle_field(name: str, upper_deg: float):
+    """A field validator of an angle within +/- ``upper_deg`` (a field's own check runs
+    with the section's other field checks: a unit error elsewhere in a [[planetary]]
+    stage hid it until the next attempt)."""
+
+    def check(cls, v):
+        try:
+            return _check_angle(v, name, upper_deg)
+        except FieldError as exc:
+            raise ValueError(str(exc)) from None
+
+    return field_validator(name)(classmethod(check))
 
 
 def _check_angle(v: float, name: str, upper_deg: float) -> float:
@@ -373,6 +387,9 @@ class Gear(Strict):
         None, description="Tooth modification of the loaded flank (used by stiffness method "
         "'ltca').")
 
+    _pressure_angle_range = _angle_field("pressure_angle", 45)
+    _helix_angle_range = _angle_field("helix_angle", 60)
+
     @model_validator(mode="after")
     def _consistent(self):
         if self.modifications is not None:  # (on a bevel or face gear: checks.py, with
@@ -381,8 +398,6 @@ class Gear(Strict):
                 raise FieldError("modifications.second_helix", (
                     "a second helix exists on double-helical gears only; remove second_helix "
                     "or set kind = 'double_helical'"))
-        _check_angle(self.pressure_angle, "pressure_angle", 45)
-        _check_angle(self.helix_angle, "helix_angle", 60)
         if self.helix_angle != 0 and self.hand is None:
             raise FieldError("hand", "a gear with a helix angle needs a hand; add "
                              "hand = 'right' or hand = 'left'")
@@ -606,6 +621,11 @@ def _backlash_shorthand(v):
 def _balanced_or_torque(v):
     if v is None or v == "balanced":
         return None
+    if isinstance(v, str) and v.strip().lower().rstrip(".") in ("balance", "balanced",
+                                                                 "balancing", "auto"):
+        raise ValueError(f"{v!r} is not a torque; did you mean \"balanced\" (the load takes "
+                         f"all the input power)? write torque = \"balanced\" or a torque "
+                         f"such as \"500 N m\"")
     x = parse_quantity(v, "torque")
     if x <= 0:
         raise ValueError("the load torque must be positive (its direction follows the speed); "
@@ -841,7 +861,21 @@ class ModelInfo(Strict):
 from .planetary import Planetary  # noqa: E402
 
 
-class Model(Strict):
+class _ModelMeta(type(Strict)):
+    """``Model(...)`` built in Python: a bad field is a ModelError naming it, as a file's
+    is, not pydantic's own text and link.  (On the metaclass: pydantic calls a model's
+    own ``__init__`` from inside its validation, where a ModelError would be wrapped.)"""
+
+    def __call__(cls, *args, **data):
+        try:
+            return super().__call__(*args, **data)
+        except ValidationError as exc:
+            from .io import _format_errors
+
+            raise ModelError(_format_errors(exc, data)) from None
+
+
+class Model(Strict, metaclass=_ModelMeta):
     """A complete gearbox description (all values SI after validation)."""
 
     model: ModelInfo = Field(description="Name, description and source of the model.")
@@ -866,16 +900,6 @@ class Model(Strict):
     _source: dict | None = PrivateAttr(default=None)
     """The data the model was validated from (set by :func:`~torquesplit.model.io.
     model_from_dict`), for :meth:`with_changes`."""
-
-    def __init__(self, /, **data):
-        # built in Python (Model(gears=..., ...)): a bad field is a ModelError naming it,
-        # as a file's is, not pydantic's own text and documentation link
-        try:
-            super().__init__(**data)
-        except ValidationError as exc:
-            from .io import _format_errors
-
-            raise ModelError(_format_errors(exc, data)) from None
 
     @classmethod
     def model_validate(cls, obj, *args, **kwargs):

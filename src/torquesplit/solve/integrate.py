@@ -1106,8 +1106,10 @@ def _message(status, s, y, t_final, t_end, counters, clock, blowup, limit_steps,
         fix = ("Use a smaller step (steps_per_period; the command line's "
                "--steps-per-period) or method='dopri', and check stiffness signs and "
                "units and that the drive and load torques balance." if method == "rk4" else
-               "Check stiffness signs and units and that the drive and load torques "
-               "balance.") + bound
+               "Tighten rtol (rtol= in Python; --set analysis.rtol=1e-6 on the command "
+               "line): a loose tolerance lets the steps grow past what the stiffest mode "
+               "allows; and check stiffness signs and units and that the drive and load "
+               "torques balance.") + bound
         return (f"Integration diverged at t = {t_final:.6g} s (step {n_steps}): {why}. "
                 f"Everything recorded before that time is valid. {fix}")
     if status == INTERRUPTED:

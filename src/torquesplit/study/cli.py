@@ -212,10 +212,12 @@ _SWEEP_WORDS = (('use spacing = "linear"', "leave out --log"),)
 
 
 def _sweep_words(message: str) -> str:
-    """A study message's remedy in the sweep's options (:data:`_SWEEP_WORDS`)."""
+    """A study message's remedy in the sweep's options (:data:`_SWEEP_WORDS`; a study
+    file's ``unit = "um"`` is the unit after the count of --vary)."""
     for study, sweep in _SWEEP_WORDS:
         message = message.replace(study, sweep)
-    return message
+    return re.sub(r'write e\.g\. unit = "([^"]+)"',
+                  r"write the unit after the count, e.g. START:STOP:NUM\1", message)
 
 
 def _sweep_note(note: str, flag: str) -> str:
@@ -572,11 +574,13 @@ def _refuse_bare_range(text: str, table: dict) -> None:
         from ..model.units import KINDS
 
         si = si_unit(kind)
-        example = KINDS[kind][1].split(" ", 1)[1]
         a, b, n = table["start"], table["stop"], table["num"]
+        # (a length: mm or um, as the numbers are a diameter's or a clearance's)
+        units = ("mm", "um") if kind == "length" else (KINDS[kind][1].split(" ", 1)[1],)
+        examples = " or ".join(f"'{a:g}:{b:g}:{n}{u}'" for u in units)
         raise ValueError(f"--vary {text!r}: {path} is a {kind.replace('_', ' ')} and the "
                          f"range has no unit (it would be read as {a:g} to {b:g} {si}); "
-                         f"write the unit after the count, e.g. '{a:g}:{b:g}:{n}{example}' "
+                         f"write the unit after the count, e.g. {examples} "
                          f"(or '{a:g}:{b:g}:{n}{si}' if {si} is meant)")
 
 

@@ -226,10 +226,12 @@ class Study:
                                  workers, words)
         store = _open_store(plan, out, resume, overwrite, words)
         try:
-            run = _Driver(plan, store, chosen or make_runner(workers, client=client,
-                                                             scheduler=scheduler,
-                                                             runner=runner),
-                          progress, out, words)
+            try:
+                runner_ = chosen or make_runner(workers, client=client, scheduler=scheduler,
+                                                runner=runner)
+            except KeyboardInterrupt:  # (while the workers start: a stop like any other)
+                raise StudyInterrupted(store.count(), plan.design.n_cases, out) from None
+            run = _Driver(plan, store, runner_, progress, out, words)
             run.execute()
             try:
                 report = getattr(run.runner, "report", None)
@@ -517,9 +519,12 @@ class _Driver:
                  self.total, n_done)
         store.start_run(repr(self.runner), int(getattr(self.runner, "workers", 0) or 0))
         t0 = time.perf_counter()
-        results = self.runner(run_case, self._payloads())
+        results = None
         state = "interrupted"
         try:
+            # (inside: a Ctrl-C while the workers start is a stop like any other, with the
+            # store's run closed and the hint to resume)
+            results = self.runner(run_case, self._payloads())
             # the cases start: a progress bar shows at once (a first case compiles)
             if self.progress is not None:
                 self.progress(Progress(int(self.finished[: self._target()].sum()),
@@ -550,7 +555,7 @@ class _Driver:
                                  f"{type(exc).__name__}: {exc}; every finished case is "
                                  f"saved, {again}") from exc
         finally:
-            close = getattr(results, "close", None)
+            close = getattr(results, "close", None) if results is not None else None
             if close is not None:
                 close()
             if state != "cases done":

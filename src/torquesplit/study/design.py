@@ -671,7 +671,10 @@ def _mc_parameter(t, raw: dict, model, where: str) -> list[tuple[Parameter, Rand
         else:
             name = g[0].path
         shown = [v for v in (t.mean, t.low, t.high) if v is not None]
-        p = Parameter(name, tuple(g), "set", (), _display_unit(shown, t.unit))
+        # (an ISO 1328 draw has no value written: its tolerances are microns)
+        display = _display_unit(shown, t.unit) or ("um" if t.distribution == "iso1328"
+                                                   else None)
+        p = Parameter(name, tuple(g), "set", (), display)
         out.append((p, _random_variable(t, p, model, where)))
     return out
 

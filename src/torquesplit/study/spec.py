@@ -465,6 +465,10 @@ def _read(source, analysis: dict) -> tuple[StudySpec, Path | None, str]:
 
 def parse_study(data: dict) -> StudySpec:
     """Validate study data; every problem becomes one line of a StudyError."""
+    given = [d for d in DESIGNS if isinstance(data, dict) and data.get(d) is not None]
+    if len(given) > 1:  # said first: an incomplete second design's missing fields hid it
+        raise StudyError(given[1], f"a study has one design, here {' and '.join(given)}; "
+                                   f"keep one of them (one study file per design)")
     try:
         return StudySpec.model_validate(data)
     except pydantic.ValidationError as exc:
