@@ -359,7 +359,9 @@ def report(res: dict) -> str:
                  "(the engine without a history), alternated, best CPU time of each. The cost "
                  "per step is the difference between runs of 2 n and n steps over n; what is "
                  "left is the fixed cost of a call (for the engine, the Python set-up of "
-                 "`integrate`: kernel arrays, step stability check, argument typing).\n")
+                 "`integrate`: its work and record arrays and the outputs; the kernel "
+                 "arrays, the step check's eigenvalues and the kernels' entry point are kept "
+                 "per structure from its first run).\n")
         L.append(_table(["quantity", "value"], [
             ["steps (n) / step", f"{ht['steps']:,} / {_f(ht['step'])} s"],
             ["engine (generated rhs) CPU µs/step", _f(ht["engine_us"])],

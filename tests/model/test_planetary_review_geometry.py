@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import copy
 import math
+import re
 import tomllib
 import warnings
 
@@ -232,3 +233,19 @@ def test_a_stage_name_with_a_space_says_what_a_name_may_hold():
     with pytest.raises(ModelError, match=r"planetary\.0\.name: 'st age' is not a name this "
                                          r"field takes; use letters, digits and '_'"):
         load(raw)
+
+
+def test_shifted_planets_that_do_not_fit_are_told_the_sun_shift_that_closes_the_gap():
+    """A planet shift of 0.3 with an unshifted sun and ring (27/33/93): the message gave
+    the unshifted tooth-count rule only."""
+    from planetary_models import load, lp_raw
+
+    raw = lp_raw(planet={**lp_raw()["planetary"][0]["planet"], "profile_shift": 0.3})
+    with pytest.raises(ModelError) as exc:
+        load(raw)
+    said = str(exc.value)
+    found = re.search(r"a sun profile_shift of (-?[\d.]+) closes the gap", said)
+    assert found, said
+    x = float(found.group(1))
+    raw["planetary"][0]["sun"]["profile_shift"] = x  # it does
+    load(raw)

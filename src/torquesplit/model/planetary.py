@@ -43,6 +43,7 @@ from __future__ import annotations
 import math
 from typing import Annotated, Literal
 
+import numpy as np
 from pydantic import BeforeValidator, Field, model_validator
 
 from .schema import (
@@ -339,6 +340,36 @@ class Planetary(Strict):
             profile_shift=member.profile_shift, internal=kind == "internal",
             double_helical=kind == "double_helical")
 
+    def _closing_sun_shift(self, a_rp: float) -> float | None:
+        """The sun's profile shift that makes the sun-planet operating centre distance
+        ``a_rp`` (the planet-ring one), the other shifts as given; None where the shifts
+        are all zero (the tooth counts are the fix) or no shift in [-1, 1.5] does it."""
+        from scipy.optimize import brentq
+
+        from ..errors import ModelError
+        from ..gears.geometry import PairGeometry
+
+        if not any(m.profile_shift for m in (self.sun, self.planet, self.ring)):
+            return None
+        planet = self._geometry(self.planet, internal=False)
+
+        def gap(x):
+            sun = self._geometry(self.sun.model_copy(update={"profile_shift": x}),
+                                 internal=False)
+            return PairGeometry(sun, planet).operating_center_distance - a_rp
+
+        def valued(x):  # (a shift that points or undercuts the teeth has none)
+            try:
+                return gap(x)
+            except (ModelError, ValueError):
+                return None
+
+        grid = [(x, valued(x)) for x in np.linspace(-1.0, 1.5, 26)]
+        for (x0, g0), (x1, g1) in zip(grid, grid[1:]):
+            if g0 is not None and g1 is not None and g0 * g1 <= 0:
+                return float(brentq(gap, x0, x1, xtol=1e-7))
+        return None
+
     def _check_fit(self) -> None:
         """Planets that do not fit: the assembly condition, overlapping planets, unequal
         centre distances, pins off the planet circle."""
@@ -366,11 +397,14 @@ class Planetary(Strict):
             raise FieldError(field, msg if ";" in msg else f"{msg}; correct the {fix}") from None
         zs, zp, zr = self.sun.teeth, self.planet.teeth, self.ring.teeth
         if abs(a_sp - a_rp) > 1e-6 * a_sp:
+            shift = self._closing_sun_shift(a_rp)
             raise FieldError("ring.teeth", (
                 f"the planets cannot mesh with sun and ring at once: the sun-planet centre "
                 f"distance is {a_sp * 1e3:.4f} mm, the planet-ring one {a_rp * 1e3:.4f} mm; "
-                f"without profile shifts the ring needs z_s + 2 z_p = {zs + 2 * zp} teeth: "
-                f"correct the tooth counts or the profile shifts"))
+                f"without profile shifts the ring needs z_s + 2 z_p = {zs + 2 * zp} teeth"
+                + (f", and with the planet's and ring's shifts as given a sun profile_shift "
+                   f"of {shift:.4f} closes the gap" if shift is not None else "")
+                + ": correct the tooth counts or the profile shifts"))
         if self.pin_radius is not None and abs(self.pin_radius - a_sp) > PIN_TOLERANCE * a_sp:
             off = self.pin_radius - a_sp
             raise FieldError("pin_radius", (
