@@ -76,3 +76,13 @@ def test_a_dopri_run_that_diverges_names_its_tolerance(tmp_path):
     res = torquesplit.simulate(path, method="dopri", rtol=0.9, cycles=50)
     assert not res.success
     assert "diverged" in res.message and "Tighten rtol" in res.message, res.message
+
+
+def test_changes_as_pairs_and_a_model_from_json_text():
+    """(path, value) pairs went through dict() before: still taken.  A JSON text of a
+    model is refused in torquesplit's words too."""
+    m = torquesplit.load_model(EXAMPLE, changes=[("meshes.m11.damping_ratio", 0.07)])
+    assert m.meshes["m11"].damping_ratio == 0.07
+    with pytest.raises(ModelError, match=r"gears\.a\.teeth: must be greater than 0"):
+        Model.model_validate_json('{"model": {"name": "x"}, "gears": {"a": {"teeth": -1}}, '
+                                  '"drives": {}, "loads": {}}')

@@ -16,10 +16,16 @@ import warnings
 import weakref
 
 
-def remember_last(fn):
+def remember_last(fn=None, *, replay: bool = True):
     """Decorator: ``fn(obj, *args)`` computed once while ``obj`` (frozen) lives and
     ``args`` stay the same; its warnings are given again on every call.  The table
-    (``id(obj) -> (weak ref, args, result, warnings)``) is ``wrapper.cache``."""
+    (``id(obj) -> (weak ref, args, result, warnings)``) is ``wrapper.cache``.
+
+    ``replay=False`` for a function that gives no warning: its calls are not recorded
+    (recording changes the process's warning filters, which threads share: a Dask
+    worker's thread could record another's warnings)."""
+    if fn is None:
+        return functools.partial(remember_last, replay=replay)
     cache: dict = {}
 
     @functools.wraps(fn)
@@ -28,9 +34,12 @@ def remember_last(fn):
         ref, last_args, result, said = cache.get(key, (None, None, None, None))
         alive = ref is not None and ref() is obj
         if not alive or last_args != args:
-            with warnings.catch_warnings(record=True) as said:
-                warnings.simplefilter("always")
-                result = fn(obj, *args)
+            if replay:
+                with warnings.catch_warnings(record=True) as said:
+                    warnings.simplefilter("always")
+                    result = fn(obj, *args)
+            else:
+                result, said = fn(obj, *args), []
             if not alive:
                 weakref.finalize(obj, cache.pop, key, None)
             cache[key] = (weakref.ref(obj), args, result, said)

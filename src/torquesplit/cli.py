@@ -528,7 +528,11 @@ def _rescued(save, out, exc) -> tuple[list[Path], Exception]:
     from .errors import OutputError
 
     stem = Path(str(out)).stem or "results"
-    for folder in (Path.cwd(), Path(tempfile.gettempdir())):
+    try:
+        here = [Path.cwd()]
+    except OSError:  # (the folder that went may be the current one)
+        here = []
+    for folder in [*here, Path(tempfile.gettempdir())]:
         path = next(p for p in (folder / f"{stem}_rescued{'' if k == 1 else f'_{k}'}.nc"
                                 for k in range(1, 10**6)) if not p.exists())
         try:

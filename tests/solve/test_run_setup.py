@@ -26,6 +26,7 @@ def test_kernel_model_and_eigenvalues_are_kept_per_structure():
     with pytest.raises(ValueError):  # shared between callers: read-only
         lam[0] = 0.0
     assert stability.stable_step(s) == stability.stable_step(other)
+    assert id(s) in stability.stable_step.cache and id(s) in kernel_model.cache
 
 
 def test_generated_functions_share_one_class():
@@ -48,14 +49,25 @@ def test_type_key_follows_what_numba_types():
     assert key(x) != key(np.zeros((2, 2)))
     assert key(np.zeros((4, 3))[:, 0]) != key(x)  # layout
     assert key((x, 1.0)) != key((x, 1))
+    # what numba may type apart for one key is not keyed: numba types it
+    for untyped in ([1], np.zeros(2, dtype=[("a", "f8"), ("b", "f8")]), 2**63,
+                    (x, [1.0])):
+        assert key(untyped) is None
+    assert integrate_module._compiled(kern.rk4_run, ([1.0],)) is kern.rk4_run
 
 
-def test_second_run_uses_the_entry_point_and_gives_the_same_result():
+def test_second_run_uses_the_entry_point_and_gives_the_same_result(monkeypatch):
     s = spur_pair(frequency=800.0, damping=50.0)
     kw = dict(method="rk4", steps_per_period=50)
+    monkeypatch.setattr(integrate_module, "_ENTRIES", {})
     first = integrate(s, np.zeros(4), (0.0, 0.01), **kw)
     args_key = [k for k in integrate_module._ENTRIES if k[0] is kern.rk4_run]
     assert args_key, "the RK4 kernel's entry point was not kept after a run"
+    found = []
+    real = integrate_module._compiled
+    monkeypatch.setattr(integrate_module, "_compiled",
+                        lambda d, a: found.append(real(d, a)) or found[-1])
     second = integrate(s, np.zeros(4), (0.0, 0.01), **kw)
+    assert found and all(f is not kern.rk4_run for f in found)  # the entry point ran
     np.testing.assert_array_equal(first.y_final, second.y_final)
     np.testing.assert_array_equal(first.cycle_max, second.cycle_max)

@@ -283,3 +283,10 @@ def test_a_study_is_written_for_a_spreadsheet_and_for_matlab(tmp_path, split_fil
     units = {str(a[0]): (str(b[0]) if b.size else "") for a, b in mat["units"]}
     assert units["peak_force_a1"] == "N"
     assert str(mat["status"][0, 0][0]) == "ok"
+
+
+def test_a_share_of_the_time_is_never_written_in_exponent_form():
+    from torquesplit.study.case import _percent
+
+    assert [_percent(f) for f in (1.0, 0.123, 0.0034, 1.2e-7)] == [
+        "100 %", "12 %", "0.34 %", "0.000012 %"]

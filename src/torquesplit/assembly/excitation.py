@@ -435,7 +435,11 @@ def impact_force_table(model: Model, kin: Kinematics, mesh_name: str, n: int):
     with warnings.catch_warnings(record=True) as caught:  # said in the model's words
         warnings.simplefilter("always")
         _, force = imp.table(n)
-    if caught and imp.duration > 0:
+    short = [w for w in caught if "MeshingInImpact.table" in str(w.message)]
+    for w in caught:  # (any other warning as it was given)
+        if w not in short:
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    if short and imp.duration > 0:
         need = int(math.ceil(4 * imp.mesh_period / imp.duration))
         warn_user(f"meshes.{mesh_name}.impact: the meshing-in impact pulse spans "
                   f"{imp.duration / imp.mesh_period * n:.1f} of the {n} table points per "

@@ -69,7 +69,11 @@ def _empty_float(*shape):
 
 @dataclass(frozen=True)
 class Structure:
-    """Assembled, immutable system: DOF map, diagonal mass, element arrays (SI)."""
+    """Assembled, immutable system: DOF map, diagonal mass, element arrays (SI).
+
+    Immutable means its arrays too: the solvers keep what they derive from a structure
+    for as long as it lives (kernel arrays, the step check's eigenvalues), so change a
+    structure by building another (``dataclasses.replace``), never in place."""
 
     dof_names: tuple[str, ...]
     """One name per DOF, ``"<body>.<x|y|z|theta>"``."""

@@ -69,9 +69,9 @@ def load_model(source, *, check: bool = True, changes=None) -> Model:
 
 
 def changes_mapping(changes) -> dict:
-    """``changes`` as ``{path: value}``: a mapping of field paths (text) to values, or
-    ``"PATH=VALUE"`` texts as ``--set`` takes them (one, or a list); anything else is
-    refused saying what to give."""
+    """``changes`` as ``{path: value}``: a mapping of field paths (text) to values, a list
+    of ``(path, value)`` pairs, or ``"PATH=VALUE"`` texts as ``--set`` takes them (one,
+    or a list); anything else is refused saying what to give."""
     from collections.abc import Mapping
 
     from ..errors import OptionTypeError
@@ -86,6 +86,10 @@ def changes_mapping(changes) -> dict:
         got = f"a key {_short(bad[0])} ({type(bad[0]).__name__})"
     elif isinstance(changes, (list, tuple)) and all(isinstance(c, str) for c in changes):
         return dict(parse_assignment(c) for c in changes)
+    elif isinstance(changes, (list, tuple)) and all(
+            isinstance(c, (list, tuple)) and len(c) == 2 and isinstance(c[0], str)
+            for c in changes):  # (path, value) pairs, as dict() takes them
+        return dict(changes)
     else:
         got = f"{_short(changes)} ({type(changes).__name__})"
     raise OptionTypeError(f"changes must map field paths to values, e.g. "

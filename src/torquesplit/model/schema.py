@@ -870,9 +870,14 @@ class _ModelMeta(type(Strict)):
         try:
             return super().__call__(*args, **data)
         except ValidationError as exc:
-            from .io import _format_errors
+            raise _model_error(exc, data) from None
 
-            raise ModelError(_format_errors(exc, data)) from None
+
+def _model_error(exc: ValidationError, data) -> ModelError:
+    """pydantic's errors of a Model as the ModelError a file's would give."""
+    from .io import _format_errors
+
+    return ModelError(_format_errors(exc, data if isinstance(data, dict) else None))
 
 
 class Model(Strict, metaclass=_ModelMeta):
@@ -907,10 +912,15 @@ class Model(Strict, metaclass=_ModelMeta):
         try:
             return super().model_validate(obj, *args, **kwargs)
         except ValidationError as exc:
-            from .io import _format_errors
+            raise _model_error(exc, obj) from None
 
-            raise ModelError(_format_errors(exc, obj if isinstance(obj, dict) else None)
-                             ) from None
+    @classmethod
+    def model_validate_json(cls, json_data, *args, **kwargs):
+        """Validate a JSON text of the sections; a bad field is a ModelError."""
+        try:
+            return super().model_validate_json(json_data, *args, **kwargs)
+        except ValidationError as exc:
+            raise _model_error(exc, None) from None
 
     def model_post_init(self, __context) -> None:
         self._identity = self._entries()

@@ -593,7 +593,7 @@ def _solution(s, sel, plan, rec, counters, clock, y, *, method, t_span, blowup, 
     return Solution(
         status=status,
         message=_message(status, s, y, t_final, t_end, counters, clock, blowup,
-                         plan.limit_steps, method),
+                         plan.limit_steps, method, plan.rtol),
         success=status == kern.FINISHED,
         method=method,
         t_span=(t0, t_end),
@@ -806,8 +806,8 @@ def finer_step_advice(structure: Structure, limited_by: str, step: float) -> str
     if not limited_by or limited_by == EXCITATION_PERIOD or not step > 0:
         return plain
     per = shortest_excitation_period(structure) / step
-    if not math.isfinite(per):
-        return plain
+    if not math.isfinite(per) or ", needs " not in limited_by:  # (an error sinusoid's
+        return plain  # period, a given step: --steps-per-period refines it as it says)
     cause = limited_by.split(", needs ")[0]  # (what _step_for says, less its numbers)
     return (f"a --steps-per-period above {round(per)}, steps_per_period= in Python: the "
             f"step is set here by {cause}, at {round(per)} steps per shortest excitation "
@@ -981,15 +981,27 @@ _ENTRIES: dict = {}
 
 
 def _type_key(a):
-    """What numba's typing of argument ``a`` depends on, found without typing it: an
-    array's dtype, dimensions, layout, writeability and alignment; a tuple's class and
-    its items'; any other value's class (a Python float is always float64, ...)."""
+    """What numba's typing of argument ``a`` depends on, found without typing it, for the
+    kinds of argument the kernels take: a plain (non-record) array's dtype, dimensions,
+    layout, writeability and alignment; a tuple's class and its items'; a float, a bool,
+    an int within int64, a generated function's class.  None for anything else (a list,
+    a record array, a huge int: numba may type two such values apart), which is then
+    typed by numba itself."""
     if isinstance(a, np.ndarray):
+        if a.dtype.fields is not None or a.dtype.kind not in "biuf":
+            return None
         f = a.flags
         return (a.dtype.str, a.ndim, f.c_contiguous, f.f_contiguous, f.writeable, f.aligned)
     if isinstance(a, tuple):
-        return (type(a), tuple(_type_key(x) for x in a))
-    return type(a)
+        items = tuple(_type_key(x) for x in a)
+        return None if any(k is None for k in items) else (type(a), items)
+    if isinstance(a, (bool, float, np.float64)):
+        return type(a)
+    if isinstance(a, int):
+        return int if -(2**63) <= a < 2**63 else None
+    if hasattr(a, "__wrapper_address__") or type(a).__name__ == "CFunc":
+        return type(a)
+    return None
 
 
 def _compiled(dispatcher, args):
@@ -997,7 +1009,10 @@ def _compiled(dispatcher, args):
     argument typing (a named tuple of 44 arrays costs about 2 ms to type, on every
     call), found by :func:`_type_key`; the dispatcher itself when it has not run with
     such arguments yet (call it, then ask again) or cannot be found."""
-    key = (dispatcher, tuple(_type_key(a) for a in args))
+    items = tuple(_type_key(a) for a in args)
+    if any(k is None for k in items):
+        return dispatcher
+    key = (dispatcher, items)
     entry = _ENTRIES.get(key)
     if entry is not None:
         return entry
@@ -1086,7 +1101,7 @@ def _initial_step(s, y, t0, t_end, rtol, atol, model) -> float:
 
 
 def _message(status, s, y, t_final, t_end, counters, clock, blowup, limit_steps,
-             method) -> str:
+             method, rtol=math.nan) -> str:
     n = s.n_dof
     n_steps = int(counters[kern.I_STEPS])
     if status == kern.FINISHED:
@@ -1106,10 +1121,11 @@ def _message(status, s, y, t_final, t_end, counters, clock, blowup, limit_steps,
         fix = ("Use a smaller step (steps_per_period; the command line's "
                "--steps-per-period) or method='dopri', and check stiffness signs and "
                "units and that the drive and load torques balance." if method == "rk4" else
-               "Tighten rtol (rtol= in Python; --set analysis.rtol=1e-6 on the command "
-               "line): a loose tolerance lets the steps grow past what the stiffest mode "
-               "allows; and check stiffness signs and units and that the drive and load "
-               "torques balance.") + bound
+               f"Tighten rtol (it was {rtol:.3g}: try {rtol / 10:.3g}, rtol= in Python, "
+               f"--set analysis.rtol={rtol / 10:.3g} on the command line): a loose "
+               f"tolerance lets the steps grow past what the stiffest mode allows; and "
+               f"check stiffness signs and units and that the drive and load torques "
+               f"balance.") + bound
         return (f"Integration diverged at t = {t_final:.6g} s (step {n_steps}): {why}. "
                 f"Everything recorded before that time is valid. {fix}")
     if status == INTERRUPTED:

@@ -216,7 +216,7 @@ def table_array(a) -> np.ndarray:
     return a if a.flags.writeable else a.copy()
 
 
-@remember_last
+@remember_last(replay=False)
 def kernel_model(structure: Structure) -> KernelModel:
     """The structure's arrays in kernel form (contiguous, writable, derived index arrays
     included); raises :class:`~torquesplit.errors.SolverError` if inconsistent.  The
@@ -224,7 +224,9 @@ def kernel_model(structure: Structure) -> KernelModel:
     (:func:`table_array`): copying them cost about 4 ms of every run of Ji & Li's drive
     (two 14 x 65536 tables).  Kept per live structure (a Structure is frozen; the
     kernels only read the model): the corner search alone cost 6 ms of every run of that
-    drive, which a study case that runs until settled repeats per run length."""
+    drive, which a study case that runs until settled repeats per run length.  So a
+    structure's arrays must not be changed in place once it has run: build another
+    (``dataclasses.replace``), as every part of torquesplit does."""
     s = structure
     _check(s)
     n_el = s.n_elements

@@ -56,7 +56,7 @@ def _system_matrix(structure: Structure) -> tuple[np.ndarray, np.ndarray]:
     return A, k_max
 
 
-@remember_last
+@remember_last(replay=False)
 def system_eigenvalues(structure: Structure) -> np.ndarray:
     """Eigenvalues of the first-order system at maximum stiffness, all gaps closed [1/s].
 
@@ -148,7 +148,7 @@ def _is_stable(h: float, lam: np.ndarray) -> bool:
     return bool(np.all(np.abs(rk4_amplification(h * lam)) <= 1.0 + _R_TOL))
 
 
-@remember_last
+@remember_last(replay=False)
 def stable_step(structure: Structure) -> float:
     """Largest RK4 step [s] for which every mode stays bounded (``inf`` if none limits).
 

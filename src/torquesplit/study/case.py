@@ -217,5 +217,9 @@ def _finish(res, names, defs, out, output_values, vals=None) -> list[float]:
 def _percent(f: float) -> str:
     """A share as a percentage with two significant digits, never in exponent form
     ('100 %', '12 %', '0.34 %'; '.2g' wrote 100 % as '1e+02 %')."""
+    import numpy as np
+
     p = 100.0 * f
-    return f"{p:.0f} %" if p >= 10 else f"{float(f'{p:.2g}'):g} %"
+    if p >= 10:
+        return f"{p:.0f} %"
+    return np.format_float_positional(float(f"{p:.2g}"), trim="-") + " %"

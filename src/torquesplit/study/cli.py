@@ -369,11 +369,12 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
                              highlight=False)
         lost = int((status == "contact_lost").sum())
         if lost:  # (kept: a separating mesh is a result; but not one to average unawares)
+            rule = " and the stopping rule" if "stopping_target_met" in ds.attrs else ""
             ui.console.print(
                 f"{lost} of these {status.size} cases lost contact (status contact_lost): "
-                f"their values are in the statistics and the stopping rule, computed on a "
-                f"mesh that separated (select status == 'ok' in results.nc to leave them "
-                f"out)", markup=False, highlight=False)
+                f"their values are in the statistics{rule}, computed on a mesh that "
+                f"separated (select status == 'ok' in results.nc to leave them out)",
+                markup=False, highlight=False)
     # what the columns are (the run's table has this legend; the study's had only names)
     for line in output_definitions([ds[v].attrs["output"] for v in out_vars]):
         ui.console.print(line, markup=False, highlight=False, soft_wrap=True)

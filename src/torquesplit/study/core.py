@@ -229,8 +229,10 @@ class Study:
             try:
                 runner_ = chosen or make_runner(workers, client=client, scheduler=scheduler,
                                                 runner=runner)
-            except KeyboardInterrupt:  # (while the workers start: a stop like any other)
-                raise StudyInterrupted(store.count(), plan.design.n_cases, out) from None
+            except KeyboardInterrupt:  # (while the workers start: a stop like any other;
+                # cases that ended in an error are not done: they run again)
+                done = sum(1 for r in store.cases() if r["status"] != "error")
+                raise StudyInterrupted(done, plan.design.n_cases, out) from None
             run = _Driver(plan, store, runner_, progress, out, words)
             run.execute()
             try:
@@ -266,10 +268,12 @@ def resume_notes(out, resume: bool, words: Words) -> list[str]:
     if not path.exists():
         return [f"{words.out} {out} holds no study to resume: the study starts from its "
                 f"first case"]
+    import contextlib
     import sqlite3
 
-    try:
-        with sqlite3.connect(f"file:{path}?mode=ro", uri=True) as db:
+    try:  # (a URI escapes a folder's '#', '?' or '%'; closing: 'with' only commits)
+        with contextlib.closing(sqlite3.connect(path.resolve().as_uri() + "?mode=ro",
+                                                uri=True)) as db:
             n = db.execute("SELECT COUNT(*) FROM cases WHERE status = 'error'").fetchone()[0]
     except sqlite3.Error:  # (the store's own checks say what is wrong with it)
         return []

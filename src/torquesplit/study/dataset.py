@@ -283,7 +283,7 @@ def case_mat_bytes(ds) -> bytes:
     ``names`` maps each field to the Dataset's name, ``units`` gives its SI unit."""
     from ..results.files import mat_bytes
 
-    taken: set = set()
+    taken: set = {"names", "units", "dimensions", "study_name"}  # (this file's own)
     data: dict = {}
     names, units = [], []
     for v in [*ds["status"].dims, *[c for c in ds.coords if c not in ds["status"].dims

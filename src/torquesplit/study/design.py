@@ -217,7 +217,7 @@ def _resolve(spec, folder, text, source) -> Plan:
     outputs, definitions = chosen
     # probe: a study whose first case gives an invalid model is refused (almost always a
     # mistake in the file); an invalid later case is recorded as refused when it runs,
-    # and one the grid reaches at a parameter's smallest or largest value is said now
+    # and one where a parameter takes its smallest or largest value is said now
     cases = _probe_cases(design)
     _validated(apply_overrides(base, design.overrides(0)), model_source,
                f"{kind}.parameters", case=0, design=design)
