@@ -1016,7 +1016,8 @@ def mesh(
         from .plot.mesh import plot_mesh_stiffness
 
         try:
-            plot_mesh_stiffness(cmp, plot, title=f"{m.model.name}: mesh {pair}")
+            plot_mesh_stiffness(cmp, plot,
+                                title=f"{m.model.name}: stiffness of mesh {pair} by method")
         except OSError as exc:
             failed = _figure_error(exc, "--plot", plot, "the table is printed, nothing saved")
             plot = None

@@ -500,6 +500,10 @@ def test_a_spectrum_of_numerical_noise_is_said_and_a_decimated_one_warns_of_fold
     fig = F.support_spectrum_figure(planets)
     assert all("no dynamic content" in " ".join(t.get_text() for t in ax.texts)
                for ax in fig.axes if ax.get_visible())
+    # and its legend gives no 1e-14 N 'mean' and 'largest' of that noise
+    labels = [ln.get_label() for ax in fig.axes if ax.get_visible() for ln in ax.lines]
+    assert any("rounding noise only" in lab for lab in labels), labels
+    assert not any("mean " in lab for lab in labels), labels
     assert "folds back" not in fig.get_suptitle()  # every step kept: nothing folds
     coarse = torquesplit.simulate("ji_li_mill_drive", cycles=60, samples_per_period=5)
     text = F.support_spectrum_figure(coarse).get_suptitle()

@@ -607,3 +607,35 @@ def test_a_kept_frequency_is_that_at_the_speed_asked_for():
     a, b = by_stage.summary()["meshes"]["m11"], by_hz.summary()["meshes"]["m11"]
     assert b["dynamic_factor"] == pytest.approx(a["dynamic_factor"], rel=1e-12)
     assert b["dynamic_factor"] > 1.001
+
+
+def test_a_mesh_keeps_its_colour_in_every_panel_of_the_sweep_figure():
+    """A lower panel where two meshes' curves coincide drew the next mesh in the colour
+    cycle's next colour: m12's transmission error read as m21's.  And without stability
+    the title claimed 'solid stable, dashed unstable'; a load sharing whose means are
+    equal but instants not got no panel."""
+    import xarray as xr
+
+    from torquesplit.steady.plot import sweep_figure
+
+    rpm = np.linspace(700.0, 790.0, 4)
+    df = np.column_stack([np.linspace(1.0, 1.2, 4) + k for k in range(3)])
+    te = np.column_stack([np.full(4, 1.0), np.full(4, 1.0), np.full(4, 3.0)]) * 1e-6
+    inst = np.column_stack([np.linspace(1.06, 1.07, 4)] * 3)
+    ds = xr.Dataset(
+        {"speed_rpm": ("point", rpm), "stable": ("point", np.ones(4, bool)),
+         "max_multiplier": ("point", np.full(4, np.nan)),
+         "dynamic_factor": (("point", "mesh"), df),
+         "load_sharing": (("point", "mesh"), np.ones((4, 3))),
+         "load_sharing_instantaneous": (("point", "mesh"), inst),
+         "rms_transmission_error": (("point", "mesh"), te)},
+        coords={"mesh": ["m11", "m21", "m12"]}, attrs={"model": "t"})
+    fig = sweep_figure(ds)
+    colours = []
+    for ax in fig.axes[:3]:
+        colours.append({ln.get_label().split(",")[0]: ln.get_color() for ln in ax.lines
+                        if ln.get_label() and not ln.get_label().startswith("_")})
+    assert colours[0]["m12"] == colours[2]["m12"] and colours[0]["m11"] == colours[2]["m11"]
+    assert "m21" not in colours[2]  # (joined m11's line)
+    assert "stability not computed" in fig.axes[0].get_title()
+    assert "instantaneous" in fig.axes[1].get_ylabel()

@@ -329,20 +329,23 @@ def dynamic_factor_figure(results, definition: str | None = None, *,
             ax.bar(x + 0.2, np.nan_to_num(ptn), 0.4, color=_color(1),
                    label="peak / nominal\n(peak / equal-split force)")]
     # each value on its bar: from 0, 1.076 and 1.105 looked the same (a reviewer)
-    if len(order) <= 12:
+    if len(order) <= 12:  # (upright beyond 4 meshes: side by side they ran into each
+        # other, '1.0001.000')
         for b in bars:
-            ax.bar_label(b, fmt="%.3f", fontsize=FONT["tick"] - 1, padding=1)
+            ax.bar_label(b, fmt="%.3f", fontsize=FONT["tick"] - 1, padding=1,
+                         rotation=0 if len(order) <= 4 else 90)
     ax.axhline(1.0, color="0.5", lw=0.9)
     top = float(np.nanmax(np.concatenate([dyn, ptn, [1.0]])))
     if top > 0.6 * limit:
         ax.axhline(limit, color="tab:red", ls=":", lw=1.3,
-                   label=f"{limit:g}: near a resonance\n(see torquesplit modes)")
+                   label=f"dynamic factor {limit:g}: a run above it is\nreported as near a "
+                         f"resonance (torquesplit modes)")
     ax.set_xticks(x, [f"{r.mesh}\n{r.group}" for r in order], rotation=0 if len(order) <= 6
                   else 60, ha="center" if len(order) <= 6 else "right")
     ax.set_xlim(-0.6, len(order) - 0.4)
-    ax.set_ylim(0, max(1.15 * top, 1.2))
+    ax.set_ylim(0, max((1.15 if len(order) <= 4 else 1.3) * top, 1.2))
     ax.set_title("per mesh, over the settled part", fontsize=FONT["title"])
-    _label(ax, "mesh and group [-]", "factor [-]")
+    _label(ax, "mesh, load-sharing group [-]", "factor [-]")
     _legend(ax)
     _suptitle(fig, results, "dynamic factors")
     return fig
@@ -495,7 +498,9 @@ def support_spectrum_figure(results, *, start_time: float | None = None, orders:
             tops = _spectral_lines(y, 0.01 * own) if not quiet else np.zeros(0, int)
             ax.plot(f_show[tops] * fscale, y[tops], ls="none", marker=_MARKERS[i % 3],
                     ms=5, mfc="none", mew=1.2, color=style["color"], zorder=4,
-                    label=f"{direction}: mean {_force_text(mean)},\n"
+                    # (a panel of rounding noise: its 1e-14 N numbers are not forces)
+                    label=f"{direction}: rounding noise only" if quiet else
+                          f"{direction}: mean {_force_text(mean)},\n"
                           f"largest {_force_text(a_show[peak])} at {_hz(f_show[peak])}")
         for j, (f, label) in enumerate(mesh_f.items()):
             for k in range(1, orders + 1):
@@ -540,7 +545,8 @@ def support_spectrum_figure(results, *, start_time: float | None = None, orders:
     smaller = [b for b in hidden if strength[b] < (1.0 - 1e-3) * least]
     others = [b for b in hidden if b not in smaller]
     more = ((f"\nnot drawn (smaller forces): {', '.join(smaller)}" if smaller else "")
-            + (f"\nnot drawn ({len(shown)} panels at most; bodies= chooses): "
+            + (f"\nnot drawn ({len(shown)} panels at most; in Python bodies= chooses "
+               f"them): "
                f"{', '.join(others)}" if others else ""))
     # a decimated history folds what is above its Nyquist frequency back into the band
     # (a 708 Hz harmonic drawn at 472 Hz from 5 samples per period)

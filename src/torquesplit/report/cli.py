@@ -205,6 +205,9 @@ def _report_inputs(h, ux, source, assign, duration, cycles, definition, quiet):
 
     for loc, msg in result_warnings(res, res.metrics(chosen)):
         ux.warn(f"{loc}: {msg}")
+    for text in h._near_critical(res):  # (as run says it, and in the report's warnings)
+        res.run_warnings.append(text)
+        ux.warn(text)
     return res, model_path, None, _quasi_if_static(m, ux, quiet)
 
 

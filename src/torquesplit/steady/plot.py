@@ -39,6 +39,11 @@ def sweep_variables(ds) -> list[str]:
     lsc = ds["load_sharing"].values if "load_sharing" in ds else np.ones(1)
     if np.any(np.abs(np.nan_to_num(lsc, nan=1.0) - 1.0) > 1e-9):
         out.append("load_sharing")
+    elif "load_sharing_instantaneous" in ds:  # (equal means, unequal instants: Ji & Li's
+        # stages, whose instantaneous coefficient moves with speed, had no panel)
+        inst = np.nan_to_num(ds["load_sharing_instantaneous"].values, nan=1.0)
+        if np.any(np.abs(inst - 1.0) > 1e-9):
+            out.append("load_sharing_instantaneous")
     if "rms_transmission_error" in ds:
         out.append("rms_transmission_error")
     return out
@@ -117,8 +122,12 @@ def sweep_figure(ds, variables=None):
     note = f"\nreplaced by their means: {'; '.join(dropped)}" if dropped else ""
     import textwrap
 
-    title = (f"{ds.attrs.get('model', '')}: speed response (solid stable, dashed unstable, "
-             f"dotted: turning points, grey: critical speeds)")
+    judged = ("max_multiplier" in ds
+              and bool(np.isfinite(np.asarray(ds["max_multiplier"].values, float)).any()))
+    lines = ("solid stable, dashed unstable" if judged else
+             "stability not computed")  # (--no-stability: no curve is judged)
+    title = (f"{ds.attrs.get('model', '')}: speed response ({lines}, dotted: turning "
+             f"points, grey: critical speeds)")
     # (wrapped: a long model name ran the title off the figure's left edge)
     axes[0].set_title(textwrap.fill(title, 80) + note, fontsize=9, pad=16)
     return fig
@@ -165,8 +174,10 @@ def _sweep_panel(ax, ds, variable):
             e = k
             while e + 1 < len(seg) and seg[e + 1] == seg[k]:
                 e += 1
+            # one colour per mesh in every panel (a curve equal to one drawn is left out:
+            # with the cycle's next colour, a lower panel's m12 took m21's)
             (line,) = ax.plot(rpm[k:e + 2], y[k:e + 2], "-" if seg[k] else "--",
-                              color=None if line is None else line.get_color(),
+                              color=LINE_COLOURS[j % len(LINE_COLOURS)],
                               label=str(mesh) if k == 0 else None, lw=1.3)
             first = first or line
             k = e + 1
