@@ -517,3 +517,18 @@ def test_dynamic_factor_bars_carry_their_values(run):
     texts = [t.get_text() for t in ax.texts]
     for r in met.rows:
         assert f"{r.dynamic_factor:.3f}" in texts and f"{r.peak_to_nominal:.3f}" in texts
+
+
+def test_figures_of_a_run_that_did_not_settle_say_so():
+    """Dong et al. 2021 at 50 cycles warned that it had not settled; its load-sharing and
+    dynamic-factor figures showed 'reported 1.3457' with no such note."""
+    import torquesplit
+
+    res = torquesplit.simulate("ji_li_mill_drive", cycles=12)
+    met = res.metrics()
+    assert not met.settling.settled  # (the premise: too short to tell)
+    for fig in (F.load_sharing_figure(res), F.dynamic_factor_figure(res)):
+        assert "had not settled by its end" in fig.get_suptitle()
+    settled = torquesplit.simulate("ji_li_mill_drive", cycles=120)
+    assert settled.metrics().settling.settled
+    assert "had not settled" not in F.dynamic_factor_figure(settled).get_suptitle()

@@ -299,7 +299,7 @@ def load_sharing_figure(results, definition: str | None = None, *,
         zoom.set_ylim(ax.get_ylim())
         _legend(zoom)
     _suptitle(fig, results, f"load-sharing coefficient, definition '{definition}'\n"
-                            f"{_DEFINITION_TEXT[definition]}")
+                            f"{_DEFINITION_TEXT[definition]}{_unsettled(met)}")
     return fig
 
 
@@ -347,7 +347,7 @@ def dynamic_factor_figure(results, definition: str | None = None, *,
     ax.set_title("per mesh, over the settled part", fontsize=FONT["title"])
     _label(ax, "mesh, load-sharing group [-]", "factor [-]")
     _legend(ax)
-    _suptitle(fig, results, "dynamic factors")
+    _suptitle(fig, results, f"dynamic factors{_unsettled(met)}")
     return fig
 
 
@@ -1190,6 +1190,14 @@ def _label(ax, xlabel: str, ylabel: str) -> None:
 def _legend(ax) -> None:
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=FONT["legend"],
               frameon=False, borderaxespad=0.0)
+
+
+def _unsettled(met) -> str:
+    """A title's note where the run did not settle (its numbers may still change: the
+    run's warnings say so, a figure in a report did not)."""
+    return ("" if met.settling.settled else
+            "\nthe run had not settled by its end: these numbers may still change (see the "
+            "run's warnings)")
 
 
 def _suptitle(fig, results, what: str) -> None:
