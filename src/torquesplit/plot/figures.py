@@ -654,8 +654,14 @@ def orbit_figure(results, *, bodies: Iterable[str] | None = None) -> Figure:
         ax.set_title(title, fontsize=FONT["title"])
         _label(ax, "x [µm]", "y [µm]")
     kind = "quasi-static" if hasattr(results, "orbits") else "dynamic"
-    _suptitle(fig, results, f"floating orbits ({kind})\n"
-                            "displacement from the nominal centre +, o start")
+    from ..model.kinematics import support_frame
+
+    frames = {support_frame(results.kinematics, b)[0] for b in orbits
+              if support_frame(results.kinematics, b)[2]}
+    frame = (f"x, y in {', '.join(sorted(frames))}'s turning frame for the bodies measured "
+             f"in it, else the housing's" if frames else "x, y in the housing frame")
+    _suptitle(fig, results, f"floating orbits ({kind}): the path of each centre about its "
+                            f"nominal position\n(+ the nominal centre, o the start; {frame})")
     return fig
 
 

@@ -56,7 +56,7 @@ def plot_mesh_stiffness(comparison, path, *, cycles: int = 2, title: str | None 
     if iso is not None:
         ax.axhline(iso / 1e6, color="k", linestyle=(0, (8, 4)), linewidth=0.8, zorder=10,
                    label=f"ISO 6336-1 $c_\\gamma b / \\cos^2\\beta_b$ = {iso / 1e6:.5g} N/µm "
-                         f"(along the flank normal)")
+                         f"(normal to the flanks, along the line of action as the curves)")
     ax.set_xlabel("mesh phase [mesh cycles]")
     ax.set_ylabel("mesh stiffness along the line of action [N/µm]")
     ax.set_xlim(0, cycles)
