@@ -277,6 +277,18 @@ def test_a_two_stage_drive_gets_a_panel_for_its_slower_meshes():
     legend = low.get_legend().get_window_extent()
     assert not legend.overlaps(low.get_window_extent())
     assert not legend.overlaps(low.xaxis.label.get_window_extent())
+    # the upper panel leaves the slow orders to the lower one (their labels stacked over
+    # its modes' numbers), and no order label sits left of an axes (one did, between the
+    # panels, at a line that leaves the lower panel at once)
+    zoom_top = low.get_ylim()[1]
+    orders = [t for t in top.texts if "x m" in t.get_text()]
+    assert orders and all(t.xyann[1] >= zoom_top for t in orders), \
+        [(t.get_text(), t.xyann) for t in orders]
+    for ax in (top, low):
+        box = ax.get_window_extent()
+        for t in ax.texts:
+            if "x m" in t.get_text():
+                assert t.get_window_extent().x1 > box.x0, t.get_text()
 
 
 def test_a_single_mesh_frequency_keeps_one_panel(lp3_figure):

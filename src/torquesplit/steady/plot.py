@@ -246,7 +246,7 @@ def campbell_figure(ds):
         fig = _figure(9, 9.5)
         ax, low = fig.subplots(2, 1, sharex=True, gridspec_kw=dict(height_ratios=[3, 2]))
         axes = [ax, low]
-    rows = _campbell_panel(ax, ds, fmax * 1.05, labelled=True)
+    rows = _campbell_panel(ax, ds, fmax * 1.05, labelled=True, floor=zoom or 0.0)
     if zoom is not None:
         _campbell_panel(low, ds, zoom, labelled=False)
         ax.set_xlabel("")  # (the speed axis is the panel's below)
@@ -285,11 +285,13 @@ def _zoom_top(ds, top: float) -> float | None:
     return 1.1 * slow if 0 < 1.1 * slow < ZOOM_SHARE * top else None
 
 
-def _campbell_panel(ax, ds, top: float, *, labelled: bool) -> int:
+def _campbell_panel(ax, ds, top: float, *, labelled: bool, floor: float = 0.0) -> int:
     """One panel of the Campbell diagram from 0 to ``top`` Hz: natural frequencies with
     their numbers, excitation lines with their orders, critical speeds (their speeds
-    printed above the axes where ``labelled``), the operating speed.  Returns the rows of
-    critical-speed labels."""
+    printed above the axes where ``labelled``), the operating speed.  Order labels below
+    ``floor`` are left to the panel below (they stacked over each other and the modes'
+    numbers), and a line that leaves the panel in its first quarter is not labelled (its
+    label sat outside the axes).  Returns the rows of critical-speed labels."""
     rpm = ds["speed_rpm"].values
     near = 0.02 * top  # two mode labels closer than this (in Hz) would overlap
     ends: list[tuple[float, list[str]]] = []
@@ -323,8 +325,9 @@ def _campbell_panel(ax, ds, top: float, *, labelled: bool) -> int:
             ax.plot(rpm, fe, lw=0.8, ls="--", color=colour, label=label if i == 0 else None)
             inside = np.flatnonzero(fe <= top)
             if len(members) > 1 and inside.size:  # the order at the line's last point
-                ends.append((float(rpm[inside[-1]]), float(fe[inside[-1]]),
-                             f"{order}x {short}".strip()))
+                x_end, y_end = float(rpm[inside[-1]]), float(fe[inside[-1]])
+                if (y_end >= floor and x_end >= rpm[0] + 0.25 * (rpm[-1] - rpm[0])):
+                    ends.append((x_end, y_end, f"{order}x {short}".strip()))
         for x, y, text in _thinned(ends, height):
             # '=' only for lines that coincide (a harmonic of one mesh on another's)
             same = next((t for t in tops if abs(t[0] - x) < 1e-9 * max(abs(x), 1.0)
