@@ -86,3 +86,33 @@ def test_changes_as_pairs_and_a_model_from_json_text():
     with pytest.raises(ModelError, match=r"gears\.a\.teeth: must be greater than 0"):
         Model.model_validate_json('{"model": {"name": "x"}, "gears": {"a": {"teeth": -1}}, '
                                   '"drives": {}, "loads": {}}')
+
+
+def test_a_researchers_session():
+    """A Python user's review: a bearing start time past the run's end took the whole
+    history (start-up included) silently; the Dataset's forces could not be scaled in
+    place; a quasi-static sweep's metrics('static_torque') was a TypeError; run_study
+    could not shorten a shipped study."""
+    import numpy as np
+
+    res = torquesplit.simulate(EXAMPLE, cycles=30)
+    end = float(res.solution.history_t[-1])
+    for bad in (end + 1.0, float("nan")):
+        with pytest.raises(OptionError, match="leaves no sample of the history"):
+            res.bearing_forces(start_time=bad)
+    ds = res.to_dataset()
+    ds["element_force"] /= 1e3  # a copy: the run's own arrays stay read-only
+    assert not res.solution.history_forces.flags.writeable
+    t, _ = res.mesh_force_history()
+    t += 1.0  # (a copy: the run's history is not moved)
+    assert res.mesh_force_history()[0][0] == res.solution.history_t[0] == t[0] - 1.0
+    from torquesplit.quasistatic import quasi_static_load_sharing
+
+    qs = quasi_static_load_sharing(torquesplit.load_model("mo2017_star_reducer"),
+                                   points_per_cycle=4, max_points=64)
+    assert np.isfinite(qs.metrics("static_torque").system)
+    with pytest.raises(OptionError, match="'static_torque' load sharing only"):
+        qs.metrics("engineering")
+    import inspect
+
+    assert "analysis" in inspect.signature(torquesplit.run_study).parameters

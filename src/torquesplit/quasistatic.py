@@ -73,8 +73,17 @@ class QuasiStaticResults:
         el = self.structure.element_names
         return self.solution.element_forces[:, [el.index(m) for m in self.mesh_names]]
 
-    def metrics(self) -> ls.LoadSharing:
-        """Static torque ratios per mesh, group and system (Mo et al. 2017 eqs. 14-15)."""
+    def metrics(self, definition: str | None = None) -> ls.LoadSharing:
+        """Static torque ratios per mesh, group and system (Mo et al. 2017 eqs. 14-15).
+
+        ``definition`` may be given as a dynamic run's ``metrics`` takes it: only
+        ``"static_torque"`` (``"static"``), the one a quasi-static sweep has."""
+        if definition not in (None, "static_torque", "static"):
+            from .errors import OptionError
+
+            raise OptionError(f"a quasi-static sweep has the 'static_torque' load sharing "
+                              f"only, not {definition!r}; the dynamic definitions are a "
+                              f"run's: torquesplit.simulate(model).metrics({definition!r})")
         groups = ls.group_meshes(self.structure.metadata["meshes"])
         return ls.static_torque(self.times, self.mesh_forces(), self.mesh_names, groups)
 

@@ -514,6 +514,12 @@ class Results:
                                            and not isinstance(start_time, bool)):
             raise OptionError(f"start_time must be a time in seconds (a number), got "
                               f"{start_time!r}; give e.g. res.metrics().settling.start_time")
+        end = float(s.history_t[-1])
+        if start_time is not None and not (math.isfinite(start_time) and start_time < end):
+            # (it took the whole history, start-up included, without a word)
+            raise OptionError(f"start_time {start_time!r} s leaves no sample of the history, "
+                              f"which ends at {end:.6g} s; give a time before that, e.g. "
+                              f"res.metrics().settling.start_time")
         if self.periodic and self.period:  # one whole period: the state repeats it (a
             # settle time inside the period weighted a part of it: a mean 6x too large)
             from .dataset import period_samples
@@ -561,7 +567,7 @@ class Results:
         s = self.solution
         el = self.structure.element_names
         cols = [list(s.history_elements).index(el.index(m)) for m in self.mesh_names]
-        return s.history_t, s.history_forces[:, cols]
+        return s.history_t.copy(), s.history_forces[:, cols]  # (yours to change in place)
 
     # ------------------------------------------------------------------ export
     def to_dataset(self, definition: str | None = None):

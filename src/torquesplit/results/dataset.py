@@ -83,7 +83,9 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
     ratio_min = np.where(res.complete_cycles, s.cycle_ratio_min[:, mesh_cols], np.nan)
     ds = xr.Dataset(
         data_vars={
-            "element_force": _var(("time", "element"), s.history_forces,
+            # (copies: the run's own arrays are read-only, and a Dataset is the user's to
+            # change in place, ds["element_force"] /= 1e3)
+            "element_force": _var(("time", "element"), s.history_forces.copy(),
                                   "N" if set(hist_units) <= {"N"} else "N or N m",
                                   "element force (mesh: normal tooth force, negative in "
                                   "back-flank contact; support: the force on the bearing; "
@@ -113,7 +115,7 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
                                  "mesh force at static equilibrium"),
             "mesh_frequency": _var(("mesh",), [res.kinematics.meshes[m].frequency
                                                for m in meshes], "Hz", "mesh frequency"),
-            "static_displacement": _var(("dof",), res.static.q, "m or rad",
+            "static_displacement": _var(("dof",), np.array(res.static.q), "m or rad",
                                         "static equilibrium displacement"),
             "contact_loss_fraction": _var(("element",),
                                           s.separation_fraction[list(s.history_elements)], "1",

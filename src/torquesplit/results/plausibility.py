@@ -253,12 +253,12 @@ def settling(results, metrics) -> list[tuple[str, str]]:
         n, w = short[m]
         return [("analysis", (
             f"the run is too short to tell whether the response has settled: mesh {m} "
-            f"completes {n} cycles, fewer than two settle windows of {w} cycles (a window "
-            f"spans at least 20 cycles and the longest excitation period, e.g. a gear "
-            f"revolution when errors turn with the gears; a cycle the start or the end "
-            f"cuts does not count), so the metrics may not average over whole excitation "
-            f"periods; simulate at least {need[m]:.3g} s ({2 * w + 1} cycles of {m}) plus "
-            f"the transient"))]
+            f"completes {n} cycle{'' if n == 1 else 's'}, fewer than two settle windows of "
+            f"{w} cycles (a window spans at least 20 cycles and the longest excitation "
+            f"period, e.g. a gear revolution when errors turn with the gears; a cycle the "
+            f"start or the end cuts does not count), so the metrics may not average over "
+            f"whole excitation periods; simulate at least {need[m]:.3g} s ({2 * w + 1} "
+            f"cycles of {m}) plus the transient"))]
     return [("analysis", (
         "the transient did not die out within the run (the peaks still drift), so the last "
         "half of the run was used for the metrics; simulate longer (--cycles or --duration) "

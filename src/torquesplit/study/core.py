@@ -319,10 +319,11 @@ def _backend_runner(plan: Plan, backend: str, precision, client, scheduler, runn
     return make_gpu_runner(precision=precision or "fp64", workers=workers)
 
 
-def run_study(spec, **kwargs):
+def run_study(spec, *, analysis: dict | None = None, **kwargs):
     """Run a study (file, name of a shipped study, dict or spec) and return its Dataset;
-    keyword arguments as :meth:`Study.run`."""
-    return Study(spec).run(**kwargs)
+    ``analysis`` as :class:`Study` takes it (``{"cycles": 30}``: a shorter trial of a
+    shipped study), the other keyword arguments as :meth:`Study.run`."""
+    return Study(spec, analysis=analysis).run(**kwargs)
 
 
 def load_results(out):
