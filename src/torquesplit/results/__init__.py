@@ -515,8 +515,10 @@ class Results:
             raise OptionError(f"start_time must be a time in seconds (a number), got "
                               f"{start_time!r}; give e.g. res.metrics().settling.start_time")
         end = float(s.history_t[-1])
-        if start_time is not None and not (math.isfinite(start_time) and start_time < end):
-            # (it took the whole history, start-up included, without a word)
+        if (start_time is not None and not (self.periodic and self.period)
+                and not (math.isfinite(start_time) and start_time < end)):
+            # (it took the whole history, start-up included, without a word; a periodic
+            # state takes its first period whatever the start time)
             raise OptionError(f"start_time {start_time!r} s leaves no sample of the history, "
                               f"which ends at {end:.6g} s; give a time before that, e.g. "
                               f"res.metrics().settling.start_time")
