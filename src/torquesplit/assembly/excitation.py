@@ -430,21 +430,12 @@ def impact_force_table(model: Model, kin: Kinematics, mesh_name: str, n: int):
         inertia_driven=kin.bodies[mk.driven].polar_inertia,
         impact_stiffness=k_mean / max(mk.transverse_contact_ratio, 1.0),
     )
-    import warnings
-
-    with warnings.catch_warnings(record=True) as caught:  # said in the model's words
-        warnings.simplefilter("always")
-        _, force = imp.table(n)
-    short = [w for w in caught if "MeshingInImpact.table" in str(w.message)]
-    for w in caught:  # (any other warning as it was given)
-        if w not in short:
-            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
-    if short and imp.duration > 0:
-        need = int(math.ceil(4 * imp.mesh_period / imp.duration))
+    if imp.pulse_samples(n) < gim.MIN_PULSE_SAMPLES:  # said in the model's words
         warn_user(f"meshes.{mesh_name}.impact: the meshing-in impact pulse spans "
-                  f"{imp.duration / imp.mesh_period * n:.1f} of the {n} table points per "
-                  f"mesh cycle, too few to resolve its peak; set [analysis] table_points to "
-                  f"at least {need}", ModelWarning)
+                  f"{imp.pulse_samples(n):.1f} of the {n} table points per mesh cycle, "
+                  f"too few to resolve its peak; set [analysis] table_points to at least "
+                  f"{imp.phases_needed()}", ModelWarning)
+    _, force = imp.table(n, warn=False)
     return np.asarray(force)
 
 

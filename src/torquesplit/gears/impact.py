@@ -38,6 +38,9 @@ import numpy as np
 
 from torquesplit.errors import ModelError, ModelWarning, warn_user
 
+MIN_PULSE_SAMPLES = 4
+"""A force table resolves the impact pulse's peak with this many samples across it."""
+
 __all__ = [
     "involute",
     "loaded_deflection",
@@ -372,18 +375,29 @@ class MeshingInImpact:
             out = out - self.mean_force
         return out
 
-    def table(self, n_phases: int = 256, *, remove_mean: bool = False):
+    def pulse_samples(self, n_phases: int) -> float:
+        """How many of ``n_phases`` samples per mesh cycle the pulse spans (inf: none)."""
+        return self.duration / self.mesh_period * n_phases if self.duration > 0 else math.inf
+
+    def phases_needed(self) -> int:
+        """The fewest samples per mesh cycle that resolve the pulse (MIN_PULSE_SAMPLES)."""
+        if self.duration <= 0:
+            return 1
+        return int(math.ceil(MIN_PULSE_SAMPLES * self.mesh_period / self.duration))
+
+    def table(self, n_phases: int = 256, *, remove_mean: bool = False, warn: bool = True):
         """(phase, force) sampled at ``n_phases`` equally spaced phases in [0, 1).
 
-        Warns when the pulse spans fewer than 4 samples: the table then misses the
-        peak; raise ``n_phases`` or evaluate :meth:`force` directly.
+        Warns (unless ``warn`` is False: a caller that says it in its own words) when the
+        pulse spans fewer than MIN_PULSE_SAMPLES samples: the table then misses the peak;
+        raise ``n_phases`` or evaluate :meth:`force` directly.
         """
         phase = np.arange(n_phases) / n_phases
-        if self.duration > 0 and self.duration / self.mesh_period * n_phases < 4:
+        if warn and self.pulse_samples(n_phases) < MIN_PULSE_SAMPLES:
             warn_user(
                 f"MeshingInImpact.table: the impact pulse spans "
-                f"{self.duration / self.mesh_period * n_phases:.1f} samples; use "
-                f"n_phases >= {int(math.ceil(4 * self.mesh_period / self.duration))}.",
+                f"{self.pulse_samples(n_phases):.1f} samples; use "
+                f"n_phases >= {self.phases_needed()}.",
                 ModelWarning,
             )
         return phase, self.force(phase, remove_mean=remove_mean)

@@ -122,15 +122,13 @@ def _angle_field(name: str, upper_deg: float):
     stage hid it until the next attempt)."""
 
     def check(cls, v):
-        try:
-            return _check_angle(v, name, upper_deg)
-        except FieldError as exc:
-            raise ValueError(str(exc)) from None
+        return _check_angle(v, name, upper_deg)
 
     return field_validator(name)(classmethod(check))
 
 
 def _check_angle(v: float, name: str, upper_deg: float) -> float:
+    """``v`` [rad], or a ValueError saying what the value read as and what to write."""
     if not (-math.radians(upper_deg) <= v <= math.radians(upper_deg)):
         # a number a user types bare (20, 14.5) is round and would be a valid angle in
         # degrees; '60 deg' arrives as 1.0472 rad, for which that hint read as nonsense
@@ -138,8 +136,8 @@ def _check_angle(v: float, name: str, upper_deg: float) -> float:
         hint = (f"a bare number is read in radians: if you meant {v:g} degrees, write "
                 f"'{v:g} deg'" if bare else
                 f"check the value ({name.replace('_', ' ')}s lie within +/-{upper_deg:g} deg)")
-        raise FieldError(name, (
-            f"{v:g} rad ({math.degrees(v):g} deg) is outside +/-{upper_deg:g} deg; {hint}"))
+        raise ValueError(f"{v:g} rad ({math.degrees(v):g} deg) is outside "
+                         f"+/-{upper_deg:g} deg; {hint}")
     return v
 
 

@@ -656,8 +656,8 @@ def orbit_figure(results, *, bodies: Iterable[str] | None = None) -> Figure:
     kind = "quasi-static" if hasattr(results, "orbits") else "dynamic"
     from ..model.kinematics import support_frame
 
-    frames = {support_frame(results.kinematics, b)[0] for b in orbits
-              if support_frame(results.kinematics, b)[2]}
+    frames = {carrier for carrier, _, turning in
+              (support_frame(results.kinematics, b) for b in orbits) if turning}
     frame = (f"x, y in {', '.join(sorted(frames))}'s turning frame for the bodies measured "
              f"in it, else the housing's" if frames else "x, y in the housing frame")
     _suptitle(fig, results, f"floating orbits ({kind}): the path of each centre about its "
