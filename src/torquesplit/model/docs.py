@@ -20,7 +20,7 @@ from pathlib import Path
 from pydantic import BaseModel
 from pydantic_core import PydanticUndefined
 
-from .schema import Model, Strict, Unit
+from .schema import Model, Strict, Unit, list_item
 from .units import KINDS
 
 #: where ``python -m torquesplit.model.docs`` writes (the repository's docs folder)
@@ -188,8 +188,8 @@ def _section_class(tp) -> type[BaseModel] | None:
     tp = _strip_optional(tp)
     if typing.get_origin(tp) is dict:
         tp = typing.get_args(tp)[1]
-    elif typing.get_origin(tp) is list and _is_table(typing.get_args(tp)[0]):
-        tp = typing.get_args(tp)[0]
+    elif _is_table(_item(tp)):
+        tp = _item(tp)
     if typing.get_origin(tp) is typing.Annotated:
         tp = typing.get_args(tp)[0]
     if isinstance(tp, type) and issubclass(tp, Strict):
@@ -201,17 +201,19 @@ def _is_table(tp) -> bool:
     return isinstance(tp, type) and issubclass(tp, Strict)
 
 
+_item = list_item
+
+
 def _is_table_list(tp) -> bool:
     """A (possibly optional) list of tables, written ``[{...}, {...}]``."""
-    tp = _strip_optional(tp)
-    return typing.get_origin(tp) is list and _is_table(typing.get_args(tp)[0])
+    return _is_table(_item(_strip_optional(tp)))
 
 
 def _header(name: str, tp) -> str:
     tp = _strip_optional(tp)
     if typing.get_origin(tp) is dict:
         return f"[{name}.NAME]"
-    if typing.get_origin(tp) is list and _is_table(typing.get_args(tp)[0]):
+    if _is_table(_item(tp)):
         return f"[[{name}]]"
     return f"[{name}]"
 
@@ -243,17 +245,17 @@ def _type_text(tp, metadata=()) -> str:
         return _type_text(typing.get_args(tp)[0], tp.__metadata__)
     if origin is typing.Literal:
         return "one of " + ", ".join(f'`"{v}"`' for v in typing.get_args(tp))
+    if _item(tp) is not None:
+        inner = _type_text(_item(tp))
+        if inner.startswith("one of "):
+            return "list of " + inner[len("one of "):]
+        plain = {"number": "list of numbers", "text": "list of names"}
+        return plain.get(inner, f"list, each {inner}")
     if origin is tuple:
         args = typing.get_args(tp)
         inner = _type_text(args[0])
         word = {"text": "names", "number": "numbers"}.get(inner, f"values, each {inner}")
         return f"list of {len(args)} {word}"
-    if origin is list:
-        inner = _type_text(typing.get_args(tp)[0])
-        if inner.startswith("one of "):
-            return "list of " + inner[len("one of "):]
-        plain = {"number": "list of numbers", "text": "list of names"}
-        return plain.get(inner, f"list, each {inner}")
     if origin in (typing.Union, types.UnionType):  # e.g. float | None with a marker
         args = [a for a in typing.get_args(tp) if a is not type(None)]
         return _type_text(args[0], metadata)

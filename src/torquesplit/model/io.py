@@ -14,7 +14,7 @@ from typing import Any
 import pydantic
 
 from ..errors import ModelError
-from .schema import FieldError, Model
+from .schema import FieldError, Model, list_item
 from .units import _short
 
 
@@ -271,8 +271,8 @@ def _fields_at(parts: list[str], lists: bool = False) -> list[str]:
             node = field.annotation
         elif typing.get_origin(node) is dict:
             node = typing.get_args(node)[1]
-        elif lists and typing.get_origin(node) is list and part.isdigit():
-            node = typing.get_args(node)[0]
+        elif lists and list_item(node) is not None and part.isdigit():
+            node = list_item(node)
         else:
             return []
     node = _strip(node)

@@ -105,7 +105,7 @@ class PlanetaryGear(Strict):
                                          "mass and inertia and, given, for the overlap "
                                          "check; default 3.5 m_n (ISO 6336-3:2006 "
                                          "Y_B = 1 from there).")
-    dofs: list[Dof] | None = Field(None, description="Degrees of freedom; default "
+    dofs: tuple[Dof, ...] | None = Field(None, description="Degrees of freedom; default "
                                    "['theta', 'x', 'y'] for the planets, ['theta'] else.")
     support: Support | None = Field(None, description="Support of the translational DOFs "
                                     "(sun and ring; the planets sit on 'planet_bearing').")
@@ -130,7 +130,7 @@ class PlanetaryCarrier(Strict):
     polar_inertia: Inertia = Field(gt=0, description="Polar moment of inertia (with the "
                                    "pins, without the planets).")
     mass: Mass | None = Field(None, gt=0, description="Mass (needed with translational DOFs).")
-    dofs: list[Dof] = Field(["theta"], description="Degrees of freedom.")
+    dofs: tuple[Dof, ...] = Field(("theta",), description="Degrees of freedom.")
     support: Support | None = Field(None, description="Support of the translational DOFs.")
     torsional_support: TorsionalSupport | None = Field(
         None, description="Holds the carrier against rotation (a star stage).")
@@ -179,7 +179,7 @@ class Planetary(Strict):
     name: str = Field("planetary", pattern=r"^[A-Za-z][A-Za-z0-9_]*$", max_length=40,
                       description="Prefix of the generated names (letters, digits, _).")
     planets: Count = Field(ge=1, le=32, description="Number of planets.")
-    angles: list[Angle] | None = Field(
+    angles: tuple[Angle, ...] | None = Field(
         None, description="Planet angles about the stage axis from the x axis (default "
         "equally spaced from 0); one per planet.")
     module: Length = Field(gt=0, description="Normal module of all three gears.")
@@ -202,7 +202,7 @@ class Planetary(Strict):
     carrier: PlanetaryCarrier = Field(description="The carrier.")
     planet_bearing: Support = Field(description="Bearing of each planet on its carrier pin "
                                     "(its other end is on the carrier: leave 'on' out).")
-    pin_errors: list[PinError] | None = Field(
+    pin_errors: tuple[PinError, ...] | None = Field(
         None, description="Pin position error of each planet: one {radial, tangential} "
         "table per planet, in planet order, e.g. [{tangential = '20 um'}, {}, {}] (pin "
         "errors are typically microns); default none.")

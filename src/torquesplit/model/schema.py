@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 import re
+import typing
 from typing import Annotated, Literal
 
 from pydantic import (BaseModel, BeforeValidator, ConfigDict, Field, PrivateAttr,
@@ -105,6 +106,18 @@ Dof = Literal["x", "y", "z", "loa", "theta"]
 """Body DOFs: translations along the global x, y, z; 'loa' a single translation along
 the (transverse) line of action of the gear's meshes, as in lumped torsion-translation
 models (Ji & Li eq. 9); 'theta' the rotation about the body's axis."""
+
+
+def list_item(tp):
+    """The item type of a list field, else None: ``list[X]`` or ``tuple[X, ...]`` (the
+    model's lists are tuples, so that a validated model cannot be changed in place, see
+    :meth:`Model.changed_in_place`)."""
+    args = typing.get_args(tp)
+    if typing.get_origin(tp) is list:
+        return args[0]
+    if typing.get_origin(tp) is tuple and len(args) == 2 and args[1] is Ellipsis:
+        return args[0]
+    return None
 
 
 class Strict(BaseModel):
@@ -372,7 +385,7 @@ class Gear(Strict):
     place: Placement | None = Field(None, description="Position from a mating gear and an angle.")
     axis: tuple[Number, Number, Number] = Field(
         (0.0, 0.0, 1.0), description="Rotation axis direction.")
-    dofs: list[Dof] = Field(["theta"], description=(
+    dofs: tuple[Dof, ...] = Field(("theta",), description=(
         "Degrees of freedom: 'theta' rotation; 'x', 'y', 'z' translations along the global "
         "axes; or 'loa', one translation along the line of action of the gear's meshes "
         "(Ji & Li eq. 9; its meshes must push it along parallel lines)."))
@@ -426,7 +439,7 @@ class Body(Strict):
     mass: Mass | None = Field(None, gt=0, description="Mass (needed with translational DOFs).")
     position: tuple[Length, Length, Length] = Field((0.0, 0.0, 0.0), description="Centre.")
     axis: tuple[Number, Number, Number] = Field((0.0, 0.0, 1.0), description="Rotation axis.")
-    dofs: list[Dof] = Field(["theta"], description=(
+    dofs: tuple[Dof, ...] = Field(("theta",), description=(
         "Degrees of freedom: 'theta' rotation; 'x', 'y', 'z' translations along the global "
         "axes; or 'loa', one translation along the line of action of the gear's meshes "
         "(Ji & Li eq. 9; its meshes must push it along parallel lines)."))
@@ -526,11 +539,11 @@ class StiffnessSpec(Strict):
         0.0, ge=0, description="Constant method: relative peak-to-peak variation of a rectangular "
         "single/double contact wave built from the contact ratio (0 = constant)."
     )
-    phase: list[Number] | None = Field(None, description="Table: mesh phases in [0, 1).")
-    values: list[Stiffness] | None = Field(None, description="Table: stiffness at each phase.")
+    phase: tuple[Number, ...] | None = Field(None, description="Table: mesh phases in [0, 1).")
+    values: tuple[Stiffness, ...] | None = Field(None, description="Table: stiffness at each phase.")
     mean: Stiffness | None = Field(None, gt=0, description="Fourier: mean stiffness.")
-    cos: list[Stiffness] = Field([], description="Fourier: cosine coefficients a_1..a_n.")
-    sin: list[Stiffness] = Field([], description="Fourier: sine coefficients b_1..b_n.")
+    cos: tuple[Stiffness, ...] = Field((), description="Fourier: cosine coefficients a_1..a_n.")
+    sin: tuple[Stiffness, ...] = Field((), description="Fourier: sine coefficients b_1..b_n.")
     fillet_foundation: Flag = Field(True, description="Potential energy and LTCA: include the "
                                     "fillet term.")
     slices: Count = Field(40, ge=1, description="Helical (and LTCA): number of slices across the "
@@ -747,7 +760,7 @@ class Drive(Strict):
     mode: Literal["torque", "speed"] = Field(
         "torque", description="'torque': constant torque; 'speed': prescribed speed (DOF removed)."
     )
-    fluctuation: list[TorqueHarmonic] = Field([], description=(
+    fluctuation: tuple[TorqueHarmonic, ...] = Field((), description=(
         "Harmonics of the drive torque about its nominal value (a 'torque' drive only), "
         "e.g. [{amplitude = '500 N m', frequency = '100 Hz'}] (see TorqueHarmonic)."))
     speed_coefficient: TorsionalDamping = Field(0.0, ge=0, description=(
@@ -795,7 +808,7 @@ class Load(Strict):
     speed_coefficient: TorsionalDamping = Field(
         0.0, ge=0, description="dT/d(speed) of the load characteristic (removes rigid-body drift)."
     )
-    fluctuation: list[TorqueHarmonic] = Field([], description=(
+    fluctuation: tuple[TorqueHarmonic, ...] = Field((), description=(
         "Harmonics of the load torque about its nominal value, e.g. [{amplitude = "
         "'20 kN m', order = 2}] (see TorqueHarmonic)."))
 
@@ -850,7 +863,7 @@ class ModelInfo(Strict):
     name: str = Field(description="Short name of the model.")
     description: str = Field("", description="One-line description.")
     reference: str = Field("", description="Source of the data (paper, drawing).")
-    accepted_warnings: list[AcceptedWarning] = Field([], description=(
+    accepted_warnings: tuple[AcceptedWarning, ...] = Field((), description=(
         "Plausibility warnings of the model checks that are known and accepted, each with "
         "its reason: not repeated on every load ('check' still lists them as accepted)."))
 
@@ -892,8 +905,8 @@ class Model(Strict, metaclass=_ModelMeta):
     drives: dict[str, Drive] = Field(description="Power inputs by name.")
     loads: dict[str, Load] = Field(description="Power outputs by name.")
     analysis: Analysis = Field(Analysis(), description="Analysis defaults.")
-    planetary: list[Planetary] = Field(
-        [], description="Planetary stages in one table each ([[planetary]]); expanded to "
+    planetary: tuple[Planetary, ...] = Field(
+        (), description="Planetary stages in one table each ([[planetary]]); expanded to "
         "the general sections (gears, bodies, meshes) on reading.")
 
     _origins: dict[str, str] = PrivateAttr(default_factory=dict)
@@ -933,8 +946,8 @@ class Model(Strict, metaclass=_ModelMeta):
     def changed_in_place(self) -> bool:
         """True when an entry of a section was replaced, added or deleted after the model
         was validated (the sections are plain dicts): such a change is not checked, and
-        results computed before it would be reused for it.  (A list inside an entry,
-        changed in place, is not seen: change a model with :meth:`with_changes`.)"""
+        results computed before it would be reused for it.  (The entries themselves are
+        frozen and their lists are tuples: nothing inside them can change.)"""
         now = self._entries()
         if len(now) != len(self._identity):
             return True
@@ -996,7 +1009,7 @@ class Model(Strict, metaclass=_ModelMeta):
         object.__setattr__(self, "gears", gears)
         object.__setattr__(self, "bodies", bodies)
         object.__setattr__(self, "meshes", meshes)
-        object.__setattr__(self, "planetary", [])
+        object.__setattr__(self, "planetary", ())
         self._origins = origins
         self._identity = self._entries()  # (the expanded sections are the validated ones)
         return self

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import pydantic
 
-from ..model.schema import Model, Unit
+from ..model.schema import Model, Unit, list_item
 from ..model.units import KINDS, parse_quantity
 from .errors import StudyError
 
@@ -71,8 +71,9 @@ def schema_field(path: str, where: str) -> Field:
                 raise StudyError(where, f"{path!r}: {here!r} must be a list index (0, 1, ...); "
                                         f"correct the path")
             args = typing.get_args(node)
-            node, meta = (args[int(part)] if typing.get_origin(node) is tuple
-                          and int(part) < len(args) else args[0]), []
+            fixed = typing.get_origin(node) is tuple and list_item(node) is None
+            node, meta = (args[int(part)] if fixed and int(part) < len(args)
+                          else args[0]), []
         else:
             raise StudyError(where, f"{path!r}: {'.'.join(parts[:i])!r} is a value, not a "
                                     f"table; shorten the path")
