@@ -540,7 +540,8 @@ class StiffnessSpec(Strict):
         "single/double contact wave built from the contact ratio (0 = constant)."
     )
     phase: tuple[Number, ...] | None = Field(None, description="Table: mesh phases in [0, 1).")
-    values: tuple[Stiffness, ...] | None = Field(None, description="Table: stiffness at each phase.")
+    values: tuple[Stiffness, ...] | None = Field(None, description="Table: stiffness at "
+                                                 "each phase.")
     mean: Stiffness | None = Field(None, gt=0, description="Fourier: mean stiffness.")
     cos: tuple[Stiffness, ...] = Field((), description="Fourier: cosine coefficients a_1..a_n.")
     sin: tuple[Stiffness, ...] = Field((), description="Fourier: sine coefficients b_1..b_n.")
