@@ -15,6 +15,8 @@ import functools
 import warnings
 import weakref
 
+from .errors import collect_model_warnings, note_warning
+
 
 def remember_last(fn=None, *, replay: bool = True):
     """Decorator: ``fn(obj, *args)`` computed once while ``obj`` (frozen) lives and
@@ -35,7 +37,9 @@ def remember_last(fn=None, *, replay: bool = True):
         alive = ref is not None and ref() is obj
         if not alive or last_args != args:
             if replay:
-                with warnings.catch_warnings(record=True) as said:
+                # (recorded here and given below, as on every later call: kept once)
+                with warnings.catch_warnings(record=True) as said, \
+                        collect_model_warnings(pause=True):
                     warnings.simplefilter("always")
                     result = fn(obj, *args)
             else:
@@ -44,6 +48,7 @@ def remember_last(fn=None, *, replay: bool = True):
                 weakref.finalize(obj, cache.pop, key, None)
             cache[key] = (weakref.ref(obj), args, result, said)
         for w in said:
+            note_warning(w.message, w.category)
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
         return result
 

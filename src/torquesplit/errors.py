@@ -12,6 +12,8 @@ text still reaches a message, so that an error never echoes a 100 KB string whol
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import re
 
 #: longest quoted value (in characters) a message repeats from the input
@@ -254,6 +256,34 @@ class ModelWarning(UserWarning):
     """A value that looks wrong but can be right (damping above critical, ...)."""
 
 
+_COLLECTORS: contextvars.ContextVar[tuple[list, ...]] = contextvars.ContextVar(
+    "torquesplit_model_warnings", default=())
+
+
+@contextlib.contextmanager
+def collect_model_warnings(pause: bool = False):
+    """Keep the text of every :class:`ModelWarning` given inside the block in the list
+    it yields, whatever the caller's warning filters (a run's record keeps the warnings
+    a caller silenced: ``simulate`` under ``warnings.simplefilter("ignore")`` lost
+    them).  ``pause``: the block's warnings are kept by no enclosing collector (a cached
+    result records its warnings and gives them again, see :mod:`torquesplit._memo`)."""
+    notes: list[str] = []
+    token = _COLLECTORS.set(() if pause else _COLLECTORS.get() + (notes,))
+    try:
+        yield notes
+    finally:
+        _COLLECTORS.reset(token)
+
+
+def note_warning(message, category: type[Warning] | None = None) -> None:
+    """Enter a warning about to be given in the open :func:`collect_model_warnings`."""
+    if category is None:
+        category = type(message) if isinstance(message, Warning) else UserWarning
+    if issubclass(category, ModelWarning):
+        for notes in _COLLECTORS.get():
+            notes.append(str(message))
+
+
 def warn_user(message, category: type[Warning] | None = None) -> None:
     """``warnings.warn`` attributed to the line that called into torquesplit (a script's
     line, a notebook's cell): the caller of the outermost torquesplit frame on the stack,
@@ -272,6 +302,7 @@ def warn_user(message, category: type[Warning] | None = None) -> None:
             outermost = level
         frame, level = frame.f_back, level + 1
     level = outermost + 1 if outermost + 1 < level else outermost
+    note_warning(message, category)
     if category is None:
         warnings.warn(message, stacklevel=level)
     else:

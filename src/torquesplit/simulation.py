@@ -19,7 +19,7 @@ import numpy as np
 
 from ._memo import remember_last
 from .assembly.structure import history_elements
-from .errors import ModelWarning, OptionError, SolverError, warn_user
+from .errors import ModelWarning, OptionError, SolverError, collect_model_warnings, warn_user
 from .model.io import load_model
 from .model.kinematics import solve_kinematics
 
@@ -115,19 +115,11 @@ def simulate(
                                                              samples_per_period)
     if not hasattr(model, "meshes"):
         model = load_model(model)
-    notes: list[str] = []
-    with warnings.catch_warnings():
+    with warnings.catch_warnings(), collect_model_warnings() as notes:
         # every ModelWarning of the run is shown (unless the caller's filters say
-        # otherwise) and kept with the results, so that files and reports carry it
+        # otherwise) and kept with the results whatever the filters, so that files and
+        # reports carry it
         warnings.simplefilter("always", ModelWarning, append=True)
-        shown = warnings.showwarning
-
-        def keep(message, category, filename, lineno, file=None, line=None):
-            if issubclass(category, ModelWarning):
-                notes.append(str(message))
-            shown(message, category, filename, lineno, file, line)
-
-        warnings.showwarning = keep
         res = _simulate(model, duration=duration, cycles=cycles, method=method,
                         steps_per_period=steps_per_period, rtol=rtol,
                         samples_per_period=samples_per_period, history_dofs=history_dofs,

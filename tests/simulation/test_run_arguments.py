@@ -143,3 +143,25 @@ def test_a_history_finer_than_a_step_set_by_stability_says_what_refines_it():
     assert (f"a finer step (a --steps-per-period above {round(per)}, steps_per_period= in "
             f"Python: the step is set here by {cause}, at {round(per)} steps per shortest "
             f"excitation period)") in said[0]
+
+
+def test_a_runs_record_keeps_the_warnings_its_caller_silenced():
+    """A reviewer: under warnings.simplefilter("ignore") a run's ModelWarnings were
+    neither shown nor kept, so its files and report lost them.  Kept whatever the
+    filters, once each, also when the model's set-up is kept from an earlier run."""
+    import warnings
+
+    import torquesplit
+
+    m = torquesplit.load_model("ji_li_mill_drive")
+    kw = dict(duration=0.05, steps_per_period=20)  # (a step warning: 20 is too coarse)
+    with warnings.catch_warnings(record=True) as shown:
+        warnings.simplefilter("always")
+        loud = torquesplit.simulate(m, **kw).run_warnings
+    assert loud and [str(w.message) for w in shown
+                     if issubclass(w.category, torquesplit.ModelWarning)] == loud
+    for _ in range(2):  # (the second: the model's set-up kept)
+        with warnings.catch_warnings(record=True) as shown:
+            warnings.simplefilter("ignore")
+            quiet = torquesplit.simulate(m, **kw).run_warnings
+        assert quiet == loud and shown == []
