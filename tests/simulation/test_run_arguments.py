@@ -165,3 +165,17 @@ def test_a_runs_record_keeps_the_warnings_its_caller_silenced():
             warnings.simplefilter("ignore")
             quiet = torquesplit.simulate(m, **kw).run_warnings
         assert quiet == loud and shown == []
+
+
+def test_the_metrics_one_line_says_when_the_run_did_not_settle():
+    """A reviewer: a run too short to tell whether it settled said so only in its
+    warnings; the metrics' line said 'settled from ...'."""
+    import warnings
+
+    import torquesplit
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        short = torquesplit.simulate("ji_li_mill_drive", cycles=3).metrics()
+    assert not short.settling.settled and short.settling.short
+    assert "not settled (too short to tell" in repr(short) and "settled from" not in repr(short)
