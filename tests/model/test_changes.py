@@ -131,3 +131,17 @@ def test_nothing_inside_a_models_entry_can_change_in_place():
         m.with_changes({"gears.stage_sun.dofs": ["theta"]})
     assert m.with_changes({"planetary.0.sun.dofs": ["theta"]}).gears[
         "stage_sun"].dofs == ("theta",)
+
+
+def test_a_table_set_on_a_table_changes_only_the_fields_it_names():
+    """A reviewer: with_changes({"gears.O1.errors": {"eccentricity": ...}}) replaced the
+    whole table, silently dropping the installation error the file gives."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        m = torquesplit.load_model("dong2021_face_gear")
+    before = m.gears["O1"].errors
+    assert before.installation > 0
+    new = m.with_changes({"gears.O1.errors": {"eccentricity": "5 um"}}).gears["O1"].errors
+    assert new.eccentricity == pytest.approx(5e-6)
+    assert new.installation == before.installation  # kept
+    assert m.gears["O1"].errors.eccentricity == before.eccentricity  # the model unchanged
