@@ -81,7 +81,8 @@ def coarse_table_warning(model, structure) -> str | None:
             f"leaving, an impact pulse); with {n} points per cycle each step is a ramp 1/{n} "
             "of a cycle long, which lowers the dynamic peaks (0.6-9 % on the shipped "
             "examples at 256); set [analysis] table_points = 16384 (no cost per step for "
-            "most models) and confirm with --check-step")
+            "most models) and confirm with --check-step (torquesplit.convergence.check_step in "
+            "Python)")
 
 
 def check_model(results):

@@ -261,7 +261,8 @@ def settling(results, metrics) -> list[tuple[str, str]]:
             f"cycles of {m}) plus the transient"))]
     return [("analysis", (
         "the transient did not die out within the run (the peaks still drift), so the last "
-        "half of the run was used for the metrics; simulate longer (--cycles or --duration) "
+        "half of the run was used for the metrics; simulate longer (--cycles or --duration; "
+        "cycles= or duration= in Python) "
         "or add damping"))]
 
 
@@ -491,8 +492,8 @@ def harmonic_truncation(results, metrics) -> list[tuple[str, str]]:
         f"{top:.2g} of the velocity energy (a converged series: below {limit:g}; the "
         f"time-domain residual is {ps.time_residual:.2g}), so the series is cut short and "
         f"the peaks and dynamic factors can be off by percent; let the harmonics double "
-        f"(--adaptive, the default without --harmonics) or solve by shooting "
-        f"(--method shooting)"))]
+        f"(--adaptive, the default without --harmonics; adaptive=True in Python) or solve "
+        f"by shooting (--method shooting; method='shooting')"))]
 
 
 #: every check, in the order the messages are listed
@@ -528,7 +529,8 @@ def static_warnings(results) -> list[tuple[str, str]]:
         out.append(("analysis", (
             f"stopped by Ctrl-C after {conv.size} of {sol.planned} positions: the load "
             f"sharing and orbits cover only the positions done; run it again to the end "
-            f"(or give fewer --revolutions) for the whole period")))
+            f"(or give fewer --revolutions, revolutions= in Python) for the whole "
+            f"period")))
     if conv.size and not conv.all():
         out.append(("analysis", (
             f"{int((~conv).sum())} of {conv.size} positions did not converge and are left "

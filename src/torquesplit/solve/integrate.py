@@ -788,7 +788,9 @@ def _error_sets_step(s: Structure, period: float, spp: int) -> str | None:
                  f"harmonic)")
     per_mesh = spp / (period * f_mesh) if f_mesh > 0 else math.nan
     return (f"{what}, {spp} steps per its period ({per_mesh:.4g} per shortest mesh "
-            f"period); fewer (--steps-per-period, checked by --check-step) make the run shorter")
+            f"period); fewer (--steps-per-period, checked by --check-step; in Python "
+            f"steps_per_period=, checked by torquesplit.convergence.check_step) make the run "
+            f"shorter")
 
 
 EXCITATION_PERIOD = "excitation period"
