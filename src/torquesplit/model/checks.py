@@ -603,6 +603,70 @@ def _label_slips(model: Model) -> list[tuple[str, str]]:
     return out
 
 
+#: a support deflecting more than this fraction of its gear's module under the nominal
+#: tooth forces, or a shaft twisting more than MAX_NOMINAL_TWIST [rad] under the torque
+#: it carries, is warned: a unit slip (the shipped examples: at most 0.023 modules and
+#: 0.015 rad, but for one printed as the paper gives it and accepted in its file)
+MAX_NOMINAL_DEFLECTION = 0.5
+MAX_NOMINAL_TWIST = 0.2
+#: a support this many times softer than its gear's meshes (ISO 6336 estimate) is warned:
+#: the member floats (shipped floating members: 0.16 of their meshes)
+MIN_SUPPORT_MESH_RATIO = 1e-4
+
+
+def compliance_warnings(model: Model, kin) -> list[tuple[str, str]]:
+    """Supports and shafts so soft that they cannot carry the nominal load: a stiffness
+    in the wrong unit (2000 N/mm for 2000 N/um) passes every other check, and in a
+    locked train the soft branch merely sheds its load (its static deflection stays
+    small), so the load sharing comes out absurd without a word.  Each is measured
+    against the nominal (equal-split) forces: a support by its deflection under the
+    resultant of its gear's nominal tooth forces, and by its stiffness beside the gear's
+    meshes; a shaft by its twist under the torque it carries."""
+    out = []
+    for kind, items in (("gears", model.gears), ("bodies", model.bodies)):
+        for name, body in items.items():
+            sup, bk = body.support, kin.bodies.get(name)
+            if sup is None or sup.stiffness is None or bk is None:
+                continue
+            k = min(v for v in (sup.stiffness, sup.stiffness_y) if v is not None)
+            resultant, mesh_k = np.zeros(3), []
+            for mk in kin.meshes.values():
+                if name in (mk.driver, mk.driven):
+                    sign = -1.0 if name == mk.driver else 1.0
+                    resultant += sign * mk.force * np.asarray(mk.line_of_action, float)
+                    mesh_k.append(mk.iso_stiffness or 0.0)
+            axis = np.asarray(bk.axis, float)
+            radial = float(np.linalg.norm(resultant - resultant.dot(axis) * axis))
+            module = (body.module if kind == "gears" else
+                      min(g.module for g in model.gears.values()))
+            loc = f"{kind}.{name}.support.stiffness"
+            if radial / k > MAX_NOMINAL_DEFLECTION * module:
+                out.append((loc, (
+                    f"{k:.3g} N/m would deflect {_length_text(radial / k)} under the "
+                    f"nominal tooth forces on {name} ({radial / 1e3:.4g} kN), more than half "
+                    f"its module: check the value and its unit (bearings are about 1e8-1e10 "
+                    f"N/m: write e.g. '2000 N/um'; a bare number is read in N/m)")))
+            elif mesh_k and max(mesh_k) > 0 and k < MIN_SUPPORT_MESH_RATIO * max(mesh_k):
+                out.append((loc, (
+                    f"{k:.3g} N/m is {max(mesh_k) / k:.3g} times softer than the meshes of "
+                    f"{name} (ISO 6336 about {max(mesh_k):.3g} N/m): the member floats, held "
+                    f"by its meshes alone; if that is meant, accept this warning, else check "
+                    f"the value and its unit (bearings are about 1e8-1e10 N/m; a bare number "
+                    f"is read in N/m)")))
+    for name, sh in model.shafts.items():
+        k = sh.torsional_stiffness
+        if sh.rigid or k is None or not k > 0:
+            continue  # (one from the diameter and length: those are checked for size)
+        torque = min((abs(kin.bodies[b].torque) for b in sh.connects if b in kin.bodies),
+                     default=0.0)
+        if torque / k > MAX_NOMINAL_TWIST:
+            out.append((f"shafts.{name}.torsional_stiffness", (
+                f"{k:.3g} N m/rad twists {torque / k:.3g} rad ({math.degrees(torque / k):.3g} "
+                f"deg) under the {torque:.4g} N m it carries: check the value and its unit "
+                f"(a bare number is read in N m/rad; 'N mm/rad' is 1000 times softer)")))
+    return out
+
+
 def plausibility_warnings(model: Model, kin) -> list[tuple[str, str]]:
     """Values that can be right but usually are not."""
     out = []
@@ -670,7 +734,8 @@ def plausibility_warnings(model: Model, kin) -> list[tuple[str, str]]:
                                "their rotations but not the motion of one about the other's "
                                "centre"))
              for loc, msg in shaft_axis_issues(model, kin, rigid=True)]
-    return out + rigid + magnitude_warnings(model, kin) + tolerance_warnings(model, kin)
+    return (out + rigid + magnitude_warnings(model, kin) + compliance_warnings(model, kin)
+            + tolerance_warnings(model, kin))
 
 
 #: a shaft's two bodies may be this far off their common axis [m] (plus SHAFT_AXIS_RELATIVE

@@ -1,0 +1,89 @@
+"""Supports and shafts too soft to carry the nominal load are warned (a first-hour
+review: a bearing stiffness in N/mm for N/um and a quill shaft in N mm/rad passed every
+check; in a locked train the soft branch merely shed its load, so the load sharing came
+out absurd without a word)."""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import pytest
+
+import torquesplit
+from torquesplit.model.checks import (MAX_NOMINAL_DEFLECTION, MAX_NOMINAL_TWIST,
+                                      compliance_warnings)
+from torquesplit.model.kinematics import solve_kinematics
+
+from .model_fixtures import pair_dict, rich_dict
+
+
+def _warnings(data: dict) -> list[tuple[str, str]]:
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        m = torquesplit.load_model(data)
+    return compliance_warnings(m, solve_kinematics(m))
+
+
+def _supported(stiffness) -> dict:
+    data = pair_dict()  # (spur: the tooth force lies across the wheel's axis)
+    data["gears"]["wheel"]["dofs"] = ["theta", "x", "y"]
+    data["gears"]["wheel"]["support"] = {"stiffness": stiffness}
+    return data
+
+
+def test_a_support_that_would_deflect_more_than_half_a_module_is_warned():
+    data = _supported("2e8 N/m")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        m = torquesplit.load_model(data)
+    kin = solve_kinematics(m)
+    assert _warnings(data) == []
+    force = next(iter(kin.meshes.values())).force
+    # the stiffness at which the nominal tooth force deflects the wheel half a module
+    edge = force / (MAX_NOMINAL_DEFLECTION * m.gears["wheel"].module)
+    assert _warnings(_supported(f"{1.01 * edge} N/m")) == []
+    (loc, msg), = _warnings(_supported(f"{0.99 * edge} N/m"))
+    assert loc == "gears.wheel.support.stiffness"
+    assert "would deflect" in msg and "nominal tooth forces on wheel" in msg
+
+
+def test_a_support_far_softer_than_its_meshes_is_warned_as_floating():
+    """A sun between balanced planet meshes carries no resultant: a bare '1500' (N/m)
+    held it by its meshes alone (and gave perfect load sharing) without a word."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        m = torquesplit.load_model("lin_parker1999_planetary",
+                                   changes={"planetary.0.sun.support.stiffness": 1500})
+    found = dict(compliance_warnings(m, solve_kinematics(m)))
+    assert "floats" in found["gears.stage_sun.support.stiffness"]
+    assert m.written_at("gears.stage_sun.support.stiffness") == (
+        "planetary.0.sun.support.stiffness")  # (where check_model reports it)
+
+
+def test_a_shaft_that_twists_too_far_under_its_torque_is_warned():
+    data = rich_dict()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        m = torquesplit.load_model(data)
+    torque = solve_kinematics(m).bodies["motor"].torque
+    edge = abs(torque) / MAX_NOMINAL_TWIST
+    data["shafts"]["input"]["torsional_stiffness"] = f"{1.01 * edge} N m/rad"
+    assert _warnings(data) == []
+    data["shafts"]["input"]["torsional_stiffness"] = f"{0.99 * edge} N m/rad"
+    (loc, msg), = _warnings(data)
+    assert loc == "shafts.input.torsional_stiffness"
+    twist = abs(torque) / (0.99 * edge)
+    assert f"{twist:.3g} rad ({math.degrees(twist):.3g} deg)" in msg
+
+
+@pytest.mark.parametrize("name", torquesplit.example_names())
+def test_no_shipped_example_warns_but_where_its_file_accepts_it(name):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        m = torquesplit.load_model(name)
+    from torquesplit.model.checks import accepted
+
+    left = [loc for loc, _ in compliance_warnings(m, solve_kinematics(m))
+            if accepted(m, loc) is None]
+    assert left == []
