@@ -99,15 +99,28 @@ def check_model(results):
 
 def agreeing_digits(a: float, b: float, most: int = 15) -> int:
     """Significant digits of ``a`` that ``b`` confirms: the largest s with
-    |a - b| <= 0.5 x 10^(e - s + 1), e the decimal exponent of a (0 if none agree; ``most``
-    if they are equal).  6.7389 against 6.7394 agree to 4 (6.739)."""
+    |a - b| <= 0.5 x 10^(e - s + 1), e the decimal exponent of a, at which both also
+    print the same (rounded to s digits in a's decimal places: 1.104934 and 1.104970
+    differ by less than half a unit of the 5th digit, but print 1.1049 and 1.1050, so
+    they agree to 4); 0 if none agree, ``most`` if they are equal.  6.7389 against
+    6.7394 agree to 4 (6.739)."""
     if a == b:
         return most
     if not (math.isfinite(a) and math.isfinite(b)) or a == 0.0:
         return 0
     e = math.floor(math.log10(abs(a)))
-    s = math.floor(e + 1 - math.log10(2.0 * abs(a - b)))
-    return max(0, min(most, s))
+    s = max(0, min(most, math.floor(e + 1 - math.log10(2.0 * abs(a - b)))))
+    while s > 0 and _printed(a, s - 1 - e) != _printed(b, s - 1 - e):
+        s -= 1
+    return s
+
+
+def _printed(x: float, places: int) -> float:
+    """``x`` as printed to ``places`` decimal places (negative: to tens, hundreds...)."""
+    if places >= 0:
+        return float(f"{x:.{places}f}")
+    scale = 10.0 ** -places
+    return float(f"{x / scale:.0f}") * scale
 
 
 @dataclass(frozen=True)

@@ -28,9 +28,13 @@ from torquesplit.model.overrides import apply_overrides, read_raw
     (6.7389, 6.7394, 4),      # 6.739: an error of 5e-4 is within half a unit of the 4th
     (6.7389, 6.7389, 15),
     (1.0, 2.0, 0),
-    (123.45, 123.40, 4),      # 0.05 is half a unit of the 4th digit (123.4)
+    (123.45, 123.40, 3),      # within half a unit of the 4th digit, but 123.5 vs 123.4
     (123.45, 123.39, 3),
-    (-0.0012345, -0.0012346, 4),
+    (-0.0012341, -0.0012342, 4),
+    # a reviewer: "5 digits hold" where the 5th printed digit moves (1.1049 vs 1.1050)
+    (1.104934, 1.104970, 4),
+    (0.99996, 1.00004, 3),    # 1.000 both (a's places: 3)
+    (1234.5, 1236.1, 2),      # 1230 vs 1240 at 3 digits
     (0.0, 1e-9, 0),
     (1.0, math.nan, 0),
 ])
