@@ -143,6 +143,9 @@ def test_steady_says_its_results_warnings_and_leaves_out_cycles_without_samples(
     waveform = [w for w in said if "saved waveform of the periodic state" in w]
     assert waveform and "--steps-per-cycle" in waveform[0]
     assert not any("--samples-per-period" in w for w in said)
+    # and every warning it printed is in its files
+    kept = json.loads((tmp_path / "sd_about.json").read_text())["warnings"]
+    assert said and [w for w in said if w not in kept] == []
     rows = list(csv.DictReader(open(tmp_path / "sd_cycles.csv", newline="")))
     for row in rows:
         for key in [k for k in row if k.endswith("_peak_N")]:
@@ -378,3 +381,22 @@ def test_steady_and_campbell_options_are_checked_and_the_summary_names_its_defin
     assert summary["load_sharing_definition"] == "engineering"  # the model's
     res = torquesplit.simulate(model, cycles=5, history_dofs="z1.theta")
     assert res.solution.history_q.shape[1] == 1  # one DOF, not its letters
+
+
+def test_a_steady_states_files_keep_the_warnings_given_while_it_was_solved(tmp_path):
+    """A reviewer: 'steady' printed that Ji & Li's speed is 0.24 % above a critical speed,
+    its files held no warning, and the report of them said 'no warnings'.  Its results
+    keep the warnings given while solving and the critical-speed notes, as a run's do,
+    also when the caller silenced them."""
+    import warnings
+
+    import torquesplit
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        st = steady_state(example_path("ji_li_mill_drive"), stability=False)
+    res = st.to_results()
+    critical = [w for w in res.warnings() if "above a critical speed" in w]
+    assert critical and critical == st.critical_notes()
+    res.save(tmp_path / "st.nc")
+    assert critical[0] in torquesplit.load_results(tmp_path / "st.nc").warnings()

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from torquesplit.errors import OptionError, SolverError, warn_user
+from torquesplit.errors import OptionError, SolverError, collect_model_warnings, warn_user
 from torquesplit.solve.kernel_data import continuous_start
 from torquesplit.steady.period import (
     base_frequency,
@@ -159,8 +159,11 @@ class SteadyState:
     """A periodic steady state of a model and everything needed to interpret it."""
 
     def __init__(self, *, model, kinematics, structure, static, period, solution,
-                 dropped, problem, options=None):
+                 dropped, problem, options=None, notes=()):
         self.model = model
+        #: the ModelWarnings given while it was solved (kept with its results)
+        self.notes = list(notes)
+        self._critical: list[str] | None = None
         #: the arguments of :func:`steady_state` that chose the problem (keep, speed,
         #: max_cycles), so that it can be solved again (e.g. finer: convergence.check_steady)
         self.options = dict(options or {})
@@ -248,7 +251,22 @@ class SteadyState:
                       static=self.static, solution=sol, periodic=True,
                       period=self.solution.period)
         res.steady = self
+        # what was said while solving, and the critical speeds near this one, as a run
+        # keeps them: its files and report carry them
+        res.run_warnings = self.notes + (self.critical_notes() if self.solution.converged
+                                         else [])
         return res
+
+    def critical_notes(self) -> list[str]:
+        """``"location: message"`` of each critical speed near the one solved, as
+        ``run`` warns of them at its own (computed once)."""
+        if self._critical is None:
+            from torquesplit.steady.maps import near_critical_notes
+
+            self._critical = near_critical_notes(
+                self.model, self.structure, self.static.q, self.kinematics,
+                speed=self.solution.speed * reference_speed(self.model))
+        return self._critical
 
     def summary(self, rows=None, results=None) -> dict:
         """What ``torquesplit steady`` prints, as a dict (its ``--json`` and the
@@ -387,16 +405,29 @@ def steady_state(model, *, method: str = "auto", harmonics: int | None = None,
     -------
     SteadyState
     """
-    from torquesplit.assembly.assemble import assemble
     from torquesplit.model.io import load_model
-    from torquesplit.model.kinematics import solve_kinematics
-    from torquesplit.solve.static import static_equilibrium
 
     _check_options(steps_per_cycle=steps_per_cycle, tol=tol, stability=stability,
                    energy_tol=energy_tol, method=method, harmonics=harmonics,
                    max_cycles=max_cycles)
     if not hasattr(model, "meshes"):
         model = load_model(model)
+    with collect_model_warnings() as notes:
+        return _steady_state(model, method=method, harmonics=harmonics, samples=samples,
+                             keep=keep, speed=speed, max_cycles=max_cycles,
+                             stability=stability, adaptive=adaptive, energy_tol=energy_tol,
+                             tol=tol, steps_per_cycle=steps_per_cycle, check=check,
+                             initial=initial, progress=progress, notes=notes)
+
+
+def _steady_state(model, *, method, harmonics, samples, keep, speed, max_cycles, stability,
+                  adaptive, energy_tol, tol, steps_per_cycle, check, initial, progress,
+                  notes) -> SteadyState:
+    """:func:`steady_state` of a loaded model; ``notes``: the list its warnings go to."""
+    from torquesplit.assembly.assemble import assemble
+    from torquesplit.model.kinematics import solve_kinematics
+    from torquesplit.solve.static import static_equilibrium
+
     kin = solve_kinematics(model)
     full = assemble(model, kin)
     dropped = []
@@ -438,7 +469,7 @@ def steady_state(model, *, method: str = "auto", harmonics: int | None = None,
     return SteadyState(model=model, kinematics=kin, structure=structure, static=static,
                        period=per, solution=sol, dropped=dropped, problem=problem,
                        options=dict(keep=keep_asked, speed=speed, max_cycles=max_cycles,
-                                    energy_tol=energy_tol))
+                                    energy_tol=energy_tol), notes=notes)
 
 
 def _at_base(per, base):

@@ -233,12 +233,7 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
 
                 for loc, msg in result_warnings(res, res.metrics()):
                     warn(f"{loc}: {msg}")
-                from torquesplit.steady.api import reference_speed
-                from torquesplit.steady.maps import near_critical_notes
-
-                for note in near_critical_notes(  # (as 'run' says it, at this speed)
-                        st.model, st.structure, st.static.q, st.kinematics,
-                        speed=st.solution.speed * reference_speed(st.model)):
+                for note in st.critical_notes():  # (as 'run' says it, at this speed)
                     warn(note)
             rows = st.mesh_table(results=res)
             saved = None
