@@ -400,3 +400,7 @@ def test_a_steady_states_files_keep_the_warnings_given_while_it_was_solved(tmp_p
     assert critical and critical == st.critical_notes()
     res.save(tmp_path / "st.nc")
     assert critical[0] in torquesplit.load_results(tmp_path / "st.nc").warnings()
+    # (the same reviewer: the slower stage's cycle starts ran ten times past the record)
+    starts = res.solution.cycle_start
+    assert np.nanmax(starts) <= res.solution.t_final
+    assert np.isnan(starts[:, -1]).sum() > 0.5 * starts.shape[0]  # (stage 2: 1/10 the cycles)

@@ -805,6 +805,9 @@ def _as_solution(st: SteadyState, shell, periods):
         csum[ok, j] = sm[ok] / span[ok]
         ccnt[:, j] = cnt
         cstart[:, j] = (bases[j] + np.arange(nc) - s.phase[e]) / s.frequency[e]
+        # a slower mesh's rows past its last cycle are no cycles: no start (as the
+        # integrator's; their starts ran ten times past the record's end)
+        cstart[cyc_n[j]:, j] = np.nan
     # per-cycle extremes of the instantaneous load-sharing ratio N f_i / sum_j f_j of each
     # group (Ji & Li eq. 18), from the same samples (what the integrator streams)
     from torquesplit.metrics.load_sharing import group_meshes
