@@ -603,6 +603,10 @@ def _label_slips(model: Model) -> list[tuple[str, str]]:
     return out
 
 
+#: the error amplitudes of a gear (``errors.grade`` bounds them, sets none)
+GEAR_ERROR_FIELDS = ("eccentricity", "installation", "tooth_thickness", "pitch",
+                     "bearing_runout")
+
 #: a support deflecting more than this fraction of its gear's module under the nominal
 #: tooth forces, or a shaft twisting more than MAX_NOMINAL_TWIST [rad] under the torque
 #: it carries, is warned: a unit slip (the shipped examples: at most 0.023 modules and
@@ -1064,12 +1068,21 @@ def tolerance_warnings(model: Model, kin) -> list[tuple[str, str]]:
     from .kinematics import gear_geometry
 
     out = []
+    # (a first-hour user's errors = {grade = 6} ran error-free, LSC 1.0000, without a word)
+    graded = [n for n, g in model.gears.items() if g.errors.grade is not None
+              and not any(getattr(g.errors, f) for f in GEAR_ERROR_FIELDS)]
+    if graded:
+        out.append((f"gears.{graded[0]}.errors.grade", (
+            f"a grade alone gives {', '.join(graded)} no error (the errors are all 0): the "
+            f"grade checks the errors given against ISO 1328-1 and bounds a study's sampling "
+            f"of them (a monte_carlo parameter with distribution 'iso1328', docs/studies.md);"
+            f" give the errors (eccentricity, pitch, ...) to run with them")))
     for name, g in model.gears.items():
+        e = g.errors
         try:
             d = 2 * gear_geometry(g).reference_radius
         except (ModelError, ValueError, ArithmeticError):  # pragma: no cover
             continue
-        e = g.errors
         loc = f"gears.{name}"
         stated = e.grade if e.grade is not None and 1 <= e.grade <= 11 else None
         for field, value, kind, what in (
