@@ -87,3 +87,25 @@ def test_no_shipped_example_warns_but_where_its_file_accepts_it(name):
     left = [loc for loc, _ in compliance_warnings(m, solve_kinematics(m))
             if accepted(m, loc) is None]
     assert left == []
+
+
+def test_a_drive_far_too_light_for_its_gears_is_warned_once():
+    """A first-hour review: power = 5000 (read in W, meant kW) gave 0.8 N/mm of face
+    width and no word; the run then spoke of contact loss and resonance."""
+    from torquesplit.model.checks import MIN_LOAD_PER_WIDTH, magnitude_warnings
+
+    def light(torque):
+        data = pair_dict()
+        data["drives"]["motor"]["torque"] = torque
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            m = torquesplit.load_model(data)
+        kin = solve_kinematics(m)
+        return m, kin, [w for w in magnitude_warnings(m, kin) if "N/mm of face width" in w[1]]
+
+    m, kin, said = light("100 N m")
+    per_width = kin.meshes["m"].force / m.gears["pinion"].face_width
+    assert said == [] and per_width > MIN_LOAD_PER_WIDTH
+    _, _, said = light(f"{100 * 0.99 * MIN_LOAD_PER_WIDTH / per_width} N m")
+    (loc, msg), = said
+    assert loc == "meshes.m" and "wrong unit" in msg

@@ -1188,6 +1188,9 @@ INERTIA_RATIO = 100.0
 MAX_PITCH_SPEED = 300.0
 #: tooth load per face width beyond what steel teeth carry [N/m] (10 kN/mm)
 MAX_LOAD_PER_WIDTH = 1e7
+#: [N/m] a nominal tooth force below this per face width is warned (the shipped examples:
+#: 14.7 N/mm and more; a power in W for kW gave 0.8 N/mm)
+MIN_LOAD_PER_WIDTH = 2e3
 #: a tooth modification amount (relief, crowning, helix slope) above this fraction of the
 #: module is flagged: modifications remove a few to tens of microns (tip relief of the
 #: order of the tooth deflection, 0.01-0.02 m_n for heavily loaded teeth)
@@ -1300,6 +1303,7 @@ def magnitude_warnings(model: Model, kin) -> list[tuple[str, str]]:
     for name, sh in model.shafts.items():
         for field in ("diameter", "length"):
             against_size(f"shafts.{name}.{field}", getattr(sh, field))
+    light = []  # (nominal tooth force per face width, mesh) below MIN_LOAD_PER_WIDTH
     for name, m in model.meshes.items():
         module = min(model.gears[x].module for x in m.gears)
         bl = m.backlash
@@ -1316,6 +1320,16 @@ def magnitude_warnings(model: Model, kin) -> list[tuple[str, str]]:
                     f"carries {mk.force / width / 1e3:.4g} N/mm of face width (steel teeth "
                     f"carry up to about 2000 N/mm); check the drive's torque or power, "
                     f"the gears' face_width and their units")))
+            elif mk.force / width < MIN_LOAD_PER_WIDTH:
+                light.append((mk.force / width, name))
+    if light:  # (one line: every mesh of a 1000-times-too-small drive is light)
+        load, name = min(light)
+        others = f" (the least of {len(light)} meshes this light)" if light[1:] else ""
+        out.append((f"meshes.{name}", (
+            f"carries {load / 1e3:.3g} N/mm of face width{others}, where loaded gears carry "
+            f"about 50-2000 N/mm: a drive's power or torque in the wrong unit? (a bare number "
+            f"is read in W or N m: write '5 MW'); a light load on purpose (rattle, idling) "
+            f"can be accepted")))
     for name, sp in model.splines.items():
         against_size(f"splines.{name}.pitch_radius", sp.pitch_radius)
         if sp.radial_clearance > sp.pitch_radius:
