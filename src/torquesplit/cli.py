@@ -726,11 +726,38 @@ def _render_run(res, met, saved, planets=None) -> None:
         f"over settled cycles of the largest member's per-cycle peak / nominal force (Ji & "
         f"Li eq. 19, engineering coefficient G_it)."
         + ("  Bearing forces: from the history, not streamed, so a peak between its samples "
-           "is missed (--samples-per-period)." if bearings else ""),
+           "is missed (--samples-per-period)." if bearings else "")
+        + _thrust_note(bearings, res),
         markup=False, highlight=False)
     if saved:
         console.print("results written to " + ", ".join(str(f) for f in saved),
                       highlight=False)
+
+
+def _thrust_note(bearings: list[dict], res) -> str:
+    """Which bearing rows leave out their gear's helical thrust: a body without an axial
+    DOF carries its meshes' axial forces nowhere (a first-hour user's 231 kN of thrust on
+    a bull gear appeared in no output)."""
+    import numpy as np
+
+    kin, model = res.kinematics, res.model
+    left = []
+    for r in bearings:
+        gear = model.gears.get(r["body"])
+        if gear is None or not set(gear.dofs) - {"theta"} <= {"x", "y"}:
+            continue  # (a 'loa' DOF moves along the line of action, thrust included)
+        axis = np.asarray(kin.bodies[r["body"]].axis, float)
+        axis /= np.linalg.norm(axis)
+        thrust = sum(mk.force * abs(float(np.asarray(mk.line_of_action) @ axis))
+                     for mk in kin.meshes.values() if r["body"] in (mk.driver, mk.driven))
+        if thrust > 1e-6 * max(mk.force for mk in kin.meshes.values()):
+            left.append(r["body"])
+    if not left:
+        return ""
+    return (f"  Axial thrust: {', '.join(left)} ha{'s' if len(left) == 1 else 've'} no "
+            f"axial DOF, so the helical meshes' axial forces (F_a of `torquesplit check`) are "
+            f"in none of these bearing forces; add 'z' to their dofs (with an "
+            f"axial_stiffness) to have them.")
 
 
 def run_table(met) -> Table:

@@ -1,0 +1,30 @@
+"""The run's notes say which bearing rows leave out a helical gear's thrust (a first-hour
+review: a bull gear with DOFs x, y, theta had 231 kN of axial thrust in `check` and in
+no bearing force, without a word)."""
+
+from __future__ import annotations
+
+import tomllib
+
+import tomli_w
+from typer.testing import CliRunner
+
+from torquesplit.cli import app
+from tests.model.model_fixtures import RICH_TOML
+
+
+def _run(tmp_path, data) -> str:
+    path = tmp_path / "rich.toml"
+    path.write_bytes(tomli_w.dumps(data).encode())
+    res = CliRunner().invoke(app, ["run", str(path), "--cycles", "20"])
+    assert res.exit_code == 0, res.output
+    return " ".join(res.stdout.split())
+
+
+def test_a_helical_gear_without_an_axial_dof_is_named(tmp_path):
+    data = tomllib.loads(RICH_TOML)
+    assert data["gears"]["wheel"]["dofs"] == ["x", "y", "theta"]
+    assert "Axial thrust: pinion, wheel have no axial DOF" in _run(tmp_path, data)
+    data["gears"]["wheel"]["dofs"] = ["x", "y", "z", "theta"]
+    data["gears"]["wheel"]["support"]["axial_stiffness"] = "1e9 N/m"
+    assert "Axial thrust: pinion has no axial DOF" in _run(tmp_path, data)
