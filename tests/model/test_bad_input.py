@@ -171,7 +171,11 @@ CASES = [
     ("no drive", setting("drives", {}),
      "drives", r"no drive; add a \[drives\.NAME\] section"),
     ("drives section missing", deleting("drives"),
-     "drives", r"required field is missing; add it"),
+     "drives", r"the model has no drives; add a \[drives\.NAME\] section where the power "
+               r"enters"),
+    ("loads section missing", deleting("loads"),
+     "loads", r"the model has no loads; add a \[loads\.NAME\] section where the power "
+              r"leaves"),
     ("no load", setting("loads", {}),
      "loads", r"no load; add a \[loads\.NAME\] section"),
     ("balanced load on the drive's body", setting("loads.out.body", "pinion"),
@@ -593,3 +597,27 @@ def test_an_accepted_warning_that_matches_nothing_is_said_by_check(tmp_path):
     assert res.exit_code == 0, res.output
     said = [ln for ln in res.stderr.splitlines() if "accepted_warnings" in ln]
     assert len(said) == 1 and "accepted_warnings.1" in said[0] and "stifness" in said[0]
+
+
+def test_a_gear_placed_from_a_gear_it_does_not_mesh_with_says_which_mesh_is_wrong():
+    """A first-hour review: a mesh that listed the wrong gear left its mate 'placed from
+    input but does not mesh with it; name a gear it meshes with: []'."""
+    data = pair_dict()
+    data["gears"]["idler"] = {"teeth": 40, "module": "2 mm", "face_width": "20 mm",
+                              "place": {"from_gear": "pinion", "angle": "180 deg"}}
+    data["meshes"]["m"]["gears"] = ["pinion", "idler"]
+    with pytest.raises(torquesplit.ModelError) as err:
+        torquesplit.load_model(data)
+    assert ("gears.wheel.place.from_gear", "'wheel' is placed from 'pinion' but does not "
+            "mesh with it; no mesh lists 'wheel' in its 'gears': check the meshes, or give "
+            "'position' instead") in err.value.issues
+
+
+def test_a_refused_gear_is_said_once_not_again_for_each_gear_placed_from_it():
+    """A first-hour review: pointed teeth of the pinion came back as 'gears.b1.place,
+    gears.b2.place, gears.b3.place: GearGeometry: addendum: the teeth are pointed'."""
+    data = pair_dict()
+    data["gears"]["pinion"]["profile_shift"] = 1.5
+    with pytest.raises(torquesplit.ModelError) as err:
+        torquesplit.load_model(data)
+    assert [loc for loc, _ in err.value.issues] == ["gears.pinion.profile_shift"]

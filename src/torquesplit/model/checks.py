@@ -165,9 +165,11 @@ def reference_issues(model: Model) -> list[tuple[str, str]]:
             if ref not in model.gears:
                 issues.append((loc, f"gear {ref!r} does not exist; {_one_of(model.gears, 'gears')}"))
             elif ref not in mates.get(name, set()):
+                known = sorted(mates.get(name, set()))
+                hint = (f"name a gear it meshes with ({', '.join(known)})" if known else
+                        f"no mesh lists {name!r} in its 'gears': check the meshes")
                 issues.append((loc, f"{name!r} is placed from {ref!r} but does not mesh with it; "
-                               f"name a gear it meshes with: {sorted(mates.get(name, set()))}, "
-                               f"or give 'position' instead"))
+                               f"{hint}, or give 'position' instead"))
     for name, s in model.shafts.items():
         for b in s.connects:
             need(f"shafts.{name}.connects", b)
@@ -375,6 +377,14 @@ def placement_issues(model: Model, skip=frozenset(), found=()) -> list[tuple[str
     if layout:
         return layout
     named = {loc.split(".")[1] for loc, _ in found if loc.startswith("gears.")}
+    # a gear placed from a refused one fails for its reason (said once, not again as
+    # 'gears.b1.place: GearGeometry: addendum: ...' for each of its mates)
+    grew = True
+    while grew:
+        more = {n for n, g in model.gears.items()
+                if g.place is not None and g.place.from_gear in named} - named
+        named |= more
+        grew = bool(more)
     unplaced = {loc.split(".")[1] for loc, _ in placed}
     # a mesh whose pair geometry is refused: its placement and frame fail for that reason
     skip = set(skip) | {".".join(loc.split(".")[:2]) for loc, _ in found

@@ -217,6 +217,12 @@ def _message(err: dict, parts: list[str], written=None) -> str:
     if kind == "missing":
         if parts and parts[-1].isdigit():
             return f"an item is missing (the list is too short); give all items ({_SEE_DOCS})"
+        if parts in (["drives"], ["loads"]):
+            what = ("where the power enters, e.g. [drives.motor] with body = 'pinion' and "
+                    "speed = '1500 rpm', power = '5 MW'" if parts == ["drives"] else
+                    "where the power leaves, e.g. [loads.out] with body = 'wheel' (its "
+                    "torque balances the drives' power unless given)")
+            return f"the model has no {parts[0]}; add a [{parts[0]}.NAME] section {what}"
         return f"required field is missing; add it ({_SEE_DOCS})"
     if kind in ("value_error", "assertion_error"):
         msg = err["msg"]
