@@ -37,7 +37,11 @@ def main() -> int:
              "Table 1, and Cooley & Parker 2012 (J. Vib. Acoust. 134:061014), the example of "
              "their rotating-carrier analysis at zero speed (dimensionless omega / "
              "sqrt(k_p / m_p)). Tolerance 0.1 % (`tests/validation/test_lin_parker1999.py`). "
-             "Tooth counts are ours: the lumped models do not depend on them.", "",
+             "Tooth counts are ours: the lumped models do not depend on them.  The "
+             "published modes are those of a carrier at rest: `torquesplit modes "
+             "lin_parker1999_planetary --no-rotating-frame` gives the Lin & Parker rows of "
+             "N = 4 (`--set planetary.0.planets=3` those of N = 3); without the flag the "
+             "turning carrier's Coriolis terms split the degenerate pairs.", "",
              "| system | N | type | multiplicity | published | ours | difference |",
              "|---|---|---|---|---|---|---|"]
     rows = []  # (system, N, published, ours, relative difference)

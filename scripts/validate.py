@@ -23,6 +23,8 @@ import time
 import warnings
 from pathlib import Path
 
+import numpy as np
+
 import torquesplit
 from torquesplit.convergence import check_model, halved_steps_per_period
 from torquesplit.errors import ModelWarning
@@ -101,6 +103,20 @@ def liu2021(quick: bool) -> dict:
     for label, impact in (("no_impact", False), ("impact", True)):
         over = {f"meshes.{m}.impact": impact for m in names if not m.endswith("12")}
         results[label] = _run(_model("liu2021_split_torque_helicopter", over), cycles=cycles)
+    # the natural frequencies next to the double-helical input stage's mesh frequency
+    # (the text says which modes its high dynamic factors sit near)
+    from torquesplit.model.kinematics import solve_kinematics
+    from torquesplit.modes import model_modes
+
+    model = _model("liu2021_split_torque_helicopter")
+    f_mesh = solve_kinematics(model).meshes["L34"].frequency
+    freqs = np.array([r.frequency for r in model_modes(model).rows])
+    results["modes_near_L34"] = {
+        "mesh_frequency": float(f_mesh),
+        "below": float(freqs[freqs < f_mesh].max()) if (freqs < f_mesh).any() else None,
+        "above": float(freqs[freqs > f_mesh].min()) if (freqs > f_mesh).any() else None,
+        "group_below_from": float(freqs[(freqs < f_mesh) & (freqs > 0.8 * f_mesh)].min()),
+    }
     return results
 
 

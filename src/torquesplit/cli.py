@@ -1482,8 +1482,9 @@ def modes(
     quiet: bool = _flag("--quiet", "No progress display."),
 ):
     """Natural modes about the static equilibrium: every mode (or those asked for), its
-    multiplicity, type (rotational, translational, planet for a planetary stage), modal
-    damping ratio and the strain-energy shares of its group.
+    multiplicity, modal damping ratio and the strain-energy shares of its group; where the
+    model has a planetary stage, its type too (rotational, translational or planet: Lin &
+    Parker 1999's classes, which only a cyclically symmetric stage has).
 
     The model is linearised about its static equilibrium with the MEAN mesh stiffness; a
     mesh (or clearance) separated at the equilibrium contributes no stiffness and no
