@@ -32,7 +32,8 @@ def _dataset():
         coords={"time": ("time", t, {"units": "s"}), "mesh": ["a", "b"],
                 "dof": ["g.theta", "g.x"], "dof_unit": ("dof", ["rad", "m"]),
                 "time_ms": ("time", 1e3 * t, {"units": "ms"})},
-        attrs={"title": "test", "labels": ["x", "y"]})
+        attrs={"title": "test", "labels": ["x", "y"], "share": 1.25, "complete": 1,
+               "speeds": [700.5, 800.0]})
 
 
 def _read(path):
@@ -60,7 +61,11 @@ def test_mat_and_netcdf_keep_every_variable_and_unit(tmp_path):
     np.testing.assert_array_equal(data["force"], ds["force"].values)
     assert data["units"]["force"] == "N" and data["units"]["time"] == "s"
     assert data["descriptions"]["force"] == "force"
-    assert json.loads(data["attributes"]["labels"]) == ["x", "y"]
+    # numbers as doubles, texts as cell arrays (a MATLAB user's review: '1.25' as text)
+    attrs = data["attributes"]
+    assert list(attrs["labels"]) == ["x", "y"]
+    assert attrs["share"] == 1.25 and attrs["complete"] == 1.0
+    np.testing.assert_array_equal(attrs["speeds"], [700.5, 800.0])
     assert list(data["mesh"]) == ["a", "b"] and "run_id" in data["provenance"]
     back = xr.open_dataset(save_dataset(ds, tmp_path / "r.nc"), engine="h5netcdf")
     np.testing.assert_array_equal(back["force"].values, ds["force"].values)

@@ -143,7 +143,25 @@ def _mat_name(name: str, taken: set) -> str:
     return out
 
 
-def _mat_data(ds, run_id: str) -> dict:
+def _mat_attribute(v):
+    """A Dataset attribute as MATLAB reads it best: a number (or a vector of numbers) as
+    a double, a text as a char array, anything else as JSON text (a reviewer's MATLAB
+    needed str2double on 'system_load_sharing = '1.045...'')."""
+    if isinstance(v, (bool, np.bool_, int, float, np.integer, np.floating)):
+        return float(v)
+    if isinstance(v, np.ndarray) and v.dtype.kind in "biuf":
+        return v.astype(float)
+    if (isinstance(v, (list, tuple)) and v and all(
+            isinstance(x, (bool, int, float, np.number)) for x in v)):
+        return np.asarray(v, dtype=float)
+    if isinstance(v, (list, tuple)) and v and all(isinstance(x, str) for x in v):
+        return np.asarray(v, dtype=object)  # (a cell array of texts)
+    if isinstance(v, str):
+        return v
+    return _json.dumps(v.tolist() if isinstance(v, np.ndarray) else v, default=str)
+
+
+def _mat_data(ds, run_id: str, attrs=None) -> dict:
     names = list(ds.data_vars) + list(ds.coords)
     taken = {"units", "descriptions", "attributes", "provenance", "names"}
     ident = {n: _mat_name(n, taken) for n in names}
@@ -157,9 +175,8 @@ def _mat_data(ds, run_id: str) -> dict:
     data["descriptions"] = {ident[n]: str(ds[n].attrs.get("long_name", "")) for n in names}
     data["names"] = {ident[n]: n for n in names}  # the Dataset's own names
     akeys: set = set()
-    data["attributes"] = {_mat_name(k, akeys): v if isinstance(v, str) else _json.dumps(
-        v.tolist() if isinstance(v, np.ndarray) else v, default=str)
-        for k, v in ds.attrs.items()}
+    data["attributes"] = {_mat_name(k, akeys): _mat_attribute(v)
+                          for k, v in (ds.attrs if attrs is None else attrs).items()}
     # the model, metrics and warnings at the top, where a run's .mat has them (not only
     # inside 'attributes')
     for key in ("model_json", "metrics_json"):
@@ -176,6 +193,7 @@ def _write(ds, plan: files.OutputPlan, claim: files.OutputClaim) -> Path:
     """Write ``ds`` to the files of ``plan`` under ``claim`` (NetCDF with the run's
     provenance in its attributes, MATLAB, or the CSV tables)."""
     ds = ds.copy()
+    attrs = dict(ds.attrs)  # (their own types: MATLAB reads a list of numbers as a vector)
     for k, v in list(ds.attrs.items()):  # NetCDF attributes: strings and numbers
         if isinstance(v, (list, tuple, dict)):
             ds.attrs[k] = _json.dumps(v, default=str)
@@ -183,7 +201,7 @@ def _write(ds, plan: files.OutputPlan, claim: files.OutputClaim) -> Path:
         ds.attrs.update(files.provenance(claim.run_id, ds.attrs.get("model_json")))
         claim.write({plan.path: files.netcdf_bytes(ds)})
     elif plan.format == "mat":
-        claim.write({plan.path: files.mat_bytes(_mat_data(ds, claim.run_id))})
+        claim.write({plan.path: files.mat_bytes(_mat_data(ds, claim.run_id, attrs))})
     else:
         dims = row_dims(ds)
         contents = {f: files.csv_bytes(*_table(ds, d)) for f, d in zip(plan.files[1:], dims[1:])}
