@@ -626,7 +626,7 @@ def test_a_mesh_keeps_its_colour_in_every_panel_of_the_sweep_figure():
         {"speed_rpm": ("point", rpm), "stable": ("point", np.ones(4, bool)),
          "max_multiplier": ("point", np.full(4, np.nan)),
          "dynamic_factor": (("point", "mesh"), df),
-         "load_sharing": (("point", "mesh"), np.ones((4, 3))),
+         "load_sharing_mean_force": (("point", "mesh"), np.ones((4, 3))),
          "load_sharing_instantaneous": (("point", "mesh"), inst),
          "rms_transmission_error": (("point", "mesh"), te)},
         coords={"mesh": ["m11", "m21", "m12"]}, attrs={"model": "t"})

@@ -473,7 +473,7 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
         }
         chosen = m.analysis.load_sharing
         other = (f"load sharing over speed: the mean-force coefficient (Dong et al. 2021 eq. "
-                 f"12, 'load_sharing' in the files) and the largest instantaneous ratio (Ji "
+                 f"12, 'load_sharing_mean_force' in the files) and the largest instantaneous ratio (Ji "
                  f"& Li eq. 18); the model's definition {chosen!r} is not computed by the "
                  f"sweep: 'torquesplit steady --speed S' gives it at a speed"
                  if chosen not in (None, "mean_force", "instantaneous", "static",

@@ -133,7 +133,8 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
     -------
     xarray.Dataset
         dims ``point`` and ``mesh``: speed, mesh frequency, dynamic factor (peak / the
-        mesh's static force), peak-to-nominal, load-sharing coefficients (``load_sharing``:
+        mesh's static force), peak-to-nominal, load-sharing coefficients
+        (``load_sharing_mean_force``:
         the ratio of mean forces, Dong et al. 2021 eq. 12, whatever the model's
         ``[analysis] load_sharing``;
         ``load_sharing_instantaneous``: the largest instantaneous ratio in its group
@@ -213,7 +214,7 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
                                {"units": "1", "long_name": "peak / the mesh's static force"}),
             "peak_to_nominal": (("point", "mesh"), stack("peak_to_nominal"),
                                 {"units": "1", "long_name": "peak / equal-split nominal force"}),
-            "load_sharing": (("point", "mesh"), stack("load_sharing"), {
+            "load_sharing_mean_force": (("point", "mesh"), stack("load_sharing"), {
                 "units": "1", "definition": "mean_force",
                 "long_name": "load-sharing coefficient N mean F_i / sum of the group's "
                              "mean forces (mean_force, Dong et al. 2021 eq. 12)"}),

@@ -23,7 +23,7 @@ def _figure(w, h):
 _SWEEP_AXES = {  # variable -> (axis label, scale of the stored SI value)
     "dynamic_factor": ("dynamic factor\n(peak / static force) [-]", 1.0),
     "peak_to_nominal": ("peak / nominal force [-]", 1.0),
-    "load_sharing": ("load-sharing coefficient\n(mean forces) [-]", 1.0),
+    "load_sharing_mean_force": ("load-sharing coefficient\n(mean forces) [-]", 1.0),
     "load_sharing_instantaneous": ("load-sharing coefficient\n(largest instantaneous) [-]",
                                    1.0),
     "rms_transmission_error": ("RMS dynamic\ntransmission error [µm]", 1e6),
@@ -36,9 +36,10 @@ def sweep_variables(ds) -> list[str]:
     coefficient where some mesh shares its load with others (a coefficient that is 1
     everywhere says nothing), and the RMS transmission error."""
     out = ["dynamic_factor"]
-    lsc = ds["load_sharing"].values if "load_sharing" in ds else np.ones(1)
+    lsc = (ds["load_sharing_mean_force"].values if "load_sharing_mean_force" in ds
+           else np.ones(1))
     if np.any(np.abs(np.nan_to_num(lsc, nan=1.0) - 1.0) > 1e-9):
-        out.append("load_sharing")
+        out.append("load_sharing_mean_force")
     elif "load_sharing_instantaneous" in ds:  # (equal means, unequal instants: Ji & Li's
         # stages, whose instantaneous coefficient moves with speed, had no panel)
         inst = np.nan_to_num(ds["load_sharing_instantaneous"].values, nan=1.0)
