@@ -272,3 +272,18 @@ def test_load_results_of_another_kind_of_file_says_what_reads_it(tmp_path):
         torquesplit.load_results(static)
     with torquesplit.open_results(static) as ds:
         assert len(ds.data_vars) > 0
+
+
+def test_an_overwritten_csv_set_leaves_no_file_of_the_old_set(tmp_path):
+    """A reviewer: '--force' over a quasi-static set left its NAME_mesh.csv beside the new
+    run's tables.  The old set's files (its NAME_about.json lists them) that the new set
+    does not write are removed; other files are not touched."""
+    save_dataset(_dataset(), tmp_path / "r.csv")
+    assert (tmp_path / "r_mesh.csv").exists()
+    (tmp_path / "r_notes.csv").write_text("mine")
+    one_table = _dataset().drop_dims("mesh")
+    save_dataset(one_table, tmp_path / "r.csv", overwrite=True)
+    assert not (tmp_path / "r_mesh.csv").exists()
+    assert (tmp_path / "r_notes.csv").read_text() == "mine"
+    assert json.loads((tmp_path / "r_about.json").read_text())["files"] == [
+        "r.csv", "r_about.json"]

@@ -753,7 +753,7 @@ class Results:
                 load_sharing_definition=met.definition if met is not None else None,
                 metrics=met.to_dict() if met is not None else None,
                 history_samples_per_period=self.history_samples_per_period(),
-                status=self.message)
+                status=self.message, files=plan.files)
             contents[summary] = files.csv_bytes(header, rows)  # last: marks the set
             claim.write(contents)
         return path

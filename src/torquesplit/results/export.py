@@ -210,7 +210,8 @@ def _write(ds, plan: files.OutputPlan, claim: files.OutputClaim) -> Path:
         rest = {k: v for k, v in ds.attrs.items()
                 if k not in ("model_json", "warnings", "warnings_json")}
         contents[files.about_path(plan.path)] = files.about_bytes(
-            claim.run_id, ds.attrs.get("model_json"), warnings, attributes=rest)
+            claim.run_id, ds.attrs.get("model_json"), warnings, attributes=rest,
+            files=plan.files)
         contents[plan.path] = files.csv_bytes(*_table(ds, dims[0]))  # last: marks the set
         claim.write(contents)
     return plan.path

@@ -109,6 +109,28 @@ def companion_files(path: Path, fmt: str) -> tuple[Path, ...]:
     return (path,)
 
 
+def _remove_replaced_set(plan: OutputPlan, contents) -> None:
+    """Before a CSV set is written over another one: remove the files of the old set (as
+    its ``NAME_about.json`` lists them) that the new set does not write (a reviewer's
+    ``--force`` left a quasi-static run's NAME_mesh.csv beside a run's NAME_groups.csv).
+    Only files named ``NAME_*`` beside it are touched."""
+    about = next((Path(f) for f in contents if Path(f).name.endswith("_about.json")), None)
+    if about is None or not about.is_file():
+        return
+    try:
+        listed = json.loads(about.read_text(encoding="utf-8")).get("files") or []
+    except (OSError, ValueError, AttributeError):
+        return
+    stem = about.name[:-len("_about.json")]
+    keep = {Path(f).name for f in plan.files}
+    for name in listed:
+        old = about.with_name(str(name))
+        if (old.name not in keep and old.name.startswith(stem + "_") and old.parent ==
+                about.parent and "/" not in str(name) and old.is_file()):
+            with contextlib.suppress(OSError):
+                old.unlink()
+
+
 def about_path(path: Path) -> Path:
     """``NAME_about.json`` beside the CSV table ``NAME.csv``."""
     return path.with_name(path.stem + "_about.json")
@@ -125,6 +147,8 @@ def about_bytes(run_id: str, model_json: str | None, warnings=(), **more) -> byt
              "model": json.loads(model_json) if model_json else None,
              "warnings": list(warnings)}
     about.update(more)
+    if "files" in about:  # (the set's file names: an overwrite removes what it leaves out)
+        about["files"] = [Path(f).name for f in about["files"]]
     return (_json.dumps(about, indent=1, default=str) + "\n").encode("utf-8")
 
 
@@ -364,6 +388,8 @@ class OutputClaim:
             The files written, in the order given.
         """
         allowed = {_key(f) for f in self.plan.files}
+        if self.plan.overwrite:
+            _remove_replaced_set(self.plan, contents)
         done: list[Path] = []
         try:
             for path, data in contents.items():
