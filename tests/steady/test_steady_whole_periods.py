@@ -400,6 +400,26 @@ def test_a_steady_states_files_keep_the_warnings_given_while_it_was_solved(tmp_p
     assert critical and critical == st.critical_notes()
     res.save(tmp_path / "st.nc")
     assert critical[0] in torquesplit.load_results(tmp_path / "st.nc").warnings()
+    # its period and stability reach MATLAB and the CSV set, and a file read back and
+    # saved again keeps them and its RMS transmission errors (they were lost)
+    import json
+
+    import scipy.io
+    import xarray as xr
+
+    mat = scipy.io.loadmat(res.save(tmp_path / "st.mat"), simplify_cells=True)["steady"]
+    assert mat["period_s"] == pytest.approx(st.solution.period) and mat["method"] == "shooting"
+    res.save(tmp_path / "st.csv")
+    about = json.loads((tmp_path / "st_about.json").read_text())["steady"]
+    assert about["period_s"] == pytest.approx(st.solution.period)
+    torquesplit.load_results(tmp_path / "st.nc").save(tmp_path / "again.nc")
+    with xr.open_dataset(tmp_path / "st.nc") as a, xr.open_dataset(tmp_path / "again.nc") as b:
+        assert set(a.data_vars) == set(b.data_vars)
+        kept = {k for k in a.attrs if k.startswith("steady_") or k == "record"}
+        assert kept and all(b.attrs[k] == a.attrs[k] or (a.attrs[k] != a.attrs[k] and
+                                                        b.attrs[k] != b.attrs[k])  # NaN
+                            for k in kept if k != "steady_json")
+        np.testing.assert_array_equal(a["rms_transmission_error"], b["rms_transmission_error"])
     # (the same reviewer: the slower stage's cycle starts ran ten times past the record)
     starts = res.solution.cycle_start
     assert np.nanmax(starts) <= res.solution.t_final

@@ -158,6 +158,19 @@ class Metrics:
         return out
 
 
+def _steady_summary(ds) -> dict:
+    """A saved periodic steady state's own numbers (``steady_*`` attributes: method,
+    period, residual, stability, largest Floquet multiplier, and what the record is),
+    without the prefix; {} for a run."""
+    if ds.attrs.get("analysis") != "periodic steady state":
+        return {}
+    out = {k[len("steady_"):]: v for k, v in ds.attrs.items()
+           if k.startswith("steady_") and k != "steady_json"}
+    out["record"] = ds.attrs.get("record", "")
+    out["dropped_excitations"] = ds.attrs.get("dropped_excitations", "none")
+    return out
+
+
 class Results:
     """A finished (or stopped) dynamic run and everything needed to interpret it."""
 
@@ -174,6 +187,9 @@ class Results:
         no transient to detect, every complete cycle counts."""
         self.period = period
         """The period of a periodic record [s] (None for a run)."""
+        self.saved_steady: dict = {}
+        """A steady state read back from its file: its ``steady_*`` (and record)
+        attributes and RMS transmission errors, which a save writes again."""
         self.kinematics = kinematics
         self.structure = structure
         self.static = static
@@ -646,6 +662,10 @@ class Results:
             data["metrics_json"] = ds.attrs.get("metrics_json", "")
             data["warnings"] = np.asarray(self.warnings(definition) or [""], dtype=object)
             data["provenance"] = files.provenance(claim.run_id, ds.attrs["model_json"])
+            steady = _steady_summary(ds)
+            if steady:  # (a reviewer's MATLAB had no stability and no period of it)
+                data["steady"] = {k: (float(v) if isinstance(v, (int, float, np.number))
+                                      else str(v)) for k, v in steady.items()}
             claim.write({plan.path: files.mat_bytes(data)})
         return plan.path
 
@@ -748,8 +768,11 @@ class Results:
                 ).tolist())]),
         }
         with files.claim_output(plan) as claim:
+            steady_info = _steady_summary(self.to_dataset(definition)) if (
+                getattr(self, "steady", None) is not None or self.saved_steady) else {}
             contents[about] = files.about_bytes(
                 claim.run_id, self.model_json(), self.warnings(definition),
+                **({"steady": steady_info} if steady_info else {}),
                 load_sharing_definition=met.definition if met is not None else None,
                 metrics=met.to_dict() if met is not None else None,
                 history_samples_per_period=self.history_samples_per_period(),

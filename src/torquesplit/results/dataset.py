@@ -235,6 +235,12 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
     if steady is not None:  # a periodic steady state: one period repeated, not a run
         _steady_attributes(ds, res, steady)
         ds = _one_period(ds, float(ds.attrs["steady_period_s"]))
+    elif getattr(res, "saved_steady", None):  # one read back: what its file said
+        saved = res.saved_steady
+        ds.attrs.update(saved["attrs"])
+        if saved.get("rms_transmission_error") is not None:
+            ds["rms_transmission_error"] = _var(
+                ("mesh",), saved["rms_transmission_error"], "m", saved["rms_long_name"])
     notes = res.warnings(definition) if hasattr(res, "warnings") else []
     ds.attrs.update({
         "warnings": "\n".join(notes),
@@ -434,4 +440,13 @@ def results_from_dataset(ds: xr.Dataset):
                   period=(float(ds.attrs["steady_period_s"]) if "steady_period_s" in ds.attrs
                           else None))
     res.saved_definition = ds.attrs.get("load_sharing_definition")
+    if res.periodic:  # (a save of it writes them again: they were lost)
+        rms = ds.get("rms_transmission_error")
+        res.saved_steady = {
+            "attrs": {k: v for k, v in ds.attrs.items() if k.startswith("steady_")
+                      or k in ("analysis", "record", "dropped_excitations",
+                               "history_periods")},
+            "rms_transmission_error": (None if rms is None else
+                                       np.asarray(rms.values, dtype=float)),
+            "rms_long_name": "" if rms is None else rms.attrs.get("long_name", "")}
     return res
