@@ -234,7 +234,8 @@ class Support(Strict):
     (``on``) to another body (a planet on its carrier pin, a gear on a moving frame)."""
 
     stiffness: Stiffness | None = Field(
-        None, gt=0, description="Radial stiffness (x and y) of the support."
+        None, gt=0, description="Radial stiffness (x and y) of the body's whole support: "
+        "all its bearings together (two bearings of 1e9 N/m side by side: 2e9 N/m)."
     )
     stiffness_y: Stiffness | None = Field(
         None, gt=0, description="Stiffness in y when it differs from x (defaults to 'stiffness')."
@@ -292,9 +293,13 @@ class GearErrors(Strict):
     """Manufacturing and assembly errors of one gear (Liu et al. 2021 eqs. 1-2, Dong et al. 2021 eq. 11)."""
 
     eccentricity: Length = Field(0.0, ge=0, description="Eccentricity amplitude (rotates with the gear).")
-    eccentricity_phase: Angle = Field(0.0, description="Angular position of the eccentricity at t = 0.")
+    eccentricity_phase: Angle = Field(0.0, description=(
+        "Angular position of the eccentricity at t = 0, from the x axis of the gear's "
+        "frame; it turns with the gear."))
     installation: Length = Field(0.0, ge=0, description="Installation (mounting) error amplitude.")
-    installation_phase: Angle = Field(0.0, description="Direction of the installation error.")
+    installation_phase: Angle = Field(0.0, description=(
+        "Direction of the installation error: a fixed offset of the gear's centre, at this "
+        "angle from the x axis of its frame (it does not turn with the gear)."))
     tooth_thickness: Length = Field(0.0, description="Tooth thickness error (Mo et al. 2017 §4).")
     pitch: Length = Field(0.0, ge=0, description=(
         "Total cumulative pitch deviation F_p (peak-to-peak over a revolution, on the "
@@ -579,7 +584,9 @@ class StiffnessSpec(Strict):
 class BacklashSpec(Strict):
     """Backlash: constant, or random per engagement (Ji & Li eq. 14)."""
 
-    nominal: Length = Field(ge=0, description="Total (circumferential-normal) backlash 2b.")
+    nominal: Length = Field(ge=0, description=(
+        "Total normal backlash j_bn = 2b, along the line of action (the mesh deflection "
+        "has a dead zone of +/- b: Ji & Li eq. 13, Dong et al. 2021 eq. 7)."))
     tolerance: Length = Field(0.0, ge=0, description="Half-width of the tolerance band.")
     distribution: Literal["constant", "normal", "uniform"] = Field(
         "constant", description="How each engagement's backlash is drawn."
