@@ -93,9 +93,9 @@ class Metrics:
         groups += f" and {more} more" if more > 0 else ""
         kv = ls._nanmax(list(d.per_group_dynamic_factor.values()))
         st = self.settling
-        why = "too short to tell" if st.short else "the transient did not die out"
+        why = "too short to tell" if st.short else "transient did not die out"
         settled = (f"settled from {st.start_time:.4g} s" if st.settled else
-                   f"not settled ({why}: see the run's warnings), from {st.start_time:.4g} s")
+                   f"not settled ({why}), from {st.start_time:.4g} s")
         return (f"Metrics({self.definition!r}: load sharing {self.load_sharing.system:.5g} "
                 f"({groups}), dynamic factor {kv:.4g}, {settled})")
 
