@@ -142,6 +142,15 @@ def _at_least(value, minimum, option: str, example: str) -> None:
                           f"{value}; give e.g. {option} {example}")
 
 
+def _out_option(check, *args, **kwargs):
+    """``check(*args, **kwargs)`` of an ``--out`` path, its problem named by the option
+    (as ``run`` says it: 'error: --out: cannot save results as ...')."""
+    try:
+        return check(*args, **kwargs)
+    except OutputError as exc:
+        raise OptionError(f"--out: {exc}") from None
+
+
 def _check_out(out: Optional[Path], force: bool):
     """The output plan of ``--out`` (None without it), its problems named by the option."""
     if out is None:
@@ -878,8 +887,8 @@ def static(
             opts.raise_any(model, assign)
             if out is not None:
                 # (the CSV tables: per position, per mesh, per planet of a stage)
-                plan = check_dataset_output(out, ("time", "mesh", "planet_entity"),
-                                            overwrite=force)
+                plan = _out_option(check_dataset_output, out,
+                                   ("time", "mesh", "planet_entity"), overwrite=force)
                 stack.enter_context(files.claim_output(plan))
             m, _ = _load(model, assign)
             from .quasistatic import quasi_static_load_sharing
@@ -1504,8 +1513,8 @@ def modes(
         opts(_positive, limit, "--below", "'5 kHz'")
         opts.raise_any(model, assign)
         if out is not None:  # (the CSV tables: per mode and per DOF, or per speed)
-            check_dataset_output(out, ("speed",) if campbell else ("mode", "dof"),
-                                 overwrite=force)
+            _out_option(check_dataset_output, out, ("speed",) if campbell else
+                        ("mode", "dof"), overwrite=force)
         m, _ = _load(model, assign)
         if not campbell and (start is not None or stop is not None):
             raise TorquesplitError("--from and --to give the speed range of a Campbell "
@@ -1532,7 +1541,7 @@ def modes(
                                     out=out, force=force)
         plan = None
         if out is not None:
-            plan = check_dataset_output(out, ("mode", "dof"), overwrite=force)
+            plan = _out_option(check_dataset_output, out, ("mode", "dof"), overwrite=force)
         from .model.kinematics import solve_kinematics
         from .modes import model_modes
 

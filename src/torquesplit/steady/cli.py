@@ -53,7 +53,9 @@ def _check_out(path, formats=None, force=False):
     from torquesplit.results import files
 
     if path is not None:
-        files.check_output(path, formats=formats, overwrite=force)
+        from torquesplit.cli import _out_option
+
+        _out_option(files.check_output, path, formats=formats, overwrite=force)
 
 
 def _emit(data, json_default):
@@ -420,7 +422,10 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
                 opts(_check_positive_speed, text, option, "'1000 rpm'")
             step = opts(_check_positive_speed, max_step, "--max-step", "'5 rpm'")
             if out is not None:  # (the CSV tables: per speed, per run-up/-down speed)
-                opts(check_dataset_output, out, ("point", "check"), overwrite=force)
+                from torquesplit.cli import _out_option
+
+                opts(_out_option, check_dataset_output, out, ("point", "check"),
+                     overwrite=force)
             if plot is not None:
                 from torquesplit import cli as ui  # (every figure option takes the same)
 
