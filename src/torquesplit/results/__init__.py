@@ -231,12 +231,15 @@ class Results:
         return [w for w in out if not (w in seen or seen.add(w))]
 
     def _model_plausibility(self) -> list[tuple[str, str]]:
-        from ..model.checks import plausibility_warnings
+        """The model's plausibility warnings, less those its file accepts with a reason
+        (``[model] accepted_warnings``: not shown by a run, so not in its files either)."""
+        from ..model.checks import accepted, as_written, plausibility_warnings
 
         try:
-            return plausibility_warnings(self.model, self.kinematics)
+            found = as_written(self.model, plausibility_warnings(self.model, self.kinematics))
         except (ValueError, ArithmeticError, KeyError):  # pragma: no cover - checked before
             return []
+        return [(loc, msg) for loc, msg in found if accepted(self.model, loc) is None]
 
     # ------------------------------------------------------------------ status
     def __repr__(self) -> str:
