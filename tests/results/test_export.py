@@ -60,6 +60,7 @@ def test_mat_and_netcdf_keep_every_variable_and_unit(tmp_path):
     data = scipy.io.loadmat(save_dataset(ds, tmp_path / "r.mat"), simplify_cells=True)
     np.testing.assert_array_equal(data["force"], ds["force"].values)
     assert data["units"]["force"] == "N" and data["units"]["time"] == "s"
+    assert data["dimensions"]["force"] == "time x mesh"  # (rows x columns, for MATLAB)
     assert data["descriptions"]["force"] == "force"
     # numbers as doubles, texts as cell arrays (a MATLAB user's review: '1.25' as text)
     attrs = data["attributes"]

@@ -108,6 +108,7 @@ def test_mat_and_csv_exports(split, tmp_path):
                if isinstance(v, np.ndarray) and not k.startswith("__")), \
         [k for k, v in mat.items() if isinstance(v, np.ndarray) and v.dtype.kind in "iu"]
     assert mat["static_force"].ravel() == pytest.approx(list(res.static_forces().values()))
+    assert str(mat["dimensions"][0, 0]["element_force"][0]) == "time x element"
     # each variable's unit and what it is (the .mat had units only, time none)
     desc = mat["descriptions"][0, 0]
     assert "history of every integration step" in str(desc["element_force"][0])

@@ -656,6 +656,10 @@ class Results:
                               else np.asarray(values))
             data["units"] = {name: ds[name].attrs.get("units", "") for name in ds.data_vars}
             data["units"]["time"] = "s"
+            # what the rows and columns of each array are ('time x element'), and that
+            # cycle and mode indices start at 0 and 1 (a MATLAB user's review)
+            data["dimensions"] = {name: " x ".join(ds[name].dims) or "scalar"
+                                  for name in ds.data_vars}
             # what each variable is, as the NetCDF's long_name (and its sampling note)
             data["descriptions"] = {
                 name: " ".join(filter(None, (ds[name].attrs.get("long_name", ""),

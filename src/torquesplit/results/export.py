@@ -163,7 +163,7 @@ def _mat_attribute(v):
 
 def _mat_data(ds, run_id: str, attrs=None) -> dict:
     names = list(ds.data_vars) + list(ds.coords)
-    taken = {"units", "descriptions", "attributes", "provenance", "names"}
+    taken = {"units", "descriptions", "attributes", "provenance", "names", "dimensions"}
     ident = {n: _mat_name(n, taken) for n in names}
     data = {}
     for name in names:
@@ -172,6 +172,7 @@ def _mat_data(ds, run_id: str, attrs=None) -> dict:
                              else np.asarray(values, dtype=float) if values.dtype.kind in "iub"
                              else np.asarray(values))
     data["units"] = {ident[n]: str(ds[n].attrs.get("units", "")) for n in names}
+    data["dimensions"] = {ident[n]: " x ".join(ds[n].dims) or "scalar" for n in names}
     data["descriptions"] = {ident[n]: str(ds[n].attrs.get("long_name", "")) for n in names}
     data["names"] = {ident[n]: n for n in names}  # the Dataset's own names
     akeys: set = set()
