@@ -165,7 +165,8 @@ OURS = {
 def dong_run_length() -> str:
     """Said once, above the studies of the Dong et al. 2021 example: its run does not
     settle (the numbers from docs/validation_results.json, ``scripts/validate.py``)."""
-    d = json.loads((ROOT / "docs" / "validation_results.json").read_text())["dong2021"]["drift"]
+    dong = json.loads((ROOT / "docs" / "validation_results.json").read_text())["dong2021"]
+    d, ulp = dong["drift"], dong["ulp"]
     return (
         "**The Dong et al. 2021 studies** (`dong_2021_*`) run every case for the example's "
         "1.21 s, which does not settle: `torquesplit run dong2021_face_gear` warns that the "
@@ -176,7 +177,10 @@ def dong_run_length() -> str:
         f"(Omega_II) therefore depend on the run length by about {d['change']:.1f}; stage I "
         f"(Omega_I) does not drift ({d['stage1_change']:.1g}).  The differences between cases "
         "are differences at this one run length: a stage-II trend or ranking smaller than "
-        "that drift may not survive a longer run.")
+        "that drift may not survive a longer run.  The response is also sensitive to the "
+        "last digit of its inputs (impacts in the clearances): a spline clearance one "
+        f"rounding unit larger moves a mean-force coefficient by {ulp['change']:.1g} "
+        f"({ulp['group']}), so differences between cases smaller than that are noise.")
 #: said under each of them
 DONG_SECTION = ("**Run length:** the run does not settle; Omega_II depends on the run length "
                 "(by how much: see the top of this page).")

@@ -145,3 +145,19 @@ def test_a_table_set_on_a_table_changes_only_the_fields_it_names():
     assert new.eccentricity == pytest.approx(5e-6)
     assert new.installation == before.installation  # kept
     assert m.gears["O1"].errors.eccentricity == before.eccentricity  # the model unchanged
+
+
+def test_a_table_that_chooses_another_method_or_is_empty_replaces_the_old_one():
+    """A reviewer: after merging came in, a stiffness switched from 'ltca' to 'constant'
+    kept the ltca table (refused), and errors = {} no longer cleared the errors."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        m = torquesplit.load_model("ji_li_mill_drive")
+        dong = torquesplit.load_model("dong2021_face_gear")
+    ltca = m.with_changes({"meshes.m11.stiffness": {"method": "ltca", "ltca": {"positions": 32}}})
+    assert ltca.meshes["m11"].stiffness.ltca.positions == 32
+    plain = ltca.with_changes({"meshes.m11.stiffness": {"method": "constant",
+                                                        "value": "4e9 N/m"}})
+    spec = plain.meshes["m11"].stiffness
+    assert spec.method == "constant" and spec.value == 4e9 and spec.ltca.positions != 32
+    assert dong.with_changes({"gears.O1.errors": {}}).gears["O1"].errors.installation == 0

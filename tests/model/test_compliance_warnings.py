@@ -45,7 +45,11 @@ def test_a_support_that_would_deflect_more_than_half_a_module_is_warned():
     assert _warnings(_supported(f"{1.01 * edge} N/m")) == []
     (loc, msg), = _warnings(_supported(f"{0.99 * edge} N/m"))
     assert loc == "gears.wheel.support.stiffness"
-    assert "would deflect" in msg and "nominal tooth forces on wheel" in msg
+    assert "would deflect" in msg and "the gear's nominal tooth forces" in msg
+    # a gear with no translational DOF: its support moves nothing, so nothing is said
+    data = _supported("1 N/m")
+    data["gears"]["wheel"]["dofs"] = ["theta"]
+    assert _warnings(data) == []
 
 
 def test_a_support_far_softer_than_its_meshes_is_warned_as_floating():
@@ -59,6 +63,17 @@ def test_a_support_far_softer_than_its_meshes_is_warned_as_floating():
     assert "floats" in found["gears.stage_sun.support.stiffness"]
     assert m.written_at("gears.stage_sun.support.stiffness") == (
         "planetary.0.sun.support.stiffness")  # (where check_model reports it)
+
+
+def test_soft_planet_bearings_are_said_once_for_their_stage():
+    """A reviewer: four planet bearings in N/mm gave four warnings at the one field they
+    are written in, differing only by the generated planet's name."""
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        torquesplit.load_model("lin_parker1999_planetary",
+                               changes={"planetary.0.planet_bearing.stiffness": 1e3})
+    soft = [str(w.message) for w in said if "planet_bearing.stiffness" in str(w.message)]
+    assert len(soft) == 1, soft
 
 
 def test_a_shaft_that_twists_too_far_under_its_torque_is_warned():

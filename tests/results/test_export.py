@@ -288,3 +288,8 @@ def test_an_overwritten_csv_set_leaves_no_file_of_the_old_set(tmp_path):
     assert (tmp_path / "r_notes.csv").read_text() == "mine"
     assert json.loads((tmp_path / "r_about.json").read_text())["files"] == [
         "r.csv", "r_about.json"]
+    # names that are no file of this folder are left alone (they raised ValueError)
+    (tmp_path / "r_about.json").write_text(json.dumps({"files": ["r_x/../r_notes.csv", "",
+                                                                  "r_sub/y.csv", 3]}))
+    save_dataset(one_table, tmp_path / "r.csv", overwrite=True)
+    assert (tmp_path / "r_notes.csv").read_text() == "mine"

@@ -639,3 +639,23 @@ def test_a_mesh_keeps_its_colour_in_every_panel_of_the_sweep_figure():
     assert "m21" not in colours[2]  # (joined m11's line)
     assert "stability not computed" in fig.axes[0].get_title()
     assert "instantaneous" in fig.axes[1].get_ylabel()
+
+
+def test_an_older_sweep_file_keeps_its_load_sharing_panel():
+    """sweep-speed's mean-force coefficient was 'load_sharing' in its files before it was
+    named 'load_sharing_mean_force': an older file still plots it (a reviewer)."""
+    import xarray as xr
+
+    from torquesplit.steady.plot import sweep_figure
+
+    rpm = np.linspace(700.0, 790.0, 4)
+    ds = xr.Dataset(
+        {"speed_rpm": ("point", rpm), "stable": ("point", np.ones(4, bool)),
+         "max_multiplier": ("point", np.full(4, np.nan)),
+         "dynamic_factor": (("point", "mesh"), np.ones((4, 2))),
+         "load_sharing": (("point", "mesh"), np.array([[1.1, 0.9]] * 4))},
+        coords={"mesh": ["m11", "m21"]}, attrs={"model": "t"})
+    for variables in (None, "load_sharing"):
+        fig = sweep_figure(ds, variables)
+        labels = [ax.get_ylabel() for ax in fig.axes]
+        assert any("mean forces" in lab for lab in labels), labels

@@ -555,7 +555,9 @@ def support_issues(model: Model) -> list[tuple[str, str]]:
                 floating = (written.startswith("planetary.") and written.endswith(".sun"))
                 hint = ("; a floating sun, held by its planet meshes alone: a support of "
                         "negligible stiffness, e.g. support = {stiffness = '1 N/m'} (a stiff "
-                        "one holds it: 1e8 N/m takes most of the equalising away)"
+                        "one holds it: 1e8 N/m takes most of the equalising away; the "
+                        "check then says the sun floats: accept that in [model] "
+                        "accepted_warnings)"
                         if floating else "")
                 issues.append((f"{kind}.{name}.support", (
                     f"the translational DOFs {free} have no support; add one, e.g. "
@@ -637,36 +639,36 @@ def compliance_warnings(model: Model, kin) -> list[tuple[str, str]]:
     resultant of its gear's nominal tooth forces, and by its stiffness beside the gear's
     meshes; a shaft by its twist under the torque it carries."""
     out = []
-    for kind, items in (("gears", model.gears), ("bodies", model.bodies)):
-        for name, body in items.items():
-            sup, bk = body.support, kin.bodies.get(name)
-            if sup is None or sup.stiffness is None or bk is None:
-                continue
-            k = min(v for v in (sup.stiffness, sup.stiffness_y) if v is not None)
-            resultant, mesh_k = np.zeros(3), []
-            for mk in kin.meshes.values():
-                if name in (mk.driver, mk.driven):
-                    sign = -1.0 if name == mk.driver else 1.0
-                    resultant += sign * mk.force * np.asarray(mk.line_of_action, float)
-                    mesh_k.append(mk.iso_stiffness or 0.0)
-            axis = np.asarray(bk.axis, float)
-            radial = float(np.linalg.norm(resultant - resultant.dot(axis) * axis))
-            module = (body.module if kind == "gears" else
-                      min(g.module for g in model.gears.values()))
-            loc = f"{kind}.{name}.support.stiffness"
-            if radial / k > MAX_NOMINAL_DEFLECTION * module:
-                out.append((loc, (
-                    f"{k:.3g} N/m would deflect {_length_text(radial / k)} under the "
-                    f"nominal tooth forces on {name} ({radial / 1e3:.4g} kN), more than half "
-                    f"its module: check the value and its unit (bearings are about 1e8-1e10 "
-                    f"N/m: write e.g. '2000 N/um'; a bare number is read in N/m)")))
-            elif mesh_k and max(mesh_k) > 0 and k < MIN_SUPPORT_MESH_RATIO * max(mesh_k):
-                out.append((loc, (
-                    f"{k:.3g} N/m is {max(mesh_k) / k:.3g} times softer than the meshes of "
-                    f"{name} (ISO 6336 about {max(mesh_k):.3g} N/m): the member floats, held "
-                    f"by its meshes alone; if that is meant, accept this warning, else check "
-                    f"the value and its unit (bearings are about 1e8-1e10 N/m; a bare number "
-                    f"is read in N/m)")))
+    for name, gear in model.gears.items():
+        sup, bk = gear.support, kin.bodies.get(name)
+        if (sup is None or sup.stiffness is None or bk is None
+                or not set(gear.dofs) - {"theta"}):  # (no translation: nothing deflects)
+            continue
+        k = min(v for v in (sup.stiffness, sup.stiffness_y) if v is not None)
+        resultant, mesh_k = np.zeros(3), []
+        for mk in kin.meshes.values():
+            if name in (mk.driver, mk.driven):
+                sign = -1.0 if name == mk.driver else 1.0
+                resultant += sign * mk.force * np.asarray(mk.line_of_action, float)
+                mesh_k.append(mk.iso_stiffness or 0.0)
+        axis = np.asarray(bk.axis, float)
+        radial = float(np.linalg.norm(resultant - resultant.dot(axis) * axis))
+        loc = f"gears.{name}.support.stiffness"
+        # (the texts name no gear: the planets of a [[planetary]] stage, which share one
+        # written field, are then said once)
+        if radial / k > MAX_NOMINAL_DEFLECTION * gear.module:
+            out.append((loc, (
+                f"{k:.3g} N/m would deflect {_length_text(radial / k)} under the gear's "
+                f"nominal tooth forces ({radial / 1e3:.4g} kN), more than half its module: "
+                f"check the value and its unit (bearings are about 1e8-1e10 N/m: write e.g. "
+                f"'2000 N/um'; a bare number is read in N/m)")))
+        elif mesh_k and max(mesh_k) > 0 and k < MIN_SUPPORT_MESH_RATIO * max(mesh_k):
+            out.append((loc, (
+                f"{k:.3g} N/m is {max(mesh_k) / k:.3g} times softer than the gear's meshes "
+                f"(ISO 6336 about {max(mesh_k):.3g} N/m): the gear floats, held by its meshes "
+                f"alone; if that is meant (a floating sun), accept this warning in "
+                f"[model] accepted_warnings, else check the value and its unit (bearings are "
+                f"about 1e8-1e10 N/m; a bare number is read in N/m)")))
     for name, sh in model.shafts.items():
         k = sh.torsional_stiffness
         if sh.rigid or k is None or not k > 0:

@@ -25,7 +25,9 @@ def set_parameter(data: dict, path: str, value: Any) -> dict:
     (``analysis`` of ``analysis.table_points``, ``errors`` of
     ``planetary.0.sun.errors.eccentricity``): it is created.  List items are addressed by
     index (``axis.2``).  A table set where the data has one merges into it: the fields it
-    names change, the others stay (:func:`_merged`).
+    names change, the others stay (:func:`_merged`); it replaces the old one where it
+    chooses another ``method`` (or distribution, kind...: :data:`SELECTORS`), where it
+    is empty (``{}`` clears a table) and where it is a whole section (``drives``).
     Only the tables and lists on the path are copied; the rest is shared with ``data``
     (neither is ever changed in place: a study sets a dozen parameters of a large model
     per case, and copying the whole model for each cost milliseconds).
@@ -49,7 +51,8 @@ def set_parameter(data: dict, path: str, value: Any) -> dict:
         node[idx] = value
     elif isinstance(node, dict):
         old = node.get(last)
-        node[last] = _merged(old, value) if isinstance(old, dict) else value
+        node[last] = (_merged(old, value) if len(parts) > 1 and _merges(old, value)
+                      else value)
     else:
         raise ModelError([(path, f"{'.'.join(parts[:-1])!r} is a value, not a table; "
                                  f"check the path")])
@@ -83,6 +86,19 @@ def _refuse_generated(data, path: str) -> None:
                                  f"{written!r} instead")]) from None
 
 
+#: keys that choose what a table is (a stiffness method, a distribution...): a table set
+#: with another choice replaces the old one, whose other fields belong to the old choice
+SELECTORS = ("method", "distribution", "kind", "model", "shape", "mode")
+
+
+def _merges(old, new) -> bool:
+    """Whether a table set on ``old`` merges into it (:func:`_merged`): both tables, the
+    new one not empty (``{}`` clears) and choosing nothing else (``{method = ...}``
+    with another method replaces the table)."""
+    return (isinstance(old, dict) and isinstance(new, dict) and bool(new)
+            and all(new[k] == old.get(k, new[k]) for k in SELECTORS if k in new))
+
+
 def _merged(old: dict, new):
     """A table set on a table: the fields it names replace those of ``old``, the others
     stay (``errors = {eccentricity = ...}`` keeps the runout); tables inside merge
@@ -91,7 +107,7 @@ def _merged(old: dict, new):
         return new
     out = dict(old)
     for key, value in new.items():
-        out[key] = _merged(out[key], value) if isinstance(out.get(key), dict) else value
+        out[key] = _merged(out[key], value) if _merges(out.get(key), value) else value
     return out
 
 

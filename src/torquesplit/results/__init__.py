@@ -158,16 +158,16 @@ class Metrics:
         return out
 
 
-def _steady_summary(ds) -> dict:
-    """A saved periodic steady state's own numbers (``steady_*`` attributes: method,
+def _steady_summary(attrs) -> dict:
+    """A periodic steady state's own numbers from its attributes (``steady_*``: method,
     period, residual, stability, largest Floquet multiplier, and what the record is),
     without the prefix; {} for a run."""
-    if ds.attrs.get("analysis") != "periodic steady state":
+    if attrs.get("analysis") != "periodic steady state":
         return {}
-    out = {k[len("steady_"):]: v for k, v in ds.attrs.items()
+    out = {k[len("steady_"):]: v for k, v in attrs.items()
            if k.startswith("steady_") and k != "steady_json"}
-    out["record"] = ds.attrs.get("record", "")
-    out["dropped_excitations"] = ds.attrs.get("dropped_excitations", "none")
+    out["record"] = attrs.get("record", "")
+    out["dropped_excitations"] = attrs.get("dropped_excitations", "none")
     return out
 
 
@@ -229,6 +229,14 @@ class Results:
                 out += [f"{loc}: {msg}" for loc, msg in result_warnings(self, met)]
         seen: set[str] = set()
         return [w for w in out if not (w in seen or seen.add(w))]
+
+    def _steady_attributes(self) -> dict:
+        """The attributes that say what this steady state is ({} for a run)."""
+        if self.steady is not None:
+            from .dataset import steady_attrs
+
+            return steady_attrs(self, self.steady.summary(results=self))
+        return dict(self.saved_steady.get("attrs", {}))
 
     def _model_plausibility(self) -> list[tuple[str, str]]:
         """The model's plausibility warnings, less those its file accepts with a reason
@@ -637,9 +645,11 @@ class Results:
         return writer(plan.path, overwrite=overwrite, definition=definition)
 
     def to_mat(self, path, *, overwrite: bool = False, definition: str | None = None) -> Path:
-        """Save for MATLAB (scipy.io.savemat): every variable of the Dataset, SI units, a
-        ``units`` and a ``descriptions`` struct (each variable's unit and what it is),
-        and a ``provenance`` struct naming the run; written atomically."""
+        """Save for MATLAB (scipy.io.savemat): every variable of the Dataset, SI units,
+        ``units``, ``descriptions`` and ``dimensions`` structs (each variable's unit, what
+        it is, what its rows and columns are), a ``provenance`` struct naming the run and,
+        for a steady state, a ``steady`` struct (period, stability, residual); written
+        atomically."""
         from . import files
 
         plan = files.check_output(path, formats={".mat": "mat"}, overwrite=overwrite)
@@ -656,8 +666,8 @@ class Results:
                               else np.asarray(values))
             data["units"] = {name: ds[name].attrs.get("units", "") for name in ds.data_vars}
             data["units"]["time"] = "s"
-            # what the rows and columns of each array are ('time x element'), and that
-            # cycle and mode indices start at 0 and 1 (a MATLAB user's review)
+            # what the rows and columns of each array are ('time x element': a MATLAB
+            # user's review)
             data["dimensions"] = {name: " x ".join(ds[name].dims) or "scalar"
                                   for name in ds.data_vars}
             # what each variable is, as the NetCDF's long_name (and its sampling note)
@@ -669,7 +679,7 @@ class Results:
             data["metrics_json"] = ds.attrs.get("metrics_json", "")
             data["warnings"] = np.asarray(self.warnings(definition) or [""], dtype=object)
             data["provenance"] = files.provenance(claim.run_id, ds.attrs["model_json"])
-            steady = _steady_summary(ds)
+            steady = _steady_summary(ds.attrs)
             if steady:  # (a reviewer's MATLAB had no stability and no period of it)
                 data["steady"] = {k: (float(v) if isinstance(v, (int, float, np.number))
                                       else str(v)) for k, v in steady.items()}
@@ -775,8 +785,7 @@ class Results:
                 ).tolist())]),
         }
         with files.claim_output(plan) as claim:
-            steady_info = _steady_summary(self.to_dataset(definition)) if (
-                getattr(self, "steady", None) is not None or self.saved_steady) else {}
+            steady_info = _steady_summary(self._steady_attributes())
             contents[about] = files.about_bytes(
                 claim.run_id, self.model_json(), self.warnings(definition),
                 **({"steady": steady_info} if steady_info else {}),

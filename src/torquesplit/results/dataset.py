@@ -268,9 +268,16 @@ def _steady_attributes(ds: xr.Dataset, res, steady) -> None:
         ("mesh",), [info["meshes"][m]["rms_transmission_error"] for m in res.mesh_names],
         "m", "RMS dynamic transmission error about its mean (the flanks' relative "
         "displacement, errors included)")
+    ds.attrs.update(steady_attrs(res, info))
+    _steady_words(ds, info)
+
+
+def steady_attrs(res, info: dict) -> dict:
+    """The attributes that say what a saved steady state is (``info``: its
+    :meth:`~torquesplit.steady.SteadyState.summary`)."""
     periods = (float(res.solution.t_final - res.solution.t_span[0]) / info["period_s"]
                if info["period_s"] else math.nan)
-    ds.attrs.update(
+    return dict(
         analysis="periodic steady state",
         steady_json=_json.dumps(info, default=float),
         steady_method=info["method"], steady_period_s=info["period_s"],
@@ -281,6 +288,11 @@ def _steady_attributes(ds: xr.Dataset, res, steady) -> None:
         dropped_excitations="; ".join(info["dropped_excitations"]) or "none",
         record=f"one period of the steady state repeated {periods:.0f} times (no start-up: "
                f"t_start..t_end is that record, not a simulated run)")
+
+
+def _steady_words(ds: xr.Dataset, info: dict) -> None:
+    """Words of a saved steady state's variables that do not describe a run it never
+    made."""
     for name in ("contact_loss_fraction", "back_contact_fraction"):
         text = ds[name].attrs.get("long_name", "")
         ds[name].attrs["long_name"] = text.replace("of the whole run (start-up included)",

@@ -124,9 +124,12 @@ def _remove_replaced_set(plan: OutputPlan, contents) -> None:
     stem = about.name[:-len("_about.json")]
     keep = {Path(f).name for f in plan.files}
     for name in listed:
-        old = about.with_name(str(name))
-        if (old.name not in keep and old.name.startswith(stem + "_") and old.parent ==
-                about.parent and "/" not in str(name) and old.is_file()):
+        # (a name of this folder only: no separator, not empty, not '..')
+        if (not isinstance(name, str) or not name.startswith(stem + "_") or name in keep
+                or any(c in name for c in "/\\") or name in (".", "..")):
+            continue
+        old = about.with_name(name)
+        if old.is_file():
             with contextlib.suppress(OSError):
                 old.unlink()
 

@@ -56,10 +56,13 @@ def sweep_figure(ds, variables=None):
     mesh against speed: stable solid, unstable dashed, turning points (jump speeds)
     dotted, critical speeds (natural frequency x mesh order) as grey lines labelled in
     the top panel, run-up / run-down time integrations as markers when present."""
+    if "load_sharing" in ds and "load_sharing_mean_force" not in ds:
+        ds = ds.rename(load_sharing="load_sharing_mean_force")  # (an older sweep file)
     if variables is None:
         variables = sweep_variables(ds)
     elif isinstance(variables, str):
         variables = [variables]
+    variables = ["load_sharing_mean_force" if v == "load_sharing" else v for v in variables]
     rpm = ds["speed_rpm"].values
     lo, hi = float(np.nanmin(rpm)), float(np.nanmax(rpm))
     groups = critical_speed_groups(ds, lo, hi)
