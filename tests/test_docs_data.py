@@ -61,3 +61,34 @@ def test_renderer_fails_loudly_on_a_missing_number():
         == "a 1.23 b 2.5"
     with pytest.raises(KeyError, match="no key 'z'"):
         render.render("{{x/z}}", {"x": {"y": 1}})
+
+
+def test_studies_page_is_its_data():
+    study = _load(ROOT / "scripts" / "study_validation.py", "study_validation")
+    data = json.loads((ROOT / "docs" / "studies_validation.json").read_text(encoding="utf-8"))
+    assert study.markdown(data) + "\n" == (ROOT / "docs" / "studies_validation.md").read_text(
+        encoding="utf-8"), "docs/studies_validation.md drifted: run scripts/study_validation.py"
+
+
+def test_a_study_case_run_today_gives_the_number_the_studies_page_prints(tmp_path):
+    """The studies page had drifted from the code (a reviewer reproduced Dong et al.
+    2021's Omega_II 1.0038 where it printed 1.0027): one case of a shipped study, run
+    now, equals the page's data."""
+    import tomllib
+    import warnings
+
+    import torquesplit
+    from torquesplit.study.shipped import study_path
+
+    data = json.loads((ROOT / "docs" / "studies_validation.json").read_text(encoding="utf-8"))
+    entry = data["ji_li_diameter"]
+    spec = tomllib.loads(study_path("ji_li_diameter").read_text(encoding="utf-8"))
+    grid = spec["grid"]["parameters"][0]
+    values = entry["parameters"]["drive_shaft_diameter"]["values"]
+    k = values.index(200.0)
+    grid.update(start="200 mm", stop="200 mm", num=1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ds = torquesplit.Study(spec).run(out=tmp_path / "one", workers=1, figures=False)
+    for name, published in entry["outputs"].items():
+        assert float(ds[name].values.ravel()[0]) == pytest.approx(published[k], rel=2e-6), name
