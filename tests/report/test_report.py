@@ -327,11 +327,12 @@ def test_the_model_has_one_identity_in_reports_of_its_file_and_of_its_results(ma
 
 
 def test_a_critical_speed_run_warns_of_is_in_the_report(tmp_path):
-    """Ji & Li's drive runs 0.24 % above a critical speed: run says so, the report's
-    warnings did not."""
+    """Ji & Li's drive at 812 rpm runs 0.09 % below a critical speed: run says so, the
+    report's warnings did not."""
     res = runner.invoke(app, ["report", "ji_li_mill_drive", "--cycles", "60", "--out",
-                              str(tmp_path / "r.html"), "--quiet"])
+                              str(tmp_path / "r.html"), "--quiet",
+                              "--set", "drives.motor.speed=812 rpm"])
     assert res.exit_code == 0, res.output
     html = (tmp_path / "r.html").read_text()
     warned = html[html.index("<h2>Warnings</h2>"):html.index("<h2>Model</h2>")]
-    assert "above a critical speed" in warned
+    assert "below a critical speed" in warned

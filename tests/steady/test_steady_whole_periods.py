@@ -384,19 +384,20 @@ def test_steady_and_campbell_options_are_checked_and_the_summary_names_its_defin
 
 
 def test_a_steady_states_files_keep_the_warnings_given_while_it_was_solved(tmp_path):
-    """A reviewer: 'steady' printed that Ji & Li's speed is 0.24 % above a critical speed,
-    its files held no warning, and the report of them said 'no warnings'.  Its results
-    keep the warnings given while solving and the critical-speed notes, as a run's do,
-    also when the caller silenced them."""
+    """A reviewer: 'steady' printed that its speed is next to a critical speed, its files
+    held no warning, and the report of them said 'no warnings'.  Its results keep the
+    warnings given while solving and the critical-speed notes, as a run's do, also when
+    the caller silenced them (Ji & Li's drive at 812 rpm, next to a driven crossing)."""
     import warnings
 
     import torquesplit
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        st = steady_state(example_path("ji_li_mill_drive"), stability=False)
+        st = steady_state(example_path("ji_li_mill_drive"), stability=False,
+                          speed="812 rpm")
     res = st.to_results()
-    critical = [w for w in res.warnings() if "above a critical speed" in w]
+    critical = [w for w in res.warnings() if "below a critical speed" in w]
     assert critical and critical == st.critical_notes()
     res.save(tmp_path / "st.nc")
     assert critical[0] in torquesplit.load_results(tmp_path / "st.nc").warnings()

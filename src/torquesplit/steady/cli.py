@@ -712,8 +712,9 @@ def campbell_command(m, start, stop, plot, as_json, console, json_default, out=N
         f" ({len(critical)} critical; {len(suppressed)} crossings that the planets' mesh "
         f"phasing leaves unexcited, Parker & Lin 2004, marked 'suppressed')" if phased
         else "") + f"; {n_driven} of {len(critical)} driven by at least "
-        f"{100 * DRIVING_HARMONIC:g} % (k harmonic or error): the others only by what the "
-        f"model leaves out")
+        f"{100 * DRIVING_HARMONIC:g} % (k harmonic or error; a k harmonic whose meshes' "
+        f"forces cancel on the mode, marked 'cancels', drives none): the others only by "
+        f"what the model leaves out")
     cols = ["speed [rpm]", "mode", "f [Hz]", "excitation", "k harmonic [%]", "error [%]"]
     cols += ["mode type", "phasing"] if phased else []
     for col in cols + ["strain energy (largest shares)"]:
@@ -723,9 +724,11 @@ def campbell_command(m, start, stop, plot, as_json, console, json_default, out=N
                   "suppressed" if c["suppressed"] else "excited"]
                  if phased else [])
         k_h, err = c.get("stiffness_harmonic"), c.get("error_share")
+        # (a harmonic whose meshes' forces cancel on the mode drives nothing there)
+        cancels = " (cancels)" if c.get("stiffness_cancelled") else ""
         t.add_row(f"{c['speed_rpm']:#.6g}", str(c["mode"]), f"{c['frequency_Hz']:#.6g}",
                   f"{c['order']} x {c['source']}",
-                  "-" if k_h is None else f"{100 * k_h:.3g}",
+                  "-" if k_h is None else f"{100 * k_h:.3g}{cancels}",
                   "-" if err is None else f"{100 * err:.3g} ({c['error_mesh']})", *extra,
                   ", ".join(f"{n} {100 * v:.0f} %" for n, v in c["energy"]))
     console.print(t)

@@ -347,10 +347,10 @@ def critical_speeds(structure, q, kin, model, w_lo, w_hi, orders=None):
         for label, order, per_rad in lines:  # f = order * per_rad * w_input
             w = fn / (order * per_rad)
             if w_lo <= w <= w_hi:
-                out.append(phasing.mark(dict(
+                out.append(_cancellation(structure, q, sol, kin, phasing.mark(dict(
                     mode=i + 1, frequency_Hz=float(fn), order=order, source=label,
                     speed_rpm=float(w * RPM), energy=sol.dominant_elements(i, 4),
-                    **_strength_of(strength, label, order)), types))
+                    **_strength_of(strength, label, order)), types)))
     out.sort(key=lambda c: c["speed_rpm"])
     return dict(natural_frequencies=sol.frequencies, crossings=out, modal=sol,
                 lines=lines, reference_speed=w_ref, strength=strength)
@@ -425,6 +425,60 @@ def _line_strength(kin, structure, lines, w_ref: float) -> dict:
 def _strength_of(strength: dict, label: str, order: int) -> dict:
     """How the model drives a crossing's line (:func:`_line_strength`), or nothing."""
     return dict(strength.get((label, order), {}))
+
+
+#: a mesh line's stiffness harmonic whose modal force is below this fraction of the sum
+#: of its meshes' contributions drives the mode not at all (the meshes' forces cancel)
+CANCELLED = 1e-6
+
+
+def _modal_force_share(structure, q, shape, meshes, order: int) -> float | None:
+    """How much of the ``order``-th harmonic of the meshes' stiffness variation reaches
+    a mode (``shape``: its displacement part): |sum_m a_m| / sum_m |a_m| with
+    a_m = c_m e^(2 pi i order phase_m) h_m (V_m . shape), c_m the harmonic of mesh m's
+    stiffness table, phase_m its mesh phase, h_m its static deflection.  0 where the
+    meshes' forces cancel on the mode (branches in phase on a mode where they move
+    against each other, half a cycle apart on one where they move together); the
+    planets' mesh phasing of Parker & Lin 2004 is a case of it.  None if no mesh of the
+    line acts on the mode."""
+    names = list(structure.element_names)
+    n = structure.n_dof
+    a = []
+    for m in meshes:
+        if m not in names:
+            continue
+        e = names.index(m)
+        table = np.asarray(structure.stiffness_table[e], dtype=float)
+        if order >= table.size // 2:
+            continue
+        c = np.fft.rfft(table)[order] / table.size
+        sl = slice(structure.v_ptr[e], structure.v_ptr[e + 1])
+        d = float(np.dot(structure.v_coef[sl], q[structure.v_dof[sl]])
+                  - structure.error_constant[e])
+        g = (float(structure.gap_values[structure.gap_ptr[e]])
+             if structure.gap_ptr[e + 1] > structure.gap_ptr[e] else 0.0)
+        h = d - math.copysign(g, d) if abs(d) > g else 0.0
+        v = complex(np.dot(structure.v_coef[sl], shape[:n][structure.v_dof[sl]]))
+        a.append(c * np.exp(2j * np.pi * order * structure.phase[e]) * h * v)
+    total = sum(abs(x) for x in a)
+    if not total > 0:
+        return None
+    return float(abs(sum(a)) / total)
+
+
+def _cancellation(structure, q, sol, kin, crossing: dict) -> dict:
+    """``stiffness_cancelled`` (and the share, :func:`_modal_force_share`) of a crossing
+    of a mesh line whose stiffness harmonic would drive it: a reviewer's Campbell
+    diagram called six crossings of Ji & Li's drive driven that the two branches' mesh
+    forces cannot excite, and 'run' warned of one at the drive's own speed."""
+    meshes = mesh_groups(kin).get(crossing["source"])
+    if not meshes or "stiffness_harmonic" not in crossing:
+        return crossing
+    share = _modal_force_share(structure, q, sol.mode_shapes[:, crossing["mode"] - 1],
+                               meshes, crossing["order"])
+    crossing["modal_force_share"] = share
+    crossing["stiffness_cancelled"] = share is None or share < CANCELLED
+    return crossing
 
 
 class _Phasing:
@@ -659,11 +713,11 @@ def _curve_crossings(model, q, speeds, F, lines, w_ref, strength=None):
                 w = speeds[i] + th * (speeds[i + 1] - speeds[i])
                 st = _structure_at(model, w / w_ref)
                 sol = modal_analysis(st, q)
-                out.append(phasing.mark(dict(
+                out.append(_cancellation(st, q, sol, phasing.kin, phasing.mark(dict(
                     mode=m + 1, frequency_Hz=float(sol.frequencies[m]), order=order,
                     source=label, speed_rpm=float(w * RPM),
                     energy=sol.dominant_elements(m, 4),
-                    **_strength_of(strength or {}, label, order)), phasing.types(st, sol)))
+                    **_strength_of(strength or {}, label, order)), phasing.types(st, sol))))
     out.sort(key=lambda c: c["speed_rpm"])
     return out
 
@@ -700,10 +754,12 @@ def near_critical_notes(model, structure, q, kinematics, speed=None) -> list[str
 
 
 def driven(crossing: dict, least: float = DRIVING_HARMONIC) -> bool:
-    """Whether the model drives a crossing: a stiffness harmonic or an error force of at
-    least ``least`` (:func:`critical_speeds`' ``stiffness_harmonic``, ``error_share``);
-    one it does not drive resonates only through what the model leaves out."""
-    return (crossing.get("stiffness_harmonic", 0.0) >= least
+    """Whether the model drives a crossing: a stiffness harmonic (whose meshes' forces do
+    not cancel on the mode: ``stiffness_cancelled``) or an error force of at least
+    ``least`` (:func:`critical_speeds`' ``stiffness_harmonic``, ``error_share``); one it
+    does not drive resonates only through what the model leaves out."""
+    return ((crossing.get("stiffness_harmonic", 0.0) >= least
+             and not crossing.get("stiffness_cancelled", False))
             or crossing.get("error_share", 0.0) >= least)
 
 
@@ -739,7 +795,8 @@ def near_critical_speeds(model, structure, q, kinematics, within: float = NEAR_C
     more = (f"; {len(near) - 1} more within {100 * within:.2g} % (torquesplit modes "
             f"--campbell lists them)" if len(near) > 1 else "")
     by = []
-    if c.get("stiffness_harmonic", 0.0) >= least_harmonic:
+    if (c.get("stiffness_harmonic", 0.0) >= least_harmonic
+            and not c.get("stiffness_cancelled", False)):
         by.append(f"a harmonic of {100 * c['stiffness_harmonic']:.2g} % of the mean mesh "
                   f"stiffness")
     if c.get("error_share", 0.0) >= least_harmonic:
