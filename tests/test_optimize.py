@@ -207,3 +207,35 @@ def test_optimize_command_names_units_and_ratios(tmp_path):
     assert res.exit_code == 2 and "add --force" in res.stderr
     assert (tmp_path / "o" / "pareto.csv").read_bytes() == before
     assert CliRunner().invoke(app, args + ["--force"]).exit_code == 0
+
+
+def test_objectives_summed_in_different_units_are_warned_of():
+    """A designer's min_sum of a TE in arc s and a pressure in Pa chose the pressure's
+    extreme without a word."""
+    d = spec_dict()
+    d["objectives"] = [{"output": "ltca.L68.te_peak_to_peak_arcsec"},
+                       {"output": "ltca.L68.max_hertz_pressure_Pa"}]
+    with pytest.warns(ModelWarning, match="min_sum.*not relative.*relative_to"):
+        read_spec(d)
+    d["objectives"] = [dict(o, relative_to="baseline") for o in d["objectives"]]
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ModelWarning)
+        read_spec(d)  # ratios: nothing to say
+    d["optimization"]["choose"] = "bogus"
+    d["optimization"]["typo"] = 1
+    with pytest.raises(ModelError, match="docs/optimization.md"):
+        read_spec(d)
+
+
+def test_the_shipped_optimisation_is_copied_by_the_example_command(tmp_path):
+    from typer.testing import CliRunner
+
+    from torquesplit.cli import app
+
+    res = CliRunner().invoke(app, ["example", "liu2021_dh_modification", "--dir", str(tmp_path)])
+    assert res.exit_code == 0, res.output
+    assert read_spec(tmp_path / "liu2021_dh_modification.toml").variables
+    listed = CliRunner().invoke(app, ["examples"])
+    assert "liu2021_dh_modification" in listed.output and "docs/optimization.md" in listed.output

@@ -1384,7 +1384,9 @@ def optimize(
     as_json: bool = ux.json_option("Print the Pareto front as JSON."),
 ):
     """Optimise model parameters (NSGA-II or any pymoo algorithm) on LTCA or dynamic outputs;
-    evaluations are stored as they finish, so an interrupted run resumes."""
+    evaluations are stored as they finish, so an interrupted run resumes.  The file's
+    format, its outputs and results: docs/optimization.md ('torquesplit example
+    liu2021_dh_modification' copies the shipped one)."""
     from .optimize import optimize as run_optimization
 
     path = Path(spec)
@@ -1634,6 +1636,11 @@ def examples():
         label = name + ("\n(start here)" if name == FIRST_EXAMPLE else "")
         t.add_row(label, info.get("description", ""), info.get("reference", ""))
     console.print(t)
+    from .examples import optimization_names
+
+    console.print("Shipped optimisations (torquesplit optimize NAME; copy one with "
+                  "'torquesplit example NAME'; the file format: docs/optimization.md): "
+                  + ", ".join(optimization_names()), highlight=False)
     console.print("The earlier names still work for old scripts but are deprecated (use "
                   "the names above; a deprecated name prints a note): "
                   + ", ".join(f"{old} -> {new}" for old, new in RENAMED.items()),
@@ -1648,20 +1655,26 @@ def example(
                                    metavar="DIR"),
     force: bool = _flag("--force", "Overwrite an existing file."),
 ):
-    """Write an example model file to the current folder (or --dir)."""
-    from .examples import current_name, example_names, example_path
+    """Write an example model file (or a shipped optimisation file) to the current folder
+    (or --dir)."""
+    from .examples import (current_name, example_names, example_path, optimization_names,
+                           optimization_path)
     from .results import files
 
     try:
         stem, note = current_name(name)
-        if stem not in example_names():
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", FutureWarning)
+            optimization = (optimization_path(name) if stem not in example_names()
+                            else None)
+        if stem not in example_names() and optimization is None:
             raise OptionError(f"no example named {name!r}; run 'torquesplit examples' to list "
-                              f"them ({', '.join(example_names())})")
+                              f"them ({', '.join(example_names() + optimization_names())})")
         if note:
             ux.warn(note, label="note")
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", FutureWarning)
-            src = example_path(stem)
+            src = optimization or example_path(stem)
         if directory.exists() and not directory.is_dir():
             raise OptionError(f"--dir {directory} is a file, not a folder; give a folder")
         try:

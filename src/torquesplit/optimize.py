@@ -305,7 +305,7 @@ def read_spec(source) -> OptimizationSpec:
         kw[key] = v
     if opt:
         issues.append((f"optimization.{sorted(opt)[0]}", "unknown field; check the spelling "
-                                                          "against torquesplit/optimize.py"))
+                                                          "against docs/optimization.md"))
     if kw["algorithm"] not in ALGORITHMS:
         issues.append(("optimization.algorithm", f"unknown algorithm {kw['algorithm']!r}; use one "
                                                  f"of {', '.join(ALGORITHMS)}"))
@@ -378,6 +378,15 @@ def read_spec(source) -> OptimizationSpec:
             issues.append((f"constraints[{i}]", "has no bound; add lower or upper"))
     if issues:
         raise ModelError(issues, name)
+    absolute = [o.output for o in objectives if o.relative_to is None]
+    if kw["choose"] == "min_sum" and len(objectives) > 1 and absolute:
+        # (a reviewer's TE in arc s plus a pressure in Pa: the choice sat at the pressure's
+        # extreme)
+        warn_user(f"{name}: choose = 'min_sum' adds the objectives as they are, and "
+                  f"{', '.join(absolute)} {'is' if len(absolute) == 1 else 'are'} not "
+                  f"relative: the chosen design is ruled by the largest numbers; give each "
+                  f"objective relative_to = 'baseline', or choose = 'knee' "
+                  f"(docs/optimization.md)", ModelWarning)
     store = kw.pop("store")
     if store is not None:
         store_path = base / store          # relative to the optimisation file
@@ -754,8 +763,11 @@ def optimize(source, *, workers: int | None = None, generations: int | None = No
         errors = Counter(r["error"] for r in store.records.values() if r.get("error"))
         why = ""
         if errors:
-            text, n = errors.most_common(1)[0]
-            why = (f"; {n} of {len(store.records)} designs failed, e.g.: {text}")
+            text, _ = errors.most_common(1)[0]
+            # (every failed design: the texts differ by their values, so the most common
+            # one's count said '2 of 16' where all 16 failed)
+            why = (f"; {sum(errors.values())} of {len(store.records)} designs failed, "
+                   f"e.g.: {text}")
         raise TorquesplitError("no feasible design found; widen the bounds or relax the "
                                "constraints" + why)
     X = np.atleast_2d(res.X)

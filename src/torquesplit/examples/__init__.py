@@ -106,6 +106,12 @@ def example_path(name: str) -> Path:
     return path
 
 
+def optimization_names() -> list[str]:
+    """Names of the shipped optimisation files (``torquesplit optimize NAME``)."""
+    folder = resources.files(__name__) / "optimize"
+    return sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".toml"))
+
+
 def optimization_path(name: str) -> Path | None:
     """Path of a shipped optimisation file (``examples/optimize``), or None."""
     stem, note = current_name(name, RENAMED_OPTIMIZATIONS)

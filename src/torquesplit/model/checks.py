@@ -722,6 +722,16 @@ def plausibility_warnings(model: Model, kin) -> list[tuple[str, str]]:
                              "('torquesplit contact' analyses them either way); set "
                              f"stiffness.method = 'ltca' on {meshes} or remove the "
                              f"modifications"))
+        elif gear.modifications is not None:
+            # (a designer's modified pinion in an LTCA mesh and a non-LTCA one: the second
+            # ran unmodified without a word)
+            plain = [m for m, mesh in model.meshes.items()
+                     if name in mesh.gears and mesh.stiffness.method != "ltca"]
+            if plain:
+                out.append((f"gears.{name}.modifications", (
+                    MODIFICATIONS_UNUSED + f": meshes {', '.join(plain)} of this gear do not "
+                    f"use it (they run as unmodified); set stiffness.method = 'ltca' on them "
+                    f"too, or accept it")))
     for name, m in model.meshes.items():
         if m.stiffness.method == "ltca":
             note = lead_slices_note(model, name, m.stiffness.slices, "slices")
@@ -1203,6 +1213,8 @@ MAX_LOAD_PER_WIDTH = 1e7
 #: [N/m] a nominal tooth force below this per face width is warned (the shipped examples:
 #: 14.7 N/mm and more; a power in W for kW gave 0.8 N/mm)
 MIN_LOAD_PER_WIDTH = 2e3
+#: [rad] a shaft misalignment beyond this is warned (gear shafts tilt by mrad at most)
+MAX_SHAFT_MISALIGNMENT = 0.01
 #: a tooth modification amount (relief, crowning, helix slope) above this fraction of the
 #: module is flagged: modifications remove a few to tens of microns (tip relief of the
 #: order of the tooth deflection, 0.01-0.02 m_n for heavily loaded teeth)
@@ -1324,6 +1336,22 @@ def magnitude_warnings(model: Model, kin) -> list[tuple[str, str]]:
         te = m.transmission_error
         against_module(f"meshes.{name}.transmission_error", abs(te.constant) + te.amplitude,
                        module, "transmission errors")
+        # (a designer's lead_mismatch = 0.002 (2 mm) and 0.2 rad of tilt ran unwarned)
+        mis = m.misalignment
+        for field in ("lead_mismatch", "base_pitch_deviation"):
+            value = abs(getattr(mis, field))
+            if value > MODIFICATION_MODULE_RATIO * module:  # (as tooth modifications)
+                out.append((f"meshes.{name}.misalignment.{field}", (
+                    f"{_length_text(value)} is {value / module:.3g} times the module "
+                    f"({module * 1e3:.4g} mm); lead and pitch deviations are microns (rarely "
+                    f"over {MODIFICATION_MODULE_RATIO:g} m_n): check the value and its unit "
+                    f"(a bare number is read in m: write '20 um')")))
+        if abs(mis.shaft_misalignment) > MAX_SHAFT_MISALIGNMENT:
+            out.append((f"meshes.{name}.misalignment.shaft_misalignment", (
+                f"{abs(mis.shaft_misalignment) * 1e3:.3g} mrad "
+                f"({math.degrees(abs(mis.shaft_misalignment)):.3g} deg) is more than gear "
+                f"shafts tilt (at most a few mrad); check the value and its unit (a bare "
+                f"number is read in rad: write '0.5 mrad' or '0.03 deg')")))
         mk = kin.meshes.get(name)
         if mk is not None and mk.force > 0:
             width = min(model.gears[x].face_width for x in m.gears)

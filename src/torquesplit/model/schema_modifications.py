@@ -134,10 +134,14 @@ class ModificationsSpec(FlankSpec):
 class MisalignmentSpec(Strict):
     """Separations the pair opens across the face and along the path (LTCA)."""
 
-    lead_mismatch: Length = Field(0.0, description="Combined helix-slope deviation of both gears "
-                                  "over the face of one helix (ISO 1328-1 f_Hbeta).")
-    shaft_misalignment: Angle = Field(0.0, description="Tilt of the axes against each other in "
-                                      "the plane of action.")
+    lead_mismatch: Length = Field(0.0, description=(
+        "Combined helix-slope deviation of both gears over the face of one helix (ISO "
+        "1328-1 f_Hbeta): it acts as a helix_slope modification of that amount (same sign) "
+        "on either gear; microns (write '20 um')."))
+    shaft_misalignment: Angle = Field(0.0, description=(
+        "Tilt of the axes against each other in the plane of action, opening the mesh "
+        "across the face as a lead_mismatch of tilt x face width does; milliradians at "
+        "most (write '0.5 mrad' or '0.03 deg')."))
     base_pitch_deviation: Length = Field(0.0, description=(
         "Normal base pitch of the driven gear minus that of the driver: > 0 brings each "
         "entering tooth pair that much early into contact (premature contact at the driven "
