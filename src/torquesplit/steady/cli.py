@@ -371,9 +371,10 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
         stop: str = typer.Option(..., "--to", help="Last speed, e.g. '3000 rpm'."),
         points: int = typer.Option(
             50, "--points", help="Points over the range to start from: the step is the "
-            "range / (points - 1), at most twice that, and shrinks where the response "
-            "changes fast, so the curve has about this many points or more; a peak "
-            "narrower than the step is missed: give more for narrow resonances."),
+            "range / (points - 1), grows to at most twice that where the response is "
+            "smooth and shrinks where it changes fast, so the curve has at least about half "
+            "this many points; a peak narrower than the step is "
+            "missed: give more, or --max-step, for narrow resonances."),
         method: str = typer.Option(
             "auto", "--method", help="shooting (one monodromy per point), hb (harmonic "
             "balance), or auto: shooting unless --harmonics is given."),
