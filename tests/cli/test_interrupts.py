@@ -189,3 +189,28 @@ def test_finishing_before_an_interrupt_leaves_an_ignored_sigint_alone():
         assert signal.getsignal(signal.SIGINT) is signal.SIG_IGN
     finally:
         signal.signal(signal.SIGINT, before)
+
+
+def test_a_sweep_that_stopped_says_its_largest_factor_is_of_the_part_computed(monkeypatch):
+    """A reviewer's sweep stopped at 9498 of 9000-11000 rpm and headed 'largest dynamic
+    factor ... 1.86' where its run-up found 2.95 beyond the stop."""
+    from typer.testing import CliRunner
+
+    from torquesplit.cli import app
+    from torquesplit.steady import sweep as S
+
+    calls = {"n": 0}
+    real = S.ShootingContinuation.multipliers
+
+    def interrupt_on_the_fourth_point(self, x, s):
+        calls["n"] += 1
+        if calls["n"] == 4:
+            raise KeyboardInterrupt
+        return real(self, x, s)
+
+    monkeypatch.setattr(S.ShootingContinuation, "multipliers", interrupt_on_the_fourth_point)
+    res = CliRunner().invoke(app, ["sweep-speed", "ji_li_mill_drive", "--from", "300 rpm",
+                                   "--to", "1500 rpm", "--points", "30"])
+    text = " ".join(res.output.split())
+    assert "over the part computed (300-" in text and "of 300 rpm-1500 rpm: the sweep stopped" \
+        in text, text

@@ -499,10 +499,16 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
                 console.print("turning points (jump speeds): " + ", ".join(
                     f"{f:.5g} rpm ({k})" for f, k in zip(summary["fold_speeds_rpm"],
                                                         ds.attrs["fold_kinds"], strict=True)))
+            rpm = ds["speed_rpm"].values
+            # (a sweep that stopped part-way: its largest factor is of the part computed,
+            # and a reviewer read 1.86 where the run-up found 2.95 beyond the stop)
+            part = ("" if ds.attrs["complete"] or not rpm.size else
+                    f", over the part computed ({np.nanmin(rpm):.5g}-{np.nanmax(rpm):.5g} rpm"
+                    f" of {_speed_text(start)}-{_speed_text(stop)}: the sweep stopped)")
             t = Table(title=("largest dynamic factor of the sweep (stability not computed)"
                              if no_stability else
                              "largest dynamic factor over the stable points of the sweep")
-                          + (" and the time integrations" if cross_check else ""))
+                          + part + (" and the time integrations" if cross_check else ""))
             cols = ["mesh", "DF (peak/static)", "at [rpm]"]
             cols += ["run-up DF", "at [rpm]", "run-down DF", "at [rpm]"] if cross_check else []
             for col in cols:
