@@ -1515,7 +1515,7 @@ def modes(
         opts(_positive, limit, "--below", "'5 kHz'")
         opts.raise_any(model, assign)
         if out is not None:  # (the CSV tables: per mode and per DOF, or per speed)
-            _out_option(check_dataset_output, out, ("speed",) if campbell else
+            _out_option(check_dataset_output, out, ("speed", "crossing") if campbell else
                         ("mode", "dof"), overwrite=force)
         m, _ = _load(model, assign)
         if not campbell and (start is not None or stop is not None):

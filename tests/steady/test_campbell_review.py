@@ -294,3 +294,26 @@ def test_a_two_stage_drive_gets_a_panel_for_its_slower_meshes():
 def test_a_single_mesh_frequency_keeps_one_panel(lp3_figure):
     _, fig = lp3_figure
     assert len(fig.axes) == 1
+
+
+def test_the_campbell_files_carry_the_crossings_as_a_table(tmp_path):
+    """A rotordynamics reviewer found the critical speeds only as text attributes, without
+    their stiffness harmonic or whether the model drives them: a CSV export now has a
+    table of them, and the .nc their variables along 'crossing'."""
+    import csv
+
+    from typer.testing import CliRunner
+
+    from torquesplit.cli import app
+
+    res = CliRunner().invoke(app, ["modes", "ji_li_mill_drive", "--campbell", "--from",
+                                   "700 rpm", "--to", "820 rpm", "--out",
+                                   str(tmp_path / "c.csv")])
+    assert res.exit_code == 0, res.output
+    rows = list(csv.DictReader(open(tmp_path / "c_crossing.csv", newline="")))
+    by_speed = {round(float(r["crossing_speed_rpm"]), 1): r for r in rows}
+    # order 3 of the stage-2 meshes: mode 4 (the branches' forces cancel on it) and mode 5
+    assert by_speed[743.2]["crossing_driven"] == "0.0"
+    assert float(by_speed[743.2]["crossing_modal_force_share"]) < 1e-9
+    assert by_speed[812.7]["crossing_driven"] == "1.0"
+    assert by_speed[812.7]["crossing_excitation"] == "3 x meshes m12, m22"

@@ -682,6 +682,7 @@ def campbell(model, start: float, stop: float, *, points: int = 41,
     ds.attrs["model_speed_rpm"] = w_ref * RPM  # the drive's speed: the operating point
     label = lambda c: (f"mode {c['mode']} ({c['frequency_Hz']:.5g} Hz) x "  # noqa: E731
                        f"{c['order']} {c['source']}")
+    _crossing_table(ds, crossings)
     ds.attrs["critical_speeds_rpm"] = [c["speed_rpm"] for c in critical]
     ds.attrs["critical_speed_labels"] = [label(c) for c in critical]
     if suppressed:
@@ -691,6 +692,36 @@ def campbell(model, start: float, stop: float, *, points: int = 41,
             f"{label(c)} ({mode_kind(c)} mode: suppressed by mesh phasing)"
             for c in suppressed]
     return ds, crossings
+
+
+def _crossing_table(ds, crossings: list[dict]) -> None:
+    """The crossings as variables along a ``crossing`` dimension (a table of its own in
+    a CSV export, arrays in MATLAB): a reviewer found the critical speeds only as text
+    attributes, without their stiffness harmonic or whether the model drives them."""
+    def col(key, default=math.nan):
+        return np.array([c.get(key, default) if c.get(key) is not None else default
+                         for c in crossings], dtype=float)
+
+    ds.coords["crossing"] = np.arange(1, len(crossings) + 1)
+    ds["crossing_speed_rpm"] = ("crossing", col("speed_rpm"),
+                                {"units": "rpm", "long_name": "critical speed"})
+    ds["crossing_mode"] = ("crossing", col("mode"), {"units": "1", "long_name": "mode number"})
+    ds["crossing_frequency"] = ("crossing", col("frequency_Hz"),
+                                {"units": "Hz", "long_name": "natural frequency"})
+    ds["crossing_excitation"] = ("crossing", np.array(
+        [f"{c['order']} x {c['source']}" for c in crossings], dtype=object),
+        {"long_name": "excitation line: order x source"})
+    ds["crossing_stiffness_harmonic"] = ("crossing", col("stiffness_harmonic"), {
+        "units": "1", "long_name": "that harmonic of the mesh stiffness over its mean"})
+    ds["crossing_error_share"] = ("crossing", col("error_share"), {
+        "units": "1", "long_name": "error force k A on the line over the nominal force"})
+    ds["crossing_modal_force_share"] = ("crossing", col("modal_force_share"), {
+        "units": "1", "long_name": "share of the meshes' harmonic forces that reaches the "
+        "mode (0: they cancel on it)"})
+    ds["crossing_driven"] = ("crossing", np.array(
+        [float(driven(c) and not c.get("suppressed", False)) for c in crossings]), {
+        "units": "1", "long_name": "1 if the model drives the crossing (a stiffness "
+        "harmonic or error of at least 1 % that reaches the mode)"})
 
 
 def _curve_crossings(model, q, speeds, F, lines, w_ref, strength=None):
