@@ -1657,16 +1657,18 @@ def example(
 ):
     """Write an example model file (or a shipped optimisation file) to the current folder
     (or --dir)."""
-    from .examples import (current_name, example_names, example_path, optimization_names,
-                           optimization_path)
+    from .examples import (RENAMED_OPTIMIZATIONS, current_name, example_names, example_path,
+                           optimization_names, optimization_path)
     from .results import files
 
     try:
         stem, note = current_name(name)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", FutureWarning)
-            optimization = (optimization_path(name) if stem not in example_names()
-                            else None)
+            # (a shipped name only: 'example /abs/path.toml' must not copy any file)
+            ostem = current_name(name, RENAMED_OPTIMIZATIONS)[0]
+            optimization = (optimization_path(ostem) if ostem in optimization_names()
+                            and stem not in example_names() else None)
         if stem not in example_names() and optimization is None:
             raise OptionError(f"no example named {name!r}; run 'torquesplit examples' to list "
                               f"them ({', '.join(example_names() + optimization_names())})")

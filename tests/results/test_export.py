@@ -127,7 +127,8 @@ def test_the_campbell_map_is_written_where_asked(tmp_path):
     assert r.exit_code == 0, r.output
     # every file written is named (a CSV set: the table and what it cannot hold)
     about = tmp_path / "map_about.json"
-    assert json.loads(r.output)["files"] == [str(out), str(about)]
+    crossings = tmp_path / "map_crossing.csv"  # (the critical speeds, a row each)
+    assert json.loads(r.output)["files"] == [str(out), str(crossings), str(about)]
     assert json.loads(about.read_text())["model"]["model"]["name"] == "ji_li_mill_drive"
     header, rows = _read(out)
     assert header[:3] == ["speed_rad/s", "speed_rpm", "natural_frequency_1_Hz"]

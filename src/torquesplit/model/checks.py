@@ -722,9 +722,11 @@ def plausibility_warnings(model: Model, kin) -> list[tuple[str, str]]:
                              "('torquesplit contact' analyses them either way); set "
                              f"stiffness.method = 'ltca' on {meshes} or remove the "
                              f"modifications"))
-        elif gear.modifications is not None:
+        elif (gear.modifications is not None
+              and not model.written_at(f"gears.{name}").startswith("planetary.")):
             # (a designer's modified pinion in an LTCA mesh and a non-LTCA one: the second
-            # ran unmodified without a word)
+            # ran unmodified without a word; a planet's sun and ring meshes, which take
+            # their flanks' modifications, are a stage's choice)
             plain = [m for m, mesh in model.meshes.items()
                      if name in mesh.gears and mesh.stiffness.method != "ltca"]
             if plain:
