@@ -474,8 +474,15 @@ def _cancellation(structure, q, sol, kin, crossing: dict) -> dict:
     meshes = mesh_groups(kin).get(crossing["source"])
     if not meshes or "stiffness_harmonic" not in crossing:
         return crossing
-    share = _modal_force_share(structure, q, sol.mode_shapes[:, crossing["mode"] - 1],
-                               meshes, crossing["order"])
+    # a degenerate mode's shape is any of its group's: judged on the whole group (the
+    # largest share of its members), so that the solver's basis cannot hide a force
+    f = np.asarray(sol.frequencies, dtype=float)
+    i = crossing["mode"] - 1
+    group = np.flatnonzero(np.abs(f - f[i]) <= 1e-6 * abs(f[i]))
+    shares = [_modal_force_share(structure, q, sol.mode_shapes[:, j], meshes,
+                                 crossing["order"]) for j in group]
+    known = [x for x in shares if x is not None]
+    share = max(known) if known else None
     crossing["modal_force_share"] = share
     crossing["stiffness_cancelled"] = share is None or share < CANCELLED
     return crossing
