@@ -336,3 +336,9 @@ def test_a_critical_speed_run_warns_of_is_in_the_report(tmp_path):
     html = (tmp_path / "r.html").read_text()
     warned = html[html.index("<h2>Warnings</h2>"):html.index("<h2>Model</h2>")]
     assert "below a critical speed" in warned
+    # the modes table: mode 4 and mode 5 lie near order 3 of the stage-2 meshes, whose
+    # in-phase forces cancel on mode 4 (the branches move against each other) only
+    rows = {m.group(1): m.group(0) for m in re.finditer(r"<tr><td[^>]*>(\d+)</td>.*?</tr>",
+                                                          html)}
+    assert "3×m12 (forces cancel)" in rows["4"] and "3×m12" in rows["5"]
+    assert "(forces cancel)" not in rows["5"]

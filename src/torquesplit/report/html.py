@@ -394,11 +394,26 @@ def _modes(res) -> str:
     # a mesh order that the planets' mesh phasing leaves unexcited for the mode's type
     # (Parker & Lin 2004) is listed as suppressed, not as a possible resonance
     stages = phased_stages(res.model, res.kinematics)
+    from ..steady.maps import CANCELLED, _modal_force_share, mesh_groups
+
+    group_of = {m: g for g in mesh_groups(res.kinematics).values() for m in g}
+    q = getattr(getattr(res, "static", None), "q", None)
+
+    def cancels(name: str, k: int, mode: int) -> bool:
+        """The meshes of that frequency exert no force of harmonic k on the mode (their
+        phases cancel it: steady.maps._modal_force_share)."""
+        if structure is None or q is None:
+            return False
+        share = _modal_force_share(structure, q, rep.solution.mode_shapes[:, mode - 1],
+                                   group_of.get(name, [name]), k)
+        return share is None or share < CANCELLED
+
     rows = []
     for r in rep.rows:
         f = float(r.frequency)
         near = [f"{k}×{name}" + (" (suppressed by phasing)" if phasing_suppresses(
-                    stages, name, k, r.type, r.whirl) else "")
+                    stages, name, k, r.type, r.whirl) else " (forces cancel)"
+                    if cancels(name, k, r.mode) else "")
                 for name, fm in mesh_f.items() for k in range(1, top[name] + 1)
                 if abs(f - k * fm) <= NEAR_FRACTION * k * fm]
         energy = ", ".join(f"{n} {100 * v:.0f} %" for n, v in list(r.strain_energy.items())[:3])
@@ -429,7 +444,9 @@ def _modes(res) -> str:
             + f'<p class="note">{rep.rigid_modes} rigid-body mode(s) left out.{more}'
               f"{turning} Mesh "
               "frequencies: " + _e(", ".join(f"{k} {v:.5g} Hz" for k, v in mesh_f.items()))
-            + "." + (" With equally spaced planets, mesh harmonic l excites the rotational "
+            + ". A mesh order marked (forces cancel) drives nothing there: the meshes of "
+              "that frequency, by their phases, exert no force of that harmonic on the mode."
+            + (" With equally spaced planets, mesh harmonic l excites the rotational "
                      "modes only when l z_s / N is an integer, the translational modes only "
                      "when (l z_s ± 1) / N is, the planet modes otherwise (Parker &amp; Lin "
                      "2004); the other orders are marked suppressed." if stages else "")
