@@ -230,12 +230,14 @@ class Results:
         seen: set[str] = set()
         return [w for w in out if not (w in seen or seen.add(w))]
 
-    def _steady_attributes(self) -> dict:
-        """The attributes that say what this steady state is ({} for a run)."""
+    def _steady_attributes(self, info: dict | None = None) -> dict:
+        """The attributes that say what this steady state is ({} for a run); ``info``:
+        its summary where the caller has it already."""
         if self.steady is not None:
             from .dataset import steady_attrs
 
-            return steady_attrs(self, self.steady.summary(results=self))
+            return steady_attrs(self, info if info is not None
+                                else self.steady.summary(results=self))
         return dict(self.saved_steady.get("attrs", {}))
 
     def _model_plausibility(self) -> list[tuple[str, str]]:
@@ -721,6 +723,7 @@ class Results:
         except (ValueError, ArithmeticError):
             met = None
         bearings: list[dict] = []
+        steady_summary = None  # (computed once: the table and the about file use it)
         if met is not None:
             name = met.definition
             rows = [[r.mesh, r.group, r.nominal_force, r.static_force, r.mean_force,
@@ -731,7 +734,8 @@ class Results:
             rows = self._planet_columns(header, rows, met)
             steady = getattr(self, "steady", None)
             if steady is not None:  # the steady table's RMS transmission error too
-                info = steady.summary(results=self)["meshes"]
+                steady_summary = steady.summary(results=self)
+                info = steady_summary["meshes"]
                 header.append("rms_transmission_error_m")
                 rows = [row + [info[row[0]]["rms_transmission_error"]] for row in rows]
             # each group's and the system's coefficients and factors: what the run's
@@ -785,7 +789,7 @@ class Results:
                 ).tolist())]),
         }
         with files.claim_output(plan) as claim:
-            steady_info = _steady_summary(self._steady_attributes())
+            steady_info = _steady_summary(self._steady_attributes(steady_summary))
             contents[about] = files.about_bytes(
                 claim.run_id, self.model_json(), self.warnings(definition),
                 **({"steady": steady_info} if steady_info else {}),

@@ -347,7 +347,7 @@ def critical_speeds(structure, q, kin, model, w_lo, w_hi, orders=None):
         for label, order, per_rad in lines:  # f = order * per_rad * w_input
             w = fn / (order * per_rad)
             if w_lo <= w <= w_hi:
-                out.append(_cancellation(structure, q, sol, kin, phasing.mark(dict(
+                out.append(_cancellation(structure, q, sol, phasing.groups, phasing.mark(dict(
                     mode=i + 1, frequency_Hz=float(fn), order=order, source=label,
                     speed_rpm=float(w * RPM), energy=sol.dominant_elements(i, 4),
                     **_strength_of(strength, label, order)), types)))
@@ -466,12 +466,12 @@ def _modal_force_share(structure, q, shape, meshes, order: int) -> float | None:
     return float(abs(sum(a)) / total)
 
 
-def _cancellation(structure, q, sol, kin, crossing: dict) -> dict:
+def _cancellation(structure, q, sol, groups: dict, crossing: dict) -> dict:
     """``stiffness_cancelled`` (and the share, :func:`_modal_force_share`) of a crossing
     of a mesh line whose stiffness harmonic would drive it: a reviewer's Campbell
     diagram called six crossings of Ji & Li's drive driven that the two branches' mesh
     forces cannot excite, and 'run' warned of one at the drive's own speed."""
-    meshes = mesh_groups(kin).get(crossing["source"])
+    meshes = groups.get(crossing["source"])  # (:func:`mesh_groups`)
     if not meshes or "stiffness_harmonic" not in crossing:
         return crossing
     # a degenerate mode's shape is any of its group's: judged on the whole group (the
@@ -751,7 +751,7 @@ def _curve_crossings(model, q, speeds, F, lines, w_ref, strength=None):
                 w = speeds[i] + th * (speeds[i + 1] - speeds[i])
                 st = _structure_at(model, w / w_ref)
                 sol = modal_analysis(st, q)
-                out.append(_cancellation(st, q, sol, phasing.kin, phasing.mark(dict(
+                out.append(_cancellation(st, q, sol, phasing.groups, phasing.mark(dict(
                     mode=m + 1, frequency_Hz=float(sol.frequencies[m]), order=order,
                     source=label, speed_rpm=float(w * RPM),
                     energy=sol.dominant_elements(m, 4),
