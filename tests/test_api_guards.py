@@ -46,6 +46,15 @@ def test_nothing_given_is_said_as_such(call, pattern):
         call()
 
 
+def test_a_model_text_given_for_a_path_is_told_how_to_pass_it():
+    from tests.model_texts import SPUR_PAIR, split_model
+
+    for text in (SPUR_PAIR, split_model()):  # (a long one: 'File name too long' from the OS)
+        with pytest.raises(OptionTypeError, match=r"got a text of \d+ characters .* "
+                           r"pass tomllib\.loads\(text\)"):
+            torquesplit.load_model(text)
+
+
 def test_paths_that_are_not_there_or_not_folders(tmp_path):
     with pytest.raises(OutputError, match=r"nope\.nc: no such file; give the \.nc file"):
         torquesplit.load_results(tmp_path / "nope.nc")

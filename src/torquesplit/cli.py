@@ -1490,6 +1490,10 @@ def modes(
                                        metavar="SPEED"),
     plot: Optional[Path] = typer.Option(None, "--plot", help="Campbell: write the diagram "
                                         "(.png, .svg or .pdf).", metavar="FILE"),
+    orders: Optional[int] = typer.Option(None, "--orders", help="Campbell: mesh-frequency "
+                                         "orders 1..N (default: those with 5 % of the "
+                                         "stiffness's fundamental, 3 to 10; a note names "
+                                         "strong orders left out).", metavar="N"),
     quiet: bool = _flag("--quiet", "No progress display."),
 ):
     """Natural modes about the static equilibrium: every mode (or those asked for), its
@@ -1510,6 +1514,7 @@ def modes(
     try:
         opts = _option_errors()
         opts(_at_least, count, 1, "--count", "20")
+        opts(_at_least, orders, 1, "--orders", "15")
         opts(_check_figure_file, plot, "--plot", force)
         limit = opts(ux.quantity, below, "frequency", "--below")
         opts(_positive, limit, "--below", "'5 kHz'")
@@ -1526,6 +1531,10 @@ def modes(
         if not campbell and plot is not None:
             raise TorquesplitError("--plot draws the Campbell diagram; add --campbell "
                                    "--from A --to B, or leave --plot out")
+        if not campbell and orders is not None:
+            raise TorquesplitError("--orders sets the excitation lines of the Campbell "
+                                   "diagram; add --campbell --from A --to B, or leave "
+                                   "--orders out")
         if campbell and (count is not None or below is not None):
             given = " and ".join(o for o, v in (("--count", count), ("--below", below))
                                  if v is not None)
@@ -1540,7 +1549,7 @@ def modes(
             from .steady.cli import campbell_command
 
             return campbell_command(m, start, stop, plot, as_json, console, _json_default,
-                                    out=out, force=force)
+                                    out=out, force=force, orders=orders)
         plan = None
         if out is not None:
             plan = _out_option(check_dataset_output, out, ("mode", "dof"), overwrite=force)

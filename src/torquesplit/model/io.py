@@ -99,6 +99,14 @@ def changes_mapping(changes) -> dict:
 
 def _resolve(source) -> Path:
     """A model file's path: ``source`` itself, or the shipped example of that name."""
+    if isinstance(source, str) and ("\n" in source or len(source) > 1024):
+        from ..errors import OptionTypeError
+
+        # (the text of a model taken for a path: 'File name too long' from the OS)
+        raise OptionTypeError(f"load_model takes a model file's path or an example's "
+                              f"name; got a text of {len(source)} characters "
+                              f"({_short(source)}): for a model's TOML text, pass "
+                              f"tomllib.loads(text) (a dict)")
     path = Path(source)
     if not path.exists() and path.suffix == "" and path.parent == Path("."):
         from torquesplit.examples import example_names, example_path

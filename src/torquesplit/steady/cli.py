@@ -674,14 +674,16 @@ def _save(ds, path, overwrite=False):
 
 
 def campbell_command(m, start, stop, plot, as_json, console, json_default, out=None,
-                     force=False):
+                     force=False, orders=None):
     """``modes --campbell``: the resonance map and the critical speeds (the map written
-    to ``out`` if given)."""
+    to ``out`` if given; mesh orders 1..``orders``, None: as the stiffness tables
+    excite them)."""
     from torquesplit.steady.maps import campbell
 
     from torquesplit.errors import TorquesplitError
 
-    ds, crossings = campbell(m, _speed(start, "--from"), _speed(stop, "--to"))
+    ds, crossings = campbell(m, _speed(start, "--from"), _speed(stop, "--to"),
+                             orders=orders)
     written, failed = [], None
     try:  # a file that cannot be written: the map is still printed, then the error
         if out is not None:
@@ -705,6 +707,8 @@ def campbell_command(m, start, stop, plot, as_json, console, json_default, out=N
                "natural_frequencies_at_speed_rpm": float(ds["speed_rpm"].values[0])}
         if suppressed:
             out["suppressed_by_mesh_phasing"] = suppressed
+        if ds.attrs.get("orders_left_out"):
+            out["orders_left_out"] = list(ds.attrs["orders_left_out"])
         out["files"] = [str(w) for w in written]
         _emit(out, json_default)
         if failed is not None:
@@ -745,6 +749,8 @@ def campbell_command(m, start, stop, plot, as_json, console, json_default, out=N
                   "at that frequency (transmission error, eccentricity) over the mesh's "
                   "nominal force, the largest and its mesh ('-': no error there)",
                   highlight=False)
+    for line in ds.attrs.get("orders_left_out", []):
+        console.print(f"note: {line}", highlight=False)
     for w in written:
         console.print(f"wrote {w}", highlight=False)
     if failed is not None:

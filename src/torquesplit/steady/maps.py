@@ -557,6 +557,42 @@ def mesh_orders(table) -> int:
     return int(min(MAX_ORDERS, max(MIN_ORDERS, strong[-1] + 1)))
 
 
+def strong_orders_beyond(table, top: int = MAX_ORDERS) -> tuple[int, float] | None:
+    """(highest order, largest share) of the stiffness table's harmonics above ``top``
+    with HARMONIC_SHARE of the fundamental's amplitude, or None: what :func:`mesh_orders`
+    leaves off the map (a steep stiffness step keeps 5 % up to the 15th order and
+    beyond)."""
+    amp = np.abs(np.fft.rfft(np.asarray(table, dtype=float)))[1:]
+    if amp.size <= top or amp[0] <= 0:
+        return None
+    share = amp[top:] / amp[0]
+    strong = np.flatnonzero(share >= HARMONIC_SHARE)
+    if strong.size == 0:
+        return None
+    return int(top + strong[-1] + 1), float(share.max())
+
+
+def orders_left_out(kin, structure) -> list[str]:
+    """A line per mesh-frequency group whose stiffness harmonics above MAX_ORDERS (the
+    map's default cap) still carry HARMONIC_SHARE of the fundamental: the map leaves them
+    out unless asked for more orders."""
+    names = list(structure.element_names)
+    out = []
+    for label, group in mesh_groups(kin).items():
+        found = [strong_orders_beyond(structure.stiffness_table[names.index(n)])
+                 for n in group if n in names]
+        found = [f for f in found if f is not None]
+        if found:
+            top = max(f[0] for f in found)
+            share = max(f[1] for f in found)
+            out.append(f"{label}: stiffness harmonics up to order {top} carry at least "
+                       f"{100 * HARMONIC_SHARE:g} % of the fundamental (up to "
+                       f"{100 * share:.3g} % above order {MAX_ORDERS}); the map draws orders "
+                       f"1..{MAX_ORDERS}: ask for orders={top} (modes --campbell --orders "
+                       f"{top}) to draw them")
+    return out
+
+
 def mesh_groups(kin) -> dict[str, list[str]]:
     """Excitation-line label -> the meshes of one mesh frequency (one line stands for
     them all): ``mesh NAME`` for one, ``meshes a1..4, b1..4`` (:func:`names_label`) for
@@ -652,16 +688,22 @@ def campbell(model, start: float, stop: float, *, points: int = 41,
         raise OptionError(f"points must be a whole number >= 2, got {points!r}")
     model, kin, s, _, _, static = _prepare(model, None, None)
     w_ref = reference_speed(model)
+    if orders is not None and not (isinstance(orders, (int, np.integer))
+                                   and not isinstance(orders, bool) and orders >= 1):
+        raise OptionError(f"orders must be a whole number >= 1, got {orders!r}")
     lo, hi = sorted((_rad_per_s(start, "start"), _rad_per_s(stop, "stop")))  # (a map: the
-    # range either way round, as sweep_speed takes it)
-    if not (lo > 0 and hi > lo and math.isfinite(hi)):
+    # range either way round, as sweep_speed takes it; from standstill as a map usually is)
+    if not (lo >= 0 and hi > lo and math.isfinite(hi)):
         raise OptionError(f"the speed range {lo * RPM:.6g}..{hi * RPM:.6g} rpm must be two "
-                          f"different positive speeds; e.g. --from '1000 rpm' --to '3000 rpm'.")
+                          f"different speeds, the lower one 0 or more; e.g. --from '0 rpm' "
+                          f"--to '3000 rpm'.")
     speeds = np.linspace(lo, hi, points)
     if s.n_gyroscopic:
         freqs = []
         for w in speeds:
-            st = _structure_at(model, w / w_ref)
+            # (a model at standstill is refused: the frequencies at a millionth of the
+            # model's speed stand for it)
+            st = _structure_at(model, max(w / w_ref, 1e-6))
             freqs.append(modal_analysis(st, static.q).frequencies)
         nf = min(len(f) for f in freqs)
         F = np.array([f[:nf] for f in freqs])
@@ -692,6 +734,9 @@ def campbell(model, start: float, stop: float, *, points: int = 41,
     _crossing_table(ds, crossings)
     ds.attrs["critical_speeds_rpm"] = [c["speed_rpm"] for c in critical]
     ds.attrs["critical_speed_labels"] = [label(c) for c in critical]
+    left_out = orders_left_out(kin, s) if orders is None else []
+    if left_out:
+        ds.attrs["orders_left_out"] = left_out
     if suppressed:
         # crossings that the planets' mesh phasing leaves unexcited (Parker & Lin 2004)
         ds.attrs["suppressed_speeds_rpm"] = [c["speed_rpm"] for c in suppressed]
@@ -749,7 +794,7 @@ def _curve_crossings(model, q, speeds, F, lines, w_ref, strength=None):
             for i in np.flatnonzero(np.sign(g[:-1, m]) * np.sign(g[1:, m]) < 0):
                 th = g[i, m] / (g[i, m] - g[i + 1, m])
                 w = speeds[i] + th * (speeds[i + 1] - speeds[i])
-                st = _structure_at(model, w / w_ref)
+                st = _structure_at(model, max(w / w_ref, 1e-6))
                 sol = modal_analysis(st, q)
                 out.append(_cancellation(st, q, sol, phasing.groups, phasing.mark(dict(
                     mode=m + 1, frequency_Hz=float(sol.frequencies[m]), order=order,
