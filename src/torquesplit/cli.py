@@ -1112,12 +1112,16 @@ def contact(
     assign: Optional[list[str]] = typer.Option(None, "--set", help=_SET_HELP,
                                                metavar="PATH=VALUE"),
     as_json: bool = ux.json_option("Print the results as JSON."),
+    out: Optional[Path] = typer.Option(None, "--out", help="Write the results: .nc, .mat "
+                                       "or .csv (tables per load, per mesh position with a "
+                                       "column per load, and the Harris map).",
+                                       metavar="FILE"),
 ):
     """Loaded tooth contact analysis of one mesh: transmission error, stiffness, load
     distribution, contact pressure, Harris map, meshing-in impact."""
     with ux.interruptible():
         _contact(model, pair, load, on, plot, force, positions, slices, harris, assign,
-                 as_json)
+                 as_json, out)
 
 
 MAX_FLANK_PRESSURE = 4e9
@@ -1125,10 +1129,19 @@ MAX_FLANK_PRESSURE = 4e9
 allowable, 3 GPa static limit): above it a contact load is a slip of units."""
 
 
+CONTACT_TABLES = ("load", "position", "harris_load")
+"""Row dimensions of ``contact --out``'s CSV tables (:mod:`torquesplit.gears.contact.export`)."""
+
+
 def _contact(model, pair, load, on, plot, force, positions, slices, harris, assign,
-             as_json) -> None:
+             as_json, out=None) -> None:
+    from .results.export import check_dataset_output
+
     try:
         opts = _option_errors()
+        if out is not None:
+            opts(_out_option, check_dataset_output, out,
+                 CONTACT_TABLES if harris > 0 else CONTACT_TABLES[:2], overwrite=force)
         if plot is not None:
             from .plot.contact import contact_figure_files
 
@@ -1211,7 +1224,25 @@ def _contact(model, pair, load, on, plot, force, positions, slices, harris, assi
     except _EXPECTED as exc:
         _fail(exc)
         return
-    figures, failed = [], None
+    figures, written, failed = [], [], None
+    given = [f"{text} on {gear or kin.meshes[pair].driven}" if not _is_force(text) else text
+             for text, gear in zip(load or [], ons)] or None
+    if out is not None:  # (a file that cannot be written: the tables are still printed)
+        from .gears.contact.export import contact_dataset
+        from .results.export import dataset_files, save_dataset, with_model
+
+        try:
+            ds = with_model(contact_dataset(results, operating_load=op_load, harris=hm,
+                                            impact=impact, given=given, mesh=pair,
+                                            gears=names), m)
+            ds.attrs["model"] = m.model.name
+            written = dataset_files(ds, save_dataset(ds, out, overwrite=force))
+        except TorquesplitError as exc:
+            failed = exc
+        except OSError as exc:
+            failed = OutputError(f"--out {out}: cannot write the results "
+                                 f"({clip_message(exc.strerror or str(exc))}); the tables "
+                                 f"are printed; choose a folder you can write to")
     if plot is not None:
         from .plot.contact import write_contact_figures
 
@@ -1220,20 +1251,19 @@ def _contact(model, pair, load, on, plot, force, positions, slices, harris, assi
                                             operating_load=op_load,
                                             title=f"{m.model.name} {pair}", gear=names[1])
         except OSError as exc:
-            failed = _figure_error(exc, "--plot", plot, "the tables are printed, nothing saved")
-    given = [f"{text} on {gear or kin.meshes[pair].driven}" if not _is_force(text) else text
-             for text, gear in zip(load or [], ons)] or None
+            failed = _figure_error(exc, "--plot", plot, "the tables are printed" + (
+                ", the results written" if written else ", nothing saved"))
     _print_contact(m, pair, names, op_load, cm, results, hm, impact, op, figures, plot,
-                   as_json, reverse, impact_note, given)
+                   as_json, reverse, impact_note, given, written)
     if failed is not None:
         _fail(failed)
 
 
 def _print_contact(m, pair, names, op_load, cm, results, hm, impact, op, figures, plot,
-                   as_json, reverse=False, impact_note=None, given=None) -> None:
+                   as_json, reverse=False, impact_note=None, given=None, written=()) -> None:
     """The loaded tooth contact analysis (or JSON); ``reverse``: the second gear (a ring)
     drives; ``impact_note``: why there is no meshing-in impact; ``given``: each load as
-    the command line gave it ('680 N m on wheel')."""
+    the command line gave it ('680 N m on wheel'); ``written``: the --out files."""
     rows = [r.summary() for r in results]
     if given is not None:  # (what each load was given as, '680 N m on wheel')
         rows = [{"given_as": g, **row} for row, g in zip(rows, given)]
@@ -1255,7 +1285,8 @@ def _print_contact(m, pair, names, op_load, cm, results, hm, impact, op, figures
             "impact": None if impact is None else {
                 "peak_force_N": impact.peak_force, "advance_m": impact.advance,
                 "corner_separation_m": impact.corner_separation},
-            "figures": [str(f) for f in figures]}, _json_default)
+            "figures": [str(f) for f in figures],
+            "files": [str(f) for f in written]}, _json_default)
         return
     driver, driven = (names[1], names[0]) if reverse else (names[0], names[1])
     console.print(f"[bold]{m.model.name}[/]: LTCA of mesh {pair} ({driver} drives {driven}), "
@@ -1302,6 +1333,8 @@ def _print_contact(m, pair, names, op_load, cm, results, hm, impact, op, figures
                   "approach)", highlight=False)
     if figures:
         console.print(f"{len(figures)} figures written to {plot}")
+    for f in written:
+        console.print(f"wrote {f}", highlight=False)
 
 
 #: the line ``contact`` prints (and ``--json`` lists in its warnings) for an internal mesh

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import csv
 import json
 import re
 import tomllib
@@ -241,3 +242,53 @@ def test_a_secant_stiffness_softened_by_the_modifications_is_said():
         if said:
             assert soft[0].startswith("meshes.m.stiffness: the secant LTCA stiffness P/Z")
             assert 'ltca.excitation = "tangent"' in soft[0]
+
+
+def test_contact_out_writes_every_load_and_the_harris_map(tmp_path):
+    """``contact --out``: the results a spreadsheet or MATLAB user needs, every load (the
+    figures show the largest one only) and the Harris map, equal to the JSON's."""
+    import scipy.io
+    import xarray as xr
+
+    model = tmp_path / "spur.toml"
+    model.write_text(SPUR)
+    args = ["contact", str(model), "--pair", "m", "--load", "4 kN", "--load", "200 N m",
+            "--harris", "3", "--json"]
+    r = CliRunner().invoke(app, args + ["--out", str(tmp_path / "c.csv")])
+    assert r.exit_code == 0, r.output
+    res = json.loads(r.stdout)
+    names = [tmp_path / f for f in ("c.csv", "c_position.csv", "c_harris_load.csv",
+                                    "c_about.json")]
+    assert res["files"] == [str(f) for f in names] and all(f.is_file() for f in names)
+    load_rows = list(csv.DictReader(names[0].open()))
+    assert [float(row["load_N"]) for row in load_rows] == pytest.approx(
+        [row["load_N"] for row in res["loads"]], rel=1e-12)
+    assert [row["given_as"] for row in load_rows] == ["4 kN", "200 N m on wheel"]
+    pos = list(csv.DictReader(names[1].open()))
+    assert len(pos) == len(res["loads"][0]["te_m"])
+    for row, label in zip(res["loads"], ("4kN", load_rows[1]["load"])):
+        assert [float(p[f"transmission_error_{label}_m"]) for p in pos] == pytest.approx(
+            row["te_m"], rel=1e-12)
+        assert float(next(lr for lr in load_rows if lr["load"] == label)[
+            "te_peak_to_peak_m"]) == pytest.approx(row["te_peak_to_peak_m"], rel=1e-12)
+    harris = list(csv.DictReader(names[2].open()))
+    assert [float(h["harris_load_N"]) for h in harris] == pytest.approx(
+        res["harris"]["load_N"], rel=1e-12)
+    # the same in NetCDF and MATLAB; without a Harris map, no table of it
+    r = CliRunner().invoke(app, args[:-3] + ["--harris", "0", "--out", str(tmp_path / "c.nc")])
+    assert r.exit_code == 0, r.output
+    ds = xr.load_dataset(tmp_path / "c.nc")
+    assert "harris_load" not in ds.dims and ds["transmission_error"].dims == ("position", "load")
+    np.testing.assert_allclose(ds["transmission_error"].values[:, 0], res["loads"][0]["te_m"],
+                               rtol=1e-12)
+    assert ds.attrs["mesh"] == "m" and ds["load_N"].attrs["units"] == "N"
+    r = CliRunner().invoke(app, args + ["--out", str(tmp_path / "c.mat")])
+    assert r.exit_code == 0, r.output
+    mat = scipy.io.loadmat(tmp_path / "c.mat", simplify_cells=True)
+    np.testing.assert_allclose(mat["transmission_error"][:, 1], res["loads"][1]["te_m"],
+                               rtol=1e-12)
+    assert mat["units"]["stiffness_secant"] == "N/m"
+    # an existing file is refused before the analysis, not after it
+    again = CliRunner().invoke(app, args[:-1] + ["--out", str(tmp_path / "c.csv")])
+    assert again.exit_code == 2 and "--out" in again.output and "--force" in again.output
+    assert "loaded tooth contact analysis" not in again.output

@@ -1,0 +1,101 @@
+"""A loaded tooth contact analysis as an xarray Dataset, for the NetCDF, MATLAB and
+spreadsheet files of ``torquesplit contact --out`` (:mod:`torquesplit.results.export`).
+
+Three tables, one per row dimension: ``load`` (the scalars of each analysed load, as the
+printed table), ``position`` (the curves over the mesh cycle: a column per load, named by
+it in kN, and the largest load's load per tooth pair), and ``harris_load`` (the Harris
+map).  SI units on
+every variable; the transmission error also in arc seconds of the driven gear (Liu et al.
+2021 eq. 3).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def contact_dataset(results, *, operating_load=None, harris=None, impact=None, given=None,
+                    mesh: str = "", gears=("", "")):
+    """The Dataset of ``results`` (one :class:`~torquesplit.gears.contact.ltca.
+    LtcaResult` per load, in the order given), the tooth-pair loads of the largest, the
+    :class:`~torquesplit.gears.contact.ltca.HarrisMap` ``harris`` and the meshing-in
+    ``impact`` (at the largest load: attributes) if given; ``operating_load``: the
+    model's [N]; ``given``: each load as the command line gave it."""
+    import xarray as xr
+
+    op = max(results, key=lambda r: r.load)  # (where the figures and the impact are)
+    rows = [r.summary() for r in results]
+    loads = np.array([r.load for r in results], dtype=float)
+    per_load = {  # name -> (summary key, unit, description)
+        "te_mean": ("te_mean_m", "m", "mean loaded transmission error along the normal"),
+        "te_peak_to_peak": ("te_peak_to_peak_m", "m",
+                            "peak-to-peak loaded transmission error (Liu et al. 2021 eq. 4)"),
+        "te_peak_to_peak_arcsec": ("te_peak_to_peak_arcsec", "arcsec",
+                                   f"the same as an angle of {gears[1]} (eq. 3)"),
+        "stiffness_secant_mean": ("stiffness_secant_mean_N_per_m", "N/m",
+                                  "mean secant mesh stiffness load / TE (eq. 5)"),
+        "stiffness_tangent_mean": ("stiffness_tangent_mean_N_per_m", "N/m",
+                                   "mean tangent mesh stiffness dload / dTE"),
+        "max_hertz_pressure": ("max_hertz_pressure_Pa", "Pa", "largest Hertz pressure"),
+        "contact_ratio": ("actual_contact_ratio", "1",
+                          "mean number of loaded tooth pairs over the cycle"),
+    }
+    data = {name: ("load", np.array([row[key] for row in rows], dtype=float),
+                   {"units": unit, "long_name": text})
+            for name, (key, unit, text) in per_load.items()}
+    if given is not None:
+        data["given_as"] = ("load", np.array(list(given), dtype=object),
+                            {"long_name": "the load as given (a torque on a gear, or a force)"})
+    curves = {  # name -> (values (position, load), unit, description)
+        "transmission_error": ([r.transmission_error for r in results], "m",
+                               "loaded transmission error along the normal"),
+        "transmission_error_arcsec": ([r.te_arcsec for r in results], "arcsec",
+                                      f"loaded transmission error as an angle of {gears[1]}"),
+        "stiffness_secant": ([r.stiffness_secant for r in results], "N/m",
+                             "secant mesh stiffness load / TE"),
+        "stiffness_tangent": ([r.stiffness_tangent for r in results], "N/m",
+                              "tangent mesh stiffness"),
+        "max_pressure": ([r.max_pressure for r in results], "Pa",
+                         "largest Hertz pressure at the position"),
+        "loaded_pairs": ([r.loaded_pairs for r in results], "1",
+                         "tooth pairs carrying load at the position"),
+    }
+    for name, (values, unit, text) in curves.items():
+        data[name] = (("position", "load"), np.stack(values, axis=1),
+                      {"units": unit, "long_name": text})
+    data["unloaded_te"] = ("position", np.asarray(op.unloaded_te, dtype=float),
+                           {"units": "m", "long_name": "transmission error at vanishing "
+                            "load (geometric: modifications and misalignment)"})
+    data["pair_load"] = (("position", "pair"), op.pair_load.sum(axis=1),
+                         {"units": "N", "long_name": f"load of each tooth pair at the "
+                          f"largest load ({op.load:.6g} N), over the helices"})
+    # the loads label the columns of the position table ('transmission_error_10kN_m')
+    labels = [f"{x / 1e3:.6g}kN" for x in loads]
+    if len(set(labels)) < len(labels):
+        labels = [f"load{k + 1}" for k in range(len(labels))]
+    coords = {"load": ("load", np.array(labels, dtype=object),
+                       {"long_name": "the load analysed (its value: load_N)"}),
+              "load_N": ("load", loads, {"units": "N", "long_name": "normal tooth load"}),
+              "phase": ("position", np.asarray(op.phase, dtype=float),
+                        {"units": "1", "long_name": "mesh position in cycles"}),
+              "position": np.arange(1, op.phase.size + 1),
+              "pair": np.arange(1, op.pair_load.shape[2] + 1)}
+    if harris is not None:
+        coords["harris_load"] = ("harris_load", np.asarray(harris.loads, dtype=float),
+                                 {"units": "N", "long_name": "normal tooth load"})
+        for name, values, unit in (
+                ("harris_te_peak_to_peak", harris.te_peak_to_peak, "m"),
+                ("harris_te_peak_to_peak_arcsec", harris.te_peak_to_peak_arcsec, "arcsec"),
+                ("harris_mean_stiffness", harris.mean_stiffness, "N/m"),
+                ("harris_contact_ratio", harris.contact_ratio, "1")):
+            data[name] = ("harris_load", np.asarray(values, dtype=float), {"units": unit})
+    ds = xr.Dataset(data, coords=coords)
+    ds.attrs.update(mesh=mesh, driver=gears[0], driven=gears[1], positions=int(op.phase.size),
+                    largest_load_N=float(op.load))
+    if operating_load is not None:
+        ds.attrs["operating_load_N"] = float(operating_load)
+    if impact is not None:  # (at the largest load)
+        ds.attrs.update(impact_peak_force_N=float(impact.peak_force),
+                        impact_advance_m=float(impact.advance),
+                        impact_corner_separation_m=float(impact.corner_separation))
+    return ds
