@@ -7,7 +7,9 @@
 hand) and ``docs/validation_results.json`` (every number, written by
 ``scripts/validate.py``).  A placeholder ``{{path/to/value:fmt}}`` is replaced by the
 value at that path of the JSON (keys separated by ``/``; a key may hold spaces and
-dots) formatted with the Python format spec ``fmt``; ``{{=expression:fmt}}`` evaluates a
+dots) formatted with the Python format spec ``fmt`` (``fmt~path``: and marked † where the
+change under a halved step at ``path`` exceeds half its last digit, :func:`held`);
+``{{=expression:fmt}}`` evaluates a
 small arithmetic expression over ``$[path]`` references (for ranges and ratios).  A
 list of texts (a run's warnings) is written as one markdown bullet per item (``:nested``:
 indented, inside a list item).
@@ -79,8 +81,26 @@ def render(template: str, data) -> str:
         if isinstance(value, list):  # bullets; fmt "nested": inside a list item
             bullet = "  - " if fmt == "nested" else "- "
             return "\n".join(bullet + str(item) for item in value) if value else bullet + "none"
+        if fmt and "~" in fmt:  # a number and how far it moves under h/2
+            fmt, change = fmt.split("~", 1)
+            return held(value, fmt, float(lookup(data, change)))
         return format(value, fmt) if fmt else str(value)
     return _FIELD.sub(field, template)
+
+
+NOT_HELD = "†"
+"""The mark of a printed number whose last digit moves when the step is halved."""
+
+
+def held(value: float, fmt: str, change: float) -> str:
+    """``value`` formatted with ``fmt`` (a fixed-point ``.Nf``), marked NOT_HELD when its
+    change under a halved step (``change``, absolute) is more than half a unit of the
+    last printed digit: the digits printed do not all hold."""
+    m = re.fullmatch(r"\.(\d+)f", fmt)
+    if m is None:
+        raise ValueError(f"a held number takes a fixed-point format (.3f), not {fmt!r}")
+    unit = 10.0 ** -int(m.group(1))
+    return format(value, fmt) + (NOT_HELD if not change <= 0.5 * unit else "")
 
 
 def render_validation() -> str:

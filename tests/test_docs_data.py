@@ -92,3 +92,17 @@ def test_a_study_case_run_today_gives_the_number_the_studies_page_prints(tmp_pat
         ds = torquesplit.Study(spec).run(out=tmp_path / "one", workers=1, figures=False)
     for name, published in entry["outputs"].items():
         assert float(ds[name].values.ravel()[0]) == pytest.approx(published[k], rel=2e-6), name
+
+
+def test_a_number_whose_digits_move_under_a_halved_step_is_marked():
+    """Liu et al. 2021's spur LSC with impact moved by 9.8e-3 under h/2 and was printed
+    1.197 beside converged numbers, unmarked (a reviewer)."""
+    render = _load(ROOT / "scripts" / "render_docs.py", "render_docs")
+    assert render.held(1.197, ".3f", 9.8e-3) == "1.197†"
+    assert render.held(1.091, ".3f", 7.2e-6) == "1.091"
+    assert render.held(1.5, ".1f", 0.05) == "1.5" and render.held(1.5, ".1f", 0.051) == "1.5†"
+    assert render.held(2.0, ".2f", float("nan")) == "2.00†"  # (a change not computed)
+    with pytest.raises(ValueError, match="fixed-point"):
+        render.held(1.0, ".3g", 0.0)
+    data = {"r": {"values": {"x": 1.197}, "halved": {"change": {"x": 9.8e-3}}}}
+    assert render.render("{{r/values/x:.3f~r/halved/change/x}}", data) == "1.197†"
