@@ -99,6 +99,14 @@ Angles are the usual trap: a bare number is in **radians**, so write
 with a hint; other angles, such as a placement angle, cannot be checked).  Inside
 torquesplit every value is SI.
 
+US customary units are read as engineers write them: `"8e6 lbf/in"`, `"105924 lbf-in"`
+or `"8827 ft-lbf"` (a hyphen is a product), `"2500 lb-ft^2"` (an inertia WR^2),
+`"2000 hp"` (`HP`, `bhp`), `"1190 RPM"` (`rev/min`, `r/min`), `"12 mil"` or `'0.012"'`
+(thousandths of an inch: pint's own mil is an angle), `"11.5e6 psi"`.  `lb` is the
+pound-mass: a torque or stiffness in `lb` is refused with the hint to write `lbf`, never
+guessed.  A gear's `module` also takes the normal diametral pitch as teeth per length
+(`module = "4 1/in"` is 6.35 mm).  Results are in SI units.
+
 Speeds and frequencies: a speed written in Hz (or `1/s`, `rps`, `kHz`) counts
 revolutions, so `speed = "50 Hz"` is 3000 rpm (2 pi x 50 rad/s); a bare number is rad/s
 (`speed = 50` is 477.5 rpm).  A frequency written in rpm or rad/s is converted the same

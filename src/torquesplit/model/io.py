@@ -207,6 +207,13 @@ def _written(data, parts: list[str]):
     return node
 
 
+#: a field name from another convention -> (the field that holds it, what to write)
+_SYNONYMS = {
+    name: ("module", "give the diametral pitch as module = '4 1/in' (teeth per inch: the "
+           "module 25.4 mm / 4)")
+    for name in ("diametral_pitch", "normal_diametral_pitch", "pitch", "dp", "DP")}
+
+
 def _message(err: dict, parts: list[str], written=None) -> str:
     kind = err["type"]
     ctx = err.get("ctx") or {}
@@ -219,8 +226,11 @@ def _message(err: dict, parts: list[str], written=None) -> str:
         got = _short(written) if zero else f"{_short(written)} (= {got} in SI units)"
     if kind == "extra_forbidden":
         name, section = (parts[-1], parts[:-1]) if parts else ("", [])
-        guess = difflib.get_close_matches(name, _fields_at(section), n=1, cutoff=0.6)
+        fields = _fields_at(section)
+        guess = difflib.get_close_matches(name, fields, n=1, cutoff=0.6)
         hint = f"did you mean {guess[0]!r}? " if guess else ""
+        if name in _SYNONYMS and _SYNONYMS[name][0] in fields:
+            hint = _SYNONYMS[name][1] + "; "
         return f"unknown field; {hint}check the spelling against docs/model-file.md"
     if kind == "missing":
         if parts and parts[-1].isdigit():

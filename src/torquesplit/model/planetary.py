@@ -58,6 +58,7 @@ from .schema import (
     Length,
     Mass,
     MisalignmentSpec,
+    Module,
     ModificationsSpec,
     Number,
     PinError,
@@ -182,7 +183,8 @@ class Planetary(Strict):
     angles: tuple[Angle, ...] | None = Field(
         None, description="Planet angles about the stage axis from the x axis (default "
         "equally spaced from 0); one per planet.")
-    module: Length = Field(gt=0, description="Normal module of all three gears.")
+    module: Module = Field(gt=0, description=(
+        "Normal module of all three gears (or their normal diametral pitch, '4 1/in')."))
     pressure_angle: Angle = Field(math.radians(20.0), description="Normal pressure angle.")
     helix_angle: Angle = Field(0.0, description="Helix angle.")
     hand: Literal["right", "left"] | None = Field(

@@ -23,7 +23,7 @@ from pydantic import (BaseModel, BeforeValidator, ConfigDict, Field, PrivateAttr
 from pydantic import Strict as StrictType
 
 from ..errors import FieldError, ModelError  # noqa: F401 - FieldError re-exported
-from .units import KINDS, parse_quantity
+from .units import KINDS, parse_module, parse_quantity
 
 
 class Unit:
@@ -86,6 +86,9 @@ Flag = Annotated[bool, StrictType()]
 """true or false only (not 0/1, not "yes")."""
 
 Length = Q("length")
+Module = Annotated[float, BeforeValidator(parse_module), Unit("length")]
+"""A normal module, or a diametral pitch read as its module (:func:`~torquesplit.model.
+units.parse_module`)."""
 Angle = Q("angle")
 Mass = Q("mass")
 Inertia = Q("inertia")
@@ -353,7 +356,9 @@ class Gear(Strict):
     """A gear: one rigid body with involute teeth."""
 
     teeth: Count = Field(gt=0, le=10_000, description="Number of teeth.")
-    module: Length = Field(gt=0, description="Normal module.")
+    module: Module = Field(gt=0, description=(
+        "Normal module, or the normal diametral pitch as teeth per length ('4 1/in': a "
+        "module of 6.35 mm)."))
     pressure_angle: Angle = Field(math.radians(20.0), description="Normal pressure angle.")
     helix_angle: Angle = Field(0.0, description="Helix angle (spiral angle for bevel gears).")
     hand: Literal["right", "left"] | None = Field(

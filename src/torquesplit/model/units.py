@@ -50,14 +50,59 @@ KINDS: dict[str, tuple[str, str]] = {
     "frequency": ("Hz", "235.9 Hz"),
     "viscosity": ("Pa s", "0.012 Pa s"),
     "force": ("N", "1200 N"),
+    "diametral_pitch": ("1/m", "4 1/in"),
 }
+
+
+def parse_module(value) -> float:
+    """A normal module [m], or a normal diametral pitch P (teeth per length: '4 1/in',
+    '4/in') read as the module 1/P (25.4 mm / 4 = 6.35 mm), as US drawings give it."""
+    try:
+        return parse_quantity(value, "length")
+    except ValueError as exc:
+        if not isinstance(value, str) or "is not a length" not in str(exc):
+            raise
+        try:
+            pitch = parse_quantity(value, "diametral_pitch")
+        except ValueError:
+            raise ValueError(f"{exc}; or give the normal diametral pitch as teeth per "
+                             f"length, e.g. '4 1/in' (the module 25.4 mm / 4)") from None
+        if not pitch > 0:
+            raise ValueError(f"{_short(value)}: a diametral pitch must be positive, e.g. "
+                             f"'4 1/in'") from None
+        return 1.0 / pitch
 
 
 @lru_cache(maxsize=1)
 def registry() -> pint.UnitRegistry:
-    """The one pint registry of torquesplit (created on first use)."""
+    """The one pint registry of torquesplit (created on first use), with the spellings a
+    gearbox engineer in US units writes: lbm, HP and bhp (the mechanical horsepower),
+    RPM and rev (and :func:`_spellings` reads the mil as a thousandth of an inch)."""
     ureg = pint.UnitRegistry()
+    ureg.define("@alias pound = lbm")
+    ureg.define("@alias horsepower = HP = bhp")
+    ureg.define("@alias revolutions_per_minute = RPM")
+    ureg.define("@alias revolution = rev")
     return ureg
+
+
+#: a hyphen between two unit names is a product, as engineers write it ('8827 lb-ft',
+#: 'lbf-in', 'N-m'); pint read it as a minus sign
+_HYPHEN = re.compile(r"(?<=[A-Za-z])-(?=[A-Za-z])")
+#: the inch mark after a number ('0.012"'), revolutions per minute as ISO writes them
+_INCH_MARK = re.compile(r'(?<=[\d.\s])"')
+_R_PER = re.compile(r"\br/(min|s)\b")
+#: the mil of US drawings, a thousandth of an inch (pint's mil is the angular mil: a
+#: backlash of '12 mil' was 'not a length')
+_MIL = re.compile(r"\bmils?\b")
+
+
+def _spellings(text: str) -> str:
+    """``text`` with the engineering spellings pint does not read made explicit."""
+    text = _HYPHEN.sub(" ", text)
+    text = _INCH_MARK.sub(" inch", text)
+    text = _MIL.sub("thou", text)
+    return _R_PER.sub(r"rev/\1", text)
 
 
 @lru_cache(maxsize=None)
@@ -114,7 +159,7 @@ def _parse_string(text: str, kind: str) -> float:
     ureg = registry()
     si_unit, example = KINDS[kind]
     try:
-        q = ureg.Quantity(_floats(text.strip()))
+        q = ureg.Quantity(_floats(_spellings(text.strip())))
         if not isinstance(q, pint.Quantity):  # pragma: no cover - older pint: a bare number
             q = ureg.Quantity(float(q))
     except Exception:
@@ -134,6 +179,10 @@ def _parse_string(text: str, kind: str) -> float:
                    else f"add the unit, e.g. '{n} {example.split(' ', 1)[1]}'")
         else:
             fix = f"write it in {si_unit} or a compatible unit, e.g. '{example}'"
+            if _POUND.search(text) and "[mass]" in str(ref.dimensionality) and kind not in (
+                    "mass", "inertia", "density"):
+                fix += ("; lb is the pound-mass: a force is written lbf (e.g. '8e6 lbf/in', "
+                        "'8827 lbf ft')")
         raise ValueError(
             f"{_short(text)} is not {_label(kind)} ({_dimension_text(q)}); "
             f"{fix}"
@@ -148,6 +197,8 @@ def _parse_string(text: str, kind: str) -> float:
     except (ArithmeticError, TypeError, ValueError):
         return math.nan
 
+
+_POUND = re.compile(r"\blbs?\b")
 
 #: kinds measured per unit time whose SI unit holds a power of the radian: a speed
 #: (rad/s) holds one, a frequency (Hz, revolutions or cycles per second) none
