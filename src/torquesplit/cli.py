@@ -755,6 +755,8 @@ def _thrust_note(bearings: list[dict], res) -> str:
         gear = model.gears.get(r["body"])
         if gear is None or not set(gear.dofs) - {"theta"} <= {"x", "y"}:
             continue  # (a 'loa' DOF moves along the line of action, thrust included)
+        if r.get("held") == "rigid":  # (its row is the sum of its mesh forces: thrust in z)
+            continue
         axis = np.asarray(kin.bodies[r["body"]].axis, float)
         axis /= np.linalg.norm(axis)
         thrust = sum(mk.force * abs(float(np.asarray(mk.line_of_action) @ axis))

@@ -28,3 +28,14 @@ def test_a_helical_gear_without_an_axial_dof_is_named(tmp_path):
     data["gears"]["wheel"]["dofs"] = ["x", "y", "z", "theta"]
     data["gears"]["wheel"]["support"]["axial_stiffness"] = "1e9 N/m"
     assert "Axial thrust: pinion has no axial DOF" in _run(tmp_path, data)
+
+
+def test_a_rigidly_held_gear_is_not_named_its_row_has_the_thrust(tmp_path):
+    """A body held rigidly has the sum of its mesh forces as its bearing row, thrust
+    included (z): the note named it all the same (an industrial reviewer's bull gear)."""
+    data = tomllib.loads(RICH_TOML)
+    data["gears"]["wheel"]["dofs"] = ["theta"]
+    data["gears"]["wheel"].pop("support", None)
+    out = _run(tmp_path, data)
+    assert "Axial thrust: pinion has no axial DOF" in out
+    assert "wheel (held rigidly)" in out
