@@ -61,3 +61,4 @@ def test_a_module_may_be_given_as_a_diametral_pitch():
                        r"give the diametral pitch as module = '4 1/in'"):
         ts.load_model(tomllib.loads(SPUR_PAIR.replace('module = "2 mm"',
                                                       'diametral_pitch = "12.7 1/in"', 1)))
+

@@ -83,7 +83,8 @@ class MeshKinematics:
     equivalent_mass: float
     """J1 J2 / (J1 rb2^2 + J2 rb1^2) [kg], the mesh's torsional equivalent mass."""
     critical_damping: float
-    """2 sqrt(k m_eq) with the mean mesh stiffness [N s/m]."""
+    """2 sqrt(k m_eq) with the mean mesh stiffness (one computed at assembly: its ISO 6336
+    estimate) [N s/m]; 0 where neither is known."""
     iso_stiffness: float | None
     """ISO 6336-1 estimate c_gamma * b [N/m] (cylindrical pairs only)."""
     conical: bool
@@ -360,13 +361,15 @@ def _solve_kinematics(model: Model) -> Kinematics:
         den = ja * arm_n**2 + jb * arm_d**2
         m_eq = ja * jb / den if den > 0 else 0.0
         spec = mesh.stiffness
-        k_mean = _mean_stiffness(spec)
-        crit = 2 * math.sqrt(k_mean * m_eq) if k_mean else 0.0
         i0, i1 = (0, 1) if mesh.gears[0] == driver else (1, 0)
         geo = fr.pair_geometry
         iso = None
         if geo is not None:
             iso = _iso_estimate(geo)
+        # (a stiffness computed at assembly, ISO 6336, potential energy or LTCA: its ISO
+        # estimate; 'check --json' gave 0 N s/m for a damping ratio of 0.06)
+        k_mean = _mean_stiffness(spec) or iso
+        crit = 2 * math.sqrt(k_mean * m_eq) if k_mean else 0.0
         meshes[name] = MeshKinematics(
             name=name, driver=driver, driven=driven, frequency=freq,
             contact_point=fr.contact_point, line_of_action=n_vec,
