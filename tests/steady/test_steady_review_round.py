@@ -216,3 +216,20 @@ def test_sweep_speed_takes_steady_states_option_checks():
             sweep_speed("ji_li_mill_drive", "700 rpm", "750 rpm", **kw)
         with pytest.raises(OptionError):
             torquesplit.steady_state("ji_li_mill_drive", **kw)
+
+
+def test_a_steady_state_that_fails_names_the_spline_friction_where_there_is_some():
+    """A reviewer's quill-shaft drive with a rubbing spline did not converge; the hint
+    named contact loss and --method hb, not the friction (it converged in one Newton
+    step without it)."""
+    from torquesplit import load_model
+    from torquesplit.steady.cli import _friction_hint
+
+    dong = load_model("dong2021_face_gear")
+    rubbing = [n for n, sp in dong.splines.items() if sp.friction_coefficient > 0]
+    hint = _friction_hint(dong)
+    assert rubbing and all(f"splines.{n}.friction_coefficient" in hint for n in rubbing)
+    assert f"--set splines.{rubbing[0]}.friction_coefficient=0" in hint
+    assert _friction_hint(load_model("ji_li_mill_drive")) == ""
+    dry = dong.with_changes({f"splines.{n}.friction_coefficient": 0.0 for n in rubbing})
+    assert _friction_hint(dry) == ""

@@ -156,6 +156,9 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
         res.check_definition(definition)  # a misspelt one raises; a diverged run's do not
     try:
         if not res.success:  # a stopped run: its coefficients are not results (as its CSV)
+            if getattr(res, "steady", None) is not None:
+                raise ValueError("the periodic state did not converge: no metrics of the "
+                                 "last iterate")
             raise ValueError("the run stopped before its end: no metrics of a part of it")
         met = res.metrics(definition)
         ds["load_sharing"] = _var(("mesh",), [met.load_sharing.per_mesh[m] for m in meshes],

@@ -265,7 +265,8 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
         if not ps.converged:
             warn(f"the periodic state did not converge ({ps.message}): its numbers are "
                  f"those of the last iterate; try --method hb, more --steps-per-cycle, or "
-                 f"'torquesplit run' (contact loss makes shooting harder to converge)")
+                 f"'torquesplit run' (contact loss makes shooting harder to converge"
+                 f"{_friction_hint(m)})")
         elif kind and as_json:
             warn(_INSTABILITY[kind])
         # the period found at the model's speeds, told at the speed solved
@@ -671,6 +672,20 @@ def _save(ds, path, overwrite=False):
     from torquesplit.results.export import save_dataset
 
     return save_dataset(ds, path, overwrite=overwrite)
+
+
+def _friction_hint(model) -> str:
+    """Where the model's splines have friction: that it is the likely cause of a steady
+    state that does not converge (its regularised Coulomb law is stiff and nearly
+    non-smooth over one period; a reviewer's quill-shaft drive converged in one Newton
+    step without it), and what to do."""
+    rubbing = [n for n, sp in model.splines.items() if sp.friction_coefficient > 0]
+    if not rubbing:
+        return ""
+    names = ", ".join(f"splines.{n}.friction_coefficient" for n in rubbing)
+    return (f", and so does spline friction ({names}): its Coulomb law, regularised over "
+            f"analysis.spline_velocity_scale, stick-slips; 'torquesplit run' integrates it "
+            f"as it is, and --set {names.split(', ')[0]}=0 shows what it changes")
 
 
 def campbell_command(m, start, stop, plot, as_json, console, json_default, out=None,
