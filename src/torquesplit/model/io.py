@@ -153,7 +153,7 @@ def _format_errors(exc: pydantic.ValidationError, data=None) -> list[tuple[str, 
         base = list(parts)
         if isinstance(error, FieldError):
             parts.append(error.field)
-        loc = ".".join(parts)
+        loc = ".".join(_as_written(data, parts))
         msg = _message(err, parts, _written(data, parts))
         found = [(loc, msg)]
         if isinstance(error, FieldError):  # the section's other problems
@@ -190,6 +190,21 @@ _TYPE_MESSAGES = {
     "list": ("must be a list", "write it as [item, item, ...]"),
     "tuple": ("must be a list", "write it as [item, item, ...]"),
 }
+
+
+def _as_written(data, parts: list[str]) -> list[str]:
+    """``parts`` up to the one-value shorthand the file wrote for a table, if it did
+    (``backlash = "-12 thou"``: its problem is at meshes.m.backlash, not at
+    meshes.m.backlash.nominal, a name the file does not hold)."""
+    node = data
+    for i, part in enumerate(parts):
+        if isinstance(node, dict) and part in node:
+            node = node[part]
+        elif isinstance(node, list) and part.isdigit() and int(part) < len(node):
+            node = node[int(part)]
+        else:
+            return parts[:i] if i and isinstance(node, (str, int, float)) else parts
+    return parts
 
 
 def _written(data, parts: list[str]):
