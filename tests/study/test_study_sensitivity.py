@@ -109,6 +109,17 @@ def test_ranking_of_a_constructed_model(split_file, tmp_path, method, kw):
         assert f"{var} [kN]" in text and f"{1e-3 * mu:.3g}" in text, text
     else:
         assert f"{var} [" not in text
+    # each factor with its interval (and Sobol's first-order index, Morris' mu and sigma
+    # beside it): the summary gave the ranking's one number per factor only
+    text = " ".join(text.split())
+    dominant = dict(output="load_sharing.cycle_peak",
+                    factor="meshes.a1.transmission_error.constant")
+    keys = (("mu_star", "mu_star_conf"), ("mu", None), ("sigma", None)) if method == "morris" \
+        else (("ST", "ST_conf"), ("S1", "S1_conf"))
+    for key, conf in keys:
+        x = ds[key].sel(**dominant).item()
+        shown = f"{x:.3g}" + ("" if conf is None else f" +/- {ds[conf].sel(**dominant).item():.2g}")
+        assert shown in text, (shown, text)
 
 
 def _ishigami(d):
@@ -149,6 +160,31 @@ def test_s1_above_st_beyond_the_intervals_is_a_warning():
         coords={"output": ["y"], "factor": ["a", "b"]})
     notes = sobol_warnings(ds)
     assert len(notes) == 1 and "y: S1 of a (0.9" in notes[0] and "samples" in notes[0]
+
+
+@pytest.mark.parametrize("s1, st, s1_conf, st_conf, said", [
+    # a reviewer's 8 samples: S1 1.45 +/- 0.87, ST 1.25 +/- 0.55, said nothing
+    ([1.447, 0.009], [1.25, 0.003], [0.87, 0.01], [0.55, 0.01],
+     "S1 of d1 1.45 +/- 0.87 and ST of d1 1.25 +/- 0.55 outside [0, 1]"),
+    ([-0.3, 0.5], [0.1, 0.6], [0.05, 0.05], [0.05, 0.05], "S1 of d1 -0.3 +/- 0.05 outside [0, 1]"),
+    ([0.5, 0.3], [0.6, 0.35], [0.05, 0.05], [0.3, 0.05], "the leading factor's total index is "
+                                                         "0.6 +/- 0.3 (d1)"),
+    ([0.5, 0.3], [0.6, 0.35], [0.05, 0.05], [0.05, 0.05], None),  # converged: quiet
+    ([0.5, -0.01], [0.6, 0.01], [0.05, 0.02], [0.05, 0.02], None),  # 0 within its interval
+])
+def test_sobol_indices_that_cannot_be_are_said(s1, st, s1_conf, st_conf, said):
+    import xarray as xr
+
+    from torquesplit.study.dataset import sobol_warnings
+
+    ds = xr.Dataset({k: (("output", "factor"), np.array([v])) for k, v in {
+        "S1": s1, "ST": st, "S1_conf": s1_conf, "ST_conf": st_conf}.items()},
+        coords={"output": ["y"], "factor": ["d1", "backlash"]})
+    notes = sobol_warnings(ds)
+    if said is None:
+        assert notes == []
+    else:
+        assert len(notes) == 1 and said in notes[0] and "raise sensitivity.samples" in notes[0]
 
 
 def test_tornado_draws_each_interval_on_its_own_bar():

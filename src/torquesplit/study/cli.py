@@ -312,22 +312,7 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
                          f"to print; the values are in {out / 'results.nc'} and the figures",
                          highlight=False)
     elif design == "sensitivity":
-        t = Table(title=f"{ds.attrs['study_name']}: factors ranked by "
-                        f"{ds.attrs['ranking']} (most important first)")
-        t.add_column("output")
-        t.add_column("ranking")
-        morris = ds.attrs["ranking"] == "mu_star"  # (in the output's unit; Sobol's are 1)
-        for v in out_vars:
-            rank = ranking(ds, ds[v].attrs["output"])
-            suffix, scale = _shown(ds[v]) if morris else ("", 1.0)
-            # (escaped: Rich reads " [kN]" as markup and drops it); no order where no index
-            # could be computed (every trajectory or base row lost a case)
-            text = (", ".join(f"{f} {x * scale:.3g}" for f, x in rank)
-                    if any(np.isfinite(x) for _, x in rank) else
-                    "none: no index could be computed (each trajectory or base row lost "
-                    "a case: see the cases' status)")
-            t.add_row(escape(v + suffix), text)
-        ui.console.print(t)
+        ui.console.print(_sensitivity_table(ds, out_vars))
         used_var = next((u for u in ("samples_used", "trajectories_used") if u in ds), None)
         if used_var is not None:
             total = int(ds[used_var].attrs["total"])
@@ -406,6 +391,50 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
     ui.console.print(f"results: {out / 'results.nc'} (and .csv, .mat); store: "
                      f"{out / 'study.sqlite'}"
                      + (f"; {_count(len(figs), 'figure')} in {out / 'figures'}" if figs else ""))
+
+
+def _sensitivity_table(ds, out_vars):
+    """The factors of each output, most important first, with their indices and 95 %
+    bootstrap half-widths: Sobol's total and first-order indices, or Morris' mu* (+/- its
+    interval), mu (its sign: the direction of the effect) and sigma (interaction or
+    nonlinearity); a reviewer's summary gave the ranking's one number per factor only."""
+    import numpy as np
+    from rich.markup import escape
+
+    from torquesplit._table import Table
+
+    from .dataset import ranking
+
+    morris = ds.attrs["ranking"] == "mu_star"  # (in the output's unit; Sobol's are 1)
+    t = Table(title=f"{ds.attrs['study_name']}: factors ranked by {ds.attrs['ranking']} "
+                    f"(most important first; +/-: 95 % bootstrap half-width)")
+    cols = (["output", "factor", "mu*", "mu", "sigma"] if morris else
+            ["output", "factor", "ST (total)", "S1 (first order)"])
+    for col in cols:
+        t.add_column(col, justify="left" if col in ("output", "factor") else "right")
+    factors = list(ds["factor"].values)
+    for v in out_vars:
+        name = ds[v].attrs["output"]
+        rank = ranking(ds, name)
+        # (escaped: Rich reads " [kN]" as markup and drops it)
+        suffix, scale = _shown(ds[v]) if morris else ("", 1.0)
+        if not any(np.isfinite(x) for _, x in rank):
+            t.add_row(escape(v + suffix), "none: no index could be computed (each "
+                      "trajectory or base row lost a case: see the cases' status)",
+                      *[""] * (len(cols) - 2))
+            continue
+        row = ds.sel(output=v)
+        for k, (factor, _) in enumerate(rank):
+            f = factors.index(factor)
+            val = lambda key: float(row[key].values[f])  # noqa: E731
+            if morris:
+                cells = [f"{val('mu_star') * scale:.3g} +/- {val('mu_star_conf') * scale:.2g}",
+                         f"{val('mu') * scale:.3g}", f"{val('sigma') * scale:.3g}"]
+            else:
+                cells = [f"{val('ST'):.3g} +/- {val('ST_conf'):.2g}",
+                         f"{val('S1'):.3g} +/- {val('S1_conf'):.2g}"]
+            t.add_row(escape(v + suffix) if k == 0 else "", escape(str(factor)), *cells)
+    return t
 
 
 def _shown(var) -> tuple[str, float]:
