@@ -241,3 +241,26 @@ def test_an_analysis_field_given_beside_a_study_file_is_named_as_given():
     with pytest.raises(StudyError, match=r"^analysis\['cycles'\] \(given with the study "
                                          r"mo_2017_errors\.toml\): does not apply"):
         Study("mo_2017_errors", analysis={"cycles": 50})
+
+
+def test_the_eta_is_the_mean_rate_of_this_sessions_cases():
+    """Two workers finishing together read as 'ETA 0:00:04' with 95 s left (rich's
+    column took the last completions' speed); a resumed study's stored cases do not make
+    the rate."""
+    import time
+
+    from rich.progress import Progress
+
+    from torquesplit.study.cli import _eta_column, eta_finish
+
+    assert eta_finish((100.0, 0), 100.0, 0, 15) is None
+    # 2 of 15 done in 27 s: 13 more at 13.5 s each
+    assert eta_finish((100.0, 0), 127.0, 2, 15) == pytest.approx(127.0 + 13 * 13.5)
+    # resumed with 10 stored: 2 new in 20 s, 3 left at 10 s each
+    assert eta_finish((0.0, 10), 20.0, 12, 15) == pytest.approx(50.0)
+    col = _eta_column()
+    with Progress() as bar:
+        task = bar.add_task("x", total=3, finish=time.monotonic() + 95.4)
+        assert str(col.render(bar.tasks[task])) in ("0:01:35", "0:01:34")
+        bar.update(task, finish=None)
+        assert str(col.render(bar.tasks[task])) == "-:--:--"

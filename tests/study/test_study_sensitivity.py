@@ -297,3 +297,4 @@ def test_no_ranking_is_printed_where_no_index_could_be_computed(split_file, tmp_
     text = cap.get()
     assert "none: no index could be computed" in text
     assert "gears.pinion.density nan" not in text
+
