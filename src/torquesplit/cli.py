@@ -1685,6 +1685,12 @@ def examples():
     console.print("Shipped optimisations (torquesplit optimize NAME; copy one with "
                   "'torquesplit example NAME'; the file format: docs/optimization.md): "
                   + ", ".join(optimization_names()), highlight=False)
+    from .study.shipped import study_names
+
+    console.print("Shipped studies, the papers' figures (torquesplit study NAME; 'torquesplit "
+                  "study --list' describes them; copy one with 'torquesplit example NAME'; "
+                  "the file format: docs/studies.md): " + ", ".join(study_names()),
+                  highlight=False)
     console.print("The earlier names still work for old scripts but are deprecated (use "
                   "the names above; a deprecated name prints a note): "
                   + ", ".join(f"{old} -> {new}" for old, new in RENAMED.items()),
@@ -1699,11 +1705,12 @@ def example(
                                    metavar="DIR"),
     force: bool = _flag("--force", "Overwrite an existing file."),
 ):
-    """Write an example model file (or a shipped optimisation file) to the current folder
-    (or --dir)."""
+    """Write an example model file (or a shipped study or optimisation file) to the
+    current folder (or --dir)."""
     from .examples import (RENAMED_OPTIMIZATIONS, current_name, example_names, example_path,
                            optimization_names, optimization_path)
     from .results import files
+    from .study.shipped import study_names, study_path
 
     try:
         stem, note = current_name(name)
@@ -1713,9 +1720,12 @@ def example(
             ostem = current_name(name, RENAMED_OPTIMIZATIONS)[0]
             optimization = (optimization_path(ostem) if ostem in optimization_names()
                             and stem not in example_names() else None)
+        if optimization is None and stem not in example_names() and name in study_names():
+            optimization = study_path(name)  # (a study file: copied as it is)
         if stem not in example_names() and optimization is None:
             raise OptionError(f"no example named {name!r}; run 'torquesplit examples' to list "
-                              f"them ({', '.join(example_names() + optimization_names())})")
+                              f"them ({', '.join(example_names() + optimization_names())}; "
+                              f"studies: {', '.join(study_names())})")
         if note:
             ux.warn(note, label="note")
         with warnings.catch_warnings():

@@ -29,6 +29,23 @@ def test_examples_and_example(tmp_path):
     assert again.exit_code == 2 and "--force" in again.output
     bad = runner.invoke(app, ["example", "nope"])
     assert bad.exit_code == 2 and "torquesplit examples" in bad.output
+    assert "ji_li_diameter" in " ".join(bad.output.split())
+
+
+def test_a_shipped_study_is_listed_and_copied_as_it_is(tmp_path):
+    """'torquesplit example ji_li_diameter' said 'no example named' and the docs said to
+    copy from src/, which an installed package does not have (a studies reviewer)."""
+    from torquesplit.study.shipped import study_names, study_path
+
+    out = " ".join(_ok(["examples"]).split())
+    assert "Shipped studies" in out and all(n in out for n in study_names())
+    _ok(["example", "ji_li_diameter", "--dir", str(tmp_path)])
+    copied = tmp_path / "ji_li_diameter.toml"
+    assert copied.read_bytes() == study_path("ji_li_diameter").read_bytes()
+    # the copy runs from where it is: its model is an example's name
+    from torquesplit.study import Study
+
+    assert Study(copied).plan().n_cases == 28
 
 
 def test_run_json_out_and_set(tmp_path):
