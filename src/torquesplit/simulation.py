@@ -9,6 +9,8 @@ holds them and computes the metrics on demand.
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import math
 import numbers
 import warnings
@@ -30,6 +32,22 @@ MAX_HISTORY_RECORDS = 200_000
 #: fewer than :data:`MIN_SAMPLES_PER_PERIOD` per shortest mesh period
 AUTO_HISTORY_RECORDS = 50_000
 MIN_SAMPLES_PER_PERIOD = 20
+
+#: set while a caller runs for the streamed metrics only (a study's case), whose sparse
+#: history is its own choice: no warning that the history is coarse (a reviewer's study
+#: warned it in every case of 120 s runs, and writes no waveforms)
+_HISTORY_UNUSED: contextvars.ContextVar[bool] = contextvars.ContextVar(
+    "torquesplit_history_unused", default=False)
+
+
+@contextlib.contextmanager
+def history_unused():
+    """Runs in this block keep a history nobody reads: its coarseness is not warned."""
+    token = _HISTORY_UNUSED.set(True)
+    try:
+        yield
+    finally:
+        _HISTORY_UNUSED.reset(token)
 #: fewest RK4 steps per excitation period a run takes (the model file's bound)
 MIN_STEPS_PER_PERIOD = 10
 #: default step budget of a run (about 1-5 minutes of integration on one core)
@@ -393,7 +411,8 @@ def prepare_run(
     # only a sampling the user asked for is worth a warning: the default one is a choice
     # of the library, and what it kept is in the bearing table's title and the files'
     # history_samples_per_period (a default run of Liu et al. 2021 warned)
-    if n_records > MAX_HISTORY_RECORDS and samples_per_period is not None:
+    if (n_records > MAX_HISTORY_RECORDS and samples_per_period is not None
+            and not _HISTORY_UNUSED.get()):
         warn_user(
             f"analysis: the history holds at most {MAX_HISTORY_RECORDS:,} samples, so this "
             f"run keeps {1.0 / (sample_interval * f_max):.3g} per shortest mesh period "

@@ -76,3 +76,32 @@ def test_grouped_warnings_say_nothing_one_case_contradicts():
                                  "to 2.475", "cases": [1, 2]}
     assert {"text": texts[0], "cases": [0]} in groups
     assert {"text": "analysis: 1e-3 s step", "cases": [2]} in groups
+
+
+def test_a_study_case_is_not_told_that_its_unread_history_is_coarse(monkeypatch, split_file):
+    """Every case of a reviewer's 120 s study warned that 'the history holds at most
+    200,000 samples ... the files' waveforms are that coarse': the study chose that
+    sparse history itself and writes no waveforms.  A run that asks for the sampling is
+    still told."""
+    import torquesplit
+    import torquesplit.simulation as sim
+
+    monkeypatch.setattr(sim, "MAX_HISTORY_RECORDS", 50)
+    said = "the history holds at most 50 samples"
+    res = torquesplit.simulate("ji_li_mill_drive", cycles=40, samples_per_period=20)
+    assert any(said in w for w in res.warnings())
+    with sim.history_unused():
+        res = torquesplit.simulate("ji_li_mill_drive", cycles=40, samples_per_period=20)
+    assert not any(said in w for w in res.warnings())
+    res = torquesplit.simulate("ji_li_mill_drive", cycles=40, samples_per_period=20)
+    assert any(said in w for w in res.warnings())  # (the block's end restores it)
+    # a study's case (in this process: one worker) runs in the block
+    data = grid_study(split_file, [{"path": "meshes.a1.transmission_error.constant",
+                                    "values": ["0 um"]}], outputs=["load_sharing.cycle_peak"],
+                      cycles=40)
+    ds = run_study(data, workers=1)
+    texts = " ".join(str(t) for t in ds["warnings"].values.ravel())
+    assert "the history holds at most" not in texts
+    # (the same sampling asked for outside a study does warn for this model too)
+    assert any(said in w for w in torquesplit.simulate(
+        split_file, cycles=40, samples_per_period=20).warnings())

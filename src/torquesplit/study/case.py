@@ -107,7 +107,9 @@ def _static(model, p, out) -> list[float]:
 
 
 def _dynamic(model, p, out) -> list[float]:
-    from ..simulation import MIN_SAMPLES_PER_PERIOD, simulate
+    import contextlib
+
+    from ..simulation import MIN_SAMPLES_PER_PERIOD, history_unused, simulate
     from .outputs import output_values
 
     a = p["analysis"]
@@ -118,8 +120,16 @@ def _dynamic(model, p, out) -> list[float]:
     # model's step time); with them the run's default, so that they are the run's table's
     from .outputs import HISTORY_FAMILIES
 
+    quiet = contextlib.nullcontext()
     if not any(n.split(".")[0] in HISTORY_FAMILIES for n in names):
         kw["samples_per_period"] = MIN_SAMPLES_PER_PERIOD
+        quiet = history_unused()  # (its coarseness is the study's choice, unread)
+    with quiet:
+        return _dynamic_runs(model, a, names, defs, kw, out, simulate, output_values)
+
+
+def _dynamic_runs(model, a, names, defs, kw, out, simulate, output_values) -> list[float]:
+    """The case's run (or, with ``analysis.settle``, its runs of growing length)."""
     settle = a.get("settle")
     if settle is None:
         res = simulate(model, duration=a.get("duration"), cycles=a.get("cycles"), **kw)
