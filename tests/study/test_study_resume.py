@@ -15,7 +15,7 @@ import tomli_w
 import xarray as xr
 from typer.testing import CliRunner
 
-from study_helpers import grid_study
+from study_helpers import grid_study, mc_study
 from torquesplit.cli import app
 from torquesplit.study import Study, StudyError, StudyInterrupted
 
@@ -297,6 +297,48 @@ def test_resume_accepts_a_changed_description(tmp_path, split_file):
     data["study"]["name"] = "another name"  # not wording only: still refused
     _write(tmp_path, data)
     with pytest.raises(StudyError, match=r"study\.name"):
+        Study(path).run(workers=1, out=out, resume=True)
+
+
+@pytest.mark.parametrize("sampling", ["random", "sobol"])
+def test_a_monte_carlo_is_extended_by_a_resume_with_more_samples(tmp_path, split_file,
+                                                                 sampling):
+    """Sample i is the same whatever the number drawn (random, Sobol): a resume with more
+    samples, or a tighter stopping rule, reuses the stored cases (a reviewer tightening
+    half_width was refused and had to recompute all); the results equal a study run at
+    that size from the start.  A Latin hypercube's points depend on its size: refused."""
+    data = mc_study(split_file, samples=4, sampling=sampling)
+    path = _write(tmp_path, data)
+    out = tmp_path / "out"
+    Study(path).run(workers=1, out=out, figures=False)
+    data["monte_carlo"]["samples"] = 8
+    _write(tmp_path, data)
+    ds = Study(path).run(workers=1, out=out, resume=True, figures=False)
+    with sqlite3.connect(out / "study.sqlite") as db:
+        assert [c for (c,) in db.execute("SELECT computed FROM runs ORDER BY run")] == [4, 4]
+    fresh = Study(_write(tmp_path, data, "fresh.toml")).run(workers=1, figures=False)
+    assert ds.sizes["sample"] == 8
+    timing = [v for v in fresh.data_vars if "time" in v and "simulated" not in v]
+    xr.testing.assert_equal(ds.drop_vars(timing).reset_coords(drop=True),
+                            fresh.drop_vars(timing).reset_coords(drop=True))
+    # and the stored study is now the extended one: a third resume computes nothing
+    Study(path).run(workers=1, out=out, resume=True, figures=False)
+    with sqlite3.connect(out / "study.sqlite") as db:
+        assert [c for (c,) in db.execute("SELECT computed FROM runs ORDER BY run")] == [4, 4, 0]
+    data["monte_carlo"]["seed"] = 8  # other samples: still a change
+    _write(tmp_path, data)
+    with pytest.raises(StudyError, match=r"monte_carlo\.seed"):
+        Study(path).run(workers=1, out=out, resume=True)
+
+
+def test_a_latin_hypercube_is_not_extended_by_a_resume(tmp_path, split_file):
+    data = mc_study(split_file, samples=4, sampling="latin_hypercube")
+    path = _write(tmp_path, data)
+    out = tmp_path / "out"
+    Study(path).run(workers=1, out=out, figures=False)
+    data["monte_carlo"]["samples"] = 8
+    _write(tmp_path, data)
+    with pytest.raises(StudyError, match=r"monte_carlo\.samples"):
         Study(path).run(workers=1, out=out, resume=True)
 
 

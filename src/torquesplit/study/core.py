@@ -402,11 +402,14 @@ def _open_folder(plan: Plan, out: Path, resume: bool, overwrite: bool,
     if store.is_new():
         store.write_meta(_provenance(plan))
         return store
+    meta = store.meta()
     try:
-        _check_same(plan, store.meta(), out, words)
+        _check_same(plan, meta, out, words)
     except StudyError:
         store.close()
         raise
+    if meta.get("study_hash") != plan.study_hash:  # a change a resume accepts: recorded
+        store.write_meta({**_provenance(plan), "created": meta.get("created")})
     return store
 
 
@@ -433,13 +436,24 @@ def _check_same(plan: Plan, meta: dict, out: Path, words: Words = API_WORDS) -> 
 
 #: fields of [study] that do not change any case: a resume accepts a change of them
 WORDING = ("description", "reference")
+#: fields of [monte_carlo] that say how many samples, not which: with random or Sobol
+#: sampling sample i is the same whatever their number, so a resume may extend (or end)
+#: the sample with another count or stopping rule (a reviewer tightening half_width had to
+#: recompute everything)
+EXTENT = ("samples", "stop")
+PREFIX_SAMPLINGS = ("random", "sobol")
 
 
 def _results_part(study: dict) -> dict:
-    """A canonical study without the fields that only describe it (:data:`WORDING`)."""
+    """A canonical study without the fields that only describe it (:data:`WORDING`) or,
+    for a Monte Carlo whose samples are a prefix of a longer draw, its extent
+    (:data:`EXTENT`)."""
     out = dict(study)
     if isinstance(out.get("study"), dict):
         out["study"] = {k: v for k, v in out["study"].items() if k not in WORDING}
+    mc = out.get("monte_carlo")
+    if isinstance(mc, dict) and mc.get("sampling", "random") in PREFIX_SAMPLINGS:
+        out["monte_carlo"] = {k: v for k, v in mc.items() if k not in EXTENT}
     return out
 
 
