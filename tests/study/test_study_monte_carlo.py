@@ -316,3 +316,23 @@ def test_a_stopping_half_width_takes_the_outputs_unit():
         Study(spec("1 kg")).plan()
     with pytest.raises(StudyError, match=r"half_width: write a plain number"):
         Study(spec("1 kN", output="load_sharing.cycle_peak")).plan()
+
+
+def test_a_shared_value_of_several_fields_needs_a_name(split_file):
+    """Its coordinate was named after its first field (gears.z2.errors.pitch for z2 and
+    z3), as a grid parameter of several fields would not be (a studies reviewer)."""
+    from torquesplit.errors import StudyError
+
+    data = mc_study(split_file, samples=4)
+    par = {"paths": ["gears.a.errors.eccentricity", "gears.b.errors.eccentricity"],
+           "distribution": "uniform", "low": "0 um", "high": "5 um", "shared": True}
+    data["monte_carlo"]["parameters"] = [par]
+    with pytest.raises(StudyError, match=r"parameters\.0\.name: a shared value that sets "
+                                         r"several fields needs a name"):
+        Study(data).plan()
+    par["name"] = "ecc_ab"
+    assert [p.name for p in Study(data).plan().design.parameters] == ["ecc_ab"]
+    par.pop("name")
+    par["shared"] = False  # one draw each: each its field's name
+    assert [p.name for p in Study(data).plan().design.parameters] == [
+        "gears.a.errors.eccentricity", "gears.b.errors.eccentricity"]

@@ -662,6 +662,10 @@ def _mc_parameter(t, raw: dict, model, where: str) -> list[tuple[Parameter, Rand
     fields = _target_fields(t, raw, where)
     P.check_unit(t.unit, fields[0].kind, f"{where}.unit")
     groups = [fields] if (t.shared or len(fields) == 1) else [[f] for f in fields]
+    if len(groups) == 1 and len(fields) > 1 and not t.name:
+        # (it was named after its first field: gears.z2.errors.pitch for z2 and z3)
+        raise StudyError(f"{where}.name", "a shared value that sets several fields needs a "
+                                          "name; add e.g. name = \"pitch_error\"")
     out = []
     for g in groups:
         if t.name and len(groups) == 1:
