@@ -290,3 +290,17 @@ def test_a_share_of_the_time_is_never_written_in_exponent_form():
 
     assert [_percent(f) for f in (1.0, 0.123, 0.0034, 1.2e-7)] == [
         "100 %", "12 %", "0.34 %", "0.000012 %"]
+
+
+def test_map_cells_print_the_digits_that_tell_them_apart():
+    """A reviewer's map labelled its cells '1.105' and '1.106' over a colour scale from
+    1.1051 to 1.1064: the labels hid the differences the colours showed."""
+    from torquesplit.study.figures import cell_digits
+
+    z = np.array([[1.10512, 1.10571], [1.10598, 1.10641]])
+    n = cell_digits(z)
+    labels = {f"{v:.{n}g}" for v in z.ravel()}
+    assert len(labels) == 4 and n == 5
+    assert cell_digits(np.array([[1.0, 2.0], [3.0, 4.0]])) == 4
+    assert cell_digits(np.array([[1.0, 1.0]])) == 4  # flat: nothing to resolve
+    assert cell_digits(np.array([[1.0, 1.0 + 1e-12]])) == 8  # (at most 8)

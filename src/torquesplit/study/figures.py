@@ -348,14 +348,28 @@ def _out_unit(var_or_name: str) -> tuple[str, float]:
 CELL_VALUES = 64
 
 
+def cell_digits(z) -> int:
+    """Significant digits that tell the cells apart: two more than the ratio of their
+    largest magnitude to their spread needs, 4 to 8 (a reviewer's map read '1.105' and
+    '1.106' over a colour scale from 1.1051 to 1.1064)."""
+    finite = np.asarray(z, dtype=float)[np.isfinite(z)]
+    if finite.size < 2:
+        return 4
+    span, size = float(np.ptp(finite)), float(np.abs(finite).max())
+    if span <= 0 or size <= 0:
+        return 4
+    return int(min(8, max(4, math.ceil(math.log10(size / span)) + 2)))
+
+
 def _cell_values(ax, x, y, z, mesh) -> None:
     """Each cell's value at its centre, dark on light colours and light on dark ones."""
+    digits = cell_digits(z)
     for (i, j), v in np.ndenumerate(z):
         if not np.isfinite(v):
             continue
         r, g, b, _ = mesh.cmap(mesh.norm(v))
         dark = 0.299 * r + 0.587 * g + 0.114 * b > 0.5
-        ax.text(x[j], y[i], f"{v:.4g}", ha="center", va="center", fontsize=6,
+        ax.text(x[j], y[i], f"{v:.{digits}g}", ha="center", va="center", fontsize=6,
                 color="k" if dark else "w")
 
 
