@@ -208,6 +208,7 @@ def test_tornado_draws_each_interval_on_its_own_bar():
         # the interval is centred on the end of its own bar
         centres = sorted(seg[:, 0].mean() for seg in c.errorbar.lines[2][0].get_segments())
         np.testing.assert_allclose(centres, sorted(vals[key]))
+    assert ax.get_legend().get_title().get_text() == "whiskers: 95 % bootstrap interval"
 
 
 def test_indices_over_fewer_rows_say_so(split_file, tmp_path):

@@ -301,7 +301,9 @@ def tornado_figure(ds, var: str) -> Figure:
     ax.set_xlabel("mu*: mean |output change| over each factor's range [" + unit + "]"
                   if key == "mu_star" else "Sobol index [-]")
     ax.grid(True, axis="x", alpha=0.3)
-    ax.legend(fontsize=8, loc="lower right")
+    # (the whiskers were in no legend: a reviewer)
+    ax.legend(fontsize=8, loc="lower right", title="whiskers: 95 % bootstrap interval",
+              title_fontsize=7)
     _suptitle(fig, f"{_title(ds)}: {ds[var].attrs.get('output', var)}")
     return fig
 
