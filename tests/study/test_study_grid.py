@@ -304,3 +304,19 @@ def test_map_cells_print_the_digits_that_tell_them_apart():
     assert cell_digits(np.array([[1.0, 2.0], [3.0, 4.0]])) == 4
     assert cell_digits(np.array([[1.0, 1.0]])) == 4  # flat: nothing to resolve
     assert cell_digits(np.array([[1.0, 1.0 + 1e-12]])) == 8  # (at most 8)
+
+
+def test_a_scale_parameter_names_what_it_scales_on_the_axis():
+    from torquesplit.study.figures import _param_label, path_pattern
+
+    paths = [f"gears.z{i}.support.shaft.bearing_stiffness" for i in range(1, 7)]
+    assert path_pattern(paths) == "gears.*.support.shaft.bearing_stiffness"
+    assert path_pattern(["meshes.a.backlash", "gears.b.errors.pitch"]) == \
+        "meshes.a.backlash and 1 more"
+    import json
+
+    import xarray as xr
+
+    ds = xr.Dataset(coords={"f": ("f", [0.5, 2.0], {"mode": "scale",
+                                                   "paths": json.dumps(paths)})})
+    assert _param_label(ds, "f") == "f (factor on gears.*.support.shaft.bearing_stiffness)"

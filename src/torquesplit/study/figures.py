@@ -418,10 +418,19 @@ def _log_axis(ds, name, set_scale) -> None:
         set_scale("log")
 
 
+def path_pattern(paths: list[str]) -> str:
+    """Paths of one shape as one pattern, '*' where they differ
+    (gears.*.support.shaft.bearing_stiffness); else the first and how many more."""
+    parts = [p.split(".") for p in paths]
+    if len(parts) > 1 and len({len(p) for p in parts}) == 1:
+        return ".".join(col[0] if len(set(col)) == 1 else "*" for col in zip(*parts))
+    return paths[0] + (f" and {len(paths) - 1} more" if len(paths) > 1 else "")
+
+
 def _param_label(ds, name) -> str:
     paths = json.loads(ds[name].attrs.get("paths", "[]"))
-    if ds[name].attrs.get("mode") == "scale":
-        return f"{name} (factor)"
+    if ds[name].attrs.get("mode") == "scale":  # (it said 'factor' of nothing: a reviewer)
+        return f"{name} (factor on {path_pattern(paths)})" if paths else f"{name} (factor)"
     if not paths or paths == [name]:
         return name
     if len(paths) <= 3:  # (a parameter set on several paths: name them, a reviewer's
