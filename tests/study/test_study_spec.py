@@ -196,8 +196,11 @@ def test_a_plan_says_what_it_will_run(split_file):
     many thousands of characters."""
     plan = Study(grid_study(split_file, [dict(K, num=3)])).plan()
     text = repr(plan)
-    assert text.startswith("<Plan of ") and "grid over" in text and "(3 = 3 cases)" in text
+    assert text.startswith("<Plan of ") and "grid over" in text and "(3 cases)" in text
     assert len(text) < 400
+    two = Study(grid_study(split_file, [dict(K, num=3), dict(K, path="meshes.b2.stiffness",
+                                                            num=2)])).plan()
+    assert "(3 x 2 = 6 cases)" in repr(two)  # (a one-axis grid said '3 = 3 cases')
 
 
 def test_a_phase_of_an_error_without_amplitude_is_said(split_file):

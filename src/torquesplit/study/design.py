@@ -151,10 +151,11 @@ class Plan:
 
     def __repr__(self) -> str:
         d = self.design
-        shape = " x ".join(map(str, d.shape)) if d.shape else str(d.n_cases)
+        shape = " x ".join(map(str, d.shape)) if len(d.shape) > 1 else ""
         params = ", ".join(p.name for p in d.parameters)
-        return (f"<Plan of {self.spec.study.name!r}: {d.kind} over {params} ({shape} = "
-                f"{d.n_cases} cases), {self.analysis.get('type', 'run')} of "
+        count = f"{shape} = {d.n_cases} cases" if shape else f"{d.n_cases} cases"
+        return (f"<Plan of {self.spec.study.name!r}: {d.kind} over {params} ({count}), "
+                f"{self.analysis.get('type', 'run')} of "
                 f"{self.model_source}, outputs {', '.join(self.outputs[:6])}"
                 f"{' ...' if len(self.outputs) > 6 else ''}>")
 
