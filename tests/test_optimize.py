@@ -199,6 +199,9 @@ def test_optimize_command_names_units_and_ratios(tmp_path):
     assert " arc s" in text and " N" in text
     assert re.search(r'\ny1 = "[0-9.e-]+ mm"\n', (tmp_path / "o" / "chosen.toml").read_text())
     assert f"evaluations stored in {tmp_path / 'evals.jsonl'}" in text
+    # stderr is no terminal here (a batch job's log): the progress is a line, not a bar
+    # that draws nothing (the last generation's at least)
+    assert "generation 1/1, 0:00:" in res.stderr
     # a second run does not write over the first one's front without --force
     before = (tmp_path / "o" / "pareto.csv").read_bytes()
     args = ["optimize", str(spec), "--population", "4", "--generations", "1", "--seed", "5",

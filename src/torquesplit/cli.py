@@ -686,6 +686,30 @@ def _render_stopped(res, saved, as_json: bool) -> None:
 _json_default = ux.json_default
 
 
+def _generation_lines():
+    """An optimisation's progress as lines where stderr is not a terminal (a batch job,
+    nohup: the bar draws nothing there), at most one per LOG_EVERY seconds and the last;
+    None on a terminal (the bar)."""
+    import time
+
+    from .study.cli import LOG_EVERY, _clock_text
+
+    con = ux._session.err_console
+    if con is None or getattr(con, "is_terminal", False):
+        return None
+    t0, last = time.monotonic(), [None]
+
+    def cb(generation, total):
+        now = time.monotonic()
+        if last[0] is not None and now - last[0] < LOG_EVERY and generation < total:
+            return
+        last[0] = now
+        con.print(f"generation {generation}/{total}, {_clock_text(now - t0)} elapsed",
+                  highlight=False, markup=False)
+
+    return cb
+
+
 def _with_progress(job, quiet: bool, label: str = "working"):
     """Run job(callback) with a progress bar on stderr (callback: fraction done)."""
     with ux.progress(label, quiet) as cb:
@@ -1452,7 +1476,8 @@ def optimize(
             res = _with_progress(lambda cb: run_optimization(
                 path, workers=workers, generations=generations, population=population,
                 seed=seed, scheduler=scheduler,
-                progress=None if cb is None else (lambda g, n: cb(g / max(n + 1, 1)))),
+                progress=(None if as_json else _generation_lines()) or (
+                    None if cb is None else (lambda g, n: cb(g / max(n + 1, 1))))),
                 as_json, "optimising")
             files = res.write(target)
         except _EXPECTED as exc:

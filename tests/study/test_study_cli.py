@@ -264,3 +264,24 @@ def test_the_eta_is_the_mean_rate_of_this_sessions_cases():
         assert str(col.render(bar.tasks[task])) in ("0:01:35", "0:01:34")
         bar.update(task, finish=None)
         assert str(col.render(bar.tasks[task])) == "-:--:--"
+
+
+def test_a_study_logged_to_a_file_says_its_progress_in_lines():
+    """Where stderr is not a terminal (a batch job, nohup) the bar drew nothing until the
+    end: a study of hours said nothing.  Lines: the first finished case, then at most
+    every LOG_EVERY seconds, and the last."""
+    from types import SimpleNamespace as P
+
+    from torquesplit.study.cli import LOG_EVERY, progress_lines
+
+    now = [0.0]
+    lines = []
+    cb = progress_lines(lines.append, clock=lambda: now[0])
+    cb(P(done=0, total=10, failed=0))  # the study starts
+    for t, done in ((5.0, 1), (10.0, 2), (5.0 + LOG_EVERY, 5), (40.0, 6), (100.0, 10)):
+        now[0] = t
+        cb(P(done=done, total=10, failed=1 if done > 4 else 0))
+    assert lines == ["cases 1/10 (0 not ok), 0:00:05 elapsed, about 0:00:45 left",
+                     f"cases 5/10 (1 not ok), 0:00:{5 + int(LOG_EVERY)} elapsed, about "
+                     f"0:00:{5 + int(LOG_EVERY)} left",
+                     "cases 10/10 (1 not ok), 0:01:40 elapsed"]

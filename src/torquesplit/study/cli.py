@@ -243,9 +243,7 @@ def _eta_column():
             finish = task.fields.get("finish")
             if finish is None:
                 return Text("-:--:--", style="progress.remaining")
-            left = int(round(max(0.0, finish - time.monotonic())))
-            return Text(f"{left // 3600}:{left // 60 % 60:02d}:{left % 60:02d}",
-                        style="progress.remaining")
+            return Text(_clock_text(finish - time.monotonic()), style="progress.remaining")
 
     return Eta()
 
@@ -260,10 +258,51 @@ def eta_finish(start: tuple[float, int], now: float, done: int, total: int):
     return now + (total - done) * (now - t0) / (done - done0)
 
 
+LOG_EVERY = 30.0
+"""Seconds between the progress lines of a study whose stderr is not a terminal."""
+
+
+def progress_lines(write, clock=None):
+    """A study's progress as plain lines for a log (stderr not a terminal: a batch job, a
+    cluster, nohup), where a bar draws nothing until the end: one when the first case
+    finishes, then at most every LOG_EVERY seconds, and the last.  ``write(text)``."""
+    import time
+
+    clock = clock or time.monotonic
+    state = {"start": None, "last": None}
+
+    def cb(p):
+        now = clock()
+        if state["start"] is None:
+            state["start"] = (now, p.done)
+            return
+        due = state["last"] is None or now - state["last"] >= LOG_EVERY or p.done >= p.total
+        if not due or p.done <= state["start"][1]:
+            return
+        state["last"] = now
+        finish = eta_finish(state["start"], now, p.done, p.total)
+        left = "" if finish is None or p.done >= p.total else \
+            f", about {_clock_text(finish - now)} left"
+        write(f"cases {p.done}/{p.total} ({p.failed} not ok), "
+              f"{_clock_text(now - state['start'][0])} elapsed{left}")
+
+    return cb
+
+
+def _clock_text(seconds: float) -> str:
+    s = int(round(max(0.0, seconds)))
+    return f"{s // 3600}:{s // 60 % 60:02d}:{s % 60:02d}"
+
+
 def _with_bar(job, total: int, quiet: bool):
     if quiet:
         return job(None)
     import time
+
+    if not getattr(_ui().err_console, "is_terminal", False):
+        con = _ui().err_console
+        return job(progress_lines(lambda text: con.print(text, highlight=False,
+                                                          markup=False)))
 
     from rich.progress import (BarColumn, MofNCompleteColumn, Progress, TextColumn,
                                TimeElapsedColumn)
