@@ -76,9 +76,12 @@ class ModelError(TorquesplitError, ValueError):
     (:func:`clip_message`).
     """
 
-    def __init__(self, issues, source: str | None = None):
+    def __init__(self, issues, source: str | None = None, lines=None):
         if isinstance(issues, str):
             issues = [("", issues)]
+        #: field path -> line of the source file (:func:`torquesplit.model.locate.
+        #: key_lines`), where the source is a file: 'drive.toml:42: gears.a.module: ...'
+        self.lines = lines
         self.issues = []
         seen = set()
         for loc, msg in issues:  # one problem found twice at one place is said once
@@ -93,18 +96,41 @@ class ModelError(TorquesplitError, ValueError):
         groups: dict[str, list[tuple[str, str]]] = {}
         for loc, msg in self.issues:
             groups.setdefault(_PAIR_PREFIX.sub("", msg) if loc else msg, []).append((loc, msg))
-        where = f"{clip_text(source, 2 * QUOTE_LIMIT)}: " if source else ""
-        lines = []
+        def where(loc: str) -> str:
+            if not source:
+                return ""
+            line = None
+            if lines and loc:
+                from .model.locate import line_of
+
+                line = line_of(lines, loc)
+            return clip_text(source, 2 * QUOTE_LIMIT) + (f":{line}" if line else "") + ": "
+
+        text = []
         for core, members in groups.items():
             if len(members) == 1:
                 loc, msg = members[0]
-                lines.append(where + (f"{loc}: " if loc else "") + msg)
+                text.append(where(loc) + (f"{loc}: " if loc else "") + msg)
                 continue
             named = [loc for loc, _ in members if loc]
+            first = named[0] if named else ""
             if len(named) > 10:
                 named = named[:9] + [f"{len(named) - 9} more"]
-            lines.append(where + (f"{', '.join(named)}: " if named else "") + core)
-        super().__init__("\n".join(lines))
+            text.append(where(first) + (f"{', '.join(named)}: " if named else "") + core)
+        super().__init__("\n".join(text))
+
+    def located(self, text: str) -> "ModelError":
+        """This error with the line of each field in ``text``, its source file's TOML
+        (unchanged where the text cannot be scanned)."""
+        from .model.locate import key_lines
+
+        try:
+            lines = key_lines(text)
+        except Exception:  # noqa: BLE001 - a locator for messages: never hide the error
+            return self
+        out = ModelError(self.issues, self.source, lines=lines)
+        out.__cause__, out.__suppress_context__ = self.__cause__, True
+        return out
 
 
 class OptionError(TorquesplitError, ValueError):

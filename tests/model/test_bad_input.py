@@ -393,7 +393,9 @@ def test_file_errors_name_the_file_and_field(tmp_path):
     path.write_text(PAIR_TOML.replace('angle = "0 deg"', 'angle = "0 kg"'))
     with pytest.raises(torquesplit.ModelError) as info:
         torquesplit.load_model(path)
-    assert str(info.value).startswith(f"{path}: gears.wheel.place.angle: '0 kg' is not an angle")
+    line = path.read_text().splitlines().index('place = {from_gear = "pinion", angle = "0 kg"}')
+    assert str(info.value).startswith(f"{path}:{line + 1}: gears.wheel.place.angle: '0 kg' is "
+                                      f"not an angle")
 
 
 def test_every_problem_is_reported_at_once():
