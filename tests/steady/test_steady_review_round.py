@@ -233,3 +233,46 @@ def test_a_steady_state_that_fails_names_the_spline_friction_where_there_is_some
     assert _friction_hint(load_model("ji_li_mill_drive")) == ""
     dry = dong.with_changes({f"splines.{n}.friction_coefficient": 0.0 for n in rubbing})
     assert _friction_hint(dry) == ""
+
+
+def test_a_sweeps_largest_dynamic_factors_are_printed_to_the_digits_that_hold():
+    """The tutorial's sweep printed DF 2.89820 where steady, at that speed, gave 2.90252
+    with its own step and 2.89433 at a quarter of it.  Each largest stable DF is solved
+    again at its speed with half the sweep's RK4 step (an independent steady solve, not
+    the continuation): the JSON gives that value and the digits of the sweep's it
+    confirms, the table prints those digits."""
+    import json
+    import math
+
+    from typer.testing import CliRunner
+
+    from torquesplit import load_model
+    from torquesplit.cli import app
+    from torquesplit.convergence import agreeing_digits
+    from torquesplit.steady.api import steady_state
+    from torquesplit.steady.cli import _held_text
+
+    args = ["sweep-speed", "ji_li_mill_drive", "--keep", "stage1", "--from", "700 rpm",
+            "--to", "760 rpm", "--points", "4", "--no-stability", "--steps-per-cycle", "40"]
+    r = CliRunner().invoke(app, args + ["--json"])
+    assert r.exit_code == 0, r.output
+    out = json.loads(r.stdout)
+    m11 = out["max_dynamic_factor"]["m11"]
+    rpm = out["max_dynamic_factor_speed_rpm"]["m11"]
+    half = out["max_dynamic_factor_at_half_step"]["m11"]
+    assert out["max_dynamic_factor_digits"]["m11"] == agreeing_digits(m11, half)
+    # the same by hand: steady at that speed with 80 steps per cycle (the Ji & Li tables
+    # jump: the check takes 4x their points, as --check-step does)
+    model = load_model("ji_li_mill_drive")
+    n = model.analysis.table_points or 65536
+    fine = load_model("ji_li_mill_drive", changes={"analysis.table_points": 4 * n})
+    st = steady_state(fine, speed=f"{rpm!r} rpm", keep="stage1", steps_per_cycle=80,
+                      stability=False, check=False)
+    by_hand = {r.mesh: r.dynamic_factor for r in st.mesh_table()}["m11"]
+    assert math.isclose(half, by_hand, rel_tol=1e-6), (half, by_hand)
+    text = CliRunner().invoke(app, args).output
+    row = next(line for line in text.splitlines() if line.startswith("│ m11"))
+    assert _held_text(m11, out["max_dynamic_factor_digits"]["m11"]) in row
+    assert "DF to the digits that hold" in text
+    assert _held_text(2.89820, 2) == "2.9" and _held_text(1.08, 5) == "1.0800"
+    assert _held_text(1.15554, 9) == "1.15554"  # (at most 6)
