@@ -322,3 +322,15 @@ def test_a_diverged_run_prints_no_coefficients_but_its_likely_cause(tmp_path):
     # check refuses the model outright: no run of it can succeed
     one_line_error(runner.invoke(app, ["check", str(model)]),
                    "beyond what any run accepts", "check the stiffness values")
+
+
+def test_a_run_shorter_than_a_mesh_cycle_prints_its_tables_without_a_traceback(tmp_path):
+    """A run too short for a whole cycle (its settle time -inf) crashed after its tables
+    on the bearing forces, and --json printed nothing (a fuzzer)."""
+    res = CliRunner().invoke(app, ["run", "ji_li_mill_drive", "--duration", "0.002 s",
+                                   "--json"])
+    assert res.exit_code == 0, res.output
+    out = json.loads(res.stdout)
+    assert out["bearing_forces_N"] == [] and out["success"]
+    res = CliRunner().invoke(app, ["run", "ji_li_mill_drive", "--duration", "0.002 s"])
+    assert res.exit_code == 0 and "Traceback" not in res.output

@@ -534,7 +534,8 @@ class Results:
         missed, as :func:`~torquesplit.results.plausibility.coarse_history` says for the
         meshes; the means are not affected.  Forces are in the frame of the support (a
         turning carrier's for planets), which ``frame`` names: ``"housing"`` or
-        ``"carrier NAME (turning)"``."""
+        ``"carrier NAME (turning)"``.  A run without a whole cycle of some mesh has no
+        settled part (its settle time is -inf): no rows."""
         s = self.solution
         if s is None or not s.history_t.size:
             return []
@@ -547,6 +548,11 @@ class Results:
             raise OptionError(f"start_time must be a time in seconds (a number), got "
                               f"{start_time!r}; give e.g. res.metrics().settling.start_time")
         end = float(s.history_t[-1])
+        if start_time == -math.inf and not (self.periodic and self.period):
+            # the settle time of a run shorter than a whole cycle of some mesh: it has no
+            # settled part, so no settled bearing forces (run crashed there after its
+            # tables, losing a --json output)
+            return []
         if (start_time is not None and not (self.periodic and self.period)
                 and not (math.isfinite(start_time) and start_time < end)):
             # (it took the whole history, start-up included, without a word; a periodic
