@@ -276,3 +276,40 @@ def test_a_sweeps_largest_dynamic_factors_are_printed_to_the_digits_that_hold():
     assert "DF to the digits that hold" in text
     assert _held_text(2.89820, 2) == "2.9" and _held_text(1.08, 5) == "1.0800"
     assert _held_text(1.15554, 9) == "1.15554"  # (at most 6)
+
+
+def test_a_falling_speed_sweep_stays_in_its_range_and_names_its_fold(tmp_path):
+    """--from above --to: the curve turned at a fold and ran to 958,635 rpm (no upper
+    guard), and a step that overshot the end below read as 'left the range backwards'
+    (a fuzzer).  A linear model sweeps down as it sweeps up."""
+    import json
+
+    from typer.testing import CliRunner
+
+    from tests.model_texts import SPUR_PAIR
+    from torquesplit.cli import app
+
+    smooth = 'stiffness = {method = "fourier", mean = "4e8 N/m", cos = ["0.2e8 N/m"], sin = []}'
+    linear = tmp_path / "linear.toml"
+    linear.write_text(SPUR_PAIR.replace('stiffness = "4e8 N/m"', smooth))
+    wave = 'stiffness = {method = "constant", value = "4e8 N/m", peak_to_peak = 0.2}'
+    runs = {}
+    for a, b in (("100 rpm", "3000 rpm"), ("3000 rpm", "100 rpm")):
+        r = CliRunner().invoke(app, ["sweep-speed", str(linear), "--from", a, "--to", b,
+                                     "--points", "5", "--no-stability", "--json"])
+        assert r.exit_code == 0, r.output
+        runs[a] = json.loads(r.stdout)
+        assert runs[a]["complete"], runs[a]["message"]
+    up, down = runs["100 rpm"], runs["3000 rpm"]
+    assert down["max_dynamic_factor"]["m"] == pytest.approx(up["max_dynamic_factor"]["m"],
+                                                            rel=2e-2)
+    rattle = tmp_path / "rattle.toml"
+    rattle.write_text(SPUR_PAIR.replace('stiffness = "4e8 N/m"', wave + '\nbacklash = "100 um"'))
+    r = CliRunner().invoke(app, ["sweep-speed", str(rattle), "--from", "3000 rpm", "--to",
+                                 "500 rpm", "--no-stability", "--out", str(tmp_path / "d.nc")])
+    import xarray as xr
+
+    rpm = xr.load_dataset(tmp_path / "d.nc")["speed_rpm"].values
+    assert rpm.max() <= 3000 + 0.5 * 2500 + 1e-6  # (it ran to 958,635 rpm)
+    if r.exit_code != 0:  # a fold turned the branch back: said, with the remedy
+        assert "turned back at a fold" in " ".join(r.output.split())

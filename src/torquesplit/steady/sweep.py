@@ -329,8 +329,19 @@ class Continuation:
                     folds.append((float(s_f), "turns back" if t[n] * direction > 0 else "turns on"))
                 z, t = zc, t_new
                 h = min(max_step, h * (1.5 if its <= 3 else (1.0 if its <= 5 else 0.6)))
-                if zc[n] < self.lowest_speed(s0, s1):
+                # backwards out of the range: below it on a rising sweep, above it on a
+                # falling one (a falling sweep had no upper guard: it turned at a fold and
+                # ran to 958,635 rpm; and its end, overshot below, read as 'backwards')
+                if (zc[n] < self.lowest_speed(s0, s1) if direction > 0
+                        else zc[n] > max(s0, s1) + 0.5 * abs(s1 - s0)):
                     message = "the branch left the speed range backwards; curve kept."
+                    if folds:  # (at a fold the response jumps: the rest of the range is
+                        # on another branch, which a sweep from the other end follows)
+                        message = (f"the branch turned back at a fold near speed factor "
+                                   f"{folds[-1][0]:.6g} (a jump: beyond it the response is "
+                                   f"on another branch) and left the speed range; curve "
+                                   f"kept: a sweep from the other end of the range follows "
+                                   f"the branch there")
                     complete = False
                     break
             else:
