@@ -106,6 +106,9 @@ def test_parse_vary_refuses_a_step_for_the_count():
         parse_vary("meshes.a1.transmission_error.constant=0:40:2.5um")
     with pytest.raises(ValueError, match="number of points"):
         parse_vary("a.b=0:40:0um")
+    for empty in ("=0:40:3um", ",=0:40:3um", " =0:40:3um"):  # (an IndexError: a fuzzer)
+        with pytest.raises(ValueError, match="names no field before '='"):
+            parse_vary(empty)
     # a pattern is named by itself (sweep has no --name): its last segment alone lost
     # which fields it sets; its folder writes '*' as 'all'
     assert parse_vary("gears.*.errors.eccentricity=0:40:2um")["name"] == \

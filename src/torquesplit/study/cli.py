@@ -643,6 +643,9 @@ def parse_vary(text: str) -> dict:
         raise ValueError(f"--vary {text!r}: {spec!r} is not START:STOP:NUM[unit]; write e.g. "
                          f"130:400:28mm or '2e8 N/m:6e8 N/m:9'")
     paths = [p.strip() for p in paths_text.split(",") if p.strip()]
+    if not paths:  # ('=0:40:3um': an IndexError)
+        raise ValueError(f"--vary {text!r} names no field before '='; write e.g. --vary "
+                         f"gears.pinion.errors.eccentricity={spec}")
     table: dict = {}
     if len(paths) == 1:
         table["path"] = paths[0]
