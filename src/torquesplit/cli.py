@@ -175,6 +175,10 @@ def _one_run_length(duration, cycles) -> None:
                           "length; give only one of them")
 
 
+MAX_MESH_POINTS = 65536
+"""Most samples per mesh cycle 'mesh' computes (the finest table a shipped example uses)."""
+
+
 def _at_most(value, most, option: str) -> None:
     if value is not None and value > most:
         raise OptionError(f"{option} {value} is more than {most}; give at most {most}")
@@ -1039,6 +1043,9 @@ def mesh(
     try:
         opts = _option_errors()
         opts(_at_least, points, 16, "--points", "256")
+        # (a fuzzer's 100,000,000 was killed for memory without a word; 3,000,000 took
+        # 18 GB: the methods keep several arrays per sample)
+        opts(_at_most, points, MAX_MESH_POINTS, "--points")
         opts(_check_figure_file, plot, "--plot", force)
         opts.raise_any(model, assign)
         # (the advice to use the modifications in a dynamic run through 'ltca' is not

@@ -626,3 +626,22 @@ def test_a_refused_gear_is_said_once_not_again_for_each_gear_placed_from_it():
     with pytest.raises(torquesplit.ModelError) as err:
         torquesplit.load_model(data)
     assert [loc for loc, _ in err.value.issues] == ["gears.pinion.profile_shift"]
+
+
+def test_a_model_name_of_a_book_is_refused_and_mesh_points_are_bounded():
+    """A 100,000-character model name took 'check' 62 s to print (1,000,000: over 300 s);
+    'mesh --points 100000000' was killed for memory without a word (a fuzzer)."""
+    from typer.testing import CliRunner
+
+    from torquesplit.cli import MAX_MESH_POINTS, app
+
+    data = pair_dict()
+    data["model"]["name"] = "x" * 100_000
+    with pytest.raises(torquesplit.ModelError, match=r"model\.name: is 100000 characters "
+                                                     r"long; give at most 200"):
+        load(data)
+    data["model"]["name"] = "x" * 200
+    load(data)
+    res = CliRunner().invoke(app, ["mesh", "ji_li_mill_drive", "--pair", "m11", "--points",
+                                   str(MAX_MESH_POINTS + 1)])
+    assert res.exit_code == 2 and f"give at most {MAX_MESH_POINTS}" in res.output

@@ -260,6 +260,10 @@ def _message(err: dict, parts: list[str], written=None) -> str:
         # a bound other than zero is in SI units, as the converted value
         zero = ctx.get("gt", ctx.get("ge", ctx.get("lt", ctx.get("le")))) == 0
         got = _short(written) if zero else f"{_short(written)} (= {got} in SI units)"
+    if kind == "string_too_long":  # (a 100,000-character name took check 62 s to print)
+        most = ctx.get("max_length")
+        return (f"is {len(value) if isinstance(value, str) else '?'} characters long; give "
+                f"at most {most} (a short name: the description may say more)")
     if kind == "extra_forbidden":
         name, section = (parts[-1], parts[:-1]) if parts else ("", [])
         fields = _fields_at(section)

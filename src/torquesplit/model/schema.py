@@ -873,7 +873,8 @@ class AcceptedWarning(Strict):
 class ModelInfo(Strict):
     """Name and source of the model."""
 
-    name: str = Field(description="Short name of the model.")
+    name: str = Field(max_length=200, description=(
+        "Short name of the model (at most 200 characters)."))
     description: str = Field("", description="One-line description.")
     reference: str = Field("", description="Source of the data (paper, drawing).")
     accepted_warnings: tuple[AcceptedWarning, ...] = Field((), description=(
