@@ -125,3 +125,17 @@ def test_a_researchers_session():
     import inspect
 
     assert "analysis" in inspect.signature(torquesplit.run_study).parameters
+
+
+def test_an_unknown_example_and_history_dofs_of_the_wrong_kind_are_torquesplit_errors():
+    """example_path('nope') raised a bare FileNotFoundError and history_dofs=5 'int object
+    is not iterable' (a fuzzer)."""
+    from torquesplit.errors import NoSuchExampleError, TorquesplitError
+
+    with pytest.raises(NoSuchExampleError, match="no example named 'nope'; use one of"):
+        torquesplit.example_path("nope")
+    assert issubclass(NoSuchExampleError, FileNotFoundError)  # (as it was)
+    with pytest.raises(OptionTypeError, match="history_dofs must be DOF names"):
+        torquesplit.simulate(EXAMPLE, cycles=5, history_dofs=5)
+    with pytest.raises(TorquesplitError):
+        torquesplit.simulate(EXAMPLE, cycles=5, history_dofs=[1, 2])

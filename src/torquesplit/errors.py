@@ -141,6 +141,13 @@ class OptionTypeError(OptionError, TypeError):
     """A function argument of the wrong kind (a ``progress`` that is not callable)."""
 
 
+class NoSuchExampleError(OptionError, FileNotFoundError):
+    """No shipped example of that name (still a ``FileNotFoundError``, as it was)."""
+
+    def __str__(self) -> str:  # (as OutputError: no "[Errno ...]")
+        return str(self.args[0]) if self.args else ""
+
+
 class OutputError(TorquesplitError, OSError):
     """Results cannot be written where asked: no such folder, a folder, a file that
     exists (and overwriting was not asked for), another run writing it, a full disk."""

@@ -384,6 +384,14 @@ def prepare_run(
     track = [names.index(m) for m in mesh_names]
     hist_el = history_elements(structure, mesh_names)
     # one DOF name, not its letters ("unknown dof 'z'" for "z1.theta")
+    if not (history_dofs is None or isinstance(history_dofs, str) or (
+            isinstance(history_dofs, (list, tuple)) and all(isinstance(d, str)
+                                                            for d in history_dofs))):
+        from .errors import OptionTypeError
+
+        # (5 raised "TypeError: 'int' object is not iterable")
+        raise OptionTypeError(f"history_dofs must be DOF names, e.g. ['z1.theta', 'z1.x'] "
+                              f"(structure.dof_names lists them), got {history_dofs!r}")
     hist_dofs = [history_dofs] if isinstance(history_dofs, str) else list(history_dofs or [])
     planned = step = None
     if method == "rk4":  # (the fixed step: the history's default and the cost use it)

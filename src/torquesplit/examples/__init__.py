@@ -93,15 +93,18 @@ def example_path(name: str) -> Path:
 
     Raises
     ------
-    FileNotFoundError
-        No example of that name (the message lists them).
+    NoSuchExampleError
+        No example of that name (the message lists them); a torquesplit error and a
+        ``FileNotFoundError``.
     """
+    from ..errors import NoSuchExampleError
+
     stem, note = current_name(name)
     if note:
         warn_user(note, FutureWarning)
     path = Path(str(resources.files(__name__) / f"{stem}.toml"))
     if not path.exists():
-        raise FileNotFoundError(
+        raise NoSuchExampleError(
             f"no example named {name!r}; use one of {', '.join(example_names())}")
     return path
 
