@@ -139,3 +139,18 @@ def test_an_unknown_example_and_history_dofs_of_the_wrong_kind_are_torquesplit_e
         torquesplit.simulate(EXAMPLE, cycles=5, history_dofs=5)
     with pytest.raises(TorquesplitError):
         torquesplit.simulate(EXAMPLE, cycles=5, history_dofs=[1, 2])
+
+
+def test_empty_change_paths_python_wording_and_table_points_of_assemble():
+    """with_changes({'': 3}) said 'unknown field' of none, changes=['x'] spoke of --set,
+    assemble(n_table=0) was taken (a fuzzer)."""
+    m = torquesplit.load_model(EXAMPLE)
+    for path in ("", "meshes..damping_ratio"):
+        with pytest.raises(ModelError, match="an empty field path, or an empty part"):
+            m.with_changes({path: 3})
+    with pytest.raises(OptionTypeError, match="changes: 'x' is not 'PATH=VALUE'") as exc:
+        torquesplit.load_model(EXAMPLE, changes=["x"])
+    assert "--set" not in str(exc.value)
+    with pytest.raises(OptionError, match="n_table must be a whole number of table points"):
+        torquesplit.assemble(m, n_table=0)
+    assert torquesplit.assemble(m, n_table=16).n_table == 16

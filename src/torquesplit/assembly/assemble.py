@@ -144,6 +144,14 @@ def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None
     :class:`Model` or what :func:`~torquesplit.load_model` reads); a refusal names the
     field as the user wrote it (a ``[[planetary]]`` stage's, not the element it
     generated), as ``torquesplit check`` does."""
+    if n_table is not None and not (isinstance(n_table, (int, np.integer))
+                                    and not isinstance(n_table, bool) and n_table >= 16):
+        from ..errors import OptionError
+
+        # (0 was taken: tables of no phase)
+        raise OptionError(f"n_table must be a whole number of table points >= 16, got "
+                          f"{n_table!r}; give e.g. n_table=256 (or leave it out: the "
+                          f"model's analysis.table_points)")
     if not isinstance(model, Model):
         from ..model.io import load_model
 

@@ -106,6 +106,11 @@ def changes_mapping(changes) -> dict:
             return dict(changes)
         got = f"a key {_short(bad[0])} ({type(bad[0]).__name__})"
     elif isinstance(changes, (list, tuple)) and all(isinstance(c, str) for c in changes):
+        bad = [c for c in changes if "=" not in c]
+        if bad:  # (in Python: not the command line's '--set' words)
+            raise OptionTypeError(f"changes: {_short(bad[0])} is not 'PATH=VALUE'; give e.g. "
+                                  f"'shafts.drive1.diameter=250 mm', or a mapping "
+                                  f"{{\"shafts.drive1.diameter\": \"250 mm\"}}")
         return dict(parse_assignment(c) for c in changes)
     elif isinstance(changes, (list, tuple)) and all(
             isinstance(c, (list, tuple)) and len(c) == 2 and isinstance(c[0], str)

@@ -37,6 +37,9 @@ def set_parameter(data: dict, path: str, value: Any) -> dict:
         raise ModelError([(path, f"a list item is addressed with a dot and its index, not "
                                  f"brackets; write {dotted}")])
     parts = path.split(".")
+    if not all(p.strip() for p in parts):  # ('' said 'unknown field' of no field)
+        raise ModelError([(path, "an empty field path, or an empty part of one ('a..b'); "
+                                 "give e.g. meshes.m11.damping_ratio")])
     out = _copy_node(data)
     node = out
     for i, key in enumerate(parts[:-1]):
