@@ -138,6 +138,14 @@ def test_bounds_are_built_before_anything_runs(change, location):
     ({"objectives": [{"output": "ltca.L68"}]}, "objectives[0].output"),
     ({"variables": [{"path": "gears.L6.modifications.topological.y1", "lower": "1 mm",
                      "upper": "0 mm"}]}, "variables[0].upper"),
+    # (a fuzzer) a mesh's name mistyped created a phantom mesh ('meshes.mm.gears:
+    # required'); a whole-number field was found out after every design was evaluated
+    ({"variables": [{"path": "meshes.mm.damping_ratio", "lower": 0.01, "upper": 0.1}]},
+     "variables[0].path"),
+    ({"variables": [{"path": "gears.L6.face_width", "lower": "20 mm", "upper": "30 mm",
+                     "also": ["gears.L9.face_width"]}]}, "variables[0].also"),
+    ({"variables": [{"path": "gears.L6.teeth", "lower": 15, "upper": 25}]},
+     "variables[0].path"),
 ])
 def test_bad_optimisation_files_name_the_field(change, location):
     d = spec_dict()

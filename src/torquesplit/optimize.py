@@ -335,6 +335,7 @@ def read_spec(source) -> OptimizationSpec:
         unknown = sorted(set(v) - {"path", "lower", "upper", "also"})
         if unknown:
             issues.append((f"{where}.{unknown[0]}", "unknown field; use path, lower, upper, also"))
+        issues += _variable_path_issues(model_data, v, where)
         unit, scale = _unit_of((v["lower"], v["upper"]), f"{where}.lower", kind)
         variables.append(Variable(str(v["path"]), lo, hi, tuple(v.get("also", ())), unit,
                                   scale))
@@ -398,6 +399,40 @@ def read_spec(source) -> OptimizationSpec:
                             fixed=dict(data.get("set", {})), variables=tuple(variables),
                             objectives=tuple(objectives), constraints=tuple(constraints),
                             store=store_path, base_dir=base, **kw)
+
+
+#: model sections whose tables are named by the user (gears.NAME...): a variable's path
+#: must name one that exists (a typo created a phantom mesh: 'meshes.mm.gears: required')
+NAMED_SECTIONS = ("gears", "bodies", "shafts", "meshes", "splines", "drives", "loads")
+
+
+def _variable_path_issues(model_data: dict, v: dict, where: str) -> list[tuple[str, str]]:
+    """Problems of a variable's path and its ``also`` paths found before any design is
+    evaluated: a gear, mesh... that the model does not have, and a field that takes a
+    whole number (teeth: a fuzzer's variable evaluated every design, then said 'no
+    feasible design ... must be a whole number; widen the bounds')."""
+    from .study.paths import schema_field
+
+    out = []
+    for key, path in [("path", v["path"])] + [("also", p) for p in v.get("also", ())]:
+        parts = str(path).split(".")
+        section = model_data.get(parts[0])
+        if (len(parts) > 2 and parts[0] in NAMED_SECTIONS and isinstance(section, dict)
+                and parts[1] not in section):
+            known = ", ".join(sorted(section)) or "none"
+            out.append((f"{where}.{key}", f"{'.'.join(parts[:2])!r} does not exist (known "
+                                          f"here: {known}); check the path"))
+            continue
+        try:
+            integer = schema_field(str(path), "path").integer
+        except (TorquesplitError, ValueError, TypeError):
+            continue  # (not a schema field: refused by name when the model is built)
+        if integer:
+            out.append((f"{where}.{key}", f"{path} takes a whole number, and an optimisation "
+                                          f"varies continuous values; optimise a continuous "
+                                          f"field, or compare the whole numbers in a study "
+                                          f"(a grid, docs/studies.md)"))
+    return out
 
 
 # ========================================================================= evaluation

@@ -336,3 +336,20 @@ def test_a_shared_value_of_several_fields_needs_a_name(split_file):
     par["shared"] = False  # one draw each: each its field's name
     assert [p.name for p in Study(data).plan().design.parameters] == [
         "gears.a.errors.eccentricity", "gears.b.errors.eccentricity"]
+
+
+def test_a_whole_number_field_is_recorded_as_the_case_ran_it(tmp_path):
+    """A uniform draw of teeth ran each case with the rounded value but recorded the draw
+    (20.236 teeth) in results.csv and .nc (a fuzzer)."""
+    from tests.model_texts import SPUR_PAIR
+
+    pair = tmp_path / "pair.toml"
+    pair.write_text(SPUR_PAIR)
+    data = mc_study(pair, samples=6)
+    data["monte_carlo"]["parameters"] = [
+        {"path": "gears.pinion.teeth", "distribution": "uniform", "low": 18, "high": 22}]
+    plan = Study(data).plan()
+    drawn = plan.design.values[:, 0]
+    assert (drawn == np.round(drawn)).all() and len(set(drawn)) > 1
+    assert all(plan.design.parameters[0].overrides(v)["gears.pinion.teeth"] == v
+               for v in drawn)

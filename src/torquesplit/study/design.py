@@ -654,6 +654,10 @@ def _monte_carlo(spec: StudySpec, raw: dict, model) -> Design:
     n = mc.samples if mc.samples is not None else mc.stop.max_samples
     u = uniform_points(mc.sampling, n, len(params), mc.seed)
     values = np.column_stack([transform(rv, u[:, j]) for j, rv in enumerate(rvs)])
+    for j, p in enumerate(params):  # a whole-number field (teeth): the value its case runs
+        # with, which the results record (they recorded the draw, 20.236 teeth)
+        if p.mode == "set" and p.fields[0].integer:
+            values[:, j] = np.round(values[:, j])
     return Design("monte_carlo", params, values, extra={"random_variables": rvs})
 
 
