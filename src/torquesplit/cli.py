@@ -1075,8 +1075,9 @@ def mesh(
                                              method=f"model file ({label})")
         g = m.gears[mk.driver]
         row = "model file" if spec.method != "ltca" else f"model file ({label})"
-        cmp = compare_methods(mk.geometry, points, young_modulus=g.youngs_modulus,
-                              poisson_ratio=g.poisson_ratio, extra={row: model_k})
+        with ux.interruptible():  # (Ctrl-C exited 130 without a word)
+            cmp = compare_methods(mk.geometry, points, young_modulus=g.youngs_modulus,
+                                  poisson_ratio=g.poisson_ratio, extra={row: model_k})
     except _EXPECTED as exc:
         _fail(exc)
         return

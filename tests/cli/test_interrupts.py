@@ -214,3 +214,45 @@ def test_a_sweep_that_stopped_says_its_largest_factor_is_of_the_part_computed(mo
     text = " ".join(res.output.split())
     assert "over the part computed (300-" in text and "of 300 rpm-1500 rpm: the sweep stopped" \
         in text, text
+
+
+def test_ctrl_c_while_the_command_line_loads_is_one_line(monkeypatch, capsys):
+    """Ctrl-C in the first half second (numpy, numba, pydantic loading) printed a 30-line
+    traceback from inside an import (a fuzzer); the entry point says it in one line."""
+    import sys
+    import types
+
+    from torquesplit import _launch
+
+    class Loading(types.ModuleType):
+        def __getattr__(self, name):
+            raise KeyboardInterrupt
+
+    monkeypatch.setitem(sys.modules, "torquesplit.cli", Loading("torquesplit.cli"))
+    with pytest.raises(SystemExit) as exc:
+        _launch.main()
+    assert exc.value.code == 130
+    assert capsys.readouterr().err == "interrupted; nothing written\n"
+
+
+@pytest.mark.parametrize("args, target", [
+    (["steady", "ji_li_mill_drive", "--keep", "stage1"], "steady"),
+    (["mesh", "ji_li_mill_drive", "--pair", "m11"], "mesh"),
+])
+def test_ctrl_c_in_steady_and_mesh_says_so(args, target, monkeypatch):
+    """Both exited 130 without a word (stderr a file: a fuzzer)."""
+    from typer.testing import CliRunner
+
+    import torquesplit.gears.stiffness as stiffness
+    import torquesplit.steady.api as api
+    from torquesplit.cli import app
+
+    def interrupt(*a, **k):
+        raise KeyboardInterrupt
+
+    if target == "steady":
+        monkeypatch.setattr(api, "steady_state", interrupt)
+    else:
+        monkeypatch.setattr(stiffness, "compare_methods", interrupt)
+    res = CliRunner().invoke(app, args)
+    assert res.exit_code == 130 and "interrupted; nothing written" in res.output

@@ -218,10 +218,11 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
             from torquesplit.steady.api import steady_state
 
             m, _ = load(model, assign)
-            from torquesplit.cli_support import collect_warnings, progress
+            from torquesplit.cli_support import collect_warnings, interruptible, progress
 
-            with collect_warnings(), progress("periodic steady state", as_json,
-                                              total=None) as update:
+            # (Ctrl-C exited 130 without a word)
+            with interruptible(), collect_warnings(), progress(
+                    "periodic steady state", as_json, total=None) as update:
                 # (a speed with its unit as text, so that the unit is judged)
                 st = steady_state(m, method=method, harmonics=harmonics, adaptive=adaptive,
                                   keep=_keep(keep), speed=_speed_argument(speed),
@@ -248,8 +249,8 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
             if check:
                 from torquesplit.convergence import check_steady
 
-                with collect_warnings(), progress("checking the resolution", as_json,
-                                                  total=None) as update:
+                with interruptible(), collect_warnings(), progress(
+                        "checking the resolution", as_json, total=None) as update:
                     step_check = check_steady(st, progress=update)
         except (TorquesplitError, ValueError, OSError) as exc:
             fail(_in_flags(exc))
@@ -458,9 +459,16 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
         except (TorquesplitError, OSError) as exc:
             failed = exc
         largest = sweep_maxima(ds)
-        with collect_warnings(), progress("checking the peaks' digits", as_json,
-                                          total=None):
-            held = peak_resolution(m, ds, largest, keep=_keep(keep), max_cycles=max_cycles)
+        try:  # (Ctrl-C here keeps the curve: it is printed without the check)
+            with collect_warnings(), progress("checking the peaks' digits", as_json,
+                                              total=None):
+                held = peak_resolution(m, ds, largest, keep=_keep(keep),
+                                       max_cycles=max_cycles)
+        except KeyboardInterrupt:
+            held = {}
+            err_console.print("[yellow]warning:[/] the check of the peaks' digits was "
+                              "interrupted (Ctrl-C): the largest dynamic factors are "
+                              "printed unchecked")
         summary = {
             "model": ds.attrs["model"], "points": int(ds.sizes["point"]),
             "complete": bool(ds.attrs["complete"]), "message": ds.attrs["message"],
