@@ -1411,6 +1411,10 @@ def _gear_per_load(on, load) -> list:
                           f"it once (for every load) or once per --load, in their order")
     if on and not load:
         raise OptionError("--on names the gear a torque --load acts on; give the --load too")
+    if on and all(_is_force(text) for text in load):  # (it was ignored without a word)
+        raise OptionError("--on names the gear a torque --load acts on, and every --load is "
+                          "a force (along the line of action, on neither gear); leave --on "
+                          "out, or give the load as a torque ('680 N m')")
     return on * len(load) if len(on) == 1 else on or [None] * len(load)
 
 

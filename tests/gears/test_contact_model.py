@@ -292,3 +292,16 @@ def test_contact_out_writes_every_load_and_the_harris_map(tmp_path):
     again = CliRunner().invoke(app, args[:-1] + ["--out", str(tmp_path / "c.csv")])
     assert again.exit_code == 2 and "--out" in again.output and "--force" in again.output
     assert "loaded tooth contact analysis" not in again.output
+
+
+def test_a_gear_named_for_force_loads_is_refused(tmp_path):
+    """--on with force loads only was ignored without a word (a fuzzer)."""
+    model = tmp_path / "spur.toml"
+    model.write_text(SPUR)
+    r = CliRunner().invoke(app, ["contact", str(model), "--pair", "m", "--load", "4 kN",
+                                 "--on", "pinion"])
+    assert r.exit_code == 2 and "every --load is a force" in " ".join(r.output.split())
+    r = CliRunner().invoke(app, ["contact", str(model), "--pair", "m", "--load", "4 kN",
+                                 "--load", "200 N m", "--on", "pinion", "--harris", "0",
+                                 "--json"])
+    assert r.exit_code == 0, r.output  # (a torque among them: --on is its gear)
