@@ -69,3 +69,20 @@ def test_a_support_stiffness_off_by_a_unit_is_said_by_check_run_and_static(tmp_p
             said = [ln for ln in res.stderr.splitlines()
                     if "gears.pinion.support: the static deflection of pinion." in ln]
             assert len(said) == expected, (command, res.stderr)
+
+
+def test_a_deflection_on_a_spline_names_the_spline():
+    """A fuzzer's spline of 1 N/m (or of 5 mm clearance) was blamed on gears.O4.support, a
+    table the file does not have, as 'a support or shaft stiffness far too small'."""
+    from types import SimpleNamespace
+
+    import torquesplit
+    from torquesplit.model.checks import deflection_warnings
+
+    dong = torquesplit.load_model("dong2021_face_gear")
+    assert "O4" in dong.splines["spline4"].connects and dong.gears["O4"].support is None
+    structure = SimpleNamespace(dof_names=["O4.x", "O4.theta", "O1.y"])
+    ((loc, msg), (loc1, msg1)) = deflection_warnings(dong, structure, [5e-3, 1.0, 9e-3])
+    assert loc == "splines.spline4" and "the stiffness of spline spline4 far too small" in msg
+    assert "radial clearance too large" in msg
+    assert loc1 == "gears.O1.support" and "a support or shaft stiffness" in msg1

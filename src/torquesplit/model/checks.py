@@ -1732,11 +1732,23 @@ def deflection_warnings(model, structure, q) -> list[tuple[str, str]]:
         limit, what = ((0.5 * gear.module, f"half the module ({0.5e3 * gear.module:g} mm)")
                        if gear is not None else (1e-3, "1 mm"))
         if size > limit:
-            where = (f"gears.{body}.support" if gear is not None else f"bodies.{body}")
+            # a body that floats on a spline: the spline's stiffness or clearance is the
+            # likelier cause (a fuzzer's spline of 1 N/m was blamed on gears.O4.support, a
+            # table the file does not have)
+            splines = [n for n, sp in model.splines.items() if body in sp.connects]
+            supported = gear is not None and gear.support is not None
+            where = (f"gears.{body}.support" if supported or (gear is not None and not splines)
+                     else f"splines.{splines[0]}" if splines else f"bodies.{body}")
+            cause = (f"the stiffness of spline {', '.join(splines)} far too small for the "
+                     f"load, or its radial clearance too large"
+                     + (f" (or the stiffness of {body}'s support or shaft)" if supported
+                        else "") + "; check the values and units"
+                     if splines else
+                     "a support or shaft stiffness far too small for the load; check its "
+                     "value and unit")
             out.append((where, (
                 f"the static deflection of {body}.{dof} is {1e3 * size:.4g} mm, more than "
-                f"{what}: a support or shaft stiffness far too small for the load; check "
-                f"its value and unit (N/mm written for N/um gives this)")))
+                f"{what}: {cause} (N/mm written for N/um gives this)")))
     return out
 
 
