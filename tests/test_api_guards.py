@@ -154,3 +154,21 @@ def test_empty_change_paths_python_wording_and_table_points_of_assemble():
     with pytest.raises(OptionError, match="n_table must be a whole number of table points"):
         torquesplit.assemble(m, n_table=0)
     assert torquesplit.assemble(m, n_table=16).n_table == 16
+
+
+def test_a_frozen_model_says_how_to_change_it_and_reprs_say_what_a_user_asked():
+    """Setting a field raised pydantic's 'Instance is frozen' ValidationError (not a
+    torquesplit error); a steady state's repr gave a speed factor, not the 700 rpm asked;
+    Metrics printed 1.0000286 as 'stage2 1' (a notebook user)."""
+    m = torquesplit.load_model(EXAMPLE)
+    with pytest.raises(OptionTypeError, match=r"a model is frozen: Gear\.teeth cannot be set; "
+                                              r"make a changed copy with model\.with_changes"):
+        m.gears["z1"].teeth = 41
+    assert m.gears["z1"].teeth != 41
+    from torquesplit.steady.api import steady_state
+
+    ss = steady_state(m, keep="stage1", speed="700 rpm", stability=False, check=False)
+    assert "at 700 rpm (speed factor 0.9395" in repr(ss)
+    res = torquesplit.simulate(EXAMPLE, cycles=30)
+    text = repr(res.metrics())
+    assert "stage2 1.0000" in text or "stage2 1.000" in text, text

@@ -146,7 +146,7 @@ class LoadSharing:
     planets' K_gamma of AGMA 6123 / ISO 6336-1, :mod:`torquesplit.metrics.planetary`)."""
 
     def __repr__(self) -> str:
-        return (f"LoadSharing({self.definition!r}: system {self.system:.5g}, "
+        return (f"LoadSharing({self.definition!r}: system {self.system:#.5g}, "
                 f"{len(self.per_group)} group{'s' if len(self.per_group) != 1 else ''}, "
                 f"{len(self.per_mesh)} mesh{'es' if len(self.per_mesh) != 1 else ''})")
 

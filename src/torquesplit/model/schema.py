@@ -129,6 +129,19 @@ class Strict(BaseModel):
     model_config = ConfigDict(extra="forbid", validate_default=True, frozen=True,
                               allow_inf_nan=False)
 
+    def __setattr__(self, name: str, value) -> None:
+        """A model is frozen: setting a field is refused in torquesplit's words (pydantic's
+        'Instance is frozen' ValidationError was not a torquesplit error), pointing to
+        ``with_changes``."""
+        if name.startswith("_"):  # (private state: the source data kept for changes)
+            return super().__setattr__(name, value)
+        from ..errors import OptionTypeError
+
+        raise OptionTypeError(f"a model is frozen: {type(self).__name__}.{name} cannot be "
+                              f"set; make a changed copy with model.with_changes({{PATH: "
+                              f"value}}), PATH the field's path as in the file (e.g. "
+                              f"'meshes.m1.damping_ratio')")
+
 
 
 

@@ -87,7 +87,8 @@ class Metrics:
         """One line: the system and group coefficients, the dynamic factor, the settle
         time (the dataclass's own repr printed every field: 3 kB)."""
         d = self.dynamic_factors
-        groups = ", ".join(f"{g} {v:.5g}" for g, v in
+        # ('#': trailing zeros kept, 1.0000286 read 'stage2 1')
+        groups = ", ".join(f"{g} {v:#.5g}" for g, v in
                            list(self.load_sharing.per_group.items())[:3])
         more = len(self.load_sharing.per_group) - 3
         groups += f" and {more} more" if more > 0 else ""
@@ -96,8 +97,8 @@ class Metrics:
         why = "too short to tell" if st.short else "transient did not die out"
         settled = (f"settled from {st.start_time:.4g} s" if st.settled else
                    f"not settled ({why}), from {st.start_time:.4g} s")
-        return (f"Metrics({self.definition!r}: load sharing {self.load_sharing.system:.5g} "
-                f"({groups}), dynamic factor {kv:.4g}, {settled})")
+        return (f"Metrics({self.definition!r}: load sharing {self.load_sharing.system:#.5g} "
+                f"({groups}), dynamic factor {kv:#.4g}, {settled})")
 
     def to_dict(self) -> dict:
         d = self.dynamic_factors
@@ -939,7 +940,8 @@ def open_results(path):
                     "no such file" if where.parent.is_dir() else
                     f"no such file (nor the folder {where.parent})")
             raise OutputError(f"{path}: {what}; give the .nc file a run saved "
-                              f"(torquesplit run --out NAME.nc)") from None
+                              f"(torquesplit run --out NAME.nc, or res.save('NAME.nc'))"
+                              ) from None
         raise OptionError(
             f"{path}: not a NetCDF results file ({exc}); open_results and load_results "
             f"read the .nc files torquesplit writes (a .mat opens with scipy.io.loadmat, a "

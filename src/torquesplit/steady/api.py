@@ -176,9 +176,14 @@ class SteadyState:
         self.problem: PeriodicProblem = problem
 
     def __repr__(self) -> str:
+        from .maps import RPM, reference_speed
+
         sol = self.solution
-        return (f"SteadyState({self.model.model.name!r}: {sol.method} at speed factor "
-                f"{sol.speed:.6g}, period {1.0 / (self.period.frequency * sol.speed):.4g} s, "
+        # (the speed solved at, in rpm: a speed factor alone did not say 700 rpm was asked)
+        rpm = reference_speed(self.model) * sol.speed * RPM
+        return (f"SteadyState({self.model.model.name!r}: {sol.method} at {rpm:.6g} rpm "
+                f"(speed factor {sol.speed:.6g}), period "
+                f"{1.0 / (self.period.frequency * sol.speed):.4g} s, "
                 f"{'converged' if sol.converged else 'NOT converged'})")
 
     @property

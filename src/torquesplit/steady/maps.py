@@ -167,8 +167,8 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
     s0, s1 = _rad_per_s(start, "start") / w_ref, _rad_per_s(stop, "stop") / w_ref
     if not (s0 > 0 and s1 > 0 and math.isfinite(s0) and math.isfinite(s1)) or s0 == s1:
         raise OptionError(f"the speed range {s0 * w_ref * RPM:.6g}..{s1 * w_ref * RPM:.6g} rpm "
-                          f"must be two different positive speeds; e.g. --from '1000 rpm' "
-                          f"--to '3000 rpm'")
+                          f"must be two different positive speeds; e.g. from '1000 rpm' to "
+                          f"'3000 rpm' (--from, --to; in Python start=, stop=)")
     if per.frequency <= 0:
         raise SolverError("the model has no time-varying excitation: its response does not "
                           "change with speed; nothing to sweep.")
@@ -698,8 +698,8 @@ def campbell(model, start: float, stop: float, *, points: int = 41,
     # range either way round, as sweep_speed takes it; from standstill as a map usually is)
     if not (lo >= 0 and hi > lo and math.isfinite(hi)):
         raise OptionError(f"the speed range {lo * RPM:.6g}..{hi * RPM:.6g} rpm must be two "
-                          f"different speeds, the lower one 0 or more; e.g. --from '0 rpm' "
-                          f"--to '3000 rpm'.")
+                          f"different speeds, the lower one 0 or more; e.g. from '0 rpm' to "
+                          f"'3000 rpm' (--from, --to; in Python start=, stop=).")
     speeds = np.linspace(lo, hi, points)
     if s.n_gyroscopic:
         freqs = []

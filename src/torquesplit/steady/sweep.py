@@ -594,8 +594,8 @@ def continue_in_speed_shooting(problem, period, q_static, s0, s1, *, points=50,
 def _check_range(s0, s1):
     if not (s0 > 0 and s1 > 0 and math.isfinite(s0) and math.isfinite(s1)) or s0 == s1:
         raise OptionError(f"the speed range {s0:.4g}..{s1:.4g} (times the model's speed) "
-                          f"must be two different positive speeds; e.g. --from '1000 rpm' "
-                          f"--to '3000 rpm'.")
+                          f"must be two different positive speeds; e.g. from '1000 rpm' to "
+                          f"'3000 rpm' (--from, --to; in Python start=, stop=).")
 
 
 def continue_in_speed(problem, period, q_static, s0, s1, *, points=50, harmonics=None,
