@@ -172,3 +172,10 @@ def test_a_frozen_model_says_how_to_change_it_and_reprs_say_what_a_user_asked():
     res = torquesplit.simulate(EXAMPLE, cycles=30)
     text = repr(res.metrics())
     assert "stage2 1.0000" in text or "stage2 1.000" in text, text
+
+
+def test_a_mistyped_example_name_is_told_the_example_in_python():
+    """The command line suggested it; load_model said 'no such file' (a notebook user)."""
+    with pytest.raises(ModelError, match=r"no such file or example; did you mean "
+                                         r"'ji_li_mill_drive'\?"):
+        torquesplit.load_model("ji_li_mil_drive")

@@ -139,6 +139,15 @@ def _resolve(source) -> Path:
 
         if str(source) in example_names():  # a shipped example by name
             path = example_path(str(source))
+        else:  # a name like an example's: a typo of it ('no such file' said nothing more)
+            import difflib
+
+            close = difflib.get_close_matches(str(source), example_names(), n=2, cutoff=0.6)
+            if close:
+                raise ModelError([("", f"no such file or example; did you mean "
+                                       f"{' or '.join(repr(c) for c in close)}? "
+                                       f"(torquesplit.example_names() lists the examples)")],
+                                 str(source))
     return path
 
 
