@@ -89,7 +89,8 @@ def render(template: str, data) -> str:
 
 
 NOT_HELD = "†"
-"""The mark of a printed number whose last digit moves when the step is halved."""
+"""The mark of a printed number that moves by more than half a unit of its last printed
+digit when the step is halved (the data hold the change, not the halved value)."""
 
 
 def held(value: float, fmt: str, change: float) -> str:

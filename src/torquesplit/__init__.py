@@ -12,6 +12,8 @@ The pipeline, one stage per subpackage (each stage returns a new object)::
                                                 campbell over a speed range)
     load_results(file.nc)       -> Results     (a saved run, its metrics recomputed)
     run_study(study_file)       -> Dataset     (study/: grids, Monte Carlo, sensitivity)
+    contact_analysis(model, mesh, loads) -> ContactAnalysis (gears/contact/: loaded tooth
+                                                contact analysis of one mesh)
 """
 
 from __future__ import annotations
@@ -35,6 +37,7 @@ __all__ = [
     "load_model", "solve_kinematics", "assemble", "simulate", "quasi_static_load_sharing",
     "model_modes", "steady_state", "sweep_speed", "campbell", "load_results",
     "open_results", "Results", "Model", "SteadyState", "Study", "run_study",
+    "contact_analysis",
 ]
 
 #: loaded only when asked for (the study and steady-state layers, xarray, scipy.stats);
@@ -42,7 +45,7 @@ __all__ = [
 _LAZY = {"Study": "study", "run_study": "study", "steady_state": "steady",
          "sweep_speed": "steady", "campbell": "steady", "load_results": "results",
          "open_results": "results", "Results": "results", "SteadyState": "steady",
-         "Model": "model.schema"}
+         "Model": "model.schema", "contact_analysis": "gears.contact.export"}
 
 
 def __getattr__(name):

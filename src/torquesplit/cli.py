@@ -290,8 +290,9 @@ def _load(model: str, assignments: Optional[list[str]] = None, *, deep: bool = F
     The model's warnings are printed at once and kept for ``--json``
     (:mod:`torquesplit.cli_support`), but for those that contain a text of
     ``irrelevant`` (advice that does not apply to the command)."""
+    from .errors import ModelError
     from .model.checks import check_model
-    from .model.io import load_model, model_from_dict
+    from .model.io import _located, load_model, model_from_dict
 
     path = _resolve_model_path(model)
     where: dict[str, str] = {}
@@ -305,11 +306,14 @@ def _load(model: str, assignments: Optional[list[str]] = None, *, deep: bool = F
             try:
                 m = model_from_dict(data, source=str(path))
                 check_model(m, source=str(path), deep=deep)
-            except ModelError as exc:
-                raise attribute_errors(exc, where, str(path)) from None
+            except ModelError as exc:  # (the file's own fields at their lines)
+                raise _located(attribute_errors(exc, where, str(path)), path) from None
         else:
             m = load_model(path, check=False)
-            check_model(m, source=str(path), deep=deep)
+            try:  # (the checks' problems at their lines, as the schema's)
+                check_model(m, source=str(path), deep=deep)
+            except ModelError as exc:
+                raise _located(exc, path) from None
     from .model.overrides import attribute_warning
 
     for w in caught:
@@ -1136,7 +1140,8 @@ def contact(
         "every --load, or once per --load, in their order."),
     plot: Optional[Path] = typer.Option(None, "--plot", help="Write the figures (PNG) into "
                                         "this folder.", metavar="DIR"),
-    force: bool = _flag("--force", "Replace existing figures in the --plot folder."),
+    force: bool = _flag("--force", "Replace an existing --out file and the figures in the "
+                                   "--plot folder."),
     positions: Optional[int] = typer.Option(None, "--positions", help="Mesh positions per cycle.",
                                             metavar="N"),
     slices: Optional[int] = typer.Option(None, "--slices", help="Slices across the face.",

@@ -417,9 +417,10 @@ def _variable_path_issues(model_data: dict, v: dict, where: str) -> list[tuple[s
     for key, path in [("path", v["path"])] + [("also", p) for p in v.get("also", ())]:
         parts = str(path).split(".")
         section = model_data.get(parts[0])
-        if (len(parts) > 2 and parts[0] in NAMED_SECTIONS and isinstance(section, dict)
-                and parts[1] not in section):
-            known = ", ".join(sorted(section)) or "none"
+        if (len(parts) > 2 and parts[0] in NAMED_SECTIONS
+                and not (isinstance(section, dict) and parts[1] in section)):
+            known = ", ".join(sorted(section)) if isinstance(section, dict) and section \
+                else "none"
             out.append((f"{where}.{key}", f"{'.'.join(parts[:2])!r} does not exist (known "
                                           f"here: {known}); check the path"))
             continue

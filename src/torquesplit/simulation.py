@@ -384,9 +384,12 @@ def prepare_run(
     track = [names.index(m) for m in mesh_names]
     hist_el = history_elements(structure, mesh_names)
     # one DOF name, not its letters ("unknown dof 'z'" for "z1.theta")
+    if history_dofs is not None and not isinstance(history_dofs, str) and hasattr(
+            history_dofs, "__iter__"):
+        history_dofs = list(history_dofs)  # (a set, an array of names, a generator)
     if not (history_dofs is None or isinstance(history_dofs, str) or (
-            isinstance(history_dofs, (list, tuple)) and all(isinstance(d, str)
-                                                            for d in history_dofs))):
+            isinstance(history_dofs, list) and all(isinstance(d, (str, np.str_))
+                                                   for d in history_dofs))):
         from .errors import OptionTypeError
 
         # (5 raised "TypeError: 'int' object is not iterable")

@@ -305,3 +305,28 @@ def test_a_gear_named_for_force_loads_is_refused(tmp_path):
                                  "--load", "200 N m", "--on", "pinion", "--harris", "0",
                                  "--json"])
     assert r.exit_code == 0, r.output  # (a torque among them: --on is its gear)
+
+
+def test_the_contact_analysis_of_python_equals_the_commands(tmp_path):
+    """Contact analysis had no public Python function (a notebook user reached into
+    gears.contact.coupling and its private _options)."""
+    model = tmp_path / "spur.toml"
+    model.write_text(SPUR)
+    r = CliRunner().invoke(app, ["contact", str(model), "--pair", "m", "--load", "4 kN",
+                                 "--load", "9 kN", "--harris", "3", "--json"])
+    assert r.exit_code == 0, r.output
+    cli = json.loads(r.stdout)
+    ca = torquesplit.contact_analysis(model, "m", ["4 kN", 9000.0], harris=3)
+    assert ca.loads == [4000.0, 9000.0] and ca.gears == tuple(cli["gears"])
+    for row, mine in zip(cli["loads"], ca.summary()):
+        for key in ("te_peak_to_peak_m", "stiffness_secant_mean_N_per_m",
+                    "max_hertz_pressure_Pa", "actual_contact_ratio"):
+            assert mine[key] == pytest.approx(row[key], rel=1e-12), key
+    ds = ca.to_dataset()
+    np.testing.assert_allclose(ds["harris_te_peak_to_peak"].values,
+                               cli["harris"]["te_peak_to_peak_m"], rtol=1e-12)
+    assert torquesplit.contact_analysis(model, "m").loads == [cli["operating_load_N"]]
+    with pytest.raises(torquesplit.OptionError, match="no mesh named 'x'"):
+        torquesplit.contact_analysis(model, "x")
+    with pytest.raises(torquesplit.OptionError, match="loads: .*not a force"):
+        torquesplit.contact_analysis(model, "m", "40 kg")

@@ -86,9 +86,59 @@ def test_a_json_model_and_a_set_argument_name_no_line(tmp_path):
     with pytest.raises(ModelError) as info:
         torquesplit.load_model(path)
     assert str(info.value).startswith(f"{path}: gears.wheel.teeth: ")
-    good = tmp_path / "ok.toml"
-    good.write_text(SPUR_PAIR)
-    with pytest.raises(ModelError) as info:
-        torquesplit.load_model(good, changes={"gears.wheel.teeth": 0})
-    assert "gears.wheel.teeth" in str(info.value)
-    assert re.search(r"\.toml:\d+:", str(info.value)) is None  # (no line of a change)
+
+
+def test_the_command_line_names_the_lines_of_schema_and_check_errors(tmp_path):
+    """The commands read the file, then check it apart: the checks' problems had no line
+    (a code review), with and without --set."""
+    from typer.testing import CliRunner
+
+    from torquesplit.cli import app
+
+    text = SPUR_PAIR.replace('gears = ["pinion", "wheel"]', 'gears = ["pinion", "whel"]')
+    path = tmp_path / "m.toml"
+    path.write_text(text)
+    line = next(i for i, t in enumerate(text.splitlines(), 1) if "whel\"" in t)
+    for extra in ([], ["--set", "meshes.m.damping_ratio=0.2"]):
+        res = CliRunner().invoke(app, ["check", str(path), *extra])
+        assert res.exit_code == 2 and f"{path}:{line}: meshes.m.gears: " in res.output, \
+            res.output
+    bad = SPUR_PAIR.replace("teeth = 40", "teeth = 0")
+    path.write_text(bad)
+    res = CliRunner().invoke(app, ["check", str(path)])
+    line = bad.splitlines().index("teeth = 0") + 1
+    assert f"{path}:{line}: gears.wheel.teeth: " in res.output
+    # a value given with --set is the argument's, not the file's: no line
+    path.write_text(SPUR_PAIR)
+    res = CliRunner().invoke(app, ["check", str(path), "--set", "gears.wheel.teeth=0"])
+    assert res.exit_code == 2 and "--set gears.wheel.teeth=0" in res.output
+    assert re.search(r"m\.toml:\d+:", res.output) is None
+
+
+def test_lines_inside_multi_line_arrays_and_strings_are_not_keys():
+    """A lone array row '  [0.5, 2e9]' was read as a table header, and a description's
+    lines inside a multi-line string as keys (a code review)."""
+    text = '''\
+[model]
+name = "x"
+description = """
+[gears.ghost]
+teeth = 3
+"""
+
+[meshes.m]
+stiffness = {method = "table", phase = [0.0, 0.5], values = [
+  "4e8 N/m",
+  [0.5, 2e9]
+]}
+damping_ratio = 0.05   # "[not a header]"
+note = 'a [bracket] = inside'
+
+[gears.ghost]
+teeth = 4
+'''
+    assert tomllib.loads(text.replace("[0.5, 2e9]", '"3e8 N/m"'))  # (TOML but the row)
+    lines = key_lines(text)
+    assert lines["meshes.m.damping_ratio"] == 13 and lines["meshes.m.note"] == 14
+    assert lines["gears.ghost.teeth"] == 17 and lines["gears.ghost"] == 16
+    assert lines["model.description"] == 3

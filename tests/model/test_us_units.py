@@ -58,7 +58,16 @@ def test_a_module_may_be_given_as_a_diametral_pitch():
     m = ts.load_model(tomllib.loads(SPUR_PAIR.replace('module = "2 mm"', 'module = "12.7 1/in"')))
     assert m.gears["pinion"].module == pytest.approx(0.002, rel=1e-12)
     with pytest.raises(ModelError, match=r"gears\.pinion\.diametral_pitch: unknown field; "
-                       r"give the diametral pitch as module = '4 1/in'"):
+                       r"give the normal diametral pitch as module = '4 1/in'"):
         ts.load_model(tomllib.loads(SPUR_PAIR.replace('module = "2 mm"',
                                                       'diametral_pitch = "12.7 1/in"', 1)))
 
+
+
+def test_a_hyphen_chain_is_one_factor_and_the_lbf_hint_only_where_it_fixes():
+    """'lb/ft-s' (a viscosity) read lb s/ft, and was told to write lbf (a code review)."""
+    assert parse_quantity("1 lb/ft-s", "viscosity") == pytest.approx(
+        0.45359237 / 0.3048, rel=1e-12)
+    with pytest.raises(ValueError) as exc:
+        parse_quantity("1 lb/ft-s", "pressure")
+    assert "lbf" not in str(exc.value)

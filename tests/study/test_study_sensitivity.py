@@ -165,7 +165,10 @@ def test_s1_above_st_beyond_the_intervals_is_a_warning():
 @pytest.mark.parametrize("s1, st, s1_conf, st_conf, said", [
     # a reviewer's 8 samples: S1 1.45 +/- 0.87, ST 1.25 +/- 0.55, said nothing
     ([1.447, 0.009], [1.25, 0.003], [0.87, 0.01], [0.55, 0.01],
-     "S1 of d1 1.45 +/- 0.87 and ST of d1 1.25 +/- 0.55 outside [0, 1]"),
+     "the leading factor's total index is 1.25 +/- 0.55 (d1)"),
+    ([0.9, 0.0], [1.3, 0.01], [0.05, 0.01], [0.1, 0.01],
+     "ST of d1 1.3 +/- 0.1 outside [0, 1]"),
+    ([0.95, 0.0], [1.01, 0.01], [0.05, 0.01], [0.05, 0.01], None),  # 1 within its interval
     ([-0.3, 0.5], [0.1, 0.6], [0.05, 0.05], [0.05, 0.05], "S1 of d1 -0.3 +/- 0.05 outside [0, 1]"),
     ([0.5, 0.3], [0.6, 0.35], [0.05, 0.05], [0.3, 0.05], "the leading factor's total index is "
                                                          "0.6 +/- 0.3 (d1)"),

@@ -259,9 +259,9 @@ def _written(data, parts: list[str]):
 
 #: a field name from another convention -> (the field that holds it, what to write)
 _SYNONYMS = {
-    name: ("module", "give the diametral pitch as module = '4 1/in' (teeth per inch: the "
-           "module 25.4 mm / 4)")
-    for name in ("diametral_pitch", "normal_diametral_pitch", "pitch", "dp", "DP")}
+    name: ("module", "give the normal diametral pitch as module = '4 1/in' (teeth per "
+           "inch: the module 25.4 mm / 4; a helical gear's transverse P_t is P_n cos(helix))")
+    for name in ("diametral_pitch", "normal_diametral_pitch", "dp", "DP")}
 
 
 def _message(err: dict, parts: list[str], written=None) -> str:
@@ -277,7 +277,7 @@ def _message(err: dict, parts: list[str], written=None) -> str:
     if kind == "string_too_long":  # (a 100,000-character name took check 62 s to print)
         most = ctx.get("max_length")
         return (f"is {len(value) if isinstance(value, str) else '?'} characters long; give "
-                f"at most {most} (a short name: the description may say more)")
+                f"at most {most}")
     if kind == "extra_forbidden":
         name, section = (parts[-1], parts[:-1]) if parts else ("", [])
         fields = _fields_at(section)

@@ -47,7 +47,14 @@ def key_lines(text: str) -> dict[str, int]:
         for k in range(1, len(parts) + 1):
             lines.setdefault(".".join(parts[:k]), line)
 
+    depth, quote = 0, None  # brackets open and the multi-line string we are in, from
+    # the lines before: a line inside either is no header and no key (a lone array row
+    # '  [0.5, 2e9]' read as a table header; a description's lines as keys)
     for number, raw in enumerate(text.splitlines(), start=1):
+        inside = depth > 0 or quote is not None
+        depth, quote = _carry(raw, depth, quote)
+        if inside:
+            continue
         m = _HEADER.match(raw)
         if m:
             parts = _parts(m.group(2))
@@ -70,6 +77,38 @@ def key_lines(text: str) -> dict[str, int]:
             for inner in _INLINE_KEY.finditer(rest):
                 lines.setdefault(".".join(path + _parts(inner.group(1))), number)
     return lines
+
+
+def _carry(line: str, depth: int, quote: str | None) -> tuple[int, str | None]:
+    """The bracket depth and the open multi-line string (its delimiter) after ``line``,
+    given those before it: quotes, comments and escapes as TOML reads them."""
+    i, n = 0, len(line)
+    while i < n:
+        if quote is not None:
+            if line.startswith(quote, i):
+                i, quote = i + len(quote), None
+                continue
+            i += 2 if line[i] == "\\" and quote[0] == '"' else 1
+            continue
+        c = line[i]
+        if c == "#":
+            break
+        if line.startswith('"""', i) or line.startswith("'''", i):
+            quote = line[i:i + 3]
+            i += 3
+            continue
+        if c in "\"'":  # a one-line string: skip to its end
+            j = i + 1
+            while j < n and line[j] != c:
+                j += 2 if c == '"' and line[j] == "\\" else 1
+            i = j + 1
+            continue
+        if c in "[{":
+            depth += 1
+        elif c in "]}":
+            depth = max(0, depth - 1)
+        i += 1
+    return depth, quote
 
 
 def line_of(lines: dict[str, int], location: str) -> int | None:

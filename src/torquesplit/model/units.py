@@ -87,8 +87,10 @@ def registry() -> pint.UnitRegistry:
 
 
 #: a hyphen between two unit names is a product, as engineers write it ('8827 lb-ft',
-#: 'lbf-in', 'N-m'); pint read it as a minus sign
-_HYPHEN = re.compile(r"(?<=[A-Za-z])-(?=[A-Za-z])")
+#: 'lbf-in', 'N-m'); pint read it as a minus sign.  The chain is one factor, its own
+#: powers inside it: 'lb/ft-s' is lb/(ft s), 'lb-ft^2' is lb ft^2
+_UNIT = r"[A-Za-z_]+(?:(?:\^|\*\*)\d+)?"
+_HYPHEN = re.compile(rf"(?<![\w.]){_UNIT}(?:-{_UNIT})+")
 #: the inch mark after a number ('0.012"'), revolutions per minute as ISO writes them
 _INCH_MARK = re.compile(r'(?<=[\d.\s])"')
 _R_PER = re.compile(r"\br/(min|s)\b")
@@ -99,7 +101,7 @@ _MIL = re.compile(r"\bmils?\b")
 
 def _spellings(text: str) -> str:
     """``text`` with the engineering spellings pint does not read made explicit."""
-    text = _HYPHEN.sub(" ", text)
+    text = _HYPHEN.sub(lambda m: "(" + m.group().replace("-", "*") + ")", text)
     text = _INCH_MARK.sub(" inch", text)
     text = _MIL.sub("thou", text)
     return _R_PER.sub(r"rev/\1", text)
@@ -179,8 +181,7 @@ def _parse_string(text: str, kind: str) -> float:
                    else f"add the unit, e.g. '{n} {example.split(' ', 1)[1]}'")
         else:
             fix = f"write it in {si_unit} or a compatible unit, e.g. '{example}'"
-            if _POUND.search(text) and "[mass]" in str(ref.dimensionality) and kind not in (
-                    "mass", "inertia", "density"):
+            if _POUND.search(text) and _as_force(text, ref):
                 fix += ("; lb is the pound-mass: a force is written lbf (e.g. '8e6 lbf/in', "
                         "'8827 lbf ft')")
         raise ValueError(
@@ -199,6 +200,16 @@ def _parse_string(text: str, kind: str) -> float:
 
 
 _POUND = re.compile(r"\blbs?\b")
+
+
+def _as_force(text: str, ref) -> bool:
+    """Whether ``text`` with its pounds read as pounds-force has the dimension wanted
+    (the hint 'write lbf' only where lbf is the fix: not for a viscosity in lb/ft-s)."""
+    try:
+        q = registry().Quantity(_floats(_spellings(_POUND.sub("lbf", text.strip()))))
+    except Exception:  # noqa: BLE001 - pint raises many kinds: no hint then
+        return False
+    return q.dimensionality == ref.dimensionality
 
 #: kinds measured per unit time whose SI unit holds a power of the radian: a speed
 #: (rad/s) holds one, a frequency (Hz, revolutions or cycles per second) none

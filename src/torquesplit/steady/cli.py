@@ -459,13 +459,15 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
         except (TorquesplitError, OSError) as exc:
             failed = exc
         largest = sweep_maxima(ds)
-        try:  # (Ctrl-C here keeps the curve: it is printed without the check)
-            with collect_warnings(), progress("checking the peaks' digits", as_json,
-                                              total=None):
-                held = peak_resolution(m, ds, largest, keep=_keep(keep),
-                                       max_cycles=max_cycles)
+        held = {}
+        try:  # (Ctrl-C here keeps the curve: it is printed without the check; a sweep
+            # already interrupted is not made to wait for it)
+            if not str(ds.attrs["message"]).startswith("interrupted"):
+                with collect_warnings(), progress("checking the peaks' digits", as_json,
+                                                  total=None):
+                    held = peak_resolution(m, ds, largest, keep=_keep(keep),
+                                           max_cycles=max_cycles)
         except KeyboardInterrupt:
-            held = {}
             err_console.print("[yellow]warning:[/] the check of the peaks' digits was "
                               "interrupted (Ctrl-C): the largest dynamic factors are "
                               "printed unchecked")
@@ -594,11 +596,14 @@ import numpy as np  # noqa: E402  (used by the commands above)
 
 
 def _held_text(value: float, digits: int) -> str:
-    """``value`` to ``digits`` significant digits (at least 2, at most 6), trailing
-    zeros kept ('2.9', '1.0800')."""
+    """``value`` to ``digits`` significant digits (at most 6), trailing zeros kept ('2.9',
+    '1.0800'); fewer than 2 that hold: 3 digits marked unresolved (the heading says the
+    digits printed hold)."""
     import math
 
-    d = min(6, max(2, digits))
+    if digits < 2:
+        return f"{value:#.3g} (unresolved)"
+    d = min(6, digits)
     places = max(0, d - 1 - math.floor(math.log10(abs(value)))) if value else d - 1
     return f"{value:.{places}f}"
 
@@ -681,7 +686,11 @@ def peak_resolution(model, ds, largest, keep=None, max_cycles=None) -> dict[str,
     from torquesplit.errors import TorquesplitError
     from torquesplit.steady.api import steady_state
 
-    fine_model, _, _ = check_model(SimpleNamespace(model=model, structure=assemble(model)))
+    try:
+        fine_model, _, _ = check_model(SimpleNamespace(model=model,
+                                                       structure=assemble(model)))
+    except Exception:  # noqa: BLE001 - a side check: the curve stands without it
+        return {}
     by_speed: dict[float, list[str]] = {}
     for mesh, row in largest.items():
         value, rpm = row["stable"]
@@ -701,7 +710,7 @@ def peak_resolution(model, ds, largest, keep=None, max_cycles=None) -> dict[str,
             else:
                 fine = steady_state(fine_model, method="hb", adaptive=False,
                                     harmonics=2 * int(ds.attrs["harmonics"]), **common)
-        except (TorquesplitError, ValueError, ArithmeticError):
+        except (TorquesplitError, ValueError, ArithmeticError, RuntimeError):
             continue
         if not fine.solution.converged:
             continue

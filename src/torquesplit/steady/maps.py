@@ -261,8 +261,8 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
         + ", pseudo-arclength continuation",
         harmonics=0 if method == "shooting" else hb.H,
         samples=cont.steps if method == "shooting" else hb.N,
-        # (RK4 steps per period = samples x this many excitation cycles: the resolution
-        # a check of the curve's numbers halves)
+        # (samples: the RK4 steps per period, this many excitation cycles long: per
+        # cycle, the resolution a check of the curve's numbers doubles)
         excitation_cycles_per_period=max(per.max_order, 1),
         fundamental_frequency_at_model_speed_Hz=per.frequency,
         complete=int(complete), message=msg,

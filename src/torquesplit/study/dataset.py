@@ -193,7 +193,8 @@ variance) leaves the ranking unresolved: said, with the remedy."""
 def sobol_warnings(ds) -> list[str]:
     """Signs that the Sobol indices are not converged (too few samples, or an output with
     failed cases), one line per output: an index outside [0, 1] (a share of the variance
-    cannot be; a reviewer's 8 samples gave S1 = 1.45 unflagged), a first-order index
+    cannot be, beyond its interval; a reviewer's 8 samples gave S1 = 1.45 +/- 0.87 and
+    ST = 1.25 +/- 0.55 unflagged: ST's is beyond it), a first-order index
     above the total one beyond both bootstrap half-widths (S1 <= ST holds for the true
     indices), and a wide interval on the leading factor's total index."""
     notes = []
@@ -204,7 +205,7 @@ def sobol_warnings(ds) -> list[str]:
             c1, ct = float(ds["S1_conf"].values[o, f]), float(ds["ST_conf"].values[o, f])
             outside += [f"{name} of {factor} {x:.3g} +/- {c:.2g}"
                         for name, x, c in (("S1", s1, c1), ("ST", st, ct))
-                        if x > 1.0 or x + np.nan_to_num(c) < 0.0]
+                        if x - np.nan_to_num(c) > 1.0 or x + np.nan_to_num(c) < 0.0]
             if s1 - st > np.nan_to_num(c1) + np.nan_to_num(ct):
                 why.append(f"S1 of {factor} ({s1:.3g} +/- {c1:.2g}) exceeds its ST "
                            f"({st:.3g} +/- {ct:.2g}) beyond the 95 % intervals")
