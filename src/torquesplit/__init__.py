@@ -18,15 +18,9 @@ The pipeline, one stage per subpackage (each stage returns a new object)::
 
 from __future__ import annotations
 
-from .assembly.assemble import assemble
 from .errors import (ModelError, ModelWarning, OptionError, OptionTypeError, OutputError,
                      SolverError, StepTooLargeError, StudyError, TorquesplitError)
 from .examples import example_names, example_path
-from .model.io import load_model
-from .model.kinematics import solve_kinematics
-from .modes import model_modes
-from .quasistatic import quasi_static_load_sharing
-from .simulation import simulate
 
 __version__ = "0.1.0"
 
@@ -40,9 +34,14 @@ __all__ = [
     "contact_analysis",
 ]
 
-#: loaded only when asked for (the study and steady-state layers, xarray, scipy.stats);
-#: the classes functions return, so that a user can name them (isinstance, annotations)
-_LAZY = {"Study": "study", "run_study": "study", "steady_state": "steady",
+#: loaded only when asked for (pydantic, numba, xarray, the study and steady-state
+#: layers): 'import torquesplit' itself is light, so that the command's entry point
+#: (:mod:`torquesplit._launch`) can turn a Ctrl-C while the rest loads into one line; the
+#: classes functions return, so that a user can name them (isinstance, annotations)
+_LAZY = {"load_model": "model.io", "solve_kinematics": "model.kinematics",
+         "assemble": "assembly.assemble", "simulate": "simulation",
+         "model_modes": "modes", "quasi_static_load_sharing": "quasistatic",
+         "Study": "study", "run_study": "study", "steady_state": "steady",
          "sweep_speed": "steady", "campbell": "steady", "load_results": "results",
          "open_results": "results", "Results": "results", "SteadyState": "steady",
          "Model": "model.schema", "contact_analysis": "gears.contact.export"}

@@ -256,3 +256,15 @@ def test_ctrl_c_in_steady_and_mesh_says_so(args, target, monkeypatch):
         monkeypatch.setattr(stiffness, "compare_methods", interrupt)
     res = CliRunner().invoke(app, args)
     assert res.exit_code == 130 and "interrupted; nothing written" in res.output
+
+
+def test_the_entry_point_loads_nothing_heavy_before_its_guard():
+    """The guard of _launch.main covers the heavy imports only if 'import torquesplit'
+    itself does not make them (it loaded pydantic, numpy and numba: a code review)."""
+    import subprocess
+    import sys
+
+    out = subprocess.run([sys.executable, "-c", "import sys, torquesplit._launch; print("
+                          "sorted(m for m in ('pydantic', 'numpy', 'numba', 'xarray') "
+                          "if m in sys.modules))"], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[]", out.stdout
