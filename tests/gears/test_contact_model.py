@@ -330,3 +330,5 @@ def test_the_contact_analysis_of_python_equals_the_commands(tmp_path):
         torquesplit.contact_analysis(model, "x")
     with pytest.raises(torquesplit.OptionError, match="loads: .*not a force"):
         torquesplit.contact_analysis(model, "m", "40 kg")
+    with pytest.raises(torquesplit.OptionError, match="positions must be a whole number from"):
+        torquesplit.contact_analysis(model, "m", positions=10**7)

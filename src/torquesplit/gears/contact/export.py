@@ -111,7 +111,8 @@ class ContactAnalysis:
 
     mesh: str
     gears: tuple[str, str]
-    """(driver, driven) as the LTCA takes them: gear 2's angle is the angular TE."""
+    """(gear 1, gear 2) as the LTCA takes them (the driver first, but where a ring
+    drives): gear 2's angle is the angular transmission error."""
     operating_load: float
     """The mesh's operating normal load [N] (the model's)."""
     results: tuple = field(repr=False)
@@ -154,10 +155,15 @@ def contact_analysis(model, mesh: str, loads=None, *, positions: int | None = No
     m = load_model(model) if not hasattr(model, "meshes") else model
     if mesh not in m.meshes:
         raise OptionError(f"no mesh named {mesh!r}; name one of {', '.join(m.meshes)}")
-    for value, name in ((positions, "positions"), (slices, "slices")):
+    from ...model.schema_modifications import MAX_POSITIONS, MIN_POSITIONS
+
+    # (the bounds of the model file's stiffness.ltca fields and of the command's options)
+    for value, name, low, high in ((positions, "positions", MIN_POSITIONS, MAX_POSITIONS),
+                                   (slices, "slices", 1, 400)):
         if value is not None and not (isinstance(value, (int, np.integer))
-                                      and not isinstance(value, bool) and value >= 1):
-            raise OptionError(f"{name} must be a whole number >= 1, got {value!r}")
+                                      and not isinstance(value, bool) and low <= value <= high):
+            raise OptionError(f"{name} must be a whole number from {low} to {high}, got "
+                              f"{value!r}")
     if not (isinstance(harris, (int, np.integer)) and not isinstance(harris, bool)
             and harris >= 0):
         raise OptionError(f"harris must be a whole number >= 0 (0: no map), got {harris!r}")
