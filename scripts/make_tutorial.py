@@ -350,8 +350,9 @@ The table gives each mesh's largest dynamic factor over the stable points of the
 and the speed where it occurs, to the digits that hold: each peak is solved again at its
 speed with half the RK4 step, and the line under the table gives both values (near a
 resonance the response is steep, and the split stage's peaks hold two or three digits at
-the default resolution; `--steps-per-cycle` refines it).  The combine stage's rows leave out its own excitation
-(its stiffness variation was replaced by its mean, as the line under the table says):
+the default resolution; `--steps-per-cycle` refines it).  The combine stage's rows
+leave out its own excitation (its stiffness variation was replaced by its mean, as the
+line under the table says):
 they are not the combine meshes' dynamic factors, which `run` or `steady` without
 `--keep` give at a speed.  The figure draws the dynamic factor, the load sharing and the
 RMS transmission error of every mesh against speed (dashed where the periodic state is
