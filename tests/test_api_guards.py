@@ -179,3 +179,26 @@ def test_a_mistyped_example_name_is_told_the_example_in_python():
     with pytest.raises(ModelError, match=r"no such file or example; did you mean "
                                          r"'ji_li_mill_drive'\?"):
         torquesplit.load_model("ji_li_mil_drive")
+
+
+def test_modes_steady_states_and_static_sweeps_save_as_their_commands_do(tmp_path):
+    """A notebook user found no save for ModalReport or SteadyState (the commands' --out)
+    and no write_figures for a quasi-static sweep (static --plots)."""
+    import xarray as xr
+
+    from torquesplit.steady.api import steady_state
+
+    m = torquesplit.load_model(EXAMPLE)
+    rep = torquesplit.model_modes(m)
+    path = rep.save(tmp_path / "modes.nc")
+    ds = xr.load_dataset(path)
+    assert ds["frequency"].values.tolist() == [r.frequency for r in rep.rows]
+    with pytest.raises(OutputError, match="exists"):
+        rep.save(tmp_path / "modes.nc")
+    st = steady_state(m, keep="stage1", speed="700 rpm", stability=False, check=False)
+    saved = torquesplit.load_results(st.save(tmp_path / "steady.nc"))
+    assert saved.saved_steady and saved.metrics().load_sharing.system == pytest.approx(
+        st.to_results().metrics().load_sharing.system, rel=1e-12)
+    qs = torquesplit.quasi_static_load_sharing(m, points_per_cycle=8, revolutions=1)
+    figures = qs.write_figures(tmp_path / "figs", formats=("png",))
+    assert figures and all(f.exists() and f.suffix == ".png" for f in figures)

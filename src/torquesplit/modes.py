@@ -159,6 +159,14 @@ class ModalReport:
         return dict(rigid_body_modes=self.rigid_modes, rotating_frame=self.rotating_frame,
                     damping_ratio=DAMPING_RATIO_DEFINITION, units=units, modes=out)
 
+    def save(self, path, *, overwrite: bool = False):
+        """Save :meth:`to_dataset` by suffix (``.nc``, ``.mat``, ``.csv``: a table per mode
+        and per DOF), as ``torquesplit modes --out`` does; atomically, an existing file
+        kept unless ``overwrite``.  Returns the path written."""
+        from .results.export import save_dataset
+
+        return save_dataset(self.to_dataset(), path, overwrite=overwrite)
+
     def to_dataset(self):
         """The modes as an xarray Dataset (frequencies, multiplicity, type, group
         strain-energy shares, shapes: real and imaginary parts)."""

@@ -155,6 +155,13 @@ class QuasiStaticResults:
         files.check_output(path, formats=files.NETCDF_FORMATS, overwrite=overwrite)
         return self.save(path, overwrite=overwrite)
 
+    def write_figures(self, directory, formats=("png", "svg"), **kwargs) -> list:
+        """Write every figure of the sweep into ``directory``, as ``torquesplit static
+        --plots`` does (:func:`torquesplit.plot.write_static_figures`); returns the paths."""
+        from .plot import write_static_figures
+
+        return write_static_figures(self, directory, formats, **kwargs)
+
     def save(self, path, *, overwrite: bool = False):
         """Save by suffix: ``.nc`` NetCDF, ``.mat`` MATLAB, ``.csv`` spreadsheet tables
         (``NAME.csv`` a row per position, ``NAME_mesh.csv`` a row per mesh; see

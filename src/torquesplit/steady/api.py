@@ -243,6 +243,12 @@ class SteadyState:
         t, F, D = self.samples()
         return t, F[:, list(elements)], D[:, list(elements)]
 
+    def save(self, path, *, overwrite: bool = False, periods: int | None = None):
+        """Save the periodic state as ``torquesplit steady --out`` does (its record as a
+        run's, :meth:`to_results`, with the steady-state attributes): ``.nc``, ``.mat`` or
+        ``.csv``.  Returns the path written."""
+        return self.to_results(periods).save(path, overwrite=overwrite)
+
     def to_results(self, periods: int | None = None):
         """The periodic state as :class:`~torquesplit.results.Results` (the state
         repeated over ``periods`` periods: default enough for 4 settle windows), whose
