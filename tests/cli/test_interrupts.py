@@ -268,3 +268,13 @@ def test_the_entry_point_loads_nothing_heavy_before_its_guard():
                           "sorted(m for m in ('pydantic', 'numpy', 'numba', 'xarray') "
                           "if m in sys.modules))"], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "[]", out.stdout
+
+
+def test_python_dash_m_torquesplit_is_the_command():
+    """'python -m torquesplit' said 'is a package and cannot be directly executed'."""
+    import subprocess
+    import sys
+
+    out = subprocess.run([sys.executable, "-m", "torquesplit", "--version"],
+                         capture_output=True, text=True, check=True)
+    assert out.stdout.startswith("torquesplit ")
