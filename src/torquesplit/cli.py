@@ -1808,9 +1808,5 @@ for _info in app.registered_commands:  # every command's --help without a type
         _info.cls = _Command
 
 
-def main():  # pragma: no cover - console entry point
-    app()
-
-
 if __name__ == "__main__":  # pragma: no cover
     sys.exit(app())

@@ -128,9 +128,7 @@ class ModelError(TorquesplitError, ValueError):
             lines = key_lines(text)
         except Exception:  # noqa: BLE001 - a locator for messages: never hide the error
             return self
-        out = ModelError(self.issues, self.source, lines=lines)
-        out.__cause__, out.__suppress_context__ = self.__cause__, True
-        return out
+        return ModelError(self.issues, self.source, lines=lines)
 
 
 class OptionError(TorquesplitError, ValueError):

@@ -37,20 +37,25 @@ def test_contact_refuses_more_positions_than_the_model_file_allows():
     assert res.exit_code == 2 and "--positions 100000 is more than 4096" in res.stderr
 
 
-def test_an_interrupted_speed_sweep_keeps_its_curve(monkeypatch):
-    """Ctrl-C during 'sweep-speed' exited 130 and wrote nothing; other stops keep the curve."""
+def _interrupt_sweep_at_point(monkeypatch, n: int) -> None:
+    """Ctrl-C as the shooting continuation computes the multipliers of its n-th point."""
     from torquesplit.steady import sweep as S
 
     calls = {"n": 0}
     real = S.ShootingContinuation.multipliers
 
-    def interrupt_on_the_third_point(self, x, s):
+    def interrupt(self, x, s):
         calls["n"] += 1
-        if calls["n"] == 3:
+        if calls["n"] == n:
             raise KeyboardInterrupt
         return real(self, x, s)
 
-    monkeypatch.setattr(S.ShootingContinuation, "multipliers", interrupt_on_the_third_point)
+    monkeypatch.setattr(S.ShootingContinuation, "multipliers", interrupt)
+
+
+def test_an_interrupted_speed_sweep_keeps_its_curve(monkeypatch):
+    """Ctrl-C during 'sweep-speed' exited 130 and wrote nothing; other stops keep the curve."""
+    _interrupt_sweep_at_point(monkeypatch, 3)
     from torquesplit import example_path
     from torquesplit.steady.maps import sweep_speed
 
@@ -197,18 +202,8 @@ def test_a_sweep_that_stopped_says_its_largest_factor_is_of_the_part_computed(mo
     from typer.testing import CliRunner
 
     from torquesplit.cli import app
-    from torquesplit.steady import sweep as S
 
-    calls = {"n": 0}
-    real = S.ShootingContinuation.multipliers
-
-    def interrupt_on_the_fourth_point(self, x, s):
-        calls["n"] += 1
-        if calls["n"] == 4:
-            raise KeyboardInterrupt
-        return real(self, x, s)
-
-    monkeypatch.setattr(S.ShootingContinuation, "multipliers", interrupt_on_the_fourth_point)
+    _interrupt_sweep_at_point(monkeypatch, 4)
     res = CliRunner().invoke(app, ["sweep-speed", "ji_li_mill_drive", "--from", "300 rpm",
                                    "--to", "1500 rpm", "--points", "30"])
     text = " ".join(res.output.split())
