@@ -28,8 +28,9 @@ KERNELS = ROOT / "src" / "torquesplit" / "solve" / "_kernels.py"
 # part -> (what to remove, what to put instead); a part whose text is not found is skipped
 REMOVALS = {
     "right-hand side (4 calls)": [("        rhs_fn(a[A_Y] + row * np.uint64(iy)", None)],
-    "excitation (t + h/2, t + h)": [("    excite(t_mid, s_half, src_half, m, w)\n", ""),
-                                    ("    excite(t_end, sb, src_end, m, w)\n", "")],
+    "excitation (t + h/2, t + h)": [
+        ("            excite(t_end if last else t_mid, sb if last else s_half,\n"
+         "                   src_end if last else src_half, m, w)\n", "            pass\n")],
     "statistics (record)": [("        record(t, a, F_MAIN, 0.0 if last else h, m, w, r, counters)\n",
                              "")],
     "  of it: parabola vertices (peak_sample)": [

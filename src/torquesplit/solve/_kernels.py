@@ -231,8 +231,9 @@ def rhs_slot(slot, iy, idy, i_f, m, w):
     the additive force p.  Writes the forces and deformations into row ``i_f`` of w.F /
     w.D.  V is read by element (CSR, unsigned indices into the state) and, for the
     generalized forces, by DOF (a gather per DOF, no scatter).  Spline component
-    elements have zero stiffness and damping here (force 0); :func:`rhs_extra` adds
-    splines and tooth friction.
+    elements have zero stiffness and damping here (force 0); :func:`rhs_extra`, called
+    here if ``extra`` (the model has splines or tooth friction), adds them (one call of
+    this kernel per stage, not two: the kernels that inline stages compile faster).
     Twin: :func:`torquesplit.solve.reference.rhs_numpy` (with :func:`rhs_extra`).
     """
     Y, force, defl = w.Y, w.F, w.D
@@ -322,7 +323,8 @@ def rhs_extra(slot, iy, idy, i_f, m, w):
 def _stage(slot, iy, idy, i_f, m, w, rhs_fn, gen, extra):
     """One right-hand-side evaluation (the only one both integrators use): the
     generated code ``rhs_fn`` (splines and tooth friction included) if ``gen``, else
-    :func:`rhs_slot` and, if the model has splines or tooth friction, :func:`rhs_extra`.
+    :func:`rhs_slot` (which adds :func:`rhs_extra` if the model has splines or tooth
+    friction).
     (Called where it is not needed, rhs_extra would still cost the passing of the
     model's arrays: 20 % of a Dong et al. 2021 step.)"""
     if gen:
@@ -854,22 +856,23 @@ def _rk4_step(t_mid, t_end, hs, s_half, sb, src_half, src_end, m, w, rhs_fn, gen
     sees t0 + (i + 1/2) h and t0 + (i + 1) h exactly."""
     Y = w.Y
     n2 = Y.shape[1]
+    hh = 0.5 * hs
+    # stages 2-4 as one loop: numba then inlines the stage and the excitation call once,
+    # not three and two times (the kernels that inline this step compile faster)
+    for s in range(3):
+        last = s == 2
+        if s != 1:  # stage 2 at t + h/2, stage 4 at t + h (stage 3 shares stage 2's)
+            excite(t_end if last else t_mid, sb if last else s_half,
+                   src_end if last else src_half, m, w)
+        c = hs if last else hh
+        ks = Y_K1 + s
+        for k in range(n2):
+            Y[Y_TRIAL, k] = Y[Y_STATE, k] + c * Y[ks, k]
+        _stage(sb if last else s_half, Y_TRIAL, ks + 1, F_TMP, m, w, rhs_fn, gen, extra)
     k1 = Y_K1
     k2 = Y_K1 + 1
     k3 = Y_K1 + 2
     k4 = Y_K1 + 3
-    hh = 0.5 * hs
-    excite(t_mid, s_half, src_half, m, w)
-    for k in range(n2):
-        Y[Y_TRIAL, k] = Y[Y_STATE, k] + hh * Y[k1, k]
-    _stage(s_half, Y_TRIAL, k2, F_TMP, m, w, rhs_fn, gen, extra)
-    for k in range(n2):
-        Y[Y_TRIAL, k] = Y[Y_STATE, k] + hh * Y[k2, k]
-    _stage(s_half, Y_TRIAL, k3, F_TMP, m, w, rhs_fn, gen, extra)
-    excite(t_end, sb, src_end, m, w)
-    for k in range(n2):
-        Y[Y_TRIAL, k] = Y[Y_STATE, k] + hs * Y[k3, k]
-    _stage(sb, Y_TRIAL, k4, F_TMP, m, w, rhs_fn, gen, extra)
     h6 = hs / 6.0
     for k in range(n2):
         Y[Y_STATE, k] += h6 * (Y[k1, k] + 2.0 * (Y[k2, k] + Y[k3, k]) + Y[k4, k])
