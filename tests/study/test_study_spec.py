@@ -216,3 +216,23 @@ def test_a_phase_of_an_error_without_amplitude_is_said(split_file):
     data["grid"]["parameters"].append({"path": "gears.a.errors.eccentricity",
                                        "values": ["0 um", "10 um"]})
     assert Study(data).plan().notes == []  # (varied: the phase matters where it is not 0)
+
+
+def test_a_model_file_given_as_a_study_and_a_study_given_as_a_model_are_told_so(tmp_path):
+    """A reviewer gave `study` a model file: ten unknown-field errors, none of which said
+    what was wrong.  Each command now says which kind of file it got and which command
+    takes it."""
+    import torquesplit
+
+    model_file = torquesplit.example_path("ji_li_mill_drive")
+    with pytest.raises(StudyError) as exc:
+        Study(model_file)
+    assert "is a model file" in str(exc.value) and "torquesplit run" in str(exc.value)
+    assert "unknown field" not in str(exc.value)
+    study_file = tmp_path / "s.toml"
+    study_file.write_text(tomli_w.dumps({"study": {"model": str(model_file)},
+                                         "grid": {"meshes.m11.backlash": [0.0]}}))
+    result = CliRunner().invoke(app, ["run", str(study_file)])
+    assert result.exit_code == 2
+    assert "is a study file" in result.output and "torquesplit study" in result.output
+    assert result.output.count("error:") == 1

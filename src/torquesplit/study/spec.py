@@ -465,6 +465,13 @@ def _read(source, analysis: dict) -> tuple[StudySpec, Path | None, str]:
 
 def parse_study(data: dict) -> StudySpec:
     """Validate study data; every problem becomes one line of a StudyError."""
+    if (isinstance(data, dict) and "study" not in data
+            and any(k in data for k in ("gears", "meshes", "bodies"))):
+        raise StudyError("", "is a model file (it has gears and meshes, no [study]), not a "
+                             "study; run it with 'torquesplit run FILE', vary one of its "
+                             "parameters with 'torquesplit sweep FILE --vary PATH=A:B:N', or "
+                             "write a study file whose [study] names it: model = 'FILE' (see "
+                             "docs/studies.md)")
     given = [d for d in DESIGNS if isinstance(data, dict) and data.get(d) is not None]
     if len(given) > 1:  # said first: an incomplete second design's missing fields hid it
         raise StudyError(given[1], f"a study has one design, here {' and '.join(given)}; "
