@@ -153,6 +153,20 @@ def test_harmonics_beyond_the_harmonic_balance_limit_are_refused():
     assert "--method shooting" in res.output, res.output
 
 
+def test_a_speed_whose_period_cannot_be_held_is_refused_before_any_work():
+    """A fuzzer's 0.001 rpm: a period of 3e10 RK4 steps was warned about (hours), then
+    died in a 941 GiB allocation with a traceback.  Refused in one line, without the
+    warning, before any integration."""
+    from typer.testing import CliRunner
+
+    from torquesplit.cli import app
+
+    res = CliRunner().invoke(app, ["steady", "ji_li_mill_drive", "--speed", "1e-3 rpm"])
+    assert res.exit_code == 2, res.output
+    assert "GiB" in res.output and "speed nearer the model's" in res.output
+    assert "warning" not in res.output and "Traceback" not in res.output
+
+
 def test_modes_below_the_lowest_says_so():
     from typer.testing import CliRunner
 

@@ -86,6 +86,10 @@ MAX_SAMPLES = 1 << 16
 (every k-th RK4 step, k the smallest divisor of the steps that gets there), the meshes'
 forces and deformations at every step: Jin et al. 2019's full period (725,200 steps, 52
 DOFs) held 2.2 GB at every step, 3.0 GB with its Results."""
+MAX_TRACK_BYTES = 4 << 30
+"""Shooting refuses a period whose per-step mesh forces and deformations would take more
+memory than this (Ji & Li's drive at 0.001 rpm: 3.2e10 steps, a 941 GiB allocation that
+failed with a traceback after the warning that it would take hours)."""
 ANNOUNCE_SECONDS = 2.0
 """A shooting solve whose integration of one period is estimated to take longer is
 announced before it starts, with what sets its steps: Ji & Li's drive at 1 rpm ran for
@@ -370,6 +374,14 @@ def periodic_solution(structure, period: Period, *, method: str = "auto", harmon
     steps = p.rk4_steps(T, steps_per_cycle, order)
     if method == "auto":  # see AUTO
         method = "hb" if harmonics is not None or stability == "hill" else "shooting"
+    if method == "shooting":
+        need = 16 * (steps + 1) * int(np.sum(np.asarray(p.model.element_kind) == MESH_KIND))
+        if need > MAX_TRACK_BYTES:
+            raise SolverError(
+                f"one period at this speed ({T:.4g} s) takes {steps:,} RK4 steps, whose mesh "
+                f"forces need {need / 2**30:.3g} GiB (at most {MAX_TRACK_BYTES / 2**30:.3g}) and hours of integration; choose a "
+                f"speed nearer the model's, --method hb, or 'torquesplit run' for a "
+                f"transient at this speed")
     if method == "shooting" and (SECONDS_PER_DOF_STEP * p.structure.n_dof * steps
                                  > ANNOUNCE_SECONDS):
         _announce(p, T, steps, stability)
