@@ -264,6 +264,30 @@ def test_newton_stuck_on_a_kink_gives_up_before_its_budget(monkeypatch):
     assert np.array_equal(q, np.zeros(s.n_dof))
 
 
+@pytest.mark.parametrize("reg", [1e-9, "per element"])
+def test_the_line_searchs_compiled_forces_are_the_newton_forces_bit_for_bit(reg):
+    """With splines, the line search's forces come from one compiled pass
+    (static._line_forces); Newton's (with tangents) from numpy.  Both the same laws and
+    regularisation: equal to the last bit, in every region of the spline law (stick,
+    float, contact), for a scalar and a per-element regularisation."""
+    from torquesplit.assembly.structure import SPLINE
+    from torquesplit.solve.static import _StaticProblem
+
+    els = [dict(name="sp", kind=SPLINE, x=([0], [1.0]), y=([1], [1.0]), stiffness=1e8,
+                clearance=1e-4, stick_limit=2e-5, friction_force=50.0, velocity_scale=1e-3),
+           dict(name="mesh", kind=MESH, dofs=[0, 2], coefs=[1.0, -R1], stiffness=K_MESH,
+                gaps=5e-6)]
+    s = build_structure(["a.x", "a.y", "b.theta"], [1.0, 1.0, 1 / J1], els)
+    p = _StaticProblem(s, 1e-9, 1e-8)
+    L = p.loads(None)
+    r = np.linspace(1e-9, 1e-8, s.n_elements) if reg == "per element" else reg
+    rng = np.random.default_rng(3)
+    for scale in (1e-5, 5e-5, 3e-4):  # stick, between, beyond the clearance
+        for _ in range(20):
+            q = rng.normal(scale=scale, size=s.n_dof)
+            assert np.array_equal(p.force(q, L, r), p.forces(q, L, r)[1])
+
+
 def test_a_warm_start_finds_the_same_equilibrium_in_fewer_steps():
     """Dong et al. 2021's drive (clearances, backlash, splines) at t = 0, Newton started
     from its mean-stiffness equilibrium (as every run sets up its start): the same

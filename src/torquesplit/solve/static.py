@@ -46,9 +46,11 @@ d'Alembert force of a uniform acceleration, reported as
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
+from numba import njit
 
 from torquesplit.assembly.structure import (
     SP_CLEARANCE,
@@ -225,6 +227,7 @@ class _StaticProblem:
         self.balance_tolerance = balance_tolerance
         self.sp_x = s.sp_el[:, 0].astype(int)
         self.sp_y = s.sp_el[:, 1].astype(int)
+        self.sp_par = np.ascontiguousarray(s.sp_par, dtype=float)
         self._spline_set = set(self.sp_x.tolist()) | set(self.sp_y.tolist())
         self._spline_row = {int(e): j for j, pair in enumerate(s.sp_el) for e in pair}
         self.reg = self._regularisation(regularisation)
@@ -373,6 +376,13 @@ class _StaticProblem:
         """The element forces of :meth:`forces` alone (the line search needs no more)."""
         delta = self.V @ q - L.e
         k, g = L.k, L.g
+        if self.s.n_splines:  # one compiled pass (the numpy one is ~25 small-array ops)
+            f = np.empty_like(delta)
+            r = np.asarray(reg, dtype=float)
+            _line_forces(delta, np.asarray(g, dtype=float), np.asarray(k, dtype=float),
+                         np.full(delta.shape, float(r)) if r.ndim == 0 else r,
+                         self.sp_x, self.sp_y, self.sp_par, f)
+            return f
         h, dh, u = (np.empty_like(delta) for _ in range(3))
         laws.dead_zones(delta, np.asarray(g, dtype=float), h, dh, u)
         f = k * h + regularisation_force(delta, g, k, reg)[1]
@@ -633,6 +643,32 @@ class _StaticProblem:
         accel = self.phi.T @ resid
         return dict(q=q, forces=forces, delta=delta, contact=contact, it=solves,
                     converged=bool(ok), accel=accel)
+
+
+@njit(cache=True, error_model="numpy")
+def _line_forces(delta, g, k, reg, sp_x, sp_y, sp_par, f):
+    """:meth:`_StaticProblem.force` for a model with splines, compiled: the same laws
+    (:func:`laws.dead_zone`, :func:`laws.spline_force` at rest) and regularisation, in the
+    same operations (bit for bit), into ``f``.  The line search evaluates it about 15
+    times a Newton step; in numpy, its spline part alone was a third of Dong et al.
+    2021's quasi-static sweep."""
+    for e in range(delta.shape[0]):
+        d, ge = delta[e], g[e]
+        h, _, _ = laws.dead_zone(d, ge)
+        rk = reg[e] * k[e] if ge > 0 else 0.0
+        f[e] = k[e] * h + rk * min(max(d, -ge), ge)
+    for j in range(sp_x.shape[0]):
+        ex, ey = sp_x[j], sp_y[j]
+        dx, dy = delta[ex], delta[ey]
+        fx, fy = laws.spline_force(dx, dy, 0.0, 0.0, sp_par[j, 0], sp_par[j, 1],
+                                   sp_par[j, 2], sp_par[j, 3], sp_par[j, 4], sp_par[j, 5])
+        rad = math.hypot(dx, dy)
+        if rad > 0:
+            f_reg = (reg[ex] * sp_par[j, SP_STIFFNESS]) * min(rad, sp_par[j, SP_CLEARANCE])
+            fx += f_reg * (dx / rad)
+            fy += f_reg * (dy / rad)
+        f[ex] = fx
+        f[ey] = fy
 
 
 def _line_search(dphi, d0: float, kinks=()) -> float:
