@@ -200,6 +200,10 @@ def test_a_periodic_state_is_not_said_to_drift():
     res = sd.to_results()
     assert res.periodic and res.success
     assert not any("not steady" in w or "over its first half" in w for w in res.warnings())
+    # the period solved is at 20 rpm (period_s); period.period is the model speed's
+    rpm = float(torquesplit.steady.maps.reference_speed(model)) * torquesplit.steady.maps.RPM
+    assert sd.period_s == pytest.approx(sd.period.period * rpm / 20.0, rel=1e-12)
+    assert f"period {sd.period_s:.4g} s" in repr(sd)
 
 
 def test_keep_takes_a_frequency_with_its_unit():

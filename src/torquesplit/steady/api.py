@@ -170,10 +170,19 @@ class SteadyState:
         self.kinematics = kinematics
         self.structure = structure
         self.static = static
+        #: the excitations kept and their orders, at the model's own speed: its
+        #: ``period.period`` is the model speed's; the period solved, at the speed asked,
+        #: is :attr:`period_s` (``solution.period``)
         self.period = period
         self.solution: PeriodicSolution = solution
         self.dropped = dropped
         self.problem: PeriodicProblem = problem
+
+    @property
+    def period_s(self) -> float:
+        """The period of this steady state [s], at the speed it was solved at (the same
+        as ``solution.period``; ``period.period`` is the model's own speed's)."""
+        return self.solution.period
 
     def __repr__(self) -> str:
         from .maps import RPM, reference_speed
@@ -183,7 +192,7 @@ class SteadyState:
         rpm = reference_speed(self.model) * sol.speed * RPM
         return (f"SteadyState({self.model.model.name!r}: {sol.method} at {rpm:.6g} rpm "
                 f"(speed factor {sol.speed:.6g}), period "
-                f"{1.0 / (self.period.frequency * sol.speed):.4g} s, "
+                f"{self.period_s:.4g} s, "
                 f"{'converged' if sol.converged else 'NOT converged'})")
 
     @property
