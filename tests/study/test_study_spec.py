@@ -236,3 +236,18 @@ def test_a_model_file_given_as_a_study_and_a_study_given_as_a_model_are_told_so(
     assert result.exit_code == 2
     assert "is a study file" in result.output and "torquesplit study" in result.output
     assert result.output.count("error:") == 1
+
+
+def test_a_run_too_short_for_any_mesh_cycle_is_refused_before_its_cases():
+    """A 2 ms sweep of Ji & Li's drive ran every case and reported them 'ok' with no
+    value (half a cycle of its fastest mesh): refused when planned, naming the field."""
+    spec = {"study": {"name": "short", "model": "ji_li_mill_drive",
+                      "outputs": ["load_sharing.engineering"]},
+            "analysis": {"duration": "2 ms"},
+            "grid": {"parameters": [{"path": "meshes.m11.damping_ratio",
+                                     "values": [0.05, 0.1]}]}}
+    with pytest.raises(StudyError, match=r"analysis\.duration: the run, 0\.002 s, holds "
+                                         r"0\.472 cycle\(s\) of the fastest mesh \(m11"):
+        Study(spec).plan()
+    spec["analysis"]["duration"] = "9 ms"  # two cycles of m11: its outputs have values
+    assert Study(spec).n_cases == 2

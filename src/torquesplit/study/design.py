@@ -201,6 +201,8 @@ def _resolve(spec, folder, text, source) -> Plan:
     # the checks below do not depend on each other: every problem is said at once
     problems = _Problems()
     analysis = problems.attempt(_analysis, spec)
+    if analysis is not None and analysis["type"] == "run":
+        problems.attempt(_long_enough, model, analysis)
     chosen = problems.attempt(_outputs, spec, model, spec.analysis.type)
     kind = spec.design
     problems.attempt(_check_generated_paths, spec, model)
@@ -402,6 +404,36 @@ def _analysis(spec: StudySpec) -> dict:
         out["settle"] = {"tolerance": a.settle.tolerance, "start": start,
                          "growth": a.settle.growth}
     return out
+
+
+MIN_CYCLES = 2
+"""A run analysis shorter than this many cycles of the model's fastest mesh is refused:
+every output is measured over whole mesh cycles (a cycle the start or the end cuts does
+not count), so its cases would all be 'ok' with no value (a reviewer's 2 ms sweep).  A
+run that covers the fast meshes but not the slow ones gives the fast ones' outputs (and
+says the others are short)."""
+
+
+def _long_enough(model, analysis: dict) -> None:
+    from ..model.kinematics import solve_kinematics
+    from .case import _full_duration
+
+    length, f_min = _full_duration(model, analysis)
+    kin = solve_kinematics(model)
+    name, f_max = max(((m, kin.meshes[m].frequency) for m in model.meshes),
+                      key=lambda x: x[1])
+    if length * f_max >= MIN_CYCLES:
+        return
+    field = ("analysis.duration" if analysis.get("duration") is not None
+             else "analysis.cycles" if analysis.get("cycles") is not None
+             else "study.model (its [analysis])")
+    least = (f"{math.ceil(MIN_CYCLES * f_min / f_max)} cycle(s) of the slowest mesh"
+             if field == "analysis.cycles" else f"{MIN_CYCLES / f_max:.3g} s")
+    raise StudyError(field, f"the run, {length:.4g} s, holds {length * f_max:.3g} cycle(s) "
+                            f"of the fastest mesh ({name}, {f_max:.6g} Hz); every output is "
+                            f"measured over whole mesh cycles, so no case would have a "
+                            f"value: give at least {least} (settling takes many more; "
+                            f"without a run length the model's own is used)")
 
 
 def _outputs(spec: StudySpec, model, analysis: str) -> tuple[list[str], list[str]]:
