@@ -250,3 +250,40 @@ def test_the_shipped_optimisation_is_copied_by_the_example_command(tmp_path):
     assert read_spec(tmp_path / "liu2021_dh_modification.toml").variables
     listed = CliRunner().invoke(app, ["examples"])
     assert "liu2021_dh_modification" in listed.output and "docs/optimization.md" in listed.output
+
+
+def test_an_installation_without_pymoo_is_told_how_to_get_it(monkeypatch):
+    """pymoo is an extra ('study'): without it 'optimize' ended in a traceback
+    (ModuleNotFoundError: No module named 'pymoo.core')."""
+    import sys
+
+    from typer.testing import CliRunner
+
+    from torquesplit.cli import app
+
+    for name in [n for n in sys.modules if n == "pymoo" or n.startswith("pymoo.")] + ["pymoo"]:
+        monkeypatch.setitem(sys.modules, name, None)
+    res = CliRunner().invoke(app, ["optimize", "liu2021_dh_modification"])
+    assert res.exit_code == 2, res.output
+    assert "pip install 'torquesplit[study]'" in res.output
+    assert "Traceback" not in res.output
+
+
+def test_the_commands_warnings_are_warning_lines(tmp_path, monkeypatch):
+    """'choose = min_sum' over objectives that are not relative warned as a raw Python
+    warning ('.../bin/torquesplit:8: ModelWarning: ...'): a 'warning:' line as every
+    other command gives."""
+    from typer.testing import CliRunner
+
+    from torquesplit.cli import app
+    from torquesplit.examples import optimization_path
+
+    text = optimization_path("liu2021_dh_modification").read_text()
+    spec = tmp_path / "norel.toml"
+    spec.write_text("\n".join(line for line in text.splitlines() if "relative_to" not in line))
+    monkeypatch.chdir(tmp_path)
+    res = CliRunner().invoke(app, ["optimize", "norel.toml", "--generations", "1",
+                                   "--population", "4", "--workers", "1", "--out", "o"])
+    assert res.exit_code == 0, res.output
+    assert "warning: norel.toml: choose = 'min_sum' adds the objectives" in res.output
+    assert "ModelWarning" not in res.output

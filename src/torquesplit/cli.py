@@ -888,9 +888,10 @@ def static(
     max_points: int = typer.Option(20000, "--max-points", help="Most positions of the sweep "
                                    "(a longer common period of the errors thins them, and "
                                    "says so).", metavar="N"),
-    out: Optional[Path] = typer.Option(None, "--out", help="Write results: .nc (NetCDF), .mat "
-                                       "(MATLAB) or .csv (NAME.csv per position, NAME_mesh.csv "
-                                       "per mesh).", metavar="FILE"),
+    out: Optional[Path] = typer.Option(
+        None, "--out", metavar="FILE",
+        help="Write results: .nc (NetCDF), .mat (MATLAB) or .csv (NAME.csv per position, "
+             "NAME_mesh.csv per mesh, NAME_group.csv per group, NAME_about.json)."),
     force: bool = _flag("--force", "Replace an existing results file and figures."),
     plots: Optional[Path] = typer.Option(None, "--plots", help="Write report figures (PNG, "
                                          "SVG) into this folder.", metavar="DIR"),
@@ -1479,7 +1480,7 @@ def optimize(
             path = shipped
     target = out or (Path.cwd() / f"{path.stem}_results")
     with ux.interruptible(lambda: "evaluations done so far are kept in the store: run the "
-                          "same command again to resume"):
+                          "same command again to resume"), ux.collect_warnings():
         try:
             _check_plots_folder(target, "--out")
             old = [f for f in ("pareto.csv", "chosen.toml", "pareto.png")

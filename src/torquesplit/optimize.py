@@ -701,8 +701,13 @@ def optimize(source, *, workers: int | None = None, generations: int | None = No
     """
     import importlib
 
-    from pymoo.core.problem import Problem
-    from pymoo.optimize import minimize
+    try:
+        from pymoo.core.problem import Problem
+        from pymoo.optimize import minimize
+    except ImportError:
+        raise OptionError("optimisation runs on pymoo, which this installation lacks; "
+                          "install it with pip install 'torquesplit[study]' (from a "
+                          "checkout: pip install '.[study]')") from None
 
     spec = source if isinstance(source, OptimizationSpec) else read_spec(source)
     over = {k: v for k, v in dict(workers=workers, generations=generations,

@@ -241,7 +241,8 @@ def test_stopping_rule_outcome_is_reported(split_file, tmp_path):
     with ui.console.capture() as cap:
         _summary(ds, tmp_path, False, False)
     assert "stopping rule: mean of load_sharing.cycle_peak" in cap.get()
-    assert "target met" in cap.get() and "95% interval" in cap.get()
+    assert "target met" in cap.get() and "95% interval)" in cap.get()
+    assert ", +/- " in cap.get()  # a mean's interval is centred: said so (it gave the ends)
     labels = [t.get_text() for t in monte_carlo_figure(ds, OUT).axes[2].get_legend().texts]
     assert any(t.startswith("stopping target +/-0.01 (mean, met)") for t in labels)
     assert "95% interval at the stop" in labels

@@ -604,7 +604,8 @@ def stopping_line(ds) -> str:
     outcome = ("target met" if a["stopping_target_met"] else
                f"target NOT met: max_samples = {rule['max_samples']} reached; raise it or "
                f"widen half_width")
-    if "stopping_lower" in a:  # (a percentile's interval is not centred on its estimate)
+    if "stopping_lower" in a and a["stopping_statistic"] != "mean":  # (a percentile's
+        # interval is not centred on its estimate; a mean's Student-t interval is)
         interval = (f"{rule['confidence']:.0%} interval {k * a['stopping_lower']:.6g} .. "
                     f"{k * a['stopping_upper']:.6g}{unit}, half-width "
                     f"{k * a['stopping_half_width']:.3g}{unit}")
