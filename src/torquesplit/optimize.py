@@ -48,11 +48,13 @@ Outputs: ``ltca.MESH.KEY`` -- any key of the LTCA summary of a mesh with
 ``te_peak_to_peak_m``, ``impact_peak_force_N`` (needs ``impact = true``),
 ``stiffness_secant_mean_N_per_m``, ``max_hertz_pressure_Pa``, ``actual_contact_ratio``...);
 ``dynamic.GROUP.dynamic_factor``, ``dynamic.GROUP.load_sharing``,
-``dynamic.MESH.dynamic_factor``, ``dynamic.system_load_sharing`` -- from a dynamic run
+``dynamic.MESH.dynamic_factor``, ``dynamic.MESH.load_sharing``,
+``dynamic.system_load_sharing`` -- from a dynamic run
 (:func:`torquesplit.simulate`, per-cycle peak definitions; slow).
 
-Results: the Pareto front (table ``pareto.csv`` and figure ``pareto.png``) and the chosen
-design written back as a model file (``chosen.toml``).  Variables are shown (tables,
+Results: the Pareto front (table ``pareto.csv``, and figure ``pareto.png`` with two
+objectives or more) and the chosen design written back as a model file
+(``chosen.toml``).  Variables are shown (tables,
 ``pareto.csv``) and written (``chosen.toml``: '0.023 mm') in the unit of their bounds;
 objectives with ``relative_to`` are ratios, headed ``(/ baseline)``.
 """

@@ -788,7 +788,7 @@ class Drive(Strict):
     )
     fluctuation: tuple[TorqueHarmonic, ...] = Field((), description=(
         "Harmonics of the drive torque about its nominal value (a 'torque' drive only), "
-        "e.g. [{amplitude = '500 N m', frequency = '100 Hz'}] (see TorqueHarmonic)."))
+        "e.g. [{amplitude = '500 N m', frequency = '100 Hz'}] (see [drives.NAME.fluctuation])."))
     speed_coefficient: TorsionalDamping = Field(0.0, ge=0, description=(
         "Slope of the drive's torque-speed characteristic, -dT/d(speed) at the nominal "
         "point (an induction motor's slip: its torque falls as it runs faster); a "
@@ -836,7 +836,7 @@ class Load(Strict):
     )
     fluctuation: tuple[TorqueHarmonic, ...] = Field((), description=(
         "Harmonics of the load torque about its nominal value, e.g. [{amplitude = "
-        "'20 kN m', order = 2}] (see TorqueHarmonic)."))
+        "'20 kN m', order = 2}] (see [drives.NAME.fluctuation])."))
 
 
 class Analysis(Strict):
