@@ -542,6 +542,9 @@ def test_a_saved_steady_state_says_what_it_is():
         [info["meshes"][m]["rms_transmission_error"] for m in ds["mesh"].values])
     assert "start-up" not in ds["contact_loss_fraction"].attrs["long_name"]
     assert json.loads(ds.attrs["steady_json"])["period_s"] == pytest.approx(info["period_s"])
+    # stability as a number a program can test (it was the text 'True') and in words
+    assert ds.attrs["steady_stable"] == int(info["stable"]) and ds.attrs["steady_stable"] in (0, 1)
+    assert ds.attrs["steady_stability"] == ("stable" if info["stable"] else "unstable")
 
 
 def test_a_saved_steady_state_holds_one_period_and_reads_back_the_same(tmp_path):

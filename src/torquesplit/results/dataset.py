@@ -280,12 +280,17 @@ def steady_attrs(res, info: dict) -> dict:
     :meth:`~torquesplit.steady.SteadyState.summary`)."""
     periods = (float(res.solution.t_final - res.solution.t_span[0]) / info["period_s"]
                if info["period_s"] else math.nan)
+    # (stable: 1 or 0, for a program; left out where the stability was not computed,
+    # which steady_stability says; it was the text 'True', which a program reads as true
+    # whatever it says)
+    stable = {} if info["stable"] is None else {"steady_stable": np.int8(info["stable"])}
     return dict(
         analysis="periodic steady state",
         steady_json=_json.dumps(info, default=float),
         steady_method=info["method"], steady_period_s=info["period_s"],
-        steady_residual=info["residual"],
-        steady_stable=("unknown" if info["stable"] is None else str(bool(info["stable"]))),
+        steady_residual=info["residual"], **stable,
+        steady_stability=("not computed" if info["stable"] is None
+                          else "stable" if info["stable"] else "unstable"),
         steady_largest_multiplier=(math.nan if info["largest_multiplier"] is None
                                    else info["largest_multiplier"]),
         dropped_excitations="; ".join(info["dropped_excitations"]) or "none",
