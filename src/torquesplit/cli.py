@@ -1169,7 +1169,7 @@ MAX_FLANK_PRESSURE = 4e9
 allowable, 3 GPa static limit): above it a contact load is a slip of units."""
 
 
-CONTACT_TABLES = ("load", "position", "harris_load")
+CONTACT_TABLES = ("load_case", "position", "harris_load")
 """Row dimensions of ``contact --out``'s CSV tables (:mod:`torquesplit.gears.contact.export`)."""
 
 

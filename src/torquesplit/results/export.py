@@ -122,9 +122,12 @@ def _table(ds, dim) -> tuple[list[str], list[list]]:
         units = ([_unit_suffix({"units": u}) for u in ds[per].values]
                  if " or " in str(da.attrs.get("units", "")) and per in ds.coords else None)
         labels = [_labels(ds, d) for d in rest]
+        # (a name that ends in its unit keeps it once, at the end: 'transmission_error_
+        # 10kN_arcsec', not 'transmission_error_arcsec_10kN_arcsec')
+        base = name[:-len(unit)] if units is None and unit and name.endswith(unit) else name
         for idx in itertools.product(*(range(ds.sizes[d]) for d in rest)):
             label = "_".join(lab[i] for lab, i in zip(labels, idx))
-            header.append(f"{name}_{label}{unit if units is None else units[idx[-1]]}")
+            header.append(f"{base}_{label}{unit if units is None else units[idx[-1]]}")
             columns.append(da.values[(slice(None),) + idx])
     rows = [[_cell(col[i]) for col in columns] for i in range(n)]
     return header, rows

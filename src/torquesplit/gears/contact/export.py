@@ -2,7 +2,7 @@
 ``torquesplit contact``) and as an xarray Dataset, for the NetCDF, MATLAB and spreadsheet
 files of ``torquesplit contact --out`` (:mod:`torquesplit.results.export`).
 
-Three tables, one per row dimension: ``load`` (the scalars of each analysed load, as the
+Three tables, one per row dimension: ``load_case`` (the scalars of each analysed load, as the
 printed table), ``position`` (the curves over the mesh cycle: a column per load, named by
 it in kN, and the largest load's load per tooth pair), and ``harris_load`` (the Harris
 map).  SI units on
@@ -43,11 +43,11 @@ def contact_dataset(results, *, operating_load=None, harris=None, impact=None, g
         "contact_ratio": ("actual_contact_ratio", "1",
                           "mean number of loaded tooth pairs over the cycle"),
     }
-    data = {name: ("load", np.array([row[key] for row in rows], dtype=float),
+    data = {name: ("load_case", np.array([row[key] for row in rows], dtype=float),
                    {"units": unit, "long_name": text})
             for name, (key, unit, text) in per_load.items()}
     if given is not None:
-        data["given_as"] = ("load", np.array(list(given), dtype=object),
+        data["given_as"] = ("load_case", np.array(list(given), dtype=object),
                             {"long_name": "the load as given (a torque on a gear, or a force)"})
     curves = {  # name -> (values (position, load), unit, description)
         "transmission_error": ([r.transmission_error for r in results], "m",
@@ -64,7 +64,7 @@ def contact_dataset(results, *, operating_load=None, harris=None, impact=None, g
                          "tooth pairs carrying load at the position"),
     }
     for name, (values, unit, text) in curves.items():
-        data[name] = (("position", "load"), np.stack(values, axis=1),
+        data[name] = (("position", "load_case"), np.stack(values, axis=1),
                       {"units": unit, "long_name": text})
     data["unloaded_te"] = ("position", np.asarray(op.unloaded_te, dtype=float),
                            {"units": "m", "long_name": "transmission error at vanishing "
@@ -76,9 +76,10 @@ def contact_dataset(results, *, operating_load=None, harris=None, impact=None, g
     labels = [f"{x / 1e3:.6g}kN" for x in loads]
     if len(set(labels)) < len(labels):
         labels = [f"load{k + 1}" for k in range(len(labels))]
-    coords = {"load": ("load", np.array(labels, dtype=object),
-                       {"long_name": "the load analysed (its value: load_N)"}),
-              "load_N": ("load", loads, {"units": "N", "long_name": "normal tooth load"}),
+    # (the dimension is not 'load': ds.load is xarray's Dataset.load(), which hid it)
+    coords = {"load_case": ("load_case", np.array(labels, dtype=object),
+                            {"long_name": "the load analysed (its value: load_N)"}),
+              "load_N": ("load_case", loads, {"units": "N", "long_name": "normal tooth load"}),
               "phase": ("position", np.asarray(op.phase, dtype=float),
                         {"units": "1", "long_name": "mesh position in cycles"}),
               "position": np.arange(1, op.phase.size + 1),
