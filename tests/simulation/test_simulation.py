@@ -113,6 +113,10 @@ def test_mat_and_csv_exports(split, tmp_path):
     desc = mat["descriptions"][0, 0]
     assert "history of every integration step" in str(desc["element_force"][0])
     assert str(mat["units"][0, 0]["time"][0]) == "s"
+    # the warnings as a cell column, one per warning (none: empty, which {''} was not)
+    said = res.warnings()
+    assert mat["warnings"].shape == (len(said), 1)
+    assert [str(w[0]) for w in mat["warnings"].ravel()] == said
     res.save(tmp_path / "run.csv")
     with open(tmp_path / "run.csv", newline="") as fh:
         rows = list(csv.DictReader(fh))

@@ -686,7 +686,8 @@ class Results:
                 for name in list(ds.data_vars) + ["time"]}
             data["model_json"] = ds.attrs["model_json"]
             data["metrics_json"] = ds.attrs.get("metrics_json", "")
-            data["warnings"] = np.asarray(self.warnings(definition) or [""], dtype=object)
+            # (none: an empty cell, which isempty() sees; {''} counted one warning)
+            data["warnings"] = files.cell_column(self.warnings(definition))
             data["provenance"] = files.provenance(claim.run_id, ds.attrs["model_json"])
             steady = _steady_summary(ds.attrs)
             if steady:  # (a reviewer's MATLAB had no stability and no period of it)

@@ -187,8 +187,7 @@ def _mat_data(ds, run_id: str, attrs=None) -> dict:
         if isinstance(ds.attrs.get(key), str) and key not in data:
             data[key] = ds.attrs[key]
     if isinstance(ds.attrs.get("warnings_json"), str) and "warnings" not in data:
-        data["warnings"] = np.asarray(json.loads(ds.attrs["warnings_json"]) or [""],
-                                      dtype=object)
+        data["warnings"] = files.cell_column(json.loads(ds.attrs["warnings_json"]))
     data["provenance"] = files.provenance(run_id, ds.attrs.get("model_json"))
     return data
 

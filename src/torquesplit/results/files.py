@@ -251,6 +251,18 @@ def new_run_id() -> str:
     return str(uuid.uuid4())
 
 
+def cell_column(texts) -> np.ndarray:
+    """Texts as a MATLAB cell column (N x 1; none: an empty cell, 0 x 1, which
+    ``isempty`` sees, where {''} counted as one text)."""
+    import numpy as np
+
+    texts = list(texts)
+    out = np.empty((len(texts), 1), dtype=object)
+    for i, t in enumerate(texts):
+        out[i, 0] = str(t)
+    return out
+
+
 def provenance(run_id: str, model_json: str | None = None) -> dict[str, str]:
     """Attributes that say which run wrote a file: its id and time, the software with
     its git commit (:func:`software_commit`), the command as a shell would take it back
