@@ -760,7 +760,9 @@ def _crossing_table(ds, crossings: list[dict]) -> None:
     ds.coords["crossing"] = np.arange(1, len(crossings) + 1)
     ds["crossing_speed_rpm"] = ("crossing", col("speed_rpm"),
                                 {"units": "rpm", "long_name": "critical speed"})
-    ds["crossing_mode"] = ("crossing", col("mode"), {"units": "1", "long_name": "mode number"})
+    modes = col("mode")  # (whole numbers: 3, not 3.0, in a CSV; MATLAB gets doubles)
+    ds["crossing_mode"] = ("crossing", modes.astype(np.int64) if np.isfinite(modes).all()
+                           else modes, {"units": "1", "long_name": "mode number"})
     ds["crossing_frequency"] = ("crossing", col("frequency_Hz"),
                                 {"units": "Hz", "long_name": "natural frequency"})
     ds["crossing_excitation"] = ("crossing", np.array(
@@ -774,7 +776,8 @@ def _crossing_table(ds, crossings: list[dict]) -> None:
         "units": "1", "long_name": "share of the meshes' harmonic forces that reaches the "
         "mode (0: they cancel on it)"})
     ds["crossing_driven"] = ("crossing", np.array(
-        [float(driven(c) and not c.get("suppressed", False)) for c in crossings]), {
+        [int(driven(c) and not c.get("suppressed", False)) for c in crossings],
+        dtype=np.int8), {
         "units": "1", "long_name": "1 if the model drives the crossing (a stiffness "
         "harmonic or error of at least 1 % that reaches the mode)"})
 
