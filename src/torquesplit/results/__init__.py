@@ -702,7 +702,8 @@ class Results:
         the run's group table and system line print), ``NAME_history.csv`` (the history's
         forces and torques, each column's unit in its name: ``m1_N``, ``shaft_Nm``),
         ``NAME_cycles.csv`` (start, peak, smallest and mean force of every mesh cycle;
-        empty for a cycle the start or the end of the run cuts, :attr:`complete_cycles`),
+        empty for a cycle the start or the end of the run cuts, :attr:`complete_cycles`;
+        ``MESH_settled`` 1 for the cycles the metrics' peaks are over),
         ``NAME_bearings.csv`` (the bearing table: :meth:`bearing_forces`) and
         ``NAME_about.json`` (the run's provenance, model, warnings and metrics:
         :func:`files.about_bytes`).  The column names do not depend on the load-sharing
@@ -732,6 +733,15 @@ class Results:
             met = None
         bearings: list[dict] = []
         steady_summary = None  # (computed once: the table and the about file use it)
+        # which cycles the metrics are over (1: in the settled span), so that the table
+        # gives the summary's peaks back (a spreadsheet user could not: the settle time
+        # was only in the about file)
+        settled_header, settled_columns = [], []
+        if met is not None:
+            n_cyc = self.solution.cycle_start.shape[0]
+            settled_header = [f"{m}_settled" for m in self.mesh_names]
+            settled_columns = [np.arange(n_cyc) >= met.settling.first_cycle[m]
+                               for m in self.mesh_names]
         if met is not None:
             name = met.definition
             rows = [[r.mesh, r.group, r.nominal_force, r.static_force, r.mean_force,
@@ -791,10 +801,11 @@ class Results:
                                                       s.history_forces[:n_hist]]).tolist()),
             cycles: files.csv_bytes(
                 ["cycle"] + [f"{m}_{q}" for q in ("start_s", "peak_N", "min_N", "mean_N")
-                             for m in self.mesh_names],
-                [[k] + row for k, row in enumerate(np.column_stack(
-                    [s.cycle_start[:, cols], *self.complete_cycle_statistics()[:3]]
-                ).tolist())]),
+                             for m in self.mesh_names] + settled_header,
+                [[k] + row + [int(c[k]) for c in settled_columns]
+                 for k, row in enumerate(np.column_stack(
+                     [s.cycle_start[:, cols], *self.complete_cycle_statistics()[:3]]
+                 ).tolist())]),
         }
         with files.claim_output(plan) as claim:
             steady_info = _steady_summary(self._steady_attributes(steady_summary))

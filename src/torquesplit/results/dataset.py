@@ -185,10 +185,19 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
                                       "cycles")
         ds["double_flank"] = _var(("mesh",), [int(r.double_flank) for r in met.rows], "1",
                                   "1: the mesh has no backlash (double-flank contact)")
+        # the settled span, so that the cycle variables give the peaks back (it was only
+        # inside metrics_json)
+        ds["first_settled_cycle"] = _var(("mesh",), np.array(
+            [met.settling.first_cycle[m] for m in meshes], dtype=np.int64), "1",
+            "first cycle of the settled span: peak_force, min_force and the coefficients "
+            "are over the cycles from this one on")
         # each load-sharing group's and the system's numbers as variables too (for
         # xarray, MATLAB and spreadsheet users: not only inside metrics_json)
         groups = list(met.load_sharing.per_group)
         ds = ds.assign_coords(group=("group", groups))
+        ds["settle_time"] = _var(("group",), [met.settling.group_time.get(g, np.nan)
+                                              for g in groups], "s",
+                                 "time from which the group's response is settled")
         ds["load_sharing_group"] = _var(("group",), [met.load_sharing.per_group[g]
                                                      for g in groups], "1",
                                         f"load-sharing coefficient of each group "
