@@ -412,8 +412,9 @@ def run(
         None, "--out", help="Write results: .nc (NetCDF-4; .h5 and .netcdf are read as .nc), "
         ".mat (MATLAB) or .csv "
         "(spreadsheet files: NAME.csv a row per mesh, NAME_groups.csv a row per "
-        "load-sharing group and the system, NAME_bearings.csv, NAME_history.csv, "
-        "NAME_cycles.csv, and NAME_about.json: model, warnings, metrics, provenance).",
+        "load-sharing group and the system, NAME_bearings.csv, NAME_elements.csv (contact "
+        "loss of every element), NAME_history.csv, NAME_cycles.csv, and NAME_about.json: "
+        "model, warnings, metrics, provenance).",
         metavar="FILE"),
     force: bool = _flag("--force", "Replace existing results files and figures."),
     plots: Optional[Path] = typer.Option(None, "--plots", help="Write report figures (PNG, "

@@ -260,14 +260,14 @@ def test_csv_results_name_every_file_written(tmp_path):
     assert res.exit_code == 0, res.output
     text = " ".join(res.stdout.split())
     for name in ("x.csv", "x_groups.csv", "x_history.csv", "x_cycles.csv", "x_bearings.csv",
-                 "x_about.json"):
+                 "x_elements.csv", "x_about.json"):
         assert (tmp_path / name).exists()
         assert name in text
     data = json.loads(runner.invoke(app, ["run", str(model), "--cycles", "5", "--json",
                                           "--force", "--out", str(tmp_path / "x.csv")]).stdout)
     assert sorted(Path(f).name for f in data["results_files"]) == [
-        "x.csv", "x_about.json", "x_bearings.csv", "x_cycles.csv", "x_groups.csv",
-        "x_history.csv"]
+        "x.csv", "x_about.json", "x_bearings.csv", "x_cycles.csv", "x_elements.csv",
+        "x_groups.csv", "x_history.csv"]
 
 
 def test_ctrl_c_says_nothing_was_written(tmp_path, monkeypatch):

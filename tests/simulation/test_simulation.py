@@ -335,3 +335,10 @@ def test_the_cycle_tables_give_the_peaks_back_over_the_settled_span(tmp_path):
     assert max(float(c["m11_peak_N"]) for c in cyc if c["m11_peak_N"]) > met.rows[0].peak_force
     groups = list(ds["group"].values)
     assert list(ds["settle_time"].values) == [met.settling.group_time[g] for g in groups]
+    # every recorded element's contact state, supports included (only in the .nc/.mat)
+    with open(tmp_path / "r_elements.csv", newline="") as fh:
+        els = list(csv.DictReader(fh))
+    assert [e["element"] for e in els] == list(ds["element"].values)
+    assert [float(e["contact_loss_fraction"]) for e in els] == list(
+        ds["contact_loss_fraction"].values)
+    assert [e["unit"] for e in els] == list(ds["element_unit"].values)

@@ -337,7 +337,7 @@ def test_every_file_a_save_writes_is_named(tmp_path):
     # every number of a mesh has its unit (the table prints kN and µm, the JSON SI)
     assert set(data["units"]) == set(data["meshes"]["m11"]) - {"group"}
     assert data["units"]["rms_transmission_error"] == "m"
-    assert sorted(listed) == sorted(str(p) for p in tmp_path.iterdir()) and len(listed) == 6
+    assert sorted(listed) == sorted(str(p) for p in tmp_path.iterdir()) and len(listed) == 7
     r = CliRunner().invoke(app, ["modes", "ji_li_mill_drive", "--out", str(tmp_path / "m.csv")])
     said = " ".join(r.stdout.split())
     for name in ("m.csv", "m_dof.csv", "m_about.json"):

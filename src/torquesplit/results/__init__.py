@@ -704,12 +704,14 @@ class Results:
         ``NAME_cycles.csv`` (start, peak, smallest and mean force of every mesh cycle;
         empty for a cycle the start or the end of the run cuts, :attr:`complete_cycles`;
         ``MESH_settled`` 1 for the cycles the metrics' peaks are over),
-        ``NAME_bearings.csv`` (the bearing table: :meth:`bearing_forces`) and
+        ``NAME_bearings.csv`` (the bearing table: :meth:`bearing_forces`),
+        ``NAME_elements.csv`` (a row per recorded element: its unit, frame and the
+        fractions of the run with its clearance open and in back contact) and
         ``NAME_about.json`` (the run's provenance, model, warnings and metrics:
         :func:`files.about_bytes`).  The column names do not depend on the load-sharing
         definition: a column ``load_sharing_definition`` names it.
 
-        All six are written atomically, and none replaces an existing file unless
+        All seven are written atomically, and none replaces an existing file unless
         ``overwrite``.  A run that did not finish has no metrics: its summary lists the
         meshes with empty metric columns and its status, its groups file the groups.
         """
@@ -786,7 +788,15 @@ class Results:
         names = [el[i] for i in s.history_elements]
         units = element_units(self.structure)
         cols = [list(s.tracked_elements).index(el.index(m)) for m in self.mesh_names]
-        summary, history, cycles, groups, bearing_file, about = plan.files
+        summary, history, cycles, groups, bearing_file, elements, about = plan.files
+        # every recorded element's contact state (a support or spline clearance open most
+        # of the run was only in the .nc and .mat: the summary is per mesh)
+        from .dataset import element_frames
+
+        contents_elements = files.csv_bytes(
+            ["element", "unit", "frame", "contact_loss_fraction", "back_contact_fraction"],
+            [[n, units[i], f, s.separation_fraction[i], s.back_contact_fraction[i]]
+             for n, i, f in zip(names, s.history_elements, element_frames(self, names))])
         n_hist = s.history_t.size
         if self.periodic and self.period:  # one period, as the .nc holds
             from .dataset import period_samples
@@ -795,6 +805,7 @@ class Results:
         contents = {
             groups: files.csv_bytes(group_header, group_rows),
             bearing_file: files.csv_bytes(bearing_header, bearing_rows),
+            elements: contents_elements,
             history: files.csv_bytes(["time_s"] + [f"{n}_{units[i].replace(' ', '')}"
                                                    for n, i in zip(names, s.history_elements)],
                                      np.column_stack([s.history_t[:n_hist],

@@ -45,7 +45,7 @@ def add_planet_load_sharing(ds: xr.Dataset, load_sharing, kinematics) -> xr.Data
     return ds
 
 
-def _element_frames(res, names: list[str]) -> list[str]:
+def element_frames(res, names: list[str]) -> list[str]:
     """Frame of each recorded element force (see the ``element_frame`` coordinate)."""
     from ..model.kinematics import support_frame
 
@@ -138,7 +138,7 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
     )
     ds = ds.assign_coords(element_unit=("element", hist_units, {
         "long_name": "unit of each element's force: N, or N m for a torque"}))
-    ds = ds.assign_coords(element_frame=("element", _element_frames(res, hist_names), {
+    ds = ds.assign_coords(element_frame=("element", element_frames(res, hist_names), {
         "long_name": "frame of the element force: a support force of a body measured in "
                      "a turning carrier's frame is in that frame (its shaft orders are "
                      "speeds relative to the carrier); 'housing' the fixed frame; '' a "

@@ -99,13 +99,15 @@ class OutputPlan:
 
 def companion_files(path: Path, fmt: str) -> tuple[Path, ...]:
     """The files a save of ``fmt`` to ``path`` writes: CSV writes ``NAME_groups.csv``,
-    ``NAME_history.csv``, ``NAME_cycles.csv``, ``NAME_bearings.csv`` and
-    ``NAME_about.json`` (:func:`about_bytes`) beside ``NAME.csv``."""
+    ``NAME_history.csv``, ``NAME_cycles.csv``, ``NAME_bearings.csv``,
+    ``NAME_elements.csv`` and ``NAME_about.json`` (:func:`about_bytes`) beside
+    ``NAME.csv``."""
     if fmt == "csv":
         return (path, path.with_name(path.stem + "_history.csv"),
                 path.with_name(path.stem + "_cycles.csv"),
                 path.with_name(path.stem + "_groups.csv"),
-                path.with_name(path.stem + "_bearings.csv"), about_path(path))
+                path.with_name(path.stem + "_bearings.csv"),
+                path.with_name(path.stem + "_elements.csv"), about_path(path))
     return (path,)
 
 
@@ -251,7 +253,7 @@ def new_run_id() -> str:
     return str(uuid.uuid4())
 
 
-def cell_column(texts) -> np.ndarray:
+def cell_column(texts):
     """Texts as a MATLAB cell column (N x 1; none: an empty cell, 0 x 1, which
     ``isempty`` sees, where {''} counted as one text)."""
     import numpy as np
