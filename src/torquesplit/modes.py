@@ -182,8 +182,8 @@ class ModalReport:
             {"frequency": (("mode",), [r.frequency for r in self.rows],
                            {"units": "Hz", "long_name": "natural frequency"}),
              "damping_ratio": (("mode",), [r.damping_ratio for r in self.rows],
-                               {"units": "1", "long_name": "modal damping ratio, "
-                                + DAMPING_RATIO_DEFINITION}),
+                               {"units": "1", "long_name": "modal damping ratio",
+                                "comment": DAMPING_RATIO_DEFINITION}),
              "damped_frequency": (("mode",), [r.damped_frequency for r in self.rows],
                                   {"units": "Hz", "long_name": "damped natural frequency "
                                    "f sqrt(1 - zeta^2) of the damping-ratio estimate"}),

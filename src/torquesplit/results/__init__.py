@@ -682,6 +682,7 @@ class Results:
             # what each variable is, as the NetCDF's long_name (and its sampling note)
             data["descriptions"] = {
                 name: " ".join(filter(None, (ds[name].attrs.get("long_name", ""),
+                                             ds[name].attrs.get("comment", ""),
                                              ds[name].attrs.get("sampling", ""))))
                 for name in list(ds.data_vars) + ["time"]}
             data["model_json"] = ds.attrs["model_json"]

@@ -87,12 +87,7 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
             # change in place, ds["element_force"] /= 1e3)
             "element_force": _var(("time", "element"), s.history_forces.copy(),
                                   "N" if set(hist_units) <= {"N"} else "N or N m",
-                                  "element force (mesh: normal tooth force, negative in "
-                                  "back-flank contact; support: the force on the bearing; "
-                                  "shaft, spline torsion, torsional support: torque [N m], "
-                                  "k (theta_a - theta_b) + damping, a the first body it "
-                                  "connects, both angles about a's axis; each element's "
-                                  "unit in 'element_unit')"),
+                                  "element force"),
             "cycle_start": _var(("cycle", "mesh"), s.cycle_start[:, mesh_cols], "s",
                                 "start time of each mesh cycle"),
             "cycle_max_force": _var(("cycle", "mesh"), c_max, "N",
@@ -136,6 +131,12 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
             "dof": ("dof", list(st.dof_names)),
         },
     )
+    # (what the force is in a comment: the long_name is a plot label)
+    ds["element_force"].attrs["comment"] = (
+        "mesh: normal tooth force, negative in back-flank contact; support: the force on "
+        "the bearing; shaft, spline torsion, torsional support: torque [N m], "
+        "k (theta_a - theta_b) + damping, a the first body it connects, both angles about "
+        "a's axis; each element's unit in 'element_unit'")
     ds = ds.assign_coords(element_unit=("element", hist_units, {
         "long_name": "unit of each element's force: N, or N m for a torque"}))
     ds = ds.assign_coords(element_frame=("element", element_frames(res, hist_names), {

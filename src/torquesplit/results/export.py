@@ -176,7 +176,11 @@ def _mat_data(ds, run_id: str, attrs=None) -> dict:
                              else np.asarray(values))
     data["units"] = {ident[n]: str(ds[n].attrs.get("units", "")) for n in names}
     data["dimensions"] = {ident[n]: " x ".join(ds[n].dims) or "scalar" for n in names}
-    data["descriptions"] = {ident[n]: str(ds[n].attrs.get("long_name", "")) for n in names}
+    # (what it is, then the definition a NetCDF keeps in 'comment': a long_name is a
+    # plot label)
+    data["descriptions"] = {ident[n]: " ".join(filter(None, (
+        str(ds[n].attrs.get("long_name", "")), str(ds[n].attrs.get("comment", "")))))
+        for n in names}
     data["names"] = {ident[n]: n for n in names}  # the Dataset's own names
     akeys: set = set()
     data["attributes"] = {_mat_name(k, akeys): _mat_attribute(v)
