@@ -652,7 +652,11 @@ def _publish_named(data: bytes, target: Path, overwrite: bool) -> None:
 def netcdf_bytes(dataset) -> bytes:
     """A Dataset as NetCDF-4 (h5netcdf) bytes, serialised in memory."""
     buffer = io.BytesIO()
-    dataset.to_netcdf(buffer, engine="h5netcdf")
+    # coordinates without a _FillValue (xarray gives every float one): a coordinate has
+    # no missing values (CF conventions, 2.5.1)
+    encoding = {name: {"_FillValue": None} for name in dataset.coords
+                if dataset[name].dtype.kind == "f"}
+    dataset.to_netcdf(buffer, engine="h5netcdf", encoding=encoding)
     return buffer.getvalue()
 
 
