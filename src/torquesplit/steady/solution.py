@@ -379,9 +379,10 @@ def periodic_solution(structure, period: Period, *, method: str = "auto", harmon
         if need > MAX_TRACK_BYTES:
             raise SolverError(
                 f"one period at this speed ({T:.4g} s) takes {steps:,} RK4 steps, whose mesh "
-                f"forces need {need / 2**30:.3g} GiB (at most {MAX_TRACK_BYTES / 2**30:.3g}) and hours of integration; choose a "
-                f"speed nearer the model's, --method hb, or 'torquesplit run' for a "
-                f"transient at this speed")
+                f"forces need {need / 2**30:.3g} GiB (at most "
+                f"{MAX_TRACK_BYTES / 2**30:.3g}) and hours of integration; choose a speed "
+                f"nearer the model's, --method hb, or 'torquesplit run' for a transient at "
+                f"this speed")
     if method == "shooting" and (SECONDS_PER_DOF_STEP * p.structure.n_dof * steps
                                  > ANNOUNCE_SECONDS):
         _announce(p, T, steps, stability)
