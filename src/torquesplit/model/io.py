@@ -163,7 +163,8 @@ def model_from_dict(data: dict[str, Any], source: str | None = None) -> Model:
     """Validate a dict against the schema; errors name every offending field."""
     if not isinstance(data, dict):
         raise ModelError([("", "a model file must contain a table of sections")], source)
-    if "study" in data and not any(k in data for k in ("gears", "meshes", "bodies")):
+    if "study" in data and not any(k in data for k in ("gears", "meshes", "bodies",
+                                                      "planetary")):
         raise ModelError([("", "is a study file (it has [study] and no gears or meshes), not "
                                "a model; run it with 'torquesplit study FILE' (in Python: "
                                "torquesplit.run_study)")], source)
