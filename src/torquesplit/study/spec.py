@@ -467,7 +467,7 @@ def parse_study(data: dict) -> StudySpec:
     """Validate study data; every problem becomes one line of a StudyError."""
     if (isinstance(data, dict) and "study" not in data
             and any(k in data for k in ("gears", "meshes", "bodies", "planetary"))):
-        raise StudyError("", "is a model file (it has gears and meshes, no [study]), not a "
+        raise StudyError("", "is a model file (a gearbox, no [study]), not a "
                              "study; run it with 'torquesplit run FILE', vary one of its "
                              "parameters with 'torquesplit sweep FILE --vary PATH=A:B:N', or "
                              "write a study file whose [study] names it: model = 'FILE' (see "
