@@ -201,13 +201,17 @@ class Solution:
 
     @property
     def separation_fraction(self) -> np.ndarray:
-        """(n_el,) fraction of the integrated time spent in separation."""
-        return self.separation_time / max(self.t_final - self.t_span[0], 1e-300)
+        """(n_el,) fraction of the integrated time spent in separation (at most 1: the
+        sum of the step lengths rounds differently from the span)."""
+        return np.minimum(self.separation_time / max(self.t_final - self.t_span[0], 1e-300),
+                          1.0)
 
     @property
     def back_contact_fraction(self) -> np.ndarray:
-        """(n_el,) fraction of the integrated time spent in back-side contact."""
-        return self.back_contact_time / max(self.t_final - self.t_span[0], 1e-300)
+        """(n_el,) fraction of the integrated time spent in back-side contact (at most 1,
+        as :attr:`separation_fraction`)."""
+        return np.minimum(self.back_contact_time / max(self.t_final - self.t_span[0], 1e-300),
+                          1.0)
 
     def cycles(self, element: int | str) -> dict[str, np.ndarray]:
         """Cycle statistics of one tracked element (by index or name) as a dict."""
