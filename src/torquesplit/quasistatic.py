@@ -112,14 +112,21 @@ class QuasiStaticResults:
                 "load_sharing": (("mesh",), [met.per_mesh[m] for m in self.mesh_names],
                                  {"units": "1",
                                   "long_name": "static torque ratio, largest over positions"}),
-                # what the command's mesh table prints (the files held only load_sharing)
+                # what the command's mesh table prints (the files held only load_sharing),
+                # named as a run's files name them (peak_force, load_sharing_group,
+                # load_sharing_system: this file said max_force, group_load_sharing and
+                # had the system's coefficient as an attribute only)
                 **{f"{k}_force": (("mesh",), f(forces, axis=0), {
-                    "units": "N", "long_name": f"{k} quasi-static mesh force over the "
+                    "units": "N", "long_name": f"{word} quasi-static mesh force over the "
                                               f"positions"})
-                   for k, f in (("min", np.min), ("mean", np.mean), ("max", np.max))},
-                "group_load_sharing": (("group",), [met.per_group[g] for g in met.groups],
+                   for k, word, f in (("min", "smallest", np.min), ("mean", "mean", np.mean),
+                                      ("peak", "largest", np.max))},
+                "load_sharing_group": (("group",), [met.per_group[g] for g in met.groups],
                                        {"units": "1", "long_name": "static torque ratio of "
                                         "the group: its largest member's"}),
+                "load_sharing_system": ((), float(met.system),
+                                        {"units": "1", "long_name": "static torque ratio of "
+                                         "the system"}),
                 "displacement": (("time", "dof"), self.solution.q,
                                  {"units": "m or rad", "long_name": "static displacement"}),
                 "converged": (("time",), self.solution.converged.astype(np.int8),

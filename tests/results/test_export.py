@@ -103,9 +103,11 @@ def test_static_writes_matlab_and_spreadsheet_files(tmp_path):
     # the mesh table's forces and groups too (the file held only the coefficient)
     for row in rows:
         printed = data["mesh_force_N"][row[0]]
-        for k in ("min", "mean", "max"):
-            assert float(row[col[f"{k}_force_N"]]) == pytest.approx(printed[k], rel=1e-12)
+        # (named as a run's: peak_force, not max_force)
+        for name, k in (("min", "min"), ("mean", "mean"), ("peak", "max")):
+            assert float(row[col[f"{name}_force_N"]]) == pytest.approx(printed[k], rel=1e-12)
     header, groups = _read(tmp_path / "q_group.csv")
+    assert header == ["group", "load_sharing_group"]
     assert {g: float(v) for g, v in groups} == pytest.approx(
         data["load_sharing"]["per_group"], rel=1e-12)
     header, rows = _read(tmp_path / "q.csv")
@@ -118,6 +120,8 @@ def test_static_writes_matlab_and_spreadsheet_files(tmp_path):
     # the model and the metrics at the top, where a run's .mat has them
     assert json.loads(data["model_json"])["model"]["name"] == "ji_li_mill_drive"
     assert json.loads(data["metrics_json"])["per_mesh"] == pytest.approx(share, rel=1e-12)
+    assert data["load_sharing_system"] == pytest.approx(
+        json.loads(data["metrics_json"])["system"], rel=1e-15)
     # a companion that exists is refused before the sweep, not after it
     (tmp_path / "x_mesh.csv").write_text("")
     r = CliRunner().invoke(app, args + ["--out", str(tmp_path / "x.csv")])
