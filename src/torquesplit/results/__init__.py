@@ -745,7 +745,6 @@ class Results:
             settled_header = [f"{m}_settled" for m in self.mesh_names]
             settled_columns = [np.arange(n_cyc) >= met.settling.first_cycle[m]
                                for m in self.mesh_names]
-        if met is not None:
             name = met.definition
             rows = [[r.mesh, r.group, r.nominal_force, r.static_force, r.mean_force,
                      r.peak_force, r.min_force, r.dynamic_factor,
