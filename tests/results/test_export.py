@@ -72,6 +72,10 @@ def test_mat_and_netcdf_keep_every_variable_and_unit(tmp_path):
     np.testing.assert_array_equal(back["force"].values, ds["force"].values)
     assert back.attrs["run_id"] and json.loads(back.attrs["labels"]) == ["x", "y"]
     back.close()
+    # no warnings: an empty cell column, which MATLAB's isempty sees ({''} did not)
+    quiet = ds.assign_attrs(warnings_json="[]")
+    mat = scipy.io.loadmat(save_dataset(quiet, tmp_path / "w.mat"))
+    assert mat["warnings"].shape == (0, 1)
     # a coordinate has no _FillValue (CF 2.5.1; xarray gave every float one); data do
     import h5py
 

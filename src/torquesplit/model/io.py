@@ -159,12 +159,15 @@ def read_file(path: Path) -> dict[str, Any]:
     return read_model_file(path)
 
 
+MODEL_SECTIONS = ("gears", "meshes", "bodies", "planetary")
+"""Top-level tables that make a file a model (a study file has [study] and none of them)."""
+
+
 def model_from_dict(data: dict[str, Any], source: str | None = None) -> Model:
     """Validate a dict against the schema; errors name every offending field."""
     if not isinstance(data, dict):
         raise ModelError([("", "a model file must contain a table of sections")], source)
-    if "study" in data and not any(k in data for k in ("gears", "meshes", "bodies",
-                                                      "planetary")):
+    if "study" in data and not any(k in data for k in MODEL_SECTIONS):
         raise ModelError([("", "is a study file (it has [study] and no gears or meshes), not "
                                "a model; run it with 'torquesplit study FILE' (in Python: "
                                "torquesplit.run_study)")], source)

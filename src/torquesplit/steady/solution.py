@@ -374,8 +374,10 @@ def periodic_solution(structure, period: Period, *, method: str = "auto", harmon
     steps = p.rk4_steps(T, steps_per_cycle, order)
     if method == "auto":  # see AUTO
         method = "hb" if harmonics is not None or stability == "hill" else "shooting"
+    # the meshes whose forces shooting keeps at every step
+    meshes = np.flatnonzero(np.asarray(p.model.element_kind) == MESH_KIND)
     if method == "shooting":
-        need = 16 * (steps + 1) * int(np.sum(np.asarray(p.model.element_kind) == MESH_KIND))
+        need = 16 * (steps + 1) * meshes.size
         if need > MAX_TRACK_BYTES:
             raise SolverError(
                 f"one period at this speed ({T:.4g} s) takes {steps:,} RK4 steps, whose mesh "
@@ -430,7 +432,6 @@ def periodic_solution(structure, period: Period, *, method: str = "auto", harmon
     else:
         tol = 1e-9 if tol is None else tol
         every = sample_stride(steps)
-        meshes = np.flatnonzero(np.asarray(p.model.element_kind) == MESH_KIND)
 
         kept = [None]
 

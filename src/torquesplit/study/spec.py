@@ -465,8 +465,10 @@ def _read(source, analysis: dict) -> tuple[StudySpec, Path | None, str]:
 
 def parse_study(data: dict) -> StudySpec:
     """Validate study data; every problem becomes one line of a StudyError."""
+    from ..model.io import MODEL_SECTIONS
+
     if (isinstance(data, dict) and "study" not in data
-            and any(k in data for k in ("gears", "meshes", "bodies", "planetary"))):
+            and any(k in data for k in MODEL_SECTIONS)):
         raise StudyError("", "is a model file (a gearbox, no [study]), not a "
                              "study; run it with 'torquesplit run FILE', vary one of its "
                              "parameters with 'torquesplit sweep FILE --vary PATH=A:B:N', or "
