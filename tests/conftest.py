@@ -4,11 +4,16 @@ from __future__ import annotations
 
 import os
 
-import pytest
-from hypothesis import settings
+# the CLI's tables are as wide as $COLUMNS where output is no terminal (160 without it):
+# the tests read them at that width whatever the shell (or pytest-xdist, which exports
+# COLUMNS=80 to its workers) says
+os.environ["COLUMNS"] = "160"
 
-import torquesplit
-from model_texts import SPUR_PAIR, split_model, write_model
+import pytest  # noqa: E402
+from hypothesis import settings  # noqa: E402
+
+import torquesplit  # noqa: E402
+from model_texts import SPUR_PAIR, split_model, write_model  # noqa: E402
 
 # property-based tests draw the same examples on every run (a CI failure reproduces);
 # HYPOTHESIS_PROFILE=explore searches afresh

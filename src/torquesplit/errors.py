@@ -36,6 +36,27 @@ def clip_text(text: str, limit: int = QUOTE_LIMIT) -> str:
     return text if len(text) <= limit else text[: max(limit - 3, 0)] + "..."
 
 
+def clip_path(path, limit: int = QUOTE_LIMIT) -> str:
+    """A path shortened to ``limit`` characters with the file's name kept whole (a
+    message about a file must name it): the folders are cut, the cut marked ``...``.  A
+    name that is itself too long keeps its end (its suffix and extension).
+
+    Examples
+    --------
+    >>> clip_path("/tmp/" + "d" * 100 + "/run_history.csv", 40)
+    '/tmp/dddddddddddddddd.../run_history.csv'
+    >>> clip_path("/tmp/" + "n" * 100 + "_history.csv", 24)
+    '...nnnnnnnnn_history.csv'
+    """
+    text = str(path)
+    if len(text) <= limit:
+        return text
+    name = text.replace("\\", "/").rsplit("/", 1)[-1]
+    if len(name) + 8 > limit:
+        return "..." + text[len(text) - max(limit - 3, 1):]
+    return text[: limit - len(name) - 4] + ".../" + name
+
+
 def clip_message(message: str) -> str:
     """A message with every unbroken run of text over twice :data:`QUOTE_LIMIT`
     characters cut to that limit (its length noted), and each line at most

@@ -46,6 +46,20 @@ def _visible(folder: Path) -> set[str]:
 
 
 # --------------------------------------------------------------------------- checks
+def test_a_message_about_a_file_deep_in_folders_names_the_file(tmp_path):
+    """A path over 80 characters was cut at its end: 'error: /tmp/.../a_hist... exists'
+    hid which file was in the way (pytest-xdist's longer temporary folders showed it)."""
+    deep = tmp_path / ("results_of_the_long_campaign_" * 3) / "run_7"
+    deep.mkdir(parents=True)
+    (deep / "gearbox_history.csv").write_text("x")
+    assert len(str(deep / "gearbox_history.csv")) > 100
+    with pytest.raises(OutputError) as info:
+        files.check_output(deep / "gearbox.csv")
+    msg = str(info.value)
+    assert "/gearbox_history.csv exists; use --force" in msg and "..." in msg
+    assert len(msg.split(" exists")[0]) <= 80
+
+
 def test_checks_before_any_computation(tmp_path):
     with pytest.raises(OutputFormatError, match=r"use a \.nc, \.mat or \.csv file"):
         files.check_output(tmp_path / "r.xlsx")

@@ -388,10 +388,14 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
             with w.block("if th > 1.0:"):
                 w("th = 1.0")
 
-    def record_body(full: bool):
+    def record_body():
         # the time integral of each cycle (_kernels.mean_sample): the interval from the
         # last instant, split where a cycle begins; part A into the last instant's cycle
-        # (still the current one), part B into this instant's (after new_cycle)
+        # (still the current one), part B into this instant's (after new_cycle).
+        # `full`: a sample of the run (_kernels.record); 0: a corner instant inside a step
+        # (_kernels.record_extrema: no counts, no contact time).  One function for both:
+        # the CPU twin types it once; on CUDA `full` is a literal, so each call site gets
+        # its own copy with the branches folded, as two functions would be.
         w("bi = 0  # slot A")
         w("b = 0  # slot A")
         w(f"cap = {par(('cap',))}")
@@ -400,7 +404,9 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
         w("entered = span >= 0.0")
         # the extremes between the instants (_kernels.peak_sample); a corner instant, and
         # a sample flagged as one, can end a parabola but not be its middle
-        w(f"kink = X[{X_PX}]" if full else "kink = 1.0")
+        w("kink = 1.0")
+        with w.block("if full != 0:"):
+            w(f"kink = X[{X_PX}]")
         w(f"smooth = X[{X_PN}] >= 2.0 and X[{X_PKK + 1}] == 0.0")
         # the load-sharing ratio at a member's cycle start between two instants, from every
         # member's force interpolated there (_kernels.ratio_starts), before the last
@@ -515,16 +521,12 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
                 w(f"X[{s}] = fe")
             with w.block(f"if fe < X[{s + 1}]:"):
                 w(f"X[{s + 1}] = fe")
-            if full:
-                w(f"WI[{WI_SC + 2 * j + 1}] += 1")
         w(f"X[{X_PT}] = t")
         w(f"X[{X_PKT}] = X[{X_PKT + 1}]")
         w(f"X[{X_PKT + 1}] = t")
         w(f"X[{X_PKK}] = X[{X_PKK + 1}]")
         w(f"X[{X_PKK + 1}] = kink")
         w(f"X[{X_PN}] += 1.0")
-        if full:
-            w(f"X[{X_PX}] = 0.0")
         for kg, grp in enumerate(L.groups):
             w("total = 0.0")
             for j in grp:  # the loads the teeth carry (_kernels.ratio_sample)
@@ -538,8 +540,13 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
                         w(f"X[{s + 3}] = ratio")
                     with w.block(f"if ratio < X[{s + 4}]:"):
                         w(f"X[{s + 4}] = ratio")
-        if not full:
-            return
+        with w.block("if full == 0:"):
+            w("return 0")
+        # a sample's count in each tracked element's cycle (new_cycle above has reset a
+        # count that began a cycle: only the element's own counter), the kink flag used
+        for j in range(n_tr):
+            w(f"WI[{WI_SC + 2 * j + 1}] += 1")
+        w(f"X[{X_PX}] = 0.0")
         for k, el in enumerate(watch):
             w(f"g = {g_of(el)}")
             w(f"d = W[{W_D + el}]")
@@ -565,12 +572,8 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
         w("sl = (d1 * (t2 - t1) + d2 * (t1 - t0)) / (t2 - t0)")
         w("return f1 - sl * sl / (4.0 * a)")
     w()
-    with w.block("def record(t, weight, X, WI, W, OF, OI, P, PT, PI, c):"):
-        record_body(True)
-        w("return 0")
-    w()
-    with w.block("def record_extrema(t, X, WI, W, OF, OI, P, PT, PI, c):"):
-        record_body(False)
+    with w.block("def record(t, weight, full, X, WI, W, OF, OI, P, PT, PI, c):"):
+        record_body()
         w("return 0")
     w()
 
@@ -668,7 +671,7 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
             w(f"te = t_corner if t_corner < tb - {kern.MERGE!r} * h else tb")
             with w.block("if not first:"):
                 w(f"rhs(I0, I{W_Y}, I{W_K1}, X, W, P, PT, PI, c)")
-                w("record_extrema(ts, X, WI, W, OF, OI, P, PT, PI, c)")
+                w("record(ts, 0.0, I0, X, WI, W, OF, OI, P, PT, PI, c)")
                 w(f"WI[{WI_CNT + _I.I_RHS}] += 1")
                 w(f"WI[{WI_CNT + _I.I_EVENTS}] += 1")
             with w.block(f"if te - ts > {kern.MERGE!r} * h:"):
@@ -739,7 +742,7 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
                 with w.block("if i > 0 and i % chunk == 0:"):
                     w("t_corner = first_corners(t, WI, PT, c, CN)")
             w(f"rhs(I0, I{W_Y}, I{W_K1}, X, W, P, PT, PI, c)")
-            w("record(t, h, X, WI, W, OF, OI, P, PT, PI, c)")
+            w("record(t, h, I1, X, WI, W, OF, OI, P, PT, PI, c)")
             w("tb = t0 + (i + 1) * h")
             with w.block("if t_corner < tb:"):
                 w("t_corner = through_corners(t, tb, t_corner, X, WI, W, OF, OI, P, PT, PI, "
@@ -759,7 +762,7 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
                 w("break")
         with w.block(f"if WI[{WI_CNT + _I.I_STATUS}] == 0 and n_steps > 0:"):
             w(f"rhs(I0, I{W_Y}, I{W_K1}, X, W, P, PT, PI, c)")
-            w("record(t_final, 0.0, X, WI, W, OF, OI, P, PT, PI, c)")
+            w("record(t_final, 0.0, I1, X, WI, W, OF, OI, P, PT, PI, c)")
         for j in range(n_tr):
             w(f"flush(I{j}, X, WI, OF, OI, c, cap)")
         with w.block(f"for k in range({2 * len(watch)}):"):

@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import _json
-from ..errors import OutputError, clip_text
+from ..errors import OutputError, clip_path
 from . import files
 
 #: suffix -> format of a Dataset export
@@ -60,7 +60,7 @@ def check_dataset_output(path, tables: tuple[str, ...] = (), *, overwrite: bool 
     extra += (files.about_path(plan.path),)
     for f in extra:
         if (f.exists() or f.is_symlink()) and not overwrite:
-            raise OutputError(f"{clip_text(str(f))} exists; use --force (overwrite=True in "
+            raise OutputError(f"{clip_path(f)} exists; use --force (overwrite=True in "
                               f"Python) to replace it, or choose another file")
     return files.OutputPlan(path=plan.path, format="table", files=(plan.path,) + extra,
                             overwrite=overwrite)

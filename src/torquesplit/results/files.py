@@ -61,7 +61,7 @@ import uuid
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..errors import OutputBusyError, OutputError, OutputFormatError, clip_text
+from ..errors import OutputBusyError, OutputError, OutputFormatError, clip_path, clip_text
 
 try:  # POSIX; elsewhere the lock is an exclusively created file
     import fcntl
@@ -189,8 +189,8 @@ def check_output(path, *, formats: dict[str, str] | None = None, overwrite: bool
     suffix = path.suffix.lower()
     if path.is_dir():
         example = path / ("results" + next(iter(formats)))
-        raise OutputError(f"{clip_text(str(path))} is a folder; give a file name in it, e.g. "
-                          f"{clip_text(str(example))}")
+        raise OutputError(f"{clip_path(path)} is a folder; give a file name in it, e.g. "
+                          f"{clip_path(example)}")
     if suffix not in formats:
         known = sorted(set(formats), key=list(formats).index)
         listed = (", ".join(known[:-1]) + " or " + known[-1]) if len(known) > 1 else known[0]
@@ -202,23 +202,23 @@ def check_output(path, *, formats: dict[str, str] | None = None, overwrite: bool
                                 f"{listed} file")
     parent = path.parent
     if not parent.exists():
-        raise OutputError(f"cannot write {clip_text(str(path))}: the folder "
-                          f"{clip_text(str(parent))} does not exist; create it first or "
+        raise OutputError(f"cannot write {clip_path(path)}: the folder "
+                          f"{clip_path(parent)} does not exist; create it first or "
                           f"choose another folder")
     if not parent.is_dir():
-        raise OutputError(f"cannot write {clip_text(str(path))}: {clip_text(str(parent))} is "
+        raise OutputError(f"cannot write {clip_path(path)}: {clip_path(parent)} is "
                           f"not a folder; choose a path in a folder")
     check_writable_folder(parent, path)
     fmt = formats[suffix]
     targets = companion_files(path, fmt)
     for f in targets:
         if f.is_dir():
-            raise OutputError(f"{clip_text(str(f))} is a folder; choose another file name")
+            raise OutputError(f"{clip_path(f)} is a folder; choose another file name")
         if f.exists() and not f.is_file():
-            raise OutputError(f"{clip_text(str(f))} is not a regular file; choose another "
+            raise OutputError(f"{clip_path(f)} is not a regular file; choose another "
                               f"file name")
         if (f.exists() or f.is_symlink()) and not overwrite:
-            raise OutputError(f"{clip_text(str(f))} exists; {_OVERWRITE_HINT}")
+            raise OutputError(f"{clip_path(f)} exists; {_OVERWRITE_HINT}")
     return OutputPlan(path=path, format=fmt, files=targets, overwrite=overwrite)
 
 
@@ -229,8 +229,8 @@ def check_writable_folder(folder, target=None) -> None:
     mount.  ``target`` is the file the user named, for the message.
     """
     folder = Path(folder)
-    named = clip_text(str(target if target is not None else folder))
-    where = clip_text(str(folder))
+    named = clip_path(target if target is not None else folder)
+    where = clip_path(folder)
     if not os.access(folder, os.W_OK | os.X_OK):
         reason = "permission denied"
     else:
@@ -370,7 +370,7 @@ class OutputClaim:
             if not self.plan.overwrite:
                 for f in self.plan.files:
                     if f.exists() or f.is_symlink():
-                        raise OutputError(f"{clip_text(str(f))} was written by another "
+                        raise OutputError(f"{clip_path(f)} was written by another "
                                           f"program or run since it was checked; "
                                           f"{_OVERWRITE_HINT}")
         except BaseException:
@@ -472,8 +472,8 @@ def _acquire(lock_path: Path, info: dict, target: Path) -> int:
             fd = os.open(lock_path, os.O_RDWR | os.O_CREAT | getattr(os, "O_CLOEXEC", 0),
                          0o644)
         except OSError as exc:
-            raise OutputError(f"cannot write {clip_text(str(target))}: the folder "
-                              f"{clip_text(str(lock_path.parent))} is not writable "
+            raise OutputError(f"cannot write {clip_path(target)}: the folder "
+                              f"{clip_path(lock_path.parent)} is not writable "
                               f"({exc.strerror or exc}); choose a folder you can write "
                               f"to") from None
         try:
@@ -529,7 +529,7 @@ def _busy_message(target: Path, holder: dict, lock_path: Path,
     fix = "wait for it to finish or choose another file"
     if stale_possible:  # pragma: no cover - Windows
         fix += f" (if no run is writing it, delete {lock_path})"
-    return f"{clip_text(str(target))} is being written by {who}; {fix}"
+    return f"{clip_path(target)} is being written by {who}; {fix}"
 
 
 # --------------------------------------------------------------------------- writing
@@ -575,12 +575,12 @@ def _publish(data: bytes, target: Path, overwrite: bool) -> None:
         with contextlib.suppress(OSError):  # make the new name itself durable
             os.fsync(dir_fd)
     except FileExistsError:
-        raise OutputError(f"{clip_text(str(target))} was written by another program or run "
+        raise OutputError(f"{clip_path(target)} was written by another program or run "
                           f"meanwhile; {_OVERWRITE_HINT}") from None
     except OSError as exc:
         if isinstance(exc, OutputError):
             raise
-        raise OutputError(f"cannot write {clip_text(str(target))} ({exc.strerror or exc}); "
+        raise OutputError(f"cannot write {clip_path(target)} ({exc.strerror or exc}); "
                           f"free disk space or choose another folder") from None
     finally:
         os.close(dir_fd)
