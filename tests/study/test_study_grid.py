@@ -61,6 +61,8 @@ def test_failing_cases_recorded_and_others_complete(split_file):
     assert "drives.motor.torque" in reason[2] and "greater than 0" in reason[2]
     lsc = ds["load_sharing.cycle_peak"].values
     assert np.isfinite(lsc[[0, 3]]).all() and np.isnan(lsc[[1, 2]]).all()
+    # a case that gave no outputs found no settled part (refused ones said 1)
+    assert ds["settled"].values[[1, 2]].tolist() == [0, 0]
     # a stiffness variation that makes the stiffness negative is refused too
     text = split_file.read_text().replace(
         '[meshes.a1]\ngears = ["pinion", "a"]\nstiffness = "4e8 N/m"',

@@ -302,14 +302,14 @@ def test_a_stopping_half_width_takes_the_outputs_unit():
     from torquesplit.study import Study
     from torquesplit.study.errors import StudyError
 
-    def spec(half_width, output="peak_force.m11"):
+    def spec(half_width, output="peak_force.m11", relative=False):
         return {"study": {"name": "t", "model": "ji_li_mill_drive", "outputs": [output]},
                 "analysis": {"cycles": 20},
                 "monte_carlo": {"seed": 1, "parameters": [
                     {"path": "meshes.m11.backlash", "distribution": "uniform",
                      "low": "0.5 mm", "high": "1 mm"}],
                     "stop": {"output": output, "half_width": half_width, "max_samples": 40,
-                             "min_samples": 8, "batch": 8}}}
+                             "min_samples": 8, "batch": 8, "relative": relative}}}
 
     assert Study(spec("1 kN")).plan().spec.monte_carlo.stop.half_width == 1000.0
     assert Study(spec(250)).plan().spec.monte_carlo.stop.half_width == 250.0
@@ -317,6 +317,14 @@ def test_a_stopping_half_width_takes_the_outputs_unit():
         Study(spec("1 kg")).plan()
     with pytest.raises(StudyError, match=r"half_width: write a plain number"):
         Study(spec("1 kN", output="load_sharing.cycle_peak")).plan()
+    # a relative half-width is a fraction: '1 kN' was read as 1000 x |statistic|, which
+    # every Monte Carlo met at its first check (a studies reviewer)
+    with pytest.raises(StudyError, match=r"half_width: with relative = true the half-width "
+                                         r"is a fraction of \|statistic\|: write a plain "
+                                         r"number \(0.01 for 1 %\), got '1 kN'"):
+        Study(spec("1 kN", relative=True)).plan()
+    assert Study(spec("0.02", relative=True)).plan().spec.monte_carlo.stop.half_width == 0.02
+    assert Study(spec(0.02, relative=True)).plan().spec.monte_carlo.stop.half_width == 0.02
 
 
 def test_a_shared_value_of_several_fields_needs_a_name(split_file):

@@ -224,18 +224,30 @@ class StopRule(_Strict):
 
     output: str = Field(description="The output whose statistic is watched (exact name).")
     statistic: Literal["mean", "p95"] = Field("mean", description="Mean or 95th percentile.")
+    # (relative before half_width: pydantic validates fields in this order, and a
+    # half-width with a unit means nothing as a fraction)
+    relative: bool = Field(False, description="half_width relative to |statistic|.")
     half_width: float = Field(gt=0, description=(
         "Target half-width of the interval: in the output's SI unit, or with its unit "
         "('1 kN' for a force); a fraction of |statistic| with relative = true."))
-    relative: bool = Field(False, description="half_width relative to |statistic|.")
 
     @field_validator("half_width", mode="before")
     @classmethod
     def _with_unit(cls, v, info):
         """A half-width written with a unit ('1 kN'), read in the output's SI unit (it was
-        refused as 'not a valid number', and a bare number's unit was said nowhere)."""
+        refused as 'not a valid number', and a bare number's unit was said nowhere).  A
+        relative one is a plain fraction: '1 kN' there was read as 1000 times |statistic|
+        and every sample met it."""
         if not isinstance(v, str):
             return v
+        if info.data.get("relative"):
+            try:
+                return float(v)
+            except ValueError:
+                raise ValueError(f"with relative = true the half-width is a fraction of "
+                                 f"|statistic|: write a plain number (0.01 for 1 %), got "
+                                 f"{v!r}; or give it with its unit and relative = false"
+                                 ) from None
         from ..model.units import KINDS, parse_quantity
         from .outputs import output_unit
 
