@@ -209,6 +209,9 @@ def test_study_run_length_from_the_command_line(tmp_path, split_file):
     ds = xr.open_dataset(out / "results.nc", engine="h5netcdf")
     assert ds["simulated_time"].values == pytest.approx([0.02, 0.02])
     assert "replaced when the study was run: duration = '20 ms'" in ds.attrs["study_toml"]
+    import json
+
+    assert json.loads(ds.attrs["analysis_settings"])["duration"] == pytest.approx(0.02)
     ds.close()
     _ok([*common, "--duration", "20ms", "--resume"])  # the same length, written otherwise
     other = runner.invoke(app, [*common, "--cycles", "7", "--resume"])

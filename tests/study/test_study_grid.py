@@ -268,23 +268,31 @@ def test_a_study_is_written_for_a_spreadsheet_and_for_matlab(tmp_path, split_fil
     ds = Study(data).run(workers=1, out=tmp_path / "o", figures=False)
     rows = list(csv.reader(io.StringIO((tmp_path / "o" / "results.csv").read_text())))
     header, body = rows[0], rows[1:]
-    assert header[:2] == ["meshes.a1.stiffness [N/m]",
+    # the case index first, as a Monte Carlo's (a grid's had none: the summary's
+    # 'case 2' was found by counting rows), then the grid's parameters
+    assert header[:3] == ["case", "meshes.a1.stiffness [N/m]",
                           "meshes.b1.transmission_error.constant [m]"]
+    assert [int(r[0]) for r in body] == list(range(8))
     assert "peak_force.a1 [N]" in header and "status" in header
     assert len(body) == 8
     col = header.index("peak_force.a1 [N]")
     got = np.array([[float(r[col]) for r in body]]).reshape(4, 2)
     np.testing.assert_array_equal(got, ds["peak_force.a1"].values)
     assert {r[header.index("status")] for r in body} == {"ok"}
-    mat = loadmat(tmp_path / "o" / "results.mat")
-    names = {str(a[0]): str(b[0]) for a, b in mat["names"]}
-    assert names["peak_force_a1"] == "peak_force.a1"
+    # the layout of a run's .mat: arrays, and structs naming them, with the attributes
+    mat = loadmat(tmp_path / "o" / "results.mat", squeeze_me=True)
+    assert mat["names"]["peak_force_a1"].item() == "peak_force.a1"
     np.testing.assert_array_equal(mat["peak_force_a1"], ds["peak_force.a1"].values)
-    np.testing.assert_array_equal(mat["meshes_a1_stiffness"].ravel(),
-                                  ds["meshes.a1.stiffness"].values)
-    units = {str(a[0]): (str(b[0]) if b.size else "") for a, b in mat["units"]}
-    assert units["peak_force_a1"] == "N"
-    assert str(mat["status"][0, 0][0]) == "ok"
+    np.testing.assert_array_equal(mat["meshes_a1_stiffness"], ds["meshes.a1.stiffness"].values)
+    assert mat["units"]["peak_force_a1"].item() == "N"
+    assert mat["dimensions"]["peak_force_a1"].item() == (
+        "meshes.a1.stiffness x meshes.b1.transmission_error.constant")
+    assert str(mat["status"][0, 0]) == "ok"
+    attrs = mat["attributes"]
+    assert attrs["study_hash"].item() == ds.attrs["study_hash"]
+    # (given as a dict: its JSON, under the name that says so)
+    assert '"grid": {' in attrs["study_json"].item() and "study_toml" not in ds.attrs
+    assert mat["provenance"]["model_sha256"].item()
 
 
 def test_a_share_of_the_time_is_never_written_in_exponent_form():

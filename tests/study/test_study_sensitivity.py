@@ -94,6 +94,18 @@ def test_ranking_of_a_constructed_model(split_file, tmp_path, method, kw):
     unit = "per output: see output_unit" if method == "morris" else "1"
     assert ds[key].attrs["units"] == unit
     assert ds.sizes["sample"] == (4 * 4 if method == "morris" else 16 * 5)
+    # MATLAB gets the indices over (output, factor) and the ranking key (its .mat had
+    # the cases only: a studies reviewer)
+    from scipy.io import loadmat
+
+    from torquesplit.study.dataset import case_mat_bytes
+
+    (tmp_path / "s.mat").write_bytes(case_mat_bytes(ds))
+    mat = loadmat(tmp_path / "s.mat", squeeze_me=True)
+    assert mat["dimensions"][key].item() == "output x factor"
+    np.testing.assert_array_equal(mat[key], ds[key].values)
+    assert list(mat["factor"]) == list(ds["factor"].values)
+    assert mat["attributes"]["ranking"].item() == key
     # the ranking table prints Morris's effect of a force in kN, with its unit (Rich read
     # an unescaped " [kN]" as markup and dropped it); Sobol's shares have none
     from torquesplit import cli as ui

@@ -164,7 +164,11 @@ def _mat_attribute(v):
     return _json.dumps(v.tolist() if isinstance(v, np.ndarray) else v, default=str)
 
 
-def _mat_data(ds, run_id: str, attrs=None) -> dict:
+def mat_fields(ds, run_id: str, attrs=None) -> dict:
+    """A Dataset as the fields of a .mat file, the layout every command's .mat shares:
+    each variable and coordinate as an array (texts as cell arrays) under a MATLAB name,
+    and the structs ``names`` (field -> the Dataset's name), ``units``, ``dimensions``,
+    ``descriptions``, ``attributes`` (the Dataset's, or ``attrs``) and ``provenance``."""
     names = list(ds.data_vars) + list(ds.coords)
     taken = {"units", "descriptions", "attributes", "provenance", "names", "dimensions"}
     ident = {n: _mat_name(n, taken) for n in names}
@@ -208,7 +212,7 @@ def _write(ds, plan: files.OutputPlan, claim: files.OutputClaim) -> Path:
         ds.attrs.update(files.provenance(claim.run_id, ds.attrs.get("model_json")))
         claim.write({plan.path: files.netcdf_bytes(ds)})
     elif plan.format == "mat":
-        claim.write({plan.path: files.mat_bytes(_mat_data(ds, claim.run_id, attrs))})
+        claim.write({plan.path: files.mat_bytes(mat_fields(ds, claim.run_id, attrs))})
     else:
         dims = row_dims(ds)
         contents = {f: files.csv_bytes(*_table(ds, d)) for f, d in zip(plan.files[1:], dims[1:])}

@@ -123,12 +123,17 @@ def build_dataset(plan, rows, n: int, meta: dict):
         "reference": plan.spec.study.reference,
         "design": d.kind,
         "analysis": plan.analysis["type"],
+        # the analysis as run: the study file's, with the command line's --duration,
+        # --cycles... (study_toml below is the file as written)
+        "analysis_settings": json.dumps(plan.analysis, default=str, sort_keys=True),
         "outputs": json.dumps(names),
         "study_hash": plan.study_hash,
         "model_hash": plan.model_hash,
         "model_source": plan.model_source,
         "torquesplit_version": str(meta.get("torquesplit_version", "")),
-        "study_toml": plan.study_text,
+        # the study as given: a file's TOML, or the JSON of a dict / a sweep's options
+        ("study_json" if plan.study_text.lstrip().startswith("{") else "study_toml"):
+            plan.study_text,
         "model_json": json.dumps(plan.model_dict),
         "cases": int(n),
     }
@@ -278,55 +283,36 @@ def case_table_bytes(ds) -> bytes:
 
     names = _case_variables(ds)
     frame = ds[names].reset_coords().to_dataframe().reset_index()
-    # the case's parameters first (a grid's dimensions, a sample's coordinates), then
-    # its variables
-    first = [c for c in frame.columns if c in ds.coords or c in ds.dims]
+    if "sample" not in frame.columns:  # a grid: its rows in case order (C order of the
+        frame.insert(0, "sample", np.arange(len(frame)))  # grid, as the summary counts)
+    # the case's index and parameters first (a grid's dimensions, a sample's
+    # coordinates), then its variables
+    first = ["sample"] + [c for c in frame.columns
+                          if c != "sample" and (c in ds.coords or c in ds.dims)]
     keep = first + [c for c in frame.columns if c in names and c not in first]
     header = ["case" if c == "sample" else _header(ds, c) if c in ds.variables else c
               for c in keep]
     rows = frame[keep].itertuples(index=False, name=None)
-    return csv_bytes(header, [[v.item() if hasattr(v, "item") else v for v in r]
-                              for r in rows])
-
-
-def _mat_name(name: str, taken: set) -> str:
-    """A MATLAB field name (letters, digits, underscores, a letter first, <= 63)."""
-    base = re.sub(r"\W", "_", name).strip("_") or "x"
-    if not base[0].isalpha():
-        base = "v_" + base
-    base = base[:63]
-    out, k = base, 1
-    while out in taken:
-        k += 1
-        out = f"{base[:59]}_{k}"
-    taken.add(out)
-    return out
+    # a case's warnings one a line in the Dataset; '; ' in a cell (a line break inside a
+    # quoted cell is CSV, but tools that count lines miscount the cases)
+    at = keep.index("warnings") if "warnings" in keep else -1
+    return csv_bytes(header, [[(str(v).replace("\n", "; ") if i == at else
+                                v.item() if hasattr(v, "item") else v)
+                               for i, v in enumerate(r)] for r in rows])
 
 
 def case_mat_bytes(ds) -> bytes:
-    """The study for MATLAB: each per-case variable and coordinate as an array of the
-    study's shape (a grid's dimensions, or one per sample), strings as cell arrays;
-    ``names`` maps each field to the Dataset's name, ``units`` gives its SI unit."""
+    """The study for MATLAB, laid out as a run's .mat
+    (:func:`torquesplit.results.export.mat_fields`): every per-case variable and
+    coordinate as an array of the study's shape (a grid's dimensions, or one per
+    sample), a sensitivity's indices over (output, factor), strings as cell arrays; the
+    structs ``names``, ``units``, ``dimensions`` and ``descriptions`` per field, and
+    ``attributes`` with the study's text, hashes, seed and stopping-rule outcome (a
+    reviewer's MATLAB had the cases but neither the ranking nor where they came from)."""
+    from ..results.export import mat_fields
     from ..results.files import mat_bytes
 
-    taken: set = {"names", "units", "dimensions", "study_name"}  # (this file's own)
-    data: dict = {}
-    names, units = [], []
-    for v in [*ds["status"].dims, *[c for c in ds.coords if c not in ds["status"].dims
-                                    and ds[c].dims and set(ds[c].dims) <= set(ds["status"].dims)],
-              *_case_variables(ds)]:
-        arr = ds[v].values
-        if arr.dtype.kind in "USO":
-            arr = np.array(arr.astype(str), dtype=object)
-        field = _mat_name(str(v), taken)
-        data[field] = arr
-        names.append([field, str(v)])
-        units.append([field, str(ds[v].attrs.get("units", ""))])
-    data["names"] = np.array(names, dtype=object)
-    data["units"] = np.array(units, dtype=object)
-    data["dimensions"] = np.array(list(ds["status"].dims), dtype=object)
-    data["study_name"] = str(ds.attrs.get("study_name", ""))
-    return mat_bytes(data)
+    return mat_bytes(mat_fields(ds, str(ds.attrs.get("study_hash", ""))[:16]))
 
 
 def ranking(ds, output: str) -> list[tuple[str, float]]:
