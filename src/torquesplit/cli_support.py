@@ -490,10 +490,15 @@ def planet_sharing_dict(k) -> dict:
     """The ``--json`` entry ``planet_load_sharing`` of a planetary model (commands leave
     the key out for a model without planets): the definition, K_gamma per stage (carrier),
     the factor per planet and the mesh groups of each stage."""
-    out = {"definition": k.definition, "per_stage": dict(k.per_stage),
+    # a quasi-static sweep's stage value is K_gamma of the position-averaged loads, and
+    # its definition's own (the static torque ratio, peak over positions) is apart: the
+    # 'definition' names what per_stage holds (it said static_torque over K_gamma)
+    out = {"definition": "K_gamma" if k.peak_per_stage else k.definition,
+           "per_stage": dict(k.per_stage),
            "per_planet": dict(k.per_planet), "groups": {c: list(g) for c, g in k.groups.items()}}
     if k.peak_per_stage:
         out["per_stage_basis"] = "loads averaged over the mesh positions (AGMA 6123 / ISO 6336-1)"
-        out["peak_instantaneous_ratio"] = {"per_stage": dict(k.peak_per_stage),
+        out["peak_instantaneous_ratio"] = {"definition": k.definition,
+                                           "per_stage": dict(k.peak_per_stage),
                                            "per_planet": dict(k.peak_per_planet)}
     return out

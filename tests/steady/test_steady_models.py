@@ -240,6 +240,7 @@ def test_cli_steady_sweep_and_campbell(tmp_path):
     assert r.exit_code == 0, r.output
     out = json.loads(r.stdout)
     assert out["complete"] and out["points"] >= 4 and (tmp_path / "s.png").exists()
+    assert out["figure_files"] == [str(tmp_path / "s.png")]  # (written without a word)
     r = CliRunner().invoke(app, ["sweep-speed", EXAMPLE, "--keep", "stage1", "--from",
                                  "-700 rpm", "--to", "-700 rpm"])
     assert r.exit_code == 2 and "--from must be a positive speed" in r.output

@@ -260,6 +260,21 @@ def test_cli_says_how_to_resume_after_ctrl_c_while_writing_figures(tmp_path, spl
     assert _runs(out) == [("interrupted", 2)]
     res = CliRunner().invoke(app, args + ["--resume"])
     assert res.exit_code == 0, res.output
+
+    # without figures the message names results.nc only (it said 'and figures')
+    from torquesplit.study import dataset
+
+    def stopped(ds, path):
+        raise KeyboardInterrupt
+
+    out2 = tmp_path / "out2"
+    args2 = ["study", str(path), "--out", str(out2), "--workers", "1", "--quiet",
+             "--no-figures"]
+    with monkeypatch.context() as m:
+        m.setattr(dataset, "write_dataset", stopped)
+        res = CliRunner().invoke(app, args2)
+    assert res.exit_code == 130
+    assert "saved in" in res.output and "results.nc not all written; to finish" in res.output
     assert _runs(out)[-1] == ("finished", 0) and list((out / "figures").glob("*.svg"))
 
 

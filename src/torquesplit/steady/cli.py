@@ -446,7 +446,7 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
         except (TorquesplitError, ValueError, OSError) as exc:
             fail(_in_flags(exc))
             return
-        saved, failed = None, None
+        saved, failed, plotted = None, None, []
         try:  # a file that cannot be written: the curves are still printed, then the error
             if out is not None:
                 from torquesplit.results.export import dataset_files
@@ -455,7 +455,7 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
             if plot is not None:
                 from torquesplit.steady.plot import save, sweep_figure
 
-                save(sweep_figure(ds), plot)
+                plotted = [save(sweep_figure(ds), plot)]
         except (TorquesplitError, OSError) as exc:
             failed = exc
         largest = sweep_maxima(ds)
@@ -491,6 +491,7 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
             "wall_time_s": ds.attrs["wall_time_s"],
             "results_file": str(saved[0]) if saved else None,
             "results_files": [str(f) for f in saved or []],
+            "figure_files": [str(f) for f in plotted],
             # (the sweep's load sharing: these two, whatever the model's definition)
             "load_sharing_definitions": ["mean_force", "instantaneous"],
         }
@@ -581,9 +582,9 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
                     for k, v in lost.items()), highlight=False)
             if other:
                 console.print(other, highlight=False)
-            if saved:
-                console.print("results written to " + ", ".join(str(f) for f in saved),
-                              highlight=False)
+            if saved or plotted:  # (the figure was written without a word)
+                console.print("results written to " + ", ".join(
+                    str(f) for f in [*(saved or []), *plotted]), highlight=False)
         if failed is not None:
             fail(failed)
             return

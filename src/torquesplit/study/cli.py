@@ -142,7 +142,8 @@ def _run(source, *, workers, scheduler, out, resume, overwrite, figures, quiet, 
                            plan.n_cases, quiet or as_json)
     except StudyInterrupted as exc:
         # every case done: stopped while results.nc and the figures were written
-        unwritten = "; results.nc and figures not all written" if exc.done >= exc.total else ""
+        unwritten = ((f"; results.nc{' and figures' if figures else ''} not all written")
+                     if exc.done >= exc.total else "")
         ui.err_console.print("[yellow]stopped:[/] ", end="")
         ui.err_console.print(f"{exc.done} of {exc.total} cases done and saved in {out}"
                              f"{unwritten}; to finish, run the same command with --resume",
