@@ -249,8 +249,9 @@ leaves out the start-up transient before computing anything.
   coefficient G_it, from their eq. 19).
 * **bearing forces**: for each supported body (here `input`), the settled mean bearing
   force by direction, the magnitude of that mean and the peak magnitude |F|; a gear with
-  no translations is held rigidly, and its row (marked so) is the sum of its meshes'
-  forces, in the housing's x, y (and z: the axial thrust of helical teeth).  They come
+  no translations sits on a rigid bearing, and its row (marked `(rigid bearing)`) is the
+  sum of its meshes' forces, in the housing's x, y (and z: the axial thrust of helical
+  teeth); a planetary stage's fixed ring's in its carrier's frame, as the planets'.  They come
   from the history, not from the streamed statistics (next bullet).  `--json` gives them
   as `bearing_forces_N`, a .nc or .mat results file (`--out`) as `bearing_mean_force`
   and `bearing_peak_force`.

@@ -847,7 +847,7 @@ def bearing_table(bearings: list[dict], res) -> Table:
     for r, frame in zip(bearings, frames):
         means = ", ".join(f"{d} {kn(v)}" for d, v in zip(r["directions"], r["mean"]))
         body = (f"{r['body']} (spline {r['via']})" if r.get("via") else
-                f"{r['body']} (held rigidly)" if r.get("held") == "rigid" else r["body"])
+                f"{r['body']} (rigid bearing)" if r.get("held") == "rigid" else r["body"])
         b.add_row(body, means, kn(r["mean_magnitude"]), kn(r["peak_magnitude"]),
                   *([frame] if turning else []))
     return b

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 
+import numpy as np
 from typer.testing import CliRunner
 
 from torquesplit.cli import app
@@ -75,3 +76,30 @@ def test_steady_gives_the_planet_load_sharing_as_run_does():
     assert abs(k["per_stage"]["stage_carrier"] - 1.0) < 1e-6  # equal spacing, no errors
     res = CliRunner().invoke(app, args)
     assert "planets (load sharing" in res.stdout
+
+
+def test_a_held_ring_has_its_reaction_in_the_carriers_frame(tmp_path):
+    """A planetary reviewer's held ring had no bearing row (its meshes turn with the
+    carrier): its load on the housing was missing from the table.  It is the sum of its
+    meshes' forces in the carrier's frame, as the planets' rows: about zero for three
+    equal planets at 120 degrees, and the pin error's imbalance with one."""
+    import torquesplit
+    from planetary_models import three_planet_toml
+
+    def ring_row(extra=""):
+        path = tmp_path / f"p{len(extra)}.toml"
+        path.write_text(three_planet_toml("p", extra=extra))
+        res = torquesplit.simulate(torquesplit.load_model(path), cycles=60)
+        rows = {r["body"]: r for r in res.bearing_forces()}
+        mesh = max(abs(r.mean_force) for r in res.metrics().rows)
+        # every row in the carrier's frame here (the floating sun's too): the bearings
+        # hold the whole stage, so their mean forces add up to nothing
+        assert {r["frame"] for r in rows.values()} == {"carrier st_carrier (turning)"}
+        total = np.sum([r["mean"] for r in rows.values()], axis=0)
+        assert np.abs(total).max() < 1e-3 * mesh, total
+        return rows["st_ring"], mesh
+
+    ring, mesh = ring_row()
+    assert ring["held"] == "rigid" and ring["mean_magnitude"] < 1e-6 * mesh
+    ring, mesh = ring_row('pin_errors = [{tangential = "20 um"}, {}, {}]\n')
+    assert ring["mean_magnitude"] > 0.1 * mesh  # (0.23 of it: 1.44 kN, as the sun's)

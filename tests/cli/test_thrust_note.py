@@ -38,4 +38,4 @@ def test_a_rigidly_held_gear_is_not_named_its_row_has_the_thrust(tmp_path):
     data["gears"]["wheel"].pop("support", None)
     out = _run(tmp_path, data)
     assert "Axial thrust: pinion has no axial DOF" in out
-    assert "wheel (held rigidly)" in out
+    assert "wheel (rigid bearing)" in out

@@ -317,7 +317,7 @@ def _bearings(bearings: list[dict], res) -> str:
     per = ("every step" if res.history_keeps_every_step() else
            f"{res.history_samples_per_period():.3g} samples per shortest mesh period")
     rows = [[b["body"] + (f" (spline {b['via']})" if b.get("via") else
-                          " (held rigidly)" if b.get("held") == "rigid" else ""),
+                          " (rigid bearing)" if b.get("held") == "rigid" else ""),
              ", ".join(f"{d} {kn(v)}" for d, v in zip(b["directions"], b["mean"])),
              kn(b["mean_magnitude"]), kn(b["peak_magnitude"])] for b in bearings]
     header = ["body", "mean force by direction [kN]", "|mean| [kN]", "peak |F| [kN]"]

@@ -528,7 +528,7 @@ class Results:
         force vector [N] (a body held by a spline alone: the spline's radial force, its
         name in ``via``; a body held rigidly, with no translational DOF: the sum of its
         meshes' forces along their lines of action, in the housing's x, y, z, axial thrust
-        included, ``held`` "rigid"), from the history from ``start_time`` (default the
+        included, or a turning carrier's where its meshes turn with it, ``held`` "rigid"), from the history from ``start_time`` (default the
         latest group settle time: pass ``metrics().settling.start_time`` when the metrics are at
         hand; a periodic state's: its first whole period, whatever ``start_time``).  The
         history is decimated (``samples_per_period``): a peak between its samples is
@@ -599,7 +599,8 @@ class Results:
             n = np.array([sign * np.asarray(self.kinematics.meshes[m].line_of_action, float)
                           for m, sign in terms])  # (meshes, 3): force on the body per N
             axes = [k for k in range(3) if np.any(np.abs(n[:, k]) > 1e-12)]
-            out.append(row(body, ["xyz"[k] for k in axes], (f @ n)[:, axes], held="rigid"))
+            out.append(row(body, ["xyz"[k] for k in axes], (f @ n)[:, axes], held="rigid",
+                           frame=rigid_frame(self.kinematics, terms)))
         return out
 
     def mesh_force_history(self) -> tuple[np.ndarray, np.ndarray]:
@@ -895,10 +896,12 @@ def rigid_bearings(model, kin) -> dict[str, list[tuple[str, float]]]:
     """Bodies held rigidly (no translational DOF) that mesh -> their meshes and the sign
     that turns a mesh's force along its line of action into the force on the body (+1
     driven, -1 driver): their bearing carries the sum (a reviewer's pinions on
-    torsion-only shafts carried the largest radial loads and had no bearing row).  Left
-    out: a body whose meshes are analysed in a turning carrier's frame (their directions
-    turn with it), and one on a rigid shaft with a body that has translations (its load
-    goes to that body's bearings)."""
+    torsion-only shafts carried the largest radial loads and had no bearing row).  A
+    body whose meshes are analysed in one turning carrier's frame (the fixed ring of a
+    planetary stage) has its sum in that frame, as the planets' bearings
+    (:func:`rigid_frame`; it had no row: a planetary reviewer missed the ring's load).
+    Left out: a body meshing in several turning frames, and one on a rigid shaft with a
+    body that has translations (its load goes to that body's bearings)."""
     def translates(name) -> bool:
         items = model.gears if name in getattr(model, "gears", {}) else model.bodies
         return any(d != "theta" for d in getattr(items.get(name), "dofs", ("theta",)))
@@ -914,11 +917,21 @@ def rigid_bearings(model, kin) -> dict[str, list[tuple[str, float]]]:
                 continue
             terms = [(m, 1.0 if mk.driven == name else -1.0) for m, mk in kin.meshes.items()
                      if name in (mk.driver, mk.driven)]
-            turning = any(kin.meshes[m].carrier and kin.bodies[kin.meshes[m].carrier].speed
-                          for m, _ in terms)  # (its meshes' directions turn with it)
-            if terms and not turning:
+            turning = {kin.meshes[m].carrier for m, _ in terms if kin.meshes[m].carrier
+                       and kin.bodies[kin.meshes[m].carrier].speed}
+            if terms and len(turning) <= 1:  # (directions that turn with one carrier)
                 out[name] = terms
     return out
+
+
+def rigid_frame(kin, terms) -> str:
+    """The frame a rigid bearing's force (:func:`rigid_bearings`) is written in: that of
+    its meshes' lines of action, a turning carrier's where they turn with it."""
+    for m, _ in terms:
+        c = kin.meshes[m].carrier
+        if c and kin.bodies[c].speed:
+            return f"carrier {c} (turning)"
+    return "housing"
 
 
 def bearing_bodies(structure, model, kin=None) -> list[str]:
