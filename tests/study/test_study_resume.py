@@ -115,6 +115,14 @@ def test_changed_study_or_model_refuses_resume(tmp_path, split_file):
                                          r"\.0\.stop: '9 um' -> '12 um'.*another out or "
                                          r"overwrite=True$"):
         Study(path).run(workers=1, out=out, resume=True)
+    # another study in the folder: said so, not as the JSON of every field that differs
+    name = data["study"]["name"]
+    data["study"]["name"] = "another"
+    _write(tmp_path, data)
+    with pytest.raises(StudyError, match=rf"^resume: .*out holds the study '{name}', not "
+                                         r"'another'; start a new study with another out"):
+        Study(path).run(workers=1, out=out, resume=True)
+    data["study"]["name"] = name
     data["grid"]["parameters"][0]["stop"] = "9 um"
     _write(tmp_path, data)
     split_file.write_text(split_file.read_text().replace('torque = "100 N m"',
@@ -311,7 +319,7 @@ def test_resume_accepts_a_changed_description(tmp_path, split_file):
         assert [c for (c,) in db.execute("SELECT computed FROM runs ORDER BY run")] == [2, 0]
     data["study"]["name"] = "another name"  # not wording only: still refused
     _write(tmp_path, data)
-    with pytest.raises(StudyError, match=r"study\.name"):
+    with pytest.raises(StudyError, match=r"holds the study 'test grid', not 'another name'"):
         Study(path).run(workers=1, out=out, resume=True)
 
 

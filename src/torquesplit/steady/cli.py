@@ -329,18 +329,23 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
                       "state)")
             chosen = m.analysis.load_sharing  # mesh_table()'s (Results.default_definition)
             chosen = "mean_force" if chosen == "static_torque" else chosen
-            for col in ("mesh", "group", "static F [kN]", "mean F [kN]", "peak F [kN]",
-                        "DF (peak/static)", "peak/nominal", f"LSC ({chosen})",
-                        "RMS TE [µm]", "contact loss"):
+            # the columns and digits of run's mesh table (6 digits here did not hold: the
+            # sun and ring mean forces of one planet differed in the 5th, equally loaded
+            # planets' factors in the 5th decimal; the JSON and the files keep them all)
+            for col in ("mesh", "group", "nominal F\n[kN]", "static F\n[kN]",
+                        "mean F\n[kN]", "peak F\n[kN]", "dynamic\nfactor",
+                        "peak/\nnominal", f"LSC\n({chosen})", "RMS TE\n[µm]",
+                        "contact\nloss"):
                 t.add_column(_h(col), justify="left" if col in ("mesh", "group") else "right")
             def cell(x, fmt):  # (an undefined number, as the JSON's null: no 'inf')
                 return format(x, fmt) if math.isfinite(x) else "-"
 
             for r in rows:
-                t.add_row(r.mesh, r.group, cell(r.static_force / 1e3, "#.6g"),
-                          cell(r.mean_force / 1e3, "#.6g"), cell(r.peak_force / 1e3, "#.6g"),
-                          cell(r.dynamic_factor, ".5f"), cell(r.peak_to_nominal, ".5f"),
-                          cell(r.load_sharing, ".5f"),
+                t.add_row(r.mesh, r.group, cell(r.nominal_force / 1e3, "#.5g"),
+                          cell(r.static_force / 1e3, "#.5g"),
+                          cell(r.mean_force / 1e3, "#.5g"), cell(r.peak_force / 1e3, "#.5g"),
+                          cell(r.dynamic_factor, ".4f"), cell(r.peak_to_nominal, ".4f"),
+                          cell(r.load_sharing, ".4f"),
                           cell(1e6 * r.rms_transmission_error, "#.4g"),
                           cell(100 * r.contact_loss, ".2f") + " %")
             console.print(t)
@@ -527,7 +532,7 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
                              if no_stability else
                              "largest dynamic factor over the stable points of the sweep")
                           + part + (" and the time integrations" if cross_check else ""))
-            cols = ["mesh", "DF (peak/static)", "at [rpm]"]
+            cols = ["mesh", "dynamic factor\n(peak/static)", "at [rpm]"]
             cols += ["run-up DF", "at [rpm]", "run-down DF", "at [rpm]"] if cross_check else []
             for col in cols:
                 t.add_column(_h(col))

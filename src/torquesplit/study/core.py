@@ -421,6 +421,11 @@ def _check_same(plan: Plan, meta: dict, out: Path, words: Words = API_WORDS) -> 
     if (meta.get("study_hash") != plan.study_hash
             and _values(_results_part(meta.get("study", {})))
             != _values(_results_part(plan.spec.canonical()))):
+        stored = (meta.get("study") or {}).get("study", {}).get("name")
+        if stored is not None and stored != plan.spec.study.name:  # another study: said
+            # so, not as the JSON of every field that differs (a studies reviewer)
+            raise StudyError(w.resume, f"{out} holds the study {stored!r}, not "
+                                       f"{plan.spec.study.name!r}; {again}")
         changes = _diff(meta.get("study", {}), plan.spec.canonical())
         raise StudyError(w.resume, f"the study changed since {out} was started "
                                    f"({changes}); undo the change, or {again}")
