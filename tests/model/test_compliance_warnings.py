@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 import warnings
 
+import numpy as np
 import pytest
 
 import torquesplit
@@ -124,3 +125,25 @@ def test_a_drive_far_too_light_for_its_gears_is_warned_once():
     _, _, said = light(f"{100 * 0.99 * MIN_LOAD_PER_WIDTH / per_width} N m")
     (loc, msg), = said
     assert loc == "meshes.m" and "wrong unit" in msg
+
+
+def test_a_floating_sun_among_unequally_spaced_planets_is_said_to_float():
+    """The floating-sun recipe (a support of 1 N/m) on a stage with unequal spacing: the
+    sun's nominal resultant made it a unit slip ('would deflect 327.5 m'), not the
+    floating member the error that recommends the recipe promises (a planetary
+    reviewer); one mesh alone cannot centre a gear, so a pair keeps the slip warning."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        m = torquesplit.load_model("lin_parker1999_planetary", changes={
+            "planetary.0.sun.support.stiffness": 1.0,
+            "planetary.0.angles": ["0 deg", "80 deg", "180 deg", "270 deg"]})
+    kin = solve_kinematics(m)
+    sun = next(n for n in m.gears if n.endswith("_sun"))
+    resultant = sum((-1.0 if sun == mk.driver else 1.0) * mk.force
+                    * np.asarray(mk.line_of_action, float)
+                    for mk in kin.meshes.values() if sun in (mk.driver, mk.driven))
+    assert float(np.linalg.norm(resultant[:2])) > 100.0  # (a resultant)
+    msg = dict(compliance_warnings(m, kin))[f"gears.{sun}.support.stiffness"]
+    assert "floats, held by its meshes alone" in msg and "would deflect" not in msg
+    (loc, msg), = _warnings(_supported("1 N/m"))
+    assert "would deflect" in msg

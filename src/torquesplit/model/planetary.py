@@ -175,7 +175,10 @@ class Planetary(Strict):
     carrier, the planet bearings on the carrier and the meshes (see
     docs/theory/planetary.md).  Any member may be held by a ``torsional_support`` (ring:
     planetary; carrier: star) or driven and loaded through ``[drives]``/``[loads]`` on
-    the generated names (``<name>_sun``, ``<name>_ring``, ``<name>_carrier``)."""
+    the generated names (``<name>_sun``, ``<name>_ring``, ``<name>_carrier``).  A
+    floating sun, held by its planet meshes alone: ``dofs = ["theta", "x", "y"]`` with a
+    support of negligible stiffness (``support = {stiffness = "1 N/m"}``); the check then
+    says that it floats: accept that warning in ``[model] accepted_warnings``."""
 
     name: str = Field("planetary", pattern=r"^[A-Za-z][A-Za-z0-9_]*$", max_length=40,
                       description="Prefix of the generated names (letters, digits, _).")
