@@ -152,6 +152,21 @@ def test_steady_says_its_results_warnings_and_leaves_out_cycles_without_samples(
             mean = row[key.replace("_peak_N", "_mean_N")]
             assert (row[key] == "") == (mean == ""), (row["cycle"], key)
     assert any(row["in1_peak_N"] == "" for row in rows)
+    # the cycles of one period, not of every repetition of it in the record (a planetary
+    # reviewer's table had 89 identical rows); the .nc keeps the whole record
+    import xarray as xr
+
+    about = json.loads((tmp_path / "sd_about.json").read_text())
+    period = about["steady"]["period_s"]
+    starts = [[float(v) for k, v in r.items() if k.endswith("_start_s") and v != ""]
+              for r in rows]
+    assert all(any(-1e-12 <= t < period for t in row) for row in starts), starts
+    assert max(max(r) for r in starts) > 0.5 * period  # (the whole period, not a part)
+    nc = CliRunner().invoke(app, ["steady", str(model), "--no-stability", "--out",
+                                  str(tmp_path / "sd.nc")])
+    assert nc.exit_code == 0, nc.output
+    with xr.open_dataset(tmp_path / "sd.nc", engine="h5netcdf") as ds:
+        assert ds.sizes["cycle"] > 3 * len(rows)
     # the table's RMS transmission error is in the summary file as in the .nc
     summary = {r["mesh"]: r for r in csv.DictReader(open(out, newline=""))}
     printed = json.loads(res.stdout)["meshes"]

@@ -705,7 +705,8 @@ class Results:
         forces and torques, each column's unit in its name: ``m1_N``, ``shaft_Nm``),
         ``NAME_cycles.csv`` (start, peak, smallest and mean force of every mesh cycle;
         empty for a cycle the start or the end of the run cuts, :attr:`complete_cycles`;
-        ``MESH_settled`` 1 for the cycles the metrics' peaks are over),
+        ``MESH_settled`` 1 for the cycles the metrics' peaks are over; a periodic
+        state's: the cycles that begin in its period),
         ``NAME_bearings.csv`` (the bearing table: :meth:`bearing_forces`),
         ``NAME_elements.csv`` (a row per recorded element: its unit, frame and the
         fractions of the run with its clearance open and in back contact) and
@@ -799,10 +800,18 @@ class Results:
             [[n, units[i], f, s.separation_fraction[i], s.back_contact_fraction[i]]
              for n, i, f in zip(names, s.history_elements, element_frames(self, names))])
         n_hist = s.history_t.size
+        cycle_rows = np.arange(s.cycle_start.shape[0])
         if self.periodic and self.period:  # one period, as the .nc holds
             from .dataset import period_samples
 
             n_hist = period_samples(s.history_t, self.period) or n_hist
+            # and the cycles that begin in it (the table listed every repetition of the
+            # period in the record: 89 identical rows, a planetary reviewer; the .nc keeps
+            # them, its metrics are recomputed from them)
+            t0, eps = float(s.t_span[0]), 1e-9 * self.period
+            start = s.cycle_start[:, cols]
+            inside = ((start >= t0 - eps) & (start < t0 + self.period - eps)).any(axis=1)
+            cycle_rows = np.flatnonzero(inside) if inside.any() else cycle_rows
         contents = {
             groups: files.csv_bytes(group_header, group_rows),
             bearing_file: files.csv_bytes(bearing_header, bearing_rows),
@@ -815,9 +824,9 @@ class Results:
                 ["cycle"] + [f"{m}_{q}" for q in ("start_s", "peak_N", "min_N", "mean_N")
                              for m in self.mesh_names] + settled_header,
                 [[k] + row + [int(c[k]) for c in settled_columns]
-                 for k, row in enumerate(np.column_stack(
+                 for k, row in zip(cycle_rows.tolist(), np.column_stack(
                      [s.cycle_start[:, cols], *self.complete_cycle_statistics()[:3]]
-                 ).tolist())]),
+                 )[cycle_rows].tolist())]),
         }
         with files.claim_output(plan) as claim:
             steady_info = _steady_summary(self._steady_attributes(steady_summary))
