@@ -56,6 +56,14 @@ def test_check_says_an_idler_planets_torque_is_per_mesh(model_file):
     res = runner.invoke(app, ["check", str(model_file), "--json"])
     bodies = json.loads(res.stdout)["bodies"]
     assert bodies["st_planet1"]["idler"] and not bodies["st_carrier"]["idler"]
+    # the torques are magnitudes: each says what it is (a reviewer could not tell a star
+    # stage's input from its output and its reaction)
+    assert [bodies[b]["role"] for b in ("st_sun", "st_carrier", "st_ring", "st_planet1")] \
+        == ["input", "output", "reaction", ""]
+    res = runner.invoke(app, ["check", "lin_parker1999_star"], terminal_width=250)
+    rows = {ln.split()[1]: ln for ln in res.stdout.splitlines() if ln.startswith("│ stage_")}
+    assert "(input)" in rows["stage_sun"] and "(output)" in rows["stage_ring"]
+    assert "(reaction)" in rows["stage_carrier"] and "(idler" in rows["stage_planet1"]
 
 
 def test_contact_says_whose_angle_the_transmission_error_is(model_file):

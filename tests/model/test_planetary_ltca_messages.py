@@ -33,6 +33,11 @@ def test_a_planet_angle_off_the_assembly_condition_is_given_the_nearest_that_fit
     with pytest.raises(ModelError, match=r"71\.001 tooth periods.*the nearest for planet 3: "
                                          r"236\.6666667 deg"):
         torquesplit.load_model(tomllib.loads(text))
+    # halfway between two that fit: both (the second alone was named)
+    text = three_planet_toml("angles", extra='angles = ["0 deg", "120 deg", "235 deg"]\n')
+    with pytest.raises(ModelError, match=r"the nearest for planet 3: 233\.3333333 deg or "
+                                         r"236\.6666667 deg"):
+        torquesplit.load_model(tomllib.loads(text))
 
 
 def test_crowning_that_too_few_slices_cannot_see_is_said(tmp_path):

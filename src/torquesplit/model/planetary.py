@@ -170,6 +170,15 @@ class PlanetaryMesh(Strict):
         return self
 
 
+def _nearest_fits(i: int, first: float, steps: float, period: float) -> str:
+    """The angle(s) nearest to a planet that does not fit: both where it lies halfway
+    (245 deg between 243.333 and 246.667 named only the second, a planetary reviewer)."""
+    lo, hi = math.floor(steps), math.ceil(steps)
+    near = ([lo, hi] if abs((steps - lo) - (hi - steps)) < 1e-6 else [round(steps)])
+    text = " or ".join(f"{math.degrees(first + k * period):.10g} deg" for k in near)
+    return f"the nearest for planet {i}: {text}"
+
+
 class Planetary(Strict):
     """A planetary (epicyclic) stage in one table: expands to the sun, planets, ring and
     carrier, the planet bearings on the carrier and the meshes (see
@@ -436,9 +445,8 @@ class Planetary(Strict):
                         f"counts with z_s + z_r divisible by {self.planets}, or give 'angles'"
                         if self.angles is None else
                         f"give angles that are multiples of 360 deg / (z_s + z_r) = "
-                        f"{math.degrees(period):.6g} deg from the first planet; the "
-                        f"nearest for planet {i}: "
-                        f"{math.degrees(angles[0] + round(steps) * period):.10g} deg")
+                        f"{math.degrees(period):.6g} deg from the first planet; "
+                        + _nearest_fits(i, angles[0], steps, period))
                 if self.angles is not None and max(abs(a) for a in angles) > 2 * math.pi:
                     # an angle beyond a turn is a number of degrees written bare: that
                     # one message (the other angles are misread the same way)

@@ -20,6 +20,7 @@ def summary(model: Model) -> dict:
 
     kin = solve_kinematics(model)
     idlers = _idlers(model)
+    roles = _roles(model)
     bodies = {}
     for name, b in kin.bodies.items():
         bodies[name] = {
@@ -35,6 +36,7 @@ def summary(model: Model) -> dict:
             "position_mm": [1e3 * float(v) for v in b.position],
             "position_computed": name in kin.positions_computed,
             "idler": name in idlers,
+            "role": roles.get(name, ""),
         }
     meshes = {}
     for name, mk in kin.meshes.items():
@@ -93,6 +95,19 @@ def _idlers(model) -> set[str]:
             and g.torsional_support is None and count.get(name, 0) >= 2}
 
 
+def _roles(model) -> dict[str, str]:
+    """What a body's torque is (the torques are magnitudes: a reviewer could not tell the
+    input of a star stage from its output and its reaction): ``input`` where a drive
+    acts, ``output`` where a load does, ``reaction`` where a torsional support holds it."""
+    out = {d.body: "input" for d in model.drives.values()}
+    out.update({ld.body: "output" for ld in model.loads.values()})
+    for items in (model.gears, getattr(model, "bodies", {})):
+        for name, item in items.items():
+            if getattr(item, "torsional_support", None) is not None and name not in out:
+                out[name] = "reaction"
+    return out
+
+
 def _num(x):
     return None if x is None or not math.isfinite(x) else float(x)
 
@@ -119,7 +134,7 @@ def render_summary(s: dict, console) -> None:
         mark = lambda flag, note="": f" (computed{note})" if flag else ""  # noqa: E731
         pos = "(" + ", ".join(f"{round(v, 4) + 0.0:.6g}" for v in b["position_mm"]) + ")"
         torque = f"{b['torque_Nm']:.6g}" + (" per mesh (idler: net 0)" if b.get("idler")
-                                             else "")
+                                             else f" ({b['role']})" if b.get("role") else "")
         t.add_row(name, f"{b['speed_rpm']:.6g}", torque,
                   (f"{b['mass_kg']:.5g}{mark(b['mass_computed'], basis)}" if b["mass_kg"]
                    else "-"),  # (a body that only turns needs no mass)
