@@ -161,10 +161,15 @@ def _sweep_panel(ax, ds, variable):
     stable = ds["stable"].values
     _, scale = _SWEEP_AXES.get(variable, ("", 1.0))
     drawn = []  # (values, first line): a curve equal to one drawn joins its label
+    # equal: to 1e-6 of the panel's largest value, far below what a figure shows (at
+    # 1e-9 relative, identical planets' curves split on their round-off, a planetary
+    # reviewer's legend listed two of three ring meshes apart from the third)
+    values = ds[variable].values * scale
+    tol = 1e-6 * float(np.nanmax(np.abs(values))) if np.isfinite(values).any() else 0.0
     for j, mesh in enumerate(ds["mesh"].values):
-        y = ds[variable].values[:, j] * scale
+        y = values[:, j]
         same = next((ln for yy, ln in drawn
-                     if np.allclose(y, yy, rtol=1e-9, atol=0.0, equal_nan=True)), None)
+                     if np.allclose(y, yy, rtol=0.0, atol=tol, equal_nan=True)), None)
         if same is not None:  # (identical planets: eight entries over one line)
             same.set_label(f"{same.get_label()}, {mesh}")
             continue
