@@ -1060,30 +1060,33 @@ def mesh(
         if pair not in m.meshes:
             raise OptionError(f"--pair: no mesh named {pair!r}; use one of "
                               f"{', '.join(m.meshes)}")
-        from .assembly.excitation import stiffness_table
-        from .gears.stiffness import compare_methods
-        from .gears.stiffness.result import MeshStiffness
-        from .model.kinematics import solve_kinematics
+        # (the contact analysis's warnings, e.g. of a secant stiffness: a raw Python
+        # warning and none in --json, an LTCA reviewer)
+        with ux.collect_warnings():
+            from .assembly.excitation import stiffness_table
+            from .gears.stiffness import compare_methods
+            from .gears.stiffness.result import MeshStiffness
+            from .model.kinematics import solve_kinematics
 
-        kin = solve_kinematics(m)
-        mk = kin.meshes[pair]
-        if mk.geometry is None:
-            raise OptionError(f"mesh {pair!r} is a bevel/face mesh: only its model-file "
-                              f"stiffness applies (no involute stiffness methods); choose a "
-                              f"cylindrical mesh")
-        spec = m.meshes[pair].stiffness
-        label = spec.method
-        if spec.method == "ltca":  # which stiffness of the contact analysis the run takes
-            label = (f"ltca, {spec.ltca.excitation}: "
-                     + ("dP/dZ" if spec.ltca.excitation == "tangent" else "P/Z")
-                     + " at the operating load")
-        model_k = MeshStiffness.from_samples(stiffness_table(m, kin, pair, points),
-                                             method=f"model file ({label})")
-        g = m.gears[mk.driver]
-        row = "model file" if spec.method != "ltca" else f"model file ({label})"
-        with ux.interruptible():  # (Ctrl-C exited 130 without a word)
-            cmp = compare_methods(mk.geometry, points, young_modulus=g.youngs_modulus,
-                                  poisson_ratio=g.poisson_ratio, extra={row: model_k})
+            kin = solve_kinematics(m)
+            mk = kin.meshes[pair]
+            if mk.geometry is None:
+                raise OptionError(f"mesh {pair!r} is a bevel/face mesh: only its model-file "
+                                  f"stiffness applies (no involute stiffness methods); choose a "
+                                  f"cylindrical mesh")
+            spec = m.meshes[pair].stiffness
+            label = spec.method
+            if spec.method == "ltca":  # which stiffness of the contact analysis the run takes
+                label = (f"ltca, {spec.ltca.excitation}: "
+                         + ("dP/dZ" if spec.ltca.excitation == "tangent" else "P/Z")
+                         + " at the operating load")
+            model_k = MeshStiffness.from_samples(stiffness_table(m, kin, pair, points),
+                                                 method=f"model file ({label})")
+            g = m.gears[mk.driver]
+            row = "model file" if spec.method != "ltca" else f"model file ({label})"
+            with ux.interruptible():  # (Ctrl-C exited 130 without a word)
+                cmp = compare_methods(mk.geometry, points, young_modulus=g.youngs_modulus,
+                                      poisson_ratio=g.poisson_ratio, extra={row: model_k})
     except _EXPECTED as exc:
         _fail(exc)
         return

@@ -64,6 +64,8 @@ def test_check_says_an_idler_planets_torque_is_per_mesh(model_file):
     rows = {ln.split()[1]: ln for ln in res.stdout.splitlines() if ln.startswith("│ stage_")}
     assert "(input)" in rows["stage_sun"] and "(output)" in rows["stage_ring"]
     assert "(reaction)" in rows["stage_carrier"] and "(idler" in rows["stage_planet1"]
+    # the power balance as what it is, its round-off as 0 ('balance -1.37e-16')
+    assert "balance (input - output) / input: 0\n" in res.stdout, res.stdout[:300]
 
 
 def test_contact_says_whose_angle_the_transmission_error_is(model_file):

@@ -203,6 +203,24 @@ def test_set_of_a_tip_relief_in_mm_warns_on_the_argument(tmp_path):
         "(3 mm): a relief zone this short does nothing" in short.stderr, short.stderr
 
 
+def test_a_relief_without_its_extent_is_told_to_add_one(tmp_path):
+    """'give exactly one of ... (got none); remove the others' where none was given (an
+    LTCA reviewer)."""
+    model = tmp_path / "spur.toml"
+    model.write_text(SPUR.replace('tip_relief = {amount = "15 um", length = "5 mm"}',
+                                  'tip_relief = {amount = "15 um"}'))
+    res = runner.invoke(app, ["check", str(model)])
+    assert res.exit_code == 2, res.output
+    assert "tip_relief: says how much relief but not where it starts: add one of length, " \
+        "start_diameter, start_roll_angle or height" in res.stderr, res.stderr
+    assert "remove" not in res.stderr
+    model.write_text(SPUR)
+    both = runner.invoke(app, ["check", str(model), "--set",
+                               "gears.pinion.modifications.tip_relief.height=0.5 mm"])
+    assert both.exit_code == 2 and "(got length, height); keep one, remove the others" \
+        in both.stderr, both.stderr
+
+
 # ------------------------------------------------------------------ negative amounts
 @pytest.mark.parametrize("path", ["gears.pinion.modifications.tip_relief.amount",
                                   "gears.pinion.modifications.crowning"])
@@ -245,3 +263,21 @@ def test_library_checks_of_modifications_format_values_readably():
             case()
         (loc, msg), = exc.value.issues
         assert "99999" not in msg and " m;" in msg, msg
+
+
+def test_mesh_says_the_contact_analysis_warnings_as_every_command_does(tmp_path):
+    """'mesh' printed the secant-stiffness warning as a raw Python warning and gave
+    "warnings": [] in --json (an LTCA reviewer)."""
+    import json
+
+    model = tmp_path / "spur.toml"
+    model.write_text(SPUR)
+    res = runner.invoke(app, ["mesh", str(model), "--pair", "m", "--json", "--set",
+                              "meshes.m.stiffness.ltca.excitation=secant"])
+    assert res.exit_code == 0, res.output
+    said = json.loads(res.stdout)["warnings"]
+    assert any("secant LTCA stiffness P/Z" in w for w in said), said
+    res = runner.invoke(app, ["mesh", str(model), "--pair", "m", "--set",
+                              "meshes.m.stiffness.ltca.excitation=secant"])
+    assert "warning: meshes.m.stiffness: the secant LTCA stiffness" in res.stderr, res.stderr
+    assert "ModelWarning" not in res.output

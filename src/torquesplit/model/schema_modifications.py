@@ -58,9 +58,13 @@ class ReliefSpec(Strict):
     def _one_start(self):
         given = [n for n in ("length", "start_diameter", "start_roll_angle", "height")
                  if getattr(self, n) is not None]
-        if len(given) != 1:
+        if not given:  # ('remove the others' where none was given, an LTCA reviewer)
+            raise ValueError("says how much relief but not where it starts: add one of "
+                             "length, start_diameter, start_roll_angle or height, e.g. "
+                             "length = '2 mm' (along the line of action)")
+        if len(given) > 1:
             raise ValueError(f"give exactly one of length, start_diameter, start_roll_angle, "
-                             f"height (got {', '.join(given) or 'none'}); remove the others")
+                             f"height (got {', '.join(given)}); keep one, remove the others")
         if self.exponent != 2.0 and self.shape != "power":
             raise FieldError("exponent", "applies to shape = 'power' only; set shape = 'power' "
                              "or remove 'exponent'")

@@ -120,9 +120,13 @@ def render_summary(s: dict, console) -> None:
     console.print(f"[bold]{escape(s['model'])}[/]  {escape(s['description'])}")
     if s["reference"]:
         console.print(f"[dim]{escape(s['reference'])}[/]")
+    # (in - out) / in: round-off printed as '0' (it read 'balance -1.37e-16' without a
+    # unit, an LTCA reviewer)
+    pb = s["power_balance"]
+    balance = "0" if abs(pb) < 1e-9 else f"{100 * pb:.2g} %"
     console.print(
         f"input {s['input_power_kW']:.6g} kW, output {s['output_power_kW']:.6g} kW, "
-        f"balance {s['power_balance']:.2e}", highlight=False)
+        f"balance (input - output) / input: {balance}", highlight=False)
     t = Table(title="bodies ((computed): from the gear's geometry; (placed): from its mates)")
     for col in ("body", "speed [rpm]", "torque [N m]", "mass [kg]", "J [kg m²]",
                 "position [mm]"):
