@@ -273,6 +273,11 @@ def test_contact_out_writes_every_load_and_the_harris_map(tmp_path):
         assert f"transmission_error_{label}_arcsec" in pos[0]
         assert float(next(lr for lr in load_rows if lr["load_case"] == label)[
             "te_peak_to_peak_m"]) == pytest.approx(row["te_peak_to_peak_m"], rel=1e-12)
+        # each tooth pair's load at each load, labelled so (it was the largest load's,
+        # under columns that did not say so: an LTCA reviewer); the pairs carry the load
+        pairs = [float(p[f"pair_load_{label}_{k}_N"]) for p in pos for k in (1, 2)]
+        total = [sum(float(p[f"pair_load_{label}_{k}_N"]) for k in (1, 2, 3)) for p in pos]
+        assert max(pairs) > 0 and total == pytest.approx([row["load_N"]] * len(pos), rel=1e-6)
     harris = list(csv.DictReader(names[2].open()))
     assert [float(h["harris_load_N"]) for h in harris] == pytest.approx(
         res["harris"]["load_N"], rel=1e-12)

@@ -69,9 +69,12 @@ def contact_dataset(results, *, operating_load=None, harris=None, impact=None, g
     data["unloaded_te"] = ("position", np.asarray(op.unloaded_te, dtype=float),
                            {"units": "m", "long_name": "transmission error at vanishing "
                             "load (geometric: modifications and misalignment)"})
-    data["pair_load"] = (("position", "pair"), op.pair_load.sum(axis=1),
-                         {"units": "N", "long_name": f"load of each tooth pair at the "
-                          f"largest load ({op.load:.6g} N), over the helices"})
+    # at every load, labelled as the other curves: at the largest only, its columns did
+    # not say which load they were of (an LTCA reviewer)
+    data["pair_load"] = (("position", "load_case", "pair"),
+                         np.stack([r.pair_load.sum(axis=1) for r in results], axis=1),
+                         {"units": "N", "long_name": "load of each tooth pair, over the "
+                          "helices"})
     # the loads label the columns of the position table ('transmission_error_10kN_m')
     labels = [f"{x / 1e3:.6g}kN" for x in loads]
     if len(set(labels)) < len(labels):
