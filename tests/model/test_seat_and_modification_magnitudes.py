@@ -281,3 +281,20 @@ def test_mesh_says_the_contact_analysis_warnings_as_every_command_does(tmp_path)
                               "meshes.m.stiffness.ltca.excitation=secant"])
     assert "warning: meshes.m.stiffness: the secant LTCA stiffness" in res.stderr, res.stderr
     assert "ModelWarning" not in res.output
+
+
+@pytest.mark.parametrize("diameter,beyond", [("85 mm", "the tip (diameter 81 mm)"),
+                                             ("71 mm", "the start of active profile"),
+                                             ("60 mm", "the start of active profile")])
+def test_a_relief_start_diameter_off_the_flank_is_given_its_range(tmp_path, diameter, beyond):
+    """Beyond the tip the message gave the range of diameters; below the start of active
+    profile it said the zone's radial height was too long (an LTCA reviewer)."""
+    model = tmp_path / "spur.toml"
+    model.write_text(SPUR.replace('tip_relief = {amount = "15 um", length = "5 mm"}',
+                                  f'tip_relief = {{amount = "15 um", start_diameter = '
+                                  f'"{diameter}"}}'))
+    res = runner.invoke(app, ["check", str(model)])
+    assert res.exit_code == 2, res.output
+    text = " ".join(res.stderr.split())
+    assert f"tip_relief.start_diameter: {diameter} lies beyond {beyond}" in text, text
+    assert "give a diameter between 71.199 and 81 mm" in text  # (this pair's SAP and tip)

@@ -358,6 +358,14 @@ def _zone(relief: Relief, fc: FlankCoordinates, tip: bool, where: str):
                 f"give a diameter between {2e3 * min(fc.r_sap, fc.r_tip):.5g} and "
                 f"{2e3 * max(fc.r_sap, fc.r_tip):.5g} mm"))])
     if height > fc.active_height * (1 + 1e-9):
+        if key == "start_diameter":  # (the range the diameter may take, as beyond the tip:
+            # a start below the active profile got the height message, an LTCA reviewer)
+            other = "start of active profile" if tip else "tip"
+            raise ModelError([(f"{where}.start_diameter", (
+                f"{relief.start_diameter * 1e3:.5g} mm lies beyond the {other} (diameter "
+                f"{2e3 * other_r:.5g} mm): the relief zone would be longer than the active "
+                f"profile; give a diameter between {2e3 * min(fc.r_sap, fc.r_tip):.5g} and "
+                f"{2e3 * max(fc.r_sap, fc.r_tip):.5g} mm"))])
         raise ModelError([(f"{where}.{key}", (
             f"the relief zone ({height * 1e3:.4g} mm radial height) is longer than the active "
             f"profile ({fc.active_height * 1e3:.4g} mm high); reduce it"))])
