@@ -1344,7 +1344,7 @@ def _print_contact(m, pair, names, op_load, cm, results, hm, impact, op, figures
     given = [""] * len(results) if given is None else given
     for col in (["given as"] if any(given) else []) + [
             "load [kN]", "TE mean [µm]", "TE p-p [µm]", arcsec, "k secant [N/µm]",
-            "k tangent [N/µm]", "p_H max [MPa]", "contact ratio"]:
+            "k tangent [N/µm]", "p_H max [MPa]", "contact ratio", "K_Hβ"]:
         t.add_column(_h(col), justify="right")
     for r, row, g in zip(results, rows, given):
         t.add_row(*([g] if any(given) else []), f"{r.load / 1e3:#.5g}",
@@ -1353,7 +1353,7 @@ def _print_contact(m, pair, names, op_load, cm, results, hm, impact, op, figures
                   f"{row['stiffness_secant_mean_N_per_m'] / 1e6:#.5g}",
                   f"{row['stiffness_tangent_mean_N_per_m'] / 1e6:#.5g}",
                   f"{row['max_hertz_pressure_Pa'] / 1e6:#.5g}",
-                  f"{row['actual_contact_ratio']:.3f}")
+                  f"{row['actual_contact_ratio']:.3f}", f"{row['face_load_factor']:.3f}")
     console.print(t)
     if hm is not None:
         h = Table(title="Harris map")

@@ -42,6 +42,9 @@ def contact_dataset(results, *, operating_load=None, harris=None, impact=None, g
         "max_hertz_pressure": ("max_hertz_pressure_Pa", "Pa", "largest Hertz pressure"),
         "contact_ratio": ("actual_contact_ratio", "1",
                           "mean number of loaded tooth pairs over the cycle"),
+        "face_load_factor": ("face_load_factor", "1",
+                             "K_Hbeta: largest load per unit face width over its mean "
+                             "(ISO 6336-1), the load averaged over the mesh positions"),
     }
     data = {name: ("load_case", np.array([row[key] for row in rows], dtype=float),
                    {"units": unit, "long_name": text})
@@ -66,6 +69,12 @@ def contact_dataset(results, *, operating_load=None, harris=None, impact=None, g
     for name, (values, unit, text) in curves.items():
         data[name] = (("position", "load_case"), np.stack(values, axis=1),
                       {"units": unit, "long_name": text})
+    # the load across the face (a reviewer had to compute K_Hbeta and the line loads
+    # from the Python result): per slice, averaged over the positions, every load
+    data["face_load"] = (("slice", "load_case"),
+                         np.stack([r.face_load.max(axis=0) for r in results], axis=1),
+                         {"units": "N/m", "long_name": "load per unit face width across the "
+                          "face, averaged over the mesh positions (the larger helix's)"})
     data["unloaded_te"] = ("position", np.asarray(op.unloaded_te, dtype=float),
                            {"units": "m", "long_name": "transmission error at vanishing "
                             "load (geometric: modifications and misalignment)"})
@@ -86,7 +95,10 @@ def contact_dataset(results, *, operating_load=None, harris=None, impact=None, g
               "phase": ("position", np.asarray(op.phase, dtype=float),
                         {"units": "1", "long_name": "mesh position in cycles"}),
               "position": np.arange(1, op.phase.size + 1),
-              "pair": np.arange(1, op.pair_load.shape[2] + 1)}
+              "pair": np.arange(1, op.pair_load.shape[2] + 1),
+              "face_position": ("slice", np.asarray(op.model.y, dtype=float),
+                                {"units": "m", "long_name": "position of the slice's middle "
+                                 "across the face, from its start"})}
     if harris is not None:
         coords["harris_load"] = ("harris_load", np.asarray(harris.loads, dtype=float),
                                  {"units": "N", "long_name": "normal tooth load"})
