@@ -257,8 +257,8 @@ def test_contact_out_writes_every_load_and_the_harris_map(tmp_path):
     r = CliRunner().invoke(app, args + ["--out", str(tmp_path / "c.csv")])
     assert r.exit_code == 0, r.output
     res = json.loads(r.stdout)
-    names = [tmp_path / f for f in ("c.csv", "c_position.csv", "c_harris_load.csv",
-                                    "c_about.json")]
+    names = [tmp_path / f for f in ("c.csv", "c_position.csv", "c_slice.csv",
+                                    "c_harris_load.csv", "c_about.json")]
     assert res["files"] == [str(f) for f in names] and all(f.is_file() for f in names)
     load_rows = list(csv.DictReader(names[0].open()))
     assert [float(row["load_N"]) for row in load_rows] == pytest.approx(
@@ -278,7 +278,13 @@ def test_contact_out_writes_every_load_and_the_harris_map(tmp_path):
         pairs = [float(p[f"pair_load_{label}_{k}_N"]) for p in pos for k in (1, 2)]
         total = [sum(float(p[f"pair_load_{label}_{k}_N"]) for k in (1, 2, 3)) for p in pos]
         assert max(pairs) > 0 and total == pytest.approx([row["load_N"]] * len(pos), rel=1e-6)
-    harris = list(csv.DictReader(names[2].open()))
+    # the load across the face at each load: it adds up to the load over the face width
+    face = list(csv.DictReader(names[2].open()))
+    width = 2 * float(face[0]["face_position_m"]) * len(face)
+    for row, label in zip(res["loads"], ("4kN", load_rows[1]["load_case"])):
+        total = sum(float(f[f"face_load_{label}_N/m"]) for f in face) * width / len(face)
+        assert total == pytest.approx(row["load_N"], rel=1e-9)
+    harris = list(csv.DictReader(names[3].open()))
     assert [float(h["harris_load_N"]) for h in harris] == pytest.approx(
         res["harris"]["load_N"], rel=1e-12)
     # the same in NetCDF and MATLAB; without a Harris map, no table of it

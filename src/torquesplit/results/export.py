@@ -249,7 +249,7 @@ def dataset_files(ds, path) -> list[Path]:
 
 #: named so, left from an earlier save of another shape, are removed with it
 KNOWN_TABLES = ("time", "mesh", "planet_entity", "dof", "mode", "point", "check", "speed",
-                "crossing", "position", "harris_load")
+                "crossing", "position", "slice", "harris_load")
 
 
 def save_dataset(ds, path, *, overwrite: bool = False) -> Path:

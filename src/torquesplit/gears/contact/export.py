@@ -2,10 +2,10 @@
 ``torquesplit contact``) and as an xarray Dataset, for the NetCDF, MATLAB and spreadsheet
 files of ``torquesplit contact --out`` (:mod:`torquesplit.results.export`).
 
-Three tables, one per row dimension: ``load_case`` (the scalars of each analysed load, as the
-printed table), ``position`` (the curves over the mesh cycle: a column per load, named by
-it in kN, and the largest load's load per tooth pair), and ``harris_load`` (the Harris
-map).  SI units on
+Four tables, one per row dimension: ``load_case`` (the scalars of each analysed load, as
+the printed table), ``position`` (the curves over the mesh cycle and the load per tooth
+pair: a column per load, named by it in kN), ``slice`` (the load per unit face width
+across the face, a column per load) and ``harris_load`` (the Harris map).  SI units on
 every variable; the transmission error also in arc seconds of the driven gear (Liu et al.
 2021 eq. 3).
 """
