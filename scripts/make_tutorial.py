@@ -247,12 +247,14 @@ leaves out the start-up transient before computing anything.
   its meshes, and **peak/nominal (eng.)**: the mean over settled cycles of the largest
   member's per-cycle peak over the nominal force (Ji & Li's engineering dynamic load
   coefficient G_it, from their eq. 19).
-* **bearing forces**: for each supported body (here `input`), the settled mean bearing
-  force by direction, the magnitude of that mean and the peak magnitude |F|; a gear with
-  no translations sits on a rigid bearing, and its row (marked `(rigid bearing)`) is the
-  sum of its meshes' forces, in the housing's x, y (and z: the axial thrust of helical
-  teeth); a planetary stage's fixed ring's in its carrier's frame, as the planets'.  They come
-  from the history, not from the streamed statistics (next bullet).  `--json` gives them
+* **bearing forces**: for each supported body (here `input` on its bearing, and every
+  other gear), the settled mean bearing force by direction, the magnitude of that mean
+  and the peak magnitude |F|; a gear with no translations sits on a rigid bearing, and
+  its row (marked `(rigid bearing)`) is the sum of its meshes' forces, in the housing's
+  x, y (and z: the axial thrust of helical teeth); a planetary stage's fixed ring's in its
+  carrier's frame, as the planets'.  The peaks come from the history, not from the
+  streamed statistics (next bullet); a rigid bearing's mean is its meshes' mean forces
+  (b1's is in1's), another's the mean of its history samples.  `--json` gives them
   as `bearing_forces_N`, a .nc or .mat results file (`--out`) as `bearing_mean_force`
   and `bearing_peak_force`.
 {{{{drift_text}}}}
@@ -326,7 +328,8 @@ to 1, the remainder coming from the three meshes' different phases.
 The branch shafts decide how much an error matters: a stiff shaft passes the error
 straight into the teeth.  `sweep` runs the model for each value of one parameter (here
 the three shaft diameters together, 25 to 40 mm in 4 steps) and tabulates an output; it
-keeps every finished case, so an interrupted sweep resumes:
+keeps every finished case, so an interrupted sweep resumes where it stopped (the same
+command with `--resume`; run again without it, it refuses to write over the folder):
 
 $ {SWEEP}
 

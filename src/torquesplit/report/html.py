@@ -326,8 +326,9 @@ def _bearings(bearings: list[dict], res) -> str:
         rows = [r + [b["frame"]] for r, b in zip(rows, bearings)]
     return ("<h3>Bearing forces</h3>" + _table(header, rows, left=2)
             + f'<p class="note">The force each body puts on its bearing over the settled '
-              f"part, from the history ({per}): a peak between its samples is missed, "
-              f"the means are not.</p>")
+              f"part, from the history ({per}): a peak between its samples is missed; a "
+              f"rigid bearing's mean is its meshes' mean forces (their streamed time "
+              f"integrals), another's the mean of the samples.</p>")
 
 
 def _planets(load_sharing, kinematics) -> str:
