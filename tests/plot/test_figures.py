@@ -517,6 +517,13 @@ def test_dynamic_factor_bars_carry_their_values(run):
     texts = [t.get_text() for t in ax.texts]
     for r in met.rows:
         assert f"{r.dynamic_factor:.3f}" in texts and f"{r.peak_to_nominal:.3f}" in texts
+    # a resonance line in the legend is on the axis too (it named a line above the axis
+    # at dynamic factors near 2, a first-hour reviewer)
+    top = max(max(r.dynamic_factor, r.peak_to_nominal) for r in met.rows)
+    ax = F.dynamic_factor_figure(run, resonance=top / 0.7).axes[0]
+    labels = [h.get_label() for h in ax.get_legend().legend_handles]
+    assert any("reported as near a resonance" in lab for lab in labels), labels
+    assert ax.get_ylim()[1] > top / 0.7
 
 
 def test_figures_of_a_run_that_did_not_settle_say_so():

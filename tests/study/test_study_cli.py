@@ -151,8 +151,9 @@ def test_summary_names_the_case_of_each_failure_units_and_an_empty_resume(tmp_pa
     assert res.exit_code == 0, res.output
     assert "holds no study to resume: the study starts from its first case" in res.stderr
     lines = res.stdout.splitlines()
-    assert any(ln.strip().startswith("not ok, case 1: Integration diverged") for ln in lines), \
-        res.stdout
+    # (with its value: 'case 1' alone was read as the first case)
+    assert any(ln.strip().startswith("not ok, case 1 (drives.motor.torque = 1e+10 N m): "
+                                     "Integration diverged") for ln in lines), res.stdout
     # forces in kN, as the figures draw them and the run's tables print them
     assert "peak_force.a1 [kN]" in res.stdout and "load_sharing.cycle_peak [" not in res.stdout
     import xarray as xr

@@ -835,8 +835,10 @@ def campbell_command(m, start, stop, plot, as_json, console, json_default, out=N
         f"phasing leaves unexcited, Parker & Lin 2004, marked 'suppressed')" if phased
         else "") + f"; {n_driven} of {len(critical)} driven by at least "
         f"{100 * DRIVING_HARMONIC:g} % (k harmonic or error; a k harmonic whose meshes' "
-        f"forces cancel on the mode, marked 'cancels', drives none): the others only by "
-        f"what the model leaves out")
+        f"forces cancel on the mode, marked 'cancels', drives none)"
+        # ('21 of 21 driven ...: the others only by ...' named others there were none of)
+        + (": the others only by what the model leaves out" if n_driven < len(critical)
+           else ""))
     cols = ["speed [rpm]", "mode", "f [Hz]", "excitation", "k harmonic [%]", "error [%]"]
     cols += ["mode type", "phasing"] if phased else []
     for col in cols + ["strain energy (largest shares)"]:

@@ -337,7 +337,7 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
     import numpy as np
     from rich.markup import escape
 
-    from .dataset import case_ranges, ranking, warning_groups
+    from .dataset import ranking, warning_groups
     from .outputs import output_definitions
 
     ui = _ui()
@@ -452,7 +452,7 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
         if s != "ok":
             of_reason.setdefault(r, []).append(k)
     for r, cases in list(of_reason.items())[:5]:
-        ui.console.print(f"  not ok, {case_ranges(cases)}: {r}", markup=False,
+        ui.console.print(f"  not ok, {_cases_with_values(ds, cases)}: {r}", markup=False,
                          highlight=False, soft_wrap=True)
     if len(of_reason) > 5:
         ui.console.print(f"  ... and {len(of_reason) - 5} more reasons (variable 'reason' "
@@ -461,14 +461,29 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
         ui.console.print(f"[yellow]{n_warned} of {status.size} cases warned[/] (variable "
                          f"'warnings' of results.nc has each case's):", highlight=False)
         for g in groups[:5]:
-            ui.console.print(f"  {case_ranges(g['cases'])}: {g['text']}", markup=False,
-                             highlight=False, soft_wrap=True)
+            ui.console.print(f"  {_cases_with_values(ds, g['cases'])}: {g['text']}",
+                             markup=False, highlight=False, soft_wrap=True)
         if len(groups) > 5:
             ui.console.print(f"  ... and {len(groups) - 5} more kinds of warning",
                              highlight=False)
     ui.console.print(f"results: {out / 'results.nc'} (and .csv, .mat); store: "
                      f"{out / 'study.sqlite'}"
                      + (f"; {_count(len(figs), 'figure')} in {out / 'figures'}" if figs else ""))
+
+
+def _cases_with_values(ds, cases: list[int]) -> str:
+    """'case 2' of a one-parameter grid with its value: 'case 2 (d = 35 mm)' (a reviewer
+    counted a sweep's cases from 1 and read the warning as another diameter's)."""
+    from .dataset import case_ranges
+    from .figures import _coord
+
+    text = case_ranges(cases)
+    dims = ds["status"].dims
+    if ds.attrs.get("design") != "grid" or len(dims) != 1 or len(cases) > 4:
+        return text
+    values, unit = _coord(ds, dims[0])
+    shown = ", ".join(f"{values[i]:.6g}" for i in cases)
+    return f"{text} ({dims[0]} = {shown}{'' if unit == '-' else ' ' + unit})"
 
 
 def _sensitivity_table(ds, out_vars):
