@@ -447,6 +447,7 @@ def coarse_history(results, metrics) -> list[tuple[str, str]]:
             f"kept steps.  {exact}; the waveform and the bearing forces do not.  More "
             f"--steps-per-cycle (Python: steps_per_cycle=) brings the waveform closer"))]
     if results.history_keeps_every_step():
+        from ..simulation import AUTO_HISTORY_RECORDS
         from ..solve.integrate import finer_step_advice
 
         s = results.solution
@@ -456,7 +457,10 @@ def coarse_history(results, metrics) -> list[tuple[str, str]]:
             f"peak_force, min_force in the files) include and the history (files, figures, "
             f"the bearing table's peak |F|) does not; "
             f"a finer step brings it closer "
-            f"({finer_step_advice(results.structure, s.step_limited_by, s.step or 0.0)})"))]
+            f"({finer_step_advice(results.structure, s.step_limited_by, s.step or 0.0)}), "
+            f"kept whole in the history with as many --samples-per-period "
+            f"(samples_per_period=; a long run's history keeps every step only up to "
+            f"{AUTO_HISTORY_RECORDS:,} of them)"))]
     more = max(100, 5 * round(per)) if math.isfinite(per) else 100
     return [("analysis", (
         f"the history ({per:.3g} samples per shortest mesh period), which the results "
