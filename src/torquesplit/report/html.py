@@ -297,7 +297,7 @@ def _run_section(res, met) -> str:
             "and peak/nominal are the largest of the group's meshes; peak/nominal (eng.) "
             "is the mean over the settled cycles of the largest member's cycle peak over "
             "the nominal force (Ji &amp; Li eq. 19, G_it). "
-            f"System load-sharing coefficient: <b>{met.load_sharing.system:.5f}</b>.</p>")
+            f"System load-sharing coefficient: <b>{met.load_sharing.system:.4f}</b>.</p>")
     return (_table(["setting", "value"], settings, left=2) + what + "<h3>Per mesh</h3>"
             + per_mesh + "<h3>Per load-sharing group</h3>" + groups
             + _planets(met.load_sharing, res.kinematics)
