@@ -56,6 +56,16 @@ def test_sweep_one_liner(tmp_path, split_file):
     assert lsc[0] < lsc[1] < lsc[2]
     bad = runner.invoke(app, ["sweep", str(split_file), "--vary", "meshes.a1.stiffness=1:2"])
     assert bad.exit_code == 2 and "START:STOP:NUM" in bad.output
+    # a resume with another range names the sweep's option, not the study field it makes
+    # ('grid.parameters.0.stop: 10.0 -> 12.0', a studies reviewer)
+    other = runner.invoke(app, ["sweep", str(split_file), "--vary",
+                                "meshes.a1.transmission_error.constant,"
+                                "meshes.a2.transmission_error.constant=0:12:3um",
+                                "--output", "load_sharing.cycle_peak", "--cycles", "40",
+                                "--workers", "1", "--out", str(out), "--resume", "--quiet"])
+    assert other.exit_code == 2, other.output
+    text = " ".join(other.stderr.split())
+    assert "--vary's STOP: 10.0 -> 12.0" in text and "grid.parameters" not in text, text
 
 
 def test_parse_vary():

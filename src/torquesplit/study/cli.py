@@ -217,6 +217,12 @@ def _sweep_words(message: str) -> str:
     file's ``unit = "um"`` is the unit after the count of --vary)."""
     for study, sweep in _SWEEP_WORDS:
         message = message.replace(study, sweep)
+    # a changed sweep's resume named the study fields it is built of (a reviewer:
+    # 'grid.parameters.0.stop: 300.0 -> 350.0')
+    message = re.sub(r"\bgrid\.parameters\.0\.(start|stop|num)\b",
+                     lambda m: f"--vary's {m.group(1).upper()}", message)
+    message = re.sub(r"\bgrid\.parameters\.0\.(unit|paths?|values)\b", "--vary", message)
+    message = re.sub(r"\banalysis\.(duration|cycles)\b", r"--\1", message)
     return re.sub(r'write e\.g\. unit = "([^"]+)"',
                   r"write the unit after the count, e.g. START:STOP:NUM\1", message)
 
