@@ -444,3 +444,24 @@ def test_a_steady_states_files_keep_the_warnings_given_while_it_was_solved(tmp_p
     starts = res.solution.cycle_start
     assert np.nanmax(starts) <= res.solution.t_final
     assert np.isnan(starts[:, -1]).sum() > 0.5 * starts.shape[0]  # (stage 2: 1/10 the cycles)
+
+
+def test_a_campbell_summary_names_no_others_where_every_crossing_is_driven(tmp_path):
+    """'21 of 21 driven by at least 1 % ...: the others only by what the model leaves
+    out' named others there were none of (a first-hour reviewer)."""
+    import re
+
+    from typer.testing import CliRunner
+
+    from torquesplit.cli import app
+
+    tutorial = Path(__file__).resolve().parents[2] / "docs" / "tutorial.md"
+    model = tmp_path / "three_branch.toml"
+    model.write_text(re.search(r"```toml\n(.*?)```", tutorial.read_text(), re.S).group(1))
+    res = CliRunner().invoke(app, ["modes", str(model), "--campbell", "--from", "2400 rpm",
+                                   "--to", "3600 rpm"], terminal_width=400)
+    assert res.exit_code == 0, res.output
+    title = " ".join(res.stdout.split())
+    found = re.search(r"; (\d+) of (\d+) driven by at least", title)
+    assert found and found.group(1) == found.group(2), title
+    assert "the others only by" not in title
