@@ -581,7 +581,8 @@ def _print_run(m, res, met, saved, figures, step_check, plots, as_json) -> None:
                       **({"planet_load_sharing": ux.planet_sharing_dict(planets)}
                          if planets else {}),
                       "statistics": res.statistics(),
-                      "bearing_forces_N": res.bearing_forces(met.settling.start_time),
+                      "bearing_forces_N": res.bearing_forces(met.settling.start_time,
+                                                             metrics=met),
                       "results_file": str(saved[0]) if saved else None,
                       "results_files": [str(f) for f in saved],
                       "figures": [str(f) for f in figures],
@@ -746,7 +747,7 @@ def _render_run(res, met, saved, planets=None) -> None:
     console.print(group_table(met))
     if planets is not None:
         _print_planets(planets, res.kinematics)
-    bearings = res.bearing_forces(met.settling.start_time)
+    bearings = res.bearing_forces(met.settling.start_time, metrics=met)
     if bearings:
         console.print(bearing_table(bearings, res))
     console.print(f"system load-sharing coefficient ({met.definition}): "

@@ -419,7 +419,7 @@ class _Job:
         return None
 
     def _fail(self, status: str, reason: str) -> None:
-        self.out.update(status=status, reason=reason, settled=False,
+        self.out.update(status=status, reason=reason,
                         values=[math.nan] * len(self.p["outputs"]))
         self.status = status
         self.finished = True

@@ -301,7 +301,8 @@ def _run_section(res, met) -> str:
     return (_table(["setting", "value"], settings, left=2) + what + "<h3>Per mesh</h3>"
             + per_mesh + "<h3>Per load-sharing group</h3>" + groups
             + _planets(met.load_sharing, res.kinematics)
-            + _bearings(res.bearing_forces(met.settling.start_time), res))
+            + _bearings(res.bearing_forces(met.settling.start_time, metrics=met),
+                        res))
 
 
 def _bearings(bearings: list[dict], res) -> str:

@@ -522,7 +522,8 @@ class Results:
         return float(met.settling.group_time.get(group, met.settling.start_time)
                      if group is not None else met.settling.start_time)
 
-    def bearing_forces(self, start_time: float | None = None) -> list[dict]:
+    def bearing_forces(self, start_time: float | None = None, *,
+                       metrics=None) -> list[dict]:
         """Per supported body, its bearing (support) force over the settled part: the mean
         of each direction [N], the magnitude of that mean and the largest magnitude of the
         force vector [N] (a body held by a spline alone: the spline's radial force, its
@@ -542,7 +543,8 @@ class Results:
         the tutorial's model).  Forces are in the frame of the support (a
         turning carrier's for planets), which ``frame`` names: ``"housing"`` or
         ``"carrier NAME (turning)"``.  A run without a whole cycle of some mesh has no
-        settled part (its settle time is -inf): no rows."""
+        settled part (its settle time is -inf): no rows.  ``metrics``: the run's
+        :meth:`metrics` where the caller has them (they are not computed again)."""
         s = self.solution
         if s is None or not s.history_t.size:
             return []
@@ -574,8 +576,9 @@ class Results:
             keep = np.zeros(s.history_t.shape, bool)
             keep[:period_samples(s.history_t, self.period) or keep.size] = True
         else:
-            t0 = (self.metrics().settling.start_time if start_time is None
-                  else float(start_time))
+            if start_time is None and metrics is None:
+                metrics = self.metrics()
+            t0 = metrics.settling.start_time if start_time is None else float(start_time)
             keep = s.history_t >= t0
         if not keep.any():
             keep = np.ones(s.history_t.shape, bool)
@@ -601,7 +604,7 @@ class Results:
         mesh_means = None
         if rigid and self.success:
             try:
-                met = self.metrics()
+                met = self.metrics() if metrics is None else metrics
                 if start_time is None or start_time == met.settling.start_time or (
                         self.periodic and self.period):
                     mesh_means = {r.mesh: r.mean_force for r in met.rows
@@ -791,7 +794,7 @@ class Results:
                           for g, members in ls_.groups.items()]
             group_rows.append(["(system)", " ".join(self.mesh_names), ls_.system, name, "",
                                "", ""])
-            bearings = self.bearing_forces(met.settling.start_time)
+            bearings = self.bearing_forces(met.settling.start_time, metrics=met)
         else:
             header.append("status")
             group_of = {m: g for g, ms in self.groups.items() for m in ms}

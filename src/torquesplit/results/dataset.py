@@ -223,7 +223,7 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
         ds.attrs["load_sharing_definition"] = met.definition
         ds.attrs["metrics_json"] = _json.dumps(met.to_dict(), default=float)
         ds = add_planet_load_sharing(ds, met.load_sharing, res.kinematics)
-        bearings = res.bearing_forces(met.settling.start_time)
+        bearings = res.bearing_forces(met.settling.start_time, metrics=met)
         if bearings:
             ds = ds.assign_coords(bearing=("bearing", [b["body"] for b in bearings]))
             ds["bearing_mean_force"] = _var(("bearing",), [b["mean_magnitude"] for b in bearings],

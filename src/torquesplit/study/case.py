@@ -63,8 +63,6 @@ def run_case(p: dict) -> dict:
         except Exception as exc:  # a bug, a memory error...: record it, keep the study going
             out.update(status="error", reason=f"{type(exc).__name__}: {_one_line(exc)}",
                        values=nan)
-    if out["status"] not in ("ok", "contact_lost"):
-        out["settled"] = False  # (no outputs: nothing found settled)
     # the model's warnings (unit slips...) and the run's (too short, unsettled...)
     out["warnings"] = sorted({_one_line(w.message) for w in caught})
     out["wall_time"] = time.perf_counter() - t0

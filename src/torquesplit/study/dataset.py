@@ -71,7 +71,8 @@ def build_dataset(plan, rows, n: int, meta: dict):
             reason[i] += " (this case: " + ", ".join(  # values as the study wrote them
                 f"{p.name} = {p.show(v)}" for p, v in zip(d.parameters, d.values[i],
                                                             strict=True)) + ")"
-        # a case without outputs (refused, diverged, error) found no settled part
+        # a case without outputs (refused, diverged, error) found no settled part (said
+        # here, where every runner's and every stored row is read)
         settled[i] = r["settled"] and r["status"] in ("ok", "contact_lost")
         sim_time[i] = np.nan if r["simulated_time"] is None else r["simulated_time"]
         wall[i] = r["wall_time"]
