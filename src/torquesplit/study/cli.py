@@ -480,14 +480,13 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
 def _cases_with_values(ds, cases: list[int]) -> str:
     """'case 2' of a one-parameter grid with its value: 'case 2 (d = 35 mm)' (a reviewer
     counted a sweep's cases from 1 and read the warning as another diameter's)."""
-    from .dataset import case_ranges
-    from .figures import _coord
+    from .dataset import case_ranges, display_values
 
     text = case_ranges(cases)
     dims = ds["status"].dims
     if ds.attrs.get("design") != "grid" or len(dims) != 1 or len(cases) > 4:
         return text
-    values, unit = _coord(ds, dims[0])
+    values, unit = display_values(ds, dims[0])
     shown = ", ".join(f"{values[i]:.6g}" for i in cases)
     return f"{text} ({dims[0]} = {shown}{'' if unit == '-' else ' ' + unit})"
 
@@ -587,13 +586,13 @@ def _grid_table(ds, title: str, columns: list[tuple[str, str]]):
     from rich.markup import escape
     from torquesplit._table import Table
 
-    from .figures import _coord
+    from .dataset import display_values
 
     t = Table(title=escape(title))
     dims = list(ds[columns[0][1]].dims)
     shown = {}
     for d in dims:
-        values, unit = _coord(ds, d)
+        values, unit = display_values(ds, d)
         shown[d] = dict(zip(ds[d].values.tolist(), values.tolist()))
         # escaped: Rich would read "[um]" as markup and drop it
         t.add_column(escape(f"{d} [{unit}]"), justify="right")

@@ -375,3 +375,25 @@ def case_ranges(cases: list[int]) -> str:
             parts.append(f"{start}" if start == c else f"{start}-{c}")
             start = None
     return ("case " if len(cases) == 1 else "cases ") + ", ".join(parts)
+
+
+def display_values(ds, name) -> tuple[np.ndarray, str]:
+    """A parameter's values in the study's display unit (its ``display_units``, SI if
+    that is unknown) and the unit as tables and figures write it ("-" for a factor)."""
+    c = ds[name]
+    si = c.attrs.get("units", "1")
+    disp = c.attrs.get("display_units", si)
+    values = np.asarray(c.values, dtype=float)
+    if disp != si and si != "1":
+        from ..model.units import convert
+
+        try:
+            return np.array([convert(v, si, disp) for v in values]), unit_text(disp)
+        except Exception:  # an unknown display unit: show SI
+            return values, unit_text(si)
+    return values, ("-" if si == "1" else unit_text(si))
+
+
+def unit_text(unit: str) -> str:
+    """A unit as tables and figures write it: µm, not um."""
+    return re.sub(r"\bu(?=[mgsNV]\b)", "µ", unit)

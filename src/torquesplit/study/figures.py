@@ -35,6 +35,7 @@ from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 
 from . import outputs as out_mod
+from .dataset import display_values
 
 log = logging.getLogger(__name__)
 
@@ -89,7 +90,7 @@ def curves_figure(ds, family: str, members: list[tuple[str, str]]) -> Figure:
     """A 1-parameter grid: the outputs of one family against the parameter."""
     var0 = members[0][1]
     pname = ds[var0].dims[0]
-    x, xunit = _coord(ds, pname)
+    x, xunit = display_values(ds, pname)
     fig = _figure(WIDTH, 4.2)
     ax = fig.add_subplot()
     unit, scale = _out_unit(var0)
@@ -141,8 +142,8 @@ def maps_figure(ds, family: str, members: list[tuple[str, str]]) -> Figure:
     axes = fig.subplots(nrows, ncols, squeeze=False).ravel()
     for ax in axes[len(panels):]:
         ax.set_visible(False)
-    x, xunit = _coord(ds, dims[0])
-    y, yunit = _coord(ds, dims[1])
+    x, xunit = display_values(ds, dims[0])
+    y, yunit = display_values(ds, dims[1])
     unit, scale = _out_unit(members[0][1])
     # one colour scale for the family (every member, every value of a third parameter):
     # the same colour is the same value in every panel
@@ -156,7 +157,7 @@ def maps_figure(ds, family: str, members: list[tuple[str, str]]) -> Figure:
         if third:
             data = data.isel({third: r})
             status = status.isel({third: r})
-            tv, tu = _coord(ds, third)
+            tv, tu = display_values(ds, third)
             title += f", {third} = {tv[r]:.4g} {tu}"
         z = data.transpose(dims[1], dims[0]).values * scale
         mesh = ax.pcolormesh(_edges(ds, dims[0], x), _edges(ds, dims[1], y),
@@ -373,29 +374,6 @@ def _cell_values(ax, x, y, z, mesh) -> None:
         dark = 0.299 * r + 0.587 * g + 0.114 * b > 0.5
         ax.text(x[j], y[i], f"{v:.{digits}g}", ha="center", va="center", fontsize=6,
                 color="k" if dark else "w")
-
-
-def _coord(ds, name) -> tuple[np.ndarray, str]:
-    """Coordinate values in the study's display unit."""
-    c = ds[name]
-    si = c.attrs.get("units", "1")
-    disp = c.attrs.get("display_units", si)
-    values = np.asarray(c.values, dtype=float)
-    if disp != si and si != "1":
-        from ..model.units import convert
-
-        try:
-            return np.array([convert(v, si, disp) for v in values]), _unit_text(disp)
-        except Exception:  # an unknown display unit: show SI
-            return values, _unit_text(si)
-    return values, ("-" if si == "1" else _unit_text(si))
-
-
-def _unit_text(unit: str) -> str:
-    """A unit as the figures write it: µm, not um."""
-    import re
-
-    return re.sub(r"\bu(?=[mgsNV]\b)", "µ", unit)
 
 
 def _edges(ds, name, values) -> np.ndarray:
