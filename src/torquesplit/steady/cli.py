@@ -834,12 +834,17 @@ def campbell_command(m, start, stop, plot, as_json, console, json_default, out=N
         f" ({len(critical)} critical; {len(suppressed)} crossings that the planets' mesh "
         f"phasing leaves unexcited, Parker & Lin 2004, marked 'suppressed')" if phased
         else "") + f"; {n_driven} of {len(critical)} driven by at least "
-        f"{100 * DRIVING_HARMONIC:g} % (k harmonic or error; a k harmonic whose meshes' "
-        f"forces cancel on the mode, marked 'cancels', drives none)"
+        f"{100 * DRIVING_HARMONIC:g} % (the mesh force harmonic, or a shaft order's k "
+        f"harmonic or error; one whose meshes' forces cancel on the mode, marked 'cancels', "
+        f"drives none)"
         # ('21 of 21 driven ...: the others only by ...' named others there were none of)
         + (": the others only by what the model leaves out" if n_driven < len(critical)
            else ""))
-    cols = ["speed [rpm]", "mode", "f [Hz]", "excitation", "k harmonic [%]", "error [%]"]
+    # without errors on any line the force harmonic is the stiffness harmonic: the two
+    # columns that split it are shown only where there are errors to split off
+    split = any(c.get("error_share") is not None for c in crossings)
+    cols = ["speed [rpm]", "mode", "f [Hz]", "excitation", "force harmonic [%]"]
+    cols += ["k harmonic [%]", "error [%]"] if split else []
     cols += ["mode type", "phasing"] if phased else []
     for col in cols + ["strain energy (largest shares)"]:
         t.add_column(_h(col))
@@ -848,19 +853,25 @@ def campbell_command(m, start, stop, plot, as_json, console, json_default, out=N
                   "suppressed" if c["suppressed"] else "excited"]
                  if phased else [])
         k_h, err = c.get("stiffness_harmonic"), c.get("error_share")
+        f_h = c.get("force_harmonic")
         # (a harmonic whose meshes' forces cancel on the mode drives nothing there)
         cancels = " (cancels)" if c.get("stiffness_cancelled") else ""
         t.add_row(f"{c['speed_rpm']:#.6g}", str(c["mode"]), f"{c['frequency_Hz']:#.6g}",
                   f"{c['order']} x {c['source']}",
-                  "-" if k_h is None else f"{100 * k_h:.3g}{cancels}",
-                  "-" if err is None else f"{100 * err:.3g} ({c['error_mesh']})", *extra,
+                  "-" if f_h is None else f"{100 * f_h:.3g}{cancels}",
+                  *(["-" if k_h is None else f"{100 * k_h:.3g}{cancels}",
+                     "-" if err is None else f"{100 * err:.3g} ({c['error_mesh']})"]
+                    if split else []), *extra,
                   ", ".join(f"{n} {100 * v:.0f} %" for n, v in c["energy"]))
     console.print(t)
-    console.print("k harmonic: the amplitude of that order of the mesh stiffness over its "
-                  "mean (how strongly the stiffness variation drives the crossing; a shaft "
-                  "order has none: '-'); error: the force amplitude k e of the model's errors "
-                  "at that frequency (transmission error, eccentricity) over the mesh's "
-                  "nominal force, the largest and its mesh ('-': no error there)",
+    console.print("force harmonic: the amplitude of that order of the static mesh force "
+                  "k(s) (delta - e(s)) over its mean, the stiffness variation and the "
+                  "transmission error together (what drives a mesh line; tip relief makes "
+                  "the two cancel; a shaft order has none: '-')" + (
+                      "; k harmonic: that of the mesh stiffness alone over its mean; error: "
+                      "the force amplitude k e of the model's errors at that frequency "
+                      "(transmission error, eccentricity) over the mesh's nominal force, the "
+                      "largest and its mesh ('-': no error there)" if split else ""),
                   highlight=False)
     for line in ds.attrs.get("orders_left_out", []):
         console.print(f"note: {line}", highlight=False)

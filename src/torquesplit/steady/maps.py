@@ -340,7 +340,7 @@ def critical_speeds(structure, q, kin, model, w_lo, w_hi, orders=None):
     sol = modal_analysis(structure, q)
     w_ref = reference_speed(model)
     lines = _order_lines(kin, model, orders, structure)
-    strength = _line_strength(kin, structure, lines, w_ref)
+    strength = _line_strength(kin, structure, lines, w_ref, q)
     phasing = _Phasing(model, kin)
     types = phasing.types(structure, sol)
     out = []
@@ -413,15 +413,76 @@ def _error_shares(kin, structure, lines, w_ref: float) -> dict:
     return out
 
 
-def _line_strength(kin, structure, lines, w_ref: float) -> dict:
+def static_mesh_force(structure, q, e: int) -> np.ndarray | None:
+    """Mesh element ``e``'s force over one mesh cycle at the static deflection ``q``, on
+    its stiffness table's phase grid: ``k(s) h(V q - e(s))`` (h the dead zone), with the
+    errors e(s) that repeat every mesh cycle (its constant and the sinusoids at mesh
+    harmonics: a transmission error, the LTCA's loaded one).  Its harmonics are what
+    drives a mesh-frequency line (the stiffness variation and the transmission error
+    together: tip relief makes them cancel).  None without a table."""
+    table = np.asarray(structure.stiffness_table[e], dtype=float)
+    f_mesh = float(structure.frequency[e])
+    if table.size < 2 or not f_mesh > 0:
+        return None
+    sl = slice(structure.v_ptr[e], structure.v_ptr[e + 1])
+    d = float(np.dot(structure.v_coef[sl], q[structure.v_dof[sl]]))
+    s = np.arange(table.size) / table.size  # mesh phase s = f t + phase (tables' grid)
+    t = (s - float(structure.phase[e])) / f_mesh
+    err = np.full(table.size, float(structure.error_constant[e]))
+    for i in range(structure.error_ptr[e], structure.error_ptr[e + 1]):
+        om = float(structure.error_omega[i])
+        n = om / (2.0 * math.pi * f_mesh)
+        if n > 0.5 and abs(n - round(n)) <= 1e-6 * n:  # periodic in the mesh cycle
+            err += float(structure.error_amplitude[i]) * np.sin(
+                om * t + float(structure.error_phase[i]))
+    g = (float(structure.gap_values[structure.gap_ptr[e]])
+         if structure.gap_ptr[e + 1] > structure.gap_ptr[e] else 0.0)
+    x = d - err
+    h = np.where(x > g, x - g, np.where(x < -g, x + g, 0.0)) if g > 0 else x
+    return table * h
+
+
+def _mesh_force_harmonics(kin, structure, lines, q) -> dict:
+    """(line label, order) -> amplitude of that harmonic of the static mesh force
+    (:func:`static_mesh_force`) over its mean, the largest over the group's meshes:
+    the stiffness harmonic and the transmission error's force taken together, with
+    their phases (each alone overstates a modified pair's excitation)."""
+    if structure is None or q is None:
+        return {}
+    names = list(structure.element_names)
+    groups = mesh_groups(kin)
+    forces = {}
+    out = {}
+    for label, order, _ in lines:
+        amps = []
+        for n in groups.get(label, ()):
+            if n not in names:
+                continue
+            if n not in forces:
+                forces[n] = static_mesh_force(structure, q, names.index(n))
+            f = forces[n]
+            if f is None or order >= f.size // 2:
+                continue
+            mean = float(f.mean())
+            if mean > 0:
+                amps.append(2 * abs(np.fft.rfft(f)[order]) / f.size / mean)
+        if amps:
+            out[(label, order)] = float(max(amps))
+    return out
+
+
+def _line_strength(kin, structure, lines, w_ref: float, q=None) -> dict:
     """(line label, order) -> how the model drives that line: ``stiffness_harmonic``
-    (:func:`_stiffness_harmonics`) and ``error_share`` / ``error_mesh``
-    (:func:`_error_shares`), the keys that apply."""
+    (:func:`_stiffness_harmonics`), ``error_share`` / ``error_mesh``
+    (:func:`_error_shares`) and, with the static deflection ``q``, ``force_harmonic``
+    (:func:`_mesh_force_harmonics`: both together), the keys that apply."""
     out: dict = {}
     for key, v in _stiffness_harmonics(kin, structure, lines).items():
         out.setdefault(key, {})["stiffness_harmonic"] = v
     for key, (share, mesh) in _error_shares(kin, structure, lines, w_ref).items():
         out.setdefault(key, {}).update(error_share=share, error_mesh=mesh)
+    for key, v in _mesh_force_harmonics(kin, structure, lines, q).items():
+        out.setdefault(key, {})["force_harmonic"] = v
     return out
 
 
@@ -430,18 +491,19 @@ def _strength_of(strength: dict, label: str, order: int) -> dict:
     return dict(strength.get((label, order), {}))
 
 
-#: a mesh line's stiffness harmonic whose modal force is below this fraction of the sum
+#: a mesh line's force harmonic whose modal force is below this fraction of the sum
 #: of its meshes' contributions drives the mode not at all (the meshes' forces cancel)
 CANCELLED = 1e-6
 
 
 def _modal_force_share(structure, q, shape, meshes, order: int) -> float | None:
-    """How much of the ``order``-th harmonic of the meshes' stiffness variation reaches
-    a mode (``shape``: its displacement part): |sum_m a_m| / sum_m |a_m| with
-    a_m = c_m e^(2 pi i order phase_m) h_m (V_m . shape), c_m the harmonic of mesh m's
-    stiffness table, phase_m its mesh phase, h_m its static deflection.  0 where the
-    meshes' forces cancel on the mode (branches in phase on a mode where they move
-    against each other, half a cycle apart on one where they move together); the
+    """How much of the ``order``-th harmonic of the meshes' static forces reaches a mode
+    (``shape``: its displacement part): |sum_m a_m| / sum_m |a_m| with
+    a_m = F_m e^(2 pi i order phase_m) (V_m . shape), F_m that harmonic of mesh m's
+    static force over its cycle (:func:`static_mesh_force`: its stiffness harmonic times
+    its static deflection, plus its transmission error's force), phase_m its mesh phase.
+    0 where the meshes' forces cancel on the mode (branches in phase on a mode where they
+    move against each other, half a cycle apart on one where they move together); the
     planets' mesh phasing of Parker & Lin 2004 is a case of it.  None if no mesh of the
     line acts on the mode."""
     names = list(structure.element_names)
@@ -451,18 +513,13 @@ def _modal_force_share(structure, q, shape, meshes, order: int) -> float | None:
         if m not in names:
             continue
         e = names.index(m)
-        table = np.asarray(structure.stiffness_table[e], dtype=float)
-        if order >= table.size // 2:
+        f = static_mesh_force(structure, q, e)
+        if f is None or order >= f.size // 2:
             continue
-        c = np.fft.rfft(table)[order] / table.size
+        c = np.fft.rfft(f)[order] / f.size
         sl = slice(structure.v_ptr[e], structure.v_ptr[e + 1])
-        d = float(np.dot(structure.v_coef[sl], q[structure.v_dof[sl]])
-                  - structure.error_constant[e])
-        g = (float(structure.gap_values[structure.gap_ptr[e]])
-             if structure.gap_ptr[e + 1] > structure.gap_ptr[e] else 0.0)
-        h = d - math.copysign(g, d) if abs(d) > g else 0.0
         v = complex(np.dot(structure.v_coef[sl], shape[:n][structure.v_dof[sl]]))
-        a.append(c * np.exp(2j * np.pi * order * structure.phase[e]) * h * v)
+        a.append(c * np.exp(2j * np.pi * order * structure.phase[e]) * v)
     total = sum(abs(x) for x in a)
     if not total > 0:
         return None
@@ -471,11 +528,12 @@ def _modal_force_share(structure, q, shape, meshes, order: int) -> float | None:
 
 def _cancellation(structure, q, sol, groups: dict, crossing: dict) -> dict:
     """``stiffness_cancelled`` (and the share, :func:`_modal_force_share`) of a crossing
-    of a mesh line whose stiffness harmonic would drive it: a reviewer's Campbell
+    of a mesh line whose force harmonic (stiffness and transmission error) would drive
+    it, True where the meshes' forces cancel on the mode: a reviewer's Campbell
     diagram called six crossings of Ji & Li's drive driven that the two branches' mesh
     forces cannot excite, and 'run' warned of one at the drive's own speed."""
     meshes = groups.get(crossing["source"])  # (:func:`mesh_groups`)
-    if not meshes or "stiffness_harmonic" not in crossing:
+    if not meshes or not ("stiffness_harmonic" in crossing or "force_harmonic" in crossing):
         return crossing
     # a degenerate mode's shape is any of its group's: judged on the whole group (the
     # largest share of its members), so that the solver's basis cannot hide a force
@@ -772,14 +830,18 @@ def _crossing_table(ds, crossings: list[dict]) -> None:
         "units": "1", "long_name": "that harmonic of the mesh stiffness over its mean"})
     ds["crossing_error_share"] = ("crossing", col("error_share"), {
         "units": "1", "long_name": "error force k A on the line over the nominal force"})
+    ds["crossing_force_harmonic"] = ("crossing", col("force_harmonic"), {
+        "units": "1", "long_name": "that harmonic of the static mesh force k(s) (delta - "
+        "e(s)) over its mean: stiffness variation and transmission error together"})
     ds["crossing_modal_force_share"] = ("crossing", col("modal_force_share"), {
         "units": "1", "long_name": "share of the meshes' harmonic forces that reaches the "
         "mode (0: they cancel on it)"})
     ds["crossing_driven"] = ("crossing", np.array(
         [int(driven(c) and not c.get("suppressed", False)) for c in crossings],
         dtype=np.int8), {
-        "units": "1", "long_name": "1 if the model drives the crossing (a stiffness "
-        "harmonic or error of at least 1 % that reaches the mode)"})
+        "units": "1", "long_name": "1 if the model drives the crossing (a mesh force "
+        "harmonic, or else a stiffness harmonic or error, of at least 1 % that reaches "
+        "the mode)"})
 
 
 def _curve_crossings(model, q, speeds, F, lines, w_ref, strength=None):
@@ -843,10 +905,16 @@ def near_critical_notes(model, structure, q, kinematics, speed=None) -> list[str
 
 
 def driven(crossing: dict, least: float = DRIVING_HARMONIC) -> bool:
-    """Whether the model drives a crossing: a stiffness harmonic (whose meshes' forces do
-    not cancel on the mode: ``stiffness_cancelled``) or an error force of at least
-    ``least`` (:func:`critical_speeds`' ``stiffness_harmonic``, ``error_share``); one it
-    does not drive resonates only through what the model leaves out."""
+    """Whether the model drives a crossing by at least ``least``: on a mesh line, the
+    harmonic of its static mesh force (``force_harmonic``: the stiffness variation and
+    the transmission error with their phases; a modification's relief can cancel the
+    stiffness harmonic), where the meshes' forces do not cancel on the mode
+    (``stiffness_cancelled``); without it (a shaft order) a stiffness harmonic or an
+    error force (``stiffness_harmonic``, ``error_share``).  One it does not drive
+    resonates only through what the model leaves out."""
+    if "force_harmonic" in crossing:
+        return (crossing["force_harmonic"] >= least
+                and not crossing.get("stiffness_cancelled", False))
     return ((crossing.get("stiffness_harmonic", 0.0) >= least
              and not crossing.get("stiffness_cancelled", False))
             or crossing.get("error_share", 0.0) >= least)
@@ -883,14 +951,21 @@ def near_critical_speeds(model, structure, q, kinematics, within: float = NEAR_C
     top, share = c["energy"][0] if c["energy"] else ("-", math.nan)
     more = (f"; {len(near) - 1} more within {100 * within:.2g} % (torquesplit modes "
             f"--campbell lists them)" if len(near) > 1 else "")
-    by = []
-    if (c.get("stiffness_harmonic", 0.0) >= least_harmonic
-            and not c.get("stiffness_cancelled", False)):
-        by.append(f"a harmonic of {100 * c['stiffness_harmonic']:.2g} % of the mean mesh "
-                  f"stiffness")
-    if c.get("error_share", 0.0) >= least_harmonic:
-        by.append(f"an error of mesh {c['error_mesh']} (k e = {100 * c['error_share']:.2g} % "
-                  f"of its nominal force)")
+    k_by = (f"a harmonic of {100 * c.get('stiffness_harmonic', 0.0):.2g} % of the mean mesh "
+            f"stiffness" if c.get("stiffness_harmonic", 0.0) >= least_harmonic
+            and not c.get("stiffness_cancelled", False) else "")
+    e_by = (f"an error of mesh {c['error_mesh']} (k e = {100 * c['error_share']:.2g} % of "
+            f"its nominal force)" if c.get("error_share", 0.0) >= least_harmonic else "")
+    if "force_harmonic" in c and k_by and e_by:  # both: with their phases, not each alone
+        by = [f"a harmonic of {100 * c['force_harmonic']:.2g} % of the static mesh force "
+              f"k (delta - e), of its stiffness ({100 * c['stiffness_harmonic']:.2g} % "
+              f"alone) and transmission error (k e {100 * c['error_share']:.2g} % alone) "
+              f"together"]
+    elif "force_harmonic" in c and not (k_by or e_by):
+        by = [f"a harmonic of {100 * c['force_harmonic']:.2g} % of the static mesh force "
+              f"k (delta - e)"]
+    else:
+        by = [x for x in (k_by, e_by) if x]
     return [("analysis", (
         f"the speed ({w * RPM:.5g} rpm) is {100 * abs(off):.2g} % "
         f"{'above' if off > 0 else 'below'} a critical speed ({c['speed_rpm']:.5g} rpm): "
