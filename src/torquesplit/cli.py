@@ -1088,6 +1088,7 @@ def mesh(
             with ux.interruptible():  # (Ctrl-C exited 130 without a word)
                 cmp = compare_methods(mk.geometry, points, young_modulus=g.youngs_modulus,
                                       poisson_ratio=g.poisson_ratio, extra={row: model_k})
+                cycle = _run_excitation(m, pair)
     except _EXPECTED as exc:
         _fail(exc)
         return
@@ -1101,19 +1102,50 @@ def mesh(
         except OSError as exc:
             failed = _figure_error(exc, "--plot", plot, "the table is printed, nothing saved")
             plot = None
-    _print_mesh(pair, cmp, plot, as_json)
+    _print_mesh(pair, cmp, plot, as_json, cycle)
     if failed is not None:
         _fail(failed)
 
 
-def _print_mesh(pair, cmp, plot, as_json) -> None:
-    """The mesh-stiffness comparison (or JSON)."""
+def _run_excitation(m, pair):
+    """What a run of ``m`` sees of mesh ``pair`` over a mesh cycle at the static
+    equilibrium (:func:`torquesplit.steady.maps.mesh_cycle`), where its error varies over
+    the cycle (an LTCA's loaded transmission error, a transmission-error harmonic); else
+    None.  (An LTCA reviewer could not see the e(s) a tangent-stiffness mesh is driven
+    by.)"""
+    import numpy as np
+
+    from .assembly.assemble import assemble
+    from .solve.static import static_equilibrium
+    from .steady.maps import mesh_cycle
+
+    spec = m.meshes[pair]
+    te = getattr(spec, "transmission_error", None)
+    if spec.stiffness.method != "ltca" and not (te is not None and te.amplitude > 0):
+        return None
+    s = assemble(m)
+    cycle = mesh_cycle(s, static_equilibrium(s).q, list(s.element_names).index(pair))
+    return cycle if cycle is not None and np.ptp(cycle.error) > 0 else None
+
+
+def _print_mesh(pair, cmp, plot, as_json, cycle=None) -> None:
+    """The mesh-stiffness comparison (or JSON), and what a run sees of the mesh over a
+    cycle where its error varies (``cycle``, :func:`_run_excitation`)."""
     if as_json:
-        ux.emit_json({"mesh": pair, "methods": cmp.rows(), "units": "N/m",
-                      "iso_c_prime_N_per_mm_um": cmp.iso.c_prime_iso,
-                      "iso_c_gamma_N_per_mm_um": cmp.iso.c_gamma_iso,
-                      "iso_mesh_stiffness_N_per_m": cmp.iso_mesh_stiffness,
-                      "plot": str(plot) if plot else None}, _json_default)
+        out = {"mesh": pair, "methods": cmp.rows(), "units": "N/m",
+               "iso_c_prime_N_per_mm_um": cmp.iso.c_prime_iso,
+               "iso_c_gamma_N_per_mm_um": cmp.iso.c_gamma_iso,
+               "iso_mesh_stiffness_N_per_m": cmp.iso_mesh_stiffness,
+               "plot": str(plot) if plot else None}
+        if cycle is not None:
+            out["run_excitation"] = {
+                "phase": cycle.phase, "stiffness_N_per_m": cycle.stiffness,
+                "error_m": cycle.error, "static_deflection_m": cycle.deflection,
+                "static_force_N": cycle.force,
+                "description": "over one mesh cycle at the static equilibrium: k(s), the "
+                               "error e(s) along the line of action and the force "
+                               "k(s) (delta - e(s)) a run is driven by"}
+        ux.emit_json(out, _json_default)
         return
     t = Table(title=f"mesh stiffness of {pair} along the line of action")
     for col in ("method", "mean [N/µm]", "min [N/µm]", "max [N/µm]", "peak-peak [N/µm]",
@@ -1129,8 +1161,37 @@ def _print_mesh(pair, cmp, plot, as_json) -> None:
                   f"cos² β_b = {cmp.iso_mesh_stiffness / 1e6:.5g} N/µm along the flank "
                   f"normal, as the table (1 N/µm = 1e6 N/m = 1 N/(mm µm) per mm of face)",
                   highlight=False)
+    if cycle is not None:
+        _print_run_excitation(pair, cycle)
     if plot is not None:
         console.print(f"plot written to {plot}")
+
+
+def _print_run_excitation(pair, cycle) -> None:
+    """The table of what a run sees of a mesh over its cycle (:func:`_run_excitation`)."""
+    import numpy as np
+    from rich.markup import escape
+
+    t = Table(title=f"what a run sees of {pair} over a mesh cycle, at the static "
+                    f"equilibrium")
+    for col in ("quantity", "mean", "min", "max", "peak-peak", "1st harmonic"):
+        t.add_column(_h(col), justify="left" if col == "quantity" else "right")
+    for name, v, scale in (("stiffness k(s) [N/µm]", cycle.stiffness, 1e-6),
+                           ("error e(s) [µm]", cycle.error, 1e6),
+                           ("force k(s) (delta - e(s)) [kN]", cycle.force, 1e-3)):
+        first = 2.0 * abs(np.fft.rfft(v)[1]) / v.size
+        t.add_row(escape(name), *(f"{x * scale:#.5g}" for x in (v.mean(), v.min(), v.max(),
+                                                         np.ptp(v), first)))
+    console.print(t)
+    mean = float(cycle.force.mean())
+    share = np.ptp(cycle.force) / mean if mean > 0 else math.nan
+    console.print(f"delta = {cycle.deflection * 1e6:.4g} µm, the mesh's static deflection; "
+                  f"e(s): the errors that repeat every mesh cycle (the LTCA's loaded "
+                  f"transmission error, the model's transmission-error harmonics) along the "
+                  f"line of action; the force's peak-to-peak is {100 * share:.3g} % of its "
+                  f"mean (the stiffness variation and the error together: tip relief makes "
+                  f"them cancel; 'torquesplit modes --campbell' rates each order); --json "
+                  f"gives the curves", highlight=False)
 
 
 # --------------------------------------------------------------------------- contact

@@ -15,7 +15,7 @@ import torquesplit
 from model_texts import RELIEVED_SPUR_LTCA, write_model
 from torquesplit.solve import static_equilibrium
 from torquesplit.solve.reference import element_forces_numpy
-from torquesplit.steady.maps import critical_speeds, driven, static_mesh_force
+from torquesplit.steady.maps import critical_speeds, driven, mesh_cycle
 
 UNMODIFIED = (RELIEVED_SPUR_LTCA
               .replace('tip_relief = {amount = "15 um", length = "5 mm"}\n', "")
@@ -46,7 +46,7 @@ def test_the_static_mesh_force_is_the_engines_force_at_the_static_state(tmp_path
     damping, at each table node of one mesh cycle."""
     _, s, q = _case(tmp_path, RELIEVED_SPUR_LTCA)
     e = list(s.element_names).index("m")
-    f = static_mesh_force(s, q, e)
+    f = mesh_cycle(s, q, e).force
     assert f is not None and np.ptp(f) > 0.05 * f.mean() > 0
     quiet = dataclasses.replace(s, damping=np.zeros_like(s.damping))
     y = np.concatenate([q, np.zeros(s.n_dof)])

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import time
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -413,13 +414,30 @@ def _error_shares(kin, structure, lines, w_ref: float) -> dict:
     return out
 
 
-def static_mesh_force(structure, q, e: int) -> np.ndarray | None:
-    """Mesh element ``e``'s force over one mesh cycle at the static deflection ``q``, on
-    its stiffness table's phase grid: ``k(s) h(V q - e(s))`` (h the dead zone), with the
-    errors e(s) that repeat every mesh cycle (its constant and the sinusoids at mesh
-    harmonics: a transmission error, the LTCA's loaded one).  Its harmonics are what
-    drives a mesh-frequency line (the stiffness variation and the transmission error
-    together: tip relief makes them cancel).  None without a table."""
+@dataclass(frozen=True)
+class MeshCycle:
+    """One mesh's excitation over a mesh cycle, on its stiffness table's phase grid, at
+    a static deflection (:func:`mesh_cycle`)."""
+
+    phase: np.ndarray
+    """Mesh phase s in [0, 1) (s = f t + phase, as the tables)."""
+    stiffness: np.ndarray
+    """k(s) [N/m]."""
+    error: np.ndarray
+    """e(s) [m] along the line of action: the constant and the sinusoids at mesh
+    harmonics (a transmission error, the LTCA's loaded one; not a shaft order's)."""
+    deflection: float
+    """V q [m], the mesh's static deflection (errors not taken off)."""
+    force: np.ndarray
+    """k(s) h(V q - e(s)) [N] (h the dead zone): the static mesh force over the cycle."""
+
+
+def mesh_cycle(structure, q, e: int) -> MeshCycle | None:
+    """Mesh element ``e``'s excitation over one mesh cycle at the static displacement
+    ``q``: its stiffness table, the errors that repeat every mesh cycle and the force
+    ``k(s) h(V q - e(s))``.  The force's harmonics are what drives a mesh-frequency line
+    (the stiffness variation and the transmission error together: tip relief makes them
+    cancel).  None without a table."""
     table = np.asarray(structure.stiffness_table[e], dtype=float)
     f_mesh = float(structure.frequency[e])
     if table.size < 2 or not f_mesh > 0:
@@ -439,12 +457,12 @@ def static_mesh_force(structure, q, e: int) -> np.ndarray | None:
          if structure.gap_ptr[e + 1] > structure.gap_ptr[e] else 0.0)
     x = d - err
     h = np.where(x > g, x - g, np.where(x < -g, x + g, 0.0)) if g > 0 else x
-    return table * h
+    return MeshCycle(phase=s, stiffness=table, error=err, deflection=d, force=table * h)
 
 
 def _mesh_force_harmonics(kin, structure, lines, q) -> dict:
     """(line label, order) -> amplitude of that harmonic of the static mesh force
-    (:func:`static_mesh_force`) over its mean, the largest over the group's meshes:
+    (:func:`mesh_cycle`) over its mean, the largest over the group's meshes:
     the stiffness harmonic and the transmission error's force taken together, with
     their phases (each alone overstates a modified pair's excitation)."""
     if structure is None or q is None:
@@ -459,7 +477,8 @@ def _mesh_force_harmonics(kin, structure, lines, q) -> dict:
             if n not in names:
                 continue
             if n not in forces:
-                forces[n] = static_mesh_force(structure, q, names.index(n))
+                cyc = mesh_cycle(structure, q, names.index(n))
+                forces[n] = None if cyc is None else cyc.force
             f = forces[n]
             if f is None or order >= f.size // 2:
                 continue
@@ -500,7 +519,7 @@ def _modal_force_share(structure, q, shape, meshes, order: int) -> float | None:
     """How much of the ``order``-th harmonic of the meshes' static forces reaches a mode
     (``shape``: its displacement part): |sum_m a_m| / sum_m |a_m| with
     a_m = F_m e^(2 pi i order phase_m) (V_m . shape), F_m that harmonic of mesh m's
-    static force over its cycle (:func:`static_mesh_force`: its stiffness harmonic times
+    static force over its cycle (:func:`mesh_cycle`: its stiffness harmonic times
     its static deflection, plus its transmission error's force), phase_m its mesh phase.
     0 where the meshes' forces cancel on the mode (branches in phase on a mode where they
     move against each other, half a cycle apart on one where they move together); the
@@ -513,9 +532,10 @@ def _modal_force_share(structure, q, shape, meshes, order: int) -> float | None:
         if m not in names:
             continue
         e = names.index(m)
-        f = static_mesh_force(structure, q, e)
-        if f is None or order >= f.size // 2:
+        cyc = mesh_cycle(structure, q, e)
+        if cyc is None or order >= cyc.force.size // 2:
             continue
+        f = cyc.force
         c = np.fft.rfft(f)[order] / f.size
         sl = slice(structure.v_ptr[e], structure.v_ptr[e + 1])
         v = complex(np.dot(structure.v_coef[sl], shape[:n][structure.v_dof[sl]]))
