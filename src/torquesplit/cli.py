@@ -1754,7 +1754,7 @@ def modes(
     for col in cols:
         t.add_column(_h(col))
     for r in rep.rows:
-        energy = ", ".join(f"{n} {100 * v:.0f} %" for n, v in list(r.strain_energy.items())[:3])
+        energy = ", ".join(f"{n} {100 * v:.0f} %" for n, v in r.largest_shares(3))
         t.add_row(str(r.mode), f"{r.frequency:#.6g}", _ratio(r.damping_ratio),
                   f"{r.damped_frequency:#.6g}" if r.frequency > 0 else "-",
                   str(r.multiplicity), *([r.type or ""] if typed else []),

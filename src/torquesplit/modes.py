@@ -65,6 +65,10 @@ DAMPING_RATIO_DEFINITION = (
     "equilibrium and of speed-dependent loads")
 
 
+SUPPORT_AXES = ("x", "y", "z", "loa")
+"""Component suffixes of a support's elements (``BODY.support.x``, ...)."""
+
+
 @dataclass(frozen=True)
 class ModeRow:
     """One natural mode, with the properties of its degenerate group."""
@@ -90,6 +94,20 @@ class ModeRow:
     """``forward`` or ``backward``: the sense of the central members' whirl in the
     turning carrier's frame against the carrier's rotation (a translational mode of a
     turning carrier; None otherwise, and for a degenerate pair: :func:`whirl_senses`)."""
+
+    def largest_shares(self, n: int = 3) -> list[tuple[str, float]]:
+        """The ``n`` largest strain-energy shares with a support's components taken
+        together (``BODY.support`` for ``BODY.support.x`` + ``.y`` + ...): a planet's
+        bearing on its pin showed as ``support.x`` in one planet and ``support.y`` in the
+        next for one rotational mode (the carrier frame's axes, not the planet's), and a
+        degenerate pair's split between x and y depends on the solver's basis; their sum
+        does not.  Every component stays in :attr:`strain_energy`."""
+        merged: dict[str, float] = {}
+        for name, v in self.strain_energy.items():
+            base, dot, comp = name.rpartition(".")
+            key = base if dot and base.endswith(".support") and comp in SUPPORT_AXES else name
+            merged[key] = merged.get(key, 0.0) + v
+        return sorted(merged.items(), key=lambda kv: -kv[1])[:n]
 
     @property
     def damped_frequency(self) -> float:

@@ -418,7 +418,7 @@ def _modes(res) -> str:
                     if cancels(name, k, r.mode) else "")
                 for name, fm in mesh_f.items() for k in range(1, top[name] + 1)
                 if abs(f - k * fm) <= NEAR_FRACTION * k * fm]
-        energy = ", ".join(f"{n} {100 * v:.0f} %" for n, v in list(r.strain_energy.items())[:3])
+        energy = ", ".join(f"{n} {100 * v:.0f} %" for n, v in r.largest_shares(3))
         rows.append([str(r.mode), _g(f, 6), str(r.multiplicity)]
                     + ([r.type or ""] if typed else [])
                     + ([r.whirl or ""] if whirls else [])
