@@ -121,16 +121,17 @@ def test_every_problem_of_a_study_file_is_said_at_once(tmp_path, split_file):
     data["grid"]["parameters"][2]["num"] = 3
     data["analysis"].pop("cycles", None)
     data["analysis"]["duration"] = "-1 s"
+    data["analysis"]["settle"] = {"start": "1 kg"}  # (said with the duration, not after)
     with pytest.raises(StudyError) as info:
         Study(data).plan()
     fields = [f for f, _ in info.value.problems]
-    assert fields == ["analysis.duration", "study.outputs", "grid.parameters.0.path",
-                      "grid.parameters.1.start"], fields
+    assert fields == ["analysis.duration", "analysis.settle.start", "study.outputs",
+                      "grid.parameters.0.path", "grid.parameters.1.start"], fields
     path = tmp_path / "bad.toml"
     path.write_text(tomli_w.dumps(data))
     res = CliRunner().invoke(app, ["study", str(path), "--quiet"])
     lines = [ln for ln in res.output.splitlines() if ln.strip()]
-    assert res.exit_code == 2 and len(lines) == 4 and all(
+    assert res.exit_code == 2 and len(lines) == 5 and all(
         ln.startswith(f"error: {path}: ") for ln in lines), res.output
     res = CliRunner().invoke(app, ["sweep", str(split_file), "--vary",
                                    "meshes.a1.stifness=2e8:6e8:3 N/m", "--output", "nope",

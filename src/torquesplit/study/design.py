@@ -390,20 +390,27 @@ def _analysis(spec: StudySpec) -> dict:
         out["revolutions"] = None if a.revolutions is None else float(a.revolutions)
         out["points_per_cycle"] = 32 if a.points_per_cycle is None else int(a.points_per_cycle)
         return out
-    out["duration"] = (None if a.duration is None
-                       else P.to_si(a.duration, "time", None, "analysis.duration"))
-    if out["duration"] is not None and out["duration"] <= 0:
-        raise StudyError("analysis.duration", "must be positive; give e.g. '2 s'")
+    problems = _Problems()  # (the duration's and the settle start's both, at once)
+    out["duration"] = problems.attempt(_positive_time, a.duration, "analysis.duration", "2 s")
     out.update(cycles=a.cycles, method=a.method, steps_per_period=a.steps_per_period,
                rtol=a.rtol)
     if a.settle is not None:
-        start = (None if a.settle.start is None
-                 else P.to_si(a.settle.start, "time", None, "analysis.settle.start"))
-        if start is not None and start <= 0:
-            raise StudyError("analysis.settle.start", "must be positive; give e.g. '1 s'")
+        start = problems.attempt(_positive_time, a.settle.start, "analysis.settle.start",
+                                 "1 s")
         out["settle"] = {"tolerance": a.settle.tolerance, "start": start,
                          "growth": a.settle.growth}
+    problems.raise_any()
     return out
+
+
+def _positive_time(value, field: str, example: str) -> float | None:
+    """A time of the study file in s (None if not given); refused unless positive."""
+    if value is None:
+        return None
+    t = P.to_si(value, "time", None, field)
+    if t <= 0:
+        raise StudyError(field, f"must be positive; give e.g. '{example}'")
+    return t
 
 
 MIN_CYCLES = 2
