@@ -750,8 +750,12 @@ def _render_run(res, met, saved, planets=None) -> None:
     bearings = res.bearing_forces(met.settling.start_time, metrics=met)
     if bearings:
         console.print(bearing_table(bearings, res))
+    unknown = [g for g, v in met.load_sharing.per_group.items() if not math.isfinite(v)]
     console.print(f"system load-sharing coefficient ({met.definition}): "
-                  f"[bold]{met.load_sharing.system:.4f}[/]", highlight=False)
+                  f"[bold]{met.load_sharing.system:.4f}[/]"
+                  + (f" (group {', '.join(unknown)} has none: the largest of the groups' "
+                     f"is not known; a longer run, --duration, gives it)" if unknown else ""),
+                  highlight=False)
     console.print(
         f"LSC ({met.definition}): {DEFINITION_TEXT[met.definition]}; "
         f"{DEFINITION_USE[met.definition]}.  Static F: the static equilibrium under the "

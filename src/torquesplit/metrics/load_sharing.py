@@ -289,6 +289,16 @@ def _ratio(x: np.ndarray) -> np.ndarray:
         return x.shape[-1] * x / np.where(s != 0, s, np.nan)
 
 
+def _system(per_group: dict[str, float]) -> float:
+    """The system's coefficient: the largest of its groups' (Ji & Li eq. 19), NaN when a
+    group has none (a run too short for a whole cycle of it: the largest is then not
+    known; Python's max() skipped a NaN or not depending on the groups' order)."""
+    values = np.array(list(per_group.values()), dtype=float)
+    if not values.size or not np.isfinite(values).all():
+        return math.nan
+    return float(values.max())
+
+
 def _nanmax(x) -> float:
     x = np.asarray(x, dtype=float)
     return float(np.nanmax(x)) if np.isfinite(x).any() else math.nan
@@ -311,8 +321,8 @@ def cycle_peak(cycle_max, cycle_start, names, groups, first_cycle) -> LoadSharin
             times[m] = cycle_start[:, col[m]]
             per_mesh[m] = _nanmax(r[first_cycle[m]:, i])
         per_group[g] = max(per_mesh[m] for m in members)  # eq. 18
-    system = max(per_group.values())  # eq. 19
-    return LoadSharing("cycle_peak", per_mesh, per_group, system, groups, per_cycle, times)
+    return LoadSharing("cycle_peak", per_mesh, per_group, _system(per_group), groups,
+                       per_cycle, times)
 
 
 def mean_force(cycle_mean, cycle_count, cycle_start, names, groups,
@@ -335,7 +345,7 @@ def mean_force(cycle_mean, cycle_count, cycle_start, names, groups,
             per_cycle[m] = rc[:, i]
             times[m] = cycle_start[:, col[m]]
         per_group[g] = max(per_mesh[m] for m in members)
-    return LoadSharing("mean_force", per_mesh, per_group, max(per_group.values()), groups,
+    return LoadSharing("mean_force", per_mesh, per_group, _system(per_group), groups,
                        per_cycle, times)
 
 
@@ -357,7 +367,7 @@ def instantaneous(cycle_ratio_max, cycle_start, names, groups, first_cycle,
             times[m] = cycle_start[:, col[m]]
             per_mesh[m] = reduce(peaks[first_cycle[m]:])
         per_group[g] = max(per_mesh[m] for m in members)
-    return LoadSharing(definition, per_mesh, per_group, max(per_group.values()), groups,
+    return LoadSharing(definition, per_mesh, per_group, _system(per_group), groups,
                        per_cycle, times)
 
 
@@ -377,7 +387,7 @@ def static_torque(times, forces, names, groups) -> LoadSharing:
             per_mesh[m] = _nanmax(r[:, i])
             mean[m] = float(r_mean[i])
         per_group[g] = max(per_mesh[m] for m in members)  # eq. 15
-    return LoadSharing("static_torque", per_mesh, per_group, max(per_group.values()),
+    return LoadSharing("static_torque", per_mesh, per_group, _system(per_group),
                        groups, per_cycle, ts, mean)
 
 

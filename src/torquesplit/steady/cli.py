@@ -488,10 +488,12 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
             # the same at its speed with twice the resolution, and the digits that hold
             "max_dynamic_factor_at_half_step": {k: v["halved"] for k, v in held.items()},
             "max_dynamic_factor_digits": {k: v["digits"] for k, v in held.items()},
-            "unstable_points": int((~ds["stable"].values).sum()),
+            "unstable_points": (int((~ds["stable"].values).sum()) if "stable" in ds
+                                else None),
             "marginal_points": _marginal(ds),
             "unresolved_peaks": unresolved_peaks(ds),
-            "period_doubling_rpm": _runs(ds, ds["instability"].values == "period doubling"),
+            "period_doubling_rpm": (_runs(ds, ds["instability"].values == "period doubling")
+                                    if "instability" in ds else []),
             "max_contact_loss": _largest_loss(ds),
             "wall_time_s": ds.attrs["wall_time_s"],
             "results_file": str(saved[0]) if saved else None,
@@ -621,7 +623,9 @@ def _marginal(ds) -> int:
     if "max_multiplier" not in ds:
         return 0
     mu = np.asarray(ds["max_multiplier"].values, float)
-    stable = np.asarray(ds["stable"].values, bool)
+    from torquesplit.steady.maps import counted_points
+
+    stable = counted_points(ds)
     return int((stable & (mu >= 1 - MARGINAL_TOL)).sum())
 
 
@@ -636,7 +640,9 @@ def _runs(ds, flag) -> list[list[float]]:
 def _largest_loss(ds) -> dict[str, list[float]]:
     """Per mesh, the largest contact-loss fraction over the stable points and its speed
     [rpm] ([0, None] without one)."""
-    stable = np.asarray(ds["stable"].values, bool)
+    from torquesplit.steady.maps import counted_points
+
+    stable = counted_points(ds)
     rpm = np.asarray(ds["speed_rpm"].values, float)[stable]
     out = {}
     for j, k in enumerate(ds["mesh"].values):
@@ -658,7 +664,9 @@ def unresolved_peaks(ds) -> list[str]:
     585.7 rpm, 1.09915, its neighbours 5.6 % of the increment lower; 77 points gave
     609.7 rpm, 1.10207), as '<mesh> (<share> % ... at <rpm>)'."""
     out = []
-    stable = np.asarray(ds["stable"].values, bool)
+    from torquesplit.steady.maps import counted_points
+
+    stable = counted_points(ds)
     rpm = np.asarray(ds["speed_rpm"].values, float)
     for j, k in enumerate(ds["mesh"].values):
         df = np.where(stable, np.asarray(ds["dynamic_factor"].values[:, j], float), np.nan)
@@ -734,7 +742,9 @@ def sweep_maxima(ds) -> dict[str, dict[str, tuple[float, float]]]:
     integrations of ``--cross-check`` (``"run_up"``, ``"run_down"``).  NaN where there is
     no such point."""
     out = {}
-    stable = np.asarray(ds["stable"].values, bool)
+    from torquesplit.steady.maps import counted_points
+
+    stable = counted_points(ds)
     rpm = np.asarray(ds["speed_rpm"].values, float)
 
     def peak(values, speeds):

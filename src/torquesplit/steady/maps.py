@@ -236,7 +236,9 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
                              {"units": "1", "long_name": "fraction of the period in which "
                               "the mesh carries no force (teeth apart)"}),
             "stable": ("point", np.array([bool(p.stable) if p.stable is not None else True
-                                          for p in pts], dtype=bool)),
+                                          for p in pts], dtype=bool), {
+                "long_name": "1 if the periodic state is stable (Floquet multipliers "
+                             "inside the unit circle)"}),
             "max_multiplier": ("point", np.array([p.max_multiplier for p in pts]),
                                {"units": "1", "long_name": "largest |Floquet multiplier|"}),
             # (over a period of several excitation cycles, a keep= fraction, a period-1
@@ -251,6 +253,10 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
         coords={"speed_rpm": ("point", sp * w_ref * RPM, {"units": "rpm"}),
                 "mesh": mesh_names},
     )
+    if not stability:  # (nothing judged: no variable that reads 'stable', a reviewer)
+        ds = ds.drop_vars(["stable", "max_multiplier", "instability"])
+        ds.attrs["stability"] = ("not computed (stability=False, --no-stability): every "
+                                 "point is counted, an unstable one too")
     w_lo, w_hi = min(s0, s1) * w_ref, max(s0, s1) * w_ref
     crit = critical_speeds(s, static.q, kin, model, w_lo, w_hi)
     if s.n_gyroscopic:  # frequencies that move with speed: the Campbell map's crossings
@@ -672,6 +678,14 @@ def orders_left_out(kin, structure) -> list[str]:
                        f"1..{MAX_ORDERS}: ask for orders={top} (modes --campbell --orders "
                        f"{top}) to draw them")
     return out
+
+
+def counted_points(ds) -> np.ndarray:
+    """The points of a speed sweep its summaries count: the stable ones, or every point
+    where stability was not computed (no ``stable`` variable)."""
+    if "stable" in ds:
+        return np.asarray(ds["stable"].values, bool)
+    return np.ones(ds.sizes["point"], dtype=bool)
 
 
 def mesh_groups(kin) -> dict[str, list[str]]:

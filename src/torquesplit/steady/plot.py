@@ -158,7 +158,9 @@ def _crowded(groups, k, span) -> bool:
 def _sweep_panel(ax, ds, variable):
     """One variable of a sweep per mesh, and its run-up / run-down markers."""
     rpm = ds["speed_rpm"].values
-    stable = ds["stable"].values
+    from torquesplit.steady.maps import counted_points
+
+    stable = counted_points(ds)
     _, scale = _SWEEP_AXES.get(variable, ("", 1.0))
     drawn = []  # (values, first line): a curve equal to one drawn joins its label
     # equal: to 1e-6 of the panel's largest value, far below what a figure shows (at

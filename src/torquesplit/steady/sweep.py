@@ -101,6 +101,10 @@ PRECONDITIONER_REUSE = 0.01
 """Relative speed change after which a continuation rebuilds its GMRES preconditioner."""
 
 
+END_TOL = 1e-3
+"""A continuation point short of the sweep's end by less than this share of the step is
+the end: it is replaced by the state at the end itself (not followed by it)."""
+
 FOLD_RESOLUTION = 1e-3
 """Turning points closer than this share of the speed range to a turning point of the
 opposite kind just before them are a zig-zag of the branch's numerical tangent, not a
@@ -286,8 +290,10 @@ class Continuation:
                                       instability(mu)))
                 if progress is not None:
                     progress(min(1.0, abs(z[n] - s0) / abs(s1 - s0)))
-                if (z[n] - s1) * direction >= 0:
-                    if z[n] != s1 and len(pts) > 1:  # past the end: the state at the end itself
+                # at or past the end (or short of it by a rounding of the arclength step:
+                # a reviewer's sweep ended 759.99985, 760 rpm): the state at the end itself
+                if (z[n] - s1) * direction >= -END_TOL * step:
+                    if z[n] != s1 and len(pts) > 1:
                         x_end, info_end = self.solve(z[:n].copy(), s1)
                         if info_end.converged:
                             mu = self.multipliers(x_end, s1) if self.stability else None
