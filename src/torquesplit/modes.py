@@ -377,8 +377,8 @@ def model_modes(model, *, rotating_frame: bool = True, below: float | None = Non
     Examples
     --------
     >>> import torquesplit
-    >>> rep = model_modes(torquesplit.example_path("lin_parker1999_planetary"),
-    ...                   rotating_frame=False)
+    >>> rep = torquesplit.model_modes(torquesplit.example_path("lin_parker1999_planetary"),
+    ...                               rotating_frame=False)
     >>> [(r.type, r.multiplicity) for r in rep.rows[:3]]
     [('translational', 2), ('translational', 2), ('translational', 2)]
     """

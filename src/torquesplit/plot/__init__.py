@@ -27,17 +27,21 @@ function                        shows                                           
                                 settled start marked
 ``load_sharing_figure``         load-sharing coefficient of each mesh cycle by   dynamic
                                 a definition, reported value, settled start
+``dynamic_factor_figure``       dynamic factor of each mesh cycle (peak / the    dynamic
+                                mesh's static force), reported value
 ``support_spectrum_figure``     amplitude spectrum of each support force, mesh   dynamic
                                 frequency orders marked (one panel per body)
 ``orbit_figure``                x-y orbit of floating bodies, equal aspect       both
 ``mesh_stiffness_figure``       mesh stiffness over two mesh cycles, phasing     both
 ``static_mesh_force_figure``    quasi-static mesh force vs rotation              static
-``static_load_sharing_figure``  static torque ratio vs rotation (Mo et al. 2017)       static
+``static_load_sharing_figure``  static torque ratio vs rotation (Mo et al. 2017)  static
 ==============================  ===============================================  ==========
 
 Units on the axes: forces kN (spectrum amplitudes N), time s or ms (runs shorter than
-1 s), frequency Hz or kHz, displacements um, mesh stiffness N/um (= 1e6 N/m),
+1 s), frequency Hz or kHz, displacements µm, mesh stiffness N/µm (= 1e6 N/m),
 rotation deg.  Coefficients are dimensionless ("[-]").
+
+Every function of the table is importable from ``torquesplit.plot`` too.
 
 Examples
 --------
@@ -49,7 +53,12 @@ Examples
 
 from __future__ import annotations
 
-__all__ = ["write_figures", "write_static_figures"]
+__all__ = [
+    "write_figures", "write_static_figures", "mesh_force_figure", "cycle_peak_figure",
+    "load_sharing_figure", "dynamic_factor_figure", "support_spectrum_figure",
+    "orbit_figure", "mesh_stiffness_figure", "static_mesh_force_figure",
+    "static_load_sharing_figure", "FigureNotApplicableError",
+]
 
 
 def __getattr__(name):

@@ -274,6 +274,8 @@ class Results:
 
     @property
     def mesh_names(self) -> list[str]:
+        """The meshes in the model file's order: the columns of
+        :meth:`mesh_force_history` and the ``mesh`` coordinate of the datasets."""
         return list(self.model.meshes)
 
     def statistics(self) -> dict:
@@ -300,6 +302,9 @@ class Results:
 
     @cached_property
     def groups(self) -> dict[str, list[str]]:
+        """Load-sharing group -> its meshes: the meshes of one ``stage`` (keyed
+        ``"path/stage"`` where the meshes name a ``path``), whose loads the coefficients
+        compare."""
         return ls.group_meshes(self._mesh_meta)
 
     def nominal_forces(self) -> dict[str, float]:
