@@ -231,6 +231,7 @@ class _StaticProblem:
         self._spline_set = set(self.sp_x.tolist()) | set(self.sp_y.tolist())
         self._spline_row = {int(e): j for j, pair in enumerate(s.sp_el) for e in pair}
         self.reg = self._regularisation(regularisation)
+        self._held_cache: dict[bytes, bool] = {}
         self.linear = np.ones(s.n_elements, dtype=bool)  # ordinary (1-D) elements
         self.linear[self.sp_x] = False
         self.linear[self.sp_y] = False
@@ -618,7 +619,7 @@ class _StaticProblem:
             on[self.sp_x] &= state[self.sp_x] != FLOAT
             on[self.sp_x] &= on[self.sp_y]
             on[self.sp_y] = on[self.sp_x]
-            held = rigid_body_modes(s, active=on).shape[1] == self.phi.shape[1]
+            held = self._held(on)
             reg2 = 0.0 if held else np.where(on, 0.0, np.broadcast_to(self.reg, on.shape))
             try:
                 q2, n2, ok2 = self.equilibrium(q, L, reg2, max_iterations - solves)
@@ -630,6 +631,19 @@ class _StaticProblem:
                 if np.array_equal(state2, state):
                     q = q2
         return self._result(q, L, solves, ok)
+
+    def _held(self, on) -> bool:
+        """Whether the elements ``on`` (in contact) hold every DOF the model holds: no
+        more rigid-body modes than the model's own.  Kept per contact pattern (a sweep
+        over mesh positions meets a few patterns; the SVD per position was a tenth of
+        a quasi-static run)."""
+        key = np.packbits(on).tobytes()
+        held = self._held_cache.get(key)
+        if held is None:
+            held = rigid_body_modes(self.s, active=on).shape[1] == self.phi.shape[1]
+            if len(self._held_cache) < 4096:
+                self._held_cache[key] = held
+        return held
 
     def _result(self, q, L: _Loads, solves, ok):
         delta, f, _, _, state, _ = self.forces(q, L, 0.0)
