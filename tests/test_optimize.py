@@ -287,3 +287,43 @@ def test_the_commands_warnings_are_warning_lines(tmp_path, monkeypatch):
     assert res.exit_code == 0, res.output
     assert "warning: norel.toml: choose = 'min_sum' adds the objectives" in res.output
     assert "ModelWarning" not in res.output
+
+
+def _planetary_spec(tmp_path, mesh="sun"):
+    return {
+        "optimization": dict(model="lin_parker1999_planetary", population=4, generations=1,
+                             seed=1, workers=1, store=str(tmp_path / "evals.jsonl")),
+        "set": {f"planetary.0.{mesh}_mesh.stiffness": {"method": "ltca",
+                                                       "ltca": {"positions": 16}}},
+        "variables": [{"path": "planetary.0.planet.modifications.crowning",
+                       "lower": "0 um", "upper": "20 um"}],
+        "objectives": [{"output": "ltca.stage_sun_planet1.te_peak_to_peak_arcsec",
+                        "relative_to": "baseline"}],
+    }
+
+
+def test_a_planetary_stages_mesh_is_optimised_through_the_stage(tmp_path):
+    """A bad-input reviewer: every optimisation of a [[planetary]] mesh ended in a
+    traceback (KeyError 'meshes') where it writes the chosen design, which it never
+    wrote.  The design goes through the stage's field; the cache setting the optimiser
+    adds is not kept."""
+    import tomllib
+
+    res = optimize(read_spec(_planetary_spec(tmp_path)))
+    data = res.chosen_model_data(units=True)
+    stage = data["planetary"][0]
+    assert stage["sun_mesh"]["stiffness"]["method"] == "ltca"
+    assert "cache" not in stage["sun_mesh"]["stiffness"]["ltca"]
+    assert stage["planet"]["modifications"]["crowning"].endswith(" um")
+    paths = res.write(tmp_path / "out")
+    chosen = [p for p in paths if p.name == "chosen.toml"][0]
+    assert tomllib.loads(chosen.read_text())["planetary"][0]["sun_mesh"]["stiffness"][
+        "method"] == "ltca"
+
+
+def test_an_ltca_output_of_a_planetary_mesh_names_the_stages_field(tmp_path):
+    spec = read_spec(_planetary_spec(tmp_path, mesh="ring"))
+    with pytest.raises(ModelError) as info:
+        evaluate_design(spec, None)
+    assert "planetary.0.sun_mesh.stiffness.method" in str(info.value), str(info.value)
+    assert '"planetary.0.sun_mesh.stiffness" = {method = "ltca"}' in str(info.value)

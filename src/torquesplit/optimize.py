@@ -466,10 +466,39 @@ def _model_data(spec: OptimizationSpec, x, units: bool = False) -> dict:
     # the optimiser's designs are not kept in the LTCA disk cache (a mesh that does not
     # use the LTCA is left as it is: evaluate_design says what it needs)
     for name in _ltca_meshes(spec):
-        stiffness = data.get("meshes", {}).get(name, {}).get("stiffness")
+        path = stiffness_path(data, name)
+        stiffness = _get_deep(data, path)
         if isinstance(stiffness, dict) and stiffness.get("method") == "ltca":
-            data = _set_deep(data, f"meshes.{name}.stiffness.ltca.cache", False)
+            data = _set_deep(data, f"{path}.ltca.cache", False)
     return data
+
+
+def stiffness_path(data: dict, mesh: str) -> str:
+    """Where mesh ``mesh``'s stiffness is written in model data ``data``:
+    ``meshes.NAME.stiffness``, or for a mesh a ``[[planetary]]`` stage generates the
+    stage's field (``planetary.0.sun_mesh.stiffness``: one for every planet's)."""
+    path = f"meshes.{mesh}.stiffness"
+    if mesh in (data.get("meshes") or {}) or not data.get("planetary"):
+        return path
+    from .model.schema import Model
+
+    try:
+        return Model.model_validate(data).written_at(path)
+    except Exception:  # (the data's own errors are said when it is read)
+        return path
+
+
+def _get_deep(data: dict, path: str):
+    """The value at a dotted path of ``data`` (list items by index), or None."""
+    node = data
+    for key in path.split("."):
+        if isinstance(node, dict):
+            node = node.get(key)
+        elif isinstance(node, list) and key.isdigit() and int(key) < len(node):
+            node = node[int(key)]
+        else:
+            return None
+    return node
 
 
 def _ltca_meshes(spec) -> set[str]:
@@ -501,8 +530,10 @@ def evaluate_design(spec: OptimizationSpec, x) -> dict[str, float]:
                     raise ModelError([("objectives", f"no mesh named {mesh!r}; name a mesh of the "
                                                      "model")])
                 if model.meshes[mesh].stiffness.method != "ltca":
-                    raise ModelError([(f"meshes.{mesh}.stiffness.method", (
-                        "an ltca output needs stiffness.method = 'ltca'; set it in [set]"))])
+                    where = stiffness_path(spec.model_data, mesh)
+                    raise ModelError([(f"{where}.method", (
+                        f"an ltca output needs the LTCA stiffness; set it in [set]: "
+                        f"\"{where}\" = {{method = \"ltca\"}}"))])
                 summary = mesh_ltca(model, kin, mesh, table_points(model, kin)).summary
                 for k, v in summary.items():
                     if isinstance(v, (int, float)) and not isinstance(v, bool):
@@ -629,7 +660,9 @@ class OptimizationResult:
         SI numbers, or with ``units`` in the unit of their bounds, '0.023 mm')."""
         data = _model_data(self.spec, self.chosen_x, units)
         for name in _ltca_meshes(self.spec):  # keep the user's cache setting
-            data["meshes"][name]["stiffness"]["ltca"].pop("cache", None)
+            ltca = _get_deep(data, f"{stiffness_path(data, name)}.ltca")
+            if isinstance(ltca, dict):
+                ltca.pop("cache", None)
         return data
 
     def objective_labels(self) -> list[str]:
