@@ -115,9 +115,13 @@ def test_overrides_are_checked_like_the_file(override):
     # a bound the field refuses: before, every design failed and 'no feasible design'
     ({"variables": [{"path": "gears.L6.modifications.topological.y1", "lower": "-1 mm",
                      "upper": "0 mm"}]}, "variables[0].lower"),
-    # a misspelt path
+    # a misspelt path: named as the path, not as its bound (a bad-input reviewer)
     ({"variables": [{"path": "gears.L6.modifications.topological.y9", "lower": "0 mm",
-                     "upper": "1 mm"}]}, "variables[0].lower"),
+                     "upper": "1 mm"}]}, "variables[0].path"),
+    # a [set] the model refuses: named there, not at the first variable's bound
+    ({"set": {"meshes.L68.stiffness": {"method": "ltca", "slices": 12,
+                                       "ltca": {"positions": 24}},
+              "meshes.L68.damping_ratio": -1.0}}, 'set."meshes.L68.damping_ratio"'),
 ])
 def test_bounds_are_built_before_anything_runs(change, location):
     d = spec_dict()

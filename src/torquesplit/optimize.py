@@ -151,6 +151,9 @@ class OptimizationSpec:
     choose: str = "min_sum"
     store: Path | None = None
     base_dir: Path = field(default_factory=Path.cwd)
+    source: str | None = None
+    """The optimisation file (None for a dict): the messages of :func:`check_bounds`
+    name it, as read_spec's do."""
 
 
 def _kind(path) -> str | None:
@@ -400,7 +403,8 @@ def read_spec(source) -> OptimizationSpec:
     return OptimizationSpec(model_data=model_data, model_source=str(mpath),
                             fixed=dict(data.get("set", {})), variables=tuple(variables),
                             objectives=tuple(objectives), constraints=tuple(constraints),
-                            store=store_path, base_dir=base, **kw)
+                            store=store_path, base_dir=base,
+                            source=None if isinstance(source, dict) else name, **kw)
 
 
 #: model sections whose tables are named by the user (gears.NAME...): a variable's path
@@ -585,6 +589,17 @@ def check_bounds(spec: OptimizationSpec) -> None:
     designs."""
     from .model.io import model_from_dict
 
+    def within(loc: str, path: str) -> bool:
+        return loc == path or loc.startswith(path + ".") or path.startswith(loc + ".")
+
+    try:  # [set] alone first: its problem is named there, not at a variable's bound
+        model_from_dict(_model_data(spec, None), source=spec.model_source)
+    except ModelError as exc:
+        loc, msg = exc.issues[0] if exc.issues else ("", str(exc))
+        key = next((k for k in spec.fixed if within(loc, k)), None)
+        if key is not None:
+            raise ModelError([(f'set."{key}"', f"{loc + ': ' if loc != key else ''}{msg}")],
+                             spec.source) from None
     lows = [v.lower for v in spec.variables]
     for i, var in enumerate(spec.variables):
         for end in ("lower", "upper"):
@@ -594,9 +609,15 @@ def check_bounds(spec: OptimizationSpec) -> None:
                 model_from_dict(_model_data(spec, x), source=spec.model_source)
             except ModelError as exc:
                 loc, msg = exc.issues[0] if exc.issues else ("", str(exc))
+                for at, why in exc.issues or ():
+                    if any(within(at, p) for p in (var.path, *var.also)) and (
+                            "unknown field" in why or "does not exist" in why):
+                        # (a misspelt path, not its bound: a reviewer's 'crowing')
+                        raise ModelError([(f"variables[{i}].path", f"{at}: {why}")],
+                                         spec.source) from None
                 raise ModelError([(f"variables[{i}].{end}", (
                     f"the model with {var.path} = {x[i]:g} (SI) is refused: "
-                    f"{loc + ': ' if loc else ''}{msg}"))]) from None
+                    f"{loc + ': ' if loc else ''}{msg}"))], spec.source) from None
 
 
 class _Store:
