@@ -333,12 +333,21 @@ def geometry_issues(model: Model, skip=frozenset()) -> list[tuple[str, str]]:
     good = set()
     for name, gear in model.gears.items():
         try:
-            gear_geometry(gear)
+            geo = gear_geometry(gear)
             good.add(name)
         except ModelError as exc:
             for loc, msg in exc.issues:
                 field = _GEOMETRY_FIELDS.get(loc.split(".")[-1])
                 issues.append((f"gears.{name}" + (f".{field}" if field else ""), _teach(msg)))
+            continue
+        d_f = 2.0 * geo.root_radius
+        if gear.gear_type != "internal" and gear.bore_diameter and gear.bore_diameter >= d_f:
+            # (a reviewer's 200 mm bore in a 72 mm pinion was taken, its computed mass the
+            # teeth's alone and the tooth stiffness's fillet foundation a ring of nothing)
+            issues.append((f"gears.{name}.bore_diameter", (
+                f"{_length_text(gear.bore_diameter)} is not smaller than the root diameter "
+                f"({_length_text(d_f)}): the gear would have no body under its teeth; give "
+                f"the bore of the gear's hub (or leave it out: a solid disc)")))
     for name, mesh in model.meshes.items():
         a, b = mesh.gears
         ga, gb = model.gears[a], model.gears[b]

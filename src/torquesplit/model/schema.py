@@ -596,7 +596,26 @@ class StiffnessSpec(Strict):
         if m != "ltca" and self.ltca != LtcaSpec():
             raise FieldError("ltca", f"applies to method 'ltca' only, the method is {m!r}; set "
                              "method = 'ltca' or remove the ltca table")
+        # a field of another method is refused, not dropped (a reviewer's
+        # {method = "iso6336", value = "1 N/m"} ran at the ISO stiffness without a word)
+        # (a value other than the default: a table written back whole, as a [[planetary]]
+        # stage's meshes are, repeats the defaults of every method)
+        for name, methods in STIFFNESS_FIELD_METHODS.items():
+            if m not in methods and getattr(self, name) != type(self).model_fields[name].default:
+                raise FieldError(name, (
+                    f"applies to method {' or '.join(repr(x) for x in methods)} only, the "
+                    f"method is {m!r}: remove it (to change the method on the command line, "
+                    f"set the whole table: --set 'meshes.NAME.stiffness={{method = "
+                    f"\"{m}\"}}')"))
         return self
+
+
+#: StiffnessSpec field -> the methods that use it (the others refuse it)
+STIFFNESS_FIELD_METHODS = {
+    "value": ("constant",), "peak_to_peak": ("constant",), "phase": ("table",),
+    "values": ("table",), "mean": ("fourier",), "cos": ("fourier",), "sin": ("fourier",),
+    "fillet_foundation": ("potential_energy", "ltca"), "slices": ("potential_energy", "ltca"),
+}
 
 
 class BacklashSpec(Strict):
