@@ -252,3 +252,16 @@ def test_a_run_too_short_for_any_mesh_cycle_is_refused_before_its_cases():
         Study(spec).plan()
     spec["analysis"]["duration"] = "9 ms"  # two cycles of m11: its outputs have values
     assert Study(spec).n_cases == 2
+
+
+def test_a_value_that_is_no_number_is_one_line_without_the_validators_names(split_file):
+    """A bad-input reviewer's NaN listed three problems at 'values.0.int', '.float' and
+    '.str': the validator's alternatives, not fields."""
+    data = grid_study(split_file, [dict(path="meshes.a1.stiffness", values=[float("nan"),
+                                                                          "5e8 N/m"])])
+    with pytest.raises(StudyError) as info:
+        Study(data).plan()
+    assert info.value.problems == [(
+        "grid.parameters.0.values.0",
+        "must be a finite number or a value with its unit ('5e8 N/m', '2 mm'), got nan; "
+        "correct the value")], info.value.problems

@@ -502,13 +502,30 @@ def _problems(exc: pydantic.ValidationError) -> list[tuple[str, str]]:
     errors = exc.errors(include_url=False)
     errors.sort(key=lambda e: e["type"] == "missing")
     out = []
+    seen_union = set()
     for err in errors:
-        parts = [str(p) for p in err["loc"] if not _internal(p)]
+        loc = err["loc"]
+        union = bool(loc) and loc[-1] in _UNION_MEMBERS
+        parts = [str(p) for p in (loc[:-1] if union else loc) if not _internal(p)]
         problem = (err.get("ctx") or {}).get("error")
         if isinstance(problem, _Problem):
             parts.append(problem.field)
+        if union:  # a value that none of a number, a whole number, a text is: one line
+            # (a reviewer's nan listed '.int', '.float' and '.str', the validator's names)
+            if tuple(parts) in seen_union:
+                continue
+            seen_union.add(tuple(parts))
+            got = repr(err.get("input"))
+            out.append((".".join(parts), (
+                f"must be a finite number or a value with its unit ('5e8 N/m', '2 mm'), got "
+                f"{got if len(got) <= 60 else got[:57] + '...'}; correct the value")))
+            continue
         out.append((".".join(parts), _message(err, parts)))
     return out
+
+
+#: the members of Value's union as pydantic names them in an error's location
+_UNION_MEMBERS = ("int", "float", "str")
 
 
 def _internal(part) -> bool:
