@@ -1459,7 +1459,10 @@ def _check_load_text(text: str) -> None:
     for kind in ("force", "torque"):
         try:
             value = parse_quantity(text, kind)
-        except ValueError:
+        except ValueError as exc:
+            if "not a finite number" in str(exc):  # (not: 'neither a force nor a torque')
+                raise OptionError(f"--load {text!r} is not a finite number; give e.g. "
+                                  f"'40 kN' or '17500 N m'") from None
             continue
         if not (value > 0):
             raise OptionError(f"--load {text!r} must be positive; give e.g. '40 kN'")

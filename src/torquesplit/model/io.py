@@ -333,6 +333,9 @@ def _message(err: dict, parts: list[str], written=None) -> str:
     if kind == "string_pattern_mismatch":  # (names: the pattern of a Field)
         return (f"{got} is not a name this field takes; use letters, digits and '_', "
                 f"starting with a letter (e.g. \"stage_1\")")
+    if kind in ("finite_number", "float_type", "float_parsing") and _is_whole(parts):
+        # (a tooth count of inf was told to write 'a plain number such as 0.05')
+        return f"must be a finite whole number, got {got}; write an integer such as 20"
     # longest prefix first: 'model_attributes_type' before 'model_type'
     for base in sorted(_TYPE_MESSAGES, key=len, reverse=True):
         if kind.startswith(base):
@@ -365,6 +368,28 @@ def _fields_at(parts: list[str], lists: bool = False) -> list[str]:
     if isinstance(node, type) and issubclass(node, pydantic.BaseModel):
         return list(node.model_fields)
     return []
+
+
+def _is_whole(parts: list[str]) -> bool:
+    """Whether the schema field at ``parts`` takes a whole number (a count)."""
+    if not parts:
+        return False
+    section = parts[:-1]
+    if parts[-1] not in _fields_at(section, lists=True):
+        return False
+    node = Model
+    for part in parts:  # (as _fields_at, to the field itself)
+        node = _strip(node)
+        if isinstance(node, type) and issubclass(node, pydantic.BaseModel):
+            node = node.model_fields[part].annotation if part in node.model_fields else None
+        elif typing.get_origin(node) is dict:
+            node = typing.get_args(node)[1]
+        elif list_item(node) is not None and part.isdigit():
+            node = list_item(node)
+        else:
+            return False
+    node = _strip(node)
+    return isinstance(node, type) and issubclass(node, int) and not issubclass(node, bool)
 
 
 def _strip(tp):

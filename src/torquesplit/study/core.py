@@ -219,7 +219,8 @@ class Study:
                 f"{words.resume_on} continues the stored study and {words.overwrite_on} "
                 f"starts it again: give one of them"))
         plan = self.plan()
-        if workers is not None and (isinstance(workers, bool) or workers < 1):
+        if workers is not None and (isinstance(workers, bool) or not isinstance(
+                workers, (int, np.integer)) or workers < 1):
             raise StudyError(words.workers, f"got {workers!r}; give at least 1 worker (1 "
                                             "runs the cases in this process)")
         chosen = _backend_runner(plan, backend, precision, client, scheduler, runner,

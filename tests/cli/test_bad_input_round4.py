@@ -1,0 +1,39 @@
+"""Smaller findings of a bad-input reviewer: a tooth count of inf was told to 'write a
+plain number such as 0.05'; contact --load 'nan kN' was 'neither a force nor a torque';
+run_study(workers='two') ended in a raw TypeError."""
+
+from __future__ import annotations
+
+import pytest
+from typer.testing import CliRunner
+
+import torquesplit
+from torquesplit.cli import app
+from torquesplit.study import StudyError
+
+
+@pytest.mark.parametrize("path", ["gears.z1.teeth", "gears.z2.teeth"])
+def test_a_count_that_is_not_finite_is_told_to_be_a_whole_number(path):
+    res = CliRunner().invoke(app, ["check", "ji_li_mill_drive", "--set", f"{path}=inf"])
+    assert res.exit_code == 2
+    assert (f"{path}: must be a finite whole number, got inf; write an integer such as 20"
+            in " ".join(res.output.split())), res.output
+    res = CliRunner().invoke(app, ["check", "ji_li_mill_drive", "--set",
+                                   "meshes.m11.damping_ratio=inf"])
+    assert "write a plain number such as 0.05" in " ".join(res.output.split())
+
+
+def test_a_load_that_is_not_finite_is_said_so():
+    res = CliRunner().invoke(app, ["contact", "ji_li_mill_drive", "--pair", "m11", "--load",
+                                   "nan kN"])
+    assert res.exit_code == 2
+    assert "--load 'nan kN' is not a finite number" in res.output, res.output
+
+
+def test_workers_that_are_not_a_number_are_refused_by_name():
+    study = {"study": {"name": "w", "model": "ji_li_mill_drive",
+                       "outputs": ["load_sharing.mean_force"]},
+             "grid": {"parameters": [{"path": "meshes.m11.damping_ratio",
+                                      "values": [0.05]}]}}
+    with pytest.raises(StudyError, match="workers: got 'two'"):
+        torquesplit.run_study(study, workers="two")
