@@ -83,7 +83,12 @@ def render(template: str, data) -> str:
             return "\n".join(bullet + str(item) for item in value) if value else bullet + "none"
         if fmt and "~" in fmt:  # a number and how far it moves under h/2
             fmt, change = fmt.split("~", 1)
-            return held(value, fmt, float(lookup(data, change)))
+            # the halved run's value beside its change, where the data have it
+            try:
+                halved = float(lookup(data, change.replace("/halved/change/", "/halved/value/")))
+            except (KeyError, TypeError, ValueError):
+                halved = None
+            return held(value, fmt, float(lookup(data, change)), halved)
         return format(value, fmt) if fmt else str(value)
     return _FIELD.sub(field, template)
 
@@ -93,15 +98,19 @@ NOT_HELD = "†"
 digit when the step is halved (the data hold the change, not the halved value)."""
 
 
-def held(value: float, fmt: str, change: float) -> str:
+def held(value: float, fmt: str, change: float, halved: float | None = None) -> str:
     """``value`` formatted with ``fmt`` (a fixed-point ``.Nf``), marked NOT_HELD when its
     change under a halved step (``change``, absolute) is more than half a unit of the
-    last printed digit: the digits printed do not all hold."""
+    last printed digit, or when the halved run's value (``halved``, where known) prints
+    otherwise (1.1052138 -> 1.1052504 moves by less than half a unit of the 4th decimal
+    and prints 1.1052 -> 1.1053: :func:`torquesplit.convergence.agreeing_digits`'s rule,
+    which ``--check-step`` applies): the digits printed do not all hold."""
     m = re.fullmatch(r"\.(\d+)f", fmt)
     if m is None:
         raise ValueError(f"a held number takes a fixed-point format (.3f), not {fmt!r}")
     unit = 10.0 ** -int(m.group(1))
-    return format(value, fmt) + (NOT_HELD if not change <= 0.5 * unit else "")
+    flips = halved is not None and format(halved, fmt) != format(value, fmt)
+    return format(value, fmt) + (NOT_HELD if flips or not abs(change) <= 0.5 * unit else "")
 
 
 def render_validation() -> str:

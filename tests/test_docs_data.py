@@ -106,3 +106,11 @@ def test_a_number_whose_digits_move_under_a_halved_step_is_marked():
         render.held(1.0, ".3g", 0.0)
     data = {"r": {"values": {"x": 1.197}, "halved": {"change": {"x": 9.8e-3}}}}
     assert render.render("{{r/values/x:.3f~r/halved/change/x}}", data) == "1.197†"
+    # a rounding that flips: less than half a unit, yet 1.1052 -> 1.1053 (a numbers
+    # reviewer; --check-step's rule), from the halved run's own value where the data have it
+    assert render.held(1.1052138, ".4f", 3.66e-5) == "1.1052"
+    assert render.held(1.1052138, ".4f", 3.66e-5, 1.1052504) == "1.1052†"
+    assert render.held(1.1052138, ".4f", 3.66e-5, 1.1051772) == "1.1052"
+    data = {"r": {"values": {"x": 1.1052138},
+                  "halved": {"change": {"x": 3.66e-5}, "value": {"x": 1.1052504}}}}
+    assert render.render("{{r/values/x:.4f~r/halved/change/x}}", data) == "1.1052†"
