@@ -37,3 +37,15 @@ def test_workers_that_are_not_a_number_are_refused_by_name():
                                       "values": [0.05]}]}}
     with pytest.raises(StudyError, match="workers: got 'two'"):
         torquesplit.run_study(study, workers="two")
+
+
+def test_an_index_past_a_list_says_how_long_the_list_is():
+    """'planetary.3' does not exist (known here: none) on a model with planetary.0."""
+    study = {"study": {"name": "p", "model": "lin_parker1999_planetary",
+                       "outputs": ["load_sharing.mean_force"]},
+             "grid": {"parameters": [{"path": "planetary.3.sun_mesh.damping_ratio",
+                                      "values": [0.05]}]}}
+    with pytest.raises(StudyError) as info:
+        torquesplit.Study(study).plan()
+    assert "'planetary.3' does not exist in the model: its list has 1 item(s), indices 0..0" \
+        in str(info.value), str(info.value)

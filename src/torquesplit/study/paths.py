@@ -177,6 +177,12 @@ def _parent(raw, parts, path, where):
         elif isinstance(node, list) and key.isdigit() and int(key) < len(node):
             node = node[int(key)]
         else:
+            if isinstance(node, list):  # (an index past the list: 'known here: none')
+                raise StudyError(where, (
+                    f"{path!r}: {here!r} does not exist in the model: its list has "
+                    f"{len(node)} item(s), indices 0..{len(node) - 1}; check the path"
+                    if node else f"{path!r}: {here!r} does not exist in the model: its list "
+                    f"is empty; check the path"))
             known = ", ".join(sorted(node)) if isinstance(node, dict) else "none"
             raise StudyError(where, f"{path!r}: {here!r} does not exist in the model (known "
                                     f"here: {known}); check the path")
