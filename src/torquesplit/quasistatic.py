@@ -77,7 +77,9 @@ class QuasiStaticResults:
         """Static torque ratios per mesh, group and system (Mo et al. 2017 eqs. 14-15).
 
         ``definition`` may be given as a dynamic run's ``metrics`` takes it: only
-        ``"static_torque"`` (``"static"``), the one a quasi-static sweep has."""
+        ``"static_torque"`` (``"static"``), the one a quasi-static sweep has.  The
+        result is the load sharing itself; its ``.load_sharing`` is the same object, so
+        ``metrics().load_sharing.system`` reads a run and a sweep alike."""
         if definition not in (None, "static_torque", "static"):
             from .errors import OptionError
 

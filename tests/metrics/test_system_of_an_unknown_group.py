@@ -39,3 +39,14 @@ def test_the_run_says_why_the_system_has_none():
     text = " ".join(res.stdout.split())
     assert ("system load-sharing coefficient (mean_force): nan (group stage2 has none"
             in text), text[-2000:]
+
+
+def test_a_quasi_static_sweeps_metrics_read_as_a_runs():
+    """A Python API reviewer: res.metrics().load_sharing worked on a run and broke on a
+    quasi-static sweep, whose metrics() is the load sharing itself."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        qs = torquesplit.quasi_static_load_sharing("mo2017_star_reducer", revolutions=0.05,
+                                                   points_per_cycle=4)
+    met = qs.metrics()
+    assert met.load_sharing is met and met.load_sharing.system == met.system > 1.0

@@ -145,6 +145,14 @@ class LoadSharing:
     the sum of its group's averages (the mean load of a path over the mean of all: the
     planets' K_gamma of AGMA 6123 / ISO 6336-1, :mod:`torquesplit.metrics.planetary`)."""
 
+    @property
+    def load_sharing(self) -> "LoadSharing":
+        """This object: code written for a run's ``metrics().load_sharing`` (a
+        :class:`~torquesplit.results.Metrics`) reads a quasi-static sweep's
+        ``metrics()``, which is the load sharing itself, the same way (a Python API
+        reviewer's code broke on the other result type)."""
+        return self
+
     def __repr__(self) -> str:
         return (f"LoadSharing({self.definition!r}: system {self.system:#.5g}, "
                 f"{len(self.per_group)} group{'s' if len(self.per_group) != 1 else ''}, "
