@@ -48,3 +48,14 @@ def test_a_bore_wider_than_the_root_circle_is_refused():
     ok = CliRunner().invoke(app, ["check", EXAMPLE, "--quiet", "--set",
                                   "gears.pinion_a.bore_diameter=20 mm"])
     assert ok.exit_code == 0, ok.output
+
+
+def test_double_helical_options_on_a_spur_pair_are_warned_of():
+    res = CliRunner().invoke(app, ["check", "lin_parker1999_planetary", "--set",
+                                   'planetary.0.sun_mesh.stiffness={method="ltca", ltca={'
+                                   'stagger=0.5, axial_float=true}}'])
+    assert res.exit_code == 0, res.output
+    text = " ".join(res.output.split())
+    for field in ("stagger", "axial_float"):
+        assert (f"planetary.0.sun_mesh.stiffness.ltca.{field}: applies to a double-helical "
+                f"pair only") in text, text[:2000]

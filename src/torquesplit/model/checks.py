@@ -757,6 +757,15 @@ def plausibility_warnings(model: Model, kin) -> list[tuple[str, str]]:
             note = lead_slices_note(model, name, m.stiffness.slices, "slices")
             if note:
                 out.append((f"meshes.{name}.stiffness.slices", note))
+            # (a reviewer's stagger and axial_float on a spur pair were taken silently)
+            kinds = {model.gears[g].gear_type for g in m.gears}
+            lt = m.stiffness.ltca
+            for field, given in (("stagger", lt.stagger != 0.0), ("axial_float", lt.axial_float)):
+                if given and "double_helical" not in kinds:
+                    out.append((f"meshes.{name}.stiffness.ltca.{field}", (
+                        f"applies to a double-helical pair only (its second helix); this "
+                        f"pair's gears are {' and '.join(sorted(kinds))}, so it changes "
+                        f"nothing: remove it")))
         if m.stiffness.method != "ltca" and m.misalignment != type(m.misalignment)():
             out.append((f"meshes.{name}.misalignment",
                         "only the stiffness method 'ltca' uses the misalignment; set "
