@@ -59,3 +59,16 @@ def test_double_helical_options_on_a_spur_pair_are_warned_of():
     for field in ("stagger", "axial_float"):
         assert (f"planetary.0.sun_mesh.stiffness.ltca.{field}: applies to a double-helical "
                 f"pair only") in text, text[:2000]
+
+
+def test_the_method_set_alone_drops_the_old_methods_fields():
+    """--set meshes.m11.stiffness.method=iso6336 on a 'constant' mesh with its value:
+    the value goes with the old method (it would be refused beside the new one); a field
+    the new method takes stays."""
+    m = torquesplit.load_model(torquesplit.example_path("ji_li_mill_drive"))
+    iso = m.with_changes({"meshes.m11.stiffness.method": "iso6336"})
+    assert iso.meshes["m11"].stiffness.method == "iso6336"
+    assert iso.meshes["m11"].stiffness.value is None
+    pe = m.with_changes({"meshes.m11.stiffness": {"method": "potential_energy", "slices": 8}})
+    lt = pe.with_changes({"meshes.m11.stiffness.method": "ltca"})
+    assert lt.meshes["m11"].stiffness.slices == 8

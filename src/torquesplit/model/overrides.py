@@ -27,7 +27,10 @@ def set_parameter(data: dict, path: str, value: Any) -> dict:
     index (``axis.2``).  A table set where the data has one merges into it: the fields it
     names change, the others stay (:func:`_merged`); it replaces the old one where it
     chooses another ``method`` (or distribution, kind...: :data:`SELECTORS`), where it
-    is empty (``{}`` clears a table) and where it is a whole section (``drives``).
+    is empty (``{}`` clears a table) and where it is a whole section (``drives``).  A
+    mesh stiffness's ``method`` set alone drops the old method's own fields (``value``
+    of 'constant' when it becomes 'iso6336': the schema refuses a field of another
+    method).
     Only the tables and lists on the path are copied; the rest is shared with ``data``
     (neither is ever changed in place: a study sets a dozen parameters of a large model
     per case, and copying the whole model for each cost milliseconds).
@@ -54,6 +57,16 @@ def set_parameter(data: dict, path: str, value: Any) -> dict:
         node[idx] = value
     elif isinstance(node, dict):
         old = node.get(last)
+        if parts[-2:] == ["stiffness", "method"] and old is not None and value != old:
+            # another stiffness method: the old one's own fields go with it (they would
+            # be refused beside the new one), those the new one takes stay
+            from .schema import STIFFNESS_FIELD_METHODS
+
+            for key in [k for k, methods in STIFFNESS_FIELD_METHODS.items()
+                        if value not in methods]:
+                node.pop(key, None)
+            if value != "ltca":
+                node.pop("ltca", None)
         node[last] = (_merged(old, value) if len(parts) > 1 and _merges(old, value)
                       else value)
     else:

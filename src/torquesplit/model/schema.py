@@ -604,9 +604,8 @@ class StiffnessSpec(Strict):
             if m not in methods and getattr(self, name) != type(self).model_fields[name].default:
                 raise FieldError(name, (
                     f"applies to method {' or '.join(repr(x) for x in methods)} only, the "
-                    f"method is {m!r}: remove it (to change the method on the command line, "
-                    f"set the whole table: --set 'meshes.NAME.stiffness={{method = "
-                    f"\"{m}\"}}')"))
+                    f"method is {m!r}: remove it (on the command line, --set "
+                    f"meshes.NAME.stiffness.method={m} drops the old method's fields)"))
         return self
 
 

@@ -594,7 +594,6 @@ class _StaticProblem:
         return q, solves, ok
 
     def solve(self, t, q0=None, max_iterations=200):
-        s = self.s
         L = self.loads(t)
         if L.W is None:
             self.check_balance(L.f_eff)

@@ -373,18 +373,30 @@ def _stiffness_harmonics(kin, structure, lines) -> dict:
     orders).  Rotation lines and errors are not rated (their amplitude is elsewhere)."""
     if structure is None:
         return {}
+    return _largest_harmonics(kin, structure, lines, lambda e: np.asarray(
+        structure.stiffness_table[e], dtype=float))
+
+
+def _largest_harmonics(kin, structure, lines, curve) -> dict:
+    """(line label, order) -> the largest over the line's meshes of that harmonic's
+    amplitude of ``curve(e)`` (mesh element e's array over one mesh cycle, or None) over
+    the curve's mean."""
     names = list(structure.element_names)
     groups = mesh_groups(kin)
+    spectra: dict[str, tuple | None] = {}  # mesh -> (its rfft, size, mean)
     out = {}
     for label, order, _ in lines:
         amps = []
         for n in groups.get(label, ()):
             if n not in names:
                 continue
-            table = np.asarray(structure.stiffness_table[names.index(n)], dtype=float)
-            mean = float(table.mean())
-            if mean > 0 and order < table.size // 2:
-                amps.append(2 * abs(np.fft.rfft(table)[order]) / table.size / mean)
+            if n not in spectra:
+                f = curve(names.index(n))
+                spectra[n] = None if f is None else (np.fft.rfft(f), f.size, float(f.mean()))
+            got = spectra[n]
+            if got is None or order >= got[1] // 2 or not got[2] > 0:
+                continue
+            amps.append(2 * abs(got[0][order]) / got[1] / got[2])
         if amps:
             out[(label, order)] = float(max(amps))
     return out
@@ -473,27 +485,12 @@ def _mesh_force_harmonics(kin, structure, lines, q) -> dict:
     their phases (each alone overstates a modified pair's excitation)."""
     if structure is None or q is None:
         return {}
-    names = list(structure.element_names)
-    groups = mesh_groups(kin)
-    forces = {}
-    out = {}
-    for label, order, _ in lines:
-        amps = []
-        for n in groups.get(label, ()):
-            if n not in names:
-                continue
-            if n not in forces:
-                cyc = mesh_cycle(structure, q, names.index(n))
-                forces[n] = None if cyc is None else cyc.force
-            f = forces[n]
-            if f is None or order >= f.size // 2:
-                continue
-            mean = float(f.mean())
-            if mean > 0:
-                amps.append(2 * abs(np.fft.rfft(f)[order]) / f.size / mean)
-        if amps:
-            out[(label, order)] = float(max(amps))
-    return out
+
+    def force(e):
+        cyc = mesh_cycle(structure, q, e)
+        return None if cyc is None else cyc.force
+
+    return _largest_harmonics(kin, structure, lines, force)
 
 
 def _line_strength(kin, structure, lines, w_ref: float, q=None) -> dict:
