@@ -308,3 +308,20 @@ def test_an_overwritten_csv_set_leaves_no_file_of_the_old_set(tmp_path):
                                                                   "r_sub/y.csv", 3]}))
     save_dataset(one_table, tmp_path / "r.csv", overwrite=True)
     assert (tmp_path / "r_notes.csv").read_text() == "mine"
+
+
+def test_a_runs_mat_file_has_the_layout_every_commands_has(tmp_path):
+    """A Python API reviewer: a run's .mat had no 'attributes' or 'names' struct (a
+    study's, a quasi-static sweep's and the modes' do), so the load-sharing definition
+    was only inside a description text."""
+    import scipy.io as sio
+
+    import torquesplit
+
+    res = torquesplit.simulate(EXAMPLE, duration=0.3)
+    m = sio.loadmat(res.to_mat(tmp_path / "r.mat"), simplify_cells=True)
+    assert m["attributes"]["load_sharing_definition"] == res.metrics().definition
+    assert m["names"]["cycle_max_force"] == "cycle_max_force"
+    assert m["units"]["time"] == "s" and m["units"]["peak_force"] == "N"
+    assert "model_json" not in m["attributes"] and m["model_json"].startswith("{")
+    assert m["provenance"]["run_id"]

@@ -686,41 +686,34 @@ class Results:
 
     def to_mat(self, path, *, overwrite: bool = False, definition: str | None = None) -> Path:
         """Save for MATLAB (scipy.io.savemat): every variable of the Dataset, SI units,
-        ``units``, ``descriptions`` and ``dimensions`` structs (each variable's unit, what
-        it is, what its rows and columns are), a ``provenance`` struct naming the run and,
-        for a steady state, a ``steady`` struct (period, stability, residual); written
+        in the layout every command's .mat shares (:func:`export.mat_fields`: the
+        ``names``, ``units``, ``descriptions``, ``dimensions`` and ``attributes`` structs,
+        a ``provenance`` struct naming the run), the model, metrics and warnings and, for
+        a steady state, a ``steady`` struct (period, stability, residual); written
         atomically."""
         from . import files
 
         plan = files.check_output(path, formats={".mat": "mat"}, overwrite=overwrite)
         with files.claim_output(plan) as claim:
             ds = self.to_dataset(definition)
-            # (integers as doubles: MATLAB refuses int64 in arithmetic with doubles)
-            data = {name: np.asarray(ds[name].values, dtype=float)
-                    if ds[name].dtype.kind in "iub" else np.asarray(ds[name].values)
-                    for name in ds.data_vars}
-            for name in ds.coords:
-                values = ds[name].values
-                data[name] = (np.asarray(values, dtype=object) if values.dtype.kind in "UO"
-                              else np.asarray(values, dtype=float) if values.dtype.kind in "iub"
-                              else np.asarray(values))
-            data["units"] = {name: ds[name].attrs.get("units", "") for name in ds.data_vars}
-            data["units"]["time"] = "s"
-            # what the rows and columns of each array are ('time x element': a MATLAB
-            # user's review)
-            data["dimensions"] = {name: " x ".join(ds[name].dims) or "scalar"
-                                  for name in ds.data_vars}
-            # what each variable is, as the NetCDF's long_name (and its sampling note)
-            data["descriptions"] = {
-                name: " ".join(filter(None, (ds[name].attrs.get("long_name", ""),
-                                             ds[name].attrs.get("comment", ""),
-                                             ds[name].attrs.get("sampling", ""))))
-                for name in list(ds.data_vars) + ["time"]}
+            # the layout every command's .mat shares (export.mat_fields: the names,
+            # units, dimensions, descriptions and attributes structs; a Python API
+            # reviewer found a run's without the attributes a study's has); the sampling
+            # note of a variable joins its description, as in the NetCDF
+            from .export import mat_fields
+
+            data = mat_fields(ds, claim.run_id, attrs={  # (the model and metrics: at the top)
+                k: v for k, v in ds.attrs.items() if k not in ("model_json", "metrics_json")})
+            for name, ident in data["names"].items():
+                note = ds[name].attrs.get("sampling", "")
+                if note:
+                    data["descriptions"][ident] = " ".join(filter(None, (
+                        data["descriptions"][ident], note)))
+            data["units"].setdefault("time", "s")
             data["model_json"] = ds.attrs["model_json"]
             data["metrics_json"] = ds.attrs.get("metrics_json", "")
             # (none: an empty cell, which isempty() sees; {''} counted one warning)
             data["warnings"] = files.cell_column(self.warnings(definition))
-            data["provenance"] = files.provenance(claim.run_id, ds.attrs["model_json"])
             steady = _steady_summary(ds.attrs)
             if steady:  # (a reviewer's MATLAB had no stability and no period of it)
                 data["steady"] = {k: (float(v) if isinstance(v, (int, float, np.number))
