@@ -49,3 +49,13 @@ def test_an_index_past_a_list_says_how_long_the_list_is():
         torquesplit.Study(study).plan()
     assert "'planetary.3' does not exist in the model: its list has 1 item(s), indices 0..0" \
         in str(info.value), str(info.value)
+
+
+def test_an_item_of_a_list_the_file_does_not_write_asks_for_the_whole_list():
+    """--set planetary.0.angles.1=45 deg on a stage without angles said 'must be a list,
+    got {'1': '45 deg'}'."""
+    res = CliRunner().invoke(app, ["check", "lin_parker1999_planetary", "--set",
+                                   "planetary.0.angles.1=45 deg"])
+    assert res.exit_code == 2
+    assert ("'planetary.0.angles' is not in the file, so it has no item 1; set the whole "
+            "list: planetary.0.angles=[a, b, ...]") in " ".join(res.output.split()), res.output

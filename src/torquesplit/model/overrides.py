@@ -46,6 +46,13 @@ def set_parameter(data: dict, path: str, value: Any) -> dict:
     out = _copy_node(data)
     node = out
     for i, key in enumerate(parts[:-1]):
+        if isinstance(node, dict) and key not in node and parts[i + 1].isdigit():
+            # (an item of a list the file does not write: a table was made of it, and
+            # 'must be a list, got {'1': '45 deg'}' said nothing of what to do)
+            where = ".".join(parts[: i + 1])
+            raise ModelError([(path, f"{where!r} is not in the file, so it has no item "
+                                     f"{parts[i + 1]}; set the whole list: "
+                                     f"{where}=[a, b, ...]")])
         if isinstance(node, dict) and key not in node and _schema_table(parts, i):
             node[key] = {}  # a table the schema knows, absent from the file: created
         child = _copy_node(_child(node, key, ".".join(parts[: i + 1]), path))
