@@ -265,3 +265,14 @@ def test_a_value_that_is_no_number_is_one_line_without_the_validators_names(spli
         "grid.parameters.0.values.0",
         "must be a finite number or a value with its unit ('5e8 N/m', '2 mm'), got nan; "
         "correct the value")], info.value.problems
+
+
+def test_a_planet_count_study_says_its_outputs_are_the_base_models_meshes():
+    """A bad-input reviewer's sweep over 2..6 planets had no columns for planet 5 and
+    blanks for the missing ones of 2 and 3, unsaid."""
+    study = {"study": {"name": "n", "model": "lin_parker1999_planetary",
+                       "outputs": ["load_sharing.mean_force.*"]},
+             "analysis": {"type": "run", "duration": "0.05 s"},
+             "grid": {"parameters": [{"path": "planetary.0.planets", "values": [3, 5]}]}}
+    notes = Study(study).plan().notes
+    assert any("planetary.0.planets changes the number of planets" in n for n in notes), notes

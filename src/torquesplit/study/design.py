@@ -231,7 +231,7 @@ def _resolve(spec, folder, text, source) -> Plan:
                        f"{kind}.parameters", case=case, design=design)
         except StudyError as exc:
             notes.append(f"{exc}; it will be recorded as refused (the other cases run)")
-    notes += _idle_phases(design, model, kind)
+    notes += _idle_phases(design, model, kind) + _mesh_count_notes(design, kind)
     canonical = spec.canonical()
     # a [[planetary]] stage's fields exist in the file's own data only (the validated copy
     # holds the elements the stage generated): cases varying one start from that data
@@ -243,6 +243,19 @@ def _resolve(spec, folder, text, source) -> Plan:
                 model_dict=canon,
                 study_hash=_hash(canonical), outputs=outputs, definitions=definitions,
                 analysis=analysis, design=design, notes=notes)
+
+
+def _mesh_count_notes(design, kind: str) -> list[str]:
+    """A note where a parameter changes how many meshes the model has (a stage's planet
+    count): the outputs are named from the base model's meshes, so a case with more
+    planets has none for the others and one with fewer leaves the missing planets' empty
+    (a reviewer's sweep over 2..6 planets said nothing of either)."""
+    return [f"{kind}.parameters: {q} changes the number of planets, and with it the "
+            f"meshes: the outputs are those of the base model's meshes, so a case with more "
+            f"planets has no outputs for the others and one with fewer leaves those of the "
+            f"planets it lacks empty"
+            for prm in design.parameters for q in prm.paths
+            if re.fullmatch(r"planetary\.\d+\.planets", q)]
 
 
 def _idle_phases(design, model, kind: str) -> list[str]:
