@@ -41,3 +41,13 @@ def test_the_cli_counts_no_unstable_point_it_did_not_judge():
     summary = json.loads(res.stdout)
     assert summary["unstable_points"] is None, summary
     assert summary["max_dynamic_factor"], summary  # (every point counted)
+
+
+def test_a_periodic_states_metrics_say_so_not_a_settle_time():
+    """'settled from 0.04189 s' on a steady state whose dataset holds 4.2 ms."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        st = torquesplit.steady_state("ji_li_mill_drive", keep="stage1", stability=False)
+    met = st.to_results().metrics()
+    assert met.settling.periodic and "a periodic state (no transient)" in repr(met)
+    assert "settled from" not in repr(met)

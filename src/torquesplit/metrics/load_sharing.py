@@ -118,6 +118,9 @@ class Settling:
     """Mesh -> first cycle of the mean forces (mean_force coefficients, the mean F
     column, the drift check): every group over one span, from ``start_time``
     (:func:`common_first_cycle`); empty: ``first_cycle``."""
+    periodic: bool = False
+    """A periodic state's record (:func:`periodic`): no transient; ``start_time`` is
+    where the slowest group's first whole cycle of the repeated state begins."""
 
     @property
     def mean_first(self) -> dict[str, int]:
@@ -287,7 +290,7 @@ def periodic(cycle_max: np.ndarray, cycle_start: np.ndarray, names,
     group_time = {g: max(t_own[m] for m in ms) for g, ms in groups.items()}
     return Settling(start_time=max(group_time.values()) if group_time else 0.0,
                     settled=True, first_cycle=first, group_time=group_time,
-                    own_first_cycle=dict(first))
+                    own_first_cycle=dict(first), periodic=True)
 
 
 def _ratio(x: np.ndarray) -> np.ndarray:

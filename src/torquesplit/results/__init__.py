@@ -95,7 +95,10 @@ class Metrics:
         kv = ls._nanmax(list(d.per_group_dynamic_factor.values()))
         st = self.settling
         why = "too short to tell" if st.short else "transient did not die out"
-        settled = (f"settled from {st.start_time:.4g} s" if st.settled else
+        # (a periodic state's 'settled from 0.04189 s' lay beyond the period its
+        # dataset holds: a Python API reviewer)
+        settled = ("a periodic state (no transient)" if st.periodic else
+                   f"settled from {st.start_time:.4g} s" if st.settled else
                    f"not settled ({why}), from {st.start_time:.4g} s")
         return (f"Metrics({self.definition!r}: load sharing {self.load_sharing.system:#.5g} "
                 f"({groups}), dynamic factor {kv:#.4g}, {settled})")
