@@ -1142,7 +1142,7 @@ def _drift(s, y) -> str:
             f"speed): nothing in the model holds its speed (a torque or power drive "
             f"against a torque load), so any imbalance accumulates: the damping's losses "
             f"of the vibration are one (drive and load torques balanced at the nominal "
-            f"ratio leave no power for them, and the train slows). Give a "
+            f"ratio leave no power for them). Give a "
             f"load a speed_coefficient (loads.NAME.speed_coefficient, a torque that "
             f"grows with speed, as a real load's does) or drive a member by its speed; a "
             f"smaller step does not help.")
