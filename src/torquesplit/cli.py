@@ -1050,7 +1050,9 @@ def mesh(
     as_json: bool = ux.json_option("Print the comparison as JSON."),
 ):
     """Mesh stiffness k(phase) of one mesh by every applicable method, with the ISO value
-    (N/µm along the line of action, in the table and in the --plot figure)."""
+    (N/µm along the line of action, in the table and in the --plot figure); for a mesh
+    whose error varies over the cycle (an LTCA's loaded transmission error), what a run
+    sees of it: k(s), e(s) and the static force."""
     try:
         opts = _option_errors()
         opts(_at_least, points, 16, "--points", "256")
