@@ -1147,6 +1147,7 @@ def _print_mesh(pair, cmp, plot, as_json, cycle=None) -> None:
             out["run_excitation"] = {
                 "phase": cycle.phase, "stiffness_N_per_m": cycle.stiffness,
                 "error_m": cycle.error, "static_deflection_m": cycle.deflection,
+                "half_gap_m": cycle.half_gap,
                 "static_force_N": cycle.force,
                 "description": "over one mesh cycle at the static equilibrium: k(s), the "
                                "error e(s) along the line of action and the force "
@@ -1191,7 +1192,10 @@ def _print_run_excitation(pair, cycle) -> None:
     console.print(t)
     mean = float(cycle.force.mean())
     share = np.ptp(cycle.force) / mean if mean > 0 else math.nan
-    console.print(f"delta = {cycle.deflection * 1e6:.4g} µm, the mesh's static deflection; "
+    gap = (f" ({cycle.half_gap * 1e6:.4g} µm of it the backlash's half-gap, which the "
+           f"teeth do not carry)" if cycle.half_gap > 0 else "")
+    console.print(f"delta = {cycle.deflection * 1e6:.4g} µm, the mesh's static "
+                  f"deformation{gap}; "
                   f"e(s): the errors that repeat every mesh cycle (the LTCA's loaded "
                   f"transmission error, the model's transmission-error harmonics) along the "
                   f"line of action; the force's peak-to-peak is {100 * share:.3g} % of its "

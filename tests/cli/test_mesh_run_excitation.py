@@ -47,3 +47,21 @@ def test_a_mesh_without_varying_error_has_no_such_table(as_json):
         assert "run_excitation" not in json.loads(res.stdout)
     else:
         assert "what a run sees" not in res.stdout
+
+
+def test_a_mesh_with_backlash_says_what_of_its_deformation_the_teeth_carry():
+    """Ji & Li's m11 with a transmission-error harmonic: its static deformation 711 um
+    is mostly the backlash's half-gap (the teeth carry 25 um)."""
+    res = CliRunner().invoke(app, ["mesh", "ji_li_mill_drive", "--pair", "m11", "--set",
+                                   'meshes.m11.transmission_error={amplitude="5 um"}',
+                                   "--json"])
+    assert res.exit_code == 0, res.output
+    run = json.loads(res.stdout)["run_excitation"]
+    carried = run["static_deflection_m"] - run["half_gap_m"]
+    k = np.mean(run["stiffness_N_per_m"])
+    assert run["half_gap_m"] > 0 and carried == pytest.approx(
+        np.mean(run["static_force_N"]) / k, rel=0.02)
+    text = " ".join(CliRunner().invoke(app, ["mesh", "ji_li_mill_drive", "--pair", "m11",
+                                             "--set", 'meshes.m11.transmission_error='
+                                             '{amplitude="5 um"}']).stdout.split())
+    assert "of it the backlash's half-gap, which the teeth do not carry" in text

@@ -445,7 +445,10 @@ class MeshCycle:
     """e(s) [m] along the line of action: the constant and the sinusoids at mesh
     harmonics (a transmission error, the LTCA's loaded one; not a shaft order's)."""
     deflection: float
-    """V q [m], the mesh's static deflection (errors not taken off)."""
+    """V q [m], the mesh's static deformation (errors not taken off; a mesh with
+    backlash: its half-gap included, which the teeth do not carry)."""
+    half_gap: float
+    """The dead zone's half-width g [m] (half the backlash; 0 without)."""
     force: np.ndarray
     """k(s) h(V q - e(s)) [N] (h the dead zone): the static mesh force over the cycle."""
 
@@ -475,7 +478,8 @@ def mesh_cycle(structure, q, e: int) -> MeshCycle | None:
          if structure.gap_ptr[e + 1] > structure.gap_ptr[e] else 0.0)
     x = d - err
     h = np.where(x > g, x - g, np.where(x < -g, x + g, 0.0)) if g > 0 else x
-    return MeshCycle(phase=s, stiffness=table, error=err, deflection=d, force=table * h)
+    return MeshCycle(phase=s, stiffness=table, error=err, deflection=d, half_gap=g,
+                     force=table * h)
 
 
 def _mesh_force_harmonics(kin, structure, lines, q) -> dict:
