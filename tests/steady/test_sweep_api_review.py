@@ -51,3 +51,12 @@ def test_a_periodic_states_metrics_say_so_not_a_settle_time():
     met = st.to_results().metrics()
     assert met.settling.periodic and "a periodic state (no transient)" in repr(met)
     assert "settled from" not in repr(met)
+
+
+def test_a_steady_states_mesh_series_defaults_to_every_mesh():
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        st = torquesplit.steady_state("ji_li_mill_drive", keep="stage1", stability=False)
+    t, F, D = st.mesh_series()
+    t2, F2, _ = st.mesh_series(list(st.model.meshes))
+    assert F.shape == (t.size, len(st.model.meshes)) and np.array_equal(F, F2)

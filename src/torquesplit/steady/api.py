@@ -230,12 +230,14 @@ class SteadyState:
         _, F, D = self.problem.accelerations(t, Y, ps.speed)
         return t, F, D
 
-    def mesh_series(self, elements):
+    def mesh_series(self, elements=None):
         """(t, forces, deformations) of the elements ``elements`` (indices or element
-        names such as mesh names) over one period at their finest: every RK4 step for
-        meshes (shooting keeps the other elements every ``sample_every`` steps only), the
-        samples otherwise."""
+        names such as mesh names; default every mesh, in the model file's order) over
+        one period at their finest: every RK4 step for meshes (shooting keeps the other
+        elements every ``sample_every`` steps only), the samples otherwise."""
         names = list(self.structure.element_names)
+        if elements is None:  # (a Python API reviewer's call without it: a TypeError)
+            elements = list(self.model.meshes)
         try:
             elements = [names.index(e) if isinstance(e, str) else int(e) for e in elements]
         except ValueError:
