@@ -350,21 +350,7 @@ def _message(err: dict, parts: list[str], written=None) -> str:
 def _fields_at(parts: list[str], lists: bool = False) -> list[str]:
     """Field names of the schema section at location ``parts`` ([] if there is none);
     with ``lists``, an index steps into a list of sections (``planetary.0.sun``)."""
-    node = Model
-    for part in parts:
-        node = _strip(node)
-        if isinstance(node, type) and issubclass(node, pydantic.BaseModel):
-            field = node.model_fields.get(part)
-            if field is None:
-                return []
-            node = field.annotation
-        elif typing.get_origin(node) is dict:
-            node = typing.get_args(node)[1]
-        elif lists and list_item(node) is not None and part.isdigit():
-            node = list_item(node)
-        else:
-            return []
-    node = _strip(node)
+    node = _schema_at(parts, lists)
     if isinstance(node, type) and issubclass(node, pydantic.BaseModel):
         return list(node.model_fields)
     return []
@@ -372,24 +358,28 @@ def _fields_at(parts: list[str], lists: bool = False) -> list[str]:
 
 def _is_whole(parts: list[str]) -> bool:
     """Whether the schema field at ``parts`` takes a whole number (a count)."""
-    if not parts:
-        return False
-    section = parts[:-1]
-    if parts[-1] not in _fields_at(section, lists=True):
-        return False
+    node = _schema_at(parts, lists=True) if parts else None
+    return isinstance(node, type) and issubclass(node, int) and not issubclass(node, bool)
+
+
+def _schema_at(parts: list[str], lists: bool = False):
+    """The schema type at location ``parts`` (``X | None`` and ``Annotated`` stripped), or
+    None where the schema has nothing there; with ``lists``, an index steps into a list."""
     node = Model
-    for part in parts:  # (as _fields_at, to the field itself)
+    for part in parts:
         node = _strip(node)
         if isinstance(node, type) and issubclass(node, pydantic.BaseModel):
-            node = node.model_fields[part].annotation if part in node.model_fields else None
+            field = node.model_fields.get(part)
+            if field is None:
+                return None
+            node = field.annotation
         elif typing.get_origin(node) is dict:
             node = typing.get_args(node)[1]
-        elif list_item(node) is not None and part.isdigit():
+        elif lists and list_item(node) is not None and part.isdigit():
             node = list_item(node)
         else:
-            return False
-    node = _strip(node)
-    return isinstance(node, type) and issubclass(node, int) and not issubclass(node, bool)
+            return None
+    return _strip(node)
 
 
 def _strip(tp):
