@@ -10,6 +10,7 @@ every shipped example.
 from __future__ import annotations
 
 import math
+import os
 
 import numpy as np
 import pytest
@@ -47,6 +48,20 @@ def test_every_feature_equals_the_engine():
     assert not np.array_equal(res.solutions[0].cycle_max, res.solutions[1].cycle_max,
                               equal_nan=True)
     assert res.sample_steps == sum(s.n_steps for s in res.solutions)
+    # one case a launch (the outputs over the budget): each case's row, the same bits
+    each = run_ensemble(runs, target="cpu", max_output_bytes=1)
+    assert [compare(a, b) for a, b in zip(each.solutions, res.solutions, strict=True)] == [
+        []] * 4
+
+
+@pytest.mark.skipif(not os.path.exists("/proc/meminfo"), reason="reads Linux's /proc/meminfo")
+def test_the_output_budget_follows_the_memory_available():
+    from torquesplit.gpu.ensemble import MIN_OUTPUT_BYTES, output_budget
+
+    with open("/proc/meminfo") as f:
+        avail = 1024 * int(next(ln for ln in f if ln.startswith("MemAvailable")).split()[1])
+    assert MIN_OUTPUT_BYTES <= output_budget("cpu") <= max(avail // 4, MIN_OUTPUT_BYTES)
+    assert output_budget("cpu") > avail // 8  # most of a quarter (the memory moves)
 
 
 @pytest.mark.parametrize("name", sorted(EXAMPLES))

@@ -56,6 +56,37 @@ def test_gpu_runner_gives_the_cpu_runners_dataset(tmp_path):
     _same(ds_cpu, again)
 
 
+def test_one_launch_holds_every_case_the_table_budget_allows(monkeypatch):
+    """Cases are set up in chunks (FIRST_BATCH, then doubling) and launched together: a
+    GPU runs a launch's cases side by side, so a study of shared tables is one launch
+    (it was a first launch of FIRST_BATCH and then more); where the tables' memory a
+    case leaves room for FIRST_BATCH cases only, launches of FIRST_BATCH."""
+    from torquesplit.gpu import backend
+
+    spec = {**GRID, "analysis": {"duration": "0.05 s"},
+            "grid": {"parameters": [{"path": "meshes.m11.damping_ratio",
+                                     "values": [0.04, 0.06, 0.08, 0.1, 0.12]}]}}
+    monkeypatch.setattr(backend, "FIRST_BATCH", 2)
+    chunks = []
+    prepare = GpuRunner._prepare
+
+    def counted(self, jobs, first):
+        chunks.append((len(jobs), first))
+        return prepare(self, jobs, first)
+
+    monkeypatch.setattr(GpuRunner, "_prepare", counted)
+    one = GpuRunner(target="cpu")
+    ds_one = torquesplit.Study(spec).run(runner=one)
+    assert chunks == [(2, True), (2, True), (1, True)]
+    assert one.report["ensembles"] == 1 and one.report["cases"] == 5
+    monkeypatch.setattr(backend, "TABLE_BUDGET", 0)  # room for FIRST_BATCH cases only
+    chunks.clear()
+    small = GpuRunner(target="cpu")
+    _same(ds_one, torquesplit.Study(spec).run(runner=small))
+    assert chunks == [(2, True), (2, True), (1, True)]
+    assert small.report["ensembles"] == 3
+
+
 def test_settle_rule_runs_in_rounds_as_the_cpu_runner():
     spec = {**GRID, "analysis": {"duration": "0.3 s",
                                  "settle": {"tolerance": 0.2, "start": "0.08 s"}}}

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import dataclasses
 import hashlib
+import itertools
 import logging
 import math
 import os
@@ -76,7 +77,7 @@ def check_plan(plan) -> None:
             "leave the bearing forces out of study.outputs, or use the CPU backend")
 
 
-#: cases in a study's first batch (its tables' memory a case is not known yet)
+#: cases set up first, before the phase tables' memory a case is known
 FIRST_BATCH = 64
 #: host memory for the distinct phase tables of one batch [bytes]
 TABLE_BUDGET = 2 * 1024**3
@@ -134,22 +135,33 @@ class GpuRunner:
 
     # ----------------------------------------------------------------- runner protocol
     def __call__(self, function, payloads):
-        batch: list[dict] = []
-        size = min(self.batch, FIRST_BATCH)  # until the tables' memory a case is known
+        it = iter(payloads)
         try:
-            for p in payloads:
-                batch.append(p)
-                if len(batch) >= size:
-                    yield from self._run_batch(batch)
-                    batch = []
-                    size = self._next_size()
-            if batch:
-                yield from self._run_batch(batch)
+            while jobs := self._gather(it):
+                yield from self._run_jobs(jobs)
         finally:
             if self._pool is not None:
                 self._pool.shutdown(wait=False, cancel_futures=True)
                 self._pool = None
                 self._tables = OrderedDict()
+
+    def _gather(self, it) -> list["_Job"]:
+        """The next launch's cases, set up for their first run.  A GPU runs the cases of
+        one launch side by side in about the time of one, so a launch takes as many as
+        ``batch`` and the phase tables' TABLE_BUDGET allow: they are set up in chunks
+        (FIRST_BATCH, then doubling), the tables' memory a case measured after each."""
+        jobs: list[_Job] = []
+        while len(jobs) < self._next_size():
+            want = min(self._next_size() - len(jobs), max(FIRST_BATCH, len(jobs)))
+            chunk = [_Job(p, self._worker()) for p in itertools.islice(it, want)]
+            if not chunk:
+                break
+            t = time.perf_counter()
+            self._prepare(chunk, True)
+            self.report["prepare_time_s"] += time.perf_counter() - t
+            jobs += chunk
+            self._measure_tables(jobs)
+        return jobs
 
     def _prepare(self, jobs: list["_Job"], first: bool) -> None:
         """Set the jobs' next runs up, in a process pool when ``workers`` > 1."""
@@ -198,20 +210,19 @@ class GpuRunner:
             results[k] = {**res, "run": _with_tables(res["run"], kept)}
 
     # ----------------------------------------------------------------------- batches
-    def _run_batch(self, payloads: list[dict]):
-        jobs = [_Job(p, self._worker()) for p in payloads]
-        active = jobs
-        first = True
+    def _run_jobs(self, jobs: list["_Job"]):
+        """Integrate set-up jobs, set up and integrate again the ones whose settle rule
+        asks for a longer run, then give every job's result."""
+        active = [j for j in jobs if not j.finished]
         while active:
-            t = time.perf_counter()
-            self._prepare(active, first)
-            first = False
-            self.report["prepare_time_s"] += time.perf_counter() - t
             ready = [j for j in active if j.run is not None and not j.finished]
             if ready:
                 self._integrate(ready)
             active = [j for j in active if not j.finished]
-        self._measure_tables(jobs)
+            if active:
+                t = time.perf_counter()
+                self._prepare(active, False)
+                self.report["prepare_time_s"] += time.perf_counter() - t
         for job in jobs:
             yield job.result()
 

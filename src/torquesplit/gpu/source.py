@@ -64,10 +64,12 @@ class KernelSource:
     n_x: int
     n_wi: int
     n_of: int
-    """Float output rows per case: cap_max x tracked x 5 statistics, contact times,
-    end state, end time."""
+    """Float outputs per case (``OF[c, :]``, case-major: a case's outputs are one row,
+    read back without a strided gather): cap_max x tracked x 6 statistics, contact
+    times, end state, end time."""
     n_oi: int
-    """Integer output rows per case: cap_max x tracked counts, contact counts, counters."""
+    """Integer outputs per case (``OI[c, :]``): cap_max x tracked counts, contact counts,
+    counters."""
     of_contact: int
     of_y: int
     of_t: int
@@ -357,11 +359,11 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
             w(f"o = (cur * {n_tr} + j) * {N_STAT}")
             for q, op in enumerate((">", "<", None, ">", "<", None)):
                 if op is None:
-                    w(f"OF[o + {q}, c] += X[st + {q}]")
+                    w(f"OF[c, o + {q}] += X[st + {q}]")
                     continue
-                with w.block(f"if X[st + {q}] {op} OF[o + {q}, c]:"):
-                    w(f"OF[o + {q}, c] = X[st + {q}]")
-            w(f"OI[cur * {n_tr} + j, c] += WI[{WI_SC} + 2 * j + 1]")
+                with w.block(f"if X[st + {q}] {op} OF[c, o + {q}]:"):
+                    w(f"OF[c, o + {q}] = X[st + {q}]")
+            w(f"OI[c, cur * {n_tr} + j] += WI[{WI_SC} + 2 * j + 1]")
         w("return 0")
     w()
     with w.block("def new_cycle(j, cy, X, WI, OF, OI, c, cap):"):
@@ -704,13 +706,13 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
         with w.block("for row in range(cap):"):
             for j in range(n_tr):
                 w(f"o = (row * {n_tr} + {j}) * {N_STAT}")
-                w("OF[o, c] = -math.inf")
-                w("OF[o + 1, c] = math.inf")
-                w("OF[o + 2, c] = 0.0")
-                w("OF[o + 3, c] = -math.inf")
-                w("OF[o + 4, c] = math.inf")
-                w("OF[o + 5, c] = 0.0")
-                w(f"OI[row * {n_tr} + {j}, c] = 0")
+                w("OF[c, o] = -math.inf")
+                w("OF[c, o + 1] = math.inf")
+                w("OF[c, o + 2] = 0.0")
+                w("OF[c, o + 3] = -math.inf")
+                w("OF[c, o + 4] = math.inf")
+                w("OF[c, o + 5] = 0.0")
+                w(f"OI[c, row * {n_tr} + {j}] = 0")
         with w.block(f"for k in range({n2}):"):
             w(f"W[{W_Y} + k] = {cast('Y0[k, c]')}")
         for j in range(n_tr):
@@ -766,13 +768,13 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
         for j in range(n_tr):
             w(f"flush(I{j}, X, WI, OF, OI, c, cap)")
         with w.block(f"for k in range({2 * len(watch)}):"):
-            w(f"OF[{of_contact} + k, c] = X[{X_CT} + k]")
-            w(f"OI[{oi_contact} + k, c] = WI[{WI_CC} + k]")
+            w(f"OF[c, {of_contact} + k] = X[{X_CT} + k]")
+            w(f"OI[c, {oi_contact} + k] = WI[{WI_CC} + k]")
         with w.block(f"for k in range({n2}):"):
-            w(f"OF[{of_y} + k, c] = W[{W_Y} + k]")
-        w(f"OF[{of_t}, c] = t_final")
+            w(f"OF[c, {of_y} + k] = W[{W_Y} + k]")
+        w(f"OF[c, {of_t}] = t_final")
         with w.block(f"for k in range({kern.N_COUNTERS}):"):
-            w(f"OI[{oi_counters} + k, c] = WI[{WI_CNT} + k]")
+            w(f"OI[c, {oi_counters} + k] = WI[{WI_CNT} + k]")
         w("return 0")
     w()
     text = "\n".join(w.lines) + "\n"
