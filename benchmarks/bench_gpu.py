@@ -217,9 +217,10 @@ def agreement() -> dict:
     2 ms (GPU_RESULTS.md).  Without a device: run 0 at 2 ms with each
     input moved by one ulp (how far rounding alone moves it).  On a device: run 0 at
     1..12 ms and run 1 (its pattern, other values) at 12 ms in one ensemble (one
-    compile), then run 0 at 12 ms with one feature switched off at a time (a compile
-    each), each logged as it finishes.  Per run: the largest relative difference of the
-    end state and of the cycle peaks."""
+    compile), run 0 ending at every step from 1 to 2 ms (one launch: the first step
+    whose end state differs, and its states), then run 0 at 12 ms with one feature
+    switched off at a time (a compile each), each logged as it finishes.  Per run: the
+    largest relative difference of the end state and of the cycle peaks."""
     import dataclasses
 
     import numpy as np
@@ -270,6 +271,25 @@ def agreement() -> dict:
         rows = {"error": f"{exc!r}"[:300]}
     out["by_length"] = rows
     _log(f"agreement by length: {rows}")
+    # step by step from 1 to 2 ms (one launch): the first step whose end state differs
+    h = engine(batch[0]).step
+    steps = list(range(int(round(1e-3 / h)), int(round(2e-3 / h)) + 1))
+    fine = [dataclasses.replace(runs[0], duration=k * h) for k in steps]
+    first = {"step": h, "found": None}
+    try:
+        sols = ens.run_ensemble(fine, target="cuda").solutions
+        for k, sol, r in zip(steps, sols, fine, strict=True):
+            ref = engine(r)
+            dy = np.abs(np.asarray(sol.y_final) - np.asarray(ref.y_final))
+            if dy.max() > 1e-12 * np.abs(ref.y_final).max():
+                first["found"] = {"steps": k, "t": k * h, "worst_states": np.argsort(
+                    dy)[::-1][:4].tolist(), "relative": float(dy.max() / np.abs(
+                        ref.y_final).max()), "n_steps": [sol.n_steps, ref.n_steps]}
+                break
+    except Exception as exc:  # noqa: BLE001 - recorded
+        first["error"] = f"{exc!r}"[:300]
+    out["first_differing_step_1_to_2ms"] = first
+    _log(f"agreement, first differing step: {first}")
     r12 = batch[-2]
     s12 = r12.structure
     sp = np.array(s12.sp_par, dtype=float).reshape(-1, 6)
