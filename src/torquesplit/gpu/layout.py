@@ -287,77 +287,82 @@ length each) and batches of another length then reuse the compiled kernel."""
 
 
 def _scalars(L: Layout, c: CaseArrays) -> list[tuple[tuple, str, float]]:
-    """Every scalar parameter of one case: (name, kind, value), in a fixed order."""
+    """Every scalar parameter of one case: (name, kind, value), in a fixed order.  (The
+    arrays are read as Python lists: a numpy scalar a read made this 0.5 ms a case,
+    the largest part of a 10,000-case study's set-up.)"""
     m = c.model
     out: list[tuple[tuple, str, float]] = []
     add = out.append
-    for j in range(len(m.v_coef)):
-        add((("v", j), _D, m.v_coef[j]))
-    for j in range(len(m.vt_coef)):
-        add((("vt", j), _D, m.vt_coef[j]))
+    for j, v in enumerate(m.v_coef.tolist()):
+        add((("v", j), _D, v))
+    for j, v in enumerate(m.vt_coef.tolist()):
+        add((("vt", j), _D, v))
     tv = set(L.tv.tolist())
+    damping, e0 = m.damping.tolist(), m.error_constant.tolist()
+    k0, p0 = m.stiffness_table[:, 0].tolist(), m.force_table[:, 0].tolist()
+    gaps, gap_ptr = m.gap_values.tolist(), m.gap_ptr.tolist()
+    frequency, phase = m.frequency.tolist(), m.phase.tolist()
+    n_gaps, has_force = L.n_gaps.tolist(), L.has_force.tolist()
     for e in range(L.ne):
-        add((("damp", e), _D, m.damping[e]))
-        add((("E0", e), _D, m.error_constant[e]))
+        add((("damp", e), _D, damping[e]))
+        add((("E0", e), _D, e0[e]))
         if e not in tv:
-            add((("K0", e), _D, m.stiffness_table[e, 0]))
-        if e not in tv or not L.has_force[e]:
-            add((("P0", e), _D, m.force_table[e, 0]))
-        if L.n_gaps[e] == 1 or e not in tv:  # a static element keeps its first half-gap
-            add((("G0", e), _D, m.gap_values[m.gap_ptr[e]]))
+            add((("K0", e), _D, k0[e]))
+        if e not in tv or not has_force[e]:
+            add((("P0", e), _D, p0[e]))
+        if n_gaps[e] == 1 or e not in tv:  # a static element keeps its first half-gap
+            add((("G0", e), _D, gaps[gap_ptr[e]]))
         if e in tv:
-            add((("f", e), _T, m.frequency[e]))
-            add((("ph", e), _T, m.phase[e]))
+            add((("f", e), _T, frequency[e]))
+            add((("ph", e), _T, phase[e]))
+    ea, ew, ep = (m.error_amplitude.tolist(), m.error_omega.tolist(),
+                  m.error_phase.tolist())
     for i in range(L.n_sin):
-        add((("ea", i), _D, m.error_amplitude[i]))
-        add((("ew", i), _T, m.error_omega[i]))
-        add((("ep", i), _T, m.error_phase[i]))
+        add((("ea", i), _D, ea[i]))
+        add((("ew", i), _T, ew[i]))
+        add((("ep", i), _T, ep[i]))
+    im, ef, cg = m.inv_mass.tolist(), m.external_force.tolist(), m.ground_damping.tolist()
     for i in range(L.n):
-        add((("im", i), _D, m.inv_mass[i]))
-        add((("ef", i), _D, m.external_force[i]))
-        add((("cg", i), _D, m.ground_damping[i]))
-    for j in range(len(m.gy_coef)):
-        add((("gy", j), _D, m.gy_coef[j]))
-    for j in range(len(m.fs_coef)):
-        add((("fs", j), _D, m.fs_coef[j]))
-    for j in range(len(m.fr_coef)):
-        add((("frc", j), _D, m.fr_coef[j]))
-    for j in range(m.sp_par.shape[0]):
+        add((("im", i), _D, im[i]))
+        add((("ef", i), _D, ef[i]))
+        add((("cg", i), _D, cg[i]))
+    for j, v in enumerate(m.gy_coef.tolist()):
+        add((("gy", j), _D, v))
+    for j, v in enumerate(m.fs_coef.tolist()):
+        add((("fs", j), _D, v))
+    for j, v in enumerate(m.fr_coef.tolist()):
+        add((("frc", j), _D, v))
+    for j, row in enumerate(np.asarray(m.sp_par).reshape(-1, 6).tolist()
+                            if m.sp_par.shape[0] else []):
         for k in range(6):
-            add((("sp", j, k), _D, m.sp_par[j, k]))
-    add((("t0",), _T, c.t0))
-    add((("h",), _T, c.h))
-    add((("n_steps",), _I, c.n_steps))
-    add((("chunk",), _I, c.chunk))
-    add((("cap",), _I, c.cap))
-    for j in range(len(c.track)):
-        add((("base", j), _I, c.track_base[j]))
-    gmin = np.zeros(len(c.groups)) if c.group_min is None else c.group_min
+            add((("sp", j, k), _D, row[k]))
+    add((("t0",), _T, float(c.t0)))
+    add((("h",), _T, float(c.h)))
+    add((("n_steps",), _I, int(c.n_steps)))
+    add((("chunk",), _I, int(c.chunk)))
+    add((("cap",), _I, int(c.cap)))
+    for j, v in enumerate(np.asarray(c.track_base).tolist()[:len(c.track)]):
+        add((("base", j), _I, v))
+    gmin = [0.0] * len(c.groups) if c.group_min is None else np.asarray(
+        c.group_min, dtype=float).tolist()
     for k in range(len(c.groups)):
         add((("gmin", k), _T, gmin[k]))
     return out
 
 
-def _tables(L: Layout, c: CaseArrays) -> tuple[np.ndarray, ...]:
-    """The case's phase tables: stiffness and force rows of the time-varying elements
-    (force only where it has one), friction rows, the concatenated multi-value half-gap
-    sequences."""
-    m = c.model
+def _phase_tables(L: Layout, m) -> tuple[np.ndarray, ...]:
+    """A kernel model's phase tables: stiffness and force rows of the time-varying
+    elements (force only where it has one), friction rows."""
     tk = m.stiffness_table[L.tv]
     tf = m.force_table[[e for e in L.tv if L.has_force[e]]]
-    tfr = m.friction_table
+    return tk, tf, m.friction_table
+
+
+def _gap_sequences(L: Layout, m) -> np.ndarray:
+    """The multi-value half-gap sequences of the time-varying elements, concatenated."""
     multi = [int(e) for e in L.tv if L.n_gaps[e] > 1]
-    gs = (np.concatenate([m.gap_values[m.gap_ptr[e]:m.gap_ptr[e + 1]] for e in multi])
-          if multi else np.zeros(0))
-    return tk, tf, tfr, gs
-
-
-def _same(col: np.ndarray) -> bool:
-    """Every entry bit-for-bit equal (so -0.0 and 0.0 differ, as they may in the code)."""
-    if col.dtype.kind == "f":
-        bits = col.view(np.int64)
-        return bool(np.all(bits == bits[0]))
-    return bool(np.all(col == col[0]))
+    return (np.concatenate([m.gap_values[m.gap_ptr[e]:m.gap_ptr[e + 1]] for e in multi])
+            if multi else np.zeros(0))
 
 
 def build_group(cases: list[CaseArrays], indices: list[int], precision) -> Group:
@@ -372,35 +377,58 @@ def build_group(cases: list[CaseArrays], indices: list[int], precision) -> Group
     for row in per_case[1:]:  # same pattern: same catalogue (else a bug here)
         if [name for name, _, _ in row] != names:
             raise AssertionError("cases of one pattern gave different parameter lists")
+    # every case's values as one (cases x parameters) array per kind: the columns
+    # equal in every case bit for bit (-0.0 and 0.0 differ, as they may in the code)
+    # become literals
+    is_int = [kind == _I for kind in kinds]
+    fl = np.array([[v for (_, _, v), i in zip(row, is_int) if not i] for row in per_case],
+                  dtype=np.float64).reshape(len(per_case), -1)
+    it = np.array([[v for (_, _, v), i in zip(row, is_int) if i] for row in per_case],
+                  dtype=np.int64).reshape(len(per_case), -1)
+    bits = fl.view(np.int64)
+    same_f = (bits == bits[:1]).all(axis=0)
+    same_i = (it == it[:1]).all(axis=0)
     rows_d, rows_t, rows_i = [], [], []
-    for k, (name, kind) in enumerate(zip(names, kinds, strict=True)):
-        dtype = np.int64 if kind == _I else np.float64
-        col = np.array([row[k][2] for row in per_case], dtype=dtype)
-        if _same(col) and name[0] not in PER_CASE:
+    kf = ki = 0
+    for name, kind, i in zip(names, kinds, is_int, strict=True):
+        if i:
+            col, same, ki = it[:, ki], same_i[ki], ki + 1
+        else:
+            col, same, kf = fl[:, kf], same_f[kf], kf + 1
+        if same and name[0] not in PER_CASE:
             g.columns[name] = ("lit", col[0].item())
             continue
         target = {_D: rows_d, _T: rows_t, _I: rows_i}[kind]
         g.columns[name] = ({_D: "P", _T: "PT", _I: "PI"}[kind], len(target))
         target.append(col)
     n_c = len(indices)
-    # table sets, de-duplicated (a case reads set PI[tset])
-    sets: dict[bytes, int] = {}
-    by_object: dict[tuple, int] = {}  # cases that share the table objects: one look
+    # table sets, de-duplicated (a case reads set PI[tset]).  The phase tables are
+    # copied and compared once per table object (the cases of a study share them), the
+    # small gap sequences per case: a key of both made every case of a backlash Monte
+    # Carlo copy and hash its 12 MB of tables (1 ms a case, 4 ms on the H200's host)
+    sets: dict[tuple, int] = {}
+    by_object: dict[tuple, int] = {}  # table objects -> index in `phase`
+    by_content: dict[bytes, int] = {}
+    phase: list[tuple] = []
     tset = np.zeros(n_c, dtype=np.int64)
     tables = []
     for k, i in enumerate(indices):
         m = cases[i].model
-        ident = (id(m.stiffness_table), id(m.force_table), id(m.friction_table),
-                 m.gap_ptr.tobytes(), m.gap_values.tobytes())
-        if ident in by_object:  # the cases (and so the objects) live through this loop
-            tset[k] = by_object[ident]
-            continue
-        t = _tables(L, cases[i])
-        key = b"".join(np.ascontiguousarray(a, dtype=np.float64).tobytes() for a in t)
+        obj = (id(m.stiffness_table), id(m.force_table), id(m.friction_table))
+        b = by_object.get(obj)  # (the cases, and so the objects, live through the loop)
+        if b is None:
+            t = _phase_tables(L, m)
+            content = b"".join(np.ascontiguousarray(a, dtype=np.float64).tobytes()
+                               for a in t)
+            b = by_object[obj] = by_content.setdefault(content, len(phase))
+            if b == len(phase):
+                phase.append(t)
+        gs = _gap_sequences(L, m)
+        key = (b, np.ascontiguousarray(gs, dtype=np.float64).tobytes())
         if key not in sets:
             sets[key] = len(tables)
-            tables.append(t)
-        tset[k] = by_object[ident] = sets[key]
+            tables.append((*phase[b], gs))
+        tset[k] = sets[key]
     if len(tables) > 1:
         g.columns[("tset",)] = ("PI", len(rows_i))
         rows_i.append(tset)
