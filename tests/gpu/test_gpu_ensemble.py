@@ -208,3 +208,35 @@ def test_a_memo_value_goes_with_its_arrays():
     del a
     gc.collect()
     assert len(memo) == 0
+
+
+def test_a_launch_copies_the_phase_tables_once_per_table_memory(monkeypatch):
+    """Cases that share their table objects and differ in half-gaps (a backlash Monte
+    Carlo) make one table set, its tables copied once (each case copied and hashed its
+    12 MB of tables before); a case with other multi-value gap sequences makes a set of
+    its own."""
+    import dataclasses
+
+    from torquesplit.gpu import layout
+    from torquesplit.gpu.ensemble import case_arrays
+
+    run = example_run("ji_li_mill_drive", 2e-3)
+    s = run.structure
+    runs = [dataclasses.replace(run, structure=dataclasses.replace(
+        s, gap_values=s.gap_values * f)) for f in (1.0, 1.1, 1.2)]
+    calls = []
+    phase = layout._phase_tables
+    monkeypatch.setattr(layout, "_phase_tables", lambda L, m: calls.append(1) or phase(L, m))
+    cases = [case_arrays(r).case for r in runs]
+    g = layout.build_group(cases, [0, 1, 2], np.float64)
+    assert len(calls) == 1 and g.TK.shape[0] == 1 and g.columns[("tset",)] == ("lit", 0)
+    assert sum(1 for k, v in g.columns.items() if k[0] == "G0" and v[0] == "P") > 0
+    # multi-value gap sequences (the feature runs' pattern a): one set per sequence
+    a, a2 = feature_runs()[:2]
+    b = dataclasses.replace(a, structure=dataclasses.replace(
+        a.structure, gap_values=a.structure.gap_values * 0.5))
+    calls.clear()
+    cs = [case_arrays(r).case for r in (a, b, a)]
+    g = layout.build_group(cs, [0, 1, 2], np.float64)
+    assert len(calls) == 1 and g.TK.shape[0] == 2
+    assert g.PI[g.columns[("tset",)][1]].tolist() == [0, 1, 0]

@@ -407,15 +407,19 @@ def build_group(cases: list[CaseArrays], indices: list[int], precision) -> Group
     # small gap sequences per case: a key of both made every case of a backlash Monte
     # Carlo copy and hash its 12 MB of tables (1 ms a case, 4 ms on the H200's host)
     sets: dict[tuple, int] = {}
-    by_object: dict[tuple, int] = {}  # table objects -> index in `phase`
+    by_object: dict[tuple, int] = {}  # table memory -> index in `phase`
     by_content: dict[bytes, int] = {}
     phase: list[tuple] = []
     tset = np.zeros(n_c, dtype=np.int64)
     tables = []
     for k, i in enumerate(indices):
         m = cases[i].model
-        obj = (id(m.stiffness_table), id(m.force_table), id(m.friction_table))
-        b = by_object.get(obj)  # (the cases, and so the objects, live through the loop)
+        # the tables' memory, not their objects: a kernel model's view of its structure's
+        # table is a new object each time (the cases, and so the memory, live through
+        # the loop)
+        obj = tuple((a.__array_interface__["data"][0], a.shape, a.strides) for a in (
+            m.stiffness_table, m.force_table, m.friction_table))
+        b = by_object.get(obj)
         if b is None:
             t = _phase_tables(L, m)
             content = b"".join(np.ascontiguousarray(a, dtype=np.float64).tobytes()
