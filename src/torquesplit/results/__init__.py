@@ -1007,6 +1007,11 @@ def open_results(path):
             from ..errors import OutputError
 
             where = Path(path)
+            if (where / "study.sqlite").is_file():  # (study.store.STORE_NAME)
+                raise OutputError(
+                    f"{path}: a study's folder, not a run's results file; "
+                    f"torquesplit.study.load_results({str(path)!r}) gives the study's "
+                    f"Dataset (its results.nc)") from None
             what = ("a folder, not a results file" if where.is_dir() else
                     "no such file" if where.parent.is_dir() else
                     f"no such file (nor the folder {where.parent})")

@@ -331,7 +331,20 @@ def load_results(out):
     """The results Dataset of a finished study folder (``results.nc``)."""
     import xarray as xr
 
-    return xr.open_dataset(Path(out) / RESULTS_NAME, engine="h5netcdf")
+    from ..errors import OutputError
+
+    where = Path(out)
+    if where.is_file():
+        raise OutputError(f"{out}: a file, not a study's folder; a run's results file opens "
+                          f"with torquesplit.load_results({str(out)!r}), any torquesplit "
+                          f".nc file with torquesplit.open_results")
+    if not (where / RESULTS_NAME).is_file():
+        why = ("no such folder" if not where.is_dir() else
+               f"no {RESULTS_NAME} in it: the study has not finished (run it again with "
+               f"resume=True, or --resume)" if (where / STORE_NAME).is_file() else
+               "not a study's folder (no study.sqlite)")
+        raise OutputError(f"{out}: {why}")
+    return xr.open_dataset(where / RESULTS_NAME, engine="h5netcdf")
 
 
 # ============================================================================ store
