@@ -54,9 +54,9 @@ def output_budget(target: str) -> int:
     memory (the outputs come back, and each case's Solution copies its share) and, on a
     CUDA device, half of its free memory.  Fewer, larger launches are faster: a GPU
     runs the cases of one launch side by side (Ji & Li's drive, 10 s a case: 0.53 MB
-    of per-cycle statistics a case, 5.3 GB for 10,000 cases; under a fixed 2 GB they
-    were three launches, 32.4 s of kernel on an H200, where 1,000 cases in one had
-    taken 6.4 s)."""
+    of per-cycle statistics a case, 5.3 GB for 10,000 cases; under a fixed 2 GB and the
+    runner's old first batch they were five launches, 32.4 s of kernel on an H200, 6.5 s
+    a launch, where 1,000 cases in one had taken 6.4 s)."""
     budget = []
     try:
         with open("/proc/meminfo") as f:
