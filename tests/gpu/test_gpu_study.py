@@ -199,6 +199,31 @@ def test_cases_set_up_in_worker_processes_give_the_same_dataset():
         GpuRunner(workers=0)
 
 
+def test_the_kernel_compiles_while_workers_set_up_the_next_cases(monkeypatch):
+    """With set-up workers, the kernel of the first chunk compiles while the workers
+    set up the next chunk; a Monte Carlo's launch then runs the source compiled ahead
+    (the same generated text), with the values of a runner that compiles at launch."""
+    from torquesplit.gpu import backend, compile as comp, ensemble
+
+    spec = {**GRID, "analysis": {"duration": "0.02 s"}}
+    del spec["grid"]
+    spec["monte_carlo"] = {"samples": 5, "seed": 3, "sampling": "random", "parameters": [
+        {"paths": ["meshes.*.backlash"], "distribution": "uniform", "low": "0.3 mm",
+         "high": "0.9 mm"},
+        {"paths": ["meshes.*.damping_ratio"], "distribution": "uniform", "low": 0.05,
+         "high": 0.15}]}
+    monkeypatch.setattr(backend, "FIRST_BATCH", 2)
+    texts = []
+    driver = comp.cpu_driver
+    monkeypatch.setattr(ensemble, "cpu_driver", lambda src, **kw: texts.append(src.text)
+                        or driver(src, **kw))
+    runner = GpuRunner(target="cpu", workers=2)
+    ds = torquesplit.Study(spec).run(runner=runner)
+    assert runner.report["compile_ahead_s"] > 0 and runner.report["ensembles"] == 1
+    assert len(texts) == 2 and texts[0] == texts[1]  # ahead (2 cases), launch (5)
+    _same(torquesplit.Study(spec).run(runner=GpuRunner(target="cpu")), ds)
+
+
 def test_workers_send_a_table_set_once_and_the_cases_share_it(monkeypatch):
     """Ji & Li's cases carry 14 MB of phase tables each; a pool worker sends a table set
     the first time and then runs without it, and the runner puts the one set back: every

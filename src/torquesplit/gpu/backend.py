@@ -24,6 +24,7 @@ to the store's metadata and the dataset's attributes by :meth:`Study.run`).
 from __future__ import annotations
 
 import dataclasses
+import functools
 import hashlib
 import itertools
 import logging
@@ -123,6 +124,7 @@ class GpuRunner:
         self._pool = None
         self._tables: OrderedDict = OrderedDict()  # table sets workers sent (bounded)
         self._case_bytes = 0.0  # host memory of a case's own tables (measured per batch)
+        self._compiled_ahead = False
         self.device = ""
         self.report: dict = {"backend": "gpu", "target": target, "precision": precision,
                              "cases": 0, "ensembles": 0, "kernel_time_s": 0.0,
@@ -157,15 +159,39 @@ class GpuRunner:
             chunk = [_Job(p, self._worker()) for p in itertools.islice(it, want)]
             if not chunk:
                 break
+            ahead = None
+            if jobs and not self._compiled_ahead:
+                ahead = functools.partial(self._compile_ahead, list(jobs))
             t = time.perf_counter()
-            self._prepare(chunk, True)
+            self._prepare(chunk, True, ahead)
             self.report["prepare_time_s"] += time.perf_counter() - t
             jobs += chunk
             self._measure_tables(jobs)
         return jobs
 
-    def _prepare(self, jobs: list["_Job"], first: bool) -> None:
-        """Set the jobs' next runs up, in a process pool when ``workers`` > 1."""
+    def _compile_ahead(self, jobs: list["_Job"]) -> None:
+        """Compile the kernel of the cases set up so far while the workers set up the
+        next ones: the launch finds it compiled where its cases vary the parameters
+        these vary (a Monte Carlo's do), and the compile (about 20 s for a 14-DOF model)
+        overlaps the set-up instead of following it.  Once per runner; a failure is
+        left to the launch, which compiles (and reports) for itself."""
+        from .ensemble import compile_ahead
+
+        self._compiled_ahead = True
+        runs = [j.run for j in jobs if j.run is not None and not j.finished]
+        if not runs:
+            return
+        t = time.perf_counter()
+        try:
+            compile_ahead(runs, target=self.target, precision=self.precision)
+        except Exception as exc:  # noqa: BLE001 - the launch compiles and reports it
+            log.debug("compiling ahead failed: %r", exc)
+            return
+        self.report["compile_ahead_s"] = time.perf_counter() - t
+
+    def _prepare(self, jobs: list["_Job"], first: bool, meanwhile=None) -> None:
+        """Set the jobs' next runs up, in a process pool when ``workers`` > 1 (calling
+        ``meanwhile()`` while the workers work)."""
         args = [(j.p, None if first else j.length) for j in jobs]
         if self.workers > 1 and len(jobs) > 1:
             if self._pool is None:
@@ -178,8 +204,11 @@ class GpuRunner:
                     self.workers, mp_context=multiprocessing.get_context("spawn"),
                     initializer=worker_start)
             chunk = max(1, len(jobs) // (4 * self.workers))
-            results = list(self._pool.map(prepare_case, *zip(*args), [True] * len(args),
-                                          chunksize=chunk))
+            pending = self._pool.map(prepare_case, *zip(*args), [True] * len(args),
+                                     chunksize=chunk)  # (submitted: the workers start)
+            if meanwhile is not None:
+                meanwhile()
+            results = list(pending)
             self._attach_tables(results, args)
         else:
             results = [prepare_case(p, length) for p, length in args]

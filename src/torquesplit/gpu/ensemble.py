@@ -36,8 +36,8 @@ from .compile import (LAST_BINDING, cpu_driver, cuda_available, cuda_kernel,
 from .layout import CaseArrays, IdentityMemo, build_group, group_cases, unknown_fields
 from .source import N_STAT, kernel_source
 
-__all__ = ["EnsembleResult", "case_arrays", "run_ensemble", "TARGETS", "PRECISIONS",
-           "BLOWUP"]
+__all__ = ["EnsembleResult", "case_arrays", "compile_ahead", "run_ensemble", "TARGETS",
+           "PRECISIONS", "BLOWUP"]
 
 TARGETS = ("cuda", "cpu")
 PRECISIONS = ("fp64", "fp32")
@@ -303,6 +303,25 @@ def run_ensemble(runs, *, target: str = "cuda", precision: str = "fp64",
         out.patterns += 1
     out.sample_steps = int(sum(s.n_steps for s in out.solutions))
     return out
+
+
+def compile_ahead(runs, *, target: str = "cuda", precision: str = "fp64") -> None:
+    """Compile the kernel of each pattern of ``runs`` as :func:`run_ensemble` would for
+    one launch of them, without running it (kept in the compiled-kernel cache: a later
+    launch whose generated source is the same, e.g. more cases of a Monte Carlo, finds
+    it)."""
+    cases = [case_arrays(r).case for r in runs]
+    dtype = np.float32 if precision == "fp32" else np.float64
+    for indices in group_cases(cases).values():
+        g = build_group(cases, indices, dtype)
+        src = kernel_source(g, precision)
+        if target == "cuda":
+            cuda_kernel(src)
+            continue
+        # the CPU driver compiles at its first call: a call with no case
+        fn = cpu_driver(src)
+        fn(0, g.P, g.PT, g.PI, g.Y0, g.TK, g.TF, g.TFR, g.GS, g.CN,
+           np.empty((0, src.n_of)), np.empty((0, src.n_oi), dtype=np.int64))
 
 
 def _launch(fn, target, g, src, threads_per_block):
