@@ -70,9 +70,9 @@ def test_one_launch_holds_every_case_the_table_budget_allows(monkeypatch):
     chunks = []
     prepare = GpuRunner._prepare
 
-    def counted(self, jobs, first):
+    def counted(self, jobs, first, meanwhile=None):
         chunks.append((len(jobs), first))
-        return prepare(self, jobs, first)
+        return prepare(self, jobs, first, meanwhile)
 
     monkeypatch.setattr(GpuRunner, "_prepare", counted)
     one = GpuRunner(target="cpu")
