@@ -287,9 +287,8 @@ length each) and batches of another length then reuse the compiled kernel."""
 
 
 def _scalars(L: Layout, c: CaseArrays) -> list[tuple[tuple, str, float]]:
-    """Every scalar parameter of one case: (name, kind, value), in a fixed order.  (The
-    arrays are read as Python lists: a numpy scalar a read made this 0.5 ms a case,
-    the largest part of a 10,000-case study's set-up.)"""
+    """Every scalar parameter of one case: (name, kind, value), in a fixed order (the
+    arrays read as Python lists, not a numpy scalar a value)."""
     m = c.model
     out: list[tuple[tuple, str, float]] = []
     add = out.append
@@ -403,9 +402,10 @@ def build_group(cases: list[CaseArrays], indices: list[int], precision) -> Group
         target.append(col)
     n_c = len(indices)
     # table sets, de-duplicated (a case reads set PI[tset]).  The phase tables are
-    # copied and compared once per table object (the cases of a study share them), the
+    # copied and compared once per table memory (the cases of a study share it), the
     # small gap sequences per case: a key of both made every case of a backlash Monte
-    # Carlo copy and hash its 12 MB of tables (1 ms a case, 4 ms on the H200's host)
+    # Carlo copy and hash its 12 MB of tables (1 ms a case here; the H200 host's whole
+    # set-up was 4 ms a case)
     sets: dict[tuple, int] = {}
     by_object: dict[tuple, int] = {}  # table memory -> index in `phase`
     by_content: dict[bytes, int] = {}
