@@ -218,8 +218,18 @@ def test_the_kernel_compiles_while_workers_set_up_the_next_cases(monkeypatch):
     monkeypatch.setattr(ensemble, "cpu_driver", lambda src, **kw: texts.append(src.text)
                         or driver(src, **kw))
     runner = GpuRunner(target="cpu", workers=2)
-    ds = torquesplit.Study(spec).run(runner=runner)
+    seen = []
+    ds = torquesplit.Study(spec).run(runner=runner, progress=seen.append)
     assert runner.report["compile_ahead_s"] > 0 and runner.report["ensembles"] == 1
+    # the progress callback hears what the runner does before the launch's cases finish
+    stages = [p.stage for p in seen if p.stage]
+    assert stages == ["2 cases set up for the next launch",
+                      "compiling the kernel while the next cases are set up (once a model "
+                      "pattern: about 20 s for a 14-DOF model)",
+                      "4 cases set up for the next launch", "5 cases set up for the next "
+                      "launch", "running 5 cases together (generated code, CPU)",
+                      "the outputs of 5 cases"]
+    assert all(p.done == 0 for p in seen if p.stage) and seen[-1].done == 5
     assert len(texts) == 2 and texts[0] == texts[1]  # ahead (2 cases), launch (5)
     _same(torquesplit.Study(spec).run(runner=GpuRunner(target="cpu")), ds)
 

@@ -302,3 +302,24 @@ def test_a_study_logged_to_a_file_says_its_progress_in_lines():
                      f"cases 5/10 (1 not ok), 0:00:{5 + int(LOG_EVERY)} elapsed, about "
                      f"0:00:{5 + int(LOG_EVERY)} left",
                      "cases 10/10 (1 not ok), 0:01:40 elapsed"]
+
+
+def test_a_logged_study_says_what_the_gpu_runner_does_between_cases():
+    """A GPU study finishes no case until a launch ends (set-up, compile and kernel of
+    thousands of cases): its stages are lines too, at most every LOG_EVERY seconds."""
+    from types import SimpleNamespace as P
+
+    from torquesplit.study.cli import LOG_EVERY, progress_lines
+
+    now = [0.0]
+    lines = []
+    cb = progress_lines(lines.append, clock=lambda: now[0])
+    cb(P(done=0, total=10, failed=0, stage=""))
+    for t, stage in ((1.0, "64 cases set up"), (2.0, "compiling"), (3.0 + LOG_EVERY, "run")):
+        now[0] = t
+        cb(P(done=0, total=10, failed=0, stage=stage))
+    now[0] = 100.0
+    cb(P(done=10, total=10, failed=0, stage=""))
+    assert lines == ["64 cases set up (0:00:01 elapsed)",
+                     f"run (0:00:{3 + int(LOG_EVERY)} elapsed)",
+                     "cases 10/10 (0 not ok), 0:01:40 elapsed"]

@@ -33,6 +33,7 @@ import os
 import time
 import warnings
 from collections import OrderedDict
+from typing import Callable
 
 import numpy as np
 
@@ -125,6 +126,8 @@ class GpuRunner:
         self._tables: OrderedDict = OrderedDict()  # table sets workers sent (bounded)
         self._case_bytes = 0.0  # host memory of a case's own tables (measured per batch)
         self._compiled_ahead = False
+        #: told what the runner does between finished cases (the study's progress sets it)
+        self.on_stage: Callable[[str], None] | None = None
         self.device = ""
         self.report: dict = {"backend": "gpu", "target": target, "precision": precision,
                              "cases": 0, "ensembles": 0, "kernel_time_s": 0.0,
@@ -167,7 +170,12 @@ class GpuRunner:
             self.report["prepare_time_s"] += time.perf_counter() - t
             jobs += chunk
             self._measure_tables(jobs)
+            self._say(f"{len(jobs)} cases set up for the next launch")
         return jobs
+
+    def _say(self, text: str) -> None:
+        if self.on_stage is not None:
+            self.on_stage(text)
 
     def _compile_ahead(self, jobs: list["_Job"]) -> None:
         """Compile the kernel of the cases set up so far while the workers set up the
@@ -181,6 +189,8 @@ class GpuRunner:
         runs = [j.run for j in jobs if j.run is not None and not j.finished]
         if not runs:
             return
+        self._say("compiling the kernel while the next cases are set up (once a model "
+                  "pattern: about 20 s for a 14-DOF model)")
         t = time.perf_counter()
         try:
             compile_ahead(runs, target=self.target, precision=self.precision)
@@ -280,7 +290,10 @@ class GpuRunner:
         from .ensemble import run_ensemble
 
         runs = [j.run for j in jobs]
+        self._say(f"running {len(runs)} cases together "
+                  f"{'on the GPU' if self.target == 'cuda' else '(generated code, CPU)'}")
         res = run_ensemble(runs, target=self.target, precision=self.precision)
+        self._say(f"the outputs of {len(runs)} cases")
         self.device = res.device
         r = self.report
         r["device"] = res.device

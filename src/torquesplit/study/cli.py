@@ -276,12 +276,17 @@ def progress_lines(write, clock=None):
     import time
 
     clock = clock or time.monotonic
-    state = {"start": None, "last": None}
+    state = {"start": None, "last": None, "stage": None}
 
     def cb(p):
         now = clock()
         if state["start"] is None:
             state["start"] = (now, p.done)
+            return
+        if getattr(p, "stage", ""):  # what a runner does between cases (the GPU runner's)
+            if state["stage"] is None or now - state["stage"] >= LOG_EVERY:
+                state["stage"] = now
+                write(f"{p.stage} ({_clock_text(now - state['start'][0])} elapsed)")
             return
         due = state["last"] is None or now - state["last"] >= LOG_EVERY or p.done >= p.total
         if not due or p.done <= state["start"][1]:
@@ -317,8 +322,9 @@ def _with_bar(job, total: int, quiet: bool):
     ui = _ui()
     bar = Progress(TextColumn("cases"), BarColumn(), MofNCompleteColumn(),
                    TextColumn("[red]{task.fields[failed]} not ok"), TimeElapsedColumn(),
-                   TextColumn("ETA"), _eta_column(), console=ui.err_console,
-                   transient=False)
+                   TextColumn("ETA"), _eta_column(),
+                   TextColumn("{task.fields[stage]}", style="dim", markup=False),
+                   console=ui.err_console, transient=False)
     # the bar shows from the first report: a study refused before it starts (its folder
     # holds another study) draws no empty bar above the error
     task, start = [], []
@@ -327,10 +333,12 @@ def _with_bar(job, total: int, quiet: bool):
         now = time.monotonic()
         if not task:
             bar.start()
-            task.append(bar.add_task("study", total=total, failed=0, finish=None))
+            task.append(bar.add_task("study", total=total, failed=0, finish=None,
+                                     stage=""))
             start.append((now, p.done))
         bar.update(task[0], completed=p.done, total=p.total, failed=p.failed,
-                   finish=eta_finish(start[0], now, p.done, p.total))
+                   finish=eta_finish(start[0], now, p.done, p.total),
+                   stage=getattr(p, "stage", ""))
 
     try:
         return job(cb)

@@ -16,6 +16,7 @@ pool, a Dask cluster; see :mod:`torquesplit.study.runners`):
 
 from __future__ import annotations
 
+import functools
 import json
 import logging
 import math
@@ -83,6 +84,9 @@ class Progress:
     """Seconds since this run started."""
     last: dict | None
     """The case that just finished (index, status, reason, values...); None at the start."""
+    stage: str = ""
+    """What the runner is doing while no case finishes (the GPU runner: setting cases up,
+    compiling its kernel, running a launch); empty with a finished case."""
 
 
 class Study:
@@ -562,6 +566,8 @@ class _Driver:
         try:
             # (inside: a Ctrl-C while the workers start is a stop like any other, with the
             # store's run closed and the hint to resume)
+            if self.progress is not None and hasattr(self.runner, "on_stage"):
+                self.runner.on_stage = functools.partial(self._stage, t0)
             results = self.runner(run_case, self._payloads())
             # the cases start: a progress bar shows at once (a first case compiles)
             if self.progress is not None:
@@ -614,6 +620,12 @@ class _Driver:
                 return
             if not self.finished[i]:
                 yield payload(i, self.plan, d.overrides(i))
+
+    def _stage(self, t0: float, text: str) -> None:
+        """The runner's report of what it is doing between finished cases."""
+        self.progress(Progress(int(self.finished[: self._target()].sum()), self.failed,
+                               self._target(), self.computed, time.perf_counter() - t0,
+                               None, stage=text))
 
     def _note(self, r: dict) -> None:
         i = int(r["index"])
