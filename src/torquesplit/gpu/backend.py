@@ -2,10 +2,12 @@
 
 A runner of :mod:`torquesplit.study.runners` is a callable ``runner(function, payloads)``
 that yields one result dict per case.  :class:`GpuRunner` is one: it takes the payloads
-in batches, sets every case up on the CPU exactly as a CPU worker would (the study's
+in batches (as many cases as ``batch`` and the phase tables' memory allow, set up in
+chunks), sets every case up on the CPU exactly as a CPU worker would (the study's
 overrides, :func:`torquesplit.simulation.prepare_run`: structure, static equilibrium as
-initial state, step), integrates the batch as one ensemble
-(:func:`torquesplit.gpu.ensemble.run_ensemble`), and turns each case's Solution into the
+initial state, step), compiles the batch's kernel while its last chunks are set up,
+integrates the batch as one ensemble (:func:`torquesplit.gpu.ensemble.run_ensemble`:
+one launch where the memory allows it), and turns each case's Solution into the
 same result dict as :func:`torquesplit.study.case.run_case` through the study's own
 functions (``output_values``, the status and contact-loss rules of
 :mod:`torquesplit.study.case`).  The driver, the store and the dataset are the CPU
@@ -95,7 +97,8 @@ class GpuRunner:
     target : {"cuda", "cpu"}
         ``"cpu"`` runs the same generated code on the CPU (tests, no device needed).
     batch : int
-        Cases per ensemble.
+        Cases per ensemble at most (fewer where their phase tables would pass
+        TABLE_BUDGET).
     check_cases : int
         FP32 only: cases also run in FP64 to report the FP32 error.
     workers : int
