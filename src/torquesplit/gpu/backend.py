@@ -5,7 +5,7 @@ that yields one result dict per case.  :class:`GpuRunner` is one: it takes the p
 in batches (as many cases as ``batch`` and the phase tables' memory allow, set up in
 chunks), sets every case up on the CPU exactly as a CPU worker would (the study's
 overrides, :func:`torquesplit.simulation.prepare_run`: structure, static equilibrium as
-initial state, step), compiles the batch's kernel while its last chunks are set up,
+initial state, step), compiles the first chunk's kernel while the next is set up,
 integrates the batch as one ensemble (:func:`torquesplit.gpu.ensemble.run_ensemble`:
 one launch where the memory allows it), and turns each case's Solution into the
 same result dict as :func:`torquesplit.study.case.run_case` through the study's own
