@@ -50,6 +50,7 @@ def test_every_feature_equals_the_engine():
     assert res.sample_steps == sum(s.n_steps for s in res.solutions)
     # one case a launch (the outputs over the budget): each case's row, the same bits
     each = run_ensemble(runs, target="cpu", max_output_bytes=1)
+    assert (res.launches, each.launches) == (2, 4)  # one a pattern; one a case
     assert [compare(a, b) for a, b in zip(each.solutions, res.solutions, strict=True)] == [
         []] * 4
 

@@ -79,6 +79,7 @@ def test_one_launch_holds_every_case_the_table_budget_allows(monkeypatch):
     ds_one = torquesplit.Study(spec).run(runner=one)
     assert chunks == [(2, True), (2, True), (1, True)]
     assert one.report["ensembles"] == 1 and one.report["cases"] == 5
+    assert one.report["launches"] == 1
     monkeypatch.setattr(backend, "TABLE_BUDGET", 0)  # room for FIRST_BATCH cases only
     chunks.clear()
     small = GpuRunner(target="cpu")

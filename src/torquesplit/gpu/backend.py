@@ -133,7 +133,8 @@ class GpuRunner:
         self.on_stage: Callable[[str], None] | None = None
         self.device = ""
         self.report: dict = {"backend": "gpu", "target": target, "precision": precision,
-                             "cases": 0, "ensembles": 0, "kernel_time_s": 0.0,
+                             "cases": 0, "ensembles": 0, "launches": 0,
+                             "kernel_time_s": 0.0,
                              "compile_time_s": 0.0, "setup_time_s": 0.0, "post_time_s": 0.0,
                              "prepare_time_s": 0.0, "metrics_time_s": 0.0,
                              "sample_steps": 0}
@@ -305,6 +306,7 @@ class GpuRunner:
         if res.binding_errors:
             r["law_binding_errors"] = res.binding_errors
         r["ensembles"] += 1
+        r["launches"] += res.launches
         r["cases"] += len(runs)
         r["kernel_time_s"] += res.kernel_time
         r["compile_time_s"] += res.compile_time

@@ -109,6 +109,8 @@ class EnsembleResult:
     :mod:`torquesplit.gpu.compile`); empty for the CPU target."""
     binding_errors: list[str] = field(default_factory=list)
     """Why the bindings tried before it did not compile."""
+    launches: int = 0
+    """Kernel launches (a pattern's cases split where their outputs pass the budget)."""
 
 
 def check_supported(run) -> None:
@@ -293,6 +295,7 @@ def run_ensemble(runs, *, target: str = "cuda", precision: str = "fp64",
             out.lines.append(src.n_lines)
             t = time.perf_counter()
             OF, OI = _launch(fn, target, g, src, threads_per_block)
+            out.launches += 1
             out.kernel_time += time.perf_counter() - t
             t = time.perf_counter()
             share = (out.kernel_time / max(len(part), 1))
