@@ -321,14 +321,13 @@ def compile_ahead(runs, *, target: str = "cuda", precision: str = "fp64") -> Non
         if target == "cuda":
             cuda_kernel(src)
             continue
-        # the CPU driver compiles at its first call: a call with no case
-        fn = cpu_driver(src)
-        fn(0, g.P, g.PT, g.PI, g.Y0, g.TK, g.TF, g.TFR, g.GS, g.CN,
-           np.empty((0, src.n_of)), np.empty((0, src.n_oi), dtype=np.int64))
+        _launch(cpu_driver(src), "cpu", g, src, n_cases=0)  # (compiles at its first call)
 
 
-def _launch(fn, target, g, src, threads_per_block):
-    n_c = g.n_cases
+def _launch(fn, target, g, src, threads_per_block=THREADS_PER_BLOCK, n_cases=None):
+    """Run the kernel on the group's cases (``n_cases`` of them: default all; 0 runs
+    none, which compiles the CPU driver); the outputs, one row a case."""
+    n_c = g.n_cases if n_cases is None else n_cases
     args = (g.P, g.PT, g.PI, g.Y0, g.TK, g.TF, g.TFR, g.GS, g.CN)
     if target == "cpu":
         OF = np.empty((n_c, src.n_of))

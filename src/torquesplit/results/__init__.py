@@ -1006,8 +1006,10 @@ def open_results(path):
         if not Path(path).is_file():
             from ..errors import OutputError
 
+            from ..study.store import STORE_NAME
+
             where = Path(path)
-            if (where / "study.sqlite").is_file():  # (study.store.STORE_NAME)
+            if (where / STORE_NAME).is_file():
                 raise OutputError(
                     f"{path}: a study's folder, not a run's results file; "
                     f"torquesplit.study.load_results({str(path)!r}) gives the study's "

@@ -347,7 +347,8 @@ def critical_speeds(structure, q, kin, model, w_lo, w_hi, orders=None):
     sol = modal_analysis(structure, q)
     w_ref = reference_speed(model)
     lines = _order_lines(kin, model, orders, structure)
-    strength = _line_strength(kin, structure, lines, w_ref, q)
+    cycles: dict = {}  # mesh element -> its MeshCycle about q (each computed once)
+    strength = _line_strength(kin, structure, lines, w_ref, q, cycles)
     phasing = _Phasing(model, kin)
     types = phasing.types(structure, sol)
     out = []
@@ -360,7 +361,7 @@ def critical_speeds(structure, q, kin, model, w_lo, w_hi, orders=None):
                 out.append(_cancellation(structure, q, sol, phasing.groups, phasing.mark(dict(
                     mode=i + 1, frequency_Hz=float(fn), order=order, source=label,
                     speed_rpm=float(w * RPM), energy=sol.dominant_elements(i, 4),
-                    **_strength_of(strength, label, order)), types)))
+                    **_strength_of(strength, label, order)), types), cycles))
     out.sort(key=lambda c: c["speed_rpm"])
     return dict(natural_frequencies=sol.frequencies, crossings=out, modal=sol,
                 lines=lines, reference_speed=w_ref, strength=strength)
@@ -482,7 +483,16 @@ def mesh_cycle(structure, q, e: int) -> MeshCycle | None:
                      force=table * h)
 
 
-def _mesh_force_harmonics(kin, structure, lines, q) -> dict:
+def _cycle_of(cycles: dict | None, structure, q, e: int) -> MeshCycle | None:
+    """:func:`mesh_cycle` of element ``e``, kept in ``cycles`` (one structure and q)."""
+    if cycles is None:
+        return mesh_cycle(structure, q, e)
+    if e not in cycles:
+        cycles[e] = mesh_cycle(structure, q, e)
+    return cycles[e]
+
+
+def _mesh_force_harmonics(kin, structure, lines, q, cycles=None) -> dict:
     """(line label, order) -> amplitude of that harmonic of the static mesh force
     (:func:`mesh_cycle`) over its mean, the largest over the group's meshes:
     the stiffness harmonic and the transmission error's force taken together, with
@@ -491,13 +501,13 @@ def _mesh_force_harmonics(kin, structure, lines, q) -> dict:
         return {}
 
     def force(e):
-        cyc = mesh_cycle(structure, q, e)
+        cyc = _cycle_of(cycles, structure, q, e)
         return None if cyc is None else cyc.force
 
     return _largest_harmonics(kin, structure, lines, force)
 
 
-def _line_strength(kin, structure, lines, w_ref: float, q=None) -> dict:
+def _line_strength(kin, structure, lines, w_ref: float, q=None, cycles=None) -> dict:
     """(line label, order) -> how the model drives that line: ``stiffness_harmonic``
     (:func:`_stiffness_harmonics`), ``error_share`` / ``error_mesh``
     (:func:`_error_shares`) and, with the static deflection ``q``, ``force_harmonic``
@@ -507,7 +517,7 @@ def _line_strength(kin, structure, lines, w_ref: float, q=None) -> dict:
         out.setdefault(key, {})["stiffness_harmonic"] = v
     for key, (share, mesh) in _error_shares(kin, structure, lines, w_ref).items():
         out.setdefault(key, {}).update(error_share=share, error_mesh=mesh)
-    for key, v in _mesh_force_harmonics(kin, structure, lines, q).items():
+    for key, v in _mesh_force_harmonics(kin, structure, lines, q, cycles).items():
         out.setdefault(key, {})["force_harmonic"] = v
     return out
 
@@ -522,7 +532,8 @@ def _strength_of(strength: dict, label: str, order: int) -> dict:
 CANCELLED = 1e-6
 
 
-def _modal_force_share(structure, q, shape, meshes, order: int) -> float | None:
+def _modal_force_share(structure, q, shape, meshes, order: int,
+                       cycles=None) -> float | None:
     """How much of the ``order``-th harmonic of the meshes' static forces reaches a mode
     (``shape``: its displacement part): |sum_m a_m| / sum_m |a_m| with
     a_m = F_m e^(2 pi i order phase_m) (V_m . shape), F_m that harmonic of mesh m's
@@ -539,7 +550,7 @@ def _modal_force_share(structure, q, shape, meshes, order: int) -> float | None:
         if m not in names:
             continue
         e = names.index(m)
-        cyc = mesh_cycle(structure, q, e)
+        cyc = _cycle_of(cycles, structure, q, e)
         if cyc is None or order >= cyc.force.size // 2:
             continue
         f = cyc.force
@@ -553,7 +564,7 @@ def _modal_force_share(structure, q, shape, meshes, order: int) -> float | None:
     return float(abs(sum(a)) / total)
 
 
-def _cancellation(structure, q, sol, groups: dict, crossing: dict) -> dict:
+def _cancellation(structure, q, sol, groups: dict, crossing: dict, cycles=None) -> dict:
     """``stiffness_cancelled`` (and the share, :func:`_modal_force_share`) of a crossing
     of a mesh line whose force harmonic (stiffness and transmission error) would drive
     it, True where the meshes' forces cancel on the mode: a reviewer's Campbell
@@ -567,8 +578,9 @@ def _cancellation(structure, q, sol, groups: dict, crossing: dict) -> dict:
     f = np.asarray(sol.frequencies, dtype=float)
     i = crossing["mode"] - 1
     group = np.flatnonzero(np.abs(f - f[i]) <= 1e-6 * abs(f[i]))
+    cycles = {} if cycles is None else cycles  # (the group's modes share the meshes')
     shares = [_modal_force_share(structure, q, sol.mode_shapes[:, j], meshes,
-                                 crossing["order"]) for j in group]
+                                 crossing["order"], cycles) for j in group]
     known = [x for x in shares if x is not None]
     share = max(known) if known else None
     crossing["modal_force_share"] = share

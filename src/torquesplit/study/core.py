@@ -346,7 +346,7 @@ def load_results(out):
         why = ("no such folder" if not where.is_dir() else
                f"no {RESULTS_NAME} in it: the study has not finished (run it again with "
                f"resume=True, or --resume)" if (where / STORE_NAME).is_file() else
-               "not a study's folder (no study.sqlite)")
+               f"not a study's folder (no {STORE_NAME})")
         raise OutputError(f"{out}: {why}")
     return xr.open_dataset(where / RESULTS_NAME, engine="h5netcdf")
 
