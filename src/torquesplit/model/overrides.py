@@ -72,8 +72,6 @@ def set_parameter(data: dict, path: str, value: Any) -> dict:
             for key in [k for k, methods in STIFFNESS_FIELD_METHODS.items()
                         if value not in methods]:
                 node.pop(key, None)
-            if value != "ltca":
-                node.pop("ltca", None)
         node[last] = (_merged(old, value) if len(parts) > 1 and _merges(old, value)
                       else value)
     else:

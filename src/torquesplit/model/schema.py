@@ -593,9 +593,6 @@ class StiffnessSpec(Strict):
         if m == "fourier" and self.mean is None:
             raise FieldError("mean", "method 'fourier' needs the mean stiffness; add "
                              "mean = '4e8 N/m' (your value)")
-        if m != "ltca" and self.ltca != LtcaSpec():
-            raise FieldError("ltca", f"applies to method 'ltca' only, the method is {m!r}; set "
-                             "method = 'ltca' or remove the ltca table")
         # a field of another method is refused, not dropped (a reviewer's
         # {method = "iso6336", value = "1 N/m"} ran at the ISO stiffness without a word)
         # (a value other than the default: a table written back whole, as a [[planetary]]
@@ -604,7 +601,7 @@ class StiffnessSpec(Strict):
             if m not in methods and getattr(self, name) != type(self).model_fields[name].default:
                 raise FieldError(name, (
                     f"applies to method {' or '.join(repr(x) for x in methods)} only, the "
-                    f"method is {m!r}: remove it (on the command line, --set "
+                    f"method is {m!r}; remove it (on the command line, --set "
                     f"meshes.NAME.stiffness.method={m} drops the old method's fields)"))
         return self
 
@@ -614,6 +611,7 @@ STIFFNESS_FIELD_METHODS = {
     "value": ("constant",), "peak_to_peak": ("constant",), "phase": ("table",),
     "values": ("table",), "mean": ("fourier",), "cos": ("fourier",), "sin": ("fourier",),
     "fillet_foundation": ("potential_energy", "ltca"), "slices": ("potential_energy", "ltca"),
+    "ltca": ("ltca",),
 }
 
 
