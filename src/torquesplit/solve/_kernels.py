@@ -590,6 +590,24 @@ def ratio_sample(slot, i_f, w, r):
                         rat_min[c, j] = ratio
 
 
+@_callee
+def enter_instant(t, kink, full, slot, i_f, m, w, r):
+    """The statistics of an instant beyond the force's max and min: with ``full`` (an
+    instant of the time record: a step sample or an RK4 corner) the peak between the
+    instants (:func:`peak_sample`, ``kink`` whether this instant is a corner), the
+    ratio at the cycle starts passed (:func:`ratio_starts`) and the cycle means
+    (:func:`mean_sample`), in that order (the last two read the last instant, which
+    mean_sample replaces); always the instantaneous ratio (:func:`ratio_sample`).  One
+    compiled callee for :func:`record` and :func:`record_extrema` (inlined into each
+    of their callers, numba compiled these four once per call site: seconds of cold
+    compile each)."""
+    if full != 0:
+        peak_sample(t, kink, slot, i_f, w, r)
+        ratio_starts(t, slot, i_f, m, w, r)
+        mean_sample(t, slot, i_f, m, w, r)
+    ratio_sample(slot, i_f, w, r)
+
+
 @_inline
 def record(t, slot, i_f, weight, m, w, r, counters):
     """Enter one accepted state at time ``t`` (forces in row ``i_f``) in the statistics.
@@ -621,11 +639,8 @@ def record(t, slot, i_f, weight, m, w, r, counters):
             if fe < cyc_min[c, j]:
                 cyc_min[c, j] = fe
             cyc_cnt[c, j] += 1
-    peak_sample(t, r.pk_x[0], slot, i_f, w, r)  # (before mean_sample: the last instant)
+    enter_instant(t, r.pk_x[0], np.int64(1), slot, i_f, m, w, r)
     r.pk_x[0] = 0
-    ratio_starts(t, slot, i_f, m, w, r)  # (before mean_sample too)
-    mean_sample(t, slot, i_f, m, w, r)
-    ratio_sample(slot, i_f, w, r)
     for j in range(watch_el.shape[0]):
         el = watch_el[j]
         g = G[slot, el]
@@ -665,12 +680,10 @@ def record_extrema(t, mean, slot, i_f, m, w, r):
                 cyc_max[c, j] = fe
             if fe < cyc_min[c, j]:
                 cyc_min[c, j] = fe
-    ratio_sample(slot, i_f, w, r)
-    if mean != 0:  # RK4's corners: instants in time order, corners among the samples
-        peak_sample(t, np.int64(1), slot, i_f, w, r)
-        ratio_starts(t, slot, i_f, m, w, r)
-        mean_sample(t, slot, i_f, m, w, r)
-    else:  # Dormand-Prince's, element by element: no parabola across the step
+    # RK4's corners (``mean``): instants in time order, corners among the samples;
+    # Dormand-Prince's, element by element: the ratio only, and no parabola across the step
+    enter_instant(t, np.int64(1), mean, slot, i_f, m, w, r)
+    if mean == 0:
         r.pk_k[(r.pk_n[0] - 1) & 1] = 1
         r.pk_x[0] = 1
 
