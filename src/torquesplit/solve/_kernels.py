@@ -242,9 +242,9 @@ def rhs_slot(slot, iy, idy, i_f, m, w):
     the additive force p.  Writes the forces and deformations into row ``i_f`` of w.F /
     w.D.  V is read by element (CSR, unsigned indices into the state) and, for the
     generalized forces, by DOF (a gather per DOF, no scatter).  Spline component
-    elements have zero stiffness and damping here (force 0); :func:`rhs_extra`, called
-    here if ``extra`` (the model has splines or tooth friction), adds them (one call of
-    this kernel per stage, not two: the kernels that inline stages compile faster).
+    elements have zero stiffness and damping here (force 0); :func:`rhs_extra`, which
+    :func:`_stage` calls after this one where the model has splines or tooth friction,
+    adds them.
     Twin: :func:`torquesplit.solve.reference.rhs_numpy` (with :func:`rhs_extra`).
     """
     Y, force, defl = w.Y, w.F, w.D
@@ -639,7 +639,8 @@ def record(t, slot, i_f, weight, m, w, r, counters):
             if fe < cyc_min[c, j]:
                 cyc_min[c, j] = fe
             cyc_cnt[c, j] += 1
-    enter_instant(t, r.pk_x[0], np.int64(1), slot, i_f, m, w, r)
+    # the row as an int64 variable: a literal row would compile a second enter_instant
+    enter_instant(t, r.pk_x[0], np.int64(1), slot, np.int64(i_f), m, w, r)
     r.pk_x[0] = 0
     for j in range(watch_el.shape[0]):
         el = watch_el[j]
