@@ -293,24 +293,27 @@ def _var_step(t_mid, t_end, hs, sa, sb, m, w, rhs_fn, gen, extra, Phi, S, force,
     s0 = sa
     s1 = np.int64(1)
     s2 = sb
-    k1 = Y_K1
-    k2 = Y_K1 + 1
-    k3 = Y_K1 + 2
-    k4 = Y_K1 + 3
+    # rows as int64 variables: literal rows would compile _var_stage once per value
+    y_state = np.int64(Y_STATE)
+    y_trial = np.int64(Y_TRIAL)
+    k1 = np.int64(Y_K1)
+    k2 = np.int64(Y_K1 + 1)
+    k3 = np.int64(Y_K1 + 2)
+    k4 = np.int64(Y_K1 + 3)
     hh = 0.5 * hs
     K1, K2, K3, K4, PT = S[0], S[1], S[2], S[3], S[4]
-    _var_stage(s0, Y_STATE, k1, m, w, rhs_fn, gen, extra, Phi, K1, force, kd, cr, spt, frv,
+    _var_stage(s0, y_state, k1, m, w, rhs_fn, gen, extra, Phi, K1, force, kd, cr, spt, frv,
                fps, DF)
     excite(t_mid, s1, np.int64(-1), m, w)
     _var_trial(w, k1, Phi, K1, PT, hh)
-    _var_stage(s1, Y_TRIAL, k2, m, w, rhs_fn, gen, extra, PT, K2, force, kd, cr, spt, frv,
+    _var_stage(s1, y_trial, k2, m, w, rhs_fn, gen, extra, PT, K2, force, kd, cr, spt, frv,
                fps, DF)
     _var_trial(w, k2, Phi, K2, PT, hh)
-    _var_stage(s1, Y_TRIAL, k3, m, w, rhs_fn, gen, extra, PT, K3, force, kd, cr, spt, frv,
+    _var_stage(s1, y_trial, k3, m, w, rhs_fn, gen, extra, PT, K3, force, kd, cr, spt, frv,
                fps, DF)
     excite(t_end, s2, np.int64(-1), m, w)
     _var_trial(w, k3, Phi, K3, PT, hs)
-    _var_stage(s2, Y_TRIAL, k4, m, w, rhs_fn, gen, extra, PT, K4, force, kd, cr, spt, frv,
+    _var_stage(s2, y_trial, k4, m, w, rhs_fn, gen, extra, PT, K4, force, kd, cr, spt, frv,
                fps, DF)
     h6 = hs / 6.0
     bad = False
