@@ -799,7 +799,7 @@ def corner_events(t_a, t_b, ya, fa, yb, fb, m, w, r, rhs_fn, gen, counters):
             if tc >= t_b:
                 break
             if tc > t_a:
-                hermite((tc - t_a) / h, h, ya, fa, yb, fb, Y_SAMPLE, w)
+                hermite((tc - t_a) / h, h, ya, fa, yb, fb, np.int64(Y_SAMPLE), w)
                 excite(tc, slot, np.int64(-1), m, w)
                 _stage(slot, Y_SAMPLE, Y_DSAMPLE, F_TMP, m, w, rhs_fn, gen, extra)
                 record_extrema(tc, np.int64(0), slot, np.int64(F_TMP), m, w, r)
@@ -1062,7 +1062,11 @@ def dopri_run(t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, blowup, dt
     t_corner = math.inf  # earliest corner still to be sampled
     if m.corner_node.shape[0] > 0:
         t_corner = first_corners(clock[F_T], m, w)
-    kf = Y_KFSAL
+    # rows as int64 variables (np.int64): a literal row passed to a compiled callee
+    # (hermite, corner_events) would compile it once per value
+    y_state = np.int64(Y_STATE)
+    y_new = np.int64(Y_NEW)
+    kf = np.int64(Y_KFSAL)
     k2 = kf + 1
     k3 = kf + 2
     k4 = kf + 3
@@ -1173,7 +1177,7 @@ def dopri_run(t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, blowup, dt
                 theta = (ts - t) / hs
                 if theta > 1.0:
                     theta = 1.0
-                hermite(theta, hs, Y_STATE, kf, Y_NEW, k7, Y_SAMPLE, w)
+                hermite(theta, hs, y_state, kf, y_new, k7, np.int64(Y_SAMPLE), w)
                 excite(ts, s0, np.int64(-1), m, w)
                 _stage(s0, Y_SAMPLE, Y_DSAMPLE, F_TMP, m, w, rhs_fn, gen, extra)
                 store_history(row, ts, np.int64(Y_SAMPLE), np.int64(F_TMP), w, r)
@@ -1183,7 +1187,7 @@ def dopri_run(t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, blowup, dt
                 counters[I_NEXT] = row + 1
                 counters[I_HIST] = row + 1
             if t_corner < t_new:
-                t_corner = corner_events(t, t_new, Y_STATE, kf, Y_NEW, k7, m, w, r, rhs_fn,
+                t_corner = corner_events(t, t_new, y_state, kf, y_new, k7, m, w, r, rhs_fn,
                                          gen, counters)
             for k in range(n2):
                 Y[Y_STATE, k] = Y[Y_NEW, k]
