@@ -21,10 +21,11 @@ import textwrap
 
 import pytest
 
-from torquesplit.solve import _kernels, laws
+from torquesplit.gears.contact import _kernels as contact_kernels
+from torquesplit.solve import _kernels, laws, static
 from torquesplit.steady import _kernels as steady_kernels
 
-MODULES = (laws, _kernels, steady_kernels)
+MODULES = (laws, _kernels, steady_kernels, static, contact_kernels)
 
 
 def _njit_kind(call: ast.expr) -> str:
