@@ -2,8 +2,8 @@
 
 :func:`measure` runs this file as a child process with ``NUMBA_CACHE_DIR`` set to a new
 temporary directory: twice with an empty cache, where the child compiles every kernel
-(cold compile; the faster is kept), then once loading the last one's cache.  The project's own cache
-(``src/torquesplit/solve/__pycache__``) is neither used nor touched.
+(cold compile; the faster is kept), then once loading the last one's cache.  The
+project's own cache (``src/torquesplit/solve/__pycache__``) is neither used nor touched.
 
 Each child prints one JSON line with, in seconds:
 

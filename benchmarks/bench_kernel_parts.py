@@ -34,14 +34,14 @@ REMOVALS = {
     "statistics (record)": [("        record(t, a, F_MAIN, 0.0 if last else h, m, w, r, counters)\n",
                              "")],
     "  of it: parabola vertices (peak_sample)": [
-        ("    peak_sample(t, r.pk_x[0], slot, i_f, w, r)  #", "    pass  #")],
+        ("        peak_sample(t, kink, slot, i_f, w, r)\n", "")],
     "  of it: ratio at cycle starts (ratio_starts)": [
-        ("    ratio_starts(t, slot, i_f, m, w, r)  #", "    pass  #")],
+        ("        ratio_starts(t, slot, i_f, m, w, r)\n", "")],
     "  of it: cycle means (mean_sample)": [
-        ("    mean_sample(t, slot, i_f, m, w, r)\n    ratio_sample", "    ratio_sample")],
+        ("        mean_sample(t, slot, i_f, m, w, r)\n    ratio_sample", "    ratio_sample")],
     "  of it: instantaneous ratio (ratio_sample)": [
-        ("    ratio_sample(slot, i_f, w, r)\n    for j in range(watch_el",
-         "    for j in range(watch_el")],
+        ("        mean_sample(t, slot, i_f, m, w, r)\n    ratio_sample(slot, i_f, w, r)\n",
+         "        mean_sample(t, slot, i_f, m, w, r)\n")],
     "divergence check": [("        bad = bad_state(Y_STATE, blowup, w)\n", "        bad = -1\n")],
 }
 

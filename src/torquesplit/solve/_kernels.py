@@ -596,11 +596,11 @@ def enter_instant(t, kink, full, slot, i_f, m, w, r):
     instant of the time record: a step sample or an RK4 corner) the peak between the
     instants (:func:`peak_sample`, ``kink`` whether this instant is a corner), the
     ratio at the cycle starts passed (:func:`ratio_starts`) and the cycle means
-    (:func:`mean_sample`), in that order (the last two read the last instant, which
-    mean_sample replaces); always the instantaneous ratio (:func:`ratio_sample`).  One
-    compiled callee for :func:`record` and :func:`record_extrema` (inlined into each
-    of their callers, numba compiled these four once per call site: seconds of cold
-    compile each)."""
+    (:func:`mean_sample`), in that order (the first two read the last instant's forces,
+    which mean_sample then replaces); always the instantaneous ratio
+    (:func:`ratio_sample`).  One compiled callee for :func:`record` and
+    :func:`record_extrema`: inlined, these four were compiled once per call site of
+    those two (rk4_run, record_extrema, dopri_run twice), seconds of cold compile each."""
     if full != 0:
         peak_sample(t, kink, slot, i_f, w, r)
         ratio_starts(t, slot, i_f, m, w, r)
