@@ -149,3 +149,31 @@ def test_bearing_forces_are_study_outputs_as_the_run_table_gives_them():
 
     with pytest.raises(StudyError, match="close: bearing_peak_force"):
         run_study(bad, workers=1)
+
+
+def test_a_study_without_bearing_outputs_does_not_compute_them(run, monkeypatch):
+    """The bearing forces come from the history (13 of a Dong et al. 2021 case's 17 ms
+    of outputs); a study that asks for none skips them, and its values are the same."""
+    from torquesplit.results import Results
+    from torquesplit.study import run_study
+
+    full = output_values(run)
+    lean = output_values(run, bearings=False)
+    assert {n for n in full if not n.startswith("bearing")} == set(lean)
+    assert all(lean[n] == full[n] or (math.isnan(lean[n]) and math.isnan(full[n]))
+               for n in lean)
+    calls = []
+    real = Results.bearing_forces
+    monkeypatch.setattr(Results, "bearing_forces",
+                        lambda self, *a, **k: calls.append(1) or real(self, *a, **k))
+    spec = {"study": {"name": "b", "model": "ji_li_mill_drive",
+                      "outputs": ["load_sharing.engineering"]},
+            "analysis": {"cycles": 20},
+            "grid": {"parameters": [{"path": "meshes.m11.damping_ratio",
+                                     "values": [0.1]}]}}
+    ds = run_study(spec, workers=1)
+    assert list(ds["status"].values) == ["ok"] and not calls
+    spec["study"]["outputs"] = ["load_sharing.engineering", "bearing_mean_force.z2"]
+    ds2 = run_study(spec, workers=1)
+    assert calls and ds2["load_sharing.engineering"].values[0] == \
+        ds["load_sharing.engineering"].values[0]

@@ -108,6 +108,7 @@ def _static(model, p, out) -> list[float]:
 
 def _dynamic(model, p, out) -> list[float]:
     import contextlib
+    import functools
 
     from ..simulation import MIN_SAMPLES_PER_PERIOD, history_unused, simulate
     from .outputs import output_values
@@ -121,11 +122,13 @@ def _dynamic(model, p, out) -> list[float]:
     from .outputs import HISTORY_FAMILIES
 
     quiet = contextlib.nullcontext()
-    if not any(n.split(".")[0] in HISTORY_FAMILIES for n in names):
+    bearings = any(n.split(".")[0] in HISTORY_FAMILIES for n in names)
+    if not bearings:
         kw["samples_per_period"] = MIN_SAMPLES_PER_PERIOD
         quiet = history_unused()  # (its coarseness is the study's choice, unread)
+    values = functools.partial(output_values, bearings=bearings)  # (unread: not computed)
     with quiet:
-        return _dynamic_runs(model, a, names, defs, kw, out, simulate, output_values)
+        return _dynamic_runs(model, a, names, defs, kw, out, simulate, values)
 
 
 def _dynamic_runs(model, a, names, defs, kw, out, simulate, output_values) -> list[float]:
