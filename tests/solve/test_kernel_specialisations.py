@@ -8,7 +8,7 @@ state's ``_var_stage`` was compiled for ``Y_STATE`` and for ``Y_TRIAL`` (about 4
 Compiling the kernels in a fresh cache to count their specialisations would cost CI
 tens of seconds, so this reads the kernels' source: a call of a compiled callee
 (``_kernel``, ``_callee``, a plain ``njit``) must not get an integer constant, a
-module-level integer (``Y_STATE``, ``F_MAIN``...) or an expression of them, directly
+module-level integer (``Y_STATE``, ``F_MAIN``...) or a local assigned one, directly
 or through a parameter that an inlined function forwards to such a callee.
 Wrap the value in ``np.int64(...)``.
 """
@@ -62,19 +62,20 @@ def _functions():
 
 
 def _is_literal(arg: ast.expr, module, local: frozenset = frozenset()) -> bool:
-    """An integer constant, a module-level integer, a local name assigned one of them
-    (``local``: numba keeps the literal type), or arithmetic of them."""
+    """What numba types as ``Literal[int]``: an integer constant (``-1`` too: Python
+    folds it), a module-level integer, or a local name assigned one of them
+    (``local``: ``kf = Y_KFSAL`` keeps the literal type).  Arithmetic on them is typed
+    int64 (checked with numba 0.68: ``k2 = kf + 1`` passed on gives an int64
+    specialisation)."""
     if isinstance(arg, ast.Constant):
         return isinstance(arg.value, int) and not isinstance(arg.value, bool)
+    if isinstance(arg, ast.UnaryOp) and isinstance(arg.operand, ast.Constant):
+        return _is_literal(arg.operand, module, local)
     if isinstance(arg, ast.Name):
         if arg.id in local:
             return True
         value = getattr(module, arg.id, None)
         return isinstance(value, int) and not isinstance(value, bool) and arg.id.isupper()
-    if isinstance(arg, ast.BinOp):
-        return _is_literal(arg.left, module, local) and _is_literal(arg.right, module, local)
-    if isinstance(arg, ast.UnaryOp):
-        return _is_literal(arg.operand, module, local)
     return False
 
 
@@ -96,7 +97,7 @@ def _literal_locals(fn: ast.FunctionDef, module) -> frozenset:
                     assigned.setdefault(name.id, []).append(None)
     literal: set[str] = set()
     changed = True
-    while changed:  # (k2 = kf + 1 after kf = Y_KFSAL)
+    while changed:  # (k = Y_K1 then j = k)
         changed = False
         for name, values in assigned.items():
             if name not in literal and len(values) == 1 and values[0] is not None \
@@ -187,9 +188,12 @@ def test_no_compiled_callee_gets_a_literal_integer():
 @pytest.mark.parametrize("source, expected", [
     ("def f(x):\n    g(Y_STATE, x)\n", True),
     ("def f(x):\n    g(np.int64(Y_STATE), x)\n", False),
-    ("def f(x):\n    g(Y_K1 + 1, x)\n", True),
+    ("def f(x):\n    g(-1, x)\n", True),
+    ("def f(x):\n    g(Y_K1 + 1, x)\n", False),
     ("def f(x):\n    g(x, 0.5)\n", False),
-    ("def f(x):\n    k = Y_K1\n    g(k + 1, x)\n", True),
+    ("def f(x):\n    k = Y_K1\n    g(k, x)\n", True),
+    ("def f(x):\n    k = Y_K1\n    j = k\n    g(j, x)\n", True),
+    ("def f(x):\n    k = Y_K1\n    g(k + 1, x)\n", False),
     ("def f(x):\n    k = Y_K1\n    k = x\n    g(k, x)\n", False),
     ("def f(x):\n    k = Y_K1\n    y[k] = x\n    g(k, x)\n", True),
 ])
