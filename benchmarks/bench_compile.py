@@ -104,13 +104,12 @@ def measure(repeat: int = 2) -> dict:
     the other benchmarks keep their best run: on a shared 2-core VM one cold compilation
     varies by 10-20 %), then a child that loads the last child's cache."""
     runs = []
-    for _ in range(max(1, repeat)):
-        with tempfile.TemporaryDirectory(prefix="torquesplit-numba-cache-") as tmp:
-            cold = run_child(tmp)
-            n_files = sum(1 for _ in Path(tmp).rglob("*.nbi"))
-            if len(runs) == max(1, repeat) - 1:
-                cached = run_child(tmp)
-        runs.append(cold)
+    with tempfile.TemporaryDirectory(prefix="torquesplit-numba-cache-") as tmp:
+        for i in range(max(1, repeat)):
+            cache = Path(tmp) / f"cold{i}"
+            runs.append(run_child(str(cache)))
+        n_files = sum(1 for _ in cache.rglob("*.nbi"))
+        cached = run_child(str(cache))
     best = min(runs, key=lambda d: d["compile"])
     return {"cold": best, "cached": cached, "cache_index_files": n_files,
             "cold_runs": [{k: d[k] for k in ("compile", "compile_cpu", "compile_dopri")}
