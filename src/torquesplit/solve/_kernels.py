@@ -122,12 +122,23 @@ _FAC_MAX = 10.0  # largest increase: h_new <= 10 h
 _BETA = 0.04
 _EXPO1 = 0.2 - _BETA * 0.75
 
+# A kernel called from Python (integrate, the steady-state solvers, tests).
 _kernel = njit(cache=True, error_model="numpy", _nrt=False)
+# A kernel called only from other kernels: without the Python and C entry points numba
+# otherwise compiles for every function.  The Python one unboxes the bundles (m alone
+# holds 44 arrays) and cost more LLVM time than most of these functions' bodies: the
+# first RK4 run's compilation went from about 19-21 s to 12-15 s
+# (benchmarks/bench_compile.py).  Called from Python, one of these crashes the
+# interpreter: tests/solve/test_kernel_entry_points.py keeps Python code from it.
+_inner = njit(cache=True, error_model="numpy", _nrt=False, no_cpython_wrapper=True,
+              no_cfunc_wrapper=True)
 _inline = njit(inline="always", error_model="numpy", _nrt=False)
-# An ordinary compiled callee (LLVM may still inline it): excite is large and is called
-# from four places, and inlining it in numba's IR cost 8 s of cold compile for no
-# measurable speed (benchmarks/bench_compile.py, bench_engine.py).
-_callee = njit(error_model="numpy", _nrt=False)
+# An ordinary compiled callee (LLVM may still inline it), called from kernels only (no
+# entry points, as _inner): excite is large and is called from four places, and
+# inlining it in numba's IR cost 8 s of cold compile for no measurable speed
+# (benchmarks/bench_compile.py, bench_engine.py).
+_callee = njit(error_model="numpy", _nrt=False, no_cpython_wrapper=True,
+               no_cfunc_wrapper=True)
 
 
 # =================================================================== excitation
@@ -214,7 +225,7 @@ def excite(t, slot, src, m, w):
         ED[us, e] += a * error_omega[ui] * c1
 
 
-@_kernel
+@_inner
 def copy_slot(src, dst, w):
     """Copy the excitation of slot ``src`` into slot ``dst`` (same time)."""
     K, P, G, E, ED, CY, FR, S, C = w.K, w.P, w.G, w.E, w.ED, w.CY, w.FR, w.S, w.C
@@ -233,7 +244,7 @@ def copy_slot(src, dst, w):
 
 
 # ======================================================================== rhs
-@_kernel
+@_inner
 def rhs_slot(slot, iy, idy, i_f, m, w):
     """Row ``idy`` of w.Y = dy/dt = [v, a] at state row ``iy`` for excitation ``slot``.
 
@@ -279,7 +290,7 @@ def rhs_slot(slot, iy, idy, i_f, m, w):
         Y[idy, n + i] = inv_mass[i] * acc
 
 
-@_kernel
+@_inner
 def rhs_extra(slot, iy, idy, i_f, m, w):
     """Spline radial elements and tooth friction, after :func:`rhs_slot` (called only for
     models that have them, so others run exactly the arithmetic they always ran).
@@ -659,7 +670,7 @@ def record(t, slot, i_f, weight, m, w, r, counters):
     counters[I_SAMPLES] += 1
 
 
-@_kernel
+@_inner
 def record_extrema(t, mean, slot, i_f, m, w, r):
     """Enter the forces of row ``i_f`` at time ``t`` in the per-cycle max / min of the
     force and of the instantaneous load-sharing ratio (a corner event: an instant, not a
@@ -689,7 +700,7 @@ def record_extrema(t, mean, slot, i_f, m, w, r):
         r.pk_x[0] = 1
 
 
-@_kernel
+@_inner
 def first_corners(t, m, w):
     """Set ``w.next_node`` of every element with corners to its first corner node after
     time t (absolute node: cycle x n_table + node); returns the earliest corner time."""
@@ -716,7 +727,7 @@ def first_corners(t, m, w):
     return next_corner_time(m, w)
 
 
-@_kernel
+@_inner
 def next_corner_time(m, w):
     """Earliest time of the elements' next corners (``w.next_node``); inf if none."""
     n_tab = m.stiffness_table.shape[1]
@@ -747,7 +758,7 @@ def _following_corner(node, c0, c1, n_tab, corner_node):
     return base + corner_node[k]
 
 
-@_kernel
+@_inner
 def advance_corners(t, m, w):
     """Move every element whose next corner is at or before t to its following corner;
     returns the earliest next corner time."""
@@ -772,7 +783,7 @@ def advance_corners(t, m, w):
     return earliest
 
 
-@_kernel
+@_inner
 def corner_events(t_a, t_b, ya, fa, yb, fb, m, w, r, rhs_fn, gen, counters):
     """Sample the statistics at every corner of an element's force inside the step
     (t_a, t_b) (see ``kernel_data.CORNER_TOL``): the state there by cubic Hermite
@@ -808,7 +819,7 @@ def corner_events(t_a, t_b, ya, fa, yb, fb, m, w, r, rhs_fn, gen, counters):
     return next_corner_time(m, w)
 
 
-@_kernel
+@_inner
 def store_history(row, t, iy, i_f, w, r):
     """One decimated history row: t, forces of history elements, q and v of DOFs.
     Twin: plain indexing, ``hist_f[row] = force[hist_el]`` etc."""
@@ -824,7 +835,7 @@ def store_history(row, t, iy, i_f, w, r):
         hist_v[row, j] = Y[iy, n + d]
 
 
-@_kernel
+@_inner
 def store_full(row, t, iy, w, r):
     """One full-state row (when ``full_t`` has room)."""
     Y, full_y = w.Y, r.full_y
@@ -903,7 +914,7 @@ def _rk4_step(t_mid, t_end, hs, s_half, sb, src_half, src_end, m, w, rhs_fn, gen
         Y[Y_STATE, k] += h6 * (Y[k1, k] + 2.0 * (Y[k2, k] + Y[k3, k]) + Y[k4, k])
 
 
-@_kernel
+@_inner
 def rk4_through_corners(t, tb, t_corner, sa, sb, m, w, r, rhs_fn, gen, counters):
     """The RK4 step from t to tb when corners of the tables fall inside it: sub-steps
     that end exactly on each corner (``kernel_data.CORNER_TOL``), so that no RK4 step
@@ -1024,7 +1035,7 @@ def rk4_run(t0, h, n_first, n_steps, record_final, record_every, blowup, m, w, r
 
 
 # ============================================================== Dormand-Prince
-@_kernel
+@_inner
 def hermite(theta, h, i0, if0, i1, if1, iout, w):
     """Cubic Hermite interpolation between rows (y0, f0) and (y1, f1) of w.Y into row
     ``iout``.  Twin: :func:`torquesplit.solve.reference.hermite_numpy`."""

@@ -253,7 +253,8 @@ def sample_jvp(m, KD, CR, SPT, FRV, FPS, dQ, dV, out, df):
             _jvp(m, KD[j], CR[j], SPT[j], FRV[j], FPS[j], DQ[c, j], DV[c, j], OUT[c, j], DF)
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@njit(cache=True, error_model="numpy", _nrt=False, no_cpython_wrapper=True,
+      no_cfunc_wrapper=True)  # (called from the kernels only: no Python entry to compile)
 def _var_stage(slot, iy, idy, m, w, rhs_fn, gen, extra, Pin, Pout, force, kd, cr, spt,
                frv, fps, DF):
     """One stage of the state (row idy of w.Y) and of its variations:
