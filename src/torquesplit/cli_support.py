@@ -198,11 +198,11 @@ def _compile_hint_column():
 
     class CompileHint(ProgressColumn):
         """A bar that has not moved for a few seconds says why it may not: the first run
-        on a machine compiles the numba kernels (about 20 s; cached for later runs)."""
+        on a machine compiles the numba kernels (about 15 s; cached for later runs)."""
 
         def render(self, task):
             if task.completed == 0 and (task.elapsed or 0.0) > COMPILE_HINT_AFTER:
-                return Text("(a first run also compiles the kernels: about 20 s, once)",
+                return Text("(a first run also compiles the kernels: about 15 s, once)",
                             style="dim")
             return Text("")
 
