@@ -163,11 +163,13 @@ def cpu_driver(src: KernelSource, contract: bool = False):
     if contract:
         for name in LAWS:
             ns[name] = njit(**flags)(getattr(laws, name).py_func)
-    jit = njit(**flags)
+    # the generated functions are called from run_all only: without numba's Python and
+    # C entry points, which cost compile time (as the engine's inner kernels)
+    inner = njit(**flags, no_cpython_wrapper=True, no_cfunc_wrapper=True)
     for name in _functions(ns):
-        ns[name] = jit(ns[name])
+        ns[name] = inner(ns[name])
     exec(_CPU_DRIVER.format(n_w=src.n_w, n_x=src.n_x, n_wi=src.n_wi), ns)
-    fn = jit(ns["run_all"])
+    fn = njit(**flags)(ns["run_all"])
     with _LOCK:
         _CACHE.setdefault(key, fn)
     return fn
