@@ -347,27 +347,35 @@ def rk4_variational(t0, h, n_steps, m, w, rhs_fn, gen, Phi, S, force, kd, cr, sp
     for it in range(n_steps):
         t = t0 + it * h
         tb = t0 + (it + 1) * h
-        if t_corner < tb:
-            ts = t
-            while True:
+        # a plain step and the sub-steps through corners share one call of _var_step
+        # (numba inlines it once: the first steady state compiles faster); a plain step
+        # passes t + h/2 and h as they were, the sub-steps their own
+        corners = t_corner < tb
+        ts = t
+        while True:
+            if corners:
                 te = sub_step_end(t_corner, tb, h)
-                if te - ts > MERGE * h:
-                    if _var_step(ts + 0.5 * (te - ts), te, te - ts, a, b, m, w, rhs_fn, gen,
-                                 extra, Phi, S, force, kd, cr, spt, frv, fps, DF):
-                        return 1
-                    a, b = b, a
-                    ts = te
-                if te >= tb:
-                    break
-                t_corner = advance_corners(te, m, w)
+                go = te - ts > MERGE * h
+                t_mid = ts + 0.5 * (te - ts)
+                hs = te - ts
+            else:
+                te = tb
+                go = True
+                t_mid = t + 0.5 * h
+                hs = h
+            if go:
+                if _var_step(t_mid, te, hs, a, b, m, w, rhs_fn, gen, extra, Phi, S, force,
+                             kd, cr, spt, frv, fps, DF):
+                    return 1
+                a, b = b, a
+                ts = te
+            if te >= tb:
+                break
+            t_corner = advance_corners(te, m, w)
+        if corners:
             if ts < tb:  # the last corner fell within MERGE h of tb
                 excite(tb, a, np.int64(-1), m, w)
             t_corner = advance_corners(tb, m, w)
-        else:
-            if _var_step(t + 0.5 * h, tb, h, a, b, m, w, rhs_fn, gen, extra, Phi, S, force,
-                         kd, cr, spt, frv, fps, DF):
-                return 1
-            a, b = b, a
     return 0
 
 
@@ -426,10 +434,14 @@ def rk4_samples(t0, h, n_steps, every, m, w, rhs_fn, gen, out_t, out_y, out_f, o
         if it == n_steps:
             break
         tb = t0 + (it + 1) * h
-        if t_corner < tb:
-            ts = t
-            first = True
-            while True:
+        # a plain step and the sub-steps through corners share one call of _rk4_step
+        # (inlined once: faster cold compile); a plain step passes t + h/2 and h as
+        # they were, the sub-steps their own
+        corners = t_corner < tb
+        ts = t
+        first = True
+        while True:
+            if corners:
                 te = sub_step_end(t_corner, tb, h)
                 if not first:  # at a corner: its forces, and k1 of the next sub-step
                     _stage(a, Y_STATE, Y_K1, F_MAIN, m, w, rhs_fn, gen, extra)
@@ -442,22 +454,26 @@ def rk4_samples(t0, h, n_steps, every, m, w, rhs_fn, gen, out_t, out_y, out_f, o
                             c_f[crow, e] = F[F_MAIN, e]
                             c_d[crow, e] = D[F_MAIN, e]
                         crow += 1
-                if te - ts > MERGE * h:
-                    _rk4_step(ts + 0.5 * (te - ts), te, te - ts, s_half, b, minus, minus, m,
-                              w, rhs_fn, gen, extra)
-                    a, b = b, a
-                    ts = te
-                    first = False
-                if te >= tb:
-                    break
-                t_corner = advance_corners(te, m, w)
+                go = te - ts > MERGE * h
+                t_mid = ts + 0.5 * (te - ts)
+                hs = te - ts
+            else:
+                te = tb
+                go = True
+                t_mid = t + 0.5 * h
+                hs = h
+            if go:
+                _rk4_step(t_mid, te, hs, s_half, b, minus, minus, m, w, rhs_fn, gen, extra)
+                a, b = b, a
+                ts = te
+                first = False
+            if te >= tb:
+                break
+            t_corner = advance_corners(te, m, w)
+        if corners:
             if ts < tb:  # the last corner fell within MERGE h of tb
                 excite(tb, a, minus, m, w)
             t_corner = advance_corners(tb, m, w)
-        else:
-            _rk4_step(t + 0.5 * h, tb, h, s_half, b, minus, minus, m, w, rhs_fn, gen,
-                      extra)
-            a, b = b, a
         if bad_state(Y_STATE, NO_BLOWUP, w) >= 0:
             return -1, crow
     return row, crow
