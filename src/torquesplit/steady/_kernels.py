@@ -327,6 +327,20 @@ def _var_step(t_mid, t_end, hs, sa, sb, m, w, rhs_fn, gen, extra, Phi, S, force,
     return bad
 
 
+@_inline
+def _next_step(corners, t_corner, t, tb, ts, h):
+    """The next (sub-)step of the step from t to tb, from ts: ``(te, go, t_mid, hs)``,
+    its end, whether to take it (a sub-step ending within MERGE h of ts is skipped), its
+    midpoint and length.  A plain step (no ``corners``) is t + h/2 and h as they are;
+    through corners each sub-step ends on the next one (:func:`sub_step_end`).  Shared by
+    :func:`rk4_variational` and :func:`rk4_samples`, which take both kinds of step
+    through one call of the step (inlined once: faster cold compile)."""
+    if corners:
+        te = sub_step_end(t_corner, tb, h)
+        return te, te - ts > MERGE * h, ts + 0.5 * (te - ts), te - ts
+    return tb, True, t + 0.5 * h, h
+
+
 @njit(cache=True, error_model="numpy", _nrt=False, nogil=True)  # threads: column blocks
 def rk4_variational(t0, h, n_steps, m, w, rhs_fn, gen, Phi, S, force, kd, cr, spt, frv,
                     fps, DF):
@@ -347,22 +361,10 @@ def rk4_variational(t0, h, n_steps, m, w, rhs_fn, gen, Phi, S, force, kd, cr, sp
     for it in range(n_steps):
         t = t0 + it * h
         tb = t0 + (it + 1) * h
-        # a plain step and the sub-steps through corners share one call of _var_step
-        # (numba inlines it once: the first steady state compiles faster); a plain step
-        # passes t + h/2 and h as they were, the sub-steps their own
         corners = t_corner < tb
         ts = t
         while True:
-            if corners:
-                te = sub_step_end(t_corner, tb, h)
-                go = te - ts > MERGE * h
-                t_mid = ts + 0.5 * (te - ts)
-                hs = te - ts
-            else:
-                te = tb
-                go = True
-                t_mid = t + 0.5 * h
-                hs = h
+            te, go, t_mid, hs = _next_step(corners, t_corner, t, tb, ts, h)
             if go:
                 if _var_step(t_mid, te, hs, a, b, m, w, rhs_fn, gen, extra, Phi, S, force,
                              kd, cr, spt, frv, fps, DF):
@@ -434,15 +436,12 @@ def rk4_samples(t0, h, n_steps, every, m, w, rhs_fn, gen, out_t, out_y, out_f, o
         if it == n_steps:
             break
         tb = t0 + (it + 1) * h
-        # a plain step and the sub-steps through corners share one call of _rk4_step
-        # (inlined once: faster cold compile); a plain step passes t + h/2 and h as
-        # they were, the sub-steps their own
         corners = t_corner < tb
         ts = t
         first = True
         while True:
+            te, go, t_mid, hs = _next_step(corners, t_corner, t, tb, ts, h)
             if corners:
-                te = sub_step_end(t_corner, tb, h)
                 if not first:  # at a corner: its forces, and k1 of the next sub-step
                     _stage(a, Y_STATE, Y_K1, F_MAIN, m, w, rhs_fn, gen, extra)
                     if crow < c_t.shape[0]:
@@ -454,14 +453,6 @@ def rk4_samples(t0, h, n_steps, every, m, w, rhs_fn, gen, out_t, out_y, out_f, o
                             c_f[crow, e] = F[F_MAIN, e]
                             c_d[crow, e] = D[F_MAIN, e]
                         crow += 1
-                go = te - ts > MERGE * h
-                t_mid = ts + 0.5 * (te - ts)
-                hs = te - ts
-            else:
-                te = tb
-                go = True
-                t_mid = t + 0.5 * h
-                hs = h
             if go:
                 _rk4_step(t_mid, te, hs, s_half, b, minus, minus, m, w, rhs_fn, gen, extra)
                 a, b = b, a
