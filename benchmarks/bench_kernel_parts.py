@@ -2,16 +2,22 @@
 
 An isolated building block timed in its own loop misses what matters in the real step
 (inlining, registers, the memory traffic of its neighbours).  Here each part is instead
-*removed* from a copy of ``solve/_kernels.py`` (a patched source, compiled in a fresh
-process without numba's cache), and the whole RK4 step of the Ji & Li drive is timed
-without it; the difference to the unpatched copy is the part's marginal cost per step.
-The parts: the four right-hand-side evaluations (the generated code), the excitation at
-t + h/2 and t + h, the statistics (per-cycle extremes, the load-sharing ratio, contact
-counters) and the divergence check; what is left is the RK4 vector arithmetic, the loop,
-the history and corner bookkeeping.  A removal that no longer matches the kernel's source
-is reported as skipped, not fatal.  Every run: ``rhs="generated"``, plain steps
-(``corners=False``), no history, best CPU time of ``repeat``.  Runnable alone:
-``python benchmarks/bench_kernel_parts.py``.
+*removed* from a copy of ``solve/_kernels.py`` and the whole RK4 step is timed without
+it; the difference to the unpatched copy is the part's marginal cost per step.  The
+parts: the four right-hand-side evaluations (the generated code), the excitation at
+t + h/2 and t + h, the statistics (per-cycle extremes, means, the load-sharing ratios,
+contact counters) and the divergence check; what is left is the RK4 vector arithmetic,
+the loop, the history and corner bookkeeping.  A removal that no longer matches the
+kernel's source is reported as skipped, not fatal.
+
+The run is the one ``simulate`` makes of the example (its step, tracked meshes and
+load-sharing groups), with ``rhs="generated"``, plain steps (``corners=False``) and no
+history.  Every copy is compiled in ONE fresh process (without numba's cache) and the
+copies are timed in turn, ``rounds`` times, each round starting with the next copy; the
+best CPU time of each is kept.  (Timing each copy in its own process, as this benchmark
+first did, compared processes whose speed differs by tens of per cent on a shared
+machine: parts summed to 180 % of the step.)  Runnable alone:
+``python benchmarks/bench_kernel_parts.py [EXAMPLE]``.
 """
 
 from __future__ import annotations
@@ -42,8 +48,11 @@ REMOVALS = {
     "  of it: instantaneous ratio (ratio_sample)": [
         ("        mean_sample(t, slot, i_f, m, w, r)\n    ratio_sample(slot, i_f, w, r)\n",
          "        mean_sample(t, slot, i_f, m, w, r)\n")],
+    "  of it: contact counters": [("    for j in range(watch_el.shape[0]):\n",
+                                   "    for j in range(0):\n")],
     "divergence check": [("        bad = bad_state(Y_STATE, blowup, w)\n", "        bad = -1\n")],
 }
+BASE = "whole step"
 
 _RUN = r"""
 import json, sys, time, warnings, importlib.util
@@ -51,24 +60,35 @@ warnings.simplefilter("ignore")
 sys.path.insert(0, {src!r})
 import torquesplit as ts
 import torquesplit.solve.integrate
-spec = importlib.util.spec_from_file_location("torquesplit.solve._kernels_part", {path!r})
-mod = importlib.util.module_from_spec(spec); spec.loader.exec_module(mod)
+from torquesplit.simulation import prepare_run
 I = sys.modules["torquesplit.solve.integrate"]
-I.kern = mod
-from torquesplit.solve import static_equilibrium
-s = ts.assemble(ts.load_model(ts.example_path({example!r})))
-y0 = static_equilibrium(s).y0
-f = float(s.frequency[s.frequency > 0].max())
-h = 1.0 / (400 * f)
-kw = dict(method="rk4", step=h, history_elements=(), history_dofs=(), corners=False,
-          rhs="generated")
-I.integrate(s, y0, (0, 100 * h), **kw)
-best = 1e9
-for _ in range({repeat}):
-    t0 = time.process_time()
-    sol = I.integrate(s, y0, (0, {steps} * h), **kw)
-    best = min(best, (time.process_time() - t0) / sol.n_steps)
-print(json.dumps({{"ns_per_step": best * 1e9, "n_dof": s.n_dof, "n_elements": s.n_elements}}))
+variants = json.loads({variants!r})
+mods = {{}}
+for k, (name, path) in enumerate(variants):
+    spec = importlib.util.spec_from_file_location(f"torquesplit.solve._kernels_part{{k}}", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    mods[name] = mod
+run = prepare_run(ts.load_model(ts.example_path({example!r})))
+s, y0 = run.structure, run.y0
+kw = dict(run.integrate_kwargs, history_elements=(), history_dofs=(), corners=False,
+          rhs="generated", progress=None)
+kw.pop("sample_interval", None)
+h = I.planned_step(s, kw.pop("steps_per_period", None), run.duration)[0]  # simulate's
+kw["step"] = h
+for name, mod in mods.items():  # compile every copy before any timing
+    I.kern = mod
+    I.integrate(s, y0, (0.0, 100 * h), **kw)
+best = {{name: float("inf") for name in mods}}
+names = list(mods)
+for rnd in range({rounds}):
+    for name in names[rnd % len(names):] + names[:rnd % len(names)]:
+        I.kern = mods[name]
+        t0 = time.process_time()
+        sol = I.integrate(s, y0, (0.0, {steps} * h), **kw)
+        best[name] = min(best[name], (time.process_time() - t0) / sol.n_steps * 1e9)
+print(json.dumps({{"ns_per_step": best, "n_dof": s.n_dof, "n_elements": s.n_elements,
+                  "step": h, "groups": len(kw["load_sharing_groups"] or ())}}))
 """
 
 
@@ -86,41 +106,49 @@ def _patched(source: str, removals) -> str | None:
     return source
 
 
-def _time(source: str, steps: int, repeat: int, example: str) -> dict:
+def _time_all(sources: dict, steps: int, rounds: int, example: str) -> dict:
+    """Best CPU ns per step of every source, all compiled in one fresh process (no
+    numba cache) and timed in turn, ``rounds`` times (each round starting one later)."""
     with tempfile.TemporaryDirectory() as tmp:
-        path = Path(tmp) / "_kernels_part.py"
-        path.write_text(source.replace("cache=True, ", ""), encoding="utf-8")
-        code = _RUN.format(src=str(ROOT / "src"), path=str(path), steps=steps, repeat=repeat,
-                           example=example)
+        variants = []
+        for k, (name, source) in enumerate(sources.items()):
+            path = Path(tmp) / f"_kernels_part{k}.py"
+            path.write_text(source.replace("cache=True, ", ""), encoding="utf-8")
+            variants.append((name, str(path)))
+        code = _RUN.format(src=str(ROOT / "src"), variants=json.dumps(variants),
+                           steps=steps, rounds=rounds, example=example)
         out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                             timeout=900, check=True).stdout
+                             timeout=1800, check=True).stdout
     return json.loads(out.strip().splitlines()[-1])
 
 
-def breakdown(steps: int = 200_000, repeat: int = 3, example: str = "ji_li_mill_drive") -> dict:
+def breakdown(steps: int = 200_000, rounds: int = 7, example: str = "ji_li_mill_drive") -> dict:
     """Marginal ns per step of each part (see the module docstring) and of the whole."""
     source = KERNELS.read_text(encoding="utf-8")
-    base = _time(source, steps, repeat, example)
-    parts, skipped = {}, {}
+    sources, skipped = {BASE: source}, {}
     for name, removals in REMOVALS.items():
         patched = _patched(source, removals)
         if patched is None:
             skipped[name] = "its text is no longer in _kernels.py"
-            continue
-        without = _time(patched, steps, repeat, example)["ns_per_step"]
-        cost = base["ns_per_step"] - without
-        parts[name] = {"ns_per_step": cost, "share": cost / base["ns_per_step"]}
-    rest = base["ns_per_step"] - sum(p["ns_per_step"] for k, p in parts.items()
-                                     if not k.startswith("  of it"))
-    parts["rest (RK4 vectors, loop, bookkeeping)"] = {
-        "ns_per_step": rest, "share": rest / base["ns_per_step"]}
-    return {"step_ns": base["ns_per_step"], "n_dof": base["n_dof"],
-            "n_elements": base["n_elements"], "parts": parts, "skipped": skipped}
+        else:
+            sources[name] = patched
+    res = _time_all(sources, steps, rounds, example)
+    ns = res["ns_per_step"]
+    base = ns[BASE]
+    parts = {name: {"ns_per_step": base - ns[name], "share": (base - ns[name]) / base}
+             for name in sources if name != BASE}
+    rest = base - sum(p["ns_per_step"] for k, p in parts.items() if not k.startswith("  of it"))
+    parts["rest (RK4 vectors, loop, bookkeeping)"] = {"ns_per_step": rest,
+                                                       "share": rest / base}
+    return {"example": example, "step_ns": base, "n_dof": res["n_dof"],
+            "n_elements": res["n_elements"], "step": res["step"], "groups": res["groups"],
+            "steps": steps, "rounds": rounds, "parts": parts, "skipped": skipped}
 
 
 if __name__ == "__main__":
     name = sys.argv[1] if len(sys.argv) > 1 else "ji_li_mill_drive"
     res = breakdown(example=name)
-    print(f"{name}, {res['step_ns']:.0f} ns per RK4 step:")
+    print(f"{name}, {res['step_ns']:.0f} ns per RK4 step of {res['step']:.3g} s "
+          f"({res['groups']} load-sharing groups, best of {res['rounds']} rounds):")
     for k, v in res["parts"].items():
         print(f"  {k:40s} {v['ns_per_step']:7.1f} ns  {100 * v['share']:5.1f} %")
