@@ -112,10 +112,11 @@ def simulate(
         Refuse (before integrating) an RK4 run that needs more steps than this, with the
         reason (usually one stiff element or a tiny inertia setting the step); default
         :data:`MAX_STEPS`.  Runs above :data:`ANNOUNCE_STEPS` steps get a cost warning.
-    rhs : {"auto", "generated", "general"}
+    rhs : {"auto", "generated", "literal", "general"}
         Right-hand side of the kernels: the model's equations compiled as straight-line
-        code, or the general element loop, or (default) the first when the run is long
-        enough to repay its compilation; same results bit for bit (see
+        code (with its values as constants: "literal"), or the general element loop, or
+        (default) the compiled code when the run is long enough to repay its
+        compilation; same results bit for bit (see
         :func:`torquesplit.solve.integrate.integrate`).
 
     Returns

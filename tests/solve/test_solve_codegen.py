@@ -93,12 +93,13 @@ def test_compiled_code_is_reused_for_the_same_pattern():
 
 def test_bad_rhs_option_is_refused():
     s = spur_pair()
-    with pytest.raises(ValueError, match="rhs must be 'auto', 'generated' or 'general'"):
+    with pytest.raises(ValueError, match="rhs must be 'auto', 'generated', 'literal' or "
+                                         "'general'"):
         integrate(s, np.zeros(2 * s.n_dof), (0.0, 1e-3), rhs="fast")
 
 
 def test_generation_failure_falls_back_to_the_general_kernel(monkeypatch):
-    def broken(model):
+    def broken(model, literal=False):
         raise RuntimeError("no compiler here")
 
     monkeypatch.setattr(codegen, "generated_rhs", broken)
@@ -161,3 +162,99 @@ def test_without_llvmlite_compilation_runs_fall_back_to_the_general_kernel(monke
     assert sol.success and sol.rhs == "general"
     ref = integrate(s, y0, (0.0, 2e-4), step=1e-6, rhs="general")
     np.testing.assert_array_equal(sol.y_final, ref.y_final)
+
+
+# ------------------------------------------------------------------ literal code
+@pytest.mark.parametrize("make, seed", [(random_structure, 0), (random_structure_extras, 2),
+                                        (_extras_gyro, 4)])
+def test_literal_code_is_rhs_slot_bit_for_bit(make, seed):
+    """The model's values as constants of the code (LLVM folds only what is exact)."""
+    s = make(seed)
+    model = kernel_model(s)
+    lit, general = codegen.generated_rhs(model, literal=True), codegen.general_rhs()
+    assert lit.literal and lit.generated
+    ir, _ = codegen.rhs_ir(model, literal=True)
+    assert "%par" not in ir.split("define void @rhs(")[0].split("entry:", 1)[1], \
+        "the literal code still loads parameters"
+    rng = np.random.default_rng(seed)
+    n = s.n_dof
+    for t in (0.0, 0.0413, 3.2):
+        for _ in range(20):
+            y = np.concatenate([rng.normal(scale=3e-6, size=n), rng.normal(scale=1e-3, size=n)])
+            for a, b in zip(_call(lit, s, t, y), _call(general, s, t, y)):
+                np.testing.assert_array_equal(a, b)
+
+
+def test_literal_code_is_per_set_of_values():
+    """Same pattern, other values of its parameters (the torque: external_force): another
+    literal code; the same parameters again, or other excitation values only (the
+    stiffness: the tables K, read at every call): the cached one."""
+    s1, s2 = spur_pair(stiffness=3.3e8, torque=17.0), spur_pair(stiffness=3.3e8, torque=29.0)
+    m1, m2 = kernel_model(s1), kernel_model(s2)
+    a1, a2 = codegen.generated_rhs(m1, literal=True), codegen.generated_rhs(m2, literal=True)
+    assert a1.function.__wrapper_address__() != a2.function.__wrapper_address__()
+    again = codegen.generated_rhs(kernel_model(spur_pair(stiffness=5.1e8, torque=17.0)),
+                                  literal=True)
+    assert again.compile_time == 0.0
+    assert again.function.__wrapper_address__() == a1.function.__wrapper_address__()
+    y0 = np.zeros(2 * s2.n_dof)
+    runs = {kind: integrate(s2, y0, (0.0, 1e-3), rhs=kind) for kind in ("literal", "general")}
+    assert runs["literal"].rhs == "literal"
+    np.testing.assert_array_equal(runs["literal"].y_final, runs["general"].y_final)
+
+
+@pytest.mark.parametrize("method", ["rk4", "dopri"])
+def test_integrate_literal_equals_general(method):
+    s = random_structure_extras(5, gyroscopic=True)
+    y0 = np.zeros(2 * s.n_dof)
+    kw = dict(method=method, full_history=True)
+    if method == "rk4":
+        kw["step"] = 2e-6
+    a = integrate(s, y0, (0.0, 0.004), rhs="literal", **kw)
+    b = integrate(s, y0, (0.0, 0.004), rhs="general", **kw)
+    assert (a.rhs, b.rhs) == ("literal", "general")
+    assert a.success and a.n_steps == b.n_steps > 100
+    for name in ("y_final", "cycle_max", "cycle_min", "cycle_mean", "history_forces",
+                 "full_y", "separation_steps", "back_contact_steps"):
+        np.testing.assert_array_equal(getattr(a, name), getattr(b, name), err_msg=name)
+
+
+def test_auto_takes_literal_code_only_where_it_repays_its_compilation(monkeypatch):
+    s = random_structure(8)
+    model = kernel_model(s)
+    codegen.generated_rhs(model)  # the pattern compiled: "auto" generates from here on
+    assert not codegen.worth_literal(model, 1e3)
+    assert codegen.worth_literal(model, 1e9)
+    y0 = np.zeros(2 * s.n_dof)
+    short = integrate(s, y0, (0.0, 1e-4), step=1e-6)
+    assert short.rhs == "generated"
+    monkeypatch.setattr(codegen, "_LITERAL_SAVING_S_PER_NONZERO", 1.0)  # (any run repays)
+    long = integrate(s, y0, (0.0, 1e-4), step=1e-6)
+    assert long.rhs == "literal"
+    np.testing.assert_array_equal(short.y_final, long.y_final)
+
+
+def test_literal_codes_are_capped_per_process(monkeypatch):
+    """MCJIT never frees code: beyond LITERAL_MAX the runs take the pattern's code, and
+    asking for a literal one by name still runs (the same results)."""
+    monkeypatch.setattr(codegen._COMPILER, "_literal", {})
+    monkeypatch.setattr(codegen, "LITERAL_MAX", 1)
+    s1, s2 = spur_pair(torque=11.0), spur_pair(torque=23.0)  # (external_force)
+    y0 = np.zeros(2 * s1.n_dof)
+    assert integrate(s1, y0, (0.0, 1e-3), rhs="literal").rhs == "literal"
+    assert not codegen.worth_literal(kernel_model(s2), 1e12)
+    b = integrate(s2, y0, (0.0, 1e-3), rhs="literal")
+    assert b.rhs == "generated"
+    with pytest.raises(RuntimeError, match="LITERAL_MAX"):
+        codegen.generated_rhs(kernel_model(s2), literal=True)
+    assert integrate(s1, y0, (0.0, 1e-3), rhs="literal").rhs == "literal"  # (cached)
+    np.testing.assert_array_equal(b.y_final,
+                                  integrate(s2, y0, (0.0, 1e-3), rhs="general").y_final)
+
+
+def test_steady_state_refuses_literal_code():
+    """The steady-state solvers change the code's parameters with the speed."""
+    from torquesplit.steady.problem import PeriodicProblem
+
+    with pytest.raises(ValueError, match="rhs='literal'.*rhs='generated'"):
+        PeriodicProblem(spur_pair(), 1000.0, rhs="literal")

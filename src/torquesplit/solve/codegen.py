@@ -39,6 +39,16 @@ damping, masses, forces) are read from a parameter vector at fixed offsets.  Com
 code is therefore kept per pattern and reused by every model with the same pattern (a
 parameter sweep compiles once).
 
+*Literal* code (``generated_rhs(model, literal=True)``, ``integrate(rhs="literal")``, and
+``"auto"``'s choice for a run long enough to repay it) writes those values into the code
+as constants instead: the same instructions, but LLVM drops a product with a coefficient
+of 1, negates for -1 and takes every other constant as an operand, so that a whole RK4
+step takes 8 % less time on Ji & Li's and Liu et al. 2021's models and 25 % less on Dong
+et al. 2021's (same-process A/B).  It folds nothing that is not exact (no fast-math
+flags): the results are bit for bit the same (tested).  Such code serves one set of
+values (the excitation arrays, e.g. the stiffness tables, still come at every call), so
+a process keeps at most ``LITERAL_MAX`` of them.
+
 Calling convention (C)::
 
     void rhs(uint64 y, uint64 dy, uint64 force, uint64 defl, uint64 K, uint64 G,
@@ -60,9 +70,14 @@ import numpy as np
 
 from . import laws
 
-__all__ = ["GeneratedRhs", "generated_rhs", "general_rhs", "rhs_ir", "worth_generating"]
+__all__ = ["GeneratedRhs", "generated_rhs", "general_rhs", "rhs_ir", "worth_generating",
+           "worth_literal"]
 
 ARG_NAMES = ("y", "dy", "force", "defl", "K", "G", "E", "ED", "P", "par", "FR")
+PARAMETER_ARRAYS = ("v_coef", "vt_coef", "gy_coef", "fs_coef", "damping", "external_force",
+                    "ground_damping", "inv_mass", "sp_par", "fr_coef")
+"""The kernel-model arrays the generated code reads through ``par`` (the rest: its
+pattern, or the excitation arrays K, G, E, ED, P and FR passed at every call)."""
 SLOT_ARGS = ("K", "G", "E", "ED", "P")
 """Excitation arrays (n_slot, ne), passed whole: the function reads row ``off / ne``.  The
 friction table values FR (n_slot, 3 n_friction) are read in row ``off / ne`` too."""
@@ -80,6 +95,10 @@ class GeneratedRhs:
     """Seconds spent generating and compiling (0.0 when the pattern was cached)."""
     lines: int
     """Lines of LLVM IR (0 for the general kernel)."""
+    literal: bool = False
+    """True: the model's values are constants of the code (:func:`generated_rhs` with
+    ``literal=True``), which then ignores ``parameters``; False: the code reads them
+    from ``parameters`` (one compiled function for every model of the pattern)."""
 
     @property
     def generated(self) -> bool:
@@ -110,13 +129,15 @@ def _law_ir(kind: str = "spring") -> tuple[str, str]:
     return _LAWS[kind]
 
 
-def rhs_ir(model) -> tuple[str, list[tuple[str, int]]]:
+def rhs_ir(model, literal: bool = False) -> tuple[str, list[tuple[str, int]]]:
     """LLVM IR of the right-hand side of a kernel model ``model``
     (:class:`~torquesplit.solve.kernel_data.KernelModel`) and the parameter layout: entry
     i of ``par`` is ``model.<name>`` (flattened) ``[index]`` for the i-th ``(name,
-    index)``.  The IR calls the element laws by name (:func:`_law_ir`);
-    :func:`_Compiler.compile` links them in."""
+    index)``.  With ``literal`` each parameter is written as its value, a constant (its
+    exact bits), instead of a load from ``par``.  The IR calls the element laws by name
+    (:func:`_law_ir`); :func:`_Compiler.compile` links them in."""
     a = _arrays(model)
+    flat = {name: np.ravel(a[name]) for name in PARAMETER_ARRAYS}
     n = a["inv_mass"].shape[0]
     ne = a["vr_ptr"].shape[0] - 1
     vr_ptr, vq_idx = a["vr_ptr"].astype(np.int64), a["vq_idx"].astype(np.int64)
@@ -176,6 +197,8 @@ def rhs_ir(model) -> tuple[str, list[tuple[str, int]]]:
 
     def param(name: str, i: int) -> str:
         layout.append((name, int(i)))
+        if literal:  # the double's bits in hex: exact, and LLVM's own notation
+            return "0x%016X" % int(flat[name][i:i + 1].view(np.uint64)[0])
         return load("par", len(layout) - 1)
 
     force = {}
@@ -331,6 +354,17 @@ def _pattern_key(model) -> str:
     return h.hexdigest()
 
 
+def _value_key(model) -> str:
+    """The pattern key and the values of every parameter array (a literal code's key)."""
+    a = _arrays(model)
+    h = hashlib.sha256(_pattern_key(model).encode())
+    for name in PARAMETER_ARRAYS:
+        arr = np.ascontiguousarray(a[name], dtype=np.float64)
+        h.update(str(arr.shape).encode())
+        h.update(arr.tobytes())
+    return h.hexdigest()
+
+
 class _Compiler:
     """One llvmlite MCJIT engine for every generated function, as numba keeps one for its
     own code, and the cache of compiled patterns (thread-safe).
@@ -343,6 +377,7 @@ class _Compiler:
     def __init__(self):
         self._lock = threading.Lock()
         self._cache: dict[str, tuple] = {}
+        self._literal: dict[str, tuple] = {}
         self._engine = None
         self._tm = None
 
@@ -392,28 +427,36 @@ class _Compiler:
             self._engine.finalize_object()
             return self._engine.get_function_address(name)
 
-    def cached(self, model) -> bool:
+    def cached(self, model, literal: bool = False) -> bool:
         with self._lock:
+            if literal:
+                return _value_key(model) in self._literal
             return _pattern_key(model) in self._cache
 
-    def get(self, model):
+    def literal_room(self) -> bool:
+        """Whether another literal code may be compiled (see :data:`LITERAL_MAX`)."""
+        with self._lock:
+            return len(self._literal) < LITERAL_MAX
+
+    def get(self, model, literal: bool = False):
         import time
 
-        key = _pattern_key(model)
+        key = _value_key(model) if literal else _pattern_key(model)
+        cache = self._literal if literal else self._cache
         with self._lock:
-            hit = self._cache.get(key)
+            hit = cache.get(key)
         if hit is not None:
             return hit, 0.0
         t0 = time.perf_counter()
-        ir, layout = rhs_ir(model)
+        ir, layout = rhs_ir(model, literal)
         with self._lock:  # another thread may have compiled it meanwhile
-            hit = self._cache.get(key)
+            hit = cache.get(key)
         if hit is not None:
             return hit, 0.0
-        address = self.compile(f"rhs_{key[:24]}", ir)
+        address = self.compile(f"rhs_{'v' if literal else ''}{key[:24]}", ir)
         entry = (address, layout, ir.count("\n"))
         with self._lock:
-            self._cache.setdefault(key, entry)
+            cache.setdefault(key, entry)
         return entry, time.perf_counter() - t0
 
 
@@ -496,6 +539,17 @@ _COMPILE_S_PER_LINE = 4e-5
 _COMPILE_S_PER_LINE2 = 5e-9
 _LINES_PER_NONZERO = 30.0
 _SAVING_S_PER_NONZERO = 5e-9
+# ... and of "auto"'s choice of literal code: it compiles in about 0.6 times the pattern's
+# time (Dong et al. 2021: 0.09 against 0.15 s) and saves, per call against the pattern's
+# code, 0.2-1 ns per non-zero (Ji & Li, Liu et al. 2021: 0.2; Dong et al. 2021: 1, most
+# of it in its splines' laws): counted as 0.2 ns per non-zero and 15 ns per spline.
+_LITERAL_COMPILE = 0.7
+_LITERAL_SAVING_S_PER_NONZERO = 0.2e-9
+_LITERAL_SAVING_S_PER_SPLINE = 15e-9
+LITERAL_MAX = 16
+"""Literal codes compiled at most per process: MCJIT never frees code (0.9 MiB for Dong
+et al. 2021's model even after its module is removed), and a study would compile one per
+case; beyond it the runs use the pattern's code (same results)."""
 
 
 def worth_generating(model, n_rhs: float) -> bool:
@@ -509,11 +563,39 @@ def worth_generating(model, n_rhs: float) -> bool:
     return n_rhs * _SAVING_S_PER_NONZERO * nnz > compile_s
 
 
-def generated_rhs(model) -> GeneratedRhs:
+def worth_literal(model, n_rhs: float) -> bool:
+    """Whether code with this model's values as constants (``generated_rhs(model,
+    literal=True)``) repays its compilation over ``n_rhs`` evaluations against the
+    pattern's code: always when it was compiled before; never once :data:`LITERAL_MAX`
+    of them were compiled in this process."""
+    if _COMPILER.cached(model, literal=True):
+        return True
+    if not _COMPILER.literal_room():
+        return False
+    a = _arrays(model)
+    nnz = float(a["v_coef"].shape[0]) + 1.0
+    lines = _LINES_PER_NONZERO * nnz
+    compile_s = _LITERAL_COMPILE * (_COMPILE_S_PER_LINE * lines + _COMPILE_S_PER_LINE2 * lines**2)
+    saving = _LITERAL_SAVING_S_PER_NONZERO * nnz + _LITERAL_SAVING_S_PER_SPLINE * (
+        np.asarray(a["sp_el"]).size // 2)
+    return n_rhs * saving > compile_s
+
+
+def generated_rhs(model, literal: bool = False) -> GeneratedRhs:
     """The compiled right-hand side of the kernel model arrays ``model`` (the tuple
-    ``integrate`` passes to the kernels), from the cache when its pattern was compiled
-    before in this process."""
-    (address, layout, lines), seconds = _COMPILER.get(model)
+    ``integrate`` passes to the kernels), from the cache when its pattern (with
+    ``literal``: its pattern and values) was compiled before in this process.
+
+    ``literal``: the model's values are constants of the code, which LLVM folds where
+    that is exact (a coefficient 1 or -1, a constant operand instead of a load): 8 % of
+    a whole RK4 step of Ji & Li's and Liu et al. 2021's models, 25 % of Dong et al.
+    2021's (same-process A/B), results bit for bit the same.  The code then serves only
+    models with these values, and is never freed: at most :data:`LITERAL_MAX` per
+    process (about 1 MiB each for a 50-DOF model)."""
+    if literal and not _COMPILER.cached(model, literal=True) and not _COMPILER.literal_room():
+        raise RuntimeError(f"{LITERAL_MAX} literal right-hand sides were compiled in this "
+                           f"process already (codegen.LITERAL_MAX); use literal=False")
+    (address, layout, lines), seconds = _COMPILER.get(model, literal)
     a = _arrays(model)
     par = np.array([np.ravel(a[name])[i] for name, i in layout], dtype=np.float64)
-    return GeneratedRhs(_function(address), par, seconds, lines)
+    return GeneratedRhs(_function(address), par, seconds, lines, literal)

@@ -144,7 +144,8 @@ class Solution:
     wall_time: float
     """Seconds spent in this call, compile time excluded."""
     rhs: str
-    """Right-hand side the kernels called: "generated" or "general" (see integrate)."""
+    """Right-hand side the kernels called: "literal", "generated" or "general" (see
+    integrate)."""
     rhs_compile_time: float
     """Seconds spent generating and compiling it in this call (0 when cached)."""
     dof_names: tuple[str, ...]
@@ -463,16 +464,20 @@ def integrate(
         Stop with status 1 when any |q| exceeds this [m or rad].
     progress : callable, optional
         ``progress(fraction_done)``, called between chunks of the run.
-    rhs : {"auto", "generated", "general"}
+    rhs : {"auto", "generated", "literal", "general"}
         Right-hand side the kernels call.  "generated": this structure's equations as
         straight-line machine code (:mod:`torquesplit.solve.codegen`, compiled in
         0.05 s for 14 DOFs to seconds for 400, cached per sparsity pattern; bit for bit
-        the general kernel's results, about twice as fast per step).  "general": the
-        kernel's element loop.  "auto" (default): generated when the run is long enough
-        to repay the compilation (:func:`codegen.worth_generating`) or the pattern is
-        already compiled.  If the code cannot be generated (e.g. an llvmlite without
-        the new pass manager) the run uses "general" with a warning; ``Solution.rhs``
-        says which one ran.
+        the general kernel's results, about twice as fast per step).  "literal": the
+        same code with this model's values as constants (compiled per set of values;
+        another 8-25 % off a step, the same results; once ``codegen.LITERAL_MAX`` of
+        them were compiled in the process, "generated").  "general": the kernel's
+        element loop.  "auto" (default): generated when the run is long enough to repay
+        the compilation (:func:`codegen.worth_generating`) or the pattern is already
+        compiled, literal when the run is long enough to repay that compilation too
+        (:func:`codegen.worth_literal`).  If the code cannot be generated (e.g. an
+        llvmlite without the new pass manager) the run uses "general" with a warning;
+        ``Solution.rhs`` says which one ran.
 
     corners : bool
         Where a table (stiffness wave, impact force, per-cycle backlash) has a corner
@@ -576,7 +581,8 @@ def integrate(
     return _solution(s, sel, plan, rec, counters, clock, y, method=method, t_span=(t0, t_end),
                      blowup=blowup, step_min=step_min, step_max=step_max,
                      compile_time=compile_time, wall_time=time.perf_counter() - t_call,
-                     rhs_name="generated" if rhs_code.generated else "general",
+                     rhs_name=("literal" if rhs_code.literal else "generated")
+                     if rhs_code.generated else "general",
                      rhs_compile_time=rhs_code.compile_time, full_history=full_history)
 
 
@@ -956,14 +962,30 @@ def _rows(buf: np.ndarray, n: int) -> np.ndarray:
     return buf[:n] if n >= 0.9 * buf.shape[0] else buf[:n].copy()
 
 
-def _rhs_code(kind: str, model, n_rhs: float) -> codegen.GeneratedRhs:
-    """The right-hand side the kernels call (see ``integrate(rhs=...)``)."""
-    if kind not in ("auto", "generated", "general"):
-        raise OptionError(f"rhs must be 'auto', 'generated' or 'general', got {kind!r}.")
+RHS_KINDS = ("auto", "generated", "literal", "general")
+
+
+def _rhs_code(kind: str, model, n_rhs: float, literal: bool = True) -> codegen.GeneratedRhs:
+    """The right-hand side the kernels call (see ``integrate(rhs=...)``); ``literal``
+    False where the caller changes the parameters after the code was chosen (the
+    steady-state solvers, whose turning frame's terms follow the speed)."""
+    if kind not in RHS_KINDS:
+        raise OptionError(f"rhs must be 'auto', 'generated', 'literal' or 'general', got "
+                          f"{kind!r}.")
     if kind == "general" or (kind == "auto" and not codegen.worth_generating(model, n_rhs)):
         return codegen.general_rhs()
+    if kind == "literal" and not literal:
+        raise OptionError("rhs='literal' writes the model's values into the code, which "
+                          "this solver changes as it goes: use rhs='generated' (the same "
+                          "results).")
+    # literal code: when asked for, or when it repays its compilation ("auto"); beyond
+    # codegen.LITERAL_MAX per process, the pattern's code (the same results)
+    use_literal = literal and (
+        (kind == "literal" and (codegen._COMPILER.cached(model, literal=True)
+                                or codegen._COMPILER.literal_room()))
+        or (kind == "auto" and codegen.worth_literal(model, n_rhs)))
     try:
-        return codegen.generated_rhs(model)
+        return codegen.generated_rhs(model, use_literal)
     except Exception as exc:  # noqa: BLE001 - any failure falls back, with a warning
         global _CODEGEN_WARNED
         if not _CODEGEN_WARNED:

@@ -112,7 +112,7 @@ class PeriodicProblem:
         self.model = kd.kernel_model(structure)
         # the integrators' right-hand side: generated for this model when that repays
         # its compilation over RHS_CALLS evaluations ("auto"), else the general loop
-        self.code = _rhs_code(rhs, self.model, RHS_CALLS)
+        self.code = _rhs_code(rhs, self.model, RHS_CALLS, literal=False)
         self.work = kd.make_work(self.model, self.code.parameters)
         s = structure
         self.n = s.n_dof
