@@ -104,9 +104,11 @@ def rk4_step(case: Case) -> float:
 def time_rk4(case: Case, n_steps: int, repeat: int = 2) -> dict:
     """Best of ``repeat`` runs of ``n_steps`` RK4 steps; us/step and simulated s per wall s.
 
-    The engine's default (the model's generated right-hand side) and the general kernel
-    (``rhs="general"``) are run alternately, so their ratio is not skewed by the machine
-    getting busier or quieter; the main figures are the default's.
+    The engine's generated right-hand side (the pattern's code: what ``rhs="auto"`` takes
+    for a run of this length), the literal code (``rhs="literal"``: the model's values
+    compiled in, what "auto" takes for runs long enough to repay that) and the general
+    kernel (``rhs="general"``) are run alternately, so their ratios are not skewed by the
+    machine getting busier or quieter; the main figures are the generated code's.
     """
     from torquesplit.solve.integrate import integrate
 
@@ -114,7 +116,7 @@ def time_rk4(case: Case, n_steps: int, repeat: int = 2) -> dict:
     span = n_steps * h
     best: dict[str, dict] = {}
     for _ in range(repeat):
-        for kind in ("generated", "general"):
+        for kind in ("generated", "literal", "general"):
             w0, c0 = time.perf_counter(), time.process_time()
             sol = integrate(case.structure, case.y0, (0.0, span), method="rk4",
                             steps_per_period=STEPS_PER_PERIOD, record_every=RECORD_EVERY,
@@ -122,7 +124,7 @@ def time_rk4(case: Case, n_steps: int, repeat: int = 2) -> dict:
             wall, cpu = time.perf_counter() - w0, time.process_time() - c0
             if kind not in best or wall < best[kind]["wall"]:
                 best[kind] = {"wall": wall, "cpu": cpu, "sol": sol}
-    sol, gen = best["generated"]["sol"], best["general"]
+    sol, gen, lit = best["generated"]["sol"], best["general"], best["literal"]
     return {
         "model": case.name, "static_converged": case.static_converged, "n_dof": case.n_dof,
         "n_elements": case.n_elements, "f_max": case.f_max,
@@ -135,6 +137,9 @@ def time_rk4(case: Case, n_steps: int, repeat: int = 2) -> dict:
         "sim_per_wall": sol.t_final / best["generated"]["wall"],
         "general_us_per_step": gen["wall"] / gen["sol"].n_steps * 1e6,
         "general_cpu_us_per_step": gen["cpu"] / gen["sol"].n_steps * 1e6,
+        "literal_us_per_step": lit["wall"] / lit["sol"].n_steps * 1e6,
+        "literal_cpu_us_per_step": lit["cpu"] / lit["sol"].n_steps * 1e6,
+        "literal_rhs": lit["sol"].rhs,
     }
 
 
