@@ -32,6 +32,7 @@ per-case overhead of a long study.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import datetime as _dt
 import json
 import math
@@ -154,6 +155,26 @@ def parallel_capacity() -> dict:
             "slowdown": sum(pair) / 2 / alone, "free_cores_estimate": 2 * alone / max(pair)}
 
 
+@contextlib.contextmanager
+def _literal_codes(allowed: bool, codegen):
+    """Literal right-hand sides as by default (``allowed``) or none, in this process
+    (the 1-worker study runs its cases here) and in the workers it starts."""
+    if allowed:
+        yield
+        return
+    before, env = codegen.LITERAL_MAX, os.environ.get("TORQUESPLIT_LITERAL_MAX")
+    codegen.LITERAL_MAX = 0
+    os.environ["TORQUESPLIT_LITERAL_MAX"] = "0"
+    try:
+        yield
+    finally:
+        codegen.LITERAL_MAX = before
+        if env is None:
+            os.environ.pop("TORQUESPLIT_LITERAL_MAX", None)
+        else:
+            os.environ["TORQUESPLIT_LITERAL_MAX"] = env
+
+
 def monte_carlo(n: int) -> dict:
     """The Dong et al. 2021 Monte Carlo at ``n`` cases on 1 and 2 workers.
 
@@ -165,7 +186,14 @@ def monte_carlo(n: int) -> dict:
     times; a line through two study sizes was tried and, on this VM, differencing two
     noisy wall times gave negative fixed parts).  A worker's first case also carries its
     process start-up (imports, kernel loading): counted as case time, so the estimate
-    leans slow.  Every timed study starts its own pool, after an untimed one-case study."""
+    leans slow.  Every timed study starts its own pool, after an untimed one-case study.
+
+    The 1 and 2 worker runs are made with ``TORQUESPLIT_LITERAL_MAX=0``: every case runs
+    the pattern's generated code, as all but a worker's first 16 cases of a 1000-case
+    study do (the literal code of a case's values is compiled at most 16 times a process,
+    ``codegen.LITERAL_MAX``); one more 1-worker run with the default shows what those
+    first cases gain."""
+    from torquesplit.solve import codegen
     from torquesplit.study import Study
 
     def spec(samples: int) -> dict:
@@ -185,11 +213,12 @@ def monte_carlo(n: int) -> dict:
     # untimed: what only the first study of a process pays (the driver's imports of the
     # study layer and the store, the model's first set-up) would otherwise sit in the
     # 1-worker run alone
-    with tempfile.TemporaryDirectory() as tmp:
+    with tempfile.TemporaryDirectory() as tmp, _literal_codes(False, codegen):
         Study(spec(1)).run(workers=1, out=Path(tmp), figures=False)
-    for workers in (1, 2):
-        with tempfile.TemporaryDirectory() as tmp:
-            _log(f"Monte Carlo, Dong et al. 2021 model: {n} cases on {workers} worker(s)")
+    for workers, literal in ((1, False), (2, False), (1, True)):
+        with tempfile.TemporaryDirectory() as tmp, _literal_codes(literal, codegen):
+            _log(f"Monte Carlo, Dong et al. 2021 model: {n} cases on {workers} worker(s)"
+                 + (", literal code" if literal else ""))
             t0 = time.perf_counter()
             Study(spec(n)).run(workers=workers, out=Path(tmp), figures=False)
             wall = time.perf_counter() - t0
@@ -198,7 +227,7 @@ def monte_carlo(n: int) -> dict:
             busy = sum(c["wall_time"] for c in cases) / workers
             res["fixed_s"] = wall - busy
             res["cases_1000_s"] = res["fixed_s"] + 1000 * busy / n
-            out[f"workers_{workers}"] = res
+            out[f"workers_{workers}" + ("_literal" if literal else "")] = res
             _log(f"  {wall:.1f} s")
     out["capacity_after"] = parallel_capacity()
     w1, w2 = out["workers_1"], out["workers_2"]
@@ -306,12 +335,23 @@ def report(res: dict) -> str:
                   "| workers | study wall [s] | per case [s] | integration per case [s] | "
                   "overhead in worker | of it after each worker's first case | overhead seen "
                   "by driver |", "|---|---|---|---|---|---|---|"]
-        for w in (w1, w2):
-            lines.append(f"| {w['workers']} | {w['study_wall_s']:.1f} | "
+        lit = mc.get("workers_1_literal")
+        for w in (w1, w2) + ((lit,) if lit else ()):
+            label = f"{w['workers']}" + (" (literal code)" if w is lit else "")
+            lines.append(f"| {label} | {w['study_wall_s']:.1f} | "
                          f"{w['mean_case_wall_s']:.2f} | {w['mean_integration_s']:.2f} | "
                          f"{100 * w['overhead_in_worker_fraction']:.2f} % | "
                          f"{100 * w['overhead_after_first_fraction']:.2f} % | "
                          f"{100 * w['overhead_seen_by_driver_fraction']:.1f} % |")
+        if lit:
+            lines += ["", "The first two rows: every case runs the pattern's generated code "
+                      "(`TORQUESPLIT_LITERAL_MAX=0`), as all but each worker's first 16 "
+                      "cases of a 1000-case study do; the 1000-case figures below are "
+                      "theirs.  The last row: the default, each case's values compiled in "
+                      "(the literal code, at most 16 a process): integration "
+                      f"{lit['mean_integration_s']:.2f} s a case against "
+                      f"{w1['mean_integration_s']:.2f} s "
+                      f"({lit['mean_integration_s'] / w1['mean_integration_s']:.2f}x)."]
         caps = [mc[k] for k in ("capacity_before", "capacity_after") if k in mc]
         if caps:
             lines += ["", "Baseline in the same run: two plain `torquesplit.simulate` processes "

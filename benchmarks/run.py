@@ -81,7 +81,7 @@ def run(quick: bool, repeat: int, skip_compile: bool = False) -> dict:
     _log("engine against the hand transcription of Ji & Li's equations")
     import bench_transcription
 
-    res["transcription"] = bench_transcription.compare(cfg["engine_steps"], max(3, repeat))
+    res["transcription"] = bench_transcription.compare(cfg["engine_steps"], max(9, repeat))
     tr = res["transcription"]
     _log(f"  engine {tr['engine_us']:.3f} / general {tr['general_us']:.3f} / hand "
          f"{tr['hand_us']:.3f} us/step")
@@ -372,7 +372,8 @@ def report(res: dict) -> str:
                  "(literal, generated and general right-hand side) over the same steps from "
                  "the same "
                  "state, each streaming the per-cycle statistics of the four mesh forces "
-                 "(the engine without a history), alternated, best CPU time of each. The cost "
+                 f"(the engine without a history), alternated, best CPU time of each over "
+                 f"{ht.get('repeat', 3)} rounds. The cost "
                  "per step is the difference between runs of 2 n and n steps over n; what is "
                  "left is the fixed cost of a call (for the engine, the Python set-up of "
                  "`integrate`: its work and record arrays and the outputs; the kernel "

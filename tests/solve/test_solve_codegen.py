@@ -245,7 +245,7 @@ def test_literal_codes_are_capped_per_process(monkeypatch):
     assert not codegen.worth_literal(kernel_model(s2), 1e12)
     b = integrate(s2, y0, (0.0, 1e-3), rhs="literal")
     assert b.rhs == "generated"
-    with pytest.raises(RuntimeError, match="LITERAL_MAX"):
+    with pytest.raises(torquesplit.errors.SolverError, match="LITERAL_MAX"):
         codegen.generated_rhs(kernel_model(s2), literal=True)
     assert integrate(s1, y0, (0.0, 1e-3), rhs="literal").rhs == "literal"  # (cached)
     np.testing.assert_array_equal(b.y_final,
@@ -258,3 +258,16 @@ def test_steady_state_refuses_literal_code():
 
     with pytest.raises(ValueError, match="rhs='literal'.*rhs='generated'"):
         PeriodicProblem(spur_pair(), 1000.0, rhs="literal")
+
+
+def test_literal_cap_from_the_environment(monkeypatch):
+    monkeypatch.setenv("TORQUESPLIT_LITERAL_MAX", "0")
+    assert codegen._literal_max() == 0
+    monkeypatch.setenv("TORQUESPLIT_LITERAL_MAX", " 40 ")
+    assert codegen._literal_max() == 40
+    monkeypatch.delenv("TORQUESPLIT_LITERAL_MAX")
+    assert codegen._literal_max() == 16
+    for bad in ("-1", "many", "2.5"):
+        monkeypatch.setenv("TORQUESPLIT_LITERAL_MAX", bad)
+        with pytest.warns(RuntimeWarning, match="TORQUESPLIT_LITERAL_MAX.*not a count"):
+            assert codegen._literal_max() == 16

@@ -43,8 +43,8 @@ parameter sweep compiles once).
 ``"auto"``'s choice for a run long enough to repay it) writes those values into the code
 as constants instead: the same instructions, but LLVM drops a product with a coefficient
 of 1, negates for -1 and takes every other constant as an operand, so that a whole RK4
-step takes 8 % less time on Ji & Li's and Liu et al. 2021's models and 25 % less on Dong
-et al. 2021's (same-process A/B).  It folds nothing that is not exact (no fast-math
+step takes 4-8 % less time on Ji & Li's and Liu et al. 2021's models and 20-25 % less on
+Dong et al. 2021's (benchmarks/RESULTS.md).  It folds nothing that is not exact (no fast-math
 flags): the results are bit for bit the same (tested).  Such code serves one set of
 values (the excitation arrays, e.g. the stiffness tables, still come at every call), so
 a process keeps at most ``LITERAL_MAX`` of them.
@@ -63,6 +63,7 @@ at flat index ``off`` = slot * ne (and row off / ne of the friction values FR).
 from __future__ import annotations
 
 import hashlib
+import os
 import threading
 from dataclasses import dataclass
 
@@ -546,10 +547,32 @@ _SAVING_S_PER_NONZERO = 5e-9
 _LITERAL_COMPILE = 0.7
 _LITERAL_SAVING_S_PER_NONZERO = 0.2e-9
 _LITERAL_SAVING_S_PER_SPLINE = 15e-9
-LITERAL_MAX = 16
-"""Literal codes compiled at most per process: MCJIT never frees code (0.9 MiB for Dong
-et al. 2021's model even after its module is removed), and a study would compile one per
-case; beyond it the runs use the pattern's code (same results)."""
+
+
+def _literal_max(default: int = 16) -> int:
+    """:data:`LITERAL_MAX`: the environment's ``TORQUESPLIT_LITERAL_MAX`` (a count >= 0)
+    or ``default``."""
+    text = os.environ.get("TORQUESPLIT_LITERAL_MAX", "").strip()
+    if not text:
+        return default
+    try:
+        value = int(text)
+        if value < 0:
+            raise ValueError
+    except ValueError:
+        import warnings
+
+        warnings.warn(f"TORQUESPLIT_LITERAL_MAX={text!r} is not a count (0, 1, 2, ...): "
+                      f"using {default}", RuntimeWarning, stacklevel=2)
+        return default
+    return value
+
+
+LITERAL_MAX = _literal_max()
+"""Literal codes compiled at most per process (16, or the environment's
+``TORQUESPLIT_LITERAL_MAX``; 0: never): MCJIT never frees code (0.9 MiB for Dong et al.
+2021's model even after its module is removed), and a study would compile one per case;
+beyond it the runs use the pattern's code (same results)."""
 
 
 def worth_generating(model, n_rhs: float) -> bool:
@@ -587,13 +610,15 @@ def generated_rhs(model, literal: bool = False) -> GeneratedRhs:
     ``literal``: its pattern and values) was compiled before in this process.
 
     ``literal``: the model's values are constants of the code, which LLVM folds where
-    that is exact (a coefficient 1 or -1, a constant operand instead of a load): 8 % of
-    a whole RK4 step of Ji & Li's and Liu et al. 2021's models, 25 % of Dong et al.
-    2021's (same-process A/B), results bit for bit the same.  The code then serves only
+    that is exact (a coefficient 1 or -1, a constant operand instead of a load): 4-8 %
+    of a whole RK4 step of Ji & Li's and Liu et al. 2021's models, 20-25 % of Dong et
+    al. 2021's (benchmarks/RESULTS.md), results bit for bit the same.  The code then serves only
     models with these values, and is never freed: at most :data:`LITERAL_MAX` per
     process (about 1 MiB each for a 50-DOF model)."""
     if literal and not _COMPILER.cached(model, literal=True) and not _COMPILER.literal_room():
-        raise RuntimeError(f"{LITERAL_MAX} literal right-hand sides were compiled in this "
+        from torquesplit.errors import SolverError
+
+        raise SolverError(f"{LITERAL_MAX} literal right-hand sides were compiled in this "
                            f"process already (codegen.LITERAL_MAX); use literal=False")
     (address, layout, lines), seconds = _COMPILER.get(model, literal)
     a = _arrays(model)

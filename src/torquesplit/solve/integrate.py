@@ -470,8 +470,9 @@ def integrate(
         0.05 s for 14 DOFs to seconds for 400, cached per sparsity pattern; bit for bit
         the general kernel's results, about twice as fast per step).  "literal": the
         same code with this model's values as constants (compiled per set of values;
-        another 8-25 % off a step, the same results; once ``codegen.LITERAL_MAX`` of
-        them were compiled in the process, "generated").  "general": the kernel's
+        another 4-25 % off a step, the same results; once ``codegen.LITERAL_MAX`` of
+        them were compiled in the process (16; environment variable
+        ``TORQUESPLIT_LITERAL_MAX``), "generated").  "general": the kernel's
         element loop.  "auto" (default): generated when the run is long enough to repay
         the compilation (:func:`codegen.worth_generating`) or the pattern is already
         compiled, literal when the run is long enough to repay that compilation too
