@@ -155,6 +155,24 @@ def parallel_capacity() -> dict:
             "slowdown": sum(pair) / 2 / alone, "free_cores_estimate": 2 * alone / max(pair)}
 
 
+def _literal_codes_needed(spec: dict) -> int:
+    """How many distinct literal right-hand sides the study's cases need (their kernel
+    models' parameter values, ``codegen._value_key``)."""
+    from torquesplit import assemble, load_model
+    from torquesplit.model.io import model_from_dict
+    from torquesplit.model.overrides import apply_overrides
+    from torquesplit.solve import codegen, kernel_data
+    from torquesplit.study import Study
+
+    plan = Study(spec).plan()
+    keys = set()
+    for i in range(plan.design.n_cases):
+        data = apply_overrides(plan.case_data, plan.design.overrides(i))
+        model = load_model(model_from_dict(data, source=plan.model_source))
+        keys.add(codegen._value_key(kernel_data.kernel_model(assemble(model))))
+    return len(keys)
+
+
 @contextlib.contextmanager
 def _literal_codes(allowed: bool, codegen):
     """Literal right-hand sides as by default (``allowed``) or none, in this process
@@ -163,12 +181,13 @@ def _literal_codes(allowed: bool, codegen):
         yield
         return
     before, env = codegen.LITERAL_MAX, os.environ.get("TORQUESPLIT_LITERAL_MAX")
-    codegen.LITERAL_MAX = 0
+    compiled = codegen._COMPILER._literal  # (those compiled here would still be used)
+    codegen.LITERAL_MAX, codegen._COMPILER._literal = 0, {}
     os.environ["TORQUESPLIT_LITERAL_MAX"] = "0"
     try:
         yield
     finally:
-        codegen.LITERAL_MAX = before
+        codegen.LITERAL_MAX, codegen._COMPILER._literal = before, compiled
         if env is None:
             os.environ.pop("TORQUESPLIT_LITERAL_MAX", None)
         else:
@@ -188,11 +207,11 @@ def monte_carlo(n: int) -> dict:
     process start-up (imports, kernel loading): counted as case time, so the estimate
     leans slow.  Every timed study starts its own pool, after an untimed one-case study.
 
-    The 1 and 2 worker runs are made with ``TORQUESPLIT_LITERAL_MAX=0``: every case runs
-    the pattern's generated code, as all but a worker's first 16 cases of a 1000-case
-    study do (the literal code of a case's values is compiled at most 16 times a process,
-    ``codegen.LITERAL_MAX``); one more 1-worker run with the default shows what those
-    first cases gain."""
+    The cases run the literal right-hand side ("auto"'s choice for runs this long): the
+    study varies errors only, which the code reads at every call, so one literal code
+    serves every case (counted over the cases: ``literal_codes``; a process compiles at
+    most 16, ``codegen.LITERAL_MAX``).  One more 1-worker run with
+    ``TORQUESPLIT_LITERAL_MAX=0`` (the pattern's code) shows what it gains."""
     from torquesplit.solve import codegen
     from torquesplit.study import Study
 
@@ -213,9 +232,10 @@ def monte_carlo(n: int) -> dict:
     # untimed: what only the first study of a process pays (the driver's imports of the
     # study layer and the store, the model's first set-up) would otherwise sit in the
     # 1-worker run alone
-    with tempfile.TemporaryDirectory() as tmp, _literal_codes(False, codegen):
+    with tempfile.TemporaryDirectory() as tmp:
         Study(spec(1)).run(workers=1, out=Path(tmp), figures=False)
-    for workers, literal in ((1, False), (2, False), (1, True)):
+    out["literal_codes"] = _literal_codes_needed(spec(n))
+    for workers, literal in ((1, True), (2, True), (1, False)):
         with tempfile.TemporaryDirectory() as tmp, _literal_codes(literal, codegen):
             _log(f"Monte Carlo, Dong et al. 2021 model: {n} cases on {workers} worker(s)"
                  + (", literal code" if literal else ""))
@@ -227,7 +247,7 @@ def monte_carlo(n: int) -> dict:
             busy = sum(c["wall_time"] for c in cases) / workers
             res["fixed_s"] = wall - busy
             res["cases_1000_s"] = res["fixed_s"] + 1000 * busy / n
-            out[f"workers_{workers}" + ("_literal" if literal else "")] = res
+            out[f"workers_{workers}" + ("" if literal else "_pattern")] = res
             _log(f"  {wall:.1f} s")
     out["capacity_after"] = parallel_capacity()
     w1, w2 = out["workers_1"], out["workers_2"]
@@ -335,23 +355,25 @@ def report(res: dict) -> str:
                   "| workers | study wall [s] | per case [s] | integration per case [s] | "
                   "overhead in worker | of it after each worker's first case | overhead seen "
                   "by driver |", "|---|---|---|---|---|---|---|"]
-        lit = mc.get("workers_1_literal")
-        for w in (w1, w2) + ((lit,) if lit else ()):
-            label = f"{w['workers']}" + (" (literal code)" if w is lit else "")
+        pat = mc.get("workers_1_pattern")
+        for w in (w1, w2) + ((pat,) if pat else ()):
+            label = f"{w['workers']}" + (" (pattern's code)" if w is pat else "")
             lines.append(f"| {label} | {w['study_wall_s']:.1f} | "
                          f"{w['mean_case_wall_s']:.2f} | {w['mean_integration_s']:.2f} | "
                          f"{100 * w['overhead_in_worker_fraction']:.2f} % | "
                          f"{100 * w['overhead_after_first_fraction']:.2f} % | "
                          f"{100 * w['overhead_seen_by_driver_fraction']:.1f} % |")
-        if lit:
-            lines += ["", "The first two rows: every case runs the pattern's generated code "
-                      "(`TORQUESPLIT_LITERAL_MAX=0`), as all but each worker's first 16 "
-                      "cases of a 1000-case study do; the 1000-case figures below are "
-                      "theirs.  The last row: the default, each case's values compiled in "
-                      "(the literal code, at most 16 a process): integration "
-                      f"{lit['mean_integration_s']:.2f} s a case against "
-                      f"{w1['mean_integration_s']:.2f} s "
-                      f"({lit['mean_integration_s'] / w1['mean_integration_s']:.2f}x)."]
+        if pat:
+            lines += ["", "The first two rows: the cases as a study runs them, each with the "
+                      "literal right-hand side (the model's values compiled in: \"auto\"'s "
+                      f"choice for runs this long); the {w1['cases']} cases need "
+                      f"{mc.get('literal_codes', '?')} distinct literal code(s), as the study "
+                      "varies errors only, which the code reads at every call (a process "
+                      "compiles at most 16).  The last row: the same cases with the pattern's "
+                      "generated code (`TORQUESPLIT_LITERAL_MAX=0`): integration "
+                      f"{w1['mean_integration_s']:.2f} s a case against "
+                      f"{pat['mean_integration_s']:.2f} s "
+                      f"({w1['mean_integration_s'] / pat['mean_integration_s']:.2f}x)."]
         caps = [mc[k] for k in ("capacity_before", "capacity_after") if k in mc]
         if caps:
             lines += ["", "Baseline in the same run: two plain `torquesplit.simulate` processes "
