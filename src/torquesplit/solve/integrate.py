@@ -976,9 +976,10 @@ def _rhs_code(kind: str, model, n_rhs: float, literal: bool = True) -> codegen.G
     if kind == "general" or (kind == "auto" and not codegen.worth_generating(model, n_rhs)):
         return codegen.general_rhs()
     if kind == "literal" and not literal:
-        raise OptionError("rhs='literal' writes the model's values into the code, which "
-                          "this solver changes as it goes: use rhs='generated' (the same "
-                          "results).")
+        raise OptionError("rhs='literal' writes the model's values into the code, but "
+                          "this solver keeps them where it can change them (a turning "
+                          "carrier's frame terms follow the speed): use rhs='generated' "
+                          "(the same results).")
     # literal code: when asked for, or when it repays its compilation ("auto"); beyond
     # codegen.LITERAL_MAX per process, the pattern's code (the same results)
     use_literal = literal and (
