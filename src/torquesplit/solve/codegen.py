@@ -434,10 +434,11 @@ class _Compiler:
                 return _value_key(model) in self._literal
             return _pattern_key(model) in self._cache
 
-    def literal_room(self) -> bool:
-        """Whether another literal code may be compiled (see :data:`LITERAL_MAX`)."""
+    def literal_available(self, model) -> bool:
+        """Whether this model's literal code is compiled or may still be (at most
+        :data:`LITERAL_MAX` a process)."""
         with self._lock:
-            return len(self._literal) < LITERAL_MAX
+            return _value_key(model) in self._literal or len(self._literal) < LITERAL_MAX
 
     def get(self, model, literal: bool = False):
         import time
@@ -593,7 +594,7 @@ def worth_literal(model, n_rhs: float) -> bool:
     of them were compiled in this process."""
     if _COMPILER.cached(model, literal=True):
         return True
-    if not _COMPILER.literal_room():
+    if not _COMPILER.literal_available(model):
         return False
     a = _arrays(model)
     nnz = float(a["v_coef"].shape[0]) + 1.0
@@ -615,7 +616,7 @@ def generated_rhs(model, literal: bool = False) -> GeneratedRhs:
     al. 2021's (benchmarks/RESULTS.md), results bit for bit the same.  The code then serves only
     models with these values, and is never freed: at most :data:`LITERAL_MAX` per
     process (about 1 MiB each for a 50-DOF model)."""
-    if literal and not _COMPILER.cached(model, literal=True) and not _COMPILER.literal_room():
+    if literal and not _COMPILER.literal_available(model):
         from torquesplit.errors import SolverError
 
         raise SolverError(f"{LITERAL_MAX} literal right-hand sides were compiled in this "

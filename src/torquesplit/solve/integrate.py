@@ -983,8 +983,7 @@ def _rhs_code(kind: str, model, n_rhs: float, literal: bool = True) -> codegen.G
     # literal code: when asked for, or when it repays its compilation ("auto"); beyond
     # codegen.LITERAL_MAX per process, the pattern's code (the same results)
     use_literal = literal and (
-        (kind == "literal" and (codegen._COMPILER.cached(model, literal=True)
-                                or codegen._COMPILER.literal_room()))
+        (kind == "literal" and codegen._COMPILER.literal_available(model))
         or (kind == "auto" and codegen.worth_literal(model, n_rhs)))
     try:
         return codegen.generated_rhs(model, use_literal)
