@@ -46,14 +46,8 @@ from numba import njit
 from torquesplit.solve import laws
 from torquesplit.solve.kernel_data import (
     A_D,
-    A_E,
-    A_ED,
     A_F,
-    A_G,
-    A_K,
-    A_P,
-    A_PAR,
-    A_FR,
+    A_SELF,
     A_Y,
     F_MAIN,
     F_TMP,
@@ -353,9 +347,12 @@ def _stage(slot, iy, idy, i_f, m, w, rhs_fn, gen, extra):
         a = w.addr
         row = np.uint64(8 * w.Y.shape[1])
         el = np.uint64(8 * w.F.shape[1])
-        rhs_fn(a[A_Y] + row * np.uint64(iy), a[A_Y] + row * np.uint64(idy),
-               a[A_F] + el * np.uint64(i_f), a[A_D] + el * np.uint64(i_f), a[A_K], a[A_G],
-               a[A_E], a[A_ED], a[A_P], a[A_PAR], a[A_FR], np.int64(slot * w.F.shape[1]))
+        # six arguments, all passed in registers (the code loads the other addresses
+        # from the block at a[A_SELF]): twelve put six on the stack at every call, 3-4 %
+        # of an RK4 step (Ji & Li, Liu et al. 2021; benchmarks/README.md)
+        rhs_fn(a[A_SELF], a[A_Y] + row * np.uint64(iy), a[A_Y] + row * np.uint64(idy),
+               a[A_F] + el * np.uint64(i_f), a[A_D] + el * np.uint64(i_f),
+               np.int64(slot * w.F.shape[1]))
     else:
         rhs_slot(slot, np.int64(iy), np.int64(idy), np.int64(i_f), m, w)
         if extra:

@@ -51,13 +51,17 @@ a process keeps at most ``LITERAL_MAX`` of them.
 
 Calling convention (C)::
 
-    void rhs(uint64 y, uint64 dy, uint64 force, uint64 defl, uint64 K, uint64 G,
-             uint64 E, uint64 ED, uint64 P, uint64 par, uint64 FR, int64 off)
+    void rhs(uint64 addr, uint64 y, uint64 dy, uint64 force, uint64 defl, int64 off)
 
-Every argument but ``off`` is the address of a float64 array's data (``Work.addr``:
-taken once per run; a state row's address is base + row x stride).  K, G, E, ED, P are
-the kernels' whole (n_slot, ne) excitation arrays; the function reads the slot starting
-at flat index ``off`` = slot * ne (and row off / ne of the friction values FR).
+``y``, ``dy``, ``force``, ``defl`` are the addresses of the float64 rows read and written
+(a state row's address is base + row x stride); ``addr`` the address of the run's table
+of data addresses (``Work.addr``, taken once per run), from which the code loads those
+of K, G, E, ED, P (the kernels' whole (n_slot, ne) excitation arrays), ``par`` and FR
+(entries ``A_K`` .. ``A_FR`` of :mod:`~torquesplit.solve.kernel_data`).  The function
+reads the slot starting at flat index ``off`` = slot * ne (and row off / ne of the
+friction values FR).  Six arguments, so that all of them travel in registers on x86-64
+and AArch64: the twelve of an earlier version put six on the stack at every call, which
+cost 3-4 % of a whole RK4 step.
 """
 
 from __future__ import annotations
@@ -69,12 +73,19 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import kernel_data as kd
 from . import laws
 
 __all__ = ["GeneratedRhs", "generated_rhs", "general_rhs", "rhs_ir", "worth_generating",
            "worth_literal"]
 
 ARG_NAMES = ("y", "dy", "force", "defl", "K", "G", "E", "ED", "P", "par", "FR")
+"""The arrays the code works on (the body's pointer arguments, in order)."""
+PASSED = ("y", "dy", "force", "defl")
+"""Those the kernels pass at every call; the code loads the others' addresses from the
+run's address table (``Work.addr``) at these entries:"""
+ADDR_INDEX = {"K": kd.A_K, "G": kd.A_G, "E": kd.A_E, "ED": kd.A_ED, "P": kd.A_P,
+              "par": kd.A_PAR, "FR": kd.A_FR}
 PARAMETER_ARRAYS = ("v_coef", "vt_coef", "gy_coef", "fs_coef", "damping", "external_force",
                     "ground_damping", "inv_mass", "sp_par", "fr_coef")
 """The kernel-model arrays the generated code reads through ``par`` (the rest: its
@@ -312,16 +323,23 @@ def rhs_ir(model, literal: bool = False) -> tuple[str, list[tuple[str, int]]]:
 
 
 def _entry_point() -> str:
-    """``rhs`` taking addresses (i64): the kernels pass addresses computed once per run
-    (``Work.addr``), not ``array.ctypes`` per call (which costs a reference-count
-    increment and decrement, atomic, per array and call: more than the arithmetic).
-    It casts them and calls the body, whose noalias arguments LLVM keeps when it
-    inlines it."""
+    """``rhs`` taking addresses (i64, see the calling convention above): the kernels pass
+    addresses computed once per run (``Work.addr``), not ``array.ctypes`` per call
+    (which costs a reference-count increment and decrement, atomic, per array and call:
+    more than the arithmetic).  It loads the addresses of the excitation arrays, ``par``
+    and FR from the table at ``addr``, casts them all and calls the body, whose noalias
+    arguments LLVM keeps when it inlines it."""
+    passed = ARG_NAMES[:len(PASSED)]
+    if passed != PASSED:
+        raise RuntimeError("the rhs body's arguments must begin with the passed rows")
+    loads = "".join(f"  %a{x} = getelementptr i64, ptr %table, i64 {ADDR_INDEX[x]}\n"
+                    f"  %{x} = load i64, ptr %a{x}, align 8\n" for x in ARG_NAMES[len(PASSED):])
     casts = "\n".join(f"  %p{i} = inttoptr i64 %{x} to ptr"
                       for i, x in enumerate(ARG_NAMES))
-    args = ", ".join(f"i64 %{x}" for x in ARG_NAMES) + ", i64 %off"
+    args = ", ".join(f"i64 %{x}" for x in ("addr",) + PASSED) + ", i64 %off"
     call = ", ".join(f"ptr %p{i}" for i in range(len(ARG_NAMES))) + ", i64 %off"
-    return (f"define void @rhs({args}) nounwind {{\nentry:\n{casts}\n"
+    return (f"define void @rhs({args}) nounwind {{\nentry:\n"
+            f"  %table = inttoptr i64 %addr to ptr\n{loads}{casts}\n"
             f"  call void @rhs_body({call})\n  ret void\n}}\n")
 
 
@@ -493,10 +511,9 @@ def _function(address: int):
     global _FUNCTION_CLASS, _SIGNATURE
     if _FUNCTION_CLASS is None:
         import numba.experimental.function_type  # noqa: F401 - registers its typeof
-        from numba import types
         from numba.core.types import WrapperAddressProtocol
 
-        _SIGNATURE = types.void(*([types.uintp] * len(ARG_NAMES)), types.int64)
+        _SIGNATURE = _signature()
 
         class _Rhs(WrapperAddressProtocol):
             def __init__(self, at: int):
@@ -521,16 +538,23 @@ def general_rhs() -> GeneratedRhs:
     itself (so the general path needs nothing of llvmlite beyond what numba uses)."""
     global _GENERAL
     if _GENERAL is None:
-        from numba import cfunc, types
+        from numba import cfunc
 
-        sig = types.void(*([types.uintp] * len(ARG_NAMES)), types.int64)
-        _GENERAL = GeneratedRhs(cfunc(sig, cache=True)(_noop), np.zeros(0), 0.0, 0)
+        _GENERAL = GeneratedRhs(cfunc(_signature(), cache=True)(_noop), np.zeros(0), 0.0, 0)
     return _GENERAL
 
 
-def _noop(y, dy, force, defl, K, G, E, ED, P, par, FR, off):  # noqa: N803 - kernel names
+def _noop(addr, y, dy, force, defl, off):
     """Body of the general placeholder (never called: the kernels test ``gen`` first)."""
     return
+
+
+def _signature():
+    """The numba signature of the calling convention: ``void(uintp addr, y, dy, force,
+    defl, int64 off)``."""
+    from numba import types
+
+    return types.void(*([types.uintp] * (1 + len(PASSED))), types.int64)
 
 
 # Cost model of "auto" (measured on the 2-core development machine, benchmarks/RESULTS.md):
