@@ -33,7 +33,7 @@ KERNELS = ROOT / "src" / "torquesplit" / "solve" / "_kernels.py"
 
 # part -> (what to remove, what to put instead); a part whose text is not found is skipped
 REMOVALS = {
-    "right-hand side (4 calls)": [("        rhs_fn(a[A_Y] + row * np.uint64(iy)", None)],
+    "right-hand side (4 calls)": [("        rhs_fn(a[A_SELF], a[A_Y] + row * np.uint64(iy)", None)],
     "excitation (t + h/2, t + h)": [
         ("            excite(t_end if last else t_mid, sb if last else s_half,\n"
          "                   src_end if last else src_half, m, w)\n", "            pass\n")],
