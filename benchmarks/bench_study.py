@@ -62,17 +62,27 @@ def _cases(folder: Path) -> list[dict]:
                 db.execute(f"SELECT {', '.join(cols)} FROM cases ORDER BY idx")]
 
 
+def _first_cases(cases: list[dict]) -> set[int]:
+    """Each worker's first case (its lowest index: a pool's workers take the cases in
+    order), which also pays the process start-up (lazy imports, loading the compiled
+    kernels, compiling the right-hand side): a fixed cost per worker, not per case."""
+    first: dict = {}
+    for c in cases:
+        first[c["worker"]] = min(first.get(c["worker"], c["idx"]), c["idx"])
+    return set(first.values())
+
+
 def _overhead(cases: list[dict], wall: float, workers: int) -> dict:
     n = len(cases)
     case_wall = sum(c["wall_time"] for c in cases)
     integ = sum(c["integration_time"] for c in cases)
     comp = sum(c["compile_time"] for c in cases)
     in_worker = case_wall - integ - comp
-    # each worker's first case also pays the process start-up (lazy imports, loading the
-    # compiled kernels from the cache): a fixed cost per worker, reported apart
-    later = [c for c in cases if c["compile_time"] == 0.0]
+    firsts = _first_cases(cases)
+    later = [c for c in cases if c["idx"] not in firsts]
     later_wall = sum(c["wall_time"] for c in later)
     later_over = later_wall - sum(c["integration_time"] for c in later)
+    steady = later_wall / len(later) if later else case_wall / n
     return {
         "cases": n, "study_wall_s": wall, "workers": workers,
         "mean_case_wall_s": case_wall / n, "mean_integration_s": integ / n,
@@ -85,6 +95,9 @@ def _overhead(cases: list[dict], wall: float, workers: int) -> dict:
         "overhead_seen_by_driver_s_per_case": (wall * workers - integ) / n,
         "overhead_seen_by_driver_fraction": (wall * workers - integ) / (wall * workers),
         "distinct_workers": len({c["worker"] for c in cases}),
+        "steady_case_wall_s": steady,
+        "first_case_extra_s": sum(c["wall_time"] - steady for c in cases
+                                  if c["idx"] in firsts),
     }
 
 
@@ -194,61 +207,100 @@ def _literal_codes(allowed: bool, codegen):
             os.environ["TORQUESPLIT_LITERAL_MAX"] = env
 
 
-def monte_carlo(n: int) -> dict:
+def _mc_spec(samples: int) -> dict:
+    """The benchmark's Monte Carlo: ISO 1328 grade 6 eccentricities with random phases on
+    every gear of Dong et al. 2021's model, its validation settings."""
+    return {
+        "study": {"name": "bench_mc", "model": "dong2021_face_gear",
+                  "outputs": ["load_sharing.mean_force", "load_sharing.mean_force.I"]},
+        "monte_carlo": {"sampling": "random", "seed": 1, "samples": samples,
+                        "parameters": [
+                            {"paths": ["gears.*.errors.eccentricity"],
+                             "distribution": "iso1328", "grade": 6},
+                            {"paths": ["gears.*.errors.eccentricity_phase"],
+                             "distribution": "uniform", "low": "0 deg",
+                             "high": "360 deg"}]},
+    }
+
+
+def _mc_warm_up() -> None:
+    """An untimed one-case study: what only the first study of a process pays (the
+    driver's imports of the study layer and the store, the model's first set-up) would
+    otherwise sit in the first timed run alone."""
+    from torquesplit.study import Study
+
+    with tempfile.TemporaryDirectory() as tmp:
+        Study(_mc_spec(1)).run(workers=1, out=Path(tmp), figures=False)
+
+
+def _mc_run(workers: int, literal: bool, count: int) -> dict:
+    """One timed Monte Carlo study of ``count`` cases on ``workers`` workers (its own
+    pool): wall time, per-case overhead, the fixed part and the 1000-case estimate."""
+    from torquesplit.solve import codegen
+    from torquesplit.study import Study
+
+    with tempfile.TemporaryDirectory() as tmp, _literal_codes(literal, codegen):
+        _log(f"Monte Carlo, Dong et al. 2021 model: {count} cases on {workers} "
+             f"worker(s)" + (", literal code" if literal else ", pattern's code"))
+        t0 = time.perf_counter()
+        Study(_mc_spec(count)).run(workers=workers, out=Path(tmp), figures=False)
+        wall = time.perf_counter() - t0
+        cases = _cases(Path(tmp))
+    res = _overhead(cases, wall, workers)
+    busy = sum(c["wall_time"] for c in cases) / workers
+    res["fixed_s"] = wall - busy
+    # each worker's first case once, the others at the steady case time (equal to the
+    # run's wall time at its own size)
+    res["cases_1000_s"] = res["fixed_s"] + (
+        1000 * res["steady_case_wall_s"] + res["first_case_extra_s"]) / workers
+    res["cases_1000_scaled_mean_s"] = res["fixed_s"] + 1000 * busy / count
+    _log(f"  {wall:.1f} s")
+    return res
+
+
+def monte_carlo_1000(n: int = 1000) -> dict:
+    """The same Monte Carlo measured at its target size, 1000 cases, on 2 workers and
+    then on 1 (about 12 + 22 minutes here; run apart: ``bench_study.py
+    monte_carlo_1000``), with the machine's parallel capacity before and after."""
+    out: dict = {"capacity_before": parallel_capacity()}
+    _mc_warm_up()
+    for workers in (2, 1):
+        out[f"workers_{workers}"] = _mc_run(workers, True, n)
+    out["capacity_after"] = parallel_capacity()
+    out["speedup_1_to_2"] = out["workers_1"]["study_wall_s"] / out["workers_2"]["study_wall_s"]
+    return out
+
+
+def monte_carlo(n: int, n_pattern: int | None = None) -> dict:
     """The Dong et al. 2021 Monte Carlo at ``n`` cases on 1 and 2 workers.
 
     A study's wall time is a fixed part (pool start, the store, idle workers at the end)
     plus its cases, which the workers run side by side: fixed = wall - (sum of the cases'
-    wall times) / workers, from the same run.  The 1000-case time is that fixed part plus
-    1000 cases at the run's mean case time, and the 1000-case speed-up is the ratio of
-    those (scaling the small study's wall time instead counts its fixed part 1000 / n
+    wall times) / workers, from the same run.  A worker's first case also carries its
+    process start-up (imports, kernel loading, compiling the right-hand side): once per
+    worker in any study, so the 1000-case time is that fixed part plus, per worker, the
+    first cases' extra time and 1000 cases at the steady case time (the mean of the
+    others), and the 1000-case speed-up is the ratio of those.  At n cases that sum is
+    the measured wall time.  (Scaling the mean case time instead counts the start-ups
+    1000 / n times: from 16 cases it predicted 49.5 s for 64 cases on 2 workers, which
+    took 47.5 s; scaling the small study's wall time also counts its fixed part 1000 / n
     times; a line through two study sizes was tried and, on this VM, differencing two
-    noisy wall times gave negative fixed parts).  A worker's first case also carries its
-    process start-up (imports, kernel loading): counted as case time, so the estimate
-    leans slow.  Every timed study starts its own pool, after an untimed one-case study.
+    noisy wall times gave negative fixed parts.)  Every timed study starts its own pool,
+    after an untimed one-case study.
 
     The cases run the literal right-hand side ("auto"'s choice for runs this long): the
     study varies errors only, which the code reads at every call, so one literal code
     serves every case (counted over the cases: ``literal_codes``; a process compiles at
     most 16, ``codegen.LITERAL_MAX``).  One more 1-worker run with
-    ``TORQUESPLIT_LITERAL_MAX=0`` (the pattern's code) shows what it gains."""
-    from torquesplit.solve import codegen
-    from torquesplit.study import Study
-
-    def spec(samples: int) -> dict:
-        return {
-            "study": {"name": "bench_mc", "model": "dong2021_face_gear",
-                      "outputs": ["load_sharing.mean_force", "load_sharing.mean_force.I"]},
-            "monte_carlo": {"sampling": "random", "seed": 1, "samples": samples,
-                            "parameters": [
-                                {"paths": ["gears.*.errors.eccentricity"],
-                                 "distribution": "iso1328", "grade": 6},
-                                {"paths": ["gears.*.errors.eccentricity_phase"],
-                                 "distribution": "uniform", "low": "0 deg",
-                                 "high": "360 deg"}]},
-        }
-
+    ``TORQUESPLIT_LITERAL_MAX=0`` (the pattern's code, ``n_pattern`` cases) shows what it
+    gains."""
     out: dict = {"capacity_before": parallel_capacity()}
-    # untimed: what only the first study of a process pays (the driver's imports of the
-    # study layer and the store, the model's first set-up) would otherwise sit in the
-    # 1-worker run alone
-    with tempfile.TemporaryDirectory() as tmp:
-        Study(spec(1)).run(workers=1, out=Path(tmp), figures=False)
-    out["literal_codes"] = _literal_codes_needed(spec(n))
-    for workers, literal in ((1, True), (2, True), (1, False)):
-        with tempfile.TemporaryDirectory() as tmp, _literal_codes(literal, codegen):
-            _log(f"Monte Carlo, Dong et al. 2021 model: {n} cases on {workers} worker(s)"
-                 + (", literal code" if literal else ""))
-            t0 = time.perf_counter()
-            Study(spec(n)).run(workers=workers, out=Path(tmp), figures=False)
-            wall = time.perf_counter() - t0
-            cases = _cases(Path(tmp))
-            res = _overhead(cases, wall, workers)
-            busy = sum(c["wall_time"] for c in cases) / workers
-            res["fixed_s"] = wall - busy
-            res["cases_1000_s"] = res["fixed_s"] + 1000 * busy / n
-            out[f"workers_{workers}" + ("" if literal else "_pattern")] = res
-            _log(f"  {wall:.1f} s")
+    _mc_warm_up()
+    out["literal_codes"] = _literal_codes_needed(_mc_spec(n))
+    n_pattern = min(n, 16) if n_pattern is None else n_pattern
+    for workers, literal, count in ((1, True, n), (2, True, n), (1, False, n_pattern)):
+        out[f"workers_{workers}" + ("" if literal else "_pattern")] = _mc_run(
+            workers, literal, count)
     out["capacity_after"] = parallel_capacity()
     w1, w2 = out["workers_1"], out["workers_2"]
     out["speedup_1_to_2"] = w1["study_wall_s"] / w2["study_wall_s"]
@@ -357,7 +409,8 @@ def report(res: dict) -> str:
                   "by driver |", "|---|---|---|---|---|---|---|"]
         pat = mc.get("workers_1_pattern")
         for w in (w1, w2) + ((pat,) if pat else ()):
-            label = f"{w['workers']}" + (" (pattern's code)" if w is pat else "")
+            label = f"{w['workers']}" + (f" (pattern's code, {w['cases']} cases)"
+                                         if w is pat else "")
             lines.append(f"| {label} | {w['study_wall_s']:.1f} | "
                          f"{w['mean_case_wall_s']:.2f} | {w['mean_integration_s']:.2f} | "
                          f"{100 * w['overhead_in_worker_fraction']:.2f} % | "
@@ -382,27 +435,48 @@ def report(res: dict) -> str:
                       "(before and after the study; 1.0 = two free cores, 2.0 = one): the "
                       "most a 2-worker study can gain here is about " + " / ".join(
                           f"{2 / c['slowdown']:.2f}x" for c in caps) + "."]
-        if "speedup_1_to_2_at_1000" in mc:
-            lines += ["", "A study's wall time = a fixed part (pool start, the store, idle "
-                      "workers at the end) + its cases run side by side; fixed = wall - "
-                      "(sum of the cases' wall times) / workers, and 1000 cases = fixed + "
-                      "1000 mean case times / workers:", "",
-                      "| workers | fixed part [s] | 1000 cases [min] |", "|---|---|---|"]
-            for w in (w1, w2):
-                lines.append(f"| {w['workers']} | {w['fixed_s']:.1f} | "
-                             f"{w['cases_1000_s'] / 60:.1f} |")
-            lines += ["", f"Speed-up 1 -> 2 workers: **{mc['speedup_1_to_2_at_1000']:.2f}x** "
-                      f"for 1000 cases (target >= 1.8x; {mc['speedup_1_to_2']:.2f}x measured "
-                      f"at {w1['cases']} cases).  1000 cases on 2 workers: "
-                      f"**{mc['extrapolated_1000_cases_2_workers_s'] / 60:.1f} min** (target "
-                      f"<= 5 min; the {w1['cases']} cases' wall time x 1000 / {w1['cases']}, "
-                      f"which counts the fixed part {1000 // w1['cases']} times: "
-                      f"{mc['scaled_1000_cases_2_workers_s'] / 60:.1f} min).", ""]
-        else:  # (a report written before the fixed part was measured)
-            lines += ["", f"Speed-up 1 -> 2 workers: **{mc['speedup_1_to_2']:.2f}x** (target "
-                      f">= 1.8x).  1000 cases on 2 workers, extrapolated: "
-                      f"**{mc['extrapolated_1000_cases_2_workers_s'] / 60:.0f} min** (target "
-                      f"<= 5 min).", ""]
+        lines += ["", "A study's wall time = a fixed part (pool start, the store, idle "
+                  "workers at the end) + its cases run side by side; fixed = wall - "
+                  "(sum of the cases' wall times) / workers.  Each worker's first case "
+                  "also pays the process start-up (imports, loading the kernels, "
+                  "compiling the right-hand side), once per worker however many cases "
+                  "follow; so 1000 cases = fixed + (the first cases' extra + 1000 steady "
+                  "case times) / workers, the steady case time being the mean of the "
+                  "other cases (at the measured size this sum is the measured wall "
+                  "time):", "",
+                  "| workers | fixed part [s] | first cases' extra [s] | steady case "
+                  "[s] | 1000 cases [min] | the same at the mean case time [min] |",
+                  "|---|---|---|---|---|---|"]
+        for w in (w1, w2):
+            lines.append(f"| {w['workers']} | {w['fixed_s']:.1f} | "
+                         f"{w['first_case_extra_s']:.2f} | {w['steady_case_wall_s']:.3f} | "
+                         f"{w['cases_1000_s'] / 60:.1f} | "
+                         f"{w['cases_1000_scaled_mean_s'] / 60:.1f} |")
+        lines += ["", f"Speed-up 1 -> 2 workers: **{mc['speedup_1_to_2_at_1000']:.2f}x** "
+                  f"for 1000 cases (target >= 1.8x; **{mc['speedup_1_to_2']:.2f}x "
+                  f"measured** at {w1['cases']} cases).  1000 cases on 2 workers: "
+                  f"**{mc['extrapolated_1000_cases_2_workers_s'] / 60:.1f} min** (target "
+                  f"<= 5 min; the {w1['cases']} cases' wall time x 1000 / {w1['cases']}, "
+                  f"which counts the fixed part and the start-ups {1000 // w1['cases']} "
+                  f"times: {mc['scaled_1000_cases_2_workers_s'] / 60:.1f} min).", ""]
+    if "monte_carlo_1000" in res:
+        m = res["monte_carlo_1000"]
+        w1, w2 = m["workers_1"], m["workers_2"]
+        caps = [m[k]["slowdown"] for k in ("capacity_before", "capacity_after")]
+        lines += [f"## The same Monte Carlo measured at {w1['cases']} cases", "",
+                  f"A separate run (`python benchmarks/bench_study.py monte_carlo_1000`, "
+                  f"{m['date']}, commit {m['commit']}; two plain `simulate` processes side "
+                  f"by side took {caps[0]:.2f}x / {caps[1]:.2f}x as long as one alone before "
+                  f"and after it):", "",
+                  "| workers | study wall [min] | per case [s] | integration per case [s] | "
+                  "overhead in worker |", "|---|---|---|---|---|"]
+        for w in (w1, w2):
+            lines.append(f"| {w['workers']} | **{w['study_wall_s'] / 60:.1f}** | "
+                         f"{w['mean_case_wall_s']:.3f} | {w['mean_integration_s']:.3f} | "
+                         f"{100 * w['overhead_in_worker_fraction']:.2f} % |")
+        lines += ["", f"Speed-up 1 -> 2 workers, measured: **{m['speedup_1_to_2']:.2f}x** "
+                  f"(target >= 1.8x).  {w2['cases']} cases on 2 workers: "
+                  f"**{w2['study_wall_s'] / 60:.1f} min** (target <= 5 min).", ""]
     if "memory" in res:
         lines += ["## Driver memory", "", "| cases | RSS before [MiB] | peak RSS [MiB] |",
                   "|---|---|---|"]
@@ -425,9 +499,13 @@ def main(argv=None) -> int:
     if "diameter" in args.parts:
         res["diameter"] = diameter()
     if "monte_carlo" in args.parts:
-        res["monte_carlo"] = monte_carlo(args.mc_cases or (6 if args.quick else 16))
+        res["monte_carlo"] = monte_carlo(args.mc_cases or (6 if args.quick else 64))
     if "memory" in args.parts:
         res["memory"] = memory()
+    if "monte_carlo_1000" in args.parts:  # (not in the default parts: about 35 minutes)
+        m = _machine()
+        res["monte_carlo_1000"] = {**monte_carlo_1000(), "date": m["date"],
+                                   "commit": m["commit"]}
     OUT_JSON.write_text(json.dumps(res, indent=1))
     OUT_MD.write_text(report(res) + "\n")
     print(report(res))
