@@ -377,6 +377,10 @@ def report(res: dict) -> str:
              f"load average at start {m['load_average'][0]:.2f}.  The numba cache was warm "
              "(kernels compiled before); each worker process still loads them and "
              "compiles the generated right-hand side once.", ""]
+    if res.get("parts_run"):  # parts run apart keep their own date and commit
+        lines += ["Parts last run: " + "; ".join(
+            f"{part} {run['date']} (commit {run['commit']})"
+            for part, run in res["parts_run"].items()) + ".", ""]
     if "diameter" in res:
         d = res["diameter"]
         s, f = d["settle"], d["fixed_30s"]
@@ -496,6 +500,8 @@ def main(argv=None) -> int:
     sys.path.insert(0, str(HERE.parent / "src"))
     res = json.loads(OUT_JSON.read_text()) if OUT_JSON.exists() else {}
     res["machine"] = _machine()
+    res.setdefault("parts_run", {}).update(
+        {part: {k: res["machine"][k] for k in ("date", "commit")} for part in args.parts})
     if "diameter" in args.parts:
         res["diameter"] = diameter()
     if "monte_carlo" in args.parts:
