@@ -81,9 +81,9 @@ __all__ = ["GeneratedRhs", "generated_rhs", "general_rhs", "rhs_ir", "worth_gene
 
 ARG_NAMES = ("y", "dy", "force", "defl", "K", "G", "E", "ED", "P", "par", "FR")
 """The arrays the code works on (the body's pointer arguments, in order)."""
-PASSED = ("y", "dy", "force", "defl")
-"""Those the kernels pass at every call; the code loads the others' addresses from the
-run's address table (``Work.addr``) at these entries:"""
+PASSED = ARG_NAMES[:4]
+"""Those the kernels pass at every call (y, dy, force, defl); the code loads the others'
+addresses from the run's address table (``Work.addr``) at these entries:"""
 ADDR_INDEX = {"K": kd.A_K, "G": kd.A_G, "E": kd.A_E, "ED": kd.A_ED, "P": kd.A_P,
               "par": kd.A_PAR, "FR": kd.A_FR}
 PARAMETER_ARRAYS = ("v_coef", "vt_coef", "gy_coef", "fs_coef", "damping", "external_force",
@@ -329,9 +329,6 @@ def _entry_point() -> str:
     more than the arithmetic).  It loads the addresses of the excitation arrays, ``par``
     and FR from the table at ``addr``, casts them all and calls the body, whose noalias
     arguments LLVM keeps when it inlines it."""
-    passed = ARG_NAMES[:len(PASSED)]
-    if passed != PASSED:
-        raise RuntimeError("the rhs body's arguments must begin with the passed rows")
     loads = "".join(f"  %a{x} = getelementptr i64, ptr %table, i64 {ADDR_INDEX[x]}\n"
                     f"  %{x} = load i64, ptr %a{x}, align 8\n" for x in ARG_NAMES[len(PASSED):])
     casts = "\n".join(f"  %p{i} = inttoptr i64 %{x} to ptr"
@@ -456,7 +453,7 @@ class _Compiler:
         """Whether this model's literal code is compiled or may still be (at most
         :data:`LITERAL_MAX` a process)."""
         with self._lock:
-            return _value_key(model) in self._literal or len(self._literal) < LITERAL_MAX
+            return len(self._literal) < LITERAL_MAX or _value_key(model) in self._literal
 
     def get(self, model, literal: bool = False):
         import time

@@ -76,8 +76,8 @@ statistics cycle index; ``S C`` (N_SLOT, n_sin) sin and cos of every error sinus
 half-gap of each element's current cycle; ``has_force`` elements with a non-zero
 additive force table; ``watch_el`` elements whose contact state is counted; ``rot``
 (2, n_sin) cos and sin of the phasor rotation over half an RK4 step; ``addr`` data
-addresses for the generated right-hand side (``A_*``, the last its own); ``par`` its parameter vector
-(empty for the general kernel), held here so that its address stays valid;
+addresses for the generated right-hand side (``A_*``, the last its own); ``par`` its
+parameter vector (empty for the general kernel), held here so that its address stays valid;
 ``next_node`` the absolute table node (cycle x n_table + node) of each element's next
 corner."""
 
@@ -350,7 +350,8 @@ def make_work(m: KernelModel, rhs_parameters: np.ndarray | None = None) -> Work:
         FR=np.zeros((N_SLOT, m.friction_table.shape[0])),
         gap_cyc=np.full(ne, -(2**62), dtype=np.int64), gap_val=np.zeros(ne),
         has_force=has_force, watch_el=watch, rot=np.zeros((2, n_sin)),
-        addr=np.zeros(A_SELF + 1, dtype=np.uint64), par=par, next_node=np.zeros(ne, dtype=np.int64),
+        addr=np.zeros(A_SELF + 1, dtype=np.uint64), par=par,
+        next_node=np.zeros(ne, dtype=np.int64),
     )
     for i, arr in ((A_Y, w.Y), (A_F, w.F), (A_D, w.D), (A_K, w.K), (A_G, w.G), (A_E, w.E),
                    (A_ED, w.ED), (A_P, w.P), (A_PAR, par), (A_FR, w.FR)):
