@@ -19,7 +19,8 @@ sys.path.insert(0, str(ROOT / "tests" / "validation"))
 sys.path.insert(0, str(ROOT / "tests" / "assembly"))
 
 
-def main() -> int:
+def build() -> tuple[str, dict]:
+    """The page's text and its data, computed now from the shipped models."""
     from planetary_models import CP, cp_raw, load, lp_raw
     from test_lin_parker1999 import COOLEY_PARKER_2012, LIN_PARKER_1999
     from test_planet_load_sharing import _hand, _model, _sun_forces
@@ -120,10 +121,15 @@ def main() -> int:
                      f"{f.min() / f.mean():.4f} |")
         out["load_sharing"].append(dict(case=label, hand=k_hand, ours=k_ours))
     lines += ["", "Speed: benchmarks/PLANETARY_RESULTS.md.", ""]
-    (ROOT / "docs" / "planetary_validation.md").write_text("\n".join(lines), encoding="utf-8")
+    return "\n".join(lines), out
+
+
+def main() -> int:
+    text, out = build()
+    (ROOT / "docs" / "planetary_validation.md").write_text(text, encoding="utf-8")
     (ROOT / "docs" / "planetary_validation.json").write_text(
         json.dumps(out, indent=1, default=float), encoding="utf-8")
-    print("\n".join(lines))
+    print(text)
     return 0
 
 

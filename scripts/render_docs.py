@@ -10,7 +10,8 @@ value at that path of the JSON (keys separated by ``/``; a key may hold spaces a
 dots) formatted with the Python format spec ``fmt`` (``fmt~path``: and marked † where the
 change under a halved step at ``path`` exceeds half its last digit, :func:`held`);
 ``{{=expression:fmt}}`` evaluates a
-small arithmetic expression over ``$[path]`` references (for ranges and ratios).  A
+small arithmetic expression over ``$[path]`` references, with ``min`` and ``max``
+(for ranges and ratios).  A
 list of texts (a run's warnings) is written as one markdown bullet per item (``:nested``:
 indented, inside a list item).
 ``benchmarks/RESULTS.md`` is rendered by ``benchmarks/run.py`` from
@@ -67,10 +68,10 @@ def _value(data, expression: str, is_expr: bool):
         return name
 
     code = _REF.sub(sub, expression)
-    if not re.fullmatch(r"[\s_v0-9.+\-*/()e]*", code):
-        raise ValueError(f"expression {expression!r} may only hold $[paths], numbers and "
-                         "+ - * /")
-    return eval(code, {"__builtins__": {}}, refs)  # noqa: S307 - checked above
+    if not re.fullmatch(r"(?:[\s_v0-9.+\-*/(),e]|min|max)*", code):
+        raise ValueError(f"expression {expression!r} may only hold $[paths], numbers, "
+                         "+ - * / and min( , ) / max( , )")
+    return eval(code, {"__builtins__": {}, "min": min, "max": max}, refs)  # noqa: S307
 
 
 def render(template: str, data) -> str:

@@ -141,15 +141,14 @@ OURS = {
     "dong_2021_quill_stiffness": (
         "Omega_I follows the ratio of the two connecting-shaft stiffnesses: equal to 1 "
         "where k_24 equals the printed k_35, growing on both sides of it.  Omega_II falls "
-        "slowly as k_24 grows, opposite to the paper; the change over the range is smaller "
-        "than the run-length drift (top of this page), so this trend may not survive a "
-        "longer run."),
+        "slowly as k_24 grows, opposite to the paper."),
     "dong_2021_support_stiffness": (
         "The paper's trend: Omega_II grows as the supports soften, most below a factor 0.5, "
         "while Omega_I does not change; the growth is smaller than the paper's."),
     "dong_2021_sensitivity": (
         "The stage-II coefficients are driven first by the spline and support clearances "
-        "and the eccentricity errors; stage I only by the connecting-shaft stiffness.  The "
+        "and the eccentricity errors (stage I: below; the quill-stiffness study shows how "
+        "Omega_I follows the ratio of the two connecting-shaft stiffnesses).  The "
         "paper names the two-stage backlash and errors; here the backlash ranks low (see "
         "the backlash studies).  The system coefficient is the largest group's, which in "
         "this model is stage I except where a stage-II group exceeds it, so it reacts only "
@@ -284,6 +283,35 @@ def _stage_columns(entry: dict) -> list[tuple[str, list]]:
     return [(k, o[k]) for k in keys]
 
 
+def _dong_drift() -> float:
+    """How much the Dong et al. 2021 stage-II coefficient moves with the run length."""
+    data = json.loads((ROOT / "docs" / "validation_results.json").read_text())
+    return float(data["dong2021"]["drift"]["change"])
+
+
+def _dong_noise() -> float:
+    """A Dong et al. 2021 coefficient's change under a one-rounding-unit input change."""
+    data = json.loads((ROOT / "docs" / "validation_results.json").read_text())
+    return float(data["dong2021"]["ulp"]["change"])
+
+
+def _against_drift(entry: dict) -> str:
+    """A grid's stage-II change over its range against the run-length drift: the page's
+    rule (a trend smaller than the drift may not survive a longer run) applied to each
+    study from its numbers, not typed beside some of them."""
+    (_, omega2), = [c for c in _stage_columns(entry) if c[0].startswith("Omega_II")]
+    arr = np.array(omega2, dtype=object).ravel()  # (a 2-parameter grid: its whole table)
+    arr = np.array([np.nan if x is None else x for x in arr], dtype=float)
+    span = float(np.nanmax(arr) - np.nanmin(arr))
+    drift = _dong_drift()
+    if span < drift:
+        return (f"Here Omega_II spans {span:.3f} over the range, less than that drift "
+                f"({drift:.2f}): this curve, flat or not, is one of this run length and may "
+                f"differ in a longer run.")
+    return (f"Here Omega_II spans {span:.3f} over the range, more than that drift "
+            f"({drift:.2f}).")
+
+
 def _fmt(x) -> str:
     return "-" if x is None or (isinstance(x, float) and not math.isfinite(x)) else f"{x:.4f}"
 
@@ -359,6 +387,8 @@ def markdown(data: dict) -> str:
             lines += ["", "**Ours:** " + e["ours"]]
         if name.startswith("dong_2021"):
             lines += ["", DONG_SECTION]
+            if e["design"] == "grid":
+                lines[-1] += "  " + _against_drift(e)
             if e["design"] == "sensitivity":
                 top = max(x for out, rank in e["ranking"].items() if "II_" in out
                           or out == "load_sharing.mean_force" for _, x in rank
@@ -366,6 +396,14 @@ def markdown(data: dict) -> str:
                 lines[-1] += (f"  The largest mu_star of the stage-II and system "
                               f"coefficients, {top:.2f}, is of the size of that drift, so "
                               f"their ranking is not resolved by these runs.")
+                rank1 = e["ranking"].get("load_sharing.mean_force.I")
+                if rank1:
+                    f1, x1 = rank1[0]
+                    noise = _dong_noise()
+                    verdict = ("below the noise, so no factor moves stage I over these ranges"
+                               if x1 < noise else "above the noise")
+                    lines[-1] += (f"  Stage I (Omega_I): the largest mu_star, {f1} "
+                                  f"{x1:.4f}, is {verdict} ({noise:.1g}, top of this page).")
         lines += ["", f"Figures: `torquesplit study {name}` writes them to "
                       f"`study_{name}/figures/`.", ""]
     notes = data.get("_notes", [])

@@ -114,3 +114,30 @@ def test_a_number_whose_digits_move_under_a_halved_step_is_marked():
     data = {"r": {"values": {"x": 1.1052138},
                   "halved": {"change": {"x": 3.66e-5}, "value": {"x": 1.1052504}}}}
     assert render.render("{{r/values/x:.4f~r/halved/change/x}}", data) == "1.1052†"
+
+
+def test_ltca_page_is_its_data():
+    ltca = _load(ROOT / "scripts" / "ltca_validation.py", "ltca_validation")
+    data = json.loads((ROOT / "docs" / "ltca_validation_results.json").read_text(
+        encoding="utf-8"))
+    assert ltca.markdown(data) == (ROOT / "docs" / "ltca_validation.md").read_text(
+        encoding="utf-8"), ("docs/ltca_validation.md drifted: run python "
+                            "scripts/ltca_validation.py --markdown-only")
+
+
+def test_planetary_page_is_computed_now():
+    """Every number of the planetary page (modes, phasing, planet load sharing) is
+    computed again here from the shipped models: the page cannot describe older code."""
+    pytest.importorskip("numba")
+    planetary = _load(ROOT / "scripts" / "planetary_validation.py", "planetary_validation")
+    text, _ = planetary.build()
+    assert text == (ROOT / "docs" / "planetary_validation.md").read_text(encoding="utf-8"), (
+        "docs/planetary_validation.md drifted: run python scripts/planetary_validation.py")
+
+
+def test_readme_compile_time_is_the_benchmarks():
+    """The quick start's compilation time is the one benchmarks/RESULTS.json measured (a
+    hand-typed 15 s had outlived the code it described)."""
+    res = json.loads((ROOT / "benchmarks" / "RESULTS.json").read_text(encoding="utf-8"))
+    text = " ".join((ROOT / "README.md").read_text(encoding="utf-8").split())
+    assert f"reuse, {res['compile']['cold']['compile']:.0f} s on the 2-core machine" in text

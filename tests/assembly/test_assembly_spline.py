@@ -7,6 +7,7 @@ import dataclasses
 import math
 import tomllib
 import warnings
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -17,6 +18,8 @@ from torquesplit.assembly.structure import SP_FRICTION, SP_VELOCITY, SPLINE
 from torquesplit.model.kinematics import solve_kinematics
 from torquesplit.solve import integrate, modal_analysis, static_equilibrium
 from torquesplit.solve.reference import element_forces_numpy
+
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def floating_pinion(clearance="1 mm", stiffness="1e9 N/m", friction=0.0, error="6 um",
@@ -169,6 +172,9 @@ def test_floating_pinion_shares_load_better_than_a_fixed_spline():
     assert lsc_float_st == pytest.approx(1.0, abs=1e-8)  # the pinion moves until equal
     assert lsc_float < 1.002
     assert lsc_float < lsc_fixed - 0.05
+    # docs/validation.md prints this pair (its Dong et al. 2021 section 6.2 row)
+    row = f"floating {lsc_float:.3f} vs fixed {lsc_fixed:.3f} (mean-force coefficient"
+    assert row in (ROOT / "docs" / "validation.md").read_text(encoding="utf-8")
     # the floating pinion sits inside its clearance: the spline carries nothing
     assert set(st.separated) == {"sp.radial.x", "sp.radial.y"}
     ex = floating.element_names.index("sp.radial.x")

@@ -220,7 +220,7 @@ def mesh_phases(model: Model, kin: Kinematics, *, strict: bool = False) -> dict[
         issues = []
         for mesh, g, d in misfits:
             if kin.meshes[mesh].carrier is None:
-                continue  # a fixed-axis loop: the user clocks the gears (seed 000)
+                continue  # a fixed-axis loop: the user clocks the gears (Liu et al. 2021)
             planet = next((b for b in model.meshes[mesh].gears if b in kin.planet_bodies),
                           g)
             issues.append((f"meshes.{mesh}", (
