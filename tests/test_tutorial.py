@@ -57,10 +57,13 @@ def test_the_tutorial_shows_every_step_and_links_only_shipped_files():
     assert "Traceback" not in text and "error:" not in text
 
 
-def test_the_load_sharing_doc_prints_ji_and_lis_digits_that_hold():
+@pytest.mark.parametrize("example", ["ji_li_mill_drive", "dong2021_face_gear"])
+def test_the_load_sharing_doc_prints_digits_that_hold(example):
     """docs/load-sharing.md's table is a run's numbers to the digits that survive half the
     step (it printed Dong et al. 2021's peak/nominal as 2.968, a value that moves by 3 %
-    with rounding-level changes)."""
+    with rounding-level changes).  Dong et al. 2021's peaks are impacts, which another
+    build of the numeric libraries moves by per cents (the page says so): they are
+    checked to 5 %, its coefficients to the printed digits."""
     import importlib.util
     import warnings
 
@@ -71,14 +74,21 @@ def test_the_load_sharing_doc_prints_ji_and_lis_digits_that_hold():
         "make_load_sharing_doc", ROOT / "scripts" / "make_load_sharing_doc.py")
     gen = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(gen)
-    row = re.search(r"^\| `ji_li_mill_drive` \|(.*)\|$", gen.DOC.read_text(encoding="utf-8"),
+    assert example in gen.EXAMPLES
+    row = re.search(rf"^\| `{example}` \|(.*)\|$", gen.DOC.read_text(encoding="utf-8"),
                     re.M)
     assert row, "regenerate docs/load-sharing.md: python scripts/make_load_sharing_doc.py"
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        res = torquesplit.simulate(torquesplit.example_path("ji_li_mill_drive"))
+        res = torquesplit.simulate(torquesplit.example_path(example))
         check = check_step(res, definitions=DYNAMIC_DEFINITIONS)
     keys = [f"load_sharing.{d}" for d in DYNAMIC_DEFINITIONS] + ["dynamic_factor",
                                                                   "peak_to_nominal"]
+    printed = [c.strip() for c in row.group(1).split("|")]
     expected = [gen._held(check.values[k], check.halved[k]) for k in keys]
-    assert [c.strip() for c in row.group(1).split("|")] == expected
+    if example == "ji_li_mill_drive":
+        assert printed == expected
+        return
+    assert printed[:-2] == expected[:-2]
+    for shown, k in zip(printed[-2:], keys[-2:]):
+        assert float(shown) == pytest.approx(check.values[k], rel=0.05), k
