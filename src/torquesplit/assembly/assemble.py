@@ -187,6 +187,7 @@ def _assemble(model: Model, kin: Kinematics | None, *, n_table: int | None,
     meta_meshes = {}
 
     phases = excitation.mesh_phases(model, kin, strict=True)
+    stages = excitation.stage_labels(model, kin)
 
     # ---- meshes
     for name, mesh in model.meshes.items():
@@ -222,7 +223,7 @@ def _assemble(model: Model, kin: Kinematics | None, *, n_table: int | None,
         if mesh.friction is not None:
             el["friction"] = _friction_projection(model, kin, dmap, name, n_table)
         elements.append(el)
-        meta_meshes[name] = dict(stage=excitation.stage_label(model, name), path=mesh.path,
+        meta_meshes[name] = dict(stage=stages[name], path=mesh.path,
                                  driver=mk.driver, driven=mk.driven,
                                  static_force=mk.force, frequency=mk.frequency)
 

@@ -19,13 +19,38 @@ from ..model.kinematics import Kinematics
 from ..model.schema import Model
 
 
-def stage_label(model: Model, mesh_name: str) -> str:
-    """The mesh's stage: the model's label, or the tooth-count pair of its gears."""
-    mesh = model.meshes[mesh_name]
-    if mesh.stage:
-        return mesh.stage
-    za, zb = sorted(model.gears[g].teeth for g in mesh.gears)
-    return f"{za}/{zb}"
+#: unlabelled meshes of one tooth-count pair whose nominal forces differ by more than this
+#: (relative) are not parallel paths of one stage
+STAGE_FORCE_RTOL = 1e-6
+
+
+def stage_labels(model: Model, kin: Kinematics) -> dict[str, str]:
+    """Each mesh's stage (its load-sharing group, within its path): the model's label or,
+    without one, the tooth-count pair of its gears ``"za/zb"``.  Unlabelled meshes of one
+    pair that carry different nominal forces are not parallel paths (a split stage and a
+    combining stage of equal ratio: grouped, the combining meshes read as twice loaded):
+    they become ``"za/zb-1"``, ``"za/zb-2"``... in the order the file first lists each
+    force (:func:`torquesplit.model.checks.plausibility_warnings` says so)."""
+    labels = {name: mesh.stage for name, mesh in model.meshes.items() if mesh.stage}
+    by_pair: dict[str, list[str]] = {}
+    for name, mesh in model.meshes.items():
+        if not mesh.stage:
+            za, zb = sorted(model.gears[g].teeth for g in mesh.gears)
+            by_pair.setdefault(f"{za}/{zb}", []).append(name)
+    for pair, names in by_pair.items():
+        levels: list[float] = []  # the distinct nominal forces, in file order
+        which = {}
+        for name in names:
+            f = abs(kin.meshes[name].force)
+            k = next((i for i, g in enumerate(levels)
+                      if abs(f - g) <= STAGE_FORCE_RTOL * max(f, g)), None)
+            if k is None:
+                levels.append(f)
+                k = len(levels) - 1
+            which[name] = k
+        for name in names:
+            labels[name] = pair if len(levels) == 1 else f"{pair}-{which[name] + 1}"
+    return {name: labels[name] for name in model.meshes}
 
 
 # --------------------------------------------------------------------------- stiffness

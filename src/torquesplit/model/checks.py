@@ -598,6 +598,62 @@ def stiffness_magnitude_issues(model: Model, kin) -> list[tuple[str, str]]:
     return out
 
 
+def _stage_groups(model: Model, kin) -> list[tuple[str, str]]:
+    """Load-sharing groups that are probably not what the file meant: unlabelled meshes
+    of one tooth-count pair split by their nominal forces (a split and a combining stage
+    of equal ratio, :func:`torquesplit.assembly.excitation.stage_labels`), and a stage
+    label held by one mesh that reads like the label of meshes parallel to it (the same
+    tooth counts and nominal force: 'splt' beside 'split', a group of one, coefficient 1
+    by definition, and its stage's group one mesh short)."""
+    import difflib
+
+    from ..assembly.excitation import STAGE_FORCE_RTOL, stage_labels
+
+    out = []
+    stages = stage_labels(model, kin)
+    split: dict[str, list[str]] = {}
+    for name, mesh in model.meshes.items():
+        if not mesh.stage and "-" in stages[name]:
+            split.setdefault(stages[name].rsplit("-", 1)[0], []).append(name)
+    for pair, names in split.items():
+        groups = {}
+        for n in names:
+            groups.setdefault(stages[n], []).append(n)
+        said = "; ".join(f"{g}: {', '.join(ms)} ({abs(kin.meshes[ms[0]].force) / 1e3:.4g} kN)"
+                         for g, ms in groups.items())
+        out.append((f"meshes.{names[0]}.stage", (
+            f"meshes {', '.join(names)} have no stage label and the same tooth counts "
+            f"({pair}) but different nominal forces, so they are not one stage: their "
+            f"load-sharing groups are {said}. Give the meshes of each stage one `stage` "
+            f"label to name the groups")))
+    members: dict[str, list[str]] = {}
+    for name, mesh in model.meshes.items():
+        if mesh.stage:
+            members.setdefault(mesh.stage, []).append(name)
+
+    def parallel(a, b):  # the same tooth counts and nominal force: parallel paths
+        fa, fb = abs(kin.meshes[a].force), abs(kin.meshes[b].force)
+        return (sorted(model.gears[g].teeth for g in model.meshes[a].gears)
+                == sorted(model.gears[g].teeth for g in model.meshes[b].gears)
+                and abs(fa - fb) <= STAGE_FORCE_RTOL * max(fa, fb))
+
+    for label, ms in members.items():
+        if len(ms) != 1:
+            continue
+        like = [other for other in difflib.get_close_matches(label, list(members), n=3,
+                                                             cutoff=0.6)
+                if other != label and len(members[other]) > 1
+                and any(parallel(m, ms[0]) for m in members[other])]
+        if like:
+            other = like[0]
+            out.append((f"meshes.{ms[0]}.stage", (
+                f"{label!r} is the stage of this mesh alone (a load-sharing group of one: "
+                f"coefficient 1 by definition), while {', '.join(members[other])}, with the "
+                f"same tooth counts and nominal force, are stage {other!r}: if it is one of "
+                f"them, write {other!r}")))
+    return out
+
+
 def _label_slips(model: Model) -> list[tuple[str, str]]:
     """Stage and path labels that differ only in spacing, case or punctuation: each
     label is a load-sharing group of its own ('stage 1' beside 'stage1' split a stage
@@ -713,7 +769,7 @@ def plausibility_warnings(model: Model, kin) -> list[tuple[str, str]]:
         if ratio is not None and ratio > 1:
             out.append((loc, f"{ratio:g} is above critical damping (1); check the value "
                              f"(typical 0.02-0.1)"))
-    out += _friction_drift(model) + _label_slips(model)
+    out += _friction_drift(model) + _label_slips(model) + _stage_groups(model, kin)
     out += _locked_speed_drives(model)
     out += _mass_magnitudes(model)
     out += _centre_distance_offsets(model, kin)

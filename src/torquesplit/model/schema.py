@@ -714,7 +714,11 @@ class Mesh(Strict):
     )
     transmission_error: TransmissionErrorSpec = Field(TransmissionErrorSpec(), description="Extra LOA error.")
     phase: Number | None = Field(None, description="Mesh phase at t = 0 in cycles (overrides clocking).")
-    stage: str | None = Field(None, description="Stage label for load-sharing groups.")
+    stage: str | None = Field(None, description=(
+        "Stage label: the meshes of one stage (within one path) form a load-sharing group. "
+        "Without it, the tooth-count pair 'za/zb' of the mesh's gears, and where meshes "
+        "of one pair carry different nominal forces (a split and a combining stage of "
+        "equal ratio) 'za/zb-1', 'za/zb-2'... (the check warns)."))
     path: str | None = Field(
         None, description="Input-path label: the power source a mesh belongs to (Liu et al. 2021: "
         "left/right engine).  Meshes of one stage share load within a path; do not use it to "

@@ -14,11 +14,12 @@ RPM = 30 / math.pi
 
 def summary(model: Model) -> dict:
     """A JSON-serialisable summary: speeds, torques, mesh frequencies, geometry, forces."""
-    from ..assembly.excitation import stage_label
+    from ..assembly.excitation import stage_labels
 
     from .kinematics import mass_basis
 
     kin = solve_kinematics(model)
+    stages = stage_labels(model, kin)
     idlers = _idlers(model)
     roles = _roles(model)
     bodies = {}
@@ -43,7 +44,7 @@ def summary(model: Model) -> dict:
         meshes[name] = {
             "driver": mk.driver,
             "driven": mk.driven,
-            "stage": stage_label(model, name),
+            "stage": stages[name],
             "frequency_Hz": mk.frequency,
             "base_radii_mm": [1e3 * r for r in mk.base_radii],
             "pitch_radii_mm": [1e3 * r for r in mk.pitch_radii],

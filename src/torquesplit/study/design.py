@@ -457,14 +457,13 @@ def _long_enough(model, analysis: dict) -> None:
 
 
 def _outputs(spec: StudySpec, model, analysis: str) -> tuple[list[str], list[str]]:
-    from ..assembly.excitation import stage_label
+    from ..assembly.excitation import stage_labels
     from ..metrics.load_sharing import group_meshes
-
-    meta = {m: {"stage": stage_label(model, m), "path": model.meshes[m].path}
-            for m in model.meshes}
     from ..model.kinematics import solve_kinematics
 
-    kin = solve_kinematics(model)  # (planetary stages: their K_gamma outputs)
+    kin = solve_kinematics(model)  # (planetary stages: their K_gamma outputs; the groups)
+    stages = stage_labels(model, kin)
+    meta = {m: {"stage": stages[m], "path": model.meshes[m].path} for m in model.meshes}
     planets = {c: [p for p, cc in kin.planet_bodies.items() if cc == c] for c in kin.carriers}
     bearings = []
     if analysis != "static" and any("bearing" in p for p in spec.study.outputs):
