@@ -336,6 +336,17 @@ def cycle_peak(cycle_max, cycle_start, names, groups, first_cycle) -> LoadSharin
                        per_cycle, times)
 
 
+def span_mean(cycle_mean, cycle_count) -> float:
+    """The count-weighted mean of the cycle means of one mesh over a span of cycles; NaN
+    where the span holds no sample (a run too short for a whole cycle of the mesh past
+    its settle time: it read 0, and its group's coefficient N F_i / sum F became N)."""
+    c = np.asarray(cycle_count)
+    total = c.sum()
+    if total <= 0:
+        return math.nan
+    return float((np.nan_to_num(np.asarray(cycle_mean, dtype=float)) * c).sum() / total)
+
+
 def mean_force(cycle_mean, cycle_count, cycle_start, names, groups,
                first_cycle) -> LoadSharing:
     """Dong et al. 2021 eq. 12: coefficients from mean forces (count-weighted cycle
@@ -343,19 +354,15 @@ def mean_force(cycle_mean, cycle_count, cycle_start, names, groups,
     col = {n: j for j, n in enumerate(names)}
     per_mesh, per_group, per_cycle, times = {}, {}, {}, {}
     for g, members in groups.items():
-        means = []
-        for m in members:
-            k0 = first_cycle[m]
-            c = cycle_count[k0:, col[m]]
-            v = np.nan_to_num(cycle_mean[k0:, col[m]])
-            means.append(float((v * c).sum() / max(c.sum(), 1)))
-        r = _ratio(np.asarray(means))
+        means = [span_mean(cycle_mean[first_cycle[m]:, col[m]],
+                           cycle_count[first_cycle[m]:, col[m]]) for m in members]
+        r = _ratio(np.asarray(means))  # (a member without a mean: NaN for every member)
         rc = _ratio(np.stack([cycle_mean[:, col[m]] for m in members], axis=-1))
         for i, m in enumerate(members):
             per_mesh[m] = float(r[i])
             per_cycle[m] = rc[:, i]
             times[m] = cycle_start[:, col[m]]
-        per_group[g] = max(per_mesh[m] for m in members)
+        per_group[g] = _nanmax([per_mesh[m] for m in members])
     return LoadSharing("mean_force", per_mesh, per_group, _system(per_group), groups,
                        per_cycle, times)
 

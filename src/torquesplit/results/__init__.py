@@ -129,9 +129,13 @@ class Metrics:
         """The transient the metrics leave out: '0.04 s', or per group where the groups'
         differ ('split 0.02 s, combine 0.04 s': each group's metrics start at its own)."""
         times = self.settling.group_time
+
+        def said(t):  # (a group without a whole cycle has no settle time: it read -inf s)
+            return f"{t:.4g} s" if math.isfinite(t) else "none (no whole cycle)"
+
         if len(set(times.values())) <= 1:
-            return f"{self.settling.start_time:.4g} s"
-        return ", ".join(f"{g} {t:.4g} s" for g, t in times.items())
+            return said(self.settling.start_time)
+        return ", ".join(f"{g} {said(t)}" for g, t in times.items())
 
     def values(self) -> dict[str, float]:
         """Every number of these metrics by a flat name (what studies ask for):
@@ -368,8 +372,7 @@ class Results:
         for j, m in enumerate(names):
             k0 = st.first_cycle[m]
             km = st.mean_first[m]  # (the mean force over the span of the coefficients)
-            c = c_cnt[km:, j]
-            mean = float((np.nan_to_num(c_mean[km:, j]) * c).sum() / max(c.sum(), 1))
+            mean = ls.span_mean(c_mean[km:, j], c_cnt[km:, j])
             back = float(s.back_contact_fraction[el.index(m)])
             double = not (self.model.meshes[m].backlash.nominal > 0)
             rows.append(MeshRow(
