@@ -1,10 +1,43 @@
 """The ``torquesplit`` command's entry point: Ctrl-C while the command line loads (numpy,
 numba, pydantic: about half a second) exits with one line and status 130, as it does
-later, not with a traceback from inside an import (a fuzzer's 30-line pydantic one)."""
+later, not with a traceback from inside an import (a fuzzer's 30-line pydantic one); an
+option the parser refuses (``--steps-per-period abc``, an unknown option, a missing
+argument) gets the commands' own ``error:`` line, and with ``--json`` their JSON
+document on stdout, not a boxed panel and an empty stdout."""
 
 from __future__ import annotations
 
+import importlib
+import re
 import sys
+
+
+def _exception_classes(name: str) -> tuple[type, ...]:
+    """The parser's exception class ``name`` from click and from the copy of click that
+    newer typer releases carry (``typer._click``), whichever exist."""
+    found = []
+    for module in ("typer._click.exceptions", "click.exceptions"):
+        try:
+            cls = getattr(importlib.import_module(module), name, None)
+        except ImportError:
+            continue
+        if cls is not None and cls not in found:
+            found.append(cls)
+    return tuple(found)
+
+
+def usage_error_lines(exc) -> list[str]:
+    """A parser's usage error as the lines the commands print: what is wrong, then what
+    to run for help."""
+    message = exc.format_message() if hasattr(exc, "format_message") else str(exc)
+    # "Invalid value for '--cycles': ..." in the commands' own form "--cycles: ..."
+    message = re.sub(r"^Invalid value for '([^']+)': ", r"\1: ", message.strip())
+    lines = [line.strip() for line in message.splitlines() if line.strip()]
+    lines = lines or [type(exc).__name__]
+    ctx = getattr(exc, "ctx", None)
+    if ctx is not None:
+        lines[-1] = f"{lines[-1].rstrip('.')}; '{ctx.command_path} --help' lists the options"
+    return lines
 
 
 def main() -> None:
@@ -13,4 +46,30 @@ def main() -> None:
     except KeyboardInterrupt:
         sys.stderr.write("interrupted; nothing written\n")
         raise SystemExit(130) from None
-    app()
+    usage = _exception_classes("UsageError")
+    no_args = _exception_classes("NoArgsIsHelpError")
+    abort = _exception_classes("Abort")
+    try:
+        code = app(standalone_mode=False, prog_name="torquesplit")
+    except no_args as exc:  # a bare group or command: its help, as the parser shows it
+        try:
+            from typer import rich_utils
+
+            rich_utils.rich_format_error(exc)
+        except (ImportError, AttributeError):
+            exc.show()
+        raise SystemExit(exc.exit_code) from None
+    except usage as exc:
+        lines = usage_error_lines(exc)
+        for line in lines:
+            sys.stderr.write(f"error: {line}\n")
+        if "--json" in sys.argv[1:]:
+            from torquesplit import cli_support
+
+            cli_support._session.json = True
+            cli_support.emit_json_errors(lines)
+        raise SystemExit(2) from None
+    except abort:
+        sys.stderr.write("interrupted\n")
+        raise SystemExit(130) from None
+    raise SystemExit(code if isinstance(code, int) else 0)
