@@ -323,3 +323,14 @@ def test_a_logged_study_says_what_the_gpu_runner_does_between_cases():
     assert lines == ["64 cases set up (0:00:01 elapsed)",
                      f"run (0:00:{3 + int(LOG_EVERY)} elapsed)",
                      "cases 10/10 (0 not ok), 0:01:40 elapsed"]
+
+
+def test_a_bare_duration_is_seconds_for_study_and_sweep_as_for_run():
+    """``run --duration 0.05`` reads seconds; ``sweep``/``study`` said '0.1' was not a
+    time, and ``study`` blamed the study file's analysis.duration for the option."""
+    from torquesplit.study.cli import _seconds, _study_with
+
+    assert _seconds("0.1") == "0.1 s" and _seconds(" 2e-3 ") == "2e-3 s"
+    assert _seconds("5 ms") == "5 ms" and _seconds(None) is None
+    st = _study_with("ji_li_diameter", {"duration": _seconds("0.1")})
+    assert st.spec.analysis.duration == "0.1 s"  # (it raised: not a time)

@@ -69,10 +69,24 @@ def study(
         ui._fail(ValueError("give a study file or a shipped study name; list them with "
                             "'torquesplit study --list'"))
         return
-    analysis = {k: v for k, v in (("duration", duration), ("cycles", cycles)) if v is not None}
+    analysis = {k: v for k, v in (("duration", _seconds(duration)), ("cycles", cycles))
+                if v is not None}
     _run(study_file, workers=workers, scheduler=scheduler, out=out, resume=resume,
          overwrite=overwrite, figures=not no_figures, quiet=quiet, as_json=as_json,
          backend=backend, precision=precision, analysis=analysis)
+
+
+def _seconds(duration: str | None) -> str | None:
+    """``--duration`` as the study file writes it: a bare number is seconds, as ``run``
+    reads it (``sweep ... --duration 0.1`` said it was not a time, and ``study`` blamed
+    the study file's analysis.duration for the option)."""
+    if duration is None:
+        return None
+    try:
+        float(duration)
+    except ValueError:
+        return duration
+    return f"{duration.strip()} s"
 
 
 def _list() -> None:
@@ -806,7 +820,7 @@ def _sweep_study(ui, model, vary, output, log_spacing, static, duration, cycles,
         outputs = [f"load_sharing.{_default_definition(load_model, path)}.*"]
     analysis: dict = {"type": "static" if static else "run"}
     if not static:
-        for key, value in (("duration", duration), ("cycles", cycles)):
+        for key, value in (("duration", _seconds(duration)), ("cycles", cycles)):
             if value is not None:
                 analysis[key] = value
         if settle is not None:
