@@ -513,3 +513,41 @@ def test_ctrl_c_while_the_workers_start_is_a_stop_with_the_hint(tmp_path, split_
     ds = Study(grid_study(split_file, GRID)).run(workers=1, out=out, resume=True,
                                                  figures=False)
     assert (ds["status"] == "ok").all()
+
+
+def test_sigterm_stops_like_ctrl_c_and_says_how_to_resume(tmp_path, split_file):
+    """A batch system's time limit (SIGTERM) ended a study with 'leaked semaphore
+    objects', its run left 'running' and no word on resuming."""
+    path, out, proc = _study_process(tmp_path, split_file, workers=2, done=2)
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=120)
+    err = err.decode()
+    assert proc.returncode == 143, err
+    assert "stopped (SIGTERM):" in err and "--resume" in err
+    assert "leaked" not in err and "Traceback" not in err
+    done = _count(out / "study.sqlite")
+    res = CliRunner().invoke(app, ["study", str(path), "--out", str(out), "--resume",
+                                   "--workers", "1", "--quiet", "--no-figures"])
+    assert res.exit_code == 0, res.output
+    with sqlite3.connect(out / "study.sqlite") as db:
+        assert db.execute("SELECT COUNT(*) FROM cases").fetchone()[0] == 10
+        computed = [c for (c,) in db.execute("SELECT computed FROM runs ORDER BY run")]
+    assert computed[-1] == 10 - done
+
+
+def test_a_stop_under_overwrite_says_to_resume_in_its_place(tmp_path, split_file,
+                                                           monkeypatch):
+    """'run the same command with --resume' under --overwrite led to 'give one of them'."""
+    import torquesplit.study.core as core
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(core, "make_runner", interrupted)
+    path = _write(tmp_path, grid_study(split_file, GRID))
+    res = CliRunner().invoke(app, ["study", str(path), "--out", str(tmp_path / "out"),
+                                   "--overwrite", "--workers", "2", "--quiet",
+                                   "--no-figures"])
+    assert res.exit_code == 130
+    assert "run the same command with --resume in place of --overwrite" in " ".join(
+        res.output.split())

@@ -8,6 +8,7 @@ Ctrl-C: every finished case is already saved; one line says how to resume; statu
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import re
@@ -76,6 +77,41 @@ def study(
          backend=backend, precision=precision, analysis=analysis)
 
 
+class _Terminated:
+    """Whether a SIGTERM stopped the study (truthy once one came)."""
+
+    def __init__(self):
+        self.seen = False
+
+    def __bool__(self) -> bool:
+        return self.seen
+
+
+@contextlib.contextmanager
+def _terminate_as_interrupt():
+    """While a study runs, SIGTERM (a batch system's time limit, ``timeout``, ``kill``)
+    stops it as Ctrl-C does: the finished cases committed, the workers shut down, one
+    line saying how to resume (it died with 'leaked semaphore objects', the store's run
+    left 'running' and its lock behind)."""
+    import signal
+    import threading
+
+    terminated = _Terminated()
+    if threading.current_thread() is not threading.main_thread():
+        yield terminated
+        return
+
+    def stop(signum, frame):
+        terminated.seen = True
+        raise KeyboardInterrupt
+
+    before = signal.signal(signal.SIGTERM, stop)
+    try:
+        yield terminated
+    finally:
+        signal.signal(signal.SIGTERM, before)
+
+
 def _seconds(duration: str | None) -> str | None:
     """``--duration`` as the study file writes it: a bare number is seconds, as ``run``
     reads it (``sweep ... --duration 0.1`` said it was not a time, and ``study`` blamed
@@ -118,6 +154,7 @@ def _run(source, *, workers, scheduler, out, resume, overwrite, figures, quiet, 
     from .errors import StudyInterrupted
 
     ui = _ui()
+    terminated = False  # (a SIGTERM while the cases run: _terminate_as_interrupt)
     try:
         st = _study_with(source, analysis)
         plan = st.plan()
@@ -148,21 +185,25 @@ def _run(source, *, workers, scheduler, out, resume, overwrite, figures, quiet, 
                         "(same results, CPU speed)", highlight=False)
                 warnings.simplefilter("ignore", GpuFallbackWarning)
             # the messages name the flags (--resume), not Study.run's arguments
-            ds = _with_bar(lambda cb: st._run(CLI_WORDS, workers=workers, client=None,
-                                              scheduler=scheduler, runner=None, out=out,
-                                              resume=resume, overwrite=overwrite,
-                                              progress=cb, figures=figures, backend=backend,
-                                              precision=precision),
-                           plan.n_cases, quiet or as_json)
+            with _terminate_as_interrupt() as terminated:
+                ds = _with_bar(lambda cb: st._run(CLI_WORDS, workers=workers, client=None,
+                                                  scheduler=scheduler, runner=None, out=out,
+                                                  resume=resume, overwrite=overwrite,
+                                                  progress=cb, figures=figures,
+                                                  backend=backend, precision=precision),
+                               plan.n_cases, quiet or as_json)
     except StudyInterrupted as exc:
         # every case done: stopped while results.nc and the figures were written
         unwritten = ((f"; results.nc{' and figures' if figures else ''} not all written")
                      if exc.done >= exc.total else "")
-        ui.err_console.print("[yellow]stopped:[/] ", end="")
+        again = ("the same command with --resume in place of --overwrite" if overwrite
+                 else "the same command with --resume")
+        why = " (SIGTERM)" if terminated else ""
+        ui.err_console.print(f"[yellow]stopped{why}:[/] ", end="")
         ui.err_console.print(f"{exc.done} of {exc.total} cases done and saved in {out}"
-                             f"{unwritten}; to finish, run the same command with --resume",
+                             f"{unwritten}; to finish, run {again}",
                              markup=False, highlight=False, soft_wrap=True)
-        raise typer.Exit(130)
+        raise typer.Exit(143 if terminated else 130)
     except (TorquesplitError, ValueError, OSError) as exc:
         from .errors import StudyError
 
