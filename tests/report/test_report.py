@@ -146,8 +146,6 @@ def test_report_refuses_before_computing(tmp_path):
     (tmp_path / "r.html").write_text("earlier")
     res = runner.invoke(app, ["report", str(model), "--out", str(tmp_path / "r.html")])
     assert res.exit_code == 2 and "exists; use --force" in res.stderr
-    res = runner.invoke(app, ["report", str(model), "--pdf"])
-    assert res.exit_code == 2 and "print it to PDF" in res.stderr
     res = runner.invoke(app, ["report", str(tmp_path / "none.nc")])
     assert res.exit_code == 2 and "no such results file" in res.stderr
 
@@ -344,3 +342,14 @@ def test_a_critical_speed_run_warns_of_is_in_the_report(tmp_path):
                                                           html)}
     assert "3×m12 (forces cancel)" in rows["4"] and "3×m12" in rows["5"]
     assert "(forces cancel)" not in rows["5"]
+
+
+def test_pdf_keeps_the_html_and_says_how_to_print_it(tmp_path):
+    """--pdf refused after nothing and wrote no HTML either: an option that could never
+    work (no pure-Python HTML-to-PDF route), advertised in --help."""
+    model = write_model(tmp_path, MODEL)
+    out = tmp_path / "r.html"
+    res = runner.invoke(app, ["report", str(model), "--pdf", "--out", str(out), "--quiet"])
+    assert res.exit_code == 0, res.output
+    assert out.exists() and "print it to PDF" in res.stderr
+    assert "--pdf" not in runner.invoke(app, ["report", "--help"]).output

@@ -78,8 +78,8 @@ def register(app, helpers) -> None:
                                                  metavar="NAME"),
         assign: Optional[list[str]] = typer.Option(None, "--set", help=h._SET_HELP,
                                                    metavar="PATH=VALUE"),
-        pdf: bool = h._flag("--pdf", "Also a PDF (not available: no pure-Python route; "
-                            "print the HTML from a browser)."),
+        # (kept for scripts that pass it, out of --help: it can make no PDF)
+        pdf: bool = typer.Option(False, "--pdf", hidden=True),
         quiet: bool = h._flag("--quiet", "No progress display."),
     ):
         """One self-contained HTML report to hand on: the model with units, its layout, the
@@ -92,12 +92,6 @@ def register(app, helpers) -> None:
         with ux.interruptible(lambda: f"report kept in {state['written']}"
                               if state["written"] else ""):
             try:
-                if pdf:
-                    from ..errors import OptionError
-
-                    raise OptionError("--pdf needs an HTML-to-PDF converter torquesplit does "
-                                      "not ship (none is pure Python); open the HTML report "
-                                      "in a browser and print it to PDF")
                 if out is not None:
                     files.check_output(out, formats=REPORT_FORMATS, overwrite=force,
                                        what="the report")
@@ -120,6 +114,10 @@ def register(app, helpers) -> None:
                 h._fail(exc)
                 return
         h.console.print(f"report written to {plan.path}", highlight=False)
+        if pdf:  # (it refused, and wrote no HTML either: an option that could never work)
+            ux.warn(f"--pdf: no PDF written: torquesplit ships no HTML-to-PDF converter "
+                    f"(none is pure Python); open {plan.path} in a browser and print it to "
+                    f"PDF", label="note")
 
 
 def drawing_bytes(model, fmt: str) -> bytes:
