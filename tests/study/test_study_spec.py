@@ -66,6 +66,12 @@ def _bad_cases(model):
         "invalid first case": (grid_study(model, [{"path": "meshes.a1.damping_ratio",
                                                    "values": [-0.1, 0.1]}]),
                                "grid.parameters", "case 0"),
+        # ('must be a valid integer, got a number with a fractional part, got 2.5')
+        "fractional count": (grid_study(model, [dict(K, num=2.5)]), "grid.parameters.0.num",
+                             "must be a whole number, got 2.5"),
+        # ('two parameters are named [p, p]; give each a different name' hid this)
+        "one path twice": (grid_study(model, [K, K]), "grid.parameters.1",
+                           "which parameter 0 also writes"),
         # a grid of 1e8 points grew to GB before its first case, silently
         "huge range": (grid_study(model, [dict(K, num=100_000_000)]),
                        "grid.parameters.0.num", "at most 1,000,000 cases"),

@@ -601,10 +601,11 @@ def _grid(spec: StudySpec, raw: dict) -> Design:
             spacings.append(t.spacing if t.values is None else "values")
     problems.raise_any()
     names = [p.name for p in params]
+    _check_disjoint(params, "grid.parameters")  # (first: two names that are one path are
+    # that path twice, which 'give each a different name' did not mend)
     if len(set(names)) != len(names):
         raise StudyError("grid.parameters", f"two parameters are named {names}; give each a "
                                             f"different name")
-    _check_disjoint(params, "grid.parameters")
     shape = tuple(len(a) for a in axes)
     if math.prod(shape) > MAX_CASES:
         raise StudyError("grid.parameters", f"{' x '.join(map(str, shape))} = "

@@ -569,6 +569,8 @@ def _message(err: dict, parts: list[str]) -> str:
         return f"must be a table, got {got}; write it as a [section] or {{key = value}}"
     if kind.startswith("list_type"):
         return f"must be a list, got {got}; write it as [item, item, ...]"
+    if kind == "int_from_float":  # ('..., got a number with a fractional part, got 2.5')
+        return f"must be a whole number, got {got}; correct the value"
     if kind.startswith(("int_", "float_", "string_", "bool_")) or kind == "union_tag_invalid":
         return f"{err['msg'].replace('Input should be', 'must be')}, got {got}; correct the value"
     msg = err["msg"].replace("Input should be", "must be")
