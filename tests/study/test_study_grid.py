@@ -329,4 +329,10 @@ def test_a_scale_parameter_names_what_it_scales_on_the_axis():
 
     ds = xr.Dataset(coords={"f": ("f", [0.5, 2.0], {"mode": "scale",
                                                    "paths": json.dumps(paths)})})
-    assert _param_label(ds, "f") == "f (factor on gears.*.support.shaft.bearing_stiffness)"
+    assert _param_label(ds, "f") == ("f (factor on gears.*.support.shaft.bearing_stiffness, "
+                                     "6 fields)")
+    two = ["gears.z2.polar_inertia", "gears.z3.polar_inertia"]
+    ds = xr.Dataset(coords={"J": ("J", [0.5, 2.0], {"mode": "scale",
+                                                   "paths": json.dumps(two)})})
+    assert _param_label(ds, "J") == "J (factor on gears.z2.polar_inertia, " \
+                                    "gears.z3.polar_inertia)"

@@ -408,7 +408,13 @@ def path_pattern(paths: list[str]) -> str:
 def _param_label(ds, name) -> str:
     paths = json.loads(ds[name].attrs.get("paths", "[]"))
     if ds[name].attrs.get("mode") == "scale":  # (it said 'factor' of nothing: a reviewer)
-        return f"{name} (factor on {path_pattern(paths)})" if paths else f"{name} (factor)"
+        if not paths:
+            return f"{name} (factor)"
+        # the fields themselves where few ('gears.*.polar_inertia' read as every gear's
+        # for the two of gears.z[23]: a reviewer), else their pattern and count
+        what = (", ".join(paths) if len(paths) <= 3
+                else f"{path_pattern(paths)}, {len(paths)} fields")
+        return f"{name} (factor on {what})"
     if not paths or paths == [name]:
         return name
     if len(paths) <= 3:  # (a parameter set on several paths: name them, a reviewer's
