@@ -302,7 +302,11 @@ def _load(model: str, assignments: Optional[list[str]] = None, *, deep: bool = F
             from .errors import ModelError
             from .model.overrides import apply_assignments, attribute_errors, read_raw
 
-            data, where = apply_assignments(read_raw(path), assignments)
+            raw = read_raw(path)
+            try:
+                data, where = apply_assignments(raw, assignments)
+            except ModelError as exc:  # and the file's own problems, all at once
+                raise _with_file_problems(exc, raw, path, deep) from None
             try:
                 m = model_from_dict(data, source=str(path))
                 check_model(m, source=str(path), deep=deep)
@@ -321,6 +325,28 @@ def _load(model: str, assignments: Optional[list[str]] = None, *, deep: bool = F
                 and not any(text in str(w.message) for text in irrelevant)):
             ux.warn(attribute_warning(str(w.message), where, str(path)))
     return m, path
+
+
+def _with_file_problems(exc, raw: dict, path, deep: bool):
+    """A ``--set`` that cannot be applied, with the problems of the file as it stands
+    (they were said only once the --set was mended: one run per problem)."""
+    import copy
+
+    from .errors import ModelError
+    from .model.checks import check_model
+    from .model.io import _located, model_from_dict
+
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            check_model(model_from_dict(copy.deepcopy(raw), source=str(path)),
+                        source=str(path), deep=deep)
+    except ModelError as file_exc:
+        lines = str(exc).splitlines() + str(_located(file_exc, path)).splitlines()
+        return ModelError([("", line) for line in lines])
+    except Exception:  # noqa: BLE001 - the --set's error is the one to say
+        return exc
+    return exc
 
 
 def _model_warnings() -> list[str]:

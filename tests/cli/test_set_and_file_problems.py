@@ -1,0 +1,29 @@
+"""A ``--set`` that cannot be applied is said together with the file's own problems (a
+first-hour reviewer: with a bad --set path the file's wrong unit was said only after the
+--set was mended, one run per problem)."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+from typer.testing import CliRunner
+
+from torquesplit.cli import app
+
+TUTORIAL = Path(__file__).resolve().parents[2] / "docs" / "tutorial.md"
+
+
+def test_a_bad_set_path_and_a_bad_unit_in_the_file_are_said_at_once(tmp_path):
+    text = re.search(r"```toml\n(.*?)```", TUTORIAL.read_text(encoding="utf-8"), re.S).group(1)
+    text, n = re.subn(r'stiffness = "100 N/um"', 'stiffness = "100 kg"', text, count=1)
+    assert n == 1
+    model = tmp_path / "m.toml"
+    model.write_text(text, encoding="utf-8")
+    res = CliRunner().invoke(app, ["check", str(model), "--set", "gears.zz.teeth=3"])
+    assert res.exit_code == 2
+    err = res.stderr
+    assert "--set gears.zz.teeth=3: 'gears.zz' does not exist" in err
+    assert re.search(r"m\.toml:\d+: gears\.\w+\.support\.stiffness: '100 kg' is not a "
+                     r"stiffness", err), err
+    assert "Traceback" not in err
