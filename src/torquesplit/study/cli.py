@@ -40,23 +40,30 @@ def study(
     study_file: Optional[str] = typer.Argument(
         None, help="Study file (.toml) or the name of a shipped study (see --list)."),
     workers: Optional[int] = typer.Option(
-        None, "--workers", help="Local worker processes (default: all cores; 1 = this process)."),
+        None, "--workers", help="Local worker processes (default: all cores; 1 = this process).",
+        metavar="N"),
     scheduler: Optional[str] = typer.Option(
         None, "--scheduler", help="Run on a Dask cluster: the scheduler address, e.g. "
-                                  "tcp://10.0.0.5:8786."),
+                                  "tcp://10.0.0.5:8786.",
+        metavar="ADDRESS"),
     out: Optional[Path] = typer.Option(
         None, "--out", help="Output folder: store, results.nc, figures "
-                            "(default: ./study_NAME)."),
+                            "(default: ./study_NAME).",
+        metavar="DIR"),
     resume: bool = typer.Option(False, "--resume", help="Continue the study stored in --out."),
     overwrite: bool = typer.Option(False, "--overwrite",
                                    help="Start again, deleting the study stored in --out."),
     list_studies: bool = typer.Option(False, "--list", help="List the shipped studies."),
     duration: Optional[str] = typer.Option(
-        None, "--duration", help="Simulated time per case, instead of the study's."),
+        None, "--duration", help="Simulated time per case, instead of the study's.",
+        metavar="TIME"),
     cycles: Optional[int] = typer.Option(
-        None, "--cycles", help="Cycles of the slowest mesh per case, instead of the study's."),
-    backend: str = typer.Option("cpu", "--backend", help=BACKEND_HELP),
-    precision: Optional[str] = typer.Option(None, "--precision", help=PRECISION_HELP),
+        None, "--cycles", help="Cycles of the slowest mesh per case, instead of the study's.",
+        metavar="N"),
+    backend: str = typer.Option("cpu", "--backend", help=BACKEND_HELP,
+        metavar="NAME"),
+    precision: Optional[str] = typer.Option(None, "--precision", help=PRECISION_HELP,
+        metavar="NAME"),
     no_figures: bool = typer.Option(False, "--no-figures", help="Do not write figures."),
     quiet: bool = typer.Option(False, "--quiet", help="No progress bar."),
     as_json: bool = json_option("Print the summary as JSON."),
@@ -790,29 +797,40 @@ def sweep(
     model: str = typer.Argument(..., help="Model file (.toml/.json) or example name."),
     vary: list[str] = typer.Option(
         ..., "--vary", help="PATH=START:STOP:NUM[unit], e.g. shafts.drive1.diameter="
-                            "130:400:28mm; several paths set together: P1,P2=..."),
+                            "130:400:28mm; several paths set together: P1,P2=...",
+        metavar="PATH=RANGE"),
     output: Optional[list[str]] = typer.Option(
         None, "--output", help="Output name or pattern (repeatable); default "
                                "load_sharing.DEF.* with DEF the model's load-sharing "
                                "definition: the coefficient of every group and of every mesh "
-                               "(add --output load_sharing.DEF for the system's)."),
+                               "(add --output load_sharing.DEF for the system's).",
+        metavar="NAME"),
     log_spacing: bool = typer.Option(False, "--log", help="Logarithmic spacing."),
     static: bool = typer.Option(False, "--static", help="Quasi-static analysis instead of a run."),
-    duration: Optional[str] = typer.Option(None, "--duration", help="Simulated time per case."),
-    cycles: Optional[int] = typer.Option(None, "--cycles", help="Cycles of the slowest mesh."),
+    duration: Optional[str] = typer.Option(None, "--duration", help="Simulated time per case.",
+        metavar="TIME"),
+    cycles: Optional[int] = typer.Option(None, "--cycles", help="Cycles of the slowest mesh.",
+        metavar="N"),
     settle: Optional[float] = typer.Option(
         None, "--settle", help="Stop each run once its outputs change by less than this "
-                               "relative tolerance between run lengths (e.g. 0.002)."),
+                               "relative tolerance between run lengths (e.g. 0.002).",
+        metavar="TOL"),
     assign: Optional[list[str]] = typer.Option(
-        None, "--set", help="Fixed model change for every case: PATH=VALUE."),
-    workers: Optional[int] = typer.Option(None, "--workers", help="Local worker processes."),
-    scheduler: Optional[str] = typer.Option(None, "--scheduler", help="Dask scheduler address."),
+        None, "--set", help="Fixed model change for every case: PATH=VALUE.",
+        metavar="PATH=VALUE"),
+    workers: Optional[int] = typer.Option(None, "--workers", help="Local worker processes.",
+        metavar="N"),
+    scheduler: Optional[str] = typer.Option(None, "--scheduler", help="Dask scheduler address.",
+        metavar="ADDRESS"),
     out: Optional[Path] = typer.Option(None, "--out", help="Output folder (default "
-                                                           "./study_sweep_PATH)."),
+                                                           "./study_sweep_PATH).",
+        metavar="DIR"),
     resume: bool = typer.Option(False, "--resume", help="Continue the sweep stored in --out."),
     overwrite: bool = typer.Option(False, "--overwrite", help="Start again in --out."),
-    backend: str = typer.Option("cpu", "--backend", help=BACKEND_HELP),
-    precision: Optional[str] = typer.Option(None, "--precision", help=PRECISION_HELP),
+    backend: str = typer.Option("cpu", "--backend", help=BACKEND_HELP,
+        metavar="NAME"),
+    precision: Optional[str] = typer.Option(None, "--precision", help=PRECISION_HELP,
+        metavar="NAME"),
     no_figures: bool = typer.Option(False, "--no-figures", help="Do not write figures."),
     quiet: bool = typer.Option(False, "--quiet", help="No progress bar."),
     as_json: bool = json_option("Print the summary as JSON."),
