@@ -101,7 +101,8 @@ def test_changed_study_or_model_refuses_resume(tmp_path, split_file):
     path = _write(tmp_path, data)
     out = tmp_path / "out"
     Study(path).run(workers=1, out=out, figures=False)
-    with pytest.raises(StudyError, match=r"^out: .* already holds a study; add resume=True "
+    with pytest.raises(StudyError, match=r"^out: .* already holds a study \(finished: its "
+                                         r"results are in .*results\.nc\); add resume=True "
                                          r"to continue it, overwrite=True to start it again"):
         Study(path).run(workers=1, out=out)
     # done: resuming recomputes nothing
@@ -529,6 +530,7 @@ def test_sigterm_stops_like_ctrl_c_and_says_how_to_resume(tmp_path, split_file):
     res = CliRunner().invoke(app, ["study", str(path), "--out", str(out), "--resume",
                                    "--workers", "1", "--quiet", "--no-figures"])
     assert res.exit_code == 0, res.output
+    assert f"resuming: {done} finished case" in res.stderr  # (it said nothing of them)
     with sqlite3.connect(out / "study.sqlite") as db:
         assert db.execute("SELECT COUNT(*) FROM cases").fetchone()[0] == 10
         computed = [c for (c,) in db.execute("SELECT computed FROM runs ORDER BY run")]

@@ -174,12 +174,16 @@ def _run(source, *, workers, scheduler, out, resume, overwrite, figures, quiet, 
                 f"[bold]{st.name}[/]: {plan.n_cases} cases ({plan.design.kind}, "
                 f"{plan.analysis['type']}), {_count(len(plan.outputs), 'output')} -> {out}",
                 highlight=False)
-        from .core import resume_notes
+        from .core import resume_notes, stored_cases
 
         for note in plan.notes:  # cases known invalid before any runs
             ui.ux.warn(_sweep_note(note, flag) if flag else note)
         for note in resume_notes(out, resume, CLI_WORDS):
             ui.ux.warn(note)
+        kept = stored_cases(out) if resume else 0
+        if kept and not as_json:  # (a resume went straight to 'cases 3/6' without a word)
+            ui.err_console.print(f"resuming: {kept} finished case{'s' if kept > 1 else ''} "
+                                 f"kept from {out}", highlight=False)
         with warnings.catch_warnings():
             if backend == "gpu":  # no device: say so in one line, not as a Python warning
                 from ..errors import GpuFallbackWarning

@@ -289,6 +289,23 @@ def resume_notes(out, resume: bool, words: Words) -> list[str]:
             f"{'are' if n > 1 else 'is'} run again"]
 
 
+def stored_cases(out) -> int:
+    """How many finished cases the study store in ``out`` holds (0 without one)."""
+    import contextlib
+    import sqlite3
+
+    path = Path(out) / STORE_NAME
+    if not path.exists():
+        return 0
+    try:
+        with contextlib.closing(sqlite3.connect(path.resolve().as_uri() + "?mode=ro",
+                                                uri=True)) as db:
+            return int(db.execute("SELECT COUNT(*) FROM cases WHERE status != 'error'"
+                                  ).fetchone()[0])
+    except sqlite3.Error:
+        return 0
+
+
 def _write_outputs(ds, out: Path, figures: bool) -> None:
     """``results.nc`` and (if asked) the figures of a study whose cases are all done."""
     from .dataset import write_dataset
@@ -407,9 +424,11 @@ def _open_folder(plan: Plan, out: Path, resume: bool, overwrite: bool,
             figure.unlink(missing_ok=True)
     exists = path.exists()
     if exists and not resume:
-        raise StudyError(words.out, f"{out} already holds a study; add {words.resume_on} to "
-                                    f"continue it, {words.overwrite_on} to start it again, or "
-                                    f"choose another folder")
+        done = (f" (finished: its results are in {out / RESULTS_NAME})"
+                if (out / RESULTS_NAME).exists() else "")
+        raise StudyError(words.out, f"{out} already holds a study{done}; add "
+                                    f"{words.resume_on} to continue it, {words.overwrite_on} "
+                                    f"to start it again, or choose another folder")
     # a folder of other results (no study store): what this study writes would replace them
     theirs = [f for f in (out / RESULTS_NAME, out / "figures") if f.exists()]
     if not exists and theirs and not overwrite:
