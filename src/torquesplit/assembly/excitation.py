@@ -20,8 +20,10 @@ from ..model.schema import Model
 
 
 #: unlabelled meshes of one tooth-count pair whose nominal forces differ by more than this
-#: (relative) are not parallel paths of one stage
-STAGE_FORCE_RTOL = 1e-6
+#: (relative) are not parallel paths of one stage: a split and a combining stage differ
+#: by the number of paths (x2, x3), parallel branches at most by their working pressure
+#: angles (profile shifts, centre distances: a few per cent of cos alpha)
+STAGE_FORCE_RTOL = 0.05
 
 
 def stage_labels(model: Model, kin: Kinematics) -> dict[str, str]:
