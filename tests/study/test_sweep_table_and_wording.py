@@ -125,3 +125,16 @@ def test_a_wrong_unit_of_vary_is_told_in_the_sweeps_words(split_file):
     assert res.exit_code == 2, res.output
     assert "write the unit after the count, e.g. START:STOP:NUMum" in res.stderr, res.stderr
     assert 'unit = "' not in res.stderr
+
+
+def test_a_unit_on_a_plain_number_field_is_said_in_the_sweeps_words(tmp_path):
+    """It said "remove 'unit'", a study file's key, to a command line."""
+    from typer.testing import CliRunner
+
+    from torquesplit.cli import app
+
+    res = CliRunner().invoke(app, ["sweep", "ji_li_mill_drive", "--vary",
+                                   "meshes.m11.damping_ratio=0.05:0.1:2mm", "--out",
+                                   str(tmp_path / "s")])
+    assert res.exit_code == 2
+    assert "write no unit after the count" in res.stderr and "'unit'" not in res.stderr

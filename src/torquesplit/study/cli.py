@@ -275,7 +275,10 @@ def _sweep_option(field: str, flag: str) -> str:
 
 #: a study file's remedy -> the sweep's (its message spoke study-file syntax to a command
 #: line: 'use spacing = "linear"' where the fix is to leave out --log)
-_SWEEP_WORDS = (('use spacing = "linear"', "leave out --log"),)
+_SWEEP_WORDS = (('use spacing = "linear"', "leave out --log"),
+                # (the study file's key, where the sweep's unit follows the count)
+                ("given for a plain-number field; remove 'unit'",
+                 "given for a plain-number field; write no unit after the count"))
 
 
 def _sweep_words(message: str) -> str:
