@@ -282,3 +282,20 @@ def test_a_planet_count_study_says_its_outputs_are_the_base_models_meshes():
              "grid": {"parameters": [{"path": "planetary.0.planets", "values": [3, 5]}]}}
     notes = Study(study).plan().notes
     assert any("planetary.0.planets changes the number of planets" in n for n in notes), notes
+
+
+def test_every_bad_value_of_one_parameter_is_said(split_file):
+    """Only the first bad value of a parameter was said (values 1 of 3; a uniform's low,
+    not its high): one run per mistake."""
+    grid = grid_study(split_file, [{"path": "meshes.a1.stiffness",
+                                    "values": ["2e8 N/m", "2 kg", "3 s"]}])
+    with pytest.raises(StudyError) as info:
+        Study(grid).plan()
+    fields = [f for f, _ in info.value.problems]
+    assert fields == ["grid.parameters.0.values.1", "grid.parameters.0.values.2"]
+    mc = mc_study(split_file)
+    mc["monte_carlo"]["parameters"][1].update(low="1 s", high="2 kg")
+    with pytest.raises(StudyError) as info:
+        Study(mc).plan()
+    fields = [f for f, _ in info.value.problems]
+    assert fields == ["monte_carlo.parameters.1.low", "monte_carlo.parameters.1.high"]

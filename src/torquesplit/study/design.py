@@ -619,13 +619,17 @@ def _grid(spec: StudySpec, raw: dict) -> Design:
 def _grid_axis(t, raw: dict, where: str) -> tuple[Parameter, np.ndarray]:
     """One grid parameter and its values (SI)."""
     p = _parameter(t, raw, where)
+    problems = _Problems()  # (every bad value at once: only the first was said)
     if t.values is not None:
-        vals = np.array([_value(v, p, t.unit, f"{where}.values.{j}")
-                         for j, v in enumerate(t.values)], dtype=float)
+        got = [problems.attempt(_value, v, p, t.unit, f"{where}.values.{j}")
+               for j, v in enumerate(t.values)]
+        problems.raise_any()
+        vals = np.array(got, dtype=float)
         shown = t.values
     else:
-        a = _value(t.start, p, t.unit, f"{where}.start")
-        b = _value(t.stop, p, t.unit, f"{where}.stop")
+        a = problems.attempt(_value, t.start, p, t.unit, f"{where}.start")
+        b = problems.attempt(_value, t.stop, p, t.unit, f"{where}.stop")
+        problems.raise_any()
         if t.num > MAX_CASES:
             raise StudyError(f"{where}.num", f"{t.num:,} points; a study holds at most "
                                              f"{MAX_CASES:,} cases: give fewer")
@@ -749,9 +753,15 @@ def _random_variable(t, p: Parameter, model, where) -> RandomVariable:
     def si(name):
         return P.to_si(getattr(t, name), kind, t.unit, f"{where}.{name}")
 
+    def each(*names):  # every bad value of the distribution at once (the first was said)
+        problems = _Problems()
+        got = [problems.attempt(si, n) for n in names]
+        problems.raise_any()
+        return got
+
     nonneg = [f.path for f in p.fields if f.nonnegative]
     if d == "normal":
-        mean, std = si("mean"), si("std")
+        mean, std = each("mean", "std")
         if std <= 0:
             raise StudyError(f"{where}.std", "must be positive; give the standard deviation")
         below = 0.5 * math.erfc(mean / (std * math.sqrt(2)))  # P(x < 0)
@@ -764,12 +774,12 @@ def _random_variable(t, p: Parameter, model, where) -> RandomVariable:
                 f"(and high)"))
         return RandomVariable("normal", (mean, std))
     if d == "uniform":
-        low, high = si("low"), si("high")
+        low, high = each("low", "high")
         if not high > low:
             raise StudyError(f"{where}.high", "must exceed 'low'; correct the bounds")
         _refuse_negative_low(low, t, nonneg, where)
         return RandomVariable("uniform", (low, high))
-    mean, std, low, high = si("mean"), si("std"), si("low"), si("high")
+    mean, std, low, high = each("mean", "std", "low", "high")
     if std <= 0:
         raise StudyError(f"{where}.std", "must be positive; give the standard deviation")
     if not high > low:
@@ -914,8 +924,10 @@ def _sensitivity_parameters(spec: StudySpec, raw: dict):
 def _sensitivity_factor(t, raw: dict, where: str):
     """A sensitivity parameter table -> (Parameter, low, high, spacing), bounds in SI."""
     p = _parameter(t, raw, where)
-    low = _value(t.low, p, t.unit, f"{where}.low")
-    high = _value(t.high, p, t.unit, f"{where}.high")
+    problems = _Problems()  # (both bounds' problems at once)
+    low = problems.attempt(_value, t.low, p, t.unit, f"{where}.low")
+    high = problems.attempt(_value, t.high, p, t.unit, f"{where}.high")
+    problems.raise_any()
     if not high > low:
         raise StudyError(f"{where}.high", "must exceed 'low'; give the range low < high")
     if t.spacing == "log" and low <= 0:
