@@ -138,3 +138,23 @@ def test_a_unit_on_a_plain_number_field_is_said_in_the_sweeps_words(tmp_path):
                                    str(tmp_path / "s")])
     assert res.exit_code == 2
     assert "write no unit after the count" in res.stderr and "'unit'" not in res.stderr
+
+
+def test_a_range_without_its_unit_is_said_once(tmp_path):
+    """After 'write the unit after the count' it also said that case 0, at 0.5 m, was an
+    invalid model: the consequence of the same slip, read in SI."""
+    from typer.testing import CliRunner
+
+    from torquesplit.cli import app
+
+    vary = ["sweep", "ji_li_mill_drive", "--vary", "meshes.m11.backlash=0.5:1.5:3",
+            "--out", str(tmp_path / "s")]
+    res = CliRunner().invoke(app, vary)
+    assert res.exit_code == 2
+    err = " ".join(res.stderr.split())
+    assert "write the unit after the count" in err
+    assert "case 0" not in err and "deeper than the whole tooth" not in err
+    res = CliRunner().invoke(app, vary + ["--output", "load_sharing.bogus"])
+    err = " ".join(res.stderr.split())  # (the other options' problems are still said)
+    assert "write the unit after the count" in err
+    assert "--output: 'load_sharing.bogus' matches no output" in err

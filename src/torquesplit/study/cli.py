@@ -870,8 +870,11 @@ def _sweep_study(ui, model, vary, output, log_spacing, static, duration, cycles,
     opts(ui._one_run_length, duration, cycles)
     opts(ui._at_least, workers, 1, "--workers", "2")
     param = opts(_vary_table, vary, log_spacing)
+    bare = False  # (a range without its unit: its cases' values are no values to judge)
     if param is not None:
+        before = len(opts.messages)
         opts(_as_option, _refuse_bare_range, vary[0], param)
+        bare = len(opts.messages) > before
         opts(_set_apart, param, assign)
     opts(_static_length, static, duration, cycles, settle)
     path = ui._resolve_model_path(model)
@@ -899,12 +902,15 @@ def _sweep_study(ui, model, vary, output, log_spacing, static, duration, cycles,
             "analysis": analysis, "grid": {"parameters": [param]},
             "set": dict(parse_assignment(a) for a in (assign or []))}
     if opts.messages:
-        if param is not None:  # the study's own problems beside the options'
+        # the study's own problems beside the options' (not those of a range read in SI
+        # for want of its unit: 'case 0 at 0.5 m' after 'write the unit after the count')
+        if param is not None:
             try:
                 Study(data).plan()
             except StudyError as exc:
                 opts.messages += [f"{_sweep_option(f, '--vary')}: {_sweep_words(m)}"
-                                  for f, m in exc.problems]
+                                  for f, m in exc.problems
+                                  if not (bare and f.startswith("grid.parameters"))]
             except (ValueError, ArithmeticError, OSError):  # said when the options are fixed
                 pass
         opts.raise_any()
