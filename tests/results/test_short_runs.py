@@ -50,3 +50,11 @@ def test_span_mean_weights_cycles_by_their_samples():
     assert span_mean([1.0, 3.0], [1, 3]) == 2.5
     assert math.isnan(span_mean([1.0, np.nan], [0, 0]))
     assert math.isnan(span_mean(np.zeros(0), np.zeros(0, dtype=int)))
+
+
+def test_a_run_without_a_settled_part_has_no_settled_bearing_forces(tmp_path):
+    """Its default (the settle time, -inf) gave the start-up's bearing forces as settled,
+    where the docstring, the CLI and the files give none."""
+    res = _run(tmp_path, 1e-4)
+    assert res.metrics().settling.start_time == -math.inf
+    assert res.bearing_forces() == []

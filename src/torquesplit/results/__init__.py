@@ -590,6 +590,8 @@ class Results:
             if start_time is None and metrics is None:
                 metrics = self.metrics()
             t0 = metrics.settling.start_time if start_time is None else float(start_time)
+            if not math.isfinite(t0):  # the default settle time of a run without a whole
+                return []  # cycle: no settled part (the start-up was given as 'settled')
             keep = s.history_t >= t0
         if not keep.any():
             keep = np.ones(s.history_t.shape, bool)
