@@ -495,3 +495,28 @@ def test_a_crossing_whose_branch_forces_nearly_cancel_is_not_driven(tmp_path):
                                           2600 * rpm, 2650 * rpm, None)["crossings"]
                if c["order"] == 1 and "in1" in c.get("meshes", [])]
     assert bearing and all(driven(c) for c in bearing)
+
+
+@pytest.mark.parametrize("method, initial", [("shooting", "abc"), ("shooting", [1, 2, 3]),
+                                             ("hb", "abc"), ("hb", [1.0, 2.0])])
+def test_a_starting_guess_of_the_wrong_kind_is_refused(method, initial):
+    """A wrong-size guess was dropped without a word (shooting) or failed deep inside
+    with a bare ValueError (harmonic balance)."""
+    import torquesplit
+    from torquesplit.errors import OptionError
+
+    m = torquesplit.load_model(torquesplit.example_path("ji_li_mill_drive"))
+    kw = {"harmonics": 4} if method == "hb" else {}
+    with pytest.raises(OptionError, match=r"initial must be a state \[q, v\] of 28 values"):
+        torquesplit.steady_state(m, method=method, initial=initial, stability=False, **kw)
+
+
+@pytest.mark.parametrize("settle", [0, -1, 2.5])
+def test_sweep_speed_refuses_a_settle_period_count_below_one(settle):
+    import torquesplit
+    from torquesplit.errors import OptionError
+
+    m = torquesplit.load_model(torquesplit.example_path("ji_li_mill_drive"))
+    with pytest.raises(OptionError, match="settle_periods must be a whole number >= 1"):
+        torquesplit.sweep_speed(m, "700 rpm", "760 rpm", points=2, cross_check=True,
+                                settle_periods=settle)

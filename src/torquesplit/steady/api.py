@@ -418,6 +418,11 @@ def steady_state(model, *, method: str = "auto", harmonics: int | None = None,
         (default 100, refined for the highest mode).
     check : bool
         HB: integrate one period from the solution and report the periodicity defect.
+    initial : array_like, optional
+        A starting guess (e.g. a neighbouring speed's solution): the state [q, v] at the
+        start of the period (2 n values in the structure's DOF order, SI), or for
+        ``method="hb"`` also a solution's harmonic coefficients; anything else is
+        refused.  Default: the static equilibrium.
     progress : callable, optional
         ``progress(None, what)`` is called as the solver moves on (settling, each Newton
         step with its defect, the harmonics tried, the Floquet multipliers): what a long

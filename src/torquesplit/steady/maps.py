@@ -150,6 +150,12 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
 
     if not (isinstance(points, (int, np.integer)) and points >= 1):
         raise OptionError(f"points must be a whole number >= 1, got {points!r}")
+    if not (isinstance(settle_periods, (int, np.integer)) and not isinstance(
+            settle_periods, bool) and settle_periods >= 1):  # (0: a ZeroDivisionError deep
+        # inside; -1: cross-check numbers that looked plausible)
+        raise OptionError(f"settle_periods must be a whole number >= 1 (periods run at "
+                          f"each speed of the cross-check), got {settle_periods!r}; give "
+                          f"e.g. 200")
     if max_step is not None and not (isinstance(max_step, (int, float))
                                      and not isinstance(max_step, bool) and max_step > 0):
         raise OptionError(f"max_step must be a positive speed in rad/s (the largest "

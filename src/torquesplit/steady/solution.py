@@ -209,12 +209,37 @@ class PeriodicSolution:
         return np.concatenate([self.q[0], self.v[0]])
 
 
+def initial_guess(initial, n: int, n_rigid: int | None = None) -> np.ndarray | None:
+    """``steady_state(initial=...)`` checked: a state [q, v] (2 n values) or, with
+    ``n_rigid`` (harmonic balance), the coefficients of another harmonic count (m n +
+    n_rigid values); a guess of another size was dropped without a word (shooting) or
+    failed deep inside (harmonic balance)."""
+    if initial is None:
+        return None
+    from ..errors import OptionError
+
+    try:
+        init = np.asarray(initial, dtype=float)
+    except (TypeError, ValueError):
+        init = None
+    sizes = f"a state [q, v] of {2 * n} values" + (
+        f", or the harmonic coefficients of a solution (m x {n} + {n_rigid} values)"
+        if n_rigid is not None else "")
+    if (init is None or init.ndim != 1 or not np.all(np.isfinite(init)) or not (
+            init.size == 2 * n or (n_rigid is not None and init.size > n_rigid
+                                   and (init.size - n_rigid) % n == 0))):
+        shown = getattr(init, "shape", None)
+        raise OptionError(f"initial must be {sizes} (finite numbers), got "
+                          f"{initial!r:.60}" + (f" of shape {shown}" if shown else ""))
+    return init
+
+
 def _initial_hb(hb: HarmonicBalance, q_static, initial):
     x = np.zeros(hb.size)
     u, _ = hb.split(x)
     if initial is not None:
-        init = np.asarray(initial, dtype=float)
-        if init.ndim == 1 and init.size == 2 * hb.p.n:  # a state: mean from it
+        init = initial_guess(initial, hb.p.n, hb.p.nr)
+        if init.size == 2 * hb.p.n:  # a state: mean from it
             u[0] = init[:hb.p.n]
         else:  # coefficients of another H
             return pad_coefficients(init, hb)
@@ -442,8 +467,8 @@ def periodic_solution(structure, period: Period, *, method: str = "auto", harmon
                             track=meshes, out=kept[0])
             return kept[0]
 
-        if initial is not None and np.size(initial) == 2 * p.n:
-            y0 = np.asarray(initial, dtype=float)
+        if initial is not None:
+            y0 = initial_guess(initial, p.n)
         else:
             y0 = np.concatenate([q_static if q_static is not None else np.zeros(p.n),
                                  np.zeros(p.n)])
