@@ -71,3 +71,14 @@ def test_a_hyphen_chain_is_one_factor_and_the_lbf_hint_only_where_it_fixes():
     with pytest.raises(ValueError) as exc:
         parse_quantity("1 lb/ft-s", "pressure")
     assert "lbf" not in str(exc.value)
+
+
+def test_newton_metres_written_nm_are_a_torque():
+    """'200 Nm' and '0.2 kNm' (a torque's usual spelling) were refused as 'neither a force
+    nor a torque': pint reads Nm as nanometres."""
+    from torquesplit.model.units import parse_quantity
+
+    assert parse_quantity("200 Nm", "torque") == pytest.approx(200.0)
+    assert parse_quantity("0.2 kNm", "torque") == pytest.approx(200.0)
+    assert parse_quantity("1.5 MNm", "torque") == pytest.approx(1.5e6)
+    assert parse_quantity("5 nm", "length") == pytest.approx(5e-9)  # (a length stays one)

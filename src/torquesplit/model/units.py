@@ -153,6 +153,10 @@ def _floats(text: str) -> str:
 _HAS_NUMBER = re.compile(r"\d|\b(inf|infinity|nan|pi)\b", re.IGNORECASE)
 
 
+#: 'Nm', 'kNm', 'MNm' where a torque is expected: newton metres, not nanometres
+_NEWTON_METRE = re.compile(r"(?<![A-Za-z])([kM]?)Nm(?![A-Za-z])")
+
+
 @lru_cache(maxsize=8192)
 def _parse_string(text: str, kind: str) -> float:
     """``text`` in the SI unit of ``kind`` (ValueError saying what was expected).  Cached:
@@ -160,6 +164,8 @@ def _parse_string(text: str, kind: str) -> float:
     once per process (pint takes about 0.4 ms a string)."""
     ureg = registry()
     si_unit, example = KINDS[kind]
+    if kind == "torque":  # 'Nm', 'kNm' (a torque's usual spelling; pint: nanometres)
+        text = _NEWTON_METRE.sub(r"\1N*m", text)
     try:
         q = ureg.Quantity(_floats(_spellings(text.strip())))
         if not isinstance(q, pint.Quantity):  # pragma: no cover - older pint: a bare number
