@@ -1781,7 +1781,8 @@ def modes(
             highlight=False)
     if not rep.rows:  # (an empty table said nothing: a reviewer's --below "10 Hz")
         lowest = [f for f in rep.solution.frequencies if f > 0]
-        console.print((f"no mode below {below}" if below is not None else "no elastic mode")
+        console.print((f"no mode below {limit:.5g} Hz" if below is not None  # (a bare
+                       else "no elastic mode")  # number echoed without its unit, Hz)
                       + (f": the lowest is {min(lowest):.5g} Hz" if lowest else ""),
                       highlight=False)
         return

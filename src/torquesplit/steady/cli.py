@@ -847,6 +847,8 @@ def campbell_command(m, start, stop, plot, as_json, console, json_default, out=N
         return
     phased = any("suppressed" in c for c in crossings)
     lo, hi = (_speed_text(x) for x in (start, stop))
+    if _speed(start, "--from") > _speed(stop, "--to"):  # (--from above --to: it echoed
+        lo, hi = hi, lo  # 'between 3600rpm and 2400rpm')
     from torquesplit.steady.maps import DRIVING_HARMONIC, driven
 
     n_driven = sum(driven(c, DRIVING_HARMONIC) for c in critical)
