@@ -127,3 +127,18 @@ def test_warnings_name_the_callers_line(model):
     said = [w for w in caught if "asks for more samples" in str(w.message)]
     assert len(said) == 1
     assert (said[0].filename, said[0].lineno) == (__file__, line)
+
+
+def test_tab_completion_lists_the_library_and_modes_take_a_limit_with_its_unit():
+    """dir(torquesplit) listed 'annotations' (a __future__ feature); dir(torquesplit.plot)
+    listed none of its figure functions; model_modes(below='1 kHz') was refused while
+    simulate(duration='5 ms') reads its unit."""
+    import torquesplit.plot
+
+    assert "annotations" not in dir(torquesplit)
+    assert set(torquesplit.plot.__all__) <= set(dir(torquesplit.plot))
+    a = torquesplit.model_modes("ji_li_mill_drive", below="1 kHz")
+    b = torquesplit.model_modes("ji_li_mill_drive", below=1000.0)
+    assert [r.frequency for r in a.rows] == [r.frequency for r in b.rows] and a.rows
+    with pytest.raises(torquesplit.errors.OptionError, match="below"):
+        torquesplit.model_modes("ji_li_mill_drive", below="1 kg")

@@ -56,4 +56,5 @@ def __getattr__(name):
 
 
 def __dir__():
-    return sorted(set(globals()) | set(__all__))
+    # (globals() holds 'annotations', the __future__ feature: not the library's)
+    return sorted((set(globals()) | set(__all__)) - {"annotations"})

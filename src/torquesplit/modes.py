@@ -355,7 +355,7 @@ def classify(structure, sol, *, rtol: float = 1e-6, tol: float = 1e-6,
     return rows
 
 
-def model_modes(model, *, rotating_frame: bool = True, below: float | None = None,
+def model_modes(model, *, rotating_frame: bool = True, below: float | str | None = None,
                 count: int | None = None, rtol: float = 1e-6) -> ModalReport:
     """Modes of a model about its static equilibrium, grouped, and classified where it has
     a planetary stage (``ModeRow.type`` None otherwise).
@@ -367,7 +367,8 @@ def model_modes(model, *, rotating_frame: bool = True, below: float | None = Non
         Include the Coriolis and centripetal terms of the bodies in a turning carrier's
         frame (False: the stationary-carrier modes of Lin & Parker 1999).
     below : float, optional
-        Keep the modes below this frequency [Hz] (whole degenerate groups).
+        Keep the modes below this frequency [Hz, or a text with its unit: "1 kHz"] (whole
+        degenerate groups).
     count : int, optional
         Keep at most this many modes (a degenerate group is not cut: the last group is
         kept whole).
@@ -390,9 +391,17 @@ def model_modes(model, *, rotating_frame: bool = True, below: float | None = Non
 
     if count is not None and not (isinstance(count, (int, np.integer)) and count >= 1):
         raise OptionError(f"count must be a whole number of modes, 1 or more, got {count!r}")
-    if below is not None and not (isinstance(below, (int, float)) and below > 0):
-        raise OptionError(f"below must be a positive frequency in Hz (a number), got "
-                          f"{below!r}")
+    if isinstance(below, str):  # '1 kHz', as simulate(duration='5 ms') reads a text
+        from .model.units import parse_quantity
+
+        try:
+            below = parse_quantity(below, "frequency")
+        except ValueError as exc:
+            raise OptionError(f"below {exc}") from None
+    if below is not None and not (isinstance(below, (int, float)) and not isinstance(
+            below, bool) and below > 0):
+        raise OptionError(f"below must be a positive frequency (in Hz, or a text with its "
+                          f"unit such as '1 kHz'), got {below!r}")
     if not (isinstance(rtol, (int, float)) and not isinstance(rtol, bool) and 0 <= rtol < 1):
         raise OptionError(f"rtol must be a relative difference of frequencies, 0 <= rtol < 1, "
                           f"got {rtol!r}; give e.g. rtol=1e-6")

@@ -68,3 +68,8 @@ def __getattr__(name):
 
         return getattr(figures, name)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__():
+    """The figure functions (lazy: tab completion listed none of them)."""
+    return sorted(set(__all__) | {"__all__", "__doc__", "__name__"})
