@@ -64,7 +64,9 @@ def test_mode_numbers_and_counts_are_checked(model):
         with pytest.raises(torquesplit.OptionError, match="count must be"):
             torquesplit.model_modes(model, count=bad)
     with pytest.raises(torquesplit.OptionError, match="below must be a positive frequency"):
-        torquesplit.model_modes(model, below="1 kHz")
+        torquesplit.model_modes(model, below=-5.0)  # ('1 kHz' is read with its unit)
+    with pytest.raises(torquesplit.OptionError, match="below '1 kg' is not a frequency"):
+        torquesplit.model_modes(model, below="1 kg")
 
 
 def test_bad_arguments_raise_the_packages_own_error(model):
