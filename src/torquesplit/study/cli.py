@@ -60,10 +60,10 @@ def study(
     cycles: Optional[int] = typer.Option(
         None, "--cycles", help="Cycles of the slowest mesh per case, instead of the study's.",
         metavar="N"),
-    backend: str = typer.Option("cpu", "--backend", help=BACKEND_HELP,
-        metavar="NAME"),
-    precision: Optional[str] = typer.Option(None, "--precision", help=PRECISION_HELP,
-        metavar="NAME"),
+    backend: str = typer.Option(
+        "cpu", "--backend", help=BACKEND_HELP, metavar="NAME"),
+    precision: Optional[str] = typer.Option(
+        None, "--precision", help=PRECISION_HELP, metavar="NAME"),
     no_figures: bool = typer.Option(False, "--no-figures", help="Do not write figures."),
     quiet: bool = typer.Option(False, "--quiet", help="No progress bar."),
     as_json: bool = json_option("Print the summary as JSON."),
@@ -834,10 +834,10 @@ def sweep(
         metavar="DIR"),
     resume: bool = typer.Option(False, "--resume", help="Continue the sweep stored in --out."),
     overwrite: bool = typer.Option(False, "--overwrite", help="Start again in --out."),
-    backend: str = typer.Option("cpu", "--backend", help=BACKEND_HELP,
-        metavar="NAME"),
-    precision: Optional[str] = typer.Option(None, "--precision", help=PRECISION_HELP,
-        metavar="NAME"),
+    backend: str = typer.Option(
+        "cpu", "--backend", help=BACKEND_HELP, metavar="NAME"),
+    precision: Optional[str] = typer.Option(
+        None, "--precision", help=PRECISION_HELP, metavar="NAME"),
     no_figures: bool = typer.Option(False, "--no-figures", help="Do not write figures."),
     quiet: bool = typer.Option(False, "--quiet", help="No progress bar."),
     as_json: bool = json_option("Print the summary as JSON."),
