@@ -3,6 +3,23 @@
 from __future__ import annotations
 
 import math
+import re
+from pathlib import Path
+
+TUTORIAL = Path(__file__).resolve().parents[1] / "docs" / "tutorial.md"
+
+
+def tutorial_model() -> str:
+    """The three-branch split drive of docs/tutorial.md, as the tutorial writes it."""
+    text = TUTORIAL.read_text(encoding="utf-8")
+    return re.search(r"```toml\n(.*?)```", text, re.S).group(1)
+
+
+def write_tutorial_model(folder: Path, name: str = "three_branch.toml") -> Path:
+    """:func:`tutorial_model` written to ``folder / name``."""
+    path = Path(folder) / name
+    path.write_text(tutorial_model(), encoding="utf-8")
+    return path
 
 
 SPUR_PAIR = """

@@ -5,17 +5,16 @@ first-hour reviewer: with a bad --set path the file's wrong unit was said only a
 from __future__ import annotations
 
 import re
-from pathlib import Path
 
 from typer.testing import CliRunner
+from model_texts import tutorial_model
 
 from torquesplit.cli import app
 
-TUTORIAL = Path(__file__).resolve().parents[2] / "docs" / "tutorial.md"
 
 
 def test_a_bad_set_path_and_a_bad_unit_in_the_file_are_said_at_once(tmp_path):
-    text = re.search(r"```toml\n(.*?)```", TUTORIAL.read_text(encoding="utf-8"), re.S).group(1)
+    text = tutorial_model()
     text, n = re.subn(r'stiffness = "100 N/um"', 'stiffness = "100 kg"', text, count=1)
     assert n == 1
     model = tmp_path / "m.toml"

@@ -9,15 +9,15 @@ import warnings
 from pathlib import Path
 
 import pytest
+from model_texts import tutorial_model
 
 import torquesplit
 from torquesplit.errors import ModelWarning
 
-TUTORIAL = Path(__file__).resolve().parents[2] / "docs" / "tutorial.md"
 
 
 def _file(tmp_path, speed: str) -> Path:
-    text = re.search(r"```toml\n(.*?)```", TUTORIAL.read_text(encoding="utf-8"), re.S).group(1)
+    text = tutorial_model()
     text, n = re.subn(r'(?m)^speed = "3000 rpm"', f"speed = {speed}", text)
     assert n == 1
     path = tmp_path / "m.toml"

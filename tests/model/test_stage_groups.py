@@ -5,11 +5,10 @@ system coefficient of 1.354 where the drive shares to 1.015, without a word)."""
 
 from __future__ import annotations
 
-import re
 import tomllib
-from pathlib import Path
 
 import pytest
+from model_texts import tutorial_model
 
 import torquesplit
 from torquesplit.assembly.excitation import stage_labels
@@ -17,13 +16,12 @@ from torquesplit.errors import ModelWarning
 from torquesplit.metrics.load_sharing import group_meshes
 from torquesplit.model.kinematics import solve_kinematics
 
-TUTORIAL = Path(__file__).resolve().parents[2] / "docs" / "tutorial.md"
 
 
 def _three_branch() -> dict:
     """The tutorial's model: input 20 t -> b1..b3 40 t (split), p1..p3 20 t -> output 40 t
     (combine): both stages are 20/40."""
-    text = re.search(r"```toml\n(.*?)```", TUTORIAL.read_text(encoding="utf-8"), re.S).group(1)
+    text = tutorial_model()
     return tomllib.loads(text)
 
 

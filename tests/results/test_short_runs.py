@@ -6,21 +6,16 @@ one branch carrying everything; at 1 ms 'transient discarded: combine -inf s')."
 from __future__ import annotations
 
 import math
-import re
 import warnings
-from pathlib import Path
 
 import numpy as np
+from model_texts import write_tutorial_model
 
 import torquesplit
 from torquesplit.metrics.load_sharing import span_mean
 
-TUTORIAL = Path(__file__).resolve().parents[2] / "docs" / "tutorial.md"
-
-
 def _run(tmp_path, duration):
-    model = tmp_path / "three_branch.toml"
-    model.write_text(re.search(r"```toml\n(.*?)```", TUTORIAL.read_text(), re.S).group(1))
+    model = write_tutorial_model(tmp_path)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         return torquesplit.simulate(torquesplit.load_model(model), duration=duration)

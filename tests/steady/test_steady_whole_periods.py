@@ -1,10 +1,10 @@
 """A steady state's table is over whole periods, at the step its meshes' cycles need."""
 
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
+from model_texts import write_tutorial_model
 
 from torquesplit import example_path
 from torquesplit.steady.api import steady_state
@@ -127,15 +127,12 @@ def test_steady_says_its_results_warnings_and_leaves_out_cycles_without_samples(
     cycles table gave a mean force of 0.0 where the cycle had no sample (blank peak)."""
     import csv
     import json
-    import re
 
     from typer.testing import CliRunner
 
     from torquesplit.cli import app
 
-    tutorial = Path(__file__).resolve().parents[2] / "docs" / "tutorial.md"
-    model = tmp_path / "three_branch.toml"
-    model.write_text(re.search(r"```toml\n(.*?)```", tutorial.read_text(), re.S).group(1))
+    model = write_tutorial_model(tmp_path)
     out = tmp_path / "sd.csv"
     res = CliRunner().invoke(app, ["steady", str(model), "--no-stability", "--json", "--out",
                                    str(out)])
@@ -456,9 +453,7 @@ def test_a_campbell_summary_names_no_others_where_every_crossing_is_driven(tmp_p
 
     from torquesplit.cli import app
 
-    tutorial = Path(__file__).resolve().parents[2] / "docs" / "tutorial.md"
-    model = tmp_path / "three_branch.toml"
-    model.write_text(re.search(r"```toml\n(.*?)```", tutorial.read_text(), re.S).group(1))
+    model = write_tutorial_model(tmp_path)
     # (around the input-bearing crossing at 2632 rpm: every crossing there is driven)
     res = CliRunner().invoke(app, ["modes", str(model), "--campbell", "--from", "2600 rpm",
                                    "--to", "2650 rpm"], terminal_width=400)
@@ -475,14 +470,11 @@ def test_a_crossing_whose_branch_forces_nearly_cancel_is_not_driven(tmp_path):
     branch 1's 15 um error (0.8 % of their sum).  With the exact-cancellation cut-off
     (1e-6) that error made it a driven crossing of a 35.5 % harmonic, a 'resonant' warning
     of run and a critical speed of the sweep, where the steady response rises smoothly."""
-    import re
 
     import torquesplit
     from torquesplit.steady.maps import critical_speeds, driven
 
-    tutorial = Path(__file__).resolve().parents[2] / "docs" / "tutorial.md"
-    model = tmp_path / "three_branch.toml"
-    model.write_text(re.search(r"```toml\n(.*?)```", tutorial.read_text(), re.S).group(1))
+    model = write_tutorial_model(tmp_path)
     m = torquesplit.load_model(model)
     res = torquesplit.simulate(m, duration=1e-3)
     rpm = math.pi / 30
@@ -525,15 +517,12 @@ def test_sweep_speed_refuses_a_settle_period_count_below_one(settle):
 def test_steady_at_another_speed_says_the_loads_keep_their_torques(tmp_path):
     """steady --speed keeps the torques where run --set ...speed keeps the power: their
     forces differed by 14 % at 3425 rpm and neither said which it held."""
-    import re
 
     from typer.testing import CliRunner
 
     from torquesplit.cli import app
 
-    tutorial = Path(__file__).resolve().parents[2] / "docs" / "tutorial.md"
-    model = tmp_path / "three_branch.toml"
-    model.write_text(re.search(r"```toml\n(.*?)```", tutorial.read_text(), re.S).group(1))
+    model = write_tutorial_model(tmp_path)
     res = CliRunner().invoke(app, ["steady", str(model), "--keep", "split", "--speed",
                                    "3100 rpm", "--no-stability"], terminal_width=300)
     assert res.exit_code == 0, res.output

@@ -26,6 +26,12 @@ from ..model.schema import Model
 STAGE_FORCE_RTOL = 0.05
 
 
+def tooth_pair(model: Model, mesh_name: str) -> str:
+    """``"za/zb"``: the tooth counts of a mesh's gears, smaller first."""
+    za, zb = sorted(model.gears[g].teeth for g in model.meshes[mesh_name].gears)
+    return f"{za}/{zb}"
+
+
 def stage_labels(model: Model, kin: Kinematics) -> dict[str, str]:
     """Each mesh's stage (its load-sharing group, within its path): the model's label or,
     without one, the tooth-count pair of its gears ``"za/zb"``.  Unlabelled meshes of one
@@ -37,8 +43,7 @@ def stage_labels(model: Model, kin: Kinematics) -> dict[str, str]:
     by_pair: dict[str, list[str]] = {}
     for name, mesh in model.meshes.items():
         if not mesh.stage:
-            za, zb = sorted(model.gears[g].teeth for g in mesh.gears)
-            by_pair.setdefault(f"{za}/{zb}", []).append(name)
+            by_pair.setdefault(tooth_pair(model, name), []).append(name)
     for pair, names in by_pair.items():
         levels: list[float] = []  # the distinct nominal forces, in file order
         which = {}

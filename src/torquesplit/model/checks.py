@@ -607,7 +607,7 @@ def _stage_groups(model: Model, kin) -> list[tuple[str, str]]:
     by definition, and its stage's group one mesh short)."""
     import difflib
 
-    from ..assembly.excitation import STAGE_FORCE_RTOL, stage_labels
+    from ..assembly.excitation import STAGE_FORCE_RTOL, stage_labels, tooth_pair
 
     out = []
     stages = stage_labels(model, kin)
@@ -633,8 +633,7 @@ def _stage_groups(model: Model, kin) -> list[tuple[str, str]]:
 
     def parallel(a, b):  # the same tooth counts and nominal force: parallel paths
         fa, fb = abs(kin.meshes[a].force), abs(kin.meshes[b].force)
-        return (sorted(model.gears[g].teeth for g in model.meshes[a].gears)
-                == sorted(model.gears[g].teeth for g in model.meshes[b].gears)
+        return (tooth_pair(model, a) == tooth_pair(model, b)
                 and abs(fa - fb) <= STAGE_FORCE_RTOL * max(fa, fb))
 
     for label, ms in members.items():
