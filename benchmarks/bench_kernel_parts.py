@@ -39,18 +39,19 @@ REMOVALS = {
          "                   src_end if last else src_half, m, w)\n", "            pass\n")],
     "statistics (record)": [("        record(t, a, F_MAIN, 0.0 if last else h, m, w, r, counters)\n",
                              "")],
-    "  of it: parabola vertices (peak_sample)": [
-        ("        peak_sample(t, kink, slot, i_f, w, r)\n", "")],
+    "  of it: parabola vertices (force_instant)": [
+        ("        g2 = regime(defl[i_f, el], G[slot, el])\n        if smooth:\n",
+         "        g2 = 0\n        if False:\n")],
     "  of it: ratio at cycle starts (ratio_starts)": [
-        ("        ratio_starts(t, slot, i_f, m, w, r)\n", "")],
-    "  of it: cycle means (mean_sample)": [
-        ("        mean_sample(t, slot, i_f, m, w, r)\n    ratio_sample", "    ratio_sample")],
+        ("        ratio_starts(t, slot, i_f, m, w, r)\n", "        pass\n")],
+    "  of it: cycle means (force_instant)": [
+        ("        if not first:\n            if c == c1 + 1:",
+         "        if False:\n            if c == c1 + 1:")],
     "  of it: instantaneous ratio (ratio_sample)": [
-        ("        mean_sample(t, slot, i_f, m, w, r)\n    ratio_sample(slot, i_f, w, r)\n",
-         "        mean_sample(t, slot, i_f, m, w, r)\n")],
+        ("    ratio_sample(slot, i_f, w, r)\n", "")],
     "  of it: contact counters": [("    for j in range(watch_el.shape[0]):\n",
                                    "    for j in range(0):\n")],
-    "divergence check": [("        bad = bad_state(Y_STATE, blowup, w)\n", "        bad = -1\n")],
+    "divergence check": [("        bad = bad_state(Y_STATE, w)\n", "        bad = -1\n")],
 }
 BASE = "whole step"
 

@@ -1,6 +1,6 @@
 """The instantaneous load-sharing ratio at cycle starts (``_kernels.ratio_starts``): the
 ratio of the group's forces interpolated at each cycle start enters both cycles' max and
-min, as the force does (``_kernels.mean_sample``), so that the per-cycle ratio peaks of
+min, as the force does (``_kernels.force_instant``), so that the per-cycle ratio peaks of
 the instantaneous and engineering coefficients (Ji & Li eq. 18) converge at second order
 where the ratio rises or falls through a cycle start."""
 

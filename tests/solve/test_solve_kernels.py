@@ -291,3 +291,39 @@ def test_cycle_extremes_at_cycle_starts_converge_with_the_step():
     moved = np.max(np.abs(coarse - fine)) / np.max(fine)
     moved_plain = np.max(np.abs(coarse_plain - fine_plain)) / np.max(fine)
     assert moved_plain > 1e-5 and moved < moved_plain / 30, (moved, moved_plain)
+
+
+@pytest.mark.parametrize("method", ["rk4", "dopri"])
+def test_constant_tables_take_the_short_excitation_path_with_the_same_results(
+        method, monkeypatch):
+    """Time-varying elements whose stiffness and force tables are constant come last in
+    the kernel model (``tv_tab[0]`` counts the others) and the excitation only updates
+    their cycle index and half-gap: every output must equal the run that interpolates
+    them too (a constant table, a constant non-zero force, and a per-cycle half-gap
+    sequence on a constant table, beside varying tables)."""
+    import dataclasses
+
+    from torquesplit.solve import kernel_data as kd
+
+    s = random_structure(3)
+    ktab, ftab = s.stiffness_table.copy(), s.force_table.copy()
+    ktab[1] = ktab[1, 0]  # mesh1: three-entry half-gap sequence
+    ktab[2] = 2e8
+    ftab[2] = 20.0
+    s = dataclasses.replace(s, stiffness_table=ktab, force_table=ftab)
+    m = kd.kernel_model(s)
+    assert m.tv_tab[0] == 2 and set(m.tv_el[:2]) == {0, 3} and set(m.tv_el[2:]) == {1, 2}
+    rng = np.random.default_rng(7)
+    y0 = np.concatenate([rng.normal(scale=1e-6, size=s.n_dof), np.zeros(s.n_dof)])
+    kw = dict(method=method, full_history=True)
+    kw.update(step=2e-6) if method == "rk4" else kw.update(rtol=1e-8)
+    short = integrate(s, y0, (0.0, 6e-3), **kw)
+    real = kd.kernel_model
+    monkeypatch.setattr(kd, "kernel_model", lambda st: real(st)._replace(
+        tv_tab=np.array([len(real(st).tv_el)], dtype=np.int64)))
+    full = integrate(s, y0, (0.0, 6e-3), **kw)
+    assert short.n_steps == full.n_steps > 100 and np.all(short.cycle_count[:3] > 0)
+    for name in ("y_final", "full_y", "cycle_max", "cycle_min", "cycle_mean", "cycle_count",
+                 "separation_time", "back_contact_time", "history_forces"):
+        a, b = getattr(short, name), getattr(full, name)
+        assert np.array_equal(a, b, equal_nan=True), name

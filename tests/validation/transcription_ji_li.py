@@ -672,7 +672,7 @@ def record(t, F, D, b, cyc, base, frequency, phase, cyc_max, cyc_min, cyc_sum, c
                     cyc_wt[c, j] += half
         prev[1 + j] = f
         prev[5 + j] = c
-        # the peak between samples (engine: _kernels.peak_sample)
+        # the peak between samples (engine: _kernels.force_instant)
         g2 = 1.0
         if b[j] > 0.0:
             g2 = 1.0 if D[j] > b[j] else (-1.0 if D[j] < -b[j] else 0.0)

@@ -160,11 +160,12 @@ def case_arrays(run) -> _Planned:
 _KERNEL_TABLES = IdentityMemo()
 
 
-#: KernelModel fields computed from the structure's phase tables (corner nodes, and the
+#: KernelModel fields computed from the structure's phase tables (corner nodes, the
+#: order of the time-varying elements (those with non-constant tables first), and the
 #: tables themselves: the structure's own arrays, or a copy where kernel_model changes
 #: one: spline components' stiffness rows zeroed)
 _FROM_TABLES = ("stiffness_table", "force_table", "friction_table", "corner_ptr",
-                "corner_node")
+                "corner_node", "tv_el", "tv_tab")
 
 
 def _kernel_model(s):

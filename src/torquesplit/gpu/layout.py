@@ -63,7 +63,7 @@ KNOWN_FIELDS = (
     "error_phase", "force_table", "tv_el", "err_el", "sin_el", "vr_ptr", "vq_idx",
     "vv_idx", "vt_ptr", "vt_el", "vt_coef", "fr_el", "fr_ptr", "fr_dof", "fr_coef",
     "fr_row", "friction_table", "sp_el", "sp_par", "gy_ptr", "gy_idx", "gy_coef",
-    "corner_ptr", "corner_node", "fs_ptr", "fs_idx", "fs_coef",
+    "corner_ptr", "corner_node", "fs_ptr", "fs_idx", "fs_coef", "tv_tab",
 )
 """The kernel arrays (:class:`~torquesplit.solve.kernel_data.KernelModel` fields) the
 generated code reproduces.  A field the engine gains later is a term the GPU kernel

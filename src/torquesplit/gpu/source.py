@@ -391,7 +391,7 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
                 w("th = 1.0")
 
     def record_body():
-        # the time integral of each cycle (_kernels.mean_sample): the interval from the
+        # the time integral of each cycle (_kernels.force_instant): the interval from the
         # last instant, split where a cycle begins; part A into the last instant's cycle
         # (still the current one), part B into this instant's (after new_cycle).
         # `full`: a sample of the run (_kernels.record); 0: a corner instant inside a step
@@ -404,7 +404,7 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
         w(f"ta = X[{X_PT}]")
         w("span = t - ta")
         w("entered = span >= 0.0")
-        # the extremes between the instants (_kernels.peak_sample); a corner instant, and
+        # the extremes between the instants (_kernels.force_instant); a corner instant, and
         # a sample flagged as one, can end a parabola but not be its middle
         w("kink = 1.0")
         with w.block("if full != 0:"):

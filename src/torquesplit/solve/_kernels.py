@@ -91,6 +91,7 @@ F_HMAX = 4  # dopri: largest accepted step
 N_CLOCK = 5
 
 MESH_KIND = 1
+_FLOAT_MAX = 1.7976931348623157e308  # the largest finite float64
 CYCLE_EPS = laws.CYCLE_EPS
 RESYNC = 64
 """RK4 recomputes the error sinusoids exactly every RESYNC steps (phasor rotation between)."""
@@ -141,7 +142,9 @@ def excite(t, slot, src, m, w):
     """Every time-dependent excitation at t into ``slot``.
 
     Time-varying tables (stiffness, additive force, friction) are interpolated at the
-    mesh phase s = f t + phase (:func:`laws.table_phase`); the half-gap is entry
+    mesh phase s = f t + phase (:func:`laws.table_phase`; the elements ``m.tv_el``
+    after the first ``m.tv_tab[0]`` have constant tables, already in every slot, and
+    need only their cycle: 4 % of a step of Lin & Parker's planetary); the half-gap is entry
     floor(s) mod n_gaps of the element's per-cycle sequence (cached in ``w.gap_cyc`` /
     ``w.gap_val``); CY is the statistics cycle index (:func:`laws.stat_cycle`).  Error
     sinusoids are evaluated exactly when ``src < 0``, else advanced from slot ``src``
@@ -164,15 +167,19 @@ def excite(t, slot, src, m, w):
     # (Liu et al. 2021's step: -10 %, Ji & Li's -4.5 %; they are non-negative by
     # construction)
     us = np.uint64(slot)
+    n_tables = m.tv_tab[0]
     for j in range(tv_el.shape[0]):
         e = np.uint64(tv_el[j])
         s = frequency[e] * t + phase[e]
-        i0, i1, wt, fl = laws.table_phase(s, n_tab)
-        u0 = np.uint64(i0)
-        u1 = np.uint64(i1)
-        K[us, e] = laws.lerp(ktab[e, u0], ktab[e, u1], wt)
-        if has_force[e]:
-            P[us, e] = laws.lerp(ftab[e, u0], ftab[e, u1], wt)
+        if j < n_tables:
+            i0, i1, wt, fl = laws.table_phase(s, n_tab)
+            u0 = np.uint64(i0)
+            u1 = np.uint64(i1)
+            K[us, e] = laws.lerp(ktab[e, u0], ktab[e, u1], wt)
+            if has_force[e]:
+                P[us, e] = laws.lerp(ftab[e, u0], ftab[e, u1], wt)
+        else:  # constant tables (in every slot since make_work): the cycle only
+            fl = math.floor(s)
         CY[us, e] = laws.stat_cycle(s, fl)
         g0 = gap_ptr[e]
         ng = gap_ptr[e + np.uint64(1)] - g0
@@ -397,71 +404,14 @@ def enter_both(v, cp, c, j, mx, mn):
 
 
 @_inline
-def mean_sample(t, slot, i_f, m, w, r):
-    """Enter the forces (row ``i_f``) at time ``t`` in the cycles' time integrals: the
-    trapezoid rule over the interval from the last instant entered, split where a cycle
-    of the element begins (the linear interpolant integrated on each side, so that a
-    cycle's mean is second order in the step).  Instants come in time order (the step
-    samples and, with RK4, the corners between them: a table ramp steeper than a step or
-    an impact pulse between two steps is then integrated, not missed).  Where a cycle
-    begins and the element's force is continuous there (``r.trk_cont``: no corner of its
-    table at node 0, :func:`kernel_data.continuous_start`), the force interpolated at
-    that start also enters both
-    cycles' max and min (on an instant, that instant's force): a force still rising
-    (falling) across the boundary has the ending cycle's extreme there, which its samples
-    alone miss by up to its slope times a step (first order: constant-stiffness meshes
-    under slower errors, Mo et al. 2017).
-    Twin: :func:`torquesplit.solve.reference.cycle_statistics_numpy`."""
-    force, CY = w.F, w.CY
-    track_el, track_base = r.track_el, r.track_base
-    cyc_sum, cyc_wt, prev_f, prev_c = r.cyc_sum, r.cyc_wt, r.prev_f, r.prev_c
-    cyc_max, cyc_min, trk_cont = r.cyc_max, r.cyc_min, r.trk_cont
-    cap = cyc_sum.shape[0]
-    ta = r.prev_t[0]
-    span = t - ta
-    first = not (span >= 0.0)  # NaN before the first instant: nothing entered yet
-    for j in range(track_el.shape[0]):
-        el = track_el[j]
-        c = CY[slot, el] - track_base[j]
-        fe = force[i_f, el]
-        if not first:
-            cp = prev_c[j]
-            fa = prev_f[j]
-            if c == cp + 1:  # the interval holds the start of cycle c: split it there
-                th = start_fraction(c, track_base[j], m.phase[el], m.frequency[el], ta, span)
-                fb = fa + th * (fe - fa)
-                da = th * span
-                db = span - da
-                if cp >= 0 and cp < cap:
-                    cyc_sum[cp, j] += 0.5 * da * (fa + fb)
-                    cyc_wt[cp, j] += da
-                if c >= 0 and c < cap:
-                    cyc_sum[c, j] += 0.5 * db * (fb + fe)
-                    cyc_wt[c, j] += db
-                if trk_cont[j] != 0:  # (on an instant too: fb is that force)
-                    enter_both(fb, cp, c, j, cyc_max, cyc_min)
-            else:  # one cycle (or, past a skipped cycle, half to each end's cycle)
-                half = 0.5 * span
-                if cp >= 0 and cp < cap:
-                    cyc_sum[cp, j] += half * fa
-                    cyc_wt[cp, j] += half
-                if c >= 0 and c < cap:
-                    cyc_sum[c, j] += half * fe
-                    cyc_wt[c, j] += half
-        prev_f[j] = fe
-        prev_c[j] = c
-    r.prev_t[0] = t
-
-
-@_inline
 def ratio_starts(t, slot, i_f, m, w, r):
     """The instantaneous load-sharing ratio N f_j / sum_i f_i (Ji & Li eq. 18) at each
     cycle start of a group member j between the last instant entered and ``t``, into the
     max and min of both cycles it divides, where j's force is continuous there
     (``r.trk_cont``): every member's force interpolated linearly at that start, as
-    :func:`mean_sample` does for the force.  Without it the ratio's extremes at a cycle
+    :func:`force_instant` does for the force.  Without it the ratio's extremes at a cycle
     start (a ratio still rising as its cycle ends) were missed by up to its slope times
-    a step, first order.  Runs before :func:`mean_sample` (which overwrites the last
+    a step, first order.  Runs before :func:`force_instant` (which overwrites the last
     instant's forces).  Twin: :func:`torquesplit.solve.reference.cycle_ratio_numpy`."""
     force, CY = w.F, w.CY
     track_el, track_base, trk_cont = r.track_el, r.track_base, r.trk_cont
@@ -519,51 +469,120 @@ def vertex(t0, t1, t2, f0, f1, f2):
 
 
 @_inline
-def peak_sample(t, kink, slot, i_f, w, r):
-    """The extremes between the instants (step samples and RK4's corner instants, in
-    time order): where the middle one of the last three is the largest (smallest), is
-    not a corner (``kink``: a kink or jump of the force may sit there; as an end point it
-    is exact) and all three share one contact regime, the vertex of the parabola
-    through them enters the middle instant's cycle maximum (minimum).  A peak between
-    two steps was otherwise missed by up to (omega h)^2 / 8 of the oscillation (6e-4 of
-    a dynamic factor at 100 steps per cycle).
+def force_instant(t, kink, full, count, slot, i_f, m, w, r):
+    """The forces (row ``i_f``) at the instant ``t`` into the cycles' statistics, one
+    pass over the tracked elements (one pass, not one per quantity: each element's
+    cycle, force and last instant are loaded once; Ji & Li's step -6 %).  Per element:
+
+    * **extremes**: the force into its cycle's max and min (and, with ``count``, the
+      cycle's sample count: a sample of the run, not a corner instant);
+    * with ``full`` (an instant of the time record: a step sample or an RK4 corner;
+      they come in time order):
+
+      - **the peak between the instants**: where the middle one of the last three is the
+        largest (smallest), is not a corner (``kink``: a kink or jump of the force may
+        sit there; as an end point it is exact) and all three share one contact regime,
+        the vertex of the parabola through them enters the middle instant's cycle
+        maximum (minimum).  A peak between two steps was otherwise missed by up to
+        (omega h)^2 / 8 of the oscillation (6e-4 of a dynamic factor at 100 steps per
+        cycle);
+      - **the cycle means**: the time integral by the trapezoid rule over the interval
+        from the last instant, split where a cycle of the element begins (the linear
+        interpolant integrated on each side, so that a cycle's mean is second order in
+        the step; a table ramp steeper than a step or an impact pulse between two steps
+        is then integrated, not missed).  Where a cycle begins and the force is
+        continuous there (``r.trk_cont``: no corner of its table at node 0,
+        :func:`kernel_data.continuous_start`), the force interpolated at that start also
+        enters both cycles' max and min (on an instant, that instant's force): a force
+        still rising (falling) across the boundary has the ending cycle's extreme there,
+        which its samples alone miss by up to its slope times a step (first order:
+        constant-stiffness meshes under slower errors, Mo et al. 2017).
+
+    The last instant's forces and cycles (``r.prev_f``, ``r.prev_c``) are then this
+    one's.  ``full`` and ``count`` are integers, not literal bools: numba would compile
+    one copy per literal value.
     Twin: :func:`torquesplit.solve.reference.cycle_statistics_numpy`."""
-    force, defl, G = w.F, w.D, w.G
-    track_el = r.track_el
-    cyc_max, cyc_min = r.cyc_max, r.cyc_min
+    force, defl, CY, G = w.F, w.D, w.CY, w.G
+    track_el, track_base, trk_cont = r.track_el, r.track_base, r.trk_cont
+    cyc_max, cyc_min, cyc_cnt = r.cyc_max, r.cyc_min, r.cyc_cnt
+    cyc_sum, cyc_wt, prev_f, prev_c = r.cyc_sum, r.cyc_wt, r.prev_f, r.prev_c
     pk_t, pk_f, pk_g, pk_k = r.pk_t, r.pk_f, r.pk_g, r.pk_k
-    prev_f, prev_c = r.prev_f, r.prev_c  # the last instant's (mean_sample runs after)
+    phase, frequency = m.phase, m.frequency
     cap = cyc_max.shape[0]
+    # the peaks: the two instants before this one alternate between the slots of pk_t,
+    # pk_g, pk_k: o the older, p the last
     n = r.pk_n[0]
-    o = n & 1  # the two instants alternate between the slots: o the older, 1 - o the last
+    o = n & 1
     p = 1 - o
     smooth = n >= 2 and pk_k[p] == 0
     t0 = pk_t[o]
     t1 = pk_t[p]
+    # the means: the interval from the last instant (NaN before the first: no interval)
+    ta = r.prev_t[0]
+    span = t - ta
+    first = not (span >= 0.0)
     for j in range(track_el.shape[0]):
         el = track_el[j]
-        f2 = force[i_f, el]
+        c = CY[slot, el] - track_base[j]
+        fe = force[i_f, el]
+        if c >= 0 and c < cap:
+            if fe > cyc_max[c, j]:
+                cyc_max[c, j] = fe
+            if fe < cyc_min[c, j]:
+                cyc_min[c, j] = fe
+            if count != 0:
+                cyc_cnt[c, j] += 1
+        if full == 0:
+            continue
+        f1 = prev_f[j]  # the last instant's force and cycle
+        c1 = prev_c[j]
+        # the peak between the instants (f0, f1, fe at t0, t1, t)
         g2 = regime(defl[i_f, el], G[slot, el])
-        f1 = prev_f[j]
         if smooth:
             f0 = pk_f[j]
-            if (f1 - f0) * (f2 - f1) <= 0.0 and (f1 != f0 or f1 != f2):  # an extremum
+            if (f1 - f0) * (fe - f1) <= 0.0 and (f1 != f0 or f1 != fe):  # an extremum
                 g1 = pk_g[j, p]
-                c1 = prev_c[j]
                 if g1 != 0 and pk_g[j, o] == g1 and g2 == g1 and c1 >= 0 and c1 < cap:
-                    if f1 >= f0 and f1 >= f2:
-                        v = vertex(t0, t1, t, f0, f1, f2)
+                    if f1 >= f0 and f1 >= fe:
+                        v = vertex(t0, t1, t, f0, f1, fe)
                         if v > cyc_max[c1, j]:
                             cyc_max[c1, j] = v
-                    elif f1 <= f0 and f1 <= f2:
-                        v = vertex(t0, t1, t, f0, f1, f2)
+                    elif f1 <= f0 and f1 <= fe:
+                        v = vertex(t0, t1, t, f0, f1, fe)
                         if v < cyc_min[c1, j]:
                             cyc_min[c1, j] = v
         pk_f[j] = f1  # the last instant's force becomes the older one
         pk_g[j, o] = g2
-    pk_t[o] = t
-    pk_k[o] = kink
-    r.pk_n[0] = n + 1
+        # the cycle means over the interval from the last instant
+        if not first:
+            if c == c1 + 1:  # the interval holds the start of cycle c: split it there
+                th = start_fraction(c, track_base[j], phase[el], frequency[el], ta, span)
+                fb = f1 + th * (fe - f1)
+                da = th * span
+                db = span - da
+                if c1 >= 0 and c1 < cap:
+                    cyc_sum[c1, j] += 0.5 * da * (f1 + fb)
+                    cyc_wt[c1, j] += da
+                if c >= 0 and c < cap:
+                    cyc_sum[c, j] += 0.5 * db * (fb + fe)
+                    cyc_wt[c, j] += db
+                if trk_cont[j] != 0:  # (on an instant too: fb is that force)
+                    enter_both(fb, c1, c, j, cyc_max, cyc_min)
+            else:  # one cycle (or, past a skipped cycle, half to each end's cycle)
+                half = 0.5 * span
+                if c1 >= 0 and c1 < cap:
+                    cyc_sum[c1, j] += half * f1
+                    cyc_wt[c1, j] += half
+                if c >= 0 and c < cap:
+                    cyc_sum[c, j] += half * fe
+                    cyc_wt[c, j] += half
+        prev_f[j] = fe
+        prev_c[j] = c
+    if full != 0:
+        pk_t[o] = t
+        pk_k[o] = kink
+        r.pk_n[0] = n + 1
+        r.prev_t[0] = t
 
 
 @_inline
@@ -599,20 +618,19 @@ def ratio_sample(slot, i_f, w, r):
 
 
 @_callee
-def enter_instant(t, kink, full, slot, i_f, m, w, r):
-    """The statistics of an instant beyond the force's max and min: with ``full`` (an
-    instant of the time record: a step sample or an RK4 corner) the peak between the
-    instants (:func:`peak_sample`, ``kink`` whether this instant is a corner), the
-    ratio at the cycle starts passed (:func:`ratio_starts`) and the cycle means
-    (:func:`mean_sample`), in that order (the first two read the last instant's forces,
-    which mean_sample then replaces); always the instantaneous ratio
+def enter_instant(t, kink, full, count, slot, i_f, m, w, r):
+    """Every statistic of the forces (row ``i_f``) at the instant ``t``: with ``full``
+    (an instant of the time record) the load-sharing ratio at the cycle starts passed
+    since the last instant (:func:`ratio_starts`, which reads the last instant's forces
+    of every group member), then per element its extremes, peak between the instants and
+    cycle means (:func:`force_instant`, which replaces the last instant's forces; with
+    ``count`` the sample counts), and always the instantaneous ratio
     (:func:`ratio_sample`).  One compiled callee for :func:`record` and
-    :func:`record_extrema`: inlined, these four were compiled once per call site of
-    those two (rk4_run, record_extrema, dopri_run twice), seconds of cold compile each."""
+    :func:`record_extrema`: inlined, these were compiled once per call site of those two
+    (rk4_run, record_extrema, dopri_run twice), seconds of cold compile each."""
     if full != 0:
-        peak_sample(t, kink, slot, i_f, w, r)
         ratio_starts(t, slot, i_f, m, w, r)
-        mean_sample(t, slot, i_f, m, w, r)
+    force_instant(t, kink, full, count, slot, i_f, m, w, r)
     ratio_sample(slot, i_f, w, r)
 
 
@@ -621,8 +639,8 @@ def record(t, slot, i_f, weight, m, w, r, counters):
     """Enter one accepted state at time ``t`` (forces in row ``i_f``) in the statistics.
 
     Per tracked element j: cycle c = CY - track_base[j] (cycles at or beyond the
-    capacity are ignored); force max, min and sample count of the cycle and its time
-    integral (:func:`mean_sample`); per load-sharing
+    capacity are ignored); force max, min and sample count of the cycle, the peak
+    between the samples and its time integral (:func:`force_instant`); per load-sharing
     group the instantaneous ratio N f_i / sum_j f_j of each member (Ji & Li eq. 18) and
     its max and min in the member's cycle.  Contact counters: separation |delta| <= g
     with g > 0; back-side contact delta < -g with g > 0, or delta < 0 for a mesh
@@ -630,25 +648,12 @@ def record(t, slot, i_f, weight, m, w, r, counters):
     Twins: :func:`torquesplit.solve.reference.cycle_statistics_numpy`,
     :func:`torquesplit.solve.reference.contact_state_numpy`.
     """
-    force, defl, CY, G, watch_el = w.F, w.D, w.CY, w.G, w.watch_el
-    track_el, track_base = r.track_el, r.track_base
-    cyc_max, cyc_min, cyc_cnt = r.cyc_max, r.cyc_min, r.cyc_cnt
+    defl, G, watch_el = w.D, w.G, w.watch_el
     sep_count, sep_time, back_count, back_time = (r.sep_count, r.sep_time, r.back_count,
                                                   r.back_time)
     element_kind = m.element_kind
-    cap = cyc_max.shape[0]
-    for j in range(track_el.shape[0]):
-        el = track_el[j]
-        c = CY[slot, el] - track_base[j]
-        if c >= 0 and c < cap:
-            fe = force[i_f, el]
-            if fe > cyc_max[c, j]:
-                cyc_max[c, j] = fe
-            if fe < cyc_min[c, j]:
-                cyc_min[c, j] = fe
-            cyc_cnt[c, j] += 1
     # the row as an int64 variable: a literal row would compile a second enter_instant
-    enter_instant(t, r.pk_x[0], np.int64(1), slot, np.int64(i_f), m, w, r)
+    enter_instant(t, r.pk_x[0], np.int64(1), np.int64(1), slot, np.int64(i_f), m, w, r)
     r.pk_x[0] = 0
     for j in range(watch_el.shape[0]):
         el = watch_el[j]
@@ -672,26 +677,13 @@ def record_extrema(t, mean, slot, i_f, m, w, r):
     """Enter the forces of row ``i_f`` at time ``t`` in the per-cycle max / min of the
     force and of the instantaneous load-sharing ratio (a corner event: an instant, not a
     sample of the run, so no counts or contact time), and with ``mean`` in the cycles'
-    time integrals (:func:`mean_sample`: RK4's corners come in time order, not
+    time integrals (:func:`force_instant`: RK4's corners come in time order, not
     Dormand-Prince's, taken element by element).  ``mean`` is an integer, not a literal
     bool: numba would compile one copy per literal value.  Twin: the max / min part of
     :func:`record`."""
-    force, CY = w.F, w.CY
-    track_el, track_base = r.track_el, r.track_base
-    cyc_max, cyc_min = r.cyc_max, r.cyc_min
-    cap = cyc_max.shape[0]
-    for j in range(track_el.shape[0]):
-        el = track_el[j]
-        c = CY[slot, el] - track_base[j]
-        if c >= 0 and c < cap:
-            fe = force[i_f, el]
-            if fe > cyc_max[c, j]:
-                cyc_max[c, j] = fe
-            if fe < cyc_min[c, j]:
-                cyc_min[c, j] = fe
     # RK4's corners (``mean``): instants in time order, corners among the samples;
     # Dormand-Prince's, element by element: the ratio only, and no parabola across the step
-    enter_instant(t, np.int64(1), mean, slot, i_f, m, w, r)
+    enter_instant(t, np.int64(1), mean, np.int64(0), slot, i_f, m, w, r)
     if mean == 0:
         r.pk_k[(r.pk_n[0] - 1) & 1] = 1
         r.pk_x[0] = 1
@@ -842,26 +834,35 @@ def store_full(row, t, iy, w, r):
 
 
 @_inline
-def bad_state(iy, blowup, w):
-    """Index of the first non-finite entry of state row ``iy`` or |q| > blowup, or -1.
+def state_limits(blowup, w):
+    """The bounds :func:`bad_state` checks, into ``w.lim``: |q| <= blowup for every
+    displacement, |v| <= the largest float (finite) for every velocity."""
+    lim = w.lim
+    n = lim.shape[0] // 2
+    for i in range(n):
+        lim[i] = blowup
+    for i in range(n, lim.shape[0]):
+        lim[i] = _FLOAT_MAX
+
+
+@_inline
+def bad_state(iy, w):
+    """Index of the first entry of state row ``iy`` outside its bound in ``w.lim`` (a
+    non-finite entry, or |q| > blowup: :func:`state_limits`), or -1.
     Twin: ``np.flatnonzero(~np.isfinite(y) | (abs(q) > blowup))[:1]``."""
     y = w.Y
-    n = y.shape[1] // 2
-    # fast path without a branch per entry: a conjunction of comparisons (false for NaN);
-    # the sum of x - x it replaces is a chain of dependent additions (28 states, in
-    # isolation: 14.4 ns before, 11.9 ns now)
+    lim = w.lim
+    # fast path without a branch per entry: one conjunction of comparisons (false for
+    # NaN) over the whole row against one bound per entry; a sum of x - x was a chain of
+    # dependent additions, and a loop per half of the row doubled the vector loops'
+    # set-up (28 states, in isolation: 14.4, 11.9 and now 9 ns)
     ok = True
-    for i in range(n):
-        ok &= abs(y[iy, i]) <= blowup
-    for i in range(n, y.shape[1]):
-        ok &= abs(y[iy, i]) < math.inf
+    for i in range(y.shape[1]):
+        ok &= abs(y[iy, i]) <= lim[i]
     if ok:
         return -1
-    for i in range(n):
-        if not abs(y[iy, i]) <= blowup:  # also true for NaN
-            return i
-    for i in range(n, y.shape[1]):
-        if not math.isfinite(y[iy, i]):
+    for i in range(y.shape[1]):
+        if not abs(y[iy, i]) <= lim[i]:  # also true for NaN
             return i
     return -1
 
@@ -970,6 +971,7 @@ def rk4_run(t0, h, n_first, n_steps, record_final, record_every, blowup, m, w, r
     Twin: :func:`torquesplit.solve.reference.rk4_numpy`.
     """
     rot, error_omega = w.rot, m.error_omega
+    state_limits(blowup, w)
     n_hist = r.hist_t.shape[0]
     n_full = r.full_t.shape[0]
     extra = m.fr_el.shape[0] > 0 or m.sp_el.shape[0] > 0
@@ -1024,7 +1026,7 @@ def rk4_run(t0, h, n_first, n_steps, record_final, record_every, blowup, m, w, r
             counters[I_RHS] += 4
         counters[I_STEPS] += 1
         clock[F_T] = tb
-        bad = bad_state(Y_STATE, blowup, w)
+        bad = bad_state(Y_STATE, w)
         if bad >= 0:
             counters[I_STATUS] = DIVERGED
             counters[I_BAD] = bad
@@ -1066,6 +1068,7 @@ def dopri_run(t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, blowup, dt
     Y = w.Y
     n2 = Y.shape[1]
     n_full = r.full_t.shape[0]
+    state_limits(blowup, w)
     extra = m.fr_el.shape[0] > 0 or m.sp_el.shape[0] > 0
     t_corner = math.inf  # earliest corner still to be sampled
     if m.corner_node.shape[0] > 0:
@@ -1174,7 +1177,7 @@ def dopri_run(t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, blowup, dt
         fac11 = enorm ** _EXPO1
         if enorm <= 1.0:
             # ------------------------------------------------ accepted
-            bad = bad_state(Y_NEW, blowup, w)
+            bad = bad_state(Y_NEW, w)
             if bad >= 0:  # stop before recording anything of this step
                 for k in range(n2):
                     Y[Y_STATE, k] = Y[Y_NEW, k]

@@ -47,12 +47,14 @@ KernelModel = namedtuple("KernelModel", (
     "error_phase", "force_table", "tv_el", "err_el", "sin_el", "vr_ptr", "vq_idx",
     "vv_idx", "vt_ptr", "vt_el", "vt_coef", "fr_el", "fr_ptr", "fr_dof", "fr_coef",
     "fr_row", "friction_table", "sp_el", "sp_par", "gy_ptr", "gy_idx", "gy_coef",
-    "corner_ptr", "corner_node", "fs_ptr", "fs_idx", "fs_coef",
+    "corner_ptr", "corner_node", "fs_ptr", "fs_idx", "fs_coef", "tv_tab",
 ))
 """A :class:`~torquesplit.assembly.structure.Structure` in kernel form.
 
 Besides the structure's own arrays (see its docstring): ``tv_el`` elements with a
-time-varying table (f > 0); ``err_el`` elements owning an error sinusoid and ``sin_el``
+time-varying table (f > 0), those whose stiffness or additive-force table changes over
+the cycle first (their number ``tv_tab[0]``; the others' tables are constant, and only
+their cycle index and half-gap are time-varying); ``err_el`` elements owning an error sinusoid and ``sin_el``
 the owner of each sinusoid; ``vr_ptr vq_idx vv_idx`` V by element (unsigned; indices
 into the state of the q and of the v entries); ``vt_ptr vt_el vt_coef`` V by DOF (the
 generalized forces are gathered, not scattered); ``gy_ptr gy_idx gy_coef`` the
@@ -65,7 +67,7 @@ a corner (:func:`corner_nodes`): the integrators also sample the statistics ther
 
 Work = namedtuple("Work", (
     "Y", "F", "D", "K", "P", "G", "E", "ED", "CY", "S", "C", "FR", "gap_cyc", "gap_val",
-    "has_force", "watch_el", "rot", "addr", "par", "next_node",
+    "has_force", "watch_el", "rot", "addr", "par", "next_node", "lim",
 ))
 """Scratch of one run.  ``Y`` (12, 2 n): state-sized rows (see the ``Y_*`` indices);
 ``F``/``D`` (2, n_el): element forces / deformations of the evaluation whose statistics
@@ -79,7 +81,8 @@ additive force table; ``watch_el`` elements whose contact state is counted; ``ro
 addresses for the generated right-hand side (``A_*``, the last its own); ``par`` its
 parameter vector (empty for the general kernel), held here so that its address stays valid;
 ``next_node`` the absolute table node (cycle x n_table + node) of each element's next
-corner."""
+corner; ``lim`` (2 n) the bound of each entry of a state that the divergence check
+applies (set by the kernels at their start: ``_kernels.state_limits``)."""
 
 Record = namedtuple("Record", (
     "track_el", "track_base", "trk_cont", "cyc_max", "cyc_min", "cyc_sum", "cyc_cnt", "cyc_wt",
@@ -257,6 +260,12 @@ def kernel_model(structure: Structure) -> KernelModel:
     damp[comps] = 0.0
     n_fm = len(s.fr_el)
     n_sp = s.sp_el.shape[0]
+    # the time-varying elements, those whose tables change over the cycle first
+    ftab = table_array(s.force_table)
+    changes = [bool(np.any(ktab[e] != ktab[e, 0]) or np.any(ftab[e] != ftab[e, 0]))
+               for e in np.flatnonzero(varying)]
+    tv_el = np.flatnonzero(varying)[np.argsort(np.logical_not(changes), kind="stable")]
+    n_tables = int(np.sum(changes))
     return KernelModel(
         inv_mass=f8(s.inv_mass), external_force=f8(s.external_force),
         ground_damping=f8(s.ground_damping), element_kind=i8(s.element_kind),
@@ -265,7 +274,7 @@ def kernel_model(structure: Structure) -> KernelModel:
         gap_values=f8(s.gap_values), error_constant=f8(s.error_constant),
         error_ptr=i8(s.error_ptr), error_amplitude=f8(s.error_amplitude),
         error_omega=f8(s.error_omega), error_phase=f8(s.error_phase),
-        force_table=table_array(s.force_table), tv_el=i8(np.flatnonzero(varying)),
+        force_table=ftab, tv_el=i8(tv_el),
         err_el=i8(err_el),
         sin_el=i8(sin_el), vr_ptr=u8(s.v_ptr), vq_idx=u8(s.v_dof),
         vv_idx=u8(np.asarray(s.v_dof) + s.n_dof), vt_ptr=u8(np.cumsum(vt_ptr)),
@@ -277,7 +286,7 @@ def kernel_model(structure: Structure) -> KernelModel:
         sp_el=i8(s.sp_el).reshape(n_sp, 2), sp_par=f8(s.sp_par).reshape(n_sp, 6),
         gy_ptr=u8(_gy_ptr(s)), gy_idx=u8(np.asarray(s.gy_idx) + s.n_dof),
         gy_coef=f8(s.gy_coef), **_corners(s), fs_ptr=u8(_fs_ptr(s)), fs_idx=u8(s.fs_idx),
-        fs_coef=f8(s.fs_coef),
+        fs_coef=f8(s.fs_coef), tv_tab=i8([n_tables]),
     )
 
 
@@ -351,7 +360,7 @@ def make_work(m: KernelModel, rhs_parameters: np.ndarray | None = None) -> Work:
         gap_cyc=np.full(ne, -(2**62), dtype=np.int64), gap_val=np.zeros(ne),
         has_force=has_force, watch_el=watch, rot=np.zeros((2, n_sin)),
         addr=np.zeros(A_SELF + 1, dtype=np.uint64), par=par,
-        next_node=np.zeros(ne, dtype=np.int64),
+        next_node=np.zeros(ne, dtype=np.int64), lim=np.zeros(2 * n),
     )
     for i, arr in ((A_Y, w.Y), (A_F, w.F), (A_D, w.D), (A_K, w.K), (A_G, w.G), (A_E, w.E),
                    (A_ED, w.ED), (A_P, w.P), (A_PAR, par), (A_FR, w.FR)):

@@ -222,7 +222,7 @@ def cycle_statistics_numpy(times, forces, frequency, phase, t0, n_cycles_cap,
     ``kernel_data.continuous_start``): the force interpolated at each cycle start enters
     both cycles' max and min.  Returns four arrays of length
     ``n_cycles_cap`` (max -inf / min +inf / mean NaN where empty).  Twin of the cycle
-    part of ``_kernels.record``, ``_kernels.mean_sample`` and ``_kernels.peak_sample``
+    part of ``_kernels.record``, ``_kernels.force_instant``
     (whose parabola formula, ``_kernels.vertex``, it calls).
     """
     times = np.asarray(times, dtype=float)

@@ -49,6 +49,7 @@ from torquesplit.solve._kernels import (
     bad_state,
     excite,
     first_corners,
+    state_limits,
     sub_step_end,
 )
 from torquesplit.solve.kernel_data import F_MAIN, Y_K1, Y_STATE, Y_TRIAL
@@ -57,8 +58,8 @@ _kernel = njit(cache=True, error_model="numpy", _nrt=False)
 _inline = njit(inline="always", error_model="numpy")
 
 NO_BLOWUP = 1.7976931348623157e308
-"""The divergence check of the period maps: a non-finite state only (``bad_state``
-with the largest float as its bound, so that an infinite displacement counts)."""
+"""The divergence check of the period maps: a non-finite state only (``state_limits``
+with the largest float as the bound of |q|, so that an infinite displacement counts)."""
 
 
 @_kernel
@@ -423,6 +424,7 @@ def rk4_samples(t0, h, n_steps, every, m, w, rhs_fn, gen, out_t, out_y, out_f, o
     t_corner = math.inf
     if m.corner_node.shape[0] > 0 and n_steps > 0:
         t_corner = first_corners(t0, m, w)
+    state_limits(NO_BLOWUP, w)
     excite(t0, a, minus, m, w)
     for it in range(n_steps + 1):
         t = t0 + it * h
@@ -465,6 +467,6 @@ def rk4_samples(t0, h, n_steps, every, m, w, rhs_fn, gen, out_t, out_y, out_f, o
             if ts < tb:  # the last corner fell within MERGE h of tb
                 excite(tb, a, minus, m, w)
             t_corner = advance_corners(tb, m, w)
-        if bad_state(Y_STATE, NO_BLOWUP, w) >= 0:
+        if bad_state(Y_STATE, w) >= 0:
             return -1, crow
     return row, crow

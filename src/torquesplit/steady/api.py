@@ -566,7 +566,7 @@ def between_samples(t, f, d, g, period, corners=(), fc=(), dc=(), gc=(), periodi
     kernels record no instant of their own there) and the three share one contact
     regime; -inf / +inf elsewhere.
     ``periodic``: the record is one period (its ends neighbours).  The integrators'
-    ``_kernels.peak_sample`` over a record."""
+    ``_kernels.force_instant`` over a record."""
     from torquesplit.solve._kernels import MERGE
 
     t = np.asarray(t, dtype=float)
@@ -623,7 +623,7 @@ def cycle_integrals(t, f, cycles, n, start, period):
     the increasing instants ``t`` in cycles ``cycles`` (cycle c begins at start + c
     period): the trapezoid rule, an interval that holds the start of a cycle split there
     (the linear interpolant on each side), past a skipped cycle half to each end's cycle;
-    cycles outside [0, n) left out.  The integrator's ``_kernels.mean_sample`` over a
+    cycles outside [0, n) left out.  The integrator's ``_kernels.force_instant`` over a
     record."""
     ta, tb, fa, fb = t[:-1], t[1:], f[:-1], f[1:]
     ca, cb = cycles[:-1], cycles[1:]
@@ -663,7 +663,7 @@ def boundary_extremes(t, f, start, period, mx, mn):
     """Enter in ``mx`` / ``mn`` (per cycle, cycle k from ``start + k period``) the force
     interpolated at every cycle start between the instants ``t`` (in time order, forces
     ``f``; on an instant, its force), in both cycles it divides: as
-    ``_kernels.mean_sample`` does for an element whose force is continuous there."""
+    ``_kernels.force_instant`` does for an element whose force is continuous there."""
     k, i, th = cycle_start_points(t, start, period, mx.shape[0])
     fb = f[i] + th * (f[i + 1] - f[i])
     for c in (k - 1, k):
