@@ -54,8 +54,8 @@ KernelModel = namedtuple("KernelModel", (
 Besides the structure's own arrays (see its docstring): ``tv_el`` elements with a
 time-varying table (f > 0), those whose stiffness or additive-force table changes over
 the cycle first (their number ``tv_tab[0]``; the others' tables are constant, and only
-their cycle index and half-gap are time-varying); ``err_el`` elements owning an error sinusoid and ``sin_el``
-the owner of each sinusoid; ``vr_ptr vq_idx vv_idx`` V by element (unsigned; indices
+their cycle index and half-gap are time-varying); ``err_el`` elements owning an error
+sinusoid and ``sin_el`` the owner of each sinusoid; ``vr_ptr vq_idx vv_idx`` V by element (unsigned; indices
 into the state of the q and of the v entries); ``vt_ptr vt_el vt_coef`` V by DOF (the
 generalized forces are gathered, not scattered); ``gy_ptr gy_idx gy_coef`` the
 gyroscopic matrix G by row (generalized force -G v); spline component elements get zero
