@@ -202,3 +202,63 @@ def test_modes_steady_states_and_static_sweeps_save_as_their_commands_do(tmp_pat
     qs = torquesplit.quasi_static_load_sharing(m, points_per_cycle=8, revolutions=1)
     figures = qs.write_figures(tmp_path / "figs", formats=("png",))
     assert figures and all(f.exists() and f.suffix == ".png" for f in figures)
+
+
+@pytest.fixture(scope="module")
+def short_run():
+    return torquesplit.simulate(EXAMPLE, cycles=20)
+
+
+@pytest.mark.parametrize("call, error, pattern", [
+    (lambda r: torquesplit.plot.mesh_force_figure("run.nc"), OptionTypeError,
+     r"^mesh_force_figure takes the Results of a dynamic run \(torquesplit\.simulate\), "
+     r"got str 'run\.nc'$"),
+    (lambda r: torquesplit.plot.static_load_sharing_figure(r), OptionTypeError,
+     r"^static_load_sharing_figure takes the results of "
+     r"torquesplit\.quasi_static_load_sharing, got Results"),
+    (lambda r: torquesplit.plot.orbit_figure(None), OptionTypeError,
+     r"takes the Results of a dynamic run .* or the results of torquesplit\.quasi_static"),
+    (lambda r: torquesplit.plot.mesh_force_figure(r, last_cycles=-1), OptionError,
+     r"^last_cycles must be a positive number, got -1; give e\.g\. last_cycles=20$"),
+    (lambda r: torquesplit.plot.mesh_force_figure(r, bins=0), OptionError,
+     r"^bins must be a whole number >= 1, got 0"),
+    (lambda r: torquesplit.plot.cycle_peak_figure(r, dense_above=2.5), OptionError,
+     r"^dense_above must be a whole number >= 1, got 2\.5"),
+    (lambda r: torquesplit.plot.load_sharing_figure(r, zoom_cycles=0), OptionError,
+     r"^zoom_cycles must be"),
+    (lambda r: torquesplit.plot.support_spectrum_figure(r, orders=-1), OptionError,
+     r"^orders must be a whole number >= 0, got -1"),
+    (lambda r: torquesplit.plot.support_spectrum_figure(r, dynamic_range=0), OptionError,
+     r"^dynamic_range must be a positive number, got 0"),
+    (lambda r: torquesplit.plot.mesh_stiffness_figure(r, points_per_cycle=1), OptionError,
+     r"^points_per_cycle must be a whole number >= 2, got 1"),
+    (lambda r: torquesplit.plot.mesh_stiffness_figure(r, cycles=math.inf), OptionError,
+     r"^cycles must be a positive number, got inf"),
+    (lambda r: r.settle_windows(0), OptionError,
+     r"^minimum must be a whole number >= 2, got 0; give e\.g\. minimum=20$"),
+])
+def test_figures_and_results_refuse_what_they_cannot_draw_or_count(short_run, call, error,
+                                                                   pattern):
+    """A string, another kind of results or a count of 0 ended in an AttributeError from
+    inside the figure, or was accepted (last_cycles=-1 drew the whole run)."""
+    import torquesplit.plot  # noqa: F401
+
+    with pytest.raises(error, match=pattern):
+        call(short_run)
+
+
+def test_campbell_and_steady_samples_refuse_counts_below_their_minimum():
+    """count=0 sliced every frequency away, count=-1 dropped the highest silently."""
+    from torquesplit.steady import campbell
+
+    for count in (0, -1, 2.5):
+        with pytest.raises(OptionError, match=r"^count must be a whole number >= 1"):
+            campbell(torquesplit.load_model(EXAMPLE), "0 rpm", "3000 rpm", count=count)
+    with pytest.raises(OptionError, match=r"^points must be a whole number >= 2, got 1"):
+        campbell(torquesplit.load_model(EXAMPLE), "0 rpm", "3000 rpm", points=1)
+    st = torquesplit.steady_state(EXAMPLE, keep="stage1", harmonics=4)
+    for kw, pattern in (({"per_cycle": -1}, r"^per_cycle must be a whole number >= 2"),
+                        ({"n": 0}, r"^n must be a whole number >= 2, got 0")):
+        with pytest.raises(OptionError, match=pattern):
+            st.samples(**kw)
+    assert len(st.samples(n=8)[0]) == 8

@@ -12,7 +12,6 @@ from __future__ import annotations
 import contextlib
 import contextvars
 import math
-import numbers
 import warnings
 from dataclasses import dataclass
 from typing import Callable
@@ -210,16 +209,9 @@ def _positive_time(value) -> float:
 
 def _whole(value, name: str, example: str) -> int:
     """A whole-number argument >= 1 (a float with a whole value is accepted)."""
-    from .errors import OptionError
+    from ._args import whole
 
-    ok = isinstance(value, numbers.Integral) and not isinstance(value, bool)
-    if isinstance(value, numbers.Real) and not isinstance(value, (bool, numbers.Integral)):
-        ok = math.isfinite(value) and float(value).is_integer()
-    if not ok:
-        raise OptionError(f"{name} must be a whole number, got {value!r}; give e.g. {example}")
-    if value < 1:
-        raise OptionError(f"{name} must be >= 1, got {value!r}; give e.g. {example}")
-    return int(value)
+    return whole(value, name, example)
 
 
 @dataclass(frozen=True)

@@ -16,15 +16,15 @@ BAD = [
     ({"duration": -1.0}, r"^duration must be a positive time, got -1\.0"),
     ({"duration": "0 s"}, r"^duration must be a positive time"),
     ({"duration": [1]}, r"^duration: got \[1\]"),
-    ({"cycles": 2.5}, r"^cycles must be a whole number, got 2\.5; give e\.g\. cycles=200$"),
+    ({"cycles": 2.5}, r"^cycles must be a whole number >= 1, got 2\.5; give e\.g\. cycles=200$"),
     ({"cycles": "3"}, r"^cycles must be a whole number"),
-    ({"cycles": -3}, r"^cycles must be >= 1, got -3; give e\.g\. cycles=200$"),
-    ({"cycles": 0}, r"^cycles must be >= 1"),
-    ({"samples_per_period": 0}, r"^samples_per_period must be >= 1, got 0"),
+    ({"cycles": -3}, r"^cycles must be a whole number >= 1, got -3; give e\.g\. cycles=200$"),
+    ({"cycles": 0}, r"^cycles must be a whole number >= 1, got 0"),
+    ({"samples_per_period": 0}, r"^samples_per_period must be a whole number >= 1, got 0"),
     ({"samples_per_period": 0.5}, r"^samples_per_period must be a whole number"),
     # 0 fell back to the model's 100 and 2.5 was cut to 2, silently
-    ({"steps_per_period": 0}, r"^steps_per_period must be >= 1, got 0"),
-    ({"steps_per_period": 2.5}, r"^steps_per_period must be a whole number, got 2\.5"),
+    ({"steps_per_period": 0}, r"^steps_per_period must be a whole number >= 1, got 0"),
+    ({"steps_per_period": 2.5}, r"^steps_per_period must be a whole number >= 1, got 2\.5"),
     ({"steps_per_period": 3}, r"^steps_per_period must be at least 10 \(as \[analysis\]"),
 ]
 

@@ -37,6 +37,7 @@ from matplotlib.figure import Figure
 from matplotlib.ticker import NullLocator
 
 from ..errors import FigureNotApplicableError, TorquesplitError  # noqa: F401 - re-exported
+from .. import _args
 from ..errors import OptionError, OptionTypeError
 
 __all__ = [
@@ -114,6 +115,11 @@ def mesh_force_figure(results, *, last_cycles: float | None = None,
     Figure
         The nominal (equal-split) static force of each mesh is the dashed line.
     """
+    _args.results_of(results, "mesh_force_figure", ("dynamic",))
+    if last_cycles is not None:
+        last_cycles = _args.positive(last_cycles, "last_cycles", "last_cycles=20")
+    band_above = _args.positive(band_above, "band_above", "band_above=30")
+    bins = _args.whole(bins, "bins", "bins=400")
     t, forces = results.mesh_force_history()
     forces = _finite(forces)
     names, groups = results.mesh_names, results.groups
@@ -190,6 +196,8 @@ def cycle_peak_figure(results, *, dense_above: int = DENSE_CYCLES) -> Figure:
     cycle).  More than ``dense_above`` cycles are drawn as the range of the peaks over
     runs of cycles with their mean (:func:`_dense_line`).
     """
+    _args.results_of(results, "cycle_peak_figure", ("dynamic",))
+    dense_above = _args.whole(dense_above, "dense_above", f"dense_above={DENSE_CYCLES}")
     s = results.solution
     groups = results.groups
     nominal = results.nominal_forces()
@@ -243,6 +251,9 @@ def load_sharing_figure(results, definition: str | None = None, *,
         reported coefficient (``results.metrics(definition).load_sharing.per_group``),
         the dotted vertical line the start of the group's settled part.
     """
+    _args.results_of(results, "load_sharing_figure", ("dynamic",))
+    dense_above = _args.whole(dense_above, "dense_above", f"dense_above={DENSE_CYCLES}")
+    zoom_cycles = _args.whole(zoom_cycles, "zoom_cycles", "zoom_cycles=40")
     met = results.metrics(definition)
     definition = met.definition
     groups = {g: ms for g, ms in results.groups.items() if len(ms) > 1}
@@ -313,6 +324,7 @@ def dynamic_factor_figure(results, definition: str | None = None, *,
     line is 1, the red dotted line the factor above which a run is reported as near a
     resonance (:data:`torquesplit.results.plausibility.RESONANCE_FACTOR`).
     """
+    _args.results_of(results, "dynamic_factor_figure", ("dynamic",))
     from ..results.plausibility import RESONANCE_FACTOR
 
     met = results.metrics(definition)
@@ -405,6 +417,14 @@ def support_spectrum_figure(results, *, start_time: float | None = None, orders:
         legend gives each direction's mean force and largest line.  Dotted: orders of
         each mesh frequency; dash-dot grey: rotation frequency of the supported body.
     """
+    _args.results_of(results, "support_spectrum_figure", ("dynamic",))
+    orders = _args.whole(orders, "orders", "orders=4", minimum=0)
+    max_panels = _args.whole(max_panels, "max_panels", "max_panels=4")
+    max_points = _args.whole(max_points, "max_points", "max_points=3000")
+    if max_frequency is not None:
+        max_frequency = _args.positive(max_frequency, "max_frequency", "max_frequency=5000 (Hz)")
+    dynamic_range = _args.positive(dynamic_range, "dynamic_range", "dynamic_range=1e-4")
+    content_range = _args.positive(content_range, "content_range", "content_range=1e-2")
     s = results.solution
     supports = results.support_columns()
     via = results.bearing_via()
@@ -606,6 +626,7 @@ def orbit_figure(results, *, bodies: Iterable[str] | None = None) -> Figure:
     zoomed on its orbit: ``+`` marks the nominal centre when it is near the orbit, else the
     panel title gives the mean offset from it.  The circle is the start.
     """
+    _args.results_of(results, "orbit_figure", ("dynamic", "static"))
     orbits = _orbits(results)
     if bodies is not None:
         wanted = list(bodies)
@@ -676,6 +697,10 @@ def mesh_stiffness_figure(results, *, cycles: float = 2.0, points_per_cycle: int
     periodic interpolation at the mesh phase ``f t + phase``), so the relative phasing
     of parallel meshes shows.  Works on dynamic and quasi-static results.
     """
+    _args.results_of(results, "mesh_stiffness_figure", ("dynamic", "static"))
+    cycles = _args.positive(cycles, "cycles", "cycles=2")
+    points_per_cycle = _args.whole(points_per_cycle, "points_per_cycle", "points_per_cycle=400",
+                             minimum=2)
     st = results.structure
     el = st.element_names
     groups = _groups(results)
@@ -699,6 +724,7 @@ def mesh_stiffness_figure(results, *, cycles: float = 2.0, points_per_cycle: int
 def static_mesh_force_figure(results) -> Figure:
     """Quasi-static mesh force against mesh position, one panel per group (over many
     revolutions: one revolution and every revolution's range, :func:`_revolution`)."""
+    _args.results_of(results, "static_mesh_force_figure", ("static",))
     angle, xlabel = _positions(results)
     forces = _finite(_static_forces(results))
     names, groups = results.mesh_names, _groups(results)
@@ -729,6 +755,7 @@ def static_load_sharing_figure(results) -> Figure:
     The dashed line is the group's reported value (largest over the positions,
     Mo et al. 2017 eq. 15: ``results.metrics().per_group``).
     """
+    _args.results_of(results, "static_load_sharing_figure", ("static",))
     angle, xlabel = _positions(results)
     groups = {g: ms for g, ms in _groups(results).items() if len(ms) > 1}
     if not groups:

@@ -22,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import _args
 from ..assembly.structure import element_units
 from ..errors import OptionError
 from ..metrics import load_sharing as ls
@@ -467,6 +468,7 @@ class Results:
     def settle_windows(self, minimum: int = 20) -> list[int]:
         """Cycles per settle window of each mesh: at least ``minimum`` and the longest
         excitation period (slowest error sinusoid or backlash sequence) in its cycles."""
+        minimum = _args.whole(minimum, "minimum", "minimum=20", minimum=2)
         st = self.structure
         # sinusoids of zero amplitude (an excitation left out, e.g. by a steady state's
         # keep=) excite nothing and do not lengthen the window

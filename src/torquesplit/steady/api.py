@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from torquesplit import _args
 from torquesplit.errors import OptionError, SolverError, collect_model_warnings, warn_user
 from torquesplit.solve.kernel_data import continuous_start
 from torquesplit.steady.period import (
@@ -209,6 +210,9 @@ class SteadyState:
         trigonometric interpolation, the forces from the model's laws at those times);
         shooting at its samples (every ``sample_every``-th RK4 step; the meshes at every
         step: :meth:`mesh_series`)."""
+        per_cycle = _args.whole(per_cycle, "per_cycle", "per_cycle=64", minimum=2)
+        if n is not None:
+            n = _args.whole(n, "n", "n=256", minimum=2)
         ps = self.solution
         if ps.method != "hb":
             return ps.t, ps.forces, ps.deformations

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from torquesplit._args import whole
 from torquesplit.errors import ModelWarning, OptionError, SolverError, warn_user
 from torquesplit.steady.solution import warn_undamped
 from torquesplit.steady.api import reference_speed
@@ -804,14 +805,13 @@ def campbell(model, start: float, stop: float, *, points: int = 41,
 
     from torquesplit.solve.modal import modal_analysis
 
-    if not (isinstance(points, (int, np.integer)) and not isinstance(points, bool)
-            and points >= 2):  # (0 failed inside xarray)
-        raise OptionError(f"points must be a whole number >= 2, got {points!r}")
+    points = whole(points, "points", "points=41", minimum=2)  # (0 failed inside xarray)
+    if orders is not None:
+        orders = whole(orders, "orders", "orders=3")
+    if count is not None:  # (0 or less sliced the frequencies away, or from the end)
+        count = whole(count, "count", "count=10")
     model, kin, s, _, _, static = _prepare(model, None, None)
     w_ref = reference_speed(model)
-    if orders is not None and not (isinstance(orders, (int, np.integer))
-                                   and not isinstance(orders, bool) and orders >= 1):
-        raise OptionError(f"orders must be a whole number >= 1, got {orders!r}")
     lo, hi = sorted((_rad_per_s(start, "start"), _rad_per_s(stop, "stop")))  # (a map: the
     # range either way round, as sweep_speed takes it; from standstill as a map usually is)
     if not (lo >= 0 and hi > lo and math.isfinite(hi)):
