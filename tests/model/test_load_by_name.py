@@ -24,3 +24,14 @@ def test_a_run_says_what_it_is():
     text = repr(res)
     assert text.startswith("<Results of 'ji_li_mill_drive': dynamic run, 0.02 s simulated, "
                            "4 meshes, ok;") and ".metrics()" in text
+
+
+def test_the_assembled_structure_and_the_kinematics_say_what_they_are_in_one_line():
+    """Their generated reprs printed every array (about 6 000 characters each for this
+    14-DOF drive) where a notebook user asked what they hold."""
+    model = torquesplit.load_model("ji_li_mill_drive")
+    s, kin = torquesplit.assemble(model), torquesplit.solve_kinematics(model)
+    assert repr(s) == ("<Structure: 14 DOFs, 14 elements (4 meshes, 10 springs), 4 "
+                       "time-varying; .dof_names, .element_names, .projection_matrix()>")
+    assert repr(kin).startswith(f"<Kinematics: {len(kin.bodies)} bodies, 4 meshes, input ")
+    assert len(repr(kin)) < 120

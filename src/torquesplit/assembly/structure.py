@@ -167,6 +167,18 @@ class Structure:
     metadata: dict = field(default_factory=dict, compare=False)
     """Free-form information for post-processing (mesh names, stages, body map...)."""
 
+    def __repr__(self) -> str:
+        """One line (the generated repr printed every array: 6 000 characters for a
+        14-DOF drive)."""
+        kinds = np.asarray(self.element_kind)
+        counts = [(int(np.sum(kinds == k)), word) for k, word in
+                  ((MESH, "meshes"), (SPRING, "springs"), (SPLINE, "spline components"))]
+        parts = ", ".join(f"{n} {word}" for n, word in counts if n)
+        varying = int(np.sum(np.asarray(self.frequency) > 0))
+        return (f"<Structure: {self.n_dof} DOFs, {self.n_elements} elements ({parts}), "
+                f"{varying} time-varying; .dof_names, .element_names, "
+                f".projection_matrix()>")
+
     # ------------------------------------------------------------------ sizes
     @property
     def n_dof(self) -> int:

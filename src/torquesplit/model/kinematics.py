@@ -126,6 +126,12 @@ class Kinematics:
     reactions: dict[str, float] = field(default_factory=dict)
     """Held body -> reaction torque of its torsional support about its axis [N m]."""
 
+    def __repr__(self) -> str:
+        """One line (the generated repr printed every body's and mesh's arrays)."""
+        return (f"<Kinematics: {len(self.bodies)} bodies, {len(self.meshes)} meshes, "
+                f"input {self.input_power / 1e3:.6g} kW; .bodies, .meshes, "
+                f".drive_torques, .load_torques>")
+
     def frame_speed(self, body: str) -> float:
         """Speed of the frame ``body``'s translations are measured in [rad/s] (signed
         about the carrier's axis; 0 for the housing)."""
