@@ -37,6 +37,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .errors import OptionError
+from .solve.modal import DEGENERATE_RTOL
 
 __all__ = ["ModeRow", "ModalReport", "classify", "model_modes", "MODE_TYPES",
            "PhasedStage", "phased_stages", "phasing_suppresses", "whirl_senses"]
@@ -288,7 +289,7 @@ def whirl_senses(structure, sol, kin) -> dict[int, int]:
     return {k: int(v) * int(np.sign(w_c)) for k, v in enumerate(sense)}
 
 
-def classify(structure, sol, *, rtol: float = 1e-6, tol: float = 1e-6,
+def classify(structure, sol, *, rtol: float = DEGENERATE_RTOL, tol: float = 1e-6,
              kin=None) -> list[ModeRow]:
     """Group and label the modes of ``sol`` (a ModalSolution of ``structure``).
 
@@ -315,7 +316,6 @@ def classify(structure, sol, *, rtol: float = 1e-6, tol: float = 1e-6,
             is_planet[idx] = True
     phi = np.asarray(sol.mode_shapes)
     freqs = np.asarray(sol.frequencies)
-    frac = np.asarray(sol.strain_energy_fraction)
     zeta = np.asarray(sol.damping_ratios)
     senses = whirl_senses(structure, sol, kin) if kin is not None and planets else {}
     rows: list[ModeRow] = []
@@ -336,10 +336,7 @@ def classify(structure, sol, *, rtol: float = 1e-6, tol: float = 1e-6,
                 kind = "translational"
             else:
                 kind = "mixed"
-        # the group's strain energy per element: sum over its modes, weighted by each
-        # mode's strain energy omega^2 / 2 (mass-normalised modes)
-        e = (freqs[members] ** 2)[:, None] * frac[members]
-        share = e.sum(axis=0) / max(float(e.sum()), 1e-300)
+        share = sol.group_shares(members)  # (basis-independent)
         order = np.argsort(-share)
         energy = {structure.element_names[k]: float(share[k]) for k in order
                   if share[k] > 1e-12}
@@ -356,7 +353,7 @@ def classify(structure, sol, *, rtol: float = 1e-6, tol: float = 1e-6,
 
 
 def model_modes(model, *, rotating_frame: bool = True, below: float | str | None = None,
-                count: int | None = None, rtol: float = 1e-6) -> ModalReport:
+                count: int | None = None, rtol: float = DEGENERATE_RTOL) -> ModalReport:
     """Modes of a model about its static equilibrium, grouped, and classified where it has
     a planetary stage (``ModeRow.type`` None otherwise).
 

@@ -30,7 +30,11 @@ from torquesplit.assembly.structure import Structure
 from torquesplit.solve import laws
 from torquesplit.solve._frozen import freeze_arrays
 
-__all__ = ["ModalSolution", "modal_analysis"]
+__all__ = ["ModalSolution", "modal_analysis", "DEGENERATE_RTOL"]
+
+DEGENERATE_RTOL = 1e-6
+"""Modes whose frequencies agree to this relative difference form one degenerate group
+(the planets' translational pairs of a carrier at rest, symmetric layouts)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -64,11 +68,37 @@ class ModalSolution:
     def n_modes(self) -> int:
         return int(self.frequencies.shape[0])
 
-    def dominant_elements(self, mode: int, n: int = 3) -> list[tuple[str, float]]:
-        """The ``n`` elements with the largest strain-energy share in ``mode``."""
-        frac = self.strain_energy_fraction[mode]
+    def dominant_elements(self, mode: int, n: int = 3, *, group_rtol: float | None = None
+                          ) -> list[tuple[str, float]]:
+        """The ``n`` elements with the largest strain-energy share in ``mode``; with
+        ``group_rtol``, in the degenerate group of ``mode`` (:meth:`group_of`,
+        :meth:`group_shares`), whose shares do not depend on the basis the eigensolver
+        returned for it, as a single mode's of the group do."""
+        frac = (self.strain_energy_fraction[mode] if group_rtol is None
+                else self.group_shares(self.group_of(mode, group_rtol)))
         order = np.argsort(-frac)[:n]
         return [(self.element_names[i], float(frac[i])) for i in order]
+
+    def group_of(self, mode: int, rtol: float = DEGENERATE_RTOL) -> list[int]:
+        """``mode`` and its neighbours in frequency within ``rtol`` (relative): its
+        degenerate group (modes in ascending frequency)."""
+        f = self.frequencies
+        near = abs(f - f[mode]) <= rtol * max(abs(float(f[mode])), 1e-300)
+        lo, hi = mode, mode
+        while lo > 0 and near[lo - 1]:
+            lo -= 1
+        while hi + 1 < len(f) and near[hi + 1]:
+            hi += 1
+        return list(range(lo, hi + 1))
+
+    def group_shares(self, members) -> np.ndarray:
+        """(n_el,) each element's share of the strain energy of the modes ``members``
+        together: the sum over them of each mode's shares weighted by its strain energy
+        omega^2 / 2 (mass-normalised modes), over the total -- the trace of the element's
+        stiffness over the group's subspace, the same in any basis of it."""
+        m = list(members)
+        e = (np.asarray(self.frequencies)[m] ** 2)[:, None] * self.strain_energy_fraction[m]
+        return e.sum(axis=0) / max(float(e.sum()), 1e-300)
 
 
 def modal_analysis(structure: Structure, q=None, *, rigid_tolerance: float = 1e-10

@@ -14,6 +14,7 @@ import numpy as np
 
 from torquesplit._args import whole
 from torquesplit.errors import ModelWarning, OptionError, SolverError, warn_user
+from torquesplit.solve.modal import DEGENERATE_RTOL
 from torquesplit.steady.solution import warn_undamped
 from torquesplit.steady.api import reference_speed
 from torquesplit.steady.solution import check_method
@@ -367,7 +368,8 @@ def critical_speeds(structure, q, kin, model, w_lo, w_hi, orders=None):
             if w_lo <= w <= w_hi:
                 out.append(_cancellation(structure, q, sol, phasing.groups, phasing.mark(dict(
                     mode=i + 1, frequency_Hz=float(fn), order=order, source=label,
-                    speed_rpm=float(w * RPM), energy=sol.dominant_elements(i, 4),
+                    speed_rpm=float(w * RPM),
+                    energy=sol.dominant_elements(i, 4, group_rtol=DEGENERATE_RTOL),
                     **_strength_of(strength, label, order)), types), cycles))
     out.sort(key=lambda c: c["speed_rpm"])
     return dict(natural_frequencies=sol.frequencies, crossings=out, modal=sol,
@@ -927,7 +929,7 @@ def _curve_crossings(model, q, speeds, F, lines, w_ref, strength=None):
                 out.append(_cancellation(st, q, sol, phasing.groups, phasing.mark(dict(
                     mode=m + 1, frequency_Hz=float(sol.frequencies[m]), order=order,
                     source=label, speed_rpm=float(w * RPM),
-                    energy=sol.dominant_elements(m, 4),
+                    energy=sol.dominant_elements(m, 4, group_rtol=DEGENERATE_RTOL),
                     **_strength_of(strength or {}, label, order)), phasing.types(st, sol))))
     out.sort(key=lambda c: c["speed_rpm"])
     return out
