@@ -144,7 +144,7 @@ def excite(t, slot, src, m, w):
     Time-varying tables (stiffness, additive force, friction) are interpolated at the
     mesh phase s = f t + phase (:func:`laws.table_phase`; the elements ``m.tv_el``
     after the first ``m.tv_tab[0]`` have constant tables, already in every slot, and
-    need only their cycle: 4 % of a step of Lin & Parker's planetary); the half-gap is entry
+    need only their cycle: -7 % on Lin & Parker's planetary step); the half-gap is entry
     floor(s) mod n_gaps of the element's per-cycle sequence (cached in ``w.gap_cyc`` /
     ``w.gap_val``); CY is the statistics cycle index (:func:`laws.stat_cycle`).  Error
     sinusoids are evaluated exactly when ``src < 0``, else advanced from slot ``src``
@@ -472,7 +472,7 @@ def vertex(t0, t1, t2, f0, f1, f2):
 def force_instant(t, kink, full, count, slot, i_f, m, w, r):
     """The forces (row ``i_f``) at the instant ``t`` into the cycles' statistics, one
     pass over the tracked elements (one pass, not one per quantity: each element's
-    cycle, force and last instant are loaded once; Ji & Li's step -6 %).  Per element:
+    cycle, force and last instant are loaded once; Ji & Li's step -2 %).  Per element:
 
     * **extremes**: the force into its cycle's max and min (and, with ``count``, the
       cycle's sample count: a sample of the run, not a corner instant);
@@ -853,9 +853,9 @@ def bad_state(iy, w):
     y = w.Y
     lim = w.lim
     # fast path without a branch per entry: one conjunction of comparisons (false for
-    # NaN) over the whole row against one bound per entry; a sum of x - x was a chain of
-    # dependent additions, and a loop per half of the row doubled the vector loops'
-    # set-up (28 states, in isolation: 14.4, 11.9 and now 9 ns)
+    # NaN) over the whole row against one bound per entry (a sum of x - x was a chain
+    # of dependent additions; one loop per half of the row, each with its own vector
+    # set-up, cost 3 % more of Ji & Li's step)
     ok = True
     for i in range(y.shape[1]):
         ok &= abs(y[iy, i]) <= lim[i]
