@@ -150,3 +150,20 @@ def test_an_undamped_mode_has_a_damping_ratio_of_zero_not_rounding():
     damped = torquesplit.load_model("split_path_planetary_differential")
     s = torquesplit.assemble(damped)
     assert undamped_note(s, static_equilibrium(s).q) == ""
+
+
+def test_a_repeated_pair_of_a_turning_carrier_shares_its_strain_energy_evenly():
+    """Planet modes (multiplicity N - 3) stay repeated with the carrier turning, and the
+    gyroscopic solver returned their two complex shapes mass-normalised but not
+    orthogonal: the group's strain energy, summed over them, gave 30 / 28 / 17 % to
+    three of five identical, equally spaced planets' bearings.  Each takes a fifth."""
+    import torquesplit
+    from torquesplit.modes import model_modes
+
+    model = torquesplit.load_model("lin_parker1999_planetary", changes="planetary.0.planets=5")
+    rows = [r for r in model_modes(model).rows if r.type == "planet"]
+    assert len(rows) == 6 and all(r.multiplicity == 2 for r in rows)
+    for r in rows:
+        shares = [r.strain_energy.get(f"stage_planet{k}.support.x", 0.0)
+                  + r.strain_energy.get(f"stage_planet{k}.support.y", 0.0) for k in range(1, 6)]
+        assert max(shares) - min(shares) <= 1e-6 * max(shares), (r.frequency, shares)
