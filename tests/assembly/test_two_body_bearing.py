@@ -110,7 +110,7 @@ def test_bearing_force_reaches_the_carrier_support(tmp_path):
 
 @pytest.mark.parametrize("on, message", [
     ("wheel", "cannot sit on its own body"),
-    ("planet", "unknown body 'planet'"),
+    ("planet", "body 'planet' does not exist; use one of the bodies"),
 ])
 def test_bad_bearing_seat_names_the_field(tmp_path, on, message):
     with pytest.raises(ModelError, match=f"gears.wheel.support.on.*{message}"):

@@ -221,6 +221,11 @@ CASES = [
      "drives.motor.speed", r"cannot read 'fast' as a speed.*'8780 rpm'"),
     ("drive on an unknown body", setting("drives.motor.body", "motor"),
      "drives.motor.body", r"body 'motor' does not exist; use one of the bodies"),
+    # (a misspelt seat was said as "the gears could not turn" around a loop)
+    ("bearing seated on an unknown body", both(
+        setting("gears.pinion.dofs", ["x", "y", "theta"]),
+        setting("gears.pinion.support", {"stiffness": "1e8 N/m", "on": "carier"})),
+     "gears.pinion.support.on", r"body 'carier' does not exist; use one of the bodies"),
     ("drive speed contradicts the ratio", _second_drive("-1000 rpm"),
      "drives.second.speed", r"-1000 rpm contradicts the -1500 rpm that the gear ratios give"),
     ("shaft without stiffness or geometry", _motor_on_shaft({}),

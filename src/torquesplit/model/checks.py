@@ -170,6 +170,11 @@ def reference_issues(model: Model) -> list[tuple[str, str]]:
                         f"no mesh lists {name!r} in its 'gears': check the meshes")
                 issues.append((loc, f"{name!r} is placed from {ref!r} but does not mesh with it; "
                                f"{hint}, or give 'position' instead"))
+    for kind, items in (("gears", model.gears), ("bodies", model.bodies)):
+        for name, item in items.items():  # a bearing's seat on another body (a planet pin)
+            seat = item.support.on if item.support is not None else None
+            if seat is not None:
+                need(f"{kind}.{name}.support.on", seat)
     for name, s in model.shafts.items():
         for b in s.connects:
             need(f"shafts.{name}.connects", b)
