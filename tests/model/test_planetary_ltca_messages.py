@@ -33,6 +33,13 @@ def test_a_planet_angle_off_the_assembly_condition_is_given_the_nearest_that_fit
     with pytest.raises(ModelError, match=r"71\.001 tooth periods.*the nearest for planet 3: "
                                          r"236\.6666667 deg"):
         torquesplit.load_model(tomllib.loads(text))
+    # angles in radians to five digits: the message shows the digits it decides by
+    # ('at 120 deg ... the nearest: 120 deg' left nothing to change)
+    text = three_planet_toml("angles", extra="angles = [0, 2.0944, 4.18879]\n")
+    with pytest.raises(ModelError, match=r"at 120\.0002806 deg from planet 1 it is "
+                                         r"36\.00008418 tooth periods .*not a whole number "
+                                         r"to 1e-06"):
+        torquesplit.load_model(tomllib.loads(text))
     # halfway between two that fit: both (the second alone was named)
     text = three_planet_toml("angles", extra='angles = ["0 deg", "120 deg", "235 deg"]\n')
     with pytest.raises(ModelError, match=r"the nearest for planet 3: 233\.3333333 deg or "

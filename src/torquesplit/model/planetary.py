@@ -456,10 +456,13 @@ class Planetary(Strict):
                         f"away (the tooth-count assembly condition); a bare number is read "
                         f"in radians: planet {i}'s angle {psi:g} is {math.degrees(psi):.6g} "
                         f"deg; write '{psi:g} deg'"))
+                # (the digits the condition is decided to: '120 deg ... the nearest: 120 deg'
+                # hid an angle written as 2.0944 rad, a planetary reviewer)
                 fit.append((where, (
-                    f"planet {i} does not fit: at {math.degrees(psi - angles[0]):.6g} deg from "
-                    f"planet 1 it is {steps:.6g} tooth periods of sun and ring away "
-                    f"(the tooth-count assembly condition); {hint}")))
+                    f"planet {i} does not fit: at {math.degrees(psi - angles[0]):.10g} deg "
+                    f"from planet 1 it is {steps:.10g} tooth periods of sun and ring away, "
+                    f"not a whole number to {FIT_TOLERANCE:g} (the tooth-count assembly "
+                    f"condition); {hint}")))
                 if self.angles is None:
                     break  # (equal spacing: one message says it for every planet)
         order = sorted(a % (2 * math.pi) for a in angles)
