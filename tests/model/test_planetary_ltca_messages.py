@@ -134,3 +134,16 @@ def test_contact_says_every_bad_load_with_the_models_problems(tmp_path, monkeypa
     assert len(lines) == 3 and all(ln.startswith("error: ") for ln in lines), res.output
     assert "'40 kg' is neither a force nor a torque" in lines[0]
     assert "'-5 kN' must be positive" in lines[1] and "crowning" in lines[2]
+
+
+@pytest.mark.parametrize("member, said", [
+    ("planet", r"a planet is an external gear \(it meshes with the sun and inside the "
+               r"ring\), so it cannot be internal; remove 'kind' \(only the ring is internal\)"),
+    ("sun", r"the sun is an external gear \(the planets mesh around it\)"),
+])
+def test_an_internal_sun_or_planet_is_told_why_not(member, said):
+    """'the planet meshes outside the planets' teeth and cannot be internal' (a review)."""
+    data = tomllib.loads(three_planet_toml("kind"))
+    data["planetary"][0][member]["kind"] = "internal"
+    with pytest.raises(ModelError, match=rf"planetary\.0\.{member}\.kind: {said}"):
+        torquesplit.load_model(data)

@@ -260,8 +260,12 @@ class Planetary(Strict):
                 problems.append((f"{member}.{exc.field}", str(exc)))
         for member in ("sun", "planet"):
             if getattr(self, member).kind == "internal":
-                problems.append((f"{member}.kind", f"the {member} meshes outside the "
-                                 f"planets' teeth and cannot be internal; remove 'kind'"))
+                # ("the planet meshes outside the planets' teeth" read as nonsense)
+                what = ("the sun is an external gear (the planets mesh around it)"
+                        if member == "sun" else "a planet is an external gear (it meshes "
+                        "with the sun and inside the ring)")
+                problems.append((f"{member}.kind", f"{what}, so it cannot be internal; "
+                                 f"remove 'kind' (only the ring is internal)"))
             if getattr(self, member).kind == "double_helical":
                 # the ring is an internal gear, and an internal gear has one helix here
                 problems.append((f"{member}.kind", (
