@@ -325,3 +325,23 @@ def test_a_runs_mat_file_has_the_layout_every_commands_has(tmp_path):
     assert m["units"]["time"] == "s" and m["units"]["peak_force"] == "N"
     assert "model_json" not in m["attributes"] and m["model_json"].startswith("{")
     assert m["provenance"]["run_id"]
+
+
+def test_a_file_read_back_reports_the_definition_it_was_saved_with(tmp_path):
+    """An exports review: a run saved with ``--definition mean_force`` read back with
+    ``load_results`` reported the model's definition (its report used the file's), so the
+    Python numbers differed from the file's own load_sharing variable."""
+    import torquesplit
+
+    res = torquesplit.simulate(EXAMPLE, duration=0.3)
+    assert res.default_definition != "mean_force"
+    back = torquesplit.load_results(res.save(tmp_path / "r.nc", definition="mean_force"))
+    met = back.metrics()
+    assert met.definition == back.default_definition == "mean_force"
+    with xr.open_dataset(tmp_path / "r.nc") as ds:
+        assert [met.load_sharing.per_mesh[m] for m in back.mesh_names] == pytest.approx(
+            list(ds["load_sharing"].values), rel=1e-12)
+    # another definition is still one argument away, and a run not read from a file keeps
+    # the model's
+    assert back.metrics(res.default_definition).definition == res.default_definition
+    assert res.metrics().definition == res.default_definition

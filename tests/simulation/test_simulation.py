@@ -113,6 +113,13 @@ def test_mat_and_csv_exports(split, tmp_path):
     desc = mat["descriptions"][0, 0]
     assert "history of every integration step" in str(desc["element_force"][0])
     assert str(mat["units"][0, 0]["time"][0]) == "s"
+    # MATLAB counts rows from 1: the first settled cycle's row is one past its index (a
+    # reviewer's cycle_max_force(first_settled_cycle:end, k) took one cycle too many)
+    assert "first_settled_cycle + 1" in str(desc["first_settled_cycle"][0])
+    met = res.metrics()
+    for k, r in enumerate(met.rows):
+        row = int(mat["first_settled_cycle"].ravel()[k]) + 1  # (MATLAB's row)
+        assert np.nanmax(mat["cycle_max_force"][row - 1:, k]) == r.peak_force
     # the warnings as a cell column, one per warning (none: empty, which {''} was not)
     said = res.warnings()
     assert mat["warnings"].shape == (len(said), 1)
@@ -327,12 +334,18 @@ def test_the_cycle_tables_give_the_peaks_back_over_the_settled_span(tmp_path):
     for r in met.rows:
         col = [float(c[f"{r.mesh}_peak_N"]) if c[f"{r.mesh}_peak_N"] else -np.inf for c in cyc]
         flags = [c[f"{r.mesh}_settled"] for c in cyc]
-        k = flags.index("1")  # the settled span: from one cycle on, to the end
-        assert set(flags[:k]) <= {"0"} and set(flags[k:]) == {"1"}
+        k = flags.index("1")  # the settled span: from one cycle on, to the mesh's last
+        n = flags.count("1")  # complete cycle, and no row where it has no cycle (the
+        # slow stage's rows past its last cycle were flagged 1, an exports review)
+        assert set(flags[:k]) <= {"0"} and set(flags[k:k + n]) == {"1"}
+        assert flags == ["1" if i >= k and c[f"{r.mesh}_peak_N"] else "0"
+                         for i, c in enumerate(cyc)]
         assert k == met.settling.first_cycle[r.mesh] > 0
         assert max(col[k:]) == r.peak_force
         assert int(ds["first_settled_cycle"].sel(mesh=r.mesh)) == k
     assert max(float(c["m11_peak_N"]) for c in cyc if c["m11_peak_N"]) > met.rows[0].peak_force
+    # the slow stage has a quarter of the fast one's cycles: its later rows are empty
+    assert sum(c["m12_peak_N"] == "" for c in cyc) > len(cyc) / 2
     groups = list(ds["group"].values)
     assert list(ds["settle_time"].values) == [met.settling.group_time[g] for g in groups]
     # every recorded element's contact state, supports included (only in the .nc/.mat)

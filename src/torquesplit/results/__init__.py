@@ -196,6 +196,10 @@ class Results:
         no transient to detect, every complete cycle counts."""
         self.period = period
         """The period of a periodic record [s] (None for a run)."""
+        self.saved_definition: str | None = None
+        """A run read back from its file: the load-sharing definition it was saved with
+        (its ``load_sharing_definition`` attribute), which :meth:`metrics` then reports
+        by default."""
         self.saved_steady: dict = {}
         """A steady state read back from its file: its ``steady_*`` (and record)
         attributes and RMS transmission errors, which a save writes again."""
@@ -394,7 +398,11 @@ class Results:
     def default_definition(self) -> str:
         """The load-sharing definition :meth:`metrics` reports when none is given: the
         model's ``[analysis] load_sharing``, or :data:`STANDARD_DEFINITION` when that is
-        the quasi-static ``static_torque`` (which needs ``torquesplit static``)."""
+        the quasi-static ``static_torque`` (which needs ``torquesplit static``); for a run
+        read back from a file, the definition it was saved with (``--definition``), so
+        that its metrics are the ones the file's tables hold."""
+        if self.saved_definition in ls.DYNAMIC_DEFINITIONS:
+            return self.saved_definition
         return default_definition(self.model)
 
     @cached_property
@@ -720,6 +728,13 @@ class Results:
                     data["descriptions"][ident] = " ".join(filter(None, (
                         data["descriptions"][ident], note)))
             data["units"].setdefault("time", "s")
+            if "first_settled_cycle" in data["names"]:
+                # MATLAB counts rows from 1: a reviewer's cycle_max_force(
+                # first_settled_cycle:end, k) took in one cycle before the settled span
+                ident = data["names"]["first_settled_cycle"]
+                data["descriptions"][ident] += (
+                    "; its row in the cycle arrays is first_settled_cycle + 1, e.g. "
+                    "max(cycle_max_force(first_settled_cycle(k)+1:end, k)) is peak_force(k)")
             data["model_json"] = ds.attrs["model_json"]
             data["metrics_json"] = ds.attrs.get("metrics_json", "")
             # (none: an empty cell, which isempty() sees; {''} counted one warning)
@@ -778,8 +793,11 @@ class Results:
         if met is not None:
             n_cyc = self.solution.cycle_start.shape[0]
             settled_header = [f"{m}_settled" for m in self.mesh_names]
-            settled_columns = [np.arange(n_cyc) >= met.settling.first_cycle[m]
-                               for m in self.mesh_names]
+            # (and only where the mesh has a complete cycle: a mesh of fewer cycles than
+            # the table's rows was flagged settled on its empty rows, an exports review)
+            complete = self.complete_cycles
+            settled_columns = [(np.arange(n_cyc) >= met.settling.first_cycle[m])
+                               & complete[:, j] for j, m in enumerate(self.mesh_names)]
             name = met.definition
             rows = [[r.mesh, r.group, r.nominal_force, r.static_force, r.mean_force,
                      r.peak_force, r.min_force, r.dynamic_factor,

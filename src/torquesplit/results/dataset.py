@@ -190,8 +190,9 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
         # inside metrics_json)
         ds["first_settled_cycle"] = _var(("mesh",), np.array(
             [met.settling.first_cycle[m] for m in meshes], dtype=np.int64), "1",
-            "first cycle of the settled span: peak_force, min_force and the coefficients "
-            "are over the cycles from this one on")
+            "first cycle of the settled span, a value of the cycle coordinate (counted "
+            "from 0): peak_force, min_force and the coefficients are over the cycles from "
+            "this one on")
         # each load-sharing group's and the system's numbers as variables too (for
         # xarray, MATLAB and spreadsheet users: not only inside metrics_json)
         groups = list(met.load_sharing.per_group)
