@@ -5,6 +5,7 @@ FileNotFoundError and an accepted rtol=2 before)."""
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import pytest
 
@@ -57,6 +58,9 @@ def test_a_model_text_given_for_a_path_is_told_how_to_pass_it():
 
 def test_paths_that_are_not_there_or_not_folders(tmp_path):
     with pytest.raises(OutputError, match=r"nope\.nc: no such file; give the \.nc file"):
+        torquesplit.load_results(tmp_path / "nope.nc")
+    # and what Python code that reads a file catches (an exports review)
+    with pytest.raises(FileNotFoundError, match="no such file"):
         torquesplit.load_results(tmp_path / "nope.nc")
     with pytest.raises(OutputError, match=r"no such file \(nor the folder"):
         torquesplit.load_results(tmp_path / "gone" / "nope.nc")
@@ -262,3 +266,52 @@ def test_campbell_and_steady_samples_refuse_counts_below_their_minimum():
         with pytest.raises(OptionError, match=pattern):
             st.samples(**kw)
     assert len(st.samples(n=8)[0]) == 8
+
+
+def test_a_folder_that_exists_but_takes_no_files_is_said_so():
+    """/proc: 'the folder /proc is not writable (No such file or directory)', of a folder
+    that is there (an exports review)."""
+    from torquesplit.results.files import check_writable_folder
+
+    if not Path("/proc").is_dir():
+        pytest.skip("no /proc on this system")
+    with pytest.raises(OutputError) as err:
+        check_writable_folder("/proc", "/proc/x.nc")
+    assert "No such file" not in str(err.value)
+    assert "/proc is not writable" in str(err.value)
+
+
+def test_a_file_of_another_kind_is_named_in_the_refusal(tmp_path):
+    """'report s.nc' of a quasi-static file said 'not a torquesplit results file of a
+    dynamic run' without the file's name (an exports review)."""
+    model = torquesplit.load_model(EXAMPLE)
+    static = torquesplit.quasi_static_load_sharing(model, revolutions=0.01).save(
+        tmp_path / "static.nc")
+    with pytest.raises(ValueError, match=r"static\.nc: not a torquesplit results file"):
+        torquesplit.load_results(static)
+
+
+def test_writing_figures_prints_no_font_lookup(caplog):
+    """A font cache without the STIX fonts made every math label print 'findfont: Font
+    family ['STIXGeneral'] not found' on the report's stderr (a reviewer)."""
+    import logging
+    import secrets
+
+    import matplotlib
+    from matplotlib.figure import Figure
+
+    from torquesplit.plot.figures import figure_svg
+
+    missing = f"NoSuchFont{secrets.token_hex(4)}"  # (findfont caches what it found)
+    lookup = logging.getLogger("matplotlib.font_manager")
+    with caplog.at_level(logging.WARNING, logger="matplotlib.font_manager"), \
+            matplotlib.rc_context({"font.family": [missing]}):
+        fig = Figure()
+        fig.suptitle(r"$K_\gamma$ of the sun")
+        svg = figure_svg(fig, "t")
+        assert not [r for r in caplog.records if r.name == "matplotlib.font_manager"]
+        from matplotlib.font_manager import FontProperties, findfont
+
+        findfont(FontProperties(family=[missing + "b"]))  # (said outside a save)
+    assert [r for r in caplog.records if r.name == "matplotlib.font_manager"]
+    assert "<svg" in svg and lookup.level == logging.NOTSET

@@ -175,6 +175,12 @@ class OutputError(TorquesplitError, OSError):
         return str(self.args[0]) if self.args else ""
 
 
+class MissingFileError(OutputError, FileNotFoundError):
+    """A file to read is not there (``load_results('nope.nc')``): an
+    :class:`OutputError` as every path problem is, and a :class:`FileNotFoundError`,
+    which is what Python code that reads files catches (an exports review)."""
+
+
 class OutputFormatError(OutputError, ValueError):
     """The output file's suffix names no format torquesplit writes (``.xlsx``)."""
 

@@ -148,6 +148,12 @@ def test_report_refuses_before_computing(tmp_path):
     assert res.exit_code == 2 and "exists; use --force" in res.stderr
     res = runner.invoke(app, ["report", str(tmp_path / "none.nc")])
     assert res.exit_code == 2 and "no such results file" in res.stderr
+    # another kind of torquesplit file is named (an exports review: it was not)
+    static = torquesplit.quasi_static_load_sharing(
+        torquesplit.load_model(model), revolutions=0.01).save(tmp_path / "static.nc")
+    res = runner.invoke(app, ["report", str(static)])
+    assert res.exit_code == 2
+    assert f"{static}: not a torquesplit results file of a dynamic run" in res.stderr
 
 
 def test_report_of_a_shipped_example_compares_with_the_paper(tmp_path):

@@ -1000,7 +1000,7 @@ def save_figure(fig: Figure, paths, *, dpi: int = 150) -> list[Path]:
     engine = fig.get_layout_engine()
     fig.set_layout_engine("none")  # keep it: every save would lay the figure out again
     out = []
-    with matplotlib.rc_context({"svg.fonttype": "none"}):
+    with matplotlib.rc_context({"svg.fonttype": "none"}), _quiet_font_fallback():
         for path in paths:
             path = Path(path)
             fig.savefig(path, dpi=dpi, bbox_inches=bbox,
@@ -1008,6 +1008,23 @@ def save_figure(fig: Figure, paths, *, dpi: int = 150) -> list[Path]:
             out.append(path)
     fig.set_layout_engine(engine)
     return out
+
+
+class _quiet_font_fallback:
+    """Silence matplotlib's font lookup while a figure is written: where its font cache
+    lacks the STIX fonts (a cache shared with a system matplotlib that ships without
+    them), every math label printed 'findfont: Font family ['STIXGeneral'] not found.
+    Falling back to DejaVu Sans' on the report's stderr (a reviewer), and the fallback
+    is what is drawn anyway.  Only for the duration of the save: no handler stays."""
+
+    def __enter__(self):
+        self._logger = logging.getLogger("matplotlib.font_manager")
+        self._level = self._logger.level
+        self._logger.setLevel(logging.ERROR)
+
+    def __exit__(self, *exc):
+        self._logger.setLevel(self._level)
+        return False
 
 
 def figure_svg(fig: Figure, salt: str) -> str:
@@ -1019,7 +1036,8 @@ def figure_svg(fig: Figure, salt: str) -> str:
     import matplotlib
 
     buffer = io.StringIO()
-    with matplotlib.rc_context({"svg.fonttype": "none", "svg.hashsalt": salt}):
+    with (matplotlib.rc_context({"svg.fonttype": "none", "svg.hashsalt": salt}),
+          _quiet_font_fallback()):
         fig.savefig(buffer, format="svg", bbox_inches="tight", pad_inches=0.1,
                     metadata={"Date": None})
     text = buffer.getvalue()

@@ -171,7 +171,10 @@ def _report_inputs(h, ux, source, assign, duration, cycles, definition, quiet):
                 with open_results(path) as ds:
                     ds.load()
                     attrs = results_attributes(ds)
-                    res = results_from_dataset(ds)
+                    try:
+                        res = results_from_dataset(ds)
+                    except OptionError as exc:  # (another kind of file: say which one)
+                        raise OptionError(f"{source}: {exc}") from None
         except (OSError, KeyError) as exc:
             raise OptionError(f"{source}: cannot read it as torquesplit results ({exc}); give "
                               f"a .nc file written by 'torquesplit run --out F.nc'") from None

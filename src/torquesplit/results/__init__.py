@@ -1029,8 +1029,7 @@ def open_results(path):
         return xr.open_dataset(path, engine="h5netcdf")
     except OSError as exc:
         if not Path(path).is_file():
-            from ..errors import OutputError
-
+            from ..errors import MissingFileError, OutputError
             from ..study.store import STORE_NAME
 
             where = Path(path)
@@ -1042,7 +1041,8 @@ def open_results(path):
             what = ("a folder, not a results file" if where.is_dir() else
                     "no such file" if where.parent.is_dir() else
                     f"no such file (nor the folder {where.parent})")
-            raise OutputError(f"{path}: {what}; give the .nc file a run saved "
+            error = OutputError if where.is_dir() else MissingFileError
+            raise error(f"{path}: {what}; give the .nc file a run saved "
                               f"(torquesplit run --out NAME.nc, or res.save('NAME.nc'))"
                               ) from None
         raise OptionError(
@@ -1059,7 +1059,10 @@ def load_results(path):
 
     with open_results(path) as ds:
         ds.load()
-        return results_from_dataset(ds)
+        try:
+            return results_from_dataset(ds)
+        except OptionError as exc:  # (which file: 'report s.nc' did not say)
+            raise type(exc)(f"{path}: {exc}") from None
 
 
 def model_from_results(dataset):

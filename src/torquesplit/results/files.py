@@ -239,6 +239,10 @@ def check_writable_folder(folder, target=None) -> None:
             os.close(os.open(probe, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600))
         except OSError as exc:
             reason = exc.strerror or exc.__class__.__name__
+            if exc.errno == errno.ENOENT and folder.is_dir():
+                # (/proc: 'not writable (No such file or directory)' of a folder that
+                # exists, a reviewer)
+                reason = "it accepts no new files"
         else:
             with contextlib.suppress(OSError):
                 os.unlink(probe)
