@@ -922,8 +922,9 @@ def static(
                                    "says so).", metavar="N"),
     out: Optional[Path] = typer.Option(
         None, "--out", metavar="FILE",
-        help="Write results: .nc (NetCDF), .mat (MATLAB) or .csv (NAME.csv per position, "
-             "NAME_mesh.csv per mesh, NAME_group.csv per group, NAME_about.json)."),
+        help="Write results: .nc (NetCDF), .mat (MATLAB) or .csv (NAME.csv per mesh, "
+             "NAME_groups.csv per group and the system, NAME_history.csv per position, "
+             "NAME_about.json)."),
     force: bool = _flag("--force", "Replace an existing results file and figures."),
     plots: Optional[Path] = typer.Option(None, "--plots", help="Write report figures (PNG, "
                                          "SVG) into this folder.", metavar="DIR"),
@@ -953,9 +954,11 @@ def static(
                      force=force)
             opts.raise_any(model, assign)
             if out is not None:
-                # (the CSV tables: per position, per mesh, per planet of a stage)
+                # (the CSV tables: per mesh, per position, per group, per planet of a
+                # stage)
                 plan = _out_option(check_dataset_output, out,
-                                   ("time", "mesh", "planet_entity"), overwrite=force)
+                                   ("mesh", "time", "group", "planet_entity"),
+                                   overwrite=force)
                 stack.enter_context(files.claim_output(plan))
             m, _ = _load(model, assign)
             from .quasistatic import quasi_static_load_sharing

@@ -15,13 +15,13 @@ import json
 import math
 import numbers
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
 from . import _json
 from .assembly.structure import dof_units
 from .errors import ModelWarning, OptionError, SolverError, warn_user
-
 from .metrics import load_sharing as ls
 from .model.io import load_model
 from .model.kinematics import solve_kinematics
@@ -109,8 +109,8 @@ class QuasiStaticResults:
         group_of = {m: g for g, ms in met.groups.items() for m in ms}
         ds = xr.Dataset(
             {
-                "mesh_force": (("time", "mesh"), forces,
-                               {"units": "N", "long_name": "quasi-static mesh force"}),
+                # (per mesh first: a .csv set's NAME.csv is then a row per mesh, as a
+                # run's is, and the positions are NAME_history.csv)
                 "load_sharing": (("mesh",), [met.per_mesh[m] for m in self.mesh_names],
                                  {"units": "1",
                                   "long_name": "static torque ratio, largest over positions"}),
@@ -123,6 +123,8 @@ class QuasiStaticResults:
                                               f"positions"})
                    for k, word, f in (("min", "smallest", np.min), ("mean", "mean", np.mean),
                                       ("peak", "largest", np.max))},
+                "mesh_force": (("time", "mesh"), forces,
+                               {"units": "N", "long_name": "quasi-static mesh force"}),
                 "load_sharing_group": (("group",), [met.per_group[g] for g in met.groups],
                                        {"units": "1", "long_name": "static torque ratio of "
                                         "the group: its largest member's"}),
@@ -173,12 +175,32 @@ class QuasiStaticResults:
 
     def save(self, path, *, overwrite: bool = False):
         """Save by suffix: ``.nc`` NetCDF, ``.mat`` MATLAB, ``.csv`` spreadsheet tables
-        (``NAME.csv`` a row per position, ``NAME_mesh.csv`` a row per mesh; see
-        :mod:`torquesplit.results.export`); atomically, an existing file kept unless
-        ``overwrite``.  Returns the path written."""
-        from .results.export import save_dataset
+        named as a run's are (``NAME.csv`` a row per mesh, ``NAME_groups.csv`` a row per
+        load-sharing group and one for the system, ``NAME_history.csv`` a row per
+        position; see :mod:`torquesplit.results.export`); atomically, an existing file
+        kept unless ``overwrite``.  Returns the path written."""
+        from .results.export import DATASET_FORMATS, save_dataset
 
-        return save_dataset(self.to_dataset(), path, overwrite=overwrite)
+        ds = self.to_dataset()
+        if DATASET_FORMATS.get(Path(path).suffix.lower()) == "table":
+            ds = system_as_group_row(ds)
+        return save_dataset(ds, path, overwrite=overwrite)
+
+
+def system_as_group_row(ds):
+    """``ds`` with the system's coefficient as the ``(system)`` row of the groups, as a
+    run's NAME_groups.csv has it: a scalar is a column of the first table, which repeated
+    it on every row (an exports review)."""
+    import xarray as xr
+
+    if "load_sharing_system" not in ds or "load_sharing_group" not in ds:
+        return ds
+    system = ds["load_sharing_group"].isel(group=[0]).copy(
+        data=[float(ds["load_sharing_system"])]).assign_coords(group=["(system)"])
+    groups = xr.concat([ds["load_sharing_group"], system], dim="group")
+    out = ds.drop_vars(["load_sharing_system", "load_sharing_group"]).drop_dims("group")
+    out["load_sharing_group"] = groups
+    return out
 
 
 def slowest_gear(kin) -> tuple[str, float, str | None]:

@@ -100,7 +100,9 @@ def test_static_writes_matlab_and_spreadsheet_files(tmp_path):
     assert r.exit_code == 0, r.output
     data = json.loads(r.output)
     share = data["load_sharing"]["per_mesh"]
-    header, rows = _read(tmp_path / "q_mesh.csv")
+    # named as a run's tables are (an exports review: NAME_mesh.csv, NAME_group.csv and
+    # a NAME.csv per position beside a run's NAME.csv per mesh and NAME_groups.csv)
+    header, rows = _read(tmp_path / "q.csv")
     col = {h: i for i, h in enumerate(header)}
     assert {row[0]: float(row[col["load_sharing"]]) for row in rows} == pytest.approx(
         share, rel=1e-12)
@@ -110,12 +112,22 @@ def test_static_writes_matlab_and_spreadsheet_files(tmp_path):
         # (named as a run's: peak_force, not max_force)
         for name, k in (("min", "min"), ("mean", "mean"), ("peak", "max")):
             assert float(row[col[f"{name}_force_N"]]) == pytest.approx(printed[k], rel=1e-12)
-    header, groups = _read(tmp_path / "q_group.csv")
+    header, groups = _read(tmp_path / "q_groups.csv")
     assert header == ["group", "load_sharing_group"]
-    assert {g: float(v) for g, v in groups} == pytest.approx(
+    # the system as a row of its own, as a run's groups table has it (it was a column of
+    # the positions' table, the same number on every row)
+    assert groups[-1][0] == "(system)"
+    assert float(groups[-1][1]) == pytest.approx(data["load_sharing"]["system"], rel=1e-12)
+    assert {g: float(v) for g, v in groups[:-1]} == pytest.approx(
         data["load_sharing"]["per_group"], rel=1e-12)
-    header, rows = _read(tmp_path / "q.csv")
+    header, rows = _read(tmp_path / "q_history.csv")
     assert header[:2] == ["time_s", "mesh_force_m11_N"] and "displacement_z1.theta_rad" in header
+    assert not any("system" in h for h in header)
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        "q.csv", "q_about.json", "q_groups.csv", "q_history.csv"]
+    # the metrics in the about file as JSON, not a JSON text inside it
+    about = json.loads((tmp_path / "q_about.json").read_text())
+    assert about["attributes"]["metrics"]["per_mesh"] == pytest.approx(share, rel=1e-12)
     r = CliRunner().invoke(app, args + ["--out", str(tmp_path / "q.mat")])
     assert r.exit_code == 0, r.output
     data = scipy.io.loadmat(tmp_path / "q.mat", simplify_cells=True)
@@ -127,10 +139,12 @@ def test_static_writes_matlab_and_spreadsheet_files(tmp_path):
     assert data["load_sharing_system"] == pytest.approx(
         json.loads(data["metrics_json"])["system"], rel=1e-15)
     # a companion that exists is refused before the sweep, not after it
-    (tmp_path / "x_mesh.csv").write_text("")
-    r = CliRunner().invoke(app, args + ["--out", str(tmp_path / "x.csv")])
-    assert r.exit_code == 2 and "x_mesh.csv exists" in r.output
-    assert "quasi-static" not in r.output
+    for companion in ("x_history.csv", "x_groups.csv"):
+        (tmp_path / companion).write_text("")
+        r = CliRunner().invoke(app, args + ["--out", str(tmp_path / "x.csv")])
+        assert r.exit_code == 2 and f"{companion} exists" in r.output
+        assert "quasi-static" not in r.output
+        (tmp_path / companion).unlink()
 
 
 def test_the_campbell_map_is_written_where_asked(tmp_path):

@@ -6,7 +6,9 @@ opens (Python, MATLAB, a spreadsheet), safely (:mod:`torquesplit.results.files`)
 A dynamic run has its own richer writer (``Results.save``).
 
 CSV: one table per *row dimension* (the first dimension of each variable, in order):
-``NAME.csv`` for the first, ``NAME_<dim>.csv`` beside it for each other, and
+``NAME.csv`` for the first, ``NAME_<dim>.csv`` beside it for each other (named as a
+run's tables are where a run has the same one: ``NAME_history.csv`` along time,
+``NAME_groups.csv`` per load-sharing group, :data:`TABLE_FILES`), and
 ``NAME_about.json`` (provenance, model, warnings, the Dataset's attributes).  A row per
 coordinate value; a 1-D variable is one column, a variable with more dimensions one
 column per label of the others (``dynamic_factor_m11``); every column's unit is in its
@@ -36,6 +38,18 @@ __all__ = ["DATASET_FORMATS", "row_dims", "check_dataset_output", "save_dataset"
            "dataset_files"]
 
 
+#: row dimension -> the name of its table beside ``NAME.csv`` where it is not the
+#: dimension's own: a run's CSV set names these so (a quasi-static sweep's were
+#: NAME_time.csv and NAME_group.csv beside a run's NAME_history.csv and NAME_groups.csv,
+#: an exports review)
+TABLE_FILES = {"time": "history", "group": "groups"}
+
+
+def table_path(path: Path, dim: str) -> Path:
+    """The file of the table whose rows run along ``dim``, beside ``path`` (NAME.csv)."""
+    return path.with_name(f"{path.stem}_{TABLE_FILES.get(dim, dim)}.csv")
+
+
 def row_dims(ds) -> tuple[str, ...]:
     """The row dimension of each CSV table: the first dimension of each data variable, in
     the order the variables come (a Dataset of scalars only: the table '' of one row)."""
@@ -56,7 +70,7 @@ def check_dataset_output(path, tables: tuple[str, ...] = (), *, overwrite: bool 
     plan = files.check_output(path, formats=DATASET_FORMATS, overwrite=overwrite, what=what)
     if plan.format != "table":
         return plan
-    extra = tuple(plan.path.with_name(f"{plan.path.stem}_{d}.csv") for d in tables[1:])
+    extra = tuple(table_path(plan.path, d) for d in tables[1:])
     extra += (files.about_path(plan.path),)
     for f in extra:
         if (f.exists() or f.is_symlink()) and not overwrite:
@@ -220,6 +234,13 @@ def _write(ds, plan: files.OutputPlan, claim: files.OutputClaim) -> Path:
         warnings = json.loads(ds.attrs["warnings_json"]) if "warnings_json" in ds.attrs else []
         rest = {k: v for k, v in ds.attrs.items()
                 if k not in ("model_json", "warnings", "warnings_json")}
+        # a JSON text attribute as the object it is (the metrics were a string inside
+        # the JSON file, an exports review): metrics_json -> metrics
+        for k in [k for k in rest if k.endswith("_json") and isinstance(rest[k], str)]:
+            try:
+                rest[k[:-len("_json")]] = json.loads(rest.pop(k))
+            except ValueError:
+                rest[k] = ds.attrs[k]
         contents[files.about_path(plan.path)] = files.about_bytes(
             claim.run_id, ds.attrs.get("model_json"), warnings, attributes=rest,
             files=plan.files)
@@ -248,8 +269,9 @@ def dataset_files(ds, path) -> list[Path]:
 
 
 #: named so, left from an earlier save of another shape, are removed with it
-KNOWN_TABLES = ("time", "mesh", "planet_entity", "dof", "mode", "point", "check", "speed",
-                "crossing", "position", "slice", "harris_load")
+KNOWN_TABLES = ("time", "mesh", "group", "planet_entity", "dof", "mode", "point", "check",
+                "speed", "crossing", "position", "slice", "harris_load") + tuple(
+    TABLE_FILES.values())
 
 
 def save_dataset(ds, path, *, overwrite: bool = False) -> Path:
@@ -266,7 +288,7 @@ def save_dataset(ds, path, *, overwrite: bool = False) -> Path:
     with files.claim_output(plan) as claim:
         out = _write(ds, plan, claim)
     if plan.format == "table" and overwrite:  # (replacing: no stale companion beside it)
-        for d in KNOWN_TABLES:
+        for d in KNOWN_TABLES:  # (and by their earlier names: NAME_time.csv)
             old = plan.path.with_name(f"{plan.path.stem}_{d}.csv")
             if old not in plan.files and old.is_file():
                 old.unlink()
