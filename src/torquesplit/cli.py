@@ -868,9 +868,9 @@ def bearing_table(bearings: list[dict], res) -> Table:
     cols = ["body", "mean force by direction\n[kN]", "|mean|\n[kN]", "peak |F|\n[kN]"]
     for col in cols + (["directions in"] if turning else []):
         b.add_column(_h(col), justify="left" if col in ("body", "directions in") else "right")
-    # a force below 1e-9 of the largest bearing force is round-off (the sun of a
-    # symmetric planetary stage: x 6.0984e-17 kN, peak 3.6e-15 kN): 0
-    tiny = 1e-9 * max((r["peak_magnitude"] for r in bearings), default=0.0)
+    from .results import bearing_round_off
+
+    tiny = bearing_round_off(bearings)  # (round-off, written 0)
 
     def kn(v):
         return f"{(0.0 if abs(v) <= tiny else v) / 1e3:#.5g}"

@@ -52,6 +52,7 @@ def test_sweep_one_liner(tmp_path, split_file):
                            "--workers", "1", "--out", str(out), "--json", "--quiet"]))
     assert data["cases"] == 3 and data["status"] == {"ok": 3}
     assert data["coordinates"]["constant"] == pytest.approx([0.0, 5e-6, 1e-5])
+    assert data["coordinate_units"] == {"constant": "m"}  # (SI: 5e-06 said no unit)
     lsc = data["outputs"]["load_sharing.cycle_peak"]
     assert lsc[0] < lsc[1] < lsc[2]
     bad = runner.invoke(app, ["sweep", str(split_file), "--vary", "meshes.a1.stiffness=1:2"])

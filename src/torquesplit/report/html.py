@@ -306,14 +306,16 @@ def _run_section(res, met) -> str:
 
 
 def _bearings(bearings: list[dict], res) -> str:
-    """The bearing table the run prints (kN; a force a million times below the largest
-    is rounding, written 0), or nothing for a model without supports."""
+    """The bearing table the run prints (kN; round-off, :func:`~torquesplit.results.
+    bearing_round_off`, written 0), or nothing for a model without supports."""
+    from ..results import bearing_round_off
+
     if not bearings:
         return ""
-    big = max(b["peak_magnitude"] for b in bearings) or 1.0
+    tiny = bearing_round_off(bearings)
 
     def kn(v):
-        return "0" if abs(v) < 1e-6 * big else _g(v / 1e3)
+        return "0" if abs(v) <= tiny else _g(v / 1e3)
 
     per = ("every step" if res.history_keeps_every_step() else
            f"{res.history_samples_per_period():.3g} samples per shortest mesh period")

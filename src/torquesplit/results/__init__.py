@@ -924,6 +924,14 @@ class Results:
         return model_to_json(self.model)
 
 
+def bearing_round_off(bearings: list[dict]) -> float:
+    """The bearing force below which a table writes 0 [N]: 1e-9 of the largest peak, the
+    round-off of a force that cancels (the sun of a symmetric planetary stage: x 6e-17
+    kN).  One bound for the terminal and the report (the report's 1e-6 wrote a real
+    0.6 N of a 600 kN drive as 0, an exports review)."""
+    return 1e-9 * max((b["peak_magnitude"] for b in bearings), default=0.0)
+
+
 def default_definition(model) -> str:
     """The dynamic load-sharing definition a run of ``model`` reports by default: its
     ``[analysis] load_sharing``, or :data:`STANDARD_DEFINITION` for the quasi-static

@@ -432,14 +432,17 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
     out_vars = [v for v in ds.data_vars if "output" in ds[v].attrs]
     figs = sorted(str(p) for p in (out / "figures").glob("*.png")) if figures else []
     if as_json:
+        coords = [c for c in ds.coords if c not in ("output", "factor")
+                  and ds[c].dtype.kind == "f"]
         data = {"study": ds.attrs["study_name"], "design": ds.attrs["design"],
                 "cases": int(status.size), "status": counts,
                 "results_file": str(out / "results.nc"),
                 "results_files": [str(out / f"results.{x}") for x in ("nc", "csv", "mat")],
                 "figures": figs,
                 "coordinates": {c: [float(x) for x in np.ravel(ds[c].values)]
-                                for c in ds.coords if c not in ("output", "factor")
-                                and ds[c].dtype.kind == "f"},
+                                for c in coords},
+                # (SI, as the outputs: a reviewer read 5e-05 without a unit)
+                "coordinate_units": {c: ds[c].attrs.get("units", "") for c in coords},
                 "outputs": {ds[v].attrs["output"]: [_num(x) for x in ds[v].values.ravel()]
                             for v in out_vars},
                 # each list runs over these dimensions, the last fastest (C order)
