@@ -363,7 +363,7 @@ def test_pdf_keeps_the_html_and_says_how_to_print_it(tmp_path):
 
 def test_a_small_bearing_force_is_not_written_as_zero():
     """An exports review: the report wrote a force under 1e-6 of the largest as 0 (a real
-    0.6 N beside 600 kN) where the terminal's table, with its 1e-9 bound, printed it."""
+    0.5 N beside 600 kN) where the terminal's table, with its 1e-9 bound, printed it."""
     from types import SimpleNamespace
 
     from torquesplit.report.html import _bearings
@@ -373,8 +373,8 @@ def test_a_small_bearing_force_is_not_written_as_zero():
                 "mean": [f], "mean_magnitude": f, "peak_magnitude": f}
 
     res = SimpleNamespace(history_keeps_every_step=lambda: True)
-    page = _bearings([bearing("big", 6e5), bearing("small", 0.6),
+    page = _bearings([bearing("big", 6e5), bearing("small", 0.5),
                       bearing("cancels", 6e-5)], res)
     cells = re.findall(r"<td[^>]*>([^<]*)</td>", page)
-    assert cells[cells.index("small") + 2] == "0.0006"
+    assert cells[cells.index("small") + 2] == "0.0005"
     assert cells[cells.index("cancels") + 2] == "0"
