@@ -221,6 +221,27 @@ def test_auto_takes_literal_code_only_where_it_repays_its_compilation(monkeypatc
     np.testing.assert_array_equal(short.y_final, long.y_final)
 
 
+def test_runs_of_the_same_values_repay_the_literal_code_together(monkeypatch):
+    """A study's cases that vary only the errors share one literal code, which one case
+    alone may not repay: the second run of the same values (with the pattern's code
+    before) takes it; other values do not count towards it."""
+    monkeypatch.setattr(codegen._COMPILER, "_literal", {})
+    monkeypatch.setattr(codegen._COMPILER, "_demand", {})
+    s, other = spur_pair(torque=13.0), spur_pair(torque=31.0)
+    y0 = np.zeros(2 * s.n_dof)
+    n_rhs = 4 * 100  # (100 RK4 steps)
+    monkeypatch.setattr(codegen, "literal_break_even", lambda model: 1.5 * n_rhs)
+    codegen.generated_rhs(kernel_model(s))  # (the pattern: "auto" generates)
+    runs = [integrate(x, y0, (0.0, 1e-4), step=1e-6) for x in (s, other, s, s)]
+    assert [r.rhs for r in runs] == ["generated", "generated", "literal", "literal"]
+    np.testing.assert_array_equal(runs[0].y_final, runs[2].y_final)
+    assert codegen._COMPILER.demand(kernel_model(other)) == n_rhs
+    # at most DEMAND_KEYS sets of values remembered, the oldest dropped
+    monkeypatch.setattr(codegen, "DEMAND_KEYS", 1)
+    codegen.note_pattern_run(kernel_model(s), 1.0)
+    assert codegen._COMPILER.demand(kernel_model(other)) == 0.0
+
+
 def test_literal_codes_are_capped_per_process(monkeypatch):
     """MCJIT never frees code: beyond LITERAL_MAX the runs take the pattern's code, and
     asking for a literal one by name still runs (the same results)."""

@@ -985,6 +985,8 @@ def _rhs_code(kind: str, model, n_rhs: float, literal: bool = True) -> codegen.G
     use_literal = literal and (
         (kind == "literal" and codegen._COMPILER.literal_available(model))
         or (kind == "auto" and codegen.worth_literal(model, n_rhs)))
+    if literal and kind == "auto" and not use_literal:
+        codegen.note_pattern_run(model, n_rhs)  # (the next run of these values may)
     try:
         return codegen.generated_rhs(model, use_literal)
     except Exception as exc:  # noqa: BLE001 - any failure falls back, with a warning
