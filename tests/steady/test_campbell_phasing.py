@@ -111,6 +111,13 @@ def test_the_campbell_table_and_json_say_which_are_suppressed():
     assert res.exit_code == 0, res.output
     assert "phasing" in res.stdout and "suppressed" in res.stdout
     assert "Parker & Lin 2004" in res.stdout
+    # a constant mesh stiffness without errors has no harmonic to cancel, and the
+    # phasing column gives the phasing's verdict: '0 (cancels)' beside 'excited' read as
+    # a contradiction (a planetary reviewer)
+    rows = [line for line in res.stdout.splitlines() if " x meshes " in line]
+    assert rows and not any("(cancels)" in line for line in rows)
+    assert sum("not suppressed" in line for line in rows) == len(data["critical_speeds"])
+    assert not any(" excited " in line for line in rows)
 
 
 def test_the_report_mode_table_marks_suppressed_orders():
@@ -125,6 +132,19 @@ def test_the_report_mode_table_marks_suppressed_orders():
     model = load_model(example_path("ji_li_mill_drive"))
     html = _modes(SimpleNamespace(model=model, kinematics=solve_kinematics(model)))
     assert "suppressed" not in html and "Parker" not in html
+    # with the static state the forces' cancellation is judged: a constant stiffness
+    # has no harmonic to cancel (it said 'forces cancel' on every unsuppressed order)
+    # (at 1835 rpm twice the mesh frequency is near the rotational mode 9, 1970 Hz,
+    # which the phasing lets through)
+    from torquesplit.model.io import model_from_dict
+    from torquesplit.model.overrides import apply_overrides, read_raw
+
+    data = apply_overrides(read_raw(example_path("lin_parker1999_planetary")),
+                           {"drives.input.speed": "1835 rpm"})
+    res = torquesplit.simulate(load_model(model_from_dict(data, source="lp")), cycles=3)
+    table = _modes(res).split("</table>")[0]
+    assert "(suppressed by phasing)" in table and "(forces cancel)" not in table
+    assert "2×stage_sun_planet1," in table  # (an order near a mode, not suppressed)
 
 
 def test_the_campbell_figure_draws_suppressed_crossings_apart(lp_map):

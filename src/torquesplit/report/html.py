@@ -405,12 +405,13 @@ def _modes(res) -> str:
 
     def cancels(name: str, k: int, mode: int) -> bool:
         """The meshes of that frequency exert no force of harmonic k on the mode (their
-        phases cancel it: steady.maps._modal_force_share)."""
+        phases cancel it: steady.maps._modal_force_share); not where they have no such
+        harmonic at all (constant stiffness, no error: nothing to cancel)."""
         if structure is None or q is None:
             return False
         share = _modal_force_share(structure, q, rep.solution.mode_shapes[:, mode - 1],
                                    group_of.get(name, [name]), k)
-        return share is None or share < CANCELLED
+        return share is not None and share < CANCELLED
 
     rows = []
     for r in rep.rows:

@@ -871,13 +871,18 @@ def campbell_command(m, start, stop, plot, as_json, console, json_default, out=N
     for col in cols + ["strain energy (largest shares)"]:
         t.add_column(_h(col))
     for c in crossings:
+        # (the phasing's verdict, not the excitation's: 'excited' beside a harmonic of
+        # 0 read as a contradiction, a planetary reviewer)
         extra = ([mode_kind(c) if c.get("mode_type") else "-",
-                  "suppressed" if c["suppressed"] else "excited"]
+                  "suppressed" if c["suppressed"] else "not suppressed"]
                  if phased else [])
         k_h, err = c.get("stiffness_harmonic"), c.get("error_share")
         f_h = c.get("force_harmonic")
-        # (a harmonic whose meshes' forces cancel on the mode drives nothing there)
-        cancels = " (cancels)" if c.get("stiffness_cancelled") else ""
+        # (a harmonic whose meshes' forces cancel on the mode drives nothing there; a
+        # harmonic of 0 has nothing to cancel: constant mesh stiffness without errors
+        # printed '0 (cancels)')
+        there = max(f_h or 0.0, k_h or 0.0) > 0.0
+        cancels = " (cancels)" if c.get("stiffness_cancelled") and there else ""
         t.add_row(f"{c['speed_rpm']:#.6g}", str(c["mode"]), f"{c['frequency_Hz']:#.6g}",
                   f"{c['order']} x {c['source']}",
                   "-" if f_h is None else f"{100 * f_h:.3g}{cancels}",
