@@ -88,6 +88,10 @@ _PAIR_PREFIX = re.compile(r"^gears '[^']*' and '[^']*': ")
 """A mesh issue's prefix naming its pair (the location names the mesh too)."""
 
 
+#: messages about a field itself, said once per field (never one line for several)
+_OWN_PROBLEMS = ("required field is missing", "an item is missing")
+
+
 class ModelError(TorquesplitError, ValueError):
     """A model file or model object is invalid.
 
@@ -114,9 +118,13 @@ class ModelError(TorquesplitError, ValueError):
         self.source = source
         # one cause at several places (a profile shift that breaks every mesh of a gear
         # and the placement of its mates): one line naming the places
-        groups: dict[str, list[tuple[str, str]]] = {}
+        # (not a field's own problem, which is no common cause: two missing fields in
+        # two tables were one line with the first one's line number, a reviewer)
+        groups: dict = {}
         for loc, msg in self.issues:
-            groups.setdefault(_PAIR_PREFIX.sub("", msg) if loc else msg, []).append((loc, msg))
+            core = _PAIR_PREFIX.sub("", msg) if loc else msg
+            key = (core, loc) if core.startswith(_OWN_PROBLEMS) else core
+            groups.setdefault(key, []).append((loc, msg))
         def where(loc: str) -> str:
             if not source:
                 return ""
@@ -128,7 +136,7 @@ class ModelError(TorquesplitError, ValueError):
             return clip_text(source, 2 * QUOTE_LIMIT) + (f":{line}" if line else "") + ": "
 
         text = []
-        for core, members in groups.items():
+        for members in groups.values():
             if len(members) == 1:
                 loc, msg = members[0]
                 text.append(where(loc) + (f"{loc}: " if loc else "") + msg)
@@ -137,6 +145,7 @@ class ModelError(TorquesplitError, ValueError):
             first = named[0] if named else ""
             if len(named) > 10:
                 named = named[:9] + [f"{len(named) - 9} more"]
+            core = _PAIR_PREFIX.sub("", members[0][1]) if members[0][0] else members[0][1]
             text.append(where(first) + (f"{', '.join(named)}: " if named else "") + core)
         super().__init__("\n".join(text))
 

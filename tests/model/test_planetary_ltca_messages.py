@@ -96,7 +96,7 @@ def test_ltca_tables_at_a_load_the_mesh_does_not_carry_are_said():
     assert ltca_load(even, even.metrics()) == []
 
 
-def test_every_problem_of_a_planetary_stage_is_said_at_once():
+def test_every_problem_of_a_planetary_stage_is_said_at_once(tmp_path):
     """A stage with five planets that break the assembly condition and overlap, or with
     two pin errors for three planets and a ring that cannot mesh, said one problem per
     attempt."""
@@ -110,8 +110,16 @@ def test_every_problem_of_a_planetary_stage_is_said_at_once():
                              extra='pin_errors = [{tangential = "5 um"}, {}]\n')
     with pytest.raises(ModelError) as info:
         torquesplit.load_model(tomllib.loads(text))
-    assert [loc for loc, _ in info.value.issues] == ["planetary.0.pin_errors",
-                                                     "planetary.0.ring.teeth"]
+    # (the tooth counts together: the stage, not the ring's line, which a --set of the
+    # sun's teeth was blamed on, a planetary reviewer)
+    assert [loc for loc, _ in info.value.issues] == ["planetary.0.pin_errors", "planetary.0"]
+    assert info.value.issues[1][1].startswith("sun 24, planet 30 and ring 85 teeth: ")
+    model = tmp_path / "stage.toml"
+    model.write_text(three_planet_toml("two", teeth=(24, 30, 84)))
+    res = CliRunner().invoke(app, ["check", str(model), "--set", "planetary.0.sun.teeth=25"])
+    assert res.exit_code == 2
+    assert "with --set planetary.0.sun.teeth=25: planetary.0: sun 25, planet 30" in res.output
+    assert "ring.teeth" not in res.output
 
 
 def test_contact_says_every_bad_load_with_the_models_problems(tmp_path, monkeypatch):
@@ -147,3 +155,27 @@ def test_an_internal_sun_or_planet_is_told_why_not(member, said):
     data["planetary"][0][member]["kind"] = "internal"
     with pytest.raises(ModelError, match=rf"planetary\.0\.{member}\.kind: {said}"):
         torquesplit.load_model(data)
+
+
+def test_missing_fields_of_two_tables_are_two_lines_each_at_its_table(tmp_path):
+    """A planetary reviewer: two missing fields in different tables came out as one line
+    with the first one's line number ('m.toml:90: drives.input.body, planetary.0.module:
+    required field is missing'); and a carrier without the mass its DOFs need was not
+    said beside a missing planet tooth count (the expansion it is checked in never ran)."""
+    text = (torquesplit.example_path("lin_parker1999_planetary")).read_text()
+    text = text.replace('module = "2.25 mm"', "", 1).replace('body = "stage_sun"\n', "", 1)
+    model = tmp_path / "m.toml"
+    model.write_text(text)
+    res = CliRunner().invoke(app, ["check", str(model)])
+    assert res.exit_code == 2
+    lines = [x for x in res.output.splitlines() if "required field is missing" in x]
+    assert len(lines) == 2, res.output
+    assert any(":49: planetary.0.module:" in x for x in lines)  # (its [[planetary]] table)
+    assert any(": drives.input.body:" in x and ":49:" not in x for x in lines)
+    text = (torquesplit.example_path("lin_parker1999_planetary")).read_text()
+    text = text.replace('mass = "5.43 kg"', "", 1).replace("teeth = 48 ", "", 1)
+    model.write_text(text)
+    with pytest.raises(ModelError) as info:
+        torquesplit.load_model(model)
+    assert [loc for loc, _ in info.value.issues] == ["planetary.0.planet.teeth",
+                                                     "planetary.0.carrier.mass"]

@@ -194,13 +194,13 @@ def _format_errors(exc: pydantic.ValidationError, data=None) -> list[tuple[str, 
         parts = [str(p) for p in err["loc"] if not _is_internal_tag(p)]
         error = (err.get("ctx") or {}).get("error")
         base = list(parts)
-        if isinstance(error, FieldError):
+        if isinstance(error, FieldError) and error.field:  # ('': the section itself)
             parts.append(error.field)
         loc = ".".join(_as_written(data, parts))
         msg = _message(err, parts, _written(data, parts))
         found = [(loc, msg)]
         if isinstance(error, FieldError):  # the section's other problems
-            found += [(".".join(base + [f]), m) for f, m in error.more]
+            found += [(".".join(base + [f] if f else base), m) for f, m in error.more]
         for key in found:
             if key not in seen:
                 seen.add(key)

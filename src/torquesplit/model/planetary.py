@@ -72,6 +72,7 @@ from .schema import (
     _check_rim,
     _stiffness_shorthand,
     _unique_dofs,
+    _needs_mass,
 )
 
 #: relative tolerance of the assembly condition (a whole number of teeth)
@@ -143,6 +144,9 @@ class PlanetaryCarrier(Strict):
     @model_validator(mode="after")
     def _dofs(self):
         _unique_dofs(self.dofs)
+        # (here, not only on the body it expands to: beside another problem of the
+        # stage, which stops the expansion, it was not said)
+        _needs_mass(self.dofs, self.mass)
         return self
 
 
@@ -416,7 +420,10 @@ class Planetary(Strict):
         zs, zp, zr = self.sun.teeth, self.planet.teeth, self.ring.teeth
         if abs(a_sp - a_rp) > 1e-6 * a_sp:
             shift = self._closing_sun_shift(a_rp)
-            raise FieldError("ring.teeth", (
+            # (the stage, not one member: which count is wrong is the user's call, and
+            # a --set of the sun's was blamed on the ring's line, a planetary reviewer)
+            raise FieldError("", (
+                f"sun {zs}, planet {zp} and ring {zr} teeth: "
                 f"the planets cannot mesh with sun and ring at once: the sun-planet centre "
                 f"distance is {a_sp * 1e3:.4f} mm, the planet-ring one {a_rp * 1e3:.4f} mm; "
                 f"without profile shifts the ring needs z_s + 2 z_p = {zs + 2 * zp} teeth"

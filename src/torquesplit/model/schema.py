@@ -480,10 +480,15 @@ class Body(Strict):
     def _consistent(self):
         _check_axis(self.axis)
         _unique_dofs(self.dofs)
-        if any(d != "theta" for d in self.dofs) and self.mass is None:
-            raise FieldError("mass", "a body with translational DOFs needs a mass; add "
-                             "mass = '12.5 kg' (your value), or remove x, y, z, loa from 'dofs'")
+        _needs_mass(self.dofs, self.mass)
         return self
+
+
+def _needs_mass(dofs, mass) -> None:
+    """A body with translational DOFs has a mass."""
+    if any(d != "theta" for d in dofs) and mass is None:
+        raise FieldError("mass", "a body with translational DOFs needs a mass; add "
+                         "mass = '12.5 kg' (your value), or remove x, y, z, loa from 'dofs'")
 
 
 def _unique_dofs(dofs):
