@@ -147,3 +147,36 @@ def test_a_floating_sun_among_unequally_spaced_planets_is_said_to_float():
     assert "floats, held by its meshes alone" in msg and "would deflect" not in msg
     (loc, msg), = _warnings(_supported("1 N/m"))
     assert "would deflect" in msg
+
+
+def test_a_sun_said_to_float_is_not_warned_of_floating():
+    """The floating-sun recipe warned on every command, and the warning said to accept
+    it (a planetary reviewer): ``support = {floating = true}`` says it once, in the
+    model, with a negligible stiffness; a gear with fewer than three meshes that cannot
+    centre it is still warned that it deflects."""
+    from torquesplit.model.schema import FLOATING_STIFFNESS, Support
+
+    assert Support.model_validate({"floating": True}).stiffness == FLOATING_STIFFNESS == 1.0
+    changes = {"planetary.0.sun.support.stiffness": "1 N/m",
+               "planetary.0.sun.support.floating": True,
+               "planetary.0.angles": ["0 deg", "80 deg", "180 deg", "270 deg"]}
+    m = torquesplit.load_model("lin_parker1999_planetary", changes=changes)
+    sun = next(n for n in m.gears if n.endswith("_sun"))
+    assert m.gears[sun].support.floating and m.gears[sun].support.stiffness == 1.0
+    assert not [w for w in compliance_warnings(m, solve_kinematics(m))
+                if w[0].startswith(f"gears.{sun}.")]
+    # the same sun written the old way is warned, and told of the field
+    del changes["planetary.0.sun.support.floating"]
+    m = torquesplit.load_model("lin_parker1999_planetary", changes=changes)
+    msg = dict(compliance_warnings(m, solve_kinematics(m)))[f"gears.{sun}.support.stiffness"]
+    assert "floating = true" in msg and "accepted_warnings" not in msg
+    # one mesh cannot centre a gear: said to float, it is still warned that it deflects
+    data = _supported("1 N/m")
+    data["gears"]["wheel"]["support"] = {"floating": True}
+    (loc, msg), = _warnings(data)
+    assert "would deflect" in msg
+    data["gears"]["wheel"]["support"] = {"floating": True, "shaft": {
+        "diameter": "80 mm", "span": "300 mm", "position": "150 mm"}}
+    with pytest.raises(torquesplit.errors.ModelError,
+                       match="floating: a floating member is held by its meshes"):
+        torquesplit.load_model(data)

@@ -6,6 +6,7 @@ modifications."""
 from __future__ import annotations
 
 import tomllib
+import warnings
 
 import pytest
 from typer.testing import CliRunner
@@ -24,8 +25,20 @@ def test_a_sun_without_support_is_told_how_to_float():
     error, where a floating sun equalises three planets.  A sun gets the recipe."""
     text = three_planet_toml("float").replace(', support = {stiffness = "1e8 N/m"}', "")
     with pytest.raises(ModelError, match=r"planetary\.0\.sun\.support: .*a floating sun, "
-                                         r"held by its planet meshes alone: .*'1 N/m'"):
+                                         r"held by its planet meshes alone: support = "
+                                         r"\{floating = true\}"):
         torquesplit.load_model(tomllib.loads(text))
+    # and the recipe as told gives a model that loads without a word of floating
+    text = three_planet_toml("float").replace('support = {stiffness = "1e8 N/m"}',
+                                              "support = {floating = true}", 1)
+    def floats(text):
+        with warnings.catch_warnings(record=True) as said:
+            warnings.simplefilter("always")
+            torquesplit.load_model(tomllib.loads(text))
+        return [w for w in said if "floats" in str(w.message)]
+
+    assert floats(text) == []
+    assert floats(text.replace("{floating = true}", '{stiffness = "1 N/m"}'))  # (before)
 
 
 def test_a_planet_angle_off_the_assembly_condition_is_given_the_nearest_that_fits():

@@ -567,11 +567,9 @@ def support_issues(model: Model) -> list[tuple[str, str]]:
             if free and body.support is None and name not in on_spline:
                 written = model.written_at(f"{kind}.{name}")
                 floating = (written.startswith("planetary.") and written.endswith(".sun"))
-                hint = ("; a floating sun, held by its planet meshes alone: a support of "
-                        "negligible stiffness, e.g. support = {stiffness = '1 N/m'} (a stiff "
-                        "one holds it: 1e8 N/m takes most of the equalising away; the "
-                        "check then says the sun floats: accept that in [model] "
-                        "accepted_warnings)"
+                hint = ("; a floating sun, held by its planet meshes alone: support = "
+                        "{floating = true} (a stiff support holds it: 1e8 N/m takes most "
+                        "of the equalising away)"
                         if floating else "")
                 issues.append((f"{kind}.{name}.support", (
                     f"the translational DOFs {free} have no support; add one, e.g. "
@@ -702,7 +700,7 @@ MIN_SUPPORT_MESH_RATIO = 1e-4
 def _floating_text(k: float, mesh: float) -> str:
     return (f"{k:.3g} N/m is {mesh / k:.3g} times softer than the gear's meshes (ISO 6336 "
             f"about {mesh:.3g} N/m): the gear floats, held by its meshes alone; if that is "
-            f"meant (a floating sun), accept this warning in [model] accepted_warnings, else "
+            f"meant (a floating sun), say so with floating = true in the support, else "
             f"check the value and its unit (bearings are about 1e8-1e10 N/m; a bare number "
             f"is read in N/m)")
 
@@ -732,6 +730,10 @@ def compliance_warnings(model: Model, kin) -> list[tuple[str, str]]:
         radial = float(np.linalg.norm(resultant - resultant.dot(axis) * axis))
         loc = f"gears.{name}.support.stiffness"
         floats = bool(mesh_k) and max(mesh_k) > 0 and k < MIN_SUPPORT_MESH_RATIO * max(mesh_k)
+        if sup.floating:  # (said to float: its softness is meant)
+            if len(mesh_k) >= 3:
+                continue  # (centred by its meshes)
+            floats = False  # (fewer cannot centre it: a resultant still deflects it)
         # (the texts name no gear: the planets of a [[planetary]] stage, which share one
         # written field, are then said once)
         if floats and len(mesh_k) >= 3:

@@ -189,9 +189,9 @@ class Planetary(Strict):
     docs/theory/planetary.md).  Any member may be held by a ``torsional_support`` (ring:
     planetary; carrier: star) or driven and loaded through ``[drives]``/``[loads]`` on
     the generated names (``<name>_sun``, ``<name>_ring``, ``<name>_carrier``).  A
-    floating sun, held by its planet meshes alone: ``dofs = ["theta", "x", "y"]`` with a
-    support of negligible stiffness (``support = {stiffness = "1 N/m"}``); the check then
-    says that it floats: accept that warning in ``[model] accepted_warnings``."""
+    floating sun, held by its planet meshes alone: ``dofs = ["theta", "x", "y"]`` with
+    ``support = {floating = true}`` (a support of negligible stiffness, 1 N/m, whose
+    softness is not warned)."""
 
     name: str = Field("planetary", pattern=r"^[A-Za-z][A-Za-z0-9_]*$", max_length=40,
                       description="Prefix of the generated names (letters, digits, _).")

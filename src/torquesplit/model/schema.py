@@ -245,6 +245,11 @@ class TorsionalSupport(Strict):
         return self
 
 
+#: the stiffness of a floating member's support when none is given [N/m]: negligible
+#: beside any mesh (1e8-1e10 N/m), enough to keep a static solve regular
+FLOATING_STIFFNESS = 1.0
+
+
 class Support(Strict):
     """Support of a body's translations: a bearing or shaft bending, to the housing or
     (``on``) to another body (a planet on its carrier pin, a gear on a moving frame)."""
@@ -286,6 +291,20 @@ class Support(Strict):
     pin_error: PinError = Field(
         PinError(), description="Position error of the seat (planet pin) on the body "
         "named by 'on' (radial, tangential); requires 'on'.")
+    floating: bool = Field(
+        False, description="The body floats by design, held by its meshes alone (a "
+        "floating sun): the support only keeps the equilibrium regular and its softness "
+        "is not warned; 'stiffness' may then be left out (1 N/m).")
+
+    @model_validator(mode="before")
+    @classmethod
+    def _floating_stiffness(cls, data):
+        # a floating member's support: negligible unless given (the recipe wrote
+        # stiffness = '1 N/m' and accepted a warning on every command, a reviewer)
+        if (isinstance(data, dict) and data.get("floating") is True
+                and data.get("stiffness") is None and data.get("shaft") is None):
+            data = {**data, "stiffness": FLOATING_STIFFNESS}
+        return data
 
     @model_validator(mode="after")
     def _one_stiffness(self):
@@ -296,6 +315,9 @@ class Support(Strict):
             raise ValueError("both 'stiffness' and 'shaft' are given; remove one of them")
         if self.damping is not None and self.damping_ratio is not None:
             raise ValueError("both 'damping' and 'damping_ratio' are given; remove one of them")
+        if self.floating and self.shaft is not None:
+            raise FieldError("floating", "a floating member is held by its meshes, not by "
+                             "a shaft's bending; remove 'shaft' (or 'floating')")
         if self.on is None and not self.pin_error.is_zero:
             raise FieldError("pin_error", (
                 "a pin position error is the error of the seat on the body named by 'on' "
