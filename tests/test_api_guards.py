@@ -315,3 +315,38 @@ def test_writing_figures_prints_no_font_lookup(caplog):
         findfont(FontProperties(family=[missing + "b"]))  # (said outside a save)
     assert [r for r in caplog.records if r.name == "matplotlib.font_manager"]
     assert "<svg" in svg and lookup.level == logging.NOTSET
+
+
+def test_a_run_too_short_to_settle_is_said_in_python():
+    """The command line printed 'the run is too short to tell whether the response has
+    settled'; ``simulate`` in Python said nothing (only ``res.warnings()`` had it), and
+    the metrics of a few cycles of a start-up read as any others."""
+    from torquesplit.errors import ModelWarning
+
+    with pytest.warns(ModelWarning, match="too short to tell whether the response has "
+                                          "settled") as said:
+        res = torquesplit.simulate(EXAMPLE, cycles=3)
+    text = [str(w.message) for w in said if "too short" in str(w.message)]
+    assert len(text) == 1 and text[0] in res.warnings()
+    assert sum("too short" in w for w in res.warnings()) == 1  # (said once there)
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ModelWarning)
+        long = torquesplit.simulate(EXAMPLE, cycles=60)  # (settled: nothing said)
+    assert long.metrics().settling.settled
+
+
+def test_run_study_takes_what_study_run_takes_by_name():
+    """``run_study(spec, **kwargs)`` hid its arguments from help() and completion."""
+    import inspect
+
+    from torquesplit.study import Study, run_study
+
+    ours = inspect.signature(run_study).parameters
+    theirs = inspect.signature(Study.run).parameters
+    assert [p for p in ours if p not in ("spec", "analysis")] == [
+        p for p in theirs if p != "self"]
+    assert all(ours[p].default == theirs[p].default for p in theirs if p != "self")
+    with pytest.raises(TypeError, match="worker"):
+        run_study("nope.toml", worker=2)

@@ -47,6 +47,24 @@ def history_unused():
         yield
     finally:
         _HISTORY_UNUSED.reset(token)
+
+
+_SETTLING_JUDGED: contextvars.ContextVar[bool] = contextvars.ContextVar(
+    "settling_judged", default=False)
+
+
+@contextlib.contextmanager
+def settling_judged():
+    """Runs in this block do not warn that they are too short or unsettled: the caller
+    judges the run it keeps (a study's stop-when-settled rule runs short trial runs
+    first, whose warnings became its case's)."""
+    token = _SETTLING_JUDGED.set(True)
+    try:
+        yield
+    finally:
+        _SETTLING_JUDGED.reset(token)
+
+
 #: fewest RK4 steps per excitation period a run takes (the model file's bound)
 MIN_STEPS_PER_PERIOD = 10
 #: default step budget of a run (about 1-5 minutes of integration on one core)
@@ -143,8 +161,26 @@ def simulate(
                         samples_per_period=samples_per_period, history_dofs=history_dofs,
                         full_history=full_history, progress=progress, rhs=rhs,
                         max_steps=max_steps)
+        _warn_unsettled(res)
     res.run_warnings = notes
     return res
+
+
+def _warn_unsettled(res) -> None:
+    """Say, as a :class:`ModelWarning`, that the run is too short to tell whether it
+    settled, or did not settle: its metrics are then of a part of a transient, which a
+    Python user heard of only by reading ``res.warnings()`` (the command line prints
+    it).  The same text as there, which lists it once."""
+    if not res.success or _SETTLING_JUDGED.get():
+        return
+    from .results.plausibility import settling
+
+    try:
+        met = res.metrics()
+    except (ValueError, ArithmeticError):  # pragma: no cover - said by res.warnings()
+        return
+    for loc, msg in settling(res, met):
+        warn_user(f"{loc}: {msg}", ModelWarning)
 
 
 def _simulate(model, *, duration, cycles, method, steps_per_period, rtol,

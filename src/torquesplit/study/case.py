@@ -110,7 +110,7 @@ def _dynamic(model, p, out) -> list[float]:
     import contextlib
     import functools
 
-    from ..simulation import MIN_SAMPLES_PER_PERIOD, history_unused, simulate
+    from ..simulation import MIN_SAMPLES_PER_PERIOD, history_unused, settling_judged, simulate
     from .outputs import output_values
 
     a = p["analysis"]
@@ -127,7 +127,9 @@ def _dynamic(model, p, out) -> list[float]:
         kw["samples_per_period"] = MIN_SAMPLES_PER_PERIOD
         quiet = history_unused()  # (its coarseness is the study's choice, unread)
     values = functools.partial(output_values, bearings=bearings)  # (unread: not computed)
-    with quiet:
+    # (the kept run's settling is warned by _finish: not that of the settle rule's
+    # shorter trial runs)
+    with quiet, settling_judged():
         return _dynamic_runs(model, a, names, defs, kw, out, simulate, values)
 
 

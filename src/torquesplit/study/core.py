@@ -341,11 +341,19 @@ def _backend_runner(plan: Plan, backend: str, precision, client, scheduler, runn
     return make_gpu_runner(precision=precision or "fp64", workers=workers)
 
 
-def run_study(spec, *, analysis: dict | None = None, **kwargs):
+def run_study(spec, *, analysis: dict | None = None, workers: int | None = None,
+              client=None, scheduler: str | None = None, runner=None, out=None,
+              resume: bool = False, overwrite: bool = False,
+              progress: Callable[[Progress], None] | None = None, figures: bool = True,
+              backend: str = "cpu", precision: str | None = None):
     """Run a study (file, name of a shipped study, dict or spec) and return its Dataset;
     ``analysis`` as :class:`Study` takes it (``{"cycles": 30}``: a shorter trial of a
-    shipped study), the other keyword arguments as :meth:`Study.run`."""
-    return Study(spec, analysis=analysis).run(**kwargs)
+    shipped study), the other arguments as :meth:`Study.run` (written out: a misspelt
+    ``worker=2`` is refused by Python naming it, and ``help(run_study)`` lists them)."""
+    return Study(spec, analysis=analysis).run(
+        workers=workers, client=client, scheduler=scheduler, runner=runner, out=out,
+        resume=resume, overwrite=overwrite, progress=progress, figures=figures,
+        backend=backend, precision=precision)
 
 
 def load_results(out):
