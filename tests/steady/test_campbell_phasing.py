@@ -175,3 +175,22 @@ def test_campbell_labels_that_would_overprint_share_one_text():
     assert "1, 2" in texts and "3" in texts
     assert "2x a = 4x b" in texts and "1x a = 2x b" in texts
     assert "1500" in texts
+
+
+def test_critical_speeds_the_model_does_not_drive_are_labelled_so(lp_map):
+    """The speed sweep's figure numbered every critical speed alike, those whose
+    harmonic is nil (constant mesh stiffness) or cancels on the mode included (a
+    reviewer): their labels say 'not driven'; a driven one's does not."""
+    from torquesplit.steady.maps import driven
+
+    ds, crossings = lp_map
+    labels = ds.attrs["critical_speed_labels"]
+    assert labels and all(lab.endswith("(not driven)") for lab in labels)
+    ds, crossings = campbell(load_model(example_path("ji_li_mill_drive")), 100 * RPM,
+                             1500 * RPM, points=21)
+    critical = [c for c in crossings if not c.get("suppressed")]
+    labels = ds.attrs["critical_speed_labels"]
+    assert len(labels) == len(critical)
+    assert [lab.endswith("(not driven)") for lab in labels] == [not driven(c)
+                                                               for c in critical]
+    assert 0 < sum(lab.endswith("(not driven)") for lab in labels) < len(labels)

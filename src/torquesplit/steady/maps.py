@@ -289,7 +289,7 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
         natural_frequencies_Hz=list(crit["natural_frequencies"]),
         natural_frequencies_at_speed_rpm=w_ref * RPM,
         critical_speeds_rpm=[c["speed_rpm"] for c in critical],
-        critical_speed_labels=[f"mode {c['mode']} x {c['order']} {c['source']}"
+        critical_speed_labels=[_undriven(c, f"mode {c['mode']} x {c['order']} {c['source']}")
                                for c in critical],
         **({"suppressed_speeds_rpm": [c["speed_rpm"] for c in suppressed],
             "suppressed_speed_labels": [
@@ -856,7 +856,7 @@ def campbell(model, start: float, stop: float, *, points: int = 41,
                        f"{c['order']} {c['source']}")
     _crossing_table(ds, crossings)
     ds.attrs["critical_speeds_rpm"] = [c["speed_rpm"] for c in critical]
-    ds.attrs["critical_speed_labels"] = [label(c) for c in critical]
+    ds.attrs["critical_speed_labels"] = [_undriven(c, label(c)) for c in critical]
     left_out = orders_left_out(kin, s) if orders is None else []
     if left_out:
         ds.attrs["orders_left_out"] = left_out
@@ -964,6 +964,13 @@ def near_critical_notes(model, structure, q, kinematics, speed=None) -> list[str
             model, structure, q, kinematics, speed=speed)]
     except Exception:  # noqa: BLE001 - a note, never a reason to lose the results
         return []
+
+
+def _undriven(crossing: dict, label: str) -> str:
+    """A critical speed's label, marked where the model does not drive it (:func:`driven`:
+    no harmonic of at least :data:`DRIVING_HARMONIC`, or the meshes' forces cancel on the
+    mode): the speed sweep's figure numbered such crossings as any other (a reviewer)."""
+    return label if driven(crossing) else f"{label} (not driven)"
 
 
 def driven(crossing: dict, least: float = DRIVING_HARMONIC) -> bool:
