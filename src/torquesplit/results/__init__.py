@@ -928,7 +928,7 @@ def bearing_round_off(bearings: list[dict]) -> float:
     """The bearing force below which a table writes 0 [N]: 1e-9 of the largest peak, the
     round-off of a force that cancels (the sun of a symmetric planetary stage: x 6e-17
     kN).  One bound for the terminal and the report (the report's 1e-6 wrote a real
-    0.6 N of a 600 kN drive as 0, an exports review)."""
+    0.5 N of a 600 kN drive as 0, an exports review)."""
     return 1e-9 * max((b["peak_magnitude"] for b in bearings), default=0.0)
 
 
@@ -1051,8 +1051,7 @@ def open_results(path):
                     f"no such file (nor the folder {where.parent})")
             error = OutputError if where.is_dir() else MissingFileError
             raise error(f"{path}: {what}; give the .nc file a run saved "
-                              f"(torquesplit run --out NAME.nc, or res.save('NAME.nc'))"
-                              ) from None
+                        f"(torquesplit run --out NAME.nc, or res.save('NAME.nc'))") from None
         raise OptionError(
             f"{path}: not a NetCDF results file ({exc}); open_results and load_results "
             f"read the .nc files torquesplit writes (a .mat opens with scipy.io.loadmat, a "
