@@ -525,7 +525,7 @@ def _check_cost(structure, duration: float, planned: tuple[float, str], max_step
             f"this run needs {n_steps:,} RK4 steps of {h:.3g} s ({why}), more than "
             f"max_steps = {max_steps:,} (about {seconds / 60:.3g} min); check the stiffness "
             "and inertias named there and their units, shorten the duration, or raise "
-            "max_steps (--max-steps)")
+            "max_steps (--max-steps; a study's [analysis] max_steps)")
     # per-cycle statistics (6 arrays per tracked mesh) and the decimated history
     memory = 8 * (6 * (f_max * duration + 2) * n_meshes
                   + MAX_HISTORY_RECORDS * (1 + n_history))

@@ -57,7 +57,7 @@ def test_case_ranges():
 def test_a_settle_rule_that_reaches_its_cap_warns(split_file):
     data = grid_study(split_file, [{"path": "meshes.a1.transmission_error.constant",
                                     "values": ["4 um"]}], outputs=["load_sharing.cycle_peak"],
-                      cycles=40, settle={"tolerance": 0.002, "start": "0.08 s"})
+                      cycles=40, settle={"tolerance": 0.002, "start": "0.02 s"})
     ds = run_study(data, workers=1)
     assert ds["settled"].values[0] == 0
     said = str(ds["warnings"].values[0])
@@ -73,6 +73,16 @@ def test_a_settle_rule_that_reaches_its_cap_warns(split_file):
                                              "values": [0.05]}]}}, workers=1)
     said = str(ds["warnings"].values[0])
     assert said.count("too short to tell") == 1 and "completes 7 cycles" in said
+    # a rule whose first run is its cap compares nothing, and says so (it said the
+    # outputs 'still changed', a studies reviewer)
+    data = grid_study(split_file, [{"path": "meshes.a1.transmission_error.constant",
+                                    "values": ["4 um"]}], outputs=["load_sharing.cycle_peak"],
+                      cycles=40, settle={"tolerance": 0.002, "start": "10 s"})
+    ds = run_study(data, workers=1)
+    said = str(ds["warnings"].values[0])
+    assert ds["settled"].values[0] == 0
+    assert "the rule's first run is already the longest" in said
+    assert "still changed" not in said
 
 
 def test_grouped_warnings_say_nothing_one_case_contradicts():
@@ -120,3 +130,50 @@ def test_a_study_case_is_not_told_that_its_unread_history_is_coarse(monkeypatch,
     # (the same sampling asked for outside a study does warn for this model too)
     assert any(said in w for w in torquesplit.simulate(
         split_file, cycles=40, samples_per_period=20).warnings())
+
+
+def test_the_step_and_position_bounds_a_message_points_to_are_study_fields(split_file):
+    """A reviewer: a case refused for 'more than max_steps ...; raise max_steps
+    (--max-steps)' and a static sweep thinned to max_points pointed to options a study
+    does not have; [analysis] max_steps and max_points are its fields now."""
+    import pytest
+
+    from torquesplit.errors import StudyError
+
+    data = grid_study(split_file, [{"path": "meshes.a1.transmission_error.constant",
+                                    "values": ["0 um"]}], max_steps=100)
+    ds = run_study(data, workers=1)
+    reason = str(ds["reason"].values[0])
+    assert ds["status"].values[0] == "refused"
+    assert "max_steps = 100" in reason and "a study's [analysis] max_steps" in reason
+    static = {"study": {"name": "s", "model": "mo2017_star_reducer",
+                        "outputs": ["load_sharing.static_torque"]},
+              "analysis": {"type": "static", "revolutions": 0.05, "max_points": 16},
+              "grid": {"parameters": [{"path": "gears.*.errors.eccentricity", "name": "e",
+                                       "values": ["0 um"]}]}}
+    ds = run_study(static, workers=1)
+    said = str(ds["warnings"].values[0])
+    assert ds["status"].values[0] == "ok" and "cut to max_points = 16 positions" in said
+    assert "a study's [analysis] max_points" in said
+    for field, other in (("max_steps", static), ("max_points", data)):
+        bad = {**other, "analysis": {**other["analysis"], field: 1000}}
+        with pytest.raises(StudyError, match=rf"analysis\.{field}"):
+            run_study(bad, workers=1)
+
+
+def test_a_cases_warnings_split_back_from_its_spreadsheet_cell(tmp_path, split_file):
+    """results.csv joined a case's warnings with '; ', which their texts contain: a case
+    of two warnings split into five (a studies reviewer)."""
+    import csv
+
+    from torquesplit.study.dataset import WARNING_JOIN
+
+    data = grid_study(split_file, [{"path": "gears.pinion.errors.eccentricity",
+                                    "values": [0.003]}],  # (3 mm: a unit slip)
+                      outputs=["load_sharing.cycle_peak"], cycles=5)
+    ds = run_study(data, workers=1, out=tmp_path / "o", figures=False)
+    n = int(ds["warning_count"].values[0])
+    assert n >= 2 and any("; " in w for w in str(ds["warnings"].values[0]).splitlines())
+    with open(tmp_path / "o" / "results.csv", newline="") as fh:
+        (row,) = list(csv.DictReader(fh))
+    assert row["warnings"].split(WARNING_JOIN) == str(ds["warnings"].values[0]).splitlines()

@@ -406,7 +406,8 @@ def prepare_case(p: dict, length: float | None = None, worker: bool = False) -> 
     out = {"run": None, "status": "ok", "reason": "", "warnings": [], "full": None,
            "length": length}
     a = p["analysis"]
-    kw = {k: a[k] for k in ("method", "steps_per_period", "rtol") if a.get(k) is not None}
+    kw = {k: a[k] for k in ("method", "steps_per_period", "rtol", "max_steps")
+          if a.get(k) is not None}
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:

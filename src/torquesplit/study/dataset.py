@@ -277,6 +277,11 @@ def _header(ds, name: str) -> str:
     return name if unit in ("", "1") else f"{name} [{unit}]"
 
 
+#: between a case's warnings in its results.csv cell: '; ', which the warnings' own texts
+#: contain, split two warnings into five (a studies reviewer)
+WARNING_JOIN = " || "
+
+
 def case_table_bytes(ds) -> bytes:
     """The study as a spreadsheet: one row per case, the parameter values (SI, the unit
     in the header) then every per-case variable (outputs, status, reason, timings)."""
@@ -294,10 +299,10 @@ def case_table_bytes(ds) -> bytes:
     header = ["case" if c == "sample" else _header(ds, c) if c in ds.variables else c
               for c in keep]
     rows = frame[keep].itertuples(index=False, name=None)
-    # a case's warnings one a line in the Dataset; '; ' in a cell (a line break inside a
-    # quoted cell is CSV, but tools that count lines miscount the cases)
+    # a case's warnings one a line in the Dataset; WARNING_JOIN in a cell (a line break
+    # inside a quoted cell is CSV, but tools that count lines miscount the cases)
     at = keep.index("warnings") if "warnings" in keep else -1
-    return csv_bytes(header, [[(str(v).replace("\n", "; ") if i == at else
+    return csv_bytes(header, [[(str(v).replace("\n", WARNING_JOIN) if i == at else
                                 v.item() if hasattr(v, "item") else v)
                                for i, v in enumerate(r)] for r in rows])
 

@@ -402,11 +402,15 @@ def _analysis(spec: StudySpec) -> dict:
         # defaults: those of torquesplit static (whole periods of the errors and tables)
         out["revolutions"] = None if a.revolutions is None else float(a.revolutions)
         out["points_per_cycle"] = 32 if a.points_per_cycle is None else int(a.points_per_cycle)
+        if a.max_points is not None:  # (only when given: a stored study's plan unchanged)
+            out["max_points"] = int(a.max_points)
         return out
     problems = _Problems()  # (the duration's and the settle start's both, at once)
     out["duration"] = problems.attempt(_positive_time, a.duration, "analysis.duration", "2 s")
     out.update(cycles=a.cycles, method=a.method, steps_per_period=a.steps_per_period,
                rtol=a.rtol)
+    if a.max_steps is not None:  # (only when given: a stored study's plan unchanged)
+        out["max_steps"] = int(a.max_steps)
     if a.settle is not None:
         start = problems.attempt(_positive_time, a.settle.start, "analysis.settle.start",
                                  "1 s")

@@ -116,16 +116,23 @@ class AnalysisSpec(_Strict):
         "and tables, at least one revolution."))
     points_per_cycle: int | None = Field(None, ge=1, description=(
         "Positions per cycle of the fastest excitation (static), default 32."))
+    max_steps: int | None = Field(None, ge=1, description=(
+        "Refuse a case's RK4 run needing more steps (run), default 2e8: what --max-steps "
+        "is to torquesplit run."))
+    max_points: int | None = Field(None, ge=16, description=(
+        "Most positions of a case's sweep (static), default 20000: what --max-points is "
+        "to torquesplit static."))
 
     @model_validator(mode="after")
     def _fits_type(self):
         if self.type == "run":
-            _forbid(self, ("revolutions", "points_per_cycle"), "to type = 'run'")
+            _forbid(self, ("revolutions", "points_per_cycle", "max_points"),
+                    "to type = 'run'")
             if self.duration is not None and self.cycles is not None:
                 raise _Problem("cycles", "give either 'duration' or 'cycles', not both")
         else:
             _forbid(self, ("duration", "cycles", "method", "steps_per_period", "rtol",
-                           "settle"), "to type = 'static'")
+                           "settle", "max_steps"), "to type = 'static'")
         return self
 
 
