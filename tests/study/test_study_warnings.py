@@ -177,3 +177,26 @@ def test_a_cases_warnings_split_back_from_its_spreadsheet_cell(tmp_path, split_f
     with open(tmp_path / "o" / "results.csv", newline="") as fh:
         (row,) = list(csv.DictReader(fh))
     assert row["warnings"].split(WARNING_JOIN) == str(ds["warnings"].values[0]).splitlines()
+
+
+def test_the_spreadsheet_names_an_output_as_the_study_file_does():
+    """A group 'left/bevel' is 'left|bevel' in the NetCDF (which forbids '/'); the
+    spreadsheet's header said so too, where --json and the study file say 'left/bevel'
+    (a studies reviewer)."""
+    import csv
+    import io
+
+    import numpy as np
+    import xarray as xr
+
+    from torquesplit.study.dataset import case_table_bytes, variable_name
+
+    name = "load_sharing.static_torque.left/bevel"
+    ds = xr.Dataset({"status": ("sample", np.array(["ok"], dtype=object)),
+                     variable_name(name): ("sample", [1.05], {"output": name, "units": "1"}),
+                     "peak_force.m1": ("sample", [2.0e3], {"output": "peak_force.m1",
+                                                           "units": "N"})},
+                    coords={"sample": [0]})
+    header = next(csv.reader(io.StringIO(case_table_bytes(ds).decode())))
+    assert name in header and "peak_force.m1 [N]" in header
+    assert not [h for h in header if "|" in h]

@@ -274,6 +274,9 @@ def _case_variables(ds) -> list[str]:
 
 def _header(ds, name: str) -> str:
     unit = ds[name].attrs.get("units", "")
+    # (an output by the name the study file and --json give it: 'left/bevel', not the
+    # NetCDF-safe variable name 'left|bevel', a studies reviewer)
+    name = ds[name].attrs.get("output", name)
     return name if unit in ("", "1") else f"{name} [{unit}]"
 
 
