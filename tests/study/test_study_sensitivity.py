@@ -106,6 +106,23 @@ def test_ranking_of_a_constructed_model(split_file, tmp_path, method, kw):
     np.testing.assert_array_equal(mat[key], ds[key].values)
     assert list(mat["factor"]) == list(ds["factor"].values)
     assert mat["attributes"]["ranking"].item() == key
+    # and a spreadsheet: a row per output and factor with its rank and every index (they
+    # were in the .nc and .mat only, a studies reviewer)
+    import csv
+    import io
+
+    from torquesplit.study.dataset import indices_table_bytes
+
+    rows = list(csv.DictReader(io.StringIO(indices_table_bytes(ds).decode())))
+    assert len(rows) == 2 * 3
+    for out in ("load_sharing.cycle_peak", "static_force.a1"):
+        mine = sorted((r for r in rows if r["output"] == out), key=lambda r: int(r["rank"]))
+        assert [r["factor"] for r in mine] == [name for name, _ in ranking(ds, out)]
+    force = next(r for r in rows if r["output"] == "static_force.a1")
+    assert force["output_unit"] == "N"
+    index_columns = [k for k in rows[0] if k.split(" ")[0] in ds.data_vars]
+    assert {k.split(" ")[0] for k in index_columns} >= (
+        {"mu", "mu_star", "sigma", "mu_star_conf"} if method == "morris" else {"S1", "ST"})
     # the ranking table prints Morris's effect of a force in kN, with its unit (Rich read
     # an unescaped " [kN]" as markup and dropped it); Sobol's shares have none
     from torquesplit import cli as ui
@@ -314,3 +331,17 @@ def test_no_ranking_is_printed_where_no_index_could_be_computed(split_file, tmp_
     assert "none: no index could be computed" in text
     assert "gears.pinion.density nan" not in text
 
+
+
+def test_a_sensitivity_folder_has_its_indices_for_a_spreadsheet(split_file, tmp_path):
+    """results_sensitivity.csv beside results.csv; gone when a study of another design
+    replaces it in the folder."""
+    out = tmp_path / "o"
+    run_study(_study(split_file, "morris", trajectories=2), workers=1, out=out, figures=False)
+    table = out / "results_sensitivity.csv"
+    assert table.is_file() and table.read_text().startswith("output,output_unit,factor,rank")
+    grid = _study(split_file, "morris")
+    del grid["sensitivity"]
+    grid["grid"] = {"parameters": [{"path": "meshes.b2.stiffness", "values": ["4e8 N/m"]}]}
+    run_study(grid, workers=1, out=out, overwrite=True, figures=False)
+    assert (out / "results.csv").is_file() and not table.exists()

@@ -261,7 +261,41 @@ def write_dataset(ds, path) -> Path:
         tmp = path.with_suffix(suffix + ".tmp")
         tmp.write_bytes(data(ds))
         tmp.replace(target)
+    # a sensitivity's indices for a spreadsheet too (they were in the .nc and .mat only,
+    # a studies reviewer)
+    indices = path.with_name(f"{path.stem}_sensitivity.csv")
+    if "factor" in ds.dims:
+        tmp = indices.with_suffix(".csv.tmp")
+        tmp.write_bytes(indices_table_bytes(ds))
+        tmp.replace(indices)
+    elif indices.is_file():  # (from an earlier study in this folder)
+        indices.unlink()
     return path
+
+
+def indices_table_bytes(ds) -> bytes:
+    """A sensitivity's indices as a spreadsheet: a row per (output, factor), the output
+    by its study-file name with its unit, the factor, its rank for that output (1: the
+    most important, by the study's ranking index) and every index (Morris mu, mu_star,
+    sigma, mu_star_conf; Sobol S1, ST and their intervals)."""
+    from ..results.files import csv_bytes
+
+    keys = [k for k in ds.data_vars if ds[k].dims == ("output", "factor")]
+    by = ds.attrs.get("ranking", keys[0] if keys else None)
+    header = ["output", "output_unit", "factor", "rank"] + [
+        f"{k} [{ds[k].attrs['units']}]" if ds[k].attrs.get("units", "1") not in ("", "1")
+        else k for k in keys]
+    rows = []
+    for o, out in enumerate(ds["output"].values):
+        name = str(out).replace("|", "/")
+        unit = str(ds["output_unit"].values[o]) if "output_unit" in ds.coords else ""
+        score = np.nan_to_num(np.asarray(ds[by].values[o], float), nan=-np.inf)
+        rank = np.empty(score.size, int)
+        rank[np.argsort(-score, kind="stable")] = np.arange(1, score.size + 1)
+        for f, factor in enumerate(ds["factor"].values):
+            rows.append([name, unit, str(factor), int(rank[f])]
+                        + [float(ds[k].values[o, f]) for k in keys])
+    return csv_bytes(header, rows)
 
 
 def _case_variables(ds) -> list[str]:
