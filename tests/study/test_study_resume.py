@@ -87,6 +87,13 @@ def test_a_folder_of_other_results_is_not_written_over(tmp_path, split_file):
     with pytest.raises(StudyError, match=r"^out: .* holds results.nc of another run"):
         Study(path).run(workers=1, out=out, figures=False)
     assert (out / "results.nc").read_bytes() == b"someone else's"
+    # a spreadsheet of theirs alone too (a studies reviewer's results.csv was replaced)
+    lone = tmp_path / "sheet"
+    lone.mkdir()
+    (lone / "results.csv").write_text("mine")
+    with pytest.raises(StudyError, match=r"^out: .* holds results.csv of another run"):
+        Study(path).run(workers=1, out=lone, figures=False)
+    assert (lone / "results.csv").read_text() == "mine"
     (out / "figures").mkdir()
     (out / "figures" / "dynamic_factor.png").write_bytes(b"another study's figure")
     Study(path).run(workers=1, out=out, figures=False, overwrite=True)

@@ -182,8 +182,11 @@ def _run(source, *, workers, scheduler, out, resume, overwrite, figures, quiet, 
             ui.ux.warn(note)
         kept = stored_cases(out) if resume else 0
         if kept and not as_json:  # (a resume went straight to 'cases 3/6' without a word)
+            # (before the stored study is compared with this one: 'kept', then a refusal
+            # of a changed --cycles, read as a contradiction, a studies reviewer)
             ui.err_console.print(f"resuming: {kept} finished case{'s' if kept > 1 else ''} "
-                                 f"kept from {out}", highlight=False)
+                                 f"stored in {out}, kept if the study is unchanged",
+                                 highlight=False)
         with warnings.catch_warnings():
             if backend == "gpu":  # no device: say so in one line, not as a Python warning
                 from ..errors import GpuFallbackWarning

@@ -438,7 +438,11 @@ def _open_folder(plan: Plan, out: Path, resume: bool, overwrite: bool,
                                     f"{words.resume_on} to continue it, {words.overwrite_on} "
                                     f"to start it again, or choose another folder")
     # a folder of other results (no study store): what this study writes would replace them
-    theirs = [f for f in (out / RESULTS_NAME, out / "figures") if f.exists()]
+    # (its .csv and .mat too: a spreadsheet's results.csv was replaced without a word, a
+    # studies reviewer)
+    written = [out / RESULTS_NAME] + [out / RESULTS_NAME.replace(".nc", x) for x in (
+        ".csv", ".mat", "_sensitivity.csv")] + [out / "figures"]
+    theirs = [f for f in written if f.exists()]
     if not exists and theirs and not overwrite:
         raise StudyError(words.out, f"{out} holds {theirs[0].name} of another run, which this "
                                     f"study would replace; choose another folder or add "
