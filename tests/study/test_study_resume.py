@@ -39,8 +39,10 @@ def _count(db_path) -> int:
 
 def _study_process(tmp_path, split_file, *, workers: int, done: int):
     """(study file, out folder, process) of a 10-case study run by the command line in a
-    process of its own, once ``done`` cases are committed (about 0.1-0.3 s a case)."""
-    path = _write(tmp_path, grid_study(split_file, GRID, cycles=2000))
+    process of its own, once ``done`` cases are committed (about 0.25-0.75 s a case: at
+    0.1-0.3 s two workers could finish the study between two looks at its store, a
+    flaky failure on a loaded machine)."""
+    path = _write(tmp_path, grid_study(split_file, GRID, cycles=5000))
     out = tmp_path / "out"
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
     proc = subprocess.Popen([sys.executable, "-m", "torquesplit.cli", "study", str(path),
@@ -72,6 +74,11 @@ def test_sigkill_then_resume_computes_each_case_once(tmp_path, split_file):
     assert sum(per_run.values()) == 10 and per_run[runs[0][0]] == first
     resumed = xr.open_dataset(out / "results.nc", engine="h5netcdf")
     clean = Study(path).run(workers=1)
+    # (the file says which run wrote it: its provenance, which the Dataset has not)
+    from torquesplit.results.files import provenance
+
+    said = {k: resumed.attrs.pop(k) for k in provenance("", "{}")}
+    assert said["software"].startswith("torquesplit") and said["model_sha256"]
     xr.testing.assert_identical(resumed.drop_vars("case_wall_time"),
                                 clean.drop_vars("case_wall_time"))
 

@@ -251,10 +251,15 @@ def write_dataset(ds, path) -> Path:
     """Save a study Dataset as NetCDF (h5netcdf), and beside it the same cases for a
     spreadsheet (``.csv``: :func:`case_table_bytes`) and for MATLAB (``.mat``:
     :func:`case_mat_bytes`); each file whole or absent."""
+    from ..results.files import provenance
+
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_suffix(".nc.tmp")
-    ds.to_netcdf(tmp, engine="h5netcdf")
+    # (the provenance the .mat has: the NetCDF had neither commit nor command, a
+    # studies reviewer)
+    ds.assign_attrs(**provenance(_run_id(ds), ds.attrs.get("model_json"))).to_netcdf(
+        tmp, engine="h5netcdf")
     tmp.replace(path)
     for suffix, data in ((".csv", case_table_bytes), (".mat", case_mat_bytes)):
         target = path.with_suffix(suffix)
@@ -355,7 +360,12 @@ def case_mat_bytes(ds) -> bytes:
     from ..results.export import mat_fields
     from ..results.files import mat_bytes
 
-    return mat_bytes(mat_fields(ds, str(ds.attrs.get("study_hash", ""))[:16]))
+    return mat_bytes(mat_fields(ds, _run_id(ds)))
+
+
+def _run_id(ds) -> str:
+    """The run id of a study's files: the start of its study hash."""
+    return str(ds.attrs.get("study_hash", ""))[:16]
 
 
 def ranking(ds, output: str) -> list[tuple[str, float]]:
