@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import json
 
+import numpy as np
 import pytest
 import tomli_w
 import xarray as xr
+from study_helpers import grid_study, mc_study
 from typer.testing import CliRunner
 
-from study_helpers import grid_study, mc_study
 from torquesplit.cli import app
 from torquesplit.study import Study
 from torquesplit.study.cli import parse_vary
@@ -82,6 +83,19 @@ def test_monte_carlo_summary_and_list(tmp_path, split_file):
     text = _ok(["study", str(path), "--out", str(tmp_path / "mc"), "--workers", "1",
                 "--quiet"])
     assert "p95" in text and "8 ok" in text
+    # over 8 cases p5 and p95 are interpolated between extremes: said
+    assert "p5 and p95 over 8 cases" in " ".join(text.split())
+    # the table's statistics in --json too (only the terminal had them, a reviewer)
+    import xarray as xr
+
+    data = json.loads(_ok(["study", str(path), "--out", str(tmp_path / "mc"), "--resume",
+                           "--json", "--no-figures"]))
+    st = data["statistics"]["load_sharing.cycle_peak"]
+    with xr.open_dataset(tmp_path / "mc" / "results.nc", engine="h5netcdf") as ds:
+        x = ds["load_sharing.cycle_peak"].values
+    assert st["cases"] == 8 and st["mean"] == pytest.approx(float(np.mean(x)), rel=1e-12)
+    assert st["p95"] == pytest.approx(float(np.quantile(x, 0.95)), rel=1e-12)
+    assert st["std"] == pytest.approx(float(np.std(x, ddof=1)), rel=1e-12)
     figs = {p.name for p in (tmp_path / "mc" / "figures").iterdir()}
     assert "mc_load_sharing.cycle_peak.png" in figs
     listed = _ok(["study", "--list"])

@@ -460,6 +460,9 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
             data["stopping_rule"] = {k[len("stopping_"):]: ds.attrs[k] for k in ds.attrs
                                      if k.startswith("stopping_") and k != "stopping_rule"}
             data["stopping_rule"]["target_met"] = bool(data["stopping_rule"]["target_met"])
+        if ds.attrs["design"] == "monte_carlo":  # (the terminal's table: not in --json)
+            data["statistics"] = {ds[v].attrs["output"]: sample_statistics(ds[v].values)
+                                  for v in out_vars}
         if ds.attrs["design"] == "sensitivity":
             data["ranking"] = {ds[v].attrs["output"]: ranking(ds, ds[v].attrs["output"])
                                for v in out_vars}
@@ -505,16 +508,18 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
             t.add_column(col, justify="left" if col == "output" else "right")
         for v in out_vars:
             suffix, scale = _shown(ds[v])
-            x = ds[v].values.ravel()
-            x = x[np.isfinite(x)] * scale
-            count = [f"{x.size} of {status.size}"] if "cases" in cols else []
-            if not x.size:
+            st = sample_statistics(ds[v].values)
+            count = [f"{st['cases']} of {status.size}"] if "cases" in cols else []
+            if not st["cases"]:
                 t.add_row(escape(v + suffix), *["-"] * 6, *count)
                 continue
-            stats = (x.mean(), x.std(ddof=1) if x.size > 1 else 0.0, x.min(),
-                     np.quantile(x, 0.05), np.quantile(x, 0.95), x.max())
-            t.add_row(escape(v + suffix), *[f"{s:.6g}" for s in stats], *count)
+            t.add_row(escape(v + suffix), *[f"{st[k] * scale:.6g}" for k in cols[1:7]],
+                      *count)
         ui.console.print(t)
+        if 0 < min(used.values()) < 20:  # (a 5 % tail of fewer than 20 is an end value)
+            ui.console.print(f"p5 and p95 over {min(used.values())} cases at the fewest are "
+                             f"interpolated between the extreme values: 20 or more give "
+                             f"them a tail to stand for", highlight=False)
         if fewer:
             ui.console.print(f"statistics over the cases with a finite value only: "
                              f"{min(used.values())} of {status.size} at the fewest",
@@ -572,6 +577,23 @@ def _cases_with_values(ds, cases: list[int]) -> str:
     values, unit = display_values(ds, dims[0])
     shown = ", ".join(f"{values[i]:.6g}" for i in cases)
     return f"{text} ({dims[0]} = {shown}{'' if unit == '-' else ' ' + unit})"
+
+
+def sample_statistics(values) -> dict:
+    """A Monte Carlo output's statistics over its cases with a finite value (SI):
+    ``cases``, ``mean``, ``std`` (sample, ddof 1), ``min``, ``p5``, ``p95``, ``max``
+    (NaN where there is none)."""
+    import numpy as np
+
+    x = np.asarray(values, dtype=float).ravel()
+    x = x[np.isfinite(x)]
+    if not x.size:
+        return {"cases": 0, **{k: math.nan for k in ("mean", "std", "min", "p5", "p95",
+                                                    "max")}}
+    return {"cases": int(x.size), "mean": float(x.mean()),
+            "std": float(x.std(ddof=1)) if x.size > 1 else 0.0, "min": float(x.min()),
+            "p5": float(np.quantile(x, 0.05)), "p95": float(np.quantile(x, 0.95)),
+            "max": float(x.max())}
 
 
 def _sensitivity_table(ds, out_vars):
