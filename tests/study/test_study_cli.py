@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -42,6 +43,10 @@ def test_study_command_writes_store_results_and_figures(tmp_path, split_file):
     again = json.loads(_ok(["study", str(path), "--out", str(out), "--resume", "--json",
                             "--no-figures"]))
     assert again["status"] == {"ok": 3} and len(again["outputs"]["peak_force.a1"]) == 3
+    # every figure file in --json: the SVGs beside the PNGs (it listed the PNGs only)
+    listed = json.loads(_ok(["study", str(path), "--out", str(out), "--resume",
+                             "--json"]))["figures"]
+    assert sorted(Path(f).name for f in listed) == figs
 
 
 def test_sweep_one_liner(tmp_path, split_file):

@@ -243,6 +243,18 @@ def test_stopping_rule_outcome_is_reported(split_file, tmp_path):
     assert "stopping rule: mean of load_sharing.cycle_peak" in cap.get()
     assert "target met" in cap.get() and "95% interval)" in cap.get()
     assert ", +/- " in cap.get()  # a mean's interval is centred: said so (it gave the ends)
+    # --json names the watched output and its unit (bare numbers, a reviewer)
+    import contextlib
+    import io
+
+    buffer = io.StringIO()
+    with contextlib.redirect_stdout(buffer):
+        _summary(ds, tmp_path, True, False)
+    import json  # (imported again below, so local here)
+
+    rule = json.loads(buffer.getvalue())["stopping_rule"]
+    assert rule["output"] == OUT and rule["units"] == ds[OUT].attrs["units"]
+    assert rule["estimate"] == a["stopping_estimate"]
     labels = [t.get_text() for t in monte_carlo_figure(ds, OUT).axes[2].get_legend().texts]
     assert any(t.startswith("stopping target +/-0.01 (mean, met)") for t in labels)
     assert "95% interval at the stop" in labels

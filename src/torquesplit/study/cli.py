@@ -433,7 +433,9 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
                 if "warning_count" in ds else 0)
     counts = {s: int((status == s).sum()) for s in sorted(set(status.tolist()))}
     out_vars = [v for v in ds.data_vars if "output" in ds[v].attrs]
-    figs = sorted(str(p) for p in (out / "figures").glob("*.png")) if figures else []
+    # (each figure's PNG and SVG: --json listed the PNGs only, a reviewer)
+    figs = sorted(str(p) for x in ("*.png", "*.svg")
+                  for p in (out / "figures").glob(x)) if figures else []
     if as_json:
         coords = [c for c in ds.coords if c not in ("output", "factor")
                   and ds[c].dtype.kind == "f"]
@@ -460,6 +462,16 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
             data["stopping_rule"] = {k[len("stopping_"):]: ds.attrs[k] for k in ds.attrs
                                      if k.startswith("stopping_") and k != "stopping_rule"}
             data["stopping_rule"]["target_met"] = bool(data["stopping_rule"]["target_met"])
+            # which output, and in what unit its estimate and widths are (a reviewer read
+            # bare numbers in N)
+            watched = json.loads(ds.attrs.get("stopping_rule", "{}")).get("output")
+            if watched:
+                from .dataset import variable_name
+
+                var = variable_name(watched)
+                data["stopping_rule"].update(
+                    output=watched,
+                    units=ds[var].attrs.get("units", "") if var in ds else "")
         if ds.attrs["design"] == "monte_carlo":  # (the terminal's table: not in --json)
             data["statistics"] = {ds[v].attrs["output"]: sample_statistics(ds[v].values)
                                   for v in out_vars}
@@ -562,7 +574,8 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
                              highlight=False)
     ui.console.print(f"results: {out / 'results.nc'} (and .csv, .mat); store: "
                      f"{out / 'study.sqlite'}"
-                     + (f"; {_count(len(figs), 'figure')} in {out / 'figures'}" if figs else ""))
+                     + (f"; {_count(sum(f.endswith('.png') for f in figs), 'figure')} in "
+                        f"{out / 'figures'} (PNG and SVG)" if figs else ""))
 
 
 def _cases_with_values(ds, cases: list[int]) -> str:
