@@ -63,6 +63,10 @@ def test_sweep_one_liner(tmp_path, split_file):
     assert lsc[0] < lsc[1] < lsc[2]
     bad = runner.invoke(app, ["sweep", str(split_file), "--vary", "meshes.a1.stiffness=1:2"])
     assert bad.exit_code == 2 and "START:STOP:NUM" in bad.output
+    # an empty range: the remedy in --vary's terms (it offered 'values', a study field)
+    bad = runner.invoke(app, ["sweep", str(split_file), "--vary", "meshes.a1.stiffness=5:5:3"])
+    assert bad.exit_code == 2 and "one value as START:START:1" in bad.output
+    assert "'values'" not in bad.output
     # a resume with another range names the sweep's option, not the study field it makes
     # ('grid.parameters.0.stop: 10.0 -> 12.0', a studies reviewer)
     other = runner.invoke(app, ["sweep", str(split_file), "--vary",

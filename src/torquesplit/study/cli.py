@@ -281,7 +281,10 @@ def _sweep_option(field: str, flag: str) -> str:
 _SWEEP_WORDS = (('use spacing = "linear"', "leave out --log"),
                 # (the study file's key, where the sweep's unit follows the count)
                 ("given for a plain-number field; remove 'unit'",
-                 "given for a plain-number field; write no unit after the count"))
+                 "given for a plain-number field; write no unit after the count"),
+                # (--vary takes a range only: one value is START:START:1)
+                ("give a different stop, or 'values'",
+                 "give a different STOP, or one value as START:START:1"))
 
 
 def _sweep_words(message: str) -> str:
