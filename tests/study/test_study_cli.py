@@ -64,7 +64,8 @@ def test_sweep_one_liner(tmp_path, split_file):
     bad = runner.invoke(app, ["sweep", str(split_file), "--vary", "meshes.a1.stiffness=1:2"])
     assert bad.exit_code == 2 and "START:STOP:NUM" in bad.output
     # an empty range: the remedy in --vary's terms (it offered 'values', a study field)
-    bad = runner.invoke(app, ["sweep", str(split_file), "--vary", "meshes.a1.stiffness=5:5:3"])
+    bad = runner.invoke(app, ["sweep", str(split_file), "--vary",
+                              "meshes.a1.stiffness=5:5:3N/um"])
     assert bad.exit_code == 2 and "one value as START:START:1" in bad.output
     assert "'values'" not in bad.output
     # a resume with another range names the sweep's option, not the study field it makes
