@@ -277,8 +277,9 @@ def quasi_static_load_sharing(model, *, revolutions: float | None = None,
         warn_user(
             f"the quasi-static sweep is cut to max_points = {max_points} positions, "
             f"{n / (period * f_max):.3g} per cycle of the fastest excitation ({f_max:.6g} "
-            f"Hz) instead of {per_cycle}; raise max_points (--max-points; a study's [analysis] max_points) or "
-            f"give fewer revolutions for the full density", ModelWarning)
+            f"Hz) instead of {per_cycle}; raise max_points (--max-points; a study's "
+            f"[analysis] max_points) or give fewer revolutions for the full density",
+            ModelWarning)
     times = np.arange(n) * (period / n)
     sol = quasi_static(structure, times, progress=progress)
     return QuasiStaticResults(model=model, kinematics=kin, structure=structure, solution=sol)
