@@ -569,3 +569,19 @@ def test_a_stop_under_overwrite_says_to_resume_in_its_place(tmp_path, split_file
     assert res.exit_code == 130
     assert "run the same command with --resume in place of --overwrite" in " ".join(
         res.output.split())
+
+
+def test_overwrite_removes_the_studys_own_figures_only(tmp_path, split_file):
+    """--overwrite removed every PNG and SVG in figures/, a user's own plot there too (a
+    studies reviewer): the study lists the figures it wrote, and removes those."""
+    data = grid_study(split_file, GRID[:1])
+    data["grid"]["parameters"][0]["num"] = 2
+    path = _write(tmp_path, data)
+    out = tmp_path / "o"
+    Study(path).run(workers=1, out=out)
+    ours = sorted(p.name for p in (out / "figures").glob("*.png"))
+    assert ours
+    (out / "figures" / "my_plot.png").write_bytes(b"mine")
+    Study(path).run(workers=1, out=out, overwrite=True, figures=False)
+    left = sorted(p.name for p in (out / "figures").iterdir())
+    assert left == ["my_plot.png"]

@@ -314,7 +314,11 @@ def _write_outputs(ds, out: Path, figures: bool) -> None:
     if figures:
         from .figures import write_study_figures
 
-        write_study_figures(ds, out / "figures")
+        written = write_study_figures(ds, out / "figures")
+        # the figures this study wrote, which an --overwrite removes (and no others: a
+        # user's own plot in figures/ went too, a studies reviewer)
+        manifest = out / "figures" / FIGURE_MANIFEST
+        manifest.write_text(json.dumps(sorted(Path(p).name for p in written)))
 
 
 def _backend_runner(plan: Plan, backend: str, precision, client, scheduler, runner,
@@ -421,6 +425,21 @@ def _open_store(plan: Plan, out, resume: bool, overwrite: bool,
     return store
 
 
+#: in a study's figures folder: the names of the figures the study wrote
+FIGURE_MANIFEST = ".torquesplit_figures.json"
+
+
+def _study_figures(folder: Path) -> list[Path]:
+    """The figures an earlier study wrote into ``folder``: those its manifest names, or
+    (a folder of a version that wrote none) every PNG and SVG there."""
+    manifest = folder / FIGURE_MANIFEST
+    try:
+        names = json.loads(manifest.read_text())
+        return [folder / Path(str(n)).name for n in names] + [manifest]
+    except (OSError, ValueError, TypeError):
+        return [*folder.glob("*.png"), *folder.glob("*.svg")]
+
+
 def _open_folder(plan: Plan, out: Path, resume: bool, overwrite: bool,
                  words: Words) -> Store:
     path = out / STORE_NAME
@@ -428,7 +447,7 @@ def _open_folder(plan: Plan, out: Path, resume: bool, overwrite: bool,
         for suffix in ("", "-wal", "-shm"):
             Path(str(path) + suffix).unlink(missing_ok=True)
     if overwrite:  # the earlier study's figures go with it (they stayed beside the new)
-        for figure in [*(out / "figures").glob("*.png"), *(out / "figures").glob("*.svg")]:
+        for figure in _study_figures(out / "figures"):
             figure.unlink(missing_ok=True)
     exists = path.exists()
     if exists and not resume:
