@@ -123,7 +123,7 @@ class ModelError(TorquesplitError, ValueError):
         groups: dict = {}
         for loc, msg in self.issues:
             core = _PAIR_PREFIX.sub("", msg) if loc else msg
-            key = (core, loc) if core.startswith(_OWN_PROBLEMS) else core
+            key = (core, loc if core.startswith(_OWN_PROBLEMS) else None)
             groups.setdefault(key, []).append((loc, msg))
         def where(loc: str) -> str:
             if not source:
@@ -136,7 +136,7 @@ class ModelError(TorquesplitError, ValueError):
             return clip_text(source, 2 * QUOTE_LIMIT) + (f":{line}" if line else "") + ": "
 
         text = []
-        for members in groups.values():
+        for (core, _), members in groups.items():
             if len(members) == 1:
                 loc, msg = members[0]
                 text.append(where(loc) + (f"{loc}: " if loc else "") + msg)
@@ -145,7 +145,6 @@ class ModelError(TorquesplitError, ValueError):
             first = named[0] if named else ""
             if len(named) > 10:
                 named = named[:9] + [f"{len(named) - 9} more"]
-            core = _PAIR_PREFIX.sub("", members[0][1]) if members[0][0] else members[0][1]
             text.append(where(first) + (f"{', '.join(named)}: " if named else "") + core)
         super().__init__("\n".join(text))
 
