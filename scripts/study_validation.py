@@ -216,7 +216,7 @@ def _num(x):
 def collect(name: str, folder: Path) -> dict:
     """Every number of one finished study."""
     from torquesplit.study import load_results
-    from torquesplit.study.figures import _coord
+    from torquesplit.study.dataset import display_values
 
     ds = load_results(folder)
     outs = [v for v in ds.data_vars if "output" in ds[v].attrs]
@@ -236,7 +236,7 @@ def collect(name: str, folder: Path) -> dict:
         dims = list(ds[outs[0]].dims)
         entry["parameters"] = {}
         for d in dims:
-            values, unit = _coord(ds, d)
+            values, unit = display_values(ds, d)
             entry["parameters"][d] = {"unit": unit, "values": [_num(v) for v in values],
                                       "paths": json.loads(ds[d].attrs["paths"])}
         entry["outputs"] = {ds[v].attrs["output"]: np.vectorize(_num, otypes=[object])(

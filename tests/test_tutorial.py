@@ -91,4 +91,7 @@ def test_the_load_sharing_doc_prints_digits_that_hold(example):
         return
     assert printed[:-2] == expected[:-2]
     for shown, k in zip(printed[-2:], keys[-2:]):
-        assert float(shown) == pytest.approx(check.values[k], rel=0.05), k
+        # within 5 % and the rounding of the digits shown (2.61 held to one digit is 3)
+        decimals = len(shown.partition(".")[2])
+        assert abs(float(shown) - check.values[k]) <= (0.05 * abs(check.values[k])
+                                                       + 0.5 * 10.0 ** -decimals), k
