@@ -146,12 +146,15 @@ def test_the_step_and_position_bounds_a_message_points_to_are_study_fields(split
     reason = str(ds["reason"].values[0])
     assert ds["status"].values[0] == "refused"
     assert "max_steps = 100" in reason and "a study's [analysis] max_steps" in reason
+    assert "settled" in ds.data_vars
     static = {"study": {"name": "s", "model": "mo2017_star_reducer",
                         "outputs": ["load_sharing.static_torque"]},
               "analysis": {"type": "static", "revolutions": 0.05, "max_points": 16},
               "grid": {"parameters": [{"path": "gears.*.errors.eccentricity", "name": "e",
                                        "values": ["0 um"]}]}}
     ds = run_study(static, workers=1)
+    # (every case of a quasi-static study was 'settled = 1': it has nothing to settle)
+    assert "settled" not in ds.data_vars
     said = str(ds["warnings"].values[0])
     assert ds["status"].values[0] == "ok" and "cut to max_points = 16 positions" in said
     assert "a study's [analysis] max_points" in said

@@ -226,37 +226,37 @@ class GearGeometry:
             )
 
     # -- basic transverse quantities (ISO 21771 §4) --------------------------------
-    @property
+    @cached_property
     def beta(self) -> float:
         """Magnitude of the reference helix angle [rad]."""
         return abs(self.helix_angle)
 
-    @property
+    @cached_property
     def transverse_module(self) -> float:
         """``m_t = m_n / cos(beta)`` [m] (ISO 21771 eq. (4.3))."""
         return self.normal_module / math.cos(self.beta)
 
-    @property
+    @cached_property
     def transverse_pressure_angle(self) -> float:
         """``alpha_t = atan(tan(alpha_n) / cos(beta))`` [rad] (ISO 21771 eq. (4.4))."""
         return math.atan(math.tan(self.normal_pressure_angle) / math.cos(self.beta))
 
-    @property
+    @cached_property
     def base_helix_angle(self) -> float:
         """``beta_b = atan(tan(beta) cos(alpha_t))`` [rad] (ISO 21771 eq. (4.12))."""
         return math.atan(math.tan(self.beta) * math.cos(self.transverse_pressure_angle))
 
-    @property
+    @cached_property
     def reference_radius(self) -> float:
         """``r = z m_t / 2`` [m]."""
         return 0.5 * self.teeth * self.transverse_module
 
-    @property
+    @cached_property
     def base_radius(self) -> float:
         """``r_b = r cos(alpha_t)`` [m]."""
         return self.reference_radius * math.cos(self.transverse_pressure_angle)
 
-    @property
+    @cached_property
     def tip_radius(self) -> float:
         """Tip radius [m]: ``r + m_n (h_a + x)``; internal ``r - m_n (h_a - x)``."""
         m = self.normal_module
@@ -264,7 +264,7 @@ class GearGeometry:
             return self.reference_radius - m * (self.addendum - self.profile_shift)
         return self.reference_radius + m * (self.addendum + self.profile_shift)
 
-    @property
+    @cached_property
     def root_radius(self) -> float:
         """Root radius [m]: ``r - m_n (h_f - x)``; internal ``r + m_n (h_f + x)``."""
         m = self.normal_module
@@ -272,22 +272,22 @@ class GearGeometry:
             return self.reference_radius + m * (self.dedendum + self.profile_shift)
         return self.reference_radius - m * (self.dedendum - self.profile_shift)
 
-    @property
+    @cached_property
     def transverse_base_pitch(self) -> float:
         """``p_bt = 2 pi r_b / z = pi m_t cos(alpha_t)`` [m]."""
         return 2.0 * math.pi * self.base_radius / self.teeth
 
-    @property
+    @cached_property
     def normal_base_pitch(self) -> float:
         """``p_bn = pi m_n cos(alpha_n)`` [m]."""
         return math.pi * self.normal_module * math.cos(self.normal_pressure_angle)
 
-    @property
+    @cached_property
     def total_face_width(self) -> float:
         """Active face width of the gear [m]: ``2 b`` if double-helical, else ``b``."""
         return 2.0 * self.face_width if self.double_helical else self.face_width
 
-    @property
+    @cached_property
     def virtual_teeth(self) -> float:
         """Virtual number of teeth ``z_n = z / (cos^2(beta_b) cos(beta))`` [-]
         (ISO 6336-1:2019, used by the single stiffness); infinite for internal gears."""
@@ -295,7 +295,7 @@ class GearGeometry:
             return math.inf
         return self.teeth / (math.cos(self.base_helix_angle) ** 2 * math.cos(self.beta))
 
-    @property
+    @cached_property
     def base_half_angle(self) -> float:
         """Half the angle the tooth subtends at the base circle [rad] (external gears).
 
@@ -309,7 +309,7 @@ class GearGeometry:
         return ((math.pi / 2 + 2.0 * self.profile_shift * math.tan(self.normal_pressure_angle))
                 / self.teeth + float(involute(self.transverse_pressure_angle)))
 
-    @property
+    @cached_property
     def tip_thickness(self) -> float:
         """Transverse tooth thickness on the tip circle [m] (external gears; negative where
         the flanks cross below the tip: a pointed tooth).
@@ -322,7 +322,7 @@ class GearGeometry:
             return 2.0 * ra * self.base_half_angle
         return 2.0 * ra * (self.base_half_angle - float(involute(math.acos(rb / ra))))
 
-    @property
+    @cached_property
     def root_half_angle(self) -> float:
         """Half angle ``theta_f`` of the tooth at the root circle [rad] (external gears).
 

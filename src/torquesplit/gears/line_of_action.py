@@ -37,6 +37,7 @@ cone angle is 0 and the face gear's is the shaft angle.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -71,16 +72,21 @@ class ContactFrame:
 
 def gear_geometry(gear, teeth=None) -> GearGeometry:
     """Involute geometry of a schema gear (``teeth`` overrides, for virtual gears)."""
-    return GearGeometry(
-        teeth=teeth if teeth is not None else gear.teeth,
-        normal_module=gear.module,
-        normal_pressure_angle=gear.pressure_angle,
-        helix_angle=abs(gear.helix_angle),
-        face_width=gear.face_width,
-        profile_shift=gear.profile_shift,
-        internal=gear.gear_type == "internal",
-        double_helical=gear.gear_type == "double_helical",
-    )
+    return _geometry(teeth if teeth is not None else gear.teeth, gear.module,
+                     gear.pressure_angle, abs(gear.helix_angle), gear.face_width,
+                     gear.profile_shift, gear.gear_type)
+
+
+@functools.lru_cache(maxsize=1024)
+def _geometry(teeth, module, pressure_angle, helix_angle, face_width, profile_shift,
+              gear_type) -> GearGeometry:
+    """One (immutable) geometry per set of values: a model's set-up asks for each gear's
+    about ten times, and its derived radii and angles are computed once."""
+    return GearGeometry(teeth=teeth, normal_module=module,
+                        normal_pressure_angle=pressure_angle, helix_angle=helix_angle,
+                        face_width=face_width, profile_shift=profile_shift,
+                        internal=gear_type == "internal",
+                        double_helical=gear_type == "double_helical")
 
 
 def _perp_unit(v: np.ndarray, axis: np.ndarray) -> np.ndarray:

@@ -180,6 +180,13 @@ def _steady_summary(attrs) -> dict:
     return out
 
 
+def _copied(obj):
+    """A dataclass of metrics with its own copies of its dict fields (their values are
+    numbers, strings or tuples): a caller's change does not reach the kept one."""
+    return dataclasses.replace(obj, **{f.name: dict(v) for f in dataclasses.fields(obj)
+                                       if isinstance(v := getattr(obj, f.name), dict)})
+
+
 class Results:
     """A finished (or stopped) dynamic run and everything needed to interpret it."""
 
@@ -349,6 +356,33 @@ class Results:
                                                and 0 < tolerance < 1):
             raise OptionError(f"tolerance must be a fraction between 0 and 1, got "
                               f"{tolerance!r}; give e.g. tolerance=0.01 (1 %)")
+        st, dyn, rows = self._metric_base(int(window), float(tolerance))
+        names = self.mesh_names
+        c_max, _, c_mean, c_cnt, c_ratio = self.complete_cycle_statistics()
+        c_start = self.solution.cycle_start[:, self._mesh_columns]
+        groups = self.groups
+        if definition == "cycle_peak":
+            lsc = ls.cycle_peak(c_max, c_start, names, groups, st.first_cycle)
+        elif definition == "mean_force":  # (every group over the same span)
+            lsc = ls.mean_force(c_mean, c_cnt, c_start, names, groups, st.mean_first)
+        else:
+            lsc = ls.instantaneous(c_ratio, c_start, names, groups, st.first_cycle,
+                                   definition)
+        rows = [dataclasses.replace(r, load_sharing=lsc.per_mesh[r.mesh]) for r in rows]
+        return Metrics(definition, st, lsc, dyn, rows)
+
+    def _metric_base(self, window: int, tolerance: float):
+        """What :meth:`metrics` gives whatever the definition: the settling, the dynamic
+        factors and the mesh rows (load sharing NaN), computed once per ``window`` and
+        ``tolerance`` (a study case asks for two definitions, the report for four); each
+        call gets its own copy of the mutable parts."""
+        cache = self.__dict__.setdefault("_metric_bases", {})
+        if (window, tolerance) not in cache:
+            cache[window, tolerance] = self._compute_metric_base(window, tolerance)
+        st, dyn, rows = cache[window, tolerance]
+        return _copied(st), _copied(dyn), rows
+
+    def _compute_metric_base(self, window: int, tolerance: float):
         s = self.solution
         names = self.mesh_names
         c_max, c_min, c_mean, c_cnt, c_ratio = self.complete_cycle_statistics()
@@ -361,13 +395,6 @@ class Results:
             # state's groups are over whole periods already)
             st = dataclasses.replace(st, mean_first_cycle=ls.common_first_cycle(
                 st, c_start, names))
-        if definition == "cycle_peak":
-            lsc = ls.cycle_peak(c_max, c_start, names, groups, st.first_cycle)
-        elif definition == "mean_force":  # (every group over the same span)
-            lsc = ls.mean_force(c_mean, c_cnt, c_start, names, groups, st.mean_first)
-        else:
-            lsc = ls.instantaneous(c_ratio, c_start, names, groups, st.first_cycle,
-                                   definition)
         nominal = self.nominal_forces()
         static = self.static_forces()
         dyn = ls.dynamic_factors(c_max, names, groups, st.first_cycle, static, nominal)
@@ -386,13 +413,13 @@ class Results:
                 min_force=-ls._nanmax(-c_min[k0:, j]),
                 dynamic_factor=dyn.dynamic_factor[m],
                 dynamic_factor_engineering=dyn.dynamic_factor_engineering[m],
-                peak_to_nominal=dyn.peak_to_nominal[m], load_sharing=lsc.per_mesh[m],
+                peak_to_nominal=dyn.peak_to_nominal[m], load_sharing=math.nan,
                 contact_loss=float(s.separation_fraction[el.index(m)]),
                 back_contact=back,
                 back_flank_force=back_flank_force(c_min[k0:, j]) if back > 0 or double else 0.0,
                 double_flank=double,
             ))
-        return Metrics(definition, st, lsc, dyn, rows)
+        return st, dyn, rows
 
     @property
     def default_definition(self) -> str:
@@ -422,7 +449,12 @@ class Results:
     def complete_cycle_statistics(self):
         """Per-cycle (max, min, mean, count, largest instantaneous ratio) of every mesh,
         (n_cycles, n_meshes) each, with the incomplete cycles (:attr:`complete_cycles`)
-        emptied: NaN statistics and count 0."""
+        emptied: NaN statistics and count 0.  Read-only arrays, computed once (every
+        metric, table and figure reads them)."""
+        return self._complete_cycle_statistics
+
+    @cached_property
+    def _complete_cycle_statistics(self):
         s = self.solution
         cols = self._mesh_columns
         partial = ~self.complete_cycles
@@ -430,6 +462,7 @@ class Results:
         for a in (s.cycle_max, s.cycle_min, s.cycle_mean, s.cycle_count, s.cycle_ratio_max):
             a = np.array(a[:, cols])
             a[partial] = 0 if a.dtype.kind in "iu" else np.nan
+            a.flags.writeable = False
             out.append(a)
         return tuple(out)
 

@@ -79,7 +79,7 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
     hist_units = [all_units[i] for i in s.history_elements]
     mesh_cols = [list(s.tracked_elements).index(el.index(m)) for m in meshes]
     # a cycle cut by the start or the end of the run holds part of a cycle: emptied
-    c_max, c_min, c_mean, _, c_ratio = res.complete_cycle_statistics()
+    c_max, c_min, c_mean, _, c_ratio = (a.copy() for a in res.complete_cycle_statistics())
     ratio_min = np.where(res.complete_cycles, s.cycle_ratio_min[:, mesh_cols], np.nan)
     ds = xr.Dataset(
         data_vars={

@@ -14,7 +14,8 @@ output variables       one per requested output, named as the output
 ``reason``             why a case is not ok ("" when it is)
 ``settled``            1 when the metrics found a settled part and, with a settle rule,
                        the outputs (``settle_time`` excepted) agreed between the last
-                       two run lengths; 0 otherwise
+                       two run lengths; 0 otherwise (runs only: a quasi-static
+                       study has no such variable)
 ``warnings``           the case's warnings, one a line ("" when none): the model checks'
                        (a unit slip), the run's (too short to tell whether it settled,
                        not settled, contact loss...); ``warning_count``: how many
@@ -104,10 +105,11 @@ def build_dataset(plan, rows, n: int, meta: dict):
         "long_name": "case status", "flag_meanings": "ok contact_lost diverged refused error "
                                                      "missing"})
     data["reason"] = var(reason.astype(str), {"long_name": "why the case is not ok"})
-    data["settled"] = var(settled.astype(np.int8), {
-        "units": "1", "long_name": "1: the run's metrics found a settled part and, with "
-                                   "analysis.settle, the outputs (settle_time excepted) "
-                                   "agreed between the last two run lengths; 0: not"})
+    if plan.analysis["type"] != "static":  # (a quasi-static sweep has nothing to settle)
+        data["settled"] = var(settled.astype(np.int8), {
+            "units": "1", "long_name": "1: the run's metrics found a settled part and, with "
+                                       "analysis.settle, the outputs (settle_time excepted) "
+                                       "agreed between the last two run lengths; 0: not"})
     data["warnings"] = var(warned.astype(str), {
         "long_name": "the case's warnings (model checks, run plausibility), one a line"})
     data["warning_count"] = var(n_warned, {"units": "1", "long_name": "number of warnings "

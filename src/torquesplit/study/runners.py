@@ -47,7 +47,8 @@ class SerialRunner:
 
 def worker_start() -> None:  # pragma: no cover - runs in the worker processes
     """A worker's set-up: Ctrl-C ignored (it goes to the whole process group: the driver
-    stops the workers itself), and an exit as soon as the driver is gone.  A driver
+    stops the workers itself), the heap frozen after the first case
+    (:data:`.case.FREEZE_HEAP`), and an exit as soon as the driver is gone.  A driver
     killed outright (SIGKILL, the out-of-memory killer) cannot stop its pool, whose
     workers then waited for work forever: a daemon thread waits on the parent
     process's sentinel, which becomes ready when it dies."""
@@ -55,7 +56,10 @@ def worker_start() -> None:  # pragma: no cover - runs in the worker processes
     import threading
     from multiprocessing.connection import wait
 
+    from . import case
+
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    case.FREEZE_HEAP = True
     parent = multiprocessing.parent_process()
     if parent is None:
         return
