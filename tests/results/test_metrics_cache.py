@@ -54,3 +54,16 @@ def test_a_callers_change_does_not_reach_the_next_call(run):
     ds = res.to_dataset()
     ds["cycle_max_force"] /= 1e3  # (a Dataset is the user's to change in place)
     assert np.isfinite(res.complete_cycle_statistics()[0]).any()
+
+
+@pytest.mark.parametrize("definition", DYNAMIC_DEFINITIONS)
+def test_per_cycle_series_are_the_callers(run, definition):
+    """The per-cycle coefficients a caller gets are its own arrays (the instantaneous
+    ones were views of the run's read-only statistics: a reviewer)."""
+    res = _fresh(run)
+    mesh = res.mesh_names[0]
+    series = res.metrics(definition).load_sharing.per_cycle[mesh]
+    kept = series.copy()
+    series[:] = -1.0
+    assert np.array_equal(res.metrics(definition).load_sharing.per_cycle[mesh], kept,
+                          equal_nan=True)

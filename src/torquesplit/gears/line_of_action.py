@@ -77,7 +77,7 @@ def gear_geometry(gear, teeth=None) -> GearGeometry:
                      gear.profile_shift, gear.gear_type)
 
 
-@functools.lru_cache(maxsize=1024)
+@functools.lru_cache(maxsize=1024, typed=True)  # (typed: 20.0 teeth is refused, 20 not)
 def _geometry(teeth, module, pressure_angle, helix_angle, face_width, profile_shift,
               gear_type) -> GearGeometry:
     """One (immutable) geometry per set of values: a model's set-up asks for each gear's

@@ -381,7 +381,7 @@ def instantaneous(cycle_ratio_max, cycle_start, names, groups, first_cycle,
     for g, members in groups.items():
         for m in members:
             peaks = cycle_ratio_max[:, col[m]]
-            per_cycle[m] = peaks
+            per_cycle[m] = peaks.copy()  # (the caller's: the run's statistics are read-only)
             times[m] = cycle_start[:, col[m]]
             per_mesh[m] = reduce(peaks[first_cycle[m]:])
         per_group[g] = max(per_mesh[m] for m in members)

@@ -53,7 +53,9 @@ def run_case(p: dict) -> dict:
         warnings.simplefilter("always")
         try:
             data = apply_overrides(p["model"], p["overrides"])
-            # (the case's data is its own: set_parameter copies what it changes)
+            # (kept uncopied: the data shares all but its overridden paths with the
+            # plan's, and nothing changes either in place: set_parameter copies the path
+            # it changes, with_changes too)
             model = load_model(model_from_dict(data, source=p["source"], share_source=True))
             if p["analysis"]["type"] == "static":
                 values = _static(model, p, out)
@@ -70,6 +72,7 @@ def run_case(p: dict) -> dict:
     global FREEZE_HEAP
     if FREEZE_HEAP:  # (after the first case: its imports and kernels are there now)
         FREEZE_HEAP = False
+        gc.collect()  # (the first case's garbage: frozen, it would never be freed)
         gc.freeze()
     out["wall_time"] = time.perf_counter() - t0
     return out
