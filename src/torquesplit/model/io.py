@@ -168,8 +168,9 @@ def model_from_dict(data: dict[str, Any], source: str | None = None, *,
     """Validate a dict against the schema; errors name every offending field.
 
     The model keeps a copy of ``data`` (:meth:`Model.with_changes` applies changes to
-    it); with ``share_source`` it keeps ``data`` itself, which the caller then must never
-    change (a study case's data, made for it alone: the copy was 1.5 ms of a case)."""
+    it); with ``share_source`` it keeps ``data`` itself, which then must never change in
+    place (a study case's data, which shares its unchanged tables with the study's; the
+    copy was 1.5 ms of a case)."""
     if not isinstance(data, dict):
         raise ModelError([("", "a model file must contain a table of sections")], source)
     if "study" in data and not any(k in data for k in MODEL_SECTIONS):
