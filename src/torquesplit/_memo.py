@@ -6,7 +6,8 @@ a run's cost check and its integrator both plan the same RK4 step.
 :func:`remember_last` keeps, for each object still alive (held by a weak reference, so
 nothing is kept alive and an entry leaves with its object), the result of the last
 arguments it was called with, and replays the warnings the first call gave, so that
-every caller sees what an uncached call would have shown.
+every caller sees what an uncached call would have shown.  :func:`hash_arrays` makes the
+keys of results computed from arrays.
 """
 
 from __future__ import annotations
@@ -54,3 +55,16 @@ def remember_last(fn=None, *, replay: bool = True):
 
     wrapper.cache = cache
     return wrapper
+
+
+def hash_arrays(h, arrays):
+    """Feed each array's dtype, shape and bytes (C order) to the hashlib object ``h``
+    and return it: the key of a result computed from those arrays (equal digests, equal
+    arrays)."""
+    import numpy as np
+
+    for x in arrays:
+        arr = np.ascontiguousarray(x)
+        h.update(str((arr.dtype, arr.shape)).encode())
+        h.update(arr.tobytes())
+    return h

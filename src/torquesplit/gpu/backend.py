@@ -39,6 +39,7 @@ from typing import Callable
 
 import numpy as np
 
+from .._memo import hash_arrays
 from ..assembly.tables import TABLES
 from ..errors import warn_user
 from .layout import IdentityMemo
@@ -372,11 +373,7 @@ def _table_key(run) -> str:
     current = tuple(getattr(run.structure, f) for f in TABLES)
 
     def digest():
-        h = hashlib.blake2b(digest_size=16)
-        for a in current:
-            h.update(str((a.dtype, a.shape)).encode())
-            h.update(np.ascontiguousarray(a).tobytes())
-        return h.hexdigest()
+        return hash_arrays(hashlib.blake2b(digest_size=16), current).hexdigest()
 
     return _KEYS.get(current, digest)
 

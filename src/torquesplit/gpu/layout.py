@@ -28,6 +28,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from torquesplit._memo import hash_arrays
 from torquesplit.solve import _kernels as kern
 
 __all__ = ["CaseArrays", "Layout", "Group", "group_cases", "pattern_key"]
@@ -153,11 +154,7 @@ def pattern_key(case: CaseArrays) -> str:
         np.asarray([c for g in case.groups for c in g], dtype=np.int64),
         np.float64(case.blowup),
     ]
-    for x in parts:
-        arr = np.ascontiguousarray(x)
-        h.update(str((arr.dtype, arr.shape)).encode())
-        h.update(arr.tobytes())
-    return h.hexdigest()
+    return hash_arrays(h, parts).hexdigest()
 
 
 def group_cases(cases: list[CaseArrays]) -> dict[str, list[int]]:

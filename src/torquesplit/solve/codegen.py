@@ -73,6 +73,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._memo import hash_arrays
 from . import kernel_data as kd
 from . import laws
 
@@ -358,16 +359,11 @@ def _pattern_key(model) -> str:
     gp, gv = a["gap_ptr"], a["gap_values"]
     gapped = np.array([np.any(gv[gp[e]:gp[e + 1]] > 0.0) for e in range(gp.shape[0] - 1)])
     has_error, has_force = _error_and_force_flags(a)
-    h = hashlib.sha256()
-    for x in (np.int64(a["inv_mass"].shape[0]), a["vr_ptr"], a["vq_idx"], a["vt_ptr"],
-              a["vt_el"], a["gy_ptr"], a["gy_idx"], a["fs_ptr"], a["fs_idx"], gapped,
-              has_error, has_force, np.asarray(a["sp_el"], dtype=np.int64), a["fr_el"],
-              a["fr_ptr"], a["fr_dof"], a["fr_row"],
-              np.int64(a["friction_table"].shape[0])):
-        arr = np.ascontiguousarray(x)
-        h.update(str((arr.dtype, arr.shape)).encode())
-        h.update(arr.tobytes())
-    return h.hexdigest()
+    return hash_arrays(hashlib.sha256(), (
+        np.int64(a["inv_mass"].shape[0]), a["vr_ptr"], a["vq_idx"], a["vt_ptr"], a["vt_el"],
+        a["gy_ptr"], a["gy_idx"], a["fs_ptr"], a["fs_idx"], gapped, has_error, has_force,
+        np.asarray(a["sp_el"], dtype=np.int64), a["fr_el"], a["fr_ptr"], a["fr_dof"],
+        a["fr_row"], np.int64(a["friction_table"].shape[0]))).hexdigest()
 
 
 def _value_key(model) -> str:

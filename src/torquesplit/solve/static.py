@@ -804,15 +804,13 @@ def _mean_key(problem: _StaticProblem, *settings) -> bytes:
     regularisation, the names its messages use and the solver ``settings``."""
     import hashlib
 
+    from torquesplit._memo import hash_arrays
+
     s, L = problem.s, problem.loads(None)
-    h = hashlib.blake2b(digest_size=20)
-    arrays = (problem.V, problem.Kf, problem.mass, problem.phi, problem.sp_par, s.sp_el,
-              np.asarray(problem.reg, dtype=float), problem.linear, L.k, L.p, L.e, L.g,
-              L.f_eff, np.empty(0) if L.W is None else L.W)
-    for a in arrays:
-        a = np.ascontiguousarray(a)
-        h.update(f"{a.dtype.str}{a.shape}".encode())
-        h.update(a.tobytes())
+    h = hash_arrays(hashlib.blake2b(digest_size=20), (
+        problem.V, problem.Kf, problem.mass, problem.phi, problem.sp_par, s.sp_el,
+        np.asarray(problem.reg, dtype=float), problem.linear, L.k, L.p, L.e, L.g, L.f_eff,
+        np.empty(0) if L.W is None else L.W))
     h.update(repr((problem.has_gaps, s.dof_names, s.element_names, settings)).encode())
     return h.digest()
 
