@@ -56,3 +56,31 @@ def test_an_error_is_not_kept():
         with pytest.raises(ValueError):
             fails(x)
     assert len(calls) == 2
+
+
+def test_remember_content_keys_on_values_not_objects():
+    import numpy as np
+
+    from torquesplit._memo import remember_content
+
+    calls = []
+
+    @remember_content(kept=2)
+    def total(x, scale):
+        calls.append(1)
+        return float(np.sum(x)) * scale
+
+    a = np.arange(4.0)
+    assert total(a, 2.0) == 12.0
+    assert total(a.copy(), 2.0) == 12.0  # another object, the same content
+    assert len(calls) == 1
+    assert total(a, 3.0) == 18.0  # another number
+    assert total(a.astype(np.float32), 2.0) == 12.0  # another dtype: another key
+    assert total(a.reshape(2, 2), 2.0) == 12.0  # another shape: another key
+    assert len(calls) == 4
+    b = a.copy()
+    b[0] = 1.0
+    assert total(b, 2.0) == 14.0
+    assert len(total.cache) == 2  # the oldest dropped
+    total(a, 2.0)  # (dropped: computed again)
+    assert len(calls) == 6

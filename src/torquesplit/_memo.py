@@ -6,8 +6,10 @@ a run's cost check and its integrator both plan the same RK4 step.
 :func:`remember_last` keeps, for each object still alive (held by a weak reference, so
 nothing is kept alive and an entry leaves with its object), the result of the last
 arguments it was called with, and replays the warnings the first call gave, so that
-every caller sees what an uncached call would have shown.  :func:`hash_arrays` makes the
-keys of results computed from arrays.
+every caller sees what an uncached call would have shown.  :func:`remember_content`
+keeps the results of a function of arrays by their content, across objects: the cases of
+a study that vary only errors or phases build new structures whose matrices are the
+same.  :func:`hash_arrays` makes the keys of results computed from arrays.
 """
 
 from __future__ import annotations
@@ -52,6 +54,30 @@ def remember_last(fn=None, *, replay: bool = True):
             note_warning(w.message, w.category)
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
         return result
+
+    wrapper.cache = cache
+    return wrapper
+
+
+def remember_content(fn=None, *, kept: int = 8):
+    """Decorator: ``fn(*arrays)`` computed once per content of its arguments (arrays or
+    numbers: dtype, shape and bytes, :func:`hash_arrays`) in this process, the oldest of
+    more than ``kept`` dropped.  For pure functions whose results nobody changes (make
+    arrays read-only); the table (digest -> result) is ``wrapper.cache``."""
+    if fn is None:
+        return functools.partial(remember_content, kept=kept)
+    import hashlib
+
+    cache: dict = {}
+
+    @functools.wraps(fn)
+    def wrapper(*args):
+        key = hash_arrays(hashlib.blake2b(digest_size=20), args).digest()
+        if key not in cache:
+            while len(cache) >= kept:
+                cache.pop(next(iter(cache)))
+            cache[key] = fn(*args)
+        return cache[key]
 
     wrapper.cache = cache
     return wrapper

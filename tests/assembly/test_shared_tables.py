@@ -40,3 +40,27 @@ def test_a_shared_set_is_held_weakly():
     del a
     gc.collect()
     assert ref() is None
+
+
+def test_a_constant_stiffness_table_is_kept_by_its_values():
+    """The rectangular wave of a "constant" stiffness is computed once per set of values
+    (a model's checks and assembly ask for it three times per mesh), read-only, and is
+    the wave of its definition."""
+    import numpy as np
+    import pytest
+
+    from torquesplit.assembly import excitation
+    from torquesplit.model.kinematics import solve_kinematics
+
+    model = torquesplit.load_model("ji_li_mill_drive")
+    kin = solve_kinematics(model)
+    name = next(m for m, mesh in model.meshes.items() if mesh.stiffness.method == "constant")
+    spec = model.meshes[name].stiffness
+    k = excitation.stiffness_table(model, kin, name, 512)
+    assert excitation.stiffness_table(model, kin, name, 512) is k
+    with pytest.raises(ValueError):
+        k[0] = 1.0
+    eps = excitation._profile_contact_ratio(kin.meshes[name])
+    wave = excitation.contact_zone_wave(np.arange(512) / 512, spec.value, spec.peak_to_peak, eps)
+    assert np.array_equal(k, wave)
+    assert excitation.stiffness_table(model, kin, name, 256).shape == (256,)

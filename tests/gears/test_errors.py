@@ -188,3 +188,27 @@ def test_a_constant_deviation_is_normalised_as_a_general_one():
         for name in ("amplitudes", "omegas", "phases"):
             assert getattr(fast, name).shape == (0,) == getattr(general, name).shape
             assert getattr(fast, name).dtype == np.float64
+
+
+def test_normalised_terms_take_the_general_paths_values():
+    """Terms already normalised (omega > 0, amplitude > 0: every sum and scaling of
+    normalised deviations) skip the normalisation steps; the values, bit for bit, are
+    those of the general path (here forced by a zero-amplitude term, which it drops)."""
+    from torquesplit.gears.errors import LineOfActionDeviation
+
+    rng = np.random.default_rng(3)
+    for n in (1, 2, 5):
+        a = rng.uniform(1e-7, 1e-5, n)
+        w = rng.uniform(1.0, 5e3, n)
+        p = rng.uniform(-12.0, 12.0, n)  # (some outside [-pi, pi): wrapped either way)
+        for c in (0.0, -0.0, 3e-6):
+            fast = LineOfActionDeviation(c, a, w, p)
+            general = LineOfActionDeviation(c, np.append(a, 0.0), np.append(w, 7.0),
+                                            np.append(p, 0.1))
+            assert repr(fast.constant) == repr(general.constant)
+            for name in ("amplitudes", "omegas", "phases"):
+                assert getattr(fast, name).tobytes() == getattr(general, name).tobytes()
+    src = np.array([2e-6])
+    e = LineOfActionDeviation(0.0, src, [3.0], [0.2])
+    src[0] = 9.0  # the deviation holds its own copy
+    assert e.amplitudes[0] == 2e-6

@@ -29,6 +29,28 @@ def test_kernel_model_and_eigenvalues_are_kept_per_structure():
     assert id(s) in stability.stable_step.cache and id(s) in kernel_model.cache
 
 
+def test_equal_matrices_of_other_structures_share_their_eigen_problems():
+    """A study's cases build a new structure each; those whose matrices are equal (errors
+    and phases varied) share the step check's eigen problems, the rigid-body modes and the
+    keys of the generated code; a changed stiffness does not."""
+    from torquesplit.solve.static import rigid_body_modes
+
+    s, same, stiffer = (spur_pair(frequency=500.0), spur_pair(frequency=500.0),
+                        spur_pair(frequency=500.0, stiffness=4e8))
+    assert stability.system_eigenvalues(same) is stability.system_eigenvalues(s)
+    assert stability.system_eigenvalues(stiffer) is not stability.system_eigenvalues(s)
+    assert stability.stable_step(stiffer) < stability.stable_step(same)
+    assert stability.highest_mode(same) == stability.highest_mode(s)
+    assert stability.highest_mode(stiffer)[0] > stability.highest_mode(s)[0]
+    phi = rigid_body_modes(s)
+    assert rigid_body_modes(same) is phi and not phi.flags.writeable
+    damped = spur_pair(frequency=500.0, damping=50.0)  # (the code reads the stiffness
+    # tables at every call, a damping coefficient from its parameters or its literals)
+    assert codegen._value_key(kernel_model(s)) == codegen._value_key(kernel_model(same))
+    assert codegen._value_key(kernel_model(s)) != codegen._value_key(kernel_model(damped))
+    assert codegen._pattern_key(kernel_model(s)) == codegen._pattern_key(kernel_model(damped))
+
+
 def test_generated_functions_share_one_class():
     """numba types a first-class function argument by a dispatch on its class: one class
     for every generated function (a class per call missed that dispatch's cache)."""

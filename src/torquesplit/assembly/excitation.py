@@ -8,6 +8,7 @@ contact.
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -121,10 +122,8 @@ def stiffness_table(model: Model, kin: Kinematics, mesh_name: str, n: int) -> np
     phase = np.arange(n) / n
     mk = kin.meshes[mesh_name]
     if spec.method == "constant":
-        if spec.peak_to_peak == 0:
-            return np.full(n, spec.value)
-        return contact_zone_wave(phase, spec.value, spec.peak_to_peak,
-                                 _profile_contact_ratio(mk))
+        return _constant_table(int(n), float(spec.value), float(spec.peak_to_peak),
+                               float(_profile_contact_ratio(mk)))
     if spec.method == "table":
         src = np.asarray(spec.phase)
         order = np.argsort(src)
@@ -155,6 +154,19 @@ def stiffness_table(model: Model, kin: Kinematics, mesh_name: str, n: int) -> np
         opts = dict(fillet_foundation=spec.fillet_foundation, slices=spec.slices)
     ms = gst.mesh_stiffness(mk.geometry, spec.method, n=n, **opts)
     return np.interp(phase, np.asarray(ms.phase), np.asarray(ms.stiffness), period=1.0)
+
+
+@functools.lru_cache(maxsize=64)
+def _constant_table(n: int, value: float, peak_to_peak: float, contact_ratio: float):
+    """The table of a "constant" stiffness (read-only), kept by its values: a model is
+    checked and assembled with three of them per mesh, and a study's cases that vary
+    something else share them (2 ms of a Dong et al. 2021 case's set-up)."""
+    if peak_to_peak == 0:
+        k = np.full(n, value)
+    else:
+        k = contact_zone_wave(np.arange(n) / n, value, peak_to_peak, contact_ratio)
+    k.flags.writeable = False
+    return k
 
 
 def _profile_contact_ratio(mk) -> float:

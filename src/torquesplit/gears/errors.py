@@ -86,14 +86,22 @@ class LineOfActionDeviation:
             for name in ("amplitudes", "omegas", "phases"):
                 object.__setattr__(self, name, np.zeros(0))
             return
-        a = np.atleast_1d(np.asarray(self.amplitudes, dtype=float)).copy()
-        w = np.atleast_1d(np.asarray(self.omegas, dtype=float)).copy()
-        p = np.atleast_1d(np.asarray(self.phases, dtype=float)).copy()
+        a = np.array(self.amplitudes, dtype=float, ndmin=1)  # (copies)
+        w = np.array(self.omegas, dtype=float, ndmin=1)
+        p = np.array(self.phases, dtype=float, ndmin=1)
         if not (a.shape == w.shape == p.shape) or a.ndim != 1:
             raise ModelError(
                 "LineOfActionDeviation: amplitudes, omegas and phases must be 1-D and of equal "
                 f"length (got {a.shape}, {w.shape}, {p.shape})."
             )
+        if a.size and w.min() > 0.0 and a.min() > 0.0:  # nothing to move or drop (the
+            # terms of a sum or a scaling of normalised ones): the steps below would leave
+            # every value as it is but the phases (a sixth of a study case's set-up)
+            object.__setattr__(self, "constant", float(self.constant) + 0.0)
+            object.__setattr__(self, "amplitudes", a)
+            object.__setattr__(self, "omegas", w)
+            object.__setattr__(self, "phases", _wrap(p))
+            return
         # a sin(-|w| t + p) = a sin(|w| t - p + pi)
         neg_w = w < 0
         w[neg_w] = -w[neg_w]

@@ -128,8 +128,15 @@ def is_conical(gear_a, gear_b) -> bool:
 def cylindrical_pair(gear_a, gear_b) -> PairGeometry:
     """PairGeometry of two cylindrical gears (an internal gear is always put second)."""
     if gear_a.gear_type == "internal":
-        return PairGeometry(gear_geometry(gear_b), gear_geometry(gear_a))
-    return PairGeometry(gear_geometry(gear_a), gear_geometry(gear_b))
+        return _pair(gear_geometry(gear_b), gear_geometry(gear_a))
+    return _pair(gear_geometry(gear_a), gear_geometry(gear_b))
+
+
+@functools.lru_cache(maxsize=1024)
+def _pair(gear_1: GearGeometry, gear_2: GearGeometry) -> PairGeometry:
+    """One (immutable) pair per pair of geometries: a model's set-up asks for each mesh's
+    about four times (its checks and interference test ran each time)."""
+    return PairGeometry(gear_1, gear_2)
 
 
 def placed_position(model, name, ref, ref_position, ref_axis, angle) -> np.ndarray:

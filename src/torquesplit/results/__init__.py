@@ -457,10 +457,11 @@ class Results:
     def _complete_cycle_statistics(self):
         s = self.solution
         cols = self._mesh_columns
+        every = list(cols) == list(range(s.cycle_max.shape[1]))  # (a copy, not a gather)
         partial = ~self.complete_cycles
         out = []
         for a in (s.cycle_max, s.cycle_min, s.cycle_mean, s.cycle_count, s.cycle_ratio_max):
-            a = np.array(a[:, cols])
+            a = np.array(a if every else a[:, cols])
             a[partial] = 0 if a.dtype.kind in "iu" else np.nan
             a.flags.writeable = False
             out.append(a)

@@ -351,10 +351,30 @@ def _error_and_force_flags(a: dict):
     return has_error, has_force
 
 
+_LAST_KEYS = threading.local()
+"""Per thread, the keys of the last kernel model asked about (``keys``: model ->
+{"pattern", "value"}, that model held): a run asks for them up to six times (cached?
+worth it? available?), each digest 0.2-0.5 ms of a Dong et al. 2021 case.  A kernel
+model's arrays are not changed in place (:func:`.kernel_data.kernel_model`)."""
+
+
+def _last_key(model, kind: str, compute) -> str:
+    last = getattr(_LAST_KEYS, "keys", None)
+    if last is None or last[0] is not model:
+        last = _LAST_KEYS.keys = (model, {})
+    if kind not in last[1]:
+        last[1][kind] = compute(model)
+    return last[1][kind]
+
+
 def _pattern_key(model) -> str:
     """What the generated code depends on: sparsity of V, V^T and G, which elements have
     a dead zone, an error, an additive force, which are spline components, which meshes
     have tooth friction on which DOFs."""
+    return _last_key(model, "pattern", _pattern_digest)
+
+
+def _pattern_digest(model) -> str:
     a = _arrays(model)
     gp, gv = a["gap_ptr"], a["gap_values"]
     gapped = np.array([np.any(gv[gp[e]:gp[e + 1]] > 0.0) for e in range(gp.shape[0] - 1)])
@@ -368,6 +388,10 @@ def _pattern_key(model) -> str:
 
 def _value_key(model) -> str:
     """The pattern key and the values of every parameter array (a literal code's key)."""
+    return _last_key(model, "value", _value_digest)
+
+
+def _value_digest(model) -> str:
     a = _arrays(model)
     h = hashlib.sha256(_pattern_key(model).encode())
     for name in PARAMETER_ARRAYS:

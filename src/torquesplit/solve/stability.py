@@ -18,7 +18,7 @@ import math
 
 import numpy as np
 
-from torquesplit._memo import remember_last
+from torquesplit._memo import remember_content, remember_last
 from torquesplit.assembly.structure import Structure
 from torquesplit.errors import StepTooLargeError
 
@@ -61,17 +61,26 @@ def system_eigenvalues(structure: Structure) -> np.ndarray:
     """Eigenvalues of the first-order system at maximum stiffness, all gaps closed [1/s].
 
     Round-off positive real parts (below 1e-8 max|lambda|) are set to zero.  Kept per
-    live structure (frozen) and returned read-only: a run with a given step checks it
-    with two of these eigenvalue problems (6 ms of every run of Ji & Li's drive).
+    live structure (frozen), and per system matrix (:func:`_eigenvalues`), and returned
+    read-only: a run with a given step checks it with two of these eigenvalue problems
+    (6 ms of every run of Ji & Li's drive).
     """
     if structure.n_dof == 0:
         lam = np.zeros(0, dtype=complex)
-    else:
-        A, _ = _system_matrix(structure)
-        lam = np.linalg.eigvals(A)
-        scale = np.max(np.abs(lam)) if lam.size else 0.0
-        tiny = (lam.real > 0) & (lam.real <= _REAL_TOL * scale)
-        lam = np.where(tiny, 1j * lam.imag, lam)
+        lam.setflags(write=False)
+        return lam
+    return _eigenvalues(_system_matrix(structure)[0])
+
+
+@remember_content
+def _eigenvalues(A: np.ndarray) -> np.ndarray:
+    """:func:`system_eigenvalues` of the system matrix ``A``, kept by its content: the
+    cases of a study that vary errors or phases have new structures but the same ``A``
+    (a fifth of a Dong et al. 2021 Monte Carlo case's set-up)."""
+    lam = np.linalg.eigvals(A)
+    scale = np.max(np.abs(lam)) if lam.size else 0.0
+    tiny = (lam.real > 0) & (lam.real <= _REAL_TOL * scale)
+    lam = np.where(tiny, 1j * lam.imag, lam)
     lam.setflags(write=False)
     return lam
 
@@ -90,13 +99,23 @@ def highest_mode(structure: Structure) -> tuple[float, str]:
         return 0.0, ""
     k_max = structure.stiffness_table.max(axis=1)
     V = structure.projection_matrix()
-    K = V.T @ (k_max[:, None] * V)
-    d = np.sqrt(structure.inv_mass)
-    lam, psi = np.linalg.eigh(0.5 * (d[:, None] * K * d[None, :] + (d[:, None] * K * d[None, :]).T))
-    phi = d * psi[:, -1]
+    f, phi = _top_mode(k_max, V, structure.inv_mass)
     energy = k_max * (V @ phi) ** 2
     name = structure.element_names[int(np.argmax(energy))] if energy.size else ""
-    return float(np.sqrt(max(lam[-1], 0.0)) / (2 * math.pi)), name
+    return f, name
+
+
+@remember_content
+def _top_mode(k_max: np.ndarray, V: np.ndarray, inv_mass: np.ndarray):
+    """Highest undamped natural frequency [Hz] of stiffnesses ``k_max`` on projections
+    ``V`` and its mass-normalised mode shape (read-only), kept by content as
+    :func:`_eigenvalues`."""
+    K = V.T @ (k_max[:, None] * V)
+    d = np.sqrt(inv_mass)
+    lam, psi = np.linalg.eigh(0.5 * (d[:, None] * K * d[None, :] + (d[:, None] * K * d[None, :]).T))
+    phi = d * psi[:, -1]
+    phi.setflags(write=False)
+    return float(np.sqrt(max(lam[-1], 0.0)) / (2 * math.pi)), phi
 
 
 def stability_cause(structure: Structure) -> str:
@@ -153,9 +172,14 @@ def stable_step(structure: Structure) -> float:
     """Largest RK4 step [s] for which every mode stays bounded (``inf`` if none limits).
 
     Found by bisection on |R(h lambda)| <= 1 (RK4's region lies within |z| < 3); kept
-    per live structure, as its eigenvalues are.
+    per live structure, as its eigenvalues are, and per set of eigenvalues.
     """
-    lam = _limiting(system_eigenvalues(structure))
+    return _largest_stable_step(_limiting(system_eigenvalues(structure)))
+
+
+@remember_content
+def _largest_stable_step(lam: np.ndarray) -> float:
+    """:func:`stable_step` of the step-limiting eigenvalues ``lam``."""
     if lam.size == 0:
         return math.inf
     lo, hi = 0.0, 4.0 / float(np.max(np.abs(lam)))

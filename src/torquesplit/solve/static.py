@@ -52,6 +52,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numba import njit
 
+from torquesplit._memo import remember_content
 from torquesplit.assembly.structure import (
     SP_CLEARANCE,
     SP_STICK,
@@ -170,13 +171,22 @@ def rigid_body_modes(structure: Structure, active: np.ndarray | None = None,
         k = s.stiffness_table
         active = (k.max(axis=1) > 0) | (k.min(axis=1) < 0)
     active = np.asarray(active, dtype=bool).copy()
-    d = np.sqrt(s.inv_mass)
-    A = s.projection_matrix()[active] * d[None, :]
-    if A.shape[0] == 0:
-        return np.diag(d)
-    _, sv, vt = np.linalg.svd(A, full_matrices=True)
-    rank = int(np.sum(sv > tolerance * sv[0])) if sv.size else 0
-    return d[:, None] * vt[rank:].T
+    return _rigid_modes(s.projection_matrix()[active], np.sqrt(s.inv_mass), float(tolerance))
+
+
+@remember_content(kept=16)
+def _rigid_modes(V: np.ndarray, d: np.ndarray, tolerance: float) -> np.ndarray:
+    """:func:`rigid_body_modes` of the active elements' projections ``V`` and square roots
+    ``d`` of the inverse masses, read-only and kept by content (a study case solves two
+    equilibria of its own structure, whose projections every case of the study shares)."""
+    A = V * d[None, :]
+    phi = np.diag(d) if A.shape[0] == 0 else None
+    if phi is None:
+        _, sv, vt = np.linalg.svd(A, full_matrices=True)
+        rank = int(np.sum(sv > tolerance * sv[0])) if sv.size else 0
+        phi = d[:, None] * vt[rank:].T
+    phi.setflags(write=False)
+    return phi
 
 
 def regularisation(delta, half_gap, stiffness, reg: float):
