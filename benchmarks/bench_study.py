@@ -81,7 +81,9 @@ def _overhead(cases: list[dict], wall: float, workers: int) -> dict:
     firsts = _first_cases(cases)
     later = [c for c in cases if c["idx"] not in firsts]
     later_wall = sum(c["wall_time"] for c in later)
-    later_over = later_wall - sum(c["integration_time"] for c in later)
+    # (the right-hand side's compilation is not overhead here either: a worker compiles
+    # the literal code once, in its second case when the first one's demand repays it)
+    later_over = later_wall - sum(c["integration_time"] + c["compile_time"] for c in later)
     steady = later_wall / len(later) if later else case_wall / n
     return {
         "cases": n, "study_wall_s": wall, "workers": workers,
