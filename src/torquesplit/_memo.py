@@ -67,17 +67,23 @@ def remember_content(fn=None, *, kept: int = 8):
     if fn is None:
         return functools.partial(remember_content, kept=kept)
     import hashlib
+    import threading
 
     cache: dict = {}
+    lock = threading.Lock()  # (a Dask worker's threads share the table)
 
     @functools.wraps(fn)
     def wrapper(*args):
         key = hash_arrays(hashlib.blake2b(digest_size=20), args).digest()
-        if key not in cache:
+        with lock:
+            if key in cache:
+                return cache[key]
+        result = fn(*args)
+        with lock:
             while len(cache) >= kept:
                 cache.pop(next(iter(cache)))
-            cache[key] = fn(*args)
-        return cache[key]
+            cache[key] = result
+        return result
 
     wrapper.cache = cache
     return wrapper

@@ -160,7 +160,7 @@ def stiffness_table(model: Model, kin: Kinematics, mesh_name: str, n: int) -> np
 def _constant_table(n: int, value: float, peak_to_peak: float, contact_ratio: float):
     """The table of a "constant" stiffness (read-only), kept by its values: a model is
     checked and assembled with three of them per mesh, and a study's cases that vary
-    something else share them (2 ms of a Dong et al. 2021 case's set-up)."""
+    something else share them (1 ms of a Dong et al. 2021 case's 20 ms set-up)."""
     if peak_to_peak == 0:
         k = np.full(n, value)
     else:

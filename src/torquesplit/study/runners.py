@@ -33,34 +33,13 @@ log = logging.getLogger(__name__)
 
 
 class SerialRunner:
-    """Run the cases in this process, in order.
-
-    While the study runs, the objects this process holds after its first case (modules,
-    compiled kernels, the caller's data) are moved out of the garbage collector's reach
-    (:func:`gc.freeze`), as a pool worker's are (:func:`worker_start`): the full
-    collections that a case's allocations trigger walked them again every time (2.5 ms
-    of a Dong et al. 2021 case's 21 ms of set-up).  They are given back when the study
-    ends, stops or fails (:func:`gc.unfreeze`); a process that froze objects itself, or
-    runs without the collector, is left as it is."""
+    """Run the cases in this process, in order."""
 
     workers = 1
 
     def __call__(self, function: Callable, payloads: Iterable) -> Iterator:
-        import gc
-
-        mine = gc.isenabled() and gc.get_freeze_count() == 0
-        frozen = False
-        try:
-            for p in payloads:
-                out = function(p)
-                if mine and not frozen:  # (after the first case: its kernels are there)
-                    gc.collect()  # (its garbage would stay for the whole study)
-                    gc.freeze()
-                    frozen = True
-                yield out
-        finally:
-            if frozen:
-                gc.unfreeze()
+        for p in payloads:
+            yield function(p)
 
     def __repr__(self) -> str:
         return "SerialRunner()"
