@@ -44,8 +44,8 @@ def test_a_shared_set_is_held_weakly():
 
 def test_a_constant_stiffness_table_is_kept_by_its_values():
     """The rectangular wave of a "constant" stiffness is computed once per set of values
-    (a model's checks and assembly ask for it three times per mesh), read-only, and is
-    the wave of its definition."""
+    (a model's checks and assembly ask for it three times per mesh), each caller gets its
+    own copy, and it is the wave of its definition."""
     import numpy as np
     import pytest
 
@@ -56,11 +56,17 @@ def test_a_constant_stiffness_table_is_kept_by_its_values():
     kin = solve_kinematics(model)
     name = next(m for m, mesh in model.meshes.items() if mesh.stiffness.method == "constant")
     spec = model.meshes[name].stiffness
+    excitation._constant_table.cache_clear()
     k = excitation.stiffness_table(model, kin, name, 512)
-    assert excitation.stiffness_table(model, kin, name, 512) is k
-    with pytest.raises(ValueError):
-        k[0] = 1.0
+    again = excitation.stiffness_table(model, kin, name, 512)
+    assert excitation._constant_table.cache_info().hits == 1
+    assert again is not k and np.array_equal(again, k)  # (each caller's own copy)
+    k[0] = -1.0
+    assert excitation.stiffness_table(model, kin, name, 512)[0] == again[0]
+    with pytest.raises(ValueError):  # (the one kept is read-only)
+        excitation._constant_table(512, float(spec.value), float(spec.peak_to_peak),
+                                   excitation._profile_contact_ratio(kin.meshes[name]))[0] = 1.0
     eps = excitation._profile_contact_ratio(kin.meshes[name])
     wave = excitation.contact_zone_wave(np.arange(512) / 512, spec.value, spec.peak_to_peak, eps)
-    assert np.array_equal(k, wave)
+    assert np.array_equal(again, wave)
     assert excitation.stiffness_table(model, kin, name, 256).shape == (256,)

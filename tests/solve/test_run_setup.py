@@ -42,13 +42,34 @@ def test_equal_matrices_of_other_structures_share_their_eigen_problems():
     assert stability.stable_step(stiffer) < stability.stable_step(same)
     assert stability.highest_mode(same) == stability.highest_mode(s)
     assert stability.highest_mode(stiffer)[0] > stability.highest_mode(s)[0]
+    from torquesplit.solve import static
+
     phi = rigid_body_modes(s)
-    assert rigid_body_modes(same) is phi and not phi.flags.writeable
+    kept = set(static._rigid_modes.cache)
+    again = rigid_body_modes(same)
+    assert set(static._rigid_modes.cache) == kept  # (no second SVD)
+    assert np.array_equal(again, phi) and again is not phi and again.flags.writeable
     damped = spur_pair(frequency=500.0, damping=50.0)  # (the code reads the stiffness
     # tables at every call, a damping coefficient from its parameters or its literals)
     assert codegen._value_key(kernel_model(s)) == codegen._value_key(kernel_model(same))
     assert codegen._value_key(kernel_model(s)) != codegen._value_key(kernel_model(damped))
     assert codegen._pattern_key(kernel_model(s)) == codegen._pattern_key(kernel_model(damped))
+
+
+def test_the_code_keys_keep_no_finished_run_alive():
+    """The generated code's keys are kept for the last kernel model's arrays, weakly:
+    a finished run's phase tables are freed with it."""
+    import gc
+    import weakref
+
+    s = random_structure(2)
+    km = kernel_model(s)
+    key = codegen._value_key(km)
+    assert codegen._value_key(km._replace()) == key  # (the same arrays: kept)
+    ref = weakref.ref(km.stiffness_table)
+    del s, km
+    gc.collect()
+    assert ref() is None
 
 
 def test_generated_functions_share_one_class():

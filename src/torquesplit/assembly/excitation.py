@@ -122,8 +122,8 @@ def stiffness_table(model: Model, kin: Kinematics, mesh_name: str, n: int) -> np
     phase = np.arange(n) / n
     mk = kin.meshes[mesh_name]
     if spec.method == "constant":
-        return _constant_table(int(n), float(spec.value), float(spec.peak_to_peak),
-                               float(_profile_contact_ratio(mk)))
+        return _constant_table(n, float(spec.value), float(spec.peak_to_peak),
+                               float(_profile_contact_ratio(mk))).copy()  # (the caller's)
     if spec.method == "table":
         src = np.asarray(spec.phase)
         order = np.argsort(src)
@@ -156,8 +156,8 @@ def stiffness_table(model: Model, kin: Kinematics, mesh_name: str, n: int) -> np
     return np.interp(phase, np.asarray(ms.phase), np.asarray(ms.stiffness), period=1.0)
 
 
-@functools.lru_cache(maxsize=64)
-def _constant_table(n: int, value: float, peak_to_peak: float, contact_ratio: float):
+@functools.lru_cache(maxsize=64, typed=True)  # (typed: n = 512.0 is not 512)
+def _constant_table(n, value: float, peak_to_peak: float, contact_ratio: float):
     """The table of a "constant" stiffness (read-only), kept by its values: a model is
     checked and assembled with three of them per mesh, and a study's cases that vary
     something else share them (1 ms of a Dong et al. 2021 case's 20 ms set-up)."""

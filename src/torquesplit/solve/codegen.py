@@ -69,6 +69,7 @@ from __future__ import annotations
 import hashlib
 import os
 import threading
+import weakref
 from dataclasses import dataclass
 
 import numpy as np
@@ -352,16 +353,23 @@ def _error_and_force_flags(a: dict):
 
 
 _LAST_KEYS = threading.local()
-"""Per thread, the keys of the last kernel model asked about (``keys``: model ->
-{"pattern", "value"}, that model held): a run asks for them up to six times (cached?
-worth it? available?), each digest 0.2-0.5 ms of a Dong et al. 2021 case.  A kernel
-model's arrays are not changed in place (:func:`.kernel_data.kernel_model`)."""
+"""Per thread, the keys of the last kernel model asked about (``keys``: weak references
+to its arrays, and {"pattern", "value"}): a run asks for them up to six times (cached?
+worth it? available?), each digest 0.2-0.5 ms of a Dong et al. 2021 case.  The same
+arrays (not only the same tuple: ``_replace`` makes a new tuple of them) give the same
+keys, as a kernel model's arrays are not changed in place
+(:func:`.kernel_data.kernel_model`); held weakly, so that nothing of a finished run (its
+phase tables: 7 MB for Ji & Li's drive) is kept alive."""
+
+
+def _same_arrays(refs, model) -> bool:
+    return len(refs) == len(model) and all(r() is x for r, x in zip(refs, model))
 
 
 def _last_key(model, kind: str, compute) -> str:
     last = getattr(_LAST_KEYS, "keys", None)
-    if last is None or last[0] is not model:
-        last = _LAST_KEYS.keys = (model, {})
+    if last is None or not _same_arrays(last[0], model):
+        last = _LAST_KEYS.keys = (tuple(weakref.ref(x) for x in model), {})
     if kind not in last[1]:
         last[1][kind] = compute(model)
     return last[1][kind]

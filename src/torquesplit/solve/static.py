@@ -171,14 +171,17 @@ def rigid_body_modes(structure: Structure, active: np.ndarray | None = None,
         k = s.stiffness_table
         active = (k.max(axis=1) > 0) | (k.min(axis=1) < 0)
     active = np.asarray(active, dtype=bool).copy()
-    return _rigid_modes(s.projection_matrix()[active], np.sqrt(s.inv_mass), float(tolerance))
+    # (the caller's own copy: the kept one is shared)
+    return _rigid_modes(s.projection_matrix()[active], np.sqrt(s.inv_mass),
+                        float(tolerance)).copy()
 
 
 @remember_content(kept=16)
 def _rigid_modes(V: np.ndarray, d: np.ndarray, tolerance: float) -> np.ndarray:
     """:func:`rigid_body_modes` of the active elements' projections ``V`` and square roots
     ``d`` of the inverse masses, read-only and kept by content (a study case solves two
-    equilibria of its own structure, whose projections every case of the study shares)."""
+    equilibria of its own structure, whose projections every case of the study shares:
+    an SVD each)."""
     A = V * d[None, :]
     phi = np.diag(d) if A.shape[0] == 0 else None
     if phi is None:
