@@ -295,9 +295,35 @@ def periodic(cycle_max: np.ndarray, cycle_start: np.ndarray, names,
 
 def _ratio(x: np.ndarray) -> np.ndarray:
     """N x_i / sum_j x_j along the last axis (NaN where the sum vanishes)."""
-    s = x.sum(axis=-1, keepdims=True)
+    s = _row_sums(x)
     with np.errstate(invalid="ignore", divide="ignore"):
         return x.shape[-1] * x / np.where(s != 0, s, np.nan)
+
+
+def _row_sums(x: np.ndarray) -> np.ndarray:
+    """``x.sum(axis=-1, keepdims=True)`` of a (cycles, members) array, bit for bit: numpy
+    adds fewer than eight values one by one to 0.0, which column by column does too,
+    without its slow reduction over a short last axis (75 us for 5136 cycles of two
+    members against 5)."""
+    n = x.shape[-1]
+    if x.ndim != 2 or not 1 <= n <= 7 or x.dtype != np.float64:
+        return x.sum(axis=-1, keepdims=True)
+    s = 0.0 + x[:, :1]  # (0.0 + -0.0 is 0.0, as numpy's)
+    for k in range(1, n):
+        s += x[:, k:k + 1]
+    return s
+
+
+def _row_max(x: np.ndarray) -> np.ndarray:
+    """``x.max(axis=-1)`` of a (cycles, members) array without NaN, column by column (the
+    same rule at equal values: the earlier one is kept)."""
+    n = x.shape[-1]
+    if x.ndim != 2 or not 1 <= n <= 7 or x.dtype != np.float64:
+        return x.max(axis=-1)
+    m = x[:, 0].copy()
+    for k in range(1, n):
+        np.maximum(m, x[:, k], out=m)
+    return m
 
 
 def _system(per_group: dict[str, float]) -> float:
@@ -455,6 +481,9 @@ def dynamic_factors(cycle_max, names, groups, first_cycle, static_force, nominal
         # Ji & Li eq. 19: G = max_i F_i / F_0, averaged over the periodic (cycle) peaks
         k0 = max(first_cycle[m] for m in members)
         x = np.stack([cycle_max[k0:, col[m]] / nominal_force[m] for m in members], axis=-1)
-        x = x[np.all(np.isfinite(x), axis=-1)]
-        g_ptn_eng[g] = float(x.max(axis=-1).mean()) if x.size else math.nan
+        finite = np.isfinite(x[:, 0])
+        for k in range(1, x.shape[1]):  # (np.all over the short axis: slow, as below)
+            finite &= np.isfinite(x[:, k])
+        x = x[finite]
+        g_ptn_eng[g] = float(_row_max(x).mean()) if x.size else math.nan
     return DynamicFactors(dyn, dyn_eng, ptn, g_dyn, g_ptn, g_ptn_eng)
