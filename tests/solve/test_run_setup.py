@@ -114,3 +114,11 @@ def test_second_run_uses_the_entry_point_and_gives_the_same_result(monkeypatch):
     assert found and all(f is not kern.rk4_run for f in found)  # the entry point ran
     np.testing.assert_array_equal(first.y_final, second.y_final)
     np.testing.assert_array_equal(first.cycle_max, second.cycle_max)
+
+
+def test_the_code_keys_of_a_model_with_a_plain_field_are_computed_not_kept():
+    km = kernel_model(random_structure(3))
+    key = codegen._pattern_key(km)
+    plain = km._replace(tv_tab=[0])  # (a list: no weak reference)
+    assert codegen._pattern_key(plain) == key
+    assert codegen._LAST_KEYS.keys is None

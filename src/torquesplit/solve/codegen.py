@@ -369,7 +369,12 @@ def _same_arrays(refs, model) -> bool:
 def _last_key(model, kind: str, compute) -> str:
     last = getattr(_LAST_KEYS, "keys", None)
     if last is None or not _same_arrays(last[0], model):
-        last = _LAST_KEYS.keys = (tuple(weakref.ref(x) for x in model), {})
+        try:
+            refs = tuple(weakref.ref(x) for x in model)
+        except TypeError:  # (a field that is not an array: not kept)
+            _LAST_KEYS.keys = None
+            return compute(model)
+        last = _LAST_KEYS.keys = (refs, {})
     if kind not in last[1]:
         last[1][kind] = compute(model)
     return last[1][kind]
