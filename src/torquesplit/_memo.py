@@ -59,30 +59,58 @@ def remember_last(fn=None, *, replay: bool = True):
     return wrapper
 
 
+class Kept:
+    """Results by key (a digest), the oldest dropped beyond ``kept``; a lock around every
+    look-up and insertion (a Dask worker's threads share a table).  ``get`` returns
+    None for a key not kept."""
+
+    def __init__(self, kept: int):
+        import threading
+
+        self.kept = kept
+        self._table: dict = {}
+        self._lock = threading.Lock()
+
+    def get(self, key):
+        with self._lock:
+            return self._table.get(key)
+
+    def put(self, key, value) -> None:
+        with self._lock:
+            while len(self._table) >= self.kept:
+                self._table.pop(next(iter(self._table)))
+            self._table[key] = value
+
+    def clear(self) -> None:
+        with self._lock:
+            self._table.clear()
+
+    def __len__(self) -> int:
+        return len(self._table)
+
+    def __iter__(self):
+        return iter(list(self._table))
+
+
 def remember_content(fn=None, *, kept: int = 8):
     """Decorator: ``fn(*arrays)`` computed once per content of its arguments (arrays or
     numbers: dtype, shape and bytes, :func:`hash_arrays`) in this process, the oldest of
     more than ``kept`` dropped.  For pure functions whose results nobody changes (make
-    arrays read-only); the table (digest -> result) is ``wrapper.cache``."""
+    arrays read-only) and are never None; the table (:class:`Kept`) is
+    ``wrapper.cache``."""
     if fn is None:
         return functools.partial(remember_content, kept=kept)
     import hashlib
-    import threading
 
-    cache: dict = {}
-    lock = threading.Lock()  # (a Dask worker's threads share the table)
+    cache = Kept(kept)
 
     @functools.wraps(fn)
     def wrapper(*args):
         key = hash_arrays(hashlib.blake2b(digest_size=20), args).digest()
-        with lock:
-            if key in cache:
-                return cache[key]
-        result = fn(*args)
-        with lock:
-            while len(cache) >= kept:
-                cache.pop(next(iter(cache)))
-            cache[key] = result
+        result = cache.get(key)
+        if result is None:
+            result = fn(*args)
+            cache.put(key, result)
         return result
 
     wrapper.cache = cache

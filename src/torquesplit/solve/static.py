@@ -52,7 +52,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numba import njit
 
-from torquesplit._memo import remember_content
+from torquesplit._memo import Kept, remember_content
 from torquesplit.assembly.structure import (
     SP_CLEARANCE,
     SP_STICK,
@@ -183,8 +183,9 @@ def _rigid_modes(V: np.ndarray, d: np.ndarray, tolerance: float) -> np.ndarray:
     equilibria of its own structure, whose projections every case of the study shares:
     an SVD each)."""
     A = V * d[None, :]
-    phi = np.diag(d) if A.shape[0] == 0 else None
-    if phi is None:
+    if A.shape[0] == 0:
+        phi = np.diag(d)
+    else:
         _, sv, vt = np.linalg.svd(A, full_matrices=True)
         rank = int(np.sum(sv > tolerance * sv[0])) if sv.size else 0
         phi = d[:, None] * vt[rank:].T
@@ -786,8 +787,9 @@ def static_equilibrium(
     key = None
     if t is None and initial is None:
         key = _mean_key(problem, regularisation, balance_tolerance, max_iterations)
-        if key in _MEAN_SOLUTIONS:
-            return _MEAN_SOLUTIONS[key]
+        kept = _MEAN_SOLUTIONS.get(key)
+        if kept is not None:
+            return kept
     r = problem.solve(t, q0=initial, max_iterations=max_iterations)
     names = tuple(structure.element_names[i] for i in np.flatnonzero(~r["contact"]))
     sol = StaticSolution(q=r["q"], element_forces=r["forces"], deformations=r["delta"],
@@ -796,19 +798,16 @@ def static_equilibrium(
                          separated=names, t=None if t is None else float(t),
                          rigid_acceleration=r["accel"])
     if key is not None:
-        while len(_MEAN_SOLUTIONS) >= _MEAN_KEPT:
-            _MEAN_SOLUTIONS.pop(next(iter(_MEAN_SOLUTIONS)))
-        _MEAN_SOLUTIONS[key] = sol
+        _MEAN_SOLUTIONS.put(key, sol)
     return sol
 
 
-_MEAN_SOLUTIONS: dict[bytes, StaticSolution] = {}
-"""Mean-excitation equilibria solved in this process, by :func:`_mean_key` (the oldest
-dropped beyond :data:`_MEAN_KEPT`): a Monte Carlo of errors that turn with the gears
+_MEAN_SOLUTIONS = Kept(8)
+"""Mean-excitation equilibria solved in this process, by :func:`_mean_key` (the oldest of
+more than 8 dropped): a Monte Carlo of errors that turn with the gears
 (eccentricity, run-out; they average out of the mean excitation) gives every case the
 same mean problem, whose solve was a quarter of a Dong et al. 2021 case's overhead.
 The solution's arrays are read-only, so a kept one is handed out as it is."""
-_MEAN_KEPT = 8
 
 
 def _mean_key(problem: _StaticProblem, *settings) -> bytes:
