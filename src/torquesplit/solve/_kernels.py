@@ -992,6 +992,11 @@ def rk4_run(t0, h, n_first, n_steps, record_final, record_every, blowup, m, w, r
     # one pass per step, and one more for the end state with ``record_final`` (the same
     # code: numba inlines record and _stage once, not twice, which saves cold compile)
     n_pass = n_steps + 1 if record_final and n_steps > 0 else n_steps
+    # steps taken, and those without corners (4 rhs each), counted in locals and written
+    # to ``counters`` and ``clock`` once at the end: stores to them at every step cost 2 %
+    # of Ji & Li's step (same-process A/B, literal code)
+    done = 0
+    plain = 0
     for it in range(n_pass):
         i = n_first + it
         t = t0 + i * h
@@ -1023,14 +1028,17 @@ def rk4_run(t0, h, n_first, n_steps, record_final, record_every, blowup, m, w, r
             _rk4_step(t0 + (i + 0.5) * h, tb, h, s_half, b, a, s_half, m, w, rhs_fn, gen,
                       extra)
             a, b = b, a
-            counters[I_RHS] += 4
-        counters[I_STEPS] += 1
-        clock[F_T] = tb
+            plain += 1
+        done += 1
         bad = bad_state(Y_STATE, w)
         if bad >= 0:
             counters[I_STATUS] = DIVERGED
             counters[I_BAD] = bad
-            return
+            break
+    counters[I_STEPS] += done
+    counters[I_RHS] += 4 * plain
+    if done > 0:
+        clock[F_T] = t0 + (n_first + done) * h
 
 
 # ============================================================== Dormand-Prince
