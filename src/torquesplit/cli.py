@@ -95,12 +95,16 @@ def _version(value: bool) -> None:
 
 
 @app.callback()
-def _main(debug: bool = typer.Option(False, "--debug", help="Show tracebacks on errors.",
+def _main(ctx: typer.Context,
+          debug: bool = typer.Option(False, "--debug", help="Show tracebacks on errors.",
                                      metavar=""),
           version: bool = typer.Option(False, "--version", callback=_version, is_eager=True,
                                        help="Print the version and exit.", metavar="")):
     _state["debug"] = debug
     ux.reset(console, err_console, debug)
+    # a model warning raised anywhere in the command (a cached result's replayed one
+    # too) is a "warning:" line, said once, never Python's own two-line form
+    ctx.with_resource(ux.collect_warnings())
 
 
 def _flag(option: str, help: str):

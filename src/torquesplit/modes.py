@@ -9,15 +9,17 @@ carrier):
   degenerate pairs of the translational modes, the N - 3 planet modes);
 * **type** (models with planets) -- from the share of the mass-weighted motion
   ``m_i |phi_i|^2`` (summed over the group, so it does not depend on the basis the
-  eigensolver picked) on the DOFs of the members that are not planets ("central"):
-  ``rotational`` when the central members do not translate, ``translational`` when they
-  do not rotate, ``planet`` when they do not move at all, ``mixed`` otherwise (each
-  below ``tol`` of the mode's motion).  The labels follow this rule, not Lin & Parker's
-  counts: when no central member translates (sun, ring and carrier ``dofs = ["theta"]``),
-  the degenerate pair of each translational type loses its central motion and is labelled
-  ``planet``; with equally spaced planets it falls at the planet modes' frequency, so
-  the planet groups have multiplicity N - 1 (2 for three planets, which have no Lin &
-  Parker planet modes; docs/theory/planetary.md);
+  eigensolver picked) on the DOFs of the stage's members that are not planets
+  ("central": carriers and the gears that mesh with a planet), within the stage's own
+  motion: ``rotational`` when the central members do not translate, ``translational``
+  when they do not rotate, ``planet`` when they do not move at all, ``mixed`` otherwise
+  (each below ``tol``); ``other`` when no member of a stage moves (a mode of the rest of
+  the model: a split path's pinion on its bearing).  The labels follow this rule, not
+  Lin & Parker's counts: when no central member translates (sun, ring and carrier
+  ``dofs = ["theta"]``), the degenerate pair of each translational type loses its central
+  motion and is labelled ``planet``; with equally spaced planets it falls at the planet
+  modes' frequency, so the planet groups have multiplicity N - 1 (2 for three planets,
+  which have no Lin & Parker planet modes; docs/theory/planetary.md);
 * **whirl** (turning carrier) -- each translational mode's whirl in the carrier's frame,
   forward or backward against its rotation (:func:`whirl_senses`), which selects the mesh
   harmonics that excite it (:meth:`PhasedStage.excites`);
@@ -42,7 +44,7 @@ from .solve.modal import DEGENERATE_RTOL
 __all__ = ["ModeRow", "ModalReport", "classify", "model_modes", "MODE_TYPES",
            "PhasedStage", "phased_stages", "phasing_suppresses", "whirl_senses"]
 
-MODE_TYPES = ("rotational", "translational", "planet", "mixed")
+MODE_TYPES = ("rotational", "translational", "planet", "mixed", "other")
 
 #: shape units of a mass-normalised mode: phi^H M phi = 1 with M in kg on translations
 #: and kg m^2 on rotations, so the modal coordinate is in m kg^(1/2) (sqrt(kg m^2))
@@ -83,7 +85,8 @@ class ModeRow:
     multiplicity: int
     """Number of modes in the group."""
     type: str | None
-    """rotational, translational, planet or mixed (None for a model without planets)."""
+    """rotational, translational, planet, mixed or other (None for a model without
+    planets)."""
     strain_energy: dict[str, float]
     """Element -> share of the group's strain energy (basis-independent), largest first."""
     motion: dict[str, float] = field(default_factory=dict)
@@ -212,7 +215,7 @@ class ModalReport:
                        {"units": "1", "long_name": "group of equal frequencies"}),
              "type": (("mode",), [r.type or "" for r in self.rows],
                       {"long_name": "mode type of a planetary stage (rotational, translational, "
-                                   "planet, mixed); empty for a model without one"}),
+                                   "planet, mixed, other); empty for a model without one"}),
              "whirl": (("mode",), [r.whirl or "" for r in self.rows],
                        {"long_name": "whirl of a translational mode of a turning carrier "
                         "in its frame against its rotation (forward, backward); empty "
@@ -304,16 +307,27 @@ def classify(structure, sol, *, rtol: float = DEGENERATE_RTOL, tol: float = 1e-6
     """
     meta = structure.metadata
     planets = set(meta.get("planet_bodies", {}))
+    # the stages' central members: carriers and the gears that mesh with a planet (the
+    # other bodies of a model -- a split path's pinions -- are no member of a stage)
+    central = set(meta.get("carriers", {}))
+    for mk in meta.get("meshes", {}).values():
+        pair = {mk.get("driver"), mk.get("driven")}
+        if pair & planets:
+            central |= pair - planets - {None}
     names = list(structure.dof_names)
     mass = 1.0 / np.asarray(structure.inv_mass)
     body = [n.rpartition(".")[0] for n in names]
     is_rot = np.array([n.endswith(".theta") for n in names])
     is_planet = np.array([b in planets for b in body])
+    is_central = np.array([b in central for b in body])
     # a rigid shaft joins rotations into one DOF named after the group's representative
     groups_of = meta.get("dof_map").theta if meta.get("dof_map") is not None else {}
     for b, (idx, _) in groups_of.items():
         if idx >= 0 and b in planets:
             is_planet[idx] = True
+        elif idx >= 0 and b in central:
+            is_central[idx] = True
+    is_central &= ~is_planet
     phi = np.asarray(sol.mode_shapes)
     freqs = np.asarray(sol.frequencies)
     zeta = np.asarray(sol.damping_ratios)
@@ -323,16 +337,23 @@ def classify(structure, sol, *, rtol: float = DEGENERATE_RTOL, tol: float = 1e-6
         w = mass[:, None] * np.abs(phi[:, members]) ** 2
         motion = w.sum(axis=1)
         total = float(motion.sum()) or 1.0
-        c_rot = float(motion[is_rot & ~is_planet].sum()) / total
-        c_tr = float(motion[~is_rot & ~is_planet].sum()) / total
+        c_rot = float(motion[is_rot & is_central].sum()) / total
+        c_tr = float(motion[~is_rot & is_central].sum()) / total
         p = float(motion[is_planet].sum()) / total
+        other = max(1.0 - c_rot - c_tr - p, 0.0)
         kind = None
         if planets:
-            if c_rot + c_tr < tol:
+            # the type by the stage's own motion (its central members' and planets'): a
+            # mode of the rest of the model is "other"
+            stage = (c_rot + c_tr + p) or 1.0
+            s_rot, s_tr = c_rot / stage, c_tr / stage
+            if other > 1.0 - tol:
+                kind = "other"
+            elif s_rot + s_tr < tol:
                 kind = "planet"
-            elif c_tr < tol:
+            elif s_tr < tol:
                 kind = "rotational"
-            elif c_rot < tol:
+            elif s_rot < tol:
                 kind = "translational"
             else:
                 kind = "mixed"
@@ -346,7 +367,8 @@ def classify(structure, sol, *, rtol: float = DEGENERATE_RTOL, tol: float = 1e-6
                                 multiplicity=len(members), type=kind,
                                 strain_energy=energy,
                                 motion={"central_rotation": c_rot,
-                                        "central_translation": c_tr, "planets": p},
+                                        "central_translation": c_tr, "planets": p,
+                                        "other": other},
                                 damping_ratio=float(zeta[members].mean()),
                                 whirl={1: "forward", -1: "backward"}.get(sense)))
     return rows
@@ -445,7 +467,8 @@ class PhasedStage:
         Des. 126), with equally spaced planets harmonic l excites the rotational modes
         only when l z_s / N is an integer, the translational modes only when
         (l z_s +- 1) / N is, the planet modes only when neither is.  A mode of no pure
-        type (``mixed``, None) is always excited.
+        type (``mixed``, None) is always excited; a mode in which no member of the stage
+        moves (``other``) never is by the stage's meshes (they do no work on it).
 
         With a turning carrier the translational pairs split into whirls (``whirl``
         forward or backward against the carrier's rotation): the planets' net mesh force
@@ -466,7 +489,7 @@ class PhasedStage:
             return trans
         if mode_type == "planet":
             return not (rot or trans)
-        return True
+        return mode_type != "other"
 
 
 def phased_stages(model, kin) -> list[PhasedStage]:

@@ -80,3 +80,112 @@ def test_planets_that_do_not_fit_are_one_line_errors(tmp_path):
     assert all(ln.startswith("error:") for ln in lines) and 1 <= len(lines) <= 2, lines
     assert "planetary.0.planets" in lines[0] and "assembly condition" in lines[0]
     assert len(lines) == 1 or "planets overlap" in lines[1]
+
+
+def _locked_split_path(tmp_path, **sun_mesh):
+    """The split-path example with pinion_b and the ring's rim such that sun and ring
+    turn as one: no power passes the stage's meshes (a planetary reviewer's case)."""
+    import copy
+
+    import tomli_w
+
+    import torquesplit
+    from torquesplit.model.reader import read_model_file
+
+    raw = copy.deepcopy(read_model_file(torquesplit.example_path(
+        "split_path_planetary_differential")))
+    raw["gears"]["pinion_b"]["teeth"] = 24
+    raw["gears"]["ring_rim"]["teeth"] = 72
+    raw["planetary"][0]["sun_mesh"].update(sun_mesh)
+    path = tmp_path / "locked.toml"
+    path.write_bytes(tomli_w.dumps(raw).encode())
+    return path
+
+
+def test_undetermined_flank_is_warned_once_and_driver_is_accepted(tmp_path):
+    """The warning of a mesh no power passes is a 'warning:' line said once (the cached
+    kinematics' replays printed Python's own form three times), names the values its
+    table takes, and driver = 'sun' or 'planet' in the stage's mesh table is accepted."""
+    import sys
+    import warnings
+
+    with warnings.catch_warnings():
+        # Python's own printing of warnings to stderr, as outside pytest (which records
+        # them)
+        warnings.showwarning = warnings._showwarning_orig
+        warnings._showwarnmsg_impl = lambda msg: sys.stderr.write(
+            warnings._formatwarnmsg(msg))
+        warnings.simplefilter("always")
+        res = runner.invoke(app, ["check", str(_locked_split_path(tmp_path))])
+    assert res.exit_code == 0, res.output
+    err = res.stderr
+    assert "ModelWarning" not in err, err
+    line = ("planetary.0.sun_mesh: no power passes this mesh in the nominal load")
+    assert err.count(line) == 1, err
+    assert "give driver = 'sun' or 'planet' there" in err
+    for driver, first in (("planet", "stage_planet1"), ("sun", "stage_sun")):
+        path = _locked_split_path(tmp_path, driver=driver)
+        res = runner.invoke(app, ["check", str(path), "--json"])
+        assert res.exit_code == 0, res.output
+        data = json.loads(res.stdout)
+        assert not any("sun_mesh: no power" in w for w in data["warnings"])
+        assert any("ring_mesh: no power" in w for w in data["warnings"])
+        assert data["meshes"]["stage_sun_planet1"]["driver"] == first
+
+
+@pytest.mark.parametrize("change, text", [
+    ({"sun_mesh": {"stiffness": "5e8 N/m", "driver": "ring"}},
+     "planetary.0.sun_mesh.driver: 'ring' is not a gear of the sun-planet meshes"),
+    ({"sun_mesh": {"stiffness": "5e8 N/m", "driver": "planet"}},
+     "planetary.0.sun_mesh.driver: 'planet' is given as driver but power flows from the "
+     "sun to the planets"),
+    ({"ring_mesh": {"stiffness": "5e8 N/m", "driver": "ring"}},
+     "planetary.0.ring_mesh.driver: 'ring' is given as driver but power flows from the "
+     "planets to the ring"),
+    ({"ring": {"teeth": 40}}, "planetary.0.ring.teeth: a ring of 40 teeth cannot hold "
+     "planets of 48: an internal gear needs more teeth than its pinion, and without "
+     "profile shifts the ring needs z_s + 2 z_p = 138"),
+])
+def test_planetary_table_errors_are_one_line(tmp_path, change, text):
+    import tomli_w
+    from planetary_models import lp_raw
+
+    raw = lp_raw(4)
+    stage = raw["planetary"][0]
+    for key, value in change.items():
+        stage[key] = {**stage.get(key, {}), **value}
+    path = tmp_path / "m.toml"
+    path.write_bytes(tomli_w.dumps(raw).encode())
+    res = runner.invoke(app, ["check", str(path)])
+    assert res.exit_code == 2
+    lines = [x for x in res.stderr.splitlines() if x.startswith("error:")]
+    assert len(lines) == 1 and text in lines[0], res.stderr
+
+
+def test_floating_member_held_by_a_stiff_support_is_warned():
+    """floating = true merged by --set into a support that gives a stiffness: the sun
+    stays on its bearing, and the check says so (it said nothing, a planetary reviewer)."""
+    res = runner.invoke(app, ["check", LP, "--set", "planetary.0.sun.support={floating=true}",
+                              "--json"])
+    assert res.exit_code == 0, res.output
+    said = [w for w in json.loads(res.stdout)["warnings"] if "floating = true, but" in w]
+    assert len(said) == 1 and "planetary.0.sun.support.floating" in said[0]
+    assert "does not float" in said[0]
+    res = runner.invoke(app, ["check", LP, "--set", "planetary.0.sun.support.floating=true",
+                              "--set", "planetary.0.sun.support.stiffness=1 N/m", "--json"])
+    assert res.exit_code == 0, res.output
+    assert not any("floating" in w for w in json.loads(res.stdout)["warnings"])
+
+
+def test_modes_of_the_rest_of_a_model_are_not_given_a_stage_type():
+    """A mode in which no member of the stage moves (a split path's pinion on its
+    bearing) is 'other', not one of Lin & Parker's types."""
+    data = _json(["modes", "split_path_planetary_differential", "--no-rotating-frame",
+                  "--json"])
+    other = [m for m in data["modes"] if m["type"] == "other"]
+    assert other, [m["type"] for m in data["modes"]]
+    for m in other:
+        assert m["motion"]["other"] > 1 - 1e-6
+        assert all(k.startswith(("pinion", "input", "path")) for k in m["strain_energy"])
+    stage = [m for m in data["modes"] if m["type"] != "other"]
+    assert {m["type"] for m in stage} >= {"rotational", "translational"}

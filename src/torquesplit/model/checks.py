@@ -697,6 +697,11 @@ MAX_NOMINAL_TWIST = 0.2
 MIN_SUPPORT_MESH_RATIO = 1e-4
 
 
+#: a support said to float (``floating = true``) this stiff beside its gear's meshes holds
+#: the gear: it does not float (warned)
+FLOATING_HOLD_RATIO = 1e-2
+
+
 def _floating_text(k: float, mesh: float) -> str:
     return (f"{k:.3g} N/m is {mesh / k:.3g} times softer than the gear's meshes (ISO 6336 "
             f"about {mesh:.3g} N/m): the gear floats, held by its meshes alone; if that is "
@@ -730,6 +735,16 @@ def compliance_warnings(model: Model, kin) -> list[tuple[str, str]]:
         radial = float(np.linalg.norm(resultant - resultant.dot(axis) * axis))
         loc = f"gears.{name}.support.stiffness"
         floats = bool(mesh_k) and max(mesh_k) > 0 and k < MIN_SUPPORT_MESH_RATIO * max(mesh_k)
+        if sup.floating and mesh_k and k >= FLOATING_HOLD_RATIO * max(mesh_k):
+            # (a --set of floating = true merges into a table that gives a stiffness: the
+            # member stayed on its bearing without a word, a planetary reviewer)
+            out.append((f"gears.{name}.support.floating", (
+                f"floating = true, but the support's stiffness {k:.3g} N/m is "
+                f"{k / max(mesh_k):.2g} of the gear's meshes' (ISO 6336 about "
+                f"{max(mesh_k):.3g} N/m): the support holds the gear, which does not float; "
+                f"for a floating member leave 'stiffness' out (1 N/m is taken), else "
+                f"remove 'floating'")))
+            continue
         if sup.floating:  # (said to float: its softness is meant)
             if len(mesh_k) >= 3:
                 continue  # (centred by its meshes)

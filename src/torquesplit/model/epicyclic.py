@@ -467,17 +467,32 @@ def solve_torques(model: Model, axes, frames, groups, speeds, layout: EpicyclicL
         if abs(p) <= 1e-9 * p_scale:
             drv = m.driver or ga
             if m.driver is None:
-                warn_user(  # named as written (a [[planetary]] stage's mesh table)
-                    f"{model.written_at('meshes.' + n)}: no power passes this mesh in the "
-                    f"nominal load, so its loaded flank is not determined; {ga!r} (listed "
-                    f"first) is taken as the driver: give 'driver' to choose the flank",
-                    ModelWarning)
+                where = model.written_at('meshes.' + n)  # (a [[planetary]] stage's table)
+                member = where.rpartition(".")[2].removesuffix("_mesh")
+                how = (f"give driver = '{member}' or 'planet' there" if
+                       where.startswith("planetary.") and member in ("sun", "ring") else
+                       "give 'driver'")
+                warn_user(
+                    f"{where}: no power passes this mesh in the nominal load, so its "
+                    f"loaded flank is not determined; {ga!r} (listed first) is taken as "
+                    f"the driver: {how} to choose the flank", ModelWarning)
         else:
             drv = ga if p < 0 else gb  # negative: the mesh takes power from the first gear
             if m.driver is not None and m.driver != drv:
-                issues.append((f"meshes.{n}.driver", (
-                    f"{m.driver!r} is given as driver but power flows from {drv!r} to it; "
-                    f"remove 'driver' or correct it")))
+                where = model.written_at(f"meshes.{n}")
+                member = where.rpartition(".")[2].removesuffix("_mesh")
+                if where.startswith("planetary.") and member in ("sun", "ring"):
+                    # (one text for every planet's mesh of the stage: said once)
+                    given = member if m.driver == ga else "planet"
+                    issues.append((f"meshes.{n}.driver", (
+                        f"{given!r} is given as driver but power flows from the "
+                        f"{'planets' if given == member else member} to the "
+                        f"{given if given == member else 'planets'}; remove 'driver' or "
+                        f"correct it")))
+                else:
+                    issues.append((f"meshes.{n}.driver", (
+                        f"{m.driver!r} is given as driver but power flows from {drv!r} to "
+                        f"it; remove 'driver' or correct it")))
         drivers[n] = (drv, gb if drv == ga else ga)
     body_torque = {bname: 0.0 for bname in groups}
     for n in meshes:

@@ -166,6 +166,11 @@ class PlanetaryMesh(Strict):
     misalignment: MisalignmentSpec = Field(MisalignmentSpec(), description="Misalignment and "
                                            "base pitch deviation of every planet's mesh "
                                            "(stiffness method 'ltca').")
+    driver: Literal["sun", "ring", "planet"] | None = Field(
+        None, description="Which gear of each of these meshes drives: 'sun' (sun_mesh) or "
+        "'ring' (ring_mesh), or 'planet'; from the power flow if omitted (needed only where "
+        "no power passes the meshes, e.g. a stage turning as one block, which 'check' warns "
+        "of).")
 
     @model_validator(mode="after")
     def _one(self):
@@ -251,6 +256,12 @@ class Planetary(Strict):
         if self.planet_bearing.on is not None:
             problems.append(("planet_bearing.on", "the planet bearings sit on the stage's "
                              "carrier; remove 'on'"))
+        for member in ("sun", "ring"):
+            drv = getattr(self, f"{member}_mesh").driver
+            if drv not in (None, member, "planet"):
+                problems.append((f"{member}_mesh.driver", (
+                    f"{drv!r} is not a gear of the {member}-planet meshes; give "
+                    f"'{member}' or 'planet', or remove 'driver'")))
         if self.ring.kind not in (None, "internal"):
             problems.append(("ring.kind", f"the ring of a planetary stage is an internal "
                              f"gear, not {self.ring.kind!r}; remove 'kind' or write "
@@ -413,6 +424,12 @@ class Planetary(Strict):
             field = {"normal_module": "module", "normal_pressure_angle": "pressure_angle",
                      "helix_angle": "helix_angle", "teeth": f"{member}.teeth",
                      "addendum": f"{member}.profile_shift"}.get(loc) if member else None
+            zs, zp, zr = self.sun.teeth, self.planet.teeth, self.ring.teeth
+            if field is None and loc == "gear2.teeth" and zr <= zp:
+                raise FieldError("ring.teeth", (
+                    f"a ring of {zr} teeth cannot hold planets of {zp}: an internal gear "
+                    f"needs more teeth than its pinion, and without profile shifts the ring "
+                    f"needs z_s + 2 z_p = {zs + 2 * zp}; correct the tooth counts")) from None
             if field is None:
                 field = "ring.teeth" if "internal" in msg else "planet.teeth"
             fix = "tooth counts" if field.endswith(".teeth") else "value"
@@ -594,6 +611,8 @@ class Planetary(Strict):
                     d["damping"] = spec.damping
                 if spec.damping_ratio is not None:
                     d["damping_ratio"] = spec.damping_ratio
+                if spec.driver is not None:
+                    d["driver"] = pname if spec.driver == "planet" else names[member]
                 meshes[mname] = d
         return gears, bodies, meshes
 
