@@ -106,6 +106,13 @@ def test_refuses_what_it_does_not_do():
     full = replace(run, integrate_kwargs={**run.integrate_kwargs, "full_history": True})
     with pytest.raises(GpuUnsupportedError, match="full state histories"):
         run_ensemble([full], target="cpu")
+    # integrate options the kernel plans for itself were ignored without a word
+    for extra, text in (({"step": 1e-6}, "step = 1e-06"), ({"blowup": 1e-9}, "blowup"),
+                        ({"corners": False}, "corners = False"),
+                        ({"max_steps": 10}, "max_steps = 10")):
+        odd = replace(run, integrate_kwargs={**run.integrate_kwargs, **extra})
+        with pytest.raises(GpuUnsupportedError, match=f"integrate options {text}"):
+            run_ensemble([odd], target="cpu")
     with pytest.raises(ValueError, match="precision"):
         run_ensemble([run], target="cpu", precision="fp16")
     with pytest.raises(ValueError, match="target"):

@@ -104,9 +104,12 @@ def test_settle_rule_runs_in_rounds_as_the_cpu_runner():
 
 
 def test_fp32_reports_its_error_per_output():
-    spec = {**GRID, "grid": {"parameters": [{"path": "meshes.m11.damping_ratio",
-                                             "values": [0.05, 0.12]}]}}
-    runner = GpuRunner(target="cpu", precision="fp32", check_cases=2)
+    # (a settle rule: each case runs in rounds, each round's run checked against FP64)
+    spec = {**GRID, "analysis": {"duration": "0.3 s",
+                                 "settle": {"tolerance": 0.2, "start": "0.08 s"}},
+            "grid": {"parameters": [{"path": "meshes.m11.damping_ratio",
+                                     "values": [0.05, 0.12]}]}}
+    runner = GpuRunner(target="cpu", precision="fp32", check_cases=4)
     ds = torquesplit.Study(spec).run(runner=runner)
     err = json.loads(ds.attrs["gpu_backend"])["fp32_error"]
     assert set(err) <= set(ds.attrs["outputs"] and json.loads(ds.attrs["outputs"]))
@@ -115,6 +118,12 @@ def test_fp32_reports_its_error_per_output():
     # exceeds the settle rule's start tolerance, 1e-4 of it: not a continuous output)
     worst = max(e["rel"] for k, e in err.items() if k != "settle_time")
     assert 0.0 < worst < 1e-2
+    # what a difference cannot say is counted: outputs finite in one precision only,
+    # runs that failed in FP32 only; cases counted once over the settle rule's rounds
+    assert all(e["one_finite"] == 0 for e in err.values())
+    report = json.loads(ds.attrs["gpu_backend"])
+    assert report.get("fp32_failed", 0) == 0
+    assert report["fp32_checked"] == 2 and report["fp32_runs_checked"] == 4
 
 
 def test_refused_by_name_before_any_case_runs():
@@ -131,6 +140,12 @@ def test_refused_by_name_before_any_case_runs():
     bearings = {**GRID, "study": {**GRID["study"], "outputs": ["bearing_peak_force.*"]}}
     with pytest.raises(GpuUnsupportedError, match="read from the history.*keeps none"):
         check_plan(torquesplit.Study(bearings).plan())
+    # a GPU runner given as the study's runner refuses the same (it ran a static study
+    # as a dynamic one, its outputs NaN and "ok")
+    with pytest.raises(GpuUnsupportedError, match="quasi-static"):
+        torquesplit.Study(static).run(runner=GpuRunner(target="cpu"))
+    with pytest.raises(GpuUnsupportedError, match="read from the history"):
+        torquesplit.Study(bearings).run(runner=GpuRunner(target="cpu"))
     with pytest.raises(StudyError, match="GPU backend only"):
         torquesplit.Study(GRID).run(precision="fp32")
     with pytest.raises(StudyError, match="unknown backend"):
@@ -149,6 +164,9 @@ def test_without_a_device_the_cpu_runner_runs_it_with_a_warning():
     msgs = [str(w.message) for w in caught if issubclass(w.category, GpuFallbackWarning)]
     assert msgs and "CPU runner" in msgs[0] and "no CUDA device" in msgs[0]
     assert "gpu_backend" not in ds.attrs
+    # the results say so too (only the command line did)
+    assert "no CUDA device" in ds.attrs["backend_fallback"]
+    assert "CPU runner" in ds.attrs["backend_fallback"]
     _same(torquesplit.run_study(spec, workers=1), ds)
 
 
@@ -163,6 +181,8 @@ def test_cli_refuses_and_falls_back_in_one_line(tmp_path):
                            "--quiet", "--no-figures", "--out", str(tmp_path / "s")])
     assert res.exit_code == 2
     assert "does not support quasi-static" in res.output
+    # refused before a note that it would fall back (the two read as a contradiction)
+    assert "running on the CPU runner" not in res.output
     res = cli.invoke(app, ["sweep", "ji_li_mill_drive", "--vary",
                            "meshes.m11.damping_ratio=0.05:0.1:2", "--duration", "0.01 s",
                            "--precision", "fp32", "--quiet", "--no-figures", "--out",
@@ -175,6 +195,12 @@ def test_cli_refuses_and_falls_back_in_one_line(tmp_path):
                                "--no-figures", "--out", str(tmp_path / "f")])
         assert res.exit_code == 0, res.output
         assert res.output.count("running on the CPU runner") == 1
+        res = cli.invoke(app, ["sweep", "ji_li_mill_drive", "--vary",
+                               "meshes.m11.damping_ratio=0.05:0.1:2", "--duration", "0.01 s",
+                               "--backend", "gpu", "--precision", "fp32", "--workers", "1",
+                               "--quiet", "--no-figures", "--out", str(tmp_path / "f32")])
+        assert res.exit_code == 0, res.output
+        assert "in FP64: --precision fp32 applies to the GPU backend only" in res.output
 
 
 def test_a_case_the_study_makes_invalid_is_refused_as_on_the_cpu():

@@ -130,6 +130,7 @@ class GpuRunner:
         self._tables: OrderedDict = OrderedDict()  # table sets workers sent (bounded)
         self._case_bytes = 0.0  # host memory of a case's own tables (measured per batch)
         self._compiled_ahead = False
+        self._fp32_cases: set = set()  # cases whose FP32 error was measured
         #: told what the runner does between finished cases (the study's progress sets it)
         self.on_stage: Callable[[str], None] | None = None
         self.device = ""
@@ -142,6 +143,12 @@ class GpuRunner:
 
     def __repr__(self) -> str:
         return f"GpuRunner(target={self.target!r}, precision={self.precision!r})"
+
+    @staticmethod
+    def check_plan(plan) -> None:
+        """Refuse, by name, a study this runner cannot run (:func:`check_plan`); a study
+        asks any runner given to it as ``runner`` with a ``check_plan``."""
+        check_plan(plan)
 
     # ----------------------------------------------------------------- runner protocol
     def __call__(self, function, payloads):
@@ -315,8 +322,8 @@ class GpuRunner:
         r["post_time_s"] += res.post_time
         r["sample_steps"] += res.sample_steps
         fp64 = None
-        if self.precision == "fp32" and r.get("fp32_checked", 0) < self.check_cases:
-            k = min(len(runs), self.check_cases - r.get("fp32_checked", 0))
+        if self.precision == "fp32" and r.get("fp32_runs_checked", 0) < self.check_cases:
+            k = min(len(runs), self.check_cases - r.get("fp32_runs_checked", 0))
             fp64 = run_ensemble(runs[:k], target=self.target, precision="fp64").solutions
         t = time.perf_counter()
         for i, (job, sol) in enumerate(zip(jobs, res.solutions, strict=True)):
@@ -326,7 +333,11 @@ class GpuRunner:
         r["metrics_time_s"] = r.get("metrics_time_s", 0.0) + time.perf_counter() - t
 
     def _fp32_error(self, job, sol32, sol64) -> None:
-        """Largest absolute and relative difference of every output, FP32 against FP64."""
+        """Largest absolute and relative difference of every output, FP32 against FP64;
+        and what a difference cannot say: runs that failed in FP32 only
+        (``fp32_failed``), outputs finite in one precision only (``one_finite`` per
+        output).  ``fp32_checked`` counts cases (a settle rule's rounds of a case once),
+        ``fp32_runs_checked`` runs."""
         from ..results import Results
         from ..study.outputs import output_values
 
@@ -334,19 +345,26 @@ class GpuRunner:
             res = Results(model=job.run.model, kinematics=job.run.kinematics,
                           structure=job.run.structure, static=job.run.static, solution=sol)
             if not res.success:
-                return {}
+                return None
             return output_values(res, job.p["definitions"])
 
         a, b = values(sol32), values(sol64)
-        err = self.report.setdefault("fp32_error", {})
+        r = self.report
+        if a is None and b is not None:
+            r["fp32_failed"] = r.get("fp32_failed", 0) + 1
+        err = r.setdefault("fp32_error", {})
         for name in job.p["outputs"]:
-            x, y = a.get(name, math.nan), b.get(name, math.nan)
+            x, y = (a or {}).get(name, math.nan), (b or {}).get(name, math.nan)
+            e = err.setdefault(name, {"abs": 0.0, "rel": 0.0, "one_finite": 0})
+            if math.isfinite(x) != math.isfinite(y):
+                e["one_finite"] += 1
             if not (math.isfinite(x) and math.isfinite(y)):
                 continue
-            e = err.setdefault(name, {"abs": 0.0, "rel": 0.0})
             e["abs"] = max(e["abs"], abs(x - y))
             e["rel"] = max(e["rel"], abs(x - y) / max(abs(y), 1e-300))
-        self.report["fp32_checked"] = self.report.get("fp32_checked", 0) + 1
+        r["fp32_runs_checked"] = r.get("fp32_runs_checked", 0) + 1
+        self._fp32_cases.add(job.p["index"])
+        r["fp32_checked"] = len(self._fp32_cases)
 
     def _worker(self) -> str:
         where = "gpu" if self.target == "cuda" else "ensemble-cpu"
@@ -556,8 +574,10 @@ def make_gpu_runner(*, precision: str = "fp64", batch: int = BATCH,
     ok, why = cuda_available()
     if not ok:
         msg = (f"backend='gpu' (--backend gpu): {why}; the study runs on the CPU runner "
-               "instead (same results, CPU speed). Run it on a machine with an NVIDIA GPU "
-               "for the GPU backend.")
+               "instead (same results, CPU speed"
+               + ("; in FP64: precision 'fp32' applies to the GPU backend only"
+                  if precision == "fp32" else "")
+               + "). Run it on a machine with an NVIDIA GPU for the GPU backend.")
         log.info(msg)
         warn_user(msg, GpuFallbackWarning)
         return None

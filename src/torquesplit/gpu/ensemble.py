@@ -124,6 +124,21 @@ def check_supported(run) -> None:
     if kw.get("full_history"):
         raise GpuUnsupportedError("full state histories (full_history)",
                                   "leave full_history off, or use the CPU backend")
+    # integrate options the kernel plans for itself (the study's step and limits): one
+    # set otherwise was ignored, the runs differing from the engine's without a word
+    ignored = [f"{k} = {kw[k]!r}" for k, default in _PLANNED_BY_THE_KERNEL.items()
+               if k in kw and kw[k] is not None and kw[k] != default]
+    if ignored:
+        raise GpuUnsupportedError(
+            f"integrate options {', '.join(ignored)} (the kernel takes the engine's planned "
+            f"step, RK4 through the table corners and the default divergence bound)",
+            "leave them out of the run's integrate_kwargs, or use the CPU backend")
+
+
+#: integrate's options the GPU kernel does not take, with the value it runs with
+_PLANNED_BY_THE_KERNEL = {"step": None, "max_steps": None, "max_step": None, "rtol": None,
+                          "atol": None, "record_every": None, "blowup": BLOWUP,
+                          "corners": True, "check_stability": None}
 
 
 def case_arrays(run) -> _Planned:

@@ -190,13 +190,24 @@ def _run(source, *, workers, scheduler, out, resume, overwrite, figures, quiet, 
         with warnings.catch_warnings():
             if backend == "gpu":  # no device: say so in one line, not as a Python warning
                 from ..errors import GpuFallbackWarning
-                from ..gpu.compile import cuda_available
+                from ..gpu.backend import check_plan
+                from ..gpu.compile import cuda_available, cuda_simulated
 
+                # what the GPU backend refuses, before a note that it would fall back
+                # (the two read as a contradiction, a GPU reviewer)
+                check_plan(plan)
                 ok, why = cuda_available()
                 if not ok:
                     ui.err_console.print(
                         f"[yellow]--backend gpu:[/] {why}; running on the CPU runner "
-                        "(same results, CPU speed)", highlight=False)
+                        "(same results, CPU speed"
+                        + ("; in FP64: --precision fp32 applies to the GPU backend only"
+                           if precision == "fp32" else "") + ")", highlight=False)
+                elif cuda_simulated():
+                    ui.err_console.print(
+                        "[yellow]--backend gpu:[/] numba's CUDA simulator "
+                        "(NUMBA_ENABLE_CUDASIM=1 is set): the same results at Python speed; "
+                        "unset it to run on the GPU", highlight=False)
                 warnings.simplefilter("ignore", GpuFallbackWarning)
             # the messages name the flags (--resume), not Study.run's arguments
             with _terminate_as_interrupt() as terminated:

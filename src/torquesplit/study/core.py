@@ -229,6 +229,7 @@ class Study:
                                             "runs the cases in this process)")
         chosen = _backend_runner(plan, backend, precision, client, scheduler, runner,
                                  workers, words)
+        fallback = _fallback_note(precision) if backend == "gpu" and chosen is None else ""
         store = _open_store(plan, out, resume, overwrite, words)
         try:
             try:
@@ -244,6 +245,8 @@ class Study:
                 report = getattr(run.runner, "report", None)
                 if report is not None:
                     store.write_meta({"gpu_backend": report})
+                # (a fallback left no trace in the results: only the command line said it)
+                store.write_meta({"backend_fallback": fallback})
                 ds = dataset_from_store(plan, store, run.n_used)
                 ds.attrs.update(run.stop_report)
                 if out is not None:
@@ -321,6 +324,16 @@ def _write_outputs(ds, out: Path, figures: bool) -> None:
         manifest.write_text(json.dumps(sorted(Path(p).name for p in written)))
 
 
+def _fallback_note(precision) -> str:
+    """Why a study asked of the GPU backend runs on the CPU runner (kept in its results
+    as ``backend_fallback``)."""
+    from ..gpu.compile import cuda_available
+
+    return (f"backend 'gpu' was asked: {cuda_available()[1]}; the cases ran on the CPU "
+            f"runner" + (" in FP64 (precision 'fp32' applies to the GPU backend only)"
+                         if precision == "fp32" else ""))
+
+
 def _backend_runner(plan: Plan, backend: str, precision, client, scheduler, runner,
                     workers=None, words: Words = API_WORDS):
     """The GPU runner for ``backend="gpu"`` (None: use the CPU runners), after refusing
@@ -332,6 +345,11 @@ def _backend_runner(plan: Plan, backend: str, precision, client, scheduler, runn
         if precision is not None:
             raise StudyError(w.precision, f"applies to the GPU backend only; add "
                                           f"{w.backend_gpu} or leave {w.precision} out")
+        # a runner given as such refuses, by name, what it cannot run (a GpuRunner passed
+        # as ``runner`` ran a static study as a dynamic one, its outputs NaN and "ok")
+        check = getattr(runner, "check_plan", None)
+        if callable(check):
+            check(plan)
         return None
     if precision not in (None, "fp64", "fp32"):
         raise StudyError(w.precision, f"unknown precision {precision!r}; use 'fp64' or "

@@ -148,6 +148,8 @@ def build_dataset(plan, rows, n: int, meta: dict):
             attrs["stopped_at"] = int(n)
     if "gpu_backend" in meta:  # the GPU runs' device, times and FP32 error (torquesplit.gpu)
         attrs["gpu_backend"] = json.dumps(meta["gpu_backend"])
+    if meta.get("backend_fallback"):  # backend 'gpu' asked, run on the CPU runner: why
+        attrs["backend_fallback"] = str(meta["backend_fallback"])
     ds = xr.Dataset(data, coords=coords, attrs=attrs)
     if d.kind == "sensitivity":
         ds = _add_indices(ds, plan, values[:n])
