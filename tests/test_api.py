@@ -99,6 +99,17 @@ def test_bad_arguments_raise_the_packages_own_error(model):
     # a wrong kind of argument is also a TypeError
     with pytest.raises(torquesplit.OptionTypeError):
         torquesplit.simulate(model, cycles=10, progress="yes")
+    # what the message says: the quasi-static definition's own command; options of the
+    # other method refused, not ignored (rtol was silently dropped by rk4)
+    with pytest.raises(torquesplit.OptionError, match="torquesplit static"):
+        run.metrics("static_torque")
+    with pytest.raises(torquesplit.OptionError, match=r"\['rtol'\] do not apply to "
+                       r"method='rk4'"):
+        torquesplit.simulate(model, cycles=10, method="rk4", rtol=1e-6)
+    with pytest.raises(torquesplit.OptionError, match=r"\['steps_per_period', 'max_steps'\] "
+                       r"do not apply to method='dopri'"):
+        torquesplit.simulate(model, cycles=10, method="dopri", steps_per_period=100,
+                             max_steps=10)
 
 
 def test_speeds_with_units_and_series_by_name(model):

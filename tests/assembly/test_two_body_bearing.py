@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import torquesplit
+import torquesplit.solve
 from torquesplit.errors import ModelError
 from torquesplit.model.io import model_from_dict
 from torquesplit.model.overrides import apply_overrides, read_raw
@@ -92,6 +93,20 @@ def test_bearing_on_a_fixed_body_is_a_grounded_bearing(tmp_path):
     # with the carrier free, the carrier's flexibility lowers the wheel's bearing modes
     free = torquesplit.solve.modal_analysis(on_carrier).frequencies
     assert free.size == 7 and free.min() < a.min()
+
+
+def test_bearing_seen_from_its_seat_is_a_grounded_bearing(tmp_path):
+    """With the wheel's translations held instead, the bearing holds the carrier as a
+    support to the housing would: the carrier's own support and the bearing in parallel
+    (5e8 + 3e8 N/m).  This side of the element sees the seat's coefficients, which the
+    test above removes with the carrier's DOFs."""
+    on_carrier = torquesplit.assemble(_model(tmp_path))
+    parallel = torquesplit.assemble(_model(tmp_path, **{
+        "gears.wheel.support.on": None, "bodies.carrier.support.stiffness": "8e8 N/m"}))
+    held = {"wheel.x", "wheel.y"}
+    a, b = _held_frequencies(on_carrier, held), _held_frequencies(parallel, held)
+    assert a.size == b.size == 5
+    np.testing.assert_allclose(a, b, rtol=1e-12)
 
 
 def test_bearing_force_reaches_the_carrier_support(tmp_path):

@@ -196,8 +196,9 @@ def settle(cycle_max: np.ndarray, cycle_start: np.ndarray, names, window=20,
     as much as the last half's do.  The cycles before the first
     whole window (fewer than W) are never counted as settled: they were not checked.  A
     drift that lasts until the end leaves only the last windows, and a mesh whose settled
-    part is shorter than a quarter of its cycles is reported as not settled (its last
-    half is used).  A run shorter than two windows cannot show that the response repeats
+    part is shorter than a quarter of its cycles, or is the last window alone (which
+    nothing confirms: the transient may end inside it), is reported as not settled (its
+    last half is used).  A run shorter than two windows cannot show that the response repeats
     over the longest excitation period: it is reported as not settled (``short``), and
     its windows shrink to a quarter of its cycles.  A group is settled from the latest
     settle time of its meshes, and every metric of the group starts there.
@@ -238,7 +239,10 @@ def settle(cycle_max: np.ndarray, cycle_start: np.ndarray, names, window=20,
                 # (a later one outside it is the response's own variation)
                 b0 = max(b0, int(np.argmax(inside)) if inside.any() else 0)
             k_set = start + b0 * w
-            ok = (n - k_set) >= n / 4
+            # settled needs two windows that agree at least: the last one alone, the
+            # reference, may hold the transient's end itself (a run of 2-4 windows whose
+            # transient reached into its last one was reported settled from it)
+            ok = (n - k_set) >= n / 4 and b0 <= n_win - 2
         if not ok:
             settled = False
             k_set = n // 2 if n else 0
