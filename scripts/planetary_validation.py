@@ -108,9 +108,10 @@ def build() -> tuple[str, dict]:
               "2010). Input torque 100 N m (the example's). 'ours' is in the stationary "
               "carrier frame, as the hand calculation and the publications (the assembly "
               "option `rotating_frame = False`); `torquesplit static` keeps the turning "
-              "carrier's centripetal terms (last column), which hold a floating sun a little "
-              "more firmly than its 1 N/m support (the centripetal term m_s Omega_c^2 of the "
-              "carrier's speed Omega_c acts on the sun as a spring).", "",
+              "carrier's centripetal terms (last column): in the carrier's frame the "
+              "floating sun's 1 N/m support is softened by m_s Omega_c^2 (Omega_c the "
+              "carrier's speed), so the sun is not quite free (last column of the floating "
+              "cases).", "",
               "| case | published / hand | ours | least planet load / mean | ours, turning "
               "carrier (`torquesplit static`) |",
               "|---|---|---|---|---|"]

@@ -39,6 +39,15 @@ def test_a_stage_field_varies_and_k_gamma_is_an_output(lp_file):
     assert k[0] == pytest.approx(1.0, abs=1e-9) and k[1] > 1.01
     planets = [v for v in ds.data_vars if v.startswith("planet_load_sharing.static_torque.")]
     assert "planet_load_sharing.static_torque.stage_carrier" in planets and len(planets) == 5
+    # described as what it is: K_gamma from the position-averaged loads (it was given the
+    # peak ratio's text of the static_torque definition, a planetary reviewer)
+    from torquesplit.study.outputs import output_definitions
+
+    said, = output_definitions(planets)
+    assert "K_gamma" in said and "averaged over the mesh positions" in said
+    assert "largest over the mesh positions" not in said
+    assert ds["planet_load_sharing.static_torque"].attrs["long_name"].startswith(
+        "planet load-sharing factor (largest planet over the mean) (static_torque)")
 
 
 def test_a_dynamic_study_gives_k_gamma_of_its_definition(lp_file):

@@ -545,7 +545,7 @@ def _modal_force_share(structure, q, shape, meshes, order: int,
                        cycles=None) -> float | None:
     """How much of the ``order``-th harmonic of the meshes' static forces reaches a mode
     (``shape``: its displacement part): |sum_m a_m| / sum_m |a_m| with
-    a_m = F_m e^(2 pi i order phase_m) (V_m . shape), F_m that harmonic of mesh m's
+    a_m = F_m e^(2 pi i order phase_m) (V_m . conj(shape)), F_m that harmonic of mesh m's
     static force over its cycle (:func:`mesh_cycle`: its stiffness harmonic times
     its static deflection, plus its transmission error's force), phase_m its mesh phase.
     0 where the meshes' forces cancel on the mode (branches in phase on a mode where they
@@ -565,7 +565,11 @@ def _modal_force_share(structure, q, shape, meshes, order: int,
         f = cyc.force
         c = np.fft.rfft(f)[order] / f.size
         sl = slice(structure.v_ptr[e], structure.v_ptr[e + 1])
-        v = complex(np.dot(structure.v_coef[sl], shape[:n][structure.v_dof[sl]]))
+        # the projection on the mode is phi^H F: the complex whirl modes of a turning
+        # carrier's frame (gyroscopic) take the conjugate (phi^T F measured the other
+        # whirl: Lin & Parker N = 5, order 2 drives the backward whirl, which it called
+        # cancelled, a planetary reviewer); a real mode is unchanged
+        v = complex(np.dot(structure.v_coef[sl], np.conj(shape[:n][structure.v_dof[sl]])))
         a.append(c * np.exp(2j * np.pi * order * structure.phase[e]) * v)
     total = sum(abs(x) for x in a)
     if not total > 0:

@@ -58,6 +58,7 @@ STATIC_DEFINITION = "static_torque"
 #: output families (name head) -> (unit, long name)
 FAMILIES: dict[str, tuple[str, str]] = {
     "load_sharing": ("1", "load-sharing coefficient"),
+    "planet_load_sharing": ("1", "planet load-sharing factor (largest planet over the mean)"),
     "dynamic_factor": ("1", "dynamic load factor (peak / own static force)"),
     "dynamic_factor_engineering": ("1", "engineering dynamic factor (mean cycle peak / own "
                                         "static force)"),
@@ -262,7 +263,19 @@ def output_definitions(names) -> list[str]:
         head = ".".join(parts[:2]) if sharing else parts[0]
         if head in seen:
             continue
-        if sharing and parts[1] in DEFINITION_TEXT:
+        if parts[0] == "planet_load_sharing" and len(parts) > 1 and \
+                parts[1] == "static_torque":
+            # (K_gamma from the loads averaged over the positions, not the peak ratio the
+            # definition's own text describes: a planetary reviewer)
+            seen[head] = ("mesh load factor K_gamma of each planetary stage: the largest "
+                          "planet's load over the mean, from the quasi-static loads averaged "
+                          "over the mesh positions (ISO 6336-1, AGMA 6123)")
+        elif parts[0] == "planet_load_sharing" and len(parts) > 1 and \
+                parts[1] in DEFINITION_TEXT:
+            seen[head] = (f"mesh load factor of each planetary stage, the largest planet "
+                          f"over the mean, by the {parts[1]} definition: "
+                          f"{DEFINITION_TEXT[parts[1]]}")
+        elif sharing and parts[1] in DEFINITION_TEXT:
             seen[head] = DEFINITION_TEXT[parts[1]]
         elif head in FAMILIES:
             seen[head] = FAMILIES[head][1]
@@ -275,6 +288,6 @@ def output_long_name(name: str) -> str:
     parts = name.split(".")
     unit_text = FAMILIES.get(parts[0], ("1", parts[0]))[1]
     _, member = family(name)
-    if parts[0] == "load_sharing" and len(parts) > 1:
+    if parts[0] in ("load_sharing", "planet_load_sharing") and len(parts) > 1:
         unit_text += f" ({parts[1]})"
     return unit_text + ("" if member == "system" else f", {member}")
