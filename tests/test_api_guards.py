@@ -372,3 +372,30 @@ def test_a_quasi_static_sweep_shorter_than_the_common_period_is_said():
     (text,) = said(1)
     assert "revolutions = 1 covers part of the excitations' common period, 25 " in text
     assert said(25) == [] and said(50) == []
+
+
+def test_exceptions_live_in_errors_and_no_data_class_is_named_error():
+    """Every exception class of the package derives from TorquesplitError and is defined
+    in torquesplit.errors (warnings too, as Warning subclasses), and no other class is
+    named *Error (a pydantic model PinError read as an exception; a CaseWarning lived in
+    study/case.py, an unused Interrupted in cli_support.py)."""
+    import importlib
+    import inspect
+    import pkgutil
+
+    import torquesplit
+    from torquesplit.errors import TorquesplitError
+
+    seen = {}
+    for info in pkgutil.walk_packages(torquesplit.__path__, "torquesplit."):
+        module = importlib.import_module(info.name)
+        for name, obj in vars(module).items():
+            if inspect.isclass(obj) and obj.__module__.startswith("torquesplit"):
+                seen[obj.__module__, obj.__qualname__] = obj
+    assert len(seen) > 100  # (the package's modules were walked)
+    for (module, name), cls in seen.items():
+        if issubclass(cls, BaseException):
+            assert module == "torquesplit.errors", (module, name)
+            assert issubclass(cls, (TorquesplitError, Warning)), name
+        else:
+            assert not name.endswith("Error"), (module, name)

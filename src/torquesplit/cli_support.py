@@ -209,10 +209,6 @@ def _compile_hint_column():
     return CompileHint()
 
 
-class Interrupted(Exception):
-    """Raised by :func:`interruptible` after it has said what was kept."""
-
-
 @contextlib.contextmanager
 def interruptible(kept: Callable[[], str] | None = None) -> Iterator[None]:
     """Turn Ctrl-C into one line, ``interrupted; <what was kept>``, and exit status 130.

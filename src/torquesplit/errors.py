@@ -322,6 +322,12 @@ class ModelWarning(UserWarning):
     """A value that looks wrong but can be right (damping above critical, ...)."""
 
 
+class CaseWarning(UserWarning):
+    """A study case's run plausibility warning (too short to tell whether it settled,
+    unsettled, resonance...): raised as a warning so that every runner that records a
+    case's warnings (``study.case.run_case``, the GPU backend) records it."""
+
+
 _COLLECTORS: contextvars.ContextVar[tuple[list, ...]] = contextvars.ContextVar(
     "torquesplit_model_warnings", default=())
 

@@ -61,7 +61,7 @@ from .schema import (
     Module,
     ModificationsSpec,
     Number,
-    PinError,
+    PinDeviation,
     StiffnessSpec,
     Strict,
     Support,
@@ -225,7 +225,7 @@ class Planetary(Strict):
     carrier: PlanetaryCarrier = Field(description="The carrier.")
     planet_bearing: Support = Field(description="Bearing of each planet on its carrier pin "
                                     "(its other end is on the carrier: leave 'on' out).")
-    pin_errors: tuple[PinError, ...] | None = Field(
+    pin_errors: tuple[PinDeviation, ...] | None = Field(
         None, description="Pin position error of each planet: one {radial, tangential} "
         "table per planet, in planet order, e.g. [{tangential = '20 um'}, {}, {}] (pin "
         "errors are typically microns); default none.")
@@ -586,7 +586,7 @@ class Planetary(Strict):
             names["ring"]: gear(self.ring, "internal", other, ["theta"],
                                 position=self.position, support=self.ring.support),
         }
-        pins = self.pin_errors or [PinError()] * self.planets
+        pins = self.pin_errors or [PinDeviation()] * self.planets
         for i, (pname, psi) in enumerate(zip(names["planets"], self.planet_angles())):
             bearing = self.planet_bearing.model_copy(update={"on": names["carrier"],
                                                              "pin_error": pins[i]})

@@ -201,7 +201,7 @@ class ShaftBending(Strict):
         return self
 
 
-class PinError(Strict):
+class PinDeviation(Strict):
     """Position error of a bearing seat on the body that carries it (a planet pin on its
     carrier; Bodas & Kahraman 2004, Ligata et al. 2008)."""
 
@@ -288,8 +288,8 @@ class Support(Strict):
         "other end: a planet pin on its carrier, a moving housing); default: the fixed "
         "housing."
     )
-    pin_error: PinError = Field(
-        PinError(), description="Position error of the seat (planet pin) on the body "
+    pin_error: PinDeviation = Field(
+        PinDeviation(), description="Position error of the seat (planet pin) on the body "
         "named by 'on' (radial, tangential); requires 'on'.")
     floating: bool = Field(
         False, description="The body floats by design, held by its meshes alone (a "

@@ -22,7 +22,7 @@ import os
 import time
 import warnings
 
-from ..errors import warn_user
+from ..errors import CaseWarning, warn_user
 
 STATUSES = ("ok", "contact_lost", "diverged", "refused", "error")
 """Case statuses, from best to worst."""
@@ -84,12 +84,6 @@ first case, the worker moves every object it holds then (modules, compiled kerne
 the model) out of the garbage collector's reach (:func:`gc.freeze`), so that the full
 collections of later cases do not walk them again (4 ms of a Dong et al. 2021 case's
 40 ms overhead)."""
-
-
-class CaseWarning(UserWarning):
-    """A run's plausibility warning (too short to tell whether it settled, unsettled,
-    resonance...): raised as a warning so that every runner that records a case's
-    warnings (run_case, the GPU backend) records it."""
 
 
 def _warn(pairs) -> None:
