@@ -7,7 +7,8 @@ clearance, a shaft (two rotations), a bearing between two bodies (two translatio
 mesh with tooth friction and a gyroscopic pair.  The reference is the law itself
 (:func:`torquesplit.solve.laws.spring_force` on the element's k(t), c, deformation, rate
 and half-gap g(t)); its consumers: the compiled general kernel, the generated code, the
-numpy twin, the static Newton problem (force and tangent, the tangent also against a
+numpy twin, the steady-state solvers' linearisation (force and both slopes), the static
+Newton problem (force and tangent, the tangent also against a
 central difference of the force) and the modal linearisation (the law's slope at the
 mean stiffness and half-gap: modes are those of the time-averaged system).  The
 right-hand side dy/dt of the three dynamic consumers is also compared with the
@@ -24,13 +25,14 @@ import pytest
 from torquesplit.assembly.structure import MESH, SPRING, build_structure
 from torquesplit.solve import codegen, laws, modal_analysis
 from torquesplit.solve.integrate import _evaluate
-from torquesplit.solve.kernel_data import kernel_model
+from torquesplit.solve.kernel_data import kernel_model, make_work
 from torquesplit.solve.reference import (
     element_forces_numpy,
     excitation_numpy,
     rhs_numpy,
 )
 from torquesplit.solve.static import _StaticProblem
+from torquesplit.steady import _kernels as sk
 
 K, C = 3.0e8, 250.0  # N/m, N s/m
 TABLE = K * (1.0 + 0.2 * np.cos(2 * np.pi * np.arange(256) / 256))
@@ -92,6 +94,16 @@ def test_every_consumer_evaluates_the_law(kind):
     y = np.concatenate([q, v])
     f, df, d, ex = _law(s, t, q, v)
     assert (f != 0.0 and df > 0.0) == contact  # (the case is where it is meant to be)
+    # the steady-state solvers' linearisation (harmonic balance, shooting): force and
+    # both slopes of the law at the sample
+    law = laws.spring_force(ex.stiffness[0], s.damping[0], d, float(s.projection_matrix()[0]
+                                                                   @ v), ex.half_gap[0])
+    m = kernel_model(s)
+    out = (np.empty((1, 1)), np.empty((1, 1)), np.empty((1, 1)), np.zeros((1, 1, 8)),
+           np.zeros((1, 1)), np.zeros((1, 1)))
+    sk.sample_linearise(np.array([t]), np.concatenate([q, v])[None, :], m, make_work(m),
+                        *out)
+    assert (out[0][0, 0], out[1][0, 0], out[2][0, 0]) == law
     code = codegen.generated_rhs(kernel_model(s))
     dy_gen, f_gen, d_gen = _evaluate(s, t, y, code=code)
     dy_ker, f_ker, d_ker = _evaluate(s, t, y)
