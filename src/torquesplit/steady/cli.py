@@ -854,7 +854,8 @@ def campbell_command(m, start, stop, plot, as_json, console, json_default, out=N
     n_driven = sum(driven(c, DRIVING_HARMONIC) for c in critical)
     t = Table(title=f"critical speeds between {lo} and {hi}" + (
         f" ({len(critical)} critical; {len(suppressed)} crossings that the planets' mesh "
-        f"phasing leaves unexcited, Parker & Lin 2004, marked 'suppressed')" if phased
+        f"phasing leaves unexcited, Parker & Lin 2004, or of a stage's meshes with a mode "
+        f"in which no stage member moves (type 'other'), marked 'suppressed')" if phased
         else "") + f"; {n_driven} of {len(critical)} driven by at least "
         f"{100 * DRIVING_HARMONIC:g} % (the mesh force harmonic, or a shaft order's k "
         f"harmonic or error; one whose meshes' forces cancel on the mode, marked 'cancels', "
