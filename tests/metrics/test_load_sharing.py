@@ -172,6 +172,33 @@ def test_settled_runs_of_any_length_hold_no_transient_cycle():
     assert checked > 2000  # (settled runs were checked, not only unsettled ones)
 
 
+def test_windows_shrunk_below_the_period_are_said_to_be_too_short():
+    """A steady response that repeats every 20 cycles, over 50 cycles (between two and
+    four windows): the windows shrink to 12 cycles, their peaks vary with the phase of the
+    period, and the run is not settled; the reason recorded, and said, is that the run is
+    too short for windows of the period (it was "the transient did not die out")."""
+    from types import SimpleNamespace
+
+    from torquesplit.results.plausibility import settling
+
+    n = 50
+    i = np.arange(n)
+    peaks = 1.0 + 0.05 * np.sin(2 * np.pi * i / 20)
+    st = ls.settle(peaks[:, None], (i / 100.0)[:, None], ["a"], window=20, tolerance=0.01)
+    assert not st.settled and st.short == {} and st.shrunk == {"a": (50, 20)}
+    results = SimpleNamespace(kinematics=SimpleNamespace(
+        meshes={"a": SimpleNamespace(frequency=100.0)}))
+    (loc, text), = settling(results, SimpleNamespace(settling=st))
+    assert loc == "analysis" and "too short to tell" in text
+    assert "fewer than four settle windows of 20 cycles" in text and "81 cycles of a" in text
+    # four windows and more: settled, nothing shrunk
+    n = 80
+    i = np.arange(n)
+    st = ls.settle((1.0 + 0.05 * np.sin(2 * np.pi * i / 20))[:, None], (i / 100.0)[:, None],
+                   ["a"], window=20, tolerance=0.01)
+    assert st.settled and st.shrunk == {}
+
+
 def test_a_run_shorter_than_two_windows_is_not_settled():
     """Steady peaks, but fewer cycles than two windows of the longest excitation period
     (here 168 cycles, a gear revolution): the run cannot show that the response repeats,

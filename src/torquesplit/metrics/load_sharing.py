@@ -114,6 +114,11 @@ class Settling:
     """Mesh -> (its cycles, the window it needs) where the run holds fewer than two
     windows: too short to check settling over the longest excitation period, so not
     settled (its metrics then use a shorter window, a best effort)."""
+    shrunk: dict[str, tuple[int, int]] = field(default_factory=dict)
+    """Mesh -> (its cycles, the window it needs) where the run holds two to four windows,
+    so its windows shrank to a quarter of the run, shorter than the longest excitation
+    period, and they did not show it settled: the response's own variation over that
+    period cannot be told from a transient (run at least four windows)."""
     mean_first_cycle: dict[str, int] = field(default_factory=dict)
     """Mesh -> first cycle of the mean forces (mean_force coefficients, the mean F
     column, the drift check): every group over one span, from ``start_time``
@@ -205,6 +210,7 @@ def settle(cycle_max: np.ndarray, cycle_start: np.ndarray, names, window=20,
     """
     own: dict[str, int] = {}
     short: dict[str, tuple[int, int]] = {}
+    shrunk: dict[str, tuple[int, int]] = {}
     settled = True
     t_own: dict[str, float] = {}
     for j, name in enumerate(names):
@@ -246,6 +252,8 @@ def settle(cycle_max: np.ndarray, cycle_start: np.ndarray, names, window=20,
         if not ok:
             settled = False
             k_set = n // 2 if n else 0
+            if w < w_req and name not in short:
+                shrunk[name] = (n, w_req)
         c = int(idx[k_set]) if n else 0
         own[name] = c
         t_own[name] = float(cycle_start[c, j]) if n else -math.inf
@@ -260,7 +268,8 @@ def settle(cycle_max: np.ndarray, cycle_start: np.ndarray, names, window=20,
             first[m] = _first_cycle_from(starts, group_time[g], own[m])
     start_time = max(group_time.values()) if group_time else 0.0
     return Settling(start_time=start_time, settled=settled, first_cycle=first,
-                    group_time=group_time, own_first_cycle=own, short=short)
+                    group_time=group_time, own_first_cycle=own, short=short,
+                    shrunk=shrunk)
 
 
 def _first_cycle_from(starts: np.ndarray, t: float, least: int) -> int:

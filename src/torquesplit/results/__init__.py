@@ -95,7 +95,8 @@ class Metrics:
         groups += f" and {more} more" if more > 0 else ""
         kv = ls._nanmax(list(d.per_group_dynamic_factor.values()))
         st = self.settling
-        why = "too short to tell" if st.short else "transient did not die out"
+        why = ("too short to tell" if st.short or st.shrunk else
+               "transient did not die out")
         # (a periodic state's 'settled from 0.04189 s' lay beyond the period its
         # dataset holds: a Python API reviewer)
         settled = ("a periodic state (no transient)" if st.periodic else

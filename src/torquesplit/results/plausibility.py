@@ -259,6 +259,20 @@ def settling(results, metrics) -> list[tuple[str, str]]:
             f"start or the end cuts does not count), so the metrics may not average over "
             f"whole excitation periods; simulate at least {need[m]:.3g} s ({2 * w + 1} "
             f"cycles of {m}) plus the transient"))]
+    shrunk = metrics.settling.shrunk
+    if shrunk:  # windows shorter than the excitation period: a drift or the period itself
+        kin = results.kinematics
+        need = {m: (4 * w + 1) / kin.meshes[m].frequency for m, (_, w) in shrunk.items()}
+        m = max(need, key=need.get)
+        n, w = shrunk[m]
+        return [("analysis", (
+            f"the run is too short to tell whether the response has settled: mesh {m} "
+            f"completes {n} cycles, fewer than four settle windows of {w} cycles, so its "
+            f"windows shrank below the longest excitation period (e.g. a gear revolution "
+            f"when errors turn with the gears) and the response's own variation over that "
+            f"period cannot be told from a transient; the last half of the run was used "
+            f"for the metrics; simulate at least {need[m]:.3g} s ({4 * w + 1} cycles of "
+            f"{m}) plus the transient"))]
     return [("analysis", (
         "the transient did not die out within the run (the peaks still drift), so the last "
         "half of the run was used for the metrics; simulate longer (--cycles or --duration; "
