@@ -47,6 +47,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..errors import OptionError
+
 #: element kinds
 SPRING = 0
 MESH = 1
@@ -337,12 +339,12 @@ def build_structure(
         s1 = float(el.get("stick_limit", 0.0))
         s2 = float(el.get("clearance", 0.0))
         if not 0.0 <= s1 <= s2:
-            raise ValueError(f"spline {el['name']!r}: need 0 <= stick_limit <= clearance, got "
+            raise OptionError(f"spline {el['name']!r}: need 0 <= stick_limit <= clearance, got "
                              f"{s1!r} and {s2!r} m")
         par = [k, c, s1, s2, float(el.get("friction_force", 0.0)),
                float(el.get("velocity_scale", 1e-4))]
         if par[SP_FRICTION] < 0 or not par[SP_VELOCITY] > 0:
-            raise ValueError(f"spline {el['name']!r}: friction_force must be >= 0 N and "
+            raise OptionError(f"spline {el['name']!r}: friction_force must be >= 0 N and "
                              f"velocity_scale > 0 m/s")
         splines.append((idx[0], idx[1], par))
     elements = expanded
@@ -393,17 +395,17 @@ def build_structure(
         fr = el.get("friction")
         if fr is not None:
             if kind[i] != MESH:
-                raise ValueError(f"element {el['name']!r}: only a MESH can have tooth friction")
+                raise OptionError(f"element {el['name']!r}: only a MESH can have tooth friction")
             table = fr["table"]
             if len(table) != FRICTION_ROWS:
-                raise ValueError(f"element {el['name']!r}: the friction table needs 3 rows "
+                raise OptionError(f"element {el['name']!r}: the friction table needs 3 rows "
                                  "(force, moment on driver, moment on driven gear)")
             base = FRICTION_ROWS * len(fr_el)
             fr_el.append(i)
             fr_tab.extend(_resample_periodic(row, grid) for row in table)
             for d, c, r in zip(fr["dofs"], fr["coefs"], fr["rows"], strict=True):
                 if not 0 <= int(r) < FRICTION_ROWS:
-                    raise ValueError(f"element {el['name']!r}: friction rows are 0, 1 or 2")
+                    raise OptionError(f"element {el['name']!r}: friction rows are 0, 1 or 2")
                 fr_dof.append(int(d))
                 fr_coef.append(float(c))
                 fr_row.append(base + int(r))
@@ -411,7 +413,7 @@ def build_structure(
     gy = sorted((int(i), int(j), float(g)) for i, j, g in gyroscopic)
     for i, j, g in gy:
         if not (0 <= i < n_dof and 0 <= j < n_dof and np.isfinite(g)):
-            raise ValueError(f"gyroscopic entry ({i}, {j}, {g}) is out of range or not "
+            raise OptionError(f"gyroscopic entry ({i}, {j}, {g}) is out of range or not "
                              f"finite; DOF indices are 0..{n_dof - 1}")
     gy_ptr = np.zeros(n_dof + 1, dtype=np.int64)
     for i, _, _ in gy:
@@ -419,7 +421,7 @@ def build_structure(
     fs = sorted((int(i), int(j), float(k)) for i, j, k in frame_stiffness)
     for i, j, k in fs:
         if not (0 <= i < n_dof and 0 <= j < n_dof and np.isfinite(k)):
-            raise ValueError(f"frame stiffness entry ({i}, {j}, {k}) is out of range or not "
+            raise OptionError(f"frame stiffness entry ({i}, {j}, {k}) is out of range or not "
                              f"finite; DOF indices are 0..{n_dof - 1}")
     fs_ptr = np.zeros(n_dof + 1, dtype=np.int64)
     for i, _, _ in fs:

@@ -46,7 +46,7 @@ from functools import cached_property
 
 import numpy as np
 
-from torquesplit.errors import ModelError
+from torquesplit.errors import ModelError, OptionTypeError
 
 __all__ = [
     "GearGeometry",
@@ -112,7 +112,7 @@ def mesh_frequency(teeth: int, angular_speed: float | None = None, *, rpm: float
 
 def _angular_speed(angular_speed: float | None, rpm: float | None) -> float:
     if (angular_speed is None) == (rpm is None):
-        raise TypeError(
+        raise OptionTypeError(
             "give exactly one of angular_speed [rad/s] or rpm=[1/min], "
             "e.g. mesh_period(23, rpm=2423)"
         )

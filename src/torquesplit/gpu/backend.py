@@ -41,7 +41,7 @@ import numpy as np
 
 from .._memo import hash_arrays
 from ..assembly.tables import TABLES
-from ..errors import warn_user
+from ..errors import OptionError, warn_user
 from .layout import IdentityMemo
 
 log = logging.getLogger(__name__)
@@ -113,18 +113,18 @@ class GpuRunner:
         from .ensemble import PRECISIONS, TARGETS
 
         if precision not in PRECISIONS:
-            raise ValueError(f"precision must be one of {PRECISIONS}, got {precision!r}; "
+            raise OptionError(f"precision must be one of {PRECISIONS}, got {precision!r}; "
                              "use 'fp64' or 'fp32'")
         if target not in TARGETS:
-            raise ValueError(f"target must be one of {TARGETS}, got {target!r}")
+            raise OptionError(f"target must be one of {TARGETS}, got {target!r}")
         if batch < 1:
-            raise ValueError(f"batch must be >= 1, got {batch}; give e.g. batch=16384")
+            raise OptionError(f"batch must be >= 1, got {batch}; give e.g. batch=16384")
         self.precision = precision
         self.target = target
         self.batch = int(batch)
         self.check_cases = int(check_cases)
         if int(workers) < 1:
-            raise ValueError(f"workers must be >= 1, got {workers}; give e.g. workers=4")
+            raise OptionError(f"workers must be >= 1, got {workers}; give e.g. workers=4")
         self.workers = int(workers)
         self._pool = None
         self._tables: OrderedDict = OrderedDict()  # table sets workers sent (bounded)

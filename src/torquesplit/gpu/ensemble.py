@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from torquesplit.errors import GpuUnsupportedError
+from torquesplit.errors import GpuUnsupportedError, OptionError
 from torquesplit.solve import _kernels as kern
 from torquesplit.solve import kernel_data as kd
 
@@ -226,7 +226,7 @@ def _group_min(kw: dict, n_groups: int) -> np.ndarray:
     if g is None:
         return np.zeros(n_groups)
     if len(g) != n_groups:
-        raise ValueError("load_sharing_min_total needs one value per load-sharing group.")
+        raise OptionError("load_sharing_min_total needs one value per load-sharing group.")
     return np.asarray(g, dtype=np.float64).reshape(n_groups)
 
 
@@ -267,10 +267,10 @@ def run_ensemble(runs, *, target: str = "cuda", precision: str = "fp64",
     from torquesplit.errors import GpuUnavailableError
 
     if target not in TARGETS:
-        raise ValueError(f"target must be one of {TARGETS}, got {target!r}; use 'cuda' "
+        raise OptionError(f"target must be one of {TARGETS}, got {target!r}; use 'cuda' "
                          f"or 'cpu'")
     if precision not in PRECISIONS:
-        raise ValueError(f"precision must be one of {PRECISIONS}, got {precision!r}; use "
+        raise OptionError(f"precision must be one of {PRECISIONS}, got {precision!r}; use "
                          f"'fp64' (default) or 'fp32'")
     device = "cpu (generated source, numba)"
     if target == "cuda":

@@ -41,6 +41,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from torquesplit.errors import OptionError
 from torquesplit.solve import _kernels as kern
 from torquesplit.solve import kernel_data as kd
 
@@ -119,7 +120,7 @@ class _Writer:
 def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
     """The Python source of the ensemble kernel of group ``g`` (see the module doc)."""
     if precision not in ("fp64", "fp32"):
-        raise ValueError(f"precision must be 'fp64' or 'fp32', got {precision!r}")
+        raise OptionError(f"precision must be 'fp64' or 'fp32', got {precision!r}")
     L = g.layout
     fp32 = precision == "fp32"
     n, ne = L.n, L.ne

@@ -55,6 +55,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..errors import OptionError
+
 DEFINITIONS = ("cycle_peak", "instantaneous", "engineering", "mean_force", "static_torque")
 DYNAMIC_DEFINITIONS = DEFINITIONS[:4]
 
@@ -412,7 +414,7 @@ def instantaneous(cycle_ratio_max, cycle_start, names, groups, first_cycle,
     ``N F_i(t) / sum_j F_j(t)`` (``Solution.cycle_ratio_max``): the largest over the
     settled cycles (``instantaneous``, g_i) or their mean (``engineering``, g_it)."""
     if definition not in ("instantaneous", "engineering"):
-        raise ValueError(f"definition must be 'instantaneous' or 'engineering', got "
+        raise OptionError(f"definition must be 'instantaneous' or 'engineering', got "
                          f"{definition!r}")
     col = {n: j for j, n in enumerate(names)}
     reduce = _nanmax if definition == "instantaneous" else _nanmean

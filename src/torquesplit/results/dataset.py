@@ -158,9 +158,9 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
     try:
         if not res.success:  # a stopped run: its coefficients are not results (as its CSV)
             if getattr(res, "steady", None) is not None:
-                raise ValueError("the periodic state did not converge: no metrics of the "
+                raise OptionError("the periodic state did not converge: no metrics of the "
                                  "last iterate")
-            raise ValueError("the run stopped before its end: no metrics of a part of it")
+            raise OptionError("the run stopped before its end: no metrics of a part of it")
         met = res.metrics(definition)
         ds["load_sharing"] = _var(("mesh",), [met.load_sharing.per_mesh[m] for m in meshes],
                                   "1", f"load-sharing coefficient ({met.definition})")

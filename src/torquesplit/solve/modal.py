@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from torquesplit.assembly.structure import Structure
+from torquesplit.errors import OptionError
 from torquesplit.solve import laws
 from torquesplit.solve._frozen import freeze_arrays
 
@@ -158,7 +159,7 @@ def modal_analysis(structure: Structure, q=None, *, rigid_tolerance: float = 1e-
     else:
         q = np.asarray(q, dtype=float)
         if q.shape != (s.n_dof,):
-            raise ValueError(f"q must hold {s.n_dof} displacements, got shape {q.shape}; "
+            raise OptionError(f"q must hold {s.n_dof} displacements, got shape {q.shape}; "
                              "pass e.g. static_equilibrium(structure).q.")
         delta = V @ q - s.error_constant
         h, slope, u = (np.empty(s.n_elements) for _ in range(3))

@@ -168,7 +168,7 @@ def _run(source, *, workers, scheduler, out, resume, overwrite, figures, quiet, 
         if out is None:
             out = Path(f"study_{_safe(name_hint or st.name)}")
         if workers is not None and workers < 1:
-            raise ValueError(f"--workers {workers}: give at least 1")
+            raise OptionError(f"--workers {workers}: give at least 1")
         if not as_json:
             ui.err_console.print(
                 f"[bold]{st.name}[/]: {plan.n_cases} cases ({plan.design.kind}, "
@@ -789,16 +789,16 @@ _RANGE = re.compile(r"^\s*(?P<start>[^:]+?)\s*:\s*(?P<stop>[^:]+?)\s*:\s*"
 def parse_vary(text: str) -> dict:
     """``PATH[,PATH]=START:STOP:NUM[unit]`` -> a grid parameter table."""
     if "=" not in text:
-        raise ValueError(f"--vary {text!r} is not PATH=START:STOP:NUM[unit]; write e.g. "
+        raise OptionError(f"--vary {text!r} is not PATH=START:STOP:NUM[unit]; write e.g. "
                          f"--vary shafts.drive1.diameter=130:400:28mm")
     paths_text, spec = (s.strip() for s in text.split("=", 1))
     m = _RANGE.match(spec)
     if not m:
-        raise ValueError(f"--vary {text!r}: {spec!r} is not START:STOP:NUM[unit]; write e.g. "
+        raise OptionError(f"--vary {text!r}: {spec!r} is not START:STOP:NUM[unit]; write e.g. "
                          f"130:400:28mm or '2e8 N/m:6e8 N/m:9'")
     paths = [p.strip() for p in paths_text.split(",") if p.strip()]
     if not paths:  # ('=0:40:3um': an IndexError)
-        raise ValueError(f"--vary {text!r} names no field before '='; write e.g. --vary "
+        raise OptionError(f"--vary {text!r} names no field before '='; write e.g. --vary "
                          f"gears.pinion.errors.eccentricity={spec}")
     table: dict = {}
     if len(paths) == 1:
@@ -811,7 +811,7 @@ def parse_vary(text: str) -> dict:
         table["name"] = paths[0].split(".")[-1]
     num = m["num"]
     if not re.fullmatch(r"\d+", num) or int(num) < 1:
-        raise ValueError(f"--vary {text!r}: the count {num!r} after the second ':' is the "
+        raise OptionError(f"--vary {text!r}: the count {num!r} after the second ':' is the "
                          f"number of points, a whole number >= 1 (not a step); write e.g. "
                          f"{m['start'].strip()}:{m['stop'].strip()}:5{m['unit'] or ''}")
     table.update(start=_number(m["start"]), stop=_number(m["stop"]), num=int(num))
@@ -842,7 +842,7 @@ def _refuse_bare_range(text: str, table: dict) -> None:
         # (a length: mm or um, as the numbers are a diameter's or a clearance's)
         units = ("mm", "um") if kind == "length" else (KINDS[kind][1].split(" ", 1)[1],)
         examples = " or ".join(f"'{a:g}:{b:g}:{n}{u}'" for u in units)
-        raise ValueError(f"--vary {text!r}: {path} is a {kind.replace('_', ' ')} and the "
+        raise OptionError(f"--vary {text!r}: {path} is a {kind.replace('_', ' ')} and the "
                          f"range has no unit (it would be read as {a:g} to {b:g} {si}); "
                          f"write the unit after the count, e.g. {examples} "
                          f"(or '{a:g}:{b:g}:{n}{si}' if {si} is meant)")

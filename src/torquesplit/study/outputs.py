@@ -51,6 +51,8 @@ from __future__ import annotations
 import fnmatch
 import math
 
+from ..errors import OptionError
+
 #: load-sharing definitions of dynamic runs, in the order they are reported
 DYNAMIC_DEFINITIONS = ("cycle_peak", "instantaneous", "engineering", "mean_force")
 STATIC_DEFINITION = "static_torque"
@@ -123,7 +125,7 @@ def output_values(result, definitions=None, *, bearings: bool = True) -> dict[st
     defs = list(DYNAMIC_DEFINITIONS if definitions is None else definitions)
     unknown = [d for d in defs if d not in DYNAMIC_DEFINITIONS]
     if unknown:
-        raise ValueError(f"unknown load-sharing definition(s) {unknown} for a dynamic run; "
+        raise OptionError(f"unknown load-sharing definition(s) {unknown} for a dynamic run; "
                          f"use {', '.join(DYNAMIC_DEFINITIONS)}")
     # no load sharing asked for: one (cheap) definition still gives the other metrics
     out = {k: float(v) for k, v in result.metric_values(defs or ["cycle_peak"]).items()}

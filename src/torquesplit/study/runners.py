@@ -84,7 +84,7 @@ class LocalPool:
                  in_flight: int = 2):
         self.workers = int(workers or os.cpu_count() or 1)
         if self.workers < 1:
-            raise ValueError("workers must be >= 1; give e.g. workers=2")
+            raise OptionError("workers must be >= 1; give e.g. workers=2")
         self.start_method = start_method
         self.in_flight = in_flight
 
@@ -140,7 +140,7 @@ class DaskRunner:
     def __init__(self, client=None, address: str | None = None, *, retries: int = 2,
                  in_flight: int = 2):
         if (client is None) == (address is None):
-            raise ValueError("give a dask.distributed Client or a scheduler address "
+            raise OptionError("give a dask.distributed Client or a scheduler address "
                              "('tcp://host:8786'), not both")
         self.client = client
         self.address = address

@@ -6,7 +6,7 @@ import inspect
 from dataclasses import dataclass
 from typing import Callable, Mapping
 
-from torquesplit.errors import ModelError
+from torquesplit.errors import ModelError, OptionTypeError
 from torquesplit.gears.geometry import PairGeometry
 from torquesplit.gears.stiffness.iso6336 import Iso6336Values, iso6336_stiffness, iso6336_values
 from torquesplit.gears.stiffness.potential_energy import potential_energy_stiffness
@@ -93,7 +93,7 @@ def mesh_stiffness(pair: PairGeometry | None, method: str, n: int = 256, **optio
     allowed = _option_names(func)
     unknown = sorted(set(options) - set(allowed))
     if unknown:
-        raise TypeError(f"mesh_stiffness(method={method!r}) got unknown option(s) {unknown}; "
+        raise OptionTypeError(f"mesh_stiffness(method={method!r}) got unknown option(s) {unknown}; "
                         f"it accepts {allowed}")
     if pair is None and method in ("iso6336", "potential_energy", "ltca"):
         raise ModelError([("pair", f"method {method!r} needs the pair geometry")])
