@@ -399,3 +399,28 @@ def test_exceptions_live_in_errors_and_no_data_class_is_named_error():
             assert issubclass(cls, (TorquesplitError, Warning)), name
         else:
             assert not name.endswith("Error"), (module, name)
+
+
+def test_argument_errors_of_the_entry_points_are_the_packages_own():
+    """Bad arguments to the API's lower entry points raise OptionError (a ValueError and
+    a TorquesplitError: one base to catch), not bare ValueError (an audit found 77)."""
+    import numpy as np
+
+    from torquesplit.assembly.structure import build_structure
+    from torquesplit.errors import OptionError, OptionTypeError
+    from torquesplit.gears.geometry import _angular_speed
+    from torquesplit.gpu.backend import GpuRunner
+    from torquesplit.solve import modal_analysis
+    from torquesplit.study.runners import LocalPool
+
+    s = build_structure(["a.x"], [1.0], [dict(name="k", dofs=[0], coefs=[1.0],
+                                              stiffness=1.0)])
+    calls = [lambda: GpuRunner(batch=0), lambda: GpuRunner(precision="fp16"),
+             lambda: modal_analysis(s, np.zeros(3)),
+             lambda: build_structure(["a.x"], [1.0], [], gyroscopic=[(0, 5, 1.0)]),
+             lambda: LocalPool(-1)]
+    for call in calls:
+        with pytest.raises(OptionError):
+            call()
+    with pytest.raises(OptionTypeError):
+        _angular_speed(1.0, 2.0)
