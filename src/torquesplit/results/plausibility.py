@@ -238,40 +238,41 @@ def resonance(results, metrics) -> list[tuple[str, str]]:
     return out
 
 
+def _longest_need(results, meshes: dict, windows: int):
+    """The mesh of ``meshes`` (mesh -> (its cycles, its window W)) that needs the longest
+    run for ``windows`` windows of whole cycles and one more (the run's start cuts a
+    cycle of a mesh that does not start at phase 0: --cycles 40 completed 39, and the
+    advice asked for the 40 it had): (mesh, its cycles, W, cycles needed, seconds)."""
+    kin = results.kinematics
+    need = {m: (windows * w + 1) / kin.meshes[m].frequency for m, (_, w) in meshes.items()}
+    m = max(need, key=need.get)
+    n, w = meshes[m]
+    return m, n, w, windows * w + 1, need[m]
+
+
 def settling(results, metrics) -> list[tuple[str, str]]:
     """A transient that did not settle by the end of the run."""
     if metrics.settling.settled:
         return []
-    short = metrics.settling.short
-    if short:  # too short to tell: name the mesh that needs the longest run
-        kin = results.kinematics
-        # two windows of whole cycles, and one more: the run's start cuts a cycle of a
-        # mesh that does not start at phase 0 (--cycles 40 completed 39, and the advice
-        # asked for the 40 it had)
-        need = {m: (2 * w + 1) / kin.meshes[m].frequency for m, (_, w) in short.items()}
-        m = max(need, key=need.get)
-        n, w = short[m]
+    if metrics.settling.short:  # too short to tell: name the mesh that needs the longest run
+        m, n, w, cycles, seconds = _longest_need(results, metrics.settling.short, 2)
         return [("analysis", (
             f"the run is too short to tell whether the response has settled: mesh {m} "
             f"completes {n} cycle{'' if n == 1 else 's'}, fewer than two settle windows of "
             f"{w} cycles (a window spans at least 20 cycles and the longest excitation "
             f"period, e.g. a gear revolution when errors turn with the gears; a cycle the "
             f"start or the end cuts does not count), so the metrics may not average over "
-            f"whole excitation periods; simulate at least {need[m]:.3g} s ({2 * w + 1} "
+            f"whole excitation periods; simulate at least {seconds:.3g} s ({cycles} "
             f"cycles of {m}) plus the transient"))]
-    shrunk = metrics.settling.shrunk
-    if shrunk:  # windows shorter than the excitation period: a drift or the period itself
-        kin = results.kinematics
-        need = {m: (4 * w + 1) / kin.meshes[m].frequency for m, (_, w) in shrunk.items()}
-        m = max(need, key=need.get)
-        n, w = shrunk[m]
+    if metrics.settling.shrunk:  # windows shorter than the excitation period
+        m, n, w, cycles, seconds = _longest_need(results, metrics.settling.shrunk, 4)
         return [("analysis", (
             f"the run is too short to tell whether the response has settled: mesh {m} "
             f"completes {n} cycles, fewer than four settle windows of {w} cycles, so its "
             f"windows shrank below the longest excitation period (e.g. a gear revolution "
             f"when errors turn with the gears) and the response's own variation over that "
             f"period cannot be told from a transient; the last half of the run was used "
-            f"for the metrics; simulate at least {need[m]:.3g} s ({4 * w + 1} cycles of "
+            f"for the metrics; simulate at least {seconds:.3g} s ({cycles} cycles of "
             f"{m}) plus the transient"))]
     return [("analysis", (
         "the transient did not die out within the run (the peaks still drift), so the last "
