@@ -338,6 +338,16 @@ class NominalTorques:
     """Held body -> reaction torque of its support about its axis [N m]."""
 
 
+def _written_mesh(model: Model, mesh: str) -> tuple[str, str | None]:
+    """Where mesh ``mesh`` is written (``planetary.0.sun_mesh`` for a [[planetary]]
+    stage's), and the stage member its table is named after ('sun' or 'ring'; None for a
+    mesh of its own)."""
+    where = model.written_at(f"meshes.{mesh}")
+    member = where.rpartition(".")[2].removesuffix("_mesh")
+    return where, (member if where.startswith("planetary.") and member in ("sun", "ring")
+                   else None)
+
+
 def solve_torques(model: Model, axes, frames, groups, speeds, layout: EpicyclicLayout,
                   issues) -> NominalTorques | None:
     """Nominal torques, mesh drivers and mesh powers (see the module docstring)."""
@@ -467,11 +477,9 @@ def solve_torques(model: Model, axes, frames, groups, speeds, layout: EpicyclicL
         if abs(p) <= 1e-9 * p_scale:
             drv = m.driver or ga
             if m.driver is None:
-                where = model.written_at('meshes.' + n)  # (a [[planetary]] stage's table)
-                member = where.rpartition(".")[2].removesuffix("_mesh")
-                how = (f"give driver = '{member}' or 'planet' there" if
-                       where.startswith("planetary.") and member in ("sun", "ring") else
-                       "give 'driver'")
+                where, member = _written_mesh(model, n)
+                how = f"give driver = '{member}' or 'planet' there" if member else \
+                    "give 'driver'"
                 warn_user(
                     f"{where}: no power passes this mesh in the nominal load, so its "
                     f"loaded flank is not determined; {ga!r} (listed first) is taken as "
@@ -479,9 +487,8 @@ def solve_torques(model: Model, axes, frames, groups, speeds, layout: EpicyclicL
         else:
             drv = ga if p < 0 else gb  # negative: the mesh takes power from the first gear
             if m.driver is not None and m.driver != drv:
-                where = model.written_at(f"meshes.{n}")
-                member = where.rpartition(".")[2].removesuffix("_mesh")
-                if where.startswith("planetary.") and member in ("sun", "ring"):
+                _, member = _written_mesh(model, n)
+                if member:
                     # (one text for every planet's mesh of the stage: said once)
                     given = member if m.driver == ga else "planet"
                     issues.append((f"meshes.{n}.driver", (

@@ -265,20 +265,17 @@ def output_definitions(names) -> list[str]:
         head = ".".join(parts[:2]) if sharing else parts[0]
         if head in seen:
             continue
-        if parts[0] == "planet_load_sharing" and len(parts) > 1 and \
-                parts[1] == "static_torque":
-            # (K_gamma from the loads averaged over the positions, not the peak ratio the
-            # definition's own text describes: a planetary reviewer)
-            seen[head] = ("mesh load factor K_gamma of each planetary stage: the largest "
-                          "planet's load over the mean, from the quasi-static loads averaged "
-                          "over the mesh positions (ISO 6336-1, AGMA 6123)")
-        elif parts[0] == "planet_load_sharing" and len(parts) > 1 and \
-                parts[1] in DEFINITION_TEXT:
-            seen[head] = (f"mesh load factor of each planetary stage, the largest planet "
-                          f"over the mean, by the {parts[1]} definition: "
-                          f"{DEFINITION_TEXT[parts[1]]}")
-        elif sharing and parts[1] in DEFINITION_TEXT:
+        if sharing and parts[1] in DEFINITION_TEXT:
             seen[head] = DEFINITION_TEXT[parts[1]]
+            if parts[0] == "planet_load_sharing":
+                # (static: K_gamma from the loads averaged over the positions, not the peak
+                # ratio the definition's own text describes: a planetary reviewer)
+                seen[head] = (
+                    "mesh load factor K_gamma of each planetary stage: the largest planet's "
+                    "load over the mean, from the quasi-static loads averaged over the mesh "
+                    "positions (ISO 6336-1, AGMA 6123)" if parts[1] == STATIC_DEFINITION
+                    else f"mesh load factor of each planetary stage, the largest planet over "
+                         f"the mean, by the {parts[1]} definition: {seen[head]}")
         elif head in FAMILIES:
             seen[head] = FAMILIES[head][1]
     return [f"{head}: {text}" for head, text in seen.items()]
