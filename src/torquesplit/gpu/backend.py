@@ -564,6 +564,18 @@ class _Job:
         return out
 
 
+def fallback_message(precision: str | None) -> str:
+    """Why a study asked of the GPU backend runs on the CPU runner: the warning
+    :func:`make_gpu_runner` gives, and the results' ``backend_fallback``."""
+    from .compile import cuda_available
+
+    return (f"backend='gpu' (--backend gpu): {cuda_available()[1]}; the study runs on the "
+            "CPU runner instead (same results, CPU speed"
+            + ("; in FP64: precision 'fp32' applies to the GPU backend only"
+               if precision == "fp32" else "")
+            + "). Run it on a machine with an NVIDIA GPU for the GPU backend.")
+
+
 def make_gpu_runner(*, precision: str = "fp64", batch: int = BATCH,
                     workers: int | None = None):
     """A :class:`GpuRunner` on the CUDA device, or — with a warning that says why — the
@@ -571,13 +583,9 @@ def make_gpu_runner(*, precision: str = "fp64", batch: int = BATCH,
     from ..errors import GpuFallbackWarning
     from .compile import cuda_available
 
-    ok, why = cuda_available()
+    ok, _ = cuda_available()
     if not ok:
-        msg = (f"backend='gpu' (--backend gpu): {why}; the study runs on the CPU runner "
-               "instead (same results, CPU speed"
-               + ("; in FP64: precision 'fp32' applies to the GPU backend only"
-                  if precision == "fp32" else "")
-               + "). Run it on a machine with an NVIDIA GPU for the GPU backend.")
+        msg = fallback_message(precision)
         log.info(msg)
         warn_user(msg, GpuFallbackWarning)
         return None
@@ -585,4 +593,4 @@ def make_gpu_runner(*, precision: str = "fp64", batch: int = BATCH,
                      workers=int(workers or os.cpu_count() or 1))
 
 
-__all__ = ["GpuRunner", "check_plan", "make_gpu_runner", "BATCH"]
+__all__ = ["GpuRunner", "check_plan", "fallback_message", "make_gpu_runner", "BATCH"]

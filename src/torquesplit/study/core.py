@@ -229,7 +229,11 @@ class Study:
                                             "runs the cases in this process)")
         chosen = _backend_runner(plan, backend, precision, client, scheduler, runner,
                                  workers, words)
-        fallback = _fallback_note(precision) if backend == "gpu" and chosen is None else ""
+        fallback = ""
+        if backend == "gpu" and chosen is None:  # (kept in the results: backend_fallback)
+            from ..gpu.backend import fallback_message
+
+            fallback = fallback_message(precision)
         store = _open_store(plan, out, resume, overwrite, words)
         try:
             try:
@@ -322,16 +326,6 @@ def _write_outputs(ds, out: Path, figures: bool) -> None:
         # user's own plot in figures/ went too, a studies reviewer)
         manifest = out / "figures" / FIGURE_MANIFEST
         manifest.write_text(json.dumps(sorted(Path(p).name for p in written)))
-
-
-def _fallback_note(precision) -> str:
-    """Why a study asked of the GPU backend runs on the CPU runner (kept in its results
-    as ``backend_fallback``)."""
-    from ..gpu.compile import cuda_available
-
-    return (f"backend 'gpu' was asked: {cuda_available()[1]}; the cases ran on the CPU "
-            f"runner" + (" in FP64 (precision 'fp32' applies to the GPU backend only)"
-                         if precision == "fp32" else ""))
 
 
 def _backend_runner(plan: Plan, backend: str, precision, client, scheduler, runner,
