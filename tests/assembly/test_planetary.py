@@ -9,7 +9,7 @@ import math
 
 import numpy as np
 import pytest
-from planetary_models import LP, general_elements, load, lp_model, lp_raw
+from planetary_models import LP, compound_raw, general_elements, load, lp_model, lp_raw
 
 import torquesplit
 from torquesplit.assembly.assemble import assemble
@@ -317,6 +317,79 @@ def test_planets_rigid_on_their_pins():
     f_r = modal_analysis(r).frequencies
     f_b = modal_analysis(b).frequencies
     np.testing.assert_allclose(f_r, f_b[:f_r.size], rtol=1e-5)
+
+
+def _mesh_forces(structure, solution):
+    return {n: float(solution.element_forces[i]) for i, n in enumerate(structure.element_names)
+            if structure.element_kind[i] == 1}
+
+
+def test_a_planet_rigid_on_its_pin_is_displaced_by_its_pin_error():
+    """A tangential pin error of 20 um on a planet without translations loads its meshes
+    as it does a planet on a bearing a million times stiffer (it was ignored: equal
+    sharing)."""
+    def forces(rigid):
+        raw = lp_raw(4, pin_errors=[{"tangential": "20 um"}, {}, {}, {}])
+        st = raw["planetary"][0]
+        if rigid:
+            st["planet"]["dofs"] = ["theta"]
+        else:
+            st["planet_bearing"] = {"stiffness": "1e14 N/m"}
+        s = torquesplit.assemble(load(raw))
+        return _mesh_forces(s, static_equilibrium(s))
+
+    r, b = forces(True), forces(False)
+    assert r.keys() == b.keys() and len(r) == 8
+    for name in r:
+        assert r[name] == pytest.approx(b[name], rel=1e-4), name
+    assert r["stage_sun_planet2"] - r["stage_sun_planet1"] > 1e3  # [N]: far from equal
+
+
+def test_a_compound_planet_gear_moves_with_its_shaft():
+    """A gear without translations on a planet's shaft (a compound planet's ring gear)
+    moves with the planet's bearing, not rigidly with the carrier's pin: its mass in the
+    planet's Coriolis term, and the same mesh forces, bearing forces and modes as with that gear on a bearing of 1e14 N/m on its
+    shaft partner; the pin bearing carries the carrier torque, T_c / (N R) = 900 N m /
+    (3 x 60 mm) = 5 kN tangentially (it carried the sun mesh's share alone)."""
+    def solve(**kw):
+        s = torquesplit.assemble(load(compound_raw(**kw)))
+        st = static_equilibrium(s)
+        f = dict(zip(s.element_names, st.element_forces))
+        return s, _mesh_forces(s, st), f, modal_analysis(s, st.q).frequencies
+
+    s0, mesh0, f0, _ = solve()
+    assert "pb0.x" not in s0.dof_names
+    # the Coriolis term of the planet's translations carries both gears' mass, 2 m Omega_c
+    i, j = (s0.dof_names.index(f"pa0.{d}") for d in "xy")
+    omega_c = 100.0 * 2 * math.pi / 60  # 900 rpm / 9
+    assert abs(s0.gyroscopic_matrix()[i, j]) == pytest.approx(2 * (0.5 + 0.2) * omega_c,
+                                                               rel=1e-12)
+    assert f0["pa0.support.y"] == pytest.approx(5000.0, rel=1e-6)  # tangential at 0 deg
+    for pin in (None, {"tangential": "20 um"}):
+        s, mesh, f, freq = solve(pin_error=pin)
+        sb, mesh_b, fb, freq_b = solve(pin_error=pin, shaft_bearing="1e14 N/m")
+        for name in mesh:
+            assert mesh[name] == pytest.approx(mesh_b[name], rel=1e-6), name
+        for e in ("pa0.support.x", "pa0.support.y", "pa1.support.y"):
+            assert f[e] == pytest.approx(fb[e], rel=1e-6, abs=1e-6), e
+        np.testing.assert_allclose(freq, freq_b[:freq.size], rtol=1e-5)
+    assert mesh["sp0"] < 0.6 * mesh["sp1"]  # the pin error unloads planet 0
+
+
+def test_compound_planet_kinematics_and_torques():
+    """Willis with a stepped planet: carrier = sun / (1 + (80/20)(40/20)) = 100 rpm,
+    planets -300 rpm; each planet shaft passes the sun mesh's torque on to its ring
+    gear, F r_b = 100 N m / 3 x 40/20 = 66.67 N m on both its gears (the body table gave
+    half of it: the rigid shaft's torque was left out)."""
+    kin = solve_kinematics(load(compound_raw()))
+    rpm = 60 / (2 * math.pi)
+    assert kin.bodies["carrier"].speed * rpm == pytest.approx(100.0, rel=1e-12)
+    assert kin.bodies["pa0"].speed * rpm == pytest.approx(-300.0, rel=1e-12)
+    assert kin.load_torques["output"] == pytest.approx(900.0, rel=1e-8)
+    for g in ("pa0", "pb0", "pa2", "pb2"):
+        assert kin.bodies[g].torque == pytest.approx(200.0 / 3, rel=1e-8), g
+    assert kin.bodies["sun"].torque == pytest.approx(100.0, rel=1e-8)
+    assert kin.bodies["carrier"].torque == pytest.approx(900.0, rel=1e-8)
 
 
 # --------------------------------------------------------------------------- bad input

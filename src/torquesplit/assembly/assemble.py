@@ -44,7 +44,7 @@ Options (``assemble(..., options={...})``):
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -70,6 +70,10 @@ class DofMap:
     names: tuple[str, ...]
     axes: dict[str, dict[str, np.ndarray]]
     """body -> {'x': unit direction, ...} of each translational DOF."""
+    host: dict[str, str] = field(default_factory=dict)
+    """planet body without translations -> the body of its planet shaft whose translations
+    it shares (the one on the pin's bearing: a compound planet's other gear); a planet
+    body not listed rides its pin rigidly (:func:`planet_bearer`)."""
 
     def project(self, body: str, vec, sign: float = 1.0, tol: float = 0.0):
         """(DOF index, sign * vec . direction) of each of ``body``'s translations whose
@@ -117,12 +121,21 @@ def number_dofs(model: Model, kin: Kinematics) -> tuple[DofMap, np.ndarray]:
                 trans[body][d] = len(names)
                 names.append(f"{body}.{d}")
                 mass.append(bk.mass)
-    # a planet without translations sits rigidly on its pin: its mass moves with the
-    # carrier's translations and, at the pin radius R, with its rotation (m R^2)
+    # a planet without translations on the shaft of one that has them (a compound
+    # planet's other gear) moves with that one; else it sits rigidly on its pin: its mass
+    # moves with the carrier's translations and, at the pin radius R, with its rotation
+    # (m R^2)
+    host: dict[str, str] = {}
     for body, carrier in kin.planet_bodies.items():
         if trans[body] or body not in kin.bodies:
             continue
         mp = kin.bodies[body].mass
+        bearer = planet_bearer(model, kin, body)
+        if bearer is not None and trans[bearer]:
+            host[body] = bearer
+            for j in trans[bearer].values():
+                mass[j] += mp
+            continue
         for j in trans.get(carrier, {}).values():
             mass[j] += mp
         idx, _ = theta.get(carrier, (-1, 1.0))
@@ -135,7 +148,8 @@ def number_dofs(model: Model, kin: Kinematics) -> tuple[DofMap, np.ndarray]:
         bad = [names[i] for i in np.flatnonzero(m <= 0)]
         raise ModelError([("", f"DOFs {bad} have no mass or inertia; give 'mass'/'polar_inertia'")])
     axes = {b: dict(kin.translation_axes.get(b, {})) for b in trans}
-    return DofMap(theta=theta, translation=trans, names=tuple(names), axes=axes), inv
+    return DofMap(theta=theta, translation=trans, names=tuple(names), axes=axes,
+                  host=host), inv
 
 
 def assemble(model: Model, kin: Kinematics | None = None, *, n_table: int | None = None,
@@ -212,6 +226,16 @@ def _assemble(model: Model, kin: Kinematics | None, *, n_table: int | None,
             c = 0.0
         gaps = excitation.half_backlash_sequence(model, kin, name)
         err_const, sines = excitation.mesh_errors(model, kin, name)
+        for body, sgn in ((mk.driver, 1.0), (mk.driven, -1.0)):
+            # a planet rigid on its pin is displaced by the pin's position error: its
+            # centre's part of V q (sgn u . n) misses it, so it is an error, e -= sgn u . n
+            # (as a centre offset in excitation.mesh_errors)
+            off = _rigid_pin_offset(model, kin, dmap, body)
+            if off is not None:
+                n = mk.line_of_action
+                err_const -= sgn * float(off[0] @ n)
+                sines = sines + [(-sgn * float(a @ n), om, ph) for a, om, ph in off[1]
+                                 if abs(float(a @ n)) > 0.0]
         el = dict(
             name=name, kind=MESH, dofs=dofs, coefs=coefs, stiffness=table,
             frequency=mk.frequency, phase=phases[name], damping=c, gaps=gaps,
@@ -499,10 +523,31 @@ def _orbit_radius(kin: Kinematics, body: str, carrier: str) -> float:
     return float(np.linalg.norm(r - a * float(r @ a)))
 
 
+def planet_bearer(model: Model, kin: Kinematics, body: str) -> str | None:
+    """The body on the carrier's pin of the planet shaft ``body`` is on: the member of
+    its rigid group (``body`` itself for a simple planet) whose bearing sits on the
+    carrier (``support.on``), one with translations first; None for a body that is no
+    planet.  Its bearing, pin and pin error are the whole planet shaft's."""
+    carrier = kin.planet_bodies.get(body)
+    if carrier is None:
+        return None
+    rep = kin.groups[body]
+    on_pin = []
+    for b in model.body_names():
+        spec = model.gears.get(b) or model.bodies[b]
+        if kin.groups[b] == rep and spec.support is not None and spec.support.on == carrier:
+            on_pin.append((not any(d in spec.dofs for d in ("x", "y", "z", "loa")), b))
+    return min(on_pin)[1] if on_pin else None
+
+
 def centre_projection(kin: Kinematics, dmap: DofMap, body: str, vec, sign: float = 1.0):
     """(DOF, coefficient) of the displacement of ``body``'s centre along ``vec``: its
-    own translations, or -- a planet without translations, rigid on its pin -- those of
-    its carrier and the carrier's rotation, ``theta_C (a_C x r) . vec``."""
+    own translations; those of the body it shares them with (``dmap.host``: a compound
+    planet's gear without translations); or -- a planet without translations, rigid on
+    its pin -- those of its carrier and the carrier's rotation,
+    ``theta_C (a_C x r) . vec``."""
+    if body in dmap.host:
+        return dmap.project(dmap.host[body], vec, sign)
     if dmap.translation.get(body) or body not in kin.planet_bodies:
         return dmap.project(body, vec, sign)
     carrier = kin.planet_bodies[body]
@@ -516,6 +561,27 @@ def centre_projection(kin: Kinematics, dmap: DofMap, body: str, vec, sign: float
     if idx >= 0 and abs(arm) > 0.0:
         out.append((idx, sign * s_c * arm))
     return out
+
+
+def _rigid_pin_offset(model: Model, kin: Kinematics, dmap: DofMap, body: str):
+    """Offset of the centre of a planet rigid on its pin (no translations, its own or its
+    shaft's): the position error of its pin and, on a carrier without translations, the
+    carrier's eccentricity, as (constant vector, [(vector amplitude, omega, phase)]); None
+    for any other body."""
+    if body in dmap.host or dmap.translation.get(body) or body not in kin.planet_bodies:
+        return None
+    carrier = kin.planet_bodies[body]
+    const, sines = np.zeros(3), []
+    bearer = planet_bearer(model, kin, body)
+    if bearer is not None:
+        kind = "gears" if bearer in model.gears else "bodies"
+        spec = model.gears.get(bearer) or model.bodies[bearer]
+        const = _seat_geometry(kin, bearer, carrier, spec.support,
+                               f"{kind}.{bearer}.support")[1]
+    if not dmap.translation.get(carrier):
+        c_const, sines = _eccentricity(model, kin, carrier)
+        const = const + c_const
+    return const, sines
 
 
 def _seat_geometry(kin: Kinematics, body: str, on: str | None, sup, where: str):

@@ -31,7 +31,9 @@ Cooley & Parker 2012 eq. 1)::
   it is a small correction.  The radial preload of the meshes is left out.
 * A planet without translations sits rigidly on its pin: its mass is carried by the
   carrier (translations and ``m R^2`` on its rotation, assembly/assemble.py) and so are
-  its rotating-frame terms and centrifugal force.
+  its rotating-frame terms and centrifugal force.  A gear without translations on the
+  shaft of a planet that has them (a compound planet) moves with that planet: its mass
+  joins the planet's in these terms.
 
 The bodies' rotations need no term (planar model, all axes parallel to a).
 """
@@ -68,8 +70,13 @@ def rotating_frame_terms(kin, dmap, ext: np.ndarray, pin_stiffness=None):
     # planets rigid on their pins (no translations) move with their carrier
     preload: dict[str, list] = {}  # carrier -> [its rotation DOF, sign, stiffness]
     rigid_pins: dict[str, list[str]] = {}
+    # gears without translations on the shaft of a planet that has them (a compound
+    # planet) move with that planet (``dmap.host``)
+    hosted: dict[str, list[str]] = {}
     for p, c in kin.planet_bodies.items():
-        if not dmap.translation.get(p):
+        if p in dmap.host:
+            hosted.setdefault(dmap.host[p], []).append(p)
+        elif not dmap.translation.get(p):
             rigid_pins.setdefault(c, []).append(p)
     for body in dmap.translation:  # the model's order: a reproducible element list
         carrier = kin.frames.get(body)
@@ -81,7 +88,7 @@ def rotating_frame_terms(kin, dmap, ext: np.ndarray, pin_stiffness=None):
         if omega == 0.0:
             continue
         a = cb.axis / np.linalg.norm(cb.axis)
-        m = kin.bodies[body].mass
+        m = kin.bodies[body].mass + sum(kin.bodies[p].mass for p in hosted.get(body, []))
         if body == carrier:
             m += sum(kin.bodies[p].mass for p in rigid_pins.get(body, []))
         dirs = {d: dmap.axes[body][d] for d in tr}
@@ -100,8 +107,8 @@ def rotating_frame_terms(kin, dmap, ext: np.ndarray, pin_stiffness=None):
                     frame.append((i, j, -m * omega**2 * ci * cj))
         # centrifugal force of the nominal position, m Omega^2 r0 outwards (for a carrier,
         # that of the planets rigid on its pins)
-        carried = [(body, m)] if body != carrier else \
-            [(p, kin.bodies[p].mass) for p in rigid_pins.get(body, [])]
+        carried = [(b, kin.bodies[b].mass) for b in [body] + hosted.get(body, [])] \
+            if body != carrier else [(p, kin.bodies[p].mass) for p in rigid_pins.get(body, [])]
         for b, mb in carried:
             r = kin.bodies[b].position - cb.position
             r0 = r - a * float(r @ a)

@@ -367,11 +367,19 @@ def solve_torques(model: Model, axes, frames, groups, speeds, layout: EpicyclicL
     b = np.zeros(len(reps))
     ratio = {n: frames[n].speed_ratio for n in meshes}
 
+    # the same sums per body (about its own axis): what a rigid shaft passes on
+    bodies = list(groups)
+    row = {name: i for i, name in enumerate(bodies)}
+    A_body = np.zeros((len(bodies), n_x))
+    b_body = np.zeros(len(bodies))
+
     def add(body, j, coef):  # coef: torque on `body` about its own axis per unit x_j
         A[col[groups[body]], j] += coef * _sign(axes, body, groups[body])
+        A_body[row[body], j] += coef
 
     def known(body, torque):
         b[col[groups[body]]] -= torque * _sign(axes, body, groups[body])
+        b_body[row[body]] -= torque
 
     for j, name in enumerate(meshes):
         ga, gb = model.meshes[name].gears
@@ -519,6 +527,16 @@ def solve_torques(model: Model, axes, frames, groups, speeds, layout: EpicyclicL
         body_torque[ld.body] += abs(load_torques.get(name, 0.0))
     for h, r in reactions.items():
         body_torque[h] += abs(r)
+    # a body on a rigid shaft (a compound planet's gear) passes the rest of its torques
+    # on through the shaft: that torque balances them (exact for a body with one rigid
+    # shaft; a held member's reaction is already counted)
+    net = A_body @ x - b_body
+    size = {}
+    for name in bodies:
+        size[groups[name]] = size.get(groups[name], 0) + 1
+    for name in bodies:
+        if size[groups[name]] > 1 and groups[name] not in held_reps:
+            body_torque[name] += abs(float(net[row[name]]))
     body_torque = {k: 0.5 * v for k, v in body_torque.items()}
     return NominalTorques(mesh_torque=tau, mesh_torque_second=tau2, drivers=drivers,
                           mesh_power={n: abs(p) for n, p in power_first.items()},
