@@ -348,9 +348,10 @@ def test_a_planet_rigid_on_its_pin_is_displaced_by_its_pin_error():
 def test_a_compound_planet_gear_moves_with_its_shaft():
     """A gear without translations on a planet's shaft (a compound planet's ring gear)
     moves with the planet's bearing, not rigidly with the carrier's pin: its mass in the
-    planet's Coriolis term, and the same mesh forces, bearing forces and modes as with that gear on a bearing of 1e14 N/m on its
-    shaft partner; the pin bearing carries the carrier torque, T_c / (N R) = 900 N m /
-    (3 x 60 mm) = 5 kN tangentially (it carried the sun mesh's share alone)."""
+    planet's Coriolis term, and the same mesh forces, bearing forces and modes as with
+    that gear on a bearing of 1e14 N/m on its shaft partner; the pin bearing carries the
+    carrier torque, T_c / (N R) = 900 N m / (3 x 60 mm) = 5 kN tangentially (it carried
+    the sun mesh's share alone)."""
     def solve(**kw):
         s = torquesplit.assemble(load(compound_raw(**kw)))
         st = static_equilibrium(s)
