@@ -169,30 +169,36 @@ body = "st_carrier"
 """
 
 
-def compound_raw(pin_error: dict | None = None, shaft_bearing: str | None = None) -> dict:
+def compound_raw(pin_error: dict | None = None, shaft_bearing: str | None = None,
+                 teeth: tuple = (20, 40, 20, 80)) -> dict:
     """Three compound (stepped) planets from the general elements: on each planet shaft
     ``pa`` (40 teeth, on the carrier's pin bearing) meshes the sun (20), ``pb`` (20, 30 mm
     behind it) the ring (80, held); module 2 mm, pins at 60 mm, sun driven at 900 rpm /
     100 N m (Willis: 1 + (80/20)(40/20) = 9, carrier 900 N m).  ``pin_error`` of planet
     0's bearing; ``shaft_bearing``: ``pb`` gets its own translations on a bearing on
-    ``pa`` of that stiffness instead of riding the shaft (the same shaft, elastic)."""
-    def gear(teeth, z, **more):
-        return dict(teeth=teeth, module="2 mm", face_width="20 mm",
+    ``pa`` of that stiffness instead of riding the shaft (the same shaft, elastic);
+    ``teeth`` of sun, pa, pb and ring (z_s + z_pa = z_r - z_pb: the pins at that many
+    mm)."""
+    zs, za, zb, zr = teeth
+    radius = zs + za  # [mm] = m (z_s + z_a) / 2 with m = 2 mm
+
+    def gear(z_teeth, z, **more):
+        return dict(teeth=z_teeth, module="2 mm", face_width="20 mm",
                     position=["0 mm", "0 mm", f"{z} mm"], **more)
 
-    gears = {"sun": gear(20, 0, mass="1 kg", polar_inertia="0.001 kg m^2"),
-             "ring": gear(80, -30, kind="internal", torsional_support={"rigid": True})}
+    gears = {"sun": gear(zs, 0, mass="1 kg", polar_inertia="0.001 kg m^2"),
+             "ring": gear(zr, -30, kind="internal", torsional_support={"rigid": True})}
     meshes, shafts = {}, {}
     for i in range(3):
         psi = 2 * math.pi * i / 3
-        at = [f"{60 * math.cos(psi):.12f} mm", f"{60 * math.sin(psi):.12f} mm"]
+        at = [f"{radius * math.cos(psi):.12f} mm", f"{radius * math.sin(psi):.12f} mm"]
         pin = {"stiffness": "2e8 N/m", "on": "carrier"}
         if i == 0 and pin_error:
             pin["pin_error"] = pin_error
-        gears[f"pa{i}"] = gear(40, 0, mass="0.5 kg", polar_inertia="0.0005 kg m^2",
+        gears[f"pa{i}"] = gear(za, 0, mass="0.5 kg", polar_inertia="0.0005 kg m^2",
                                dofs=["theta", "x", "y"], support=pin)
         gears[f"pa{i}"]["position"][:2] = at
-        gears[f"pb{i}"] = gear(20, -30, mass="0.2 kg", polar_inertia="0.0001 kg m^2")
+        gears[f"pb{i}"] = gear(zb, -30, mass="0.2 kg", polar_inertia="0.0001 kg m^2")
         gears[f"pb{i}"]["position"][:2] = at
         if shaft_bearing:
             gears[f"pb{i}"].update(dofs=["theta", "x", "y"],

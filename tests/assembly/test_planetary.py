@@ -393,6 +393,44 @@ def test_compound_planet_kinematics_and_torques():
     assert kin.bodies["carrier"].torque == pytest.approx(900.0, rel=1e-8)
 
 
+@pytest.mark.parametrize("teeth, fits", [((20, 40, 20, 80), True), ((20, 30, 24, 74), True),
+                                         ((20, 30, 26, 76), False)])
+def test_compound_planets_clocked_alike(teeth, fits):
+    """Identical compound planets (the gears of every planet shaft clocked alike) fit
+    where (z_s z_b + z_r z_a) / (N gcd(z_a, z_b)) is whole: 60, 150, and 466.67 (refused,
+    naming the ring mesh of a planet; giving the meshes' phases clocks each planet on its
+    own).  Where they fit, the ring meshes of planets at psi differ by -sigma z_r psi / 2 pi
+    as for simple planets, and the first planet's gears have a tooth at one angle."""
+    from torquesplit.assembly.excitation import _phase_terms, mesh_phases
+
+    raw = compound_raw(teeth=teeth)
+    if not fits:
+        with pytest.raises(ModelError, match=r"meshes\.rp[12].*compound planets cannot all "
+                                             r"be clocked alike"):
+            load(raw)
+        for i in range(3):
+            raw["meshes"][f"rp{i}"]["phase"] = 0.1 * i
+        load(raw)  # planets clocked each on its own
+        return
+    model = load(raw)
+    kin = solve_kinematics(model)
+    ph = mesh_phases(model, kin, strict=True)
+    zs, zr = teeth[0], teeth[3]
+    for i in (1, 2):
+        for mesh, z in (("sp", zs), ("rp", zr)):
+            gap = (ph[f"{mesh}{i}"] - ph[f"{mesh}0"]) % 1.0
+            expect = {(-z * i / 3) % 1.0, (z * i / 3) % 1.0}  # sigma: either sense
+            assert min(abs((gap - e + 0.5) % 1.0 - 0.5) for e in expect) < 1e-9
+    # the tooth angle of pa0 (from sp0) and of pb0 (from rp0) agree, modulo pb's pitch
+
+    def tooth(mesh, gear):
+        z, sigma, tau, c = _phase_terms(model, kin, mesh, gear)
+        return tau + 2 * math.pi * (ph[mesh] - c) / (sigma * z)
+
+    miss = (tooth("rp0", "pb0") - tooth("sp0", "pa0")) * teeth[2] / (2 * math.pi)
+    assert abs((miss + 0.5) % 1.0 - 0.5) < 1e-9
+
+
 # --------------------------------------------------------------------------- bad input
 def _general(**change):
     data = general_elements(lp_model(4))

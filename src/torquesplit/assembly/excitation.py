@@ -236,6 +236,8 @@ def mesh_phases(model: Model, kin: Kinematics, *, strict: bool = False) -> dict[
     phases: dict[str, float] = {}
     gamma: dict[str, float] = {}
     misfits: list[tuple[str, str, float]] = []
+    shaft = compound_partners(model, kin)
+    component: dict[str, str] = {}  # mesh -> the mesh its phasing started from
     order = [n for n, m in model.meshes.items() if m.phase is not None] + list(model.meshes)
     for start in order:
         if start in phases:
@@ -245,6 +247,7 @@ def mesh_phases(model: Model, kin: Kinematics, *, strict: bool = False) -> dict[
         stack = [start]
         while stack:
             cur = stack.pop()
+            component[cur] = start
             for g in model.meshes[cur].gears:
                 if g not in gamma:
                     gamma[g] = tooth_angle(cur, g, phases[cur])
@@ -260,6 +263,9 @@ def mesh_phases(model: Model, kin: Kinematics, *, strict: bool = False) -> dict[
                     else:
                         phases[other] = phase(other, g, gamma[g])
                     stack.append(other)
+    if shaft:
+        misfits += _clock_compound_planets(model, kin, shaft, on_gear, phases, component,
+                                           phase, tooth_angle)
     if strict:
         issues = []
         for mesh, g, d in misfits:
@@ -267,6 +273,16 @@ def mesh_phases(model: Model, kin: Kinematics, *, strict: bool = False) -> dict[
                 continue  # a fixed-axis loop: the user clocks the gears (Liu et al. 2021)
             planet = next((b for b in model.meshes[mesh].gears if b in kin.planet_bodies),
                           g)
+            if planet in shaft:
+                issues.append((f"meshes.{mesh}", (
+                    f"the compound planets cannot all be clocked alike: with the gears of "
+                    f"each planet shaft clocked as on the first one, the teeth of "
+                    f"{planet!r} miss by {d:+.4f} of a mesh cycle here (identical compound "
+                    f"planets fit only where (z_s z_2 + z_r z_1) / (N gcd(z_1, z_2)) is a "
+                    f"whole number for equal spacing, z_1 the planet gear on the sun, z_2 "
+                    f"on the ring); change the tooth counts or the angles, or give the "
+                    f"meshes' 'phase' (planets clocked each on its own)")))
+                continue
             issues.append((f"meshes.{mesh}", (
                 f"the teeth of planet {planet!r} cannot mesh here: around the loop of "
                 f"meshes through it the tooth positions miss by {d:+.4f} of a mesh cycle "
@@ -279,6 +295,77 @@ def mesh_phases(model: Model, kin: Kinematics, *, strict: bool = False) -> dict[
 
             raise ModelError(issues[:1] if len(issues) > 3 else issues)
     return phases
+
+
+def _clock_compound_planets(model, kin, shaft, on_gear, phases, component, phase,
+                            tooth_angle) -> list[tuple[str, str, float]]:
+    """Phases of compound planets (:func:`mesh_phases`' second pass).  The meshes reached
+    through a planet's other gear (its ring meshes) were phased apart from the first
+    gear's: shifted together (a turn of that train) so that the gears of the first planet
+    shaft have a tooth at one angle, unless a mesh there has a given ``phase``.  Every
+    other planet shaft must then be clocked as the first (identical planets): its two
+    tooth angles may differ from the first's only by whole teeth of either gear, i.e. by
+    a multiple of gcd(z_1, z_2) / z_1 of the second gear's mesh cycle (not checked where
+    a mesh of either shaft has a given ``phase``).  Returns the misfits (mesh, gear, miss
+    in cycles)."""
+    def angle(g):
+        return tooth_angle(on_gear[g][0], g, phases[on_gear[g][0]])
+
+    def reach(g):  # the gears, not planets, that g meshes with: its role on the shaft
+        return frozenset(o for m in on_gear[g] for o in model.meshes[m].gears
+                         if o not in kin.planet_bodies)
+
+    shafts, seen = [], set()
+    for g in model.gears:
+        if g in shaft and g not in seen and on_gear[g]:
+            members = [g] + [o for o in shaft[g] if on_gear[o]]
+            seen.update(members)
+            shafts.append((kin.planet_bodies[g], members))
+    misfits = []
+    first: dict[str, list[str]] = {}  # carrier -> the first shaft's gears
+    for carrier, members in shafts:
+        ref = first.setdefault(carrier, members)
+        if ref is members:  # the first shaft of this carrier: join its trains
+            g0 = members[0]
+            for gk in members[1:]:
+                xk = on_gear[gk][0]
+                start = component[xk]
+                if start == component[on_gear[g0][0]] or any(
+                        model.meshes[m].phase is not None
+                        for m, c in component.items() if c == start):
+                    continue
+                shift = phase(xk, gk, angle(g0)) - phases[xk]
+                for m, c in list(component.items()):
+                    if c == start:
+                        phases[m] = (phases[m] + shift) % 1.0
+                        component[m] = component[on_gear[g0][0]]
+            continue
+        if any(model.meshes[m].phase is not None for g in members + ref for m in on_gear[g]):
+            continue  # the user clocks these planets (given phases)
+        roles = {reach(r): r for r in ref}
+        match = [(g, roles.get(reach(g))) for g in members]
+        if any(r is None for _, r in match):
+            continue  # not a copy of the first shaft: nothing to compare
+        (g1, r1), rest = match[0], match[1:]
+        for g2, r2 in rest:
+            z1, z2 = model.gears[g1].teeth, model.gears[g2].teeth
+            step = math.gcd(z1, z2) / z1
+            d = ((angle(g2) - angle(g1)) - (angle(r2) - angle(r1))) * z2 / (2 * math.pi)
+            d = (d / step + 0.5) % 1.0 - 0.5
+            if abs(d) * step > 1e-6:
+                misfits.append((on_gear[g2][0], g2, d * step))
+    return misfits
+
+
+def compound_partners(model: Model, kin: Kinematics) -> dict[str, list[str]]:
+    """Gear -> the other gears of its compound planet: planet gears of one carrier joined
+    by rigid shafts (they turn together; :func:`mesh_phases` clocks them alike)."""
+    groups: dict[str, list[str]] = {}
+    for g in model.gears:
+        if g in kin.planet_bodies:
+            groups.setdefault(kin.groups[g], []).append(g)
+    return {g: [o for o in members if o != g]
+            for members in groups.values() if len(members) > 1 for g in members}
 
 
 def _phase_terms(model: Model, kin: Kinematics, mesh_name: str, gear: str):
