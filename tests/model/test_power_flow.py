@@ -126,6 +126,25 @@ def test_a_speed_held_sun_puts_in_what_the_carrier_takes():
         400.0 * abs(carrier.speed), rel=1e-12)
 
 
+def test_a_speed_drive_that_would_have_to_take_power_out_is_refused_as_such():
+    """A differential: the sun driven at 1000 rpm with 100 N m, the ring held at -200 rpm
+    by a 'speed' drive, the carrier loaded with 50 N m.  The ring would have to take the
+    difference out (a brake): a drive cannot, and the message said "nothing is left"."""
+    from torquesplit.model.overrides import read_raw
+
+    raw = read_raw(torquesplit.example_path("lin_parker1999_planetary"))
+    raw["planetary"][0]["ring"].pop("torsional_support")
+    raw["drives"]["ring"] = {"body": "stage_ring", "speed": "-200 rpm", "mode": "speed"}
+    raw["loads"]["output"]["torque"] = "50 N m"
+    with pytest.raises(torquesplit.ModelError) as info:
+        torquesplit.load_model(raw)
+    (loc, msg), = info.value.issues
+    assert loc == "drives.ring"
+    # carrier (42 x 1000 - 138 x 200) / 180 = 80 rpm: 50 N m take 0.419 kW of 10.472 kW
+    assert "put in 10.472 kW and the loads take 0.418879 kW" in msg
+    assert "would have to take 10.0531 kW out" in msg and "nothing is left" not in msg
+
+
 _CHAIN = """
 [model]
 name = "three gears"

@@ -655,10 +655,14 @@ def drive_input_torques(model: Model, speeds, issues) -> dict[str, float]:
     p_other = sum(t * abs(model.drives[n].speed) for n, t in out.items() if t is not None)
     name = open_[0]
     if not p_loads > p_other:
+        left = ("nothing is left for this 'speed' drive" if p_loads == p_other else
+                f"this 'speed' drive would have to take {(p_other - p_loads) / 1e3:.6g} kW "
+                f"out (a brake or generator holding its speed), but a drive only puts power "
+                f"in and a load has no speed")
         issues.append((f"drives.{name}", (
-            f"the other drives put in {p_other / 1e3:.6g} kW, all the loads take "
-            f"({p_loads / 1e3:.6g} kW): nothing is left for this 'speed' drive; give its "
-            f"power or torque, or correct the loads")))
+            f"the other drives put in {p_other / 1e3:.6g} kW and the loads take "
+            f"{p_loads / 1e3:.6g} kW: {left}; correct the loads' torques, or give this "
+            f"drive's power or torque")))
         return out
     out[name] = (p_loads - p_other) / abs(model.drives[name].speed)
     return out
