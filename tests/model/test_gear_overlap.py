@@ -297,3 +297,21 @@ def test_the_rim_of_a_planetary_stage_ring_is_named_as_written():
     ring = next(n for n, g in model.gears.items() if g.gear_type == "internal")
     assert _rim_fields(model, ring) == ("planetary.0.ring.rim_thickness or "
                                         "planetary.0.ring.outer_diameter")
+
+
+def test_a_gear_of_the_users_own_on_a_stages_planet_is_the_one_to_move():
+    """An idler of the user's placed on a [[planetary]] stage's planet: the error names
+    the idler's place (it named the generated planet, which the file does not have)."""
+    from torquesplit.model.reader import read_model_file
+
+    data = read_model_file(torquesplit.example_path("lin_parker1999_planetary"))
+    data["gears"] = {"idler": {"teeth": 30, "module": "2.25 mm",
+                               "pressure_angle": "24.6 deg", "face_width": "30 mm",
+                               "place": {"from_gear": "stage_sun", "angle": "45 deg"}}}
+    data["meshes"] = {"extra": {"gears": ["stage_sun", "idler"], "stiffness": "5e8 N/m"}}
+    data["loads"]["out2"] = {"body": "idler"}
+    with pytest.raises(ModelError) as info:
+        _load(data)
+    overlaps = [(loc, msg) for loc, msg in info.value.issues if "overlap" in msg]
+    assert overlaps and all(loc == "gears.idler" and "check gears.idler.place" in msg
+                            for loc, msg in overlaps), overlaps

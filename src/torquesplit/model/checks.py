@@ -1071,6 +1071,10 @@ def _overlap_issue(model: Model, first, second, d: float) -> tuple[str, str]:
     (a, ia, oa), (b, ib, ob) = first, second
     ring = [n for n, inner in ((a, ia), (b, ib)) if inner > 0]
     move = b if len(ring) != 1 or ring[0] == a else a
+    other = a if move == b else b
+    if (model.written_at(f"gears.{move}").startswith("planetary.")
+            and not model.written_at(f"gears.{other}").startswith("planetary.")):
+        move = other  # a gear of the user's own, not one a [[planetary]] stage placed
     fix = f"check gears.{move}.place / position"
     plane = "with their faces in the same plane"
     if not ring:
