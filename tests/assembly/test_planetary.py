@@ -474,6 +474,12 @@ def test_bad_planetary_input_names_the_field(change, where, text):
     ({"planets": 6}, "planetary.0.planets", "planets overlap"),
     ({"pin_radius": "110 mm"}, "planetary.0.pin_radius", "outside the circle the planets"),
     ({"angles": ["0 deg", "90 deg"]}, "planetary.0.angles", "one angle per planet"),
+    ({"angles": ["0 deg", "90 deg", "90 deg", "270 deg"]}, "planetary.0.angles",
+     r"planets 2 and 3 are at the same angle \(90 deg"),
+    ({"angles": ["0 deg", "90 deg", "180 deg", "360 deg"]}, "planetary.0.angles",
+     r"planets 1 and 4 are at the same angle \(0 deg"),
+    ({"angles": ["0 deg", "180 deg", "200 deg", "270 deg"]}, "planetary.0.angles",
+     "planets overlap: planets 2 and 3, 20 deg apart"),
 ])
 def test_bad_shorthand_names_the_field(stage, where, text):
     raw = lp_raw(4)

@@ -203,7 +203,8 @@ class Planetary(Strict):
     planets: Count = Field(ge=1, le=32, description="Number of planets.")
     angles: tuple[Angle, ...] | None = Field(
         None, description="Planet angles about the stage axis from the x axis (default "
-        "equally spaced from 0); one per planet.")
+        "equally spaced from 0); one per planet, in any order: planet k (and its entry of "
+        "'pin_errors') is the one at the k-th angle.")
     module: Module = Field(gt=0, description=(
         "Normal module of all three gears (or their normal diametral pitch, '4 1/in')."))
     pressure_angle: Angle = Field(math.radians(20.0), description="Normal pressure angle.")
@@ -493,19 +494,25 @@ class Planetary(Strict):
                     f"condition); {hint}")))
                 if self.angles is None:
                     break  # (equal spacing: one message says it for every planet)
-        order = sorted(a % (2 * math.pi) for a in angles)
+        # (planet numbers from 1, in the order of 'angles', which may be any order)
+        order = sorted((a % (2 * math.pi), i) for i, a in enumerate(angles, start=1))
         tip = planet.tip_radius
         for k in range(len(order)):
-            gap = (order[(k + 1) % len(order)] - order[k]) % (2 * math.pi)
             if len(order) == 1:
                 break
+            (a1, i1), (a2, i2) = order[k], order[(k + 1) % len(order)]
+            gap = (a2 - a1) % (2 * math.pi)
             chord = 2 * a_sp * math.sin(min(gap, 2 * math.pi) / 2)
             if chord <= 2 * tip:
+                i1, i2 = sorted((i1, i2))
                 fit.append((where, (
-                    f"planets overlap: two planets {math.degrees(gap):.4g} deg apart are "
-                    f"{chord * 1e3:.4f} mm apart, less than the planet tip diameter "
-                    f"{2 * tip * 1e3:.4f} mm; use fewer planets, smaller planets or wider "
-                    f"angles")))
+                    f"planets {i1} and {i2} are at the same angle ({math.degrees(a1):.6g} "
+                    f"deg, modulo 360 deg); give each planet its own angle"
+                    if chord < 1e-9 * a_sp else
+                    f"planets overlap: planets {i1} and {i2}, {math.degrees(gap):.4g} deg "
+                    f"apart, are {chord * 1e3:.4f} mm apart, less than the planet tip "
+                    f"diameter {2 * tip * 1e3:.4f} mm; use fewer planets, smaller planets or "
+                    f"wider angles")))
                 break  # (one overlap said)
         if fit:
             raise FieldError.of(fit)
