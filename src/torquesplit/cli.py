@@ -1779,7 +1779,8 @@ def modes(
                   + ", ".join(f"{k} {v:.5g} Hz" for k, v in mesh_f.items()), highlight=False)
     if carrier_rpm:
         console.print("modes at the model's speed: " + ", ".join(
-            f"carrier {c} turning at {v:.5g} rpm" for c, v in carrier_rpm.items())
+            f"carrier {c} turning at {v:.5g} rpm" if v else f"carrier {c} at rest (a star "
+            "stage: no rotating-frame terms)" for c, v in carrier_rpm.items())
             + ("" if not any(carrier_rpm.values()) else
                " (Coriolis and centripetal terms in: a degenerate pair splits into forward "
                "and backward whirl; --no-rotating-frame gives the modes at rest, as the "

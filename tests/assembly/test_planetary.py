@@ -473,6 +473,8 @@ def test_bad_planetary_input_names_the_field(change, where, text):
     ({"planets": 7}, "planetary.0.planets", "assembly condition"),
     ({"planets": 6}, "planetary.0.planets", "planets overlap"),
     ({"pin_radius": "110 mm"}, "planetary.0.pin_radius", "outside the circle the planets"),
+    ({"pin_radius": "50 mm"}, "planetary.0.pin_radius", "are 51.25 mm inside the circle"),
+    ({"pin_radius": "101.2502 mm"}, "planetary.0.pin_radius", "are 0.2 um outside the"),
     ({"angles": ["0 deg", "90 deg"]}, "planetary.0.angles", "one angle per planet"),
     ({"angles": ["0 deg", "90 deg", "90 deg", "270 deg"]}, "planetary.0.angles",
      r"planets 2 and 3 are at the same angle \(90 deg"),

@@ -58,6 +58,14 @@ def test_modes_below_and_count_keep_groups_whole(tmp_path):
     ds.close()
 
 
+def test_modes_of_a_star_stage_say_the_carrier_is_at_rest():
+    """(It said "turning at 0 rpm".)"""
+    res = runner.invoke(app, ["modes", "lin_parker1999_star", "--count", "2"])
+    assert res.exit_code == 0, res.output
+    text = " ".join(res.output.split())
+    assert "carrier stage_carrier at rest (a star stage" in text and "at 0 rpm" not in text
+
+
 @pytest.mark.parametrize("args, text", [
     (["modes", LP, "--below", "fast"], "--below"),
     (["modes", LP, "--count", "0"], "--count"),

@@ -452,7 +452,9 @@ class Planetary(Strict):
             off = self.pin_radius - a_sp
             raise FieldError("pin_radius", (
                 f"pins at {self.pin_radius * 1e3:.9g} mm from the axis are "
-                f"{abs(off) * 1e6:.4g} um {'outside' if off > 0 else 'inside'} the circle "
+                + (f"{abs(off) * 1e6:.4g} um" if abs(off) < 1e-3 else
+                   f"{abs(off) * 1e3:.6g} mm")
+                + f" {'outside' if off > 0 else 'inside'} the circle "
                 f"the planets mesh on (the operating sun-planet centre distance, "
                 f"{a_sp * 1e3:.9g} mm; tolerance {PIN_TOLERANCE:g} of it, "
                 f"{PIN_TOLERANCE * a_sp * 1e6:.2g} um): remove 'pin_radius' or write "
