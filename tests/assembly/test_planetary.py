@@ -455,6 +455,9 @@ def _general(**change):
     ({"loads.output.body": "stage_ring"}, "torsional_support", "is driven or loaded"),
     ({"gears.stage_planet1.support.pin_error": {"radial": 1e-5}, "gears.stage_planet1.support.on":
       None}, "gears.stage_planet1.support.pin_error", "requires|add on"),
+    ({"gears.stage_planet1.support.on": None}, "could not turn",
+     "'stage_planet1' turns about a fixed axis between a ring and another gear (a star "
+     "gear): if a planet, seat its bearing on the carrier (support.on)"),
 ])
 def test_bad_planetary_input_names_the_field(change, where, text):
     data = _general(**change)

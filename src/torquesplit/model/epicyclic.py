@@ -280,12 +280,23 @@ def solve_speeds(model: Model, axes, frames, groups, layout: EpicyclicLayout,
     resid = A @ w - y
     if np.max(np.abs(resid)) > 1e-9 * scale:
         k = int(np.argmax(np.abs(resid)))
+        # gears between a ring and another gear that turn about fixed axes: star gears,
+        # or planets whose bearings were meant to sit on a carrier
+        ring_mates = {g for m in model.meshes.values() for g in m.gears
+                      if any(model.gears[o].gear_type == "internal" for o in m.gears if o != g)}
+        fixed = [g for g in ring_mates if g not in layout.planet_bodies
+                 and model.gears[g].gear_type != "internal"
+                 and sum(g in m.gears for m in model.meshes.values()) >= 2]
+        hint = (f"; {', '.join(repr(g) for g in sorted(fixed)[:3])} "
+                f"{'turn' if len(fixed) > 1 else 'turns'} about a fixed axis between a ring "
+                f"and another gear (a star gear): if a planet, seat its bearing on the "
+                f"carrier (support.on)" if fixed else "")
         issues.append((where[k], (
             "the gears could not turn: the speeds the meshes, shafts, held members and "
             "drives impose contradict each other around a loop through here (a power-split "
             "loop needs the same ratio on every path, a differential at most as many given "
             "speeds as it has inputs); check tooth counts, axis directions, which members "
-            "are held (torsional_support) and the drive speeds")))
+            "are held (torsional_support) and the drive speeds" + hint)))
         return {}
     if rank < len(reps):
         _, _, vt = np.linalg.svd(A)
