@@ -141,10 +141,10 @@ def test_errors_below_the_module_are_not_refused():
 
 # ------------------------------------------------------------------ 3. pin radius
 @pytest.mark.parametrize("radius, side, offset", [
-    ("80 mm", "inside", None), ("83.86 mm", "outside", "2.629 um")])
+    ("80 mm", "3.85737 mm inside", None), ("83.86 mm", "2.629 um outside", "2.629 um")])
 def test_a_pin_radius_off_the_mesh_circle_says_where_and_the_exact_value(radius, side, offset):
     loc, msg = _issue(_raw(pin_radius=radius))
-    assert loc == "planetary.0.pin_radius" and f"um {side} the circle" in msg, msg
+    assert loc == "planetary.0.pin_radius" and f"{side} the circle" in msg, msg
     assert "pin_radius = '83.8573706 mm'" in msg and "tolerance 1e-06" in msg, msg
     # a small offset is a real pin error: pointed to; 3.9 mm is beyond the module
     assert ("pin_errors = [{radial = '2.629 um'}" in msg) == (offset is not None), msg
