@@ -83,3 +83,25 @@ def test_a_model_object_takes_the_paths_of_its_file(lp_file):
     spec["study"]["model"] = torquesplit.load_model(lp_file)
     with pytest.raises(StudyError, match=r"planetary\.0\.sun_mesh\.backlash"):
         Study(spec).plan()
+
+
+def test_pin_errors_vary_where_the_file_leaves_them_out(lp_file):
+    """The shipped example gives no pin_errors: a study writes the list out (an empty
+    table per planet, nothing changed) and varies one planet's, with the same K_gamma as
+    the file that lists them; a pattern ranges over every planet (it was refused:
+    "'planetary.0.pin_errors' does not exist in the model")."""
+    import torquesplit
+    from torquesplit.model.overrides import read_raw
+    from torquesplit.study.paths import expand
+
+    analysis = {"type": "static", "revolutions": 0.02}
+    path = "planetary.0.pin_errors.0.tangential"
+    ref = run_study(_study(lp_file, path, ["planet_load_sharing.*"], analysis))
+    got = run_study(_study(torquesplit.example_path("lin_parker1999_planetary"), path,
+                           ["planet_load_sharing.*"], analysis))
+    k = got["planet_load_sharing.static_torque"].values
+    assert k[1] > 1.01 and (k == ref["planet_load_sharing.static_torque"].values).all()
+    raw = read_raw(torquesplit.example_path("lin_parker1999_planetary"))
+    assert expand("planetary.0.pin_errors.*.radial", raw, "here") == [
+        f"planetary.0.pin_errors.{i}.radial" for i in range(4)]
+    assert raw["planetary"][0]["pin_errors"] == [{}, {}, {}, {}]

@@ -145,6 +145,8 @@ def expand(path: str, raw: dict, where: str) -> list[str]:
             elif _is_section(prefix + [seg]):
                 node[seg] = {}
                 keys = [seg]
+            elif _per_planet(node, prefix + [seg]):
+                keys = [seg]
             else:
                 keys = []
         elif isinstance(node, list):
@@ -172,6 +174,7 @@ def _parent(raw, parts, path, where):
         here = ".".join(parts[: i + 1])
         if isinstance(node, dict) and key not in node and _is_section(parts[: i + 1]):
             node[key] = {}  # a table the file leaves out (defaults): write it out empty
+        _per_planet(node, parts[: i + 1])
         if isinstance(node, dict) and key in node:
             node = node[key]
         elif isinstance(node, list) and key.isdigit() and int(key) < len(node):
@@ -187,6 +190,25 @@ def _parent(raw, parts, path, where):
             raise StudyError(where, f"{path!r}: {here!r} does not exist in the model (known "
                                     f"here: {known}); check the path")
     return node
+
+
+PER_PLANET = ("pin_errors",)
+"""The lists of a ``[[planetary]]`` stage with one table per planet, all fields
+defaulted: a study may vary their fields where the file leaves the list out."""
+
+
+def _per_planet(node, parts: list[str]) -> bool:
+    """Write out, in the raw data ``node`` of a ``[[planetary]]`` stage, its per-planet
+    list ``parts[-1]`` (:data:`PER_PLANET`) that the file leaves out: one empty table per
+    planet (nothing changes; the study then sets one planet's field).  True if done."""
+    if not (len(parts) == 3 and parts[0] == "planetary" and parts[2] in PER_PLANET
+            and isinstance(node, dict) and parts[2] not in node):
+        return False
+    count = node.get("planets")
+    if isinstance(count, bool) or not isinstance(count, int) or not 0 < count <= 64:
+        return False  # (the stage's own check names a bad count)
+    node[parts[2]] = [{} for _ in range(count)]
+    return True
 
 
 def _is_section(parts: list[str]) -> bool:
