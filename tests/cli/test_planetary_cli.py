@@ -178,6 +178,8 @@ def test_floating_member_held_by_a_stiff_support_is_warned():
     assert res.exit_code == 0, res.output
     said = [w for w in json.loads(res.stdout)["warnings"] if "floating = true, but" in w]
     assert len(said) == 1 and "planetary.0.sun.support.floating" in said[0]
+    # and says how to make it float from the command line too (a studies reviewer)
+    assert "so set planetary.0.sun.support.stiffness=1 N/m too" in " ".join(said[0].split())
     assert "does not float" in said[0]
     res = runner.invoke(app, ["check", LP, "--set", "planetary.0.sun.support.floating=true",
                               "--set", "planetary.0.sun.support.stiffness=1 N/m", "--json"])

@@ -742,8 +742,9 @@ def compliance_warnings(model: Model, kin) -> list[tuple[str, str]]:
                 f"floating = true, but the support's stiffness {k:.3g} N/m is "
                 f"{k / max(mesh_k):.2g} of the gear's meshes' (ISO 6336 about "
                 f"{max(mesh_k):.3g} N/m): the support holds the gear, which does not float; "
-                f"for a floating member leave 'stiffness' out (1 N/m is taken), else "
-                f"remove 'floating'")))
+                f"for a floating member leave 'stiffness' out (1 N/m is taken; a --set of "
+                f"the support merges into the file's table, so set "
+                f"{model.written_at(loc)}=1 N/m too), else remove 'floating'")))
             continue
         if sup.floating:  # (said to float: its softness is meant)
             if len(mesh_k) >= 3:
