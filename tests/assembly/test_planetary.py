@@ -377,6 +377,59 @@ def test_a_compound_planet_gear_moves_with_its_shaft():
     assert mesh["sp0"] < 0.6 * mesh["sp1"]  # the pin error unloads planet 0
 
 
+def test_a_compound_planet_bearing_damping_ratio_counts_both_gears():
+    """c = 2 zeta sqrt(k m), m the planet shaft's mass (0.5 + 0.2 kg) against the
+    carrier's (5 kg) in series."""
+    raw = compound_raw()
+    raw["gears"]["pa0"]["support"]["damping_ratio"] = 0.05
+    s = torquesplit.assemble(load(raw))
+    c = dict(zip(s.element_names, s.damping))["pa0.support.x"]
+    m = 0.7 * 5.0 / 5.7
+    assert c == pytest.approx(2 * 0.05 * math.sqrt(2e8 * m), rel=1e-12)
+
+
+def test_a_gear_seated_on_a_planet_rigid_on_its_pin():
+    """The other way round: the pin's gear rigid on its pin, the ring gear on a bearing
+    of 1e14 N/m seated on it (the seat moves with the pin and its error; it was held by
+    the housing, and the stage did not balance): as both rigid on the pin."""
+    def forces(seated):
+        raw = compound_raw(pin_error={"tangential": "20 um"},
+                           shaft_bearing="1e14 N/m" if seated else None)
+        for i in range(3):
+            raw["gears"][f"pa{i}"]["dofs"] = ["theta"]
+        s = torquesplit.assemble(load(raw))
+        return _mesh_forces(s, static_equilibrium(s))
+
+    rigid, seated = forces(False), forces(True)
+    for name in rigid:
+        assert seated[name] == pytest.approx(rigid[name], rel=2e-5), name  # (1e14 N/m)
+    assert rigid["sp0"] < 0 < rigid["sp1"]  # 20 um: planet 0's teeth pull (no backlash)
+
+
+def test_rigid_planets_on_a_rigid_carrier_see_its_eccentricity():
+    """A carrier without translations offsets every pin by its eccentricity: planets
+    rigid on their pins load as planets on bearings a million times stiffer."""
+    def forces(rigid):
+        raw = lp_raw(3)
+        st = raw["planetary"][0]
+        st["carrier"]["dofs"] = ["theta"]
+        st["carrier"].pop("support", None)
+        st["carrier"].update(eccentricity="10 um", eccentricity_phase="30 deg")
+        st["sun"]["dofs"] = ["theta"]  # (a fixed sun: the offsets load the planets)
+        st["sun"].pop("support", None)
+        if rigid:
+            st["planet"]["dofs"] = ["theta"]
+        else:
+            st["planet_bearing"] = {"stiffness": "1e14 N/m"}
+        s = torquesplit.assemble(load(raw))
+        return _mesh_forces(s, static_equilibrium(s))
+
+    r, b = forces(True), forces(False)
+    for name in r:
+        assert r[name] == pytest.approx(b[name], rel=1e-4), name
+    assert max(r.values()) > 1.2 * min(r.values())
+
+
 def test_compound_planet_kinematics_and_torques():
     """Willis with a stepped planet: carrier = sun / (1 + (80/20)(40/20)) = 100 rpm,
     planets -300 rpm; each planet shaft passes the sun mesh's torque on to its ring
@@ -391,6 +444,16 @@ def test_compound_planet_kinematics_and_torques():
         assert kin.bodies[g].torque == pytest.approx(200.0 / 3, rel=1e-8), g
     assert kin.bodies["sun"].torque == pytest.approx(100.0, rel=1e-8)
     assert kin.bodies["carrier"].torque == pytest.approx(900.0, rel=1e-8)
+    # a held member on a rigid shaft: both carry the reaction, T_s z_r / z_s (it was
+    # halved: the reaction was counted on the held body alone)
+    raw = lp_raw(4)
+    raw["planetary"][0]["ring"].pop("torsional_support")
+    raw["bodies"] = {"housing": {"polar_inertia": "1 kg m^2",
+                                 "torsional_support": {"rigid": True}}}
+    raw["shafts"] = {"fix": {"connects": ["stage_ring", "housing"], "rigid": True}}
+    kin = solve_kinematics(load(raw))
+    for b in ("stage_ring", "housing"):
+        assert kin.bodies[b].torque == pytest.approx(100.0 * ZR / ZS, rel=1e-8), b
 
 
 @pytest.mark.parametrize("teeth, fits", [((20, 40, 20, 80), True), ((20, 30, 24, 74), True),
@@ -408,6 +471,10 @@ def test_compound_planets_clocked_alike(teeth, fits):
         with pytest.raises(ModelError, match=r"meshes\.rp[12].*compound planets cannot all "
                                              r"be clocked alike"):
             load(raw)
+        # a phase given on the first planet's meshes clocks that planet only
+        raw["meshes"]["rp0"]["phase"] = 0.3
+        with pytest.raises(ModelError, match=r"meshes\.rp[12].*clocked alike"):
+            load(raw)
         for i in range(3):
             raw["meshes"][f"rp{i}"]["phase"] = 0.1 * i
         load(raw)  # planets clocked each on its own
@@ -416,11 +483,13 @@ def test_compound_planets_clocked_alike(teeth, fits):
     kin = solve_kinematics(model)
     ph = mesh_phases(model, kin, strict=True)
     zs, zr = teeth[0], teeth[3]
+    # -sigma z psi / 2 pi, sigma the sign of the central gear's speed in the carrier's
+    # frame: the sun turns at +800 rpm there (sigma +1), the held ring at -100 rpm (-1)
     for i in (1, 2):
-        for mesh, z in (("sp", zs), ("rp", zr)):
+        for mesh, z, sigma in (("sp", zs, 1), ("rp", zr, -1)):
             gap = (ph[f"{mesh}{i}"] - ph[f"{mesh}0"]) % 1.0
-            expect = {(-z * i / 3) % 1.0, (z * i / 3) % 1.0}  # sigma: either sense
-            assert min(abs((gap - e + 0.5) % 1.0 - 0.5) for e in expect) < 1e-9
+            expect = (-sigma * z * i / 3) % 1.0
+            assert abs((gap - expect + 0.5) % 1.0 - 0.5) < 1e-9, (mesh, i, gap, expect)
     # the tooth angle of pa0 (from sp0) and of pb0 (from rp0) agree, modulo pb's pitch
 
     def tooth(mesh, gear):

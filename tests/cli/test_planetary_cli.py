@@ -180,6 +180,16 @@ def test_floating_member_held_by_a_stiff_support_is_warned():
     assert len(said) == 1 and "planetary.0.sun.support.floating" in said[0]
     # and says how to make it float from the command line too (a studies reviewer)
     assert "so set planetary.0.sun.support.stiffness=1 N/m too" in " ".join(said[0].split())
+    # held in one direction is held: following that advice with a stiffness_y left
+    # warned of nothing (a reviewer; the star's carrier does not turn, so y may differ)
+    res = runner.invoke(app, ["check", "lin_parker1999_star", "--set",
+                              'planetary.0.sun.support={floating=true, stiffness_y="1e9 N/m"}',
+                              "--set", "planetary.0.sun.support.stiffness=1 N/m", "--json"])
+    assert res.exit_code == 0, res.output
+    said = [" ".join(w.split()) for w in json.loads(res.stdout)["warnings"]
+            if "floating = true, but" in w]
+    assert len(said) == 1 and "stiffness 1e+09 N/m" in said[0]
+    assert "planetary.0.sun.support.stiffness_y=1 N/m" in said[0]
     assert "does not float" in said[0]
     res = runner.invoke(app, ["check", LP, "--set", "planetary.0.sun.support.floating=true",
                               "--set", "planetary.0.sun.support.stiffness=1 N/m", "--json"])

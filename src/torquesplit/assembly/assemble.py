@@ -310,7 +310,9 @@ def _assemble(model: Model, kin: Kinematics | None, *, n_table: int | None,
                 f"{body!r} is measured in the frame of the turning carrier "
                 f"{kin.frames[body]!r}, where a bearing to the housing with different x and "
                 f"y stiffness turns; give it one radial stiffness (remove 'stiffness_y')"))])
-        m = kin.bodies[body].mass
+        # (with the gears that share its translations: a compound planet's other gear)
+        m = kin.bodies[body].mass + sum(kin.bodies[p].mass for p, h in dmap.host.items()
+                                        if h == body)
         if on is not None:  # equivalent mass of the two bodies for the damping ratio
             m_on = kin.bodies[on].mass
             m = m * m_on / (m + m_on) if m_on > 0 else m
@@ -318,8 +320,13 @@ def _assemble(model: Model, kin: Kinematics | None, *, n_table: int | None,
         ecc_const, ecc_sines = _eccentricity(model, kin, body)
         if on is not None and not dmap.translation[on]:
             # a seat body without translations (a carrier on rigid bearings): its
-            # eccentricity moves the pins it carries
+            # eccentricity moves the pins it carries; a planet rigid on its pin (the
+            # seat of a compound planet's other gear) is displaced by its pin's offset
             seat_const, seat_sines = _eccentricity(model, kin, on)
+            rigid = _rigid_pin_offset(model, kin, dmap, on)
+            if rigid is not None:
+                seat_const = seat_const + rigid[0]
+                seat_sines = seat_sines + rigid[1]
             pin_offset = pin_offset + seat_const
             ecc_sines = ecc_sines + seat_sines
         # a radial clearance joins the two translations across the body's axis into one
@@ -351,7 +358,10 @@ def _assemble(model: Model, kin: Kinematics | None, *, n_table: int | None,
             # axis, its rotation: theta_C (a_C x r) . u)
             dofs, coefs = [j], [1.0]
             if on is not None:
-                for jj, cc in dmap.project(on, u, -1.0, tol=1e-15):
+                # (a seat without translations of its own moves as its centre does: a
+                # planet rigid on its pin with the carrier, a compound planet's gear
+                # with its shaft partner)
+                for jj, cc in centre_projection(kin, dmap, on, u, -1.0, tol=1e-15):
                     dofs.append(jj)
                     coefs.append(cc)
                 idx_on, s_on = dmap.theta.get(on, (-1, 1.0))
@@ -540,25 +550,26 @@ def planet_bearer(model: Model, kin: Kinematics, body: str) -> str | None:
     return min(on_pin)[1] if on_pin else None
 
 
-def centre_projection(kin: Kinematics, dmap: DofMap, body: str, vec, sign: float = 1.0):
+def centre_projection(kin: Kinematics, dmap: DofMap, body: str, vec, sign: float = 1.0,
+                      tol: float = 0.0):
     """(DOF, coefficient) of the displacement of ``body``'s centre along ``vec``: its
     own translations; those of the body it shares them with (``dmap.host``: a compound
     planet's gear without translations); or -- a planet without translations, rigid on
     its pin -- those of its carrier and the carrier's rotation,
     ``theta_C (a_C x r) . vec``."""
     if body in dmap.host:
-        return dmap.project(dmap.host[body], vec, sign)
+        return dmap.project(dmap.host[body], vec, sign, tol)
     if dmap.translation.get(body) or body not in kin.planet_bodies:
-        return dmap.project(body, vec, sign)
+        return dmap.project(body, vec, sign, tol)
     carrier = kin.planet_bodies[body]
     c = kin.bodies[carrier]
     a = c.axis / np.linalg.norm(c.axis)
     r = kin.bodies[body].position - c.position
     r = r - a * float(r @ a)
-    out = list(dmap.project(carrier, vec, sign))
+    out = list(dmap.project(carrier, vec, sign, tol))
     idx, s_c = dmap.theta.get(carrier, (-1, 1.0))
     arm = float(cross(a, r) @ np.asarray(vec, dtype=float))
-    if idx >= 0 and abs(arm) > 0.0:
+    if idx >= 0 and abs(arm) > tol:
         out.append((idx, sign * s_c * arm))
     return out
 

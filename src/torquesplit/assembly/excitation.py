@@ -305,8 +305,8 @@ def _clock_compound_planets(model, kin, shaft, on_gear, phases, component, phase
     shaft have a tooth at one angle, unless a mesh there has a given ``phase``.  Every
     other planet shaft must then be clocked as the first (identical planets): its two
     tooth angles may differ from the first's only by whole teeth of either gear, i.e. by
-    a multiple of gcd(z_1, z_2) / z_1 of the second gear's mesh cycle (not checked where
-    a mesh of either shaft has a given ``phase``).  Returns the misfits (mesh, gear, miss
+    a multiple of gcd(z_1, z_2) / z_1 of the second gear's mesh cycle (not checked for a
+    planet a mesh of which has a given ``phase``: the user clocks it).  Returns the misfits (mesh, gear, miss
     in cycles)."""
     def angle(g):
         return tooth_angle(on_gear[g][0], g, phases[on_gear[g][0]])
@@ -340,8 +340,8 @@ def _clock_compound_planets(model, kin, shaft, on_gear, phases, component, phase
                         phases[m] = (phases[m] + shift) % 1.0
                         component[m] = component[on_gear[g0][0]]
             continue
-        if any(model.meshes[m].phase is not None for g in members + ref for m in on_gear[g]):
-            continue  # the user clocks these planets (given phases)
+        if any(model.meshes[m].phase is not None for g in members for m in on_gear[g]):
+            continue  # the user clocks this planet (given phases)
         roles = {reach(r): r for r in ref}
         match = [(g, roles.get(reach(g))) for g in members]
         if any(r is None for _, r in match):

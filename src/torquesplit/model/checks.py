@@ -735,16 +735,25 @@ def compliance_warnings(model: Model, kin) -> list[tuple[str, str]]:
         radial = float(np.linalg.norm(resultant - resultant.dot(axis) * axis))
         loc = f"gears.{name}.support.stiffness"
         floats = bool(mesh_k) and max(mesh_k) > 0 and k < MIN_SUPPORT_MESH_RATIO * max(mesh_k)
-        if sup.floating and mesh_k and k >= FLOATING_HOLD_RATIO * max(mesh_k):
+        # (held in one direction is held: the stiffer of stiffness and stiffness_y)
+        k_held = max(v for v in (sup.stiffness, sup.stiffness_y) if v is not None)
+        if sup.floating and mesh_k and k_held >= FLOATING_HOLD_RATIO * max(mesh_k):
             # (a --set of floating = true merges into a table that gives a stiffness: the
             # member stayed on its bearing without a word, a planetary reviewer)
+            fields = " and ".join(f for f, v in (("stiffness", sup.stiffness),
+                                                 ("stiffness_y", sup.stiffness_y))
+                                  if v is not None)
+            loc_y = model.written_at(f"gears.{name}.support.stiffness_y")
+            sets = " and ".join(f"{at}=1 N/m" for at, v in (
+                (model.written_at(loc), sup.stiffness), (loc_y, sup.stiffness_y))
+                if v is not None)
             out.append((f"gears.{name}.support.floating", (
-                f"floating = true, but the support's stiffness {k:.3g} N/m is "
-                f"{k / max(mesh_k):.2g} of the gear's meshes' (ISO 6336 about "
+                f"floating = true, but the support's stiffness {k_held:.3g} N/m is "
+                f"{k_held / max(mesh_k):.2g} of the gear's meshes' (ISO 6336 about "
                 f"{max(mesh_k):.3g} N/m): the support holds the gear, which does not float; "
-                f"for a floating member leave 'stiffness' out (1 N/m is taken; a --set of "
-                f"the support merges into the file's table, so set "
-                f"{model.written_at(loc)}=1 N/m too), else remove 'floating'")))
+                f"for a floating member leave {fields} out (1 N/m is taken; a --set of "
+                f"the support merges into the file's table, so set {sets} too), else "
+                f"remove 'floating'")))
             continue
         if sup.floating:  # (said to float: its softness is meant)
             if len(mesh_k) >= 3:

@@ -540,13 +540,15 @@ def solve_torques(model: Model, axes, frames, groups, speeds, layout: EpicyclicL
         body_torque[h] += abs(r)
     # a body on a rigid shaft (a compound planet's gear) passes the rest of its torques
     # on through the shaft: that torque balances them (exact for a body with one rigid
-    # shaft; a held member's reaction is already counted)
+    # shaft), a held member's reaction among them
     net = A_body @ x - b_body
+    for h, r in reactions.items():
+        net[row[h]] += r
     size = {}
     for name in bodies:
         size[groups[name]] = size.get(groups[name], 0) + 1
     for name in bodies:
-        if size[groups[name]] > 1 and groups[name] not in held_reps:
+        if size[groups[name]] > 1:
             body_torque[name] += abs(float(net[row[name]]))
     body_torque = {k: 0.5 * v for k, v in body_torque.items()}
     return NominalTorques(mesh_torque=tau, mesh_torque_second=tau2, drivers=drivers,
