@@ -306,8 +306,8 @@ def _clock_compound_planets(model, kin, shaft, on_gear, phases, component, phase
     other planet shaft must then be clocked as the first (identical planets): its two
     tooth angles may differ from the first's only by whole teeth of either gear, i.e. by
     a multiple of gcd(z_1, z_2) / z_1 of the second gear's mesh cycle (not checked for a
-    planet a mesh of which has a given ``phase``: the user clocks it).  Returns the misfits (mesh, gear, miss
-    in cycles)."""
+    planet a mesh of which has a given ``phase``: the user clocks it).  Returns the
+    misfits (mesh, gear, miss in cycles)."""
     def angle(g):
         return tooth_angle(on_gear[g][0], g, phases[on_gear[g][0]])
 
