@@ -268,9 +268,6 @@ def rhs_slot(slot, iy, idy, i_f, m, w):
     gy_ptr, gy_idx, gy_coef = m.gy_ptr, m.gy_idx, m.gy_coef
     fs_ptr, fs_idx, fs_coef = m.fs_ptr, m.fs_idx, m.fs_coef
     n = inv_mass.shape[0]
-    # a model without rotating-frame terms skips their empty row loops: -5 % of the
-    # general path's step (Ji & Li; same-process A/B)
-    frame = gy_ptr[n] + fs_ptr[n] > 0
     for el in range(vr_ptr.shape[0] - 1):
         d = -E[slot, el]
         r = -ED[slot, el]
@@ -286,11 +283,10 @@ def rhs_slot(slot, iy, idy, i_f, m, w):
         acc = external_force[i] - ground_damping[i] * vi
         for j in range(vt_ptr[i], vt_ptr[i + 1]):
             acc -= vt_coef[j] * force[i_f, vt_el[j]]
-        if frame:
-            for j in range(gy_ptr[i], gy_ptr[i + 1]):
-                acc -= gy_coef[j] * Y[iy, gy_idx[j]]
-            for j in range(fs_ptr[i], fs_ptr[i + 1]):
-                acc -= fs_coef[j] * Y[iy, fs_idx[j]]
+        for j in range(gy_ptr[i], gy_ptr[i + 1]):
+            acc -= gy_coef[j] * Y[iy, gy_idx[j]]
+        for j in range(fs_ptr[i], fs_ptr[i + 1]):
+            acc -= fs_coef[j] * Y[iy, fs_idx[j]]
         Y[idy, i] = vi
         Y[idy, n + i] = inv_mass[i] * acc
 
