@@ -380,17 +380,17 @@ def solve_torques(model: Model, axes, frames, groups, speeds, layout: EpicyclicL
 
     # the same sums per body (about its own axis): what a rigid shaft passes on
     bodies = list(groups)
-    row = {name: i for i, name in enumerate(bodies)}
+    body_row = {name: i for i, name in enumerate(bodies)}
     A_body = np.zeros((len(bodies), n_x))
     b_body = np.zeros(len(bodies))
 
     def add(body, j, coef):  # coef: torque on `body` about its own axis per unit x_j
         A[col[groups[body]], j] += coef * _sign(axes, body, groups[body])
-        A_body[row[body], j] += coef
+        A_body[body_row[body], j] += coef
 
     def known(body, torque):
         b[col[groups[body]]] -= torque * _sign(axes, body, groups[body])
-        b_body[row[body]] -= torque
+        b_body[body_row[body]] -= torque
 
     for j, name in enumerate(meshes):
         ga, gb = model.meshes[name].gears
@@ -543,13 +543,13 @@ def solve_torques(model: Model, axes, frames, groups, speeds, layout: EpicyclicL
     # shaft), a held member's reaction among them
     net = A_body @ x - b_body
     for h, r in reactions.items():
-        net[row[h]] += r
+        net[body_row[h]] += r
     size = {}
     for name in bodies:
         size[groups[name]] = size.get(groups[name], 0) + 1
     for name in bodies:
         if size[groups[name]] > 1:
-            body_torque[name] += abs(float(net[row[name]]))
+            body_torque[name] += abs(float(net[body_row[name]]))
     body_torque = {k: 0.5 * v for k, v in body_torque.items()}
     return NominalTorques(mesh_torque=tau, mesh_torque_second=tau2, drivers=drivers,
                           mesh_power={n: abs(p) for n, p in power_first.items()},
