@@ -709,17 +709,33 @@ def _radial_pair(sup, axes: dict, axis) -> tuple[str, ...]:
 def pin_stiffness(model, kin):
     """``f(body, direction)``: the stiffness of a planet's bearing on its carrier's pin
     along a unit direction [N/m] (None for a body not on a pin), for the centrifugal
-    pin-preload term of :func:`torquesplit.assembly.rotating.rotating_frame_terms`."""
+    pin-preload term of :func:`torquesplit.assembly.rotating.rotating_frame_terms`;
+    ``f.seated(body, direction)`` the bodies on bearings on that planet, with theirs."""
+
+    def along(sup, direction):
+        k_rad = support_stiffness(sup)
+        k_xyz = np.array([k_rad, sup.stiffness_y or k_rad, sup.axial_stiffness or k_rad])
+        return float(k_xyz @ np.asarray(direction) ** 2)
 
     def stiffness(body, direction):
         spec = model.gears.get(body) or model.bodies[body]
         sup = spec.support
         if sup is None or sup.on != kin.planet_bodies.get(body):
             return None
-        k_rad = support_stiffness(sup)
-        k_xyz = np.array([k_rad, sup.stiffness_y or k_rad, sup.axial_stiffness or k_rad])
-        return float(k_xyz @ np.asarray(direction) ** 2)
+        return along(sup, direction)
 
+    def seated(body, direction):
+        """(body, stiffness along ``direction``) of each body with translations on a
+        bearing on ``body`` (a compound planet's gear on the planet on the pin)."""
+        out = []
+        for b in model.body_names():
+            spec = model.gears.get(b) or model.bodies[b]
+            if (spec.support is not None and spec.support.on == body
+                    and any(d in spec.dofs for d in ("x", "y", "z", "loa"))):
+                out.append((b, along(spec.support, direction)))
+        return out
+
+    stiffness.seated = seated
     return stiffness
 
 

@@ -33,7 +33,8 @@ Cooley & Parker 2012 eq. 1)::
   carrier (translations and ``m R^2`` on its rotation, assembly/assemble.py) and so are
   its rotating-frame terms and centrifugal force.  A gear without translations on the
   shaft of a planet that has them (a compound planet) moves with that planet: its mass
-  joins the planet's in these terms.
+  joins the planet's in these terms.  A gear with translations on a bearing on the planet
+  loads the pin through that bearing: its static share enters the planet's pin preload.
 
 The bodies' rotations need no term (planar model, all axes parallel to a).
 """
@@ -125,17 +126,36 @@ def rotating_frame_terms(kin, dmap, ext: np.ndarray, pin_stiffness=None):
             r = kin.bodies[body].position - kin.bodies[c_name].position
             r0 = r - a * float(r @ a)
             big_r = float(np.linalg.norm(r0))
-            k_t = pin_stiffness(body, cross(a, r0 / big_r)) if big_r > 0 else None
+            tangent = cross(a, r0 / big_r) if big_r > 0 else None
+            k_t = pin_stiffness(body, tangent) if big_r > 0 else None
             if idx >= 0 and k_t is not None:
-                soft = m * omega**2
+                soft, load = m * omega**2, m * omega**2 * big_r
+                # a body with translations on a bearing on this planet (a compound
+                # planet's other gear) loads the pin through that bearing k_i: statically
+                # as a softening s_i = k_i m_i Omega^2 / (k_i - m_i Omega^2) at its radius
+                for b, k_i in getattr(pin_stiffness, "seated", lambda *_: [])(body, tangent):
+                    m_i = kin.bodies[b].mass
+                    soft_i = m_i * omega**2
+                    if not k_i > soft_i:
+                        raise ModelError([(f"gears.{b}.support", (
+                            f"the bearing of {b!r} on the planet {body!r} ({k_i:.3g} N/m) is "
+                            f"softer than its centrifugal softening m Omega^2 = {soft_i:.3g} "
+                            f"N/m at the carrier's speed; give a stiffer bearing or a lower "
+                            f"speed"))])
+                    r_i = kin.bodies[b].position - kin.bodies[c_name].position
+                    s_i = k_i * soft_i / (k_i - soft_i)
+                    soft += s_i
+                    load += s_i * float(np.linalg.norm(r_i - a * float(r_i @ a)))
                 if not k_t > soft:
                     raise ModelError([(f"gears.{body}.support", (
                         f"the planet's bearing ({k_t:.3g} N/m along its pin's tangent) is "
                         f"softer than its centrifugal softening m Omega^2 = {soft:.3g} N/m at "
                         f"the carrier's speed: it would fly off its pin; give a stiffer "
                         f"bearing or a lower speed"))])
+                # P R, P = k_t delta the pin bearing's static load (delta = load / (k_t -
+                # soft); one planet body: m Omega^2 R k_t / (k_t - m Omega^2))
                 preload.setdefault(c_name, [idx, s_c, 0.0])[2] += \
-                    soft * big_r**2 * k_t / (k_t - soft)
+                    big_r * k_t * load / (k_t - soft)
     # the pin preloads of all the planets of a carrier, on its rotation
     for c_name, (idx, s_c, k) in preload.items():
         frame.append((idx, idx, k * s_c * s_c))

@@ -97,11 +97,17 @@ def planet_load_sharing(load_sharing, kinematics) -> PlanetLoadSharing:
             continue
         groups[carrier] = gs
         per_stage[carrier] = max(ls.per_group[g] for g in gs)
+        # one factor per planet shaft, named after its body on the pin: a compound
+        # planet's gears (one rigid group) count together
+        pins = kinematics.carriers.get(carrier, ())
         for planet, c in kinematics.planet_bodies.items():
             if c != carrier:
                 continue
+            name = next((q for q in pins if kinematics.groups[q] == kinematics.groups[planet]),
+                        planet)
             mine = [ls.per_mesh[n] for n, mk in planet_meshes.items()
                     if planet in (mk.driver, mk.driven)]
             if mine:
-                per_planet[planet] = max(mine)
+                per_planet[name] = max(mine + ([per_planet[name]] if name in per_planet
+                                               else []))
     return PlanetLoadSharing(ls.definition, per_stage, per_planet, groups)

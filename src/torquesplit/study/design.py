@@ -468,7 +468,8 @@ def _outputs(spec: StudySpec, model, analysis: str) -> tuple[list[str], list[str
     kin = solve_kinematics(model)  # (planetary stages: their K_gamma outputs; the groups)
     stages = stage_labels(model, kin)
     meta = {m: {"stage": stages[m], "path": model.meshes[m].path} for m in model.meshes}
-    planets = {c: [p for p, cc in kin.planet_bodies.items() if cc == c] for c in kin.carriers}
+    # (a planet's output is named after its body on the pin, as planet_load_sharing does)
+    planets = {c: list(pins) for c, pins in kin.carriers.items()}
     bearings = []
     if analysis != "static" and any("bearing" in p for p in spec.study.outputs):
         from ..assembly.assemble import assemble
