@@ -690,3 +690,39 @@ def test_ring_floating_on_a_spline_in_the_turning_frame():
     assert np.max(np.abs(st.q)) < 1e-2
     np.testing.assert_allclose(rhs(s, 1e-6, st.y0), rhs_numpy(s, 1e-6, st.y0),
                                rtol=1e-7, atol=1e-6)
+
+
+def test_the_compound_planet_recipe_of_the_theory_doc():
+    """docs/theory/planetary.md's compound-planet snippet, its shaft repeated at 120 and
+    240 deg as the text says, is :func:`planetary_models.compound_raw` (the same mesh
+    forces), loads as it is (one planet) and gives equal sharing with three."""
+    import re
+    import tomllib
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[2] / "docs" / "theory" /
+            "planetary.md").read_text(encoding="utf-8")
+    section = text[text.index("## Compound (stepped) planets"):]
+    raw = tomllib.loads(re.search(r"```toml\n(.*?)```", section, re.S).group(1))
+    load(raw)  # one planet shaft alone is a model too
+    for i in (1, 2):
+        psi = 2 * math.pi * i / 3
+        at = [f"{60 * math.cos(psi):.12f} mm", f"{60 * math.sin(psi):.12f} mm"]
+        for g in ("pa", "pb"):
+            spec = copy.deepcopy(raw["gears"][f"{g}0"])
+            spec["position"][:2] = at
+            raw["gears"][f"{g}{i}"] = spec
+        raw["shafts"][f"ps{i}"] = {"connects": [f"pa{i}", f"pb{i}"], "rigid": True}
+        for m, pair in (("sp", ["sun", f"pa{i}"]), ("rp", [f"pb{i}", "ring"])):
+            raw["meshes"][f"{m}{i}"] = dict(raw["meshes"][f"{m}0"], gears=pair)
+
+    def forces(data):
+        s = torquesplit.assemble(load(data))
+        return _mesh_forces(s, static_equilibrium(s))
+
+    got, ref = forces(raw), forces(compound_raw())
+    assert got.keys() == ref.keys()
+    for name in ref:
+        assert got[name] == pytest.approx(ref[name], rel=1e-9), name
+    assert got["sp0"] == pytest.approx(got["sp2"], rel=1e-9)  # equal sharing
+    assert got["rp1"] == pytest.approx(2 * got["sp1"], rel=1e-6)  # (40/20 base radii)

@@ -290,7 +290,10 @@ class Support(Strict):
     )
     pin_error: PinDeviation = Field(
         PinDeviation(), description="Position error of the seat (planet pin) on the body "
-        "named by 'on' (radial, tangential); requires 'on'.")
+        "named by 'on' (radial: outwards from its axis; tangential: in its positive sense "
+        "of rotation); requires 'on'.  A pin ahead in the direction the planet's loads push "
+        "it unloads that planet: with the carrier as output, a positive tangential error "
+        "on a carrier turning positively.")
     floating: bool = Field(
         False, description="The body floats by design, held by its meshes alone (a "
         "floating sun): the support only keeps the equilibrium regular and its softness "
