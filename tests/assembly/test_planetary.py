@@ -726,3 +726,26 @@ def test_the_compound_planet_recipe_of_the_theory_doc():
         assert got[name] == pytest.approx(ref[name], rel=1e-9), name
     assert got["sp0"] == pytest.approx(got["sp2"], rel=1e-9)  # equal sharing
     assert got["rp1"] == pytest.approx(2 * got["sp1"], rel=1e-6)  # (40/20 base radii)
+
+
+@pytest.mark.parametrize("change, words", [
+    ("elastic", "'pb0' is joined to the planet 'pa0' by the elastic shaft 'ps0', so it turns "
+                "about a fixed axis: make the shaft rigid (rigid = true) for a compound planet"),
+    ("no shaft", "'pb1' is joined to nothing but this mesh: if it is a compound planet's "
+                 "gear, join it to its planet gear with a rigid shaft"),
+    ("one elastic", "'pb0' is joined to the planet 'pa0' by the elastic shaft 'ps0', so it "
+                    "turns about a fixed axis: make the shaft rigid"),
+])
+def test_a_compound_planet_written_wrong_is_told_how(change, words):
+    """(A first-hour reviewer got "check which members are held and driven" and "the
+    speeds ... contradict each other around a loop".)"""
+    raw = compound_raw()
+    if change in ("elastic", "one elastic"):
+        for i in range(3 if change == "elastic" else 1):
+            raw["shafts"][f"ps{i}"] = {"connects": [f"pa{i}", f"pb{i}"],
+                                       "torsional_stiffness": "1e5 N m/rad"}
+    else:
+        del raw["shafts"]["ps1"]
+    with pytest.raises(ModelError) as info:
+        load(raw)
+    assert any(words in msg for _, msg in info.value.issues), info.value.issues

@@ -291,6 +291,19 @@ def solve_speeds(model: Model, axes, frames, groups, layout: EpicyclicLayout,
                 f"{'turn' if len(fixed) > 1 else 'turns'} about a fixed axis between a ring "
                 f"and another gear (a star gear): if a planet, seat its bearing on the "
                 f"carrier (support.on)" if fixed else "")
+        # a ring's mate joined to a planet by an elastic shaft turns about a fixed axis
+        # too: only a rigid shaft makes it a compound planet's gear
+        for sname, sh in model.shafts.items():
+            a_, b_ = sh.connects
+            for g, p in ((a_, b_), (b_, a_)):
+                if (not sh.rigid and g in ring_mates and g not in layout.planet_bodies
+                        and p in layout.planet_bodies):
+                    hint += (f"; {g!r} is joined to the planet {p!r} by the elastic shaft "
+                             f"{sname!r}, so it turns about a fixed axis: make the shaft "
+                             f"rigid (rigid = true) for a compound planet")
+                    break
+            if len(hint) > 600:
+                break
         issues.append((where[k], (
             "the gears could not turn: the speeds the meshes, shafts, held members and "
             "drives impose contradict each other around a loop through here (a power-split "

@@ -344,10 +344,31 @@ def _solve_kinematics(model: Model) -> Kinematics:
         za = model.gears[driver].teeth
         freq = abs(rel[driver]) * za / (2 * math.pi)
         if not freq > 0:
+            # a gear joined to nothing but this mesh (a compound planet's second gear
+            # without its shaft) turns with whatever it meshes: say so
+            ends = {b for part in (*model.shafts.values(), *model.splines.values())
+                    for b in part.connects}
+            ends |= {d.body for d in model.drives.values()} | {
+                ld.body for ld in model.loads.values()}
+            alone = [g for g in (driver, driven) if g not in ends
+                     and sum(g in m.gears for m in model.meshes.values()) == 1]
+            hint = (f"; {alone[0]!r} is joined to nothing but this mesh: if it is a compound "
+                    f"planet's gear, join it to its planet gear with a rigid shaft"
+                    if alone else "")
+            for sname, sh in model.shafts.items():
+                pair = sh.connects
+                g = next((x for x in pair if x in (driver, driven)
+                          and x not in layout.planet_bodies), None)
+                p = next((x for x in pair if x in layout.planet_bodies), None)
+                if not sh.rigid and g is not None and p is not None:
+                    hint += (f"; {g!r} is joined to the planet {p!r} by the elastic shaft "
+                             f"{sname!r}, so it turns about a fixed axis: make the shaft "
+                             f"rigid (rigid = true) for a compound planet")
+                    break
             issues.append((f"meshes.{name}", (
                 f"the gears of this mesh do not turn against each other (speed "
                 f"{rel[driver] * 30 / math.pi:.6g} rpm in its frame), so it has no mesh "
-                f"cycle; check which members are held and driven")))
+                f"cycle; check which members are held and driven" + hint)))
             continue
         p_mesh = edge_power[name]
         if nominal is not None:
