@@ -90,12 +90,28 @@ class QuasiStaticResults:
         return ls.static_torque(self.times, self.mesh_forces(), self.mesh_names, groups)
 
     def orbits(self) -> dict[str, np.ndarray]:
-        """Floating orbit (n_times, 2) [m] of every body with x and y DOFs."""
+        """Floating orbit (n_times, 2) [m] of every body with x and y DOFs, relative to
+        its bearing's seat: a planet's to its pin's nominal place on the (turning,
+        twisted) carrier, pin error included, not the pin's own motion with the carrier's
+        rotation (which depends on what else the model holds); a body on the housing's
+        or held by a spline: its own displacement."""
         out = {}
-        dmap = self.structure.metadata["dof_map"]
+        s = self.structure
+        dmap = s.metadata["dof_map"]
+        q = self.solution.q
         for body, tr in dmap.translation.items():
-            if "x" in tr and "y" in tr:
-                out[body] = self.solution.q[:, [tr["x"], tr["y"]]]
+            if "x" not in tr or "y" not in tr:
+                continue
+            cols = []
+            for d in ("x", "y"):
+                name = f"{body}.support.{d}"
+                if name in s.element_names:  # V q of its support: u - u_seat
+                    e = s.element_names.index(name)
+                    sl = slice(s.v_ptr[e], s.v_ptr[e + 1])
+                    cols.append(q[:, s.v_dof[sl]] @ np.asarray(s.v_coef[sl]))
+                else:
+                    cols.append(q[:, tr[d]])
+            out[body] = np.stack(cols, axis=-1)
         return out
 
     def to_dataset(self):

@@ -749,3 +749,35 @@ def test_a_compound_planet_written_wrong_is_told_how(change, words):
     with pytest.raises(ModelError) as info:
         load(raw)
     assert any(words in msg for _, msg in info.value.issues), info.value.issues
+
+
+def test_a_planets_static_orbit_is_taken_from_its_pin():
+    """A planet's floating orbit is its centre relative to its pin's nominal place: the
+    bearing's deflection F / k plus the pin error (10 um tangential: y of planet 1 at
+    0 deg).  It was the planet's displacement in the carrier's frame, which carries the
+    pin along with the carrier's twist (12.7 um where 26 were expected; 161 um once a
+    second stage joined: a first-hour reviewer), and it no longer moves with what else
+    the model holds: an output shaft and inertia on the carrier leave it alone."""
+    from torquesplit.quasistatic import quasi_static_load_sharing
+
+    def orbit(extra):
+        raw = lp_raw(4, pin_errors=[{"tangential": "10 um"}, {}, {}, {}])
+        if extra:
+            raw["bodies"] = {"out": {"polar_inertia": "1 kg m^2",
+                                     "position": ["0 mm", "0 mm", "-200 mm"]}}
+            raw["shafts"] = {"q": {"connects": ["stage_carrier", "out"],
+                                   "torsional_stiffness": "1e4 N m/rad"}}
+            raw["loads"]["output"]["body"] = "out"
+        qs = quasi_static_load_sharing(load(raw), revolutions=0.02)
+        f = dict(zip(qs.structure.element_names, qs.solution.element_forces[0]))
+        return qs.orbits()["stage_planet1"][0], f
+
+    (x, y), f = orbit(False)
+    assert y == pytest.approx(f["stage_planet1.support.y"] / LP["k_bearing"] + 10e-6,
+                              rel=1e-9)
+    assert x == pytest.approx(f["stage_planet1.support.x"] / LP["k_bearing"], rel=1e-9)
+    # (the planet's displacement in the carrier's frame went from 7.7 to 3870 um; the
+    # bearing force itself moves by 0.2 %: the pin preload's term on the carrier's
+    # linearised twist)
+    (x2, y2), _ = orbit(True)
+    assert (x2, y2) == pytest.approx((x, y), rel=3e-3)
