@@ -324,21 +324,27 @@ def _mesh_forces(structure, solution):
             if structure.element_kind[i] == 1}
 
 
-def test_a_planet_rigid_on_its_pin_is_displaced_by_its_pin_error():
-    """A tangential pin error of 20 um on a planet without translations loads its meshes
-    as it does a planet on a bearing a million times stiffer (it was ignored: equal
-    sharing)."""
-    def forces(rigid):
-        raw = lp_raw(4, pin_errors=[{"tangential": "20 um"}, {}, {}, {}])
-        st = raw["planetary"][0]
+def _rigid_and_stiff_pins(raw):
+    """Static mesh forces of the stage ``raw`` with its planets rigid on their pins, and
+    with them on bearings of 1e14 N/m (a million times the example's)."""
+    out = []
+    for rigid in (True, False):
+        data = copy.deepcopy(raw)
+        st = data["planetary"][0]
         if rigid:
             st["planet"]["dofs"] = ["theta"]
         else:
             st["planet_bearing"] = {"stiffness": "1e14 N/m"}
-        s = torquesplit.assemble(load(raw))
-        return _mesh_forces(s, static_equilibrium(s))
+        s = torquesplit.assemble(load(data))
+        out.append(_mesh_forces(s, static_equilibrium(s)))
+    return out
 
-    r, b = forces(True), forces(False)
+
+def test_a_planet_rigid_on_its_pin_is_displaced_by_its_pin_error():
+    """A tangential pin error of 20 um on a planet without translations loads its meshes
+    as it does a planet on a bearing a million times stiffer (it was ignored: equal
+    sharing)."""
+    r, b = _rigid_and_stiff_pins(lp_raw(4, pin_errors=[{"tangential": "20 um"}, {}, {}, {}]))
     assert r.keys() == b.keys() and len(r) == 8
     for name in r:
         assert r[name] == pytest.approx(b[name], rel=1e-4), name
@@ -447,22 +453,14 @@ def test_a_gear_seated_on_a_planet_rigid_on_its_pin():
 def test_rigid_planets_on_a_rigid_carrier_see_its_eccentricity():
     """A carrier without translations offsets every pin by its eccentricity: planets
     rigid on their pins load as planets on bearings a million times stiffer."""
-    def forces(rigid):
-        raw = lp_raw(3)
-        st = raw["planetary"][0]
-        st["carrier"]["dofs"] = ["theta"]
-        st["carrier"].pop("support", None)
-        st["carrier"].update(eccentricity="10 um", eccentricity_phase="30 deg")
-        st["sun"]["dofs"] = ["theta"]  # (a fixed sun: the offsets load the planets)
-        st["sun"].pop("support", None)
-        if rigid:
-            st["planet"]["dofs"] = ["theta"]
-        else:
-            st["planet_bearing"] = {"stiffness": "1e14 N/m"}
-        s = torquesplit.assemble(load(raw))
-        return _mesh_forces(s, static_equilibrium(s))
-
-    r, b = forces(True), forces(False)
+    raw = lp_raw(3)
+    st = raw["planetary"][0]
+    st["carrier"]["dofs"] = ["theta"]
+    st["carrier"].pop("support", None)
+    st["carrier"].update(eccentricity="10 um", eccentricity_phase="30 deg")
+    st["sun"]["dofs"] = ["theta"]  # (a fixed sun: the offsets load the planets)
+    st["sun"].pop("support", None)
+    r, b = _rigid_and_stiff_pins(raw)
     for name in r:
         assert r[name] == pytest.approx(b[name], rel=1e-4), name
     assert max(r.values()) > 1.2 * min(r.values())

@@ -136,22 +136,15 @@ def rotating_frame_terms(kin, dmap, ext: np.ndarray, pin_stiffness=None):
                 for b, k_i in getattr(pin_stiffness, "seated", lambda *_: [])(body, tangent):
                     m_i = kin.bodies[b].mass
                     soft_i = m_i * omega**2
-                    if not k_i > soft_i:
-                        raise ModelError([(f"gears.{b}.support", (
-                            f"the bearing of {b!r} on the planet {body!r} ({k_i:.3g} N/m) is "
-                            f"softer than its centrifugal softening m Omega^2 = {soft_i:.3g} "
-                            f"N/m at the carrier's speed; give a stiffer bearing or a lower "
-                            f"speed"))])
+                    _stiffer_than_spin(f"gears.{b}.support", f"the bearing of {b!r} on the "
+                                       f"planet {body!r} ({k_i:.3g} N/m)", k_i, soft_i, "")
                     r_i = kin.bodies[b].position - kin.bodies[c_name].position
                     s_i = k_i * soft_i / (k_i - soft_i)
                     soft += s_i
                     load += s_i * float(np.linalg.norm(r_i - a * float(r_i @ a)))
-                if not k_t > soft:
-                    raise ModelError([(f"gears.{body}.support", (
-                        f"the planet's bearing ({k_t:.3g} N/m along its pin's tangent) is "
-                        f"softer than its centrifugal softening m Omega^2 = {soft:.3g} N/m at "
-                        f"the carrier's speed: it would fly off its pin; give a stiffer "
-                        f"bearing or a lower speed"))])
+                _stiffer_than_spin(f"gears.{body}.support", f"the planet's bearing "
+                                   f"({k_t:.3g} N/m along its pin's tangent)", k_t, soft,
+                                   ": it would fly off its pin")
                 # P R, P = k_t delta the pin bearing's static load (delta = load / (k_t -
                 # soft); one planet body: m Omega^2 R k_t / (k_t - m Omega^2))
                 preload.setdefault(c_name, [idx, s_c, 0.0])[2] += \
@@ -160,6 +153,15 @@ def rotating_frame_terms(kin, dmap, ext: np.ndarray, pin_stiffness=None):
     for c_name, (idx, s_c, k) in preload.items():
         frame.append((idx, idx, k * s_c * s_c))
     return frame, gyro
+
+
+def _stiffer_than_spin(where: str, bearing: str, k: float, soft: float, then: str) -> None:
+    """Refuse a bearing ``k`` not stiffer than the centrifugal softening ``soft`` =
+    m Omega^2 of what it holds (the static preload would be unbounded)."""
+    if not k > soft:
+        raise ModelError([(where, (
+            f"{bearing} is softer than its centrifugal softening m Omega^2 = {soft:.3g} N/m "
+            f"at the carrier's speed{then}; give a stiffer bearing or a lower speed"))])
 
 
 class FrameTermsAt:

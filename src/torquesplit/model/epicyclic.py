@@ -211,6 +211,22 @@ def _sign(axes, body, rep) -> float:
     return 1.0 if float(axes[body] @ axes[rep]) > 0 else -1.0
 
 
+def elastic_shaft_hint(model: Model, planet_bodies, gears, most: int) -> str:
+    """The errors' note on each of ``gears`` (at most ``most``) that an elastic shaft joins
+    to a planet: it is no planet gear, so it turns about a fixed axis (only a rigid shaft
+    makes a compound planet); '' if none."""
+    found = []
+    for sname, sh in model.shafts.items():
+        a, b = sh.connects
+        for g, p in ((a, b), (b, a)):
+            if not sh.rigid and g in gears and g not in planet_bodies and p in planet_bodies:
+                found.append(f"; {g!r} is joined to the planet {p!r} by the elastic shaft "
+                             f"{sname!r}, so it turns about a fixed axis: make the shaft "
+                             f"rigid (rigid = true) for a compound planet")
+                break
+    return "".join(found[:most])
+
+
 def solve_speeds(model: Model, axes, frames, groups, layout: EpicyclicLayout,
                  issues) -> dict[str, float]:
     """Signed speed of every body about its own axis [rad/s] (see module docstring)."""
@@ -293,17 +309,7 @@ def solve_speeds(model: Model, axes, frames, groups, layout: EpicyclicLayout,
                 f"carrier (support.on)" if fixed else "")
         # a ring's mate joined to a planet by an elastic shaft turns about a fixed axis
         # too: only a rigid shaft makes it a compound planet's gear
-        for sname, sh in model.shafts.items():
-            a_, b_ = sh.connects
-            for g, p in ((a_, b_), (b_, a_)):
-                if (not sh.rigid and g in ring_mates and g not in layout.planet_bodies
-                        and p in layout.planet_bodies):
-                    hint += (f"; {g!r} is joined to the planet {p!r} by the elastic shaft "
-                             f"{sname!r}, so it turns about a fixed axis: make the shaft "
-                             f"rigid (rigid = true) for a compound planet")
-                    break
-            if len(hint) > 600:
-                break
+        hint += elastic_shaft_hint(model, layout.planet_bodies, ring_mates, 3)
         issues.append((where[k], (
             "the gears could not turn: the speeds the meshes, shafts, held members and "
             "drives impose contradict each other around a loop through here (a power-split "

@@ -355,16 +355,7 @@ def _solve_kinematics(model: Model) -> Kinematics:
             hint = (f"; {alone[0]!r} is joined to nothing but this mesh: if it is a compound "
                     f"planet's gear, join it to its planet gear with a rigid shaft"
                     if alone else "")
-            for sname, sh in model.shafts.items():
-                pair = sh.connects
-                g = next((x for x in pair if x in (driver, driven)
-                          and x not in layout.planet_bodies), None)
-                p = next((x for x in pair if x in layout.planet_bodies), None)
-                if not sh.rigid and g is not None and p is not None:
-                    hint += (f"; {g!r} is joined to the planet {p!r} by the elastic shaft "
-                             f"{sname!r}, so it turns about a fixed axis: make the shaft "
-                             f"rigid (rigid = true) for a compound planet")
-                    break
+            hint += epi.elastic_shaft_hint(model, layout.planet_bodies, (driver, driven), 1)
             issues.append((f"meshes.{name}", (
                 f"the gears of this mesh do not turn against each other (speed "
                 f"{rel[driver] * 30 / math.pi:.6g} rpm in its frame), so it has no mesh "
