@@ -779,3 +779,23 @@ def test_a_planets_static_orbit_is_taken_from_its_pin():
     # linearised twist)
     (x2, y2), _ = orbit(True)
     assert (x2, y2) == pytest.approx((x, y), rel=3e-3)
+
+
+@pytest.mark.parametrize("bearing, where, words", [
+    # the second gear's own bearing on the planet: m Omega^2 = 0.2 kg (100 rpm)^2
+    ({"shaft_bearing": "10 N/m"}, "gears.pb0.support",
+     "the bearing of 'pb0' on the planet 'pa0' (10 N/m) is softer than its centrifugal "
+     "softening m Omega^2 = 21.9 N/m"),
+    # the pin's bearing holds both gears of a rigid planet shaft: 0.7 kg (100 rpm)^2
+    ({"pin": "10 N/m"}, "gears.pa0.support",
+     "the planet's bearing (10 N/m along its pin's tangent) is softer than its centrifugal "
+     "softening m Omega^2 = 76.8 N/m at the carrier's speed: it would fly off its pin"),
+])
+def test_a_bearing_softer_than_its_centrifugal_softening_is_refused(bearing, where, words):
+    raw = compound_raw(shaft_bearing=bearing.get("shaft_bearing"))
+    for i in range(3):
+        raw["gears"][f"pa{i}"]["support"]["stiffness"] = bearing.get("pin", "2e8 N/m")
+    with pytest.raises(ModelError) as info:
+        torquesplit.assemble(load(raw))
+    assert any(loc == where and words in msg for loc, msg in info.value.issues), \
+        info.value.issues
