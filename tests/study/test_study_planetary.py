@@ -4,10 +4,11 @@ the file's data, where the stage table is) and its mesh-load factor K_gamma
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 import tomli_w
-
 from planetary_models import lp_raw
+
 from torquesplit.study import Study, run_study
 from torquesplit.study.errors import StudyError
 
@@ -105,3 +106,51 @@ def test_pin_errors_vary_where_the_file_leaves_them_out(lp_file):
     assert expand("planetary.0.pin_errors.*.radial", raw, "here") == [
         f"planetary.0.pin_errors.{i}.radial" for i in range(4)]
     assert raw["planetary"][0]["pin_errors"] == [{}, {}, {}, {}]
+
+
+
+def test_a_static_study_gives_the_peak_instantaneous_ratio_beside_k_gamma(tmp_path):
+    """The quasi-static peak of the planets' instantaneous load ratio (Mo et al. 2017, not
+    K_gamma), which `static` prints beside K_gamma, is a study output too: per stage and
+    per planet, the largest N F_i / sum F over the positions of the sweep.  On sequentially
+    phased planets (25/29/83) it differs from K_gamma even without errors; a run (dynamic)
+    study has no such output."""
+    import tomllib
+
+    from planetary_models import three_planet_toml
+
+    from torquesplit.quasistatic import quasi_static_load_sharing
+    from torquesplit.study.outputs import output_definitions
+
+    text = three_planet_toml("p3seq", teeth=(25, 29, 83), face_width="50 mm",
+                             floating_sun=False, mesh='{method = "iso6336"}',
+                             damping_ratio=None)
+    raw = tomllib.loads(text)
+    raw["planetary"][0]["pin_errors"] = [{"tangential": "0 um"}, {}, {}]
+    model = tmp_path / "seq.toml"
+    model.write_text(tomli_w.dumps(raw), encoding="utf-8")
+    path = "planetary.0.pin_errors.0.tangential"
+    ds = run_study(_study(model, path, ["planet_*"], {"type": "static"}))
+    assert set(ds["status"].values) == {"ok"}
+    peak = ds["planet_peak_instantaneous_ratio"].values
+    names = [v for v in ds.data_vars if v.startswith("planet_peak_instantaneous_ratio.")]
+    assert len(names) == 4 and "planet_peak_instantaneous_ratio.st_planet2" in names
+    assert "not K_gamma" in ds["planet_peak_instantaneous_ratio"].attrs["long_name"]
+    said, = output_definitions(["planet_peak_instantaneous_ratio"])
+    assert "Mo et al. 2017" in said
+    # K_gamma 1 without errors, the peak ratio not (the phased stiffness cycles)
+    assert ds["planet_load_sharing.static_torque"].values[0] == pytest.approx(1.0, abs=1e-5)
+    assert peak[0] > 1.05
+    # by hand from the quasi-static sweep of the second case (10 um on planet 1)
+    raw["planetary"][0]["pin_errors"][0]["tangential"] = "10 um"
+    qs = quasi_static_load_sharing(raw)
+    f = qs.mesh_forces()
+    cols = [[qs.mesh_names.index(f"st_{m}_planet{i}") for i in range(1, 4)]
+            for m in ("sun", "ring")]
+    by_hand = max(np.max(3 * f[:, c] / f[:, c].sum(axis=1, keepdims=True)) for c in cols)
+    assert peak[1] == pytest.approx(by_hand, rel=1e-12)
+    p2 = max(np.max(3 * f[:, c[1]] / f[:, c].sum(axis=1)) for c in cols)
+    assert ds["planet_peak_instantaneous_ratio.st_planet2"].values[1] == pytest.approx(
+        p2, rel=1e-12)
+    with pytest.raises(StudyError, match="planet_peak_instantaneous_ratio"):
+        Study(_study(model, path, ["planet_peak_instantaneous_ratio"], {"cycles": 40})).plan()

@@ -16,8 +16,9 @@ ratio of mean loads, is the ``mean_force`` one (dynamic) or the position-average
   the sweep -- the mean load per planet over the mean of all, as the standards define it
   (AGMA 6123-B06 §5, ISO 6336-1) -- and, apart, the peak of the instantaneous ratio over
   the positions (Mo et al. 2017 eqs. 14-15 generalised to planets), which is not
-  K_gamma: with sequentially phased planets it exceeds 1 (1.0841 for a 25/29/83 spur
-  stage) although every planet carries the same mean load;
+  K_gamma: with sequentially phased planets it exceeds 1 (1.0915 for a 25/29/83 spur
+  stage) although every planet carries the same mean load (studies:
+  ``planet_peak_instantaneous_ratio[.<carrier>|.<planet>]``);
 * dynamic: ``mean_force`` gives K_gamma from the mean forces of the settled run; the
   peak-based ``cycle_peak``, ``instantaneous`` and ``engineering`` give the same ratio of
   peak forces, a planet load-sharing coefficient that contains the dynamics (not
@@ -57,6 +58,10 @@ class PlanetLoadSharing:
         out = {key: max(self.per_stage.values())} if self.per_stage else {}
         out.update({f"{key}.{c}": v for c, v in self.per_stage.items()})
         out.update({f"{key}.{p}": v for p, v in self.per_planet.items()})
+        if self.peak_per_stage:  # quasi-static: the peak ratio beside K_gamma
+            out["planet_peak_instantaneous_ratio"] = max(self.peak_per_stage.values())
+            for who, v in (*self.peak_per_stage.items(), *self.peak_per_planet.items()):
+                out[f"planet_peak_instantaneous_ratio.{who}"] = v
         return out
 
 

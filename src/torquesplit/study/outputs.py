@@ -61,6 +61,9 @@ STATIC_DEFINITION = "static_torque"
 FAMILIES: dict[str, tuple[str, str]] = {
     "load_sharing": ("1", "load-sharing coefficient"),
     "planet_load_sharing": ("1", "planet load-sharing factor (largest planet over the mean)"),
+    "planet_peak_instantaneous_ratio": ("1", "largest instantaneous planet load ratio over "
+                                            "the mesh positions (Mo et al. 2017), not "
+                                            "K_gamma"),
     "dynamic_factor": ("1", "dynamic load factor (peak / own static force)"),
     "dynamic_factor_engineering": ("1", "engineering dynamic factor (mean cycle peak / own "
                                         "static force)"),
@@ -192,6 +195,10 @@ def available_outputs(mesh_names, groups: dict[str, list[str]], analysis: str,
             for carrier, members in planets.items():
                 names += [f"planet_load_sharing.{d}.{x}" for x in (carrier, *members)]
     if analysis == "static":
+        if planets:
+            names.append("planet_peak_instantaneous_ratio")
+            for carrier, members in planets.items():
+                names += [f"planet_peak_instantaneous_ratio.{x}" for x in (carrier, *members)]
         for fam in ("peak_force", "min_force", "mean_force"):
             names += [f"{fam}.{m}" for m in mesh_names]
         return names
