@@ -80,3 +80,84 @@ def test_a_sweeps_critical_speeds_do_not_depend_on_the_files_speed():
         out.append(ds.attrs["critical_speeds_rpm"])
     assert len(out[0]) >= 1
     np.testing.assert_allclose(out[1], out[0], rtol=1e-9)
+
+
+def _state(model, speed=None):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return steady_state(model, speed=speed, method="shooting", stability=False)
+
+
+def test_the_statics_metrics_and_exports_of_a_state_at_another_speed_are_that_speeds():
+    """A state solved at another speed than the file's took its static equilibrium (the
+    carrier's centrifugal loads, so every dynamic factor), its exported cycles and mesh
+    frequencies and its near-critical-speed note from the file's speed: the --out file
+    disagreed with the printed table (a reviewer's finding).  Each now equals the state
+    of the file written at that speed."""
+    asked = _state(_stage("10000 rpm"), "3000 rpm")
+    at_file = _state(_stage("3000 rpm"))
+    # the static equilibrium, and the static forces the dynamic factors divide by
+    np.testing.assert_allclose(asked.static.q, at_file.static.q, rtol=1e-9, atol=1e-15)
+    rows = {r.mesh: r for r in asked.mesh_table()}
+    for r in at_file.mesh_table():
+        for field in ("static_force", "dynamic_factor", "mean_force", "peak_force"):
+            assert getattr(rows[r.mesh], field) == pytest.approx(getattr(r, field),
+                                                                 rel=1e-7), field
+    # and the frame terms change them here: 10000 rpm's statics are not 3000 rpm's
+    own = _state(_stage("10000 rpm"))
+    assert np.max(np.abs(own.static.q - at_file.static.q)) > 1e-3 * np.max(
+        np.abs(at_file.static.q))
+    # the record a run's exports are made of: its cycles and mesh frequencies
+    ra, rf = asked.to_results(), at_file.to_results()
+    assert ra.solution.cycle_count.sum(axis=0).tolist() == \
+        rf.solution.cycle_count.sum(axis=0).tolist()
+    da, df = ra.to_dataset(), rf.to_dataset()
+    np.testing.assert_allclose(da["mesh_frequency"].values, df["mesh_frequency"].values,
+                               rtol=1e-12)
+    for var in ("mean_force", "static_displacement"):
+        np.testing.assert_allclose(da[var].values, df[var].values, rtol=1e-7,
+                                   atol=1e-9 * float(np.max(np.abs(df[var].values))))
+
+
+def test_the_critical_speed_note_of_a_state_at_another_speed_uses_that_speeds_modes():
+    """The note named mode 18 at 7174.9 Hz, its frequency at the file's 3000 rpm, where
+    at 4500 rpm it is 7177.7 Hz (the differential example, driven by the torque of its
+    50 kW at 3000 rpm: the same loads at both speeds)."""
+    def model(speed):
+        raw = read_raw(torquesplit.example_path("split_path_planetary_differential"))
+        drive = raw["drives"]["motor"]
+        drive.pop("power")
+        drive.update(torque=f"{50e3 / (3000 * np.pi / 30)!r} N m", speed=speed)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            return torquesplit.load_model(raw)
+
+    import re
+
+    def notes(st):  # (which planet's mesh of a symmetric stage leads a mode: any)
+        return [re.sub(r"planet\d", "planet#", n) for n in st.critical_notes()]
+
+    asked = notes(_state(model("3000 rpm"), "4500 rpm"))
+    at_file = notes(_state(model("4500 rpm")))
+    assert len(at_file) == 1 and "mode 18 (7177.7 Hz" in at_file[0]
+    assert asked == at_file
+
+
+def test_a_sweeps_dynamic_factors_divide_by_each_speeds_static_force():
+    """The sweep divided every point's peak by the static force at the file's speed
+    (the carrier's centrifugal loads of that speed)."""
+    from torquesplit.steady.maps import sweep_speed
+
+    rpm = np.pi / 30
+    out = []
+    for speed in ("3000 rpm", "10000 rpm"):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            ds = sweep_speed(_stage(speed, SMOOTH), 2990 * rpm, 3000 * rpm, points=3,
+                             method="hb", stability=False)
+        out.append(ds.sel(point=0))
+    assert float(out[0].speed_rpm) == pytest.approx(2990, rel=1e-12)
+    assert float(out[1].speed_rpm) == pytest.approx(2990, rel=1e-12)
+    np.testing.assert_allclose(out[1].peak_force.values, out[0].peak_force.values, rtol=1e-7)
+    np.testing.assert_allclose(out[1].dynamic_factor.values, out[0].dynamic_factor.values,
+                               rtol=1e-7)

@@ -185,11 +185,10 @@ class FrameTermsAt:
         self.loads = structure.external_force - own  # (without the centrifugal forces)
 
     def __call__(self, factor: float):
-        import dataclasses
+        from ..model.kinematics import kinematics_at
 
-        s, kin = self.structure, self.kin
-        scaled = dataclasses.replace(kin, bodies={
-            n: dataclasses.replace(b, speed=b.speed * factor) for n, b in kin.bodies.items()})
+        s = self.structure
+        scaled = kinematics_at(self.kin, factor)
         ext = np.zeros(s.n_dof)
         try:
             frame, gyro = rotating_frame_terms(scaled, self.dmap, ext, self.stiff)

@@ -237,6 +237,24 @@ def bearing_frame(kin, body: str) -> str:
 
 
 # --------------------------------------------------------------------------- solver
+def kinematics_at(kin: Kinematics, factor: float) -> Kinematics:
+    """``kin`` at ``factor`` times every speed with the torques held (a speed change at
+    constant load, as the steady state at another speed and a speed sweep take it): body
+    and mesh speeds, powers and mesh frequencies scaled; forces and torques unchanged."""
+    if factor == 1.0:
+        return kin
+    from dataclasses import replace
+
+    bodies = {n: replace(b, speed=b.speed * factor, power=b.power * factor)
+              for n, b in kin.bodies.items()}
+    meshes = {n: replace(m, frequency=m.frequency * factor, power=m.power * factor,
+                         driver_speed=m.driver_speed * factor,
+                         driven_speed=m.driven_speed * factor)
+              for n, m in kin.meshes.items()}
+    return replace(kin, bodies=bodies, meshes=meshes, input_power=kin.input_power * factor,
+                   output_power=kin.output_power * factor)
+
+
 def solve_kinematics(model) -> Kinematics:
     """Layout, speeds, power flow, torques and forces of the nominal equal split.
 

@@ -223,12 +223,10 @@ def damping_pull(results, metrics) -> list[tuple[str, str]]:
 def resonance(results, metrics) -> list[tuple[str, str]]:
     """Meshes whose dynamic factor exceeds :data:`RESONANCE_FACTOR`."""
     out = []
-    kin = results.kinematics
-    steady = getattr(results, "steady", None)  # a steady state at another speed: its own
-    factor = steady.solution.speed if steady is not None else 1.0  # mesh frequencies
+    kin = results.kinematics  # (a steady state's: at the speed it was solved at)
     for r in metrics.rows:
         if math.isfinite(r.dynamic_factor) and r.dynamic_factor > RESONANCE_FACTOR:
-            f = kin.meshes[r.mesh].frequency * factor
+            f = kin.meshes[r.mesh].frequency
             out.append((f"meshes.{r.mesh}", (
                 f"dynamic factor {r.dynamic_factor:.3g} (settled peak {_kn(r.peak_force)} / "
                 f"static {_kn(r.static_force)}): the run is near a resonance (mesh "

@@ -170,6 +170,8 @@ class SteadyState:
         self.options = dict(options or {})
         self.kinematics = kinematics
         self.structure = structure
+        #: the static equilibrium at the speed solved (a turning carrier's centrifugal
+        #: loads are that speed's)
         self.static = static
         #: the excitations kept and their orders, at the model's own speed: its
         #: ``period.period`` is the model speed's; the period solved, at the speed asked,
@@ -178,6 +180,16 @@ class SteadyState:
         self.solution: PeriodicSolution = solution
         self.dropped = dropped
         self.problem: PeriodicProblem = problem
+        # the model at the speed solved (torques held): what the metrics, the exports
+        # and the critical speeds of this state read; ``kinematics`` and ``structure``
+        # are the model's own speed's, which the solver scales (``solution.speed``)
+        from torquesplit.model.kinematics import kinematics_at
+
+        factor = solution.speed
+        #: :attr:`kinematics` at the speed solved
+        self.kinematics_at = kinematics_at(kinematics, factor)
+        #: :attr:`structure` at the speed solved (:meth:`PeriodicProblem.structure_at`)
+        self.structure_at = problem.structure_at(factor)
 
     @property
     def period_s(self) -> float:
@@ -270,10 +282,11 @@ class SteadyState:
         metrics take every complete cycle of whole periods (``Results.periodic``)."""
         from torquesplit.results import Results
 
-        shell = Results(model=self.model, kinematics=self.kinematics,
-                        structure=self.structure, static=self.static, solution=None)
+        kin, s = self.kinematics_at, self.structure_at  # (at the speed solved)
+        shell = Results(model=self.model, kinematics=kin, structure=s, static=self.static,
+                        solution=None)
         sol = _as_solution(self, shell, periods)
-        res = Results(model=self.model, kinematics=self.kinematics, structure=self.structure,
+        res = Results(model=self.model, kinematics=kin, structure=s,
                       static=self.static, solution=sol, periodic=True,
                       period=self.solution.period)
         res.steady = self
@@ -289,8 +302,11 @@ class SteadyState:
         if self._critical is None:
             from torquesplit.steady.maps import near_critical_notes
 
+            # (the modes at the speed solved; the excitation lines per unit speed are
+            # the model's own)
             self._critical = near_critical_notes(
-                self.model, self.structure, self.static.q, self.kinematics,
+                self.model, self.problem.structure_at(self.solution.speed, frequencies=False),
+                self.static.q, self.kinematics,
                 speed=self.solution.speed * reference_speed(self.model))
         return self._critical
 
@@ -351,8 +367,9 @@ class SteadyState:
             vmax, vmin = np.full(1, -np.inf), np.full(1, np.inf)
             if self.solution.method != "hb":  # (a truncated series rings between samples)
                 t_c, f_c, d_c = corner_columns(self.solution, e)
-                vmax, vmin = between_samples(t, f, d, half_gaps(self.structure, e, t), T,
-                                             t_c, f_c, d_c, half_gaps(self.structure, e, t_c),
+                s = self.structure_at  # (the gap sequences at the speed solved)
+                vmax, vmin = between_samples(t, f, d, half_gaps(s, e, t), T,
+                                             t_c, f_c, d_c, half_gaps(s, e, t_c),
                                              kinks=kinks)
             peak = float(max(f.max(), Fc[:, e].max(initial=-np.inf), vmax.max()))
             least = float(min(f.min(), Fc[:, e].min(initial=np.inf), vmin.min()))
@@ -492,6 +509,14 @@ def _steady_state(model, *, method, harmonics, samples, keep, speed, max_cycles,
 
     warn_undamped(structure, static.q)
     problem = periodic_problem(model, kin, structure, per.frequency)
+    if factor != 1.0 and structure.metadata.get("rotating_frame"):
+        # a turning carrier's centrifugal loads at the speed asked: the equilibrium the
+        # state starts from and its static forces (the dynamic factors) are that speed's
+        static = static_equilibrium(problem.structure_at(factor, frequencies=False))
+        if not np.all(np.isfinite(static.q)):
+            raise SolverError(f"the static equilibrium at {factor:.6g} times the model's "
+                              f"speed failed (the carrier's centrifugal loads), so the "
+                              f"periodic state has no start; check the planet bearings.")
     sol = periodic_solution(structure, per, method=method, harmonics=harmonics,
                             samples=samples, speed=factor, q_static=static.q, initial=initial,
                             tol=tol, adaptive=adaptive, energy_tol=energy_tol,
@@ -735,7 +760,7 @@ def _as_solution(st: SteadyState, shell, periods):
     from torquesplit.assembly.structure import history_elements
     from torquesplit.solve.integrate import Solution
 
-    s = st.structure
+    s = st.structure_at  # (its frequencies at the speed solved: the cycles)
     ps = st.solution
     T = ps.period
     names = list(s.element_names)

@@ -201,13 +201,21 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
     meta = s.metadata["meshes"]
     groups = group_meshes({m: meta[m] for m in mesh_names})
     gcols = [[mesh_names.index(m) for m in g] for g in groups.values()]
-    static_f = np.array([static.element_forces[e] for e in track])
     nominal = np.array([kin.meshes[m].force for m in mesh_names])
+
+    def static_f(speed):  # the static forces at a point's speed (the dynamic factors)
+        if s.metadata.get("rotating_frame"):  # (a turning carrier's centrifugal loads)
+            from torquesplit.solve.static import static_equilibrium
+
+            at = static_equilibrium(problem.structure_at(speed, frequencies=False))
+            return np.array([at.element_forces[e] for e in track])
+        return np.array([static.element_forces[e] for e in track])
+
     if method == "shooting":
-        rows = [shooting_point_metrics(cont, p.x, p.speed, track, gcols, static_f, nominal)
-                for p in pts]
+        rows = [shooting_point_metrics(cont, p.x, p.speed, track, gcols, static_f(p.speed),
+                                       nominal) for p in pts]
     else:
-        rows = [point_metrics(hb, p.x, p.speed, track, gcols, static_f, nominal,
+        rows = [point_metrics(hb, p.x, p.speed, track, gcols, static_f(p.speed), nominal,
                               order=per.max_order) for p in pts]
     sp = np.array([p.speed for p in pts])
 
@@ -319,8 +327,9 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
         down, dn_rms = stepped_sweep(problem, per, static.q, grid[::-1],
                                      settle_periods=settle_periods, track=track)
         ds = ds.assign_coords(check_speed_rpm=("check", grid * w_ref * RPM))
-        ds["run_up_dynamic_factor"] = (("check", "mesh"), up / static_f)
-        ds["run_down_dynamic_factor"] = (("check", "mesh"), down[::-1] / static_f)
+        at_grid = np.array([static_f(g) for g in grid])
+        ds["run_up_dynamic_factor"] = (("check", "mesh"), up / at_grid)
+        ds["run_down_dynamic_factor"] = (("check", "mesh"), down[::-1] / at_grid)
         ds["run_up_rms_transmission_error"] = (("check", "mesh"), up_rms)
         ds["run_down_rms_transmission_error"] = (("check", "mesh"), dn_rms[::-1])
     return ds

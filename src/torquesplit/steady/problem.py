@@ -20,6 +20,7 @@ phase) do not.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 from concurrent.futures import ThreadPoolExecutor
@@ -130,6 +131,28 @@ class PeriodicProblem:
         # frame at that speed (assembly.rotating.FrameTermsAt); None: no turning frame
         self._frame_terms = frame_terms
         self._par_speed = 1.0  # the speed the generated code's parameters hold
+
+    def structure_at(self, speed: float, frequencies: bool = True) -> Structure:
+        """The structure at ``speed`` times the model's speed, as :meth:`model_at` runs
+        it: a turning carrier's Coriolis, centripetal and centrifugal terms at that speed
+        and, with ``frequencies``, every excitation frequency (and the meshes' in the
+        metadata) scaled: what the statics, the metrics and the exports of a state solved
+        at that speed read."""
+        key = float(speed)
+        s = self.structure
+        if key == 1.0:
+            return s
+        if self._frame_terms is not None:
+            gy, fs, ext = self._frame_terms(key)
+            s = dataclasses.replace(s, gy_coef=gy, fs_coef=fs, external_force=ext)
+        if not frequencies:
+            return s
+        from torquesplit.steady.period import scale_speed
+
+        meshes = {m: {**v, "frequency": v["frequency"] * key}
+                  for m, v in s.metadata.get("meshes", {}).items()}
+        return dataclasses.replace(scale_speed(s, key), metadata={**s.metadata,
+                                                                   "meshes": meshes})
 
     @property
     def nr(self) -> int:
