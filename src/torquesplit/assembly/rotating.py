@@ -15,26 +15,27 @@ Cooley & Parker 2012 eq. 1)::
   ``G_xy = -2 m Omega``, ``G_yx = +2 m Omega`` (Lin & Parker 1999, the 2 m Omega blocks
   of G);
 * centripetal softening ``-m Omega^2`` on every in-plane translation (Lin & Parker 1999
-  K_Omega = diag(m, m, 0) per body): entries ``-m Omega^2 V_k V_k^T`` of the frame
-  stiffness matrix K_f (generalized force -K_f q), V_k the body's displacement along
-  two orthonormal directions of the carrier's plane;
+  K_Omega = diag(m, m, 0) per body), of the displacement from where the carrier's
+  rotation theta_c takes the body's nominal position r0, u - theta_c a x r0: entries
+  ``-m Omega^2 V_k V_k^T`` of the frame stiffness matrix K_f (generalized force -K_f q),
+  V_k that displacement along two orthonormal directions of the carrier's plane (for the
+  members on the axis, r0 = 0: Lin & Parker's).  A rotation of the whole train only
+  shifts the nominal rotation and turns the centrifugal forces with it, so the kinematic
+  rigid rotation (the gear ratios') is an exact zero-frequency mode, which torques
+  balanced by the gear ratios do not load.  (The planets' absolute translations alone
+  would make it diverge; a geometric stiffness of the pin preload on the carrier's
+  rotation, used before, kept it at zero frequency with the planets turned by
+  (R + delta) / R of it, which balanced torques loaded by about m Omega^2 / k_t: a
+  torque-driven train's speed drifted.)  The geometric stiffness of the preloads (pins,
+  meshes) is left out consistently, terms of order m Omega^2 / k_t;
 * centrifugal force ``m Omega^2 r0`` (outwards, constant in the carrier frame) on the
   translations of a body off the axis (the planets), an external force;
-* the geometric stiffness of that preload in the planet's pin, ``P R`` on the carrier's
-  rotation (one K_f entry on the carrier's rotation for all its planets; R the pin
-  radius, P = m Omega^2 R k_t / (k_t - m Omega^2) the static centrifugal load of a
-  bearing of stiffness k_t along the pin's tangent): when the
-  carrier turns by theta the pin, and the preload with it, turns too.  With it the rigid
-  rotation of carrier, sun and planets stays a zero-frequency mode in the turning frame
-  (it is only a shift of the nominal rotation).  The lumped models in the literature
-  omit it; their examples hold every member torsionally (Cooley & Parker 2012), where
-  it is a small correction.  The radial preload of the meshes is left out.
 * A planet without translations sits rigidly on its pin: its mass is carried by the
   carrier (translations and ``m R^2`` on its rotation, assembly/assemble.py) and so are
   its rotating-frame terms and centrifugal force.  A gear without translations on the
   shaft of a planet that has them (a compound planet) moves with that planet: its mass
   joins the planet's in these terms.  A gear with translations on a bearing on the planet
-  loads the pin through that bearing: its static share enters the planet's pin preload.
+  loads the pin through that bearing, which must be stiffer than that gear's softening.
 
 The bodies' rotations need no term (planar model, all axes parallel to a).
 """
@@ -61,15 +62,14 @@ def rotating_frame_terms(kin, dmap, ext: np.ndarray, pin_stiffness=None):
     carrier's frame; adds the centrifugal forces to ``ext`` in place.
 
     ``pin_stiffness(body, direction)`` gives the stiffness of a planet's bearing along
-    a unit direction (for the pin-preload term).  Returns ``(frame_stiffness,
-    gyroscopic)``, lists of ``(i, j, value)`` for
+    a unit direction (to refuse a bearing softer than the centrifugal softening).
+    Returns ``(frame_stiffness, gyroscopic)``, lists of ``(i, j, value)`` for
     :func:`~torquesplit.assembly.structure.build_structure`: the inertial terms are not
     elements (they carry no force of their own), so they cost one multiply-add per entry.
     """
     frame: list[tuple[int, int, float]] = []
     gyro: list[tuple[int, int, float]] = []
     # planets rigid on their pins (no translations) move with their carrier
-    preload: dict[str, list] = {}  # carrier -> [its rotation DOF, sign, stiffness]
     rigid_pins: dict[str, list[str]] = {}
     # gears without translations on the shaft of a planet that has them (a compound
     # planet) move with that planet (``dmap.host``)
@@ -100,9 +100,18 @@ def rotating_frame_terms(kin, dmap, ext: np.ndarray, pin_stiffness=None):
                 if abs(g) > 1e-14 * 2.0 * m * abs(omega):
                     gyro.append((i, j, g))
         # centripetal softening -m Omega^2 in the carrier's plane (Lin & Parker 1999
-        # K_Omega): -m Omega^2 (V_k V_k^T) for the projection V_k of each in-plane direction
+        # K_Omega): -m Omega^2 (V_k V_k^T) for the projection V_k of each in-plane
+        # direction, of the displacement from where the carrier's rotation theta_c takes
+        # the body's nominal position r0 (theta_c a x r0): a rigid rotation of the train
+        # only shifts the nominal rotation, and its centrifugal forces turn with it
+        r_nom = kin.bodies[body].position - cb.position
+        r_nom = r_nom - a * float(r_nom @ a)
+        idx_c, s_c = dmap.theta.get(carrier, (-1, 1.0))
+        turn = cross(a, r_nom) if body != carrier and idx_c >= 0 else None
         for e in in_plane_basis(a):
             rows = dmap.project(body, e, 1.0, tol=1e-15)
+            if turn is not None and abs(float(e @ turn)) > 0.0:
+                rows = [*rows, (idx_c, -s_c * float(e @ turn))]
             for i, ci in rows:
                 for j, cj in rows:
                     frame.append((i, j, -m * omega**2 * ci * cj))
@@ -116,42 +125,23 @@ def rotating_frame_terms(kin, dmap, ext: np.ndarray, pin_stiffness=None):
             if float(np.linalg.norm(r0)) > 0.0:
                 for j, c in dmap.project(body, mb * omega**2 * r0, 1.0, tol=0.0):
                     ext[j] += c
-        # the planet's centrifugal preload P in its pin turns with the carrier: geometric
-        # stiffness P R on the carrier's rotation, P = m Omega^2 R k_t / (k_t - m Omega^2)
-        # the bearing's static share (k_t its stiffness along the pin's tangent); without
-        # it the rigid rotation of carrier and planets would soften
+        # a planet's bearing must be stiffer than the centrifugal softening of what it
+        # holds (the planet, and a gear on a bearing on it: statically a softening
+        # s_i = k_i m_i Omega^2 / (k_i - m_i Omega^2)), or its static preload has no bound
         if body in kin.planet_bodies and body != carrier and pin_stiffness is not None:
-            c_name = kin.planet_bodies[body]
-            idx, s_c = dmap.theta.get(c_name, (-1, 1.0))
-            r = kin.bodies[body].position - kin.bodies[c_name].position
-            r0 = r - a * float(r @ a)
-            big_r = float(np.linalg.norm(r0))
-            tangent = cross(a, r0 / big_r) if big_r > 0 else None
+            big_r = float(np.linalg.norm(r_nom))
+            tangent = cross(a, r_nom / big_r) if big_r > 0 else None
             k_t = pin_stiffness(body, tangent) if big_r > 0 else None
-            if idx >= 0 and k_t is not None:
-                soft, load = m * omega**2, m * omega**2 * big_r
-                # a body with translations on a bearing on this planet (a compound
-                # planet's other gear) loads the pin through that bearing k_i: statically
-                # as a softening s_i = k_i m_i Omega^2 / (k_i - m_i Omega^2) at its radius
+            if k_t is not None:
+                soft = m * omega**2
                 for b, k_i in getattr(pin_stiffness, "seated", lambda *_: [])(body, tangent):
-                    m_i = kin.bodies[b].mass
-                    soft_i = m_i * omega**2
+                    soft_i = kin.bodies[b].mass * omega**2
                     _stiffer_than_spin(f"gears.{b}.support", f"the bearing of {b!r} on the "
                                        f"planet {body!r} ({k_i:.3g} N/m)", k_i, soft_i, "")
-                    r_i = kin.bodies[b].position - kin.bodies[c_name].position
-                    s_i = k_i * soft_i / (k_i - soft_i)
-                    soft += s_i
-                    load += s_i * float(np.linalg.norm(r_i - a * float(r_i @ a)))
+                    soft += k_i * soft_i / (k_i - soft_i)
                 _stiffer_than_spin(f"gears.{body}.support", f"the planet's bearing "
                                    f"({k_t:.3g} N/m along its pin's tangent)", k_t, soft,
                                    ": it would fly off its pin")
-                # P R, P = k_t delta the pin bearing's static load (delta = load / (k_t -
-                # soft); one planet body: m Omega^2 R k_t / (k_t - m Omega^2))
-                preload.setdefault(c_name, [idx, s_c, 0.0])[2] += \
-                    big_r * k_t * load / (k_t - soft)
-    # the pin preloads of all the planets of a carrier, on its rotation
-    for c_name, (idx, s_c, k) in preload.items():
-        frame.append((idx, idx, k * s_c * s_c))
     return frame, gyro
 
 
@@ -168,8 +158,8 @@ class FrameTermsAt:
     """The rotating-frame terms of ``structure`` at ``factor`` times the model's speeds
     (a speed sweep at constant load), called as ``terms(factor) -> (gy_coef, fs_coef,
     external_force)`` in the structure's own order.  Coriolis scales with the carrier's
-    speed, centripetal softening and centrifugal force with its square, the planets' pin
-    preload as m Omega^2 R k_t / (k_t - m Omega^2): recomputed, not scaled.  The drive and
+    speed, centripetal softening and centrifugal force with its square: recomputed, not
+    scaled (the bearings are checked against the softening at that speed).  The drive and
     load torques stay the file's (the model's own centrifugal forces are taken out of the
     structure's external forces once, here)."""
 

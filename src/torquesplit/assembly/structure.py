@@ -159,7 +159,7 @@ class Structure:
     """(n_dof + 1,) int64, or empty for none: the frame stiffness matrix K_f by row (CSR).
     The generalized force on DOF i is ``-sum_j K_f,ij q_j``: the inertial stiffness of a
     turning frame (centripetal softening -m Omega^2 of a body's in-plane translations,
-    the geometric stiffness of a planet's centrifugal pin preload).  Not an element: it
+    measured from where the carrier's rotation takes its nominal position).  Not an element: it
     holds nothing and carries no force of its own."""
     fs_idx: np.ndarray = field(default_factory=_empty_int)
     """(n_fs,) int64 column (DOF) of each entry of K_f."""
