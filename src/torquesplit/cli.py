@@ -606,8 +606,10 @@ def _print_run(m, res, met, saved, figures, step_check, plots, as_json) -> None:
     ``planet_load_sharing``; a model without planets has neither."""
     planets = ux.planet_sharing(met.load_sharing, res.kinematics)
     if as_json:
+        metrics = met.to_dict()
+        rows = list(metrics["meshes"].values())
         ux.emit_json({"model": m.model.name, "success": res.success,
-                      "metrics": met.to_dict(),
+                      "metrics": metrics,
                       **({"planet_load_sharing": ux.planet_sharing_dict(planets)}
                          if planets else {}),
                       "statistics": res.statistics(),
@@ -617,7 +619,11 @@ def _print_run(m, res, met, saved, figures, step_check, plots, as_json) -> None:
                       "results_files": [str(f) for f in saved],
                       "figures": [str(f) for f in figures],
                       **({"step_check": step_check.to_dict()} if step_check else {}),
-                      "units": ux.MESH_UNITS},
+                      # SI, of exactly the keys the rows have (it listed an RMS
+                      # transmission error that a run does not give, a reviewer)
+                      "units": {**{k: u for k, u in ux.MESH_UNITS.items()
+                                   if k == "settle_time_s" or any(k in r for r in rows)},
+                                **({"planet_load_sharing": "1"} if planets else {})}},
                      _json_default)
     else:
         _render_run(res, met, saved, planets)
@@ -885,7 +891,33 @@ def bearing_table(bearings: list[dict], res) -> Table:
                 f"{r['body']} (rigid bearing)" if r.get("held") == "rigid" else r["body"])
         b.add_row(body, means, kn(r["mean_magnitude"]), kn(r["peak_magnitude"]),
                   *([frame] if turning else []))
+    spin = _centrifugal_loads(res.kinematics, [r["body"] for r in bearings])
+    if spin:  # (4.49 kN on a planet's bearing with 0.59 kN tooth forces: a reviewer)
+        b.caption = f"the planets' mean forces include their centrifugal force m Ω_c² r: {spin}"
+        b.caption_justify = "left"
     return b
+
+
+def _centrifugal_loads(kin, bodies) -> str:
+    """``"stage_planet1 4.4897 kN, ..."``: the centrifugal force m Omega_c^2 r of each
+    planet among ``bodies`` whose carrier turns (one value where they are all equal)."""
+    import numpy as np
+
+    out = {}
+    for body in bodies:
+        carrier = kin.planet_bodies.get(body)
+        if carrier is None or not kin.bodies[carrier].speed:
+            continue
+        c = kin.bodies[carrier]
+        a = c.axis / np.linalg.norm(c.axis)
+        r = kin.bodies[body].position - c.position
+        r = float(np.linalg.norm(r - a * float(r @ a)))
+        out[body] = kin.bodies[body].mass * c.speed ** 2 * r
+    if not out:
+        return ""
+    if max(out.values()) - min(out.values()) <= 1e-9 * max(out.values()):
+        return f"{next(iter(out.values())) / 1e3:#.5g} kN each"
+    return ", ".join(f"{b} {v / 1e3:#.5g} kN" for b, v in out.items())
 
 
 def group_table(met) -> Table:

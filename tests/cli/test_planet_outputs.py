@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 
 import numpy as np
+import pytest
 from typer.testing import CliRunner
 
 from torquesplit.cli import app
@@ -19,7 +20,7 @@ def test_the_bearing_table_says_which_frame_its_directions_are_in():
     res = CliRunner().invoke(app, ["run", EXAMPLE, "--cycles", "30"])
     assert res.exit_code == 0, res.output
     table = res.stdout[res.stdout.index("bearing forces"):]
-    assert "directions in" in table and "carrier stage_carrier (turning)" in table
+    assert "directions in" in table and "turning with stage_carrier" in table
 
 
 def test_the_bearing_rows_of_the_files_say_their_frame_too(tmp_path):
@@ -32,7 +33,7 @@ def test_the_bearing_rows_of_the_files_say_their_frame_too(tmp_path):
     assert res.exit_code == 0, res.output
     rows = json.loads(res.stdout)["bearing_forces_N"]
     frames = {r["body"]: r["frame"] for r in rows}
-    assert frames["stage_planet1"] == "carrier stage_carrier (turning)", frames
+    assert frames["stage_planet1"] == "turning with stage_carrier", frames
     path = next(tmp_path.glob("*bearings.csv"))
     table = list(csv.DictReader(path.read_text().splitlines()))
     assert {r["body"]: r["frame"] for r in table} == frames
@@ -41,7 +42,7 @@ def test_the_bearing_rows_of_the_files_say_their_frame_too(tmp_path):
     assert res.exit_code == 0, res.output
     html = (tmp_path / "rep.html").read_text()
     bearings = html[html.index("<h3>Bearing forces</h3>"):]
-    assert "directions in" in bearings and "carrier stage_carrier (turning)" in bearings
+    assert "directions in" in bearings and "turning with stage_carrier" in bearings
 
 
 def test_a_planet_factor_that_counts_pulling_teeth_says_so():
@@ -94,7 +95,7 @@ def test_a_held_ring_has_its_reaction_in_the_carriers_frame(tmp_path):
         mesh = max(abs(r.mean_force) for r in res.metrics().rows)
         # every row in the carrier's frame here (the floating sun's too): the bearings
         # hold the whole stage, so their mean forces add up to nothing
-        assert {r["frame"] for r in rows.values()} == {"carrier st_carrier (turning)"}
+        assert {r["frame"] for r in rows.values()} == {"turning with st_carrier"}
         total = np.sum([r["mean"] for r in rows.values()], axis=0)
         assert np.abs(total).max() < 1e-3 * mesh, total
         return rows["st_ring"], mesh
@@ -103,3 +104,45 @@ def test_a_held_ring_has_its_reaction_in_the_carriers_frame(tmp_path):
     assert ring["held"] == "rigid" and ring["mean_magnitude"] < 1e-6 * mesh
     ring, mesh = ring_row('pin_errors = [{tangential = "20 um"}, {}, {}]\n')
     assert ring["mean_magnitude"] > 0.1 * mesh  # (0.23 of it: 1.44 kN, as the sun's)
+
+
+def test_check_says_which_frame_a_planet_mesh_and_speed_are_in():
+    """The differential's sun meshes read 'stage_planet1->stage_sun' with 1.56 kW each,
+    as an output would: that is the flank the teeth drive in the carrier's frame.  The
+    table marks those meshes and says so; the JSON names each mesh's frame; a planet's
+    speed on its pin (its bearing's) is beside its absolute one; an idler puts in no
+    power (a planet read 5.7 kW: one mesh's torque times its speed)."""
+    res = CliRunner().invoke(app, ["check", "split_path_planetary_differential"])
+    assert res.exit_code == 0, res.output
+    out = " ".join(res.stdout.split())
+    assert "stage_planet1->stage_sun *" in out and "path_a pinion_a->sun_wheel *" not in out
+    assert "* in the frame turning with stage_carrier: the driving flank" in out
+    assert "-2200 (-600 on its pin)" in out
+    res = CliRunner().invoke(app, ["check", "split_path_planetary_differential", "--json"])
+    s = json.loads(res.stdout)
+    assert s["meshes"]["stage_sun_planet1"]["frame"] == "turning with stage_carrier"
+    assert s["meshes"]["path_a"]["frame"] == "housing"
+    planet = s["bodies"]["stage_planet1"]
+    # -2200 rpm absolute, the carrier at -1600 rpm: -600 rpm on the pin
+    assert planet["speed_relative_to_carrier_rpm"] == pytest.approx(-600.0, rel=1e-12)
+    assert planet["carrier"] == "stage_carrier" and planet["power_kW"] == 0.0
+    assert "speed_relative_to_carrier_rpm" not in s["bodies"]["stage_sun"]
+
+
+def test_the_run_says_what_a_planets_bearing_carries(tmp_path):
+    """4.49 kN on a planet's bearing beside 0.59 kN tooth forces: its centrifugal force
+    m Omega_c^2 r (1.7756 kg, 1600 rpm, 90 mm), said under the table; the JSON's units
+    are those of the keys it has (it listed an RMS transmission error a run has not)."""
+    res = CliRunner().invoke(app, ["run", "split_path_planetary_differential",
+                                   "--cycles", "30"])
+    assert res.exit_code == 0, res.output
+    out = " ".join(res.stdout.split())
+    m = 1.7756
+    assert "include their centrifugal force m Ω_c² r: 4.486" in out
+    assert m * (1600 * np.pi / 30) ** 2 * 0.090 == pytest.approx(4486, rel=2e-4)
+    res = CliRunner().invoke(app, ["run", EXAMPLE, "--cycles", "30", "--json"])
+    d = json.loads(res.stdout)
+    assert "rms_transmission_error" not in d["units"]
+    assert d["units"]["planet_load_sharing"] == "1" and d["units"]["peak_force"] == "N"
+    assert set(d["units"]) - {"settle_time_s", "planet_load_sharing"} <= set(
+        next(iter(d["metrics"]["meshes"].values())))

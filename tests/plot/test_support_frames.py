@@ -62,7 +62,7 @@ def test_the_spectrum_names_the_frame_and_marks_relative_speeds(run):
 def test_the_dataset_says_the_frame_of_each_force(run):
     ds = results_to_dataset(run)
     frames = dict(zip(ds["element"].values, ds["element_frame"].values))
-    assert frames["st_planet1.support.x"] == "carrier st_carrier (turning)"
-    assert frames["st_sun.support.y"] == "carrier st_carrier (turning)"
+    assert frames["st_planet1.support.x"] == "turning with st_carrier"
+    assert frames["st_sun.support.y"] == "turning with st_carrier"
     assert frames["st_sun_planet1"] == ""
     assert "turning carrier" in ds["element_frame"].attrs["long_name"]

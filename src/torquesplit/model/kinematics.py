@@ -228,12 +228,19 @@ def support_frame(kin, body: str) -> tuple[str | None, float | None, float]:
             w_frame / (2 * math.pi))
 
 
+def frame_label(carrier: str | None) -> str:
+    """A force's frame in words: ``"housing"``, or ``"turning with NAME"`` for axes fixed
+    to the turning carrier NAME (it read "carrier NAME (turning)": "carrier stage_carrier
+    (turning)" on a sun's bearing to the housing, a reviewer)."""
+    return f"turning with {carrier}" if carrier else "housing"
+
+
 def bearing_frame(kin, body: str) -> str:
-    """The frame a body's bearing force is written in, in words: ``"housing"``, or
-    ``"carrier NAME (turning)"`` for a body whose translations are measured in a turning
-    carrier's frame (:func:`support_frame`)."""
+    """The frame a body's bearing force is written in (:func:`frame_label`): the housing,
+    or a turning carrier for a body whose translations are measured in its frame
+    (:func:`support_frame`)."""
     carrier, _, turning = support_frame(kin, body)
-    return f"carrier {carrier} (turning)" if carrier and turning else "housing"
+    return frame_label(carrier if turning else None)
 
 
 # --------------------------------------------------------------------------- solver

@@ -16,7 +16,7 @@ def summary(model: Model) -> dict:
     """A JSON-serialisable summary: speeds, torques, mesh frequencies, geometry, forces."""
     from ..assembly.excitation import stage_labels
 
-    from .kinematics import mass_basis
+    from .kinematics import frame_label, mass_basis
 
     kin = solve_kinematics(model)
     stages = stage_labels(model, kin)
@@ -24,10 +24,17 @@ def summary(model: Model) -> dict:
     roles = _roles(model)
     bodies = {}
     for name, b in kin.bodies.items():
+        carrier = kin.planet_bodies.get(name)
         bodies[name] = {
-            "speed_rpm": b.speed * RPM,
+            "speed_rpm": b.speed * RPM,  # (absolute: in the housing's frame)
+            # a planet's speed on its pin (its bearing's), relative to its carrier
+            **({"carrier": carrier,
+                "speed_relative_to_carrier_rpm": (b.speed - kin.bodies[carrier].speed) * RPM}
+               if carrier else {}),
             "torque_Nm": b.torque,
-            "power_kW": b.power / 1e3,
+            # (an idler passes power on: none is put in or taken out; its torque times
+            # its speed read as 5.7 kW on a planet, a reviewer)
+            "power_kW": 0.0 if name in idlers else b.power / 1e3,
             "mass_kg": b.mass,
             "polar_inertia_kgm2": b.polar_inertia,
             "mass_computed": b.mass_computed,
@@ -41,7 +48,11 @@ def summary(model: Model) -> dict:
         }
     meshes = {}
     for name, mk in kin.meshes.items():
+        turning = mk.carrier if mk.carrier and kin.bodies[mk.carrier].speed else None
         meshes[name] = {
+            # the frame of the driving flank, the frequency and the power: a turning
+            # carrier's for the meshes of its planets (speeds relative to it)
+            "frame": frame_label(turning),
             "driver": mk.driver,
             "driven": mk.driven,
             "stage": stages[name],
@@ -128,19 +139,25 @@ def render_summary(s: dict, console) -> None:
     console.print(
         f"input {s['input_power_kW']:.6g} kW, output {s['output_power_kW']:.6g} kW, "
         f"balance (input - output) / input: {balance}", highlight=False)
-    t = Table(title="bodies ((computed): from the gear's geometry; (placed): from its mates)")
+    planets = any("speed_relative_to_carrier_rpm" in b for b in s["bodies"].values())
+    t = Table(title="bodies ((computed): from the gear's geometry; (placed): from its mates"
+                    + ("; speeds absolute, a planet's on its pin beside it)" if planets
+                       else ")"))
     for col in ("body", "speed [rpm]", "torque [N m]", "mass [kg]", "J [kg m²]",
                 "position [mm]"):
         t.add_column(escape(col), justify="right" if col not in ("body", "position [mm]")
                      else "left")
     for name, b in s["bodies"].items():
+        speed = f"{b['speed_rpm']:.6g}" + (
+            f" ({b['speed_relative_to_carrier_rpm']:.6g} on its pin)"
+            if "speed_relative_to_carrier_rpm" in b else "")
         basis = f": {b['computed_from']}" if (b.get("computed_from") or "").startswith("rim") \
             else ""
         mark = lambda flag, note="": f" (computed{note})" if flag else ""  # noqa: E731
         pos = "(" + ", ".join(f"{round(v, 4) + 0.0:.6g}" for v in b["position_mm"]) + ")"
         torque = f"{b['torque_Nm']:.6g}" + (" per mesh (idler: net 0)" if b.get("idler")
                                              else f" ({b['role']})" if b.get("role") else "")
-        t.add_row(name, f"{b['speed_rpm']:.6g}", torque,
+        t.add_row(name, speed, torque,
                   (f"{b['mass_kg']:.5g}{mark(b['mass_computed'], basis)}" if b["mass_kg"]
                    else "-"),  # (a body that only turns needs no mass)
                   f"{b['polar_inertia_kgm2']:.5g}{mark(b['inertia_computed'])}",
@@ -155,9 +172,12 @@ def render_summary(s: dict, console) -> None:
                                                                    else ()):
         t.add_column(escape(col), justify="left" if col in ("mesh", "driver->driven", "stage",
                                                             "LOA n") else "right")
+    turning = sorted({m["frame"] for m in s["meshes"].values()} - {"housing"})
     for name, m in s["meshes"].items():
         fmt = lambda x: "-" if x is None else f"{x:.4f}"  # noqa: E731
-        t.add_row(name, f"{m['driver']}->{m['driven']}", m["stage"], f"{m['frequency_Hz']:.6g}",
+        mark = " *" if m["frame"] != "housing" else ""
+        t.add_row(name, f"{m['driver']}->{m['driven']}{mark}", m["stage"],
+                  f"{m['frequency_Hz']:.6g}",
                   "/".join(f"{r:.2f}" for r in m["base_radii_mm"]),
                   fmt(m["transverse_contact_ratio"]), fmt(m["overlap_contact_ratio"]),
                   fmt(m["total_contact_ratio"]),
@@ -165,6 +185,12 @@ def render_summary(s: dict, console) -> None:
                   f"{m['torque_driver_Nm']:.6g}", f"{m['tooth_force_N'] / 1e3:.5g}",
                   *([f"{m['axial_force_N'] / 1e3:.5g}"] if axial else []))
     console.print(t)
+    if turning:  # (a sun read as an output: its mesh's driver is the planet there)
+        console.print(
+            f"* in the frame {', '.join(turning)}: the driving flank and the mesh "
+            f"frequency are those the teeth see, with speeds relative to the carrier (the "
+            f"bodies table's speeds and torques give the power flow in the housing's frame)",
+            highlight=False)
     for a in s.get("accepted_warnings", ()):  # (the file's own, with its reason)
         console.print(f"accepted warning: {escape(a['field'])} ({escape(a['reason'])})",
                       highlight=False)

@@ -1258,7 +1258,14 @@ def _suptitle(fig, results, what: str) -> None:
     name = results.model.model.name
     note = "" if getattr(results, "success", True) else \
         f"\nrun stopped: {results.message}"
-    fig.suptitle(f"{name}: {what}{note}", fontsize=FONT["suptitle"])
+    # each line wrapped to the figure's width (a list of the bodies not drawn ran off
+    # both edges, a reviewer): about 0.55 em a character
+    import textwrap
+
+    width = max(40, int(fig.get_figwidth() * 72 / (0.55 * float(FONT["suptitle"]))))
+    text = "\n".join(textwrap.fill(line, width) or line
+                     for line in f"{name}: {what}{note}".split("\n"))
+    fig.suptitle(text, fontsize=FONT["suptitle"])
 
 
 def _nominal_lines(ax, values) -> None:

@@ -598,7 +598,7 @@ class Results:
         integrals of the mesh table: its samples' mean was 0.4 % off a mesh's mean force in
         the tutorial's model).  Forces are in the frame of the support (a
         turning carrier's for planets), which ``frame`` names: ``"housing"`` or
-        ``"carrier NAME (turning)"``.  A run without a whole cycle of some mesh has no
+        ``"turning with NAME"``.  A run without a whole cycle of some mesh has no
         settled part (its settle time is -inf): no rows.  ``metrics``: the run's
         :meth:`metrics` where the caller has them (they are not computed again)."""
         s = self.solution
@@ -1030,11 +1030,13 @@ def rigid_bearings(model, kin) -> dict[str, list[tuple[str, float]]]:
 def rigid_frame(kin, terms) -> str:
     """The frame a rigid bearing's force (:func:`rigid_bearings`) is written in: that of
     its meshes' lines of action, a turning carrier's where they turn with it."""
+    from ..model.kinematics import frame_label
+
     for m, _ in terms:
         c = kin.meshes[m].carrier
         if c and kin.bodies[c].speed:
-            return f"carrier {c} (turning)"
-    return "housing"
+            return frame_label(c)
+    return frame_label(None)
 
 
 def bearing_bodies(structure, model, kin=None) -> list[str]:

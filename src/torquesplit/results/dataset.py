@@ -47,7 +47,7 @@ def add_planet_load_sharing(ds: xr.Dataset, load_sharing, kinematics) -> xr.Data
 
 def element_frames(res, names: list[str]) -> list[str]:
     """Frame of each recorded element force (see the ``element_frame`` coordinate)."""
-    from ..model.kinematics import support_frame
+    from ..model.kinematics import frame_label, support_frame
 
     out = []
     for name in names:
@@ -56,7 +56,7 @@ def element_frames(res, names: list[str]) -> list[str]:
             out.append("")
             continue
         carrier, _, f_frame = support_frame(res.kinematics, body)
-        out.append(f"carrier {carrier} (turning)" if carrier and f_frame else "housing")
+        out.append(frame_label(carrier if f_frame else None))
     return out
 
 
