@@ -1845,6 +1845,15 @@ def modes(
                   "approximation, coupling of modes ignored); f_d = f sqrt(1 - zeta^2)"
                   + ("; whirl: FW/BW, the central members whirl with/against the carrier's "
                      "rotation in its frame" if whirls else ""), highlight=False)
+    turning = {c: v for c, v in carrier_rpm.items() if v} if rep.rotating_frame else {}
+    if turning:  # (frequencies of which frame: a reviewer with an accelerometer)
+        console.print(
+            "f: frequencies of the equations as assembled, the translations of a stage's "
+            "members measured in its turning carrier's frame: a translational mode at f "
+            "there is seen at f ± the carrier's rotation frequency ("
+            + ", ".join(f"{c} {abs(v) / 60:.4g} Hz" for c, v in turning.items())
+            + ") in the housing's frame; mesh frequencies of a stage are relative to its "
+            "carrier, as the teeth see them", highlight=False)
     if saved:
         console.print("modes written to " + ", ".join(str(f) for f in saved), highlight=False)
 

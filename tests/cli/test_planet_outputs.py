@@ -146,3 +146,17 @@ def test_the_run_says_what_a_planets_bearing_carries(tmp_path):
     assert d["units"]["planet_load_sharing"] == "1" and d["units"]["peak_force"] == "N"
     assert set(d["units"]) - {"settle_time_s", "planet_load_sharing"} <= set(
         next(iter(d["metrics"]["meshes"].values())))
+
+
+def test_modes_say_which_frame_their_frequencies_are_in():
+    """A turning carrier's translational modes are seen at f +- its rotation frequency on
+    the housing (1600 rpm: 26.67 Hz); the table did not say its f is the carrier
+    frame's.  A star stage (carrier at rest) has no such note."""
+    res = CliRunner().invoke(app, ["modes", "split_path_planetary_differential"])
+    assert res.exit_code == 0, res.output
+    out = " ".join(res.stdout.split())
+    assert "measured in its turning carrier's frame" in out
+    assert "(stage_carrier 26.67 Hz) in the housing's frame" in out
+    res = CliRunner().invoke(app, ["modes", "lin_parker1999_star"])
+    assert res.exit_code == 0, res.output
+    assert "turning carrier's frame" not in " ".join(res.stdout.split())
