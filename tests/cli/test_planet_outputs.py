@@ -160,3 +160,32 @@ def test_modes_say_which_frame_their_frequencies_are_in():
     res = CliRunner().invoke(app, ["modes", "lin_parker1999_star"])
     assert res.exit_code == 0, res.output
     assert "turning carrier's frame" not in " ".join(res.stdout.split())
+
+
+def test_the_csv_set_holds_the_cycle_ratios_and_the_planets(tmp_path):
+    """The cycle table left out the per-cycle extremes of the instantaneous load-sharing
+    ratio the .nc has, and the about file the planets' factors and bearing forces that
+    --json gives (a reviewer of the outputs)."""
+    import csv
+
+    import xarray as xr
+
+    for out in ("r.csv", "r.nc"):
+        res = CliRunner().invoke(app, ["run", EXAMPLE, "--cycles", "30", "--set",
+                                       'planetary.0.pin_errors=[{tangential="10 um"},{},{},{}]',
+                                       "--out", str(tmp_path / out)])
+        assert res.exit_code == 0, res.output
+    rows = list(csv.DictReader((tmp_path / "r_cycles.csv").read_text().splitlines()))
+    ds = xr.open_dataset(tmp_path / "r.nc")
+    m = "stage_sun_planet2"
+    j = list(ds["mesh"].values).index(m)
+    for q, var in (("ratio_max", "cycle_ratio_max"), ("ratio_min", "cycle_ratio_min")):
+        got = np.array([float(r[f"{m}_{q}"]) if r[f"{m}_{q}"] else np.nan for r in rows])
+        want = ds[var].values[:len(got), j]
+        np.testing.assert_allclose(got, want, rtol=1e-12, equal_nan=True)
+        assert np.nanmax(got) > 1.01  # (the pin error loads planet 2's neighbours)
+    about = json.loads((tmp_path / "r_about.json").read_text())
+    k = about["planet_load_sharing"]["per_stage"]["stage_carrier"]
+    assert k == pytest.approx(float(ds["planet_load_sharing"].sel(
+        planet_entity="stage_carrier")), rel=1e-12) and k > 1.01
+    assert {b["body"] for b in about["bearing_forces_N"]} >= {"stage_planet1", "stage_sun"}

@@ -786,14 +786,17 @@ class Results:
         ``NAME_groups.csv`` (a row per load-sharing group, then one for the system: what
         the run's group table and system line print), ``NAME_history.csv`` (the history's
         forces and torques, each column's unit in its name: ``m1_N``, ``shaft_Nm``),
-        ``NAME_cycles.csv`` (start, peak, smallest and mean force of every mesh cycle;
-        empty for a cycle the start or the end of the run cuts, :attr:`complete_cycles`;
+        ``NAME_cycles.csv`` (start, peak, smallest and mean force and the largest and
+        smallest instantaneous load-sharing ratio of every mesh cycle, as the .nc's
+        ``cycle_*``; empty for a cycle the start or the end of the run cuts,
+        :attr:`complete_cycles`, whose start may precede the run's;
         ``MESH_settled`` 1 for the cycles the metrics' peaks are over; a periodic
         state's: the cycles that begin in its period),
         ``NAME_bearings.csv`` (the bearing table: :meth:`bearing_forces`),
         ``NAME_elements.csv`` (a row per recorded element: its unit, frame and the
         fractions of the run with its clearance open and in back contact) and
-        ``NAME_about.json`` (the run's provenance, model, warnings and metrics:
+        ``NAME_about.json`` (the run's provenance, model, warnings and metrics, and as
+        ``run --json`` the bearing table and the planets' factors:
         :func:`files.about_bytes`).  The column names do not depend on the load-sharing
         definition: a column ``load_sharing_definition`` names it.
 
@@ -906,12 +909,17 @@ class Results:
                                                    for n, i in zip(names, s.history_elements)],
                                      np.column_stack([s.history_t[:n_hist],
                                                       s.history_forces[:n_hist]]).tolist()),
+            # (the instantaneous load-sharing ratio's extremes per cycle too, as the .nc
+            # has them: the CSV left them out, a reviewer)
             cycles: files.csv_bytes(
-                ["cycle"] + [f"{m}_{q}" for q in ("start_s", "peak_N", "min_N", "mean_N")
+                ["cycle"] + [f"{m}_{q}" for q in ("start_s", "peak_N", "min_N", "mean_N",
+                                                  "ratio_max", "ratio_min")
                              for m in self.mesh_names] + settled_header,
                 [[k] + row + [int(c[k]) for c in settled_columns]
                  for k, row in zip(cycle_rows.tolist(), np.column_stack(
-                     [s.cycle_start[:, cols], *self.complete_cycle_statistics()[:3]]
+                     [s.cycle_start[:, cols], *self.complete_cycle_statistics()[:3],
+                      self.complete_cycle_statistics()[4],
+                      np.where(self.complete_cycles, s.cycle_ratio_min[:, cols], np.nan)]
                  )[cycle_rows].tolist())]),
         }
         with files.claim_output(plan) as claim:
@@ -921,11 +929,25 @@ class Results:
                 **({"steady": steady_info} if steady_info else {}),
                 load_sharing_definition=met.definition if met is not None else None,
                 metrics=met.to_dict() if met is not None else None,
+                # (the planets' factors and the bearing table, as --json gives them)
+                **self._about_extras(met, bearings),
                 history_samples_per_period=self.history_samples_per_period(),
                 status=self.message, files=plan.files)
             contents[summary] = files.csv_bytes(header, rows)  # last: marks the set
             claim.write(contents)
         return path
+
+    def _about_extras(self, met, bearings) -> dict:
+        """The ``planet_load_sharing`` and ``bearing_forces_N`` entries of the about file
+        (those ``run --json`` gives), where the run has them."""
+        out: dict = {"bearing_forces_N": bearings} if bearings else {}
+        if met is not None:
+            from ..cli_support import planet_sharing, planet_sharing_dict
+
+            k = planet_sharing(met.load_sharing, self.kinematics)
+            if k is not None:
+                out["planet_load_sharing"] = planet_sharing_dict(k)
+        return out
 
     def _planet_columns(self, header: list, rows: list, met) -> list:
         """The CSV summary of a planetary model gets each mesh's stage K_gamma and its
