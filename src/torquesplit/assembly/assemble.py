@@ -457,11 +457,13 @@ def _assemble(model: Model, kin: Kinematics | None, *, n_table: int | None,
 
     # ---- rotating frames: Coriolis, centripetal softening, centrifugal force
     gyroscopic, frame_stiffness = [], []
+    free: frozenset = frozenset()
     if rotating and kin.frames:
-        from .rotating import rotating_frame_terms
+        from .rotating import free_carriers, rotating_frame_terms
 
-        frame_stiffness, gyroscopic = rotating_frame_terms(kin, dmap, ext,
-                                                           pin_stiffness(model, kin))
+        free = free_carriers(kin, dmap, elements, inv_mass)
+        frame_stiffness, gyroscopic = rotating_frame_terms(
+            kin, dmap, ext, pin_stiffness(model, kin), free_carriers=free)
 
     # ---- drives and loads (and their torque fluctuations: elements of an additive force)
     fixed_frequency: list[str] = []
@@ -493,6 +495,8 @@ def _assemble(model: Model, kin: Kinematics | None, *, n_table: int | None,
         planet_bodies=dict(kin.planet_bodies),
         frames=dict(kin.frames),
         rotating_frame=bool(rotating and gyroscopic),
+        # (carriers turning with the train's rigid-body motion: assembly.rotating)
+        free_carriers=sorted(free),
         fixed_frequency_elements=fixed_frequency,
         torque_fluctuation_elements=[el["name"] for el in elements
                                      if ".fluctuation" in el["name"]],

@@ -15,19 +15,23 @@ Cooley & Parker 2012 eq. 1)::
   ``G_xy = -2 m Omega``, ``G_yx = +2 m Omega`` (Lin & Parker 1999, the 2 m Omega blocks
   of G);
 * centripetal softening ``-m Omega^2`` on every in-plane translation (Lin & Parker 1999
-  K_Omega = diag(m, m, 0) per body), of the displacement from where the carrier's
-  rotation theta_c takes the body's nominal position r0, u - theta_c a x r0: entries
-  ``-m Omega^2 V_k V_k^T`` of the frame stiffness matrix K_f (generalized force -K_f q),
-  V_k that displacement along two orthonormal directions of the carrier's plane (for the
-  members on the axis, r0 = 0: Lin & Parker's).  A rotation of the whole train only
-  shifts the nominal rotation and turns the centrifugal forces with it, so the kinematic
-  rigid rotation (the gear ratios') is an exact zero-frequency mode, which torques
-  balanced by the gear ratios do not load.  (The planets' absolute translations alone
-  would make it diverge; a geometric stiffness of the pin preload on the carrier's
-  rotation, used before, kept it at zero frequency with the planets turned by
-  (R + delta) / R of it, which balanced torques loaded by about m Omega^2 / k_t: a
-  torque-driven train's speed drifted.)  The geometric stiffness of the preloads (pins,
-  meshes) is left out consistently, terms of order m Omega^2 / k_t;
+  K_Omega = diag(m, m, 0) per body): entries ``-m Omega^2 V_k V_k^T`` of the frame
+  stiffness matrix K_f (generalized force -K_f q), V_k the displacement along two
+  orthonormal directions of the carrier's plane.  For a carrier held against turning
+  with the train, the displacement is the body's own, and the planet's centrifugal
+  preload P in its pin turns with the carrier: a geometric stiffness ``P R`` on the
+  carrier's rotation (R the pin radius, P = m Omega^2 R k_t / (k_t - m Omega^2) the
+  static load of a bearing of stiffness k_t along the pin's tangent), the exact
+  linearisation of the preloaded pin.  For a carrier whose rotation is part of the
+  train's rigid-body motion (:func:`free_carriers`), the displacement is measured from
+  where the carrier's rotation theta_c takes the body's nominal position r0,
+  u - theta_c a x r0, so that the kinematic rigid rotation (the gear ratios') is an
+  exact zero-frequency mode which torques balanced by the gear ratios do not load: with
+  the exact form the zero mode turns the planets by (R + delta) / R of the carrier while
+  the meshes, linearised about the nominal geometry, keep the gear ratios, and balanced
+  torques loaded it by about m Omega^2 / k_t (a torque-driven train's speed drifted).
+  The difference between the forms is of order 2 m Omega^2 / k_t in the modes that twist
+  the carrier against its planets.  The radial preload of the meshes is left out;
 * centrifugal force ``m Omega^2 r0`` (outwards, constant in the carrier frame) on the
   translations of a body off the axis (the planets), an external force;
 * A planet without translations sits rigidly on its pin: its mass is carried by the
@@ -57,18 +61,23 @@ def in_plane_basis(axis) -> tuple[np.ndarray, np.ndarray]:
     return e1, cross(a, e1)
 
 
-def rotating_frame_terms(kin, dmap, ext: np.ndarray, pin_stiffness=None):
+def rotating_frame_terms(kin, dmap, ext: np.ndarray, pin_stiffness=None,
+                         free_carriers=()):
     """Frame-stiffness and gyroscopic entries of every body measured in a turning
     carrier's frame; adds the centrifugal forces to ``ext`` in place.
 
     ``pin_stiffness(body, direction)`` gives the stiffness of a planet's bearing along
-    a unit direction (to refuse a bearing softer than the centrifugal softening).
+    a unit direction (for the pin-preload term, and to refuse a bearing softer than the
+    centrifugal softening).  ``free_carriers``: the carriers whose rotation is part of a
+    rigid-body motion of the train (:func:`free_carriers`), whose softening is measured
+    from the pin's rigid rotation; the others' is absolute, with the pin preload.
     Returns ``(frame_stiffness, gyroscopic)``, lists of ``(i, j, value)`` for
     :func:`~torquesplit.assembly.structure.build_structure`: the inertial terms are not
     elements (they carry no force of their own), so they cost one multiply-add per entry.
     """
     frame: list[tuple[int, int, float]] = []
     gyro: list[tuple[int, int, float]] = []
+    preload: dict[str, list] = {}  # carrier -> [its rotation DOF, sign, stiffness]
     # planets rigid on their pins (no translations) move with their carrier
     rigid_pins: dict[str, list[str]] = {}
     # gears without translations on the shaft of a planet that has them (a compound
@@ -107,7 +116,8 @@ def rotating_frame_terms(kin, dmap, ext: np.ndarray, pin_stiffness=None):
         r_nom = kin.bodies[body].position - cb.position
         r_nom = r_nom - a * float(r_nom @ a)
         idx_c, s_c = dmap.theta.get(carrier, (-1, 1.0))
-        turn = cross(a, r_nom) if body != carrier and idx_c >= 0 else None
+        turn = (cross(a, r_nom) if body != carrier and idx_c >= 0 and carrier in free_carriers
+                else None)
         for e in in_plane_basis(a):
             rows = dmap.project(body, e, 1.0, tol=1e-15)
             if turn is not None and abs(float(e @ turn)) > 0.0:
@@ -133,16 +143,58 @@ def rotating_frame_terms(kin, dmap, ext: np.ndarray, pin_stiffness=None):
             tangent = cross(a, r_nom / big_r) if big_r > 0 else None
             k_t = pin_stiffness(body, tangent) if big_r > 0 else None
             if k_t is not None:
-                soft = m * omega**2
+                soft, load = m * omega**2, m * omega**2 * big_r
                 for b, k_i in getattr(pin_stiffness, "seated", lambda *_: [])(body, tangent):
                     soft_i = kin.bodies[b].mass * omega**2
                     _stiffer_than_spin(f"gears.{b}.support", f"the bearing of {b!r} on the "
                                        f"planet {body!r} ({k_i:.3g} N/m)", k_i, soft_i, "")
-                    soft += k_i * soft_i / (k_i - soft_i)
+                    s_i = k_i * soft_i / (k_i - soft_i)
+                    r_i = kin.bodies[b].position - cb.position
+                    soft += s_i
+                    load += s_i * float(np.linalg.norm(r_i - a * float(r_i @ a)))
                 _stiffer_than_spin(f"gears.{body}.support", f"the planet's bearing "
                                    f"({k_t:.3g} N/m along its pin's tangent)", k_t, soft,
                                    ": it would fly off its pin")
+                if idx_c >= 0 and carrier not in free_carriers:
+                    # the pin preload P R, P = k_t delta the bearing's static load (delta =
+                    # load / (k_t - soft); one planet body: m Omega^2 R k_t / (k_t -
+                    # m Omega^2)): when the carrier turns by theta the preload turns too
+                    preload.setdefault(carrier, [idx_c, s_c, 0.0])[2] += \
+                        big_r * k_t * load / (k_t - soft)
+    # the pin preloads of all the planets of a held carrier, on its rotation
+    for idx, s_c, k in preload.values():
+        frame.append((idx, idx, k * s_c * s_c))
     return frame, gyro
+
+
+def free_carriers(kin, dmap, elements, inv_mass) -> frozenset:
+    """The turning carriers whose rotation is part of a rigid-body motion of the train
+    (the null space of the stiff elements' projections, :mod:`assembly.structure`
+    element dicts): a train driven and loaded by torques turns freely, with its carrier.
+    Their planets' softening is measured from the pin's rigid rotation, so that this
+    motion, the gear ratios', stays free of load; a carrier held (a shaft to a member at
+    a set speed, a torsional spring) keeps the exact terms of its pins."""
+    from ..solve.static import rigid_modes_of
+
+    turning = [c for c in kin.carriers if kin.bodies[c].speed
+               and dmap.theta.get(c, (-1, 1.0))[0] >= 0]
+    if not turning:
+        return frozenset()
+    rows = []
+    for el in elements:
+        parts = ([el["x"], el["y"]] if "x" in el and "y" in el else
+                 [(el["dofs"], el["coefs"])] if np.any(np.asarray(el.get("stiffness", 0.0))
+                                                       != 0.0) else [])
+        for dofs, coefs in parts:
+            row = np.zeros(len(inv_mass))
+            np.add.at(row, np.asarray(dofs, dtype=np.int64), np.asarray(coefs, dtype=float))
+            rows.append(row)
+    phi = rigid_modes_of(np.array(rows).reshape(len(rows), len(inv_mass)), inv_mass)
+    if phi.shape[1] == 0:
+        return frozenset()
+    big = float(np.abs(phi).max())
+    return frozenset(c for c in turning
+                     if float(np.abs(phi[dmap.theta[c][0]]).max()) > 1e-9 * big)
 
 
 def _stiffer_than_spin(where: str, bearing: str, k: float, soft: float, then: str) -> None:
@@ -170,8 +222,9 @@ class FrameTermsAt:
         self.structure = structure
         self.dmap = structure.metadata["dof_map"]
         self.stiff = pin_stiffness(model, kin)
+        self.free = frozenset(structure.metadata.get("free_carriers", ()))
         own = np.zeros(structure.n_dof)
-        rotating_frame_terms(kin, self.dmap, own, self.stiff)
+        rotating_frame_terms(kin, self.dmap, own, self.stiff, self.free)
         self.loads = structure.external_force - own  # (without the centrifugal forces)
 
     def __call__(self, factor: float):
@@ -181,7 +234,7 @@ class FrameTermsAt:
         scaled = kinematics_at(self.kin, factor)
         ext = np.zeros(s.n_dof)
         try:
-            frame, gyro = rotating_frame_terms(scaled, self.dmap, ext, self.stiff)
+            frame, gyro = rotating_frame_terms(scaled, self.dmap, ext, self.stiff, self.free)
         except ModelError as exc:  # (a sweep keeps its curve on a SolverError)
             from ..errors import SolverError
 

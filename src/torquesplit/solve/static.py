@@ -171,8 +171,13 @@ def rigid_body_modes(structure: Structure, active: np.ndarray | None = None,
         k = s.stiffness_table
         active = (k.max(axis=1) > 0) | (k.min(axis=1) < 0)
     active = np.asarray(active, dtype=bool).copy()
-    # (the caller's own copy: the kept one is shared)
-    return _rigid_modes(s.projection_matrix()[active], np.sqrt(s.inv_mass),
+    return rigid_modes_of(s.projection_matrix()[active], s.inv_mass, tolerance)
+
+
+def rigid_modes_of(V: np.ndarray, inv_mass: np.ndarray, tolerance: float = 1e-8) -> np.ndarray:
+    """:func:`rigid_body_modes` of projection rows ``V`` (n_rows, n_dof) and inverse
+    masses: the mass-normalised motions no row deforms (the caller's own copy)."""
+    return _rigid_modes(np.asarray(V, dtype=float), np.sqrt(np.asarray(inv_mass, float)),
                         float(tolerance)).copy()
 
 
