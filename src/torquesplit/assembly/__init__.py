@@ -8,6 +8,6 @@ module             content
                    splines), drives and loads
 ``excitation``     per-mesh tables: stiffness, phasing, backlash, errors, impact
 ``rotating``       terms of the bodies measured in a turning carrier's frame: Coriolis,
-                   centripetal, centrifugal
+                   centripetal, centrifugal, pin preload
 =================  ==================================================================
 """

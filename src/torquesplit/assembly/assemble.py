@@ -712,9 +712,9 @@ def _radial_pair(sup, axes: dict, axis) -> tuple[str, ...]:
 
 def pin_stiffness(model, kin):
     """``f(body, direction)``: the stiffness of a planet's bearing on its carrier's pin
-    along a unit direction [N/m] (None for a body not on a pin), for the check of
-    :func:`torquesplit.assembly.rotating.rotating_frame_terms` against the centrifugal
-    softening;
+    along a unit direction [N/m] (None for a body not on a pin), for the pin-preload term
+    of :func:`torquesplit.assembly.rotating.rotating_frame_terms` and its check against
+    the centrifugal softening;
     ``f.seated(body, direction)`` the bodies on bearings on that planet, with theirs."""
 
     def along(sup, direction):

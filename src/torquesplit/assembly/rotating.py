@@ -39,7 +39,8 @@ Cooley & Parker 2012 eq. 1)::
   its rotating-frame terms and centrifugal force.  A gear without translations on the
   shaft of a planet that has them (a compound planet) moves with that planet: its mass
   joins the planet's in these terms.  A gear with translations on a bearing on the planet
-  loads the pin through that bearing, which must be stiffer than that gear's softening.
+  loads the pin through that bearing (its static share enters a held carrier's pin
+  preload), which must be stiffer than that gear's softening.
 
 The bodies' rotations need no term (planar model, all axes parallel to a).
 """
@@ -110,9 +111,10 @@ def rotating_frame_terms(kin, dmap, ext: np.ndarray, pin_stiffness=None,
                     gyro.append((i, j, g))
         # centripetal softening -m Omega^2 in the carrier's plane (Lin & Parker 1999
         # K_Omega): -m Omega^2 (V_k V_k^T) for the projection V_k of each in-plane
-        # direction, of the displacement from where the carrier's rotation theta_c takes
-        # the body's nominal position r0 (theta_c a x r0): a rigid rotation of the train
-        # only shifts the nominal rotation, and its centrifugal forces turn with it
+        # direction; for a carrier that turns with the train's rigid-body motion, of the
+        # displacement from where its rotation theta_c takes the body's nominal position
+        # r0 (theta_c a x r0): that rotation only shifts the nominal one, and the
+        # centrifugal forces turn with it
         r_nom = kin.bodies[body].position - cb.position
         r_nom = r_nom - a * float(r_nom @ a)
         idx_c, s_c = dmap.theta.get(carrier, (-1, 1.0))
@@ -210,8 +212,9 @@ class FrameTermsAt:
     """The rotating-frame terms of ``structure`` at ``factor`` times the model's speeds
     (a speed sweep at constant load), called as ``terms(factor) -> (gy_coef, fs_coef,
     external_force)`` in the structure's own order.  Coriolis scales with the carrier's
-    speed, centripetal softening and centrifugal force with its square: recomputed, not
-    scaled (the bearings are checked against the softening at that speed).  The drive and
+    speed, centripetal softening and centrifugal force with its square, a held carrier's
+    pin preload as m Omega^2 R k_t / (k_t - m Omega^2): recomputed, not scaled (and the
+    bearings checked against the softening at that speed).  The drive and
     load torques stay the file's (the model's own centrifugal forces are taken out of the
     structure's external forces once, here)."""
 

@@ -158,8 +158,8 @@ class Structure:
     fs_ptr: np.ndarray = field(default_factory=_empty_int)
     """(n_dof + 1,) int64, or empty for none: the frame stiffness matrix K_f by row (CSR).
     The generalized force on DOF i is ``-sum_j K_f,ij q_j``: the inertial stiffness of a
-    turning frame (centripetal softening -m Omega^2 of a body's in-plane translations,
-    measured from where the carrier's rotation takes its nominal position).  Not an element: it
+    turning frame (centripetal softening -m Omega^2 of a body's in-plane translations, a
+    held carrier's pin preload: :mod:`~torquesplit.assembly.rotating`).  Not an element: it
     holds nothing and carries no force of its own."""
     fs_idx: np.ndarray = field(default_factory=_empty_int)
     """(n_fs,) int64 column (DOF) of each entry of K_f."""

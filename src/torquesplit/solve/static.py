@@ -160,8 +160,8 @@ def rigid_body_modes(structure: Structure, active: np.ndarray | None = None,
     ``active`` (n_el bool) defaults to every element whose stiffness table is not all
     zero, dead zones closed.  Computed from the projection vectors alone (singular
     values of V M^-1/2 below ``tolerance`` x the largest), so stiffness magnitudes do
-    not affect it.  The inertial stiffness of a turning frame (centripetal softening:
-    ``Structure.fs_*``) is not an element and does not hold a rigid motion: the rigid
+    not affect it.  The inertial stiffness of a turning frame (centripetal softening, pin
+    preload: ``Structure.fs_*``) is not an element and does not hold a rigid motion: the rigid
     rotation of a planetary train is that of its kinematics, on which the nominal torques
     balance, and which that stiffness leaves unloaded (``assembly.rotating``).
     """
