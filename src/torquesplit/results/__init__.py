@@ -901,6 +901,7 @@ class Results:
             start = s.cycle_start[:, cols]
             inside = ((start >= t0 - eps) & (start < t0 + self.period - eps)).any(axis=1)
             cycle_rows = np.flatnonzero(inside) if inside.any() else cycle_rows
+        cycle_stats = self.complete_cycle_statistics()
         contents = {
             groups: files.csv_bytes(group_header, group_rows),
             bearing_file: files.csv_bytes(bearing_header, bearing_rows),
@@ -917,8 +918,7 @@ class Results:
                              for m in self.mesh_names] + settled_header,
                 [[k] + row + [int(c[k]) for c in settled_columns]
                  for k, row in zip(cycle_rows.tolist(), np.column_stack(
-                     [s.cycle_start[:, cols], *self.complete_cycle_statistics()[:3],
-                      self.complete_cycle_statistics()[4],
+                     [s.cycle_start[:, cols], *cycle_stats[:3], cycle_stats[4],
                       np.where(self.complete_cycles, s.cycle_ratio_min[:, cols], np.nan)]
                  )[cycle_rows].tolist())]),
         }
