@@ -161,3 +161,32 @@ def test_a_sweeps_dynamic_factors_divide_by_each_speeds_static_force():
     np.testing.assert_allclose(out[1].peak_force.values, out[0].peak_force.values, rtol=1e-7)
     np.testing.assert_allclose(out[1].dynamic_factor.values, out[0].dynamic_factor.values,
                                rtol=1e-7)
+
+
+def test_the_undamped_mode_warning_of_a_state_at_another_speed_is_that_speeds():
+    """`steady --speed` listed the undamped modes at the file's speed (265.37 Hz at
+    100 rpm where 20000 rpm has 185.73 Hz: Cooley & Parker's undamped stage, a
+    reviewer)."""
+    import re
+
+    from planetary_models import cp_raw
+
+    def undamped(raw, speed=None):
+        with warnings.catch_warnings(record=True) as got:
+            warnings.simplefilter("always")
+            model = torquesplit.load_model(raw)
+            steady_state(model, speed=speed, method="hb", harmonics=2, stability=False,
+                         max_cycles=20)
+        said = [str(w.message) for w in got if "without damping" in str(w.message)]
+        assert said, [str(w.message) for w in got]
+        return [float(x) for x in re.findall(r"([0-9.]+) Hz", said[0])]
+
+    def raw(speed):
+        r = cp_raw(4, sun_speed=speed)
+        r["loads"]["out"]["fluctuation"] = [{"amplitude": "1 N m", "order": 3}]
+        return r
+
+    asked = undamped(raw("100 rpm"), "20000 rpm")
+    at_file = undamped(raw("20000 rpm"))
+    np.testing.assert_allclose(asked, at_file, rtol=1e-6)
+    assert asked != undamped(raw("100 rpm"))

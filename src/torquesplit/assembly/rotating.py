@@ -175,7 +175,7 @@ def free_carriers(kin, dmap, elements, inv_mass) -> frozenset:
     element dicts): a train driven and loaded by torques turns freely, with its carrier.
     Their planets' softening is measured from the pin's rigid rotation, so that this
     motion, the gear ratios', stays free of load; a carrier held (a shaft to a member at
-    a set speed, a torsional spring) keeps the exact terms of its pins."""
+    a set speed) keeps the exact terms of its pins."""
     from ..solve.static import rigid_modes_of
 
     turning = [c for c in kin.carriers if kin.bodies[c].speed

@@ -507,16 +507,18 @@ def _steady_state(model, *, method, harmonics, samples, keep, speed, max_cycles,
         adaptive = harmonics is None
     from torquesplit.steady.solution import warn_undamped
 
-    warn_undamped(structure, static.q)
     problem = periodic_problem(model, kin, structure, per.frequency)
+    at_speed = structure
     if factor != 1.0 and structure.metadata.get("rotating_frame"):
         # a turning carrier's centrifugal loads at the speed asked: the equilibrium the
         # state starts from and its static forces (the dynamic factors) are that speed's
-        static = static_equilibrium(problem.structure_at(factor, frequencies=False))
+        at_speed = problem.structure_at(factor, frequencies=False)
+        static = static_equilibrium(at_speed)
         if not np.all(np.isfinite(static.q)):
             raise SolverError(f"the static equilibrium at {factor:.6g} times the model's "
                               f"speed failed (the carrier's centrifugal loads), so the "
                               f"periodic state has no start; check the planet bearings.")
+    warn_undamped(at_speed, static.q)  # (the modes at that speed, a reviewer)
     sol = periodic_solution(structure, per, method=method, harmonics=harmonics,
                             samples=samples, speed=factor, q_static=static.q, initial=initial,
                             tol=tol, adaptive=adaptive, energy_tol=energy_tol,
