@@ -189,3 +189,11 @@ def test_the_csv_set_holds_the_cycle_ratios_and_the_planets(tmp_path):
     assert k == pytest.approx(float(ds["planet_load_sharing"].sel(
         planet_entity="stage_carrier")), rel=1e-12) and k > 1.01
     assert {b["body"] for b in about["bearing_forces_N"]} >= {"stage_planet1", "stage_sun"}
+
+
+def test_a_star_stages_planets_have_no_speed_on_their_pin_beside_their_speed():
+    """The carrier of a star stage is at rest: '-875 (-875 on its pin)' said nothing."""
+    res = CliRunner().invoke(app, ["check", "lin_parker1999_star", "--json"])
+    assert res.exit_code == 0, res.output
+    planet = json.loads(res.stdout)["bodies"]["stage_planet1"]
+    assert "speed_relative_to_carrier_rpm" not in planet and planet["power_kW"] == 0.0

@@ -154,3 +154,27 @@ def test_a_static_study_gives_the_peak_instantaneous_ratio_beside_k_gamma(tmp_pa
         p2, rel=1e-12)
     with pytest.raises(StudyError, match="planet_peak_instantaneous_ratio"):
         Study(_study(model, path, ["planet_peak_instantaneous_ratio"], {"cycles": 40})).plan()
+
+
+def test_a_one_path_parameter_takes_its_path_as_name_and_planet_names_read_short(lp_file):
+    """'paths = [one path]' was refused for want of a name, which the docs say defaults to
+    the path; the planet factors' family is 'planet_load_sharing.<definition>' with the
+    members 'system', '<carrier>', '<planet>' (the figure's legend read
+    'static_torque = static_torque.stage_carrier = ...' and squeezed the axes, a
+    reviewer), and the definitions line says what a planet's column is."""
+    from torquesplit.study.outputs import family, output_definitions, output_long_name
+
+    data = _study(lp_file, "planetary.0.pin_errors.0.tangential",
+                  ["planet_load_sharing.*"], {"type": "static", "revolutions": 0.02})
+    p = data["grid"]["parameters"][0]
+    p["paths"] = [p.pop("path")]
+    plan = Study(data).plan()
+    assert plan.design.parameters[0].name == "planetary.0.pin_errors.0.tangential"
+    assert family("planet_load_sharing.static_torque.stage_planet2") == (
+        "planet_load_sharing.static_torque", "stage_planet2")
+    assert family("planet_load_sharing.mean_force") == ("planet_load_sharing.mean_force",
+                                                        "system")
+    assert output_long_name("planet_load_sharing.static_torque.stage_planet2").endswith(
+        "(static_torque), stage_planet2")
+    said, = output_definitions(["planet_load_sharing.static_torque.stage_planet2"])
+    assert ".<planet>: that planet's own load over the mean" in said

@@ -25,6 +25,8 @@ def summary(model: Model) -> dict:
     bodies = {}
     for name, b in kin.bodies.items():
         carrier = kin.planet_bodies.get(name)
+        carrier = carrier if carrier and kin.bodies[carrier].speed else None  # (a star's
+        # carrier is at rest: a planet's speed on its pin is its speed)
         bodies[name] = {
             "speed_rpm": b.speed * RPM,  # (absolute: in the housing's frame)
             # a planet's speed on its pin (its bearing's), relative to its carrier

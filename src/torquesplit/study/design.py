@@ -555,7 +555,7 @@ def _parameter(t, raw: dict, where: str, name_default: str | None = None) -> Par
                                               "name = \"support_stiffness_factor\"")
         return Parameter(name, tuple(fields), "scale", tuple(base), None)
     fields = _target_fields(t, raw, where)
-    if t.name is None and (t.paths is not None or len(fields) > 1):
+    if t.name is None and len(fields) > 1:  # (paths = [one path] takes its name too)
         raise StudyError(f"{where}.name", "a parameter that sets several fields needs a name; "
                                           "add e.g. name = \"diameter\"")
     name = t.name or fields[0].path

@@ -86,6 +86,10 @@ def write_study_figures(ds, directory, formats=("png", "svg"), dpi: int = 130) -
 
 
 # ============================================================================ grid
+LEGEND_WIDTH = 28
+"""Characters per line of a legend entry (several equal members joined by '=')."""
+
+
 def curves_figure(ds, family: str, members: list[tuple[str, str]]) -> Figure:
     """A 1-parameter grid: the outputs of one family against the parameter."""
     var0 = members[0][1]
@@ -102,8 +106,8 @@ def curves_figure(ds, family: str, members: list[tuple[str, str]]) -> Figure:
         y = ds[var].values * scale
         same = next((line for yy, line in drawn
                      if np.allclose(y, yy, rtol=1e-12, atol=0.0, equal_nan=True)), None)
-        if same is not None:
-            same.set_label(f"{same.get_label()} = {member}")
+        if same is not None:  # (wrapped: the equal members ran over the axes, a reviewer)
+            same.set_label(_wrap(f"{same.get_label()} = {member}", LEGEND_WIDTH))
             continue
         if member == "system":
             line, = ax.plot(x, y, color="k", lw=2.4, marker="o", ms=3, label="system",
@@ -114,8 +118,8 @@ def curves_figure(ds, family: str, members: list[tuple[str, str]]) -> Figure:
         drawn.append((y, line))
     _mark_failed(ax, x, ds["status"].values)
     _log_axis(ds, pname, ax.set_xscale)
-    ax.set_xlabel(f"{_param_label(ds, pname)} [{xunit}]")
-    ax.set_ylabel(f"{_family_text(family)} [{unit}]")
+    ax.set_xlabel(_wrap(f"{_param_label(ds, pname)} [{xunit}]", 70))
+    ax.set_ylabel(_wrap(f"{_family_text(family)} [{unit}]", 45))
     ax.grid(True, alpha=0.3)
     ax.yaxis.get_major_formatter().set_useOffset(False)
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False, fontsize=8)
@@ -477,9 +481,15 @@ def _family_text(family: str) -> str:
     """ "load_sharing.engineering" -> "load-sharing coefficient (engineering)"."""
     head = family.split(".")[0]
     text = out_mod.FAMILIES.get(head, ("", family))[1]
-    if head == "load_sharing" and "." in family:
+    if head in ("load_sharing", "planet_load_sharing") and "." in family:
         text += f" ({family.split('.', 1)[1]})"
     return text
+
+
+def _wrap(text: str, width: int) -> str:
+    """``text`` broken into lines of about ``width`` characters at its spaces only (a
+    dotted output or field name stays whole)."""
+    return textwrap.fill(text, width, break_long_words=False, break_on_hyphens=False)
 
 
 def _safe(name: str) -> str:

@@ -243,9 +243,10 @@ def definitions_needed(names) -> list[str]:
 
 def family(name: str) -> tuple[str, str]:
     """Split an output name into (family, member): ``("load_sharing.engineering",
-    "stage1")``, ``("peak_force", "m11")``, ``("dynamic_factor", "system")``."""
+    "stage1")``, ``("planet_load_sharing.mean_force", "planet2")``, ``("peak_force",
+    "m11")``, ``("dynamic_factor", "system")``."""
     parts = name.split(".")
-    if parts[0] == "load_sharing":
+    if parts[0] in ("load_sharing", "planet_load_sharing"):
         head = ".".join(parts[:2])
         rest = ".".join(parts[2:])
     else:
@@ -282,7 +283,8 @@ def output_definitions(names) -> list[str]:
                     "load over the mean, from the quasi-static loads averaged over the mesh "
                     "positions (ISO 6336-1, AGMA 6123)" if parts[1] == STATIC_DEFINITION
                     else f"mesh load factor of each planetary stage, the largest planet over "
-                         f"the mean, by the {parts[1]} definition: {seen[head]}")
+                         f"the mean, by the {parts[1]} definition: {seen[head]}") + (
+                    "; .<planet>: that planet's own load over the mean")
         elif head in FAMILIES:
             seen[head] = FAMILIES[head][1]
     return [f"{head}: {text}" for head, text in seen.items()]
