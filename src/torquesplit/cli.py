@@ -1087,12 +1087,24 @@ def _print_static(m, res, met, orbits, saved, figures, plots, as_json) -> None:
         _print_planets(planets, res.kinematics)
     console.print(f"system load-sharing coefficient (static_torque): [bold]{met.system:.5f}[/]")
     if orbits:
+        from .model.kinematics import frame_label
+
+        kin = res.kinematics
+        frames = {b: frame_label(c if (c := kin.frames.get(b)) and kin.bodies[c].speed
+                                 else None) for b in orbits}
+        turning = any(f != "housing" for f in frames.values())  # (as the bearing table)
         o = Table(title="floating orbits (centre displacement from its nominal position)")
-        for col in ("body", "x range [µm]", "y range [µm]"):
+        for col in ("body", "x range [µm]", "y range [µm]") + (("directions in",) if turning
+                                                                 else ()):
             o.add_column(_h(col))
+
+        def um(v):  # (rounded; no '-0.000')
+            return f"{round(1e6 * v, 3) + 0.0:.3f}"
+
         for b, xy in orbits.items():
-            o.add_row(b, f"{1e6 * xy[:, 0].min():.3f} .. {1e6 * xy[:, 0].max():.3f}",
-                      f"{1e6 * xy[:, 1].min():.3f} .. {1e6 * xy[:, 1].max():.3f}")
+            o.add_row(b, f"{um(xy[:, 0].min())} .. {um(xy[:, 0].max())}",
+                      f"{um(xy[:, 1].min())} .. {um(xy[:, 1].max())}",
+                      *([frames[b]] if turning else []))
         console.print(o)
     if saved:
         console.print("results written to " + ", ".join(str(f) for f in saved),

@@ -197,3 +197,16 @@ def test_a_star_stages_planets_have_no_speed_on_their_pin_beside_their_speed():
     assert res.exit_code == 0, res.output
     planet = json.loads(res.stdout)["bodies"]["stage_planet1"]
     assert "speed_relative_to_carrier_rpm" not in planet and planet["power_kW"] == 0.0
+
+
+def test_the_static_orbits_say_their_frame():
+    """A planet's 11.2 um outwards is in its carrier's turning frame, the pinions' in the
+    housing's; the table did not say so (a reviewer), and printed '-0.000'."""
+    res = CliRunner().invoke(app, ["static", "split_path_planetary_differential", "--quiet"])
+    assert res.exit_code == 0, res.output
+    orbits = res.stdout[res.stdout.index("floating orbits"):]
+    assert "directions in" in orbits and "-0.000" not in orbits
+    rows = {line.split("│")[1].strip(): line for line in orbits.splitlines()
+            if line.startswith("│")}
+    assert "turning with stage_carrier" in rows["stage_planet1"]
+    assert "housing" in rows["pinion_a"]
