@@ -243,7 +243,9 @@ class FrameTermsAt:
 
             raise SolverError(f"at {factor:.6g} times the model's speed: "
                               f"{'; '.join(m for _, m in exc.issues)}") from None
-        frame, gyro = sorted(frame), sorted(gyro)
+        from .structure import merged_entries
+
+        frame, gyro = merged_entries(frame), merged_entries(gyro)  # (as the structure's)
         if (len(gyro) != s.gy_coef.size or len(frame) != s.fs_coef.size
                 or [j for _, j, _ in gyro] != s.gy_idx.tolist()
                 or [j for _, j, _ in frame] != s.fs_idx.tolist()):

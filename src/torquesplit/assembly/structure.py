@@ -278,6 +278,19 @@ class Structure:
         return V.T @ (c[:, None] * V) + np.diag(self.ground_damping)
 
 
+def merged_entries(entries) -> list[tuple[int, int, float]]:
+    """``(i, j, value)`` entries sorted, those on one (i, j) added into one (in sorted
+    order): each costs a multiply-add per right-hand side (a free carrier's rotation row
+    had one per planet direction for the same entry)."""
+    out: list[list] = []
+    for i, j, v in sorted((int(i), int(j), float(v)) for i, j, v in entries):
+        if out and out[-1][0] == i and out[-1][1] == j:
+            out[-1][2] += v
+        else:
+            out.append([i, j, v])
+    return [(i, j, v) for i, j, v in out]
+
+
 def build_structure(
     dof_names,
     inv_mass,
@@ -410,7 +423,7 @@ def build_structure(
                 fr_coef.append(float(c))
                 fr_row.append(base + int(r))
             fr_ptr.append(len(fr_dof))
-    gy = sorted((int(i), int(j), float(g)) for i, j, g in gyroscopic)
+    gy = merged_entries(gyroscopic)
     for i, j, g in gy:
         if not (0 <= i < n_dof and 0 <= j < n_dof and np.isfinite(g)):
             raise OptionError(f"gyroscopic entry ({i}, {j}, {g}) is out of range or not "
@@ -418,7 +431,7 @@ def build_structure(
     gy_ptr = np.zeros(n_dof + 1, dtype=np.int64)
     for i, _, _ in gy:
         gy_ptr[i + 1] += 1
-    fs = sorted((int(i), int(j), float(k)) for i, j, k in frame_stiffness)
+    fs = merged_entries(frame_stiffness)
     for i, j, k in fs:
         if not (0 <= i < n_dof and 0 <= j < n_dof and np.isfinite(k)):
             raise OptionError(f"frame stiffness entry ({i}, {j}, {k}) is out of range or not "
