@@ -210,3 +210,14 @@ def test_the_static_orbits_say_their_frame():
             if line.startswith("│")}
     assert "turning with stage_carrier" in rows["stage_planet1"]
     assert "housing" in rows["pinion_a"]
+
+
+def test_every_command_with_a_progress_display_takes_quiet():
+    """'steady' and 'sweep-speed' had no --quiet, unlike the other commands (a reviewer)."""
+    for command in ("run", "static", "steady", "sweep-speed", "study", "modes"):
+        res = CliRunner().invoke(app, [command, "--help"])
+        assert "--quiet" in res.stdout, command
+    res = CliRunner().invoke(app, ["steady", "ji_li_mill_drive", "--quiet", "--no-stability",
+                                   "--json"])
+    assert res.exit_code == 0, res.output
+    assert json.loads(res.stdout)["converged"]

@@ -202,6 +202,7 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
             False, "--check-step", help="Solve again at half the RK4 step (harmonic "
             "balance: twice the harmonics) and report how many significant digits of "
             "every number hold."),
+        quiet: bool = typer.Option(False, "--quiet", help="No progress display."),
         assign: Optional[list[str]] = typer.Option(None, "--set", help=set_help,
                                                    metavar="PATH=VALUE"),
     ):
@@ -224,7 +225,7 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
 
             # (Ctrl-C exited 130 without a word)
             with interruptible(), collect_warnings(), progress(
-                    "periodic steady state", as_json, total=None) as update:
+                    "periodic steady state", as_json or quiet, total=None) as update:
                 # (a speed with its unit as text, so that the unit is judged)
                 st = steady_state(m, method=method, harmonics=harmonics, adaptive=adaptive,
                                   keep=_keep(keep), speed=_speed_argument(speed),
@@ -259,7 +260,7 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
                 from torquesplit.convergence import check_steady
 
                 with interruptible(), collect_warnings(), progress(
-                        "checking the resolution", as_json, total=None) as update:
+                        "checking the resolution", as_json or quiet, total=None) as update:
                     step_check = check_steady(st, progress=update)
         except (TorquesplitError, ValueError, OSError) as exc:
             fail(_in_flags(exc))
@@ -421,6 +422,7 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
         force: bool = typer.Option(False, "--force", help="Replace existing --out / --plot "
                                    "files."),
         as_json: bool = json_option("Print a summary as JSON."),
+        quiet: bool = typer.Option(False, "--quiet", help="No progress display."),
         assign: Optional[list[str]] = typer.Option(None, "--set", help=set_help,
                                                    metavar="PATH=VALUE"),
     ):
@@ -452,7 +454,7 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
             m, _ = load(model, assign)
             from torquesplit.cli_support import collect_warnings, progress
 
-            with collect_warnings(), progress("speed sweep", as_json, total=None):
+            with collect_warnings(), progress("speed sweep", as_json or quiet, total=None):
                 ds = sweep_speed(m, _speed(start, "--from"), _speed(stop, "--to"),
                                  points=points, harmonics=harmonics, keep=_keep(keep),
                                  max_cycles=max_cycles, stability=not no_stability,
@@ -478,8 +480,8 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
         try:  # (Ctrl-C here keeps the curve: it is printed without the check; a sweep
             # already interrupted is not made to wait for it)
             if not str(ds.attrs["message"]).startswith("interrupted"):
-                with collect_warnings(), progress("checking the peaks' digits", as_json,
-                                                  total=None):
+                with collect_warnings(), progress("checking the peaks' digits",
+                                                  as_json or quiet, total=None):
                     held = peak_resolution(m, ds, largest, keep=_keep(keep),
                                            max_cycles=max_cycles)
         except KeyboardInterrupt:
