@@ -901,18 +901,15 @@ def bearing_table(bearings: list[dict], res) -> Table:
 def _centrifugal_loads(kin, bodies) -> str:
     """``"stage_planet1 4.4897 kN, ..."``: the centrifugal force m Omega_c^2 r of each
     planet among ``bodies`` whose carrier turns (one value where they are all equal)."""
-    import numpy as np
+    from .assembly.assemble import orbit_radius
 
     out = {}
     for body in bodies:
         carrier = kin.planet_bodies.get(body)
         if carrier is None or not kin.bodies[carrier].speed:
             continue
-        c = kin.bodies[carrier]
-        a = c.axis / np.linalg.norm(c.axis)
-        r = kin.bodies[body].position - c.position
-        r = float(np.linalg.norm(r - a * float(r @ a)))
-        out[body] = kin.bodies[body].mass * c.speed ** 2 * r
+        out[body] = (kin.bodies[body].mass * kin.bodies[carrier].speed ** 2
+                     * orbit_radius(kin, body, carrier))
     if not out:
         return ""
     if max(out.values()) - min(out.values()) <= 1e-9 * max(out.values()):

@@ -140,7 +140,7 @@ def number_dofs(model: Model, kin: Kinematics) -> tuple[DofMap, np.ndarray]:
             mass[j] += mp
         idx, _ = theta.get(carrier, (-1, 1.0))
         if idx >= 0:
-            mass[idx] += mp * _orbit_radius(kin, body, carrier) ** 2
+            mass[idx] += mp * orbit_radius(kin, body, carrier) ** 2
     m = np.asarray(mass)
     with np.errstate(divide="ignore", over="ignore"):
         inv = 1.0 / m
@@ -530,7 +530,8 @@ def _bearing_seat(model: Model, dmap: DofMap, body: str, on: str | None,
     return on
 
 
-def _orbit_radius(kin: Kinematics, body: str, carrier: str) -> float:
+def orbit_radius(kin: Kinematics, body: str, carrier: str) -> float:
+    """Distance of ``body``'s nominal centre from ``carrier``'s axis [m]."""
     c = kin.bodies[carrier]
     a = c.axis / np.linalg.norm(c.axis)
     r = kin.bodies[body].position - c.position

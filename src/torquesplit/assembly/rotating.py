@@ -229,8 +229,17 @@ class FrameTermsAt:
         own = np.zeros(structure.n_dof)
         rotating_frame_terms(kin, self.dmap, own, self.stiff, self.free)
         self.loads = structure.external_force - own  # (without the centrifugal forces)
+        self._kept: dict[float, tuple] = {}  # (a solver and its statics ask per speed)
 
     def __call__(self, factor: float):
+        key = float(factor)
+        if key not in self._kept:
+            if len(self._kept) > 8:
+                self._kept.clear()
+            self._kept[key] = self._terms(key)
+        return self._kept[key]
+
+    def _terms(self, factor: float):
         from ..model.kinematics import kinematics_at
 
         s = self.structure
