@@ -303,6 +303,11 @@ def test_ctrl_c_after_saving_says_what_was_kept(tmp_path, monkeypatch):
 def test_a_real_sigint_stops_a_run_and_keeps_what_it_computed(tmp_path):
     """Ctrl-C during the integration ends the run as a stopped one: its partial results
     are written (with their status) and said; nothing is lost, no traceback."""
+    from torquesplit.solve.integrate import compile_kernels
+
+    # the kernels in numba's cache first: a Ctrl-C while the run compiles them stops it
+    # with nothing computed (tests/solve/test_run_setup.py), which is not this test's case
+    compile_kernels(("rk4",))
     model = write_model(tmp_path, SPUR_PAIR)
     out = tmp_path / "r.nc"
     proc = subprocess.Popen([sys.executable, "-m", "torquesplit.cli", "run", str(model),

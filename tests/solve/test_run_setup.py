@@ -149,3 +149,27 @@ def test_scratch_arrays_start_on_a_cache_line_with_numpys_values():
     assert w.par is par
     assert w.addr[kd.A_Y] == w.Y.ctypes.data and w.addr[kd.A_K] == w.K.ctypes.data
     assert w.addr[kd.A_SELF] == w.addr.ctypes.data
+
+
+def test_ctrl_c_while_the_kernels_compile_stops_the_caller(monkeypatch):
+    """A Ctrl-C that lands while the first run compiles its kernels stops that run: the
+    warm-up inside :func:`compile_kernels` ended as an interrupted run of its own, and a
+    first ``torquesplit run`` went on to its end.  The method counts as not compiled."""
+    import importlib
+
+    mod = importlib.import_module("torquesplit.solve.integrate")
+    monkeypatch.setattr(mod, "_COMPILE_TIMES", {})
+
+    def interrupt(*args):  # Ctrl-C inside the kernel's first call: while it compiles
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(mod, "_compiled", lambda function, args: interrupt)
+    s = spur_pair()
+    with mod.stop_on_interrupt(), pytest.raises(KeyboardInterrupt):
+        integrate(s, np.zeros(2 * s.n_dof), (0.0, 1e-3), step=1e-5)
+    assert "rk4" not in mod._COMPILE_TIMES
+    # a run's own interrupt (kernels compiled) still ends it as a stopped run
+    mod._COMPILE_TIMES["rk4"] = 0.0
+    with mod.stop_on_interrupt():
+        sol = integrate(s, np.zeros(2 * s.n_dof), (0.0, 1e-3), step=1e-5)
+    assert sol.status == mod.INTERRUPTED and not sol.success

@@ -90,6 +90,8 @@ Record = namedtuple("Record", (
     "grp_ptr", "grp_col", "grp_min", "rat_max", "rat_min",
     "sep_count", "back_count", "sep_time", "back_time",
     "hist_el", "hist_dof", "hist_t", "hist_f", "hist_q", "hist_v", "full_t", "full_y",
+    "pv_ptr", "pv_el", "pv_cf", "pv_gap", "pv_e3", "pv_n", "pv_col", "pv_run", "pv_f", "pv_g",
+    "hist_p",
 ))
 """Outputs of a run.  Per tracked element: ``trk_cont`` 1 where its force is continuous
 at its cycle starts (:func:`continuous_start`), else 0.  Per tracked element (columns)
@@ -106,7 +108,16 @@ load-sharing group (``grp_col[grp_ptr[g]:grp_ptr[g+1]]`` its tracked columns) th
 largest and smallest instantaneous ratio ``N f_i / sum_j f_j`` of each member in each of
 its cycles (``rat_max``, ``rat_min``), formed only while the group's total force exceeds
 ``grp_min[g]`` (the ratio of nearly nothing is not load sharing); per element the samples and time in separation
-and in back-side contact; the decimated history and the optional full state."""
+and in back-side contact; the decimated history and the optional full state; the
+streamed force vectors (vector v: terms ``pv_ptr[v]:pv_ptr[v+1]``, element ``pv_el[k]``'s
+force times the direction ``pv_cf[k]`` (3,), summed; ``pv_gap[k]`` 1 where that element
+has a gap, so that its contact regime can change; the first ``pv_n[2]`` a support's
+(orthogonal unit directions, no gap), also as their elements ``pv_e3``: those below
+``pv_n[0]`` with one term, below ``pv_n[1]`` two, then three; vector v is column
+``pv_col[v]`` of the output): each one's largest squared magnitude since the
+last history row (``pv_run``), its last two instants' squared magnitudes and
+contact-regime codes (``pv_f``, ``pv_g`` (n_v, 2), slots as ``pk_t``'s) and, per history
+row, its largest magnitude since the row before (``hist_p``)."""
 
 # rows of Work.Y
 Y_STATE = 0  # the state (copied in and out of the caller's y)
@@ -398,12 +409,14 @@ def continuous_start(corner_ptr, corner_node, e: int) -> bool:
 
 def make_record(track_el, track_base, n_cycles_cap: int, groups, n_el: int, hist_el,
                 hist_dof, n_hist: int, n_full: int, n_dof: int, group_min=None,
-                continuous=None) -> Record:
+                continuous=None, vectors=(), gapped=()) -> Record:
     """Output arrays of a run.  ``groups``: lists of tracked columns, one per
     load-sharing group (the ratio statistics); ``group_min``: the group total force below
     which no ratio is formed [N] (default 0: any positive total); ``continuous``: per
     tracked element, whether its force is continuous at its cycle starts (default none:
-    no forces interpolated at cycle starts)."""
+    no forces interpolated at cycle starts); ``vectors``: the streamed force vectors,
+    each a list of (element, direction (3,)) terms (default none); ``gapped``: the
+    elements with a gap (their contact regime can change)."""
     n_tr = len(track_el)
     cap = int(n_cycles_cap)
     grp_ptr = np.zeros(len(groups) + 1, dtype=np.int64)
@@ -432,11 +445,41 @@ def make_record(track_el, track_base, n_cycles_cap: int, groups, n_el: int, hist
         hist_t=np.zeros(n_hist), hist_f=np.zeros((n_hist, n_he)),
         hist_q=np.zeros((n_hist, n_hd)), hist_v=np.zeros((n_hist, n_hd)),
         full_t=np.zeros(n_full), full_y=np.zeros((n_full, 2 * n_dof)),
+        **_vector_arrays(vectors, gapped),
+        hist_p=np.zeros((n_hist, len(vectors))),
     )
 
 
+def _vector_arrays(vectors, gapped) -> dict:
+    """The streamed force vectors' arrays of a :class:`Record` (its docstring says what
+    each holds): a support's vectors (orthogonal unit directions, no gap, at most three
+    terms) first, by number of terms, then the others."""
+    def simple(v) -> bool:
+        d = np.array([c for _, c in v], dtype=float).reshape(-1, 3)
+        return (len(v) <= 3 and not any(e in gapped for e, _ in v)
+                and bool(np.all((d == 0) | (np.abs(d) == 1)))
+                and bool(np.array_equal(np.abs(d) @ np.abs(d).T, np.eye(len(v)))))
+
+    order = sorted(range(len(vectors)),
+                   key=lambda i: len(vectors[i]) if simple(vectors[i]) else 4)
+    vs = [vectors[i] for i in order]
+    counts = [sum(1 for v in vs if simple(v) and len(v) <= k) for k in (1, 2, 3)]
+    e3 = np.zeros((counts[2], 3), dtype=np.int64)
+    for i, v in enumerate(vs[:counts[2]]):
+        e3[i, :len(v)] = [e for e, _ in v]
+    return dict(
+        pv_ptr=np.concatenate([[0], np.cumsum([len(v) for v in vs])]).astype(np.int64),
+        pv_el=np.array([e for v in vs for e, _ in v], dtype=np.int64),
+        pv_cf=np.array([c for v in vs for _, c in v], dtype=np.float64).reshape(-1, 3),
+        pv_gap=np.array([e in gapped for v in vs for e, _ in v], dtype=np.int64),
+        pv_e3=e3, pv_n=np.array(counts, dtype=np.int64),
+        pv_col=np.array(order, dtype=np.int64),
+        pv_run=np.full(len(vs), -np.inf), pv_f=np.zeros((len(vs), 2)),
+        pv_g=np.zeros((len(vs), 2), dtype=np.int64))
+
+
 def record_bytes(n_cycles_cap: int, n_tracked: int, n_hist: int, n_hist_el: int,
-                 n_hist_dof: int, n_full: int, n_dof: int) -> int:
+                 n_hist_dof: int, n_full: int, n_dof: int, n_vectors: int = 0) -> int:
     """Bytes of the output arrays :func:`make_record` would allocate."""
-    return 8 * (n_hist * (1 + n_hist_el + 2 * n_hist_dof) + n_full * (1 + 2 * n_dof)
-                + 7 * n_cycles_cap * n_tracked)
+    return 8 * (n_hist * (1 + n_hist_el + 2 * n_hist_dof + n_vectors)
+                + n_full * (1 + 2 * n_dof) + 7 * n_cycles_cap * n_tracked)
