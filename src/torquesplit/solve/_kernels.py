@@ -45,6 +45,20 @@ from numba import njit
 
 from torquesplit.solve import laws
 from torquesplit.solve.kernel_data import (
+    PK_NEXT,
+    PV_CF,
+    PV_COL,
+    PV_E3,
+    PV_EL,
+    PV_F,
+    PV_G,
+    PV_GAP,
+    PV_N1,
+    PV_N2,
+    PV_N3,
+    PV_NV,
+    PV_PTR,
+    PV_RUN,
     A_D,
     A_F,
     A_SELF,
@@ -417,7 +431,7 @@ def ratio_starts(t, slot, i_f, m, w, r):
     track_el, track_base, trk_cont = r.track_el, r.track_base, r.trk_cont
     grp_ptr, grp_col, grp_min = r.grp_ptr, r.grp_col, r.grp_min
     rat_max, rat_min, prev_f, prev_c = r.rat_max, r.rat_min, r.prev_f, r.prev_c
-    ta = r.prev_t[0]
+    ta = last_instant(r)
     span = t - ta
     if not (span >= 0.0):  # NaN before the first instant: no interval yet
         return
@@ -440,6 +454,14 @@ def ratio_starts(t, slot, i_f, m, w, r):
                 fb = laws.positive_part(fa + th * (force[i_f, el] - fa))[0]
                 ratio = (grp_ptr[g + 1] - grp_ptr[g]) * fb / total
                 enter_both(ratio, cp, c, j, rat_max, rat_min)
+
+
+@_inline
+def last_instant(r):
+    """Time of the last instant entered in the time record (NaN before the first): the
+    newer of the two slots of ``r.pk_t``."""
+    n = r.pk_n[0]
+    return r.pk_t[1 - (n & 1)] if n >= 1 else math.nan
 
 
 @_inline
@@ -518,7 +540,7 @@ def force_instant(t, kink, full, count, slot, i_f, m, w, r):
     t0 = pk_t[o]
     t1 = pk_t[p]
     # the means: the interval from the last instant (NaN before the first: no interval)
-    ta = r.prev_t[0]
+    ta = pk_t[p] if n >= 1 else math.nan
     span = t - ta
     first = not (span >= 0.0)
     for j in range(track_el.shape[0]):
@@ -582,21 +604,22 @@ def force_instant(t, kink, full, count, slot, i_f, m, w, r):
         pk_t[o] = t
         pk_k[o] = kink
         r.pk_n[0] = n + 1
-        r.prev_t[0] = t
 
 
 @_inline
-def magnitude2(v, i_f, force, ptr, el, cf):
-    """|sum_k cf_k f_k|^2 of streamed vector ``v`` (its terms ``ptr[v]:ptr[v+1]``:
-    element ``el[k]``'s force in row ``i_f`` times its direction ``cf[k]``)."""
+def magnitude2(v, i_f, force, pi, px):
+    """|sum_k cf_k f_k|^2 of streamed vector ``v`` (its terms: element ``el[k]``'s force
+    in row ``i_f`` times its direction ``cf[k]``; ``r.pv_i``, ``r.pv_x`` as
+    :class:`~.kernel_data.Record` lays them out)."""
+    o_el, o_cf = pi[PV_EL], pi[PV_CF]
     sx = 0.0
     sy = 0.0
     sz = 0.0
-    for k in range(ptr[v], ptr[v + 1]):
-        f = force[i_f, el[k]]
-        sx += cf[k, 0] * f
-        sy += cf[k, 1] * f
-        sz += cf[k, 2] * f
+    for k in range(pi[pi[PV_PTR] + v], pi[pi[PV_PTR] + v + 1]):
+        f = force[i_f, pi[o_el + k]]
+        sx += px[o_cf + 3 * k] * f
+        sy += px[o_cf + 3 * k + 1] * f
+        sz += px[o_cf + 3 * k + 2] * f
     return sx * sx + sy * sy + sz * sz
 
 
@@ -610,55 +633,58 @@ def vertex_bound(f0, f1, f2, q0, q2):
 
 
 @_inline
-def peak_enter(t, v, fe, code, coded, full, smooth, q0, q2, o, p, run, pv_f, pv_g, pk_t):
+def peak_enter(t, v, fe, code, coded, full, smooth, q0, q2, o, p, pi, px, pk_t):
     """Squared magnitude ``fe`` of vector ``v`` at the instant ``t`` (its terms' regime
     ``code``, with ``coded``: a term has a gap) into its largest since the last history
     row, and with ``full`` the vertex of the parabola through the last three instants'
     where the middle one is the largest, is not a corner (``smooth``) and the code is the
     same at all three.  The vertex is computed only where it can raise the largest
     (:func:`vertex_bound`, ``q0``, ``q2`` of this instant's intervals).  Computed at
-    every extremum, it cost 60 ns of Lin & Parker's step (seven bearings,
-    the sun's force round-off noise: an extremum every few steps)."""
-    top = max(run[v], fe)
-    run[v] = top
+    every extremum, it cost 60 ns of Lin & Parker's step (seven bearings, the sun's force
+    round-off noise: an extremum every few steps)."""
+    run = pi[PV_RUN] + v
+    last = pi[PV_F] + 2 * v  # the last two instants' squared magnitudes, slots as pk_t's
+    top = max(px[run], fe)
+    px[run] = top
     if full == 0:
         return
-    f0 = pv_f[v, o]
-    f1 = pv_f[v, p]
+    f0 = px[last + o]
+    f1 = px[last + p]
     # one branch, taken where the vertex is needed (its parts as & of comparisons, not
     # branches: a static force's round-off made every third instant an extremum)
     if smooth & (f1 >= fe) & (f1 >= f0) & (f1 > min(f0, fe)) & (
             vertex_bound(f0, f1, fe, q0, q2) > top):
-        if coded == 0 or (pv_g[v, o] == code and pv_g[v, p] == code):
-            run[v] = max(top, vertex(pk_t[o], pk_t[p], t, f0, f1, fe))
-    pv_f[v, o] = fe  # this instant takes the older one's slot (force_instant: pk_t)
+        g = pi[PV_G] + 2 * v
+        if coded == 0 or (pi[g + o] == code and pi[g + p] == code):
+            px[run] = max(top, vertex(pk_t[o], pk_t[p], t, f0, f1, fe))
+    px[last + o] = fe  # this instant takes the older one's slot (force_instant: pk_t)
     if coded != 0:
-        pv_g[v, o] = code
+        pi[pi[PV_G] + 2 * v + o] = code
 
 
 @_inline
 def magnitude_instant(t, full, slot, i_f, w, r):
-    """The streamed force vectors (``r.pv_*``: a body's bearing force from its support
-    elements or its meshes) at an instant (forces in row ``i_f``): each squared magnitude
-    into its largest since the last history row (``r.pv_run``), and with ``full`` (an
+    """The streamed force vectors (``r.pv_i``, ``r.pv_x``: a body's bearing force from its
+    support elements or its meshes) at an instant (forces in row ``i_f``): each squared
+    magnitude into its largest since the last history row, and with ``full`` (an
     instant of the time record: they come in time order) the peak between the instants,
     as :func:`force_instant` finds a force's: where the middle one of the last three is
     the largest, is not a corner and every term keeps its contact regime over the three,
-    the vertex of the parabola through them.  Reads the instants' slots before
-    :func:`force_instant` moves them on.  A support's vectors (orthogonal unit
-    directions, no gap, at most three terms: ``r.pv_e3``) take loops by number of terms,
-    with neither directions nor regimes; the others the general loop (Ji & Li's drive:
-    its six supports cost +3.8 % of a step, +10 % through the general loop).  Without
-    it the bearing table's peaks came from the decimated history: 4.3 % apart at 20 and
-    33 samples per period on the split-path differential.
+    the vertex of the parabola through them.  Called before :func:`enter_instant`, whose
+    :func:`force_instant` moves the instants' slots on.  A support's vectors (orthogonal
+    unit directions, no gap, at most three terms) take loops by number of terms, with
+    neither directions nor regimes; the others the general loop (Ji & Li's drive: its six
+    supports cost +5 % of a step, +10 % through the general loop).  Two packed arrays,
+    not one per quantity: the Record is passed to :func:`enter_instant`, a call, and nine
+    more arrays in it cost 3 % of that drive's step.  Without it the bearing table's
+    peaks came from the decimated history: 4.3 % apart at 20 and 33 samples per period
+    on the split-path differential.
     Twin: :func:`torquesplit.solve.reference.history_peaks_numpy`."""
-    ptr, el, cf, gapped, run = r.pv_ptr, r.pv_el, r.pv_cf, r.pv_gap, r.pv_run
-    n_v = ptr.shape[0] - 1
+    pi, px = r.pv_i, r.pv_x
+    n_v = pi[PV_NV]
     if n_v == 0:
         return
-    e3 = r.pv_e3
-    force, defl, G = w.F, w.D, w.G
-    pv_f, pv_g, pk_t = r.pv_f, r.pv_g, r.pk_t
+    force, defl, G, pk_t = w.F, w.D, w.G, r.pk_t
     n = r.pk_n[0]
     o = n & 1
     p = 1 - o
@@ -669,29 +695,31 @@ def magnitude_instant(t, full, slot, i_f, w, r):
         h2 = t - pk_t[p]
         q0 = 0.25 * (h2 / h0) ** 2
         q2 = 0.25 * (h0 / h2) ** 2
-    n1, n2, n3 = r.pv_n[0], r.pv_n[1], r.pv_n[2]
-    for v in range(n1):  # (by number of terms: no weights, no padding)
-        a = force[i_f, e3[v, 0]]
-        peak_enter(t, v, a * a, 0, np.int64(0), full, smooth, q0, q2, o, p, run, pv_f,
-                   pv_g, pk_t)
+    e3 = pi[PV_E3]  # a support's elements, three per vector
+    n1, n2, n3 = pi[PV_N1], pi[PV_N2], pi[PV_N3]
+    for v in range(n1):  # (by number of terms: no directions, no padding)
+        a = force[i_f, pi[e3 + 3 * v]]
+        peak_enter(t, v, a * a, 0, np.int64(0), full, smooth, q0, q2, o, p, pi, px, pk_t)
     for v in range(n1, n2):
-        a = force[i_f, e3[v, 0]]
-        b = force[i_f, e3[v, 1]]
-        peak_enter(t, v, a * a + b * b, 0, np.int64(0), full, smooth, q0, q2, o, p, run,
-                   pv_f, pv_g, pk_t)
+        a = force[i_f, pi[e3 + 3 * v]]
+        b = force[i_f, pi[e3 + 3 * v + 1]]
+        peak_enter(t, v, a * a + b * b, 0, np.int64(0), full, smooth, q0, q2, o, p, pi, px,
+                   pk_t)
     for v in range(n2, n3):
-        a = force[i_f, e3[v, 0]]
-        b = force[i_f, e3[v, 1]]
-        c = force[i_f, e3[v, 2]]
+        a = force[i_f, pi[e3 + 3 * v]]
+        b = force[i_f, pi[e3 + 3 * v + 1]]
+        c = force[i_f, pi[e3 + 3 * v + 2]]
         peak_enter(t, v, a * a + b * b + c * c, 0, np.int64(0), full, smooth, q0, q2, o, p,
-                   run, pv_f, pv_g, pk_t)
+                   pi, px, pk_t)
+    ptr, o_el, o_gap = pi[PV_PTR], pi[PV_EL], pi[PV_GAP]
     for v in range(n3, n_v):
         code = 0  # the terms' contact regimes (those with a gap: the others' is always 1)
-        for k in range(ptr[v], ptr[v + 1]):
-            if gapped[k] != 0:
-                code = code * 3 + regime(defl[i_f, el[k]], G[slot, el[k]]) + 1
-        peak_enter(t, v, magnitude2(v, i_f, force, ptr, el, cf), code, np.int64(1), full,
-                   smooth, q0, q2, o, p, run, pv_f, pv_g, pk_t)
+        for k in range(pi[ptr + v], pi[ptr + v + 1]):
+            if pi[o_gap + k] != 0:
+                e = pi[o_el + k]
+                code = code * 3 + regime(defl[i_f, e], G[slot, e]) + 1
+        peak_enter(t, v, magnitude2(v, i_f, force, pi, px), code, np.int64(1), full, smooth,
+                   q0, q2, o, p, pi, px, pk_t)
 
 
 @_inline
@@ -739,7 +767,6 @@ def enter_instant(t, kink, full, count, slot, i_f, m, w, r):
     (rk4_run, record_extrema, dopri_run twice), seconds of cold compile each."""
     if full != 0:
         ratio_starts(t, slot, i_f, m, w, r)
-    magnitude_instant(t, full, slot, i_f, w, r)
     force_instant(t, kink, full, count, slot, i_f, m, w, r)
     ratio_sample(slot, i_f, w, r)
 
@@ -763,8 +790,10 @@ def record(t, slot, i_f, weight, m, w, r, counters):
                                                   r.back_time)
     element_kind = m.element_kind
     # the row as an int64 variable: a literal row would compile a second enter_instant
-    enter_instant(t, r.pk_x[0], np.int64(1), np.int64(1), slot, np.int64(i_f), m, w, r)
-    r.pk_x[0] = 0
+    magnitude_instant(t, np.int64(1), slot, np.int64(i_f), w, r)
+    enter_instant(t, r.pk_k[PK_NEXT], np.int64(1), np.int64(1), slot, np.int64(i_f), m, w,
+                  r)
+    r.pk_k[PK_NEXT] = 0
     for j in range(watch_el.shape[0]):
         el = watch_el[j]
         g = G[slot, el]
@@ -793,10 +822,11 @@ def record_extrema(t, mean, slot, i_f, m, w, r):
     :func:`record`."""
     # RK4's corners (``mean``): instants in time order, corners among the samples;
     # Dormand-Prince's, element by element: the ratio only, and no parabola across the step
+    magnitude_instant(t, mean, slot, i_f, w, r)
     enter_instant(t, np.int64(1), mean, np.int64(0), slot, i_f, m, w, r)
     if mean == 0:
         r.pk_k[(r.pk_n[0] - 1) & 1] = 1
-        r.pk_x[0] = 1
+        r.pk_k[PK_NEXT] = 1
 
 
 @_inner
@@ -921,23 +951,24 @@ def corner_events(t_a, t_b, ya, fa, yb, fb, m, w, r, rhs_fn, gen, counters):
 @_inner
 def store_history(row, t, iy, i_f, w, r):
     """One decimated history row: t, forces of history elements, q and v of DOFs, and
-    each streamed vector's largest magnitude since the last row (this row's included: a
-    Dormand-Prince sample is interpolated, no instant of the record), which then starts
-    again.  Twin: plain indexing, ``hist_f[row] = force[hist_el]`` etc., and
+    in ``hist_f``'s last columns each streamed vector's largest magnitude since the last
+    row (this row's included: a Dormand-Prince sample is interpolated, no instant of the
+    record), which then starts again.  Twin: plain indexing, ``hist_f[row] = force[hist_el]`` etc., and
     :func:`torquesplit.solve.reference.history_peaks_numpy`."""
     Y, F, hist_el, hist_dof = w.Y, w.F, r.hist_el, r.hist_dof
     hist_f, hist_q, hist_v = r.hist_f, r.hist_q, r.hist_v
-    ptr, run, hist_p = r.pv_ptr, r.pv_run, r.hist_p
+    pi, px = r.pv_i, r.pv_x
     n = Y.shape[1] // 2
     r.hist_t[row] = t
-    for j in range(hist_el.shape[0]):
+    n_he = hist_el.shape[0]
+    for j in range(n_he):
         hist_f[row, j] = F[i_f, hist_el[j]]
-    entered = r.prev_t[0] == t  # (RK4: this instant is in pv_run already)
-    for v in range(ptr.shape[0] - 1):
-        top = run[v] if entered else max(run[v], magnitude2(v, i_f, F, ptr, r.pv_el,
-                                                            r.pv_cf))
-        hist_p[row, r.pv_col[v]] = math.sqrt(top)
-        run[v] = -math.inf
+    entered = last_instant(r) == t  # (RK4: this instant is in the largest already)
+    for v in range(pi[PV_NV]):
+        run = pi[PV_RUN] + v
+        top = px[run] if entered else max(px[run], magnitude2(v, i_f, F, pi, px))
+        hist_f[row, n_he + pi[pi[PV_COL] + v]] = math.sqrt(top)
+        px[run] = -math.inf
     for j in range(hist_dof.shape[0]):
         d = hist_dof[j]
         hist_q[row, j] = Y[iy, d]
@@ -1065,7 +1096,7 @@ def rk4_through_corners(t, tb, t_corner, sa, sb, m, w, r, rhs_fn, gen, counters)
             r.pk_k[(r.pk_n[0] - 1) & 1] = 1
         if te >= tb:
             if t_corner <= tb + MERGE * h:  # a corner on the step's end: so is its sample
-                r.pk_x[0] = 1
+                r.pk_k[PK_NEXT] = 1
             break
         t_corner = advance_corners(te, m, w)
     if ts < tb:  # the last corner fell within MERGE h of tb: nothing left to step

@@ -659,7 +659,7 @@ def _solution(s, sel, plan, rec, counters, clock, y, *, method, t_span, blowup, 
         history_elements=tuple(sel.hist_el),
         history_dofs=tuple(sel.hist_dof),
         history_t=_rows(rec.hist_t, n_rec),
-        history_forces=_rows(rec.hist_f, n_rec),
+        history_forces=_rows(rec.hist_f[:, :len(sel.hist_el)], n_rec),
         history_q=_rows(rec.hist_q, n_rec),
         history_v=_rows(rec.hist_v, n_rec),
         full_t=_rows(rec.full_t, n_full_rec) if full_history else None,
@@ -670,7 +670,8 @@ def _solution(s, sel, plan, rec, counters, clock, y, *, method, t_span, blowup, 
         separation_time=rec.sep_time,
         back_contact_time=rec.back_time,
         history_peak_names=tuple(peak_names),
-        history_peaks=_rows(rec.hist_p, n_rec) if len(peak_names) else None,
+        history_peaks=(_rows(rec.hist_f[:, len(sel.hist_el):], n_rec) if len(peak_names)
+                       else None),
     )
 
 
