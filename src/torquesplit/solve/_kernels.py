@@ -772,7 +772,7 @@ def enter_instant(t, kink, full, count, slot, i_f, m, w, r):
 
 
 @_inline
-def record(t, slot, i_f, weight, m, w, r, counters):
+def record(t, slot, i_f, weight, m, w, r, counters, streams):
     """Enter one accepted state at time ``t`` (forces in row ``i_f``) in the statistics.
 
     Per tracked element j: cycle c = CY - track_base[j] (cycles at or beyond the
@@ -790,7 +790,8 @@ def record(t, slot, i_f, weight, m, w, r, counters):
                                                   r.back_time)
     element_kind = m.element_kind
     # the row as an int64 variable: a literal row would compile a second enter_instant
-    magnitude_instant(t, np.int64(1), slot, np.int64(i_f), w, r)
+    if streams:
+        magnitude_instant(t, np.int64(1), slot, np.int64(i_f), w, r)
     enter_instant(t, r.pk_k[PK_NEXT], np.int64(1), np.int64(1), slot, np.int64(i_f), m, w,
                   r)
     r.pk_k[PK_NEXT] = 0
@@ -1142,6 +1143,7 @@ def rk4_run(t0, h, n_first, n_steps, record_final, record_every, blowup, m, w, r
     next_rec = -(-n_first // every) * every
     # one pass per step, and one more for the end state with ``record_final`` (the same
     # code: numba inlines record and _stage once, not twice, which saves cold compile)
+    streams = r.pv_i[PV_NV] > 0  # (loop-invariant: the loop without them stays lean)
     n_pass = n_steps + 1 if record_final and n_steps > 0 else n_steps
     # steps taken, and those without corners (4 rhs each), counted in locals and written
     # to ``counters`` and ``clock`` once at the end: stores to them at every step cost 2 %
@@ -1158,7 +1160,7 @@ def rk4_run(t0, h, n_first, n_steps, record_final, record_every, blowup, m, w, r
                 next_sync += RESYNC
         # stage 1 at t: its forces are those of the accepted state y(t)
         _stage(a, Y_STATE, Y_K1, F_MAIN, m, w, rhs_fn, gen, extra)
-        record(t, a, F_MAIN, 0.0 if last else h, m, w, r, counters)
+        record(t, a, F_MAIN, 0.0 if last else h, m, w, r, counters, streams)
         if i == next_rec:
             next_rec += every
             if record_every > 0 and counters[I_HIST] < n_hist:
@@ -1257,7 +1259,7 @@ def dopri_run(t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, blowup, dt
         counters[I_RHS] += 1
         counters[I_FSAL] = 1
         if counters[I_SAMPLES] == 0:
-            record(t, s1, F_MAIN, 0.0, m, w, r, counters)
+            record(t, s1, F_MAIN, 0.0, m, w, r, counters, r.pv_i[PV_NV] > 0)
         while counters[I_NEXT] < n_hist and t0 + counters[I_NEXT] * dt_sample <= t:
             row = counters[I_NEXT]
             store_history(row, t, np.int64(Y_STATE), np.int64(F_MAIN), w, r)
@@ -1266,6 +1268,7 @@ def dopri_run(t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, blowup, dt
                 counters[I_FULL] = row + 1
             counters[I_NEXT] = row + 1
             counters[I_HIST] = row + 1
+    streams = r.pv_i[PV_NV] > 0
     while t < t_stop:
         if counters[I_STEPS] >= max_steps:
             counters[I_STATUS] = MAX_STEPS
@@ -1374,7 +1377,7 @@ def dopri_run(t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, blowup, dt
                 clock[F_HMIN] = hs
             if hs > clock[F_HMAX]:
                 clock[F_HMAX] = hs
-            record(t, s1, F_MAIN, hs, m, w, r, counters)
+            record(t, s1, F_MAIN, hs, m, w, r, counters, streams)
             fac = fac11 / facold ** _BETA
             fac = max(1.0 / _FAC_MAX, min(1.0 / _FAC_MIN, fac / _SAFE))
             h_new = hs / fac
