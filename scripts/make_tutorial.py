@@ -252,15 +252,14 @@ leaves out the start-up transient before computing anything.
   and the peak magnitude |F|; a gear with no translations sits on a rigid bearing, and
   its row (marked `(rigid bearing)`) is the sum of its meshes' forces, in the housing's
   x, y (and z: the axial thrust of helical teeth); a planetary stage's fixed ring's in its
-  carrier's frame, as the planets'.  The peaks are streamed at every step, as the mesh
-  forces' are (the corners and the peaks between steps included), so they do not depend
-  on the history's sampling; a rigid bearing's mean is its meshes' mean forces (b1's is
-  in1's), another's the mean of its history samples (next bullet).  `--json` gives them
+  carrier's frame, as the planets'.  The peaks come from the history, not from the
+  streamed statistics (next bullet); a rigid bearing's mean is its meshes' mean forces
+  (b1's is in1's), another's the mean of its history samples.  `--json` gives them
   as `bearing_forces_N`, a .nc or .mat results file (`--out`) as `bearing_mean_force`
   and `bearing_peak_force`.
 {{{{drift_text}}}}
 * **the history**, which results files (`--out`), figures (`--plots`) and the bearing
-  table's means are made from, holds every integration step of this run ({{{{history_samples}}}} samples):
+  table are made from, holds every integration step of this run ({{{{history_samples}}}} samples):
   by default a run keeps every step up to 50,000 samples, and a longer one every k-th
   step: 50,000 samples, or more where 20 per shortest mesh period need more (at most
   200,000: fewer per period on a very long run).  This drive rings at its mesh modes

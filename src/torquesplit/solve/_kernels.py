@@ -45,20 +45,6 @@ from numba import njit
 
 from torquesplit.solve import laws
 from torquesplit.solve.kernel_data import (
-    PK_NEXT,
-    PV_CF,
-    PV_COL,
-    PV_E3,
-    PV_EL,
-    PV_F,
-    PV_G,
-    PV_GAP,
-    PV_N1,
-    PV_N2,
-    PV_N3,
-    PV_NV,
-    PV_PTR,
-    PV_RUN,
     A_D,
     A_F,
     A_SELF,
@@ -431,7 +417,7 @@ def ratio_starts(t, slot, i_f, m, w, r):
     track_el, track_base, trk_cont = r.track_el, r.track_base, r.trk_cont
     grp_ptr, grp_col, grp_min = r.grp_ptr, r.grp_col, r.grp_min
     rat_max, rat_min, prev_f, prev_c = r.rat_max, r.rat_min, r.prev_f, r.prev_c
-    ta = last_instant(r)
+    ta = r.prev_t[0]
     span = t - ta
     if not (span >= 0.0):  # NaN before the first instant: no interval yet
         return
@@ -454,14 +440,6 @@ def ratio_starts(t, slot, i_f, m, w, r):
                 fb = laws.positive_part(fa + th * (force[i_f, el] - fa))[0]
                 ratio = (grp_ptr[g + 1] - grp_ptr[g]) * fb / total
                 enter_both(ratio, cp, c, j, rat_max, rat_min)
-
-
-@_inline
-def last_instant(r):
-    """Time of the last instant entered in the time record (NaN before the first): the
-    newer of the two slots of ``r.pk_t``."""
-    n = r.pk_n[0]
-    return r.pk_t[1 - (n & 1)] if n >= 1 else math.nan
 
 
 @_inline
@@ -540,7 +518,7 @@ def force_instant(t, kink, full, count, slot, i_f, m, w, r):
     t0 = pk_t[o]
     t1 = pk_t[p]
     # the means: the interval from the last instant (NaN before the first: no interval)
-    ta = pk_t[p] if n >= 1 else math.nan
+    ta = r.prev_t[0]
     span = t - ta
     first = not (span >= 0.0)
     for j in range(track_el.shape[0]):
@@ -604,122 +582,7 @@ def force_instant(t, kink, full, count, slot, i_f, m, w, r):
         pk_t[o] = t
         pk_k[o] = kink
         r.pk_n[0] = n + 1
-
-
-@_inline
-def magnitude2(v, i_f, force, pi, px):
-    """|sum_k cf_k f_k|^2 of streamed vector ``v`` (its terms: element ``el[k]``'s force
-    in row ``i_f`` times its direction ``cf[k]``; ``r.pv_i``, ``r.pv_x`` as
-    :class:`~.kernel_data.Record` lays them out)."""
-    o_el, o_cf = pi[PV_EL], pi[PV_CF]
-    sx = 0.0
-    sy = 0.0
-    sz = 0.0
-    for k in range(pi[pi[PV_PTR] + v], pi[pi[PV_PTR] + v + 1]):
-        f = force[i_f, pi[o_el + k]]
-        sx += px[o_cf + 3 * k] * f
-        sy += px[o_cf + 3 * k + 1] * f
-        sz += px[o_cf + 3 * k + 2] * f
-    return sx * sx + sy * sy + sz * sz
-
-
-@_inline
-def vertex_bound(f0, f1, f2, q0, q2):
-    """An upper bound of :func:`vertex` where f1 >= f0, f2: f1 + max(q0 (f1 - f0),
-    q2 (f1 - f2)), q0 = (h2 / h0)^2 / 4, q2 = (h0 / h2)^2 / 4, h0 = t1 - t0, h2 = t2 - t1.
-    (The vertex t* lies nearer t1 than the lower neighbour; on t2's side, |a| h0^2 <=
-    f1 - f0 and f1 is at most |a| (h2 / 2)^2 below it; likewise on t0's.)"""
-    return f1 + max(q0 * (f1 - f0), q2 * (f1 - f2))
-
-
-@_inline
-def peak_enter(t, v, fe, code, coded, full, smooth, q0, q2, o, p, pi, px, pk_t):
-    """Squared magnitude ``fe`` of vector ``v`` at the instant ``t`` (its terms' regime
-    ``code``, with ``coded``: a term has a gap) into its largest since the last history
-    row, and with ``full`` the vertex of the parabola through the last three instants'
-    where the middle one is the largest, is not a corner (``smooth``) and the code is the
-    same at all three.  The vertex is computed only where it can raise the largest
-    (:func:`vertex_bound`, ``q0``, ``q2`` of this instant's intervals).  Computed at
-    every extremum, it cost 60 ns of Lin & Parker's step (seven bearings, the sun's force
-    round-off noise: an extremum every few steps)."""
-    run = pi[PV_RUN] + v
-    last = pi[PV_F] + 2 * v  # the last two instants' squared magnitudes, slots as pk_t's
-    top = max(px[run], fe)
-    px[run] = top
-    if full == 0:
-        return
-    f0 = px[last + o]
-    f1 = px[last + p]
-    # one branch, taken where the vertex is needed (its parts as & of comparisons, not
-    # branches: a static force's round-off made every third instant an extremum)
-    if smooth & (f1 >= fe) & (f1 >= f0) & (f1 > min(f0, fe)) & (
-            vertex_bound(f0, f1, fe, q0, q2) > top):
-        g = pi[PV_G] + 2 * v
-        if coded == 0 or (pi[g + o] == code and pi[g + p] == code):
-            px[run] = max(top, vertex(pk_t[o], pk_t[p], t, f0, f1, fe))
-    px[last + o] = fe  # this instant takes the older one's slot (force_instant: pk_t)
-    if coded != 0:
-        pi[pi[PV_G] + 2 * v + o] = code
-
-
-@_inline
-def magnitude_instant(t, full, slot, i_f, w, r):
-    """The streamed force vectors (``r.pv_i``, ``r.pv_x``: a body's bearing force from its
-    support elements or its meshes) at an instant (forces in row ``i_f``): each squared
-    magnitude into its largest since the last history row, and with ``full`` (an
-    instant of the time record: they come in time order) the peak between the instants,
-    as :func:`force_instant` finds a force's: where the middle one of the last three is
-    the largest, is not a corner and every term keeps its contact regime over the three,
-    the vertex of the parabola through them.  Called before :func:`enter_instant`, whose
-    :func:`force_instant` moves the instants' slots on.  A support's vectors (orthogonal
-    unit directions, no gap, at most three terms) take loops by number of terms, with
-    neither directions nor regimes; the others the general loop (Ji & Li's drive: its six
-    supports cost +5 % of a step, +10 % through the general loop).  Two packed arrays,
-    not one per quantity: the Record is passed to :func:`enter_instant`, a call, and nine
-    more arrays in it cost 3 % of that drive's step.  Without it the bearing table's
-    peaks came from the decimated history: 4.3 % apart at 20 and 33 samples per period
-    on the split-path differential.
-    Twin: :func:`torquesplit.solve.reference.history_peaks_numpy`."""
-    pi, px = r.pv_i, r.pv_x
-    n_v = pi[PV_NV]
-    if n_v == 0:
-        return
-    force, defl, G, pk_t = w.F, w.D, w.G, r.pk_t
-    n = r.pk_n[0]
-    o = n & 1
-    p = 1 - o
-    smooth = n >= 2 and r.pk_k[p] == 0
-    q0 = q2 = 0.0
-    if smooth and full != 0:
-        h0 = pk_t[p] - pk_t[o]
-        h2 = t - pk_t[p]
-        q0 = 0.25 * (h2 / h0) ** 2
-        q2 = 0.25 * (h0 / h2) ** 2
-    e3 = pi[PV_E3]  # a support's elements, three per vector
-    n1, n2, n3 = pi[PV_N1], pi[PV_N2], pi[PV_N3]
-    for v in range(n1):  # (by number of terms: no directions, no padding)
-        a = force[i_f, pi[e3 + 3 * v]]
-        peak_enter(t, v, a * a, 0, np.int64(0), full, smooth, q0, q2, o, p, pi, px, pk_t)
-    for v in range(n1, n2):
-        a = force[i_f, pi[e3 + 3 * v]]
-        b = force[i_f, pi[e3 + 3 * v + 1]]
-        peak_enter(t, v, a * a + b * b, 0, np.int64(0), full, smooth, q0, q2, o, p, pi, px,
-                   pk_t)
-    for v in range(n2, n3):
-        a = force[i_f, pi[e3 + 3 * v]]
-        b = force[i_f, pi[e3 + 3 * v + 1]]
-        c = force[i_f, pi[e3 + 3 * v + 2]]
-        peak_enter(t, v, a * a + b * b + c * c, 0, np.int64(0), full, smooth, q0, q2, o, p,
-                   pi, px, pk_t)
-    ptr, o_el, o_gap = pi[PV_PTR], pi[PV_EL], pi[PV_GAP]
-    for v in range(n3, n_v):
-        code = 0  # the terms' contact regimes (those with a gap: the others' is always 1)
-        for k in range(pi[ptr + v], pi[ptr + v + 1]):
-            if pi[o_gap + k] != 0:
-                e = pi[o_el + k]
-                code = code * 3 + regime(defl[i_f, e], G[slot, e]) + 1
-        peak_enter(t, v, magnitude2(v, i_f, force, pi, px), code, np.int64(1), full, smooth,
-                   q0, q2, o, p, pi, px, pk_t)
+        r.prev_t[0] = t
 
 
 @_inline
@@ -772,7 +635,7 @@ def enter_instant(t, kink, full, count, slot, i_f, m, w, r):
 
 
 @_inline
-def record(t, slot, i_f, weight, m, w, r, counters, streams):
+def record(t, slot, i_f, weight, m, w, r, counters):
     """Enter one accepted state at time ``t`` (forces in row ``i_f``) in the statistics.
 
     Per tracked element j: cycle c = CY - track_base[j] (cycles at or beyond the
@@ -790,11 +653,8 @@ def record(t, slot, i_f, weight, m, w, r, counters, streams):
                                                   r.back_time)
     element_kind = m.element_kind
     # the row as an int64 variable: a literal row would compile a second enter_instant
-    if streams:
-        magnitude_instant(t, np.int64(1), slot, np.int64(i_f), w, r)
-    enter_instant(t, r.pk_k[PK_NEXT], np.int64(1), np.int64(1), slot, np.int64(i_f), m, w,
-                  r)
-    r.pk_k[PK_NEXT] = 0
+    enter_instant(t, r.pk_x[0], np.int64(1), np.int64(1), slot, np.int64(i_f), m, w, r)
+    r.pk_x[0] = 0
     for j in range(watch_el.shape[0]):
         el = watch_el[j]
         g = G[slot, el]
@@ -823,11 +683,10 @@ def record_extrema(t, mean, slot, i_f, m, w, r):
     :func:`record`."""
     # RK4's corners (``mean``): instants in time order, corners among the samples;
     # Dormand-Prince's, element by element: the ratio only, and no parabola across the step
-    magnitude_instant(t, mean, slot, i_f, w, r)
     enter_instant(t, np.int64(1), mean, np.int64(0), slot, i_f, m, w, r)
     if mean == 0:
         r.pk_k[(r.pk_n[0] - 1) & 1] = 1
-        r.pk_k[PK_NEXT] = 1
+        r.pk_x[0] = 1
 
 
 @_inner
@@ -951,25 +810,14 @@ def corner_events(t_a, t_b, ya, fa, yb, fb, m, w, r, rhs_fn, gen, counters):
 
 @_inner
 def store_history(row, t, iy, i_f, w, r):
-    """One decimated history row: t, forces of history elements, q and v of DOFs, and
-    in ``hist_f``'s last columns each streamed vector's largest magnitude since the last
-    row (this row's included: a Dormand-Prince sample is interpolated, no instant of the
-    record), which then starts again.  Twin: plain indexing, ``hist_f[row] = force[hist_el]`` etc., and
-    :func:`torquesplit.solve.reference.history_peaks_numpy`."""
+    """One decimated history row: t, forces of history elements, q and v of DOFs.
+    Twin: plain indexing, ``hist_f[row] = force[hist_el]`` etc."""
     Y, F, hist_el, hist_dof = w.Y, w.F, r.hist_el, r.hist_dof
     hist_f, hist_q, hist_v = r.hist_f, r.hist_q, r.hist_v
-    pi, px = r.pv_i, r.pv_x
     n = Y.shape[1] // 2
     r.hist_t[row] = t
-    n_he = hist_el.shape[0]
-    for j in range(n_he):
+    for j in range(hist_el.shape[0]):
         hist_f[row, j] = F[i_f, hist_el[j]]
-    entered = last_instant(r) == t  # (RK4: this instant is in the largest already)
-    for v in range(pi[PV_NV]):
-        run = pi[PV_RUN] + v
-        top = px[run] if entered else max(px[run], magnitude2(v, i_f, F, pi, px))
-        hist_f[row, n_he + pi[pi[PV_COL] + v]] = math.sqrt(top)
-        px[run] = -math.inf
     for j in range(hist_dof.shape[0]):
         d = hist_dof[j]
         hist_q[row, j] = Y[iy, d]
@@ -1097,7 +945,7 @@ def rk4_through_corners(t, tb, t_corner, sa, sb, m, w, r, rhs_fn, gen, counters)
             r.pk_k[(r.pk_n[0] - 1) & 1] = 1
         if te >= tb:
             if t_corner <= tb + MERGE * h:  # a corner on the step's end: so is its sample
-                r.pk_k[PK_NEXT] = 1
+                r.pk_x[0] = 1
             break
         t_corner = advance_corners(te, m, w)
     if ts < tb:  # the last corner fell within MERGE h of tb: nothing left to step
@@ -1143,7 +991,6 @@ def rk4_run(t0, h, n_first, n_steps, record_final, record_every, blowup, m, w, r
     next_rec = -(-n_first // every) * every
     # one pass per step, and one more for the end state with ``record_final`` (the same
     # code: numba inlines record and _stage once, not twice, which saves cold compile)
-    streams = r.pv_i[PV_NV] > 0  # (loop-invariant: the loop without them stays lean)
     n_pass = n_steps + 1 if record_final and n_steps > 0 else n_steps
     # steps taken, and those without corners (4 rhs each), counted in locals and written
     # to ``counters`` and ``clock`` once at the end: stores to them at every step cost 2 %
@@ -1160,7 +1007,7 @@ def rk4_run(t0, h, n_first, n_steps, record_final, record_every, blowup, m, w, r
                 next_sync += RESYNC
         # stage 1 at t: its forces are those of the accepted state y(t)
         _stage(a, Y_STATE, Y_K1, F_MAIN, m, w, rhs_fn, gen, extra)
-        record(t, a, F_MAIN, 0.0 if last else h, m, w, r, counters, streams)
+        record(t, a, F_MAIN, 0.0 if last else h, m, w, r, counters)
         if i == next_rec:
             next_rec += every
             if record_every > 0 and counters[I_HIST] < n_hist:
@@ -1259,7 +1106,7 @@ def dopri_run(t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, blowup, dt
         counters[I_RHS] += 1
         counters[I_FSAL] = 1
         if counters[I_SAMPLES] == 0:
-            record(t, s1, F_MAIN, 0.0, m, w, r, counters, r.pv_i[PV_NV] > 0)
+            record(t, s1, F_MAIN, 0.0, m, w, r, counters)
         while counters[I_NEXT] < n_hist and t0 + counters[I_NEXT] * dt_sample <= t:
             row = counters[I_NEXT]
             store_history(row, t, np.int64(Y_STATE), np.int64(F_MAIN), w, r)
@@ -1268,7 +1115,6 @@ def dopri_run(t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, blowup, dt
                 counters[I_FULL] = row + 1
             counters[I_NEXT] = row + 1
             counters[I_HIST] = row + 1
-    streams = r.pv_i[PV_NV] > 0
     while t < t_stop:
         if counters[I_STEPS] >= max_steps:
             counters[I_STATUS] = MAX_STEPS
@@ -1377,7 +1223,7 @@ def dopri_run(t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, blowup, dt
                 clock[F_HMIN] = hs
             if hs > clock[F_HMAX]:
                 clock[F_HMAX] = hs
-            record(t, s1, F_MAIN, hs, m, w, r, counters, streams)
+            record(t, s1, F_MAIN, hs, m, w, r, counters)
             fac = fac11 / facold ** _BETA
             fac = max(1.0 / _FAC_MAX, min(1.0 / _FAC_MIN, fac / _SAFE))
             h_new = hs / fac

@@ -196,13 +196,6 @@ class Solution:
     contact events."""
     back_contact_time: np.ndarray
     """(n_el,) time spent in back-side contact [s], weighted like ``separation_time``."""
-    history_peak_names: tuple[str, ...] = ()
-    """Names of the streamed force vectors (``integrate``'s ``history_peaks``)."""
-    history_peaks: np.ndarray | None = None
-    """(n_records, n_vectors) each streamed vector's largest magnitude [N] since the
-    record before (this record included), over every accepted state, RK4 corner and peak
-    between states (the vertex of a parabola through three of them): the largest over a
-    span of records does not depend on the sampling.  None without vectors."""
 
     def __post_init__(self):
         freeze_arrays(self)
@@ -407,7 +400,6 @@ def integrate(
     n_cycles_cap: int | None = None,
     history_elements=None,
     history_dofs=None,
-    history_peaks=None,
     record_every: int | None = None,
     sample_interval: float | None = None,
     full_history: bool = False,
@@ -469,13 +461,6 @@ def integrate(
     history_elements, history_dofs : sequence of int or str, optional
         Elements (forces) and DOFs (q and v) kept in the decimated history.
         Default: all of them.  Pass ``()`` to keep none.
-    history_peaks : mapping of str to sequence of (int or str, (3,) array_like), optional
-        Force vectors whose magnitude is streamed: name -> terms (element, direction),
-        the vector being the sum of each element's force times its direction (a
-        bearing's force from its x and y support elements, or a body's from its meshes'
-        lines of action).  Each one's largest magnitude between history records is taken
-        at every accepted state, corner and peak between states, so its peak over a span
-        does not depend on the sampling (``Solution.history_peaks``).  Default: none.
     record_every : int, optional (rk4)
         History every ``record_every`` steps, default 1.
     sample_interval : float, optional
@@ -571,9 +556,8 @@ def integrate(
     n_rhs_planned = 4 * min(plan.n_steps, plan.limit_steps) if rk4 else 6 * span / plan.h_max
     rhs_code = _rhs_code(rhs, model, n_rhs_planned)
     n_hist = plan.n_hist if (sel.hist_el or sel.hist_dof or (full_history and not rk4)) else 0
-    vectors = _vectors(s, history_peaks)
     need = kd.record_bytes(sel.n_cycles_cap, len(sel.track), n_hist, len(sel.hist_el),
-                           len(sel.hist_dof), plan.n_full, s.n_dof, len(vectors))
+                           len(sel.hist_dof), plan.n_full, s.n_dof)
     if need > _MEMORY_LIMIT:
         raise SolverError(
             f"the requested outputs need {need / 1024**3:.1f} GiB; record less: raise "
@@ -585,9 +569,7 @@ def integrate(
                          s.n_elements, sel.hist_el, sel.hist_dof, n_hist, plan.n_full,
                          s.n_dof, load_sharing_min_total,
                          [kd.continuous_start(full_model.corner_ptr, full_model.corner_node, e)
-                          for e in sel.track], list(vectors.values()) if n_hist else (),
-                         {e for e in range(s.n_elements)
-                          if np.any(s.gap_values[s.gap_ptr[e]:s.gap_ptr[e + 1]] > 0.0)})
+                          for e in sel.track])
     work = kd.make_work(model, rhs_code.parameters)
     work.Y[kd.Y_STATE] = y
     counters = np.zeros(kern.N_COUNTERS, dtype=np.int64)
@@ -613,13 +595,12 @@ def integrate(
                      compile_time=compile_time, wall_time=time.perf_counter() - t_call,
                      rhs_name=("literal" if rhs_code.literal else "generated")
                      if rhs_code.generated else "general",
-                     rhs_compile_time=rhs_code.compile_time, full_history=full_history,
-                     peak_names=tuple(vectors) if n_hist else ())
+                     rhs_compile_time=rhs_code.compile_time, full_history=full_history)
 
 
 def _solution(s, sel, plan, rec, counters, clock, y, *, method, t_span, blowup, step_min,
               step_max, compile_time, wall_time, rhs_name, rhs_compile_time,
-              full_history, peak_names=()) -> Solution:
+              full_history) -> Solution:
     """The :class:`Solution` of a finished run from its output arrays (``rec``, a
     :class:`~.kernel_data.Record`), counters, clock and end state ``y``: the one place
     that turns a run's raw outputs into a Solution (the GPU ensemble backend,
@@ -659,7 +640,7 @@ def _solution(s, sel, plan, rec, counters, clock, y, *, method, t_span, blowup, 
         history_elements=tuple(sel.hist_el),
         history_dofs=tuple(sel.hist_dof),
         history_t=_rows(rec.hist_t, n_rec),
-        history_forces=_rows(rec.hist_f[:, :len(sel.hist_el)], n_rec),
+        history_forces=_rows(rec.hist_f, n_rec),
         history_q=_rows(rec.hist_q, n_rec),
         history_v=_rows(rec.hist_v, n_rec),
         full_t=_rows(rec.full_t, n_full_rec) if full_history else None,
@@ -669,9 +650,6 @@ def _solution(s, sel, plan, rec, counters, clock, y, *, method, t_span, blowup, 
         back_contact_steps=rec.back_count,
         separation_time=rec.sep_time,
         back_contact_time=rec.back_time,
-        history_peak_names=tuple(peak_names),
-        history_peaks=(_rows(rec.hist_f[:, len(sel.hist_el):], n_rec) if len(peak_names)
-                       else None),
     )
 
 
@@ -708,30 +686,6 @@ def _initial_state(s: Structure, y0) -> np.ndarray:
         raise OptionError("y0 contains NaN or inf; start from finite displacements and "
                           "velocities, e.g. static_equilibrium(structure).y0.")
     return y
-
-
-def _vectors(s: Structure, history_peaks) -> dict[str, list[tuple[int, np.ndarray]]]:
-    """``integrate``'s ``history_peaks`` checked: name -> [(element index, direction)]."""
-    if history_peaks is None:
-        return {}
-    if not hasattr(history_peaks, "items"):
-        raise OptionTypeError(f"history_peaks must map a name to (element, direction) "
-                              f"terms, e.g. {{'b1': [('b1.support.x', (1, 0, 0))]}}, got "
-                              f"{history_peaks!r}")
-    out = {}
-    for name, terms in history_peaks.items():
-        bad = OptionError(f"history_peaks[{name!r}] needs one or more terms (element, "
-                          f"direction), each direction three finite numbers (x, y, z), "
-                          f"got {terms!r}")
-        try:
-            els, dirs = zip(*terms)
-            dirs = [np.asarray(d, dtype=float).reshape(-1) for d in dirs]
-        except (TypeError, ValueError):
-            raise bad from None
-        if any(d.shape != (3,) or not np.all(np.isfinite(d)) for d in dirs):
-            raise bad
-        out[str(name)] = list(zip(_resolve(s.element_names, els, "element"), dirs))
-    return out
 
 
 @dataclass(frozen=True)

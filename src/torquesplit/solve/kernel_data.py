@@ -86,49 +86,27 @@ applies (set by the kernels at their start: ``_kernels.state_limits``)."""
 
 Record = namedtuple("Record", (
     "track_el", "track_base", "trk_cont", "cyc_max", "cyc_min", "cyc_sum", "cyc_cnt", "cyc_wt",
-    "prev_f", "prev_c", "pk_t", "pk_f", "pk_g", "pk_k", "pk_n",
+    "prev_t", "prev_f", "prev_c", "pk_t", "pk_f", "pk_g", "pk_k", "pk_n", "pk_x",
     "grp_ptr", "grp_col", "grp_min", "rat_max", "rat_min",
     "sep_count", "back_count", "sep_time", "back_time",
     "hist_el", "hist_dof", "hist_t", "hist_f", "hist_q", "hist_v", "full_t", "full_y",
-    "pv_i", "pv_x",
 ))
 """Outputs of a run.  Per tracked element: ``trk_cont`` 1 where its force is continuous
 at its cycle starts (:func:`continuous_start`), else 0.  Per tracked element (columns)
 and cycle (rows, counted from the cycle containing the start time): force max, min,
 time integral (trapezoid rule over the step samples and the corner instants, each half-interval in its end's cycle) and
 its time (``cyc_wt``: their ratio is the cycle's mean force), sample count; the last
-instant entered's forces and cycles (``prev_f``, ``prev_c``); for the peaks between the
-instants, the last two (slots alternating): ``pk_t`` (2,) their times (the newer one's
-is the last instant's), ``pk_g`` (n_tr, 2) contact regimes, ``pk_k`` (3,) whether each
-is a corner and (``PK_NEXT``) whether the next sample is, ``pk_f`` (n_tr,) the older
-one's forces (the last one's are ``prev_f``), ``pk_n`` (1,) instants entered (single
-values ride in these arrays: each array of the Record is an argument more of the calls
-that take it); per
+instant entered (``prev_t`` (1,), NaN before the first; ``prev_f``, ``prev_c`` its
+forces and cycles); for the peaks between the instants, the last two (slots
+alternating): ``pk_t`` (2,) their times, ``pk_g`` (n_tr, 2) contact regimes, ``pk_k``
+(2,) whether each is a corner, ``pk_f`` (n_tr,) the older one's forces (the last one's
+are ``prev_f``), ``pk_n`` (1,) instants entered, ``pk_x`` (1,) whether the next sample
+is a corner; per
 load-sharing group (``grp_col[grp_ptr[g]:grp_ptr[g+1]]`` its tracked columns) the
 largest and smallest instantaneous ratio ``N f_i / sum_j f_j`` of each member in each of
 its cycles (``rat_max``, ``rat_min``), formed only while the group's total force exceeds
 ``grp_min[g]`` (the ratio of nearly nothing is not load sharing); per element the samples and time in separation
-and in back-side contact; the decimated history (``hist_f``: the history elements'
-forces, then each streamed force vector's largest magnitude since the row before) and
-the optional full state.  The streamed force vectors (``integrate``'s ``history_peaks``)
-in two packed arrays (each array of the Record is an argument more of the calls that
-take it), laid out by :func:`vector_arrays`: ``pv_i`` (int64) a header (the ``PV_*``
-indices) of the vector count, the counts below which a support's vectors have one, two,
-three terms (``PV_N1..3``: orthogonal unit directions, no gap), and offsets into
-``pv_i`` of each vector's first term (``PV_PTR``, n_v + 1), the terms' elements
-(``PV_EL``), whether each has a gap (``PV_GAP``), a support's elements three per vector
-(``PV_E3``), each vector's output column (``PV_COL``) and its last two instants'
-contact-regime codes (``PV_G``, slots as ``pk_t``'s), and offsets into ``pv_x``
-(float64) of the terms' directions (``PV_CF``, three each), each vector's largest
-squared magnitude since the last history row (``PV_RUN``) and its last two instants'
-squared magnitudes (``PV_F``)."""
-
-PK_NEXT = 2  # Record.pk_k[PK_NEXT]: whether the next sample is a corner
-
-# header of Record.pv_i (the streamed force vectors: :func:`vector_arrays`)
-(PV_NV, PV_N1, PV_N2, PV_N3, PV_PTR, PV_EL, PV_GAP, PV_E3, PV_COL, PV_G, PV_CF, PV_RUN,
- PV_F) = range(13)
-PV_HEAD = 13
+and in back-side contact; the decimated history and the optional full state."""
 
 # rows of Work.Y
 Y_STATE = 0  # the state (copied in and out of the caller's y)
@@ -420,21 +398,18 @@ def continuous_start(corner_ptr, corner_node, e: int) -> bool:
 
 def make_record(track_el, track_base, n_cycles_cap: int, groups, n_el: int, hist_el,
                 hist_dof, n_hist: int, n_full: int, n_dof: int, group_min=None,
-                continuous=None, vectors=(), gapped=()) -> Record:
+                continuous=None) -> Record:
     """Output arrays of a run.  ``groups``: lists of tracked columns, one per
     load-sharing group (the ratio statistics); ``group_min``: the group total force below
     which no ratio is formed [N] (default 0: any positive total); ``continuous``: per
     tracked element, whether its force is continuous at its cycle starts (default none:
-    no forces interpolated at cycle starts); ``vectors``: the streamed force vectors,
-    each a list of (element, direction (3,)) terms (default none); ``gapped``: the
-    elements with a gap (their contact regime can change)."""
+    no forces interpolated at cycle starts)."""
     n_tr = len(track_el)
     cap = int(n_cycles_cap)
     grp_ptr = np.zeros(len(groups) + 1, dtype=np.int64)
     grp_ptr[1:] = np.cumsum([len(g) for g in groups])
     grp_col = np.array([c for g in groups for c in g], dtype=np.int64)
     n_he, n_hd = len(hist_el), len(hist_dof)
-    pv_i, pv_x, _ = vector_arrays(list(vectors), gapped)
     return Record(
         track_el=np.asarray(track_el, dtype=np.int64),
         track_base=np.asarray(track_base, dtype=np.int64),
@@ -442,11 +417,11 @@ def make_record(track_el, track_base, n_cycles_cap: int, groups, n_el: int, hist
                   else np.asarray(continuous, dtype=np.int64).reshape(n_tr)),
         cyc_max=np.full((cap, n_tr), -np.inf), cyc_min=np.full((cap, n_tr), np.inf),
         cyc_sum=np.zeros((cap, n_tr)), cyc_cnt=np.zeros((cap, n_tr), dtype=np.int64),
-        cyc_wt=np.zeros((cap, n_tr)), prev_f=np.zeros(n_tr),
+        cyc_wt=np.zeros((cap, n_tr)), prev_t=np.full(1, np.nan), prev_f=np.zeros(n_tr),
         prev_c=np.zeros(n_tr, dtype=np.int64), pk_t=np.zeros(2), pk_f=np.zeros(n_tr),
         pk_g=np.zeros((n_tr, 2), dtype=np.int64),
-        pk_k=np.zeros(3, dtype=np.int64), pk_n=np.zeros(1, dtype=np.int64),
-        grp_ptr=grp_ptr, grp_col=grp_col,
+        pk_k=np.zeros(2, dtype=np.int64), pk_n=np.zeros(1, dtype=np.int64),
+        pk_x=np.zeros(1, dtype=np.int64), grp_ptr=grp_ptr, grp_col=grp_col,
         grp_min=(np.zeros(len(groups)) if group_min is None
                  else np.asarray(group_min, dtype=np.float64).reshape(len(groups))),
         rat_max=np.full((cap, n_tr), -np.inf), rat_min=np.full((cap, n_tr), np.inf),
@@ -454,54 +429,14 @@ def make_record(track_el, track_base, n_cycles_cap: int, groups, n_el: int, hist
         sep_time=np.zeros(n_el), back_time=np.zeros(n_el),
         hist_el=np.asarray(hist_el, dtype=np.int64),
         hist_dof=np.asarray(hist_dof, dtype=np.int64),
-        hist_t=np.zeros(n_hist), hist_f=np.zeros((n_hist, n_he + len(vectors))),
+        hist_t=np.zeros(n_hist), hist_f=np.zeros((n_hist, n_he)),
         hist_q=np.zeros((n_hist, n_hd)), hist_v=np.zeros((n_hist, n_hd)),
         full_t=np.zeros(n_full), full_y=np.zeros((n_full, 2 * n_dof)),
-        pv_i=pv_i, pv_x=pv_x,
     )
 
 
-def vector_arrays(vectors, gapped=()) -> tuple[np.ndarray, np.ndarray, list[int]]:
-    """``Record.pv_i`` and ``pv_x`` of the streamed force vectors (``vectors``: lists of
-    (element, direction (3,)) terms; ``gapped``: the elements with a gap, whose contact
-    regime can change), and the vectors' order in them: a support's (orthogonal unit
-    directions, no gap, at most three terms) first, by number of terms, then the
-    others."""
-    gapped = set(gapped)
-
-    def simple(v) -> bool:
-        d = np.array([c for _, c in v], dtype=float).reshape(-1, 3)
-        return (len(v) <= 3 and not any(e in gapped for e, _ in v)
-                and bool(np.all((d == 0) | (np.abs(d) == 1)))
-                and bool(np.array_equal(np.abs(d) @ np.abs(d).T, np.eye(len(v)))))
-
-    order = sorted(range(len(vectors)),
-                   key=lambda i: len(vectors[i]) if simple(vectors[i]) else 4)
-    vs = [vectors[i] for i in order]
-    counts = [sum(1 for v in vs if simple(v) and len(v) <= k) for k in (1, 2, 3)]
-    terms = [(e, np.asarray(c, dtype=float)) for v in vs for e, c in v]
-    e3 = np.zeros((counts[2], 3), dtype=np.int64)
-    for i, v in enumerate(vs[:counts[2]]):
-        e3[i, :len(v)] = [e for e, _ in v]
-    parts = [np.concatenate([[0], np.cumsum([len(v) for v in vs])]),  # PV_PTR
-             [e for e, _ in terms], [e in gapped for e, _ in terms],  # PV_EL, PV_GAP
-             e3.ravel(), order, np.zeros(2 * len(vs))]  # PV_E3, PV_COL, PV_G
-    head = np.zeros(PV_HEAD, dtype=np.int64)
-    head[[PV_NV, PV_N1, PV_N2, PV_N3]] = [len(vs), *counts]
-    at = PV_HEAD
-    for key, part in zip((PV_PTR, PV_EL, PV_GAP, PV_E3, PV_COL, PV_G), parts):
-        head[key] = at
-        at += len(part)
-    n_t = len(terms)
-    head[[PV_CF, PV_RUN, PV_F]] = [0, 3 * n_t, 3 * n_t + len(vs)]
-    pv_i = np.concatenate([head, *[np.asarray(x, dtype=np.int64) for x in parts]])
-    pv_x = np.concatenate([np.array([c for _, c in terms]).reshape(-1),
-                           np.full(len(vs), -np.inf), np.zeros(2 * len(vs))])
-    return pv_i.astype(np.int64), pv_x.astype(np.float64), order
-
-
 def record_bytes(n_cycles_cap: int, n_tracked: int, n_hist: int, n_hist_el: int,
-                 n_hist_dof: int, n_full: int, n_dof: int, n_vectors: int = 0) -> int:
+                 n_hist_dof: int, n_full: int, n_dof: int) -> int:
     """Bytes of the output arrays :func:`make_record` would allocate."""
-    return 8 * (n_hist * (1 + n_hist_el + 2 * n_hist_dof + n_vectors)
-                + n_full * (1 + 2 * n_dof) + 7 * n_cycles_cap * n_tracked)
+    return 8 * (n_hist * (1 + n_hist_el + 2 * n_hist_dof) + n_full * (1 + 2 * n_dof)
+                + 7 * n_cycles_cap * n_tracked)

@@ -287,52 +287,6 @@ def cycle_statistics_numpy(times, forces, frequency, phase, t0, n_cycles_cap,
     return cmax, cmin, mean, ccnt
 
 
-def history_peaks_numpy(times, magnitudes, regimes, rows, kinks=None):
-    """Per history row, each streamed force vector's largest magnitude since the row
-    before (``integrate``'s ``history_peaks``), from its magnitudes (n, n_v) at the
-    instants ``times`` (n,: increasing, the step samples and corner instants), their
-    terms' contact regimes (n, n_v: one code each, equal where every term's regime,
-    :func:`contact_regime_numpy`, is) and the
-    instants where a history row is written (``rows``, indices into ``times``).  An
-    instant's magnitude belongs to the first row at or after it; where the middle one of
-    three consecutive instants is the largest (not all three equal), is not a corner
-    (``kinks``: default none) and every term keeps its regime over the three, the root
-    of the vertex of the parabola through their squares belongs to the row of the
-    third.  Returns (len(rows), n_v).  Twin of ``_kernels.magnitude_instant`` with
-    ``store_history`` (the RK4 history, whose rows are instants; the parabola's formula
-    is the kernel's)."""
-    from torquesplit.solve._kernels import vertex
-
-    times = np.asarray(times, dtype=float)
-    f = np.asarray(magnitudes, dtype=float) ** 2
-    g = np.asarray(regimes)
-    kinks = np.zeros(times.size, bool) if kinks is None else np.asarray(kinks, bool)
-    rows = np.asarray(rows, dtype=int)
-    row_of = np.searchsorted(rows, np.arange(times.size))  # first row at or after
-    out = np.full((rows.size, f.shape[1]), -np.inf)
-    for i in range(times.size):
-        if row_of[i] < rows.size:
-            out[row_of[i]] = np.maximum(out[row_of[i]], f[i])
-    for i in range(1, times.size - 1):
-        if kinks[i] or row_of[i + 1] >= rows.size:
-            continue
-        for v in range(f.shape[1]):
-            f0, f1, f2 = f[i - 1, v], f[i, v], f[i + 1, v]
-            same = g[i - 1, v] == g[i, v] == g[i + 1, v]
-            if same and f1 >= f0 and f1 >= f2 and (f1 > f0 or f1 > f2):
-                peak = vertex(times[i - 1], times[i], times[i + 1], f0, f1, f2)
-                out[row_of[i + 1], v] = max(out[row_of[i + 1], v], peak)
-    return np.sqrt(out)
-
-
-def contact_regime_numpy(deformation, half_gap):
-    """Contact regime of elements: 1 in contact (d > g, or no gap), -1 in back-side
-    contact (d < -g), 0 apart (``_kernels.regime``)."""
-    d = np.asarray(deformation, dtype=float)
-    g = np.asarray(half_gap, dtype=float)
-    return np.where(g > 0, np.where(d > g, 1, np.where(d < -g, -1, 0)), 1)
-
-
 def cycle_ratio_numpy(times, forces, frequency, phase, t0, n_cycles_cap, group_min=0.0,
                       continuous_start=None):
     """Per-cycle max and min of the instantaneous load-sharing ratio N f_j / sum_i f_i
