@@ -971,9 +971,10 @@ def static(
     from .results import files
     from .results.export import check_dataset_output
 
-    state = {"saved": None}
+    state = {"saved": None, "figures": False}
     with contextlib.ExitStack() as stack, ux.interruptible(
             lambda: (f"results kept in {', '.join(str(f) for f in state['saved'])}"
+                     + ("; figures incomplete" if state["figures"] else "")
                      if state["saved"] else "")):
         try:
             opts = _option_errors()
@@ -1027,12 +1028,14 @@ def static(
         if plots is not None:
             from .plot import write_static_figures
 
+            state["figures"] = True  # (a Ctrl-C now: "figures incomplete", as run says)
             try:
                 with ux.progress("writing figures", quiet or as_json, total=None):
                     figures = write_static_figures(res, plots)
             except OSError as exc:
                 failed = failed or _figure_error(exc, "--plots", plots,
                                                  _kept_results(saved or []))
+            state["figures"] = False
     _print_static(m, res, met, orbits, saved, figures, plots, as_json)
     if failed is not None:
         _fail(failed)

@@ -300,6 +300,22 @@ def test_ctrl_c_after_saving_says_what_was_kept(tmp_path, monkeypatch):
     assert "figures incomplete" in last and (tmp_path / "r.nc").exists()
 
 
+def test_ctrl_c_while_static_figures_are_written_says_they_are_incomplete(tmp_path,
+                                                                          monkeypatch):
+    """'static --plots' said 'results kept in s.nc' with the figure folder empty."""
+    import torquesplit.plot.figures as figures
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(figures, "write_jobs", interrupted)
+    res = runner.invoke(app, ["static", "ji_li_mill_drive", "--revolutions", "0.05", "--out",
+                              str(tmp_path / "s.nc"), "--plots", str(tmp_path / "figs")])
+    assert res.exit_code == 130, res.output
+    last = res.stderr.strip().splitlines()[-1]
+    assert last == f"interrupted; results kept in {tmp_path / 's.nc'}; figures incomplete"
+
+
 def test_a_real_sigint_stops_a_run_and_keeps_what_it_computed(tmp_path):
     """Ctrl-C during the integration ends the run as a stopped one: its partial results
     are written (with their status) and said; nothing is lost, no traceback."""

@@ -65,6 +65,25 @@ def test_an_interrupted_speed_sweep_keeps_its_curve(monkeypatch):
     assert ds.attrs["message"].startswith("interrupted (Ctrl-C) after 2 points")
 
 
+def test_a_speed_sweep_interrupted_before_its_first_point_stops(monkeypatch):
+    """Ctrl-C before the first point (while the kernels compiled) gave an empty curve
+    whose checks then called a half-built kernel (numba's RuntimeError, a traceback), or
+    exited 130 without a word: there is nothing to keep, so the interrupt propagates and
+    the command says so in one line."""
+    _interrupt_sweep_at_point(monkeypatch, 1)
+    from torquesplit import example_path
+    from torquesplit.steady.maps import sweep_speed
+
+    with pytest.raises(KeyboardInterrupt):
+        sweep_speed(example_path("ji_li_mill_drive"), 300 * 0.10472, 1500 * 0.10472,
+                    points=30)
+    _interrupt_sweep_at_point(monkeypatch, 1)  # (a counter of its own)
+    res = CliRunner().invoke(app, ["sweep-speed", "ji_li_mill_drive", "--from", "300 rpm",
+                                   "--to", "1500 rpm", "--points", "30"])
+    assert res.exit_code == 130, res.output
+    assert res.stderr.strip().splitlines()[-1] == "interrupted; nothing written"
+
+
 def _interrupting_progress(at: float):
     def progress(fraction):
         if fraction >= at:

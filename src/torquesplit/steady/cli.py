@@ -452,9 +452,11 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
                 opts(ui._check_figure_file, plot, "--plot", force)
             opts.raise_any(model, assign)
             m, _ = load(model, assign)
-            from torquesplit.cli_support import collect_warnings, progress
+            from torquesplit.cli_support import collect_warnings, interruptible, progress
 
-            with collect_warnings(), progress("speed sweep", as_json or quiet, total=None):
+            # (Ctrl-C before the first point exited 130 without a word)
+            with interruptible(), collect_warnings(), progress("speed sweep",
+                                                              as_json or quiet, total=None):
                 ds = sweep_speed(m, _speed(start, "--from"), _speed(stop, "--to"),
                                  points=points, harmonics=harmonics, keep=_keep(keep),
                                  max_cycles=max_cycles, stability=not no_stability,

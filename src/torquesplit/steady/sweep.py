@@ -354,6 +354,10 @@ class Continuation:
                 message = f"stopped after {max_points} points; curve kept."
                 complete = False
         except KeyboardInterrupt:
+            if not pts:  # nothing to keep: the caller stops (a Ctrl-C while the kernels
+                # compiled gave an empty curve whose checks then called a half-built
+                # kernel: numba's RuntimeError)
+                raise
             message = (f"interrupted (Ctrl-C) after {len(pts)} points; the curve up to "
                        f"there is kept.")
             complete = False
