@@ -1976,5 +1976,7 @@ for _info in app.registered_commands:  # every command's --help without a type
         _info.cls = _Command
 
 
-if __name__ == "__main__":  # pragma: no cover
-    sys.exit(app())
+if __name__ == "__main__":  # pragma: no cover - as the installed script runs it
+    from torquesplit._launch import main
+
+    main()
