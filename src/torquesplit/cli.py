@@ -1794,8 +1794,10 @@ def modes(
             kin = solve_kinematics(m)
             rep = model_modes(m, rotating_frame=rotating_frame, below=limit, count=count)
         saved = None
-        if plan is not None:
-            with files.claim_output(plan):
+        if plan is not None:  # (Ctrl-C here exited 130 without a word; the file is
+            # finished first, then the interrupt says so)
+            with ux.interruptible(lambda: f"results kept in {saved[0]}" if saved else ""), \
+                    ux.finish_before_interrupt(), files.claim_output(plan):
                 ds = rep.to_dataset()
                 ds.attrs["model"] = m.model.name
                 from .results.export import with_model

@@ -292,3 +292,28 @@ def test_python_dash_m_torquesplit_is_the_command():
     out = subprocess.run([sys.executable, "-m", "torquesplit", "--version"],
                          capture_output=True, text=True, check=True)
     assert out.stdout.startswith("torquesplit ")
+
+
+def test_modes_interrupted_while_saving_or_plotting_says_so(tmp_path, monkeypatch):
+    """'modes' exited 130 without a word when Ctrl-C landed in its save, and 'modes
+    --campbell' too, also after its map's file was written (which it did not name)."""
+    import torquesplit.results.export as export
+    import torquesplit.steady.plot as plot
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(export, "save_dataset", interrupted)
+    res = CliRunner().invoke(app, ["modes", "ji_li_mill_drive", "--out",
+                                   str(tmp_path / "m.nc")])
+    assert res.exit_code == 130, res.output
+    assert res.stderr.strip().splitlines()[-1] == "interrupted; nothing written"
+    monkeypatch.undo()  # (the map's file is saved; its figure is interrupted)
+    monkeypatch.setattr(plot, "save", interrupted)
+    out = tmp_path / "c.nc"
+    res = CliRunner().invoke(app, ["modes", "ji_li_mill_drive", "--campbell", "--from",
+                                   "500 rpm", "--to", "3000 rpm", "--out", str(out),
+                                   "--plot", str(tmp_path / "c.png")])
+    assert res.exit_code == 130, res.output
+    last = res.stderr.strip().splitlines()[-1]
+    assert last == f"interrupted; kept {out}; the figure is incomplete" and out.exists()

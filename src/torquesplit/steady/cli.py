@@ -813,25 +813,30 @@ def campbell_command(m, start, stop, plot, as_json, console, json_default, out=N
     """``modes --campbell``: the resonance map and the critical speeds (the map written
     to ``out`` if given; mesh orders 1..``orders``, None: as the stiffness tables
     excite them)."""
+    from torquesplit.cli_support import interruptible
     from torquesplit.steady.maps import campbell
 
     from torquesplit.errors import TorquesplitError
 
-    ds, crossings = campbell(m, _speed(start, "--from"), _speed(stop, "--to"),
-                             orders=orders)
     written, failed = [], None
-    try:  # a file that cannot be written: the map is still printed, then the error
-        if out is not None:
-            from torquesplit.results.export import dataset_files
+    # (Ctrl-C exited 130 without a word, and after the map's file, without naming it)
+    with interruptible(lambda: f"kept {', '.join(str(w) for w in written)}"
+                       + ("; the figure is incomplete" if plot is not None
+                          and plot not in written else "") if written else ""):
+        ds, crossings = campbell(m, _speed(start, "--from"), _speed(stop, "--to"),
+                                 orders=orders)
+        try:  # a file that cannot be written: the map is still printed, then the error
+            if out is not None:
+                from torquesplit.results.export import dataset_files
 
-            written += dataset_files(ds, _save(_with_model(ds, m), out, force))
-        if plot is not None:
-            from torquesplit.steady.plot import campbell_figure, save
+                written += dataset_files(ds, _save(_with_model(ds, m), out, force))
+            if plot is not None:
+                from torquesplit.steady.plot import campbell_figure, save
 
-            save(campbell_figure(ds), plot)
-            written.append(plot)
-    except (TorquesplitError, OSError) as exc:
-        failed = exc
+                save(campbell_figure(ds), plot)
+                written.append(plot)
+        except (TorquesplitError, OSError) as exc:
+            failed = exc
     from torquesplit.steady.maps import mode_kind, split_suppressed
 
     critical, suppressed = split_suppressed(crossings)
