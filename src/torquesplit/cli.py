@@ -1312,9 +1312,14 @@ def contact(
 ):
     """Loaded tooth contact analysis of one mesh: transmission error, stiffness, load
     distribution, contact pressure, Harris map, meshing-in impact."""
-    with ux.interruptible():
+    state = {"written": [], "figures": False}  # (what an interrupt keeps: a reviewer's
+    # Ctrl-C during the figures said 'nothing written' with the results file complete)
+    with ux.interruptible(lambda: (
+            f"results kept in {', '.join(str(f) for f in state['written'])}"
+            + ("; figures incomplete" if state["figures"] else "")
+            if state["written"] else "")):
         _contact(model, pair, load, on, plot, force, positions, slices, harris, assign,
-                 as_json, out)
+                 as_json, out, state)
 
 
 MAX_FLANK_PRESSURE = 4e9
@@ -1327,7 +1332,7 @@ CONTACT_TABLES = ("load_case", "position", "harris_load")
 
 
 def _contact(model, pair, load, on, plot, force, positions, slices, harris, assign,
-             as_json, out=None) -> None:
+             as_json, out=None, state=None) -> None:
     from .results.export import check_dataset_output
 
     try:
@@ -1430,6 +1435,8 @@ def _contact(model, pair, load, on, plot, force, positions, slices, harris, assi
                                             gears=names), m)
             ds.attrs["model"] = m.model.name
             written = dataset_files(ds, save_dataset(ds, out, overwrite=force))
+            if state is not None:
+                state["written"] = written
         except TorquesplitError as exc:
             failed = exc
         except OSError as exc:
@@ -1439,6 +1446,8 @@ def _contact(model, pair, load, on, plot, force, positions, slices, harris, assi
     if plot is not None:
         from .plot.contact import write_contact_figures
 
+        if state is not None:
+            state["figures"] = True
         try:
             figures = write_contact_figures(results, hm, plot, operating=op,
                                             operating_load=op_load,
@@ -1446,6 +1455,8 @@ def _contact(model, pair, load, on, plot, force, positions, slices, harris, assi
         except OSError as exc:
             failed = _figure_error(exc, "--plot", plot, "the tables are printed" + (
                 ", the results written" if written else ", nothing saved"))
+        if state is not None:
+            state["figures"] = False
     _print_contact(m, pair, names, op_load, cm, results, hm, impact, op, figures, plot,
                    as_json, reverse, impact_note, given, written)
     if failed is not None:

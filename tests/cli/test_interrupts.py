@@ -317,3 +317,43 @@ def test_modes_interrupted_while_saving_or_plotting_says_so(tmp_path, monkeypatc
     assert res.exit_code == 130, res.output
     last = res.stderr.strip().splitlines()[-1]
     assert last == f"interrupted; kept {out}; the figure is incomplete" and out.exists()
+
+
+def test_contact_interrupted_while_writing_figures_names_its_results(tmp_path, monkeypatch):
+    """'contact --out --plot' interrupted during its figures said 'nothing written'
+    though its results file was complete (a reviewer)."""
+    import torquesplit.plot.contact as contact
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(contact, "write_contact_figures", interrupted)
+    out = tmp_path / "k.nc"
+    res = CliRunner().invoke(app, ["contact", "ji_li_mill_drive", "--pair", "m11", "--out",
+                                   str(out), "--plot", str(tmp_path / "figs")])
+    assert res.exit_code == 130, res.output
+    last = res.stderr.strip().splitlines()[-1]
+    assert last == f"interrupted; results kept in {out}; figures incomplete" and out.exists()
+
+
+def test_steady_interrupted_after_its_solve_says_what_it_kept(tmp_path, monkeypatch):
+    """'steady --out --check-step': a Ctrl-C in the step check said 'nothing written'
+    with the results file complete, and one before the save exited 130 without a word
+    (a reviewer)."""
+    import torquesplit.convergence as convergence
+    import torquesplit.results.plausibility as plausibility
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(convergence, "check_steady", interrupted)
+    out = tmp_path / "a.nc"
+    res = CliRunner().invoke(app, ["steady", "ji_li_mill_drive", "--out", str(out),
+                                   "--check-step"])
+    assert res.exit_code == 130, res.output
+    assert res.stderr.strip().splitlines()[-1] == f"interrupted; results kept in {out}"
+    monkeypatch.setattr(plausibility, "result_warnings", interrupted)
+    res = CliRunner().invoke(app, ["steady", "ji_li_mill_drive", "--out",
+                                   str(tmp_path / "b.nc")])
+    assert res.exit_code == 130, res.output
+    assert res.stderr.strip().splitlines()[-1] == "interrupted; nothing written"

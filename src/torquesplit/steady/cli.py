@@ -232,36 +232,46 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
                                   max_cycles="auto" if max_cycles is None else max_cycles,
                                   stability=stability, steps_per_cycle=steps_per_cycle,
                                   progress=update)
-            res = st.to_results()
-            if st.solution.converged:  # what the results say, as 'run' prints it
-                from torquesplit.cli_support import warn
-                from torquesplit.results.plausibility import result_warnings
+            # (a Ctrl-C after the solve exited 130 without a word, and during the step
+            # check said 'nothing written' with the results file complete: a reviewer)
+            state = {"saved": None}
+            with interruptible(lambda: f"results kept in "
+                               f"{', '.join(str(f) for f in state['saved'])}"
+                               if state["saved"] else ""):
+                res = st.to_results()
+                if st.solution.converged:  # what the results say, as 'run' prints it
+                    from torquesplit.cli_support import warn
+                    from torquesplit.results.plausibility import result_warnings
 
-                for loc, msg in result_warnings(res, res.metrics()):
-                    warn(f"{loc}: {msg}")
-                for note in st.critical_notes():  # (as 'run' says it, at this speed)
-                    warn(note)
-            if speed is not None:  # (run at a --set speed keeps the power: forces 14 % apart
-                # at 3425 rpm on the tutorial's drive, neither saying which it held)
-                from torquesplit.cli_support import warn
+                    for loc, msg in result_warnings(res, res.metrics()):
+                        warn(f"{loc}: {msg}")
+                    for note in st.critical_notes():  # (as 'run' says it, at this speed)
+                        warn(note)
+                if speed is not None:  # (run at a --set speed keeps the power: forces 14 % apart
+                    # at 3425 rpm on the tutorial's drive, neither saying which it held)
+                    from torquesplit.cli_support import warn
 
-                warn("--speed: the loads keep the model's torques (forces as at its own "
-                     "speed; 'run --set drives.NAME.speed=...' keeps its power instead)",
-                     label="note")
-            rows = st.mesh_table(results=res)
-            saved = None
-            if out is not None:  # (every file named where the save is reported)
-                from torquesplit.results.files import RESULT_FORMATS, companion_files
+                    warn("--speed: the loads keep the model's torques (forces as at its own "
+                         "speed; 'run --set drives.NAME.speed=...' keeps its power instead)",
+                         label="note")
+                rows = st.mesh_table(results=res)
+                saved = None
+                if out is not None:  # (every file named where the save is reported; a Ctrl-C
+                    # waits for it, then names it)
+                    from torquesplit.cli_support import finish_before_interrupt
+                    from torquesplit.results.files import RESULT_FORMATS, companion_files
 
-                path = res.save(out, overwrite=force)
-                saved = list(companion_files(path, RESULT_FORMATS[path.suffix.lower()]))
-            step_check = None
-            if check:
-                from torquesplit.convergence import check_steady
+                    with finish_before_interrupt():
+                        path = res.save(out, overwrite=force)
+                        saved = state["saved"] = list(
+                            companion_files(path, RESULT_FORMATS[path.suffix.lower()]))
+                step_check = None
+                if check:
+                    from torquesplit.convergence import check_steady
 
-                with interruptible(), collect_warnings(), progress(
-                        "checking the resolution", as_json or quiet, total=None) as update:
-                    step_check = check_steady(st, progress=update)
+                    with collect_warnings(), progress(
+                            "checking the resolution", as_json or quiet, total=None) as update:
+                        step_check = check_steady(st, progress=update)
         except (TorquesplitError, ValueError, OSError) as exc:
             fail(_in_flags(exc))
             return
