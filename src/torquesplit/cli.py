@@ -235,9 +235,7 @@ def _figure_error(exc: BaseException, option: str, target: Path, kept: str):
 
 def _kept_results(saved) -> str:
     """What a command that failed to write its figures kept."""
-    if saved:
-        return "results kept in " + ", ".join(str(f) for f in saved)
-    return "the results are printed but not saved (no --out)"
+    return ux.kept_files(saved) or "the results are printed but not saved (no --out)"
 
 
 def _check_figure_file(path: Optional[Path], option: str, force: bool = False) -> None:
@@ -470,14 +468,8 @@ def run(
     state = {"saved": [], "figures": None}
     save_failed = None
 
-    def kept() -> str:
-        if state["saved"]:
-            done = ", ".join(str(f) for f in state["saved"])
-            return f"results kept in {done}" + (
-                "; figures incomplete" if state["figures"] is not None else "")
-        return "nothing written"
-
-    with contextlib.ExitStack() as stack, ux.interruptible(kept):
+    with contextlib.ExitStack() as stack, ux.interruptible(
+            lambda: ux.kept_files(state["saved"], state["figures"] is not None)):
         try:
             opts = _option_errors()
             opts(_check_method, method)
@@ -973,9 +965,7 @@ def static(
 
     state = {"saved": None, "figures": False}
     with contextlib.ExitStack() as stack, ux.interruptible(
-            lambda: (f"results kept in {', '.join(str(f) for f in state['saved'])}"
-                     + ("; figures incomplete" if state["figures"] else "")
-                     if state["saved"] else "")):
+            lambda: ux.kept_files(state["saved"], state["figures"])):
         try:
             opts = _option_errors()
             opts(_positive, revolutions, "--revolutions", "1")
@@ -1040,8 +1030,7 @@ def static(
     if failed is not None:
         _fail(failed)
     elif res.solution.interrupted:
-        ux.exit_interrupted(f"results kept in {', '.join(str(f) for f in saved)}"
-                            if saved else "")
+        ux.exit_interrupted(ux.kept_files(saved))
 
 
 def _print_static(m, res, met, orbits, saved, figures, plots, as_json) -> None:
@@ -1314,10 +1303,7 @@ def contact(
     distribution, contact pressure, Harris map, meshing-in impact."""
     state = {"written": [], "figures": False}  # (what an interrupt keeps: a reviewer's
     # Ctrl-C during the figures said 'nothing written' with the results file complete)
-    with ux.interruptible(lambda: (
-            f"results kept in {', '.join(str(f) for f in state['written'])}"
-            + ("; figures incomplete" if state["figures"] else "")
-            if state["written"] else "")):
+    with ux.interruptible(lambda: ux.kept_files(state["written"], state["figures"])):
         _contact(model, pair, load, on, plot, force, positions, slices, harris, assign,
                  as_json, out, state)
 
@@ -1807,7 +1793,7 @@ def modes(
         saved = None
         if plan is not None:  # (Ctrl-C here exited 130 without a word; the file is
             # finished first, then the interrupt says so)
-            with ux.interruptible(lambda: f"results kept in {saved[0]}" if saved else ""), \
+            with ux.interruptible(lambda: ux.kept_files(saved)), \
                     ux.finish_before_interrupt(), files.claim_output(plan):
                 ds = rep.to_dataset()
                 ds.attrs["model"] = m.model.name

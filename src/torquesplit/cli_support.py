@@ -260,6 +260,16 @@ def finish_before_interrupt() -> Iterator[None]:
         raise KeyboardInterrupt
 
 
+def kept_files(files, figures_incomplete: bool = False) -> str:
+    """What an interrupted command kept, for :func:`interruptible` and
+    :func:`exit_interrupted`: ``"results kept in a.nc[; figures incomplete]"``, or ""
+    (said as "nothing written") when no file was written."""
+    if not files:
+        return ""
+    return ("results kept in " + ", ".join(str(f) for f in files)
+            + ("; figures incomplete" if figures_incomplete else ""))
+
+
 def exit_interrupted(what: str = "") -> None:
     """Print ``interrupted; <what was kept>`` on stderr and exit with status 130 (also
     after a command that stopped on Ctrl-C and reported what it had computed)."""

@@ -234,10 +234,10 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
                                   progress=update)
             # (a Ctrl-C after the solve exited 130 without a word, and during the step
             # check said 'nothing written' with the results file complete: a reviewer)
-            state = {"saved": None}
-            with interruptible(lambda: f"results kept in "
-                               f"{', '.join(str(f) for f in state['saved'])}"
-                               if state["saved"] else ""):
+            from torquesplit.cli_support import kept_files
+
+            saved = None
+            with interruptible(lambda: kept_files(saved)):
                 res = st.to_results()
                 if st.solution.converged:  # what the results say, as 'run' prints it
                     from torquesplit.cli_support import warn
@@ -255,7 +255,6 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
                          "speed; 'run --set drives.NAME.speed=...' keeps its power instead)",
                          label="note")
                 rows = st.mesh_table(results=res)
-                saved = None
                 if out is not None:  # (every file named where the save is reported; a Ctrl-C
                     # waits for it, then names it)
                     from torquesplit.cli_support import finish_before_interrupt
@@ -263,8 +262,8 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
 
                     with finish_before_interrupt():
                         path = res.save(out, overwrite=force)
-                        saved = state["saved"] = list(
-                            companion_files(path, RESULT_FORMATS[path.suffix.lower()]))
+                        saved = list(companion_files(path,
+                                                     RESULT_FORMATS[path.suffix.lower()]))
                 step_check = None
                 if check:
                     from torquesplit.convergence import check_steady
