@@ -235,28 +235,12 @@ def finish_before_interrupt() -> Iterator[None]:
     """Within this block a Ctrl-C waits: the block (metrics and the results files of a
     finished computation) runs to its end, then the interrupt is raised, so that what was
     computed is on disk when :func:`interruptible` says what was kept.  A second Ctrl-C
-    interrupts at once.  Main thread only (elsewhere the block runs unguarded)."""
-    import signal
-    import threading
+    interrupts at once (:func:`torquesplit.errors.held_interrupt`)."""
+    from .errors import held_interrupt
 
-    current = (signal.getsignal(signal.SIGINT)
-               if threading.current_thread() is threading.main_thread() else None)
-    if current in (None, signal.SIG_IGN):  # not ours to change (a thread, a nohup job)
+    with held_interrupt() as ctrl_c:
         yield
-        return
-    hits = []
-
-    def later(signum, frame):
-        hits.append(signum)
-        if len(hits) > 1:
-            raise KeyboardInterrupt
-
-    before = signal.signal(signal.SIGINT, later)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGINT, before)
-    if hits:
+    if ctrl_c.hit:
         raise KeyboardInterrupt
 
 

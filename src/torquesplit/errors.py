@@ -15,6 +15,7 @@ from __future__ import annotations
 import contextlib
 import contextvars
 import re
+from collections.abc import Iterator
 
 #: longest quoted value (in characters) a message repeats from the input
 QUOTE_LIMIT = 80
@@ -391,3 +392,38 @@ def from_interrupt(exc: BaseException | None) -> bool:
         exc = exc.__cause__ or exc.__context__
         seen += 1
     return False
+
+
+class HeldInterrupt:
+    """What :func:`held_interrupt` saw: ``hit`` is True when a Ctrl-C came during its block."""
+
+    hit: bool = False
+
+
+@contextlib.contextmanager
+def held_interrupt() -> Iterator[HeldInterrupt]:
+    """Within this block a Ctrl-C waits: the block runs to its end and the object yielded
+    says whether one came, so that a computation can finish what the user would lose (a
+    speed sweep's curve, a results file) and then stop.  A second Ctrl-C interrupts at
+    once.  Main thread only, and only where Python's own handler is installed (elsewhere,
+    in a thread or a job that ignores SIGINT, the block runs unguarded)."""
+    import signal
+    import threading
+
+    held = HeldInterrupt()
+    current = (signal.getsignal(signal.SIGINT)
+               if threading.current_thread() is threading.main_thread() else None)
+    if current in (None, signal.SIG_IGN):  # not ours to change
+        yield held
+        return
+
+    def later(signum, frame):
+        if held.hit:
+            raise KeyboardInterrupt
+        held.hit = True
+
+    before = signal.signal(signal.SIGINT, later)
+    try:
+        yield held
+    finally:
+        signal.signal(signal.SIGINT, before)

@@ -1,5 +1,6 @@
 """Ctrl-C: one line and status 130 wherever it lands, and a speed sweep keeps its curve."""
 
+import numpy as np
 import pytest
 import typer
 from typer.testing import CliRunner
@@ -357,3 +358,116 @@ def test_steady_interrupted_after_its_solve_says_what_it_kept(tmp_path, monkeypa
                                    str(tmp_path / "b.nc")])
     assert res.exit_code == 130, res.output
     assert res.stderr.strip().splitlines()[-1] == "interrupted; nothing written"
+
+
+def _last_words(text: str, expected: str) -> bool:
+    """Whether ``text`` ends with ``expected``, whatever the console's line breaks."""
+    return "".join(text.split()).endswith("".join(expected.split()))
+
+
+SWEEP = ["sweep-speed", "ji_li_mill_drive", "--from", "300 rpm", "--to", "1500 rpm",
+         "--points", "30", "--quiet"]
+SHORT_SWEEP = SWEEP[:5] + ["400 rpm", "--points", "4", "--quiet"]
+
+
+def _sigint_on_call(monkeypatch, owner, name: str) -> None:
+    """A real Ctrl-C (SIGINT to this process) as ``owner.name`` is first called."""
+    import os
+    import signal
+
+    real, calls = getattr(owner, name), []
+
+    def interrupted(*args, **kwargs):
+        calls.append(1)
+        if len(calls) == 1:
+            os.kill(os.getpid(), signal.SIGINT)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(owner, name, interrupted)
+
+
+@pytest.fixture
+def terminal_sigint():
+    """Ctrl-C as at a terminal (a background job, e.g. CI started with '&', ignores it)."""
+    import signal
+
+    before = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, before)
+
+
+def test_a_sweep_interrupted_part_way_exits_130_after_keeping_its_curve(tmp_path,
+                                                                       monkeypatch):
+    """A sweep stopped by Ctrl-C part-way exited 1, as a sweep that failed; it now writes
+    and prints the curve computed, then exits 130 naming the file."""
+    _interrupt_sweep_at_point(monkeypatch, 4)
+    res = CliRunner().invoke(app, SWEEP)
+    assert res.exit_code == 130, res.output
+    assert "interrupted (Ctrl-C) after 3 points" in " ".join(res.output.split())
+    assert res.stderr.strip().splitlines()[-1] == (
+        "interrupted; the curve computed is printed above; nothing written")
+    _interrupt_sweep_at_point(monkeypatch, 4)
+    out = tmp_path / "curve.csv"
+    res = CliRunner().invoke(app, SWEEP + ["--out", str(out)])
+    assert res.exit_code == 130, res.output
+    assert _last_words(res.stderr, f"interrupted; results kept in {out}, "
+                       f"{tmp_path / 'curve_about.json'}")
+    assert out.exists()
+
+
+def test_a_sweep_interrupted_in_the_check_of_its_peaks_exits_130(monkeypatch):
+    """Ctrl-C in the check of the peaks' digits (inside compiled code: a SystemError
+    chained from the interrupt) printed the table and exited 0, as a finished check."""
+    import torquesplit.steady.api as api
+
+    def interrupted(*args, **kwargs):
+        _chained_interrupt()
+
+    monkeypatch.setattr(api, "steady_state", interrupted)
+    res = CliRunner().invoke(app, SHORT_SWEEP)
+    assert res.exit_code == 130, res.output
+    text = " ".join(res.output.split())
+    assert "the check of the peaks' digits was interrupted" in text
+    assert "largest dynamic factor over the stable points" in text
+
+
+def test_a_ctrl_c_as_the_sweep_finishes_its_curve_keeps_the_curve(monkeypatch,
+                                                                  terminal_sigint):
+    """A Ctrl-C after the continuation, while the curve's metrics were computed, lost the
+    whole curve ('interrupted; nothing written'); it now waits for the curve's metrics,
+    and one in the cross-check keeps the curve without it."""
+    from torquesplit import example_path
+    from torquesplit.steady import maps
+
+    _sigint_on_call(monkeypatch, maps, "shooting_point_metrics")
+    ds = maps.sweep_speed(example_path("ji_li_mill_drive"), 300 * 0.10472, 400 * 0.10472,
+                          points=4, cross_check=True)
+    assert ds.attrs["complete"] and "check_speed_rpm" not in ds.coords
+    assert ds.attrs["message"].startswith(
+        "interrupted (Ctrl-C) once the curve's %d points were computed; the curve is kept "
+        "(the cross-check not run)" % ds.sizes["point"])
+    assert ds.sizes["point"] >= 3 and np.isfinite(ds["dynamic_factor"].values).all()
+    monkeypatch.undo()
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(maps, "stepped_sweep", interrupted)
+    ds = maps.sweep_speed(example_path("ji_li_mill_drive"), 300 * 0.10472, 400 * 0.10472,
+                          points=4, cross_check=True)
+    assert ds.attrs["message"].startswith("interrupted (Ctrl-C) in the run-up and run-down")
+    assert ds.attrs["complete"] and "run_up_dynamic_factor" not in ds
+
+
+def test_a_ctrl_c_while_the_sweep_is_written_finishes_its_files(tmp_path, monkeypatch,
+                                                               terminal_sigint):
+    """A Ctrl-C while the curve's files were written left them half-written and said
+    nothing of them."""
+    import torquesplit.steady.plot as plot
+
+    _sigint_on_call(monkeypatch, plot, "sweep_figure")
+    out, fig = tmp_path / "curve.nc", tmp_path / "curve.png"
+    res = CliRunner().invoke(app, SHORT_SWEEP + ["--out", str(out), "--plot", str(fig)])
+    assert res.exit_code == 130, res.output
+    assert _last_words(res.stderr, f"interrupted; results kept in {out}, {fig}")
+    assert out.exists() and fig.stat().st_size > 1000

@@ -164,7 +164,7 @@ def _harmonics_need_hb(harmonics, method: str) -> None:
 def register(app, load, fail, console, err_console, json_default, set_help=""):
     """Add the commands to ``app`` (helpers of :mod:`torquesplit.cli` passed in; ``load``
     takes the model argument and the ``--set`` assignments)."""
-    from torquesplit.errors import TorquesplitError
+    from torquesplit.errors import TorquesplitError, from_interrupt
 
     @app.command()
     def steady(
@@ -461,7 +461,14 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
                 opts(ui._check_figure_file, plot, "--plot", force)
             opts.raise_any(model, assign)
             m, _ = load(model, assign)
-            from torquesplit.cli_support import collect_warnings, interruptible, progress
+            from torquesplit.cli_support import (
+                collect_warnings,
+                exit_interrupted,
+                finish_before_interrupt,
+                interruptible,
+                kept_files,
+                progress,
+            )
 
             # (Ctrl-C before the first point exited 130 without a word)
             with interruptible(), collect_warnings(), progress("speed sweep",
@@ -474,28 +481,43 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
         except (TorquesplitError, ValueError, OSError) as exc:
             fail(_in_flags(exc))
             return
+        # (Ctrl-C: the curve is kept. A sweep stopped part-way exited 1 as any stop, not
+        # 130; one in the check of the peaks' digits exited 0)
+        interrupted = str(ds.attrs["message"]).startswith("interrupted")
         saved, failed, plotted = None, None, []
+
+        def kept() -> str:
+            return kept_files([*(saved or []), *plotted]) or (
+                "the curve computed is printed above; nothing written")
+
         try:  # a file that cannot be written: the curves are still printed, then the error
-            if out is not None:
-                from torquesplit.results.export import dataset_files
+            with finish_before_interrupt():  # (a Ctrl-C: the files are finished, the curve
+                # printed, then the command stops)
+                if out is not None:
+                    from torquesplit.results.export import dataset_files
 
-                saved = dataset_files(ds, _save(_with_model(ds, m), out, force))
-            if plot is not None:
-                from torquesplit.steady.plot import save, sweep_figure
+                    saved = dataset_files(ds, _save(_with_model(ds, m), out, force))
+                if plot is not None:
+                    from torquesplit.steady.plot import save, sweep_figure
 
-                plotted = [save(sweep_figure(ds), plot)]
+                    plotted = [save(sweep_figure(ds), plot)]
         except (TorquesplitError, OSError) as exc:
             failed = exc
+        except KeyboardInterrupt:
+            interrupted = True
         largest = sweep_maxima(ds)
         held = {}
         try:  # (Ctrl-C here keeps the curve: it is printed without the check; a sweep
             # already interrupted is not made to wait for it)
-            if not str(ds.attrs["message"]).startswith("interrupted"):
+            if not interrupted:
                 with collect_warnings(), progress("checking the peaks' digits",
                                                   as_json or quiet, total=None):
                     held = peak_resolution(m, ds, largest, keep=_keep(keep),
                                            max_cycles=max_cycles)
-        except KeyboardInterrupt:
+        except (KeyboardInterrupt, SystemError) as exc:
+            if not from_interrupt(exc):
+                raise
+            interrupted = True
             err_console.print("[yellow]warning:[/] the check of the peaks' digits was "
                               "interrupted (Ctrl-C): the largest dynamic factors are "
                               "printed unchecked")
@@ -618,6 +640,8 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
         if failed is not None:
             fail(failed)
             return
+        if interrupted:
+            exit_interrupted(kept())
         if not ds.attrs["complete"]:
             err_console.print(f"[yellow]warning:[/] {ds.attrs['message']}")
             raise typer.Exit(1)
@@ -720,13 +744,15 @@ def peak_resolution(model, ds, largest, keep=None, max_cycles=None) -> dict[str,
 
     from torquesplit.assembly.assemble import assemble
     from torquesplit.convergence import agreeing_digits, check_model
-    from torquesplit.errors import TorquesplitError
+    from torquesplit.errors import TorquesplitError, from_interrupt
     from torquesplit.steady.api import steady_state
 
     try:
         fine_model, _, _ = check_model(SimpleNamespace(model=model,
                                                        structure=assemble(model)))
-    except Exception:  # noqa: BLE001 - a side check: the curve stands without it
+    except Exception as exc:  # noqa: BLE001 - a side check: the curve stands without it
+        if from_interrupt(exc):  # (Ctrl-C inside compiled code: a SystemError, not a failure)
+            raise
         return {}
     by_speed: dict[float, list[str]] = {}
     for mesh, row in largest.items():

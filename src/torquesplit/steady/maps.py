@@ -13,7 +13,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from torquesplit._args import whole
-from torquesplit.errors import ModelWarning, OptionError, SolverError, warn_user
+from torquesplit.errors import (
+    ModelWarning,
+    OptionError,
+    SolverError,
+    from_interrupt,
+    held_interrupt,
+    warn_user,
+)
 from torquesplit.solve.modal import DEGENERATE_RTOL
 from torquesplit.steady.solution import warn_undamped
 from torquesplit.steady.api import reference_speed
@@ -144,7 +151,9 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
         over the period), RMS transmission error, peak and mean force, stability and
         largest Floquet multiplier; attributes: turning points (jump speeds), natural frequencies and their mesh-order crossings, status
         message.  A continuation that fails keeps the points computed so far
-        (``attrs['complete'] == 0`` and the reason in ``attrs['message']``).
+        (``attrs['complete'] == 0`` and the reason in ``attrs['message']``); so does a
+        Ctrl-C, whose message starts "interrupted" (one after the continuation waits for
+        the curve's metrics; one in the cross-check leaves the cross-check out).
     """
     import xarray as xr
 
@@ -195,137 +204,155 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
             problem, per, static.q, s0, s1, points=points, harmonics=harmonics,
             samples=samples, stability=stability, max_step=step_max, progress=progress)
     msg = _message_in_rpm(msg, w_ref, pts, s1, complete)
-    mesh_names = list(model.meshes)
-    names = list(s.element_names)
-    track = [names.index(m) for m in mesh_names]
-    meta = s.metadata["meshes"]
-    groups = group_meshes({m: meta[m] for m in mesh_names})
-    gcols = [[mesh_names.index(m) for m in g] for g in groups.values()]
-    nominal = np.array([kin.meshes[m].force for m in mesh_names])
+    # (a Ctrl-C from here on lost the curve computed, "nothing written": it now waits
+    # for the curve's metrics, then ends the sweep with them)
+    with held_interrupt() as ctrl_c:
+        mesh_names = list(model.meshes)
+        names = list(s.element_names)
+        track = [names.index(m) for m in mesh_names]
+        meta = s.metadata["meshes"]
+        groups = group_meshes({m: meta[m] for m in mesh_names})
+        gcols = [[mesh_names.index(m) for m in g] for g in groups.values()]
+        nominal = np.array([kin.meshes[m].force for m in mesh_names])
 
-    def static_f(speed):  # the static forces at a point's speed (the dynamic factors)
-        if s.metadata.get("rotating_frame"):  # (a turning carrier's centrifugal loads)
-            from torquesplit.solve.static import static_equilibrium
+        def static_f(speed):  # the static forces at a point's speed (the dynamic factors)
+            if s.metadata.get("rotating_frame"):  # (a turning carrier's centrifugal loads)
+                from torquesplit.solve.static import static_equilibrium
 
-            at = static_equilibrium(problem.structure_at(speed, frequencies=False))
-            return np.array([at.element_forces[e] for e in track])
-        return np.array([static.element_forces[e] for e in track])
+                at = static_equilibrium(problem.structure_at(speed, frequencies=False))
+                return np.array([at.element_forces[e] for e in track])
+            return np.array([static.element_forces[e] for e in track])
 
-    if method == "shooting":
-        rows = [shooting_point_metrics(cont, p.x, p.speed, track, gcols, static_f(p.speed),
-                                       nominal) for p in pts]
-    else:
-        rows = [point_metrics(hb, p.x, p.speed, track, gcols, static_f(p.speed), nominal,
-                              order=per.max_order) for p in pts]
-    sp = np.array([p.speed for p in pts])
+        if method == "shooting":
+            rows = [shooting_point_metrics(cont, p.x, p.speed, track, gcols, static_f(p.speed),
+                                           nominal) for p in pts]
+        else:
+            rows = [point_metrics(hb, p.x, p.speed, track, gcols, static_f(p.speed), nominal,
+                                  order=per.max_order) for p in pts]
+        sp = np.array([p.speed for p in pts])
 
-    def stack(key):
-        return np.array([r[key] for r in rows]) if rows else np.zeros((0, len(track)))
+        def stack(key):
+            return np.array([r[key] for r in rows]) if rows else np.zeros((0, len(track)))
 
-    f_mesh = np.array([[meta[m]["frequency"] for m in mesh_names]]) * sp[:, None]
-    ds = xr.Dataset(
-        {
-            "speed": ("point", sp * w_ref, {"units": "rad/s", "long_name": "input speed"}),
-            "mesh_frequency": (("point", "mesh"), f_mesh, {"units": "Hz"}),
-            "dynamic_factor": (("point", "mesh"), stack("dynamic_factor"),
-                               {"units": "1", "long_name": "peak / the mesh's static force"}),
-            "peak_to_nominal": (("point", "mesh"), stack("peak_to_nominal"),
-                                {"units": "1", "long_name": "peak / equal-split nominal force"}),
-            "load_sharing_mean_force": (("point", "mesh"), stack("load_sharing"), {
-                "units": "1", "definition": "mean_force",
-                "long_name": "load-sharing coefficient N mean F_i / sum of the group's "
-                             "mean forces (mean_force, Dong et al. 2021 eq. 12)"}),
-            "load_sharing_instantaneous": (("point", "mesh"),
-                                           stack("load_sharing_instantaneous"), {
-                "units": "1", "definition": "instantaneous",
-                "long_name": "largest instantaneous N F_i / sum F_j over the period "
-                             "(Ji & Li eq. 18)"}),
-            "rms_transmission_error": (("point", "mesh"), stack("rms_transmission_error"),
-                                       {"units": "m", "long_name": "RMS dynamic "
-                                        "transmission error about its mean (the flanks' "
-                                        "relative displacement, errors included)"}),
-            "peak_force": (("point", "mesh"), stack("peak_force"),
-                           {"units": "N", "long_name": "peak mesh force"}),
-            "mean_force": (("point", "mesh"), stack("mean_force"),
-                           {"units": "N", "long_name": "mean mesh force"}),
-            "contact_loss": (("point", "mesh"), stack("contact_loss"),
-                             {"units": "1", "long_name": "fraction of the period in which "
-                              "the mesh carries no force (teeth apart)"}),
-            "stable": ("point", np.array([bool(p.stable) if p.stable is not None else True
-                                          for p in pts], dtype=bool), {
-                "long_name": "1 if the periodic state is stable (Floquet multipliers "
-                             "inside the unit circle)"}),
-            "max_multiplier": ("point", np.array([p.max_multiplier for p in pts]),
-                               {"units": "1", "long_name": "largest |Floquet multiplier|"}),
-            # (over a period of several excitation cycles, a keep= fraction, a period-1
-            # orbit's multipliers are powers of its own: they do not say how it loses
-            # stability, so none is named)
-            "instability": ("point", np.array([p.instability if sub == 1 else ""
-                                               for p in pts], dtype=str), {
-                "long_name": "how an unstable orbit loses stability: 'period doubling' (a "
-                             "multiplier below -1: the response is not this orbit), 'fold' "
-                             "(above 1), 'torus' (a complex pair); empty where stable"}),
-        },
-        coords={"speed_rpm": ("point", sp * w_ref * RPM, {"units": "rpm"}),
-                "mesh": mesh_names},
-    )
-    if not stability:  # (nothing judged: no variable that reads 'stable', a reviewer)
-        ds = ds.drop_vars(["stable", "max_multiplier", "instability"])
-        ds.attrs["stability"] = ("not computed (stability=False, --no-stability): every "
-                                 "point is counted, an unstable one too")
-    w_lo, w_hi = min(s0, s1) * w_ref, max(s0, s1) * w_ref
-    crit = critical_speeds(s, static.q, kin, model, w_lo, w_hi)
-    if s.n_gyroscopic:  # frequencies that move with speed: the Campbell map's crossings
-        crit["crossings"] = campbell(model, w_lo, w_hi)[1]
-    critical, suppressed = split_suppressed(crit["crossings"])
-    ds.attrs.update(
-        model=model.model.name,
-        method=("shooting" if method == "shooting" else "harmonic balance")
-        + ", pseudo-arclength continuation",
-        harmonics=0 if method == "shooting" else hb.H,
-        samples=cont.steps if method == "shooting" else hb.N,
-        # (samples: the RK4 steps per period, this many excitation cycles long: per
-        # cycle, the resolution a check of the curve's numbers doubles)
-        excitation_cycles_per_period=max(per.max_order, 1),
-        fundamental_frequency_at_model_speed_Hz=per.frequency,
-        complete=int(complete), message=msg,
-        requested_speeds_rpm=[s0 * w_ref * RPM, s1 * w_ref * RPM],
-        fold_speeds_rpm=[f * w_ref * RPM for f, _ in folds],
-        fold_kinds=[k for _, k in folds],
-        kept_excitations="all" if keep is None else str(keep),
-        dropped_excitations=[x.describe() for x in dropped],
-        natural_frequencies_Hz=list(crit["natural_frequencies"]),
-        natural_frequencies_at_speed_rpm=w_ref * RPM,
-        critical_speeds_rpm=[c["speed_rpm"] for c in critical],
-        critical_speed_labels=[_undriven(c, f"mode {c['mode']} x {c['order']} {c['source']}")
-                               for c in critical],
-        **({"suppressed_speeds_rpm": [c["speed_rpm"] for c in suppressed],
-            "suppressed_speed_labels": [
-                f"mode {c['mode']} x {c['order']} {c['source']} ({mode_kind(c)} mode: "
-                f"suppressed by mesh phasing, Parker & Lin 2004)" for c in suppressed]}
-           if suppressed else {}),
-        loads="torques held at the model's values",
-        wall_time_s=time.perf_counter() - t_start,
-    )
-    if method != "shooting" and rows and float(np.max(stack("contact_loss"))) > 0:
-        warn_user(
-            "harmonic balance over contact loss: a truncated series rings where the teeth "
-            "separate, so the jump speeds and the peaks there can be off by per cents (on a "
-            "single spur pair a fold 6 % off); shooting (--method shooting, the default "
-            "without --harmonics) steps through the separations", ModelWarning)
-    gaps = unresolved_critical_speeds(sp * w_ref * RPM, [c["speed_rpm"] for c in critical])
-    ds.attrs["unresolved_critical_speeds_rpm"] = gaps
-    if gaps:
-        ds.attrs["message"] += (
-            f"; the points lie too far apart to resolve the critical speed(s) at "
-            f"{', '.join(f'{c:.5g}' for c in gaps[:5])} rpm (no point within "
-            f"{100 * RESOLVE:g} % of them): give more --points or a narrower range")
+        f_mesh = np.array([[meta[m]["frequency"] for m in mesh_names]]) * sp[:, None]
+        ds = xr.Dataset(
+            {
+                "speed": ("point", sp * w_ref, {"units": "rad/s", "long_name": "input speed"}),
+                "mesh_frequency": (("point", "mesh"), f_mesh, {"units": "Hz"}),
+                "dynamic_factor": (("point", "mesh"), stack("dynamic_factor"),
+                                   {"units": "1", "long_name": "peak / the mesh's static force"}),
+                "peak_to_nominal": (("point", "mesh"), stack("peak_to_nominal"),
+                                    {"units": "1", "long_name": "peak / equal-split nominal force"}),
+                "load_sharing_mean_force": (("point", "mesh"), stack("load_sharing"), {
+                    "units": "1", "definition": "mean_force",
+                    "long_name": "load-sharing coefficient N mean F_i / sum of the group's "
+                                 "mean forces (mean_force, Dong et al. 2021 eq. 12)"}),
+                "load_sharing_instantaneous": (("point", "mesh"),
+                                               stack("load_sharing_instantaneous"), {
+                    "units": "1", "definition": "instantaneous",
+                    "long_name": "largest instantaneous N F_i / sum F_j over the period "
+                                 "(Ji & Li eq. 18)"}),
+                "rms_transmission_error": (("point", "mesh"), stack("rms_transmission_error"),
+                                           {"units": "m", "long_name": "RMS dynamic "
+                                            "transmission error about its mean (the flanks' "
+                                            "relative displacement, errors included)"}),
+                "peak_force": (("point", "mesh"), stack("peak_force"),
+                               {"units": "N", "long_name": "peak mesh force"}),
+                "mean_force": (("point", "mesh"), stack("mean_force"),
+                               {"units": "N", "long_name": "mean mesh force"}),
+                "contact_loss": (("point", "mesh"), stack("contact_loss"),
+                                 {"units": "1", "long_name": "fraction of the period in which "
+                                  "the mesh carries no force (teeth apart)"}),
+                "stable": ("point", np.array([bool(p.stable) if p.stable is not None else True
+                                              for p in pts], dtype=bool), {
+                    "long_name": "1 if the periodic state is stable (Floquet multipliers "
+                                 "inside the unit circle)"}),
+                "max_multiplier": ("point", np.array([p.max_multiplier for p in pts]),
+                                   {"units": "1", "long_name": "largest |Floquet multiplier|"}),
+                # (over a period of several excitation cycles, a keep= fraction, a period-1
+                # orbit's multipliers are powers of its own: they do not say how it loses
+                # stability, so none is named)
+                "instability": ("point", np.array([p.instability if sub == 1 else ""
+                                                   for p in pts], dtype=str), {
+                    "long_name": "how an unstable orbit loses stability: 'period doubling' (a "
+                                 "multiplier below -1: the response is not this orbit), 'fold' "
+                                 "(above 1), 'torus' (a complex pair); empty where stable"}),
+            },
+            coords={"speed_rpm": ("point", sp * w_ref * RPM, {"units": "rpm"}),
+                    "mesh": mesh_names},
+        )
+        if not stability:  # (nothing judged: no variable that reads 'stable', a reviewer)
+            ds = ds.drop_vars(["stable", "max_multiplier", "instability"])
+            ds.attrs["stability"] = ("not computed (stability=False, --no-stability): every "
+                                     "point is counted, an unstable one too")
+        w_lo, w_hi = min(s0, s1) * w_ref, max(s0, s1) * w_ref
+        crit = critical_speeds(s, static.q, kin, model, w_lo, w_hi)
+        if s.n_gyroscopic:  # frequencies that move with speed: the Campbell map's crossings
+            crit["crossings"] = campbell(model, w_lo, w_hi)[1]
+        critical, suppressed = split_suppressed(crit["crossings"])
+        ds.attrs.update(
+            model=model.model.name,
+            method=("shooting" if method == "shooting" else "harmonic balance")
+            + ", pseudo-arclength continuation",
+            harmonics=0 if method == "shooting" else hb.H,
+            samples=cont.steps if method == "shooting" else hb.N,
+            # (samples: the RK4 steps per period, this many excitation cycles long: per
+            # cycle, the resolution a check of the curve's numbers doubles)
+            excitation_cycles_per_period=max(per.max_order, 1),
+            fundamental_frequency_at_model_speed_Hz=per.frequency,
+            complete=int(complete), message=msg,
+            requested_speeds_rpm=[s0 * w_ref * RPM, s1 * w_ref * RPM],
+            fold_speeds_rpm=[f * w_ref * RPM for f, _ in folds],
+            fold_kinds=[k for _, k in folds],
+            kept_excitations="all" if keep is None else str(keep),
+            dropped_excitations=[x.describe() for x in dropped],
+            natural_frequencies_Hz=list(crit["natural_frequencies"]),
+            natural_frequencies_at_speed_rpm=w_ref * RPM,
+            critical_speeds_rpm=[c["speed_rpm"] for c in critical],
+            critical_speed_labels=[_undriven(c, f"mode {c['mode']} x {c['order']} {c['source']}")
+                                   for c in critical],
+            **({"suppressed_speeds_rpm": [c["speed_rpm"] for c in suppressed],
+                "suppressed_speed_labels": [
+                    f"mode {c['mode']} x {c['order']} {c['source']} ({mode_kind(c)} mode: "
+                    f"suppressed by mesh phasing, Parker & Lin 2004)" for c in suppressed]}
+               if suppressed else {}),
+            loads="torques held at the model's values",
+            wall_time_s=time.perf_counter() - t_start,
+        )
+        if method != "shooting" and rows and float(np.max(stack("contact_loss"))) > 0:
+            warn_user(
+                "harmonic balance over contact loss: a truncated series rings where the teeth "
+                "separate, so the jump speeds and the peaks there can be off by per cents (on a "
+                "single spur pair a fold 6 % off); shooting (--method shooting, the default "
+                "without --harmonics) steps through the separations", ModelWarning)
+        gaps = unresolved_critical_speeds(sp * w_ref * RPM, [c["speed_rpm"] for c in critical])
+        ds.attrs["unresolved_critical_speeds_rpm"] = gaps
+        if gaps:
+            ds.attrs["message"] += (
+                f"; the points lie too far apart to resolve the critical speed(s) at "
+                f"{', '.join(f'{c:.5g}' for c in gaps[:5])} rpm (no point within "
+                f"{100 * RESOLVE:g} % of them): give more --points or a narrower range")
+    if ctrl_c.hit:
+        if not str(msg).startswith("interrupted"):
+            ds.attrs["message"] = (
+                f"interrupted (Ctrl-C) once the curve's {len(pts)} points were computed; "
+                f"the curve is kept{' (the cross-check not run)' if cross_check else ''}: "
+                f"{ds.attrs['message']}")
+        return ds
     if cross_check:
         grid = np.linspace(min(s0, s1), max(s0, s1), points)
-        up, up_rms = stepped_sweep(problem, per, static.q, grid, settle_periods=settle_periods,
-                                   track=track)
-        down, dn_rms = stepped_sweep(problem, per, static.q, grid[::-1],
-                                     settle_periods=settle_periods, track=track)
+        try:  # (the run-up and run-down: minutes; a Ctrl-C keeps the curve without them)
+            up, up_rms = stepped_sweep(problem, per, static.q, grid,
+                                       settle_periods=settle_periods, track=track)
+            down, dn_rms = stepped_sweep(problem, per, static.q, grid[::-1],
+                                         settle_periods=settle_periods, track=track)
+        except (KeyboardInterrupt, SystemError) as exc:
+            if not from_interrupt(exc):
+                raise
+            ds.attrs["message"] = ("interrupted (Ctrl-C) in the run-up and run-down "
+                                   "cross-check, which is left out; the curve is kept: "
+                                   + ds.attrs["message"])
+            return ds
         ds = ds.assign_coords(check_speed_rpm=("check", grid * w_ref * RPM))
         at_grid = np.array([static_f(g) for g in grid])
         ds["run_up_dynamic_factor"] = (("check", "mesh"), up / at_grid)
