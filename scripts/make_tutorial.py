@@ -283,7 +283,8 @@ twice the steps, so the command integrates about three times as long as a plain 
 The ISO 6336 stiffness steps between single and double tooth contact, and a table of n
 points per mesh cycle (`[analysis] table_points`: 16384 here, the default where a table
 steps) makes each step a ramp one n-th of a cycle long, so the check also runs with four
-times the table points:
+times the table points.  The bearing table comes from the history, so the check also
+samples it twice as often:
 
 $ torquesplit run three_branch.toml --check-step --quiet
 
@@ -292,7 +293,10 @@ peaks move in their second digit: the drive runs near a resonance (next paragrap
 where the peaks depend on the step and on how sharply the tables resolve the jumps (half
 the step and 65536 table points move them by about 1 %).  Refine both (`--steps-per-period`, `--set
 analysis.table_points=...`), and report only the digits that hold; the mean-force
-coefficients move far less than the peaks (`--json` gives every number's digits).
+coefficients move far less than the peaks (`--json` gives every number's digits).  The
+bearing peaks move most: the history holds the state at the steps only, not at the
+tables' corners inside them, where the largest force falls (the warning above the
+table); the mesh table's peaks include those corners.
 
 A dynamic factor of about {{{{dynamic_factor}}}} is large.  The modes show where it can come from:
 

@@ -801,7 +801,8 @@ def _render_run(res, met, saved, planets=None) -> None:
         f"over settled cycles of the largest member's per-cycle peak / nominal force (Ji & "
         f"Li eq. 19, engineering coefficient G_it)."
         + ("  Bearing forces: from the history, not streamed, so a peak between its samples "
-           "is missed (--samples-per-period)." if bearings else "")
+           "is missed (--samples-per-period; --check-step checks them at twice the "
+           "sampling)." if bearings else "")
         + _thrust_note(bearings, res),
         markup=False, highlight=False)
     if saved:

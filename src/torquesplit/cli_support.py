@@ -359,6 +359,12 @@ def render_step_check(check, rows: int = 12, printed: int = PRINTED_DIGITS,
         was += (f"; {check.table_points} -> {check.check_table_points} table points: "
                 f"the tables have jumps")
         refine = f"{refine} and [analysis] table_points"
+    if check.check_history_samples > check.history_samples > 0:  # the bearing table's
+        what += " and history"
+        was += (f"; {check.history_samples:.3g} -> {check.check_history_samples:.3g} "
+                f"history samples per period: the bearing forces")
+        if any(r[0].startswith("bearing_") for r in short):
+            refine = f"{refine}; the bearing forces: --samples-per-period"
     console.print(
         f"step check, the same {'run' if check.method in ('rk4', 'dopri') else 'state'} at "
         f"{what} ({was}): "

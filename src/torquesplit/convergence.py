@@ -142,6 +142,11 @@ class StepCheck:
     """Points per mesh period of the run's excitation tables (0: not recorded)."""
     check_table_points: int = 0
     """The check's (more than ``table_points`` where the tables have jumps)."""
+    history_samples: float = 0.0
+    """History samples per shortest mesh period of the run (0: no bearing forces
+    compared), from which its bearing forces come."""
+    check_history_samples: float = 0.0
+    """The check's (twice the run's, where the steps allow)."""
 
     def rows(self) -> list[tuple[str, float, float, float, int]]:
         """(name, value, at half the step, relative change, agreeing significant digits)
@@ -166,6 +171,8 @@ class StepCheck:
         return {"method": self.method, "step": self.step, "halved_step": self.halved_step,
                 "table_points": self.table_points,
                 "check_table_points": self.check_table_points,
+                "history_samples_per_period": self.history_samples,
+                "check_history_samples_per_period": self.check_history_samples,
                 "metrics": {n: {"value": a, "halved": b, "relative_change": r, "digits": d}
                             for n, a, b, r, d in self.rows()}}
 
@@ -192,7 +199,9 @@ def check_step(results, *, definitions=None, rtol: float | None = None,
     Dormand-Prince: its tolerance ``rtol``, default the model's, / TIGHTER_RTOL), and
     with TABLE_REFINEMENT times its table points where its tables have jumps
     (:func:`check_model`), every metric of the load-sharing ``definitions`` (default:
-    all) compared.  Costs about twice the first run."""
+    all) compared; and with twice its history's samples per period, its bearing table
+    (:func:`bearing_values`: it comes from the history, so a finer step alone left its
+    sampling, the larger error, unchecked).  Costs about twice the first run."""
     import warnings
 
     from .simulation import simulate
@@ -200,23 +209,54 @@ def check_step(results, *, definitions=None, rtol: float | None = None,
     sol = results.solution
     duration = sol.t_span[1] - sol.t_span[0]
     model, n, n_check = check_model(results)
+    bearings = bearing_values(results)
+    samples = results.history_samples_per_period() if bearings else 0.0
+    finer = dict(samples_per_period=math.ceil(2.0 * samples * (1.0 - 1e-12))) if samples else {}
     with warnings.catch_warnings():
-        # the check's own table points are no setting of the user's: the run warned
+        # the check's own table points and history are no settings of the user's: the
+        # run warned
         warnings.filterwarnings("ignore", message="analysis.table_points: ")
+        warnings.filterwarnings("ignore", message="analysis: the history holds at most ")
+        warnings.filterwarnings("ignore", message="analysis: samples_per_period=")
         if sol.method == "rk4":
             spp = halved_steps_per_period(results)
             half = simulate(model, duration=duration, method="rk4",
-                            steps_per_period=spp, progress=progress)
+                            steps_per_period=spp, progress=progress, **finer)
             step, halved_step = sol.step, half.solution.step
         else:
             rtol = float(results.model.analysis.rtol if rtol is None else rtol)
             half = simulate(model, duration=duration, method=sol.method,
-                            rtol=rtol / TIGHTER_RTOL, progress=progress)
+                            rtol=rtol / TIGHTER_RTOL, progress=progress, **finer)
             step, halved_step = rtol, rtol / TIGHTER_RTOL
-    return StepCheck(values=results.metric_values(definitions),
-                     halved=half.metric_values(definitions),
+    return StepCheck(values={**results.metric_values(definitions), **bearings},
+                     halved={**half.metric_values(definitions),
+                             **(bearing_values(half) if bearings else {})},
                      method=sol.method, step=float(step), halved_step=float(halved_step),
-                     table_points=n, check_table_points=n_check)
+                     table_points=n, check_table_points=n_check, history_samples=samples,
+                     check_history_samples=(half.history_samples_per_period()
+                                            if bearings else 0.0))
+
+
+def bearing_values(results) -> dict[str, float]:
+    """The bearing table's numbers by flat name: per body, the magnitude of its settled
+    mean force (``bearing_mean_force.<body>``) and its largest magnitude
+    (``bearing_peak_force.<body>``) [N], leaving out those at round-off
+    (:func:`~torquesplit.results.bearing_round_off`: the sun of a symmetric stage,
+    whose digits are noise).  Empty for a run without a settled bearing table."""
+    from .results import bearing_round_off
+
+    try:
+        rows = results.bearing_forces()
+    except (ValueError, ArithmeticError):  # (no settled part: no table to check)
+        return {}
+    tiny = bearing_round_off(rows)
+    out = {}
+    for b in rows:
+        for key, field in (("bearing_mean_force", "mean_magnitude"),
+                           ("bearing_peak_force", "peak_magnitude")):
+            if abs(b[field]) > tiny:
+                out[f"{key}.{b['body']}"] = float(b[field])
+    return out
 
 
 def _steady_values(st) -> dict:
