@@ -471,3 +471,34 @@ def test_a_ctrl_c_while_the_sweep_is_written_finishes_its_files(tmp_path, monkey
     assert res.exit_code == 130, res.output
     assert _last_words(res.stderr, f"interrupted; results kept in {out}, {fig}")
     assert out.exists() and fig.stat().st_size > 1000
+
+
+def test_an_interrupted_sweep_with_a_cross_check_keeps_its_curve(monkeypatch):
+    """With --cross-check, a Ctrl-C part-way through the continuation still ran the whole
+    run-up and run-down (minutes), and one in the cross-check ended in a traceback
+    (KeyError 'run_up'), exit 1, with the files written but not named (a reviewer)."""
+    from torquesplit.steady import maps
+
+    called = []
+    real = maps.stepped_sweep
+
+    def counted(*args, **kwargs):
+        called.append(1)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(maps, "stepped_sweep", counted)
+    _interrupt_sweep_at_point(monkeypatch, 3)
+    res = CliRunner().invoke(app, SWEEP + ["--cross-check"])
+    assert res.exit_code == 130, res.output
+    assert not called
+    monkeypatch.undo()
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(maps, "stepped_sweep", interrupted)
+    res = CliRunner().invoke(app, SHORT_SWEEP + ["--cross-check"])
+    assert res.exit_code == 130, res.output
+    text = " ".join(res.output.split())
+    assert "interrupted (Ctrl-C) in the run-up and run-down cross-check" in text
+    assert "largest dynamic factor" in text and "run-up DF" not in text

@@ -554,7 +554,8 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
                  f"sweep: 'torquesplit steady --speed S' gives it at a speed"
                  if chosen not in (None, "mean_force", "instantaneous", "static",
                                    "static_torque") else None)
-        if cross_check:
+        checked = cross_check and "run_up_dynamic_factor" in ds  # (not when interrupted)
+        if checked:
             for key in ("run_up", "run_down"):
                 summary[f"{key}_max_dynamic_factor"] = {k: v[key][0]
                                                         for k, v in largest.items()}
@@ -578,9 +579,9 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
             t = Table(title=("largest dynamic factor of the sweep (stability not computed)"
                              if no_stability else
                              "largest dynamic factor over the stable points of the sweep")
-                          + part + (" and the time integrations" if cross_check else ""))
+                          + part + (" and the time integrations" if checked else ""))
             cols = ["mesh", "dynamic factor\n(peak/static)", "at [rpm]"]
-            cols += ["run-up DF", "at [rpm]", "run-down DF", "at [rpm]"] if cross_check else []
+            cols += ["run-up DF", "at [rpm]", "run-down DF", "at [rpm]"] if checked else []
             for col in cols:
                 t.add_column(_h(col))
             for k, v in largest.items():

@@ -328,16 +328,19 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
         gaps = unresolved_critical_speeds(sp * w_ref * RPM, [c["speed_rpm"] for c in critical])
         ds.attrs["unresolved_critical_speeds_rpm"] = gaps
         if gaps:
-            ds.attrs["message"] += (
+            ds.attrs["message"] = ds.attrs["message"].rstrip(".") + (
                 f"; the points lie too far apart to resolve the critical speed(s) at "
                 f"{', '.join(f'{c:.5g}' for c in gaps[:5])} rpm (no point within "
                 f"{100 * RESOLVE:g} % of them): give more --points or a narrower range")
-    if ctrl_c.hit:
+    if ctrl_c.hit or str(msg).startswith("interrupted"):  # (an interrupted sweep ran its
+        # whole cross-check, minutes, after the Ctrl-C: a reviewer)
         if not str(msg).startswith("interrupted"):
+            rest = str(ds.attrs["message"])
+            rest = rest[len("complete"):].lstrip("; ") if rest.startswith("complete") else rest
             ds.attrs["message"] = (
                 f"interrupted (Ctrl-C) once the curve's {len(pts)} points were computed; "
-                f"the curve is kept{' (the cross-check not run)' if cross_check else ''}: "
-                f"{ds.attrs['message']}")
+                f"the curve is kept{' (the cross-check not run)' if cross_check else ''}"
+                + (f"; {rest}" if rest else ""))
         return ds
     if cross_check:
         grid = np.linspace(min(s0, s1), max(s0, s1), points)
