@@ -4,7 +4,8 @@ Every case is a :class:`Case`: an assembled structure and its static equilibrium
 initial state :func:`torquesplit.simulate` uses).  :func:`time_rk4` runs a fixed number
 of RK4 steps at 100 steps per shortest mesh period (or the smaller stable step that
 ``integrate`` picks itself, see ``steps_per_period`` in the result) with the streaming
-outputs ``simulate`` uses (per-cycle statistics of every mesh, history every 100 steps);
+outputs ``simulate`` uses (per-cycle statistics of every mesh, the bearings' force peaks,
+history every 100 steps);
 :func:`time_dopri` runs the engine's adaptive Dormand-Prince for comparison with scipy.
 
 Wall times use ``time.perf_counter``; CPU times ``time.process_time`` (the kernels are
@@ -35,6 +36,9 @@ class Case:
     """Highest mesh frequency [Hz]."""
     static_converged: bool = True
     """False: the static iteration cycled; y0 is its last iterate (timings still valid)."""
+    history_peaks: dict | None = None
+    """The bearing table's force vectors that ``simulate`` streams (``integrate``'s
+    ``history_peaks``)."""
 
     @property
     def n_dof(self) -> int:
@@ -48,12 +52,16 @@ class Case:
 def make_case(name: str, model) -> Case:
     """Assemble ``model`` and start from its static equilibrium."""
     import torquesplit
+    from torquesplit.model.kinematics import solve_kinematics
+    from torquesplit.results import bearing_vectors
     from torquesplit.solve.static import static_equilibrium
 
     s = torquesplit.assemble(model)
     st = static_equilibrium(s)
     return Case(name=name, structure=s, y0=st.y0, f_max=float(s.frequency.max()),
-                static_converged=bool(st.converged))
+                static_converged=bool(st.converged),
+                history_peaks=bearing_vectors(s.element_names, model,
+                                              solve_kinematics(model)))
 
 
 def example_cases(names=None) -> tuple[list[Case], dict[str, str]]:
@@ -120,7 +128,7 @@ def time_rk4(case: Case, n_steps: int, repeat: int = 2) -> dict:
             w0, c0 = time.perf_counter(), time.process_time()
             sol = integrate(case.structure, case.y0, (0.0, span), method="rk4",
                             steps_per_period=STEPS_PER_PERIOD, record_every=RECORD_EVERY,
-                            rhs=kind)
+                            history_peaks=case.history_peaks, rhs=kind)
             wall, cpu = time.perf_counter() - w0, time.process_time() - c0
             if kind not in best or wall < best[kind]["wall"]:
                 best[kind] = {"wall": wall, "cpu": cpu, "sol": sol}

@@ -4,8 +4,8 @@
 the benchmark run inflates its peak) and reads one JSON line back.  The child loads the
 kernels (from numba's cache), assembles the Ji & Li mill drive, then integrates
 ``--steps`` RK4 steps at 100 steps per shortest mesh period with the outputs
-``simulate`` streams: per-cycle statistics of every mesh and a history of every element
-force and DOF every ``--record-every`` steps.  It reports, in MiB:
+``simulate`` streams: per-cycle statistics of every mesh, the bearings' force peaks and a
+history of every element force and DOF every ``--record-every`` steps.  It reports, in MiB:
 
 * ``tracemalloc_peak`` -- the largest Python/numpy allocation total during the
   ``integrate`` call (numpy registers its buffers with tracemalloc; numba's scratch
@@ -75,6 +75,8 @@ def _child(n_steps: int, record_every: int) -> None:
     import numpy as np
 
     import torquesplit
+    from torquesplit.model.kinematics import solve_kinematics
+    from torquesplit.results import bearing_vectors
     from torquesplit.solve.integrate import compile_kernels, integrate
     from torquesplit.solve.static import static_equilibrium
 
@@ -94,8 +96,9 @@ def _child(n_steps: int, record_every: int) -> None:
     hwm_reset = _reset_peak()
     tracemalloc.start()
     w0, c0 = time.perf_counter(), time.process_time()
+    peaks = bearing_vectors(s.element_names, model, solve_kinematics(model))
     sol = integrate(s, st.y0, (0.0, n_steps * h), method="rk4", steps_per_period=100,
-                    record_every=record_every)
+                    record_every=record_every, history_peaks=peaks)
     wall, cpu = time.perf_counter() - w0, time.process_time() - c0
     _, peak = tracemalloc.get_traced_memory()
     tracemalloc.stop()

@@ -292,8 +292,8 @@ def report(res: dict) -> str:
     L.append(f"{cfg['engine_steps']:,} RK4 steps per model from the static equilibrium, "
              "100 steps per shortest mesh period (or the finer stable step `integrate` "
              "chooses itself, see 'steps/period'), streaming outputs as in `simulate` "
-             "(cycle statistics of every mesh, history of every element and DOF every "
-             "100 steps).\n")
+             "(cycle statistics of every mesh, the bearings' force peaks, history of every "
+             "element and DOF every 100 steps).\n")
     if res["skipped"]:
         L.append("Shipped examples left out because they do not load in this checkout "
                  "(src/ is edited concurrently):\n")

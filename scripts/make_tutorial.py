@@ -259,7 +259,8 @@ leaves out the start-up transient before computing anything.
   and `bearing_peak_force`.
 {{{{drift_text}}}}
 * **the history**, which results files (`--out`), figures (`--plots`) and the bearing
-  table are made from, holds every integration step of this run ({{{{history_samples}}}} samples):
+  table's means are made from (its peaks are taken at every step and table corner, as
+  the mesh table's), holds every integration step of this run ({{{{history_samples}}}} samples):
   by default a run keeps every step up to 50,000 samples, and a longer one every k-th
   step: 50,000 samples, or more where 20 per shortest mesh period need more (at most
   200,000: fewer per period on a very long run).  This drive rings at its mesh modes
@@ -283,8 +284,8 @@ twice the steps, so the command integrates about three times as long as a plain 
 The ISO 6336 stiffness steps between single and double tooth contact, and a table of n
 points per mesh cycle (`[analysis] table_points`: 16384 here, the default where a table
 steps) makes each step a ramp one n-th of a cycle long, so the check also runs with four
-times the table points.  The bearing table comes from the history, so the check also
-samples it twice as often:
+times the table points.  The bearing table's means come from the history, so the
+check also samples it twice as often:
 
 $ torquesplit run three_branch.toml --check-step --quiet
 
@@ -293,10 +294,7 @@ peaks move in their second digit: the drive runs near a resonance (next paragrap
 where the peaks depend on the step and on how sharply the tables resolve the jumps (half
 the step and 65536 table points move them by about 1 %).  Refine both (`--steps-per-period`, `--set
 analysis.table_points=...`), and report only the digits that hold; the mean-force
-coefficients move far less than the peaks (`--json` gives every number's digits).  The
-bearing peaks move most: the history holds the state at the steps only, not at the
-tables' corners inside them, where the largest force falls (the warning above the
-table); the mesh table's peaks include those corners.
+coefficients move far less than the peaks (`--json` gives every number's digits).
 
 A dynamic factor of about {{{{dynamic_factor}}}} is large.  The modes show where it can come from:
 

@@ -428,8 +428,9 @@ def run(
         metavar="N"),
     samples_per_period: Optional[int] = typer.Option(
         None, "--samples-per-period", help="History samples per shortest mesh period, for "
-        "--out files, --plots figures and the bearing-force table (the mesh table's "
-        "forces and coefficients are streamed at every step and do not depend on it); "
+        "--out files, --plots figures and the bearing-force table's means (the mesh "
+        "table's forces and coefficients and the bearings' peaks are streamed at every "
+        "step and do not depend on it); "
         "default: every step of a run of at most 50,000, else every k-th step: 50,000 "
         "samples, or more where 20 per period need more, at most 200,000 (the bearing "
         "table's title says how many per period); a run warns when the history misses "
@@ -800,9 +801,7 @@ def _render_run(res, met, saved, planets=None) -> None:
         f"peak/nominal are the largest of the group's meshes; peak/nominal (eng.) = mean "
         f"over settled cycles of the largest member's per-cycle peak / nominal force (Ji & "
         f"Li eq. 19, engineering coefficient G_it)."
-        + ("  Bearing forces: from the history, not streamed, so a peak between its samples "
-           "is missed (--samples-per-period; --check-step checks them at twice the "
-           "sampling)." if bearings else "")
+        + (f"  Bearing forces: {_bearing_source(bearings)}." if bearings else "")
         + _thrust_note(bearings, res),
         markup=False, highlight=False)
     if saved:
@@ -863,7 +862,9 @@ def bearing_table(bearings: list[dict], res) -> Table:
     history (:meth:`Results.bearing_forces`)."""
     per = ("every step" if res.history_keeps_every_step() else
            f"{res.history_samples_per_period():.3g} samples per shortest mesh period")
-    b = Table(title=f"bearing forces (settled; from the history, {per})")
+    streamed = all(r.get("peak_streamed") for r in bearings)
+    b = Table(title=f"bearing forces (settled; {'peaks at every step, means ' if streamed else ''}"
+                    f"from the history, {per})")
     # the force on the body's bearing, by direction of the frame it is written in: a
     # planet's (and any body's of a turning carrier's model) turns with the carrier
     frames = [r["frame"] for r in bearings]
@@ -889,6 +890,16 @@ def bearing_table(bearings: list[dict], res) -> Table:
         b.caption = f"the planets' mean forces include their centrifugal force m Ω_c² r: {spin}"
         b.caption_justify = "left"
     return b
+
+
+def _bearing_source(bearings: list[dict]) -> str:
+    """Where the bearing table's numbers come from, for its note."""
+    if all(r.get("peak_streamed") for r in bearings):
+        return ("peak |F| streamed at every step (corners and the peaks between steps "
+                "included, as the mesh forces'); means from the history's samples "
+                "(--samples-per-period)")
+    return ("from the history, not streamed, so a peak between its samples is missed "
+            "(--samples-per-period; --check-step checks them at twice the sampling)")
 
 
 def _centrifugal_loads(kin, bodies) -> str:

@@ -363,8 +363,8 @@ def render_step_check(check, rows: int = 12, printed: int = PRINTED_DIGITS,
         what += " and history"
         was += (f"; {check.history_samples:.3g} -> {check.check_history_samples:.3g} "
                 f"history samples per period: the bearing forces")
-        if any(r[0].startswith("bearing_") for r in short):
-            refine = f"{refine}; the bearing forces: --samples-per-period"
+        if any(r[0].startswith("bearing_mean_force") for r in short):
+            refine = f"{refine}; the bearing means: --samples-per-period"
     console.print(
         f"step check, the same {'run' if check.method in ('rk4', 'dopri') else 'state'} at "
         f"{what} ({was}): "

@@ -144,7 +144,7 @@ class StepCheck:
     """The check's (more than ``table_points`` where the tables have jumps)."""
     history_samples: float = 0.0
     """History samples per shortest mesh period of the run (0: no bearing forces
-    compared), from which its bearing forces come."""
+    compared), from which its bearing forces' means come."""
     check_history_samples: float = 0.0
     """The check's (twice the run's, where the steps allow)."""
 
@@ -200,8 +200,9 @@ def check_step(results, *, definitions=None, rtol: float | None = None,
     with TABLE_REFINEMENT times its table points where its tables have jumps
     (:func:`check_model`), every metric of the load-sharing ``definitions`` (default:
     all) compared; and with twice its history's samples per period, its bearing table
-    (:func:`bearing_values`: it comes from the history, so a finer step alone left its
-    sampling, the larger error, unchecked).  Costs about twice the first run."""
+    (:func:`bearing_values`: its means come from the history, so a finer step alone left
+    their sampling unchecked; its peaks are taken at every step).  Costs about twice the
+    first run."""
     import warnings
 
     from .simulation import simulate

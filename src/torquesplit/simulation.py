@@ -114,7 +114,8 @@ def simulate(
         steps_per_period`` (itself 100 unless set, as in the papers).
     samples_per_period : int, optional
         History samples per shortest mesh period, >= 1 (plots, exports and the bearing
-        forces: every mesh metric is computed from statistics streamed at every step).
+        forces' means: every mesh metric and the bearings' peaks are computed from
+        quantities streamed at every step).
         Default: every RK4 step while the run has at most
         :data:`AUTO_HISTORY_RECORDS`, else every k-th step (at most that many samples;
         Dormand-Prince: that many evenly over the run), never fewer than
@@ -466,10 +467,15 @@ def prepare_run(
     # no load-sharing ratio while a group carries less than 1 % of its nominal load
     min_total = [GROUP_MIN_LOAD * sum(abs(kin.meshes[m].force) for m in ms)
                  for ms in mesh_groups]
+    from .results import bearing_vectors
+
     kwargs = dict(
         method=method, track_elements=track, load_sharing_groups=groups,
         load_sharing_min_total=min_total,
         history_elements=hist_el, history_dofs=hist_dofs, full_history=full_history,
+        # the bearing table's peaks, streamed at every step (not the history's samples);
+        # none where the history is not read (a study without bearing outputs)
+        history_peaks=None if _HISTORY_UNUSED.get() else bearing_vectors(names, model, kin),
         progress=progress, rhs=rhs,
         # the history is sampled in time, so its size never depends on the step
         sample_interval=sample_interval,

@@ -209,7 +209,7 @@ def test_support_clearance_larger_than_the_motion_carries_no_force(tmp_path):
 def test_bearing_forces_of_the_settled_part(tmp_path):
     """A report writer found no bearing loads anywhere but the thinned history: each
     supported body's settled mean and peak bearing force are in the run's table, its JSON
-    and its file, computed from the history after the settle time."""
+    and its file, computed after the settle time (the mean from the history)."""
     import re
     from pathlib import Path
 
@@ -228,7 +228,10 @@ def test_bearing_forces_of_the_settled_part(tmp_path):
                 for d in r["directions"]]
         f = s.history_forces[keep][:, cols]
         np.testing.assert_allclose(r["mean"], f.mean(axis=0), rtol=1e-12)
-        assert r["peak_magnitude"] == pytest.approx(np.sqrt((f ** 2).sum(axis=1)).max())
+        # the peak, streamed at every step, holds the samples' and the corners and peaks
+        # between the steps (tests/results/test_bearing_peaks.py): a little higher
+        sampled = np.sqrt((f ** 2).sum(axis=1)).max()
+        assert r["peak_streamed"] and sampled <= r["peak_magnitude"] <= sampled * 1.002
         assert r["peak_magnitude"] >= r["mean_magnitude"] > 0
     assert rows, "the split model has supported bodies"
     ds = res.to_dataset()
@@ -263,7 +266,7 @@ def test_bearing_forces_of_the_settled_part(tmp_path):
 
     out = CliRunner().invoke(app, ["run", str(tmp_path / "model.toml"), "--duration", "0.1",
                                    "--quiet"])
-    assert "bearing forces (settled; from the history" in out.stdout
+    assert "bearing forces (settled; peaks at every step, means from the history" in out.stdout
 
 
 def test_every_element_force_is_kept_shaft_torques_in_newton_metres(tmp_path):

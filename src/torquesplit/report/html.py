@@ -319,6 +319,9 @@ def _bearings(bearings: list[dict], res) -> str:
 
     per = ("every step" if res.history_keeps_every_step() else
            f"{res.history_samples_per_period():.3g} samples per shortest mesh period")
+    peak = ("peak |F| streamed at every step (corners and the peaks between steps "
+            "included)" if all(b.get("peak_streamed") for b in bearings) else
+            f"peak |F| from the history ({per}): a peak between its samples is missed")
     rows = [[b["body"] + (f" (spline {b['via']})" if b.get("via") else
                           " (rigid bearing)" if b.get("held") == "rigid" else ""),
              ", ".join(f"{d} {kn(v)}" for d, v in zip(b["directions"], b["mean"])),
@@ -329,9 +332,9 @@ def _bearings(bearings: list[dict], res) -> str:
         rows = [r + [b["frame"]] for r, b in zip(rows, bearings)]
     return ("<h3>Bearing forces</h3>" + _table(header, rows, left=2)
             + f'<p class="note">The force each body puts on its bearing over the settled '
-              f"part, from the history ({per}): a peak between its samples is missed; a "
-              f"rigid bearing's mean is its meshes' mean forces (their streamed time "
-              f"integrals), another's the mean of the samples.</p>")
+              f"part: {peak}; a rigid bearing's mean is its meshes' mean forces (their "
+              f"streamed time integrals), another's the mean of the history's samples "
+              f"({per}).</p>")
 
 
 def _planets(load_sharing, kinematics) -> str:

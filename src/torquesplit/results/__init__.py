@@ -642,16 +642,24 @@ class Results:
             keep = np.ones(s.history_t.shape, bool)
         out = []
         via = self.bearing_via()
+        kept = np.flatnonzero(keep)
+        streamed = dict(zip(s.history_peak_names, range(len(s.history_peak_names)))) \
+            if s.history_peaks is not None and not (self.periodic and self.period) else {}
 
         def row(body, directions, forces, **extra):
             mean = forces.mean(axis=0)
             magnitude = np.sqrt((forces ** 2).sum(axis=1))
+            peak = float(magnitude.max())
+            if body in streamed:  # every step's, from the first kept sample on (the
+                # samples' own: the span before it is not settled)
+                peak = max(peak, float(np.nanmax(s.history_peaks[kept[1:], streamed[body]],
+                                                 initial=-np.inf)))
             return {"body": body, "via": via.get(body), "frame": bearing_frame(
                         self.kinematics, body), "directions": directions,
                     "mean": [float(v) for v in mean],
                     "mean_magnitude": float(np.sqrt((mean ** 2).sum())),
-                    "peak_magnitude": float(magnitude.max()), "samples": int(keep.sum()),
-                    **extra}
+                    "peak_magnitude": peak, "peak_streamed": body in streamed,
+                    "samples": int(keep.sum()), **extra}
 
         for body, parts in by_body.items():
             forces = s.history_forces[keep][:, [c for _, c, _ in parts]]
@@ -1014,6 +1022,25 @@ def _bearing_elements(element_names, model) -> dict[str, list[tuple[str, int, fl
             e = f"{name}.radial.{direction}"
             if e in index:
                 out.setdefault(body, []).append((direction, index[e], -1.0))
+    return out
+
+
+def bearing_vectors(element_names, model, kin) -> dict[str, list[tuple[int, np.ndarray]]]:
+    """Per body of the bearing table, its bearing force as a sum of element forces times
+    directions (element index, (3,)): the run streams each one's magnitude
+    (``integrate``'s ``history_peaks``) for the table's peaks.  A support's directions
+    are the body's own axes, each element one of them (the table's magnitude is over its
+    columns); a rigid bearing's are its meshes' lines of action, signed as
+    :func:`rigid_bearings` says."""
+    out: dict[str, list[tuple[int, np.ndarray]]] = {}
+    for body, parts in _bearing_elements(element_names, model).items():
+        if len(parts) <= 3:  # (x, y, z at most)
+            out[body] = [(e, sign * np.eye(3)[k]) for k, (_, e, sign) in enumerate(parts)]
+    index = {n: i for i, n in enumerate(element_names)}
+    for body, terms in rigid_bearings(model, kin).items():
+        if body not in out and all(m in index for m, _ in terms):
+            out[body] = [(index[m], sign * np.asarray(kin.meshes[m].line_of_action, float))
+                         for m, sign in terms]
     return out
 
 

@@ -151,6 +151,14 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
                                   "displacement from the nominal rigid motion")
         ds["velocity"] = _var(("time", "history_dof"), s.history_v, "m/s or rad/s",
                               "vibratory velocity")
+    if s.history_peaks is not None:  # (the bearing table's peaks: a file read back gives
+        # the run's, not its samples')
+        ds = ds.assign_coords(streamed_bearing=("streamed_bearing",
+                                                list(s.history_peak_names)))
+        ds["bearing_force_peak"] = _var(
+            ("time", "streamed_bearing"), s.history_peaks.copy(), "N",
+            "largest bearing force magnitude since the sample before (this one included), "
+            "streamed at every integration step")
     _note_sampling(ds, s.history_t, res.statistics().get("step_s"),
                    res.history_keeps_every_step())
     if definition is not None and hasattr(res, "check_definition"):
@@ -230,10 +238,11 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
             ds["bearing_mean_force"] = _var(("bearing",), [b["mean_magnitude"] for b in bearings],
                                             "N", "magnitude of the settled mean bearing force "
                                             "(from the history)")
-            ds["bearing_peak_force"] = _var(("bearing",), [b["peak_magnitude"] for b in bearings],
-                                            "N", "largest settled bearing force magnitude "
-                                            "(from the history: a peak between its samples "
-                                            "is missed)")
+            ds["bearing_peak_force"] = _var(
+                ("bearing",), [b["peak_magnitude"] for b in bearings], "N",
+                "largest settled bearing force magnitude " + (
+                    "(streamed at every step)" if all(b.get("peak_streamed") for b in bearings)
+                    else "(from the history: a peak between its samples is missed)"))
             directions = sorted({d for b in bearings for d in b["directions"]})
             ds = ds.assign_coords(bearing_direction=("bearing_direction", directions))
             ds["bearing_mean_force_component"] = _var(
@@ -461,7 +470,10 @@ def results_from_dataset(ds: xr.Dataset):
         full_t=None, full_y=None, n_samples=int(count.sum()),
         separation_steps=np.zeros(len(names), np.int64),
         back_contact_steps=np.zeros(len(names), np.int64),
-        separation_time=sep_t, back_contact_time=back_t)
+        separation_time=sep_t, back_contact_time=back_t,
+        **({"history_peak_names": tuple(str(b) for b in ds["streamed_bearing"].values),
+            "history_peaks": np.asarray(ds["bearing_force_peak"].values, dtype=float)}
+           if "bearing_force_peak" in ds else {}))
     notes = json.loads(ds.attrs.get("warnings_json", "[]"))
     # a steady state's record repeats one period: every complete cycle counts, as when
     # it was saved (its history holds the first period, :func:`_one_period`)

@@ -467,22 +467,37 @@ def coarse_history(results, metrics) -> list[tuple[str, str]]:
         return [("analysis", (
             f"the history keeps every RK4 step, yet {missed}: that extreme falls inside a "
             f"step, at a corner of a stiffness table, which the mesh table's numbers (and "
-            f"peak_force, min_force in the files) include and the history (files, figures, "
-            f"the bearing table's peak |F|) does not; "
+            f"peak_force, min_force in the files) include and the history (files, "
+            f"figures{'' if streamed_peaks(results) else BEARING_PEAK}) does not; "
             f"a finer step brings it closer "
             f"({finer_step_advice(results.structure, s.step_limited_by, s.step or 0.0)}), "
             f"kept whole in the history with as many --samples-per-period "
             f"(samples_per_period=; a long run's history keeps every step only up to "
             f"{AUTO_HISTORY_RECORDS:,} of them)"))]
     more = max(100, 5 * round(per)) if math.isfinite(per) else 100
+    streamed = streamed_peaks(results)
     return [("analysis", (
         f"the history ({per:.3g} samples per shortest mesh period), which the results "
         f"files and the figures hold, {missed}: the response is faster "
         f"than its sampling and the saved waveform is not the response's.  The mesh "
-        f"table's forces, load sharing and dynamic factors are streamed at every step and "
-        f"unaffected; the bearing table is computed from this history, so its peak |F| "
-        f"can be low too; for waveforms and bearing peaks, run again with "
+        f"table's forces, load sharing and dynamic factors"
+        f"{STREAMED_TOO if streamed else ''} are streamed at every "
+        f"step and unaffected; "
+        f"{'for waveforms' if streamed else BEARING_HISTORY}, run again with "
         f"--samples-per-period {more} (Python: samples_per_period={more})"))]
+
+
+BEARING_PEAK = ", the bearing table's peak |F|"
+STREAMED_TOO = ", and the bearing table's peaks,"
+BEARING_HISTORY = ("the bearing table is computed from this history, so its peak |F| can "
+                   "be low too; for waveforms and bearing peaks")
+
+
+def streamed_peaks(results) -> bool:
+    """Whether the run streamed the bearing table's peaks at every step (``integrate``'s
+    ``history_peaks``), or they come from the history's samples."""
+    s = results.solution
+    return s is not None and s.history_peaks is not None
 
 
 def harmonic_truncation(results, metrics) -> list[tuple[str, str]]:

@@ -49,6 +49,7 @@ from torquesplit.solve.kernel_data import (
     A_F,
     A_SELF,
     A_Y,
+    DENSE_HEAD,
     F_MAIN,
     F_TMP,
     SLOT_EVENT,
@@ -634,6 +635,56 @@ def enter_instant(t, kink, full, count, slot, i_f, m, w, r):
     ratio_sample(slot, i_f, w, r)
 
 
+@_callee
+def dense_row(t, kink, i_f, force, head, buf, dirs):
+    """The instant ``t`` (forces ``force[i_f]``; ``kink`` 1 at a corner of the tables)
+    into the dense record ``buf`` of a run that keeps one: each force vector's squared
+    magnitude, reduced between chunks (:mod:`~torquesplit.solve.vector_peaks`); a full
+    buffer counts the rows lost.  ``head`` (``Record.dense_el``): rows written and lost,
+    the numbers of vectors and of pairs, whether corners are entered, the pairs' two
+    elements each (a support's x and y: the sum of their squared forces), then the other
+    vectors' pointers to their terms, flags (1: distinct unit axes, the sum of the
+    squared forces) and terms' elements; ``dirs`` those terms' directions.  A callee
+    with its arrays alone, called only where the run keeps vectors: inlined, in
+    :func:`record` or in the RK4 loop, it slowed the step of runs without them by 1-4 %
+    (same-process A/B)."""
+    k = head[0]
+    if k >= buf.shape[0]:
+        head[1] += 1
+        return
+    n_v = head[2]
+    n_p = head[3]
+    buf[k, 0] = t
+    buf[k, 1] = kink
+    for v in range(n_p):  # (pairs: no pointers, flags or directions to load)
+        x = force[i_f, head[DENSE_HEAD + 2 * v]]
+        y = force[i_f, head[DENSE_HEAD + 2 * v + 1]]
+        buf[k, 2 + v] = x * x + y * y
+    n_g = n_v - n_p
+    ptr = DENSE_HEAD + 2 * n_p  # vector n_p + g: terms from head[ptr + g], flag below
+    el = ptr + 2 * n_g + 1
+    for g in range(n_g):
+        a0 = head[ptr + g]
+        a1 = head[ptr + g + 1]
+        if head[ptr + n_g + 1 + g] != 0:
+            f = 0.0
+            for j in range(a0, a1):
+                x = force[i_f, head[el + j]]
+                f += x * x
+        else:
+            sx = 0.0
+            sy = 0.0
+            sz = 0.0
+            for j in range(a0, a1):
+                x = force[i_f, head[el + j]]
+                sx += x * dirs[j, 0]
+                sy += x * dirs[j, 1]
+                sz += x * dirs[j, 2]
+            f = sx * sx + sy * sy + sz * sz
+        buf[k, 2 + n_p + g] = f
+    head[0] = k + 1
+
+
 @_inline
 def record(t, slot, i_f, weight, m, w, r, counters):
     """Enter one accepted state at time ``t`` (forces in row ``i_f``) in the statistics.
@@ -654,6 +705,8 @@ def record(t, slot, i_f, weight, m, w, r, counters):
     element_kind = m.element_kind
     # the row as an int64 variable: a literal row would compile a second enter_instant
     enter_instant(t, r.pk_x[0], np.int64(1), np.int64(1), slot, np.int64(i_f), m, w, r)
+    if r.dense_el[2] > 0:  # (the bearing table's vectors: RK4 runs that keep them)
+        dense_row(t, r.pk_x[0], np.int64(i_f), w.F, r.dense_el, r.dense, r.dense_dir)
     r.pk_x[0] = 0
     for j in range(watch_el.shape[0]):
         el = watch_el[j]
@@ -684,6 +737,11 @@ def record_extrema(t, mean, slot, i_f, m, w, r):
     # RK4's corners (``mean``): instants in time order, corners among the samples;
     # Dormand-Prince's, element by element: the ratio only, and no parabola across the step
     enter_instant(t, np.int64(1), mean, np.int64(0), slot, i_f, m, w, r)
+    # (in time order: RK4's, which alone keep it; only where a vector's term has corners:
+    # a kink of another element's force does not make a vector's peak, and Ji & Li's
+    # supports paid for a row at each of its meshes' 16 corners a cycle)
+    if mean != 0 and r.dense_el[4] != 0:
+        dense_row(t, np.int64(1), i_f, w.F, r.dense_el, r.dense, r.dense_dir)
     if mean == 0:
         r.pk_k[(r.pk_n[0] - 1) & 1] = 1
         r.pk_x[0] = 1
@@ -943,6 +1001,9 @@ def rk4_through_corners(t, tb, t_corner, sa, sb, m, w, r, rhs_fn, gen, counters)
             first = False
         elif first:  # a corner on the step's start: its sample (the last instant) is that corner
             r.pk_k[(r.pk_n[0] - 1) & 1] = 1
+            if r.dense_el[0] > 0:  # (and the dense record's last row: its parabola through
+                # the corner overshot the corner's force, 2.6e-4 on a rectangular wave)
+                r.dense[r.dense_el[0] - 1, 1] = 1.0
         if te >= tb:
             if t_corner <= tb + MERGE * h:  # a corner on the step's end: so is its sample
                 r.pk_x[0] = 1

@@ -46,6 +46,7 @@ from torquesplit.solve.stability import (
     stable_step,
     system_eigenvalues,
 )
+from torquesplit.solve.vector_peaks import VectorPeaks
 
 __all__ = ["Solution", "integrate", "planned_step", "rhs", "element_forces", "rhs_numpy",
            "element_forces_numpy", "compile_kernels", "STATUS_MESSAGES"]
@@ -196,6 +197,15 @@ class Solution:
     contact events."""
     back_contact_time: np.ndarray
     """(n_el,) time spent in back-side contact [s], weighted like ``separation_time``."""
+    history_peak_names: tuple[str, ...] = ()
+    """Names of the force vectors whose magnitude was taken at every instant
+    (``integrate``'s ``history_peaks``)."""
+    history_peaks: np.ndarray | None = None
+    """(n_records, n_vectors) each vector's largest magnitude [N] since the record
+    before (this record included), over every RK4 step, table corner and peak between
+    them (the vertex of a parabola through three): its largest over a span of records
+    does not depend on the sampling (:mod:`~torquesplit.solve.vector_peaks`).  None
+    without vectors, for a Dormand-Prince run, or where the dense record overflowed."""
 
     def __post_init__(self):
         freeze_arrays(self)
@@ -400,6 +410,7 @@ def integrate(
     n_cycles_cap: int | None = None,
     history_elements=None,
     history_dofs=None,
+    history_peaks=None,
     record_every: int | None = None,
     sample_interval: float | None = None,
     full_history: bool = False,
@@ -461,6 +472,14 @@ def integrate(
     history_elements, history_dofs : sequence of int or str, optional
         Elements (forces) and DOFs (q and v) kept in the decimated history.
         Default: all of them.  Pass ``()`` to keep none.
+    history_peaks : mapping of str to sequence of (int or str, (3,) array_like), optional
+        Force vectors whose magnitude is taken at every instant (rk4): name -> terms
+        (element, direction), the vector being the sum of each element's force times its
+        direction (a bearing's force from its x and y support elements, or a body's from
+        its meshes' lines of action).  Each one's largest magnitude between history
+        records, over every step, corner and peak between steps, is
+        ``Solution.history_peaks``: its peak over a span does not depend on the
+        sampling.  Default: none.  Ignored by dopri and without a history.
     record_every : int, optional (rk4)
         History every ``record_every`` steps, default 1.
     sample_interval : float, optional
@@ -565,11 +584,17 @@ def integrate(
             "history_dofs, drop full_history, or lower n_cycles_cap.")
     if load_sharing_min_total is not None and len(load_sharing_min_total) != len(sel.groups):
         raise OptionError("load_sharing_min_total needs one value per load-sharing group.")
+    vectors = _vectors(s, history_peaks)
+    peaks = (VectorPeaks.build(vectors, n_hist, t0, plan.every * plan.h,
+                               np.flatnonzero(np.diff(model.corner_ptr)))
+             if vectors and rk4 and n_hist else None)
     rec = kd.make_record(sel.track, sel.track_base, sel.n_cycles_cap, sel.groups,
                          s.n_elements, sel.hist_el, sel.hist_dof, n_hist, plan.n_full,
                          s.n_dof, load_sharing_min_total,
                          [kd.continuous_start(full_model.corner_ptr, full_model.corner_node, e)
-                          for e in sel.track])
+                          for e in sel.track],
+                         dense=peaks.layout if peaks is not None else None,
+                         n_dense=_dense_rows(model, plan) if peaks is not None else 0)
     work = kd.make_work(model, rhs_code.parameters)
     work.Y[kd.Y_STATE] = y
     counters = np.zeros(kern.N_COUNTERS, dtype=np.int64)
@@ -578,7 +603,12 @@ def integrate(
     blowup = float(blowup)
 
     if rk4:
-        _run_rk4(t0, plan, blowup, model, work, rec, rhs_code, counters, clock, progress)
+        try:
+            _run_rk4(t0, plan, blowup, model, work, rec, rhs_code, counters, clock, progress,
+                     peaks)
+        finally:  # (what the last chunk recorded, whatever stopped it)
+            if peaks is not None:
+                peaks.drain(rec)
         step_min = step_max = plan.h
     else:
         clock[kern.F_H] = min(_initial_step(s, y, t0, t_end, plan.rtol, plan.atol, model),
@@ -595,12 +625,13 @@ def integrate(
                      compile_time=compile_time, wall_time=time.perf_counter() - t_call,
                      rhs_name=("literal" if rhs_code.literal else "generated")
                      if rhs_code.generated else "general",
-                     rhs_compile_time=rhs_code.compile_time, full_history=full_history)
+                     rhs_compile_time=rhs_code.compile_time, full_history=full_history,
+                     peaks=peaks if peaks is not None and not peaks.lost(rec) else None)
 
 
 def _solution(s, sel, plan, rec, counters, clock, y, *, method, t_span, blowup, step_min,
               step_max, compile_time, wall_time, rhs_name, rhs_compile_time,
-              full_history) -> Solution:
+              full_history, peaks=None) -> Solution:
     """The :class:`Solution` of a finished run from its output arrays (``rec``, a
     :class:`~.kernel_data.Record`), counters, clock and end state ``y``: the one place
     that turns a run's raw outputs into a Solution (the GPU ensemble backend,
@@ -650,6 +681,8 @@ def _solution(s, sel, plan, rec, counters, clock, y, *, method, t_span, blowup, 
         back_contact_steps=rec.back_count,
         separation_time=rec.sep_time,
         back_contact_time=rec.back_time,
+        history_peak_names=peaks.names if peaks is not None else (),
+        history_peaks=peaks.magnitudes(n_rec) if peaks is not None else None,
     )
 
 
@@ -686,6 +719,48 @@ def _initial_state(s: Structure, y0) -> np.ndarray:
         raise OptionError("y0 contains NaN or inf; start from finite displacements and "
                           "velocities, e.g. static_equilibrium(structure).y0.")
     return y
+
+
+def _vectors(s: Structure, history_peaks) -> dict[str, list[tuple[int, np.ndarray]]]:
+    """``integrate``'s ``history_peaks`` checked: name -> [(element index, direction)]."""
+    if history_peaks is None:
+        return {}
+    if not hasattr(history_peaks, "items"):
+        raise OptionTypeError(f"history_peaks must map a name to (element, direction) "
+                              f"terms, e.g. {{'b1': [('b1.support.x', (1, 0, 0))]}}, got "
+                              f"{history_peaks!r}")
+    out = {}
+    for name, terms in history_peaks.items():
+        bad = OptionError(f"history_peaks[{name!r}] needs one or more terms (element, "
+                          f"direction), each direction three finite numbers (x, y, z), "
+                          f"got {terms!r}")
+        try:
+            els, dirs = zip(*terms)
+            dirs = [np.asarray(d, dtype=float).reshape(-1) for d in dirs]
+        except (TypeError, ValueError):
+            raise bad from None
+        if any(d.shape != (3,) or not np.all(np.isfinite(d)) for d in dirs):
+            raise bad
+        out[str(name)] = list(zip(_resolve(s.element_names, els, "element"), dirs,
+                                  strict=True))
+    return out
+
+
+DENSE_CHUNK = 256 * kern.RESYNC
+"""Most RK4 steps in a chunk of a run with a dense record (16,384): its buffer stays
+about a megabyte, where a chunk of a 10-million-step run (1/64 of it) held 10 MB and
+took the benchmark's run over its memory limit."""
+
+
+def _dense_rows(model, plan) -> int:
+    """Rows of the dense record for one chunk of an RK4 run: its steps and at most the
+    table corners that can fall inside them (per element, its corners per cycle at its
+    mesh frequency), with half as many again to spare; a record that still fills up
+    counts what it lost and the run keeps no peaks (the history's then stand)."""
+    n_corners = np.diff(model.corner_ptr)
+    per_second = float(np.sum(n_corners * np.abs(model.frequency)))
+    steps = min(rk4_chunk(plan.limit_steps), DENSE_CHUNK) + 1
+    return steps + math.ceil(1.5 * steps * plan.h * per_second) + 16
 
 
 @dataclass(frozen=True)
@@ -1067,9 +1142,14 @@ def _compiled(dispatcher, args):
     return entry
 
 
-def _run_rk4(t0, plan, blowup, model, work, rec, rhs_code, counters, clock, progress):
-    """Run the RK4 kernel in chunks (multiples of RESYNC steps, about 1.5 % each)."""
+def _run_rk4(t0, plan, blowup, model, work, rec, rhs_code, counters, clock, progress,
+             peaks=None):
+    """Run the RK4 kernel in chunks (multiples of RESYNC steps, about 1.5 % each); with
+    ``peaks`` (:class:`~.vector_peaks.VectorPeaks`) the dense record is entered and
+    emptied after each chunk, of at most :data:`DENSE_CHUNK` steps."""
     chunk = rk4_chunk(plan.limit_steps)
+    if peaks is not None:
+        chunk = min(chunk, DENSE_CHUNK)
     done = 0
     run = None
     while done < plan.limit_steps:
@@ -1082,6 +1162,8 @@ def _run_rk4(t0, plan, blowup, model, work, rec, rhs_code, counters, clock, prog
         try:
             run(*args)
             done += m
+            if peaks is not None:
+                peaks.drain(rec)
             if counters[kern.I_STATUS] != kern.FINISHED:
                 return
             if progress is not None:

@@ -90,6 +90,7 @@ Record = namedtuple("Record", (
     "grp_ptr", "grp_col", "grp_min", "rat_max", "rat_min",
     "sep_count", "back_count", "sep_time", "back_time",
     "hist_el", "hist_dof", "hist_t", "hist_f", "hist_q", "hist_v", "full_t", "full_y",
+    "dense", "dense_el", "dense_dir",
 ))
 """Outputs of a run.  Per tracked element: ``trk_cont`` 1 where its force is continuous
 at its cycle starts (:func:`continuous_start`), else 0.  Per tracked element (columns)
@@ -106,7 +107,15 @@ load-sharing group (``grp_col[grp_ptr[g]:grp_ptr[g+1]]`` its tracked columns) th
 largest and smallest instantaneous ratio ``N f_i / sum_j f_j`` of each member in each of
 its cycles (``rat_max``, ``rat_min``), formed only while the group's total force exceeds
 ``grp_min[g]`` (the ratio of nearly nothing is not load sharing); per element the samples and time in separation
-and in back-side contact; the decimated history and the optional full state."""
+and in back-side contact; the decimated history and the optional full state; the dense
+record of the instants (``dense``: rows t, kink, then each force vector's squared
+magnitude; ``dense_el`` and ``dense_dir`` the vectors' layout,
+:func:`torquesplit.solve._kernels.dense_row`), which
+:mod:`~torquesplit.solve.vector_peaks` reduces between chunks."""
+
+#: ``Record.dense_el``'s header: rows written, rows lost, vectors, pairs, whether the
+#: tables' corners are instants of the record (1: some term has corners); the layout follows
+DENSE_HEAD = 5
 
 # rows of Work.Y
 Y_STATE = 0  # the state (copied in and out of the caller's y)
@@ -398,12 +407,15 @@ def continuous_start(corner_ptr, corner_node, e: int) -> bool:
 
 def make_record(track_el, track_base, n_cycles_cap: int, groups, n_el: int, hist_el,
                 hist_dof, n_hist: int, n_full: int, n_dof: int, group_min=None,
-                continuous=None) -> Record:
+                continuous=None, dense=None, n_dense: int = 0) -> Record:
     """Output arrays of a run.  ``groups``: lists of tracked columns, one per
     load-sharing group (the ratio statistics); ``group_min``: the group total force below
     which no ratio is formed [N] (default 0: any positive total); ``continuous``: per
     tracked element, whether its force is continuous at its cycle starts (default none:
-    no forces interpolated at cycle starts)."""
+    no forces interpolated at cycle starts); ``dense``: the force vectors whose squared
+    magnitudes the dense record keeps at every instant, ``(pairs, ptr, axes, elements,
+    directions, corners)`` as :class:`~.vector_peaks.VectorPeaks` lays them out, ``n_dense`` its
+    rows (none without vectors)."""
     n_tr = len(track_el)
     cap = int(n_cycles_cap)
     grp_ptr = np.zeros(len(groups) + 1, dtype=np.int64)
@@ -432,7 +444,24 @@ def make_record(track_el, track_base, n_cycles_cap: int, groups, n_el: int, hist
         hist_t=np.zeros(n_hist), hist_f=np.zeros((n_hist, n_he)),
         hist_q=np.zeros((n_hist, n_hd)), hist_v=np.zeros((n_hist, n_hd)),
         full_t=np.zeros(n_full), full_y=np.zeros((n_full, 2 * n_dof)),
+        **_dense_arrays(dense, n_dense),
     )
+
+
+def _dense_arrays(dense, n_dense: int) -> dict:
+    """The dense record's arrays of :func:`make_record` (see :data:`Record`);
+    ``dense``: ``(pairs, ptr, axes, elements, directions, corners)``, the pairs' elements
+    (n_p, 2), then the other vectors' terms, and whether the record takes the corners."""
+    if dense is None or len(dense[0]) + len(dense[1]) - 1 <= 0:
+        return dict(dense=np.zeros((0, 2)), dense_el=np.zeros(DENSE_HEAD, dtype=np.int64),
+                    dense_dir=np.zeros((0, 3)))
+    pairs, ptr, axes, elements, dirs, corners = (np.asarray(a) for a in dense)
+    n_p, n_v = len(pairs), len(pairs) + len(ptr) - 1
+    head = np.array([0, 0, n_v, n_p, int(corners)], dtype=np.int64)
+    return dict(dense=np.zeros((int(n_dense), 2 + n_v)),
+                dense_el=np.concatenate([head, pairs.reshape(-1), ptr, axes,
+                                         elements]).astype(np.int64),
+                dense_dir=np.ascontiguousarray(dirs, dtype=np.float64).reshape(-1, 3))
 
 
 def record_bytes(n_cycles_cap: int, n_tracked: int, n_hist: int, n_hist_el: int,

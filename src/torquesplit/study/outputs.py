@@ -36,8 +36,8 @@ name                                        value
                                             of a supported body [N] (the run's bearing
                                             table, :meth:`Results.bearing_forces`)
 ``bearing_peak_force.<body>``               largest settled bearing force magnitude [N]
-                                            (from the history: a peak between its
-                                            samples is missed)
+                                            (streamed at every step, as the run's
+                                            bearing table's)
 ==========================================  ==============================================
 
 Quasi-static results give ``load_sharing.static_torque[.<group|mesh>]`` and
@@ -80,12 +80,12 @@ FAMILIES: dict[str, tuple[str, str]] = {
     "back_flank_force": ("N", "largest back-flank (tensile) force"),
     "settle_time": ("s", "start of the settled part of the run"),
     "bearing_mean_force": ("N", "settled mean bearing force (magnitude)"),
-    "bearing_peak_force": ("N", "largest settled bearing force (magnitude, from the "
-                                "history)"),
+    "bearing_peak_force": ("N", "largest settled bearing force (magnitude, streamed at "
+                                "every step)"),
 }
 
-#: output families read from the history (not streamed): a run without one (the GPU
-#: backend's) cannot give them
+#: output families read from the history (the means from its samples, the peaks from the
+#: streams written with it): a run without one (the GPU backend's) cannot give them
 HISTORY_FAMILIES = ("bearing_mean_force", "bearing_peak_force")
 
 #: outputs that change with the run length by nature (the settled part starts later in a
