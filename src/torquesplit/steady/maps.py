@@ -242,7 +242,8 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
                 "dynamic_factor": (("point", "mesh"), stack("dynamic_factor"),
                                    {"units": "1", "long_name": "peak / the mesh's static force"}),
                 "peak_to_nominal": (("point", "mesh"), stack("peak_to_nominal"),
-                                    {"units": "1", "long_name": "peak / equal-split nominal force"}),
+                                    {"units": "1",
+                                     "long_name": "peak / equal-split nominal force"}),
                 "load_sharing_mean_force": (("point", "mesh"), stack("load_sharing"), {
                     "units": "1", "definition": "mean_force",
                     "long_name": "load-sharing coefficient N mean F_i / sum of the group's "
