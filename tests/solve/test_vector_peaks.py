@@ -56,12 +56,13 @@ def test_the_compiled_reduction_equals_its_twin_chunk_by_chunk(seed):
     # the peaks between the instants raised some rows above their instants' largest
     plain = vector_peaks_numpy(t, np.ones(n), forces, vectors, 0.0, dt, n_rows)
     assert np.all(expect >= plain) and np.sum(expect > plain * (1 + 1e-9)) > 10
-    # rows past the record are not kept; a time before row 0's goes to row 0
+    # a time before row 0's goes to row 0, one after the last row's to the last row
     short = VectorPeaks.build(vectors, 5, 0.5, dt)
     assert short.names == peaks.names
     enter_dense(buf, n, short.row_t0, short.row_dt, short.peaks, short.last, rows)
     np.testing.assert_allclose(short.peaks,
                                vector_peaks_numpy(t, kink, forces, vectors, 0.5, dt, 5))
+    assert np.all(short.peaks[-1] >= buf[t > 0.5 + 4 * dt, 2:].max(axis=0))
 
 
 def _drive():
@@ -96,8 +97,11 @@ def test_the_kernels_dense_record_holds_every_step():
     np.testing.assert_allclose(every.history_peaks, np.sqrt(twin), rtol=1e-12)
     coarse = integrate(run.structure, run.y0, span, record_every=7, **kw)
     np.testing.assert_allclose(np.nanmax(coarse.history_peaks[1:], axis=0),
-                               np.nanmax(every.history_peaks[1:coarse.history_t.size * 7 - 6],
-                                         axis=0), rtol=1e-12)
+                               np.nanmax(every.history_peaks[1:], axis=0), rtol=1e-12)
+    # a history of one record (t = 0) holds the whole run's in it (it held none)
+    one = integrate(run.structure, run.y0, span, record_every=10**9, **kw)
+    np.testing.assert_allclose(one.history_peaks[0],
+                               np.nanmax(every.history_peaks, axis=0), rtol=1e-12)
     # Dormand-Prince keeps none (its peaks come from the history)
     dopri = integrate(run.structure, run.y0, span, method="dopri", history_peaks=vectors,
                       history_dofs=(), track_elements=kw["track_elements"])

@@ -13,7 +13,8 @@ the peaks inside the kernels doubled their cold compile and cost 14-19 % of a st
 (branch ``bearing-peak-stream``).
 
 A history row j (time t_j) holds the largest over the instants in (t_{j-1}, t_j], its own
-included; a peak between instants goes to the interval of the middle one.
+included, and the last row those after it too; a peak between instants goes to the
+interval of the middle one.
 Twin: :func:`vector_peaks_numpy`.
 """
 
@@ -45,8 +46,10 @@ def _vertex(t0, t1, t2, f0, f1, f2):
 def enter_dense(buf, n, row_t0, row_dt, peaks, last, rows):
     """Enter the ``n`` first rows of the dense record ``buf`` (t, kink, each vector's
     squared magnitude) in ``peaks`` (n_rows, n_vectors), their largest per history
-    interval.  History row j of a time t is ceil((t - row_t0) / row_dt) (rows past
-    ``peaks`` are not kept); ``rows`` is scratch space for them (at least ``n``).
+    interval.  History row j of a time t is ceil((t - row_t0) / row_dt), the last row
+    of ``peaks`` for the instants after it (a run whose end falls between two records:
+    a history of one row kept a peak of 0, a reviewer); ``rows`` is scratch space for
+    them (at least ``n``).
     ``last`` (n_vectors, 7) carries the last two instants of each vector from one call
     to the next: times, squared magnitudes, the last one's kink and row, and the count
     entered (zeros to start).  One vector at a time over the instants, its state in
@@ -54,7 +57,7 @@ def enter_dense(buf, n, row_t0, row_dt, peaks, last, rows):
     n_v = peaks.shape[1]
     n_rows = peaks.shape[0]
     for i in range(n):
-        rows[i] = max(math.ceil((buf[i, 0] - row_t0) / row_dt - 1e-9), 0)
+        rows[i] = min(max(math.ceil((buf[i, 0] - row_t0) / row_dt - 1e-9), 0), n_rows - 1)
     for v in range(n_v):
         t0, t1, f0, f1 = last[v, 0], last[v, 1], last[v, 2], last[v, 3]
         k1, j1, seen = last[v, 4], np.int64(last[v, 5]), np.int64(last[v, 6])
@@ -174,7 +177,7 @@ def vector_peaks_numpy(t, kink, forces, vectors, row_t0, row_dt, n_rows) -> np.n
     magnitudes' largest per row (-inf: none)."""
     t = np.asarray(t, float)
     out = np.full((n_rows, len(vectors)), -np.inf)
-    rows = np.maximum(np.ceil((t - row_t0) / row_dt - 1e-9).astype(np.int64), 0)
+    rows = np.clip(np.ceil((t - row_t0) / row_dt - 1e-9).astype(np.int64), 0, n_rows - 1)
     for v, terms in enumerate(vectors.values()):
         vec = sum(forces[:, e][:, None] * np.asarray(d, float)[None, :] for e, d in terms)
         f = (vec ** 2).sum(axis=1)
