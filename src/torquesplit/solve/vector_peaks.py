@@ -26,20 +26,9 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
+from torquesplit.solve._kernels import vertex  # (the mesh forces' peak between instants)
+
 __all__ = ["VectorPeaks", "enter_dense", "vector_peaks_numpy"]
-
-
-@njit(cache=True, error_model="numpy", _nrt=False)
-def _vertex(t0, t1, t2, f0, f1, f2):
-    """Value at the vertex of the parabola through (t0, f0), (t1, f1), (t2, f2), t0 < t1
-    < t2 (f1 where it is a line); :func:`torquesplit.solve._kernels.vertex`'s formula."""
-    d1 = (f1 - f0) / (t1 - t0)
-    d2 = (f2 - f1) / (t2 - t1)
-    a = (d2 - d1) / (t2 - t0)
-    if a == 0.0:
-        return f1
-    s = (d1 * (t2 - t1) + d2 * (t1 - t0)) / (t2 - t0)
-    return f1 - s * s / (4.0 * a)
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
@@ -80,7 +69,7 @@ def enter_dense(buf, n, row_t0, row_dt, peaks, last, rows):
             # extremum at every third instant: 4.7 ns a vector and instant, against 1.7)
             if (f1 >= f and f1 >= f0 and f1 - min(f0, f) > 1e-13 * f1 and k1 == 0.0
                     and seen >= 2 and t0 < t1 < t):
-                top = _vertex(t0, t1, t, f0, f1, f)
+                top = vertex(t0, t1, t, f0, f1, f)
                 if j1 == cur_j:
                     cur = max(cur, top)
                 elif 0 <= j1 < n_rows and top > peaks[j1, v]:
