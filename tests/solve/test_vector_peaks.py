@@ -102,10 +102,42 @@ def test_the_kernels_dense_record_holds_every_step():
     one = integrate(run.structure, run.y0, span, record_every=10**9, **kw)
     np.testing.assert_allclose(one.history_peaks[0],
                                np.nanmax(every.history_peaks, axis=0), rtol=1e-12)
-    # Dormand-Prince keeps none (its peaks come from the history)
-    dopri = integrate(run.structure, run.y0, span, method="dopri", history_peaks=vectors,
-                      history_dofs=(), track_elements=kw["track_elements"])
-    assert dopri.history_peaks is None and dopri.history_peak_names == ()
+
+
+def test_dormand_prince_keeps_the_peaks_of_every_accepted_step(monkeypatch):
+    """Dormand-Prince enters every accepted step (it kept the history's samples): the
+    peaks over the run do not depend on the sampling, equal the every-step ones of its
+    twin, and a dense record emptied every few steps (the kernel returns when it is half
+    full) changes neither them nor the trajectory."""
+    run, vectors = _drive()
+    kw = dict(method="dopri", max_step=2e-4, history_dofs=(),
+              track_elements=run.integrate_kwargs["track_elements"])
+    span = (0.0, 0.01)
+    runs = {si: integrate(run.structure, run.y0, span, history_peaks=vectors,
+                          sample_interval=si, **kw) for si in (2e-4, 3.7e-5)}
+    coarse, fine = runs[2e-4], runs[3.7e-5]
+    assert sorted(coarse.history_peak_names) == sorted(vectors) and coarse.n_steps > 300
+    np.testing.assert_array_equal(np.nanmax(coarse.history_peaks, axis=0),
+                                  np.nanmax(fine.history_peaks, axis=0))
+    # the fine history's samples (interpolated between the steps) reach no higher
+    names = fine.history_peak_names
+    cols = {e: list(fine.history_elements).index(e) for t in vectors.values() for e, _ in t}
+    forces = np.zeros((fine.history_t.size, run.structure.n_elements))
+    for e, c in cols.items():
+        forces[:, e] = fine.history_forces[:, c]
+    sampled = np.sqrt(_squared(forces, {n: vectors[n] for n in names}))
+    assert np.all(np.nanmax(sampled, axis=0) < np.nanmax(fine.history_peaks, axis=0)
+                  + 1e-12)
+    # the kernel returning every 8 steps to have its record emptied: bit for bit the same
+    plain = integrate(run.structure, run.y0, span, sample_interval=2e-4, **kw)
+    integ = importlib.import_module("torquesplit.solve.integrate")
+    monkeypatch.setattr(integ, "DENSE_CHUNK", 4)
+    small = integrate(run.structure, run.y0, span, history_peaks=vectors,
+                      sample_interval=2e-4, **kw)
+    assert small.n_steps == plain.n_steps == coarse.n_steps
+    np.testing.assert_array_equal(small.y_final, plain.y_final)
+    np.testing.assert_array_equal(coarse.y_final, plain.y_final)
+    np.testing.assert_array_equal(small.history_peaks, coarse.history_peaks)
 
 
 def test_history_peaks_refuses_bad_terms():
@@ -117,6 +149,17 @@ def test_history_peaks_refuses_bad_terms():
         integrate(s, run.y0, (0.0, 1e-4), history_peaks={"a": [(0, (1.0, 0.0))]})
     with pytest.raises(OptionError, match="unknown element 'nope'"):
         integrate(s, run.y0, (0.0, 1e-4), history_peaks={"a": [("nope", (1.0, 0.0, 0.0))]})
+    # an index is an integer (1.7 was element 1, True element 1), a direction not zero
+    for index in (1.7, True, np.float64(2.0)):
+        with pytest.raises(OptionTypeError, match="each element is a name or an integer"):
+            integrate(s, run.y0, (0.0, 1e-4), history_peaks={"a": [(index, (1, 0, 0))]})
+    with pytest.raises(OptionTypeError, match="each dof is a name or an integer index, got 0.5"):
+        integrate(s, run.y0, (0.0, 1e-4), history_dofs=[0.5])
+    with pytest.raises(OptionError, match=r"history_peaks\['a'\]: a direction of \(0, 0, 0\)"):
+        integrate(s, run.y0, (0.0, 1e-4), history_peaks={"a": [(0, (1, 0, 0)), (1, (0, 0, 0))]})
+    sol = integrate(s, run.y0, (0.0, 1e-4), history_peaks={"a": [(np.int64(1), (0, 1, 0))]},
+                    history_elements=[np.int32(1)], history_dofs=())
+    assert sol.history_elements == (1,) and sol.history_peaks.shape[1] == 1
 
 
 def test_a_dense_record_that_overflows_keeps_no_peaks(monkeypatch):

@@ -705,7 +705,7 @@ def record(t, slot, i_f, weight, m, w, r, counters):
     element_kind = m.element_kind
     # the row as an int64 variable: a literal row would compile a second enter_instant
     enter_instant(t, r.pk_x[0], np.int64(1), np.int64(1), slot, np.int64(i_f), m, w, r)
-    if r.dense_el[2] > 0:  # (the bearing table's vectors: RK4 runs that keep them)
+    if r.dense_el[2] > 0:  # (the bearing table's vectors: runs that keep them)
         dense_row(t, r.pk_x[0], np.int64(i_f), w.F, r.dense_el, r.dense, r.dense_dir)
     r.pk_x[0] = 0
     for j in range(watch_el.shape[0]):
@@ -737,10 +737,12 @@ def record_extrema(t, mean, slot, i_f, m, w, r):
     # RK4's corners (``mean``): instants in time order, corners among the samples;
     # Dormand-Prince's, element by element: the ratio only, and no parabola across the step
     enter_instant(t, np.int64(1), mean, np.int64(0), slot, i_f, m, w, r)
-    # (in time order: RK4's, which alone keep it; only where a vector's term has corners:
-    # a kink of another element's force does not make a vector's peak, and Ji & Li's
-    # supports paid for a row at each of its meshes' 16 corners a cycle)
-    if mean != 0 and r.dense_el[4] != 0:
+    # (only where a vector's term has corners: a kink of another element's force does
+    # not make a vector's peak, and Ji & Li's supports paid for a row at each of its
+    # meshes' 16 corners a cycle.  Dormand-Prince's come element by element, not in time
+    # order: the reduction takes no parabola through an instant out of order or a corner,
+    # nor through the end of a step that held corners, which its kink marks)
+    if r.dense_el[4] != 0:
         dense_row(t, np.int64(1), i_f, w.F, r.dense_el, r.dense, r.dense_dir)
     if mean == 0:
         r.pk_k[(r.pk_n[0] - 1) & 1] = 1
@@ -1129,7 +1131,9 @@ def dopri_run(t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, blowup, dt
     rtol max(|y_i|, |y_new_i|)).  Every accepted state enters the statistics, and so do
     the forces at the corners inside each accepted step (:func:`corner_events`); the
     decimated (and optional full) histories are written at the uniform times
-    t0 + k dt_sample by cubic Hermite interpolation between accepted steps.
+    t0 + k dt_sample by cubic Hermite interpolation between accepted steps.  A run
+    that keeps a dense record (:func:`dense_row`) returns when it is half full, for the
+    caller to empty it.
     Status: DIVERGED (non-finite or |q| > blowup after an accepted step),
     STEP_UNDERFLOW (h < max(h_min, 10 eps |t|)), MAX_STEPS (accepted steps).
     Twin: :func:`torquesplit.solve.reference.dopri_numpy`.
@@ -1293,6 +1297,8 @@ def dopri_run(t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, blowup, dt
             h = h_new
             facold = max(enorm, 1.0e-4)
             counters[I_LAST_REJECTED] = 0
+            if r.dense_el[2] > 0 and 2 * r.dense_el[0] >= r.dense.shape[0]:
+                break  # (the dense record half full: the caller empties it, calls again)
         else:
             counters[I_REJECTED] += 1
             counters[I_LAST_REJECTED] = 1

@@ -22,6 +22,7 @@ import contextlib
 import difflib
 import logging
 import math
+import operator
 import threading
 import time
 from dataclasses import dataclass
@@ -202,10 +203,10 @@ class Solution:
     (``integrate``'s ``history_peaks``)."""
     history_peaks: np.ndarray | None = None
     """(n_records, n_vectors) each vector's largest magnitude [N] since the record
-    before (this record included), over every RK4 step, table corner and peak between
-    them (the vertex of a parabola through three): its largest over a span of records
-    does not depend on the sampling (:mod:`~torquesplit.solve.vector_peaks`).  None
-    without vectors, for a Dormand-Prince run, or where the dense record overflowed."""
+    before (this record included), over every (accepted) step, table corner and peak
+    between them (the vertex of a parabola through three): its largest over a span of
+    records does not depend on the sampling (:mod:`~torquesplit.solve.vector_peaks`).
+    None without vectors or where the dense record overflowed."""
 
     def __post_init__(self):
         freeze_arrays(self)
@@ -329,7 +330,14 @@ def _resolve(names: Sequence[str], selection, what: str) -> list[int]:
                                   f"structure.{what}_names or an index.")
             out.append(names.index(item))
         else:
-            i = int(item)
+            try:  # (an integer: 1.7 or True is not an index)
+                if isinstance(item, bool | np.bool_):
+                    raise TypeError
+                i = operator.index(item)
+            except TypeError:
+                raise OptionTypeError(f"each {what} is a name or an integer index, got "
+                                      f"{item!r}; use one of structure.{what}_names or "
+                                      "its index.") from None
             if not 0 <= i < len(names):
                 raise OptionError(f"{what} index {i} is out of range 0..{len(names) - 1}; "
                                   f"use an index or a name from structure.{what}_names.")
@@ -473,13 +481,13 @@ def integrate(
         Elements (forces) and DOFs (q and v) kept in the decimated history.
         Default: all of them.  Pass ``()`` to keep none.
     history_peaks : mapping of str to sequence of (int or str, (3,) array_like), optional
-        Force vectors whose magnitude is taken at every instant (rk4): name -> terms
+        Force vectors whose magnitude is taken at every instant: name -> terms
         (element, direction), the vector being the sum of each element's force times its
         direction (a bearing's force from its x and y support elements, or a body's from
         its meshes' lines of action).  Each one's largest magnitude between history
-        records, over every step, corner and peak between steps, is
+        records, over every (accepted) step, corner and peak between steps, is
         ``Solution.history_peaks``: its peak over a span does not depend on the
-        sampling.  Default: none.  Ignored by dopri and without a history.
+        sampling.  Default: none.  Ignored without a history.
     record_every : int, optional (rk4)
         History every ``record_every`` steps, default 1.
     sample_interval : float, optional
@@ -585,9 +593,10 @@ def integrate(
     if load_sharing_min_total is not None and len(load_sharing_min_total) != len(sel.groups):
         raise OptionError("load_sharing_min_total needs one value per load-sharing group.")
     vectors = _vectors(s, history_peaks)
-    peaks = (VectorPeaks.build(vectors, n_hist, t0, plan.every * plan.h,
+    peaks = (VectorPeaks.build(vectors, n_hist, t0,
+                               plan.every * plan.h if rk4 else plan.dt_sample,
                                np.flatnonzero(np.diff(model.corner_ptr)))
-             if vectors and rk4 and n_hist else None)
+             if vectors and n_hist else None)
     rec = kd.make_record(sel.track, sel.track_base, sel.n_cycles_cap, sel.groups,
                          s.n_elements, sel.hist_el, sel.hist_dof, n_hist, plan.n_full,
                          s.n_dof, load_sharing_min_total,
@@ -614,8 +623,12 @@ def integrate(
         clock[kern.F_H] = min(_initial_step(s, y, t0, t_end, plan.rtol, plan.atol, model),
                               plan.h_max)
         counters[kern.I_RHS] = 2  # the two evaluations of the starting-step estimate
-        _run_dopri(t0, t_end, plan, blowup, model, work, rec, rhs_code, counters, clock,
-                   progress)
+        try:
+            _run_dopri(t0, t_end, plan, blowup, model, work, rec, rhs_code, counters, clock,
+                       progress, peaks)
+        finally:
+            if peaks is not None:
+                peaks.drain(rec)
         accepted = counters[kern.I_STEPS] > 0
         step_min = float(clock[kern.F_HMIN]) if accepted else math.nan
         step_max = float(clock[kern.F_HMAX]) if accepted else math.nan
@@ -741,6 +754,10 @@ def _vectors(s: Structure, history_peaks) -> dict[str, list[tuple[int, np.ndarra
             raise bad from None
         if any(d.shape != (3,) or not np.all(np.isfinite(d)) for d in dirs):
             raise bad
+        if not all(np.any(d) for d in dirs):
+            raise OptionError(f"history_peaks[{name!r}]: a direction of (0, 0, 0) adds "
+                              "nothing; give each term its element's axis or line of "
+                              "action, e.g. (1, 0, 0).")
         out[str(name)] = list(zip(_resolve(s.element_names, els, "element"), dirs,
                                   strict=True))
     return out
@@ -755,10 +772,15 @@ took the benchmark's run over its memory limit."""
 def _dense_rows(model, plan) -> int:
     """Rows of the dense record for one chunk of an RK4 run: its steps and at most the
     table corners that can fall inside them (per element, its corners per cycle at its
-    mesh frequency), with half as many again to spare; a record that still fills up
+    mesh frequency), with half as many again to spare.  A Dormand-Prince run returns
+    when its record is half full: twice :data:`DENSE_CHUNK` rows and the most a step can
+    add (its end and the corners in the largest step).  A record that still fills up
     counts what it lost and the run keeps no peaks (the history's then stand)."""
     n_corners = np.diff(model.corner_ptr)
     per_second = float(np.sum(n_corners * np.abs(model.frequency)))
+    if not math.isnan(plan.dt_sample):  # (Dormand-Prince)
+        per_step = 1 + math.ceil(1.5 * plan.h_max * per_second) + int(np.sum(n_corners > 0))
+        return 2 * (DENSE_CHUNK + per_step) + 16
     steps = min(rk4_chunk(plan.limit_steps), DENSE_CHUNK) + 1
     return steps + math.ceil(1.5 * steps * plan.h * per_second) + 16
 
@@ -1178,8 +1200,10 @@ def _run_rk4(t0, plan, blowup, model, work, rec, rhs_code, counters, clock, prog
 
 
 def _run_dopri(t0, t_end, plan, blowup, model, work, rec, rhs_code, counters, clock,
-               progress):
-    """Run the Dormand-Prince kernel up to successive 1/64 fractions of the span."""
+               progress, peaks=None):
+    """Run the Dormand-Prince kernel up to successive 1/64 fractions of the span; with
+    ``peaks`` (:class:`~.vector_peaks.VectorPeaks`) the kernel also returns when its
+    dense record is half full, to have it entered and emptied."""
     clock[kern.F_FACOLD] = 1e-4
     clock[kern.F_HMIN] = math.inf
     clock[kern.F_HMAX] = 0.0
@@ -1196,6 +1220,11 @@ def _run_dopri(t0, t_end, plan, blowup, model, work, rec, rhs_code, counters, cl
             run = _compiled(kern.dopri_run, args)
         try:
             run(*args)
+            while peaks is not None and counters[kern.I_STATUS] == kern.FINISHED:
+                peaks.drain(rec)
+                if clock[kern.F_T] >= t_stop:
+                    break
+                run(*args)
             if counters[kern.I_STATUS] != kern.FINISHED:
                 return
             if progress is not None:

@@ -2,7 +2,7 @@
 
 The bearing table's peak |F| came from the decimated history, so it moved with the
 sampling: 4.3 % on the split-path differential between 20 and 33 samples per period.
-The kernels now keep, for RK4 runs that ask for it, a dense record of the instants
+The kernels now keep, for runs that ask for it, a dense record of the instants
 (every step, and the tables' corners where a vector's term has them) with each vector's
 squared magnitude (``Record.dense``,
 :func:`torquesplit.solve._kernels.dense_row`).  Between chunks of the run
