@@ -37,8 +37,7 @@ REMOVALS = {
     "excitation (t + h/2, t + h)": [
         ("            excite(t_end if last else t_mid, sb if last else s_half,\n"
          "                   src_end if last else src_half, m, w)\n", "            pass\n")],
-    "statistics (record)": [("        record(t, a, F_MAIN, 0.0 if last else h, m, w, r, counters)\n",
-                             "")],
+    "statistics (record)": [("        record(t, a, F_MAIN, m, w, r, counters)\n", "")],
     "  of it: parabola vertices (force_instant)": [
         ("        g2 = regime(defl[i_f, el], G[slot, el])\n        if smooth:\n",
          "        g2 = 0\n        if False:\n")],

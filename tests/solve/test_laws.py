@@ -160,3 +160,30 @@ def test_every_consumer_uses_the_spline_law():
     lam = np.sort(np.linalg.eigvalsh(np.array([[t[0], t[1]], [t[2], t[3]]])))
     np.testing.assert_allclose(np.sort(modal.frequencies), np.sqrt(lam) / (2 * math.pi),
                                rtol=1e-12)
+
+
+def test_negative_share_equals_its_twin_and_may_cross_never_misses_a_crossing():
+    """The contact times' split of an interval (``laws.negative_share``, the parabola
+    through three samples) against the roots in numpy, on crossings, dips between two
+    positive samples and rises between two negative ones; ``may_cross`` (the kernels'
+    shortcut to a whole interval) is true wherever the share is not 0 or 1."""
+    from torquesplit.solve.reference import negative_share_numpy
+
+    rng = np.random.default_rng(5)
+    a, b = rng.normal(size=(2, 4000))
+    c = rng.normal(scale=3.0, size=4000)
+    c[:200] = 0.0  # (the chord)
+    a[200:300] = b[200:300] = 0.1  # a dip below zero between two positive samples
+    c[200:300] = np.linspace(0.2, 1.0, 100)
+    expect = negative_share_numpy(a, b, c)
+    got = np.array([laws.negative_share(x, y, z) for x, y, z in zip(a, b, c, strict=True)])
+    np.testing.assert_allclose(got, expect, rtol=1e-12, atol=1e-12)
+    assert np.all((got >= 0) & (got <= 1))
+    partial = (got > 1e-15) & (got < 1 - 1e-15)
+    assert partial.sum() > 1000 and np.sum(partial & (np.sign(a) == np.sign(b))) > 100
+    cross = np.array([laws.may_cross(x, y, z) for x, y, z in zip(a, b, c, strict=True)])
+    assert not np.any(partial & ~cross)
+    assert np.all(got[~cross] == (a[~cross] < 0))
+    # the dips: none at a sag of 0.4 or less (the parabola's lowest point 0.1 - sag / 4)
+    assert np.all(got[200:300][c[200:300] <= 0.4] == 0.0)
+    assert np.all(got[200:300][c[200:300] > 0.41] > 0.0)

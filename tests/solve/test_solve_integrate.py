@@ -136,13 +136,17 @@ def test_backlash_contact_loss_is_counted():
     assert np.min(sol.cycle_min) < 0  # back-flank force
     f = sol.history_forces[:, 0]
     assert np.any(f == 0.0)
-    assert sol.separation_time[0] == pytest.approx(sol.separation_steps[0] * sol.step)
-    # the adaptive method crowds its steps at the impacts, but the time shares agree
+    # the times split the steps where the contact changes (on the parabola through three
+    # samples): at the default step, and at a tolerance where the adaptive method crowds
+    # its steps at the impacts, they equal a tight adaptive run's (2.4732e-4 s
+    # separated), where whole steps gave 2.45e-4 at the default step and 3.20e-4 at 200
+    # steps per period
+    ref = integrate(s, st.y0, (0.0, 0.02), method="dopri", rtol=1e-10)
     dp = integrate(s, st.y0, (0.0, 0.02), method="dopri", rtol=1e-8)
     assert dp.separation_steps[0] / dp.n_samples > 3 * dp.separation_fraction[0]
-    assert dp.separation_fraction[0] == pytest.approx(sol.separation_fraction[0], rel=0.1)
-    assert dp.back_contact_fraction[0] == pytest.approx(sol.back_contact_fraction[0],
-                                                        rel=0.1)
+    for r in (sol, dp):
+        assert r.separation_time[0] == pytest.approx(ref.separation_time[0], rel=5e-4)
+        assert r.back_contact_time[0] == pytest.approx(ref.back_contact_time[0], rel=1e-5)
 
 
 def test_step_ten_times_too_large_is_refused_with_safe_step():

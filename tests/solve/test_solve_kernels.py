@@ -3,14 +3,26 @@
 from __future__ import annotations
 
 import importlib
+import math
 
 import numpy as np
 import pytest
-from solve_models import random_structure, spur_pair
+from solve_models import (
+    J1,
+    J2,
+    K_MESH,
+    R1,
+    R2,
+    pair_frequency,
+    random_structure,
+    spur_pair,
+)
 
+from torquesplit.assembly.structure import MESH, SPRING, build_structure
 from torquesplit.solve import element_forces, integrate, rhs
 from torquesplit.solve.reference import (
     contact_state_numpy,
+    contact_times_numpy,
     cycle_statistics_numpy,
     dopri_numpy,
     element_forces_numpy,
@@ -232,6 +244,30 @@ def test_contact_counters_equal_twin_over_the_full_history():
     np.testing.assert_array_equal(sol.separation_steps, sep)
     np.testing.assert_array_equal(sol.back_contact_steps, back)
     assert sep.sum() > 0 and back.sum() > 0
+    # the times: split where delta + g or delta - g changes sign between two steps
+    sep_t, back_t = contact_times_numpy(s, sol.full_t, sol.full_y)
+    np.testing.assert_allclose(sol.separation_time, sep_t, rtol=1e-12, atol=1e-18)
+    np.testing.assert_allclose(sol.back_contact_time, back_t, rtol=1e-12, atol=1e-18)
+    steps = (sep + back) * sol.step  # (whole steps: they differ)
+    assert np.max(np.abs(sol.separation_time + sol.back_contact_time - steps)) > 0.1 * sol.step
+
+
+@pytest.mark.parametrize("kind, gaps", [(MESH, [0.0, 10e-6]), (SPRING, [10e-6, 0.0])])
+def test_contact_times_equal_twin_where_the_clearance_comes_and_goes(kind, gaps):
+    """Per-cycle gaps that mix 0 and > 0 (a reviewer's case): a clearance element in a
+    cycle without clearance has no contact state; the kernel kept its last gapped
+    sample and split the next interval from it (0.13 % off), the twin took the gaps at
+    the first instant for the whole run."""
+    el = dict(name="e", kind=kind, dofs=[0, 1], coefs=[R1, -R2], stiffness=K_MESH,
+              damping=50.0, gaps=gaps, frequency=1000.0,
+              errors=[(40e-6, 2 * math.pi * pair_frequency(), 0.0)])
+    s = build_structure(["g1.theta", "g2.theta"], [1 / J1, 1 / J2], [el],
+                        external_force=[20.0, -20.0 * R2 / R1], n_table=64)
+    sol = integrate(s, np.zeros(4), (0.0, 0.01), step=2e-6, full_history=True)
+    sep_t, back_t = contact_times_numpy(s, sol.full_t, sol.full_y)
+    assert sol.separation_time[0] > 1e-5 and sol.back_contact_time[0] > 1e-3
+    np.testing.assert_allclose(sol.separation_time, sep_t, rtol=1e-12, atol=1e-18)
+    np.testing.assert_allclose(sol.back_contact_time, back_t, rtol=1e-12, atol=1e-18)
 
 
 def test_cycle_means_converge_with_the_step_through_the_corners():

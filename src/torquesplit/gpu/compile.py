@@ -61,7 +61,8 @@ def kernel(n_cases, P, PT, PI, Y0, TK, TF, TFR, GS, CN, OF, OI):
 
 
 #: the element laws the generated code calls (by these names)
-LAWS = ("spring_force", "spline_force", "positive_part", "table_phase", "lerp", "stat_cycle")
+LAWS = ("spring_force", "spline_force", "positive_part", "table_phase", "lerp", "stat_cycle",
+        "negative_share", "may_cross")
 _LAW_DISPATCHERS: dict = {}
 
 
@@ -84,7 +85,8 @@ def law_functions() -> dict:
 
 #: the scalar laws, among them those that the laws of :data:`LAWS` call
 SCALAR_LAWS = ("dead_zone", "spring_force", "spline_radial", "spline_force",
-               "spline_tangent", "positive_part", "table_phase", "lerp", "stat_cycle")
+               "spline_tangent", "positive_part", "table_phase", "lerp", "stat_cycle",
+               "negative_share", "may_cross")
 _CUDA_LAWS: dict = {}
 
 

@@ -36,6 +36,7 @@ contact counts, next corner node per element, the counters of ``_kernels`` (``I_
 
 from __future__ import annotations
 
+import contextlib
 import math
 from dataclasses import dataclass
 
@@ -168,8 +169,10 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
     X_PKK = X_PKT + 2  # whether each is a corner
     X_PN = X_PKK + 2  # instants entered
     X_PX = X_PN + 1  # whether the next sample is a corner
-    X_CT = X_PX + 1
-    n_x = X_CT + 2 * len(watch) + 1
+    X_CT = X_PX + 1  # per watched element: time separated, time in back-side contact
+    X_CP = X_CT + 2 * len(watch)  # per watched element: _kernels' Record.contact_prev
+    X_CS = X_CP + 3 * len(watch)  # the last two samples' times (Record.contact_t)
+    n_x = X_CS + 2 + 1
     n_tv = max(len(tv), 1)
     WI_SC = 3 * n_tv
     WI_CC = WI_SC + 2 * n_tr
@@ -550,20 +553,70 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
         for j in range(n_tr):
             w(f"WI[{WI_SC + 2 * j + 1}] += 1")
         w(f"X[{X_PX}] = 0.0")
+        # contact counts and times (_kernels.record: the times over the interval since
+        # the last sample, on the parabola through the last three)
+        w(f"n_s = WI[{WI_CNT + _I.I_SAMPLES}]")
+        w("h1 = 0.0")
+        w("h0 = 0.0")
+        with w.block("if n_s > 0:"):
+            w(f"h1 = t - X[{X_CS}]")
+        with w.block("if n_s > 1:"):
+            w(f"h0 = X[{X_CS}] - X[{X_CS + 1}]")
+        w("k_sag = 0.0")
+        w("k_ratio = 0.0")
+        with w.block("if h0 > 0.0 and h1 > 0.0:"):
+            w("k_sag = h1 / (h0 + h1)")
+            w("k_ratio = h1 / h0")
+        w(f"X[{X_CS + 1}] = X[{X_CS}]")
+        w(f"X[{X_CS}] = t")
         for k, el in enumerate(watch):
+            sep, back, p = X_CT + 2 * k, X_CT + 2 * k + 1, X_CP + 3 * k
             w(f"g = {g_of(el)}")
             w(f"d = W[{W_D + el}]")
-            with w.block("if g > 0.0:"):
-                with w.block("if d < -g:"):
-                    w(f"WI[{WI_CC + 2 * k + 1}] += 1")
-                    w(f"X[{X_CT + 2 * k + 1}] += weight")
-                with w.block("elif d <= g:"):
-                    w(f"WI[{WI_CC + 2 * k}] += 1")
-                    w(f"X[{X_CT + 2 * k}] += weight")
+            w("state = 0.0")
             if L.element_kind[el] == kern.MESH_KIND:
-                with w.block("elif d < 0.0:"):
+                w("lo = d")
+                w("hi = d")
+                scope = contextlib.nullcontext()
+            else:  # (no contact state without a gap)
+                scope = w.block("if g > 0.0:")
+            with scope:
+                with w.block("if g > 0.0:"):
+                    w("lo = d + g")
+                    w("hi = d - g")
+                with w.block("if lo < 0.0:"):
                     w(f"WI[{WI_CC + 2 * k + 1}] += 1")
-                    w(f"X[{X_CT + 2 * k + 1}] += weight")
+                    w("state = 2.0")
+                with w.block("elif g > 0.0 and hi <= 0.0:"):
+                    w(f"WI[{WI_CC + 2 * k}] += 1")
+                    w("state = 1.0")
+                w(f"lo1 = X[{p}]")
+                w(f"hi1 = X[{p + 1}]")
+                w(f"sag = k_sag * ((lo - lo1) - (lo1 - X[{p + 2}]) * k_ratio)")
+                with w.block("if state == 0.0:"):
+                    w("cross = may_cross(hi1, hi, sag)")
+                with w.block("elif state == 2.0:"):
+                    w("cross = may_cross(lo1, lo, sag)")
+                with w.block("else:"):
+                    w("cross = may_cross(lo1, lo, sag) | may_cross(hi1, hi, sag)")
+                with w.block("if cross:"):
+                    w("f_back = negative_share(lo1, lo, sag)")
+                    w(f"X[{back}] += h1 * f_back")
+                    w("f_sep = negative_share(hi1, hi, sag) - f_back")
+                    with w.block("if f_sep > 0.0:"):
+                        w(f"X[{sep}] += h1 * f_sep")
+                with w.block("elif state == 2.0:"):
+                    w(f"X[{back}] += h1")
+                with w.block("elif state == 1.0:"):
+                    w(f"X[{sep}] += h1")
+                w(f"X[{p + 2}] = lo1")
+                w(f"X[{p}] = lo")
+                w(f"X[{p + 1}] = hi")
+            if L.element_kind[el] != kern.MESH_KIND:
+                with w.block("else:"):  # (a cycle without clearance: no state, no time)
+                    w(f"X[{p + 2}] = X[{p}]")
+                    w(f"X[{p}] = d")
+                    w(f"X[{p + 1}] = d")
         w(f"WI[{WI_CNT + _I.I_SAMPLES}] += 1")
 
     with w.block("def vertex(t0, t1, t2, f0, f1, f2):"):  # _kernels.vertex
@@ -575,7 +628,7 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
         w("sl = (d1 * (t2 - t1) + d2 * (t1 - t0)) / (t2 - t0)")
         w("return f1 - sl * sl / (4.0 * a)")
     w()
-    with w.block("def record(t, weight, full, X, WI, W, OF, OI, P, PT, PI, c):"):
+    with w.block("def record(t, full, X, WI, W, OF, OI, P, PT, PI, c):"):
         record_body()
         w("return 0")
     w()
@@ -674,7 +727,7 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
             w(f"te = t_corner if t_corner < tb - {kern.MERGE!r} * h else tb")
             with w.block("if not first:"):
                 w(f"rhs(I0, I{W_Y}, I{W_K1}, X, W, P, PT, PI, c)")
-                w("record(ts, 0.0, I0, X, WI, W, OF, OI, P, PT, PI, c)")
+                w("record(ts, I0, X, WI, W, OF, OI, P, PT, PI, c)")
                 w(f"WI[{WI_CNT + _I.I_RHS}] += 1")
                 w(f"WI[{WI_CNT + _I.I_EVENTS}] += 1")
             with w.block(f"if te - ts > {kern.MERGE!r} * h:"):
@@ -727,6 +780,8 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
         with w.block(f"for k in range({2 * len(watch)}):"):
             w(f"X[{X_CT} + k] = 0.0")
             w(f"WI[{WI_CC} + k] = 0")
+        with w.block(f"for k in range({3 * len(watch) + 2}):"):
+            w(f"X[{X_CP} + k] = 0.0")
         with w.block(f"for k in range({kern.N_COUNTERS}):"):
             w(f"WI[{WI_CNT} + k] = 0")
         for i in range(n_sin):
@@ -745,7 +800,7 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
                 with w.block("if i > 0 and i % chunk == 0:"):
                     w("t_corner = first_corners(t, WI, PT, c, CN)")
             w(f"rhs(I0, I{W_Y}, I{W_K1}, X, W, P, PT, PI, c)")
-            w("record(t, h, I1, X, WI, W, OF, OI, P, PT, PI, c)")
+            w("record(t, I1, X, WI, W, OF, OI, P, PT, PI, c)")
             w("tb = t0 + (i + 1) * h")
             with w.block("if t_corner < tb:"):
                 w("t_corner = through_corners(t, tb, t_corner, X, WI, W, OF, OI, P, PT, PI, "
@@ -765,7 +820,7 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
                 w("break")
         with w.block(f"if WI[{WI_CNT + _I.I_STATUS}] == 0 and n_steps > 0:"):
             w(f"rhs(I0, I{W_Y}, I{W_K1}, X, W, P, PT, PI, c)")
-            w("record(t_final, 0.0, I1, X, WI, W, OF, OI, P, PT, PI, c)")
+            w("record(t_final, I1, X, WI, W, OF, OI, P, PT, PI, c)")
         for j in range(n_tr):
             w(f"flush(I{j}, X, WI, OF, OI, c, cap)")
         with w.block(f"for k in range({2 * len(watch)}):"):

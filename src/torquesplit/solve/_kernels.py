@@ -685,8 +685,18 @@ def dense_row(t, kink, i_f, force, head, buf, dirs):
     head[0] = k + 1
 
 
+@_callee
+def split_interval(lo1, lo, hi1, hi, sag):
+    """The shares of an interval in back-side contact (delta + g from ``lo1`` to ``lo``
+    negative) and separated (delta - g from ``hi1`` to ``hi`` negative, the other not),
+    both on the parabola of sag ``sag`` (:func:`laws.negative_share`).  A callee: the
+    rare case of :func:`record`, kept out of the step loop's code."""
+    f_back = laws.negative_share(lo1, lo, sag)
+    return f_back, max(laws.negative_share(hi1, hi, sag) - f_back, 0.0)
+
+
 @_inline
-def record(t, slot, i_f, weight, m, w, r, counters):
+def record(t, slot, i_f, m, w, r, counters):
     """Enter one accepted state at time ``t`` (forces in row ``i_f``) in the statistics.
 
     Per tracked element j: cycle c = CY - track_base[j] (cycles at or beyond the
@@ -695,14 +705,31 @@ def record(t, slot, i_f, weight, m, w, r, counters):
     group the instantaneous ratio N f_i / sum_j f_j of each member (Ji & Li eq. 18) and
     its max and min in the member's cycle.  Contact counters: separation |delta| <= g
     with g > 0; back-side contact delta < -g with g > 0, or delta < 0 for a mesh
-    without backlash; ``weight`` is the time the sample stands for.
+    without backlash.  Their times: over the interval since the last sample, delta + g
+    and delta - g follow the parabola through the last three samples (the chord for
+    the second sample), split where they change sign (:func:`laws.negative_share`; counted
+    by whole steps, the time moved by tens of per cent with the step where the back
+    flank is only grazed).
     Twins: :func:`torquesplit.solve.reference.cycle_statistics_numpy`,
-    :func:`torquesplit.solve.reference.contact_state_numpy`.
+    :func:`torquesplit.solve.reference.contact_state_numpy`,
+    :func:`torquesplit.solve.reference.contact_times_numpy`.
     """
     defl, G, watch_el = w.D, w.G, w.watch_el
     sep_count, sep_time, back_count, back_time = (r.sep_count, r.sep_time, r.back_count,
                                                   r.back_time)
     element_kind = m.element_kind
+    # per element, the last sample's delta + g and delta - g, the one before's delta + g;
+    # h0 and h1 the last two intervals between samples (0: none yet)
+    last = r.contact_prev
+    n_s = counters[I_SAMPLES]
+    h1 = t - r.contact_t[0] if n_s > 0 else 0.0
+    h0 = r.contact_t[0] - r.contact_t[1] if n_s > 1 else 0.0
+    # the parabola's sag over the interval (h1^2 times the second divided difference):
+    # k_sag ((lo - lo1) - (lo1 - lo0) k_ratio), 0 without a sample before the interval
+    k_sag = h1 / (h0 + h1) if h0 > 0.0 and h1 > 0.0 else 0.0
+    k_ratio = h1 / h0 if k_sag != 0.0 else 0.0
+    r.contact_t[1] = r.contact_t[0]
+    r.contact_t[0] = t
     # the row as an int64 variable: a literal row would compile a second enter_instant
     enter_instant(t, r.pk_x[0], np.int64(1), np.int64(1), slot, np.int64(i_f), m, w, r)
     if r.dense_el[2] > 0:  # (the bearing table's vectors: runs that keep them)
@@ -712,16 +739,49 @@ def record(t, slot, i_f, weight, m, w, r, counters):
         el = watch_el[j]
         g = G[slot, el]
         d = defl[i_f, el]
+        state = 0  # 1: separated, 2: back-side contact
         if g > 0.0:
-            if d < -g:
+            lo = d + g
+            hi = d - g
+            if lo < 0.0:
                 back_count[el] += 1
-                back_time[el] += weight
-            elif d <= g:
+                state = 2
+            elif hi <= 0.0:
                 sep_count[el] += 1
-                sep_time[el] += weight
-        elif element_kind[el] == MESH_KIND and d < 0.0:
-            back_count[el] += 1
-            back_time[el] += weight
+                state = 1
+        elif element_kind[el] == MESH_KIND:
+            lo = d
+            hi = d
+            if d < 0.0:
+                back_count[el] += 1
+                state = 2
+        else:  # (a clearance element in a cycle without clearance: no state, no time)
+            last[el, 2] = last[el, 0]
+            last[el, 0] = d
+            last[el, 1] = d
+            continue
+        lo1 = last[el, 0]
+        hi1 = last[el, 1]
+        sag = k_sag * ((lo - lo1) - (lo1 - last[el, 2]) * k_ratio)
+        # (delta - g <= delta + g on the same parabola: in contact, delta - g alone can
+        # change sign first, in back-side contact delta + g alone)
+        if state == 0:
+            cross = laws.may_cross(hi1, hi, sag)
+        elif state == 2:
+            cross = laws.may_cross(lo1, lo, sag)
+        else:
+            cross = laws.may_cross(lo1, lo, sag) | laws.may_cross(hi1, hi, sag)
+        if cross:
+            f_back, f_sep = split_interval(lo1, lo, hi1, hi, sag)
+            back_time[el] += h1 * f_back
+            sep_time[el] += h1 * f_sep
+        elif state == 2:  # (one state throughout the interval)
+            back_time[el] += h1
+        elif state == 1:
+            sep_time[el] += h1
+        last[el, 2] = lo1
+        last[el, 0] = lo
+        last[el, 1] = hi
     counters[I_SAMPLES] += 1
 
 
@@ -1070,7 +1130,7 @@ def rk4_run(t0, h, n_first, n_steps, record_final, record_every, blowup, m, w, r
                 next_sync += RESYNC
         # stage 1 at t: its forces are those of the accepted state y(t)
         _stage(a, Y_STATE, Y_K1, F_MAIN, m, w, rhs_fn, gen, extra)
-        record(t, a, F_MAIN, 0.0 if last else h, m, w, r, counters)
+        record(t, a, F_MAIN, m, w, r, counters)
         if i == next_rec:
             next_rec += every
             if record_every > 0 and counters[I_HIST] < n_hist:
@@ -1171,7 +1231,7 @@ def dopri_run(t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, blowup, dt
         counters[I_RHS] += 1
         counters[I_FSAL] = 1
         if counters[I_SAMPLES] == 0:
-            record(t, s1, F_MAIN, 0.0, m, w, r, counters)
+            record(t, s1, F_MAIN, m, w, r, counters)
         while counters[I_NEXT] < n_hist and t0 + counters[I_NEXT] * dt_sample <= t:
             row = counters[I_NEXT]
             store_history(row, t, np.int64(Y_STATE), np.int64(F_MAIN), w, r)
@@ -1288,7 +1348,7 @@ def dopri_run(t0, t_end, t_stop, rtol, atol, h_max, h_min, max_steps, blowup, dt
                 clock[F_HMIN] = hs
             if hs > clock[F_HMAX]:
                 clock[F_HMAX] = hs
-            record(t, s1, F_MAIN, hs, m, w, r, counters)
+            record(t, s1, F_MAIN, m, w, r, counters)
             fac = fac11 / facold ** _BETA
             fac = max(1.0 / _FAC_MAX, min(1.0 / _FAC_MIN, fac / _SAFE))
             h_new = hs / fac

@@ -88,7 +88,7 @@ Record = namedtuple("Record", (
     "track_el", "track_base", "trk_cont", "cyc_max", "cyc_min", "cyc_sum", "cyc_cnt", "cyc_wt",
     "prev_t", "prev_f", "prev_c", "pk_t", "pk_f", "pk_g", "pk_k", "pk_n", "pk_x",
     "grp_ptr", "grp_col", "grp_min", "rat_max", "rat_min",
-    "sep_count", "back_count", "sep_time", "back_time",
+    "sep_count", "back_count", "sep_time", "back_time", "contact_t", "contact_prev",
     "hist_el", "hist_dof", "hist_t", "hist_f", "hist_q", "hist_v", "full_t", "full_y",
     "dense", "dense_el", "dense_dir",
 ))
@@ -107,7 +107,9 @@ load-sharing group (``grp_col[grp_ptr[g]:grp_ptr[g+1]]`` its tracked columns) th
 largest and smallest instantaneous ratio ``N f_i / sum_j f_j`` of each member in each of
 its cycles (``rat_max``, ``rat_min``), formed only while the group's total force exceeds
 ``grp_min[g]`` (the ratio of nearly nothing is not load sharing); per element the samples and time in separation
-and in back-side contact; the decimated history and the optional full state; the dense
+and in back-side contact, with the last two samples' times (``contact_t`` (2,)) and,
+per element, the last one's delta + g and delta - g and the one before's delta + g
+(``contact_prev`` (n_el, 3)); the decimated history and the optional full state; the dense
 record of the instants (``dense``: rows t, kink, then each force vector's squared
 magnitude; ``dense_el`` and ``dense_dir`` the vectors' layout,
 :func:`torquesplit.solve._kernels.dense_row`), which
@@ -438,7 +440,8 @@ def make_record(track_el, track_base, n_cycles_cap: int, groups, n_el: int, hist
                  else np.asarray(group_min, dtype=np.float64).reshape(len(groups))),
         rat_max=np.full((cap, n_tr), -np.inf), rat_min=np.full((cap, n_tr), np.inf),
         sep_count=np.zeros(n_el, dtype=np.int64), back_count=np.zeros(n_el, dtype=np.int64),
-        sep_time=np.zeros(n_el), back_time=np.zeros(n_el),
+        sep_time=np.zeros(n_el), back_time=np.zeros(n_el), contact_t=np.zeros(2),
+        contact_prev=np.zeros((n_el, 3)),
         hist_el=np.asarray(hist_el, dtype=np.int64),
         hist_dof=np.asarray(hist_dof, dtype=np.int64),
         hist_t=np.zeros(n_hist), hist_f=np.zeros((n_hist, n_he)),

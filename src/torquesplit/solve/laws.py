@@ -222,6 +222,45 @@ def stat_cycle(s, fl):
 
 
 # ========================================================= batch evaluators (Python)
+@_law
+def negative_share(a, b, c):
+    """The fraction of [0, 1] where q(u) = a + (b - a) u + c u (u - 1) is negative: the
+    parabola from ``a`` (u = 0) to ``b`` (u = 1) that sags ``c`` / 4 below its chord
+    at u = 1/2 (``c`` = 0: the chord).  Not an element law: the contact times'
+    (``_kernels.record``), here to be compiled for the GPU as the laws are.  Twin:
+    ``reference.negative_share_numpy``."""
+    if c == 0.0:
+        if a < 0.0:
+            return 1.0 if b < 0.0 else a / (a - b)
+        return b / (b - a) if b < 0.0 else 0.0
+    lin = b - a - c  # q = c u^2 + lin u + a
+    disc = lin * lin - 4.0 * c * a
+    if disc <= 0.0:  # (no real roots: the sign of c throughout)
+        return 1.0 if c < 0.0 else 0.0
+    qq = -0.5 * (lin + math.copysign(math.sqrt(disc), lin))
+    r1 = qq / c
+    r2 = a / qq
+    if r1 > r2:
+        r1, r2 = r2, r1
+    # (no min / max here: numba-cuda's builtin min of two floats does not compile)
+    if r1 < 0.0:
+        r1 = 0.0
+    if r2 > 1.0:
+        r2 = 1.0
+    inside = r2 - r1 if r2 > r1 else 0.0  # where q has the sign of -c
+    return inside if c > 0.0 else 1.0 - inside
+
+
+@_law
+def may_cross(a, b, c):
+    """Whether q of :func:`negative_share` can change sign on [0, 1]: the parabola lies
+    within |c| / 4 of its chord.  On the safe side (whatever the sign of c), and
+    without a branch on that sign: a sag of round-off, of either sign, made one of the
+    kernels' branches a coin toss (2.3 ns a mesh and step)."""
+    s = 0.25 * abs(c)
+    return ((a < 0.0) != (b < 0.0)) | (s >= abs(a)) | (s >= abs(b))
+
+
 _batch = njit(cache=True, error_model="numpy")
 
 

@@ -190,6 +190,60 @@ def contact_state_numpy(structure: Structure, t: float, y: np.ndarray):
     return separated, back
 
 
+def negative_share_numpy(a, b, c):
+    """The fraction of [0, 1] where q(u) = a + (b - a) u + c u (u - 1) is negative,
+    elementwise, from q's roots (the parabola through three samples, ``c`` = 0 the
+    chord).  Twin of ``_kernels.negative_share``, without its shortcuts."""
+    a, b, c = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (a, b, c)))
+    out = np.empty(a.shape)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        chord = np.where(a < 0, np.where(b < 0, 1.0, a / (a - b)),
+                         np.where(b < 0, b / (b - a), 0.0))
+    for i in np.ndindex(a.shape):
+        if c[i] == 0.0:
+            out[i] = chord[i]
+            continue
+        roots = np.roots([c[i], b[i] - a[i] - c[i], a[i]])
+        roots = np.sort(roots[np.abs(roots.imag) == 0].real)
+        if roots.size < 2 or roots[0] == roots[1]:
+            out[i] = 1.0 if c[i] < 0 else 0.0
+            continue
+        inside = max(min(roots[1], 1.0) - max(roots[0], 0.0), 0.0)
+        out[i] = inside if c[i] > 0 else 1.0 - inside
+    return out
+
+
+def contact_times_numpy(structure: Structure, times, ys):
+    """Time in separation and in back-side contact [s] (two arrays (n_el,)) over the
+    samples (t_k, y_k): between two samples delta + g and delta - g (delta alone for a
+    mesh without backlash) follow the parabola through that interval's two samples and
+    the one before (the first interval: the chord), and the interval is split where
+    they change sign (:func:`negative_share_numpy`).  An interval that ends in a cycle
+    without clearance of an element other than a mesh counts nothing.  Twin of the
+    contact times in ``_kernels.record``."""
+    mesh = structure.element_kind == MESH
+    lo, hi, gapped = [], [], []
+    for t, y in zip(times, ys, strict=True):
+        _, delta = element_forces_numpy(structure, t, y)
+        g = excitation_numpy(structure, t).half_gap
+        gap = np.where(g > 0, g, 0.0)
+        lo.append(delta + gap)
+        hi.append(delta - gap)
+        gapped.append(g > 0)
+    lo, hi, gapped = np.array(lo), np.array(hi), np.array(gapped)
+    h = np.diff(np.asarray(times, dtype=float))[:, None]
+    # the sag of the parabola through samples k-2, k-1, k over (t_k-1, t_k): h_k^2 times
+    # its second divided difference (Newton), of delta + g for both
+    c = np.zeros_like(lo[1:])
+    c[1:] = h[1:] ** 2 * ((lo[2:] - lo[1:-1]) / h[1:] - (lo[1:-1] - lo[:-2]) / h[:-1]) / (
+        h[1:] + h[:-1])
+    back = negative_share_numpy(lo[:-1], lo[1:], c)
+    sep = np.maximum(negative_share_numpy(hi[:-1], hi[1:], c) - back, 0.0)
+    end = gapped[1:]  # (the state at each interval's end decides whether it counts)
+    return ((h * np.where(end | mesh, sep, 0.0)).sum(axis=0),
+            (h * np.where(end | mesh, back, 0.0)).sum(axis=0))
+
+
 def hermite_numpy(theta, h, y0, f0, y1, f1):
     """Cubic Hermite interpolant between (y0, f0) and (y1, f1) at t0 + theta h.
 
