@@ -192,12 +192,13 @@ class Solution:
     """(n_el,) accepted states with delta < -g (back flank; mesh without backlash:
     delta < 0)."""
     separation_time: np.ndarray
-    """(n_el,) time spent in separation [s]: each accepted state weighted by the step it
-    stands for (rk4: the step that starts there; dopri: the step that ends there).
-    Unlike ``separation_steps`` this is not biased by adaptive steps crowding at
-    contact events."""
+    """(n_el,) time spent in separation [s]: each interval between two accepted states
+    split where delta - g or delta + g changes sign, on the parabola through three
+    states (:func:`~torquesplit.solve._kernels.record`).  Unlike ``separation_steps``
+    it is not biased by adaptive steps crowding at contact events, and converges with
+    the step where the contact is only grazed."""
     back_contact_time: np.ndarray
-    """(n_el,) time spent in back-side contact [s], weighted like ``separation_time``."""
+    """(n_el,) time spent in back-side contact [s], split like ``separation_time``."""
     history_peak_names: tuple[str, ...] = ()
     """Names of the force vectors whose magnitude was taken at every instant
     (``integrate``'s ``history_peaks``)."""
