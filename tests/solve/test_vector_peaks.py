@@ -128,10 +128,12 @@ def test_dormand_prince_keeps_the_peaks_of_every_accepted_step(monkeypatch):
     sampled = np.sqrt(_squared(forces, {n: vectors[n] for n in names}))
     assert np.all(np.nanmax(sampled, axis=0) < np.nanmax(fine.history_peaks, axis=0)
                   + 1e-12)
-    # the kernel returning every 8 steps to have its record emptied: bit for bit the same
+    # the kernel returning every 3 steps to have its record of 6 rows emptied (no corners
+    # here: a row a step), within the 64 parts of the span (5 steps each): the same bit
+    # for bit, where without the returns the record overflowed and kept no peaks
     plain = integrate(run.structure, run.y0, span, sample_interval=2e-4, **kw)
     integ = importlib.import_module("torquesplit.solve.integrate")
-    monkeypatch.setattr(integ, "DENSE_CHUNK", 4)
+    monkeypatch.setattr(integ, "_dense_rows", lambda model, plan: 6)
     small = integrate(run.structure, run.y0, span, history_peaks=vectors,
                       sample_interval=2e-4, **kw)
     assert small.n_steps == plain.n_steps == coarse.n_steps
