@@ -193,7 +193,7 @@ def contact_state_numpy(structure: Structure, t: float, y: np.ndarray):
 def negative_share_numpy(a, b, c):
     """The fraction of [0, 1] where q(u) = a + (b - a) u + c u (u - 1) is negative,
     elementwise, from q's roots (the parabola through three samples, ``c`` = 0 the
-    chord).  Twin of ``_kernels.negative_share``, without its shortcuts."""
+    chord).  Twin of ``laws.negative_share``, without its shortcuts."""
     a, b, c = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (a, b, c)))
     out = np.empty(a.shape)
     with np.errstate(divide="ignore", invalid="ignore"):
