@@ -62,7 +62,7 @@ def kernel(n_cases, P, PT, PI, Y0, TK, TF, TFR, GS, CN, OF, OI):
 
 #: the element laws the generated code calls (by these names)
 LAWS = ("spring_force", "spline_force", "positive_part", "table_phase", "lerp", "stat_cycle",
-        "negative_share", "may_cross")
+        "contact_shares")
 _LAW_DISPATCHERS: dict = {}
 
 
@@ -86,7 +86,7 @@ def law_functions() -> dict:
 #: the scalar laws, among them those that the laws of :data:`LAWS` call
 SCALAR_LAWS = ("dead_zone", "spring_force", "spline_radial", "spline_force",
                "spline_tangent", "positive_part", "table_phase", "lerp", "stat_cycle",
-               "negative_share", "may_cross")
+               "negative_share", "may_cross", "contact_shares")
 _CUDA_LAWS: dict = {}
 
 

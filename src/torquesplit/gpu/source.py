@@ -554,7 +554,7 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
             w(f"WI[{WI_SC + 2 * j + 1}] += 1")
         w(f"X[{X_PX}] = 0.0")
         # contact counts and times (_kernels.record: the times over the interval since
-        # the last sample, on the parabola through the last three)
+        # the last sample, on the parabola through the last three: laws.contact_shares)
         w(f"n_s = WI[{WI_CNT + _I.I_SAMPLES}]")
         w("h1 = 0.0")
         w("h0 = 0.0")
@@ -591,24 +591,12 @@ def kernel_source(g: Group, precision: str = "fp64") -> KernelSource:
                     w(f"WI[{WI_CC + 2 * k}] += 1")
                     w("state = 1.0")
                 w(f"lo1 = X[{p}]")
-                w(f"hi1 = X[{p + 1}]")
-                w(f"sag = k_sag * ((lo - lo1) - (lo1 - X[{p + 2}]) * k_ratio)")
-                with w.block("if state == 0.0:"):
-                    w("cross = may_cross(hi1, hi, sag)")
-                with w.block("elif state == 2.0:"):
-                    w("cross = may_cross(lo1, lo, sag)")
-                with w.block("else:"):
-                    w("cross = may_cross(lo1, lo, sag) | may_cross(hi1, hi, sag)")
-                with w.block("if cross:"):
-                    w("f_back = negative_share(lo1, lo, sag)")
+                w(f"f_back, f_sep = contact_shares(X[{p + 2}], lo1, X[{p + 1}], lo, hi, state, "
+                  "k_sag, k_ratio)")
+                with w.block("if f_back != 0.0:"):
                     w(f"X[{back}] += h1 * f_back")
-                    w("f_sep = negative_share(hi1, hi, sag) - f_back")
-                    with w.block("if f_sep > 0.0:"):
-                        w(f"X[{sep}] += h1 * f_sep")
-                with w.block("elif state == 2.0:"):
-                    w(f"X[{back}] += h1")
-                with w.block("elif state == 1.0:"):
-                    w(f"X[{sep}] += h1")
+                with w.block("if f_sep != 0.0:"):
+                    w(f"X[{sep}] += h1 * f_sep")
                 w(f"X[{p + 2}] = lo1")
                 w(f"X[{p}] = lo")
                 w(f"X[{p + 1}] = hi")

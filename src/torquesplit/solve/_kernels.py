@@ -685,16 +685,6 @@ def dense_row(t, kink, i_f, force, head, buf, dirs):
     head[0] = k + 1
 
 
-@_callee
-def split_interval(lo1, lo, hi1, hi, sag):
-    """The shares of an interval in back-side contact (delta + g from ``lo1`` to ``lo``
-    negative) and separated (delta - g from ``hi1`` to ``hi`` negative, the other not),
-    both on the parabola of sag ``sag`` (:func:`laws.negative_share`).  A callee: the
-    rare case of :func:`record`, kept out of the step loop's code."""
-    f_back = laws.negative_share(lo1, lo, sag)
-    return f_back, max(laws.negative_share(hi1, hi, sag) - f_back, 0.0)
-
-
 @_inline
 def record(t, slot, i_f, m, w, r, counters):
     """Enter one accepted state at time ``t`` (forces in row ``i_f``) in the statistics.
@@ -707,9 +697,9 @@ def record(t, slot, i_f, m, w, r, counters):
     with g > 0; back-side contact delta < -g with g > 0, or delta < 0 for a mesh
     without backlash.  Their times: over the interval since the last sample, delta + g
     and delta - g follow the parabola through the last three samples (the chord for
-    the second sample), split where they change sign (:func:`laws.negative_share`; counted
-    by whole steps, the time moved by tens of per cent with the step where the back
-    flank is only grazed).
+    the second sample), split where they change sign (:func:`laws.contact_shares`;
+    counted by whole steps, the time moved by tens of per cent with the step where the
+    back flank is only grazed).
     Twins: :func:`torquesplit.solve.reference.cycle_statistics_numpy`,
     :func:`torquesplit.solve.reference.contact_state_numpy`,
     :func:`torquesplit.solve.reference.contact_times_numpy`.
@@ -761,24 +751,12 @@ def record(t, slot, i_f, m, w, r, counters):
             last[el, 1] = d
             continue
         lo1 = last[el, 0]
-        hi1 = last[el, 1]
-        sag = k_sag * ((lo - lo1) - (lo1 - last[el, 2]) * k_ratio)
-        # (delta - g <= delta + g on the same parabola: in contact, delta - g alone can
-        # change sign first, in back-side contact delta + g alone)
-        if state == 0:
-            cross = laws.may_cross(hi1, hi, sag)
-        elif state == 2:
-            cross = laws.may_cross(lo1, lo, sag)
-        else:
-            cross = laws.may_cross(lo1, lo, sag) | laws.may_cross(hi1, hi, sag)
-        if cross:
-            f_back, f_sep = split_interval(lo1, lo, hi1, hi, sag)
+        f_back, f_sep = laws.contact_shares(last[el, 2], lo1, last[el, 1], lo, hi, state,
+                                            k_sag, k_ratio)
+        if f_back != 0.0:
             back_time[el] += h1 * f_back
+        if f_sep != 0.0:
             sep_time[el] += h1 * f_sep
-        elif state == 2:  # (one state throughout the interval)
-            back_time[el] += h1
-        elif state == 1:
-            sep_time[el] += h1
         last[el, 2] = lo1
         last[el, 0] = lo
         last[el, 1] = hi

@@ -261,6 +261,36 @@ def may_cross(a, b, c):
     return ((a < 0.0) != (b < 0.0)) | (s >= abs(a)) | (s >= abs(b))
 
 
+
+@_law
+def contact_shares(lo0, lo1, hi1, lo, hi, state, k_sag, k_ratio):
+    """The shares of the interval between two samples spent in back-side contact and
+    separated: delta + g goes ``lo0``, ``lo1``, ``lo`` over the last three samples (the
+    parabola through them, ``k_sag`` ((lo - lo1) - (lo1 - lo0) ``k_ratio``) its sag
+    over the interval), delta - g from ``hi1`` to ``hi`` on the same parabola; ``state``
+    the sample's (0 contact, 1 separated, 2 back side).  The split
+    (:func:`negative_share`) only where a sign can change (:func:`may_cross`; delta - g
+    <= delta + g, so in contact delta - g alone can change sign first, in back-side
+    contact delta + g alone).  The contact times of ``_kernels.record`` and of the GPU
+    ensemble kernel.  Twin: ``reference.contact_times_numpy``."""
+    sag = k_sag * ((lo - lo1) - (lo1 - lo0) * k_ratio)
+    if state == 0:
+        cross = may_cross(hi1, hi, sag)
+    elif state == 2:
+        cross = may_cross(lo1, lo, sag)
+    else:
+        cross = may_cross(lo1, lo, sag) | may_cross(hi1, hi, sag)
+    if cross:
+        f_back = negative_share(lo1, lo, sag)
+        f_sep = negative_share(hi1, hi, sag) - f_back
+        return f_back, f_sep if f_sep > 0.0 else 0.0
+    if state == 2:  # (one state throughout the interval)
+        return 1.0, 0.0
+    if state == 1:
+        return 0.0, 1.0
+    return 0.0, 0.0
+
+
 _batch = njit(cache=True, error_model="numpy")
 
 
