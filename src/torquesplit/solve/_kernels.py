@@ -43,6 +43,7 @@ import math
 import numpy as np
 from numba import njit
 
+from torquesplit._jit_cache import track_imports
 from torquesplit.solve import laws
 from torquesplit.solve.kernel_data import (
     A_D,
@@ -61,6 +62,8 @@ from torquesplit.solve.kernel_data import (
     Y_STATE,
     Y_TRIAL,
 )
+
+track_imports()  # before any @njit(cache=True): see torquesplit._jit_cache
 
 # ----------------------------------------------------------------- status codes
 FINISHED = 0

@@ -74,9 +74,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._jit_cache import track_imports
 from .._memo import hash_arrays
 from . import kernel_data as kd
 from . import laws
+
+track_imports()  # before any @njit(cache=True): see torquesplit._jit_cache
 
 __all__ = ["GeneratedRhs", "generated_rhs", "general_rhs", "rhs_ir", "worth_generating",
            "worth_literal", "note_pattern_run"]

@@ -48,6 +48,10 @@ import math
 import numpy as np
 from numba import cfunc, njit, types
 
+from torquesplit._jit_cache import track_imports
+
+track_imports()  # before any @njit(cache=True): see torquesplit._jit_cache
+
 __all__ = [
     "STICK", "FLOAT", "CONTACT", "CYCLE_EPS",
     "dead_zone", "spring_force", "spline_radial", "spline_force", "spline_tangent",

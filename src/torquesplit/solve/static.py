@@ -52,6 +52,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numba import njit
 
+from torquesplit._jit_cache import track_imports
 from torquesplit._memo import Kept, remember_content
 from torquesplit.assembly.structure import (
     SP_CLEARANCE,
@@ -64,6 +65,8 @@ from torquesplit.solve import laws
 from torquesplit.solve._frozen import freeze_arrays
 from torquesplit.solve.laws import CONTACT, FLOAT
 from torquesplit.solve.reference import excitation_numpy
+
+track_imports()  # before any @njit(cache=True): see torquesplit._jit_cache
 
 __all__ = ["StaticSolution", "QuasiStaticSolution", "static_equilibrium", "quasi_static",
            "rigid_body_modes"]

@@ -26,7 +26,10 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from torquesplit.solve._kernels import vertex  # (the mesh forces' peak between instants)
+from torquesplit._jit_cache import track_imports
+from torquesplit.solve._kernels import vertex  # the mesh forces' peak between instants
+
+track_imports()  # before any @njit(cache=True): see torquesplit._jit_cache
 
 __all__ = ["VectorPeaks", "enter_dense", "vector_peaks_numpy"]
 

@@ -40,6 +40,7 @@ import math
 import numpy as np
 from numba import njit
 
+from torquesplit._jit_cache import track_imports
 from torquesplit.solve import laws
 from torquesplit.solve._kernels import (
     MERGE,
@@ -53,6 +54,8 @@ from torquesplit.solve._kernels import (
     sub_step_end,
 )
 from torquesplit.solve.kernel_data import F_MAIN, Y_K1, Y_STATE, Y_TRIAL
+
+track_imports()  # before any @njit(cache=True): see torquesplit._jit_cache
 
 _kernel = njit(cache=True, error_model="numpy", _nrt=False)
 _inline = njit(inline="always", error_model="numpy")

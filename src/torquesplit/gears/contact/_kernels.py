@@ -47,6 +47,10 @@ import math
 import numpy as np
 from numba import njit
 
+from torquesplit._jit_cache import track_imports
+
+track_imports()  # before any @njit(cache=True): see torquesplit._jit_cache
+
 __all__ = [
     "contact_deflection",
     "contact_deflection_twin",
