@@ -22,6 +22,7 @@ kinematics                      loops that cannot turn, power that does not bala
                                 carriers and planets (model/epicyclic.py)
 :func:`shaft_axis_issues`       shafts joining bodies that are not on a common axis
 :func:`overlap_issues`          gears that do not mesh but occupy the same space
+:func:`face_overlap_issues`     meshing gears whose faces do not overlap along the axis
 :func:`nominal_load_issues`     meshes that carry no load (no power passes them)
 :func:`balance_issues`          torques out of balance by more than
                                 :data:`BALANCE_TOLERANCE` (what the static solution of
@@ -91,6 +92,7 @@ def check_model(model: Model, source: str | None = None, *, deep: bool = False) 
     except KinematicsError as exc:
         raise ModelError(as_written(model, exc.issues), source) from None
     issues = shaft_axis_issues(model, kin) + overlap_issues(model, kin)
+    issues += face_overlap_issues(model, kin)
     on_planets = planet_drive_issues(model, kin)
     issues += nominal_load_issues(model, kin) + (on_planets or balance_issues(model, kin))
     issues += stiffness_table_issues(model, kin) + planet_fit_issues(model, kin)
@@ -804,6 +806,7 @@ def plausibility_warnings(model: Model, kin) -> list[tuple[str, str]]:
     out += _locked_speed_drives(model)
     out += _mass_magnitudes(model)
     out += _centre_distance_offsets(model, kin)
+    out += _face_overlap_warnings(model, kin)
     pairs: dict[frozenset, str] = {}
     for name, m in model.meshes.items():
         key = frozenset(m.gears)
@@ -943,6 +946,65 @@ def overlap_issues(model: Model, kin) -> list[tuple[str, str]]:
     :func:`_axially_located`).  Positions are those at t = 0."""
     return [_overlap_issue(model, a, b, d)
             for a, b, d, refused in _overlapping_pairs(model, kin) if refused]
+
+
+def face_overlap(model: Model, kin) -> list[tuple[str, float, float, float, float]]:
+    """``(mesh, axial offset, overlap, narrower face, wider face)`` [m] of every cylindrical
+    mesh whose two faces, along the common axis, do not cover each other's narrower face:
+    the teeth touch over ``overlap`` only (none where it is <= 0).  Gears whose plane the
+    file does not state (:func:`_axially_located`) are left out."""
+    from .kinematics import gear_geometry
+
+    located = _axially_located(model)
+    out = []
+    for name, m in model.meshes.items():
+        a, b = m.gears
+        ga, gb = model.gears[a], model.gears[b]
+        if {ga.gear_type, gb.gear_type} & {"bevel", "face"} or not {a, b} <= located \
+                or a not in kin.bodies or b not in kin.bodies:
+            continue
+        try:
+            wa, wb = gear_geometry(ga).total_face_width, gear_geometry(gb).total_face_width
+        except (ModelError, ValueError, ArithmeticError):  # pragma: no cover - checked before
+            continue
+        axis = np.asarray(kin.bodies[a].axis, float)
+        axial = float(np.dot(np.asarray(kin.bodies[b].position, float)
+                             - np.asarray(kin.bodies[a].position, float), axis))
+        overlap = min(wa / 2, axial + wb / 2) - max(-wa / 2, axial - wb / 2)
+        if overlap < min(wa, wb) - OVERLAP_TOLERANCE:
+            out.append((name, axial, overlap, min(wa, wb), max(wa, wb)))
+    return out
+
+
+def _face_overlap_text(model: Model, name: str, axial: float, narrow: float,
+                       wide: float) -> str:
+    a, b = model.meshes[name].gears
+    return (f"the centres of {a} and {b} are {abs(axial) * 1e3:.4g} mm apart along their "
+            f"axis, with faces {narrow * 1e3:.4g} mm and {wide * 1e3:.4g} mm wide")
+
+
+def face_overlap_issues(model: Model, kin) -> list[tuple[str, str]]:
+    """Meshing gears whose faces do not overlap at all along their axis (an axial
+    position typed wrong): their teeth never touch."""
+    return [(f"meshes.{name}", (
+        f"{_face_overlap_text(model, name, axial, narrow, wide)}: their faces do not "
+        f"overlap and the teeth never touch; give both gears the same axial position "
+        f"(the component of 'position' along 'axis')"))
+        for name, axial, overlap, narrow, wide in face_overlap(model, kin)
+        if overlap <= OVERLAP_TOLERANCE]
+
+
+def _face_overlap_warnings(model: Model, kin) -> list[tuple[str, str]]:
+    """Meshing gears whose faces overlap along the axis over less than the narrower
+    face: the mesh stiffness and the tooth loads are those of the whole narrower face."""
+    return [(f"meshes.{name}", (
+        f"{_face_overlap_text(model, name, axial, narrow, wide)}: the teeth touch over "
+        f"{overlap * 1e3:.4g} mm only, but the mesh stiffness is that of the whole "
+        f"{narrow * 1e3:.4g} mm face; align the gears along the axis ('position'), or, "
+        f"if the offset is meant, give the width in contact as the narrower gear's "
+        f"face_width"))
+        for name, axial, overlap, narrow, wide in face_overlap(model, kin)
+        if overlap > OVERLAP_TOLERANCE]
 
 
 #: a pair's given positions further than this from its operating centre distance [m]

@@ -240,10 +240,10 @@ def _finish(res, names, defs, out, output_values, vals=None) -> list[float]:
                                    f"s); raise the run length (duration or cycles) or the "
                                    f"tolerance")])
     out["settled"] = out["settled"] and met.settling.settled
-    from ..results.plausibility import result_warnings
+    from ..results.plausibility import contact_lost, result_warnings
 
     _warn(result_warnings(res, met, history=False))  # (no output is from the history)
-    lost = [(r.mesh, r.contact_loss) for r in met.rows if r.contact_loss > 0]
+    lost = [(r.mesh, r.contact_loss) for r in met.rows if contact_lost(r)]
     if lost:
         out["status"] = "contact_lost"
         out["reason"] = "contact lost in " + ", ".join(
