@@ -294,7 +294,8 @@ peaks move in their second digit: the drive runs near a resonance (next paragrap
 where the peaks depend on the step and on how sharply the tables resolve the jumps (half
 the step and 65536 table points move them by about 1 %).  Refine both (`--steps-per-period`, `--set
 analysis.table_points=...`), and report only the digits that hold; the mean-force
-coefficients move far less than the peaks (`--json` gives every number's digits).
+coefficients move far less than the peaks: they hold {{{{lsc_digits}}}} significant digits
+(`--json` gives every number's digits).
 
 A dynamic factor of about {{{{dynamic_factor}}}} is large.  The modes show where it can come from:
 
@@ -339,7 +340,10 @@ command with `--resume`; run again without it, it refuses to write over the fold
 $ {SWEEP}
 
 Thicker shafts share worse: the usual trade-off of a locked train, where the compliance
-of the branches is what evens out the errors.  Grids of several parameters, tolerance
+of the branches is what evens out the errors.  The table prints six digits; the same
+sweep at half the step (`--set analysis.steps_per_period=200`) moves them by up to
+{{{{sweep_change}}}}, so they hold {{{{sweep_decimals}}}} decimals:
+{{{{sweep_held}}}}.  Grids of several parameters, tolerance
 Monte Carlo and sensitivity ranking are `torquesplit study` files: [studies.md](studies.md).
 
 ## 8. Over the speed range
@@ -356,7 +360,9 @@ split-stage mesh cycle:
 $ {SPEED_SWEEP}
 
 The table gives each mesh's largest dynamic factor over the stable points of the range
-and the speed where it occurs, to the digits that hold: each peak is solved again at its
+and the speed where it occurs (to the spacing of the curve's points there: the peak lies
+between its neighbours; more `--points` narrow it), to the digits that hold: each peak is
+solved again at its
 speed with half the RK4 step, and the line under the table gives both values (near a
 resonance the response is steep, and the split stage's peaks hold two or three digits at
 the default resolution; `--steps-per-cycle` refines it).  The combine stage's rows
@@ -482,6 +488,12 @@ def _numbers(work: Path) -> dict[str, str]:
     if bearing.get("stiffness_cancelled") or not shaft.get("stiffness_cancelled"):
         raise SystemExit("the tutorial's text expects the input-bearing crossing driven and "
                          "the branch-shaft crossing cancelled by the branches' phasing")
+    sweep_change, sweep_decimals, sweep_held = _sweep_held(work)
+    check = json.loads(_run("torquesplit run three_branch.toml --check-step --json "
+                            "2>/dev/null", work))["step_check"]["metrics"]
+    lsc = sorted({v["digits"] for k, v in check.items()
+                  if k.startswith("load_sharing.mean_force")})
+    lsc_digits = f"{lsc[0]}" if len(lsc) == 1 else f"{lsc[0]} to {lsc[-1]}"
     met = run["metrics"]
     meshes = set(met["meshes"])
     f_split = modes["mesh_frequencies_Hz"]["in1"]
@@ -513,7 +525,33 @@ def _numbers(work: Path) -> dict[str, str]:
         "shaft_Hz": f"{shaft['frequency_Hz']:.0f}",
         "shaft_rpm": f"{shaft['speed_rpm']:.0f}",
         "shaft_share": f"{100 * shaft['modal_force_share']:.1f}",
+        "sweep_change": sweep_change, "sweep_decimals": sweep_decimals,
+        "sweep_held": sweep_held, "lsc_digits": lsc_digits,
     }
+
+
+def _sweep_held(work: Path) -> tuple[str, str, str]:
+    """The section 7 sweep against the same sweep at half the step: the largest change,
+    the decimals every value keeps (:func:`torquesplit.convergence.agreeing_digits`), and
+    the values to those decimals."""
+    import json
+
+    from torquesplit.convergence import agreeing_digits
+
+    def values(extra: str, out: str) -> list[float]:
+        got = json.loads(_run(f"{SWEEP} --json --quiet --no-figures --out {out} {extra} "
+                              "2>/dev/null", work))
+        return got["outputs"]["load_sharing.mean_force"]
+
+    base = values("", "sweep_check")
+    fine = values("--set analysis.steps_per_period=200", "sweep_fine")
+    change = max(abs(a - b) for a, b in zip(base, fine, strict=True))
+    decimals = min(agreeing_digits(a, b, 7) - 1 for a, b in zip(base, fine, strict=True))
+    if not 1 <= decimals <= 5:
+        raise SystemExit(f"the tutorial's sweep sentence expects 1-5 decimals that hold, "
+                         f"got {decimals} (change {change:.2g})")
+    held = ", ".join(f"{a:.{decimals}f}" for a in base)
+    return f"{change:.1g}", str(decimals), held
 
 
 def main() -> None:

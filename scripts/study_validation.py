@@ -189,9 +189,10 @@ def dong_run_length() -> str:
         "run is too short to tell whether the response has settled (fewer than four "
         "windows of a gear revolution) and that the "
         f"mean-force coefficient of its group "
-        f"{d['group']} is {d['whole']:.4g} over the part used, {d['first']:.4g} over its "
-        f"first half and {d['second']:.4g} over its second ({d['long']:.4g} with "
-        f"`--duration \"2.4 s\"`; docs/validation.md).  Their stage-II coefficients "
+        f"{d['group']} is {d['whole']:.2f} over the part used, {d['first']:.2f} over its "
+        f"first half and {d['second']:.2f} over its second ({d['long']:.2f} with "
+        f"`--duration \"2.4 s\"`; two decimals: at half the step each moves in its third; "
+        f"docs/validation.md).  Their stage-II coefficients "
         f"(Omega_II) therefore depend on the run length by about {d['change']:.1f}; stage I "
         f"(Omega_I) does not drift ({d['stage1_change']:.1g}).  The differences between cases "
         "are differences at this one run length: a stage-II trend or ranking smaller than "
@@ -204,19 +205,46 @@ DONG_SECTION = ("**Run length:** the run does not settle; Omega_II depends on th
                 "(by how much: see the top of this page).")
 
 
+def refinement(name: str) -> dict:
+    """The ``[analysis]`` of a study's refined run: half the step of a dynamic study
+    (twice its steps per period), twice the mesh positions per cycle of a quasi-static
+    one.  Every number on the page is printed to the digits this run reproduces."""
+    from torquesplit.study import Study
+
+    plan = Study(name).plan()
+    a = plan.analysis
+    if a["type"] == "static":
+        return {"points_per_cycle": 2 * int(a["points_per_cycle"])}
+    steps = a.get("steps_per_period") or plan.model.analysis.steps_per_period
+    return {"steps_per_period": 2 * int(steps)}
+
+
 def _run(names, results: Path) -> None:
     from torquesplit.study import Study
 
     for name in names:
-        t0 = time.perf_counter()
-        print(f"{name} ...", file=sys.stderr, flush=True)
-        Study(name).run(out=results / name, resume=True, figures=True)
-        print(f"{name}: {time.perf_counter() - t0:.0f} s", file=sys.stderr, flush=True)
+        for folder, analysis in ((name, None), (f"{name}{REFINED}", refinement(name))):
+            t0 = time.perf_counter()
+            print(f"{folder} ...", file=sys.stderr, flush=True)
+            Study(name, analysis=analysis).run(out=results / folder, resume=True,
+                                               figures=analysis is None)
+            print(f"{folder}: {time.perf_counter() - t0:.0f} s", file=sys.stderr, flush=True)
+
+
+#: the folder suffix of a study's refined run
+REFINED = "_refined"
 
 
 def _num(x):
     x = float(x)
     return round(x, 6) if math.isfinite(x) else None
+
+
+def collect_refined(name: str, folder: Path) -> dict:
+    """The refined run's numbers (:func:`refinement`), as :func:`collect` gives them."""
+    entry = collect(name, folder)
+    keep = ("outputs", "ranking", "status")
+    return {"analysis": refinement(name), **{k: entry[k] for k in keep if k in entry}}
 
 
 def collect(name: str, folder: Path) -> dict:
@@ -319,8 +347,33 @@ def _against_drift(entry: dict) -> str:
             f"({drift:.2f}).")
 
 
-def _fmt(x) -> str:
-    return "-" if x is None or (isinstance(x, float) and not math.isfinite(x)) else f"{x:.4f}"
+#: decimals of the page's numbers at most
+DECIMALS = 4
+
+
+def _fmt(x, ref) -> str:
+    """``x`` to the decimals (at most DECIMALS) that the refined run's ``ref`` reproduces
+    (:func:`torquesplit.convergence.agreeing_digits`: also printed alike); '-' for a
+    missing value."""
+    from torquesplit.convergence import agreeing_digits
+
+    if x is None or not math.isfinite(x):
+        return "-"
+    if x == 0.0:
+        return f"{x:.{DECIMALS}f}" if ref == 0.0 else "0"
+    e = math.floor(math.log10(abs(x)))
+    most = max(1, e + 1 + DECIMALS)
+    ok = 0 if ref is None or not math.isfinite(ref) else agreeing_digits(x, ref, most)
+    return f"{x:.{max(0, min(DECIMALS, ok - 1 - e))}f}"
+
+
+def _refined_columns(entry: dict) -> dict:
+    """The refined run's stage columns, by label."""
+    return dict(_stage_columns({"outputs": entry["refined"]["outputs"]}))
+
+
+def _nan(values) -> np.ndarray:
+    return np.array([np.nan if x is None else x for x in values], dtype=float)
 
 
 def markdown(data: dict) -> str:
@@ -332,7 +385,12 @@ def markdown(data: dict) -> str:
              "print no tables for these studies: what they state (quoted below) are ranges "
              "and trends read off missing figures. The example models assume what the papers "
              "leave out (see each model file and docs/validation.md), and nothing was tuned "
-             "to a published number, so the comparison is of trend and magnitude.", ""]
+             "to a published number, so the comparison is of trend and magnitude.", "",
+             f"Every study was run twice: as shipped, and refined (half the step of a "
+             f"dynamic study; twice the mesh positions per cycle of a quasi-static one). "
+             f"Each number is the shipped run's, printed to the decimals (at most "
+             f"{DECIMALS}) that the refined run reproduces: a number with fewer decimals "
+             f"than its neighbours moved with the discretisation.", ""]
     if any(name.startswith("dong_2021") for name in data):
         lines += [dong_run_length(), ""]
     for name, e in data.items():
@@ -356,19 +414,21 @@ def markdown(data: dict) -> str:
         if e["design"] == "grid":
             params = e["parameters"]
             cols = _stage_columns(e)
+            fine = _refined_columns(e)
             if len(params) == 1:
                 (pname, p), = params.items()
                 lines += [f"| {pname} [{p['unit']}] | " + " | ".join(c for c, _ in cols) + " |",
                           "|---" * (len(cols) + 1) + "|"]
                 for i, v in enumerate(p["values"]):
-                    lines.append(f"| {v:.4g} | " + " | ".join(_fmt(c[i]) for _, c in cols)
-                                 + " |")
+                    lines.append(f"| {v:.4g} | " + " | ".join(
+                        _fmt(c[i], fine[label][i]) for label, c in cols) + " |")
                 lines.append("")
                 for label, c in cols:
-                    arr = np.array([np.nan if x is None else x for x in c], dtype=float)
-                    lines.append(f"- {label}: {_fmt(arr[0])} -> {_fmt(arr[-1])} over the "
-                                 f"range (min {_fmt(np.nanmin(arr))}, max "
-                                 f"{_fmt(np.nanmax(arr))})")
+                    arr, ref = _nan(c), _nan(fine[label])
+                    lines.append(f"- {label}: {_fmt(arr[0], ref[0])} -> "
+                                 f"{_fmt(arr[-1], ref[-1])} over the range (min "
+                                 f"{_fmt(np.nanmin(arr), np.nanmin(ref))}, max "
+                                 f"{_fmt(np.nanmax(arr), np.nanmax(ref))})")
             else:
                 (n1, p1), (n2, p2) = list(params.items())[:2]
                 for label, c in cols:
@@ -377,19 +437,23 @@ def markdown(data: dict) -> str:
                               "| | " + " | ".join(f"{v:.4g}" for v in p2["values"]) + " |",
                               "|---" * (len(p2["values"]) + 1) + "|"]
                     for i, v in enumerate(p1["values"]):
-                        lines.append(f"| {v:.4g} | " + " | ".join(_fmt(x) for x in c[i]) + " |")
+                        lines.append(f"| {v:.4g} | " + " | ".join(
+                            _fmt(x, r) for x, r in zip(c[i], fine[label][i])) + " |")
                     lines.append("")
         elif e["design"] == "monte_carlo":
             lines += ["| output | n | mean | std | p5 | p95 | min | max |",
                       "|---|---|---|---|---|---|---|---|"]
             for k, s in e["outputs"].items():
+                r = e["refined"]["outputs"][k]
                 lines.append(f"| {k} | {s['n']} | " + " | ".join(
-                    _fmt(s[q]) for q in ("mean", "std", "p5", "p95", "min", "max")) + " |")
+                    _fmt(s[q], r[q]) for q in ("mean", "std", "p5", "p95", "min", "max"))
+                    + " |")
         else:
             for out, rank in e["ranking"].items():
+                ref = dict(e["refined"]["ranking"][out])
                 lines.append(f"- `{out}`, factors by {e['ranking_by']} (output change over "
                              f"each factor's range): " + ", ".join(
-                                 f"{f} {_fmt(x)}" for f, x in rank))
+                                 f"{f} {_fmt(x, ref.get(f))}" for f, x in rank))
         if e.get("ours"):
             lines += ["", "**Ours:** " + e["ours"]]
         if name.startswith("dong_2021"):
@@ -409,8 +473,10 @@ def markdown(data: dict) -> str:
                     noise = _dong_noise()
                     verdict = ("below the noise, so no factor moves stage I over these ranges"
                                if x1 < noise else "above the noise")
+                    ref1 = dict(e["refined"]["ranking"]["load_sharing.mean_force.I"])
                     lines[-1] += (f"  Stage I (Omega_I): the largest mu_star, {f1} "
-                                  f"{x1:.4f}, is {verdict} ({noise:.1g}, top of this page).")
+                                  f"{_fmt(x1, ref1.get(f1))}, is {verdict} ({noise:.1g}, top "
+                                  f"of this page).")
         lines += ["", f"Figures: `torquesplit study {name}` writes them to "
                       f"`study_{name}/figures/`.", ""]
     notes = data.get("_notes", [])
@@ -433,8 +499,10 @@ def main(argv=None) -> int:
     data = json.loads(OUT_JSON.read_text()) if OUT_JSON.exists() else {}
     for name in args.names:
         folder = args.results / name
-        if (folder / "results.nc").exists():
+        refined = args.results / f"{name}{REFINED}"
+        if (folder / "results.nc").exists() and (refined / "results.nc").exists():
             data[name] = collect(name, folder)
+            data[name]["refined"] = collect_refined(name, refined)
     data = {k: data[k] for k in [n for n in study_names() if n in data]
             + [k for k in data if k.startswith("_")]}
     OUT_JSON.write_text(json.dumps(data, indent=1))

@@ -313,7 +313,9 @@ def _load(model: str, assignments: Optional[list[str]] = None, *, deep: bool = F
                 m = model_from_dict(data, source=str(path))
                 check_model(m, source=str(path), deep=deep)
             except ModelError as exc:  # (the file's own fields at their lines)
-                raise _located(attribute_errors(exc, where, str(path)), path) from None
+                own = _file_issue_locations(raw, path, deep)
+                raise _located(attribute_errors(exc, where, str(path), own),
+                               path) from None
         else:
             m = load_model(path, check=False)
             try:  # (the checks' problems at their lines, as the schema's)
@@ -327,6 +329,27 @@ def _load(model: str, assignments: Optional[list[str]] = None, *, deep: bool = F
                 and not any(text in str(w.message) for text in irrelevant)):
             ux.warn(attribute_warning(str(w.message), where, str(path)))
     return m, path
+
+
+def _file_issue_locations(raw: dict, path, deep: bool) -> set[str] | None:
+    """Locations of the problems of the file without its ``--set`` overrides (empty: it
+    passes; None: it cannot even be read as a model, so nothing is said of the cause)."""
+    import copy
+
+    from .errors import ModelError
+    from .model.checks import check_model
+    from .model.io import model_from_dict
+
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            check_model(model_from_dict(copy.deepcopy(raw), source=str(path)),
+                        source=str(path), deep=deep)
+    except ModelError as exc:
+        return {loc for loc, _ in exc.issues}
+    except Exception:  # noqa: BLE001 - (the overrides' own error is the one to report)
+        return None
+    return set()
 
 
 def _with_file_problems(exc, raw: dict, path, deep: bool):

@@ -7,7 +7,7 @@ from __future__ import annotations
 import re
 
 from typer.testing import CliRunner
-from model_texts import tutorial_model
+from model_texts import SPUR_PAIR, tutorial_model
 
 from torquesplit.cli import app
 
@@ -37,3 +37,35 @@ def test_modes_echo_a_bare_limit_with_its_unit_and_a_range_in_order(tmp_path):
                                    "760rpm", "--to", "740rpm"], terminal_width=300)
     assert res.exit_code == 0, res.output
     assert "critical speeds between 740rpm and 760rpm" in res.stdout
+
+
+def test_a_check_that_only_a_set_breaks_names_the_set(tmp_path):
+    """--set gears.pinion.teeth=21 made meshes fail their centre distance, and the error
+    pointed at the mesh's line of the file, which is right (a first-hour reviewer)."""
+    placed = SPUR_PAIR.replace('place = {from_gear = "pinion", angle = "0 deg"}',
+                               'position = ["60 mm", "0 mm", "0 mm"]')
+    model = tmp_path / "pair.toml"
+    model.write_text(placed, encoding="utf-8")
+    res = CliRunner().invoke(app, ["check", str(model), "--set", "gears.pinion.teeth=21"])
+    assert res.exit_code == 2, res.output
+    errors = [ln for ln in res.stderr.splitlines() if ln.startswith("error:")]
+    assert errors and all(ln.startswith(f"error: {model} with --set gears.pinion.teeth=21: "
+                                        "meshes.") for ln in errors), res.stderr
+    assert "centre distance" in errors[0]
+    # the file's own problem stays the file's, at its line
+    broken = placed.replace('face_width = "20 mm"', 'face_width = "20 kg"', 1)
+    model.write_text(broken, encoding="utf-8")
+    res = CliRunner().invoke(app, ["check", str(model), "--set", "gears.pinion.teeth=21"])
+    assert re.search(rf"{re.escape(str(model))}:\d+: gears\.\w+\.face_width: ", res.stderr), \
+        res.stderr
+
+
+def test_the_same_field_set_twice_is_refused():
+    """The last of two --set of one field won without a word (a first-hour reviewer)."""
+    res = CliRunner().invoke(app, ["check", "ji_li_mill_drive",
+                                   "--set", "meshes.m11.damping_ratio=0.05",
+                                   "--set", "meshes.m11.damping_ratio=0.07"])
+    assert res.exit_code == 2, res.output
+    assert ("error: --set meshes.m11.damping_ratio=0.07: sets meshes.m11.damping_ratio again "
+            "(--set meshes.m11.damping_ratio=0.05 before it): give each field once") \
+        in res.stderr, res.stderr

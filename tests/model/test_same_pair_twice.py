@@ -82,7 +82,28 @@ def test_a_deflection_on_a_spline_names_the_spline():
     dong = torquesplit.load_model("dong2021_face_gear")
     assert "O4" in dong.splines["spline4"].connects and dong.gears["O4"].support is None
     structure = SimpleNamespace(dof_names=["O4.x", "O4.theta", "O1.y"])
-    ((loc, msg), (loc1, msg1)) = deflection_warnings(dong, structure, [5e-3, 1.0, 9e-3])
+    ((loc, msg), (loc1, msg1)) = deflection_warnings(dong, structure, [5e-3, 1.0, 6e-3])
     assert loc == "splines.spline4" and "the stiffness of spline spline4 far too small" in msg
     assert "radial clearance too large" in msg
     assert loc1 == "gears.O1.support" and "a support or shaft stiffness" in msg1
+
+
+def test_a_gear_deflected_beyond_its_tooth_depth_is_refused_not_warned_of():
+    """Supports in N/m for N/mm moved a reviewer's idler 26 mm (module 3 mm), and the run
+    printed a load-sharing table under a warning: beyond the whole tooth depth (2.25
+    modules) the teeth are out of the mesh."""
+    from types import SimpleNamespace
+
+    import torquesplit
+    from torquesplit.model.checks import deflection_issues, deflection_warnings
+
+    dong = torquesplit.load_model("dong2021_face_gear")
+    m = dong.gears["O1"].module
+    structure = SimpleNamespace(dof_names=["O1.x", "O1.y"])
+    below, beyond = [0.0, 2.2 * m], [0.0, 2.3 * m]
+    assert deflection_issues(dong, structure, below) == []
+    assert len(deflection_warnings(dong, structure, below)) == 1
+    assert deflection_warnings(dong, structure, beyond) == []
+    (loc, msg), = deflection_issues(dong, structure, beyond)
+    assert loc == "gears.O1.support" and f"the static deflection of O1.y is {2.3e3 * m:.4g} mm" \
+        in msg and "more than the whole depth of its teeth" in msg

@@ -148,3 +148,35 @@ def test_a_sweep_over_two_excitation_cycles_names_no_instability(pair, tmp_path)
     assert json.loads(r.stdout)["unstable_points"] > 0
     with xr.open_dataset(out, engine="h5netcdf") as ds:
         assert set(ds["instability"].values.tolist()) == {""}
+
+
+def test_the_theory_pages_period_doubling_numbers_hold_with_twice_the_steps(pair):
+    """docs/theory/steady.md prints the period-1 multiplier and DF and the period-2 DF
+    and contact loss of this pair: each equals the computed value to its printed digits,
+    at the default 100 steps per cycle and at 200 (a reviewer: DF 3.103 printed, 3.102
+    converged)."""
+    import re
+    from pathlib import Path
+
+    import torquesplit
+
+    text = " ".join((Path(__file__).resolve().parents[2] / "docs" / "theory"
+                     / "steady.md").read_text(encoding="utf-8").split())
+    mu, df1, df2, loss = re.search(
+        r"the period-1 orbit has μ = (-?[\d.]+) and DF ([\d.]+); the period-2 orbit DF "
+        r"([\d.]+), (\d+) % contact loss", text).groups()
+
+    def printed_as(value: float, shown: str) -> bool:
+        decimals = len(shown.partition(".")[2])
+        return f"{value:.{decimals}f}" == shown
+
+    for steps in (None, 200):
+        one = torquesplit.steady_state(pair, speed="16052 rpm", steps_per_cycle=steps)
+        m = one.solution.multipliers
+        assert printed_as(float(m[np.argmax(np.abs(m))].real), mu), (steps, m)
+        assert printed_as(one.mesh_table()[0].dynamic_factor, df1), steps
+        two = torquesplit.steady_state(pair, speed="16052 rpm", steps_per_cycle=steps,
+                                       keep=round(one.solution.frequency / 2, 3))
+        row = two.mesh_table()[0]
+        assert printed_as(row.dynamic_factor, df2), (steps, row.dynamic_factor)
+        assert printed_as(100 * row.contact_loss, loss), (steps, row.contact_loss)

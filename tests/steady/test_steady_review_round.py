@@ -265,7 +265,7 @@ def test_a_sweeps_largest_dynamic_factors_are_printed_to_the_digits_that_hold():
     from torquesplit.cli import app
     from torquesplit.convergence import agreeing_digits
     from torquesplit.steady.api import steady_state
-    from torquesplit.steady.cli import _held_text
+    from torquesplit.steady.cli import _held_text, _speed_at_text
 
     args = ["sweep-speed", "ji_li_mill_drive", "--keep", "stage1", "--from", "700 rpm",
             "--to", "760 rpm", "--points", "4", "--no-stability", "--steps-per-cycle", "40"]
@@ -289,6 +289,13 @@ def test_a_sweeps_largest_dynamic_factors_are_printed_to_the_digits_that_hold():
     row = next(line for line in text.splitlines() if line.startswith("│ m11"))
     assert _held_text(m11, out["max_dynamic_factor_digits"]["m11"]) in row
     assert "DF to the digits that hold" in text
+    # the speed to the spacing of the curve's points beside it (2615.38 rpm was printed
+    # where more points put the peak at 2615.01: a reviewer)
+    assert " ± " in row, row
+    assert _speed_at_text(2615.37566, [2613.68574, 2615.37566, 2617.03833]) == "2615 ± 2"
+    assert _speed_at_text(2615.3, [2614.9, 2615.3, 2616.0]) == "2615.3 ± 0.7"
+    assert _speed_at_text(700.0, [700.0, 720.0]) == "700 ± 20"
+    assert _speed_at_text(700.0, [700.0]) == "700"
     assert _held_text(2.89820, 2) == "2.9" and _held_text(1.08, 5) == "1.0800"
     assert _held_text(1.15554, 9) == "1.15554"  # (at most 6)
 

@@ -1890,14 +1890,37 @@ def _readiness(model: Model, kin=None) -> tuple[list, list]:
 
     coarse = coarse_table_warning(model, structure)  # (what every run warns of)
     notes = [tuple(coarse.split(": ", 1))] if coarse else []
+    refused = deflection_issues(model, structure, q)  # (as every run refuses them)
+    if refused:
+        return refused, []
     return [], notes + deflection_warnings(model, structure, q)  # (and every run)
+
+
+#: a gear's whole tooth depth in normal modules (ISO 53 basic rack: addendum 1, dedendum
+#: 1.25): a static translation beyond it takes the teeth out of the mesh
+TOOTH_DEPTH_MODULES = 2.25
 
 
 def deflection_warnings(model, structure, q) -> list[tuple[str, str]]:
     """Translations of the static equilibrium ``q`` larger than half the module of their
-    gear (or 1 mm for a body without teeth): a support or shaft stiffness far too small
-    for the load, usually a unit slip ('500 N/mm' for '500 N/um': a reviewer's pinion sat
-    21 mm off its centre without a word).  One message per body, at its largest DOF."""
+    gear (or 1 mm for a body without teeth), up to the whole tooth depth (beyond it,
+    :func:`deflection_issues` refuses): a support or shaft stiffness far too small for the
+    load, usually a unit slip ('500 N/mm' for '500 N/um': a reviewer's pinion sat 21 mm
+    off its centre without a word).  One message per body, at its largest DOF."""
+    return [(loc, msg) for loc, msg, refused in _deflections(model, structure, q)
+            if not refused]
+
+
+def deflection_issues(model, structure, q) -> list[tuple[str, str]]:
+    """Gears whose static translation exceeds their whole tooth depth
+    (TOOTH_DEPTH_MODULES normal modules): the teeth would be out of the mesh, so no
+    number of the run would mean anything (a reviewer's supports in N/m for N/mm moved
+    an idler 26 mm, and the run printed a load-sharing table)."""
+    return [(loc, msg) for loc, msg, refused in _deflections(model, structure, q) if refused]
+
+
+def _deflections(model, structure, q) -> list[tuple[str, str, bool]]:
+    """(location, message, refused) of every body translated more than its limit."""
     q = np.asarray(q, dtype=float)
     worst: dict[str, tuple[float, str]] = {}
     for name, value in zip(structure.dof_names, q):
@@ -1911,24 +1934,31 @@ def deflection_warnings(model, structure, q) -> list[tuple[str, str]]:
         gear = model.gears.get(body)
         limit, what = ((0.5 * gear.module, f"half the module ({0.5e3 * gear.module:g} mm)")
                        if gear is not None else (1e-3, "1 mm"))
-        if size > limit:
-            # a body that floats on a spline: the spline's stiffness or clearance is the
-            # likelier cause (a fuzzer's spline of 1 N/m was blamed on gears.O4.support, a
-            # table the file does not have)
-            splines = [n for n, sp in model.splines.items() if body in sp.connects]
-            supported = gear is not None and gear.support is not None
-            where = (f"gears.{body}.support" if supported or (gear is not None and not splines)
-                     else f"splines.{splines[0]}" if splines else f"bodies.{body}")
-            cause = (f"the stiffness of spline {', '.join(splines)} far too small for the "
-                     f"load, or its radial clearance too large"
-                     + (f" (or the stiffness of {body}'s support or shaft)" if supported
-                        else "") + "; check the values and units"
-                     if splines else
-                     "a support or shaft stiffness far too small for the load; check its "
-                     "value and unit")
-            out.append((where, (
-                f"the static deflection of {body}.{dof} is {1e3 * size:.4g} mm, more than "
-                f"{what}: {cause} (N/mm written for N/um gives this)")))
+        if size <= limit:
+            continue
+        depth = TOOTH_DEPTH_MODULES * gear.module if gear is not None else math.inf
+        refused = size > depth
+        if refused:
+            what = (f"the whole depth of its teeth ({depth * 1e3:.4g} mm): they would be out "
+                    f"of the mesh, and no number of a run would mean anything")
+        # a body that floats on a spline: the spline's stiffness or clearance is the
+        # likelier cause (a fuzzer's spline of 1 N/m was blamed on gears.O4.support, a
+        # table the file does not have)
+        splines = [n for n, sp in model.splines.items() if body in sp.connects]
+        supported = gear is not None and gear.support is not None
+        where = (f"gears.{body}.support" if supported or (gear is not None and not splines)
+                 else f"splines.{splines[0]}" if splines else f"bodies.{body}")
+        cause = (f"the stiffness of spline {', '.join(splines)} far too small for the "
+                 f"load, or its radial clearance too large"
+                 + (f" (or the stiffness of {body}'s support or shaft)" if supported
+                    else "") + "; check the values and units"
+                 if splines else
+                 "a support or shaft stiffness far too small for the load; check its "
+                 "value and unit")
+        out.append((where, (
+            f"the static deflection of {body}.{dof} is {1e3 * size:.4g} mm, more than "
+            f"{what}: {cause} (a unit a thousand times too small gives this: N/m written "
+            f"for N/mm, N/mm for N/um)"), refused))
     return out
 
 

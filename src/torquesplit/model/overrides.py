@@ -192,6 +192,10 @@ def apply_assignments(data: dict, assignments) -> tuple[dict, dict[str, str]]:
         source = f"--set {clip_text(text)}"
         try:
             path, value = parse_assignment(text)
+            if path in where:  # (the last one won without a word: a reviewer)
+                raise ModelError([("", (
+                    f"sets {path} again (--set {clip_text(where[path])} before it): give "
+                    f"each field once"))], source)
             data = apply_overrides(data, {path: value})
         except ModelError as exc:
             issues = [("" if loc in ("--set", path_of(text)) else loc, msg)
@@ -217,15 +221,24 @@ def path_of(text: str) -> str:
     return text.split("=", 1)[0].strip()
 
 
-def attribute_errors(exc: ModelError, where: Mapping[str, str], source: str) -> ModelError:
+def attribute_errors(exc: ModelError, where: Mapping[str, str], source: str,
+                     own: set[str] | None = None) -> ModelError:
     """``exc`` with each issue reported against what caused it.
 
     An issue inside an overridden field (``meshes.m.stiffness.value`` for ``--set
     meshes.m.stiffness=...``) is reported against the ``--set`` argument; one in a
     section that an override changed (``meshes.m`` for ``--set meshes.m.damping=...``)
-    against the file *with* that argument; any other against the file (``source``).
+    against the file *with* that argument; any other against the file (``source``),
+    unless ``own`` (the locations of the issues the file has without the overrides) shows
+    that the file alone does not have it: then against the file with every ``--set``
+    (a mesh that no longer fits after ``--set gears.pinion.teeth=21`` was reported at
+    the file's line of the mesh, a reviewer).
     """
     causes = [_cause(loc, where, source) for loc, _ in exc.issues]
+    if own is not None and where:
+        every = f"{source} with " + ", ".join(f"--set {clip_text(t)}" for t in where.values())
+        causes = [every if cause == source and loc not in own else cause
+                  for cause, (loc, _) in zip(causes, exc.issues)]
     if len(set(causes)) == 1:
         return ModelError(exc.issues, causes[0])
     return ModelError([(f"{c}: {loc}" if loc else c, msg)

@@ -589,6 +589,8 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
                                if key in v for c in (f"{v[key][0]:.5f}", f"{v[key][1]:.6g}")]
                 if k in held:  # (to the digits that hold: 2.9 where 2.89820 was computed)
                     cells[1] = _held_text(v["stable"][0], held[k]["digits"])
+                if "stable" in v:  # (a point of the curve: its speed to the points' spacing)
+                    cells[2] = _speed_at_text(v["stable"][1], rpm)
                 t.add_row(*cells)
             console.print(t)
             if held:
@@ -649,6 +651,22 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
 
 
 import numpy as np  # noqa: E402  (used by the commands above)
+
+
+def _speed_at_text(at: float, rpm) -> str:
+    """The speed of a curve's largest point, to the spacing of the points beside it (the
+    peak lies somewhere between them: a reviewer saw 2615.38 rpm become 2615.01 with
+    more points): '2615 ± 2'."""
+    import math
+
+    speeds = np.unique(np.asarray(rpm, dtype=float)[np.isfinite(rpm)])
+    i = int(np.argmin(np.abs(speeds - at)))
+    gaps = [abs(speeds[j] - speeds[i]) for j in (i - 1, i + 1) if 0 <= j < speeds.size]
+    if not gaps or max(gaps) <= 0.0:
+        return f"{at:.6g}"
+    width = max(gaps)
+    places = max(0, -math.floor(math.log10(width)))
+    return f"{at:.{places}f} ± {width:.{places}f}"
 
 
 def _held_text(value: float, digits: int) -> str:
