@@ -26,10 +26,29 @@ def _exception_classes(name: str) -> tuple[type, ...]:
     return tuple(found)
 
 
+def _options_starting(exc) -> list[str]:
+    """The command's options that an unknown option abbreviates (``--steps`` for
+    ``--steps-per-period``), which the parser's close-match list leaves out (a
+    first-hour reviewer was offered --check-step, --max-steps, --set)."""
+    name = getattr(exc, "option_name", None)
+    ctx = getattr(exc, "ctx", None)
+    command = getattr(ctx, "command", None)
+    if not name or not name.startswith("--") or command is None:
+        return []
+    opts = {o for param in getattr(command, "params", ()) for o in getattr(param, "opts", ())}
+    return sorted(o for o in opts if o.startswith(name) and o != name)
+
+
 def usage_error_lines(exc) -> list[str]:
     """A parser's usage error as the lines the commands print: what is wrong, then what
     to run for help."""
     message = exc.format_message() if hasattr(exc, "format_message") else str(exc)
+    longer = _options_starting(exc)
+    if longer:
+        near = sorted(set(getattr(exc, "possibilities", None) or ()) - set(longer))
+        message = (f"No such option: {exc.option_name} (did you mean "
+                   f"{' or '.join(longer)}?"
+                   + (f" Close ones: {', '.join(near)}" if near else "") + ")")
     # "Invalid value for '--cycles': ..." in the commands' own form "--cycles: ..."
     message = re.sub(r"^Invalid value for '([^']+)': ", r"\1: ", message.strip())
     lines = [line.strip() for line in message.splitlines() if line.strip()]

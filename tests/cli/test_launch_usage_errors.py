@@ -55,3 +55,14 @@ def test_a_good_command_exits_with_its_own_status(monkeypatch, capsys):
     code, _, err = _launch_with(monkeypatch, capsys, "run", "ji_li_mill_drive",
                                 "--steps-per-period", "0")
     assert code == 2 and "--steps-per-period must be a whole number" in err
+
+
+@pytest.mark.parametrize("typed, meant", [("--steps", "--steps-per-period"),
+                                          ("--step", "--steps-per-period"),
+                                          ("--cycle", "--cycles")])
+def test_an_abbreviated_option_is_named_in_full(monkeypatch, capsys, typed, meant):
+    """'--steps' was answered with --check-step, --max-steps, --set, not the option meant
+    (a first-hour reviewer)."""
+    code, _, err = _launch_with(monkeypatch, capsys, "run", "ji_li_mill_drive", typed, "50")
+    assert code == 2 and err.startswith(f"error: No such option: {typed} (did you mean "
+                                        f"{meant}?"), err
