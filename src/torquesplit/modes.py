@@ -403,6 +403,7 @@ def model_modes(model, *, rotating_frame: bool = True, below: float | str | None
     [('translational', 2), ('translational', 2), ('translational', 2)]
     """
     from .assembly.assemble import assemble
+    from .model.checks import refuse_out_of_mesh
     from .model.io import load_model
     from .model.kinematics import solve_kinematics
     from .solve.modal import modal_analysis
@@ -428,7 +429,9 @@ def model_modes(model, *, rotating_frame: bool = True, below: float | str | None
         model = load_model(model)
     kin = solve_kinematics(model)
     st = assemble(model, kin, options={"rotating_frame": rotating_frame})
-    sol = modal_analysis(st, static_equilibrium(st).q)
+    q = static_equilibrium(st).q
+    refuse_out_of_mesh(model, st, q, warn=True)  # (modes about an equilibrium out of mesh)
+    sol = modal_analysis(st, q)
     rows = classify(st, sol, rtol=rtol, kin=kin)
     if below is not None:
         rows = [r for r in rows if r.frequency < below]

@@ -306,16 +306,12 @@ def quasi_static_load_sharing(model, *, revolutions: float | None = None,
 def _refuse_out_of_mesh(model, structure, sol) -> None:
     """A gear translated beyond its tooth depth at any converged position: refused as
     ``check`` and ``run`` refuse it (:func:`~torquesplit.model.checks.deflection_issues`)."""
-    from .errors import ModelError
-    from .model.checks import as_written, deflection_issues
+    from .model.checks import refuse_out_of_mesh
 
     q = np.asarray(sol.q, dtype=float)
     conv = np.asarray(sol.converged, bool)
-    if not conv.any():
-        return
-    issues = deflection_issues(model, structure, np.abs(q[conv]).max(axis=0))
-    if issues:
-        raise ModelError(as_written(model, issues))
+    if conv.any():
+        refuse_out_of_mesh(model, structure, np.abs(q[conv]).max(axis=0))
 
 
 def _positions_per_cycle(structure, f_max: float, points_per_cycle: int,

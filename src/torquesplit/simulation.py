@@ -356,13 +356,9 @@ def prepare_run(
         raise SolverError(
             "the static equilibrium failed; check the clearances and the supports "
             "(a body free to move inside its clearance needs a support or a spring)")
-    from .model.checks import as_written, deflection_issues
+    from .model.checks import refuse_out_of_mesh
 
-    out_of_mesh = deflection_issues(model, structure, static.q)
-    if out_of_mesh:  # (check refuses them too: a model that passes it runs)
-        from .errors import ModelError
-
-        raise ModelError(as_written(model, out_of_mesh), getattr(model, "source", None))
+    refuse_out_of_mesh(model, structure, static.q)  # (as check does: a model that passes runs)
     if not begin.converged:  # (the state the run starts from)
         # e.g. a member floating inside its clearance with no net load: its position is
         # not determined; the regularised solution is a valid starting state

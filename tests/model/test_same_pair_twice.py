@@ -64,7 +64,8 @@ def test_a_support_stiffness_off_by_a_unit_is_said_by_check_run_and_static(tmp_p
     for text, expected in ((slip, 1), (slip.replace("500 N/mm", "500 N/um"), 0)):
         path = tmp_path / f"pair{expected}.toml"
         path.write_text(text)
-        for command in (["check"], ["run", "--cycles", "20"], ["static"]):
+        for command in (["check"], ["run", "--cycles", "20"], ["static"], ["modes"],
+                        ["steady"]):
             res = CliRunner().invoke(app, [command[0], str(path), *command[1:]])
             said = [ln for ln in res.stderr.splitlines()
                     if "gears.pinion.support: the static deflection of pinion." in ln]

@@ -1919,6 +1919,21 @@ def deflection_issues(model, structure, q) -> list[tuple[str, str]]:
     return [(loc, msg) for loc, msg, refused in _deflections(model, structure, q) if refused]
 
 
+def refuse_out_of_mesh(model, structure, q, *, warn: bool = False) -> None:
+    """Raise the ModelError of :func:`deflection_issues`, if any: what ``run`` and
+    ``static`` do with a static equilibrium that takes a gear out of its mesh (``check``
+    lists it with the other problems).  ``warn``: say it as a warning instead, for the
+    linear analyses (``modes``, ``steady``, ``sweep-speed``), which a study of a
+    published linear model may take beyond it (Cooley & Parker's planets at 20000 rpm
+    sit 4.8 mm out in the carrier frame)."""
+    issues = as_written(model, deflection_issues(model, structure, q))
+    if issues and warn:
+        for loc, msg in issues:
+            warn_user(f"{loc}: {msg}", ModelWarning)
+    elif issues:
+        raise ModelError(issues)
+
+
 def _deflections(model, structure, q) -> list[tuple[str, str, bool]]:
     """(location, message, refused) of every body translated more than its limit."""
     q = np.asarray(q, dtype=float)

@@ -498,6 +498,9 @@ def _steady_state(model, *, method, harmonics, samples, keep, speed, max_cycles,
     if not np.all(np.isfinite(static.q)):
         raise SolverError("the static equilibrium failed, so the periodic state has no start; "
                           "check the clearances and supports (see the run command).")
+    from torquesplit.model.checks import refuse_out_of_mesh
+
+    refuse_out_of_mesh(model, structure, static.q, warn=True)
     if per.frequency <= 0:
         raise SolverError("the model has no time-varying excitation (constant mesh stiffness, "
                           "no errors or tables), so its steady state is the static "

@@ -77,6 +77,9 @@ def _prepare(model, keep, max_cycles):
 
         per = _at_base(per, base)
     static = static_equilibrium(structure)
+    from torquesplit.model.checks import refuse_out_of_mesh
+
+    refuse_out_of_mesh(model, structure, static.q, warn=True)
     return model, kin, structure, dropped, per, static
 
 
