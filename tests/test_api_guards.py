@@ -240,6 +240,16 @@ def short_run():
      r"^cycles must be a positive number, got inf"),
     (lambda r: r.settle_windows(0), OptionError,
      r"^minimum must be a whole number >= 2, got 0; give e\.g\. minimum=20$"),
+    # (a Python API reviewer: an AttributeError, a TypeError and a ValueError from inside
+    # the figures, and a group typo that gave the overall start without a word)
+    (lambda r: torquesplit.plot.write_figures(r.model, "never"), OptionTypeError,
+     r"^write_figures takes the Results of a dynamic run"),
+    (lambda r: torquesplit.plot.dynamic_factor_figure(r, resonance="abc"), OptionError,
+     r"^resonance must be a positive number, got 'abc'"),
+    (lambda r: torquesplit.plot.support_spectrum_figure(r, start_time="abc"), OptionError,
+     r"^start_time must be a finite number, got 'abc'; give e\.g\. start_time=0\.5"),
+    (lambda r: r.history_start(group="bogus"), OptionError,
+     r"^no load-sharing group 'bogus'; the groups are stage1, stage2$"),
 ])
 def test_figures_and_results_refuse_what_they_cannot_draw_or_count(short_run, call, error,
                                                                    pattern):
@@ -424,3 +434,28 @@ def test_argument_errors_of_the_entry_points_are_the_packages_own():
             call()
     with pytest.raises(OptionTypeError):
         _angular_speed(1.0, 2.0)
+
+
+def test_one_name_where_names_are_taken_is_that_name(short_run):
+    """mesh_series('m11') said "unknown element 'm'" and bodies='z1' "no support force
+    history of z, 1" (a Python API reviewer): one name is taken as one name."""
+    import torquesplit.plot  # noqa: F401
+
+    ss = torquesplit.steady_state(EXAMPLE)
+    t, forces, _ = ss.mesh_series("m11")
+    t2, forces2, _ = ss.mesh_series(["m11"])
+    assert forces.shape == forces2.shape and (forces == forces2).all()
+    fig = torquesplit.plot.support_spectrum_figure(short_run, bodies="z1")
+    assert len(fig.axes) == len(torquesplit.plot.support_spectrum_figure(
+        short_run, bodies=["z1"]).axes)
+
+
+def test_a_scheduler_address_without_a_port_is_an_option_error(tmp_path):
+    from torquesplit.study import run_study
+
+    spec = {"study": {"name": "x", "model": EXAMPLE, "outputs": ["load_sharing.mean_force"]},
+            "analysis": {"cycles": 5},
+            "grid": {"parameters": [{"path": "meshes.m11.damping_ratio", "values": [0.05]}]}}
+    with pytest.raises(OptionError, match=r"^scheduler address 'nowhere': .*give e\.g\. "
+                                          r"'tcp://host:8786'$"):
+        run_study(spec, scheduler="nowhere", out=tmp_path / "x")

@@ -175,3 +175,13 @@ def test_the_ltca_page_prints_the_digits_a_finer_ltca_reproduces():
     for case in ("unmodified", "modified"):
         fine = data[case]["harris_fine"]
         assert len(fine["te_pp_arcsec"]) == len(data[case]["coupled"]["harris_te_pp_arcsec"])
+
+
+def test_the_load_sharing_page_marks_a_number_of_one_digit():
+    """Dong et al. 2021's dynamic factor 2.613 (2.656 at half the step) printed "3", under
+    the sentence that a factor above 3 warns (a numbers reviewer)."""
+    page = _load(ROOT / "scripts" / "make_load_sharing_doc.py", "make_load_sharing_doc")
+    assert page._held(2.613, 2.656) == "2.6†"
+    assert page._held(1.3191, 1.31913, 2) == "1.3" and page._held(1.0656, 1.0656) == "1.0656"
+    text = (ROOT / "docs" / "load-sharing.md").read_text(encoding="utf-8")
+    assert "† only the first digit holds at half the step" in text

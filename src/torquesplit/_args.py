@@ -32,6 +32,15 @@ def positive(value, name: str, example: str) -> float:
     return float(value)
 
 
+def number(value, name: str, example: str) -> float:
+    """``value`` as a finite number (a string such as 'abc' was a ValueError)."""
+    ok = isinstance(value, numbers.Real) and not isinstance(value, bool)
+    if not ok or not math.isfinite(value):
+        raise OptionError(f"{name} must be a finite number, got {value!r}; give e.g. "
+                          f"{example}")
+    return float(value)
+
+
 def results_of(results, function: str, kinds: tuple[str, ...]) -> None:
     """Refuse a first argument that is not results of one of ``kinds`` ("dynamic": a
     :class:`~torquesplit.results.Results`, "static": a

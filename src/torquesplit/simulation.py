@@ -393,14 +393,10 @@ def prepare_run(
     if steps_per_period is None:
         steps_per_period = an.steps_per_period
     else:  # as the model file takes it (0 fell back to the model's, 2.5 was cut to 2)
-        steps_per_period = _whole(steps_per_period, "steps_per_period",
-                                  "steps_per_period=100")
-        if steps_per_period < MIN_STEPS_PER_PERIOD:
-            from .errors import OptionError
+        from ._args import whole
 
-            raise OptionError(f"steps_per_period must be at least {MIN_STEPS_PER_PERIOD} "
-                              f"(as [analysis] steps_per_period), got {steps_per_period}; "
-                              f"give e.g. steps_per_period=100")
+        steps_per_period = whole(steps_per_period, "steps_per_period",
+                                 "steps_per_period=100", minimum=MIN_STEPS_PER_PERIOD)
     if duration is None:
         if cycles is not None:
             duration = cycles / f_min

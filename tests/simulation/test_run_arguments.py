@@ -23,9 +23,11 @@ BAD = [
     ({"samples_per_period": 0}, r"^samples_per_period must be a whole number >= 1, got 0"),
     ({"samples_per_period": 0.5}, r"^samples_per_period must be a whole number"),
     # 0 fell back to the model's 100 and 2.5 was cut to 2, silently
-    ({"steps_per_period": 0}, r"^steps_per_period must be a whole number >= 1, got 0"),
-    ({"steps_per_period": 2.5}, r"^steps_per_period must be a whole number >= 1, got 2\.5"),
-    ({"steps_per_period": 3}, r"^steps_per_period must be at least 10 \(as \[analysis\]"),
+    ({"steps_per_period": 0}, r"^steps_per_period must be a whole number >= 10, got 0"),
+    ({"steps_per_period": 2.5}, r"^steps_per_period must be a whole number >= 10, got 2\.5"),
+    ({"steps_per_period": 3}, r"^steps_per_period must be a whole number >= 10, got 3"),
+    # (a reviewer: '100' was told "a whole number >= 1", the minimum being 10)
+    ({"steps_per_period": "100"}, r"^steps_per_period must be a whole number >= 10, got '100'"),
 ]
 
 

@@ -322,13 +322,15 @@ def dynamic_factor_figure(results, definition: str | None = None, *,
     peak / nominal (settled peak / equal-split nominal force: load sharing and dynamics
     together, Ji & Li eq. 19) come from ``results.metrics(definition).rows``; the grey
     line is 1, the red dotted line the factor above which a run is reported as near a
-    resonance (:data:`torquesplit.results.plausibility.RESONANCE_FACTOR`).
+    resonance (:data:`torquesplit.results.plausibility.RESONANCE_FACTOR`; ``resonance``,
+    a positive factor, moves it).
     """
     _args.results_of(results, "dynamic_factor_figure", ("dynamic",))
     from ..results.plausibility import RESONANCE_FACTOR
 
     met = results.metrics(definition)
-    limit = RESONANCE_FACTOR if resonance is None else resonance
+    limit = (RESONANCE_FACTOR if resonance is None
+             else _args.positive(resonance, "resonance", "resonance=3.0"))
     rows = met.rows
     order = [r for g in met.load_sharing.groups for r in rows if r.group == g]
     fig = _figure(WIDTH, 3.4 + 0.12 * len(order))
@@ -430,7 +432,7 @@ def support_spectrum_figure(results, *, start_time: float | None = None, orders:
     via = results.bearing_via()
     chosen = bodies is not None
     if chosen:
-        wanted = list(bodies)
+        wanted = [bodies] if isinstance(bodies, str) else list(bodies)  # (one name)
         unknown = [b for b in wanted if b not in supports]
         if unknown:
             raise FigureNotApplicableError(
@@ -442,7 +444,8 @@ def support_spectrum_figure(results, *, start_time: float | None = None, orders:
             "the run recorded no support force; give a gear a [gears.<name>.support] table "
             "(with translational dofs) to get bearing forces")
     t = s.history_t
-    t0 = results.history_start() if start_time is None else float(start_time)
+    t0 = results.history_start() if start_time is None else _args.number(
+        start_time, "start_time", "start_time=0.5 (s)")
     keep = t >= t0
     if keep.sum() < 16:
         raise FigureNotApplicableError(
@@ -629,7 +632,7 @@ def orbit_figure(results, *, bodies: Iterable[str] | None = None) -> Figure:
     _args.results_of(results, "orbit_figure", ("dynamic", "static"))
     orbits = _orbits(results)
     if bodies is not None:
-        wanted = list(bodies)
+        wanted = [bodies] if isinstance(bodies, str) else list(bodies)  # (one name)
         unknown = [b for b in wanted if b not in orbits]
         if unknown:
             raise FigureNotApplicableError(
@@ -866,6 +869,7 @@ def write_figures(results, directory, formats=("png", "svg"), *,
         raise OptionTypeError("write_figures takes a dynamic run; for quasi-static results "
                               "call "
                         "write_static_figures(results, directory)")
+    _args.results_of(results, "write_figures", ("dynamic",))  # (a Model: AttributeError)
     _check_formats(formats)
     jobs = figure_jobs(results, definition=definition, last_cycles=last_cycles)
     return write_jobs(jobs, directory, formats, prefix=prefix, dpi=dpi)

@@ -575,8 +575,13 @@ class Results:
         if self.periodic and s is not None and s.history_t.size:
             return float(s.history_t[0])
         met = self.metrics() if metrics is None else metrics
-        return float(met.settling.group_time.get(group, met.settling.start_time)
-                     if group is not None else met.settling.start_time)
+        if group is None:
+            return float(met.settling.start_time)
+        times = met.settling.group_time
+        if group not in times:  # (a typo gave the overall start without a word: a reviewer)
+            raise OptionError(f"no load-sharing group {group!r}; the groups are "
+                              f"{', '.join(times) or '(none)'}")
+        return float(times[group])
 
     def bearing_forces(self, start_time: float | None = None, *,
                        metrics=None) -> list[dict]:

@@ -437,7 +437,8 @@ def coarse_history(results, metrics) -> list[tuple[str, str]]:
         return []
     worst = None
     for j, row in enumerate(metrics.rows):
-        start = results.history_start(metrics, row.group)
+        group = row.group if row.group in metrics.settling.group_time else None
+        start = results.history_start(metrics, group)
         seen = forces[t >= start, j]
         seen = seen[np.isfinite(seen)]
         if not (seen.size and row.peak_force > 0 and math.isfinite(row.peak_force)):

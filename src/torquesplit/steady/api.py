@@ -254,6 +254,8 @@ class SteadyState:
         names = list(self.structure.element_names)
         if elements is None:  # (a Python API reviewer's call without it: a TypeError)
             elements = list(self.model.meshes)
+        elif isinstance(elements, (str, int, np.integer)):  # one element ('m11' was read
+            elements = [elements]  # letter by letter: "unknown element 'm'", a reviewer)
         try:
             elements = [names.index(e) if isinstance(e, str) else int(e) for e in elements]
         except ValueError:

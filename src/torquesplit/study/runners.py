@@ -160,7 +160,11 @@ class DaskRunner:
             raise ImportError("running on Dask needs dask.distributed; install it with "
                               "pip install 'torquesplit[study]'") from None
         own = self.client is None
-        client = Client(self.address) if own else self.client
+        try:
+            client = Client(self.address) if own else self.client
+        except ValueError as exc:  # (distributed's own 'missing port number in address')
+            raise OptionError(f"scheduler address {self.address!r}: {exc}; give e.g. "
+                              f"'tcp://host:8786'") from None
         items = iter(payloads)
         window = self.in_flight * max(1, sum(client.nthreads().values()))
         queue = as_completed()
