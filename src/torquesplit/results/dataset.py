@@ -61,6 +61,9 @@ def element_frames(res, names: list[str]) -> list[str]:
 
 
 CUT = " (NaN: a cycle cut by the start or the end of the run)"
+#: the variable of the bearings' largest force magnitude per history interval (files
+#: before 2026-11-30 called it bearing_force_peak)
+INTERVAL_PEAK = "bearing_interval_peak_force"
 
 
 def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
@@ -155,10 +158,13 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
         # the run's, not its samples')
         ds = ds.assign_coords(streamed_bearing=("streamed_bearing",
                                                 list(s.history_peak_names)))
-        ds["bearing_force_peak"] = _var(
+        # (named apart from bearing_peak_force, the settled peak of each bearing: a
+        # MATLAB user took one for the other, a reviewer; files before read back too)
+        ds[INTERVAL_PEAK] = _var(
             ("time", "streamed_bearing"), s.history_peaks.copy(), "N",
-            "largest bearing force magnitude since the sample before (this one included), "
-            "streamed at every integration step")
+            "largest bearing force magnitude since the history sample before (this one "
+            "included), streamed at every integration step (the settled peak of each "
+            "bearing: bearing_peak_force)")
     _note_sampling(ds, s.history_t, res.statistics().get("step_s"),
                    res.history_keeps_every_step())
     if definition is not None and hasattr(res, "check_definition"):
@@ -472,8 +478,9 @@ def results_from_dataset(ds: xr.Dataset):
         back_contact_steps=np.zeros(len(names), np.int64),
         separation_time=sep_t, back_contact_time=back_t,
         **({"history_peak_names": tuple(str(b) for b in ds["streamed_bearing"].values),
-            "history_peaks": np.asarray(ds["bearing_force_peak"].values, dtype=float)}
-           if "bearing_force_peak" in ds else {}))
+            "history_peaks": np.asarray(ds[peaks].values, dtype=float)}
+           if (peaks := next((v for v in (INTERVAL_PEAK, "bearing_force_peak") if v in ds),
+                             None)) else {}))
     notes = json.loads(ds.attrs.get("warnings_json", "[]"))
     # a steady state's record repeats one period: every complete cycle counts, as when
     # it was saved (its history holds the first period, :func:`_one_period`)
