@@ -126,6 +126,19 @@ def _held(value: float, checked: float, most: int = 5) -> str:
     return f"{value:.{decimals}f}{mark}"
 
 
+#: the table's numbers, in its column order
+KEYS = tuple(f"load_sharing.{d}" for d in DYNAMIC_DEFINITIONS) + ("dynamic_factor",
+                                                                   "peak_to_nominal")
+
+
+def cells(name: str, check) -> list[str]:
+    """The table row of example ``name`` from its ``check_step`` result: each number to
+    the digits its halved run confirms, an example's peak-based ones to PEAK_DIGITS."""
+    most = {k: 5 if k == "load_sharing.mean_force" else PEAK_DIGITS.get(name, 5)
+            for k in KEYS}
+    return [_held(check.values[k], check.halved[k], most[k]) for k in KEYS]
+
+
 def main() -> None:
     lines = [HEAD]
     for d in DYNAMIC_DEFINITIONS:
@@ -145,12 +158,7 @@ def main() -> None:
             warnings.simplefilter("ignore")
             res = torquesplit.simulate(torquesplit.load_model(torquesplit.example_path(name)))
             check = check_step(res, definitions=DYNAMIC_DEFINITIONS)
-        keys = [f"load_sharing.{d}" for d in DYNAMIC_DEFINITIONS] + ["dynamic_factor",
-                                                                      "peak_to_nominal"]
-        most = {k: PEAK_DIGITS.get(name, 5) if k != "load_sharing.mean_force" else 5
-                for k in keys}
-        cells = [_held(check.values[k], check.halved[k], most[k]) for k in keys]
-        lines.append(f"| `{name}` | " + " | ".join(cells) + " |\n")
+        lines.append(f"| `{name}` | " + " | ".join(cells(name, check)) + " |\n")
         print(f"{name} done", file=sys.stderr)
     lines.append(f"\n{ONE_DIGIT} only the first digit holds at half the step.  The "
                  "peak-based coefficients include the dynamic increment: they differ "
