@@ -108,3 +108,23 @@ def test_a_gear_deflected_beyond_its_tooth_depth_is_refused_not_warned_of():
     (loc, msg), = deflection_issues(dong, structure, beyond)
     assert loc == "gears.O1.support" and f"the static deflection of O1.y is {2.3e3 * m:.4g} mm" \
         in msg and "more than the whole depth of its teeth" in msg
+
+
+def test_an_axial_float_beyond_the_tooth_depth_is_warned_of_not_refused():
+    """Along its axis a gear stays in mesh (a helical gear floats axially): only its
+    translation in its plane is held against the tooth depth."""
+    import tomllib
+    from types import SimpleNamespace
+
+    import torquesplit
+    from model_texts import SPUR_PAIR
+    from torquesplit.model.checks import deflection_issues, deflection_warnings
+
+    model = torquesplit.load_model(tomllib.loads(SPUR_PAIR))  # (axes along z)
+    m = model.gears["pinion"].module
+    structure = SimpleNamespace(dof_names=["pinion.z", "pinion.x"])
+    assert deflection_issues(model, structure, [3 * m, 0.0]) == []
+    (_, msg), = deflection_warnings(model, structure, [3 * m, 0.0])
+    assert "pinion.z" in msg and "more than half the module" in msg
+    (_, msg), = deflection_issues(model, structure, [3 * m, 0.1 * m + 2.25 * m])
+    assert "the static deflection of pinion.x" in msg

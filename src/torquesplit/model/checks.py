@@ -1934,16 +1934,36 @@ def refuse_out_of_mesh(model, structure, q, *, warn: bool = False) -> None:
         raise ModelError(issues)
 
 
+_GLOBAL = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
+
+
+def _in_plane(gear, dof: str) -> bool:
+    """Whether translation ``dof`` of ``gear`` moves it in its plane (towards or away from
+    its mates), not along its axis (a helical gear's axial float leaves it in mesh)."""
+    if dof not in _GLOBAL:
+        return True  # ('loa': along the line of action, in the plane)
+    axis = np.asarray(gear.axis, dtype=float)
+    norm = float(np.linalg.norm(axis))
+    return norm == 0.0 or abs(float(np.dot(axis, _GLOBAL[dof]))) / norm < 0.5
+
+
 def _deflections(model, structure, q) -> list[tuple[str, str, bool]]:
-    """(location, message, refused) of every body translated more than its limit."""
+    """(location, message, refused) of every body translated more than its limit: its
+    largest translation against half the module (1 mm without teeth); a gear's largest
+    translation in its plane against its tooth depth (refused)."""
     q = np.asarray(q, dtype=float)
     worst: dict[str, tuple[float, str]] = {}
+    in_plane: dict[str, tuple[float, str]] = {}
     for name, value in zip(structure.dof_names, q):
         body, _, dof = str(name).rpartition(".")
         if dof == "theta" or not np.isfinite(value):
             continue
         if abs(value) > worst.get(body, (0.0, ""))[0]:
             worst[body] = (abs(value), dof)
+        gear = model.gears.get(body)
+        if gear is not None and _in_plane(gear, dof) \
+                and abs(value) > in_plane.get(body, (0.0, ""))[0]:
+            in_plane[body] = (abs(value), dof)
     out = []
     for body, (size, dof) in worst.items():
         gear = model.gears.get(body)
@@ -1952,7 +1972,9 @@ def _deflections(model, structure, q) -> list[tuple[str, str, bool]]:
         if size <= limit:
             continue
         depth = TOOTH_DEPTH_MODULES * gear.module if gear is not None else math.inf
-        refused = size > depth
+        refused = in_plane.get(body, (0.0, ""))[0] > depth
+        if refused:
+            size, dof = in_plane[body]
         if refused:
             what = (f"the whole depth of its teeth ({depth * 1e3:.4g} mm): they would be out "
                     f"of the mesh, and no number of a run would mean anything")
