@@ -68,7 +68,7 @@ def test_a_support_stiffness_off_by_a_unit_is_said_by_check_run_and_static(tmp_p
                         ["steady"]):
             res = CliRunner().invoke(app, [command[0], str(path), *command[1:]])
             said = [ln for ln in res.stderr.splitlines()
-                    if "gears.pinion.support: the static deflection of pinion." in ln]
+                    if "gears.pinion.support: the static deflection of pinion" in ln]
             assert len(said) == expected, (command, res.stderr)
 
 
@@ -106,8 +106,11 @@ def test_a_gear_deflected_beyond_its_tooth_depth_is_refused_not_warned_of():
     assert len(deflection_warnings(dong, structure, below)) == 1
     assert deflection_warnings(dong, structure, beyond) == []
     (loc, msg), = deflection_issues(dong, structure, beyond)
-    assert loc == "gears.O1.support" and f"the static deflection of O1.y is {2.3e3 * m:.4g} mm" \
-        in msg and "more than the whole depth of its teeth" in msg
+    assert loc == "gears.O1.support" and "more than the whole depth of its teeth" in msg
+    from torquesplit.model.checks import _plane_translation
+
+    plane = _plane_translation(dong.gears["O1"], {"x": 0.0, "y": 2.3 * m})
+    assert f"the static deflection of O1 in its plane is {1e3 * plane:.4g} mm" in msg
 
 
 def test_an_axial_float_beyond_the_tooth_depth_is_warned_of_not_refused():
@@ -127,4 +130,16 @@ def test_an_axial_float_beyond_the_tooth_depth_is_warned_of_not_refused():
     (_, msg), = deflection_warnings(model, structure, [3 * m, 0.0])
     assert "pinion.z" in msg and "more than half the module" in msg
     (_, msg), = deflection_issues(model, structure, [3 * m, 0.1 * m + 2.25 * m])
-    assert "the static deflection of pinion.x" in msg
+    assert f"the static deflection of pinion in its plane is {2.35e3 * m:.4g} mm" in msg
+    # the verdict does not depend on the model's orientation: 3 modules at 45 deg in the
+    # plane (2.12 along x and y, each below the tooth depth) are refused too
+    diagonal = SimpleNamespace(dof_names=["pinion.x", "pinion.y"])
+    (_, msg), = deflection_issues(model, diagonal, [2.12 * m, 2.12 * m])
+    assert f"in its plane is {2.12e3 * m * 2**0.5:.4g} mm" in msg
+    # a slanted axis: the translation's component along it is taken out
+    from torquesplit.model.checks import _plane_translation
+
+    slanted = SimpleNamespace(axis=(1.0, 1.0, 0.0))
+    assert _plane_translation(slanted, {"x": 1.0, "y": 1.0}) < 1e-12
+    assert abs(_plane_translation(slanted, {"x": 1.0, "y": -1.0}) - 2**0.5) < 1e-12
+    assert abs(_plane_translation(slanted, {"loa": 3.0, "z": 4.0}) - 5.0) < 1e-12

@@ -163,9 +163,9 @@ def contact_loss(results, metrics) -> list[tuple[str, str]]:
                 f"meshes.{r.mesh}.backlash and the excitation")))
         else:
             out.append((f"meshes.{r.mesh}", (
-                f"contact loss {_pct(r.contact_loss)} of the whole run, all of it in the "
-                f"start-up transient: the settled response keeps contact (its smallest "
-                f"force {_kn(r.min_force)}); the start from the static equilibrium "
+                f"contact loss {_pct(r.contact_loss)} of the whole run, in the start-up "
+                f"transient only: the settled response's smallest force is positive "
+                f"({_kn(r.min_force)}), so the start from the static equilibrium is what "
                 f"separates the teeth")))
     return out
 
