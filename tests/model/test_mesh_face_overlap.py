@@ -108,3 +108,19 @@ length = "100 mm"
     assert model.gears["wheel"].position is None
     with pytest.raises(ModelError, match="their faces do not overlap"):
         torquesplit.load_model(tomllib.loads(_text("100 mm") + hub))
+
+
+def test_a_double_helical_pair_offset_along_its_axis_is_said_to_misalign_its_apexes():
+    """Its face is two helices, not one block: an offset puts the apexes apart, which the
+    model does not represent (a checks reviewer: the overlap said was wrong for them)."""
+    text = _text("5 mm").replace('"60 mm"', '"69.28203230 mm"')  # (m_t = 2 mm / cos 30)
+    for gear in ("pinion", "wheel"):
+        hand = "right" if gear == "pinion" else "left"
+        text = text.replace(f"[gears.{gear}]\n", f'[gears.{gear}]\nkind = "double_helical"\n'
+                            f'helix_angle = "30 deg"\nhand = "{hand}"\n')
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        torquesplit.load_model(tomllib.loads(text))
+    said = [str(w.message) for w in caught if "apexes" in str(w.message)]
+    assert len(said) == 1 and "the apexes of these double-helical gears do not line up" \
+        in said[0] and "touch over" not in said[0], [str(w.message) for w in caught]

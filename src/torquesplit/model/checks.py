@@ -996,15 +996,26 @@ def face_overlap_issues(model: Model, kin) -> list[tuple[str, str]]:
 
 def _face_overlap_warnings(model: Model, kin) -> list[tuple[str, str]]:
     """Meshing gears whose faces overlap along the axis over less than the narrower
-    face: the mesh stiffness and the tooth loads are those of the whole narrower face."""
-    return [(f"meshes.{name}", (
-        f"{_face_overlap_text(model, name, axial, narrow, wide)}: the teeth touch over "
-        f"{overlap * 1e3:.4g} mm only, but the mesh stiffness is that of the whole "
-        f"{narrow * 1e3:.4g} mm face; align the gears along the axis ('position'), or, "
-        f"if the offset is meant, give the width in contact as the narrower gear's "
-        f"face_width"))
-        for name, axial, overlap, narrow, wide in face_overlap(model, kin)
-        if overlap > OVERLAP_TOLERANCE]
+    face: the mesh stiffness and the tooth loads are those of the whole narrower face.
+    A double-helical pair offset along its axis has its apexes apart, which the model
+    does not represent (its overlap is not that of one face: said so instead)."""
+    out = []
+    for name, axial, overlap, narrow, wide in face_overlap(model, kin):
+        if overlap <= OVERLAP_TOLERANCE:
+            continue
+        text = _face_overlap_text(model, name, axial, narrow, wide)
+        if any(model.gears[g].gear_type == "double_helical" for g in model.meshes[name].gears):
+            out.append((f"meshes.{name}", (
+                f"{text}: the apexes of these double-helical gears do not line up, which "
+                f"the model does not represent (it takes both helices in full contact); "
+                f"align the gears along the axis ('position')")))
+        else:
+            out.append((f"meshes.{name}", (
+                f"{text}: the teeth touch over {overlap * 1e3:.4g} mm only, but the mesh "
+                f"stiffness is that of the whole {narrow * 1e3:.4g} mm face; align the "
+                f"gears along the axis ('position'), or, if the offset is meant, give the "
+                f"width in contact as the narrower gear's face_width")))
+    return out
 
 
 #: a pair's given positions further than this from its operating centre distance [m]
