@@ -125,3 +125,19 @@ def test_a_periodic_state_has_no_start_up_to_blame():
     metrics = types.SimpleNamespace(rows=[_row(0.01, 40.0)])
     (loc, msg), = contact_loss(types.SimpleNamespace(periodic=True), metrics)
     assert loc == "meshes.m" and "of the periodic state: the teeth separate" in msg
+
+
+def test_a_study_whose_first_case_no_run_accepts_is_refused_before_it_starts():
+    """A shaft diameter of 200 (read in m) put every gear out of its mesh: each case was
+    refused as it ran and the study exited 0 (a studies reviewer).  The first case is
+    checked as `torquesplit check` checks a model, before anything runs."""
+    from torquesplit.errors import StudyError
+
+    spec = {"study": {"name": "b", "model": "ji_li_mill_drive",
+                      "outputs": ["load_sharing.engineering"]},
+            "analysis": {"cycles": 20},
+            "grid": {"parameters": [{"path": "shafts.drive1.diameter",
+                                     "values": [200, 300]}]}}
+    with pytest.raises(StudyError, match=r"case 0 \(shafts\.drive1\.diameter = 200 m\) gives "
+                                         r"an invalid model: .*more than the whole depth"):
+        run_study(spec, workers=1)

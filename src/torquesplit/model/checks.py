@@ -2006,8 +2006,9 @@ def _deflections(model, structure, q) -> list[tuple[str, str, bool]]:
                  + (f" (or the stiffness of {body}'s support or shaft)" if supported
                     else "") + "; check the values and units"
                  if splines else
-                 "a support or shaft stiffness far too small for the load; check its "
-                 "value and unit")
+                 "a support or shaft stiffness far too small for the load (or one far too "
+                 "large for the static solution to resolve: a length in m for mm); check "
+                 "its value and unit")
         out.append((where, (
             f"the static deflection of {subject}, more than "
             f"{what}: {cause} (a unit a thousand times too small gives this: N/m written "

@@ -223,7 +223,7 @@ def _resolve(spec, folder, text, source) -> Plan:
     # and one where a parameter takes its smallest or largest value is said now
     cases = _probe_cases(design)
     _validated(apply_overrides(base, design.overrides(0)), model_source,
-               f"{kind}.parameters", case=0, design=design)
+               f"{kind}.parameters", case=0, design=design, deep=True)
     notes = []
     for case in cases[1:]:
         try:
@@ -369,11 +369,21 @@ def _model_data(name, folder: Path | None) -> tuple[str, dict]:
                                     f"the model file, relative to the study file")
 
 
-def _validated(data: dict, model_source: str, where: str, case=None, design=None):
+def _validated(data: dict, model_source: str, where: str, case=None, design=None,
+               deep: bool = False):
+    """The model of ``data``, or a StudyError naming the case; ``deep``: also what every
+    run does before it integrates (assembly, static equilibrium: ``torquesplit check``'s
+    refusals; a study whose every case was refused by them ran to the end and exited 0,
+    a reviewer)."""
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            return load_model(model_from_dict(data, source=model_source))
+            model = load_model(model_from_dict(data, source=model_source))
+            if deep:
+                from ..model.checks import check_model
+
+                check_model(model, source=model_source, deep=True)
+            return model
     except TorquesplitError as exc:
         what = "the model with the study's changes is invalid"
         if case is not None:
