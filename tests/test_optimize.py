@@ -331,3 +331,21 @@ def test_an_ltca_output_of_a_planetary_mesh_names_the_stages_field(tmp_path):
         evaluate_design(spec, None)
     assert "planetary.0.sun_mesh.stiffness.method" in str(info.value), str(info.value)
     assert '"planetary.0.sun_mesh.stiffness" = {method = "ltca"}' in str(info.value)
+
+
+def test_every_bad_bound_of_a_file_is_said_at_once_with_its_name(tmp_path):
+    """A bound in the wrong unit was said alone, without the file's name; the next one
+    after it was fixed (a studies reviewer)."""
+    path = tmp_path / "o.toml"
+    path.write_text('[optimization]\nmodel = "ji_li_mill_drive"\npopulation = 4\n'
+                    'generations = 1\n[[variables]]\npath = "shafts.drive1.diameter"\n'
+                    'lower = "200 N"\nupper = "300 kg"\n[[objectives]]\n'
+                    'output = "dynamic.stage1.load_sharing"\n[[constraints]]\n'
+                    'output = "dynamic.stage2.dynamic_factor"\nupper = "2 m"\n',
+                    encoding="utf-8")
+    with pytest.raises(ModelError) as err:
+        read_spec(path)
+    where = [loc for loc, _ in err.value.issues]
+    assert where == ["variables[0].lower", "variables[0].upper", "constraints[0].upper"]
+    assert "is not a length" in err.value.issues[0][1]
+    assert err.value.source and str(err.value.source).endswith("o.toml")

@@ -320,6 +320,15 @@ def read_spec(source) -> OptimizationSpec:
     if kw["choose"] not in ("min_sum", "knee"):
         issues.append(("optimization.choose",
                        f"unknown choice {kw['choose']!r}; use 'min_sum' or 'knee'"))
+    def attempt(function, *args):
+        """``function(*args)``, its ModelError's problems added to the others (one was
+        said at a time, without the file's name: a reviewer)."""
+        try:
+            return function(*args)
+        except ModelError as exc:
+            issues.extend(exc.issues)
+            return None
+
     variables = []
     for i, v in enumerate(data.get("variables", [])):
         where = f"variables[{i}]"
@@ -333,18 +342,21 @@ def read_spec(source) -> OptimizationSpec:
                     issues.append((f"{where}.{end}", (
                         f"{v['path']} is a plain number, but the bound {v[end]!r} has a "
                         f"unit; write the number alone")))
-        lo = _si(v["lower"], f"{where}.lower", kind)
-        hi = _si(v["upper"], f"{where}.upper", kind)
-        if not lo < hi:
+        lo = attempt(_si, v["lower"], f"{where}.lower", kind)
+        hi = attempt(_si, v["upper"], f"{where}.upper", kind)
+        if lo is not None and hi is not None and not lo < hi:
             issues.append((f"{where}.upper", f"must exceed lower ({lo:g}); correct the bounds"))
         unknown = sorted(set(v) - {"path", "lower", "upper", "also"})
         if unknown:
             issues.append((f"{where}.{unknown[0]}", "unknown field; use path, lower, upper, also"))
         issues += _variable_path_issues(model_data, v, where)
-        unit, scale = _unit_of((v["lower"], v["upper"]), f"{where}.lower", kind)
+        shown = attempt(_unit_of, (v["lower"], v["upper"]), f"{where}.lower", kind)
+        if lo is None or hi is None or shown is None:
+            continue
+        unit, scale = shown
         variables.append(Variable(str(v["path"]), lo, hi, tuple(v.get("also", ())), unit,
                                   scale))
-    if not variables:
+    if not data.get("variables"):
         issues.append(("variables", "no variables; add [[variables]] with path, lower, upper"))
 
     def outputs(key):
@@ -368,10 +380,10 @@ def read_spec(source) -> OptimizationSpec:
                                                       "relative_to = 'baseline' or remove it"))
             if o.get("sense", "min") not in ("min", "max"):
                 issues.append((f"{where}.sense", "must be 'min' or 'max'; use one of them"))
-            lower = None if o.get("lower") is None else _bound(o["lower"], f"{where}.lower",
-                                                                 str(o["output"]))
-            upper = None if o.get("upper") is None else _bound(o["upper"], f"{where}.upper",
-                                                                 str(o["output"]))
+            lower = None if o.get("lower") is None else attempt(
+                _bound, o["lower"], f"{where}.lower", str(o["output"]))
+            upper = None if o.get("upper") is None else attempt(
+                _bound, o["upper"], f"{where}.upper", str(o["output"]))
             out.append(Output(str(o["output"]), o.get("relative_to"), o.get("sense", "min"),
                               lower, upper))
         return out
@@ -379,9 +391,9 @@ def read_spec(source) -> OptimizationSpec:
     objectives, constraints = outputs("objectives"), outputs("constraints")
     if not objectives:
         issues.append(("objectives", "no objectives; add [[objectives]] with an output"))
-    for i, c in enumerate(constraints):
-        if c.lower is None and c.upper is None:
-            issues.append((f"constraints[{i}]", "has no bound; add lower or upper"))
+    for i, c in enumerate(data.get("constraints", [])):  # (as written: a bound refused
+        if isinstance(c, dict) and c.get("lower") is None and c.get("upper") is None:  # above
+            issues.append((f"constraints[{i}]", "has no bound; add lower or upper"))  # is one)
     if issues:
         raise ModelError(issues, name)
     absolute = [o.output for o in objectives if o.relative_to is None]
