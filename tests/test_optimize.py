@@ -349,3 +349,24 @@ def test_every_bad_bound_of_a_file_is_said_at_once_with_its_name(tmp_path):
     assert where == ["variables[0].lower", "variables[0].upper", "constraints[0].upper"]
     assert "is not a length" in err.value.issues[0][1]
     assert err.value.source and str(err.value.source).endswith("o.toml")
+
+
+def test_a_mistyped_dynamic_output_is_refused_before_the_baseline_runs(tmp_path, monkeypatch):
+    """'dynamic.stage3.load_sharing' was said after a whole run of the baseline (30 s of
+    Ji & Li's drive), with a dozen outputs listed (a studies reviewer)."""
+    import torquesplit
+
+    def no_run(*args, **kwargs):
+        raise AssertionError("the baseline ran before its outputs were checked")
+
+    monkeypatch.setattr(torquesplit, "simulate", no_run)
+    spec = read_spec({"optimization": {"model": "ji_li_mill_drive", "population": 4,
+                                       "generations": 1},
+                      "variables": [{"path": "shafts.drive1.diameter", "lower": "200 mm",
+                                     "upper": "300 mm"}],
+                      "objectives": [{"output": "dynamic.stage3.load_sharing",
+                                      "relative_to": "baseline"}]})
+    with pytest.raises(ModelError, match=r"output 'dynamic\.stage3\.load_sharing' is not "
+                                         r"produced; did you mean 'dynamic\.stage\d\."
+                                         r"load_sharing'"):
+        evaluate_design(spec, None)

@@ -522,6 +522,30 @@ def _ltca_meshes(spec) -> set[str]:
             if o.output.startswith("ltca.")}
 
 
+def _check_dynamic_outputs(model, wanted) -> None:
+    """Refuse a dynamic output the model cannot give, with the closest names, before its
+    run (a mistyped group was said after a whole run of the baseline, listing a dozen
+    outputs: a reviewer).  The set-up is kept for the run that follows."""
+    import difflib
+
+    from .metrics.load_sharing import group_meshes
+    from .simulation import _set_up
+
+    structure = _set_up(model)[1]
+    names = list(group_meshes(structure.metadata["meshes"])) + list(model.meshes)
+    known = ["dynamic.system_load_sharing"] + [
+        f"dynamic.{n}.{k}" for n in names for k in ("dynamic_factor", "load_sharing")]
+    for w in wanted:
+        if w.startswith("dynamic.") and w not in known:
+            near = difflib.get_close_matches(w, known, n=3, cutoff=0.6)
+            raise ModelError([("objectives", (
+                f"output {w!r} is not produced"
+                + (f"; did you mean {' or '.join(repr(n) for n in near)}?" if near else
+                   f"; use dynamic.GROUP.load_sharing or dynamic.GROUP.dynamic_factor with "
+                   f"a group or mesh of the model ({', '.join(names[:8])}), or "
+                   f"dynamic.system_load_sharing")))])
+
+
 def evaluate_design(spec: OptimizationSpec, x) -> dict[str, float]:
     """Every output the objectives and constraints name, for variables ``x`` (SI), or for
     the baseline model (``x = None``)."""
@@ -559,6 +583,7 @@ def evaluate_design(spec: OptimizationSpec, x) -> dict[str, float]:
         if any(w.startswith("dynamic.") for w in wanted):
             from .simulation import MIN_SAMPLES_PER_PERIOD
 
+            _check_dynamic_outputs(model, wanted)  # (before the run, not after it)
             # (metrics only: the sparse history, as a study's case)
             res = torquesplit.simulate(model, samples_per_period=MIN_SAMPLES_PER_PERIOD)
             met = res.metrics("cycle_peak").to_dict()
