@@ -459,3 +459,12 @@ def test_a_scheduler_address_without_a_port_is_an_option_error(tmp_path):
     with pytest.raises(OptionError, match=r"^scheduler address 'nowhere': .*give e\.g\. "
                                           r"'tcp://host:8786'$"):
         run_study(spec, scheduler="nowhere", out=tmp_path / "x")
+
+
+def test_the_per_cycle_statistics_are_named(short_run):
+    """A bare 5-tuple whose meaning went by position (a Python API reviewer)."""
+    stats = short_run.complete_cycle_statistics()
+    assert stats._fields == ("max", "min", "mean", "count", "ratio_max")
+    high, low, mean, count, ratio = stats  # (still unpacks as the five arrays)
+    assert high is stats.max and count is stats.count and ratio is stats.ratio_max
+    assert (stats.max >= stats.min)[stats.count > 0].all()

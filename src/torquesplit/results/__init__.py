@@ -18,6 +18,7 @@ import math
 import numbers
 from dataclasses import dataclass
 from functools import cached_property
+from typing import NamedTuple
 from pathlib import Path
 
 import numpy as np
@@ -32,6 +33,17 @@ from ..model.kinematics import bearing_frame
 #: K_gamma of the design standards (see docs/load-sharing.md)
 STANDARD_DEFINITION = ls.STANDARD_DEFINITION
 
+
+class CycleStatistics(NamedTuple):
+    """Per-cycle statistics of every mesh, (n_cycles, n_meshes) each
+    (:meth:`Results.complete_cycle_statistics`; a reviewer guessed the meaning of a bare
+    5-tuple by position)."""
+
+    max: np.ndarray  #: largest force of the cycle [N]
+    min: np.ndarray  #: smallest force of the cycle [N]
+    mean: np.ndarray  #: mean force of the cycle [N]
+    count: np.ndarray  #: samples in the cycle (0: a cycle cut by the start or end)
+    ratio_max: np.ndarray  #: largest instantaneous load-sharing ratio in the cycle
 
 @dataclass(frozen=True)
 class MeshRow:
@@ -447,11 +459,12 @@ class Results:
         tol = 1e-6 / f
         return (start >= s.t_span[0] - tol) & (start + 1.0 / f <= s.t_final + tol)
 
-    def complete_cycle_statistics(self):
+    def complete_cycle_statistics(self) -> "CycleStatistics":
         """Per-cycle (max, min, mean, count, largest instantaneous ratio) of every mesh,
         (n_cycles, n_meshes) each, with the incomplete cycles (:attr:`complete_cycles`)
         emptied: NaN statistics and count 0.  Read-only arrays, computed once (every
-        metric, table and figure reads them)."""
+        metric, table and figure reads them); a named tuple (``.max``, ``.min``,
+        ``.mean``, ``.count``, ``.ratio_max``) that unpacks as the five arrays."""
         return self._complete_cycle_statistics
 
     @cached_property
@@ -466,7 +479,7 @@ class Results:
             a[partial] = 0 if a.dtype.kind in "iu" else np.nan
             a.flags.writeable = False
             out.append(a)
-        return tuple(out)
+        return CycleStatistics(*out)
 
     def check_definition(self, definition: str | None) -> str:
         """``definition``, or the model's default when None; an unknown one, or the
