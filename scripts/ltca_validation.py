@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 import torquesplit
+from torquesplit.convergence import held_decimals
 from torquesplit.errors import ModelWarning
 from torquesplit.gears.contact import (
     ContactModel,
@@ -84,26 +85,15 @@ def light_load() -> list[dict]:
 FINE = (80, 128)
 
 
-def _decimals(x: float, ref: float, most: int) -> int:
-    """Decimals of ``x`` (at most ``most``) that ``ref`` reproduces
-    (:func:`torquesplit.convergence.agreeing_digits`), at least 0."""
-    from torquesplit.convergence import agreeing_digits
-
-    if x == 0.0:
-        return most if ref == 0.0 else 0
-    e = math.floor(math.log10(abs(x)))
-    return max(0, min(most, agreeing_digits(x, ref, e + 1 + most) - 1 - e))
-
-
 def _held_f(x: float, ref: float, most: int) -> str:
-    return f"{x:.{_decimals(x, ref, most)}f}"
+    return f"{x:.{held_decimals(x, ref, most)}f}"
 
 
 def _dyn_held(run: dict, group: str, key: str) -> str:
     """A section 4 number to the decimals (at most 4) that its run at half the step and
     its run with the finer LTCA both reproduce."""
     x = run["groups"][group][key]
-    return f"{x:.{min(_decimals(x, run[k][group][key], 4) for k in ('halved_step', 'fine_ltca'))}f}"
+    return f"{x:.{min(held_decimals(x, run[k][group][key], 4) for k in ('halved_step', 'fine_ltca'))}f}"
 
 
 def liu_static() -> dict:
@@ -433,7 +423,7 @@ def markdown(res: dict) -> str:
         f_paper = mo["te_peak_to_peak_arcsec"] / un["te_peak_to_peak_arcsec"]
         conv = {n: s["modified"]["te_pp_arcsec_by_slices"][n]
                 / s["unmodified"]["te_pp_arcsec_by_slices"][n] for n in ("40", "80")}
-        f1 = f"{f_paper:.{min(_decimals(f_paper, r, 2) for r in conv.values())}f}"
+        f1 = f"{f_paper:.{min(held_decimals(f_paper, r, 2) for r in conv.values())}f}"
         f1_moves = max(abs(r / f_paper - 1) for r in conv.values())
         L.append("## 5. NSGA-II on the paper's objective\n")
         L.append("`torquesplit optimize liu2021_dh_modification` (the shipped optimisation file: "

@@ -353,18 +353,12 @@ DECIMALS = 4
 
 def _fmt(x, ref) -> str:
     """``x`` to the decimals (at most DECIMALS) that the refined run's ``ref`` reproduces
-    (:func:`torquesplit.convergence.agreeing_digits`: also printed alike); '-' for a
-    missing value."""
-    from torquesplit.convergence import agreeing_digits
+    (:func:`torquesplit.convergence.held_decimals`); '-' for a missing value."""
+    from torquesplit.convergence import held_decimals
 
     if x is None or not math.isfinite(x):
         return "-"
-    if x == 0.0:
-        return f"{x:.{DECIMALS}f}" if ref == 0.0 else "0"
-    e = math.floor(math.log10(abs(x)))
-    most = max(1, e + 1 + DECIMALS)
-    ok = 0 if ref is None or not math.isfinite(ref) else agreeing_digits(x, ref, most)
-    return f"{x:.{max(0, min(DECIMALS, ok - 1 - e))}f}"
+    return f"{x:.{held_decimals(x, ref, DECIMALS)}f}"
 
 
 def _refined_columns(entry: dict) -> dict:

@@ -331,9 +331,10 @@ def _load(model: str, assignments: Optional[list[str]] = None, *, deep: bool = F
     return m, path
 
 
-def _file_issue_locations(raw: dict, path, deep: bool) -> set[str] | None:
-    """Locations of the problems of the file without its ``--set`` overrides (empty: it
-    passes; None: it cannot even be read as a model, so nothing is said of the cause)."""
+def _file_problems(raw: dict, path, deep: bool):
+    """The ModelError of the file as it stands, without its ``--set`` overrides; None if
+    it passes; False if it cannot even be checked (the --set's error is then the one to
+    say)."""
     import copy
 
     from .errors import ModelError
@@ -346,32 +347,32 @@ def _file_issue_locations(raw: dict, path, deep: bool) -> set[str] | None:
             check_model(model_from_dict(copy.deepcopy(raw), source=str(path)),
                         source=str(path), deep=deep)
     except ModelError as exc:
-        return {loc for loc, _ in exc.issues}
+        return exc
     except Exception:  # noqa: BLE001 - (the overrides' own error is the one to report)
+        return False
+    return None
+
+
+def _file_issue_locations(raw: dict, path, deep: bool) -> set[str] | None:
+    """Locations of the problems of the file without its ``--set`` overrides (empty: it
+    passes; None: it cannot even be read as a model, so nothing is said of the cause)."""
+    found = _file_problems(raw, path, deep)
+    if found is False:
         return None
-    return set()
+    return set() if found is None else {loc for loc, _ in found.issues}
 
 
 def _with_file_problems(exc, raw: dict, path, deep: bool):
     """A ``--set`` that cannot be applied, with the problems of the file as it stands
     (they were said only once the --set was mended: one run per problem)."""
-    import copy
-
     from .errors import ModelError
-    from .model.checks import check_model
-    from .model.io import _located, model_from_dict
+    from .model.io import _located
 
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            check_model(model_from_dict(copy.deepcopy(raw), source=str(path)),
-                        source=str(path), deep=deep)
-    except ModelError as file_exc:
-        lines = str(exc).splitlines() + str(_located(file_exc, path)).splitlines()
-        return ModelError([("", line) for line in lines])
-    except Exception:  # noqa: BLE001 - the --set's error is the one to say
+    found = _file_problems(raw, path, deep)
+    if not found:
         return exc
-    return exc
+    lines = str(exc).splitlines() + str(_located(found, path)).splitlines()
+    return ModelError([("", line) for line in lines])
 
 
 def _model_warnings() -> list[str]:

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 __all__ = ["StepCheck", "check_step", "check_steady", "halved_steps_per_period",
-           "agreeing_digits", "has_jumps", "jump_elements", "coarse_table_warning"]
+           "agreeing_digits", "held_decimals", "has_jumps", "jump_elements", "coarse_table_warning"]
 
 TIGHTER_RTOL = 32.0
 """Dormand-Prince: the check's tolerance is the run's divided by this (~ half the step)."""
@@ -113,6 +113,18 @@ def agreeing_digits(a: float, b: float, most: int = 15) -> int:
     while s > 0 and _printed(a, s - 1 - e) != _printed(b, s - 1 - e):
         s -= 1
     return s
+
+
+def held_decimals(value: float, checked: float | None, most: int) -> int:
+    """Decimal places of ``value``, at most ``most``, that ``checked`` (the same number
+    refined) reproduces by :func:`agreeing_digits`' rule; 0 where ``checked`` is missing
+    or not finite.  What the generated pages print a number to."""
+    if checked is None or not (math.isfinite(value) and math.isfinite(checked)):
+        return 0
+    if value == 0.0:
+        return most if checked == 0.0 else 0
+    e = math.floor(math.log10(abs(value)))
+    return max(0, min(most, agreeing_digits(value, checked, max(1, e + 1 + most)) - 1 - e))
 
 
 def _printed(x: float, places: int) -> float:

@@ -8,36 +8,18 @@ import tomllib
 import warnings
 
 import pytest
+from model_texts import SPUR_PAIR
 from typer.testing import CliRunner
 
 import torquesplit
 from torquesplit.cli import app
 from torquesplit.errors import ModelError, ModelWarning
 
-PAIR = """
-[model]
-name = "one pair, the wheel placed by hand"
-[gears.pinion]
-teeth = 20
-module = "2 mm"
-face_width = "PINION_WIDTH"
-position = ["0 mm", "0 mm", "0 mm"]
-[gears.wheel]
-teeth = 40
-module = "2 mm"
-face_width = "20 mm"
-position = ["60 mm", "0 mm", "OFFSET"]
-[meshes.m1]
-gears = ["pinion", "wheel"]
-stiffness = "4e8 N/m"
-[drives.motor]
-body = "pinion"
-speed = "3000 rpm"
-torque = "100 N m"
-[loads.out]
-body = "wheel"
-torque = "balanced"
-"""
+#: the spur pair of the tests, the wheel placed by hand (OFFSET: its axial position)
+PAIR = (SPUR_PAIR.replace('face_width = "20 mm"', 'face_width = "PINION_WIDTH"', 1)
+        .replace('place = {from_gear = "pinion", angle = "0 deg"}',
+                 'position = ["60 mm", "0 mm", "OFFSET"]')
+        .replace("[meshes.m]", "[meshes.m1]"))
 
 
 def _text(offset: str, pinion_width: str = "20 mm") -> str:
@@ -102,8 +84,7 @@ connects = ["wheel", "hub"]
 diameter = "20 mm"
 length = "100 mm"
 """
-    text = _text("100 mm").replace('position = ["60 mm", "0 mm", "100 mm"]\n[meshes',
-                                   "[meshes") + hub
+    text = _text("100 mm").replace('position = ["60 mm", "0 mm", "100 mm"]\n', "") + hub
     model = torquesplit.load_model(tomllib.loads(text))
     assert model.gears["wheel"].position is None
     with pytest.raises(ModelError, match="their faces do not overlap"):

@@ -1901,10 +1901,11 @@ def _readiness(model: Model, kin=None) -> tuple[list, list]:
 
     coarse = coarse_table_warning(model, structure)  # (what every run warns of)
     notes = [tuple(coarse.split(": ", 1))] if coarse else []
-    refused = deflection_issues(model, structure, q)  # (as every run refuses them)
+    found = _deflections(model, structure, q)  # (as every run refuses or warns of them)
+    refused = [(loc, msg) for loc, msg, out in found if out]
     if refused:
         return refused, []
-    return [], notes + deflection_warnings(model, structure, q)  # (and every run)
+    return [], notes + [(loc, msg) for loc, msg, out in found if not out]
 
 
 #: a gear's whole tooth depth in normal modules (ISO 53 basic rack: addendum 1, dedendum
