@@ -321,8 +321,9 @@ bearing (its stiffness, or the inertia it carries), which moves the critical spe
 
 ## 6. Change a parameter
 
-`--set` changes one field for one command, without editing the file.  Mount branch 1
-correctly:
+`--set` changes one field for one command, without editing the file (a field the file
+gives another way gives way: `--set drives.motor.torque=...` replaces a `power`,
+`damping_ratio` a `damping`).  Mount branch 1 correctly:
 
 $ torquesplit run three_branch.toml --set gears.b1.errors.installation=0
 

@@ -383,7 +383,8 @@ def _model_warnings() -> list[str]:
 # --------------------------------------------------------------------------- check
 _MODEL_HELP = ("Model file (.toml/.json) or example name (see 'torquesplit examples').")
 _SET_HELP = ("Override a model field for this command: PATH=VALUE, e.g. "
-             "shafts.s1.diameter='250 mm' (repeat for several).")
+             "shafts.s1.diameter='250 mm' (repeat for several); it replaces a field the "
+             "file gives another way (torque a drive's power).")
 
 
 @app.command()

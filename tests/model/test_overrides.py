@@ -39,3 +39,39 @@ def test_a_list_item_in_brackets_is_told_the_dotted_index():
     """'position[0]' was an 'unknown field' of the gear."""
     with pytest.raises(ModelError, match=r"not brackets; write shafts\.s1\.axis\.2"):
         set_parameter(_data(), "shafts.s1.axis[2]", -1.0)
+
+
+def test_a_field_set_replaces_the_files_other_way_of_saying_it():
+    """``--set drives.motor.torque=...`` on a drive given a power was refused with "remove
+    one of them", which the command line cannot do (a first-hour reviewer).  The example
+    then loads with the torque set, and its other fields stay."""
+    import torquesplit
+    from torquesplit.model.overrides import read_raw
+
+    raw = read_raw(torquesplit.example_path("ji_li_mill_drive"))
+    assert "power" in raw["drives"]["motor"]
+    model = torquesplit.load_model(apply_overrides(raw, {"drives.motor.torque": "32 kN m"}))
+    assert model.drives["motor"].torque == pytest.approx(32e3)
+    assert model.drives["motor"].power is None
+    support = apply_overrides(raw, {"gears.z1.support.damping": "1e3 N s/m"})
+    assert support["gears"]["z1"]["support"]["damping"] == "1e3 N s/m"
+    assert "damping_ratio" not in support["gears"]["z1"]["support"]
+    assert "shaft" in support["gears"]["z1"]["support"]  # (not an alternative of damping)
+    assert raw["gears"]["z1"]["support"]["damping_ratio"] == 0.065  # the original untouched
+
+
+@pytest.mark.parametrize("table, path, value, gone, kept", [
+    ({"stiffness": "1 N/m", "damping": 1.0}, "rigid", True, ("stiffness", "damping"), ()),
+    ({"stiffness": "1 N/m", "damping": 1.0}, "rigid", False, (), ("stiffness", "damping")),
+    ({"rigid": True, "diameter": "1 m"}, "torsional_stiffness", "1 N m/rad",
+     ("rigid", "diameter"), ()),
+    ({"torsional_stiffness": "1 N m/rad", "shear_modulus": 1.0}, "length", "1 m",
+     ("torsional_stiffness",), ("shear_modulus",)),
+    ({"shaft": {"length": "1 m"}}, "stiffness", "1 N/m", ("shaft",), ()),
+    ({"position": [0, 0, 0]}, "place", {"at": "x"}, ("position",), ()),
+])
+def test_each_alternative_gives_way_and_nothing_else(table, path, value, gone, kept):
+    out = set_parameter({"t": {"a": table}}, f"t.a.{path}", value)["t"]["a"]
+    assert out[path] == value
+    assert not set(gone) & set(out)
+    assert set(kept) <= set(out)
