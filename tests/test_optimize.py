@@ -181,7 +181,7 @@ def test_results_show_variables_in_the_unit_of_their_bounds(tmp_path):
     assert topo["y1"] == "0.023 mm" and topo["y6"] == "8.19 mm"
     rows = list(csv.reader((tmp_path / "pareto.csv").open()))
     assert rows[0][1] == "gears.L6.modifications.topological.y1 [mm]"
-    assert rows[0][-1] == "ltca.L68.impact_peak_force_N (/ baseline)"
+    assert rows[0][-2:] == ["ltca.L68.impact_peak_force_N (/ baseline)", "warnings"]
     assert float(rows[2][1]) == pytest.approx(0.023) and rows[2][0] == "1"
 
 
@@ -370,3 +370,72 @@ def test_a_mistyped_dynamic_output_is_refused_before_the_baseline_runs(tmp_path,
                                          r"produced; did you mean 'dynamic\.stage\d\."
                                          r"load_sharing'"):
         evaluate_design(spec, None)
+
+
+def _eccentricity_spec(tmp_path, lower="1000 um"):
+    """Ji & Li's drive, one error of one gear, a run too short to settle: every design
+    and the baseline have a plausibility warning, and no design beats the baseline
+    (every eccentricity above 1 mm shares worse than none)."""
+    return {"optimization": dict(model="ji_li_mill_drive", population=4, generations=1,
+                                 seed=1, workers=1, store=str(tmp_path / "evals.jsonl")),
+            "set": {"analysis.duration": "0.6 s"},
+            "variables": [{"path": "gears.z2.errors.eccentricity", "lower": lower,
+                           "upper": "3000 um"}],
+            "objectives": [{"output": "dynamic.system_load_sharing"}]}
+
+
+def test_a_designs_run_warnings_and_a_better_baseline_are_said(tmp_path):
+    """A studies/optimisation reviewer: the evaluations kept no word of their runs'
+    warnings (a case of a study is marked contact_lost, not settled...), and a chosen
+    design worse than the model without the variables was written out without a note."""
+    import csv
+
+    import tomli_w
+    from typer.testing import CliRunner
+
+    from torquesplit.cli import app
+
+    spec = tmp_path / "opt.toml"
+    spec.write_text(tomli_w.dumps(_eccentricity_spec(tmp_path)), encoding="utf-8")
+    res = CliRunner().invoke(app, ["optimize", str(spec), "--out", str(tmp_path / "o")])
+    assert res.exit_code == 0, res.output
+    text = " ".join(res.output.split())
+    assert "warning: design 1 (*) of the front: analysis: the run is too short" in text
+    assert "warning: the baseline model: analysis: the run is too short" in text
+    assert "the chosen design is no better than the baseline" in text
+    rows = list(csv.DictReader((tmp_path / "o" / "pareto.csv").open()))
+    assert rows and all("the run is too short" in r["warnings"] for r in rows)
+    # the notes come back from the store with the evaluations
+    again = optimize(_eccentricity_spec(tmp_path))
+    assert again.computed == 0 and all("too short" in n[0] for n in again.notes)
+
+
+def test_the_baseline_is_compared_objective_by_objective():
+    from torquesplit.optimize import OptimizationResult
+
+    def result(baseline_F):
+        return OptimizationResult(spec=None, X=np.zeros((2, 1)),
+                                  F=np.array([[1.0, 2.0], [2.0, 1.0]]), outputs=({}, {}),
+                                  baseline={}, chosen=1, evaluations=2, computed=2,
+                                  baseline_F=None if baseline_F is None
+                                  else np.array(baseline_F))
+    assert result([2.0, 1.0]).baseline_not_worse  # equal in both
+    assert result([1.5, 0.5]).baseline_not_worse
+    assert not result([1.5, 1.5]).baseline_not_worse  # the chosen is better in one
+    assert not result(None).baseline_not_worse
+
+
+def test_a_diverged_design_is_a_failed_evaluation_not_ranked(monkeypatch, tmp_path):
+    """A run that diverged gave the metrics of its part before the divergence, ranked
+    like any design."""
+    import torquesplit
+    from torquesplit.optimize import _evaluate_job
+
+    class Diverged:
+        success = False
+        message = "the state left every bound at t = 0.1 s"
+
+    monkeypatch.setattr(torquesplit, "simulate", lambda *a, **k: Diverged())
+    rec = _evaluate_job(read_spec(_eccentricity_spec(tmp_path)), (1e-3,))
+    assert rec["outputs"] is None
+    assert rec["error"] == "the dynamic run diverged: the state left every bound at t = 0.1 s"

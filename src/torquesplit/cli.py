@@ -1696,12 +1696,15 @@ def optimize(
     values = res.objective_values()
     if as_json:
         ux.emit_json({"pareto": [{"x": dict(zip(names, map(float, x))),
-                                  "objectives": dict(zip(objs, map(float, f)))}
-                                 for x, f in zip(res.X, values)],
+                                  "objectives": dict(zip(objs, map(float, f))),
+                                  "warnings": list(res.design_notes(i))}
+                                 for i, (x, f) in enumerate(zip(res.X, values))],
                       "x_units": "SI",
                       "objectives_relative_to": {o.output: o.relative_to
                                                  for o in res.spec.objectives},
                       "chosen": int(res.chosen), "baseline": res.baseline,
+                      "baseline_warnings": list(res.baseline_notes),
+                      "baseline_not_worse": res.baseline_not_worse,
                       "evaluations": res.evaluations, "computed": res.computed,
                       "store": None if res.spec.store is None else str(res.spec.store),
                       "files": [str(f) for f in files]}, _json_default)
@@ -1714,7 +1717,7 @@ def optimize(
                 *res.objective_labels()):
         t.add_column(_h(col), justify="right")
     for i, (x, f) in enumerate(zip(res.X, values)):
-        t.add_row("*" if i == res.chosen else "",
+        t.add_row(f"{i + 1}{' *' if i == res.chosen else ''}",
                   *[f"{v.shown(a):.4g}" for v, a in zip(res.spec.variables, x)],
                   *[f"{v:.4g}" for v in f])
     console.print(t)
@@ -1723,6 +1726,19 @@ def optimize(
         console.print("baseline (the model without the variables): " + ", ".join(
             f"{o} = {res.baseline[o]:.5g}" + (f" {output_unit(o)}" if output_unit(o) else "")
             for o in relative), highlight=False)
+    flagged = [i for i in range(len(res.X)) if res.design_notes(i)]
+    for i in flagged[:3] if res.chosen not in flagged else [res.chosen]:
+        ux.warn(f"design {i + 1}{' (*)' if i == res.chosen else ''} of the front: "
+                f"{res.design_notes(i)[0]}")
+    if flagged:
+        console.print(f"{len(flagged)} of {len(res.X)} designs of the front have warnings "
+                      f"(the 'warnings' column of pareto.csv)", highlight=False)
+    if res.baseline_notes:
+        ux.warn(f"the baseline model: {res.baseline_notes[0]}")
+    if res.baseline_not_worse:
+        ux.warn("the chosen design is no better than the baseline (the model without the "
+                "variables) in any objective: widen the variables' bounds, add generations, "
+                "or keep the baseline")
     console.print(f"chosen design (*) written to {target / 'chosen.toml'}; front in "
                   f"{target / 'pareto.csv'}", highlight=False)
     if res.spec.store is not None:

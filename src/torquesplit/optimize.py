@@ -546,9 +546,11 @@ def _check_dynamic_outputs(model, wanted) -> None:
                    f"dynamic.system_load_sharing")))])
 
 
-def evaluate_design(spec: OptimizationSpec, x) -> dict[str, float]:
+def evaluate_design(spec: OptimizationSpec, x, notes: list[str] | None = None
+                    ) -> dict[str, float]:
     """Every output the objectives and constraints name, for variables ``x`` (SI), or for
-    the baseline model (``x = None``)."""
+    the baseline model (``x = None``).  ``notes`` gets the dynamic run's plausibility
+    warnings (contact lost, not settled...: a study's case statuses), one line each."""
     from .model.io import model_from_dict
 
     data = _model_data(spec, x)
@@ -586,7 +588,15 @@ def evaluate_design(spec: OptimizationSpec, x) -> dict[str, float]:
             _check_dynamic_outputs(model, wanted)  # (before the run, not after it)
             # (metrics only: the sparse history, as a study's case)
             res = torquesplit.simulate(model, samples_per_period=MIN_SAMPLES_PER_PERIOD)
-            met = res.metrics("cycle_peak").to_dict()
+            if not res.success:  # (a diverged run's partial metrics were ranked as a design)
+                raise TorquesplitError(f"the dynamic run diverged: {res.message}")
+            metrics = res.metrics("cycle_peak")
+            if notes is not None:
+                from .results.plausibility import result_warnings
+
+                notes += [f"{where}: {text}" for where, text
+                          in result_warnings(res, metrics, history=False)]
+            met = metrics.to_dict()
             out["dynamic.system_load_sharing"] = float(met["system_load_sharing"])
             for g, v in met["groups"].items():
                 out[f"dynamic.{g}.dynamic_factor"] = float(v["dynamic_factor"])
@@ -603,7 +613,9 @@ def evaluate_design(spec: OptimizationSpec, x) -> dict[str, float]:
 
 def _evaluate_job(spec: OptimizationSpec, x: tuple[float, ...]) -> dict:
     try:
-        return {"x": list(x), "outputs": evaluate_design(spec, x), "error": None}
+        notes: list[str] = []
+        return {"x": list(x), "outputs": evaluate_design(spec, x, notes), "error": None,
+                "notes": [n.splitlines()[0] for n in notes]}
     except (TorquesplitError, ValueError) as exc:
         return {"x": list(x), "outputs": None, "error": str(exc).splitlines()[0]}
 
@@ -708,6 +720,19 @@ class OptimizationResult:
     chosen: int
     evaluations: int
     computed: int
+    notes: tuple[tuple[str, ...], ...] = ()
+    """Per design of the front, its dynamic run's plausibility warnings (contact lost,
+    not settled...), one line each."""
+    baseline_notes: tuple[str, ...] = ()
+    baseline_F: np.ndarray | None = None
+    """(n_obj,) the baseline's objective values (as minimised, as F)."""
+
+    @property
+    def baseline_not_worse(self) -> bool:
+        """Whether the baseline is at least as good as the chosen design in every
+        objective (then the variables' bounds or the objectives deserve a look)."""
+        return self.baseline_F is not None and bool(np.all(self.baseline_F
+                                                           <= self.F[self.chosen]))
 
     @property
     def chosen_x(self) -> np.ndarray:
@@ -722,6 +747,10 @@ class OptimizationResult:
             if isinstance(ltca, dict):
                 ltca.pop("cache", None)
         return data
+
+    def design_notes(self, i: int) -> tuple[str, ...]:
+        """Design i's plausibility warnings (none where the front was built without)."""
+        return self.notes[i] if i < len(self.notes) else ()
 
     def objective_labels(self) -> list[str]:
         """Headers of the objective columns: '(/ baseline)' for a ratio to the baseline,
@@ -739,8 +768,9 @@ class OptimizationResult:
         return self.F * sign
 
     def write(self, directory) -> list[Path]:
-        """pareto.csv (variables in the unit of their bounds, named in the header),
-        pareto.png and chosen.toml (variables with units) in ``directory``."""
+        """pareto.csv (variables in the unit of their bounds, named in the header; a
+        design's plausibility warnings in the last column), pareto.png and chosen.toml
+        (variables with units) in ``directory``."""
         import tomli_w
 
         d = Path(directory)
@@ -750,11 +780,11 @@ class OptimizationResult:
         paths = [d / "pareto.csv", d / "chosen.toml"]
         with paths[0].open("w", newline="") as fh:
             w = csv.writer(fh)
-            w.writerow(["chosen", *names, *objs])
+            w.writerow(["chosen", *names, *objs, "warnings"])
             for i, (x, f) in enumerate(zip(self.X, self.objective_values())):
                 w.writerow([int(i == self.chosen),
                             *(v.shown(a) for v, a in zip(self.spec.variables, x)),
-                            *map(float, f)])
+                            *map(float, f), "; ".join(self.design_notes(i))])
         paths[1].write_text("# chosen by torquesplit optimize (" + self.spec.choose + ")\n"
                             + tomli_w.dumps(self.chosen_model_data(units=True)))
         if self.F.shape[1] >= 2:
@@ -819,7 +849,8 @@ def optimize(source, *, workers: int | None = None, generations: int | None = No
     if store.other:
         warn_user(f"optimization.store: {store.other} stored evaluation(s) are of another "
                       f"model, [set] or outputs and are not reused", ModelWarning)
-    baseline = evaluate_design(spec, None)
+    baseline_notes: list[str] = []
+    baseline = evaluate_design(spec, None, baseline_notes)
     for o in (*spec.objectives,):
         if o.relative_to and not baseline[o.output]:
             raise ModelError([("objectives", f"the baseline value of {o.output!r} is 0; it cannot "
@@ -908,7 +939,8 @@ def optimize(source, *, workers: int | None = None, generations: int | None = No
     F = np.atleast_2d(res.F)
     order = np.lexsort(F.T[::-1])
     X, F = X[order], F[order]
-    outputs = tuple(store.get(tuple(float(v) for v in x))["outputs"] for x in X)
+    records = [store.get(tuple(float(v) for v in x)) for x in X]
+    outputs = tuple(r["outputs"] for r in records)
     if spec.choose == "knee" and F.shape[1] >= 2 and len(F) > 2:
         span = np.ptp(F, axis=0)
         span[span == 0] = 1.0
@@ -918,4 +950,7 @@ def optimize(source, *, workers: int | None = None, generations: int | None = No
         chosen = int(np.argmin(F.sum(axis=1)))
     return OptimizationResult(spec=spec, X=X, F=F, outputs=outputs, baseline=baseline,
                               chosen=chosen, evaluations=counters["evaluations"],
-                              computed=counters["computed"])
+                              computed=counters["computed"],
+                              notes=tuple(tuple(r.get("notes", ())) for r in records),
+                              baseline_notes=tuple(n.splitlines()[0] for n in baseline_notes),
+                              baseline_F=np.array(objectives_of({"outputs": baseline})[0]))
