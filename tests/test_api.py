@@ -155,3 +155,36 @@ def test_tab_completion_lists_the_library_and_modes_take_a_limit_with_its_unit()
     assert [r.frequency for r in a.rows] == [r.frequency for r in b.rows] and a.rows
     with pytest.raises(torquesplit.errors.OptionError, match="below"):
         torquesplit.model_modes("ji_li_mill_drive", below="1 kg")
+
+
+def test_every_result_is_saved_by_one_function_with_its_model(model, tmp_path):
+    """An exports reviewer: sweep_speed returned a bare Dataset (whose to_netcdf('x.csv')
+    wrote NetCDF under a .csv name), campbell a tuple, a contact analysis had no save,
+    and the modes saved from Python named no model.  torquesplit.save writes each by
+    suffix, as its command does, with the model the file came from."""
+    import scipy.io
+    import xarray as xr
+
+    from torquesplit.model.io import model_to_json
+
+    results = {
+        "modes": torquesplit.model_modes(model, count=4),
+        "contact": torquesplit.contact_analysis(model, "m11", positions=16, slices=4),
+        "sweep": torquesplit.sweep_speed(model, "740 rpm", "745 rpm", points=2,
+                                         stability=False),
+        "campbell": torquesplit.campbell(model, "0 rpm", "800 rpm", points=3),
+    }
+    for name, result in results.items():
+        for suffix in (".nc", ".mat", ".csv"):
+            assert torquesplit.save(result, tmp_path / f"{name}{suffix}") == \
+                tmp_path / f"{name}{suffix}"
+        with xr.open_dataset(tmp_path / f"{name}.nc") as ds:
+            assert ds.attrs["model_json"] == model_to_json(model), name
+            assert ds.attrs["model_sha256"], name
+        assert scipy.io.loadmat(tmp_path / f"{name}.mat")["model_json"][0] == \
+            model_to_json(model), name
+        assert (tmp_path / f"{name}.csv").read_bytes()[:1] != b"\x89"  # (not HDF5)
+    with pytest.raises(torquesplit.OutputError, match="exists"):
+        torquesplit.save(results["modes"], tmp_path / "modes.nc")
+    with pytest.raises(torquesplit.OptionError, match="not a dict"):
+        torquesplit.save({}, tmp_path / "x.nc")

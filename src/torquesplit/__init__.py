@@ -14,6 +14,8 @@ The pipeline, one stage per subpackage (each stage returns a new object)::
     run_study(study_file)       -> Dataset     (study/: grids, Monte Carlo, sensitivity)
     contact_analysis(model, mesh, loads) -> ContactAnalysis (gears/contact/: loaded tooth
                                                 contact analysis of one mesh)
+    save(result, "file.mat")    -> Path        (any of these results, by suffix: .nc,
+                                                .mat, .csv; as the commands write them)
 """
 
 from __future__ import annotations
@@ -31,7 +33,7 @@ __all__ = [
     "load_model", "solve_kinematics", "assemble", "simulate", "quasi_static_load_sharing",
     "model_modes", "steady_state", "sweep_speed", "campbell", "load_results",
     "open_results", "Results", "Model", "SteadyState", "Study", "run_study",
-    "contact_analysis",
+    "contact_analysis", "save",
 ]
 
 #: loaded only when asked for (pydantic, numba, xarray, the study and steady-state
@@ -44,7 +46,8 @@ _LAZY = {"load_model": "model.io", "solve_kinematics": "model.kinematics",
          "Study": "study", "run_study": "study", "steady_state": "steady",
          "sweep_speed": "steady", "campbell": "steady", "load_results": "results",
          "open_results": "results", "Results": "results", "SteadyState": "steady",
-         "Model": "model.schema", "contact_analysis": "gears.contact.export"}
+         "Model": "model.schema", "contact_analysis": "gears.contact.export",
+         "save": "results.export"}
 
 
 def __getattr__(name):

@@ -133,6 +133,8 @@ class ModalReport:
     dof_names: tuple[str, ...]
     rotating_frame: bool
     """True if the modes include the carrier-frame Coriolis and centripetal terms."""
+    model: object = field(default=None, repr=False)
+    """The :class:`~torquesplit.model.schema.Model` (a saved file names and holds it)."""
 
     def __repr__(self) -> str:
         f = [r.frequency for r in self.rows]
@@ -185,9 +187,13 @@ class ModalReport:
         """Save :meth:`to_dataset` by suffix (``.nc``, ``.mat``, ``.csv``: a table per mode
         and per DOF), as ``torquesplit modes --out`` does; atomically, an existing file
         kept unless ``overwrite``.  Returns the path written."""
-        from .results.export import save_dataset
+        from .results.export import save_dataset, with_model
 
-        return save_dataset(self.to_dataset(), path, overwrite=overwrite)
+        ds = self.to_dataset()
+        if self.model is not None:  # (an API save named no model: an exports reviewer)
+            ds = with_model(ds, self.model)
+            ds.attrs["model"] = self.model.model.name
+        return save_dataset(ds, path, overwrite=overwrite)
 
     def to_dataset(self):
         """The modes as an xarray Dataset (frequencies, multiplicity, type, group
@@ -440,7 +446,8 @@ def model_modes(model, *, rotating_frame: bool = True, below: float | str | None
         rows = [r for r in rows if r.mode <= count or r.group == last]
     return ModalReport(solution=sol, rows=rows, rigid_modes=int(sol.rigid_modes.shape[1]),
                        dof_names=tuple(st.dof_names),
-                       rotating_frame=bool(st.metadata.get("rotating_frame", False)))
+                       rotating_frame=bool(st.metadata.get("rotating_frame", False)),
+                       model=model)
 
 
 # --------------------------------------------------------------------------- mesh phasing

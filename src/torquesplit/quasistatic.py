@@ -164,7 +164,9 @@ class QuasiStaticResults:
                    "warnings": "\n".join(self.warnings()),
                    "warnings_json": json.dumps(self.warnings()),
                    "load_sharing_definition": "static_torque",
-                   "system_load_sharing": float(met.system),
+                   # (the system's coefficient is the variable load_sharing_system; an
+                   # attribute system_load_sharing beside it said it twice, an exports
+                   # review)
                    "model_json": model_to_json(self.model),
                    "metrics_json": _json.dumps({"per_mesh": met.per_mesh,
                                                 "per_group": met.per_group,

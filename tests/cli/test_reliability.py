@@ -289,8 +289,9 @@ def test_set_errors_name_the_argument_not_the_file(tmp_path):
     assert str(model) not in err
     res = runner.invoke(app, ["run", str(model), "--set", "meshes.zz.damping_ratio=1"])
     one_line_error(res, "error: --set meshes.zz.damping_ratio=1: 'meshes.zz' does not exist")
-    res = runner.invoke(app, ["run", str(model), "--set", "meshes.m.damping=1000 N s/m"])
-    one_line_error(res, f"{model} with --set meshes.m.damping=1000 N s/m: meshes.m: both")
+    res = runner.invoke(app, ["run", str(model), "--set", "gears.wheel.module=4 mm"])
+    one_line_error(res, f"{model} with --set gears.wheel.module=4 mm: meshes.m: gears "
+                        f"'pinion' and 'wheel' cannot mesh: modules 2 mm and 4 mm differ")
     res = runner.invoke(app, ["run", str(model), "--set", "gears.pinion.teeth=" + "9" * 5000])
     one_line_error(res, "integer of more than 4300 digits")
     res = runner.invoke(app, ["run", str(model), "--set", "x=" + "[" * 5000])

@@ -288,6 +288,14 @@ def test_a_study_is_written_for_a_spreadsheet_and_for_matlab(tmp_path, split_fil
     assert mat["units"]["peak_force_a1"].item() == "N"
     assert mat["dimensions"]["peak_force_a1"].item() == (
         "meshes.a1.stiffness x meshes.b1.transmission_error.constant")
+    # torquesplit.save of the returned Dataset writes the same files (its own save
+    # wrote every column with its unit run into the name, 'peak_force.a1_N')
+    import torquesplit
+
+    for suffix in (".csv", ".mat"):
+        assert torquesplit.save(ds, tmp_path / f"again{suffix}") == tmp_path / f"again{suffix}"
+    assert (tmp_path / "again.csv").read_bytes() == (tmp_path / "o" / "results.csv").read_bytes()
+    assert loadmat(tmp_path / "again.mat")["names"]["peak_force_a1"].item() == "peak_force.a1"
     assert str(mat["status"][0, 0]) == "ok"
     attrs = mat["attributes"]
     assert attrs["study_hash"].item() == ds.attrs["study_hash"]

@@ -249,6 +249,34 @@ def _write(ds, plan: files.OutputPlan, claim: files.OutputClaim) -> Path:
     return plan.path
 
 
+def save(result, path, *, overwrite: bool = False) -> Path:
+    """Save any torquesplit result by the suffix of ``path`` (``.nc`` NetCDF, ``.mat``
+    MATLAB, ``.csv`` spreadsheet tables), as the command that computes it writes it:
+    a run's :class:`~torquesplit.results.Results`, a steady state, quasi-static load
+    sharing, modes, a contact analysis (their own ``save``), the Dataset of
+    :func:`~torquesplit.sweep_speed` or :func:`~torquesplit.run_study`, or what
+    :func:`~torquesplit.campbell` returns.  Atomically; an existing file is kept unless
+    ``overwrite``.  Returns the path written.  (``Dataset.to_netcdf`` writes NetCDF
+    whatever the suffix: a '.csv' that no spreadsheet opens.)"""
+    import xarray as xr
+
+    from ..errors import OptionError
+
+    if isinstance(result, tuple) and len(result) == 2 and isinstance(result[0], xr.Dataset):
+        result = result[0]  # campbell's (map, crossings): the map holds the crossings
+    if isinstance(result, xr.Dataset):
+        from ..study.dataset import is_study, save_study
+
+        return (save_study if is_study(result) else save_dataset)(result, path,
+                                                                  overwrite=overwrite)
+    if callable(getattr(result, "save", None)):
+        return result.save(path, overwrite=overwrite)
+    raise OptionError(f"torquesplit.save takes a result of torquesplit (simulate, "
+                      f"steady_state, quasi_static_load_sharing, model_modes, "
+                      f"contact_analysis, sweep_speed, campbell, run_study), not a "
+                      f"{type(result).__name__}")
+
+
 def with_model(ds, model, warnings=()):
     """``ds`` with the model it came from (``model_json``, as a run's file holds it: the
     file can be re-run) and the warnings its command printed."""

@@ -109,6 +109,13 @@ def _message_in_rpm(msg: str, w_ref: float, pts, s1: float, complete: bool) -> s
 
 
 
+def _model_json(model) -> str:
+    """The model as a run's file holds it (``model_json``: a saved map can be re-run)."""
+    from torquesplit.model.io import model_to_json
+
+    return model_to_json(model)
+
+
 def sweep_speed(model, start: float, stop: float, *, points: int = 50,
                 harmonics: int | None = None, samples: int | None = None, keep=None,
                 max_cycles: int | None = MAX_CYCLES, stability: bool = True,
@@ -156,7 +163,10 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
         message.  A continuation that fails keeps the points computed so far
         (``attrs['complete'] == 0`` and the reason in ``attrs['message']``); so does a
         Ctrl-C, whose message starts "interrupted" (one after the continuation waits for
-        the curve's metrics; one in the cross-check leaves the cross-check out).
+        the curve's metrics; one in the cross-check leaves the cross-check out).  The
+        points are along ``point``, not indexed by speed: past a fold the curve passes a
+        speed more than once.  Save it with :func:`torquesplit.save` (``.nc``, ``.mat``,
+        ``.csv`` as ``sweep-speed --out`` writes them; the model in ``model_json``).
     """
     import xarray as xr
 
@@ -295,7 +305,7 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
             crit["crossings"] = campbell(model, w_lo, w_hi)[1]
         critical, suppressed = split_suppressed(crit["crossings"])
         ds.attrs.update(
-            model=model.model.name,
+            model=model.model.name, model_json=_model_json(model),
             method=("shooting" if method == "shooting" else "harmonic balance")
             + ", pseudo-arclength continuation",
             harmonics=0 if method == "shooting" else hb.H,
@@ -848,7 +858,8 @@ def campbell(model, start: float, stop: float, *, points: int = 41,
     an :class:`xarray.Dataset` (dims ``speed``, ``mode``, ``line``; ``attrs``
     ``critical_speeds_rpm`` and ``critical_speed_labels``, and the crossings that the
     planets' mesh phasing suppresses apart) and the list of crossings as dicts (mode,
-    frequency_Hz, order, source, speed_rpm, energy: the strain-energy shares).
+    frequency_Hz, order, source, speed_rpm, energy: the strain-energy shares), which
+    :func:`torquesplit.save` writes by suffix as ``modes --campbell --out`` does.
     """
     import xarray as xr
 
@@ -898,6 +909,7 @@ def campbell(model, start: float, stop: float, *, points: int = 41,
                 "mode": np.arange(1, F.shape[1] + 1),
                 "line": [f"{o} x {lab}" for lab, o, _ in lines]})
     ds.attrs["model"] = model.model.name
+    ds.attrs["model_json"] = _model_json(model)  # (a saved map says what it is of)
     ds.attrs["model_speed_rpm"] = w_ref * RPM  # the drive's speed: the operating point
     label = lambda c: (f"mode {c['mode']} ({c['frequency_Hz']:.5g} Hz) x "  # noqa: E731
                        f"{c['order']} {c['source']}")

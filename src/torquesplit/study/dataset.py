@@ -282,6 +282,44 @@ def write_dataset(ds, path) -> Path:
     return path
 
 
+def is_study(ds) -> bool:
+    """Whether a Dataset is a study's (:func:`build_dataset`): its cases' status and the
+    study's hash."""
+    return "status" in ds and "study_hash" in ds.attrs
+
+
+def save_study(ds, path, *, overwrite: bool = False) -> Path:
+    """Save a study Dataset by suffix as ``torquesplit study`` writes its results
+    (``.nc`` with provenance, ``.csv`` :func:`case_table_bytes` and a sensitivity's
+    ``NAME_sensitivity.csv``, ``.mat`` :func:`case_mat_bytes`); atomically, an existing
+    file kept unless ``overwrite``.  Returns the path written."""
+    from ..results import files
+    from ..results.export import DATASET_FORMATS
+
+    plan = files.check_output(path, formats=DATASET_FORMATS, overwrite=overwrite)
+    contents = {}
+    if plan.format == "netcdf":
+        contents[plan.path] = files.netcdf_bytes(ds.assign_attrs(
+            **files.provenance(_run_id(ds), ds.attrs.get("model_json"))))
+    elif plan.format == "mat":
+        contents[plan.path] = case_mat_bytes(ds)
+    else:
+        if "factor" in ds.dims:
+            indices = plan.path.with_name(f"{plan.path.stem}_sensitivity.csv")
+            if indices.exists() and not overwrite:
+                from ..errors import OutputError
+
+                raise OutputError(f"{indices} exists; use overwrite=True to replace it, or "
+                                  f"choose another file")
+            plan = files.OutputPlan(path=plan.path, format="table",
+                                    files=(plan.path, indices), overwrite=overwrite)
+            contents[indices] = indices_table_bytes(ds)
+        contents[plan.path] = case_table_bytes(ds)  # (last: marks the set)
+    with files.claim_output(plan, _run_id(ds) or None) as claim:
+        claim.write(contents)
+    return plan.path
+
+
 def indices_table_bytes(ds) -> bytes:
     """A sensitivity's indices as a spreadsheet: a row per (output, factor), the output
     by its study-file name with its unit, the factor, its rank for that output (1: the

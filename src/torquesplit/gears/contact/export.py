@@ -135,6 +135,8 @@ class ContactAnalysis:
     """One :class:`~torquesplit.gears.contact.ltca.LtcaResult` per load, in order."""
     harris: object = field(default=None, repr=False)
     """The :class:`~torquesplit.gears.contact.ltca.HarrisMap`, or None."""
+    model: object = field(default=None, repr=False)
+    """The :class:`~torquesplit.model.schema.Model` (a saved file names and holds it)."""
 
     @property
     def loads(self) -> list[float]:
@@ -149,6 +151,18 @@ class ContactAnalysis:
         """The results as ``torquesplit contact --out`` writes them (:func:`contact_dataset`)."""
         return contact_dataset(self.results, operating_load=self.operating_load,
                                harris=self.harris, mesh=self.mesh, gears=self.gears)
+
+    def save(self, path, *, overwrite: bool = False):
+        """Save :meth:`to_dataset` by suffix (``.nc``, ``.mat``, ``.csv``) with its model,
+        as ``torquesplit contact --out`` does; atomically, an existing file kept unless
+        ``overwrite``.  Returns the path written."""
+        from ...results.export import save_dataset, with_model
+
+        ds = self.to_dataset()
+        if self.model is not None:
+            ds = with_model(ds, self.model)
+            ds.attrs["model"] = self.model.model.name
+        return save_dataset(ds, path, overwrite=overwrite)
 
 
 def contact_analysis(model, mesh: str, loads=None, *, positions: int | None = None,
@@ -200,4 +214,4 @@ def contact_analysis(model, mesh: str, loads=None, *, positions: int | None = No
     results = tuple(cm.solve(f).require_converged(f"meshes.{mesh}") for f in forces)
     hm = cm.harris_map(np.linspace(0.1, 1.5, harris) * max(forces)) if harris else None
     return ContactAnalysis(mesh=mesh, gears=tuple(names), operating_load=float(op_load),
-                           results=results, harris=hm)
+                           results=results, harris=hm, model=m)
