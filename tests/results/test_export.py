@@ -68,6 +68,12 @@ def test_mat_and_netcdf_keep_every_variable_and_unit(tmp_path):
     assert attrs["share"] == 1.25 and attrs["complete"] == 1.0
     np.testing.assert_array_equal(attrs["speeds"], [700.5, 800.0])
     assert list(data["mesh"]) == ["a", "b"] and "run_id" in data["provenance"]
+    # a flag as a MATLAB logical (scipy reads it back as uint8), a count as a double
+    flags = ds.assign(stable=("mesh", np.array([True, False])),
+                      count=("mesh", np.array([3, 4], dtype=np.int64)))
+    mat = scipy.io.loadmat(save_dataset(flags, tmp_path / "f.mat"))
+    assert mat["stable"].dtype == np.uint8 and mat["stable"].ravel().tolist() == [1, 0]
+    assert mat["count"].dtype == np.float64
     back = xr.open_dataset(save_dataset(ds, tmp_path / "r.nc"), engine="h5netcdf")
     np.testing.assert_array_equal(back["force"].values, ds["force"].values)
     assert back.attrs["run_id"] and json.loads(back.attrs["labels"]) == ["x", "y"]
