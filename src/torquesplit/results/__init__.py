@@ -919,6 +919,7 @@ class Results:
              for n, i, f in zip(names, s.history_elements, element_frames(self, names))])
         n_hist = s.history_t.size
         cycle_rows = np.arange(s.cycle_start.shape[0])
+        in_table = np.ones((cycle_rows.size, len(cols)), dtype=bool)  # by cycle and mesh
         if self.periodic and self.period:  # one period, as the .nc holds
             from .dataset import period_samples
 
@@ -928,9 +929,19 @@ class Results:
             # them, its metrics are recomputed from them)
             t0, eps = float(s.t_span[0]), 1e-9 * self.period
             start = s.cycle_start[:, cols]
-            inside = ((start >= t0 - eps) & (start < t0 + self.period - eps)).any(axis=1)
+            in_table = (start >= t0 - eps) & (start < t0 + self.period - eps)
+            inside = in_table.any(axis=1)
             cycle_rows = np.flatnonzero(inside) if inside.any() else cycle_rows
+            # a mesh's cells only where its own cycle begins in the period: a row is a
+            # cycle index, which the slower meshes reach later (a period's rows held the
+            # faster mesh's cycles and six repetitions of the slower one's, an exports
+            # reviewer)
+            in_table = in_table if inside.any() else np.ones_like(in_table)
         cycle_stats = self.complete_cycle_statistics()
+        cycle_table = np.column_stack(
+            [s.cycle_start[:, cols], *cycle_stats[:3], cycle_stats[4],
+             np.where(self.complete_cycles, s.cycle_ratio_min[:, cols], np.nan)])
+        cycle_table[~np.tile(in_table, 6)] = np.nan  # (six quantities per mesh, in order)
         contents = {
             groups: files.csv_bytes(group_header, group_rows),
             bearing_file: files.csv_bytes(bearing_header, bearing_rows),
@@ -945,11 +956,9 @@ class Results:
                 ["cycle"] + [f"{m}_{q}" for q in ("start_s", "peak_N", "min_N", "mean_N",
                                                   "ratio_max", "ratio_min")
                              for m in self.mesh_names] + settled_header,
-                [[k] + row + [int(c[k]) for c in settled_columns]
-                 for k, row in zip(cycle_rows.tolist(), np.column_stack(
-                     [s.cycle_start[:, cols], *cycle_stats[:3], cycle_stats[4],
-                      np.where(self.complete_cycles, s.cycle_ratio_min[:, cols], np.nan)]
-                 )[cycle_rows].tolist())]),
+                [[k] + row + [int(c[k]) if in_table[k, m] else ""
+                              for m, c in enumerate(settled_columns)]
+                 for k, row in zip(cycle_rows.tolist(), cycle_table[cycle_rows].tolist())]),
         }
         with files.claim_output(plan) as claim:
             steady_info = _steady_summary(self._steady_attributes(steady_summary))
