@@ -142,6 +142,8 @@ def test_mat_and_csv_exports(split, tmp_path):
         assert max(settled) == r.peak_force
         k = int(ds["first_settled_cycle"].sel(mesh=r.mesh))
         assert float(ds["cycle_max_force"].sel(mesh=r.mesh)[k:].max()) == r.peak_force
+    # whether the rule found it settled, as a variable (a study's file has one)
+    assert int(ds["settled"]) == int(met.settling.settled)
     # the groups' and the system's rows, as the run's tables print them
     # the same columns whatever the definition, which a column names
     assert rows[0]["load_sharing_definition"] == met.definition

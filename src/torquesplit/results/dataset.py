@@ -207,6 +207,11 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
             "first cycle of the settled span, a value of the cycle coordinate (counted "
             "from 0): peak_force, min_force and the coefficients are over the cycles from "
             "this one on")
+        # whether the settle rule found the response settled (in metrics_json only: a
+        # study's file has it as a variable, an exports reviewer)
+        ds["settled"] = _var((), np.int8(met.settling.settled), "1",
+                             "1: every mesh settled by the settle rule; 0: some mesh never "
+                             "did, and its metrics are over the last half of the run")
         # each load-sharing group's and the system's numbers as variables too (for
         # xarray, MATLAB and spreadsheet users: not only inside metrics_json)
         groups = list(met.load_sharing.per_group)
