@@ -59,12 +59,50 @@ def usage_error_lines(exc) -> list[str]:
     return lines
 
 
+def _stop_as_interrupt(signum, frame) -> None:
+    """SIGTERM (a batch system's time limit, ``kill``, ``docker stop``) and SIGHUP (a
+    closed terminal or ssh session) stop the command as Ctrl-C does: what it computed is
+    kept, its files finished (a run's SIGTERM left no file and a lock behind, a
+    reliability reviewer).  The SIGINT handler in force is called, so that a block that
+    holds Ctrl-C (:func:`torquesplit.errors.held_interrupt`) holds these too."""
+    import signal
+
+    from torquesplit.errors import STOP_SIGNAL
+
+    STOP_SIGNAL[0] = signum
+    handler = signal.getsignal(signal.SIGINT)
+    if callable(handler):
+        handler(signal.SIGINT, frame)
+    elif handler != signal.SIG_IGN:
+        raise KeyboardInterrupt
+
+
+def _handle_stop_signals() -> None:
+    """Install :func:`_stop_as_interrupt` for SIGTERM and SIGHUP where Python's defaults
+    are (not where the caller chose to ignore them: ``nohup`` ignores SIGHUP)."""
+    import signal
+
+    for name in ("SIGTERM", "SIGHUP"):
+        sig = getattr(signal, name, None)  # (no SIGHUP on Windows)
+        if sig is not None and signal.getsignal(sig) == signal.SIG_DFL:
+            signal.signal(sig, _stop_as_interrupt)
+
+
+def _exit_code(code: int) -> int:
+    """An interrupted command's 130 as the shell's code of the signal that came
+    (128 + its number: 143 for SIGTERM, 129 for SIGHUP)."""
+    from torquesplit.errors import STOP_SIGNAL
+
+    return 128 + STOP_SIGNAL[0] if code == 130 and STOP_SIGNAL[0] else code
+
+
 def main() -> None:
+    _handle_stop_signals()
     try:
         from torquesplit.cli import app
     except KeyboardInterrupt:
         sys.stderr.write("interrupted; nothing written\n")
-        raise SystemExit(130) from None
+        raise SystemExit(_exit_code(130)) from None
     usage = _exception_classes("UsageError")
     no_args = _exception_classes("NoArgsIsHelpError")
     abort = _exception_classes("Abort")
@@ -90,5 +128,8 @@ def main() -> None:
         raise SystemExit(2) from None
     except abort:
         sys.stderr.write("interrupted\n")
-        raise SystemExit(130) from None
-    raise SystemExit(code if isinstance(code, int) else 0)
+        raise SystemExit(_exit_code(130)) from None
+    except SystemExit as exc:  # (typer.Exit(130) of a command stopped by a signal)
+        raise SystemExit(_exit_code(exc.code) if isinstance(exc.code, int) else
+                         exc.code) from None
+    raise SystemExit(_exit_code(code) if isinstance(code, int) else 0)

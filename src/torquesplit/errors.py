@@ -400,6 +400,19 @@ class HeldInterrupt:
     hit: bool = False
 
 
+#: the terminating signal that stopped the command as Ctrl-C does (SIGTERM, SIGHUP:
+#: ``torquesplit._launch``), 0 for none
+STOP_SIGNAL = [0]
+
+
+def interrupt_name() -> str:
+    """What interrupted the computation, for its messages: 'Ctrl-C', or the signal that
+    stopped the command ('SIGTERM', 'SIGHUP')."""
+    import signal
+
+    return signal.Signals(STOP_SIGNAL[0]).name if STOP_SIGNAL[0] else "Ctrl-C"
+
+
 @contextlib.contextmanager
 def held_interrupt() -> Iterator[HeldInterrupt]:
     """Within this block a Ctrl-C waits: the block runs to its end and the object yielded

@@ -502,3 +502,71 @@ def test_an_interrupted_sweep_with_a_cross_check_keeps_its_curve(monkeypatch):
     text = " ".join(res.output.split())
     assert "interrupted (Ctrl-C) in the run-up and run-down cross-check" in text
     assert "largest dynamic factor" in text and "run-up DF" not in text
+
+
+def test_sigterm_and_sighup_are_ctrl_c_with_their_own_exit_code():
+    """The handler: the SIGINT handler in force is called (a block that holds Ctrl-C
+    holds these too), the messages name the signal, the exit code is the shell's."""
+    import os
+    import signal
+
+    from torquesplit import _launch
+    from torquesplit.errors import STOP_SIGNAL, held_interrupt, interrupt_name
+
+    before = {s: signal.getsignal(s) for s in (signal.SIGTERM, signal.SIGHUP)}
+    try:
+        for s in before:
+            signal.signal(s, signal.SIG_DFL)
+        _launch._handle_stop_signals()
+        assert interrupt_name() == "Ctrl-C" and _launch._exit_code(130) == 130
+        with pytest.raises(KeyboardInterrupt):
+            os.kill(os.getpid(), signal.SIGHUP)
+        assert interrupt_name() == "SIGHUP" and _launch._exit_code(130) == 129
+        assert _launch._exit_code(1) == 1
+        with held_interrupt() as held:  # held, as a Ctrl-C is
+            os.kill(os.getpid(), signal.SIGTERM)
+        assert held.hit and _launch._exit_code(130) == 143
+        signal.signal(signal.SIGHUP, signal.SIG_IGN)  # (nohup's choice is left alone)
+        _launch._handle_stop_signals()
+        assert signal.getsignal(signal.SIGHUP) == signal.SIG_IGN
+    finally:
+        STOP_SIGNAL[0] = 0  # (this process's later tests: no signal came)
+        for s, h in before.items():
+            signal.signal(s, h)
+
+
+def test_sigterm_stops_a_run_as_ctrl_c_does(tmp_path):
+    """A batch system's time limit (SIGTERM) or a closed ssh session (SIGHUP) killed a
+    run with nothing written and its output's lock left behind (a reliability
+    reviewer): they now stop it as Ctrl-C does, its partial results kept, with the
+    shell's code of the signal."""
+    import signal
+    import subprocess
+    import sys
+
+    import xarray as xr
+
+    out = tmp_path / "h.nc"
+    command = [sys.executable, "-m", "torquesplit", "run", "ji_li_mill_drive"]
+    # (the kernels compiled or loaded first: the signal is to land in the integration)
+    subprocess.run(command + ["--duration", "0.01", "--quiet"], capture_output=True,
+                   check=True, cwd=tmp_path)
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "torquesplit", "run", "ji_li_mill_drive", "--set",
+         "analysis.duration=300", "--out", str(out)], stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE, text=True, cwd=tmp_path)
+    err = []
+    for line in proc.stderr:  # the run's size, said just before it integrates
+        err.append(line)
+        if "this run takes" in line:
+            break
+    import time
+
+    time.sleep(5.0)  # (the run integrates about 25 s; set-up after that line: ~1 s)
+    proc.send_signal(signal.SIGTERM)
+    stdout, rest = proc.communicate(timeout=120)
+    assert proc.returncode == 143, "".join(err) + rest + stdout
+    assert "Interrupted (SIGTERM) at t =" in stdout, "".join(err) + rest + stdout
+    assert not list(tmp_path.glob(".*.lock"))
+    with xr.open_dataset(out, engine="h5netcdf") as ds:
+        assert ds.attrs["message"].startswith("Interrupted (SIGTERM)")

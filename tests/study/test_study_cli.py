@@ -199,6 +199,18 @@ def test_summary_names_the_case_of_each_failure_units_and_an_empty_resume(tmp_pa
         first = float(ds[var].values[0])
     assert f"{first * 1e-3:.6g}" in res.stdout and f"{first:.6g}" not in res.stdout
     assert "2 outputs" in res.stderr
+    # a study none of whose cases gave results fails (it exited 0, a reliability
+    # reviewer); its files are written all the same, and --json says so too
+    data["grid"]["parameters"][0]["values"] = ["100 N m", "120 N m"]
+    data["analysis"].update(method="dopri", rtol=0.9)  # (steps past the stable one)
+    path.write_text(tomli_w.dumps(data))
+    for extra in ([], ["--json"]):
+        res = runner.invoke(app, ["study", str(path), "--out", str(tmp_path / f"all{extra}"),
+                                  "--workers", "1", "--no-figures", "--quiet", *extra])
+        assert res.exit_code == 1, res.output
+        assert "error: no case gave results (2 diverged)" in res.stderr
+        assert (tmp_path / f"all{extra}" / "results.nc").is_file()
+    assert json.loads(res.stdout)["success"] is False
 
 
 def test_a_sweeps_remedy_is_in_its_options(tmp_path):

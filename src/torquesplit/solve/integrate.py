@@ -33,7 +33,7 @@ import numpy as np
 from torquesplit._memo import remember_last
 from torquesplit.assembly.structure import Structure
 from torquesplit.errors import (ModelWarning, OptionError, OptionTypeError, SolverError,
-                                from_interrupt, warn_user)
+                                from_interrupt, interrupt_name, warn_user)
 from torquesplit.solve import _kernels as kern
 from torquesplit.solve import codegen
 from torquesplit.solve import kernel_data as kd
@@ -1329,8 +1329,8 @@ def _message(status, s, y, t_final, t_end, counters, clock, blowup, limit_steps,
         return (f"Integration diverged at t = {t_final:.6g} s (step {n_steps}): {why}. "
                 f"Everything recorded before that time is valid. {fix}")
     if status == INTERRUPTED:
-        return (f"Interrupted (Ctrl-C) at t = {t_final:.6g} s (step {n_steps}) of "
-                f"t_end = {t_end:.6g} s. Everything recorded before that time is valid.")
+        return (f"Interrupted ({interrupt_name()}) at t = {t_final:.6g} s (step {n_steps}) "
+                f"of t_end = {t_end:.6g} s. Everything recorded before that time is valid.")
     if status == kern.STEP_UNDERFLOW:
         return (f"Required step size {clock[kern.F_H]:.3g} s fell below the minimum at "
                 f"t = {t_final:.6g} s (step {n_steps}); the response is too stiff or "

@@ -14,7 +14,7 @@ from typing import Optional
 import typer
 from torquesplit._table import Table
 from torquesplit.cli_support import MESH_UNITS, OptionErrors, json_option
-from torquesplit.errors import OptionError
+from torquesplit.errors import OptionError, interrupt_name
 
 RPM = 60.0 / (2 * math.pi)
 
@@ -519,8 +519,8 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
                 raise
             interrupted = True
             err_console.print("[yellow]warning:[/] the check of the peaks' digits was "
-                              "interrupted (Ctrl-C): the largest dynamic factors are "
-                              "printed unchecked")
+                              f"interrupted ({interrupt_name()}): the largest dynamic "
+                              "factors are printed unchecked")
         summary = {
             "model": ds.attrs["model"], "points": int(ds.sizes["point"]),
             "complete": bool(ds.attrs["complete"]), "message": ds.attrs["message"],

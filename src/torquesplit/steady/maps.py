@@ -19,6 +19,7 @@ from torquesplit.errors import (
     SolverError,
     from_interrupt,
     held_interrupt,
+    interrupt_name,
     warn_user,
 )
 from torquesplit.solve.modal import DEGENERATE_RTOL
@@ -352,8 +353,8 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
             rest = str(ds.attrs["message"])
             rest = rest[len("complete"):].lstrip("; ") if rest.startswith("complete") else rest
             ds.attrs["message"] = (
-                f"interrupted (Ctrl-C) once the curve's {len(pts)} points were computed; "
-                f"the curve is kept{' (the cross-check not run)' if cross_check else ''}"
+                f"interrupted ({interrupt_name()}) once the curve's {len(pts)} points were "
+                f"computed; the curve is kept{' (the cross-check not run)' if cross_check else ''}"
                 + (f"; {rest}" if rest else ""))
         return ds
     if cross_check:
@@ -366,9 +367,9 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
         except (KeyboardInterrupt, SystemError) as exc:
             if not from_interrupt(exc):
                 raise
-            ds.attrs["message"] = ("interrupted (Ctrl-C) in the run-up and run-down "
-                                   "cross-check, which is left out; the curve is kept: "
-                                   + ds.attrs["message"])
+            ds.attrs["message"] = (f"interrupted ({interrupt_name()}) in the run-up and "
+                                   "run-down cross-check, which is left out; the curve is "
+                                   "kept: " + ds.attrs["message"])
             return ds
         ds = ds.assign_coords(check_speed_rpm=("check", grid * w_ref * RPM))
         at_grid = np.array([static_f(g) for g in grid])

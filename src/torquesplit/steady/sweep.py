@@ -26,7 +26,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from torquesplit.errors import ModelWarning, OptionError, SolverError, warn_user
+from torquesplit.errors import (
+    ModelWarning,
+    OptionError,
+    SolverError,
+    interrupt_name,
+    warn_user,
+)
 from torquesplit.steady.harmonic import HarmonicBalance
 from torquesplit.steady.newton import floquet_hill, floquet_monodromy
 from torquesplit.steady.solution import (
@@ -358,8 +364,8 @@ class Continuation:
                 # compiled gave an empty curve whose checks then called a half-built
                 # kernel: numba's RuntimeError)
                 raise
-            message = (f"interrupted (Ctrl-C) after {len(pts)} points; the curve up to "
-                       f"there is kept.")
+            message = (f"interrupted ({interrupt_name()}) after {len(pts)} points; the curve "
+                       f"up to there is kept.")
             complete = False
         return pts, merge_folds(folds, FOLD_RESOLUTION * abs(s1 - s0)), message, complete
 

@@ -446,6 +446,9 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
     n_warned = (int((ds["warning_count"].values.ravel() > 0).sum())
                 if "warning_count" in ds else 0)
     counts = {s: int((status == s).sum()) for s in sorted(set(status.tolist()))}
+    # a study none of whose cases gave outputs failed (it exited 0, a reliability
+    # reviewer: a script took 'cases: 4 diverged' for success)
+    failed = status.size > 0 and not any(counts.get(s) for s in ("ok", "contact_lost"))
     out_vars = [v for v in ds.data_vars if "output" in ds[v].attrs]
     # (each figure's PNG and SVG: --json listed the PNGs only, a reviewer)
     figs = sorted(str(p) for x in ("*.png", "*.svg")
@@ -453,7 +456,8 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
     if as_json:
         coords = [c for c in ds.coords if c not in ("output", "factor")
                   and ds[c].dtype.kind == "f"]
-        data = {"study": ds.attrs["study_name"], "design": ds.attrs["design"],
+        data = {"success": not failed,
+                "study": ds.attrs["study_name"], "design": ds.attrs["design"],
                 "cases": int(status.size), "status": counts,
                 "results_file": str(out / "results.nc"),
                 "results_files": [str(out / f"results.{x}") for x in ("nc", "csv", "mat")],
@@ -495,6 +499,7 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
             data["sensitivity_warnings"] = json.loads(ds.attrs.get("sensitivity_warnings",
                                                                     "[]"))
         print(_json.dumps(data, indent=2))
+        _fail_if_no_results(failed, counts)
         return
     from torquesplit._table import Table
 
@@ -590,6 +595,20 @@ def _summary(ds, out: Path, as_json: bool, figures: bool) -> None:
                      f"{out / 'study.sqlite'}"
                      + (f"; {_count(sum(f.endswith('.png') for f in figs), 'figure')} in "
                         f"{out / 'figures'} (PNG and SVG)" if figs else ""))
+    _fail_if_no_results(failed, counts)
+
+
+def _fail_if_no_results(failed: bool, counts: dict) -> None:
+    """Exit 1, as a failed run does, where no case gave outputs (the reasons are
+    printed above; what was computed stays in the store and the results files)."""
+    if failed:
+        ui = _ui()
+        ui.err_console.print(
+            "[red]error:[/] no case gave results ("
+            + ", ".join(f"{n} {s}" for s, n in counts.items())
+            + "): see the reasons above; fix the cause and run the study again",
+            highlight=False)
+        raise typer.Exit(1)
 
 
 def _cases_with_values(ds, cases: list[int]) -> str:
