@@ -861,8 +861,10 @@ def optimize(source, *, workers: int | None = None, generations: int | None = No
         from .study.runners import make_runner
 
         external = make_runner(client=client, scheduler=scheduler, runner=runner)
-    from .study.runners import worker_start
+    from .study.runners import start_helpers, worker_start
 
+    if spec.workers > 1 and external is None:
+        start_helpers()
     pool = (ProcessPoolExecutor(max_workers=spec.workers, initializer=worker_start)
             if spec.workers > 1 and external is None else None)
 

@@ -223,7 +223,11 @@ def _run(source, *, workers, scheduler, out, resume, overwrite, figures, quiet, 
                      if exc.done >= exc.total else "")
         again = ("the same command with --resume in place of --overwrite" if overwrite
                  else "the same command with --resume")
-        why = " (SIGTERM)" if terminated else ""
+        from ..errors import interrupt_name
+
+        # (a SIGHUP stops it as Ctrl-C does, and exits 129: torquesplit._launch)
+        cause = "SIGTERM" if terminated else interrupt_name()
+        why = f" ({cause})" if cause != "Ctrl-C" else ""
         ui.err_console.print(f"[yellow]stopped{why}:[/] ", end="")
         ui.err_console.print(f"{exc.done} of {exc.total} cases done and saved in {out}"
                              f"{unwritten}; to finish, run {again}",

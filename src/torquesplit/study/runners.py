@@ -46,7 +46,7 @@ class SerialRunner:
 
 
 def worker_start() -> None:  # pragma: no cover - runs in the worker processes
-    """A worker's set-up: Ctrl-C ignored (it goes to the whole process group: the driver
+    """A worker's set-up: Ctrl-C and SIGHUP ignored (they go to the whole process group: the driver
     stops the workers itself), the heap frozen after the first case
     (:data:`.case.FREEZE_HEAP`), and an exit as soon as the driver is gone.  A driver
     killed outright (SIGKILL, the out-of-memory killer) cannot stop its pool, whose
@@ -59,6 +59,8 @@ def worker_start() -> None:  # pragma: no cover - runs in the worker processes
     from . import case
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if hasattr(signal, "SIGHUP"):  # (a closed session's SIGHUP reaches the whole group:
+        signal.signal(signal.SIGHUP, signal.SIG_IGN)  # the driver stops, and so stops them)
     case.FREEZE_HEAP = True
     parent = multiprocessing.parent_process()
     if parent is None:
@@ -69,6 +71,26 @@ def worker_start() -> None:  # pragma: no cover - runs in the worker processes
         os._exit(1)
 
     threading.Thread(target=watch, name="torquesplit-driver-watch", daemon=True).start()
+
+
+def start_helpers() -> None:
+    """Start multiprocessing's resource tracker (a helper process of every pool) with
+    SIGHUP ignored, as the workers ignore it: a closed session's SIGHUP reaches the whole
+    process group, and a tracker it killed left four tracebacks of leaked semaphores
+    under the study's 'stopped' line.  An ignored signal stays ignored across the
+    tracker's exec.  Main thread only (elsewhere the tracker starts as it would)."""
+    import threading
+    from multiprocessing import resource_tracker
+
+    hup = getattr(signal, "SIGHUP", None)
+    if hup is None or threading.current_thread() is not threading.main_thread():
+        resource_tracker.ensure_running()
+        return
+    before = signal.signal(hup, signal.SIG_IGN)
+    try:
+        resource_tracker.ensure_running()
+    finally:
+        signal.signal(hup, before)
 
 
 class LocalPool:
@@ -93,6 +115,7 @@ class LocalPool:
         from concurrent.futures import ProcessPoolExecutor
 
         ctx = multiprocessing.get_context(self.start_method)
+        start_helpers()
         pool = ProcessPoolExecutor(self.workers, mp_context=ctx, initializer=worker_start)
         items = iter(payloads)
         pending: set = set()
