@@ -510,6 +510,9 @@ def run(
             opts(_check_plots_folder, plots)
             plan = opts(_check_out, out, force)
             opts.raise_any(model, assign)
+            # results of an earlier run that --force would replace: a run that does not
+            # finish leaves them and puts its partial results beside them
+            earlier = plan is not None and any(f.exists() for f in plan.files)
             if plan is not None:
                 stack.enter_context(files.claim_output(plan))
             m, path = _load(model, assign)
@@ -543,7 +546,9 @@ def run(
                     for text in _near_critical(res):  # (in the files' warnings too)
                         res.run_warnings.append(text)
                         ux.warn(text)
-                if out is not None:
+                if out is not None and earlier and not res.success:
+                    state["saved"], save_failed = _save_partial_beside(res, plan, chosen)
+                elif out is not None:
                     try:
                         res.save(out, overwrite=force, definition=chosen)
                         state["saved"] = list(plan.files)
@@ -582,6 +587,24 @@ def run(
     else:
         _print_run(m, res, met, saved, [], step_check, None, as_json)
         _fail(failed)
+
+
+def _save_partial_beside(res, plan, definition) -> tuple[list[Path], Exception | None]:
+    """A run that did not finish (interrupted, diverged) where ``--force`` would replace
+    an earlier run's results: those are kept, and this run's partial results go to
+    ``NAME.partial.SUFFIX`` beside them, said in a warning (--force replaced a complete
+    file with a partial one, which 'report' then refused: a reliability reviewer).
+    Returns the files written and the error of a save that failed."""
+    from .results import files
+
+    partial = plan.path.with_name(f"{plan.path.stem}.partial{plan.path.suffix}")
+    try:
+        res.save(partial, overwrite=True, definition=definition)
+    except _EXPECTED as exc:
+        return [], exc
+    ux.warn(f"the run did not finish: {plan.path} (an earlier run's results, which --force "
+            f"would have replaced) is kept; this run's partial results are in {partial}")
+    return list(files.check_output(partial, overwrite=True).files), None
 
 
 def _rescued(save, out, exc) -> tuple[list[Path], Exception]:

@@ -123,6 +123,17 @@ def test_the_run_command_saves_what_it_computed_when_interrupted(tmp_path, monke
                                    "--out", str(out)])
     assert res.exit_code == 130, res.output
     assert "Interrupted (Ctrl-C)" in res.stdout and out.exists()
+    # --force over an earlier run's results: those are kept, the partial ones go beside
+    # them (a reliability reviewer's complete file was replaced by a partial one)
+    before = out.read_bytes()
+    res = CliRunner().invoke(app, ["run", "ji_li_mill_drive", "--duration", "0.2",
+                                   "--out", str(out), "--force"])
+    assert res.exit_code == 130, res.output
+    assert out.read_bytes() == before
+    assert f"this run's partial results are in {tmp_path / 'r.partial.nc'}" in " ".join(
+        res.stderr.split())
+    assert f"are in {tmp_path / 'r.partial.nc'}" in " ".join(res.stdout.split())
+    assert (tmp_path / "r.partial.nc").is_file()
 
 
 def test_an_interrupted_static_sweep_keeps_the_positions_done(tmp_path, monkeypatch):
