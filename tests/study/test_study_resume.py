@@ -585,3 +585,46 @@ def test_overwrite_removes_the_studys_own_figures_only(tmp_path, split_file):
     Study(path).run(workers=1, out=out, overwrite=True, figures=False)
     left = sorted(p.name for p in (out / "figures").iterdir())
     assert left == ["my_plot.png"]
+
+
+def test_a_broken_or_full_store_is_one_line_that_says_what_is_kept(tmp_path, split_file,
+                                                                   monkeypatch):
+    """A store that is not SQLite, or that cannot be written (a full disk), ended the
+    study in sqlite's traceback (a reliability reviewer); the cases committed before a
+    failed write are kept, and --resume finishes the study."""
+    path = _write(tmp_path, grid_study(split_file, GRID))
+    (tmp_path / "bad").mkdir()
+    (tmp_path / "bad" / "study.sqlite").write_text("garbage")
+    res = CliRunner().invoke(app, ["study", str(path), "--out", str(tmp_path / "bad"),
+                                   "--resume", "--workers", "1", "--quiet"])
+    assert res.exit_code == 2, res.output
+    assert "study.sqlite is not a readable study store (file is not a database): move it " \
+           "aside" in " ".join(res.stderr.split())
+    assert "Traceback" not in res.output
+
+    from torquesplit.study import store as store_module
+
+    real_put = store_module.Store.put
+    calls = []
+
+    def put(self, r):
+        calls.append(r["index"])
+        if len(calls) == 4:  # the fourth commit meets a full disk
+            with self._writing():
+                raise sqlite3.OperationalError("disk I/O error")
+        real_put(self, r)
+
+    monkeypatch.setattr(store_module.Store, "put", put)
+    out = tmp_path / "full"
+    res = CliRunner().invoke(app, ["study", str(path), "--out", str(out), "--workers", "1",
+                                   "--quiet"])
+    assert res.exit_code == 2, res.output
+    said = " ".join(res.stderr.split())
+    assert (f"error: cannot write the study store {out / 'study.sqlite'} (disk I/O error); "
+            f"the cases finished before are kept in it") in said and "--resume" in said
+    assert "Traceback" not in res.output and _count(out / "study.sqlite") == 3
+    monkeypatch.setattr(store_module.Store, "put", real_put)
+    res = CliRunner().invoke(app, ["study", str(path), "--out", str(out), "--workers", "1",
+                                   "--resume", "--quiet", "--json", "--no-figures"])
+    assert res.exit_code == 0, res.output
+    assert _count(out / "study.sqlite") == 10

@@ -28,7 +28,7 @@ from typing import Callable
 
 import numpy as np
 
-from ..errors import warn_user
+from ..errors import OutputError, warn_user
 from .case import payload, run_case
 from .design import Plan, resolve
 from .errors import StudyError, StudyInterrupted
@@ -648,6 +648,9 @@ class _Driver:
             state = "cases done"  # Study.run marks it finished once the outputs are written
         except KeyboardInterrupt:
             raise StudyInterrupted(int(self.finished.sum()), self._target(), self.out) from None
+        except OutputError:  # the store cannot be written: its message says what to do
+            state = "failed"
+            raise
         except (OSError, RuntimeError) as exc:  # a worker process died, a cluster went away
             state = "failed"
             again = (f"run it again with {self.words.resume_on}" if self.out else

@@ -82,25 +82,60 @@ class StoreLock:
             self.file.close()
 
 
+class _StoreWrite:
+    """Context of a write to the store: sqlite's error as an
+    :class:`~torquesplit.errors.OutputError` naming the file, what is kept (every case
+    committed before) and how to go on (free space, --resume)."""
+
+    def __init__(self, path):
+        self.path = path
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, kind, exc, tb):
+        if exc is None or not isinstance(exc, sqlite3.Error):
+            return False
+        from ..errors import OutputError
+
+        raise OutputError(f"cannot write the study store {self.path} ({exc}); the cases "
+                          f"finished before are kept in it: free disk space (or mend the "
+                          f"folder), then run the same command with --resume "
+                          f"(resume=True in Python)") from None
+
+
 class Store:
     """An open study store (``path`` ``":memory:"`` for a study without an output folder)."""
 
     def __init__(self, path):
         self.path = path if path == ":memory:" else Path(path)
-        self.db = sqlite3.connect(str(path), isolation_level=None, timeout=30.0)
-        if path != ":memory:":
-            self.db.execute("PRAGMA journal_mode=WAL")
-        self.db.execute("PRAGMA synchronous=NORMAL")
-        self.db.executescript(SCHEMA)
         self.run_id: int | None = None
         self.lock: StoreLock | None = None
+        try:
+            self.db = sqlite3.connect(str(path), isolation_level=None, timeout=30.0)
+            if path != ":memory:":
+                self.db.execute("PRAGMA journal_mode=WAL")
+            self.db.execute("PRAGMA synchronous=NORMAL")
+            self.db.executescript(SCHEMA)
+        except sqlite3.DatabaseError as exc:  # (a traceback, a reliability reviewer)
+            from ..errors import OutputError
+
+            raise OutputError(f"{path} is not a readable study store ({exc}): move it "
+                              f"aside (its finished cases cannot be read back), or start "
+                              f"the study again with --overwrite (overwrite=True in "
+                              f"Python)") from None
+
+    def _writing(self):
+        """A write that fails (a full disk, a folder gone) as one message that says what
+        is kept and how to go on, not sqlite's traceback."""
+        return _StoreWrite(self.path)
 
     # ------------------------------------------------------------------ meta
     def is_new(self) -> bool:
         return self.db.execute("SELECT COUNT(*) FROM meta").fetchone()[0] == 0
 
     def write_meta(self, meta: dict) -> None:
-        with self.db:
+        with self._writing(), self.db:
             self.db.execute("BEGIN")
             self.db.executemany("INSERT OR REPLACE INTO meta VALUES (?, ?)",
                                 [(k, json.dumps(v)) for k, v in meta.items()])
@@ -110,15 +145,22 @@ class Store:
 
     # ------------------------------------------------------------------ runs
     def start_run(self, runner: str, workers: int) -> int:
-        cur = self.db.execute("INSERT INTO runs (started, state, runner, workers) "
-                              "VALUES (?, 'running', ?, ?)", (time.time(), runner, workers))
+        with self._writing():
+            cur = self.db.execute("INSERT INTO runs (started, state, runner, workers) "
+                                  "VALUES (?, 'running', ?, ?)",
+                                  (time.time(), runner, workers))
         self.run_id = int(cur.lastrowid)
         return self.run_id
 
     def end_run(self, state: str) -> None:
+        """Record how the run ended; best effort (it runs where the study stops, also
+        after a write that failed: its error is the one to report)."""
         if self.run_id is not None:
-            self.db.execute("UPDATE runs SET finished = ?, state = ? WHERE run = ?",
-                            (time.time(), state, self.run_id))
+            try:
+                self.db.execute("UPDATE runs SET finished = ?, state = ? WHERE run = ?",
+                                (time.time(), state, self.run_id))
+            except sqlite3.Error:
+                pass
 
     def runs(self) -> list[dict]:
         cols = ("run", "started", "finished", "state", "runner", "workers", "computed")
@@ -128,7 +170,7 @@ class Store:
     # ------------------------------------------------------------------ cases
     def put(self, r: dict) -> None:
         """Commit one finished case (one transaction)."""
-        with self.db:
+        with self._writing(), self.db:
             self.db.execute("BEGIN")
             self.db.execute(
                 # (replaces a case that ended in an error, run again on resume)
