@@ -59,6 +59,14 @@ def test_interrupted_optimisation_resumes_from_its_store(tmp_path):
     resumed = optimize(read_spec(d))
     assert resumed.computed == 0
     np.testing.assert_array_equal(first.F, resumed.F)
+    # a line cut by a kill or a full disk is dropped, not glued to the next record (which
+    # was then lost as well: a reliability reviewer)
+    lines = store.read_text().splitlines()
+    store.write_text("\n".join(lines[:-1]) + "\n" + lines[-1][:20])
+    again = optimize(read_spec(d))
+    assert again.computed == 1 and store.read_text().endswith("\n")
+    assert len(store.read_text().splitlines()) == len(lines)
+    assert optimize(read_spec(d)).computed == 0
 
 
 def test_a_store_of_another_model_is_not_reused(tmp_path):
@@ -439,3 +447,13 @@ def test_a_diverged_design_is_a_failed_evaluation_not_ranked(monkeypatch, tmp_pa
     rec = _evaluate_job(read_spec(_eccentricity_spec(tmp_path)), (1e-3,))
     assert rec["outputs"] is None
     assert rec["error"] == "the dynamic run diverged: the state left every bound at t = 0.1 s"
+
+
+def test_a_model_file_given_for_an_optimisation_is_told_so():
+    """'optimize MODEL.toml' said 'analysis: unknown section' (a reliability reviewer);
+    'study' already told a model file from a study."""
+    import torquesplit
+
+    with pytest.raises(ModelError, match=r"is a model file \(a gearbox, no \[optimization\]\), "
+                                         r"not an optimisation; run it with 'torquesplit run"):
+        read_spec(torquesplit.example_path("ji_li_mill_drive"))

@@ -279,6 +279,15 @@ def read_spec(source) -> OptimizationSpec:
                              str(path)) from None
         base, name = path.resolve().parent, str(path)
     known = {"optimization", "set", "variables", "objectives", "constraints"}
+    from .model.io import MODEL_SECTIONS
+
+    if "optimization" not in data and any(k in data for k in MODEL_SECTIONS):
+        # (it said 'analysis: unknown section', a reliability reviewer; 'study' says this)
+        raise ModelError([("", "is a model file (a gearbox, no [optimization]), not an "
+                               "optimisation; run it with 'torquesplit run FILE', or write an "
+                               "optimisation file whose [optimization] names it: model = "
+                               "'FILE' (see docs/optimization.md; 'torquesplit example "
+                               "liu2021_dh_modification' copies one)")], name)
     extra = sorted(set(data) - known)
     if extra:
         raise ModelError([(extra[0], f"unknown section; use {', '.join(sorted(known))}")], name)
@@ -680,7 +689,13 @@ class _Store:
         self.other = 0
         """Stored evaluations of another model or outputs, not reused."""
         if path is not None and path.exists():
-            for line in path.read_text().splitlines():
+            text = path.read_text()
+            if text and not text.endswith("\n"):  # a line cut by a kill or a full disk:
+                # cut off, or the next record is appended to it and lost too (a
+                # reliability reviewer)
+                with path.open("r+") as fh:
+                    fh.truncate(len(text[: text.rfind("\n") + 1].encode()))
+            for line in text.splitlines():
                 try:
                     rec = json.loads(line)
                     if rec.get("fingerprint", "") != fingerprint:
