@@ -415,8 +415,18 @@ def test_a_sweep_interrupted_part_way_exits_130_after_keeping_its_curve(tmp_path
     res = CliRunner().invoke(app, SWEEP)
     assert res.exit_code == 130, res.output
     assert "interrupted (Ctrl-C) after 3 points" in " ".join(res.output.split())
-    assert res.stderr.strip().splitlines()[-1] == (
-        "interrupted; the curve computed is printed above; nothing written")
+    # (it said 'the curve computed is printed above', where only its maxima are)
+    assert " ".join(res.stderr.split()).endswith(
+        "interrupted; nothing written: the curve's 3 points are kept only by --out (their "
+        "largest dynamic factors are printed above; --json prints every point)")
+    _interrupt_sweep_at_point(monkeypatch, 4)
+    res = CliRunner().invoke(app, SWEEP + ["--json"])
+    assert res.exit_code == 130, res.output
+    import json
+
+    curve = json.loads(res.stdout)["curve"]
+    assert len(curve["speed_rpm"]) == 3 and all(len(v) == 3
+                                                for v in curve["dynamic_factor"].values())
     _interrupt_sweep_at_point(monkeypatch, 4)
     out = tmp_path / "curve.csv"
     res = CliRunner().invoke(app, SWEEP + ["--out", str(out)])

@@ -487,8 +487,12 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
         saved, failed, plotted = None, None, []
 
         def kept() -> str:
+            # (it said 'the curve computed is printed above', where only its largest
+            # dynamic factors are, a reliability reviewer; --json holds the points)
             return kept_files([*(saved or []), *plotted]) or (
-                "the curve computed is printed above; nothing written")
+                f"nothing written: the curve's {int(ds.sizes['point'])} points are kept only "
+                f"by --out (their largest dynamic factors are printed above"
+                f"{'' if as_json else '; --json prints every point'})")
 
         try:  # a file that cannot be written: the curves are still printed, then the error
             with finish_before_interrupt():  # (a Ctrl-C: the files are finished, the curve
@@ -523,6 +527,10 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
                               "factors are printed unchecked")
         summary = {
             "model": ds.attrs["model"], "points": int(ds.sizes["point"]),
+            # the curve itself (a script had only its maxima without a file)
+            "curve": {"speed_rpm": ds["speed_rpm"].values.tolist(),
+                      "dynamic_factor": {str(k): ds["dynamic_factor"].sel(mesh=k).values
+                                         .tolist() for k in ds["mesh"].values}},
             "complete": bool(ds.attrs["complete"]), "message": ds.attrs["message"],
             "fold_speeds_rpm": ds.attrs["fold_speeds_rpm"],
             "critical_speeds_rpm": ds.attrs["critical_speeds_rpm"],
