@@ -245,6 +245,21 @@ class StudyError(TorquesplitError, ValueError):
         return StudyError.of(self.problems, source)
 
 
+class SteadyInterrupted(TorquesplitError, KeyboardInterrupt):
+    """A steady state was stopped (Ctrl-C) while its stability was computed, after the
+    periodic state had converged: ``steady`` is that state
+    (:class:`~torquesplit.steady.SteadyState`, its stability "interrupted").
+
+    Also a :class:`KeyboardInterrupt`, so code that stops on Ctrl-C keeps doing so.
+    """
+
+    def __init__(self, steady):
+        self.steady = steady
+        super().__init__("stopped while the Floquet multipliers were computed; the "
+                         "converged periodic state is kept (the exception's 'steady'), "
+                         "its stability not computed")
+
+
 class StudyInterrupted(TorquesplitError, KeyboardInterrupt):
     """A study was stopped (Ctrl-C) after committing the cases that had finished.
 

@@ -591,3 +591,33 @@ def test_sigterm_stops_a_run_as_ctrl_c_does(tmp_path):
     assert not list(tmp_path.glob(".*.lock"))
     with xr.open_dataset(out, engine="h5netcdf") as ds:
         assert ds.attrs["message"].startswith("Interrupted (SIGTERM)")
+
+
+def test_steady_interrupted_in_its_stability_keeps_the_converged_state(tmp_path,
+                                                                      monkeypatch):
+    """Ctrl-C while the Floquet multipliers were computed threw the converged periodic
+    state away ('interrupted; nothing written', after the stability's seconds: a
+    reliability reviewer).  The state is printed and written, its stability 'not
+    computed', and the command stops with 130; Python gets a KeyboardInterrupt that
+    holds it."""
+    import torquesplit
+    import torquesplit.steady.solution as solution
+    from torquesplit.errors import SteadyInterrupted
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(solution, "floquet_monodromy", interrupted)
+    out = tmp_path / "s.nc"
+    res = CliRunner().invoke(app, ["steady", "ji_li_mill_drive", "--out", str(out)])
+    assert res.exit_code == 130, res.output
+    assert "stability: not computed (interrupted by Ctrl-C while the Floquet multipliers " \
+           "were computed)" in " ".join(res.stdout.split())
+    assert "meshes (periodic steady state)" in res.stdout and out.exists()
+    assert res.stderr.strip().splitlines()[-1] == f"interrupted; results kept in {out}"
+    with pytest.raises(SteadyInterrupted) as stopped:
+        torquesplit.steady_state("ji_li_mill_drive")
+    assert isinstance(stopped.value, KeyboardInterrupt)
+    st = stopped.value.steady
+    assert st.solution.converged and st.solution.multipliers is None
+    assert st.solution.stability_method == "interrupted"

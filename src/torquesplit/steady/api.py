@@ -454,6 +454,12 @@ def steady_state(model, *, method: str = "auto", harmonics: int | None = None,
     Returns
     -------
     SteadyState
+
+    Raises
+    ------
+    SteadyInterrupted
+        Ctrl-C while the stability was computed, after the state converged: a
+        KeyboardInterrupt whose ``steady`` holds the state, its stability "interrupted".
     """
     from torquesplit.model.io import load_model
 
@@ -529,10 +535,15 @@ def _steady_state(model, *, method, harmonics, samples, keep, speed, max_cycles,
                             tol=tol, adaptive=adaptive, energy_tol=energy_tol,
                             stability=stability, steps_per_cycle=steps_per_cycle,
                             check=check, problem=problem, progress=progress)
-    return SteadyState(model=model, kinematics=kin, structure=structure, static=static,
-                       period=per, solution=sol, dropped=dropped, problem=problem,
-                       options=dict(keep=keep_asked, speed=speed, max_cycles=max_cycles,
-                                    energy_tol=energy_tol), notes=notes)
+    state = SteadyState(model=model, kinematics=kin, structure=structure, static=static,
+                        period=per, solution=sol, dropped=dropped, problem=problem,
+                        options=dict(keep=keep_asked, speed=speed, max_cycles=max_cycles,
+                                     energy_tol=energy_tol), notes=notes)
+    if sol.stability_method == "interrupted":  # Ctrl-C in the stability: stop, with it
+        from torquesplit.errors import SteadyInterrupted
+
+        raise SteadyInterrupted(state)
+    return state
 
 
 def _at_base(per, base):

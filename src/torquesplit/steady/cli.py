@@ -224,14 +224,21 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
             from torquesplit.cli_support import collect_warnings, interruptible, progress
 
             # (Ctrl-C exited 130 without a word)
+            from torquesplit.errors import SteadyInterrupted
+
+            stopped = False  # (Ctrl-C in the stability: the converged state is kept)
             with interruptible(), collect_warnings(), progress(
                     "periodic steady state", as_json or quiet, total=None) as update:
-                # (a speed with its unit as text, so that the unit is judged)
-                st = steady_state(m, method=method, harmonics=harmonics, adaptive=adaptive,
-                                  keep=_keep(keep), speed=_speed_argument(speed),
-                                  max_cycles="auto" if max_cycles is None else max_cycles,
-                                  stability=stability, steps_per_cycle=steps_per_cycle,
-                                  progress=update)
+                try:
+                    # (a speed with its unit as text, so that the unit is judged)
+                    st = steady_state(m, method=method, harmonics=harmonics,
+                                      adaptive=adaptive, keep=_keep(keep),
+                                      speed=_speed_argument(speed),
+                                      max_cycles="auto" if max_cycles is None else max_cycles,
+                                      stability=stability, steps_per_cycle=steps_per_cycle,
+                                      progress=update)
+                except SteadyInterrupted as exc:
+                    st, stopped, check = exc.steady, True, False  # (no step check either)
             # (a Ctrl-C after the solve exited 130 without a word, and during the step
             # check said 'nothing written' with the results file complete: a reviewer)
             from torquesplit.cli_support import kept_files
@@ -343,6 +350,9 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
                                      if kind == "period doubling" else ""), highlight=False)
             elif not stability:
                 console.print("stability: not computed (--no-stability)")
+            elif ps.stability_method == "interrupted":
+                console.print(f"stability: not computed (interrupted by {interrupt_name()} "
+                              f"while the Floquet multipliers were computed)")
             t = Table(title="meshes (periodic steady state)" if ps.converged else
                       "meshes: NOT CONVERGED (the last Newton iterate, not a periodic "
                       "state)")
@@ -387,6 +397,11 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
             if saved:
                 console.print("results written to " + ", ".join(str(f) for f in saved),
                               highlight=False)
+        if stopped:  # the state printed and written, then the command stops as asked
+            from torquesplit.cli_support import exit_interrupted
+
+            exit_interrupted(kept_files(saved) or "the periodic state is printed above; "
+                                                  "nothing written")
         if not ps.converged:
             raise typer.Exit(1)
 

@@ -14,7 +14,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from torquesplit.errors import ModelWarning, OptionError, SolverError, warn_user
+from torquesplit.errors import (
+    ModelWarning,
+    OptionError,
+    SolverError,
+    from_interrupt,
+    warn_user,
+)
 from torquesplit.solve._frozen import freeze_arrays
 from torquesplit.solve._kernels import MESH_KIND
 from torquesplit.steady.harmonic import HarmonicBalance
@@ -276,6 +282,19 @@ def top_energy(hb: HarmonicBalance, x, speed=1.0) -> float:
     return float(e[k > 0.75 * hb.H].sum() / tot)
 
 
+def _stability(compute):
+    """``compute()``'s (multipliers, method); a Ctrl-C while it runs gives (None,
+    "interrupted"): the converged state is kept (:class:`~torquesplit.errors.
+    SteadyInterrupted` then stops the caller with it), where it was thrown away after the
+    stability's seconds (a reliability reviewer)."""
+    try:
+        return compute()
+    except (KeyboardInterrupt, SystemError) as exc:
+        if not from_interrupt(exc):
+            raise
+        return None, "interrupted"
+
+
 def _announce(p, T, steps, stability) -> None:
     """Warn before a shooting solve of ``steps`` RK4 steps per period ``T``: how long
     each integration of the period is, roughly, and what sets the steps."""
@@ -436,20 +455,22 @@ def periodic_solution(structure, period: Period, *, method: str = "auto", harmon
         t = hb.times(speed)
         _, lam = hb.split(x)
         v = hb._states(q, v, lam)[:, p.n:]  # physical velocity (rigid speed offset included)
-        if stability:
-            say("Floquet multipliers")
-            if stability == "hill" or (stability is True and hill_applies(p, H, f)):
-                multipliers = floquet_hill(hb, x, speed, None if stability == "hill" else H)
-                stab_method = "hill"
         defect = math.nan
         y0 = np.concatenate([q[0], v[0]])
         if check:  # one period as the integrators step it (through the tables' corners)
             yT = p.integrate(y0, 0.0, T, steps, every=steps, speed=speed, max_rows=1)[3]
             defect = _defect(p, y0, yT)
-        if stability and multipliers is None:
-            multipliers = floquet_monodromy(p, p.integrate_variational(y0, 0.0, T, steps,
-                                                                       speed)[1])
-            stab_method = "monodromy"
+        if stability:
+            say("Floquet multipliers")
+
+            def hb_multipliers():
+                if stability == "hill" or (stability is True and hill_applies(p, H, f)):
+                    return floquet_hill(hb, x, speed, None if stability == "hill" else H), \
+                        "hill"
+                return floquet_monodromy(p, p.integrate_variational(y0, 0.0, T, steps,
+                                                                    speed)[1]), "monodromy"
+
+            multipliers, stab_method = _stability(hb_multipliers)
         msg = (f"harmonic balance, {H} harmonics of {f:.6g} Hz, {hb.N} samples: "
                + ("converged" if info.converged else "did NOT converge")
                + f" in {info.iterations} Newton steps (residual {info.residual:.2e})")
@@ -500,9 +521,13 @@ def periodic_solution(structure, period: Period, *, method: str = "auto", harmon
             if Phi is None:  # matrix-free Newton: the monodromy at the solution
                 say(f"Floquet multipliers: the monodromy, {2 * p.n} columns over "
                     f"{steps:,} RK4 steps")
-                _, Phi = p.integrate_variational(y0, 0.0, T, steps, speed)
-            multipliers = floquet_monodromy(p, Phi)
-            stab_method = "monodromy"
+
+            def shooting_multipliers():
+                at = Phi if Phi is not None else p.integrate_variational(y0, 0.0, T, steps,
+                                                                         speed)[1]
+                return floquet_monodromy(p, at), "monodromy"
+
+            multipliers, stab_method = _stability(shooting_multipliers)
         newton = info.iterations - info.anderson
         steps_taken = " and ".join(
             [f"{info.anderson} Anderson-accelerated period maps"] * bool(info.anderson)
