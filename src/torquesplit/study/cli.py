@@ -110,6 +110,9 @@ def _terminate_as_interrupt():
 
     def stop(signum, frame):
         terminated.seen = True
+        handler = signal.getsignal(signal.SIGINT)  # (noted as a Ctrl-C is: study.runners)
+        if callable(handler):
+            handler(signal.SIGINT, frame)
         raise KeyboardInterrupt
 
     before = signal.signal(signal.SIGTERM, stop)

@@ -21,6 +21,7 @@ live for the whole study, so each compiles its kernels once (see
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import os
 import signal
@@ -38,11 +39,55 @@ class SerialRunner:
     workers = 1
 
     def __call__(self, function: Callable, payloads: Iterable) -> Iterator:
-        for p in payloads:
-            yield function(p)
+        """Each case's result; a Ctrl-C stops the cases even where it landed inside
+        compiled code and came out of the case as another error (numba's
+        '_get_wrapper_address() missing ... sig', recorded as the case's error while the
+        study ran on and exited 0: a reliability reviewer): the case's result is then
+        dropped (it runs again on --resume) and KeyboardInterrupt raised."""
+        with _noting_interrupts() as seen:
+            for p in payloads:
+                result = function(p)
+                if seen:
+                    raise KeyboardInterrupt
+                yield result
 
     def __repr__(self) -> str:
         return "SerialRunner()"
+
+
+class _Seen:
+    """Whether a SIGINT came (truthy once one did)."""
+
+    def __init__(self):
+        self.hit = False
+
+    def __bool__(self) -> bool:
+        return self.hit
+
+
+@contextlib.contextmanager
+def _noting_interrupts():
+    """Within the block, a SIGINT is noted before the handler in force runs (Python's
+    raises KeyboardInterrupt as ever).  Main thread only, and only where a handler of
+    Python's is installed; elsewhere nothing is noted."""
+    import threading
+
+    seen = _Seen()
+    current = (signal.getsignal(signal.SIGINT)
+               if threading.current_thread() is threading.main_thread() else None)
+    if not callable(current):
+        yield seen
+        return
+
+    def note(signum, frame):
+        seen.hit = True
+        current(signum, frame)
+
+    signal.signal(signal.SIGINT, note)
+    try:
+        yield seen
+    finally:
+        signal.signal(signal.SIGINT, current)
 
 
 def worker_start() -> None:  # pragma: no cover - runs in the worker processes
