@@ -9,6 +9,7 @@ with a seed.  Coarse LTCA grid and a small population to keep the test short.
 from __future__ import annotations
 
 import re
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -457,3 +458,37 @@ def test_a_model_file_given_for_an_optimisation_is_told_so():
     with pytest.raises(ModelError, match=r"is a model file \(a gearbox, no \[optimization\]\), "
                                          r"not an optimisation; run it with 'torquesplit run"):
         read_spec(torquesplit.example_path("ji_li_mill_drive"))
+
+
+def test_a_full_disk_names_the_file_it_could_not_write(tmp_path):
+    """'error: File too large; check the path and its permissions' named no file (a
+    reliability reviewer, ulimit -f): each result file is written whole or not at all,
+    and the one that failed is named."""
+    import subprocess
+    import sys
+    import textwrap
+
+    child = textwrap.dedent(f"""
+        import resource, signal, sys
+        sys.path.insert(0, {str(Path(__file__).parent)!r})
+        import numpy as np
+        from test_optimize import spec_dict, PAPER
+        from torquesplit.errors import OutputError
+        from torquesplit.optimize import OptimizationResult, read_spec
+        res = OptimizationResult(spec=read_spec(spec_dict()), X=np.array([PAPER, PAPER]),
+                                 F=np.array([[0.5, 0.1], [0.3, 0.2]]), outputs=({{}}, {{}}),
+                                 baseline={{}}, chosen=1, evaluations=2, computed=2)
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (8000, 8000))
+        try:
+            res.write({str(tmp_path / "o")!r})
+        except OutputError as exc:
+            print(exc)
+    """)
+    out = subprocess.run([sys.executable, "-c", child], capture_output=True, text=True,
+                         check=True, cwd=tmp_path)
+    said = re.match(r"cannot write (\S+) \(File too large\); free disk space", out.stdout)
+    assert said, out.stdout + out.stderr
+    assert Path(said.group(1)).parent == tmp_path / "o"
+    assert not Path(said.group(1)).exists()  # (no part of it)
+    assert (tmp_path / "o" / "pareto.csv").read_text().startswith("chosen,")

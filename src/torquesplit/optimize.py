@@ -785,23 +785,31 @@ class OptimizationResult:
     def write(self, directory) -> list[Path]:
         """pareto.csv (variables in the unit of their bounds, named in the header; a
         design's plausibility warnings in the last column), pareto.png and chosen.toml
-        (variables with units) in ``directory``."""
+        (variables with units) in ``directory``, each written atomically (whole or
+        absent); a file that cannot be written (a full disk) is an
+        :class:`~torquesplit.errors.OutputError` naming it (it said 'File too large;
+        check the path and its permissions', no path: a reliability reviewer)."""
+        import io
+
         import tomli_w
+
+        from .results import files
 
         d = Path(directory)
         d.mkdir(parents=True, exist_ok=True)
         names = [v.label() for v in self.spec.variables]
         objs = self.objective_labels()
-        paths = [d / "pareto.csv", d / "chosen.toml"]
-        with paths[0].open("w", newline="") as fh:
-            w = csv.writer(fh)
-            w.writerow(["chosen", *names, *objs, "warnings"])
-            for i, (x, f) in enumerate(zip(self.X, self.objective_values())):
-                w.writerow([int(i == self.chosen),
-                            *(v.shown(a) for v, a in zip(self.spec.variables, x)),
-                            *map(float, f), "; ".join(self.design_notes(i))])
-        paths[1].write_text("# chosen by torquesplit optimize (" + self.spec.choose + ")\n"
-                            + tomli_w.dumps(self.chosen_model_data(units=True)))
+        table = io.StringIO(newline="")
+        w = csv.writer(table)
+        w.writerow(["chosen", *names, *objs, "warnings"])
+        for i, (x, f) in enumerate(zip(self.X, self.objective_values())):
+            w.writerow([int(i == self.chosen),
+                        *(v.shown(a) for v, a in zip(self.spec.variables, x)),
+                        *map(float, f), "; ".join(self.design_notes(i))])
+        contents = {d / "pareto.csv": table.getvalue().encode("utf-8"),
+                    d / "chosen.toml": ("# chosen by torquesplit optimize ("
+                                        + self.spec.choose + ")\n" + tomli_w.dumps(
+                                            self.chosen_model_data(units=True))).encode()}
         if self.F.shape[1] >= 2:
             from matplotlib.figure import Figure
 
@@ -817,10 +825,13 @@ class OptimizationResult:
             ax.legend()
             ax.set_title(f"{self.spec.algorithm}: {len(self.F)} Pareto designs, "
                          f"{self.evaluations} evaluations")
-            p = d / "pareto.png"
-            fig.savefig(p, dpi=120)
-            paths.append(p)
-        return paths
+            png = io.BytesIO()
+            fig.savefig(png, format="png", dpi=120)
+            contents[d / "pareto.png"] = png.getvalue()
+        for path, data in contents.items():
+            files.write_atomically(path, data, overwrite=True,
+                                   formats={path.suffix: path.suffix[1:]})
+        return list(contents)
 
 
 # ============================================================================= driver
