@@ -27,7 +27,7 @@ from . import cli_support as ux
 from .model.checks import MODIFICATIONS_UNUSED
 from .cli_support import header as _h
 from .errors import (ModelError, ModelWarning, OptionError, OutputError, TorquesplitError,
-                     clip_message)
+                     clip_message, interrupt_name)
 
 
 class _Command(typer.core.TyperCommand):
@@ -556,13 +556,22 @@ def run(
                         # companion file appeared): the run is kept elsewhere, said last
                         state["saved"], save_failed = _rescued(
                             lambda p: res.save(p, definition=chosen), out, exc)
-            step_check = None
+            step_check, check_stopped = None, False
             if check and met is not None:
                 from .convergence import check_step
+                from .errors import from_interrupt
 
-                with ux.collect_warnings(), ux.progress("checking the step (half of it)",
-                                                        quiet or as_json) as cb:
-                    step_check = check_step(res, definitions=[chosen], progress=cb)
+                try:
+                    with ux.collect_warnings(), ux.progress("checking the step (half of it)",
+                                                            quiet or as_json) as cb:
+                        step_check = check_step(res, definitions=[chosen], progress=cb)
+                except (KeyboardInterrupt, SystemError) as exc:
+                    # the run's own tables are printed, then the stop (it said only
+                    # 'results kept in', not that no check was made: a reliability
+                    # reviewer)
+                    if not from_interrupt(exc):
+                        raise
+                    check_stopped = True
         except _EXPECTED as exc:
             _fail(exc)
             return
@@ -587,6 +596,10 @@ def run(
     else:
         _print_run(m, res, met, saved, [], step_check, None, as_json)
         _fail(failed)
+    if check_stopped:
+        ux.warn(f"the step check (--check-step) was interrupted ({interrupt_name()}): the "
+                f"tables are the run's, complete, their digits not checked")
+        ux.exit_interrupted(ux.kept_files(saved))
 
 
 def _save_partial_beside(res, plan, definition) -> tuple[list[Path], Exception | None]:

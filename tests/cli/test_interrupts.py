@@ -621,3 +621,25 @@ def test_steady_interrupted_in_its_stability_keeps_the_converged_state(tmp_path,
     st = stopped.value.steady
     assert st.solution.converged and st.solution.multipliers is None
     assert st.solution.stability_method == "interrupted"
+
+
+def test_a_run_whose_step_check_is_interrupted_prints_its_tables_and_says_so(tmp_path,
+                                                                            monkeypatch):
+    """Ctrl-C in the second run of --check-step said only 'interrupted; results kept in
+    cs.nc' (a reliability reviewer): the run's tables are printed, and that its digits
+    were not checked."""
+    import torquesplit.convergence as convergence
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(convergence, "check_step", interrupted)
+    out = tmp_path / "cs.nc"
+    res = CliRunner().invoke(app, ["run", "ji_li_mill_drive", "--duration", "0.3",
+                                   "--check-step", "--out", str(out)])
+    assert res.exit_code == 130, res.output
+    assert "load sharing" in res.stdout and out.exists()
+    said = " ".join(res.stderr.split())
+    assert "warning: the step check (--check-step) was interrupted (Ctrl-C): the tables " \
+           "are the run's, complete, their digits not checked" in said
+    assert said.endswith(f"interrupted; results kept in {out}")
