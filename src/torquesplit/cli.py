@@ -792,7 +792,7 @@ def _generation_lines():
     None on a terminal (the bar)."""
     import time
 
-    from .study.cli import LOG_EVERY, _clock_text
+    from .cli_support import LOG_EVERY, clock_text
 
     con = ux._session.err_console
     if con is None or getattr(con, "is_terminal", False):
@@ -804,7 +804,7 @@ def _generation_lines():
         if last[0] is not None and now - last[0] < LOG_EVERY and generation < total:
             return
         last[0] = now
-        con.print(f"generation {generation}/{total}, {_clock_text(now - t0)} elapsed",
+        con.print(f"generation {generation}/{total}, {clock_text(now - t0)} elapsed",
                   highlight=False, markup=False)
 
     return cb

@@ -159,12 +159,17 @@ def progress(label: str, quiet: bool = False, *, total: Optional[float] = 1.0):
     """A transient progress bar on stderr while the block runs (a terminal only).
 
     Yields a callback ``update(fraction, what=None)``; with ``total=None`` the bar is a
-    spinner (work of unknown length) and ``fraction`` is ignored.  ``quiet`` or a
-    non-terminal stderr: the callback does nothing.
+    spinner (work of unknown length) and ``fraction`` is ignored.  A non-terminal stderr
+    (a batch job's log, nohup), where a bar draws nothing: a line at most every
+    :data:`LOG_EVERY` seconds once that long has passed (a long run printed nothing
+    for its whole length: a reliability reviewer).  ``quiet``: nothing.
     """
     con = _session.err_console
-    if quiet or con is None or not getattr(con, "is_terminal", False):
+    if quiet or con is None:
         yield lambda fraction=None, what=None: None
+        return
+    if not getattr(con, "is_terminal", False):
+        yield _progress_lines(con, label, total)
         return
     from rich.progress import (BarColumn, Progress, SpinnerColumn, TextColumn,
                                TimeElapsedColumn, TimeRemainingColumn)
@@ -186,6 +191,38 @@ def progress(label: str, quiet: bool = False, *, total: Optional[float] = 1.0):
             bar.update(task, **kwargs)
 
         yield update
+
+
+#: seconds between the progress lines of a command whose stderr is not a terminal
+LOG_EVERY = 30.0
+
+
+def _progress_lines(con, label: str, total, clock=None):
+    """:func:`progress`'s callback for a log: ``label: 45 %, 0:01:30 elapsed`` (with a
+    ``total``) at most every :data:`LOG_EVERY` seconds, the first after that long."""
+    import time
+
+    clock = clock or time.monotonic
+    t0 = clock()
+    last = [t0]
+
+    def update(fraction=None, what=None):
+        now = clock()
+        if now - last[0] < LOG_EVERY:
+            return
+        last[0] = now
+        done = (f"{100 * fraction:.0f} %, " if fraction is not None and total is not None
+                else "")
+        con.print(f"{label}{': ' + what if what else ''}: {done}{clock_text(now - t0)} "
+                  f"elapsed", highlight=False, markup=False)
+
+    return update
+
+
+def clock_text(seconds: float) -> str:
+    """``H:MM:SS`` of a duration (progress lines)."""
+    s = int(round(max(0.0, seconds)))
+    return f"{s // 3600}:{s // 60 % 60:02d}:{s % 60:02d}"
 
 
 #: seconds without progress after which a bar says that a first run compiles

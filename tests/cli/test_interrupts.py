@@ -643,3 +643,27 @@ def test_a_run_whose_step_check_is_interrupted_prints_its_tables_and_says_so(tmp
     assert "warning: the step check (--check-step) was interrupted (Ctrl-C): the tables " \
            "are the run's, complete, their digits not checked" in said
     assert said.endswith(f"interrupted; results kept in {out}")
+
+
+def test_a_long_command_logs_its_progress_where_no_bar_draws():
+    """A run piped or in a batch job printed nothing for its whole length (a reliability
+    reviewer): a line at most every LOG_EVERY seconds, the first after that long."""
+    import io
+
+    from rich.console import Console
+
+    buf = io.StringIO()
+    con = Console(file=buf, force_terminal=False, width=200)
+    now = [0.0]
+    update = ux._progress_lines(con, "integrating", 1.0, clock=lambda: now[0])
+    for t, f in ((1.0, 0.01), (ux.LOG_EVERY - 1, 0.2), (ux.LOG_EVERY + 1, 0.31),
+                 (ux.LOG_EVERY + 5, 0.35), (2 * ux.LOG_EVERY + 2, 0.62)):
+        now[0] = t
+        update(f)
+    assert buf.getvalue().splitlines() == [
+        f"integrating: 31 %, 0:00:{int(ux.LOG_EVERY) + 1} elapsed",
+        f"integrating: 62 %, 0:01:0{2 * int(ux.LOG_EVERY) + 2 - 60} elapsed"]
+    spin = ux._progress_lines(con, "steady state", None, clock=lambda: now[0])
+    now[0] += ux.LOG_EVERY
+    spin(None, "Newton")
+    assert buf.getvalue().splitlines()[-1] == "steady state: Newton: 0:00:30 elapsed"

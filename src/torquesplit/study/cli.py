@@ -19,7 +19,7 @@ from typing import Optional
 import typer
 
 from .. import _json
-from ..cli_support import json_option
+from ..cli_support import LOG_EVERY, clock_text, json_option
 from ..errors import OptionError
 
 BACKEND_HELP = ("cpu (default) or gpu: integrate the cases as ensembles on a CUDA GPU, one "
@@ -343,7 +343,7 @@ def _eta_column():
             finish = task.fields.get("finish")
             if finish is None:
                 return Text("-:--:--", style="progress.remaining")
-            return Text(_clock_text(finish - time.monotonic()), style="progress.remaining")
+            return Text(clock_text(finish - time.monotonic()), style="progress.remaining")
 
     return Eta()
 
@@ -356,10 +356,6 @@ def eta_finish(start: tuple[float, int], now: float, done: int, total: int):
     if done <= done0 or now <= t0:
         return None
     return now + (total - done) * (now - t0) / (done - done0)
-
-
-LOG_EVERY = 30.0
-"""Seconds between the progress lines of a study whose stderr is not a terminal."""
 
 
 def progress_lines(write, clock=None):
@@ -379,7 +375,7 @@ def progress_lines(write, clock=None):
         if getattr(p, "stage", ""):  # what a runner does between cases (the GPU runner's)
             if state["stage"] is None or now - state["stage"] >= LOG_EVERY:
                 state["stage"] = now
-                write(f"{p.stage} ({_clock_text(now - state['start'][0])} elapsed)")
+                write(f"{p.stage} ({clock_text(now - state['start'][0])} elapsed)")
             return
         due = state["last"] is None or now - state["last"] >= LOG_EVERY or p.done >= p.total
         if not due or p.done <= state["start"][1]:
@@ -387,16 +383,11 @@ def progress_lines(write, clock=None):
         state["last"] = now
         finish = eta_finish(state["start"], now, p.done, p.total)
         left = "" if finish is None or p.done >= p.total else \
-            f", about {_clock_text(finish - now)} left"
+            f", about {clock_text(finish - now)} left"
         write(f"cases {p.done}/{p.total} ({p.failed} not ok), "
-              f"{_clock_text(now - state['start'][0])} elapsed{left}")
+              f"{clock_text(now - state['start'][0])} elapsed{left}")
 
     return cb
-
-
-def _clock_text(seconds: float) -> str:
-    s = int(round(max(0.0, seconds)))
-    return f"{s // 3600}:{s // 60 % 60:02d}:{s % 60:02d}"
 
 
 def _with_bar(job, total: int, quiet: bool):
