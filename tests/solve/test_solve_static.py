@@ -338,3 +338,20 @@ def test_the_mean_equilibrium_is_kept_for_its_exact_inputs_only():
     # the equilibrium at a time is never kept (its errors differ from case to case)
     at0 = static_equilibrium(torquesplit.assemble(model), 0.0, initial=fresh.q)
     assert static_equilibrium(torquesplit.assemble(model), 0.0, initial=fresh.q) is not at0
+
+
+def test_a_tiny_inertia_makes_no_false_rigid_body_mode():
+    """A motor inertia of 1e-12 kg m^2 beside bodies of 1e4-1e5 (a unit slip) made its
+    column dominate V M^-1/2: the other constraints fell below the rank tolerance, a
+    second rigid-body mode appeared, and the static check blamed the drive and load
+    torques (a reliability reviewer).  The modes are those of the inertias' order of
+    magnitude, mass-orthonormal and undeforming."""
+    from torquesplit.solve.static import rigid_modes_of
+
+    V = np.array([[1.0, -1.0, 0.0], [0.0, 0.1, -0.3]])  # a shaft, then a mesh
+    for inertia in (1.0, 1e-12):
+        inv_mass = 1.0 / np.array([inertia, 1e4, 1e5])
+        phi = rigid_modes_of(V, inv_mass)
+        assert phi.shape == (3, 1), inertia
+        np.testing.assert_allclose(V @ phi, 0.0, atol=1e-12 * np.abs(phi).max())
+        np.testing.assert_allclose(phi.T @ (phi / inv_mass[:, None]), np.eye(1), rtol=1e-12)

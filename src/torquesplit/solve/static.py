@@ -197,6 +197,18 @@ def _rigid_modes(V: np.ndarray, d: np.ndarray, tolerance: float) -> np.ndarray:
         _, sv, vt = np.linalg.svd(A, full_matrices=True)
         rank = int(np.sum(sv > tolerance * sv[0])) if sv.size else 0
         phi = d[:, None] * vt[rank:].T
+        # the rank judged on V's columns scaled to one: a body of an inertia 1e12 times
+        # smaller than the others' (a unit slip) made its column dominate V M^-1/2 and
+        # the others' constraints fall below the tolerance, a false rigid-body mode that
+        # the load balance then blamed (a reliability reviewer)
+        c = np.linalg.norm(V, axis=0)
+        c = 1.0 / np.where(c > 0, c, 1.0)
+        _, sc, wt = np.linalg.svd(V * c[None, :], full_matrices=True)
+        free = int(np.sum(sc > tolerance * sc[0])) if sc.size else 0
+        if free != rank:  # the null space of V, made mass-orthonormal
+            N = c[:, None] * wt[free:].T
+            w, U = np.linalg.eigh(N.T @ (N / (d * d)[:, None]))
+            phi = N @ (U / np.sqrt(w)[None, :]) @ U.T
     phi.setflags(write=False)
     return phi
 
