@@ -138,6 +138,17 @@ def test_steady_says_its_results_warnings_and_leaves_out_cycles_without_samples(
                                    str(out)])
     assert res.exit_code == 0, res.output
     said = json.loads(res.stdout)["warnings"]
+    # each group's and the system's numbers, as a run's --json has them (the steady
+    # state's had the meshes only: an exports reviewer)
+    printed = json.loads(res.stdout)
+    import torquesplit.steady as steady
+
+    met = steady.steady_state(str(model), stability=False).to_results().metrics().to_dict()
+    assert printed["groups"].keys() == met["groups"].keys() and printed["groups"]
+    for g, v in met["groups"].items():
+        assert printed["groups"][g]["load_sharing"] == pytest.approx(v["load_sharing"])
+        assert printed["groups"][g]["dynamic_factor"] == pytest.approx(v["dynamic_factor"])
+    assert printed["system_load_sharing"] == pytest.approx(met["system_load_sharing"])
     waveform = [w for w in said if "saved waveform of the periodic state" in w]
     assert waveform and "--steps-per-cycle" in waveform[0]
     assert not any("--samples-per-period" in w for w in said)

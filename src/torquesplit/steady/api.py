@@ -322,7 +322,11 @@ class SteadyState:
 
         ps = self.solution
         mu = ps.multipliers
+        results = self.to_results() if results is None else results
         rows = self.mesh_table(results=results) if rows is None else rows
+        # each group's and the system's numbers, as a run's --json has them (a steady
+        # state's had the meshes only: an exports reviewer)
+        met = results.metrics().to_dict()
         return {
             "model": self.model.model.name, "method": ps.method, "converged": ps.converged,
             "message": ps.message, "period_s": ps.period, "fundamental_Hz": ps.frequency,
@@ -337,6 +341,7 @@ class SteadyState:
             "load_sharing_definition": default_definition(self.model),
             "meshes": {r.mesh: {k: v for k, v in r.__dict__.items() if k != "mesh"}
                        for r in rows},
+            "groups": met["groups"], "system_load_sharing": met["system_load_sharing"],
         }
 
     def dropped_text(self) -> list[str]:

@@ -304,7 +304,7 @@ def register(app, load, fail, console, err_console, json_default, set_help=""):
         planets = (planet_sharing(res.metrics().load_sharing, st.kinematics)
                    if ps.converged else None)
         info = {
-            **st.summary(rows), "instability": kind or None,
+            **st.summary(rows, results=res), "instability": kind or None,
             **({"planet_load_sharing": planet_sharing_dict(planets)} if planets else {}),
             **({} if ps.converged else {"stable": None}),
             "results_file": str(saved[0]) if saved else None,
