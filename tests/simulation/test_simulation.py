@@ -144,6 +144,12 @@ def test_mat_and_csv_exports(split, tmp_path):
         assert float(ds["cycle_max_force"].sel(mesh=r.mesh)[k:].max()) == r.peak_force
     # whether the rule found it settled, as a variable (a study's file has one)
     assert int(ds["settled"]) == int(met.settling.settled)
+    # what the .nc has of each mesh and group, in the tables too (an exports reviewer)
+    for r in rows:
+        assert int(r["first_settled_cycle"]) == int(ds["first_settled_cycle"].sel(
+            mesh=r["mesh"]))
+        assert float(r["mesh_frequency_Hz"]) == float(ds["mesh_frequency"].sel(mesh=r["mesh"]))
+        assert int(r["double_flank"]) == int(ds["double_flank"].sel(mesh=r["mesh"]))
     # the groups' and the system's rows, as the run's tables print them
     # the same columns whatever the definition, which a column names
     assert rows[0]["load_sharing_definition"] == met.definition
@@ -153,6 +159,9 @@ def test_mat_and_csv_exports(split, tmp_path):
     groups = {r["group"]: float(r["load_sharing"]) for r in group_rows}
     assert {r["load_sharing_definition"] for r in group_rows} == {met.definition}
     assert groups.pop("(system)") == pytest.approx(met.load_sharing.system)
+    times = {r["group"]: float(r["settle_time_s"]) for r in group_rows}
+    assert times.pop("(system)") == met.settling.start_time
+    assert times == {g: float(ds["settle_time"].sel(group=g)) for g in times}
     assert groups == pytest.approx(met.load_sharing.per_group)
     # what the tables cannot hold
     about = json.loads((tmp_path / "run_about.json").read_text())

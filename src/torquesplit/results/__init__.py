@@ -843,10 +843,15 @@ class Results:
                   "peak_force_N", "min_force_N", "dynamic_factor",
                   "dynamic_factor_engineering", "peak_to_nominal", "load_sharing",
                   "load_sharing_definition", "contact_loss_fraction", "back_contact_fraction",
-                  "back_flank_force_N"]
+                  # (what the .nc has of each mesh: the CSV left them out, an exports
+                  # reviewer)
+                  "back_flank_force_N", "mesh_frequency_Hz", "double_flank",
+                  "first_settled_cycle"]
         group_header = ["group", "meshes", "load_sharing", "load_sharing_definition",
                         "dynamic_factor", "peak_to_nominal",
-                        "peak_to_nominal_engineering"]  # G_it (Ji & Li eq. 19)
+                        "peak_to_nominal_engineering",  # G_it (Ji & Li eq. 19)
+                        "settle_time_s"]
+        frequency = {m: self.kinematics.meshes[m].frequency for m in self.mesh_names}
         try:
             met = self.metrics(definition) if self.success else None
         except (ValueError, ArithmeticError):
@@ -869,7 +874,8 @@ class Results:
             rows = [[r.mesh, r.group, r.nominal_force, r.static_force, r.mean_force,
                      r.peak_force, r.min_force, r.dynamic_factor,
                      r.dynamic_factor_engineering, r.peak_to_nominal, r.load_sharing, name,
-                     r.contact_loss, r.back_contact, r.back_flank_force]
+                     r.contact_loss, r.back_contact, r.back_flank_force, frequency[r.mesh],
+                     int(r.double_flank), met.settling.first_cycle[r.mesh]]
                     for r in met.rows]
             rows = self._planet_columns(header, rows, met)
             steady = getattr(self, "steady", None)
@@ -883,18 +889,19 @@ class Results:
             d, ls_ = met.dynamic_factors, met.load_sharing
             group_rows = [[g, " ".join(members), ls_.per_group[g], name,
                            d.per_group_dynamic_factor[g], d.per_group_peak_to_nominal[g],
-                           d.per_group_peak_to_nominal_engineering.get(g, "")]
+                           d.per_group_peak_to_nominal_engineering.get(g, ""),
+                           met.settling.group_time.get(g, "")]
                           for g, members in ls_.groups.items()]
             group_rows.append(["(system)", " ".join(self.mesh_names), ls_.system, name, "",
-                               "", ""])
+                               "", "", met.settling.start_time])
             bearings = self.bearing_forces(met.settling.start_time, metrics=met)
         else:
             header.append("status")
             group_of = {m: g for g, ms in self.groups.items() for m in ms}
             nominal, static = self.nominal_forces(), self.static_forces()
             rows = [[m, group_of.get(m, ""), nominal[m], static[m]] + [""] * 11
-                    + [self.message] for m in self.mesh_names]
-            group_rows = [[g, " ".join(ms)] + [""] * 5 for g, ms in self.groups.items()]
+                    + [frequency[m], "", ""] + [self.message] for m in self.mesh_names]
+            group_rows = [[g, " ".join(ms)] + [""] * 6 for g, ms in self.groups.items()]
         # the bearing table, one column per direction of any support's frame
         directions = sorted({d for b in bearings for d in b["directions"]})
         bearing_header = (["body", "via", "frame"] + [f"mean_force_{d}_N" for d in directions]
