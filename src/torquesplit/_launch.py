@@ -64,7 +64,9 @@ def _stop_as_interrupt(signum, frame) -> None:
     closed terminal or ssh session) stop the command as Ctrl-C does: what it computed is
     kept, its files finished (a run's SIGTERM left no file and a lock behind, a
     reliability reviewer).  The SIGINT handler in force is called, so that a block that
-    holds Ctrl-C (:func:`torquesplit.errors.held_interrupt`) holds these too."""
+    holds Ctrl-C (:func:`torquesplit.errors.held_interrupt`) holds these too; where SIGINT
+    is ignored (a job started in the background) they raise KeyboardInterrupt
+    themselves."""
     import signal
 
     from torquesplit.errors import STOP_SIGNAL
@@ -73,7 +75,7 @@ def _stop_as_interrupt(signum, frame) -> None:
     handler = signal.getsignal(signal.SIGINT)
     if callable(handler):
         handler(signal.SIGINT, frame)
-    elif handler != signal.SIG_IGN:
+    else:  # (SIGINT ignored: a background job's, where SIGTERM is the way to stop it)
         raise KeyboardInterrupt
 
 

@@ -534,10 +534,11 @@ def test_sigterm_and_sighup_are_ctrl_c_with_their_own_exit_code():
     from torquesplit import _launch
     from torquesplit.errors import STOP_SIGNAL, held_interrupt, interrupt_name
 
-    before = {s: signal.getsignal(s) for s in (signal.SIGTERM, signal.SIGHUP)}
+    before = {s: signal.getsignal(s) for s in (signal.SIGTERM, signal.SIGHUP, signal.SIGINT)}
     try:
         for s in before:
             signal.signal(s, signal.SIG_DFL)
+        signal.signal(signal.SIGINT, signal.default_int_handler)  # (a terminal's)
         _launch._handle_stop_signals()
         assert interrupt_name() == "Ctrl-C" and _launch._exit_code(130) == 130
         with pytest.raises(KeyboardInterrupt):
@@ -547,6 +548,10 @@ def test_sigterm_and_sighup_are_ctrl_c_with_their_own_exit_code():
         with held_interrupt() as held:  # held, as a Ctrl-C is
             os.kill(os.getpid(), signal.SIGTERM)
         assert held.hit and _launch._exit_code(130) == 143
+        # a background job ignores SIGINT: SIGTERM stops it all the same
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+        with pytest.raises(KeyboardInterrupt):
+            os.kill(os.getpid(), signal.SIGTERM)
         signal.signal(signal.SIGHUP, signal.SIG_IGN)  # (nohup's choice is left alone)
         _launch._handle_stop_signals()
         assert signal.getsignal(signal.SIGHUP) == signal.SIG_IGN

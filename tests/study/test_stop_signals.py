@@ -13,6 +13,7 @@ CHILD = """
 import signal
 from multiprocessing import resource_tracker
 from torquesplit.study.runners import start_helpers
+signal.signal(signal.SIGHUP, signal.SIG_DFL)  # (as in a terminal; nohup ignores it)
 start_helpers()
 status = open(f"/proc/{resource_tracker._resource_tracker._pid}/status").read()
 ignored = int(next(l for l in status.splitlines() if l.startswith("SigIgn:")).split()[1], 16)
@@ -48,9 +49,13 @@ def test_a_ctrl_c_a_case_swallowed_still_stops_a_serial_study():
         return {"index": i, "status": "ok"}
 
     got = []
-    with pytest.raises(KeyboardInterrupt):
-        for r in SerialRunner()(case, range(4)):
-            got.append(r)
+    before = signal.signal(signal.SIGINT, signal.default_int_handler)  # (a terminal's:
+    try:  # a background job, CI's, ignores SIGINT)
+        with pytest.raises(KeyboardInterrupt):
+            for r in SerialRunner()(case, range(4)):
+                got.append(r)
+        assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # restored
+    finally:
+        signal.signal(signal.SIGINT, before)
     assert got == [{"index": 0, "status": "ok"}]
-    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # restored
     assert [r["index"] for r in SerialRunner()(lambda i: {"index": i}, range(3))] == [0, 1, 2]
