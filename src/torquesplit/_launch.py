@@ -69,12 +69,14 @@ def _stop_as_interrupt(signum, frame) -> None:
     themselves."""
     import signal
 
-    from torquesplit.errors import STOP_SIGNAL
+    from torquesplit.errors import HOLDING, STOP_SIGNAL
 
     STOP_SIGNAL[0] = signum
     handler = signal.getsignal(signal.SIGINT)
     if callable(handler):
         handler(signal.SIGINT, frame)
+    elif HOLDING and not HOLDING[-1].hit:  # (SIGINT ignored, a file being finished)
+        HOLDING[-1].hit = True
     else:  # (SIGINT ignored: a background job's, where SIGTERM is the way to stop it)
         raise KeyboardInterrupt
 

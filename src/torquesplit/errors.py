@@ -418,6 +418,9 @@ class HeldInterrupt:
 #: the terminating signal that stopped the command as Ctrl-C does (SIGTERM, SIGHUP:
 #: ``torquesplit._launch``), 0 for none
 STOP_SIGNAL = [0]
+#: the :func:`held_interrupt` blocks open where SIGINT is ignored (a background job):
+#: there a SIGTERM or SIGHUP waits for the innermost, as a Ctrl-C would elsewhere
+HOLDING: list = []
 
 
 def interrupt_name() -> str:
@@ -433,16 +436,24 @@ def held_interrupt() -> Iterator[HeldInterrupt]:
     """Within this block a Ctrl-C waits: the block runs to its end and the object yielded
     says whether one came, so that a computation can finish what the user would lose (a
     speed sweep's curve, a results file) and then stop.  A second Ctrl-C interrupts at
-    once.  Main thread only, and only where Python's own handler is installed (elsewhere,
-    in a thread or a job that ignores SIGINT, the block runs unguarded)."""
+    once.  Main thread only (in a thread the block runs unguarded); in a job that
+    ignores SIGINT, the SIGTERM or SIGHUP that stops the command (:mod:`torquesplit.
+    _launch`) is held instead."""
     import signal
     import threading
 
     held = HeldInterrupt()
     current = (signal.getsignal(signal.SIGINT)
                if threading.current_thread() is threading.main_thread() else None)
-    if current in (None, signal.SIG_IGN):  # not ours to change
+    if current is None:  # a thread: unguarded
         yield held
+        return
+    if current == signal.SIG_IGN:  # not ours to change; a SIGTERM or SIGHUP is held
+        HOLDING.append(held)  # all the same (torquesplit._launch)
+        try:
+            yield held
+        finally:
+            HOLDING.remove(held)
         return
 
     def later(signum, frame):

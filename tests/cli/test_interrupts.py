@@ -552,6 +552,12 @@ def test_sigterm_and_sighup_are_ctrl_c_with_their_own_exit_code():
         signal.signal(signal.SIGINT, signal.SIG_IGN)
         with pytest.raises(KeyboardInterrupt):
             os.kill(os.getpid(), signal.SIGTERM)
+        with held_interrupt() as held:  # and waits while a file is finished
+            os.kill(os.getpid(), signal.SIGTERM)
+        assert held.hit
+        with pytest.raises(KeyboardInterrupt), held_interrupt():  # a second one: at once
+            os.kill(os.getpid(), signal.SIGTERM)
+            os.kill(os.getpid(), signal.SIGTERM)
         signal.signal(signal.SIGHUP, signal.SIG_IGN)  # (nohup's choice is left alone)
         _launch._handle_stop_signals()
         assert signal.getsignal(signal.SIGHUP) == signal.SIG_IGN
