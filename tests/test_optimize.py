@@ -487,8 +487,8 @@ def test_a_full_disk_names_the_file_it_could_not_write(tmp_path):
     """)
     out = subprocess.run([sys.executable, "-c", child], capture_output=True, text=True,
                          check=True, cwd=tmp_path)
-    said = re.match(r"cannot write (\S+) \(File too large\); free disk space", out.stdout)
+    said = re.match(r"cannot write \S+/(pareto\.csv|chosen\.toml|pareto\.png) \(File too "
+                    r"large\); free disk space", out.stdout)  # (a long path is clipped)
     assert said, out.stdout + out.stderr
-    assert Path(said.group(1)).parent == tmp_path / "o"
-    assert not Path(said.group(1)).exists()  # (no part of it)
+    assert not (tmp_path / "o" / said.group(1)).exists()  # (no part of it)
     assert (tmp_path / "o" / "pareto.csv").read_text().startswith("chosen,")
