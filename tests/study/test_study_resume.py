@@ -601,6 +601,25 @@ def test_a_broken_or_full_store_is_one_line_that_says_what_is_kept(tmp_path, spl
     assert "study.sqlite is not a readable study store (file is not a database): move it " \
            "aside" in " ".join(res.stderr.split())
     assert "Traceback" not in res.output
+    # a folder that cannot be opened, or a store another process holds, is not a broken
+    # store: no advice to --overwrite (which would drop the finished cases)
+    from torquesplit.errors import OutputError
+    from torquesplit.study.store import Store
+
+    with pytest.raises(OutputError, match=r"cannot open the study store .* check that its "
+                                          r"folder exists") as err:
+        Store(tmp_path / "missing" / "study.sqlite")
+    assert "overwrite" not in str(err.value)
+    held = sqlite3.connect(tmp_path / "held.sqlite", isolation_level=None)
+    held.execute("BEGIN EXCLUSIVE")
+    monkeypatch.setattr(sqlite3, "connect", lambda *a, **k: held.__class__(
+        a[0], isolation_level=None, timeout=0.1))
+    with pytest.raises(OutputError, match=r"is in use by another process \(database is "
+                                          r"locked\)") as err:
+        Store(tmp_path / "held.sqlite")
+    assert "overwrite" not in str(err.value)
+    monkeypatch.undo()
+    held.close()
 
     from torquesplit.study import store as store_module
 

@@ -120,6 +120,14 @@ class Store:
         except sqlite3.DatabaseError as exc:  # (a traceback, a reliability reviewer)
             from ..errors import OutputError
 
+            if "locked" in str(exc):
+                raise OutputError(f"the study store {path} is in use by another process "
+                                  f"({exc}); wait for it to finish, or choose another "
+                                  f"folder") from None
+            if isinstance(exc, sqlite3.OperationalError):  # (the file is not the cause)
+                raise OutputError(f"cannot open the study store {path} ({exc}): check that "
+                                  f"its folder exists and can be written, and free disk "
+                                  f"space") from None
             raise OutputError(f"{path} is not a readable study store ({exc}): move it "
                               f"aside (its finished cases cannot be read back), or start "
                               f"the study again with --overwrite (overwrite=True in "
