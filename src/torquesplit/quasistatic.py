@@ -119,6 +119,7 @@ class QuasiStaticResults:
         import xarray as xr
 
         from .model.io import model_to_json
+        from .results.dataset import FLAG
 
         met = self.metrics()
         forces = self.mesh_forces()
@@ -150,7 +151,8 @@ class QuasiStaticResults:
                 "displacement": (("time", "dof"), self.solution.q,
                                  {"units": "m or rad", "long_name": "static displacement"}),
                 "converged": (("time",), self.solution.converged.astype(np.int8),
-                              {"units": "1", "long_name": "equilibrium converged (1) or not"}),
+                              {"units": "1", "long_name": "equilibrium converged (1) or not",
+                               **FLAG}),
             },
             coords={"time": ("time", self.times, {"units": "s", "long_name": "time"}),
                     "mesh": ("mesh", self.mesh_names),

@@ -74,6 +74,13 @@ def test_mat_and_netcdf_keep_every_variable_and_unit(tmp_path):
     mat = scipy.io.loadmat(save_dataset(flags, tmp_path / "f.mat"))
     assert mat["stable"].dtype == np.uint8 and mat["stable"].ravel().tolist() == [1, 0]
     assert mat["count"].dtype == np.float64
+    # a 0/1 variable marked with CF flag attributes (a run's double_flank and settled, a
+    # study's settled, a static sweep's converged) is a logical too (a code reviewer)
+    from torquesplit.results.dataset import FLAG
+
+    marked = ds.assign(both=("mesh", np.array([1, 0], dtype=np.int8), FLAG))
+    mat = scipy.io.loadmat(save_dataset(marked, tmp_path / "g.mat"))
+    assert mat["both"].dtype == np.uint8 and mat["both"].ravel().tolist() == [1, 0]
     back = xr.open_dataset(save_dataset(ds, tmp_path / "r.nc"), engine="h5netcdf")
     np.testing.assert_array_equal(back["force"].values, ds["force"].values)
     assert back.attrs["run_id"] and json.loads(back.attrs["labels"]) == ["x", "y"]

@@ -102,11 +102,12 @@ def test_mat_and_csv_exports(split, tmp_path):
     mat = loadmat(res.save(tmp_path / "run.mat"))
     np.testing.assert_allclose(mat["element_force"], res.solution.history_forces)
     # MATLAB: time a column beside the (time x element) forces; no integer arrays (int64
-    # refuses arithmetic with doubles)
+    # refuses arithmetic with doubles) but the flags, logicals (scipy reads them as uint8)
     assert mat["time"].shape == (res.solution.history_t.size, 1)
-    assert all(v.dtype.kind not in "iu" for k, v in mat.items()
-               if isinstance(v, np.ndarray) and not k.startswith("__")), \
-        [k for k, v in mat.items() if isinstance(v, np.ndarray) and v.dtype.kind in "iu"]
+    ints = [k for k, v in mat.items() if isinstance(v, np.ndarray) and not k.startswith("__")
+            and v.dtype.kind in "iu"]
+    assert sorted(ints) == ["double_flank", "settled"], ints
+    assert all(mat[k].dtype == np.uint8 for k in ints)
     assert mat["static_force"].ravel() == pytest.approx(list(res.static_forces().values()))
     assert str(mat["dimensions"][0, 0]["element_force"][0]) == "time x element"
     # each variable's unit and what it is (the .mat had units only, time none)

@@ -13,8 +13,19 @@ from ..assembly.structure import element_units
 from ..errors import OptionError
 
 
-def _var(dims, data, units, long_name):
-    return xr.Variable(dims, np.asarray(data), attrs={"units": units, "long_name": long_name})
+def _var(dims, data, units, long_name, **attrs):
+    return xr.Variable(dims, np.asarray(data), attrs={"units": units, "long_name": long_name,
+                                                      **attrs})
+
+
+#: a 0/1 variable's CF flag attributes: a MATLAB file makes it a logical
+#: (:func:`torquesplit.results.export.mat_fields`)
+FLAG = {"flag_values": np.array([0, 1], dtype=np.int8), "flag_meanings": "false true"}
+
+
+def is_flag(attrs) -> bool:
+    """Whether a variable's attributes mark it a 0/1 flag (:data:`FLAG`)."""
+    return np.ravel(attrs.get("flag_values", [])).tolist() == [0, 1]
 
 
 def add_planet_load_sharing(ds: xr.Dataset, load_sharing, kinematics) -> xr.Dataset:
@@ -199,7 +210,7 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
                                       "largest back-flank (tensile) force over the settled "
                                       "cycles")
         ds["double_flank"] = _var(("mesh",), [int(r.double_flank) for r in met.rows], "1",
-                                  "1: the mesh has no backlash (double-flank contact)")
+                                  "1: the mesh has no backlash (double-flank contact)", **FLAG)
         # the settled span, so that the cycle variables give the peaks back (it was only
         # inside metrics_json)
         ds["first_settled_cycle"] = _var(("mesh",), np.array(
@@ -211,7 +222,7 @@ def results_to_dataset(res, definition: str | None = None) -> xr.Dataset:
         # study's file has it as a variable, an exports reviewer)
         ds["settled"] = _var((), np.int8(met.settling.settled), "1",
                              "1: every mesh settled by the settle rule; 0: some mesh never "
-                             "did, and its metrics are over the last half of the run")
+                             "did, and its metrics are over the last half of the run", **FLAG)
         # each load-sharing group's and the system's numbers as variables too (for
         # xarray, MATLAB and spreadsheet users: not only inside metrics_json)
         groups = list(met.load_sharing.per_group)

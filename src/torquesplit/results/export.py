@@ -187,12 +187,16 @@ def mat_fields(ds, run_id: str, attrs=None) -> dict:
     taken = {"units", "descriptions", "attributes", "provenance", "names", "dimensions"}
     ident = {n: _mat_name(n, taken) for n in names}
     data = {}
+    from .dataset import is_flag
+
     for name in names:
         values = ds[name].values
-        # flags as MATLAB logicals (scipy writes a bool array so); counts and indices as
-        # doubles, MATLAB's own type, in which they take part in arithmetic as numbers
-        # (an int64 divides with rounding and mixes with nothing but scalars)
+        # flags (bool, or 0/1 marked with CF flag_values) as MATLAB logicals (scipy writes
+        # a bool array so); counts and indices as doubles, MATLAB's own type, in which
+        # they take part in arithmetic as numbers (an int64 divides with rounding and
+        # mixes with nothing but scalars)
         data[ident[name]] = (np.asarray(values, dtype=object) if values.dtype.kind in "UO"
+                             else np.asarray(values, dtype=bool) if is_flag(ds[name].attrs)
                              else np.asarray(values, dtype=float) if values.dtype.kind in "iu"
                              else np.asarray(values))
     data["units"] = {ident[n]: str(ds[n].attrs.get("units", "")) for n in names}

@@ -53,6 +53,8 @@ def build_dataset(plan, rows, n: int, meta: dict):
     """Dataset of the first ``n`` cases of ``plan`` from the finished ``rows``."""
     import xarray as xr
 
+    from ..results.dataset import FLAG
+
     names = plan.outputs
     d = plan.design
     values = np.full((n, len(names)), np.nan)
@@ -107,7 +109,7 @@ def build_dataset(plan, rows, n: int, meta: dict):
     data["reason"] = var(reason.astype(str), {"long_name": "why the case is not ok"})
     if plan.analysis["type"] != "static":  # (a quasi-static sweep has nothing to settle)
         data["settled"] = var(settled.astype(np.int8), {
-            "units": "1", "long_name": "1: the run's metrics found a settled part and, with "
+            **FLAG, "units": "1", "long_name": "1: the run's metrics found a settled part and, with "
                                        "analysis.settle, the outputs (settle_time excepted) "
                                        "agreed between the last two run lengths; 0: not"})
     data["warnings"] = var(warned.astype(str), {
