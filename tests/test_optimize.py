@@ -432,6 +432,37 @@ def test_the_baseline_is_compared_objective_by_objective():
     assert result([1.5, 0.5]).baseline_not_worse
     assert not result([1.5, 1.5]).baseline_not_worse  # the chosen is better in one
     assert not result(None).baseline_not_worse
+    from dataclasses import replace  # a baseline that breaks a constraint is no option
+
+    assert not replace(result([1.5, 0.5]), baseline_feasible=False).baseline_not_worse
+
+
+def test_a_failed_baseline_is_named_and_stops_only_what_needs_it(monkeypatch):
+    """A diverged baseline read 'the dynamic run diverged' as a design's failure and
+    stopped every optimisation (a code reviewer): it is named; an optimisation whose
+    objectives are not relative to it goes on, with a warning."""
+    import torquesplit.optimize as opt
+    from torquesplit.errors import SolverError
+
+    def evaluate(spec, x, notes=None):
+        if x is None:
+            raise SolverError("the dynamic run diverged: at t = 0.1 s")
+        return {"ltca.L68.te_peak_to_peak_arcsec": 1.0 + float(np.sum(x)),
+                "ltca.L68.impact_peak_force_N": 1.0}
+
+    monkeypatch.setattr(opt, "evaluate_design", evaluate)
+    with pytest.raises(ModelError, match=r"the baseline \(the model without the variables\), "
+                                         r"to which the objectives are relative, failed: the "
+                                         r"dynamic run diverged"):
+        optimize(read_spec(spec_dict(population=4, generations=1)))
+    d = spec_dict(population=4, generations=1)
+    for o in d["objectives"]:
+        o.pop("relative_to")
+    with pytest.warns(ModelWarning, match=r"the baseline \(the model without the variables\) "
+                                          r"failed, so the chosen design is compared with "
+                                          r"nothing"):
+        res = optimize(read_spec(d))
+    assert res.baseline == {} and res.baseline_F is None and not res.baseline_not_worse
 
 
 def test_a_diverged_design_is_a_failed_evaluation_not_ranked(monkeypatch, tmp_path):

@@ -629,12 +629,19 @@ def _evaluate_job(spec: OptimizationSpec, x: tuple[float, ...]) -> dict:
         return {"x": list(x), "outputs": None, "error": str(exc).splitlines()[0]}
 
 
+#: what an evaluation record holds: 2 since a diverged run is a failed design and each
+#: record keeps its run's warnings ('notes'); records of an earlier format are not
+#: reused (one had ranked a diverged run's partial metrics: a code reviewer)
+STORE_FORMAT = 2
+
+
 def fingerprint(spec: OptimizationSpec) -> str:
     """What an evaluation depends on besides the variables' values: the model with the
     fixed settings ([set]), the variables' paths and the outputs asked for.  A stored
     evaluation of another fingerprint is not reused (a changed [set] reused them)."""
     wanted = sorted(o.output for o in (*spec.objectives, *spec.constraints))
-    text = json.dumps({"model": _model_data(spec, None), "outputs": wanted,
+    text = json.dumps({"store": STORE_FORMAT, "model": _model_data(spec, None),
+                       "outputs": wanted,
                        "variables": [(v.path, list(v.also)) for v in spec.variables]},
                       sort_keys=True, default=str)
     return hashlib.sha256(text.encode()).hexdigest()[:16]
@@ -740,14 +747,18 @@ class OptimizationResult:
     not settled...), one line each."""
     baseline_notes: tuple[str, ...] = ()
     baseline_F: np.ndarray | None = None
-    """(n_obj,) the baseline's objective values (as minimised, as F)."""
+    """(n_obj,) the baseline's objective values (as minimised, as F); None where the
+    baseline failed."""
+    baseline_feasible: bool = True
+    """Whether the baseline meets the constraints."""
 
     @property
     def baseline_not_worse(self) -> bool:
-        """Whether the baseline is at least as good as the chosen design in every
-        objective (then the variables' bounds or the objectives deserve a look)."""
-        return self.baseline_F is not None and bool(np.all(self.baseline_F
-                                                           <= self.F[self.chosen]))
+        """Whether the baseline meets the constraints and is at least as good as the
+        chosen design in every objective (then the variables' bounds or the objectives
+        deserve a look)."""
+        return (self.baseline_F is not None and self.baseline_feasible
+                and bool(np.all(self.baseline_F <= self.F[self.chosen])))
 
     @property
     def chosen_x(self) -> np.ndarray:
@@ -874,9 +885,21 @@ def optimize(source, *, workers: int | None = None, generations: int | None = No
     store = _Store(spec.store, fingerprint(spec))
     if store.other:
         warn_user(f"optimization.store: {store.other} stored evaluation(s) are of another "
-                      f"model, [set] or outputs and are not reused", ModelWarning)
+                      f"model, [set] or outputs (or of an earlier torquesplit's store "
+                      f"format) and are not reused", ModelWarning)
     baseline_notes: list[str] = []
-    baseline = evaluate_design(spec, None, baseline_notes)
+    try:
+        baseline = evaluate_design(spec, None, baseline_notes)
+    except TorquesplitError as exc:  # (it read as a design's failure: a code reviewer)
+        if any(o.relative_to for o in spec.objectives):
+            raise ModelError([("optimization.model", (
+                f"the baseline (the model without the variables), to which the objectives "
+                f"are relative, failed: {str(exc).splitlines()[0]}; fix the model or its "
+                f"[set], or remove relative_to"))], spec.source) from None
+        warn_user(f"the baseline (the model without the variables) failed, so the chosen "
+                  f"design is compared with nothing: {str(exc).splitlines()[0]}",
+                  ModelWarning)
+        baseline, baseline_notes = {}, []
     for o in (*spec.objectives,):
         if o.relative_to and not baseline[o.output]:
             raise ModelError([("objectives", f"the baseline value of {o.output!r} is 0; it cannot "
@@ -981,4 +1004,7 @@ def optimize(source, *, workers: int | None = None, generations: int | None = No
                               computed=counters["computed"],
                               notes=tuple(tuple(r.get("notes", ())) for r in records),
                               baseline_notes=tuple(n.splitlines()[0] for n in baseline_notes),
-                              baseline_F=np.array(objectives_of({"outputs": baseline})[0]))
+                              **({} if not baseline else dict(
+                                  baseline_F=np.array(objectives_of({"outputs": baseline})[0]),
+                                  baseline_feasible=bool(np.all(np.array(objectives_of(
+                                      {"outputs": baseline})[1]) <= 0.0)))))
