@@ -75,3 +75,25 @@ def test_each_alternative_gives_way_and_nothing_else(table, path, value, gone, k
     assert out[path] == value
     assert not set(gone) & set(out)
     assert set(kept) <= set(out)
+
+
+def test_a_table_set_whole_gives_way_too_and_two_ways_at_once_are_refused():
+    """A code reviewer: --set shafts.s='{torsional_stiffness=...}' merged into a shaft that
+    keeps its diameter and length (refused again: 'remove one of them'); --set power and
+    --set torque of one drive kept the torque alone without a word."""
+    from torquesplit.model.overrides import apply_assignments
+
+    d = {"shafts": {"s": {"diameter": "1 m", "length": "2 m", "shear_modulus": 1.0}}}
+    assert set_parameter(d, "shafts.s", {"torsional_stiffness": 1e6})["shafts"]["s"] == {
+        "shear_modulus": 1.0, "torsional_stiffness": 1e6}
+    drive = {"drives": {"m": {"power": "1 kW"}}}
+    with pytest.raises(ModelError, match=r"--set drives\.m\.torque=10: sets what --set "
+                                         r"drives\.m\.power=5e3 sets, another way"):
+        apply_assignments(drive, ["drives.m.power=5e3", "drives.m.torque=10"])
+    with pytest.raises(ModelError, match=r"drives\.m\.torque: sets what drives\.m\.power "
+                                         r"sets, another way"):
+        apply_overrides(drive, {"drives.m.power": 5e3, "drives.m.torque": 10})
+    # one field of each of two tables is no clash
+    assert apply_overrides({"drives": {"a": {}, "b": {}}},
+                           {"drives.a.power": 1, "drives.b.torque": 2}) == {
+        "drives": {"a": {"power": 1}, "b": {"torque": 2}}}

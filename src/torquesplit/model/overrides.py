@@ -74,9 +74,7 @@ def set_parameter(data: dict, path: str, value: Any) -> dict:
             for key in [k for k, methods in STIFFNESS_FIELD_METHODS.items()
                         if value not in methods]:
                 node.pop(key, None)
-        if last != "rigid" or value is not False:  # (the file's choice gives way)
-            for other in ALTERNATIVES.get(last, ()):
-                node.pop(other, None)
+        _give_way(node, last, value)  # (the file's other way of saying it)
         node[last] = (_merged(old, value) if len(parts) > 1 and _merges(old, value)
                       else value)
     else:
@@ -85,8 +83,35 @@ def set_parameter(data: dict, path: str, value: Any) -> dict:
     return out
 
 
+def _give_way(table: dict, key: str, value) -> None:
+    """Remove from ``table`` (a copy) the fields that say what ``key`` set to ``value``
+    says another way (:data:`ALTERNATIVES`; ``rigid = false`` replaces nothing)."""
+    if key != "rigid" or value is not False:
+        for other in ALTERNATIVES.get(key, ()):
+            table.pop(other, None)
+
+
+def alternative_clash(paths) -> tuple[str, str] | None:
+    """Two of ``paths`` that set one table's field two ways (``drives.m.power`` and
+    ``drives.m.torque``), which would leave the last one alone without a word; None if
+    none do."""
+    seen: dict[tuple[str, str], str] = {}
+    for path in paths:
+        table, _, key = str(path).rpartition(".")
+        for other in ALTERNATIVES.get(key, ()):
+            if (table, other) in seen:
+                return seen[table, other], path
+        seen[table, key] = path
+    return None
+
+
 def apply_overrides(data: dict, overrides: Mapping[str, Any]) -> dict:
-    """Apply several ``{path: value}`` overrides in order (``data`` is not changed)."""
+    """Apply several ``{path: value}`` overrides in order (``data`` is not changed);
+    two that set one field two ways (:func:`alternative_clash`) are refused."""
+    clash = alternative_clash(overrides)
+    if clash:
+        raise ModelError([(clash[1], f"sets what {clash[0]} sets, another way; give one of "
+                                     f"them")])
     for path, value in overrides.items():
         try:
             data = set_parameter(data, path, value)
@@ -147,6 +172,8 @@ def _merged(old: dict, new):
         return new
     out = dict(old)
     for key, value in new.items():
+        if key not in old:  # (a table set whole names the field another way too)
+            _give_way(out, key, value)
         out[key] = _merged(out[key], value) if _merges(out.get(key), value) else value
     return out
 
@@ -215,6 +242,11 @@ def apply_assignments(data: dict, assignments) -> tuple[dict, dict[str, str]]:
                 raise ModelError([("", (
                     f"sets {path} again (--set {clip_text(where[path])} before it): give "
                     f"each field once"))], source)
+            clash = alternative_clash([*where, path])
+            if clash:  # (power then torque: the torque alone was kept, a code reviewer)
+                raise ModelError([("", (
+                    f"sets what --set {clip_text(where[clash[0]])} sets, another way: "
+                    f"give one of them"))], source)
             data = apply_overrides(data, {path: value})
         except ModelError as exc:
             issues = [("" if loc in ("--set", path_of(text)) else loc, msg)
