@@ -1492,7 +1492,6 @@ def _contact(model, pair, load, on, plot, force, positions, slices, harris, assi
             ds = with_model(contact_dataset(results, operating_load=op_load, harris=hm,
                                             impact=impact, given=given, mesh=pair,
                                             gears=names), m)
-            ds.attrs["model"] = m.model.name
             written = dataset_files(ds, save_dataset(ds, out, overwrite=force))
             if state is not None:
                 state["written"] = written
@@ -1885,10 +1884,7 @@ def modes(
             with ux.interruptible(lambda: ux.kept_files(saved)), \
                     ux.finish_before_interrupt(), files.claim_output(plan):
                 ds = rep.to_dataset()
-                ds.attrs["model"] = m.model.name
-                from .results.export import with_model
-
-                from .results.export import dataset_files
+                from .results.export import dataset_files, with_model
 
                 saved = dataset_files(ds, save_dataset(with_model(ds, m, ux.session().warnings),
                                                        plan.path, overwrite=force))

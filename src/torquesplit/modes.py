@@ -192,7 +192,6 @@ class ModalReport:
         ds = self.to_dataset()
         if self.model is not None:  # (an API save named no model: an exports reviewer)
             ds = with_model(ds, self.model)
-            ds.attrs["model"] = self.model.model.name
         return save_dataset(ds, path, overwrite=overwrite)
 
     def to_dataset(self):

@@ -286,10 +286,12 @@ def save(result, path, *, overwrite: bool = False) -> Path:
 
 def with_model(ds, model, warnings=()):
     """``ds`` with the model it came from (``model_json``, as a run's file holds it: the
-    file can be re-run) and the warnings its command printed."""
+    file can be re-run; its name as ``model`` where the Dataset has none) and the
+    warnings its command printed."""
     from ..model.io import model_to_json
 
     ds = ds.copy()
+    ds.attrs.setdefault("model", model.model.name)
     ds.attrs["model_json"] = model_to_json(model)
     ds.attrs["warnings"] = "\n".join(warnings)
     ds.attrs["warnings_json"] = json.dumps(list(warnings))

@@ -660,7 +660,15 @@ def netcdf_bytes(dataset) -> bytes:
     # no missing values (CF conventions, 2.5.1)
     encoding = {name: {"_FillValue": None} for name in dataset.coords
                 if dataset[name].dtype.kind == "f"}
-    dataset.to_netcdf(buffer, engine="h5netcdf", encoding=encoding)
+    try:  # (the Dataset is in memory: under a Dask client xarray took a cluster lock named
+        # by the buffer, which the cluster does not know; a study's results on Dask)
+        import dask
+
+        local = dask.config.set(scheduler="synchronous")
+    except ImportError:
+        local = contextlib.nullcontext()
+    with local:
+        dataset.to_netcdf(buffer, engine="h5netcdf", encoding=encoding)
     return buffer.getvalue()
 
 

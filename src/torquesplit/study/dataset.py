@@ -254,33 +254,13 @@ _INDEX_NAMES = {
 
 
 def write_dataset(ds, path) -> Path:
-    """Save a study Dataset as NetCDF (h5netcdf), and beside it the same cases for a
-    spreadsheet (``.csv``: :func:`case_table_bytes`) and for MATLAB (``.mat``:
-    :func:`case_mat_bytes`); each file whole or absent."""
-    from ..results.files import provenance
-
+    """Save a study Dataset as NetCDF, and beside it the same cases for a spreadsheet
+    (``.csv``: :func:`case_table_bytes`, and a sensitivity's indices) and for MATLAB
+    (``.mat``: :func:`case_mat_bytes`); each file whole or absent (:func:`save_study`)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_suffix(".nc.tmp")
-    # (the provenance the .mat has: the NetCDF had neither commit nor command, a
-    # studies reviewer)
-    ds.assign_attrs(**provenance(_run_id(ds), ds.attrs.get("model_json"))).to_netcdf(
-        tmp, engine="h5netcdf")
-    tmp.replace(path)
-    for suffix, data in ((".csv", case_table_bytes), (".mat", case_mat_bytes)):
-        target = path.with_suffix(suffix)
-        tmp = path.with_suffix(suffix + ".tmp")
-        tmp.write_bytes(data(ds))
-        tmp.replace(target)
-    # a sensitivity's indices for a spreadsheet too (they were in the .nc and .mat only,
-    # a studies reviewer)
-    indices = path.with_name(f"{path.stem}_sensitivity.csv")
-    if "factor" in ds.dims:
-        tmp = indices.with_suffix(".csv.tmp")
-        tmp.write_bytes(indices_table_bytes(ds))
-        tmp.replace(indices)
-    elif indices.is_file():  # (from an earlier study in this folder)
-        indices.unlink()
+    for suffix in (".nc", ".csv", ".mat"):
+        save_study(ds, path.with_suffix(suffix), overwrite=True)
     return path
 
 
@@ -306,8 +286,12 @@ def save_study(ds, path, *, overwrite: bool = False) -> Path:
     elif plan.format == "mat":
         contents[plan.path] = case_mat_bytes(ds)
     else:
+        # a sensitivity's indices for a spreadsheet too (they were in the .nc and .mat
+        # only, a studies reviewer)
+        indices = plan.path.with_name(f"{plan.path.stem}_sensitivity.csv")
+        if "factor" not in ds.dims and overwrite and indices.is_file():
+            indices.unlink()  # (an earlier study's, in this folder)
         if "factor" in ds.dims:
-            indices = plan.path.with_name(f"{plan.path.stem}_sensitivity.csv")
             if indices.exists() and not overwrite:
                 from ..errors import OutputError
 

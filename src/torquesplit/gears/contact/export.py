@@ -153,15 +153,15 @@ class ContactAnalysis:
                                harris=self.harris, mesh=self.mesh, gears=self.gears)
 
     def save(self, path, *, overwrite: bool = False):
-        """Save :meth:`to_dataset` by suffix (``.nc``, ``.mat``, ``.csv``) with its model,
-        as ``torquesplit contact --out`` does; atomically, an existing file kept unless
-        ``overwrite``.  Returns the path written."""
+        """Save :meth:`to_dataset` by suffix (``.nc``, ``.mat``, ``.csv``) with its model;
+        atomically, an existing file kept unless ``overwrite``.  Returns the path written.
+        (``torquesplit contact --out`` also writes the meshing-in impact and each load as
+        the command line gave it.)"""
         from ...results.export import save_dataset, with_model
 
         ds = self.to_dataset()
         if self.model is not None:
             ds = with_model(ds, self.model)
-            ds.attrs["model"] = self.model.model.name
         return save_dataset(ds, path, overwrite=overwrite)
 
 
