@@ -615,8 +615,9 @@ def _save_partial_beside(res, plan, definition) -> tuple[list[Path], Exception |
         res.save(partial, overwrite=True, definition=definition)
     except _EXPECTED as exc:
         return [], exc
-    ux.warn(f"the run did not finish: {plan.path} (an earlier run's results, which --force "
-            f"would have replaced) is kept; this run's partial results are in {partial}")
+    kept = ", ".join(str(f) for f in plan.files if f.exists())
+    ux.warn(f"the run did not finish: {kept} (an earlier run's results, which --force "
+            f"would have replaced) kept; this run's partial results are in {partial}")
     return list(files.check_output(partial, overwrite=True).files), None
 
 

@@ -583,9 +583,10 @@ def test_sigterm_stops_a_run_as_ctrl_c_does(tmp_path):
     # (the kernels compiled or loaded first: the signal is to land in the integration)
     subprocess.run(command + ["--duration", "0.01", "--quiet"], capture_output=True,
                    check=True, cwd=tmp_path)
-    proc = subprocess.Popen(
+    proc = subprocess.Popen(  # (a run of minutes: the signal comes long before its end)
         [sys.executable, "-m", "torquesplit", "run", "ji_li_mill_drive", "--set",
-         "analysis.duration=300", "--out", str(out)], stdout=subprocess.PIPE,
+         "analysis.duration=1200", "--samples-per-period", "2", "--out", str(out)],
+        stdout=subprocess.PIPE,
         stderr=subprocess.PIPE, text=True, cwd=tmp_path)
     err = []
     for line in proc.stderr:  # the run's size, said just before it integrates
@@ -594,7 +595,7 @@ def test_sigterm_stops_a_run_as_ctrl_c_does(tmp_path):
             break
     import time
 
-    time.sleep(5.0)  # (the run integrates about 25 s; set-up after that line: ~1 s)
+    time.sleep(5.0)  # (set-up after that line: about a second)
     proc.send_signal(signal.SIGTERM)
     stdout, rest = proc.communicate(timeout=120)
     assert proc.returncode == 143, "".join(err) + rest + stdout

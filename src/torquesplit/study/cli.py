@@ -110,10 +110,9 @@ def _terminate_as_interrupt():
 
     def stop(signum, frame):
         terminated.seen = True
-        handler = signal.getsignal(signal.SIGINT)  # (noted as a Ctrl-C is: study.runners)
-        if callable(handler):
-            handler(signal.SIGINT, frame)
-        raise KeyboardInterrupt
+        from .._launch import _stop_as_interrupt  # (as every command stops on it)
+
+        _stop_as_interrupt(signum, frame)
 
     before = signal.signal(signal.SIGTERM, stop)
     try:

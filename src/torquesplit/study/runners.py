@@ -91,8 +91,8 @@ def _noting_interrupts():
 
 
 def worker_start() -> None:  # pragma: no cover - runs in the worker processes
-    """A worker's set-up: Ctrl-C and SIGHUP ignored (they go to the whole process group: the driver
-    stops the workers itself), the heap frozen after the first case
+    """A worker's set-up: Ctrl-C, SIGHUP and SIGTERM ignored (they go to the whole process
+    group: the driver stops the workers itself), the heap frozen after the first case
     (:data:`.case.FREEZE_HEAP`), and an exit as soon as the driver is gone.  A driver
     killed outright (SIGKILL, the out-of-memory killer) cannot stop its pool, whose
     workers then waited for work forever: a daemon thread waits on the parent
@@ -103,9 +103,11 @@ def worker_start() -> None:  # pragma: no cover - runs in the worker processes
 
     from . import case
 
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    if hasattr(signal, "SIGHUP"):  # (a closed session's SIGHUP reaches the whole group:
-        signal.signal(signal.SIGHUP, signal.SIG_IGN)  # the driver stops, and so stops them)
+    # Ctrl-C, a closed session's SIGHUP and a batch system's SIGTERM reach the whole
+    # process group: the driver stops on them, and stops (kills) its workers
+    for name in ("SIGINT", "SIGHUP", "SIGTERM"):
+        if hasattr(signal, name):
+            signal.signal(getattr(signal, name), signal.SIG_IGN)
     case.FREEZE_HEAP = True
     parent = multiprocessing.parent_process()
     if parent is None:
@@ -190,7 +192,7 @@ class LocalPool:
                 # stop at once: running cases are lost (they were not committed) and will
                 # run again on --resume.  ProcessPoolExecutor has no public terminate.
                 for proc in list(getattr(pool, "_processes", {}).values()):
-                    proc.terminate()
+                    proc.kill()  # (SIGKILL: they ignore SIGTERM, see worker_start)
             pool.shutdown(wait=finished, cancel_futures=True)
 
     def __repr__(self) -> str:
