@@ -252,9 +252,9 @@ leaves out the start-up transient before computing anything.
   and the peak magnitude |F|; a gear with no translations sits on a rigid bearing, and
   its row (marked `(rigid bearing)`) is the sum of its meshes' forces, in the housing's
   x, y (and z: the axial thrust of helical teeth); a planetary stage's fixed ring's in its
-  carrier's frame, as the planets'.  The peaks come from the history, not from the
-  streamed statistics (next bullet); a rigid bearing's mean is its meshes' mean forces
-  (b1's is in1's), another's the mean of its history samples.  `--json` gives them
+  carrier's frame, as the planets'.  The peaks are streamed at every step and table
+  corner, as the mesh table's are (next bullet); the means: a rigid bearing's is its
+  meshes' mean forces (b1's is in1's), another's the mean of its history samples.  `--json` gives them
   as `bearing_forces_N`, a .nc or .mat results file (`--out`) as `bearing_mean_force`
   and `bearing_peak_force`.
 {{{{drift_text}}}}
