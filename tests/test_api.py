@@ -174,6 +174,11 @@ def test_every_result_is_saved_by_one_function_with_its_model(model, tmp_path):
                                          stability=False),
         "campbell": torquesplit.campbell(model, "0 rpm", "800 rpm", points=3),
     }
+    for name in ("sweep", "campbell"):  # (each variable says what it is, for a file's reader)
+        ds = results[name][0] if name == "campbell" else results[name]
+        bare = [v for v in [*ds.data_vars, *(c for c in ds.coords if c not in ds.dims)]
+                if "long_name" not in ds[v].attrs]
+        assert bare == [], (name, bare)
     for name, result in results.items():
         for suffix in (".nc", ".mat", ".csv"):
             assert torquesplit.save(result, tmp_path / f"{name}{suffix}") == \

@@ -252,7 +252,8 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
         ds = xr.Dataset(
             {
                 "speed": ("point", sp * w_ref, {"units": "rad/s", "long_name": "input speed"}),
-                "mesh_frequency": (("point", "mesh"), f_mesh, {"units": "Hz"}),
+                "mesh_frequency": (("point", "mesh"), f_mesh,
+                                   {"units": "Hz", "long_name": "mesh frequency"}),
                 "dynamic_factor": (("point", "mesh"), stack("dynamic_factor"),
                                    {"units": "1", "long_name": "peak / the mesh's static force"}),
                 "peak_to_nominal": (("point", "mesh"), stack("peak_to_nominal"),
@@ -293,7 +294,8 @@ def sweep_speed(model, start: float, stop: float, *, points: int = 50,
                                  "multiplier below -1: the response is not this orbit), 'fold' "
                                  "(above 1), 'torus' (a complex pair); empty where stable"}),
             },
-            coords={"speed_rpm": ("point", sp * w_ref * RPM, {"units": "rpm"}),
+            coords={"speed_rpm": ("point", sp * w_ref * RPM,
+                                  {"units": "rpm", "long_name": "input speed"}),
                     "mesh": mesh_names},
         )
         if not stability:  # (nothing judged: no variable that reads 'stable', a reviewer)
@@ -903,10 +905,16 @@ def campbell(model, start: float, stop: float, *, points: int = 41,
     crossings = [c for c in crit["crossings"] if count is None or c["mode"] <= count]
     critical, suppressed = split_suppressed(crossings)
     ds = xr.Dataset(
-        {"natural_frequency": (("speed", "mode"), F, {"units": "Hz"}),
-         "excitation_frequency": (("speed", "line"), L, {"units": "Hz"})},
-        coords={"speed": ("speed", speeds, {"units": "rad/s"}),
-                "speed_rpm": ("speed", speeds * RPM, {"units": "rpm"}),
+        # (every variable with its long_name, as the sweep's: an exports reviewer)
+        {"natural_frequency": (("speed", "mode"), F, {
+            "units": "Hz", "long_name": "natural frequency (linearised about the static "
+                                       "equilibrium, mean mesh stiffness)"}),
+         "excitation_frequency": (("speed", "line"), L, {
+             "units": "Hz", "long_name": "frequency of each excitation line (an order of a "
+                                        "mesh or shaft frequency)"})},
+        coords={"speed": ("speed", speeds, {"units": "rad/s", "long_name": "input speed"}),
+                "speed_rpm": ("speed", speeds * RPM,
+                              {"units": "rpm", "long_name": "input speed"}),
                 "mode": np.arange(1, F.shape[1] + 1),
                 "line": [f"{o} x {lab}" for lab, o, _ in lines]})
     ds.attrs["model"] = model.model.name
