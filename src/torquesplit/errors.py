@@ -410,9 +410,14 @@ def from_interrupt(exc: BaseException | None) -> bool:
 
 
 class HeldInterrupt:
-    """What :func:`held_interrupt` saw: ``hit`` is True when a Ctrl-C came during its block."""
+    """What :func:`held_interrupt` saw: ``hit`` is True when a Ctrl-C came during its block
+    (the object is as true as ``hit``; a study's SIGTERM and a serial run's SIGINT are
+    noted in one too)."""
 
     hit: bool = False
+
+    def __bool__(self) -> bool:
+        return self.hit
 
 
 #: the terminating signal that stopped the command as Ctrl-C does (SIGTERM, SIGHUP:

@@ -84,16 +84,6 @@ def study(
          backend=backend, precision=precision, analysis=analysis)
 
 
-class _Terminated:
-    """Whether a SIGTERM stopped the study (truthy once one came)."""
-
-    def __init__(self):
-        self.seen = False
-
-    def __bool__(self) -> bool:
-        return self.seen
-
-
 @contextlib.contextmanager
 def _terminate_as_interrupt():
     """While a study runs, SIGTERM (a batch system's time limit, ``timeout``, ``kill``)
@@ -103,13 +93,15 @@ def _terminate_as_interrupt():
     import signal
     import threading
 
-    terminated = _Terminated()
+    from ..errors import HeldInterrupt
+
+    terminated = HeldInterrupt()  # (true once a SIGTERM came)
     if threading.current_thread() is not threading.main_thread():
         yield terminated
         return
 
     def stop(signum, frame):
-        terminated.seen = True
+        terminated.hit = True
         from .._launch import _stop_as_interrupt  # (as every command stops on it)
 
         _stop_as_interrupt(signum, frame)

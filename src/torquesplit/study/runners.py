@@ -28,7 +28,7 @@ import signal
 from concurrent.futures import FIRST_COMPLETED, wait
 from typing import Callable, Iterable, Iterator
 
-from ..errors import OptionError
+from ..errors import HeldInterrupt, OptionError
 
 log = logging.getLogger(__name__)
 
@@ -55,16 +55,6 @@ class SerialRunner:
         return "SerialRunner()"
 
 
-class _Seen:
-    """Whether a SIGINT came (truthy once one did)."""
-
-    def __init__(self):
-        self.hit = False
-
-    def __bool__(self) -> bool:
-        return self.hit
-
-
 @contextlib.contextmanager
 def _noting_interrupts():
     """Within the block, a SIGINT is noted before the handler in force runs (Python's
@@ -72,7 +62,7 @@ def _noting_interrupts():
     Python's is installed; elsewhere nothing is noted."""
     import threading
 
-    seen = _Seen()
+    seen = HeldInterrupt()  # (true once a SIGINT came)
     current = (signal.getsignal(signal.SIGINT)
                if threading.current_thread() is threading.main_thread() else None)
     if not callable(current):
